@@ -1,0 +1,44 @@
+"""ecofmaps: friction from fretting loops, corrected for rig compliance and wear-scar shape.
+
+The public API in SI units (m, N, N/m, J). See the README for an overview and the
+paper this package implements.
+"""
+
+from importlib.metadata import PackageNotFoundError, version
+
+from ecofmaps._inputs import RegimeWarning
+from ecofmaps.loop import fretting_loop, simulate
+from ecofmaps.model import (
+    GROSS_SLIP,
+    INVALID,
+    NO_GROSS_SLIP,
+    SELF_LOCKING,
+    Regime,
+    dissipated_energy,
+    energy_cof,
+    max_force,
+    regime,
+    slip_amplitude,
+)
+
+try:
+    __version__ = version("ecofmaps")
+except PackageNotFoundError:  # running from a source tree that is not installed
+    __version__ = "0+unknown"
+
+__all__ = [
+    "GROSS_SLIP",
+    "INVALID",
+    "NO_GROSS_SLIP",
+    "SELF_LOCKING",
+    "Regime",
+    "RegimeWarning",
+    "__version__",
+    "dissipated_energy",
+    "energy_cof",
+    "fretting_loop",
+    "max_force",
+    "regime",
+    "simulate",
+    "slip_amplitude",
+]

@@ -1,0 +1,110 @@
+"""Input handling shared by the public entry points: float64 and validation.
+
+The public functions accept anything array-like, including JAX tracers (under
+``jax.jit``, ``jax.vmap`` and ``jax.grad``). Concrete inputs are checked here and
+bad values raise a :class:`ValueError` that names the parameter and its valid
+range; traced inputs cannot be inspected, so the kernels turn them into NaN plus
+the ``INVALID`` regime code instead.
+"""
+
+from __future__ import annotations
+
+import functools
+import warnings
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+__all__ = ["RegimeWarning", "as_float64", "check", "float64", "is_concrete", "warn_nan"]
+
+# Results are float64 (the model needs the digits); switching JAX's 64-bit mode on when
+# ecofmaps is imported keeps them float64 in the caller's own arithmetic too. Every public
+# entry point also runs in 64-bit mode itself (:func:`float64`), so a caller who switches
+# it off again still gets float64 results.
+jax.config.update("jax_enable_x64", True)
+
+
+class RegimeWarning(RuntimeWarning):
+    """A concrete call returned NaN because a point is outside the gross-slip regime."""
+
+
+def float64(function):
+    """Run ``function`` with JAX's 64-bit mode on, whatever the caller's configuration."""
+
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        with jax.enable_x64(True):
+            return function(*args, **kwargs)
+
+    return wrapper
+
+
+def is_concrete(*values) -> bool:
+    """True when none of ``values`` is a JAX tracer (so they can be inspected)."""
+    return not any(isinstance(value, jax.core.Tracer) for value in values)
+
+
+def as_float64(value):
+    """``value`` as a float64 JAX array (call inside :func:`float64`)."""
+    return jnp.asarray(value, dtype=jnp.float64)
+
+
+_RULES = {
+    "positive": (lambda a: a > 0, "0 < {name} < inf"),
+    "positive_or_inf": (lambda a: a > 0, "0 < {name} <= inf"),
+    "non_negative": (lambda a: a >= 0, "0 <= {name} < inf"),
+    "finite": (lambda a: np.ones(np.shape(a), dtype=bool), "-inf < {name} < inf"),
+}
+
+
+def check(name: str, value, rule: str, unit: str = "") -> None:
+    """Raise ``ValueError`` if a concrete ``value`` breaks ``rule``; do nothing for tracers.
+
+    Parameters
+    ----------
+    name : str
+        The parameter's keyword name, quoted in the message.
+    value : array_like
+        The value to check.
+    rule : {'positive', 'positive_or_inf', 'non_negative', 'finite'}
+        The valid range. Every rule rejects NaN; only ``'positive_or_inf'`` admits +inf.
+    unit : str
+        Unit shown with the range, e.g. ``'m'``.
+    """
+    if not is_concrete(value):
+        return
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a real number or array of them, got {value!r}") from None
+    test, valid = _RULES[rule]
+    allowed_inf = rule == "positive_or_inf"
+    ok = test(array) & (np.isfinite(array) | (allowed_inf & (array == np.inf)))
+    if np.all(ok):
+        return
+    bad = np.argwhere(~ok)[0] if array.ndim else ()
+    where = f" at index {tuple(int(i) for i in bad)}" if array.ndim else ""
+    count = "" if array.size <= 1 else f" ({np.count_nonzero(~ok)} of {array.size} values)"
+    suffix = f" [{unit}]" if unit else ""
+    raise ValueError(
+        f"{name} must satisfy {valid.format(name=name)}{suffix}; "
+        f"got {array[tuple(bad)]!r}{where}{count}"
+    )
+
+
+def warn_nan(values, regimes, reasons: dict[int, str], quantity: str) -> None:
+    """Warn when a concrete result holds NaN for a physical reason (a regime), naming it."""
+    values = np.asarray(values)
+    regimes = np.asarray(regimes)
+    nan = np.isnan(values)
+    if not nan.any():
+        return
+    for code, reason in reasons.items():
+        count = int(np.count_nonzero(nan & (regimes == code)))
+        if count:
+            warnings.warn(
+                f"{quantity} is NaN at {count} of {values.size} point(s): {reason}",
+                RegimeWarning,
+                stacklevel=3,
+            )

@@ -1,0 +1,175 @@
+"""The ``ecofmaps`` command.
+
+Each subcommand is a pair of functions: ``_add_<name>(subparsers)`` declares its options
+and ``_run_<name>(args)`` does the work through the public API. Quantities are read with
+units (``50um``, ``35MN/m``); a bare number is SI. Errors in the input end the command
+with exit status 2 and a one-line message, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import warnings
+
+from ecofmaps import RegimeWarning, __version__, model
+from ecofmaps.units import parse_quantity, parse_values
+
+__all__ = ["main"]
+
+# The paper's Example 2 (Section 3 and Figure 5): the defaults of `ecofmaps model`.
+EXAMPLE_2 = {
+    "amplitude": 50e-6,
+    "load": 450.0,
+    "stiffness": 35e6,
+    "mu": 0.8,
+    "aspect_ratio": 0.2,
+}
+
+
+class CommandError(Exception):
+    """A user error found after parsing (bad file, bad value): reported in one line."""
+
+
+def quantity(kind: str):
+    """An argparse ``type`` reading one quantity of ``kind`` with units (see ecofmaps.units)."""
+
+    def parse(text: str) -> float:
+        try:
+            return parse_quantity(text, kind)
+        except ValueError as error:
+            raise argparse.ArgumentTypeError(str(error)) from None
+
+    parse.__name__ = kind
+    return parse
+
+
+def quantities(kind: str):
+    """An argparse ``type`` reading a list ``a,b,c`` or a range ``start:stop:num``."""
+
+    def parse(text: str):
+        try:
+            return parse_values(text, kind)
+        except ValueError as error:
+            raise argparse.ArgumentTypeError(str(error)) from None
+
+    parse.__name__ = kind
+    return parse
+
+
+# --- ecofmaps model ----------------------------------------------------------------------
+
+
+def _add_model(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "model",
+        help="evaluate the model at one point (default: the paper's Example 2)",
+        description=(
+            "Evaluate the compliant wear-scar interaction model at one point and print "
+            "the slip amplitude, peak force, dissipated energy, energy CoF and regime. "
+            "Defaults are the paper's Example 2: amplitude 50um, load 450N, stiffness "
+            "35MN/m, mu 0.8, aspect ratio 0.2."
+        ),
+    )
+    parser.add_argument(
+        "--amplitude", type=quantity("length"), default=EXAMPLE_2["amplitude"],
+        help="displacement amplitude Δ* (default 50um)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--load", type=quantity("force"), default=EXAMPLE_2["load"],
+        help="normal load P (default 450N)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--stiffness", type=quantity("stiffness"), default=EXAMPLE_2["stiffness"],
+        help="rig stiffness S, 'inf' for a rigid rig (default 35MN/m)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--mu", type=quantity("dimensionless"), default=EXAMPLE_2["mu"],
+        help="contact coefficient of friction μ (default 0.8)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--aspect-ratio", type=quantity("dimensionless"), default=EXAMPLE_2["aspect_ratio"],
+        help="groove depth over half-width z_o/x_o (default 0.2)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--groove-half-width", type=quantity("length"), default=None,
+        help="groove half-width x_o (default: the amplitude, as in the paper)",
+    )  # fmt: skip
+    parser.set_defaults(handler=_run_model)
+
+
+def _run_model(args) -> int:
+    point = dict(
+        amplitude=args.amplitude,
+        load=args.load,
+        stiffness=args.stiffness,
+        mu=args.mu,
+        aspect_ratio=args.aspect_ratio,
+        groove_half_width=args.groove_half_width,
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RegimeWarning)
+        code = model.Regime(int(model.regime(**point)))
+        slip = float(model.slip_amplitude(**point))
+        peak = float(model.max_force(**point))
+        energy = float(model.dissipated_energy(**point))
+        ecof = float(model.energy_cof(**point))
+    half_width = args.amplitude if args.groove_half_width is None else args.groove_half_width
+    stiffness = "inf (rigid)" if math.isinf(args.stiffness) else f"{args.stiffness / 1e6:.6g} MN/m"
+    rows = [
+        ("displacement amplitude", "Δ*", f"{args.amplitude * 1e6:.6g} µm"),
+        ("normal load", "P", f"{args.load:.6g} N"),
+        ("rig stiffness", "S", stiffness),
+        ("contact CoF", "μ", f"{args.mu:.6g}"),
+        ("groove aspect ratio", "z_o/x_o", f"{args.aspect_ratio:.6g}"),
+        ("groove half-width", "x_o", f"{half_width * 1e6:.6g} µm"),
+        None,
+        ("regime", "", code.name.lower().replace("_", " ")),
+        ("slip amplitude", "δ*", f"{slip * 1e6:.6g} µm"),
+        ("peak tangential force", "Q*", f"{peak:.6g} N"),
+        ("dissipated energy", "E_d", f"{energy * 1e3:.6g} mJ"),
+        ("energy CoF", "μ_E", f"{ecof:.6g}" if math.isfinite(ecof) else "undefined"),
+        ("ECoF / contact CoF", "μ_E/μ", f"{ecof / args.mu:.6g}" if math.isfinite(ecof) else ""),
+    ]
+    print(f"ecofmaps {__version__}: compliant wear-scar interaction model")
+    for row in rows:
+        print("" if row is None else f"  {row[0]:<24} {row[1]:<8} {row[2]}")
+    return 0
+
+
+# --- the command -------------------------------------------------------------------------
+
+_SUBCOMMANDS = (_add_model,)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``ecofmaps`` argument parser with every subcommand."""
+    parser = argparse.ArgumentParser(
+        prog="ecofmaps",
+        description=(
+            "Fretting friction maps: how far the energy coefficient of friction drifts "
+            "from the contact one with rig stiffness and wear-scar shape, the paper's "
+            "figures, and corrections. Quantities take units: 50um, 450N, 35MN/m."
+        ),
+    )
+    parser.add_argument("--version", action="version", version=f"ecofmaps {__version__}")
+    subparsers = parser.add_subparsers(title="commands", metavar="COMMAND", required=True)
+    for add in _SUBCOMMANDS:
+        add(subparsers)
+    return parser
+
+
+def main(argv=None) -> int:
+    """Run the ``ecofmaps`` command; return its exit status."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.handler(args)
+    except (CommandError, ValueError, OSError) as error:
+        print(f"{parser.prog}: error: {error}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

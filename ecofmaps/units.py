@@ -1,0 +1,117 @@
+"""Quantities with units, as the command line reads and prints them.
+
+The Python API speaks SI; people type ``50um``, ``35MN/m`` or ``450 N``. These helpers
+turn such text into SI floats with pint, and check the dimension, so ``--amplitude 35MN/m``
+is an error that says what was expected. A bare number is taken as SI.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+import pint
+
+__all__ = ["DIMENSIONS", "parse_quantity", "parse_values"]
+
+#: Physical dimension of each kind of quantity, with its SI unit and an example.
+DIMENSIONS = {
+    "length": ("[length]", "m", "50um"),
+    "force": ("[force]", "N", "450N"),
+    "stiffness": ("[force] / [length]", "N/m", "35MN/m"),
+    "stiffness_ratio": ("1 / [length]", "1/m", "0.08/um"),
+    "energy": ("[energy]", "J", "0.05J"),
+    "dimensionless": ("", "1", "0.8"),
+}
+
+
+@functools.cache
+def _registry() -> pint.UnitRegistry:
+    return pint.UnitRegistry()
+
+
+def parse_quantity(text: str, kind: str) -> float:
+    """One quantity as an SI float.
+
+    Parameters
+    ----------
+    text : str
+        A number with an optional unit: ``'50um'``, ``'50 µm'``, ``'35MN/m'``, ``'0.8'``,
+        ``'inf'``. A bare number is SI.
+    kind : str
+        A key of :data:`DIMENSIONS` (``'length'``, ``'force'``, ``'stiffness'``, ...).
+
+    Returns
+    -------
+    value : float
+        The value in the SI unit of ``kind`` (m, N, N/m, 1/m, J or 1).
+
+    Raises
+    ------
+    ValueError
+        If ``text`` is not a number with a unit, or the unit has the wrong dimension.
+    """
+    dimension, si_unit, example = DIMENSIONS[kind]
+    text = text.strip()
+    try:
+        return float(text)
+    except ValueError:
+        pass
+    registry = _registry()
+    try:
+        quantity = registry.Quantity(text.replace("µ", "u").replace("μ", "u"))
+    except Exception:  # pint raises many kinds of error for bad text
+        raise ValueError(
+            f"cannot read {text!r} as a {kind} (expected a number with a unit, e.g. {example})"
+        ) from None
+    if not isinstance(quantity, registry.Quantity):
+        return float(quantity)
+    if quantity.dimensionality != registry.Quantity(1, si_unit).dimensionality:
+        raise ValueError(
+            f"{text!r} is not a {kind}: its unit {quantity.units:~} has dimension "
+            f"{quantity.dimensionality}, expected {dimension or 'none'} (e.g. {example})"
+        )
+    return float(quantity.to(si_unit).magnitude)
+
+
+def parse_values(text: str, kind: str) -> np.ndarray:
+    """A list or a range of quantities as a 1-D float64 array in SI.
+
+    Parameters
+    ----------
+    text : str
+        Comma-separated quantities (``'25um,50um'``) or a linear range
+        ``'start:stop:num'`` with both ends included (``'0:0.3:61'``,
+        ``'1um:10um:10'``).
+    kind : str
+        A key of :data:`DIMENSIONS`.
+
+    Returns
+    -------
+    values : numpy.ndarray
+        The values in SI units.
+
+    Raises
+    ------
+    ValueError
+        If an item cannot be read, or a range's ``num`` is not an integer >= 2.
+    """
+    if ":" in text and not text.strip().startswith(":"):
+        parts = text.split(":")
+        if len(parts) != 3:
+            raise ValueError(f"a range is start:stop:num, got {text!r}")
+        start, stop = (parse_quantity(part, kind) for part in parts[:2])
+        try:
+            num = int(parts[2])
+        except ValueError:
+            num = -1
+        if num < 2:
+            raise ValueError(f"the number of points in {text!r} must be an integer >= 2")
+        return np.linspace(start, stop, num)
+    values = [parse_quantity(item, kind) for item in text.split(",") if item.strip()]
+    if not values:
+        raise ValueError(f"no value in {text!r}")
+    if not all(math.isfinite(v) or v == math.inf for v in values):
+        raise ValueError(f"{text!r} holds a NaN")
+    return np.asarray(values, dtype=np.float64)
