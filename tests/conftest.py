@@ -1,0 +1,27 @@
+"""Shared test set-up: a private cache, a headless matplotlib, hypothesis profiles."""
+
+import os
+
+import pytest
+from hypothesis import HealthCheck, settings
+
+os.environ.setdefault("MPLBACKEND", "Agg")
+
+# JAX compiles on first call, so a per-example deadline would measure compilation.
+settings.register_profile(
+    "default", deadline=None, max_examples=60, suppress_health_check=[HealthCheck.too_slow]
+)
+settings.register_profile("thorough", parent=settings.get_profile("default"), max_examples=1000)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _private_cache(tmp_path_factory):
+    """Every test writes its cache under a temporary directory, never the user's."""
+    previous = os.environ.get("ECOFMAPS_CACHE")
+    os.environ["ECOFMAPS_CACHE"] = str(tmp_path_factory.mktemp("ecofmaps-cache"))
+    yield
+    if previous is None:
+        del os.environ["ECOFMAPS_CACHE"]
+    else:
+        os.environ["ECOFMAPS_CACHE"] = previous
