@@ -7,7 +7,9 @@ paper this package implements.
 from importlib.metadata import PackageNotFoundError, version
 
 from ecofmaps._inputs import RegimeWarning
+from ecofmaps.cache import CacheWarning, cache_entries, clear_cache
 from ecofmaps.loop import fretting_loop, simulate
+from ecofmaps.maps import compute_loops, compute_map, compute_universal_map
 from ecofmaps.model import (
     GROSS_SLIP,
     INVALID,
@@ -31,9 +33,15 @@ __all__ = [
     "INVALID",
     "NO_GROSS_SLIP",
     "SELF_LOCKING",
+    "CacheWarning",
     "Regime",
     "RegimeWarning",
     "__version__",
+    "cache_entries",
+    "clear_cache",
+    "compute_loops",
+    "compute_map",
+    "compute_universal_map",
     "dissipated_energy",
     "energy_cof",
     "fretting_loop",
