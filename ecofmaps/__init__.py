@@ -8,6 +8,7 @@ from importlib.metadata import PackageNotFoundError, version
 
 from ecofmaps._inputs import RegimeWarning
 from ecofmaps.cache import CacheWarning, cache_entries, clear_cache
+from ecofmaps.fit import LoopFit, fit_loop
 from ecofmaps.loop import fretting_loop, simulate
 from ecofmaps.maps import compute_loops, compute_map, compute_universal_map
 from ecofmaps.model import (
@@ -34,6 +35,7 @@ __all__ = [
     "NO_GROSS_SLIP",
     "SELF_LOCKING",
     "CacheWarning",
+    "LoopFit",
     "Regime",
     "RegimeWarning",
     "__version__",
@@ -44,6 +46,7 @@ __all__ = [
     "compute_universal_map",
     "dissipated_energy",
     "energy_cof",
+    "fit_loop",
     "fretting_loop",
     "max_force",
     "regime",

@@ -1,0 +1,218 @@
+"""The model fit to a measured loop (ecofmaps.fit), on loops simulated with known parameters.
+
+The measured loops are made by ``ecofmaps.simulate`` (the stick/slip return map driven in
+time), which is independent of the closed-form branches the fit evaluates.
+"""
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+import ecofmaps
+from ecofmaps.fit import MIN_SAMPLES, LoopFit, fit_loop
+
+LOAD = 450.0  # P [N], the paper's Section 3
+AMPLITUDE = 50e-6  # Δ* = x_o [m]
+# The paper's Example 2 of Section 3 (μ_E is 4 % above μ) and the two loops of Figure 10.
+EXAMPLE_2 = dict(mu=0.8, aspect_ratio=0.2, stiffness=35e6)
+FIGURE_10 = {
+    "Example 1": dict(mu=0.825, aspect_ratio=1.8e-6 / AMPLITUDE, stiffness=45e6),
+    "Example 2": dict(mu=0.825, aspect_ratio=8.0e-6 / AMPLITUDE, stiffness=35e6),
+}
+SAMPLES = 201  # every loop has this many samples, so the fit compiles once
+
+
+def measured_loop(mu, aspect_ratio, stiffness, phase=None, cycles=2):
+    """Samples of the last of ``cycles`` sine cycles driven through ``simulate``.
+
+    ``phase`` (default: uniform, starting at a maximum) are the sampling instants within
+    the cycle in units of the period, in [0, 1]; the peaks are always sampled, so the
+    measured reversals are the true ones.
+    """
+    if phase is None:
+        phase = np.linspace(0.0, 1.0, SAMPLES)
+    time = np.concatenate(
+        [np.linspace(0.0, cycles - 1, 100 * (cycles - 1) + 1), cycles - 1 + phase]
+    )
+    displacement = AMPLITUDE * np.cos(2.0 * np.pi * time)
+    force = ecofmaps.simulate(
+        displacement, LOAD, stiffness, mu, aspect_ratio, groove_half_width=AMPLITUDE
+    )
+    count = phase.size
+    return displacement[-count:], np.asarray(force)[-count:]
+
+
+def assert_recovered(fit, mu, aspect_ratio, stiffness, rtol):
+    assert fit.success, fit.message
+    assert fit.mu == pytest.approx(mu, rel=rtol)
+    assert fit.stiffness == pytest.approx(stiffness, rel=rtol)
+    # z_o relative to the groove half-width x_o = Δ*, so a flat groove is tested too
+    assert fit.groove_depth == pytest.approx(aspect_ratio * AMPLITUDE, abs=rtol * AMPLITUDE)
+    assert fit.aspect_ratio == pytest.approx(aspect_ratio, abs=rtol)
+    assert fit.amplitude == pytest.approx(AMPLITUDE, rel=rtol)
+
+
+# --- noise-free loops: the fit returns the parameters that made them -----------------------
+
+
+@pytest.mark.parametrize(
+    "parameters",
+    [EXAMPLE_2, *FIGURE_10.values(), dict(mu=0.5, aspect_ratio=0.0, stiffness=20e6)],
+    ids=["Example 2 (Section 3)", *FIGURE_10, "flat groove"],
+)
+def test_recovers_noise_free_loop(parameters):
+    displacement, force = measured_loop(**parameters)
+    fit = fit_loop(displacement, force, LOAD)
+    assert_recovered(fit, rtol=1e-9, **parameters)
+    assert fit.displacement_offset == pytest.approx(0.0, abs=1e-9 * AMPLITUDE)
+    assert fit.force_offset == pytest.approx(0.0, abs=1e-9 * LOAD)
+    # the model passes through every sample; the reported residual is the samples' own
+    assert fit.rms_residual < 1e-9 * LOAD
+    assert fit.r_squared == pytest.approx(1.0, abs=1e-12)
+    np.testing.assert_allclose(fit.model_force, force, rtol=0, atol=1e-9 * LOAD)
+    residual = np.sqrt(np.mean((fit.force - fit.model_force) ** 2))
+    assert fit.rms_residual == pytest.approx(residual, rel=1e-12, abs=0)
+
+
+def test_recovers_offsets_and_any_start_and_sampling():
+    """Shifted axes, a loop that starts mid-stroke, non-uniform sampling instants."""
+    rng = np.random.default_rng(7)
+    inner = np.sort(rng.uniform(0.0, 1.0, SAMPLES - 3))
+    phase = np.sort(np.concatenate([inner, [0.0, 0.5, 1.0]]))  # the two peaks sampled
+    displacement, force = measured_loop(**EXAMPLE_2, phase=phase)
+    start = 37  # one period, starting on the falling branch
+    displacement = np.roll(displacement[:-1], -start)
+    force = np.roll(force[:-1], -start)
+    displacement = np.append(displacement, displacement[0]) + 3e-6
+    force = np.append(force, force[0]) - 12.0
+    fit = fit_loop(displacement, force, LOAD)
+    assert_recovered(fit, rtol=1e-9, **EXAMPLE_2)
+    assert fit.displacement_offset == pytest.approx(3e-6, rel=1e-9)
+    assert fit.force_offset == pytest.approx(-12.0, rel=1e-9)
+
+
+@given(
+    mu=st.floats(0.1, 1.5),
+    aspect_ratio=st.floats(0.0, 0.4),
+    mu_lam=st.floats(0.02, 0.9),
+)
+def test_recovers_any_gross_slip_loop(mu, aspect_ratio, mu_lam):
+    """Over the gross-slip domain: μ in [0.1, 1.5], z_o/x_o <= 0.4, μP/(SΔ*) up to 0.9."""
+    stiffness = LOAD * mu / (mu_lam * AMPLITUDE)
+    displacement, force = measured_loop(mu, aspect_ratio, stiffness)
+    fit = fit_loop(displacement, force, LOAD)
+    assert_recovered(fit, mu, aspect_ratio, stiffness, rtol=1e-8)
+
+
+# --- noisy loops: stated tolerances ---------------------------------------------------------
+
+
+def noisy(displacement, force, seed):
+    """Noise of 0.5 % of Δ* on displacement and 1 % of Q* on force, and offsets."""
+    rng = np.random.default_rng(seed)
+    peak = np.max(np.abs(force))
+    displacement = displacement + rng.normal(0.0, 0.005 * AMPLITUDE, displacement.size) + 2e-6
+    force = force + rng.normal(0.0, 0.01 * peak, force.size) + 8.0
+    return displacement, force
+
+
+@pytest.mark.parametrize("name", list(FIGURE_10))
+def test_recovers_noisy_loop(name):
+    """Ten noisy copies of each Figure 10 loop: μ within 1 %, S within 5 %, z_o within 10 %."""
+    parameters = FIGURE_10[name]
+    clean_displacement, clean_force = measured_loop(**parameters)
+    depth = parameters["aspect_ratio"] * AMPLITUDE
+    peak = np.max(np.abs(clean_force))
+    for seed in range(10):
+        displacement, force = noisy(clean_displacement, clean_force, seed)
+        fit = fit_loop(displacement, force, LOAD)
+        assert fit.success, fit.message
+        assert fit.mu == pytest.approx(parameters["mu"], rel=0.01)
+        assert fit.stiffness == pytest.approx(parameters["stiffness"], rel=0.05)
+        assert fit.groove_depth == pytest.approx(depth, rel=0.10)
+        assert fit.displacement_offset == pytest.approx(2e-6, abs=0.005 * AMPLITUDE)
+        assert fit.force_offset == pytest.approx(8.0, abs=0.01 * peak)
+        # the residual is the noise: force noise 1 % of Q*, and on the stick segments the
+        # displacement noise times S; it cannot be below the force noise alone by much
+        floor = 0.01 * peak
+        ceiling = np.hypot(floor, parameters["stiffness"] * 0.005 * AMPLITUDE)
+        assert 0.8 * floor < fit.rms_residual < ceiling
+        assert fit.r_squared > 0.99
+
+
+# --- bad input ------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def loop():
+    return measured_loop(**EXAMPLE_2)
+
+
+@pytest.mark.parametrize("load", [0.0, -450.0, np.nan, np.inf])
+def test_rejects_bad_load(loop, load):
+    with pytest.raises(ValueError, match=r"load must satisfy 0 < load < inf \[N\]"):
+        fit_loop(*loop, load)
+
+
+def test_rejects_load_array(loop):
+    with pytest.raises(ValueError, match="load must be a single number"):
+        fit_loop(*loop, [450.0, 450.0])
+
+
+def test_rejects_too_few_samples(loop):
+    displacement, force = loop
+    step = displacement.size // (MIN_SAMPLES - 2)
+    with pytest.raises(ValueError, match=f"at least {MIN_SAMPLES} samples"):
+        fit_loop(displacement[::step], force[::step], LOAD)
+
+
+@pytest.mark.parametrize("name", ["displacement", "force"])
+@pytest.mark.parametrize("value", [np.nan, np.inf])
+def test_rejects_non_finite_samples(loop, name, value):
+    samples = dict(zip(("displacement", "force"), (np.array(a) for a in loop), strict=True))
+    samples[name][17] = value
+    with pytest.raises(ValueError, match=rf"{name} must satisfy .* at index \(17,\)"):
+        fit_loop(samples["displacement"], samples["force"], LOAD)
+
+
+def test_rejects_mismatched_or_multidimensional_arrays(loop):
+    displacement, force = loop
+    with pytest.raises(ValueError, match="same length"):
+        fit_loop(displacement, force[:-1], LOAD)
+    with pytest.raises(ValueError, match="displacement must be one-dimensional"):
+        fit_loop(displacement.reshape(3, -1), force.reshape(3, -1), LOAD)
+    with pytest.raises(ValueError, match="does not vary"):
+        fit_loop(np.zeros_like(displacement), force, LOAD)
+
+
+def test_rejects_loop_without_gross_slip():
+    """A rig too compliant for the contact to slip: the loop closes onto Q = SΔ."""
+    displacement, force = measured_loop(mu=0.8, aspect_ratio=0.2, stiffness=5e6)
+    assert ecofmaps.regime(AMPLITUDE, LOAD, 5e6, 0.8, 0.2) == ecofmaps.NO_GROSS_SLIP
+    with pytest.raises(ValueError, match="no gross slip"):
+        fit_loop(displacement, force, LOAD)
+
+
+def test_rejects_anticlockwise_loop(loop):
+    displacement, force = loop
+    with pytest.raises(ValueError, match="anticlockwise"):
+        fit_loop(displacement, -force, LOAD)
+
+
+# --- the result -----------------------------------------------------------------------------
+
+
+def test_result_is_float64_and_model_loop_matches_fretting_loop(loop):
+    fit = fit_loop(*loop, LOAD)
+    assert isinstance(fit, LoopFit)
+    assert ecofmaps.LoopFit is LoopFit and ecofmaps.fit_loop is fit_loop
+    for name in ("mu", "stiffness", "groove_depth", "aspect_ratio", "amplitude", "rms_residual"):
+        assert type(getattr(fit, name)) is float
+    assert fit.model_force.dtype == np.float64
+    displacement, force = fit.model_loop(num=51)
+    expected = ecofmaps.fretting_loop(AMPLITUDE, LOAD, num=51, **EXAMPLE_2)
+    np.testing.assert_allclose(displacement, expected[0], rtol=0, atol=1e-12 * AMPLITUDE)
+    np.testing.assert_allclose(force, expected[1], rtol=0, atol=1e-9 * LOAD)
+    with pytest.raises(AttributeError):
+        fit.mu = 1.0
