@@ -19,9 +19,10 @@ from ecofmaps.model import (
     GROSS_SLIP,
     INVALID,
     NO_GROSS_SLIP,
+    _slip_roots,
     check_model_inputs,
     dimensionless,
-    slip_position,
+    locking_margin,
     slip_ratio,
     traction_ratio,
 )
@@ -37,9 +38,20 @@ def _steady_loop(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width
     mu, kappa, lam, code = (x[..., None] for x in (mu, kappa, lam, code))
     d = slip_ratio(mu, kappa, lam)
     t = jnp.linspace(-1.0, 1.0, num)
-    # Forward-slip branch, sampled uniformly in contact position from -d to d (eq. 9, 10).
-    xi = t * d
-    q_slip = traction_ratio(xi, mu, kappa)
+    # Forward-slip branch from -d to d (eq. 9, 10). A shallow groove (u = mu*kappa*d < 1/2)
+    # is sampled uniformly in position; a deep one so that the margin to the locking
+    # point, w = 1 - mu*kappa*xi, falls geometrically from 1 + u to its end value, which
+    # puts the points where the force rises steeply and keeps the digits of w there.
+    a = mu * kappa
+    u = a * d
+    shallow = u < 0.5
+    w_end = locking_margin(1.0, mu, kappa, lam)
+    w_end = jnp.where(shallow, 0.5, w_end)
+    w_deep = (1.0 + u) * jnp.exp((t + 1.0) / 2.0 * jnp.log(w_end / (1.0 + u)))
+    xi = jnp.where(shallow, t * d, (1.0 - w_deep) / jnp.where(shallow, 1.0, a))
+    w = jnp.where(shallow, 1.0 - a * xi, w_deep)
+    xi = xi.at[..., 0].set(-d[..., 0]).at[..., -1].set(d[..., 0])
+    q_slip = (mu + kappa * xi) / w  # eq. 9
     target_slip = xi + lam * q_slip
     # No gross slip: the contact sticks at the centre and the loop is the line Q = S*Delta.
     stick = code == int(NO_GROSS_SLIP)
@@ -95,8 +107,11 @@ def fretting_loop(amplitude, load, stiffness, mu, aspect_ratio, groove_half_widt
     Notes
     -----
     The slip branches are eq. 9 with eq. 10, :math:`\Delta = x + Q_\pm(x)/S`, sampled
-    uniformly in the contact position :math:`x`; the stick segments are the straight lines
-    of slope :math:`S`. With no gross slip the loop collapses onto :math:`Q = S\Delta`.
+    uniformly in :math:`x` for a shallow groove (:math:`\mu k\delta^* < 1/2`), and for a
+    deeper one so that the margin to the locking point :math:`1 - \mu k x` falls
+    geometrically along the branch (dense where the force rises steeply); the stick
+    segments are the straight lines of slope :math:`S`. With no gross slip the loop
+    collapses onto :math:`Q = S\Delta`.
     Self-locking points give NaN.
     """
     if not isinstance(num, int) or num < 2:
@@ -117,15 +132,14 @@ def _return_map(displacement, mu, kappa, lam, length):
         gap = d - xi
         forward = gap > lam * traction_ratio(xi, mu, kappa)
         backward = gap < lam * traction_ratio(xi, mu, kappa, -1.0)
-        xi_forward = slip_position(d, mu, kappa, lam)
-        xi_backward = -slip_position(-d, mu, kappa, lam)
+        xi_forward, w_forward = _slip_roots(d, mu, kappa, lam)
+        xi_backward, w_backward = _slip_roots(-d, mu, kappa, lam)
+        q_forward = (mu + kappa * xi_forward) / w_forward  # eq. 9, digits kept near locking
+        q_backward = -(mu + kappa * xi_backward) / w_backward
+        xi_backward = -xi_backward
         q_stick = jnp.where(lam > 0.0, gap / jnp.where(lam > 0.0, lam, 1.0), q)
         xi_new = jnp.where(forward, xi_forward, jnp.where(backward, xi_backward, xi))
-        q_new = jnp.where(
-            forward,
-            traction_ratio(xi_forward, mu, kappa),
-            jnp.where(backward, traction_ratio(xi_backward, mu, kappa, -1.0), q_stick),
-        )
+        q_new = jnp.where(forward, q_forward, jnp.where(backward, q_backward, q_stick))
         q_new = jnp.where(jnp.isfinite(q_new), q_new, jnp.nan)
         return (xi_new, q_new), q_new
 

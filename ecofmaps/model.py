@@ -19,7 +19,7 @@ time history). Three numbers then fix everything:
   :math:`Q = P` over :math:`L` (0 for a rigid rig).
 
 The core functions (:func:`traction_ratio`, :func:`slip_position`, :func:`slip_ratio`,
-:func:`ecof_ratio`, :func:`normalized_max_force`, :func:`normalized_energy`,
+:func:`locking_margin`, :func:`ecof_ratio`, :func:`normalized_max_force`, :func:`normalized_energy`,
 :func:`regime_code`) are pure ``jax.numpy`` functions of these numbers that broadcast
 and work under ``jit``, ``vmap`` and ``grad``; they do no input checking. The SI-unit
 functions (:func:`slip_amplitude`, :func:`dissipated_energy`, :func:`energy_cof`,
@@ -47,6 +47,7 @@ __all__ = [
     "dissipated_energy",
     "ecof_ratio",
     "energy_cof",
+    "locking_margin",
     "max_force",
     "normalized_energy",
     "normalized_max_force",
@@ -165,6 +166,27 @@ def traction_ratio(position, mu, kappa, direction=1.0):
     return (direction * mu + slope) / (1.0 - direction * mu * slope)
 
 
+def _slip_roots(target, mu, kappa, lam):
+    """Forward-slip equilibrium: the position and its margin to the locking point."""
+    a = mu * kappa
+    h = a * target + lam * kappa - 1.0
+    g = lam * kappa * (1.0 + mu * mu)
+    root = jnp.sqrt(h * h + 4.0 * g)
+    # Each jnp.where evaluates both branches: feed the unused one a harmless value so that
+    # neither produces inf/NaN that would poison gradients.
+    h_positive = h > 0.0
+    margin = jnp.where(h_positive, 2.0 * g / jnp.where(h_positive, h + root, 1.0), (root - h) / 2.0)
+    b = h + 2.0
+    c = target - lam * mu
+    b_positive = b > 0.0
+    position = jnp.where(
+        b_positive,
+        2.0 * c / jnp.where(b_positive, b + root, 1.0),
+        (b - root) / (2.0 * jnp.where(b_positive, 1.0, a)),
+    )
+    return position, margin
+
+
 def slip_position(target, mu, kappa, lam):
     r"""Contact position reached by forward slip when the actuator is at ``target``.
 
@@ -174,8 +196,7 @@ def slip_position(target, mu, kappa, lam):
     :math:`b = 1 + \mu\kappa D + \lambda\kappa`, :math:`c = D - \lambda\mu`. The root is
     taken as :math:`2c/(b + \sqrt{b^2 - 4ac})` (no cancellation when :math:`b > 0`, finite
     as :math:`\kappa \to 0`), and the discriminant is summed from non-negative terms,
-    :math:`(1 - aD)^2 + 2\lambda\kappa(1 + aD) + \lambda^2\kappa^2 + 4a\lambda\mu`, so it
-    keeps its digits near the rigid locking point.
+    :math:`b^2 - 4ac = (aD + \lambda\kappa - 1)^2 + 4\lambda\kappa(1 + \mu^2)`.
 
     Parameters
     ----------
@@ -190,19 +211,32 @@ def slip_position(target, mu, kappa, lam):
         The contact position :math:`x/L`; it equals the locking point :math:`1/(\mu\kappa)`
         when a rigid rig (``lam = 0``) is pushed beyond it. [1]
     """
-    a = mu * kappa
-    ad = a * target
-    b = 1.0 + ad + lam * kappa
-    c = target - lam * mu
-    disc = (1.0 - ad) ** 2 + 2.0 * lam * kappa * (1.0 + ad) + (lam * kappa) ** 2
-    disc = disc + 4.0 * a * lam * mu
-    root = jnp.sqrt(jnp.maximum(disc, 0.0))
-    positive = b > 0.0
-    # Both branches are evaluated; feed each a harmless value where it is not used so
-    # that neither produces inf/NaN that would poison gradients.
-    denominator_plus = jnp.where(positive, b + root, 1.0)
-    a_minus = jnp.where(positive, 1.0, a)
-    return jnp.where(positive, 2.0 * c / denominator_plus, (b - root) / (2.0 * a_minus))
+    return _slip_roots(target, mu, kappa, lam)[0]
+
+
+def locking_margin(target, mu, kappa, lam):
+    r"""Margin :math:`w = 1 - \mu\kappa\xi` of the forward-slip position to the locking point.
+
+    The denominator of eq. 9 at the position :func:`slip_position` returns, computed
+    without cancellation: :math:`w` solves :math:`w^2 + (aD + \lambda\kappa - 1)w -
+    \lambda\kappa(1 + \mu^2) = 0` (the quadratic of eq. 16 in :math:`w`), whose positive
+    root is taken in the form that never subtracts nearly equal numbers. It keeps its
+    relative accuracy when a stiff rig drives a deep groove close to locking, where
+    :math:`1 - \mu\kappa\xi` computed from :math:`\xi` would lose every digit.
+
+    Parameters
+    ----------
+    target : array_like
+        Actuator displacement :math:`D = \Delta/L`. [1]
+    mu, kappa, lam : array_like
+        Friction coefficient, curvature number, compliance ratio. [1]
+
+    Returns
+    -------
+    w : jax.Array
+        In :math:`(0, \infty)`; 0 at or beyond the locking point of a rigid rig. [1]
+    """
+    return _slip_roots(target, mu, kappa, lam)[1]
 
 
 def regime_code(mu, kappa, lam):
@@ -263,16 +297,22 @@ _SERIES_LIMIT = 0.5
 _SERIES = tuple(1.0 / (2 * n + 1) for n in range(28, 0, -1))
 
 
-def _artanh_excess(u):
-    r""":math:`\operatorname{artanh}(u)/u - 1` without cancellation at small :math:`u`."""
-    small = jnp.abs(u) < _SERIES_LIMIT
+def _artanh_excess(u, margin):
+    r""":math:`\operatorname{artanh}(u)/u - 1` for :math:`u = 1 - w` in :math:`[0, 1)`.
+
+    A series at :math:`u < 1/2` (no cancellation as :math:`u \to 0`); above, the logarithm
+    of :math:`(2 - w)/w` with the margin :math:`w` itself, so the digits of :math:`1 - u`
+    are not lost near the locking point.
+    """
+    small = u < _SERIES_LIMIT
     u_small = jnp.where(small, u, 0.0)
-    u_large = jnp.where(small, 0.75, u)
+    w_large = jnp.where(small, 0.25, margin)
     u2 = u_small * u_small
     series = jnp.zeros_like(u2)
     for coefficient in _SERIES:  # Horner's rule, unrolled at trace time
         series = (series + coefficient) * u2
-    return jnp.where(small, series, jnp.arctanh(u_large) / u_large - 1.0)
+    direct = 0.5 * jnp.log((2.0 - w_large) / w_large) / (1.0 - w_large) - 1.0
+    return jnp.where(small, series, direct)
 
 
 def ecof_ratio(mu, kappa, lam):
@@ -296,8 +336,8 @@ def ecof_ratio(mu, kappa, lam):
         self-locking, or for invalid input. [1]
     """
     d = slip_ratio(mu, kappa, lam)
-    u = mu * kappa * d
-    ratio = 1.0 + (1.0 + mu * mu) / (mu * mu) * _artanh_excess(u)
+    excess = _artanh_excess(mu * kappa * d, locking_margin(1.0, mu, kappa, lam))
+    ratio = 1.0 + (1.0 + mu * mu) / (mu * mu) * excess
     return jnp.where(d > 0.0, ratio, jnp.nan)
 
 
@@ -317,7 +357,7 @@ def normalized_max_force(mu, kappa, lam):
     """
     d = slip_ratio(mu, kappa, lam)
     stick = d == 0.0
-    q = traction_ratio(jnp.where(stick, 0.0, d), mu, kappa)
+    q = (mu + kappa * d) / locking_margin(1.0, mu, kappa, lam)  # eq. 9, digits kept
     return jnp.where(stick, 1.0 / jnp.where(stick, lam, 1.0), q)
 
 
