@@ -89,7 +89,7 @@ def check(name: str, value, rule: str, unit: str = "") -> None:
     suffix = f" [{unit}]" if unit else ""
     raise ValueError(
         f"{name} must satisfy {valid.format(name=name)}{suffix}; "
-        f"got {array[tuple(bad)]!r}{where}{count}"
+        f"got {array[tuple(bad)].item()!r}{where}{count}"
     )
 
 

@@ -1,0 +1,61 @@
+"""The `ecofmaps` command: top level and `ecofmaps model`."""
+
+import subprocess
+import sys
+
+import pytest
+
+from ecofmaps.cli import main
+
+
+def test_model_prints_example_2_with_units(capsys):
+    assert main(["model"]) == 0
+    out = capsys.readouterr().out
+    assert "50 µm" in out and "450 N" in out and "35 MN/m" in out
+    assert "gross slip" in out
+    assert "32.7302 µm" in out  # δ*, eq. 16
+    assert "48.946 mJ" in out  # E_d, eq. 12
+    assert "μ_E/μ    1.0385" in out  # about 4 % (Section 4)
+
+
+def test_model_takes_units_and_a_rigid_rig(capsys):
+    assert main(["model", "--stiffness", "inf", "--amplitude", "0.03mm"]) == 0
+    out = capsys.readouterr().out
+    assert "inf (rigid)" in out and "slip amplitude           δ*       30 µm" in out
+
+
+def test_model_without_gross_slip_says_so(capsys):
+    assert main(["model", "--stiffness", "5MN/m"]) == 0
+    out = capsys.readouterr().out
+    assert "no gross slip" in out and "undefined" in out
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (["model", "--amplitude", "35MN/m"], "argument --amplitude: '35MN/m' is not a length"),
+        (["model", "--load=-3N"], "load must satisfy 0 < load < inf [N]; got -3.0"),
+        (["model", "--mu", "abc"], "argument --mu: cannot read 'abc'"),
+        (["frobnicate"], "invalid choice: 'frobnicate'"),
+    ],
+)
+def test_bad_input_is_one_line_and_exit_2(arguments, message, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        status = main(arguments)
+        raise SystemExit(status)
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert message in err
+    assert "Traceback" not in err
+
+
+def test_console_script_help_and_version():
+    run = subprocess.run(
+        [sys.executable, "-m", "ecofmaps.cli", "--help"], capture_output=True, text=True
+    )
+    assert run.returncode == 0
+    assert "model" in run.stdout
+    run = subprocess.run(
+        [sys.executable, "-m", "ecofmaps.cli", "--version"], capture_output=True, text=True
+    )
+    assert run.stdout.startswith("ecofmaps ")
