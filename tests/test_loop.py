@@ -243,3 +243,39 @@ def test_simulation_rejects_bad_input(change, message):
     arguments.update(change)
     with pytest.raises(ValueError, match=message):
         ecofmaps.simulate(**arguments)
+
+
+def test_loop_and_simulation_areas_at_random_points():
+    """E_d (closed form) against the area of the steady loop and of a simulated sinusoidal
+    cycle at ~600 random points over the tribologically meaningful domain, all in one call.
+    Sampling errors, measured: steady loop at 401 points a branch 1.2e-5 here (4.7e-4 at the
+    worst grid point, near locking), tolerance 1e-3; the simulation cuts the stick-to-slip
+    corners, O(1/n^2), 5.8e-6 at 2000 samples a cycle, tolerance 2e-5."""
+    rng = np.random.default_rng(17)
+    count = 660
+    amplitude = 10 ** rng.uniform(-6, -3.5, count)
+    load = 10 ** rng.uniform(0, 4, count)
+    mu = rng.uniform(0.05, 2.0, count)
+    aspect_ratio = rng.uniform(0.0, 1.0, count)
+    width = amplitude * rng.uniform(0.5, 10.0, count)
+    mu_lam = np.where(rng.random(count) < 0.1, 0.0, rng.uniform(1e-9, 0.99, count))
+    with np.errstate(divide="ignore"):
+        stiffness = load * mu / (mu_lam * amplitude)
+    rigid_locked = (mu_lam == 0) & (mu * 2 * aspect_ratio * amplitude / width >= 0.99)
+    keep = ~rigid_locked
+    args = [a[keep] for a in (amplitude, load, stiffness, mu, aspect_ratio, width)]
+    assert keep.sum() >= 500
+    energy = np.asarray(ecofmaps.dissipated_energy(*args))
+
+    displacement, force = (np.asarray(a) for a in ecofmaps.fretting_loop(*args, num=401))
+    loop_area = np.sum((force[:, 1:] + force[:, :-1]) / 2 * np.diff(displacement), axis=1)
+    np.testing.assert_allclose(loop_area, energy, rtol=1e-3)
+
+    samples = 2000
+    t = np.arange(3 * samples + 1) / samples
+    displacement = args[0][:, None] * np.sin(2 * np.pi * t)
+    force = np.asarray(ecofmaps.simulate(displacement, *args[1:]))
+    cycle = slice(samples, 2 * samples + 1)  # the second cycle: steady after the first peak
+    d, q = displacement[:, cycle], force[:, cycle]
+    simulated_area = np.sum((q[:, 1:] + q[:, :-1]) / 2 * np.diff(d), axis=1)
+    np.testing.assert_allclose(simulated_area, energy, rtol=2e-5)
