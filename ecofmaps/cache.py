@@ -122,9 +122,9 @@ def cache_key(function: str, inputs: Mapping[str, object]) -> str:
         if value is None:
             digest.update(b"None\0")
             continue
-        array = np.ascontiguousarray(value, dtype="<f8")
+        array = np.asarray(value, dtype="<f8")  # not ascontiguousarray: it makes 0-d 1-d
         digest.update(f"{array.shape}\0".encode())
-        digest.update(array.tobytes())
+        digest.update(array.tobytes(order="C"))
     return digest.hexdigest()
 
 
