@@ -215,9 +215,168 @@ def _run_figures(args) -> int:
     return 0
 
 
+# --- ecofmaps map ------------------------------------------------------------------------
+
+_GRID_HELP = "; one value, a list or a range start:stop:num"
+
+
+def _add_map(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "map",
+        help="compute the model over a grid of test conditions into a netCDF file",
+        description=textwrap.fill(
+            "Compute the steady-loop quantities of the model (slip amplitude and slip ratio, "
+            "energy CoF and its ratio to mu, compliance ratio P/(S*amplitude), regime, and "
+            "with --load the dissipated energy and peak force) over a grid, and write them "
+            "as an xarray Dataset to a netCDF file (atomically: an existing file is replaced "
+            "only once the new one is complete). The groove half-width equals the amplitude, "
+            "as in the paper. Each of --stiffness-ratio, --aspect-ratio, --amplitude and --mu "
+            "takes one value (a scalar coordinate of the result), a comma-separated list or a "
+            "range start:stop:num (num evenly spaced points, both ends included); each list or "
+            "range is a dimension, in this order. Values take units (50um, 0.08/um, 450N); a "
+            "bare number is SI. Results are kept in the cache (see 'ecofmaps cache') unless "
+            "--no-cache.",
+            width=80,
+        ),
+        epilog=(
+            "example (the grid of Figure 11):\n  ecofmaps map --stiffness-ratio 0.01/um:0.3/um:30 "
+            "--aspect-ratio 0:0.3:31 \\\n      --amplitude 25um,50um --mu 0.8 --load 450N "
+            "--out fig11.nc"
+        ),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "--stiffness-ratio", type=quantities("stiffness_ratio"), required=True, metavar="S/P",
+        help="rig stiffness over normal load S/P [1/m], 'inf' for a rigid rig" + _GRID_HELP,
+    )  # fmt: skip
+    parser.add_argument(
+        "--aspect-ratio", type=quantities("dimensionless"), required=True, metavar="Z/X",
+        help="groove depth over half-width z_o/x_o (>= 0)" + _GRID_HELP,
+    )  # fmt: skip
+    parser.add_argument(
+        "--amplitude", type=quantities("length"), required=True, metavar="DELTA",
+        help="displacement amplitude Δ* [m], e.g. 25um,50um" + _GRID_HELP,
+    )  # fmt: skip
+    parser.add_argument(
+        "--mu", type=quantities("dimensionless"), required=True, metavar="MU",
+        help="contact coefficient of friction μ (> 0)" + _GRID_HELP,
+    )  # fmt: skip
+    parser.add_argument(
+        "--load", type=quantity("force"), default=None, metavar="P",
+        help="normal load P [N], one value; adds dissipated_energy [J] and max_force [N]",
+    )  # fmt: skip
+    parser.add_argument(
+        "--out", required=True, metavar="FILE.nc",
+        help="netCDF file to write (its directory must exist)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--no-cache", action="store_true",
+        help="compute afresh and do not store the result in the cache",
+    )  # fmt: skip
+    parser.add_argument(
+        "--cache-dir", default=None, metavar="DIR",
+        help="cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)",
+    )  # fmt: skip
+    parser.set_defaults(handler=_run_map)
+
+
+def _run_map(args) -> int:
+    from ecofmaps.cache import write_netcdf
+    from ecofmaps.maps import compute_map
+
+    out = Path(args.out)
+    if not out.parent.is_dir():
+        raise CommandError(f"cannot write {out}: the directory {out.parent} does not exist")
+    grid = {
+        name: values[0] if values.size == 1 else values
+        for name, values in (
+            ("stiffness_ratio", args.stiffness_ratio),
+            ("aspect_ratio", args.aspect_ratio),
+            ("amplitude", args.amplitude),
+            ("mu", args.mu),
+        )
+    }
+    dataset = compute_map(**grid, load=args.load, cache=not args.no_cache, cache_dir=args.cache_dir)
+    write_netcdf(dataset, out)
+    shape = " x ".join(f"{size} {dim}" for dim, size in dataset.sizes.items()) or "1 point"
+    regimes = ", ".join(
+        f"{code.name.lower().replace('_', ' ')} {count}"
+        for code in model.Regime
+        if (count := int((dataset.regime == code).sum()))
+    )
+    print(f"wrote {out}: {shape}")
+    print(f"  regimes: {regimes}")
+    if math.isfinite(low := float(dataset.ecof_ratio.min())):  # NaN-skipping
+        print(f"  ECoF / contact CoF: {low:.6g} to {float(dataset.ecof_ratio.max()):.6g}")
+    return 0
+
+
+# --- ecofmaps cache ----------------------------------------------------------------------
+
+
+def _size(count: int) -> str:
+    """A byte count for people: 512 B, 12.3 kB, 4.5 MB."""
+    for unit, scale in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if count >= scale:
+            return f"{count / scale:.1f} {unit}"
+    return f"{count} B"
+
+
+def _add_cache(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "cache",
+        help="list or clear the cache of computed maps",
+        description=textwrap.fill(
+            "Computed maps are kept as netCDF files, one per grid and package version, in the "
+            "directory given by --cache-dir, else the ECOFMAPS_CACHE environment variable, "
+            "else the per-user cache directory. 'list' shows them with their sizes; 'clear' "
+            "removes them (and temporary files of interrupted writes; other files are left "
+            "alone).",
+            width=80,
+        ),
+    )
+    actions = parser.add_subparsers(title="actions", metavar="ACTION", required=True)
+    for name, handler, text in (
+        ("list", _run_cache_list, "list the cached maps with their sizes"),
+        ("clear", _run_cache_clear, "remove every cached map"),
+    ):
+        action = actions.add_parser(name, help=text, description=text + ".")
+        action.add_argument(
+            "--cache-dir", default=None, metavar="DIR",
+            help="cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)",
+        )  # fmt: skip
+        action.set_defaults(handler=handler)
+
+
+def _run_cache_list(args) -> int:
+    from ecofmaps.cache import cache_directory, cache_entries
+
+    directory = cache_directory(args.cache_dir)
+    entries = cache_entries(directory)
+    if not entries:
+        print(f"no cached maps in {directory}")
+        return 0
+    print(f"cached maps in {directory}:")
+    for entry in entries:
+        modified = entry.modified.astimezone().strftime("%Y-%m-%d %H:%M:%S")
+        print(f"  {_size(entry.size):>9}  {modified}  {entry.path.name}")
+    total = sum(entry.size for entry in entries)
+    print(f"{len(entries)} file(s), {_size(total)}")
+    return 0
+
+
+def _run_cache_clear(args) -> int:
+    from ecofmaps.cache import cache_directory, clear_cache
+
+    directory = cache_directory(args.cache_dir)
+    count, size = clear_cache(directory)
+    print(f"removed {count} file(s), {_size(size)}, from {directory}")
+    return 0
+
+
 # --- the command -------------------------------------------------------------------------
 
-_SUBCOMMANDS = (_add_model, _add_figures)
+_SUBCOMMANDS = (_add_model, _add_figures, _add_map, _add_cache)
 
 
 def build_parser() -> argparse.ArgumentParser:
