@@ -4,6 +4,7 @@ The public API in SI units (m, N, N/m, J). See the README for an overview and th
 paper this package implements.
 """
 
+import importlib
 from importlib.metadata import PackageNotFoundError, version
 
 from ecofmaps._inputs import RegimeWarning
@@ -23,6 +24,15 @@ from ecofmaps.model import (
     regime,
     slip_amplitude,
 )
+
+
+def __getattr__(name: str):
+    # ecofmaps.figures (the paper's figures) needs matplotlib: it is imported on first use,
+    # ecofmaps.figures.make_figure(...), not with the package.
+    if name == "figures":
+        return importlib.import_module("ecofmaps.figures")
+    raise AttributeError(f"module 'ecofmaps' has no attribute {name!r}")
+
 
 try:
     __version__ = version("ecofmaps")
@@ -46,6 +56,7 @@ __all__ = [
     "compute_universal_map",
     "dissipated_energy",
     "energy_cof",
+    "figures",
     "fit_loop",
     "fretting_loop",
     "max_force",

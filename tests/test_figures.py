@@ -7,6 +7,8 @@ of curves, plotted values in the tribologist's units, contour levels, labels, ma
 
 import math
 import re
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -353,3 +355,13 @@ def test_command_reports_an_unusable_directory(tmp_path, capsys):
     assert main(["figures", "--out", str(blocker), "--only", "fig8"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("ecofmaps: error:") and len(err.strip().splitlines()) == 1
+
+
+def test_figures_are_loaded_on_first_use_only():
+    # `import ecofmaps` does not pay for matplotlib; `ecofmaps.figures` loads it when used.
+    code = (
+        "import sys, ecofmaps\n"
+        "assert 'matplotlib' not in sys.modules, 'import ecofmaps pulled in matplotlib'\n"
+        "assert 'fig11b' in ecofmaps.figures.FIGURES and 'matplotlib' in sys.modules\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
