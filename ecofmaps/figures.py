@@ -6,7 +6,8 @@ server). Axes speak the tribologist's units: µm, N, MN/m, mJ.
 
 :data:`FIGURES` is the registry used by ``ecofmaps figures``: for each figure name, the
 function that builds its Dataset with the paper's parameters (through the cached map
-functions) and the function that draws it. :func:`make_figure` does both, and
+functions) and the function that draws it. :func:`make_figure` does both for one figure,
+:func:`make_figures` for several (building each shared Dataset once), and
 :func:`save_figure` writes a figure atomically.
 
 The paper's parameters (Section 3): :math:`\Delta^* = x_o = 50` µm, :math:`P = 450` N,
@@ -364,7 +365,8 @@ def ecof_ratio_curves(dataset: xr.Dataset) -> Figure:
     Parameters
     ----------
     dataset : xarray.Dataset
-        As for :func:`slip_amplitude_curves`.
+        As for :func:`slip_amplitude_curves`, with :math:`S/P` = 35 MN/m / 450 N among
+        its ``stiffness_ratio`` values.
 
     Returns
     -------
@@ -395,7 +397,8 @@ def ecof_ratio_curves(dataset: xr.Dataset) -> Figure:
         markersize=9,
         zorder=5,
         label=(
-            rf"Example 2 ($S$ = 35 MN/m, $z_o/x_o$ = 0.2): $\mu_E/\mu$ = {value:.3f} "
+            rf"Example 2 ($S$ = {example['stiffness'] * _MEGA:g} MN/m, "
+            rf"$z_o/x_o$ = {example['aspect_ratio']:g}): $\mu_E/\mu$ = {value:.3f} "
             rf"(+{(value - 1) * 100:.1f} %)"
         ),
     )
