@@ -37,12 +37,14 @@ __all__ = [
     "ECOF_RATIO_LEVELS",
     "FIGURES",
     "FigureRecipe",
+    "cof_evolution",
     "dissipated_energy_curves",
     "ecof_ratio_contours",
     "ecof_ratio_curves",
     "loops_by_aspect_ratio",
     "make_figure",
     "make_figures",
+    "measured_loops",
     "rigid_and_compliant_loops",
     "save_figure",
     "slip_amplitude_curves",
@@ -592,6 +594,164 @@ def universal_ecof_ratio_map(dataset: xr.Dataset) -> Figure:
         + r"$\mu_E/\mu$:"
         + "\n"
         + r"Fig. 11a ($\Delta^*$ = 25 µm) and 11b (50 µm) are two windows of this one chart",
+        fontsize="medium",
+    )
+    return figure
+
+
+# --- Figure 9 and measured loops: results of ecofmaps.analyze_loops -------------------------
+
+
+def _evenly_spread(labels, count: int) -> list:
+    """Up to ``count`` of ``labels`` spread evenly, the first and the last included."""
+    picks = np.unique(np.linspace(0, len(labels) - 1, min(count, len(labels))).round().astype(int))
+    return [labels[i] for i in picks]
+
+
+def measured_loops(results: xr.Dataset, cycles=None, columns: int = 3) -> Figure:
+    r"""Measured loops, each with the line :math:`Q = S\Delta` and its two GICoF crossings.
+
+    Parameters
+    ----------
+    results : xarray.Dataset
+        From :func:`ecofmaps.analyze_loops` with ``keep_loops=True``.
+    cycles : sequence of int, optional
+        Cycle numbers to draw, one panel each; by default six spread evenly over the
+        recording, the first and the last included.
+    columns : int
+        Panels per row.
+
+    Returns
+    -------
+    figure : matplotlib.figure.Figure
+        One panel per cycle: the centred loop, :math:`Q` [N] against :math:`\Delta` [µm],
+        the line :math:`Q = S\Delta` with the cycle's stiffness, and the crossings whose
+        :math:`Q/P` is the GICoF.
+
+    Notes
+    -----
+    The paper's Section 5 and Figure 6 (eq. 17-18): where the loop meets
+    :math:`Q = S\Delta` the contact is at the bottom of the groove, and :math:`Q/P = \mu`.
+    """
+    if "loop_displacement" not in results:
+        raise ValueError("results hold no loops: call analyze_loops(..., keep_loops=True)")
+    labels = list(results["cycle"].values)
+    chosen = _evenly_spread(labels, 6) if cycles is None else list(cycles)
+    rows = -(-len(chosen) // columns)
+    width = min(columns, len(chosen))
+    figure = Figure(figsize=(3.6 * width + 0.6, 3.1 * rows + 0.9), layout="constrained")
+    axes = figure.subplots(rows, width, squeeze=False, sharex=True, sharey=True)
+    load = _scalar(results, "load")
+    for ax, label in zip(axes.flat, chosen, strict=False):
+        cycle = results.sel(cycle=label)
+        x = cycle["loop_displacement"].values * _MICRO
+        q = cycle["loop_force"].values
+        ax.plot(x, q, color="tab:blue", linewidth=1.2, label="measured loop")
+        stiffness = float(cycle["stiffness"])
+        # The line across the loop's height, within its width. [µm]
+        reach = np.nanmax(np.abs(q)) / stiffness * _MICRO
+        ends = np.array([max(np.nanmin(x), -reach), min(np.nanmax(x), reach)])
+        ax.plot(
+            ends,
+            stiffness * ends / _MICRO,
+            color="0.35",
+            linestyle="--",
+            linewidth=1.0,
+            label=r"$Q = S\Delta$",
+        )
+        crossings = np.array(
+            [
+                float(cycle["crossing_displacement_forward"]),
+                float(cycle["crossing_displacement_backward"]),
+            ]
+        )
+        ratios = np.array([float(cycle["gicof_forward"]), -float(cycle["gicof_backward"])])
+        ax.plot(
+            crossings * _MICRO,
+            ratios * load,
+            linestyle="none",
+            marker="o",
+            markersize=6,
+            markerfacecolor="tab:red",
+            markeredgecolor="black",
+            label="GICoF crossings",
+        )
+        ax.axhline(0.0, color="0.7", linewidth=0.6)
+        ax.axvline(0.0, color="0.7", linewidth=0.6)
+        ax.grid(alpha=0.3)
+        ax.set_title(
+            f"cycle {label}: GICoF {float(cycle['gicof']):.3f}, ECoF {float(cycle['ecof']):.3f}\n"
+            f"S = {stiffness * _MEGA:.1f} MN/m, {cycle['regime'].values!s}",
+            fontsize="small",
+        )
+    for ax in axes.flat[len(chosen) :]:
+        ax.set_visible(False)
+    for ax in axes[-1]:
+        ax.set_xlabel(_LABELS["displacement"])
+    for ax in axes[:, 0]:
+        ax.set_ylabel(_LABELS["force"])
+    axes.flat[0].legend(loc="upper left", fontsize="x-small")
+    figure.suptitle(
+        rf"Measured loops and the line $Q = S\Delta$ (P = {load:g} N): "
+        "the GICoF is Q/P at the crossings",
+        fontsize="medium",
+    )
+    return figure
+
+
+def cof_evolution(results: xr.Dataset) -> Figure:
+    r"""Figure 9: the ECoF and the GICoF over the cycles of a test.
+
+    Parameters
+    ----------
+    results : xarray.Dataset
+        From :func:`ecofmaps.analyze_loops`.
+
+    Returns
+    -------
+    figure : matplotlib.figure.Figure
+        Top: :math:`\mu_E` (eq. 1) and the GICoF against the cycle number.
+        Bottom: how far the ECoF is above the GICoF, :math:`\mu_E/\text{GICoF} - 1` [%].
+
+    Notes
+    -----
+    The paper's Figure 9: with a flat scar the two coefficients agree; as the scar deepens
+    into a groove the ECoF rises above the GICoF, which stays at the contact :math:`\mu`.
+    Cycles in partial slip have neither and leave gaps.
+    """
+    figure = Figure(figsize=(7.0, 5.6), layout="constrained")
+    top, bottom = figure.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
+    cycle = results["cycle"].values
+    marker = dict(marker="o", markersize=2.5) if cycle.size <= 400 else {}
+    top.plot(
+        cycle,
+        results["ecof"],
+        color="tab:orange",
+        linewidth=1.3,
+        label=r"ECoF $\mu_E = E_d/(4P\delta^*)$",
+        **marker,
+    )
+    top.plot(
+        cycle,
+        results["gicof"],
+        color="tab:blue",
+        linewidth=1.3,
+        label=r"GICoF ($Q/P$ on $Q = S\Delta$)",
+        **marker,
+    )
+    top.set_ylabel("Coefficient of friction [1]")
+    top.grid(alpha=0.3)
+    top.legend(loc="best", fontsize="small")
+    excess = (results["ecof"] / results["gicof"] - 1.0) * 100.0
+    bottom.plot(cycle, excess, color="tab:purple", linewidth=1.2, **marker)
+    bottom.axhline(0.0, color="0.5", linewidth=0.8)
+    bottom.set_ylabel("ECoF / GICoF − 1 [%]")
+    bottom.set_xlabel("Cycle")
+    bottom.grid(alpha=0.3)
+    amplitude = float(results["amplitude"].median()) * _MICRO
+    figure.suptitle(
+        "Fig. 9  Evolution of the ECoF and the GICoF\n"
+        + _parameters(f"P = {_scalar(results, 'load'):g} N", rf"$\Delta^*$ ≈ {amplitude:.1f} µm"),
         fontsize="medium",
     )
     return figure
