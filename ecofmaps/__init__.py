@@ -8,6 +8,7 @@ import importlib
 from importlib.metadata import PackageNotFoundError, version
 
 from ecofmaps._inputs import RegimeWarning
+from ecofmaps.analysis import analyze_loops
 from ecofmaps.cache import CacheWarning, cache_entries, clear_cache
 from ecofmaps.fit import LoopFit, fit_loop
 from ecofmaps.loop import fretting_loop, simulate
@@ -24,6 +25,8 @@ from ecofmaps.model import (
     regime,
     slip_amplitude,
 )
+from ecofmaps.recordings import read_recording
+from ecofmaps.synthetic import synthetic_recording
 
 
 def __getattr__(name: str):
@@ -49,6 +52,7 @@ __all__ = [
     "Regime",
     "RegimeWarning",
     "__version__",
+    "analyze_loops",
     "cache_entries",
     "clear_cache",
     "compute_loops",
@@ -60,7 +64,9 @@ __all__ = [
     "fit_loop",
     "fretting_loop",
     "max_force",
+    "read_recording",
     "regime",
     "simulate",
     "slip_amplitude",
+    "synthetic_recording",
 ]
