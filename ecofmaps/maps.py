@@ -164,21 +164,24 @@ def _evaluate_grid(kernel, axes, extra, max_chunk: int) -> dict[str, np.ndarray]
     return results
 
 
-def _dataset(axes: dict, values: dict, title: str, extra_dims=None) -> xr.Dataset:
-    """A Dataset of grid ``values`` over ``axes`` (scalars become scalar coordinates)."""
+def _dataset(axes: dict, values: dict, title: str, extra=None) -> xr.Dataset:
+    """A Dataset of grid ``values`` over ``axes`` (scalars become scalar coordinates).
+
+    ``extra`` coordinates are not grid axes: 0-d ones are scalar coordinates, 1-D ones
+    trailing dimensions of the values that have more axes than the grid.
+    """
     dims = [name for name, axis in axes.items() if axis.ndim == 1]
     squeeze = tuple(i for i, axis in enumerate(axes.values()) if axis.ndim == 0)
-    extra_dims = extra_dims or {}
+    extra = extra or {}
+    trailing = [name for name, coordinate in extra.items() if coordinate.ndim == 1]
     coords = {
         name: ((name,) if axis.ndim == 1 else (), axis, _attrs(name))
-        for name, axis in {**axes, **extra_dims}.items()
+        for name, axis in {**axes, **extra}.items()
     }
     data_vars = {}
     for name in sorted(values, key=list(_ATTRS).index):
-        value = values[name]
-        value = np.squeeze(value, axis=squeeze)
-        value_dims = dims + list(extra_dims)[: value.ndim - len(dims)]
-        data_vars[name] = (value_dims, value, _attrs(name))
+        value = np.squeeze(values[name], axis=squeeze)
+        data_vars[name] = (dims + trailing[: value.ndim - len(dims)], value, _attrs(name))
     return xr.Dataset(data_vars, coords=coords, attrs=_global_attrs(title))
 
 
@@ -320,9 +323,8 @@ def compute_map(
         values = _evaluate_grid(
             _map_kernel, [np.atleast_1d(a) for a in axes.values()], (load,), max_chunk
         )
-        scalars = {} if load is None else {"load": load}
-        dataset = _dataset(axes, values, "ECoF map of the compliant wear-scar model")
-        return dataset.assign_coords({n: ((), v, _attrs(n)) for n, v in scalars.items()})
+        extra = {} if load is None else {"load": load}
+        return _dataset(axes, values, "ECoF map of the compliant wear-scar model", extra)
 
     if not cache:
         return compute()
@@ -456,4 +458,4 @@ def compute_loops(stiffness, aspect_ratio, amplitude, load, mu, num=201) -> xr.D
     values["force"] = force
     values = {name: np.asarray(value) for name, value in values.items()}
     point = np.arange(2 * num + 1)
-    return _dataset(axes, values, "Steady fretting loops", extra_dims={"point": point})
+    return _dataset(axes, values, "Steady fretting loops", extra={"point": point})

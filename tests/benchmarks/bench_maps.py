@@ -1,0 +1,224 @@
+"""Speed benchmarks of ecofmaps, run as a script (pytest does not collect this file).
+
+    python tests/benchmarks/bench_maps.py            # every section, full sizes
+    python tests/benchmarks/bench_maps.py --quick    # small sizes, a few seconds
+    python tests/benchmarks/bench_maps.py --only maps
+
+Each section is a function ``section(quick: bool) -> None`` that prints its own table; add
+yours to ``SECTIONS`` (name -> function). Times are the best of several repeats, with the
+machine's load average printed alongside: on a shared machine it matters.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import resource
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # tests/, for brute_force
+
+from brute_force import steady_loop
+
+from ecofmaps.maps import compute_map
+
+
+def timed(function) -> tuple[float, float]:
+    """Wall time and CPU time (user + system, all threads) of one call of ``function()``. [s]"""
+    before = resource.getrusage(resource.RUSAGE_SELF)
+    start = time.perf_counter()
+    function()
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_SELF)
+    cpu = after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
+    return wall, cpu
+
+
+def load_average() -> str:
+    return "load average {:.1f} {:.1f} {:.1f} on {} cores".format(*os.getloadavg(), os.cpu_count())
+
+
+# ---------------------------------------------------------------------------------------
+# maps: compute_map against plain NumPy and per-point SciPy
+# ---------------------------------------------------------------------------------------
+
+LOAD = 450.0  # [N]
+MU = 0.8
+AMPLITUDE = np.array([25e-6, 50e-6])  # [m], Figure 11
+
+
+def figure_11_grid(points: int) -> dict:
+    """A Figure 11-like grid of about ``points`` points: S/P x z_o/x_o x two amplitudes."""
+    rows = round(math.sqrt(points / 2.0 / 0.8))
+    columns = round(points / 2.0 / rows)
+    return dict(
+        stiffness_ratio=np.geomspace(1e4, 3e5, rows),  # [1/m]
+        aspect_ratio=np.linspace(0.0, 0.4, columns),
+        amplitude=AMPLITUDE,
+        mu=MU,
+        load=LOAD,
+    )
+
+
+# Coefficients 1/(2n+1), n = 28..1, of artanh(u)/u - 1 = sum u^(2n)/(2n+1) for |u| < 1/2.
+_SERIES = tuple(1.0 / (2 * n + 1) for n in range(28, 0, -1))
+
+
+def numpy_map(stiffness_ratio, aspect_ratio, amplitude, mu, load) -> dict:
+    """The closed forms of compute_map in plain vectorised NumPy (float64), no JAX.
+
+    Eq. 16 (slip ratio d, cancellation-free quadratic root), the corrected eq. 13-15
+    (mu_E/mu with a series for artanh(u)/u - 1 at small u), eq. 12 and eq. 9.
+    """
+    s = stiffness_ratio[:, None, None]
+    a = amplitude[None, None, :]
+    kappa = 2.0 * aspect_ratio[None, :, None]  # x_o = amplitude
+    lam = 1.0 / (s * a)  # P/(S amplitude)
+    mu_kappa = mu * kappa
+    h = mu_kappa + lam * kappa - 1.0
+    root = np.sqrt(h * h + 4.0 * lam * kappa * (1.0 + mu * mu))
+    d = 2.0 * (1.0 - lam * mu) / (h + 2.0 + root)
+    stick = mu * lam >= 1.0
+    locked = (lam == 0.0) & (mu_kappa >= 1.0)
+    regime = np.where(stick, 1, np.where(locked, 2, 0)).astype(np.int32)
+    d = np.where(stick, 0.0, np.where(locked, np.nan, d))
+    u = mu_kappa * d
+    excess = np.empty_like(u)
+    small = np.abs(u) < 0.5
+    u2 = u[small] ** 2
+    series = np.zeros_like(u2)
+    for coefficient in _SERIES:
+        series = (series + coefficient) * u2
+    excess[small] = series
+    large = u[~small]
+    excess[~small] = np.arctanh(large) / large - 1.0
+    ratio = np.where(d > 0.0, 1.0 + (1.0 + mu * mu) / (mu * mu) * excess, np.nan)
+    slope = kappa * d
+    peak = np.where(stick, 1.0 / lam, (mu + slope) / (1.0 - mu * slope))
+    return {
+        "slip_amplitude": a * d,
+        "slip_ratio": d,
+        "ecof": mu * ratio,
+        "ecof_ratio": ratio,
+        "compliance_ratio": np.broadcast_to(lam, d.shape),
+        "regime": regime,
+        "dissipated_energy": np.where(stick, 0.0, 4.0 * load * a * d * mu * ratio),
+        "max_force": load * peak,
+    }
+
+
+def max_relative_difference(a, b) -> float:
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    if not np.array_equal(np.isnan(a), np.isnan(b)):
+        return math.inf
+    ok = ~np.isnan(a) & (a != 0.0)
+    return float(np.max(np.abs(a[ok] - b[ok]) / np.abs(a[ok]), initial=0.0))
+
+
+def scipy_points(grid: dict, count: int, seed: int = 0) -> list[tuple[dict, dict]]:
+    """``count`` random grid indices (i, j, k) with the brentq + quad results there."""
+    rng = np.random.default_rng(seed)
+    results = []
+    for _ in range(count):
+        index = dict(
+            stiffness_ratio=int(rng.integers(grid["stiffness_ratio"].size)),
+            aspect_ratio=int(rng.integers(grid["aspect_ratio"].size)),
+            amplitude=int(rng.integers(grid["amplitude"].size)),
+        )
+        reference = steady_loop(
+            amplitude=float(grid["amplitude"][index["amplitude"]]),
+            load=LOAD,
+            stiffness=float(grid["stiffness_ratio"][index["stiffness_ratio"]]) * LOAD,
+            mu=MU,
+            aspect_ratio=float(grid["aspect_ratio"][index["aspect_ratio"]]),
+        )
+        results.append((index, reference))
+    return results
+
+
+def maps(quick: bool) -> None:
+    """Points per second of compute_map (cache off), NumPy and SciPy, and their ratios.
+
+    JAX and NumPy run alternately, ``repeats`` times each, and the best wall and CPU times
+    are kept, so both see the same machine load. "compile" is the first call's extra time.
+    """
+    sizes = [10**4, 10**5] if quick else [10**4, 10**5, 10**6, 10**7]
+    repeats = 2 if quick else 5
+    print(f"compute_map (cache off, jit, float64) vs plain NumPy; {load_average()}")
+    print(
+        f"{'points':>9} {'grid':>12} {'compile':>8} {'JAX':>9} {'NumPy':>9} "
+        f"{'JAX/NumPy':>9} {'JAX/NumPy':>9} {'max rel':>8}"
+    )
+    print(
+        f"{'':>9} {'':>12} {'[s]':>8} {'[pt/s]':>9} {'[pt/s]':>9} {'wall':>9} {'CPU':>9} "
+        f"{'diff':>8}"
+    )
+    jax_speed = {}
+    for size in sizes:
+        grid = figure_11_grid(size)
+        axes = [grid[k] for k in ("stiffness_ratio", "aspect_ratio", "amplitude")]
+        points = math.prod(a.size for a in axes)
+        first, _ = timed(lambda g=grid: compute_map(**g, cache=False))  # compiles
+        jax_wall = jax_cpu = numpy_wall = numpy_cpu = math.inf
+        for _ in range(repeats):
+            wall, cpu = timed(lambda g=grid: compute_map(**g, cache=False))
+            jax_wall, jax_cpu = min(jax_wall, wall), min(jax_cpu, cpu)
+            wall, cpu = timed(lambda a=axes: numpy_map(*a, MU, LOAD))
+            numpy_wall, numpy_cpu = min(numpy_wall, wall), min(numpy_cpu, cpu)
+        result = compute_map(**grid, cache=False)
+        reference = numpy_map(*axes, MU, LOAD)
+        difference = max(max_relative_difference(result[n], reference[n]) for n in reference)
+        del result, reference
+        jax_speed[size] = points / jax_wall
+        shape = "x".join(str(a.size) for a in axes)
+        print(
+            f"{points:9.2e} {shape:>12} {first - jax_wall:8.2f} {points / jax_wall:9.3g} "
+            f"{points / numpy_wall:9.3g} {numpy_wall / jax_wall:9.1f} {numpy_cpu / jax_cpu:9.1f} "
+            f"{difference:8.1e}"
+        )
+    grid = figure_11_grid(10**4)
+    count = 20 if quick else 200
+    start = time.perf_counter()
+    samples = scipy_points(grid, count)
+    scipy_speed = count / (time.perf_counter() - start)
+    result = compute_map(**grid, cache=False)
+    difference = 0.0
+    for index, reference in samples:
+        value = result.isel(index)
+        for name, expected in reference.items():
+            difference = max(difference, max_relative_difference(value[name], expected))
+    largest = max(sizes)
+    print(
+        f"SciPy per point (brentq on eq. 16 + quad of eq. 12), {count} points: "
+        f"{scipy_speed:.3g} pt/s; JAX/SciPy at {largest:.0e} points: "
+        f"{jax_speed[largest] / scipy_speed:.3g}; max rel diff {difference:.1e}"
+    )
+
+
+# ---------------------------------------------------------------------------------------
+
+#: The benchmark sections, run in this order; append yours.
+SECTIONS = {
+    "maps": maps,
+}
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="small sizes, a few seconds")
+    parser.add_argument("--only", nargs="+", choices=list(SECTIONS), help="run only these")
+    args = parser.parse_args(argv)
+    for name in args.only or SECTIONS:
+        print(f"== {name} ==")
+        SECTIONS[name](args.quick)
+        print()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

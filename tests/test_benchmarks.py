@@ -1,0 +1,31 @@
+"""The benchmark script runs (``--quick``), so it cannot rot; it measures nothing here."""
+
+import importlib.util
+import re
+from pathlib import Path
+
+BENCH = Path(__file__).parent / "benchmarks" / "bench_maps.py"
+
+
+def load_bench():
+    spec = importlib.util.spec_from_file_location("bench_maps", BENCH)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_quick_run_prints_every_section(capsys):
+    """Every section runs; the maps section's NumPy and SciPy agree with compute_map."""
+    bench = load_bench()
+    assert bench.main(["--quick"]) == 0
+    out = capsys.readouterr().out
+    for name in bench.SECTIONS:
+        assert f"== {name} ==" in out
+    maps = out.split("== maps ==")[1].split("\n== ")[0]
+    rows = [line.split() for line in maps.splitlines() if re.match(r"\s*\d\.\d+e\+0\d\s", line)]
+    assert len(rows) == 2  # 1e4 and 1e5 points in quick mode
+    for row in rows:
+        assert float(row[-1]) < 1e-12  # max relative difference, NumPy vs JAX
+        assert float(row[3]) > 0 and float(row[4]) > 0  # points per second
+    scipy = re.search(r"SciPy per point .* max rel diff (\S+)", maps)
+    assert scipy and float(scipy.group(1)) < 1e-10  # brentq + quad vs JAX
