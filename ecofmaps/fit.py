@@ -19,6 +19,8 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ecofmaps._inputs import check, float64
+from ecofmaps.analysis import analyze_loops
+from ecofmaps.cycles import labelled_cycles, split_cycles
 from ecofmaps.loop import fretting_loop
 from ecofmaps.model import slip_position, traction_ratio
 
@@ -27,16 +29,18 @@ __all__ = ["LoopFit", "fit_loop"]
 #: Fewest samples accepted for one loop: six parameters, two branches, stick and slip.
 MIN_SAMPLES = 20
 
-# Share of the force swing after a reversal read as the stick segment for the starting
-# stiffness; the stick segment covers more than half of it unless the groove is so deep
-# that Q* > 1.7 P.
-_STICK_SHARE = 0.4
+# Force window after each reversal where analyze_loops starts the stick segment (it then
+# grows it along the stick line): narrower than its default, so that it holds only stick
+# also when the groove slope at the reversal exceeds mu and the stick is short.
+_STICK_WINDOW = (0.0, 0.15)
 # Contact positions within this share of the slip amplitude are read as slipping for the
 # starting mu and groove slope.
 _SLIP_SHARE = 0.6
 # A loop whose area is negative by more than this share of its bounding box runs
 # anticlockwise; a smaller negative area is noise on a loop without gross slip.
 _ORIENTATION_SHARE = 0.05
+# Samples are padded to a multiple of this for the compiled residual.
+_BUCKET = 64
 _TOLERANCE = 1e-12
 _MAX_EVALUATIONS = 200
 
@@ -75,11 +79,14 @@ class LoopFit:
     message : str
         How the least squares ended.
     displacement, force : numpy.ndarray
-        The measured samples fitted (one cycle). [m], [N]
+        The measured samples fitted: one cycle, from its lowest displacement on. [m], [N]
     model_force : numpy.ndarray
         The fitted model's force at each sample, on that sample's branch. [N]
     rising : numpy.ndarray of bool
         True for samples on the rising-displacement branch.
+    cycle : int
+        Number of the cycle fitted: the recorded one, or 1, 2, ... over the complete
+        cycles found at the reversals (as in :func:`ecofmaps.analyze_loops`). [1]
     """
 
     mu: float
@@ -99,6 +106,7 @@ class LoopFit:
     force: np.ndarray
     model_force: np.ndarray
     rising: np.ndarray
+    cycle: int
 
     def model_loop(self, num=201):
         """The fitted steady loop, offsets included, for plotting.
@@ -146,61 +154,36 @@ def _model_force(parameters, displacement, rising):
     return jnp.where(rising, up, down) + offset
 
 
-def _residual(parameters, displacement, force, rising):
-    return _model_force(parameters, displacement, rising) - force
+def _residual(parameters, displacement, force, rising, weight):
+    return weight * (_model_force(parameters, displacement, rising) - force)
 
 
 _residual_jit = jax.jit(_residual)
 _jacobian_jit = jax.jit(jax.jacfwd(_residual))
 
 
-def _branches(displacement):
-    """True for samples on the rising branch of one cycle (reversals at the extremes)."""
-    low, high = int(np.argmin(displacement)), int(np.argmax(displacement))
-    index = np.arange(displacement.size)
-    if low < high:
-        return (index >= low) & (index <= high)
-    return (index >= low) | (index <= high)
+def _starting_values(x, y, rising, stiffness, slip_half_width, energy_ratio):
+    r"""Scaled starting parameters (:math:`\Delta/L`, :math:`Q/P`, centred) from the loop.
 
-
-def _starting_values(x, y, rising):
-    r"""Scaled starting parameters from the loop itself (centred, :math:`\Delta/L`, Q/P).
-
-    The stick segments after the reversals give :math:`S` (their slope) and :math:`\delta^*`
-    (their offset); the contact position :math:`x = \Delta - Q/S` (eq. 10) on the slip
-    segments gives :math:`\mu` and the groove slope from :math:`Q_\pm/P \approx \pm\mu +
-    k(1 + \mu^2) x` (eq. 9 to first order in :math:`x`).
+    ``stiffness`` (:math:`SL/P`), ``slip_half_width`` (:math:`\delta^*/L`) and
+    ``energy_ratio`` come from :func:`ecofmaps.analyze_loops`. The contact position
+    :math:`x = \Delta - Q/S` (eq. 10) on the slip segments gives :math:`\mu` and the
+    groove slope :math:`k` by least squares on :math:`Q_\pm/P \approx \pm\mu + k(1 +
+    \mu^2) x` (eq. 9 to first order in :math:`x`; at :math:`x = 0` this is the GICoF).
     """
-    low, high = y.min(), y.max()
-    swing = high - low
-    # ∮ Q dΔ over the closed loop is the dissipated energy, > 0 clockwise (eq. 12)
-    energy = np.trapezoid(np.append(y, y[0]), np.append(x, x[0]))
-    if energy < -_ORIENTATION_SHARE * swing * (x.max() - x.min()):
+    if energy_ratio < -_ORIENTATION_SHARE:
         raise ValueError(
             "the loop runs anticlockwise (its area ∮Q dΔ is negative): force and "
             "displacement must be positive in the same direction"
         )
-    stick_up = rising & (y < low + _STICK_SHARE * swing)
-    stick_down = ~rising & (y > high - _STICK_SHARE * swing)
-    if min(np.count_nonzero(stick_up), np.count_nonzero(stick_down)) < 2:
+    slipping = np.zeros_like(rising)
+    if stiffness > 0 and slip_half_width > 0:
+        contact = x - y / stiffness
+        slipping = np.abs(contact) < _SLIP_SHARE * slip_half_width
+    if min(np.count_nonzero(slipping & rising), np.count_nonzero(slipping & ~rising)) < 2:
         raise ValueError(
-            "too few samples on the stick segments after the reversals to read the rig "
-            "stiffness; give at least a few samples between each reversal and slip"
-        )
-    stick = stick_up | stick_down
-    design = np.stack([x[stick], stick_up[stick], stick_down[stick]], axis=1).astype(float)
-    (s, up, down), *_ = np.linalg.lstsq(design, y[stick], rcond=None)
-    slip_half_width = (up - down) / (2.0 * s) if s > 0 else 0.0
-    contact = x - y / s if s > 0 else x
-    slipping = np.abs(contact) < _SLIP_SHARE * slip_half_width
-    if (
-        s <= 0
-        or slip_half_width <= 0
-        or min(np.count_nonzero(slipping & rising), np.count_nonzero(slipping & ~rising)) < 2
-    ):
-        raise ValueError(
-            "the loop shows no gross slip (it has no slip segment between the stick "
-            "segments), so mu and the groove depth cannot be fitted"
+            "the loop shows no gross slip (no slip segment between the stick segments, or "
+            "too few samples on it), so mu and the groove depth cannot be fitted"
         )
     sign = np.where(rising, 1.0, -1.0)
     design = np.stack([sign[slipping], contact[slipping]], axis=1)
@@ -208,84 +191,153 @@ def _starting_values(x, y, rising):
     if mu <= 0:
         raise ValueError("the loop's slip segments give mu <= 0: it is not a fretting loop")
     groove_slope = max(slope, 0.0) / (1.0 + mu * mu)
-    return np.array([mu, s, groove_slope / 2.0, 1.0, 0.0, 0.0])
+    return np.array([mu, stiffness, groove_slope / 2.0, 1.0, 0.0, 0.0])
+
+
+def _select_cycle(x, cycle, cycle_number, hysteresis):
+    """Sample indices of one complete cycle (lowest displacement first, closed), its number."""
+    if cycle is None:
+        cycles = split_cycles(x, hysteresis)
+    else:
+        labels = np.asarray(cycle, dtype=np.float64)
+        check("cycle", labels, "finite")
+        if labels.shape != x.shape:
+            raise ValueError(
+                f"cycle must have one value per sample: {labels.size} values for {x.size} samples"
+            )
+        cycles = labelled_cycles(x, labels)
+    if cycles.label.size == 0:
+        raise ValueError(
+            f"no complete cycle in {x.size} samples: too few samples for one cycle, or the "
+            "loop does not close"
+        )
+    row = -1
+    if cycle_number is not None:
+        (rows,) = np.nonzero(cycles.label == cycle_number)
+        if rows.size == 0:
+            raise ValueError(
+                f"cycle_number {cycle_number!r} is not a complete cycle of the recording; "
+                f"complete cycles are numbered {cycles.label[0]} to {cycles.label[-1]}"
+            )
+        row = rows[0]
+    return cycles.samples[row][cycles.valid[row]], int(cycles.label[row])
 
 
 @float64
-def fit_loop(displacement, force, load):
-    r"""Fit the model's steady loop to one measured fretting loop (the paper's Figure 10).
+def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hysteresis=0.5):
+    r"""Fit the model's steady loop to a measured fretting loop (the paper's Figure 10).
 
     Parameters
     ----------
     displacement : array_like
-        Actuator displacement :math:`\Delta_i` of one cycle, in time order: the samples
-        between (and including) two successive maxima, or any stretch of exactly one
-        period. [m]
+        Applied displacement :math:`\Delta` at each sample, in time order: a single loop
+        (about one period, starting anywhere on it) or a recording of many cycles. [m]
     force : array_like
-        Tangential force :math:`Q_i` at the same instants, positive in the direction of
-        positive displacement. [N]
+        Tangential force :math:`Q` at each sample, positive in the direction of positive
+        displacement. [N]
     load : float
         Normal load :math:`P`. [N]
+    cycle : array_like, optional
+        Cycle number of each sample, as for :func:`ecofmaps.analyze_loops`; without it
+        the recording is cut at its displacement reversals, or read as a single loop. [1]
+    cycle_number : int, optional
+        The cycle to fit, a value of the ``cycle`` coordinate of
+        :func:`ecofmaps.analyze_loops`'s result; default the last complete cycle. [1]
+    hysteresis : float
+        Band of the reversal detector, as a share of the displacement's half-range
+        (0 < hysteresis < 1); see :mod:`ecofmaps.cycles`. [1]
 
     Returns
     -------
     fit : LoopFit
         The fitted :math:`\mu`, :math:`S`, :math:`z_o`, :math:`\Delta^*` (= :math:`x_o`),
-        the loop's centre, the residual and convergence information.
+        the loop's centre, the residual, convergence information and the samples fitted.
 
     Raises
     ------
     ValueError
-        If ``load`` is not positive and finite, the arrays are not one-dimensional of the
-        same length with at least :data:`MIN_SAMPLES` finite samples, the displacement does
-        not vary, or the loop shows no gross slip or runs anticlockwise.
+        If ``load`` is not a positive finite number; the arrays are not one-dimensional of
+        one length, or hold NaN or infinity; the recording has no complete cycle, or none
+        numbered ``cycle_number``; the cycle has fewer than :data:`MIN_SAMPLES` samples;
+        or the loop shows no gross slip or runs anticlockwise.
 
     Notes
     -----
-    Each sample is on the rising branch (between the minimum and the maximum of
-    :math:`\Delta`) or the falling one. On the rising branch of the steady loop the contact
-    sticks at :math:`x = -\delta^*` after the reversal, :math:`Q = S(\Delta + \delta^*)`,
-    then slips forward with :math:`Q = Q_+(x)`, :math:`x + Q_+(x)/S = \Delta` (eq. 9, 10,
-    16); the falling branch is its image under :math:`(\Delta, Q) \to (-\Delta, -Q)`. The
-    loop may be shifted by an offset in displacement and in force, fitted with the rest.
-    Six parameters are fitted, in scaled form (:math:`\mu`, :math:`SL/P`, :math:`z_o/L`,
-    :math:`\Delta^*/L` and the offsets in units of :math:`L` and :math:`P`, with :math:`L`
-    half the measured peak-to-peak displacement), by ``scipy.optimize.least_squares``
-    (trust region reflective, bounds :math:`\mu > 0`, :math:`S > 0`, :math:`z_o \ge 0`)
-    with the Jacobian from ``jax.jacfwd``. Starting values come from the loop itself
-    (stick slopes, and :math:`Q/P` against the contact position on the slip segments).
-    The paper sets :math:`\mu` to the loop's GICoF and reads :math:`S` off the loop (Section
-    4.2, Figure 10); for the model loop both equal the fitted values.
+    The cycle runs from its lowest displacement to its highest (the rising branch) and
+    back (the falling branch). On the rising branch of the steady loop the contact sticks
+    at :math:`x = -\delta^*` after the reversal, :math:`Q = S(\Delta + \delta^*)`, until it
+    slips forward with :math:`Q = Q_+(x)` and :math:`x + Q_+(x)/S = \Delta` (eq. 9, 10,
+    16); the falling branch is its image under :math:`(\Delta, Q) \to (-\Delta, -Q)`. So
+    each sample has a model force in closed form, at its own displacement on its own
+    branch, whatever the sampling or the waveform.
+
+    Six parameters are fitted: :math:`\mu`, :math:`S`, :math:`z_o`, :math:`\Delta^*` (which
+    sets the reversals, and :math:`x_o = \Delta^*` as in the paper) and the loop's centre
+    in displacement and in force (sensor offsets). They are scaled by :math:`P` and by
+    :math:`L`, half the cycle's peak-to-peak displacement, and found by
+    ``scipy.optimize.least_squares`` (trust region reflective, bounds :math:`\mu > 0`,
+    :math:`S > 0`, :math:`z_o \ge 0`, :math:`\Delta^* > 0`) with the Jacobian from
+    ``jax.jacfwd``. The starting point is the loop's own analysis
+    (:func:`ecofmaps.analyze_loops`: centre, amplitude, stick stiffness, slip amplitude)
+    and a straight-line fit of :math:`Q/P` against the contact position
+    :math:`\Delta - Q/S` on the slip segments for :math:`\mu` and the groove slope.
+    The paper sets :math:`\mu` to the loop's GICoF and reads :math:`S` off the loop
+    (Section 4.2, Figure 10); for a loop of the model both equal the fitted values.
     """
     check("load", load, "positive", "N")
     if np.ndim(load) != 0:
         raise ValueError(f"load must be a single number [N], got shape {np.shape(load)}")
+    if not 0.0 < hysteresis < 1.0:
+        raise ValueError(f"hysteresis must satisfy 0 < hysteresis < 1; got {hysteresis!r}")
     load = float(load)
-    x = np.asarray(displacement, dtype=np.float64)
-    y = np.asarray(force, dtype=np.float64)
-    for name, values in (("displacement", x), ("force", y)):
+    all_x = np.asarray(displacement, dtype=np.float64)
+    all_y = np.asarray(force, dtype=np.float64)
+    for name, values in (("displacement", all_x), ("force", all_y)):
         if values.ndim != 1:
             raise ValueError(f"{name} must be one-dimensional, got shape {values.shape}")
-    if x.size != y.size:
+    if all_x.size != all_y.size:
         raise ValueError(
-            f"displacement and force must have the same length, got {x.size} and {y.size}"
+            f"displacement and force must have the same length, got {all_x.size} and {all_y.size}"
         )
-    if x.size < MIN_SAMPLES:
-        raise ValueError(f"a loop needs at least {MIN_SAMPLES} samples, got {x.size}")
-    check("displacement", x, "finite", "m")
-    check("force", y, "finite", "N")
-    length = (x.max() - x.min()) / 2.0
-    if not length > 0:
+    check("displacement", all_x, "finite", "m")
+    check("force", all_y, "finite", "N")
+    if all_x.size < MIN_SAMPLES:
+        raise ValueError(f"a loop needs at least {MIN_SAMPLES} samples, got {all_x.size}")
+    if not np.ptp(all_x) > 0:
         raise ValueError("displacement does not vary: a loop needs a displacement stroke")
 
-    rising = _branches(x)
-    centre = (x.max() + x.min()) / 2.0
-    offset = (y.max() + y.min()) / 2.0
+    index, number = _select_cycle(all_x, cycle, cycle_number, hysteresis)
+    analysis = analyze_loops(all_x[index], all_y[index], load, stick_window=_STICK_WINDOW).isel(
+        cycle=0
+    )
+    # The last point closes the loop (it is the first point of the next cycle, or the
+    # first point again): fit each sample once.
+    x, y = all_x[index[:-1]], all_y[index[:-1]]
+    if x.size < MIN_SAMPLES:
+        raise ValueError(f"a loop needs at least {MIN_SAMPLES} samples, got {x.size}")
+    rising = np.arange(x.size) <= np.argmax(x)
+    length = float(analysis.amplitude)
+    centre = float(analysis.displacement_offset)
+    offset = float(analysis.force_offset)
     scaled_x = (x - centre) / length
     scaled_y = (y - offset) / load
-    start = _starting_values(scaled_x, scaled_y, rising)
+    start = _starting_values(
+        scaled_x,
+        scaled_y,
+        rising,
+        stiffness=float(analysis.stiffness) * length / load,
+        slip_half_width=float(analysis.slip_amplitude) / length,
+        energy_ratio=float(analysis.energy_ratio),
+    )
 
-    arguments = (jnp.asarray(scaled_x), jnp.asarray(scaled_y), jnp.asarray(rising))
+    # Padded with zero-weight samples to a multiple of _BUCKET, so that loops of nearly the
+    # same length share one compiled residual and Jacobian.
+    size = _BUCKET * -(-x.size // _BUCKET)
+    pad = size - x.size
+    arguments = tuple(
+        jnp.asarray(np.pad(values, (0, pad)))
+        for values in (scaled_x, scaled_y, rising, np.ones(x.size))
+    )
     tiny = np.finfo(np.float64).tiny
     solution = least_squares(
         lambda p: np.asarray(_residual_jit(jnp.asarray(p), *arguments)),
@@ -300,7 +352,7 @@ def fit_loop(displacement, force, load):
         max_nfev=_MAX_EVALUATIONS,
     )
     mu, s, a, amplitude, shift, force_shift = (float(v) for v in solution.x)
-    model_force = y + load * solution.fun
+    model_force = y + load * solution.fun[: x.size]
     residual = y - model_force
     gross_slip = mu / (s * amplitude) < 1.0
     message = solution.message
@@ -324,4 +376,5 @@ def fit_loop(displacement, force, load):
         force=y,
         model_force=model_force,
         rising=rising,
+        cycle=number,
     )
