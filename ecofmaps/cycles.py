@@ -99,19 +99,37 @@ class Cycles:
         """
         x = np.where(self.valid, displacement[self.samples], np.nan)
         q = np.where(self.valid, force[self.samples], np.nan)
-        segment = self.valid[:, 1:]
-        weight = np.where(segment, np.abs(np.diff(x, axis=1)), 0.0)
-        total = weight.sum(axis=1)
-        centre_x = masked_sum(weight * 0.5 * (x[:, 1:] + x[:, :-1]), segment) / total
-        centre_q = masked_sum(weight * 0.5 * (q[:, 1:] + q[:, :-1]), segment) / total
-        if not self.continuous:
-            return x - centre_x[:, None], q - centre_q[:, None], centre_x, centre_q
         points = np.count_nonzero(self.valid, axis=1)
         middle = masked_sum(self.samples.astype(np.float64), self.valid) / points
-        index = np.arange(displacement.size, dtype=np.float64)
-        drift_x = np.interp(index, middle, centre_x)[self.samples]
-        drift_q = np.interp(index, middle, centre_q)[self.samples]
-        return x - drift_x, q - drift_q, centre_x, centre_q
+        at = self.samples.astype(np.float64)
+        segments = self.valid[:, 1:].copy()
+        if self.continuous:  # the segment closing the loop is no part of the path
+            segments[np.arange(points.size), points - 2] = False
+
+        def centred(values, path):
+            """``values`` less their mean weighted by the displacement travelled on ``path``."""
+            weight = np.where(segments, np.abs(np.diff(path, axis=1)), 0.0)
+            middles = 0.5 * (values[:, 1:] + values[:, :-1])
+            centre = masked_sum(weight * middles, segments) / weight.sum(axis=1)
+            if self.continuous:
+                return values - _interpolate(at, middle, centre), centre
+            return values - centre[:, None], centre
+
+        x, centre_x = centred(x, x)
+        # The force's weights come from the displacement without its drift, so that a drift
+        # does not weigh one branch more than the other.
+        q, centre_q = centred(q, x)
+        return x, q, centre_x, centre_q
+
+
+def _interpolate(at, points, values):
+    """Piecewise-linear interpolation, extended linearly beyond the first and last points."""
+    inside = np.interp(at, points, values)
+    if points.size < 2:
+        return inside
+    first = values[0] + (at - points[0]) * (values[1] - values[0]) / (points[1] - points[0])
+    last = values[-1] + (at - points[-1]) * (values[-1] - values[-2]) / (points[-1] - points[-2])
+    return np.where(at < points[0], first, np.where(at > points[-1], last, inside))
 
 
 def masked_sum(values, mask):
