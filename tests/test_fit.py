@@ -311,3 +311,36 @@ def test_result_is_float64_and_model_loop_matches_fretting_loop(loop):
     np.testing.assert_allclose(force, expected[1], rtol=0, atol=1e-9 * LOAD)
     with pytest.raises(AttributeError):
         fit.mu = 1.0
+
+
+# --- the figure (the paper's Figure 10) -----------------------------------------------------
+
+
+def test_figure_overlays_measured_and_fitted_loops():
+    from ecofmaps.figures import measured_and_fitted_loops
+
+    fits = {}
+    for seed, (name, parameters) in enumerate(FIGURE_10.items()):
+        fits[name] = fit_loop(*noisy(*measured_loop(**parameters), seed), LOAD)
+    figure = measured_and_fitted_loops(fits)
+    panels = [ax for ax in figure.axes if ax.get_xlabel()]
+    assert len(panels) == 2
+    for ax, letter, (name, fit) in zip(panels, "ab", fits.items(), strict=True):
+        assert ax.get_xlabel() == "Applied displacement $\\Delta$ [µm]"
+        assert ax.get_ylabel() == "Tangential force $Q$ [N]"
+        assert ax.get_title().startswith(f"({letter}) {name}: P = 450 N")
+        assert f"$\\mu$ = {fit.mu:.3f}" in ax.get_title()
+        assert [text.get_text() for text in ax.get_legend().get_texts()] == [
+            "measured",
+            "fitted model",
+        ]
+        labelled = {line.get_label(): line for line in ax.get_lines()}
+        measured, model = labelled["measured"], labelled["fitted model"]
+        np.testing.assert_array_equal(measured.get_xdata(), fit.displacement * 1e6)
+        np.testing.assert_array_equal(measured.get_ydata(), fit.force)
+        assert measured.get_linestyle() == "None"
+        loop_displacement, loop_force = fit.model_loop()
+        np.testing.assert_allclose(model.get_xdata(), loop_displacement * 1e6, rtol=1e-15)
+        np.testing.assert_allclose(model.get_ydata(), loop_force, rtol=1e-15)
+    single = measured_and_fitted_loops(fits["Example 2"])
+    assert len([ax for ax in single.axes if ax.get_xlabel()]) == 1
