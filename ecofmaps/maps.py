@@ -167,6 +167,8 @@ def _evaluate_grid(kernel, axes, extra, max_chunk: int) -> dict[str, np.ndarray]
 def _dataset(axes: dict, values: dict, title: str, extra=None) -> xr.Dataset:
     """A Dataset of grid ``values`` over ``axes`` (scalars become scalar coordinates).
 
+    A value is an array over the whole grid (with a length-1 axis for each scalar
+    coordinate), or a ``(dims, array)`` pair for one that depends on fewer parameters.
     ``extra`` coordinates are not grid axes: 0-d ones are scalar coordinates, 1-D ones
     trailing dimensions of the values that have more axes than the grid.
     """
@@ -180,6 +182,9 @@ def _dataset(axes: dict, values: dict, title: str, extra=None) -> xr.Dataset:
     }
     data_vars = {}
     for name in sorted(values, key=list(_ATTRS).index):
+        if isinstance(values[name], tuple):
+            data_vars[name] = (*values[name], _attrs(name))
+            continue
         value = np.squeeze(values[name], axis=squeeze)
         data_vars[name] = (dims + trailing[: value.ndim - len(dims)], value, _attrs(name))
     return xr.Dataset(data_vars, coords=coords, attrs=_global_attrs(title))
@@ -218,7 +223,6 @@ def _map_kernel(stiffness_ratio, aspect_ratio, amplitude, mu, load):
     kappa = model.curvature_number(1.0, aspect_ratio, 1.0)  # x_o = Δ*: κ = 2 z_o/x_o
     lam = model.compliance_ratio(amplitude, 1.0, stiffness_ratio)  # 1/((S/P) Δ*)
     values = _steady_state(mu, kappa, lam, amplitude, load)
-    values["compliance_ratio"] = lam
     shape = jnp.broadcast_shapes(stiffness_ratio.shape, aspect_ratio.shape, amplitude.shape)
     return _broadcast(values, jnp.broadcast_shapes(shape, mu.shape))
 
@@ -276,10 +280,11 @@ def compute_map(
         Dimensions ``stiffness_ratio``, ``aspect_ratio``, ``amplitude``, ``mu`` (in this
         order; only those given as arrays, the others are scalar coordinates). Variables:
         ``slip_amplitude`` [m], ``slip_ratio`` [1], ``ecof`` [1], ``ecof_ratio`` [1],
-        ``compliance_ratio`` [1], ``regime`` (:class:`ecofmaps.Regime` codes, int32) and,
-        with a load, ``dissipated_energy`` [J] and ``max_force`` [N]. Every variable and
-        coordinate has ``long_name`` and ``units``. ECoF values are NaN where there is no
-        gross slip; every value is NaN when self-locking (rigid rig, :math:`\mu\kappa \ge 1`).
+        ``regime`` (:class:`ecofmaps.Regime` codes, int32), ``compliance_ratio`` [1] (over
+        ``stiffness_ratio`` and ``amplitude`` only) and, with a load, ``dissipated_energy``
+        [J] and ``max_force`` [N]. Every variable and coordinate has ``long_name`` and
+        ``units``. ECoF values are NaN where there is no gross slip; every value but the
+        regime is NaN when self-locking (rigid rig, :math:`\mu\kappa \ge 1`).
 
     Raises
     ------
@@ -323,6 +328,14 @@ def compute_map(
         values = _evaluate_grid(
             _map_kernel, [np.atleast_1d(a) for a in axes.values()], (load,), max_chunk
         )
+        # λ depends on S/P and Δ* only: a variable over those two (eq. 16).
+        stiffness, amplitude = axes["stiffness_ratio"], axes["amplitude"]
+        lam = model.compliance_ratio(
+            np.atleast_1d(amplitude), 1.0, np.atleast_1d(stiffness)[:, None]
+        )
+        scalars = tuple(i for i, axis in enumerate((stiffness, amplitude)) if axis.ndim == 0)
+        dims = tuple(n for n in ("stiffness_ratio", "amplitude") if axes[n].ndim == 1)
+        values["compliance_ratio"] = (dims, np.squeeze(lam, axis=scalars))
         extra = {} if load is None else {"load": load}
         return _dataset(axes, values, "ECoF map of the compliant wear-scar model", extra)
 

@@ -71,6 +71,7 @@ def test_every_variable_and_coordinate_is_labelled(grid):
 def test_dimensions_and_scalar_coordinates(grid):
     assert grid.ecof_ratio.dims == ("stiffness_ratio", "aspect_ratio", "amplitude", "mu")
     assert grid.regime.dtype == np.int32
+    assert grid.compliance_ratio.dims == ("stiffness_ratio", "amplitude")  # λ = P/(SΔ*)
     assert all(grid[v].dtype == np.float64 for v in grid.data_vars if v != "regime")
     assert set(grid.data_vars) == {*VARIABLES, "dissipated_energy", "max_force"}
     assert float(grid["load"]) == LOAD and grid["load"].dims == ()
@@ -105,7 +106,8 @@ def test_map_equals_the_si_api(grid):
         assert_close(grid[name], values, rtol=1e-12)
     assert_close(grid.slip_ratio, expected["slip_amplitude"] / point["amplitude"], rtol=1e-12)
     assert_close(grid.ecof_ratio, expected["ecof"] / point["mu"], rtol=1e-12)
-    assert_close(grid.compliance_ratio, LOAD / (point["stiffness"] * point["amplitude"]), 1e-15)
+    compliance_ratio = grid.compliance_ratio.broadcast_like(grid.ecof_ratio)
+    assert_close(compliance_ratio, LOAD / (point["stiffness"] * point["amplitude"]), 1e-15)
 
 
 @given(
@@ -166,7 +168,7 @@ def test_maps_collapse_onto_the_compliance_ratio():
     np.testing.assert_array_equal(2.0 * at_25.slip_amplitude.values, at_50.slip_amplitude.values)
     # ... and the universal map holds both at λ = 1/((S/P) Δ*).
     universal = compute_universal_map(
-        at_25.compliance_ratio.values[:, 0], FIG11["aspect_ratio"], 0.8, cache=False
+        at_25.compliance_ratio.values, FIG11["aspect_ratio"], 0.8, cache=False
     )
     for name in ("slip_ratio", "ecof_ratio", "regime"):
         np.testing.assert_array_equal(universal[name].values, at_25[name].values, err_msg=name)

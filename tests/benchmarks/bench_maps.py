@@ -105,7 +105,7 @@ def numpy_map(stiffness_ratio, aspect_ratio, amplitude, mu, load) -> dict:
         "slip_ratio": d,
         "ecof": mu * ratio,
         "ecof_ratio": ratio,
-        "compliance_ratio": np.broadcast_to(lam, d.shape),
+        "compliance_ratio": lam[:, 0, :],  # over S/P and amplitude, as in compute_map
         "regime": regime,
         "dissipated_energy": np.where(stick, 0.0, 4.0 * load * a * d * mu * ratio),
         "max_force": load * peak,
