@@ -72,6 +72,12 @@ class LoopFit:
         Root mean square of measured minus model force over the samples. [N]
     r_squared : float
         Coefficient of determination :math:`1 - \sum r_i^2 / \sum (Q_i - \bar Q)^2`. [1]
+    standard_errors : dict of str to float
+        Standard error of each fitted quantity (keys ``mu``, ``stiffness``,
+        ``groove_depth``, ``aspect_ratio``, ``amplitude``, ``displacement_offset``,
+        ``force_offset``), in its unit, from the Jacobian at the solution and the residual
+        variance (a linearisation that treats the residuals as independent and alike;
+        meaningless for a parameter held at its bound, such as a flat groove).
     success : bool
         True when the least squares converged to a loop in gross slip.
     evaluations : int
@@ -99,6 +105,7 @@ class LoopFit:
     load: float
     rms_residual: float
     r_squared: float
+    standard_errors: dict
     success: bool
     evaluations: int
     message: str
@@ -355,6 +362,22 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
     model_force = y + load * solution.fun[: x.size]
     residual = y - model_force
     gross_slip = mu / (s * amplitude) < 1.0
+    # Linearised standard errors: covariance s^2 (J^T J)^-1 of the scaled parameters, with
+    # s^2 the residual variance, carried to SI units (a ratio by its gradient).
+    jacobian = solution.jac[: x.size]
+    variance = np.sum(solution.fun[: x.size] ** 2) / (x.size - solution.x.size)
+    covariance = variance * np.linalg.pinv(jacobian.T @ jacobian)
+    deviation = np.sqrt(np.diag(covariance))
+    ratio_gradient = np.array([0.0, 0.0, 1.0 / amplitude, -a / amplitude**2, 0.0, 0.0])
+    standard_errors = {
+        "mu": float(deviation[0]),
+        "stiffness": float(deviation[1] * load / length),
+        "groove_depth": float(deviation[2] * length),
+        "aspect_ratio": float(np.sqrt(ratio_gradient @ covariance @ ratio_gradient)),
+        "amplitude": float(deviation[3] * length),
+        "displacement_offset": float(deviation[4] * length),
+        "force_offset": float(deviation[5] * load),
+    }
     message = solution.message
     if not gross_slip:
         message = f"{message} (but the fitted loop has no gross slip: mu * P / (S Δ*) >= 1)"
@@ -369,6 +392,7 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
         load=load,
         rms_residual=float(np.sqrt(np.mean(residual**2))),
         r_squared=float(1.0 - np.sum(residual**2) / np.sum((y - y.mean()) ** 2)),
+        standard_errors=standard_errors,
         success=bool(solution.success and gross_slip),
         evaluations=int(solution.nfev),
         message=message,
