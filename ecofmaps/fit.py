@@ -63,9 +63,10 @@ class LoopFit:
         Displacement amplitude :math:`\Delta^*` of the fitted loop, which is also the groove
         half-width :math:`x_o`. [m]
     displacement_offset : float
-        Centre of the loop in displacement, subtracted before the fit. [m]
+        Centre of the fitted loop in displacement (a sensor offset), fitted with the
+        rest. [m]
     force_offset : float
-        Centre of the loop in force (a load-cell offset). [N]
+        Centre of the fitted loop in force (a load-cell offset), fitted with the rest. [N]
     load : float
         Normal load :math:`P`, as given. [N]
     rms_residual : float
