@@ -46,7 +46,10 @@ back down the *falling* branch.
   and most of it cancels from their mean.
 * regime: 'gross slip' when the energy ratio :math:`A` exceeds ``gross_slip_threshold``
   (default 0.2, the sliding transition of Fouvry, Kapsa and Vincent), else
-  'partial slip'. ECoF and GICoF describe sliding: they are NaN in partial slip.
+  'partial slip'. ECoF and GICoF describe sliding: they are NaN in partial slip. Like
+  Fouvry's criterion, this also calls partial slip a gross-slip loop that slips over less
+  than about a fifth of the stroke (for the model, :math:`A \approx \delta^*/\Delta^*`
+  times :math:`\mu_E P/Q^*`); lower the threshold to read such loops.
 
 For the model's loop every quantity is exact up to the sampling: :math:`\Delta^*`,
 :math:`Q^*`, :math:`S`, :math:`\delta^*` and the GICoF to rounding when the loop's
@@ -255,7 +258,8 @@ def _line_crossing(x, y, branch, first, sign, stiffness, half_width, load):
     )
     moments = np.stack([masked_sum(p * y, window) for p in regressors], axis=-1)
     normal[~enough] = np.eye(3)
-    intercept = np.linalg.solve(normal, moments[..., None])[:, 0, 0]
+    # The pseudo-inverse: on a flat groove Q is constant and xQ is a multiple of x.
+    intercept = (np.linalg.pinv(normal) @ moments[..., None])[:, 0, 0]
     force = np.where(enough, intercept, stiffness * guess)
     return force / stiffness, force
 
