@@ -39,7 +39,7 @@ def synthetic_recording(
     aspect_ratio,
     groove_half_width=None,
     *,
-    cycles=1,
+    cycles=None,
     samples_per_cycle=200,
     start_phase=0.0,
     displacement_noise=0.0,
@@ -62,8 +62,8 @@ def synthetic_recording(
         Groove depth over half-width :math:`z_o/x_o`, one value or one per cycle. [1]
     groove_half_width : float, optional
         Groove half-width :math:`x_o`; defaults to ``amplitude`` (the paper's choice). [m]
-    cycles : int
-        Number of cycles (taken from ``aspect_ratio`` when it holds one per cycle). [1]
+    cycles : int, optional
+        Number of cycles; by default one per value of ``aspect_ratio``. [1]
     samples_per_cycle : int
         Samples in each cycle (>= 8). [1]
     start_phase : float
@@ -97,9 +97,11 @@ def synthetic_recording(
     ratio = np.atleast_1d(np.asarray(aspect_ratio, dtype=np.float64))
     if ratio.ndim != 1:
         raise ValueError("aspect_ratio must be one value or one per cycle")
-    cycles = ratio.size if ratio.size > 1 else int(cycles)
+    cycles = ratio.size if cycles is None else int(cycles)
     if cycles < 1 or ratio.size not in (1, cycles):
-        raise ValueError(f"cycles must be >= 1 and match aspect_ratio; got {cycles!r}")
+        raise ValueError(
+            f"cycles must be >= 1 and match the {ratio.size} aspect ratios; got {cycles!r}"
+        )
     if int(samples_per_cycle) < 8:
         raise ValueError(f"samples_per_cycle must be >= 8; got {samples_per_cycle!r}")
     if not 0.0 <= sampling_jitter < 0.5:
