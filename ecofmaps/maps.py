@@ -30,8 +30,8 @@ from ecofmaps.loop import fretting_loop
 
 __all__ = ["MAX_CHUNK", "compute_loops", "compute_map", "compute_universal_map"]
 
-#: Default bound on the number of grid points evaluated in one block.
-MAX_CHUNK = 2**20
+#: Default bound on the number of grid points evaluated in one block (results of about 870 MB).
+MAX_CHUNK = 2**24
 
 PAPER = (
     "X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent "
@@ -142,13 +142,18 @@ def _blocks(shape: tuple[int, ...], max_chunk: int):
 def _evaluate_grid(kernel, axes, extra, max_chunk: int) -> dict[str, np.ndarray]:
     """Evaluate ``kernel(*block_axes, *extra)`` over the grid spanned by 1-D ``axes``.
 
-    ``kernel`` is jit-compiled and returns a dict of arrays of the block's full shape. All
-    blocks have one shape (the last one along the split axis is padded by repeating its
-    last value, and the padding is dropped), so the kernel compiles once.
+    ``kernel`` is jit-compiled and returns a dict of arrays of the block's full shape. A
+    grid of at most ``max_chunk`` points is one block, and its arrays are XLA's own buffers,
+    read-only, without a copy (XLA spreads the work over the cores; a copy would not be).
+    Otherwise all blocks have one shape (the last one along the split axis is padded by
+    repeating its last value, and the padding is dropped), so the kernel compiles once, and
+    they are copied into the result arrays.
     """
     if not (isinstance(max_chunk, int) and max_chunk >= 1):
         raise ValueError(f"max_chunk must be an integer >= 1, got {max_chunk!r}")
     shape = tuple(axis.size for axis in axes)
+    if math.prod(shape) <= max_chunk:
+        return jax.device_get(kernel(*axes, *extra))
     results: dict[str, np.ndarray] = {}
     for starts, stops, rows in _blocks(shape, max_chunk):
         k = len(starts) - 1
@@ -272,7 +277,8 @@ def compute_map(
     cache_dir : str or os.PathLike, optional
         Cache directory; default ``$ECOFMAPS_CACHE`` or the per-user cache directory.
     max_chunk : int
-        Largest number of grid points evaluated in one block. [1]
+        Largest number of grid points evaluated in one block; a bigger grid is evaluated
+        block by block and copied into place. [1]
 
     Returns
     -------
@@ -284,7 +290,9 @@ def compute_map(
         ``stiffness_ratio`` and ``amplitude`` only) and, with a load, ``dissipated_energy``
         [J] and ``max_force`` [N]. Every variable and coordinate has ``long_name`` and
         ``units``. ECoF values are NaN where there is no gross slip; every value but the
-        regime is NaN when self-locking (rigid rig, :math:`\mu\kappa \ge 1`).
+        regime is NaN when self-locking (rigid rig, :math:`\mu\kappa \ge 1`). Freshly
+        computed arrays of a grid of at most ``max_chunk`` points are read-only (they are
+        the computation's buffers, not copies): ``.copy()`` the Dataset to write into them.
 
     Raises
     ------
