@@ -35,8 +35,8 @@ back down the *falling* branch.
 * gicof: :math:`Q/P` where the loop crosses the line :math:`Q = S\Delta` (eq. 17-18, the
   paper's Figure 6): gicof_forward on the rising branch, gicof_backward (sign reversed) on
   the falling one, and gicof their mean. On the line the contact position
-  :math:`x = \Delta - Q/S` (eq. 10) is zero. The branch's samples with
-  :math:`|x| < ` ``crossing_window`` :math:`\times\,\delta^*` are fitted by least squares
+  :math:`x = \Delta - Q/S` (eq. 10) is zero. The branch's samples with :math:`|x| <`
+  ``crossing_window`` :math:`\times\,\delta^*` (default 0.7) are fitted by least squares
   with :math:`Q = a + bx + cxQ`, which is eq. 9 exactly for any groove slope
   (:math:`a = \mu P`, :math:`b = kP`, :math:`c = \mu k`) and a smooth three-parameter
   curve for other loops; the crossing is :math:`Q = a`. In the model the window lies

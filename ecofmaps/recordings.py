@@ -90,13 +90,14 @@ class Recording:
 
 
 def _delimiter(path: Path, header: str):
-    """The field separator: from the suffix, else the first of tab or comma in the header."""
+    """The field separator: from the suffix, else the first of tab, comma or semicolon found
+    in the header, else None (any run of whitespace)."""
     if path.suffix.lower() in _DELIMITERS:
         return _DELIMITERS[path.suffix.lower()]
     for candidate in ("\t", ",", ";"):
         if candidate in header:
             return candidate
-    return None  # any run of whitespace
+    return None
 
 
 def _numbers(path, name, cells, lines, scale) -> np.ndarray:
