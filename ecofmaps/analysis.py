@@ -411,8 +411,8 @@ def analyze_loops(
     >>> import numpy as np, ecofmaps
     >>> displacement, force = ecofmaps.fretting_loop(50e-6, 450.0, 35e6, 0.8, 0.2)
     >>> results = ecofmaps.analyze_loops(np.asarray(displacement), np.asarray(force), 450.0)
-    >>> print(f"{float(results.gicof[0]):.6f} {float(results.ecof[0]):.4f}")
-    0.800000 0.8307
+    >>> print(f"{float(results.gicof[0]):.6f} {float(results.ecof[0]):.3f}")
+    0.800000 0.831
     """
     options = _check_options(load, hysteresis, stick_window, crossing_window, gross_slip_threshold)
     load = float(load)
