@@ -680,8 +680,13 @@ def measured_loops(results: xr.Dataset, cycles=None, columns: int = 3) -> Figure
         ax.axhline(0.0, color="0.7", linewidth=0.6)
         ax.axvline(0.0, color="0.7", linewidth=0.6)
         ax.grid(alpha=0.3)
+        reading = (
+            f"GICoF {float(cycle['gicof']):.3f}, ECoF {float(cycle['ecof']):.3f}"
+            if cycle["regime"] == "gross slip"
+            else "no GICoF or ECoF"
+        )
         ax.set_title(
-            f"cycle {label}: GICoF {float(cycle['gicof']):.3f}, ECoF {float(cycle['ecof']):.3f}\n"
+            f"cycle {label}: {reading}\n"
             f"S = {stiffness * _MEGA:.1f} MN/m, {cycle['regime'].values!s}",
             fontsize="small",
         )
