@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import functools
 import math
+import re
+from decimal import Decimal
 
 import numpy as np
 import pint
@@ -24,6 +26,10 @@ DIMENSIONS = {
     "energy": ("[energy]", "J", "0.05J"),
     "dimensionless": ("", "1", "0.8"),
 }
+
+
+# A plain decimal number followed by a unit name, e.g. "25um", "3.3 MN/m", "1e-3 m".
+_NUMBER_AND_UNIT = re.compile(r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*([^\d\s(].*)")
 
 
 @functools.cache
@@ -72,7 +78,18 @@ def parse_quantity(text: str, kind: str) -> float:
             f"{text!r} is not a {kind}: its unit {quantity.units:~} has dimension "
             f"{quantity.dimensionality}, expected {dimension or 'none'} (e.g. {example})"
         )
-    return float(quantity.to(si_unit).magnitude)
+    # Scale a typed decimal by its unit's factor in decimal arithmetic, so that '25um' is the
+    # float nearest 25e-6 (pint's float product gives 2.4999999999999998e-05). Expressions
+    # such as '(35MN/m)/(450N)' are left to pint's own arithmetic.
+    match = _NUMBER_AND_UNIT.fullmatch(text.replace("µ", "u").replace("μ", "u"))
+    try:
+        unit = registry.parse_units(match.group(2)) if match else None
+    except Exception:  # the rest is not a plain unit
+        unit = None
+    if unit is None or unit != quantity.units:
+        return float(quantity.to(si_unit).magnitude)
+    factor = registry.Quantity(1, unit).to(si_unit).magnitude
+    return float(Decimal(match.group(1)) * Decimal(repr(float(factor))))
 
 
 def parse_values(text: str, kind: str) -> np.ndarray:

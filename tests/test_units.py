@@ -44,6 +44,21 @@ def test_parse_quantity_rejects(text, kind, message):
         parse_quantity(text, kind)
 
 
+@pytest.mark.parametrize(
+    ("text", "kind", "expected"),
+    [("25um", "length", 25e-6), ("3.3um", "length", 3.3e-6), ("70MN/m", "stiffness", 70e6),
+     ("0.1mm", "length", 1e-4), ("48.9mJ", "energy", 0.0489),
+     ("77.8/mm", "stiffness_ratio", 77.8e3)],
+)  # fmt: skip
+def test_typed_decimals_are_the_nearest_float(text, kind, expected):
+    """'25um' is exactly the float 25e-6 (so .sel(amplitude=25e-6) finds it)."""
+    assert parse_quantity(text, kind) == expected
+
+
+def test_unit_expressions():
+    assert parse_quantity("(35MN/m)/(450N)", "stiffness_ratio") == pytest.approx(35e6 / 450)
+
+
 def test_parse_values_lists_and_ranges():
     np.testing.assert_allclose(parse_values("25um,50um", "length"), [25e-6, 50e-6])
     np.testing.assert_allclose(parse_values("0:0.3:4", "dimensionless"), [0, 0.1, 0.2, 0.3])
