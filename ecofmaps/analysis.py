@@ -12,8 +12,11 @@ Each loop runs from its lowest displacement up the *rising* branch to its highes
 back down the *falling* branch.
 
 * amplitude :math:`\Delta^*` and max_force :math:`Q^*`: half the peak-to-peak ranges.
-* stiffness :math:`S`: the slope of the stick segments that follow the two reversals, one
-  least-squares slope common to both (each line with its own intercept). A segment
+* stiffness :math:`S`: the slope of the stick segments that follow the two reversals. One
+  compliance :math:`1/S` common to both segments, each with its own intercept, is fitted
+  by least squares of :math:`\Delta` on :math:`Q`, :math:`\Delta = c + Q/S` (eq. 10 with
+  the contact position :math:`c` fixed): the displacement's noise is larger, relative to
+  the segment's span, than the force's, and a rigid rig gives :math:`S = \infty`. A segment
   starts as the branch's samples whose force has moved away from the reversal's by a share
   between ``stick_window[0]`` and ``stick_window[1]`` (default 5 % and 45 %) of the
   branch's force swing, up to the first sample beyond the upper share: in the model the
@@ -25,8 +28,8 @@ back down the *falling* branch.
   A sparsely sampled loop with fewer than two samples in a window (a model loop draws each
   stick segment as one straight line) uses the chord from the reversal instead.
 * slip_amplitude :math:`\delta^*`: half the width of the loop at :math:`Q = 0` (Figure 1a).
-  Where a grown stick segment reaches across zero force, the crossing is the zero of its
-  fitted line; otherwise a straight line through the branch's samples with
+  Where a grown stick segment reaches across zero force, the crossing is its fitted line's
+  intercept :math:`c`; otherwise a straight line through the branch's samples with
   :math:`|Q| < Q^*/4` and the two samples around the crossing.
 * dissipated_energy :math:`E_d = \oint Q\,d\Delta`: the loop's area by the trapezoidal
   (shoelace) rule; the noise of the samples averages out of it.
@@ -145,7 +148,7 @@ def _bracket(value, branch, first, sign):
 
 
 def _crossing(x, value, branch, first, sign):
-    """Displacement where ``value`` changes sign, interpolated between two samples."""
+    """``x`` where ``value`` changes sign on a branch, interpolated between two samples."""
     after = _bracket(value, branch, first, sign)[:, None]
     x0, x1 = (np.take_along_axis(x, after - k, axis=1)[:, 0] for k in (1, 0))
     v0, v1 = (np.take_along_axis(value, after - k, axis=1)[:, 0] for k in (1, 0))
@@ -154,13 +157,14 @@ def _crossing(x, value, branch, first, sign):
     return x0 + share * (x1 - x0)
 
 
-def _zero_force_crossing(x, y, branch, first, sign, stick, slope, intercept):
+def _zero_force_crossing(x, y, branch, first, sign, stick, intercept):
     r"""Displacement where a branch crosses :math:`Q = 0`.
 
-    Where the stick segment ``stick`` reaches across zero force, it is the zero of the
-    line fitted to it, :math:`Q = c + S\Delta`. Elsewhere a straight line
+    Where the stick segment ``stick`` reaches across zero force, it is the intercept of
+    the line fitted to it, :math:`\Delta = c + Q/S`. Elsewhere a straight line
     :math:`\Delta = a + bQ` is fitted to the two samples around the crossing and the
-    branch's samples with :math:`|Q| < Q^*/4`, and gives :math:`a`.
+    branch's samples with :math:`|Q|` below ``_ZERO_FORCE_BAND`` times :math:`Q^*`, and
+    gives :math:`a`.
     """
     after = _bracket(y, branch, first, sign)[:, None]
     j = np.arange(x.shape[1])[None, :]
@@ -168,7 +172,7 @@ def _zero_force_crossing(x, y, branch, first, sign, stick, slope, intercept):
     near = branch & ((np.abs(y) <= band[:, None]) | (j == after) | (j == after - 1))
     local = _common_slope(y, x, [near])[1][0]
     across = np.any(stick & (y < 0.0), axis=1) & np.any(stick & (y > 0.0), axis=1)
-    return np.where(across, -intercept / slope, local)
+    return np.where(across, intercept, local)
 
 
 def _stick_mask(y, branch, window):
@@ -207,22 +211,22 @@ def _common_slope(x, y, masks):
 
 
 def _stick_lines(x, y, branches, window):
-    """Lines through the stick segments after the two reversals (module notes).
+    r"""Lines :math:`\Delta = c + Q/S` through the stick segments after the two reversals.
 
-    A first slope is fitted to the samples in the force window; each segment then grows
+    A first line is fitted to the samples in the force window; each segment then grows
     along its branch until two samples in a row lie more than ``_STICK_SPREAD`` standard
-    deviations off the fitted line (the slip that follows bends away from it; a single
-    noisy sample does not stop it), and the lines are fitted again to the grown segments.
-    Returns the common slope (the stiffness), the intercept of each line and the mask of
-    each segment.
+    deviations off its line (the slip that follows bends away from it; a single noisy
+    sample does not stop it), and the lines are fitted again to the grown segments.
+    Returns the common compliance :math:`1/S`, the intercept :math:`c` of each line and
+    the mask of each segment.
     """
     masks = [_stick_mask(y, branch, window) for branch in branches]
-    slope, intercepts = _common_slope(x, y, masks)
-    residuals = [y - intercept[:, None] - slope[:, None] * x for intercept in intercepts]
+    compliance, intercepts = _common_slope(y, x, masks)
+    residuals = [x - intercept[:, None] - compliance[:, None] * y for intercept in intercepts]
     squares = sum(masked_sum(r * r, m) for r, m in zip(residuals, masks, strict=True))
     points = sum(np.count_nonzero(m, axis=1) for m in masks)
     spread = np.sqrt(squares / np.maximum(points - 3, 1))
-    span = np.nanmax(y, axis=1) - np.nanmin(y, axis=1)
+    span = np.nanmax(x, axis=1) - np.nanmin(x, axis=1)
     tolerance = np.maximum(_STICK_SPREAD * spread, 1e-9 * span)[:, None]
     grown = []
     for branch, mask, residual in zip(branches, masks, residuals, strict=True):
@@ -231,37 +235,36 @@ def _stick_lines(x, y, branches, window):
         outside[:, :-1] &= outside[:, 1:]
         off = np.maximum.accumulate(outside, axis=1)
         grown.append(mask | (after & ~off))
-    slope, intercepts = _common_slope(x, y, grown)
-    return slope, intercepts, grown
+    compliance, intercepts = _common_slope(y, x, grown)
+    return compliance, intercepts, grown
 
 
-def _line_crossing(x, y, branch, first, sign, stiffness, half_width, load):
-    r"""Force where a branch crosses :math:`Q = S\Delta` (module notes).
+def _line_crossing(x, y, branch, first, sign, compliance, half_width, load):
+    r"""Displacement and force where a branch crosses :math:`Q = S\Delta` (module notes).
 
-    In the contact position :math:`\xi = \Delta - Q/S` (eq. 10) the crossing is
-    :math:`\xi = 0`. The branch's samples with :math:`|\xi|` below ``half_width`` are
-    fitted by least squares with :math:`Q = a + b\xi + c\xi Q`, which is eq. 9 for any
-    groove slope (:math:`a = \mu P`, :math:`b = kP`, :math:`c = \mu k`) and a smooth
-    three-parameter curve otherwise; the crossing is :math:`Q = a`. With fewer than
-    ``_FIT_SAMPLES`` samples in the window, it is the linear interpolation between the two
-    samples around the crossing.
+    On the line the contact position :math:`\xi = \Delta - Q/S` (eq. 10) is zero. The
+    branch's samples with :math:`|\xi|` below ``half_width`` are fitted by least squares
+    with :math:`Q = a + b\xi + c\xi Q`, which is eq. 9 for any groove slope
+    (:math:`a = \mu P`, :math:`b = kP`, :math:`c = \mu k`) and a smooth three-parameter
+    curve otherwise; the crossing is :math:`Q = a`. With fewer than ``_FIT_SAMPLES``
+    samples in the window, :math:`Q` is interpolated linearly at :math:`\xi = 0` between
+    the two samples around the crossing.
     """
-    slope = stiffness[:, None]
-    guess = _crossing(x, y - slope * x, branch, first, sign)
-    position = (x - y / slope) / half_width[:, None]
-    window = branch & (np.abs(position) <= 1.0)
+    position = x - y * compliance[:, None]  # the contact position (eq. 10)
+    guess = _crossing(y, position, branch, first, sign)  # Q there, interpolated
+    scaled = position / half_width[:, None]
+    window = branch & (np.abs(scaled) <= 1.0)
     enough = np.count_nonzero(window, axis=1) >= _FIT_SAMPLES
-    regressors = (np.ones_like(x), position, position * y / load)
+    regressors = (np.ones_like(x), scaled, scaled * y / load)
     normal = np.stack(
         [np.stack([masked_sum(p * q, window) for q in regressors], axis=-1) for p in regressors],
         axis=-2,
     )
     moments = np.stack([masked_sum(p * y, window) for p in regressors], axis=-1)
     normal[~enough] = np.eye(3)
-    # The pseudo-inverse: on a flat groove Q is constant and xQ is a multiple of x.
     intercept = (np.linalg.pinv(normal) @ moments[..., None])[:, 0, 0]
-    force = np.where(enough, intercept, stiffness * guess)
-    return force / stiffness, force
+    force = np.where(enough, intercept, guess)
+    return force * compliance, force
 
 
 # --- the public function ------------------------------------------------------------------
@@ -273,14 +276,15 @@ def _loop_quantities(x, q, valid, load, options):
     max_force = 0.5 * (np.nanmax(q, axis=1) - np.nanmin(q, axis=1))
     rising, falling, top = _branches(x, valid)
     start = np.zeros_like(top)
-    stiffness, intercepts, sticks = _stick_lines(x, q, (rising, falling), options["stick_window"])
-    left = _zero_force_crossing(x, q, rising, start, -1.0, sticks[0], stiffness, intercepts[0])
-    right = _zero_force_crossing(x, q, falling, top, 1.0, sticks[1], stiffness, intercepts[1])
+    compliance, intercepts, sticks = _stick_lines(x, q, (rising, falling), options["stick_window"])
+    stiffness = 1.0 / compliance
+    left = _zero_force_crossing(x, q, rising, start, -1.0, sticks[0], intercepts[0])
+    right = _zero_force_crossing(x, q, falling, top, 1.0, sticks[1], intercepts[1])
     slip = 0.5 * (right - left)
     energy = _dissipated_energy(x, q, valid)
     half_width = options["crossing_window"] * np.abs(slip)
-    rising_x, rising_q = _line_crossing(x, q, rising, start, 1.0, stiffness, half_width, load)
-    falling_x, falling_q = _line_crossing(x, q, falling, top, -1.0, stiffness, half_width, load)
+    rising_x, rising_q = _line_crossing(x, q, rising, start, 1.0, compliance, half_width, load)
+    falling_x, falling_q = _line_crossing(x, q, falling, top, -1.0, compliance, half_width, load)
     energy_ratio = energy / (4.0 * amplitude * max_force)
     gross = energy_ratio > options["gross_slip_threshold"]
     sliding = np.where(gross, 1.0, np.nan)  # NaN for the coefficients in partial slip

@@ -107,6 +107,19 @@ def test_model_loop_is_read_exactly(point):
     )
 
 
+def test_rigid_rig():
+    """S = ∞ (Figure 5's rigid loop): vertical sides, δ* = Δ*, the crossings at Δ = 0."""
+    point = dict(EXAMPLE_2, stiffness=np.inf)
+    displacement, force = (np.asarray(a) for a in ecofmaps.fretting_loop(**point))
+    result = analyze_loops(displacement, force, LOAD).isel(cycle=0)
+    assert np.isposinf(result.stiffness)
+    assert relative(result.slip_amplitude, AMPLITUDE) < EXACT
+    assert relative(result.gicof_forward, point["mu"]) < EXACT
+    assert relative(result.gicof_backward, point["mu"]) < EXACT
+    assert result.crossing_displacement_forward == 0.0
+    assert relative(result.ecof, ecofmaps.energy_cof(**point)) < 1e-3  # 201-point loop
+
+
 @given(
     mu=st.floats(0.1, 1.5),
     aspect_ratio=st.floats(0.0, 0.4),
