@@ -29,10 +29,11 @@ __all__ = ["LoopFit", "fit_loop"]
 #: Fewest samples accepted for one loop: six parameters, two branches, stick and slip.
 MIN_SAMPLES = 20
 
-# Force window after each reversal where analyze_loops starts the stick segment (it then
-# grows it along the stick line): narrower than its default, so that it holds only stick
-# also when the groove slope at the reversal exceeds mu and the stick is short.
-_STICK_WINDOW = (0.0, 0.15)
+# Force windows after each reversal where analyze_loops starts the stick segments (it then
+# grows them along the stick line): its default, and a narrow one that holds only stick
+# also when the groove slope at the reversal exceeds mu and the stick is short. Slip in a
+# window only lowers its slope, so the steeper of the two is the start.
+_STICK_WINDOWS = ((0.05, 0.45), (0.0, 0.15))
 # Contact positions within this share of the slip amplitude are read as slipping for the
 # starting mu and groove slope.
 _SLIP_SHARE = 0.6
@@ -184,6 +185,11 @@ def _starting_values(x, y, rising, stiffness, slip_half_width, energy_ratio):
             "the loop runs anticlockwise (its area ∮Q dΔ is negative): force and "
             "displacement must be positive in the same direction"
         )
+    if stiffness == np.inf:
+        raise ValueError(
+            "the loop's stick segments are vertical (a rigid rig, S = inf): the model's "
+            "stiffness cannot be fitted"
+        )
     slipping = np.zeros_like(rising)
     if stiffness > 0 and slip_half_width > 0:
         contact = x - y / stiffness
@@ -267,7 +273,8 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
         If ``load`` is not a positive finite number; the arrays are not one-dimensional of
         one length, or hold NaN or infinity; the recording has no complete cycle, or none
         numbered ``cycle_number``; the cycle has fewer than :data:`MIN_SAMPLES` samples;
-        or the loop shows no gross slip or runs anticlockwise.
+        or the loop shows no gross slip, runs anticlockwise, or has vertical stick
+        segments (a rigid rig).
 
     Notes
     -----
@@ -315,8 +322,12 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
         raise ValueError("displacement does not vary: a loop needs a displacement stroke")
 
     index, number = _select_cycle(all_x, cycle, cycle_number, hysteresis)
-    analysis = analyze_loops(all_x[index], all_y[index], load, stick_window=_STICK_WINDOW).isel(
-        cycle=0
+    analysis = max(
+        (
+            analyze_loops(all_x[index], all_y[index], load, stick_window=window).isel(cycle=0)
+            for window in _STICK_WINDOWS
+        ),
+        key=lambda result: float(result.stiffness),
     )
     # The last point closes the loop (it is the first point of the next cycle, or the
     # first point again): fit each sample once.

@@ -58,20 +58,12 @@ def assert_recovered(fit, mu, aspect_ratio, stiffness, rtol):
 # --- noise-free loops: the fit returns the parameters that made them -----------------------
 
 
-# analyze_loops (which gives the fit its starting point) fails on a noise-free loop of a
-# flat groove: its GICoF regression Q = a + bξ + cξQ is singular when Q is constant on the
-# slip (analysis._line_crossing, np.linalg.solve). Strict, so the fix is noticed.
-FLAT_GROOVE_BUG = pytest.mark.xfail(
-    raises=np.linalg.LinAlgError, strict=True, reason="analyze_loops: singular GICoF fit"
-)
-
-
 @pytest.mark.parametrize(
     "parameters",
     [
         EXAMPLE_2,
         *FIGURE_10.values(),
-        pytest.param(dict(mu=0.5, aspect_ratio=0.0, stiffness=20e6), marks=FLAT_GROOVE_BUG),
+        dict(mu=0.5, aspect_ratio=0.0, stiffness=20e6),
     ],
     ids=["Example 2 (Section 3)", *FIGURE_10, "flat groove"],
 )
@@ -113,7 +105,7 @@ def test_recovers_offsets_and_any_start_and_sampling():
 
 @given(
     mu=st.floats(0.1, 1.5),
-    aspect_ratio=st.floats(1e-3, 0.4),  # 0 exactly: FLAT_GROOVE_BUG
+    aspect_ratio=st.floats(0.0, 0.4),
     mu_lam=st.floats(0.02, 0.9),
 )
 def test_recovers_any_gross_slip_loop(mu, aspect_ratio, mu_lam):
@@ -308,6 +300,13 @@ def test_rejects_loop_without_gross_slip():
     displacement, force = measured_loop(mu=0.8, aspect_ratio=0.2, stiffness=5e6)
     assert ecofmaps.regime(AMPLITUDE, LOAD, 5e6, 0.8, 0.2) == ecofmaps.NO_GROSS_SLIP
     with pytest.raises(ValueError, match="no gross slip"):
+        fit_loop(displacement, force, LOAD)
+
+
+def test_rejects_rigid_loop():
+    """Vertical stick segments: the rig's stiffness is infinite and cannot be fitted."""
+    displacement, force = ecofmaps.fretting_loop(AMPLITUDE, LOAD, np.inf, 0.8, 0.2, num=100)
+    with pytest.raises(ValueError, match="rigid rig"):
         fit_loop(displacement, force, LOAD)
 
 
