@@ -10,6 +10,13 @@ from importlib.metadata import PackageNotFoundError, version
 from ecofmaps._inputs import RegimeWarning
 from ecofmaps.analysis import analyze_loops
 from ecofmaps.cache import CacheWarning, cache_entries, clear_cache
+from ecofmaps.correction import (
+    CorrectionStatus,
+    Interval,
+    correct_ecof,
+    correction_factor,
+    lookup_correction,
+)
 from ecofmaps.fit import LoopFit, fit_loop
 from ecofmaps.loop import fretting_loop, simulate
 from ecofmaps.maps import compute_loops, compute_map, compute_universal_map
@@ -48,6 +55,8 @@ __all__ = [
     "NO_GROSS_SLIP",
     "SELF_LOCKING",
     "CacheWarning",
+    "CorrectionStatus",
+    "Interval",
     "LoopFit",
     "Regime",
     "RegimeWarning",
@@ -58,11 +67,14 @@ __all__ = [
     "compute_loops",
     "compute_map",
     "compute_universal_map",
+    "correct_ecof",
+    "correction_factor",
     "dissipated_energy",
     "energy_cof",
     "figures",
     "fit_loop",
     "fretting_loop",
+    "lookup_correction",
     "max_force",
     "read_recording",
     "regime",
