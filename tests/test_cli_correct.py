@@ -1,0 +1,206 @@
+"""`ecofmaps correct`: one point, CSV tables, errors naming file and line, atomic output."""
+
+import csv
+import io
+import os
+
+import numpy as np
+import pytest
+
+import ecofmaps
+from ecofmaps import cli
+
+EXAMPLE_2 = ["--amplitude", "50um", "--load", "450N", "--stiffness", "35MN/m"]
+
+
+def run(capsys, *argv):
+    """Run the command in-process; return (exit status, stdout, stderr)."""
+    try:
+        status = cli.main([str(a) for a in argv])
+    except SystemExit as stop:  # argparse errors and --help
+        status = stop.code
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+def printed(out: str, label: str) -> str:
+    """The value printed on the line starting with ``label``."""
+    line = next(line for line in out.splitlines() if line.strip().startswith(label))
+    return line.split()[-1] if label != "regime" else line.split(maxsplit=1)[1].strip()
+
+
+def test_one_point(capsys):
+    status, out, err = run(capsys, "correct", "--ecof", "0.83", *EXAMPLE_2, "--aspect-ratio", "0.2")
+    assert status == 0 and err == ""
+    mu = float(ecofmaps.correct_ecof(0.83, 50e-6, 450.0, 35e6, 0.2))
+    assert float(printed(out, "contact CoF")) == pytest.approx(mu, rel=5e-6)  # 6 digits
+    assert float(printed(out, "correction factor")) == pytest.approx(mu / 0.83, rel=5e-6)
+    assert len(printed(out, "contact CoF").replace("0.", "", 1)) >= 4
+    assert printed(out, "regime") == "gross slip"
+
+
+def test_one_point_from_the_scar(capsys):
+    status, out, _ = run(
+        capsys, "correct", "--ecof", "0.83", *EXAMPLE_2, "--scar-depth", "8um",
+        "--scar-half-width", "40 µm",
+    )  # fmt: skip
+    assert status == 0
+    assert "0.2 (scar 8 µm deep, 40 µm half-width)" in out
+    mu = float(ecofmaps.correct_ecof(0.83, 50e-6, 450.0, 35e6, 0.2))
+    assert float(printed(out, "contact CoF")) == pytest.approx(mu, rel=5e-6)
+
+
+POINT = "--ecof 0.83 --amplitude 50um --load 450N --stiffness 35MN/m"
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        ("--ecof 5 --amplitude 50um --load 450N --stiffness 35MN/m --aspect-ratio 0.2",
+         "ecof = 5 cannot be corrected"),
+        ("--ecof 0 --amplitude 50um --load 450N --stiffness 35MN/m --aspect-ratio 0.2",
+         "ecof must satisfy 0 < ecof"),
+        (POINT, "give --aspect-ratio, or both --scar-depth"),
+        (POINT + " --aspect-ratio 0.2 --scar-depth 8um --scar-half-width 40um",
+         "give --aspect-ratio, or both"),
+        (POINT + " --scar-depth 8um", "give --aspect-ratio, or both"),
+        ("--ecof 0.83 --amplitude 50um --aspect-ratio 0.2", "give --load, --stiffness"),
+        (POINT + " --aspect-ratio 0.2 --out x.csv", "--out writes a corrected TABLE"),
+        # z_o/x_o = 5 and λ = P/(SΔ*) = 1e-3: μ_E falls from 9.43 to 5.68 as μ rises
+        ("--ecof 7 --amplitude 50um --load 450N --stiffness 9000MN/m --aspect-ratio 5",
+         "three contact CoFs"),
+    ],
+)  # fmt: skip
+def test_one_point_errors(capsys, argv, message):
+    status, out, err = run(capsys, "correct", *argv.split())
+    assert status == 2 and out == ""
+    assert message in err and "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_units_are_checked(capsys):
+    """argparse reads the quantities: a wrong dimension is a usage error (status 2)."""
+    argv = "--ecof 0.83 --amplitude 450N --load 450N --stiffness 35MN/m --aspect-ratio 0.2"
+    status, _, err = run(capsys, "correct", *argv.split())
+    assert status == 2 and "argument --amplitude: '450N' is not a length" in err
+
+
+# --- tables -------------------------------------------------------------------------------
+
+TABLE = """\
+source,ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio,scar_depth_um,scar_half_width_um
+Example 2,0.8308,50,450,35,0.2,,
+"rigid, deep",0.9,25,200,inf,,3,40
+
+flat,0.7,50,450,35,0,,
+"""
+
+
+def write(path, text):
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def read_csv(text):
+    return list(csv.DictReader(io.StringIO(text)))
+
+
+def test_table_to_file(tmp_path, capsys):
+    table = write(tmp_path / "ecof.csv", TABLE)
+    out = tmp_path / "corrected.csv"
+    status, stdout, err = run(capsys, "correct", table, "--out", out)
+    assert status == 0 and err == ""
+    assert f"wrote {out}: 3 rows corrected" in stdout
+    rows = read_csv(out.read_text(encoding="utf-8"))
+    assert list(rows[0]) == [*TABLE.splitlines()[0].split(","), "mu", "correction_factor", "regime"]
+    # every input cell kept as written
+    assert [r["source"] for r in rows] == ["Example 2", "rigid, deep", "flat"]
+    assert rows[1]["stiffness_MN_per_m"] == "inf" and rows[1]["aspect_ratio"] == ""
+    expected = np.asarray(
+        ecofmaps.correct_ecof(
+            np.array([0.8308, 0.9, 0.7]), np.array([50e-6, 25e-6, 50e-6]),
+            np.array([450.0, 200.0, 450.0]), np.array([35e6, np.inf, 35e6]),
+            np.array([0.2, 3.0 / 40.0, 0.0]),
+        )
+    )  # fmt: skip
+    mu = np.array([float(r["mu"]) for r in rows])
+    np.testing.assert_allclose(mu, expected, rtol=1e-9)  # 10 significant digits
+    factor = np.array([float(r["correction_factor"]) for r in rows])
+    np.testing.assert_allclose(factor, expected / np.array([0.8308, 0.9, 0.7]), rtol=1e-9)
+    assert mu[0] == pytest.approx(0.8, abs=2e-6) and mu[2] == 0.7  # Example 2; flat scar
+    assert {r["regime"] for r in rows} == {"gross slip"}
+
+
+def test_table_to_stdout(tmp_path, capsys):
+    table = write(tmp_path / "ecof.csv", TABLE)
+    status, stdout, _ = run(capsys, "correct", table)
+    assert status == 0
+    assert len(read_csv(stdout)) == 3
+
+
+BAD_TABLES = [
+    # (text, line, message)
+    ("", 1, "the file is empty"),
+    ("ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio\n", 1, "no data rows"),
+    ("ecof,amplitude_um,stiffness_MN_per_m,aspect_ratio\n0.8,50,35,0.2\n", 1,
+     "missing column(s) load_N"),
+    ("ecof,amplitude_um,load_N,stiffness_MN_per_m\n0.8,50,450,35\n", 1,
+     "missing column(s) aspect_ratio (or scar_depth_um + scar_half_width_um)"),
+    ("ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio,mu\n0.8,50,450,35,0.2,1\n", 1,
+     "column(s) mu would be overwritten"),
+    ("ecof,ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio\n", 1,
+     "repeated column(s) ecof"),
+    ("ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio\n0.8,50,450,35,0.2\n"
+     "0.8,50,450,35,abc\n", 3, "aspect_ratio = 'abc' is not a number"),
+    ("ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio\n0.8,50,450,35,0.2\n\n"
+     "0.8,50,-450,35,0.2\n", 4, "load_N must be > 0 and finite, got -450"),
+    ("ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio\n0.8,50,450,35\n", 2,
+     "4 fields, but the header has 5 columns"),
+    ("ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio\n0.8,50,450,35,0.2\n"
+     "9,50,450,35,0.2\n", 3, "ecof = 9 cannot be corrected"),
+    ("ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio,scar_depth_um,scar_half_width_um\n"
+     "0.8,50,450,35,0.2,8,40\n", 2, "give the aspect ratio one way"),
+    ("ecof,amplitude_um,load_N,stiffness_MN_per_m,scar_depth_um,scar_half_width_um\n"
+     "0.8,50,450,35,8,\n", 2, "give the aspect ratio one way"),
+    ("ecof,amplitude_um,load_N,stiffness_MN_per_m,scar_depth_um,scar_half_width_um\n"
+     "0.8,50,450,35,8,0\n", 2, "scar_half_width_um must be > 0"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("text", "line", "message"), BAD_TABLES)
+def test_bad_table_names_file_and_line(tmp_path, capsys, text, line, message):
+    """One-line error naming file and line; an existing OUT is left exactly as it was."""
+    table = write(tmp_path / "bad.csv", text)
+    out = write(tmp_path / "out.csv", "previous results\n")
+    os.utime(out, (1_000_000_000, 1_000_000_000))
+    status, stdout, err = run(capsys, "correct", table, "--out", out)
+    assert status == 2 and stdout == ""
+    assert f"{table}, line {line}: " in err and message in err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert out.read_text(encoding="utf-8") == "previous results\n"
+    assert out.stat().st_mtime == 1_000_000_000
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.csv", "out.csv"]  # no temp left
+
+
+def test_bad_table_writes_no_new_file(tmp_path, capsys):
+    table = write(
+        tmp_path / "bad.csv",
+        "ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio\n0.8,x,1,1,0\n",
+    )
+    status, _, err = run(capsys, "correct", table, "--out", tmp_path / "new.csv")
+    assert status == 2 and "line 2: amplitude_um = 'x'" in err
+    assert not (tmp_path / "new.csv").exists()
+
+
+def test_table_command_errors(tmp_path, capsys):
+    table = write(tmp_path / "ecof.csv", TABLE)
+    status, _, err = run(capsys, "correct", table, "--ecof", "0.8")
+    assert status == 2 and "give a TABLE or one point's options, not both (--ecof)" in err
+    status, _, err = run(capsys, "correct", tmp_path / "missing.csv")
+    assert status == 2 and "missing.csv" in err
+    status, _, err = run(capsys, "correct", table, "--out", tmp_path / "no" / "out.csv")
+    assert status == 2 and "its directory does not exist" in err
+    binary = tmp_path / "binary.csv"
+    binary.write_bytes(b"\xff\xfe\x00ecof")
+    status, _, err = run(capsys, "correct", binary)
+    assert status == 2 and "line 1: not a UTF-8 text file" in err
