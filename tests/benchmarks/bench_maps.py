@@ -243,11 +243,85 @@ def loops(quick: bool) -> None:
 
 
 # ---------------------------------------------------------------------------------------
+# correction: correct_ecof against a per-value SciPy brentq inversion
+# ---------------------------------------------------------------------------------------
+
+
+def correction(quick: bool) -> None:
+    """Corrections per second of correct_ecof (1e6 values) and of per-value SciPy brentq.
+
+    Test conditions drawn over the range of the paper's rigs (Δ* 10-100 µm, P 50-1000 N,
+    S 10-100 MN/m, z_o/x_o 0-0.5, μ 0.1-1.5 in gross slip); the ECoFs are the model's,
+    so the true μ is known. SciPy inverts one value at a time with brentq on μ_E(μ), once
+    on the NumPy closed form (numpy_map) and once on brute force (brentq on eq. 16 + quad
+    of eq. 12, tests/brute_force.py); both run on a sample and are extrapolated.
+    """
+    import warnings
+
+    from scipy.integrate import IntegrationWarning
+    from scipy.optimize import brentq
+
+    from ecofmaps import correct_ecof, energy_cof
+
+    count = 10**5 if quick else 10**6
+    sample = 20 if quick else 200
+    repeats = 2 if quick else 5
+    rng = np.random.default_rng(0)
+    amplitude = rng.uniform(10e-6, 100e-6, count)
+    load = rng.uniform(50.0, 1000.0, count)
+    stiffness = rng.uniform(10e6, 100e6, count)
+    ratio = rng.uniform(0.0, 0.5, count)
+    mu = rng.uniform(0.1, 1.5, count)
+    mu = np.minimum(mu, 0.95 * stiffness * amplitude / load)  # gross slip
+    ecof = np.asarray(energy_cof(amplitude, load, stiffness, mu, ratio))
+    arguments = (ecof, amplitude, load, stiffness, ratio)
+    first, _ = timed(lambda: correct_ecof(*arguments).block_until_ready())  # compiles
+    best = (math.inf, math.inf)
+    for _ in range(repeats):
+        best = min(best, timed(lambda: correct_ecof(*arguments).block_until_ready()))
+    corrected = np.asarray(correct_ecof(*arguments))
+    error = max_relative_difference(mu, corrected)
+    wall, cpu = best
+
+    def closed_form(m, i):
+        return numpy_map(
+            np.array([stiffness[i] / load[i]]), np.array([ratio[i]]), np.array([amplitude[i]]),
+            m, load[i],
+        )["ecof"].item() - ecof[i]  # fmt: skip
+
+    def brute_force(m, i):
+        return steady_loop(amplitude[i], load[i], stiffness[i], m, ratio[i])["ecof"] - ecof[i]
+
+    print(f"correct_ecof (jit, float64) vs per-value SciPy brentq; {load_average()}")
+    print(f"{'values':>9} {'compile':>8} {'wall':>7} {'CPU':>7} {'speed':>10} {'max rel':>8}")
+    print(f"{'':>9} {'[s]':>8} {'[s]':>7} {'[s]':>7} {'[value/s]':>10} {'err μ':>8}")
+    print(
+        f"{count:9.2e} {first - wall:8.2f} {wall:7.3f} {cpu:7.3f} {count / wall:10.3g} {error:8.1e}"
+    )
+    for name, residual in (("NumPy closed form", closed_form), ("brute force", brute_force)):
+        start = time.perf_counter()
+        with warnings.catch_warnings():  # quad: roundoff stops it short of epsrel=1e-13
+            warnings.simplefilter("ignore", IntegrationWarning)
+            roots = [
+                brentq(residual, 1e-9, ecof[i], args=(i,), xtol=1e-15, rtol=8.9e-16)
+                for i in range(sample)
+            ]
+        speed = sample / (time.perf_counter() - start)
+        difference = max_relative_difference(np.array(roots), corrected[:sample])
+        print(
+            f"SciPy brentq on the {name}, {sample} values: {speed:.3g} value/s, "
+            f"{count / speed:.3g} s for {count:.0e} (extrapolated); correct_ecof/SciPy "
+            f"{count / wall / speed:.3g}; max rel diff {difference:.1e}"
+        )
+
+
+# ---------------------------------------------------------------------------------------
 
 #: The benchmark sections, run in this order; append yours.
 SECTIONS = {
     "maps": maps,
     "loops": loops,
+    "correction": correction,
 }
 
 
