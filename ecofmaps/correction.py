@@ -27,9 +27,11 @@ The inversion, in the dimensionless core of :mod:`ecofmaps.model` (:math:`\mu`,
   :math:`\kappa \to \infty` limit of the largest such :math:`\lambda`; at :math:`\kappa = 10`
   it is 0.0248, and the smallest :math:`\kappa` grows from 1 as :math:`\lambda` grows from
   0, e.g. 2.5 at :math:`\lambda = 10^{-4}`). The fall lies in :math:`1/\kappa < \mu < 1`,
-  where :math:`\mu_E/\mu > 4`. The tests check these bounds on dense grids. There, an
-  ECoF between the local minimum and maximum of :math:`\mu_E(\mu)` comes from three
-  contact CoFs (status ``AMBIGUOUS``).
+  where :math:`\mu_E/\mu > 4`. There, an ECoF between the local minimum and maximum of
+  :math:`\mu_E(\mu)` comes from three contact CoFs (status ``AMBIGUOUS``); the local
+  minimum is above 1.6 (its infimum, reached as :math:`\kappa \to \infty` and
+  :math:`\lambda \to \lambda_\infty`), so no ECoF below 1.6 is ever ambiguous. The tests
+  check these bounds on dense grids.
 * :math:`\mu_E` rises with :math:`z_o/x_o` at fixed :math:`\mu` (:math:`\kappa\delta^*`
   rises with :math:`\kappa`, and :math:`\mu_E` is the mean of a convex function over
   :math:`[-\kappa\delta^*, \kappa\delta^*]` in the slope), so for an aspect ratio known

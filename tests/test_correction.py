@@ -240,6 +240,10 @@ def test_fall_region():
     for kappa, lam in [(1.2, 1e-100), (2.0, 1e-8), (1e6, 0.0705)]:
         mu = np.geomspace(1.0 / kappa, 1.0, 100_000)
         assert np.any(ecof_slope(mu, kappa, lam) < 0), (kappa, lam)
+    # Only ECoFs above 1.6 can be ambiguous: the fall's bottom, over the whole region.
+    kappa, lam = np.meshgrid(np.geomspace(1.001, 1e8, 40), np.geomspace(1e-12, 0.0711, 40))
+    low = np.asarray(ecof_fall(kappa, lam)[1])
+    assert np.isfinite(low).mean() > 0.5 and np.nanmin(low) > 1.6
 
 
 def test_ambiguous_ecof():
