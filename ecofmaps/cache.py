@@ -17,7 +17,6 @@ from __future__ import annotations
 import hashlib
 import os
 import re
-import uuid
 import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -27,6 +26,8 @@ from pathlib import Path
 import numpy as np
 import platformdirs
 import xarray as xr
+
+from ecofmaps.files import TEMPORARY_NAME, atomic_path
 
 __all__ = [
     "ENVIRONMENT_VARIABLE",
@@ -48,7 +49,6 @@ _KEY_ATTRIBUTE = "ecofmaps_cache_key"
 # Length of the key in file names: 128 bits of the hash.
 _NAME_DIGITS = 32
 _ENTRY = re.compile(rf"^(?P<function>[A-Za-z_][A-Za-z0-9_]*)-[0-9a-f]{{{_NAME_DIGITS}}}\.nc$")
-_TEMPORARY = re.compile(r"^\..+\.[0-9a-f]{32}\.tmp$")
 
 
 class CacheWarning(UserWarning):
@@ -147,15 +147,8 @@ def write_netcdf(dataset: xr.Dataset, path) -> Path:
     path : pathlib.Path
     """
     path = Path(path)
-    temporary = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
-    try:
+    with atomic_path(path) as temporary:
         dataset.to_netcdf(temporary, engine="h5netcdf")
-        with open(temporary, "rb+") as file:
-            os.fsync(file.fileno())
-        os.replace(temporary, path)
-    except BaseException:
-        temporary.unlink(missing_ok=True)
-        raise
     return path
 
 
@@ -281,7 +274,7 @@ def clear_cache(cache_dir=None) -> tuple[int, int]:
     """
     directory = cache_directory(cache_dir)
     count = size = 0
-    for path in _files(directory, _ENTRY) + _files(directory, _TEMPORARY):
+    for path in _files(directory, _ENTRY) + _files(directory, TEMPORARY_NAME):
         try:
             file_size = path.stat().st_size
             path.unlink()

@@ -16,8 +16,6 @@ The paper's parameters (Section 3): :math:`\Delta^* = x_o = 50` µm, :math:`P = 
 
 from __future__ import annotations
 
-import os
-import tempfile
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,6 +28,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
+from ecofmaps.files import atomic_path
 from ecofmaps.maps import compute_loops, compute_map, compute_universal_map
 from ecofmaps.model import NO_GROSS_SLIP, compliance_ratio, energy_cof
 
@@ -1040,15 +1039,6 @@ def save_figure(figure: Figure, path, dpi: int = 150) -> Path:
     """
     path = Path(path)
     file_format = path.suffix.lstrip(".").lower()
-    descriptor, temporary = tempfile.mkstemp(
-        prefix=f".{path.stem}-", suffix=path.suffix, dir=path.parent
-    )
-    try:
-        with os.fdopen(descriptor, "wb") as stream:
-            figure.savefig(stream, format=file_format, dpi=dpi, metadata=_METADATA.get(file_format))
-        os.chmod(temporary, 0o644)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
+    with atomic_path(path) as temporary:
+        figure.savefig(temporary, format=file_format, dpi=dpi, metadata=_METADATA.get(file_format))
     return path

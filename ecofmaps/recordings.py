@@ -12,14 +12,13 @@ Dataset into the table that ``ecofmaps loops`` writes, in the tribologist's unit
 from __future__ import annotations
 
 import dataclasses
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import xarray as xr
 
+from ecofmaps.files import FileLineError, atomic_path
 from ecofmaps.units import parse_quantity
 
 __all__ = [
@@ -49,20 +48,8 @@ RESULT_COLUMNS = {
 _DELIMITERS = {".csv": ",", ".tsv": "\t", ".tab": "\t"}
 
 
-class RecordingError(ValueError):
-    """A damaged recording: the message names the file and the 1-based line number.
-
-    Attributes
-    ----------
-    path : pathlib.Path
-    line : int
-        1-based line number in the file.
-    """
-
-    def __init__(self, path, line: int, message: str):
-        self.path = Path(path)
-        self.line = int(line)
-        super().__init__(f"{self.path}, line {self.line}: {message}")
+class RecordingError(FileLineError):
+    """A damaged recording: the message names the file and the 1-based line number."""
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -245,13 +232,6 @@ def write_text(path, text: str) -> Path:
     path : pathlib.Path
     """
     path = Path(path)
-    descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}-", dir=path.parent)
-    try:
-        with os.fdopen(descriptor, "w", encoding="utf-8", newline="") as stream:
-            stream.write(text)
-        os.chmod(temporary, 0o644)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
+    with atomic_path(path) as temporary:
+        temporary.write_text(text, encoding="utf-8", newline="")
     return path
