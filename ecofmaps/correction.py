@@ -269,6 +269,13 @@ def _mark_ambiguous(mu, status, ecof, high, low):
     return jnp.where(ambiguous, jnp.nan, mu), status
 
 
+def _fall_if_needed(status, kappa, lam):
+    """:func:`ecof_fall` at every point, scanned only if a corrected point may fall."""
+    needed = jnp.any(_may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
+    nan = jnp.full(status.shape, jnp.nan)
+    return jax.lax.cond(needed, lambda: ecof_fall(kappa, lam), lambda: (nan, nan))
+
+
 def _root_and_status(ecof, kappa, lam):
     """The root and status without the ambiguity check, NaN wherever it is not corrected."""
     ecof, kappa, lam = jnp.broadcast_arrays(ecof, kappa, lam)
@@ -300,8 +307,10 @@ def contact_cof(ecof, kappa, lam):
     Returns
     -------
     mu : jax.Array
-        The contact CoF, with :math:`|\mu_E(\mu) - \mu_E^{given}| \le 10^{-12}\mu_E^{given}`;
-        NaN unless the status is ``CORRECTED``. [1]
+        The contact CoF, within a few ulp of the exact root: :math:`|\mu_E(\mu) -
+        \mu_E^{given}| \le 10^{-12}\mu_E^{given}` wherever one ulp of :math:`\mu` moves
+        :math:`\mu_E` by less (everywhere but a rigid rig next to locking,
+        :math:`1 - \mu\kappa < 10^{-5}`); NaN unless the status is ``CORRECTED``. [1]
     status : jax.Array of int32
         :class:`CorrectionStatus` codes.
 
@@ -309,15 +318,9 @@ def contact_cof(ecof, kappa, lam):
     -----
     Inverts the corrected eq. 13-15 with eq. 16 (module docstring).
     """
-    ecof, kappa, lam = (as_float64(v) for v in (ecof, kappa, lam))
+    ecof, kappa, lam = jnp.broadcast_arrays(*(as_float64(v) for v in (ecof, kappa, lam)))
     mu, status = _root_and_status(ecof, kappa, lam)
-    check_fall = jnp.any(_may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
-    high, low = jax.lax.cond(
-        check_fall,
-        lambda: ecof_fall(kappa * jnp.ones_like(mu), lam * jnp.ones_like(mu)),
-        lambda: (jnp.full_like(mu, jnp.nan), jnp.full_like(mu, jnp.nan)),
-    )
-    return _mark_ambiguous(mu, status, ecof, high, low)
+    return _mark_ambiguous(mu, status, ecof, *_fall_if_needed(status, kappa, lam))
 
 
 # ---------------------------------------------------------------------------------------
@@ -359,12 +362,7 @@ def _si_correct(ecof, amplitude, load, stiffness, aspect_ratio):
     """μ, status and the fall (high, low) at concrete or traced SI inputs."""
     mu, status, kappa, lam = _si_root(ecof, amplitude, load, stiffness, aspect_ratio)
     if not is_concrete(mu):
-        check_fall = jnp.any(_may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
-        high, low = jax.lax.cond(
-            check_fall,
-            lambda: ecof_fall(kappa, lam),
-            lambda: (jnp.full_like(mu, jnp.nan), jnp.full_like(mu, jnp.nan)),
-        )
+        high, low = _fall_if_needed(status, kappa, lam)
     else:
         # Only the few points where mu_E(mu) may fall are scanned, in one padded batch.
         where = np.flatnonzero(
@@ -525,8 +523,10 @@ correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy
     Returns
     -------
     mu : jax.Array of float64, or Interval
-        The contact CoF, with :math:`|\\mu_E(\\mu) - ` ``ecof`` :math:`| \\le 10^{{-12}}`
-        ``ecof``; NaN where it cannot be corrected. With ``aspect_ratio=(low, high)``, an
+        The contact CoF, within a few ulp of the exact root, so that :math:`|\\mu_E(\\mu) - `
+        ``ecof`` :math:`| \\le 10^{{-12}}` ``ecof`` except on a rigid rig next to locking
+        (:math:`1 - \\mu\\kappa < 10^{{-5}}`), where one ulp of :math:`\\mu` moves :math:`\\mu_E` by
+        more; NaN where it cannot be corrected. With ``aspect_ratio=(low, high)``, an
         :class:`Interval` ``(low, high)`` of arrays: every contact CoF that gives ``ecof``
         with an aspect ratio in the interval (``low`` from the deeper scar). [1]
     status : jax.Array of int32
