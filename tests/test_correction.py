@@ -493,3 +493,24 @@ def test_lookup_on_a_map_with_scalar_coordinates():
         one, 0.83, 60e-6, 450.0, 450.0 * 1e5, 0.2, return_status=True
     )
     assert int(status) == int(CorrectionStatus.OUTSIDE_MAP)
+
+
+def test_benchmark_section_agrees_with_scipy(capsys):
+    """The 'correction' benchmark (quick): μ recovered, and SciPy's brentq gives the same."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).parent / "benchmarks" / "bench_maps.py"
+    spec = importlib.util.spec_from_file_location("bench_maps", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    bench.correction(quick=True)
+    out = capsys.readouterr().out
+    row = next(line.split() for line in out.splitlines() if line.strip().startswith("1.00e+05"))
+    assert float(row[4]) > 0 and float(row[5]) < 1e-13  # speed; max rel error of μ
+    differences = [
+        float(line.rsplit(" ", 1)[1])
+        for line in out.splitlines()
+        if line.startswith("SciPy brentq")
+    ]
+    assert len(differences) == 2 and max(differences) < 1e-12
