@@ -332,16 +332,7 @@ def _core_numbers(amplitude, load, stiffness, aspect_ratio):
     """:math:`\\kappa` and :math:`\\lambda` with :math:`x_o = \\Delta^*`, and SI validity."""
     kappa = model.curvature_number(1.0, aspect_ratio, 1.0)  # x_o = Δ*: κ = 2 z_o/x_o
     lam = model.compliance_ratio(amplitude, load, stiffness)
-    valid = (
-        (amplitude > 0.0)
-        & jnp.isfinite(amplitude)
-        & (load > 0.0)
-        & jnp.isfinite(load)
-        & (stiffness > 0.0)
-        & ~jnp.isnan(stiffness)
-        & (aspect_ratio >= 0.0)
-        & jnp.isfinite(aspect_ratio)
-    )
+    valid = model.valid_geometry(amplitude, load, stiffness, aspect_ratio, amplitude)
     return kappa, lam, valid
 
 

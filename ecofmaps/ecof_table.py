@@ -31,6 +31,7 @@ import numpy as np
 
 from ecofmaps import model
 from ecofmaps.correction import CorrectionStatus, correct_ecof
+from ecofmaps.files import FileLineError
 
 __all__ = ["ADDED_COLUMNS", "COLUMNS", "TableError", "correct_table"]
 
@@ -56,20 +57,8 @@ _RANGES = {
 }
 
 
-class TableError(ValueError):
-    """A bad table: the message names the file and the 1-based line number (header: 1).
-
-    Attributes
-    ----------
-    path : pathlib.Path
-    line : int
-        1-based line number in the file.
-    """
-
-    def __init__(self, path, line: int, message: str):
-        self.path = Path(path)
-        self.line = int(line)
-        super().__init__(f"{self.path}, line {self.line}: {message}")
+class TableError(FileLineError):
+    """A bad table: the message names the file and the 1-based line number (header: 1)."""
 
 
 def _number(path, line: int, name: str, text: str) -> float:

@@ -401,7 +401,16 @@ def dimensionless(amplitude, load, stiffness, mu, aspect_ratio, groove_half_widt
     """
     kappa = curvature_number(amplitude, aspect_ratio, groove_half_width)
     lam = compliance_ratio(amplitude, load, stiffness)
-    si_valid = (
+    valid = valid_geometry(amplitude, load, stiffness, aspect_ratio, groove_half_width)
+    code = jnp.where(valid, regime_code(mu, kappa, lam), int(INVALID)).astype(jnp.int32)
+    return mu, kappa, lam, code
+
+
+def valid_geometry(amplitude, load, stiffness, aspect_ratio, groove_half_width):
+    """True where the SI inputs other than mu are in range (traced-input counterpart of
+    :func:`check_model_inputs`): all finite and > 0, stiffness may be inf, aspect ratio >= 0.
+    """
+    return (
         (amplitude > 0.0)
         & jnp.isfinite(amplitude)
         & (load > 0.0)
@@ -413,8 +422,6 @@ def dimensionless(amplitude, load, stiffness, mu, aspect_ratio, groove_half_widt
         & (groove_half_width > 0.0)
         & jnp.isfinite(groove_half_width)
     )
-    code = jnp.where(si_valid, regime_code(mu, kappa, lam), int(INVALID)).astype(jnp.int32)
-    return mu, kappa, lam, code
 
 
 @jax.jit(static_argnames="quantity")
