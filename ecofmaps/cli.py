@@ -164,7 +164,7 @@ def _add_figures(subparsers) -> None:
     listing = "\n".join(f"  {name:<10} {recipe.description}" for name, recipe in FIGURES.items())
     parser = subparsers.add_parser(
         "figures",
-        help="write the paper's Figures 5-11 and the universal map (default into figures/)",
+        help="write the paper's Figures 5-8 and 11 and the universal map (default: figures/)",
         description=textwrap.fill(
             "Write the paper's Figures 5, 6, 7a, 7b, 8, 11a, 11b and the universal map of "
             "the ECoF ratio, one file per figure and format (fig5.png, ...). Parameters are "
@@ -645,7 +645,9 @@ def build_parser() -> argparse.ArgumentParser:
         description=(
             "Fretting friction maps: how far the energy coefficient of friction drifts "
             "from the contact one with rig stiffness and wear-scar shape, the paper's "
-            "figures, and corrections. Quantities take units: 50um, 450N, 35MN/m."
+            "figures, corrections of reported ECoF values, and the per-cycle analysis of "
+            "measured loops (ECoF, GICoF, rig stiffness). Quantities take units: 50um, "
+            "450N, 35MN/m."
         ),
     )
     parser.add_argument("--version", action="version", version=f"ecofmaps {__version__}")
