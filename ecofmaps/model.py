@@ -291,17 +291,16 @@ def slip_ratio(mu, kappa, lam):
     return jnp.where((code == int(GROSS_SLIP)) | (code == int(NO_GROSS_SLIP)), d, jnp.nan)
 
 
-# Coefficients 1/(2n+1), n = 1..14, of artanh(u)/u - 1 = sum u^(2n)/(2n+1). At |u| < 1/4
-# the first omitted term is below 2e-18 of the sum; above, the direct formula loses at most a
-# factor 1/0.0216 of its last digit to the subtraction of 1.
-_SERIES_LIMIT = 0.25
-_SERIES = tuple(1.0 / (2 * n + 1) for n in range(14, 0, -1))
+# Coefficients 1/(2n+1), n = 1..28, of artanh(u)/u - 1 = sum u^(2n)/(2n+1). At |u| < 1/2
+# the first omitted term is below 1e-17 of the sum.
+_SERIES_LIMIT = 0.5
+_SERIES = tuple(1.0 / (2 * n + 1) for n in range(28, 0, -1))
 
 
 def _artanh_excess(u, margin):
     r""":math:`\operatorname{artanh}(u)/u - 1` for :math:`u = 1 - w` in :math:`[0, 1)`.
 
-    A series at :math:`u < 1/4` (no cancellation as :math:`u \to 0`); above, the logarithm
+    A series at :math:`u < 1/2` (no cancellation as :math:`u \to 0`); above, the logarithm
     of :math:`(2 - w)/w` with the margin :math:`w` itself, so the digits of :math:`1 - u`
     are not lost near the locking point.
     """
