@@ -8,8 +8,6 @@ import importlib
 from importlib.metadata import PackageNotFoundError, version
 
 from ecofmaps._inputs import RegimeWarning
-from ecofmaps.analysis import analyze_loops
-from ecofmaps.cache import CacheWarning, cache_entries, clear_cache
 from ecofmaps.correction import (
     CorrectionStatus,
     Interval,
@@ -17,9 +15,16 @@ from ecofmaps.correction import (
     correction_factor,
     lookup_correction,
 )
-from ecofmaps.fit import LoopFit, fit_loop
-from ecofmaps.loop import fretting_loop, simulate
-from ecofmaps.maps import compute_loops, compute_map, compute_universal_map
+from ecofmaps.io import read_recording
+from ecofmaps.maps import (
+    CacheWarning,
+    cache_entries,
+    clear_cache,
+    compute_loops,
+    compute_map,
+    compute_universal_map,
+)
+from ecofmaps.measured import LoopFit, analyze_loops, fit_loop, synthetic_recording
 from ecofmaps.model import (
     GROSS_SLIP,
     INVALID,
@@ -28,12 +33,12 @@ from ecofmaps.model import (
     Regime,
     dissipated_energy,
     energy_cof,
+    fretting_loop,
     max_force,
     regime,
+    simulate,
     slip_amplitude,
 )
-from ecofmaps.recordings import read_recording
-from ecofmaps.synthetic import synthetic_recording
 
 
 def __getattr__(name: str):

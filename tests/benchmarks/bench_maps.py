@@ -21,11 +21,10 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # tests/, for brute_force
-
-from brute_force import steady_loop
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository, for tests/
 
 from ecofmaps.maps import compute_map
+from tests.brute_force import steady_loop
 
 
 def timed(function) -> tuple[float, float]:
@@ -212,8 +211,8 @@ def loops(quick: bool) -> None:
     (1 % of Q*, 0.5 % of Δ*), offsets and a drift are added, so every cycle differs. The
     best of ``repeats`` calls is kept; the median GICoF against μ = 0.8 checks the result.
     """
-    from ecofmaps.analysis import analyze_loops
-    from ecofmaps.synthetic import synthetic_recording
+    from ecofmaps.measured.analysis import analyze_loops
+    from ecofmaps.measured.synthetic import synthetic_recording
 
     point = dict(amplitude=50e-6, load=LOAD, stiffness=35e6, mu=MU, aspect_ratio=0.2)
     samples_per_cycle = 200

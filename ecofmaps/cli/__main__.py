@@ -1,0 +1,7 @@
+"""``python -m ecofmaps.cli``: the ``ecofmaps`` command."""
+
+import sys
+
+from ecofmaps.cli.main import main
+
+sys.exit(main())

@@ -1,0 +1,201 @@
+"""Tables of reported ECoF values, corrected row by row to the contact CoF.
+
+The table ``ecofmaps correct TABLE.csv`` reads: comma-separated, a header line naming the
+columns, one test per line. Columns (in any order, names exact, others kept as they are):
+
+=====================  ==================================================  =======
+``ecof``               reported energy coefficient of friction μ_E          [1]
+``amplitude_um``       displacement amplitude Δ*                            [µm]
+``load_N``             normal load P                                        [N]
+``stiffness_MN_per_m`` rig stiffness S (``inf`` for a rigid rig)            [MN/m]
+``aspect_ratio``       wear scar depth over half-width z_o/x_o = D/W        [1]
+``scar_depth_um``      or the scar depth D ...                              [µm]
+``scar_half_width_um`` ... and half-width W (eq. 11)                        [µm]
+=====================  ==================================================  =======
+
+Each row gives its aspect ratio one way: ``aspect_ratio``, or ``scar_depth_um`` and
+``scar_half_width_um`` (a table may hold both kinds of rows, with the other cells empty).
+Blank lines are skipped. The output keeps every input column and cell as written and adds
+``mu``, ``correction_factor`` (μ/μ_E) and ``regime``. A bad row raises :class:`TableError`,
+naming the file and the 1-based line number in the file (the header is line 1).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ecofmaps import model
+from ecofmaps.correction.inversion import CorrectionStatus, correct_ecof
+from ecofmaps.io.files import FileLineError
+
+__all__ = ["ADDED_COLUMNS", "COLUMNS", "TableError", "correct_table"]
+
+#: Input columns: name -> (factor to SI, rule, description).
+COLUMNS = {
+    "ecof": (1.0, "positive", "the reported energy CoF"),
+    "amplitude_um": (1e-6, "positive", "the displacement amplitude in µm"),
+    "load_N": (1.0, "positive", "the normal load in N"),
+    "stiffness_MN_per_m": (1e6, "positive_or_inf", "the rig stiffness in MN/m"),
+    "aspect_ratio": (1.0, "non_negative", "the scar's depth over half-width"),
+    "scar_depth_um": (1e-6, "non_negative", "the scar depth in µm"),
+    "scar_half_width_um": (1e-6, "positive", "the scar half-width in µm"),
+}
+#: Columns added to the output.
+ADDED_COLUMNS = ("mu", "correction_factor", "regime")
+
+_REQUIRED = ("ecof", "amplitude_um", "load_N", "stiffness_MN_per_m")
+_SCAR = ("scar_depth_um", "scar_half_width_um")
+_RANGES = {
+    "positive": (lambda v: 0.0 < v < math.inf, "> 0 and finite"),
+    "positive_or_inf": (lambda v: v > 0.0, "> 0 (inf for a rigid rig)"),
+    "non_negative": (lambda v: 0.0 <= v < math.inf, ">= 0 and finite"),
+}
+
+
+class TableError(FileLineError):
+    """A bad table: the message names the file and the 1-based line number (header: 1)."""
+
+
+def _number(path, line: int, name: str, text: str) -> float:
+    """The cell ``text`` of column ``name`` in SI, range-checked."""
+    factor, rule, description = COLUMNS[name]
+    try:
+        value = float(text)
+    except ValueError:
+        raise TableError(
+            path, line, f"{name} = {text.strip()!r} is not a number ({description})"
+        ) from None
+    test, valid = _RANGES[rule]
+    if not test(value):
+        raise TableError(path, line, f"{name} must be {valid}, got {text.strip()}")
+    return value * factor
+
+
+def _read(path: Path):
+    """Header, rows (cells as written), their line numbers and the SI columns."""
+    try:
+        with open(path, encoding="utf-8-sig", newline="") as stream:
+            records = list(_records(csv.reader(stream)))
+    except UnicodeDecodeError as error:
+        raise TableError(path, 1, f"not a UTF-8 text file ({error.reason})") from None
+    except csv.Error as error:
+        raise TableError(path, 1, f"not a CSV table ({error})") from None
+    if not records:
+        raise TableError(path, 1, "the file is empty; expected a header line")
+    (header, header_line), records = records[0], records[1:]
+    header = [name.strip() for name in header]
+    _check_header(path, header_line, header)
+    if not records:
+        raise TableError(path, header_line, "the table has a header but no data rows")
+    column = {name: header.index(name) for name in COLUMNS if name in header}
+    values = {name: [] for name in COLUMNS}
+    for row, line in records:
+        if len(row) != len(header):
+            raise TableError(
+                path, line, f"{len(row)} fields, but the header has {len(header)} columns"
+            )
+        for name in _REQUIRED:
+            values[name].append(_number(path, line, name, row[column[name]]))
+        given_ratio = "aspect_ratio" in column and row[column["aspect_ratio"]].strip() != ""
+        given_scar = [name in column and row[column[name]].strip() != "" for name in _SCAR]
+        if given_ratio == any(given_scar) or (any(given_scar) and not all(given_scar)):
+            raise TableError(
+                path,
+                line,
+                "give the aspect ratio one way: aspect_ratio, or both scar_depth_um and "
+                "scar_half_width_um",
+            )
+        ratio = (
+            _number(path, line, "aspect_ratio", row[column["aspect_ratio"]])
+            if given_ratio
+            else _number(path, line, "scar_depth_um", row[column["scar_depth_um"]])
+            / _number(path, line, "scar_half_width_um", row[column["scar_half_width_um"]])
+        )
+        values["aspect_ratio"].append(ratio)
+    si = {name: np.asarray(values[name]) for name in (*_REQUIRED, "aspect_ratio")}
+    return header, records, si
+
+
+def _records(reader):
+    """Non-blank rows with the file line each ends on (csv counts the lines it reads)."""
+    for row in reader:
+        if any(cell.strip() for cell in row):
+            yield row, reader.line_num
+
+
+def _check_header(path, line: int, header: list[str]) -> None:
+    duplicates = sorted({name for name in header if header.count(name) > 1})
+    if duplicates:
+        raise TableError(path, line, f"repeated column(s) {', '.join(duplicates)}")
+    missing = [name for name in _REQUIRED if name not in header]
+    if "aspect_ratio" not in header and not all(name in header for name in _SCAR):
+        missing.append("aspect_ratio (or " + " + ".join(_SCAR) + ")")
+    if missing:
+        raise TableError(
+            path,
+            line,
+            f"missing column(s) {', '.join(missing)}; the table needs {', '.join(_REQUIRED)} "
+            f"and aspect_ratio or {' + '.join(_SCAR)}",
+        )
+    taken = [name for name in ADDED_COLUMNS if name in header]
+    if taken:
+        raise TableError(
+            path, line, f"column(s) {', '.join(taken)} would be overwritten by the results"
+        )
+
+
+def correct_table(path) -> tuple[str, int]:
+    """Correct every row of a table of reported ECoF values (see the module docstring).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The CSV table.
+
+    Returns
+    -------
+    text : str
+        The output table as CSV text: the input columns and cells, then ``mu``,
+        ``correction_factor`` (both to 10 significant digits) and ``regime``.
+    rows : int
+        The number of data rows.
+
+    Raises
+    ------
+    TableError
+        For a file that cannot be read as such a table, a bad value, or a row whose ECoF
+        cannot be corrected (the reason, as :func:`ecofmaps.correct_ecof` gives it); the
+        first such row is named by its line.
+    OSError
+        If the file cannot be opened.
+    """
+    path = Path(path)
+    header, records, si = _read(path)
+    point = dict(
+        amplitude=si["amplitude_um"],
+        load=si["load_N"],
+        stiffness=si["stiffness_MN_per_m"],
+        aspect_ratio=si["aspect_ratio"],
+    )
+    mu, status = correct_ecof(si["ecof"], **point, return_status=True)
+    mu, status = np.asarray(mu), np.asarray(status)
+    failed = np.flatnonzero(status != CorrectionStatus.CORRECTED)
+    if failed.size:
+        i = int(failed[0])
+        try:  # a single point raises with its reason
+            correct_ecof(si["ecof"][i], **{name: value[i] for name, value in point.items()})
+        except ValueError as error:
+            raise TableError(path, records[i][1], str(error)) from None
+    regimes = np.asarray(model.regime(mu=mu, **point))
+    stream = io.StringIO()
+    writer = csv.writer(stream, lineterminator="\n")
+    writer.writerow([*header, *ADDED_COLUMNS])
+    for (row, _), value, ecof, code in zip(records, mu, si["ecof"], regimes, strict=True):
+        name = model.Regime(int(code)).name.lower().replace("_", " ")
+        writer.writerow([*row, f"{value:.10g}", f"{value / ecof:.10g}", name])
+    return stream.getvalue(), len(records)

@@ -1,0 +1,7 @@
+"""Measured fretting loops: cycles, per-cycle analysis, model fits and synthetic recordings."""
+
+from ecofmaps.measured.analysis import analyze_loops
+from ecofmaps.measured.fit import LoopFit, fit_loop
+from ecofmaps.measured.synthetic import synthetic_recording
+
+__all__ = ["LoopFit", "analyze_loops", "fit_loop", "synthetic_recording"]

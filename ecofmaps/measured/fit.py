@@ -1,0 +1,418 @@
+r"""The model's steady loop fitted to a measured fretting loop (the paper's Figure 10).
+
+:func:`fit_loop` finds the contact coefficient of friction :math:`\mu`, the rig stiffness
+:math:`S` and the groove depth :math:`z_o` (with the paper's choice :math:`x_o = \Delta^*`)
+whose steady loop passes closest, in the least-squares sense, to the measured samples
+:math:`(\Delta_i, Q_i)`. The model force at each sample is the steady loop's force at the
+same actuator displacement on the same branch (rising or falling :math:`\Delta`), in closed
+form, so the residual has exact JAX derivatives; SciPy's trust-region least squares uses
+them with bounds :math:`\mu > 0`, :math:`S > 0`, :math:`z_o \ge 0`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ecofmaps._inputs import check, float64
+from ecofmaps.measured.analysis import analyze_loops
+from ecofmaps.measured.cycles import labelled_cycles, split_cycles
+from ecofmaps.model.core import slip_position, traction_ratio
+from ecofmaps.model.simulation import fretting_loop
+
+__all__ = ["LoopFit", "fit_loop"]
+
+#: Fewest samples accepted for one loop: six parameters, two branches, stick and slip.
+MIN_SAMPLES = 20
+
+# Force windows after each reversal where analyze_loops starts the stick segments (it then
+# grows them along the stick line): its default, and a narrow one that holds only stick
+# also when the groove slope at the reversal exceeds mu and the stick is short. Slip in a
+# window only lowers its slope, so the steeper of the two is the start.
+_STICK_WINDOWS = ((0.05, 0.45), (0.0, 0.15))
+# Contact positions within this share of the slip amplitude are read as slipping for the
+# starting mu and groove slope.
+_SLIP_SHARE = 0.6
+# A loop whose area is negative by more than this share of its bounding box runs
+# anticlockwise; a smaller negative area is noise on a loop without gross slip.
+_ORIENTATION_SHARE = 0.05
+# Samples are padded to a multiple of this for the compiled residual.
+_BUCKET = 64
+_TOLERANCE = 1e-12
+_MAX_EVALUATIONS = 200
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class LoopFit:
+    r"""The model fitted to one measured loop, returned by :func:`fit_loop`.
+
+    Attributes
+    ----------
+    mu : float
+        Contact coefficient of friction :math:`\mu`. [1]
+    stiffness : float
+        Rig stiffness :math:`S`. [N/m]
+    groove_depth : float
+        Groove depth :math:`z_o`. [m]
+    aspect_ratio : float
+        Groove aspect ratio :math:`z_o/x_o` with :math:`x_o = \Delta^*`. [1]
+    amplitude : float
+        Displacement amplitude :math:`\Delta^*` of the fitted loop, which is also the groove
+        half-width :math:`x_o`. [m]
+    displacement_offset : float
+        Centre of the fitted loop in displacement (a sensor offset), fitted with the
+        rest. [m]
+    force_offset : float
+        Centre of the fitted loop in force (a load-cell offset), fitted with the rest. [N]
+    load : float
+        Normal load :math:`P`, as given. [N]
+    rms_residual : float
+        Root mean square of measured minus model force over the samples. [N]
+    r_squared : float
+        Coefficient of determination :math:`1 - \sum r_i^2 / \sum (Q_i - \bar Q)^2`. [1]
+    standard_errors : dict of str to float
+        Standard error of each fitted quantity (keys ``mu``, ``stiffness``,
+        ``groove_depth``, ``aspect_ratio``, ``amplitude``, ``displacement_offset``,
+        ``force_offset``), in its unit, from the Jacobian at the solution and the residual
+        variance (a linearisation that treats the residuals as independent and alike;
+        meaningless for a parameter held at its bound, such as a flat groove).
+    success : bool
+        True when the least squares converged to a loop in gross slip.
+    evaluations : int
+        Residual evaluations the least squares used. [1]
+    message : str
+        How the least squares ended.
+    displacement, force : numpy.ndarray
+        The measured samples fitted: one cycle, from its lowest displacement on. [m], [N]
+    model_force : numpy.ndarray
+        The fitted model's force at each sample, on that sample's branch. [N]
+    rising : numpy.ndarray of bool
+        True for samples on the rising-displacement branch.
+    cycle : int
+        Number of the cycle fitted: the recorded one, or 1, 2, ... over the complete
+        cycles found at the reversals (as in :func:`ecofmaps.analyze_loops`). [1]
+    """
+
+    mu: float
+    stiffness: float
+    groove_depth: float
+    aspect_ratio: float
+    amplitude: float
+    displacement_offset: float
+    force_offset: float
+    load: float
+    rms_residual: float
+    r_squared: float
+    standard_errors: dict
+    success: bool
+    evaluations: int
+    message: str
+    displacement: np.ndarray
+    force: np.ndarray
+    model_force: np.ndarray
+    rising: np.ndarray
+    cycle: int
+
+    def model_loop(self, num=201):
+        """The fitted steady loop, offsets included, for plotting.
+
+        Parameters
+        ----------
+        num : int
+            Points on each slip branch (see :func:`ecofmaps.fretting_loop`). [1]
+
+        Returns
+        -------
+        displacement, force : numpy.ndarray
+            One closed cycle of the fitted model loop. [m], [N]
+        """
+        displacement, force = fretting_loop(
+            self.amplitude, self.load, self.stiffness, self.mu, self.aspect_ratio, num=num
+        )
+        return (
+            np.asarray(displacement) + self.displacement_offset,
+            np.asarray(force) + self.force_offset,
+        )
+
+
+def _rising_branch(target, mu, kappa, lam):
+    r""":math:`Q/P` of the steady loop's rising branch at actuator position ``target``.
+
+    After the reversal at :math:`(-1, -q^*)` the contact sticks at :math:`\xi = -d`, so
+    :math:`q = (D + d)/\lambda`, until the forward-slip force
+    :math:`Q_+(\xi_+(D))` (eq. 9 at the root of eq. 10) is lower; it is the smaller of the two.
+    """
+    d = slip_position(1.0, mu, kappa, lam)
+    stick = (target + d) / lam
+    slip = traction_ratio(slip_position(target, mu, kappa, lam), mu, kappa)
+    return jnp.minimum(stick, slip)
+
+
+def _model_force(parameters, displacement, rising):
+    """Model Q/P at each scaled sample; parameters (mu, s, a, A, c, q) as in :func:`fit_loop`."""
+    mu, s, a, amplitude, centre, offset = parameters
+    lam = 1.0 / (s * amplitude)
+    kappa = 2.0 * a / amplitude
+    target = (displacement - centre) / amplitude
+    up = _rising_branch(target, mu, kappa, lam)
+    down = -_rising_branch(-target, mu, kappa, lam)
+    return jnp.where(rising, up, down) + offset
+
+
+def _residual(parameters, displacement, force, rising, weight):
+    return weight * (_model_force(parameters, displacement, rising) - force)
+
+
+_residual_jit = jax.jit(_residual)
+_jacobian_jit = jax.jit(jax.jacfwd(_residual))
+
+
+def _starting_values(x, y, rising, stiffness, slip_half_width, energy_ratio):
+    r"""Scaled starting parameters (:math:`\Delta/L`, :math:`Q/P`, centred) from the loop.
+
+    ``stiffness`` (:math:`SL/P`), ``slip_half_width`` (:math:`\delta^*/L`) and
+    ``energy_ratio`` come from :func:`ecofmaps.analyze_loops`. The contact position
+    :math:`x = \Delta - Q/S` (eq. 10) on the slip segments gives :math:`\mu` and the
+    groove slope :math:`k` by least squares on :math:`Q_\pm/P \approx \pm\mu + k(1 +
+    \mu^2) x` (eq. 9 to first order in :math:`x`; at :math:`x = 0` this is the GICoF).
+    """
+    if energy_ratio < -_ORIENTATION_SHARE:
+        raise ValueError(
+            "the loop runs anticlockwise (its area ∮Q dΔ is negative): force and "
+            "displacement must be positive in the same direction"
+        )
+    if stiffness == np.inf:
+        raise ValueError(
+            "the loop's stick segments are vertical (a rigid rig, S = inf): the model's "
+            "stiffness cannot be fitted"
+        )
+    slipping = np.zeros_like(rising)
+    if stiffness > 0 and slip_half_width > 0:
+        contact = x - y / stiffness
+        slipping = np.abs(contact) < _SLIP_SHARE * slip_half_width
+    if min(np.count_nonzero(slipping & rising), np.count_nonzero(slipping & ~rising)) < 2:
+        raise ValueError(
+            "the loop shows no gross slip (no slip segment between the stick segments, or "
+            "too few samples on it), so mu and the groove depth cannot be fitted"
+        )
+    sign = np.where(rising, 1.0, -1.0)
+    design = np.stack([sign[slipping], contact[slipping]], axis=1)
+    (mu, slope), *_ = np.linalg.lstsq(design, y[slipping], rcond=None)
+    if mu <= 0:
+        raise ValueError("the loop's slip segments give mu <= 0: it is not a fretting loop")
+    groove_slope = max(slope, 0.0) / (1.0 + mu * mu)
+    return np.array([mu, stiffness, groove_slope / 2.0, 1.0, 0.0, 0.0])
+
+
+def _select_cycle(x, cycle, cycle_number, hysteresis):
+    """Sample indices of one complete cycle (lowest displacement first, closed), its number."""
+    if cycle is None:
+        cycles = split_cycles(x, hysteresis)
+    else:
+        labels = np.asarray(cycle, dtype=np.float64)
+        check("cycle", labels, "finite")
+        if labels.shape != x.shape:
+            raise ValueError(
+                f"cycle must have one value per sample: {labels.size} values for {x.size} samples"
+            )
+        cycles = labelled_cycles(x, labels)
+    if cycles.label.size == 0:
+        raise ValueError(
+            f"no complete cycle in {x.size} samples: too few samples for one cycle, or the "
+            "loop does not close"
+        )
+    row = -1
+    if cycle_number is not None:
+        (rows,) = np.nonzero(cycles.label == cycle_number)
+        if rows.size == 0:
+            raise ValueError(
+                f"cycle_number {cycle_number!r} is not a complete cycle of the recording; "
+                f"complete cycles are numbered {cycles.label[0]} to {cycles.label[-1]}"
+            )
+        row = rows[0]
+    return cycles.samples[row][cycles.valid[row]], int(cycles.label[row])
+
+
+@float64
+def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hysteresis=0.5):
+    r"""Fit the model's steady loop to a measured fretting loop (the paper's Figure 10).
+
+    Parameters
+    ----------
+    displacement : array_like
+        Applied displacement :math:`\Delta` at each sample, in time order: a single loop
+        (about one period, starting anywhere on it) or a recording of many cycles. [m]
+    force : array_like
+        Tangential force :math:`Q` at each sample, positive in the direction of positive
+        displacement. [N]
+    load : float
+        Normal load :math:`P`. [N]
+    cycle : array_like, optional
+        Cycle number of each sample, as for :func:`ecofmaps.analyze_loops`; without it
+        the recording is cut at its displacement reversals, or read as a single loop. [1]
+    cycle_number : int, optional
+        The cycle to fit, a value of the ``cycle`` coordinate of
+        :func:`ecofmaps.analyze_loops`'s result; default the last complete cycle. [1]
+    hysteresis : float
+        Band of the reversal detector, as a share of the displacement's half-range
+        (0 < hysteresis < 1); see :mod:`ecofmaps.measured.cycles`. [1]
+
+    Returns
+    -------
+    fit : LoopFit
+        The fitted :math:`\mu`, :math:`S`, :math:`z_o`, :math:`\Delta^*` (= :math:`x_o`),
+        the loop's centre, the residual, convergence information and the samples fitted.
+
+    Raises
+    ------
+    ValueError
+        If ``load`` is not a positive finite number; the arrays are not one-dimensional of
+        one length, or hold NaN or infinity; the recording has no complete cycle, or none
+        numbered ``cycle_number``; the cycle has fewer than :data:`MIN_SAMPLES` samples;
+        or the loop shows no gross slip, runs anticlockwise, or has vertical stick
+        segments (a rigid rig).
+
+    Notes
+    -----
+    The cycle runs from its lowest displacement to its highest (the rising branch) and
+    back (the falling branch). On the rising branch of the steady loop the contact sticks
+    at :math:`x = -\delta^*` after the reversal, :math:`Q = S(\Delta + \delta^*)`, until it
+    slips forward with :math:`Q = Q_+(x)` and :math:`x + Q_+(x)/S = \Delta` (eq. 9, 10,
+    16); the falling branch is its image under :math:`(\Delta, Q) \to (-\Delta, -Q)`. So
+    each sample has a model force in closed form, at its own displacement on its own
+    branch, whatever the sampling or the waveform.
+
+    Six parameters are fitted: :math:`\mu`, :math:`S`, :math:`z_o`, :math:`\Delta^*` (which
+    sets the reversals, and :math:`x_o = \Delta^*` as in the paper) and the loop's centre
+    in displacement and in force (sensor offsets). They are scaled by :math:`P` and by
+    :math:`L`, half the cycle's peak-to-peak displacement, and found by
+    ``scipy.optimize.least_squares`` (trust region reflective, bounds :math:`\mu > 0`,
+    :math:`S > 0`, :math:`z_o \ge 0`, :math:`\Delta^* > 0`) with the Jacobian from
+    ``jax.jacfwd``. The starting point is the loop's own analysis
+    (:func:`ecofmaps.analyze_loops`: centre, amplitude, stick stiffness, slip amplitude)
+    and a straight-line fit of :math:`Q/P` against the contact position
+    :math:`\Delta - Q/S` on the slip segments for :math:`\mu` and the groove slope.
+    The paper sets :math:`\mu` to the loop's GICoF and reads :math:`S` off the loop
+    (Section 4.2, Figure 10); for a loop of the model both equal the fitted values.
+    """
+    check("load", load, "positive", "N")
+    if np.ndim(load) != 0:
+        raise ValueError(f"load must be a single number [N], got shape {np.shape(load)}")
+    if not 0.0 < hysteresis < 1.0:
+        raise ValueError(f"hysteresis must satisfy 0 < hysteresis < 1; got {hysteresis!r}")
+    load = float(load)
+    all_x = np.asarray(displacement, dtype=np.float64)
+    all_y = np.asarray(force, dtype=np.float64)
+    for name, values in (("displacement", all_x), ("force", all_y)):
+        if values.ndim != 1:
+            raise ValueError(f"{name} must be one-dimensional, got shape {values.shape}")
+    if all_x.size != all_y.size:
+        raise ValueError(
+            f"displacement and force must have the same length, got {all_x.size} and {all_y.size}"
+        )
+    check("displacement", all_x, "finite", "m")
+    check("force", all_y, "finite", "N")
+    if all_x.size < MIN_SAMPLES:
+        raise ValueError(f"a loop needs at least {MIN_SAMPLES} samples, got {all_x.size}")
+    if not np.ptp(all_x) > 0:
+        raise ValueError("displacement does not vary: a loop needs a displacement stroke")
+
+    index, number = _select_cycle(all_x, cycle, cycle_number, hysteresis)
+    analysis = max(
+        (
+            analyze_loops(all_x[index], all_y[index], load, stick_window=window).isel(cycle=0)
+            for window in _STICK_WINDOWS
+        ),
+        key=lambda result: float(result.stiffness),
+    )
+    # The last point closes the loop (it is the first point of the next cycle, or the
+    # first point again): fit each sample once.
+    x, y = all_x[index[:-1]], all_y[index[:-1]]
+    if x.size < MIN_SAMPLES:
+        raise ValueError(f"a loop needs at least {MIN_SAMPLES} samples, got {x.size}")
+    rising = np.arange(x.size) <= np.argmax(x)
+    length = float(analysis.amplitude)
+    centre = float(analysis.displacement_offset)
+    offset = float(analysis.force_offset)
+    scaled_x = (x - centre) / length
+    scaled_y = (y - offset) / load
+    start = _starting_values(
+        scaled_x,
+        scaled_y,
+        rising,
+        stiffness=float(analysis.stiffness) * length / load,
+        slip_half_width=float(analysis.slip_amplitude) / length,
+        energy_ratio=float(analysis.energy_ratio),
+    )
+
+    # Padded with zero-weight samples to a multiple of _BUCKET, so that loops of nearly the
+    # same length share one compiled residual and Jacobian.
+    size = _BUCKET * -(-x.size // _BUCKET)
+    pad = size - x.size
+    arguments = tuple(
+        jnp.asarray(np.pad(values, (0, pad)))
+        for values in (scaled_x, scaled_y, rising, np.ones(x.size))
+    )
+    # scipy.optimize costs 0.4 s to import: load it when a fit runs, not with `import ecofmaps`.
+    from scipy.optimize import least_squares
+
+    tiny = np.finfo(np.float64).tiny
+    solution = least_squares(
+        lambda p: np.asarray(_residual_jit(jnp.asarray(p), *arguments)),
+        start,
+        jac=lambda p: np.asarray(_jacobian_jit(jnp.asarray(p), *arguments)),
+        bounds=([tiny, tiny, 0.0, tiny, -np.inf, -np.inf], np.inf),
+        method="trf",
+        x_scale="jac",
+        ftol=_TOLERANCE,
+        xtol=_TOLERANCE,
+        gtol=_TOLERANCE,
+        max_nfev=_MAX_EVALUATIONS,
+    )
+    mu, s, a, amplitude, shift, force_shift = (float(v) for v in solution.x)
+    model_force = y + load * solution.fun[: x.size]
+    residual = y - model_force
+    gross_slip = mu / (s * amplitude) < 1.0
+    # Linearised standard errors: covariance s^2 (J^T J)^-1 of the scaled parameters, with
+    # s^2 the residual variance, carried to SI units (a ratio by its gradient).
+    jacobian = solution.jac[: x.size]
+    variance = np.sum(solution.fun[: x.size] ** 2) / (x.size - solution.x.size)
+    covariance = variance * np.linalg.pinv(jacobian.T @ jacobian)
+    deviation = np.sqrt(np.diag(covariance))
+    ratio_gradient = np.array([0.0, 0.0, 1.0 / amplitude, -a / amplitude**2, 0.0, 0.0])
+    standard_errors = {
+        "mu": float(deviation[0]),
+        "stiffness": float(deviation[1] * load / length),
+        "groove_depth": float(deviation[2] * length),
+        "aspect_ratio": float(np.sqrt(ratio_gradient @ covariance @ ratio_gradient)),
+        "amplitude": float(deviation[3] * length),
+        "displacement_offset": float(deviation[4] * length),
+        "force_offset": float(deviation[5] * load),
+    }
+    message = solution.message
+    if not gross_slip:
+        message = f"{message} (but the fitted loop has no gross slip: mu * P / (S Δ*) >= 1)"
+    return LoopFit(
+        mu=mu,
+        stiffness=float(s * load / length),
+        groove_depth=float(a * length),
+        aspect_ratio=a / amplitude,
+        amplitude=float(amplitude * length),
+        displacement_offset=float(centre + shift * length),
+        force_offset=float(offset + force_shift * load),
+        load=load,
+        rms_residual=float(np.sqrt(np.mean(residual**2))),
+        r_squared=float(1.0 - np.sum(residual**2) / np.sum((y - y.mean()) ** 2)),
+        standard_errors=standard_errors,
+        success=bool(solution.success and gross_slip),
+        evaluations=int(solution.nfev),
+        message=message,
+        displacement=x,
+        force=y,
+        model_force=model_force,
+        rising=rising,
+        cycle=number,
+    )

@@ -1,0 +1,223 @@
+r"""Synthetic fretting recordings made with the model, and the example shipped in the package.
+
+:func:`synthetic_recording` imposes a sinusoidal displacement on the model
+(:func:`ecofmaps.simulate`), one cycle per row so that the groove may change from cycle to
+cycle, and adds what a rig's sensors add: offsets, a slow drift, Gaussian noise and, if
+asked, an irregular sampling clock. Each cycle is simulated twice over from rest and the
+second pass kept, so every recorded loop is the steady loop of its own groove.
+
+:func:`example_recording` is the deterministic generator of the recording shipped as
+``ecofmaps/data/synthetic_fretting_test.csv`` (see :func:`example_path`), which
+``ecofmaps loops --example`` analyses.
+"""
+
+from __future__ import annotations
+
+import importlib.resources
+from pathlib import Path
+
+import numpy as np
+
+from ecofmaps.io.recordings import write_text
+from ecofmaps.model.simulation import simulate
+
+__all__ = [
+    "EXAMPLE",
+    "EXAMPLE_FILE",
+    "example_path",
+    "example_recording",
+    "synthetic_recording",
+    "write_example",
+]
+
+
+def synthetic_recording(
+    amplitude,
+    load,
+    stiffness,
+    mu,
+    aspect_ratio,
+    groove_half_width=None,
+    *,
+    cycles=None,
+    samples_per_cycle=200,
+    start_phase=0.0,
+    displacement_noise=0.0,
+    force_noise=0.0,
+    displacement_offset=0.0,
+    force_offset=0.0,
+    displacement_drift=0.0,
+    sampling_jitter=0.0,
+    seed=0,
+):
+    r"""A recording of consecutive fretting cycles under a sinusoidal displacement.
+
+    Parameters
+    ----------
+    amplitude : float
+        Displacement amplitude :math:`\Delta^*`. [m]
+    load, stiffness, mu : float
+        Normal load :math:`P` [N], rig stiffness :math:`S` [N/m], contact CoF [1].
+    aspect_ratio : float or array_like
+        Groove depth over half-width :math:`z_o/x_o`, one value or one per cycle. [1]
+    groove_half_width : float, optional
+        Groove half-width :math:`x_o`; defaults to ``amplitude`` (the paper's choice). [m]
+    cycles : int, optional
+        Number of cycles; by default one per value of ``aspect_ratio``. [1]
+    samples_per_cycle : int
+        Samples in each cycle (>= 8). [1]
+    start_phase : float
+        Phase of the first sample, in cycles: 0 starts at the lowest displacement,
+        0.25 at zero displacement on the rise. [1]
+    displacement_noise, force_noise : float
+        Standard deviations of the Gaussian noise added to the recorded displacement [m]
+        and force [N].
+    displacement_offset, force_offset : float
+        Constant offsets added to the recorded displacement [m] and force [N].
+    displacement_drift : float
+        Drift of the recorded displacement per cycle, growing linearly in time. [m]
+    sampling_jitter : float
+        Each sampling instant moves at random by up to this share of the sampling
+        interval either way (0 <= jitter < 0.5), for a non-uniform clock. [1]
+    seed : int
+        Seed of the random numbers (noise and jitter).
+
+    Returns
+    -------
+    displacement, force : numpy.ndarray
+        The recorded signals, ``cycles * samples_per_cycle`` samples. [m], [N]
+
+    Notes
+    -----
+    The actuator imposes :math:`\Delta(t) = -\Delta^*\cos 2\pi t`; the force is
+    :func:`ecofmaps.simulate`'s stick/slip history for it (eq. 9, 10), which does not
+    depend on the sampling. The noise, offsets and drift are added to the recorded
+    signals only, as a sensor would.
+    """
+    ratio = np.atleast_1d(np.asarray(aspect_ratio, dtype=np.float64))
+    if ratio.ndim != 1:
+        raise ValueError("aspect_ratio must be one value or one per cycle")
+    cycles = ratio.size if cycles is None else int(cycles)
+    if cycles < 1 or ratio.size not in (1, cycles):
+        raise ValueError(
+            f"cycles must be >= 1 and match the {ratio.size} aspect ratios; got {cycles!r}"
+        )
+    if int(samples_per_cycle) < 8:
+        raise ValueError(f"samples_per_cycle must be >= 8; got {samples_per_cycle!r}")
+    if not 0.0 <= sampling_jitter < 0.5:
+        raise ValueError(f"sampling_jitter must satisfy 0 <= jitter < 0.5; got {sampling_jitter!r}")
+    n = int(samples_per_cycle)
+    rng = np.random.default_rng(seed)
+    half_width = amplitude if groove_half_width is None else groove_half_width
+    instants = np.arange(cycles * n) + rng.uniform(-sampling_jitter, sampling_jitter, cycles * n)
+    phase = instants.reshape(cycles, n) / n + start_phase
+    # Two passes over each cycle from rest; the second is the steady loop.
+    imposed = -amplitude * np.cos(2.0 * np.pi * np.concatenate([phase, phase + 1.0], axis=1))
+    force = np.asarray(
+        simulate(imposed, load, stiffness, mu, np.broadcast_to(ratio, (cycles,)), half_width)
+    )[:, n:].ravel()
+    displacement = imposed[:, n:].ravel()
+    displacement = (
+        displacement
+        + displacement_offset
+        + displacement_drift * instants / n
+        + rng.normal(0.0, 1.0, displacement.size) * displacement_noise
+    )
+    force = force + force_offset + rng.normal(0.0, 1.0, force.size) * force_noise
+    return displacement, force
+
+
+#: The parameters of the shipped example: the paper's Example 2 rig (Section 3) with a
+#: groove that deepens from flat to z_o/x_o = 0.2 over a 300 000-cycle test, one loop
+#: recorded every 2000 cycles.
+EXAMPLE = {
+    "amplitude": 50e-6,
+    "load": 450.0,
+    "stiffness": 35e6,
+    "mu": 0.8,
+    "final_aspect_ratio": 0.2,
+    "test_cycles": 300_000,
+    "recorded_every": 2000,
+    "samples_per_cycle": 160,
+    "displacement_noise": 0.25e-6,
+    "force_noise": 4.0,
+    "displacement_offset": 3.0e-6,
+    "force_offset": 6.0,
+    "displacement_drift": 2.0e-6,
+    "seed": 20160101,
+}
+
+#: File name of the shipped example in ``ecofmaps/data``.
+EXAMPLE_FILE = "synthetic_fretting_test.csv"
+
+_HEADER = """\
+# SYNTHETIC DATA, not a measurement: made by ecofmaps.measured.synthetic.example_recording().
+# The model's fretting loops (Jin, Sun & Shipway 2016) for the paper's Example 2 rig:
+# P = 450 N, S = 35 MN/m, mu = 0.8, amplitude 50 um = groove half-width x_o, with a groove
+# whose depth grows as z_o/x_o = 0.2 * sqrt(N / 300000) over a 300 000-cycle test.
+# One loop of 160 samples is recorded every 2000 cycles (the cycle column), starting at
+# zero displacement on the rise. Added: noise of 0.25 um and 4 N (0.5 % of the amplitude,
+# about 1 % of Q*), offsets of 3 um and 6 N, and a displacement drift of 2 um over the test.
+# ECoF rises with the groove while the GICoF stays at mu = 0.8.
+# Columns: test cycle number, displacement [um], tangential force [N].
+"""
+
+
+def example_recording():
+    """The shipped example: the cycle number, displacement and force of every sample.
+
+    Returns
+    -------
+    cycle : numpy.ndarray of int64
+        The test cycle at which each recorded loop was taken. [1]
+    displacement, force : numpy.ndarray
+        [m], [N]
+
+    Notes
+    -----
+    Deterministic: a fixed seed, see :data:`EXAMPLE` for the parameters.
+    """
+    p = EXAMPLE
+    recorded = np.arange(1, p["test_cycles"] // p["recorded_every"] + 1) * p["recorded_every"]
+    ratio = p["final_aspect_ratio"] * np.sqrt(recorded / p["test_cycles"])
+    displacement, force = synthetic_recording(
+        p["amplitude"],
+        p["load"],
+        p["stiffness"],
+        p["mu"],
+        ratio,
+        samples_per_cycle=p["samples_per_cycle"],
+        start_phase=0.25,
+        displacement_noise=p["displacement_noise"],
+        force_noise=p["force_noise"],
+        displacement_offset=p["displacement_offset"],
+        force_offset=p["force_offset"],
+        displacement_drift=p["displacement_drift"] / recorded.size,
+        seed=p["seed"],
+    )
+    cycle = np.repeat(recorded, p["samples_per_cycle"])
+    return cycle, displacement, force
+
+
+def write_example(path):
+    """Write :func:`example_recording` as the shipped CSV file (atomically).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Destination file.
+
+    Returns
+    -------
+    path : pathlib.Path
+    """
+    cycle, displacement, force = example_recording()
+    rows = "\n".join(
+        f"{c:d},{d:.4f},{f:.3f}" for c, d, f in zip(cycle, displacement * 1e6, force, strict=True)
+    )
+    return write_text(path, f"{_HEADER}cycle,displacement,force\n{rows}\n")
+
+
+def example_path() -> Path:
+    """Path of the shipped example recording (see :func:`example_recording`)."""
+    return Path(str(importlib.resources.files("ecofmaps") / "data" / EXAMPLE_FILE))

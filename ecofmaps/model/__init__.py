@@ -1,0 +1,54 @@
+"""The compliant wear-scar interaction model (the paper's Sections 2 and 3).
+
+:mod:`~ecofmaps.model.core` holds the dimensionless core on (μ, κ, λ),
+:mod:`~ecofmaps.model.steady_state` the steady loop's quantities in SI units,
+:mod:`~ecofmaps.model.simulation` the steady loop and the time-domain return map, and
+:mod:`~ecofmaps.model.regimes` the regime codes.
+"""
+
+from ecofmaps.model.core import (
+    compliance_ratio,
+    curvature_number,
+    ecof_ratio,
+    locking_margin,
+    normalized_energy,
+    normalized_max_force,
+    regime_code,
+    slip_position,
+    slip_ratio,
+    traction_ratio,
+)
+from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP, SELF_LOCKING, Regime
+from ecofmaps.model.simulation import fretting_loop, simulate
+from ecofmaps.model.steady_state import (
+    dissipated_energy,
+    energy_cof,
+    max_force,
+    regime,
+    slip_amplitude,
+)
+
+__all__ = [
+    "GROSS_SLIP",
+    "INVALID",
+    "NO_GROSS_SLIP",
+    "SELF_LOCKING",
+    "Regime",
+    "compliance_ratio",
+    "curvature_number",
+    "dissipated_energy",
+    "ecof_ratio",
+    "energy_cof",
+    "fretting_loop",
+    "locking_margin",
+    "max_force",
+    "normalized_energy",
+    "normalized_max_force",
+    "regime",
+    "regime_code",
+    "simulate",
+    "slip_amplitude",
+    "slip_position",
+    "slip_ratio",
+    "traction_ratio",
+]

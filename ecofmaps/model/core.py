@@ -1,0 +1,325 @@
+r"""The compliant wear-scar interaction model: traction, slip amplitude, energy, ECoF.
+
+A rigid round-ended pad slides in a parabolic groove :math:`z = z_o (x/x_o)^2` under a
+normal load :math:`P`; a spring of stiffness :math:`S` (the rig's compliance) links it
+to the actuator, which imposes the displacement :math:`\Delta`. Coulomb friction
+:math:`\mu` acts at the contact point.
+
+The dimensionless core
+----------------------
+Lengths are measured in units of a reference length :math:`L` (the displacement
+amplitude :math:`\Delta^*` for the steady loop, the groove half-width :math:`x_o` for a
+time history). Three numbers then fix everything:
+
+* ``mu``: the contact coefficient of friction :math:`\mu`;
+* ``kappa``: the curvature number :math:`\kappa = k L` with :math:`k = 2 z_o/x_o^2`
+  the groove's slope per unit length (eq. 7), so the slope at :math:`\xi = x/L` is
+  :math:`\kappa\xi`;
+* ``lam``: the compliance ratio :math:`\lambda = P/(S L)`, the rig's deflection at
+  :math:`Q = P` over :math:`L` (0 for a rigid rig).
+
+The core functions (:func:`traction_ratio`, :func:`slip_position`, :func:`slip_ratio`,
+:func:`locking_margin`, :func:`ecof_ratio`, :func:`normalized_max_force`, :func:`normalized_energy`,
+:func:`regime_code`) are pure ``jax.numpy`` functions of these numbers that broadcast
+and work under ``jit``, ``vmap`` and ``grad``; they do no input checking. The SI-unit
+functions (:func:`slip_amplitude`, :func:`dissipated_energy`, :func:`energy_cof`,
+:func:`max_force`, :func:`regime`) validate concrete inputs, are jit-compiled, and
+always compute in float64.
+"""
+
+from __future__ import annotations
+
+import jax.numpy as jnp
+
+from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP, SELF_LOCKING
+
+__all__ = [
+    "compliance_ratio",
+    "curvature_number",
+    "ecof_ratio",
+    "locking_margin",
+    "normalized_energy",
+    "normalized_max_force",
+    "regime_code",
+    "slip_position",
+    "slip_ratio",
+    "traction_ratio",
+]
+
+
+def curvature_number(length, aspect_ratio, groove_half_width):
+    r"""Curvature number :math:`\kappa = 2 (z_o/x_o)(L/x_o)`.
+
+    Parameters
+    ----------
+    length : array_like
+        The reference length :math:`L` (the amplitude :math:`\Delta^*`). [m]
+    aspect_ratio : array_like
+        Groove depth over half-width :math:`z_o/x_o`. [1]
+    groove_half_width : array_like
+        Groove half-width :math:`x_o`. [m]
+
+    Returns
+    -------
+    kappa : jax.Array
+        The groove slope at :math:`x = L`, eq. 7. [1]
+    """
+    return 2.0 * aspect_ratio * length / groove_half_width
+
+
+def compliance_ratio(length, load, stiffness):
+    r"""Compliance ratio :math:`\lambda = P/(S L)`; 0 for a rigid rig (``stiffness=inf``).
+
+    Parameters
+    ----------
+    length : array_like
+        The reference length :math:`L` (the amplitude :math:`\Delta^*`). [m]
+    load : array_like
+        Normal load :math:`P`. [N]
+    stiffness : array_like
+        Rig stiffness :math:`S`. [N/m]
+
+    Returns
+    -------
+    lam : jax.Array
+        The rig's deflection at :math:`Q = P` in units of :math:`L`. [1]
+    """
+    return load / (stiffness * length)
+
+
+def traction_ratio(position, mu, kappa, direction=1.0):
+    r"""Tangential force over normal load while slipping, :math:`Q/P` (eq. 9).
+
+    .. math:: \frac{Q_s}{P} = \frac{s\mu + \kappa\xi}{1 - s\mu\kappa\xi}
+
+    Parameters
+    ----------
+    position : array_like
+        Contact position :math:`\xi = x/L`. [1]
+    mu : array_like
+        Contact coefficient of friction. [1]
+    kappa : array_like
+        Curvature number. [1]
+    direction : array_like
+        Sign :math:`s` of the slip velocity, +1 or -1. [1]
+
+    Returns
+    -------
+    q : jax.Array
+        :math:`Q/P`; infinite at the locking point :math:`s\mu\kappa\xi = 1`. [1]
+    """
+    slope = kappa * position
+    return (direction * mu + slope) / (1.0 - direction * mu * slope)
+
+
+def _slip_roots(target, mu, kappa, lam):
+    """Forward-slip equilibrium: the position and its margin to the locking point."""
+    a = mu * kappa
+    h = a * target + lam * kappa - 1.0
+    g = lam * kappa * (1.0 + mu * mu)
+    root = jnp.sqrt(h * h + 4.0 * g)
+    # Each jnp.where evaluates both branches: feed the unused one a harmless value so that
+    # neither produces inf/NaN that would poison gradients.
+    h_positive = h > 0.0
+    margin = jnp.where(h_positive, 2.0 * g / jnp.where(h_positive, h + root, 1.0), (root - h) / 2.0)
+    b = h + 2.0
+    c = target - lam * mu
+    b_positive = b > 0.0
+    position = jnp.where(
+        b_positive,
+        2.0 * c / jnp.where(b_positive, b + root, 1.0),
+        (b - root) / (2.0 * jnp.where(b_positive, 1.0, a)),
+    )
+    return position, margin
+
+
+def slip_position(target, mu, kappa, lam):
+    r"""Contact position reached by forward slip when the actuator is at ``target``.
+
+    Solves :math:`\xi + \lambda\, Q_+(\xi)/P = D` (eq. 9 with eq. 10) for the root below
+    the locking point :math:`\mu\kappa\xi = 1`; with :math:`D = 1` this is eq. 16.
+    Multiplying out gives :math:`a\xi^2 - b\xi + c = 0` with :math:`a = \mu\kappa`,
+    :math:`b = 1 + \mu\kappa D + \lambda\kappa`, :math:`c = D - \lambda\mu`. The root is
+    taken as :math:`2c/(b + \sqrt{b^2 - 4ac})` (no cancellation when :math:`b > 0`, finite
+    as :math:`\kappa \to 0`), and the discriminant is summed from non-negative terms,
+    :math:`b^2 - 4ac = (aD + \lambda\kappa - 1)^2 + 4\lambda\kappa(1 + \mu^2)`.
+
+    Parameters
+    ----------
+    target : array_like
+        Actuator displacement :math:`D = \Delta/L`. [1]
+    mu, kappa, lam : array_like
+        Friction coefficient, curvature number, compliance ratio. [1]
+
+    Returns
+    -------
+    xi : jax.Array
+        The contact position :math:`x/L`; it equals the locking point :math:`1/(\mu\kappa)`
+        when a rigid rig (``lam = 0``) is pushed beyond it. [1]
+    """
+    return _slip_roots(target, mu, kappa, lam)[0]
+
+
+def locking_margin(target, mu, kappa, lam):
+    r"""Margin :math:`w = 1 - \mu\kappa\xi` of the forward-slip position to the locking point.
+
+    The denominator of eq. 9 at the position :func:`slip_position` returns, computed
+    without cancellation: :math:`w` solves :math:`w^2 + (aD + \lambda\kappa - 1)w -
+    \lambda\kappa(1 + \mu^2) = 0` (the quadratic of eq. 16 in :math:`w`), whose positive
+    root is taken in the form that never subtracts nearly equal numbers. It keeps its
+    relative accuracy when a stiff rig drives a deep groove close to locking, where
+    :math:`1 - \mu\kappa\xi` computed from :math:`\xi` would lose every digit.
+
+    Parameters
+    ----------
+    target : array_like
+        Actuator displacement :math:`D = \Delta/L`. [1]
+    mu, kappa, lam : array_like
+        Friction coefficient, curvature number, compliance ratio. [1]
+
+    Returns
+    -------
+    w : jax.Array
+        In :math:`(0, \infty)`; 0 at or beyond the locking point of a rigid rig. [1]
+    """
+    return _slip_roots(target, mu, kappa, lam)[1]
+
+
+def regime_code(mu, kappa, lam):
+    r"""Regime of each point, as :class:`Regime` integer codes.
+
+    Parameters
+    ----------
+    mu, kappa, lam : array_like
+        Friction coefficient (> 0), curvature number (>= 0), compliance ratio (>= 0). [1]
+
+    Returns
+    -------
+    code : jax.Array of int32
+        ``INVALID`` for inputs out of range or NaN; else ``NO_GROSS_SLIP`` where
+        :math:`\mu\lambda \ge 1`; ``SELF_LOCKING`` where :math:`\lambda = 0` and
+        :math:`\mu\kappa \ge 1`; ``GROSS_SLIP`` elsewhere.
+    """
+    valid = (
+        (mu > 0.0)
+        & jnp.isfinite(mu)
+        & (kappa >= 0.0)
+        & jnp.isfinite(kappa)
+        & (lam >= 0.0)
+        & jnp.isfinite(lam)
+    )
+    code = jnp.where(
+        mu * lam >= 1.0,
+        int(NO_GROSS_SLIP),
+        jnp.where((lam == 0.0) & (mu * kappa >= 1.0), int(SELF_LOCKING), int(GROSS_SLIP)),
+    )
+    return jnp.where(valid, code, int(INVALID)).astype(jnp.int32)
+
+
+def slip_ratio(mu, kappa, lam):
+    r"""Slip amplitude over displacement amplitude, :math:`d = \delta^*/\Delta^*` (eq. 16).
+
+    Parameters
+    ----------
+    mu, kappa, lam : array_like
+        Friction coefficient, curvature number :math:`2 (z_o/x_o)(\Delta^*/x_o)` and
+        compliance ratio :math:`P/(S\Delta^*)`. [1]
+
+    Returns
+    -------
+    d : jax.Array
+        In :math:`(0, 1]` in gross slip, 0 with no gross slip, NaN when self-locking or
+        invalid. Flat groove: :math:`1 - \mu\lambda`; rigid rig: 1. [1]
+    """
+    code = regime_code(mu, kappa, lam)
+    d = slip_position(1.0, mu, kappa, lam)
+    d = jnp.where(code == int(NO_GROSS_SLIP), 0.0, d)
+    return jnp.where((code == int(GROSS_SLIP)) | (code == int(NO_GROSS_SLIP)), d, jnp.nan)
+
+
+# Coefficients 1/(2n+1), n = 1..28, of artanh(u)/u - 1 = sum u^(2n)/(2n+1). At |u| < 1/2
+# the first omitted term is below 1e-17 of the sum.
+_SERIES_LIMIT = 0.5
+_SERIES = tuple(1.0 / (2 * n + 1) for n in range(28, 0, -1))
+
+
+def _artanh_excess(u, margin):
+    r""":math:`\operatorname{artanh}(u)/u - 1` for :math:`u = 1 - w` in :math:`[0, 1)`.
+
+    A series at :math:`u < 1/2` (no cancellation as :math:`u \to 0`); above, the logarithm
+    of :math:`(2 - w)/w` with the margin :math:`w` itself, so the digits of :math:`1 - u`
+    are not lost near the locking point.
+    """
+    small = u < _SERIES_LIMIT
+    u_small = jnp.where(small, u, 0.0)
+    w_large = jnp.where(small, 0.25, margin)
+    u2 = u_small * u_small
+    series = jnp.zeros_like(u2)
+    for coefficient in _SERIES:  # Horner's rule, unrolled at trace time
+        series = (series + coefficient) * u2
+    direct = 0.5 * jnp.log((2.0 - w_large) / w_large) / (1.0 - w_large) - 1.0
+    return jnp.where(small, series, direct)
+
+
+def ecof_ratio(mu, kappa, lam):
+    r"""Energy coefficient of friction over the contact one, :math:`\mu_E/\mu`.
+
+    The corrected eq. 13-15 (the printed coefficient :math:`(1 + 1/\mu)` of the logarithm
+    must read :math:`(1 + 1/\mu^2)`), with :math:`u = \mu\kappa d`:
+
+    .. math:: \frac{\mu_E}{\mu} = 1 + \frac{1 + \mu^2}{\mu^2}
+              \left(\frac{\operatorname{artanh} u}{u} - 1\right)
+
+    Parameters
+    ----------
+    mu, kappa, lam : array_like
+        Friction coefficient, curvature number, compliance ratio. [1]
+
+    Returns
+    -------
+    ratio : jax.Array
+        :math:`\ge 1`; exactly 1 for a flat groove; NaN with no gross slip, when
+        self-locking, or for invalid input. [1]
+    """
+    d = slip_ratio(mu, kappa, lam)
+    excess = _artanh_excess(mu * kappa * d, locking_margin(1.0, mu, kappa, lam))
+    ratio = 1.0 + (1.0 + mu * mu) / (mu * mu) * excess
+    return jnp.where(d > 0.0, ratio, jnp.nan)
+
+
+def normalized_max_force(mu, kappa, lam):
+    r"""Peak tangential force over normal load, :math:`Q^*/P` (eq. 9 at :math:`x = \delta^*`).
+
+    Parameters
+    ----------
+    mu, kappa, lam : array_like
+        Friction coefficient, curvature number, compliance ratio. [1]
+
+    Returns
+    -------
+    q_max : jax.Array
+        :math:`Q_+(\delta^*)/P` in gross slip; :math:`1/\lambda` (the stick line at
+        :math:`\Delta^*`) with no gross slip; NaN when self-locking or invalid. [1]
+    """
+    d = slip_ratio(mu, kappa, lam)
+    stick = d == 0.0
+    q = (mu + kappa * d) / locking_margin(1.0, mu, kappa, lam)  # eq. 9, digits kept
+    return jnp.where(stick, 1.0 / jnp.where(stick, lam, 1.0), q)
+
+
+def normalized_energy(mu, kappa, lam):
+    r"""Dissipated energy per cycle over :math:`P\Delta^*`: :math:`4 d\,\mu_E` (eq. 1, 12).
+
+    Parameters
+    ----------
+    mu, kappa, lam : array_like
+        Friction coefficient, curvature number, compliance ratio. [1]
+
+    Returns
+    -------
+    e : jax.Array
+        :math:`E_d/(P\Delta^*)`; 0 with no gross slip; NaN when self-locking or invalid. [1]
+    """
+    d = slip_ratio(mu, kappa, lam)
+    energy = 4.0 * d * mu * ecof_ratio(mu, kappa, lam)
+    return jnp.where(d == 0.0, 0.0, energy)

@@ -1,0 +1,199 @@
+r"""Fretting loops from the model: the steady loop and a time-domain simulation.
+
+:func:`fretting_loop` draws the steady loop of a sinusoid-like stroke between
+:math:`\pm\Delta^*` in closed form (Figures 5 and 6 of the paper). :func:`simulate` runs
+the stick/slip return map over any displacement history :math:`\Delta(t)` with
+``jax.lax.scan``, solving the slip exactly at each step, so it has no time-step error
+and follows any change of amplitude.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+
+import jax
+import jax.numpy as jnp
+
+from ecofmaps._inputs import as_float64, check, float64, is_concrete
+from ecofmaps.model.core import _slip_roots, locking_margin, slip_ratio, traction_ratio
+from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
+from ecofmaps.model.steady_state import check_model_inputs, dimensionless
+
+__all__ = ["fretting_loop", "simulate"]
+
+
+@partial(jax.jit, static_argnames="num")
+def _steady_loop(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width, num):
+    mu, kappa, lam, code = dimensionless(
+        amplitude, load, stiffness, mu, aspect_ratio, groove_half_width
+    )
+    mu, kappa, lam, code = (x[..., None] for x in (mu, kappa, lam, code))
+    d = slip_ratio(mu, kappa, lam)
+    t = jnp.linspace(-1.0, 1.0, num)
+    # Forward-slip branch from -d to d (eq. 9, 10). A shallow groove (u = mu*kappa*d < 1/2)
+    # is sampled uniformly in position; a deep one so that the margin to the locking
+    # point, w = 1 - mu*kappa*xi, falls geometrically from 1 + u to its end value, which
+    # puts the points where the force rises steeply and keeps the digits of w there.
+    a = mu * kappa
+    u = a * d
+    shallow = u < 0.5
+    w_end = locking_margin(1.0, mu, kappa, lam)
+    w_end = jnp.where(shallow, 0.5, w_end)
+    w_deep = (1.0 + u) * jnp.exp((t + 1.0) / 2.0 * jnp.log(w_end / (1.0 + u)))
+    xi = jnp.where(shallow, t * d, (1.0 - w_deep) / jnp.where(shallow, 1.0, a))
+    w = jnp.where(shallow, 1.0 - a * xi, w_deep)
+    xi = xi.at[..., 0].set(-d[..., 0]).at[..., -1].set(d[..., 0])
+    q_slip = (mu + kappa * xi) / w  # eq. 9
+    target_slip = xi + lam * q_slip
+    # No gross slip: the contact sticks at the centre and the loop is the line Q = S*Delta.
+    stick = code == int(NO_GROSS_SLIP)
+    target = jnp.where(stick, t, target_slip)
+    q = jnp.where(stick, t / jnp.where(stick, lam, 1.0), q_slip)
+    ok = (code == int(GROSS_SLIP)) | stick
+    target = jnp.where(ok, target, jnp.nan)
+    q = jnp.where(ok, q, jnp.nan)
+    # The loop starts at the reversal point (-1, -q*); the backward branch is the forward
+    # one turned through 180 degrees, and it ends where the loop began.
+    start_target = jnp.where(ok[..., :1], -1.0, jnp.nan)
+    targets = jnp.concatenate([start_target, target, -target], axis=-1)
+    forces = jnp.concatenate([-q[..., -1:], q, -q], axis=-1)
+    return targets * amplitude[..., None], forces * load[..., None]
+
+
+@float64
+def fretting_loop(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width=None, num=201):
+    r"""The steady fretting loop: displacement and tangential force around one cycle.
+
+    Parameters
+    ----------
+    amplitude : array_like
+        Displacement amplitude :math:`\Delta^*`. [m]
+    load : array_like
+        Normal load :math:`P`. [N]
+    stiffness : array_like
+        Rig stiffness :math:`S`; ``numpy.inf`` for a rigid rig. [N/m]
+    mu : array_like
+        Contact coefficient of friction. [1]
+    aspect_ratio : array_like
+        Groove depth over half-width :math:`z_o/x_o`. [1]
+    groove_half_width : array_like, optional
+        Groove half-width :math:`x_o`; defaults to ``amplitude``. [m]
+    num : int
+        Points on each slip branch (>= 2). [1]
+
+    Returns
+    -------
+    displacement, force : jax.Array of float64
+        Shape ``broadcast(inputs).shape + (2 * num + 1,)``. The loop starts at the
+        reversal :math:`(-\Delta^*, -Q^*)`, sticks up to the onset of forward slip, slips
+        to :math:`(\Delta^*, Q^*)`, sticks down, slips back and ends where it began
+        (first point = last point). It runs clockwise, so the shoelace sum
+        :math:`\oint Q\,d\Delta` is :math:`E_d > 0`. [m], [N]
+
+    Raises
+    ------
+    ValueError
+        For a concrete input out of range (see :func:`ecofmaps.slip_amplitude`), or
+        ``num < 2``.
+
+    Notes
+    -----
+    The slip branches are eq. 9 with eq. 10, :math:`\Delta = x + Q_\pm(x)/S`, sampled
+    uniformly in :math:`x` for a shallow groove (:math:`\mu k\delta^* < 1/2`), and for a
+    deeper one so that the margin to the locking point :math:`1 - \mu k x` falls
+    geometrically along the branch (dense where the force rises steeply); the stick
+    segments are the straight lines of slope :math:`S`. With no gross slip the loop
+    collapses onto :math:`Q = S\Delta`.
+    Self-locking points give NaN.
+    """
+    if not isinstance(num, int) or num < 2:
+        raise ValueError(f"num must be an integer >= 2, got {num!r}")
+    values = check_model_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
+    values = jnp.broadcast_arrays(*values)
+    return _steady_loop(*values, num=num)
+
+
+@jax.jit
+def _return_map(displacement, mu, kappa, lam, length):
+    """Stick/slip history in the units of ``length``: contact position and Q/P."""
+    target = jnp.moveaxis(displacement / length[..., None], -1, 0)
+    batch = target.shape[1:]
+
+    def step(state, d):
+        xi, q = state
+        gap = d - xi
+        forward = gap > lam * traction_ratio(xi, mu, kappa)
+        backward = gap < lam * traction_ratio(xi, mu, kappa, -1.0)
+        xi_forward, w_forward = _slip_roots(d, mu, kappa, lam)
+        xi_backward, w_backward = _slip_roots(-d, mu, kappa, lam)
+        q_forward = (mu + kappa * xi_forward) / w_forward  # eq. 9, digits kept near locking
+        q_backward = -(mu + kappa * xi_backward) / w_backward
+        xi_backward = -xi_backward
+        q_stick = jnp.where(lam > 0.0, gap / jnp.where(lam > 0.0, lam, 1.0), q)
+        xi_new = jnp.where(forward, xi_forward, jnp.where(backward, xi_backward, xi))
+        q_new = jnp.where(forward, q_forward, jnp.where(backward, q_backward, q_stick))
+        q_new = jnp.where(jnp.isfinite(q_new), q_new, jnp.nan)
+        return (xi_new, q_new), q_new
+
+    start = (jnp.zeros(batch), jnp.zeros(batch))
+    _, q = jax.lax.scan(step, start, target)
+    return jnp.moveaxis(q, 0, -1)
+
+
+@float64
+def simulate(displacement, load, stiffness, mu, aspect_ratio, groove_half_width):
+    r"""Tangential force history for any actuator displacement history :math:`\Delta(t)`.
+
+    Parameters
+    ----------
+    displacement : array_like
+        Actuator displacement :math:`\Delta` at successive instants, time along the last
+        axis; any leading axes broadcast against the other parameters. [m]
+    load : array_like
+        Normal load :math:`P`. [N]
+    stiffness : array_like
+        Rig stiffness :math:`S`; ``numpy.inf`` for a rigid rig. [N/m]
+    mu : array_like
+        Contact coefficient of friction. [1]
+    aspect_ratio : array_like
+        Groove depth over half-width :math:`z_o/x_o`. [1]
+    groove_half_width : array_like
+        Groove half-width :math:`x_o`. [m]
+
+    Returns
+    -------
+    force : jax.Array of float64
+        Tangential force :math:`Q` at each instant, shape of ``displacement`` broadcast
+        with the parameters' shape plus the time axis. NaN once a rigid rig drives the pad
+        into the locking point. [N]
+
+    Raises
+    ------
+    ValueError
+        For a concrete input out of range; ``displacement`` must be finite.
+
+    Notes
+    -----
+    The pad starts at rest at the groove centre (:math:`x = 0`, :math:`Q = 0`, at
+    :math:`\Delta = 0`). At each new :math:`\Delta` it sticks while
+    :math:`Q_-(x) \le S(\Delta - x) \le Q_+(x)` (eq. 9, 10); otherwise it slips to the exact
+    equilibrium :math:`x' + Q_\pm(x')/S = \Delta` (the quadratic of eq. 16), so the result
+    does not depend on the sampling. A rigid rig (:math:`S = \infty`) has :math:`x = \Delta`
+    in slip and keeps its last force while :math:`\Delta` stands still.
+    """
+    check("displacement", displacement, "finite", "m")
+    if is_concrete(displacement) and jnp.ndim(displacement) == 0:
+        raise ValueError("displacement must have a time axis (at least one dimension)")
+    values = check_model_inputs(1.0, load, stiffness, mu, aspect_ratio, groove_half_width)
+    _, load, stiffness, mu, aspect_ratio, groove_half_width = values
+    length = groove_half_width
+    mu, kappa, lam, code = dimensionless(length, load, stiffness, mu, aspect_ratio, length)
+    displacement = as_float64(displacement)
+    batch = jnp.broadcast_shapes(displacement.shape[:-1], jnp.shape(mu), jnp.shape(kappa))
+    batch = jnp.broadcast_shapes(batch, jnp.shape(lam), jnp.shape(code))
+    displacement = jnp.broadcast_to(displacement, batch + displacement.shape[-1:])
+    mu, kappa, lam, length, load, code = (
+        jnp.broadcast_to(x, batch) for x in (mu, kappa, lam, length, load, code)
+    )
+    force = _return_map(displacement, mu, kappa, lam, length) * load[..., None]
+    return jnp.where(code[..., None] == int(INVALID), jnp.nan, force)

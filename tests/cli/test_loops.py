@@ -1,0 +1,248 @@
+"""Recording files and ``ecofmaps loops``: formats, columns, units, damaged files, output."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import ecofmaps
+from ecofmaps.cli import main
+from ecofmaps.io.recordings import RESULT_COLUMNS, RecordingError, read_recording, results_table
+from ecofmaps.measured.synthetic import EXAMPLE, example_path, synthetic_recording
+
+LOAD = 450.0
+POINT = dict(amplitude=50e-6, load=LOAD, stiffness=35e6, mu=0.8, aspect_ratio=0.2)
+COLUMNS = list(RESULT_COLUMNS)
+
+
+@pytest.fixture(scope="module")
+def recording():
+    """Four whole cycles of the model (Example 2), 200 samples each: Δ [m], Q [N]."""
+    displacement, force = synthetic_recording(**POINT, cycles=5)
+    return displacement[:801], force[:801]
+
+
+def write_csv(path, displacement, force, separator=",", header=("displacement", "force")):
+    """A recording file: displacement in µm, force in N, with a comment line."""
+    lines = [f"# a test recording written by {__name__}", separator.join(header)]
+    lines += [f"{d * 1e6:.9f}{separator}{f:.9f}" for d, f in zip(displacement, force, strict=True)]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def run(capsys, *arguments):
+    """``ecofmaps loops ARGS``: exit status, stdout, stderr."""
+    status = main(["loops", *map(str, arguments)])
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+# --- reading files ---------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("suffix", "separator"), [(".csv", ","), (".tsv", "\t"), (".txt", "  ")])
+def test_read_formats(tmp_path, recording, suffix, separator):
+    """CSV, TSV and whitespace-separated text read the same samples, in SI units."""
+    displacement, force = recording
+    path = write_csv(tmp_path / f"loops{suffix}", displacement, force, separator)
+    read = read_recording(path)
+    np.testing.assert_allclose(read.displacement, displacement, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(read.force, force, rtol=0, atol=1e-9)
+    assert read.cycle is None
+    assert read.last_line == 2 + displacement.size
+
+
+def test_read_columns_units_and_cycles(tmp_path, recording):
+    """Other column names (any case), units and an explicit cycle column."""
+    displacement, force = recording
+    table = pd.DataFrame(
+        {
+            "Time": np.arange(displacement.size),
+            "Cycle No": np.repeat([1, 2, 3, 4, 5], [200, 200, 200, 200, 1]),
+            "Disp": displacement * 1e3,  # mm
+            "Q": force / 1e3,  # kN
+        }
+    )
+    path = tmp_path / "rig.tsv"
+    table.to_csv(path, sep="\t", index=False)
+    read = read_recording(
+        path,
+        displacement_column="disp",
+        force_column="q",
+        cycle_column="cycle no",
+        displacement_unit="mm",
+        force_unit="kN",
+    )
+    np.testing.assert_allclose(read.displacement, displacement, rtol=1e-15)
+    np.testing.assert_allclose(read.force, force, rtol=1e-15)
+    np.testing.assert_array_equal(read.cycle, table["Cycle No"])
+
+
+def test_default_cycle_column_is_used(tmp_path, recording):
+    displacement, force = recording
+    path = tmp_path / "with_cycles.csv"
+    lines = ["displacement,force,cycle"]
+    lines += [
+        f"{float(d) * 1e6!r},{float(f)!r},{i // 200}"
+        for i, (d, f) in enumerate(zip(*recording, strict=True))
+    ]
+    path.write_text("\n".join(lines) + "\n")
+    read = read_recording(path)
+    np.testing.assert_array_equal(read.cycle, np.arange(displacement.size) // 200)
+    np.testing.assert_array_equal(read.force, force)  # repr round-trips exactly
+
+
+@pytest.mark.parametrize(
+    ("content", "line", "message"),
+    [
+        ("# note\ndisplacement,force\n1,2\n3,x4\n", 4, "non-numeric value 'x4' in column 'force'"),
+        ("displacement,force\n1,2\n\n3,\n", 4, "non-numeric value '' in column 'force'"),
+        ("displacement,force\n1,2\n3,nan\n", 3, "non-numeric value 'nan' in column 'force'"),
+        ("displacement,force\n1,2\n3,4,5\n", 3, "3 fields where the header has 2"),
+        ("# only\n\ndisp,force\n1,2\n", 3, "no displacement column 'displacement'"),
+        ("displacement,force\n", 1, "no data after the header"),
+        ("# nothing here\n", 1, "no header line and no data"),
+    ],
+)
+def test_damaged_files_name_the_line(tmp_path, content, line, message):
+    path = tmp_path / "damaged.csv"
+    path.write_text(content)
+    with pytest.raises(RecordingError, match=message) as raised:
+        read_recording(path)
+    assert raised.value.line == line
+    assert str(raised.value).startswith(f"{path}, line {line}: ")
+
+
+def test_missing_explicit_cycle_column(tmp_path, recording):
+    path = write_csv(tmp_path / "loops.csv", *recording)
+    with pytest.raises(RecordingError, match="line 2: no cycle column 'n'"):
+        read_recording(path, cycle_column="n")
+
+
+def test_results_table_units(recording):
+    results = ecofmaps.analyze_loops(*recording, LOAD)
+    table = results_table(results)
+    assert list(table.columns) == COLUMNS
+    np.testing.assert_allclose(table.amplitude_um, results.amplitude * 1e6, rtol=1e-15)
+    np.testing.assert_allclose(table.dissipated_energy_mJ, results.dissipated_energy * 1e3)
+    np.testing.assert_allclose(table.stiffness_MN_per_m, results.stiffness / 1e6, rtol=1e-15)
+    assert table.regime.tolist() == ["gross slip"] * 4
+
+
+# --- the command -----------------------------------------------------------------------------
+
+
+def test_loops_command(tmp_path, capsys, recording):
+    """One file: exactly the issue's columns, the analysis's values in µm, N, mJ, MN/m."""
+    path = write_csv(tmp_path / "test.csv", *recording)
+    out = tmp_path / "results.csv"
+    status, stdout, _ = run(capsys, path, "--load", "450N", "--out", out)
+    assert status == 0
+    assert f"wrote {out}: 4 cycles" in stdout
+    table = pd.read_csv(out)
+    assert list(table.columns) == COLUMNS
+    expected = results_table(ecofmaps.analyze_loops(*recording, LOAD))
+    np.testing.assert_array_equal(table.cycle, [1, 2, 3, 4])
+    for column in COLUMNS[1:-1]:
+        np.testing.assert_allclose(table[column], expected[column], rtol=1e-5, err_msg=column)
+    np.testing.assert_allclose(table.gicof, POINT["mu"], rtol=1e-6)
+    np.testing.assert_allclose(table.stiffness_MN_per_m, 35.0, rtol=1e-6)
+    assert table.regime.tolist() == ["gross slip"] * 4
+
+
+def test_several_files_and_plots(tmp_path, capsys, recording):
+    """Several files add a first 'file' column; --plots writes two PNGs per file."""
+    first = write_csv(tmp_path / "a.csv", *recording)
+    displacement, force = recording
+    second = write_csv(tmp_path / "b.txt", displacement * 2, force, separator=" ")
+    out, plots = tmp_path / "all.csv", tmp_path / "plots"
+    status, _, _ = run(capsys, first, second, "--load", "0.45kN", "--out", out, "--plots", plots)
+    assert status == 0
+    table = pd.read_csv(out)
+    assert list(table.columns) == ["file", *COLUMNS]
+    assert table.file.tolist() == [str(first)] * 4 + [str(second)] * 4
+    np.testing.assert_allclose(table.amplitude_um[4:], 100.0, rtol=1e-9)
+    for name in ("a", "b"):
+        for kind in ("loops", "evolution"):
+            png = plots / f"{name}_{kind}.png"
+            assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_table_to_stdout(tmp_path, capsys, recording):
+    path = write_csv(tmp_path / "test.csv", *recording)
+    status, stdout, _ = run(capsys, path, "--load", "450N")
+    assert status == 0
+    assert stdout.splitlines()[0] == ",".join(COLUMNS)
+    assert len(stdout.splitlines()) == 5
+
+
+def test_example(tmp_path, capsys):
+    """The shipped example: ECoF rises by about 4 % while the GICoF stays at μ = 0.8."""
+    out = tmp_path / "example.csv"
+    status, stdout, _ = run(capsys, "--example", "--out", out)
+    assert status == 0
+    assert "GICoF median 0.80" in stdout
+    table = pd.read_csv(out)
+    cycles = EXAMPLE["test_cycles"] // EXAMPLE["recorded_every"]
+    assert len(table) == cycles
+    assert table.cycle.iloc[-1] == EXAMPLE["test_cycles"]
+    assert abs(table.gicof.median() / EXAMPLE["mu"] - 1) < 0.01
+    assert (table.regime == "gross slip").all()
+    first, last = table.ecof.iloc[:10].mean(), table.ecof.iloc[-10:].mean()
+    assert 0.998 < first / EXAMPLE["mu"] < 1.004  # a flat scar: μ_E = μ
+    # The model's μ_E at the final groove z_o/x_o = 0.2 (about 4 % above μ, Section 4).
+    final = float(
+        ecofmaps.energy_cof(EXAMPLE["amplitude"], LOAD, EXAMPLE["stiffness"], EXAMPLE["mu"], 0.2)
+    )
+    assert abs(last / final - 1) < 0.005
+    assert example_path().is_file()
+
+
+def test_damaged_file_writes_nothing(tmp_path, capsys, recording):
+    """A bad cell in the second file stops everything: the old output stays as it was."""
+    good = write_csv(tmp_path / "good.csv", *recording)
+    bad = write_csv(tmp_path / "bad.csv", *recording)
+    lines = bad.read_text().splitlines()
+    lines[57] = "12.5,oops"
+    bad.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "results.csv"
+    out.write_text("previous results\n")
+    status, stdout, stderr = run(
+        capsys, good, bad, "--load", "450N", "--out", out, "--plots", tmp_path / "plots"
+    )
+    assert status == 2
+    assert (
+        stderr == f"ecofmaps: error: {bad}, line 58: non-numeric value 'oops' in column 'force'\n"
+    )
+    assert stdout == ""
+    assert out.read_text() == "previous results\n"
+    assert not (tmp_path / "plots").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.csv", "good.csv", "results.csv"]
+
+
+def test_too_few_samples_names_the_last_line(tmp_path, capsys, recording):
+    displacement, force = recording
+    short = write_csv(tmp_path / "short.csv", displacement[:120], force[:120])
+    status, _, stderr = run(capsys, short, "--load", "450N")
+    assert status == 2
+    assert stderr.startswith(f"ecofmaps: error: {short}, line 122: too few samples for one cycle")
+    assert stderr.count("\n") == 1
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        ([], "give one or more recording FILEs, or --example"),
+        (["--example", "x.csv"], "give one or more recording FILEs, or --example"),
+        (["x.csv"], "--load is required"),
+        (["x.csv", "--load", "0N"], "--load must be > 0 N"),
+        (["missing.csv", "--load", "450N"], "No such file"),
+        (["--example", "--out", "no/such/dir/r.csv"], "its directory does not exist"),
+        (["--example", "--displacement-unit", "N"], "is not a length"),
+    ],
+)
+def test_command_errors(tmp_path, capsys, monkeypatch, arguments, message):
+    monkeypatch.chdir(tmp_path)
+    status, _, stderr = run(capsys, *arguments)
+    assert status == 2
+    assert message in stderr
+    assert stderr.count("\n") == 1 and "Traceback" not in stderr

@@ -1,0 +1,176 @@
+"""The `ecofmaps map` and `ecofmaps cache` commands: units, ranges, lists, errors, round trip."""
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from ecofmaps import cli, compute_map
+from ecofmaps.maps.cache import cache_entries
+from ecofmaps.units import parse_values
+
+FIG11 = [
+    "--stiffness-ratio", "0.02/um:0.2/um:10",
+    "--aspect-ratio", "0:0.3:7",
+    "--amplitude", "25um,50um",
+    "--mu", "0.8",
+]  # fmt: skip
+
+
+def run(capsys, *argv):
+    """Run the command in-process; return (exit status, stdout, stderr)."""
+    try:
+        status = cli.main(list(argv))
+    except SystemExit as stop:  # argparse errors and --help
+        status = stop.code
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+def test_map_round_trip_is_identical(tmp_path, capsys):
+    """The netCDF file holds exactly what compute_map returns for the parsed values."""
+    out = tmp_path / "fig11.nc"
+    status, stdout, _ = run(capsys, "map", *FIG11, "--load", "450 N", "--out", str(out))
+    assert status == 0
+    assert f"wrote {out}: 10 stiffness_ratio x 7 aspect_ratio x 2 amplitude" in stdout
+    assert "regimes: gross slip" in stdout and "ECoF / contact CoF: 1 to 1.1" in stdout
+    stiffness_ratio = parse_values("0.02/um:0.2/um:10", "stiffness_ratio")
+    np.testing.assert_allclose(stiffness_ratio, np.linspace(2e4, 2e5, 10), rtol=1e-15)
+    expected = compute_map(
+        stiffness_ratio=stiffness_ratio,
+        aspect_ratio=np.linspace(0.0, 0.3, 7),
+        amplitude=parse_values("25um,50um", "length"),  # pint: 25um -> 2.4999999999999998e-05
+        mu=0.8,
+        load=450.0,
+        cache=False,
+    )
+    with xr.open_dataset(out, engine="h5netcdf") as written:
+        xr.testing.assert_identical(written.load(), expected)
+
+
+def test_map_parses_units_lists_and_ranges(tmp_path, capsys):
+    out = tmp_path / "map.nc"
+    argv = ["--stiffness-ratio", "(35MN/m)/(450N),inf", "--aspect-ratio", "0.2,0.7",
+            "--amplitude", "50e-6", "--mu", "0.5:1:3", "--out", str(out)]  # fmt: skip
+    assert run(capsys, "map", *argv)[0] == 0
+    with xr.open_dataset(out, engine="h5netcdf") as written:
+        written = written.load()
+    assert written.ecof_ratio.dims == ("stiffness_ratio", "aspect_ratio", "mu")
+    np.testing.assert_allclose(written.stiffness_ratio, [35e6 / 450.0, np.inf], rtol=1e-15)
+    np.testing.assert_array_equal(written.aspect_ratio, [0.2, 0.7])
+    np.testing.assert_array_equal(written.mu, [0.5, 0.75, 1.0])
+    assert written.amplitude.dims == () and float(written.amplitude) == 50e-6  # bare: SI
+    assert "dissipated_energy" not in written  # no --load
+
+
+def test_map_replaces_an_existing_file(tmp_path, capsys):
+    out = tmp_path / "map.nc"
+    out.write_text("old")
+    assert run(capsys, "map", *FIG11, "--out", str(out))[0] == 0
+    with xr.open_dataset(out, engine="h5netcdf") as written:
+        assert written.sizes == {"stiffness_ratio": 10, "aspect_ratio": 7, "amplitude": 2}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["map.nc"]
+
+
+def test_map_uses_the_cache_unless_told_not_to(tmp_path, capsys):
+    cache_dir = tmp_path / "cache"
+    argv = ["map", *FIG11, "--cache-dir", str(cache_dir), "--out", str(tmp_path / "a.nc")]
+    assert run(capsys, *argv, "--no-cache")[0] == 0
+    assert cache_entries(cache_dir) == []
+    assert run(capsys, *argv)[0] == 0
+    assert len(cache_entries(cache_dir)) == 1
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--amplitude", "35MN/m", "argument --amplitude: '35MN/m' is not a length"),
+        ("--amplitude", "fifty", "argument --amplitude: cannot read 'fifty' as a length"),
+        ("--stiffness-ratio", "35MN/m", "'35MN/m' is not a stiffness_ratio"),
+        ("--aspect-ratio", "0:0.3:x", "the number of points in '0:0.3:x' must be an integer"),
+        ("--aspect-ratio", "0:0.3", "a range is start:stop:num"),
+        ("--mu", "nan", "'nan' holds a NaN"),
+        ("--mu", "0.8um", "'0.8um' is not a dimensionless"),
+        ("--load", "450N,500N", "argument --load: cannot read '450N,500N' as a force"),
+    ],
+)
+def test_bad_values_are_rejected_by_the_parser(tmp_path, capsys, option, value, message):
+    argv = dict(zip(FIG11[::2], FIG11[1::2], strict=True)) | {option: value}
+    flat = [item for pair in argv.items() for item in pair]
+    status, stdout, stderr = run(capsys, "map", *flat, "--out", str(tmp_path / "x.nc"))
+    assert status == 2 and stdout == ""
+    assert stderr.splitlines()[-1].startswith("ecofmaps map: error: ")
+    assert message in stderr.splitlines()[-1]
+    assert "Traceback" not in stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--stiffness-ratio", "0", "stiffness_ratio must satisfy 0 < stiffness_ratio <= inf"),
+        ("--aspect-ratio", "-0.1,0.2", "aspect_ratio must satisfy 0 <= aspect_ratio < inf"),
+        ("--amplitude", "inf", "amplitude must satisfy 0 < amplitude < inf [m]"),
+        ("--mu", "0", "mu must satisfy 0 < mu < inf"),
+        ("--load", "0N", "load must satisfy 0 < load < inf [N]"),
+    ],
+)
+def test_values_out_of_range_end_with_one_line(tmp_path, capsys, option, value, message):
+    argv = dict(zip(FIG11[::2], FIG11[1::2], strict=True)) | {option: value}
+    flat = [f"{key}={item}" for key, item in argv.items()]
+    status, stdout, stderr = run(capsys, "map", *flat, "--out", str(tmp_path / "x.nc"))
+    assert status == 2 and stdout == ""
+    assert stderr.count("\n") == 1 and stderr.startswith("ecofmaps: error: ")
+    assert message in stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_missing_directory_ends_with_one_line(tmp_path, capsys):
+    out = tmp_path / "missing" / "x.nc"
+    status, _, stderr = run(capsys, "map", *FIG11, "--out", str(out))
+    assert status == 2
+    message = f"cannot write {out}: the directory {out.parent} does not exist"
+    assert stderr == f"ecofmaps: error: {message}\n"
+
+
+def test_required_options(capsys):
+    status, _, stderr = run(capsys, "map", "--mu", "0.8")
+    assert status == 2
+    assert "the following arguments are required: --stiffness-ratio, --aspect-ratio" in stderr
+
+
+def test_cache_list_and_clear(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("ECOFMAPS_CACHE", str(tmp_path / "cache"))
+    status, stdout, _ = run(capsys, "cache", "list")
+    assert status == 0 and stdout == f"no cached maps in {tmp_path / 'cache'}\n"
+    assert run(capsys, "map", *FIG11, "--out", str(tmp_path / "a.nc"))[0] == 0
+    assert run(capsys, "map", *FIG11[:-1], "0.5,0.8", "--out", str(tmp_path / "b.nc"))[0] == 0
+    entries = cache_entries()
+    status, stdout, _ = run(capsys, "cache", "list")
+    assert status == 0
+    lines = stdout.splitlines()
+    assert lines[0] == f"cached maps in {tmp_path / 'cache'}:"
+    assert all(entry.path.name in stdout for entry in entries) and len(lines) == 4
+    assert lines[-1].startswith("2 file(s), ") and lines[-1].endswith(" kB")
+    status, stdout, _ = run(capsys, "cache", "clear")
+    assert status == 0 and stdout.startswith("removed 2 file(s), ")
+    assert cache_entries() == []
+    other = tmp_path / "other"
+    assert run(capsys, "cache", "list", "--cache-dir", str(other))[1].endswith(f"{other}\n")
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (["map", "--help"], ["--stiffness-ratio", "--aspect-ratio", "--amplitude", "--mu",
+                             "--load", "--out", "--no-cache", "--cache-dir", "start:stop:num",
+                             "atomically", "[1/m]"]),
+        (["cache", "--help"], ["list", "clear", "ECOFMAPS_CACHE"]),
+        (["cache", "clear", "--help"], ["--cache-dir"]),
+        (["--help"], ["map", "cache"]),
+    ],
+)  # fmt: skip
+def test_help_is_complete(capsys, argv, expected):
+    status, stdout, _ = run(capsys, *argv)
+    assert status == 0
+    for word in expected:
+        assert word in stdout
