@@ -5,9 +5,9 @@ paper this package implements.
 """
 
 import importlib
-from importlib.metadata import PackageNotFoundError, version
 
 from ecofmaps._inputs import RegimeWarning
+from ecofmaps._version import __version__
 from ecofmaps.correction import (
     CorrectionStatus,
     Interval,
@@ -48,11 +48,6 @@ def __getattr__(name: str):
         return importlib.import_module("ecofmaps.figures")
     raise AttributeError(f"module 'ecofmaps' has no attribute {name!r}")
 
-
-try:
-    __version__ = version("ecofmaps")
-except PackageNotFoundError:  # running from a source tree that is not installed
-    __version__ = "0+unknown"
 
 __all__ = [
     "GROSS_SLIP",

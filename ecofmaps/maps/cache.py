@@ -1,19 +1,23 @@
-"""The disk cache of computed maps: netCDF files keyed by the grid and the package version.
+"""The disk cache of computed maps: netCDF files keyed by the grid and the model's revision.
 
 A map is stored as one netCDF file (engine h5netcdf) named ``<function>-<key>.nc``, where the
-key is a SHA-256 hash of the package version, the function's name and the exact float64 bytes
-(and shapes) of every input. The directory is, in order of precedence, the ``cache_dir``
-argument, the ``ECOFMAPS_CACHE`` environment variable, or the per-user cache directory
-(``platformdirs.user_cache_dir("ecofmaps")``).
+key is a SHA-256 hash of the package version, the model's revision (a hash of the source of
+the modules that compute maps, :func:`model_revision`, so an edited model never serves a
+stale map), the function's name and the exact float64 bytes (and shapes) of every input. The
+directory is, in order of precedence, the ``cache_dir`` argument, the ``ECOFMAPS_CACHE``
+environment variable, or the per-user cache directory (``platformdirs.user_cache_dir``).
 
 Files are written atomically (a temporary file in the same directory, then ``os.replace``),
 so a reader never sees a half-written file and two processes writing the same entry leave one
-valid file. A file that cannot be read, or that holds another key, is reported with a
-:class:`CacheWarning`, removed and recomputed.
+valid file. Each file also holds a SHA-256 checksum of its data (every variable's and
+coordinate's values, dtype and shape), verified when it is read. A file that cannot be read,
+that holds another key, or whose data do not match their checksum (damaged on disk) is
+reported with a :class:`CacheWarning`, removed and recomputed.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 import re
@@ -27,6 +31,7 @@ import numpy as np
 import platformdirs
 import xarray as xr
 
+from ecofmaps._version import __version__
 from ecofmaps.io.files import TEMPORARY_NAME, atomic_path
 
 __all__ = [
@@ -38,14 +43,19 @@ __all__ = [
     "cache_key",
     "cached_dataset",
     "clear_cache",
+    "data_checksum",
+    "model_revision",
     "write_netcdf",
 ]
 
 #: Environment variable that overrides the per-user cache directory.
 ENVIRONMENT_VARIABLE = "ECOFMAPS_CACHE"
 
-# The global attribute that ties a cache file to its key; removed again on reading.
+# The global attributes that tie a cache file to its key and to its data; removed on reading.
 _KEY_ATTRIBUTE = "ecofmaps_cache_key"
+_CHECKSUM_ATTRIBUTE = "ecofmaps_data_sha256"
+# The sources, relative to the package, whose code decides what a cached map holds.
+_MODEL_SOURCES = ("model/*.py", "maps/grid.py", "_nomenclature.py", "paper.py")
 # Length of the key in file names: 128 bits of the hash.
 _NAME_DIGITS = 32
 _ENTRY = re.compile(rf"^(?P<function>[A-Za-z_][A-Za-z0-9_]*)-[0-9a-f]{{{_NAME_DIGITS}}}\.nc$")
@@ -98,8 +108,49 @@ def cache_directory(cache_dir=None) -> Path:
     return Path(platformdirs.user_cache_dir("ecofmaps"))
 
 
+@functools.cache
+def model_revision() -> str:
+    """SHA-256 of the source of the modules that compute maps (the model, the grid, the names).
+
+    Returns
+    -------
+    revision : str
+        64 hexadecimal digits; any edit of those files gives another revision, and so other
+        cache keys.
+    """
+    package = Path(__file__).resolve().parents[1]
+    digest = hashlib.sha256()
+    for pattern in _MODEL_SOURCES:
+        for path in sorted(package.glob(pattern)):
+            digest.update(f"{path.relative_to(package).as_posix()}\0".encode())
+            digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def data_checksum(dataset: xr.Dataset) -> str:
+    """SHA-256 of a Dataset's data: every variable's and coordinate's name, dtype, shape, values.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+
+    Returns
+    -------
+    checksum : str
+        64 hexadecimal digits. Attributes are not included.
+    """
+    digest = hashlib.sha256()
+    for name in sorted(map(str, dataset.variables)):
+        values = np.asarray(dataset[name].values)
+        if values.dtype.kind in "OUS":  # text: its characters
+            values = np.asarray(values.astype(str), dtype="U")
+        digest.update(f"{name}\0{values.dtype.str}\0{values.shape}\0".encode())
+        digest.update(np.ascontiguousarray(values).tobytes())
+    return digest.hexdigest()
+
+
 def cache_key(function: str, inputs: Mapping[str, object]) -> str:
-    """SHA-256 key of a computation: package version, function name, exact input values.
+    """SHA-256 key of a computation: version, model revision, function, exact input values.
 
     Parameters
     ----------
@@ -114,9 +165,7 @@ def cache_key(function: str, inputs: Mapping[str, object]) -> str:
     key : str
         64 hexadecimal digits.
     """
-    from ecofmaps import __version__
-
-    digest = hashlib.sha256(f"ecofmaps {__version__}\0{function}\0".encode())
+    digest = hashlib.sha256(f"ecofmaps {__version__}\0{model_revision()}\0{function}\0".encode())
     for name, value in inputs.items():
         digest.update(f"{name}\0".encode())
         if value is None:
@@ -158,7 +207,10 @@ def _read(path: Path, key: str) -> xr.Dataset:
         dataset = stored.load()
     if dataset.attrs.get(_KEY_ATTRIBUTE) != key:
         raise ValueError("it is not the cache entry of this computation (foreign file)")
-    dataset.attrs = {name: v for name, v in dataset.attrs.items() if name != _KEY_ATTRIBUTE}
+    if dataset.attrs.get(_CHECKSUM_ATTRIBUTE) != data_checksum(dataset):
+        raise ValueError("its data do not match their checksum (the file is damaged)")
+    private = (_KEY_ATTRIBUTE, _CHECKSUM_ATTRIBUTE)
+    dataset.attrs = {name: v for name, v in dataset.attrs.items() if name not in private}
     return dataset
 
 
@@ -210,7 +262,8 @@ def cached_dataset(
     dataset = compute()
     try:
         directory.mkdir(parents=True, exist_ok=True)
-        write_netcdf(dataset.assign_attrs({_KEY_ATTRIBUTE: key}), path)
+        stamps = {_KEY_ATTRIBUTE: key, _CHECKSUM_ATTRIBUTE: data_checksum(dataset)}
+        write_netcdf(dataset.assign_attrs(stamps), path)
     except OSError as error:
         warnings.warn(f"could not write cache file {path}: {error}", CacheWarning, stacklevel=3)
     return dataset

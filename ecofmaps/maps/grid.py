@@ -23,8 +23,10 @@ import jax.numpy as jnp
 import numpy as np
 import xarray as xr
 
-from ecofmaps import model
+from ecofmaps import _nomenclature as nomenclature
+from ecofmaps import model, paper
 from ecofmaps._inputs import check, float64
+from ecofmaps._version import __version__
 from ecofmaps.maps.cache import cached_dataset
 from ecofmaps.model.simulation import fretting_loop
 from ecofmaps.model.steady_state import dimensionless
@@ -34,37 +36,6 @@ __all__ = ["MAX_CHUNK", "compute_loops", "compute_map", "compute_universal_map"]
 #: Default bound on the number of grid points evaluated in one block (results of about 870 MB).
 MAX_CHUNK = 2**24
 
-PAPER = (
-    "X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent "
-    "coefficient of friction from fretting loops exhibiting non-Coulomb frictional behaviour"
-)
-MODEL = (
-    "compliant wear-scar interaction model: a rigid round-ended pad with Coulomb friction in a "
-    "parabolic groove z = z_o (x/x_o)^2, driven through a spring of stiffness S (the rig); "
-    "steady loops of displacement amplitude Delta*, groove half-width x_o = Delta*"
-)
-
-# Names, units (CF / UDUNITS spelling) and descriptions of every coordinate and variable.
-_ATTRS = {
-    "stiffness_ratio": ("rig stiffness over normal load S/P", "m-1"),
-    "stiffness": ("rig stiffness S", "N m-1"),
-    "aspect_ratio": ("groove depth over half-width z_o/x_o", "1"),
-    "amplitude": ("displacement amplitude Δ*", "m"),
-    "mu": ("contact coefficient of friction μ", "1"),
-    "load": ("normal load P", "N"),
-    "point": ("point along the loop (from the reversal at -Δ*)", "1"),
-    "slip_amplitude": ("slip amplitude δ*", "m"),
-    "slip_ratio": ("slip amplitude over displacement amplitude δ*/Δ*", "1"),
-    "ecof": ("energy coefficient of friction μ_E", "1"),
-    "ecof_ratio": ("energy CoF over contact CoF μ_E/μ", "1"),
-    "compliance_ratio": ("compliance ratio λ = P/(S Δ*)", "1"),
-    "regime": ("contact regime", "1"),
-    "dissipated_energy": ("energy dissipated per cycle E_d", "J"),
-    "max_force": ("peak tangential force Q*", "N"),
-    "displacement": ("actuator displacement Δ", "m"),
-    "force": ("tangential force Q", "N"),
-}
-
 _REGIME_ATTRS = {
     "flag_values": np.array([int(code) for code in model.Regime], dtype=np.int32),
     "flag_meanings": " ".join(code.name.lower() for code in model.Regime),
@@ -72,20 +43,17 @@ _REGIME_ATTRS = {
 
 
 def _attrs(name: str) -> dict:
-    long_name, units = _ATTRS[name]
-    attrs = {"long_name": long_name, "units": units}
+    attrs = nomenclature.attrs(name)
     if name == "regime":
         attrs.update(_REGIME_ATTRS)
     return attrs
 
 
 def _global_attrs(title: str) -> dict:
-    from ecofmaps import __version__
-
     return {
         "title": title,
-        "model": MODEL,
-        "references": PAPER,
+        "model": paper.MODEL,
+        "references": paper.CITATION,
         "source": f"ecofmaps {__version__}",
         "ecofmaps_version": __version__,
     }
@@ -187,7 +155,7 @@ def _dataset(axes: dict, values: dict, title: str, extra=None) -> xr.Dataset:
         for name, axis in {**axes, **extra}.items()
     }
     data_vars = {}
-    for name in sorted(values, key=list(_ATTRS).index):
+    for name in sorted(values, key=list(nomenclature.QUANTITIES).index):
         if isinstance(values[name], tuple):
             data_vars[name] = (*values[name], _attrs(name))
             continue

@@ -1,7 +1,9 @@
 """The disk cache: round trips, keys, recovery from bad files, concurrent writers, clearing."""
 
+import fnmatch
 import multiprocessing
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -71,9 +73,65 @@ def test_keys_tell_grids_apart(monkeypatch):
         cache.cache_key("compute_map", {**axes, "mu": np.array([0.8])}),  # 1-D, not scalar
         cache.cache_key("compute_map", {**axes, "load": np.float64(450.0)}),
     ]
-    monkeypatch.setattr(ecofmaps, "__version__", "999.0")
+    monkeypatch.setattr(cache, "__version__", "999.0")
+    others.append(cache.cache_key("compute_map", axes))
+    monkeypatch.undo()
+    monkeypatch.setattr(cache, "model_revision", lambda: "an edited model")
     others.append(cache.cache_key("compute_map", axes))
     assert len({key, *others}) == len(others) + 1
+
+
+def test_model_revision_hashes_the_model_sources():
+    revision = cache.model_revision()
+    assert len(revision) == 64 and revision == cache.model_revision()
+    package = Path(ecofmaps.__file__).parent
+    sources = [p.relative_to(package).as_posix() for p in package.rglob("*.py")]
+    for pattern in cache._MODEL_SOURCES:  # every pattern names real files
+        assert any(fnmatch.fnmatch(name, pattern) for name in sources), pattern
+
+
+def test_an_edited_model_does_not_serve_its_old_maps(tmp_path, monkeypatch):
+    """A map cached before a change of the model's source is not read after it (issue 8)."""
+    old = compute_map(**GRID, cache_dir=tmp_path)
+    stale = only_entry(tmp_path).path
+    # Make the stored entry hold something the new model would not compute.
+    with xr.open_dataset(stale, engine="h5netcdf") as stored:
+        tampered = stored.load()
+    tampered["ecof_ratio"] = tampered["ecof_ratio"] * 2.0
+    tampered.attrs["ecofmaps_data_sha256"] = cache.data_checksum(tampered)
+    cache.write_netcdf(tampered, stale)
+    monkeypatch.setattr(cache, "model_revision", lambda: "an edited model")
+    fresh = compute_map(**GRID, cache_dir=tmp_path)
+    xr.testing.assert_identical(fresh, old)
+    assert len(cache_entries(tmp_path)) == 2  # the new revision's entry beside the old one
+
+
+def test_damaged_data_are_reported_removed_and_recomputed(tmp_path):
+    """Bytes overwritten inside the data section give a checksum mismatch, not a map (issue 9)."""
+    expected = compute_map(**GRID, cache_dir=tmp_path)
+    path = only_entry(tmp_path).path
+    content = bytearray(path.read_bytes())
+    data = np.ascontiguousarray(expected["ecof_ratio"].values).tobytes()
+    start = bytes(content).find(data)
+    assert start > 0  # stored uncompressed, contiguous
+    content[start + 8 : start + 16] = np.float64(32.5).tobytes()  # one value replaced
+    path.write_bytes(bytes(content))
+    with pytest.warns(CacheWarning, match="do not match their checksum"):
+        recovered = compute_map(**GRID, cache_dir=tmp_path)
+    xr.testing.assert_identical(recovered, expected)
+    xr.testing.assert_identical(compute_map(**GRID, cache_dir=tmp_path), expected)  # valid now
+
+
+def test_checksum_sees_every_value():
+    dataset = compute_map(**GRID, cache=False)
+    checksum = cache.data_checksum(dataset)
+    assert checksum == cache.data_checksum(dataset.copy(deep=True))
+    assert checksum == cache.data_checksum(dataset.assign_attrs(note="attributes do not count"))
+    for name in ("ecof_ratio", "regime", "aspect_ratio"):
+        values = dataset[name].values.copy()
+        values.flat[np.flatnonzero(np.isfinite(values))[0]] += 1
+        changed = dataset.assign_coords if name in dataset.coords else dataset.assign
+        assert cache.data_checksum(changed({name: (dataset[name].dims, values)})) != checksum
 
 
 def test_different_grids_are_different_entries(tmp_path):

@@ -1,0 +1,208 @@
+r"""Every quantity ecofmaps names, once: symbol, long name, units, display, range.
+
+Dataset attributes (``long_name``, ``units``), plot axis labels, the column names of the
+tables ecofmaps writes and reads, the rows the command line prints and the range checks of
+concrete inputs all read :data:`QUANTITIES`. A quantity is known by its name in the Python
+API (the keyword argument, the Dataset variable).
+
+Units: ``units`` is the SI unit in CF/UDUNITS spelling (``'N m-1'``), as xarray writes it
+to netCDF; ``display_unit`` and ``display_factor`` are the tribologist's unit (µm, MN/m, mJ)
+and the factor from SI to it, used by figures, tables and the command line.
+
+Examples
+--------
+>>> from ecofmaps._nomenclature import QUANTITIES, attrs, column
+>>> attrs("slip_amplitude")
+{'long_name': 'slip amplitude δ*', 'units': 'm'}
+>>> column("stiffness"), QUANTITIES["stiffness"].display_factor
+('stiffness_MN_per_m', 1e-06)
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+__all__ = [
+    "QUANTITIES",
+    "RANGES",
+    "Quantity",
+    "attrs",
+    "axis_label",
+    "column",
+    "display",
+    "within",
+]
+
+
+@dataclasses.dataclass(frozen=True)
+class Quantity:
+    r"""One named quantity.
+
+    Attributes
+    ----------
+    words : str
+        What it is, in words (``'slip amplitude'``).
+    symbol : str
+        Its symbol in plain text (``'δ*'``); empty if it has none.
+    latex : str
+        Its symbol in matplotlib's mathtext (``r'\delta^*'``), for plot labels.
+    units : str
+        SI unit, CF/UDUNITS spelling (``'1'`` for a number).
+    kind : str
+        Its physical dimension, a key of :data:`ecofmaps.units.DIMENSIONS`.
+    display_unit : str
+        The unit people read it in (``'µm'``, ``'MN/m'``); empty for a number.
+    display_factor : float
+        Factor from SI to ``display_unit``.
+    valid : str or None
+        Its valid range as a key of :data:`RANGES`, for the checks of concrete inputs.
+    label : str or None
+        The words of a plot axis when they differ from ``words`` (``''``: the symbol alone).
+    axis_unit : str or None
+        The unit of a plot axis when it differs from ``display_unit``.
+    """
+
+    words: str
+    symbol: str
+    latex: str
+    units: str = "1"
+    kind: str = "dimensionless"
+    display_unit: str = ""
+    display_factor: float = 1.0
+    valid: str | None = None
+    label: str | None = None
+    axis_unit: str | None = None
+
+    @property
+    def long_name(self) -> str:
+        """Words and symbol: the netCDF ``long_name``."""
+        return f"{self.words} {self.symbol}" if self.symbol else self.words
+
+
+def _length(words, symbol="", latex="", valid=None, **extra) -> Quantity:
+    return Quantity(words, symbol, latex, "m", "length", "µm", 1e6, valid, **extra)
+
+
+def _force(words, symbol="", latex="", valid=None, **extra) -> Quantity:
+    return Quantity(words, symbol, latex, "N", "force", "N", 1.0, valid, **extra)
+
+
+def _number(words, symbol="", latex="", valid=None, **extra) -> Quantity:
+    return Quantity(words, symbol, latex, valid=valid, **extra)
+
+
+#: Valid ranges: name -> (test on an array, in words with ``{name}`` for the quantity).
+#: Every range rejects NaN; only ``positive_or_inf`` admits +inf.
+RANGES = {
+    "positive": (lambda a: (a > 0) & (a < math.inf), "0 < {name} < inf"),
+    "positive_or_inf": (lambda a: a > 0, "0 < {name} <= inf"),
+    "non_negative": (lambda a: (a >= 0) & (a < math.inf), "0 <= {name} < inf"),
+    "finite": (lambda a: (a > -math.inf) & (a < math.inf), "-inf < {name} < inf"),
+}
+
+#: Every quantity by its name in the API.
+QUANTITIES: dict[str, Quantity] = {
+    # --- test conditions and the groove -------------------------------------------------
+    "amplitude": _length("displacement amplitude", "Δ*", r"\Delta^*", "positive"),
+    "load": _force("normal load", "P", "P", "positive"),
+    "stiffness": Quantity(
+        "rig stiffness", "S", "S", "N m-1", "stiffness", "MN/m", 1e-6, "positive_or_inf"
+    ),
+    "mu": _number("contact coefficient of friction", "μ", r"\mu", "positive"),
+    "aspect_ratio": _number("groove aspect ratio", "z_o/x_o", "z_o/x_o", "non_negative"),
+    "groove_half_width": _length("groove half-width", "x_o", "x_o", "positive"),
+    "scar_depth": _length("wear scar depth", "D", "D", "non_negative"),
+    "scar_half_width": _length("wear scar half-width", "W", "W", "positive"),
+    "stiffness_ratio": Quantity(
+        "rig stiffness over normal load",
+        "S/P",
+        "S/P",
+        "m-1",
+        "stiffness_ratio",
+        "1/mm",
+        1e-3,
+        "positive_or_inf",
+        label="stiffness over load",
+        axis_unit="(MN/m)/kN = 1/mm",
+    ),
+    "compliance_ratio": _number(
+        "compliance ratio", "λ = P/(S Δ*)", r"\lambda = P/(S\Delta^*)", "non_negative"
+    ),
+    # --- loops and the steady state -----------------------------------------------------
+    "displacement": _length("applied displacement", "Δ", r"\Delta", "finite"),
+    "force": _force("tangential force", "Q", "Q", "finite"),
+    "force_ratio": _number("tangential force over normal load", "Q/P", "Q/P", label=""),
+    "point": _number("point round the loop"),
+    "slip_amplitude": _length("slip amplitude", "δ*", r"\delta^*"),
+    "slip_ratio": _number(
+        "slip amplitude over displacement amplitude", "δ*/Δ*", r"\delta^*/\Delta^*"
+    ),
+    "max_force": _force("peak tangential force", "Q*", "Q^*"),
+    "dissipated_energy": Quantity(
+        "dissipated energy per cycle", "E_d", "E_d", "J", "energy", "mJ", 1e3
+    ),
+    "ecof": _number("energy coefficient of friction", "μ_E", r"\mu_E", "positive"),
+    "ecof_ratio": _number("energy CoF over contact CoF", "μ_E/μ", r"\mu_E/\mu", label=""),
+    "regime": _number("regime"),
+    # --- measured loops -----------------------------------------------------------------
+    "cycle": _number("cycle number"),
+    "cof_max": _number("peak coefficient of friction", "Q*/P", "Q^*/P"),
+    "energy_ratio": _number("energy ratio", "A = E_d/(4Δ*Q*)", r"A = E_d/(4\Delta^* Q^*)"),
+    "gicof": _number("geometry-independent coefficient of friction (GICoF)"),
+    "gicof_forward": _number("GICoF on the rising-displacement branch"),
+    "gicof_backward": _number("GICoF on the falling-displacement branch"),
+    "crossing_displacement_forward": _length("displacement where Q = SΔ, rising branch"),
+    "crossing_displacement_backward": _length("displacement where Q = SΔ, falling branch"),
+    "displacement_offset": _length("displacement offset removed (loop centre)"),
+    "force_offset": _force("force offset removed (loop centre)"),
+    "loop_displacement": _length("applied displacement, centred", "Δ", r"\Delta"),
+    "loop_force": _force("tangential force, centred", "Q", "Q"),
+    # --- correction ---------------------------------------------------------------------
+    "correction_factor": _number("contact CoF over energy CoF", "μ/μ_E", r"\mu/\mu_E"),
+}
+
+
+def attrs(name: str) -> dict:
+    """The netCDF attributes ``long_name`` and ``units`` of quantity ``name``."""
+    quantity = QUANTITIES[name]
+    return {"long_name": quantity.long_name, "units": quantity.units}
+
+
+def axis_label(name: str) -> str:
+    r"""A plot axis label: words, symbol and display unit, ``Slip amplitude $\delta^*$ [µm]``."""
+    quantity = QUANTITIES[name]
+    words = quantity.words if quantity.label is None else quantity.label
+    parts = [words[:1].upper() + words[1:]] if words else []
+    if quantity.latex:
+        parts.append(f"${quantity.latex}$")
+    unit = quantity.axis_unit or quantity.display_unit or "1"
+    return " ".join(parts) + f" [{unit}]"
+
+
+def column(name: str) -> str:
+    """The column name of quantity ``name`` in tables: the name and its display unit.
+
+    ``amplitude_um``, ``max_force_N``, ``stiffness_MN_per_m``, ``dissipated_energy_mJ``;
+    a number keeps its bare name (``ecof``).
+    """
+    unit = QUANTITIES[name].display_unit
+    if not unit:
+        return name
+    return f"{name}_{unit.replace('µ', 'u').replace('/', '_per_')}"
+
+
+def display(name: str, value) -> np.ndarray:
+    """``value`` [SI] of quantity ``name`` in its display unit."""
+    return np.asarray(value) * QUANTITIES[name].display_factor
+
+
+def within(name: str, value, rule: str | None = None):
+    """Boolean array: where ``value`` lies in the valid range of ``name`` (or of ``rule``).
+
+    Works on NumPy and JAX arrays (and tracers) alike; NaN is never within.
+    """
+    test, _ = RANGES[rule or QUANTITIES[name].valid]
+    return test(value)
