@@ -18,22 +18,30 @@ import numpy as np
 
 __all__ = ["RegimeWarning", "as_float64", "check", "float64", "is_concrete", "warn_nan"]
 
-# Results are float64 (the model needs the digits); switching JAX's 64-bit mode on when
-# ecofmaps is imported keeps them float64 in the caller's own arithmetic too. Every public
-# entry point also runs in 64-bit mode itself (:func:`float64`), so a caller who switches
-# it off again still gets float64 results.
-jax.config.update("jax_enable_x64", True)
-
 
 class RegimeWarning(RuntimeWarning):
     """A concrete call returned NaN because a point is outside the gross-slip regime."""
 
 
 def float64(function):
-    """Run ``function`` with JAX's 64-bit mode on, whatever the caller's configuration."""
+    """Run ``function`` with JAX's 64-bit mode on, whatever the caller's configuration.
+
+    Concrete calls compute and return float64 whether or not the caller switched JAX's
+    64-bit mode on; importing ecofmaps does not switch it on. Traced calls (inside the
+    caller's ``jax.jit``, ``jax.vmap`` or ``jax.grad``) receive arrays whose precision the
+    caller's mode has already fixed, so they require the mode on and raise a ``ValueError``
+    that says how, instead of silently computing in float32.
+    """
 
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
+        if not jax.config.jax_enable_x64 and not is_concrete(*args, *kwargs.values()):
+            raise ValueError(
+                f"ecofmaps.{function.__name__} under jax.jit, jax.vmap or jax.grad needs JAX's "
+                "64-bit mode (the model needs float64): call "
+                "jax.config.update('jax_enable_x64', True) at start-up, or trace inside "
+                "'with jax.enable_x64(True):'"
+            )
         with jax.enable_x64(True):
             return function(*args, **kwargs)
 

@@ -2,10 +2,16 @@
 
 import os
 
+import jax
 import pytest
 from hypothesis import HealthCheck, settings
 
 os.environ.setdefault("MPLBACKEND", "Agg")
+
+# The tests call the pure-jax.numpy core and jit the public functions themselves, which needs
+# JAX's 64-bit mode, as it does for any user who does so. ecofmaps itself never switches it
+# on (tests/model/test_steady_state.py checks that, and float64 results with it off).
+jax.config.update("jax_enable_x64", True)
 
 # JAX compiles on first call, so a per-example deadline would measure compilation.
 settings.register_profile(

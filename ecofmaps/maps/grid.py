@@ -36,6 +36,20 @@ __all__ = ["MAX_CHUNK", "compute_loops", "compute_map", "compute_universal_map"]
 #: Default bound on the number of grid points evaluated in one block (results of about 870 MB).
 MAX_CHUNK = 2**24
 
+# The order of the variables in a Dataset (xarray orders the dimensions as they first appear).
+_VARIABLES = (
+    "displacement",
+    "force",
+    "slip_amplitude",
+    "slip_ratio",
+    "ecof",
+    "ecof_ratio",
+    "compliance_ratio",
+    "regime",
+    "dissipated_energy",
+    "max_force",
+)
+
 _REGIME_ATTRS = {
     "flag_values": np.array([int(code) for code in model.Regime], dtype=np.int32),
     "flag_meanings": " ".join(code.name.lower() for code in model.Regime),
@@ -155,7 +169,7 @@ def _dataset(axes: dict, values: dict, title: str, extra=None) -> xr.Dataset:
         for name, axis in {**axes, **extra}.items()
     }
     data_vars = {}
-    for name in sorted(values, key=list(nomenclature.QUANTITIES).index):
+    for name in sorted(values, key=_VARIABLES.index):
         if isinstance(values[name], tuple):
             data_vars[name] = (*values[name], _attrs(name))
             continue

@@ -1,5 +1,8 @@
 """The steady-loop model (ecofmaps.model) against brute force, limits and the paper."""
 
+import subprocess
+import sys
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -341,6 +344,23 @@ def test_results_are_float64_even_with_x64_switched_off():
     assert result.dtype == jnp.float64
     assert code.dtype == jnp.int32
     assert float(result) == pytest.approx(0.8307990199151581, rel=1e-15)
+
+
+def test_import_leaves_jax_configuration_alone():
+    """A library must not change its host's global state (issue 8): 64-bit mode stays off."""
+    script = (
+        "import jax, ecofmaps; "
+        "print(jax.config.jax_enable_x64, ecofmaps.energy_cof(5e-5, 450.0, 35e6, 0.8, 0.2).dtype, "
+        "jax.numpy.asarray(1.0).dtype)"
+    )
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.split() == ["False", "float64", "float32"]
+
+
+def test_tracing_without_64_bit_mode_is_refused_clearly():
+    with jax.enable_x64(False), pytest.raises(ValueError, match="jax_enable_x64"):
+        jax.jit(ecofmaps.energy_cof)(50e-6, 450.0, 35e6, 0.8, 0.2)
 
 
 def test_core_has_no_python_loop_over_points():
