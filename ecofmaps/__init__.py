@@ -6,7 +6,7 @@ paper this package implements.
 
 import importlib
 
-from ecofmaps._inputs import RegimeWarning
+from ecofmaps._codes import RegimeWarning
 from ecofmaps._version import __version__
 from ecofmaps.correction import (
     CorrectionStatus,

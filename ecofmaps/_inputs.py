@@ -1,30 +1,129 @@
-"""Input handling shared by the public entry points: float64 and validation.
+"""Input handling shared by the public entry points: units, float64 and validation.
 
 The public functions accept anything array-like, including JAX tracers (under
-``jax.jit``, ``jax.vmap`` and ``jax.grad``). Concrete inputs are checked here and
-bad values raise a :class:`ValueError` that names the parameter and its valid
-range; traced inputs cannot be inspected, so the kernels turn them into NaN plus
-the ``INVALID`` regime code instead.
+``jax.jit``, ``jax.vmap`` and ``jax.grad``), in SI units, and pint Quantities of any unit
+registry, which :func:`si_units` converts to SI by the parameter's name (its dimension is in
+:mod:`ecofmaps._nomenclature`): a Quantity of the wrong dimension, a string, a boolean or
+``None`` where a number is expected raises a :class:`ValueError` naming the parameter.
+Concrete inputs are checked by :func:`check`, and bad values raise a :class:`ValueError`
+that names the parameter and its valid range; traced inputs cannot be inspected, so the
+kernels turn them into NaN plus the ``INVALID`` regime code instead.
 """
 
 from __future__ import annotations
 
 import functools
-import warnings
+import inspect
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-__all__ = ["RegimeWarning", "as_float64", "check", "float64", "is_concrete", "warn_nan"]
+from ecofmaps._nomenclature import QUANTITIES, RANGES
+from ecofmaps.units import DIMENSIONS
+
+__all__ = ["as_float64", "check", "float64", "is_concrete", "si_units", "to_si"]
 
 
-class RegimeWarning(RuntimeWarning):
-    """A concrete call returned NaN because a point is outside the gross-slip regime."""
+def _is_quantity(value) -> bool:
+    """True for a pint Quantity of any registry (without importing pint)."""
+    return type(value).__module__.split(".")[0] == "pint" and hasattr(value, "magnitude")
+
+
+def to_si(name: str, value, quantity: str | None = None):
+    """``value`` in SI units: a pint Quantity converted, plain numbers and arrays as they are.
+
+    Parameters
+    ----------
+    name : str
+        The parameter's name, quoted in messages.
+    value : object
+        A number, an array (NumPy, JAX, a tracer, a list), or a pint Quantity.
+    quantity : str, optional
+        The quantity of :data:`ecofmaps._nomenclature.QUANTITIES` whose dimension ``value``
+        must have; by default ``name``.
+
+    Returns
+    -------
+    value : object
+        The SI magnitude of a Quantity; anything else unchanged.
+
+    Raises
+    ------
+    ValueError
+        For ``None``, a string or a boolean (or an array of them), or a Quantity whose
+        dimension is not the parameter's.
+    """
+    if isinstance(value, jax.core.Tracer):
+        return value
+    described = QUANTITIES.get(quantity or name)
+    kind = "dimensionless" if described is None else described.kind
+    _, si_unit, example = DIMENSIONS[kind]
+    if _is_quantity(value):
+        try:
+            return value.to(si_unit).magnitude
+        except Exception:  # pint's DimensionalityError, or an offset unit
+            raise ValueError(
+                f"{name} must be a {kind.replace('_', ' ')} [{si_unit}], e.g. {example}; got "
+                f"{value!r} of dimension {value.dimensionality}"
+            ) from None
+    try:
+        kind_of = "U" if isinstance(value, str) else np.asarray(value).dtype.kind
+    except ValueError:  # a ragged sequence: left to the function's own checks
+        return value
+    if (
+        value is None
+        or isinstance(value, bool)
+        or (kind_of in "bUSO" and not _numeric_objects(value))
+    ):
+        raise ValueError(
+            f"{name} must be a real number or array of them [{si_unit}] (or a pint "
+            f"Quantity), got {value!r}"
+        )
+    return value
+
+
+def _numeric_objects(value) -> bool:
+    """True for an object array (or list) that holds only real numbers."""
+    array = np.asarray(value)
+    if array.dtype.kind != "O":
+        return False
+    return all(
+        isinstance(item, (int, float, np.integer, np.floating)) and not isinstance(item, bool)
+        for item in array.ravel()
+    )
+
+
+def _converted(parameters: inspect.Signature, args, kwargs):
+    """``args`` and ``kwargs`` with every pint Quantity converted to SI by parameter name."""
+    bound = parameters.bind_partial(*args, **kwargs)
+    for name, value in bound.arguments.items():
+        if isinstance(value, tuple) and any(_is_quantity(item) for item in value):
+            bound.arguments[name] = tuple(to_si(name, item) for item in value)
+        elif _is_quantity(value) or (name in QUANTITIES and value is not None):
+            bound.arguments[name] = to_si(name, value)
+    return bound.args, bound.kwargs
+
+
+def si_units(function):
+    """Accept pint Quantities for ``function``'s parameters, converted to SI by name.
+
+    A parameter named after a quantity of :mod:`ecofmaps._nomenclature` takes a Quantity
+    of that quantity's dimension; strings and booleans are refused there (see
+    :func:`to_si`). Other parameters pass through.
+    """
+    parameters = inspect.signature(function)
+
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        args, kwargs = _converted(parameters, args, kwargs)
+        return function(*args, **kwargs)
+
+    return wrapper
 
 
 def float64(function):
-    """Run ``function`` with JAX's 64-bit mode on, whatever the caller's configuration.
+    """A public JAX entry point: pint Quantities in SI (:func:`si_units`), then float64.
 
     Concrete calls compute and return float64 whether or not the caller switched JAX's
     64-bit mode on; importing ecofmaps does not switch it on. Traced calls (inside the
@@ -32,9 +131,11 @@ def float64(function):
     caller's mode has already fixed, so they require the mode on and raise a ``ValueError``
     that says how, instead of silently computing in float32.
     """
+    parameters = inspect.signature(function)
 
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
+        args, kwargs = _converted(parameters, args, kwargs)
         if not jax.config.jax_enable_x64 and not is_concrete(*args, *kwargs.values()):
             raise ValueError(
                 f"ecofmaps.{function.__name__} under jax.jit, jax.vmap or jax.grad needs JAX's "
@@ -58,15 +159,7 @@ def as_float64(value):
     return jnp.asarray(value, dtype=jnp.float64)
 
 
-_RULES = {
-    "positive": (lambda a: a > 0, "0 < {name} < inf"),
-    "positive_or_inf": (lambda a: a > 0, "0 < {name} <= inf"),
-    "non_negative": (lambda a: a >= 0, "0 <= {name} < inf"),
-    "finite": (lambda a: np.ones(np.shape(a), dtype=bool), "-inf < {name} < inf"),
-}
-
-
-def check(name: str, value, rule: str, unit: str = "") -> None:
+def check(name: str, value, rule: str | None = None, unit: str | None = None) -> None:
     """Raise ``ValueError`` if a concrete ``value`` breaks ``rule``; do nothing for tracers.
 
     Parameters
@@ -74,21 +167,25 @@ def check(name: str, value, rule: str, unit: str = "") -> None:
     name : str
         The parameter's keyword name, quoted in the message.
     value : array_like
-        The value to check.
-    rule : {'positive', 'positive_or_inf', 'non_negative', 'finite'}
-        The valid range. Every rule rejects NaN; only ``'positive_or_inf'`` admits +inf.
-    unit : str
-        Unit shown with the range, e.g. ``'m'``.
+        The value to check, in SI units (see :func:`to_si`).
+    rule : {'positive', 'positive_or_inf', 'non_negative', 'finite'}, optional
+        The valid range (:data:`ecofmaps._nomenclature.RANGES`); by default the range of
+        quantity ``name``. Every rule rejects NaN; only ``'positive_or_inf'`` admits +inf.
+    unit : str, optional
+        Unit shown with the range, e.g. ``'m'``; by default quantity ``name``'s SI unit.
     """
     if not is_concrete(value):
         return
+    described = QUANTITIES.get(name)
+    rule = rule or described.valid
+    unit = unit if unit is not None else ("" if described is None else described.units)
+    to_si(name, value, name if described else "mu")  # None, strings, booleans: refused
     try:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a real number or array of them, got {value!r}") from None
-    test, valid = _RULES[rule]
-    allowed_inf = rule == "positive_or_inf"
-    ok = test(array) & (np.isfinite(array) | (allowed_inf & (array == np.inf)))
+    test, valid = RANGES[rule]
+    ok = test(array)
     if np.all(ok):
         return
     bad = np.argwhere(~ok)[0] if array.ndim else ()
@@ -99,20 +196,3 @@ def check(name: str, value, rule: str, unit: str = "") -> None:
         f"{name} must satisfy {valid.format(name=name)}{suffix}; "
         f"got {array[tuple(bad)].item()!r}{where}{count}"
     )
-
-
-def warn_nan(values, regimes, reasons: dict[int, str], quantity: str) -> None:
-    """Warn when a concrete result holds NaN for a physical reason (a regime), naming it."""
-    values = np.asarray(values)
-    regimes = np.asarray(regimes)
-    nan = np.isnan(values)
-    if not nan.any():
-        return
-    for code, reason in reasons.items():
-        count = int(np.count_nonzero(nan & (regimes == code)))
-        if count:
-            warnings.warn(
-                f"{quantity} is NaN at {count} of {values.size} point(s): {reason}",
-                RegimeWarning,
-                stacklevel=3,
-            )

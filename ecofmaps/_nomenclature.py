@@ -160,6 +160,10 @@ QUANTITIES: dict[str, Quantity] = {
     "force_offset": _force("force offset removed (loop centre)"),
     "loop_displacement": _length("applied displacement, centred", "Δ", r"\Delta"),
     "loop_force": _force("tangential force, centred", "Q", "Q"),
+    # --- synthetic recordings -----------------------------------------------------------
+    "displacement_noise": _length("standard deviation of the displacement noise"),
+    "force_noise": _force("standard deviation of the force noise"),
+    "displacement_drift": _length("displacement drift per cycle"),
     # --- correction ---------------------------------------------------------------------
     "correction_factor": _number("contact CoF over energy CoF", "μ/μ_E", r"\mu/\mu_E"),
 }

@@ -1,16 +1,20 @@
 """Reported energy coefficients of friction corrected to the contact one."""
 
 from ecofmaps.correction.inversion import (
+    AMBIGUOUS_ECOF_MIN,
+    LAMBDA_INFINITY,
     CorrectionStatus,
     Interval,
     contact_cof,
     correct_ecof,
     correction_factor,
     ecof_fall,
-    lookup_correction,
 )
+from ecofmaps.correction.lookup import lookup_correction
 
 __all__ = [
+    "AMBIGUOUS_ECOF_MIN",
+    "LAMBDA_INFINITY",
     "CorrectionStatus",
     "Interval",
     "contact_cof",

@@ -16,7 +16,8 @@ columns, one test per line. Columns (in any order, names exact, others kept as t
 Each row gives its aspect ratio one way: ``aspect_ratio``, or ``scar_depth_um`` and
 ``scar_half_width_um`` (a table may hold both kinds of rows, with the other cells empty).
 Blank lines are skipped. The output keeps every input column and cell as written and adds
-``mu``, ``correction_factor`` (μ/μ_E) and ``regime``. A bad row raises :class:`TableError`,
+``mu`` and ``correction_factor`` (μ/μ_E); every corrected row is a gross-slip test (a row
+whose ECoF no gross-slip loop gives stops the run). A bad row raises :class:`TableError`,
 naming the file and the 1-based line number in the file (the header is line 1).
 """
 
@@ -24,37 +25,34 @@ from __future__ import annotations
 
 import csv
 import io
-import math
 from pathlib import Path
 
 import numpy as np
 
-from ecofmaps import model
+from ecofmaps import _nomenclature as nomenclature
 from ecofmaps.correction.inversion import CorrectionStatus, correct_ecof
 from ecofmaps.io.files import FileLineError
 
 __all__ = ["ADDED_COLUMNS", "COLUMNS", "TableError", "correct_table"]
 
-#: Input columns: name -> (factor to SI, rule, description).
+#: Input columns: column name -> quantity name (its unit and range in the nomenclature).
 COLUMNS = {
-    "ecof": (1.0, "positive", "the reported energy CoF"),
-    "amplitude_um": (1e-6, "positive", "the displacement amplitude in µm"),
-    "load_N": (1.0, "positive", "the normal load in N"),
-    "stiffness_MN_per_m": (1e6, "positive_or_inf", "the rig stiffness in MN/m"),
-    "aspect_ratio": (1.0, "non_negative", "the scar's depth over half-width"),
-    "scar_depth_um": (1e-6, "non_negative", "the scar depth in µm"),
-    "scar_half_width_um": (1e-6, "positive", "the scar half-width in µm"),
+    nomenclature.column(name): name
+    for name in (
+        "ecof",
+        "amplitude",
+        "load",
+        "stiffness",
+        "aspect_ratio",
+        "scar_depth",
+        "scar_half_width",
+    )
 }
 #: Columns added to the output.
-ADDED_COLUMNS = ("mu", "correction_factor", "regime")
+ADDED_COLUMNS = ("mu", "correction_factor")
 
-_REQUIRED = ("ecof", "amplitude_um", "load_N", "stiffness_MN_per_m")
-_SCAR = ("scar_depth_um", "scar_half_width_um")
-_RANGES = {
-    "positive": (lambda v: 0.0 < v < math.inf, "> 0 and finite"),
-    "positive_or_inf": (lambda v: v > 0.0, "> 0 (inf for a rigid rig)"),
-    "non_negative": (lambda v: 0.0 <= v < math.inf, ">= 0 and finite"),
-}
+_REQUIRED = tuple(nomenclature.column(n) for n in ("ecof", "amplitude", "load", "stiffness"))
+_SCAR = tuple(nomenclature.column(n) for n in ("scar_depth", "scar_half_width"))
 
 
 class TableError(FileLineError):
@@ -63,17 +61,18 @@ class TableError(FileLineError):
 
 def _number(path, line: int, name: str, text: str) -> float:
     """The cell ``text`` of column ``name`` in SI, range-checked."""
-    factor, rule, description = COLUMNS[name]
+    quantity = nomenclature.QUANTITIES[COLUMNS[name]]
+    unit = f" in {quantity.display_unit}" if quantity.display_unit else ""
     try:
         value = float(text)
     except ValueError:
         raise TableError(
-            path, line, f"{name} = {text.strip()!r} is not a number ({description})"
+            path, line, f"{name} = {text.strip()!r} is not a number (the {quantity.words}{unit})"
         ) from None
-    test, valid = _RANGES[rule]
-    if not test(value):
-        raise TableError(path, line, f"{name} must be {valid}, got {text.strip()}")
-    return value * factor
+    if not nomenclature.within(COLUMNS[name], value):
+        valid = nomenclature.RANGES[quantity.valid][1].format(name=name)
+        raise TableError(path, line, f"{name} must satisfy {valid}, got {text.strip()}")
+    return value / quantity.display_factor
 
 
 def _read(path: Path):
@@ -93,7 +92,7 @@ def _read(path: Path):
     if not records:
         raise TableError(path, header_line, "the table has a header but no data rows")
     column = {name: header.index(name) for name in COLUMNS if name in header}
-    values = {name: [] for name in COLUMNS}
+    values = {name: [] for name in (*_REQUIRED, "aspect_ratio")}
     for row, line in records:
         if len(row) != len(header):
             raise TableError(
@@ -160,8 +159,8 @@ def correct_table(path) -> tuple[str, int]:
     Returns
     -------
     text : str
-        The output table as CSV text: the input columns and cells, then ``mu``,
-        ``correction_factor`` (both to 10 significant digits) and ``regime``.
+        The output table as CSV text: the input columns and cells, then ``mu`` and
+        ``correction_factor`` (both to 10 significant digits).
     rows : int
         The number of data rows.
 
@@ -191,11 +190,9 @@ def correct_table(path) -> tuple[str, int]:
             correct_ecof(si["ecof"][i], **{name: value[i] for name, value in point.items()})
         except ValueError as error:
             raise TableError(path, records[i][1], str(error)) from None
-    regimes = np.asarray(model.regime(mu=mu, **point))
     stream = io.StringIO()
     writer = csv.writer(stream, lineterminator="\n")
     writer.writerow([*header, *ADDED_COLUMNS])
-    for (row, _), value, ecof, code in zip(records, mu, si["ecof"], regimes, strict=True):
-        name = model.Regime(int(code)).name.lower().replace("_", " ")
-        writer.writerow([*row, f"{value:.10g}", f"{value / ecof:.10g}", name])
+    for (row, _), value, ecof in zip(records, mu, si["ecof"], strict=True):
+        writer.writerow([*row, f"{value:.10g}", f"{value / ecof:.10g}"])
     return stream.getvalue(), len(records)

@@ -50,16 +50,11 @@ _VARIABLES = (
     "max_force",
 )
 
-_REGIME_ATTRS = {
-    "flag_values": np.array([int(code) for code in model.Regime], dtype=np.int32),
-    "flag_meanings": " ".join(code.name.lower() for code in model.Regime),
-}
-
 
 def _attrs(name: str) -> dict:
     attrs = nomenclature.attrs(name)
     if name == "regime":
-        attrs.update(_REGIME_ATTRS)
+        attrs.update(model.Regime.flag_attrs())
     return attrs
 
 

@@ -67,7 +67,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from ecofmaps._inputs import check
+from ecofmaps._inputs import check, si_units
 from ecofmaps.measured.cycles import MIN_SAMPLES, labelled_cycles, masked_sum, split_cycles
 
 __all__ = ["GROSS_SLIP_THRESHOLD", "analyze_loops"]
@@ -344,6 +344,7 @@ def _check_options(load, hysteresis, stick_window, crossing_window, gross_slip_t
     }
 
 
+@si_units
 def analyze_loops(
     displacement,
     force,

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ecofmaps._inputs import si_units
 from ecofmaps.io.recordings import write_text
 from ecofmaps.model.simulation import simulate
 
@@ -31,6 +32,7 @@ __all__ = [
 ]
 
 
+@si_units
 def synthetic_recording(
     amplitude,
     load,

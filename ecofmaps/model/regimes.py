@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import enum
+from ecofmaps._codes import Code
 
 __all__ = ["GROSS_SLIP", "INVALID", "NO_GROSS_SLIP", "SELF_LOCKING", "Regime"]
 
 
-class Regime(enum.IntEnum):
+class Regime(Code):
     """Regime codes returned by :func:`regime` and stored in maps.
 
     Attributes
@@ -24,21 +24,23 @@ class Regime(enum.IntEnum):
         An input outside its valid range (or NaN).
     """
 
-    GROSS_SLIP = 0
-    NO_GROSS_SLIP = 1
-    SELF_LOCKING = 2
-    INVALID = 3
+    GROSS_SLIP = 0, "gross slip"
+    NO_GROSS_SLIP = (
+        1,
+        "no gross slip",
+        "no gross slip (mu * load / (stiffness * amplitude) >= 1), so the energy coefficient "
+        "of friction is undefined",
+    )
+    SELF_LOCKING = (
+        2,
+        "self-locking",
+        "self-locking (rigid rig with mu * curvature number >= 1: the pad jams on the groove "
+        "flank)",
+    )
+    INVALID = 3, "invalid", "invalid input"
 
 
 GROSS_SLIP = Regime.GROSS_SLIP
 NO_GROSS_SLIP = Regime.NO_GROSS_SLIP
 SELF_LOCKING = Regime.SELF_LOCKING
 INVALID = Regime.INVALID
-
-_NAN_REASONS = {
-    int(NO_GROSS_SLIP): "no gross slip (mu * load / (stiffness * amplitude) >= 1), "
-    "so the energy coefficient of friction is undefined",
-    int(SELF_LOCKING): "self-locking (rigid rig with mu * curvature number >= 1: the pad "
-    "jams on the groove flank)",
-    int(INVALID): "invalid input",
-}

@@ -11,7 +11,8 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from ecofmaps._inputs import as_float64, check, float64, is_concrete, warn_nan
+from ecofmaps._codes import warn_nan
+from ecofmaps._inputs import as_float64, check, float64, is_concrete
 from ecofmaps.model.core import (
     compliance_ratio,
     curvature_number,
@@ -21,7 +22,7 @@ from ecofmaps.model.core import (
     regime_code,
     slip_ratio,
 )
-from ecofmaps.model.regimes import _NAN_REASONS, INVALID
+from ecofmaps.model.regimes import INVALID, Regime
 
 __all__ = [
     "check_model_inputs",
@@ -105,7 +106,7 @@ def _evaluate(quantity, arguments):
     values = check_model_inputs(*arguments)
     result, code = _steady_state(quantity, *values)
     if is_concrete(*arguments) and quantity != "regime":
-        warn_nan(result, code, _NAN_REASONS, quantity)
+        warn_nan(result, code, Regime, quantity)
     return result
 
 

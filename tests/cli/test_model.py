@@ -1,5 +1,6 @@
 """The `ecofmaps` command: top level and `ecofmaps model`."""
 
+import re
 import subprocess
 import sys
 
@@ -21,7 +22,7 @@ def test_model_prints_example_2_with_units(capsys):
 def test_model_takes_units_and_a_rigid_rig(capsys):
     assert main(["model", "--stiffness", "inf", "--amplitude", "0.03mm"]) == 0
     out = capsys.readouterr().out
-    assert "inf (rigid)" in out and "slip amplitude           δ*       30 µm" in out
+    assert "inf (rigid)" in out and re.search(r"slip amplitude +δ\* +30 µm", out)
 
 
 def test_model_without_gross_slip_says_so(capsys):

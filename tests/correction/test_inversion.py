@@ -13,7 +13,15 @@ from scipy.optimize import brentq
 
 import ecofmaps
 from ecofmaps import model
-from ecofmaps.correction import CorrectionStatus, Interval, contact_cof, ecof_fall, inversion
+from ecofmaps.correction import (
+    AMBIGUOUS_ECOF_MIN,
+    LAMBDA_INFINITY,
+    CorrectionStatus,
+    Interval,
+    contact_cof,
+    ecof_fall,
+    inversion,
+)
 from tests.brute_force import steady_loop
 
 EXAMPLE_2 = dict(amplitude=50e-6, load=450.0, stiffness=35e6)  # and mu = 0.8, z_o/x_o = 0.2
@@ -226,24 +234,25 @@ def test_fall_against_a_dense_scan(kappa, lam):
 
 
 def test_fall_region():
-    """μ_E(μ) rises for κ <= 1 (all λ) and for λ >= 0.075 (all κ); it falls just inside.
+    """μ_E(μ) rises for κ <= 1 (all λ) and for λ >= λ_∞ (all κ); it falls just inside.
 
     The bounds the correction relies on to skip the scan for a fall (module docstring),
-    checked on dense grids of dμ_E/dμ, and the limit λ_∞ ≈ 0.0710 as κ -> ∞.
+    checked on dense grids of dμ_E/dμ, and the limit λ_∞ = LAMBDA_INFINITY as κ -> ∞.
     """
     rising = [(kappa, lam) for kappa in (0.5, 1.0) for lam in (1e-12, 1e-6, 1e-3, 0.05, 1.0)]
     rising += [(kappa, inversion._FALL_LAMBDA) for kappa in (10.0, 1e3, 1e6)]
+    rising += [(kappa, LAMBDA_INFINITY) for kappa in (1e4, 1e8)]
     for kappa, lam in rising:
         mu = np.geomspace(1e-4 / kappa, (1 - 1e-9) / lam, 100_000)
         assert np.all(ecof_slope(mu, kappa, lam) > 0), (kappa, lam)
         assert np.isnan(float(ecof_fall(kappa, lam)[0]))
-    for kappa, lam in [(1.2, 1e-100), (2.0, 1e-8), (1e6, 0.0705)]:
+    for kappa, lam in [(1.2, 1e-100), (2.0, 1e-8), (1e6, 0.0705), (1e8, 0.0710)]:
         mu = np.geomspace(1.0 / kappa, 1.0, 100_000)
         assert np.any(ecof_slope(mu, kappa, lam) < 0), (kappa, lam)
     # Only ECoFs above 1.6 can be ambiguous: the fall's bottom, over the whole region.
-    kappa, lam = np.meshgrid(np.geomspace(1.001, 1e8, 40), np.geomspace(1e-12, 0.0711, 40))
+    kappa, lam = np.meshgrid(np.geomspace(1.001, 1e8, 40), np.geomspace(1e-12, LAMBDA_INFINITY, 40))
     low = np.asarray(ecof_fall(kappa, lam)[1])
-    assert np.isfinite(low).mean() > 0.5 and np.nanmin(low) > 1.6
+    assert np.isfinite(low).mean() > 0.5 and np.nanmin(low) > AMBIGUOUS_ECOF_MIN
 
 
 def test_ambiguous_ecof():

@@ -296,6 +296,25 @@ def test_universal_map_matches_fig11(drawn):
     np.testing.assert_allclose(read.values, map_50.ecof_ratio.values, rtol=1e-3)
 
 
+def test_figures_draw_what_they_are_given_and_nothing_else(drawn):
+    """Pure functions of their Dataset and arguments (issue 8): no marker guessed from the data."""
+    _, dataset = drawn["fig11b"]
+    ax = figures.ecof_ratio_contours(dataset).axes[0]
+    assert _markers(ax) == [] and ax.get_title().startswith("Fig. 11 ")
+    rig = {"a 60 MN/m rig": dict(stiffness=60e6, load=500.0, aspect_ratio=0.1)}
+    ax = figures.ecof_ratio_contours(dataset, number="11x", markers=rig).axes[0]
+    (marker,) = _markers(ax)
+    assert (marker.get_xdata()[0], marker.get_ydata()[0]) == (60e6 / 500.0 * 1e-3, 0.1)
+    assert "a 60 MN/m rig" in marker.get_label() and ax.get_title().startswith("Fig. 11x ")
+    _, dataset = drawn["fig8"]
+    assert _markers(figures.ecof_ratio_curves(dataset).axes[0]) == []
+    _, dataset = drawn["universal"]
+    figure = figures.universal_ecof_ratio_map(dataset)
+    assert _markers(figure.axes[0]) == []
+    # The map does not depend on the load: its title does not print one.
+    assert "P =" not in figure.axes[0].get_title() and "windows" not in figure.axes[0].get_title()
+
+
 def test_make_figures_rejects_unknown_names():
     with pytest.raises(ValueError, match=r"unknown figure 'fig9'; valid names: fig5, fig6"):
         list(figures.make_figures(["fig8", "fig9"]))

@@ -1,0 +1,55 @@
+"""Integer codes that carry their own words: the regimes and statuses results hold per point.
+
+Maps and arrays store the integer; the member knows its ``label`` (how tables and the
+command line print it) and its ``reason`` (why a value is NaN there), so no side table
+repeats them (as optimistix's ``RESULTS`` does).
+"""
+
+from __future__ import annotations
+
+import enum
+import warnings
+
+import numpy as np
+
+__all__ = ["Code", "RegimeWarning", "warn_nan"]
+
+
+class RegimeWarning(RuntimeWarning):
+    """A concrete call returned NaN because a point is outside the gross-slip regime."""
+
+
+class Code(enum.IntEnum):
+    """An integer code with a ``label`` and the ``reason`` a value is NaN under it (or '')."""
+
+    def __new__(cls, value: int, label: str, reason: str = ""):
+        member = int.__new__(cls, value)
+        member._value_ = value
+        member.label = label
+        member.reason = reason
+        return member
+
+    @classmethod
+    def flag_attrs(cls) -> dict:
+        """CF ``flag_values`` and ``flag_meanings`` attributes of a variable holding the codes."""
+        return {
+            "flag_values": np.array([int(code) for code in cls], dtype=np.int32),
+            "flag_meanings": " ".join(code.name.lower() for code in cls),
+        }
+
+
+def warn_nan(values, codes, kind: type[Code], quantity: str) -> None:
+    """Warn when a concrete result holds NaN for a reason its code gives, naming the reason."""
+    values = np.asarray(values)
+    codes = np.asarray(codes)
+    nan = np.isnan(values)
+    if not nan.any():
+        return
+    for code in kind:
+        count = int(np.count_nonzero(nan & (codes == code)))
+        if count and code.reason:
+            warnings.warn(
+                f"{quantity} is NaN at {count} of {values.size} point(s): {code.reason}",
+                RegimeWarning,
+                stacklevel=3,
+            )

@@ -1,0 +1,111 @@
+"""``ecofmaps correct``: reported ECoF values corrected to the contact CoF (a point or a table)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from ecofmaps._version import __version__
+from ecofmaps.cli._common import CommandError, print_rows, quantity, row
+
+__all__ = ["add", "run"]
+
+_POINT_OPTIONS = ("ecof", "amplitude", "load", "stiffness")
+
+
+def add(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "correct",
+        help="correct reported ECoF values to the contact CoF (one point or a CSV table)",
+        description=(
+            "Correct a reported energy coefficient of friction μ_E to the contact CoF μ the "
+            "model puts behind it, given the test's amplitude, load and rig stiffness and the "
+            "wear scar's depth over half-width z_o/x_o = D/W (eq. 11; x_o = Δ*). One point: "
+            "--ecof --amplitude --load --stiffness and --aspect-ratio (or --scar-depth and "
+            "--scar-half-width). A table: TABLE.csv with columns ecof, amplitude_um, load_N, "
+            "stiffness_MN_per_m and aspect_ratio or scar_depth_um + scar_half_width_um; the "
+            "output keeps every column and adds mu, correction_factor and regime. A bad row "
+            "stops the run, naming the file and line (the header is line 1); nothing is "
+            "written then."
+        ),
+    )
+    parser.add_argument("table", nargs="?", metavar="TABLE", help="CSV table of reported ECoFs")
+    parser.add_argument(
+        "--out", metavar="OUT", default=None,
+        help="write the corrected table here (CSV; default: standard output)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--ecof", type=quantity("dimensionless"), help="reported energy CoF μ_E, e.g. 0.83"
+    )
+    parser.add_argument(
+        "--amplitude", type=quantity("length"), help="displacement amplitude Δ*, e.g. 50um"
+    )
+    parser.add_argument("--load", type=quantity("force"), help="normal load P, e.g. 450N")
+    parser.add_argument(
+        "--stiffness", type=quantity("stiffness"),
+        help="rig stiffness S, e.g. 35MN/m ('inf' for a rigid rig)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--aspect-ratio", type=quantity("dimensionless"),
+        help="wear scar depth over half-width z_o/x_o = D/W, e.g. 0.2",
+    )  # fmt: skip
+    parser.add_argument("--scar-depth", type=quantity("length"), help="scar depth D, e.g. 8um")
+    parser.add_argument(
+        "--scar-half-width", type=quantity("length"), help="scar half-width W, e.g. 40um"
+    )
+    parser.set_defaults(handler=run)
+
+
+def run(args) -> int:
+    from ecofmaps.correction.inversion import correct_ecof
+    from ecofmaps.correction.tables import correct_table
+    from ecofmaps.io.recordings import write_text
+
+    given = [name for name in (*_POINT_OPTIONS, "aspect_ratio", "scar_depth", "scar_half_width")
+             if getattr(args, name) is not None]  # fmt: skip
+    if args.table is not None:
+        if given:
+            options = ", ".join("--" + name.replace("_", "-") for name in given)
+            raise CommandError(f"give a TABLE or one point's options, not both ({options})")
+        if args.out is not None and not Path(args.out).parent.is_dir():
+            raise CommandError(f"cannot write {args.out}: its directory does not exist")
+        text, rows = correct_table(args.table)
+        if args.out is None:
+            sys.stdout.write(text)
+            return 0
+        write_text(args.out, text)
+        print(f"wrote {args.out}: {rows} rows corrected")
+        return 0
+    if args.out is not None:
+        raise CommandError("--out writes a corrected TABLE; give the TABLE too")
+    missing = ["--" + name for name in _POINT_OPTIONS if getattr(args, name) is None]
+    if missing:
+        raise CommandError(f"give {', '.join(missing)} (or a TABLE)")
+    scar = [value is not None for value in (args.scar_depth, args.scar_half_width)]
+    if (args.aspect_ratio is not None) == any(scar) or any(scar) != all(scar):
+        raise CommandError("give --aspect-ratio, or both --scar-depth and --scar-half-width")
+    point = dict(amplitude=args.amplitude, load=args.load, stiffness=args.stiffness)
+    if args.aspect_ratio is not None:
+        ratio = args.aspect_ratio
+        ratio_text = f"{ratio:.6g}"
+    else:
+        ratio = args.scar_depth / args.scar_half_width
+        ratio_text = (
+            f"{ratio:.6g} (scar {args.scar_depth * 1e6:.6g} µm deep, "
+            f"{args.scar_half_width * 1e6:.6g} µm half-width)"
+        )
+    mu = float(correct_ecof(args.ecof, **point, aspect_ratio=ratio))
+    rows = [
+        row("ecof", args.ecof, "(reported)"),
+        row("amplitude", args.amplitude),
+        row("load", args.load),
+        row("stiffness", args.stiffness),
+        row("aspect_ratio", ratio_text),
+        None,
+        row("mu", mu),
+        row("correction_factor", mu / args.ecof),
+    ]
+    print_rows(
+        f"ecofmaps {__version__}: reported ECoF corrected to the contact CoF (x_o = Δ*)", rows
+    )
+    return 0

@@ -1,0 +1,580 @@
+r"""Legacy energy coefficients of friction corrected to the contact one.
+
+Much of the fretting literature reports the energy coefficient of friction
+:math:`\mu_E = E_d/(4P\delta^*)` (eq. 1). With the rig's compliance and a wear scar shaped
+like a groove it is not the contact :math:`\mu` (Figures 8 and 11). Given the test
+conditions (:math:`\Delta^*`, :math:`P`, :math:`S`) and the scar's aspect ratio
+:math:`z_o/x_o = D/W` (eq. 11, with :math:`x_o = \Delta^*` as in the paper),
+:func:`correct_ecof` inverts the model's :math:`\mu_E(\mu)` exactly
+(:func:`ecofmaps.correction.lookup.lookup_correction` reads the same inversion off a map).
+
+The inversion, in the dimensionless core of :mod:`ecofmaps.model` (:math:`\mu`,
+:math:`\kappa = 2 z_o/x_o`, :math:`\lambda = P/(S\Delta^*)`):
+
+* :math:`\mu_E(\mu)` is continuous on the gross-slip range :math:`0 < \mu < \mu_{max}`,
+  with :math:`\mu_{max} = 1/\lambda` (:math:`1/\kappa` for a rigid rig, where the pad
+  locks), and :math:`\mu \le \mu_E`. It runs from 0 (:math:`\mu \to 0`) to :math:`1/\lambda`
+  (:math:`\mu \to 1/\lambda`, where :math:`\delta^* \to 0`; to :math:`\infty` for a rigid
+  rig), and :math:`\mu_E < (1 - \delta^*/\Delta^*)/\lambda < 1/\lambda` throughout, since
+  :math:`\mu_E P` is the mean of :math:`Q_+` over the slip and :math:`Q_+` rises to its
+  peak :math:`S(\Delta^* - \delta^*)` (eq. 9, 10, 12). So every ECoF in
+  :math:`(0, S\Delta^*/P)` comes from some :math:`\mu`, and no other does: a larger one
+  would need a contact CoF that stops gross slip (status ``NO_GROSS_SLIP``).
+* :math:`\mu_E(\mu)` rises monotonically unless the groove is deep and the rig stiff:
+  it falls over part of its range only when :math:`\kappa > 1` and
+  :math:`\lambda < \lambda_\infty` (:data:`LAMBDA_INFINITY` :math:`\approx 0.071`, the
+  :math:`\kappa \to \infty` limit of the largest such :math:`\lambda`; at :math:`\kappa = 10`
+  it is 0.0248, and the smallest :math:`\kappa` grows from 1 as :math:`\lambda` grows from
+  0, e.g. 2.5 at :math:`\lambda = 10^{-4}`). The fall lies in :math:`1/\kappa < \mu < 1`,
+  where :math:`\mu_E/\mu > 4`. There, an ECoF between the local minimum and maximum of
+  :math:`\mu_E(\mu)` comes from three contact CoFs (status ``AMBIGUOUS``); the local
+  minimum is above :data:`AMBIGUOUS_ECOF_MIN` = 1.6 (its infimum, reached as
+  :math:`\kappa \to \infty` and :math:`\lambda \to \lambda_\infty`), so no ECoF below
+  1.6 is ever ambiguous. The tests
+  check these bounds on dense grids.
+* :math:`\mu_E` rises with :math:`z_o/x_o` at fixed :math:`\mu` (:math:`\kappa\delta^*`
+  rises with :math:`\kappa`, and :math:`\mu_E` is the mean of a convex function over
+  :math:`[-\kappa\delta^*, \kappa\delta^*]` in the slope), so for an aspect ratio known
+  only to lie in :math:`[a, b]` the contact CoFs the ECoF allows are exactly
+  :math:`[\mu(b), \mu(a)]` wherever the inversion at both ends is unique.
+
+The root is found by Newton's method on :math:`\mu_E(\mu) - \mu_E^{given}` with the slope
+from ``jax.jvp``, kept inside a bracket that shrinks at every step (a bisection when a
+Newton step leaves it), under ``jax.lax.while_loop`` over whole arrays: about five steps
+from the start :math:`\mu = \mu_E^{given}`, an upper bound.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ecofmaps import model
+from ecofmaps._codes import Code, warn_nan
+from ecofmaps._inputs import as_float64, check, float64, is_concrete
+from ecofmaps.model.steady_state import valid_geometry
+
+__all__ = [
+    "AMBIGUOUS_ECOF_MIN",
+    "LAMBDA_INFINITY",
+    "CorrectionStatus",
+    "Interval",
+    "contact_cof",
+    "correct_ecof",
+    "correction_factor",
+    "ecof_fall",
+]
+
+
+#: :math:`\lambda_\infty`: :math:`\mu_E(\mu)` falls over part of its range only where
+#: :math:`\lambda = P/(S\Delta^*)` is below this (its :math:`\kappa \to \infty` limit; the tests
+#: check it on dense grids). [1]
+LAMBDA_INFINITY = 0.07102
+
+#: No ECoF below this is ever ambiguous: the infimum of the local minimum of a falling
+#: :math:`\mu_E(\mu)`, reached as :math:`\kappa \to \infty` and
+#: :math:`\lambda \to \lambda_\infty`. [1]
+AMBIGUOUS_ECOF_MIN = 1.6
+
+
+class CorrectionStatus(Code):
+    """Outcome of a correction, per point (``return_status=True``).
+
+    Attributes
+    ----------
+    CORRECTED
+        One contact CoF gives the ECoF; it is returned.
+    NO_GROSS_SLIP
+        The ECoF is at or above :math:`S\\Delta^*/P`, above every gross-slip
+        :math:`\\mu_E` of these test conditions: a contact CoF high enough to give it would
+        stop gross slip (:math:`\\mu P \\ge S\\Delta^*`), and with no gross slip there is
+        no ECoF. The value cannot come from the model with these conditions.
+    AMBIGUOUS
+        Several contact CoFs give the ECoF (deep groove, :math:`\\kappa > 1`, and stiff rig,
+        :math:`\\lambda <` :data:`LAMBDA_INFINITY`, where :math:`\\mu_E(\\mu)` falls over
+        part of its range).
+    INVALID
+        An input out of its range or NaN (only under ``jax.jit``/``jax.vmap``: concrete
+        inputs raise ``ValueError``).
+    OUTSIDE_MAP
+        :func:`lookup_correction` only: the point, or the ECoF, is outside the map.
+    """
+
+    CORRECTED = 0, "corrected"
+    NO_GROSS_SLIP = (
+        1,
+        "no gross slip",
+        "the ECoF is at or above stiffness * amplitude / load, the largest energy CoF of any "
+        "gross-slip loop with these test conditions",
+    )
+    AMBIGUOUS = (
+        2,
+        "ambiguous",
+        "several contact CoFs give the ECoF (deep groove and stiff rig, where the ECoF falls "
+        "as mu rises over part of its range)",
+    )
+    INVALID = 3, "invalid", "invalid input"
+    OUTSIDE_MAP = 4, "outside the map", "the point or the ECoF is outside the map"
+
+
+class Interval(NamedTuple):
+    """The contact CoFs (or correction factors) allowed by an ECoF: ``low <= high``."""
+
+    low: jax.Array
+    high: jax.Array
+
+
+# ---------------------------------------------------------------------------------------
+# The dimensionless core: mu from mu_E at (kappa, lam)
+# ---------------------------------------------------------------------------------------
+
+_EPS = float(np.finfo(np.float64).eps)
+_MAX_STEPS = 300  # the bracket [0, mu_E] halves at least every two steps
+
+# mu_E(mu) can fall only for kappa > _FALL_KAPPA and 0 < lam < _FALL_LAMBDA (module
+# docstring); the fall lies in 1/kappa < mu < 1, scanned on _FALL_GRID points in log(mu)
+# and located to _FALL_BISECTIONS halvings of a grid step.
+_FALL_KAPPA = 1.0
+_FALL_LAMBDA = 0.075  # a margin above LAMBDA_INFINITY
+_FALL_GRID = 256
+_FALL_BISECTIONS = 48
+
+
+def _ecof_and_slope(mu, kappa, lam):
+    """:math:`\\mu_E` and :math:`d\\mu_E/d\\mu` at each point (forward mode, elementwise)."""
+    return jax.jvp(lambda m: m * model.ecof_ratio(m, kappa, lam), (mu,), (jnp.ones_like(mu),))
+
+
+def _root(ecof, kappa, lam):
+    """The :math:`\\mu` with :math:`\\mu_E(\\mu) =` ``ecof`` by bracketed Newton (see module).
+
+    The bracket starts as :math:`(0, \\min(\\mu_E, \\mu_{max}))`; :math:`\\mu_E - ecof` is
+    negative at its lower end and positive (or NaN, past the gross-slip or locking limit)
+    at its upper one, and every step keeps it so. A Newton step is taken only if it stays
+    inside the bracket and is less than half the step before it; otherwise the bracket is
+    bisected (as in Numerical Recipes' ``rtsafe``), so the bracket at least halves every
+    two steps even where Newton's method would cycle (the steep rise of :math:`\\mu_E`
+    near the locking point of a stiff rig).
+    """
+    mu_max = jnp.where(lam > 0.0, 1.0 / lam, 1.0 / kappa)
+    low = jnp.zeros_like(ecof)
+    high = jnp.minimum(ecof, mu_max)
+    start = jnp.where(ecof < mu_max, ecof, 0.5 * high)
+
+    def unfinished(state):
+        *_, done, step = state
+        return (step < _MAX_STEPS) & ~jnp.all(done)
+
+    def newton(state):
+        mu, low, high, previous, done, step = state
+        value, slope = _ecof_and_slope(mu, kappa, lam)
+        residual = value - ecof
+        above = ~(residual <= 0.0)  # NaN: beyond the gross-slip (or locking) limit
+        low = jnp.where(above, low, mu)
+        high = jnp.where(above, mu, high)
+        change = residual / slope
+        proposal = mu - change
+        small = (residual == 0.0) | (jnp.abs(change) <= 4.0 * _EPS * mu)
+        fast = (proposal > low) & (proposal < high) & (jnp.abs(change) < 0.5 * previous)
+        following = jnp.where(small | fast, proposal, 0.5 * (low + high))
+        converged = small | (high - low <= 4.0 * _EPS * high)
+        following = jnp.where(done, mu, following)
+        return following, low, high, jnp.abs(following - mu), done | converged, step + 1
+
+    done = jnp.zeros(ecof.shape, dtype=bool)
+    state = (start, low, high, high - low, done, 0)
+    mu, *_ = jax.lax.while_loop(unfinished, newton, state)
+    return mu
+
+
+def _status(ecof, kappa, lam):
+    """``CORRECTED``, ``NO_GROSS_SLIP`` (:math:`\\mu_E \\ge 1/\\lambda`) or ``INVALID``."""
+    valid = (
+        (ecof > 0.0)
+        & jnp.isfinite(ecof)
+        & (kappa >= 0.0)
+        & jnp.isfinite(kappa)
+        & (lam >= 0.0)
+        & jnp.isfinite(lam)
+    )
+    reachable = ecof * lam < 1.0
+    code = jnp.where(
+        valid,
+        jnp.where(reachable, int(CorrectionStatus.CORRECTED), int(CorrectionStatus.NO_GROSS_SLIP)),
+        int(CorrectionStatus.INVALID),
+    )
+    return code.astype(jnp.int32)
+
+
+def _may_fall(kappa, lam):
+    """Where :math:`\\mu_E(\\mu)` may fall over part of its range (module docstring)."""
+    return (kappa > _FALL_KAPPA) & (lam > 0.0) & (lam < _FALL_LAMBDA)
+
+
+def ecof_fall(kappa, lam):
+    r"""Where :math:`\mu_E(\mu)` falls: its local maximum and minimum, or NaN where it rises.
+
+    Parameters
+    ----------
+    kappa : array_like
+        Curvature number :math:`\kappa = 2 z_o/x_o` (with :math:`x_o = \Delta^*`). [1]
+    lam : array_like
+        Compliance ratio :math:`\lambda = P/(S\Delta^*)`. [1]
+
+    Returns
+    -------
+    high : jax.Array
+        :math:`\mu_E` at the local maximum, where the fall starts; NaN where
+        :math:`\mu_E(\mu)` rises over the whole gross-slip range. [1]
+    low : jax.Array
+        :math:`\mu_E` at the local minimum, where it ends. An ECoF in ``[low, high]``
+        comes from three contact CoFs (two at the ends). [1]
+
+    Notes
+    -----
+    The fall exists only for :math:`\kappa > 1` and :math:`0 < \lambda <` :data:`LAMBDA_INFINITY`
+    and lies in
+    :math:`1/\kappa < \mu < 1` (module docstring); there the slope
+    :math:`d\mu_E/d\mu` (``jax.jvp`` of the corrected eq. 13-15 with eq. 16) is sampled at
+    256 points evenly spaced in :math:`\log\mu`, and its two sign changes are bisected. A
+    fall narrower than one grid step (:math:`\ln\kappa/255` in :math:`\log\mu`), at the very
+    edge of the region where it exists, is not seen: the contact CoFs it would make
+    ambiguous then lie within about two grid steps of each other.
+    """
+    kappa, lam = jnp.broadcast_arrays(as_float64(kappa), as_float64(lam))
+    may_fall = _may_fall(kappa, lam)
+    kappa = jnp.where(may_fall, kappa, 2.0)[..., None]  # harmless values elsewhere
+    lam = jnp.where(may_fall, lam, 0.01)[..., None]
+    fraction = jnp.linspace(0.0, 1.0, _FALL_GRID)
+    log_mu = -jnp.log(kappa) * (1.0 - fraction)  # from 1/kappa to 1
+    _, slope = _ecof_and_slope(jnp.exp(log_mu), kappa, lam)
+    falling = slope <= 0.0
+    found = may_fall & jnp.any(falling, axis=-1)
+    first = jnp.clip(jnp.argmax(falling, axis=-1), 1, _FALL_GRID - 2)
+    last = jnp.clip(_FALL_GRID - 1 - jnp.argmax(falling[..., ::-1], axis=-1), 1, _FALL_GRID - 2)
+
+    # Brackets of the slope's sign changes: rising at `rise`, falling at `fall`.
+    def at(index):
+        return jnp.take_along_axis(log_mu, index[..., None], axis=-1)[..., 0]
+
+    rise = jnp.stack([at(first - 1), at(last + 1)], axis=-1)
+    fall = jnp.stack([at(first), at(last)], axis=-1)
+
+    def halve(_, bracket):
+        rise, fall = bracket
+        middle = 0.5 * (rise + fall)
+        _, slope = _ecof_and_slope(jnp.exp(middle), kappa, lam)
+        up = slope > 0.0
+        return jnp.where(up, middle, rise), jnp.where(up, fall, middle)
+
+    rise, fall = jax.lax.fori_loop(0, _FALL_BISECTIONS, halve, (rise, fall))
+    extremum = jnp.exp(0.5 * (rise + fall))
+    value, _ = _ecof_and_slope(extremum, kappa, lam)
+    high = jnp.where(found, value[..., 0], jnp.nan)
+    low = jnp.where(found, value[..., 1], jnp.nan)
+    return high, low
+
+
+def _mark_ambiguous(mu, status, ecof, high, low):
+    """NaN and ``AMBIGUOUS`` where ``ecof`` lies in the fall ``[low, high]``."""
+    ambiguous = (status == int(CorrectionStatus.CORRECTED)) & (ecof >= low) & (ecof <= high)
+    status = jnp.where(ambiguous, int(CorrectionStatus.AMBIGUOUS), status).astype(jnp.int32)
+    return jnp.where(ambiguous, jnp.nan, mu), status
+
+
+def _fall_if_needed(status, kappa, lam):
+    """:func:`ecof_fall` at every point, scanned only if a corrected point may fall."""
+    needed = jnp.any(_may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
+    nan = jnp.full(status.shape, jnp.nan)
+    return jax.lax.cond(needed, lambda: ecof_fall(kappa, lam), lambda: (nan, nan))
+
+
+def _root_and_status(ecof, kappa, lam):
+    """The root and status without the ambiguity check, NaN wherever it is not corrected."""
+    ecof, kappa, lam = jnp.broadcast_arrays(ecof, kappa, lam)
+    status = _status(ecof, kappa, lam)
+    corrected = status == int(CorrectionStatus.CORRECTED)
+    mu = _root(
+        jnp.where(corrected, ecof, 0.5),
+        jnp.where(corrected, kappa, 0.0),
+        jnp.where(corrected, lam, 0.0),
+    )
+    return jnp.where(corrected, mu, jnp.nan), status
+
+
+def contact_cof(ecof, kappa, lam):
+    r"""The contact CoF :math:`\mu` whose energy CoF is ``ecof``: the dimensionless core.
+
+    A pure ``jax.numpy`` function of the core numbers of :mod:`ecofmaps.model`; it
+    broadcasts and works under ``jax.jit`` and ``jax.vmap``, and checks nothing.
+
+    Parameters
+    ----------
+    ecof : array_like
+        Energy coefficient of friction :math:`\mu_E`. [1]
+    kappa : array_like
+        Curvature number :math:`\kappa = 2 z_o/x_o` (with :math:`x_o = \Delta^*`). [1]
+    lam : array_like
+        Compliance ratio :math:`\lambda = P/(S\Delta^*)`, 0 for a rigid rig. [1]
+
+    Returns
+    -------
+    mu : jax.Array
+        The contact CoF, within a few ulp of the exact root: :math:`|\mu_E(\mu) -
+        \mu_E^{given}| \le 10^{-12}\mu_E^{given}` wherever one ulp of :math:`\mu` moves
+        :math:`\mu_E` by less (everywhere but a rigid rig next to locking,
+        :math:`1 - \mu\kappa < 10^{-5}`); NaN unless the status is ``CORRECTED``. [1]
+    status : jax.Array of int32
+        :class:`CorrectionStatus` codes.
+
+    Notes
+    -----
+    Inverts the corrected eq. 13-15 with eq. 16 (module docstring).
+    """
+    ecof, kappa, lam = jnp.broadcast_arrays(*(as_float64(v) for v in (ecof, kappa, lam)))
+    mu, status = _root_and_status(ecof, kappa, lam)
+    return _mark_ambiguous(mu, status, ecof, *_fall_if_needed(status, kappa, lam))
+
+
+# ---------------------------------------------------------------------------------------
+# SI-unit API
+# ---------------------------------------------------------------------------------------
+
+
+def _core_numbers(amplitude, load, stiffness, aspect_ratio):
+    """:math:`\\kappa` and :math:`\\lambda` with :math:`x_o = \\Delta^*`, and SI validity."""
+    kappa = model.curvature_number(1.0, aspect_ratio, 1.0)  # x_o = Δ*: κ = 2 z_o/x_o
+    lam = model.compliance_ratio(amplitude, load, stiffness)
+    valid = valid_geometry(amplitude, load, stiffness, aspect_ratio, amplitude)
+    return kappa, lam, valid
+
+
+@jax.jit
+def _si_root(ecof, amplitude, load, stiffness, aspect_ratio):
+    """Root, status, kappa and lam over the broadcast shape; no ambiguity check."""
+    kappa, lam, valid = _core_numbers(amplitude, load, stiffness, aspect_ratio)
+    mu, status = _root_and_status(ecof, kappa, lam)
+    status = jnp.where(valid, status, int(CorrectionStatus.INVALID)).astype(jnp.int32)
+    mu = jnp.where(valid, mu, jnp.nan)
+    return mu, status, *jnp.broadcast_arrays(kappa, lam, mu)[:2]
+
+
+_ecof_fall = jax.jit(ecof_fall)
+
+
+def _si_correct(ecof, amplitude, load, stiffness, aspect_ratio):
+    """μ, status and the fall (high, low) at concrete or traced SI inputs."""
+    mu, status, kappa, lam = _si_root(ecof, amplitude, load, stiffness, aspect_ratio)
+    if not is_concrete(mu):
+        high, low = _fall_if_needed(status, kappa, lam)
+    else:
+        # Only the few points where mu_E(mu) may fall are scanned, in one padded batch.
+        where = np.flatnonzero(
+            np.asarray(_may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
+        )
+        high = np.full(mu.size, np.nan)
+        low = np.full(mu.size, np.nan)
+        if where.size:
+            size = max(8, 1 << (where.size - 1).bit_length())  # few distinct shapes to compile
+            padded = np.pad(where, (0, size - where.size), mode="edge")
+            fall = _ecof_fall(kappa.ravel()[padded], lam.ravel()[padded])
+            high[where], low[where] = (np.asarray(v)[: where.size] for v in fall)
+        high, low = high.reshape(mu.shape), low.reshape(mu.shape)
+    ecof = jnp.broadcast_to(ecof, mu.shape)
+    mu, status = _mark_ambiguous(mu, status, ecof, jnp.asarray(high), jnp.asarray(low))
+    return mu, status, (kappa, lam, high, low)
+
+
+def _aspect_ratio(aspect_ratio, scar_depth, scar_half_width):
+    """The aspect ratio (or a ``(low, high)`` tuple of them) from either way of giving it."""
+    if aspect_ratio is not None:
+        if scar_depth is not None or scar_half_width is not None:
+            raise ValueError(
+                "give the groove aspect ratio one way: aspect_ratio, or scar_depth and "
+                "scar_half_width (z_o/x_o = D/W, eq. 11), not both"
+            )
+        if isinstance(aspect_ratio, tuple):
+            if len(aspect_ratio) != 2:
+                raise ValueError(
+                    "aspect_ratio as a tuple is an interval (low, high) of two values or "
+                    f"arrays, got {len(aspect_ratio)} items (use a list or an array for "
+                    "per-point values)"
+                )
+            low, high = aspect_ratio
+            check("aspect_ratio low", low, "non_negative", "1")
+            check("aspect_ratio high", high, "non_negative", "1")
+            if is_concrete(low, high) and np.any(np.asarray(low) > np.asarray(high)):
+                raise ValueError(
+                    f"aspect_ratio interval must have low <= high, got ({low!r}, {high!r})"
+                )
+            return as_float64(low), as_float64(high)
+        check("aspect_ratio", aspect_ratio, "non_negative", "1")
+        return as_float64(aspect_ratio)
+    if scar_depth is None or scar_half_width is None:
+        raise ValueError(
+            "give the groove aspect ratio: aspect_ratio, or both scar_depth and "
+            "scar_half_width (z_o/x_o = D/W, eq. 11)"
+        )
+    check("scar_depth", scar_depth, "non_negative", "m")
+    check("scar_half_width", scar_half_width, "positive", "m")
+    return as_float64(scar_depth) / as_float64(scar_half_width)
+
+
+def _failure_message(status, ecof, details) -> str:
+    """The reason a concrete single-point correction failed, with the numbers."""
+    kappa, lam, high, low = (float(np.asarray(v)) for v in details)
+    if status == CorrectionStatus.NO_GROSS_SLIP:
+        return (
+            f"ecof = {ecof:.6g} cannot be corrected: it is at or above stiffness * amplitude "
+            f"/ load = {1.0 / lam:.6g}, and every gross-slip loop with these test conditions "
+            "has a smaller energy CoF (a contact CoF that high would stop gross slip). "
+            "Check the amplitude, load and stiffness."
+        )
+    return (
+        f"ecof = {ecof:.6g} cannot be corrected uniquely: with this deep groove "
+        f"(z_o/x_o = {kappa / 2.0:.6g}) and stiff rig (load / (stiffness * amplitude) = "
+        f"{lam:.6g}) the energy CoF falls from {high:.6g} to {low:.6g} as mu rises, and "
+        "three contact CoFs give any value between."
+    )
+
+
+@float64
+def _correct(ecof, amplitude, load, stiffness, aspect_ratio, scar_depth, scar_half_width,
+             return_status, factor, caller):  # fmt: skip
+    check("ecof", ecof, "positive", "1")
+    check("amplitude", amplitude, "positive", "m")
+    check("load", load, "positive", "N")
+    check("stiffness", stiffness, "positive_or_inf", "N/m")
+    ratio = _aspect_ratio(aspect_ratio, scar_depth, scar_half_width)
+    ecof, amplitude, load, stiffness = (as_float64(v) for v in (ecof, amplitude, load, stiffness))
+    ends = ratio if isinstance(ratio, tuple) else (ratio,)
+    results = [_si_correct(ecof, amplitude, load, stiffness, end) for end in ends]
+    values = [mu / ecof if factor else mu for mu, _, _ in results]
+    status = results[0][1]
+    if len(results) == 2:  # the larger aspect ratio allows the smaller mu (module docstring)
+        high_end = results[1][1]
+        status = jnp.where(status == int(CorrectionStatus.CORRECTED), high_end, status)
+        both = status == int(CorrectionStatus.CORRECTED)
+        values = Interval(*(jnp.where(both, v, jnp.nan) for v in (values[1], values[0])))
+    else:
+        values = values[0]
+    concrete = is_concrete(status)
+    if concrete and not return_status:
+        codes = np.asarray(status)
+        if codes.ndim == 0 and codes != CorrectionStatus.CORRECTED:
+            failed = next(r for r in results if np.asarray(r[1]) != CorrectionStatus.CORRECTED)
+            raise ValueError(_failure_message(CorrectionStatus(int(codes)), float(ecof), failed[2]))
+        first = values[0] if isinstance(values, Interval) else values
+        warn_nan(first, codes, CorrectionStatus, caller)
+    return (values, status) if return_status else values
+
+
+_PARAMETERS = """
+    Parameters
+    ----------
+    ecof : array_like
+        The reported energy coefficient of friction :math:`\\mu_E = E_d/(4P\\delta^*)`. [1]
+    amplitude : array_like
+        Displacement amplitude :math:`\\Delta^*` of the test (also the groove half-width
+        :math:`x_o`, as in the paper). [m]
+    load : array_like
+        Normal load :math:`P`. [N]
+    stiffness : array_like
+        Rig stiffness :math:`S`; ``numpy.inf`` for a rigid rig. [N/m]
+    aspect_ratio : array_like or tuple (low, high), optional
+        The wear scar's depth over half-width, :math:`z_o/x_o = D/W` (eq. 11). A ``tuple``
+        of two values (or arrays) is an interval for a scar known only roughly; give
+        per-point values as a list or an array. [1]
+    scar_depth : array_like, optional
+        Wear scar depth :math:`D`, instead of ``aspect_ratio`` (with ``scar_half_width``). [m]
+    scar_half_width : array_like, optional
+        Wear scar half-width :math:`W`. [m]
+    return_status : bool
+        Also return the :class:`CorrectionStatus` of every point, and never raise or warn
+        for a point that cannot be corrected.
+"""
+
+_RAISES = """
+    Raises
+    ------
+    ValueError
+        For a concrete input out of its range (ecof, amplitude, load and scar_half_width
+        finite and > 0, stiffness > 0 with inf allowed, aspect_ratio and scar_depth finite
+        and >= 0, an interval with low <= high), for the aspect ratio given neither or both
+        ways, and, without ``return_status``, for a single point that cannot be corrected
+        (the message says why). Under ``jax.jit``/``jax.vmap`` such points are NaN with the
+        status ``INVALID``.
+
+    Warns
+    -----
+    ecofmaps.RegimeWarning
+        For concrete arrays (without ``return_status``) with points that cannot be
+        corrected, naming the reasons; those points are NaN.
+"""
+
+
+def correct_ecof(ecof, amplitude, load, stiffness, aspect_ratio=None, scar_depth=None,
+                 scar_half_width=None, *, return_status=False):  # fmt: skip
+    return _correct(ecof, amplitude, load, stiffness, aspect_ratio, scar_depth,
+                    scar_half_width, return_status, False, "correct_ecof")  # fmt: skip
+
+
+correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy CoF :math:`\\mu_E`.
+
+    The exact inversion of the model's :math:`\\mu_E(\\mu; \\Delta^*, P, S, z_o/x_o)`, with
+    :math:`x_o = \\Delta^*`, vectorised and jit-compiled, in float64.
+{_PARAMETERS}
+    Returns
+    -------
+    mu : jax.Array of float64, or Interval
+        The contact CoF, within a few ulp of the exact root, so that :math:`|\\mu_E(\\mu) - `
+        ``ecof`` :math:`| \\le 10^{{-12}}` ``ecof`` except on a rigid rig next to locking
+        (:math:`1 - \\mu\\kappa < 10^{{-5}}`), where one ulp of :math:`\\mu` moves :math:`\\mu_E` by
+        more; NaN where it cannot be corrected. With ``aspect_ratio=(low, high)``, an
+        :class:`Interval` ``(low, high)`` of arrays: every contact CoF that gives ``ecof``
+        with an aspect ratio in the interval (``low`` from the deeper scar). [1]
+    status : jax.Array of int32
+        Only with ``return_status=True``: :class:`CorrectionStatus` codes (for an interval,
+        the first failure of its two ends).
+{_RAISES}
+    Notes
+    -----
+    Inverts the corrected eq. 13-15 with eq. 16 by bracketed Newton steps (see
+    :mod:`ecofmaps.correction` for the domain: which ECoFs can be reached, where the
+    inversion is unique, and why the interval is exact). :math:`\\mu \\le \\mu_E`, with
+    equality for a flat scar.
+
+    Examples
+    --------
+    >>> import ecofmaps
+    >>> mu = ecofmaps.correct_ecof(0.8308, amplitude=50e-6, load=450.0, stiffness=35e6,
+    ...                            aspect_ratio=0.2)  # the paper's Example 2
+    >>> round(float(mu), 3)
+    0.8
+"""
+
+
+def correction_factor(ecof, amplitude, load, stiffness, aspect_ratio=None, scar_depth=None,
+                      scar_half_width=None, *, return_status=False):  # fmt: skip
+    return _correct(ecof, amplitude, load, stiffness, aspect_ratio, scar_depth,
+                    scar_half_width, return_status, True, "correction_factor")  # fmt: skip
+
+
+correction_factor.__doc__ = f"""The ratio :math:`\\mu/\\mu_E` of contact CoF to reported ECoF.
+{_PARAMETERS}
+    Returns
+    -------
+    factor : jax.Array of float64, or Interval
+        :math:`\\mu/\\mu_E \\le 1` (1 for a flat scar), with :math:`\\mu` from
+        :func:`correct_ecof`; an :class:`Interval` for an aspect-ratio interval. [1]
+    status : jax.Array of int32
+        Only with ``return_status=True``: :class:`CorrectionStatus` codes.
+{_RAISES}
+    Notes
+    -----
+    The reciprocal of the :math:`\\mu_E/\\mu` of Figures 8 and 11, read at the contact CoF
+    that gives the reported :math:`\\mu_E` rather than at a chosen :math:`\\mu`.
+"""

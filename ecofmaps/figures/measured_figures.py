@@ -1,0 +1,249 @@
+r"""Figures of measured loops: the loops with :math:`Q = S\Delta`, Figure 9 and Figure 10.
+
+Each function takes the results of :func:`ecofmaps.analyze_loops` or
+:func:`ecofmaps.fit_loop` and returns a :class:`matplotlib.figure.Figure`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+import xarray as xr
+from matplotlib.figure import Figure
+
+from ecofmaps.figures.style import (
+    MEGA,
+    MICRO,
+    axis_label,
+    force_ratio_axis,
+    parameters,
+    scalar,
+)
+
+__all__ = ["cof_evolution", "measured_and_fitted_loops", "measured_loops"]
+
+
+def _evenly_spread(labels, count: int) -> list:
+    """Up to ``count`` of ``labels`` spread evenly, the first and the last included."""
+    picks = np.unique(np.linspace(0, len(labels) - 1, min(count, len(labels))).round().astype(int))
+    return [labels[i] for i in picks]
+
+
+def measured_loops(results: xr.Dataset, cycles=None, columns: int = 3) -> Figure:
+    r"""Measured loops, each with the line :math:`Q = S\Delta` and its two GICoF crossings.
+
+    Parameters
+    ----------
+    results : xarray.Dataset
+        From :func:`ecofmaps.analyze_loops` with ``keep_loops=True``.
+    cycles : sequence of int, optional
+        Cycle numbers to draw, one panel each; by default six spread evenly over the
+        recording, the first and the last included.
+    columns : int
+        Panels per row.
+
+    Returns
+    -------
+    figure : matplotlib.figure.Figure
+        One panel per cycle: the centred loop, :math:`Q` [N] against :math:`\Delta` [µm],
+        the line :math:`Q = S\Delta` with the cycle's stiffness, and the crossings whose
+        :math:`Q/P` is the GICoF.
+
+    Notes
+    -----
+    The paper's Section 5 and Figure 6 (eq. 17-18): where the loop meets
+    :math:`Q = S\Delta` the contact is at the bottom of the groove, and :math:`Q/P = \mu`.
+    """
+    if "loop_displacement" not in results:
+        raise ValueError("results hold no loops: call analyze_loops(..., keep_loops=True)")
+    labels = list(results["cycle"].values)
+    chosen = _evenly_spread(labels, 6) if cycles is None else list(cycles)
+    rows = -(-len(chosen) // columns)
+    width = min(columns, len(chosen))
+    figure = Figure(figsize=(3.6 * width + 0.6, 3.1 * rows + 0.9), layout="constrained")
+    axes = figure.subplots(rows, width, squeeze=False, sharex=True, sharey=True)
+    load = scalar(results, "load")
+    for ax, label in zip(axes.flat, chosen, strict=False):
+        cycle = results.sel(cycle=label)
+        x = cycle["loop_displacement"].values * MICRO
+        q = cycle["loop_force"].values
+        ax.plot(x, q, color="tab:blue", linewidth=1.2, label="measured loop")
+        stiffness = float(cycle["stiffness"])
+        # The line across the loop's height, within its width. [µm]
+        reach = np.nanmax(np.abs(q)) / stiffness * MICRO
+        ends = np.array([max(np.nanmin(x), -reach), min(np.nanmax(x), reach)])
+        ax.plot(
+            ends,
+            stiffness * ends / MICRO,
+            color="0.35",
+            linestyle="--",
+            linewidth=1.0,
+            label=r"$Q = S\Delta$",
+        )
+        crossings = np.array(
+            [
+                float(cycle["crossing_displacement_forward"]),
+                float(cycle["crossing_displacement_backward"]),
+            ]
+        )
+        ratios = np.array([float(cycle["gicof_forward"]), -float(cycle["gicof_backward"])])
+        ax.plot(
+            crossings * MICRO,
+            ratios * load,
+            linestyle="none",
+            marker="o",
+            markersize=6,
+            markerfacecolor="tab:red",
+            markeredgecolor="black",
+            label="GICoF crossings",
+        )
+        ax.axhline(0.0, color="0.7", linewidth=0.6)
+        ax.axvline(0.0, color="0.7", linewidth=0.6)
+        ax.grid(alpha=0.3)
+        reading = (
+            f"GICoF {float(cycle['gicof']):.3f}, ECoF {float(cycle['ecof']):.3f}"
+            if cycle["regime"] == "gross slip"
+            else "no GICoF or ECoF"
+        )
+        ax.set_title(
+            f"cycle {label}: {reading}\n"
+            f"S = {stiffness * MEGA:.1f} MN/m, {cycle['regime'].values!s}",
+            fontsize="small",
+        )
+    for ax in axes.flat[len(chosen) :]:
+        ax.set_visible(False)
+    for ax in axes[-1]:
+        ax.set_xlabel(axis_label("displacement"))
+    for ax in axes[:, 0]:
+        ax.set_ylabel(axis_label("force"))
+    axes.flat[0].legend(loc="upper left", fontsize="x-small")
+    figure.suptitle(
+        rf"Measured loops and the line $Q = S\Delta$ (P = {load:g} N): "
+        "the GICoF is Q/P at the crossings",
+        fontsize="medium",
+    )
+    return figure
+
+
+def cof_evolution(results: xr.Dataset) -> Figure:
+    r"""Figure 9: the ECoF and the GICoF over the cycles of a test.
+
+    Parameters
+    ----------
+    results : xarray.Dataset
+        From :func:`ecofmaps.analyze_loops`.
+
+    Returns
+    -------
+    figure : matplotlib.figure.Figure
+        Top: :math:`\mu_E` (eq. 1) and the GICoF against the cycle number.
+        Bottom: how far the ECoF is above the GICoF, :math:`\mu_E/\text{GICoF} - 1` [%].
+
+    Notes
+    -----
+    The paper's Figure 9: with a flat scar the two coefficients agree; as the scar deepens
+    into a groove the ECoF rises above the GICoF, which stays at the contact :math:`\mu`.
+    Cycles in partial slip have neither and leave gaps.
+    """
+    figure = Figure(figsize=(7.0, 5.6), layout="constrained")
+    top, bottom = figure.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
+    cycle = results["cycle"].values
+    marker = dict(marker="o", markersize=2.5) if cycle.size <= 400 else {}
+    top.plot(
+        cycle,
+        results["ecof"],
+        color="tab:orange",
+        linewidth=1.3,
+        label=r"ECoF $\mu_E = E_d/(4P\delta^*)$",
+        **marker,
+    )
+    top.plot(
+        cycle,
+        results["gicof"],
+        color="tab:blue",
+        linewidth=1.3,
+        label=r"GICoF ($Q/P$ on $Q = S\Delta$)",
+        **marker,
+    )
+    top.set_ylabel("Coefficient of friction [1]")
+    top.grid(alpha=0.3)
+    top.legend(loc="best", fontsize="small")
+    excess = (results["ecof"] / results["gicof"] - 1.0) * 100.0
+    bottom.plot(cycle, excess, color="tab:purple", linewidth=1.2, **marker)
+    bottom.axhline(0.0, color="0.5", linewidth=0.8)
+    bottom.set_ylabel("ECoF / GICoF − 1 [%]")
+    bottom.set_xlabel("Cycle")
+    bottom.grid(alpha=0.3)
+    amplitude = float(results["amplitude"].median()) * MICRO
+    figure.suptitle(
+        "Fig. 9  Evolution of the ECoF and the GICoF\n"
+        + parameters(f"P = {scalar(results, 'load'):g} N", rf"$\Delta^*$ ≈ {amplitude:.1f} µm"),
+        fontsize="medium",
+    )
+    return figure
+
+
+# --- Figure 10: measured loops and the fitted model ----------------------------------------
+
+
+def measured_and_fitted_loops(fits) -> Figure:
+    r"""Figure 10: measured fretting loops overlaid with the model fitted to them.
+
+    Parameters
+    ----------
+    fits : LoopFit or mapping of str to LoopFit
+        From :func:`ecofmaps.fit_loop`. A mapping draws one panel per entry, titled by
+        its key, side by side (the paper's Figure 10 has Example 1 and Example 2).
+
+    Returns
+    -------
+    figure : matplotlib.figure.Figure
+        In each panel the measured samples (dots) and the fitted model loop (line), Q [N]
+        (left) and Q/P (right) against Δ [µm]; the title gives the fitted μ, S [MN/m],
+        z_o [µm] and the RMS force residual [N].
+
+    Notes
+    -----
+    Figure 10 of the paper overlays the final measured loops of its two tests and the
+    model with :math:`x_o = \Delta^* = 50` µm, :math:`\mu` = GICoF = 0.825, S = 45 and
+    35 MN/m, :math:`z_o` = 1.8 and 8.0 µm (Section 4.2); here the model's parameters are
+    the least-squares fit.
+    """
+    panels = dict(fits) if isinstance(fits, Mapping) else {"": fits}
+    figure = Figure(figsize=(5.6 * len(panels), 5.2), layout="constrained")
+    axes = figure.subplots(1, len(panels), squeeze=False)[0]
+    for index, (ax, (name, fit)) in enumerate(zip(axes, panels.items(), strict=True)):
+        displacement, force = fit.model_loop()
+        ax.plot(fit.displacement * MICRO, fit.force, "o", color="0.15", markersize=2.5,
+                alpha=0.7, zorder=3, label="measured")  # fmt: skip
+        ax.plot(
+            displacement * MICRO,
+            force,
+            color="crimson",
+            linewidth=1.8,
+            label="fitted model",
+        )
+        ax.axhline(fit.force_offset, color="0.6", linewidth=0.6)
+        ax.axvline(fit.displacement_offset * MICRO, color="0.6", linewidth=0.6)
+        ax.set_xlabel(axis_label("displacement"))
+        ax.set_ylabel(axis_label("force"))
+        ax.grid(alpha=0.3)
+        force_ratio_axis(ax, fit.load)
+        panel = f"({chr(ord('a') + index)}) " if len(panels) > 1 else ""
+        panel += f"{name}: " if name else ""
+        ax.set_title(
+            f"{panel}P = {fit.load:g} N, "
+            rf"$x_o = \Delta^*$ = {fit.amplitude * MICRO:.1f} µm"
+            "\n"
+            + parameters(
+                rf"fit: $\mu$ = {fit.mu:.3f}",
+                f"S = {fit.stiffness * MEGA:.1f} MN/m",
+                rf"$z_o$ = {fit.groove_depth * MICRO:.2f} µm",
+                f"RMS residual {fit.rms_residual:.2g} N",
+            ),
+            fontsize="medium",
+        )
+        ax.legend(loc="best", fontsize="small")
+    figure.suptitle("Fig. 10  Measured fretting loops and the fitted model", fontsize="medium")
+    return figure

@@ -1,0 +1,242 @@
+r"""The figures ``ecofmaps figures`` writes: each one's Dataset, drawing function and markers.
+
+:data:`FIGURES` is the registry: for each figure name, the function that builds its Dataset
+with the paper's parameters (:mod:`ecofmaps.paper`, through the cached map functions), the
+function that draws it, and what it marks. :func:`make_figure` does both for one figure,
+:func:`make_figures` for several (building each shared Dataset once).
+
+The paper's parameters (Section 3): :math:`\Delta^* = x_o = 50` µm, :math:`P = 450` N,
+:math:`S = 35` MN/m, :math:`\mu = 0.8`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+
+import numpy as np
+import xarray as xr
+from matplotlib.figure import Figure
+
+from ecofmaps import paper
+from ecofmaps.figures.model_figures import (
+    dissipated_energy_curves,
+    ecof_ratio_contours,
+    ecof_ratio_curves,
+    loops_by_aspect_ratio,
+    rigid_and_compliant_loops,
+    slip_amplitude_curves,
+    universal_ecof_ratio_map,
+)
+from ecofmaps.maps.grid import compute_loops, compute_map, compute_universal_map
+
+__all__ = [
+    "ASPECT_RATIOS",
+    "COMPLIANCE_RATIOS",
+    "FIGURES",
+    "FigureRecipe",
+    "make_figure",
+    "make_figures",
+]
+
+#: Groove aspect ratios z_o/x_o of Figures 7, 8, 11 and the universal map (the paper's 0 to
+#: 0.3, finely). [1]
+ASPECT_RATIOS = np.linspace(0.0, 0.3, 61)
+#: λ of the universal map, on a logarithmic scale: near-rigid rigs to well past the end of
+#: gross slip at μλ = 1, covering Figure 11 at both amplitudes. [1]
+COMPLIANCE_RATIOS = np.geomspace(0.01, 2.0, 161)
+
+
+@dataclass(frozen=True)
+class FigureRecipe:
+    """How to make one figure: its Dataset (paper's parameters) and its drawing function.
+
+    Attributes
+    ----------
+    name : str
+        File stem, e.g. ``'fig7a'``.
+    description : str
+        One line saying what the figure shows.
+    data : callable
+        ``data() -> xarray.Dataset``, built through the cached map functions. Recipes that
+        share a ``data`` function share its Dataset (see :func:`make_figures`).
+    draw : callable
+        ``draw(dataset, **options) -> matplotlib.figure.Figure``.
+    selection : dict
+        Coordinate values picked from the Dataset with ``.sel`` before drawing.
+    options : dict
+        Keyword arguments of ``draw``: the figure's number, the points it marks.
+    """
+
+    name: str
+    description: str
+    data: Callable[[], xr.Dataset]
+    draw: Callable[..., Figure]
+    selection: dict = field(default_factory=dict)
+    options: dict = field(default_factory=dict)
+
+    def dataset(self) -> xr.Dataset:
+        """The Dataset this figure draws."""
+        return self.data().sel(self.selection)
+
+    def figure(self, dataset: xr.Dataset) -> Figure:
+        """The figure, drawn from ``dataset`` (the Dataset of :attr:`data`, before selection)."""
+        return self.draw(dataset.sel(self.selection), **self.options)
+
+
+def _loops() -> xr.Dataset:
+    """The loops of Figures 5 and 6: rigid and 35 MN/m rigs, z_o/x_o = 0, 0.1, 0.2, 0.3."""
+    return compute_loops(
+        stiffness=np.array([np.inf, paper.STIFFNESS]),
+        aspect_ratio=np.array([0.0, 0.1, 0.2, 0.3]),
+        amplitude=paper.AMPLITUDE,
+        load=paper.LOAD,
+        mu=paper.MU,
+    )
+
+
+def _stiffness_curves_data() -> xr.Dataset:
+    return compute_map(
+        stiffness_ratio=np.array(paper.FIGURE_7_STIFFNESSES) / paper.LOAD,
+        aspect_ratio=ASPECT_RATIOS,
+        amplitude=paper.AMPLITUDE,
+        mu=paper.MU,
+        load=paper.LOAD,
+    )
+
+
+def _ecof_ratio_map(panel: str) -> Callable[[], xr.Dataset]:
+    amplitude = paper.FIGURE_11_AMPLITUDES[panel]
+
+    def data() -> xr.Dataset:
+        return compute_map(paper.FIGURE_11_STIFFNESS_RATIOS, ASPECT_RATIOS, amplitude, paper.MU)
+
+    data.__name__ = f"_ecof_ratio_map_{panel}"
+    return data
+
+
+def _universal_map() -> xr.Dataset:
+    return compute_universal_map(COMPLIANCE_RATIOS, ASPECT_RATIOS, paper.MU)
+
+
+_EXAMPLE_2 = {"Example 2": paper.EXAMPLE_2}
+
+FIGURES: dict[str, FigureRecipe] = {
+    recipe.name: recipe
+    for recipe in (
+        FigureRecipe(
+            "fig5",
+            "loop of a rigid rig against S = 35 MN/m, z_o/x_o = 0.2",
+            _loops,
+            rigid_and_compliant_loops,
+            {"aspect_ratio": paper.ASPECT_RATIO},
+        ),
+        FigureRecipe(
+            "fig6",
+            "loops for z_o/x_o = 0, 0.1, 0.2, 0.3 at S = 35 MN/m, with Q = SΔ",
+            _loops,
+            loops_by_aspect_ratio,
+            {"stiffness": paper.STIFFNESS},
+        ),
+        FigureRecipe(
+            "fig7a",
+            "slip amplitude against z_o/x_o for S = 20, 35, 50, 100 MN/m and rigid",
+            _stiffness_curves_data,
+            slip_amplitude_curves,
+        ),
+        FigureRecipe(
+            "fig7b",
+            "dissipated energy against z_o/x_o for S = 20, 35, 50, 100 MN/m and rigid",
+            _stiffness_curves_data,
+            dissipated_energy_curves,
+        ),
+        FigureRecipe(
+            "fig8",
+            "μ_E/μ against z_o/x_o for S = 20, 35, 50, 100 MN/m and rigid, Example 2 marked",
+            _stiffness_curves_data,
+            ecof_ratio_curves,
+            options={"markers": _EXAMPLE_2},
+        ),
+        FigureRecipe(
+            "fig11a",
+            "contours of μ_E/μ over S/P and z_o/x_o at Δ* = 25 µm",
+            _ecof_ratio_map("11a"),
+            ecof_ratio_contours,
+            options={"number": "11a"},
+        ),
+        FigureRecipe(
+            "fig11b",
+            "contours of μ_E/μ over S/P and z_o/x_o at Δ* = 50 µm, Example 2 marked",
+            _ecof_ratio_map("11b"),
+            ecof_ratio_contours,
+            options={"number": "11b", "markers": _EXAMPLE_2},
+        ),
+        FigureRecipe(
+            "universal",
+            "μ_E/μ over λ = P/(SΔ*) and z_o/x_o: Fig. 11a and 11b in one chart",
+            _universal_map,
+            universal_ecof_ratio_map,
+            options={
+                "markers": paper.FIGURE_10_FITS,
+                "windows": {
+                    panel: (amplitude, paper.FIGURE_11_STIFFNESS_RATIOS)
+                    for panel, amplitude in paper.FIGURE_11_AMPLITUDES.items()
+                },
+            },
+        ),
+    )
+}
+
+
+def _recipe(name: str) -> FigureRecipe:
+    if name not in FIGURES:
+        raise ValueError(f"unknown figure {name!r}; valid names: {', '.join(FIGURES)}")
+    return FIGURES[name]
+
+
+def make_figure(name: str) -> Figure:
+    """Build the Dataset of figure ``name`` (from the cache when there) and draw it.
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`FIGURES`.
+
+    Returns
+    -------
+    figure : matplotlib.figure.Figure
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is not a key of :data:`FIGURES`.
+    """
+    recipe = _recipe(name)
+    return recipe.figure(recipe.data())
+
+
+def make_figures(names=None) -> Iterator[tuple[str, Figure]]:
+    """Draw several figures, building each Dataset only once.
+
+    Parameters
+    ----------
+    names : iterable of str, optional
+        Keys of :data:`FIGURES`; default all of them, in order.
+
+    Yields
+    ------
+    name : str
+    figure : matplotlib.figure.Figure
+        Drawn lazily, so a caller can time each one.
+
+    Raises
+    ------
+    ValueError
+        If a name is not a key of :data:`FIGURES` (before anything is computed).
+    """
+    recipes = [_recipe(name) for name in (FIGURES if names is None else names)]
+    datasets: dict = {}
+    for recipe in recipes:
+        if recipe.data not in datasets:
+            datasets[recipe.data] = recipe.data()
+        yield recipe.name, recipe.figure(datasets[recipe.data])

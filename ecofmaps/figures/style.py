@@ -1,0 +1,94 @@
+"""The look shared by every figure: sizes, labels from the nomenclature, colours, saving.
+
+Figures are :class:`matplotlib.figure.Figure` objects built without pyplot state, so they
+can be made in a loop or a server; :func:`save_figure` writes one atomically.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+from matplotlib import colormaps
+from matplotlib.figure import Figure
+
+from ecofmaps._nomenclature import QUANTITIES, axis_label
+from ecofmaps.io.files import atomic_path
+
+__all__ = ["ECOF_RATIO_LEVELS", "FIGSIZE", "axis_label", "save_figure"]
+
+#: Contour levels of μ_E/μ shared by Figure 11 and the universal map, so they read alike.
+ECOF_RATIO_LEVELS = (1.01, 1.02, 1.03, 1.04, 1.05, 1.06, 1.08, 1.10, 1.12, 1.14, 1.17, 1.20, 1.25)
+
+#: The level drawn heavier: the paper's "most tests are within 5 %".
+HIGHLIGHT_LEVEL = 1.05
+
+#: Size of a one-panel figure. [inch]
+FIGSIZE = (6.4, 4.6)
+
+#: Factors from SI to the units the figures speak.
+MICRO = QUANTITIES["displacement"].display_factor  # m -> µm
+MEGA = QUANTITIES["stiffness"].display_factor  # N/m -> MN/m
+MILLI = QUANTITIES["dissipated_energy"].display_factor  # J -> mJ
+PER_MM = QUANTITIES["stiffness_ratio"].display_factor  # 1/m -> 1/mm = (MN/m)/kN
+
+
+def scalar(dataset: xr.Dataset, name: str) -> float:
+    """A parameter held as a scalar coordinate of ``dataset``, as a float."""
+    return float(dataset[name].values)
+
+
+def stiffness_label(stiffness: float) -> str:
+    """Legend text for a rig stiffness [N/m]."""
+    if np.isinf(stiffness):
+        return r"rigid ($S = \infty$)"
+    return f"S = {stiffness * MEGA:g} MN/m"
+
+
+def stiffness_colors(stiffnesses) -> list:
+    """One colour per stiffness: a sequential map for finite rigs, black for the rigid one."""
+    finite = [s for s in stiffnesses if np.isfinite(s)]
+    cmap = colormaps["plasma"]
+    shades = dict(zip(finite, cmap(np.linspace(0.05, 0.8, len(finite))), strict=True))
+    return [shades.get(s, "black") for s in stiffnesses]
+
+
+def parameters(*items: str) -> str:
+    """A figure subtitle listing the fixed parameters."""
+    return ",  ".join(items)
+
+
+def force_ratio_axis(ax, load: float) -> None:
+    """A right-hand axis reading the force axis [N] as :math:`Q/P`."""
+    secondary = ax.secondary_yaxis("right", functions=(lambda q: q / load, lambda r: r * load))
+    secondary.set_ylabel(axis_label("force_ratio"))
+
+
+# No time stamps in the files, so regenerating an unchanged figure gives the same bytes.
+_METADATA = {"pdf": {"CreationDate": None}, "svg": {"Date": None}}
+
+
+def save_figure(figure: Figure, path, dpi: int = 150) -> Path:
+    """Write ``figure`` to ``path`` atomically; the format follows the file's suffix.
+
+    The figure is written to a temporary file in the same directory and renamed over
+    ``path``, so an existing file is never left half written.
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+    path : str or os.PathLike
+        Destination, ending in ``.png``, ``.pdf`` or ``.svg``. Its directory must exist.
+    dpi : int
+        Resolution of raster output. [1/inch]
+
+    Returns
+    -------
+    path : pathlib.Path
+    """
+    path = Path(path)
+    file_format = path.suffix.lstrip(".").lower()
+    with atomic_path(path) as temporary:
+        figure.savefig(temporary, format=file_format, dpi=dpi, metadata=_METADATA.get(file_format))
+    return path

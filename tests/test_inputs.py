@@ -1,0 +1,109 @@
+"""Inputs of the public API: pint Quantities in any unit, refused types, float64 (issue 9)."""
+
+import jax
+import numpy as np
+import pint
+import pytest
+
+import ecofmaps
+
+UNITS = pint.UnitRegistry()
+Q_ = UNITS.Quantity
+
+EXAMPLE_2_SI = dict(amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8, aspect_ratio=0.2)
+EXAMPLE_2_UNITS = dict(
+    amplitude=Q_(50, "um"),
+    load=Q_(0.45, "kN"),
+    stiffness=Q_(35, "N/um"),
+    mu=0.8,
+    aspect_ratio=Q_(20, "percent"),
+)
+
+
+@pytest.mark.parametrize(
+    "function",
+    [
+        ecofmaps.slip_amplitude,
+        ecofmaps.dissipated_energy,
+        ecofmaps.energy_cof,
+        ecofmaps.max_force,
+        ecofmaps.regime,
+    ],
+)
+def test_quantities_are_converted_to_si(function):
+    """Converted by pint's factors: equal to the SI call up to the rounding of the conversion."""
+    expected = function(**EXAMPLE_2_SI)
+    assert float(function(**EXAMPLE_2_UNITS)) == pytest.approx(float(expected), rel=1e-15)
+    # positionally too, and a Quantity wrapping an array
+    amplitude = Q_(np.array([25.0, 50.0]), "um")
+    got = function(amplitude, *list(EXAMPLE_2_UNITS.values())[1:])
+    reference = function(np.array([25e-6, 50e-6]), 450.0, 35e6, 0.8, 0.2)
+    np.testing.assert_allclose(np.asarray(got), np.asarray(reference), rtol=1e-15)
+
+
+def test_quantities_everywhere_in_the_api():
+    ecof = ecofmaps.energy_cof(**EXAMPLE_2_SI)
+    mu = ecofmaps.correct_ecof(ecof, **{k: EXAMPLE_2_UNITS[k] for k in ("amplitude", "load")},
+                               stiffness=Q_(35, "MN/m"), scar_depth=Q_(8, "um"),
+                               scar_half_width=Q_(0.04, "mm"))  # fmt: skip
+    assert float(mu) == pytest.approx(0.8, rel=1e-12)
+    low, high = ecofmaps.correct_ecof(
+        ecof,
+        **EXAMPLE_2_SI | {"mu": None}
+        and {"amplitude": Q_(50, "um"), "load": 450.0, "stiffness": 35e6},
+        aspect_ratio=(0.1, 0.3),
+    )
+    assert float(low) < 0.8 < float(high)
+    grid = ecofmaps.compute_map(Q_([50.0, 100.0], "1/mm"), 0.2, Q_(50, "um"), 0.8, cache=False)
+    expected = ecofmaps.compute_map(np.array([5e4, 1e5]), 0.2, 50e-6, 0.8, cache=False)
+    np.testing.assert_allclose(grid.ecof.values, expected.ecof.values, rtol=1e-15)
+    displacement, force = ecofmaps.fretting_loop(**EXAMPLE_2_UNITS)
+    reference = ecofmaps.fretting_loop(**EXAMPLE_2_SI)
+    np.testing.assert_allclose(np.asarray(force), np.asarray(reference[1]), rtol=1e-14)
+    results = ecofmaps.analyze_loops(
+        Q_(np.asarray(displacement) * 1e6, "um"), Q_(np.asarray(force), "N"), Q_(450, "N")
+    )
+    assert float(results.gicof[0]) == pytest.approx(0.8, rel=1e-9)
+    recording = ecofmaps.synthetic_recording(
+        Q_(50, "um"), Q_(450, "N"), Q_(35, "MN/m"), 0.8, 0.2, displacement_noise=Q_(0.1, "um")
+    )
+    same = ecofmaps.synthetic_recording(50e-6, 450.0, 35e6, 0.8, 0.2, displacement_noise=1e-7)
+    np.testing.assert_allclose(recording[0], same[0], rtol=1e-14)
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"amplitude": Q_(35, "MN/m")}, r"amplitude must be a length \[m\].*dimension"),
+        ({"load": Q_(450, "m")}, r"load must be a force \[N\]"),
+        ({"stiffness": Q_(35, "N")}, r"stiffness must be a stiffness \[N/m\]"),
+        ({"mu": Q_(0.8, "m")}, r"mu must be a dimensionless"),
+        ({"amplitude": "50um"}, r"amplitude must be a real number .* got '50um'"),
+        ({"load": True}, r"load must be a real number .* got True"),
+        ({"mu": np.array([True, False])}, r"mu must be a real number"),
+        ({"aspect_ratio": None}, r"aspect_ratio must be a real number .* got None"),
+        ({"stiffness": ["35e6"]}, r"stiffness must be a real number"),
+    ],
+)
+def test_wrong_dimensions_and_types_are_refused_by_name(change, message):
+    with pytest.raises(ValueError, match=message):
+        ecofmaps.energy_cof(**{**EXAMPLE_2_SI, **change})
+
+
+def test_refusals_reach_every_entry_point():
+    with pytest.raises(ValueError, match="load must be a force"):
+        ecofmaps.analyze_loops(np.zeros(10), np.zeros(10), Q_(450, "m"))
+    with pytest.raises(ValueError, match="ecof must be a real number"):
+        ecofmaps.correct_ecof("0.8", 50e-6, 450.0, 35e6, 0.2)
+    with pytest.raises(ValueError, match="amplitude must be a length"):
+        ecofmaps.compute_map(5e4, 0.2, Q_(50, "N"), 0.8, cache=False)
+    with pytest.raises(ValueError, match="load must be a real number .* got None"):
+        ecofmaps.compute_loops(35e6, 0.2, 50e-6, None, 0.8)
+
+
+def test_plain_arrays_still_jit_and_vmap():
+    energy_cof = jax.jit(ecofmaps.energy_cof)
+    assert float(energy_cof(**EXAMPLE_2_SI)) == float(ecofmaps.energy_cof(**EXAMPLE_2_SI))
+    batched = jax.vmap(ecofmaps.energy_cof, in_axes=(0, None, None, None, None))
+    values = batched(np.array([25e-6, 50e-6]), 450.0, 35e6, 0.8, 0.2)
+    assert values.shape == (2,) and values.dtype == np.float64
