@@ -1,84 +1,68 @@
 """ecofmaps: friction from fretting loops, corrected for rig compliance and wear-scar shape.
 
-The public API in SI units (m, N, N/m, J). See the README for an overview and the
-paper this package implements.
+The public API in SI units (m, N, N/m, J), or pint Quantities. See the README for an
+overview and the paper this package implements (:mod:`ecofmaps.paper`).
+
+The names below are imported on first use, so ``import ecofmaps`` is quick and the command
+line starts (and answers Ctrl-C) before JAX, xarray or matplotlib are loaded.
 """
 
 import importlib
 
-from ecofmaps._codes import RegimeWarning
-from ecofmaps._version import __version__
-from ecofmaps.correction import (
-    CorrectionStatus,
-    Interval,
-    correct_ecof,
-    correction_factor,
-    lookup_correction,
-)
-from ecofmaps.io import read_recording
-from ecofmaps.maps import (
-    CacheWarning,
-    cache_entries,
-    clear_cache,
-    compute_loops,
-    compute_map,
-    compute_universal_map,
-)
-from ecofmaps.measured import LoopFit, analyze_loops, fit_loop, synthetic_recording
-from ecofmaps.model import (
-    GROSS_SLIP,
-    INVALID,
-    NO_GROSS_SLIP,
-    SELF_LOCKING,
-    Regime,
-    dissipated_energy,
-    energy_cof,
-    fretting_loop,
-    max_force,
-    regime,
-    simulate,
-    slip_amplitude,
-)
+from ecofmaps._version import __version__ as __version__
+
+#: Each public name, by the module that defines it.
+_PUBLIC = {
+    "ecofmaps._codes": ("RegimeWarning",),
+    "ecofmaps.correction": (
+        "CorrectionStatus",
+        "Interval",
+        "correct_ecof",
+        "correction_factor",
+        "lookup_correction",
+    ),
+    "ecofmaps.io": ("read_recording",),
+    "ecofmaps.maps": (
+        "CacheWarning",
+        "cache_entries",
+        "clear_cache",
+        "compute_loops",
+        "compute_map",
+        "compute_universal_map",
+    ),
+    "ecofmaps.measured": ("LoopFit", "analyze_loops", "fit_loop", "synthetic_recording"),
+    "ecofmaps.model": (
+        "GROSS_SLIP",
+        "INVALID",
+        "NO_GROSS_SLIP",
+        "SELF_LOCKING",
+        "Regime",
+        "dissipated_energy",
+        "energy_cof",
+        "fretting_loop",
+        "max_force",
+        "regime",
+        "simulate",
+        "slip_amplitude",
+    ),
+}
+_HOME = {name: module for module, names in _PUBLIC.items() for name in names}
+#: Subpackages reachable as attributes (``ecofmaps.figures`` needs matplotlib).
+_SUBMODULES = ("cli", "correction", "figures", "io", "maps", "measured", "model", "paper")
 
 
 def __getattr__(name: str):
-    # ecofmaps.figures (the paper's figures) needs matplotlib: it is imported on first use,
-    # ecofmaps.figures.make_figure(...), not with the package.
-    if name == "figures":
-        return importlib.import_module("ecofmaps.figures")
+    if name in _HOME:
+        value = getattr(importlib.import_module(_HOME[name]), name)
+        globals()[name] = value  # imported once
+        return value
+    if name in _SUBMODULES:
+        return importlib.import_module(f"ecofmaps.{name}")
     raise AttributeError(f"module 'ecofmaps' has no attribute {name!r}")
 
 
-__all__ = [
-    "GROSS_SLIP",
-    "INVALID",
-    "NO_GROSS_SLIP",
-    "SELF_LOCKING",
-    "CacheWarning",
-    "CorrectionStatus",
-    "Interval",
-    "LoopFit",
-    "Regime",
-    "RegimeWarning",
-    "__version__",
-    "analyze_loops",
-    "cache_entries",
-    "clear_cache",
-    "compute_loops",
-    "compute_map",
-    "compute_universal_map",
-    "correct_ecof",
-    "correction_factor",
-    "dissipated_energy",
-    "energy_cof",
-    "figures",
-    "fit_loop",
-    "fretting_loop",
-    "lookup_correction",
-    "max_force",
-    "read_recording",
-    "regime",
-    "simulate",
-    "slip_amplitude",
-    "synthetic_recording",
-]
+def __dir__():
+    return sorted({*globals(), *__all__})
+
+
+__all__ = sorted([*_HOME, *_SUBMODULES, "__version__"])

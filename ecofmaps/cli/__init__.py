@@ -1,5 +1,5 @@
 """The ``ecofmaps`` command."""
 
-from ecofmaps.cli.main import build_parser, main
+from ecofmaps.cli.main import build_parser, console, main
 
-__all__ = ["build_parser", "main"]
+__all__ = ["build_parser", "console", "main"]

@@ -1,8 +1,6 @@
 """``python -m ecofmaps.cli``: the ``ecofmaps`` command."""
 
-import sys
-
-from ecofmaps.cli.main import main
+from ecofmaps.cli.main import console
 
 if __name__ == "__main__":
-    sys.exit(main())
+    console()

@@ -4,41 +4,134 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
+from pathlib import Path
 
-from ecofmaps._nomenclature import QUANTITIES
-from ecofmaps.units import parse_quantity, parse_values
+import numpy as np
 
-__all__ = ["CommandError", "print_rows", "quantities", "quantity", "row"]
+from ecofmaps._nomenclature import QUANTITIES, RANGES, within
+from ecofmaps.cli.main import CommandError
+from ecofmaps.units import DIMENSIONS, parse_quantity, parse_values
+
+__all__ = [
+    "CommandError",
+    "print_rows",
+    "quantities",
+    "quantity",
+    "refuse_to_overwrite",
+    "row",
+    "unit",
+]
 
 
-class CommandError(Exception):
-    """A user error found after parsing (bad file, bad value): reported in one line."""
+def _in_range(name: str, values: np.ndarray, text: str) -> None:
+    """Raise ``ValueError`` if ``values`` [SI] leave the valid range of quantity ``name``."""
+    described = QUANTITIES[name]
+    if described.valid is None or np.all(within(name, values)):
+        return
+    symbol = described.symbol or name
+    unit = f" [{described.units}]" if described.units != "1" else ""
+    valid = RANGES[described.valid][1].format(name=symbol)
+    raise ValueError(f"{text!r} is out of range: the {described.words} must satisfy {valid}{unit}")
 
 
-def quantity(kind: str):
-    """An argparse ``type`` reading one quantity of ``kind`` with units (see ecofmaps.units)."""
+def quantity(name: str):
+    """An argparse ``type`` reading one value of quantity ``name`` with units, range-checked.
+
+    The dimension and the valid range are quantity ``name``'s in the nomenclature, so a bad
+    value is reported by argparse with the option the user typed.
+    """
+    kind = QUANTITIES[name].kind
 
     def parse(text: str) -> float:
         try:
-            return parse_quantity(text, kind)
+            value = parse_quantity(text, kind)
+            _in_range(name, np.asarray(value), text)
         except ValueError as error:
             raise argparse.ArgumentTypeError(str(error)) from None
+        return value
 
     parse.__name__ = kind
     return parse
 
 
-def quantities(kind: str):
-    """An argparse ``type`` reading a list ``a,b,c`` or a range ``start:stop:num``."""
+def quantities(name: str):
+    """An argparse ``type`` reading a list ``a,b,c`` or a range ``start:stop:num`` of ``name``.
+
+    Every value must be in quantity ``name``'s range, and no value may repeat (a grid axis).
+    """
+    kind = QUANTITIES[name].kind
 
     def parse(text: str):
         try:
-            return parse_values(text, kind)
+            values = parse_values(text, kind)
+            _in_range(name, values, text)
         except ValueError as error:
             raise argparse.ArgumentTypeError(str(error)) from None
+        unique, counts = np.unique(values, return_counts=True)
+        if np.any(counts > 1):
+            raise argparse.ArgumentTypeError(
+                f"{text!r} repeats the value {unique[counts > 1][0]:g}: a grid axis takes "
+                "each value once"
+            )
+        return values
 
     parse.__name__ = kind
     return parse
+
+
+def unit(kind: str):
+    """An argparse ``type`` reading a unit of ``kind`` (``'um'``, ``'kN'``): kept as text.
+
+    The text must name a unit of that dimension whose size is positive and finite: an empty
+    text, a number (``'0um'``) or a unit of another kind is an error naming the option.
+    """
+
+    def parse(text: str) -> str:
+        if not text.strip():
+            raise argparse.ArgumentTypeError(f"an empty unit; give a {kind} unit such as "
+                                             f"{DIMENSIONS[kind][1]}")  # fmt: skip
+        try:
+            scale = parse_quantity(f"1 {text}", kind)
+        except ValueError as error:
+            raise argparse.ArgumentTypeError(str(error).replace("'1 ", "'")) from None
+        if not (0.0 < scale < math.inf) or text.strip()[0] in "0123456789.+-":
+            raise argparse.ArgumentTypeError(
+                f"{text!r} is not a unit (a number in front of it makes a quantity); give a "
+                f"{kind} unit such as {DIMENSIONS[kind][1]}"
+            )
+        return text
+
+    parse.__name__ = f"{kind} unit"
+    return parse
+
+
+def refuse_to_overwrite(outputs, inputs) -> None:
+    """Raise :class:`CommandError` if an output path is one of the input files.
+
+    Parameters
+    ----------
+    outputs : iterable of (str, path-like)
+        Each output as (the option that names it, its path).
+    inputs : iterable of path-like
+        The files the command reads.
+    """
+    sources = [Path(path) for path in inputs]
+    for option, output in outputs:
+        if output is None:
+            continue
+        target = Path(output)
+        for source in sources:
+            same = (
+                os.path.samefile(source, target)
+                if source.exists() and target.exists()
+                else source.resolve() == target.resolve()
+            )
+            if same:
+                raise CommandError(
+                    f"{option} {output} would write over the input file {source}: "
+                    "choose another output"
+                )
 
 
 def row(name: str, value, note: str = "") -> tuple[str, str, str]:

@@ -6,7 +6,7 @@ import sys
 from pathlib import Path
 
 from ecofmaps._version import __version__
-from ecofmaps.cli._common import CommandError, print_rows, quantity, row
+from ecofmaps.cli._common import CommandError, print_rows, quantity, refuse_to_overwrite, row
 
 __all__ = ["add", "run"]
 
@@ -34,24 +34,22 @@ def add(subparsers) -> None:
         "--out", metavar="OUT", default=None,
         help="write the corrected table here (CSV; default: standard output)",
     )  # fmt: skip
+    parser.add_argument("--ecof", type=quantity("ecof"), help="reported energy CoF μ_E, e.g. 0.83")
     parser.add_argument(
-        "--ecof", type=quantity("dimensionless"), help="reported energy CoF μ_E, e.g. 0.83"
+        "--amplitude", type=quantity("amplitude"), help="displacement amplitude Δ*, e.g. 50um"
     )
-    parser.add_argument(
-        "--amplitude", type=quantity("length"), help="displacement amplitude Δ*, e.g. 50um"
-    )
-    parser.add_argument("--load", type=quantity("force"), help="normal load P, e.g. 450N")
+    parser.add_argument("--load", type=quantity("load"), help="normal load P, e.g. 450N")
     parser.add_argument(
         "--stiffness", type=quantity("stiffness"),
         help="rig stiffness S, e.g. 35MN/m ('inf' for a rigid rig)",
     )  # fmt: skip
     parser.add_argument(
-        "--aspect-ratio", type=quantity("dimensionless"),
+        "--aspect-ratio", type=quantity("aspect_ratio"),
         help="wear scar depth over half-width z_o/x_o = D/W, e.g. 0.2",
     )  # fmt: skip
-    parser.add_argument("--scar-depth", type=quantity("length"), help="scar depth D, e.g. 8um")
+    parser.add_argument("--scar-depth", type=quantity("scar_depth"), help="scar depth D, e.g. 8um")
     parser.add_argument(
-        "--scar-half-width", type=quantity("length"), help="scar half-width W, e.g. 40um"
+        "--scar-half-width", type=quantity("scar_half_width"), help="scar half-width W, e.g. 40um"
     )
     parser.set_defaults(handler=run)
 
@@ -69,6 +67,7 @@ def run(args) -> int:
             raise CommandError(f"give a TABLE or one point's options, not both ({options})")
         if args.out is not None and not Path(args.out).parent.is_dir():
             raise CommandError(f"cannot write {args.out}: its directory does not exist")
+        refuse_to_overwrite([("--out", args.out)], [args.table])
         text, rows = correct_table(args.table)
         if args.out is None:
             sys.stdout.write(text)
@@ -94,7 +93,12 @@ def run(args) -> int:
             f"{ratio:.6g} (scar {args.scar_depth * 1e6:.6g} µm deep, "
             f"{args.scar_half_width * 1e6:.6g} µm half-width)"
         )
-    mu = float(correct_ecof(args.ecof, **point, aspect_ratio=ratio))
+    scar = (
+        {"aspect_ratio": ratio}
+        if args.aspect_ratio is not None
+        else {"scar_depth": args.scar_depth, "scar_half_width": args.scar_half_width}
+    )
+    mu = float(correct_ecof(args.ecof, **point, **scar))
     rows = [
         row("ecof", args.ecof, "(reported)"),
         row("amplitude", args.amplitude),

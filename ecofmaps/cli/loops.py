@@ -7,7 +7,7 @@ import sys
 import textwrap
 from pathlib import Path
 
-from ecofmaps.cli._common import CommandError, quantity
+from ecofmaps.cli._common import CommandError, quantity, refuse_to_overwrite, unit
 
 __all__ = ["add", "run"]
 
@@ -43,7 +43,7 @@ def add(subparsers) -> None:
         help="analyse the shipped synthetic example (load 450N) instead of FILEs",
     )  # fmt: skip
     parser.add_argument(
-        "--load", type=quantity("force"), default=None, metavar="P",
+        "--load", type=quantity("load"), default=None, metavar="P",
         help="normal load P, e.g. 450N (required unless --example)",
     )  # fmt: skip
     parser.add_argument(
@@ -69,11 +69,11 @@ def add(subparsers) -> None:
         "(default: 'cycle' if the file has it; else cycles are cut at the reversals)",
     )  # fmt: skip
     parser.add_argument(
-        "--displacement-unit", default="um", metavar="UNIT",
+        "--displacement-unit", type=unit("length"), default="um", metavar="UNIT",
         help="unit of the displacement column (default: um)",
     )  # fmt: skip
     parser.add_argument(
-        "--force-unit", default="N", metavar="UNIT",
+        "--force-unit", type=unit("force"), default="N", metavar="UNIT",
         help="unit of the force column (default: N)",
     )  # fmt: skip
     parser.set_defaults(handler=run)
@@ -101,10 +101,28 @@ def run(args) -> int:
     load = EXAMPLE["load"] if args.example and args.load is None else args.load
     if load is None:
         raise CommandError("--load is required: the normal load, e.g. --load 450N")
-    if not load > 0.0:
-        raise CommandError(f"--load must be > 0 N; got {load:g} N")
+    columns = {
+        "--displacement-col": args.displacement_col,
+        "--force-col": args.force_col,
+        "--cycle-col": args.cycle_col,
+    }
+    named = [(option, name.strip().lower()) for option, name in columns.items() if name]
+    for index, (option, name) in enumerate(named):
+        for other, other_name in named[:index]:
+            if name == other_name:
+                raise CommandError(f"{other} and {option} name the same column {name!r}")
     if args.out is not None and not Path(args.out).parent.is_dir():
         raise CommandError(f"cannot write {args.out}: its directory does not exist")
+    plots = (
+        []
+        if args.plots is None
+        else [
+            ("--plots", Path(args.plots) / f"{name}_{kind}.png")
+            for name in _plot_names(paths)
+            for kind in ("loops", "evolution")
+        ]
+    )
+    refuse_to_overwrite([("--out", args.out), *plots], paths)
     analyses = []
     for path in paths:
         recording = read_recording(

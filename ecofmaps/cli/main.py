@@ -10,21 +10,34 @@ traceback.
 from __future__ import annotations
 
 import argparse
+import importlib
+import os
 import sys
 
+from ecofmaps._interrupts import interrupts_stop_writes
 from ecofmaps._version import __version__
-from ecofmaps.cli import cache, correct, figures, loops, model
-from ecofmaps.cli import map as grid_map
-from ecofmaps.cli._common import CommandError
 
-__all__ = ["build_parser", "main"]
+__all__ = ["CommandError", "build_parser", "console", "main"]
 
-_SUBCOMMANDS = (model, figures, grid_map, cache, loops, correct)
+
+class CommandError(Exception):
+    """A user error found after parsing (bad file, bad value): reported in one line."""
+
+
+#: The subcommands, each a module of :mod:`ecofmaps.cli`, in the order ``--help`` lists them.
+_SUBCOMMANDS = ("model", "figures", "map", "cache", "loops", "correct")
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose usage errors are one line, like every other error."""
+
+    def error(self, message):
+        self.exit(2, f"ecofmaps: error: {message} (see '{self.prog} --help')\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The ``ecofmaps`` argument parser with every subcommand."""
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="ecofmaps",
         description=(
             "Fretting friction maps: how far the energy coefficient of friction drifts "
@@ -36,17 +49,65 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"ecofmaps {__version__}")
     subparsers = parser.add_subparsers(title="commands", metavar="COMMAND", required=True)
-    for subcommand in _SUBCOMMANDS:
-        subcommand.add(subparsers)
+    for name in _SUBCOMMANDS:
+        importlib.import_module(f"ecofmaps.cli.{name}").add(subparsers)
     return parser
 
 
+#: Exit status of a run stopped by Ctrl-C (128 + SIGINT), as shells report it.
+INTERRUPTED = 130
+
+
 def main(argv=None) -> int:
-    """Run the ``ecofmaps`` command; return its exit status."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    try:
-        return args.handler(args)
-    except (CommandError, ValueError, OSError) as error:
-        print(f"{parser.prog}: error: {error}", file=sys.stderr)
-        return 2
+    """Run the ``ecofmaps`` command; return its exit status.
+
+    0 on success; 2 for a user error (bad option, bad file: one line naming it); 130 when
+    interrupted by Ctrl-C (files are written atomically, so nothing is left half written);
+    1 for an unexpected failure (one line; ``ECOFMAPS_DEBUG=1`` shows the traceback).
+    """
+    interrupted = None
+    try:  # the subcommands import JAX and xarray: an interrupt may come during the imports
+        with interrupts_stop_writes() as interrupted:
+            try:
+                args = build_parser().parse_args(argv)
+            except SystemExit as stop:  # a usage error (printed), --help or --version
+                return int(stop.code or 0)
+            return args.handler(args)
+    except KeyboardInterrupt:
+        return _report(INTERRUPTED, "interrupted; no output was left half written")
+    except Exception as error:
+        if interrupted is not None and interrupted.is_set():  # an interrupt turned into an error
+            return _report(INTERRUPTED, "interrupted; no output was left half written")
+        if isinstance(error, (CommandError, ValueError, OSError)):
+            return _report(2, f"error: {error}")
+        if isinstance(error, MemoryError):
+            return _report(1, "error: not enough memory for this run")
+        if os.environ.get("ECOFMAPS_DEBUG"):
+            raise
+        return _report(
+            1,
+            f"error: unexpected {type(error).__name__}: {error} (a bug: please report it; "
+            "ECOFMAPS_DEBUG=1 shows the traceback)",
+        )
+
+
+def _report(status: int, message: str) -> int:
+    """Print ``ecofmaps: <message>`` on standard error; return ``status``."""
+    print(f"ecofmaps: {message}", file=sys.stderr)
+    return status
+
+
+def console() -> None:
+    """The ``ecofmaps`` console script: run :func:`main` and exit with its status.
+
+    After Ctrl-C the process ends at once (``os._exit``) once its messages are flushed:
+    JAX's worker threads may still be busy with the interrupted computation, and tearing
+    the interpreter down around them can crash it. Files were already cleaned up, since
+    every file is written through a temporary that the interrupt removed.
+    """
+    status = main()
+    if status == INTERRUPTED:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(status)
+    sys.exit(status)

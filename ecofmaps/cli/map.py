@@ -4,8 +4,11 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 import textwrap
 from pathlib import Path
+
+import numpy as np
 
 from ecofmaps.cli._common import CommandError, quantities, quantity
 from ecofmaps.model import Regime
@@ -45,19 +48,19 @@ def add(subparsers) -> None:
         help="rig stiffness over normal load S/P [1/m], 'inf' for a rigid rig" + _GRID_HELP,
     )  # fmt: skip
     parser.add_argument(
-        "--aspect-ratio", type=quantities("dimensionless"), required=True, metavar="Z/X",
+        "--aspect-ratio", type=quantities("aspect_ratio"), required=True, metavar="Z/X",
         help="groove depth over half-width z_o/x_o (>= 0)" + _GRID_HELP,
     )  # fmt: skip
     parser.add_argument(
-        "--amplitude", type=quantities("length"), required=True, metavar="DELTA",
+        "--amplitude", type=quantities("amplitude"), required=True, metavar="DELTA",
         help="displacement amplitude Δ* [m], e.g. 25um,50um" + _GRID_HELP,
     )  # fmt: skip
     parser.add_argument(
-        "--mu", type=quantities("dimensionless"), required=True, metavar="MU",
+        "--mu", type=quantities("mu"), required=True, metavar="MU",
         help="contact coefficient of friction μ (> 0)" + _GRID_HELP,
     )  # fmt: skip
     parser.add_argument(
-        "--load", type=quantity("force"), default=None, metavar="P",
+        "--load", type=quantity("load"), default=None, metavar="P",
         help="normal load P [N], one value; adds dissipated_energy [J] and max_force [N]",
     )  # fmt: skip
     parser.add_argument(
@@ -91,6 +94,8 @@ def run(args) -> int:
             ("mu", args.mu),
         )
     }
+    points = math.prod(values.size for values in grid.values() if np.ndim(values))
+    print(f"ecofmaps map: {points:,} points into {out}", file=sys.stderr, flush=True)
     dataset = compute_map(**grid, load=args.load, cache=not args.no_cache, cache_dir=args.cache_dir)
     write_netcdf(dataset, out)
     shape = " x ".join(f"{size} {dim}" for dim, size in dataset.sizes.items()) or "1 point"

@@ -25,11 +25,11 @@ def add(subparsers) -> None:
         ),
     )
     parser.add_argument(
-        "--amplitude", type=quantity("length"), default=paper.EXAMPLE_2["amplitude"],
+        "--amplitude", type=quantity("amplitude"), default=paper.EXAMPLE_2["amplitude"],
         help="displacement amplitude Δ* (default 50um)",
     )  # fmt: skip
     parser.add_argument(
-        "--load", type=quantity("force"), default=paper.EXAMPLE_2["load"],
+        "--load", type=quantity("load"), default=paper.EXAMPLE_2["load"],
         help="normal load P (default 450N)",
     )  # fmt: skip
     parser.add_argument(
@@ -37,15 +37,15 @@ def add(subparsers) -> None:
         help="rig stiffness S, 'inf' for a rigid rig (default 35MN/m)",
     )  # fmt: skip
     parser.add_argument(
-        "--mu", type=quantity("dimensionless"), default=paper.EXAMPLE_2["mu"],
+        "--mu", type=quantity("mu"), default=paper.EXAMPLE_2["mu"],
         help="contact coefficient of friction μ (default 0.8)",
     )  # fmt: skip
     parser.add_argument(
-        "--aspect-ratio", type=quantity("dimensionless"), default=paper.EXAMPLE_2["aspect_ratio"],
+        "--aspect-ratio", type=quantity("aspect_ratio"), default=paper.EXAMPLE_2["aspect_ratio"],
         help="groove depth over half-width z_o/x_o (default 0.2)",
     )  # fmt: skip
     parser.add_argument(
-        "--groove-half-width", type=quantity("length"), default=None,
+        "--groove-half-width", type=quantity("groove_half_width"), default=None,
         help="groove half-width x_o (default: the amplitude, as in the paper)",
     )  # fmt: skip
     parser.set_defaults(handler=run)

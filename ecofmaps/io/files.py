@@ -14,6 +14,8 @@ import re
 import uuid
 from pathlib import Path
 
+from ecofmaps._interrupts import INTERRUPTED
+
 __all__ = ["TEMPORARY_NAME", "FileLineError", "atomic_path"]
 
 #: Names of the temporary files :func:`atomic_path` writes (left behind only by a crash).
@@ -42,6 +44,8 @@ def atomic_path(path):
         yield temporary
         with open(temporary, "rb+") as stream:
             os.fsync(stream.fileno())
+        if INTERRUPTED.is_set():  # an interrupt that was swallowed on its way up
+            raise KeyboardInterrupt
         os.replace(temporary, path)
     except BaseException:
         temporary.unlink(missing_ok=True)

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 
 import jax
 import jax.numpy as jnp
@@ -69,14 +70,58 @@ def _global_attrs(title: str) -> dict:
 
 
 def _axis(name: str, value, rule: str, unit: str) -> np.ndarray:
-    """``value`` checked (``ValueError`` naming ``name``) as a float64 scalar or 1-D array."""
+    """``value`` checked (``ValueError`` naming ``name``) as a float64 scalar or 1-D array.
+
+    A 1-D array is a grid axis: it must hold each value once.
+    """
     check(name, value, rule, unit)
     array = np.asarray(value, dtype=np.float64)
     if array.ndim > 1:
         raise ValueError(f"{name} must be a single value or a 1-D array, got shape {array.shape}")
     if array.size == 0:
         raise ValueError(f"{name} must hold at least one value, got an empty array")
+    unique, counts = np.unique(array, return_counts=True)
+    if np.any(counts > 1):
+        repeated = unique[counts > 1][0]
+        where = np.flatnonzero(array == repeated)
+        raise ValueError(
+            f"{name} repeats the value {repeated!r} (at indices {where.tolist()}): a grid axis "
+            "takes each value once"
+        )
     return array
+
+
+def available_memory() -> int | None:
+    """Memory the system can give this process now, or None where it cannot tell. [byte]"""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def _check_memory(kernel, axes, extra, max_chunk: int) -> None:
+    """Refuse, before allocating, a grid whose results would not fit in the free memory.
+
+    The results' sizes come from ``jax.eval_shape`` (no computation); one block's working
+    arrays (taken as twice its results) come on top.
+    """
+    outputs = jax.eval_shape(kernel, *axes, *extra)
+    per_point = sum(out.dtype.itemsize for out in jax.tree_util.tree_leaves(outputs))
+    points = math.prod(axis.size for axis in axes)
+    needed = per_point * (points + 2 * min(points, max_chunk))
+    free = available_memory()
+    if free is not None and needed > free:
+        raise ValueError(
+            f"the grid of {points:.3g} points needs about {needed / 1e9:.3g} GB of memory for "
+            f"its results, more than the {free / 1e9:.3g} GB available: use a smaller grid"
+        )
 
 
 # ---------------------------------------------------------------------------------------
@@ -129,6 +174,7 @@ def _evaluate_grid(kernel, axes, extra, max_chunk: int) -> dict[str, np.ndarray]
     """
     if not (isinstance(max_chunk, int) and max_chunk >= 1):
         raise ValueError(f"max_chunk must be an integer >= 1, got {max_chunk!r}")
+    _check_memory(kernel, axes, extra, max_chunk)
     shape = tuple(axis.size for axis in axes)
     if math.prod(shape) <= max_chunk:
         return jax.device_get(kernel(*axes, *extra))

@@ -58,8 +58,6 @@ POINT = "--ecof 0.83 --amplitude 50um --load 450N --stiffness 35MN/m"
     [
         ("--ecof 5 --amplitude 50um --load 450N --stiffness 35MN/m --aspect-ratio 0.2",
          "ecof = 5 cannot be corrected"),
-        ("--ecof 0 --amplitude 50um --load 450N --stiffness 35MN/m --aspect-ratio 0.2",
-         "ecof must satisfy 0 < ecof"),
         (POINT, "give --aspect-ratio, or both --scar-depth"),
         (POINT + " --aspect-ratio 0.2 --scar-depth 8um --scar-half-width 40um",
          "give --aspect-ratio, or both"),
@@ -78,11 +76,27 @@ def test_one_point_errors(capsys, argv, message):
     assert len(err.strip().splitlines()) == 1
 
 
-def test_units_are_checked(capsys):
-    """argparse reads the quantities: a wrong dimension is a usage error (status 2)."""
-    argv = "--ecof 0.83 --amplitude 450N --load 450N --stiffness 35MN/m --aspect-ratio 0.2"
-    status, _, err = run(capsys, "correct", *argv.split())
-    assert status == 2 and "argument --amplitude: '450N' is not a length" in err
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ("--amplitude 450N", "argument --amplitude: '450N' is not a length"),
+        ("--ecof 0", "argument --ecof: '0' is out of range: the energy coefficient of friction "
+         "must satisfy 0 < μ_E < inf"),
+        ("--load inf", "argument --load: 'inf' is out of range"),
+        ("--scar-half-width 0um", "argument --scar-half-width: '0um' is out of range"),
+        ("--scar-depth -1um", "argument --scar-depth: '-1um' is out of range"),
+    ],
+)  # fmt: skip
+def test_options_are_read_and_checked_by_argparse(capsys, change, message):
+    """Quantities are read with units and range-checked naming the option (status 2)."""
+    options = dict(zip(*[iter(f"{POINT} --aspect-ratio 0.2".split())] * 2, strict=True))
+    options.update(dict([change.split()]))
+    if "--scar" in change:
+        del options["--aspect-ratio"]
+        options = {"--scar-depth": "8um", "--scar-half-width": "40um", **options}
+        options.update(dict([change.split()]))
+    status, _, err = run(capsys, "correct", *[f"{key}={value}" for key, value in options.items()])
+    assert status == 2 and message in err.splitlines()[-1] and "Traceback" not in err
 
 
 # --- tables -------------------------------------------------------------------------------

@@ -98,7 +98,7 @@ def test_bad_values_are_rejected_by_the_parser(tmp_path, capsys, option, value, 
     flat = [item for pair in argv.items() for item in pair]
     status, stdout, stderr = run(capsys, "map", *flat, "--out", str(tmp_path / "x.nc"))
     assert status == 2 and stdout == ""
-    assert stderr.splitlines()[-1].startswith("ecofmaps map: error: ")
+    assert stderr.count("\n") == 1 and stderr.startswith("ecofmaps: error: ")
     assert message in stderr.splitlines()[-1]
     assert "Traceback" not in stderr
     assert list(tmp_path.iterdir()) == []
@@ -107,11 +107,32 @@ def test_bad_values_are_rejected_by_the_parser(tmp_path, capsys, option, value, 
 @pytest.mark.parametrize(
     ("option", "value", "message"),
     [
-        ("--stiffness-ratio", "0", "stiffness_ratio must satisfy 0 < stiffness_ratio <= inf"),
-        ("--aspect-ratio", "-0.1,0.2", "aspect_ratio must satisfy 0 <= aspect_ratio < inf"),
-        ("--amplitude", "inf", "amplitude must satisfy 0 < amplitude < inf [m]"),
-        ("--mu", "0", "mu must satisfy 0 < mu < inf"),
-        ("--load", "0N", "load must satisfy 0 < load < inf [N]"),
+        (
+            "--stiffness-ratio",
+            "0",
+            "argument --stiffness-ratio: '0' is out of range: the rig "
+            "stiffness over normal load must satisfy 0 < S/P <= inf [m-1]",
+        ),
+        (
+            "--aspect-ratio",
+            "-0.1,0.2",
+            "argument --aspect-ratio: '-0.1,0.2' is out of range: "
+            "the groove aspect ratio must satisfy 0 <= z_o/x_o < inf",
+        ),
+        (
+            "--amplitude",
+            "inf",
+            "argument --amplitude: 'inf' is out of range: the displacement "
+            "amplitude must satisfy 0 < Δ* < inf [m]",
+        ),
+        ("--mu", "0", "argument --mu: '0' is out of range"),
+        ("--load", "0N", "argument --load: '0N' is out of range"),
+        (
+            "--aspect-ratio",
+            "0.1,0.2,0.1",
+            "argument --aspect-ratio: '0.1,0.2,0.1' repeats the "
+            "value 0.1: a grid axis takes each value once",
+        ),
     ],
 )
 def test_values_out_of_range_end_with_one_line(tmp_path, capsys, option, value, message):

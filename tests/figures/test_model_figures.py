@@ -361,10 +361,9 @@ def test_command_writes_the_figures(tmp_path, capsys):
     ],
 )
 def test_command_rejects_bad_options(tmp_path, capsys, arguments, message):
-    with pytest.raises(SystemExit) as exit_info:
-        main(["figures", "--out", str(tmp_path), *arguments])
-    assert exit_info.value.code == 2
-    assert message in capsys.readouterr().err
+    assert main(["figures", "--out", str(tmp_path), *arguments]) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1 and err.startswith("ecofmaps: error: ")
     assert list(tmp_path.iterdir()) == []
 
 

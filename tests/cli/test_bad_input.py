@@ -1,0 +1,201 @@
+"""Odd and bad input through the command line (issue 9): one line, status != 0, inputs kept.
+
+Each case drives the ``ecofmaps`` command with an input a new user might give and checks
+the outcome: the exit status, the one-line message naming the option or file, the input
+files unchanged and no output left behind.
+"""
+
+import contextlib
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from ecofmaps.cli import main
+from ecofmaps.maps import grid
+
+
+def run(capsys, *argv):
+    status = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def one_line_error(err: str) -> bool:
+    return err.count("\n") == 1 and err.startswith("ecofmaps: error: ") and "Traceback" not in err
+
+
+@pytest.fixture
+def recording(tmp_path):
+    """The shipped example, copied: a recording a command must never write over."""
+    from ecofmaps.measured.synthetic import example_path
+
+    path = tmp_path / "rec.csv"
+    path.write_bytes(example_path().read_bytes())
+    return path
+
+
+# --- no command writes over its input --------------------------------------------------------
+
+
+def test_loops_refuses_to_write_results_over_the_recording(tmp_path, capsys, recording):
+    before = recording.read_bytes()
+    status, out, err = run(capsys, "loops", recording, "--load", "450N", "--out", recording)
+    assert status == 2 and out == "" and one_line_error(err)
+    assert f"--out {recording} would write over the input file" in err
+    assert recording.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rec.csv"]
+
+
+def test_loops_refuses_plots_over_an_input(tmp_path, capsys):
+    from ecofmaps.measured.synthetic import example_path
+
+    # A recording named like the plot the command would write for it.
+    tricky = tmp_path / "rec_loops.png"
+    tricky.write_bytes(example_path().read_bytes())
+    renamed = tmp_path / "rec.csv"
+    renamed.write_bytes(example_path().read_bytes())
+    status, _, err = run(capsys, "loops", renamed, tricky, "--load", "450N", "--plots", tmp_path)
+    assert status == 2 and one_line_error(err) and "--plots" in err
+
+
+def test_correct_refuses_to_write_over_its_table(tmp_path, capsys):
+    table = tmp_path / "t.csv"
+    text = "ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio\n0.83,50,450,35,0.2\n"
+    table.write_text(text)
+    status, _, err = run(capsys, "correct", table, "--out", table)
+    assert status == 2 and one_line_error(err) and "would write over the input file" in err
+    assert table.read_text() == text
+
+
+def test_the_same_file_by_another_name_is_refused(tmp_path, capsys, recording):
+    link = tmp_path / "link.csv"
+    link.symlink_to(recording)
+    before = recording.read_bytes()
+    status, _, err = run(capsys, "loops", recording, "--load", "450N", "--out", link)
+    assert status == 2 and "would write over the input file" in err
+    assert recording.read_bytes() == before
+
+
+# --- messages name what the user typed ------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["correct", "--ecof", "0.83", "--amplitude", "50um", "--load", "450N", "--stiffness",
+          "35MN/m", "--scar-depth", "8um", "--scar-half-width", "0um"],
+         "argument --scar-half-width: '0um' is out of range"),
+        (["correct", "--ecof", "0.83", "--amplitude", "50um", "--load", "450N", "--stiffness",
+          "35MN/m", "--scar-depth=-8um", "--scar-half-width", "40um"],
+         "argument --scar-depth: '-8um' is out of range"),
+        (["loops", "--example", "--load", "inf"], "argument --load: 'inf' is out of range"),
+        (["loops", "--example", "--force-unit", ""], "argument --force-unit: an empty unit"),
+        (["loops", "--example", "--force-unit", "0N"], "'0N' is not a unit"),
+        (["loops", "--example", "--force-unit", "um"], "--force-unit: 'um' is not a force"),
+        (["loops", "--example", "--cycle-col", "Force"],
+         "--force-col and --cycle-col name the same column 'force'"),
+        (["map", "--stiffness-ratio", "0.1/um", "--aspect-ratio", "0.1,0.2,0.1", "--amplitude",
+          "50um", "--mu", "0.8", "--out", "x.nc"], "repeats the value 0.1"),
+        (["model", "--amplitude", "true"], "argument --amplitude: cannot read 'true'"),
+    ],
+)  # fmt: skip
+def test_errors_name_the_option(tmp_path, monkeypatch, capsys, argv, message):
+    monkeypatch.chdir(tmp_path)
+    status, out, err = run(capsys, *argv)
+    assert status == 2 and out == "" and one_line_error(err)
+    assert message in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_grid_too_large_for_memory_is_refused_before_allocating(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(grid, "available_memory", lambda: 10**9)  # 1 GB free
+    status, _, err = run(
+        capsys, "map", "--stiffness-ratio", "0.01/um:0.3/um:3000", "--aspect-ratio",
+        "0:0.3:3000", "--amplitude", "25um,50um", "--mu", "0.8", "--no-cache",
+        "--out", tmp_path / "big.nc",
+    )  # fmt: skip
+    assert status == 2 and "ecofmaps: error: the grid of 1.8e+07 points needs about" in err
+    assert "more than the 1 GB available" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_unexpected_failure_is_one_line_with_status_1(capsys, monkeypatch):
+    from ecofmaps.cli import model
+
+    def broken(args):
+        raise KeyError("a bug")
+
+    monkeypatch.setattr(model, "run", broken)
+    status, _, err = run(capsys, "model")
+    assert status == 1 and err.count("\n") == 1
+    assert err.startswith("ecofmaps: error: unexpected KeyError: 'a bug' (a bug: please report")
+
+
+# --- Ctrl-C -----------------------------------------------------------------------------------
+
+
+def interrupted_run(command, wait_for: str, delay: float, env=None):
+    """Run ``command``, press Ctrl-C ``delay`` s after it printed ``wait_for`` on stderr."""
+    process = subprocess.Popen(
+        command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
+    )
+    started = process.stderr.readline()
+    assert wait_for in started, started
+    time.sleep(delay)
+    process.send_signal(signal.SIGINT)
+    stdout, stderr = process.communicate(timeout=300)
+    return process.returncode, stdout, stderr
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.2])
+def test_ctrl_c_exits_130_with_one_line_and_leaves_no_output(tmp_path, delay):
+    """Ctrl-C during a map run: status 130, one line, no output file.
+
+    JAX runs a garbage-collector callback in which Python swallows a KeyboardInterrupt;
+    the run must stop all the same.
+    """
+    out = tmp_path / "m.nc"
+    command = [
+        sys.executable, "-m", "ecofmaps.cli", "map", "--stiffness-ratio", "0.01/um:0.3/um:1500",
+        "--aspect-ratio", "0:0.3:1500", "--amplitude", "25um,50um", "--mu", "0.8", "--load",
+        "450N", "--no-cache", "--out", str(out),
+    ]  # fmt: skip
+    status, stdout, stderr = interrupted_run(command, "ecofmaps map: 4,500,000 points", delay)
+    assert status == 130, stderr
+    assert stderr == "ecofmaps: interrupted; no output was left half written\n"
+    assert stdout == "" and list(tmp_path.iterdir()) == []
+
+
+def test_ctrl_c_during_figures_keeps_whole_files_only(tmp_path):
+    """Ctrl-C after the first figure: status 130; what is there is whole, nothing half written."""
+    env = {**os.environ, "ECOFMAPS_CACHE": str(tmp_path / "cache")}
+    command = [sys.executable, "-m", "ecofmaps.cli", "figures", "--out", str(tmp_path / "figs")]
+    status, _, stderr = interrupted_run(command, "ecofmaps figures: 8 figure(s)", 0.5, env)
+    assert status == 130, stderr
+    assert stderr.splitlines()[-1] == "ecofmaps: interrupted; no output was left half written"
+    assert "Traceback" not in stderr
+    for path in (tmp_path / "figs").iterdir():
+        assert path.suffix == ".png" and path.read_bytes().endswith(b"IEND\xaeB`\x82")
+
+
+def test_interrupted_writes_do_not_land_even_when_the_interrupt_was_swallowed(tmp_path):
+    """An interrupt Python swallowed (in a gc callback) still stops every atomic write."""
+    from ecofmaps._interrupts import interrupts_stop_writes
+    from ecofmaps.io.files import atomic_path
+
+    path = tmp_path / "out.txt"
+    with pytest.raises(KeyboardInterrupt), interrupts_stop_writes() as interrupted:
+        with contextlib.suppress(KeyboardInterrupt):  # swallowed, as Python does in a gc callback
+            signal.raise_signal(signal.SIGINT)
+        assert interrupted.is_set()
+        with atomic_path(path) as temporary:
+            temporary.write_text("half")
+    assert list(tmp_path.iterdir()) == []
+    # Outside the block, writes work again.
+    with atomic_path(path) as temporary:
+        temporary.write_text("whole")
+    assert path.read_text() == "whole"
