@@ -24,7 +24,13 @@ from ecofmaps.maps import (
     compute_map,
     compute_universal_map,
 )
-from ecofmaps.measured import LoopFit, analyze_loops, fit_loop, synthetic_recording
+from ecofmaps.measured import (
+    LoopFit,
+    analyze_loops,
+    fit_loop,
+    resolve_loops,
+    synthetic_recording,
+)
 from ecofmaps.model import (
     GROSS_SLIP,
     INVALID,
@@ -83,6 +89,7 @@ __all__ = [
     "max_force",
     "read_recording",
     "regime",
+    "resolve_loops",
     "simulate",
     "slip_amplitude",
     "synthetic_recording",
