@@ -122,6 +122,9 @@ _CURVATURE_SIGNIFICANCE = 5.0
 #: Values of μ(ξ) beyond this many robust standard deviations of the median are clipped.
 _WINSOR = 3.0
 
+#: Cycles analysed together: a block's arrays stay in the processor's cache.
+_BLOCK = 512
+
 #: Points of each cycle's own grid over its central part, for the per-cycle values.
 _CENTRAL_POINTS = 201
 
@@ -248,10 +251,11 @@ def _curvature(xi, q, stick):
     return curvature, 1.0 / np.sqrt(np.where(solvable, norm, 1.0))
 
 
-def _stick_and_slip(xi, q, branches, sticks, floor, slip_threshold):
+def _stick_and_slip(xi, q, branches, sticks, floor, slip_threshold, judge=True):
     """Noise, straightness of the stick sets and the slip of each branch (module notes).
 
-    Returns the noise σ of ξ, whether both stick sets are straight, and the two slip masks.
+    Returns the noise σ of ξ, whether both stick sets are straight (when ``judge``), and
+    the two slip masks.
     """
     # σ from the second differences within the stick sets: a smooth trend of ξ (a rounded
     # loop, a wrong stiffness) hardly enters them, white noise does with variance 6σ².
@@ -270,8 +274,9 @@ def _stick_and_slip(xi, q, branches, sticks, floor, slip_threshold):
         judged = np.count_nonzero(stick, axis=1) >= _STICK_SAMPLES
         reversal = np.take_along_axis(xi, np.argmax(branch, axis=1)[:, None], axis=1)[:, 0]
         level = np.where(judged, _masked_median(xi, stick), reversal)
-        curvature, unit_error = _curvature(xi, q, stick)
-        straight &= np.abs(curvature) <= _CURVATURE_SIGNIFICANCE * unit_error * sigma + floor
+        if judge:
+            curvature, unit_error = _curvature(xi, q, stick)
+            straight &= np.abs(curvature) <= _CURVATURE_SIGNIFICANCE * unit_error * sigma + floor
         # Slip: beyond the threshold, and every later sample of the branch too.
         beyond = np.where(branch, sign * xi, np.inf)
         least = np.minimum.accumulate(beyond[:, ::-1], axis=1)[:, ::-1]
@@ -290,42 +295,45 @@ def _sorted_branch(xi, q, slip):
     )
 
 
-def _resample(xs, qs, count, at, inside):
-    r"""``qs(xs)`` at the positions ``at`` (one row per cycle), by a 3-point linear fraction.
+def _resample(xs, qs, count, grid, scale, inside):
+    r"""``qs(xs)`` at the positions ``scale * grid`` (one row per cycle), by 3-point fractions.
 
-    ``xs`` rows are sorted, padded with +inf beyond ``count``; positions outside
-    ``inside`` give NaN. The fraction through the three samples nearest a position,
+    ``xs`` rows are sorted, padded with +inf beyond ``count``; ``grid`` is increasing and
+    common to the rows, ``scale`` (one per row) stretches it; positions outside
+    ``inside`` give NaN. The fraction through three samples around a position (the two
+    that bracket it and the one before, or the first three),
     :math:`Q - Q_1 = m d/(1 + c d)` with :math:`d = \xi - \xi_1`, is used where its
     denominator stays above 1/2 over the three samples; elsewhere the line through the
-    two samples around the position.
+    two samples that bracket the position.
 
     Returns the values, and the index of the sample before each position and the
     position's share of the way to the next sample (the weights of the straight line).
     """
     cycles, width = xs.shape
-    finite = np.isfinite(xs)
-    scale = 2.0 * max(
-        float(np.max(np.abs(xs), where=finite, initial=0.0)),
-        float(np.max(np.abs(at), where=np.isfinite(at), initial=0.0)),
-        1e-300,
-    )
-    # One sorted array for all rows: row r's positions are moved to 4r (|xs/scale| <= 1/2).
-    rows = 4.0 * np.arange(cycles)[:, None]
-    keys = np.where(finite, xs / scale, 0.75) + rows
-    targets = np.where(np.isfinite(at), at / scale, 0.0) + rows
-    right = np.searchsorted(keys.ravel(), targets.ravel(), side="right").reshape(at.shape)
-    right -= width * np.arange(cycles)[:, None]
+    points = grid.size
+    at = scale[:, None] * grid[None, :]
+    # How many samples lie at or below each position: each sample counts from the first
+    # grid point at or above it on (a histogram over the grid, summed).
+    with np.errstate(invalid="ignore", divide="ignore"):
+        bins = np.searchsorted(grid, xs / scale[:, None], side="left")
+    rows = (points + 1) * np.arange(cycles)[:, None]
+    histogram = np.bincount((rows + bins).ravel(), minlength=cycles * (points + 1))
+    right = np.cumsum(histogram.reshape(cycles, points + 1)[:, :points], axis=1)
+    base = width * np.arange(cycles)[:, None]
+    left = np.clip(right - 1, 0, np.maximum(count - 2, 0)[:, None])
+    # The three samples around the position: left - 1, left, left + 1, or 0, 1, 2 at the start.
+    middle = np.clip(left, 1, np.maximum(count - 2, 1)[:, None])
     last = np.maximum(count - 1, 0)[:, None]
-    left = np.clip(right - 1, 0, np.maximum(last - 1, 0))
-    after = np.minimum(left + 1, last)
-    x0, x1 = (np.take_along_axis(xs, i, axis=1) for i in (left, after))
-    q0, q1 = (np.take_along_axis(qs, i, axis=1) for i in (left, after))
+    flat_x, flat_q = xs.ravel(), qs.ravel()
+    index = [base + np.minimum(middle + k, last) for k in (-1, 0, 1)]
+    xa, xb, xc = (flat_x[i] for i in index)
+    qa, qb, qc = (flat_q[i] for i in index)
+    first = left == middle
+    x0, x1 = np.where(first, xb, xa), np.where(first, xc, xb)
+    q0, q1 = np.where(first, qb, qa), np.where(first, qc, qb)
     share = np.divide(at - x0, x1 - x0, out=np.zeros_like(x0), where=x1 > x0)
     linear = q0 + share * (q1 - q0)
-    # The linear fraction through the three samples centred on the nearest one.
-    middle = np.clip(np.where(at - x0 <= x1 - at, left, after), 1, np.maximum(last - 1, 1))
-    xa, xb, xc = (np.take_along_axis(xs, np.minimum(middle + k, last), axis=1) for k in (-1, 0, 1))
-    qa, qb, qc = (np.take_along_axis(qs, np.minimum(middle + k, last), axis=1) for k in (-1, 0, 1))
+    # The linear fraction through the three samples.
     da, dc = xa - xb, xc - xb
     fa, fc = qa - qb, qc - qb
     slope_a, slope_c = fa / da, fc / dc
@@ -341,10 +349,10 @@ def _resample(xs, qs, count, at, inside):
     return np.where(inside & (count[:, None] >= 2), value, np.nan), left, share
 
 
-def _read(forward, backward, at, inside, load):
-    """Q+, Q-, μ and g at the positions ``at``, and the line weights of each branch."""
-    q_forward, *line_forward = _resample(*forward, at, inside)
-    q_backward, *line_backward = _resample(*backward, at, inside)
+def _read(forward, backward, grid, scale, inside, load):
+    """Q+, Q-, μ and g at the positions ``scale * grid``, and the line weights of each branch."""
+    q_forward, *line_forward = _resample(*forward, grid, scale, inside)
+    q_backward, *line_backward = _resample(*backward, grid, scale, inside)
     up = np.arctan(q_forward / load)
     down = np.arctan(q_backward / load)
     mu = np.tan(0.5 * (up - down))
@@ -384,13 +392,14 @@ def _weights(left, share, gain, width):
     )
 
 
-def _resolve(x, q, valid, load, stiffness, amplitude, gross, given, options):
-    """Every resolved quantity of the centred loops ``x``, ``q`` (module notes).
+def _slip_branches(x, q, valid, stiffness, amplitude, given, options):
+    """The stiffness, the checks of the stick sets, and the two slip branches (module notes).
 
-    ``stiffness`` is the given S (``given`` True) or analyze_loops's, per cycle. Returns
-    the per-position and per-cycle arrays, the quality and the grid.
+    Returns a dict with the compliance and its standard error, ``mismatch`` and
+    ``curved`` (per cycle), the sorted slip branches ``forward`` and ``backward`` and the
+    range ``lowest`` .. ``highest`` where both slip.
     """
-    cycles, width = x.shape
+    cycles = x.shape[0]
     floor = _ROUNDING * amplitude
     branches = _branches(x, valid)
     moved = [_moved(q, branch) for branch in branches]
@@ -403,7 +412,9 @@ def _resolve(x, q, valid, load, stiffness, amplitude, gross, given, options):
     # does the slip start?
     start = np.where(np.isinf(stiffness), 0.0, 1.0 / stiffness)
     xi = x - start[:, None] * q
-    *_, slips = _stick_and_slip(xi, q, branches, windows, floor, options["slip_threshold"])
+    *_, slips = _stick_and_slip(
+        xi, q, branches, windows, floor, options["slip_threshold"], judge=False
+    )
     # The stick sets: from the window's lower share up to a margin before the slip.
     sticks = []
     for share, branch, slip, window in zip(moved, branches, slips, windows, strict=True):
@@ -427,46 +438,57 @@ def _resolve(x, q, valid, load, stiffness, amplitude, gross, given, options):
     sigma, straight, slips = _stick_and_slip(
         xi, q, branches, sticks, floor, options["slip_threshold"]
     )
-    curved = negative | ~straight
-    # A given stiffness that does not fit the stick sides tilts them in ξ.
-    tilt, _ = _compliance(xi, q, sticks)
-    span = np.max(
-        [
-            np.max(np.where(s, q, -np.inf), axis=1) - np.min(np.where(s, q, np.inf), axis=1)
-            for s in sticks
-        ],
-        axis=0,
-    )
-    mismatch = given & ~(np.abs(tilt) * span <= _TILT_SPREAD * sigma + floor)
-
+    mismatch = np.zeros(cycles, dtype=bool)
+    if given:  # a stiffness that does not fit the stick sides tilts them in ξ
+        tilt, _ = _compliance(xi, q, sticks)
+        span = np.max(
+            [
+                np.max(np.where(s, q, -np.inf), axis=1) - np.min(np.where(s, q, np.inf), axis=1)
+                for s in sticks
+            ],
+            axis=0,
+        )
+        mismatch = ~(np.abs(tilt) * span <= _TILT_SPREAD * sigma + floor)
     forward = _sorted_branch(xi, q, slips[0])
     backward = _sorted_branch(xi, q, slips[1])
     ends = []
     for xs, _, count in (forward, backward):
         last = np.take_along_axis(xs, np.maximum(count - 1, 0)[:, None], axis=1)[:, 0]
         ends.append((np.where(count > 0, xs[:, 0], np.nan), np.where(count > 0, last, np.nan)))
-    lowest = np.maximum(ends[0][0], ends[1][0])
-    highest = np.minimum(ends[0][1], ends[1][1])
-    overlap = (lowest < 0.0) & (highest > 0.0)
+    return {
+        "compliance": compliance,
+        "compliance_se": compliance_se,
+        "mismatch": mismatch,
+        "curved": negative | ~straight,
+        "forward": forward,
+        "backward": backward,
+        "lowest": np.maximum(ends[0][0], ends[1][0]),
+        "highest": np.minimum(ends[0][1], ends[1][1]),
+    }
 
-    usable = gross & ~mismatch & ~curved & overlap
 
-    # Per cycle, on its own grid over its central part: mu_resolved, its standard error,
-    # and the line g ≈ g0 + kξ. Nothing here depends on the other cycles.
-    central = np.where(usable, options["central"] * np.minimum(highest, -lowest), np.nan)
-    at = central[:, None] * np.linspace(-1.0, 1.0, _CENTRAL_POINTS)[None, :]
-    inside = usable[:, None] & np.ones_like(at, dtype=bool)
-    q_forward, q_backward, mu, slope, lines = _read(forward, backward, at, inside, load)
+def _central_values(forward, backward, central, load):
+    """mu_resolved, its noise variance, k and g0 of g ≈ g0 + kξ, and the sensitivity to 1/S.
+
+    Read on each cycle's own grid over its central part, ``|ξ| <= central``: nothing here
+    depends on the other cycles.
+    """
+    width = forward[0].shape[1]
+    usable = np.isfinite(central)
+    unit = np.linspace(-1.0, 1.0, _CENTRAL_POINTS)
+    at = central[:, None] * unit[None, :]
+    inside = np.broadcast_to(usable[:, None], at.shape)
+    q_forward, q_backward, mu, slope, lines = _read(forward, backward, unit, central, inside, load)
     finite = np.isfinite(mu)
     points = np.count_nonzero(finite, axis=1)
     middle = _masked_median(mu, finite)
     bound = (_WINSOR * _MAD * _masked_median(np.abs(mu - middle[:, None]), finite))[:, None]
     clipped = np.clip(mu, middle[:, None] - bound, middle[:, None] + bound)
     mu_resolved = _masked_sum(clipped, finite) / points
-    # The standard error: each branch's noise through the weights of its samples.
+    # The noise variance: each branch's noise through the weights of its samples.
     kept = finite & (np.abs(mu - middle[:, None]) <= bound)
     factor = 0.5 * (1.0 + mu**2) / load
-    variance = np.zeros(cycles)
+    variance = np.zeros(central.size)
     for branch, force, (left, share), sign in (
         (forward, q_forward, lines[0], 1.0),
         (backward, q_backward, lines[1], -1.0),
@@ -474,63 +496,111 @@ def _resolve(x, q, valid, load, stiffness, amplitude, gross, given, options):
         gain = np.where(kept, sign * factor / (1.0 + (force / load) ** 2), 0.0) / points[:, None]
         weight = _weights(left, share, gain, width)
         variance += _noise(*branch, central) ** 2 * np.sum(weight**2, axis=1)
-    samples = [
-        np.count_nonzero(np.abs(np.where(np.isfinite(xs), xs, np.inf)) <= central[:, None], axis=1)
-        for xs, _, _ in (forward, backward)
-    ]
-    few = np.minimum(*samples) < _SLIP_SAMPLES
     mean_xi = _masked_sum(at, finite) / points
     mean_g = _masked_sum(slope, finite) / points
     dxi = at - mean_xi[:, None]
     k = _masked_sum(dxi * (slope - mean_g[:, None]), finite) / _masked_sum(dxi**2, finite)
-    tilt = mean_g - k * mean_xi
-    # The stiffness's uncertainty, through the sensitivity of mu_resolved to 1/S.
+    # The sensitivity of mu_resolved to the compliance 1/S (module notes).
     turning = k[:, None] / (1.0 + slope**2) * (q_forward - q_backward)
     sensitivity = 0.5 * (1.0 + mu_resolved**2) * _masked_sum(turning, finite) / points
+    return mu_resolved, variance, k, mean_g - k * mean_xi, sensitivity
 
-    quality = np.full(cycles, "ok", dtype=object)
-    reasons = (~gross, mismatch, curved, ~overlap, few | ~np.isfinite(mu_resolved))
-    for flag, bad in reversed(list(zip(QUALITY_FLAGS, reasons, strict=True))):
-        quality = np.where(bad, flag, quality)
-    ok = quality == "ok"
 
-    # Over the grid of positions common to all cycles: the values along the stroke.
-    grid = options["positions"]
-    if np.ndim(grid) == 0:
-        reach = np.where(ok, np.maximum(highest, -lowest), np.nan)
-        half = float(np.nanmax(reach)) if np.any(ok) else 0.0
-        grid = np.linspace(-half, half, int(grid))
-    at = np.broadcast_to(grid, (cycles, grid.size))
-    inside = ok[:, None] & (at >= lowest[:, None]) & (at <= highest[:, None])
-    q_forward, q_backward, mu, slope, _ = _read(forward, backward, at, inside, load)
-    if options["force_offset"] is None:
-        # The loops were centred on their force, which cannot tell a tilt of the groove
-        # from a force offset: the slope is levelled.
+def _along_stroke(forward, backward, grid, lowest, highest, tilt, load, level):
+    """Q±, μ, g (levelled by ``tilt`` if ``level``) and h over the common ``grid``."""
+    cycles = lowest.size
+    inside = np.isfinite(tilt)[:, None] & (grid >= lowest[:, None]) & (grid <= highest[:, None])
+    q_forward, q_backward, mu, slope, _ = _read(
+        forward, backward, grid, np.ones(cycles), inside, load
+    )
+    if level:
         slope = slope - tilt[:, None]
     # The felt profile: trapezoidal integral of g, zero at ξ = 0.
     pieces = np.nan_to_num(0.5 * (slope[:, 1:] + slope[:, :-1]) * np.diff(grid))
     profile = np.concatenate([np.zeros((cycles, 1)), np.cumsum(pieces, axis=1)], axis=1)
     profile -= profile[:, np.searchsorted(grid, 0.0)][:, None]
-    profile = np.where(inside, profile, np.nan)
-
-    per_cycle_ok = np.where(ok, 1.0, np.nan)
-    per_position = {
+    return {
         "mu": mu,
         "slope": slope,
-        "profile": profile,
+        "profile": np.where(inside, profile, np.nan),
         "force_forward": q_forward,
         "force_backward": q_backward,
     }
+
+
+def _blocks(cycles):
+    """Slices of at most ``_BLOCK`` cycles: the arrays of a block stay in the cache."""
+    return [slice(start, start + _BLOCK) for start in range(0, max(cycles, 1), _BLOCK)]
+
+
+def _resolve(x, q, valid, load, stiffness, amplitude, gross, given, options):
+    """Every resolved quantity of the centred loops ``x``, ``q`` (module notes).
+
+    ``stiffness`` is the given S (``given`` True) or analyze_loops's, per cycle. Returns
+    the per-position and per-cycle arrays, the quality and the grid. The work is done
+    on blocks of cycles, each block vectorised.
+    """
+    cycles = x.shape[0]
+    parts = []
+    for block in _blocks(cycles):
+        part = _slip_branches(
+            x[block], q[block], valid[block], stiffness[block], amplitude[block], given, options
+        )
+        lowest, highest = part["lowest"], part["highest"]
+        overlap = (lowest < 0.0) & (highest > 0.0)
+        usable = gross[block] & ~part["mismatch"] & ~part["curved"] & overlap
+        central = np.where(usable, options["central"] * np.minimum(highest, -lowest), np.nan)
+        values = _central_values(part["forward"], part["backward"], central, load)
+        samples = [
+            np.count_nonzero(np.abs(np.where(np.isfinite(xs), xs, np.inf)) <= central[:, None], 1)
+            for xs, _, _ in (part["forward"], part["backward"])
+        ]
+        few = (np.minimum(*samples) < _SLIP_SAMPLES) | ~np.isfinite(values[0])
+        reasons = (~gross[block], part["mismatch"], part["curved"], ~overlap, few)
+        part["quality"] = np.select(reasons, QUALITY_FLAGS, "ok")
+        part["values"] = values
+        parts.append(part)
+
+    def joined(name):
+        return np.concatenate([part[name] for part in parts])
+
+    quality = joined("quality")
+    ok = quality == "ok"
+    lowest, highest = joined("lowest"), joined("highest")
+    mu_resolved, variance, k, tilt, sensitivity = (
+        np.concatenate([part["values"][i] for part in parts]) for i in range(5)
+    )
+    nan = np.where(ok, 1.0, np.nan)
+    compliance = joined("compliance")
     per_cycle = {
-        "mu_resolved": mu_resolved * per_cycle_ok,
-        "mu_resolved_se": np.sqrt(variance + (sensitivity * compliance_se) ** 2) * per_cycle_ok,
-        "aspect_ratio": 0.5 * k * amplitude * per_cycle_ok,
-        "tilt": tilt * per_cycle_ok,
+        "mu_resolved": mu_resolved * nan,
+        "mu_resolved_se": np.sqrt(variance + (sensitivity * joined("compliance_se")) ** 2) * nan,
+        "aspect_ratio": 0.5 * k * amplitude * nan,
+        "tilt": tilt * nan,
         "stiffness": 1.0 / compliance,
-        "position_min": lowest * per_cycle_ok,
-        "position_max": highest * per_cycle_ok,
+        "position_min": lowest * nan,
+        "position_max": highest * nan,
     }
-    return per_position, per_cycle, quality.astype(str), grid
+    # Over the grid of positions common to all cycles: the values along the stroke.
+    grid = options["positions"]
+    if np.ndim(grid) == 0:
+        reach = np.maximum(highest, -lowest)[ok]
+        grid = np.linspace(-1.0, 1.0, grid) * (reach.max() if reach.size else 0.0)
+    along = [
+        _along_stroke(
+            part["forward"],
+            part["backward"],
+            grid,
+            lowest[block],
+            highest[block],
+            per_cycle["tilt"][block],
+            load,
+            options["force_offset"] is None,
+        )
+        for part, block in zip(parts, _blocks(cycles), strict=True)
+    ]
+    per_position = {name: np.concatenate([a[name] for a in along]) for name in along[0]}
+    return per_position, per_cycle, quality, grid
 
 
 # --- the public functions -------------------------------------------------------------------
