@@ -111,6 +111,7 @@ QUALITY_FLAGS = (
     "curved-stick",
     "no-overlap",
     "few-slip-samples",
+    "mu-varies",
 )
 
 #: A given stiffness does not fit when it tilts the stick sets by this many σ.
@@ -118,6 +119,11 @@ _TILT_SPREAD = 3.0
 
 #: A stick set is curved when its quadratic term exceeds this many standard errors.
 _CURVATURE_SIGNIFICANCE = 5.0
+
+#: μ(ξ) varies along the stroke when the means over the inner and the outer half of the
+#: central part differ by this share of μ and by this many standard errors.
+_VARIATION = 0.03
+_VARIATION_SIGNIFICANCE = 4.0
 
 #: Values of μ(ξ) beyond this many robust standard deviations of the median are clipped.
 _WINSOR = 3.0
@@ -448,7 +454,8 @@ def _slip_branches(x, q, valid, stiffness, amplitude, given, options):
             ],
             axis=0,
         )
-        mismatch = ~(np.abs(tilt) * span <= _TILT_SPREAD * sigma + floor)
+        judged = np.all([np.count_nonzero(s, axis=1) >= _STICK_SAMPLES for s in sticks], axis=0)
+        mismatch = judged & ~(np.abs(tilt) * span <= _TILT_SPREAD * sigma + floor)
     forward = _sorted_branch(xi, q, slips[0])
     backward = _sorted_branch(xi, q, slips[1])
     ends = []
@@ -468,10 +475,11 @@ def _slip_branches(x, q, valid, stiffness, amplitude, given, options):
 
 
 def _central_values(forward, backward, central, load):
-    """mu_resolved, its noise variance, k and g0 of g ≈ g0 + kξ, and the sensitivity to 1/S.
+    """mu_resolved, its noise variance, k and g0 of g ≈ g0 + kξ, the sensitivity to 1/S.
 
     Read on each cycle's own grid over its central part, ``|ξ| <= central``: nothing here
-    depends on the other cycles.
+    depends on the other cycles. Also whether μ(ξ) varies between the inner and the outer
+    half of the part beyond ``_VARIATION`` of μ and beyond its noise.
     """
     width = forward[0].shape[1]
     usable = np.isfinite(central)
@@ -485,17 +493,31 @@ def _central_values(forward, backward, central, load):
     bound = (_WINSOR * _MAD * _masked_median(np.abs(mu - middle[:, None]), finite))[:, None]
     clipped = np.clip(mu, middle[:, None] - bound, middle[:, None] + bound)
     mu_resolved = _masked_sum(clipped, finite) / points
-    # The noise variance: each branch's noise through the weights of its samples.
+    # The noise variance: each branch's noise through the weights of its samples. The same
+    # for the difference between the means over the inner and the outer half of the part.
     kept = finite & (np.abs(mu - middle[:, None]) <= bound)
+    inner = kept & (np.abs(unit) <= 0.5)
+    outer = kept & ~inner
+    share_inner = np.count_nonzero(inner, axis=1)[:, None]
+    share_outer = np.count_nonzero(outer, axis=1)[:, None]
+    contrast = np.where(inner, 1.0 / share_inner, np.where(outer, -1.0 / share_outer, 0.0))
+    variation = _masked_sum(mu * contrast, kept)
     factor = 0.5 * (1.0 + mu**2) / load
     variance = np.zeros(central.size)
+    variation_variance = np.zeros(central.size)
     for branch, force, (left, share), sign in (
         (forward, q_forward, lines[0], 1.0),
         (backward, q_backward, lines[1], -1.0),
     ):
-        gain = np.where(kept, sign * factor / (1.0 + (force / load) ** 2), 0.0) / points[:, None]
-        weight = _weights(left, share, gain, width)
-        variance += _noise(*branch, central) ** 2 * np.sum(weight**2, axis=1)
+        gain = np.where(kept, sign * factor / (1.0 + (force / load) ** 2), 0.0)
+        noise = _noise(*branch, central) ** 2
+        weight = _weights(left, share, gain / points[:, None], width)
+        variance += noise * np.sum(weight**2, axis=1)
+        weight = _weights(left, share, gain * contrast, width)
+        variation_variance += noise * np.sum(weight**2, axis=1)
+    varies = (np.abs(variation) > _VARIATION * mu_resolved) & (
+        np.abs(variation) > _VARIATION_SIGNIFICANCE * np.sqrt(variation_variance)
+    )
     mean_xi = _masked_sum(at, finite) / points
     mean_g = _masked_sum(slope, finite) / points
     dxi = at - mean_xi[:, None]
@@ -503,7 +525,7 @@ def _central_values(forward, backward, central, load):
     # The sensitivity of mu_resolved to the compliance 1/S (module notes).
     turning = k[:, None] / (1.0 + slope**2) * (q_forward - q_backward)
     sensitivity = 0.5 * (1.0 + mu_resolved**2) * _masked_sum(turning, finite) / points
-    return mu_resolved, variance, k, mean_g - k * mean_xi, sensitivity
+    return mu_resolved, variance, k, mean_g - k * mean_xi, sensitivity, varies
 
 
 def _along_stroke(forward, backward, grid, lowest, highest, tilt, load, level):
@@ -556,7 +578,7 @@ def _resolve(x, q, valid, load, stiffness, amplitude, gross, given, options):
             for xs, _, _ in (part["forward"], part["backward"])
         ]
         few = (np.minimum(*samples) < _SLIP_SAMPLES) | ~np.isfinite(values[0])
-        reasons = (~gross[block], part["mismatch"], part["curved"], ~overlap, few)
+        reasons = (~gross[block], part["mismatch"], part["curved"], ~overlap, few, values[5])
         part["quality"] = np.select(reasons, QUALITY_FLAGS, "ok")
         part["values"] = values
         parts.append(part)
