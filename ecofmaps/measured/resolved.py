@@ -247,13 +247,18 @@ def _curvature(xi, q, stick):
     polynomial w = u² - 1 - m₃u orthogonal to 1 and u over the set (m₃ the mean of u³).
     """
     count = np.count_nonzero(stick, axis=1)
-    mean = _masked_sum(q, stick) / count
-    u = q - mean[:, None]
-    u = u / np.sqrt(_masked_sum(u * u, stick) / count)[:, None]
-    w = u * u - 1.0 - (_masked_sum(u**3, stick) / count)[:, None] * u
-    norm = _masked_sum(w * w, stick)
+    u = np.where(stick, q, 0.0)
+    u -= (np.sum(u, axis=1) / count)[:, None]
+    u *= stick
+    square = u * u
+    u /= np.sqrt(np.sum(square, axis=1) / count)[:, None]
+    np.multiply(u, u, out=square)
+    skew = np.sum(square * u, axis=1) / count
+    w = square - 1.0 - skew[:, None] * u
+    w *= stick
+    norm = np.sum(w * w, axis=1)
     solvable = (count > _STICK_SAMPLES) & (norm > 0.0)
-    curvature = np.where(solvable, _masked_sum(w * xi, stick) / norm, 0.0)
+    curvature = np.where(solvable, np.sum(w * np.where(stick, xi, 0.0), axis=1) / norm, 0.0)
     return curvature, 1.0 / np.sqrt(np.where(solvable, norm, 1.0))
 
 
@@ -550,6 +555,10 @@ def _along_stroke(forward, backward, grid, lowest, highest, tilt, load, level):
     }
 
 
+#: The values along the stroke, over (cycle, position).
+_ALONG = ("mu", "slope", "profile", "force_forward", "force_backward")
+
+
 def _blocks(cycles):
     """Slices of at most ``_BLOCK`` cycles: the arrays of a block stay in the cache."""
     return [slice(start, start + _BLOCK) for start in range(0, max(cycles, 1), _BLOCK)]
@@ -608,8 +617,9 @@ def _resolve(x, q, valid, load, stiffness, amplitude, gross, given, options):
     if np.ndim(grid) == 0:
         reach = np.maximum(highest, -lowest)[ok]
         grid = np.linspace(-1.0, 1.0, grid) * (reach.max() if reach.size else 0.0)
-    along = [
-        _along_stroke(
+    per_position = {name: np.empty((cycles, grid.size)) for name in _ALONG}
+    for part, block in zip(parts, _blocks(cycles), strict=True):
+        along = _along_stroke(
             part["forward"],
             part["backward"],
             grid,
@@ -619,9 +629,8 @@ def _resolve(x, q, valid, load, stiffness, amplitude, gross, given, options):
             load,
             options["force_offset"] is None,
         )
-        for part, block in zip(parts, _blocks(cycles), strict=True)
-    ]
-    per_position = {name: np.concatenate([a[name] for a in along]) for name in along[0]}
+        for name in _ALONG:
+            per_position[name][block] = along[name]
     return per_position, per_cycle, quality, grid
 
 
