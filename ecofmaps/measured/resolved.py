@@ -14,84 +14,103 @@ slope of whatever groove the pad sits in. Where both branches slip over the same
 and :math:`h(\xi) = \int_0^\xi g\,d\xi` is the scar's profile as the pad feels it. The
 GICoF (eq. 17-18) is the special case :math:`\xi = 0`. :func:`resolve_loops` reads them
 off every cycle of a recording; :func:`resolve_analyzed_loops` does the same from the loops
-that :func:`ecofmaps.analyze_loops` kept (``keep_loops=True``), so cycles, centring and the
-stiffness come from there. The work is on padded arrays, one row per cycle: no Python loop
-over cycles or samples.
+that :func:`ecofmaps.analyze_loops` kept (``keep_loops=True``): cycles, centring, offsets
+and a first stiffness come from there. The work is vectorised over blocks of 512 cycles
+(padded rows, no Python loop over cycles or samples; :mod:`~ecofmaps.measured.stick_slip`
+and :mod:`~ecofmaps.measured.resampling` hold the kernels).
 
 The method, per cycle
 ---------------------
 Each centred loop runs from its lowest displacement up the *rising* branch to its highest
 and back down the *falling* one.
 
-* **Stick windows.** On each branch, the samples whose force has moved away from the
+* **Stick sets.** A first pass takes the samples whose force has moved away from the
   reversal's by a share between ``stick_window[0]`` and ``stick_window[1]`` (default 5 %
-  and 45 %) of the branch's force swing, up to the first sample beyond the upper share. In
-  the model the contact sticks there (up to zero force at least, when the groove slope at
-  the reversal is below :math:`\mu`): the contact position :math:`\xi` stands still, and
-  the samples lie on a vertical line of the :math:`(\xi, Q)` plane.
-* **Stiffness.** Given, or measured: the compliance :math:`1/S` common to the two windows,
-  each with its own intercept, fitted by least squares of :math:`\Delta` on :math:`Q`
-  (:math:`\Delta = \xi_s + Q/S`). This is the start of :func:`ecofmaps.analyze_loops`'s
-  stiffness, without the growth of the segments towards the slip, whose first samples
-  lean the line. Where a window has fewer than three samples (sparse loops), the
-  stiffness of :func:`ecofmaps.analyze_loops` is used.
-* **Noise and stick level.** The stick level :math:`\xi_s` of each branch is the median
-  of :math:`\xi` over its window. The noise :math:`\sigma` of :math:`\xi` is read from the
-  differences of successive samples in the two windows,
-  :math:`\operatorname{median}|\xi_{i+1} - \xi_i| / (0.6745\sqrt2)`, which a slow
-  curvature of the window does not inflate.
+  and 45 %) of the branch's force swing, with :func:`~ecofmaps.analyze_loops`'s stiffness
+  (or the given one), and finds where the slip starts (below). The stick set is then every
+  sample from the lower share up to 5 % of the swing before the first slip sample: in the
+  model the contact sticks there, :math:`\xi` stands still, and the samples lie on a
+  vertical line of the :math:`(\xi, Q)` plane.
+* **Stiffness.** Given, or measured: the compliance :math:`1/S` common to the two stick
+  sets, each with its own intercept, by least squares of :math:`\Delta` on :math:`Q`
+  (:math:`\Delta = \xi_s + Q/S`), with its standard error from the residuals. Where a set
+  has fewer than three samples (sparse loops), :func:`~ecofmaps.analyze_loops`'s
+  stiffness is kept.
+* **Noise and stick level.** The noise :math:`\sigma` of :math:`\xi` comes from its
+  second differences within the stick sets,
+  :math:`\operatorname{median}|\xi_{i-1} - 2\xi_i + \xi_{i+1}| / (0.6745\sqrt6)`, which a
+  smooth trend of :math:`\xi` (a rounded loop, a wrong stiffness) hardly enters; it
+  assumes noise that is white from sample to sample. The stick level :math:`\xi_s` is the
+  median of :math:`\xi` over the set (the reversal's :math:`\xi` for a set of fewer than
+  three samples).
 * **Slip.** A sample of the rising branch slips if it and every later sample of the
   branch lie more than ``slip_threshold`` (default 4) times :math:`\sigma` above the stick
   level (below it on the falling branch). Only the run of slip up to the next reversal
   counts, so a noisy stick sample cannot pass for slip; the first samples of slip, within
   the threshold of the stick level, are left out. Noise-free, :math:`\sigma = 0` and
   every sample that has moved (by more than :math:`10^{-9}\Delta^*`) slips.
-* **Resampling.** The slip samples of each branch, sorted by :math:`\xi`, are
-  interpolated onto a grid of positions common to all cycles, symmetric about
-  :math:`\xi = 0`, over the range where both branches slip (interpolation only: nothing
-  is read beyond a branch's outermost slip samples). Through the three samples nearest
-  each grid point the interpolant is the linear fraction :math:`Q = (a + b\xi)/(1 + c\xi)`,
-  which is eq. 9 for a parabolic groove, so the model's branches are resampled exactly;
-  where it would have a pole near the three samples (noisy samples that do not rise
-  monotonically, or a branch that is flat to rounding), the straight line between the two
-  samples around the grid point.
-* **Averages.** ``mu_resolved`` is the mean of :math:`\mu(\xi)` over the central part of
-  the stroke, :math:`|\xi| \le` ``central`` times the shorter half of the resolved range,
-  after values beyond three robust standard deviations of the median are clipped to
-  that bound (winsorised). Its standard error comes from batch means: the central part is
-  cut into ``blocks`` (default 8) equal lengths of :math:`\xi`, each several samples
-  long, so that their means are nearly independent although neighbouring grid points share
-  samples; the standard error is the standard deviation of the block means over
-  :math:`\sqrt{\text{blocks}}`. When the stiffness is measured, its own uncertainty (from
-  the scatter about the stick lines) is added in quadrature through the sensitivity
+* **Resampling.** The slip samples of each branch, sorted by :math:`\xi`, are read at
+  given positions inside the range where both branches slip (never beyond a branch's
+  outermost slip samples) by the linear fraction :math:`Q - Q_1 = m d/(1 + c d)`,
+  :math:`d = \xi - \xi_1`, through three samples around the position. It is eq. 9 on a
+  parabolic groove, so the model's branches are read exactly; where it would have a pole
+  near the three samples (noisy samples that do not rise monotonically, a branch flat to
+  rounding), the straight line between the two samples around the position.
+* **Per cycle**, on the cycle's own grid of 201 positions over its central part
+  :math:`|\xi| \le` ``central`` times the shorter half of the resolved range (so that
+  nothing depends on the other cycles): ``mu_resolved``, the mean of :math:`\mu(\xi)` after
+  values beyond three robust standard deviations of the median are clipped to that bound;
+  ``aspect_ratio`` :math:`z_o/x_o = k\Delta^*/2` from the least-squares line
+  :math:`g \approx g_0 + k\xi` (eq. 7 with the paper's :math:`x_o = \Delta^*`), and
+  ``tilt`` :math:`g_0`.
+* **Standard error.** The mean is a linear combination of the samples of the two branches
+  through the resampling (neighbouring positions share samples): each sample's weight is
+  the sum over the positions of :math:`\partial\mu/\partial Q_\pm` times its share in the
+  straight line there. The noise of each branch comes from its samples in the central part,
+  each against the line through its two neighbours (variance
+  :math:`\sigma^2(1 + u^2 + (1-u)^2)` for white noise); the variance of ``mu_resolved`` is
+  the sum of the squared weights times it. When the stiffness is measured, its uncertainty
+  is added in quadrature through the sensitivity
   :math:`\partial\bar\mu/\partial(1/S) = \tfrac12(1 + \bar\mu^2)\,
   \overline{\alpha'(\xi)(Q_+ - Q_-)}`: an error of :math:`S` moves the two branches in
-  opposite directions along :math:`\xi`, and with a sloping groove that shifts every
-  :math:`\mu(\xi)` the same way.
-* **Equivalent parabolic groove.** A least-squares line :math:`g \approx g_0 + k\xi`
-  over the central part; ``aspect_ratio`` is :math:`z_o/x_o = k\Delta^*/2` (eq. 7 with the
-  paper's :math:`x_o = \Delta^*`). The intercept :math:`g_0` absorbs a tilt of the groove
-  and the small shift of :math:`\xi` that an error of the loop's centre makes.
-* **Felt profile.** :math:`h(\xi)`, the trapezoidal integral of :math:`g` over the grid,
-  zero at :math:`\xi = 0`.
+  opposite directions along :math:`\xi`, and on a sloping groove that shifts every
+  :math:`\mu(\xi)` the same way (the GICoF equally).
+* **Along the stroke**, on a grid of positions common to all cycles (``positions``
+  points over the widest resolved range, or the positions given): :math:`Q_\pm(\xi)`,
+  :math:`\mu(\xi)`, :math:`g(\xi)` and :math:`h(\xi)`, the trapezoidal integral of
+  :math:`g`, zero at :math:`\xi = 0`. The loops' centring removes a force offset that a
+  tilt of the groove cannot be told from; so, unless ``force_offset`` gives the force's
+  zero, :math:`g` and :math:`h` are levelled: :math:`g_0` is taken off :math:`g`. Levelling
+  also takes off the tilt that the noise of the loop's force centre adds.
 
 Quality
 -------
 A cycle whose numbers cannot be stood behind has NaN for every resolved value and its
 ``quality`` says why (the first reason, in this order):
 
-* ``'not-gross-slip'``: :func:`ecofmaps.analyze_loops` labels it partial slip.
-* ``'curved-stick'``: a stick window is not a vertical line in :math:`\xi`: the spread of
-  :math:`\xi` about its stick level exceeds three times the noise :math:`\sigma` (a rounded
-  loop, as polymers and micro-slip draw, or a given stiffness that is wrong), or the
-  measured compliance is negative beyond three standard errors.
+* ``'not-gross-slip'``: :func:`~ecofmaps.analyze_loops` labels it partial slip.
+* ``'stiffness-mismatch'``: the given stiffness tilts the stick sets in :math:`\xi` by
+  more than three times the noise :math:`\sigma` over their force span (for Example 2's
+  loops, about 5 % off).
+* ``'curved-stick'``: a stick set is not a straight line, its quadratic term beyond five
+  standard errors (a rounded loop, as polymers and micro-slip draw), or the measured
+  compliance is negative beyond three standard errors.
 * ``'no-overlap'``: no range of :math:`\xi` around the loop's centre where both branches
-  slip.
-* ``'few-slip-samples'``: a block of the central part holds fewer than two slip samples of
-  either branch (a sparsely sampled or digitised loop): the average would be read off
-  straight lines between samples far apart, and its scatter would not show its error.
+  slip (a slip within the noise, at the onset of gross slip).
+* ``'few-slip-samples'``: fewer than eight slip samples of either branch in the central
+  part (a sparsely sampled or digitised loop): the average would be read off straight
+  lines between samples far apart, and the noise could not be told.
+* ``'mu-varies'``: the means of :math:`\mu(\xi)` over the inner and the outer half of the
+  central part differ by more than 3 % and four standard errors. The model's
+  :math:`\mu(\xi)` is constant for any groove; a rounded loop's falls towards the ends of
+  the stroke, also where the noise hides the curvature of its stick sides.
 
 Otherwise ``'ok'``.
+
+References
+----------
+X. Jin, W. Sun, P.H. Shipway (2016): eq. 7 (the groove), eq. 9 (the slip traction at the
+local slope), eq. 10 (the contact position), eq. 17-18 (the GICoF, here at :math:`\xi = 0`).
 """
 
 from __future__ import annotations
@@ -101,6 +120,8 @@ import xarray as xr
 
 from ecofmaps._inputs import check
 from ecofmaps.measured.analysis import GROSS_SLIP_THRESHOLD, analyze_loops
+from ecofmaps.measured.resampling import branch_noise, read_branches, sample_weights
+from ecofmaps.measured.stick_slip import masked_median, masked_sum, slip_branches
 
 __all__ = ["resolve_analyzed_loops", "resolve_loops"]
 
@@ -113,12 +134,6 @@ QUALITY_FLAGS = (
     "few-slip-samples",
     "mu-varies",
 )
-
-#: A given stiffness does not fit when it tilts the stick sets by this many σ.
-_TILT_SPREAD = 3.0
-
-#: A stick set is curved when its quadratic term exceeds this many standard errors.
-_CURVATURE_SIGNIFICANCE = 5.0
 
 #: μ(ξ) varies along the stroke when the means over the inner and the outer half of the
 #: central part differ by this share of μ and by this many standard errors.
@@ -137,18 +152,8 @@ _CENTRAL_POINTS = 201
 #: Fewest slip samples of each branch in the central part.
 _SLIP_SAMPLES = 8
 
-#: Fewest samples in a stick set to measure the stiffness, the stick level and the noise.
-_STICK_SAMPLES = 3
-
-#: The stick set ends this share of the force swing before the first slip sample.
-_STICK_MARGIN = 0.05
-
-#: A sample has moved off the stick level, noise-free, beyond this share of Δ*.
-_ROUNDING = 1e-9
-
-#: Normal-distribution constants: MAD -> σ, and the median of |N(0, 6)| (second differences).
+#: The median absolute deviation of a normal distribution over its standard deviation.
 _MAD = 1.482602218505602
-_SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
 
 # -> _nomenclature
 _ATTRS = {
@@ -177,306 +182,9 @@ def _attrs(name: str) -> dict:
     return {"long_name": long_name, "units": units}
 
 
-def _masked_sum(values, mask):
-    return np.sum(np.where(mask, values, 0.0), axis=-1)
-
-
-def _masked_median(values, mask):
-    """Median of each row over ``mask`` (NaN for an empty row)."""
-    ordered = np.sort(np.where(mask, values, np.inf), axis=-1)
-    count = np.count_nonzero(mask, axis=-1)
-    low = np.take_along_axis(ordered, np.maximum(count - 1, 0)[:, None] // 2, axis=-1)[:, 0]
-    high = np.take_along_axis(ordered, count[:, None] // 2, axis=-1)[:, 0]
-    return np.where(count > 0, 0.5 * (low + high), np.nan)
-
-
 # --- per-cycle kernels ---------------------------------------------------------------------
 # Arrays of shape (cycles, width), rows running once round a loop from its lowest
 # displacement; ``valid`` marks the loop's points, NaN padding elsewhere.
-
-
-def _branches(x, valid):
-    """Masks of the rising branch (start to top) and of the falling one (top to the end)."""
-    top = np.argmax(np.where(valid, x, -np.inf), axis=1)
-    j = np.arange(x.shape[1])[None, :]
-    return valid & (j <= top[:, None]), valid & (j >= top[:, None])
-
-
-def _moved(q, branch):
-    """Share of the branch's force swing by which each sample has moved from its reversal."""
-    span = np.max(np.where(branch, q, -np.inf), axis=1) - np.min(
-        np.where(branch, q, np.inf), axis=1
-    )
-    start = np.take_along_axis(q, np.argmax(branch, axis=1)[:, None], axis=1)
-    return np.abs(q - start) / span[:, None]
-
-
-def _before(mask, branch):
-    """The samples of ``branch`` before the first sample of ``mask``."""
-    return branch & ~np.maximum.accumulate(branch & mask, axis=1)
-
-
-def _compliance(x, q, sticks):
-    """Least-squares compliance common to lines Δ = ξ_s + cQ through each stick set.
-
-    Returns the compliance and its standard error (from the residuals about the lines).
-    """
-    covariance = np.zeros(x.shape[0])
-    variance = np.zeros(x.shape[0])
-    centred = []
-    for mask in sticks:
-        count = np.count_nonzero(mask, axis=1)[:, None]
-        dq = q - _masked_sum(q, mask)[:, None] / count
-        dx = x - _masked_sum(x, mask)[:, None] / count
-        covariance += _masked_sum(dq * dx, mask)
-        variance += _masked_sum(dq * dq, mask)
-        centred.append((dq, dx))
-    compliance = covariance / variance
-    squares = sum(
-        _masked_sum((dx - compliance[:, None] * dq) ** 2, mask)
-        for (dq, dx), mask in zip(centred, sticks, strict=True)
-    )
-    points = sum(np.count_nonzero(mask, axis=1) for mask in sticks)
-    return compliance, np.sqrt(squares / np.maximum(points - 3, 1) / variance)
-
-
-def _curvature(xi, q, stick):
-    """Quadratic term of ξ = a + bu + cu² over a stick set, and its standard error per σ.
-
-    ``u`` is the force standardised over the set; the quadratic is fitted with the
-    polynomial w = u² - 1 - m₃u orthogonal to 1 and u over the set (m₃ the mean of u³).
-    """
-    count = np.count_nonzero(stick, axis=1)
-    u = np.where(stick, q, 0.0)
-    u -= (np.sum(u, axis=1) / count)[:, None]
-    u *= stick
-    square = u * u
-    u /= np.sqrt(np.sum(square, axis=1) / count)[:, None]
-    np.multiply(u, u, out=square)
-    skew = np.sum(square * u, axis=1) / count
-    w = square - 1.0 - skew[:, None] * u
-    w *= stick
-    norm = np.sum(w * w, axis=1)
-    solvable = (count > _STICK_SAMPLES) & (norm > 0.0)
-    curvature = np.where(solvable, np.sum(w * np.where(stick, xi, 0.0), axis=1) / norm, 0.0)
-    return curvature, 1.0 / np.sqrt(np.where(solvable, norm, 1.0))
-
-
-def _stick_and_slip(xi, q, branches, sticks, floor, slip_threshold, judge=True):
-    """Noise, straightness of the stick sets and the slip of each branch (module notes).
-
-    Returns the noise σ of ξ, whether both stick sets are straight (when ``judge``), and
-    the two slip masks.
-    """
-    # σ from the second differences within the stick sets: a smooth trend of ξ (a rounded
-    # loop, a wrong stiffness) hardly enters them, white noise does with variance 6σ².
-    second = np.abs(xi[:, :-2] - 2.0 * xi[:, 1:-1] + xi[:, 2:])
-    triples = np.zeros_like(second, dtype=bool)
-    for stick in sticks:
-        triples |= stick[:, :-2] & stick[:, 1:-1] & stick[:, 2:]
-    sigma = _masked_median(second, triples) / _SECOND_DIFFERENCE
-    sigma = np.where(np.isfinite(sigma), sigma, 0.0)
-    threshold = slip_threshold * sigma + floor
-    straight = np.ones(xi.shape[0], dtype=bool)
-    slips = []
-    for branch, stick, sign in zip(branches, sticks, (1.0, -1.0), strict=True):
-        # The stick level: the set's median, or the reversal's ξ where the set has too few
-        # samples to judge (a sparse loop, or the model's loop drawn with straight sides).
-        judged = np.count_nonzero(stick, axis=1) >= _STICK_SAMPLES
-        reversal = np.take_along_axis(xi, np.argmax(branch, axis=1)[:, None], axis=1)[:, 0]
-        level = np.where(judged, _masked_median(xi, stick), reversal)
-        if judge:
-            curvature, unit_error = _curvature(xi, q, stick)
-            straight &= np.abs(curvature) <= _CURVATURE_SIGNIFICANCE * unit_error * sigma + floor
-        # Slip: beyond the threshold, and every later sample of the branch too.
-        beyond = np.where(branch, sign * xi, np.inf)
-        least = np.minimum.accumulate(beyond[:, ::-1], axis=1)[:, ::-1]
-        slips.append(branch & (least > (sign * level + threshold)[:, None]))
-    return sigma, straight, slips
-
-
-def _sorted_branch(xi, q, slip):
-    """The slip samples of a branch sorted by ξ (padded with +inf / NaN), and their count."""
-    key = np.where(slip, xi, np.inf)
-    order = np.argsort(key, axis=1, kind="stable")
-    return (
-        np.take_along_axis(key, order, axis=1),
-        np.take_along_axis(np.where(slip, q, np.nan), order, axis=1),
-        np.count_nonzero(slip, axis=1),
-    )
-
-
-def _resample(xs, qs, count, grid, scale, inside):
-    r"""``qs(xs)`` at the positions ``scale * grid`` (one row per cycle), by 3-point fractions.
-
-    ``xs`` rows are sorted, padded with +inf beyond ``count``; ``grid`` is increasing and
-    common to the rows, ``scale`` (one per row) stretches it; positions outside
-    ``inside`` give NaN. The fraction through three samples around a position (the two
-    that bracket it and the one before, or the first three),
-    :math:`Q - Q_1 = m d/(1 + c d)` with :math:`d = \xi - \xi_1`, is used where its
-    denominator stays above 1/2 over the three samples; elsewhere the line through the
-    two samples that bracket the position.
-
-    Returns the values, and the index of the sample before each position and the
-    position's share of the way to the next sample (the weights of the straight line).
-    """
-    cycles, width = xs.shape
-    points = grid.size
-    at = scale[:, None] * grid[None, :]
-    # How many samples lie at or below each position: each sample counts from the first
-    # grid point at or above it on (a histogram over the grid, summed).
-    with np.errstate(invalid="ignore", divide="ignore"):
-        bins = np.searchsorted(grid, xs / scale[:, None], side="left")
-    rows = (points + 1) * np.arange(cycles)[:, None]
-    histogram = np.bincount((rows + bins).ravel(), minlength=cycles * (points + 1))
-    right = np.cumsum(histogram.reshape(cycles, points + 1)[:, :points], axis=1)
-    base = width * np.arange(cycles)[:, None]
-    left = np.clip(right - 1, 0, np.maximum(count - 2, 0)[:, None])
-    # The three samples around the position: left - 1, left, left + 1, or 0, 1, 2 at the start.
-    middle = np.clip(left, 1, np.maximum(count - 2, 1)[:, None])
-    last = np.maximum(count - 1, 0)[:, None]
-    flat_x, flat_q = xs.ravel(), qs.ravel()
-    index = [base + np.minimum(middle + k, last) for k in (-1, 0, 1)]
-    xa, xb, xc = (flat_x[i] for i in index)
-    qa, qb, qc = (flat_q[i] for i in index)
-    first = left == middle
-    x0, x1 = np.where(first, xb, xa), np.where(first, xc, xb)
-    q0, q1 = np.where(first, qb, qa), np.where(first, qc, qb)
-    share = np.divide(at - x0, x1 - x0, out=np.zeros_like(x0), where=x1 > x0)
-    linear = q0 + share * (q1 - q0)
-    # The linear fraction through the three samples.
-    da, dc = xa - xb, xc - xb
-    fa, fc = qa - qb, qc - qb
-    slope_a, slope_c = fa / da, fc / dc
-    pole = (slope_c - slope_a) / (fa - fc)
-    d = at - xb
-    fraction = qb + (slope_a + pole * fa) * d / (1.0 + pole * d)
-    safe = (
-        (count[:, None] >= 3)
-        & (np.minimum(1.0 + pole * da, 1.0 + pole * dc) >= 0.5)
-        & np.isfinite(fraction)
-    )
-    value = np.where(safe, fraction, linear)
-    return np.where(inside & (count[:, None] >= 2), value, np.nan), left, share
-
-
-def _read(forward, backward, grid, scale, inside, load):
-    """Q+, Q-, μ and g at the positions ``scale * grid``, and the line weights of each branch."""
-    q_forward, *line_forward = _resample(*forward, grid, scale, inside)
-    q_backward, *line_backward = _resample(*backward, grid, scale, inside)
-    up = np.arctan(q_forward / load)
-    down = np.arctan(q_backward / load)
-    mu = np.tan(0.5 * (up - down))
-    slope = np.tan(0.5 * (up + down))
-    return q_forward, q_backward, mu, slope, (line_forward, line_backward)
-
-
-def _noise(xs, qs, count, central):
-    """Standard deviation of a branch's samples about the branch, in its central part.
-
-    Each sample is compared with the line through its two neighbours; the residual's
-    variance is σ² (1 + u² + (1 - u)²) for white noise of σ, u the sample's share of the
-    way between them.
-    """
-    x0, x1, x2 = xs[:, :-2], xs[:, 1:-1], xs[:, 2:]
-    q0, q1, q2 = qs[:, :-2], qs[:, 1:-1], qs[:, 2:]
-    u = np.divide(x1 - x0, x2 - x0, out=np.full_like(x0, 0.5), where=x2 > x0)
-    residual = q1 - q0 - u * (q2 - q0)
-    use = (np.arange(1, xs.shape[1] - 1)[None, :] < (count - 1)[:, None]) & (
-        np.abs(x1) <= central[:, None]
-    )
-    return np.sqrt(_masked_sum(residual**2, use) / _masked_sum(1.0 + u**2 + (1.0 - u) ** 2, use))
-
-
-def _weights(left, share, gain, width):
-    """Weight of each sample of a branch in a sum over grid points of ``gain`` times its value.
-
-    The grid value is read as the straight line between samples ``left`` and ``left + 1``.
-    """
-    cycles = left.shape[0]
-    base = (width * np.arange(cycles))[:, None]
-    gain = np.where(np.isfinite(gain), gain, 0.0)
-    index = np.concatenate([(base + left).ravel(), (base + left + 1).ravel()])
-    weight = np.concatenate([(gain * (1.0 - share)).ravel(), (gain * share).ravel()])
-    return np.bincount(index, weight, minlength=cycles * width + 1)[: cycles * width].reshape(
-        cycles, width
-    )
-
-
-def _slip_branches(x, q, valid, stiffness, amplitude, given, options):
-    """The stiffness, the checks of the stick sets, and the two slip branches (module notes).
-
-    Returns a dict with the compliance and its standard error, ``mismatch`` and
-    ``curved`` (per cycle), the sorted slip branches ``forward`` and ``backward`` and the
-    range ``lowest`` .. ``highest`` where both slip.
-    """
-    cycles = x.shape[0]
-    floor = _ROUNDING * amplitude
-    branches = _branches(x, valid)
-    moved = [_moved(q, branch) for branch in branches]
-    low, high = options["stick_window"]
-    windows = [
-        _before(share > high, branch) & (share >= low)
-        for share, branch in zip(moved, branches, strict=True)
-    ]
-    # First pass, with the given stiffness or analyze_loops's and the stick windows: where
-    # does the slip start?
-    start = np.where(np.isinf(stiffness), 0.0, 1.0 / stiffness)
-    xi = x - start[:, None] * q
-    *_, slips = _stick_and_slip(
-        xi, q, branches, windows, floor, options["slip_threshold"], judge=False
-    )
-    # The stick sets: from the window's lower share up to a margin before the slip.
-    sticks = []
-    for share, branch, slip, window in zip(moved, branches, slips, windows, strict=True):
-        onset = np.take_along_axis(share, np.argmax(slip, axis=1)[:, None], axis=1)
-        onset = np.where(slip.any(axis=1)[:, None], onset, high + _STICK_MARGIN)
-        stick = _before(slip, branch) & (share >= low) & (share <= onset - _STICK_MARGIN)
-        enough = np.count_nonzero(stick, axis=1) >= _STICK_SAMPLES
-        sticks.append(np.where(enough[:, None], stick, window))
-    if given:
-        compliance, compliance_se = start, np.zeros(cycles)
-    else:
-        fitted, fitted_se = _compliance(x, q, sticks)
-        enough = np.all([np.count_nonzero(s, axis=1) >= _STICK_SAMPLES for s in sticks], axis=0)
-        measured = enough & np.isfinite(fitted)
-        compliance = np.where(measured, fitted, start)
-        compliance_se = np.where(measured, fitted_se, 0.0)
-    negative = compliance < -3.0 * compliance_se
-    compliance = np.maximum(compliance, 0.0)
-    # Second pass, with the stiffness used and the stick sets.
-    xi = x - compliance[:, None] * q
-    sigma, straight, slips = _stick_and_slip(
-        xi, q, branches, sticks, floor, options["slip_threshold"]
-    )
-    mismatch = np.zeros(cycles, dtype=bool)
-    if given:  # a stiffness that does not fit the stick sides tilts them in ξ
-        tilt, _ = _compliance(xi, q, sticks)
-        span = np.max(
-            [
-                np.max(np.where(s, q, -np.inf), axis=1) - np.min(np.where(s, q, np.inf), axis=1)
-                for s in sticks
-            ],
-            axis=0,
-        )
-        judged = np.all([np.count_nonzero(s, axis=1) >= _STICK_SAMPLES for s in sticks], axis=0)
-        mismatch = judged & ~(np.abs(tilt) * span <= _TILT_SPREAD * sigma + floor)
-    forward = _sorted_branch(xi, q, slips[0])
-    backward = _sorted_branch(xi, q, slips[1])
-    ends = []
-    for xs, _, count in (forward, backward):
-        last = np.take_along_axis(xs, np.maximum(count - 1, 0)[:, None], axis=1)[:, 0]
-        ends.append((np.where(count > 0, xs[:, 0], np.nan), np.where(count > 0, last, np.nan)))
-    return {
-        "compliance": compliance,
-        "compliance_se": compliance_se,
-        "mismatch": mismatch,
-        "curved": negative | ~straight,
-        "forward": forward,
-        "backward": backward,
-        "lowest": np.maximum(ends[0][0], ends[1][0]),
-        "highest": np.minimum(ends[0][1], ends[1][1]),
-    }
 
 
 def _central_values(forward, backward, central, load):
@@ -491,13 +199,15 @@ def _central_values(forward, backward, central, load):
     unit = np.linspace(-1.0, 1.0, _CENTRAL_POINTS)
     at = central[:, None] * unit[None, :]
     inside = np.broadcast_to(usable[:, None], at.shape)
-    q_forward, q_backward, mu, slope, lines = _read(forward, backward, unit, central, inside, load)
+    q_forward, q_backward, mu, slope, lines = read_branches(
+        forward, backward, unit, central, inside, load
+    )
     finite = np.isfinite(mu)
     points = np.count_nonzero(finite, axis=1)
-    middle = _masked_median(mu, finite)
-    bound = (_WINSOR * _MAD * _masked_median(np.abs(mu - middle[:, None]), finite))[:, None]
+    middle = masked_median(mu, finite)
+    bound = (_WINSOR * _MAD * masked_median(np.abs(mu - middle[:, None]), finite))[:, None]
     clipped = np.clip(mu, middle[:, None] - bound, middle[:, None] + bound)
-    mu_resolved = _masked_sum(clipped, finite) / points
+    mu_resolved = masked_sum(clipped, finite) / points
     # The noise variance: each branch's noise through the weights of its samples. The same
     # for the difference between the means over the inner and the outer half of the part.
     kept = finite & (np.abs(mu - middle[:, None]) <= bound)
@@ -506,7 +216,7 @@ def _central_values(forward, backward, central, load):
     share_inner = np.count_nonzero(inner, axis=1)[:, None]
     share_outer = np.count_nonzero(outer, axis=1)[:, None]
     contrast = np.where(inner, 1.0 / share_inner, np.where(outer, -1.0 / share_outer, 0.0))
-    variation = _masked_sum(mu * contrast, kept)
+    variation = masked_sum(mu * contrast, kept)
     factor = 0.5 * (1.0 + mu**2) / load
     variance = np.zeros(central.size)
     variation_variance = np.zeros(central.size)
@@ -515,21 +225,21 @@ def _central_values(forward, backward, central, load):
         (backward, q_backward, lines[1], -1.0),
     ):
         gain = np.where(kept, sign * factor / (1.0 + (force / load) ** 2), 0.0)
-        noise = _noise(*branch, central) ** 2
-        weight = _weights(left, share, gain / points[:, None], width)
+        noise = branch_noise(*branch, central) ** 2
+        weight = sample_weights(left, share, gain / points[:, None], width)
         variance += noise * np.sum(weight**2, axis=1)
-        weight = _weights(left, share, gain * contrast, width)
+        weight = sample_weights(left, share, gain * contrast, width)
         variation_variance += noise * np.sum(weight**2, axis=1)
     varies = (np.abs(variation) > _VARIATION * mu_resolved) & (
         np.abs(variation) > _VARIATION_SIGNIFICANCE * np.sqrt(variation_variance)
     )
-    mean_xi = _masked_sum(at, finite) / points
-    mean_g = _masked_sum(slope, finite) / points
+    mean_xi = masked_sum(at, finite) / points
+    mean_g = masked_sum(slope, finite) / points
     dxi = at - mean_xi[:, None]
-    k = _masked_sum(dxi * (slope - mean_g[:, None]), finite) / _masked_sum(dxi**2, finite)
+    k = masked_sum(dxi * (slope - mean_g[:, None]), finite) / masked_sum(dxi**2, finite)
     # The sensitivity of mu_resolved to the compliance 1/S (module notes).
     turning = k[:, None] / (1.0 + slope**2) * (q_forward - q_backward)
-    sensitivity = 0.5 * (1.0 + mu_resolved**2) * _masked_sum(turning, finite) / points
+    sensitivity = 0.5 * (1.0 + mu_resolved**2) * masked_sum(turning, finite) / points
     return mu_resolved, variance, k, mean_g - k * mean_xi, sensitivity, varies
 
 
@@ -537,7 +247,7 @@ def _along_stroke(forward, backward, grid, lowest, highest, tilt, load, level):
     """Q±, μ, g (levelled by ``tilt`` if ``level``) and h over the common ``grid``."""
     cycles = lowest.size
     inside = np.isfinite(tilt)[:, None] & (grid >= lowest[:, None]) & (grid <= highest[:, None])
-    q_forward, q_backward, mu, slope, _ = _read(
+    q_forward, q_backward, mu, slope, _ = read_branches(
         forward, backward, grid, np.ones(cycles), inside, load
     )
     if level:
@@ -574,8 +284,15 @@ def _resolve(x, q, valid, load, stiffness, amplitude, gross, given, options):
     cycles = x.shape[0]
     parts = []
     for block in _blocks(cycles):
-        part = _slip_branches(
-            x[block], q[block], valid[block], stiffness[block], amplitude[block], given, options
+        part = slip_branches(
+            x[block],
+            q[block],
+            valid[block],
+            stiffness[block],
+            amplitude[block],
+            given,
+            options["stick_window"],
+            options["slip_threshold"],
         )
         lowest, highest = part["lowest"], part["highest"]
         overlap = (lowest < 0.0) & (highest > 0.0)
@@ -816,8 +533,11 @@ def resolve_loops(
         loop is centred on its own force instead, which also takes away the force a
         tilted groove adds to both branches: give the offset (0 for a zeroed sensor) to
         read a groove's tilt. [N]
-    positions : int
-        Points of the grid of contact positions, odd (>= 5) so that :math:`\xi = 0` is one.
+    positions : int or array_like
+        Points of the grid of contact positions common to all cycles, odd (>= 5) so that
+        :math:`\xi = 0` is one, spread over the widest resolved range; or the positions
+        themselves, increasing and with 0 among them (to compare recordings, or blocks of
+        one). [1] or [m]
     central : float
         Share of the resolved half-range, about :math:`\xi = 0`, averaged for
         ``mu_resolved`` and fitted for ``aspect_ratio`` (0 < central <= 1). [1]
@@ -838,10 +558,12 @@ def resolve_loops(
         Over ``(cycle, position)``: ``mu`` :math:`\mu(\xi)`, ``slope`` :math:`g(\xi)`,
         ``profile`` :math:`h(\xi)` [m], ``force_forward`` and ``force_backward``
         :math:`Q_\pm(\xi)` [N]; NaN outside the range where both branches slip. Over
-        ``cycle``: ``mu_resolved``, ``mu_resolved_se``, ``aspect_ratio``, ``stiffness``
-        (the one used) [N/m], ``position_offset`` (where :math:`\xi = 0` lies in the
-        recording's contact position), ``position_min``, ``position_max`` [m] and
-        ``quality`` (``'ok'`` or the reason the values are NaN). The ``position``
+        ``cycle``: ``mu_resolved``, ``mu_resolved_se``, ``aspect_ratio``, ``tilt``
+        (:math:`g_0`), ``stiffness`` (the one used) [N/m], ``position_offset`` (where
+        :math:`\xi = 0` lies in the recording's contact position), ``position_min``,
+        ``position_max`` [m] and ``quality`` (``'ok'`` or the reason the values are NaN).
+        With the force centred (``force_offset=None``), ``slope`` and ``profile`` are
+        levelled (``tilt`` taken off). The ``position``
         coordinate is :math:`\xi` [m], common to all cycles; the load is a scalar
         coordinate. ``resolved.sel(cycle=...).mu.plot()`` labels itself.
 
@@ -861,6 +583,12 @@ def resolve_loops(
     groove slope) and eq. 10 (the contact position); the GICoF (eq. 17-18) is its value at
     :math:`\xi = 0`, and eq. 7 with :math:`x_o = \Delta^*` gives the equivalent
     parabolic groove.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway, *Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour*, 2016: eq. 7, 9, 10, 17-18.
 
     Examples
     --------
