@@ -213,9 +213,9 @@ def _central_values(forward, backward, central, load):
     kept = finite & (np.abs(mu - middle[:, None]) <= bound)
     inner = kept & (np.abs(unit) <= 0.5)
     outer = kept & ~inner
-    share_inner = np.count_nonzero(inner, axis=1)[:, None]
-    share_outer = np.count_nonzero(outer, axis=1)[:, None]
-    contrast = np.where(inner, 1.0 / share_inner, np.where(outer, -1.0 / share_outer, 0.0))
+    inner_points = np.count_nonzero(inner, axis=1)[:, None]
+    outer_points = np.count_nonzero(outer, axis=1)[:, None]
+    contrast = np.where(inner, 1.0 / inner_points, np.where(outer, -1.0 / outer_points, 0.0))
     variation = masked_sum(mu * contrast, kept)
     factor = 0.5 * (1.0 + mu**2) / load
     variance = np.zeros(central.size)
@@ -230,7 +230,7 @@ def _central_values(forward, backward, central, load):
         variance += noise * np.sum(weight**2, axis=1)
         weight = sample_weights(left, share, gain * contrast, width)
         variation_variance += noise * np.sum(weight**2, axis=1)
-    varies = (np.abs(variation) > _VARIATION * mu_resolved) & (
+    varies = (np.abs(variation) > _VARIATION * np.abs(mu_resolved)) & (
         np.abs(variation) > _VARIATION_SIGNIFICANCE * np.sqrt(variation_variance)
     )
     mean_xi = masked_sum(at, finite) / points
@@ -331,9 +331,10 @@ def _resolve(x, q, valid, load, stiffness, amplitude, gross, given, options):
     }
     # Over the grid of positions common to all cycles: the values along the stroke.
     grid = options["positions"]
-    if np.ndim(grid) == 0:
+    if np.ndim(grid) == 0:  # over the widest resolved range, or the stroke if none is
         reach = np.maximum(highest, -lowest)[ok]
-        grid = np.linspace(-1.0, 1.0, grid) * (reach.max() if reach.size else 0.0)
+        half = reach.max() if reach.size else np.max(amplitude, initial=0.0, where=amplitude > 0)
+        grid = np.linspace(-1.0, 1.0, grid) * (half if half > 0.0 else 1.0)
     per_position = {name: np.empty((cycles, grid.size)) for name in _ALONG}
     for part, block in zip(parts, _blocks(cycles), strict=True):
         along = _along_stroke(

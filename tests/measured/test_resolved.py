@@ -381,6 +381,7 @@ def assert_flagged(result, *flags):
         assert result[name].isnull().all(), name
     for name in ("mu", "slope", "profile", "force_forward", "force_backward"):
         assert result[name].isnull().all(), name
+    assert (np.diff(result.position) > 0).all()  # over the stroke when nothing is resolved
 
 
 def test_partial_slip_is_not_read():
