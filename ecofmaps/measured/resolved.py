@@ -331,6 +331,8 @@ def _resolve(x, q, valid, load, stiffness, amplitude, gross, given, options):
     }
     # Over the grid of positions common to all cycles: the values along the stroke.
     grid = options["positions"]
+    if grid is None:
+        return {}, per_cycle, quality, None
     if np.ndim(grid) == 0:  # over the widest resolved range, or the stroke if none is
         reach = np.maximum(highest, -lowest)[ok]
         half = reach.max() if reach.size else np.max(amplitude, initial=0.0, where=amplitude > 0)
@@ -365,7 +367,9 @@ def _check_options(stiffness, force_offset, positions, central, slip_threshold, 
         check("force_offset", force_offset, "finite", "N")
         if np.ndim(force_offset) != 0:
             raise ValueError("force_offset must be a single value [N]")
-    if np.ndim(positions) == 0:
+    if positions is None:
+        pass
+    elif np.ndim(positions) == 0:
         if (
             isinstance(positions, bool)
             or not isinstance(positions, int | np.integer)
@@ -482,9 +486,10 @@ def resolve_analyzed_loops(
     data["quality"] = ("cycle", quality, _attrs("quality"))
     coords = {
         "cycle": ("cycle", loops["cycle"].values, _attrs("cycle")),
-        "position": ("position", grid, _attrs("position")),
         "load": ((), load, _attrs("load")),
     }
+    if grid is not None:
+        coords["position"] = ("position", grid, _attrs("position"))
     attrs = {
         "title": "Fretting loops read along the stroke (ecofmaps.resolve_loops)",
         "stiffness_from": "given" if given else "the stick sets of each loop",
@@ -534,11 +539,12 @@ def resolve_loops(
         loop is centred on its own force instead, which also takes away the force a
         tilted groove adds to both branches: give the offset (0 for a zeroed sensor) to
         read a groove's tilt. [N]
-    positions : int or array_like
+    positions : int or array_like or None
         Points of the grid of contact positions common to all cycles, odd (>= 5) so that
         :math:`\xi = 0` is one, spread over the widest resolved range; or the positions
         themselves, increasing and with 0 among them (to compare recordings, or blocks of
-        one). [1] or [m]
+        one); or None for the per-cycle values alone (the values along the stroke take
+        8 kB per cycle at 201 positions). [1] or [m]
     central : float
         Share of the resolved half-range, about :math:`\xi = 0`, averaged for
         ``mu_resolved`` and fitted for ``aspect_ratio`` (0 < central <= 1). [1]

@@ -516,12 +516,16 @@ def test_each_cycle_on_its_own():
 
 
 def test_given_grid_and_options(noisy_recording):
-    """A grid of positions (with 0, any spacing), a wider central part, a given force offset."""
+    """A grid of positions (with 0, any spacing), none, a narrower central part, a given
+    force offset."""
     grid = np.concatenate([np.linspace(-30e-6, 0, 31), np.linspace(1e-6, 30e-6, 10)])
     result = resolve_loops(*noisy_recording, LOAD, positions=grid, central=0.5)
     np.testing.assert_array_equal(result.position, grid)
     assert (result.profile.sel(position=0.0) == 0.0).all()
     assert result.attrs["central"] == 0.5
+    alone = resolve_loops(*noisy_recording, LOAD, positions=None)  # per cycle only
+    assert "position" not in alone.dims and "mu" not in alone
+    xr.testing.assert_identical(alone, resolve_loops(*noisy_recording, LOAD).drop_dims("position"))
     zeroed = resolve_loops(*noisy_recording, LOAD, force_offset=NOISE["force_offset"])
     assert zeroed.attrs["force_from"] == "given force offset"
     np.testing.assert_allclose(zeroed.mu_resolved, MU, rtol=0.005)
