@@ -30,7 +30,13 @@ _PUBLIC = {
         "compute_map",
         "compute_universal_map",
     ),
-    "ecofmaps.measured": ("LoopFit", "analyze_loops", "fit_loop", "synthetic_recording"),
+    "ecofmaps.measured": (
+        "LoopFit",
+        "analyze_loops",
+        "fit_loop",
+        "resolve_loops",
+        "synthetic_recording",
+    ),
     "ecofmaps.model": (
         "GROSS_SLIP",
         "INVALID",

@@ -160,6 +160,23 @@ QUANTITIES: dict[str, Quantity] = {
     "force_offset": _force("force offset removed (loop centre)"),
     "loop_displacement": _length("applied displacement, centred", "Δ", r"\Delta"),
     "loop_force": _force("tangential force, centred", "Q", "Q"),
+    "quality": _number("'ok', or why the values of the cycle are NaN"),
+    # --- the loop read along the stroke -------------------------------------------------
+    "position": _length("contact position, centred", "ξ = Δ - Q/S", r"\xi = \Delta - Q/S"),
+    "slope": _number("groove slope felt by the contact", "g(ξ)", r"g(\xi)"),
+    "profile": _length("felt groove profile, zero at the centre", "h(ξ) = ∫g dξ", r"h(\xi)"),
+    "force_forward": _force(
+        "tangential force on the forward slip branch, centred", "Q+(ξ)", r"Q_+(\xi)"
+    ),
+    "force_backward": _force(
+        "tangential force on the backward slip branch, centred", "Q-(ξ)", r"Q_-(\xi)"
+    ),
+    "mu_resolved": _number("coefficient of friction averaged over the central stroke", "μ", r"\mu"),
+    "mu_resolved_se": _number("standard error of the resolved coefficient of friction"),
+    "tilt": _number("mean groove slope g0 of g ≈ g0 + kξ"),
+    "position_offset": _length("contact position of the loop centre in the recording"),
+    "position_min": _length("lower end of the range where both branches slip"),
+    "position_max": _length("upper end of the range where both branches slip"),
     # --- synthetic recordings -----------------------------------------------------------
     "displacement_noise": _length("standard deviation of the displacement noise"),
     "force_noise": _force("standard deviation of the force noise"),

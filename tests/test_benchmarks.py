@@ -29,3 +29,17 @@ def test_quick_run_prints_every_section(capsys):
         assert float(row[3]) > 0 and float(row[4]) > 0  # points per second
     scipy = re.search(r"SciPy per point .* max rel diff (\S+)", maps)
     assert scipy and float(scipy.group(1)) < 1e-10  # brentq + quad vs JAX
+
+
+def test_resolved_section(capsys):
+    """The 'resolved' section: resolve_loops and the lean NumPy both read μ = 0.8 (0.5 %)."""
+    bench = load_bench()
+    assert bench.main(["--only", "resolved", "--quick"]) == 0
+    out = capsys.readouterr().out
+    rows = [
+        line.split() for line in out.splitlines() if re.match(r"\s*\d+\s+\d\.\d+e\+0\d\s", line)
+    ]
+    assert len(rows) == 1  # 1e3 cycles in quick mode
+    for row in rows:
+        assert all(float(value) > 0 for value in row[2:6])  # samples per second
+        assert float(row[-2]) < 0.005 and float(row[-1]) < 0.005  # median |μ/0.8 - 1|

@@ -1,7 +1,16 @@
-"""Measured fretting loops: cycles, per-cycle analysis, model fits and synthetic recordings."""
+"""Measured fretting loops: cycles, per-cycle analysis, the stroke-resolved reading, model fits
+and synthetic recordings."""
 
 from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.fit import LoopFit, fit_loop
+from ecofmaps.measured.resolved import resolve_analyzed_loops, resolve_loops
 from ecofmaps.measured.synthetic import synthetic_recording
 
-__all__ = ["LoopFit", "analyze_loops", "fit_loop", "synthetic_recording"]
+__all__ = [
+    "LoopFit",
+    "analyze_loops",
+    "fit_loop",
+    "resolve_analyzed_loops",
+    "resolve_loops",
+    "synthetic_recording",
+]

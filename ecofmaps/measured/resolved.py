@@ -1,0 +1,612 @@
+r"""Friction and groove slope read along the whole stroke of every measured loop.
+
+At the contact position :math:`\xi = \Delta - Q/S` (eq. 10) the model's two slip branches
+are :math:`Q_+/P = \tan(\alpha + \varphi)` and :math:`Q_-/P = \tan(\alpha - \varphi)`
+(eq. 9), with :math:`\varphi = \arctan\mu` and :math:`\alpha = \arctan g(\xi)` the local
+slope of whatever groove the pad sits in. Where both branches slip over the same
+:math:`\xi`, they give both, exactly:
+
+.. math::
+
+    \mu(\xi) = \tan\frac{\arctan(Q_+/P) - \arctan(Q_-/P)}{2}, \qquad
+    g(\xi) = \tan\frac{\arctan(Q_+/P) + \arctan(Q_-/P)}{2},
+
+and :math:`h(\xi) = \int_0^\xi g\,d\xi` is the scar's profile as the pad feels it. The
+GICoF (eq. 17-18) is the special case :math:`\xi = 0`. :func:`resolve_loops` reads them
+off every cycle of a recording; :func:`resolve_analyzed_loops` does the same from the loops
+that :func:`ecofmaps.analyze_loops` kept (``keep_loops=True``): cycles, centring, offsets
+and a first stiffness come from there. The work is vectorised over blocks of 512 cycles
+(padded rows, no Python loop over cycles or samples; :mod:`~ecofmaps.measured.stick_slip`
+and :mod:`~ecofmaps.measured.resampling` hold the kernels).
+
+The method, per cycle
+---------------------
+Each centred loop runs from its lowest displacement up the *rising* branch to its highest
+and back down the *falling* one.
+
+* **Stick sets.** A first pass takes the samples whose force has moved away from the
+  reversal's by a share between ``stick_window[0]`` and ``stick_window[1]`` (default 5 %
+  and 45 %) of the branch's force swing, with :func:`~ecofmaps.analyze_loops`'s stiffness
+  (or the given one), and finds where the slip starts (below). The stick set is then every
+  sample from the lower share up to 5 % of the swing before the first slip sample: in the
+  model the contact sticks there, :math:`\xi` stands still, and the samples lie on a
+  vertical line of the :math:`(\xi, Q)` plane.
+* **Stiffness.** Given, or measured: the compliance :math:`1/S` common to the two stick
+  sets, each with its own intercept, by least squares of :math:`\Delta` on :math:`Q`
+  (:math:`\Delta = \xi_s + Q/S`), with its standard error from the residuals. Where a set
+  has fewer than three samples (sparse loops), :func:`~ecofmaps.analyze_loops`'s
+  stiffness is kept.
+* **Noise and stick level.** The noise :math:`\sigma` of :math:`\xi` comes from its
+  second differences within the stick sets,
+  :math:`\operatorname{median}|\xi_{i-1} - 2\xi_i + \xi_{i+1}| / (0.6745\sqrt6)`, which a
+  smooth trend of :math:`\xi` (a rounded loop, a wrong stiffness) hardly enters; it
+  assumes noise that is white from sample to sample. The stick level :math:`\xi_s` is the
+  median of :math:`\xi` over the set (the reversal's :math:`\xi` for a set of fewer than
+  three samples).
+* **Slip.** A sample of the rising branch slips if it and every later sample of the
+  branch lie more than ``slip_threshold`` (default 4) times :math:`\sigma` above the stick
+  level (below it on the falling branch). Only the run of slip up to the next reversal
+  counts, so a noisy stick sample cannot pass for slip; the first samples of slip, within
+  the threshold of the stick level, are left out. Noise-free, :math:`\sigma = 0` and
+  every sample that has moved (by more than :math:`10^{-9}\Delta^*`) slips.
+* **Resampling.** The slip samples of each branch, sorted by :math:`\xi`, are read at
+  given positions inside the range where both branches slip (never beyond a branch's
+  outermost slip samples) by the linear fraction :math:`Q - Q_1 = m d/(1 + c d)`,
+  :math:`d = \xi - \xi_1`, through three samples around the position. It is eq. 9 on a
+  parabolic groove, so the model's branches are read exactly; where it would have a pole
+  near the three samples (noisy samples that do not rise monotonically, a branch flat to
+  rounding), the straight line between the two samples around the position.
+* **Per cycle**, on the cycle's own grid of 201 positions over its central part
+  :math:`|\xi| \le` ``central`` times the shorter half of the resolved range (so that
+  nothing depends on the other cycles): ``mu_resolved``, the mean of :math:`\mu(\xi)` after
+  values beyond three robust standard deviations of the median are clipped to that bound;
+  ``aspect_ratio`` :math:`z_o/x_o = k\Delta^*/2` from the least-squares line
+  :math:`g \approx g_0 + k\xi` (eq. 7 with the paper's :math:`x_o = \Delta^*`), and
+  ``tilt`` :math:`g_0`.
+* **Standard error.** The mean is a linear combination of the samples of the two branches
+  through the resampling (neighbouring positions share samples): each sample's weight is
+  the sum over the positions of :math:`\partial\mu/\partial Q_\pm` times its share in the
+  straight line there. The noise of each branch comes from its samples in the central part,
+  each against the line through its two neighbours (variance
+  :math:`\sigma^2(1 + u^2 + (1-u)^2)` for white noise); the variance of ``mu_resolved`` is
+  the sum of the squared weights times it. When the stiffness is measured, its uncertainty
+  is added in quadrature through the sensitivity
+  :math:`\partial\bar\mu/\partial(1/S) = \tfrac12(1 + \bar\mu^2)\,
+  \overline{\alpha'(\xi)(Q_+ - Q_-)}`: an error of :math:`S` moves the two branches in
+  opposite directions along :math:`\xi`, and on a sloping groove that shifts every
+  :math:`\mu(\xi)` the same way (the GICoF equally).
+* **Along the stroke**, on a grid of positions common to all cycles (``positions``
+  points over the widest resolved range, or the positions given): :math:`Q_\pm(\xi)`,
+  :math:`\mu(\xi)`, :math:`g(\xi)` and :math:`h(\xi)`, the trapezoidal integral of
+  :math:`g`, zero at :math:`\xi = 0`. The loops' centring removes a force offset that a
+  tilt of the groove cannot be told from; so, unless ``force_offset`` gives the force's
+  zero, :math:`g` and :math:`h` are levelled: :math:`g_0` is taken off :math:`g`. Levelling
+  also takes off the tilt that the noise of the loop's force centre adds.
+
+Quality
+-------
+A cycle whose numbers cannot be stood behind has NaN for every resolved value and its
+``quality`` says why (the first reason, in this order):
+
+* ``'not-gross-slip'``: :func:`~ecofmaps.analyze_loops` labels it partial slip.
+* ``'stiffness-mismatch'``: the given stiffness tilts the stick sets in :math:`\xi` by
+  more than three times the noise :math:`\sigma` over their force span (for Example 2's
+  loops, about 5 % off).
+* ``'curved-stick'``: a stick set is not a straight line, its quadratic term beyond five
+  standard errors (a rounded loop, as polymers and micro-slip draw), or the measured
+  compliance is negative beyond three standard errors.
+* ``'no-overlap'``: no range of :math:`\xi` around the loop's centre where both branches
+  slip (a slip within the noise, at the onset of gross slip).
+* ``'few-slip-samples'``: fewer than eight slip samples of either branch in the central
+  part (a sparsely sampled or digitised loop): the average would be read off straight
+  lines between samples far apart, and the noise could not be told.
+* ``'mu-varies'``: the means of :math:`\mu(\xi)` over the inner and the outer half of the
+  central part differ by more than 3 % and four standard errors. The model's
+  :math:`\mu(\xi)` is constant for any groove; a rounded loop's falls towards the ends of
+  the stroke, also where the noise hides the curvature of its stick sides.
+
+Otherwise ``'ok'``.
+
+References
+----------
+X. Jin, W. Sun, P.H. Shipway (2016): eq. 7 (the groove), eq. 9 (the slip traction at the
+local slope), eq. 10 (the contact position), eq. 17-18 (the GICoF, here at :math:`\xi = 0`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ecofmaps import _nomenclature as nomenclature
+from ecofmaps._inputs import check, si_units
+from ecofmaps.measured.analysis import GROSS_SLIP_THRESHOLD, analyze_loops
+from ecofmaps.measured.resampling import branch_noise, read_branches, sample_weights
+from ecofmaps.measured.stick_slip import masked_median, masked_sum, slip_branches
+
+__all__ = ["resolve_analyzed_loops", "resolve_loops"]
+
+#: Quality flags, in the order they are tested.
+QUALITY_FLAGS = (
+    "not-gross-slip",
+    "stiffness-mismatch",
+    "curved-stick",
+    "no-overlap",
+    "few-slip-samples",
+    "mu-varies",
+)
+
+#: μ(ξ) varies along the stroke when the means over the inner and the outer half of the
+#: central part differ by this share of μ and by this many standard errors.
+_VARIATION = 0.03
+_VARIATION_SIGNIFICANCE = 4.0
+
+#: Values of μ(ξ) beyond this many robust standard deviations of the median are clipped.
+_WINSOR = 3.0
+
+#: Cycles analysed together: a block's arrays stay in the processor's cache.
+_BLOCK = 512
+
+#: Points of each cycle's own grid over its central part, for the per-cycle values.
+_CENTRAL_POINTS = 201
+
+#: Fewest slip samples of each branch in the central part.
+_SLIP_SAMPLES = 8
+
+#: The median absolute deviation of a normal distribution over its standard deviation.
+_MAD = 1.482602218505602
+
+# How this module reads the quantities that have a general meaning elsewhere (netCDF comment).
+_COMMENTS = {
+    "mu": "read along the stroke: tan((atan(Q+/P) - atan(Q-/P))/2) at each position",
+    "aspect_ratio": "of the parabola that fits the felt slope, g ≈ g0 + kξ, z_o/x_o = kΔ*/2",
+    "stiffness": "the rig stiffness used for the contact position",
+    "tilt": "levelled off the slope when the force is centred",
+}
+
+
+def _attrs(name: str) -> dict:
+    attrs = nomenclature.attrs(name)
+    if name in _COMMENTS:
+        attrs["comment"] = _COMMENTS[name]
+    return attrs
+
+
+# --- per-cycle kernels ---------------------------------------------------------------------
+# Arrays of shape (cycles, width), rows running once round a loop from its lowest
+# displacement; ``valid`` marks the loop's points, NaN padding elsewhere.
+
+
+def _central_values(forward, backward, central, load):
+    """mu_resolved, its noise variance, k and g0 of g ≈ g0 + kξ, the sensitivity to 1/S.
+
+    Read on each cycle's own grid over its central part, ``|ξ| <= central``: nothing here
+    depends on the other cycles. Also whether μ(ξ) varies between the inner and the outer
+    half of the part beyond ``_VARIATION`` of μ and beyond its noise.
+    """
+    width = forward[0].shape[1]
+    usable = np.isfinite(central)
+    unit = np.linspace(-1.0, 1.0, _CENTRAL_POINTS)
+    at = central[:, None] * unit[None, :]
+    inside = np.broadcast_to(usable[:, None], at.shape)
+    q_forward, q_backward, mu, slope, lines = read_branches(
+        forward, backward, unit, central, inside, load
+    )
+    finite = np.isfinite(mu)
+    points = np.count_nonzero(finite, axis=1)
+    middle = masked_median(mu, finite)
+    bound = (_WINSOR * _MAD * masked_median(np.abs(mu - middle[:, None]), finite))[:, None]
+    clipped = np.clip(mu, middle[:, None] - bound, middle[:, None] + bound)
+    mu_resolved = masked_sum(clipped, finite) / points
+    # The noise variance: each branch's noise through the weights of its samples. The same
+    # for the difference between the means over the inner and the outer half of the part.
+    kept = finite & (np.abs(mu - middle[:, None]) <= bound)
+    inner = kept & (np.abs(unit) <= 0.5)
+    outer = kept & ~inner
+    inner_points = np.count_nonzero(inner, axis=1)[:, None]
+    outer_points = np.count_nonzero(outer, axis=1)[:, None]
+    contrast = np.where(inner, 1.0 / inner_points, np.where(outer, -1.0 / outer_points, 0.0))
+    variation = masked_sum(mu * contrast, kept)
+    factor = 0.5 * (1.0 + mu**2) / load
+    variance = np.zeros(central.size)
+    variation_variance = np.zeros(central.size)
+    for branch, force, (left, share), sign in (
+        (forward, q_forward, lines[0], 1.0),
+        (backward, q_backward, lines[1], -1.0),
+    ):
+        gain = np.where(kept, sign * factor / (1.0 + (force / load) ** 2), 0.0)
+        noise = branch_noise(*branch, central) ** 2
+        weight = sample_weights(left, share, gain / points[:, None], width)
+        variance += noise * np.sum(weight**2, axis=1)
+        weight = sample_weights(left, share, gain * contrast, width)
+        variation_variance += noise * np.sum(weight**2, axis=1)
+    varies = (np.abs(variation) > _VARIATION * np.abs(mu_resolved)) & (
+        np.abs(variation) > _VARIATION_SIGNIFICANCE * np.sqrt(variation_variance)
+    )
+    mean_xi = masked_sum(at, finite) / points
+    mean_g = masked_sum(slope, finite) / points
+    dxi = at - mean_xi[:, None]
+    k = masked_sum(dxi * (slope - mean_g[:, None]), finite) / masked_sum(dxi**2, finite)
+    # The sensitivity of mu_resolved to the compliance 1/S (module notes).
+    turning = k[:, None] / (1.0 + slope**2) * (q_forward - q_backward)
+    sensitivity = 0.5 * (1.0 + mu_resolved**2) * masked_sum(turning, finite) / points
+    return mu_resolved, variance, k, mean_g - k * mean_xi, sensitivity, varies
+
+
+def _along_stroke(forward, backward, grid, lowest, highest, tilt, load, level):
+    """Q±, μ, g (levelled by ``tilt`` if ``level``) and h over the common ``grid``."""
+    cycles = lowest.size
+    inside = np.isfinite(tilt)[:, None] & (grid >= lowest[:, None]) & (grid <= highest[:, None])
+    q_forward, q_backward, mu, slope, _ = read_branches(
+        forward, backward, grid, np.ones(cycles), inside, load
+    )
+    if level:
+        slope = slope - tilt[:, None]
+    # The felt profile: trapezoidal integral of g, zero at ξ = 0.
+    pieces = np.nan_to_num(0.5 * (slope[:, 1:] + slope[:, :-1]) * np.diff(grid))
+    profile = np.concatenate([np.zeros((cycles, 1)), np.cumsum(pieces, axis=1)], axis=1)
+    profile -= profile[:, np.searchsorted(grid, 0.0)][:, None]
+    return {
+        "mu": mu,
+        "slope": slope,
+        "profile": np.where(inside, profile, np.nan),
+        "force_forward": q_forward,
+        "force_backward": q_backward,
+    }
+
+
+#: The values along the stroke, over (cycle, position).
+_ALONG = ("mu", "slope", "profile", "force_forward", "force_backward")
+
+
+def _blocks(cycles):
+    """Slices of at most ``_BLOCK`` cycles: the arrays of a block stay in the cache."""
+    return [slice(start, start + _BLOCK) for start in range(0, max(cycles, 1), _BLOCK)]
+
+
+def _resolve(x, q, valid, load, stiffness, amplitude, gross, given, options):
+    """Every resolved quantity of the centred loops ``x``, ``q`` (module notes).
+
+    ``stiffness`` is the given S (``given`` True) or analyze_loops's, per cycle. Returns
+    the per-position and per-cycle arrays, the quality and the grid. The work is done
+    on blocks of cycles, each block vectorised.
+    """
+    cycles = x.shape[0]
+    parts = []
+    for block in _blocks(cycles):
+        part = slip_branches(
+            x[block],
+            q[block],
+            valid[block],
+            stiffness[block],
+            amplitude[block],
+            given,
+            options["stick_window"],
+            options["slip_threshold"],
+        )
+        lowest, highest = part["lowest"], part["highest"]
+        overlap = (lowest < 0.0) & (highest > 0.0)
+        usable = gross[block] & ~part["mismatch"] & ~part["curved"] & overlap
+        central = np.where(usable, options["central"] * np.minimum(highest, -lowest), np.nan)
+        values = _central_values(part["forward"], part["backward"], central, load)
+        samples = [
+            np.count_nonzero(np.abs(np.where(np.isfinite(xs), xs, np.inf)) <= central[:, None], 1)
+            for xs, _, _ in (part["forward"], part["backward"])
+        ]
+        few = (np.minimum(*samples) < _SLIP_SAMPLES) | ~np.isfinite(values[0])
+        reasons = (~gross[block], part["mismatch"], part["curved"], ~overlap, few, values[5])
+        part["quality"] = np.select(reasons, QUALITY_FLAGS, "ok")
+        part["values"] = values
+        parts.append(part)
+
+    def joined(name):
+        return np.concatenate([part[name] for part in parts])
+
+    quality = joined("quality")
+    ok = quality == "ok"
+    lowest, highest = joined("lowest"), joined("highest")
+    mu_resolved, variance, k, tilt, sensitivity = (
+        np.concatenate([part["values"][i] for part in parts]) for i in range(5)
+    )
+    nan = np.where(ok, 1.0, np.nan)
+    compliance = joined("compliance")
+    per_cycle = {
+        "mu_resolved": mu_resolved * nan,
+        "mu_resolved_se": np.sqrt(variance + (sensitivity * joined("compliance_se")) ** 2) * nan,
+        "aspect_ratio": 0.5 * k * amplitude * nan,
+        "tilt": tilt * nan,
+        "stiffness": 1.0 / compliance,
+        "position_min": lowest * nan,
+        "position_max": highest * nan,
+    }
+    # Over the grid of positions common to all cycles: the values along the stroke.
+    grid = options["positions"]
+    if grid is None:
+        return {}, per_cycle, quality, None
+    if np.ndim(grid) == 0:  # over the widest resolved range, or the stroke if none is
+        reach = np.maximum(highest, -lowest)[ok]
+        half = reach.max() if reach.size else np.max(amplitude, initial=0.0, where=amplitude > 0)
+        grid = np.linspace(-1.0, 1.0, grid) * (half if half > 0.0 else 1.0)
+    per_position = {name: np.empty((cycles, grid.size)) for name in _ALONG}
+    for part, block in zip(parts, _blocks(cycles), strict=True):
+        along = _along_stroke(
+            part["forward"],
+            part["backward"],
+            grid,
+            lowest[block],
+            highest[block],
+            per_cycle["tilt"][block],
+            load,
+            options["force_offset"] is None,
+        )
+        for name in _ALONG:
+            per_position[name][block] = along[name]
+    return per_position, per_cycle, quality, grid
+
+
+# --- the public functions -------------------------------------------------------------------
+
+
+def _check_options(stiffness, force_offset, positions, central, slip_threshold, stick_window):
+    """The options as a dict, or a ValueError naming the one out of range."""
+    if stiffness is not None:
+        check("stiffness", stiffness, "positive_or_inf", "N/m")
+        if np.ndim(stiffness) != 0:
+            raise ValueError("stiffness must be a single value [N/m]")
+    if force_offset is not None:
+        check("force_offset", force_offset, "finite", "N")
+        if np.ndim(force_offset) != 0:
+            raise ValueError("force_offset must be a single value [N]")
+    if positions is None:
+        pass
+    elif np.ndim(positions) == 0:
+        if (
+            isinstance(positions, bool)
+            or not isinstance(positions, int | np.integer)
+            or positions < 5
+            or positions % 2 == 0
+        ):
+            raise ValueError(
+                f"positions must be an odd integer >= 5 or an array of positions; got {positions!r}"
+            )
+        positions = int(positions)
+    else:
+        check("positions", positions, "finite", "m")
+        positions = np.asarray(positions, dtype=np.float64)
+        if positions.ndim != 1 or positions.size < 3 or np.any(np.diff(positions) <= 0.0):
+            raise ValueError("positions must be one-dimensional and increasing, >= 3 of them [m]")
+        if not np.any(positions == 0.0):
+            raise ValueError("positions must include 0 (the centre, where the profile is zero) [m]")
+    if not 0.0 < central <= 1.0:
+        raise ValueError(f"central must satisfy 0 < central <= 1; got {central!r}")
+    if not slip_threshold > 0.0:
+        raise ValueError(f"slip_threshold must satisfy slip_threshold > 0; got {slip_threshold!r}")
+    low, high = (float(share) for share in stick_window)
+    if not 0.0 <= low < high <= 1.0:
+        raise ValueError(f"stick_window must satisfy 0 <= low < high <= 1; got {stick_window!r}")
+    return {
+        "stiffness": None if stiffness is None else float(stiffness),
+        "force_offset": None if force_offset is None else float(force_offset),
+        "positions": positions,
+        "central": float(central),
+        "slip_threshold": float(slip_threshold),
+        "stick_window": (low, high),
+    }
+
+
+_NEEDED = (
+    "loop_displacement",
+    "loop_force",
+    "stiffness",
+    "amplitude",
+    "regime",
+    "displacement_offset",
+    "force_offset",
+)
+
+
+def resolve_analyzed_loops(
+    loops,
+    stiffness=None,
+    *,
+    force_offset=None,
+    positions=201,
+    central=0.8,
+    slip_threshold=4.0,
+    stick_window=(0.05, 0.45),
+) -> xr.Dataset:
+    r"""Friction and groove slope along the stroke of the loops :func:`analyze_loops` kept.
+
+    The work of :func:`resolve_loops` after its call of :func:`ecofmaps.analyze_loops`:
+    for a recording already analysed with ``keep_loops=True``.
+
+    Parameters
+    ----------
+    loops : xarray.Dataset
+        The result of :func:`ecofmaps.analyze_loops` with ``keep_loops=True``.
+    stiffness, force_offset, positions, central, slip_threshold, stick_window
+        As for :func:`resolve_loops`.
+
+    Returns
+    -------
+    resolved : xarray.Dataset
+        As for :func:`resolve_loops`.
+
+    Raises
+    ------
+    ValueError
+        If ``loops`` lacks the loops (``keep_loops=False``), or for options out of range.
+    """
+    if not isinstance(loops, xr.Dataset) or any(name not in loops for name in _NEEDED):
+        raise ValueError(
+            "loops must be the Dataset of analyze_loops(..., keep_loops=True), with "
+            + ", ".join(_NEEDED)
+        )
+    options = _check_options(
+        stiffness, force_offset, positions, central, slip_threshold, stick_window
+    )
+    load = float(loops["load"])
+    x = np.asarray(loops["loop_displacement"].values, dtype=np.float64)
+    q = np.asarray(loops["loop_force"].values, dtype=np.float64)
+    removed = np.asarray(loops["force_offset"].values, dtype=np.float64)
+    if options["force_offset"] is not None:  # the force as recorded, less the given offset
+        q = q + (removed - options["force_offset"])[:, None]
+        removed = np.full_like(removed, options["force_offset"])
+    given = options["stiffness"] is not None
+    rig = np.full(x.shape[0], options["stiffness"]) if given else loops["stiffness"].values
+    with np.errstate(divide="ignore", invalid="ignore"):
+        per_position, per_cycle, quality, grid = _resolve(
+            x,
+            q,
+            np.isfinite(x) & np.isfinite(q),
+            load,
+            np.asarray(rig, dtype=np.float64),
+            np.asarray(loops["amplitude"].values, dtype=np.float64),
+            loops["regime"].values == "gross slip",
+            given,
+            options,
+        )
+        per_cycle["position_offset"] = (
+            loops["displacement_offset"].values - removed / per_cycle["stiffness"]
+        )
+    dims = ("cycle", "position")
+    data = {name: (dims, value, _attrs(name)) for name, value in per_position.items()}
+    for name, value in per_cycle.items():
+        data[name] = ("cycle", value, _attrs(name))
+    data["quality"] = ("cycle", quality, _attrs("quality"))
+    coords = {
+        "cycle": ("cycle", loops["cycle"].values, _attrs("cycle")),
+        "load": ((), load, _attrs("load")),
+    }
+    if grid is not None:
+        coords["position"] = ("position", grid, _attrs("position"))
+    attrs = {
+        "title": "Fretting loops read along the stroke (ecofmaps.resolve_loops)",
+        "stiffness_from": "given" if given else "the stick sets of each loop",
+        "force_from": (
+            "loops centred" if options["force_offset"] is None else "given force offset"
+        ),
+        "central": options["central"],
+        "slip_threshold": options["slip_threshold"],
+        "stick_window": list(options["stick_window"]),
+    }
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+@si_units
+def resolve_loops(
+    displacement,
+    force,
+    load,
+    stiffness=None,
+    cycle=None,
+    *,
+    force_offset=None,
+    positions=201,
+    central=0.8,
+    slip_threshold=4.0,
+    stick_window=(0.05, 0.45),
+    hysteresis=0.5,
+    gross_slip_threshold=GROSS_SLIP_THRESHOLD,
+) -> xr.Dataset:
+    r"""Friction and groove slope read along the whole stroke of every loop of a recording.
+
+    Parameters
+    ----------
+    displacement : array_like
+        Applied displacement :math:`\Delta` at each sample, in time order. Offsets and a
+        slow drift are removed (:func:`ecofmaps.analyze_loops`). [m]
+    force : array_like
+        Tangential force :math:`Q` at each sample. [N]
+    load : float
+        Normal load :math:`P`. [N]
+    stiffness : float, optional
+        Rig stiffness :math:`S` (``numpy.inf`` for a rigid rig); by default measured on
+        each loop. [N/m]
+    cycle : array_like, optional
+        Cycle number of each sample, as for :func:`ecofmaps.analyze_loops`. [1]
+    force_offset : float, optional
+        The force sensor's offset, subtracted from the recorded force. By default each
+        loop is centred on its own force instead, which also takes away the force a
+        tilted groove adds to both branches: give the offset (0 for a zeroed sensor) to
+        read a groove's tilt. [N]
+    positions : int or array_like or None
+        Points of the grid of contact positions common to all cycles, odd (>= 5) so that
+        :math:`\xi = 0` is one, spread over the widest resolved range; or the positions
+        themselves, increasing and with 0 among them (to compare recordings, or blocks of
+        one); or None for the per-cycle values alone (the values along the stroke take
+        8 kB per cycle at 201 positions). [1] or [m]
+    central : float
+        Share of the resolved half-range, about :math:`\xi = 0`, averaged for
+        ``mu_resolved`` and fitted for ``aspect_ratio`` (0 < central <= 1). [1]
+    slip_threshold : float
+        How many noise standard deviations of :math:`\xi` a sample must lie beyond the
+        stick level to count as slipping (> 0). [1]
+    stick_window : tuple of float
+        Shares of a branch's force swing, away from its reversal, that bound the first
+        stick window (0 <= low < high <= 1); also passed to
+        :func:`ecofmaps.analyze_loops`. [1]
+    hysteresis, gross_slip_threshold : float
+        Passed to :func:`ecofmaps.analyze_loops`: the reversal detector's band, and the
+        energy ratio above which a loop is gross slip. [1]
+
+    Returns
+    -------
+    resolved : xarray.Dataset
+        Over ``(cycle, position)``: ``mu`` :math:`\mu(\xi)`, ``slope`` :math:`g(\xi)`,
+        ``profile`` :math:`h(\xi)` [m], ``force_forward`` and ``force_backward``
+        :math:`Q_\pm(\xi)` [N]; NaN outside the range where both branches slip. Over
+        ``cycle``: ``mu_resolved``, ``mu_resolved_se``, ``aspect_ratio``, ``tilt``
+        (:math:`g_0`), ``stiffness`` (the one used) [N/m], ``position_offset`` (where
+        :math:`\xi = 0` lies in the recording's contact position), ``position_min``,
+        ``position_max`` [m] and ``quality`` (``'ok'`` or the reason the values are NaN).
+        With the force centred (``force_offset=None``), ``slope`` and ``profile`` are
+        levelled (``tilt`` taken off). The ``position``
+        coordinate is :math:`\xi` [m], common to all cycles; the load is a scalar
+        coordinate. ``resolved.sel(cycle=...).mu.plot()`` labels itself.
+
+    Raises
+    ------
+    ValueError
+        For bad inputs or options (those of :func:`ecofmaps.analyze_loops` too).
+
+    See Also
+    --------
+    resolve_analyzed_loops : the same from :func:`ecofmaps.analyze_loops`'s result.
+
+    Notes
+    -----
+    The method and the quality flags are in the documentation of
+    :mod:`ecofmaps.measured.resolved`. It rests on eq. 9 (the slip traction at any local
+    groove slope) and eq. 10 (the contact position); the GICoF (eq. 17-18) is its value at
+    :math:`\xi = 0`, and eq. 7 with :math:`x_o = \Delta^*` gives the equivalent
+    parabolic groove.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway, *Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour*, 2016: eq. 7, 9, 10, 17-18.
+
+    Examples
+    --------
+    >>> import numpy as np, ecofmaps
+    >>> displacement, force = ecofmaps.fretting_loop(50e-6, 450.0, 35e6, 0.8, 0.2)
+    >>> resolved = ecofmaps.resolve_loops(np.asarray(displacement), np.asarray(force), 450.0)
+    >>> print(f"{float(resolved.mu_resolved[0]):.9f} {float(resolved.aspect_ratio[0]):.9f}")
+    0.800000000 0.200000000
+    """
+    options = _check_options(
+        stiffness, force_offset, positions, central, slip_threshold, stick_window
+    )
+    loops = analyze_loops(
+        displacement,
+        force,
+        load,
+        cycle,
+        hysteresis=hysteresis,
+        stick_window=stick_window,
+        gross_slip_threshold=gross_slip_threshold,
+        keep_loops=True,
+    )
+    return resolve_analyzed_loops(loops, **options)

@@ -1,0 +1,230 @@
+r"""Stick and slip along each branch of centred fretting loops, and the rig stiffness.
+
+The arrays hold one loop per row, as :func:`ecofmaps.analyze_loops` keeps them: each row
+runs from the loop's lowest displacement up the *rising* branch to its highest and back
+down the *falling* one, NaN-padded. :func:`slip_branches` finds the stick sets after the
+two reversals, measures the stiffness on them (or checks a given one), and returns the
+samples of each branch that slip, sorted by contact position :math:`\xi = \Delta - Q/S`
+(eq. 10). The method is described in :mod:`ecofmaps.measured.resolved`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["masked_median", "masked_sum", "slip_branches"]
+
+#: A given stiffness does not fit when it tilts the stick sets by this many σ.
+_TILT_SPREAD = 3.0
+
+#: A stick set is curved when its quadratic term exceeds this many standard errors.
+_CURVATURE_SIGNIFICANCE = 5.0
+
+#: Fewest samples in a stick set to measure the stiffness, the stick level and the noise.
+_STICK_SAMPLES = 3
+
+#: The stick set ends this share of the force swing before the first slip sample.
+_STICK_MARGIN = 0.05
+
+#: A sample has moved off the stick level, noise-free, beyond this share of Δ*.
+_ROUNDING = 1e-9
+
+#: The median of |N(0, 6)|, the second difference of white noise of unit variance.
+_SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
+
+
+def masked_sum(values, mask):
+    """Sum of each row over ``mask`` (NaN elsewhere is ignored)."""
+    return np.sum(np.where(mask, values, 0.0), axis=-1)
+
+
+def masked_median(values, mask):
+    """Median of each row over ``mask`` (NaN for an empty row)."""
+    ordered = np.sort(np.where(mask, values, np.inf), axis=-1)
+    count = np.count_nonzero(mask, axis=-1)
+    low = np.take_along_axis(ordered, np.maximum(count - 1, 0)[:, None] // 2, axis=-1)[:, 0]
+    high = np.take_along_axis(ordered, count[:, None] // 2, axis=-1)[:, 0]
+    return np.where(count > 0, 0.5 * (low + high), np.nan)
+
+
+def _branches(x, valid):
+    """Masks of the rising branch (start to top) and of the falling one (top to the end)."""
+    top = np.argmax(np.where(valid, x, -np.inf), axis=1)
+    j = np.arange(x.shape[1])[None, :]
+    return valid & (j <= top[:, None]), valid & (j >= top[:, None])
+
+
+def _moved(q, branch):
+    """Share of the branch's force swing by which each sample has moved from its reversal."""
+    span = np.max(np.where(branch, q, -np.inf), axis=1) - np.min(
+        np.where(branch, q, np.inf), axis=1
+    )
+    start = np.take_along_axis(q, np.argmax(branch, axis=1)[:, None], axis=1)
+    return np.abs(q - start) / span[:, None]
+
+
+def _before(mask, branch):
+    """The samples of ``branch`` before the first sample of ``mask``."""
+    return branch & ~np.maximum.accumulate(branch & mask, axis=1)
+
+
+def _compliance(x, q, sticks):
+    """Least-squares compliance common to lines Δ = ξ_s + cQ through each stick set.
+
+    Returns the compliance and its standard error (from the residuals about the lines).
+    """
+    covariance = np.zeros(x.shape[0])
+    variance = np.zeros(x.shape[0])
+    centred = []
+    for mask in sticks:
+        count = np.count_nonzero(mask, axis=1)[:, None]
+        dq = q - masked_sum(q, mask)[:, None] / count
+        dx = x - masked_sum(x, mask)[:, None] / count
+        covariance += masked_sum(dq * dx, mask)
+        variance += masked_sum(dq * dq, mask)
+        centred.append((dq, dx))
+    compliance = covariance / variance
+    squares = sum(
+        masked_sum((dx - compliance[:, None] * dq) ** 2, mask)
+        for (dq, dx), mask in zip(centred, sticks, strict=True)
+    )
+    points = sum(np.count_nonzero(mask, axis=1) for mask in sticks)
+    return compliance, np.sqrt(squares / np.maximum(points - 3, 1) / variance)
+
+
+def _curvature(xi, q, stick):
+    """Quadratic term of ξ = a + bu + cu² over a stick set, and its standard error per σ.
+
+    ``u`` is the force standardised over the set; the quadratic is fitted with the
+    polynomial w = u² - 1 - m₃u orthogonal to 1 and u over the set (m₃ the mean of u³).
+    """
+    count = np.count_nonzero(stick, axis=1)
+    u = np.where(stick, q, 0.0)
+    u -= (np.sum(u, axis=1) / count)[:, None]
+    u *= stick
+    square = u * u
+    u /= np.sqrt(np.sum(square, axis=1) / count)[:, None]
+    np.multiply(u, u, out=square)
+    skew = np.sum(square * u, axis=1) / count
+    w = square - 1.0 - skew[:, None] * u
+    w *= stick
+    norm = np.sum(w * w, axis=1)
+    solvable = (count > _STICK_SAMPLES) & (norm > 0.0)
+    curvature = np.where(solvable, np.sum(w * np.where(stick, xi, 0.0), axis=1) / norm, 0.0)
+    return curvature, 1.0 / np.sqrt(np.where(solvable, norm, 1.0))
+
+
+def _stick_and_slip(xi, q, branches, sticks, floor, slip_threshold, judge=True):
+    """Noise, straightness of the stick sets and the slip of each branch (module notes).
+
+    Returns the noise σ of ξ, whether both stick sets are straight (when ``judge``), and
+    the two slip masks.
+    """
+    # σ from the second differences within the stick sets: a smooth trend of ξ (a rounded
+    # loop, a wrong stiffness) hardly enters them, white noise does with variance 6σ².
+    second = np.abs(xi[:, :-2] - 2.0 * xi[:, 1:-1] + xi[:, 2:])
+    triples = np.zeros_like(second, dtype=bool)
+    for stick in sticks:
+        triples |= stick[:, :-2] & stick[:, 1:-1] & stick[:, 2:]
+    sigma = masked_median(second, triples) / _SECOND_DIFFERENCE
+    sigma = np.where(np.isfinite(sigma), sigma, 0.0)
+    threshold = slip_threshold * sigma + floor
+    straight = np.ones(xi.shape[0], dtype=bool)
+    slips = []
+    for branch, stick, sign in zip(branches, sticks, (1.0, -1.0), strict=True):
+        # The stick level: the set's median, or the reversal's ξ where the set has too few
+        # samples to judge (a sparse loop, or the model's loop drawn with straight sides).
+        judged = np.count_nonzero(stick, axis=1) >= _STICK_SAMPLES
+        reversal = np.take_along_axis(xi, np.argmax(branch, axis=1)[:, None], axis=1)[:, 0]
+        level = np.where(judged, masked_median(xi, stick), reversal)
+        if judge:
+            curvature, unit_error = _curvature(xi, q, stick)
+            straight &= np.abs(curvature) <= _CURVATURE_SIGNIFICANCE * unit_error * sigma + floor
+        # Slip: beyond the threshold, and every later sample of the branch too.
+        beyond = np.where(branch, sign * xi, np.inf)
+        least = np.minimum.accumulate(beyond[:, ::-1], axis=1)[:, ::-1]
+        slips.append(branch & (least > (sign * level + threshold)[:, None]))
+    return sigma, straight, slips
+
+
+def _sorted_branch(xi, q, slip):
+    """The slip samples of a branch sorted by ξ (padded with +inf / NaN), and their count."""
+    key = np.where(slip, xi, np.inf)
+    order = np.argsort(key, axis=1, kind="stable")
+    return (
+        np.take_along_axis(key, order, axis=1),
+        np.take_along_axis(np.where(slip, q, np.nan), order, axis=1),
+        np.count_nonzero(slip, axis=1),
+    )
+
+
+def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_threshold):
+    """The stiffness, the checks of the stick sets, and the two slip branches (module notes).
+
+    Returns a dict with the compliance and its standard error, ``mismatch`` and
+    ``curved`` (per cycle), the sorted slip branches ``forward`` and ``backward`` and the
+    range ``lowest`` .. ``highest`` where both slip.
+    """
+    cycles = x.shape[0]
+    floor = _ROUNDING * amplitude
+    branches = _branches(x, valid)
+    moved = [_moved(q, branch) for branch in branches]
+    low, high = stick_window
+    windows = [
+        _before(share > high, branch) & (share >= low)
+        for share, branch in zip(moved, branches, strict=True)
+    ]
+    # First pass, with the given stiffness or analyze_loops's and the stick windows: where
+    # does the slip start?
+    start = np.where(np.isinf(stiffness), 0.0, 1.0 / stiffness)
+    xi = x - start[:, None] * q
+    *_, slips = _stick_and_slip(xi, q, branches, windows, floor, slip_threshold, judge=False)
+    # The stick sets: from the window's lower share up to a margin before the slip.
+    sticks = []
+    for share, branch, slip, window in zip(moved, branches, slips, windows, strict=True):
+        onset = np.take_along_axis(share, np.argmax(slip, axis=1)[:, None], axis=1)
+        onset = np.where(slip.any(axis=1)[:, None], onset, high + _STICK_MARGIN)
+        stick = _before(slip, branch) & (share >= low) & (share <= onset - _STICK_MARGIN)
+        enough = np.count_nonzero(stick, axis=1) >= _STICK_SAMPLES
+        sticks.append(np.where(enough[:, None], stick, window))
+    if given:
+        compliance, compliance_se = start, np.zeros(cycles)
+    else:
+        fitted, fitted_se = _compliance(x, q, sticks)
+        enough = np.all([np.count_nonzero(s, axis=1) >= _STICK_SAMPLES for s in sticks], axis=0)
+        measured = enough & np.isfinite(fitted)
+        compliance = np.where(measured, fitted, start)
+        compliance_se = np.where(measured, fitted_se, 0.0)
+    negative = compliance < -3.0 * compliance_se
+    compliance = np.maximum(compliance, 0.0)
+    # Second pass, with the stiffness used and the stick sets.
+    xi = x - compliance[:, None] * q
+    sigma, straight, slips = _stick_and_slip(xi, q, branches, sticks, floor, slip_threshold)
+    mismatch = np.zeros(cycles, dtype=bool)
+    if given:  # a stiffness that does not fit the stick sides tilts them in ξ
+        tilt, _ = _compliance(xi, q, sticks)
+        span = np.max(
+            [
+                np.max(np.where(s, q, -np.inf), axis=1) - np.min(np.where(s, q, np.inf), axis=1)
+                for s in sticks
+            ],
+            axis=0,
+        )
+        judged = np.all([np.count_nonzero(s, axis=1) >= _STICK_SAMPLES for s in sticks], axis=0)
+        mismatch = judged & ~(np.abs(tilt) * span <= _TILT_SPREAD * sigma + floor)
+    forward = _sorted_branch(xi, q, slips[0])
+    backward = _sorted_branch(xi, q, slips[1])
+    ends = []
+    for xs, _, count in (forward, backward):
+        last = np.take_along_axis(xs, np.maximum(count - 1, 0)[:, None], axis=1)[:, 0]
+        ends.append((np.where(count > 0, xs[:, 0], np.nan), np.where(count > 0, last, np.nan)))
+    return {
+        "compliance": compliance,
+        "compliance_se": compliance_se,
+        "mismatch": mismatch,
+        "curved": negative | ~straight,
+        "forward": forward,
+        "backward": backward,
+        "lowest": np.maximum(ends[0][0], ends[1][0]),
+        "highest": np.minimum(ends[0][1], ends[1][1]),
+    }
