@@ -10,6 +10,7 @@ from ecofmaps.figures.measured_figures import (
     cof_evolution,
     measured_and_fitted_loops,
     measured_loops,
+    resolved_loops,
 )
 from ecofmaps.figures.model_figures import (
     dissipated_energy_curves,
@@ -36,6 +37,7 @@ __all__ = [
     "make_figures",
     "measured_and_fitted_loops",
     "measured_loops",
+    "resolved_loops",
     "rigid_and_compliant_loops",
     "save_figure",
     "slip_amplitude_curves",

@@ -10,6 +10,7 @@ from collections.abc import Mapping
 
 import numpy as np
 import xarray as xr
+from matplotlib import colormaps
 from matplotlib.figure import Figure
 
 from ecofmaps.figures.style import (
@@ -21,7 +22,7 @@ from ecofmaps.figures.style import (
     scalar,
 )
 
-__all__ = ["cof_evolution", "measured_and_fitted_loops", "measured_loops"]
+__all__ = ["cof_evolution", "measured_and_fitted_loops", "measured_loops", "resolved_loops"]
 
 
 def _evenly_spread(labels, count: int) -> list:
@@ -246,4 +247,118 @@ def measured_and_fitted_loops(fits) -> Figure:
         )
         ax.legend(loc="best", fontsize="small")
     figure.suptitle("Fig. 10  Measured fretting loops and the fitted model", fontsize="medium")
+    return figure
+
+
+# --- the loops read along the stroke: ecofmaps.resolve_loops --------------------------------
+
+
+def resolved_loops(resolved: xr.Dataset, results: xr.Dataset | None = None, cycles=None) -> Figure:
+    r"""Friction and felt groove read along the stroke, cycle by cycle, and over the test.
+
+    Parameters
+    ----------
+    resolved : xarray.Dataset
+        From :func:`ecofmaps.resolve_loops` (with its ``position`` dimension).
+    results : xarray.Dataset, optional
+        From :func:`ecofmaps.analyze_loops` for the same recording: its ECoF and GICoF are
+        drawn beside the resolved :math:`\mu` for comparison.
+    cycles : sequence of int, optional
+        Cycle numbers drawn along the stroke; by default up to five cycles whose quality is
+        ``'ok'``, spread evenly over the test, the first and the last included.
+
+    Returns
+    -------
+    figure : matplotlib.figure.Figure
+        (a) :math:`\mu(\xi)` against the contact position :math:`\xi` [µm], each cycle's
+        ``mu_resolved`` dashed and the central part it averages shaded; (b) the felt
+        profile :math:`h(\xi)` [µm] with each cycle's equivalent parabola
+        :math:`k\xi^2/2` dotted; (c) :math:`h` over (position, cycle), the groove deepening
+        as the test runs; (d) ``mu_resolved`` :math:`\pm 2` standard errors over the cycles
+        (with the ECoF and GICoF when ``results`` is given) and the equivalent
+        ``aspect_ratio`` on a right-hand axis; cycles with no resolved value are marked
+        along the bottom with their quality.
+
+    Notes
+    -----
+    :math:`\mu(\xi) = \tan((\arctan q_+ - \arctan q_-)/2)` and
+    :math:`g(\xi) = \tan((\arctan q_+ + \arctan q_-)/2)` with :math:`q_\pm = Q_\pm/P` on the
+    two slip branches at the same :math:`\xi = \Delta - Q/S` (eq. 9, 10); the GICoF
+    (eq. 17-18) is :math:`\mu(0)`.
+    """
+    if "position" not in resolved.dims:
+        raise ValueError("resolved holds no positions: call resolve_loops(..., positions=201)")
+    labels = list(resolved["cycle"].values)
+    ok = [label for label, quality in zip(labels, resolved["quality"].values, strict=True)
+          if quality == "ok"]  # fmt: skip
+    chosen = _evenly_spread(ok, 5) if cycles is None else list(cycles)
+    figure = Figure(figsize=(11.0, 8.2), layout="constrained")
+    (stroke, felt), (image, test) = figure.subplots(2, 2)
+    xi = resolved["position"].values * MICRO
+    colors = colormaps["viridis"](np.linspace(0.0, 0.85, max(len(chosen), 1)))
+    central = float(resolved.attrs.get("central", np.nan))
+    for label, color in zip(chosen, colors, strict=False):
+        cycle = resolved.sel(cycle=label)
+        mu = float(cycle["mu_resolved"])
+        stroke.plot(xi, cycle["mu"], color=color, linewidth=1.2, label=f"cycle {label}")
+        stroke.axhline(mu, color=color, linestyle="--", linewidth=0.9)
+        felt.plot(xi, cycle["profile"] * MICRO, color=color, linewidth=1.4, label=f"cycle {label}")
+        k = 2.0 * float(cycle["aspect_ratio"]) / float(cycle["amplitude"])  # z_o/x_o = kΔ*/2
+        felt.plot(xi, 0.5 * k * (xi / MICRO) ** 2 * MICRO, color=color, linestyle=":",
+                  linewidth=1.0)  # fmt: skip
+    if chosen and np.isfinite(central):
+        reach = central * min(
+            -float(resolved.sel(cycle=chosen)["position_min"].max()),
+            float(resolved.sel(cycle=chosen)["position_max"].min()),
+        )
+        stroke.axvspan(-reach * MICRO, reach * MICRO, color="0.9", zorder=0,
+                       label="central part averaged")  # fmt: skip
+    stroke.set_xlabel(axis_label("position"))
+    stroke.set_ylabel(r"Coefficient of friction $\mu(\xi)$ [1]")
+    stroke.set_title(r"(a) $\mu$ along the stroke (dashed: its average)", fontsize="medium")
+    stroke.legend(loc="lower center", fontsize="x-small", ncols=2)
+    felt.plot([], [], color="0.4", linestyle=":", label=r"equivalent parabola $k\xi^2/2$")
+    felt.set_xlabel(axis_label("position"))
+    felt.set_ylabel(r"Felt groove profile $h(\xi)$ [µm]")
+    felt.set_title("(b) the scar as the contact feels it", fontsize="medium")
+    felt.legend(loc="upper center", fontsize="x-small", ncols=2)
+    for ax in (stroke, felt, test):
+        ax.grid(alpha=0.3)
+    profile = resolved["profile"].transpose("cycle", "position").values * MICRO
+    mesh = image.pcolormesh(xi, np.arange(len(labels)), profile, shading="nearest",
+                            cmap="cividis")  # fmt: skip
+    ticks = np.unique(np.linspace(0, len(labels) - 1, min(len(labels), 6)).round().astype(int))
+    image.set_yticks(ticks, [str(labels[i]) for i in ticks])
+    image.set_xlabel(axis_label("position"))
+    image.set_ylabel("Cycle")
+    image.set_title("(c) felt profile over the test", fontsize="medium")
+    figure.colorbar(mesh, ax=image, label=r"$h(\xi)$ [µm]")
+    number = resolved["cycle"].values
+    mu = resolved["mu_resolved"].values
+    error = 2.0 * resolved["mu_resolved_se"].values
+    test.fill_between(number, mu - error, mu + error, color="tab:green", alpha=0.25,
+                      label=r"$\pm$2 standard errors")  # fmt: skip
+    test.plot(number, mu, color="tab:green", linewidth=1.4, label=r"$\mu$ read along the stroke")
+    if results is not None:
+        test.plot(number, results["ecof"], color="tab:orange", linewidth=1.0,
+                  label=r"ECoF $\mu_E$")  # fmt: skip
+        test.plot(number, results["gicof"], color="tab:blue", linewidth=1.0, label="GICoF")
+    missing = resolved["quality"].values != "ok"
+    if missing.any():
+        bottom = np.nanmin(mu - error) if np.isfinite(mu).any() else 0.0
+        test.plot(number[missing], np.full(missing.sum(), bottom), "x", color="crimson",
+                  label="no resolved value: " + ", ".join(
+                      sorted(set(resolved["quality"].values[missing]))))  # fmt: skip
+    test.set_xlabel("Cycle")
+    test.set_ylabel("Coefficient of friction [1]")
+    ratio = test.twinx()
+    ratio.plot(number, resolved["aspect_ratio"], color="0.3", linestyle="--", linewidth=1.0)
+    ratio.set_ylabel(axis_label("aspect_ratio") + " (dashed)")
+    test.set_title(r"(d) $\mu$ over the test, and the equivalent groove", fontsize="medium")
+    test.legend(loc="best", fontsize="x-small")
+    figure.suptitle(
+        rf"Loops read along the stroke (P = {scalar(resolved, 'load'):g} N): "
+        r"$\mu(\xi)$ and $g(\xi)$ from the two slip branches at the same $\xi = \Delta - Q/S$",
+        fontsize="medium",
+    )
     return figure

@@ -469,6 +469,7 @@ def resolve_analyzed_loops(
         per_cycle["position_offset"] = (
             loops["displacement_offset"].values - removed / per_cycle["stiffness"]
         )
+        per_cycle["amplitude"] = loops["amplitude"].values  # the x_o of aspect_ratio
     dims = ("cycle", "position")
     data = {name: (dims, value, _attrs(name)) for name, value in per_position.items()}
     for name, value in per_cycle.items():
@@ -559,7 +560,8 @@ def resolve_loops(
         ``cycle``: ``mu_resolved``, ``mu_resolved_se``, ``aspect_ratio``, ``tilt``
         (:math:`g_0`), ``stiffness`` (the one used) [N/m], ``position_offset`` (where
         :math:`\xi = 0` lies in the recording's contact position), ``position_min``,
-        ``position_max`` [m] and ``quality`` (``'ok'`` or the reason the values are NaN).
+        ``position_max`` [m], ``amplitude`` (:math:`\Delta^*`, the :math:`x_o` of
+        ``aspect_ratio``) [m] and ``quality`` (``'ok'`` or the reason the values are NaN).
         With the force centred (``force_offset=None``), ``slope`` and ``profile`` are
         levelled (``tilt`` taken off). The ``position``
         coordinate is :math:`\xi` [m], common to all cycles; the load is a scalar

@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from ecofmaps.figures import cof_evolution, measured_loops, save_figure
+from ecofmaps.figures import cof_evolution, measured_loops, resolved_loops, save_figure
 from ecofmaps.measured.analysis import analyze_loops
+from ecofmaps.measured.resolved import resolve_analyzed_loops
 from ecofmaps.measured.synthetic import synthetic_recording
 
 LOAD = 450.0
@@ -70,3 +71,35 @@ def test_cof_evolution(results):
 def test_measured_loops_needs_the_loops(results):
     with pytest.raises(ValueError, match="keep_loops=True"):
         measured_loops(results.drop_vars(["loop_displacement", "loop_force"]))
+
+
+def test_resolved_loops_draws_the_datasets_numbers(results, tmp_path):
+    """μ(ξ) and h(ξ) of chosen cycles in µm, h over (position, cycle), μ over the test."""
+    resolved = resolve_analyzed_loops(results)
+    figure = resolved_loops(resolved, results)
+    stroke, felt, image, test = figure.axes[:4]  # then the colour bar and the twin axis
+    last = resolved.where(resolved.quality == "ok", drop=True).isel(cycle=-1)
+    name = f"cycle {last.cycle.item()}"
+    (mu,) = [line for line in stroke.get_lines() if line.get_label() == name]
+    np.testing.assert_allclose(mu.get_xdata(), resolved.position * 1e6)
+    np.testing.assert_allclose(mu.get_ydata(), last.mu)
+    (profile,) = [line for line in felt.get_lines() if line.get_label() == name]
+    np.testing.assert_allclose(profile.get_ydata(), last.profile * 1e6)
+    assert "[µm]" in stroke.get_xlabel() and "[µm]" in felt.get_ylabel()
+    assert image.get_ylabel() == "Cycle"
+    series = {line.get_label(): line for line in test.get_lines()}
+    np.testing.assert_allclose(series["GICoF"].get_ydata(), results.gicof)
+    np.testing.assert_allclose(series[r"$\mu$ read along the stroke"].get_ydata(),
+                               resolved.mu_resolved)  # fmt: skip
+    save_figure(figure, tmp_path / "resolved.png")
+
+
+def test_resolved_loops_marks_cycles_without_a_value(results):
+    partial = results.copy()
+    partial["regime"] = partial["regime"].copy(data=np.where(
+        np.arange(partial.cycle.size) == 2, "partial slip", partial["regime"].values))  # fmt: skip
+    resolved = resolve_analyzed_loops(partial)
+    test = resolved_loops(resolved).axes[3]
+    (marks,) = [line for line in test.get_lines() if "no resolved value" in line.get_label()]
+    assert "not-gross-slip" in marks.get_label()
+    assert 3 in marks.get_xdata()  # the third cycle's number
