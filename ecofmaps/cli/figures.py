@@ -26,7 +26,7 @@ def figure_formats(text: str) -> tuple[str, ...]:
 
 
 def add(subparsers) -> None:
-    from ecofmaps.figures import FIGURES
+    from ecofmaps.figures.recipes import FIGURES
 
     listing = "\n".join(f"  {name:<10} {recipe.description}" for name, recipe in FIGURES.items())
     parser = subparsers.add_parser(

@@ -11,7 +11,6 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps.cli._common import CommandError, quantities, quantity
-from ecofmaps.model import Regime
 
 __all__ = ["add", "run"]
 
@@ -81,6 +80,7 @@ def add(subparsers) -> None:
 def run(args) -> int:
     from ecofmaps.maps.cache import write_netcdf
     from ecofmaps.maps.grid import compute_map
+    from ecofmaps.model import Regime
 
     out = Path(args.out)
     if not out.parent.is_dir():

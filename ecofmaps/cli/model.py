@@ -4,11 +4,10 @@ from __future__ import annotations
 
 import warnings
 
-from ecofmaps import model, paper
+from ecofmaps import paper
 from ecofmaps._codes import RegimeWarning
 from ecofmaps._version import __version__
 from ecofmaps.cli._common import print_rows, quantity, row
-from ecofmaps.model import Regime
 
 __all__ = ["add", "run"]
 
@@ -52,6 +51,9 @@ def add(subparsers) -> None:
 
 
 def run(args) -> int:
+    from ecofmaps import model
+    from ecofmaps.model import Regime
+
     point = dict(
         amplitude=args.amplitude,
         load=args.load,

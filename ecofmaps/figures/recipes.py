@@ -11,24 +11,18 @@ The paper's parameters (Section 3): :math:`\Delta^* = x_o = 50` µm, :math:`P = 
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
-from matplotlib.figure import Figure
 
 from ecofmaps import paper
-from ecofmaps.figures.model_figures import (
-    dissipated_energy_curves,
-    ecof_ratio_contours,
-    ecof_ratio_curves,
-    loops_by_aspect_ratio,
-    rigid_and_compliant_loops,
-    slip_amplitude_curves,
-    universal_ecof_ratio_map,
-)
-from ecofmaps.maps.grid import compute_loops, compute_map, compute_universal_map
+
+if TYPE_CHECKING:  # imported when a figure is made: the registry reads without them
+    import xarray as xr
+    from matplotlib.figure import Figure
 
 __all__ = [
     "ASPECT_RATIOS",
@@ -60,8 +54,9 @@ class FigureRecipe:
     data : callable
         ``data() -> xarray.Dataset``, built through the cached map functions. Recipes that
         share a ``data`` function share its Dataset (see :func:`make_figures`).
-    draw : callable
-        ``draw(dataset, **options) -> matplotlib.figure.Figure``.
+    draw : str
+        The drawing function, ``draw(dataset, **options) -> matplotlib.figure.Figure``, by
+        its name in :mod:`ecofmaps.figures.model_figures` (imported when a figure is made).
     selection : dict
         Coordinate values picked from the Dataset with ``.sel`` before drawing.
     options : dict
@@ -71,7 +66,7 @@ class FigureRecipe:
     name: str
     description: str
     data: Callable[[], xr.Dataset]
-    draw: Callable[..., Figure]
+    draw: str
     selection: dict = field(default_factory=dict)
     options: dict = field(default_factory=dict)
 
@@ -81,11 +76,14 @@ class FigureRecipe:
 
     def figure(self, dataset: xr.Dataset) -> Figure:
         """The figure, drawn from ``dataset`` (the Dataset of :attr:`data`, before selection)."""
-        return self.draw(dataset.sel(self.selection), **self.options)
+        draw = getattr(importlib.import_module("ecofmaps.figures.model_figures"), self.draw)
+        return draw(dataset.sel(self.selection), **self.options)
 
 
 def _loops() -> xr.Dataset:
     """The loops of Figures 5 and 6: rigid and 35 MN/m rigs, z_o/x_o = 0, 0.1, 0.2, 0.3."""
+    from ecofmaps.maps.grid import compute_loops
+
     return compute_loops(
         stiffness=np.array([np.inf, paper.STIFFNESS]),
         aspect_ratio=np.array([0.0, 0.1, 0.2, 0.3]),
@@ -96,6 +94,8 @@ def _loops() -> xr.Dataset:
 
 
 def _stiffness_curves_data() -> xr.Dataset:
+    from ecofmaps.maps.grid import compute_map
+
     return compute_map(
         stiffness_ratio=np.array(paper.FIGURE_7_STIFFNESSES) / paper.LOAD,
         aspect_ratio=ASPECT_RATIOS,
@@ -109,6 +109,8 @@ def _ecof_ratio_map(panel: str) -> Callable[[], xr.Dataset]:
     amplitude = paper.FIGURE_11_AMPLITUDES[panel]
 
     def data() -> xr.Dataset:
+        from ecofmaps.maps.grid import compute_map
+
         return compute_map(paper.FIGURE_11_STIFFNESS_RATIOS, ASPECT_RATIOS, amplitude, paper.MU)
 
     data.__name__ = f"_ecof_ratio_map_{panel}"
@@ -116,6 +118,8 @@ def _ecof_ratio_map(panel: str) -> Callable[[], xr.Dataset]:
 
 
 def _universal_map() -> xr.Dataset:
+    from ecofmaps.maps.grid import compute_universal_map
+
     return compute_universal_map(COMPLIANCE_RATIOS, ASPECT_RATIOS, paper.MU)
 
 
@@ -128,54 +132,54 @@ FIGURES: dict[str, FigureRecipe] = {
             "fig5",
             "loop of a rigid rig against S = 35 MN/m, z_o/x_o = 0.2",
             _loops,
-            rigid_and_compliant_loops,
+            "rigid_and_compliant_loops",
             {"aspect_ratio": paper.ASPECT_RATIO},
         ),
         FigureRecipe(
             "fig6",
             "loops for z_o/x_o = 0, 0.1, 0.2, 0.3 at S = 35 MN/m, with Q = SΔ",
             _loops,
-            loops_by_aspect_ratio,
+            "loops_by_aspect_ratio",
             {"stiffness": paper.STIFFNESS},
         ),
         FigureRecipe(
             "fig7a",
             "slip amplitude against z_o/x_o for S = 20, 35, 50, 100 MN/m and rigid",
             _stiffness_curves_data,
-            slip_amplitude_curves,
+            "slip_amplitude_curves",
         ),
         FigureRecipe(
             "fig7b",
             "dissipated energy against z_o/x_o for S = 20, 35, 50, 100 MN/m and rigid",
             _stiffness_curves_data,
-            dissipated_energy_curves,
+            "dissipated_energy_curves",
         ),
         FigureRecipe(
             "fig8",
             "μ_E/μ against z_o/x_o for S = 20, 35, 50, 100 MN/m and rigid, Example 2 marked",
             _stiffness_curves_data,
-            ecof_ratio_curves,
+            "ecof_ratio_curves",
             options={"markers": _EXAMPLE_2},
         ),
         FigureRecipe(
             "fig11a",
             "contours of μ_E/μ over S/P and z_o/x_o at Δ* = 25 µm",
             _ecof_ratio_map("11a"),
-            ecof_ratio_contours,
+            "ecof_ratio_contours",
             options={"number": "11a"},
         ),
         FigureRecipe(
             "fig11b",
             "contours of μ_E/μ over S/P and z_o/x_o at Δ* = 50 µm, Example 2 marked",
             _ecof_ratio_map("11b"),
-            ecof_ratio_contours,
+            "ecof_ratio_contours",
             options={"number": "11b", "markers": _EXAMPLE_2},
         ),
         FigureRecipe(
             "universal",
             "μ_E/μ over λ = P/(SΔ*) and z_o/x_o: Fig. 11a and 11b in one chart",
             _universal_map,
-            universal_ecof_ratio_map,
+            "universal_ecof_ratio_map",
             options={
                 "markers": paper.FIGURE_10_FITS,
                 "windows": {

@@ -376,10 +376,13 @@ def test_command_reports_an_unusable_directory(tmp_path, capsys):
 
 
 def test_figures_are_loaded_on_first_use_only():
-    # `import ecofmaps` does not pay for matplotlib; `ecofmaps.figures` loads it when used.
+    # `import ecofmaps` pays for neither JAX nor matplotlib; the registry of figures reads
+    # without them (so `ecofmaps --help` is quick); drawing loads them.
     code = (
         "import sys, ecofmaps\n"
         "assert 'matplotlib' not in sys.modules, 'import ecofmaps pulled in matplotlib'\n"
-        "assert 'fig11b' in ecofmaps.figures.FIGURES and 'matplotlib' in sys.modules\n"
+        "assert 'fig11b' in ecofmaps.figures.FIGURES\n"
+        "assert 'matplotlib' not in sys.modules and 'jax' not in sys.modules\n"
+        "assert callable(ecofmaps.figures.save_figure) and 'matplotlib' in sys.modules\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
