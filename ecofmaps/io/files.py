@@ -9,12 +9,14 @@ sees a half-written file and a failed write leaves an existing file as it was.
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import re
+import shutil
 import uuid
 from pathlib import Path
 
-__all__ = ["TEMPORARY_NAME", "FileLineError", "atomic_path"]
+__all__ = ["TEMPORARY_NAME", "FileLineError", "atomic_path", "atomic_store"]
 
 #: Names of the temporary files :func:`atomic_path` writes (left behind only by a crash).
 TEMPORARY_NAME = re.compile(r"^\..+\.[0-9a-f]{32}\.tmp$")
@@ -45,6 +47,84 @@ def atomic_path(path):
         os.replace(temporary, path)
     except BaseException:
         temporary.unlink(missing_ok=True)
+        raise
+
+
+def _temporary(path: Path) -> Path:
+    return path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
+
+
+def _remove(path: Path) -> None:
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path, ignore_errors=True)
+    else:
+        path.unlink(missing_ok=True)
+
+
+def _sync(path: Path) -> None:
+    """Flush a file, or every file and folder of a directory, to disk."""
+    paths = [path]
+    if path.is_dir():
+        for folder, _, names in os.walk(path):
+            paths += [Path(folder)] + [Path(folder) / name for name in names]
+    for item in paths:
+        descriptor = os.open(item, os.O_RDONLY)
+        try:
+            os.fsync(descriptor)
+        finally:
+            os.close(descriptor)
+
+
+@contextlib.contextmanager
+def atomic_store(path, *, overwrite: bool = False):
+    """A temporary path to write a file or a directory store (zarr) at, moved onto ``path``
+    when the block succeeds.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file or directory to create; its directory must exist.
+    overwrite : bool
+        Replace an existing ``path``; otherwise an existing one is an error, raised before
+        anything is written.
+
+    Yields
+    ------
+    temporary : pathlib.Path
+        ``.<name>.<32 hex digits>.tmp`` beside ``path``, not yet existing: create the file or
+        directory there. On success it is flushed to disk and renamed to ``path`` (an old
+        ``path`` is moved aside first and removed after); if the block raises (or is
+        interrupted), it is removed and ``path`` is left as it was. A crash leaves only a
+        hidden ``.tmp`` name (:data:`TEMPORARY_NAME`), never a store under ``path``.
+
+    Raises
+    ------
+    FileExistsError
+        If ``path`` exists and ``overwrite`` is false.
+    """
+    path = Path(path)
+    if os.path.lexists(path) and not overwrite:
+        message = "exists already (overwrite=True replaces it)"
+        raise FileExistsError(errno.EEXIST, message, str(path))
+    temporary = _temporary(path)
+    try:
+        yield temporary
+        _sync(temporary)
+        if temporary.is_dir() or path.is_dir():
+            old = _temporary(path)
+            if os.path.lexists(path):
+                os.replace(path, old)
+            try:
+                os.replace(temporary, path)
+            except BaseException:
+                if os.path.lexists(old):
+                    os.replace(old, path)
+                raise
+            _remove(old)
+        else:
+            os.replace(temporary, path)
+    except BaseException:
+        _remove(temporary)
         raise
 
 
