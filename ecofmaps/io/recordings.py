@@ -136,16 +136,18 @@ class _LineIndex:
     def build(cls, blocks, first: int = 0) -> _LineIndex:
         """From the line numbers of consecutive blocks of samples, the first being sample
         ``first`` of the file."""
-        starts, offsets, sample = [], [], first
+        starts, offsets, sample, last = [], [], first, None
         for numbers in blocks:
+            if numbers.size == 0:
+                continue
             offset = numbers - np.arange(sample, sample + numbers.size)
-            change = np.flatnonzero(np.diff(offset)) + 1
-            first = np.concatenate([[0], change])
-            if offsets and offsets[-1][-1] == offset[0]:
-                first = first[1:]
-            starts.append(first + sample)
-            offsets.append(offset[first])
+            runs = np.concatenate([[0], np.flatnonzero(np.diff(offset)) + 1])
+            if last == offset[0]:
+                runs = runs[1:]
+            starts.append(runs + sample)
+            offsets.append(offset[runs])
             sample += numbers.size
+            last = offset[-1]
         return cls(
             np.concatenate(starts or [np.zeros(0, np.int64)]).astype(np.int64),
             np.concatenate(offsets or [np.zeros(0, np.int64)]).astype(np.int64),

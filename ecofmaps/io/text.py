@@ -249,7 +249,7 @@ class _Layout:
                 decimal=self.decimal or ".",
                 quotechar='"',
                 keep_default_na=False,
-                na_values=list(MISSING),
+                na_values=["", *MISSING],
                 skip_blank_lines=False,
                 skipinitialspace=True,
                 lineterminator="\n",
@@ -276,20 +276,23 @@ class _Layout:
                     numbers[first],
                     f"non-numeric value {column.iloc[first]!r} in column {name!r}",
                 )
-            data = column.to_numpy(dtype=np.float64)
-            missing = ~np.isfinite(data)
-            if missing.any():
-                if self.nan_policy == "raise":
-                    first = int(np.argmax(missing))
-                    lines = body.split("\n") if lines is None else lines
-                    cell = _fields(lines[first], self.separator)[index]
-                    what = "non-finite" if np.isinf(data[first]) else "missing"
-                    raise RecordingError(
-                        self.path, numbers[first], f"{what} value {cell!r} in column {name!r}"
-                    )
-                data = np.where(missing, np.nan, data)
-            values[role] = _to_si(data, self.scales[role])
-        return values
+            values[role] = column.to_numpy(dtype=np.float64)
+        missing = {role: ~np.isfinite(data) for role, data in values.items()}
+        if self.nan_policy == "raise" and any(bad.any() for bad in missing.values()):
+            first, role = min(
+                (int(np.argmax(bad)), role) for role, bad in missing.items() if bad.any()
+            )
+            index = self.columns[role]
+            lines = body.split("\n") if lines is None else lines
+            cell = _fields(lines[first], self.separator)[index]
+            what = "non-finite" if np.isinf(values[role][first]) else "missing"
+            raise RecordingError(
+                self.path, numbers[first], f"{what} value {cell!r} in column {self.names[index]!r}"
+            )
+        return {
+            role: _to_si(np.where(missing[role], np.nan, data), self.scales[role])
+            for role, data in values.items()
+        }
 
 
 def _to_si(values: np.ndarray, factor: float) -> np.ndarray:
