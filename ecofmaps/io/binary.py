@@ -19,6 +19,7 @@ chunk files (which zarr would silently read as the fill value) from its chunk co
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import logging
 import threading
@@ -335,6 +336,10 @@ class Column:
                 root = _open_zarr(self.path)
                 self._handle = (root, _zarr_array(root, self.variable))
         return self._handle[1]
+
+    def __del__(self):
+        with contextlib.suppress(Exception):
+            self.close()
 
     def close(self) -> None:
         """Close the file (it is opened again on the next read)."""

@@ -18,6 +18,7 @@ from __future__ import annotations
 import contextlib
 import itertools
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -263,6 +264,14 @@ class RecordingWriter:
     def _finish(self) -> None:
         if self.format == "tdms" and self._segments == 0:
             self._append_tdms({role: np.zeros(0) for role in self.roles})
+        if self.format == "zarr":
+            import zarr
+
+            # Consolidated metadata lets xarray open the store without a warning; zarr
+            # notes that it is not yet part of the format-3 specification.
+            with warnings.catch_warnings():
+                warnings.filterwarnings("ignore", "Consolidated metadata", UserWarning)
+                zarr.consolidate_metadata(str(self._temporary))
 
 
 def _tdms_value(value):
