@@ -19,7 +19,6 @@ chunk files (which zarr would silently read as the fill value) from its chunk co
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import logging
 import threading
@@ -338,8 +337,10 @@ class Column:
         return self._handle[1]
 
     def __del__(self):
-        with contextlib.suppress(Exception):
+        try:  # noqa: SIM105 - contextlib may be gone at interpreter shutdown
             self.close()
+        except Exception:
+            pass
 
     def close(self) -> None:
         """Close the file (it is opened again on the next read)."""
