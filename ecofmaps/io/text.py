@@ -46,8 +46,6 @@ BLOCK_BYTES = 1 << 24
 #: Cell contents read as a missing sample (besides an empty cell and infinite values).
 MISSING = ("nan", "NaN", "NAN", "-nan", "-NaN", "NA", "N/A", "n/a", "#N/A", "null", "NULL", "None")
 
-_BLANK_LINE = re.compile(r"^[ \t\r]*$", re.MULTILINE)
-_COMMENT_LINE = re.compile(r"^[ \t]*#", re.MULTILINE)
 _COMMA_DECIMAL = re.compile(r"(?:^|[;\t \"])[+-]?\d*,\d+(?:[eE][+-]?\d+)?(?=$|[;\t \"])", re.M)
 _POINT_DECIMAL = re.compile(r"\d\.\d|(?:^|[;\t \"])[+-]?\.\d", re.MULTILINE)
 _NUMBER = re.compile(r"^[+-]?(?:\d+[.,]?\d*|[.,]\d+)(?:[eE][+-]?\d+)?$")
@@ -223,24 +221,42 @@ class _Layout:
                     self.path, number, f"{count} fields where the header has {self.width}"
                 )
 
-    def parse(self, lines: list[str] | None, body: str, numbers: np.ndarray) -> dict:
-        """The wanted columns of the data lines ``body`` (``lines`` if already split), in SI."""
+    def data_lines(self, lines: list[str]) -> list[int]:
+        """The indices of the lines that hold data: not blank (blanks other than the
+        separator), not a ``#`` comment."""
+        blanks = " \r" if self.separator == "\t" else " \t\r"
+        return [
+            k for k, line in enumerate(lines) if (text := line.strip(blanks)) and text[0] != "#"
+        ]
+
+    def parse(self, body, numbers: np.ndarray, lines: list[str] | None = None):
+        """The wanted columns of the data lines ``body``, in SI, by role.
+
+        Without ``lines``, ``body`` is a block as read (UTF-8 bytes, or text), and the
+        result is None if anything is amiss (a line with the wrong number of cells or
+        blank, a cell that is not a number, a missing sample to raise for, a byte that is
+        not UTF-8), for the caller to drop blank and comment lines and call again with the
+        text ``lines`` kept, which are then checked one by one and the error raised."""
         from ecofmaps.io.recordings import RecordingError
 
+        careful = lines is not None
+        raw = isinstance(body, bytes)
         if self.decimal is None:
-            self.decide_decimal(body)
+            self.decide_decimal(body.decode("utf-8", errors="replace") if raw else body)
         count = numbers.size
+        separator = self.separator.encode() if raw and self.separator else self.separator
         counted = (
-            body.count(self.separator) == count * (self.width - 1)
-            if self.separator is not None
+            body.count(separator) == count * (self.width - 1)
+            if separator is not None
             else len(body.split()) == count * self.width
         )
         if not counted:  # a line with too few or too many cells, or separators in quotes
-            lines = body.split("\n") if lines is None else lines
+            if not careful:
+                return None
             self.field_error(lines, numbers)
         try:
             frame = pd.read_csv(
-                io.StringIO(body),
+                io.BytesIO(body) if raw else io.StringIO(body),
                 sep=self.separator or r"\s+",
                 header=None,
                 names=list(range(self.width)),
@@ -252,20 +268,26 @@ class _Layout:
                 na_values=["", *MISSING],
                 skip_blank_lines=False,
                 skipinitialspace=True,
-                lineterminator="\n",
+                lineterminator=None if raw else "\n",
+                encoding="utf-8" if raw else None,
                 **_EXACT,
             )
-        except pd.errors.ParserError as error:
-            lines = body.split("\n") if lines is None else lines
+        except (pd.errors.ParserError, UnicodeDecodeError) as error:
+            if not careful:
+                return None
             self.field_error(lines, numbers)
             raise RecordingError(self.path, numbers[0], f"cannot parse: {error}") from None
-        if len(frame) != count:  # a quoted line end
+        if len(frame) != count:  # a quoted line end, or a lone carriage return
+            if not careful:
+                return None
             raise RecordingError(self.path, numbers[0], "a quoted cell spans lines")
         values = {}
         for role, index in self.columns.items():
             column = frame[index]
             name = self.names[index]
             if not pd.api.types.is_numeric_dtype(column.dtype):
+                if not careful:
+                    return None
                 cells = column.astype(object).where(column.notna(), None)
                 if self.decimal == ",":
                     cells = cells.str.replace(",", ".", regex=False)
@@ -279,11 +301,12 @@ class _Layout:
             values[role] = column.to_numpy(dtype=np.float64)
         missing = {role: ~np.isfinite(data) for role, data in values.items()}
         if self.nan_policy == "raise" and any(bad.any() for bad in missing.values()):
+            if not careful:
+                return None
             first, role = min(
                 (int(np.argmax(bad)), role) for role, bad in missing.items() if bad.any()
             )
             index = self.columns[role]
-            lines = body.split("\n") if lines is None else lines
             cell = _fields(lines[first], self.separator)[index]
             what = "non-finite" if np.isinf(values[role][first]) else "missing"
             raise RecordingError(
@@ -338,37 +361,40 @@ def text_blocks(path: Path, options: dict, block_bytes: int = BLOCK_BYTES):
     line = 1  # number of the first line of the block
     with _open_text(path) as stream:
         for raw in _raw_blocks(stream, block_bytes):
-            text = decoder(raw, line)
+            start = line
+            line += raw.count(b"\n") + (not raw.endswith(b"\n"))
+            if layout is not None and decoder.encoding == "utf-8" and b"#" not in raw:
+                # Most blocks hold data lines only: parsed from the bytes as they are.
+                numbers = start + np.arange(line - start, dtype=np.int64)
+                values = layout.parse(raw[:-1] if raw.endswith(b"\n") else raw, numbers)
+                if values is not None:
+                    yield values, numbers
+                    continue
+            # The header, comments, blank lines, or something amiss: line by line.
+            text = decoder(raw, start)
             if "\r" in text:
                 text = text.replace("\r\n", "\n")
-            body = text[:-1] if text.endswith("\n") else text
-            lines_in_block = raw.count(b"\n") + (not raw.endswith(b"\n"))
-            start = line
-            line += lines_in_block
+            lines = (text[:-1] if text.endswith("\n") else text).split("\n")
             if layout is None:
-                lines = body.split("\n")
                 header = next((k for k, text in enumerate(lines) if _is_data(text)), None)
                 if header is None:
                     continue
                 layout = _Layout(path, start + header, lines[header], options)
                 yield layout
-                lines = lines[header + 1 :]
                 start += header + 1
+                lines = lines[header + 1 :]
                 body = "\n".join(lines)
-            else:
-                lines = None
-            if _BLANK_LINE.search(body) or _COMMENT_LINE.search(body):
-                lines = body.split("\n") if lines is None else lines
-                kept = [k for k, text in enumerate(lines) if _is_data(text)]
-                if not kept:
-                    continue
-                numbers = start + np.asarray(kept, dtype=np.int64)
-                lines = [lines[k] for k in kept]
-                body = "\n".join(lines)
-            elif not body:
+                if lines and "#" not in body:  # the rest of the first block, as it is
+                    numbers = start + np.arange(len(lines), dtype=np.int64)
+                    values = layout.parse(body, numbers)
+                    if values is not None:
+                        yield values, numbers
+                        continue
+            kept = layout.data_lines(lines)
+            if not kept:
                 continue
-            else:
-                numbers = start + np.arange(body.count("\n") + 1, dtype=np.int64)
-            yield layout.parse(lines, body, numbers), numbers
+            numbers = start + np.asarray(kept, dtype=np.int64)
+            lines = [lines[k] for k in kept]
+            yield layout.parse("\n".join(lines), numbers, lines=lines), numbers
     if layout is None:
         raise RecordingError(path, max(line - 1, 1), "no header line and no data")

@@ -50,6 +50,12 @@ def load_average() -> str:
 
 
 def _peak_mb() -> float:
+    """Peak resident memory of this process [MB]: VmHWM, which starts afresh at exec
+    (ru_maxrss does not: a child would report its parent's peak)."""
+    with open("/proc/self/status") as status:
+        for line in status:
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1024.0
     import resource
 
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0

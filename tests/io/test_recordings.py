@@ -3,6 +3,8 @@
 import numpy as np
 import pandas as pd
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from ecofmaps.io.recordings import (
     RecordingError,
@@ -349,3 +351,42 @@ def test_lazy_text_and_slices(tmp_path, recording):
     assert part.line(0) == 153 and part.last_line == 162
     np.testing.assert_array_equal(part.force, read.compute().force[150:160])
     assert not read.missing.compute().any()
+
+
+FINITE = st.floats(allow_nan=False, allow_infinity=False, width=64)
+
+
+@given(
+    values=st.lists(st.tuples(FINITE, FINITE), min_size=1, max_size=40),
+    separator=st.sampled_from([",", ";", "\t", " "]),
+    comma=st.booleans(),
+    quoted=st.booleans(),
+    newline=st.sampled_from(["\n", "\r\n"]),
+    notes=st.sets(st.integers(0, 40), max_size=5),
+    block_bytes=st.integers(1, 300),
+)
+@settings(suppress_health_check=[HealthCheck.function_scoped_fixture])
+def test_text_round_trip(tmp_path, values, separator, comma, quoted, newline, notes, block_bytes):
+    """Any float64 written as repr, in any of the styles labs' files come in (decimal comma
+    when the separator allows it, quotes, CRLF, comment lines anywhere), reads back bit for
+    bit, each sample with its line, whatever the block size."""
+    comma = comma and separator != ","
+    quote = '"' if quoted and separator != " " else ""
+
+    def cell(value):
+        text = repr(value).replace(".", ",") if comma else repr(value)
+        return f"{quote}{text}{quote}"
+
+    lines, numbers = [f"displacement [m]{separator}force [N]"], []
+    for k, (d, f) in enumerate(values):
+        if k in notes:
+            lines.append("# a note, with: separators; inside")
+        lines.append(f"{cell(d)}{separator}{cell(f)}")
+        numbers.append(len(lines))
+    path = tmp_path / "round.csv"
+    path.write_bytes(newline.join(lines).encode() + newline.encode())
+    read = read_recording(path, _block_bytes=block_bytes)
+    displacement, force = (np.array(column) for column in zip(*values, strict=True))
+    np.testing.assert_array_equal(read.displacement.view(np.int64), displacement.view(np.int64))
+    np.testing.assert_array_equal(read.force.view(np.int64), force.view(np.int64))
+    np.testing.assert_array_equal(read.line(np.arange(read.size)), numbers)
