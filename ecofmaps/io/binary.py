@@ -370,7 +370,7 @@ class Column:
             raise RecordingError(
                 self.path, where, f"read {raw.size} samples where {stop - start} were expected"
             )
-        values = raw.astype(np.float64)
+        values = raw.astype(np.float64, copy=not raw.flags.writeable)  # a copy, or the new array
         if self.variable.packing is not None:
             scale, offset, fills = self.variable.packing
             for fill in fills:
