@@ -48,6 +48,8 @@ class Variable:
         Its full name, ``group/name`` (``Rig/Force``), or ``name`` at the root.
     group : str
         The group path (``''`` for the root).
+    short : str
+        Its own name, without the group (a TDMS channel's may hold a ``/``).
     size : int
         Number of samples.
     units : tuple of str
@@ -60,15 +62,11 @@ class Variable:
 
     name: str
     group: str
+    short: str
     size: int
     units: tuple = ()
     chunk: int = 0
     packing: tuple | None = None
-
-    @property
-    def short(self) -> str:
-        """The name without its group."""
-        return self.name.rsplit("/", 1)[-1]
 
 
 def _text(value) -> str | None:
@@ -148,6 +146,7 @@ def _tdms_variables(path: Path) -> list[Variable]:
             Variable(
                 name=f"{group.name}/{channel.name}",
                 group=group.name,
+                short=channel.name,
                 size=len(channel),
                 units=_units(channel.properties),
             )
@@ -182,11 +181,12 @@ def _hdf5_variables(path: Path) -> list[Variable]:
             return
         if "not a netCDF variable" in str(_text(item.attrs.get("NAME", b"")) or ""):
             return  # a netCDF dimension without values
-        group = name.rpartition("/")[0]
+        group, _, short = name.rpartition("/")
         found.append(
             Variable(
                 name=name,
                 group=group,
+                short=short,
                 size=int(item.shape[0]),
                 units=_units(item.attrs),
                 chunk=int(item.chunks[0]) if item.chunks else 0,
@@ -224,10 +224,12 @@ def _zarr_variables(path: Path) -> list[Variable]:
         if not np.issubdtype(item.dtype, np.number):
             continue
         name = name or path.stem
+        group, _, short = name.rpartition("/")
         found.append(
             Variable(
                 name=name,
-                group=name.rpartition("/")[0],
+                group=group,
+                short=short,
                 size=int(item.shape[0]),
                 units=_units(item.attrs),
                 chunk=int(item.chunks[0]),
@@ -325,9 +327,8 @@ class Column:
         """The open channel or dataset (opened on first use in this process)."""
         if self._handle is None:
             if self.kind == "tdms":
-                group, _, channel = self.variable.name.partition("/")
                 handle = _open_tdms(self.path)
-                self._handle = (handle, handle[group][channel])
+                self._handle = (handle, handle[self.variable.group][self.variable.short])
             elif self.kind == "hdf5":
                 handle = _open_hdf5(self.path)
                 self._handle = (handle, handle[self.variable.name])
@@ -412,6 +413,11 @@ def _select(path: Path, kind: str, found: list[Variable], options: dict) -> dict
     for role, name in wanted.items():
         full = [k for k, v in enumerate(found) if v.name.strip("/").lower() == name.lower()]
         matches = full or matching_columns([v.short for v in found], name)
+        if role != "displacement" and len(matches) != 1 and "displacement" in chosen:
+            # The force and cycle channels are sought in the displacement's group first.
+            group = chosen["displacement"].group
+            beside = [k for k in matches if found[k].group == group]
+            matches = beside if len(beside) == 1 or not required[role] else matches
         if len(matches) > 1:
             names = ", ".join(repr(found[k].name) for k in matches)
             raise RecordingError(

@@ -29,6 +29,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import itertools
+import numbers
 from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
@@ -137,16 +138,16 @@ class _LineIndex:
         """From the line numbers of consecutive blocks of samples, the first being sample
         ``first`` of the file."""
         starts, offsets, sample, last = [], [], first, None
-        for numbers in blocks:
-            if numbers.size == 0:
+        for lines in blocks:
+            if lines.size == 0:
                 continue
-            offset = numbers - np.arange(sample, sample + numbers.size)
+            offset = lines - np.arange(sample, sample + lines.size)
             runs = np.concatenate([[0], np.flatnonzero(np.diff(offset)) + 1])
             if last == offset[0]:
                 runs = runs[1:]
             starts.append(runs + sample)
             offsets.append(offset[runs])
-            sample += numbers.size
+            sample += lines.size
             last = offset[-1]
         return cls(
             np.concatenate(starts or [np.zeros(0, np.int64)]).astype(np.int64),
@@ -377,6 +378,14 @@ def _options(
     }
 
 
+def _check_count(name: str, value) -> None:
+    """A positive integer option (None allowed), or a ValueError naming it."""
+    if value is None:
+        return
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:
+        raise ValueError(f"{name} must be a positive integer; got {value!r}")
+
+
 def _read_text(path: Path, options: dict, block_bytes: int) -> Recording:
     from ecofmaps.io.text import text_blocks
 
@@ -411,7 +420,7 @@ def read_recording(
     nan_policy="propagate",
     lazy=None,
     chunks=None,
-    _block_bytes=None,
+    block_bytes=None,
 ) -> Recording:
     """Read the displacement and force (and cycle) columns of a recording, in SI units.
 
@@ -447,6 +456,10 @@ def read_recording(
     chunks : int, optional
         Samples per dask block; by default a multiple of the file's own chunks near
         2**22 samples.
+    block_bytes : int, optional
+        Bytes of a text file parsed at a time (default
+        :data:`ecofmaps.io.text.BLOCK_BYTES`, 16 MiB): the memory the parsing needs, beyond
+        the arrays, is a small multiple of it.
 
     Returns
     -------
@@ -484,8 +497,8 @@ def read_recording(
     )
     if lazy not in (None, True, False):
         raise ValueError(f"lazy must be True, False or None; got {lazy!r}")
-    if chunks is not None and (isinstance(chunks, bool) or not int(chunks) == chunks > 0):
-        raise ValueError(f"chunks must be a positive number of samples; got {chunks!r}")
+    _check_count("chunks", chunks)
+    _check_count("block_bytes", block_bytes)
     path = Path(path)
     kind = recording_format(path)
     if kind == "text":
@@ -493,7 +506,7 @@ def read_recording(
             raise ValueError("group applies to TDMS, HDF5/netCDF and zarr files, not to text")
         from ecofmaps.io.text import BLOCK_BYTES
 
-        recording = _read_text(path, options, _block_bytes or BLOCK_BYTES)
+        recording = _read_text(path, options, block_bytes or BLOCK_BYTES)
         if lazy:
             import dask.array as da
 
@@ -519,7 +532,8 @@ def recording_blocks(path, samples: int = 1 << 20, **options) -> Iterator[Record
     samples : int
         Samples per block (the last block may be shorter).
     **options
-        The options of :func:`read_recording` (columns, units, group, nan_policy).
+        The options of :func:`read_recording` (columns, units, group, nan_policy,
+        block_bytes).
 
     Yields
     ------
@@ -532,10 +546,10 @@ def recording_blocks(path, samples: int = 1 << 20, **options) -> Iterator[Record
     A text file is parsed block by block (its text is never held whole); a rig file is
     read range by range.
     """
-    if isinstance(samples, bool) or not int(samples) == samples > 0:
-        raise ValueError(f"samples must be a positive number of samples; got {samples!r}")
+    _check_count("samples", samples)
     samples = int(samples)
-    block_bytes = options.pop("_block_bytes", None)
+    block_bytes = options.pop("block_bytes", None)
+    _check_count("block_bytes", block_bytes)
     path = Path(path)
     if recording_format(path) != "text":
         recording = read_recording(path, lazy=True, chunks=samples, **options)

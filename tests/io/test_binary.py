@@ -315,3 +315,31 @@ def test_nan_policy_on_lazy_reads(tmp_path):
     lazy.displacement[:4000].compute()
     with pytest.raises(RecordingError, match=r"variable 'displacement', sample 4321: missing"):
         lazy.displacement.compute()
+
+
+def test_tdms_channel_names_with_units_and_groups(tmp_path):
+    """LabVIEW channel names carry units ('Displacement/µm', 'Force [kN]'); the force and
+    cycle channels are taken from the displacement's group when others match too."""
+    path = tmp_path / "named.tdms"
+    with TdmsWriter(path) as writer:
+        writer.write_segment(
+            [
+                RootObject(),
+                GroupObject("Rig"),
+                ChannelObject("Rig", "Displacement/µm", DISPLACEMENT),
+                ChannelObject("Rig", "Force [kN]", FORCE),
+                ChannelObject("Rig", "cycle", CYCLE),
+                ChannelObject("Calibration", "Force [N]", FORCE[:10]),
+                ChannelObject("Calibration", "cycle", CYCLE[:10]),
+            ]
+        )
+    read = read_recording(path)
+    check(read)
+    np.testing.assert_array_equal(read.cycle, CYCLE)
+    assert read.columns == {
+        "displacement": "Rig/Displacement/µm",
+        "force": "Rig/Force [kN]",
+        "cycle": "Rig/cycle",
+    }
+    lazy = read_recording(path, lazy=True, chunks=2000)
+    np.testing.assert_array_equal(lazy.force.compute(), read.force)

@@ -150,7 +150,7 @@ def test_decimal_comma_found_after_integer_lines(tmp_path):
     lines = ["displacement;force"] + ["1;2"] * 50 + ["1,5;2,25"]
     path = tmp_path / "late.csv"
     path.write_text("\n".join(lines) + "\n")
-    read = read_recording(path, _block_bytes=64)
+    read = read_recording(path, block_bytes=64)
     assert read.force[-1] == 2.25 and read.displacement[-1] == 1.5e-6
     assert read.last_line == 52
 
@@ -186,7 +186,7 @@ def test_latin1_byte_in_a_later_block_names_its_line(tmp_path):
         pytest.warns(RecordingWarning, match=r"line 32: byte 0xb0"),
         pytest.raises(RecordingError, match="line 32: non-numeric value '4 # °C'"),
     ):
-        read_bytes(tmp_path, "\n".join(lines).encode("latin-1"), _block_bytes=40)
+        read_bytes(tmp_path, "\n".join(lines).encode("latin-1"), block_bytes=40)
 
 
 def test_utf16_export(tmp_path):
@@ -255,7 +255,9 @@ def test_the_same_column_twice(tmp_path):
         ("displacement_column", None, "displacement_column must be a column name"),
         ("group", "Rig", "group applies to TDMS"),
         ("lazy", "yes", "lazy must be True, False or None"),
-        ("chunks", 0, "chunks must be a positive number"),
+        ("chunks", 0, "chunks must be a positive integer"),
+        ("chunks", 2.5, "chunks must be a positive integer"),
+        ("block_bytes", "big", "block_bytes must be a positive integer"),
     ],
 )
 def test_bad_options_name_the_option(tmp_path, recording, option, value, message):
@@ -317,7 +319,7 @@ def test_blocks_give_the_same_arrays_as_the_whole(tmp_path, recording, block_byt
     path = tmp_path / "blocks.csv"
     path.write_text("\n".join(lines) + "\n")
     whole = read_recording(path)
-    read = read_recording(path, _block_bytes=block_bytes)
+    read = read_recording(path, block_bytes=block_bytes)
     for name in ("displacement", "force", "cycle"):
         np.testing.assert_array_equal(getattr(read, name), getattr(whole, name))
     np.testing.assert_allclose(whole.displacement, displacement, rtol=1e-15)
@@ -325,7 +327,7 @@ def test_blocks_give_the_same_arrays_as_the_whole(tmp_path, recording, block_byt
     everywhere = np.arange(read.size)
     np.testing.assert_array_equal(read.line(everywhere), whole.line(everywhere))
     assert read.last_line == whole.last_line == len(lines)
-    blocks = list(recording_blocks(path, samples=123, _block_bytes=block_bytes))
+    blocks = list(recording_blocks(path, samples=123, block_bytes=block_bytes))
     assert [b.start for b in blocks] == list(range(0, read.size, 123))
     np.testing.assert_array_equal(np.concatenate([b.force for b in blocks]), whole.force)
     np.testing.assert_array_equal(
@@ -336,9 +338,9 @@ def test_blocks_give_the_same_arrays_as_the_whole(tmp_path, recording, block_byt
     damaged[700] = damaged[700].replace(";", ";x", 1)
     path.write_text("\n".join(damaged) + "\n")
     with pytest.raises(RecordingError, match="line 701: non-numeric value 'x"):
-        read_recording(path, _block_bytes=block_bytes)
+        read_recording(path, block_bytes=block_bytes)
     with pytest.raises(RecordingError, match="line 701: non-numeric value 'x"):
-        list(recording_blocks(path, samples=50, _block_bytes=block_bytes))
+        list(recording_blocks(path, samples=50, block_bytes=block_bytes))
 
 
 def test_lazy_text_and_slices(tmp_path, recording):
@@ -385,7 +387,7 @@ def test_text_round_trip(tmp_path, values, separator, comma, quoted, newline, no
         numbers.append(len(lines))
     path = tmp_path / "round.csv"
     path.write_bytes(newline.join(lines).encode() + newline.encode())
-    read = read_recording(path, _block_bytes=block_bytes)
+    read = read_recording(path, block_bytes=block_bytes)
     displacement, force = (np.array(column) for column in zip(*values, strict=True))
     np.testing.assert_array_equal(read.displacement.view(np.int64), displacement.view(np.int64))
     np.testing.assert_array_equal(read.force.view(np.int64), force.view(np.int64))

@@ -129,7 +129,7 @@ def test_convert_failure_midway_leaves_nothing(tmp_path):
     lines[2000] = "7;1,0;oops"
     source.write_text("\n".join(lines) + "\n")
     with pytest.raises(RecordingError, match=r"big.csv, line 2001: non-numeric value 'oops'"):
-        convert_recording(source, tmp_path / "big.zarr", chunk_samples=300, _block_bytes=2000)
+        convert_recording(source, tmp_path / "big.zarr", chunk_samples=300, block_bytes=2000)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["big.csv"]
     with pytest.raises(ValueError, match="would write over its source"):
         convert_recording(source, tmp_path / "." / "big.csv")
