@@ -176,11 +176,11 @@ class _Layout:
                 "(e.g. displacement,force)",
             )
         wanted = {"displacement": options["displacement_column"], "force": options["force_column"]}
-        if options["cycle_column"] is not None:
-            wanted["cycle"] = options["cycle_column"]
-        elif find_column(self.names, "cycle", "cycle", required=False) is not None:
-            wanted["cycle"] = "cycle"
         try:
+            if options["cycle_column"] is not None:
+                wanted["cycle"] = options["cycle_column"]
+            elif find_column(self.names, "cycle", "cycle", required=False) is not None:
+                wanted["cycle"] = "cycle"
             self.columns = {
                 role: find_column(self.names, name, role) for role, name in wanted.items()
             }

@@ -111,6 +111,7 @@ def test_default_cycle_column_is_used(tmp_path, recording):
             1,
             "is in 'V', which is not a force unit; give force_unit",
         ),
+        ("displacement,force,cycle N,cycle kN\n1,2,3,4\n", 1, "several cycle columns match"),
     ],
 )
 def test_damaged_files_name_the_line(tmp_path, content, line, message):
