@@ -28,9 +28,8 @@ import functools
 import math
 import re
 
-from ecofmaps.units import parse_quantity
-
 __all__ = [
+    "COMMON_UNITS",
     "DEFAULT_UNITS",
     "KINDS",
     "ColumnError",
@@ -46,6 +45,20 @@ KINDS = {"displacement": "length", "force": "force"}
 #: The unit of a column whose name, metadata and options say none.
 DEFAULT_UNITS = {"displacement": "um", "force": "N"}
 
+#: The units rigs write most, with their kind and factor to SI, read without starting pint
+#: (whose registry takes a good part of a second to build); any other goes to pint.
+COMMON_UNITS = {
+    "m": ("length", 1.0),
+    "mm": ("length", 1e-3),
+    "um": ("length", 1e-6),
+    "µm": ("length", 1e-6),
+    "μm": ("length", 1e-6),
+    "nm": ("length", 1e-9),
+    "N": ("force", 1.0),
+    "kN": ("force", 1e3),
+    "mN": ("force", 1e-3),
+}
+
 _BRACKETED = re.compile(r"^(?P<base>.*?)\s*(?:\[(?P<square>[^\[\]]*)\]|\((?P<round>[^()]*)\))$")
 _SLASHED = re.compile(r"^(?P<base>[^/]*?)\s*/\s*(?P<unit>[^/]+?)$")
 _SUFFIXED = re.compile(r"^(?P<base>.*?[^_\s])[_\s]+(?P<unit>[^_\s]+)$")
@@ -59,8 +72,12 @@ class ColumnError(ValueError):
 def _unit_kind(unit: str) -> str | None:
     """'length' or 'force' if ``unit`` reads as one, 'other' for another unit, else None."""
     text = unit.strip()
+    if text in COMMON_UNITS:
+        return COMMON_UNITS[text][0]
     if not text or text[0].isdigit():
         return None
+    from ecofmaps.units import parse_quantity  # pint, imported only when needed
+
     for kind in ("length", "force"):
         try:
             parse_quantity(f"1 {text}", kind)
@@ -169,6 +186,10 @@ def matching_columns(names, wanted: str) -> list[int]:
 
 
 def _factor(unit: str, kind: str, option: str | None) -> float:
+    if unit.strip() in COMMON_UNITS and COMMON_UNITS[unit.strip()][0] == kind:
+        return COMMON_UNITS[unit.strip()][1]
+    from ecofmaps.units import parse_quantity  # pint, imported only when needed
+
     try:
         return parse_quantity(f"1 {unit}", kind)
     except ValueError as error:

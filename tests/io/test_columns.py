@@ -4,7 +4,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from ecofmaps.io.columns import ColumnError, column_scale, find_column, split_unit
+from ecofmaps.io.columns import COMMON_UNITS, ColumnError, column_scale, find_column, split_unit
+from ecofmaps.units import parse_quantity
 
 LENGTHS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "micron": 1e-6, "nm": 1e-9}
 FORCES = {"N": 1.0, "kN": 1e3, "mN": 1e-3}
@@ -88,3 +89,10 @@ def test_column_scale(role, option, carried, expected):
 def test_column_scale_errors(role, option, carried, error, message):
     with pytest.raises(error, match=message):
         column_scale(role, option, carried, "column")
+
+
+@pytest.mark.parametrize("unit", sorted(COMMON_UNITS))
+def test_common_units_agree_with_pint(unit):
+    """The table read without pint gives exactly pint's factor (ecofmaps.units)."""
+    kind, factor = COMMON_UNITS[unit]
+    assert parse_quantity(f"1 {unit}", kind) == factor
