@@ -469,6 +469,8 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
         columns[role] = Column(path, kind, variable, factor, options["nan_policy"])
         units[role] = unit
     size = chosen["displacement"].size
+    if size == 0:
+        raise RecordingError(path, f"{_KIND[kind]} {chosen['displacement'].name!r}", "no samples")
     lazy = size > LAZY_SAMPLES if lazy is None else lazy
     if lazy:
         import dask.array as da
@@ -477,7 +479,7 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
         stat = path.stat()
         native = max(v.chunk for v in chosen.values()) or 1
         block = int(chunks) if chunks else max(native, DEFAULT_CHUNK // native * native)
-        token = tokenize(str(path.resolve()), stat.st_mtime_ns, stat.st_size, options)
+        token = tokenize(str(path.resolve()), stat.st_mtime_ns, stat.st_size, options, block)
         arrays = {
             role: da.from_array(
                 column,

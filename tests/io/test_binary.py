@@ -343,3 +343,18 @@ def test_tdms_channel_names_with_units_and_groups(tmp_path):
     }
     lazy = read_recording(path, lazy=True, chunks=2000)
     np.testing.assert_array_equal(lazy.force.compute(), read.force)
+
+
+def test_empty_variables_and_two_chunkings(tmp_path):
+    """No samples is an error; two lazy reads with other chunks are other dask arrays."""
+    path = tmp_path / "empty.h5"
+    with h5py.File(path, "w") as handle:
+        handle["displacement"] = np.zeros(0)
+        handle["force"] = np.zeros(0)
+    with pytest.raises(RecordingError, match="variable 'displacement': no samples"):
+        read_recording(path)
+    path = write_zarr(tmp_path / "rig.zarr")
+    first = read_recording(path, lazy=True, chunks=1000).force
+    second = read_recording(path, lazy=True, chunks=3000).force
+    assert first.name != second.name
+    np.testing.assert_array_equal((first - second).compute(), 0.0)
