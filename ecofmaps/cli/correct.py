@@ -57,7 +57,7 @@ def add(subparsers) -> None:
 def run(args) -> int:
     from ecofmaps.correction.inversion import correct_ecof
     from ecofmaps.correction.tables import correct_table
-    from ecofmaps.io.recordings import write_text
+    from ecofmaps.io.files import write_text
 
     given = [name for name in (*_POINT_OPTIONS, "aspect_ratio", "scar_depth", "scar_half_width")
              if getattr(args, name) is not None]  # fmt: skip

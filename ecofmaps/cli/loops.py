@@ -69,12 +69,17 @@ def add(subparsers) -> None:
         "(default: 'cycle' if the file has it; else cycles are cut at the reversals)",
     )  # fmt: skip
     parser.add_argument(
-        "--displacement-unit", type=unit("length"), default="um", metavar="UNIT",
-        help="unit of the displacement column (default: um)",
+        "--displacement-unit", type=unit("length"), default=None, metavar="UNIT",
+        help="unit of the displacement column (default: the one its name or the file gives, "
+        "as in 'displacement [mm]' or a channel's unit, else um)",
     )  # fmt: skip
     parser.add_argument(
-        "--force-unit", type=unit("force"), default="N", metavar="UNIT",
-        help="unit of the force column (default: N)",
+        "--force-unit", type=unit("force"), default=None, metavar="UNIT",
+        help="unit of the force column (default: from its name or the file, else N)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--group", default=None, metavar="NAME",
+        help="TDMS group, or HDF5/netCDF/zarr group, holding the channels (default: any)",
     )  # fmt: skip
     parser.set_defaults(handler=run)
 
@@ -91,7 +96,9 @@ def _plot_names(paths) -> list[str]:
 def run(args) -> int:
     import pandas as pd
 
-    from ecofmaps.io.recordings import RecordingError, read_recording, results_table, write_text
+    from ecofmaps.io.files import write_text
+    from ecofmaps.io.recordings import read_recording
+    from ecofmaps.io.tables import results_table
     from ecofmaps.measured.analysis import analyze_loops
     from ecofmaps.measured.synthetic import EXAMPLE, example_path
 
@@ -132,6 +139,8 @@ def run(args) -> int:
             cycle_column=args.cycle_col,
             displacement_unit=args.displacement_unit,
             force_unit=args.force_unit,
+            group=args.group,
+            nan_policy="raise",
         )
         try:
             results = analyze_loops(
@@ -142,7 +151,7 @@ def run(args) -> int:
                 keep_loops=args.plots is not None,
             )
         except ValueError as error:
-            raise RecordingError(path, recording.last_line, str(error)) from None
+            raise recording.error(str(error)) from None
         analyses.append(results)
     tables = [results_table(results) for results in analyses]
     if len(paths) > 1:

@@ -1,6 +1,27 @@
-"""Files: atomic writers, file-and-line errors, recordings of fretting loops."""
+"""Files: atomic writers, file-and-line errors, recordings of fretting loops (text, TDMS,
+HDF5/netCDF, zarr), read whole, in blocks or lazily, written block by block."""
 
-from ecofmaps.io.files import FileLineError, atomic_path
-from ecofmaps.io.recordings import Recording, RecordingError, read_recording
+from ecofmaps.io.files import FileLineError, atomic_path, atomic_store
+from ecofmaps.io.recordings import (
+    Recording,
+    RecordingError,
+    RecordingWarning,
+    read_recording,
+    recording_blocks,
+    recording_format,
+)
+from ecofmaps.io.writers import RecordingWriter, convert_recording
 
-__all__ = ["FileLineError", "Recording", "RecordingError", "atomic_path", "read_recording"]
+__all__ = [
+    "FileLineError",
+    "Recording",
+    "RecordingError",
+    "RecordingWarning",
+    "RecordingWriter",
+    "atomic_path",
+    "atomic_store",
+    "convert_recording",
+    "read_recording",
+    "recording_blocks",
+    "recording_format",
+]

@@ -9,14 +9,16 @@ sees a half-written file and a failed write leaves an existing file as it was.
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import re
+import shutil
 import uuid
 from pathlib import Path
 
 from ecofmaps._interrupts import INTERRUPTED
 
-__all__ = ["TEMPORARY_NAME", "FileLineError", "atomic_path"]
+__all__ = ["TEMPORARY_NAME", "FileLineError", "atomic_path", "atomic_store", "write_text"]
 
 #: Names of the temporary files :func:`atomic_path` writes (left behind only by a crash).
 TEMPORARY_NAME = re.compile(r"^\..+\.[0-9a-f]{32}\.tmp$")
@@ -38,17 +40,106 @@ def atomic_path(path):
         leaving the block it is flushed to disk and moved onto ``path`` (``os.replace``);
         if the block raises, it is removed and ``path`` is left as it was.
     """
+    with atomic_store(path, overwrite=True) as temporary:
+        yield temporary
+
+
+def write_text(path, text: str) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically (a temporary file, then a rename).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Destination; its directory must exist.
+    text : str
+
+    Returns
+    -------
+    path : pathlib.Path
+    """
     path = Path(path)
-    temporary = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
+    with atomic_path(path) as temporary:
+        temporary.write_text(text, encoding="utf-8", newline="")
+    return path
+
+
+def _temporary(path: Path) -> Path:
+    return path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
+
+
+def _remove(path: Path) -> None:
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path, ignore_errors=True)
+    else:
+        path.unlink(missing_ok=True)
+
+
+def _sync(path: Path) -> None:
+    """Flush a file, or every file and folder of a directory, to disk."""
+    paths = [path]
+    if path.is_dir():
+        for folder, _, names in os.walk(path):
+            paths += [Path(folder)] + [Path(folder) / name for name in names]
+    for item in paths:
+        descriptor = os.open(item, os.O_RDONLY)
+        try:
+            os.fsync(descriptor)
+        finally:
+            os.close(descriptor)
+
+
+@contextlib.contextmanager
+def atomic_store(path, *, overwrite: bool = False):
+    """A temporary path to write a file or a directory store (zarr) at, moved onto ``path``
+    when the block succeeds.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file or directory to create; its directory must exist.
+    overwrite : bool
+        Replace an existing ``path``; otherwise an existing one is an error, raised before
+        anything is written.
+
+    Yields
+    ------
+    temporary : pathlib.Path
+        ``.<name>.<32 hex digits>.tmp`` beside ``path``, not yet existing: create the file or
+        directory there. On success it is flushed to disk and renamed to ``path`` (an old
+        ``path`` is moved aside first and removed after); if the block raises (or is
+        interrupted), it is removed and ``path`` is left as it was. A crash leaves only a
+        hidden ``.tmp`` name (:data:`TEMPORARY_NAME`), never a store under ``path``.
+
+    Raises
+    ------
+    FileExistsError
+        If ``path`` exists and ``overwrite`` is false.
+    """
+    path = Path(path)
+    if os.path.lexists(path) and not overwrite:
+        message = "exists already (overwrite=True replaces it)"
+        raise FileExistsError(errno.EEXIST, message, str(path))
+    temporary = _temporary(path)
     try:
         yield temporary
-        with open(temporary, "rb+") as stream:
-            os.fsync(stream.fileno())
+        _sync(temporary)
         if INTERRUPTED.is_set():  # an interrupt that was swallowed on its way up
             raise KeyboardInterrupt
-        os.replace(temporary, path)
+        if temporary.is_dir() or path.is_dir():
+            old = _temporary(path)
+            if os.path.lexists(path):
+                os.replace(path, old)
+            try:
+                os.replace(temporary, path)
+            except BaseException:
+                if os.path.lexists(old):
+                    os.replace(old, path)
+                raise
+            _remove(old)
+        else:
+            os.replace(temporary, path)
     except BaseException:
-        temporary.unlink(missing_ok=True)
+        _remove(temporary)
         raise
 
 

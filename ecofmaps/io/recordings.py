@@ -1,104 +1,391 @@
-"""Recordings of fretting loops in text files, and the per-cycle results table.
+"""Recordings of fretting loops: text files and rig formats, read whole or lazily.
 
-:func:`read_recording` reads comma-, tab- or whitespace-separated columns with a header
-line (lines starting with ``#`` and blank lines are skipped). By default the columns are
-``displacement`` in µm and ``force`` in N, and an optional ``cycle``; names are matched
-without regard to case. A damaged file raises :class:`RecordingError`, which names the
-file and the 1-based line. :func:`results_table` turns :func:`ecofmaps.analyze_loops`'s
-Dataset into the table that ``ecofmaps loops`` writes, in the tribologist's units, and
-:func:`write_text` writes a file atomically.
+:func:`read_recording` reads the displacement, force and (optional) cycle-number columns
+of a recording into a :class:`Recording`, in SI units, whatever the file's format:
+
+- text: CSV, TSV, spreadsheet exports, whitespace-separated columns with a header line
+  (:mod:`ecofmaps.io.text`: separator and decimal comma detected, quotes, encodings,
+  missing cells), parsed in blocks;
+- TDMS (LabVIEW), HDF5 and netCDF-4, zarr stores (:mod:`ecofmaps.io.binary`): channels or
+  variables chosen by name (and ``group``), units from their metadata, read lazily as dask
+  arrays when large.
+
+The format is found from the file's first bytes (a zarr store is a directory), not its
+suffix. Columns are found by name without regard to case, and a unit carried by the name
+(``force [kN]``, ``delta_mm``) or the metadata is used when no unit option is given
+(:mod:`ecofmaps.io.columns`). A damaged file raises :class:`RecordingError`, which names
+the file and the 1-based line, or, where a file has no lines, the channel or variable and
+the 0-based sample index. Missing samples (empty cells, NaN) are NaN in the arrays, found
+by :attr:`Recording.missing`, with their lines; ``nan_policy='raise'`` makes them errors.
+
+:func:`recording_blocks` gives a recording block by block with bounded memory, which
+:func:`ecofmaps.io.writers.convert_recording` uses to turn a large text file into a chunked
+store once. :func:`results_table` turns :func:`ecofmaps.analyze_loops`'s Dataset into the
+table that ``ecofmaps loops`` writes, and :func:`write_text` writes a file atomically.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
+import itertools
+import numbers
+from collections.abc import Iterator, Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
-import pandas as pd
-import xarray as xr
 
-from ecofmaps.io.files import FileLineError, atomic_path
-from ecofmaps.units import parse_quantity
+from ecofmaps.io.files import FileLineError
 
 __all__ = [
-    "RESULT_COLUMNS",
+    "LAZY_SAMPLES",
     "Recording",
     "RecordingError",
+    "RecordingWarning",
     "read_recording",
-    "results_table",
-    "write_text",
+    "recording_blocks",
+    "recording_format",
 ]
 
-#: The columns of the results table: name -> (Dataset variable, factor from SI).
-RESULT_COLUMNS = {
-    "cycle": ("cycle", 1),
-    "amplitude_um": ("amplitude", 1e6),
-    "slip_amplitude_um": ("slip_amplitude", 1e6),
-    "max_force_N": ("max_force", 1.0),
-    "dissipated_energy_mJ": ("dissipated_energy", 1e3),
-    "ecof": ("ecof", 1.0),
-    "cof_max": ("cof_max", 1.0),
-    "energy_ratio": ("energy_ratio", 1.0),
-    "stiffness_MN_per_m": ("stiffness", 1e-6),
-    "gicof": ("gicof", 1.0),
-    "regime": ("regime", None),
-}
+#: Rig files with more samples than this are read lazily (dask arrays) by default.
+LAZY_SAMPLES = 1 << 24
 
-_DELIMITERS = {".csv": ",", ".tsv": "\t", ".tab": "\t"}
+_NAN_POLICIES = ("propagate", "raise")
+_MAGIC = {
+    b"TDSm": "tdms",
+    b"\x89HDF\r\n\x1a\n": "hdf5",
+    b"CDF\x01": "netcdf3",
+    b"CDF\x02": "netcdf3",
+}
+_SUFFIXES = {
+    ".tdms": "tdms",
+    ".h5": "hdf5",
+    ".hdf5": "hdf5",
+    ".hdf": "hdf5",
+    ".nc": "hdf5",
+    ".nc4": "hdf5",
+    ".zarr": "zarr",
+}
+_ZARR_METADATA = ("zarr.json", ".zgroup", ".zarray")
 
 
 class RecordingError(FileLineError):
-    """A damaged recording: the message names the file and the 1-based line number."""
+    """A damaged recording: the message names the file and where in it.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    line : int, str or None
+        The 1-based line of a text file; or, in a file without lines, a position such as
+        ``"channel 'Rig/force', sample 1200"``; or None for the file as a whole.
+    message : str
+
+    Attributes
+    ----------
+    path : pathlib.Path
+    line : int or None
+        The 1-based line, for a text file.
+    position : str
+        ``'line 12'``, the position given, or ``''``.
+    """
+
+    def __init__(self, path, line, message: str):
+        self.path = Path(path)
+        if line is None or isinstance(line, str):
+            self.line, self.position = None, line or ""
+        else:
+            self.line = int(line)
+            self.position = f"line {self.line}"
+        where = f"{self.path}, {self.position}" if self.position else f"{self.path}"
+        ValueError.__init__(self, f"{where}: {message}")
+
+
+class RecordingWarning(UserWarning):
+    """Something in a recording was read in a way the user should know (e.g. as Latin-1)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class _LineIndex:
+    """The 1-based line of each sample of a text file, as runs: from sample ``starts[k]`` on,
+    line = sample + ``offsets[k]`` (comment and blank lines start new runs)."""
+
+    starts: np.ndarray
+    offsets: np.ndarray
+
+    @classmethod
+    def build(cls, blocks, first: int = 0) -> _LineIndex:
+        """From the line numbers of consecutive blocks of samples, the first being sample
+        ``first`` of the file."""
+        starts, offsets, sample, last = [], [], first, None
+        for lines in blocks:
+            if lines.size == 0:
+                continue
+            offset = lines - np.arange(sample, sample + lines.size)
+            runs = np.concatenate([[0], np.flatnonzero(np.diff(offset)) + 1])
+            if last == offset[0]:
+                runs = runs[1:]
+            starts.append(runs + sample)
+            offsets.append(offset[runs])
+            sample += lines.size
+            last = offset[-1]
+        return cls(
+            np.concatenate(starts or [np.zeros(0, np.int64)]).astype(np.int64),
+            np.concatenate(offsets or [np.zeros(0, np.int64)]).astype(np.int64),
+        )
+
+    def __call__(self, index):
+        index = np.asarray(index, dtype=np.int64)
+        run = np.searchsorted(self.starts, index, side="right") - 1
+        return index + self.offsets[run]
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class Recording:
     """The samples read from a recording file, in SI units.
 
+    The arrays are NumPy arrays, or dask arrays for a large rig file read lazily (see
+    ``lazy`` in :func:`read_recording`): ``recording.displacement.chunks`` then gives the
+    blocks, ``recording[start:stop]`` reads one range into memory and
+    :meth:`compute` all of it.
+
     Attributes
     ----------
     path : pathlib.Path
-    displacement : numpy.ndarray
-        [m]
-    force : numpy.ndarray
-        [N]
-    cycle : numpy.ndarray or None
+    displacement : numpy.ndarray or dask.array.Array
+        [m]; NaN where a sample is missing.
+    force : numpy.ndarray or dask.array.Array
+        [N]; NaN where a sample is missing.
+    cycle : numpy.ndarray or dask.array.Array or None
         The cycle number of each sample, if the file has a cycle column. [1]
-    last_line : int
-        1-based line number of the last sample in the file.
+    last_line : int or None
+        1-based line number of the last sample, for a text file.
+    columns : Mapping[str, str]
+        For each of ``'displacement'``, ``'force'`` (and ``'cycle'``): the column, channel
+        or variable it was read from, as named in the file.
+    units : Mapping[str, str]
+        The unit each column was read in (``'um'``, ``'kN'``, ...).
+    start : int
+        0-based index in the file of the first sample (non-zero for a block).
     """
 
     path: Path
-    displacement: np.ndarray
-    force: np.ndarray
-    cycle: np.ndarray | None
-    last_line: int
+    displacement: Any
+    force: Any
+    cycle: Any = None
+    last_line: int | None = None
+    columns: Mapping[str, str] = dataclasses.field(default_factory=dict)
+    units: Mapping[str, str] = dataclasses.field(default_factory=dict)
+    start: int = 0
+    lines: _LineIndex | None = dataclasses.field(default=None, repr=False)
 
+    @property
+    def size(self) -> int:
+        """Number of samples."""
+        return int(self.displacement.shape[0])
 
-def _delimiter(path: Path, header: str):
-    """The field separator: from the suffix, else the first of tab, comma or semicolon found
-    in the header, else None (any run of whitespace)."""
-    if path.suffix.lower() in _DELIMITERS:
-        return _DELIMITERS[path.suffix.lower()]
-    for candidate in ("\t", ",", ";"):
-        if candidate in header:
-            return candidate
-    return None
+    def __len__(self) -> int:
+        return self.size
 
+    @property
+    def lazy(self) -> bool:
+        """Whether the arrays are dask arrays, read when computed."""
+        return not isinstance(self.displacement, np.ndarray)
 
-def _numbers(path, name, cells, lines, scale) -> np.ndarray:
-    """A column's cells as float64 times ``scale``; the first bad cell raises its line."""
-    values = pd.to_numeric(pd.Series(cells, dtype=object), errors="coerce").to_numpy(
-        dtype=np.float64
-    )
-    bad = ~np.isfinite(values)
-    if bad.any():
-        first = int(np.argmax(bad))
-        raise RecordingError(
-            path, lines[first], f"non-numeric value {cells[first]!r} in column {name!r}"
+    @functools.cached_property
+    def missing(self):
+        """Mask of the missing samples (NaN in any column read): numpy or dask, as the data.
+
+        Examples
+        --------
+        The lines of the missing samples of a text file:
+        ``recording.line(np.flatnonzero(recording.missing))``.
+        """
+        arrays = [self.displacement, self.force] + ([] if self.cycle is None else [self.cycle])
+        if self.lazy:
+            import dask.array as da
+
+            return ~functools.reduce(da.logical_and, [da.isfinite(a) for a in arrays])
+        return ~functools.reduce(np.logical_and, [np.isfinite(a) for a in arrays])
+
+    def line(self, index):
+        """1-based line numbers of samples in a text file (None for other formats).
+
+        Parameters
+        ----------
+        index : int or array_like of int
+            0-based sample indices in this recording (or block).
+        """
+        if self.lines is None:
+            return None
+        lines = self.lines(np.asarray(index) + self.start)
+        return int(lines) if np.ndim(lines) == 0 else lines
+
+    def position(self, index=None) -> str | int | None:
+        """Where sample ``index`` is in the file: its line (int) for a text file, else
+        ``'sample N'`` (0-based in the file); for ``index=None`` the end of the file (its
+        last line, or None)."""
+        if index is None:
+            return self.last_line
+        if self.lines is not None:
+            return self.line(index)
+        return f"sample {self.start + int(index)}"
+
+    def error(self, message: str, index=None) -> RecordingError:
+        """A :class:`RecordingError` naming the file and the position of sample ``index``
+        (by default the end of the file), e.g. for an analysis that fails on the samples."""
+        return RecordingError(self.path, self.position(index), message)
+
+    def __getitem__(self, key: slice) -> Recording:
+        """Samples ``start:stop`` (step 1) in memory, keeping their positions in the file."""
+        if not isinstance(key, slice) or key.step not in (None, 1):
+            raise TypeError("a Recording is indexed by a slice start:stop")
+        first, stop, _ = key.indices(self.size)
+        stop = max(stop, first)
+        arrays = [self.displacement, self.force, self.cycle]
+        taken = [None if a is None else a[first:stop] for a in arrays]
+        if self.lazy:
+            import dask
+
+            taken = list(dask.compute(*taken))
+        last = None
+        if self.lines is not None and stop > first:
+            last = int(self.lines(self.start + stop - 1))
+        return dataclasses.replace(
+            self,
+            displacement=taken[0],
+            force=taken[1],
+            cycle=taken[2],
+            last_line=last,
+            start=self.start + first,
         )
-    return values * scale
+
+    def compute(self) -> Recording:
+        """The recording with NumPy arrays (reads a lazy one whole; else itself)."""
+        return self[:] if self.lazy else self
+
+
+def recording_format(path) -> str:
+    """The format of a recording file: ``'text'``, ``'tdms'``, ``'hdf5'`` or ``'zarr'``.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A file, or a zarr store (a directory).
+
+    Returns
+    -------
+    format : str
+        Found from the first bytes (``TDSm``, the HDF5 signature) or, for a directory, its
+        zarr metadata; any other file is text.
+
+    Raises
+    ------
+    RecordingError
+        For a directory that is not a zarr store, a netCDF-3 file, or a file whose suffix
+        names a rig format its content is not (truncated or mislabelled).
+    OSError
+        If the file cannot be read.
+    """
+    path = Path(path)
+    if path.is_dir():
+        if any((path / name).exists() for name in _ZARR_METADATA):
+            return "zarr"
+        raise RecordingError(path, None, "a directory, and not a zarr store (no zarr.json)")
+    with open(path, "rb") as stream:
+        head = stream.read(8)
+    for magic, kind in _MAGIC.items():
+        if head.startswith(magic):
+            if kind == "netcdf3":
+                raise RecordingError(
+                    path,
+                    None,
+                    "a netCDF-3 (classic) file: save it as netCDF-4 (HDF5), e.g. with xarray: "
+                    "xr.open_dataset(path).to_netcdf(new_path, engine='h5netcdf')",
+                )
+            return kind
+    expected = _SUFFIXES.get(path.suffix.lower())
+    if expected is not None:
+        raise RecordingError(
+            path,
+            None,
+            f"not a {expected.upper()} file: it does not start with the format's signature "
+            f"(an empty, truncated or mislabelled file; first bytes {head!r})",
+        )
+    return "text"
+
+
+def _options(
+    displacement_column="displacement",
+    force_column="force",
+    cycle_column=None,
+    displacement_unit=None,
+    force_unit=None,
+    group=None,
+    nan_policy="propagate",
+) -> dict:
+    """The reading options, checked, as one dict."""
+    for name, value in (
+        ("displacement_column", displacement_column),
+        ("force_column", force_column),
+    ):
+        if not isinstance(value, str) or not value.strip():
+            raise ValueError(f"{name} must be a column name; got {value!r}")
+    for name, value in (
+        ("cycle_column", cycle_column),
+        ("displacement_unit", displacement_unit),
+        ("force_unit", force_unit),
+        ("group", group),
+    ):
+        if value is not None and (not isinstance(value, str) or not value.strip()):
+            raise ValueError(f"{name} must be a non-empty string or None; got {value!r}")
+    if nan_policy not in _NAN_POLICIES:
+        raise ValueError(f"nan_policy must be one of {_NAN_POLICIES}; got {nan_policy!r}")
+    from ecofmaps.io.columns import KINDS, column_scale
+
+    for role in KINDS:
+        unit = {"displacement": displacement_unit, "force": force_unit}[role]
+        if unit is not None:
+            column_scale(role, unit, [], role)  # a ValueError naming the option
+    return {
+        "displacement_column": displacement_column,
+        "force_column": force_column,
+        "cycle_column": cycle_column,
+        "displacement_unit": displacement_unit,
+        "force_unit": force_unit,
+        "group": group,
+        "nan_policy": nan_policy,
+    }
+
+
+def _check_count(name: str, value) -> None:
+    """A positive integer option (None allowed), or a ValueError naming it."""
+    if value is None:
+        return
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:
+        raise ValueError(f"{name} must be a positive integer; got {value!r}")
+
+
+def _read_text(path: Path, options: dict, block_bytes: int) -> Recording:
+    from ecofmaps.io.text import text_blocks
+
+    blocks = text_blocks(path, options, block_bytes)
+    layout = next(blocks)
+    parts = list(blocks)
+    if not parts:
+        raise RecordingError(path, layout.header_line, "no data after the header")
+    values = {role: np.concatenate([part[0][role] for part in parts]) for role in layout.columns}
+    numbers = [part[1] for part in parts]
+    return Recording(
+        path=path,
+        displacement=values["displacement"],
+        force=values["force"],
+        cycle=values.get("cycle"),
+        last_line=int(numbers[-1][-1]),
+        columns={role: layout.names[k] for role, k in layout.columns.items()},
+        units={role: layout.units[role] for role in layout.columns},
+        lines=_LineIndex.build(numbers),
+    )
 
 
 def read_recording(
@@ -107,26 +394,52 @@ def read_recording(
     displacement_column="displacement",
     force_column="force",
     cycle_column=None,
-    displacement_unit="um",
-    force_unit="N",
+    displacement_unit=None,
+    force_unit=None,
+    group=None,
+    nan_policy="propagate",
+    lazy=None,
+    chunks=None,
+    block_bytes=None,
 ) -> Recording:
-    """Read the displacement and force columns of a recording file.
+    """Read the displacement and force (and cycle) columns of a recording, in SI units.
 
     Parameters
     ----------
     path : str or os.PathLike
-        A text file: a header line of column names, then one sample per line. Fields are
-        separated by commas (``.csv``), tabs (``.tsv``) or, for other suffixes, by the
-        first of tab, comma or semicolon found in the header, else by whitespace. Lines
-        starting with ``#`` and blank lines are skipped.
+        A text file (a header line of column names, then one sample per line; see
+        :mod:`ecofmaps.io.text`), a TDMS file, an HDF5 or netCDF-4 file, or a zarr store
+        (a directory). The format is found from the content.
     displacement_column, force_column : str
-        Names of the displacement and tangential force columns.
+        Names of the displacement and tangential force columns (channels, variables):
+        matched without regard to case, and to a unit in the name
+        (``displacement`` finds ``Displacement [µm]``).
     cycle_column : str, optional
         Name of a column of cycle numbers, which must then exist. By default a column
         named ``cycle`` is used if there is one.
-    displacement_unit, force_unit : str
+    displacement_unit, force_unit : str, optional
         Units of the displacement and force columns (``'um'``, ``'mm'``, ``'N'``,
-        ``'kN'``, ...).
+        ``'kN'``, ...). By default the unit the file gives (in the column's name, or a
+        channel's ``unit_string``/``NI_UnitDescription``, a variable's ``units``), else µm
+        and N. A unit given here that disagrees with the file's is an error.
+    group : str, optional
+        TDMS group, or HDF5/netCDF/zarr group path, holding the channels. By default the
+        channels are sought in all groups (and must be found in only one).
+    nan_policy : {'propagate', 'raise'}
+        Missing samples (empty cells, NaN, infinities) are NaN in the arrays and marked by
+        :attr:`Recording.missing` (``'propagate'``), or an error naming the line or sample
+        (``'raise'``; for a lazy recording, raised when the block holding it is read).
+    lazy : bool, optional
+        Return dask arrays read block by block (True), or NumPy arrays (False). By default
+        lazy for rig files of more than :data:`LAZY_SAMPLES` samples. A text file is always
+        parsed whole (in blocks, into memory); ``lazy=True`` then wraps the arrays in dask.
+    chunks : int, optional
+        Samples per dask block; by default a multiple of the file's own chunks near
+        2**22 samples.
+    block_bytes : int, optional
+        Bytes of a text file parsed at a time (default
+        :data:`ecofmaps.io.text.BLOCK_BYTES`, 16 MiB): the memory the parsing needs, beyond
+        the arrays, is a small multiple of it.
 
     Returns
     -------
@@ -136,102 +449,125 @@ def read_recording(
     Raises
     ------
     RecordingError
-        For a missing column, a line with the wrong number of fields, a non-numeric or
-        non-finite cell, or no data; the message names the file and the line.
+        For a missing, ambiguous or doubtful column (a unit that disagrees), a line with
+        the wrong number of fields, a cell that is not a number, no data, channels of
+        different lengths, a truncated or damaged file; the message names the file and the
+        line (text) or the channel and sample (other formats).
     ValueError
-        For a unit of the wrong kind.
+        For options of the wrong kind, e.g. a unit that is not a length or a force (the
+        message names the option).
     OSError
         If the file cannot be read.
+
+    Examples
+    --------
+    >>> import ecofmaps
+    >>> recording = ecofmaps.read_recording(ecofmaps.measured.synthetic.example_path())
+    >>> recording.size, recording.units["displacement"], recording.lazy
+    (24000, 'um', False)
     """
+    options = _options(
+        displacement_column,
+        force_column,
+        cycle_column,
+        displacement_unit,
+        force_unit,
+        group,
+        nan_policy,
+    )
+    if lazy not in (None, True, False):
+        raise ValueError(f"lazy must be True, False or None; got {lazy!r}")
+    _check_count("chunks", chunks)
+    _check_count("block_bytes", block_bytes)
     path = Path(path)
-    metres = parse_quantity(f"1 {displacement_unit}", "length")
-    newtons = parse_quantity(f"1 {force_unit}", "force")
-    text = path.read_text(encoding="utf-8-sig")
-    numbered = [
-        (number, line)
-        for number, line in enumerate(text.splitlines(), start=1)
-        if line.strip() and not line.lstrip().startswith("#")
-    ]
-    if not numbered:
-        raise RecordingError(path, max(text.count("\n"), 1), "no header line and no data")
-    header_line, header = numbered[0]
-    separator = _delimiter(path, header)
-    names = [name.strip().strip('"').strip().lower() for name in header.split(separator)]
-    wanted = {"displacement": displacement_column, "force": force_column}
-    if cycle_column is not None or "cycle" in names:
-        wanted["cycle"] = "cycle" if cycle_column is None else cycle_column
-    columns = {}
-    for role, name in wanted.items():
-        if name.lower() not in names:
-            raise RecordingError(
-                path,
-                header_line,
-                f"no {role} column {name!r} in the header (columns: {', '.join(names)})",
+    kind = recording_format(path)
+    if kind == "text":
+        if group is not None:
+            raise ValueError("group applies to TDMS, HDF5/netCDF and zarr files, not to text")
+        from ecofmaps.io.text import BLOCK_BYTES
+
+        recording = _read_text(path, options, block_bytes or BLOCK_BYTES)
+        if lazy:
+            import dask.array as da
+
+            size = chunks or recording.size
+            arrays = [recording.displacement, recording.force, recording.cycle]
+            wrapped = [None if a is None else da.from_array(a, chunks=size) for a in arrays]
+            recording = dataclasses.replace(
+                recording, displacement=wrapped[0], force=wrapped[1], cycle=wrapped[2]
             )
-        columns[role] = names.index(name.lower())
-    lines = np.array([number for number, _ in numbered[1:]], dtype=np.int64)
-    if lines.size == 0:
-        raise RecordingError(path, header_line, "no data after the header")
-    rows = [line.split(separator) for _, line in numbered[1:]]
-    widths = np.fromiter(map(len, rows), dtype=np.int64, count=len(rows))
-    if np.any(widths != len(names)):
-        first = int(np.argmax(widths != len(names)))
-        raise RecordingError(
-            path,
-            lines[first],
-            f"{widths[first]} fields where the header has {len(names)}",
-        )
-    scales = {"displacement": metres, "force": newtons, "cycle": 1.0}
-    values = {
-        role: _numbers(path, wanted[role], [row[k] for row in rows], lines, scales[role])
-        for role, k in columns.items()
-    }
-    return Recording(
-        path=path,
-        displacement=values["displacement"],
-        force=values["force"],
-        cycle=values.get("cycle"),
-        last_line=int(lines[-1]),
-    )
+        return recording
+    from ecofmaps.io.binary import read_binary
+
+    return read_binary(path, kind, options, lazy=lazy, chunks=chunks)
 
 
-def results_table(results: xr.Dataset) -> pd.DataFrame:
-    """The per-cycle results in the tribologist's units, one row per cycle.
-
-    Parameters
-    ----------
-    results : xarray.Dataset
-        From :func:`ecofmaps.analyze_loops`.
-
-    Returns
-    -------
-    table : pandas.DataFrame
-        Exactly the columns of :data:`RESULT_COLUMNS`: cycle, amplitude_um,
-        slip_amplitude_um, max_force_N, dissipated_energy_mJ, ecof, cof_max,
-        energy_ratio, stiffness_MN_per_m, gicof, regime.
-    """
-    return pd.DataFrame(
-        {
-            column: results[name].values if factor is None else results[name].values * factor
-            for column, (name, factor) in RESULT_COLUMNS.items()
-        }
-    )
-
-
-def write_text(path, text: str) -> Path:
-    """Write ``text`` to ``path`` atomically (a temporary file, then a rename).
+def recording_blocks(path, samples: int = 1 << 20, **options) -> Iterator[Recording]:
+    """A recording block by block, each in memory, with bounded memory overall.
 
     Parameters
     ----------
     path : str or os.PathLike
-        Destination; its directory must exist.
-    text : str
+        As for :func:`read_recording`.
+    samples : int
+        Samples per block (the last block may be shorter).
+    **options
+        The options of :func:`read_recording` (columns, units, group, nan_policy,
+        block_bytes).
 
-    Returns
-    -------
-    path : pathlib.Path
+    Yields
+    ------
+    block : Recording
+        NumPy arrays; ``block.start`` is the index of its first sample in the file, and
+        lines and errors name the file's lines.
+
+    Notes
+    -----
+    A text file is parsed block by block (its text is never held whole); a rig file is
+    read range by range.
     """
+    _check_count("samples", samples)
+    samples = int(samples)
+    block_bytes = options.pop("block_bytes", None)
+    _check_count("block_bytes", block_bytes)
     path = Path(path)
-    with atomic_path(path) as temporary:
-        temporary.write_text(text, encoding="utf-8", newline="")
-    return path
+    if recording_format(path) != "text":
+        recording = read_recording(path, lazy=True, chunks=samples, **options)
+        for first in range(0, recording.size, samples):
+            yield recording[first : first + samples]
+        return
+    from ecofmaps.io.text import BLOCK_BYTES, text_blocks
+
+    checked = _options(**options)
+    if checked["group"] is not None:
+        raise ValueError("group applies to TDMS, HDF5/netCDF and zarr files, not to text")
+    parts = text_blocks(path, checked, block_bytes or BLOCK_BYTES)
+    layout = next(parts)
+    columns = {role: layout.names[k] for role, k in layout.columns.items()}
+    units = {role: layout.units[role] for role in layout.columns}
+    pending: list = []  # parsed blocks not yet given out: (values by role, line numbers)
+    held = first = 0
+    for part in itertools.chain(parts, [None]):  # None: the end, give out the rest
+        if part is not None:
+            pending.append(part)
+            held += part[1].size
+        while held >= samples or (held and part is None):
+            joined = {role: np.concatenate([p[0][role] for p in pending]) for role in columns}
+            lines = np.concatenate([p[1] for p in pending])
+            count = min(samples, held)
+            yield Recording(
+                path=path,
+                displacement=joined["displacement"][:count],
+                force=joined["force"][:count],
+                cycle=joined["cycle"][:count] if "cycle" in joined else None,
+                last_line=int(lines[count - 1]),
+                columns=columns,
+                units=units,
+                start=first,
+                lines=_LineIndex.build([lines[:count]], first),
+            )
+            pending = [({role: joined[role][count:] for role in columns}, lines[count:])]
+            held -= count
+            first += count
+    if first == 0:
+        raise RecordingError(path, layout.header_line, "no data after the header")

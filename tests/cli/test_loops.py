@@ -6,7 +6,7 @@ import pytest
 
 import ecofmaps
 from ecofmaps.cli import main
-from ecofmaps.io.recordings import RESULT_COLUMNS, RecordingError, read_recording, results_table
+from ecofmaps.io.tables import RESULT_COLUMNS, results_table
 from ecofmaps.measured.synthetic import EXAMPLE, example_path, synthetic_recording
 
 LOAD = 450.0
@@ -34,88 +34,6 @@ def run(capsys, *arguments):
     status = main(["loops", *map(str, arguments)])
     out, err = capsys.readouterr()
     return status, out, err
-
-
-# --- reading files ---------------------------------------------------------------------------
-
-
-@pytest.mark.parametrize(("suffix", "separator"), [(".csv", ","), (".tsv", "\t"), (".txt", "  ")])
-def test_read_formats(tmp_path, recording, suffix, separator):
-    """CSV, TSV and whitespace-separated text read the same samples, in SI units."""
-    displacement, force = recording
-    path = write_csv(tmp_path / f"loops{suffix}", displacement, force, separator)
-    read = read_recording(path)
-    np.testing.assert_allclose(read.displacement, displacement, rtol=0, atol=1e-15)
-    np.testing.assert_allclose(read.force, force, rtol=0, atol=1e-9)
-    assert read.cycle is None
-    assert read.last_line == 2 + displacement.size
-
-
-def test_read_columns_units_and_cycles(tmp_path, recording):
-    """Other column names (any case), units and an explicit cycle column."""
-    displacement, force = recording
-    table = pd.DataFrame(
-        {
-            "Time": np.arange(displacement.size),
-            "Cycle No": np.repeat([1, 2, 3, 4, 5], [200, 200, 200, 200, 1]),
-            "Disp": displacement * 1e3,  # mm
-            "Q": force / 1e3,  # kN
-        }
-    )
-    path = tmp_path / "rig.tsv"
-    table.to_csv(path, sep="\t", index=False)
-    read = read_recording(
-        path,
-        displacement_column="disp",
-        force_column="q",
-        cycle_column="cycle no",
-        displacement_unit="mm",
-        force_unit="kN",
-    )
-    np.testing.assert_allclose(read.displacement, displacement, rtol=1e-15)
-    np.testing.assert_allclose(read.force, force, rtol=1e-15)
-    np.testing.assert_array_equal(read.cycle, table["Cycle No"])
-
-
-def test_default_cycle_column_is_used(tmp_path, recording):
-    displacement, force = recording
-    path = tmp_path / "with_cycles.csv"
-    lines = ["displacement,force,cycle"]
-    lines += [
-        f"{float(d) * 1e6!r},{float(f)!r},{i // 200}"
-        for i, (d, f) in enumerate(zip(*recording, strict=True))
-    ]
-    path.write_text("\n".join(lines) + "\n")
-    read = read_recording(path)
-    np.testing.assert_array_equal(read.cycle, np.arange(displacement.size) // 200)
-    np.testing.assert_array_equal(read.force, force)  # repr round-trips exactly
-
-
-@pytest.mark.parametrize(
-    ("content", "line", "message"),
-    [
-        ("# note\ndisplacement,force\n1,2\n3,x4\n", 4, "non-numeric value 'x4' in column 'force'"),
-        ("displacement,force\n1,2\n\n3,\n", 4, "non-numeric value '' in column 'force'"),
-        ("displacement,force\n1,2\n3,nan\n", 3, "non-numeric value 'nan' in column 'force'"),
-        ("displacement,force\n1,2\n3,4,5\n", 3, "3 fields where the header has 2"),
-        ("# only\n\ndisp,force\n1,2\n", 3, "no displacement column 'displacement'"),
-        ("displacement,force\n", 1, "no data after the header"),
-        ("# nothing here\n", 1, "no header line and no data"),
-    ],
-)
-def test_damaged_files_name_the_line(tmp_path, content, line, message):
-    path = tmp_path / "damaged.csv"
-    path.write_text(content)
-    with pytest.raises(RecordingError, match=message) as raised:
-        read_recording(path)
-    assert raised.value.line == line
-    assert str(raised.value).startswith(f"{path}, line {line}: ")
-
-
-def test_missing_explicit_cycle_column(tmp_path, recording):
-    path = write_csv(tmp_path / "loops.csv", *recording)
-    with pytest.raises(RecordingError, match="line 2: no cycle column 'n'"):
-        read_recording(path, cycle_column="n")
 
 
 def test_results_table_units(recording):

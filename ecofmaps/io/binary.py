@@ -1,0 +1,506 @@
+"""Recordings in rig formats: TDMS, HDF5 / netCDF-4 and zarr, read lazily.
+
+Each format lists its one-dimensional numeric channels (TDMS) or variables (HDF5, zarr)
+with their group, length and units (a TDMS channel's ``unit_string`` or
+``NI_UnitDescription``, a variable's ``units`` attribute). The columns asked for are found
+by name as in a text header (:mod:`ecofmaps.io.columns`), in the group given or in any
+group. Each is wrapped in a :class:`Column`, an array-like that reads a range of samples on
+demand, in float64 and SI, with CF packing decoded (``scale_factor``, ``add_offset``,
+``_FillValue``/``missing_value`` -> NaN), and turns any failure into a
+:class:`~ecofmaps.io.recordings.RecordingError` naming the file, the channel and the
+samples. A large recording is a dask array over such columns (``dask.array.from_array``),
+so it is read block by block; a :class:`Column` pickles without its open file, so the
+blocks can be read by other processes (a dask cluster).
+
+A truncated file is refused when it is opened: HDF5 checks its own length, a TDMS file
+whose last segment is short is found from npTDMS's notice, and a zarr store with missing
+chunk files (which zarr would silently read as the fill value) from its chunk count.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import threading
+from pathlib import Path
+
+import numpy as np
+
+from ecofmaps.io.columns import ColumnError, column_scale, matching_columns, split_unit
+from ecofmaps.io.recordings import LAZY_SAMPLES, Recording, RecordingError
+
+__all__ = ["DEFAULT_CHUNK", "Column", "Variable", "read_binary", "variables"]
+
+#: Samples per dask block when the file does not suggest a chunking.
+DEFAULT_CHUNK = 1 << 22
+
+_KIND = {"tdms": "channel", "hdf5": "variable", "zarr": "variable"}
+_UNIT_ATTRIBUTES = ("units", "unit", "Units", "Unit", "unit_string", "NI_UnitDescription")
+
+
+@dataclasses.dataclass(frozen=True)
+class Variable:
+    """A one-dimensional channel or variable of a rig file.
+
+    Attributes
+    ----------
+    name : str
+        Its full name, ``group/name`` (``Rig/Force``), or ``name`` at the root.
+    group : str
+        The group path (``''`` for the root).
+    short : str
+        Its own name, without the group (a TDMS channel's may hold a ``/``).
+    size : int
+        Number of samples.
+    units : tuple of str
+        The units its metadata gives (none, or one).
+    chunk : int
+        Samples per chunk in the file, or 0 if the file does not say.
+    packing : tuple
+        ``(scale_factor, add_offset, fill_values)`` of CF packing, or None.
+    """
+
+    name: str
+    group: str
+    short: str
+    size: int
+    units: tuple = ()
+    chunk: int = 0
+    packing: tuple | None = None
+
+
+def _text(value) -> str | None:
+    """An attribute as text (bytes decoded, arrays of one item unwrapped), or None."""
+    if isinstance(value, np.ndarray) and value.size == 1:
+        value = value.reshape(()).item()
+    if isinstance(value, bytes):
+        value = value.decode("utf-8", errors="replace")
+    if isinstance(value, str) and value.strip():
+        return value.strip()
+    return None
+
+
+def _units(attrs) -> tuple:
+    for key in _UNIT_ATTRIBUTES:
+        if key in attrs:
+            unit = _text(attrs[key])
+            if unit is not None:
+                return (unit,)
+    return ()
+
+
+def _packing(attrs):
+    """CF packing from a variable's attributes, or None."""
+    keys = ("scale_factor", "add_offset", "_FillValue", "missing_value")
+    if not any(key in attrs for key in keys):
+        return None
+    fills = tuple(
+        float(np.asarray(attrs[key]).reshape(-1)[0])
+        for key in ("_FillValue", "missing_value")
+        if key in attrs and np.asarray(attrs[key]).size
+    )
+    scale = float(np.asarray(attrs.get("scale_factor", 1.0)).reshape(-1)[0])
+    offset = float(np.asarray(attrs.get("add_offset", 0.0)).reshape(-1)[0])
+    return scale, offset, fills
+
+
+# --- TDMS ------------------------------------------------------------------------------------
+
+
+class _TdmsNotices(logging.Handler):
+    """Collects npTDMS's warnings while a file is opened (a short last segment)."""
+
+    def __init__(self):
+        super().__init__(logging.WARNING)
+        self.messages: list[str] = []
+
+    def emit(self, record):
+        self.messages.append(record.getMessage())
+
+
+def _open_tdms(path: Path):
+    from nptdms import TdmsFile
+
+    logger = logging.getLogger("nptdms")
+    notices = _TdmsNotices()
+    logger.addHandler(notices)
+    propagate, logger.propagate = logger.propagate, False
+    try:
+        handle = TdmsFile.open(path)
+    except Exception as error:
+        raise RecordingError(path, None, f"cannot read as TDMS: {error}") from None
+    finally:
+        logger.removeHandler(notices)
+        logger.propagate = propagate
+    if notices.messages:
+        handle.close()
+        raise RecordingError(
+            path, None, f"truncated or damaged TDMS file ({'; '.join(notices.messages)})"
+        )
+    return handle
+
+
+def _tdms_variables(path: Path) -> list[Variable]:
+    with _open_tdms(path) as handle:
+        return [
+            Variable(
+                name=f"{group.name}/{channel.name}",
+                group=group.name,
+                short=channel.name,
+                size=len(channel),
+                units=_units(channel.properties),
+            )
+            for group in handle.groups()
+            for channel in group.channels()
+            if len(channel) and np.issubdtype(channel.dtype, np.number)
+        ]
+
+
+# --- HDF5 and netCDF-4 -----------------------------------------------------------------------
+
+
+def _open_hdf5(path: Path):
+    import h5py
+
+    try:
+        return h5py.File(path, "r")
+    except OSError as error:
+        message = f"cannot open as HDF5 (truncated or damaged): {error}"
+        raise RecordingError(path, None, message) from None
+
+
+def _hdf5_variables(path: Path) -> list[Variable]:
+    import h5py
+
+    found = []
+
+    def visit(name, item):
+        if not isinstance(item, h5py.Dataset) or item.ndim != 1:
+            return
+        if not np.issubdtype(item.dtype, np.number):
+            return
+        if "not a netCDF variable" in str(_text(item.attrs.get("NAME", b"")) or ""):
+            return  # a netCDF dimension without values
+        group, _, short = name.rpartition("/")
+        found.append(
+            Variable(
+                name=name,
+                group=group,
+                short=short,
+                size=int(item.shape[0]),
+                units=_units(item.attrs),
+                chunk=int(item.chunks[0]) if item.chunks else 0,
+                packing=_packing(item.attrs),
+            )
+        )
+
+    with _open_hdf5(path) as handle:
+        handle.visititems(visit)
+    return found
+
+
+# --- zarr ------------------------------------------------------------------------------------
+
+
+def _open_zarr(path: Path):
+    import zarr
+
+    try:
+        return zarr.open(store=str(path), mode="r")
+    except Exception as error:
+        raise RecordingError(path, None, f"cannot open as a zarr store: {error}") from None
+
+
+def _zarr_variables(path: Path) -> list[Variable]:
+    import zarr
+
+    root = _open_zarr(path)
+    is_array = isinstance(root, zarr.Array)
+    members = [("", root)] if is_array else list(root.members(max_depth=None))
+    found = []
+    for name, item in members:
+        if not isinstance(item, zarr.Array) or item.ndim != 1:
+            continue
+        if not np.issubdtype(item.dtype, np.number):
+            continue
+        name = name or path.stem
+        group, _, short = name.rpartition("/")
+        found.append(
+            Variable(
+                name=name,
+                group=group,
+                short=short,
+                size=int(item.shape[0]),
+                units=_units(item.attrs),
+                chunk=int(item.chunks[0]),
+                packing=_packing(item.attrs),
+            )
+        )
+    return found
+
+
+def _zarr_array(root, variable: Variable):
+    """The array of ``variable`` in a store opened at ``root`` (which may be the array)."""
+    import zarr
+
+    return root if isinstance(root, zarr.Array) else root[variable.name]
+
+
+def _zarr_complete(path: Path, variable: Variable) -> None:
+    """Refuse a zarr array some of whose chunk files are missing (read as fill values)."""
+    array = _zarr_array(_open_zarr(path), variable)
+    present, expected = array.nchunks_initialized, array.nchunks
+    if present < expected:
+        raise RecordingError(
+            path,
+            f"variable {variable.name!r}",
+            f"{expected - present} of its {expected} chunks are missing "
+            "(a truncated or partly copied store)",
+        )
+
+
+_LISTS = {"tdms": _tdms_variables, "hdf5": _hdf5_variables, "zarr": _zarr_variables}
+
+
+def variables(path, kind: str) -> list[Variable]:
+    """The one-dimensional numeric channels or variables of a rig file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    kind : {'tdms', 'hdf5', 'zarr'}
+        The format (see :func:`ecofmaps.io.recordings.recording_format`).
+
+    Returns
+    -------
+    variables : list of Variable
+    """
+    return _LISTS[kind](Path(path))
+
+
+# --- reading ranges --------------------------------------------------------------------------
+
+
+class Column:
+    """One channel or variable as an array-like of float64 in SI, read range by range.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+    kind : {'tdms', 'hdf5', 'zarr'}
+    variable : Variable
+    factor : float
+        From the file's values (after CF unpacking) to SI.
+    nan_policy : {'propagate', 'raise'}
+        Non-finite values become NaN, or raise :class:`RecordingError` naming the sample.
+
+    Notes
+    -----
+    Indexing with a slice (step 1) returns a NumPy array; what dask's ``from_array``
+    needs (``shape``, ``dtype``, ``ndim``). The open file is kept per process and per
+    column, behind a lock, and is not pickled.
+    """
+
+    def __init__(self, path: Path, kind: str, variable: Variable, factor: float, nan_policy):
+        self.path, self.kind, self.variable = path, kind, variable
+        self.factor, self.nan_policy = factor, nan_policy
+        self.shape = (variable.size,)
+        self.dtype = np.dtype(np.float64)
+        self.ndim = 1
+        self._handle = None
+        self._lock = threading.Lock()
+
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        state["_handle"] = None
+        del state["_lock"]
+        return state
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self._lock = threading.Lock()
+
+    def __len__(self) -> int:
+        return self.variable.size
+
+    def _source(self):
+        """The open channel or dataset (opened on first use in this process)."""
+        if self._handle is None:
+            if self.kind == "tdms":
+                handle = _open_tdms(self.path)
+                self._handle = (handle, handle[self.variable.group][self.variable.short])
+            elif self.kind == "hdf5":
+                handle = _open_hdf5(self.path)
+                self._handle = (handle, handle[self.variable.name])
+            else:
+                root = _open_zarr(self.path)
+                self._handle = (root, _zarr_array(root, self.variable))
+        return self._handle[1]
+
+    def __del__(self):
+        try:  # noqa: SIM105 - contextlib may be gone at interpreter shutdown
+            self.close()
+        except Exception:
+            pass
+
+    def close(self) -> None:
+        """Close the file (it is opened again on the next read)."""
+        with self._lock:
+            if self._handle is not None and hasattr(self._handle[0], "close"):
+                self._handle[0].close()
+            self._handle = None
+
+    def __getitem__(self, key):
+        if isinstance(key, tuple) and len(key) == 1:
+            key = key[0]
+        if not isinstance(key, slice):
+            raise TypeError("a Column is read by a slice start:stop")
+        start, stop, step = key.indices(self.variable.size)
+        if step != 1:
+            raise TypeError("a Column is read by a slice start:stop (step 1)")
+        stop = max(start, stop)
+        where = f"{_KIND[self.kind]} {self.variable.name!r}, samples {start} to {stop - 1}"
+        try:
+            with self._lock:
+                raw = np.asarray(self._source()[start:stop])
+        except RecordingError:
+            raise
+        except Exception as error:
+            raise RecordingError(self.path, where, f"cannot read: {error}") from None
+        if raw.shape != (stop - start,):
+            raise RecordingError(
+                self.path, where, f"read {raw.size} samples where {stop - start} were expected"
+            )
+        values = raw.astype(np.float64, copy=not raw.flags.writeable)  # a copy, or the new array
+        if self.variable.packing is not None:
+            scale, offset, fills = self.variable.packing
+            for fill in fills:
+                values[raw == fill] = np.nan
+            if scale != 1.0 or offset != 0.0:
+                values = values * scale + offset
+        missing = ~np.isfinite(values)
+        if missing.any():
+            if self.nan_policy == "raise":
+                first = int(np.argmax(missing))
+                raise RecordingError(
+                    self.path,
+                    f"{_KIND[self.kind]} {self.variable.name!r}, sample {start + first}",
+                    f"missing value ({values[first]})",
+                )
+            values[missing] = np.nan
+        from ecofmaps.io.text import _to_si
+
+        return _to_si(values, self.factor)
+
+
+def _select(path: Path, kind: str, found: list[Variable], options: dict) -> dict:
+    """The variable for each role, by name (and group)."""
+    noun = _KIND[kind]
+    if options["group"] is not None:
+        group = options["group"].strip("/")
+        groups = sorted({v.group for v in found})
+        found = [v for v in found if v.group == group]
+        if not found:
+            listed = ", ".join(repr(g) for g in groups)
+            raise RecordingError(path, None, f"no group {group!r} with channels (groups: {listed})")
+    if not found:
+        raise RecordingError(path, None, f"no one-dimensional numeric {noun} in the file")
+    wanted = {"displacement": options["displacement_column"], "force": options["force_column"]}
+    required = {"displacement": True, "force": True}
+    wanted["cycle"] = options["cycle_column"] or "cycle"
+    required["cycle"] = options["cycle_column"] is not None
+    chosen = {}
+    for role, name in wanted.items():
+        full = [k for k, v in enumerate(found) if v.name.strip("/").lower() == name.lower()]
+        matches = full or matching_columns([v.short for v in found], name)
+        if role != "displacement" and len(matches) != 1 and "displacement" in chosen:
+            # The force and cycle channels are sought in the displacement's group first.
+            group = chosen["displacement"].group
+            beside = [k for k in matches if found[k].group == group]
+            matches = beside if len(beside) == 1 or not required[role] else matches
+        if len(matches) > 1:
+            names = ", ".join(repr(found[k].name) for k in matches)
+            raise RecordingError(
+                path,
+                None,
+                f"several {role} {noun}s match {name!r}: {names}; choose one with its full "
+                "name or with group",
+            )
+        if not matches:
+            if not required[role]:
+                continue
+            names = ", ".join(repr(v.name) for v in found)
+            raise RecordingError(path, None, f"no {role} {noun} {name!r} ({noun}s: {names})")
+        chosen[role] = found[matches[0]]
+    if chosen["displacement"] == chosen["force"]:
+        raise RecordingError(
+            path,
+            None,
+            f"the displacement and force {noun}s are the same {noun} {chosen['force'].name!r}",
+        )
+    reference = chosen["displacement"]
+    for variable in chosen.values():
+        if variable.size != reference.size:
+            raise RecordingError(
+                path,
+                f"{noun} {variable.name!r}",
+                f"{variable.size} samples where the displacement {noun} "
+                f"{reference.name!r} has {reference.size}",
+            )
+    return chosen
+
+
+def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None) -> Recording:
+    """A rig file as a :class:`~ecofmaps.io.recordings.Recording` (see
+    :func:`ecofmaps.io.read_recording` for the options)."""
+    chosen = _select(path, kind, variables(path, kind), options)
+    if kind == "zarr":
+        for variable in chosen.values():
+            _zarr_complete(path, variable)
+    columns, units = {}, {}
+    for role, variable in chosen.items():
+        factor, unit = 1.0, "1"
+        if role != "cycle":
+            carried = [u for u in [split_unit(variable.short)[1], *variable.units] if u]
+            try:
+                factor, unit = column_scale(role, options[f"{role}_unit"], carried, variable.name)
+            except ColumnError as error:
+                raise RecordingError(path, f"{_KIND[kind]} {variable.name!r}", str(error)) from None
+        columns[role] = Column(path, kind, variable, factor, options["nan_policy"])
+        units[role] = unit
+    size = chosen["displacement"].size
+    if size == 0:
+        raise RecordingError(path, f"{_KIND[kind]} {chosen['displacement'].name!r}", "no samples")
+    lazy = size > LAZY_SAMPLES if lazy is None else lazy
+    if lazy:
+        import dask.array as da
+        from dask.base import tokenize
+
+        stat = path.stat()
+        native = max(v.chunk for v in chosen.values()) or 1
+        block = int(chunks) if chunks else max(native, DEFAULT_CHUNK // native * native)
+        token = tokenize(str(path.resolve()), stat.st_mtime_ns, stat.st_size, options, block)
+        arrays = {
+            role: da.from_array(
+                column,
+                chunks=(min(block, max(size, 1)),),
+                asarray=False,
+                lock=False,
+                name=f"ecofmaps-{kind}-{role}-{token}",
+                meta=np.empty(0, np.float64),
+            )
+            for role, column in columns.items()
+        }
+    else:
+        arrays = {}
+        for role, column in columns.items():
+            arrays[role] = column[0:size]
+            column.close()
+    return Recording(
+        path=path,
+        displacement=arrays["displacement"],
+        force=arrays["force"],
+        cycle=arrays.get("cycle"),
+        columns={role: variable.name for role, variable in chosen.items()},
+        units=units,
+    )

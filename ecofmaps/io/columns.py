@@ -1,0 +1,255 @@
+"""Column names as labs write them: finding a column, and the unit its name carries.
+
+Rig software and spreadsheets put the unit in the column's name: ``force [N]``,
+``displacement (um)``, ``Displacement/µm``, ``delta_mm``, ``Ftr_kN``. :func:`split_unit`
+separates such a name into its base and its unit; :func:`find_column` finds a column by
+its name or its base (without regard to case), so ``displacement`` finds
+``Displacement [µm]``; :func:`column_scale` decides the factor to SI from the unit given as
+an option, the unit the file carries, or the default (µm and N).
+
+The rules, in order, for a name's unit:
+
+1. A unit in square brackets or parentheses at the end (``force [N]``,
+   ``displacement (um)``) is always split off if it reads as a unit (of any kind: ``[V]``
+   is a unit, ``(tangential)`` is not and stays part of the name).
+2. A unit after a slash (``Displacement/µm``, ``F / kN``), an underscore (``delta_mm``) or
+   a space (``force N``) is split off only if it is a length or a force, so ``time_s``
+   and ``cycle_no`` keep their names.
+
+A unit option given explicitly and a unit carried by the file must agree (same factor):
+a disagreement is an error, as one of them is wrong by a factor the analysis cannot see.
+A carried unit of another kind (``force [V]``, a raw sensor channel) is overruled by an
+explicit option, and is an error without one.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import re
+
+__all__ = [
+    "COMMON_UNITS",
+    "DEFAULT_UNITS",
+    "KINDS",
+    "ColumnError",
+    "column_scale",
+    "find_column",
+    "matching_columns",
+    "split_unit",
+]
+
+#: The kind of quantity of each column role, as :func:`ecofmaps.units.parse_quantity` names it.
+KINDS = {"displacement": "length", "force": "force"}
+
+#: The unit of a column whose name, metadata and options say none.
+DEFAULT_UNITS = {"displacement": "um", "force": "N"}
+
+#: The units rigs write most, with their kind and factor to SI, read without starting pint
+#: (whose registry takes a good part of a second to build); any other goes to pint.
+COMMON_UNITS = {
+    "m": ("length", 1.0),
+    "mm": ("length", 1e-3),
+    "um": ("length", 1e-6),
+    "µm": ("length", 1e-6),
+    "μm": ("length", 1e-6),
+    "nm": ("length", 1e-9),
+    "N": ("force", 1.0),
+    "kN": ("force", 1e3),
+    "mN": ("force", 1e-3),
+}
+
+_BRACKETED = re.compile(r"^(?P<base>.*?)\s*(?:\[(?P<square>[^\[\]]*)\]|\((?P<round>[^()]*)\))$")
+_SLASHED = re.compile(r"^(?P<base>[^/]*?)\s*/\s*(?P<unit>[^/]+?)$")
+_SUFFIXED = re.compile(r"^(?P<base>.*?[^_\s])[_\s]+(?P<unit>[^_\s]+)$")
+
+
+class ColumnError(ValueError):
+    """A column that cannot be found or whose unit cannot be trusted (no file position)."""
+
+
+@functools.lru_cache(maxsize=1024)
+def _unit_kind(unit: str) -> str | None:
+    """'length' or 'force' if ``unit`` reads as one, 'other' for another unit, else None."""
+    text = unit.strip()
+    if text in COMMON_UNITS:
+        return COMMON_UNITS[text][0]
+    if not text or text[0].isdigit():
+        return None
+    from ecofmaps.units import parse_quantity  # pint, imported only when needed
+
+    for kind in ("length", "force"):
+        try:
+            parse_quantity(f"1 {text}", kind)
+        except ValueError as error:
+            if "is not a" not in str(error):
+                return None  # not a unit at all
+            continue
+        return kind
+    return "other"
+
+
+def _normal(name: str) -> str:
+    """A name without case, surrounding quotes or repeated blanks."""
+    return " ".join(name.strip().strip("\"'").split()).lower()
+
+
+def split_unit(name: str) -> tuple[str, str | None]:
+    """A column name's base and the unit it carries.
+
+    Parameters
+    ----------
+    name : str
+        A column, channel or variable name, e.g. ``'force [N]'``, ``'delta_mm'``.
+
+    Returns
+    -------
+    base : str
+        The name without its unit, surrounding quotes and blanks.
+    unit : str or None
+        The unit as written (``'N'``, ``'mm'``, ``'µm'``), or None.
+
+    Examples
+    --------
+    >>> split_unit("force [N]"), split_unit("Displacement/µm"), split_unit("Ftr_kN")
+    (('force', 'N'), ('Displacement', 'µm'), ('Ftr', 'kN'))
+    >>> split_unit("time_s"), split_unit("Force (tangential)")
+    (('time_s', None), ('Force (tangential)', None))
+    """
+    text = name.strip().strip("\"'").strip()
+    match = _BRACKETED.match(text)
+    if match and match.group("base"):
+        unit = (match.group("square") or match.group("round") or "").strip()
+        if _unit_kind(unit) is not None:
+            return match.group("base").strip(), unit
+    for pattern in (_SLASHED, _SUFFIXED):
+        match = pattern.match(text)
+        if match and match.group("base") and _unit_kind(match.group("unit")) in KINDS.values():
+            return match.group("base").strip(), match.group("unit").strip()
+    return text, None
+
+
+def find_column(names, wanted: str, role: str, *, required: bool = True) -> int | None:
+    """The index of the column ``wanted`` among ``names``.
+
+    Parameters
+    ----------
+    names : sequence of str
+        The names in the file (header cells, channels or variables).
+    wanted : str
+        The name asked for: matched first against the whole names, then against their
+        bases (:func:`split_unit`), without regard to case or repeated blanks.
+    role : str
+        What the column holds (``'displacement'``, ``'force'``, ``'cycle'``), for messages.
+    required : bool
+        Whether a missing column is an error; if not, None is returned for it.
+
+    Returns
+    -------
+    index : int or None
+
+    Raises
+    ------
+    ColumnError
+        If no name matches (and the column is required), or several match only by their
+        base.
+
+    Examples
+    --------
+    >>> find_column(["time", "Displacement [µm]", "Ftr_kN"], "displacement", "displacement")
+    1
+    >>> find_column(["time", "Displacement [µm]", "Ftr_kN"], "FTR", "force")
+    2
+    """
+    matches = matching_columns(names, wanted)
+    if len(matches) > 1:
+        found = ", ".join(repr(names[k]) for k in matches)
+        raise ColumnError(f"several {role} columns match {wanted!r}: {found}")
+    if not matches and not required:
+        return None
+    if not matches:
+        listed = ", ".join(repr(name) for name in names)
+        raise ColumnError(f"no {role} column {wanted!r} (columns: {listed})")
+    return matches[0]
+
+
+def matching_columns(names, wanted: str) -> list[int]:
+    """The indices of the names that match ``wanted`` (see :func:`find_column`): the one
+    whole name equal to it, else those whose base is its base."""
+    target = _normal(wanted)
+    whole = [k for k, name in enumerate(names) if _normal(name) == target]
+    if len(whole) == 1:
+        return whole
+    base = _normal(split_unit(wanted)[0])
+    by_base = [k for k, name in enumerate(names) if _normal(split_unit(name)[0]) == base]
+    return whole if len(whole) > 1 else by_base
+
+
+def _factor(unit: str, kind: str, option: str | None) -> float:
+    if unit.strip() in COMMON_UNITS and COMMON_UNITS[unit.strip()][0] == kind:
+        return COMMON_UNITS[unit.strip()][1]
+    from ecofmaps.units import parse_quantity  # pint, imported only when needed
+
+    try:
+        return parse_quantity(f"1 {unit}", kind)
+    except ValueError as error:
+        if option is None:
+            raise
+        raise ValueError(f"{option}={unit!r} is not a {kind} unit ({error})") from None
+
+
+def column_scale(role: str, option_unit, carried, column: str) -> tuple[float, str]:
+    """The factor from a column's values to SI, and the unit it stands for.
+
+    Parameters
+    ----------
+    role : str
+        ``'displacement'`` or ``'force'``.
+    option_unit : str or None
+        The unit given as the option ``<role>_unit``; None to take the file's.
+    carried : sequence of str
+        The units the file gives for the column (from its name and its metadata), any
+        number of them, each a unit's text.
+    column : str
+        The column's name in the file, for messages.
+
+    Returns
+    -------
+    factor : float
+        Multiply the values by it (or divide by its reciprocal) for SI (m or N).
+    unit : str
+        The unit used.
+
+    Raises
+    ------
+    ValueError
+        If ``option_unit`` is not a unit of the role's kind; the message names the option.
+    ColumnError
+        If units disagree (an option against the file, or two in the file), or the file
+        gives a unit of another kind and no option overrules it.
+    """
+    kind = KINDS[role]
+    option = f"{role}_unit"
+    given = None if option_unit is None else (option_unit, _factor(option_unit, kind, option))
+    readable = []
+    for unit in dict.fromkeys(carried):
+        if _unit_kind(unit) == kind:
+            readable.append((unit, _factor(unit, kind, None)))
+        elif given is None:
+            raise ColumnError(
+                f"the {role} column {column!r} is in {unit!r}, which is not a {kind} unit; "
+                f"give {option} to say how to read it"
+            )
+    for unit, factor in readable:
+        for other, other_factor in readable if given is None else [given]:
+            if not math.isclose(factor, other_factor, rel_tol=1e-12):
+                told = f"{option}={other!r}" if given is not None else repr(other)
+                raise ColumnError(
+                    f"the {role} column {column!r} is in {unit!r}, but {told} says otherwise "
+                    f"(a factor {factor / other_factor:.6g}); remove one or make them agree"
+                )
+    if given is not None:
+        return given[1], given[0]
+    if readable:
+        return readable[0][1], readable[0][0]
+    return _factor(DEFAULT_UNITS[role], kind, None), DEFAULT_UNITS[role]

@@ -1,0 +1,400 @@
+"""Recordings in text files (CSV, TSV, spreadsheet exports), read in blocks.
+
+The file is read in blocks of about :data:`BLOCK_BYTES` bytes cut at line ends, so a
+large file is never held whole as text: only the columns asked for are kept, as float64.
+Each block is parsed by pandas' C parser, and every sample keeps the number of the line
+it came from, for messages.
+
+What the reader accepts:
+
+- Separator: the first of tab, semicolon or comma found in the header line (outside
+  quotes), else runs of blanks; whatever the file's suffix.
+- Decimal comma (``1,25;-3,5``) when the separator is not a comma: decided from the
+  first block whose numbers show either a comma or a point.
+- Quoted cells (``"1.25"``), a byte-order mark, CRLF line ends, lines starting with
+  ``#`` and blank lines anywhere (skipped).
+- Encoding: UTF-8; a file that is not (a Latin-1 ``µ`` from an old rig PC) is read as
+  Latin-1 from its first undecodable line on, with a :class:`RecordingWarning` naming the
+  file and the line. Latin-1 decodes every byte, and the digits, signs and separators are
+  the same in both, so no number can change; only names can. A UTF-16 file (a
+  spreadsheet's "Unicode text" export, found by its byte-order mark) is decoded as such.
+- Missing samples: an empty cell, ``nan``, ``NA``, ``N/A``, ``null`` (and a few more,
+  :data:`MISSING`) or an infinite value is a missing sample, NaN in the arrays; with
+  ``nan_policy='raise'`` it is an error naming the line. Any other text in a cell is an
+  error naming the line.
+"""
+
+from __future__ import annotations
+
+import codecs
+import csv
+import io
+import re
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ecofmaps.io.columns import ColumnError, column_scale, find_column, split_unit
+
+__all__ = ["BLOCK_BYTES", "MISSING", "text_blocks"]
+
+#: Bytes of text parsed at a time (cut at the last line end within).
+BLOCK_BYTES = 1 << 24
+
+#: Cell contents read as a missing sample (besides an empty cell and infinite values).
+MISSING = ("nan", "NaN", "NAN", "-nan", "-NaN", "NA", "N/A", "n/a", "#N/A", "null", "NULL", "None")
+
+_COMMA_DECIMAL = re.compile(r"(?:^|[;\t \"])[+-]?\d*,\d+(?:[eE][+-]?\d+)?(?=$|[;\t \"])", re.M)
+_POINT_DECIMAL = re.compile(r"\d\.\d|(?:^|[;\t \"])[+-]?\.\d", re.MULTILINE)
+_NUMBER = re.compile(r"^[+-]?(?:\d+[.,]?\d*|[.,]\d+)(?:[eE][+-]?\d+)?$")
+# pandas 3 parses floats exactly by default and deprecates the option; pandas 2 needs it.
+_EXACT = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
+
+
+def _is_data(line: str) -> bool:
+    """Whether a line holds data (or the header): not blank, not a ``#`` comment."""
+    stripped = line.strip()
+    return bool(stripped) and not stripped.startswith("#")
+
+
+def _raw_blocks(stream, block_bytes: int):
+    """Bytes of whole lines, about ``block_bytes`` at a time (the last may lack a newline)."""
+    rest = b""
+    while True:
+        data = stream.read(block_bytes)
+        if not data:
+            if rest:
+                yield rest
+            return
+        data = rest + data
+        cut = data.rfind(b"\n") + 1
+        if cut == 0:
+            rest = data
+            continue
+        rest = data[cut:]
+        yield data[:cut]
+
+
+class _Decoder:
+    """UTF-8 text, falling back to Latin-1 (with a warning) from the first bad line on."""
+
+    def __init__(self, path: Path):
+        self.path = path
+        self.encoding = "utf-8"
+
+    def __call__(self, data: bytes, first_line: int) -> str:
+        if self.encoding == "utf-8":
+            try:
+                return data.decode("utf-8")
+            except UnicodeDecodeError as error:
+                from ecofmaps.io.recordings import RecordingWarning
+
+                line = first_line + data.count(b"\n", 0, error.start)
+                byte = data[error.start]
+                warnings.warn(
+                    f"{self.path}, line {line}: byte 0x{byte:02x} is not UTF-8; the file is "
+                    "read as Latin-1 from this line on (numbers are the same in both)",
+                    RecordingWarning,
+                    stacklevel=5,
+                )
+                self.encoding = "latin-1"
+                return data[: error.start].decode("utf-8") + data[error.start :].decode("latin-1")
+        return data.decode("latin-1")
+
+
+def _open_text(path: Path):
+    """A binary stream of the file's UTF-8 (or Latin-1) bytes, without byte-order mark."""
+    stream = open(path, "rb")  # noqa: SIM115 - closed by the caller
+    head = stream.read(4)
+    if head.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)) and not head.startswith(
+        codecs.BOM_UTF32_LE
+    ):
+        # A spreadsheet's "Unicode text": limited to about a million rows, so decoded whole.
+        with stream:
+            data = head + stream.read()
+        try:
+            return io.BytesIO(data.decode("utf-16").encode("utf-8"))
+        except UnicodeDecodeError as error:
+            from ecofmaps.io.recordings import RecordingError
+
+            text = data[: error.start].decode("utf-16", errors="replace")
+            raise RecordingError(
+                path, text.count("\n") + 1, "damaged UTF-16 text (an odd byte)"
+            ) from None
+    stream.seek(len(codecs.BOM_UTF8) if head.startswith(codecs.BOM_UTF8) else 0)
+    return stream
+
+
+def _separator(header: str):
+    """The field separator of the header line: tab, semicolon or comma (outside quotes),
+    else None (runs of blanks)."""
+    unquoted = re.sub(r'"[^"]*"', "", header)
+    for candidate in ("\t", ";", ","):
+        if candidate in unquoted:
+            return candidate
+    return None
+
+
+def _fields(line: str, separator) -> list[str]:
+    """The cells of one line, quotes removed."""
+    if separator is None:
+        return [cell.strip('"') for cell in line.split()]
+    return [cell.strip() for cell in next(csv.reader([line], delimiter=separator))]
+
+
+def _header_names(line: str, separator) -> list[str]:
+    """The column names; with blank separators a bracketed unit joins the name before it."""
+    names = _fields(line, separator)
+    if separator is None:
+        joined: list[str] = []
+        for name in names:
+            if joined and re.fullmatch(r"\[[^\]]*\]|\([^)]*\)", name):
+                joined[-1] = f"{joined[-1]} {name}"
+            else:
+                joined.append(name)
+        names = joined
+    return [name.lstrip("\ufeff") for name in names]
+
+
+class _Layout:
+    """What the header says: separator, names, the columns wanted and their scales."""
+
+    def __init__(self, path: Path, header_line: int, header: str, options: dict):
+        from ecofmaps.io.recordings import RecordingError
+
+        self.path = path
+        self.header_line = header_line
+        self.separator = _separator(header)
+        self.names = _header_names(header, self.separator)
+        if self.names and all(_NUMBER.match(name) for name in self.names):
+            raise RecordingError(
+                path,
+                header_line,
+                "the first line holds numbers, not column names: add a header line "
+                "(e.g. displacement,force)",
+            )
+        wanted = {"displacement": options["displacement_column"], "force": options["force_column"]}
+        try:
+            if options["cycle_column"] is not None:
+                wanted["cycle"] = options["cycle_column"]
+            elif find_column(self.names, "cycle", "cycle", required=False) is not None:
+                wanted["cycle"] = "cycle"
+            self.columns = {
+                role: find_column(self.names, name, role) for role, name in wanted.items()
+            }
+            if self.columns["displacement"] == self.columns["force"]:
+                raise ColumnError(
+                    f"the displacement and force columns are the same column "
+                    f"{self.names[self.columns['force']]!r}"
+                )
+            self.scales, self.units = {}, {}
+            for role in ("displacement", "force"):
+                name = self.names[self.columns[role]]
+                carried = [unit for unit in [split_unit(name)[1]] if unit is not None]
+                self.scales[role], self.units[role] = column_scale(
+                    role, options[f"{role}_unit"], carried, name
+                )
+        except ColumnError as error:
+            raise RecordingError(path, header_line, str(error)) from None
+        self.scales["cycle"], self.units["cycle"] = 1.0, "1"
+        self.width = len(self.names)
+        self.decimal = "." if self.separator == "," else None
+        self.nan_policy = options["nan_policy"]
+
+    def decide_decimal(self, body: str) -> None:
+        """Decimal comma or point, from the first block whose numbers show one."""
+        if _COMMA_DECIMAL.search(body):
+            self.decimal = ","
+        elif _POINT_DECIMAL.search(body):
+            self.decimal = "."
+
+    def field_error(self, lines: list[str], numbers) -> None:
+        """Raise for the first line whose number of cells is not the header's."""
+        from ecofmaps.io.recordings import RecordingError
+
+        for line, number in zip(lines, numbers, strict=True):
+            count = len(_fields(line, self.separator))
+            if count != self.width:
+                raise RecordingError(
+                    self.path, number, f"{count} fields where the header has {self.width}"
+                )
+
+    def data_lines(self, lines: list[str]) -> list[int]:
+        """The indices of the lines that hold data: not blank (blanks other than the
+        separator), not a ``#`` comment."""
+        blanks = " \r" if self.separator == "\t" else " \t\r"
+        return [
+            k for k, line in enumerate(lines) if (text := line.strip(blanks)) and text[0] != "#"
+        ]
+
+    def parse(self, body, numbers: np.ndarray, lines: list[str] | None = None):
+        """The wanted columns of the data lines ``body``, in SI, by role.
+
+        Without ``lines``, ``body`` is a block as read (UTF-8 bytes, or text), and the
+        result is None if anything is amiss (a line with the wrong number of cells or
+        blank, a cell that is not a number, a missing sample to raise for, a byte that is
+        not UTF-8), for the caller to drop blank and comment lines and call again with the
+        text ``lines`` kept, which are then checked one by one and the error raised."""
+        from ecofmaps.io.recordings import RecordingError
+
+        careful = lines is not None
+        raw = isinstance(body, bytes)
+        if self.decimal is None:
+            self.decide_decimal(body.decode("utf-8", errors="replace") if raw else body)
+        count = numbers.size
+        separator = self.separator.encode() if raw and self.separator else self.separator
+        counted = (
+            body.count(separator) == count * (self.width - 1)
+            if separator is not None
+            else len(body.split()) == count * self.width
+        )
+        if not counted:  # a line with too few or too many cells, or separators in quotes
+            if not careful:
+                return None
+            self.field_error(lines, numbers)
+        try:
+            frame = pd.read_csv(
+                io.BytesIO(body) if raw else io.StringIO(body),
+                sep=self.separator or r"\s+",
+                header=None,
+                names=list(range(self.width)),
+                usecols=sorted(set(self.columns.values())),
+                engine="c",
+                decimal=self.decimal or ".",
+                quotechar='"',
+                keep_default_na=False,
+                na_values=["", *MISSING],
+                skip_blank_lines=False,
+                skipinitialspace=True,
+                lineterminator=None if raw else "\n",
+                encoding="utf-8" if raw else None,
+                **_EXACT,
+            )
+        except (pd.errors.ParserError, UnicodeDecodeError) as error:
+            if not careful:
+                return None
+            self.field_error(lines, numbers)
+            raise RecordingError(self.path, numbers[0], f"cannot parse: {error}") from None
+        if len(frame) != count:  # a quoted line end, or a lone carriage return
+            if not careful:
+                return None
+            raise RecordingError(self.path, numbers[0], "a quoted cell spans lines")
+        values = {}
+        for role, index in self.columns.items():
+            column = frame[index]
+            name = self.names[index]
+            if not pd.api.types.is_numeric_dtype(column.dtype):
+                if not careful:
+                    return None
+                cells = column.astype(object).where(column.notna(), None)
+                if self.decimal == ",":
+                    cells = cells.str.replace(",", ".", regex=False)
+                bad = (pd.to_numeric(cells, errors="coerce").isna() & column.notna()).to_numpy()
+                first = int(np.argmax(bad))
+                raise RecordingError(
+                    self.path,
+                    numbers[first],
+                    f"non-numeric value {column.iloc[first]!r} in column {name!r}",
+                )
+            values[role] = column.to_numpy(dtype=np.float64)
+        missing = {role: ~np.isfinite(data) for role, data in values.items()}
+        if self.nan_policy == "raise" and any(bad.any() for bad in missing.values()):
+            if not careful:
+                return None
+            first, role = min(
+                (int(np.argmax(bad)), role) for role, bad in missing.items() if bad.any()
+            )
+            index = self.columns[role]
+            cell = _fields(lines[first], self.separator)[index]
+            what = "non-finite" if np.isinf(values[role][first]) else "missing"
+            raise RecordingError(
+                self.path, numbers[first], f"{what} value {cell!r} in column {self.names[index]!r}"
+            )
+        return {
+            role: _to_si(np.where(missing[role], np.nan, data), self.scales[role])
+            for role, data in values.items()
+        }
+
+
+def _to_si(values: np.ndarray, factor: float) -> np.ndarray:
+    """``values * factor``; for a factor 10^-k, divided by the exact 10^k instead, so that a
+    typed ``25`` µm is the float nearest 25e-6 (one rounding, not two)."""
+    if factor == 1.0:
+        return values
+    inverse = round(1.0 / factor)
+    if factor < 1.0 and inverse == 1.0 / factor and float(inverse) == inverse:
+        return values / float(inverse)
+    return values * factor
+
+
+def text_blocks(path: Path, options: dict, block_bytes: int = BLOCK_BYTES):
+    """Parse a text recording block by block.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+    options : dict
+        The column, unit and nan_policy options of :func:`ecofmaps.io.read_recording`.
+    block_bytes : int
+        Bytes of text parsed at a time.
+
+    Yields
+    ------
+    layout : _Layout
+        First, once: the header's layout (names, the columns used, units).
+    values, lines : dict, numpy.ndarray
+        Then per block: the wanted columns in SI by role, and the 1-based line number of
+        each sample.
+
+    Raises
+    ------
+    RecordingError
+        For a missing or doubtful column, a line with the wrong number of fields, a cell
+        that is not a number (or, with ``nan_policy='raise'``, a missing one), or no data.
+    """
+    from ecofmaps.io.recordings import RecordingError
+
+    decoder = _Decoder(path)
+    layout = None
+    line = 1  # number of the first line of the block
+    with _open_text(path) as stream:
+        for raw in _raw_blocks(stream, block_bytes):
+            start = line
+            line += raw.count(b"\n") + (not raw.endswith(b"\n"))
+            if layout is not None and decoder.encoding == "utf-8" and b"#" not in raw:
+                # Most blocks hold data lines only: parsed from the bytes as they are.
+                numbers = start + np.arange(line - start, dtype=np.int64)
+                values = layout.parse(raw[:-1] if raw.endswith(b"\n") else raw, numbers)
+                if values is not None:
+                    yield values, numbers
+                    continue
+            # The header, comments, blank lines, or something amiss: line by line.
+            text = decoder(raw, start)
+            if "\r" in text:
+                text = text.replace("\r\n", "\n")
+            lines = (text[:-1] if text.endswith("\n") else text).split("\n")
+            if layout is None:
+                header = next((k for k, text in enumerate(lines) if _is_data(text)), None)
+                if header is None:
+                    continue
+                layout = _Layout(path, start + header, lines[header], options)
+                yield layout
+                start += header + 1
+                lines = lines[header + 1 :]
+                body = "\n".join(lines)
+                if lines and "#" not in body:  # the rest of the first block, as it is
+                    numbers = start + np.arange(len(lines), dtype=np.int64)
+                    values = layout.parse(body, numbers)
+                    if values is not None:
+                        yield values, numbers
+                        continue
+            kept = layout.data_lines(lines)
+            if not kept:
+                continue
+            numbers = start + np.asarray(kept, dtype=np.int64)
+            lines = [lines[k] for k in kept]
+            yield layout.parse("\n".join(lines), numbers, lines=lines), numbers
+    if layout is None:
+        raise RecordingError(path, max(line - 1, 1), "no header line and no data")

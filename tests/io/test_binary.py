@@ -1,0 +1,360 @@
+"""Rig formats: TDMS, HDF5 / netCDF-4 and zarr files written by their own libraries, read
+through read_recording, whole and lazily; damaged files name the file and the channel."""
+
+import itertools
+import pickle
+
+import h5py
+import numpy as np
+import pytest
+import xarray as xr
+import zarr
+from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
+
+from ecofmaps.io.binary import Column, variables
+from ecofmaps.io.recordings import (
+    RecordingError,
+    read_recording,
+    recording_blocks,
+    recording_format,
+)
+
+SIZE = 5003
+RNG = np.random.default_rng(7)
+DISPLACEMENT = RNG.normal(0.0, 30.0, SIZE)  # µm
+FORCE = RNG.normal(0.0, 0.3, SIZE)  # kN
+CYCLE = np.arange(SIZE) // 250
+
+
+def write_tdms(path, *, segments=3, force_size=SIZE, units=("um", "kN"), group="Rig"):
+    """A LabVIEW-like file: channels 'Displacement', 'Ftr' and 'Cycle' in one group, the
+    units in the first segment's properties, the data spread over several segments."""
+    edges = np.linspace(0, SIZE, segments + 1).astype(int)
+    with TdmsWriter(path) as writer:
+        for k, (a, b) in enumerate(itertools.pairwise(edges)):
+            first = k == 0
+            objects = [
+                RootObject({"name": "test"} if first else {}),
+                GroupObject(group),
+                ChannelObject(
+                    group,
+                    "Displacement",
+                    DISPLACEMENT[a:b],
+                    properties={"unit_string": units[0]} if first else {},
+                ),
+                ChannelObject(
+                    group,
+                    "Ftr",
+                    FORCE[a : min(b, force_size)],
+                    properties={"NI_UnitDescription": units[1]} if first else {},
+                ),
+                ChannelObject(group, "Cycle", CYCLE[a:b].astype(np.int32)),
+                ChannelObject("Other", "Temperature", np.ones(b - a)),
+            ]
+            writer.write_segment(objects)
+    return path
+
+
+def write_hdf5(path, *, group="rig/run1"):
+    with h5py.File(path, "w") as handle:
+        handle.create_dataset(f"{group}/displacement", data=DISPLACEMENT, chunks=(1000,))
+        handle[f"{group}/displacement"].attrs["units"] = b"um"
+        handle.create_dataset(f"{group}/force_kN", data=FORCE, chunks=(1000,))
+        handle[f"{group}/cycle"] = CYCLE
+        handle["notes"] = np.bytes_("not a channel")
+    return path
+
+
+def write_zarr(path):
+    root = zarr.open_group(str(path), mode="w")
+    for name, data, unit in (("displacement", DISPLACEMENT, "um"), ("force", FORCE, "kN")):
+        array = root.create_array(name, shape=data.shape, chunks=(1000,), dtype=data.dtype)
+        array[:] = data
+        array.attrs["units"] = unit
+    return path
+
+
+def check(recording):
+    np.testing.assert_array_equal(recording.displacement, DISPLACEMENT / 1e6)
+    np.testing.assert_array_equal(recording.force, FORCE * 1e3)
+
+
+def test_tdms(tmp_path):
+    """Channels found in their group by name; units from unit_string/NI_UnitDescription."""
+    path = write_tdms(tmp_path / "rig.tdms")
+    assert recording_format(path) == "tdms"
+    read = read_recording(path, force_column="ftr")
+    check(read)
+    np.testing.assert_array_equal(read.cycle, CYCLE)
+    assert read.columns == {
+        "displacement": "Rig/Displacement",
+        "force": "Rig/Ftr",
+        "cycle": "Rig/Cycle",
+    }
+    assert read.units == {"displacement": "um", "force": "kN", "cycle": "1"}
+    assert read.last_line is None and read.line(3) is None and read.position(3) == "sample 3"
+    same = read_recording(path, force_column="Rig/Ftr", group="Rig", force_unit="kN")
+    np.testing.assert_array_equal(same.force, read.force)
+
+
+def test_hdf5_and_netcdf(tmp_path):
+    """Variables in a group; units from attrs or the name; netCDF written by xarray too."""
+    path = write_hdf5(tmp_path / "rig.h5")
+    read = read_recording(path)
+    check(read)
+    np.testing.assert_array_equal(read.cycle, CYCLE)
+    assert read.columns["force"] == "rig/run1/force_kN"
+    nc = tmp_path / "rig.nc"
+    dataset = xr.Dataset(
+        {
+            "displacement": ("time", DISPLACEMENT, {"units": "micrometre"}),
+            "force": ("time", FORCE, {"units": "kN"}),
+        }
+    )
+    dataset.to_netcdf(nc, engine="h5netcdf", group="test")
+    check(read_recording(nc, group="/test"))
+
+
+def test_netcdf_packing_and_fill_values(tmp_path):
+    """CF packing is decoded: int16 counts times scale_factor plus add_offset; the fill
+    value is a missing sample."""
+    counts = np.array([10, -20, 30, -32767, 40], dtype=np.int16)
+    dataset = xr.Dataset(
+        {
+            "displacement": ("t", counts.astype(np.float64) * 0.5 + 1.0),
+            "force": ("t", np.arange(5.0)),
+        }
+    )
+    dataset.displacement.attrs["units"] = "um"
+    dataset.displacement[3] = np.nan
+    encoding = {
+        "displacement": {
+            "dtype": "int16",
+            "scale_factor": 0.5,
+            "add_offset": 1.0,
+            "_FillValue": -32767,
+        }
+    }
+    path = tmp_path / "packed.nc"
+    dataset.to_netcdf(path, engine="h5netcdf", encoding=encoding)
+    with h5py.File(path) as handle:
+        assert handle["displacement"].dtype == np.int16
+    read = read_recording(path)
+    np.testing.assert_array_equal(read.displacement * 1e6, [6.0, -9.0, 16.0, np.nan, 21.0])
+    np.testing.assert_array_equal(read.missing, [0, 0, 0, 1, 0])
+    with pytest.raises(RecordingError, match=r"variable 'displacement', sample 3: missing"):
+        read_recording(path, nan_policy="raise")
+
+
+def test_zarr(tmp_path):
+    path = write_zarr(tmp_path / "rig.zarr")
+    assert recording_format(path) == "zarr"
+    read = read_recording(path)
+    check(read)
+    assert read.cycle is None
+
+
+@pytest.mark.parametrize("kind", ["tdms", "h5", "zarr"])
+def test_lazy_reading_is_blockwise_and_equal(tmp_path, kind):
+    """lazy=True gives dask arrays whose blocks read equal to the eager read; slices and
+    blocks keep their positions; the columns pickle without their open file."""
+    path = {"tdms": write_tdms, "h5": write_hdf5, "zarr": write_zarr}[kind](
+        tmp_path / f"rig.{kind}"
+    )
+    options = {"force_column": "ftr"} if kind == "tdms" else {}
+    eager = read_recording(path, **options)
+    lazy = read_recording(path, lazy=True, chunks=700, **options)
+    assert lazy.lazy and lazy.displacement.chunks == ((700,) * 7 + (SIZE - 4900,),)
+    np.testing.assert_array_equal(lazy.force.compute(), eager.force)
+    np.testing.assert_array_equal(lazy.compute().displacement, eager.displacement)
+    assert not lazy.missing.any().compute()
+    part = lazy[1234:1300]
+    assert part.start == 1234 and part.position(0) == "sample 1234"
+    np.testing.assert_array_equal(part.force, eager.force[1234:1300])
+    blocks = list(recording_blocks(path, samples=1500, **options))
+    assert [b.start for b in blocks] == [0, 1500, 3000, 4500]
+    np.testing.assert_array_equal(np.concatenate([b.force for b in blocks]), eager.force)
+    copy = pickle.loads(pickle.dumps(lazy.force))
+    np.testing.assert_array_equal(copy[100:110].compute(), eager.force[100:110])
+
+
+def test_column_pickles_without_its_file(tmp_path):
+    """A Column keeps its open file per process: a pickled copy opens its own."""
+    path = write_hdf5(tmp_path / "rig.h5")
+    variable = next(v for v in variables(path, "hdf5") if v.short == "force_kN")
+    column = Column(path, "hdf5", variable, 1e3, "propagate")
+    np.testing.assert_array_equal(column[10:20], FORCE[10:20] * 1e3)
+    copy = pickle.loads(pickle.dumps(column))
+    assert copy._handle is None and column._handle is not None
+    np.testing.assert_array_equal(copy[(slice(5, 9),)], FORCE[5:9] * 1e3)
+    with pytest.raises(TypeError, match="slice"):
+        column[3]
+    column.close()
+    copy.close()
+
+
+def test_group_choice(tmp_path):
+    """The same channel names in two groups: ambiguous without group, found with it."""
+    path = tmp_path / "two.h5"
+    with h5py.File(path, "w") as handle:
+        for group, scale in (("a", 1.0), ("b", 2.0)):
+            handle[f"{group}/displacement"] = DISPLACEMENT * scale
+            handle[f"{group}/force"] = FORCE * scale
+    with pytest.raises(RecordingError, match=r"several displacement variables match .*'a/displ"):
+        read_recording(path)
+    read = read_recording(path, group="b", force_unit="kN")
+    np.testing.assert_array_equal(read.force, FORCE * 2e3)
+    read = read_recording(path, displacement_column="a/displacement", force_column="A/Force")
+    np.testing.assert_array_equal(read.displacement, DISPLACEMENT / 1e6)
+    with pytest.raises(RecordingError, match=r"no group 'c' with channels \(groups: 'a', 'b'\)"):
+        read_recording(path, group="c")
+
+
+# --- damaged files ---------------------------------------------------------------------------
+
+
+def test_missing_channel_names_the_file_and_the_channels(tmp_path):
+    path = write_tdms(tmp_path / "rig.tdms")
+    with pytest.raises(RecordingError) as raised:
+        read_recording(path)
+    assert str(raised.value) == (
+        f"{path}: no force channel 'force' (channels: 'Rig/Displacement', 'Rig/Ftr', "
+        "'Rig/Cycle', 'Other/Temperature')"
+    )
+    with pytest.raises(RecordingError, match="no cycle variable 'n'"):
+        read_recording(write_zarr(tmp_path / "rig.zarr"), cycle_column="n")
+
+
+def test_channel_of_another_length(tmp_path):
+    path = write_tdms(tmp_path / "short.tdms", force_size=SIZE - 10)
+    with pytest.raises(RecordingError) as raised:
+        read_recording(path, force_column="Ftr")
+    assert str(raised.value) == (
+        f"{path}, channel 'Rig/Ftr': {SIZE - 10} samples where the displacement channel "
+        f"'Rig/Displacement' has {SIZE}"
+    )
+
+
+def test_truncated_tdms(tmp_path):
+    path = write_tdms(tmp_path / "rig.tdms")
+    data = path.read_bytes()
+    for cut in (len(data) - 3000, 40):
+        damaged = tmp_path / f"cut{cut}.tdms"
+        damaged.write_bytes(data[:cut])
+        with pytest.raises(RecordingError, match=rf"cut{cut}.tdms: truncated or damaged TDMS"):
+            read_recording(damaged, force_column="ftr")
+
+
+def test_truncated_hdf5(tmp_path):
+    path = write_hdf5(tmp_path / "rig.h5")
+    damaged = tmp_path / "cut.h5"
+    damaged.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
+    with pytest.raises(RecordingError, match=r"cut.h5: cannot open as HDF5 \(truncated"):
+        read_recording(damaged)
+
+
+def test_zarr_with_missing_or_damaged_chunks(tmp_path):
+    """A missing chunk file (zarr would read the fill value) is refused when the store is
+    opened; a damaged one when its block is read, naming the variable and the samples."""
+    path = write_zarr(tmp_path / "rig.zarr")
+    (path / "force" / "c" / "2").unlink()
+    with pytest.raises(RecordingError, match=r"variable 'force': 1 of its 6 chunks are missing"):
+        read_recording(path)
+    path = write_zarr(tmp_path / "rig2.zarr")
+    (path / "force" / "c" / "3").write_bytes(b"\x00" * 10)
+    lazy = read_recording(path, lazy=True, chunks=1000)
+    np.testing.assert_array_equal(lazy.force[:3000].compute(), FORCE[:3000] * 1e3)
+    with pytest.raises(RecordingError, match=r"rig2.zarr, variable 'force', samples 3000 to 3999"):
+        lazy.force.compute()
+
+
+@pytest.mark.parametrize(
+    ("name", "content", "message"),
+    [
+        ("empty.tdms", b"", "not a TDMS file"),
+        ("text.h5", b"displacement,force\n1,2\n", "not a HDF5 file"),
+        ("old.nc", b"CDF\x01\x00\x00\x00\x00", "a netCDF-3 .classic. file"),
+    ],
+)
+def test_mislabelled_files(tmp_path, name, content, message):
+    path = tmp_path / name
+    path.write_bytes(content)
+    with pytest.raises(RecordingError, match=message):
+        read_recording(path)
+
+
+def test_a_directory_that_is_not_a_store(tmp_path):
+    with pytest.raises(RecordingError, match="a directory, and not a zarr store"):
+        read_recording(tmp_path)
+
+
+def test_units_in_metadata_and_options(tmp_path):
+    """A unit option that disagrees with a channel's unit_string is an error naming the
+    channel; one of another kind in the file (volts) needs the option."""
+    path = write_tdms(tmp_path / "rig.tdms")
+    with pytest.raises(RecordingError, match=r"channel 'Rig/Displacement': .* is in 'um', but"):
+        read_recording(path, force_column="Ftr", displacement_unit="mm")
+    volts = write_tdms(tmp_path / "volts.tdms", units=("V", "kN"))
+    with pytest.raises(RecordingError, match="is in 'V', which is not a length unit"):
+        read_recording(volts, force_column="Ftr")
+    read = read_recording(volts, force_column="Ftr", displacement_unit="mm")
+    np.testing.assert_array_equal(read.displacement, DISPLACEMENT / 1e3)
+
+
+def test_nan_policy_on_lazy_reads(tmp_path):
+    """With nan_policy='raise' a missing sample is an error when its block is read."""
+    data = DISPLACEMENT.copy()
+    data[4321] = np.nan
+    path = tmp_path / "gap.h5"
+    with h5py.File(path, "w") as handle:
+        handle["displacement"] = data
+        handle["force"] = FORCE
+    read = read_recording(path)
+    assert np.flatnonzero(read.missing).tolist() == [4321]
+    lazy = read_recording(path, lazy=True, chunks=1000, nan_policy="raise")
+    lazy.displacement[:4000].compute()
+    with pytest.raises(RecordingError, match=r"variable 'displacement', sample 4321: missing"):
+        lazy.displacement.compute()
+
+
+def test_tdms_channel_names_with_units_and_groups(tmp_path):
+    """LabVIEW channel names carry units ('Displacement/µm', 'Force [kN]'); the force and
+    cycle channels are taken from the displacement's group when others match too."""
+    path = tmp_path / "named.tdms"
+    with TdmsWriter(path) as writer:
+        writer.write_segment(
+            [
+                RootObject(),
+                GroupObject("Rig"),
+                ChannelObject("Rig", "Displacement/µm", DISPLACEMENT),
+                ChannelObject("Rig", "Force [kN]", FORCE),
+                ChannelObject("Rig", "cycle", CYCLE),
+                ChannelObject("Calibration", "Force [N]", FORCE[:10]),
+                ChannelObject("Calibration", "cycle", CYCLE[:10]),
+            ]
+        )
+    read = read_recording(path)
+    check(read)
+    np.testing.assert_array_equal(read.cycle, CYCLE)
+    assert read.columns == {
+        "displacement": "Rig/Displacement/µm",
+        "force": "Rig/Force [kN]",
+        "cycle": "Rig/cycle",
+    }
+    lazy = read_recording(path, lazy=True, chunks=2000)
+    np.testing.assert_array_equal(lazy.force.compute(), read.force)
+
+
+def test_empty_variables_and_two_chunkings(tmp_path):
+    """No samples is an error; two lazy reads with other chunks are other dask arrays."""
+    path = tmp_path / "empty.h5"
+    with h5py.File(path, "w") as handle:
+        handle["displacement"] = np.zeros(0)
+        handle["force"] = np.zeros(0)
+    with pytest.raises(RecordingError, match="variable 'displacement': no samples"):
+        read_recording(path)
+    path = write_zarr(tmp_path / "rig.zarr")
+    first = read_recording(path, lazy=True, chunks=1000).force
+    second = read_recording(path, lazy=True, chunks=3000).force
+    assert first.name != second.name
+    np.testing.assert_array_equal((first - second).compute(), 0.0)
