@@ -448,9 +448,15 @@ physical_points = st.fixed_dictionaries(
 def test_property_loop_area_is_dissipated_energy(point):
     """Shoelace area of the steady loop (401 points a branch) vs E_d. The chords cut the
     curved slip branches: the worst relative error over a grid of this domain is 4.7e-4, most
-    of it near the locking point; the tolerance is 1e-3."""
+    of it near the locking point; the tolerance is 1e-3. A rigid rig within 1e-12 of
+    locking (1 - mu*kappa < 1e-12; hypothesis finds mu equal to the width) is left out: there
+    Q_+ spans more than 28 e-folds along the branch and 401 points give errors of 1e-3 and
+    more (1.3e-3 at 1e-15), while float64 fixes 1 - mu*kappa itself only to 1e-16."""
     args = si(point)
     if not gross_slip(args):
+        return
+    kappa = 2.0 * args["aspect_ratio"] * args["amplitude"] / args["groove_half_width"]
+    if np.isinf(args["stiffness"]) and 1.0 - args["mu"] * kappa < 1e-12:
         return
     displacement, force = (np.asarray(a) for a in ecofmaps.fretting_loop(**args, num=401))
     area = np.sum((force[1:] + force[:-1]) / 2 * np.diff(displacement))  # ∮ Q dΔ, closed polygon
