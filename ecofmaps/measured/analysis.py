@@ -2,9 +2,11 @@ r"""Measured fretting loops, cycle by cycle: ECoF, GICoF, rig stiffness and the 
 
 :func:`analyze_loops` reads a recording of the actuator displacement :math:`\Delta` and the
 tangential force :math:`Q` (many cycles, or a single loop), cuts it into cycles and
-removes the offsets and a slow drift (:mod:`ecofmaps.measured.cycles`), and measures each loop. The
-work is done on padded arrays with one row per cycle, with no Python loop over samples or
-cycles: a recording of :math:`10^4` cycles of 200 samples takes a second or two.
+removes the offsets and a slow drift (:mod:`ecofmaps.measured.cycles`), and measures each loop.
+The work is vectorised over a block of cycles at a time, with no Python loop over samples
+or cycles, and its memory does not grow with the recording beyond the per-cycle results:
+each loop is a padded row, and each of its two branches (from one reversal to the next)
+another, so that every per-branch step runs once over both branches of every cycle.
 
 The quantities, per cycle
 -------------------------
@@ -68,23 +70,21 @@ import numpy as np
 import xarray as xr
 
 from ecofmaps._inputs import check
-from ecofmaps.measured.cycles import MIN_SAMPLES, labelled_cycles, masked_sum, split_cycles
+from ecofmaps.measured.branches import (
+    both,
+    branch_rows,
+    line_crossings,
+    stick_lines,
+    zero_force_crossings,
+)
+from ecofmaps.measured.centring import loop_blocks
+from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles, find_cycles
 
-__all__ = ["GROSS_SLIP_THRESHOLD", "analyze_loops"]
+__all__ = ["GROSS_SLIP_THRESHOLD", "analyze_loops", "measure_cycles"]
 
 #: Energy ratio :math:`A = E_d/(4\Delta^* Q^*)` above which a loop is gross slip (the
 #: sliding transition of Fouvry, Kapsa and Vincent).
 GROSS_SLIP_THRESHOLD = 0.2
-
-#: Samples with :math:`|Q|` below this share of :math:`Q^*` locate a zero-force crossing
-#: that is not on a stick segment.
-_ZERO_FORCE_BAND = 0.25
-
-#: A stick segment grows until two samples in a row are this many standard deviations off.
-_STICK_SPREAD = 3.0
-
-#: Fewest samples in the window of the curve fitted at a GICoF crossing.
-_FIT_SAMPLES = 5
 
 _ATTRS = {
     "cycle": ("cycle number", "1"),
@@ -110,185 +110,37 @@ _ATTRS = {
     "loop_force": ("tangential force Q, centred", "N"),
 }
 
+#: Names of _ATTRS that are not per-cycle quantities.
+_NOT_PER_CYCLE = ("cycle", "regime", "load", "point", "loop_displacement", "loop_force")
+
 
 def _attrs(name: str) -> dict:
     long_name, units = _ATTRS[name]
     return {"long_name": long_name, "units": units}
 
 
-# --- per-cycle kernels ---------------------------------------------------------------------
-# Each takes arrays of shape (cycles, width) whose rows run once round a loop from its
-# lowest displacement; ``valid`` marks the points of each loop, the rest is padding (NaN).
-
-
-def _branches(x, valid):
-    """Masks of the rising branch (start to top) and the falling one (top to the end)."""
-    top = np.argmax(np.where(valid, x, -np.inf), axis=1)
-    j = np.arange(x.shape[1])[None, :]
-    rising = valid & (j <= top[:, None])
-    falling = valid & (j >= top[:, None])
-    return rising, falling, top
-
-
-def _dissipated_energy(x, y, valid):
-    r"""The loop's area :math:`\oint Q\,d\Delta` by the trapezoidal rule."""
-    return masked_sum(0.5 * (y[:, 1:] + y[:, :-1]) * np.diff(x, axis=1), valid[:, 1:])
-
-
-def _bracket(value, branch, first, sign):
-    """Index of the sample just past the sign change of ``value`` on a branch.
-
-    ``value`` runs from the sign ``sign`` to ``-sign`` along the branch, which starts at
-    index ``first``. The change is placed after as many samples as the branch has on the
-    starting side, so a few noisy samples on the wrong side do not move it far.
-    """
-    count = np.count_nonzero(branch & (sign * value > 0.0), axis=1)
-    last = first + np.count_nonzero(branch, axis=1) - 1
-    return np.clip(first + count, first + 1, last)
-
-
-def _crossing(x, value, branch, first, sign):
-    """``x`` where ``value`` changes sign on a branch, interpolated between two samples."""
-    after = _bracket(value, branch, first, sign)[:, None]
-    x0, x1 = (np.take_along_axis(x, after - k, axis=1)[:, 0] for k in (1, 0))
-    v0, v1 = (np.take_along_axis(value, after - k, axis=1)[:, 0] for k in (1, 0))
-    change = v0 - v1
-    share = np.divide(v0, change, out=np.full_like(v0, 0.5), where=change != 0.0)
-    return x0 + share * (x1 - x0)
-
-
-def _zero_force_crossing(x, y, branch, first, sign, stick, intercept):
-    r"""Displacement where a branch crosses :math:`Q = 0`.
-
-    Where the stick segment ``stick`` reaches across zero force, it is the intercept of
-    the line fitted to it, :math:`\Delta = c + Q/S`. Elsewhere a straight line
-    :math:`\Delta = a + bQ` is fitted to the two samples around the crossing and the
-    branch's samples with :math:`|Q|` below ``_ZERO_FORCE_BAND`` times :math:`Q^*`, and
-    gives :math:`a`.
-    """
-    after = _bracket(y, branch, first, sign)[:, None]
-    j = np.arange(x.shape[1])[None, :]
-    band = _ZERO_FORCE_BAND * 0.5 * (np.nanmax(y, axis=1) - np.nanmin(y, axis=1))
-    near = branch & ((np.abs(y) <= band[:, None]) | (j == after) | (j == after - 1))
-    local = _common_slope(y, x, [near])[1][0]
-    across = np.any(stick & (y < 0.0), axis=1) & np.any(stick & (y > 0.0), axis=1)
-    return np.where(across, intercept, local)
-
-
-def _stick_mask(y, branch, window):
-    """The stick segment after the reversal at the start of ``branch`` (module notes)."""
-    low, high = window
-    span = np.max(np.where(branch, y, -np.inf), axis=1) - np.min(
-        np.where(branch, y, np.inf), axis=1
+def _loop_values(block, load, options):
+    """Every per-cycle quantity of a block of centred loops (module notes)."""
+    x, y = block.displacement, block.force
+    highest, lowest = block.extremes(x)
+    amplitude = 0.5 * (highest - lowest)
+    max_force = 0.5 * np.subtract(*block.extremes(y))
+    # The loop's area by trapezoids, the segment that closes it included.
+    first, last = block.offset, block.offset + block.count - 1
+    closing = (y[first] + y[last]) * (x[first] - x[last])
+    energy = 0.5 * (block.sums((y[1:] + y[:-1]) * np.diff(x)) + closing)
+    bx, by, valid, length = branch_rows(block, block.first_point(x, highest))
+    compliance, intercept, stick = stick_lines(
+        bx, by, valid, highest - lowest, options["stick_window"]
     )
-    start = np.take_along_axis(y, np.argmax(branch, axis=1)[:, None], axis=1)
-    moved = np.abs(y - start) / span[:, None]
-    beyond = np.maximum.accumulate(branch & (moved > high), axis=1)
-    mask = branch & (moved >= low) & ~beyond
-    # Sparse sampling (a model loop draws each stick segment as one straight line): the
-    # chord from the reversal to the first sample past the lower share.
-    j = np.arange(y.shape[1])[None, :]
-    chord = (j == np.argmax(branch, axis=1)[:, None]) | (
-        j == np.argmax(branch & (moved >= low), axis=1)[:, None]
-    )
-    return np.where(np.count_nonzero(mask, axis=1)[:, None] < 2, chord, mask)
-
-
-def _common_slope(x, y, masks):
-    """Least-squares slope common to lines through each mask's points, and their intercepts."""
-    covariance = np.zeros(x.shape[0])
-    variance = np.zeros(x.shape[0])
-    means = []
-    for mask in masks:
-        count = np.count_nonzero(mask, axis=1)
-        mean_x, mean_y = masked_sum(x, mask) / count, masked_sum(y, mask) / count
-        dx, dy = x - mean_x[:, None], y - mean_y[:, None]
-        covariance += masked_sum(dx * dy, mask)
-        variance += masked_sum(dx * dx, mask)
-        means.append((mean_x, mean_y))
-    slope = covariance / variance
-    return slope, [mean_y - slope * mean_x for mean_x, mean_y in means]
-
-
-def _stick_lines(x, y, branches, window):
-    r"""Lines :math:`\Delta = c + Q/S` through the stick segments after the two reversals.
-
-    A first line is fitted to the samples in the force window; each segment then grows
-    along its branch until two samples in a row lie more than ``_STICK_SPREAD`` standard
-    deviations off its line (the slip that follows bends away from it; a single noisy
-    sample does not stop it), and the lines are fitted again to the grown segments.
-    Returns the common compliance :math:`1/S`, the intercept :math:`c` of each line and
-    the mask of each segment.
-    """
-    masks = [_stick_mask(y, branch, window) for branch in branches]
-    compliance, intercepts = _common_slope(y, x, masks)
-    residuals = [x - intercept[:, None] - compliance[:, None] * y for intercept in intercepts]
-    squares = sum(masked_sum(r * r, m) for r, m in zip(residuals, masks, strict=True))
-    points = sum(np.count_nonzero(m, axis=1) for m in masks)
-    spread = np.sqrt(squares / np.maximum(points - 3, 1))
-    span = np.nanmax(x, axis=1) - np.nanmin(x, axis=1)
-    tolerance = np.maximum(_STICK_SPREAD * spread, 1e-9 * span)[:, None]
-    grown = []
-    for branch, mask, residual in zip(branches, masks, residuals, strict=True):
-        after = np.maximum.accumulate(mask, axis=1) & branch
-        outside = after & (np.abs(residual) > tolerance)
-        outside[:, :-1] &= outside[:, 1:]
-        off = np.maximum.accumulate(outside, axis=1)
-        grown.append(mask | (after & ~off))
-    compliance, intercepts = _common_slope(y, x, grown)
-    return compliance, intercepts, grown
-
-
-def _line_crossing(x, y, branch, first, sign, compliance, half_width, load):
-    r"""Displacement and force where a branch crosses :math:`Q = S\Delta` (module notes).
-
-    On the line the contact position :math:`\xi = \Delta - Q/S` (eq. 10) is zero. The
-    branch's samples with :math:`|\xi|` below ``half_width`` are fitted by least squares
-    with :math:`Q = a + b\xi + c\xi Q`, which is eq. 9 for any groove slope
-    (:math:`a = \mu P`, :math:`b = kP`, :math:`c = \mu k`) and a smooth three-parameter
-    curve otherwise; the crossing is :math:`Q = a`. With fewer than ``_FIT_SAMPLES``
-    samples in the window, :math:`Q` is interpolated linearly at :math:`\xi = 0` between
-    the two samples around the crossing.
-    """
-    position = x - y * compliance[:, None]  # the contact position (eq. 10)
-    guess = _crossing(y, position, branch, first, sign)  # Q there, interpolated
-    scaled = position / half_width[:, None]
-    window = branch & (np.abs(scaled) <= 1.0)
-    enough = np.count_nonzero(window, axis=1) >= _FIT_SAMPLES
-    regressors = (np.ones_like(x), scaled, scaled * y / load)
-    normal = np.stack(
-        [np.stack([masked_sum(p * q, window) for q in regressors], axis=-1) for p in regressors],
-        axis=-2,
-    )
-    moments = np.stack([masked_sum(p * y, window) for p in regressors], axis=-1)
-    normal[~enough] = np.eye(3)
-    intercept = (np.linalg.pinv(normal) @ moments[..., None])[:, 0, 0]
-    force = np.where(enough, intercept, guess)
-    return force * compliance, force
-
-
-# --- the public function ------------------------------------------------------------------
-
-
-def _loop_quantities(x, q, valid, load, options):
-    """Every per-cycle quantity of the centred loops ``x``, ``q`` (module notes)."""
-    amplitude = 0.5 * (np.nanmax(x, axis=1) - np.nanmin(x, axis=1))
-    max_force = 0.5 * (np.nanmax(q, axis=1) - np.nanmin(q, axis=1))
-    rising, falling, top = _branches(x, valid)
-    start = np.zeros_like(top)
-    compliance, intercepts, sticks = _stick_lines(x, q, (rising, falling), options["stick_window"])
-    stiffness = 1.0 / compliance
-    left = _zero_force_crossing(x, q, rising, start, -1.0, sticks[0], intercepts[0])
-    right = _zero_force_crossing(x, q, falling, top, 1.0, sticks[1], intercepts[1])
-    slip = 0.5 * (right - left)
-    energy = _dissipated_energy(x, q, valid)
+    crossing = zero_force_crossings(bx, by, valid, length, max_force, stick, intercept)
+    cycles = block.count.size
+    slip = 0.5 * (crossing[cycles:] - crossing[:cycles])
     half_width = options["crossing_window"] * np.abs(slip)
-    rising_x, rising_q = _line_crossing(x, q, rising, start, 1.0, compliance, half_width, load)
-    falling_x, falling_q = _line_crossing(x, q, falling, top, -1.0, compliance, half_width, load)
+    at, force = line_crossings(bx, by, valid, length, both(compliance), both(half_width), load)
     energy_ratio = energy / (4.0 * amplitude * max_force)
-    gross = energy_ratio > options["gross_slip_threshold"]
-    sliding = np.where(gross, 1.0, np.nan)  # NaN for the coefficients in partial slip
-    values = {
+    sliding = np.where(energy_ratio > options["gross_slip_threshold"], 1.0, np.nan)
+    return {
         "amplitude": amplitude,
         "slip_amplitude": slip,
         "max_force": max_force,
@@ -296,14 +148,80 @@ def _loop_quantities(x, q, valid, load, options):
         "ecof": sliding * energy / (4.0 * load * slip),
         "cof_max": max_force / load,
         "energy_ratio": energy_ratio,
-        "stiffness": stiffness,
-        "gicof": sliding * (rising_q - falling_q) / (2.0 * load),
-        "gicof_forward": sliding * rising_q / load,
-        "gicof_backward": -sliding * falling_q / load,
-        "crossing_displacement_forward": sliding * rising_x,
-        "crossing_displacement_backward": sliding * falling_x,
+        "stiffness": 1.0 / compliance,
+        "gicof": sliding * (force[:cycles] - force[cycles:]) / (2.0 * load),
+        "gicof_forward": sliding * force[:cycles] / load,
+        "gicof_backward": -sliding * force[cycles:] / load,
+        "crossing_displacement_forward": sliding * at[:cycles],
+        "crossing_displacement_backward": sliding * at[cycles:],
     }
-    return values, np.where(gross, "gross slip", "partial slip")
+
+
+def measure_cycles(
+    cycles: Cycles,
+    displacement,
+    force,
+    load,
+    *,
+    stick_window=(0.05, 0.45),
+    crossing_window=0.7,
+    gross_slip_threshold=GROSS_SLIP_THRESHOLD,
+    rows=None,
+    keep_loops=False,
+):
+    """The per-cycle quantities of :func:`analyze_loops` for cycles already found.
+
+    Parameters
+    ----------
+    cycles : Cycles
+        Cycles of the recording (:func:`ecofmaps.measured.cycles.find_cycles`).
+    displacement, force : numpy.ndarray
+        The recording, float64 and finite. [m], [N]
+    load : float
+        Normal load :math:`P`. [N]
+    stick_window, crossing_window, gross_slip_threshold
+        As for :func:`analyze_loops` (not checked here).
+    rows : slice, optional
+        Consecutive cycles to measure; default all.
+    keep_loops : bool
+        Also return the centred loops as NaN-padded (cycle, point) arrays.
+
+    Returns
+    -------
+    values : dict of str to numpy.ndarray
+        Each quantity of :func:`analyze_loops` over the cycles, offsets included.
+    regime : numpy.ndarray of str
+    loops : tuple of numpy.ndarray or None
+        Centred displacement and force round each loop, if ``keep_loops``. [m], [N]
+    """
+    first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
+    options = {
+        "stick_window": stick_window,
+        "crossing_window": crossing_window,
+        "gross_slip_threshold": gross_slip_threshold,
+    }
+    names = [name for name in _ATTRS if name not in _NOT_PER_CYCLE]
+    values = {name: np.empty(stop - first) for name in names}
+    loops = None
+    if keep_loops:
+        width = int(cycles.count[first:stop].max()) + 1
+        loops = tuple(np.full((stop - first, width), np.nan) for _ in range(2))
+    with np.errstate(divide="ignore", invalid="ignore"):  # degenerate cycles give NaN
+        for block in loop_blocks(cycles, displacement, force, slice(first, stop)):
+            out = slice(block.rows.start - first, block.rows.stop - first)
+            computed = _loop_values(block, load, options)
+            computed["displacement_offset"] = block.displacement_centre
+            computed["force_offset"] = block.force_centre
+            for name, value in computed.items():
+                values[name][out] = value
+            if keep_loops:
+                for loop, centred in zip(loops, block.loops(loops[0].shape[1]), strict=True):
+                    loop[out] = centred
+    regime = np.where(values["energy_ratio"] > gross_slip_threshold, "gross slip", "partial slip")
+    return values, regime, loops
+
+
+# --- the public function ------------------------------------------------------------------
 
 
 def _series(name, values, size=None):
@@ -315,7 +233,8 @@ def _series(name, values, size=None):
         raise ValueError(
             f"{name} must have one value per sample: {array.size} values for {size} samples"
         )
-    check(name, array, "finite")
+    if not np.isfinite(array).all():
+        check(name, array, "finite")
     return array
 
 
@@ -406,9 +325,10 @@ def analyze_loops(
 
     Notes
     -----
-    The methods are in the documentation of :mod:`ecofmaps.measured.analysis` and
-    :mod:`ecofmaps.measured.cycles`. The ECoF is eq. 1; the GICoF is the paper's Section 5
-    (eq. 17-18), and equals :math:`\mu` for the model's loop whatever the groove.
+    The methods are in the documentation of :mod:`ecofmaps.measured.analysis`,
+    :mod:`ecofmaps.measured.cycles` and :mod:`ecofmaps.measured.centring`. The ECoF is
+    eq. 1; the GICoF is the paper's Section 5 (eq. 17-18), and equals :math:`\mu` for the
+    model's loop whatever the groove.
 
     Examples
     --------
@@ -426,26 +346,20 @@ def analyze_loops(
         raise ValueError(
             f"too few samples for one cycle: {x.size} (a cycle needs at least {MIN_SAMPLES})"
         )
-    if cycle is None:
-        cycles = split_cycles(x, hysteresis)
-    else:
-        cycles = labelled_cycles(x, _series("cycle", cycle, x.size))
+    cycles = find_cycles(x, cycle, hysteresis)
     if cycles.label.size == 0:
         raise ValueError(
             f"too few samples for one cycle: no complete cycle in {x.size} samples "
             "(the loop does not close, or the recording does not oscillate)"
         )
-    loop_x, loop_q, centre_x, centre_q = cycles.centred_loops(x, q)
-    with np.errstate(divide="ignore", invalid="ignore"):  # degenerate cycles give NaN
-        values, regime = _loop_quantities(loop_x, loop_q, cycles.valid, load, options)
-    values.update(displacement_offset=centre_x, force_offset=centre_q)
+    values, regime, loops = measure_cycles(cycles, x, q, load, keep_loops=keep_loops, **options)
     data = {name: ("cycle", value, _attrs(name)) for name, value in values.items()}
     data["regime"] = ("cycle", regime, _attrs("regime"))
     coords = {"cycle": ("cycle", cycles.label, _attrs("cycle")), "load": ((), load, _attrs("load"))}
     if keep_loops:
-        data["loop_displacement"] = (("cycle", "point"), loop_x, _attrs("loop_displacement"))
-        data["loop_force"] = (("cycle", "point"), loop_q, _attrs("loop_force"))
-        coords["point"] = ("point", np.arange(loop_x.shape[1]), _attrs("point"))
+        data["loop_displacement"] = (("cycle", "point"), loops[0], _attrs("loop_displacement"))
+        data["loop_force"] = (("cycle", "point"), loops[1], _attrs("loop_force"))
+        coords["point"] = ("point", np.arange(loops[0].shape[1]), _attrs("point"))
     attrs = {
         "title": "Fretting loops analysed cycle by cycle (ecofmaps.analyze_loops)",
         "cycles_from": "displacement reversals" if cycle is None else "cycle numbers",

@@ -1,0 +1,234 @@
+r"""The steps of :func:`ecofmaps.analyze_loops` that run along each branch of each loop.
+
+A branch runs from one reversal to the next: the rising branch from a loop's lowest
+displacement to its highest, the falling branch back. Each is laid out as a row (branch,
+point) starting at its reversal and padded by repeating its last point: the rising
+branches of a block's cycles, then their falling branches, so that every step runs once
+over both branches of every cycle, vectorised. The methods are described in
+:mod:`ecofmaps.measured.analysis`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["both", "branch_rows", "line_crossings", "stick_lines", "zero_force_crossings"]
+
+#: Samples with :math:`|Q|` below this share of :math:`Q^*` locate a zero-force crossing
+#: that is not on a stick segment.
+_ZERO_FORCE_BAND = 0.25
+
+#: A stick segment grows until two samples in a row are this many standard deviations off.
+_STICK_SPREAD = 3.0
+
+#: Fewest samples in the window of the curve fitted at a GICoF crossing.
+_FIT_SAMPLES = 5
+
+#: In a GICoF window where the variance of :math:`\xi Q` not explained by :math:`\xi` is
+#: below this share of its own (rounding: the force is constant along the slip), the line
+#: :math:`Q = a + b\xi` is fitted.
+_COLLINEAR = 1e-24
+
+
+def _dot(a, b):
+    """Sum of ``a * b`` along each row."""
+    return np.einsum("ij,ij->i", a, b)
+
+
+def both(values):
+    """A per-cycle array for the rising then the falling branch rows."""
+    return np.concatenate([values, values])
+
+
+def _from_first(flags):
+    """True from the first True of each row on (a cumulative OR along the rows)."""
+    first = np.argmax(flags, axis=1)
+    found = flags[np.arange(flags.shape[0]), first]
+    return np.arange(flags.shape[1]) >= np.where(found, first, flags.shape[1])[:, None]
+
+
+def _columns(mask) -> slice:
+    """The columns that hold every True of ``mask`` (sums over it need no others)."""
+    (used,) = np.nonzero(np.any(mask, axis=0))
+    return slice(used[0], used[-1] + 1) if used.size else slice(0, 0)
+
+
+def _bracket(before, length):
+    """Index of the sample just past a sign change on each branch row.
+
+    ``before`` marks the branch's samples on the starting side. The change is placed after
+    as many samples as the branch has on that side, so a few noisy samples on the wrong
+    side do not move it far.
+    """
+    return np.clip(np.count_nonzero(before, axis=1), 1, length - 1)
+
+
+def branch_rows(block, top):
+    """The rising branches (start to top) and falling ones (top to the end) as rows."""
+    cycles = top.size
+    first = np.concatenate([np.zeros_like(top), top])
+    last = np.concatenate([top, block.count])
+    j = np.arange(int((last - first).max()) + 1)
+    point = np.minimum(first[:, None] + j, last[:, None])
+    index = block.samples(point, np.tile(np.arange(cycles), 2))
+    valid = j <= (last - first)[:, None]
+    return block.displacement[index], block.force[index], valid, last - first + 1
+
+
+def _line(mask, u, v):
+    """Sums of the least-squares line of ``v`` on ``u`` through each row's masked points.
+
+    Returns the count, the means of ``u`` and ``v``, and the sums of du dv and du du
+    (deviations from the means).
+    """
+    weight = mask.astype(np.float64)
+    count = weight.sum(axis=1)
+    mean_u = _dot(weight, u) / count
+    mean_v = _dot(weight, v) / count
+    du = (u - mean_u[:, None]) * weight
+    return count, mean_u, mean_v, _dot(du, v - mean_v[:, None]), _dot(du, du)
+
+
+def _common_line(mask, y, x):
+    r"""Lines :math:`\Delta = c + Q/S` through both branches' masked points, one slope.
+
+    Returns the compliance :math:`1/S` of each cycle, the intercept :math:`c` of each
+    branch row and the count of its points.
+    """
+    count, mean_y, mean_x, covariance, variance = _line(mask, y, x)
+    cycles = count.size // 2
+    compliance = (covariance[:cycles] + covariance[cycles:]) / (
+        variance[:cycles] + variance[cycles:]
+    )
+    return compliance, mean_x - both(compliance) * mean_y, count
+
+
+def stick_lines(x, y, valid, span, window):
+    r"""Lines :math:`\Delta = c + Q/S` through the stick segments after the two reversals.
+
+    A segment starts as the branch's samples whose force has moved away from the
+    reversal's by a share of the branch's force swing within ``window``, up to the first
+    sample beyond it (with fewer than two, the chord from the reversal to the first sample
+    past the lower share). A first line is fitted; each segment then grows along its
+    branch until two samples in a row lie more than ``_STICK_SPREAD`` standard deviations
+    off its line (the slip that follows bends away from it; a single noisy sample does
+    not stop it), and the lines are fitted again to the grown segments. Returns the
+    common compliance :math:`1/S`, the intercept :math:`c` of each branch row and the
+    mask of each segment (over the first columns: no segment reaches further).
+    """
+    low, high = window
+    swing = np.max(y, axis=1) - np.min(y, axis=1)
+    moved = np.abs(y - y[:, :1]) / swing[:, None]
+    mask = valid & (moved >= low) & ~_from_first(moved > high)
+    sparse = np.flatnonzero(np.count_nonzero(mask, axis=1) < 2)
+    if sparse.size:
+        reach = np.argmax(valid[sparse] & (moved[sparse] >= low), axis=1)
+        j = np.arange(x.shape[1])
+        mask[sparse] = (j == 0) | (j == reach[:, None])
+    reach = _columns(mask).stop  # the segments end before this column
+    compliance, intercept, count = _common_line(mask[:, :reach], y[:, :reach], x[:, :reach])
+    slope = both(compliance)[:, None]
+    residual = x[:, :reach] - intercept[:, None] - slope * y[:, :reach]
+    squares = _dot(residual * mask[:, :reach], residual)
+    cycles = compliance.size
+    points = count[:cycles] + count[cycles:]
+    spread = np.sqrt((squares[:cycles] + squares[cycles:]) / np.maximum(points - 3, 1))
+    tolerance = both(np.maximum(_STICK_SPREAD * spread, 1e-9 * span))[:, None]
+    # The growth is followed over the first columns, and over all if it reaches their end.
+    end = min(x.shape[1], 2 * reach + 8)
+    while True:
+        residual = x[:, :end] - intercept[:, None] - slope * y[:, :end]
+        after = _from_first(mask[:, :end]) & valid[:, :end]
+        outside = after & (np.abs(residual) > tolerance)
+        outside[:, :-1] &= outside[:, 1:]  # two in a row; a branch's last sample alone is not
+        outside[:, -1] = False
+        grown = mask[:, :end] | (after & ~_from_first(outside))
+        if end == x.shape[1] or not grown[:, -1].any():
+            break
+        end = x.shape[1]
+    compliance, intercept, _ = _common_line(grown, y[:, :end], x[:, :end])
+    return compliance, intercept, grown
+
+
+def zero_force_crossings(x, y, valid, length, max_force, stick, intercept):
+    r"""Displacement where each branch row crosses :math:`Q = 0`.
+
+    Where the stick segment ``stick`` reaches across zero force, it is the intercept of
+    the line fitted to it, :math:`\Delta = c + Q/S`. Elsewhere a straight line
+    :math:`\Delta = a + bQ` is fitted to the two samples around the crossing and the
+    branch's samples with :math:`|Q|` below ``_ZERO_FORCE_BAND`` times the loop's
+    ``max_force`` :math:`Q^*`, and gives :math:`a`.
+    """
+    cycles = length.size // 2
+    negative, positive = y < 0.0, y > 0.0
+    # Samples before the crossing: negative force on the rising branch, positive on the other.
+    before = np.concatenate([negative[:cycles], positive[cycles:]]) & valid
+    after = _bracket(before, length)
+    near = valid & (np.abs(y) <= both(_ZERO_FORCE_BAND * max_force)[:, None])
+    rows = np.arange(length.size)
+    near[rows, after] = True  # the two samples around the crossing (after >= 1 if valid)
+    near[rows[after >= 1], after[after >= 1] - 1] = True
+    columns = _columns(near)
+    _, mean_y, mean_x, covariance, variance = _line(near[:, columns], y[:, columns], x[:, columns])
+    local = mean_x - covariance / variance * mean_y
+    reach = stick.shape[1]  # no stick segment reaches further
+    across = np.any(stick & negative[:, :reach], axis=1) & np.any(
+        stick & positive[:, :reach], axis=1
+    )
+    return np.where(across, intercept, local)
+
+
+def _curve_intercept(window, scaled, y, load):
+    r"""Intercept :math:`a` of the least-squares :math:`Q = a + b\xi + c\xi Q` in each window.
+
+    The regressors are centred on their means and :math:`\xi Q` is orthogonalised against
+    :math:`\xi` sample by sample (Gram-Schmidt), so that :math:`a` stays exact when the two
+    are nearly collinear (a force nearly constant along the slip). Where :math:`\xi Q`
+    adds only rounding to :math:`\xi` (a flat groove), :math:`Q = a + b\xi` is fitted.
+    """
+    columns = _columns(window)
+    window, scaled, y = window[:, columns], scaled[:, columns], y[:, columns]
+    weight = window.astype(np.float64)
+    count = weight.sum(axis=1)
+    s = np.where(window, scaled, 0.0)
+    z = s * y / load
+    mean_s, mean_z = s.sum(axis=1) / count, z.sum(axis=1) / count
+    mean_q = _dot(weight, y) / count
+    ds, dz, dq = (
+        (values - mean[:, None]) * weight
+        for values, mean in ((s, mean_s), (z, mean_z), (y, mean_q))
+    )
+    ss = _dot(ds, ds)
+    ratio = _dot(ds, dz) / ss
+    rest = dz - ratio[:, None] * ds  # the part of ξQ that ξ does not explain
+    squares = _dot(rest, rest)
+    c = np.where(squares > _COLLINEAR * _dot(dz, dz), _dot(rest, dq) / squares, 0.0)
+    return mean_q - _dot(ds, dq) / ss * mean_s - c * (mean_z - ratio * mean_s)
+
+
+def line_crossings(x, y, valid, length, compliance, half_width, load):
+    r"""Displacement and force where each branch row crosses :math:`Q = S\Delta`.
+
+    On the line the contact position :math:`\xi = \Delta - Q/S` (eq. 10) is zero. The
+    branch's samples with :math:`|\xi|` below ``half_width`` are fitted by least squares
+    with :math:`Q = a + b\xi + c\xi Q`, which is eq. 9 for any groove slope
+    (:math:`a = \mu P`, :math:`b = kP`, :math:`c = \mu k`) and a smooth three-parameter
+    curve otherwise; the crossing is :math:`Q = a`. With fewer than ``_FIT_SAMPLES``
+    samples in the window, :math:`Q` is interpolated linearly at :math:`\xi = 0` between
+    the two samples around the crossing.
+    """
+    cycles = length.size // 2
+    position = x - y * compliance[:, None]  # the contact position (eq. 10)
+    before = np.concatenate([position[:cycles] > 0.0, position[cycles:] < 0.0]) & valid
+    after = _bracket(before, length)
+    rows = np.arange(length.size)
+    q0, q1 = y[rows, after - 1], y[rows, after]
+    v0, v1 = position[rows, after - 1], position[rows, after]
+    change = v0 - v1
+    share = np.divide(v0, change, out=np.full_like(v0, 0.5), where=change != 0.0)
+    guess = q0 + share * (q1 - q0)
+    scaled = position / half_width[:, None]
+    window = valid & (np.abs(scaled) <= 1.0)
+    enough = np.count_nonzero(window, axis=1) >= _FIT_SAMPLES
+    force = np.where(enough, _curve_intercept(window, scaled, y, load), guess)
+    return force * compliance, force
