@@ -66,6 +66,8 @@ groove slope at the ends of the slip, :math:`2 z_o \delta^*/x_o^2`, is below :ma
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import xarray as xr
 
@@ -79,6 +81,15 @@ from ecofmaps.measured.branches import (
 )
 from ecofmaps.measured.centring import loop_blocks
 from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles, find_cycles
+from ecofmaps.measured.quality import (
+    ALL,
+    ANTICLOCKWISE_SHARE,
+    REASONS,
+    LoopQualityWarning,
+    apply_quality,
+    quality_strings,
+    quality_summary,
+)
 
 __all__ = ["GROSS_SLIP_THRESHOLD", "analyze_loops", "measure_cycles"]
 
@@ -110,8 +121,19 @@ _ATTRS = {
     "loop_force": ("tangential force Q, centred", "N"),
 }
 
+_ATTRS |= {  # -> _nomenclature
+    "stick_residual": ("root mean square displacement off the stick lines", "m"),
+    "quality": ("plausibility: 'ok' or the reasons for NaN (ecofmaps.measured.quality)", ""),
+}
+
 #: Names of _ATTRS that are not per-cycle quantities.
-_NOT_PER_CYCLE = ("cycle", "regime", "load", "point", "loop_displacement", "loop_force")
+_NOT_PER_CYCLE = ("cycle", "regime", "quality", "load", "point", "loop_displacement", "loop_force")
+
+#: A stick segment must explain all but this share of the displacement's variance along it.
+_UNEXPLAINED = 0.2
+
+#: Plausible displacement amplitudes: outside this range the unit is probably wrong. [m]
+_AMPLITUDE_RANGE = (0.1e-6, 10e-3)
 
 
 def _attrs(name: str) -> dict:
@@ -120,41 +142,84 @@ def _attrs(name: str) -> dict:
 
 
 def _loop_values(block, load, options):
-    """Every per-cycle quantity of a block of centred loops (module notes)."""
+    """Every per-cycle quantity of a block of centred loops, and the checks it failed.
+
+    Returns the quantities (module notes; not yet NaN where a check fails) and the flags
+    of :data:`ecofmaps.measured.quality.REASONS` (reason -> per cycle).
+    """
     x, y = block.displacement, block.force
     highest, lowest = block.extremes(x)
-    amplitude = 0.5 * (highest - lowest)
+    span = highest - lowest
+    amplitude = 0.5 * span
     max_force = 0.5 * np.subtract(*block.extremes(y))
     # The loop's area by trapezoids, the segment that closes it included.
     first, last = block.offset, block.offset + block.count - 1
     closing = (y[first] + y[last]) * (x[first] - x[last])
     energy = 0.5 * (block.sums((y[1:] + y[:-1]) * np.diff(x)) + closing)
     bx, by, valid, length = branch_rows(block, block.first_point(x, highest))
-    compliance, intercept, stick = stick_lines(
-        bx, by, valid, highest - lowest, options["stick_window"]
+    compliance, intercept, stick, fit = stick_lines(bx, by, valid, span, options["stick_window"])
+    crossing, zero_on_loop = zero_force_crossings(
+        bx, by, valid, length, max_force, stick, intercept, span
     )
-    crossing = zero_force_crossings(bx, by, valid, length, max_force, stick, intercept)
     cycles = block.count.size
     slip = 0.5 * (crossing[cycles:] - crossing[:cycles])
     half_width = options["crossing_window"] * np.abs(slip)
-    at, force = line_crossings(bx, by, valid, length, both(compliance), both(half_width), load)
+    scale = (both(max_force), both(span))
+    at, force, on_loop = line_crossings(
+        bx, by, valid, length, both(compliance), both(half_width), load, scale
+    )
     energy_ratio = energy / (4.0 * amplitude * max_force)
-    sliding = np.where(energy_ratio > options["gross_slip_threshold"], 1.0, np.nan)
-    return {
+    values = {
         "amplitude": amplitude,
         "slip_amplitude": slip,
         "max_force": max_force,
         "dissipated_energy": energy,
-        "ecof": sliding * energy / (4.0 * load * slip),
+        "ecof": energy / (4.0 * load * slip),
         "cof_max": max_force / load,
         "energy_ratio": energy_ratio,
-        "stiffness": 1.0 / compliance,
-        "gicof": sliding * (force[:cycles] - force[cycles:]) / (2.0 * load),
-        "gicof_forward": sliding * force[:cycles] / load,
-        "gicof_backward": -sliding * force[cycles:] / load,
-        "crossing_displacement_forward": sliding * at[:cycles],
-        "crossing_displacement_backward": sliding * at[cycles:],
+        "stiffness": 1.0 / (compliance + 0.0),  # + 0.0: a rigid rig is +inf, not -inf
+        "gicof": (force[:cycles] - force[cycles:]) / (2.0 * load),
+        "gicof_forward": force[:cycles] / load,
+        "gicof_backward": -force[cycles:] / load,
+        "crossing_displacement_forward": at[:cycles],
+        "crossing_displacement_backward": at[cycles:],
+        "displacement_offset": block.displacement_centre,
+        "force_offset": block.force_centre,
+        "stick_residual": fit["residual"],
     }
+    rounding = 1e-9
+    anticlockwise = energy_ratio < -ANTICLOCKWISE_SHARE
+    flags = {
+        "few-samples": block.count < MIN_SAMPLES,
+        "constant-force": max_force <= rounding * np.abs(block.force_centre),
+        "several-loops": _turns_back(bx, options["hysteresis"] * span)
+        if not block.continuous
+        else np.zeros(cycles, dtype=bool),
+        "anticlockwise": anticlockwise,
+        "energy-ratio-above-1": energy_ratio > 1.0 + rounding,
+        "negative-stiffness": compliance < 0.0,
+        "no-stick": ~(fit["unexplained"] <= _UNEXPLAINED) & ~np.isinf(values["stiffness"])
+        | np.isnan(compliance),
+        "negative-area": (energy_ratio < 0.0) & ~anticlockwise,
+        "negative-slip": ~(slip > 0.0),
+        "no-zero-crossing": ~(zero_on_loop[:cycles] & zero_on_loop[cycles:]),
+        "curved-stick": fit["curved"],
+        "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]),
+        "not-gross-slip": ~(energy_ratio > options["gross_slip_threshold"]),
+    }
+    return values, flags
+
+
+def _turns_back(x, band):
+    """True for the cycles whose displacement turns back within a branch by more than
+    ``band``: the rising branches (the first half of the rows) fall below their running
+    maximum, or the falling ones rise above their running minimum (the rows' padding
+    repeats their last point, which changes neither)."""
+    cycles = band.size
+    rising, falling = x[:cycles], x[cycles:]
+    drop = np.max(np.maximum.accumulate(rising, axis=1) - rising, axis=1)
+    rise = np.max(falling - np.minimum.accumulate(falling, axis=1), axis=1)
+    return np.maximum(drop, rise) > band
 
 
 def measure_cycles(
@@ -163,9 +228,11 @@ def measure_cycles(
     force,
     load,
     *,
+    hysteresis=0.5,
     stick_window=(0.05, 0.45),
     crossing_window=0.7,
     gross_slip_threshold=GROSS_SLIP_THRESHOLD,
+    flip_force=False,
     rows=None,
     keep_loops=False,
 ):
@@ -179,7 +246,7 @@ def measure_cycles(
         The recording, float64 and finite. [m], [N]
     load : float
         Normal load :math:`P`. [N]
-    stick_window, crossing_window, gross_slip_threshold
+    hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
         As for :func:`analyze_loops` (not checked here).
     rows : slice, optional
         Consecutive cycles to measure; default all.
@@ -189,36 +256,62 @@ def measure_cycles(
     Returns
     -------
     values : dict of str to numpy.ndarray
-        Each quantity of :func:`analyze_loops` over the cycles, offsets included.
-    regime : numpy.ndarray of str
+        Each quantity of :func:`analyze_loops` over the cycles, offsets and stick residual
+        included, as measured: not yet NaN where a check fails.
+    flags : dict of str to numpy.ndarray of bool
+        The checks of :data:`ecofmaps.measured.quality.REASONS` each cycle failed.
     loops : tuple of numpy.ndarray or None
         Centred displacement and force round each loop, if ``keep_loops``. [m], [N]
     """
     first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
     options = {
+        "hysteresis": hysteresis,
         "stick_window": stick_window,
         "crossing_window": crossing_window,
         "gross_slip_threshold": gross_slip_threshold,
     }
     names = [name for name in _ATTRS if name not in _NOT_PER_CYCLE]
     values = {name: np.empty(stop - first) for name in names}
+    flags = {reason: np.zeros(stop - first, dtype=bool) for reason in REASONS}
     loops = None
     if keep_loops:
         width = int(cycles.count[first:stop].max()) + 1
         loops = tuple(np.full((stop - first, width), np.nan) for _ in range(2))
+    sign = -1.0 if flip_force else 1.0
+    blocks = loop_blocks(cycles, displacement, force, slice(first, stop), sign)
     with np.errstate(divide="ignore", invalid="ignore"):  # degenerate cycles give NaN
-        for block in loop_blocks(cycles, displacement, force, slice(first, stop)):
+        for block in blocks:
             out = slice(block.rows.start - first, block.rows.stop - first)
-            computed = _loop_values(block, load, options)
-            computed["displacement_offset"] = block.displacement_centre
-            computed["force_offset"] = block.force_centre
+            computed, failed = _loop_values(block, load, options)
             for name, value in computed.items():
                 values[name][out] = value
+            for reason, flag in failed.items():
+                flags[reason][out] = flag
             if keep_loops:
                 for loop, centred in zip(loops, block.loops(loops[0].shape[1]), strict=True):
                     loop[out] = centred
-    regime = np.where(values["energy_ratio"] > gross_slip_threshold, "gross slip", "partial slip")
-    return values, regime, loops
+    return values, flags, loops
+
+
+def _refusal_hint(flags: dict) -> str:
+    """What the user may do about a recording whose every cycle is refused."""
+    if flags["anticlockwise"].all():
+        if flags["negative-stiffness"].any():
+            return (
+                "The loops run anticlockwise with stick sides sloping down: the force is "
+                "recorded positive against the displacement. If so, read it with the other "
+                "sign: flip_force=True (on the command line, --flip-force)."
+            )
+        return (
+            "The loops run anticlockwise with stick sides sloping up: the recording runs "
+            "backwards in time, or the displacement and force columns are swapped."
+        )
+    if flags["constant-force"].all():
+        return "The force does not vary: is the force channel connected?"
+    return (
+        "Is it a recording of fretting loops, with the displacement and the force in their "
+        "own columns?"
+    )
 
 
 # --- the public function ------------------------------------------------------------------
@@ -238,7 +331,9 @@ def _series(name, values, size=None):
     return array
 
 
-def _check_options(load, hysteresis, stick_window, crossing_window, gross_slip_threshold):
+def _check_options(
+    load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
+):
     check("load", load, "positive", "N")
     if np.ndim(load) != 0:
         raise ValueError("load must be a single value [N]")
@@ -256,10 +351,14 @@ def _check_options(load, hysteresis, stick_window, crossing_window, gross_slip_t
             "gross_slip_threshold must satisfy 0 < gross_slip_threshold < 1; "
             f"got {gross_slip_threshold!r}"
         )
+    if not isinstance(flip_force, bool | np.bool_):
+        raise ValueError(f"flip_force must be True or False; got {flip_force!r}")
     return {
+        "hysteresis": float(hysteresis),
         "stick_window": (low, high),
         "crossing_window": float(crossing_window),
         "gross_slip_threshold": float(gross_slip_threshold),
+        "flip_force": bool(flip_force),
     }
 
 
@@ -273,9 +372,10 @@ def analyze_loops(
     stick_window=(0.05, 0.45),
     crossing_window=0.7,
     gross_slip_threshold=GROSS_SLIP_THRESHOLD,
+    flip_force=False,
     keep_loops=False,
 ) -> xr.Dataset:
-    r"""Per-cycle friction quantities of a recording of fretting loops.
+    r"""Per-cycle friction quantities of a recording of fretting loops, each checked.
 
     Parameters
     ----------
@@ -283,7 +383,8 @@ def analyze_loops(
         Applied displacement :math:`\Delta` at each sample, in time order. Offsets and a
         slow drift are removed; the sampling need not be uniform. [m]
     force : array_like
-        Tangential force :math:`Q` at each sample; offsets are removed. [N]
+        Tangential force :math:`Q` at each sample, positive in the direction of positive
+        displacement (the loops then run clockwise); offsets are removed. [N]
     load : float
         Normal load :math:`P`. [N]
     cycle : array_like, optional
@@ -301,6 +402,10 @@ def analyze_loops(
         share of the slip amplitude (> 0). [1]
     gross_slip_threshold : float
         Energy ratio :math:`A` above which a loop is gross slip (0 < threshold < 1). [1]
+    flip_force : bool
+        Read the force with the other sign: for a rig whose force is recorded positive
+        against the displacement (its loops run anticlockwise, with stick sides sloping
+        down).
     keep_loops : bool
         Also return the centred loops, ``loop_displacement`` and ``loop_force`` over
         ``(cycle, point)`` (NaN-padded), for plotting.
@@ -312,23 +417,34 @@ def analyze_loops(
         dissipated_energy [J], ecof, cof_max, energy_ratio, stiffness [N/m], gicof,
         gicof_forward, gicof_backward, crossing_displacement_forward and
         crossing_displacement_backward [m] (in the centred loop), displacement_offset [m]
-        and force_offset [N] (the centres removed), and regime ('gross slip' or
-        'partial slip'); the load is a scalar coordinate. The attributes
-        ``incomplete_cycles`` and ``dropped_samples`` count what was dropped.
-        ``results.to_dataframe()`` gives a table.
+        and force_offset [N] (the centres removed, of the force as read), regime ('gross
+        slip', 'partial slip', or 'unknown' for a refused cycle), stick_residual [m] (root
+        mean square displacement off the stick lines) and quality ('ok', or why values
+        are NaN: :mod:`ecofmaps.measured.quality`); the load is a scalar coordinate. The
+        attributes ``incomplete_cycles`` and ``dropped_samples`` count what was dropped;
+        ``quality_summary`` is one line on what was flagged. ``results.to_dataframe()``
+        gives a table.
 
     Raises
     ------
     ValueError
         For inputs of the wrong shape, non-finite samples, a load that is not positive,
-        options out of range, or a recording without a complete cycle.
+        options out of range, a recording without a complete cycle, or one whose every
+        cycle is refused (not a loop that can be read as recorded).
+
+    Warns
+    -----
+    LoopQualityWarning
+        When cycles were flagged (other than for partial slip), with the one-line summary;
+        and when the displacement amplitude is below 0.1 µm or above 10 mm (a displacement
+        not in metres).
 
     Notes
     -----
     The methods are in the documentation of :mod:`ecofmaps.measured.analysis`,
-    :mod:`ecofmaps.measured.cycles` and :mod:`ecofmaps.measured.centring`. The ECoF is
-    eq. 1; the GICoF is the paper's Section 5 (eq. 17-18), and equals :math:`\mu` for the
-    model's loop whatever the groove.
+    :mod:`ecofmaps.measured.cycles` and :mod:`ecofmaps.measured.centring`; the checks in
+    :mod:`ecofmaps.measured.quality`. The ECoF is eq. 1; the GICoF is the paper's Section 5
+    (eq. 17-18), and equals :math:`\mu` for the model's loop whatever the groove.
 
     Examples
     --------
@@ -337,8 +453,12 @@ def analyze_loops(
     >>> results = ecofmaps.analyze_loops(np.asarray(displacement), np.asarray(force), 450.0)
     >>> print(f"{float(results.gicof[0]):.6f} {float(results.ecof[0]):.3f}")
     0.800000 0.831
+    >>> print(results.quality.values[0], "|", results.attrs["quality_summary"])
+    ok | 1 cycles: 1 ok
     """
-    options = _check_options(load, hysteresis, stick_window, crossing_window, gross_slip_threshold)
+    options = _check_options(
+        load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
+    )
     load = float(load)
     x = _series("displacement", displacement)
     q = _series("force", force, x.size)
@@ -352,9 +472,30 @@ def analyze_loops(
             f"too few samples for one cycle: no complete cycle in {x.size} samples "
             "(the loop does not close, or the recording does not oscillate)"
         )
-    values, regime, loops = measure_cycles(cycles, x, q, load, keep_loops=keep_loops, **options)
-    data = {name: ("cycle", value, _attrs(name)) for name, value in values.items()}
+    values, flags, loops = measure_cycles(cycles, x, q, load, keep_loops=keep_loops, **options)
+    _check_units(values["amplitude"])
+    quality = quality_strings(flags, cycles.label.size)
+    summary = quality_summary(quality)
+    refused = np.zeros(quality.size, dtype=bool)
+    for reason, flag in flags.items():
+        refused |= flag & (REASONS[reason][1] == ALL)
+    if refused.all():
+        raise ValueError(f"no plausible cycle in the recording ({summary}). {_refusal_hint(flags)}")
+    if np.any((quality != "ok") & (quality != "not-gross-slip")):
+        warnings.warn(f"cycles flagged: {summary}", LoopQualityWarning, stacklevel=2)
+    values = apply_quality(values, flags)
+    regime = np.where(
+        refused,
+        "unknown",
+        np.where(
+            values["energy_ratio"] > options["gross_slip_threshold"], "gross slip", "partial slip"
+        ),
+    )
+    names = [name for name in values if name != "stick_residual"]
+    data = {name: ("cycle", values[name], _attrs(name)) for name in names}
     data["regime"] = ("cycle", regime, _attrs("regime"))
+    data["stick_residual"] = ("cycle", values["stick_residual"], _attrs("stick_residual"))
+    data["quality"] = ("cycle", quality, _attrs("quality"))
     coords = {"cycle": ("cycle", cycles.label, _attrs("cycle")), "load": ((), load, _attrs("load"))}
     if keep_loops:
         data["loop_displacement"] = (("cycle", "point"), loops[0], _attrs("loop_displacement"))
@@ -366,5 +507,21 @@ def analyze_loops(
         "incomplete_cycles": cycles.incomplete_cycles,
         "dropped_samples": cycles.dropped_samples,
         "gross_slip_threshold": options["gross_slip_threshold"],
+        "flip_force": int(options["flip_force"]),
+        "quality_summary": summary,
     }
     return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def _check_units(amplitude):
+    """Warn when the displacement amplitudes look like another unit than metres."""
+    typical = float(np.nanmedian(amplitude)) if amplitude.size else np.nan
+    low, high = _AMPLITUDE_RANGE
+    if not low <= typical <= high:
+        warnings.warn(
+            f"the displacement amplitude is {typical:.3g} m (median over the cycles), outside "
+            "0.1 µm to 10 mm: is the displacement in metres? analyze_loops takes SI units; "
+            "on the command line, --displacement-unit gives the unit of the column",
+            LoopQualityWarning,
+            stacklevel=3,
+        )

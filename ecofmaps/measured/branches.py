@@ -24,6 +24,13 @@ _STICK_SPREAD = 3.0
 #: Fewest samples in the window of the curve fitted at a GICoF crossing.
 _FIT_SAMPLES = 5
 
+#: A stick segment is curved when a term in the squared force, added to its line, is
+#: significant by more than this many standard errors ...
+_CURVATURE_T = 5.0
+
+#: ... and changes its slope from one end to the other by more than this share.
+_CURVATURE_CHANGE = 0.05
+
 #: In a GICoF window where the variance of :math:`\xi Q` not explained by :math:`\xi` is
 #: below this share of its own (rounding: the force is constant along the slip), the line
 #: :math:`Q = a + b\xi` is fitted.
@@ -78,29 +85,32 @@ def branch_rows(block, top):
 def _line(mask, u, v):
     """Sums of the least-squares line of ``v`` on ``u`` through each row's masked points.
 
-    Returns the count, the means of ``u`` and ``v``, and the sums of du dv and du du
-    (deviations from the means).
+    Returns the count, the means of ``u`` and ``v``, and the sums of du dv, du du and
+    dv dv (deviations from the means).
     """
     weight = mask.astype(np.float64)
     count = weight.sum(axis=1)
     mean_u = _dot(weight, u) / count
     mean_v = _dot(weight, v) / count
     du = (u - mean_u[:, None]) * weight
-    return count, mean_u, mean_v, _dot(du, v - mean_v[:, None]), _dot(du, du)
+    dv = (v - mean_v[:, None]) * weight
+    return count, mean_u, mean_v, _dot(du, dv), _dot(du, du), _dot(dv, dv)
 
 
 def _common_line(mask, y, x):
     r"""Lines :math:`\Delta = c + Q/S` through both branches' masked points, one slope.
 
     Returns the compliance :math:`1/S` of each cycle, the intercept :math:`c` of each
-    branch row and the count of its points.
+    branch row, and each row's sums (count, mean force, mean displacement, sums of
+    products) from :func:`_line`.
     """
-    count, mean_y, mean_x, covariance, variance = _line(mask, y, x)
+    sums = _line(mask, y, x)
+    count, mean_y, mean_x, covariance, variance, _ = sums
     cycles = count.size // 2
     compliance = (covariance[:cycles] + covariance[cycles:]) / (
         variance[:cycles] + variance[cycles:]
     )
-    return compliance, mean_x - both(compliance) * mean_y, count
+    return compliance, mean_x - both(compliance) * mean_y, sums
 
 
 def stick_lines(x, y, valid, span, window):
@@ -112,9 +122,11 @@ def stick_lines(x, y, valid, span, window):
     past the lower share). A first line is fitted; each segment then grows along its
     branch until two samples in a row lie more than ``_STICK_SPREAD`` standard deviations
     off its line (the slip that follows bends away from it; a single noisy sample does
-    not stop it), and the lines are fitted again to the grown segments. Returns the
-    common compliance :math:`1/S`, the intercept :math:`c` of each branch row and the
-    mask of each segment (over the first columns: no segment reaches further).
+    not stop it), and the lines are fitted again to the grown segments.
+
+    Returns the common compliance :math:`1/S` of each cycle, the intercept :math:`c` of
+    each branch row, the mask of each segment (over the first columns: no segment reaches
+    further) and, per cycle, how well the lines fit (:func:`_stick_fit`).
     """
     low, high = window
     swing = np.max(y, axis=1) - np.min(y, axis=1)
@@ -126,12 +138,12 @@ def stick_lines(x, y, valid, span, window):
         j = np.arange(x.shape[1])
         mask[sparse] = (j == 0) | (j == reach[:, None])
     reach = _columns(mask).stop  # the segments end before this column
-    compliance, intercept, count = _common_line(mask[:, :reach], y[:, :reach], x[:, :reach])
+    compliance, intercept, sums = _common_line(mask[:, :reach], y[:, :reach], x[:, :reach])
     slope = both(compliance)[:, None]
     residual = x[:, :reach] - intercept[:, None] - slope * y[:, :reach]
     squares = _dot(residual * mask[:, :reach], residual)
     cycles = compliance.size
-    points = count[:cycles] + count[cycles:]
+    points = sums[0][:cycles] + sums[0][cycles:]
     spread = np.sqrt((squares[:cycles] + squares[cycles:]) / np.maximum(points - 3, 1))
     tolerance = both(np.maximum(_STICK_SPREAD * spread, 1e-9 * span))[:, None]
     # The growth is followed over the first columns, and over all if it reaches their end.
@@ -146,36 +158,82 @@ def stick_lines(x, y, valid, span, window):
         if end == x.shape[1] or not grown[:, -1].any():
             break
         end = x.shape[1]
-    compliance, intercept, _ = _common_line(grown, y[:, :end], x[:, :end])
-    return compliance, intercept, grown
+    compliance, intercept, sums = _common_line(grown, y[:, :end], x[:, :end])
+    fit = _stick_fit(grown, x[:, :end], y[:, :end], compliance, intercept, sums)
+    return compliance, intercept, grown, fit
 
 
-def zero_force_crossings(x, y, valid, length, max_force, stick, intercept):
-    r"""Displacement where each branch row crosses :math:`Q = 0`.
+def _stick_fit(mask, x, y, compliance, intercept, sums):
+    r"""How well the lines through the stick segments ``mask`` fit, per cycle.
+
+    ``residual`` is the root mean square displacement off the lines; ``unexplained`` the
+    share of the displacement's variance along the segments that they leave; ``curved``
+    is True where a segment bends: a term :math:`bQ^2` added to its line is significant
+    (more than ``_CURVATURE_T`` standard errors) and changes its slope
+    :math:`d\Delta/dQ` from one end of the segment to the other by more than
+    ``_CURVATURE_CHANGE`` of the compliance.
+    """
+    count, mean_y, _, _, _, variance = sums
+    cycles = compliance.size
+    weight = mask.astype(np.float64)
+    residual = (x - intercept[:, None] - both(compliance)[:, None] * y) * weight
+    squares = _dot(residual, residual)
+    square = ((y - mean_y[:, None]) * weight) ** 2  # the squared force, centred on its mean
+    centred = (square - (square.sum(axis=1) / count)[:, None]) * weight
+    spread = _dot(centred, centred)
+    bend = _dot(residual, centred) / spread
+    error = np.sqrt(np.maximum(squares - bend * bend * spread, 0.0) / np.maximum(count - 3, 1))
+    significance = np.abs(bend) * np.sqrt(spread) / error
+    reach = np.sqrt(np.max(square, axis=1))  # the largest force from the segment's mean
+    change = 4.0 * np.abs(bend) * reach / np.abs(both(compliance))
+    curved = (count > 3) & (significance > _CURVATURE_T) & (change > _CURVATURE_CHANGE)
+    total = squares[:cycles] + squares[cycles:]
+    points = count[:cycles] + count[cycles:]
+    return {
+        "residual": np.sqrt(total / points),
+        "unexplained": total / (variance[:cycles] + variance[cycles:]),
+        "curved": curved[:cycles] | curved[cycles:],
+    }
+
+
+def zero_force_crossings(x, y, valid, length, max_force, stick, intercept, span):
+    r"""Displacement where each branch row crosses :math:`Q = 0`, and whether on the loop.
 
     Where the stick segment ``stick`` reaches across zero force, it is the intercept of
     the line fitted to it, :math:`\Delta = c + Q/S`. Elsewhere a straight line
     :math:`\Delta = a + bQ` is fitted to the two samples around the crossing and the
     branch's samples with :math:`|Q|` below ``_ZERO_FORCE_BAND`` times the loop's
-    ``max_force`` :math:`Q^*`, and gives :math:`a`.
+    ``max_force`` :math:`Q^*`, and gives :math:`a`. The crossing is on the loop if the
+    branch has samples of both signs of force and it lies within the displacements of
+    those samples (to rounding of the displacement ``span``).
     """
     cycles = length.size // 2
     negative, positive = y < 0.0, y > 0.0
     # Samples before the crossing: negative force on the rising branch, positive on the other.
     before = np.concatenate([negative[:cycles], positive[cycles:]]) & valid
-    after = _bracket(before, length)
+    count = np.count_nonzero(before, axis=1)
+    after = np.clip(count, 1, length - 1)
     near = valid & (np.abs(y) <= both(_ZERO_FORCE_BAND * max_force)[:, None])
     rows = np.arange(length.size)
     near[rows, after] = True  # the two samples around the crossing (after >= 1 if valid)
     near[rows[after >= 1], after[after >= 1] - 1] = True
     columns = _columns(near)
-    _, mean_y, mean_x, covariance, variance = _line(near[:, columns], y[:, columns], x[:, columns])
+    near, x_near = near[:, columns], x[:, columns]
+    _, mean_y, mean_x, covariance, variance, _ = _line(near, y[:, columns], x_near)
     local = mean_x - covariance / variance * mean_y
     reach = stick.shape[1]  # no stick segment reaches further
     across = np.any(stick & negative[:, :reach], axis=1) & np.any(
         stick & positive[:, :reach], axis=1
     )
-    return np.where(across, intercept, local)
+    crossing = np.where(across, intercept, local)
+    rounding = 1e-9 * both(span)
+    on_loop = (
+        (count >= 1)
+        & (count <= length - 1)
+        & (crossing >= np.min(np.where(near, x_near, np.inf), axis=1) - rounding)
+        & (crossing <= np.max(np.where(near, x_near, -np.inf), axis=1) + rounding)
+    )
+    return crossing, on_loop
 
 
 def _curve_intercept(window, scaled, y, load):
@@ -206,8 +264,8 @@ def _curve_intercept(window, scaled, y, load):
     return mean_q - _dot(ds, dq) / ss * mean_s - c * (mean_z - ratio * mean_s)
 
 
-def line_crossings(x, y, valid, length, compliance, half_width, load):
-    r"""Displacement and force where each branch row crosses :math:`Q = S\Delta`.
+def line_crossings(x, y, valid, length, compliance, half_width, load, scale):
+    r"""Where each branch row crosses :math:`Q = S\Delta`: displacement, force, on the loop.
 
     On the line the contact position :math:`\xi = \Delta - Q/S` (eq. 10) is zero. The
     branch's samples with :math:`|\xi|` below ``half_width`` are fitted by least squares
@@ -216,10 +274,16 @@ def line_crossings(x, y, valid, length, compliance, half_width, load):
     curve otherwise; the crossing is :math:`Q = a`. With fewer than ``_FIT_SAMPLES``
     samples in the window, :math:`Q` is interpolated linearly at :math:`\xi = 0` between
     the two samples around the crossing.
+
+    The crossing is on the loop if measured samples of the branch lie on both sides of
+    :math:`\xi = 0` (in the window, or the two interpolated between), and its force and
+    displacement lie within theirs (to rounding of ``scale``: :math:`Q^*` and the
+    displacement span of each row).
     """
     cycles = length.size // 2
     position = x - y * compliance[:, None]  # the contact position (eq. 10)
-    before = np.concatenate([position[:cycles] > 0.0, position[cycles:] < 0.0]) & valid
+    # Samples before the crossing: ξ < 0 on the rising branch (from -δ*), ξ > 0 on the other.
+    before = np.concatenate([position[:cycles] < 0.0, position[cycles:] > 0.0]) & valid
     after = _bracket(before, length)
     rows = np.arange(length.size)
     q0, q1 = y[rows, after - 1], y[rows, after]
@@ -231,4 +295,20 @@ def line_crossings(x, y, valid, length, compliance, half_width, load):
     window = valid & (np.abs(scaled) <= 1.0)
     enough = np.count_nonzero(window, axis=1) >= _FIT_SAMPLES
     force = np.where(enough, _curve_intercept(window, scaled, y, load), guess)
-    return force * compliance, force
+    displacement = force * compliance
+    # On the loop: the fitted window, or the interpolated pair, holds samples on both
+    # sides of ξ = 0, and the crossing lies within their forces and displacements.
+    window[rows, after] |= ~enough
+    window[rows, after - 1] |= ~enough
+    columns = _columns(window)
+    window, before = window[:, columns], before[:, columns]
+    sides = np.any(window & before, axis=1) & np.any(window & ~before, axis=1)
+    force_scale, displacement_scale = scale
+    on_loop = sides & (np.where(enough, True, (share >= 0.0) & (share <= 1.0)))
+    for value, samples, rounding in (
+        (force, y[:, columns], 1e-9 * force_scale),
+        (displacement, x[:, columns], 1e-9 * displacement_scale),
+    ):
+        on_loop &= value >= np.min(np.where(window, samples, np.inf), axis=1) - rounding
+        on_loop &= value <= np.max(np.where(window, samples, -np.inf), axis=1) + rounding
+    return displacement, force, on_loop

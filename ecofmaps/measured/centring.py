@@ -130,7 +130,9 @@ def _reduce(ufunc, values, begin, end):
     return ufunc.reduceat(values, cuts)[::2]
 
 
-def loop_blocks(cycles: Cycles, displacement, force, rows=None) -> Iterator[LoopBlock]:
+def loop_blocks(
+    cycles: Cycles, displacement, force, rows=None, force_sign=1.0
+) -> Iterator[LoopBlock]:
     """The loops of ``cycles``, each moved to its centre (module notes), block by block.
 
     Parameters
@@ -142,6 +144,8 @@ def loop_blocks(cycles: Cycles, displacement, force, rows=None) -> Iterator[Loop
     rows : slice, optional
         Consecutive cycles to lay out (default all). The centring of cycles cut at the
         reversals still uses their neighbours.
+    force_sign : float
+        +1, or -1 to read the force with the other sign (without copying the recording).
 
     Yields
     ------
@@ -152,7 +156,7 @@ def loop_blocks(cycles: Cycles, displacement, force, rows=None) -> Iterator[Loop
     blocks = _blocks(cycles.count[first:stop] + 1, first)
     if not cycles.continuous:
         for block in blocks:
-            yield _labelled_block(cycles, displacement, force, block)
+            yield _labelled_block(cycles, displacement, force, block, force_sign)
         return
     start, count = cycles.start, cycles.count
     size = start.size
@@ -171,7 +175,7 @@ def loop_blocks(cycles: Cycles, displacement, force, rows=None) -> Iterator[Loop
         if ready < needed:
             cut = slice(ready, needed)
             centre_q[cut] = _path_means(
-                x, force[low:high], start[cut] - low, count[cut], closed=False
+                x, _signed(force[low:high], force_sign), start[cut] - low, count[cut], closed=False
             )
             ready = needed
         a, b = int(start[block.start]), int(start[block.stop - 1] + count[block.stop - 1])
@@ -179,7 +183,7 @@ def loop_blocks(cycles: Cycles, displacement, force, rows=None) -> Iterator[Loop
         yield LoopBlock(
             rows=block,
             displacement=x[a - low : b - low],
-            force=force[a:b] - _drift(a, b, middle, centre_q, near),
+            force=_signed(force[a:b], force_sign) - _drift(a, b, middle, centre_q, near),
             offset=start[block] - a,
             count=count[block],
             rotation=cycles.rotation[block],
@@ -189,12 +193,17 @@ def loop_blocks(cycles: Cycles, displacement, force, rows=None) -> Iterator[Loop
         )
 
 
-def _labelled_block(cycles: Cycles, displacement, force, block: slice) -> LoopBlock:
+def _signed(values, sign):
+    """``values``, or ``-values`` if ``sign`` is negative."""
+    return values if sign > 0 else -values
+
+
+def _labelled_block(cycles: Cycles, displacement, force, block: slice, sign) -> LoopBlock:
     """The loops of labelled cycles, each moved by its own centre."""
     start, count = cycles.start[block], cycles.count[block]
     offset = np.concatenate([[0], np.cumsum(count[:-1])])
     index = np.repeat(start - offset, count) + np.arange(int(count.sum()))
-    x, q = displacement[index], force[index]
+    x, q = displacement[index], _signed(force[index], sign)
     centre_x = _path_means(x, x, offset, count, closed=True)
     x -= np.repeat(centre_x, count)
     # The force's weights come from the centred displacement, as for drifting loops.

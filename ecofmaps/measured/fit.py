@@ -20,6 +20,7 @@ import numpy as np
 from ecofmaps._inputs import check, float64
 from ecofmaps.measured.analysis import measure_cycles
 from ecofmaps.measured.cycles import MIN_SAMPLES, find_cycles
+from ecofmaps.measured.quality import ANTICLOCKWISE_SHARE
 from ecofmaps.model.core import slip_position, traction_ratio
 from ecofmaps.model.simulation import fretting_loop
 
@@ -35,9 +36,6 @@ _STICK_WINDOWS = ((0.05, 0.45), (0.0, 0.15))
 _SLIP_SHARE = 0.6
 # A slip amplitude below this share of the amplitude is rounding: the loop does not slip.
 _NO_SLIP = 1e-9
-# A loop whose area is negative by more than this share of its bounding box runs
-# anticlockwise; a smaller negative area is noise on a loop without gross slip.
-_ORIENTATION_SHARE = 0.05
 # Samples are padded to a multiple of this for the compiled residual.
 _BUCKET = 64
 _TOLERANCE = 1e-12
@@ -178,7 +176,7 @@ def _starting_values(x, y, rising, stiffness, slip_half_width, energy_ratio):
     groove slope :math:`k` by least squares on :math:`Q_\pm/P \approx \pm\mu + k(1 +
     \mu^2) x` (eq. 9 to first order in :math:`x`; at :math:`x = 0` this is the GICoF).
     """
-    if energy_ratio < -_ORIENTATION_SHARE:
+    if energy_ratio < -ANTICLOCKWISE_SHARE:
         raise ValueError(
             "the loop runs anticlockwise (its area ∮Q dΔ is negative): force and "
             "displacement must be positive in the same direction"
