@@ -2,6 +2,7 @@
 
 from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.fit import LoopFit, fit_loop
+from ecofmaps.measured.quality import LoopQualityWarning
 from ecofmaps.measured.synthetic import synthetic_recording
 
-__all__ = ["LoopFit", "analyze_loops", "fit_loop", "synthetic_recording"]
+__all__ = ["LoopFit", "LoopQualityWarning", "analyze_loops", "fit_loop", "synthetic_recording"]

@@ -49,12 +49,23 @@ back down the *falling* branch.
   five samples in the window, the crossing is interpolated between two samples. A small
   error in :math:`S` or in the centring moves the two crossings in opposite directions,
   and most of it cancels from their mean.
+* stick_residual: the root mean square displacement off the stick lines.
 * regime: 'gross slip' when the energy ratio :math:`A` exceeds ``gross_slip_threshold``
   (default 0.2, the sliding transition of Fouvry, Kapsa and Vincent), else
   'partial slip'. ECoF and GICoF describe sliding: they are NaN in partial slip. Like
   Fouvry's criterion, this also calls partial slip a gross-slip loop that slips over less
   than about a fifth of the stroke (for the model, :math:`A \approx \delta^*/\Delta^*`
   times :math:`\mu_E P/Q^*`); lower the threshold to read such loops.
+
+Every cycle is checked before its numbers are reported (:mod:`ecofmaps.measured.quality`):
+a loop that runs anticlockwise, has no area, no straight stick sides, a constant force,
+crossings that are not on the measured loop, ... has the values concerned NaN and the
+reasons in its ``quality``; the stick sides are *curved* when a :math:`Q^2` term is
+significant and changes their slope by more than 5 % from end to end. A crossing with
+:math:`Q = S\Delta` is on the loop when the branch has measured samples on both sides of
+:math:`\xi = 0` in the fitted window (or the two interpolated between) and the crossing's
+force lies within theirs; a zero-force crossing when it lies within the displacements of
+the branch's samples near zero force.
 
 For the model's loop every quantity is exact up to the sampling: :math:`\Delta^*`,
 :math:`Q^*`, :math:`S`, :math:`\delta^*` and the GICoF to rounding when the loop's
@@ -164,9 +175,8 @@ def _loop_values(block, load, options):
     cycles = block.count.size
     slip = 0.5 * (crossing[cycles:] - crossing[:cycles])
     half_width = options["crossing_window"] * np.abs(slip)
-    scale = (both(max_force), both(span))
     at, force, on_loop = line_crossings(
-        bx, by, valid, length, both(compliance), both(half_width), load, scale
+        bx, by, valid, length, both(compliance), both(half_width), load, both(max_force)
     )
     energy_ratio = energy / (4.0 * amplitude * max_force)
     values = {
@@ -191,7 +201,7 @@ def _loop_values(block, load, options):
     anticlockwise = energy_ratio < -ANTICLOCKWISE_SHARE
     flags = {
         "few-samples": block.count < MIN_SAMPLES,
-        "constant-force": max_force <= rounding * np.abs(block.force_centre),
+        "constant-force": ~(block.force_swing > 0.0),
         "several-loops": _turns_back(bx, options["hysteresis"] * span)
         if not block.continuous
         else np.zeros(cycles, dtype=bool),

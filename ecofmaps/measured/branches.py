@@ -82,30 +82,33 @@ def branch_rows(block, top):
     return block.displacement[index], block.force[index], valid, last - first + 1
 
 
-def _line(mask, u, v):
+def _line(mask, u, v, spread=False):
     """Sums of the least-squares line of ``v`` on ``u`` through each row's masked points.
 
-    Returns the count, the means of ``u`` and ``v``, and the sums of du dv, du du and
-    dv dv (deviations from the means).
+    Returns the count, the means of ``u`` and ``v``, and the sums of du dv and du du
+    (deviations from the means), and of dv dv if ``spread``.
     """
     weight = mask.astype(np.float64)
     count = weight.sum(axis=1)
     mean_u = _dot(weight, u) / count
     mean_v = _dot(weight, v) / count
     du = (u - mean_u[:, None]) * weight
-    dv = (v - mean_v[:, None]) * weight
-    return count, mean_u, mean_v, _dot(du, dv), _dot(du, du), _dot(dv, dv)
+    dv = v - mean_v[:, None]
+    sums = (count, mean_u, mean_v, _dot(du, dv), _dot(du, du))
+    if spread:
+        dv *= weight
+        sums += (_dot(dv, dv),)
+    return sums
 
 
-def _common_line(mask, y, x):
+def _common_line(mask, y, x, spread=False):
     r"""Lines :math:`\Delta = c + Q/S` through both branches' masked points, one slope.
 
     Returns the compliance :math:`1/S` of each cycle, the intercept :math:`c` of each
-    branch row, and each row's sums (count, mean force, mean displacement, sums of
-    products) from :func:`_line`.
+    branch row, and each row's sums from :func:`_line`.
     """
-    sums = _line(mask, y, x)
-    count, mean_y, mean_x, covariance, variance, _ = sums
+    sums = _line(mask, y, x, spread)
+    count, mean_y, mean_x, covariance, variance = sums[:5]
     cycles = count.size // 2
     compliance = (covariance[:cycles] + covariance[cycles:]) / (
         variance[:cycles] + variance[cycles:]
@@ -158,7 +161,7 @@ def stick_lines(x, y, valid, span, window):
         if end == x.shape[1] or not grown[:, -1].any():
             break
         end = x.shape[1]
-    compliance, intercept, sums = _common_line(grown, y[:, :end], x[:, :end])
+    compliance, intercept, sums = _common_line(grown, y[:, :end], x[:, :end], spread=True)
     fit = _stick_fit(grown, x[:, :end], y[:, :end], compliance, intercept, sums)
     return compliance, intercept, grown, fit
 
@@ -173,15 +176,17 @@ def _stick_fit(mask, x, y, compliance, intercept, sums):
     :math:`d\Delta/dQ` from one end of the segment to the other by more than
     ``_CURVATURE_CHANGE`` of the compliance.
     """
-    count, mean_y, _, _, _, variance = sums
+    count, mean_y, _, _, force_variance, variance = sums
     cycles = compliance.size
     weight = mask.astype(np.float64)
     residual = (x - intercept[:, None] - both(compliance)[:, None] * y) * weight
     squares = _dot(residual, residual)
-    square = ((y - mean_y[:, None]) * weight) ** 2  # the squared force, centred on its mean
-    centred = (square - (square.sum(axis=1) / count)[:, None]) * weight
-    spread = _dot(centred, centred)
-    bend = _dot(residual, centred) / spread
+    # The residual against the squared force from its mean, sq: each branch's residual
+    # sums to zero (its own intercept), so it needs no centring; sq's spread is
+    # sum(sq^2) - n mean(sq)^2, with sum(sq) the force's variance.
+    square = ((y - mean_y[:, None]) * weight) ** 2
+    spread = _dot(square, square) - force_variance**2 / count
+    bend = _dot(residual, square) / spread
     error = np.sqrt(np.maximum(squares - bend * bend * spread, 0.0) / np.maximum(count - 3, 1))
     significance = np.abs(bend) * np.sqrt(spread) / error
     reach = np.sqrt(np.max(square, axis=1))  # the largest force from the segment's mean
@@ -219,7 +224,7 @@ def zero_force_crossings(x, y, valid, length, max_force, stick, intercept, span)
     near[rows[after >= 1], after[after >= 1] - 1] = True
     columns = _columns(near)
     near, x_near = near[:, columns], x[:, columns]
-    _, mean_y, mean_x, covariance, variance, _ = _line(near, y[:, columns], x_near)
+    _, mean_y, mean_x, covariance, variance = _line(near, y[:, columns], x_near)
     local = mean_x - covariance / variance * mean_y
     reach = stick.shape[1]  # no stick segment reaches further
     across = np.any(stick & negative[:, :reach], axis=1) & np.any(
@@ -276,9 +281,8 @@ def line_crossings(x, y, valid, length, compliance, half_width, load, scale):
     the two samples around the crossing.
 
     The crossing is on the loop if measured samples of the branch lie on both sides of
-    :math:`\xi = 0` (in the window, or the two interpolated between), and its force and
-    displacement lie within theirs (to rounding of ``scale``: :math:`Q^*` and the
-    displacement span of each row).
+    :math:`\xi = 0` (in the window, or the two interpolated between), and its force lies
+    within theirs (to rounding of ``scale``, the loop's :math:`Q^*`).
     """
     cycles = length.size // 2
     position = x - y * compliance[:, None]  # the contact position (eq. 10)
@@ -297,18 +301,17 @@ def line_crossings(x, y, valid, length, compliance, half_width, load, scale):
     force = np.where(enough, _curve_intercept(window, scaled, y, load), guess)
     displacement = force * compliance
     # On the loop: the fitted window, or the interpolated pair, holds samples on both
-    # sides of ξ = 0, and the crossing lies within their forces and displacements.
+    # sides of ξ = 0, and the crossing's force lies within theirs.
     window[rows, after] |= ~enough
     window[rows, after - 1] |= ~enough
     columns = _columns(window)
-    window, before = window[:, columns], before[:, columns]
+    window, before, y = window[:, columns], before[:, columns], y[:, columns]
     sides = np.any(window & before, axis=1) & np.any(window & ~before, axis=1)
-    force_scale, displacement_scale = scale
-    on_loop = sides & (np.where(enough, True, (share >= 0.0) & (share <= 1.0)))
-    for value, samples, rounding in (
-        (force, y[:, columns], 1e-9 * force_scale),
-        (displacement, x[:, columns], 1e-9 * displacement_scale),
-    ):
-        on_loop &= value >= np.min(np.where(window, samples, np.inf), axis=1) - rounding
-        on_loop &= value <= np.max(np.where(window, samples, -np.inf), axis=1) + rounding
+    rounding = 1e-9 * scale
+    on_loop = (
+        sides
+        & np.where(enough, True, (share >= 0.0) & (share <= 1.0))
+        & (force >= np.min(np.where(window, y, np.inf), axis=1) - rounding)
+        & (force <= np.max(np.where(window, y, -np.inf), axis=1) + rounding)
+    )
     return displacement, force, on_loop

@@ -55,6 +55,9 @@ class LoopBlock:
         As for :class:`Cycles`: the segment that closes each loop is not travelled.
     displacement_centre, force_centre : numpy.ndarray, shape (cycles,)
         The centres removed. [m], [N]
+    force_swing : numpy.ndarray, shape (cycles,)
+        Range of the force as recorded over each cycle, before centring (a dead channel
+        holds still; centred, its drift correction would make it a ramp). [N]
     """
 
     rows: slice
@@ -66,6 +69,7 @@ class LoopBlock:
     continuous: bool
     displacement_centre: np.ndarray
     force_centre: np.ndarray
+    force_swing: np.ndarray
 
     def samples(self, point, rows=slice(None)):
         """Index into ``displacement`` and ``force`` of points round the loops ``rows``.
@@ -94,10 +98,7 @@ class LoopBlock:
 
     def extremes(self, values):
         """Largest and smallest of ``values`` over each cycle's samples."""
-        stop = self.offset + self.count
-        return _reduce(np.maximum, values, self.offset, stop), _reduce(
-            np.minimum, values, self.offset, stop
-        )
+        return _extremes(values, self.offset, self.count)
 
     def first_point(self, values, target):
         """The first point round each loop where ``values`` equals its ``target``.
@@ -119,6 +120,12 @@ class LoopBlock:
         if self.continuous:
             point = np.where(found, point, self.count - 1)
         return point
+
+
+def _extremes(values, offset, count):
+    """Largest and smallest of ``values`` over each stretch (``offset``, ``count``)."""
+    stop = offset + count
+    return _reduce(np.maximum, values, offset, stop), _reduce(np.minimum, values, offset, stop)
 
 
 def _reduce(ufunc, values, begin, end):
@@ -180,16 +187,19 @@ def loop_blocks(
             ready = needed
         a, b = int(start[block.start]), int(start[block.stop - 1] + count[block.stop - 1])
         near = slice(max(block.start - 1, 0), block.stop + 1)
+        offset = start[block] - a
+        swing = np.subtract(*_extremes(force[a:b], offset, count[block]))
         yield LoopBlock(
             rows=block,
             displacement=x[a - low : b - low],
             force=_signed(force[a:b], force_sign) - _drift(a, b, middle, centre_q, near),
-            offset=start[block] - a,
+            offset=offset,
             count=count[block],
             rotation=cycles.rotation[block],
             continuous=True,
             displacement_centre=centre_x[block],
             force_centre=centre_q[block],
+            force_swing=swing,
         )
 
 
@@ -204,6 +214,7 @@ def _labelled_block(cycles: Cycles, displacement, force, block: slice, sign) -> 
     offset = np.concatenate([[0], np.cumsum(count[:-1])])
     index = np.repeat(start - offset, count) + np.arange(int(count.sum()))
     x, q = displacement[index], _signed(force[index], sign)
+    swing = np.subtract(*_extremes(q, offset, count))
     centre_x = _path_means(x, x, offset, count, closed=True)
     x -= np.repeat(centre_x, count)
     # The force's weights come from the centred displacement, as for drifting loops.
@@ -219,6 +230,7 @@ def _labelled_block(cycles: Cycles, displacement, force, block: slice, sign) -> 
         continuous=False,
         displacement_centre=centre_x,
         force_centre=centre_q,
+        force_swing=swing,
     )
 
 

@@ -20,7 +20,7 @@ import numpy as np
 from ecofmaps._inputs import check, float64
 from ecofmaps.measured.analysis import measure_cycles
 from ecofmaps.measured.cycles import MIN_SAMPLES, find_cycles
-from ecofmaps.measured.quality import ANTICLOCKWISE_SHARE
+from ecofmaps.measured.quality import ALL, ANTICLOCKWISE_SHARE, REASONS, SEPARATOR
 from ecofmaps.model.core import slip_position, traction_ratio
 from ecofmaps.model.simulation import fretting_loop
 
@@ -259,8 +259,9 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
         If ``load`` is not a positive finite number; the arrays are not one-dimensional of
         one length, or hold NaN or infinity; the recording has no complete cycle, or none
         numbered ``cycle_number``; the cycle has fewer than :data:`MIN_SAMPLES` samples;
-        or the loop shows no gross slip, runs anticlockwise, or has vertical stick
-        segments (a rigid rig).
+        or the loop shows no gross slip, runs anticlockwise, has vertical stick segments
+        (a rigid rig), or is refused by the checks of :func:`ecofmaps.analyze_loops`
+        (:mod:`ecofmaps.measured.quality`).
 
     Notes
     -----
@@ -310,16 +311,26 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
     cycles, row = _select_cycle(all_x, cycle, cycle_number, hysteresis)
     index = cycles.indices([row])[0][0]
     number = int(cycles.label[row])
-    analysis = max(
+    analysis, flags, _ = max(
         (
             measure_cycles(
                 cycles, all_x, all_y, load, stick_window=window, rows=slice(row, row + 1)
-            )[0]
+            )
             for window in _STICK_WINDOWS
         ),
-        key=lambda values: float(values["stiffness"][0]),
+        key=lambda measured: float(measured[0]["stiffness"][0]),
     )
     analysis = {name: float(value[0]) for name, value in analysis.items()}
+    refusals = [
+        reason
+        for reason, flag in flags.items()
+        if flag[0] and REASONS[reason][1] == ALL and reason != "anticlockwise"
+    ]
+    if refusals and not flags["anticlockwise"][0]:
+        raise ValueError(
+            f"cycle {number} is no fretting loop that can be read as recorded: "
+            f"{SEPARATOR.join(refusals)} ({'; '.join(REASONS[r][0] for r in refusals)})"
+        )
     # The last point closes the loop (it is the first point of the next cycle, or the
     # first point again): fit each sample once.
     x, y = all_x[index[:-1]], all_y[index[:-1]]
