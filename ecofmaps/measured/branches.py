@@ -26,7 +26,7 @@ _FIT_SAMPLES = 5
 
 #: A stick segment is curved when a term in the squared force, added to its line, is
 #: significant by more than this many standard errors ...
-_CURVATURE_T = 5.0
+_CURVATURE_T = 8.0
 
 #: ... and changes its slope from one end to the other by more than this share.
 _CURVATURE_CHANGE = 0.05
@@ -132,15 +132,25 @@ def stick_lines(x, y, valid, span, window):
     further) and, per cycle, how well the lines fit (:func:`_stick_fit`).
     """
     low, high = window
+    rows, width = x.shape
     swing = np.max(y, axis=1) - np.min(y, axis=1)
-    moved = np.abs(y - y[:, :1]) / swing[:, None]
-    mask = valid & (moved >= low) & ~_from_first(moved > high)
-    sparse = np.flatnonzero(np.count_nonzero(mask, axis=1) < 2)
+    # The segments begin before the force has moved past the upper share: look at the
+    # first columns, and at all of them if a branch has not moved that far there.
+    limit = min(width, max(16, width // 3))
+    while True:
+        moved = np.abs(y[:, :limit] - y[:, :1]) / swing[:, None]
+        beyond = moved > high
+        if limit == width or np.all(np.any(beyond | ~valid[:, :limit], axis=1)):
+            break
+        limit = width
+    mask = np.zeros((rows, width), dtype=bool)
+    mask[:, :limit] = valid[:, :limit] & (moved >= low) & ~_from_first(beyond)
+    sparse = np.flatnonzero(np.count_nonzero(mask[:, :limit], axis=1) < 2)
     if sparse.size:
-        reach = np.argmax(valid[sparse] & (moved[sparse] >= low), axis=1)
-        j = np.arange(x.shape[1])
+        reach = np.argmax(valid[sparse, :limit] & (moved[sparse] >= low), axis=1)
+        j = np.arange(width)
         mask[sparse] = (j == 0) | (j == reach[:, None])
-    reach = _columns(mask).stop  # the segments end before this column
+    reach = _columns(mask[:, :limit]).stop  # the segments end before this column
     compliance, intercept, sums = _common_line(mask[:, :reach], y[:, :reach], x[:, :reach])
     slope = both(compliance)[:, None]
     residual = x[:, :reach] - intercept[:, None] - slope * y[:, :reach]
@@ -161,6 +171,8 @@ def stick_lines(x, y, valid, span, window):
         if end == x.shape[1] or not grown[:, -1].any():
             break
         end = x.shape[1]
+    end = _columns(grown).stop
+    grown = grown[:, :end]
     compliance, intercept, sums = _common_line(grown, y[:, :end], x[:, :end], spread=True)
     fit = _stick_fit(grown, x[:, :end], y[:, :end], compliance, intercept, sums)
     return compliance, intercept, grown, fit
@@ -215,7 +227,9 @@ def zero_force_crossings(x, y, valid, length, max_force, stick, intercept, span)
     cycles = length.size // 2
     negative, positive = y < 0.0, y > 0.0
     # Samples before the crossing: negative force on the rising branch, positive on the other.
-    before = np.concatenate([negative[:cycles], positive[cycles:]]) & valid
+    before = np.empty_like(valid)
+    np.logical_and(negative[:cycles], valid[:cycles], out=before[:cycles])
+    np.logical_and(positive[cycles:], valid[cycles:], out=before[cycles:])
     count = np.count_nonzero(before, axis=1)
     after = np.clip(count, 1, length - 1)
     near = valid & (np.abs(y) <= both(_ZERO_FORCE_BAND * max_force)[:, None])
@@ -244,13 +258,15 @@ def zero_force_crossings(x, y, valid, length, max_force, stick, intercept, span)
 def _curve_intercept(window, scaled, y, load):
     r"""Intercept :math:`a` of the least-squares :math:`Q = a + b\xi + c\xi Q` in each window.
 
+    ``window`` marks the samples of each row to fit, ``scaled`` their contact position
+    :math:`\xi` over the window's half-width, ``y`` their force (columns that hold no window
+    may be left out).
+
     The regressors are centred on their means and :math:`\xi Q` is orthogonalised against
     :math:`\xi` sample by sample (Gram-Schmidt), so that :math:`a` stays exact when the two
     are nearly collinear (a force nearly constant along the slip). Where :math:`\xi Q`
     adds only rounding to :math:`\xi` (a flat groove), :math:`Q = a + b\xi` is fitted.
     """
-    columns = _columns(window)
-    window, scaled, y = window[:, columns], scaled[:, columns], y[:, columns]
     weight = window.astype(np.float64)
     count = weight.sum(axis=1)
     s = np.where(window, scaled, 0.0)
@@ -287,7 +303,10 @@ def line_crossings(x, y, valid, length, compliance, half_width, load, scale):
     cycles = length.size // 2
     position = x - y * compliance[:, None]  # the contact position (eq. 10)
     # Samples before the crossing: ξ < 0 on the rising branch (from -δ*), ξ > 0 on the other.
-    before = np.concatenate([position[:cycles] < 0.0, position[cycles:] > 0.0]) & valid
+    before = np.empty_like(valid)
+    np.less(position[:cycles], 0.0, out=before[:cycles])
+    np.greater(position[cycles:], 0.0, out=before[cycles:])
+    before &= valid
     after = _bracket(before, length)
     rows = np.arange(length.size)
     q0, q1 = y[rows, after - 1], y[rows, after]
@@ -295,16 +314,18 @@ def line_crossings(x, y, valid, length, compliance, half_width, load, scale):
     change = v0 - v1
     share = np.divide(v0, change, out=np.full_like(v0, 0.5), where=change != 0.0)
     guess = q0 + share * (q1 - q0)
-    scaled = position / half_width[:, None]
-    window = valid & (np.abs(scaled) <= 1.0)
+    window = valid & (np.abs(position) <= half_width[:, None])
     enough = np.count_nonzero(window, axis=1) >= _FIT_SAMPLES
-    force = np.where(enough, _curve_intercept(window, scaled, y, load), guess)
+    columns = _columns(window)
+    scaled = position[:, columns] / half_width[:, None]
+    intercept = _curve_intercept(window[:, columns], scaled, y[:, columns], load)
+    force = np.where(enough, intercept, guess)
     displacement = force * compliance
     # On the loop: the fitted window, or the interpolated pair, holds samples on both
     # sides of ξ = 0, and the crossing's force lies within theirs.
     window[rows, after] |= ~enough
     window[rows, after - 1] |= ~enough
-    columns = _columns(window)
+    columns = _columns(window)  # now with the pairs interpolated between
     window, before, y = window[:, columns], before[:, columns], y[:, columns]
     sides = np.any(window & before, axis=1) & np.any(window & ~before, axis=1)
     rounding = 1e-9 * scale
