@@ -222,7 +222,9 @@ def zero_force_crossings(x, y, valid, length, max_force, stick, intercept, span)
     branch's samples with :math:`|Q|` below ``_ZERO_FORCE_BAND`` times the loop's
     ``max_force`` :math:`Q^*`, and gives :math:`a`. The crossing is on the loop if the
     branch has samples of both signs of force and it lies within the displacements of
-    those samples (to rounding of the displacement ``span``).
+    those samples (to rounding of the displacement ``span``). Else it is taken between
+    the two samples around the crossing, if they have forces of both signs: where the
+    stick line crosses zero force between them, or on the chord joining them.
     """
     cycles = length.size // 2
     negative, positive = y < 0.0, y > 0.0
@@ -246,12 +248,18 @@ def zero_force_crossings(x, y, valid, length, max_force, stick, intercept, span)
     )
     crossing = np.where(across, intercept, local)
     rounding = 1e-9 * both(span)
-    on_loop = (
-        (count >= 1)
-        & (count <= length - 1)
-        & (crossing >= np.min(np.where(near, x_near, np.inf), axis=1) - rounding)
-        & (crossing <= np.max(np.where(near, x_near, -np.inf), axis=1) + rounding)
+    inside = (crossing >= np.min(np.where(near, x_near, np.inf), axis=1) - rounding) & (
+        crossing <= np.max(np.where(near, x_near, -np.inf), axis=1) + rounding
     )
+    # Else, between the two samples around the crossing: the stick line if it crosses zero
+    # force there (the stick goes on past zero force between two samples), or the chord.
+    x0, x1, y0, y1 = x[rows, after - 1], x[rows, after], y[rows, after - 1], y[rows, after]
+    low, high = np.minimum(x0, x1) - rounding, np.maximum(x0, x1) + rounding
+    chord = x0 + np.divide(y0, y0 - y1, out=np.full_like(y0, 0.5), where=y0 != y1) * (x1 - x0)
+    stick_between = (intercept >= low) & (intercept <= high)
+    crossing = np.where(inside, crossing, np.where(stick_between, intercept, chord))
+    straddle = (y0 * y1 <= 0.0) & (y0 != y1)
+    on_loop = (count >= 1) & (count <= length - 1) & (inside | straddle)
     return crossing, on_loop
 
 
