@@ -157,7 +157,8 @@ def quality_strings(flags: dict, size: int) -> np.ndarray:
         SEPARATOR.join(names[bit] for bit in range(len(names)) if value >> bit & 1) or "ok"
         for value in codes
     ]
-    return np.array(texts, dtype=str)[inverse]
+    # One shared str per distinct quality: 8 bytes a cycle, however long the reasons.
+    return np.array(texts, dtype=object)[inverse]
 
 
 def add_reason(quality, where, reason: str) -> np.ndarray:
