@@ -3,10 +3,11 @@ r"""Measured fretting loops, cycle by cycle: ECoF, GICoF, rig stiffness and the 
 :func:`analyze_loops` reads a recording of the actuator displacement :math:`\Delta` and the
 tangential force :math:`Q` (many cycles, or a single loop), cuts it into cycles and
 removes the offsets and a slow drift (:mod:`ecofmaps.measured.cycles`), and measures each loop.
-The work is vectorised over a block of cycles at a time, with no Python loop over samples
-or cycles, and its memory does not grow with the recording beyond the per-cycle results:
-each loop is a padded row, and each of its two branches (from one reversal to the next)
-another, so that every per-branch step runs once over both branches of every cycle.
+The work is vectorised over a block of cycles at a time (:mod:`ecofmaps.measured.centring`),
+with no Python loop over samples or cycles, and its memory does not grow with the recording
+beyond the per-cycle results: each branch of each loop (from one reversal to the next) is a
+padded row, so that every per-branch step runs once over both branches of every cycle
+(:mod:`ecofmaps.measured.branches`).
 
 The quantities, per cycle
 -------------------------

@@ -235,7 +235,9 @@ def _labelled_block(cycles: Cycles, displacement, force, block: slice, sign) -> 
 
 
 def _blocks(points: np.ndarray, offset: int) -> Iterator[slice]:
-    """Slices of consecutive rows whose padded layout holds about ``_BLOCK`` points."""
+    """Slices of consecutive rows of about ``_BLOCK`` points in all, such that padding
+    each row to the longest does not more than double that (a long loop among short ones
+    gets a block of its own)."""
     rows = max(1, _BLOCK // max(int(np.median(points)), 1)) if points.size else 1
     pending = [(a, min(a + rows, points.size)) for a in range(0, points.size, rows)][::-1]
     while pending:
