@@ -203,14 +203,16 @@ def _loop_values(block, load, options):
     flags = {
         "few-samples": block.count < MIN_SAMPLES,
         "constant-force": ~(block.force_swing > 0.0),
-        "several-loops": _turns_back(bx, options["hysteresis"] * span)
-        if not block.continuous
-        else np.zeros(cycles, dtype=bool),
+        # A cycle cut at the reversals cannot turn back by more than the band: that
+        # would have been a reversal.
+        "several-loops": np.zeros(cycles, dtype=bool)
+        if block.continuous
+        else _turns_back(bx, options["hysteresis"] * span),
         "anticlockwise": anticlockwise,
         "energy-ratio-above-1": energy_ratio > 1.0 + rounding,
         "negative-stiffness": compliance < 0.0,
-        "no-stick": ~(fit["unexplained"] <= _UNEXPLAINED) & ~np.isinf(values["stiffness"])
-        | np.isnan(compliance),
+        "no-stick": (~(fit["unexplained"] <= _UNEXPLAINED) & ~np.isinf(values["stiffness"]))
+        | np.isnan(compliance),  # a rigid rig's vertical stick sides explain all but 0/0
         "negative-area": (energy_ratio < 0.0) & ~anticlockwise,
         "negative-slip": ~(slip > 0.0),
         "no-zero-crossing": ~(zero_on_loop[:cycles] & zero_on_loop[cycles:]),
