@@ -8,11 +8,16 @@ repeats them (as optimistix's ``RESULTS`` does).
 from __future__ import annotations
 
 import enum
+import sys
 import warnings
+from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Code", "RegimeWarning", "warn_nan"]
+__all__ = ["Code", "RegimeWarning", "warn", "warn_nan"]
+
+# Warnings point at the first line outside the package: the caller's call.
+_PACKAGE = str(Path(__file__).resolve().parent)
 
 
 class RegimeWarning(RuntimeWarning):
@@ -38,6 +43,14 @@ class Code(enum.IntEnum):
         }
 
 
+def warn(message: str, category: type[Warning]) -> None:
+    """``warnings.warn`` attributed to the caller's line: the first frame outside ecofmaps."""
+    frame, level = sys._getframe(1), 2  # stacklevel 2: the frame that called warn()
+    while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE):
+        frame, level = frame.f_back, level + 1
+    warnings.warn(message, category, stacklevel=level)
+
+
 def warn_nan(values, codes, kind: type[Code], quantity: str) -> None:
     """Warn when a concrete result holds NaN for a reason its code gives, naming the reason."""
     values = np.asarray(values)
@@ -48,8 +61,7 @@ def warn_nan(values, codes, kind: type[Code], quantity: str) -> None:
     for code in kind:
         count = int(np.count_nonzero(nan & (codes == code)))
         if count and code.reason:
-            warnings.warn(
+            warn(
                 f"{quantity} is NaN at {count} of {values.size} point(s): {code.reason}",
                 RegimeWarning,
-                stacklevel=3,
             )

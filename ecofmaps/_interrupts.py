@@ -1,4 +1,4 @@
-"""Ctrl-C that really stops: an interrupt that Python swallowed still stops every write.
+"""Ctrl-C that stops the command line cleanly, at the next safe point, writing nothing more.
 
 Standard library only, so the command line can install it before importing anything heavy.
 """
@@ -7,32 +7,41 @@ from __future__ import annotations
 
 import contextlib
 import signal
-import sys
 import threading
 
-__all__ = ["INTERRUPTED", "interrupts_stop_writes"]
+__all__ = ["INTERRUPTED", "check_interrupted", "interrupts_stop_writes"]
 
 #: Set by the Ctrl-C handler of :func:`interrupts_stop_writes`, only while it is installed.
 INTERRUPTED = threading.Event()
 
 
+def check_interrupted() -> None:
+    """Raise ``KeyboardInterrupt`` if Ctrl-C was pressed under :func:`interrupts_stop_writes`.
+
+    Called where stopping is safe: between blocks of work and before a file is renamed into
+    place. Outside the block (the library used from Python) it does nothing.
+    """
+    if INTERRUPTED.is_set():
+        raise KeyboardInterrupt
+
+
 @contextlib.contextmanager
 def interrupts_stop_writes():
-    """Within the block, Ctrl-C stops the program and every write not yet finished.
+    """Within the block, Ctrl-C stops the program at the next safe point, writing nothing more.
 
-    Ctrl-C raises ``KeyboardInterrupt`` as usual; it is also remembered, because Python
-    swallows an exception raised inside a garbage-collector callback (JAX runs one), and
-    then the program would go on. Every :func:`ecofmaps.io.files.atomic_path` finishing
-    after the interrupt raises ``KeyboardInterrupt`` instead of renaming its file into
-    place, and so does leaving the block. Python's report of the swallowed exception
-    (``Exception ignored in: ...``) is not printed. Only in the main thread; where Ctrl-C
-    is ignored (a background job) it stays ignored.
+    The first Ctrl-C only sets a flag; :func:`check_interrupted`, called between blocks of
+    work and before every :func:`ecofmaps.io.files.atomic_store` renames its file into
+    place, then raises ``KeyboardInterrupt``, and so does leaving the block. A
+    ``KeyboardInterrupt`` raised at once, anywhere, would land inside JAX's compiled
+    extensions (during their import, or in a garbage-collector callback) and crash the
+    process or be swallowed there. A second Ctrl-C raises at once. Only in the main
+    thread; where Ctrl-C is ignored (a background job) it stays ignored.
 
     Yields
     ------
     interrupted : threading.Event
         Set once Ctrl-C was pressed in the block; it stays set after the block, so a caller
-        can tell an interrupt from the error it turned into (an extension's ImportError).
+        can tell an interrupt from an error it caused.
     """
     interrupted = threading.Event()
     previous = signal.getsignal(signal.SIGINT)
@@ -41,24 +50,16 @@ def interrupts_stop_writes():
         return
 
     def handler(signum, frame):
+        if interrupted.is_set():  # the second Ctrl-C: stop now
+            raise KeyboardInterrupt
         interrupted.set()
         INTERRUPTED.set()
-        raise KeyboardInterrupt
-
-    previous_hook = sys.unraisablehook
-
-    def unraisable(report):
-        if not isinstance(report.exc_value, KeyboardInterrupt):
-            previous_hook(report)
 
     INTERRUPTED.clear()
     signal.signal(signal.SIGINT, handler)
-    sys.unraisablehook = unraisable
     try:
         yield interrupted
-        if interrupted.is_set():
-            raise KeyboardInterrupt
+        check_interrupted()
     finally:
         signal.signal(signal.SIGINT, previous)
-        sys.unraisablehook = previous_hook
         INTERRUPTED.clear()

@@ -160,6 +160,7 @@ QUANTITIES: dict[str, Quantity] = {
     "force_offset": _force("force offset removed (loop centre)"),
     "loop_displacement": _length("applied displacement, centred", "Δ", r"\Delta"),
     "loop_force": _force("tangential force, centred", "Q", "Q"),
+    "stick_residual": _length("root mean square displacement off the stick lines"),
     "quality": _number("'ok', or why the values of the cycle are NaN"),
     # --- the loop read along the stroke -------------------------------------------------
     "position": _length("contact position, centred", "ξ = Δ - Q/S", r"\xi = \Delta - Q/S"),

@@ -55,7 +55,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 #: Exit status of a run stopped by Ctrl-C (128 + SIGINT), as shells report it.
-INTERRUPTED = 130
+EXIT_INTERRUPTED = 130
 
 
 def main(argv=None) -> int:
@@ -74,10 +74,10 @@ def main(argv=None) -> int:
                 return int(stop.code or 0)
             return args.handler(args)
     except KeyboardInterrupt:
-        return _report(INTERRUPTED, "interrupted; no output was left half written")
+        return _report(EXIT_INTERRUPTED, "interrupted; no output was left half written")
     except Exception as error:
         if interrupted is not None and interrupted.is_set():  # an interrupt turned into an error
-            return _report(INTERRUPTED, "interrupted; no output was left half written")
+            return _report(EXIT_INTERRUPTED, "interrupted; no output was left half written")
         if isinstance(error, (CommandError, ValueError, OSError)):
             return _report(2, f"error: {error}")
         if isinstance(error, MemoryError):
@@ -106,7 +106,7 @@ def console() -> None:
     every file is written through a temporary that the interrupt removed.
     """
     status = main()
-    if status == INTERRUPTED:
+    if status == EXIT_INTERRUPTED:
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(status)

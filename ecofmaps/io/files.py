@@ -16,7 +16,7 @@ import shutil
 import uuid
 from pathlib import Path
 
-from ecofmaps._interrupts import INTERRUPTED
+from ecofmaps._interrupts import check_interrupted
 
 __all__ = ["TEMPORARY_NAME", "FileLineError", "atomic_path", "atomic_store", "write_text"]
 
@@ -123,8 +123,7 @@ def atomic_store(path, *, overwrite: bool = False):
     try:
         yield temporary
         _sync(temporary)
-        if INTERRUPTED.is_set():  # an interrupt that was swallowed on its way up
-            raise KeyboardInterrupt
+        check_interrupted()  # after Ctrl-C on the command line, nothing more lands
         if temporary.is_dir() or path.is_dir():
             old = _temporary(path)
             if os.path.lexists(path):

@@ -30,12 +30,13 @@ import codecs
 import csv
 import io
 import re
-import warnings
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from ecofmaps._codes import warn
+from ecofmaps._interrupts import check_interrupted
 from ecofmaps.io.columns import ColumnError, column_scale, find_column, split_unit
 
 __all__ = ["BLOCK_BYTES", "MISSING", "text_blocks"]
@@ -93,11 +94,10 @@ class _Decoder:
 
                 line = first_line + data.count(b"\n", 0, error.start)
                 byte = data[error.start]
-                warnings.warn(
+                warn(
                     f"{self.path}, line {line}: byte 0x{byte:02x} is not UTF-8; the file is "
                     "read as Latin-1 from this line on (numbers are the same in both)",
                     RecordingWarning,
-                    stacklevel=5,
                 )
                 self.encoding = "latin-1"
                 return data[: error.start].decode("utf-8") + data[error.start :].decode("latin-1")
@@ -361,6 +361,7 @@ def text_blocks(path: Path, options: dict, block_bytes: int = BLOCK_BYTES):
     line = 1  # number of the first line of the block
     with _open_text(path) as stream:
         for raw in _raw_blocks(stream, block_bytes):
+            check_interrupted()
             start = line
             line += raw.count(b"\n") + (not raw.endswith(b"\n"))
             if layout is not None and decoder.encoding == "utf-8" and b"#" not in raw:

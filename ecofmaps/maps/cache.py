@@ -21,7 +21,6 @@ import functools
 import hashlib
 import os
 import re
-import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from datetime import UTC, datetime
@@ -31,6 +30,7 @@ import numpy as np
 import platformdirs
 import xarray as xr
 
+from ecofmaps._codes import warn
 from ecofmaps._version import __version__
 from ecofmaps.io.files import TEMPORARY_NAME, atomic_path
 
@@ -252,11 +252,10 @@ def cached_dataset(
         try:
             return _read(path, key)
         except Exception as error:  # any unreadable file is recomputed, whatever h5py says
-            warnings.warn(
+            warn(
                 f"removed unusable cache file {path} ({type(error).__name__}: {error}); "
                 "recomputing",
                 CacheWarning,
-                stacklevel=3,
             )
             path.unlink(missing_ok=True)
     dataset = compute()
@@ -265,7 +264,7 @@ def cached_dataset(
         stamps = {_KEY_ATTRIBUTE: key, _CHECKSUM_ATTRIBUTE: data_checksum(dataset)}
         write_netcdf(dataset.assign_attrs(stamps), path)
     except OSError as error:
-        warnings.warn(f"could not write cache file {path}: {error}", CacheWarning, stacklevel=3)
+        warn(f"could not write cache file {path}: {error}", CacheWarning)
     return dataset
 
 

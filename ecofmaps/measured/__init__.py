@@ -3,11 +3,13 @@ and synthetic recordings."""
 
 from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.fit import LoopFit, fit_loop
+from ecofmaps.measured.quality import LoopQualityWarning
 from ecofmaps.measured.resolved import resolve_analyzed_loops, resolve_loops
 from ecofmaps.measured.synthetic import synthetic_recording
 
 __all__ = [
     "LoopFit",
+    "LoopQualityWarning",
     "analyze_loops",
     "fit_loop",
     "resolve_analyzed_loops",

@@ -2,9 +2,12 @@ r"""Measured fretting loops, cycle by cycle: ECoF, GICoF, rig stiffness and the 
 
 :func:`analyze_loops` reads a recording of the actuator displacement :math:`\Delta` and the
 tangential force :math:`Q` (many cycles, or a single loop), cuts it into cycles and
-removes the offsets and a slow drift (:mod:`ecofmaps.measured.cycles`), and measures each loop. The
-work is done on padded arrays with one row per cycle, with no Python loop over samples or
-cycles: a recording of :math:`10^4` cycles of 200 samples takes a second or two.
+removes the offsets and a slow drift (:mod:`ecofmaps.measured.cycles`), and measures each loop.
+The work is vectorised over a block of cycles at a time (:mod:`ecofmaps.measured.centring`),
+with no Python loop over samples or cycles, and its memory does not grow with the recording
+beyond the per-cycle results: each branch of each loop (from one reversal to the next) is a
+padded row, so that every per-branch step runs once over both branches of every cycle
+(:mod:`ecofmaps.measured.branches`).
 
 The quantities, per cycle
 -------------------------
@@ -47,12 +50,23 @@ back down the *falling* branch.
   five samples in the window, the crossing is interpolated between two samples. A small
   error in :math:`S` or in the centring moves the two crossings in opposite directions,
   and most of it cancels from their mean.
+* stick_residual: the root mean square displacement off the stick lines.
 * regime: 'gross slip' when the energy ratio :math:`A` exceeds ``gross_slip_threshold``
   (default 0.2, the sliding transition of Fouvry, Kapsa and Vincent), else
   'partial slip'. ECoF and GICoF describe sliding: they are NaN in partial slip. Like
   Fouvry's criterion, this also calls partial slip a gross-slip loop that slips over less
   than about a fifth of the stroke (for the model, :math:`A \approx \delta^*/\Delta^*`
   times :math:`\mu_E P/Q^*`); lower the threshold to read such loops.
+
+Every cycle is checked before its numbers are reported (:mod:`ecofmaps.measured.quality`):
+a loop that runs anticlockwise, has no area, no straight stick sides, a constant force,
+crossings that are not on the measured loop, ... has the values concerned NaN and the
+reasons in its ``quality``; the stick sides are *curved* when a :math:`Q^2` term is
+significant and changes their slope by more than 5 % from end to end. A crossing with
+:math:`Q = S\Delta` is on the loop when the branch has measured samples on both sides of
+:math:`\xi = 0` in the fitted window (or the two interpolated between) and the crossing's
+force lies within theirs; a zero-force crossing when it lies within the displacements of
+the branch's samples near zero force.
 
 For the model's loop every quantity is exact up to the sampling: :math:`\Delta^*`,
 :math:`Q^*`, :math:`S`, :math:`\delta^*` and the GICoF to rounding when the loop's
@@ -67,243 +81,253 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
+from ecofmaps import _nomenclature as nomenclature
+from ecofmaps._codes import warn
 from ecofmaps._inputs import check, si_units
-from ecofmaps.measured.cycles import MIN_SAMPLES, labelled_cycles, masked_sum, split_cycles
+from ecofmaps._interrupts import check_interrupted
+from ecofmaps.measured.branches import (
+    both,
+    branch_rows,
+    line_crossings,
+    stick_lines,
+    zero_force_crossings,
+)
+from ecofmaps.measured.centring import loop_blocks
+from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles, find_cycles
+from ecofmaps.measured.quality import (
+    ALL,
+    ANTICLOCKWISE_SHARE,
+    REASONS,
+    LoopQualityWarning,
+    apply_quality,
+    quality_strings,
+    quality_summary,
+)
 
-__all__ = ["GROSS_SLIP_THRESHOLD", "analyze_loops"]
+__all__ = ["GROSS_SLIP_THRESHOLD", "analyze_loops", "measure_cycles"]
 
 #: Energy ratio :math:`A = E_d/(4\Delta^* Q^*)` above which a loop is gross slip (the
 #: sliding transition of Fouvry, Kapsa and Vincent).
 GROSS_SLIP_THRESHOLD = 0.2
 
-#: Samples with :math:`|Q|` below this share of :math:`Q^*` locate a zero-force crossing
-#: that is not on a stick segment.
-_ZERO_FORCE_BAND = 0.25
+#: The per-cycle quantities, in the Dataset's order.
+_PER_CYCLE = (
+    "amplitude",
+    "slip_amplitude",
+    "max_force",
+    "dissipated_energy",
+    "ecof",
+    "cof_max",
+    "energy_ratio",
+    "stiffness",
+    "gicof",
+    "gicof_forward",
+    "gicof_backward",
+    "crossing_displacement_forward",
+    "crossing_displacement_backward",
+    "displacement_offset",
+    "force_offset",
+    "stick_residual",
+)
 
-#: A stick segment grows until two samples in a row are this many standard deviations off.
-_STICK_SPREAD = 3.0
-
-#: Fewest samples in the window of the curve fitted at a GICoF crossing.
-_FIT_SAMPLES = 5
-
-_ATTRS = {
-    "cycle": ("cycle number", "1"),
-    "amplitude": ("displacement amplitude Δ*", "m"),
-    "slip_amplitude": ("slip amplitude δ* (loop half-width at Q = 0)", "m"),
-    "max_force": ("peak tangential force Q*", "N"),
-    "dissipated_energy": ("dissipated energy per cycle E_d (loop area)", "J"),
-    "ecof": ("energy coefficient of friction μ_E = E_d/(4Pδ*)", "1"),
-    "cof_max": ("peak coefficient of friction Q*/P", "1"),
-    "energy_ratio": ("energy ratio A = E_d/(4Δ*Q*)", "1"),
-    "stiffness": ("rig stiffness S (slope of the stick segments)", "N/m"),
-    "gicof": ("geometry-independent coefficient of friction (GICoF)", "1"),
-    "gicof_forward": ("GICoF on the rising-displacement branch", "1"),
-    "gicof_backward": ("GICoF on the falling-displacement branch", "1"),
-    "crossing_displacement_forward": ("displacement where Q = SΔ, rising branch", "m"),
-    "crossing_displacement_backward": ("displacement where Q = SΔ, falling branch", "m"),
-    "displacement_offset": ("displacement offset removed (loop centre)", "m"),
-    "force_offset": ("force offset removed (loop centre)", "N"),
-    "regime": ("fretting regime (gross slip or partial slip)", ""),
-    "load": ("normal load P", "N"),
-    "point": ("point round the loop", "1"),
-    "loop_displacement": ("displacement Δ, centred", "m"),
-    "loop_force": ("tangential force Q, centred", "N"),
+#: How the quantities are measured on a loop (the netCDF ``comment`` attribute).
+_COMMENTS = {
+    "slip_amplitude": "half the loop's width at Q = 0",
+    "dissipated_energy": "the loop's area",
+    "stiffness": "slope of the stick segments",
+    "regime": "gross slip or partial slip by the energy ratio, unknown where refused",
+    "quality": "'ok' or the reasons for NaN, joined by '+' (ecofmaps.measured.quality)",
 }
+
+#: A stick segment must explain all but this share of the displacement's variance along it.
+_UNEXPLAINED = 0.2
+
+#: Plausible displacement amplitudes: outside this range the unit is probably wrong. [m]
+_AMPLITUDE_RANGE = (0.1e-6, 10e-3)
 
 
 def _attrs(name: str) -> dict:
-    long_name, units = _ATTRS[name]
-    return {"long_name": long_name, "units": units}
+    attrs = nomenclature.attrs(name)
+    if name in _COMMENTS:
+        attrs["comment"] = _COMMENTS[name]
+    return attrs
 
 
-# --- per-cycle kernels ---------------------------------------------------------------------
-# Each takes arrays of shape (cycles, width) whose rows run once round a loop from its
-# lowest displacement; ``valid`` marks the points of each loop, the rest is padding (NaN).
+def _loop_values(block, load, options):
+    """Every per-cycle quantity of a block of centred loops, and the checks it failed.
 
-
-def _branches(x, valid):
-    """Masks of the rising branch (start to top) and the falling one (top to the end)."""
-    top = np.argmax(np.where(valid, x, -np.inf), axis=1)
-    j = np.arange(x.shape[1])[None, :]
-    rising = valid & (j <= top[:, None])
-    falling = valid & (j >= top[:, None])
-    return rising, falling, top
-
-
-def _dissipated_energy(x, y, valid):
-    r"""The loop's area :math:`\oint Q\,d\Delta` by the trapezoidal rule."""
-    return masked_sum(0.5 * (y[:, 1:] + y[:, :-1]) * np.diff(x, axis=1), valid[:, 1:])
-
-
-def _bracket(value, branch, first, sign):
-    """Index of the sample just past the sign change of ``value`` on a branch.
-
-    ``value`` runs from the sign ``sign`` to ``-sign`` along the branch, which starts at
-    index ``first``. The change is placed after as many samples as the branch has on the
-    starting side, so a few noisy samples on the wrong side do not move it far.
+    Returns the quantities (module notes; not yet NaN where a check fails) and the flags
+    of :data:`ecofmaps.measured.quality.REASONS` (reason -> per cycle).
     """
-    count = np.count_nonzero(branch & (sign * value > 0.0), axis=1)
-    last = first + np.count_nonzero(branch, axis=1) - 1
-    return np.clip(first + count, first + 1, last)
-
-
-def _crossing(x, value, branch, first, sign):
-    """``x`` where ``value`` changes sign on a branch, interpolated between two samples."""
-    after = _bracket(value, branch, first, sign)[:, None]
-    x0, x1 = (np.take_along_axis(x, after - k, axis=1)[:, 0] for k in (1, 0))
-    v0, v1 = (np.take_along_axis(value, after - k, axis=1)[:, 0] for k in (1, 0))
-    change = v0 - v1
-    share = np.divide(v0, change, out=np.full_like(v0, 0.5), where=change != 0.0)
-    return x0 + share * (x1 - x0)
-
-
-def _zero_force_crossing(x, y, branch, first, sign, stick, intercept):
-    r"""Displacement where a branch crosses :math:`Q = 0`.
-
-    Where the stick segment ``stick`` reaches across zero force, it is the intercept of
-    the line fitted to it, :math:`\Delta = c + Q/S`. Elsewhere a straight line
-    :math:`\Delta = a + bQ` is fitted to the two samples around the crossing and the
-    branch's samples with :math:`|Q|` below ``_ZERO_FORCE_BAND`` times :math:`Q^*`, and
-    gives :math:`a`.
-    """
-    after = _bracket(y, branch, first, sign)[:, None]
-    j = np.arange(x.shape[1])[None, :]
-    band = _ZERO_FORCE_BAND * 0.5 * (np.nanmax(y, axis=1) - np.nanmin(y, axis=1))
-    near = branch & ((np.abs(y) <= band[:, None]) | (j == after) | (j == after - 1))
-    local = _common_slope(y, x, [near])[1][0]
-    across = np.any(stick & (y < 0.0), axis=1) & np.any(stick & (y > 0.0), axis=1)
-    return np.where(across, intercept, local)
-
-
-def _stick_mask(y, branch, window):
-    """The stick segment after the reversal at the start of ``branch`` (module notes)."""
-    low, high = window
-    span = np.max(np.where(branch, y, -np.inf), axis=1) - np.min(
-        np.where(branch, y, np.inf), axis=1
+    x, y = block.displacement, block.force
+    highest, lowest = block.extremes(x)
+    span = highest - lowest
+    amplitude = 0.5 * span
+    max_force = 0.5 * np.subtract(*block.extremes(y))
+    # The loop's area by trapezoids, the segment that closes it included.
+    first, last = block.offset, block.offset + block.count - 1
+    closing = (y[first] + y[last]) * (x[first] - x[last])
+    energy = 0.5 * (block.sums((y[1:] + y[:-1]) * np.diff(x)) + closing)
+    bx, by, valid, length = branch_rows(block, block.first_point(x, highest))
+    compliance, intercept, stick, fit = stick_lines(bx, by, valid, span, options["stick_window"])
+    crossing, zero_on_loop = zero_force_crossings(
+        bx, by, valid, length, max_force, stick, intercept, span
     )
-    start = np.take_along_axis(y, np.argmax(branch, axis=1)[:, None], axis=1)
-    moved = np.abs(y - start) / span[:, None]
-    beyond = np.maximum.accumulate(branch & (moved > high), axis=1)
-    mask = branch & (moved >= low) & ~beyond
-    # Sparse sampling (a model loop draws each stick segment as one straight line): the
-    # chord from the reversal to the first sample past the lower share.
-    j = np.arange(y.shape[1])[None, :]
-    chord = (j == np.argmax(branch, axis=1)[:, None]) | (
-        j == np.argmax(branch & (moved >= low), axis=1)[:, None]
-    )
-    return np.where(np.count_nonzero(mask, axis=1)[:, None] < 2, chord, mask)
-
-
-def _common_slope(x, y, masks):
-    """Least-squares slope common to lines through each mask's points, and their intercepts."""
-    covariance = np.zeros(x.shape[0])
-    variance = np.zeros(x.shape[0])
-    means = []
-    for mask in masks:
-        count = np.count_nonzero(mask, axis=1)
-        mean_x, mean_y = masked_sum(x, mask) / count, masked_sum(y, mask) / count
-        dx, dy = x - mean_x[:, None], y - mean_y[:, None]
-        covariance += masked_sum(dx * dy, mask)
-        variance += masked_sum(dx * dx, mask)
-        means.append((mean_x, mean_y))
-    slope = covariance / variance
-    return slope, [mean_y - slope * mean_x for mean_x, mean_y in means]
-
-
-def _stick_lines(x, y, branches, window):
-    r"""Lines :math:`\Delta = c + Q/S` through the stick segments after the two reversals.
-
-    A first line is fitted to the samples in the force window; each segment then grows
-    along its branch until two samples in a row lie more than ``_STICK_SPREAD`` standard
-    deviations off its line (the slip that follows bends away from it; a single noisy
-    sample does not stop it), and the lines are fitted again to the grown segments.
-    Returns the common compliance :math:`1/S`, the intercept :math:`c` of each line and
-    the mask of each segment.
-    """
-    masks = [_stick_mask(y, branch, window) for branch in branches]
-    compliance, intercepts = _common_slope(y, x, masks)
-    residuals = [x - intercept[:, None] - compliance[:, None] * y for intercept in intercepts]
-    squares = sum(masked_sum(r * r, m) for r, m in zip(residuals, masks, strict=True))
-    points = sum(np.count_nonzero(m, axis=1) for m in masks)
-    spread = np.sqrt(squares / np.maximum(points - 3, 1))
-    span = np.nanmax(x, axis=1) - np.nanmin(x, axis=1)
-    tolerance = np.maximum(_STICK_SPREAD * spread, 1e-9 * span)[:, None]
-    grown = []
-    for branch, mask, residual in zip(branches, masks, residuals, strict=True):
-        after = np.maximum.accumulate(mask, axis=1) & branch
-        outside = after & (np.abs(residual) > tolerance)
-        outside[:, :-1] &= outside[:, 1:]
-        off = np.maximum.accumulate(outside, axis=1)
-        grown.append(mask | (after & ~off))
-    compliance, intercepts = _common_slope(y, x, grown)
-    return compliance, intercepts, grown
-
-
-def _line_crossing(x, y, branch, first, sign, compliance, half_width, load):
-    r"""Displacement and force where a branch crosses :math:`Q = S\Delta` (module notes).
-
-    On the line the contact position :math:`\xi = \Delta - Q/S` (eq. 10) is zero. The
-    branch's samples with :math:`|\xi|` below ``half_width`` are fitted by least squares
-    with :math:`Q = a + b\xi + c\xi Q`, which is eq. 9 for any groove slope
-    (:math:`a = \mu P`, :math:`b = kP`, :math:`c = \mu k`) and a smooth three-parameter
-    curve otherwise; the crossing is :math:`Q = a`. With fewer than ``_FIT_SAMPLES``
-    samples in the window, :math:`Q` is interpolated linearly at :math:`\xi = 0` between
-    the two samples around the crossing.
-    """
-    position = x - y * compliance[:, None]  # the contact position (eq. 10)
-    guess = _crossing(y, position, branch, first, sign)  # Q there, interpolated
-    scaled = position / half_width[:, None]
-    window = branch & (np.abs(scaled) <= 1.0)
-    enough = np.count_nonzero(window, axis=1) >= _FIT_SAMPLES
-    regressors = (np.ones_like(x), scaled, scaled * y / load)
-    normal = np.stack(
-        [np.stack([masked_sum(p * q, window) for q in regressors], axis=-1) for p in regressors],
-        axis=-2,
-    )
-    moments = np.stack([masked_sum(p * y, window) for p in regressors], axis=-1)
-    normal[~enough] = np.eye(3)
-    intercept = (np.linalg.pinv(normal) @ moments[..., None])[:, 0, 0]
-    force = np.where(enough, intercept, guess)
-    return force * compliance, force
-
-
-# --- the public function ------------------------------------------------------------------
-
-
-def _loop_quantities(x, q, valid, load, options):
-    """Every per-cycle quantity of the centred loops ``x``, ``q`` (module notes)."""
-    amplitude = 0.5 * (np.nanmax(x, axis=1) - np.nanmin(x, axis=1))
-    max_force = 0.5 * (np.nanmax(q, axis=1) - np.nanmin(q, axis=1))
-    rising, falling, top = _branches(x, valid)
-    start = np.zeros_like(top)
-    compliance, intercepts, sticks = _stick_lines(x, q, (rising, falling), options["stick_window"])
-    stiffness = 1.0 / compliance
-    left = _zero_force_crossing(x, q, rising, start, -1.0, sticks[0], intercepts[0])
-    right = _zero_force_crossing(x, q, falling, top, 1.0, sticks[1], intercepts[1])
-    slip = 0.5 * (right - left)
-    energy = _dissipated_energy(x, q, valid)
+    cycles = block.count.size
+    slip = 0.5 * (crossing[cycles:] - crossing[:cycles])
     half_width = options["crossing_window"] * np.abs(slip)
-    rising_x, rising_q = _line_crossing(x, q, rising, start, 1.0, compliance, half_width, load)
-    falling_x, falling_q = _line_crossing(x, q, falling, top, -1.0, compliance, half_width, load)
+    at, force, on_loop = line_crossings(
+        bx, by, valid, length, both(compliance), both(half_width), load, both(max_force)
+    )
     energy_ratio = energy / (4.0 * amplitude * max_force)
-    gross = energy_ratio > options["gross_slip_threshold"]
-    sliding = np.where(gross, 1.0, np.nan)  # NaN for the coefficients in partial slip
     values = {
         "amplitude": amplitude,
         "slip_amplitude": slip,
         "max_force": max_force,
         "dissipated_energy": energy,
-        "ecof": sliding * energy / (4.0 * load * slip),
+        "ecof": energy / (4.0 * load * slip),
         "cof_max": max_force / load,
         "energy_ratio": energy_ratio,
-        "stiffness": stiffness,
-        "gicof": sliding * (rising_q - falling_q) / (2.0 * load),
-        "gicof_forward": sliding * rising_q / load,
-        "gicof_backward": -sliding * falling_q / load,
-        "crossing_displacement_forward": sliding * rising_x,
-        "crossing_displacement_backward": sliding * falling_x,
+        "stiffness": 1.0 / (compliance + 0.0),  # + 0.0: a rigid rig is +inf, not -inf
+        "gicof": (force[:cycles] - force[cycles:]) / (2.0 * load),
+        "gicof_forward": force[:cycles] / load,
+        "gicof_backward": -force[cycles:] / load,
+        "crossing_displacement_forward": at[:cycles],
+        "crossing_displacement_backward": at[cycles:],
+        "displacement_offset": block.displacement_centre,
+        "force_offset": block.force_centre,
+        "stick_residual": fit["residual"],
     }
-    return values, np.where(gross, "gross slip", "partial slip")
+    rounding = 1e-9
+    anticlockwise = energy_ratio < -ANTICLOCKWISE_SHARE
+    flags = {
+        "few-samples": block.count < MIN_SAMPLES,
+        "constant-force": ~(block.force_swing > 0.0),
+        # A cycle cut at the reversals cannot turn back by more than the band: that
+        # would have been a reversal.
+        "several-loops": np.zeros(cycles, dtype=bool)
+        if block.continuous
+        else _turns_back(bx, options["hysteresis"] * span),
+        "anticlockwise": anticlockwise,
+        "energy-ratio-above-1": energy_ratio > 1.0 + rounding,
+        "negative-stiffness": compliance < 0.0,
+        "no-stick": (~(fit["unexplained"] <= _UNEXPLAINED) & ~np.isinf(values["stiffness"]))
+        | np.isnan(compliance),  # a rigid rig's vertical stick sides explain all but 0/0
+        "negative-area": (energy_ratio < 0.0) & ~anticlockwise,
+        "negative-slip": ~(slip > 0.0),
+        "no-zero-crossing": ~(zero_on_loop[:cycles] & zero_on_loop[cycles:]),
+        "curved-stick": fit["curved"],
+        "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]),
+        "not-gross-slip": ~(energy_ratio > options["gross_slip_threshold"]),
+    }
+    return values, flags
+
+
+def _turns_back(x, band):
+    """True for the cycles whose displacement turns back within a branch by more than
+    ``band``: the rising branches (the first half of the rows) fall below their running
+    maximum, or the falling ones rise above their running minimum (the rows' padding
+    repeats their last point, which changes neither)."""
+    cycles = band.size
+    rising, falling = x[:cycles], x[cycles:]
+    drop = np.max(np.maximum.accumulate(rising, axis=1) - rising, axis=1)
+    rise = np.max(falling - np.minimum.accumulate(falling, axis=1), axis=1)
+    return np.maximum(drop, rise) > band
+
+
+def measure_cycles(
+    cycles: Cycles,
+    displacement,
+    force,
+    load,
+    *,
+    hysteresis=0.5,
+    stick_window=(0.05, 0.45),
+    crossing_window=0.7,
+    gross_slip_threshold=GROSS_SLIP_THRESHOLD,
+    flip_force=False,
+    rows=None,
+    keep_loops=False,
+):
+    """The per-cycle quantities of :func:`analyze_loops` for cycles already found.
+
+    Parameters
+    ----------
+    cycles : Cycles
+        Cycles of the recording (:func:`ecofmaps.measured.cycles.find_cycles`).
+    displacement, force : numpy.ndarray
+        The recording, float64 and finite. [m], [N]
+    load : float
+        Normal load :math:`P`. [N]
+    hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
+        As for :func:`analyze_loops` (not checked here).
+    rows : slice, optional
+        Consecutive cycles to measure; default all.
+    keep_loops : bool
+        Also return the centred loops as NaN-padded (cycle, point) arrays.
+
+    Returns
+    -------
+    values : dict of str to numpy.ndarray
+        Each quantity of :func:`analyze_loops` over the cycles, offsets and stick residual
+        included, as measured: not yet NaN where a check fails.
+    flags : dict of str to numpy.ndarray of bool
+        The checks of :data:`ecofmaps.measured.quality.REASONS` each cycle failed.
+    loops : tuple of numpy.ndarray or None
+        Centred displacement and force round each loop, if ``keep_loops``. [m], [N]
+    """
+    first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
+    options = {
+        "hysteresis": hysteresis,
+        "stick_window": stick_window,
+        "crossing_window": crossing_window,
+        "gross_slip_threshold": gross_slip_threshold,
+    }
+    values = {name: np.empty(stop - first) for name in _PER_CYCLE}
+    flags = {reason: np.zeros(stop - first, dtype=bool) for reason in REASONS}
+    loops = None
+    if keep_loops:
+        width = int(cycles.count[first:stop].max()) + 1
+        loops = tuple(np.full((stop - first, width), np.nan) for _ in range(2))
+    sign = -1.0 if flip_force else 1.0
+    blocks = loop_blocks(cycles, displacement, force, slice(first, stop), sign)
+    with np.errstate(divide="ignore", invalid="ignore"):  # degenerate cycles give NaN
+        for block in blocks:
+            check_interrupted()
+            out = slice(block.rows.start - first, block.rows.stop - first)
+            computed, failed = _loop_values(block, load, options)
+            for name, value in computed.items():
+                values[name][out] = value
+            for reason, flag in failed.items():
+                flags[reason][out] = flag
+            if keep_loops:
+                for loop, centred in zip(loops, block.loops(loops[0].shape[1]), strict=True):
+                    loop[out] = centred
+    return values, flags, loops
+
+
+def _refusal_hint(flags: dict) -> str:
+    """What the user may do about a recording whose every cycle is refused."""
+    if flags["anticlockwise"].all():
+        if flags["negative-stiffness"].any():
+            return (
+                "The loops run anticlockwise with stick sides sloping down: the force is "
+                "recorded positive against the displacement. If so, read it with the other "
+                "sign: flip_force=True (on the command line, --flip-force)."
+            )
+        return (
+            "The loops run anticlockwise with stick sides sloping up: the recording runs "
+            "backwards in time, or the displacement and force columns are swapped."
+        )
+    if flags["constant-force"].all():
+        return "The force does not vary: is the force channel connected?"
+    return (
+        "Is it a recording of fretting loops, with the displacement and the force in their "
+        "own columns?"
+    )
+
+
+# --- the public function ------------------------------------------------------------------
 
 
 def _series(name, values, size=None):
@@ -315,11 +339,14 @@ def _series(name, values, size=None):
         raise ValueError(
             f"{name} must have one value per sample: {array.size} values for {size} samples"
         )
-    check(name, array, "finite")
+    if not np.isfinite(array).all():
+        check(name, array, "finite")
     return array
 
 
-def _check_options(load, hysteresis, stick_window, crossing_window, gross_slip_threshold):
+def _check_options(
+    load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
+):
     check("load", load, "positive", "N")
     if np.ndim(load) != 0:
         raise ValueError("load must be a single value [N]")
@@ -337,10 +364,14 @@ def _check_options(load, hysteresis, stick_window, crossing_window, gross_slip_t
             "gross_slip_threshold must satisfy 0 < gross_slip_threshold < 1; "
             f"got {gross_slip_threshold!r}"
         )
+    if not isinstance(flip_force, bool | np.bool_):
+        raise ValueError(f"flip_force must be True or False; got {flip_force!r}")
     return {
+        "hysteresis": float(hysteresis),
         "stick_window": (low, high),
         "crossing_window": float(crossing_window),
         "gross_slip_threshold": float(gross_slip_threshold),
+        "flip_force": bool(flip_force),
     }
 
 
@@ -355,9 +386,10 @@ def analyze_loops(
     stick_window=(0.05, 0.45),
     crossing_window=0.7,
     gross_slip_threshold=GROSS_SLIP_THRESHOLD,
+    flip_force=False,
     keep_loops=False,
 ) -> xr.Dataset:
-    r"""Per-cycle friction quantities of a recording of fretting loops.
+    r"""Per-cycle friction quantities of a recording of fretting loops, each checked.
 
     Parameters
     ----------
@@ -365,7 +397,8 @@ def analyze_loops(
         Applied displacement :math:`\Delta` at each sample, in time order. Offsets and a
         slow drift are removed; the sampling need not be uniform. [m]
     force : array_like
-        Tangential force :math:`Q` at each sample; offsets are removed. [N]
+        Tangential force :math:`Q` at each sample, positive in the direction of positive
+        displacement (the loops then run clockwise); offsets are removed. [N]
     load : float
         Normal load :math:`P`. [N]
     cycle : array_like, optional
@@ -383,6 +416,10 @@ def analyze_loops(
         share of the slip amplitude (> 0). [1]
     gross_slip_threshold : float
         Energy ratio :math:`A` above which a loop is gross slip (0 < threshold < 1). [1]
+    flip_force : bool
+        Read the force with the other sign: for a rig whose force is recorded positive
+        against the displacement (its loops run anticlockwise, with stick sides sloping
+        down).
     keep_loops : bool
         Also return the centred loops, ``loop_displacement`` and ``loop_force`` over
         ``(cycle, point)`` (NaN-padded), for plotting.
@@ -394,21 +431,33 @@ def analyze_loops(
         dissipated_energy [J], ecof, cof_max, energy_ratio, stiffness [N/m], gicof,
         gicof_forward, gicof_backward, crossing_displacement_forward and
         crossing_displacement_backward [m] (in the centred loop), displacement_offset [m]
-        and force_offset [N] (the centres removed), and regime ('gross slip' or
-        'partial slip'); the load is a scalar coordinate. The attributes
-        ``incomplete_cycles`` and ``dropped_samples`` count what was dropped.
-        ``results.to_dataframe()`` gives a table.
+        and force_offset [N] (the centres removed, of the force as read), regime ('gross
+        slip', 'partial slip', or 'unknown' for a refused cycle), stick_residual [m] (root
+        mean square displacement off the stick lines) and quality ('ok', or why values
+        are NaN: :mod:`ecofmaps.measured.quality`); the load is a scalar coordinate. The
+        attributes ``incomplete_cycles`` and ``dropped_samples`` count what was dropped;
+        ``quality_summary`` is one line on what was flagged. ``results.to_dataframe()``
+        gives a table.
 
     Raises
     ------
     ValueError
         For inputs of the wrong shape, non-finite samples, a load that is not positive,
-        options out of range, or a recording without a complete cycle.
+        options out of range, a recording without a complete cycle, or one whose every
+        cycle is refused (not a loop that can be read as recorded).
+
+    Warns
+    -----
+    LoopQualityWarning
+        When cycles were flagged (other than for partial slip), with the one-line summary;
+        and when the displacement amplitude is below 0.1 µm or above 10 mm (a displacement
+        not in metres).
 
     Notes
     -----
-    The methods are in the documentation of :mod:`ecofmaps.measured.analysis` and
-    :mod:`ecofmaps.measured.cycles`. The ECoF is eq. 1; the GICoF is the paper's Section 5
+    The methods are in the documentation of :mod:`ecofmaps.measured.analysis`,
+    :mod:`ecofmaps.measured.cycles` and :mod:`ecofmaps.measured.centring`; the checks in
+    :mod:`ecofmaps.measured.quality`. The ECoF is eq. 1; the GICoF is the paper's Section 5
     (eq. 17-18), and equals :math:`\mu` for the model's loop whatever the groove.
 
     Examples
@@ -418,8 +467,12 @@ def analyze_loops(
     >>> results = ecofmaps.analyze_loops(np.asarray(displacement), np.asarray(force), 450.0)
     >>> print(f"{float(results.gicof[0]):.6f} {float(results.ecof[0]):.3f}")
     0.800000 0.831
+    >>> print(results.quality.values[0], "|", results.attrs["quality_summary"])
+    ok | 1 cycles: 1 ok
     """
-    options = _check_options(load, hysteresis, stick_window, crossing_window, gross_slip_threshold)
+    options = _check_options(
+        load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
+    )
     load = float(load)
     x = _series("displacement", displacement)
     q = _series("force", force, x.size)
@@ -427,31 +480,61 @@ def analyze_loops(
         raise ValueError(
             f"too few samples for one cycle: {x.size} (a cycle needs at least {MIN_SAMPLES})"
         )
-    if cycle is None:
-        cycles = split_cycles(x, hysteresis)
-    else:
-        cycles = labelled_cycles(x, _series("cycle", cycle, x.size))
+    cycles = find_cycles(x, cycle, hysteresis)
     if cycles.label.size == 0:
         raise ValueError(
             f"too few samples for one cycle: no complete cycle in {x.size} samples "
             "(the loop does not close, or the recording does not oscillate)"
         )
-    loop_x, loop_q, centre_x, centre_q = cycles.centred_loops(x, q)
-    with np.errstate(divide="ignore", invalid="ignore"):  # degenerate cycles give NaN
-        values, regime = _loop_quantities(loop_x, loop_q, cycles.valid, load, options)
-    values.update(displacement_offset=centre_x, force_offset=centre_q)
-    data = {name: ("cycle", value, _attrs(name)) for name, value in values.items()}
+    values, flags, loops = measure_cycles(cycles, x, q, load, keep_loops=keep_loops, **options)
+    _check_units(values["amplitude"])
+    quality = quality_strings(flags, cycles.label.size)
+    summary = quality_summary(quality)
+    refused = np.zeros(quality.size, dtype=bool)
+    for reason, flag in flags.items():
+        refused |= flag & (REASONS[reason][1] == ALL)
+    if refused.all():
+        raise ValueError(f"no plausible cycle in the recording ({summary}). {_refusal_hint(flags)}")
+    if np.any((quality != "ok") & (quality != "not-gross-slip")):
+        warn(f"cycles flagged: {summary}", LoopQualityWarning)
+    values = apply_quality(values, flags)
+    regime = np.where(
+        refused,
+        "unknown",
+        np.where(
+            values["energy_ratio"] > options["gross_slip_threshold"], "gross slip", "partial slip"
+        ),
+    )
+    names = [name for name in values if name != "stick_residual"]
+    data = {name: ("cycle", values[name], _attrs(name)) for name in names}
     data["regime"] = ("cycle", regime, _attrs("regime"))
+    data["stick_residual"] = ("cycle", values["stick_residual"], _attrs("stick_residual"))
+    data["quality"] = ("cycle", quality, _attrs("quality"))
     coords = {"cycle": ("cycle", cycles.label, _attrs("cycle")), "load": ((), load, _attrs("load"))}
     if keep_loops:
-        data["loop_displacement"] = (("cycle", "point"), loop_x, _attrs("loop_displacement"))
-        data["loop_force"] = (("cycle", "point"), loop_q, _attrs("loop_force"))
-        coords["point"] = ("point", np.arange(loop_x.shape[1]), _attrs("point"))
+        data["loop_displacement"] = (("cycle", "point"), loops[0], _attrs("loop_displacement"))
+        data["loop_force"] = (("cycle", "point"), loops[1], _attrs("loop_force"))
+        coords["point"] = ("point", np.arange(loops[0].shape[1]), _attrs("point"))
     attrs = {
         "title": "Fretting loops analysed cycle by cycle (ecofmaps.analyze_loops)",
         "cycles_from": "displacement reversals" if cycle is None else "cycle numbers",
         "incomplete_cycles": cycles.incomplete_cycles,
         "dropped_samples": cycles.dropped_samples,
         "gross_slip_threshold": options["gross_slip_threshold"],
+        "flip_force": int(options["flip_force"]),
+        "quality_summary": summary,
     }
     return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def _check_units(amplitude):
+    """Warn when the displacement amplitudes look like another unit than metres."""
+    typical = float(np.nanmedian(amplitude)) if amplitude.size else np.nan
+    low, high = _AMPLITUDE_RANGE
+    if not low <= typical <= high:
+        warn(
+            f"the displacement amplitude is {typical:.3g} m (median over the cycles), outside "
+            "0.1 µm to 10 mm: is the displacement in metres? analyze_loops takes SI units; "
+            "on the command line, --displacement-unit gives the unit of the column",
+            LoopQualityWarning,
+        )

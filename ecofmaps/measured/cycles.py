@@ -1,11 +1,17 @@
-r"""A recording of fretting loops cut into cycles, each laid out as one row of a padded array.
+r"""A recording of fretting loops cut into cycles.
 
 A recording is a long series of samples :math:`(\Delta_i, Q_i)`. :func:`split_cycles` cuts
 it at the displacement reversals; :func:`labelled_cycles` uses a cycle number recorded with
-each sample instead. Both return :class:`Cycles`: for every complete cycle, the indices of
-its samples as one row of a padded 2-D array, running once round the loop from its lowest
-displacement back to it (the last point closes the loop). Everything is vectorised: no
-Python loop over samples or over cycles.
+each sample instead; :func:`find_cycles` chooses between the two, for
+:func:`ecofmaps.analyze_loops` and :func:`ecofmaps.fit_loop` alike. They return
+:class:`Cycles`: for every complete cycle, the stretch of samples it covers (first sample
+and count) and where in the stretch its loop begins, at its lowest displacement. A loop
+runs once round from there and back to it (the last point closes the loop).
+:mod:`ecofmaps.measured.centring` moves the loops to their centres.
+
+No Python loop runs over samples or over cycles, and nothing the size of the recording is
+held beyond the recording itself: the passes over it (the detrending, its percentiles, the
+Schmitt trigger, the extremes of each run) go a chunk of ``_CHUNK`` samples at a time.
 
 Finding the reversals
 ---------------------
@@ -25,18 +31,6 @@ the same kind (a recording that starts or ends exactly at a reversal). The sampl
 the first and after the last bottom reversal are incomplete cycles: they are dropped and
 counted. A recording with fewer than two bottom reversals is read as a single loop if it
 closes (see :func:`labelled_cycles`).
-
-Offsets and drift
------------------
-:meth:`Cycles.centred_loops` moves every loop to its centre: the mean of :math:`\Delta`
-and of :math:`Q` along the loop weighted by the displacement travelled,
-:math:`\oint \Delta\,|d\Delta| / \oint |d\Delta|` (trapezoids). For a loop symmetric
-about a point (the model's steady loop, with or without ploughing peaks at both ends of
-the stroke) that point is the centre, and the mean averages the noise of every sample.
-For cycles cut from one continuous recording, the centres are interpolated linearly along
-the sample index from the middle of one cycle to the next and subtracted sample by
-sample, which also removes a slow drift of :math:`\Delta` (or of :math:`Q`) within each
-cycle; labelled cycles (possibly recorded far apart) are each moved by their own centre.
 """
 
 from __future__ import annotations
@@ -45,29 +39,39 @@ import dataclasses
 
 import numpy as np
 
-__all__ = ["MIN_SAMPLES", "Cycles", "labelled_cycles", "masked_sum", "split_cycles"]
+from ecofmaps._inputs import check
+
+__all__ = ["MIN_SAMPLES", "Cycles", "find_cycles", "labelled_cycles", "split_cycles"]
 
 #: Fewest samples in one complete cycle: two branches, each with a stick and a slip part.
+#: The one definition for the analysis, the fit and the synthetic recordings.
 MIN_SAMPLES = 8
+
+#: Samples read at once by the passes over the whole recording.
+_CHUNK = 1 << 18
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class Cycles:
-    """Complete cycles of a recording as rows of a padded index array.
+    """Complete cycles of a recording: the stretch of samples of each, and its loop's start.
 
     Attributes
     ----------
-    samples : numpy.ndarray of int, shape (cycles, width)
-        Row ``k`` lists the sample indices of cycle ``k`` in order round the loop, starting
-        at its lowest displacement and ending with the point that closes the loop; padded
-        by repeating the closing index.
-    valid : numpy.ndarray of bool, shape (cycles, width)
-        True on the points of each loop, False on the padding.
+    start : numpy.ndarray of int64, shape (cycles,)
+        First sample of each cycle's stretch of the recording.
+    count : numpy.ndarray of int64, shape (cycles,)
+        Samples in the stretch. A cycle cut at the reversals runs from its bottom
+        reversal to the next one, both included.
+    rotation : numpy.ndarray of int64, shape (cycles,)
+        Where the loop begins, counted from ``start``: its lowest displacement (0 for
+        cycles cut at the reversals). The loop runs through the stretch from there,
+        wraps round to its beginning and ends by repeating its first sample.
     label : numpy.ndarray of int64, shape (cycles,)
         The cycle number: the recorded one, or 1, 2, ... in order of the complete cycles.
     continuous : bool
-        True when the cycles follow each other without a gap (cut at reversals), so a slow
-        drift can be interpolated from one cycle to the next.
+        True when the cycles follow each other without a gap (cut at the reversals: each
+        stretch ends on the sample that begins the next), so a slow drift can be
+        interpolated from one cycle to the next.
     incomplete_cycles : int
         Incomplete cycles dropped (at the ends of the recording, or labelled cycles that do
         not close).
@@ -75,110 +79,182 @@ class Cycles:
         Samples that belong to no complete cycle.
     """
 
-    samples: np.ndarray
-    valid: np.ndarray
+    start: np.ndarray
+    count: np.ndarray
+    rotation: np.ndarray
     label: np.ndarray
     continuous: bool
     incomplete_cycles: int
     dropped_samples: int
 
-    def centred_loops(self, displacement, force):
-        """The loops as padded rows, each moved to its centre (module notes).
+    @property
+    def width(self) -> int:
+        """Points round the longest loop, the closing point included. [1]"""
+        return int(self.count.max()) + 1 if self.count.size else 1
+
+    def indices(self, rows=slice(None), width=None):
+        """Sample indices round the loops ``rows``, one padded row per loop.
 
         Parameters
         ----------
-        displacement, force : numpy.ndarray
-            The recording the cycles were found in. [m], [N]
+        rows : slice or array_like of int
+            The cycles (rows of this table).
+        width : int, optional
+            Points per row; default the longest of these loops, closing point included.
 
         Returns
         -------
-        x, q : numpy.ndarray, shape (cycles, width)
-            Centred displacement and force round each loop, NaN on the padding. [m], [N]
-        centre_x, centre_q : numpy.ndarray, shape (cycles,)
-            The centres removed. [m], [N]
+        samples : numpy.ndarray of int64, shape (rows, width)
+            Row ``k`` lists the samples of loop ``k`` in order round it, from its lowest
+            displacement to the point that closes it, then repeats that closing sample.
+        points : numpy.ndarray of int64, shape (rows,)
+            Points round each loop, the closing one included.
         """
-        x = np.where(self.valid, displacement[self.samples], np.nan)
-        q = np.where(self.valid, force[self.samples], np.nan)
-        points = np.count_nonzero(self.valid, axis=1)
-        middle = masked_sum(self.samples.astype(np.float64), self.valid) / points
-        at = self.samples.astype(np.float64)
-        segments = self.valid[:, 1:].copy()
-        if self.continuous:  # the segment closing the loop is no part of the path
-            segments[np.arange(points.size), points - 2] = False
-
-        def centred(values, path):
-            """``values`` less their mean weighted by the displacement travelled on ``path``."""
-            weight = np.where(segments, np.abs(np.diff(path, axis=1)), 0.0)
-            middles = 0.5 * (values[:, 1:] + values[:, :-1])
-            centre = masked_sum(weight * middles, segments) / weight.sum(axis=1)
-            if self.continuous:
-                return values - _interpolate(at, middle, centre), centre
-            return values - centre[:, None], centre
-
-        x, centre_x = centred(x, x)
-        # The force's weights come from the displacement without its drift, so that a drift
-        # does not weigh one branch more than the other.
-        q, centre_q = centred(q, x)
-        return x, q, centre_x, centre_q
+        start, count, rotation = self.start[rows], self.count[rows], self.rotation[rows]
+        if width is None:
+            width = int(count.max()) + 1
+        j = np.arange(width)[None, :]
+        if self.continuous:  # no rotation: the stretch, then its first sample again
+            return start[:, None] + np.where(j < count[:, None], j, 0), count + 1
+        count, rotation = count[:, None], rotation[:, None]
+        position = rotation + j
+        position = np.where(position >= count, position - count, position)
+        position = np.where(j < count, position, rotation)
+        return start[:, None] + position, self.count[rows] + 1
 
 
-def _interpolate(at, points, values):
-    """Piecewise-linear interpolation, extended linearly beyond the first and last points."""
-    inside = np.interp(at, points, values)
-    if points.size < 2:
-        return inside
-    first = values[0] + (at - points[0]) * (values[1] - values[0]) / (points[1] - points[0])
-    last = values[-1] + (at - points[-1]) * (values[-1] - values[-2]) / (points[-1] - points[-2])
-    return np.where(at < points[0], first, np.where(at > points[-1], last, inside))
+def _chunks(size: int):
+    """``(a, b)`` bounds of the chunks of a recording of ``size`` samples."""
+    return ((a, min(a + _CHUNK, size)) for a in range(0, size, _CHUNK))
 
 
-def masked_sum(values, mask):
-    """Sum of ``values`` over each row where ``mask`` is True (NaN elsewhere is ignored)."""
-    return np.sum(np.where(mask, values, 0.0), axis=1)
+def _first_at(x: np.ndarray, starts: np.ndarray, value: np.ndarray) -> np.ndarray:
+    """Index of the first sample equal to ``value[k]`` in each run ``k`` beginning at ``starts``.
+
+    Every run holds its value (its extreme, say).
+    """
+    ends = np.append(starts[1:], x.size)
+    first = np.full(starts.size, -1, dtype=np.int64)
+    for a, b in _chunks(x.size):
+        r0, r1 = np.searchsorted(ends, a, side="right"), np.searchsorted(starts, b)
+        lengths = np.minimum(ends[r0:r1], b) - np.maximum(starts[r0:r1], a)
+        hits = np.flatnonzero(x[a:b] == np.repeat(value[r0:r1], lengths)) + a
+        run = np.searchsorted(starts, hits, side="right") - 1
+        leading = np.flatnonzero(np.diff(run, prepend=-1))  # the first hit of each run
+        run, hits = run[leading], hits[leading]
+        fresh = first[run] < 0
+        first[run[fresh]] = hits[fresh]
+    return first
 
 
-def _run_index(starts: np.ndarray, size: int) -> np.ndarray:
-    """For each of ``size`` samples, the number of the run (beginning at ``starts``) it is in."""
-    first = np.zeros(size, dtype=np.int64)
-    first[starts] = 1
-    return np.cumsum(first) - 1
+def _largest_steps(x: np.ndarray, starts: np.ndarray) -> np.ndarray:
+    """Largest step between consecutive samples within each run beginning at ``starts``."""
+    cuts = np.union1d(starts, np.arange(0, x.size, _CHUNK))
+    ends = np.append(starts[1:], x.size) - 1  # no step from a run's last sample
+    largest = np.empty(cuts.size)
+    for a, b in _chunks(x.size):
+        p, q = np.searchsorted(cuts, [a, b])
+        step = np.abs(np.diff(x[a : b + 1], append=x[-1]))[: b - a]
+        inside = ends[(ends >= a) & (ends < b)]
+        step[inside - a] = 0.0
+        largest[p:q] = np.maximum.reduceat(step, cuts[p:q] - a)
+    return np.maximum.reduceat(largest, np.searchsorted(cuts, starts))
 
 
-def _first_of_runs(values: np.ndarray, starts: np.ndarray) -> np.ndarray:
-    """Index of the first maximum of ``values`` within each run beginning at ``starts``."""
-    run = _run_index(starts, values.size)
-    best = np.maximum.reduceat(values, starts)
-    hits = np.flatnonzero(values == best[run])
-    _, first = np.unique(run[hits], return_index=True)
-    return hits[first]
+#: Quantiles of the reversal detector's range (the 1st and 99th percentiles).
+_QUANTILES = np.array([1.0, 99.0]) / 100.0
+
+#: Size of the random sample that brackets the percentiles of a long recording.
+_SAMPLE = 1 << 16
 
 
-def _padded(start: np.ndarray, count: np.ndarray, rotation: np.ndarray, closing: np.ndarray):
-    """Index rows ``start + (rotation + j) mod count`` for ``j < count``, then ``closing``."""
-    width = int(count.max()) + 1
-    j = np.arange(width)[None, :]
-    count = count[:, None]
-    inside = (rotation[:, None] + j) % count + start[:, None]
-    samples = np.where(j < count, inside, closing[:, None])
-    return samples, j <= count
+def _percentiles(values, size: int):
+    """``np.percentile`` of ``values(0, size)`` at the 1st and 99th percentile, exactly.
+
+    A long recording is not held at once: a random sample of it brackets each order
+    statistic needed (by eight standard errors of the sample's quantile), one pass a chunk
+    at a time counts the values below each bracket and keeps those inside, and the order
+    statistics are selected among these. NumPy's linear interpolation between them is
+    repeated operation by operation, so the result is the same to the last bit.
+    """
+    if size <= _CHUNK:
+        return np.percentile(values(0, size), _QUANTILES * 100.0, overwrite_input=True)
+    virtual = (size - 1) * _QUANTILES  # NumPy's virtual index, method "linear"
+    rank = np.floor(virtual).astype(np.int64)
+    sample = np.sort(values(np.random.default_rng(0).integers(0, size, _SAMPLE)))
+    spread = 8.0 * np.sqrt(_QUANTILES * (1.0 - _QUANTILES) * _SAMPLE) + 8.0
+    low = np.floor(_QUANTILES * _SAMPLE - spread).astype(np.int64)
+    high = np.ceil(_QUANTILES * _SAMPLE + spread).astype(np.int64)
+    low = np.where(low > 0, sample[np.clip(low, 0, _SAMPLE - 1)], -np.inf)
+    high = np.where(high < _SAMPLE - 1, sample[np.clip(high, 0, _SAMPLE - 1)], np.inf)
+    tails = []  # the values up to the first bracket's top or from the second's bottom
+    for a, b in _chunks(size):
+        chunk = values(a, b)
+        tails.append(chunk[(chunk <= high[0]) | (chunk >= low[1])])
+    tails = np.concatenate(tails)
+    result = np.empty(2)
+    for k in range(2):
+        kept = tails[(tails >= low[k]) & (tails <= high[k])]
+        below = (
+            np.count_nonzero(tails < low[k]) if k == 0 else size - np.count_nonzero(tails >= low[k])
+        )
+        j = rank[k] - below
+        if not 0 <= j < kept.size - 1:  # the sample missed: hold the whole recording once
+            whole = np.concatenate([values(a, b) for a, b in _chunks(size)])
+            return np.percentile(whole, _QUANTILES * 100.0, overwrite_input=True)
+        previous, following = np.partition(kept, [j, j + 1])[[j, j + 1]]
+        gamma = virtual[k] - rank[k]
+        difference = following - previous
+        result[k] = (
+            following - difference * (1.0 - gamma)
+            if gamma >= 0.5
+            else previous + difference * gamma
+        )
+    return result
 
 
-def _runs(detrended: np.ndarray, hysteresis: float):
-    """Schmitt-trigger runs of ``detrended``: their starts, kind (+1/-1), and the stroke."""
-    low, high = np.percentile(detrended, [1.0, 99.0])
+def _runs(x: np.ndarray, hysteresis: float):
+    """Schmitt-trigger runs of the detrended displacement: starts, kind (+1/-1), stroke."""
+    n = x.size
+    if n < 2:
+        raise ValueError("the displacement does not oscillate: no reversal can be found")
+    middle = 0.5 * (n - 1)
+    mean = x.mean()
+    # The least-squares slope over t = i - (n - 1)/2, whose squares sum to n(n² - 1)/12.
+    slope = sum(
+        np.einsum("i,i->", np.arange(a - middle, b - middle), x[a:b]) for a, b in _chunks(n)
+    ) / ((n * (n * n - 1)) / 12)
+
+    def detrended(a, b=None):
+        """The detrended displacement at samples a to b - 1, or at the indices ``a``."""
+        if b is None:
+            return (x[a] - mean) - (a - middle) * slope
+        # Exact: the sample indices less the middle are integers or halves below 2**52.
+        return (x[a:b] - mean) - np.arange(a - middle, b - middle) * slope
+
+    low, high = _percentiles(detrended, n)
     half_range = 0.5 * (high - low)
     if not half_range > 0.0:
         raise ValueError("the displacement does not oscillate: no reversal can be found")
     centre = 0.5 * (high + low)
     level = hysteresis * half_range
-    state = np.where(detrended > centre + level, 1, np.where(detrended < centre - level, -1, 0))
-    # The 99th percentile lies above the band, so some state is decided. Forward-fill the
-    # last decided state; samples before the first decision take that first one.
-    decided = np.flatnonzero(state)
-    last = np.maximum.accumulate(np.where(state != 0, np.arange(state.size), decided[0]))
-    state = state[last]
-    starts = np.concatenate([[0], np.flatnonzero(np.diff(state)) + 1])
-    kind = state[starts]
+    # A run begins where the state (+1 above the band, -1 below it, 0 inside) differs from
+    # the last one decided; samples before the first decision take that first one. The 99th
+    # percentile lies above the band, so some state is decided.
+    starts, kinds, previous = [], [], 0
+    for a, b in _chunks(n):
+        d = detrended(a, b)
+        state = (d > centre + level).view(np.int8) - (d < centre - level).view(np.int8)
+        entries = np.concatenate([[0], np.flatnonzero(state[1:] != state[:-1]) + 1])
+        kind = state[entries]
+        entries, kind = entries[kind != 0], kind[kind != 0]  # into a decided state
+        change = kind != np.concatenate([[previous], kind[:-1]])
+        starts.append(entries[change] + a)
+        kinds.append(kind[change])
+        if kind.size:
+            previous = kind[-1]
+    starts, kind = np.concatenate(starts), np.concatenate(kinds).astype(np.float64)
+    starts[0] = 0
     return starts, kind, 2.0 * half_range
 
 
@@ -212,10 +288,9 @@ def split_cycles(displacement, hysteresis: float = 0.5, tolerance: float = 0.01)
     """
     x = np.asarray(displacement, dtype=np.float64)
     n = x.size
-    t = np.arange(n, dtype=np.float64) - 0.5 * (n - 1)
-    detrended = x - x.mean() - t * (np.dot(t, x) / np.dot(t, t))
-    starts, kind, stroke = _runs(detrended, hysteresis)
-    extreme = _first_of_runs(x * kind[_run_index(starts, n)], starts)
+    starts, kind, stroke = _runs(x, hysteresis)
+    highest, lowest = np.maximum.reduceat(x, starts), np.minimum.reduceat(x, starts)
+    extreme = _first_at(x, starts, np.where(kind > 0, highest, lowest))
     accepted = np.ones(starts.size, dtype=bool)
     runs = starts.size
     for edge, boundary, neighbour in ((0, 0, 2), (runs - 1, n - 1, runs - 3)):
@@ -232,15 +307,14 @@ def split_cycles(displacement, hysteresis: float = 0.5, tolerance: float = 0.01)
         # Not two bottom reversals: the recording may still be one closed loop that starts
         # and ends elsewhere on the loop.
         return labelled_cycles(x, np.zeros(n, dtype=np.int64), tolerance)
-    start, stop = bottoms[:-1], bottoms[1:]
     # Each loop runs from its bottom reversal to the next and back to its first sample, so
     # it is closed even if the displacement drifted in between.
-    count = stop - start + 1
-    samples, valid = _padded(start, count, np.zeros_like(count), start)
+    start = bottoms[:-1]
     leading, trailing = int(bottoms[0]), int(n - 1 - bottoms[-1])
     return Cycles(
-        samples=samples,
-        valid=valid,
+        start=start,
+        count=bottoms[1:] - start + 1,
+        rotation=np.zeros_like(start),
         label=np.arange(1, start.size + 1, dtype=np.int64),
         continuous=True,
         incomplete_cycles=int(leading > 0) + int(trailing > 0),
@@ -279,29 +353,24 @@ def labelled_cycles(displacement, cycle, tolerance: float = 0.01) -> Cycles:
     x = np.asarray(displacement, dtype=np.float64)
     label = np.asarray(cycle)
     n = x.size
-    starts = np.concatenate([[0], np.flatnonzero(np.diff(label)) + 1])
-    count = np.diff(np.append(starts, n))
-    top = np.maximum.reduceat(x, starts)
+    starts = np.concatenate([[0], np.flatnonzero(label[1:] != label[:-1]) + 1])
+    ends = np.append(starts[1:], n)
+    count = ends - starts
     bottom = np.minimum.reduceat(x, starts)
-    stroke = top - bottom
-    lowest = _first_of_runs(-x, starts)
-    step = np.abs(np.diff(x, append=x[-1]))
-    step[np.append(starts[1:], n) - 1] = 0.0  # no step across a cycle boundary
-    largest_step = np.maximum.reduceat(step, starts)
-    gap = np.abs(x[np.append(starts[1:], n) - 1] - x[starts])
+    stroke = np.maximum.reduceat(x, starts) - bottom
+    lowest = _first_at(x, starts, bottom)
+    gap = np.abs(x[ends - 1] - x[starts])
     complete = (
         (count >= MIN_SAMPLES)
         & (stroke >= 0.5 * np.median(stroke))
         & (stroke > 0.0)
-        & (gap <= 1.5 * largest_step + tolerance * stroke)
+        & (gap <= 1.5 * _largest_steps(x, starts) + tolerance * stroke)
     )
-    if not complete.any():
-        return _no_cycles(n, incomplete=starts.size)
-    start, count, lowest = starts[complete], count[complete], lowest[complete]
-    samples, valid = _padded(start, count, lowest - start, lowest)
+    start, count = starts[complete], count[complete]
     return Cycles(
-        samples=samples,
-        valid=valid,
+        start=start,
+        count=count,
+        rotation=lowest[complete] - start,
         label=np.rint(label[start].astype(np.float64)).astype(np.int64),
         continuous=False,
         incomplete_cycles=int(np.count_nonzero(~complete)),
@@ -309,12 +378,39 @@ def labelled_cycles(displacement, cycle, tolerance: float = 0.01) -> Cycles:
     )
 
 
-def _no_cycles(samples: int, incomplete: int) -> Cycles:
-    return Cycles(
-        samples=np.zeros((0, 1), dtype=np.int64),
-        valid=np.zeros((0, 1), dtype=bool),
-        label=np.zeros(0, dtype=np.int64),
-        continuous=True,
-        incomplete_cycles=incomplete,
-        dropped_samples=samples,
-    )
+def find_cycles(displacement, cycle=None, hysteresis: float = 0.5) -> Cycles:
+    """The complete cycles of a recording: numbered ones, or cut at the reversals.
+
+    Parameters
+    ----------
+    displacement : numpy.ndarray
+        Displacement at each sample, in time order, float64. [m]
+    cycle : array_like, optional
+        Cycle number of each sample (see :func:`labelled_cycles`); without it the
+        recording is cut at its reversals (:func:`split_cycles`). [1]
+    hysteresis : float
+        Band of the reversal detector (see :func:`split_cycles`). [1]
+
+    Returns
+    -------
+    cycles : Cycles
+
+    Raises
+    ------
+    ValueError
+        If ``cycle`` does not hold one finite number per sample, or the displacement does
+        not oscillate.
+    """
+    if cycle is None:
+        return split_cycles(displacement, hysteresis)
+    label = np.asarray(cycle)
+    if label.ndim != 1:
+        raise ValueError("cycle must be one-dimensional (one value per sample)")
+    if label.size != displacement.size:
+        raise ValueError(
+            f"cycle must have one value per sample: {label.size} values for "
+            f"{displacement.size} samples"
+        )
+    if label.dtype.kind not in "iub":  # integers are finite; anything else is checked
+        check("cycle", label, "finite")
+    return labelled_cycles(displacement, label)

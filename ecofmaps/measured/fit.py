@@ -18,15 +18,13 @@ import jax.numpy as jnp
 import numpy as np
 
 from ecofmaps._inputs import check, float64
-from ecofmaps.measured.analysis import analyze_loops
-from ecofmaps.measured.cycles import labelled_cycles, split_cycles
+from ecofmaps.measured.analysis import measure_cycles
+from ecofmaps.measured.cycles import MIN_SAMPLES, find_cycles
+from ecofmaps.measured.quality import ALL, ANTICLOCKWISE_SHARE, REASONS, SEPARATOR
 from ecofmaps.model.core import slip_position, traction_ratio
 from ecofmaps.model.simulation import fretting_loop
 
 __all__ = ["LoopFit", "fit_loop"]
-
-#: Fewest samples accepted for one loop: six parameters, two branches, stick and slip.
-MIN_SAMPLES = 20
 
 # Force windows after each reversal where analyze_loops starts the stick segments (it then
 # grows them along the stick line): its default, and a narrow one that holds only stick
@@ -36,9 +34,8 @@ _STICK_WINDOWS = ((0.05, 0.45), (0.0, 0.15))
 # Contact positions within this share of the slip amplitude are read as slipping for the
 # starting mu and groove slope.
 _SLIP_SHARE = 0.6
-# A loop whose area is negative by more than this share of its bounding box runs
-# anticlockwise; a smaller negative area is noise on a loop without gross slip.
-_ORIENTATION_SHARE = 0.05
+# A slip amplitude below this share of the amplitude is rounding: the loop does not slip.
+_NO_SLIP = 1e-9
 # Samples are padded to a multiple of this for the compiled residual.
 _BUCKET = 64
 _TOLERANCE = 1e-12
@@ -179,7 +176,7 @@ def _starting_values(x, y, rising, stiffness, slip_half_width, energy_ratio):
     groove slope :math:`k` by least squares on :math:`Q_\pm/P \approx \pm\mu + k(1 +
     \mu^2) x` (eq. 9 to first order in :math:`x`; at :math:`x = 0` this is the GICoF).
     """
-    if energy_ratio < -_ORIENTATION_SHARE:
+    if energy_ratio < -ANTICLOCKWISE_SHARE:
         raise ValueError(
             "the loop runs anticlockwise (its area ∮Q dΔ is negative): force and "
             "displacement must be positive in the same direction"
@@ -190,7 +187,7 @@ def _starting_values(x, y, rising, stiffness, slip_half_width, energy_ratio):
             "stiffness cannot be fitted"
         )
     slipping = np.zeros_like(rising)
-    if stiffness > 0 and slip_half_width > 0:
+    if stiffness > 0 and slip_half_width > _NO_SLIP:
         contact = x - y / stiffness
         slipping = np.abs(contact) < _SLIP_SHARE * slip_half_width
     if min(np.count_nonzero(slipping & rising), np.count_nonzero(slipping & ~rising)) < 2:
@@ -208,32 +205,22 @@ def _starting_values(x, y, rising, stiffness, slip_half_width, energy_ratio):
 
 
 def _select_cycle(x, cycle, cycle_number, hysteresis):
-    """Sample indices of one complete cycle (lowest displacement first, closed), its number."""
-    if cycle is None:
-        cycles = split_cycles(x, hysteresis)
-    else:
-        labels = np.asarray(cycle, dtype=np.float64)
-        check("cycle", labels, "finite")
-        if labels.shape != x.shape:
-            raise ValueError(
-                f"cycle must have one value per sample: {labels.size} values for {x.size} samples"
-            )
-        cycles = labelled_cycles(x, labels)
+    """The complete cycles of the recording and the row of the one to fit."""
+    cycles = find_cycles(x, cycle, hysteresis)
     if cycles.label.size == 0:
         raise ValueError(
             f"no complete cycle in {x.size} samples: too few samples for one cycle, or the "
             "loop does not close"
         )
-    row = -1
-    if cycle_number is not None:
-        (rows,) = np.nonzero(cycles.label == cycle_number)
-        if rows.size == 0:
-            raise ValueError(
-                f"cycle_number {cycle_number!r} is not a complete cycle of the recording; "
-                f"complete cycles are numbered {cycles.label[0]} to {cycles.label[-1]}"
-            )
-        row = rows[0]
-    return cycles.samples[row][cycles.valid[row]], int(cycles.label[row])
+    if cycle_number is None:
+        return cycles, cycles.label.size - 1
+    (rows,) = np.nonzero(cycles.label == cycle_number)
+    if rows.size == 0:
+        raise ValueError(
+            f"cycle_number {cycle_number!r} is not a complete cycle of the recording; "
+            f"complete cycles are numbered {cycles.label[0]} to {cycles.label[-1]}"
+        )
+    return cycles, int(rows[0])
 
 
 @float64
@@ -272,8 +259,9 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
         If ``load`` is not a positive finite number; the arrays are not one-dimensional of
         one length, or hold NaN or infinity; the recording has no complete cycle, or none
         numbered ``cycle_number``; the cycle has fewer than :data:`MIN_SAMPLES` samples;
-        or the loop shows no gross slip, runs anticlockwise, or has vertical stick
-        segments (a rigid rig).
+        or the loop shows no gross slip, runs anticlockwise, has vertical stick segments
+        (a rigid rig), or is refused by the checks of :func:`ecofmaps.analyze_loops`
+        (:mod:`ecofmaps.measured.quality`).
 
     Notes
     -----
@@ -320,32 +308,47 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
     if not np.ptp(all_x) > 0:
         raise ValueError("displacement does not vary: a loop needs a displacement stroke")
 
-    index, number = _select_cycle(all_x, cycle, cycle_number, hysteresis)
-    analysis = max(
+    cycles, row = _select_cycle(all_x, cycle, cycle_number, hysteresis)
+    index = cycles.indices([row])[0][0]
+    number = int(cycles.label[row])
+    analysis, flags, _ = max(
         (
-            analyze_loops(all_x[index], all_y[index], load, stick_window=window).isel(cycle=0)
+            measure_cycles(
+                cycles, all_x, all_y, load, stick_window=window, rows=slice(row, row + 1)
+            )
             for window in _STICK_WINDOWS
         ),
-        key=lambda result: float(result.stiffness),
+        key=lambda measured: float(measured[0]["stiffness"][0]),
     )
+    analysis = {name: float(value[0]) for name, value in analysis.items()}
+    refusals = [
+        reason
+        for reason, flag in flags.items()
+        if flag[0] and REASONS[reason][1] == ALL and reason != "anticlockwise"
+    ]
+    if refusals and not flags["anticlockwise"][0]:
+        raise ValueError(
+            f"cycle {number} is no fretting loop that can be read as recorded: "
+            f"{SEPARATOR.join(refusals)} ({'; '.join(REASONS[r][0] for r in refusals)})"
+        )
     # The last point closes the loop (it is the first point of the next cycle, or the
     # first point again): fit each sample once.
     x, y = all_x[index[:-1]], all_y[index[:-1]]
     if x.size < MIN_SAMPLES:
         raise ValueError(f"a loop needs at least {MIN_SAMPLES} samples, got {x.size}")
     rising = np.arange(x.size) <= np.argmax(x)
-    length = float(analysis.amplitude)
-    centre = float(analysis.displacement_offset)
-    offset = float(analysis.force_offset)
+    length = analysis["amplitude"]
+    centre = analysis["displacement_offset"]
+    offset = analysis["force_offset"]
     scaled_x = (x - centre) / length
     scaled_y = (y - offset) / load
     start = _starting_values(
         scaled_x,
         scaled_y,
         rising,
-        stiffness=float(analysis.stiffness) * length / load,
-        slip_half_width=float(analysis.slip_amplitude) / length,
-        energy_ratio=float(analysis.energy_ratio),
+        stiffness=analysis["stiffness"] * length / load,
+        slip_half_width=analysis["slip_amplitude"] / length,
+        energy_ratio=analysis["energy_ratio"],
     )
 
     # Padded with zero-weight samples to a multiple of _BUCKET, so that loops of nearly the

@@ -120,6 +120,7 @@ import xarray as xr
 
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._inputs import check, si_units
+from ecofmaps._interrupts import check_interrupted
 from ecofmaps.measured.analysis import GROSS_SLIP_THRESHOLD, analyze_loops
 from ecofmaps.measured.resampling import branch_noise, read_branches, sample_weights
 from ecofmaps.measured.stick_slip import masked_median, masked_sum, slip_branches
@@ -274,6 +275,7 @@ def _resolve(x, q, valid, load, stiffness, amplitude, gross, given, options):
     cycles = x.shape[0]
     parts = []
     for block in _blocks(cycles):
+        check_interrupted()
         part = slip_branches(
             x[block],
             q[block],

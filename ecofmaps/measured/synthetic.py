@@ -25,6 +25,7 @@ import numpy as np
 
 from ecofmaps._inputs import si_units
 from ecofmaps.io.files import write_text
+from ecofmaps.measured.cycles import MIN_SAMPLES
 from ecofmaps.model.simulation import simulate
 
 __all__ = [
@@ -75,7 +76,7 @@ def synthetic_recording(
     cycles : int, optional
         Number of cycles; by default one per value of ``aspect_ratio``. [1]
     samples_per_cycle : int
-        Samples in each cycle (>= 8). [1]
+        Samples in each cycle (at least :data:`~ecofmaps.measured.cycles.MIN_SAMPLES`). [1]
     start_phase : float
         Phase of the first sample, in cycles: 0 starts at the lowest displacement,
         0.25 at zero displacement on the rise. [1]
@@ -112,8 +113,8 @@ def synthetic_recording(
         raise ValueError(
             f"cycles must be >= 1 and match the {ratio.size} aspect ratios; got {cycles!r}"
         )
-    if int(samples_per_cycle) < 8:
-        raise ValueError(f"samples_per_cycle must be >= 8; got {samples_per_cycle!r}")
+    if int(samples_per_cycle) < MIN_SAMPLES:
+        raise ValueError(f"samples_per_cycle must be >= {MIN_SAMPLES}; got {samples_per_cycle!r}")
     if not 0.0 <= sampling_jitter < 0.5:
         raise ValueError(f"sampling_jitter must satisfy 0 <= jitter < 0.5; got {sampling_jitter!r}")
     n = int(samples_per_cycle)

@@ -201,44 +201,144 @@ def maps(quick: bool) -> None:
 
 
 # ---------------------------------------------------------------------------------------
-# loops: analyze_loops on long noisy recordings
+# loops: analyze_loops against a lean NumPy pass, and its peak memory
 # ---------------------------------------------------------------------------------------
 
+SAMPLES_PER_CYCLE = 200
 
-def loops(quick: bool) -> None:
-    """Samples per second of analyze_loops on recordings of 200 samples per cycle.
 
-    Ten simulated cycles of the paper's Example 2 are repeated to length, and fresh noise
-    (1 % of Q*, 0.5 % of Δ*), offsets and a drift are added, so every cycle differs. The
-    best of ``repeats`` calls is kept; the median GICoF against μ = 0.8 checks the result.
+def loop_recording(cycles: int, seed: int = 0):
+    """A noisy recording of ``cycles`` cycles of 200 samples (Example 2, Section 3).
+
+    Ten simulated cycles are repeated to length, and fresh noise (1 % of Q*, 0.5 % of Δ*),
+    offsets and a drift are added in place, a chunk at a time, so that every cycle differs
+    and nothing but the two arrays is held. [m], [N]
     """
-    from ecofmaps.measured.analysis import analyze_loops
     from ecofmaps.measured.synthetic import synthetic_recording
 
     point = dict(amplitude=50e-6, load=LOAD, stiffness=35e6, mu=MU, aspect_ratio=0.2)
-    samples_per_cycle = 200
-    base_x, base_q = synthetic_recording(**point, cycles=10, samples_per_cycle=samples_per_cycle)
-    sizes = [10**3, 10**4] if quick else [10**3, 10**4, 3 * 10**4]
-    repeats = 2 if quick else 3
-    rng = np.random.default_rng(0)
-    print(f"analyze_loops, {samples_per_cycle} samples per cycle; {load_average()}")
-    print(f"{'cycles':>7} {'samples':>9} {'wall':>7} {'CPU':>7} {'speed':>10} {'GICoF/μ-1':>10}")
-    print(f"{'':>7} {'':>9} {'[s]':>7} {'[s]':>7} {'[sample/s]':>10} {'median':>10}")
+    base = synthetic_recording(**point, cycles=10, samples_per_cycle=SAMPLES_PER_CYCLE)
+    displacement, force = (np.tile(values, cycles // 10) for values in base)
+    rng = np.random.default_rng(seed)
+    chunk = 1 << 20
+    for a in range(0, displacement.size, chunk):
+        b = min(a + chunk, displacement.size)
+        drift = 2e-6 * np.arange(a, b) / displacement.size
+        displacement[a:b] += 0.25e-6 * rng.normal(size=b - a) + 3e-6 + drift
+        force[a:b] += 6.0 * rng.normal(size=b - a) + 5.0
+    return displacement, force
+
+
+def lean_loops(displacement, force, samples_per_cycle=SAMPLES_PER_CYCLE):
+    """The leanest honest per-cycle pass: loop area and amplitude on a (cycle, sample) view.
+
+    The recording is cut every ``samples_per_cycle`` samples (no reversal detection, no
+    centring, no drift); the area is the closed trapezoidal sum, as in analyze_loops.
+    """
+    x = displacement.reshape(-1, samples_per_cycle)
+    q = force.reshape(-1, samples_per_cycle)
+    amplitude = 0.5 * (x.max(axis=1) - x.min(axis=1))
+    closing = (q[:, 0] + q[:, -1]) * (x[:, 0] - x[:, -1])
+    area = 0.5 * (np.einsum("ij,ij->i", q[:, 1:] + q[:, :-1], np.diff(x, axis=1)) + closing)
+    return amplitude, area
+
+
+def _status(key: str) -> int:
+    """A memory figure of this process from /proc/self/status. [B]"""
+    with open("/proc/self/status") as status:
+        for line in status:
+            if line.startswith(key):
+                return int(line.split()[1]) * 1024
+    raise KeyError(key)
+
+
+def memory_child(samples: int, implementation: str) -> None:
+    """Run in a fresh process: peak memory of one analyze_loops call, printed as numbers.
+
+    The recording is made first; the peak resident size (VmHWM) is then reset (Linux
+    ``clear_refs``), so the peak measured is that of the call, on top of the process
+    with its recording.
+    """
+    if implementation == "reference":
+        from tests.measured.reference.analysis import analyze_loops
+    else:
+        from ecofmaps.measured.analysis import analyze_loops
+    displacement, force = loop_recording(samples // SAMPLES_PER_CYCLE)
+    analyze_loops(displacement[:20_000], force[:20_000], LOAD)  # imports and first calls
+    with open("/proc/self/clear_refs", "w") as refs:
+        refs.write("5")  # reset the peak resident size
+    before = _status("VmRSS:")
+    start = time.perf_counter()
+    analyze_loops(displacement, force, LOAD)
+    wall = time.perf_counter() - start
+    print(before, _status("VmHWM:"), displacement.nbytes + force.nbytes, wall)
+
+
+def peak_memory(samples: int, implementation: str = "analyze_loops"):
+    """Resident memory before and at the peak of analyze_loops in a fresh process. [B]"""
+    import subprocess
+
+    command = [sys.executable, __file__, "--memory-child", str(samples), implementation]
+    done = subprocess.run(command, capture_output=True, text=True, check=True)
+    before, peak, size, wall = done.stdout.split()
+    return int(before), int(peak), int(size), float(wall)
+
+
+def loops(quick: bool) -> None:
+    """Samples per second of analyze_loops and of the lean NumPy pass; peak memory.
+
+    Both run alternately on the same recordings (200 samples per cycle, see
+    loop_recording), ``repeats`` times each, best wall and CPU times kept. The lean pass
+    (lean_loops) only computes each cycle's loop area and amplitude on a reshaped view:
+    the floor for any per-cycle analysis in NumPy. The median GICoF against μ = 0.8 and
+    the median difference of the two loop areas check the results. Memory: one call on a
+    large recording in a fresh process (peak_memory), above the memory before the call
+    ("extra") and in all, relative to the recording's two float64 arrays; the frozen
+    padded implementation it replaced (tests/measured/reference) alongside, smaller.
+    """
+    from ecofmaps.measured.analysis import analyze_loops
+
+    sizes = [10**3, 10**4] if quick else [10**3, 10**4, 10**5]
+    repeats = 2 if quick else 5
+    print(f"analyze_loops vs lean NumPy, {SAMPLES_PER_CYCLE} samples per cycle; {load_average()}")
+    header = ("cycles", "samples", "wall", "CPU", "analyze", "analyze", "lean", "lean")
+    print(" ".join(f"{h:>9}" for h in header), f"{'CPU':>7} {'GICoF/μ-1':>10} {'E_d':>8}")
+    units = ("", "", "[s]", "[s]", "wall [/s]", "CPU [/s]", "wall [/s]", "CPU [/s]")
+    print(" ".join(f"{u:>9}" for u in units), f"{'ratio':>7} {'median':>10} {'diff':>8}")
     for cycles in sizes:
-        copies = cycles // 10
-        size = base_x.size * copies
-        displacement = np.tile(base_x, copies) + 0.25e-6 * rng.normal(size=size) + 3e-6
-        displacement += 2e-6 * np.arange(size) / size  # drift
-        force = np.tile(base_q, copies) + 6.0 * rng.normal(size=size) + 5.0
-        best = (math.inf, math.inf)
+        displacement, force = loop_recording(cycles, seed=cycles)
+        size = displacement.size
+        wall = cpu = lean_wall = lean_cpu = math.inf
         for _ in range(repeats):
-            best = min(best, timed(lambda d=displacement, f=force: analyze_loops(d, f, LOAD)))
+            w, c = timed(lambda d=displacement, f=force: analyze_loops(d, f, LOAD))
+            wall, cpu = min(wall, w), min(cpu, c)
+            w, c = timed(lambda d=displacement, f=force: lean_loops(d, f))
+            lean_wall, lean_cpu = min(lean_wall, w), min(lean_cpu, c)
         result = analyze_loops(displacement, force, LOAD)
         error = float(np.median(result.gicof / MU - 1.0))
-        wall, cpu = best
+        area = lean_loops(displacement, force)[1][: result.cycle.size]
+        difference = float(np.median(np.abs(result.dissipated_energy.values / area - 1.0)))
+        row = (result.cycle.size, size, wall, cpu)
         print(
-            f"{result.cycle.size:7d} {size:9.2e} {wall:7.2f} {cpu:7.2f} {size / wall:10.3g} "
-            f"{error:+10.1e}"
+            f"{row[0]:9d} {row[1]:9.2e} {row[2]:9.3f} {row[3]:9.3f} {size / wall:9.3g} "
+            f"{size / cpu:9.3g} {size / lean_wall:9.3g} {size / lean_cpu:9.3g} "
+            f"{cpu / lean_cpu:7.1f} {error:+10.1e} {difference:8.1e}"
+        )
+    print("peak resident memory of one call, in a fresh process (reset after the recording)")
+    header = ("", "samples", "input", "extra", "extra/", "peak/", "speed")
+    print(f"{header[0]:>20}", " ".join(f"{h:>9}" for h in header[1:]))
+    units = ("", "", "[MiB]", "[MiB]", "input", "input", "wall [/s]")
+    print(f"{units[0]:>20}", " ".join(f"{u:>9}" for u in units[1:]))
+    large = 2 * 10**6 if quick else 10**8
+    for name, implementation, samples in (
+        ("analyze_loops", "analyze_loops", large),
+        ("reference (padded)", "reference", large if quick else 2 * 10**7),
+    ):
+        before, peak, size, wall = peak_memory(samples, implementation)
+        extra = peak - before
+        print(
+            f"{name:>20} {samples:9.2e} {size / 2**20:9.0f} {extra / 2**20:9.0f} "
+            f"{extra / size:9.2f} {peak / size:9.2f} {samples / wall:9.3g}"
         )
 
 
@@ -457,7 +557,11 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="small sizes, a few seconds")
     parser.add_argument("--only", nargs="+", choices=list(SECTIONS), help="run only these")
+    parser.add_argument("--memory-child", nargs=2, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.memory_child:  # a fresh process of peak_memory
+        memory_child(int(args.memory_child[0]), args.memory_child[1])
+        return 0
     for name in args.only or SECTIONS:
         print(f"== {name} ==")
         SECTIONS[name](args.quick)

@@ -5,7 +5,6 @@ the outcome: the exit status, the one-line message naming the option or file, th
 files unchanged and no output left behind.
 """
 
-import contextlib
 import os
 import signal
 import subprocess
@@ -153,11 +152,7 @@ def interrupted_run(command, wait_for: str, delay: float, env=None):
 
 @pytest.mark.parametrize("delay", [0.0, 0.2])
 def test_ctrl_c_exits_130_with_one_line_and_leaves_no_output(tmp_path, delay):
-    """Ctrl-C during a map run: status 130, one line, no output file.
-
-    JAX runs a garbage-collector callback in which Python swallows a KeyboardInterrupt;
-    the run must stop all the same.
-    """
+    """Ctrl-C during a map run: status 130, one line, no output file."""
     out = tmp_path / "m.nc"
     command = [
         sys.executable, "-m", "ecofmaps.cli", "map", "--stiffness-ratio", "0.01/um:0.3/um:1500",
@@ -182,20 +177,30 @@ def test_ctrl_c_during_figures_keeps_whole_files_only(tmp_path):
         assert path.suffix == ".png" and path.read_bytes().endswith(b"IEND\xaeB`\x82")
 
 
-def test_interrupted_writes_do_not_land_even_when_the_interrupt_was_swallowed(tmp_path):
-    """An interrupt Python swallowed (in a gc callback) still stops every atomic write."""
-    from ecofmaps._interrupts import interrupts_stop_writes
+def test_the_first_ctrl_c_stops_writes_at_the_next_safe_point(tmp_path):
+    """The first Ctrl-C only sets a flag (raising inside JAX's extensions would crash them):
+    the next atomic write raises instead of landing, and so does leaving the block."""
+    from ecofmaps._interrupts import check_interrupted, interrupts_stop_writes
     from ecofmaps.io.files import atomic_path
 
     path = tmp_path / "out.txt"
     with pytest.raises(KeyboardInterrupt), interrupts_stop_writes() as interrupted:
-        with contextlib.suppress(KeyboardInterrupt):  # swallowed, as Python does in a gc callback
-            signal.raise_signal(signal.SIGINT)
+        signal.raise_signal(signal.SIGINT)  # returns: nothing raised yet
         assert interrupted.is_set()
-        with atomic_path(path) as temporary:
+        with pytest.raises(KeyboardInterrupt), atomic_path(path) as temporary:
             temporary.write_text("half")
-    assert list(tmp_path.iterdir()) == []
-    # Outside the block, writes work again.
-    with atomic_path(path) as temporary:
+        assert list(tmp_path.iterdir()) == []
+    assert interrupted.is_set()
+    check_interrupted()  # outside the block: nothing to stop
+    with atomic_path(path) as temporary:  # and writes work again
         temporary.write_text("whole")
     assert path.read_text() == "whole"
+
+
+def test_a_second_ctrl_c_stops_at_once():
+    from ecofmaps._interrupts import interrupts_stop_writes
+
+    with pytest.raises(KeyboardInterrupt), interrupts_stop_writes():  # leaving raises too
+        signal.raise_signal(signal.SIGINT)  # the first: a flag
+        with pytest.raises(KeyboardInterrupt):
+            signal.raise_signal(signal.SIGINT)  # the second: at once

@@ -365,3 +365,10 @@ def test_figure_overlays_measured_and_fitted_loops():
         np.testing.assert_allclose(model.get_ydata(), loop_force, rtol=1e-15)
     single = measured_and_fitted_loops(fits["Example 2"])
     assert len([ax for ax in single.axes if ax.get_xlabel()]) == 1
+
+
+def test_rejects_a_cycle_the_analysis_refuses():
+    """A dead force channel: the analysis refuses the cycle, and so does the fit."""
+    displacement, force = measured_loop(**EXAMPLE_2)
+    with pytest.raises(ValueError, match=r"no fretting loop .* constant-force"):
+        fit_loop(displacement, np.full_like(force, 12.5), LOAD)

@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 
 import ecofmaps
 from ecofmaps.measured.analysis import analyze_loops
+from ecofmaps.measured.quality import LoopQualityWarning
 from ecofmaps.measured.resolved import QUALITY_FLAGS, resolve_analyzed_loops, resolve_loops
 from ecofmaps.measured.synthetic import synthetic_recording
 from tests.return_map import return_map
@@ -419,11 +420,13 @@ def rounded_loop(cycles=4, samples=SAMPLES, rounding=15e-6):
 
 
 def test_rounded_loop_is_refused():
-    """A rounded loop is gross slip by its energy ratio and has a GICoF, but no stick lines
-    and no constant friction."""
+    """A rounded loop is gross slip by its energy ratio, but has no stick lines and no
+    constant friction: analyze_loops gives it no GICoF, and resolve_loops no μ."""
     displacement, force = rounded_loop()
-    analysis = analyze_loops(displacement, force, LOAD, keep_loops=True)
-    assert (analysis.regime == "gross slip").all() and analysis.gicof.notnull().all()
+    with pytest.warns(LoopQualityWarning, match="curved-stick"):
+        analysis = analyze_loops(displacement, force, LOAD, keep_loops=True)
+    assert (analysis.regime == "gross slip").all() and analysis.gicof.isnull().all()
+    assert all("curved-stick" in quality for quality in analysis.quality.values)
     assert_flagged(resolve_analyzed_loops(analysis), "curved-stick")
     # Noisy, with a larger rounding: the curvature still shows above the noise.
     rng = np.random.default_rng(4)

@@ -1,0 +1,324 @@
+r"""Measured loops moved to their centres and laid out a block of cycles at a time.
+
+:func:`loop_blocks` hands :func:`ecofmaps.analyze_loops` the cycles of a recording
+(:class:`ecofmaps.measured.cycles.Cycles`) a block at a time, about ``_BLOCK`` samples, so
+that its memory does not grow with the recording: each block is the centred samples of its
+cycles, once, in time order, with where each cycle lies among them (:class:`LoopBlock`).
+Sums over each cycle's samples use ``np.add.reduceat`` over the cycles' boundaries.
+
+Offsets and drift
+-----------------
+Every loop is moved to its centre: the mean of :math:`\Delta` and of :math:`Q` along the
+loop weighted by the displacement travelled, :math:`\oint \Delta\,|d\Delta| / \oint
+|d\Delta|` (trapezoids). For a loop symmetric about a point (the model's steady loop, with
+or without ploughing peaks at both ends of the stroke) that point is the centre, and the
+mean averages the noise of every sample. For cycles cut from one continuous recording, the
+centres are interpolated linearly along the sample index from the middle of one cycle to
+the next and subtracted sample by sample, which also removes a slow drift of
+:math:`\Delta` (or of :math:`Q`) within each cycle; the weights of the force's centre come
+from the displacement so centred. Labelled cycles (possibly recorded far apart) are each
+moved by their own centre.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+from collections.abc import Iterator
+
+import numpy as np
+
+from ecofmaps.measured.cycles import Cycles
+
+__all__ = ["LoopBlock", "loop_blocks"]
+
+#: Samples of the cycles laid out at once by :func:`loop_blocks`.
+_BLOCK = 1 << 17
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class LoopBlock:
+    """The centred loops of a block of consecutive cycles, from :func:`loop_blocks`.
+
+    Attributes
+    ----------
+    rows : slice
+        The cycles of the block (rows of the :class:`Cycles`).
+    displacement, force : numpy.ndarray, shape (samples,)
+        Centred displacement and force of every sample of the block's cycles, once, in
+        time order: each cycle is a stretch of them (cycles cut at the reversals share the
+        sample between them). [m], [N]
+    offset, count, rotation : numpy.ndarray of int64, shape (cycles,)
+        Where each cycle's stretch begins in ``displacement``, its samples, and where its
+        loop begins in it (as for :class:`Cycles`).
+    continuous : bool
+        As for :class:`Cycles`: the segment that closes each loop is not travelled.
+    displacement_centre, force_centre : numpy.ndarray, shape (cycles,)
+        The centres removed. [m], [N]
+    force_swing : numpy.ndarray, shape (cycles,)
+        Range of the force as recorded over each cycle, before centring (a dead channel
+        holds still; centred, its drift correction would make it a ramp). [N]
+    """
+
+    rows: slice
+    displacement: np.ndarray
+    force: np.ndarray
+    offset: np.ndarray
+    count: np.ndarray
+    rotation: np.ndarray
+    continuous: bool
+    displacement_centre: np.ndarray
+    force_centre: np.ndarray
+    force_swing: np.ndarray
+
+    def samples(self, point, rows=slice(None)):
+        """Index into ``displacement`` and ``force`` of points round the loops ``rows``.
+
+        ``point`` (one row per loop) counts from the loop's lowest displacement, 0 to
+        ``count``; ``count`` is the point that closes the loop.
+        """
+        offset, count = self.offset[rows][:, None], self.count[rows][:, None]
+        if self.continuous:  # no rotation: the stretch, then its first sample again
+            return offset + np.where(point < count, point, 0)
+        position = self.rotation[rows][:, None] + point
+        return offset + position - count * (position >= count)
+
+    def loops(self, width: int):
+        """The loops as padded rows (cycle, point) of ``width`` points, NaN past each end."""
+        point = np.minimum(np.arange(width), self.count[:, None])
+        index = self.samples(point)
+        inside = np.arange(width) <= self.count[:, None]
+        return tuple(
+            np.where(inside, values[index], np.nan) for values in (self.displacement, self.force)
+        )
+
+    def sums(self, values):
+        """Sum of ``values[i]`` over each loop's segments from sample i to i + 1 in its stretch."""
+        return _reduce(np.add, values, self.offset, self.offset + self.count - 1)
+
+    def extremes(self, values):
+        """Largest and smallest of ``values`` over each cycle's samples."""
+        return _extremes(values, self.offset, self.count)
+
+    def first_point(self, values, target):
+        """The first point round each loop where ``values`` equals its ``target``.
+
+        Every loop holds its target (its largest value, say).
+        """
+        tiles = np.diff(self.offset, append=values.size)
+        hits = np.flatnonzero(values == np.repeat(target, tiles))
+        begin = self.offset + self.rotation  # where each loop begins
+        after = np.searchsorted(hits, begin)
+        inside = after < hits.size
+        found = inside & (hits[np.minimum(after, hits.size - 1)] < self.offset + tiles)
+        # Else the loop's first hit lies before its beginning (it wraps round), or, for
+        # cycles cut at the reversals, on the sample it shares with the next cycle.
+        wrapped = hits[np.minimum(np.searchsorted(hits, self.offset), hits.size - 1)]
+        hit = np.where(found, hits[np.minimum(after, hits.size - 1)], wrapped)
+        point = hit - begin
+        point = np.where(point < 0, point + self.count, point)
+        if self.continuous:
+            point = np.where(found, point, self.count - 1)
+        return point
+
+
+def _extremes(values, offset, count):
+    """Largest and smallest of ``values`` over each stretch (``offset``, ``count``)."""
+    stop = offset + count
+    return _reduce(np.maximum, values, offset, stop), _reduce(np.minimum, values, offset, stop)
+
+
+def _reduce(ufunc, values, begin, end):
+    """``ufunc`` reduced over ``values[begin[k]:end[k]]`` for each k (ranges in order)."""
+    cuts = np.empty(2 * begin.size, dtype=np.int64)
+    cuts[0::2], cuts[1::2] = begin, end
+    if cuts[-1] >= values.size:
+        return ufunc.reduceat(values, cuts[:-1])[::2]
+    return ufunc.reduceat(values, cuts)[::2]
+
+
+def loop_blocks(
+    cycles: Cycles, displacement, force, rows=None, force_sign=1.0
+) -> Iterator[LoopBlock]:
+    """The loops of ``cycles``, each moved to its centre (module notes), block by block.
+
+    Parameters
+    ----------
+    cycles : Cycles
+        The cycles of the recording.
+    displacement, force : numpy.ndarray
+        The recording the cycles were found in, float64. [m], [N]
+    rows : slice, optional
+        Consecutive cycles to lay out (default all). The centring of cycles cut at the
+        reversals still uses their neighbours.
+    force_sign : float
+        +1, or -1 to read the force with the other sign (without copying the recording).
+
+    Yields
+    ------
+    block : LoopBlock
+        Consecutive cycles, about ``_BLOCK`` samples in all, in order.
+    """
+    first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
+    blocks = _blocks(cycles.count[first:stop] + 1, first)
+    if not cycles.continuous:
+        for block in blocks:
+            yield _labelled_block(cycles, displacement, force, block, force_sign)
+        return
+    start, count = cycles.start, cycles.count
+    size = start.size
+    middle, centre_x = _displacement_centres(cycles, displacement, first, stop)
+    centre_q = np.empty(size)
+    ready = max(first - 1, 0)  # the force's centres are known below this cycle
+    for block in blocks:
+        # The centred values depend on the sample index alone. The force's drift within
+        # the block needs the centres of the cycles on both sides of it.
+        needed = min(block.stop + 1, size)
+        begin, end = min(ready, block.start), max(needed, block.stop)
+        low, high = int(start[begin]), int(start[end - 1] + count[end - 1])
+        x = displacement[low:high] - _drift(
+            low, high, middle, centre_x, slice(max(begin - 1, 0), end + 1)
+        )
+        if ready < needed:
+            cut = slice(ready, needed)
+            centre_q[cut] = _path_means(
+                x, _signed(force[low:high], force_sign), start[cut] - low, count[cut], closed=False
+            )
+            ready = needed
+        a, b = int(start[block.start]), int(start[block.stop - 1] + count[block.stop - 1])
+        near = slice(max(block.start - 1, 0), block.stop + 1)
+        offset = start[block] - a
+        swing = np.subtract(*_extremes(force[a:b], offset, count[block]))
+        yield LoopBlock(
+            rows=block,
+            displacement=x[a - low : b - low],
+            force=_signed(force[a:b], force_sign) - _drift(a, b, middle, centre_q, near),
+            offset=offset,
+            count=count[block],
+            rotation=cycles.rotation[block],
+            continuous=True,
+            displacement_centre=centre_x[block],
+            force_centre=centre_q[block],
+            force_swing=swing,
+        )
+
+
+def _signed(values, sign):
+    """``values``, or ``-values`` if ``sign`` is negative."""
+    return values if sign > 0 else -values
+
+
+def _labelled_block(cycles: Cycles, displacement, force, block: slice, sign) -> LoopBlock:
+    """The loops of labelled cycles, each moved by its own centre."""
+    start, count = cycles.start[block], cycles.count[block]
+    offset = np.concatenate([[0], np.cumsum(count[:-1])])
+    index = np.repeat(start - offset, count) + np.arange(int(count.sum()))
+    x, q = displacement[index], _signed(force[index], sign)
+    swing = np.subtract(*_extremes(q, offset, count))
+    centre_x = _path_means(x, x, offset, count, closed=True)
+    x -= np.repeat(centre_x, count)
+    # The force's weights come from the centred displacement, as for drifting loops.
+    centre_q = _path_means(x, q, offset, count, closed=True)
+    q -= np.repeat(centre_q, count)
+    return LoopBlock(
+        rows=block,
+        displacement=x,
+        force=q,
+        offset=offset,
+        count=count,
+        rotation=cycles.rotation[block],
+        continuous=False,
+        displacement_centre=centre_x,
+        force_centre=centre_q,
+        force_swing=swing,
+    )
+
+
+def _blocks(points: np.ndarray, offset: int) -> Iterator[slice]:
+    """Slices of consecutive rows of about ``_BLOCK`` points in all, such that padding
+    each row to the longest does not more than double that (a long loop among short ones
+    gets a block of its own)."""
+    rows = max(1, _BLOCK // max(int(np.median(points)), 1)) if points.size else 1
+    pending = [(a, min(a + rows, points.size)) for a in range(0, points.size, rows)][::-1]
+    while pending:
+        a, b = pending.pop()
+        if b - a > 1 and (b - a) * int(points[a:b].max()) > 2 * _BLOCK:
+            # A long loop among short ones: split the block rather than pad it.
+            middle = (a + b) // 2
+            pending += [(middle, b), (a, middle)]
+        else:
+            yield slice(a + offset, b + offset)
+
+
+def _path_means(path, values, offset, count, closed: bool):
+    """Mean of ``values`` round each loop weighted by the distance along ``path``.
+
+    The loops are stretches (``offset``, ``count``) of the flat arrays; ``closed`` adds
+    the segment from each stretch's last sample back to its first.
+    """
+    weight = np.abs(np.diff(path))
+    weighted = weight * (0.5 * (values[1:] + values[:-1]))
+    stop = offset + count - 1
+    total = _reduce(np.add, weighted, offset, stop)
+    length = _reduce(np.add, weight, offset, stop)
+    if closed:
+        gap = np.abs(path[offset] - path[stop])
+        total += gap * (0.5 * (values[offset] + values[stop]))
+        length += gap
+    return total / length
+
+
+def _displacement_centres(cycles: Cycles, displacement, first: int, stop: int):
+    """Middle sample of every cycle cut at the reversals, and the displacement centres of
+    cycles ``first - 2`` to ``stop + 1`` (NaN for the others), a block at a time.
+
+    A cycle's path runs over its stretch only: the segment that closes the loop, from the
+    next reversal back to the first sample, is not travelled.
+    """
+    start, count = cycles.start, cycles.count
+    # The mean sample index round the loop, its closing point included (exact integers).
+    middle = ((count * (2 * start + count - 1)) // 2 + start) / (count + 1)
+    centre = np.full(start.size, np.nan)
+    first, stop = max(first - 2, 0), min(stop + 2, start.size)
+    groups = np.flatnonzero(np.diff((start[first:stop] - start[first]) // _BLOCK)) + first + 1
+    for a, b in itertools.pairwise([first, *groups.tolist(), stop]):
+        low, high = int(start[a]), int(start[b - 1] + count[b - 1])
+        x = displacement[low:high]
+        centre[a:b] = _path_means(x, x, start[a:b] - low, count[a:b], closed=False)
+    return middle, centre
+
+
+def _drift(low: int, high: int, points, values, near: slice):
+    """``values`` interpolated over ``points`` at the samples ``low`` to ``high - 1``.
+
+    Piecewise linear, extended linearly beyond the first and last points;
+    ``points[near]`` bracket every sample that lies between two points. Inside, the
+    arithmetic is that of ``np.interp``, bit for bit, on the segments between points.
+    """
+    xp, fp = points[near], values[near]
+    # Sample i lies on segment j when xp[j] <= i < xp[j + 1].
+    edges = np.clip(np.ceil(xp).astype(np.int64), low, high) - low
+    result = np.empty(high - low)
+    result[: edges[0]] = fp[0]
+    result[edges[-1] :] = fp[-1]
+    if xp.size > 1:
+        lengths = np.diff(edges)
+        slope = (fp[1:] - fp[:-1]) / (xp[1:] - xp[:-1])
+        at = np.arange(low + edges[0], low + edges[-1], dtype=np.float64)
+        result[edges[0] : edges[-1]] = np.repeat(slope, lengths) * (
+            at - np.repeat(xp[:-1], lengths)
+        ) + np.repeat(fp[:-1], lengths)
+    if points.size < 2:
+        return result
+    if near.start == 0 and edges[0] > 0:
+        at = np.arange(low, low + edges[0], dtype=np.float64)
+        result[: edges[0]] = values[0] + (at - points[0]) * (values[1] - values[0]) / (
+            points[1] - points[0]
+        )
+    if near.stop >= points.size:
+        at = np.arange(low + edges[-1], high, dtype=np.float64)
+        beyond = at > points[-1]
+        result[edges[-1] :][beyond] = values[-1] + (at[beyond] - points[-1]) * (
+            values[-1] - values[-2]
+        ) / (points[-1] - points[-2])
+    return result
