@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 import textwrap
+import warnings
 from pathlib import Path
 
 from ecofmaps.cli._common import CommandError, quantity, refuse_to_overwrite, unit
@@ -17,16 +18,18 @@ def add(subparsers) -> None:
         "loops",
         help="analyse recorded fretting loops cycle by cycle: ECoF, GICoF, stiffness, ...",
         description=textwrap.fill(
-            "Read recordings of fretting loops (CSV, TSV or whitespace-separated text with a "
-            "header line; lines starting with # are skipped), cut them into cycles at the "
-            "displacement reversals or by a cycle column, and write one row per cycle: "
+            "Read recordings of fretting loops (text with a header line in any common "
+            "dialect, TDMS, HDF5/netCDF-4 or zarr), cut them into cycles at the displacement "
+            "reversals or by a cycle column, check every loop, and write one row per cycle: "
             "cycle, amplitude_um, slip_amplitude_um, max_force_N, dissipated_energy_mJ, ecof, "
-            "cof_max, energy_ratio, stiffness_MN_per_m, gicof, regime (and first a file "
-            "column when several files are given). By default the columns are "
-            "'displacement' in um and 'force' in N, with an optional 'cycle'. A damaged file "
-            "stops the command with its name and line number, and nothing is written; files "
-            "are written atomically. --example analyses the synthetic recording shipped with "
-            "ecofmaps.",
+            "cof_max, energy_ratio, stiffness_MN_per_m, gicof, regime, then mu_resolved, "
+            "mu_resolved_se and aspect_ratio (friction and groove read along the whole "
+            "stroke) and quality ('ok', or why values are NaN); first a file column when "
+            "several files are given. By default the columns are 'displacement' and 'force' "
+            "(units from their names or the file, else um and N), with an optional 'cycle'. "
+            "A damaged file stops the command with its name and line number, and nothing is "
+            "written; files are written atomically and never over an input. --example "
+            "analyses the synthetic recording shipped with ecofmaps.",
             width=80,
         ),
         epilog=(
@@ -52,8 +55,24 @@ def add(subparsers) -> None:
     )  # fmt: skip
     parser.add_argument(
         "--plots", default=None, metavar="DIR",
-        help="also write, per file, its loops with the line Q = SΔ (<name>_loops.png) and "
-        "the ECoF and GICoF over the cycles (<name>_evolution.png) into DIR",
+        help="also write, per file, its loops with the line Q = SΔ (<name>_loops.png), "
+        "the ECoF and GICoF over the cycles (<name>_evolution.png) and the loops read along "
+        "the stroke (<name>_resolved.png) into DIR",
+    )  # fmt: skip
+    parser.add_argument(
+        "--resolved", default=None, metavar="FILE.nc",
+        help="also write the loops read along the stroke (one FILE): μ(ξ), the groove slope "
+        "g(ξ) and the felt profile h(ξ) over (cycle, position), a netCDF file",
+    )  # fmt: skip
+    parser.add_argument(
+        "--no-resolve", action="store_true",
+        help="skip the reading along the stroke (about ten times faster; no mu_resolved, "
+        "mu_resolved_se, aspect_ratio)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--flip-force", action="store_true",
+        help="read the force with the other sign (a rig recording it positive against the "
+        "displacement: its loops run anticlockwise)",
     )  # fmt: skip
     parser.add_argument(
         "--displacement-col", default="displacement", metavar="NAME",
@@ -93,13 +112,58 @@ def _plot_names(paths) -> list[str]:
     ]
 
 
+def _analysed(path, recording, load, args, resolved_file: bool):
+    """The analysis of one recording, its reading along the stroke, and its warnings."""
+    from ecofmaps.measured.analysis import analyze_loops
+    from ecofmaps.measured.resolved import resolve_analyzed_loops, with_resolved
+
+    plots = args.plots is not None
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            results = analyze_loops(
+                recording.displacement,
+                recording.force,
+                load,
+                cycle=recording.cycle,
+                flip_force=args.flip_force,
+                keep_loops=plots or not args.no_resolve,
+            )
+        except ValueError as error:
+            raise recording.error(str(error)) from None
+        resolved = None
+        if not args.no_resolve:
+            positions = 201 if plots or resolved_file else None
+            resolved = resolve_analyzed_loops(results, positions=positions)
+            results = with_resolved(results, resolved)
+    for warning in caught:  # one line each, naming the file, not a Python source line
+        print(f"ecofmaps loops: warning: {path.name}: {warning.message}", file=sys.stderr)
+    return results, resolved
+
+
+def _summary(path, results) -> str:
+    """One line on a recording's cycles: counts, the quality, the friction over the test."""
+    gross = results.where(results.regime == "gross slip", drop=True)
+    summary = f"  {path.name}: {results.attrs['quality_summary']}"
+    if results.attrs["incomplete_cycles"]:
+        summary += f" ({results.attrs['incomplete_cycles']} incomplete dropped)"
+    if gross.cycle.size and gross.gicof.notnull().any():
+        summary += f"; GICoF median {float(gross.gicof.median()):.4f}"
+    if "mu_resolved" in gross and gross.mu_resolved.notnull().any():
+        summary += f", μ read along the stroke median {float(gross.mu_resolved.median()):.4f}"
+    ecof = gross.ecof.dropna("cycle") if gross.cycle.size else gross.ecof
+    if ecof.size:
+        summary += f"; ECoF {float(ecof[0]):.4f} (first) to {float(ecof[-1]):.4f} (last)"
+    return summary
+
+
 def run(args) -> int:
     import pandas as pd
 
     from ecofmaps.io.files import write_text
     from ecofmaps.io.recordings import read_recording
     from ecofmaps.io.tables import results_table
-    from ecofmaps.measured.analysis import analyze_loops
+    from ecofmaps.maps.cache import write_netcdf
     from ecofmaps.measured.synthetic import EXAMPLE, example_path
 
     if args.example == bool(args.files):
@@ -118,18 +182,25 @@ def run(args) -> int:
         for other, other_name in named[:index]:
             if name == other_name:
                 raise CommandError(f"{other} and {option} name the same column {name!r}")
-    if args.out is not None and not Path(args.out).parent.is_dir():
-        raise CommandError(f"cannot write {args.out}: its directory does not exist")
+    if args.resolved is not None:
+        if args.no_resolve:
+            raise CommandError("--resolved writes the reading along the stroke; not --no-resolve")
+        if len(paths) > 1:
+            raise CommandError("--resolved writes the reading of one recording: give one FILE")
+    for option, target in (("--out", args.out), ("--resolved", args.resolved)):
+        if target is not None and not Path(target).parent.is_dir():
+            raise CommandError(f"cannot write {target} ({option}): its directory does not exist")
+    kinds = ("loops", "evolution") + (() if args.no_resolve else ("resolved",))
     plots = (
         []
         if args.plots is None
         else [
             ("--plots", Path(args.plots) / f"{name}_{kind}.png")
             for name in _plot_names(paths)
-            for kind in ("loops", "evolution")
+            for kind in kinds
         ]
     )
-    refuse_to_overwrite([("--out", args.out), *plots], paths)
+    refuse_to_overwrite([("--out", args.out), ("--resolved", args.resolved), *plots], paths)
     analyses = []
     for path in paths:
         recording = read_recording(
@@ -142,48 +213,35 @@ def run(args) -> int:
             group=args.group,
             nan_policy="raise",
         )
-        try:
-            results = analyze_loops(
-                recording.displacement,
-                recording.force,
-                load,
-                cycle=recording.cycle,
-                keep_loops=args.plots is not None,
-            )
-        except ValueError as error:
-            raise recording.error(str(error)) from None
-        analyses.append(results)
-    tables = [results_table(results) for results in analyses]
+        analyses.append(_analysed(path, recording, load, args, args.resolved is not None))
+    tables = [results_table(results) for results, _ in analyses]
     if len(paths) > 1:
         for path, table in zip(paths, tables, strict=True):
             table.insert(0, "file", str(path))
     text = pd.concat(tables).to_csv(index=False, float_format="%.6g", lineterminator="\n")
     if args.plots is not None:
-        from ecofmaps.figures import cof_evolution, measured_loops, save_figure
+        from ecofmaps.figures import cof_evolution, measured_loops, resolved_loops, save_figure
 
         folder = Path(args.plots)
         folder.mkdir(parents=True, exist_ok=True)
-        for name, results in zip(_plot_names(paths), analyses, strict=True):
-            save_figure(measured_loops(results), folder / f"{name}_loops.png")
+        for name, (results, resolved) in zip(_plot_names(paths), analyses, strict=True):
+            save_figure(measured_loops(results, resolved=resolved), folder / f"{name}_loops.png")
             save_figure(cof_evolution(results), folder / f"{name}_evolution.png")
+            if resolved is not None:
+                save_figure(resolved_loops(resolved, results), folder / f"{name}_resolved.png")
+    if args.resolved is not None:
+        write_netcdf(analyses[0][1], args.resolved)
     if args.out is None:
         sys.stdout.write(text)
+        for path, (results, _) in zip(paths, analyses, strict=True):
+            print(_summary(path, results).strip(), file=sys.stderr)
         return 0
     write_text(args.out, text)
     print(f"wrote {args.out}: {sum(len(table) for table in tables)} cycles")
-    for path, results in zip(paths, analyses, strict=True):
-        gross = results.where(results.regime == "gross slip", drop=True)
-        summary = f"  {path.name}: {results.cycle.size} cycles"
-        if results.attrs["incomplete_cycles"]:
-            summary += f" ({results.attrs['incomplete_cycles']} incomplete dropped)"
-        if gross.cycle.size:
-            summary += (
-                f"; GICoF median {float(gross.gicof.median()):.4f}, ECoF "
-                f"{float(gross.ecof[0]):.4f} (first) to {float(gross.ecof[-1]):.4f} (last)"
-            )
-        if gross.cycle.size < results.cycle.size:
-            summary += f"; {results.cycle.size - gross.cycle.size} in partial slip"
-        print(summary)
+    for path, (results, _) in zip(paths, analyses, strict=True):
+        print(_summary(path, results))
+    if args.resolved is not None:
+        print(f"  the loops read along the stroke in {args.resolved}")
     if args.plots is not None:
         print(f"  plots in {args.plots}")
     return 0

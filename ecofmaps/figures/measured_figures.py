@@ -31,7 +31,9 @@ def _evenly_spread(labels, count: int) -> list:
     return [labels[i] for i in picks]
 
 
-def measured_loops(results: xr.Dataset, cycles=None, columns: int = 3) -> Figure:
+def measured_loops(
+    results: xr.Dataset, cycles=None, columns: int = 3, resolved: xr.Dataset | None = None
+) -> Figure:
     r"""Measured loops, each with the line :math:`Q = S\Delta` and its two GICoF crossings.
 
     Parameters
@@ -43,13 +45,19 @@ def measured_loops(results: xr.Dataset, cycles=None, columns: int = 3) -> Figure
         recording, the first and the last included.
     columns : int
         Panels per row.
+    resolved : xarray.Dataset, optional
+        From :func:`ecofmaps.resolve_analyzed_loops` of the same ``results``: the part of
+        the stroke it read is shaded.
 
     Returns
     -------
     figure : matplotlib.figure.Figure
         One panel per cycle: the centred loop, :math:`Q` [N] against :math:`\Delta` [µm],
-        the line :math:`Q = S\Delta` with the cycle's stiffness, and the crossings whose
-        :math:`Q/P` is the GICoF.
+        the line :math:`Q = S\Delta` with the cycle's stiffness, the crossings whose
+        :math:`Q/P` is the GICoF, and, with ``resolved``, the band of contact positions
+        :math:`\xi_{min} \le \Delta - Q/S \le \xi_{max}` where both branches were read.
+        The title gives the cycle's GICoF and ECoF (a dash where they are NaN) and its
+        ``quality`` when not ``'ok'``.
 
     Notes
     -----
@@ -71,17 +79,20 @@ def measured_loops(results: xr.Dataset, cycles=None, columns: int = 3) -> Figure
         q = cycle["loop_force"].values
         ax.plot(x, q, color="tab:blue", linewidth=1.2, label="measured loop")
         stiffness = float(cycle["stiffness"])
-        # The line across the loop's height, within its width. [µm]
-        reach = np.nanmax(np.abs(q)) / stiffness * MICRO
-        ends = np.array([max(np.nanmin(x), -reach), min(np.nanmax(x), reach)])
-        ax.plot(
-            ends,
-            stiffness * ends / MICRO,
-            color="0.35",
-            linestyle="--",
-            linewidth=1.0,
-            label=r"$Q = S\Delta$",
-        )
+        if np.isfinite(stiffness) and stiffness > 0:
+            # The line across the loop's height, within its width. [µm]
+            reach = np.nanmax(np.abs(q)) / stiffness * MICRO
+            ends = np.array([max(np.nanmin(x), -reach), min(np.nanmax(x), reach)])
+            ax.plot(
+                ends,
+                stiffness * ends / MICRO,
+                color="0.35",
+                linestyle="--",
+                linewidth=1.0,
+                label=r"$Q = S\Delta$",
+            )
+        if resolved is not None:
+            _resolved_band(ax, resolved.sel(cycle=label), q)
         crossings = np.array(
             [
                 float(cycle["crossing_displacement_forward"]),
@@ -103,13 +114,14 @@ def measured_loops(results: xr.Dataset, cycles=None, columns: int = 3) -> Figure
         ax.axvline(0.0, color="0.7", linewidth=0.6)
         ax.grid(alpha=0.3)
         reading = (
-            f"GICoF {float(cycle['gicof']):.3f}, ECoF {float(cycle['ecof']):.3f}"
+            f"GICoF {_number(cycle['gicof'])}, ECoF {_number(cycle['ecof'])}"
             if cycle["regime"] == "gross slip"
             else "no GICoF or ECoF"
         )
+        quality = str(cycle["quality"].values) if "quality" in cycle else "ok"
+        state = str(cycle["regime"].values) + ("" if quality == "ok" else f"; {quality}")
         ax.set_title(
-            f"cycle {label}: {reading}\n"
-            f"S = {stiffness * MEGA:.1f} MN/m, {cycle['regime'].values!s}",
+            f"cycle {label}: {reading}\nS = {_number(stiffness * MEGA, '.1f')} MN/m, {state}",
             fontsize="small",
         )
     for ax in axes.flat[len(chosen) :]:
@@ -125,6 +137,30 @@ def measured_loops(results: xr.Dataset, cycles=None, columns: int = 3) -> Figure
         fontsize="medium",
     )
     return figure
+
+
+def _number(value, form: str = ".3f") -> str:
+    """``value`` formatted, or a dash where it is NaN."""
+    value = float(value)
+    return format(value, form) if np.isfinite(value) else "–"
+
+
+def _resolved_band(ax, cycle: xr.Dataset, q) -> None:
+    """Shade the contact positions ξ_min <= Δ - Q/S <= ξ_max that were read along the stroke."""
+    low, high = float(cycle["position_min"]), float(cycle["position_max"])
+    if not (np.isfinite(low) and np.isfinite(high)):
+        return
+    force = np.linspace(np.nanmin(q), np.nanmax(q), 2)
+    compliance = 1.0 / float(cycle["stiffness"])
+    ax.fill_betweenx(
+        force,
+        (low + compliance * force) * MICRO,
+        (high + compliance * force) * MICRO,
+        color="tab:green",
+        alpha=0.12,
+        linewidth=0,
+        label="read along the stroke",
+    )
 
 
 def cof_evolution(results: xr.Dataset) -> Figure:

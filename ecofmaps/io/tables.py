@@ -28,6 +28,10 @@ RESULT_QUANTITIES = (
     "stiffness",
     "gicof",
     "regime",
+    "mu_resolved",
+    "mu_resolved_se",
+    "aspect_ratio",
+    "quality",
 )
 
 #: The table's column names, in order.
@@ -45,13 +49,16 @@ def results_table(results: xr.Dataset) -> pd.DataFrame:
     Returns
     -------
     table : pandas.DataFrame
-        Exactly the columns of :data:`RESULT_COLUMNS`: cycle, amplitude_um,
+        The columns of :data:`RESULT_COLUMNS` that ``results`` holds: cycle, amplitude_um,
         slip_amplitude_um, max_force_N, dissipated_energy_mJ, ecof, cof_max,
-        energy_ratio, stiffness_MN_per_m, gicof, regime.
+        energy_ratio, stiffness_MN_per_m, gicof, regime, then (with ``resolve=True``)
+        mu_resolved, mu_resolved_se, aspect_ratio, and quality.
     """
     columns = {}
     for name, column in zip(RESULT_QUANTITIES, RESULT_COLUMNS, strict=True):
+        if name not in results:
+            continue
         values = results[name].values
-        numeric = np.issubdtype(values.dtype, np.number) and name not in ("cycle", "regime")
+        numeric = np.issubdtype(values.dtype, np.number) and name != "cycle"
         columns[column] = nomenclature.display(name, values) if numeric else values
     return pd.DataFrame(columns)

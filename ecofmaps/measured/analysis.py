@@ -387,6 +387,7 @@ def analyze_loops(
     crossing_window=0.7,
     gross_slip_threshold=GROSS_SLIP_THRESHOLD,
     flip_force=False,
+    resolve=False,
     keep_loops=False,
 ) -> xr.Dataset:
     r"""Per-cycle friction quantities of a recording of fretting loops, each checked.
@@ -420,6 +421,10 @@ def analyze_loops(
         Read the force with the other sign: for a rig whose force is recorded positive
         against the displacement (its loops run anticlockwise, with stick sides sloping
         down).
+    resolve : bool
+        Also read each loop along the stroke (:func:`ecofmaps.resolve_loops`) and add
+        ``mu_resolved``, ``mu_resolved_se`` and ``aspect_ratio`` (the equivalent parabolic
+        groove), with that reading's reasons in ``quality``. About ten times the work.
     keep_loops : bool
         Also return the centred loops, ``loop_displacement`` and ``loop_force`` over
         ``(cycle, point)`` (NaN-padded), for plotting.
@@ -436,8 +441,9 @@ def analyze_loops(
         mean square displacement off the stick lines) and quality ('ok', or why values
         are NaN: :mod:`ecofmaps.measured.quality`); the load is a scalar coordinate. The
         attributes ``incomplete_cycles`` and ``dropped_samples`` count what was dropped;
-        ``quality_summary`` is one line on what was flagged. ``results.to_dataframe()``
-        gives a table.
+        ``quality_summary`` is one line on what was flagged. With ``resolve``, also
+        mu_resolved, mu_resolved_se and aspect_ratio. ``results.to_dataframe()`` gives a
+        table.
 
     Raises
     ------
@@ -486,7 +492,8 @@ def analyze_loops(
             f"too few samples for one cycle: no complete cycle in {x.size} samples "
             "(the loop does not close, or the recording does not oscillate)"
         )
-    values, flags, loops = measure_cycles(cycles, x, q, load, keep_loops=keep_loops, **options)
+    kept = keep_loops or resolve  # the reading along the stroke reads the kept loops
+    values, flags, loops = measure_cycles(cycles, x, q, load, keep_loops=kept, **options)
     _check_units(values["amplitude"])
     quality = quality_strings(flags, cycles.label.size)
     summary = quality_summary(quality)
@@ -511,7 +518,7 @@ def analyze_loops(
     data["stick_residual"] = ("cycle", values["stick_residual"], _attrs("stick_residual"))
     data["quality"] = ("cycle", quality, _attrs("quality"))
     coords = {"cycle": ("cycle", cycles.label, _attrs("cycle")), "load": ((), load, _attrs("load"))}
-    if keep_loops:
+    if kept:
         data["loop_displacement"] = (("cycle", "point"), loops[0], _attrs("loop_displacement"))
         data["loop_force"] = (("cycle", "point"), loops[1], _attrs("loop_force"))
         coords["point"] = ("point", np.arange(loops[0].shape[1]), _attrs("point"))
@@ -524,7 +531,19 @@ def analyze_loops(
         "flip_force": int(options["flip_force"]),
         "quality_summary": summary,
     }
-    return xr.Dataset(data, coords=coords, attrs=attrs)
+    results = xr.Dataset(data, coords=coords, attrs=attrs)
+    if resolve:
+        results = _with_resolved(results)
+    if not keep_loops:
+        results = results.drop_vars(["loop_displacement", "loop_force", "point"], errors="ignore")
+    return results
+
+
+def _with_resolved(results: xr.Dataset) -> xr.Dataset:
+    """``results`` with the values read along the stroke, and that reading's quality."""
+    from ecofmaps.measured.resolved import resolve_analyzed_loops, with_resolved  # built on this
+
+    return with_resolved(results, resolve_analyzed_loops(results, positions=None))
 
 
 def _check_units(amplitude):

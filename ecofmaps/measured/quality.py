@@ -19,8 +19,9 @@ column needs no quoting in a CSV file. Each reason names the quantities it leave
 (its *scope*). A reason whose scope is every quantity (:data:`ALL`) refuses the cycle: it
 is not a loop that can be read as recorded, and its ``regime`` is ``'unknown'``. The others
 leave the rest of the cycle's numbers standing; ``'not-gross-slip'`` is the partial-slip
-regime, where the ECoF and the GICoF are not defined. Reasons added by other steps
-(``'few-slip-samples'`` of the stroke-resolved analysis) use :func:`add_reason`.
+regime, where the ECoF and the GICoF are not defined. The last four reasons come from the
+reading along the stroke (:func:`ecofmaps.resolve_loops`, or ``analyze_loops(...,
+resolve=True)``), which adds them with :func:`add_reason` and leaves only its own values NaN.
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ __all__ = [
     "ALL",
     "ANTICLOCKWISE_SHARE",
     "REASONS",
+    "RESOLVED",
     "SEPARATOR",
     "LoopQualityWarning",
     "add_reason",
@@ -65,6 +67,8 @@ _GICOF = (
     "crossing_displacement_backward",
 )
 _SLIP = ("slip_amplitude", "ecof")
+#: The values read along the stroke (:func:`ecofmaps.resolve_loops`).
+RESOLVED = ("mu_resolved", "mu_resolved_se", "aspect_ratio")
 
 #: Every reason a cycle can be flagged for, in the order they are listed in ``quality``:
 #: name -> (what it means, the quantities it leaves NaN).
@@ -100,7 +104,7 @@ REASONS = {
     "negative-slip": ("δ* <= 0: the zero-force crossings in the wrong order", _SLIP),
     "curved-stick": (
         "the stick sides are curved (a polymer, micro-slip): no straight line gives S",
-        ("stiffness", *_GICOF),
+        ("stiffness", *_GICOF, *RESOLVED),
     ),
     "no-crossing": (
         "a branch's crossing with Q = SΔ is not on the measured loop (between its samples, "
@@ -109,11 +113,27 @@ REASONS = {
     ),
     "not-gross-slip": (
         "partial slip: the energy ratio A is not above the threshold",
-        ("ecof", *_GICOF),
+        ("ecof", *_GICOF, *RESOLVED),
+    ),
+    "stiffness-mismatch": (
+        "the stiffness does not fit the stick sides: a given S tilts them beyond the noise, "
+        "or the one fitted on them for the stroke-resolved reading slopes down",
+        RESOLVED,
+    ),
+    "no-overlap": (
+        "no range of contact positions around the loop's centre where both branches slip "
+        "(a slip within the noise)",
+        RESOLVED,
     ),
     "few-slip-samples": (
-        "too few slipping samples to resolve friction along the stroke (resolve_loops)",
-        (),
+        "fewer than eight slipping samples of a branch in the central part of the stroke (a "
+        "sparse or digitised loop): friction cannot be read along the stroke",
+        RESOLVED,
+    ),
+    "mu-varies": (
+        "the friction read along the stroke differs between the inner and the outer half of "
+        "its central part by more than 3 % and four standard errors (not the model's loop)",
+        RESOLVED,
     ),
 }
 

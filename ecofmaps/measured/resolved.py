@@ -86,15 +86,16 @@ and back down the *falling* one.
 Quality
 -------
 A cycle whose numbers cannot be stood behind has NaN for every resolved value and its
-``quality`` says why (the first reason, in this order):
+``quality`` says why. It starts as :func:`~ecofmaps.analyze_loops`'s (see
+:mod:`ecofmaps.measured.quality`): a cycle refused there, in partial slip
+(``'not-gross-slip'``) or with curved stick sides (``'curved-stick'``: a rounded loop, as
+polymers and micro-slip draw) is not read. This reading adds its own reasons (joined with
+``'+'``, in the order of :data:`ecofmaps.measured.quality.REASONS`), the first that applies:
 
-* ``'not-gross-slip'``: :func:`~ecofmaps.analyze_loops` labels it partial slip.
 * ``'stiffness-mismatch'``: the given stiffness tilts the stick sets in :math:`\xi` by
   more than three times the noise :math:`\sigma` over their force span (for Example 2's
-  loops, about 5 % off).
-* ``'curved-stick'``: a stick set is not a straight line, its quadratic term beyond five
-  standard errors (a rounded loop, as polymers and micro-slip draw), or the measured
-  compliance is negative beyond three standard errors.
+  loops, about 5 % off), or the stiffness measured on them slopes down beyond three
+  standard errors.
 * ``'no-overlap'``: no range of :math:`\xi` around the loop's centre where both branches
   slip (a slip within the noise, at the onset of gross slip).
 * ``'few-slip-samples'``: fewer than eight slip samples of either branch in the central
@@ -122,20 +123,22 @@ from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._inputs import check, si_units
 from ecofmaps._interrupts import check_interrupted
 from ecofmaps.measured.analysis import GROSS_SLIP_THRESHOLD, analyze_loops
+from ecofmaps.measured.quality import (
+    ALL,
+    REASONS,
+    RESOLVED,
+    add_reason,
+    has_reason,
+    quality_summary,
+)
 from ecofmaps.measured.resampling import branch_noise, read_branches, sample_weights
 from ecofmaps.measured.stick_slip import masked_median, masked_sum, slip_branches
 
 __all__ = ["resolve_analyzed_loops", "resolve_loops"]
 
 #: Quality flags, in the order they are tested.
-QUALITY_FLAGS = (
-    "not-gross-slip",
-    "stiffness-mismatch",
-    "curved-stick",
-    "no-overlap",
-    "few-slip-samples",
-    "mu-varies",
-)
+#: The reasons this reading adds to a cycle's ``quality`` (ecofmaps.measured.quality).
+QUALITY_FLAGS = ("stiffness-mismatch", "no-overlap", "few-slip-samples", "mu-varies")
 
 #: μ(ξ) varies along the stroke when the means over the inner and the outer half of the
 #: central part differ by this share of μ and by this many standard errors.
@@ -260,18 +263,29 @@ def _along_stroke(forward, backward, grid, lowest, highest, tilt, load, level):
 _ALONG = ("mu", "slope", "profile", "force_forward", "force_backward")
 
 
+def _reaches_resolved(quality) -> np.ndarray:
+    """True for the cycles whose ``quality`` lists a reason that leaves the resolved values NaN."""
+    reaching = [
+        r for r, (_, scope) in REASONS.items() if scope == ALL or set(RESOLVED) & set(scope)
+    ]
+    return np.logical_or.reduce([has_reason(quality, reason) for reason in reaching])
+
+
 def _blocks(cycles):
     """Slices of at most ``_BLOCK`` cycles: the arrays of a block stay in the cache."""
     return [slice(start, start + _BLOCK) for start in range(0, max(cycles, 1), _BLOCK)]
 
 
-def _resolve(x, q, valid, load, stiffness, amplitude, gross, given, options):
+def _resolve(x, q, valid, load, stiffness, amplitude, quality, given, options):
     """Every resolved quantity of the centred loops ``x``, ``q`` (module notes).
 
-    ``stiffness`` is the given S (``given`` True) or analyze_loops's, per cycle. Returns
-    the per-position and per-cycle arrays, the quality and the grid. The work is done
-    on blocks of cycles, each block vectorised.
+    ``stiffness`` is the given S (``given`` True) or analyze_loops's, per cycle, and
+    ``quality`` analyze_loops's: a cycle it flags for a reason that reaches the resolved
+    values is not read. Returns the per-position and per-cycle arrays, the quality (with
+    this reading's reasons added) and the grid. The work is done on blocks of cycles, each
+    block vectorised.
     """
+    inherited = _reaches_resolved(quality)
     cycles = x.shape[0]
     parts = []
     for block in _blocks(cycles):
@@ -288,7 +302,7 @@ def _resolve(x, q, valid, load, stiffness, amplitude, gross, given, options):
         )
         lowest, highest = part["lowest"], part["highest"]
         overlap = (lowest < 0.0) & (highest > 0.0)
-        usable = gross[block] & ~part["mismatch"] & ~part["curved"] & overlap
+        usable = ~inherited[block] & ~part["mismatch"] & overlap
         central = np.where(usable, options["central"] * np.minimum(highest, -lowest), np.nan)
         values = _central_values(part["forward"], part["backward"], central, load)
         samples = [
@@ -296,16 +310,18 @@ def _resolve(x, q, valid, load, stiffness, amplitude, gross, given, options):
             for xs, _, _ in (part["forward"], part["backward"])
         ]
         few = (np.minimum(*samples) < _SLIP_SAMPLES) | ~np.isfinite(values[0])
-        reasons = (~gross[block], part["mismatch"], part["curved"], ~overlap, few, values[5])
-        part["quality"] = np.select(reasons, QUALITY_FLAGS, "ok")
+        flags = (part["mismatch"], ~overlap, few, values[5])
+        part["flags"] = np.where(inherited[block], 0, np.select(flags, range(1, 5), 0))
         part["values"] = values
         parts.append(part)
 
     def joined(name):
         return np.concatenate([part[name] for part in parts])
 
-    quality = joined("quality")
-    ok = quality == "ok"
+    flag = joined("flags")
+    for code, reason in enumerate(QUALITY_FLAGS, start=1):
+        quality = add_reason(quality, flag == code, reason)
+    ok = ~inherited & (flag == 0)
     lowest, highest = joined("lowest"), joined("highest")
     mu_resolved, variance, k, tilt, sensitivity = (
         np.concatenate([part["values"][i] for part in parts]) for i in range(5)
@@ -464,7 +480,7 @@ def resolve_analyzed_loops(
             load,
             np.asarray(rig, dtype=np.float64),
             np.asarray(loops["amplitude"].values, dtype=np.float64),
-            loops["regime"].values == "gross slip",
+            loops["quality"].values,
             given,
             options,
         )
@@ -494,6 +510,32 @@ def resolve_analyzed_loops(
         "stick_window": list(options["stick_window"]),
     }
     return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+#: The per-cycle values of the reading that :func:`ecofmaps.analyze_loops` reports.
+REPORTED = ("mu_resolved", "mu_resolved_se", "aspect_ratio")
+
+
+def with_resolved(results: xr.Dataset, resolved: xr.Dataset) -> xr.Dataset:
+    """``results`` of :func:`ecofmaps.analyze_loops` with the values ``resolved`` read off them.
+
+    Parameters
+    ----------
+    results : xarray.Dataset
+        From :func:`ecofmaps.analyze_loops`.
+    resolved : xarray.Dataset
+        From :func:`resolve_analyzed_loops` of the same ``results``.
+
+    Returns
+    -------
+    results : xarray.Dataset
+        With ``mu_resolved``, ``mu_resolved_se`` and ``aspect_ratio`` added after the other
+        per-cycle values, and ``quality`` (and its summary) with the reading's reasons.
+    """
+    results = results.assign({name: resolved[name] for name in REPORTED})
+    results["quality"] = results["quality"].copy(data=resolved["quality"].values)
+    results.attrs["quality_summary"] = quality_summary(resolved["quality"].values)
+    return results
 
 
 @si_units

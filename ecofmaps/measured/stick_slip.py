@@ -17,9 +17,6 @@ __all__ = ["masked_median", "masked_sum", "slip_branches"]
 #: A given stiffness does not fit when it tilts the stick sets by this many σ.
 _TILT_SPREAD = 3.0
 
-#: A stick set is curved when its quadratic term exceeds this many standard errors.
-_CURVATURE_SIGNIFICANCE = 5.0
-
 #: Fewest samples in a stick set to measure the stiffness, the stick level and the noise.
 _STICK_SAMPLES = 3
 
@@ -92,33 +89,10 @@ def _compliance(x, q, sticks):
     return compliance, np.sqrt(squares / np.maximum(points - 3, 1) / variance)
 
 
-def _curvature(xi, q, stick):
-    """Quadratic term of ξ = a + bu + cu² over a stick set, and its standard error per σ.
+def _stick_and_slip(xi, branches, sticks, floor, slip_threshold):
+    """Noise and the slip of each branch (module notes).
 
-    ``u`` is the force standardised over the set; the quadratic is fitted with the
-    polynomial w = u² - 1 - m₃u orthogonal to 1 and u over the set (m₃ the mean of u³).
-    """
-    count = np.count_nonzero(stick, axis=1)
-    u = np.where(stick, q, 0.0)
-    u -= (np.sum(u, axis=1) / count)[:, None]
-    u *= stick
-    square = u * u
-    u /= np.sqrt(np.sum(square, axis=1) / count)[:, None]
-    np.multiply(u, u, out=square)
-    skew = np.sum(square * u, axis=1) / count
-    w = square - 1.0 - skew[:, None] * u
-    w *= stick
-    norm = np.sum(w * w, axis=1)
-    solvable = (count > _STICK_SAMPLES) & (norm > 0.0)
-    curvature = np.where(solvable, np.sum(w * np.where(stick, xi, 0.0), axis=1) / norm, 0.0)
-    return curvature, 1.0 / np.sqrt(np.where(solvable, norm, 1.0))
-
-
-def _stick_and_slip(xi, q, branches, sticks, floor, slip_threshold, judge=True):
-    """Noise, straightness of the stick sets and the slip of each branch (module notes).
-
-    Returns the noise σ of ξ, whether both stick sets are straight (when ``judge``), and
-    the two slip masks.
+    Returns the noise σ of ξ and the two slip masks.
     """
     # σ from the second differences within the stick sets: a smooth trend of ξ (a rounded
     # loop, a wrong stiffness) hardly enters them, white noise does with variance 6σ².
@@ -129,7 +103,6 @@ def _stick_and_slip(xi, q, branches, sticks, floor, slip_threshold, judge=True):
     sigma = masked_median(second, triples) / _SECOND_DIFFERENCE
     sigma = np.where(np.isfinite(sigma), sigma, 0.0)
     threshold = slip_threshold * sigma + floor
-    straight = np.ones(xi.shape[0], dtype=bool)
     slips = []
     for branch, stick, sign in zip(branches, sticks, (1.0, -1.0), strict=True):
         # The stick level: the set's median, or the reversal's ξ where the set has too few
@@ -137,14 +110,11 @@ def _stick_and_slip(xi, q, branches, sticks, floor, slip_threshold, judge=True):
         judged = np.count_nonzero(stick, axis=1) >= _STICK_SAMPLES
         reversal = np.take_along_axis(xi, np.argmax(branch, axis=1)[:, None], axis=1)[:, 0]
         level = np.where(judged, masked_median(xi, stick), reversal)
-        if judge:
-            curvature, unit_error = _curvature(xi, q, stick)
-            straight &= np.abs(curvature) <= _CURVATURE_SIGNIFICANCE * unit_error * sigma + floor
         # Slip: beyond the threshold, and every later sample of the branch too.
         beyond = np.where(branch, sign * xi, np.inf)
         least = np.minimum.accumulate(beyond[:, ::-1], axis=1)[:, ::-1]
         slips.append(branch & (least > (sign * level + threshold)[:, None]))
-    return sigma, straight, slips
+    return sigma, slips
 
 
 def _sorted_branch(xi, q, slip):
@@ -161,9 +131,10 @@ def _sorted_branch(xi, q, slip):
 def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_threshold):
     """The stiffness, the checks of the stick sets, and the two slip branches (module notes).
 
-    Returns a dict with the compliance and its standard error, ``mismatch`` and
-    ``curved`` (per cycle), the sorted slip branches ``forward`` and ``backward`` and the
-    range ``lowest`` .. ``highest`` where both slip.
+    Returns a dict with the compliance and its standard error, ``mismatch`` (per cycle: a
+    given stiffness that tilts the stick sets, or a measured one that slopes down), the
+    sorted slip branches ``forward`` and ``backward`` and the range ``lowest`` ..
+    ``highest`` where both slip.
     """
     cycles = x.shape[0]
     floor = _ROUNDING * amplitude
@@ -178,7 +149,7 @@ def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_t
     # does the slip start?
     start = np.where(np.isinf(stiffness), 0.0, 1.0 / stiffness)
     xi = x - start[:, None] * q
-    *_, slips = _stick_and_slip(xi, q, branches, windows, floor, slip_threshold, judge=False)
+    _, slips = _stick_and_slip(xi, branches, windows, floor, slip_threshold)
     # The stick sets: from the window's lower share up to a margin before the slip.
     sticks = []
     for share, branch, slip, window in zip(moved, branches, slips, windows, strict=True):
@@ -199,8 +170,8 @@ def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_t
     compliance = np.maximum(compliance, 0.0)
     # Second pass, with the stiffness used and the stick sets.
     xi = x - compliance[:, None] * q
-    sigma, straight, slips = _stick_and_slip(xi, q, branches, sticks, floor, slip_threshold)
-    mismatch = np.zeros(cycles, dtype=bool)
+    sigma, slips = _stick_and_slip(xi, branches, sticks, floor, slip_threshold)
+    mismatch = negative
     if given:  # a stiffness that does not fit the stick sides tilts them in ξ
         tilt, _ = _compliance(xi, q, sticks)
         span = np.max(
@@ -211,7 +182,7 @@ def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_t
             axis=0,
         )
         judged = np.all([np.count_nonzero(s, axis=1) >= _STICK_SAMPLES for s in sticks], axis=0)
-        mismatch = judged & ~(np.abs(tilt) * span <= _TILT_SPREAD * sigma + floor)
+        mismatch = mismatch | judged & ~(np.abs(tilt) * span <= _TILT_SPREAD * sigma + floor)
     forward = _sorted_branch(xi, q, slips[0])
     backward = _sorted_branch(xi, q, slips[1])
     ends = []
@@ -222,7 +193,6 @@ def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_t
         "compliance": compliance,
         "compliance_se": compliance_se,
         "mismatch": mismatch,
-        "curved": negative | ~straight,
         "forward": forward,
         "backward": backward,
         "lowest": np.maximum(ends[0][0], ends[1][0]),

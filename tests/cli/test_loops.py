@@ -1,8 +1,11 @@
 """Recording files and ``ecofmaps loops``: formats, columns, units, damaged files, output."""
 
+import io
+
 import numpy as np
 import pandas as pd
 import pytest
+import xarray as xr
 
 import ecofmaps
 from ecofmaps.cli import main
@@ -12,6 +15,7 @@ from ecofmaps.measured.synthetic import EXAMPLE, example_path, synthetic_recordi
 LOAD = 450.0
 POINT = dict(amplitude=50e-6, load=LOAD, stiffness=35e6, mu=0.8, aspect_ratio=0.2)
 COLUMNS = list(RESULT_COLUMNS)
+RESOLVED_COLUMNS = ("mu_resolved", "mu_resolved_se", "aspect_ratio")
 
 
 @pytest.fixture(scope="module")
@@ -37,9 +41,11 @@ def run(capsys, *arguments):
 
 
 def test_results_table_units(recording):
-    results = ecofmaps.analyze_loops(*recording, LOAD)
+    results = ecofmaps.analyze_loops(*recording, LOAD, resolve=True)
     table = results_table(results)
     assert list(table.columns) == COLUMNS
+    plain = results_table(ecofmaps.analyze_loops(*recording, LOAD))  # without the resolved ones
+    assert list(plain.columns) == [c for c in COLUMNS if c not in RESOLVED_COLUMNS]
     np.testing.assert_allclose(table.amplitude_um, results.amplitude * 1e6, rtol=1e-15)
     np.testing.assert_allclose(table.dissipated_energy_mJ, results.dissipated_energy * 1e3)
     np.testing.assert_allclose(table.stiffness_MN_per_m, results.stiffness / 1e6, rtol=1e-15)
@@ -58,10 +64,18 @@ def test_loops_command(tmp_path, capsys, recording):
     assert f"wrote {out}: 4 cycles" in stdout
     table = pd.read_csv(out)
     assert list(table.columns) == COLUMNS
-    expected = results_table(ecofmaps.analyze_loops(*recording, LOAD))
+    expected = results_table(ecofmaps.analyze_loops(*recording, LOAD, resolve=True))
     np.testing.assert_array_equal(table.cycle, [1, 2, 3, 4])
-    for column in COLUMNS[1:-1]:
+    for column in COLUMNS[1:]:
+        if column in ("regime", "quality"):
+            assert table[column].tolist() == expected[column].tolist()
+            continue
+        if column == "mu_resolved_se":  # noise-free: the rounding of the CSV file's digits
+            assert (table[column] < 1e-4).all() and (expected[column] < 1e-4).all()
+            continue
         np.testing.assert_allclose(table[column], expected[column], rtol=1e-5, err_msg=column)
+    np.testing.assert_allclose(table.mu_resolved, POINT["mu"], rtol=1e-6)
+    assert table.quality.tolist() == ["ok"] * 4
     np.testing.assert_allclose(table.gicof, POINT["mu"], rtol=1e-6)
     np.testing.assert_allclose(table.stiffness_MN_per_m, 35.0, rtol=1e-6)
     assert table.regime.tolist() == ["gross slip"] * 4
@@ -171,3 +185,74 @@ def test_command_errors(tmp_path, capsys, monkeypatch, arguments, message):
     assert status == 2
     assert message in stderr
     assert stderr.count("\n") == 1 and "Traceback" not in stderr
+
+
+# --- the loops read along the stroke, the checks, the sign convention --------------------------
+
+
+def test_resolved_writes_the_reading_along_the_stroke(tmp_path, capsys, recording):
+    """--resolved writes resolve_loops's Dataset; its per-cycle values are the table's."""
+    path = write_csv(tmp_path / "test.csv", *recording)
+    out, resolved = tmp_path / "results.csv", tmp_path / "resolved.nc"
+    status, stdout, _ = run(capsys, path, "--load", "450N", "--out", out, "--resolved", resolved)
+    assert status == 0 and f"the loops read along the stroke in {resolved}" in stdout
+    with xr.open_dataset(resolved, engine="h5netcdf") as stored:
+        stored = stored.load()
+    assert set(stored.dims) == {"cycle", "position"} and stored.position.size == 201
+    table = pd.read_csv(out)
+    np.testing.assert_allclose(table.mu_resolved, stored.mu_resolved, rtol=1e-5)
+    np.testing.assert_allclose(stored.mu.sel(position=0.0, method="nearest"), 0.8, rtol=1e-5)
+
+
+def test_no_resolve_gives_the_fast_table(tmp_path, capsys, recording):
+    path = write_csv(tmp_path / "test.csv", *recording)
+    status, stdout, stderr = run(capsys, path, "--load", "450N", "--no-resolve")
+    assert status == 0
+    header = stdout.splitlines()[0].split(",")
+    assert "mu_resolved" not in header and header[-1] == "quality"
+    assert stderr.startswith("test.csv: 4 cycles: 4 ok")  # the summary, beside the table
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        (["--resolved", "r.nc", "--no-resolve"], "not --no-resolve"),
+        (["--resolved", "no/such/dir/r.nc"], "cannot write no/such/dir/r.nc (--resolved)"),
+    ],
+)
+def test_resolved_option_errors(tmp_path, capsys, monkeypatch, recording, options, message):
+    monkeypatch.chdir(tmp_path)
+    path = write_csv(tmp_path / "test.csv", *recording)
+    status, _, stderr = run(capsys, path, "--load", "450N", *options)
+    assert status == 2 and message in stderr and stderr.count("\n") == 1
+
+
+def test_a_force_recorded_against_the_displacement(tmp_path, capsys, recording):
+    """The other sign convention is refused with the way out; --flip-force reads it."""
+    displacement, force = recording
+    path = write_csv(tmp_path / "flipped.csv", displacement, -force)
+    status, _, stderr = run(capsys, path, "--load", "450N")
+    assert status == 2 and stderr.count("\n") == 1
+    assert "no plausible cycle" in stderr and "anticlockwise" in stderr and "flip" in stderr
+    status, stdout, _ = run(capsys, path, "--load", "450N", "--flip-force")
+    table = pd.read_csv(io.StringIO(stdout))
+    assert status == 0 and table.quality.tolist() == ["ok"] * 4
+    np.testing.assert_allclose(table.gicof, 0.8, rtol=1e-6)
+
+
+def test_flagged_cycles_are_one_line_warnings_and_nan(tmp_path, capsys, recording):
+    """A cycle with a dead force channel: NaN with its reason, one warning line naming the file."""
+    displacement, force = recording
+    force = force.copy()
+    force[200:400] = force[200]  # the second cycle: the channel stuck
+    path = write_csv(tmp_path / "stuck.csv", displacement, force)
+    status, stdout, stderr = run(capsys, path, "--load", "450N")
+    table = pd.read_csv(io.StringIO(stdout))
+    assert status == 0
+    flagged = table[table.quality != "ok"]
+    assert len(flagged) >= 1 and flagged.ecof.isna().all() and flagged.gicof.isna().all()
+    warnings = [line for line in stderr.splitlines() if "warning" in line]
+    assert warnings and all(
+        line.startswith("ecofmaps loops: warning: stuck.csv: ") for line in warnings
+    )
+    assert "Traceback" not in stderr and ".py:" not in stderr

@@ -5,6 +5,7 @@ import pytest
 
 from ecofmaps.figures import cof_evolution, measured_loops, resolved_loops, save_figure
 from ecofmaps.measured.analysis import analyze_loops
+from ecofmaps.measured.quality import add_reason
 from ecofmaps.measured.resolved import resolve_analyzed_loops
 from ecofmaps.measured.synthetic import synthetic_recording
 
@@ -96,8 +97,10 @@ def test_resolved_loops_draws_the_datasets_numbers(results, tmp_path):
 
 def test_resolved_loops_marks_cycles_without_a_value(results):
     partial = results.copy()
-    partial["regime"] = partial["regime"].copy(data=np.where(
-        np.arange(partial.cycle.size) == 2, "partial slip", partial["regime"].values))  # fmt: skip
+    third = np.arange(partial.cycle.size) == 2
+    partial["quality"] = partial["quality"].copy(
+        data=add_reason(partial["quality"].values, third, "not-gross-slip")
+    )
     resolved = resolve_analyzed_loops(partial)
     test = resolved_loops(resolved).axes[3]
     (marks,) = [line for line in test.get_lines() if "no resolved value" in line.get_label()]

@@ -14,8 +14,8 @@ from hypothesis import strategies as st
 
 import ecofmaps
 from ecofmaps.measured.analysis import analyze_loops
-from ecofmaps.measured.quality import LoopQualityWarning
-from ecofmaps.measured.resolved import QUALITY_FLAGS, resolve_analyzed_loops, resolve_loops
+from ecofmaps.measured.quality import REASONS, LoopQualityWarning
+from ecofmaps.measured.resolved import resolve_analyzed_loops, resolve_loops
 from ecofmaps.measured.synthetic import synthetic_recording
 from tests.return_map import return_map
 
@@ -376,8 +376,9 @@ def test_shaped_grooves_with_noise(shaped_loops, name):
 
 def assert_flagged(result, *flags):
     """Every cycle is flagged with one of ``flags``, and all its resolved values are NaN."""
-    assert set(flags) <= set(QUALITY_FLAGS)
-    assert np.isin(result.quality, flags).all(), result.quality.values
+    assert set(flags) <= set(REASONS)
+    for quality in result.quality.values:
+        assert set(quality.split("+")) & set(flags), quality
     for name in ("mu_resolved", "mu_resolved_se", "aspect_ratio", "tilt", "position_min"):
         assert result[name].isnull().all(), name
     for name in ("mu", "slope", "profile", "force_forward", "force_backward"):
@@ -389,7 +390,8 @@ def test_partial_slip_is_not_read():
     """The model with μλ >= 1: the contact sticks, the loop is the line Q = SΔ with noise."""
     point = dict(EXAMPLE_2, stiffness=5e6)
     displacement, force = synthetic_recording(**point, cycles=6, **NOISE, seed=2)
-    assert_flagged(resolve_loops(displacement, force, LOAD), "not-gross-slip")
+    with pytest.warns(LoopQualityWarning, match="not-gross-slip"):
+        assert_flagged(resolve_loops(displacement, force, LOAD), "not-gross-slip")
 
 
 def test_wrong_stiffness_is_refused():
@@ -435,7 +437,8 @@ def test_rounded_loop_is_refused():
     force = force + 2.0 * rng.normal(size=force.size)
     # Where the noise hides the curvature of the stick sides, μ(ξ) still falls towards the
     # ends of the stroke: the branches never run as the model's.
-    assert_flagged(resolve_loops(displacement, force, LOAD), "curved-stick", "mu-varies")
+    with pytest.warns(LoopQualityWarning, match="curved-stick"):  # one of four cycles
+        assert_flagged(resolve_loops(displacement, force, LOAD), "curved-stick", "mu-varies")
 
 
 def test_slip_within_the_noise_is_refused():
@@ -579,3 +582,24 @@ def test_bad_analysis():
     analysis = analyze_loops(displacement, force, LOAD, keep_loops=True)
     with pytest.raises(ValueError, match="central must satisfy"):
         resolve_analyzed_loops(analysis, central=-1.0)
+
+
+def test_analyze_loops_reports_the_resolved_values():
+    """resolve=True adds mu_resolved, mu_resolved_se and aspect_ratio, read off the same loops,
+    and the reading's reasons to quality, which leave only its own values NaN."""
+    displacement, force = synthetic_recording(
+        **EXAMPLE_2, cycles=4, **NOISE, seed=5, samples_per_cycle=200
+    )
+    plain = analyze_loops(displacement, force, LOAD)
+    both = analyze_loops(displacement, force, LOAD, resolve=True)
+    resolved = resolve_loops(displacement, force, LOAD)
+    for name in ("mu_resolved", "mu_resolved_se", "aspect_ratio"):
+        np.testing.assert_array_equal(both[name], resolved[name])
+    xr.testing.assert_identical(
+        both.drop_vars(["mu_resolved", "mu_resolved_se", "aspect_ratio"]), plain
+    )
+    # A sparse loop: the analysis stands, the reading along the stroke cannot be made.
+    displacement, force = synthetic_recording(**EXAMPLE_2, cycles=3, samples_per_cycle=24)
+    sparse = analyze_loops(displacement, force, LOAD, resolve=True)
+    assert all(quality.endswith("few-slip-samples") for quality in sparse.quality.values)
+    assert sparse.mu_resolved.isnull().all() and sparse.gicof.notnull().all()
