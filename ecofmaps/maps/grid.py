@@ -193,10 +193,12 @@ def _split(shape: tuple[int, ...], points: int) -> tuple[int, int]:
 
     The split axis is the first one whose trailing axes hold at most ``points`` points
     together; a block takes one index along the axes before ``k``, ``rows`` consecutive
-    indices along ``k`` and all of the axes after it.
+    indices along ``k`` and all of the axes after it. The blocks along ``k`` are as even as
+    can be, so the last one (padded up to ``rows`` in a tile) wastes little.
     """
     k = next(i for i in range(len(shape)) if math.prod(shape[i + 1 :]) <= points)
-    return k, min(shape[k], max(1, points // math.prod(shape[k + 1 :])))
+    count = -(-shape[k] // max(1, points // math.prod(shape[k + 1 :])))  # blocks along k
+    return k, -(-shape[k] // count)
 
 
 def _tiles(split: tuple[int, int], region):
@@ -303,8 +305,10 @@ def _block_lengths(chunks, shape, dims, split) -> list[int]:
         if chunks < 1:
             raise ValueError(f"{usage}, got {chunks!r}")
         k, rows = _split(shape, int(chunks))
-        if k == split[0] and rows > split[1]:
-            rows -= rows % split[1]  # whole tiles: none is evaluated twice
+        if k == split[0] and rows > split[1]:  # whole tiles: none is evaluated twice
+            tiles = -(-shape[k] // split[1])
+            blocks = -(-tiles // (rows // split[1]))
+            rows = -(-tiles // blocks) * split[1]
         return [1] * k + [rows] + list(shape[k + 1 :])
     unknown = [name for name in chunks if name not in dims]
     if unknown:

@@ -329,8 +329,9 @@ def test_blocks_take_whole_tiles():
     """chunks=N: the blocks of the split axis hold whole tiles, so no tile is evaluated twice."""
     chunked = compute_map(np.geomspace(1e4, 1e5, 100), np.linspace(0, 0.3, 30), 50e-6, 0.8,
                           chunks=1000, max_chunk=120)  # fmt: skip
-    # Tiles of 4 rows (120 points); blocks of 33 rows (990 points) would cut them: 32 rows.
-    assert chunked.ecof_ratio.chunks == ((32, 32, 32, 4), (30,))
+    # Tiles of 4 rows (120 points), 25 of them; blocks of at most 25 rows (balanced: 4 blocks
+    # of at most 33 rows, 990 points) hold 6 whole tiles: 5 blocks of 5 tiles (20 rows).
+    assert chunked.ecof_ratio.chunks == ((20, 20, 20, 20, 20), (30,))
 
 
 @pytest.mark.parametrize(
@@ -405,6 +406,8 @@ def test_tiles_cover_any_region_once(shape, points, data):
     split = grid_module._split(tuple(shape), points)
     k, rows = split
     assert rows * math.prod(shape[k + 1 :]) <= max(points, math.prod(shape[k + 1 :]))
+    count = -(-shape[k] // rows)  # tiles along the split axis: as even as can be
+    assert count * rows - shape[k] < count
     region = []
     for size in shape:
         start = data.draw(st.integers(0, size - 1))
