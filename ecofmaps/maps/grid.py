@@ -3,9 +3,13 @@ r"""Parameter maps: the model over whole grids, as labelled xarray Datasets.
 Each function takes one value or one 1-D array per parameter; the arrays become the
 Dataset's dimensions (in the order of the arguments), the single values its scalar
 coordinates. The grid is evaluated with the dimensionless core of :mod:`ecofmaps.model`
-inside one ``jax.jit`` (broadcasting, float64, no Python loop over points), in regular
-blocks of at most ``max_chunk`` points so that any grid that fits in memory as a result can
-be computed. :func:`compute_map` and :func:`compute_universal_map` keep their results in the
+by a ``jax.jit``-compiled kernel (broadcasting, float64, no Python loop over points), in
+tiles of at most ``max_chunk`` points small enough for the processor's cache, on every
+core, so the cost grows linearly with the grid and the memory needed is that of the results.
+With ``chunks=`` the map is instead a dask-backed Dataset: each block is evaluated from the
+same tiles when it is computed or written (:func:`ecofmaps.maps.write_map`), so a grid far
+beyond memory can be written to disk, and its values equal the in-memory map's to the bit.
+:func:`compute_map` and :func:`compute_universal_map` keep their in-memory results in the
 disk cache (:mod:`ecofmaps.maps.cache`).
 
 As in the paper, the groove half-width is the displacement amplitude, :math:`x_o = \Delta^*`,
