@@ -29,6 +29,7 @@ _PUBLIC = {
         "compute_loops",
         "compute_map",
         "compute_universal_map",
+        "write_map",
     ),
     "ecofmaps.measured": (
         "LoopFit",

@@ -1,8 +1,14 @@
-"""``ecofmaps map``: the model over a grid of test conditions, into a netCDF file."""
+"""``ecofmaps map``: the model over a grid of test conditions, into a netCDF file or zarr store.
+
+A grid of more than ``--chunk-points`` points, and any grid written to a zarr store, is
+computed block by block straight into the output (:func:`ecofmaps.maps.write_map`), with a
+progress bar on a terminal; a smaller one is computed at once and kept in the cache.
+"""
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import sys
 import textwrap
@@ -15,30 +21,50 @@ from ecofmaps.cli._common import CommandError, quantities, quantity
 __all__ = ["add", "run"]
 
 _GRID_HELP = "; one value, a list or a range start:stop:num"
+#: Default of --chunk-points: blocks of 2**22 points (about 220 MB of results with a load).
+_CHUNK_POINTS = 2**22
+
+
+def _points(text: str) -> int:
+    """An argparse ``type``: a whole number of points >= 1 (``4194304``, ``4e6``)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value.is_integer() and value >= 1):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of points >= 1")
+    return int(value)
 
 
 def add(subparsers) -> None:
     parser = subparsers.add_parser(
         "map",
-        help="compute the model over a grid of test conditions into a netCDF file",
+        help="compute the model over a grid of test conditions into a netCDF file or zarr store",
         description=textwrap.fill(
             "Compute the steady-loop quantities of the model (slip amplitude and slip ratio, "
             "energy CoF and its ratio to mu, compliance ratio P/(S*amplitude), regime, and "
             "with --load the dissipated energy and peak force) over a grid, and write them "
-            "as an xarray Dataset to a netCDF file (atomically: an existing file is replaced "
-            "only once the new one is complete). The groove half-width equals the amplitude, "
+            "as an xarray Dataset to a netCDF file, or to a zarr store if --out ends in .zarr "
+            "(atomically: an existing output is replaced only once the new one is complete). "
+            "The groove half-width equals the amplitude, "
             "as in the paper. Each of --stiffness-ratio, --aspect-ratio, --amplitude and --mu "
             "takes one value (a scalar coordinate of the result), a comma-separated list or a "
             "range start:stop:num (num evenly spaced points, both ends included); each list or "
             "range is a dimension, in this order. Values take units (50um, 0.08/um, 450N); a "
-            "bare number is SI. Results are kept in the cache (see 'ecofmaps cache') unless "
-            "--no-cache.",
+            "bare number is SI. A grid of more than --chunk-points points, and any zarr "
+            "store, is computed block by block straight into the output, with a few blocks "
+            "in memory at a time (grids far beyond memory work), and a progress bar on a "
+            "terminal; it is not cached. Smaller grids are kept in the cache (see 'ecofmaps "
+            "cache') unless --no-cache.",
             width=80,
         ),
         epilog=(
             "example (the grid of Figure 11):\n  ecofmaps map --stiffness-ratio 0.01/um:0.3/um:30 "
             "--aspect-ratio 0:0.3:31 \\\n      --amplitude 25um,50um --mu 0.8 --load 450N "
-            "--out fig11.nc"
+            "--out fig11.nc\n"
+            "a billion points, block by block into a zarr store:\n"
+            "  ecofmaps map --stiffness-ratio 0.01/um:0.3/um:25000 --aspect-ratio 0:0.4:20000 "
+            "\\\n      --amplitude 25um,50um --mu 0.8 --out big.zarr"
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -63,12 +89,23 @@ def add(subparsers) -> None:
         help="normal load P [N], one value; adds dissipated_energy [J] and max_force [N]",
     )  # fmt: skip
     parser.add_argument(
-        "--out", required=True, metavar="FILE.nc",
-        help="netCDF file to write (its directory must exist)",
+        "--out", required=True, metavar="FILE.nc|FILE.zarr",
+        help="netCDF file, or zarr store if the name ends in .zarr, to write (its directory "
+        "must exist)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--chunk-points", type=_points, default=_CHUNK_POINTS, metavar="N",
+        help=f"grid points per block (default {_CHUNK_POINTS}); a larger grid is computed "
+        "block by block into --out",
+    )  # fmt: skip
+    parser.add_argument(
+        "--quiet", action="store_true",
+        help="no progress bar (there is none either when standard error is not a terminal)",
     )  # fmt: skip
     parser.add_argument(
         "--no-cache", action="store_true",
-        help="compute afresh and do not store the result in the cache",
+        help="compute afresh and do not store the result in the cache (grids computed "
+        "block by block never are)",
     )  # fmt: skip
     parser.add_argument(
         "--cache-dir", default=None, metavar="DIR",
@@ -78,7 +115,7 @@ def add(subparsers) -> None:
 
 
 def run(args) -> int:
-    from ecofmaps.maps.cache import write_netcdf
+    from ecofmaps.maps.files import ZARR_SUFFIX, write_map
     from ecofmaps.maps.grid import compute_map
     from ecofmaps.model import Regime
 
@@ -96,14 +133,64 @@ def run(args) -> int:
     }
     points = math.prod(values.size for values in grid.values() if np.ndim(values))
     print(f"ecofmaps map: {points:,} points into {out}", file=sys.stderr, flush=True)
-    dataset = compute_map(**grid, load=args.load, cache=not args.no_cache, cache_dir=args.cache_dir)
-    write_netcdf(dataset, out)
+    chunked = out.suffix == ZARR_SUFFIX or points > args.chunk_points
+    if chunked:
+        dataset = compute_map(**grid, load=args.load, chunks=args.chunk_points)
+    else:
+        dataset = compute_map(
+            **grid, load=args.load, cache=not args.no_cache, cache_dir=args.cache_dir
+        )
+    # The summary is computed in the same pass over the blocks as the output.
+    summary = [(dataset.regime == code).sum().data for code in Regime]
+    summary += [dataset.ecof_ratio.min().data, dataset.ecof_ratio.max().data]
+    with _progress(dataset, shown=chunked and not args.quiet and sys.stderr.isatty()):
+        *counts, low, high = write_map(dataset, out, also=summary)
     shape = " x ".join(f"{size} {dim}" for dim, size in dataset.sizes.items()) or "1 point"
     regimes = ", ".join(
-        f"{code.label} {count}" for code in Regime if (count := int((dataset.regime == code).sum()))
+        f"{code.label} {int(count)}" for code, count in zip(Regime, counts, strict=True) if count
     )
     print(f"wrote {out}: {shape}")
     print(f"  regimes: {regimes}")
-    if math.isfinite(low := float(dataset.ecof_ratio.min())):  # NaN-skipping
-        print(f"  ECoF / contact CoF: {low:.6g} to {float(dataset.ecof_ratio.max()):.6g}")
+    if math.isfinite(low := float(low)):  # NaN-skipping
+        print(f"  ECoF / contact CoF: {low:.6g} to {float(high):.6g}")
     return 0
+
+
+@contextlib.contextmanager
+def _progress(dataset, shown: bool):
+    """A progress bar on standard error (points and blocks done, rate, ETA) while in the block.
+
+    It counts the blocks of a chunked map as their dask tasks finish; on an error or
+    Ctrl-C it is cleared, so the error is the last line.
+    """
+    if not shown:
+        yield
+        return
+    from dask.callbacks import Callback
+    from tqdm import tqdm
+
+    from ecofmaps.maps.grid import BLOCK_TASK
+
+    blocks = math.prod(len(c) for c in dataset.regime.chunks)
+    bar = tqdm(
+        total=dataset.regime.size, unit="pt", unit_scale=True, desc="ecofmaps map",
+        file=sys.stderr, dynamic_ncols=True, postfix=f"0/{blocks} blocks",
+    )  # fmt: skip
+    done = 0
+
+    class Blocks(Callback):
+        def _posttask(self, key, result, dsk, state, worker_id):
+            nonlocal done
+            if isinstance(key, tuple) and str(key[0]).startswith(BLOCK_TASK):
+                done += 1
+                bar.set_postfix_str(f"{done}/{blocks} blocks", refresh=False)
+                bar.update(next(iter(result.values())).size)
+
+    try:
+        with Blocks():
+            yield
+    except BaseException:
+        bar.leave = False
+        raise
+    finally:
+        bar.close()

@@ -65,15 +65,79 @@ def figure_11_grid(points: int) -> dict:
     )
 
 
+def closed_forms(xp, stiffness_ratio, aspect_ratio, amplitude, mu, load) -> dict:
+    """The closed forms of compute_map, written once for NumPy (xp=np) and JAX (xp=jnp).
+
+    Eq. 16 (slip ratio d, cancellation-free quadratic root), the corrected eq. 13-15
+    (mu_E/mu = 1 + (1 + mu^2)/mu^2 (artanh(u)/u - 1), u = mu kappa d, with the library's
+    artanh), eq. 12 and eq. 9, over an (S/P, z_o/x_o, amplitude) grid at one mu.
+    """
+    s = stiffness_ratio[:, None, None]
+    a = amplitude[None, None, :]
+    kappa = 2.0 * aspect_ratio[None, :, None]  # x_o = amplitude
+    lam = 1.0 / (s * a)  # P/(S amplitude)
+    mu_kappa = mu * kappa
+    h = mu_kappa + lam * kappa - 1.0
+    d = 2.0 * (1.0 - lam * mu) / (h + 2.0 + xp.sqrt(h * h + 4.0 * lam * kappa * (1.0 + mu * mu)))
+    stick = mu * lam >= 1.0
+    locked = (lam == 0.0) & (mu_kappa >= 1.0)
+    d = xp.where(stick, 0.0, xp.where(locked, xp.nan, d))
+    u = mu_kappa * d
+    slipping = u > 0.0
+    excess = xp.arctanh(u) / xp.where(slipping, u, 1.0) - 1.0
+    ratio = xp.where(slipping, 1.0 + (1.0 + mu * mu) / (mu * mu) * excess, 1.0)
+    ratio = xp.where(d > 0.0, ratio, xp.nan)
+    slope = kappa * d
+    return {
+        "slip_amplitude": a * d,
+        "slip_ratio": d,
+        "ecof": mu * ratio,
+        "ecof_ratio": ratio,
+        "compliance_ratio": lam[:, 0, :],  # over S/P and amplitude, as in compute_map
+        "regime": xp.where(stick, 1, xp.where(locked, 2, 0)).astype(xp.int32),
+        "dissipated_energy": xp.where(stick, 0.0, 4.0 * load * a * d * mu * ratio),
+        "max_force": load * xp.where(stick, 1.0 / lam, (mu + slope) / (1.0 - mu * slope)),
+    }
+
+
+def numpy_map(stiffness_ratio, aspect_ratio, amplitude, mu, load) -> dict:
+    """The leanest honest baseline: the closed forms in plain vectorised NumPy (float64)."""
+    with np.errstate(divide="ignore", invalid="ignore"):  # 1/0 = inf for a rigid rig
+        return closed_forms(np, stiffness_ratio, aspect_ratio, amplitude, mu, load)
+
+
+@functools.cache
+def _jit_closed_forms():
+    import jax
+    import jax.numpy as jnp
+
+    return jax.jit(functools.partial(closed_forms, jnp))
+
+
+def jit_map(stiffness_ratio, aspect_ratio, amplitude, mu, load) -> dict:
+    """The hardware-ish floor: the same closed forms in one jax.jit, float64, as NumPy arrays.
+
+    XLA fuses the formulas into a few passes over the grid and writes the same outputs as
+    compute_map (the grid's arrays, and compliance_ratio over S/P and amplitude); nothing
+    else: no validation, no tiles, no Dataset.
+    """
+    import jax
+
+    with jax.enable_x64(True):
+        values = _jit_closed_forms()(stiffness_ratio, aspect_ratio, amplitude, mu, load)
+        return {name: np.asarray(value) for name, value in values.items()}
+
+
 # Coefficients 1/(2n+1), n = 28..1, of artanh(u)/u - 1 = sum u^(2n)/(2n+1) for |u| < 1/2.
 _SERIES = tuple(1.0 / (2 * n + 1) for n in range(28, 0, -1))
 
 
-def numpy_map(stiffness_ratio, aspect_ratio, amplitude, mu, load) -> dict:
-    """The closed forms of compute_map in plain vectorised NumPy (float64), no JAX.
+def numpy_series_map(stiffness_ratio, aspect_ratio, amplitude, mu, load) -> dict:
+    """The closed forms of compute_map in NumPy, with the model's series for artanh(u)/u - 1.
 
     Eq. 16 (slip ratio d, cancellation-free quadratic root), the corrected eq. 13-15
-    (mu_E/mu with a series for artanh(u)/u - 1 at small u), eq. 12 and eq. 9.
+    (mu_E/mu with a 28-term series for artanh(u)/u - 1 at small u, masked), eq. 12 and
+    eq. 9. Not the leanest NumPy (see numpy_map): kept to compare with earlier reports.
     """
     s = stiffness_ratio[:, None, None]
     a = amplitude[None, None, :]
@@ -141,45 +205,163 @@ def scipy_points(grid: dict, count: int, seed: int = 0) -> list[tuple[dict, dict
     return results
 
 
-def maps(quick: bool) -> None:
-    """Points per second of compute_map (cache off), NumPy and SciPy, and their ratios.
+IMPLEMENTATIONS = {
+    "compute_map": lambda g: compute_map(**g, cache=False),
+    "NumPy lean": lambda g: numpy_map(*_axes(g), MU, LOAD),
+    "NumPy series": lambda g: numpy_series_map(*_axes(g), MU, LOAD),
+    "jit floor": lambda g: jit_map(*_axes(g), MU, LOAD),
+}
 
-    JAX and NumPy run alternately, ``repeats`` times each, and the best wall and CPU times
-    are kept, so both see the same machine load. "compile" is the first call's extra time.
+
+def _axes(grid: dict) -> list[np.ndarray]:
+    return [grid[k] for k in ("stiffness_ratio", "aspect_ratio", "amplitude")]
+
+
+def own_peak_memory() -> int:
+    """This process's peak resident memory, VmHWM. [byte]"""
+    with open("/proc/self/status", encoding="ascii") as status:
+        line = next(line for line in status if line.startswith("VmHWM:"))
+    return int(line.split()[1]) * 1024
+
+
+def one_process(name: str, points: int, repeats: int) -> dict:
+    """Time ``IMPLEMENTATIONS[name]`` on a Figure 11 grid of ``points`` in a fresh process.
+
+    The first call (compilation and all) is followed by ``repeats`` timed calls; the
+    process's peak resident memory (VmHWM) is read at its end.
     """
+    import json
+    import subprocess
+
+    command = [sys.executable, __file__, "--child", name, str(points), str(repeats)]
+    result = subprocess.run(command, capture_output=True, text=True, check=False)
+    if result.returncode:
+        return {"error": result.stderr.strip().splitlines()[-1:]}
+    return json.loads(result.stdout.splitlines()[-1])
+
+
+def _child(name: str, points: int, repeats: int) -> None:
+    import json
+
+    grid = figure_11_grid(points)
+    call = IMPLEMENTATIONS[name]
+    start = time.perf_counter()
+    call(grid)
+    first = time.perf_counter() - start
+    best = math.inf
+    for _ in range(repeats):
+        start = time.perf_counter()
+        call(grid)
+        best = min(best, time.perf_counter() - start)
+    points = math.prod(a.size for a in _axes(grid))
+    print(json.dumps({"points": points, "first": first, "best": best, "peak": own_peak_memory()}))
+
+
+# ecofmaps map run in a fresh interpreter that reports its own peak memory at the end (the
+# child's ru_maxrss would not do: Linux carries the parent's peak over into it at exec).
+_CLI_CHILD = """
+import sys
+from ecofmaps.cli import main
+status = main(sys.argv[1:])
+with open("/proc/self/status", encoding="ascii") as file:
+    peak = next(line for line in file if line.startswith("VmHWM:")).split()[1]
+print(f"status {status} VmHWM {peak}")
+"""
+
+
+def map_into_zarr(points: int, directory: Path) -> dict:
+    """``ecofmaps map --out FILE.zarr`` on a Figure 11-like grid without load, in a subprocess.
+
+    Returns the wall time, the command's peak resident memory (its VmHWM, read by the
+    process itself at the end) and the store's size on disk; the store is removed
+    afterwards.
+    """
+    import shutil
+    import subprocess
+
+    grid = figure_11_grid(points)
+    rows, columns = grid["stiffness_ratio"].size, grid["aspect_ratio"].size
+    out = directory / "bench-map.zarr"
+    command = [
+        sys.executable, "-c", _CLI_CHILD, "map", "--stiffness-ratio",
+        f"0.01/um:0.3/um:{rows}", "--aspect-ratio", f"0:0.4:{columns}", "--amplitude",
+        "25um,50um", "--mu", "0.8", "--quiet", "--out", str(out),
+    ]  # fmt: skip
+    start = time.perf_counter()
+    result = subprocess.run(command, capture_output=True, text=True, check=False)
+    elapsed = time.perf_counter() - start
+    size = sum(f.stat().st_size for f in out.rglob("*") if f.is_file()) if out.exists() else 0
+    shutil.rmtree(out, ignore_errors=True)
+    last = result.stdout.strip().splitlines()[-1:] or [""]
+    if not last[0].startswith("status 0 "):
+        return {"error": result.stderr.strip().splitlines()[-1:]}
+    return {
+        "points": rows * columns * 2,
+        "time": elapsed,
+        "peak": int(last[0].split()[-1]) * 1024,
+        "size": size,
+    }
+
+
+def maps(quick: bool, scratch: Path | None = None) -> None:
+    """compute_map against the lean NumPy, the NumPy with the series, a minimal jax.jit.
+
+    1. Warm, in this process: the implementations run alternately, ``repeats`` times each,
+       and the best wall and CPU times are kept, so all see the same machine load; the
+       largest relative difference between them checks the values. "compile" is the
+       first call's extra time. Then SciPy per point, and the small-grid overhead.
+    2. Large grids, each implementation in a fresh process: best of 2 after a first call,
+       and the process's peak resident memory (VmHWM); sizes that would need more than
+       60 % of the memory available are skipped. The scaling exponent is the slope of
+       log(time) against log(points) over these sizes.
+    3. Block by block into a zarr store (``ecofmaps map --out FILE.zarr``, in a subprocess,
+       into ``scratch``): time and peak resident memory; 1e9 points in the full run when
+       the disk has room.
+    """
+    from ecofmaps.maps.grid import _map_kernel
+
     sizes = [10**4, 10**5] if quick else [10**4, 10**5, 10**6, 10**7]
     repeats = 2 if quick else 5
-    print(f"compute_map (cache off, jit, float64) vs plain NumPy; {load_average()}")
+    names = list(IMPLEMENTATIONS)
     print(
-        f"{'points':>9} {'grid':>12} {'compile':>8} {'JAX':>9} {'NumPy':>9} "
-        f"{'JAX/NumPy':>9} {'JAX/NumPy':>9} {'max rel':>8}"
+        f"compute_map (cache off, float64) vs NumPy and jax.jit of its formulas; {load_average()}"
     )
     print(
-        f"{'':>9} {'':>12} {'[s]':>8} {'[pt/s]':>9} {'[pt/s]':>9} {'wall':>9} {'CPU':>9} "
-        f"{'diff':>8}"
+        f"{'points':>9} {'grid':>13} {'compile':>7} {'map':>9} {'lean':>9} {'series':>9} "
+        f"{'floor':>9} {'map/lean':>8} {'map/lean':>8} {'map/ser.':>8} {'floor/':>7} {'max rel':>8}"
     )
-    jax_speed = {}
+    print(
+        f"{'':>9} {'':>13} {'[s]':>7} {'[pt/s]':>9} {'[pt/s]':>9} {'[pt/s]':>9} {'[pt/s]':>9} "
+        f"{'wall':>8} {'CPU':>8} {'wall':>8} {'map':>7} {'diff':>8}"
+    )
     for size in sizes:
         grid = figure_11_grid(size)
-        axes = [grid[k] for k in ("stiffness_ratio", "aspect_ratio", "amplitude")]
-        points = math.prod(a.size for a in axes)
+        points = math.prod(a.size for a in _axes(grid))
         first, _ = timed(lambda g=grid: compute_map(**g, cache=False))  # compiles
-        jax_wall = jax_cpu = numpy_wall = numpy_cpu = math.inf
+        for name in names[1:]:
+            IMPLEMENTATIONS[name](grid)  # warm (compiles the floor)
+        best = {name: (math.inf, math.inf) for name in names}
         for _ in range(repeats):
-            wall, cpu = timed(lambda g=grid: compute_map(**g, cache=False))
-            jax_wall, jax_cpu = min(jax_wall, wall), min(jax_cpu, cpu)
-            wall, cpu = timed(lambda a=axes: numpy_map(*a, MU, LOAD))
-            numpy_wall, numpy_cpu = min(numpy_wall, wall), min(numpy_cpu, cpu)
+            for name in names:
+                wall, cpu = timed(lambda g=grid, n=name: IMPLEMENTATIONS[n](g))
+                best[name] = (min(best[name][0], wall), min(best[name][1], cpu))
         result = compute_map(**grid, cache=False)
-        reference = numpy_map(*axes, MU, LOAD)
-        difference = max(max_relative_difference(result[n], reference[n]) for n in reference)
+        difference = 0.0
+        for name in names[1:]:
+            reference = IMPLEMENTATIONS[name](grid)
+            difference = max(
+                difference, *(max_relative_difference(result[n], reference[n]) for n in reference)
+            )
         del result, reference
-        jax_speed[size] = points / jax_wall
-        shape = "x".join(str(a.size) for a in axes)
+        wall = {name: best[name][0] for name in names}
+        shape = "x".join(str(a.size) for a in _axes(grid))
         print(
-            f"{points:9.2e} {shape:>12} {first - jax_wall:8.2f} {points / jax_wall:9.3g} "
-            f"{points / numpy_wall:9.3g} {numpy_wall / jax_wall:9.1f} {numpy_cpu / jax_cpu:9.1f} "
-            f"{difference:8.1e}"
+            f"{points:9.2e} {shape:>13} {first - wall['compute_map']:7.2f} "
+            + " ".join(f"{points / wall[n]:9.3g}" for n in names)
+            + f" {wall['NumPy lean'] / wall['compute_map']:8.2f}"
+            f" {best['NumPy lean'][1] / best['compute_map'][1]:8.2f}"
+            f" {wall['NumPy series'] / wall['compute_map']:8.2f}"
+            f" {wall['jit floor'] / wall['compute_map']:7.2f} {difference:8.1e}"
         )
     grid = figure_11_grid(10**4)
     count = 20 if quick else 200
@@ -192,12 +374,123 @@ def maps(quick: bool) -> None:
         value = result.isel(index)
         for name, expected in reference.items():
             difference = max(difference, max_relative_difference(value[name], expected))
-    largest = max(sizes)
     print(
         f"SciPy per point (brentq on eq. 16 + quad of eq. 12), {count} points: "
-        f"{scipy_speed:.3g} pt/s; JAX/SciPy at {largest:.0e} points: "
-        f"{jax_speed[largest] / scipy_speed:.3g}; max rel diff {difference:.1e}"
+        f"{scipy_speed:.3g} pt/s; compute_map/SciPy at {points:.0e} points: "
+        f"{points / wall['compute_map'] / scipy_speed:.3g}; max rel diff {difference:.1e}"
     )
+    _small_grid_overhead(grid, _map_kernel, 50 if quick else 500)
+    _large_grids(quick)
+    _into_zarr(quick, scratch)
+
+
+def _small_grid_overhead(grid: dict, kernel, repeats: int) -> None:
+    """compute_map's time at 1e4 points against its kernel's alone (best of ``repeats``)."""
+    import jax
+
+    axes = [np.atleast_1d(grid[k]) for k in ("stiffness_ratio", "aspect_ratio", "amplitude")]
+    axes.append(np.atleast_1d(np.float64(MU)))
+
+    def kernel_alone():
+        with jax.enable_x64(True):
+            return {n: np.asarray(v) for n, v in kernel(*axes, np.float64(LOAD)).items()}
+
+    kernel_alone()
+    best = {"map": math.inf, "kernel": math.inf}
+    for _ in range(repeats):
+        best["map"] = min(best["map"], timed(lambda: compute_map(**grid, cache=False))[0])
+        best["kernel"] = min(best["kernel"], timed(kernel_alone)[0])
+    overhead = best["map"] - best["kernel"]
+    points = math.prod(a.size for a in axes)
+    print(
+        f"small grid ({points:.0e} points): compute_map {1e3 * best['map']:.3f} ms, its jit "
+        f"kernel alone {1e3 * best['kernel']:.3f} ms: {1e3 * overhead:.3f} ms of validation "
+        f"and Dataset ({overhead / best['kernel']:.2f}x the kernel)"
+    )
+
+
+def _large_grids(quick: bool) -> None:
+    """Each implementation in its own process: its first call, its best later one, its peak.
+
+    The first call is what a user computing one large map sees (compilation included, a
+    fraction of a second): fresh memory for every result. Later calls may reuse memory the
+    previous call freed (XLA's allocator keeps it, NumPy returns it to the system), which
+    on a virtual machine, where touching fresh memory is costly, flatters the jit floor.
+    """
+    from ecofmaps.maps.grid import available_memory
+
+    sizes = [10**5, 3 * 10**5] if quick else [10**7, 3 * 10**7, 10**8, 2 * 10**8]
+    names = ["compute_map", "jit floor", "NumPy lean"]
+    print(f"large grids, each in its own process: first call, best of 2 later; {load_average()}")
+    print(
+        f"{'points':>9} "
+        + " ".join(f"{n[:11]:>11} {'':>9} {'peak':>5}" for n in names)
+        + f" {'map/floor':>9} {'map/floor':>9} {'map/lean':>8}"
+    )
+    print(
+        f"{'[pt/s]':>9} " + " ".join(f"{'first':>11} {'best':>9} {'[GB]':>5}" for _ in names)
+        + f" {'first':>9} {'best':>9} {'best':>8}"
+    )  # fmt: skip
+    per_point: dict[str, float] = {}
+    times: dict[str, list[tuple[int, float, float]]] = {n: [] for n in names}
+    for size in sizes:
+        cells, runs = [], {}
+        for name in names:
+            free = available_memory() or math.inf
+            if name in per_point and per_point[name] * size > 0.75 * free:
+                cells.append(f"{'(memory)':>11} {'':>9} {'':>5}")
+                continue
+            run = one_process(name, size, 2)
+            if "error" in run:
+                cells.append(f"{'failed':>11} {'':>9} {'':>5}")
+                print(f"  {name} at {size:.0e} points failed: {run['error']}")
+                continue
+            per_point[name] = run["peak"] / run["points"]
+            runs[name] = run
+            times[name].append((run["points"], run["first"], run["best"]))
+            points = run["points"]
+            cells.append(
+                f"{points / run['first']:11.3g} {points / run['best']:9.3g} "
+                f"{run['peak'] / 1e9:5.2f}"
+            )
+        ratios = []
+        for other, key in (("jit floor", "first"), ("jit floor", "best"), ("NumPy lean", "best")):
+            ok = {other, "compute_map"} <= set(runs)
+            ratio = runs[other][key] / runs["compute_map"][key] if ok else math.nan
+            ratios.append(f"{ratio:9.2f}" if ok else f"{'':>9}")
+        print(f"{size:9.0e} " + " ".join(cells) + " " + " ".join(ratios))
+    for name in names:
+        if len(times[name]) >= 2:
+            x = np.log([p for p, _, _ in times[name]])
+            first = np.polyfit(x, np.log([f for _, f, _ in times[name]]), 1)[0]
+            best = np.polyfit(x, np.log([b for _, _, b in times[name]]), 1)[0]
+            print(
+                f"  {name}: time ~ points^{first:.2f} (first call), ^{best:.2f} (best) over "
+                f"{times[name][0][0]:.0e} to {times[name][-1][0]:.0e} points"
+            )
+
+
+def _into_zarr(quick: bool, scratch: Path | None) -> None:
+    import shutil
+    import tempfile
+
+    sizes = [10**5] if quick else [10**8, 10**9]
+    with tempfile.TemporaryDirectory(dir=scratch) as directory:
+        print(f"block by block into zarr (ecofmaps map --out FILE.zarr, no load); {load_average()}")
+        for size in sizes:
+            needed = 40 * size  # bytes on disk, with room to spare (about 20 B/point written)
+            if shutil.disk_usage(directory).free < needed:
+                print(f"  {size:.0e} points: skipped, {needed / 1e9:.0f} GB of free disk needed")
+                continue
+            run = map_into_zarr(size, Path(directory))
+            if "error" in run:
+                print(f"  {size:.0e} points: failed: {run['error']}")
+                continue
+            print(
+                f"  {run['points']:.3g} points: {run['time']:.1f} s, "
+                f"{run['points'] / run['time']:.3g} pt/s, peak RSS {run['peak'] / 1e9:.2f} GB, "
+                f"store {run['size'] / 1e9:.2f} GB"
+            )
 
 
 # ---------------------------------------------------------------------------------------
@@ -274,7 +567,7 @@ def memory_child(samples: int, implementation: str) -> None:
     print(before, _status("VmHWM:"), displacement.nbytes + force.nbytes, wall)
 
 
-def peak_memory(samples: int, implementation: str = "analyze_loops"):
+def loops_peak_memory(samples: int, implementation: str = "analyze_loops"):
     """Resident memory before and at the peak of analyze_loops in a fresh process. [B]"""
     import subprocess
 
@@ -292,7 +585,7 @@ def loops(quick: bool) -> None:
     (lean_loops) only computes each cycle's loop area and amplitude on a reshaped view:
     the floor for any per-cycle analysis in NumPy. The median GICoF against μ = 0.8 and
     the median difference of the two loop areas check the results. Memory: one call on a
-    large recording in a fresh process (peak_memory), above the memory before the call
+    large recording in a fresh process (loops_peak_memory), above the memory before the call
     ("extra") and in all, relative to the recording's two float64 arrays; the frozen
     padded implementation it replaced (tests/measured/reference) alongside, smaller.
     """
@@ -334,7 +627,7 @@ def loops(quick: bool) -> None:
         ("analyze_loops", "analyze_loops", large),
         ("reference (padded)", "reference", large if quick else 2 * 10**7),
     ):
-        before, peak, size, wall = peak_memory(samples, implementation)
+        before, peak, size, wall = loops_peak_memory(samples, implementation)
         extra = peak - before
         print(
             f"{name:>20} {samples:9.2e} {size / 2**20:9.0f} {extra / 2**20:9.0f} "
@@ -558,13 +851,25 @@ def main(argv=None) -> int:
     parser.add_argument("--quick", action="store_true", help="small sizes, a few seconds")
     parser.add_argument("--only", nargs="+", choices=list(SECTIONS), help="run only these")
     parser.add_argument("--memory-child", nargs=2, help=argparse.SUPPRESS)
+    parser.add_argument(
+        "--scratch", type=Path, default=None,
+        help="directory for the maps section's zarr stores (default: the system's temporary)",
+    )  # fmt: skip
+    parser.add_argument("--child", nargs=3, help=argparse.SUPPRESS)  # one_process's work
     args = parser.parse_args(argv)
-    if args.memory_child:  # a fresh process of peak_memory
+    if args.memory_child:  # a fresh process of loops_peak_memory
         memory_child(int(args.memory_child[0]), args.memory_child[1])
+        return 0
+    if args.child:
+        name, points, repeats = args.child
+        _child(name, int(points), int(repeats))
         return 0
     for name in args.only or SECTIONS:
         print(f"== {name} ==")
-        SECTIONS[name](args.quick)
+        if name == "maps":
+            maps(args.quick, args.scratch)
+        else:
+            SECTIONS[name](args.quick)
         print()
     return 0
 

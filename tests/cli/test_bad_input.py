@@ -111,14 +111,26 @@ def test_errors_name_the_option(tmp_path, monkeypatch, capsys, argv, message):
 
 
 def test_a_grid_too_large_for_memory_is_refused_before_allocating(tmp_path, capsys, monkeypatch):
-    monkeypatch.setattr(grid, "available_memory", lambda: 10**9)  # 1 GB free
+    monkeypatch.setattr(grid, "available_memory", lambda: 5 * 10**8)  # 0.5 GB free
     status, _, err = run(
-        capsys, "map", "--stiffness-ratio", "0.01/um:0.3/um:3000", "--aspect-ratio",
-        "0:0.3:3000", "--amplitude", "25um,50um", "--mu", "0.8", "--no-cache",
-        "--out", tmp_path / "big.nc",
-    )  # fmt: skip
+        capsys,
+        "map",
+        "--stiffness-ratio",
+        "0.01/um:0.3/um:3000",
+        "--aspect-ratio",
+        "0:0.3:3000",
+        "--amplitude",
+        "25um,50um",
+        "--mu",
+        "0.8",
+        "--no-cache",
+        "--chunk-points",
+        "1e9",
+        "--out",
+        tmp_path / "big.nc",
+    )  # fmt: skip  (at once in memory: below --chunk-points it would be block by block)
     assert status == 2 and "ecofmaps: error: the grid of 1.8e+07 points needs about" in err
-    assert "more than the 1 GB available" in err
+    assert "more than the 0.5 GB available" in err and "--chunk-points" in err
     assert list(tmp_path.iterdir()) == []
 
 

@@ -1,10 +1,12 @@
 """The `ecofmaps map` and `ecofmaps cache` commands: units, ranges, lists, errors, round trip."""
 
+import sys
+
 import numpy as np
 import pytest
 import xarray as xr
 
-from ecofmaps import cli, compute_map
+from ecofmaps import Regime, cli, compute_map
 from ecofmaps.maps.cache import cache_entries
 from ecofmaps.units import parse_values
 
@@ -184,7 +186,8 @@ def test_cache_list_and_clear(tmp_path, capsys, monkeypatch):
     [
         (["map", "--help"], ["--stiffness-ratio", "--aspect-ratio", "--amplitude", "--mu",
                              "--load", "--out", "--no-cache", "--cache-dir", "start:stop:num",
-                             "atomically", "[1/m]"]),
+                             "atomically", "[1/m]", "zarr", "--chunk-points", "--quiet",
+                             "block by block", "progress bar"]),
         (["cache", "--help"], ["list", "clear", "ECOFMAPS_CACHE"]),
         (["cache", "clear", "--help"], ["--cache-dir"]),
         (["--help"], ["map", "cache"]),
@@ -195,3 +198,113 @@ def test_help_is_complete(capsys, argv, expected):
     assert status == 0
     for word in expected:
         assert word in stdout
+
+
+# --- zarr, block by block, progress -----------------------------------------------------------
+
+
+def fig11_map(load=None):
+    """compute_map of the FIG11 options, in memory."""
+    return compute_map(
+        stiffness_ratio=parse_values("0.02/um:0.2/um:10", "stiffness_ratio"),
+        aspect_ratio=np.linspace(0.0, 0.3, 7),
+        amplitude=parse_values("25um,50um", "length"),
+        mu=0.8,
+        load=load,
+        cache=False,
+    )
+
+
+@pytest.mark.parametrize("name", ["fig11.zarr", "fig11.nc"])
+def test_map_block_by_block_round_trip_is_identical(tmp_path, capsys, name):
+    """A zarr store, or a grid above --chunk-points: block by block, identical, not cached."""
+    out, cache_dir = tmp_path / name, tmp_path / "cache"
+    argv = ["map", *FIG11, "--load", "450N", "--chunk-points", "30", "--out", str(out)]
+    status, stdout, stderr = run(capsys, *argv, "--cache-dir", str(cache_dir))
+    assert status == 0
+    assert stderr == f"ecofmaps map: 140 points into {out}\n"  # no progress: not a terminal
+    expected = fig11_map(450.0)
+    regimes = ", ".join(
+        f"{code.label} {n}" for code in Regime if (n := int((expected.regime == code).sum()))
+    )
+    assert f"wrote {out}: 10 stiffness_ratio x 7 aspect_ratio x 2 amplitude" in stdout
+    assert f"  regimes: {regimes}\n" in stdout and "ECoF / contact CoF: 1 to 1.1" in stdout
+    if name.endswith(".zarr"):
+        with xr.open_zarr(out) as written:
+            assert written.ecof_ratio.encoding["chunks"] == (2, 7, 2)  # 30 points: 2 rows
+            written = written.compute()
+    else:
+        with xr.open_dataset(out, engine="h5netcdf") as written:
+            written = written.load()
+    xr.testing.assert_identical(written, expected)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [name]  # nothing cached
+
+
+def test_map_replaces_an_existing_store_and_refuses_other_directories(tmp_path, capsys):
+    out = tmp_path / "m.zarr"
+    assert run(capsys, "map", *FIG11, "--out", str(out))[0] == 0
+    assert run(capsys, "map", *FIG11, "--load", "450N", "--out", str(out))[0] == 0
+    with xr.open_zarr(out) as written:
+        xr.testing.assert_identical(written.compute(), fig11_map(450.0))
+    mine = tmp_path / "mine.zarr"
+    mine.mkdir()
+    status, stdout, stderr = run(capsys, "map", *FIG11, "--out", str(mine))
+    assert status == 2 and stdout == ""
+    assert stderr.splitlines()[-1] == (
+        f"ecofmaps: error: {mine} is a directory but not a zarr store: it is not replaced"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.zarr", "mine.zarr"]
+
+
+def test_a_grid_block_by_block_is_not_refused_for_memory(tmp_path, capsys, monkeypatch):
+    from ecofmaps.maps import grid
+
+    monkeypatch.setattr(grid, "available_memory", lambda: 1000)  # 1 kB free
+    out = tmp_path / "m.nc"
+    status, _, stderr = run(capsys, "map", *FIG11, "--chunk-points", "100", "--out", str(out))
+    assert status == 0, stderr
+    status, _, stderr = run(capsys, "map", *FIG11, "--no-cache", "--out", str(out))
+    assert status == 2 and "needs about" in stderr and "--chunk-points" in stderr
+
+
+@pytest.mark.parametrize(
+    ("argv", "bar"),
+    [([], True), (["--quiet"], False), (["--chunk-points", "1000"], False)],  # in memory: no bar
+)
+def test_progress_bar_on_a_terminal_only(tmp_path, capsys, monkeypatch, argv, bar):
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
+    out = tmp_path / "m.nc"
+    status, _, stderr = run(capsys, "map", *FIG11, "--chunk-points", "30", *argv, "--out", str(out))
+    assert status == 0
+    first, *rest = stderr.split("\n", 1)
+    assert first == f"ecofmaps map: 140 points into {out}"
+    if bar:
+        assert "ecofmaps map: 100%" in rest[0] and "140/140" in rest[0]
+        assert "5/5 blocks" in rest[0] and "pt/s" in rest[0]
+    else:
+        assert rest == [""]
+
+
+@pytest.mark.parametrize("value", ["0", "-3", "1.5", "many", "inf"])
+def test_bad_chunk_points_are_named(tmp_path, capsys, value):
+    status, _, stderr = run(capsys, "map", *FIG11, f"--chunk-points={value}", "--out",
+                            str(tmp_path / "m.nc"))  # fmt: skip
+    assert status == 2 and stderr.count("\n") == 1
+    assert f"argument --chunk-points: {value!r} is not a whole number of points >= 1" in stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_ctrl_c_during_a_zarr_write_leaves_no_store(tmp_path):
+    """Ctrl-C while blocks are written: status 130, one line, no store and no temporary."""
+    from tests.cli.test_bad_input import interrupted_run
+
+    out = tmp_path / "big.zarr"
+    command = [
+        sys.executable, "-m", "ecofmaps.cli", "map", "--stiffness-ratio", "0.01/um:0.3/um:4000",
+        "--aspect-ratio", "0:0.3:2500", "--amplitude", "25um,50um", "--mu", "0.8", "--load",
+        "450N", "--chunk-points", "100000", "--out", str(out),
+    ]  # fmt: skip
+    status, stdout, stderr = interrupted_run(command, "ecofmaps map: 20,000,000 points", 1.5)
+    assert status == 130, stderr
+    assert stderr == "ecofmaps: interrupted; no output was left half written\n"
+    assert stdout == "" and list(tmp_path.iterdir()) == []

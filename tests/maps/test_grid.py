@@ -1,8 +1,10 @@
 """Parameter maps: labels, values against the SI API and brute force, collapse, chunking."""
 
+import itertools
 import math
 import warnings
 
+import jax.numpy as jnp
 import numpy as np
 import pytest
 import xarray as xr
@@ -11,6 +13,8 @@ from hypothesis import strategies as st
 
 import ecofmaps
 from ecofmaps import Regime, compute_loops, compute_map, compute_universal_map
+from ecofmaps.maps import grid as grid_module
+from ecofmaps.maps.grid import MAX_CHUNK
 from tests.brute_force import steady_loop
 
 # A grid that holds every regime: rigid rig (inf), no gross slip (mu*lam >= 1 at small S/P),
@@ -260,3 +264,167 @@ def test_bad_input_of_the_other_maps_is_named():
         compute_loops(0.0, 0.2, 50e-6, 450.0, 0.8)
     with pytest.raises(ValueError, match="num must be an integer >= 2"):
         compute_loops(35e6, 0.2, 50e-6, 450.0, 0.8, num=1)
+
+
+# --- chunked maps (dask) ----------------------------------------------------------------------
+
+# Small axes with every regime; each is given as an array or as its first value alone.
+AXES = dict(
+    stiffness_ratio=np.array([1.3e4, 3e4, 2e5, np.inf, 7.7e4]),
+    aspect_ratio=np.array([0.0, 0.2, 0.7, 0.05]),
+    amplitude=np.array([25e-6, 50e-6, 10e-6]),
+    mu=np.array([0.8, 0.5]),
+)
+
+
+@pytest.mark.parametrize("given", list(itertools.product([False, True], repeat=4)))
+def test_chunked_equals_in_memory_to_the_bit(given):
+    """Every combination of scalar and 1-D axes, awkward blocks and tiles: identical."""
+    arguments = {n: a if array else a[0] for (n, a), array in zip(AXES.items(), given, strict=True)}
+    dims = [name for name, array in zip(AXES, given, strict=True) if array]
+    awkward = [1, 7, "auto"]
+    if dims:
+        awkward += [{dims[0]: 2}, {dims[-1]: 1, dims[0]: None}]
+    for max_chunk in (7, MAX_CHUNK):  # the grid in tiles of at most 7 points, or at once
+        expected = compute_map(**arguments, load=LOAD, cache=False, max_chunk=max_chunk)
+        for chunks in awkward:
+            chunked = compute_map(**arguments, load=LOAD, chunks=chunks, max_chunk=max_chunk)
+            lazy = [v for v in chunked.data_vars if chunked[v].chunks is not None]
+            assert sorted(lazy) == sorted(set(chunked.data_vars) - {"compliance_ratio"})
+            xr.testing.assert_identical(chunked.compute(), expected)
+
+
+@pytest.mark.parametrize("given", list(itertools.product([False, True], repeat=3)))
+def test_chunked_universal_map_equals_in_memory_to_the_bit(given):
+    axes = dict(
+        compliance_ratio=np.array([0.0, 0.5, 1.25, 0.1]),
+        aspect_ratio=np.array([0.3, 0.0, 0.7]),
+        mu=np.array([0.8, 1.2]),
+    )
+    arguments = {n: a if array else a[0] for (n, a), array in zip(axes.items(), given, strict=True)}
+    for max_chunk in (3, MAX_CHUNK):
+        expected = compute_universal_map(**arguments, cache=False, max_chunk=max_chunk)
+        for chunks in (1, 5, "auto"):
+            chunked = compute_universal_map(**arguments, chunks=chunks, max_chunk=max_chunk)
+            xr.testing.assert_identical(chunked.compute(), expected)
+
+
+def test_chunked_map_is_lazy_and_evaluates_each_block_once(monkeypatch, grid):
+    calls = []
+    block = grid_module._block
+
+    def counted(*args):
+        calls.append(args[4])  # the block's region
+        return block(*args)
+
+    monkeypatch.setattr(grid_module, "_block", counted)
+    chunked = compute_map(STIFFNESS_RATIO, ASPECT_RATIO, AMPLITUDE, MU, LOAD, chunks=60)
+    assert calls == []  # lazy
+    assert chunked.ecof_ratio.chunks == ((2, 2, 1), (5,), (2,), (3,))  # 2 x 5 x 2 x 3 = 60
+    xr.testing.assert_identical(chunked.compute(), grid)  # all variables at once
+    assert len(calls) == len(set(calls)) == 3
+
+
+def test_blocks_take_whole_tiles():
+    """chunks=N: the blocks of the split axis hold whole tiles, so no tile is evaluated twice."""
+    chunked = compute_map(np.geomspace(1e4, 1e5, 100), np.linspace(0, 0.3, 30), 50e-6, 0.8,
+                          chunks=1000, max_chunk=120)  # fmt: skip
+    # Tiles of 4 rows (120 points), 25 of them; blocks of at most 25 rows (balanced: 4 blocks
+    # of at most 33 rows, 990 points) hold 6 whole tiles: 5 blocks of 5 tiles (20 rows).
+    assert chunked.ecof_ratio.chunks == ((20, 20, 20, 20, 20), (30,))
+
+
+@pytest.mark.parametrize(
+    ("chunks", "message"),
+    [
+        (0, r"chunks must be 'auto', an integer >= 1 \(grid points per block\) or a dict"),
+        (-5, "chunks must be 'auto', an integer >= 1"),
+        (True, "chunks must be 'auto', an integer >= 1"),
+        (2.5, "chunks must be 'auto', an integer >= 1"),
+        ("big", "chunks must be 'auto', an integer >= 1.* got 'big'"),
+        ({"load": 2}, "chunks names 'load', which is not a dimension of this map"),
+        ({"mu": 2}, "chunks names 'mu', which is not a dimension of this map .its dimensions: "
+                    "stiffness_ratio, aspect_ratio."),
+        ({"aspect_ratio": 0}, r"chunks\['aspect_ratio'\] must be an integer >= 1, or -1 or None"),
+        ({"aspect_ratio": "x"}, r"chunks\['aspect_ratio'\] must be an integer >= 1"),
+    ],
+)  # fmt: skip
+def test_bad_chunks_are_named(chunks, message):
+    with pytest.raises(ValueError, match=message):
+        compute_map(np.array([1e4, 1e5]), np.array([0.0, 0.2]), 50e-6, 0.8, chunks=chunks)
+
+
+def test_a_chunked_map_is_not_cached(tmp_path):
+    with pytest.raises(ValueError, match="cache=True with chunks: a chunked map is not cached"):
+        compute_map(1e5, 0.2, 50e-6, 0.8, chunks="auto", cache=True)
+    with pytest.raises(ValueError, match="cache must be True, False or None"):
+        compute_universal_map(0.5, 0.2, 0.8, cache="yes")
+    with pytest.raises(ValueError, match="max_chunk must be an integer >= 1"):
+        compute_map(1e5, 0.2, 50e-6, 0.8, chunks="auto", max_chunk=0)
+    compute_map(np.array([1e4, 1e5]), 0.2, 50e-6, 0.8, chunks=1, cache_dir=tmp_path).compute()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_memory_refusal_names_the_chunked_way_out(monkeypatch):
+    monkeypatch.setattr(grid_module, "available_memory", lambda: 10_000)  # 10 kB free
+    axes = (np.geomspace(1e4, 1e5, 100), np.linspace(0, 0.3, 30), 50e-6, 0.8)
+    message = (
+        r"the grid of 3e\+03 points needs about 0.000\d+ GB of memory for its results, more "
+        r"than the 1e-05 GB available: use a smaller grid, or compute it block by block with "
+        r"chunks='auto' and write it with ecofmaps.maps.write_map"
+    )
+    with pytest.raises(ValueError, match=message):
+        compute_map(*axes, cache=False)
+    chunked = compute_map(*axes, chunks=1000).compute()  # not refused: a block at a time
+    monkeypatch.undo()
+    xr.testing.assert_identical(chunked, compute_map(*axes, cache=False))
+
+
+def test_a_failing_tile_stops_the_map():
+    """An error in one tile's evaluation is raised; the threads stop at their next tile."""
+    calls = []
+
+    def kernel(x, y):
+        calls.append(x.size)
+        if len(calls) == 3:
+            raise FloatingPointError("tile 3")
+        return {"ecof_ratio": jnp.add.outer(x, y)}
+
+    axes = [np.arange(40.0), np.arange(5.0)]
+    with pytest.raises(FloatingPointError, match="tile 3"):
+        grid_module._evaluate_grid(kernel, axes, (), max_chunk=10)
+    assert len(calls) < 20  # 20 tiles of 2 rows
+
+
+@given(
+    shape=st.lists(st.integers(1, 6), min_size=1, max_size=4),
+    points=st.integers(1, 200),
+    data=st.data(),
+)
+def test_tiles_cover_any_region_once(shape, points, data):
+    """The tiles that overlap a region cover each of its points exactly once."""
+    split = grid_module._split(tuple(shape), points)
+    k, rows = split
+    assert rows * math.prod(shape[k + 1 :]) <= max(points, math.prod(shape[k + 1 :]))
+    count = -(-shape[k] // rows)  # tiles along the split axis: as even as can be
+    assert count * rows - shape[k] < count
+    region = []
+    for size in shape:
+        start = data.draw(st.integers(0, size - 1))
+        region.append((start, data.draw(st.integers(start + 1, size))))
+    covered = np.zeros(shape, int)
+    for index, start in grid_module._tiles(split, region):
+        assert start % rows == 0
+        covered[(*index, slice(start, start + rows))] += 1
+    inside = tuple(slice(a, b) for a, b in region)
+    assert (covered[inside] == 1).all()
+
+
+def test_dataset_is_what_xarray_would_build(grid):
+    """The map's Dataset, built directly, is the one xarray.Dataset(...) builds from its parts."""
+    loops = compute_loops(np.array([35e6, np.inf]), 0.2, 50e-6, 450.0, 0.8, num=5)
+    for dataset in (grid, loops, compute_map(1e5, 0.2, 50e-6, 0.8, cache=False)):
+        rebuilt = xr.Dataset(dataset.data_vars, coords=dataset.coords, attrs=dataset.attrs)
+        xr.testing.assert_identical(dataset, rebuilt)
+        assert dict(dataset.xindexes).keys() == dict(rebuilt.xindexes).keys()
+        assert list(dataset.variables) == list(rebuilt.variables)

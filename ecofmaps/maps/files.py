@@ -1,0 +1,116 @@
+"""Maps written to a netCDF file or a zarr store, block by block when they are chunked.
+
+A map in memory is written at once. A chunked map (``compute_map(..., chunks=...)``) is
+evaluated block by block as it is written, on one thread per core, so a grid far larger
+than memory goes to disk with a few blocks in memory at a time. Either way the output is
+written under a temporary name beside its destination and renamed into place only when
+complete (:func:`ecofmaps.io.files.atomic_store`):
+an interrupted or failed write leaves nothing that looks complete, and an existing file
+or store as it was.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import contextlib
+from collections.abc import Sequence
+from pathlib import Path
+
+import xarray as xr
+
+from ecofmaps.io.files import atomic_store
+
+__all__ = ["ZARR_SUFFIX", "write_map"]
+
+#: The suffix of the paths that :func:`write_map` writes as zarr stores.
+ZARR_SUFFIX = ".zarr"
+
+
+def _check_destination(path: Path, zarr: bool) -> None:
+    """Refuse, before any work, a destination that would be replaced by mistake."""
+    if zarr and path.is_dir() and not _is_zarr_store(path):
+        raise ValueError(f"{path} is a directory but not a zarr store: it is not replaced")
+    if not zarr and path.is_dir():
+        raise ValueError(f"{path} is a directory: a netCDF file cannot replace it")
+
+
+def _is_zarr_store(path: Path) -> bool:
+    return any((path / name).is_file() for name in ("zarr.json", ".zgroup", ".zarray"))
+
+
+@contextlib.contextmanager
+def _threads():
+    """A thread per core for dask; on leaving, queued tasks are dropped and running ones end.
+
+    The temporary output is removed only after this, so that no task still writes into
+    it (or creates it again) after an interrupt.
+    """
+    from ecofmaps.maps.grid import _workers
+
+    pool = concurrent.futures.ThreadPoolExecutor(_workers())
+    try:
+        yield pool
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def write_map(dataset: xr.Dataset, path, *, also: Sequence = ()) -> tuple:
+    """Write a map to a netCDF file, or to a zarr store if ``path`` ends in ``.zarr``.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        A map, in memory or chunked (its dask-backed variables are evaluated block by
+        block as they are written, on one thread per core).
+    path : str or os.PathLike
+        The file (netCDF 4, engine h5netcdf) or zarr store (a directory, zarr format 2
+        with consolidated metadata, read by ``xarray.open_zarr``) to create or replace;
+        its parent directory must exist.
+    also : sequence of dask or NumPy arrays, optional
+        Values computed in the same pass over the blocks (a chunked map's summary, e.g.
+        ``dataset.regime.max().data``), so that the blocks are not evaluated twice.
+
+    Returns
+    -------
+    values : tuple
+        The computed values of ``also``, in order.
+
+    Raises
+    ------
+    ValueError
+        If ``path`` is a directory that is not a zarr store, or a directory where a
+        netCDF file is asked for (nothing is replaced).
+    OSError
+        If the output cannot be written (the temporary output is removed).
+
+    Notes
+    -----
+    The output is written under ``.<name>.<32 hex digits>.tmp`` beside ``path`` and renamed
+    onto it once complete; on any failure, Ctrl-C included, the running blocks finish, the
+    temporary output is removed and an existing ``path`` is left as it was. A zarr store's
+    chunks are the map's blocks.
+
+    Examples
+    --------
+    >>> import numpy as np, tempfile, xarray as xr
+    >>> from ecofmaps import compute_map
+    >>> lazy = compute_map(np.geomspace(2e4, 2e5, 30), np.linspace(0, 0.3, 20), 50e-6, 0.8,
+    ...                    chunks=100)
+    >>> with tempfile.TemporaryDirectory() as directory:
+    ...     (top,) = write_map(lazy, f"{directory}/map.zarr", also=[lazy.ecof_ratio.max().data])
+    ...     stored = xr.open_zarr(f"{directory}/map.zarr").compute()
+    >>> stored.identical(lazy.compute()), round(float(top), 4)
+    (True, 1.1361)
+    """
+    import dask
+
+    path = Path(path)
+    zarr = path.suffix == ZARR_SUFFIX
+    _check_destination(path, zarr)
+    with atomic_store(path, overwrite=True) as temporary, _threads() as pool:
+        if zarr:
+            written = dataset.to_zarr(temporary, compute=False, zarr_format=2, consolidated=True)
+        else:
+            written = dataset.to_netcdf(temporary, engine="h5netcdf", compute=False)
+        _, *values = dask.compute(written, *also, scheduler="threads", pool=pool)
+    return tuple(values)
