@@ -38,6 +38,7 @@ from xarray.core.indexes import PandasIndex
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps import model, paper
 from ecofmaps._inputs import check, float64
+from ecofmaps._interrupts import check_interrupted
 from ecofmaps._version import __version__
 from ecofmaps.maps.cache import cached_dataset
 from ecofmaps.model.simulation import fretting_loop
@@ -227,13 +228,15 @@ def _fill(out, kernel, axes, extra, split, region, tiles, stop=None) -> None:
     and each point's value does not depend on how the grid is cut into blocks: the
     in-memory and chunked maps are equal to the bit. ``out`` maps each result's name to
     an array of the region's shape (allocated here on the first tile when empty).
-    ``stop``, a ``threading.Event``, ends the loop at the next tile once it is set.
+    ``stop``, a ``threading.Event``, ends the loop at the next tile once it is set; after
+    Ctrl-C on the command line the loop raises ``KeyboardInterrupt`` at the next tile.
     """
     k, rows = split
     offset = tuple(start for start, _ in region)
     trailing = tuple(slice(start, stop) for start, stop in region[k + 1 :])
     with jax.enable_x64(True):
         for index, start in tiles:
+            check_interrupted()
             if stop is not None and stop.is_set():
                 return
             along = axes[k][start : start + rows]
