@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import enum
 
-__all__ = ["GROSS_SLIP", "INVALID", "NO_GROSS_SLIP", "SELF_LOCKING", "Regime"]
+__all__ = ["BEYOND_PROFILE", "GROSS_SLIP", "INVALID", "NO_GROSS_SLIP", "SELF_LOCKING", "Regime"]
 
 
 class Regime(enum.IntEnum):
@@ -18,27 +18,37 @@ class Regime(enum.IntEnum):
         :math:`\\mu\\lambda \\ge 1`: the rig's deflection takes all of the amplitude;
         the contact sticks, :math:`\\delta^* = 0`, :math:`E_d = 0`, :math:`\\mu_E` undefined.
     SELF_LOCKING
-        Rigid rig (:math:`\\lambda = 0`) and :math:`\\mu\\kappa \\ge 1`: the pad jams on the
-        groove flank before the end of the stroke; no solution.
+        Rigid rig (:math:`\\lambda = 0`) and :math:`\\mu\\kappa \\ge 1` (on a scar profile:
+        :math:`\\mu|g| \\ge 1` somewhere in the stroke): the pad jams on the groove flank
+        before the end of the stroke; no solution. With any compliance the pad stops short
+        of such a flank instead, where the rig's force balances it.
     INVALID
         An input outside its valid range (or NaN).
+    BEYOND_PROFILE
+        On a scar profile: the pad slips past an end of the measured trace, whose slope
+        there is unknown; the trace is too short for this stroke.
     """
 
     GROSS_SLIP = 0
     NO_GROSS_SLIP = 1
     SELF_LOCKING = 2
     INVALID = 3
+    BEYOND_PROFILE = 4
 
 
 GROSS_SLIP = Regime.GROSS_SLIP
 NO_GROSS_SLIP = Regime.NO_GROSS_SLIP
 SELF_LOCKING = Regime.SELF_LOCKING
 INVALID = Regime.INVALID
+BEYOND_PROFILE = Regime.BEYOND_PROFILE
 
 _NAN_REASONS = {
-    int(NO_GROSS_SLIP): "no gross slip (mu * load / (stiffness * amplitude) >= 1), "
-    "so the energy coefficient of friction is undefined",
-    int(SELF_LOCKING): "self-locking (rigid rig with mu * curvature number >= 1: the pad "
-    "jams on the groove flank)",
+    int(NO_GROSS_SLIP): "no gross slip (the rig's deflection takes the whole stroke: "
+    "mu * load / (stiffness * amplitude) >= 1 in a groove flat at its centre), so the energy "
+    "coefficient of friction is undefined",
+    int(SELF_LOCKING): "self-locking (rigid rig with mu * groove slope >= 1 in the stroke: "
+    "the pad jams on the groove flank)",
     int(INVALID): "invalid input",
+    int(BEYOND_PROFILE): "the pad slips beyond an end of the scar profile (the trace is too "
+    "short for this stroke)",
 }
