@@ -87,10 +87,11 @@ __all__ = [
 
 _TINY = float(np.nextafter(0.0, 1.0))  # the interval [0, _TINY) holds only lambda = 0
 
-# log1p(r)/r - 1 + r/2 = sum_{m>=0} (-1)^m r^(m+2)/(m+3) for |r| < 1/2; at |r| = 1/2 the
-# first omitted term is below 1e-17 of the sum.
-_SERIES_LIMIT = 0.5
-_E2_SERIES = tuple((-1.0) ** m / (m + 3) for m in range(52, -1, -1))
+# log1p(r)/r - 1 + r/2 = sum_{m>=0} (-1)^m r^(m+2)/(m+3) for |r| < 1/8, where the first
+# omitted term is below 1e-17 of the sum; above, the direct formula loses at most a factor
+# 3/r^2 < 200 of eps relative to log1p(r)/r.
+_SERIES_LIMIT = 0.125
+_E2_SERIES = tuple((-1.0) ** m / (m + 3) for m in range(17, -1, -1))
 
 
 class Side(NamedTuple):
@@ -102,8 +103,8 @@ class Side(NamedTuple):
     position: jax.Array  # (U, N) sample positions in units of the stroke, increasing
     slope: jax.Array  # (U, N)
     force: jax.Array  # (U, N) q_+ at the samples, +inf where mu g >= 1
-    lower: jax.Array  # (U, K, N + 1) sparse table of the intervals' lower ends (K = 1: dense)
-    upper: jax.Array  # (U, K, N + 1) ... and upper ends; column N is a sentinel
+    bounds: jax.Array  # (U, K, N + 1, 2) sparse table of the intervals' ends (K = 1: dense);
+    # column N is a sentinel
 
 
 class Tables(NamedTuple):
@@ -268,17 +269,19 @@ def _intervals(position, force, levels: int):
     lower = jnp.where(finite & (force < 0.0), ratio, -jnp.inf)
     lower = jnp.concatenate([lower, jnp.array([jnp.inf])])
     upper = jnp.concatenate([upper, jnp.array([-jnp.inf])])
-    return (
-        _sparse(lower, levels, jnp.maximum, jnp.inf),
-        _sparse(upper, levels, jnp.minimum, -jnp.inf),
+    return jnp.stack(
+        [
+            _sparse(lower, levels, jnp.maximum, jnp.inf),
+            _sparse(upper, levels, jnp.minimum, -jnp.inf),
+        ],
+        axis=-1,
     )
 
 
 def _side(position, slope, mu, sparse: bool) -> Side:
     force = traction_forward(slope, mu)
     levels = _levels(position.size) if sparse else 1
-    lower, upper = _intervals(position, force, levels)
-    return Side(position, slope, force, lower, upper)
+    return Side(position, slope, force, _intervals(position, force, levels))
 
 
 def _range_levels(count: int) -> int:
@@ -348,19 +351,28 @@ def profile_tables(position, slope, mu, length, sparse: bool = True) -> Tables:
 # ---------------------------------------------------------------------------------------
 
 
+def _at(table, group, *index):
+    """``table[group, *index]`` as one gather from the flattened table (XLA's gathers with
+    several index dimensions are several times slower on CPU)."""
+    flat = group
+    for size, i in zip(table.shape[1:], index, strict=True):
+        flat = flat * size + i
+    return table.reshape(-1)[flat]
+
+
 def _first_holding(side: Side, group, value, begin, sparse: bool):
     """First sample index >= ``begin`` whose interval does not hold ``value``, or N."""
     n = side.position.shape[-1]
     if sparse:
         index = begin
-        for level in reversed(range(side.lower.shape[-2])):
-            column = jnp.minimum(index, n)
-            below = (side.lower[group, level, column] < value) & (
-                value < side.upper[group, level, column]
-            )
+        rows = side.bounds.reshape(-1, 2)
+        levels, columns = side.bounds.shape[1:3]
+        for level in reversed(range(levels)):
+            bounds = rows[(group * levels + level) * columns + jnp.minimum(index, n)]
+            below = (bounds[..., 0] < value) & (value < bounds[..., 1])
             index = jnp.where(below, index + 2**level, index)
         return jnp.minimum(index, n)
-    lower, upper = side.lower[group, 0, :n], side.upper[group, 0, :n]
+    lower, upper = side.bounds[group, 0, :n, 0], side.bounds[group, 0, :n, 1]
     holds = ~((lower < value) & (value < upper)) & (jnp.arange(n) >= begin)
     return jnp.where(jnp.any(holds), jnp.argmax(holds), n)
 
@@ -370,8 +382,8 @@ def _range(table, group, first, last, combine, identity, sparse: bool):
     if sparse:
         count = jnp.maximum(last - first + 1, 1).astype(jnp.int32)
         level = 31 - jax.lax.clz(count)
-        a = table[group, level, first]
-        b = table[group, level, jnp.maximum(last - jnp.left_shift(1, level) + 1, 0)]
+        a = _at(table, group, level, first)
+        b = _at(table, group, level, jnp.maximum(last - jnp.left_shift(1, level) + 1, 0))
         return jnp.where(last >= first, combine(a, b), identity)
     row = table[group, 0]
     index = jnp.arange(row.size)
@@ -393,8 +405,8 @@ def _mirror(segment, fraction, n: int):
 
 def _point(side: Side, group, segment, fraction):
     """Position and slope at ``(segment, fraction)``."""
-    p0, p1 = side.position[group, segment], side.position[group, segment + 1]
-    g0, g1 = side.slope[group, segment], side.slope[group, segment + 1]
+    p0, p1 = _at(side.position, group, segment), _at(side.position, group, segment + 1)
+    g0, g1 = _at(side.slope, group, segment), _at(side.slope, group, segment + 1)
     return p0 + fraction * (p1 - p0), g0 + fraction * (g1 - g0)
 
 
@@ -408,10 +420,10 @@ def _passage(side: Side, group, mu, lam, value, level, segment, fraction, sparse
     off = (j >= n) & ~stick
     j = jnp.clip(j, 1, n - 1)
     same = j - 1 == segment
-    left = side.position[group, j - 1]
+    left = _at(side.position, group, j - 1)
     a = jnp.where(same, start, left)
-    slope_a = jnp.where(same, start_slope, side.slope[group, j - 1])
-    b, slope_b = side.position[group, j], side.slope[group, j]
+    slope_a = jnp.where(same, start_slope, _at(side.slope, group, j - 1))
+    b, slope_b = _at(side.position, group, j), _at(side.slope, group, j)
     t = _crossing(a, b - a, slope_a, slope_b - slope_a, mu, lam, level)
     reached = a + t * (b - a)
     new = _normal(j - 1, (reached - left) / (b - left), n)
@@ -439,8 +451,8 @@ def steady_loop(tables: Tables, group, lam, sparse: bool = True) -> SteadyLoop:
     """
     forward, backward = tables.forward, tables.backward
     n = forward.position.shape[-1]
-    mu = tables.mu[group]
-    k, t = tables.start_segment[group], tables.start_fraction[group]
+    mu = _at(tables.mu, group)
+    k, t = _at(tables.start_segment, group), _at(tables.start_fraction, group)
     k, t, off_1 = _passage(forward, group, mu, lam, lam, 1.0, k, t, sparse)
     k, t, off_2 = _passage(backward, group, mu, lam, lam, 1.0, *_mirror(k, t, n), sparse)
     k_minus, t_minus = _mirror(k, t, n)
@@ -448,14 +460,16 @@ def steady_loop(tables: Tables, group, lam, sparse: bool = True) -> SteadyLoop:
     minus, slope_minus = _point(forward, group, k_minus, t_minus)
     plus, slope_plus = _point(forward, group, k_plus, t_plus)
     width = plus - minus
-    # The integral of e over [xi_-, xi_+]: the partial end segments and the table between.
-    p, g, excess = forward.position[group], forward.slope[group], tables.excess[group]
-    same = k_minus == k_plus
-    whole = width * mean_excess(slope_minus, slope_plus, mu)
-    left = (p[k_minus + 1] - minus) * mean_excess(slope_minus, g[k_minus + 1], mu)
-    right = (plus - p[k_plus]) * mean_excess(g[k_plus], slope_plus, mu)
-    between = excess[k_plus] - excess[k_minus + 1]
-    integral = jnp.where(same, whole, left + between + right)
+
+    # The integral of e over [xi_-, xi_+], from the table at the segments' starts.
+    def cumulative(segment, position, slope):
+        start = _at(forward.position, group, segment)
+        excess = _at(tables.excess, group, segment)
+        return excess + (position - start) * mean_excess(
+            _at(forward.slope, group, segment), slope, mu
+        )
+
+    integral = cumulative(k_plus, plus, slope_plus) - cumulative(k_minus, minus, slope_minus)
     stuck = width == 0.0
     ratio = 1.0 + integral / jnp.where(stuck, 1.0, width)
     critical = _range(tables.critical, group, k_minus, k_plus, jnp.minimum, jnp.inf, sparse)
@@ -609,13 +623,14 @@ def simulation_tables(position, slope, mu, lam) -> Tables:
         levels = _levels(p.size)
         lower = jnp.concatenate([values, jnp.array([jnp.inf])])
         upper = jnp.concatenate([jnp.full(p.size, jnp.inf), jnp.array([-jnp.inf])])
-        return Side(
-            p,
-            g,
-            force,
-            _sparse(lower, levels, jnp.maximum, jnp.inf),
-            _sparse(upper, levels, jnp.minimum, -jnp.inf),
+        bounds = jnp.stack(
+            [
+                _sparse(lower, levels, jnp.maximum, jnp.inf),
+                _sparse(upper, levels, jnp.minimum, -jnp.inf),
+            ],
+            axis=-1,
         )
+        return Side(p, g, force, bounds)
 
     n = position.size
     start = jnp.clip(jnp.searchsorted(position, 0.0, side="right") - 1, 0, n - 2)
