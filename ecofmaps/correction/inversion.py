@@ -89,6 +89,10 @@ class CorrectionStatus(enum.IntEnum):
         inputs raise ``ValueError``).
     OUTSIDE_MAP
         :func:`lookup_correction` only: the point, or the ECoF, is outside the map.
+    UNREACHABLE
+        On a scar profile only: no contact CoF gives the ECoF although it is below
+        :math:`S\\Delta^*/P`: it falls in a jump of :math:`\\mu_E(\\mu)` (the loop's ends
+        jump where the pad starts to jump) or would need the pad to slip off the trace.
     """
 
     CORRECTED = 0
@@ -96,6 +100,7 @@ class CorrectionStatus(enum.IntEnum):
     AMBIGUOUS = 2
     INVALID = 3
     OUTSIDE_MAP = 4
+    UNREACHABLE = 5
 
 
 class Interval(NamedTuple):
@@ -111,6 +116,8 @@ _REASONS = {
     int(CorrectionStatus.AMBIGUOUS): "several contact CoFs give the ECoF (deep groove and "
     "stiff rig, where the ECoF falls as mu rises over part of its range)",
     int(CorrectionStatus.OUTSIDE_MAP): "the point or the ECoF is outside the map",
+    int(CorrectionStatus.UNREACHABLE): "no contact CoF gives the ECoF on this scar profile "
+    "(it falls in a jump of the ECoF as mu rises, or needs a slip beyond the trace)",
 }
 
 # ---------------------------------------------------------------------------------------
@@ -428,7 +435,17 @@ def _failure_message(status, ecof, details) -> str:
 
 @float64
 def _correct(ecof, amplitude, load, stiffness, aspect_ratio, scar_depth, scar_half_width,
-             return_status, factor, caller):  # fmt: skip
+             return_status, factor, caller, profile=None, mapping="scaled"):  # fmt: skip
+    if profile is not None:
+        if aspect_ratio is not None or scar_depth is not None or scar_half_width is not None:
+            raise ValueError(
+                "give the groove one way: aspect_ratio, scar_depth and scar_half_width, or "
+                "profile, not several"
+            )
+        return _correct_on_profile(ecof, amplitude, load, stiffness, profile, mapping,
+                                   return_status, factor, caller)  # fmt: skip
+    if mapping != "scaled":
+        raise ValueError("mapping applies to a profile only (profile=...)")
     check("ecof", ecof, "positive", "1")
     check("amplitude", amplitude, "positive", "m")
     check("load", load, "positive", "N")
@@ -477,6 +494,12 @@ _PARAMETERS = """
         Wear scar depth :math:`D`, instead of ``aspect_ratio`` (with ``scar_half_width``). [m]
     scar_half_width : array_like, optional
         Wear scar half-width :math:`W`. [m]
+    profile : ScarProfile, optional
+        The wear scar's profile, of any shape, instead of an aspect ratio (the correction
+        then inverts the model on that profile; concrete inputs only, not under
+        ``jax.jit``/``jax.vmap``).
+    mapping : {'scaled', 'physical'}
+        With a profile: :math:`X = xW/\\Delta^*` (eq. 11) or :math:`X = x`.
     return_status : bool
         Also return the :class:`CorrectionStatus` of every point, and never raise or warn
         for a point that cannot be corrected.
@@ -502,9 +525,11 @@ _RAISES = """
 
 
 def correct_ecof(ecof, amplitude, load, stiffness, aspect_ratio=None, scar_depth=None,
-                 scar_half_width=None, *, return_status=False):  # fmt: skip
+                 scar_half_width=None, *, profile=None, mapping="scaled",
+                 return_status=False):  # fmt: skip
     return _correct(ecof, amplitude, load, stiffness, aspect_ratio, scar_depth,
-                    scar_half_width, return_status, False, "correct_ecof")  # fmt: skip
+                    scar_half_width, return_status, False, "correct_ecof", profile,
+                    mapping)  # fmt: skip
 
 
 correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy CoF :math:`\\mu_E`.
@@ -532,6 +557,13 @@ correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy
     inversion is unique, and why the interval is exact). :math:`\\mu \\le \\mu_E`, with
     equality for a flat scar.
 
+    On a profile :math:`\\mu_E(\\mu)` is scanned on a grid of 400 contact CoFs, log-spaced
+    from a fiftieth of the smallest ECoF to the largest (:math:`\\mu \\le \\mu_E` on every
+    profile), to bracket the root and to find several (``AMBIGUOUS``); then the bracket is
+    narrowed by the Illinois method to a few ulp. A fall of :math:`\\mu_E(\\mu)` narrower
+    than one grid step (1 % of :math:`\\mu` for one ECoF; the steps widen with the spread of
+    the ECoFs corrected together), or below the grid, is not seen.
+
     Examples
     --------
     >>> import ecofmaps
@@ -543,9 +575,11 @@ correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy
 
 
 def correction_factor(ecof, amplitude, load, stiffness, aspect_ratio=None, scar_depth=None,
-                      scar_half_width=None, *, return_status=False):  # fmt: skip
+                      scar_half_width=None, *, profile=None, mapping="scaled",
+                      return_status=False):  # fmt: skip
     return _correct(ecof, amplitude, load, stiffness, aspect_ratio, scar_depth,
-                    scar_half_width, return_status, True, "correction_factor")  # fmt: skip
+                    scar_half_width, return_status, True, "correction_factor", profile,
+                    mapping)  # fmt: skip
 
 
 correction_factor.__doc__ = f"""The ratio :math:`\\mu/\\mu_E` of contact CoF to reported ECoF.
@@ -722,3 +756,129 @@ def lookup_correction(map_dataset, ecof, amplitude, load, stiffness, aspect_rati
             raise ValueError(f"ecof = {float(ecof):.6g} cannot be read off the map: {reason}")
         warn_nan(mu, status, _REASONS, "lookup_correction")
     return (mu, status) if return_status else mu
+
+
+# ---------------------------------------------------------------------------------------
+# On a scar profile
+# ---------------------------------------------------------------------------------------
+
+_PROFILE_GRID = 400  # contact CoFs scanned per point
+_PROFILE_SPAN = 0.02  # the grid runs from this fraction of the smallest ECoF ...
+_PROFILE_STEPS = 200  # at most this many Illinois steps (each at least halves every two)
+
+
+def _ecof_on_profile(profile, mu, amplitude, load, stiffness, mapping):
+    """mu_E at concrete points (NaN outside gross slip), as a NumPy array."""
+    from ecofmaps.model.on_profile import steady_numbers
+
+    numbers = steady_numbers(profile, amplitude, load, stiffness, mu, mapping=mapping)
+    return np.asarray(numbers["ecof_ratio"]) * np.asarray(mu)
+
+
+def _correct_on_profile(ecof, amplitude, load, stiffness, profile, mapping, return_status,
+                        factor, caller):  # fmt: skip
+    """correct_ecof / correction_factor on a profile (see correct_ecof's Notes).
+
+    The bracket [a, b] keeps mu_E(a) <= ecof < mu_E(b) (NaN, beyond gross slip or the
+    trace, counts as above); a point whose narrowed bracket still misses the ECoF by more
+    than 1e-9 of it lies at a jump of mu_E(mu) (``UNREACHABLE``).
+    """
+    from ecofmaps.model.on_profile import as_profile, check_mapping
+
+    check_mapping(mapping, None)
+    profile = as_profile(profile)
+    for name, value, rule, unit in (
+        ("ecof", ecof, "positive", "1"),
+        ("amplitude", amplitude, "positive", "m"),
+        ("load", load, "positive", "N"),
+        ("stiffness", stiffness, "positive_or_inf", "N/m"),
+    ):
+        check(name, value, rule, unit)
+    if not is_concrete(ecof, amplitude, load, stiffness, *profile):
+        raise ValueError(
+            f"{caller} on a profile needs concrete inputs: it does not run under "
+            "jax.jit or jax.vmap"
+        )
+    ecof, amplitude, load, stiffness = np.broadcast_arrays(
+        *(np.asarray(v, dtype=np.float64) for v in (ecof, amplitude, load, stiffness))
+    )
+    shape = ecof.shape
+    ecof, amplitude, load, stiffness = (v.ravel() for v in (ecof, amplitude, load, stiffness))
+    lam = load / (stiffness * amplitude)
+    status = np.where(ecof * lam < 1.0, CorrectionStatus.CORRECTED, CorrectionStatus.NO_GROSS_SLIP)
+    status = status.astype(np.int32)
+    mu = np.full(ecof.size, np.nan)
+    todo = np.flatnonzero(status == CorrectionStatus.CORRECTED)
+    if todo.size:
+        target = ecof[todo]
+        rig = (amplitude[todo, None], load[todo, None], stiffness[todo, None])
+        top = target.max() * (1.0 + 1e-9)  # mu_E(mu) >= mu: every root is below the largest ECoF
+        grid = np.geomspace(_PROFILE_SPAN * target.min(), top, _PROFILE_GRID)
+        with np.errstate(invalid="ignore"):
+            values = _ecof_on_profile(profile, grid[None, :], *rig, mapping)
+        above = ~(values <= target[:, None])  # NaN: beyond gross slip or the trace
+        rises = ~above[:, :-1] & above[:, 1:]
+        count = rises.sum(axis=1) + above[:, 0]
+        ambiguous = count > 1
+        first = np.argmax(rises, axis=1)
+        low = np.where(above[:, 0], 0.0, grid[first])
+        high = np.where(above[:, 0], grid[0], grid[first + 1])
+        status[todo[ambiguous]] = CorrectionStatus.AMBIGUOUS
+        keep = ~ambiguous
+        root, reached = _illinois(
+            profile, target[keep], low[keep], high[keep], tuple(v[keep, 0] for v in rig), mapping
+        )
+        mu[todo[keep]] = np.where(reached, root, np.nan)
+        status[todo[keep][~reached]] = CorrectionStatus.UNREACHABLE
+    values = mu / ecof if factor else mu
+    values, status = values.reshape(shape), status.reshape(shape)
+    if not return_status:
+        if status.ndim == 0 and status != CorrectionStatus.CORRECTED:
+            code = CorrectionStatus(int(status))
+            if code == CorrectionStatus.NO_GROSS_SLIP:
+                detail = f"it is at or above stiffness * amplitude / load = {1.0 / lam[0]:.6g}"
+            else:
+                detail = _REASONS[int(code)]
+            raise ValueError(f"ecof = {float(ecof[0]):.6g} cannot be corrected on this "
+                             f"profile: {detail}")  # fmt: skip
+        warn_nan(values, status, _REASONS, caller)
+    return (jnp.asarray(values), jnp.asarray(status)) if return_status else jnp.asarray(values)
+
+
+def _illinois(profile, target, low, high, rig, mapping):
+    """Roots of mu_E(mu) = target in the brackets [low, high] (Illinois method).
+
+    Returns the roots and whether mu_E reaches the target there (within 1e-9 of it).
+    """
+    f_low = np.where(low > 0.0, _residual(profile, low, target, rig, mapping), -target)
+    f_high = _residual(profile, high, target, rig, mapping)  # may be NaN: above
+    side = np.zeros(target.size, dtype=np.int8)  # which end moved last (-1 low, +1 high)
+    active = np.ones(target.size, dtype=bool)
+    for _ in range(_PROFILE_STEPS):  # every point every step: one shape to compile
+        if not active.any():
+            break
+        a, b, fa, fb = low, high, f_low, f_high
+        secant = np.isfinite(fb) & (fb > fa)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            trial = np.where(secant, (a * fb - b * fa) / (fb - fa), 0.5 * (a + b))
+        trial = np.where((trial > a) & (trial < b), trial, 0.5 * (a + b))
+        value = _residual(profile, trial, target, rig, mapping)
+        up = ~(value <= 0.0) & active
+        down = (value <= 0.0) & active
+        # Illinois: halve the residual kept at the end that stays twice running.
+        f_high = np.where(up, value, np.where(down & (side == -1) & np.isfinite(fb), 0.5 * fb, fb))
+        f_low = np.where(down, value, np.where(up & (side == 1), 0.5 * fa, fa))
+        high = np.where(up, trial, b)
+        low = np.where(down, trial, a)
+        side = np.where(up, 1, np.where(down, -1, side))
+        done = (value == 0.0) | (high - low <= 4.0 * _EPS * high)
+        active &= ~done
+    root = np.where(np.abs(f_low) <= np.abs(np.nan_to_num(f_high, nan=np.inf)), low, high)
+    check_value = _residual(profile, root, target, rig, mapping) + target
+    reached = np.abs(check_value - target) <= 1e-9 * target
+    return root, reached
+
+
+def _residual(profile, mu, target, rig, mapping):
+    with np.errstate(invalid="ignore"):
+        return _ecof_on_profile(profile, mu, *rig, mapping) - target

@@ -40,6 +40,8 @@ MAPPINGS = ("scaled", "physical")
 # Memory bound of one batch of shared tables (floats), and of the per-point O(N) work.
 _TABLE_BUDGET = 2**25
 _POINT_BATCH = 256
+# Points share tables unless there are more groups than this and than a 16th of the points.
+_FEW_GROUPS = 64
 
 
 def as_profile(profile) -> ScarProfile:
@@ -193,13 +195,12 @@ def _groups(mu: np.ndarray, key: np.ndarray):
     return unique, group.reshape(-1)
 
 
-def _shared(profile, mu, key, lam, physical):
-    """Loops and jump areas of flat concrete (mu, key) with shared tables.
+def _shared(profile, unique, group, lam, physical):
+    """Loops and jump areas of points in groups ``unique[:, group]`` with shared tables.
 
     Groups and points are padded to powers of two, so that few shapes are compiled; with
     concrete profiles the results are reassembled on the host (NumPy).
     """
-    unique, group = _groups(np.asarray(mu), np.asarray(key))
     count = unique.shape[1]
     n = profile.position.shape[-1]
     per_group = 8 * n * (core._levels(n) + 1)
@@ -298,12 +299,19 @@ def steady_numbers(profile, amplitude, load, stiffness, mu, groove_half_width=No
     values = _inputs(amplitude, load, stiffness, mu, groove_half_width)
     shape = values[0].shape
     mu, key, lam, valid = _prepare(*values, profile.half_width, physical)
-    if is_concrete(mu, key, lam):
-        loops, jumps = _shared(profile, mu, key, lam, physical)
-    else:
+    own = not is_concrete(mu, key, lam)
+    if not own:
+        unique, group = _groups(np.asarray(mu), np.asarray(key))
+        own = unique.shape[1] > max(_FEW_GROUPS, lam.size // 16)
+    if own:  # each point its own O(N) tables
+        padded = _pad(np.arange(lam.size))
         loops, jumps = _own_loops(
-            profile.position, profile.slope, profile.half_width, mu, key, lam, physical
-        )
+            profile.position, profile.slope, profile.half_width, mu[padded], key[padded],
+            lam[padded], physical,
+        )  # fmt: skip
+        loops, jumps = jax.tree.map(lambda leaf: leaf[: lam.size], (loops, jumps))
+    else:
+        loops, jumps = _shared(profile, unique, group, lam, physical)
     loops = loops._replace(ends=())
     numbers = _finish(loops, jumps, mu, lam, valid)
     return {name: value.reshape(shape) for name, value in numbers.items()}

@@ -58,7 +58,6 @@ line is kept in ``reference_height`` and ``reference_slope``.
 
 from __future__ import annotations
 
-import itertools
 from typing import NamedTuple
 
 import jax
@@ -179,14 +178,19 @@ def _fraction(name: str, value, low=0.0, high=1.0) -> float:
 
 
 def _grid(breakpoints, samples: int) -> np.ndarray:
-    """About ``samples`` positions evenly spread, with every breakpoint among them."""
+    """Exactly ``samples`` positions, about evenly spread, with every breakpoint among them."""
     if not (isinstance(samples, int | np.integer) and samples >= 2 * MIN_SCAR_SAMPLES):
         raise ValueError(f"samples must be an integer >= {2 * MIN_SCAR_SAMPLES}, got {samples!r}")
     breakpoints = np.unique(np.asarray(breakpoints, dtype=np.float64))
-    span = breakpoints[-1] - breakpoints[0]
+    lengths = np.diff(breakpoints)
+    if samples - 1 < 2 * lengths.size:
+        raise ValueError(f"samples must be at least {2 * lengths.size + 1} for this shape")
+    # Intervals per piece: at least 2 each, the rest by largest remainders of the share.
+    share = 2 + (samples - 1 - 2 * lengths.size) * lengths / lengths.sum()
+    counts = np.floor(share).astype(int)
+    counts[np.argsort(counts - share)[: samples - 1 - counts.sum()]] += 1
     pieces = [breakpoints[:1]]
-    for left, right in itertools.pairwise(breakpoints):
-        count = max(2, round((samples - 1) * (right - left) / span))
+    for left, right, count in zip(breakpoints[:-1], breakpoints[1:], counts, strict=True):
         pieces.append(np.linspace(left, right, count + 1)[1:])
     return np.concatenate(pieces)
 
@@ -221,7 +225,7 @@ def parabolic_profile(depth, half_width, *, tilt=0.0, samples=2001, extent=2.0) 
     tilt : float
         Slope added to the whole trace, :math:`z + tX` (a tilted specimen). [1]
     samples : int
-        About this many samples, evenly spaced, with samples at the edges. [1]
+        Number of samples, about evenly spaced, with samples at the edges. [1]
     extent : float
         The trace runs from :math:`-\text{extent}\,W` to :math:`\text{extent}\,W`; flat
         unworn surface outside the scar. [1]
