@@ -15,7 +15,7 @@ from ecofmaps.correction import (
     correction_factor,
     lookup_correction,
 )
-from ecofmaps.io import read_recording
+from ecofmaps.io import read_recording, read_scar_profile
 from ecofmaps.maps import (
     CacheWarning,
     cache_entries,
@@ -26,18 +26,25 @@ from ecofmaps.maps import (
 )
 from ecofmaps.measured import LoopFit, analyze_loops, fit_loop, synthetic_recording
 from ecofmaps.model import (
+    BEYOND_PROFILE,
     GROSS_SLIP,
     INVALID,
     NO_GROSS_SLIP,
     SELF_LOCKING,
     Regime,
+    ScarProfile,
     dissipated_energy,
     energy_cof,
+    flat_bottomed_profile,
     fretting_loop,
     max_force,
+    parabolic_profile,
     regime,
+    ridged_profile,
+    scar_profile,
     simulate,
     slip_amplitude,
+    w_shaped_profile,
 )
 
 
@@ -55,6 +62,7 @@ except PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "0+unknown"
 
 __all__ = [
+    "BEYOND_PROFILE",
     "GROSS_SLIP",
     "INVALID",
     "NO_GROSS_SLIP",
@@ -65,6 +73,7 @@ __all__ = [
     "LoopFit",
     "Regime",
     "RegimeWarning",
+    "ScarProfile",
     "__version__",
     "analyze_loops",
     "cache_entries",
@@ -78,12 +87,18 @@ __all__ = [
     "energy_cof",
     "figures",
     "fit_loop",
+    "flat_bottomed_profile",
     "fretting_loop",
     "lookup_correction",
     "max_force",
+    "parabolic_profile",
     "read_recording",
+    "read_scar_profile",
     "regime",
+    "ridged_profile",
+    "scar_profile",
     "simulate",
     "slip_amplitude",
     "synthetic_recording",
+    "w_shaped_profile",
 ]

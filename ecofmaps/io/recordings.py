@@ -25,6 +25,7 @@ __all__ = [
     "RESULT_COLUMNS",
     "Recording",
     "RecordingError",
+    "read_columns",
     "read_recording",
     "results_table",
     "write_text",
@@ -87,7 +88,7 @@ def _delimiter(path: Path, header: str):
     return None
 
 
-def _numbers(path, name, cells, lines, scale) -> np.ndarray:
+def _numbers(path, name, cells, lines, scale, error=RecordingError) -> np.ndarray:
     """A column's cells as float64 times ``scale``; the first bad cell raises its line."""
     values = pd.to_numeric(pd.Series(cells, dtype=object), errors="coerce").to_numpy(
         dtype=np.float64
@@ -95,10 +96,77 @@ def _numbers(path, name, cells, lines, scale) -> np.ndarray:
     bad = ~np.isfinite(values)
     if bad.any():
         first = int(np.argmax(bad))
-        raise RecordingError(
-            path, lines[first], f"non-numeric value {cells[first]!r} in column {name!r}"
-        )
+        raise error(path, lines[first], f"non-numeric value {cells[first]!r} in column {name!r}")
     return values * scale
+
+
+def read_columns(path, required, optional=None, error=RecordingError):
+    """Named numeric columns of a text table with a header line.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file; separators and comment lines as for :func:`read_recording`.
+    required : dict of str to str
+        Role -> column name (matched without regard to case); each must exist.
+    optional : dict of str to str, optional
+        Role -> column name, read if the header has it.
+    error : type of FileLineError
+        The error raised, naming the file and the 1-based line.
+
+    Returns
+    -------
+    values : dict of str to numpy.ndarray
+        Each role's column as float64 (unscaled).
+    lines : numpy.ndarray of int64
+        The 1-based line number of each row.
+
+    Raises
+    ------
+    error
+        For no data, a missing column, a line with the wrong number of fields, or a
+        non-numeric or non-finite cell.
+    """
+    path = Path(path)
+    text = path.read_text(encoding="utf-8-sig")
+    numbered = [
+        (number, line)
+        for number, line in enumerate(text.splitlines(), start=1)
+        if line.strip() and not line.lstrip().startswith("#")
+    ]
+    if not numbered:
+        raise error(path, max(text.count("\n"), 1), "no header line and no data")
+    header_line, header = numbered[0]
+    separator = _delimiter(path, header)
+    names = [name.strip().strip('"').strip().lower() for name in header.split(separator)]
+    wanted = dict(required)
+    wanted.update({role: name for role, name in (optional or {}).items() if name.lower() in names})
+    columns = {}
+    for role, name in wanted.items():
+        if name.lower() not in names:
+            raise error(
+                path,
+                header_line,
+                f"no {role} column {name!r} in the header (columns: {', '.join(names)})",
+            )
+        columns[role] = names.index(name.lower())
+    lines = np.array([number for number, _ in numbered[1:]], dtype=np.int64)
+    if lines.size == 0:
+        raise error(path, header_line, "no data after the header")
+    rows = [line.split(separator) for _, line in numbered[1:]]
+    widths = np.fromiter(map(len, rows), dtype=np.int64, count=len(rows))
+    if np.any(widths != len(names)):
+        first = int(np.argmax(widths != len(names)))
+        raise error(
+            path,
+            lines[first],
+            f"{widths[first]} fields where the header has {len(names)}",
+        )
+    values = {
+        role: _numbers(path, wanted[role], [row[k] for row in rows], lines, 1.0, error)
+        for role, k in columns.items()
+    }
+    return values, lines
 
 
 def read_recording(
@@ -146,46 +214,13 @@ def read_recording(
     path = Path(path)
     metres = parse_quantity(f"1 {displacement_unit}", "length")
     newtons = parse_quantity(f"1 {force_unit}", "force")
-    text = path.read_text(encoding="utf-8-sig")
-    numbered = [
-        (number, line)
-        for number, line in enumerate(text.splitlines(), start=1)
-        if line.strip() and not line.lstrip().startswith("#")
-    ]
-    if not numbered:
-        raise RecordingError(path, max(text.count("\n"), 1), "no header line and no data")
-    header_line, header = numbered[0]
-    separator = _delimiter(path, header)
-    names = [name.strip().strip('"').strip().lower() for name in header.split(separator)]
-    wanted = {"displacement": displacement_column, "force": force_column}
-    if cycle_column is not None or "cycle" in names:
-        wanted["cycle"] = "cycle" if cycle_column is None else cycle_column
-    columns = {}
-    for role, name in wanted.items():
-        if name.lower() not in names:
-            raise RecordingError(
-                path,
-                header_line,
-                f"no {role} column {name!r} in the header (columns: {', '.join(names)})",
-            )
-        columns[role] = names.index(name.lower())
-    lines = np.array([number for number, _ in numbered[1:]], dtype=np.int64)
-    if lines.size == 0:
-        raise RecordingError(path, header_line, "no data after the header")
-    rows = [line.split(separator) for _, line in numbered[1:]]
-    widths = np.fromiter(map(len, rows), dtype=np.int64, count=len(rows))
-    if np.any(widths != len(names)):
-        first = int(np.argmax(widths != len(names)))
-        raise RecordingError(
-            path,
-            lines[first],
-            f"{widths[first]} fields where the header has {len(names)}",
-        )
-    scales = {"displacement": metres, "force": newtons, "cycle": 1.0}
-    values = {
-        role: _numbers(path, wanted[role], [row[k] for row in rows], lines, scales[role])
-        for role, k in columns.items()
-    }
+    required = {"displacement": displacement_column, "force": force_column}
+    if cycle_column is not None:
+        required["cycle"] = cycle_column
+    optional = {"cycle": "cycle"} if cycle_column is None else None
+    values, lines = read_columns(path, required, optional)
+    values["displacement"] = values["displacement"] * metres
+    values["force"] = values["force"] * newtons
     return Recording(
         path=path,
         displacement=values["displacement"],
