@@ -48,8 +48,8 @@ edges, the centre their midpoint; ``half_width=`` overrides the half-width (the 
 stays the detected one). The depth is the largest depth of the smoothed profile below the
 line between the edges, and the worn area the area between the line and the profile
 there. A depression no deeper
-than 5 times the shoulders' noise (1.4826 times their median absolute deviation) is not a
-scar.
+than 5 times the shoulders' noise (1.4826 times their median absolute deviation), or than
+5 % of the trace's relief about the line (so a bump is not taken for a scar), is not a scar.
 
 *Levelling* (``level=True``) subtracts the reference line from the heights and its tilt
 from the slopes; without it the tilt stays in the slopes (a genuinely tilted scar), and the
@@ -84,8 +84,10 @@ MIN_SCAR_SAMPLES = 20
 # (the first that leaves _MIN_SHOULDER samples on each side).
 _SHOULDER_FACTORS = (1.5, 1.25, 1.1)
 _MIN_SHOULDER = 5
-# A depression is a scar only if it is deeper than this many times the shoulders' noise.
+# A depression is a scar only if it is deeper than this many times the shoulders' noise,
+# and than this fraction of the relief (highest minus lowest) about the reference line.
 _NOISE_FACTOR = 5.0
+_MIN_RELIEF = 0.05
 # Local quadratic fits reach this many standard deviations of their Gaussian weights.
 _REACH = 4.0
 # Edges and depth are read on heights smoothed over this many sample spacings (at most).
@@ -389,7 +391,7 @@ def _array(name: str, value) -> np.ndarray:
     if bad.any():
         index = int(np.argmax(bad))
         raise ValueError(
-            f"{name} must be finite; {name}[{index}] = {array[index]!r} "
+            f"{name} must be finite; {name}[{index}] = {float(array[index])!r} "
             f"({np.count_nonzero(bad)} of {array.size} values)"
         )
     return array
@@ -510,13 +512,13 @@ def _scar_extent(x, zs, half_width):
         shoulder_noise = 1.4826 * np.median(np.abs(r[mask] - np.median(r[mask])))
         deepest = int(np.argmin(r))
         depth = -r[deepest]
-        if not depth > _NOISE_FACTOR * shoulder_noise:
+        if not depth > max(_NOISE_FACTOR * shoulder_noise, _MIN_RELIEF * (r.max() - r.min())):
             raise ValueError(
                 "z: no depression found: the deepest point is "
                 f"{depth:.3g} m below the unworn surface (a straight line fitted to the "
-                f"trace's ends), within {_NOISE_FACTOR:g} times its noise "
-                f"({shoulder_noise:.3g} m). Heights must increase upwards (the scar is a "
-                "depression), in metres."
+                f"trace's ends): not more than {_NOISE_FACTOR:g} times its noise "
+                f"({shoulder_noise:.3g} m) and {_MIN_RELIEF:.0%} of the trace's relief. Heights "
+                "must increase upwards (the scar is a depression), in metres."
             )
         tolerance = _LINE_TOLERANCE * depth
         left = _crossing(x, r, deepest, -1, tolerance)
