@@ -223,7 +223,7 @@ def test_bad_traces(change, message):
 
 def test_bad_trace_parameters():
     x, z = _trace()
-    with pytest.raises(ValueError, match="half_width = 0.0001 m does not fit the trace"):
+    with pytest.raises(ValueError, match=r"half_width = 0\.0001 m does not fit the trace"):
         ecofmaps.scar_profile(x, z, half_width=100e-6)
     with pytest.raises(ValueError, match="half_width must be > 0"):
         ecofmaps.scar_profile(x, z, half_width=-1.0)
