@@ -461,15 +461,18 @@ def steady_loop(tables: Tables, group, lam, sparse: bool = True) -> SteadyLoop:
     plus, slope_plus = _point(forward, group, k_plus, t_plus)
     width = plus - minus
 
-    # The integral of e over [xi_-, xi_+], from the table at the segments' starts.
-    def cumulative(segment, position, slope):
-        start = _at(forward.position, group, segment)
-        excess = _at(tables.excess, group, segment)
-        return excess + (position - start) * mean_excess(
-            _at(forward.slope, group, segment), slope, mu
-        )
+    # The integral of e over [xi_-, xi_+]: the table between the samples inside and the end
+    # pieces, each taken from the sample on the loop's side (a locking point, where e is
+    # singular, can lie just beyond either end).
+    def piece(a, slope_a, b, slope_b):
+        return (b - a) * mean_excess(slope_a, slope_b, mu)
 
-    integral = cumulative(k_plus, plus, slope_plus) - cumulative(k_minus, minus, slope_minus)
+    after, slope_after = _point(forward, group, k_minus + 1, 0.0)
+    before, slope_before = _point(forward, group, k_plus, 0.0)
+    table = _at(tables.excess, group, k_plus) - _at(tables.excess, group, k_minus + 1)
+    split = piece(minus, slope_minus, after, slope_after) + table
+    split = split + piece(before, slope_before, plus, slope_plus)
+    integral = jnp.where(k_minus == k_plus, piece(minus, slope_minus, plus, slope_plus), split)
     stuck = width == 0.0
     ratio = 1.0 + integral / jnp.where(stuck, 1.0, width)
     critical = _range(tables.critical, group, k_minus, k_plus, jnp.minimum, jnp.inf, sparse)
@@ -481,7 +484,9 @@ def steady_loop(tables: Tables, group, lam, sparse: bool = True) -> SteadyLoop:
     trough = jnp.maximum(
         trough, jnp.maximum(traction_forward(-slope_minus, mu), traction_forward(-slope_plus, mu))
     )
-    locked = (lam == 0.0) & ~(jnp.isfinite(peak) & jnp.isfinite(trough))
+    # A rigid rig passes a locking point; a rig stiff enough to stop the pad within rounding
+    # of one (lambda ~ 1e-17 of the stroke) gives an infinite force there too.
+    locked = ~(jnp.isfinite(peak) & jnp.isfinite(trough) & jnp.isfinite(integral))
     stick_force = (1.0 - plus) / jnp.where(lam > 0.0, lam, 1.0)  # the stick line at D = 1
     off = off_1 | off_2 | off_3
     regime = jnp.where(

@@ -41,9 +41,9 @@ settle.
 
 *Edges.* From the deepest point below the reference line, the first samples on either side
 that reach the line (to within :math:`10^{-9}` of the depth); the edge is where the wall,
-extended by the straight line through its last two samples below the line, reaches it
-(exact for a straight wall cut into a flat surface, second order in the sample spacing for
-a curved one), kept between those samples. The half-width is half the distance of the two
+extended by a straight line, reaches it. The straight line runs through two samples of the wall beyond the reach
+of the light smoothing from that last sample (the last two without smoothing): exact for a
+straight wall cut into a flat surface, second order in that distance for a curved one. The half-width is half the distance of the two
 edges, the centre their midpoint; ``half_width=`` overrides the half-width (the centre
 stays the detected one). The depth is the largest depth of the smoothed profile below the
 line between the edges, and the worn area the area between the line and the profile
@@ -466,28 +466,33 @@ def _line(x, z, mask):
     return (lambda at: offset + tilt * (at - centre)), tilt
 
 
-def _crossing(x, r, start, step, tolerance):
+def _crossing(x, r, start, step, tolerance, reach):
     """Where ``r`` first reaches 0 (to ``tolerance``) from index ``start`` in direction
-    ``step``: the wall's last two samples below it, extended by a straight line, clipped to
-    the interval between the last sample below and the first one reaching it; None if the
-    end of the trace comes first."""
+    ``step``: the wall below it, extended by the straight line through two samples at least
+    ``reach`` samples short of the first sample reaching it (beyond the smoothing's reach of
+    a kink there), clipped to between the nearer of them and that sample; None if the end
+    of the trace comes first."""
     if step < 0:
         found = np.flatnonzero(r[:start] >= -tolerance)
         if found.size == 0:
             return None
         outer = found[-1]
-        inner, second = outer + 1, min(outer + 2, start)
+        last = outer + 1
+        inner = min(last + reach, start)
+        second = min(inner + 1, start)
     else:
         found = np.flatnonzero(r[start:] >= -tolerance)
         if found.size == 0:
             return None
         outer = start + found[0]
-        inner, second = outer - 1, max(outer - 2, start - 1)
+        last = outer - 1
+        inner = max(last - reach, start - 1)
+        second = max(inner - 1, start - 1)
     rise = (r[inner] - r[second]) / (x[inner] - x[second]) if second != inner else 0.0
-    if rise * (x[outer] - x[inner]) > 0.0:  # the wall climbs towards the line
+    if rise * (x[outer] - x[last]) > 0.0:  # the wall climbs towards the line
         edge = x[inner] - r[inner] / rise
     else:
-        edge = x[inner] + r[inner] / (r[inner] - r[outer]) * (x[outer] - x[inner])
+        edge = x[last] + r[last] / (r[last] - r[outer]) * (x[outer] - x[last])
     return float(np.clip(edge, *sorted((x[inner], x[outer]))))
 
 
@@ -501,7 +506,7 @@ def _shoulders(x, centre, half_width):
     return None
 
 
-def _scar_extent(x, zs, half_width):
+def _scar_extent(x, zs, half_width, reach=0):
     """Reference line, centre, half-width and depth of the scar in smoothed heights ``zs``."""
     span = x[-1] - x[0]
     mask = (x < x[0] + span / 5.0) | (x > x[-1] - span / 5.0)
@@ -521,8 +526,8 @@ def _scar_extent(x, zs, half_width):
                 "must increase upwards (the scar is a depression), in metres."
             )
         tolerance = _LINE_TOLERANCE * depth
-        left = _crossing(x, r, deepest, -1, tolerance)
-        right = _crossing(x, r, deepest + 1, +1, tolerance)
+        left = _crossing(x, r, deepest, -1, tolerance, reach)
+        right = _crossing(x, r, deepest + 1, +1, tolerance, reach)
         if left is None or right is None:
             side = "left" if left is None else "right"
             raise ValueError(
@@ -623,7 +628,8 @@ def scar_profile(x, z, half_width=None, smoothing=None, level=False) -> ScarProf
     light = _EDGE_SMOOTHING * spacing
     light = light if smoothing is None else min(smoothing, light)
     zs, _ = local_quadratic(x, z, light)
-    line, tilt, centre, width, r = _scar_extent(x, zs, half_width)
+    reach = int(np.ceil(_REACH * light / spacing))
+    line, tilt, centre, width, r = _scar_extent(x, zs, half_width, reach)
     sigma = AUTO_SMOOTHING * width if smoothing is None else smoothing
     sigma = 0.0 if sigma == 0.0 else max(sigma, spacing)
     if sigma > width / 5.0:

@@ -21,7 +21,8 @@ class Regime(enum.IntEnum):
         Rigid rig (:math:`\\lambda = 0`) and :math:`\\mu\\kappa \\ge 1` (on a scar profile:
         :math:`\\mu|g| \\ge 1` somewhere in the stroke): the pad jams on the groove flank
         before the end of the stroke; no solution. With any compliance the pad stops short
-        of such a flank instead, where the rig's force balances it.
+        of such a flank instead, where the rig's force balances it (unless the rig is so
+        stiff that it stops within rounding of the locking point, which is then reported).
     INVALID
         An input outside its valid range (or NaN).
     BEYOND_PROFILE
