@@ -41,9 +41,10 @@ settle.
 
 *Edges.* From the deepest point below the reference line, the first samples on either side
 that reach the line (to within :math:`10^{-9}` of the depth); the edge is where the wall,
-extended by a straight line, reaches it. The straight line runs through two samples of the wall beyond the reach
-of the light smoothing from that last sample (the last two without smoothing): exact for a
-straight wall cut into a flat surface, second order in that distance for a curved one. The half-width is half the distance of the two
+extended by a straight line, reaches it. The straight line runs through two samples of the
+wall beyond the reach of the light smoothing from the last sample below the line (the last
+two without smoothing): exact for a straight wall cut into a flat surface, second order in
+that distance for a curved one. The half-width is half the distance of the two
 edges, the centre their midpoint; ``half_width=`` overrides the half-width (the centre
 stays the detected one). The depth is the largest depth of the smoothed profile below the
 line between the edges, and the worn area the area between the line and the profile
