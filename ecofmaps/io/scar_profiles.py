@@ -106,7 +106,8 @@ def read_scar_profile(
         raise ScarProfileError(
             path,
             lines[i + 1],
-            f"position {values['x'][i + 1]!r} {kind} {values['x'][i]!r} on line {lines[i]}: "
+            f"position {float(values['x'][i + 1])!r} {kind} {float(values['x'][i])!r} on line "
+            f"{lines[i]}: "
             f"column {x_column!r} must increase strictly (sort the trace and drop repeated "
             "positions)",
         )
