@@ -23,15 +23,16 @@ spacing.
 The scar's edges, levelling and smoothing (measured profiles)
 --------------------------------------------------------------
 *Smoothing.* Slopes are taken from a local quadratic least-squares fit at every sample
-with Gaussian weights of standard deviation ``smoothing`` (a Savitzky-Golay filter for
-uneven spacing). A quadratic is reproduced exactly, so the smoothing removes noise and
-features much narrower than ``smoothing`` without bending a parabolic scar. The default,
+with Gaussian weights of standard deviation ``smoothing``, cut off at 4 standard deviations
+(a Savitzky-Golay filter for uneven spacing). A quadratic is reproduced exactly, so the
+smoothing removes noise and features much narrower than ``smoothing`` without bending a
+parabolic scar. The default,
 :data:`AUTO_SMOOTHING` of the half-width (2 %: 10 µm on a 500 µm half-width scar, several
 times the radius of a profilometer stylus tip and the spacing of its samples), leaves the
 slope of a real trace with about 1 % noise; ``smoothing=0`` uses the exact slope of the
 parabola through each sample and its two neighbours. The edges and the worn area are
-read on heights smoothed only over one sample spacing (or less, or not at all,
-as ``smoothing`` asks), since heavier smoothing would move an edge where the slope jumps.
+read on heights smoothed only over one sample spacing (not at all with ``smoothing=0``),
+since heavier smoothing would move an edge where the slope jumps.
 
 *Reference line (the unworn surface).* A straight line (offset and tilt) fitted by least
 squares to the *shoulders*: the samples farther than 1.5 half-widths from the scar centre
@@ -89,8 +90,10 @@ _MIN_SHOULDER = 5
 # and than this fraction of the relief (highest minus lowest) about the reference line.
 _NOISE_FACTOR = 5.0
 _MIN_RELIEF = 0.05
-# Local quadratic fits reach this many standard deviations of their Gaussian weights.
+# Local quadratic fits reach this many standard deviations of their Gaussian weights, which
+# are lowered to reach zero there (so a sample's weight never jumps as positions move).
 _REACH = 4.0
+_EDGE_WEIGHT = float(np.exp(-0.5 * _REACH**2))
 # Edges and depth are read on heights smoothed over this many sample spacings (at most).
 _EDGE_SMOOTHING = 1.0
 # The profile reaches the reference line when within this fraction of the depth of it.
@@ -185,6 +188,13 @@ def _grid(breakpoints, samples: int) -> np.ndarray:
     if not (isinstance(samples, int | np.integer) and samples >= 2 * MIN_SCAR_SAMPLES):
         raise ValueError(f"samples must be an integer >= {2 * MIN_SCAR_SAMPLES}, got {samples!r}")
     breakpoints = np.unique(np.asarray(breakpoints, dtype=np.float64))
+    # Breakpoints closer than 1e-9 of the span (a flat bottom of nearly zero width) merge.
+    tolerance = 1e-9 * (breakpoints[-1] - breakpoints[0])
+    kept = [breakpoints[0]]
+    for point in breakpoints[1:-1]:
+        if point - kept[-1] > tolerance and breakpoints[-1] - point > tolerance:
+            kept.append(point)
+    breakpoints = np.array([*kept, breakpoints[-1]])
     lengths = np.diff(breakpoints)
     if samples - 1 < 2 * lengths.size:
         raise ValueError(f"samples must be at least {2 * lengths.size + 1} for this shape")
@@ -428,18 +438,22 @@ def local_quadratic(x: np.ndarray, z: np.ndarray, smoothing: float):
 
     Notes
     -----
-    Each fit uses the samples within 4 standard deviations, and at least two on each side
-    (three on one side at the ends), so it is defined for any spacing. Quadratics are
-    reproduced exactly.
+    The weights are :math:`e^{-d^2/2} - e^{-8}` for samples within :math:`d = 4` standard
+    deviations (continuous, zero at the reach). Where the samples are sparse the standard
+    deviation is widened so that the nearest two samples on each side (three on one side at
+    the ends) lie within 80 % of the reach: each fit is defined for any spacing. Quadratics
+    are reproduced exactly.
     """
     if smoothing == 0.0:
         return z.copy(), np.gradient(z, x, edge_order=2)
     n = x.size
     rows = np.arange(n)
-    left = np.minimum(np.searchsorted(x, x - _REACH * smoothing, side="left"), rows - 2)
-    right = np.maximum(np.searchsorted(x, x + _REACH * smoothing, side="right"), rows + 3)
-    left = np.clip(np.minimum(left, n - 5), 0, None)
-    right = np.clip(np.maximum(right, 5), None, n)
+    # Widen the weights where samples are sparse: the nearest two on each side (three on
+    # one side at the ends) within 80 % of the reach.
+    span = np.maximum(x - x[np.clip(rows - 2, 0, n - 5)], x[np.clip(rows + 2, 4, n - 1)] - x)
+    sigma = np.maximum(smoothing, span / (0.8 * _REACH))
+    left = np.searchsorted(x, x - _REACH * sigma, side="left")
+    right = np.searchsorted(x, x + _REACH * sigma, side="right")
     width = int(np.max(right - left))
     height, slope = np.empty(n), np.empty(n)
     chunk = max(1, _CHUNK // width)
@@ -448,14 +462,14 @@ def local_quadratic(x: np.ndarray, z: np.ndarray, smoothing: float):
         index = left[block, None] + np.arange(width)[None, :]
         valid = index < right[block, None]
         index = np.minimum(index, n - 1)
-        d = (x[index] - x[block, None]) / smoothing
-        weight = np.where(valid, np.exp(-0.5 * d * d), 0.0)
+        d = (x[index] - x[block, None]) / sigma[block, None]
+        weight = np.where(valid, np.maximum(np.exp(-0.5 * d * d) - _EDGE_WEIGHT, 0.0), 0.0)
         # Weighted normal equations of z ~ a + b d + c d^2 (d in units of the smoothing).
         powers = [np.sum(weight * d**k, axis=1) for k in range(5)]
         rhs = np.stack([np.sum(weight * z[index] * d**k, axis=1) for k in range(3)], axis=-1)
         matrix = np.stack([np.stack(powers[i : i + 3], axis=-1) for i in range(3)], axis=-2)
         solution = np.linalg.solve(matrix, rhs[..., None])[..., 0]
-        height[block], slope[block] = solution[:, 0], solution[:, 1] / smoothing
+        height[block], slope[block] = solution[:, 0], solution[:, 1] / sigma[block]
     return height, slope
 
 
@@ -626,8 +640,7 @@ def scar_profile(x, z, half_width=None, smoothing=None, level=False) -> ScarProf
     spacing = float(np.median(np.diff(x)))
     # The edges are found on lightly smoothed heights (a kink at an edge would move under
     # heavier smoothing); the slopes are smoothed over 2 % of the half-width by default.
-    light = _EDGE_SMOOTHING * spacing
-    light = light if smoothing is None else min(smoothing, light)
+    light = 0.0 if smoothing == 0.0 else _EDGE_SMOOTHING * spacing
     zs, _ = local_quadratic(x, z, light)
     reach = int(np.ceil(_REACH * light / spacing))
     line, tilt, centre, width, r = _scar_extent(x, zs, half_width, reach)
