@@ -198,8 +198,9 @@ def _groups(mu: np.ndarray, key: np.ndarray):
 def _shared(profile, unique, group, lam, physical):
     """Loops and jump areas of points in groups ``unique[:, group]`` with shared tables.
 
-    Groups and points are padded to powers of two, so that few shapes are compiled; with
-    concrete profiles the results are reassembled on the host (NumPy).
+    Groups and points are padded to powers of two, so that few shapes are compiled; the
+    results may be longer than the points (padding at the end). With many groups, in
+    batches that bound the tables' memory.
     """
     count = unique.shape[1]
     n = profile.position.shape[-1]
@@ -207,26 +208,31 @@ def _shared(profile, unique, group, lam, physical):
     batch = min(_bucket(count), max(1, 1 << (_TABLE_BUDGET // per_group).bit_length() - 1))
     arguments = (profile.position, profile.slope, profile.half_width)
     unique = np.pad(unique, ((0, 0), (0, -count % batch)), mode="edge")
-    concrete = is_concrete(*arguments)
-    host = jax.device_get if concrete else (lambda tree: tree)
-    stack = np if concrete else jnp
     lam = np.asarray(lam)
-    parts, order = [], []
-    for first in range(0, count, batch):
-        members = np.flatnonzero((group >= first) & (group < first + batch))
-        padded = _pad(members)
-        tables = _shared_tables(*arguments, *unique[:, first : first + batch], physical, True)
-        part = _shared_loops(tables, group[padded] - first, lam[padded])
-        parts.append(jax.tree.map(lambda leaf, m=members.size: leaf[:m], host(part)))
-        order.append(members)
-    order = np.concatenate(order)
-    inverse = np.empty_like(order)
-    inverse[order] = np.arange(order.size)
-    loops = jax.tree.map(lambda *leaves: stack.concatenate(leaves)[inverse], *parts)
+    if count <= batch:  # one batch, the points in order
+        padded = _pad(np.arange(lam.size))
+        tables = _shared_tables(*arguments, *unique, physical, True)
+        loops = _shared_loops(tables, group[padded], lam[padded])
+    else:
+        parts, order = [], []
+        for first in range(0, count, batch):
+            members = np.flatnonzero((group >= first) & (group < first + batch))
+            padded = _pad(members)
+            tables = _shared_tables(*arguments, *unique[:, first : first + batch], physical, True)
+            part = _shared_loops(tables, group[padded] - first, lam[padded])
+            parts.append(jax.tree.map(lambda leaf, m=members.size: leaf[:m], part))
+            order.append(members)
+        order = np.concatenate(order)
+        inverse = np.empty_like(order)
+        inverse[order] = np.arange(order.size)
+        loops = jax.tree.map(lambda *leaves: jnp.concatenate(leaves)[inverse], *parts)
     dense = _shared_tables(*arguments, *unique[:, :count], physical, False)
-    if concrete:
-        jumps = np.zeros(lam.shape)
-        where = np.flatnonzero(~loops.monotone)
+    size = loops.monotone.shape[0]
+    group = np.pad(group, (0, size - group.size), mode="edge")
+    lam = np.pad(lam, (0, size - lam.size), mode="edge")
+    if is_concrete(loops.monotone):
+        jumps = np.zeros(size)
+        where = np.flatnonzero(~np.asarray(loops.monotone))
         if where.size:
             padded = _pad(where)
             ends = jax.tree.map(lambda leaf: leaf[padded], loops.ends)
@@ -236,7 +242,7 @@ def _shared(profile, unique, group, lam, physical):
         jumps = jax.lax.cond(
             jnp.any(~loops.monotone),
             lambda: _shared_jumps(dense, group, lam, loops.ends),
-            lambda: jnp.zeros(lam.shape),
+            lambda: jnp.zeros(size),
         )
     return loops, jumps
 
@@ -253,7 +259,9 @@ def _prepare(amplitude, load, stiffness, mu, half_width, profile_half_width, phy
 
 @jax.jit
 def _finish(loops, jumps, mu, lam, valid) -> dict:
-    """The steady-loop numbers from the loops and the jumps' areas (module docstring)."""
+    """The steady-loop numbers from the loops and the jumps' areas (module docstring); the
+    loops may be padded beyond the points."""
+    loops, jumps = jax.tree.map(lambda leaf: leaf[: mu.shape[0]], (loops, jumps))
     slip = 0.5 * (loops.plus - loops.minus)
     scale = 4.0 * mu * jnp.where(lam > 0.0, lam, 1.0) * jnp.where(slip > 0.0, slip, 1.0)
     ratio = loops.ecof_ratio + jnp.where(jumps > 0.0, jumps / scale, 0.0)
@@ -309,7 +317,6 @@ def steady_numbers(profile, amplitude, load, stiffness, mu, groove_half_width=No
             profile.position, profile.slope, profile.half_width, mu[padded], key[padded],
             lam[padded], physical,
         )  # fmt: skip
-        loops, jumps = jax.tree.map(lambda leaf: leaf[: lam.size], (loops, jumps))
     else:
         loops, jumps = _shared(profile, unique, group, lam, physical)
     loops = loops._replace(ends=())
