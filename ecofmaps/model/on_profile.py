@@ -213,11 +213,13 @@ def _shared(profile, unique, group, lam, physical):
         padded = _pad(np.arange(lam.size))
         tables = _shared_tables(*arguments, *unique, physical, True)
         loops = _shared_loops(tables, group[padded], lam[padded])
-    else:
+    else:  # every batch padded to one shape: one compilation
         parts, order = [], []
-        for first in range(0, count, batch):
-            members = np.flatnonzero((group >= first) & (group < first + batch))
-            padded = _pad(members)
+        starts = range(0, count, batch)
+        members_of = [np.flatnonzero((group >= f) & (group < f + batch)) for f in starts]
+        width = _bucket(max(m.size for m in members_of))
+        for first, members in zip(starts, members_of, strict=True):
+            padded = np.pad(members, (0, width - members.size), mode="edge")
             tables = _shared_tables(*arguments, *unique[:, first : first + batch], physical, True)
             part = _shared_loops(tables, group[padded] - first, lam[padded])
             parts.append(jax.tree.map(lambda leaf, m=members.size: leaf[:m], part))
