@@ -223,8 +223,8 @@ slip_amplitude.__doc__ = f"""Slip amplitude :math:`\\delta^*` of the steady fret
 {_PROFILE_NOTES}
     Examples
     --------
-    >>> float(slip_amplitude(50e-6, 450.0, 35e6, 0.8, 0.2))  # Example 2 of the paper
-    4.00...e-05
+    >>> round(float(slip_amplitude(50e-6, 450.0, 35e6, 0.8, 0.2)) * 1e6, 3)  # Example 2 [um]
+    32.73
 """
 
 
