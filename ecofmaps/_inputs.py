@@ -159,8 +159,10 @@ def _to_numpy(leaf):
 
 
 def is_concrete(*values) -> bool:
-    """True when none of ``values`` is a JAX tracer (so they can be inspected)."""
-    return not any(isinstance(value, jax.core.Tracer) for value in values)
+    """True when no leaf of ``values`` (pytrees such as a scar profile included) is a JAX
+    tracer, so they can be inspected."""
+    leaves = jax.tree_util.tree_leaves(values)
+    return not any(isinstance(leaf, jax.core.Tracer) for leaf in leaves)
 
 
 def as_float64(value):

@@ -165,7 +165,7 @@ QUANTITIES: dict[str, Quantity] = {
     # --- the loop read along the stroke -------------------------------------------------
     "position": _length("contact position, centred", "ξ = Δ - Q/S", r"\xi = \Delta - Q/S"),
     "slope": _number("groove slope felt by the contact", "g(ξ)", r"g(\xi)"),
-    "profile": _length("felt groove profile, zero at the centre", "h(ξ) = ∫g dξ", r"h(\xi)"),
+    "felt_profile": _length("felt groove profile, zero at the centre", "h(ξ) = ∫g dξ", r"h(\xi)"),
     "force_forward": _force(
         "tangential force on the forward slip branch, centred", "Q+(ξ)", r"Q_+(\xi)"
     ),

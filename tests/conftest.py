@@ -21,6 +21,16 @@ settings.register_profile("thorough", parent=settings.get_profile("default"), ma
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
 
 
+def pytest_configure(config):
+    """A silent regime warning in a test is an error.
+
+    Registered here, not in pyproject.toml: naming the class there makes pytest import
+    ecofmaps before it has put the checkout on sys.path, so with a non-editable install (as in
+    CI) the installed copy is imported and the doctests of the checkout refuse to collect.
+    """
+    config.addinivalue_line("filterwarnings", "error::ecofmaps.RegimeWarning")
+
+
 @pytest.fixture(autouse=True, scope="session")
 def _private_cache(tmp_path_factory):
     """Every test writes its cache under a temporary directory, never the user's."""

@@ -81,7 +81,7 @@ def test_quantities_everywhere_in_the_api():
         ({"amplitude": "50um"}, r"amplitude must be a real number .* got '50um'"),
         ({"load": True}, r"load must be a real number .* got True"),
         ({"mu": np.array([True, False])}, r"mu must be a real number"),
-        ({"aspect_ratio": None}, r"aspect_ratio must be a real number .* got None"),
+        ({"aspect_ratio": None}, r"exactly one way: aspect_ratio .* or profile .* got neither"),
         ({"stiffness": ["35e6"]}, r"stiffness must be a real number"),
     ],
 )

@@ -101,6 +101,10 @@ class CorrectionStatus(Code):
         inputs raise ``ValueError``).
     OUTSIDE_MAP
         :func:`lookup_correction` only: the point, or the ECoF, is outside the map.
+    UNREACHABLE
+        On a scar profile only: no contact CoF gives the ECoF although it is below
+        :math:`S\\Delta^*/P`: it falls in a jump of :math:`\\mu_E(\\mu)` (the loop's ends
+        jump where the pad starts to jump) or would need the pad to slip off the trace.
     """
 
     CORRECTED = 0, "corrected"
@@ -118,6 +122,12 @@ class CorrectionStatus(Code):
     )
     INVALID = 3, "invalid", "invalid input"
     OUTSIDE_MAP = 4, "outside the map", "the point or the ECoF is outside the map"
+    UNREACHABLE = (
+        5,
+        "unreachable",
+        "no contact CoF gives the ECoF on this scar profile (it falls in a jump of the ECoF as "
+        "mu rises, or needs a slip beyond the trace)",
+    )
 
 
 class Interval(NamedTuple):
@@ -443,7 +453,19 @@ def _failure_message(status, ecof, details) -> str:
 
 @float64
 def _correct(ecof, amplitude, load, stiffness, aspect_ratio, scar_depth, scar_half_width,
-             return_status, factor, caller):  # fmt: skip
+             return_status, factor, caller, profile=None, mapping="scaled"):  # fmt: skip
+    if profile is not None:
+        if aspect_ratio is not None or scar_depth is not None or scar_half_width is not None:
+            raise ValueError(
+                "give the groove one way: aspect_ratio, scar_depth and scar_half_width, or "
+                "profile, not several"
+            )
+        from ecofmaps.correction.on_profile import correct_on_profile  # built on this module
+
+        return correct_on_profile(ecof, amplitude, load, stiffness, profile, mapping,
+                                  return_status, factor, caller)  # fmt: skip
+    if mapping != "scaled":
+        raise ValueError("mapping applies to a profile only (profile=...)")
     check("ecof", ecof, "positive", "1")
     check("amplitude", amplitude, "positive", "m")
     check("load", load, "positive", "N")
@@ -492,6 +514,12 @@ _PARAMETERS = """
         Wear scar depth :math:`D`, instead of ``aspect_ratio`` (with ``scar_half_width``). [m]
     scar_half_width : array_like, optional
         Wear scar half-width :math:`W`. [m]
+    profile : ScarProfile, optional
+        The wear scar's profile, of any shape, instead of an aspect ratio (the correction
+        then inverts the model on that profile; concrete inputs only, not under
+        ``jax.jit``/``jax.vmap``).
+    mapping : {'scaled', 'physical'}
+        With a profile: :math:`X = xW/\\Delta^*` (eq. 11) or :math:`X = x`.
     return_status : bool
         Also return the :class:`CorrectionStatus` of every point, and never raise or warn
         for a point that cannot be corrected.
@@ -517,9 +545,11 @@ _RAISES = """
 
 
 def correct_ecof(ecof, amplitude, load, stiffness, aspect_ratio=None, scar_depth=None,
-                 scar_half_width=None, *, return_status=False):  # fmt: skip
+                 scar_half_width=None, *, profile=None, mapping="scaled",
+                 return_status=False):  # fmt: skip
     return _correct(ecof, amplitude, load, stiffness, aspect_ratio, scar_depth,
-                    scar_half_width, return_status, False, "correct_ecof")  # fmt: skip
+                    scar_half_width, return_status, False, "correct_ecof", profile,
+                    mapping)  # fmt: skip
 
 
 correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy CoF :math:`\\mu_E`.
@@ -547,6 +577,13 @@ correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy
     inversion is unique, and why the interval is exact). :math:`\\mu \\le \\mu_E`, with
     equality for a flat scar.
 
+    On a profile :math:`\\mu_E(\\mu)` is scanned on a grid of 400 contact CoFs, log-spaced
+    from a fiftieth of the smallest ECoF to the largest (:math:`\\mu \\le \\mu_E` on every
+    profile), to bracket the root and to find several (``AMBIGUOUS``); then the bracket is
+    narrowed by the Illinois method to a few ulp. A fall of :math:`\\mu_E(\\mu)` narrower
+    than one grid step (1 % of :math:`\\mu` for one ECoF; the steps widen with the spread of
+    the ECoFs corrected together), or below the grid, is not seen.
+
     Examples
     --------
     >>> import ecofmaps
@@ -558,9 +595,11 @@ correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy
 
 
 def correction_factor(ecof, amplitude, load, stiffness, aspect_ratio=None, scar_depth=None,
-                      scar_half_width=None, *, return_status=False):  # fmt: skip
+                      scar_half_width=None, *, profile=None, mapping="scaled",
+                      return_status=False):  # fmt: skip
     return _correct(ecof, amplitude, load, stiffness, aspect_ratio, scar_depth,
-                    scar_half_width, return_status, True, "correction_factor")  # fmt: skip
+                    scar_half_width, return_status, True, "correction_factor", profile,
+                    mapping)  # fmt: skip
 
 
 correction_factor.__doc__ = f"""The ratio :math:`\\mu/\\mu_E` of contact CoF to reported ECoF.

@@ -338,10 +338,12 @@ def resolved_loops(resolved: xr.Dataset, results: xr.Dataset | None = None, cycl
         mu = float(cycle["mu_resolved"])
         stroke.plot(xi, cycle["mu"], color=color, linewidth=1.2, label=f"cycle {label}")
         stroke.axhline(mu, color=color, linestyle="--", linewidth=0.9)
-        felt.plot(xi, cycle["profile"] * MICRO, color=color, linewidth=1.4, label=f"cycle {label}")
+        felt.plot(
+            xi, cycle["felt_profile"] * MICRO, color=color, linewidth=1.4, label=f"cycle {label}"
+        )
         k = 2.0 * float(cycle["aspect_ratio"]) / float(cycle["amplitude"])  # z_o/x_o = kΔ*/2
-        felt.plot(xi, 0.5 * k * (xi / MICRO) ** 2 * MICRO, color=color, linestyle=":",
-                  linewidth=1.0)  # fmt: skip
+        parabola = 0.5 * k * (xi / MICRO) ** 2 * MICRO
+        felt.plot(xi, parabola, color=color, linestyle=":", linewidth=1.0)
     if chosen and np.isfinite(central):
         reach = central * min(
             -float(resolved.sel(cycle=chosen)["position_min"].max()),
@@ -360,7 +362,7 @@ def resolved_loops(resolved: xr.Dataset, results: xr.Dataset | None = None, cycl
     felt.legend(loc="upper center", fontsize="x-small", ncols=2)
     for ax in (stroke, felt, test):
         ax.grid(alpha=0.3)
-    profile = resolved["profile"].transpose("cycle", "position").values * MICRO
+    profile = resolved["felt_profile"].transpose("cycle", "position").values * MICRO
     mesh = image.pcolormesh(xi, np.arange(len(labels)), profile, shading="nearest",
                             cmap="cividis")  # fmt: skip
     ticks = np.unique(np.linspace(0, len(labels) - 1, min(len(labels), 6)).round().astype(int))

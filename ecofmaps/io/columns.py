@@ -39,11 +39,12 @@ __all__ = [
     "split_unit",
 ]
 
-#: The kind of quantity of each column role, as :func:`ecofmaps.units.parse_quantity` names it.
-KINDS = {"displacement": "length", "force": "force"}
+#: The kind of quantity of each column role, as :func:`ecofmaps.units.parse_quantity` names it:
+#: a recording's displacement and force, a scar profile's position x and height z.
+KINDS = {"displacement": "length", "force": "force", "x": "length", "z": "length"}
 
 #: The unit of a column whose name, metadata and options say none.
-DEFAULT_UNITS = {"displacement": "um", "force": "N"}
+DEFAULT_UNITS = {"displacement": "um", "force": "N", "x": "um", "z": "um"}
 
 #: The units rigs write most, with their kind and factor to SI, read without starting pint
 #: (whose registry takes a good part of a second to build); any other goes to pint.
@@ -204,7 +205,7 @@ def column_scale(role: str, option_unit, carried, column: str) -> tuple[float, s
     Parameters
     ----------
     role : str
-        ``'displacement'`` or ``'force'``.
+        A key of :data:`KINDS`.
     option_unit : str or None
         The unit given as the option ``<role>_unit``; None to take the file's.
     carried : sequence of str

@@ -88,10 +88,13 @@ class RecordingError(FileLineError):
         The 1-based line, for a text file.
     position : str
         ``'line 12'``, the position given, or ``''``.
+    message : str
+        What is wrong, without the file and the position.
     """
 
     def __init__(self, path, line, message: str):
         self.path = Path(path)
+        self.message = message
         if line is None or isinstance(line, str):
             self.line, self.position = None, line or ""
         else:
@@ -341,10 +344,9 @@ def _options(
             raise ValueError(f"{name} must be a non-empty string or None; got {value!r}")
     if nan_policy not in _NAN_POLICIES:
         raise ValueError(f"nan_policy must be one of {_NAN_POLICIES}; got {nan_policy!r}")
-    from ecofmaps.io.columns import KINDS, column_scale
+    from ecofmaps.io.columns import column_scale
 
-    for role in KINDS:
-        unit = {"displacement": displacement_unit, "force": force_unit}[role]
+    for role, unit in (("displacement", displacement_unit), ("force", force_unit)):
         if unit is not None:
             column_scale(role, unit, [], role)  # a ValueError naming the option
     return {

@@ -175,22 +175,31 @@ class _Layout:
                 "the first line holds numbers, not column names: add a header line "
                 "(e.g. displacement,force)",
             )
-        wanted = {"displacement": options["displacement_column"], "force": options["force_column"]}
+        # The columns by role: a recording's, or those given (a scar profile's x and z).
+        wanted = options.get("columns") or {
+            "displacement": options["displacement_column"],
+            "force": options["force_column"],
+        }
         try:
-            if options["cycle_column"] is not None:
+            if "columns" in options:  # exactly the columns given
+                pass
+            elif options["cycle_column"] is not None:
                 wanted["cycle"] = options["cycle_column"]
             elif find_column(self.names, "cycle", "cycle", required=False) is not None:
                 wanted["cycle"] = "cycle"
             self.columns = {
                 role: find_column(self.names, name, role) for role, name in wanted.items()
             }
-            if self.columns["displacement"] == self.columns["force"]:
-                raise ColumnError(
-                    f"the displacement and force columns are the same column "
-                    f"{self.names[self.columns['force']]!r}"
-                )
+            roles = list(self.columns)
+            for index, role in enumerate(roles):
+                for other in roles[:index]:
+                    if self.columns[role] == self.columns[other]:
+                        raise ColumnError(
+                            f"the {other} and {role} columns are the same column "
+                            f"{self.names[self.columns[role]]!r}"
+                        )
             self.scales, self.units = {}, {}
-            for role in ("displacement", "force"):
+            for role in (role for role in roles if role != "cycle"):
                 name = self.names[self.columns[role]]
                 carried = [unit for unit in [split_unit(name)[1]] if unit is not None]
                 self.scales[role], self.units[role] = column_scale(

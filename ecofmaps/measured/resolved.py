@@ -253,14 +253,14 @@ def _along_stroke(forward, backward, grid, lowest, highest, tilt, load, level):
     return {
         "mu": mu,
         "slope": slope,
-        "profile": np.where(inside, profile, np.nan),
+        "felt_profile": np.where(inside, profile, np.nan),
         "force_forward": q_forward,
         "force_backward": q_backward,
     }
 
 
 #: The values along the stroke, over (cycle, position).
-_ALONG = ("mu", "slope", "profile", "force_forward", "force_backward")
+_ALONG = ("mu", "slope", "felt_profile", "force_forward", "force_backward")
 
 
 def _reaches_resolved(quality) -> np.ndarray:
@@ -599,14 +599,14 @@ def resolve_loops(
     -------
     resolved : xarray.Dataset
         Over ``(cycle, position)``: ``mu`` :math:`\mu(\xi)`, ``slope`` :math:`g(\xi)`,
-        ``profile`` :math:`h(\xi)` [m], ``force_forward`` and ``force_backward``
+        ``felt_profile`` :math:`h(\xi)` [m], ``force_forward`` and ``force_backward``
         :math:`Q_\pm(\xi)` [N]; NaN outside the range where both branches slip. Over
         ``cycle``: ``mu_resolved``, ``mu_resolved_se``, ``aspect_ratio``, ``tilt``
         (:math:`g_0`), ``stiffness`` (the one used) [N/m], ``position_offset`` (where
         :math:`\xi = 0` lies in the recording's contact position), ``position_min``,
         ``position_max`` [m], ``amplitude`` (:math:`\Delta^*`, the :math:`x_o` of
         ``aspect_ratio``) [m] and ``quality`` (``'ok'`` or the reason the values are NaN).
-        With the force centred (``force_offset=None``), ``slope`` and ``profile`` are
+        With the force centred (``force_offset=None``), ``slope`` and ``felt_profile`` are
         levelled (``tilt`` taken off). The ``position``
         coordinate is :math:`\xi` [m], common to all cycles; the load is a scalar
         coordinate. ``resolved.sel(cycle=...).mu.plot()`` labels itself.

@@ -8,7 +8,9 @@ second pass kept, so every recorded loop is the steady loop of its own groove.
 
 :func:`example_recording` is the deterministic generator of the recording shipped as
 ``ecofmaps/data/synthetic_fretting_test.csv`` (see :func:`example_path`), which
-``ecofmaps loops --example`` analyses.
+``ecofmaps loops --example`` analyses. :func:`scar_example_trace` generates the synthetic
+profilometer trace across a wear scar shipped as
+``ecofmaps/data/synthetic_scar_profile.csv`` (see :func:`scar_example_path`).
 
 :func:`long_recording` makes a long test (10⁵–10⁶ cycles, 10⁸ samples and more) block by
 block, with the example's rig, deepening groove, noise, offsets and drift, and
@@ -32,12 +34,17 @@ __all__ = [
     "EXAMPLE",
     "EXAMPLE_FILE",
     "LONG_TEST",
+    "SCAR_EXAMPLE",
+    "SCAR_EXAMPLE_FILE",
     "example_path",
     "example_recording",
     "long_recording",
+    "scar_example_path",
+    "scar_example_trace",
     "synthetic_recording",
     "write_example",
     "write_long_recording",
+    "write_scar_example",
 ]
 
 
@@ -389,3 +396,101 @@ def write_long_recording(
         for cycle, displacement, force in blocks:
             writer.write(displacement, force, cycle if cycle_numbers else None)
     return Path(path)
+
+
+# ---------------------------------------------------------------------------------------
+# The shipped example scar profile
+# ---------------------------------------------------------------------------------------
+
+#: Parameters of the shipped example scar profile (SI units).
+SCAR_EXAMPLE = {
+    "depth": 80e-6,  # of the flat bottom below the unworn surface [m]
+    "half_width": 500e-6,  # [m]: D/W = 0.16, the paper's Example 2 (z_o = 8 um, x_o = 50 um)
+    "flat_fraction": 0.4,  # flat bottom over the half-width; parabolic walls
+    "hump_height": 5e-6,  # a less worn centre [m]
+    "hump_width": 80e-6,  # its standard deviation [m]
+    "ridge_height": 4e-6,  # ploughing ridges beside the edges [m]
+    "ridge_width": 150e-6,  # [m]
+    "roughness": 0.4e-6,  # amplitude of the worn surface's waviness [m]
+    "roughness_wavelength": 45e-6,  # [m]
+    "tilt": 0.004,  # the specimen's tilt in the profilometer [1]
+    "offset": 12e-6,  # height of the unworn surface at x = 0 [m]
+    "noise": 0.05e-6,  # profilometer noise, standard deviation [m]
+    "spacing": 2e-6,  # sample spacing [m]
+    "length": 2.7e-3,  # trace length [m]
+    "centre": 1.34e-3,  # scar centre in the trace [m]
+    "seed": 20161125,
+}
+
+#: File name of the shipped example scar profile in ``ecofmaps/data``.
+SCAR_EXAMPLE_FILE = "synthetic_scar_profile.csv"
+
+_SCAR_HEADER = """\
+# SYNTHETIC DATA, not a measurement: made by ecofmaps.measured.synthetic.scar_example_trace().
+# A profilometer trace across a cylinder-on-flat fretting scar like the paper's Example 2
+# (depth over half-width D/W = 0.16: 80 um deep, 500 um half-width): a flat bottom (40 % of
+# the half-width) with parabolic walls, a 5 um hump at the less worn centre, 4 um ploughing
+# ridges 150 um wide beside the edges, and a 0.4 um waviness of the worn surface. As
+# recorded: tilted by 0.004 (0.23 degrees), offset by 12 um, with 0.05 um noise, sampled
+# every 2 um over 2.7 mm. ecofmaps.read_scar_profile levels it on the unworn shoulders.
+# Columns: position x [um], height z [um].
+"""
+
+
+def scar_example_trace():
+    """The shipped example scar profile as a profilometer records it.
+
+    Returns
+    -------
+    x, z : numpy.ndarray
+        Positions from the start of the trace and heights. [m]
+
+    Notes
+    -----
+    Deterministic: a fixed seed, see :data:`SCAR_EXAMPLE` for the parameters. The scar is
+    the U shape of :func:`ecofmaps.flat_bottomed_profile` with a Gaussian hump at the
+    centre, :math:`H\\sin^2(\\pi v)` ridges beside the edges (as
+    :func:`ecofmaps.ridged_profile`) and a waviness of random phase in the scar; then the
+    tilt, offset and noise of the recording.
+    """
+    p = SCAR_EXAMPLE
+    rng = np.random.default_rng(p["seed"])
+    x = np.arange(round(p["length"] / p["spacing"]) + 1) * p["spacing"]
+    u = x - p["centre"]
+    width, flat = p["half_width"], p["flat_fraction"] * p["half_width"]
+    s = np.clip((np.abs(u) - flat) / (width - flat), 0.0, 1.0)
+    inside = np.abs(u) < width
+    z = np.where(inside, -p["depth"] * (1.0 - s * s), 0.0)
+    z += np.where(inside, p["hump_height"] * np.exp(-0.5 * (u / p["hump_width"]) ** 2), 0.0)
+    v = (np.abs(u) - width) / p["ridge_width"]
+    z += np.where((v > 0.0) & (v < 1.0), p["ridge_height"] * np.sin(np.pi * v) ** 2, 0.0)
+    phase = rng.uniform(0.0, 2.0 * np.pi, 3)
+    waves = sum(
+        np.sin(2.0 * np.pi * u / (p["roughness_wavelength"] * k) + f)
+        for k, f in zip((1.0, 1.7, 2.9), phase, strict=True)
+    )
+    z += np.where(inside, p["roughness"] / 3.0 * waves * (1.0 - s * s), 0.0)
+    z += p["offset"] + p["tilt"] * x + p["noise"] * rng.normal(size=x.size)
+    return x, z
+
+
+def write_scar_example(path):
+    """Write :func:`scar_example_trace` as the shipped CSV file (atomically), in µm.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Destination file.
+
+    Returns
+    -------
+    path : pathlib.Path
+    """
+    x, z = scar_example_trace()
+    rows = "\n".join(f"{a:.1f},{b:.4f}" for a, b in zip(x * 1e6, z * 1e6, strict=True))
+    return write_text(path, f"{_SCAR_HEADER}x,z\n{rows}\n")
+
+
+def scar_example_path() -> Path:
+    """Path of the shipped example scar profile (see :func:`scar_example_trace`)."""
+    return Path(str(importlib.resources.files("ecofmaps") / "data" / SCAR_EXAMPLE_FILE))

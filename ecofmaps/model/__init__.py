@@ -18,7 +18,22 @@ from ecofmaps.model.core import (
     slip_ratio,
     traction_ratio,
 )
-from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP, SELF_LOCKING, Regime
+from ecofmaps.model.profiles import (
+    ScarProfile,
+    flat_bottomed_profile,
+    parabolic_profile,
+    ridged_profile,
+    scar_profile,
+    w_shaped_profile,
+)
+from ecofmaps.model.regimes import (
+    BEYOND_PROFILE,
+    GROSS_SLIP,
+    INVALID,
+    NO_GROSS_SLIP,
+    SELF_LOCKING,
+    Regime,
+)
 from ecofmaps.model.simulation import fretting_loop, simulate
 from ecofmaps.model.steady_state import (
     dissipated_energy,
@@ -29,26 +44,33 @@ from ecofmaps.model.steady_state import (
 )
 
 __all__ = [
+    "BEYOND_PROFILE",
     "GROSS_SLIP",
     "INVALID",
     "NO_GROSS_SLIP",
     "SELF_LOCKING",
     "Regime",
+    "ScarProfile",
     "compliance_ratio",
     "curvature_number",
     "dissipated_energy",
     "ecof_ratio",
     "energy_cof",
+    "flat_bottomed_profile",
     "fretting_loop",
     "locking_margin",
     "max_force",
     "normalized_energy",
     "normalized_max_force",
+    "parabolic_profile",
     "regime",
     "regime_code",
+    "ridged_profile",
+    "scar_profile",
     "simulate",
     "slip_amplitude",
     "slip_position",
     "slip_ratio",
     "traction_ratio",
+    "w_shaped_profile",
 ]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ecofmaps._codes import Code
 
-__all__ = ["GROSS_SLIP", "INVALID", "NO_GROSS_SLIP", "SELF_LOCKING", "Regime"]
+__all__ = ["BEYOND_PROFILE", "GROSS_SLIP", "INVALID", "NO_GROSS_SLIP", "SELF_LOCKING", "Regime"]
 
 
 class Regime(Code):
@@ -18,29 +18,42 @@ class Regime(Code):
         :math:`\\mu\\lambda \\ge 1`: the rig's deflection takes all of the amplitude;
         the contact sticks, :math:`\\delta^* = 0`, :math:`E_d = 0`, :math:`\\mu_E` undefined.
     SELF_LOCKING
-        Rigid rig (:math:`\\lambda = 0`) and :math:`\\mu\\kappa \\ge 1`: the pad jams on the
-        groove flank before the end of the stroke; no solution.
+        Rigid rig (:math:`\\lambda = 0`) and :math:`\\mu\\kappa \\ge 1` (on a scar profile:
+        :math:`\\mu|g| \\ge 1` somewhere in the stroke): the pad jams on the groove flank
+        before the end of the stroke; no solution. With any compliance the pad stops short
+        of such a flank instead, where the rig's force balances it (unless the rig is so
+        stiff that it stops within rounding of the locking point, which is then reported).
     INVALID
         An input outside its valid range (or NaN).
+    BEYOND_PROFILE
+        On a scar profile: the pad slips past an end of the measured trace, whose slope
+        there is unknown; the trace is too short for this stroke.
     """
 
     GROSS_SLIP = 0, "gross slip"
     NO_GROSS_SLIP = (
         1,
         "no gross slip",
-        "no gross slip (mu * load / (stiffness * amplitude) >= 1), so the energy coefficient "
-        "of friction is undefined",
+        "no gross slip (the rig's deflection takes the whole stroke: mu * load / (stiffness * "
+        "amplitude) >= 1 in a groove flat at its centre), so the energy coefficient of "
+        "friction is undefined",
     )
     SELF_LOCKING = (
         2,
         "self-locking",
-        "self-locking (rigid rig with mu * curvature number >= 1: the pad jams on the groove "
-        "flank)",
+        "self-locking (rigid rig with mu * groove slope >= 1 in the stroke: the pad jams on "
+        "the groove flank)",
     )
     INVALID = 3, "invalid", "invalid input"
+    BEYOND_PROFILE = (
+        4,
+        "beyond the profile",
+        "the pad slips beyond an end of the scar profile (the trace is too short for this stroke)",
+    )
 
 
 GROSS_SLIP = Regime.GROSS_SLIP
 NO_GROSS_SLIP = Regime.NO_GROSS_SLIP
 SELF_LOCKING = Regime.SELF_LOCKING
 INVALID = Regime.INVALID
+BEYOND_PROFILE = Regime.BEYOND_PROFILE

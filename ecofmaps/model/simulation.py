@@ -17,7 +17,7 @@ import jax.numpy as jnp
 from ecofmaps._inputs import as_float64, check, float64, is_concrete
 from ecofmaps.model.core import _slip_roots, locking_margin, slip_ratio, traction_ratio
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
-from ecofmaps.model.steady_state import check_model_inputs, dimensionless
+from ecofmaps.model.steady_state import check_model_inputs, dimensionless, one_geometry
 
 __all__ = ["fretting_loop", "simulate"]
 
@@ -61,7 +61,8 @@ def _steady_loop(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width
 
 
 @float64
-def fretting_loop(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width=None, num=201):
+def fretting_loop(amplitude, load, stiffness, mu, aspect_ratio=None, groove_half_width=None,
+                  num=201, *, profile=None, mapping="scaled"):  # fmt: skip
     r"""The steady fretting loop: displacement and tangential force around one cycle.
 
     Parameters
@@ -74,12 +75,18 @@ def fretting_loop(amplitude, load, stiffness, mu, aspect_ratio, groove_half_widt
         Rig stiffness :math:`S`; ``numpy.inf`` for a rigid rig. [N/m]
     mu : array_like
         Contact coefficient of friction. [1]
-    aspect_ratio : array_like
-        Groove depth over half-width :math:`z_o/x_o`. [1]
+    aspect_ratio : array_like, optional
+        Groove depth over half-width :math:`z_o/x_o` (a parabolic groove). Give this or
+        ``profile``. [1]
     groove_half_width : array_like, optional
         Groove half-width :math:`x_o`; defaults to ``amplitude``. [m]
     num : int
         Points on each slip branch (>= 2). [1]
+    profile : ScarProfile, optional
+        A scar profile of any shape instead of ``aspect_ratio`` (see
+        :func:`ecofmaps.slip_amplitude`).
+    mapping : {'scaled', 'physical'}
+        On a profile: :math:`X = xW/x_o` (eq. 11) or :math:`X = x`.
 
     Returns
     -------
@@ -105,9 +112,21 @@ def fretting_loop(amplitude, load, stiffness, mu, aspect_ratio, groove_half_widt
     segments are the straight lines of slope :math:`S`. With no gross slip the loop
     collapses onto :math:`Q = S\Delta`.
     Self-locking points give NaN.
+
+    On a profile each slip branch is sampled uniformly in :math:`x` between the loop's ends;
+    where the pad jumps (:math:`x + Q_+/S` falls) its points lie on the vertical
+    :math:`\Delta = \text{const}`, :math:`Q = S(\Delta - x)`; the branches are not
+    mirror images of each other on an asymmetric scar. Points off the trace are NaN.
     """
     if not isinstance(num, int) or num < 2:
         raise ValueError(f"num must be an integer >= 2, got {num!r}")
+    one_geometry(aspect_ratio, profile, mapping)
+    if profile is not None:
+        from ecofmaps.model.on_profile import profile_loop
+
+        return profile_loop(
+            profile, amplitude, load, stiffness, mu, groove_half_width, mapping, num
+        )
     values = check_model_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
     values = jnp.broadcast_arrays(*values)
     return _steady_loop(*values, num=num)
@@ -141,7 +160,8 @@ def _return_map(displacement, mu, kappa, lam, length):
 
 
 @float64
-def simulate(displacement, load, stiffness, mu, aspect_ratio, groove_half_width):
+def simulate(displacement, load, stiffness, mu, aspect_ratio=None, groove_half_width=None, *,
+             profile=None, mapping="scaled"):  # fmt: skip
     r"""Tangential force history for any actuator displacement history :math:`\Delta(t)`.
 
     Parameters
@@ -155,10 +175,17 @@ def simulate(displacement, load, stiffness, mu, aspect_ratio, groove_half_width)
         Rig stiffness :math:`S`; ``numpy.inf`` for a rigid rig. [N/m]
     mu : array_like
         Contact coefficient of friction. [1]
-    aspect_ratio : array_like
-        Groove depth over half-width :math:`z_o/x_o`. [1]
+    aspect_ratio : array_like, optional
+        Groove depth over half-width :math:`z_o/x_o` (a parabolic groove). Give this or
+        ``profile``. [1]
     groove_half_width : array_like
-        Groove half-width :math:`x_o`. [m]
+        Groove half-width :math:`x_o`: required with ``aspect_ratio`` and with a profile in
+        the scaled mapping :math:`X = xW/x_o` (use the amplitude to match the steady loop
+        of :func:`ecofmaps.fretting_loop`). [m]
+    profile : ScarProfile, optional
+        A scar profile of any shape instead of ``aspect_ratio``.
+    mapping : {'scaled', 'physical'}
+        On a profile: :math:`X = xW/x_o` (eq. 11) or :math:`X = x` (no ``groove_half_width``).
 
     Returns
     -------
@@ -180,10 +207,24 @@ def simulate(displacement, load, stiffness, mu, aspect_ratio, groove_half_width)
     equilibrium :math:`x' + Q_\pm(x')/S = \Delta` (the quadratic of eq. 16), so the result
     does not depend on the sampling. A rigid rig (:math:`S = \infty`) has :math:`x = \Delta`
     in slip and keeps its last force while :math:`\Delta` stands still.
+
+    On a profile the pad starts at rest at the scar centre, and a slip goes to the first
+    equilibrium :math:`x' + Q_\pm(x')/S = \Delta` beyond the pad (first passage; where
+    :math:`x + Q_+/S` falls the pad jumps), found exactly on the piecewise linear slope
+    (:mod:`ecofmaps.model.profile_core`). A pad that runs off the trace gives NaN.
     """
     check("displacement", displacement, "finite", "m")
     if is_concrete(displacement) and jnp.ndim(displacement) == 0:
         raise ValueError("displacement must have a time axis (at least one dimension)")
+    one_geometry(aspect_ratio, profile, mapping)
+    if profile is not None:
+        from ecofmaps.model.on_profile import profile_simulation
+
+        return profile_simulation(
+            profile, displacement, load, stiffness, mu, groove_half_width, mapping
+        )
+    if groove_half_width is None:
+        raise ValueError("simulate with aspect_ratio needs groove_half_width (x_o) [m]")
     values = check_model_inputs(1.0, load, stiffness, mu, aspect_ratio, groove_half_width)
     _, load, stiffness, mu, aspect_ratio, groove_half_width = values
     length = groove_half_width

@@ -24,6 +24,16 @@ from ecofmaps.model.core import (
 )
 from ecofmaps.model.regimes import INVALID, Regime
 
+_ON_PROFILE = {
+    "slip_amplitude": lambda numbers, amplitude, load: amplitude * numbers["slip_ratio"],
+    "dissipated_energy": lambda numbers, amplitude, load: (
+        load * amplitude * numbers["normalized_energy"]
+    ),
+    "energy_cof": lambda numbers, amplitude, load: numbers["mu"] * numbers["ecof_ratio"],
+    "max_force": lambda numbers, amplitude, load: load * numbers["normalized_max_force"],
+    "regime": lambda numbers, amplitude, load: numbers["regime"],
+}
+
 __all__ = [
     "check_model_inputs",
     "dimensionless",
@@ -102,7 +112,41 @@ def check_model_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half
     return values
 
 
-def _evaluate(quantity, arguments):
+def one_geometry(aspect_ratio, profile, mapping="scaled") -> None:
+    """``ValueError`` unless exactly one of ``aspect_ratio`` and ``profile`` is given."""
+    if (aspect_ratio is None) == (profile is None):
+        raise ValueError(
+            "give the groove exactly one way: aspect_ratio (a parabolic groove, z_o/x_o = D/W, "
+            "eq. 11) or profile (a ScarProfile of any shape), "
+            + ("not both" if profile is not None else "got neither")
+        )
+    if profile is None and mapping != "scaled":
+        raise ValueError("mapping applies to a profile only (profile=...)")
+
+
+def _evaluate_on_profile(quantity, arguments, profile, mapping):
+    from ecofmaps.model.on_profile import steady_numbers
+
+    amplitude, load, stiffness, mu, _, groove_half_width = arguments
+    numbers = steady_numbers(profile, amplitude, load, stiffness, mu, groove_half_width, mapping)
+    result = _profile_quantity(quantity, numbers, *(as_float64(v) for v in (amplitude, load, mu)))
+    if is_concrete(result) and quantity != "regime":
+        warn_nan(result, numbers["regime"], Regime, quantity)
+    return result
+
+
+@jax.jit(static_argnames="quantity")
+def _profile_quantity(quantity, numbers, amplitude, load, mu):
+    numbers = {**numbers, "mu": mu}
+    return jnp.broadcast_to(
+        _ON_PROFILE[quantity](numbers, amplitude, load), numbers["regime"].shape
+    )
+
+
+def _evaluate(quantity, arguments, profile=None, mapping="scaled"):
+    one_geometry(arguments[4], profile, mapping)
+    if profile is not None:
+        return _evaluate_on_profile(quantity, arguments, profile, mapping)
     values = check_model_inputs(*arguments)
     result, code = _steady_state(quantity, *values)
     if is_concrete(*arguments) and quantity != "regime":
@@ -121,11 +165,21 @@ _PARAMETERS = """
         Rig stiffness :math:`S`; ``numpy.inf`` for a rigid rig. [N/m]
     mu : array_like
         Contact coefficient of friction :math:`\\mu`. [1]
-    aspect_ratio : array_like
-        Groove depth over half-width :math:`z_o/x_o` (eq. 11: scar depth over half-width
-        :math:`D/W`). [1]
+    aspect_ratio : array_like, optional
+        Groove depth over half-width :math:`z_o/x_o` of a parabolic groove (eq. 11: scar
+        depth over half-width :math:`D/W`). Give this or ``profile``. [1]
     groove_half_width : array_like, optional
-        Groove half-width :math:`x_o`; defaults to ``amplitude`` as in the paper. [m]
+        Groove half-width :math:`x_o`; defaults to ``amplitude`` as in the paper. On a
+        profile it sets the mapping :math:`X = xW/x_o` of eq. 11. [m]
+    profile : ScarProfile, optional
+        A wear-scar profile of any shape (:func:`ecofmaps.scar_profile`,
+        :func:`ecofmaps.read_scar_profile`, the profile families), instead of
+        ``aspect_ratio``: the pad at contact position :math:`x` feels its slope at
+        :math:`X = xW/x_o` (eq. 9 pointwise). A parabolic profile reproduces the closed
+        forms with ``aspect_ratio=D/W``.
+    mapping : {'scaled', 'physical'}
+        On a profile: ``'scaled'``, :math:`X = xW/x_o` (eq. 11, the paper's); or
+        ``'physical'``, :math:`X = x`.
 """
 
 _RAISES = """
@@ -133,16 +187,25 @@ _RAISES = """
     ------
     ValueError
         For a concrete input out of its range: amplitude, load, mu and groove_half_width
-        must be finite and > 0, stiffness > 0 (inf allowed), aspect_ratio finite and >= 0.
-        Under ``jax.jit``/``jax.vmap`` such points give NaN and the ``INVALID`` regime.
+        must be finite and > 0, stiffness > 0 (inf allowed), aspect_ratio finite and >= 0;
+        for both or neither of aspect_ratio and profile, or a bad mapping. Under
+        ``jax.jit``/``jax.vmap`` such points give NaN and the ``INVALID`` regime.
+"""
+
+_PROFILE_NOTES = """
+    On a profile the steady loop's ends solve :math:`x + Q_\\pm(x)/S = \\pm\\Delta^*` by
+    first passage from where the last stroke ended, the pad jumping where
+    :math:`x + Q_+(x)/S` falls; :math:`\\delta^* = (x_+ - x_-)/2` and :math:`E_d` is the
+    area of the loop the return map draws (:mod:`ecofmaps.model.profile_core`). The regime
+    ``BEYOND_PROFILE`` marks a stroke that runs off the trace.
 """
 
 
 @float64
-def slip_amplitude(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width=None):
-    return _evaluate(
-        "slip_amplitude", (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
-    )
+def slip_amplitude(amplitude, load, stiffness, mu, aspect_ratio=None, groove_half_width=None, *,
+        profile=None, mapping="scaled"):  # fmt: skip
+    arguments = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
+    return _evaluate("slip_amplitude", arguments, profile, mapping)
 
 
 slip_amplitude.__doc__ = f"""Slip amplitude :math:`\\delta^*` of the steady fretting loop (eq. 16).
@@ -158,19 +221,19 @@ slip_amplitude.__doc__ = f"""Slip amplitude :math:`\\delta^*` of the steady fret
     Solves :math:`\\delta^* + Q_+(\\delta^*)/S = \\Delta^*` (eq. 9, 10, 16) in closed form;
     see :func:`slip_position`. Flat groove: :math:`\\Delta^* - \\mu P/S`; rigid rig:
     :math:`\\Delta^*`.
-
+{_PROFILE_NOTES}
     Examples
     --------
-    >>> float(slip_amplitude(50e-6, 450.0, 35e6, 0.8, 0.2))  # Example 2 of the paper
-    3.273018924824522e-05
+    >>> round(float(slip_amplitude(50e-6, 450.0, 35e6, 0.8, 0.2)) * 1e6, 3)  # Example 2 [um]
+    32.73
 """
 
 
 @float64
-def dissipated_energy(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width=None):
-    return _evaluate(
-        "dissipated_energy", (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
-    )
+def dissipated_energy(amplitude, load, stiffness, mu, aspect_ratio=None, groove_half_width=None, *,
+        profile=None, mapping="scaled"):  # fmt: skip
+    arguments = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
+    return _evaluate("dissipated_energy", arguments, profile, mapping)
 
 
 dissipated_energy.__doc__ = f"""Energy dissipated per cycle :math:`E_d`, the loop's area (eq. 12).
@@ -184,14 +247,14 @@ dissipated_energy.__doc__ = f"""Energy dissipated per cycle :math:`E_d`, the loo
     Notes
     -----
     Evaluated as :math:`4 P \\delta^* \\mu_E` with the corrected eq. 14.
-"""
+{_PROFILE_NOTES}"""
 
 
 @float64
-def energy_cof(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width=None):
-    return _evaluate(
-        "energy_cof", (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
-    )
+def energy_cof(amplitude, load, stiffness, mu, aspect_ratio=None, groove_half_width=None, *,
+        profile=None, mapping="scaled"):  # fmt: skip
+    arguments = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
+    return _evaluate("energy_cof", arguments, profile, mapping)
 
 
 energy_cof.__doc__ = f"""Energy coefficient of friction :math:`\\mu_E = E_d/(4P\\delta^*)` (eq. 1).
@@ -208,12 +271,14 @@ energy_cof.__doc__ = f"""Energy coefficient of friction :math:`\\mu_E = E_d/(4P\
     :math:`(x_o^2/2z_o)(1 + 1/\\mu)`; it must be :math:`(x_o^2/2z_o)(1 + 1/\\mu^2)`.
     With :math:`u = \\mu k \\delta^*`, :math:`\\mu_E = \\mu + ((1+\\mu^2)/\\mu)
     (\\operatorname{{artanh}}(u)/u - 1)`, summed as a series at small :math:`u`.
-"""
+{_PROFILE_NOTES}"""
 
 
 @float64
-def max_force(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width=None):
-    return _evaluate("max_force", (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width))
+def max_force(amplitude, load, stiffness, mu, aspect_ratio=None, groove_half_width=None, *,
+        profile=None, mapping="scaled"):  # fmt: skip
+    arguments = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
+    return _evaluate("max_force", arguments, profile, mapping)
 
 
 max_force.__doc__ = f"""Peak tangential force :math:`Q^*` of the steady loop (eq. 9).
@@ -222,13 +287,18 @@ max_force.__doc__ = f"""Peak tangential force :math:`Q^*` of the steady loop (eq
     -------
     max_force : jax.Array of float64
         :math:`Q^* = Q_+(\\delta^*)`; :math:`S\\Delta^*` with no gross slip; NaN when
-        self-locking. [N]
-{_RAISES}"""
+        self-locking. On a profile, the largest tangential force over the loop (with no
+        gross slip, the rig's force at :math:`\\Delta^*` on the stuck pad). [N]
+{_RAISES}
+    Notes
+    -----{_PROFILE_NOTES}"""
 
 
 @float64
-def regime(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width=None):
-    return _evaluate("regime", (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width))
+def regime(amplitude, load, stiffness, mu, aspect_ratio=None, groove_half_width=None, *,
+        profile=None, mapping="scaled"):  # fmt: skip
+    arguments = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
+    return _evaluate("regime", arguments, profile, mapping)
 
 
 regime.__doc__ = f"""Regime of each point as :class:`Regime` codes.
@@ -236,7 +306,9 @@ regime.__doc__ = f"""Regime of each point as :class:`Regime` codes.
     Returns
     -------
     regime : jax.Array of int32
-        ``GROSS_SLIP`` (0), ``NO_GROSS_SLIP`` (1), ``SELF_LOCKING`` (2) or ``INVALID`` (3,
-        only under ``jit``/``vmap``: concrete invalid input raises). Compare with the
-        :class:`Regime` members.
-{_RAISES}"""
+        ``GROSS_SLIP`` (0), ``NO_GROSS_SLIP`` (1), ``SELF_LOCKING`` (2), ``INVALID`` (3,
+        only under ``jit``/``vmap``: concrete invalid input raises) or, on a profile,
+        ``BEYOND_PROFILE`` (4). Compare with the :class:`Regime` members.
+{_RAISES}
+    Notes
+    -----{_PROFILE_NOTES}"""

@@ -836,6 +836,116 @@ def correction(quick: bool) -> None:
 
 
 # ---------------------------------------------------------------------------------------
+# profile: energy_cof on a scar profile against per-point SciPy first passage
+# ---------------------------------------------------------------------------------------
+
+
+def profile(quick: bool) -> None:
+    """Points per second of energy_cof on one 1000-sample scar profile over (S/P, Δ*) grids.
+
+    Two profiles of the Example 2 aspect ratio (D/W = 0.2, W = 100 µm): a flat-bottomed
+    scar, where the pad never jumps, and a W-shaped one, where it jumps over the hump on
+    the softest rigs (those points take the O(N) jump pass). The grid is square in S/P
+    (1e4-3e5 /m) and Δ* (10-100 µm), μ = 0.8, the scaled mapping (one set of tables). The
+    baseline is the tests' brute force per point (tests/brute_force.py: NumPy first-passage
+    scan and SciPy brentq for the loop's ends, SciPy quad split at every sample for E_d), on
+    a sample of the grid and extrapolated; the closed form on the parabola of the same D/W
+    is shown for scale. Best of ``repeats`` warm calls.
+    """
+    import warnings
+
+    from ecofmaps import (
+        RegimeWarning,
+        energy_cof,
+        flat_bottomed_profile,
+        w_shaped_profile,
+    )
+    from ecofmaps.model.on_profile import steady_numbers
+    from tests.brute_force import ProfileBruteForce
+
+    depth, width = 20e-6, 100e-6
+    profiles = {
+        "flat-bottomed": flat_bottomed_profile(depth, width, 0.4, samples=1000),
+        "W-shaped": w_shaped_profile(depth, width, 0.3, samples=1000),
+    }
+    sizes = [10**4] if quick else [10**4, 10**5, 10**6]
+    repeats = 2 if quick else 3
+    sample = 3 if quick else 20
+    print(f"energy_cof on a 1000-sample profile (jit, float64) vs SciPy; {load_average()}")
+    print(
+        f"{'profile':>14} {'points':>9} {'compile':>8} {'wall':>9} {'CPU':>9} {'closed':>9} "
+        f"{'jumps':>6} {'vs SciPy':>9}"
+    )
+    print(
+        f"{'':>14} {'':>9} {'[s]':>8} {'[pt/s]':>9} {'[pt/s]':>9} {'[pt/s]':>9} {'[%]':>6} "
+        f"{'wall':>9}"
+    )
+    rng = np.random.default_rng(0)
+    for name, scar in profiles.items():
+        scipy_speed, difference = math.nan, 0.0
+        for size in sizes:
+            side = round(math.sqrt(size))
+            ratio = np.geomspace(1e4, 3e5, side)[:, None]  # [1/m]
+            amplitude = np.linspace(10e-6, 100e-6, side)[None, :]
+            stiffness = ratio * LOAD
+
+            def run(scar=scar, amplitude=amplitude, stiffness=stiffness):
+                energy_cof(amplitude, LOAD, stiffness, MU, profile=scar).block_until_ready()
+
+            def closed(amplitude=amplitude, stiffness=stiffness):
+                energy_cof(amplitude, LOAD, stiffness, MU, depth / width).block_until_ready()
+
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RegimeWarning)  # no gross slip on soft rigs
+                first, _ = timed(run)
+                best = (math.inf, math.inf)
+                for _ in range(repeats):
+                    best = min(best, timed(run))
+                closed_wall = min(timed(closed)[0] for _ in range(repeats + 1))
+                numbers = steady_numbers(scar, amplitude, LOAD, stiffness, MU)
+            points = side * side
+            wall, cpu = best
+            ecof = np.asarray(numbers["ecof_ratio"]) * MU
+            slip = np.asarray(numbers["slip_ratio"])
+            if math.isnan(scipy_speed):
+                gross = np.flatnonzero(np.isfinite(ecof.ravel()) & (slip.ravel() > 0))
+                chosen = rng.choice(gross, size=min(sample, gross.size), replace=False)
+                start = time.perf_counter()
+                for k in chosen:
+                    i, j = np.unravel_index(k, ecof.shape)
+                    reference = ProfileBruteForce(
+                        scar.position, scar.slope, float(amplitude[0, j]), LOAD,
+                        float(stiffness[i, 0]), MU, float(scar.half_width),
+                    ).steady_loop()  # fmt: skip
+                    difference = max(difference, abs(reference["ecof"] / ecof[i, j] - 1.0))
+                scipy_speed = chosen.size / (time.perf_counter() - start)
+            jumps = _jump_fraction(scar, amplitude, stiffness)
+            print(
+                f"{name:>14} {points:9.2e} {first - wall:8.2f} {points / wall:9.3g} "
+                f"{points / cpu:9.3g} {points / closed_wall:9.3g} {100 * jumps:6.2f} "
+                f"{points / wall / scipy_speed:9.3g}"
+            )
+        print(
+            f"{name:>14}: SciPy brute force per point, {sample} points: {scipy_speed:.3g} pt/s; "
+            f"max rel diff of μ_E {difference:.1e}"
+        )
+
+
+def _jump_fraction(scar, amplitude, stiffness) -> float:
+    """Fraction of the grid's gross-slip points where the pad jumps (the O(N) pass runs)."""
+    from ecofmaps.model import on_profile
+
+    prepared = on_profile._prepare(
+        *on_profile._inputs(amplitude, LOAD, stiffness, MU, None), scar.half_width, False
+    )
+    mu, key, lam, _ = (np.asarray(v) for v in prepared)
+    unique, group = on_profile._groups(mu, key)
+    loops, _ = on_profile._shared(scar, unique, group, lam, False)
+    gross = np.asarray(loops.regime) == 0
+    return float(np.mean(~np.asarray(loops.monotone)[gross])) if gross.any() else 0.0
+
+
+# ---------------------------------------------------------------------------------------
 
 #: The benchmark sections, run in this order; append yours.
 SECTIONS = {
@@ -843,6 +953,7 @@ SECTIONS = {
     "loops": loops,
     "correction": correction,
     "resolved": resolved,
+    "profile": profile,
 }
 
 

@@ -85,7 +85,7 @@ def test_resolved_loops_draws_the_datasets_numbers(results, tmp_path):
     np.testing.assert_allclose(mu.get_xdata(), resolved.position * 1e6)
     np.testing.assert_allclose(mu.get_ydata(), last.mu)
     (profile,) = [line for line in felt.get_lines() if line.get_label() == name]
-    np.testing.assert_allclose(profile.get_ydata(), last.profile * 1e6)
+    np.testing.assert_allclose(profile.get_ydata(), last.felt_profile * 1e6)
     assert "[µm]" in stroke.get_xlabel() and "[µm]" in felt.get_ylabel()
     assert image.get_ylabel() == "Cycle"
     series = {line.get_label(): line for line in test.get_lines()}

@@ -20,6 +20,7 @@ from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.quality import (
     ALL,
     REASONS,
+    RESOLVED,
     SEPARATOR,
     LoopQualityWarning,
     add_reason,
@@ -344,7 +345,7 @@ def test_vocabulary():
     """Reasons are lower-case words joined by hyphens; joined by '+', split back alike."""
     for reason, (meaning, scope) in REASONS.items():
         assert re.fullmatch(r"[a-z0-9]+(-[a-z0-9]+)*", reason), reason
-        assert meaning and (scope == ALL or set(scope) <= set(PER_CYCLE)), reason
+        assert meaning and (scope == ALL or set(scope) <= {*PER_CYCLE, *RESOLVED}), reason
     flags = {
         "negative-slip": np.array([True, False, False, True]),
         "curved-stick": np.array([True, False, True, False]),

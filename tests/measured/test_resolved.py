@@ -80,7 +80,7 @@ def assert_read_exactly(result, point, ratios=None):
         depth = groove_slope(here) * xi[inside].max() ** 2 / 2
         profile = groove_slope(here) * xi[inside] ** 2 / 2
         atol = EXACT * depth + 1e-15 * AMPLITUDE  # g's rounding (~1e-16) integrated
-        np.testing.assert_allclose(cycle.profile.values[inside], profile, rtol=0, atol=atol)
+        np.testing.assert_allclose(cycle.felt_profile.values[inside], profile, rtol=0, atol=atol)
         assert abs(float(cycle.mu_resolved) / point["mu"] - 1) < EXACT
         assert abs(float(cycle.aspect_ratio) - ratio) < EXACT * max(ratio, 1.0)
         assert abs(float(cycle.tilt)) < EXACT
@@ -298,11 +298,11 @@ def felt_profile(result, height, slope, offset, level):
 
 def profile_errors(result, truth):
     """max |h - h_true| over the resolved range, as a share of the true depth there, per cycle."""
-    inside = np.isfinite(result.profile.values)
+    inside = np.isfinite(result.felt_profile.values)
     errors = []
     for k in range(result.cycle.size):
         true = truth[k][inside[k]]
-        measured = result.profile.values[k][inside[k]]
+        measured = result.felt_profile.values[k][inside[k]]
         errors.append(np.abs(measured - true).max() / (true.max() - true.min()))
     return np.array(errors)
 
@@ -362,9 +362,9 @@ def test_shaped_grooves_with_noise(shaped_loops, name):
     errors = profile_errors(result, truth)
     assert np.median(errors) < 0.05
     assert errors.max() < 0.10
-    everywhere = np.isfinite(result.profile.values).all(axis=0)
+    everywhere = np.isfinite(result.felt_profile.values).all(axis=0)
     mean, true = (
-        result.profile.values[:, everywhere].mean(axis=0),
+        result.felt_profile.values[:, everywhere].mean(axis=0),
         truth[:, everywhere].mean(axis=0),
     )
     assert np.abs(mean - true).max() < 0.05 * (true.max() - true.min())
@@ -381,7 +381,7 @@ def assert_flagged(result, *flags):
         assert set(quality.split("+")) & set(flags), quality
     for name in ("mu_resolved", "mu_resolved_se", "aspect_ratio", "tilt", "position_min"):
         assert result[name].isnull().all(), name
-    for name in ("mu", "slope", "profile", "force_forward", "force_backward"):
+    for name in ("mu", "slope", "felt_profile", "force_forward", "force_backward"):
         assert result[name].isnull().all(), name
     assert (np.diff(result.position) > 0).all()  # over the stroke when nothing is resolved
 
@@ -527,7 +527,7 @@ def test_given_grid_and_options(noisy_recording):
     grid = np.concatenate([np.linspace(-30e-6, 0, 31), np.linspace(1e-6, 30e-6, 10)])
     result = resolve_loops(*noisy_recording, LOAD, positions=grid, central=0.5)
     np.testing.assert_array_equal(result.position, grid)
-    assert (result.profile.sel(position=0.0) == 0.0).all()
+    assert (result.felt_profile.sel(position=0.0) == 0.0).all()
     assert result.attrs["central"] == 0.5
     alone = resolve_loops(*noisy_recording, LOAD, positions=None)  # per cycle only
     assert "position" not in alone.dims and "mu" not in alone

@@ -16,6 +16,15 @@ from ecofmaps.measured.synthetic import (
 POINT = dict(amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8)
 
 
+def test_shipped_scar_profile_is_regenerated_byte_for_byte(tmp_path):
+    """ecofmaps/data/synthetic_scar_profile.csv is what scar_example_trace() writes."""
+    from ecofmaps.measured.synthetic import scar_example_path, write_scar_example
+
+    rewritten = write_scar_example(tmp_path / "scar.csv")
+    assert rewritten.read_bytes() == scar_example_path().read_bytes()
+    assert scar_example_path().read_text().startswith("# SYNTHETIC DATA, not a measurement")
+
+
 def test_shipped_example_is_regenerated(tmp_path):
     """The generator reproduces the shipped file to the printed digits (0.1 nm, 1 mN)."""
     shipped = read_recording(example_path())

@@ -1,0 +1,126 @@
+"""Wear-scar profiles in text files: a profilometer trace across the scar.
+
+:func:`read_scar_profile` reads two columns, the position along the fretting direction and
+the height (``x`` and ``z`` in µm by default), from a comma-, tab- or whitespace-separated
+file with a header line (the columns are read as :func:`ecofmaps.read_recording` reads
+them), levels the trace on the unworn shoulders and returns the
+:class:`~ecofmaps.model.profiles.ScarProfile` the model uses. A damaged file raises
+:class:`ScarProfileError`, which names the file and the 1-based line.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ecofmaps.io.files import FileLineError
+from ecofmaps.model.profiles import ScarProfile, scar_profile
+
+__all__ = ["ScarProfileError", "read_scar_profile"]
+
+
+class ScarProfileError(FileLineError):
+    """A damaged or unusable scar-profile file: the message names the file and the line."""
+
+
+def read_scar_profile(
+    path,
+    *,
+    x_column="x",
+    z_column="z",
+    x_unit=None,
+    z_unit=None,
+    level=True,
+    half_width=None,
+    smoothing=None,
+) -> ScarProfile:
+    """Read a wear-scar profile (a profilometer trace across the scar) from a text file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A text file: a header line of column names, then one sample per line, in any of
+        the dialects :func:`ecofmaps.read_recording` reads (separators, decimal comma,
+        quotes, comments and encodings; see :mod:`ecofmaps.io.text`).
+    x_column, z_column : str
+        Names of the position and height columns (matched without regard to case or to a
+        unit in the name: ``x`` finds ``X [mm]``).
+    x_unit, z_unit : str, optional
+        Their units of length (``'um'``, ``'mm'``, ``'nm'``, ``'m'``, ...); by default the
+        unit the column's name gives, else µm. A unit given that disagrees with the name's
+        is an error.
+    level : bool
+        Remove the tilt and offset of the unworn surface, a line fitted on the shoulders
+        outside the scar (on by default: a specimen is rarely mounted level in the
+        profilometer). See :func:`ecofmaps.scar_profile`.
+    half_width : float, optional
+        The scar's half-width, overriding the detected one. [m]
+    smoothing : float, optional
+        Smoothing length of the slopes; default 2 % of the half-width, 0 for none. [m]
+
+    Returns
+    -------
+    profile : ScarProfile
+        In SI units (m), positions relative to the scar's centre.
+
+    Raises
+    ------
+    ScarProfileError
+        For a missing column, a line with the wrong number of fields, a non-numeric or
+        non-finite cell, positions that do not increase strictly (unsorted or repeated),
+        no data, or a trace that is not a usable scar (no depression, a scar reaching the
+        end of the trace, too few samples across it, a half-width that does not fit): the
+        message names the file and the line (for the whole trace, its first data line).
+    ValueError
+        For a unit that is not a length.
+    OSError
+        If the file cannot be read.
+
+    Examples
+    --------
+    >>> import ecofmaps
+    >>> from ecofmaps.measured.synthetic import scar_example_path
+    >>> p = ecofmaps.read_scar_profile(scar_example_path())
+    >>> round(float(p.half_width) * 1e6), round(float(p.aspect_ratio), 3)
+    (500, 0.16)
+    """
+    from ecofmaps.io.recordings import RecordingError
+    from ecofmaps.io.text import text_blocks
+
+    path = Path(path)
+    options = {
+        "columns": {"x": x_column, "z": z_column},
+        "x_unit": x_unit,
+        "z_unit": z_unit,
+        "nan_policy": "raise",
+    }
+    try:
+        blocks = text_blocks(path, options)
+        layout = next(blocks)
+        parts = list(blocks)
+    except RecordingError as error:  # the same damage, named as a profile's
+        raise ScarProfileError(path, error.line or 1, error.message) from None
+    if not parts:
+        raise ScarProfileError(path, layout.header_line, "no data after the header")
+    x, z = (np.concatenate([part[0][role] for part in parts]) for role in ("x", "z"))
+    lines = np.concatenate([part[1] for part in parts])
+    typed = x / layout.scales["x"]  # the positions as the file gives them, for messages
+    steps = np.diff(x)
+    if np.any(steps <= 0.0):
+        i = int(np.argmax(steps <= 0.0))
+        kind = "repeats" if steps[i] == 0.0 else "goes back from"
+        raise ScarProfileError(
+            path,
+            lines[i + 1],
+            f"position {float(typed[i + 1])!r} {kind} {float(typed[i])!r} on line "
+            f"{lines[i]}: "
+            f"column {x_column!r} must increase strictly (sort the trace and drop repeated "
+            "positions)",
+        )
+    try:
+        return scar_profile(x, z, half_width=half_width, smoothing=smoothing, level=level)
+    except ValueError as error:
+        raise ScarProfileError(
+            path, lines[0], f"the trace (lines {lines[0]}-{lines[-1]}): {error}"
+        ) from None

@@ -1,0 +1,415 @@
+r"""The model on a scar profile in SI units: steady loops, drawn loops and time histories.
+
+:func:`steady_numbers` evaluates the steady loop of :mod:`ecofmaps.model.profile_core` at
+any broadcast set of points. Points that share :math:`\mu` and the stroke length
+:math:`A = \Delta^*W/x_o` (all of them when :math:`x_o = \Delta^*`, whatever the
+amplitude, load and stiffness) share one set of tables, built once, and cost
+:math:`O(\log N)` each; points where the pad jumps get the jumps' areas in :math:`O(N)`.
+When :math:`\mu` or :math:`A` is traced (under ``jax.jit``/``jax.vmap``), each point
+builds its own :math:`O(N)` tables. The public functions of
+:mod:`ecofmaps.model.steady_state` and :mod:`ecofmaps.model.simulation` call in here when
+given ``profile=``.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import partial
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ecofmaps._inputs import as_float64, check, is_concrete
+from ecofmaps.model import profile_core as core
+from ecofmaps.model.profiles import ScarProfile
+from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
+
+__all__ = [
+    "MAPPINGS",
+    "as_profile",
+    "check_mapping",
+    "profile_loop",
+    "profile_simulation",
+    "steady_numbers",
+]
+
+#: How a pad position x maps onto the profile: eq. 11, X = x W/x_o; or X = x.
+MAPPINGS = ("scaled", "physical")
+
+# Memory bound of one batch of shared tables (floats), and of the per-point O(N) work.
+_TABLE_BUDGET = 2**25
+_POINT_BATCH = 256
+# Points share tables unless there are more groups than this and than a 16th of the points.
+_FEW_GROUPS = 64
+
+
+def as_profile(profile) -> ScarProfile:
+    """``profile`` as float64 arrays, checked when concrete; ``ValueError`` if it is not one."""
+    if not isinstance(profile, ScarProfile):
+        raise ValueError(
+            "profile must be a ScarProfile (from ecofmaps.scar_profile, "
+            f"ecofmaps.read_scar_profile or a profile family), got {type(profile).__name__}"
+        )
+    profile = ScarProfile(*(as_float64(leaf) for leaf in profile))
+    if is_concrete(*profile):
+        position = np.asarray(profile.position)
+        if position.ndim != 1 or position.size < 3:
+            raise ValueError(
+                "profile.position must be a 1-D array of at least 3 samples (a batch of "
+                "profiles is mapped over with jax.vmap)"
+            )
+        if profile.slope.shape != position.shape:
+            raise ValueError("profile.slope must have the shape of profile.position")
+        if not (np.all(np.isfinite(position)) and np.all(np.diff(position) > 0.0)):
+            raise ValueError("profile.position must be finite and strictly increasing")
+        if not np.all(np.isfinite(np.asarray(profile.slope))):
+            raise ValueError("profile.slope must be finite")
+        width = float(profile.half_width)
+        if not (math.isfinite(width) and width > 0.0):
+            raise ValueError(f"profile.half_width must be finite and > 0, got {width!r}")
+        if not position[0] < 0.0 < position[-1]:
+            raise ValueError("profile.position must run from before to after the scar centre 0")
+    return profile
+
+
+def check_mapping(mapping, groove_half_width) -> bool:
+    """True for the physical mapping; ``ValueError`` for a bad combination."""
+    if mapping not in MAPPINGS:
+        raise ValueError(f"mapping must be one of {MAPPINGS}, got {mapping!r}")
+    if mapping == "physical" and groove_half_width is not None:
+        raise ValueError(
+            "groove_half_width sets the scaled mapping X = x W/x_o (eq. 11); "
+            "mapping='physical' (X = x) takes none"
+        )
+    return mapping == "physical"
+
+
+def _inputs(amplitude, load, stiffness, mu, groove_half_width):
+    check("amplitude", amplitude, "positive", "m")
+    check("load", load, "positive", "N")
+    check("stiffness", stiffness, "positive_or_inf", "N/m")
+    check("mu", mu, "positive", "1")
+    if groove_half_width is not None:
+        check("groove_half_width", groove_half_width, "positive", "m")
+    values = [as_float64(v) for v in (amplitude, load, stiffness, mu)]
+    values.append(values[0] if groove_half_width is None else as_float64(groove_half_width))
+    return jnp.broadcast_arrays(*values)
+
+
+def _valid(amplitude, load, stiffness, mu, half_width):
+    return (
+        (amplitude > 0.0)
+        & jnp.isfinite(amplitude)
+        & (load > 0.0)
+        & jnp.isfinite(load)
+        & (stiffness > 0.0)
+        & ~jnp.isnan(stiffness)
+        & (mu > 0.0)
+        & jnp.isfinite(mu)
+        & (half_width > 0.0)
+        & jnp.isfinite(half_width)
+    )
+
+
+# ---------------------------------------------------------------------------------------
+# Kernels
+# ---------------------------------------------------------------------------------------
+
+
+def _stroke(half_width, key, physical: bool):
+    """The stroke length A from the grouping key (Δ*/x_o, or Δ* for the physical mapping)."""
+    return key if physical else half_width * key
+
+
+def _drop_group(tables):
+    return jax.tree.map(lambda leaf: leaf[:, 0], tables)
+
+
+def _jumps(tables, group, lam, ends):
+    """The jumps' areas of both strokes (backward on the mirrored profile)."""
+    n = tables.forward.position.shape[-1]
+    mu = tables.mu[group]
+    lower, upper = ends
+    forward = core.jump_area(tables.forward, group, mu, lam, lower, upper)
+    mirrored = (core._mirror(*upper, n), core._mirror(*lower, n))
+    return forward + core.jump_area(tables.backward, group, mu, lam, *mirrored)
+
+
+@partial(jax.jit, static_argnames=("physical", "sparse"))
+def _shared_tables(position, slope, half_width, mu, key, physical, sparse):
+    """One set of tables per group (mu, key), stacked.
+
+    Built in a call of their own: inside the points' computation XLA would fuse the
+    tables' construction into every lookup and repeat it per point.
+    """
+    length = _stroke(half_width, key, physical)
+    build = jax.vmap(core.profile_tables, in_axes=(None, None, 0, 0, None))
+    return _drop_group(build(position, slope, mu, length, sparse))
+
+
+@jax.jit
+def _shared_loops(tables, group, lam):
+    """Steady loops of points in groups with shared sparse tables."""
+    return jax.vmap(core.steady_loop, in_axes=(None, 0, 0, None))(tables, group, lam, True)
+
+
+@jax.jit
+def _shared_jumps(tables, group, lam, ends):
+    one = partial(_jumps, tables)
+    return jax.lax.map(lambda point: one(*point), (group, lam, ends), batch_size=_POINT_BATCH)
+
+
+def _own_loop(position, slope, half_width, physical, point):
+    """One point with its own O(N) tables, jumps included."""
+    mu, key, lam = point
+    tables = core.profile_tables(position, slope, mu, _stroke(half_width, key, physical), False)
+    loop = core.steady_loop(tables, 0, lam, False)
+    return loop, _jumps(tables, 0, lam, loop.ends)
+
+
+@partial(jax.jit, static_argnames="physical")
+def _own_loops(position, slope, half_width, mu, key, lam, physical):
+    one = partial(_own_loop, position, slope, half_width, physical)
+    return jax.lax.map(one, (mu, key, lam), batch_size=_POINT_BATCH)
+
+
+def _pad(indices: np.ndarray) -> np.ndarray:
+    """Indices padded (with the last one) to a power of two: few shapes to compile."""
+    return np.pad(indices, (0, _bucket(indices.size) - indices.size), mode="edge")
+
+
+def _bucket(size: int) -> int:
+    """``size`` rounded up to a power of two (at least 8)."""
+    return max(8, 1 << (size - 1).bit_length())
+
+
+def _groups(mu: np.ndarray, key: np.ndarray):
+    """The distinct (mu, key) pairs, as a (2, U) array, and each point's pair."""
+    if mu.size and np.all(mu == mu[0]) and np.all(key == key[0]):
+        return np.array([[mu[0]], [key[0]]]), np.zeros(mu.size, dtype=np.int64)
+    mus, mu_index = np.unique(mu, return_inverse=True)
+    keys, key_index = np.unique(key, return_inverse=True)
+    pairs, group = np.unique(mu_index * keys.size + key_index, return_inverse=True)
+    unique = np.stack([mus[pairs // keys.size], keys[pairs % keys.size]])
+    return unique, group.reshape(-1)
+
+
+def _shared(profile, unique, group, lam, physical):
+    """Loops and jump areas of points in groups ``unique[:, group]`` with shared tables.
+
+    Groups and points are padded to powers of two, so that few shapes are compiled; the
+    results may be longer than the points (padding at the end). With many groups, in
+    batches that bound the tables' memory.
+    """
+    count = unique.shape[1]
+    n = profile.position.shape[-1]
+    per_group = 8 * n * (core._levels(n) + 1)
+    batch = min(_bucket(count), max(1, 1 << (_TABLE_BUDGET // per_group).bit_length() - 1))
+    arguments = (profile.position, profile.slope, profile.half_width)
+    unique = np.pad(unique, ((0, 0), (0, -count % batch)), mode="edge")
+    lam = np.asarray(lam)
+    if count <= batch:  # one batch, the points in order
+        padded = _pad(np.arange(lam.size))
+        tables = _shared_tables(*arguments, *unique, physical, True)
+        loops = _shared_loops(tables, group[padded], lam[padded])
+    else:  # every batch padded to one shape: one compilation
+        parts, order = [], []
+        starts = range(0, count, batch)
+        members_of = [np.flatnonzero((group >= f) & (group < f + batch)) for f in starts]
+        width = _bucket(max(m.size for m in members_of))
+        for first, members in zip(starts, members_of, strict=True):
+            padded = np.pad(members, (0, width - members.size), mode="edge")
+            tables = _shared_tables(*arguments, *unique[:, first : first + batch], physical, True)
+            part = _shared_loops(tables, group[padded] - first, lam[padded])
+            parts.append(jax.tree.map(lambda leaf, m=members.size: leaf[:m], part))
+            order.append(members)
+        order = np.concatenate(order)
+        inverse = np.empty_like(order)
+        inverse[order] = np.arange(order.size)
+        loops = jax.tree.map(lambda *leaves: jnp.concatenate(leaves)[inverse], *parts)
+    dense = _shared_tables(*arguments, *unique[:, :count], physical, False)
+    size = loops.monotone.shape[0]
+    group = np.pad(group, (0, size - group.size), mode="edge")
+    lam = np.pad(lam, (0, size - lam.size), mode="edge")
+    if is_concrete(loops.monotone):
+        jumps = np.zeros(size)
+        where = np.flatnonzero(~np.asarray(loops.monotone))
+        if where.size:
+            padded = _pad(where)
+            ends = jax.tree.map(lambda leaf: leaf[padded], loops.ends)
+            values = _shared_jumps(dense, group[padded], lam[padded], ends)
+            jumps[where] = np.asarray(values)[: where.size]
+    else:
+        jumps = jax.lax.cond(
+            jnp.any(~loops.monotone),
+            lambda: _shared_jumps(dense, group, lam, loops.ends),
+            lambda: jnp.zeros(size),
+        )
+    return loops, jumps
+
+
+@partial(jax.jit, static_argnames="physical")
+def _prepare(amplitude, load, stiffness, mu, half_width, profile_half_width, physical):
+    """Flat (mu, key, lam, valid) with harmless stand-ins at invalid points."""
+    valid = _valid(amplitude, load, stiffness, mu, half_width)
+    lam = jnp.where(valid, load / (stiffness * amplitude), 0.1)
+    key = amplitude if physical else amplitude / half_width
+    key = jnp.where(valid, key, profile_half_width if physical else 1.0)
+    return tuple(v.reshape(-1) for v in (jnp.where(valid, mu, 0.5), key, lam, valid))
+
+
+@jax.jit
+def _finish(loops, jumps, mu, lam, valid) -> dict:
+    """The steady-loop numbers from the loops and the jumps' areas (module docstring); the
+    loops may be padded beyond the points."""
+    loops, jumps = jax.tree.map(lambda leaf: leaf[: mu.shape[0]], (loops, jumps))
+    slip = 0.5 * (loops.plus - loops.minus)
+    scale = 4.0 * mu * jnp.where(lam > 0.0, lam, 1.0) * jnp.where(slip > 0.0, slip, 1.0)
+    ratio = loops.ecof_ratio + jnp.where(jumps > 0.0, jumps / scale, 0.0)
+    regime = jnp.where(valid, loops.regime, int(INVALID)).astype(jnp.int32)
+    gross = regime == int(GROSS_SLIP)
+    settled = gross | (regime == int(NO_GROSS_SLIP))
+    energy = jnp.where(gross, 4.0 * slip * mu * ratio, jnp.where(settled, 0.0, jnp.nan))
+    return {
+        "slip_ratio": jnp.where(settled, slip, jnp.nan),
+        "ecof_ratio": jnp.where(gross, ratio, jnp.nan),
+        "normalized_energy": energy,
+        "normalized_max_force": jnp.where(settled, loops.peak_force, jnp.nan),
+        "regime": regime,
+        "minus": jnp.where(settled, loops.minus, jnp.nan),
+        "plus": jnp.where(settled, loops.plus, jnp.nan),
+    }
+
+
+def steady_numbers(profile, amplitude, load, stiffness, mu, groove_half_width=None,
+                   mapping="scaled") -> dict:  # fmt: skip
+    r"""The steady loop on ``profile`` at every point, in the units of the core.
+
+    Parameters
+    ----------
+    profile : ScarProfile
+    amplitude, load, stiffness, mu, groove_half_width : array_like
+        As for :func:`ecofmaps.slip_amplitude` (SI); ``groove_half_width`` :math:`x_o`
+        defaults to ``amplitude``.
+    mapping : {'scaled', 'physical'}
+        :math:`X = xW/x_o` (eq. 11) or :math:`X = x`.
+
+    Returns
+    -------
+    numbers : dict of jax.Array
+        Over the broadcast shape: ``slip_ratio`` :math:`\delta^*/\Delta^*`, ``ecof_ratio``
+        :math:`\mu_E/\mu`, ``normalized_energy`` :math:`E_d/(P\Delta^*)`,
+        ``normalized_max_force`` :math:`Q^*/P`, ``regime``, and the loop's ends ``minus``
+        and ``plus`` (contact positions over :math:`\Delta^*`). NaN (but the regime) outside
+        gross slip and no gross slip.
+    """
+    physical = check_mapping(mapping, groove_half_width)
+    profile = as_profile(profile)
+    values = _inputs(amplitude, load, stiffness, mu, groove_half_width)
+    shape = values[0].shape
+    mu, key, lam, valid = _prepare(*values, profile.half_width, physical)
+    own = not is_concrete(mu, key, lam)
+    if not own:
+        unique, group = _groups(np.asarray(mu), np.asarray(key))
+        own = unique.shape[1] > max(_FEW_GROUPS, lam.size // 16)
+    if own:  # each point its own O(N) tables
+        padded = _pad(np.arange(lam.size))
+        loops, jumps = _own_loops(
+            profile.position, profile.slope, profile.half_width, mu[padded], key[padded],
+            lam[padded], physical,
+        )  # fmt: skip
+    else:
+        loops, jumps = _shared(profile, unique, group, lam, physical)
+    loops = loops._replace(ends=())
+    numbers = _finish(loops, jumps, mu, lam, valid)
+    return {name: value.reshape(shape) for name, value in numbers.items()}
+
+
+# ---------------------------------------------------------------------------------------
+# Drawn loops and time histories
+# ---------------------------------------------------------------------------------------
+
+
+def _drawn(position, slope, half_width, physical, num, point):
+    mu, key, lam = point
+    tables = core.profile_tables(position, slope, mu, _stroke(half_width, key, physical), False)
+    loop = core.steady_loop(tables, 0, lam, False)
+    actuator, force = core.draw_loop(tables, 0, lam, loop, num)
+    ok = (loop.regime == int(GROSS_SLIP)) | (loop.regime == int(NO_GROSS_SLIP))
+    return jnp.where(ok, actuator, jnp.nan), jnp.where(ok, force, jnp.nan)
+
+
+@partial(jax.jit, static_argnames=("physical", "num"))
+def _drawn_loops(position, slope, half_width, mu, key, lam, physical, num):
+    one = partial(_drawn, position, slope, half_width, physical, num)
+    return jax.lax.map(one, (mu, key, lam), batch_size=_POINT_BATCH)
+
+
+def profile_loop(profile, amplitude, load, stiffness, mu, groove_half_width, mapping, num):
+    """Displacement and force around the steady loop on ``profile`` (see fretting_loop)."""
+    physical = check_mapping(mapping, groove_half_width)
+    profile = as_profile(profile)
+    amplitude, load, stiffness, mu, half_width = _inputs(
+        amplitude, load, stiffness, mu, groove_half_width
+    )
+    shape = amplitude.shape
+    valid = _valid(amplitude, load, stiffness, mu, half_width).reshape(-1)
+    lam = jnp.where(valid, (load / (stiffness * amplitude)).reshape(-1), 0.1)
+    key = (amplitude if physical else amplitude / half_width).reshape(-1)
+    key = jnp.where(valid, key, profile.half_width if physical else 1.0)
+    mu_flat = jnp.where(valid, mu.reshape(-1), 0.5)
+    actuator, force = _drawn_loops(
+        profile.position, profile.slope, profile.half_width, mu_flat, key, lam, physical, num
+    )
+    actuator = jnp.where(valid[:, None], actuator, jnp.nan) * amplitude.reshape(-1, 1)
+    force = jnp.where(valid[:, None], force, jnp.nan) * load.reshape(-1, 1)
+    return actuator.reshape(*shape, -1), force.reshape(*shape, -1)
+
+
+def _history(position, slope, history):
+    """Q/P over a history of D for one (mu, lam): the return map from rest at the centre."""
+    mu, lam, targets = history
+    tables = core.simulation_tables(position, slope, mu, lam)
+    start = (tables.start_segment[0], tables.start_fraction[0], jnp.zeros(()), jnp.array(False))
+    _, q = jax.lax.scan(partial(core.simulation_step, tables, lam), start, targets)
+    return q
+
+
+@jax.jit
+def _histories(position, slope, mu, lam, targets):
+    return jax.lax.map(partial(_history, position, slope), (mu, lam, targets))
+
+
+def profile_simulation(profile, displacement, load, stiffness, mu, groove_half_width, mapping):
+    """Tangential force history on ``profile`` (see simulate); displacement has time last."""
+    physical = check_mapping(mapping, groove_half_width)
+    profile = as_profile(profile)
+    if not physical and groove_half_width is None:
+        raise ValueError(
+            "simulate on a profile with the scaled mapping X = x W/x_o (eq. 11) needs "
+            "groove_half_width = x_o (the steady loop uses x_o = amplitude); or give "
+            "mapping='physical'"
+        )
+    check("load", load, "positive", "N")
+    check("stiffness", stiffness, "positive_or_inf", "N/m")
+    check("mu", mu, "positive", "1")
+    if groove_half_width is not None:
+        check("groove_half_width", groove_half_width, "positive", "m")
+    displacement = as_float64(displacement)
+    load, stiffness, mu = (as_float64(v) for v in (load, stiffness, mu))
+    x_o = profile.half_width if physical else as_float64(groove_half_width)
+    batch = jnp.broadcast_shapes(displacement.shape[:-1], load.shape, stiffness.shape, mu.shape,
+                                 x_o.shape)  # fmt: skip
+    steps = displacement.shape[-1]
+    displacement = jnp.broadcast_to(displacement, (*batch, steps))
+    load, stiffness, mu, x_o = (jnp.broadcast_to(v, batch) for v in (load, stiffness, mu, x_o))
+    valid = _valid(jnp.ones(batch), load, stiffness, mu, x_o)
+    # Units of the scar's half-width W: X/W = x/x_o, D = Δ/x_o, λ = P/(S x_o).
+    lam = jnp.where(valid, load / (stiffness * x_o), 0.1).reshape(-1)
+    targets = (displacement / x_o[..., None]).reshape(-1, steps)
+    mu_flat = jnp.where(valid, mu, 0.5).reshape(-1)
+    position = profile.position / profile.half_width
+    q = _histories(position, profile.slope, mu_flat, lam, targets)
+    force = q.reshape(*batch, steps) * load[..., None]
+    return jnp.where(valid[..., None], force, jnp.nan)
