@@ -63,6 +63,8 @@ class Runner:
         Address of an existing dask scheduler (``tcp://host:8786``).
     cluster : bool
         Start a ``LocalCluster`` of ``workers`` processes (one thread each).
+    client : distributed.Client, optional
+        A client of a cluster already connected (left open).
     timeout : float
         Seconds to wait for the scheduler at ``scheduler`` to answer.
 
@@ -71,7 +73,9 @@ class Runner:
     Use as a context manager: the cluster or thread pool is closed on leaving it.
     """
 
-    def __init__(self, workers=None, *, scheduler=None, cluster=False, timeout=CONNECT_TIMEOUT):
+    def __init__(
+        self, workers=None, *, scheduler=None, cluster=False, client=None, timeout=CONNECT_TIMEOUT
+    ):
         if workers is not None and (
             isinstance(workers, bool) or int(workers) != workers or workers < 1
         ):
@@ -80,17 +84,21 @@ class Runner:
             raise ValueError("give a scheduler address or start a local cluster, not both")
         self.scheduler, self.cluster, self.timeout = scheduler, cluster, float(timeout)
         self.workers = int(workers) if workers else (1 if scheduler else os.cpu_count() or 1)
+        self._given = client
         self._client = self._cluster = self._pool = None
 
     @property
     def kind(self) -> str:
         """``'threads'``, ``'local cluster'`` or ``'cluster at <address>'``."""
-        if self.scheduler:
-            return f"cluster at {self.scheduler}"
+        if self.scheduler or self._given is not None:
+            return f"cluster at {self.scheduler or self._given.scheduler.address}"
         return "local cluster" if self.cluster else "threads"
 
     def __enter__(self) -> Runner:
-        if self.scheduler is not None:
+        if self._given is not None:
+            self._client = self._given
+            self.workers = max(len(self._client.scheduler_info()["workers"]), 1)
+        elif self.scheduler is not None:
             self._client = _connect(self.scheduler, self.timeout)
             self.workers = max(len(self._client.scheduler_info()["workers"]), 1)
         elif self.cluster:
@@ -111,7 +119,7 @@ class Runner:
     def __exit__(self, *exc):
         if self._pool is not None:
             self._pool.shutdown(wait=True, cancel_futures=True)
-        if self._client is not None:
+        if self._client is not None and self._given is None:
             self._client.close()
         if self._cluster is not None:
             self._cluster.close()
