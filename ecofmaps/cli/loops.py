@@ -7,6 +7,7 @@ import sys
 import textwrap
 from pathlib import Path
 
+from ecofmaps.cli import loops_long
 from ecofmaps.cli._common import CommandError, quantity, refuse_to_overwrite, unit
 
 __all__ = ["add", "run"]
@@ -81,6 +82,7 @@ def add(subparsers) -> None:
         "--group", default=None, metavar="NAME",
         help="TDMS group, or HDF5/netCDF/zarr group, holding the channels (default: any)",
     )  # fmt: skip
+    loops_long.add_options(parser)
     parser.set_defaults(handler=run)
 
 
@@ -99,7 +101,7 @@ def run(args) -> int:
     from ecofmaps.io.files import write_text
     from ecofmaps.io.recordings import read_recording
     from ecofmaps.io.tables import results_table
-    from ecofmaps.measured.analysis import analyze_loops
+    from ecofmaps.measured.analysis import MissingSampleError, analyze_loops
     from ecofmaps.measured.synthetic import EXAMPLE, example_path
 
     if args.example == bool(args.files):
@@ -130,8 +132,9 @@ def run(args) -> int:
         ]
     )
     refuse_to_overwrite([("--out", args.out), *plots], paths)
-    analyses = []
-    for path in paths:
+    long_run = loops_long.LongRun(args, paths)
+    analyses, recordings = [], []
+    for index, path in enumerate(paths):
         recording = read_recording(
             path,
             displacement_column=args.displacement_col,
@@ -140,19 +143,26 @@ def run(args) -> int:
             displacement_unit=args.displacement_unit,
             force_unit=args.force_unit,
             group=args.group,
-            nan_policy="raise",
+            lazy=long_run.lazy,
         )
         try:
-            results = analyze_loops(
-                recording.displacement,
-                recording.force,
-                load,
-                cycle=recording.cycle,
-                keep_loops=args.plots is not None,
-            )
+            if recording.lazy:
+                results = long_run.analyse(index, path, recording, load)
+            else:
+                results = analyze_loops(
+                    recording.displacement,
+                    recording.force,
+                    load,
+                    cycle=recording.cycle,
+                    keep_loops=args.plots is not None,
+                    nan_policy=args.nan_policy,
+                )
+        except MissingSampleError as error:
+            raise recording.error(loops_long.MISSING, error.sample) from None
         except ValueError as error:
             raise recording.error(str(error)) from None
         analyses.append(results)
+        recordings.append(recording)
     tables = [results_table(results) for results in analyses]
     if len(paths) > 1:
         for path, table in zip(paths, tables, strict=True):
@@ -170,12 +180,14 @@ def run(args) -> int:
         sys.stdout.write(text)
         return 0
     write_text(args.out, text)
+    long_run.finish()
     print(f"wrote {args.out}: {sum(len(table) for table in tables)} cycles")
-    for path, results in zip(paths, analyses, strict=True):
+    for path, results, recording in zip(paths, analyses, recordings, strict=True):
         gross = results.where(results.regime == "gross slip", drop=True)
         summary = f"  {path.name}: {results.cycle.size} cycles"
         if results.attrs["incomplete_cycles"]:
             summary += f" ({results.attrs['incomplete_cycles']} incomplete dropped)"
+        summary += loops_long.skipped(results, recording)
         if gross.cycle.size:
             summary += (
                 f"; GICoF median {float(gross.gicof.median()):.4f}, ECoF "

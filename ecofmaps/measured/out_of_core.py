@@ -86,8 +86,8 @@ class LongAnalysis:
     nan_policy : {'skip', 'raise'}
     cycles : Cycles, optional
         The cycles, if found before (a resumed run); else they are found here.
-    samples : int
-        Samples per task (about).
+    samples : int, optional
+        Samples per task (about; default :data:`TASK_SAMPLES`).
     **options
         The checked options of :func:`ecofmaps.measured.analysis.check_options`.
 
@@ -118,7 +118,7 @@ class LongAnalysis:
         runner,
         nan_policy="skip",
         cycles=None,
-        samples=TASK_SAMPLES,
+        samples=None,
         **options,
     ):
         self.arrays = (displacement, force)
@@ -138,7 +138,7 @@ class LongAnalysis:
             raise _missing_error(cycles.first_missing)
         if cycles.label.size == 0:
             raise no_cycle_error(int(displacement.shape[0]))
-        self.tasks = _tasks(cycles.count, samples)
+        self.tasks = _tasks(cycles.count, samples or TASK_SAMPLES)
         self.tally = Tally()
 
     def _task(self, rows: slice):
@@ -173,7 +173,9 @@ class LongAnalysis:
             The task (index into :attr:`tasks`).
         part : xarray.Dataset
             The per-cycle results of its cycles, as in :func:`ecofmaps.analyze_loops`'s
-            Dataset (without the recording's attributes); counted in :attr:`tally`.
+            Dataset (without the recording's attributes, with the riders of
+            :func:`~ecofmaps.measured.analysis.cycle_results` that a resumed run counts
+            again); counted in :attr:`tally`.
         """
         skip = set(skip)
         wanted = [k for k in range(len(self.tasks)) if k not in skip]
@@ -182,7 +184,8 @@ class LongAnalysis:
             part = cycle_results(
                 values, flags, self.cycles.label[self.tasks[index]], self.load, self.options
             )
-            yield index, self.tally.add(part)
+            self.tally.add(part)
+            yield index, part
 
     def finish(self, results: xr.Dataset) -> xr.Dataset:
         """The joined parts (all of them, in order) with the recording's attributes, after

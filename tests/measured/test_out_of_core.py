@@ -118,10 +118,14 @@ RECORDINGS = {
 
 @pytest.mark.parametrize("name", RECORDINGS)
 @pytest.mark.parametrize("chunks", [1700, 3000])
-def test_same_numbers_as_in_memory(small_blocks, name, chunks):
+def test_same_numbers_as_in_memory(small_blocks, name, chunks, monkeypatch):
     displacement, force, cycle = RECORDINGS[name]()
     memory = analysed(displacement, force, cycle)
+    tasks = []
+    original = out_of_core._tasks
+    monkeypatch.setattr(out_of_core, "_tasks", lambda *a: tasks.append(original(*a)) or tasks[-1])
     lazy = analysed(*lazily(displacement, force, cycle, chunks=chunks), scheduler="threads")
+    assert len(tasks[0]) >= 3  # several tasks, each with its halo
     assert_equal_results(lazy, memory)
 
 
