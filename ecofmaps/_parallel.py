@@ -65,24 +65,23 @@ class Runner:
         Start a ``LocalCluster`` of ``workers`` processes (one thread each).
     client : distributed.Client, optional
         A client of a cluster already connected (left open).
-    timeout : float
-        Seconds to wait for the scheduler at ``scheduler`` to answer.
+    timeout : float, optional
+        Seconds to wait for the scheduler at ``scheduler`` to answer (default
+        :data:`CONNECT_TIMEOUT`).
 
     Notes
     -----
     Use as a context manager: the cluster or thread pool is closed on leaving it.
     """
 
-    def __init__(
-        self, workers=None, *, scheduler=None, cluster=False, client=None, timeout=CONNECT_TIMEOUT
-    ):
+    def __init__(self, workers=None, *, scheduler=None, cluster=False, client=None, timeout=None):
         if workers is not None and (
             isinstance(workers, bool) or int(workers) != workers or workers < 1
         ):
             raise ValueError(f"workers must be a positive integer; got {workers!r}")
         if scheduler is not None and cluster:
             raise ValueError("give a scheduler address or start a local cluster, not both")
-        self.scheduler, self.cluster, self.timeout = scheduler, cluster, float(timeout)
+        self.scheduler, self.cluster, self.timeout = scheduler, cluster, timeout
         self.workers = int(workers) if workers else (1 if scheduler else os.cpu_count() or 1)
         self._given = client
         self._client = self._cluster = self._pool = None
@@ -99,7 +98,7 @@ class Runner:
             self._client = self._given
             self.workers = max(len(self._client.scheduler_info()["workers"]), 1)
         elif self.scheduler is not None:
-            self._client = _connect(self.scheduler, self.timeout)
+            self._client = _connect(self.scheduler, self.timeout or CONNECT_TIMEOUT)
             self.workers = max(len(self._client.scheduler_info()["workers"]), 1)
         elif self.cluster:
             from distributed import Client, LocalCluster

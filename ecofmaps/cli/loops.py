@@ -99,7 +99,7 @@ def run(args) -> int:
     import pandas as pd
 
     from ecofmaps.io.files import write_text
-    from ecofmaps.io.recordings import read_recording
+    from ecofmaps.io.recordings import RecordingError, read_recording
     from ecofmaps.io.tables import results_table
     from ecofmaps.measured.analysis import MissingSampleError, analyze_loops
     from ecofmaps.measured.synthetic import EXAMPLE, example_path
@@ -159,6 +159,8 @@ def run(args) -> int:
                 )
         except MissingSampleError as error:
             raise recording.error(loops_long.MISSING, error.sample) from None
+        except RecordingError:  # a block of a long recording that cannot be read
+            raise
         except ValueError as error:
             raise recording.error(str(error)) from None
         analyses.append(results)

@@ -94,6 +94,11 @@ def _fingerprint(args, paths) -> dict:
     return {"format": 1, "files": files, "options": options}
 
 
+_UNFINISHED = (
+    "{folder} holds an unfinished run: add --resume to continue it, or delete it to start again"
+)
+
+
 class _Partial:
     """The folder ``<out>.partial`` of an unfinished run (see the module notes)."""
 
@@ -102,10 +107,7 @@ class _Partial:
         record = self.folder / "run.json"
         if self.folder.exists():
             if not resume:
-                raise CommandError(
-                    f"{self.folder} holds an unfinished run: add --resume to continue it, or "
-                    "delete it to start again"
-                )
+                raise CommandError(_UNFINISHED.format(folder=self.folder))
             try:
                 found = json.loads(record.read_text(encoding="utf-8"))
             except (OSError, ValueError):
@@ -202,6 +204,9 @@ class LongRun:
             raise CommandError("--resume continues the run kept beside --out: give --out")
         self.args = args
         self.lazy = True if (args.workers or args.scheduler or args.resume) else None
+        folder = Path(f"{args.out}{PARTIAL_SUFFIX}")
+        if args.out is not None and folder.exists() and not args.resume:
+            raise CommandError(_UNFINISHED.format(folder=folder))
         self.fingerprint = _fingerprint(args, paths) if args.out is not None else None
         self.partial = None
 
@@ -217,9 +222,9 @@ class LongRun:
     def analyse(self, index: int, path: Path, recording, load: float):
         """The results of recording ``index`` (read lazily), as :func:`ecofmaps.analyze_loops`
         gives them; its blocks kept beside ``--out`` as they complete."""
-        if self.partial is None and self.fingerprint is not None:
-            self.partial = _Partial(self.args.out, self.fingerprint, self.args.resume)
-        with self._runner() as runner:
+        with self._runner() as runner:  # a cluster that does not answer: nothing written
+            if self.partial is None and self.fingerprint is not None:
+                self.partial = _Partial(self.args.out, self.fingerprint, self.args.resume)
             return _analyse(index, path, recording, load, self.args, runner, self.partial)
 
     def finish(self) -> None:
