@@ -4,8 +4,9 @@ A recording read lazily (a rig file of more than :data:`ecofmaps.io.recordings.L
 samples, or any file with ``--workers``, ``--scheduler`` or ``--resume``) is analysed by
 :class:`ecofmaps.measured.out_of_core.LongAnalysis` on local threads, a local cluster of
 ``--workers`` processes or the dask cluster at ``--scheduler``. With ``--out``, each block's
-results are written as it completes into ``<out>.partial/`` (netCDF, one file per block,
-each renamed into place when whole, with the cycles found and what the run was), so an
+results are written as it completes into ``<out>.partial/`` (NumPy ``.npz``, one file per block,
+each renamed into place when whole: what its cycles measured, from which the results are
+made again; with the cycles found and what the run was), so an
 interrupted run keeps what it finished and ``--resume`` continues it; the table is written
 to ``--out`` only at the end, and the folder removed. A progress bar (cycles, rate, time
 left) is shown on a terminal, unless ``--quiet``.
@@ -147,17 +148,23 @@ class _Partial:
         _write(self.folder / f"file{index}-cycles.npz", lambda path: _savez(path, values))
 
     def done(self, index: int) -> dict:
-        """The blocks of file ``index`` kept: block -> path."""
-        prefix = f"file{index}-block"
-        return {
-            int(path.stem[len(prefix) :]): path
-            for path in self.folder.glob(f"{prefix}*.nc")
-            if path.stem[len(prefix) :].isdigit()
-        }
+        """The blocks of file ``index`` kept: block -> (values, flags) as measured."""
+        import numpy as np
 
-    def keep(self, index: int, block: int, part) -> None:
-        path = self.folder / f"file{index}-block{block:06d}.nc"
-        _write(path, lambda temporary: part.to_netcdf(temporary, engine="h5netcdf"))
+        prefix = f"file{index}-block"
+        kept = {}
+        for path in self.folder.glob(f"{prefix}*.npz"):
+            if path.stem[len(prefix) :].isdigit():
+                with np.load(path) as stored:
+                    values = {k[2:]: stored[k] for k in stored.files if k.startswith("v:")}
+                    flags = {k[2:]: stored[k] for k in stored.files if k.startswith("f:")}
+                kept[int(path.stem[len(prefix) :])] = (values, flags)
+        return kept
+
+    def keep(self, index: int, block: int, values: dict, flags: dict) -> None:
+        """Keep what block ``block`` of file ``index`` measured."""
+        stored = {f"v:{k}": v for k, v in values.items()} | {f"f:{k}": v for k, v in flags.items()}
+        _write(self.folder / f"file{index}-block{block:06d}.npz", lambda p: _savez(p, stored))
 
     def remove(self) -> None:
         shutil.rmtree(self.folder, ignore_errors=True)
@@ -280,18 +287,14 @@ def _analyse(index, path, recording, load, args, runner, partial):
     if partial is not None:
         partial.keep_cycles(index, analysis.cycles)
         done = partial.done(index)
-    parts = {}
-    for block, stored in done.items():
-        with xr.open_dataset(stored, engine="h5netcdf") as part:
-            parts[block] = part.load()
-        analysis.tally.add(parts[block])
+    parts = {block: analysis.part(block, *measured) for block, measured in done.items()}
     bar = _bar(analysis, path, shown, sum(parts[b].cycle.size for b in parts))
     try:
-        for block, part in analysis.parts(skip=done):
+        for block, values, flags in analysis.measured(skip=done):
             if partial is not None:
-                partial.keep(index, block, part)
-            parts[block] = part
-            bar.update(part.cycle.size)
+                partial.keep(index, block, values, flags)
+            parts[block] = analysis.part(block, values, flags)
+            bar.update(parts[block].cycle.size)
     except KeyboardInterrupt:
         bar.leave = False
         bar.close()

@@ -159,8 +159,8 @@ class LongAnalysis:
         inner = slice(rows.start - first, rows.stop - first)
         return (table, low, inner, self.load, self.options, x, q)
 
-    def parts(self, skip=()):
-        """The results of each task, in order, as they come.
+    def measured(self, skip=()):
+        """What each task measured, in order, as it comes.
 
         Parameters
         ----------
@@ -171,21 +171,31 @@ class LongAnalysis:
         ------
         index : int
             The task (index into :attr:`tasks`).
-        part : xarray.Dataset
-            The per-cycle results of its cycles, as in :func:`ecofmaps.analyze_loops`'s
-            Dataset (without the recording's attributes, with the riders of
-            :func:`~ecofmaps.measured.analysis.cycle_results` that a resumed run counts
-            again); counted in :attr:`tally`.
+        values, flags : dict of str to numpy.ndarray
+            Its cycles' quantities and checks, from
+            :func:`~ecofmaps.measured.analysis.measure_cycles` (:meth:`part` makes the
+            results of them).
         """
         skip = set(skip)
         wanted = [k for k in range(len(self.tasks)) if k not in skip]
         results = self.runner.map(_measure, (self._task(self.tasks[k]) for k in wanted))
         for index, (values, flags, _) in zip(wanted, results, strict=False):
-            part = cycle_results(
-                values, flags, self.cycles.label[self.tasks[index]], self.load, self.options
-            )
-            self.tally.add(part)
-            yield index, part
+            yield index, values, flags
+
+    def part(self, index: int, values: dict, flags: dict) -> xr.Dataset:
+        """The per-cycle results of task ``index`` from what it measured, as in
+        :func:`ecofmaps.analyze_loops`'s Dataset (without the recording's attributes);
+        counted in :attr:`tally`."""
+        part = cycle_results(
+            values, flags, self.cycles.label[self.tasks[index]], self.load, self.options
+        )
+        self.tally.add(part)
+        return part
+
+    def parts(self):
+        """The results of each task, in order, as they come (see :meth:`part`)."""
+        for index, values, flags in self.measured():
+            yield index, self.part(index, values, flags)
 
     def finish(self, results: xr.Dataset) -> xr.Dataset:
         """The joined parts (all of them, in order) with the recording's attributes, after

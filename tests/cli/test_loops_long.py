@@ -88,11 +88,11 @@ def test_an_interrupted_run_resumes(long_test, tmp_path, capsys, small_tasks, mo
     keep = loops_long._Partial.keep
     kept = []
 
-    def interrupted(self, index, block, part):
+    def interrupted(self, index, block, values, flags):
         if len(kept) == 2:
             raise KeyboardInterrupt
         kept.append(block)
-        keep(self, index, block, part)
+        keep(self, index, block, values, flags)
 
     monkeypatch.setattr(loops_long._Partial, "keep", interrupted)
     status, _, err = run(capsys, long_test[".zarr"], "--load", "450N", "--out", out,
@@ -101,7 +101,7 @@ def test_an_interrupted_run_resumes(long_test, tmp_path, capsys, small_tasks, mo
     assert "2 of 6 blocks" in err and "--resume" in err
     assert not out.exists()
     partial = tmp_path / "r.csv.partial"
-    assert len(list(partial.glob("file0-block*.nc"))) == 2
+    assert len(list(partial.glob("file0-block*.npz"))) == 2
     monkeypatch.setattr(loops_long._Partial, "keep", keep)
     status, _, err = run(capsys, long_test[".zarr"], "--load", "450N", "--out", out)
     assert status == 2 and "holds an unfinished run: add --resume" in err
