@@ -101,15 +101,22 @@ class Runner:
             self._client = _connect(self.scheduler, self.timeout or CONNECT_TIMEOUT)
             self.workers = max(len(self._client.scheduler_info()["workers"]), 1)
         elif self.cluster:
+            import dask
             from distributed import Client, LocalCluster
 
-            self._cluster = LocalCluster(
-                n_workers=self.workers,
-                threads_per_worker=1,
-                processes=True,
-                dashboard_address=None,
-                silence_logs=40,  # errors only
-            )
+            # distributed sets MALLOC_TRIM_THRESHOLD_ in its workers, which stops glibc from
+            # raising its mmap threshold: every NumPy temporary above 128 kB is then mapped
+            # afresh and faulted in page by page (measured: the analysis ran 2-3x slower).
+            environ = dask.config.get("distributed.nanny.pre-spawn-environ")
+            environ = {k: v for k, v in environ.items() if k != "MALLOC_TRIM_THRESHOLD_"}
+            with dask.config.set({"distributed.nanny.pre-spawn-environ": environ}):
+                self._cluster = LocalCluster(
+                    n_workers=self.workers,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=None,
+                    silence_logs=40,  # errors only
+                )
             self._client = Client(self._cluster, set_as_default=False)
         else:
             self._pool = concurrent.futures.ThreadPoolExecutor(self.workers)

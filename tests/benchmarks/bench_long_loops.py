@@ -11,9 +11,9 @@ resident memory (the sum over it and its children, sampled every 50 ms, so the w
 processes of a local cluster count) are reported; each is repeated ``--repeat`` times and
 the best time kept. The runs:
 
-- ``memory``: the in-memory path, the baseline: the whole recording read into NumPy
-  (``read_recording(lazy=False)``) and ``analyze_loops`` on it, one thread; the time of the
-  analysis alone is printed beside the time of the whole;
+- ``memory``: the in-memory path, the baseline: ``ecofmaps loops`` with the whole
+  recording read into NumPy and ``analyze_loops`` on it, one thread; the time of
+  ``analyze_loops`` alone is printed beside the time of the whole command;
 - ``threads``: ``ecofmaps loops FILE --load 450N --out r.csv --quiet``, the default for a
   file this long: out of core on the threads of the process (one per core);
 - ``workers 1``, ``workers 2``: the same with ``--workers 1`` and ``--workers 2`` (a local
@@ -41,13 +41,21 @@ CHUNK = 1 << 20
 LOAD = "450N"
 _MEMORY_SCRIPT = """
 import sys, time
-from ecofmaps.io import read_recording
-from ecofmaps.measured.analysis import analyze_loops
-start = time.perf_counter()
-recording = read_recording(sys.argv[1], lazy=False)
-read = time.perf_counter()
-analyze_loops(recording.displacement, recording.force, 450.0)
-print(read - start, time.perf_counter() - read)
+import ecofmaps.io.binary, ecofmaps.measured.analysis as analysis
+from ecofmaps.cli import main
+ecofmaps.io.binary.LAZY_SAMPLES = 1 << 62  # read whole, analyse in memory
+spent = []
+inner = analysis.analyze_loops
+def timed(*args, **kwargs):
+    start = time.perf_counter()
+    try:
+        return inner(*args, **kwargs)
+    finally:
+        spent.append(time.perf_counter() - start)
+analysis.analyze_loops = timed
+status = main(["loops", *sys.argv[1:]])
+print("analysed", spent[0], file=sys.stderr)
+sys.exit(status)
 """
 
 
@@ -74,7 +82,7 @@ def measured(command: list[str]) -> tuple[float, float, str]:
     out, err = process.communicate()
     if process.returncode:
         raise RuntimeError(f"{' '.join(command)} failed:\n{err}")
-    return wall, peak / 1e9, out
+    return wall, peak / 1e9, out + err
 
 
 def make_files(folder: Path, samples: int) -> dict:
@@ -111,7 +119,7 @@ def main(argv=None) -> int:
         path = paths[kind]
         print(f"\n{kind}: {path}")
         runs = {
-            "memory": [sys.executable, "-c", _MEMORY_SCRIPT, str(path)],
+            "memory": [sys.executable, "-c", _MEMORY_SCRIPT, str(path), "--load", LOAD],
             "threads": [*ecofmaps, "loops", str(path), "--load", LOAD, "--quiet"],
             "workers 1": [*ecofmaps, "loops", str(path), "--load", LOAD, "--quiet",
                           "--workers", "1"],
@@ -123,11 +131,7 @@ def main(argv=None) -> int:
             out = folder / "r.csv"
             for _ in range(args.repeat):
                 out.unlink(missing_ok=True)
-                extra = [] if name == "memory" else ["--out", str(out)]
-                wall, peak, printed = measured(command + extra)
-                if name == "memory":
-                    reading, analysing = (float(v) for v in printed.split())
-                    wall = reading + analysing
+                wall, peak, printed = measured([*command, "--out", str(out)])
                 if name not in best or wall < best[name][0]:
                     best[name] = (wall, peak, printed)
             wall, peak, printed = best[name]
@@ -135,15 +139,12 @@ def main(argv=None) -> int:
                 f"  {name:<10} {wall:7.1f} s  {samples / wall:9.3g} samples/s  peak {peak:5.2f} GB"
             )
             if name == "memory":
-                reading, analysing = (float(v) for v in printed.split())
-                line += (
-                    f"  (read {reading:.1f} s, analyse {analysing:.1f} s: "
-                    f"{samples / analysing:.3g} samples/s)"
-                )
+                analysing = float(printed.split()[-1])
+                line += f"  (analyze_loops {analysing:.1f} s: {samples / analysing:.3g} samples/s)"
             print(line, flush=True)
         memory, one, two = best["memory"][0], best["workers 1"][0], best["workers 2"][0]
         print(
-            f"  workers 1 / memory (read + analyse): {memory / one:.2f} of the speed; "
+            f"  workers 1 / memory: {memory / one:.2f} of the speed; "
             f"workers 2 / workers 1: {one / two:.2f}x; threads / workers 1: "
             f"{one / best['threads'][0]:.2f}x"
         )
