@@ -161,3 +161,23 @@ def test_bad_input_leaves_nothing(long_test, tmp_path, capsys, monkeypatch, case
     assert status == 2
     assert re.search(message, err), err
     assert list(tmp_path.glob("r.csv*")) == []
+
+
+def test_convert_a_csv_file_then_analyse_it(tmp_path, capsys):
+    """``ecofmaps convert`` keeps every sample (in SI) and the cycle column: the same table."""
+    from ecofmaps.cli import main
+    from ecofmaps.measured.synthetic import example_path
+
+    store = tmp_path / "example.zarr"
+    assert main(["convert", str(example_path()), str(store), "--chunk-samples", "5000"]) == 0
+    assert "24000 samples of displacement, force, cycle" in capsys.readouterr().out
+    assert main(["convert", str(example_path()), str(store)]) == 2
+    assert "exists already: --overwrite" in capsys.readouterr().err
+    tables = []
+    for path in (example_path(), store):
+        status, _, err = run(capsys, path, "--load", "450N", "--out", tmp_path / "r.csv",
+                             "--resume")  # fmt: skip
+        assert status == 0, err
+        tables.append((tmp_path / "r.csv").read_text())
+        (tmp_path / "r.csv").unlink()
+    assert tables[0] == tables[1]
