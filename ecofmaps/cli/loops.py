@@ -8,6 +8,7 @@ import textwrap
 import warnings
 from pathlib import Path
 
+from ecofmaps.cli import loops_long
 from ecofmaps.cli._common import CommandError, quantity, refuse_to_overwrite, unit
 
 __all__ = ["add", "run"]
@@ -100,6 +101,7 @@ def add(subparsers) -> None:
         "--group", default=None, metavar="NAME",
         help="TDMS group, or HDF5/netCDF/zarr group, holding the channels (default: any)",
     )  # fmt: skip
+    loops_long.add_options(parser)
     parser.set_defaults(handler=run)
 
 
@@ -114,7 +116,7 @@ def _plot_names(paths) -> list[str]:
 
 def _analysed(path, recording, load, args, resolved_file: bool):
     """The analysis of one recording, its reading along the stroke, and its warnings."""
-    from ecofmaps.measured.analysis import analyze_loops
+    from ecofmaps.measured.analysis import MissingSampleError, analyze_loops
     from ecofmaps.measured.resolved import resolve_analyzed_loops, with_resolved
 
     plots = args.plots is not None
@@ -128,7 +130,10 @@ def _analysed(path, recording, load, args, resolved_file: bool):
                 cycle=recording.cycle,
                 flip_force=args.flip_force,
                 keep_loops=plots or not args.no_resolve,
+                nan_policy=args.nan_policy,
             )
+        except MissingSampleError as error:
+            raise recording.error(loops_long.MISSING, error.sample) from None
         except ValueError as error:
             raise recording.error(str(error)) from None
         resolved = None
@@ -141,12 +146,13 @@ def _analysed(path, recording, load, args, resolved_file: bool):
     return results, resolved
 
 
-def _summary(path, results) -> str:
+def _summary(path, results, recording) -> str:
     """One line on a recording's cycles: counts, the quality, the friction over the test."""
     gross = results.where(results.regime == "gross slip", drop=True)
     summary = f"  {path.name}: {results.attrs['quality_summary']}"
     if results.attrs["incomplete_cycles"]:
         summary += f" ({results.attrs['incomplete_cycles']} incomplete dropped)"
+    summary += loops_long.skipped(results, recording)
     if gross.cycle.size and gross.gicof.notnull().any():
         summary += f"; GICoF median {float(gross.gicof.median()):.4f}"
     if "mu_resolved" in gross and gross.mu_resolved.notnull().any():
@@ -201,8 +207,9 @@ def run(args) -> int:
         ]
     )
     refuse_to_overwrite([("--out", args.out), ("--resolved", args.resolved), *plots], paths)
-    analyses = []
-    for path in paths:
+    long_run = loops_long.LongRun(args, paths)
+    analyses, recordings = [], []
+    for index, path in enumerate(paths):
         recording = read_recording(
             path,
             displacement_column=args.displacement_col,
@@ -211,9 +218,18 @@ def run(args) -> int:
             displacement_unit=args.displacement_unit,
             force_unit=args.force_unit,
             group=args.group,
-            nan_policy="raise",
+            lazy=long_run.lazy,
         )
-        analyses.append(_analysed(path, recording, load, args, args.resolved is not None))
+        if recording.lazy:
+            if args.resolved is not None:
+                raise CommandError(
+                    f"--resolved reads every loop along the stroke, which a long recording "
+                    f"({path}) analysed out of core does not keep: leave out --resolved"
+                )
+            analyses.append((long_run.analyse(index, path, recording, load), None))
+        else:
+            analyses.append(_analysed(path, recording, load, args, args.resolved is not None))
+        recordings.append(recording)
     tables = [results_table(results) for results, _ in analyses]
     if len(paths) > 1:
         for path, table in zip(paths, tables, strict=True):
@@ -233,13 +249,14 @@ def run(args) -> int:
         write_netcdf(analyses[0][1], args.resolved)
     if args.out is None:
         sys.stdout.write(text)
-        for path, (results, _) in zip(paths, analyses, strict=True):
-            print(_summary(path, results).strip(), file=sys.stderr)
+        for path, (results, _), recording in zip(paths, analyses, recordings, strict=True):
+            print(_summary(path, results, recording).strip(), file=sys.stderr)
         return 0
     write_text(args.out, text)
+    long_run.finish()
     print(f"wrote {args.out}: {sum(len(table) for table in tables)} cycles")
-    for path, (results, _) in zip(paths, analyses, strict=True):
-        print(_summary(path, results))
+    for path, (results, _), recording in zip(paths, analyses, recordings, strict=True):
+        print(_summary(path, results, recording))
     if args.resolved is not None:
         print(f"  the loops read along the stroke in {args.resolved}")
     if args.plots is not None:

@@ -101,10 +101,22 @@ from ecofmaps.measured.quality import (
     LoopQualityWarning,
     apply_quality,
     quality_strings,
-    quality_summary,
+    summary_of_counts,
 )
+from ecofmaps.measured.samples import is_lazy
 
-__all__ = ["GROSS_SLIP_THRESHOLD", "analyze_loops", "measure_cycles"]
+__all__ = [
+    "GROSS_SLIP_THRESHOLD",
+    "NAN_POLICIES",
+    "MissingSampleError",
+    "Tally",
+    "analyze_loops",
+    "cycle_results",
+    "measure_cycles",
+]
+
+#: What :func:`analyze_loops` does with missing samples: skip their cycles, or raise.
+NAN_POLICIES = ("skip", "raise")
 
 #: Energy ratio :math:`A = E_d/(4\Delta^* Q^*)` above which a loop is gross slip (the
 #: sliding transition of Fouvry, Kapsa and Vincent).
@@ -256,7 +268,8 @@ def measure_cycles(
     cycles : Cycles
         Cycles of the recording (:func:`ecofmaps.measured.cycles.find_cycles`).
     displacement, force : numpy.ndarray
-        The recording, float64 and finite. [m], [N]
+        The recording, float64; NaN only in the cycles marked missing. Any object that
+        gives stretches of it by sample index (``displacement[a:b]``) will do. [m], [N]
     load : float
         Normal load :math:`P`. [N]
     hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
@@ -283,8 +296,10 @@ def measure_cycles(
         "crossing_window": crossing_window,
         "gross_slip_threshold": gross_slip_threshold,
     }
-    values = {name: np.empty(stop - first) for name in _PER_CYCLE}
+    values = {name: np.full(stop - first, np.nan) for name in _PER_CYCLE}
     flags = {reason: np.zeros(stop - first, dtype=bool) for reason in REASONS}
+    if cycles.missing is not None:  # not measured: their values stay NaN
+        flags["missing-samples"] = cycles.missing[first:stop].copy()
     loops = None
     if keep_loops:
         width = int(cycles.count[first:stop].max()) + 1
@@ -307,9 +322,12 @@ def measure_cycles(
 
 
 def _refusal_hint(flags: dict) -> str:
-    """What the user may do about a recording whose every cycle is refused."""
-    if flags["anticlockwise"].all():
-        if flags["negative-stiffness"].any():
+    """What the user may do about a recording whose every cycle is refused (``flags``:
+    whether every cycle, or any for ``negative-stiffness``, carries the reason)."""
+    if flags["missing-samples"]:
+        return "Every cycle holds a missing sample (NaN or an empty cell)."
+    if flags["anticlockwise"]:
+        if flags["negative-stiffness"]:
             return (
                 "The loops run anticlockwise with stick sides sloping down: the force is "
                 "recorded positive against the displacement. If so, read it with the other "
@@ -319,7 +337,7 @@ def _refusal_hint(flags: dict) -> str:
             "The loops run anticlockwise with stick sides sloping up: the recording runs "
             "backwards in time, or the displacement and force columns are swapped."
         )
-    if flags["constant-force"].all():
+    if flags["constant-force"]:
         return "The force does not vary: is the force channel connected?"
     return (
         "Is it a recording of fretting loops, with the displacement and the force in their "
@@ -330,23 +348,43 @@ def _refusal_hint(flags: dict) -> str:
 # --- the public function ------------------------------------------------------------------
 
 
-def _series(name, values, size=None):
-    """``values`` as a finite 1-D float64 array of ``size`` samples."""
-    array = np.asarray(values, dtype=np.float64)
+class MissingSampleError(ValueError):
+    """A missing sample where ``nan_policy='raise'``: ``sample`` is its 0-based index."""
+
+    def __init__(self, sample: int, message: str):
+        self.sample = int(sample)
+        super().__init__(message)
+
+
+def _missing_error(sample: int) -> MissingSampleError:
+    return MissingSampleError(
+        sample,
+        f"sample {sample} is missing (NaN or empty); nan_policy='skip' analyses the cycles "
+        "without missing samples and reports the others as skipped",
+    )
+
+
+def _series(name, values, size=None, dtype=np.float64):
+    """``values`` as a 1-D array (NumPy, or dask as it is) of ``size`` samples."""
+    if hasattr(values, "dims"):  # an xarray DataArray: its NumPy or dask data
+        values = values.data
+    array = values if is_lazy(values) else np.asarray(values, dtype=dtype)
     if array.ndim != 1:
         raise ValueError(f"{name} must be one-dimensional (one value per sample)")
-    if size is not None and array.size != size:
+    if size is not None and array.shape[0] != size:
         raise ValueError(
-            f"{name} must have one value per sample: {array.size} values for {size} samples"
+            f"{name} must have one value per sample: {array.shape[0]} values for {size} samples"
         )
-    if not np.isfinite(array).all():
-        check(name, array, "finite")
+    if is_lazy(array) and array.dtype.kind not in "fiub":
+        raise ValueError(f"{name} must hold numbers; got dtype {array.dtype}")
     return array
 
 
-def _check_options(
+def check_options(
     load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
 ):
+    """The options of :func:`analyze_loops`, checked (a ValueError naming the one that is
+    not valid), as keyword arguments of :func:`measure_cycles`."""
     check("load", load, "positive", "N")
     if np.ndim(load) != 0:
         raise ValueError("load must be a single value [N]")
@@ -389,15 +427,20 @@ def analyze_loops(
     flip_force=False,
     resolve=False,
     keep_loops=False,
+    missing=None,
+    nan_policy="skip",
+    scheduler=None,
+    workers=None,
 ) -> xr.Dataset:
     r"""Per-cycle friction quantities of a recording of fretting loops, each checked.
 
     Parameters
     ----------
-    displacement : array_like
+    displacement : array_like, dask.array.Array or xarray.DataArray
         Applied displacement :math:`\Delta` at each sample, in time order. Offsets and a
-        slow drift are removed; the sampling need not be uniform. [m]
-    force : array_like
+        slow drift are removed; the sampling need not be uniform. A dask array (or an
+        xarray object backed by one) is analysed out of core, block by block (Notes). [m]
+    force : array_like, dask.array.Array or xarray.DataArray
         Tangential force :math:`Q` at each sample, positive in the direction of positive
         displacement (the loops then run clockwise); offsets are removed. [N]
     load : float
@@ -427,7 +470,21 @@ def analyze_loops(
         groove), with that reading's reasons in ``quality``. About ten times the work.
     keep_loops : bool
         Also return the centred loops, ``loop_displacement`` and ``loop_force`` over
-        ``(cycle, point)`` (NaN-padded), for plotting.
+        ``(cycle, point)`` (NaN-padded), for plotting (recordings in memory only).
+    missing : array_like of bool, optional
+        True for samples to treat as missing besides the non-finite ones (NaN, inf in
+        any of the displacement, force and cycle number).
+    nan_policy : {'skip', 'raise'}
+        A cycle that holds a missing sample is skipped: its values are NaN and its
+        ``quality`` is ``'missing-samples'`` (``'skip'``); or any missing sample is an
+        error, :class:`MissingSampleError` naming it (``'raise'``).
+    scheduler : {None, 'threads', 'processes'}, str or distributed.Client
+        Where a dask recording's blocks run: the current ``distributed`` client if there
+        is one, else threads of this process (None); threads; a ``LocalCluster`` of
+        ``workers`` processes; the dask scheduler at an address (``'tcp://host:8786'``),
+        whose workers must reach the recording's file; or a client.
+    workers : int, optional
+        Threads, or processes of the local cluster (default: one per core; 2).
 
     Returns
     -------
@@ -440,17 +497,19 @@ def analyze_loops(
         slip', 'partial slip', or 'unknown' for a refused cycle), stick_residual [m] (root
         mean square displacement off the stick lines) and quality ('ok', or why values
         are NaN: :mod:`ecofmaps.measured.quality`); the load is a scalar coordinate. The
-        attributes ``incomplete_cycles`` and ``dropped_samples`` count what was dropped;
-        ``quality_summary`` is one line on what was flagged. With ``resolve``, also
-        mu_resolved, mu_resolved_se and aspect_ratio. ``results.to_dataframe()`` gives a
-        table.
+        attributes ``incomplete_cycles`` and ``dropped_samples`` count what was dropped,
+        ``missing_samples``, ``skipped_cycles`` and ``first_missing_sample`` (or -1) what
+        was missing; ``quality_summary`` is one line on what was flagged and skipped. With
+        ``resolve``, also mu_resolved, mu_resolved_se and aspect_ratio.
+        ``results.to_dataframe()`` gives a table.
 
     Raises
     ------
     ValueError
-        For inputs of the wrong shape, non-finite samples, a load that is not positive,
-        options out of range, a recording without a complete cycle, or one whose every
-        cycle is refused (not a loop that can be read as recorded).
+        For inputs of the wrong shape, a load that is not positive, options out of
+        range, a recording without a complete cycle, or one whose every cycle is refused
+        (not a loop that can be read as recorded); :class:`MissingSampleError` for a
+        missing sample with ``nan_policy='raise'``.
 
     Warns
     -----
@@ -466,6 +525,13 @@ def analyze_loops(
     :mod:`ecofmaps.measured.quality`. The ECoF is eq. 1; the GICoF is the paper's Section 5
     (eq. 17-18), and equals :math:`\mu` for the model's loop whatever the groove.
 
+    A dask recording (a long test read lazily by :func:`ecofmaps.read_recording`) is never
+    held whole: its cycles are found by passes a block at a time
+    (:mod:`ecofmaps.measured.cycles`), then measured in tasks of whole cycles, each with
+    two whole cycles on either side for the centring's drift
+    (:mod:`ecofmaps.measured.out_of_core`). The results are those of the same recording in
+    memory.
+
     Examples
     --------
     >>> import numpy as np, ecofmaps
@@ -476,34 +542,128 @@ def analyze_loops(
     >>> print(results.quality.values[0], "|", results.attrs["quality_summary"])
     ok | 1 cycles: 1 ok
     """
-    options = _check_options(
+    options = check_options(
         load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
     )
+    if nan_policy not in NAN_POLICIES:
+        raise ValueError(f"nan_policy must be one of {NAN_POLICIES}; got {nan_policy!r}")
     load = float(load)
     x = _series("displacement", displacement)
-    q = _series("force", force, x.size)
-    if x.size < MIN_SAMPLES:
+    q = _series("force", force, x.shape[0])
+    label = None if cycle is None else _series("cycle", cycle, x.shape[0], dtype=None)
+    mask = None if missing is None else _series("missing", missing, x.shape[0], dtype=bool)
+    if x.shape[0] < MIN_SAMPLES:
         raise ValueError(
-            f"too few samples for one cycle: {x.size} (a cycle needs at least {MIN_SAMPLES})"
+            f"too few samples for one cycle: {x.shape[0]} (a cycle needs at least {MIN_SAMPLES})"
         )
-    cycles = find_cycles(x, cycle, hysteresis)
+    if any(is_lazy(a) for a in (x, q, label, mask)):
+        if keep_loops:
+            raise ValueError(
+                "keep_loops needs the recording in memory: give NumPy arrays (a long "
+                "recording's loops would not fit)"
+            )
+        from ecofmaps.measured.out_of_core import LongAnalysis
+
+        with runner_for(scheduler, workers) as runner:
+            analysis = LongAnalysis(
+                x,
+                q,
+                load,
+                label,
+                missing=mask,
+                runner=runner,
+                nan_policy=nan_policy,
+                resolve=resolve,
+                **options,
+            )
+            parts = [part for _, part in analysis.parts()]
+        return analysis.finish(xr.concat(parts, "cycle") if parts else parts)
+    if nan_policy == "raise":
+        bad = ~np.isfinite(x) | ~np.isfinite(q)
+        if label is not None and label.dtype.kind not in "iub":
+            bad |= ~np.isfinite(label)
+        if mask is not None:
+            bad |= mask
+        if bad.any():
+            raise _missing_error(int(np.argmax(bad)))
+    cycles = find_cycles(x, label, hysteresis, force=q, missing=mask)
     if cycles.label.size == 0:
-        raise ValueError(
-            f"too few samples for one cycle: no complete cycle in {x.size} samples "
-            "(the loop does not close, or the recording does not oscillate)"
-        )
+        raise no_cycle_error(x.shape[0])
     kept = keep_loops or resolve  # the reading along the stroke reads the kept loops
     values, flags, loops = measure_cycles(cycles, x, q, load, keep_loops=kept, **options)
-    _check_units(values["amplitude"])
-    quality = quality_strings(flags, cycles.label.size)
-    summary = quality_summary(quality)
-    refused = np.zeros(quality.size, dtype=bool)
+    results = cycle_results(values, flags, cycles.label, load, options)
+    tally = Tally()
+    tally.add(results)
+    if kept:
+        results = with_loops(results, loops)
+    results = tally.finish(
+        results, cycles, "displacement reversals" if cycle is None else "cycle numbers", options
+    )
+    if resolve:
+        results = with_read_along_stroke(results)
+    if not keep_loops:
+        results = results.drop_vars(["loop_displacement", "loop_force", "point"], errors="ignore")
+    return results
+
+
+def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
+    """``results`` with the centred loops of :func:`measure_cycles` (``keep_loops=True``)."""
+    results["loop_displacement"] = (("cycle", "point"), loops[0], _attrs("loop_displacement"))
+    results["loop_force"] = (("cycle", "point"), loops[1], _attrs("loop_force"))
+    results.coords["point"] = ("point", np.arange(loops[0].shape[1]), _attrs("point"))
+    return results
+
+
+def with_read_along_stroke(results: xr.Dataset) -> xr.Dataset:
+    """``results`` (with its loops) with the values read along the stroke
+    (:data:`ecofmaps.measured.resolved.REPORTED`), and that reading's quality."""
+    from ecofmaps.measured.resolved import resolve_analyzed_loops, with_resolved  # built on this
+
+    return with_resolved(results, resolve_analyzed_loops(results, positions=None))
+
+
+def no_cycle_error(samples: int) -> ValueError:
+    """The error for a recording without a complete cycle."""
+    return ValueError(
+        f"too few samples for one cycle: no complete cycle in {samples} samples "
+        "(the loop does not close, or the recording does not oscillate)"
+    )
+
+
+def runner_for(scheduler, workers):
+    """The :class:`ecofmaps._parallel.Runner` for :func:`analyze_loops`' ``scheduler`` and
+    ``workers`` (see there)."""
+    from ecofmaps._parallel import Runner
+
+    if scheduler is None:
+        try:
+            from distributed import default_client
+
+            return Runner(client=default_client())
+        except (ImportError, ValueError):  # no client: threads
+            return Runner(workers)
+    if scheduler == "threads":
+        return Runner(workers)
+    if scheduler == "processes":
+        return Runner(workers or 2, cluster=True)
+    if isinstance(scheduler, str):
+        return Runner(scheduler=scheduler)
+    return Runner(client=scheduler)
+
+
+def cycle_results(values: dict, flags: dict, label, load: float, options: dict) -> xr.Dataset:
+    """The per-cycle Dataset of :func:`analyze_loops` for some cycles, without the
+    recording's attributes: ``values`` and ``flags`` from :func:`measure_cycles`.
+
+    The raw amplitudes and whether each cycle is refused ride along as ``_amplitude`` and
+    ``_refused`` until :meth:`Tally.finish` takes them off.
+    """
+    size = label.size
+    quality = quality_strings(flags, size)
+    refused = np.zeros(size, dtype=bool)
     for reason, flag in flags.items():
         refused |= flag & (REASONS[reason][1] == ALL)
-    if refused.all():
-        raise ValueError(f"no plausible cycle in the recording ({summary}). {_refusal_hint(flags)}")
-    if np.any((quality != "ok") & (quality != "not-gross-slip")):
-        warn(f"cycles flagged: {summary}", LoopQualityWarning)
+    raw_amplitude = values["amplitude"]
     values = apply_quality(values, flags)
     regime = np.where(
         refused,
@@ -517,40 +677,103 @@ def analyze_loops(
     data["regime"] = ("cycle", regime, _attrs("regime"))
     data["stick_residual"] = ("cycle", values["stick_residual"], _attrs("stick_residual"))
     data["quality"] = ("cycle", quality, _attrs("quality"))
-    coords = {"cycle": ("cycle", cycles.label, _attrs("cycle")), "load": ((), load, _attrs("load"))}
-    if kept:
-        data["loop_displacement"] = (("cycle", "point"), loops[0], _attrs("loop_displacement"))
-        data["loop_force"] = (("cycle", "point"), loops[1], _attrs("loop_force"))
-        coords["point"] = ("point", np.arange(loops[0].shape[1]), _attrs("point"))
-    attrs = {
-        "title": "Fretting loops analysed cycle by cycle (ecofmaps.analyze_loops)",
-        "cycles_from": "displacement reversals" if cycle is None else "cycle numbers",
-        "incomplete_cycles": cycles.incomplete_cycles,
-        "dropped_samples": cycles.dropped_samples,
-        "gross_slip_threshold": options["gross_slip_threshold"],
-        "flip_force": int(options["flip_force"]),
-        "quality_summary": summary,
+    data["_amplitude"] = ("cycle", raw_amplitude)
+    data["_refused"] = ("cycle", refused)
+    hints = {
+        "missing-samples": flags["missing-samples"],
+        "anticlockwise": flags["anticlockwise"],
+        "constant-force": flags["constant-force"],
     }
-    results = xr.Dataset(data, coords=coords, attrs=attrs)
-    if resolve:
-        results = _with_resolved(results)
-    if not keep_loops:
-        results = results.drop_vars(["loop_displacement", "loop_force", "point"], errors="ignore")
-    return results
+    for reason, flag in hints.items():
+        data[f"_{reason}"] = ("cycle", flag)
+    data["_negative-stiffness"] = ("cycle", flags["negative-stiffness"])
+    coords = {"cycle": ("cycle", label, _attrs("cycle")), "load": ((), load, _attrs("load"))}
+    return xr.Dataset(data, coords=coords)
 
 
-def _with_resolved(results: xr.Dataset) -> xr.Dataset:
-    """``results`` with the values read along the stroke, and that reading's quality."""
-    from ecofmaps.measured.resolved import resolve_analyzed_loops, with_resolved  # built on this
+class Tally:
+    """What :func:`analyze_loops` says about a whole recording, gathered from its parts
+    (:func:`cycle_results`) as they come: the quality summary, whether every cycle was
+    refused, and the typical amplitude."""
 
-    return with_resolved(results, resolve_analyzed_loops(results, positions=None))
+    def __init__(self):
+        self.counts: dict = {}
+        self.cycles = self.refused = self.flagged = 0
+        self.every = {"missing-samples": True, "anticlockwise": True, "constant-force": True}
+        self.negative_stiffness = False
+        self.amplitudes: list = []
+
+    def add(self, part: xr.Dataset) -> xr.Dataset:
+        """Count the cycles of ``part``; return it without its riders."""
+        texts, counts = np.unique(part.quality.values, return_counts=True)
+        for text, count in zip(texts.tolist(), counts.tolist(), strict=True):
+            self.counts[text] = self.counts.get(text, 0) + count
+            if text not in ("ok", "not-gross-slip"):
+                self.flagged += count
+        self.cycles += part.cycle.size
+        self.refused += int(part["_refused"].sum())
+        for reason in self.every:
+            self.every[reason] &= bool(part[f"_{reason}"].all())
+        self.negative_stiffness |= bool(part["_negative-stiffness"].any())
+        self.amplitudes.append(part["_amplitude"].values)
+        return strip(part)
+
+    @property
+    def summary(self) -> str:
+        """The one-line quality summary so far."""
+        return summary_of_counts(self.counts)
+
+    def finish(self, results, cycles: Cycles, cycles_from: str, options: dict) -> xr.Dataset:
+        """Check the whole recording and give ``results`` (the parts, joined) its
+        attributes.
+
+        Raises
+        ------
+        ValueError
+            If every cycle was refused.
+        """
+        summary = self.summary
+        _check_units(np.concatenate(self.amplitudes) if self.amplitudes else np.zeros(0))
+        if self.cycles and self.refused == self.cycles:
+            hint = dict(self.every, **{"negative-stiffness": self.negative_stiffness})
+            raise ValueError(
+                f"no plausible cycle in the recording ({summary}). {_refusal_hint(hint)}"
+            )
+        if self.flagged:
+            warn(f"cycles flagged: {summary}", LoopQualityWarning)
+        results = strip(results)
+        results.attrs.update(
+            {
+                "title": "Fretting loops analysed cycle by cycle (ecofmaps.analyze_loops)",
+                "cycles_from": cycles_from,
+                "incomplete_cycles": cycles.incomplete_cycles,
+                "dropped_samples": cycles.dropped_samples,
+                "missing_samples": cycles.missing_samples,
+                "first_missing_sample": cycles.first_missing,
+                "skipped_cycles": int(self.counts_of("missing-samples")),
+                "gross_slip_threshold": options["gross_slip_threshold"],
+                "flip_force": int(options["flip_force"]),
+                "quality_summary": summary,
+            }
+        )
+        return results
+
+    def counts_of(self, reason: str) -> int:
+        """Cycles whose quality lists ``reason``."""
+        return sum(c for text, c in self.counts.items() if reason in text.split("+"))
+
+
+def strip(part: xr.Dataset) -> xr.Dataset:
+    """``part`` without the riders of :func:`cycle_results`."""
+    return part.drop_vars([name for name in part.data_vars if str(name).startswith("_")])
 
 
 def _check_units(amplitude):
     """Warn when the displacement amplitudes look like another unit than metres."""
-    typical = float(np.nanmedian(amplitude)) if amplitude.size else np.nan
+    finite = amplitude[np.isfinite(amplitude)]
+    typical = float(np.median(finite)) if finite.size else np.nan
     low, high = _AMPLITUDE_RANGE
-    if not low <= typical <= high:
+    if np.isfinite(typical) and not low <= typical <= high:
         warn(
             f"the displacement amplitude is {typical:.3g} m (median over the cycles), outside "
             "0.1 µm to 10 mm: is the displacement in metres? analyze_loops takes SI units; "

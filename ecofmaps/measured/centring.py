@@ -18,6 +18,12 @@ the next and subtracted sample by sample, which also removes a slow drift of
 :math:`\Delta` (or of :math:`Q`) within each cycle; the weights of the force's centre come
 from the displacement so centred. Labelled cycles (possibly recorded far apart) are each
 moved by their own centre.
+
+Cycles that hold a missing sample (:attr:`ecofmaps.measured.cycles.Cycles.missing`) are not
+laid out, and the drift is interpolated between the centres of the whole cycles on either
+side of them. A block's samples are read as ``displacement[a:b]`` (and, for labelled
+cycles, ``displacement[indices]``) with indices into the whole recording, so the arrays may
+be any object that gives a stretch of it by those indices.
 """
 
 from __future__ import annotations
@@ -160,24 +166,28 @@ def loop_blocks(
         Consecutive cycles, about ``_BLOCK`` samples in all, in order.
     """
     first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
-    blocks = _blocks(cycles.count[first:stop] + 1, first)
+    # The whole cycles, by position among them: a block is consecutive whole cycles.
+    kept = np.flatnonzero(cycles.whole)
+    begin, end = (int(p) for p in np.searchsorted(kept, [first, stop]))
     if not cycles.continuous:
-        for block in blocks:
-            yield _labelled_block(cycles, displacement, force, block, force_sign)
+        for block in _whole_blocks(cycles, kept, begin, end):
+            yield _labelled_block(cycles, displacement, force, kept[block], force_sign)
         return
-    start, count = cycles.start, cycles.count
-    size = start.size
-    middle, centre_x = _displacement_centres(cycles, displacement, first, stop)
+    if begin == end:  # no whole cycle among the rows
+        return
+    start, count = cycles.start[kept], cycles.count[kept]
+    size = kept.size
+    middle, centre_x = _displacement_centres(start, count, displacement, begin, end)
     centre_q = np.empty(size)
-    ready = max(first - 1, 0)  # the force's centres are known below this cycle
-    for block in blocks:
+    ready = max(begin - 1, 0)  # the force's centres are known below this cycle
+    for block in _whole_blocks(cycles, kept, begin, end):
         # The centred values depend on the sample index alone. The force's drift within
         # the block needs the centres of the cycles on both sides of it.
         needed = min(block.stop + 1, size)
-        begin, end = min(ready, block.start), max(needed, block.stop)
-        low, high = int(start[begin]), int(start[end - 1] + count[end - 1])
+        lower, upper = min(ready, block.start), max(needed, block.stop)
+        low, high = int(start[lower]), int(start[upper - 1] + count[upper - 1])
         x = displacement[low:high] - _drift(
-            low, high, middle, centre_x, slice(max(begin - 1, 0), end + 1)
+            low, high, middle, centre_x, slice(max(lower - 1, 0), upper + 1)
         )
         if ready < needed:
             cut = slice(ready, needed)
@@ -190,12 +200,12 @@ def loop_blocks(
         offset = start[block] - a
         swing = np.subtract(*_extremes(force[a:b], offset, count[block]))
         yield LoopBlock(
-            rows=block,
+            rows=slice(int(kept[block.start]), int(kept[block.stop - 1]) + 1),
             displacement=x[a - low : b - low],
             force=_signed(force[a:b], force_sign) - _drift(a, b, middle, centre_q, near),
             offset=offset,
             count=count[block],
-            rotation=cycles.rotation[block],
+            rotation=cycles.rotation[kept[block]],
             continuous=True,
             displacement_centre=centre_x[block],
             force_centre=centre_q[block],
@@ -203,13 +213,21 @@ def loop_blocks(
         )
 
 
+def _whole_blocks(cycles: Cycles, kept, begin: int, end: int) -> Iterator[slice]:
+    """Blocks of consecutive whole cycles ``kept[begin:end]``, as slices of ``kept``."""
+    breaks = np.flatnonzero(np.diff(kept[begin:end]) != 1) + begin + 1
+    for a, b in itertools.pairwise([begin, *breaks.tolist(), end]):
+        yield from _blocks(cycles.count[kept[a:b]] + 1, a)
+
+
 def _signed(values, sign):
     """``values``, or ``-values`` if ``sign`` is negative."""
     return values if sign > 0 else -values
 
 
-def _labelled_block(cycles: Cycles, displacement, force, block: slice, sign) -> LoopBlock:
-    """The loops of labelled cycles, each moved by its own centre."""
+def _labelled_block(cycles: Cycles, displacement, force, block, sign) -> LoopBlock:
+    """The loops of consecutive labelled cycles (rows ``block``), each moved by its own
+    centre."""
     start, count = cycles.start[block], cycles.count[block]
     offset = np.concatenate([[0], np.cumsum(count[:-1])])
     index = np.repeat(start - offset, count) + np.arange(int(count.sum()))
@@ -221,7 +239,7 @@ def _labelled_block(cycles: Cycles, displacement, force, block: slice, sign) -> 
     centre_q = _path_means(x, q, offset, count, closed=True)
     q -= np.repeat(centre_q, count)
     return LoopBlock(
-        rows=block,
+        rows=slice(int(block[0]), int(block[-1]) + 1),
         displacement=x,
         force=q,
         offset=offset,
@@ -268,14 +286,14 @@ def _path_means(path, values, offset, count, closed: bool):
     return total / length
 
 
-def _displacement_centres(cycles: Cycles, displacement, first: int, stop: int):
-    """Middle sample of every cycle cut at the reversals, and the displacement centres of
-    cycles ``first - 2`` to ``stop + 1`` (NaN for the others), a block at a time.
+def _displacement_centres(start, count, displacement, first: int, stop: int):
+    """Middle sample of every cycle cut at the reversals (stretches ``start``, ``count``),
+    and the displacement centres of cycles ``first - 2`` to ``stop + 1`` (NaN for the
+    others), a block at a time.
 
     A cycle's path runs over its stretch only: the segment that closes the loop, from the
     next reversal back to the first sample, is not travelled.
     """
-    start, count = cycles.start, cycles.count
     # The mean sample index round the loop, its closing point included (exact integers).
     middle = ((count * (2 * start + count - 1)) // 2 + start) / (count + 1)
     centre = np.full(start.size, np.nan)

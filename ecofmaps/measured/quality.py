@@ -41,6 +41,7 @@ __all__ = [
     "quality_strings",
     "quality_summary",
     "refused",
+    "summary_of_counts",
 ]
 
 
@@ -73,6 +74,10 @@ RESOLVED = ("mu_resolved", "mu_resolved_se", "aspect_ratio")
 #: Every reason a cycle can be flagged for, in the order they are listed in ``quality``:
 #: name -> (what it means, the quantities it leaves NaN).
 REASONS = {
+    "missing-samples": (
+        "the cycle holds a missing sample (NaN or an empty cell): skipped, not analysed",
+        ALL,
+    ),
     "few-samples": ("fewer samples in the cycle than a loop needs (MIN_SAMPLES)", ALL),
     "constant-force": ("the force does not vary over the cycle (a dead channel)", ALL),
     "several-loops": (
@@ -224,17 +229,26 @@ def apply_quality(values: dict, flags: dict) -> dict:
 
 
 def quality_summary(quality) -> str:
-    """One line: how many cycles are ``'ok'`` and how many carry each reason."""
+    """One line: how many cycles are ``'ok'``, how many were skipped for missing samples,
+    and how many carry each other reason."""
     texts, counts = np.unique(np.ravel(quality), return_counts=True)
+    return summary_of_counts(dict(zip(texts.tolist(), counts.tolist(), strict=True)))
+
+
+def summary_of_counts(counts) -> str:
+    """:func:`quality_summary` from the number of cycles of each distinct ``quality``."""
     per_reason = {}
-    for text, count in zip(texts, counts, strict=True):
+    for text, count in counts.items():
         if text != "ok":
             for reason in text.split(SEPARATOR):
                 per_reason[reason] = per_reason.get(reason, 0) + int(count)
-    ok = int(counts[texts == "ok"].sum())
+    skipped = per_reason.pop("missing-samples", 0)
     order = list(REASONS)
     flagged = ", ".join(
         f"{reason} {per_reason[reason]}"
         for reason in sorted(per_reason, key=lambda r: order.index(r) if r in order else 99)
     )
-    return f"{int(counts.sum())} cycles: {ok} ok" + (f"; {flagged}" if flagged else "")
+    summary = f"{sum(int(c) for c in counts.values())} cycles: {int(counts.get('ok', 0))} ok"
+    if skipped:
+        summary += f", {skipped} skipped (missing samples)"
+    return summary + (f"; {flagged}" if flagged else "")

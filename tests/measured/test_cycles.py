@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 
 from ecofmaps.measured import centring, cycles
 from ecofmaps.measured.analysis import analyze_loops
+from ecofmaps.measured.samples import Samples
 from ecofmaps.measured.synthetic import synthetic_recording
 from tests.measured.reference import cycles as reference
 from tests.measured.reference.analysis import analyze_loops as reference_analysis
@@ -32,6 +33,15 @@ def signal(kind: int, size: int, seed: int):
     ][kind]
 
 
+def percentiles(values):
+    """The reversal detector's percentiles of ``values`` (taken as detrended already)."""
+    samples = Samples(values, None, chunk=cycles._CHUNK)
+    sample_at = np.sort(np.random.default_rng(0).integers(0, values.size, cycles._SAMPLE))
+    line = (0.0, 0.0, 0.0, 0.5 * (values.size - 1))
+    gaps = np.zeros((0, 2), np.int64)
+    return cycles._percentiles(samples, gaps, line, sample_at, values[sample_at], values.size)
+
+
 @pytest.fixture
 def small_chunks(monkeypatch):
     """Chunks of 1000 samples, percentile samples of 256 and blocks of 700 samples."""
@@ -48,7 +58,7 @@ def test_percentiles_are_numpys_to_the_bit(kind, size, seed):
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(cycles, "_CHUNK", 1000)
         patch.setattr(cycles, "_SAMPLE", 256)
-        result = cycles._percentiles(lambda a, b=None: values[a:b] if b else values[a], size)
+        result = percentiles(values)
     np.testing.assert_array_equal(result, np.percentile(values, [1.0, 99.0]))
 
 

@@ -1,0 +1,200 @@
+"""Blocks of work run on local threads or on a dask cluster, their results as they come.
+
+A long recording is analysed as many independent tasks, each of which reads its own stretch
+of the recording (a slice of a dask array, so the reading happens where the task runs) and
+returns a small result. :class:`Runner` runs such tasks with a bounded number in flight, so
+that memory holds a few blocks at a time whatever the recording's length, and gives the
+results back in the order of the tasks as soon as each is ready (so they can be written as
+they complete):
+
+- ``Runner()``: threads of this process (``workers``, default one per core); each task's
+  dask graph is computed in its thread;
+- ``Runner(workers=N)``: a ``dask.distributed.LocalCluster`` of N single-threaded worker
+  processes, started here and closed after;
+- ``Runner(scheduler="tcp://host:8786")``: the workers of an existing dask cluster, which
+  must have ecofmaps installed and reach the recording's file at the same path.
+
+Tasks are plain functions of this package (pickled by name for other processes). Between
+results :func:`ecofmaps._interrupts.check_interrupted` is called, so Ctrl-C on the command
+line stops the run at the next block without raising inside dask.
+"""
+
+from __future__ import annotations
+
+import collections
+import concurrent.futures
+import os
+
+from ecofmaps._interrupts import check_interrupted
+
+__all__ = ["CONNECT_TIMEOUT", "Runner", "SchedulerError"]
+
+#: Seconds to wait for a dask scheduler given by address to answer.
+CONNECT_TIMEOUT = 10.0
+
+
+class SchedulerError(OSError):
+    """A dask scheduler that cannot be reached (the message names its address)."""
+
+
+def _materialised(arguments):
+    """``arguments`` with every dask collection in them computed here, on this thread."""
+    import dask
+
+    if not any(dask.is_dask_collection(value) for value in arguments):
+        return arguments
+    return dask.compute(*arguments, scheduler="sync")
+
+
+def _call(function, arguments):
+    """Run one task: read its dask inputs where it runs, then call ``function``."""
+    return function(*_materialised(arguments))
+
+
+class Runner:
+    """Run tasks on threads or on a dask cluster, a bounded number at a time.
+
+    Parameters
+    ----------
+    workers : int, optional
+        With ``scheduler=None`` and ``cluster=False``: threads (default ``os.cpu_count()``).
+        With ``cluster=True``: worker processes of a new ``LocalCluster``.
+    scheduler : str, optional
+        Address of an existing dask scheduler (``tcp://host:8786``).
+    cluster : bool
+        Start a ``LocalCluster`` of ``workers`` processes (one thread each).
+    client : distributed.Client, optional
+        A client of a cluster already connected (left open).
+    timeout : float, optional
+        Seconds to wait for the scheduler at ``scheduler`` to answer (default
+        :data:`CONNECT_TIMEOUT`).
+
+    Notes
+    -----
+    Use as a context manager: the cluster or thread pool is closed on leaving it.
+    """
+
+    def __init__(self, workers=None, *, scheduler=None, cluster=False, client=None, timeout=None):
+        if workers is not None and (
+            isinstance(workers, bool) or int(workers) != workers or workers < 1
+        ):
+            raise ValueError(f"workers must be a positive integer; got {workers!r}")
+        if scheduler is not None and cluster:
+            raise ValueError("give a scheduler address or start a local cluster, not both")
+        self.scheduler, self.cluster, self.timeout = scheduler, cluster, timeout
+        self.workers = int(workers) if workers else (1 if scheduler else os.cpu_count() or 1)
+        self._given = client
+        self._client = self._cluster = self._pool = None
+
+    @property
+    def kind(self) -> str:
+        """``'threads'``, ``'local cluster'`` or ``'cluster at <address>'``."""
+        if self.scheduler or self._given is not None:
+            return f"cluster at {self.scheduler or self._given.scheduler.address}"
+        return "local cluster" if self.cluster else "threads"
+
+    def __enter__(self) -> Runner:
+        if self._given is not None:
+            self._client = self._given
+            self.workers = max(len(self._client.scheduler_info()["workers"]), 1)
+        elif self.scheduler is not None:
+            self._client = _connect(self.scheduler, self.timeout or CONNECT_TIMEOUT)
+            self.workers = max(len(self._client.scheduler_info()["workers"]), 1)
+        elif self.cluster:
+            import dask
+            from distributed import Client, LocalCluster
+
+            # distributed sets MALLOC_TRIM_THRESHOLD_ in its workers, which stops glibc from
+            # raising its mmap threshold: every NumPy temporary above 128 kB is then mapped
+            # afresh and faulted in page by page (measured: the analysis ran 2-3x slower).
+            environ = dask.config.get("distributed.nanny.pre-spawn-environ")
+            environ = {k: v for k, v in environ.items() if k != "MALLOC_TRIM_THRESHOLD_"}
+            with dask.config.set({"distributed.nanny.pre-spawn-environ": environ}):
+                self._cluster = LocalCluster(
+                    n_workers=self.workers,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=None,
+                    silence_logs=40,  # errors only
+                )
+            self._client = Client(self._cluster, set_as_default=False)
+        else:
+            self._pool = concurrent.futures.ThreadPoolExecutor(self.workers)
+        return self
+
+    def __exit__(self, *exc):
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+        if self._client is not None and self._given is None:
+            self._client.close()
+        if self._cluster is not None:
+            self._cluster.close()
+        self._client = self._cluster = self._pool = None
+        return False
+
+    def _submit(self, function, arguments):
+        if self._pool is not None:
+            return self._pool.submit(_call, function, arguments)
+        return self._client.submit(_call, function, arguments, pure=False)
+
+    def map(self, function, tasks, *, in_flight=None):
+        """``function(*arguments)`` for each ``arguments`` of ``tasks``, results in order.
+
+        Parameters
+        ----------
+        function : callable
+            A module-level function (picklable by name).
+        tasks : iterable of tuple
+            The arguments of each call; dask collections among them are computed where
+            the call runs, just before it.
+        in_flight : int, optional
+            Calls submitted and not yet handed back at once (default twice the workers):
+            the memory held is about that many blocks.
+
+        Yields
+        ------
+        result
+            Each call's result, in the order of ``tasks``, as soon as it and every earlier
+            one are done.
+        """
+        if self._pool is None and self._client is None:
+            raise RuntimeError("a Runner is used within a with block")
+        limit = in_flight or 2 * self.workers
+        pending = collections.deque()
+        tasks = iter(tasks)
+        exhausted = False
+        try:
+            while True:
+                while not exhausted and len(pending) < limit:
+                    arguments = next(tasks, None)
+                    if arguments is None:
+                        exhausted = True
+                    else:
+                        pending.append(self._submit(function, arguments))
+                if not pending:
+                    return
+                future = pending.popleft()
+                while True:
+                    try:
+                        result = future.result(timeout=0.2)
+                        break
+                    except (concurrent.futures.TimeoutError, TimeoutError):
+                        check_interrupted()
+                check_interrupted()
+                yield result
+        finally:
+            for future in pending:
+                future.cancel()
+
+
+def _connect(address: str, timeout: float):
+    """A client of the dask scheduler at ``address``, or :class:`SchedulerError`."""
+    from distributed import Client
+
+    try:
+        return Client(address, timeout=timeout, set_as_default=False)
+    except (OSError, TimeoutError, ValueError) as error:
+        raise SchedulerError(
+            f"cannot reach the dask scheduler at {address}: no answer within {timeout:g} s "
+            f"({type(error).__name__}: {error}); is it running, and is the address right?"
+        ) from None

@@ -1,0 +1,321 @@
+"""``ecofmaps loops`` on long tests: out of core, in parallel, resumable, with progress.
+
+A recording read lazily (a rig file of more than :data:`ecofmaps.io.recordings.LAZY_SAMPLES`
+samples, or any file with ``--workers``, ``--scheduler`` or ``--resume``) is analysed by
+:class:`ecofmaps.measured.out_of_core.LongAnalysis` on local threads, a local cluster of
+``--workers`` processes or the dask cluster at ``--scheduler``. With ``--out``, each block's
+results are written as it completes into ``<out>.partial/`` (NumPy ``.npz``, one file per block,
+each renamed into place when whole: what its cycles measured, from which the results are
+made again; with the cycles found and what the run was), so an
+interrupted run keeps what it finished and ``--resume`` continues it; the table is written
+to ``--out`` only at the end, and the folder removed. A progress bar (cycles, rate, time
+left) is shown on a terminal, unless ``--quiet``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import inspect
+import json
+import os
+import shutil
+import sys
+from pathlib import Path
+
+from ecofmaps.cli._common import CommandError
+
+__all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun", "add_options", "skipped"]
+
+#: The message for a missing sample with ``--nan-policy raise`` (the file and line before it).
+MISSING = (
+    "missing sample (an empty cell or NaN); --nan-policy skip analyses the cycles without "
+    "missing samples and reports the others as skipped"
+)
+
+#: Suffix of the folder that holds an unfinished run's blocks beside ``--out``.
+PARTIAL_SUFFIX = ".partial"
+
+#: Options that change how a run goes, not what it computes (left out of its fingerprint).
+_RUNTIME = ("workers", "scheduler", "resume", "quiet", "out", "plots", "handler", "files")
+
+
+def _workers(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of workers >= 1")
+    return value
+
+
+def add_options(parser) -> None:
+    """The options of long runs, for ``ecofmaps loops``."""
+    group = parser.add_argument_group(
+        "long tests",
+        "a rig file of more than 2**24 samples is analysed out of core, a block of whole "
+        "cycles at a time (the numbers are those of the analysis in memory)",
+    )
+    group.add_argument(
+        "--nan-policy", choices=("skip", "raise"), default="skip",
+        help="a cycle with a missing sample (NaN or an empty cell) is skipped and counted "
+        "(skip, the default), or any missing sample stops the command naming its line",
+    )  # fmt: skip
+    group.add_argument(
+        "--workers", type=_workers, default=None, metavar="N",
+        help="analyse out of core on a local dask cluster of N processes",
+    )  # fmt: skip
+    group.add_argument(
+        "--scheduler", default=None, metavar="ADDRESS",
+        help="analyse out of core on the dask cluster at ADDRESS (tcp://host:8786); its "
+        "workers must have ecofmaps and see the files at the same paths",
+    )  # fmt: skip
+    group.add_argument(
+        "--resume", action="store_true",
+        help="continue an interrupted run from the blocks kept in <out>.partial/ (needs "
+        "--out and the same files and options)",
+    )  # fmt: skip
+    group.add_argument(
+        "--quiet", action="store_true", help="no progress bar (none is shown off a terminal)",
+    )  # fmt: skip
+
+
+def _fingerprint(args, paths) -> dict:
+    """What the run computes: the files as they are now and the options that matter."""
+    files = []
+    for path in paths:
+        stat = Path(path).stat()
+        files.append([str(Path(path).resolve()), stat.st_size, stat.st_mtime_ns])
+    options = {
+        key: value
+        for key, value in sorted(vars(args).items())
+        if key not in _RUNTIME and isinstance(value, str | int | float | bool | type(None))
+    }
+    return {"format": 1, "files": files, "options": options}
+
+
+_UNFINISHED = (
+    "{folder} holds an unfinished run: add --resume to continue it, or delete it to start again"
+)
+
+
+class _Partial:
+    """The folder ``<out>.partial`` of an unfinished run (see the module notes)."""
+
+    def __init__(self, out, fingerprint: dict, resume: bool):
+        self.folder = Path(f"{out}{PARTIAL_SUFFIX}")
+        record = self.folder / "run.json"
+        if self.folder.exists():
+            if not resume:
+                raise CommandError(_UNFINISHED.format(folder=self.folder))
+            try:
+                found = json.loads(record.read_text(encoding="utf-8"))
+            except (OSError, ValueError):
+                found = None
+            if found != fingerprint:
+                raise CommandError(
+                    f"{self.folder} holds a run of other files or options: delete it to start "
+                    "again with these"
+                )
+        else:
+            self.folder.mkdir()
+            _write(record, lambda path: path.write_text(json.dumps(fingerprint), "utf-8"))
+
+    def cycles(self, index: int):
+        """The cycles of file ``index`` found before, or None."""
+        import numpy as np
+
+        from ecofmaps.measured.cycles import Cycles
+
+        path = self.folder / f"file{index}-cycles.npz"
+        if not path.exists():
+            return None
+        with np.load(path) as stored:
+            fields = {f.name: stored[f.name] for f in dataclasses.fields(Cycles)}
+        fields["missing"] = None if fields["missing"].ndim == 0 else fields["missing"]
+        for name in ("continuous",):
+            fields[name] = bool(fields[name])
+        for name in ("incomplete_cycles", "dropped_samples", "missing_samples", "first_missing"):
+            fields[name] = int(fields[name])
+        return Cycles(**fields)
+
+    def keep_cycles(self, index: int, cycles) -> None:
+        import numpy as np
+
+        values = dataclasses.asdict(cycles)
+        values["missing"] = np.asarray(False) if cycles.missing is None else cycles.missing
+        _write(self.folder / f"file{index}-cycles.npz", lambda path: _savez(path, values))
+
+    def done(self, index: int) -> dict:
+        """The blocks of file ``index`` kept: block -> (values, flags) as measured."""
+        import numpy as np
+
+        prefix = f"file{index}-block"
+        kept = {}
+        for path in self.folder.glob(f"{prefix}*.npz"):
+            if path.stem[len(prefix) :].isdigit():
+                with np.load(path) as stored:
+                    values = {k[2:]: stored[k] for k in stored.files if k.startswith("v:")}
+                    flags = {k[2:]: stored[k] for k in stored.files if k.startswith("f:")}
+                kept[int(path.stem[len(prefix) :])] = (values, flags)
+        return kept
+
+    def keep(self, index: int, block: int, values: dict, flags: dict) -> None:
+        """Keep what block ``block`` of file ``index`` measured."""
+        stored = {f"v:{k}": v for k, v in values.items()} | {f"f:{k}": v for k, v in flags.items()}
+        _write(self.folder / f"file{index}-block{block:06d}.npz", lambda p: _savez(p, stored))
+
+    def remove(self) -> None:
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+
+def _savez(path: Path, values: dict) -> None:
+    import numpy as np
+
+    with open(path, "wb") as stream:
+        np.savez(stream, **values)
+
+
+def _write(path: Path, write) -> None:
+    """``write(temporary)``, then rename the temporary onto ``path`` (whole, or nothing)."""
+    temporary = path.with_name(f".{path.name}.tmp")
+    try:
+        write(temporary)
+        os.replace(temporary, path)
+    finally:
+        temporary.unlink(missing_ok=True)
+
+
+class LongRun:
+    """The long recordings of one ``ecofmaps loops`` command (module notes).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The command's options.
+    paths : list of pathlib.Path
+        Its recordings.
+
+    Attributes
+    ----------
+    lazy : bool or None
+        ``lazy`` for :func:`ecofmaps.read_recording`: True when a long run was asked for
+        (``--workers``, ``--scheduler``, ``--resume``), else None (large rig files only).
+    """
+
+    def __init__(self, args, paths):
+        if args.workers and args.scheduler:
+            raise CommandError("give --workers or --scheduler, not both")
+        if args.resume and args.out is None:
+            raise CommandError("--resume continues the run kept beside --out: give --out")
+        self.args = args
+        self.lazy = True if (args.workers or args.scheduler or args.resume) else None
+        folder = Path(f"{args.out}{PARTIAL_SUFFIX}")
+        if args.out is not None and folder.exists() and not args.resume:
+            raise CommandError(_UNFINISHED.format(folder=folder))
+        self.fingerprint = _fingerprint(args, paths) if args.out is not None else None
+        self.partial = None
+
+    def _runner(self):
+        from ecofmaps._parallel import Runner
+
+        if self.args.scheduler:
+            return Runner(scheduler=self.args.scheduler)
+        if self.args.workers:
+            return Runner(self.args.workers, cluster=True)
+        return Runner()
+
+    def analyse(self, index: int, path: Path, recording, load: float):
+        """The results of recording ``index`` (read lazily), as :func:`ecofmaps.analyze_loops`
+        gives them; its blocks kept beside ``--out`` as they complete."""
+        with self._runner() as runner:  # a cluster that does not answer: nothing written
+            if self.partial is None and self.fingerprint is not None:
+                self.partial = _Partial(self.args.out, self.fingerprint, self.args.resume)
+            return _analyse(index, path, recording, load, self.args, runner, self.partial)
+
+    def finish(self) -> None:
+        """Remove the kept blocks: the table is written."""
+        if self.partial is not None:
+            self.partial.remove()
+
+
+def skipped(results, recording) -> str:
+    """For a file's summary line: the cycles skipped for missing samples, and where the
+    first missing sample is (``''`` if none)."""
+    count = results.attrs.get("skipped_cycles", 0)
+    if not count:
+        return ""
+    first = recording.position(results.attrs["first_missing_sample"])
+    where = f"line {first}" if isinstance(first, int) else first
+    return f"; {count} skipped for missing samples (the first at {where})"
+
+
+def _analyse(index, path, recording, load, args, runner, partial):
+    """One long recording, block by block (module notes)."""
+    import xarray as xr
+
+    from ecofmaps.measured.analysis import analyze_loops, check_options
+    from ecofmaps.measured.out_of_core import LongAnalysis
+
+    if args.plots is not None:
+        raise CommandError(
+            f"--plots draws every loop, which a long recording ({path}) analysed out of core "
+            "does not keep: leave out --plots (or --workers, --scheduler, --resume)"
+        )
+    defaults = inspect.signature(analyze_loops).parameters
+    options = check_options(
+        load,
+        *(defaults[name].default for name in ("hysteresis", "stick_window", "crossing_window")),
+        defaults["gross_slip_threshold"].default,
+        getattr(args, "flip_force", False),
+    )
+    shown = not args.quiet and sys.stderr.isatty()
+    if shown:
+        print(f"{path.name}: finding the cycles of {recording.size} samples", file=sys.stderr)
+    analysis = LongAnalysis(
+        recording.displacement,
+        recording.force,
+        load,
+        recording.cycle,
+        runner=runner,
+        nan_policy=args.nan_policy,
+        resolve=not args.no_resolve,
+        cycles=None if partial is None else partial.cycles(index),
+        **options,
+    )
+    done = {}
+    if partial is not None:
+        partial.keep_cycles(index, analysis.cycles)
+        done = partial.done(index)
+    parts = {block: analysis.part(block, *measured) for block, measured in done.items()}
+    bar = _bar(analysis, path, shown, sum(parts[b].cycle.size for b in parts))
+    try:
+        for block, values, flags in analysis.measured(skip=done):
+            if partial is not None:
+                partial.keep(index, block, values, flags)
+            parts[block] = analysis.part(block, values, flags)
+            bar.update(parts[block].cycle.size)
+    except KeyboardInterrupt:
+        bar.leave = False
+        bar.close()
+        if partial is not None:
+            print(
+                f"ecofmaps: {len(parts)} of {len(analysis.tasks)} blocks of {path} are kept in "
+                f"{partial.folder}: run the same command with --resume to continue",
+                file=sys.stderr,
+            )
+        raise
+    bar.close()
+    joined = xr.concat([parts[k] for k in sorted(parts)], "cycle")
+    return analysis.finish(joined)
+
+
+def _bar(analysis, path, shown: bool, initial: int):
+    from tqdm import tqdm
+
+    return tqdm(
+        total=int(analysis.cycles.label.size), initial=initial, unit=" cycles",
+        desc=path.name, file=sys.stderr, disable=not shown, dynamic_ncols=True,
+        smoothing=0.1,
+    )  # fmt: skip

@@ -1,0 +1,244 @@
+r"""The per-cycle analysis of a long recording held as dask arrays, a block of cycles at a time.
+
+:class:`LongAnalysis` is what :func:`ecofmaps.analyze_loops` does with a dask recording, in
+steps that a caller can follow (the command line writes each block's results as it comes):
+
+1. The cycles are found by passes over the recording a block of samples at a time
+   (:func:`ecofmaps.measured.cycles.find_cycles` on :class:`~ecofmaps.measured.samples.Samples`):
+   the straight line through the displacement, its percentiles, the reversals (or the
+   runs of cycle numbers), and the runs of missing samples. Only their results, a few
+   numbers per cycle, are held.
+2. The cycles are cut into tasks of whole cycles, about ``samples`` samples each, so no
+   cycle is cut at a task's edge. Each task reads the stretch of its cycles and of two
+   whole cycles on either side (a *halo*: the centring interpolates each cycle's centre
+   from its neighbours', :mod:`ecofmaps.measured.centring`) and measures its cycles with
+   :func:`ecofmaps.measured.analysis.measure_cycles`, with the sample indices of the whole
+   recording. So every number is computed from the same samples, with the same arithmetic,
+   as in memory; only sums over a loop's padded rows may be grouped differently (to the
+   last bits).
+3. :meth:`LongAnalysis.finish` checks the whole recording (every cycle refused, units) and
+   gives the joined results their attributes, as :func:`~ecofmaps.analyze_loops` does.
+
+The tasks run on a :class:`ecofmaps._parallel.Runner` (threads, a local cluster of
+processes, or a dask cluster), a few at a time, so memory holds a few blocks whatever the
+length of the recording.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import xarray as xr
+
+from ecofmaps.measured.analysis import (
+    MissingSampleError,
+    Tally,
+    _missing_error,
+    cycle_results,
+    measure_cycles,
+    no_cycle_error,
+    strip,
+    with_loops,
+    with_read_along_stroke,
+)
+from ecofmaps.measured.cycles import Cycles, find_cycles
+from ecofmaps.measured.quality import quality_summary
+from ecofmaps.measured.resolved import REPORTED
+from ecofmaps.measured.resolved import _attrs as _read_attrs
+
+__all__ = ["HALO", "TASK_SAMPLES", "LongAnalysis", "MissingSampleError"]
+
+#: Samples of the recording measured by one task (about; whole cycles).
+TASK_SAMPLES = 1 << 22
+
+#: Whole cycles on either side of a task's cycles that it reads for the centring.
+HALO = 2
+
+
+class _Stretch:
+    """A stretch of a recording (samples ``low`` on) indexed like the whole recording."""
+
+    def __init__(self, values, low: int):
+        self.values, self.low = values, low
+
+    def __getitem__(self, key):
+        if isinstance(key, slice):
+            return self.values[key.start - self.low : key.stop - self.low]
+        return self.values[np.asarray(key) - self.low]
+
+
+#: The prefix of the names under which a task's values hold its reading along the stroke.
+READ = "read:"
+
+
+def _measure(
+    cycles: Cycles, low: int, rows: slice, load: float, options: dict, x, q, resolve: bool
+):
+    """One task: the cycles ``rows`` of the table ``cycles`` measured on the stretch of the
+    recording that begins at sample ``low``; with ``resolve``, also read along the stroke
+    (the values :data:`~ecofmaps.measured.resolved.REPORTED` and the reading's quality,
+    named with the prefix :data:`READ`), so the loops never leave the task."""
+    values, flags, loops = measure_cycles(
+        cycles, _Stretch(x, low), _Stretch(q, low), load, rows=rows, keep_loops=resolve, **options
+    )
+    if resolve:
+        part = strip(cycle_results(values, flags, cycles.label[rows], load, options))
+        read = with_read_along_stroke(with_loops(part, loops))
+        values = values | {f"{READ}{name}": read[name].values for name in (*REPORTED, "quality")}
+    return values, flags, None
+
+
+class LongAnalysis:
+    """:func:`ecofmaps.analyze_loops` of a dask recording, in steps (module notes).
+
+    Parameters
+    ----------
+    displacement, force : dask.array.Array
+        [m], [N]
+    load : float
+        Normal load. [N]
+    cycle : dask.array.Array, optional
+        Cycle numbers. [1]
+    missing : dask.array.Array of bool, optional
+        Samples to treat as missing.
+    runner : ecofmaps._parallel.Runner
+        Where the passes and the tasks run (entered).
+    nan_policy : {'skip', 'raise'}
+    resolve : bool
+        Also read each loop along the stroke, as :func:`ecofmaps.analyze_loops` does.
+    cycles : Cycles, optional
+        The cycles, if found before (a resumed run); else they are found here.
+    samples : int, optional
+        Samples per task (about; default :data:`TASK_SAMPLES`).
+    **options
+        The checked options of :func:`ecofmaps.measured.analysis.check_options`.
+
+    Attributes
+    ----------
+    cycles : Cycles
+    tasks : list of slice
+        The rows (cycles) of each task, in order.
+    tally : ecofmaps.measured.analysis.Tally
+        What the parts given out so far add up to.
+
+    Raises
+    ------
+    MissingSampleError
+        With ``nan_policy='raise'``, naming the first missing sample.
+    ValueError
+        If the recording holds no complete cycle.
+    """
+
+    def __init__(
+        self,
+        displacement,
+        force,
+        load,
+        cycle=None,
+        *,
+        missing=None,
+        runner,
+        nan_policy="skip",
+        resolve=False,
+        cycles=None,
+        samples=None,
+        **options,
+    ):
+        self.arrays = (displacement, force)
+        self.resolve = bool(resolve)
+        self.load, self.options, self.runner = float(load), options, runner
+        self.cycles_from = "displacement reversals" if cycle is None else "cycle numbers"
+        if cycles is None:
+            cycles = find_cycles(
+                displacement,
+                cycle,
+                options["hysteresis"],
+                force=force,
+                missing=missing,
+                runner=runner,
+            )
+        self.cycles = cycles
+        if nan_policy == "raise" and cycles.first_missing >= 0:
+            raise _missing_error(cycles.first_missing)
+        if cycles.label.size == 0:
+            raise no_cycle_error(int(displacement.shape[0]))
+        self.tasks = _tasks(cycles.count, samples or TASK_SAMPLES)
+        self.tally = Tally()
+
+    def _task(self, rows: slice):
+        """The arguments of the task that measures ``rows``."""
+        cycles = self.cycles
+        first, stop = rows.start, rows.stop
+        if cycles.continuous:  # a halo of whole cycles on either side
+            kept = np.flatnonzero(cycles.whole)
+            begin, end = np.searchsorted(kept, [first, stop])
+            if begin > 0:
+                first = min(first, int(kept[max(begin - HALO, 0)]))
+            if end < kept.size:
+                stop = max(stop, int(kept[min(end + HALO, kept.size) - 1]) + 1)
+        table = cycles.rows(slice(first, stop))
+        low = int(table.start[0])
+        high = int(table.start[-1] + table.count[-1])
+        x, q = (array[low:high] for array in self.arrays)
+        inner = slice(rows.start - first, rows.stop - first)
+        return (table, low, inner, self.load, self.options, x, q, self.resolve)
+
+    def measured(self, skip=()):
+        """What each task measured, in order, as it comes.
+
+        Parameters
+        ----------
+        skip : collection of int
+            Tasks not to run (done before, in a run that is resumed).
+
+        Yields
+        ------
+        index : int
+            The task (index into :attr:`tasks`).
+        values, flags : dict of str to numpy.ndarray
+            Its cycles' quantities and checks, from
+            :func:`~ecofmaps.measured.analysis.measure_cycles` (:meth:`part` makes the
+            results of them).
+        """
+        skip = set(skip)
+        wanted = [k for k in range(len(self.tasks)) if k not in skip]
+        results = self.runner.map(_measure, (self._task(self.tasks[k]) for k in wanted))
+        for index, (values, flags, _) in zip(wanted, results, strict=False):
+            yield index, values, flags
+
+    def part(self, index: int, values: dict, flags: dict) -> xr.Dataset:
+        """The per-cycle results of task ``index`` from what it measured, as in
+        :func:`ecofmaps.analyze_loops`'s Dataset (without the recording's attributes);
+        counted in :attr:`tally`."""
+        read = {k[len(READ) :]: v for k, v in values.items() if k.startswith(READ)}
+        values = {k: v for k, v in values.items() if not k.startswith(READ)}
+        part = cycle_results(
+            values, flags, self.cycles.label[self.tasks[index]], self.load, self.options
+        )
+        self.tally.add(part)
+        if read:  # as ecofmaps.measured.resolved.with_resolved adds them
+            part = part.assign({k: ("cycle", read[k], _read_attrs(k)) for k in REPORTED})
+            part["quality"] = part["quality"].copy(data=read["quality"])
+        return part
+
+    def parts(self):
+        """The results of each task, in order, as they come (see :meth:`part`)."""
+        for index, values, flags in self.measured():
+            yield index, self.part(index, values, flags)
+
+    def finish(self, results: xr.Dataset) -> xr.Dataset:
+        """The joined parts (all of them, in order) with the recording's attributes, after
+        the checks of the whole recording (see :meth:`ecofmaps.measured.analysis.Tally.finish`)."""
+        results = self.tally.finish(results, self.cycles, self.cycles_from, self.options)
+        if self.resolve:  # the summary of the reading's quality, as with_resolved gives it
+            results.attrs["quality_summary"] = quality_summary(results["quality"].values)
+        return results
+
+
+def _tasks(count, samples: int) -> list[slice]:
+    """Consecutive rows of cycles of about ``samples`` samples in all (at least one)."""
+    ends = np.cumsum(count)
+    targets = np.arange(samples, int(ends[-1]), samples)
+    bounds = np.unique(np.concatenate([[0], np.searchsorted(ends, targets), [count.size]]))
+    return [slice(int(a), int(b)) for a, b in itertools.pairwise(bounds)]

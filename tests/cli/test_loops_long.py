@@ -1,0 +1,183 @@
+"""``ecofmaps loops`` on long tests: missing samples, out of core (threads, two worker
+processes), blocks kept as they complete and a resumed run, damaged files and clusters that
+do not answer (issue 11 item 5, issue 12 items 2, 3 and Bad input)."""
+
+import re
+
+import numpy as np
+import pytest
+
+from ecofmaps.cli import loops_long
+from ecofmaps.measured import out_of_core
+from ecofmaps.measured.synthetic import synthetic_recording, write_long_recording
+from tests.cli.test_loops import POINT, run, write_csv
+
+
+@pytest.fixture
+def small_tasks(monkeypatch):
+    """Tasks of about 1000 samples: a test of 60 cycles of 100 is six blocks."""
+    monkeypatch.setattr(out_of_core, "TASK_SAMPLES", 1000)
+
+
+@pytest.fixture(scope="module")
+def long_test(tmp_path_factory):
+    """A long synthetic test of 60 cycles as zarr and TDMS, and its table in memory."""
+    folder = tmp_path_factory.mktemp("long")
+    paths = {}
+    for suffix in (".zarr", ".tdms"):
+        paths[suffix] = write_long_recording(
+            folder / f"test{suffix}", cycles=60, samples_per_cycle=100, chunk_samples=700
+        )
+    return paths
+
+
+def in_memory_table(capsys, path, tmp_path):
+    status, _, err = run(capsys, path, "--load", "450N", "--out", tmp_path / "memory.csv")
+    assert status == 0, err
+    return (tmp_path / "memory.csv").read_text()
+
+
+def test_missing_cells_are_skipped_and_named(tmp_path, capsys):
+    displacement, force = synthetic_recording(**POINT, cycles=6)
+    path = write_csv(tmp_path / "gaps.csv", displacement, force)
+    lines = path.read_text().splitlines()
+    # line 1 is a comment, line 2 the header: sample k is on line k + 3
+    lines[350 + 2] = lines[350 + 2].split(",")[0] + ","  # an empty force cell
+    lines[900 + 2] = "nan," + lines[900 + 2].split(",")[1]
+    path.write_text("\n".join(lines) + "\n")
+    status, out, err = run(capsys, path, "--load", "450N", "--out", tmp_path / "r.csv")
+    assert status == 0, err
+    assert "2 skipped for missing samples (the first at line 353)" in out
+    table = (tmp_path / "r.csv").read_text().splitlines()
+    assert len(table) == 1 + 6
+    assert sum(",unknown" in row for row in table) == 2
+    status, out, err = run(
+        capsys, path, "--load", "450N", "--out", tmp_path / "s.csv", "--nan-policy", "raise"
+    )
+    assert status == 2
+    assert f"{path}, line 353: missing sample" in err and "--nan-policy skip" in err
+    assert not (tmp_path / "s.csv").exists()
+
+
+@pytest.mark.parametrize("suffix", [".zarr", ".tdms"])
+def test_out_of_core_gives_the_table_in_memory(long_test, tmp_path, capsys, small_tasks, suffix):
+    expected = in_memory_table(capsys, long_test[suffix], tmp_path)
+    out = tmp_path / "long.csv"
+    status, printed, err = run(capsys, long_test[suffix], "--load", "450N", "--out", out,
+                               "--resume")  # fmt: skip
+    assert status == 0, err
+    assert out.read_text() == expected
+    assert "wrote" in printed and not (tmp_path / "long.csv.partial").exists()
+    assert err == ""  # not a terminal: no progress bar
+
+
+def test_two_worker_processes(long_test, tmp_path, capsys):
+    expected = in_memory_table(capsys, long_test[".tdms"], tmp_path)
+    out = tmp_path / "workers.csv"
+    status, _, err = run(capsys, long_test[".tdms"], "--load", "450N", "--out", out,
+                         "--workers", "2")  # fmt: skip
+    assert status == 0, err
+    assert out.read_text() == expected
+
+
+def test_an_interrupted_run_resumes(long_test, tmp_path, capsys, small_tasks, monkeypatch):
+    """Ctrl-C after two blocks: nothing at --out, two blocks kept; a rerun must say
+    --resume; with it, the table of an uninterrupted run."""
+    expected = in_memory_table(capsys, long_test[".zarr"], tmp_path)
+    out = tmp_path / "r.csv"
+    keep = loops_long._Partial.keep
+    kept = []
+
+    def interrupted(self, index, block, values, flags):
+        if len(kept) == 2:
+            raise KeyboardInterrupt
+        kept.append(block)
+        keep(self, index, block, values, flags)
+
+    monkeypatch.setattr(loops_long._Partial, "keep", interrupted)
+    status, _, err = run(capsys, long_test[".zarr"], "--load", "450N", "--out", out,
+                         "--workers", "1")  # fmt: skip
+    assert status == 130
+    assert "2 of 6 blocks" in err and "--resume" in err
+    assert not out.exists()
+    partial = tmp_path / "r.csv.partial"
+    assert len(list(partial.glob("file0-block*.npz"))) == 2
+    monkeypatch.setattr(loops_long._Partial, "keep", keep)
+    status, _, err = run(capsys, long_test[".zarr"], "--load", "450N", "--out", out)
+    assert status == 2 and "holds an unfinished run: add --resume" in err
+    status, _, err = run(capsys, long_test[".zarr"], "--load", "400N", "--out", out, "--resume")
+    assert status == 2 and "holds a run of other files or options" in err
+    status, _, err = run(capsys, long_test[".zarr"], "--load", "450N", "--out", out, "--resume")
+    assert status == 0, err
+    assert out.read_text() == expected
+    assert not partial.exists()
+
+
+def damaged(path, tmp_path):
+    """A copy of ``path`` cut short (a file) or missing a chunk (a zarr store)."""
+    import shutil
+
+    copy = tmp_path / f"cut{path.suffix}"
+    if path.is_dir():
+        shutil.copytree(path, copy)
+        next(iter(sorted((copy / "force" / "c").iterdir()))).unlink()
+    else:
+        data = path.read_bytes()
+        copy.write_bytes(data[: len(data) * 2 // 3])
+    return copy
+
+
+@pytest.mark.parametrize(
+    ("case", "message"),
+    [
+        (".zarr", r"cut.zarr, variable 'force': 1 of its \d+ chunks are missing"),
+        (".tdms", r"cut.tdms: truncated or damaged TDMS file"),
+        (".h5", r"cut.h5: cannot open as HDF5 \(truncated or damaged"),
+        ("no channel", r"test.zarr: no force variable 'friction'"),
+        ("short channel", r"short.h5, variable 'force': 5000 samples where the displacement"),
+        ("no scheduler", r"cannot reach the dask scheduler at tcp://127.0.0.1:9: no answer"),
+    ],
+)
+def test_bad_input_leaves_nothing(long_test, tmp_path, capsys, monkeypatch, case, message):
+    import h5py
+
+    monkeypatch.setattr("ecofmaps._parallel.CONNECT_TIMEOUT", 1.0)
+    arguments = ["--load", "450N", "--out", tmp_path / "r.csv", "--resume"]
+    if case == ".h5":
+        path = write_long_recording(tmp_path / "test.h5", cycles=60, samples_per_cycle=100)
+        path = damaged(path, tmp_path)
+    elif case in (".zarr", ".tdms"):
+        path = damaged(long_test[case], tmp_path)
+    elif case == "no channel":
+        path, arguments = long_test[".zarr"], [*arguments, "--force-col", "friction"]
+    elif case == "short channel":
+        path = tmp_path / "short.h5"
+        with h5py.File(path, "w") as handle:
+            handle["displacement"] = np.zeros(6000)
+            handle["force"] = np.zeros(5000)
+    else:
+        path, arguments = long_test[".zarr"], [*arguments, "--scheduler", "tcp://127.0.0.1:9"]
+    status, _, err = run(capsys, path, *arguments)
+    assert status == 2
+    assert re.search(message, err), err
+    assert list(tmp_path.glob("r.csv*")) == []
+
+
+def test_convert_a_csv_file_then_analyse_it(tmp_path, capsys):
+    """``ecofmaps convert`` keeps every sample (in SI) and the cycle column: the same table."""
+    from ecofmaps.cli import main
+    from ecofmaps.measured.synthetic import example_path
+
+    store = tmp_path / "example.zarr"
+    assert main(["convert", str(example_path()), str(store), "--chunk-samples", "5000"]) == 0
+    assert "24000 samples of displacement, force, cycle" in capsys.readouterr().out
+    assert main(["convert", str(example_path()), str(store)]) == 2
+    assert "exists already: --overwrite" in capsys.readouterr().err
+    tables = []
+    for path in (example_path(), store):
+        status, _, err = run(capsys, path, "--load", "450N", "--out", tmp_path / "r.csv",
+                             "--resume")  # fmt: skip
+        assert status == 0, err
+        tables.append((tmp_path / "r.csv").read_text())
+        (tmp_path / "r.csv").unlink()
+    assert tables[0] == tables[1]

@@ -1,0 +1,267 @@
+"""A recording held as dask arrays, analysed block by block: the numbers of the same
+recording in memory; and recordings with missing samples (issue 11 item 5, issue 12 item 2).
+
+Chunks of the passes over the recording, dask blocks and the tasks of cycles are made small
+and awkward here (1000, 1700 and 777 samples), so that runs, cycles, percentile brackets,
+halos and missing samples straddle every edge. Every per-cycle quantity must equal the
+analysis in memory to 1e-12 of its natural scale (tests/measured/test_equivalence.py), the
+quality and regime strings and the attributes exactly.
+"""
+
+import warnings
+
+import dask.array as da
+import numpy as np
+import pytest
+import xarray as xr
+
+from ecofmaps.measured import cycles, out_of_core
+from ecofmaps.measured.analysis import MissingSampleError, analyze_loops
+from ecofmaps.measured.quality import LoopQualityWarning
+from ecofmaps.measured.synthetic import synthetic_recording
+from tests.measured.test_analysis import mindlin_recording
+from tests.measured.test_equivalence import (
+    COEFFICIENTS,
+    DISPLACEMENTS,
+    EXAMPLE_2,
+    FORCES,
+    LOAD,
+    TOLERANCE,
+    noisy,
+)
+
+READ = ("mu_resolved", "mu_resolved_se", "aspect_ratio")
+
+
+@pytest.fixture
+def small_blocks(monkeypatch):
+    """Passes a chunk of 1000 samples at a time, tasks of about 777 samples."""
+    monkeypatch.setattr(cycles, "_CHUNK", 1000)
+    monkeypatch.setattr(cycles, "_SAMPLE", 256)
+    monkeypatch.setattr(out_of_core, "TASK_SAMPLES", 777)
+
+
+def analysed(displacement, force, cycle=None, **options):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", LoopQualityWarning)
+        return analyze_loops(displacement, force, LOAD, cycle, **options)
+
+
+def lazily(*arrays, chunks=1700):
+    return [None if a is None else da.from_array(a, chunks=chunks) for a in arrays]
+
+
+def assert_equal_results(lazy, memory):
+    """Every per-cycle number within 1e-12 of its natural scale; the rest exactly."""
+    assert lazy.attrs == memory.attrs
+    np.testing.assert_array_equal(lazy.cycle, memory.cycle)
+    for name in ("regime", "quality"):
+        np.testing.assert_array_equal(lazy[name].values, memory[name].values)
+    amplitude = np.abs(memory.amplitude.values)
+    scale = dict.fromkeys(DISPLACEMENTS, amplitude) | {"stick_residual": amplitude}
+    scale |= dict.fromkeys(FORCES, np.abs(memory.max_force.values))
+    scale |= dict.fromkeys(COEFFICIENTS, np.abs(memory.cof_max.values))
+    scale |= {"dissipated_energy": 4 * amplitude * np.abs(memory.max_force.values)}
+    scale |= {"stiffness": np.abs(memory.stiffness.values)}
+    if "mu_resolved" in memory:  # read along the stroke: coefficients and slopes
+        scale |= dict.fromkeys(READ, np.abs(memory.cof_max.values))
+    assert set(scale) == {n for n in memory.data_vars if memory[n].dtype.kind == "f"}
+    for name, natural in scale.items():
+        a, b = lazy[name].values, memory[name].values
+        np.testing.assert_array_equal(np.isnan(a), np.isnan(b), err_msg=name)
+        both = ~np.isnan(b)
+        allowed = TOLERANCE * np.maximum(np.abs(b[both]), natural[both])
+        assert np.all(np.abs(a[both] - b[both]) <= allowed), name
+
+
+def with_gaps(displacement, force, where):
+    """A copy with NaN displacement or force at the samples ``where`` (alternately)."""
+    x, q = displacement.copy(), force.copy()
+    for k, index in enumerate(where):
+        (x if k % 2 == 0 else q)[index] = np.nan
+    return x, q
+
+
+def labelled_with_offsets():
+    displacement, force = noisy(EXAMPLE_2, 12, 7, start_phase=0.3)
+    jumps = np.repeat(np.arange(12) * 1e-6, 200)  # a new offset for each loop
+    return displacement + jumps, force + 3e3 * jumps, np.repeat(np.arange(1, 13) * 100, 200)
+
+
+def dead_channel():
+    """The force channel dies in the 7th of ten cycles: flagged cycles beside good ones."""
+    displacement, force = noisy(EXAMPLE_2, 10, 3)
+    force[1300:] = 7.25
+    return displacement, force, None
+
+
+def missing_everywhere():
+    """NaN in the middle of cycles, a run of empty samples, at a reversal, at both ends."""
+    displacement, force = noisy(EXAMPLE_2, 14, 5)
+    bottom = 5 * 200  # a bottom reversal of the sinusoid
+    x, q = with_gaps(displacement, force, [0, 450, bottom, 2101, *range(2400, 2440), -1])
+    return x, q, None
+
+
+RECORDINGS = {
+    "noise, offsets, drift": lambda: (*noisy(EXAMPLE_2, 30, 1), None),
+    "jittered clock, mid-stroke start": lambda: (
+        *noisy(EXAMPLE_2, 25, 2, sampling_jitter=0.4, samples_per_cycle=139, start_phase=0.37),
+        None,
+    ),
+    "labelled, new offset each loop": labelled_with_offsets,
+    "partial slip (Mindlin)": lambda: (*mindlin_recording(0.9, cycles=8), None),
+    "flagged cycles (dead force channel)": dead_channel,
+    "missing samples": missing_everywhere,
+    "missing samples, labelled": lambda: (
+        *with_gaps(*labelled_with_offsets()[:2], [10, 777, 2300, 2399]),
+        labelled_with_offsets()[2].astype(np.float64),
+    ),
+}
+
+
+@pytest.mark.parametrize("name", RECORDINGS)
+@pytest.mark.parametrize("chunks", [1700, 3000])
+def test_same_numbers_as_in_memory(small_blocks, name, chunks, monkeypatch):
+    displacement, force, cycle = RECORDINGS[name]()
+    memory = analysed(displacement, force, cycle)
+    tasks = []
+    original = out_of_core._tasks
+    monkeypatch.setattr(out_of_core, "_tasks", lambda *a: tasks.append(original(*a)) or tasks[-1])
+    lazy = analysed(*lazily(displacement, force, cycle, chunks=chunks), scheduler="threads")
+    assert len(tasks[0]) >= 3  # several tasks, each with its halo
+    assert_equal_results(lazy, memory)
+
+
+@pytest.mark.parametrize(
+    "name", ["noise, offsets, drift", "labelled, new offset each loop", "missing samples"]
+)
+def test_read_along_the_stroke_as_in_memory(small_blocks, name):
+    """resolve=True: each task reads its own loops along the stroke, which never leave it;
+    the values and the reading's quality as in memory."""
+    displacement, force, cycle = RECORDINGS[name]()
+    memory = analysed(displacement, force, cycle, resolve=True)
+    lazy = analysed(*lazily(displacement, force, cycle), scheduler="threads", resolve=True)
+    assert memory.mu_resolved.notnull().sum() >= 8
+    assert_equal_results(lazy, memory)
+
+
+def test_xarray_and_a_missing_mask(small_blocks):
+    """DataArrays backed by dask, and samples marked missing by a mask."""
+    displacement, force = noisy(EXAMPLE_2, 12, 11)
+    mask = np.zeros(displacement.size, dtype=bool)
+    mask[[650, 1999]] = True
+    data = xr.Dataset(
+        {"x": ("sample", displacement), "q": ("sample", force), "m": ("sample", mask)}
+    ).chunk(sample=1300)
+    lazy = analysed(data.x, data.q, missing=data.m, scheduler="threads", workers=2)
+    memory = analysed(displacement, force, missing=mask)
+    assert lazy.attrs["skipped_cycles"] == 2
+    assert_equal_results(lazy, memory)
+
+
+def test_a_local_cluster_of_two_processes(small_blocks):
+    """The blocks run in two worker processes: the same numbers (the passes' chunk and the
+    tasks' cycles travel with the tasks, not as settings of this process)."""
+    displacement, force, _ = missing_everywhere()
+    memory = analysed(displacement, force)
+    lazy = analysed(*lazily(displacement, force), scheduler="processes", workers=2)
+    assert_equal_results(lazy, memory)
+
+
+def test_a_scheduler_that_does_not_answer():
+    from ecofmaps._parallel import Runner, SchedulerError
+
+    with (
+        pytest.raises(
+            SchedulerError, match=r"scheduler at tcp://127\.0\.0\.1:9: no answer within 1 s"
+        ),
+        Runner(scheduler="tcp://127.0.0.1:9", timeout=1.0),
+    ):
+        pass
+
+
+# --- missing samples, in memory ----------------------------------------------------------------
+
+
+def test_a_few_missing_samples_skip_their_cycles_only():
+    """Each NaN skips the one cycle that holds it; cycles three or more away from a skipped
+    one are measured as in the recording without gaps (to rounding): the centring reaches no
+    further (a neighbour's displacement drift is interpolated across the gap, which moves
+    its force centre, which the next cycle's force drift uses). Those nearer move by less
+    than the rig's noise moves them (1 % of the force here)."""
+    displacement, force = noisy(EXAMPLE_2, 20, 4)
+    clean = analysed(displacement, force)
+    gaps = [430, 2250, 2251, 3615]
+    result = analysed(*with_gaps(displacement, force, gaps))
+    found = cycles.find_cycles(displacement)
+    skipped = np.unique(np.searchsorted(found.start, gaps, side="right") - 1)
+    np.testing.assert_array_equal(skipped, [2, 11, 18])  # of 20 cycles
+    assert (result.quality.values[skipped] == "missing-samples").all()
+    assert (result.regime.values[skipped] == "unknown").all()
+    assert result[["gicof", "ecof", "amplitude"]].isel(cycle=skipped).isnull().all()
+    assert result.attrs["quality_summary"] == "20 cycles: 17 ok, 3 skipped (missing samples)"
+    assert result.attrs["skipped_cycles"] == 3
+    assert result.attrs["missing_samples"] == 4
+    assert result.attrs["first_missing_sample"] == 430
+    rows = np.arange(clean.cycle.size)
+    distance = np.min(np.abs(rows[:, None] - skipped[None, :]), axis=1)
+    far, near = distance >= 3, (distance > 0) & (distance < 3)
+    for name in ("gicof", "ecof", "stiffness", "displacement_offset", "force_offset"):
+        np.testing.assert_allclose(result[name].values[far], clean[name].values[far], rtol=1e-12)
+    for name in ("gicof", "ecof", "stiffness", "amplitude", "max_force"):
+        np.testing.assert_allclose(result[name].values[near], clean[name].values[near], rtol=1e-2)
+
+
+def test_missing_at_a_reversal_and_at_the_ends():
+    """A recording that begins and ends on a bottom reversal (samples 0 and 1999): with NaN
+    there, the first and last cuts move to the lowest finite samples near them, and the
+    missing samples are dropped with the incomplete ends; a NaN force at the reversal at
+    1000 skips the cycle that holds it."""
+    displacement, force = noisy(EXAMPLE_2, 10, 6)
+    clean = cycles.find_cycles(displacement)
+    assert (clean.start[0], clean.start[-1] + clean.count[-1]) == (0, 2000)
+    x, q = with_gaps(displacement, force, [0, 1000, -1])
+    found = cycles.find_cycles(x, force=q)
+    first, last = found.start[0], found.start[-1] + found.count[-1] - 1
+    assert 1 <= first <= 5 and 1993 <= last <= 1998
+    assert found.dropped_samples == first + 1999 - last
+    result = analysed(x, q)
+    assert result.cycle.size == clean.label.size == 10
+    assert result.attrs["skipped_cycles"] == 1
+    assert list(result.quality.values).count("missing-samples") == 1
+    assert (result.quality.values != "ok").sum() == 1
+
+
+def test_missing_cycle_numbers_take_the_one_before():
+    displacement, force, cycle = labelled_with_offsets()
+    cycle = cycle.astype(np.float64)
+    cycle[[450, 1800]] = np.nan  # inside the 3rd loop and on the 10th's first sample
+    result = analysed(displacement, force, cycle)
+    np.testing.assert_array_equal(result.cycle, np.arange(1, 13) * 100)
+    # The sample without a number joins the 9th loop, which holds a missing sample then;
+    # the 10th, one sample short, still closes.
+    assert list(result.cycle.values[result.quality.values == "missing-samples"]) == [300, 900]
+
+
+def test_nan_policy_raise_names_the_sample():
+    displacement, force = noisy(EXAMPLE_2, 6, 1)
+    x, q = with_gaps(displacement, force, [777, 900])
+    with pytest.raises(MissingSampleError, match="sample 777 is missing") as caught:
+        analyze_loops(x, q, LOAD, nan_policy="raise")
+    assert caught.value.sample == 777
+    with pytest.raises(MissingSampleError, match="sample 900 is missing"):
+        analyze_loops(*lazily(displacement, q), LOAD, nan_policy="raise", scheduler="threads")
+    mask = np.zeros(x.size, dtype=bool)
+    mask[5] = True
+    with pytest.raises(MissingSampleError, match="sample 5 is missing"):
+        analyze_loops(displacement, force, LOAD, missing=mask, nan_policy="raise")
+    with pytest.raises(ValueError, match="nan_policy must be one of"):
+        analyze_loops(displacement, force, LOAD, nan_policy="omit")
+
+
+def test_every_cycle_missing_is_an_error():
+    displacement, force = synthetic_recording(**EXAMPLE_2, cycles=4)
+    force[100::200] = np.nan
+    with pytest.raises(ValueError, match=r"no plausible cycle.*Every cycle holds a missing"):
+        analyze_loops(displacement, force, LOAD)
