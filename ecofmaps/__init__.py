@@ -35,8 +35,10 @@ _PUBLIC = {
         "LoopFit",
         "analyze_loops",
         "fit_loop",
+        "long_recording",
         "resolve_loops",
         "synthetic_recording",
+        "write_long_recording",
     ),
     "ecofmaps.model": (
         "BEYOND_PROFILE",

@@ -40,7 +40,8 @@ def add(subparsers) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
-        "files", nargs="*", metavar="FILE", help="recording files (CSV, TSV or text)",
+        "files", nargs="*", metavar="FILE",
+        help="recording files (CSV, TSV or other text, TDMS, HDF5/netCDF-4, zarr)",
     )  # fmt: skip
     parser.add_argument(
         "--example", action="store_true",

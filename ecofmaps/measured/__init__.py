@@ -5,14 +5,16 @@ from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.fit import LoopFit, fit_loop
 from ecofmaps.measured.quality import LoopQualityWarning
 from ecofmaps.measured.resolved import resolve_analyzed_loops, resolve_loops
-from ecofmaps.measured.synthetic import synthetic_recording
+from ecofmaps.measured.synthetic import long_recording, synthetic_recording, write_long_recording
 
 __all__ = [
     "LoopFit",
     "LoopQualityWarning",
     "analyze_loops",
     "fit_loop",
+    "long_recording",
     "resolve_analyzed_loops",
     "resolve_loops",
     "synthetic_recording",
+    "write_long_recording",
 ]

@@ -890,10 +890,10 @@ def profile(quick: bool) -> None:
             stiffness = ratio * LOAD
 
             def run(scar=scar, amplitude=amplitude, stiffness=stiffness):
-                energy_cof(amplitude, LOAD, stiffness, MU, profile=scar).block_until_ready()
+                energy_cof(amplitude, LOAD, stiffness, MU, profile=scar)  # NumPy: waited for
 
             def closed(amplitude=amplitude, stiffness=stiffness):
-                energy_cof(amplitude, LOAD, stiffness, MU, depth / width).block_until_ready()
+                energy_cof(amplitude, LOAD, stiffness, MU, depth / width)
 
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RegimeWarning)  # no gross slip on soft rigs
