@@ -54,7 +54,7 @@ _PUBLIC = {
         "fretting_loop",
         "max_force",
         "parabolic_profile",
-        "regime",
+        "slip_regime",
         "ridged_profile",
         "scar_profile",
         "simulate",

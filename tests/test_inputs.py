@@ -27,7 +27,7 @@ EXAMPLE_2_UNITS = dict(
         ecofmaps.dissipated_energy,
         ecofmaps.energy_cof,
         ecofmaps.max_force,
-        ecofmaps.regime,
+        ecofmaps.slip_regime,
     ],
 )
 def test_quantities_are_converted_to_si(function):

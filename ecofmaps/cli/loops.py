@@ -149,7 +149,9 @@ def _analysed(path, recording, load, args, resolved_file: bool):
 
 def _summary(path, results, recording) -> str:
     """One line on a recording's cycles: counts, the quality, the friction over the test."""
-    gross = results.where(results.regime == "gross slip", drop=True)
+    from ecofmaps.model.regimes import GROSS_SLIP
+
+    gross = results.where(results.regime == GROSS_SLIP, drop=True)
     summary = f"  {path.name}: {results.attrs['quality_summary']}"
     if results.attrs["incomplete_cycles"]:
         summary += f" ({results.attrs['incomplete_cycles']} incomplete dropped)"

@@ -64,7 +64,7 @@ def run(args) -> int:
     )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RegimeWarning)
-        code = Regime(int(model.regime(**point)))
+        code = Regime(int(model.slip_regime(**point)))
         ecof = float(model.energy_cof(**point))
         rows = [
             row("amplitude", args.amplitude),

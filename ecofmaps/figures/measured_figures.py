@@ -21,6 +21,7 @@ from ecofmaps.figures.style import (
     parameters,
     scalar,
 )
+from ecofmaps.model.regimes import GROSS_SLIP, Regime
 
 __all__ = ["cof_evolution", "measured_and_fitted_loops", "measured_loops", "resolved_loops"]
 
@@ -115,11 +116,11 @@ def measured_loops(
         ax.grid(alpha=0.3)
         reading = (
             f"GICoF {_number(cycle['gicof'])}, ECoF {_number(cycle['ecof'])}"
-            if cycle["regime"] == "gross slip"
+            if int(cycle["regime"]) == GROSS_SLIP
             else "no GICoF or ECoF"
         )
         quality = str(cycle["quality"].values) if "quality" in cycle else "ok"
-        state = str(cycle["regime"].values) + ("" if quality == "ok" else f"; {quality}")
+        state = Regime(int(cycle["regime"])).label + ("" if quality == "ok" else f"; {quality}")
         ax.set_title(
             f"cycle {label}: {reading}\nS = {_number(stiffness * MEGA, '.1f')} MN/m, {state}",
             fontsize="small",

@@ -12,6 +12,7 @@ import pandas as pd
 import xarray as xr
 
 from ecofmaps import _nomenclature as nomenclature
+from ecofmaps.model.regimes import Regime
 
 __all__ = ["RESULT_COLUMNS", "results_table"]
 
@@ -59,6 +60,9 @@ def results_table(results: xr.Dataset) -> pd.DataFrame:
         if name not in results:
             continue
         values = results[name].values
+        if name == "regime":  # the codes' labels, as ecofmaps map and model print them
+            columns[column] = [Regime(int(code)).label for code in values]
+            continue
         numeric = np.issubdtype(values.dtype, np.number) and name != "cycle"
         columns[column] = nomenclature.display(name, values) if numeric else values
     return pd.DataFrame(columns)

@@ -51,9 +51,11 @@ back down the *falling* branch.
   error in :math:`S` or in the centring moves the two crossings in opposite directions,
   and most of it cancels from their mean.
 * stick_residual: the root mean square displacement off the stick lines.
-* regime: 'gross slip' when the energy ratio :math:`A` exceeds ``gross_slip_threshold``
-  (default 0.2, the sliding transition of Fouvry, Kapsa and Vincent), else
-  'partial slip'. ECoF and GICoF describe sliding: they are NaN in partial slip. Like
+* regime: the :class:`ecofmaps.Regime` code, as in the model and the maps: ``GROSS_SLIP``
+  when the energy ratio :math:`A` exceeds ``gross_slip_threshold`` (default 0.2, the
+  sliding transition of Fouvry, Kapsa and Vincent), else ``NO_GROSS_SLIP`` (partial
+  slip); ``INVALID`` for a refused cycle. ECoF and GICoF describe sliding: they are NaN in
+  partial slip. Like
   Fouvry's criterion, this also calls partial slip a gross-slip loop that slips over less
   than about a fifth of the stroke (for the model, :math:`A \approx \delta^*/\Delta^*`
   times :math:`\mu_E P/Q^*`); lower the threshold to read such loops.
@@ -104,6 +106,7 @@ from ecofmaps.measured.quality import (
     summary_of_counts,
 )
 from ecofmaps.measured.samples import is_lazy
+from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP, Regime
 
 __all__ = [
     "GROSS_SLIP_THRESHOLD",
@@ -147,7 +150,8 @@ _COMMENTS = {
     "slip_amplitude": "half the loop's width at Q = 0",
     "dissipated_energy": "the loop's area",
     "stiffness": "slope of the stick segments",
-    "regime": "gross slip or partial slip by the energy ratio, unknown where refused",
+    "regime": "GROSS_SLIP when the energy ratio exceeds gross_slip_threshold, else NO_GROSS_SLIP "
+    "(partial slip); INVALID where the cycle is refused",
     "quality": "'ok' or the reasons for NaN, joined by '+' (ecofmaps.measured.quality)",
 }
 
@@ -493,8 +497,9 @@ def analyze_loops(
         dissipated_energy [J], ecof, cof_max, energy_ratio, stiffness [N/m], gicof,
         gicof_forward, gicof_backward, crossing_displacement_forward and
         crossing_displacement_backward [m] (in the centred loop), displacement_offset [m]
-        and force_offset [N] (the centres removed, of the force as read), regime ('gross
-        slip', 'partial slip', or 'unknown' for a refused cycle), stick_residual [m] (root
+        and force_offset [N] (the centres removed, of the force as read), regime
+        (:class:`ecofmaps.Regime` codes: GROSS_SLIP, NO_GROSS_SLIP for partial slip, INVALID
+        for a refused cycle; int32 with CF flag attributes), stick_residual [m] (root
         mean square displacement off the stick lines) and quality ('ok', or why values
         are NaN: :mod:`ecofmaps.measured.quality`); the load is a scalar coordinate. The
         attributes ``incomplete_cycles`` and ``dropped_samples`` count what was dropped,
@@ -665,16 +670,11 @@ def cycle_results(values: dict, flags: dict, label, load: float, options: dict) 
         refused |= flag & (REASONS[reason][1] == ALL)
     raw_amplitude = values["amplitude"]
     values = apply_quality(values, flags)
-    regime = np.where(
-        refused,
-        "unknown",
-        np.where(
-            values["energy_ratio"] > options["gross_slip_threshold"], "gross slip", "partial slip"
-        ),
-    )
+    sliding = values["energy_ratio"] > options["gross_slip_threshold"]
+    regime = np.where(refused, INVALID, np.where(sliding, GROSS_SLIP, NO_GROSS_SLIP))
     names = [name for name in values if name != "stick_residual"]
     data = {name: ("cycle", values[name], _attrs(name)) for name in names}
-    data["regime"] = ("cycle", regime, _attrs("regime"))
+    data["regime"] = ("cycle", regime.astype(np.int32), _attrs("regime") | Regime.flag_attrs())
     data["stick_residual"] = ("cycle", values["stick_residual"], _attrs("stick_residual"))
     data["quality"] = ("cycle", quality, _attrs("quality"))
     data["_amplitude"] = ("cycle", raw_amplitude)

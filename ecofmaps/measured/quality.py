@@ -17,7 +17,7 @@ that table, joined by ``'+'`` (``'negative-slip+curved-stick'``): the reasons ho
 lower-case letters, digits and hyphens, so ``quality.split('+')`` gives them back and the
 column needs no quoting in a CSV file. Each reason names the quantities it leaves NaN
 (its *scope*). A reason whose scope is every quantity (:data:`ALL`) refuses the cycle: it
-is not a loop that can be read as recorded, and its ``regime`` is ``'unknown'``. The others
+is not a loop that can be read as recorded, and its ``regime`` is ``INVALID``. The others
 leave the rest of the cycle's numbers standing; ``'not-gross-slip'`` is the partial-slip
 regime, where the ECoF and the GICoF are not defined. The last four reasons come from the
 reading along the stroke (:func:`ecofmaps.resolve_loops`, or ``analyze_loops(...,

@@ -39,8 +39,8 @@ from ecofmaps.model.steady_state import (
     dissipated_energy,
     energy_cof,
     max_force,
-    regime,
     slip_amplitude,
+    slip_regime,
 )
 
 __all__ = [
@@ -63,7 +63,6 @@ __all__ = [
     "normalized_energy",
     "normalized_max_force",
     "parabolic_profile",
-    "regime",
     "regime_code",
     "ridged_profile",
     "scar_profile",
@@ -71,6 +70,7 @@ __all__ = [
     "slip_amplitude",
     "slip_position",
     "slip_ratio",
+    "slip_regime",
     "traction_ratio",
     "w_shaped_profile",
 ]

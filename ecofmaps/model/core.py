@@ -23,7 +23,7 @@ The core functions (:func:`traction_ratio`, :func:`slip_position`, :func:`slip_r
 :func:`regime_code`) are pure ``jax.numpy`` functions of these numbers that broadcast
 and work under ``jit``, ``vmap`` and ``grad``; they do no input checking. The SI-unit
 functions (:func:`slip_amplitude`, :func:`dissipated_energy`, :func:`energy_cof`,
-:func:`max_force`, :func:`regime`) validate concrete inputs, are jit-compiled, and
+:func:`max_force`, :func:`slip_regime`) validate concrete inputs, are jit-compiled, and
 always compute in float64.
 """
 

@@ -8,7 +8,7 @@ __all__ = ["BEYOND_PROFILE", "GROSS_SLIP", "INVALID", "NO_GROSS_SLIP", "SELF_LOC
 
 
 class Regime(Code):
-    """Regime codes returned by :func:`regime` and stored in maps.
+    """Regime codes returned by :func:`ecofmaps.slip_regime` and stored in maps.
 
     Attributes
     ----------

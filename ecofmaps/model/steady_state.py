@@ -40,8 +40,8 @@ __all__ = [
     "dissipated_energy",
     "energy_cof",
     "max_force",
-    "regime",
     "slip_amplitude",
+    "slip_regime",
     "valid_geometry",
 ]
 
@@ -295,13 +295,13 @@ max_force.__doc__ = f"""Peak tangential force :math:`Q^*` of the steady loop (eq
 
 
 @float64
-def regime(amplitude, load, stiffness, mu, aspect_ratio=None, groove_half_width=None, *,
+def slip_regime(amplitude, load, stiffness, mu, aspect_ratio=None, groove_half_width=None, *,
         profile=None, mapping="scaled"):  # fmt: skip
     arguments = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
     return _evaluate("regime", arguments, profile, mapping)
 
 
-regime.__doc__ = f"""Regime of each point as :class:`Regime` codes.
+slip_regime.__doc__ = f"""Regime of each point as :class:`Regime` codes.
 {_PARAMETERS}
     Returns
     -------

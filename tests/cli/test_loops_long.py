@@ -50,7 +50,7 @@ def test_missing_cells_are_skipped_and_named(tmp_path, capsys):
     assert "2 skipped for missing samples (the first at line 353)" in out
     table = (tmp_path / "r.csv").read_text().splitlines()
     assert len(table) == 1 + 6
-    assert sum(",unknown" in row for row in table) == 2
+    assert sum(",invalid," in row for row in table) == 2
     status, out, err = run(
         capsys, path, "--load", "450N", "--out", tmp_path / "s.csv", "--nan-policy", "raise"
     )

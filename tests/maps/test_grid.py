@@ -103,7 +103,7 @@ def test_map_equals_the_si_api(grid):
             "ecof": ecofmaps.energy_cof(**point),
             "dissipated_energy": ecofmaps.dissipated_energy(**point),
             "max_force": ecofmaps.max_force(**point),
-            "regime": ecofmaps.regime(**point),
+            "regime": ecofmaps.slip_regime(**point),
         }
     for name, values in expected.items():
         assert grid[name].shape == values.shape
@@ -127,7 +127,7 @@ def test_single_points_equal_the_si_api(stiffness_ratio, aspect_ratio, amplitude
     si["aspect_ratio"] = aspect_ratio
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ecofmaps.RegimeWarning)
-        assert int(point.regime) == int(ecofmaps.regime(**si))
+        assert int(point.regime) == int(ecofmaps.slip_regime(**si))
         assert_close(point.slip_amplitude, ecofmaps.slip_amplitude(**si), rtol=1e-12)
         assert_close(point.ecof, ecofmaps.energy_cof(**si), rtol=1e-12)
         assert_close(point.dissipated_energy, ecofmaps.dissipated_energy(**si), rtol=1e-12)

@@ -298,7 +298,7 @@ def test_rejects_mismatched_or_multidimensional_arrays(loop):
 def test_rejects_loop_without_gross_slip():
     """A rig too compliant for the contact to slip: the loop closes onto Q = SΔ."""
     displacement, force = measured_loop(mu=0.8, aspect_ratio=0.2, stiffness=5e6)
-    assert ecofmaps.regime(AMPLITUDE, LOAD, 5e6, 0.8, 0.2) == ecofmaps.NO_GROSS_SLIP
+    assert ecofmaps.slip_regime(AMPLITUDE, LOAD, 5e6, 0.8, 0.2) == ecofmaps.NO_GROSS_SLIP
     with pytest.raises(ValueError, match="no gross slip"):
         fit_loop(displacement, force, LOAD)
 

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
+import ecofmaps
 from ecofmaps.measured import cycles, out_of_core
 from ecofmaps.measured.analysis import MissingSampleError, analyze_loops
 from ecofmaps.measured.quality import LoopQualityWarning
@@ -198,7 +199,7 @@ def test_a_few_missing_samples_skip_their_cycles_only():
     skipped = np.unique(np.searchsorted(found.start, gaps, side="right") - 1)
     np.testing.assert_array_equal(skipped, [2, 11, 18])  # of 20 cycles
     assert (result.quality.values[skipped] == "missing-samples").all()
-    assert (result.regime.values[skipped] == "unknown").all()
+    assert (result.regime.values[skipped] == ecofmaps.INVALID).all()
     assert result[["gicof", "ecof", "amplitude"]].isel(cycle=skipped).isnull().all()
     assert result.attrs["quality_summary"] == "20 cycles: 17 ok, 3 skipped (missing samples)"
     assert result.attrs["skipped_cycles"] == 3

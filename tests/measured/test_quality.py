@@ -70,7 +70,7 @@ def test_model_loops_are_ok(point):
         result = analyze_loops(displacement, force, LOAD)
     assert result.quality.values.tolist() == ["ok"]
     assert result.attrs["quality_summary"] == "1 cycles: 1 ok"
-    assert result.regime.values.tolist() == ["gross slip"]
+    assert result.regime.values.tolist() == [ecofmaps.GROSS_SLIP]
     assert not any(np.isnan(result[name]).any() for name in PER_CYCLE)
     assert float(result.stick_residual[0]) < 1e-12 * AMPLITUDE  # straight stick sides
 
@@ -145,7 +145,7 @@ def test_dead_force_channel(rig):
     assert refused(quality[cycle >= 6]).all()  # the 6th holds a live sample or two
     assert all("constant-force" in text for text in quality[cycle >= 7])
     assert result.gicof.sel(cycle=slice(6, None)).isnull().all()
-    assert (result.regime.sel(cycle=slice(6, None)) == "unknown").all()
+    assert (result.regime.sel(cycle=slice(6, None)) == ecofmaps.INVALID).all()
     with pytest.raises(ValueError, match=r"constant-force 10.*force does not vary"):
         quiet(displacement, np.full_like(force, 7.25), LOAD)
 
@@ -232,7 +232,7 @@ def test_micro_slip_is_curved():
     """Mindlin's partial slip loop: curved stick sides and no gross slip, E_d stands."""
     result = quiet(*mindlin_recording(0.9), LOAD)
     assert (result.quality == "curved-stick+not-gross-slip").all()
-    assert (result.regime == "partial slip").all()
+    assert (result.regime == ecofmaps.NO_GROSS_SLIP).all()
     assert result.stiffness.isnull().all() and result.dissipated_energy.notnull().all()
 
 
@@ -387,8 +387,8 @@ def assert_plausible(result):
     its reason."""
     quality = result.quality.values
     refusal = refused(quality)
-    assert (result.regime.values[refusal] == "unknown").all()
-    assert not np.isin(result.regime.values[~refusal], ["unknown"]).any()
+    assert (result.regime.values[refusal] == ecofmaps.INVALID).all()
+    assert not np.isin(result.regime.values[~refusal], [ecofmaps.INVALID]).any()
     scopes = [scope_of(text) for text in quality]
     for name in PER_CYCLE:
         value = result[name].values
@@ -409,7 +409,7 @@ def assert_plausible(result):
     assert np.all(slip[has_slip] <= amplitude[has_slip] * (1.0 + 1e-8))
     assert np.all(reported("stiffness") > 0.0)
     assert np.all(reported("ecof") > 0.0)
-    assert np.all(result.regime.values[result.ecof.notnull().values] == "gross slip")
+    assert np.all(result.regime.values[result.ecof.notnull().values] == ecofmaps.GROSS_SLIP)
     # The GICoF crossings lie within the measured (centred) loop.
     for branch, sign in (("forward", 1.0), ("backward", -1.0)):
         force = sign * result[f"gicof_{branch}"].values * LOAD

@@ -427,7 +427,7 @@ def test_rounded_loop_is_refused():
     displacement, force = rounded_loop()
     with pytest.warns(LoopQualityWarning, match="curved-stick"):
         analysis = analyze_loops(displacement, force, LOAD, keep_loops=True)
-    assert (analysis.regime == "gross slip").all() and analysis.gicof.isnull().all()
+    assert (analysis.regime == ecofmaps.GROSS_SLIP).all() and analysis.gicof.isnull().all()
     assert all("curved-stick" in quality for quality in analysis.quality.values)
     assert_flagged(resolve_analyzed_loops(analysis), "curved-stick")
     # Noisy, with a larger rounding: the curvature still shows above the noise.
@@ -448,7 +448,7 @@ def test_slip_within_the_noise_is_refused():
     assert 1.4e-6 < float(ecofmaps.slip_amplitude(**point)) < 1.6e-6
     displacement, force = synthetic_recording(**point, cycles=6, **NOISE, seed=2)
     analysis = analyze_loops(displacement, force, LOAD, keep_loops=True, gross_slip_threshold=0.01)
-    assert (analysis.regime == "gross slip").all()
+    assert (analysis.regime == ecofmaps.GROSS_SLIP).all()
     assert float(np.abs(analysis.gicof / MU - 1).max()) > 0.2
     assert_flagged(resolve_analyzed_loops(analysis), "no-overlap")
 
@@ -461,7 +461,7 @@ def test_sparse_digitised_loop_is_refused(samples):
         **point, cycles=3, samples_per_cycle=samples, force_noise=1.0, seed=5
     )
     analysis = analyze_loops(displacement, force, LOAD, keep_loops=True)
-    assert (analysis.regime == "gross slip").all()
+    assert (analysis.regime == ecofmaps.GROSS_SLIP).all()
     assert_flagged(resolve_analyzed_loops(analysis), "few-slip-samples")
 
 

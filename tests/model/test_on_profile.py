@@ -150,8 +150,8 @@ def test_parabola_family_reproduces_the_closed_forms():
                 expected = np.asarray(function(**points, aspect_ratio=ratio))
                 np.testing.assert_allclose(got, expected, rtol=1e-10, atol=0, err_msg=name)
         np.testing.assert_array_equal(
-            ecofmaps.regime(**points, profile=profile),
-            ecofmaps.regime(**points, aspect_ratio=ratio),
+            ecofmaps.slip_regime(**points, profile=profile),
+            ecofmaps.slip_regime(**points, aspect_ratio=ratio),
         )
 
 
@@ -178,11 +178,11 @@ def test_locking():
     warning that names it); any compliance stops the pad short of it (a finite loop)."""
     steep = ecofmaps.parabolic_profile(0.8 * W, W)  # slope 1.6 at the edges: mu g = 1.28
     rigid = dict(amplitude=50e-6, load=450.0, stiffness=np.inf, mu=0.8, profile=steep)
-    assert int(ecofmaps.regime(**rigid)) == Regime.SELF_LOCKING
+    assert int(ecofmaps.slip_regime(**rigid)) == Regime.SELF_LOCKING
     with pytest.warns(ecofmaps.RegimeWarning, match="self-locking"):
         assert np.isnan(ecofmaps.energy_cof(**rigid))
     compliant = {**rigid, "stiffness": 1e9}
-    assert int(ecofmaps.regime(**compliant)) == Regime.GROSS_SLIP
+    assert int(ecofmaps.slip_regime(**compliant)) == Regime.GROSS_SLIP
     slip = float(ecofmaps.slip_amplitude(**compliant))
     assert 0.0 < slip < 50e-6 / 1.28  # short of the locking point, x = W/(mu g'W)
     assert np.isfinite(ecofmaps.energy_cof(**compliant))
@@ -196,17 +196,17 @@ def test_beyond_the_trace():
     """A stroke that runs off the trace is BEYOND_PROFILE, NaN, and said so."""
     profile = ecofmaps.parabolic_profile(D, W, extent=1.2)
     rig = dict(amplitude=80e-6, load=450.0, stiffness=1e9, mu=0.8, profile=profile)
-    assert int(ecofmaps.regime(**rig, mapping="physical")) == Regime.BEYOND_PROFILE
+    assert int(ecofmaps.slip_regime(**rig, mapping="physical")) == Regime.BEYOND_PROFILE
     with pytest.warns(ecofmaps.RegimeWarning, match="beyond an end of the scar profile"):
         assert np.isnan(ecofmaps.slip_amplitude(**rig, mapping="physical"))
-    assert int(ecofmaps.regime(**rig)) == Regime.GROSS_SLIP  # scaled: X = x W/Δ* stays inside
+    assert int(ecofmaps.slip_regime(**rig)) == Regime.GROSS_SLIP  # scaled: X = x W/Δ* stays inside
 
 
 def test_no_gross_slip():
     """μλ >= 1 at a flat groove centre: δ* = 0, E_d = 0, μ_E NaN, Q* = SΔ* (as eq. 16)."""
     profile = FAMILIES["w"][0]
     rig = dict(amplitude=50e-6, load=450.0, stiffness=5e6, mu=0.8, profile=profile)
-    assert int(ecofmaps.regime(**rig)) == Regime.NO_GROSS_SLIP
+    assert int(ecofmaps.slip_regime(**rig)) == Regime.NO_GROSS_SLIP
     assert float(ecofmaps.slip_amplitude(**rig)) == 0.0
     assert float(ecofmaps.dissipated_energy(**rig)) == 0.0
     assert float(ecofmaps.max_force(**rig)) == pytest.approx(5e6 * 50e-6, rel=1e-15)
@@ -267,7 +267,7 @@ def test_properties_on_random_w_shapes(hump, ratio, tilt, mu, mu_lam):
     profile = ecofmaps.w_shaped_profile(ratio * W, W, hump, tilt=tilt, samples=1000)
     stiffness = np.inf if mu_lam == 0.0 else 450.0 * mu / (mu_lam * 50e-6)
     rig = dict(amplitude=50e-6, load=450.0, stiffness=stiffness, mu=mu, profile=profile)
-    if int(ecofmaps.regime(**rig)) != Regime.GROSS_SLIP:
+    if int(ecofmaps.slip_regime(**rig)) != Regime.GROSS_SLIP:
         return  # a rigid rig may lock on the steepest flanks
     ecof = float(ecofmaps.energy_cof(**rig))
     slip = float(ecofmaps.slip_amplitude(**rig))

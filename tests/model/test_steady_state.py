@@ -224,26 +224,26 @@ def test_slip_position_handles_negative_b():
 def test_no_gross_slip():
     """mu lambda >= 1: the contact sticks; delta* = 0, E_d = 0, mu_E = NaN (with a warning)."""
     point = dict(EXAMPLE_2, stiffness=5e6)
-    assert int(ecofmaps.regime(**point)) == ecofmaps.NO_GROSS_SLIP
+    assert int(ecofmaps.slip_regime(**point)) == ecofmaps.NO_GROSS_SLIP
     assert float(ecofmaps.slip_amplitude(**point)) == 0.0
     assert float(ecofmaps.dissipated_energy(**point)) == 0.0
     assert float(ecofmaps.max_force(**point)) == pytest.approx(5e6 * 50e-6)
     with pytest.warns(ecofmaps.RegimeWarning, match="no gross slip"):
         assert np.isnan(ecofmaps.energy_cof(**point))
     boundary = dict(EXAMPLE_2, stiffness=450 * 0.8 / 50e-6)
-    assert int(ecofmaps.regime(**boundary)) == ecofmaps.NO_GROSS_SLIP
+    assert int(ecofmaps.slip_regime(**boundary)) == ecofmaps.NO_GROSS_SLIP
 
 
 def test_self_locking():
     """Rigid rig with mu kappa >= 1 jams on the flank: NaN and the SELF_LOCKING code."""
     point = dict(EXAMPLE_2, stiffness=np.inf, aspect_ratio=1 / 1.6)
-    assert int(ecofmaps.regime(**point)) == ecofmaps.SELF_LOCKING
+    assert int(ecofmaps.slip_regime(**point)) == ecofmaps.SELF_LOCKING
     for name in ("slip_amplitude", "dissipated_energy", "energy_cof", "max_force"):
         with pytest.warns(ecofmaps.RegimeWarning, match="self-locking"):
             assert np.isnan(getattr(ecofmaps, name)(**point))
     # any compliance keeps the root below the locking point
     soft = dict(point, stiffness=1e15)
-    assert int(ecofmaps.regime(**soft)) == ecofmaps.GROSS_SLIP
+    assert int(ecofmaps.slip_regime(**soft)) == ecofmaps.GROSS_SLIP
     assert np.isfinite(ecofmaps.energy_cof(**soft))
 
 
@@ -267,7 +267,7 @@ BAD_INPUTS = [
 
 @pytest.mark.parametrize(("name", "value", "message"), BAD_INPUTS)
 @pytest.mark.parametrize(
-    "function", ["slip_amplitude", "dissipated_energy", "energy_cof", "max_force", "regime"]
+    "function", ["slip_amplitude", "dissipated_energy", "energy_cof", "max_force", "slip_regime"]
 )
 def test_bad_input_raises(function, name, value, message):
     point = {**EXAMPLE_2, "groove_half_width": 50e-6, name: value}
@@ -283,9 +283,9 @@ def test_bad_array_input_names_the_index():
 def test_invalid_inside_jit_is_nan_with_regime_code():
     """Traced inputs cannot raise: NaN and INVALID instead."""
     ecof = jax.jit(ecofmaps.energy_cof)(50e-6, 450.0, 35e6, -0.8, 0.2)
-    code = jax.jit(ecofmaps.regime)(50e-6, 450.0, 35e6, -0.8, 0.2)
+    code = jax.jit(ecofmaps.slip_regime)(50e-6, 450.0, 35e6, -0.8, 0.2)
     assert np.isnan(ecof) and int(code) == ecofmaps.INVALID
-    codes = jax.vmap(lambda p: ecofmaps.regime(50e-6, p, 35e6, 0.8, 0.2))(
+    codes = jax.vmap(lambda p: ecofmaps.slip_regime(50e-6, p, 35e6, 0.8, 0.2))(
         jnp.array([450.0, 0.0, jnp.nan, 1e9])
     )
     assert codes.tolist() == [
@@ -340,7 +340,7 @@ def test_grad_is_finite_at_a_flat_groove():
 def test_results_are_float64_even_with_x64_switched_off():
     with jax.enable_x64(False):
         result = ecofmaps.energy_cof(50e-6, 450.0, 35e6, 0.8, 0.2)
-        code = ecofmaps.regime(50e-6, 450.0, 35e6, 0.8, 0.2)
+        code = ecofmaps.slip_regime(50e-6, 450.0, 35e6, 0.8, 0.2)
     assert result.dtype == jnp.float64
     assert code.dtype == jnp.int32
     assert float(result) == pytest.approx(0.8307990199151581, rel=1e-15)
@@ -405,7 +405,7 @@ def si(point):
 
 
 def gross_slip(args):
-    return int(ecofmaps.regime(**args)) == ecofmaps.GROSS_SLIP
+    return int(ecofmaps.slip_regime(**args)) == ecofmaps.GROSS_SLIP
 
 
 @given(domain_points)
