@@ -3,6 +3,7 @@
     python tests/benchmarks/bench_long_loops.py                   # 2e8 samples (issue 12)
     python tests/benchmarks/bench_long_loops.py --samples 2e7     # a moderate size
     python tests/benchmarks/bench_long_loops.py --folder DIR      # keep (and reuse) the files
+    python tests/benchmarks/bench_long_loops.py --no-resolve      # the analysis only
 
 A long synthetic test (:func:`ecofmaps.measured.synthetic.write_long_recording`: the
 example's rig, a deepening groove, noise, offsets and drift; 200 samples a cycle) is written
@@ -108,11 +109,19 @@ def main(argv=None) -> int:
     parser.add_argument("--repeat", type=int, default=2)
     parser.add_argument("--folder", type=Path, default=None)
     parser.add_argument("--formats", default="zarr,tdms")
+    parser.add_argument(
+        "--no-resolve", action="store_true",
+        help="pass --no-resolve to every run (the analysis without the reading along the stroke)",
+    )  # fmt: skip
     args = parser.parse_args(argv)
+    extra = ["--no-resolve"] if args.no_resolve else []
     samples = int(args.samples) // SAMPLES_PER_CYCLE * SAMPLES_PER_CYCLE
     folder = args.folder or Path(tempfile.mkdtemp(prefix="ecofmaps-bench-"))
     folder.mkdir(parents=True, exist_ok=True)
-    print(f"ecofmaps loops on a long test of {samples:.3g} samples; {load_average()}")
+    print(
+        f"ecofmaps loops {' '.join(extra)} on a long test of {samples:.3g} samples; "
+        f"{load_average()}"
+    )
     paths = make_files(folder, samples)
     ecofmaps = [sys.executable, "-m", "ecofmaps.cli"]
     for kind in args.formats.split(","):
@@ -131,7 +140,7 @@ def main(argv=None) -> int:
             out = folder / "r.csv"
             for _ in range(args.repeat):
                 out.unlink(missing_ok=True)
-                wall, peak, printed = measured([*command, "--out", str(out)])
+                wall, peak, printed = measured([*command, *extra, "--out", str(out)])
                 if name not in best or wall < best[name][0]:
                     best[name] = (wall, peak, printed)
             wall, peak, printed = best[name]
