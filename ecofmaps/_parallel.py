@@ -24,6 +24,7 @@ from __future__ import annotations
 import collections
 import concurrent.futures
 import os
+import time
 
 from ecofmaps._interrupts import check_interrupted
 
@@ -31,6 +32,9 @@ __all__ = ["CONNECT_TIMEOUT", "Runner", "SchedulerError"]
 
 #: Seconds to wait for a dask scheduler given by address to answer.
 CONNECT_TIMEOUT = 10.0
+
+#: Seconds between looks at a running task (and at Ctrl-C).
+_POLL = 0.01
 
 
 class SchedulerError(OSError):
@@ -174,14 +178,13 @@ class Runner:
                 if not pending:
                     return
                 future = pending.popleft()
-                while True:
-                    try:
-                        result = future.result(timeout=0.2)
-                        break
-                    except (concurrent.futures.TimeoutError, TimeoutError):
-                        check_interrupted()
+                # Polled, not future.result(timeout=...): distributed's result with a timeout
+                # can lose the result in a race (an UnboundLocalError inside distributed).
+                while not future.done():
+                    time.sleep(_POLL)
+                    check_interrupted()
                 check_interrupted()
-                yield result
+                yield future.result()
         finally:
             for future in pending:
                 future.cancel()
