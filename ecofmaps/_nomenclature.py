@@ -116,6 +116,7 @@ QUANTITIES: dict[str, Quantity] = {
     "groove_half_width": _length("groove half-width", "x_o", "x_o", "positive"),
     "scar_depth": _length("wear scar depth", "D", "D", "non_negative"),
     "scar_half_width": _length("wear scar half-width", "W", "W", "positive"),
+    "smoothing": _length("slope smoothing length of a scar profile", "", "", "non_negative"),
     "stiffness_ratio": Quantity(
         "rig stiffness over normal load",
         "S/P",
