@@ -79,7 +79,8 @@ def run(args) -> int:
             raise CommandError(f"give a TABLE or one point's options, not both ({options})")
         if args.out is not None and not Path(args.out).parent.is_dir():
             raise CommandError(f"cannot write {args.out}: its directory does not exist")
-        refuse_to_overwrite([("--out", args.out)], [args.table, args.scar_profile])
+        inputs = [path for path in (args.table, args.scar_profile) if path is not None]
+        refuse_to_overwrite([("--out", args.out)], inputs)
         profile = read_profile(args)
         text, rows = correct_table(args.table, profile=profile, mapping=args.mapping)
         if args.out is None:
