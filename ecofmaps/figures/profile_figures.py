@@ -55,10 +55,11 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
     -------
     figure : matplotlib.figure.Figure
         Two panels over the position :math:`X` [µm] relative to the scar centre: the height
-        :math:`z` [µm] with the unworn surface (the reference line of the levelling) and the
-        depth :math:`D`; and the slope :math:`g = dz/dX` the model uses (after smoothing),
-        with the slope :math:`2DX/W^2` of the parabola of the same :math:`D/W`. Both mark the
-        detected edges :math:`\pm W`.
+        :math:`z` [µm] with the unworn surface (the reference line of the levelling), the
+        depth :math:`D` and the parabola of the same :math:`D/W`; and the slope
+        :math:`g = dz/dX` the model uses (after smoothing), with the parabola's slope
+        :math:`2DX/W^2` (plus the tilt of the unworn surface, if not levelled). Both mark
+        the detected edges :math:`\pm W`.
 
     Notes
     -----
@@ -77,7 +78,7 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
 
     figure = Figure(figsize=(7.4, 6.4), layout="constrained")
     top, bottom = figure.subplots(2, 1, sharex=True, height_ratios=(1.25, 1.0))
-    top.plot(x, height, color="tab:blue", linewidth=1.3, label="profile $z(X)$")
+    top.plot(x, height, color="tab:blue", linewidth=1.6, label="profile $z(X)$")
     top.plot(x, surface * MICRO, color="0.3", linewidth=1.0, linestyle="--",
              label="unworn surface (levelling line)")  # fmt: skip
     bottom_of_scar = float(profile.reference_height) * MICRO - depth * MICRO
@@ -87,9 +88,11 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
     )  # fmt: skip
     top.text(0.02 * width * MICRO, bottom_of_scar + 0.5 * depth * MICRO,
              f"  D = {depth * MICRO:.4g} µm", color="crimson", va="center")  # fmt: skip
-    parabola = 2.0 * depth * position / width**2
+    parabola = 2.0 * depth * position / width**2 + float(profile.reference_slope)
     inside = np.abs(position) <= width
-    bottom.plot(x, slope, color="tab:blue", linewidth=1.3, label="slope the model uses")
+    bowl = surface[inside] - depth * (1.0 - (position[inside] / width) ** 2)
+    top.plot(x[inside], bowl * MICRO, **_SHORTCUT, label="parabola of the same D/W")
+    bottom.plot(x, slope, color="tab:blue", linewidth=1.6, label="slope the model uses")
     bottom.plot(x[inside], parabola[inside], **_SHORTCUT,
                 label=f"parabola of the same D/W = {depth / width:.3g}")  # fmt: skip
     bottom.axhline(0.0, color="0.6", linewidth=0.6)
