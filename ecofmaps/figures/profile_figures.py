@@ -66,6 +66,14 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
     The pad at slip position :math:`x` feels the slope at :math:`X = xW/x_o` (eq. 11, with
     :math:`x_o = \Delta^*` by default), so only the slopes within :math:`|X| \le
     \delta^* W/\Delta^*` enter a steady loop; eq. 9 holds pointwise there.
+
+    Examples
+    --------
+    >>> import ecofmaps
+    >>> from ecofmaps.figures import scar_profile_figure
+    >>> figure = scar_profile_figure(ecofmaps.parabolic_profile(10e-6, 50e-6), "a parabola")
+    >>> [ax.get_ylabel() for ax in figure.axes]
+    ['Height of the scar profile $z$ [µm]', 'Slope of the scar profile $g = dz/dX$ [1]']
     """
     position = np.asarray(profile.position)
     if position.ndim != 1:
