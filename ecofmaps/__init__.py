@@ -36,6 +36,7 @@ _PUBLIC = {
         "analyze_loops",
         "fit_loop",
         "resolve_loops",
+        "scar_example_path",
         "synthetic_recording",
     ),
     "ecofmaps.model": (

@@ -5,7 +5,7 @@ from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.fit import LoopFit, fit_loop
 from ecofmaps.measured.quality import LoopQualityWarning
 from ecofmaps.measured.resolved import resolve_analyzed_loops, resolve_loops
-from ecofmaps.measured.synthetic import synthetic_recording
+from ecofmaps.measured.synthetic import scar_example_path, synthetic_recording
 
 __all__ = [
     "LoopFit",
@@ -14,5 +14,6 @@ __all__ = [
     "fit_loop",
     "resolve_analyzed_loops",
     "resolve_loops",
+    "scar_example_path",
     "synthetic_recording",
 ]
