@@ -270,3 +270,11 @@ def test_damaged_profiles_name_file_and_line(capsys, tmp_path, kind, line, messa
         assert status == 2 and out == "", err
         assert err.startswith(f"ecofmaps: error: {path}, line {line}: "), err
         assert message in err and len(err.strip().splitlines()) == 1
+
+
+def test_correct_with_the_physical_mapping(capsys, example):
+    status, out, _ = run(capsys, "correct", "--ecof", "0.85", *RIG, "--scar-profile", EXAMPLE,
+                         "--mapping", "physical")  # fmt: skip
+    assert status == 0 and "(X = x)" in out.splitlines()[0]
+    mu = float(ecofmaps.correct_ecof(0.85, **POINT, profile=example, mapping="physical"))
+    assert float(values(out, "contact coefficient")[0]) == pytest.approx(mu, rel=5e-6)
