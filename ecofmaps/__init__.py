@@ -37,6 +37,7 @@ _PUBLIC = {
         "fit_loop",
         "long_recording",
         "resolve_loops",
+        "scar_example_path",
         "synthetic_recording",
         "write_long_recording",
     ),

@@ -116,6 +116,12 @@ QUANTITIES: dict[str, Quantity] = {
     "groove_half_width": _length("groove half-width", "x_o", "x_o", "positive"),
     "scar_depth": _length("wear scar depth", "D", "D", "non_negative"),
     "scar_half_width": _length("wear scar half-width", "W", "W", "positive"),
+    "smoothing": _length("slope smoothing length of a scar profile", "", "", "non_negative"),
+    "scar_position": _length("position across the scar", "X", "X"),
+    "scar_height": _length("height of the scar profile", "z", "z"),
+    "scar_slope": _number("slope of the scar profile", "g = dz/dX", "g = dz/dX"),
+    "shape": _number("scar shape"),
+    "groove": _number("groove: the scar profile, or the parabola of the same D/W (eq. 11)"),
     "stiffness_ratio": Quantity(
         "rig stiffness over normal load",
         "S/P",
@@ -184,6 +190,13 @@ QUANTITIES: dict[str, Quantity] = {
     "displacement_drift": _length("displacement drift per cycle"),
     # --- correction ---------------------------------------------------------------------
     "correction_factor": _number("contact CoF over energy CoF", "μ/μ_E", r"\mu/\mu_E"),
+    "shortcut_error": _number(
+        "error of the contact CoF corrected with the D/W shortcut",
+        "μ'/μ - 1",
+        r"\mu'/\mu - 1",
+        display_unit="%",
+        display_factor=100.0,
+    ),
 }
 
 

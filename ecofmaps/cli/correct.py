@@ -7,10 +7,18 @@ from pathlib import Path
 
 from ecofmaps._version import __version__
 from ecofmaps.cli._common import CommandError, print_rows, quantity, refuse_to_overwrite, row
+from ecofmaps.cli._profile import (
+    add_profile_options,
+    profile_rows,
+    read_profile,
+    two_columns_header,
+    two_values,
+)
 
 __all__ = ["add", "run"]
 
 _POINT_OPTIONS = ("ecof", "amplitude", "load", "stiffness")
+_GROOVE_OPTIONS = ("aspect_ratio", "scar_depth", "scar_half_width")
 
 
 def add(subparsers) -> None:
@@ -24,8 +32,11 @@ def add(subparsers) -> None:
             "--ecof --amplitude --load --stiffness and --aspect-ratio (or --scar-depth and "
             "--scar-half-width). A table: TABLE.csv with columns ecof, amplitude_um, load_N, "
             "stiffness_MN_per_m and aspect_ratio or scar_depth_um + scar_half_width_um; the "
-            "output keeps every column and adds mu, correction_factor and regime. A bad row "
-            "stops the run, naming the file and line (the header is line 1); nothing is "
+            "output keeps every column and adds mu and correction_factor. With "
+            "--scar-profile FILE a measured wear-scar profile gives the scar instead (of the "
+            "point, or of every row of a table, which then has no scar columns), and the "
+            "parabola of the same D/W is given beside it (mu_parabolic in a table). A bad "
+            "row stops the run, naming the file and line (the header is line 1); nothing is "
             "written then."
         ),
     )
@@ -51,6 +62,7 @@ def add(subparsers) -> None:
     parser.add_argument(
         "--scar-half-width", type=quantity("scar_half_width"), help="scar half-width W, e.g. 40um"
     )
+    add_profile_options(parser)
     parser.set_defaults(handler=run)
 
 
@@ -59,7 +71,7 @@ def run(args) -> int:
     from ecofmaps.correction.tables import correct_table
     from ecofmaps.io.files import write_text
 
-    given = [name for name in (*_POINT_OPTIONS, "aspect_ratio", "scar_depth", "scar_half_width")
+    given = [name for name in (*_POINT_OPTIONS, *_GROOVE_OPTIONS)
              if getattr(args, name) is not None]  # fmt: skip
     if args.table is not None:
         if given:
@@ -67,19 +79,25 @@ def run(args) -> int:
             raise CommandError(f"give a TABLE or one point's options, not both ({options})")
         if args.out is not None and not Path(args.out).parent.is_dir():
             raise CommandError(f"cannot write {args.out}: its directory does not exist")
-        refuse_to_overwrite([("--out", args.out)], [args.table])
-        text, rows = correct_table(args.table)
+        inputs = [path for path in (args.table, args.scar_profile) if path is not None]
+        refuse_to_overwrite([("--out", args.out)], inputs)
+        profile = read_profile(args)
+        text, rows = correct_table(args.table, profile=profile, mapping=args.mapping)
         if args.out is None:
             sys.stdout.write(text)
             return 0
         write_text(args.out, text)
-        print(f"wrote {args.out}: {rows} rows corrected")
+        on = "" if profile is None else f" on the scar profile {args.scar_profile}"
+        print(f"wrote {args.out}: {rows} rows corrected{on}")
         return 0
     if args.out is not None:
         raise CommandError("--out writes a corrected TABLE; give the TABLE too")
     missing = ["--" + name for name in _POINT_OPTIONS if getattr(args, name) is None]
     if missing:
         raise CommandError(f"give {', '.join(missing)} (or a TABLE)")
+    profile = read_profile(args, conflicting=_GROOVE_OPTIONS)
+    if profile is not None:
+        return _point_on_profile(args, profile)
     scar = [value is not None for value in (args.scar_depth, args.scar_half_width)]
     if (args.aspect_ratio is not None) == any(scar) or any(scar) != all(scar):
         raise CommandError("give --aspect-ratio, or both --scar-depth and --scar-half-width")
@@ -111,5 +129,34 @@ def run(args) -> int:
     ]
     print_rows(
         f"ecofmaps {__version__}: reported ECoF corrected to the contact CoF (x_o = Δ*)", rows
+    )
+    return 0
+
+
+def _point_on_profile(args, profile) -> int:
+    """One ECoF corrected on the measured profile, beside the D/W shortcut (eq. 11)."""
+    from ecofmaps.correction.inversion import correct_ecof
+
+    rig = dict(amplitude=args.amplitude, load=args.load, stiffness=args.stiffness)
+    mu = float(correct_ecof(args.ecof, **rig, profile=profile, mapping=args.mapping))
+    shortcut, _ = correct_ecof(
+        args.ecof, **rig, aspect_ratio=float(profile.aspect_ratio), return_status=True
+    )
+    shortcut = float(shortcut)  # NaN (printed 'undefined') where the parabola cannot
+    rows = [
+        row("ecof", args.ecof, "(reported)"),
+        row("amplitude", args.amplitude),
+        row("load", args.load),
+        row("stiffness", args.stiffness),
+        *profile_rows(args, profile),
+        None,
+        two_columns_header(),
+        two_values("mu", mu, shortcut),
+        two_values("correction_factor", mu / args.ecof, shortcut / args.ecof),
+    ]
+    print_rows(
+        f"ecofmaps {__version__}: reported ECoF corrected to the contact CoF on a measured "
+        f"scar profile ({'X = x' if args.mapping == 'physical' else 'X = x W/Δ*, eq. 11'})",
+        rows,
     )
     return 0

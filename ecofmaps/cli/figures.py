@@ -31,10 +31,12 @@ def add(subparsers) -> None:
     listing = "\n".join(f"  {name:<10} {recipe.description}" for name, recipe in FIGURES.items())
     parser = subparsers.add_parser(
         "figures",
-        help="write the paper's Figures 5-8 and 11 and the universal map (default: figures/)",
+        help="write the paper's Figures 5-8 and 11, the universal map and the scar shapes "
+        "(default: figures/)",
         description=textwrap.fill(
-            "Write the paper's Figures 5, 6, 7a, 7b, 8, 11a, 11b and the universal map of "
-            "the ECoF ratio, one file per figure and format (fig5.png, ...). Parameters are "
+            "Write the paper's Figures 5, 6, 7a, 7b, 8, 11a, 11b, the universal map of "
+            "the ECoF ratio and the comparison of scar shapes at equal D/W (shapes), one file "
+            "per figure and format (fig5.png, ...). Parameters are "
             "the paper's: amplitude 50um (= groove half-width), load 450N, stiffness 35MN/m, "
             "mu 0.8. Maps are read from the cache when there (see ECOFMAPS_CACHE) and stored "
             "there otherwise; files are written atomically. Progress goes to stderr.",

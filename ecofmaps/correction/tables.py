@@ -13,6 +13,12 @@ columns, one test per line. Columns (in any order, names exact, others kept as t
 ``scar_half_width_um`` ... and half-width W (eq. 11)                        [µm]
 =====================  ==================================================  =======
 
+On a measured scar profile (``correct_table(path, profile=...)``, ``ecofmaps correct
+TABLE --scar-profile FILE``) the profile gives every row's scar: the table has no
+``aspect_ratio`` or scar columns, and the output adds ``mu_parabolic``, the contact CoF
+the paper's shortcut gives (the parabola of the profile's :math:`D/W`, eq. 11; ``nan``
+where it cannot correct the row), beside ``mu`` on the profile.
+
 Each row gives its aspect ratio one way: ``aspect_ratio``, or ``scar_depth_um`` and
 ``scar_half_width_um`` (a table may hold both kinds of rows, with the other cells empty).
 Blank lines are skipped. The output keeps every input column and cell as written and adds
@@ -33,7 +39,7 @@ from ecofmaps import _nomenclature as nomenclature
 from ecofmaps.correction.inversion import CorrectionStatus, correct_ecof
 from ecofmaps.io.files import FileLineError
 
-__all__ = ["ADDED_COLUMNS", "COLUMNS", "TableError", "correct_table"]
+__all__ = ["ADDED_COLUMNS", "COLUMNS", "SHORTCUT_COLUMN", "TableError", "correct_table"]
 
 #: Input columns: column name -> quantity name (its unit and range in the nomenclature).
 COLUMNS = {
@@ -50,6 +56,8 @@ COLUMNS = {
 }
 #: Columns added to the output.
 ADDED_COLUMNS = ("mu", "correction_factor")
+#: Column added on a profile: the contact CoF of the parabola of the same D/W (eq. 11).
+SHORTCUT_COLUMN = "mu_parabolic"
 
 _REQUIRED = tuple(nomenclature.column(n) for n in ("ecof", "amplitude", "load", "stiffness"))
 _SCAR = tuple(nomenclature.column(n) for n in ("scar_depth", "scar_half_width"))
@@ -75,8 +83,11 @@ def _number(path, line: int, name: str, text: str) -> float:
     return value / quantity.display_factor
 
 
-def _read(path: Path):
-    """Header, rows (cells as written), their line numbers and the SI columns."""
+def _read(path: Path, on_profile: bool = False):
+    """Header, rows (cells as written), their line numbers and the SI columns.
+
+    On a profile the rows give no aspect ratio (the SI columns have none).
+    """
     try:
         with open(path, encoding="utf-8-sig", newline="") as stream:
             records = list(_records(csv.reader(stream)))
@@ -88,7 +99,7 @@ def _read(path: Path):
         raise TableError(path, 1, "the file is empty; expected a header line")
     (header, header_line), records = records[0], records[1:]
     header = [name.strip() for name in header]
-    _check_header(path, header_line, header)
+    _check_header(path, header_line, header, on_profile)
     if not records:
         raise TableError(path, header_line, "the table has a header but no data rows")
     column = {name: header.index(name) for name in COLUMNS if name in header}
@@ -100,6 +111,8 @@ def _read(path: Path):
             )
         for name in _REQUIRED:
             values[name].append(_number(path, line, name, row[column[name]]))
+        if on_profile:
+            continue
         given_ratio = "aspect_ratio" in column and row[column["aspect_ratio"]].strip() != ""
         given_scar = [name in column and row[column[name]].strip() != "" for name in _SCAR]
         if given_ratio == any(given_scar) or (any(given_scar) and not all(given_scar)):
@@ -116,7 +129,7 @@ def _read(path: Path):
             / _number(path, line, "scar_half_width_um", row[column["scar_half_width_um"]])
         )
         values["aspect_ratio"].append(ratio)
-    si = {name: np.asarray(values[name]) for name in (*_REQUIRED, "aspect_ratio")}
+    si = {name: np.asarray(values[name]) for name in values if values[name]}
     return header, records, si
 
 
@@ -127,12 +140,19 @@ def _records(reader):
             yield row, reader.line_num
 
 
-def _check_header(path, line: int, header: list[str]) -> None:
+def _check_header(path, line: int, header: list[str], on_profile: bool) -> None:
     duplicates = sorted({name for name in header if header.count(name) > 1})
     if duplicates:
         raise TableError(path, line, f"repeated column(s) {', '.join(duplicates)}")
+    if on_profile:
+        shapes = [name for name in ("aspect_ratio", *_SCAR) if name in header]
+        if shapes:
+            raise TableError(
+                path, line, f"column(s) {', '.join(shapes)} give the scar, but so does the "
+                "profile: drop the columns, or correct without the profile"
+            )  # fmt: skip
     missing = [name for name in _REQUIRED if name not in header]
-    if "aspect_ratio" not in header and not all(name in header for name in _SCAR):
+    if not on_profile and "aspect_ratio" not in header and not all(n in header for n in _SCAR):
         missing.append("aspect_ratio (or " + " + ".join(_SCAR) + ")")
     if missing:
         raise TableError(
@@ -141,26 +161,33 @@ def _check_header(path, line: int, header: list[str]) -> None:
             f"missing column(s) {', '.join(missing)}; the table needs {', '.join(_REQUIRED)} "
             f"and aspect_ratio or {' + '.join(_SCAR)}",
         )
-    taken = [name for name in ADDED_COLUMNS if name in header]
+    added = (*ADDED_COLUMNS, SHORTCUT_COLUMN) if on_profile else ADDED_COLUMNS
+    taken = [name for name in added if name in header]
     if taken:
         raise TableError(
             path, line, f"column(s) {', '.join(taken)} would be overwritten by the results"
         )
 
 
-def correct_table(path) -> tuple[str, int]:
-    """Correct every row of a table of reported ECoF values (see the module docstring).
+def correct_table(path, profile=None, mapping="scaled") -> tuple[str, int]:
+    r"""Correct every row of a table of reported ECoF values (see the module docstring).
 
     Parameters
     ----------
     path : str or os.PathLike
         The CSV table.
+    profile : ScarProfile, optional
+        A measured wear-scar profile that gives every row's scar (the table then has no
+        scar columns).
+    mapping : {'scaled', 'physical'}
+        On a profile: :math:`X = xW/\Delta^*` (eq. 11) or :math:`X = x`.
 
     Returns
     -------
     text : str
         The output table as CSV text: the input columns and cells, then ``mu`` and
-        ``correction_factor`` (both to 10 significant digits).
+        ``correction_factor`` (both to 10 significant digits), and on a profile
+        ``mu_parabolic``.
     rows : int
         The number of data rows.
 
@@ -174,25 +201,30 @@ def correct_table(path) -> tuple[str, int]:
         If the file cannot be opened.
     """
     path = Path(path)
-    header, records, si = _read(path)
-    point = dict(
-        amplitude=si["amplitude_um"],
-        load=si["load_N"],
-        stiffness=si["stiffness_MN_per_m"],
-        aspect_ratio=si["aspect_ratio"],
-    )
-    mu, status = correct_ecof(si["ecof"], **point, return_status=True)
+    header, records, si = _read(path, on_profile=profile is not None)
+    rig = dict(amplitude=si["amplitude_um"], load=si["load_N"], stiffness=si["stiffness_MN_per_m"])
+    if profile is None:
+        scar = {"aspect_ratio": si["aspect_ratio"]}
+        added = [[] for _ in records]
+    else:
+        scar = {"profile": profile, "mapping": mapping}
+        shortcut, _ = correct_ecof(
+            si["ecof"], **rig, aspect_ratio=float(profile.aspect_ratio), return_status=True
+        )
+        added = [[f"{value:.10g}"] for value in np.asarray(shortcut)]
+    mu, status = correct_ecof(si["ecof"], **rig, **scar, return_status=True)
     mu, status = np.asarray(mu), np.asarray(status)
     failed = np.flatnonzero(status != CorrectionStatus.CORRECTED)
     if failed.size:
         i = int(failed[0])
+        one = {name: value[i] if name == "aspect_ratio" else value for name, value in scar.items()}
         try:  # a single point raises with its reason
-            correct_ecof(si["ecof"][i], **{name: value[i] for name, value in point.items()})
+            correct_ecof(si["ecof"][i], **{name: value[i] for name, value in rig.items()}, **one)
         except ValueError as error:
             raise TableError(path, records[i][1], str(error)) from None
     stream = io.StringIO()
     writer = csv.writer(stream, lineterminator="\n")
-    writer.writerow([*header, *ADDED_COLUMNS])
-    for (row, _), value, ecof in zip(records, mu, si["ecof"], strict=True):
-        writer.writerow([*row, f"{value:.10g}", f"{value / ecof:.10g}"])
+    writer.writerow([*header, *ADDED_COLUMNS, *([] if profile is None else [SHORTCUT_COLUMN])])
+    for (row, _), value, ecof, more in zip(records, mu, si["ecof"], added, strict=True):
+        writer.writerow([*row, f"{value:.10g}", f"{value / ecof:.10g}", *more])
     return stream.getvalue(), len(records)

@@ -2,9 +2,11 @@
 
 :mod:`~ecofmaps.figures.model_figures` draws the model's figures (the paper's Figures 5-8
 and 11, and the universal map), :mod:`~ecofmaps.figures.measured_figures` those of measured
-loops (Figures 9 and 10, the loops read along the stroke), :mod:`~ecofmaps.figures.recipes`
-the set ``ecofmaps figures`` writes, and :mod:`~ecofmaps.figures.style` what they share.
-The names are imported on first use: the registry of figures reads without matplotlib.
+loops (Figures 9 and 10, the loops read along the stroke),
+:mod:`~ecofmaps.figures.profile_figures` those of wear-scar profiles (a measured profile,
+and scars of several shapes), :mod:`~ecofmaps.figures.recipes` the set ``ecofmaps figures``
+writes, and :mod:`~ecofmaps.figures.style` what they share. The names are imported on
+first use: the registry of figures reads without matplotlib.
 """
 
 import importlib
@@ -26,6 +28,7 @@ _PUBLIC = {
         "slip_amplitude_curves",
         "universal_ecof_ratio_map",
     ),
+    "profile_figures": ("scar_profile_figure", "scar_shape_comparison"),
     "recipes": ("FIGURES", "FigureRecipe", "make_figure", "make_figures"),
     "style": ("ECOF_RATIO_LEVELS", "save_figure"),
 }

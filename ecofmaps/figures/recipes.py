@@ -28,6 +28,7 @@ __all__ = [
     "ASPECT_RATIOS",
     "COMPLIANCE_RATIOS",
     "FIGURES",
+    "SCAR_SHAPES",
     "FigureRecipe",
     "make_figure",
     "make_figures",
@@ -56,11 +57,14 @@ class FigureRecipe:
         share a ``data`` function share its Dataset (see :func:`make_figures`).
     draw : str
         The drawing function, ``draw(dataset, **options) -> matplotlib.figure.Figure``, by
-        its name in :mod:`ecofmaps.figures.model_figures` (imported when a figure is made).
+        its name in the module ``module`` of :mod:`ecofmaps.figures` (imported when a figure
+        is made).
     selection : dict
         Coordinate values picked from the Dataset with ``.sel`` before drawing.
     options : dict
         Keyword arguments of ``draw``: the figure's number, the points it marks.
+    module : str
+        The module of :mod:`ecofmaps.figures` that holds ``draw``.
     """
 
     name: str
@@ -69,6 +73,7 @@ class FigureRecipe:
     draw: str
     selection: dict = field(default_factory=dict)
     options: dict = field(default_factory=dict)
+    module: str = "model_figures"
 
     def dataset(self) -> xr.Dataset:
         """The Dataset this figure draws."""
@@ -76,7 +81,7 @@ class FigureRecipe:
 
     def figure(self, dataset: xr.Dataset) -> Figure:
         """The figure, drawn from ``dataset`` (the Dataset of :attr:`data`, before selection)."""
-        draw = getattr(importlib.import_module("ecofmaps.figures.model_figures"), self.draw)
+        draw = getattr(importlib.import_module(f"ecofmaps.figures.{self.module}"), self.draw)
         return draw(dataset.sel(self.selection), **self.options)
 
 
@@ -121,6 +126,85 @@ def _universal_map() -> xr.Dataset:
     from ecofmaps.maps.grid import compute_universal_map
 
     return compute_universal_map(COMPLIANCE_RATIOS, ASPECT_RATIOS, paper.MU)
+
+
+#: Shape parameters of the analytic scar families of the ``shapes`` figure, beside depth and
+#: half-width (the paper's Example 2: D/W = 0.2, W = x_o = Δ*). [1] (fractions of D or W)
+SCAR_SHAPES = {
+    "parabolic": ("parabolic_profile", {}),
+    "flat-bottomed": ("flat_bottomed_profile", {"flat_fraction": 0.5}),
+    "W-shaped": ("w_shaped_profile", {"hump": 0.25}),
+    "ridged": ("ridged_profile", {"ridge_height": 0.3, "ridge_width": 0.6}),
+}
+
+
+def _scar_shapes() -> xr.Dataset:
+    """The four scar families at Example 2's D/W: profiles, loops, μ_E/μ over S/P (Fig. 11's)."""
+    import xarray as xr
+
+    import ecofmaps
+    from ecofmaps._nomenclature import attrs
+    from ecofmaps.maps.grid import compute_map
+
+    depth, width = paper.ASPECT_RATIO * paper.AMPLITUDE, paper.AMPLITUDE
+    rig = dict(amplitude=paper.AMPLITUDE, load=paper.LOAD, stiffness=paper.STIFFNESS, mu=paper.MU)
+    example = paper.STIFFNESS / paper.LOAD
+    # Figure 11's S/P with Example 2's among them: its steady values come from the same map.
+    ratios = np.union1d(paper.FIGURE_11_STIFFNESS_RATIOS, [example])
+    at_example = int(np.searchsorted(ratios, example))
+    position = np.linspace(-1.6, 1.6, 321) * width
+    steady = ("slip_amplitude", "dissipated_energy", "ecof")
+    grid = dict(amplitude=paper.AMPLITUDE, mu=paper.MU, load=paper.LOAD)
+    parabola = compute_map(ratios, paper.ASPECT_RATIO, **grid)
+    parabola_loop = np.asarray(ecofmaps.fretting_loop(**rig, aspect_ratio=paper.ASPECT_RATIO))
+    columns = {name: [] for name in ("height", "loop", "steady", "ratio", "error")}
+    for family, parameters in SCAR_SHAPES.values():
+        scale = {"ridge_height": depth, "ridge_width": width}
+        options = {k: v * scale.get(k, 1.0) for k, v in parameters.items()}
+        profile = getattr(ecofmaps, family)(depth, width, **options)
+        columns["height"].append(np.interp(position, profile.position, profile.height))
+        loop = np.asarray(ecofmaps.fretting_loop(**rig, profile=profile))
+        columns["loop"].append(np.stack([loop, parabola_loop]))
+        on_profile = compute_map(ratios, **grid, profile=profile)
+        columns["steady"].append(
+            [[float(m[name][at_example]) for m in (on_profile, parabola)] for name in steady]
+        )
+        ratio = on_profile["ecof_ratio"].values
+        columns["ratio"].append(np.stack([ratio, parabola["ecof_ratio"].values]))
+        # μ from the profile's μ_E corrected with the parabola of the same D/W (eq. 11)
+        corrected = ecofmaps.correct_ecof(
+            paper.MU * ratio, paper.AMPLITUDE, paper.LOAD, ratios * paper.LOAD, paper.ASPECT_RATIO
+        )
+        columns["error"].append(np.asarray(corrected) / paper.MU - 1.0)
+    loops = np.array(columns["loop"])
+    steady_values = np.array(columns["steady"])
+    groove = ("shape", "groove")
+    variables = {
+        "scar_height": (("shape", "scar_position"), np.array(columns["height"])),
+        "displacement": ((*groove, "point"), loops[:, :, 0]),
+        "force": ((*groove, "point"), loops[:, :, 1]),
+        **{name: (groove, steady_values[:, i]) for i, name in enumerate(steady)},
+        "ecof_ratio": ((*groove, "stiffness_ratio"), np.array(columns["ratio"])),
+        "shortcut_error": (("shape", "stiffness_ratio"), np.array(columns["error"])),
+    }
+    coords = {
+        "shape": list(SCAR_SHAPES),
+        "groove": ["profile", "parabola"],
+        "scar_position": position,
+        "stiffness_ratio": ratios,
+        **rig,
+        "scar_depth": depth,
+        "scar_half_width": width,
+    }
+    dataset = xr.Dataset(
+        {name: (dims, values, attrs(name)) for name, (dims, values) in variables.items()},
+        coords={name: ((name if np.ndim(v) else ()), v, attrs(name)) for name, v in coords.items()},
+    )
+    dataset.attrs["title"] = (
+        "Scar shapes at equal D/W: the model on each profile against the parabola of the same "
+        "D/W (the paper's eq. 11 shortcut)"
+    )
+    return dataset
 
 
 _EXAMPLE_2 = {"Example 2": paper.EXAMPLE_2}
@@ -187,6 +271,14 @@ FIGURES: dict[str, FigureRecipe] = {
                     for panel, amplitude in paper.FIGURE_11_AMPLITUDES.items()
                 },
             },
+        ),
+        FigureRecipe(
+            "shapes",
+            "four scar shapes at Example 2's D/W: loops, μ_E/μ over S/P, and the D/W shortcut's "
+            "error",
+            _scar_shapes,
+            "scar_shape_comparison",
+            module="profile_figures",
         ),
     )
 }

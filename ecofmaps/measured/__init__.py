@@ -5,7 +5,12 @@ from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.fit import LoopFit, fit_loop
 from ecofmaps.measured.quality import LoopQualityWarning
 from ecofmaps.measured.resolved import resolve_analyzed_loops, resolve_loops
-from ecofmaps.measured.synthetic import long_recording, synthetic_recording, write_long_recording
+from ecofmaps.measured.synthetic import (
+    long_recording,
+    scar_example_path,
+    synthetic_recording,
+    write_long_recording,
+)
 
 __all__ = [
     "LoopFit",
@@ -15,6 +20,7 @@ __all__ = [
     "long_recording",
     "resolve_analyzed_loops",
     "resolve_loops",
+    "scar_example_path",
     "synthetic_recording",
     "write_long_recording",
 ]

@@ -161,7 +161,10 @@ def _profile(position, height, slope, depth, half_width, worn_area, centre=0.0,
              reference_height=0.0, reference_slope=0.0) -> ScarProfile:  # fmt: skip
     values = (position, height, slope, depth, half_width, worn_area, centre,
               reference_height, reference_slope)  # fmt: skip
-    return ScarProfile(*(jnp.asarray(v, dtype=jnp.float64) for v in values))
+    # JAX's 64-bit mode is on only inside the public entry points (importing ecofmaps does
+    # not switch it on): without it these arrays would be float32.
+    with jax.enable_x64(True):
+        return ScarProfile(*(jnp.asarray(v, dtype=jnp.float64) for v in values))
 
 
 # ---------------------------------------------------------------------------------------

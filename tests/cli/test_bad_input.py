@@ -181,7 +181,7 @@ def test_ctrl_c_during_figures_keeps_whole_files_only(tmp_path):
     """Ctrl-C after the first figure: status 130; what is there is whole, nothing half written."""
     env = {**os.environ, "ECOFMAPS_CACHE": str(tmp_path / "cache")}
     command = [sys.executable, "-m", "ecofmaps.cli", "figures", "--out", str(tmp_path / "figs")]
-    status, _, stderr = interrupted_run(command, "ecofmaps figures: 8 figure(s)", 0.5, env)
+    status, _, stderr = interrupted_run(command, "ecofmaps figures: 9 figure(s)", 0.5, env)
     assert status == 130, stderr
     assert stderr.splitlines()[-1] == "ecofmaps: interrupted; no output was left half written"
     assert "Traceback" not in stderr

@@ -1,5 +1,8 @@
 """Scar profiles: the analytic families, measured traces (edges, levelling, smoothing), errors."""
 
+import subprocess
+import sys
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -235,3 +238,19 @@ def test_bad_trace_parameters():
     coarse_z = np.where(np.abs(coarse_x) < W, D * ((coarse_x / W) ** 2 - 1), 0.0)
     with pytest.raises(ValueError, match=r"x: only \d+ samples across the scar"):
         ecofmaps.scar_profile(coarse_x, coarse_z)
+
+
+def test_profiles_are_float64_without_jax_64_bit_mode():
+    """A fresh process (JAX's 64-bit mode off, as in a script or the command line) still
+    gets float64 profiles: the file's positions are not truncated to float32."""
+    script = (
+        "import warnings; warnings.simplefilter('error')\n"
+        "import ecofmaps\n"
+        "from ecofmaps.measured.synthetic import scar_example_path\n"
+        "p = ecofmaps.read_scar_profile(scar_example_path())\n"
+        "q = ecofmaps.w_shaped_profile(10e-6, 50e-6)\n"
+        "print(*{str(leaf.dtype) for leaf in (*p, *q, p.aspect_ratio, p.edges)})\n"
+    )
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.split() == ["float64"]

@@ -1,0 +1,159 @@
+"""The ``--scar-profile FILE`` options that ``ecofmaps model`` and ``ecofmaps correct`` share.
+
+A measured wear-scar profile (a profilometer trace across the scar, read by
+:func:`ecofmaps.read_scar_profile`) replaces the parabolic groove of the paper's eq. 11.
+The reading options are those of :func:`ecofmaps.read_scar_profile`; they apply only with
+``--scar-profile``, and the groove options of the parabola (``--aspect-ratio``, the scar's
+depth and half-width) cannot be given with it.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from ecofmaps.cli._common import CommandError, quantity, row, unit
+
+__all__ = [
+    "PROFILE_OPTIONS",
+    "add_profile_options",
+    "profile_rows",
+    "read_profile",
+    "two_columns_header",
+    "two_values",
+]
+
+#: The reading options (argparse destinations) that need ``--scar-profile``.
+PROFILE_OPTIONS = (
+    "x_column", "z_column", "x_unit", "z_unit", "no_level", "profile_half_width", "smoothing",
+    "mapping",
+)  # fmt: skip
+_DEFAULTS = {"x_column": "x", "z_column": "z", "no_level": False, "mapping": "scaled"}
+
+
+def add_profile_options(parser: argparse.ArgumentParser) -> None:
+    """Add ``--scar-profile FILE`` and its reading options, in a group of their own."""
+    group = parser.add_argument_group(
+        "measured scar profile",
+        "a profilometer trace across the wear scar (text: a header line, then x and z per "
+        "line, in um unless the names or --x-unit/--z-unit say otherwise), used instead of "
+        "the parabolic groove of eq. 11",
+    )
+    group.add_argument(
+        "--scar-profile", metavar="FILE", default=None,
+        help="the scar's profile (CSV, TSV or whitespace-separated text)",
+    )  # fmt: skip
+    group.add_argument(
+        "--x-column", default=None, metavar="NAME",
+        help="name of the position column (default: x)",
+    )  # fmt: skip
+    group.add_argument(
+        "--z-column", default=None, metavar="NAME",
+        help="name of the height column (default: z)",
+    )  # fmt: skip
+    group.add_argument(
+        "--x-unit", type=unit("length"), default=None, metavar="UNIT",
+        help="unit of the positions (default: the one the column's name gives, else um)",
+    )  # fmt: skip
+    group.add_argument(
+        "--z-unit", type=unit("length"), default=None, metavar="UNIT",
+        help="unit of the heights (default: the one the column's name gives, else um)",
+    )  # fmt: skip
+    group.add_argument(
+        "--no-level", action="store_true", default=None,
+        help="keep the trace's tilt and offset (default: level it on the unworn shoulders)",
+    )  # fmt: skip
+    group.add_argument(
+        "--profile-half-width", type=quantity("scar_half_width"), default=None, metavar="W",
+        help="the scar's half-width W, e.g. 500um (default: the one detected at the edges)",
+    )  # fmt: skip
+    group.add_argument(
+        "--smoothing", type=quantity("smoothing"), default=None, metavar="LENGTH",
+        help="length over which the slopes are smoothed, e.g. 10um; 0 for none "
+        "(default: 2%% of the half-width)",
+    )  # fmt: skip
+    group.add_argument(
+        "--mapping", choices=("scaled", "physical"), default=None,
+        help="where the pad at slip position x sits on the profile: 'scaled', X = x W/x_o "
+        "(eq. 11, the paper's; default), or 'physical', X = x",
+    )  # fmt: skip
+
+
+def read_profile(args, conflicting=()):
+    """The profile ``--scar-profile`` names (read with its options), or ``None``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+    conflicting : iterable of str
+        Destinations of the parabola's groove options, which cannot be given with a profile.
+
+    Raises
+    ------
+    CommandError
+        For a groove option given with ``--scar-profile``, or a reading option without it.
+    ScarProfileError
+        For a damaged file (its name and line).
+    """
+    if args.scar_profile is None:
+        given = [name for name in PROFILE_OPTIONS if getattr(args, name) is not None]
+        if given:
+            raise CommandError(f"{_options(given)} reads a --scar-profile: give the FILE too")
+        for name, value in _DEFAULTS.items():
+            setattr(args, name, value)
+        return None
+    given = [name for name in conflicting if getattr(args, name) is not None]
+    if given:
+        raise CommandError(
+            f"give --scar-profile or {_options(given)}, not both (the profile gives the "
+            "scar's shape, and its D/W)"
+        )
+    for name, value in _DEFAULTS.items():
+        if getattr(args, name) is None:
+            setattr(args, name, value)
+    from ecofmaps.io.scar_profiles import read_scar_profile
+
+    return read_scar_profile(
+        args.scar_profile,
+        x_column=args.x_column,
+        z_column=args.z_column,
+        x_unit=args.x_unit,
+        z_unit=args.z_unit,
+        level=not args.no_level,
+        half_width=args.profile_half_width,
+        smoothing=args.smoothing,
+    )
+
+
+def _options(names) -> str:
+    return ", ".join("--" + name.replace("_", "-") for name in names)
+
+
+def profile_rows(args, profile) -> list:
+    """Rows naming the profile: its file and samples, depth D, half-width W, D/W."""
+    samples = int(profile.position.shape[-1])
+    reading = [f"{samples} samples", "as given" if args.no_level else "levelled"]
+    if args.smoothing is not None:
+        reading.append(f"slopes smoothed over {args.smoothing * 1e6:.6g} µm")
+    how = "(given)" if args.profile_half_width is not None else "(detected)"
+    return [
+        ("scar profile", "", f"{args.scar_profile} ({', '.join(reading)})"),
+        row("scar_depth", float(profile.depth)),
+        row("scar_half_width", float(profile.half_width), how),
+        ("scar aspect ratio", "D/W", f"{float(profile.aspect_ratio):.6g}"),
+    ]
+
+
+#: Width of the first value column when a profile's values stand beside the parabola's.
+_COLUMN = 18
+
+
+def two_values(name: str, on_profile, on_parabola, note: str = "") -> tuple[str, str, str]:
+    """One row of :func:`ecofmaps.cli._common.row` with two values: profile, parabola."""
+    words, symbol, first = row(name, on_profile, note)
+    second = row(name, on_parabola)[2]
+    return words, symbol, f"{first:<{_COLUMN}} {second}"
+
+
+def two_columns_header() -> tuple[str, str, str]:
+    """The header row over :func:`two_values`."""
+    return "", "", f"{'on the profile':<{_COLUMN}} parabola of the same D/W (eq. 11 shortcut)"

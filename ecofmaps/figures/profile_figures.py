@@ -1,0 +1,274 @@
+r"""Figures of wear-scar profiles: a measured profile as the model reads it, and scar shapes.
+
+:func:`scar_profile_figure` draws one :class:`~ecofmaps.model.profiles.ScarProfile`: its
+heights with the unworn surface and the detected edges :math:`\pm W`, and the slope
+:math:`g(X)` the model uses, beside the parabola of the same :math:`D/W`.
+:func:`scar_shape_comparison` draws the ``shapes`` figure of ``ecofmaps figures`` from its
+Dataset (:mod:`ecofmaps.figures.recipes`): scars of four shapes at one :math:`D/W`, their
+loops and :math:`\mu_E/\mu` over :math:`S/P` against the parabola of that :math:`D/W`,
+and how far the paper's :math:`D/W` shortcut (eq. 11) misses the contact CoF.
+Both are pure functions of their inputs.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+from matplotlib.figure import Figure
+
+from ecofmaps.figures.style import (
+    MEGA,
+    MICRO,
+    MILLI,
+    PER_MM,
+    axis_label,
+    force_ratio_axis,
+    parameters,
+    scalar,
+)
+
+__all__ = ["scar_profile_figure", "scar_shape_comparison"]
+
+#: Colour of each scar shape; the parabola of the same D/W (the shortcut) is black, dashed.
+SHAPE_COLORS = {
+    "parabolic": "tab:orange",
+    "flat-bottomed": "tab:blue",
+    "W-shaped": "tab:green",
+    "ridged": "tab:red",
+}
+_SHORTCUT = dict(color="black", linestyle="--", linewidth=1.4)
+_EDGE = dict(color="0.45", linestyle=":", linewidth=1.2)
+
+
+def scar_profile_figure(profile, name: str | None = None) -> Figure:
+    r"""A scar profile as the model reads it: heights, edges, and the slope it uses.
+
+    Parameters
+    ----------
+    profile : ScarProfile
+        One profile (:func:`ecofmaps.read_scar_profile`, :func:`ecofmaps.scar_profile`, a
+        profile family), not a batch.
+    name : str, optional
+        What to call it in the title (e.g. the file's name).
+
+    Returns
+    -------
+    figure : matplotlib.figure.Figure
+        Two panels over the position :math:`X` [µm] relative to the scar centre: the height
+        :math:`z` [µm] with the unworn surface (the reference line of the levelling), the
+        depth :math:`D` and the parabola of the same :math:`D/W`; and the slope
+        :math:`g = dz/dX` the model uses (after smoothing), with the parabola's slope
+        :math:`2DX/W^2` (plus the tilt of the unworn surface, if not levelled). Both mark
+        the detected edges :math:`\pm W`.
+
+    Notes
+    -----
+    The pad at slip position :math:`x` feels the slope at :math:`X = xW/x_o` (eq. 11, with
+    :math:`x_o = \Delta^*` by default), so only the slopes within :math:`|X| \le
+    \delta^* W/\Delta^*` enter a steady loop; eq. 9 holds pointwise there.
+
+    Examples
+    --------
+    >>> import ecofmaps
+    >>> from ecofmaps.figures import scar_profile_figure
+    >>> figure = scar_profile_figure(ecofmaps.parabolic_profile(10e-6, 50e-6), "a parabola")
+    >>> [ax.get_ylabel() for ax in figure.axes]
+    ['Height of the scar profile $z$ [µm]', 'Slope of the scar profile $g = dz/dX$ [1]']
+    """
+    position = np.asarray(profile.position)
+    if position.ndim != 1:
+        raise ValueError("scar_profile_figure draws one profile, not a batch")
+    x = position * MICRO
+    height = np.asarray(profile.height) * MICRO
+    slope = np.asarray(profile.slope)
+    depth, width = float(profile.depth), float(profile.half_width)
+    surface = float(profile.reference_height) + float(profile.reference_slope) * position
+
+    figure = Figure(figsize=(7.4, 6.4), layout="constrained")
+    top, bottom = figure.subplots(2, 1, sharex=True, height_ratios=(1.25, 1.0))
+    top.plot(x, height, color="tab:blue", linewidth=1.6, label="profile $z(X)$")
+    top.plot(x, surface * MICRO, color="0.3", linewidth=1.0, linestyle="--",
+             label="unworn surface (levelling line)")  # fmt: skip
+    bottom_of_scar = float(profile.reference_height) * MICRO - depth * MICRO
+    top.annotate(
+        "", xy=(0.0, bottom_of_scar), xytext=(0.0, float(profile.reference_height) * MICRO),
+        arrowprops=dict(arrowstyle="<->", color="crimson", linewidth=1.2),
+    )  # fmt: skip
+    top.text(0.02 * width * MICRO, bottom_of_scar + 0.5 * depth * MICRO,
+             f"  D = {depth * MICRO:.4g} µm", color="crimson", va="center")  # fmt: skip
+    parabola = 2.0 * depth * position / width**2 + float(profile.reference_slope)
+    inside = np.abs(position) <= width
+    bowl = surface[inside] - depth * (1.0 - (position[inside] / width) ** 2)
+    top.plot(x[inside], bowl * MICRO, **_SHORTCUT, label="parabola of the same D/W")
+    bottom.plot(x, slope, color="tab:blue", linewidth=1.6, label="slope the model uses")
+    bottom.plot(x[inside], parabola[inside], **_SHORTCUT,
+                label=f"parabola of the same D/W = {depth / width:.3g}")  # fmt: skip
+    bottom.axhline(0.0, color="0.6", linewidth=0.6)
+    for ax in (top, bottom):
+        for edge, label in ((-width, "edges $\\pm W$"), (width, None)):
+            ax.axvline(edge * MICRO, **_EDGE, label=label)
+        ax.grid(alpha=0.3)
+        ax.legend(loc="lower left" if ax is top else "upper left", fontsize="small")
+    top.set_ylabel(axis_label("scar_height"))
+    bottom.set_ylabel(axis_label("scar_slope"))
+    bottom.set_xlabel(axis_label("scar_position") + " from the scar centre")
+    # The slopes outside the scar can dwarf those inside (steep walls, ridges): show the
+    # scar's range, with a margin.
+    within = np.abs(position) <= 1.5 * width
+    reach = max(float(np.max(np.abs(slope[within]))), 2.0 * depth / width)
+    bottom.set_ylim(-1.15 * reach, 1.15 * reach)
+    title = "Wear-scar profile" + (f": {name}" if name else "")
+    top.set_title(
+        title + "\n" + parameters(
+            f"D = {depth * MICRO:.4g} µm", f"W = {width * MICRO:.4g} µm",
+            f"D/W = {depth / width:.3g}", f"{position.size} samples",
+        ),
+        fontsize="medium",
+    )  # fmt: skip
+    return figure
+
+
+def scar_shape_comparison(dataset: xr.Dataset) -> Figure:
+    r"""Scars of four shapes at one :math:`D/W` against the parabola of that :math:`D/W`.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        The ``shapes`` figure's Dataset (:data:`ecofmaps.figures.FIGURES`): dimensions
+        ``shape`` (the scar families), ``groove`` (``'profile'``, ``'parabola'``),
+        ``scar_position``, ``point`` and ``stiffness_ratio``; variables ``scar_height``,
+        ``displacement``, ``force``, ``slip_amplitude``, ``dissipated_energy``, ``ecof``,
+        ``ecof_ratio`` and ``shortcut_error``; scalar ``amplitude``, ``load``,
+        ``stiffness``, ``mu``, ``scar_depth``, ``scar_half_width``.
+
+    Returns
+    -------
+    figure : matplotlib.figure.Figure
+        Top row: the profiles, then the steady loop on each non-parabolic scar against the
+        parabola's (legends give :math:`\delta^*`, :math:`E_d` and :math:`\mu_E`). Bottom
+        row: :math:`\mu_E/\mu` over :math:`S/P` for every shape and the parabola; and the
+        error :math:`\mu'/\mu - 1` [%] of the contact CoF :math:`\mu'` that the paper's
+        shortcut (the parabola of the scar's :math:`D/W`) makes of each scar's
+        :math:`\mu_E`.
+
+    Notes
+    -----
+    The model on a profile (eq. 9 pointwise, :math:`X = xW/x_o` of eq. 11 with
+    :math:`x_o = \Delta^*`). The pad only reaches :math:`|X| \le \delta^* W/\Delta^* < W`,
+    so what lies beyond the edges (the ridges) is never felt, and a scar flatter in its
+    middle than the parabola (flat-bottomed, W-shaped) biases :math:`\mu_E` less.
+    """
+    shapes = list(dataset["shape"].values)
+    others = [shape for shape in shapes if shape != "parabolic"]
+    load, mu = scalar(dataset, "load"), scalar(dataset, "mu")
+    depth, width = scalar(dataset, "scar_depth"), scalar(dataset, "scar_half_width")
+    amplitude, stiffness = scalar(dataset, "amplitude"), scalar(dataset, "stiffness")
+
+    figure = Figure(figsize=(15.0, 9.0), layout="constrained")
+    grid = figure.add_gridspec(2, 2 * len(shapes), height_ratios=(1.0, 1.05))
+    ax_shapes = figure.add_subplot(grid[0, 0:2])
+    loop_axes = [figure.add_subplot(grid[0, 2 * i : 2 * i + 2]) for i in range(1, len(shapes))]
+    for ax in loop_axes[1:]:
+        ax.sharey(loop_axes[0])
+    half = grid.ncols // 2
+    ax_ratio = figure.add_subplot(grid[1, :half])
+    ax_error = figure.add_subplot(grid[1, half:])
+
+    # The profiles, with the reach of the pad on the parabola.
+    x = dataset["scar_position"].values * MICRO
+    for shape in shapes:  # the parabola on top, thinner: other scars may share parts of it
+        ax_shapes.plot(x, dataset["scar_height"].sel(shape=shape) * MICRO,
+                       color=SHAPE_COLORS.get(shape), label=shape,
+                       **({"linewidth": 1.4, "zorder": 3} if shape == "parabolic" else
+                          {"linewidth": 2.6, "zorder": 2}))  # fmt: skip
+    reach = float(dataset["slip_amplitude"].sel(shape="parabolic", groove="parabola"))
+    reach *= width / amplitude
+    ax_shapes.axvspan(-reach * MICRO, reach * MICRO, color="0.85", zorder=0,
+                      label=r"reach of the pad, $|X| \leq \delta^* W/\Delta^*$")  # fmt: skip
+    for edge in (-width, width):
+        ax_shapes.axvline(edge * MICRO, **_EDGE)
+    ax_shapes.set_xlabel(axis_label("scar_position"))
+    ax_shapes.set_ylabel(axis_label("scar_height"))
+    ax_shapes.set_title(f"Scars of equal D/W = {depth / width:g}\n(edges ±W dotted)",
+                        fontsize="medium")  # fmt: skip
+    ax_shapes.set_ylim(-1.25 * depth * MICRO, 2.1 * depth * MICRO)  # the legend above
+    ax_shapes.legend(loc="upper center", fontsize="x-small", ncols=2)
+    ax_shapes.grid(alpha=0.3)
+
+    # The loops, each against the parabola's.
+    for ax, shape in zip(loop_axes, others, strict=True):
+        own = dict(color=SHAPE_COLORS.get(shape), linewidth=2.0, zorder=2)
+        for groove, style in (("profile", own), ("parabola", dict(_SHORTCUT, zorder=3))):
+            point = dataset.sel(shape=shape, groove=groove)
+            ax.plot(
+                point["displacement"] * MICRO, point["force"], **style,
+                label=(
+                    f"{shape + ' scar' if groove == 'profile' else 'parabola, same D/W'}\n"
+                    rf"$\delta^*$ = {float(point['slip_amplitude']) * MICRO:.1f} µm, "
+                    rf"$E_d$ = {float(point['dissipated_energy']) * MILLI:.1f} mJ, "
+                    rf"$\mu_E$ = {float(point['ecof']):.3f}"
+                ),
+            )  # fmt: skip
+        loops = dataset["force"].sel(shape=shape).values
+        if np.allclose(loops[0], loops[1], rtol=1e-6, atol=1e-9 * load):
+            ax.text(0.97, 0.04, "the parabola's loop: this scar differs\nonly beyond the pad's "
+                    "reach", transform=ax.transAxes, ha="right", va="bottom",
+                    fontsize="small", color=SHAPE_COLORS.get(shape))  # fmt: skip
+        ax.axhline(0.0, color="0.6", linewidth=0.6)
+        ax.axvline(0.0, color="0.6", linewidth=0.6)
+        ax.set_xlabel(axis_label("displacement"))
+        ax.grid(alpha=0.3)
+        ax.set_title(f"{shape} scar", fontsize="medium")
+        ax.legend(loc="upper left", fontsize="x-small")
+    loop_axes[0].set_ylabel(axis_label("force"))
+    for ax in loop_axes[:-1]:
+        ax.tick_params(labelleft=ax is loop_axes[0])
+    force_ratio_axis(loop_axes[-1], load)
+    peak = float(np.nanmax(np.abs(dataset["force"].values)))
+    loop_axes[0].set_ylim(-1.08 * peak, 1.75 * peak)  # room for the legends above the loops
+
+    # μ_E/μ over S/P, and the shortcut's error.
+    ratios = dataset["stiffness_ratio"].values * PER_MM
+    shortcut = dataset["ecof_ratio"].sel(shape="parabolic", groove="parabola")
+    same_label = f"parabola, D/W = {depth / width:g}"
+    ax_ratio.plot(ratios, shortcut, **_SHORTCUT, zorder=3, label=same_label)
+    ax_error.axhline(0.0, **_SHORTCUT, zorder=3, label="no error (the parabola itself)")
+    for shape in shapes:
+        style = dict(color=SHAPE_COLORS.get(shape), linewidth=2.0, zorder=2)
+        if shape == "parabolic":  # on the parabola's closed form: points, so both show
+            style = dict(color=SHAPE_COLORS["parabolic"], marker="o", markersize=4,
+                         linestyle="none", markevery=6, zorder=4)  # fmt: skip
+        ax_ratio.plot(ratios, dataset["ecof_ratio"].sel(shape=shape, groove="profile"),
+                      label=f"{shape} scar", **style)  # fmt: skip
+        if shape != "parabolic":
+            error = dataset["shortcut_error"].sel(shape=shape) * 100.0
+            ax_error.plot(ratios, error, label=f"{shape} scar", **style)
+    example = stiffness / load * PER_MM
+    for ax in (ax_ratio, ax_error):
+        ax.axvline(example, color="crimson", linewidth=1.0, linestyle="-.",
+                   label=f"Example 2, S = {stiffness * MEGA:g} MN/m")  # fmt: skip
+        ax.set_xlabel(axis_label("stiffness_ratio"))
+        ax.set_xlim(ratios[0], ratios[-1])
+        ax.grid(alpha=0.3)
+    ax_ratio.set_ylabel(axis_label("ecof_ratio"))
+    ax_ratio.set_title(r"Energy CoF over the contact CoF, $\mu$ = " + f"{mu:g}",
+                       fontsize="medium")  # fmt: skip
+    ax_ratio.legend(loc="upper left", fontsize="small")
+    ax_error.set_ylabel(r"Error of $\mu'$ from the D/W shortcut, $\mu'/\mu - 1$ [%]")
+    ax_error.set_title(
+        r"The D/W shortcut: $\mu_E$ of each scar corrected as if it were the parabola",
+        fontsize="medium",
+    )
+    ax_error.legend(loc="upper right", fontsize="small")
+    figure.suptitle(
+        "Scar shape at equal depth over half-width: how wrong the D/W shortcut is\n"
+        + parameters(
+            rf"$x_o = \Delta^*$ = {amplitude * MICRO:g} µm",
+            f"W = {width * MICRO:g} µm, D = {depth * MICRO:g} µm",
+            f"P = {load:g} N",
+            f"S = {stiffness * MEGA:g} MN/m (loops)",
+            rf"$\mu$ = {mu:g}",
+        ),
+        fontsize="medium",
+    )
+    return figure
