@@ -122,7 +122,8 @@ import xarray as xr
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._inputs import check, si_units
 from ecofmaps._interrupts import check_interrupted
-from ecofmaps.measured.analysis import GROSS_SLIP_THRESHOLD, analyze_loops
+from ecofmaps.measured.analysis import analyze_loops
+from ecofmaps.measured.per_cycle import GROSS_SLIP_THRESHOLD
 from ecofmaps.measured.quality import (
     ALL,
     REASONS,

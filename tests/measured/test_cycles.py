@@ -153,7 +153,7 @@ def test_a_long_loop_gets_a_block_of_its_own():
 
 def test_one_cycle_of_a_long_recording():
     """Measuring one cycle uses its neighbours' centres: as in the whole analysis."""
-    from ecofmaps.measured.analysis import measure_cycles
+    from ecofmaps.measured.per_cycle import measure_cycles
 
     displacement, force = synthetic_recording(**EXAMPLE_2, cycles=8, displacement_drift=1e-6)
     found = cycles.find_cycles(displacement)
