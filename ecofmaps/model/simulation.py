@@ -211,7 +211,7 @@ def simulate(displacement, load, stiffness, mu, aspect_ratio=None, groove_half_w
     On a profile the pad starts at rest at the scar centre, and a slip goes to the first
     equilibrium :math:`x' + Q_\pm(x')/S = \Delta` beyond the pad (first passage; where
     :math:`x + Q_+/S` falls the pad jumps), found exactly on the piecewise linear slope
-    (:mod:`ecofmaps.model.profile_core`). A pad that runs off the trace gives NaN.
+    (:mod:`ecofmaps.model.first_passage`). A pad that runs off the trace gives NaN.
     """
     check("displacement", displacement, "finite", "m")
     if is_concrete(displacement) and jnp.ndim(displacement) == 0:

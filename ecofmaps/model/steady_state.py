@@ -196,7 +196,7 @@ _PROFILE_NOTES = """
     On a profile the steady loop's ends solve :math:`x + Q_\\pm(x)/S = \\pm\\Delta^*` by
     first passage from where the last stroke ended, the pad jumping where
     :math:`x + Q_+(x)/S` falls; :math:`\\delta^* = (x_+ - x_-)/2` and :math:`E_d` is the
-    area of the loop the return map draws (:mod:`ecofmaps.model.profile_core`). The regime
+    area of the loop the return map draws (:mod:`ecofmaps.model.first_passage`). The regime
     ``BEYOND_PROFILE`` marks a stroke that runs off the trace.
 """
 
