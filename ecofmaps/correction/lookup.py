@@ -14,7 +14,8 @@ import numpy as np
 
 from ecofmaps._codes import warn_nan
 from ecofmaps._inputs import check, si_units
-from ecofmaps.correction.inversion import CorrectionStatus, _aspect_ratio
+from ecofmaps.correction.inversion import _aspect_ratio
+from ecofmaps.correction.outcomes import CorrectionStatus
 
 __all__ = ["lookup_correction"]
 
