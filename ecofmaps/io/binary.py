@@ -7,7 +7,7 @@ by name as in a text header (:mod:`ecofmaps.io.columns`), in the group given or 
 group. Each is wrapped in a :class:`Column`, an array-like that reads a range of samples on
 demand, in float64 and SI, with CF packing decoded (``scale_factor``, ``add_offset``,
 ``_FillValue``/``missing_value`` -> NaN), and turns any failure into a
-:class:`~ecofmaps.io.recordings.RecordingError` naming the file, the channel and the
+:class:`~ecofmaps.io.recording_types.RecordingError` naming the file, the channel and the
 samples. A large recording is a dask array over such columns (``dask.array.from_array``),
 so it is read block by block; a :class:`Column` pickles without its open file, so the
 blocks can be read by other processes (a dask cluster).
@@ -27,7 +27,8 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps.io.columns import ColumnError, column_scale, matching_columns, split_unit
-from ecofmaps.io.recordings import LAZY_SAMPLES, Recording, RecordingError
+from ecofmaps.io.recording_types import Recording, RecordingError
+from ecofmaps.io.recordings import LAZY_SAMPLES
 
 __all__ = ["DEFAULT_CHUNK", "Column", "Variable", "read_binary", "variables"]
 
@@ -451,7 +452,7 @@ def _select(path: Path, kind: str, found: list[Variable], options: dict) -> dict
 
 
 def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None) -> Recording:
-    """A rig file as a :class:`~ecofmaps.io.recordings.Recording` (see
+    """A rig file as a :class:`~ecofmaps.io.recording_types.Recording` (see
     :func:`ecofmaps.io.read_recording` for the options)."""
     chosen = _select(path, kind, variables(path, kind), options)
     if kind == "zarr":

@@ -12,12 +12,8 @@ import zarr
 from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
 
 from ecofmaps.io.binary import Column, variables
-from ecofmaps.io.recordings import (
-    RecordingError,
-    read_recording,
-    recording_blocks,
-    recording_format,
-)
+from ecofmaps.io.recording_types import RecordingError
+from ecofmaps.io.recordings import read_recording, recording_blocks, recording_format
 
 SIZE = 5003
 RNG = np.random.default_rng(7)
