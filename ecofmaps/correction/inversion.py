@@ -159,6 +159,12 @@ def contact_cof(ecof, kappa, lam):
     Notes
     -----
     Inverts the corrected eq. 13-15 with eq. 16 (module docstring).
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 13-15, 16.
     """
     ecof, kappa, lam = jnp.broadcast_arrays(*(as_float64(v) for v in (ecof, kappa, lam)))
     mu, status = _root_and_status(ecof, kappa, lam)
@@ -400,6 +406,12 @@ correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy
     than one grid step (1 % of :math:`\\mu` for one ECoF; the steps widen with the spread of
     the ECoFs corrected together), or below the grid, is not seen.
 
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 11, 13-15, 16.
+
     Examples
     --------
     >>> import ecofmaps
@@ -432,4 +444,10 @@ correction_factor.__doc__ = f"""The ratio :math:`\\mu/\\mu_E` of contact CoF to 
     -----
     The reciprocal of the :math:`\\mu_E/\\mu` of Figures 8 and 11, read at the contact CoF
     that gives the reported :math:`\\mu_E` rather than at a chosen :math:`\\mu`.
-"""
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 11, 13-15, 16.
+    """

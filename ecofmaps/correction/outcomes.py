@@ -158,6 +158,12 @@ def ecof_fall(kappa, lam):
     fall narrower than one grid step (:math:`\ln\kappa/255` in :math:`\log\mu`), at the very
     edge of the region where it exists, is not seen: the contact CoFs it would make
     ambiguous then lie within about two grid steps of each other.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 13-15, 16.
     """
     kappa, lam = jnp.broadcast_arrays(as_float64(kappa), as_float64(lam))
     may_fall = _may_fall(kappa, lam)

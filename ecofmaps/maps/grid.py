@@ -211,6 +211,12 @@ def compute_map(
     double the disk space of the user's own store; and evaluating a block costs about as
     much as reading it back from disk.
 
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 1, 9, 11, 12, 13-15, 16.
+
     Examples
     --------
     >>> import numpy as np
@@ -317,6 +323,12 @@ def compute_universal_map(
     :math:`\mu_E/\mu` depends on :math:`(\mu, z_o/x_o, \lambda)` only (eq. 13-16): this one
     chart holds both panels of Figure 11, whose axes :math:`S/P` map onto
     :math:`\lambda = 1/((S/P)\Delta^*)`.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 13-16.
     """
     axes = {
         "compliance_ratio": _axis("compliance_ratio", compliance_ratio, "non_negative", "1"),
@@ -383,6 +395,12 @@ def compute_loops(stiffness, aspect_ratio, amplitude, load, mu, num=201) -> xr.D
     -----
     Slip branches from eq. 9 with eq. 10, stick segments of slope :math:`S`; the per-loop
     quantities from eq. 16 (:math:`\delta^*`), eq. 9 (:math:`Q^*`) and eq. 12 (:math:`E_d`).
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 10, 12, 16.
     """
     axes = {
         "stiffness": _axis("stiffness", stiffness, "positive_or_inf", "N/m"),

@@ -71,6 +71,12 @@ def compute_profile_map(stiffness_ratio, amplitude, mu, load=None, *, profile, m
     :math:`\lambda = P/(S\Delta^*)`, as in eq. 16; the steady loop comes from
     :func:`ecofmaps.model.on_profile.steady_numbers` (one set of tables per :math:`\mu`).
 
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 11, 16.
+
     Examples
     --------
     >>> import numpy as np, ecofmaps

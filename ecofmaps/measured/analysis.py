@@ -287,6 +287,12 @@ def analyze_loops(
     (:mod:`ecofmaps.measured.out_of_core`). The results are those of the same recording in
     memory.
 
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 1, 9, 10, 17-18.
+
     Examples
     --------
     >>> import numpy as np, ecofmaps

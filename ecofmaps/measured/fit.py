@@ -285,6 +285,12 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
     :math:`\Delta - Q/S` on the slip segments for :math:`\mu` and the groove slope.
     The paper sets :math:`\mu` to the loop's GICoF and reads :math:`S` off the loop
     (Section 4.2, Figure 10); for a loop of the model both equal the fitted values.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 10, 16.
     """
     check("load", load, "positive", "N")
     if np.ndim(load) != 0:

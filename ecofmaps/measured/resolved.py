@@ -236,6 +236,12 @@ def resolve_analyzed_loops(
     ------
     ValueError
         If ``loops`` lacks the loops (``keep_loops=False``), or for options out of range.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 7, 9, 10, 17-18.
     """
     if not isinstance(loops, xr.Dataset) or any(name not in loops for name in _NEEDED):
         raise ValueError(
@@ -412,9 +418,9 @@ def resolve_loops(
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway, *Derivation of a wear scar geometry-independent
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
     coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour*, 2016: eq. 7, 9, 10, 17-18.
+    behaviour: eq. 7, 9, 10, 17-18.
 
     Examples
     --------

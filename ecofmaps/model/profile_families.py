@@ -98,6 +98,12 @@ def parabolic_profile(depth, half_width, *, tilt=0.0, samples=2001, extent=2.0) 
         eq. 11); piecewise linear slopes are exact for it, so the model on this profile
         reproduces the closed forms with ``aspect_ratio=D/W`` to rounding.
 
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 7, 11.
+
     Examples
     --------
     >>> p = parabolic_profile(10e-6, 50e-6)

@@ -385,6 +385,12 @@ def scar_profile(x, z, half_width=None, smoothing=None, level=False) -> ScarProf
     The edges, the reference line and the smoothing follow the rules of the module
     docstring. The model maps a pad position :math:`x` to :math:`X = xW/x_o` (eq. 11).
 
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 11.
+
     Examples
     --------
     >>> import numpy as np
