@@ -169,7 +169,7 @@ def _progress(dataset, shown: bool):
     from dask.callbacks import Callback
     from tqdm import tqdm
 
-    from ecofmaps.maps.grid import BLOCK_TASK
+    from ecofmaps.maps.tiles import BLOCK_TASK
 
     blocks = math.prod(len(c) for c in dataset.regime.chunks)
     bar = tqdm(

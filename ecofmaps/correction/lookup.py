@@ -14,7 +14,8 @@ import numpy as np
 
 from ecofmaps._codes import warn_nan
 from ecofmaps._inputs import check, si_units
-from ecofmaps.correction.inversion import CorrectionStatus, _aspect_ratio
+from ecofmaps.correction.inversion import _aspect_ratio
+from ecofmaps.correction.outcomes import CorrectionStatus
 
 __all__ = ["lookup_correction"]
 
@@ -103,6 +104,12 @@ def lookup_correction(map_dataset, ecof, amplitude, load, stiffness, aspect_rati
     :math:`\mu`: its error is second order in the grid steps, about
     :math:`\sum_i h_i^2 |\partial_i^2\mu_E|/8` in :math:`\mu_E`, divided by
     :math:`d\mu_E/d\mu` in :math:`\mu`.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 13-15, 16.
     """
     from scipy.interpolate import RegularGridInterpolator
 

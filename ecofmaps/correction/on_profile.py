@@ -14,7 +14,8 @@ import numpy as np
 
 from ecofmaps._codes import warn_nan
 from ecofmaps._inputs import check, is_concrete
-from ecofmaps.correction.inversion import _EPS, CorrectionStatus
+from ecofmaps.correction.inversion import _EPS
+from ecofmaps.correction.outcomes import CorrectionStatus
 
 __all__ = ["correct_on_profile"]
 

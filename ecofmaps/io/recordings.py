@@ -1,7 +1,8 @@
 """Recordings of fretting loops: text files and rig formats, read whole or lazily.
 
-:func:`read_recording` reads the displacement, force and (optional) cycle-number columns
-of a recording into a :class:`Recording`, in SI units, whatever the file's format:
+:func:`read_recording` reads the displacement, force and (optional) cycle-number columns of
+a recording into a :class:`~ecofmaps.io.recording_types.Recording`, in SI units, whatever
+the file's format:
 
 - text: CSV, TSV, spreadsheet exports, whitespace-separated columns with a header line
   (:mod:`ecofmaps.io.text`: separator and decimal comma detected, quotes, encodings,
@@ -13,36 +14,34 @@ of a recording into a :class:`Recording`, in SI units, whatever the file's forma
 The format is found from the file's first bytes (a zarr store is a directory), not its
 suffix. Columns are found by name without regard to case, and a unit carried by the name
 (``force [kN]``, ``delta_mm``) or the metadata is used when no unit option is given
-(:mod:`ecofmaps.io.columns`). A damaged file raises :class:`RecordingError`, which names
-the file and the 1-based line, or, where a file has no lines, the channel or variable and
-the 0-based sample index. Missing samples (empty cells, NaN) are NaN in the arrays, found
-by :attr:`Recording.missing`, with their lines; ``nan_policy='raise'`` makes them errors.
+(:mod:`ecofmaps.io.columns`). A damaged file raises
+:class:`~ecofmaps.io.recording_types.RecordingError`, which names the file and the 1-based
+line, or, where a file has no lines, the channel or variable and the 0-based sample index.
+Missing samples (empty cells, NaN) are NaN in the arrays, found by
+:attr:`~ecofmaps.io.recording_types.Recording.missing`, with their lines;
+``nan_policy='raise'`` makes them errors.
 
 :func:`recording_blocks` gives a recording block by block with bounded memory, which
 :func:`ecofmaps.io.writers.convert_recording` uses to turn a large text file into a chunked
-store once. :func:`results_table` turns :func:`ecofmaps.analyze_loops`'s Dataset into the
-table that ``ecofmaps loops`` writes, and :func:`write_text` writes a file atomically.
+store once. :func:`ecofmaps.io.tables.results_table` turns :func:`ecofmaps.analyze_loops`'s
+Dataset into the table that ``ecofmaps loops`` writes, and
+:func:`ecofmaps.io.files.write_text` writes a file atomically.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import functools
 import itertools
 import numbers
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
-from ecofmaps.io.files import FileLineError
+from ecofmaps.io.recording_types import Recording, RecordingError, _LineIndex
 
 __all__ = [
     "LAZY_SAMPLES",
-    "Recording",
-    "RecordingError",
-    "RecordingWarning",
     "read_recording",
     "recording_blocks",
     "recording_format",
@@ -68,204 +67,6 @@ _SUFFIXES = {
     ".zarr": "zarr",
 }
 _ZARR_METADATA = ("zarr.json", ".zgroup", ".zarray")
-
-
-class RecordingError(FileLineError):
-    """A damaged recording: the message names the file and where in it.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-    line : int, str or None
-        The 1-based line of a text file; or, in a file without lines, a position such as
-        ``"channel 'Rig/force', sample 1200"``; or None for the file as a whole.
-    message : str
-
-    Attributes
-    ----------
-    path : pathlib.Path
-    line : int or None
-        The 1-based line, for a text file.
-    position : str
-        ``'line 12'``, the position given, or ``''``.
-    message : str
-        What is wrong, without the file and the position.
-    """
-
-    def __init__(self, path, line, message: str):
-        self.path = Path(path)
-        self.message = message
-        if line is None or isinstance(line, str):
-            self.line, self.position = None, line or ""
-        else:
-            self.line = int(line)
-            self.position = f"line {self.line}"
-        where = f"{self.path}, {self.position}" if self.position else f"{self.path}"
-        ValueError.__init__(self, f"{where}: {message}")
-
-
-class RecordingWarning(UserWarning):
-    """Something in a recording was read in a way the user should know (e.g. as Latin-1)."""
-
-
-@dataclasses.dataclass(frozen=True)
-class _LineIndex:
-    """The 1-based line of each sample of a text file, as runs: from sample ``starts[k]`` on,
-    line = sample + ``offsets[k]`` (comment and blank lines start new runs)."""
-
-    starts: np.ndarray
-    offsets: np.ndarray
-
-    @classmethod
-    def build(cls, blocks, first: int = 0) -> _LineIndex:
-        """From the line numbers of consecutive blocks of samples, the first being sample
-        ``first`` of the file."""
-        starts, offsets, sample, last = [], [], first, None
-        for lines in blocks:
-            if lines.size == 0:
-                continue
-            offset = lines - np.arange(sample, sample + lines.size)
-            runs = np.concatenate([[0], np.flatnonzero(np.diff(offset)) + 1])
-            if last == offset[0]:
-                runs = runs[1:]
-            starts.append(runs + sample)
-            offsets.append(offset[runs])
-            sample += lines.size
-            last = offset[-1]
-        return cls(
-            np.concatenate(starts or [np.zeros(0, np.int64)]).astype(np.int64),
-            np.concatenate(offsets or [np.zeros(0, np.int64)]).astype(np.int64),
-        )
-
-    def __call__(self, index):
-        index = np.asarray(index, dtype=np.int64)
-        run = np.searchsorted(self.starts, index, side="right") - 1
-        return index + self.offsets[run]
-
-
-@dataclasses.dataclass(frozen=True, eq=False)
-class Recording:
-    """The samples read from a recording file, in SI units.
-
-    The arrays are NumPy arrays, or dask arrays for a large rig file read lazily (see
-    ``lazy`` in :func:`read_recording`): ``recording.displacement.chunks`` then gives the
-    blocks, ``recording[start:stop]`` reads one range into memory and
-    :meth:`compute` all of it.
-
-    Attributes
-    ----------
-    path : pathlib.Path
-    displacement : numpy.ndarray or dask.array.Array
-        [m]; NaN where a sample is missing.
-    force : numpy.ndarray or dask.array.Array
-        [N]; NaN where a sample is missing.
-    cycle : numpy.ndarray or dask.array.Array or None
-        The cycle number of each sample, if the file has a cycle column. [1]
-    last_line : int or None
-        1-based line number of the last sample, for a text file.
-    columns : Mapping[str, str]
-        For each of ``'displacement'``, ``'force'`` (and ``'cycle'``): the column, channel
-        or variable it was read from, as named in the file.
-    units : Mapping[str, str]
-        The unit each column was read in (``'um'``, ``'kN'``, ...).
-    start : int
-        0-based index in the file of the first sample (non-zero for a block).
-    """
-
-    path: Path
-    displacement: Any
-    force: Any
-    cycle: Any = None
-    last_line: int | None = None
-    columns: Mapping[str, str] = dataclasses.field(default_factory=dict)
-    units: Mapping[str, str] = dataclasses.field(default_factory=dict)
-    start: int = 0
-    lines: _LineIndex | None = dataclasses.field(default=None, repr=False)
-
-    @property
-    def size(self) -> int:
-        """Number of samples."""
-        return int(self.displacement.shape[0])
-
-    def __len__(self) -> int:
-        return self.size
-
-    @property
-    def lazy(self) -> bool:
-        """Whether the arrays are dask arrays, read when computed."""
-        return not isinstance(self.displacement, np.ndarray)
-
-    @functools.cached_property
-    def missing(self):
-        """Mask of the missing samples (NaN in any column read): numpy or dask, as the data.
-
-        Examples
-        --------
-        The lines of the missing samples of a text file:
-        ``recording.line(np.flatnonzero(recording.missing))``.
-        """
-        arrays = [self.displacement, self.force] + ([] if self.cycle is None else [self.cycle])
-        if self.lazy:
-            import dask.array as da
-
-            return ~functools.reduce(da.logical_and, [da.isfinite(a) for a in arrays])
-        return ~functools.reduce(np.logical_and, [np.isfinite(a) for a in arrays])
-
-    def line(self, index):
-        """1-based line numbers of samples in a text file (None for other formats).
-
-        Parameters
-        ----------
-        index : int or array_like of int
-            0-based sample indices in this recording (or block).
-        """
-        if self.lines is None:
-            return None
-        lines = self.lines(np.asarray(index) + self.start)
-        return int(lines) if np.ndim(lines) == 0 else lines
-
-    def position(self, index=None) -> str | int | None:
-        """Where sample ``index`` is in the file: its line (int) for a text file, else
-        ``'sample N'`` (0-based in the file); for ``index=None`` the end of the file (its
-        last line, or None)."""
-        if index is None:
-            return self.last_line
-        if self.lines is not None:
-            return self.line(index)
-        return f"sample {self.start + int(index)}"
-
-    def error(self, message: str, index=None) -> RecordingError:
-        """A :class:`RecordingError` naming the file and the position of sample ``index``
-        (by default the end of the file), e.g. for an analysis that fails on the samples."""
-        return RecordingError(self.path, self.position(index), message)
-
-    def __getitem__(self, key: slice) -> Recording:
-        """Samples ``start:stop`` (step 1) in memory, keeping their positions in the file."""
-        if not isinstance(key, slice) or key.step not in (None, 1):
-            raise TypeError("a Recording is indexed by a slice start:stop")
-        first, stop, _ = key.indices(self.size)
-        stop = max(stop, first)
-        arrays = [self.displacement, self.force, self.cycle]
-        taken = [None if a is None else a[first:stop] for a in arrays]
-        if self.lazy:
-            import dask
-
-            taken = list(dask.compute(*taken))
-        last = None
-        if self.lines is not None and stop > first:
-            last = int(self.lines(self.start + stop - 1))
-        return dataclasses.replace(
-            self,
-            displacement=taken[0],
-            force=taken[1],
-            cycle=taken[2],
-            last_line=last,
-            start=self.start + first,
-        )
-
-    def compute(self) -> Recording:
-        """The recording with NumPy arrays (reads a lazy one whole; else itself)."""
-        return self[:] if self.lazy else self
 
 
 def recording_format(path) -> str:

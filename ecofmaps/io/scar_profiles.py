@@ -85,7 +85,7 @@ def read_scar_profile(
     >>> round(float(p.half_width) * 1e6), round(float(p.aspect_ratio), 3)
     (500, 0.16)
     """
-    from ecofmaps.io.recordings import RecordingError
+    from ecofmaps.io.recording_types import RecordingError
     from ecofmaps.io.text import text_blocks
 
     path = Path(path)

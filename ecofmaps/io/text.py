@@ -90,7 +90,7 @@ class _Decoder:
             try:
                 return data.decode("utf-8")
             except UnicodeDecodeError as error:
-                from ecofmaps.io.recordings import RecordingWarning
+                from ecofmaps.io.recording_types import RecordingWarning
 
                 line = first_line + data.count(b"\n", 0, error.start)
                 byte = data[error.start]
@@ -117,7 +117,7 @@ def _open_text(path: Path):
         try:
             return io.BytesIO(data.decode("utf-16").encode("utf-8"))
         except UnicodeDecodeError as error:
-            from ecofmaps.io.recordings import RecordingError
+            from ecofmaps.io.recording_types import RecordingError
 
             text = data[: error.start].decode("utf-16", errors="replace")
             raise RecordingError(
@@ -162,7 +162,7 @@ class _Layout:
     """What the header says: separator, names, the columns wanted and their scales."""
 
     def __init__(self, path: Path, header_line: int, header: str, options: dict):
-        from ecofmaps.io.recordings import RecordingError
+        from ecofmaps.io.recording_types import RecordingError
 
         self.path = path
         self.header_line = header_line
@@ -221,7 +221,7 @@ class _Layout:
 
     def field_error(self, lines: list[str], numbers) -> None:
         """Raise for the first line whose number of cells is not the header's."""
-        from ecofmaps.io.recordings import RecordingError
+        from ecofmaps.io.recording_types import RecordingError
 
         for line, number in zip(lines, numbers, strict=True):
             count = len(_fields(line, self.separator))
@@ -246,7 +246,7 @@ class _Layout:
         blank, a cell that is not a number, a missing sample to raise for, a byte that is
         not UTF-8), for the caller to drop blank and comment lines and call again with the
         text ``lines`` kept, which are then checked one by one and the error raised."""
-        from ecofmaps.io.recordings import RecordingError
+        from ecofmaps.io.recording_types import RecordingError
 
         careful = lines is not None
         raw = isinstance(body, bytes)
@@ -363,7 +363,7 @@ def text_blocks(path: Path, options: dict, block_bytes: int = BLOCK_BYTES):
         For a missing or doubtful column, a line with the wrong number of fields, a cell
         that is not a number (or, with ``nan_policy='raise'``, a missing one), or no data.
     """
-    from ecofmaps.io.recordings import RecordingError
+    from ecofmaps.io.recording_types import RecordingError
 
     decoder = _Decoder(path)
     layout = None

@@ -55,7 +55,15 @@ ENVIRONMENT_VARIABLE = "ECOFMAPS_CACHE"
 _KEY_ATTRIBUTE = "ecofmaps_cache_key"
 _CHECKSUM_ATTRIBUTE = "ecofmaps_data_sha256"
 # The sources, relative to the package, whose code decides what a cached map holds.
-_MODEL_SOURCES = ("model/*.py", "maps/grid.py", "_nomenclature.py", "paper.py")
+_MODEL_SOURCES = (
+    "model/*.py",
+    "maps/grid.py",
+    "maps/tiles.py",
+    "maps/dataset.py",
+    "maps/on_profile.py",
+    "_nomenclature.py",
+    "paper.py",
+)
 # Length of the key in file names: 128 bits of the hash.
 _NAME_DIGITS = 32
 _ENTRY = re.compile(rf"^(?P<function>[A-Za-z_][A-Za-z0-9_]*)-[0-9a-f]{{{_NAME_DIGITS}}}\.nc$")

@@ -45,7 +45,7 @@ def _threads():
     The temporary output is removed only after this, so that no task still writes into
     it (or creates it again) after an interrupt.
     """
-    from ecofmaps.maps.grid import _workers
+    from ecofmaps.maps.tiles import _workers
 
     pool = concurrent.futures.ThreadPoolExecutor(_workers())
     try:

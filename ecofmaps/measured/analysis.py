@@ -83,270 +83,20 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from ecofmaps import _nomenclature as nomenclature
-from ecofmaps._codes import warn
 from ecofmaps._inputs import check, si_units
-from ecofmaps._interrupts import check_interrupted
-from ecofmaps.measured.branches import (
-    both,
-    branch_rows,
-    line_crossings,
-    stick_lines,
-    zero_force_crossings,
-)
-from ecofmaps.measured.centring import loop_blocks
-from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles, find_cycles
-from ecofmaps.measured.quality import (
-    ALL,
-    ANTICLOCKWISE_SHARE,
-    REASONS,
-    LoopQualityWarning,
-    apply_quality,
-    quality_strings,
-    summary_of_counts,
-)
+from ecofmaps.measured.cycles import MIN_SAMPLES, find_cycles
+from ecofmaps.measured.per_cycle import GROSS_SLIP_THRESHOLD, measure_cycles
+from ecofmaps.measured.results import Tally, cycle_results, with_loops, with_read_along_stroke
 from ecofmaps.measured.samples import is_lazy
-from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP, Regime
 
 __all__ = [
-    "GROSS_SLIP_THRESHOLD",
     "NAN_POLICIES",
     "MissingSampleError",
-    "Tally",
     "analyze_loops",
-    "cycle_results",
-    "measure_cycles",
 ]
 
 #: What :func:`analyze_loops` does with missing samples: skip their cycles, or raise.
 NAN_POLICIES = ("skip", "raise")
-
-#: Energy ratio :math:`A = E_d/(4\Delta^* Q^*)` above which a loop is gross slip (the
-#: sliding transition of Fouvry, Kapsa and Vincent).
-GROSS_SLIP_THRESHOLD = 0.2
-
-#: The per-cycle quantities, in the Dataset's order.
-_PER_CYCLE = (
-    "amplitude",
-    "slip_amplitude",
-    "max_force",
-    "dissipated_energy",
-    "ecof",
-    "cof_max",
-    "energy_ratio",
-    "stiffness",
-    "gicof",
-    "gicof_forward",
-    "gicof_backward",
-    "crossing_displacement_forward",
-    "crossing_displacement_backward",
-    "displacement_offset",
-    "force_offset",
-    "stick_residual",
-)
-
-#: How the quantities are measured on a loop (the netCDF ``comment`` attribute).
-_COMMENTS = {
-    "slip_amplitude": "half the loop's width at Q = 0",
-    "dissipated_energy": "the loop's area",
-    "stiffness": "slope of the stick segments",
-    "regime": "GROSS_SLIP when the energy ratio exceeds gross_slip_threshold, else NO_GROSS_SLIP "
-    "(partial slip); INVALID where the cycle is refused",
-    "quality": "'ok' or the reasons for NaN, joined by '+' (ecofmaps.measured.quality)",
-}
-
-#: A stick segment must explain all but this share of the displacement's variance along it.
-_UNEXPLAINED = 0.2
-
-#: Plausible displacement amplitudes: outside this range the unit is probably wrong. [m]
-_AMPLITUDE_RANGE = (0.1e-6, 10e-3)
-
-
-def _attrs(name: str) -> dict:
-    attrs = nomenclature.attrs(name)
-    if name in _COMMENTS:
-        attrs["comment"] = _COMMENTS[name]
-    return attrs
-
-
-def _loop_values(block, load, options):
-    """Every per-cycle quantity of a block of centred loops, and the checks it failed.
-
-    Returns the quantities (module notes; not yet NaN where a check fails) and the flags
-    of :data:`ecofmaps.measured.quality.REASONS` (reason -> per cycle).
-    """
-    x, y = block.displacement, block.force
-    highest, lowest = block.extremes(x)
-    span = highest - lowest
-    amplitude = 0.5 * span
-    max_force = 0.5 * np.subtract(*block.extremes(y))
-    # The loop's area by trapezoids, the segment that closes it included.
-    first, last = block.offset, block.offset + block.count - 1
-    closing = (y[first] + y[last]) * (x[first] - x[last])
-    energy = 0.5 * (block.sums((y[1:] + y[:-1]) * np.diff(x)) + closing)
-    bx, by, valid, length = branch_rows(block, block.first_point(x, highest))
-    compliance, intercept, stick, fit = stick_lines(bx, by, valid, span, options["stick_window"])
-    crossing, zero_on_loop = zero_force_crossings(
-        bx, by, valid, length, max_force, stick, intercept, span
-    )
-    cycles = block.count.size
-    slip = 0.5 * (crossing[cycles:] - crossing[:cycles])
-    half_width = options["crossing_window"] * np.abs(slip)
-    at, force, on_loop = line_crossings(
-        bx, by, valid, length, both(compliance), both(half_width), load, both(max_force)
-    )
-    energy_ratio = energy / (4.0 * amplitude * max_force)
-    values = {
-        "amplitude": amplitude,
-        "slip_amplitude": slip,
-        "max_force": max_force,
-        "dissipated_energy": energy,
-        "ecof": energy / (4.0 * load * slip),
-        "cof_max": max_force / load,
-        "energy_ratio": energy_ratio,
-        "stiffness": 1.0 / (compliance + 0.0),  # + 0.0: a rigid rig is +inf, not -inf
-        "gicof": (force[:cycles] - force[cycles:]) / (2.0 * load),
-        "gicof_forward": force[:cycles] / load,
-        "gicof_backward": -force[cycles:] / load,
-        "crossing_displacement_forward": at[:cycles],
-        "crossing_displacement_backward": at[cycles:],
-        "displacement_offset": block.displacement_centre,
-        "force_offset": block.force_centre,
-        "stick_residual": fit["residual"],
-    }
-    rounding = 1e-9
-    anticlockwise = energy_ratio < -ANTICLOCKWISE_SHARE
-    flags = {
-        "few-samples": block.count < MIN_SAMPLES,
-        "constant-force": ~(block.force_swing > 0.0),
-        # A cycle cut at the reversals cannot turn back by more than the band: that
-        # would have been a reversal.
-        "several-loops": np.zeros(cycles, dtype=bool)
-        if block.continuous
-        else _turns_back(bx, options["hysteresis"] * span),
-        "anticlockwise": anticlockwise,
-        "energy-ratio-above-1": energy_ratio > 1.0 + rounding,
-        "negative-stiffness": compliance < 0.0,
-        "no-stick": (~(fit["unexplained"] <= _UNEXPLAINED) & ~np.isinf(values["stiffness"]))
-        | np.isnan(compliance),  # a rigid rig's vertical stick sides explain all but 0/0
-        "negative-area": (energy_ratio < 0.0) & ~anticlockwise,
-        "negative-slip": ~(slip > 0.0),
-        "no-zero-crossing": ~(zero_on_loop[:cycles] & zero_on_loop[cycles:]),
-        "curved-stick": fit["curved"],
-        "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]),
-        "not-gross-slip": ~(energy_ratio > options["gross_slip_threshold"]),
-    }
-    return values, flags
-
-
-def _turns_back(x, band):
-    """True for the cycles whose displacement turns back within a branch by more than
-    ``band``: the rising branches (the first half of the rows) fall below their running
-    maximum, or the falling ones rise above their running minimum (the rows' padding
-    repeats their last point, which changes neither)."""
-    cycles = band.size
-    rising, falling = x[:cycles], x[cycles:]
-    drop = np.max(np.maximum.accumulate(rising, axis=1) - rising, axis=1)
-    rise = np.max(falling - np.minimum.accumulate(falling, axis=1), axis=1)
-    return np.maximum(drop, rise) > band
-
-
-def measure_cycles(
-    cycles: Cycles,
-    displacement,
-    force,
-    load,
-    *,
-    hysteresis=0.5,
-    stick_window=(0.05, 0.45),
-    crossing_window=0.7,
-    gross_slip_threshold=GROSS_SLIP_THRESHOLD,
-    flip_force=False,
-    rows=None,
-    keep_loops=False,
-):
-    """The per-cycle quantities of :func:`analyze_loops` for cycles already found.
-
-    Parameters
-    ----------
-    cycles : Cycles
-        Cycles of the recording (:func:`ecofmaps.measured.cycles.find_cycles`).
-    displacement, force : numpy.ndarray
-        The recording, float64; NaN only in the cycles marked missing. Any object that
-        gives stretches of it by sample index (``displacement[a:b]``) will do. [m], [N]
-    load : float
-        Normal load :math:`P`. [N]
-    hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
-        As for :func:`analyze_loops` (not checked here).
-    rows : slice, optional
-        Consecutive cycles to measure; default all.
-    keep_loops : bool
-        Also return the centred loops as NaN-padded (cycle, point) arrays.
-
-    Returns
-    -------
-    values : dict of str to numpy.ndarray
-        Each quantity of :func:`analyze_loops` over the cycles, offsets and stick residual
-        included, as measured: not yet NaN where a check fails.
-    flags : dict of str to numpy.ndarray of bool
-        The checks of :data:`ecofmaps.measured.quality.REASONS` each cycle failed.
-    loops : tuple of numpy.ndarray or None
-        Centred displacement and force round each loop, if ``keep_loops``. [m], [N]
-    """
-    first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
-    options = {
-        "hysteresis": hysteresis,
-        "stick_window": stick_window,
-        "crossing_window": crossing_window,
-        "gross_slip_threshold": gross_slip_threshold,
-    }
-    values = {name: np.full(stop - first, np.nan) for name in _PER_CYCLE}
-    flags = {reason: np.zeros(stop - first, dtype=bool) for reason in REASONS}
-    if cycles.missing is not None:  # not measured: their values stay NaN
-        flags["missing-samples"] = cycles.missing[first:stop].copy()
-    loops = None
-    if keep_loops:
-        width = int(cycles.count[first:stop].max()) + 1
-        loops = tuple(np.full((stop - first, width), np.nan) for _ in range(2))
-    sign = -1.0 if flip_force else 1.0
-    blocks = loop_blocks(cycles, displacement, force, slice(first, stop), sign)
-    with np.errstate(divide="ignore", invalid="ignore"):  # degenerate cycles give NaN
-        for block in blocks:
-            check_interrupted()
-            out = slice(block.rows.start - first, block.rows.stop - first)
-            computed, failed = _loop_values(block, load, options)
-            for name, value in computed.items():
-                values[name][out] = value
-            for reason, flag in failed.items():
-                flags[reason][out] = flag
-            if keep_loops:
-                for loop, centred in zip(loops, block.loops(loops[0].shape[1]), strict=True):
-                    loop[out] = centred
-    return values, flags, loops
-
-
-def _refusal_hint(flags: dict) -> str:
-    """What the user may do about a recording whose every cycle is refused (``flags``:
-    whether every cycle, or any for ``negative-stiffness``, carries the reason)."""
-    if flags["missing-samples"]:
-        return "Every cycle holds a missing sample (NaN or an empty cell)."
-    if flags["anticlockwise"]:
-        if flags["negative-stiffness"]:
-            return (
-                "The loops run anticlockwise with stick sides sloping down: the force is "
-                "recorded positive against the displacement. If so, read it with the other "
-                "sign: flip_force=True (on the command line, --flip-force)."
-            )
-        return (
-            "The loops run anticlockwise with stick sides sloping up: the recording runs "
-            "backwards in time, or the displacement and force columns are swapped."
-        )
-    if flags["constant-force"]:
-        return "The force does not vary: is the force channel connected?"
-    return (
-        "Is it a recording of fretting loops, with the displacement and the force in their "
-        "own columns?"
-    )
 
 
 # --- the public function ------------------------------------------------------------------
@@ -537,6 +287,12 @@ def analyze_loops(
     (:mod:`ecofmaps.measured.out_of_core`). The results are those of the same recording in
     memory.
 
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 1, 9, 10, 17-18.
+
     Examples
     --------
     >>> import numpy as np, ecofmaps
@@ -611,22 +367,6 @@ def analyze_loops(
     return results
 
 
-def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
-    """``results`` with the centred loops of :func:`measure_cycles` (``keep_loops=True``)."""
-    results["loop_displacement"] = (("cycle", "point"), loops[0], _attrs("loop_displacement"))
-    results["loop_force"] = (("cycle", "point"), loops[1], _attrs("loop_force"))
-    results.coords["point"] = ("point", np.arange(loops[0].shape[1]), _attrs("point"))
-    return results
-
-
-def with_read_along_stroke(results: xr.Dataset) -> xr.Dataset:
-    """``results`` (with its loops) with the values read along the stroke
-    (:data:`ecofmaps.measured.resolved.REPORTED`), and that reading's quality."""
-    from ecofmaps.measured.resolved import resolve_analyzed_loops, with_resolved  # built on this
-
-    return with_resolved(results, resolve_analyzed_loops(results, positions=None))
-
-
 def no_cycle_error(samples: int) -> ValueError:
     """The error for a recording without a complete cycle."""
     return ValueError(
@@ -654,129 +394,3 @@ def runner_for(scheduler, workers):
     if isinstance(scheduler, str):
         return Runner(scheduler=scheduler)
     return Runner(client=scheduler)
-
-
-def cycle_results(values: dict, flags: dict, label, load: float, options: dict) -> xr.Dataset:
-    """The per-cycle Dataset of :func:`analyze_loops` for some cycles, without the
-    recording's attributes: ``values`` and ``flags`` from :func:`measure_cycles`.
-
-    The raw amplitudes and whether each cycle is refused ride along as ``_amplitude`` and
-    ``_refused`` until :meth:`Tally.finish` takes them off.
-    """
-    size = label.size
-    quality = quality_strings(flags, size)
-    refused = np.zeros(size, dtype=bool)
-    for reason, flag in flags.items():
-        refused |= flag & (REASONS[reason][1] == ALL)
-    raw_amplitude = values["amplitude"]
-    values = apply_quality(values, flags)
-    sliding = values["energy_ratio"] > options["gross_slip_threshold"]
-    regime = np.where(refused, INVALID, np.where(sliding, GROSS_SLIP, NO_GROSS_SLIP))
-    names = [name for name in values if name != "stick_residual"]
-    data = {name: ("cycle", values[name], _attrs(name)) for name in names}
-    data["regime"] = ("cycle", regime.astype(np.int32), _attrs("regime") | Regime.flag_attrs())
-    data["stick_residual"] = ("cycle", values["stick_residual"], _attrs("stick_residual"))
-    data["quality"] = ("cycle", quality, _attrs("quality"))
-    data["_amplitude"] = ("cycle", raw_amplitude)
-    data["_refused"] = ("cycle", refused)
-    hints = {
-        "missing-samples": flags["missing-samples"],
-        "anticlockwise": flags["anticlockwise"],
-        "constant-force": flags["constant-force"],
-    }
-    for reason, flag in hints.items():
-        data[f"_{reason}"] = ("cycle", flag)
-    data["_negative-stiffness"] = ("cycle", flags["negative-stiffness"])
-    coords = {"cycle": ("cycle", label, _attrs("cycle")), "load": ((), load, _attrs("load"))}
-    return xr.Dataset(data, coords=coords)
-
-
-class Tally:
-    """What :func:`analyze_loops` says about a whole recording, gathered from its parts
-    (:func:`cycle_results`) as they come: the quality summary, whether every cycle was
-    refused, and the typical amplitude."""
-
-    def __init__(self):
-        self.counts: dict = {}
-        self.cycles = self.refused = self.flagged = 0
-        self.every = {"missing-samples": True, "anticlockwise": True, "constant-force": True}
-        self.negative_stiffness = False
-        self.amplitudes: list = []
-
-    def add(self, part: xr.Dataset) -> xr.Dataset:
-        """Count the cycles of ``part``; return it without its riders."""
-        texts, counts = np.unique(part.quality.values, return_counts=True)
-        for text, count in zip(texts.tolist(), counts.tolist(), strict=True):
-            self.counts[text] = self.counts.get(text, 0) + count
-            if text not in ("ok", "not-gross-slip"):
-                self.flagged += count
-        self.cycles += part.cycle.size
-        self.refused += int(part["_refused"].sum())
-        for reason in self.every:
-            self.every[reason] &= bool(part[f"_{reason}"].all())
-        self.negative_stiffness |= bool(part["_negative-stiffness"].any())
-        self.amplitudes.append(part["_amplitude"].values)
-        return strip(part)
-
-    @property
-    def summary(self) -> str:
-        """The one-line quality summary so far."""
-        return summary_of_counts(self.counts)
-
-    def finish(self, results, cycles: Cycles, cycles_from: str, options: dict) -> xr.Dataset:
-        """Check the whole recording and give ``results`` (the parts, joined) its
-        attributes.
-
-        Raises
-        ------
-        ValueError
-            If every cycle was refused.
-        """
-        summary = self.summary
-        _check_units(np.concatenate(self.amplitudes) if self.amplitudes else np.zeros(0))
-        if self.cycles and self.refused == self.cycles:
-            hint = dict(self.every, **{"negative-stiffness": self.negative_stiffness})
-            raise ValueError(
-                f"no plausible cycle in the recording ({summary}). {_refusal_hint(hint)}"
-            )
-        if self.flagged:
-            warn(f"cycles flagged: {summary}", LoopQualityWarning)
-        results = strip(results)
-        results.attrs.update(
-            {
-                "title": "Fretting loops analysed cycle by cycle (ecofmaps.analyze_loops)",
-                "cycles_from": cycles_from,
-                "incomplete_cycles": cycles.incomplete_cycles,
-                "dropped_samples": cycles.dropped_samples,
-                "missing_samples": cycles.missing_samples,
-                "first_missing_sample": cycles.first_missing,
-                "skipped_cycles": int(self.counts_of("missing-samples")),
-                "gross_slip_threshold": options["gross_slip_threshold"],
-                "flip_force": int(options["flip_force"]),
-                "quality_summary": summary,
-            }
-        )
-        return results
-
-    def counts_of(self, reason: str) -> int:
-        """Cycles whose quality lists ``reason``."""
-        return sum(c for text, c in self.counts.items() if reason in text.split("+"))
-
-
-def strip(part: xr.Dataset) -> xr.Dataset:
-    """``part`` without the riders of :func:`cycle_results`."""
-    return part.drop_vars([name for name in part.data_vars if str(name).startswith("_")])
-
-
-def _check_units(amplitude):
-    """Warn when the displacement amplitudes look like another unit than metres."""
-    finite = amplitude[np.isfinite(amplitude)]
-    typical = float(np.median(finite)) if finite.size else np.nan
-    low, high = _AMPLITUDE_RANGE
-    if np.isfinite(typical) and not low <= typical <= high:
-        warn(
-            f"the displacement amplitude is {typical:.3g} m (median over the cycles), outside "
-            "0.1 µm to 10 mm: is the displacement in metres? analyze_loops takes SI units; "
-            "on the command line, --displacement-unit gives the unit of the column",
-            LoopQualityWarning,
-        )

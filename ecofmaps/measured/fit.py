@@ -18,8 +18,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from ecofmaps._inputs import check, float64
-from ecofmaps.measured.analysis import measure_cycles
 from ecofmaps.measured.cycles import MIN_SAMPLES, find_cycles
+from ecofmaps.measured.per_cycle import measure_cycles
 from ecofmaps.measured.quality import ALL, ANTICLOCKWISE_SHARE, REASONS, SEPARATOR
 from ecofmaps.model.core import slip_position, traction_ratio
 from ecofmaps.model.simulation import fretting_loop
@@ -285,6 +285,12 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
     :math:`\Delta - Q/S` on the slip segments for :math:`\mu` and the groove slope.
     The paper sets :math:`\mu` to the loop's GICoF and reads :math:`S` off the loop
     (Section 4.2, Figure 10); for a loop of the model both equal the fitted values.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 10, 16.
     """
     check("load", load, "positive", "N")
     if np.ndim(load) != 0:

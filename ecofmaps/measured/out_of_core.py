@@ -12,7 +12,7 @@ steps that a caller can follow (the command line writes each block's results as 
    cycle is cut at a task's edge. Each task reads the stretch of its cycles and of two
    whole cycles on either side (a *halo*: the centring interpolates each cycle's centre
    from its neighbours', :mod:`ecofmaps.measured.centring`) and measures its cycles with
-   :func:`ecofmaps.measured.analysis.measure_cycles`, with the sample indices of the whole
+   :func:`ecofmaps.measured.per_cycle.measure_cycles`, with the sample indices of the whole
    recording. So every number is computed from the same samples, with the same arithmetic,
    as in memory; only sums over a loop's padded rows may be grouped differently (to the
    last bits).
@@ -31,21 +31,19 @@ import itertools
 import numpy as np
 import xarray as xr
 
-from ecofmaps.measured.analysis import (
-    MissingSampleError,
+from ecofmaps.measured.analysis import MissingSampleError, _missing_error, no_cycle_error
+from ecofmaps.measured.cycles import Cycles, find_cycles
+from ecofmaps.measured.per_cycle import measure_cycles
+from ecofmaps.measured.quality import quality_summary
+from ecofmaps.measured.resolved import REPORTED
+from ecofmaps.measured.resolved import _attrs as _read_attrs
+from ecofmaps.measured.results import (
     Tally,
-    _missing_error,
     cycle_results,
-    measure_cycles,
-    no_cycle_error,
     strip,
     with_loops,
     with_read_along_stroke,
 )
-from ecofmaps.measured.cycles import Cycles, find_cycles
-from ecofmaps.measured.quality import quality_summary
-from ecofmaps.measured.resolved import REPORTED
-from ecofmaps.measured.resolved import _attrs as _read_attrs
 
 __all__ = ["HALO", "TASK_SAMPLES", "LongAnalysis", "MissingSampleError"]
 
@@ -119,7 +117,7 @@ class LongAnalysis:
     cycles : Cycles
     tasks : list of slice
         The rows (cycles) of each task, in order.
-    tally : ecofmaps.measured.analysis.Tally
+    tally : ecofmaps.measured.results.Tally
         What the parts given out so far add up to.
 
     Raises
@@ -198,7 +196,7 @@ class LongAnalysis:
             The task (index into :attr:`tasks`).
         values, flags : dict of str to numpy.ndarray
             Its cycles' quantities and checks, from
-            :func:`~ecofmaps.measured.analysis.measure_cycles` (:meth:`part` makes the
+            :func:`~ecofmaps.measured.per_cycle.measure_cycles` (:meth:`part` makes the
             results of them).
         """
         skip = set(skip)
@@ -229,7 +227,7 @@ class LongAnalysis:
 
     def finish(self, results: xr.Dataset) -> xr.Dataset:
         """The joined parts (all of them, in order) with the recording's attributes, after
-        the checks of the whole recording (see :meth:`ecofmaps.measured.analysis.Tally.finish`)."""
+        the checks of the whole recording (see :meth:`ecofmaps.measured.results.Tally.finish`)."""
         results = self.tally.finish(results, self.cycles, self.cycles_from, self.options)
         if self.resolve:  # the summary of the reading's quality, as with_resolved gives it
             results.attrs["quality_summary"] = quality_summary(results["quality"].values)

@@ -111,6 +111,12 @@ def synthetic_recording(
     :func:`ecofmaps.simulate`'s stick/slip history for it (eq. 9, 10), which does not
     depend on the sampling. The noise, offsets and drift are added to the recorded
     signals only, as a sensor would.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 10.
     """
     ratio = np.atleast_1d(np.asarray(aspect_ratio, dtype=np.float64))
     if ratio.ndim != 1:
@@ -294,6 +300,12 @@ def long_recording(cycles, samples_per_cycle=200, *, block_cycles=4096, seed=0, 
     as in :func:`example_recording`; each block is :func:`synthetic_recording`'s steady
     loops (eq. 9, 10) from zero displacement on the rise, with its offset advanced by the
     drift so far, so the drift runs on without a step from block to block.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 10.
     """
     unknown = set(parameters) - set(LONG_TEST)
     if unknown:

@@ -18,14 +18,13 @@ from ecofmaps.model.core import (
     slip_ratio,
     traction_ratio,
 )
-from ecofmaps.model.profiles import (
-    ScarProfile,
+from ecofmaps.model.profile_families import (
     flat_bottomed_profile,
     parabolic_profile,
     ridged_profile,
-    scar_profile,
     w_shaped_profile,
 )
+from ecofmaps.model.profiles import ScarProfile, scar_profile
 from ecofmaps.model.regimes import (
     BEYOND_PROFILE,
     GROSS_SLIP,

@@ -63,6 +63,12 @@ def curvature_number(length, aspect_ratio, groove_half_width):
     -------
     kappa : jax.Array
         The groove slope at :math:`x = L`, eq. 7. [1]
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 7.
     """
     return 2.0 * aspect_ratio * length / groove_half_width
 
@@ -107,6 +113,12 @@ def traction_ratio(position, mu, kappa, direction=1.0):
     -------
     q : jax.Array
         :math:`Q/P`; infinite at the locking point :math:`s\mu\kappa\xi = 1`. [1]
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9.
     """
     slope = kappa * position
     return (direction * mu + slope) / (1.0 - direction * mu * slope)
@@ -156,6 +168,12 @@ def slip_position(target, mu, kappa, lam):
     xi : jax.Array
         The contact position :math:`x/L`; it equals the locking point :math:`1/(\mu\kappa)`
         when a rigid rig (``lam = 0``) is pushed beyond it. [1]
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 10, 16.
     """
     return _slip_roots(target, mu, kappa, lam)[0]
 
@@ -181,6 +199,12 @@ def locking_margin(target, mu, kappa, lam):
     -------
     w : jax.Array
         In :math:`(0, \infty)`; 0 at or beyond the locking point of a rigid rig. [1]
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 16.
     """
     return _slip_roots(target, mu, kappa, lam)[1]
 
@@ -199,6 +223,12 @@ def regime_code(mu, kappa, lam):
         ``INVALID`` for inputs out of range or NaN; else ``NO_GROSS_SLIP`` where
         :math:`\mu\lambda \ge 1`; ``SELF_LOCKING`` where :math:`\lambda = 0` and
         :math:`\mu\kappa \ge 1`; ``GROSS_SLIP`` elsewhere.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 16.
     """
     valid = (
         (mu > 0.0)
@@ -230,6 +260,12 @@ def slip_ratio(mu, kappa, lam):
     d : jax.Array
         In :math:`(0, 1]` in gross slip, 0 with no gross slip, NaN when self-locking or
         invalid. Flat groove: :math:`1 - \mu\lambda`; rigid rig: 1. [1]
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 16.
     """
     code = regime_code(mu, kappa, lam)
     d = slip_position(1.0, mu, kappa, lam)
@@ -280,6 +316,12 @@ def ecof_ratio(mu, kappa, lam):
     ratio : jax.Array
         :math:`\ge 1`; exactly 1 for a flat groove; NaN with no gross slip, when
         self-locking, or for invalid input. [1]
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 1, 13-15, 16.
     """
     d = slip_ratio(mu, kappa, lam)
     excess = _artanh_excess(mu * kappa * d, locking_margin(1.0, mu, kappa, lam))
@@ -300,6 +342,12 @@ def normalized_max_force(mu, kappa, lam):
     q_max : jax.Array
         :math:`Q_+(\delta^*)/P` in gross slip; :math:`1/\lambda` (the stick line at
         :math:`\Delta^*`) with no gross slip; NaN when self-locking or invalid. [1]
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 16.
     """
     d = slip_ratio(mu, kappa, lam)
     stick = d == 0.0
@@ -319,6 +367,12 @@ def normalized_energy(mu, kappa, lam):
     -------
     e : jax.Array
         :math:`E_d/(P\Delta^*)`; 0 with no gross slip; NaN when self-locking or invalid. [1]
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 1, 12.
     """
     d = slip_ratio(mu, kappa, lam)
     energy = 4.0 * d * mu * ecof_ratio(mu, kappa, lam)

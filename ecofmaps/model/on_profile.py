@@ -1,6 +1,6 @@
 r"""The model on a scar profile in SI units: steady loops, drawn loops and time histories.
 
-:func:`steady_numbers` evaluates the steady loop of :mod:`ecofmaps.model.profile_core` at
+:func:`steady_numbers` evaluates the steady loop of :mod:`ecofmaps.model.first_passage` at
 any broadcast set of points. Points that share :math:`\mu` and the stroke length
 :math:`A = \Delta^*W/x_o` (all of them when :math:`x_o = \Delta^*`, whatever the
 amplitude, load and stiffness) share one set of tables, built once, and cost
@@ -21,6 +21,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ecofmaps._inputs import as_float64, check, is_concrete
+from ecofmaps.model import first_passage
 from ecofmaps.model import profile_core as core
 from ecofmaps.model.profiles import ScarProfile
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
@@ -131,9 +132,9 @@ def _jumps(tables, group, lam, ends):
     n = tables.forward.position.shape[-1]
     mu = tables.mu[group]
     lower, upper = ends
-    forward = core.jump_area(tables.forward, group, mu, lam, lower, upper)
-    mirrored = (core._mirror(*upper, n), core._mirror(*lower, n))
-    return forward + core.jump_area(tables.backward, group, mu, lam, *mirrored)
+    forward = first_passage.jump_area(tables.forward, group, mu, lam, lower, upper)
+    mirrored = (first_passage._mirror(*upper, n), first_passage._mirror(*lower, n))
+    return forward + first_passage.jump_area(tables.backward, group, mu, lam, *mirrored)
 
 
 @partial(jax.jit, static_argnames=("physical", "sparse"))
@@ -151,7 +152,7 @@ def _shared_tables(position, slope, half_width, mu, key, physical, sparse):
 @jax.jit
 def _shared_loops(tables, group, lam):
     """Steady loops of points in groups with shared sparse tables."""
-    return jax.vmap(core.steady_loop, in_axes=(None, 0, 0, None))(tables, group, lam, True)
+    return jax.vmap(first_passage.steady_loop, in_axes=(None, 0, 0, None))(tables, group, lam, True)
 
 
 @jax.jit
@@ -164,7 +165,7 @@ def _own_loop(position, slope, half_width, physical, point):
     """One point with its own O(N) tables, jumps included."""
     mu, key, lam = point
     tables = core.profile_tables(position, slope, mu, _stroke(half_width, key, physical), False)
-    loop = core.steady_loop(tables, 0, lam, False)
+    loop = first_passage.steady_loop(tables, 0, lam, False)
     return loop, _jumps(tables, 0, lam, loop.ends)
 
 
@@ -334,8 +335,8 @@ def steady_numbers(profile, amplitude, load, stiffness, mu, groove_half_width=No
 def _drawn(position, slope, half_width, physical, num, point):
     mu, key, lam = point
     tables = core.profile_tables(position, slope, mu, _stroke(half_width, key, physical), False)
-    loop = core.steady_loop(tables, 0, lam, False)
-    actuator, force = core.draw_loop(tables, 0, lam, loop, num)
+    loop = first_passage.steady_loop(tables, 0, lam, False)
+    actuator, force = first_passage.draw_loop(tables, 0, lam, loop, num)
     ok = (loop.regime == int(GROSS_SLIP)) | (loop.regime == int(NO_GROSS_SLIP))
     return jnp.where(ok, actuator, jnp.nan), jnp.where(ok, force, jnp.nan)
 
@@ -370,9 +371,9 @@ def profile_loop(profile, amplitude, load, stiffness, mu, groove_half_width, map
 def _history(position, slope, history):
     """Q/P over a history of D for one (mu, lam): the return map from rest at the centre."""
     mu, lam, targets = history
-    tables = core.simulation_tables(position, slope, mu, lam)
+    tables = first_passage.simulation_tables(position, slope, mu, lam)
     start = (tables.start_segment[0], tables.start_fraction[0], jnp.zeros(()), jnp.array(False))
-    _, q = jax.lax.scan(partial(core.simulation_step, tables, lam), start, targets)
+    _, q = jax.lax.scan(partial(first_passage.simulation_step, tables, lam), start, targets)
     return q
 
 

@@ -8,9 +8,7 @@ a batch that ``jax.vmap`` maps over.
 
 Profiles come from measured arrays (:func:`scar_profile`; files are read by
 :func:`ecofmaps.read_scar_profile`) or from the analytic families used in studies
-(:func:`parabolic_profile`, :func:`flat_bottomed_profile`, :func:`w_shaped_profile`,
-:func:`ridged_profile`), each built from :math:`(D, W)` and shape parameters, with an
-optional tilt.
+(:mod:`ecofmaps.model.profile_families`).
 
 The slope between samples
 -------------------------
@@ -70,11 +68,7 @@ __all__ = [
     "AUTO_SMOOTHING",
     "MIN_SCAR_SAMPLES",
     "ScarProfile",
-    "flat_bottomed_profile",
-    "parabolic_profile",
-    "ridged_profile",
     "scar_profile",
-    "w_shaped_profile",
 ]
 
 #: Default smoothing length as a fraction of the scar's half-width. [1]
@@ -165,228 +159,6 @@ def _profile(position, height, slope, depth, half_width, worn_area, centre=0.0,
     # not switch it on): without it these arrays would be float32.
     with jax.enable_x64(True):
         return ScarProfile(*(jnp.asarray(v, dtype=jnp.float64) for v in values))
-
-
-# ---------------------------------------------------------------------------------------
-# Analytic families
-# ---------------------------------------------------------------------------------------
-
-
-def _positive(name: str, value) -> float:
-    value = float(value)
-    if not (np.isfinite(value) and value > 0.0):
-        raise ValueError(f"{name} must be finite and > 0, got {value!r}")
-    return value
-
-
-def _fraction(name: str, value, low=0.0, high=1.0) -> float:
-    value = float(value)
-    if not (np.isfinite(value) and low <= value < high):
-        raise ValueError(f"{name} must satisfy {low} <= {name} < {high}, got {value!r}")
-    return value
-
-
-def _grid(breakpoints, samples: int) -> np.ndarray:
-    """Exactly ``samples`` positions, about evenly spread, with every breakpoint among them."""
-    if not (isinstance(samples, int | np.integer) and samples >= 2 * MIN_SCAR_SAMPLES):
-        raise ValueError(f"samples must be an integer >= {2 * MIN_SCAR_SAMPLES}, got {samples!r}")
-    breakpoints = np.unique(np.asarray(breakpoints, dtype=np.float64))
-    # Breakpoints closer than 1e-9 of the span (a flat bottom of nearly zero width) merge.
-    tolerance = 1e-9 * (breakpoints[-1] - breakpoints[0])
-    kept = [breakpoints[0]]
-    for point in breakpoints[1:-1]:
-        if point - kept[-1] > tolerance and breakpoints[-1] - point > tolerance:
-            kept.append(point)
-    breakpoints = np.array([*kept, breakpoints[-1]])
-    lengths = np.diff(breakpoints)
-    if samples - 1 < 2 * lengths.size:
-        raise ValueError(f"samples must be at least {2 * lengths.size + 1} for this shape")
-    # Intervals per piece: at least 2 each, the rest by largest remainders of the share.
-    share = 2 + (samples - 1 - 2 * lengths.size) * lengths / lengths.sum()
-    counts = np.floor(share).astype(int)
-    counts[np.argsort(counts - share)[: samples - 1 - counts.sum()]] += 1
-    pieces = [breakpoints[:1]]
-    for left, right, count in zip(breakpoints[:-1], breakpoints[1:], counts, strict=True):
-        pieces.append(np.linspace(left, right, count + 1)[1:])
-    return np.concatenate(pieces)
-
-
-def _family(position, height, slope, depth, half_width, tilt):
-    """A profile from the exact heights and slopes of a shape symmetric about X = 0."""
-    tilt = float(tilt)
-    if not np.isfinite(tilt):
-        raise ValueError(f"tilt must be finite, got {tilt!r}")
-    inside = np.abs(position) <= half_width
-    worn = np.trapezoid(np.where(inside, -np.minimum(height, 0.0), 0.0), position)
-    return _profile(position, height + tilt * position, slope + tilt, depth, half_width, worn,
-                    reference_slope=tilt)  # fmt: skip
-
-
-def _extent(extent, needed=1.0) -> float:
-    extent = float(extent)
-    if not (np.isfinite(extent) and extent > needed):
-        raise ValueError(f"extent must be finite and > {needed:g} (half-widths), got {extent!r}")
-    return extent
-
-
-def parabolic_profile(depth, half_width, *, tilt=0.0, samples=2001, extent=2.0) -> ScarProfile:
-    r"""A parabolic scar, the paper's groove: :math:`z = -D(1 - (X/W)^2)` for :math:`|X| \le W`.
-
-    Parameters
-    ----------
-    depth : float
-        Scar depth :math:`D`. [m]
-    half_width : float
-        Scar half-width :math:`W`. [m]
-    tilt : float
-        Slope added to the whole trace, :math:`z + tX` (a tilted specimen). [1]
-    samples : int
-        Number of samples, about evenly spaced, with samples at the edges. [1]
-    extent : float
-        The trace runs from :math:`-\text{extent}\,W` to :math:`\text{extent}\,W`; flat
-        unworn surface outside the scar. [1]
-
-    Returns
-    -------
-    profile : ScarProfile
-        Exact heights and slopes :math:`g = 2DX/W^2` (eq. 7 with :math:`z_o/x_o = D/W`,
-        eq. 11); piecewise linear slopes are exact for it, so the model on this profile
-        reproduces the closed forms with ``aspect_ratio=D/W`` to rounding.
-
-    Examples
-    --------
-    >>> p = parabolic_profile(10e-6, 50e-6)
-    >>> float(p.aspect_ratio)
-    0.2
-    """
-    depth, half_width = _positive("depth", depth), _positive("half_width", half_width)
-    extent = _extent(extent)
-    x = _grid([-extent * half_width, -half_width, 0.0, half_width, extent * half_width], samples)
-    inside = np.abs(x) <= half_width
-    u = x / half_width
-    z = np.where(inside, -depth * (1.0 - u * u), 0.0)
-    g = np.where(inside, 2.0 * depth * u / half_width, 0.0)
-    return _family(x, z, g, depth, half_width, tilt)
-
-
-def flat_bottomed_profile(depth, half_width, flat_fraction=0.5, *, tilt=0.0, samples=2001,
-                          extent=2.0) -> ScarProfile:  # fmt: skip
-    r"""A flat-bottomed (U-shaped) scar: a flat bottom with parabolic walls.
-
-    :math:`z = -D` for :math:`|X| \le a` and :math:`z = -D(1 - s^2)`,
-    :math:`s = (|X| - a)/(W - a)`, for :math:`a < |X| \le W`, with :math:`a = fW`: the walls
-    meet the bottom tangentially (continuous slope) and the unworn surface at the edges.
-
-    Parameters
-    ----------
-    depth, half_width : float
-        :math:`D` and :math:`W`. [m]
-    flat_fraction : float
-        :math:`f = a/W` in ``[0, 1)``: the flat bottom's half-width over the scar's
-        (0 gives the parabola). [1]
-    tilt, samples, extent
-        As for :func:`parabolic_profile`.
-
-    Returns
-    -------
-    profile : ScarProfile
-    """
-    depth, half_width = _positive("depth", depth), _positive("half_width", half_width)
-    flat = _fraction("flat_fraction", flat_fraction) * half_width
-    extent = _extent(extent)
-    edges = [-extent * half_width, -half_width, -flat, 0.0, flat, half_width, extent * half_width]
-    x = _grid(edges, samples)
-    s = np.clip((np.abs(x) - flat) / (half_width - flat), 0.0, None)
-    inside = np.abs(x) <= half_width
-    z = np.where(inside, -depth * (1.0 - s * s), 0.0)
-    g = np.where(inside, 2.0 * depth * s * np.sign(x) / (half_width - flat), 0.0)
-    return _family(x, z, g, depth, half_width, tilt)
-
-
-def w_shaped_profile(depth, half_width, hump=0.25, *, tilt=0.0, samples=2001,
-                     extent=2.0) -> ScarProfile:  # fmt: skip
-    r"""A W-shaped scar: two troughs with a hump between them (the less worn centre).
-
-    The quartic :math:`z = D\left[(u^2 - m^2)^2/(1 - m^2)^2 - 1\right]`, :math:`u = X/W`,
-    for :math:`|u| \le 1`: depth :math:`D` at the troughs :math:`u = \pm m`, zero at the
-    edges, and the hump :math:`hD` above the troughs at the centre, with
-    :math:`m^2 = \sqrt h/(1 + \sqrt h)`.
-
-    Parameters
-    ----------
-    depth, half_width : float
-        :math:`D` and :math:`W`. [m]
-    hump : float
-        :math:`h` in ``[0, 1)``: the hump's height above the troughs over the depth. [1]
-    tilt, samples, extent
-        As for :func:`parabolic_profile`.
-
-    Returns
-    -------
-    profile : ScarProfile
-    """
-    depth, half_width = _positive("depth", depth), _positive("half_width", half_width)
-    hump = _fraction("hump", hump)
-    extent = _extent(extent)
-    m2 = np.sqrt(hump) / (1.0 + np.sqrt(hump))
-    trough = np.sqrt(m2) * half_width
-    edges = [-extent * half_width, -half_width, -trough, 0.0, trough, half_width,
-             extent * half_width]  # fmt: skip
-    x = _grid(edges, samples)
-    u = x / half_width
-    inside = np.abs(u) <= 1.0
-    scale = depth / (1.0 - m2) ** 2
-    z = np.where(inside, scale * (u * u - m2) ** 2 - depth, 0.0)
-    g = np.where(inside, 4.0 * scale * u * (u * u - m2) / half_width, 0.0)
-    return _family(x, z, g, depth, half_width, tilt)
-
-
-def ridged_profile(depth, half_width, ridge_height, ridge_width, *, tilt=0.0, samples=2001,
-                   extent=2.0) -> ScarProfile:  # fmt: skip
-    r"""A parabolic scar with ploughing ridges piled up beside its edges (Figure 1b).
-
-    Inside the edges the parabola of :func:`parabolic_profile`; outside them a ridge
-    :math:`z = H\sin^2(\pi v)`, :math:`v = (|X| - W)/w`, for :math:`0 \le v \le 1`, then the
-    flat unworn surface. The ridge's crest, :math:`H` high at :math:`w/2` beyond the edge,
-    bends the slope down at the rate :math:`2\pi^2 H/w^2`: when the rig's compliance
-    :math:`P/S` times :math:`(1 + \mu^2)` times that rate exceeds 1 (in the units of the
-    mapping), :math:`x + Q_+(x)/S` falls over the crest and the pad jumps across it.
-
-    Parameters
-    ----------
-    depth, half_width : float
-        :math:`D` and :math:`W`. [m]
-    ridge_height : float
-        :math:`H` > 0. [m]
-    ridge_width : float
-        :math:`w` > 0, the ridge's width at its foot; :math:`W + w` must lie inside the
-        trace (``extent``). [m]
-    tilt, samples, extent
-        As for :func:`parabolic_profile`.
-
-    Returns
-    -------
-    profile : ScarProfile
-    """
-    depth, half_width = _positive("depth", depth), _positive("half_width", half_width)
-    height = _positive("ridge_height", ridge_height)
-    width = _positive("ridge_width", ridge_width)
-    extent = _extent(extent, 1.0 + width / half_width)
-    crest = half_width + 0.5 * width
-    foot = half_width + width
-    edges = [-extent * half_width, -foot, -crest, -half_width, 0.0, half_width, crest, foot,
-             extent * half_width]  # fmt: skip
-    x = _grid(edges, samples)
-    u = x / half_width
-    v = (np.abs(x) - half_width) / width
-    inside = np.abs(u) <= 1.0
-    ridge = (v > 0.0) & (v <= 1.0)
-    z = np.where(
-        inside, -depth * (1.0 - u * u), np.where(ridge, height * np.sin(np.pi * v) ** 2, 0.0)
-    )
-    ridge_slope = np.pi * height / width * np.sin(2.0 * np.pi * v) * np.sign(x)
-    g = np.where(inside, 2.0 * depth * u / half_width, np.where(ridge, ridge_slope, 0.0))
-    return _family(x, z, g, depth, half_width, tilt)
 
 
 # ---------------------------------------------------------------------------------------
@@ -615,6 +387,12 @@ def scar_profile(x, z, half_width=None, smoothing=None, level=False) -> ScarProf
     -----
     The edges, the reference line and the smoothing follow the rules of the module
     docstring. The model maps a pad position :math:`x` to :math:`X = xW/x_o` (eq. 11).
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 11.
 
     Examples
     --------

@@ -117,6 +117,12 @@ def fretting_loop(amplitude, load, stiffness, mu, aspect_ratio=None, groove_half
     where the pad jumps (:math:`x + Q_+/S` falls) its points lie on the vertical
     :math:`\Delta = \text{const}`, :math:`Q = S(\Delta - x)`; the branches are not
     mirror images of each other on an asymmetric scar. Points off the trace are NaN.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 10, 11.
     """
     if not isinstance(num, int) or num < 2:
         raise ValueError(f"num must be an integer >= 2, got {num!r}")
@@ -211,7 +217,13 @@ def simulate(displacement, load, stiffness, mu, aspect_ratio=None, groove_half_w
     On a profile the pad starts at rest at the scar centre, and a slip goes to the first
     equilibrium :math:`x' + Q_\pm(x')/S = \Delta` beyond the pad (first passage; where
     :math:`x + Q_+/S` falls the pad jumps), found exactly on the piecewise linear slope
-    (:mod:`ecofmaps.model.profile_core`). A pad that runs off the trace gives NaN.
+    (:mod:`ecofmaps.model.first_passage`). A pad that runs off the trace gives NaN.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 10, 11, 16.
     """
     check("displacement", displacement, "finite", "m")
     if is_concrete(displacement) and jnp.ndim(displacement) == 0:

@@ -196,7 +196,7 @@ _PROFILE_NOTES = """
     On a profile the steady loop's ends solve :math:`x + Q_\\pm(x)/S = \\pm\\Delta^*` by
     first passage from where the last stroke ended, the pad jumping where
     :math:`x + Q_+(x)/S` falls; :math:`\\delta^* = (x_+ - x_-)/2` and :math:`E_d` is the
-    area of the loop the return map draws (:mod:`ecofmaps.model.profile_core`). The regime
+    area of the loop the return map draws (:mod:`ecofmaps.model.first_passage`). The regime
     ``BEYOND_PROFILE`` marks a stroke that runs off the trace.
 """
 
@@ -222,6 +222,12 @@ slip_amplitude.__doc__ = f"""Slip amplitude :math:`\\delta^*` of the steady fret
     see :func:`slip_position`. Flat groove: :math:`\\Delta^* - \\mu P/S`; rigid rig:
     :math:`\\Delta^*`.
 {_PROFILE_NOTES}
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 10, 11, 16.
+
     Examples
     --------
     >>> round(float(slip_amplitude(50e-6, 450.0, 35e6, 0.8, 0.2)) * 1e6, 3)  # Example 2 [um]
@@ -247,7 +253,13 @@ dissipated_energy.__doc__ = f"""Energy dissipated per cycle :math:`E_d`, the loo
     Notes
     -----
     Evaluated as :math:`4 P \\delta^* \\mu_E` with the corrected eq. 14.
-{_PROFILE_NOTES}"""
+{_PROFILE_NOTES}
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 11, 12, 14.
+"""
 
 
 @float64
@@ -271,7 +283,13 @@ energy_cof.__doc__ = f"""Energy coefficient of friction :math:`\\mu_E = E_d/(4P\
     :math:`(x_o^2/2z_o)(1 + 1/\\mu)`; it must be :math:`(x_o^2/2z_o)(1 + 1/\\mu^2)`.
     With :math:`u = \\mu k \\delta^*`, :math:`\\mu_E = \\mu + ((1+\\mu^2)/\\mu)
     (\\operatorname{{artanh}}(u)/u - 1)`, summed as a series at small :math:`u`.
-{_PROFILE_NOTES}"""
+{_PROFILE_NOTES}
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 1, 9, 11, 13-15.
+"""
 
 
 @float64
@@ -291,7 +309,13 @@ max_force.__doc__ = f"""Peak tangential force :math:`Q^*` of the steady loop (eq
         gross slip, the rig's force at :math:`\\Delta^*` on the stuck pad). [N]
 {_RAISES}
     Notes
-    -----{_PROFILE_NOTES}"""
+    -----{_PROFILE_NOTES}
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 11, 16.
+"""
 
 
 @float64
@@ -311,4 +335,10 @@ slip_regime.__doc__ = f"""Regime of each point as :class:`Regime` codes.
         ``BEYOND_PROFILE`` (4). Compare with the :class:`Regime` members.
 {_RAISES}
     Notes
-    -----{_PROFILE_NOTES}"""
+    -----{_PROFILE_NOTES}
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 11, 16.
+"""

@@ -417,7 +417,7 @@ def _large_grids(quick: bool) -> None:
     previous call freed (XLA's allocator keeps it, NumPy returns it to the system), which
     on a virtual machine, where touching fresh memory is costly, flatters the jit floor.
     """
-    from ecofmaps.maps.grid import available_memory
+    from ecofmaps.maps.tiles import available_memory
 
     sizes = [10**5, 3 * 10**5] if quick else [10**7, 3 * 10**7, 10**8, 2 * 10**8]
     names = ["compute_map", "jit floor", "NumPy lean"]

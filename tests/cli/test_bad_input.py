@@ -14,7 +14,7 @@ import time
 import pytest
 
 from ecofmaps.cli import main
-from ecofmaps.maps import grid
+from ecofmaps.maps import tiles
 
 
 def run(capsys, *argv):
@@ -111,7 +111,7 @@ def test_errors_name_the_option(tmp_path, monkeypatch, capsys, argv, message):
 
 
 def test_a_grid_too_large_for_memory_is_refused_before_allocating(tmp_path, capsys, monkeypatch):
-    monkeypatch.setattr(grid, "available_memory", lambda: 5 * 10**8)  # 0.5 GB free
+    monkeypatch.setattr(tiles, "available_memory", lambda: 5 * 10**8)  # 0.5 GB free
     status, _, err = run(
         capsys,
         "map",

@@ -257,9 +257,9 @@ def test_map_replaces_an_existing_store_and_refuses_other_directories(tmp_path, 
 
 
 def test_a_grid_block_by_block_is_not_refused_for_memory(tmp_path, capsys, monkeypatch):
-    from ecofmaps.maps import grid
+    from ecofmaps.maps import tiles
 
-    monkeypatch.setattr(grid, "available_memory", lambda: 1000)  # 1 kB free
+    monkeypatch.setattr(tiles, "available_memory", lambda: 1000)  # 1 kB free
     out = tmp_path / "m.nc"
     status, _, stderr = run(capsys, "map", *FIG11, "--chunk-points", "100", "--out", str(out))
     assert status == 0, stderr

@@ -20,7 +20,7 @@ from ecofmaps.correction import (
     Interval,
     contact_cof,
     ecof_fall,
-    inversion,
+    outcomes,
 )
 from tests.brute_force import steady_loop
 
@@ -240,7 +240,7 @@ def test_fall_region():
     checked on dense grids of dμ_E/dμ, and the limit λ_∞ = LAMBDA_INFINITY as κ -> ∞.
     """
     rising = [(kappa, lam) for kappa in (0.5, 1.0) for lam in (1e-12, 1e-6, 1e-3, 0.05, 1.0)]
-    rising += [(kappa, inversion._FALL_LAMBDA) for kappa in (10.0, 1e3, 1e6)]
+    rising += [(kappa, outcomes._FALL_LAMBDA) for kappa in (10.0, 1e3, 1e6)]
     rising += [(kappa, LAMBDA_INFINITY) for kappa in (1e4, 1e8)]
     for kappa, lam in rising:
         mu = np.geomspace(1e-4 / kappa, (1 - 1e-9) / lam, 100_000)

@@ -6,12 +6,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from ecofmaps.io.recordings import (
-    RecordingError,
-    RecordingWarning,
-    read_recording,
-    recording_blocks,
-)
+from ecofmaps.io.recording_types import RecordingError, RecordingWarning
+from ecofmaps.io.recordings import read_recording, recording_blocks
 from ecofmaps.measured.synthetic import synthetic_recording
 
 POINT = dict(amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8, aspect_ratio=0.2)

@@ -4,9 +4,10 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from ecofmaps.io.binary import variables
 from ecofmaps.io.files import TEMPORARY_NAME, atomic_store
-from ecofmaps.io.recordings import RecordingError, read_recording
+from ecofmaps.io.recording_types import RecordingError
+from ecofmaps.io.recordings import read_recording
+from ecofmaps.io.rig_formats import variables
 from ecofmaps.io.writers import RecordingWriter, convert_recording
 
 RNG = np.random.default_rng(3)

@@ -9,7 +9,7 @@ import xarray as xr
 from ecofmaps import Regime, compute_map, compute_universal_map, write_map
 from ecofmaps._interrupts import interrupts_stop_writes
 from ecofmaps.io.files import atomic_store
-from ecofmaps.maps import grid
+from ecofmaps.maps import tiles
 
 AXES = (np.geomspace(1e4, 3e5, 23), np.linspace(0.0, 0.7, 11), np.array([25e-6, 50e-6]), 0.8)
 
@@ -45,13 +45,13 @@ def test_zarr_chunks_are_the_blocks(tmp_path):
 
 def test_also_is_computed_in_the_same_pass(tmp_path, monkeypatch):
     calls = []
-    block = grid._block
+    block = tiles._block
 
     def counted(*args):
         calls.append(args[4])
         return block(*args)
 
-    monkeypatch.setattr(grid, "_block", counted)
+    monkeypatch.setattr(tiles, "_block", counted)
     dataset = compute_map(*AXES, chunks=100)
     also = [(dataset.regime == code).sum().data for code in Regime] + [dataset.ecof_ratio.max()]
     *counts, top = write_map(dataset, tmp_path / "m.zarr", also=also)
@@ -65,7 +65,7 @@ def test_also_is_computed_in_the_same_pass(tmp_path, monkeypatch):
 def failing_blocks(monkeypatch, after: int, error: BaseException):
     """Make the block evaluation raise ``error`` once ``after`` blocks were evaluated."""
     calls = []
-    block = grid._block
+    block = tiles._block
 
     def failing(*args):
         calls.append(None)
@@ -73,7 +73,7 @@ def failing_blocks(monkeypatch, after: int, error: BaseException):
             raise error
         return block(*args)
 
-    monkeypatch.setattr(grid, "_block", failing)
+    monkeypatch.setattr(tiles, "_block", failing)
 
 
 @pytest.mark.parametrize("name", ["map.nc", "map.zarr"])

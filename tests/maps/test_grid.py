@@ -13,8 +13,8 @@ from hypothesis import strategies as st
 
 import ecofmaps
 from ecofmaps import Regime, compute_loops, compute_map, compute_universal_map
-from ecofmaps.maps import grid as grid_module
-from ecofmaps.maps.grid import MAX_CHUNK
+from ecofmaps.maps import tiles
+from ecofmaps.maps.tiles import MAX_CHUNK
 from tests.brute_force import steady_loop
 
 # A grid that holds every regime: rigid rig (inf), no gross slip (mu*lam >= 1 at small S/P),
@@ -311,13 +311,13 @@ def test_chunked_universal_map_equals_in_memory_to_the_bit(given):
 
 def test_chunked_map_is_lazy_and_evaluates_each_block_once(monkeypatch, grid):
     calls = []
-    block = grid_module._block
+    block = tiles._block
 
     def counted(*args):
         calls.append(args[4])  # the block's region
         return block(*args)
 
-    monkeypatch.setattr(grid_module, "_block", counted)
+    monkeypatch.setattr(tiles, "_block", counted)
     chunked = compute_map(STIFFNESS_RATIO, ASPECT_RATIO, AMPLITUDE, MU, LOAD, chunks=60)
     assert calls == []  # lazy
     assert chunked.ecof_ratio.chunks == ((2, 2, 1), (5,), (2,), (3,))  # 2 x 5 x 2 x 3 = 60
@@ -366,7 +366,7 @@ def test_a_chunked_map_is_not_cached(tmp_path):
 
 
 def test_memory_refusal_names_the_chunked_way_out(monkeypatch):
-    monkeypatch.setattr(grid_module, "available_memory", lambda: 10_000)  # 10 kB free
+    monkeypatch.setattr(tiles, "available_memory", lambda: 10_000)  # 10 kB free
     axes = (np.geomspace(1e4, 1e5, 100), np.linspace(0, 0.3, 30), 50e-6, 0.8)
     message = (
         r"the grid of 3e\+03 points needs about 0.000\d+ GB of memory for its results, more "
@@ -392,7 +392,7 @@ def test_a_failing_tile_stops_the_map():
 
     axes = [np.arange(40.0), np.arange(5.0)]
     with pytest.raises(FloatingPointError, match="tile 3"):
-        grid_module._evaluate_grid(kernel, axes, (), max_chunk=10)
+        tiles._evaluate_grid(kernel, axes, (), max_chunk=10)
     assert len(calls) < 20  # 20 tiles of 2 rows
 
 
@@ -403,7 +403,7 @@ def test_a_failing_tile_stops_the_map():
 )
 def test_tiles_cover_any_region_once(shape, points, data):
     """The tiles that overlap a region cover each of its points exactly once."""
-    split = grid_module._split(tuple(shape), points)
+    split = tiles._split(tuple(shape), points)
     k, rows = split
     assert rows * math.prod(shape[k + 1 :]) <= max(points, math.prod(shape[k + 1 :]))
     count = -(-shape[k] // rows)  # tiles along the split axis: as even as can be
@@ -413,7 +413,7 @@ def test_tiles_cover_any_region_once(shape, points, data):
         start = data.draw(st.integers(0, size - 1))
         region.append((start, data.draw(st.integers(start + 1, size))))
     covered = np.zeros(shape, int)
-    for index, start in grid_module._tiles(split, region):
+    for index, start in tiles._tiles(split, region):
         assert start % rows == 0
         covered[(*index, slice(start, start + rows))] += 1
     inside = tuple(slice(a, b) for a, b in region)

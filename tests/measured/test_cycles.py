@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ecofmaps.measured import centring, cycles
+from ecofmaps.measured import centring, cycles, passes
 from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.samples import Samples
 from ecofmaps.measured.synthetic import synthetic_recording
@@ -35,18 +35,18 @@ def signal(kind: int, size: int, seed: int):
 
 def percentiles(values):
     """The reversal detector's percentiles of ``values`` (taken as detrended already)."""
-    samples = Samples(values, None, chunk=cycles._CHUNK)
-    sample_at = np.sort(np.random.default_rng(0).integers(0, values.size, cycles._SAMPLE))
+    samples = Samples(values, None, chunk=passes._CHUNK)
+    sample_at = np.sort(np.random.default_rng(0).integers(0, values.size, passes._SAMPLE))
     line = (0.0, 0.0, 0.0, 0.5 * (values.size - 1))
     gaps = np.zeros((0, 2), np.int64)
-    return cycles._percentiles(samples, gaps, line, sample_at, values[sample_at], values.size)
+    return passes._percentiles(samples, gaps, line, sample_at, values[sample_at], values.size)
 
 
 @pytest.fixture
 def small_chunks(monkeypatch):
     """Chunks of 1000 samples, percentile samples of 256 and blocks of 700 samples."""
-    monkeypatch.setattr(cycles, "_CHUNK", 1000)
-    monkeypatch.setattr(cycles, "_SAMPLE", 256)
+    monkeypatch.setattr(passes, "_CHUNK", 1000)
+    monkeypatch.setattr(passes, "_SAMPLE", 256)
     monkeypatch.setattr(centring, "_BLOCK", 700)
 
 
@@ -56,8 +56,8 @@ def test_percentiles_are_numpys_to_the_bit(kind, size, seed):
     """The bracketed percentiles of a long recording equal np.percentile exactly."""
     values = signal(kind, size, seed)
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(cycles, "_CHUNK", 1000)
-        patch.setattr(cycles, "_SAMPLE", 256)
+        patch.setattr(passes, "_CHUNK", 1000)
+        patch.setattr(passes, "_SAMPLE", 256)
         result = percentiles(values)
     np.testing.assert_array_equal(result, np.percentile(values, [1.0, 99.0]))
 
@@ -68,8 +68,8 @@ def test_split_cycles_as_the_reference(kind, size, seed):
     """Reversals, cycles and what is dropped: as the padded implementation, chunk by chunk."""
     x = signal(kind, size, seed)
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(cycles, "_CHUNK", 1000)
-        patch.setattr(cycles, "_SAMPLE", 256)
+        patch.setattr(passes, "_CHUNK", 1000)
+        patch.setattr(passes, "_SAMPLE", 256)
         try:
             found = cycles.split_cycles(x)
         except ValueError as error:
@@ -99,7 +99,7 @@ def test_labelled_cycles_as_the_reference(kind, size, length, seed):
     x = signal(kind, size, seed)
     label = np.arange(size) // length * 10
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(cycles, "_CHUNK", 1000)
+        patch.setattr(passes, "_CHUNK", 1000)
         found = cycles.labelled_cycles(x, label)
     expected = reference.labelled_cycles(x, label)
     assert found.label.size == expected.label.size
@@ -153,7 +153,7 @@ def test_a_long_loop_gets_a_block_of_its_own():
 
 def test_one_cycle_of_a_long_recording():
     """Measuring one cycle uses its neighbours' centres: as in the whole analysis."""
-    from ecofmaps.measured.analysis import measure_cycles
+    from ecofmaps.measured.per_cycle import measure_cycles
 
     displacement, force = synthetic_recording(**EXAMPLE_2, cycles=8, displacement_drift=1e-6)
     found = cycles.find_cycles(displacement)

@@ -16,7 +16,7 @@ import pytest
 import xarray as xr
 
 import ecofmaps
-from ecofmaps.measured import cycles, out_of_core
+from ecofmaps.measured import cycles, out_of_core, passes
 from ecofmaps.measured.analysis import MissingSampleError, analyze_loops
 from ecofmaps.measured.quality import LoopQualityWarning
 from ecofmaps.measured.synthetic import synthetic_recording
@@ -37,8 +37,8 @@ READ = ("mu_resolved", "mu_resolved_se", "aspect_ratio")
 @pytest.fixture
 def small_blocks(monkeypatch):
     """Passes a chunk of 1000 samples at a time, tasks of about 777 samples."""
-    monkeypatch.setattr(cycles, "_CHUNK", 1000)
-    monkeypatch.setattr(cycles, "_SAMPLE", 256)
+    monkeypatch.setattr(passes, "_CHUNK", 1000)
+    monkeypatch.setattr(passes, "_SAMPLE", 256)
     monkeypatch.setattr(out_of_core, "TASK_SAMPLES", 777)
 
 

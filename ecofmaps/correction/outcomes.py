@@ -1,0 +1,213 @@
+r"""What a correction comes out as: the status codes, the intervals, and where it is ambiguous.
+
+:class:`CorrectionStatus` says per point whether an ECoF was corrected, and why not;
+:class:`Interval` holds the contact CoFs an ECoF allows when the scar's aspect ratio is only
+known to lie in an interval. Where the groove is deep and the rig stiff, :math:`\mu_E(\mu)`
+falls over part of its range (:func:`ecof_fall`, below :data:`LAMBDA_INFINITY`), and an
+ECoF in the fall comes from three contact CoFs: the exact inversion
+(:mod:`ecofmaps.correction.inversion`, whose module docstring gives the bounds) marks it
+``AMBIGUOUS``.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+
+from ecofmaps import model
+from ecofmaps._codes import Code
+from ecofmaps._inputs import as_float64
+
+__all__ = ["AMBIGUOUS_ECOF_MIN", "LAMBDA_INFINITY", "CorrectionStatus", "Interval", "ecof_fall"]
+
+#: :math:`\lambda_\infty`: :math:`\mu_E(\mu)` falls over part of its range only where
+#: :math:`\lambda = P/(S\Delta^*)` is below this (its :math:`\kappa \to \infty` limit; the tests
+#: check it on dense grids). [1]
+LAMBDA_INFINITY = 0.07102
+
+#: No ECoF below this is ever ambiguous: the infimum of the local minimum of a falling
+#: :math:`\mu_E(\mu)`, reached as :math:`\kappa \to \infty` and
+#: :math:`\lambda \to \lambda_\infty`. [1]
+AMBIGUOUS_ECOF_MIN = 1.6
+
+
+class CorrectionStatus(Code):
+    """Outcome of a correction, per point (``return_status=True``).
+
+    Attributes
+    ----------
+    CORRECTED
+        One contact CoF gives the ECoF; it is returned.
+    NO_GROSS_SLIP
+        The ECoF is at or above :math:`S\\Delta^*/P`, above every gross-slip
+        :math:`\\mu_E` of these test conditions: a contact CoF high enough to give it would
+        stop gross slip (:math:`\\mu P \\ge S\\Delta^*`), and with no gross slip there is
+        no ECoF. The value cannot come from the model with these conditions.
+    AMBIGUOUS
+        Several contact CoFs give the ECoF (deep groove, :math:`\\kappa > 1`, and stiff rig,
+        :math:`\\lambda <` :data:`LAMBDA_INFINITY`, where :math:`\\mu_E(\\mu)` falls over
+        part of its range).
+    INVALID
+        An input out of its range or NaN (only under ``jax.jit``/``jax.vmap``: concrete
+        inputs raise ``ValueError``).
+    OUTSIDE_MAP
+        :func:`lookup_correction` only: the point, or the ECoF, is outside the map.
+    UNREACHABLE
+        On a scar profile only: no contact CoF gives the ECoF although it is below
+        :math:`S\\Delta^*/P`: it falls in a jump of :math:`\\mu_E(\\mu)` (the loop's ends
+        jump where the pad starts to jump) or would need the pad to slip off the trace.
+    """
+
+    CORRECTED = 0, "corrected"
+    NO_GROSS_SLIP = (
+        1,
+        "no gross slip",
+        "the ECoF is at or above stiffness * amplitude / load, the largest energy CoF of any "
+        "gross-slip loop with these test conditions",
+    )
+    AMBIGUOUS = (
+        2,
+        "ambiguous",
+        "several contact CoFs give the ECoF (deep groove and stiff rig, where the ECoF falls "
+        "as mu rises over part of its range)",
+    )
+    INVALID = 3, "invalid", "invalid input"
+    OUTSIDE_MAP = 4, "outside the map", "the point or the ECoF is outside the map"
+    UNREACHABLE = (
+        5,
+        "unreachable",
+        "no contact CoF gives the ECoF on this scar profile (it falls in a jump of the ECoF as "
+        "mu rises, or needs a slip beyond the trace)",
+    )
+
+
+class Interval(NamedTuple):
+    """The contact CoFs (or correction factors) allowed by an ECoF: ``low <= high``."""
+
+    low: jax.Array
+    high: jax.Array
+
+
+# mu_E(mu) can fall only for kappa > _FALL_KAPPA and 0 < lam < _FALL_LAMBDA (docstring of
+# ecofmaps.correction.inversion); the fall lies in 1/kappa < mu < 1, scanned on _FALL_GRID
+# points in log(mu) and located to _FALL_BISECTIONS halvings of a grid step.
+_FALL_KAPPA = 1.0
+_FALL_LAMBDA = 0.075  # a margin above LAMBDA_INFINITY
+_FALL_GRID = 256
+_FALL_BISECTIONS = 48
+
+
+def _ecof_and_slope(mu, kappa, lam):
+    """:math:`\\mu_E` and :math:`d\\mu_E/d\\mu` at each point (forward mode, elementwise)."""
+    return jax.jvp(lambda m: m * model.ecof_ratio(m, kappa, lam), (mu,), (jnp.ones_like(mu),))
+
+
+def _status(ecof, kappa, lam):
+    """``CORRECTED``, ``NO_GROSS_SLIP`` (:math:`\\mu_E \\ge 1/\\lambda`) or ``INVALID``."""
+    valid = (
+        (ecof > 0.0)
+        & jnp.isfinite(ecof)
+        & (kappa >= 0.0)
+        & jnp.isfinite(kappa)
+        & (lam >= 0.0)
+        & jnp.isfinite(lam)
+    )
+    reachable = ecof * lam < 1.0
+    code = jnp.where(
+        valid,
+        jnp.where(reachable, int(CorrectionStatus.CORRECTED), int(CorrectionStatus.NO_GROSS_SLIP)),
+        int(CorrectionStatus.INVALID),
+    )
+    return code.astype(jnp.int32)
+
+
+def _may_fall(kappa, lam):
+    """Where :math:`\\mu_E(\\mu)` may fall over part of its range (see
+    :mod:`ecofmaps.correction.inversion`)."""
+    return (kappa > _FALL_KAPPA) & (lam > 0.0) & (lam < _FALL_LAMBDA)
+
+
+def ecof_fall(kappa, lam):
+    r"""Where :math:`\mu_E(\mu)` falls: its local maximum and minimum, or NaN where it rises.
+
+    Parameters
+    ----------
+    kappa : array_like
+        Curvature number :math:`\kappa = 2 z_o/x_o` (with :math:`x_o = \Delta^*`). [1]
+    lam : array_like
+        Compliance ratio :math:`\lambda = P/(S\Delta^*)`. [1]
+
+    Returns
+    -------
+    high : jax.Array
+        :math:`\mu_E` at the local maximum, where the fall starts; NaN where
+        :math:`\mu_E(\mu)` rises over the whole gross-slip range. [1]
+    low : jax.Array
+        :math:`\mu_E` at the local minimum, where it ends. An ECoF in ``[low, high]``
+        comes from three contact CoFs (two at the ends). [1]
+
+    Notes
+    -----
+    The fall exists only for :math:`\kappa > 1` and :math:`0 < \lambda <` :data:`LAMBDA_INFINITY`
+    and lies in
+    :math:`1/\kappa < \mu < 1` (:mod:`ecofmaps.correction.inversion`); there the slope
+    :math:`d\mu_E/d\mu` (``jax.jvp`` of the corrected eq. 13-15 with eq. 16) is sampled at
+    256 points evenly spaced in :math:`\log\mu`, and its two sign changes are bisected. A
+    fall narrower than one grid step (:math:`\ln\kappa/255` in :math:`\log\mu`), at the very
+    edge of the region where it exists, is not seen: the contact CoFs it would make
+    ambiguous then lie within about two grid steps of each other.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 13-15, 16.
+    """
+    kappa, lam = jnp.broadcast_arrays(as_float64(kappa), as_float64(lam))
+    may_fall = _may_fall(kappa, lam)
+    kappa = jnp.where(may_fall, kappa, 2.0)[..., None]  # harmless values elsewhere
+    lam = jnp.where(may_fall, lam, 0.01)[..., None]
+    fraction = jnp.linspace(0.0, 1.0, _FALL_GRID)
+    log_mu = -jnp.log(kappa) * (1.0 - fraction)  # from 1/kappa to 1
+    _, slope = _ecof_and_slope(jnp.exp(log_mu), kappa, lam)
+    falling = slope <= 0.0
+    found = may_fall & jnp.any(falling, axis=-1)
+    first = jnp.clip(jnp.argmax(falling, axis=-1), 1, _FALL_GRID - 2)
+    last = jnp.clip(_FALL_GRID - 1 - jnp.argmax(falling[..., ::-1], axis=-1), 1, _FALL_GRID - 2)
+
+    # Brackets of the slope's sign changes: rising at `rise`, falling at `fall`.
+    def at(index):
+        return jnp.take_along_axis(log_mu, index[..., None], axis=-1)[..., 0]
+
+    rise = jnp.stack([at(first - 1), at(last + 1)], axis=-1)
+    fall = jnp.stack([at(first), at(last)], axis=-1)
+
+    def halve(_, bracket):
+        rise, fall = bracket
+        middle = 0.5 * (rise + fall)
+        _, slope = _ecof_and_slope(jnp.exp(middle), kappa, lam)
+        up = slope > 0.0
+        return jnp.where(up, middle, rise), jnp.where(up, fall, middle)
+
+    rise, fall = jax.lax.fori_loop(0, _FALL_BISECTIONS, halve, (rise, fall))
+    extremum = jnp.exp(0.5 * (rise + fall))
+    value, _ = _ecof_and_slope(extremum, kappa, lam)
+    high = jnp.where(found, value[..., 0], jnp.nan)
+    low = jnp.where(found, value[..., 1], jnp.nan)
+    return high, low
+
+
+def _mark_ambiguous(mu, status, ecof, high, low):
+    """NaN and ``AMBIGUOUS`` where ``ecof`` lies in the fall ``[low, high]``."""
+    ambiguous = (status == int(CorrectionStatus.CORRECTED)) & (ecof >= low) & (ecof <= high)
+    status = jnp.where(ambiguous, int(CorrectionStatus.AMBIGUOUS), status).astype(jnp.int32)
+    return jnp.where(ambiguous, jnp.nan, mu), status
+
+
+def _fall_if_needed(status, kappa, lam):
+    """:func:`ecof_fall` at every point, scanned only if a corrected point may fall."""
+    needed = jnp.any(_may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
+    nan = jnp.full(status.shape, jnp.nan)
+    return jax.lax.cond(needed, lambda: ecof_fall(kappa, lam), lambda: (nan, nan))

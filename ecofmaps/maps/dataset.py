@@ -1,0 +1,110 @@
+"""The labelled xarray Dataset of a map: checked grid axes, variables and attributes.
+
+Every coordinate and variable takes its ``long_name`` and ``units`` from
+:mod:`ecofmaps._nomenclature` (the regime codes their CF flag attributes), and every map
+carries the paper's model and citation as global attributes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+from xarray.core.indexes import PandasIndex
+
+from ecofmaps import _nomenclature as nomenclature
+from ecofmaps import model, paper
+from ecofmaps._inputs import check
+from ecofmaps._version import __version__
+
+# The order of the variables in a Dataset (xarray orders the dimensions as they first appear).
+_VARIABLES = (
+    "displacement",
+    "force",
+    "slip_amplitude",
+    "slip_ratio",
+    "ecof",
+    "ecof_ratio",
+    "compliance_ratio",
+    "regime",
+    "dissipated_energy",
+    "max_force",
+)
+
+
+def _attrs(name: str) -> dict:
+    attrs = nomenclature.attrs(name)
+    if name == "regime":
+        attrs.update(model.Regime.flag_attrs())
+    return attrs
+
+
+def _global_attrs(title: str) -> dict:
+    return {
+        "title": title,
+        "model": paper.MODEL,
+        "references": paper.CITATION,
+        "source": f"ecofmaps {__version__}",
+        "ecofmaps_version": __version__,
+    }
+
+
+def _axis(name: str, value, rule: str, unit: str) -> np.ndarray:
+    """``value`` checked (``ValueError`` naming ``name``) as a float64 scalar or 1-D array.
+
+    A 1-D array is a grid axis: it must hold each value once.
+    """
+    check(name, value, rule, unit)
+    array = np.asarray(value, dtype=np.float64)
+    if array.ndim > 1:
+        raise ValueError(f"{name} must be a single value or a 1-D array, got shape {array.shape}")
+    if array.size == 0:
+        raise ValueError(f"{name} must hold at least one value, got an empty array")
+    ordered = np.sort(array, axis=None)
+    if np.any(ordered[1:] == ordered[:-1]):
+        unique, counts = np.unique(array, return_counts=True)
+        repeated = unique[counts > 1][0]
+        where = np.flatnonzero(array == repeated)
+        raise ValueError(
+            f"{name} repeats the value {repeated!r} (at indices {where.tolist()}): a grid axis "
+            "takes each value once"
+        )
+    return array
+
+
+def _dataset(axes: dict, values: dict, title: str, extra=None) -> xr.Dataset:
+    """A Dataset of grid ``values`` over ``axes`` (scalars become scalar coordinates).
+
+    A value is an array over the whole grid (with a length-1 axis for each scalar
+    coordinate), or a ``(dims, array)`` pair for one that depends on fewer parameters.
+    ``extra`` coordinates are not grid axes: 0-d ones are scalar coordinates, 1-D ones
+    trailing dimensions of the values that have more axes than the grid.
+    """
+    dims = [name for name, axis in axes.items() if axis.ndim == 1]
+    squeeze = tuple(i for i, axis in enumerate(axes.values()) if axis.ndim == 0)
+    extra = extra or {}
+    trailing = [name for name, coordinate in extra.items() if coordinate.ndim == 1]
+    coords = {
+        name: ((name,) if axis.ndim == 1 else (), axis, _attrs(name))
+        for name, axis in {**axes, **extra}.items()
+    }
+    variables, indexes = {}, {}
+    for name, (dim, value, attrs) in coords.items():
+        if dim:  # a dimension coordinate, indexed as xarray.Dataset would index it
+            indexes[name] = PandasIndex(pd.Index(value), name)
+            variables.update(indexes[name].create_variables({name: xr.Variable(dim, value, attrs)}))
+        else:
+            variables[name] = xr.Variable(dim, value, attrs)
+    for name in sorted(values, key=_VARIABLES.index):
+        if isinstance(values[name], tuple):
+            variables[name] = xr.Variable(*values[name], _attrs(name))
+            continue
+        value = np.squeeze(values[name], axis=squeeze)
+        variables[name] = xr.Variable(
+            dims + trailing[: value.ndim - len(dims)], value, _attrs(name)
+        )
+    # What xarray.Dataset(data_vars, coords, attrs) builds, without its merging and alignment
+    # of variables that are consistent by construction (a third of a small map's time).
+    return xr.Dataset._construct_direct(
+        variables, set(coords), attrs=_global_attrs(title), indexes=indexes
+    )

@@ -1,0 +1,306 @@
+"""Grid evaluation in tiles (in memory, on every core) and in blocks of tiles (dask).
+
+A jit-compiled kernel of the map functions (:mod:`ecofmaps.maps.grid`) is evaluated over the
+grid spanned by 1-D axes in tiles of at most ``max_chunk`` points, small enough for the
+processor's cache, by one thread per core, so the cost grows linearly with the grid and the
+memory needed is that of the results (checked against the free memory before allocating).
+A chunked map is a dask graph of blocks of the same tiles, so its values equal the
+in-memory map's to the bit.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import functools
+import itertools
+import math
+import operator
+import os
+import threading
+from collections.abc import Mapping
+
+import jax
+import numpy as np
+
+from ecofmaps._interrupts import check_interrupted
+
+__all__ = ["BLOCK_POINTS", "BLOCK_TASK", "MAX_CHUNK", "available_memory"]
+
+
+#: Default bound on the number of grid points evaluated in one call of a kernel (a tile):
+#: its working arrays (about 1.4 MB) stay in the processor's cache.
+MAX_CHUNK = 2**14
+
+
+#: Grid points in one block of a chunked map with ``chunks='auto'`` (results of about
+#: 220 MB for :func:`compute_map` with a load).
+BLOCK_POINTS = 2**22
+
+
+#: Prefix of the dask keys of the tasks that evaluate the blocks of a chunked map.
+BLOCK_TASK = "ecofmaps-block"
+
+
+def available_memory() -> int | None:
+    """Memory the system can give this process now, or None where it cannot tell. [byte]"""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+@functools.lru_cache(maxsize=64)
+def _bytes_per_point(kernel, axes: int, extra: tuple) -> int:
+    """Bytes of ``kernel``'s results per grid point, from ``jax.eval_shape`` on one point.
+
+    ``extra`` holds the shapes and dtypes of the extra arguments (``None`` for ``None``).
+    """
+    point = [jax.ShapeDtypeStruct((1,), np.float64)] * axes
+    arguments = [None if e is None else jax.ShapeDtypeStruct(*e) for e in extra]
+    with jax.enable_x64(True):
+        outputs = jax.eval_shape(kernel, *point, *arguments)
+    return sum(out.dtype.itemsize * out.size for out in jax.tree_util.tree_leaves(outputs))
+
+
+def _signature(extra) -> tuple:
+    return tuple(None if e is None else (np.shape(e), np.result_type(e)) for e in extra)
+
+
+def _check_memory(kernel, axes, extra, max_chunk: int) -> None:
+    """Refuse, before allocating, a grid whose results would not fit in the free memory.
+
+    The results' sizes come from ``jax.eval_shape`` (no computation); the working arrays
+    of the blocks evaluated at once (each taken as twice its results) come on top. The
+    way out is named: a chunked map (``chunks=``) is computed block by block and never
+    needs more than a few blocks in memory.
+    """
+    per_point = _bytes_per_point(kernel, len(axes), _signature(extra))
+    points = math.prod(axis.size for axis in axes)
+    needed = per_point * (points + 2 * _workers() * min(points, max_chunk))
+    free = available_memory()
+    if free is not None and needed > free:
+        raise ValueError(
+            f"the grid of {points:.3g} points needs about {needed / 1e9:.3g} GB of memory for "
+            f"its results, more than the {free / 1e9:.3g} GB available: use a smaller grid, "
+            "or compute it block by block with chunks='auto' and write it with "
+            "ecofmaps.maps.write_map (ecofmaps map does so above --chunk-points points, "
+            "e.g. into --out FILE.zarr)"
+        )
+
+
+def _workers() -> int:
+    """Threads that evaluate tiles at once: the cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def _split(shape: tuple[int, ...], points: int) -> tuple[int, int]:
+    """How blocks of at most ``points`` points tile ``shape``: split axis ``k`` and ``rows``.
+
+    The split axis is the first one whose trailing axes hold at most ``points`` points
+    together; a block takes one index along the axes before ``k``, ``rows`` consecutive
+    indices along ``k`` and all of the axes after it. The blocks along ``k`` are as even as
+    can be, so the last one (padded up to ``rows`` in a tile) wastes little.
+    """
+    k = next(i for i in range(len(shape)) if math.prod(shape[i + 1 :]) <= points)
+    count = -(-shape[k] // max(1, points // math.prod(shape[k + 1 :])))  # blocks along k
+    return k, -(-shape[k] // count)
+
+
+def _tiles(split: tuple[int, int], region):
+    """The tiles (``index``, ``start``) of a grid split by ``split`` that overlap ``region``.
+
+    ``region`` holds a ``(start, stop)`` pair per axis. A tile is the block of
+    :func:`_split` at ``index`` along the axes before the split axis and at rows
+    ``start:start + rows`` along it (the tiles' starts are multiples of ``rows``).
+    """
+    k, rows = split
+    first = region[k][0] // rows * rows
+    for index in itertools.product(*(range(start, stop) for start, stop in region[:k])):
+        for start in range(first, region[k][1], rows):
+            yield index, start
+
+
+def _fill(out, kernel, axes, extra, split, region, tiles, stop=None) -> None:
+    """Evaluate ``tiles`` and copy their part inside ``region`` into the arrays ``out``.
+
+    Every tile has the same shape (the last one along the split axis is padded by
+    repeating its last value, and the padding is dropped), so the kernel compiles once
+    and each point's value does not depend on how the grid is cut into blocks: the
+    in-memory and chunked maps are equal to the bit. ``out`` maps each result's name to
+    an array of the region's shape (allocated here on the first tile when empty).
+    ``stop``, a ``threading.Event``, ends the loop at the next tile once it is set; after
+    Ctrl-C on the command line the loop raises ``KeyboardInterrupt`` at the next tile.
+    """
+    k, rows = split
+    offset = tuple(start for start, _ in region)
+    trailing = tuple(slice(start, stop) for start, stop in region[k + 1 :])
+    with jax.enable_x64(True):
+        for index, start in tiles:
+            check_interrupted()
+            if stop is not None and stop.is_set():
+                return
+            along = axes[k][start : start + rows]
+            if along.size < rows:
+                along = np.pad(along, (0, rows - along.size), mode="edge")
+            tile_axes = [axis[i : i + 1] for axis, i in zip(axes, index, strict=False)]
+            values = kernel(*tile_axes, along, *axes[k + 1 :], *extra)
+            low, high = max(start, region[k][0]), min(start + rows, region[k][1])
+            source = (0,) * k + (slice(low - start, high - start), *trailing)
+            target = (
+                *(i - o for i, o in zip(index, offset, strict=False)),
+                slice(low - offset[k], high - offset[k]),
+            )
+            for name, value in values.items():
+                if name not in out:
+                    shape = tuple(stop - start for start, stop in region)
+                    out[name] = np.empty(shape, dtype=value.dtype)
+                out[name][target] = np.asarray(value)[source]
+
+
+def _evaluate_grid(kernel, axes, extra, max_chunk: int) -> dict[str, np.ndarray]:
+    """Evaluate ``kernel(*block_axes, *extra)`` over the grid spanned by 1-D ``axes``.
+
+    ``kernel`` is jit-compiled and returns a dict of arrays of the block's full shape. A
+    grid of at most ``max_chunk`` points is one call, and its arrays are XLA's own
+    buffers, read-only, without a copy. A larger grid is cut into tiles of at most
+    ``max_chunk`` points (:func:`_split`), which threads (one per core) evaluate and copy
+    into the result arrays: a tile's working arrays stay in the processor's cache, and
+    the cost grows linearly with the number of points.
+    """
+    if not (isinstance(max_chunk, int) and not isinstance(max_chunk, bool) and max_chunk >= 1):
+        raise ValueError(f"max_chunk must be an integer >= 1, got {max_chunk!r}")
+    _check_memory(kernel, axes, extra, max_chunk)
+    shape = tuple(axis.size for axis in axes)
+    if math.prod(shape) <= max_chunk:
+        return {name: np.asarray(value) for name, value in kernel(*axes, *extra).items()}
+    split = _split(shape, max_chunk)
+    region = tuple((0, size) for size in shape)
+    tiles = list(_tiles(split, region))
+    with jax.enable_x64(True):
+        first = [axis[:1] for axis in axes]
+        first[split[0]] = axes[split[0]][: split[1]]
+        outputs = jax.eval_shape(kernel, *first, *extra)
+    out = {name: np.empty(shape, dtype=spec.dtype) for name, spec in outputs.items()}
+    workers = min(_workers(), len(tiles))
+    stop = threading.Event()  # set on an error or Ctrl-C: the other threads end early
+    with concurrent.futures.ThreadPoolExecutor(workers) as pool:
+        futures = [
+            pool.submit(_fill, out, kernel, axes, extra, split, region, tiles[i::workers], stop)
+            for i in range(workers)
+        ]
+        try:
+            for future in futures:
+                future.result()
+        finally:
+            stop.set()
+    return out
+
+
+def _block_lengths(chunks, shape, dims, split) -> list[int]:
+    """The block length along each axis that ``chunks`` asks for (see :func:`compute_map`)."""
+    usage = (
+        "chunks must be 'auto', an integer >= 1 (grid points per block) or a dict of block "
+        "lengths by dimension name"
+    )
+    if isinstance(chunks, str):
+        if chunks != "auto":
+            raise ValueError(f"{usage}, got {chunks!r}")
+        chunks = BLOCK_POINTS
+    if isinstance(chunks, bool) or not isinstance(chunks, (int, np.integer, Mapping)):
+        raise ValueError(f"{usage}, got {chunks!r}")
+    if not isinstance(chunks, Mapping):
+        if chunks < 1:
+            raise ValueError(f"{usage}, got {chunks!r}")
+        k, rows = _split(shape, int(chunks))
+        if k == split[0] and rows > split[1]:  # whole tiles: none is evaluated twice
+            tiles = -(-shape[k] // split[1])
+            blocks = -(-tiles // (rows // split[1]))
+            rows = -(-tiles // blocks) * split[1]
+        return [1] * k + [rows] + list(shape[k + 1 :])
+    unknown = [name for name in chunks if name not in dims]
+    if unknown:
+        named = ", ".join(d for d in dims if d) or "none: every parameter is a single value"
+        raise ValueError(
+            f"chunks names {unknown[0]!r}, which is not a dimension of this map (its "
+            f"dimensions: {named})"
+        )
+    lengths = []
+    for name, size in zip(dims, shape, strict=True):
+        length = chunks.get(name, -1) if name else 1
+        if length is None or (not isinstance(length, bool) and length == -1):
+            length = size
+        if isinstance(length, bool) or not isinstance(length, (int, np.integer)) or length < 1:
+            raise ValueError(
+                f"chunks[{name!r}] must be an integer >= 1, or -1 or None for the whole "
+                f"dimension; got {length!r}"
+            )
+        lengths.append(min(int(length), size))
+    return lengths
+
+
+def _chunked_grid(kernel, axes, extra, max_chunk: int, chunks, dims) -> dict:
+    """The results of :func:`_evaluate_grid` as dask arrays, one task per block.
+
+    Each block's task evaluates the tiles that overlap it (the same tiles as in memory,
+    so the values are equal to the bit) and returns its arrays by name; the variables'
+    chunks are taken from it, so a block is evaluated once for all of them. Keys of the
+    block tasks start with :data:`BLOCK_TASK`.
+    """
+    import dask.array as da
+    from dask.base import tokenize
+    from dask.highlevelgraph import HighLevelGraph
+
+    if not (isinstance(max_chunk, int) and not isinstance(max_chunk, bool) and max_chunk >= 1):
+        raise ValueError(f"max_chunk must be an integer >= 1, got {max_chunk!r}")
+    shape = tuple(axis.size for axis in axes)
+    split = _split(shape, max_chunk)
+    lengths = _block_lengths(chunks, shape, dims, split)
+    block_chunks = tuple(
+        (length,) * (size // length) + ((size % length,) if size % length else ())
+        for size, length in zip(shape, lengths, strict=True)
+    )
+    starts = [np.cumsum((0, *c)) for c in block_chunks]
+    with jax.enable_x64(True):
+        outputs = jax.eval_shape(kernel, *(axis[:1] for axis in axes), *extra)
+    token = tokenize(kernel.__name__, *axes, *extra, max_chunk, block_chunks)
+    name = f"{BLOCK_TASK}-{token}"
+    blocks = {}
+    for index in itertools.product(*(range(len(c)) for c in block_chunks)):
+        region = tuple((int(s[i]), int(s[i + 1])) for s, i in zip(starts, index, strict=True))
+        tiles = functools.partial(_tiles, split, region)
+        blocks[(name, *index)] = (
+            functools.partial(_block, kernel, axes, extra, split, region, tiles),
+        )
+    arrays = {}
+    for variable, spec in outputs.items():
+        layer = f"{variable}-{token}"
+        getters = {(layer, *key[1:]): (operator.getitem, key, variable) for key in blocks}
+        graph = HighLevelGraph({name: blocks, layer: getters}, {name: set(), layer: {name}})
+        arrays[variable] = da.Array(graph, layer, chunks=block_chunks, dtype=spec.dtype)
+    return arrays
+
+
+def _block(kernel, axes, extra, split, region, tiles) -> dict[str, np.ndarray]:
+    """One block of a chunked map: its arrays by name (a dask task)."""
+    out: dict[str, np.ndarray] = {}
+    _fill(out, kernel, axes, extra, split, region, tiles())
+    return out
+
+
+def _grid_values(kernel, axes: dict, extra: tuple, max_chunk: int, chunks) -> dict:
+    """The kernel's results over the grid of ``axes`` (name -> 0-d or 1-D array)."""
+    grid = [np.atleast_1d(axis) for axis in axes.values()]
+    if chunks is None:
+        return _evaluate_grid(kernel, grid, extra, max_chunk)
+    dims = [name if axis.ndim else None for name, axis in axes.items()]
+    return _chunked_grid(kernel, grid, extra, max_chunk, chunks, dims)

@@ -1,0 +1,237 @@
+r"""The per-cycle kernels of the loop read along the stroke (:mod:`ecofmaps.measured.resolved`).
+
+On both slip branches at the same contact position :math:`\xi = \Delta - Q/S`,
+:math:`\mu(\xi) = \tan((\arctan q_+ - \arctan q_-)/2)` and
+:math:`g(\xi) = \tan((\arctan q_+ + \arctan q_-)/2)` with :math:`q_\pm = Q_\pm/P` (eq. 9 at
+the local slope). :func:`_resolve` reads them for a block of cycles at a time, vectorised
+over the cycles: the per-cycle values over each cycle's central part
+(:func:`_central_values`), the values along the stroke on a common grid
+(:func:`_along_stroke`), and the checks of :data:`QUALITY_FLAGS`. The method and its checks
+are described in :mod:`ecofmaps.measured.resolved`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ecofmaps._interrupts import check_interrupted
+from ecofmaps.measured.quality import (
+    ALL,
+    REASONS,
+    RESOLVED,
+    add_reason,
+    has_reason,
+)
+from ecofmaps.measured.resampling import branch_noise, read_branches, sample_weights
+from ecofmaps.measured.stick_slip import masked_median, masked_sum, slip_branches
+
+__all__ = ["QUALITY_FLAGS"]
+
+#: Quality flags, in the order they are tested.
+#: The reasons this reading adds to a cycle's ``quality`` (ecofmaps.measured.quality).
+QUALITY_FLAGS = ("stiffness-mismatch", "no-overlap", "few-slip-samples", "mu-varies")
+
+#: μ(ξ) varies along the stroke when the means over the inner and the outer half of the
+#: central part differ by this share of μ and by this many standard errors.
+_VARIATION = 0.03
+_VARIATION_SIGNIFICANCE = 4.0
+
+#: Values of μ(ξ) beyond this many robust standard deviations of the median are clipped.
+_WINSOR = 3.0
+
+#: Cycles analysed together: a block's arrays stay in the processor's cache.
+_BLOCK = 512
+
+#: Points of each cycle's own grid over its central part, for the per-cycle values.
+_CENTRAL_POINTS = 201
+
+#: Fewest slip samples of each branch in the central part.
+_SLIP_SAMPLES = 8
+
+#: The median absolute deviation of a normal distribution over its standard deviation.
+_MAD = 1.482602218505602
+
+
+# Arrays of shape (cycles, width), rows running once round a loop from its lowest
+# displacement; ``valid`` marks the loop's points, NaN padding elsewhere.
+
+
+def _central_values(forward, backward, central, load):
+    """mu_resolved, its noise variance, k and g0 of g ≈ g0 + kξ, the sensitivity to 1/S.
+
+    Read on each cycle's own grid over its central part, ``|ξ| <= central``: nothing here
+    depends on the other cycles. Also whether μ(ξ) varies between the inner and the outer
+    half of the part beyond ``_VARIATION`` of μ and beyond its noise.
+    """
+    width = forward[0].shape[1]
+    usable = np.isfinite(central)
+    unit = np.linspace(-1.0, 1.0, _CENTRAL_POINTS)
+    at = central[:, None] * unit[None, :]
+    inside = np.broadcast_to(usable[:, None], at.shape)
+    q_forward, q_backward, mu, slope, lines = read_branches(
+        forward, backward, unit, central, inside, load
+    )
+    finite = np.isfinite(mu)
+    points = np.count_nonzero(finite, axis=1)
+    middle = masked_median(mu, finite)
+    bound = (_WINSOR * _MAD * masked_median(np.abs(mu - middle[:, None]), finite))[:, None]
+    clipped = np.clip(mu, middle[:, None] - bound, middle[:, None] + bound)
+    mu_resolved = masked_sum(clipped, finite) / points
+    # The noise variance: each branch's noise through the weights of its samples. The same
+    # for the difference between the means over the inner and the outer half of the part.
+    kept = finite & (np.abs(mu - middle[:, None]) <= bound)
+    inner = kept & (np.abs(unit) <= 0.5)
+    outer = kept & ~inner
+    inner_points = np.count_nonzero(inner, axis=1)[:, None]
+    outer_points = np.count_nonzero(outer, axis=1)[:, None]
+    contrast = np.where(inner, 1.0 / inner_points, np.where(outer, -1.0 / outer_points, 0.0))
+    variation = masked_sum(mu * contrast, kept)
+    factor = 0.5 * (1.0 + mu**2) / load
+    variance = np.zeros(central.size)
+    variation_variance = np.zeros(central.size)
+    for branch, force, (left, share), sign in (
+        (forward, q_forward, lines[0], 1.0),
+        (backward, q_backward, lines[1], -1.0),
+    ):
+        gain = np.where(kept, sign * factor / (1.0 + (force / load) ** 2), 0.0)
+        noise = branch_noise(*branch, central) ** 2
+        weight = sample_weights(left, share, gain / points[:, None], width)
+        variance += noise * np.sum(weight**2, axis=1)
+        weight = sample_weights(left, share, gain * contrast, width)
+        variation_variance += noise * np.sum(weight**2, axis=1)
+    varies = (np.abs(variation) > _VARIATION * np.abs(mu_resolved)) & (
+        np.abs(variation) > _VARIATION_SIGNIFICANCE * np.sqrt(variation_variance)
+    )
+    mean_xi = masked_sum(at, finite) / points
+    mean_g = masked_sum(slope, finite) / points
+    dxi = at - mean_xi[:, None]
+    k = masked_sum(dxi * (slope - mean_g[:, None]), finite) / masked_sum(dxi**2, finite)
+    # The sensitivity of mu_resolved to the compliance 1/S (module notes).
+    turning = k[:, None] / (1.0 + slope**2) * (q_forward - q_backward)
+    sensitivity = 0.5 * (1.0 + mu_resolved**2) * masked_sum(turning, finite) / points
+    return mu_resolved, variance, k, mean_g - k * mean_xi, sensitivity, varies
+
+
+def _along_stroke(forward, backward, grid, lowest, highest, tilt, load, level):
+    """Q±, μ, g (levelled by ``tilt`` if ``level``) and h over the common ``grid``."""
+    cycles = lowest.size
+    inside = np.isfinite(tilt)[:, None] & (grid >= lowest[:, None]) & (grid <= highest[:, None])
+    q_forward, q_backward, mu, slope, _ = read_branches(
+        forward, backward, grid, np.ones(cycles), inside, load
+    )
+    if level:
+        slope = slope - tilt[:, None]
+    # The felt profile: trapezoidal integral of g, zero at ξ = 0.
+    pieces = np.nan_to_num(0.5 * (slope[:, 1:] + slope[:, :-1]) * np.diff(grid))
+    profile = np.concatenate([np.zeros((cycles, 1)), np.cumsum(pieces, axis=1)], axis=1)
+    profile -= profile[:, np.searchsorted(grid, 0.0)][:, None]
+    return {
+        "mu": mu,
+        "slope": slope,
+        "felt_profile": np.where(inside, profile, np.nan),
+        "force_forward": q_forward,
+        "force_backward": q_backward,
+    }
+
+
+#: The values along the stroke, over (cycle, position).
+_ALONG = ("mu", "slope", "felt_profile", "force_forward", "force_backward")
+
+
+def _reaches_resolved(quality) -> np.ndarray:
+    """True for the cycles whose ``quality`` lists a reason that leaves the resolved values NaN."""
+    reaching = [
+        r for r, (_, scope) in REASONS.items() if scope == ALL or set(RESOLVED) & set(scope)
+    ]
+    return np.logical_or.reduce([has_reason(quality, reason) for reason in reaching])
+
+
+def _blocks(cycles):
+    """Slices of at most ``_BLOCK`` cycles: the arrays of a block stay in the cache."""
+    return [slice(start, start + _BLOCK) for start in range(0, max(cycles, 1), _BLOCK)]
+
+
+def _resolve(x, q, valid, load, stiffness, amplitude, quality, given, options):
+    """Every resolved quantity of the centred loops ``x``, ``q`` (module notes).
+
+    ``stiffness`` is the given S (``given`` True) or analyze_loops's, per cycle, and
+    ``quality`` analyze_loops's: a cycle it flags for a reason that reaches the resolved
+    values is not read. Returns the per-position and per-cycle arrays, the quality (with
+    this reading's reasons added) and the grid. The work is done on blocks of cycles, each
+    block vectorised.
+    """
+    inherited = _reaches_resolved(quality)
+    cycles = x.shape[0]
+    parts = []
+    for block in _blocks(cycles):
+        check_interrupted()
+        part = slip_branches(
+            x[block],
+            q[block],
+            valid[block],
+            stiffness[block],
+            amplitude[block],
+            given,
+            options["stick_window"],
+            options["slip_threshold"],
+        )
+        lowest, highest = part["lowest"], part["highest"]
+        overlap = (lowest < 0.0) & (highest > 0.0)
+        usable = ~inherited[block] & ~part["mismatch"] & overlap
+        central = np.where(usable, options["central"] * np.minimum(highest, -lowest), np.nan)
+        values = _central_values(part["forward"], part["backward"], central, load)
+        samples = [
+            np.count_nonzero(np.abs(np.where(np.isfinite(xs), xs, np.inf)) <= central[:, None], 1)
+            for xs, _, _ in (part["forward"], part["backward"])
+        ]
+        few = (np.minimum(*samples) < _SLIP_SAMPLES) | ~np.isfinite(values[0])
+        flags = (part["mismatch"], ~overlap, few, values[5])
+        part["flags"] = np.where(inherited[block], 0, np.select(flags, range(1, 5), 0))
+        part["values"] = values
+        parts.append(part)
+
+    def joined(name):
+        return np.concatenate([part[name] for part in parts])
+
+    flag = joined("flags")
+    for code, reason in enumerate(QUALITY_FLAGS, start=1):
+        quality = add_reason(quality, flag == code, reason)
+    ok = ~inherited & (flag == 0)
+    lowest, highest = joined("lowest"), joined("highest")
+    mu_resolved, variance, k, tilt, sensitivity = (
+        np.concatenate([part["values"][i] for part in parts]) for i in range(5)
+    )
+    nan = np.where(ok, 1.0, np.nan)
+    compliance = joined("compliance")
+    per_cycle = {
+        "mu_resolved": mu_resolved * nan,
+        "mu_resolved_se": np.sqrt(variance + (sensitivity * joined("compliance_se")) ** 2) * nan,
+        "aspect_ratio": 0.5 * k * amplitude * nan,
+        "tilt": tilt * nan,
+        "stiffness": 1.0 / compliance,
+        "position_min": lowest * nan,
+        "position_max": highest * nan,
+    }
+    # Over the grid of positions common to all cycles: the values along the stroke.
+    grid = options["positions"]
+    if grid is None:
+        return {}, per_cycle, quality, None
+    if np.ndim(grid) == 0:  # over the widest resolved range, or the stroke if none is
+        reach = np.maximum(highest, -lowest)[ok]
+        half = reach.max() if reach.size else np.max(amplitude, initial=0.0, where=amplitude > 0)
+        grid = np.linspace(-1.0, 1.0, grid) * (half if half > 0.0 else 1.0)
+    per_position = {name: np.empty((cycles, grid.size)) for name in _ALONG}
+    for part, block in zip(parts, _blocks(cycles), strict=True):
+        along = _along_stroke(
+            part["forward"],
+            part["backward"],
+            grid,
+            lowest[block],
+            highest[block],
+            per_cycle["tilt"][block],
+            load,
+            options["force_offset"] is None,
+        )
+        for name in _ALONG:
+            per_position[name][block] = along[name]
+    return per_position, per_cycle, quality, grid

@@ -1,0 +1,217 @@
+r"""The per-cycle results of :func:`~ecofmaps.measured.analysis.analyze_loops` as a Dataset.
+
+:func:`cycle_results` turns the measurements of
+:func:`ecofmaps.measured.per_cycle.measure_cycles` into the labelled per-cycle Dataset (NaN
+with a reason in ``quality`` where a check fails, the regime codes), and :class:`Tally`
+gathers what is said about a whole recording from its parts as they come (the quality
+summary, the refusal of every cycle with a hint, the check of the amplitude's unit), so a
+recording analysed in parts (:mod:`ecofmaps.measured.out_of_core`) gives the same result.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ecofmaps import _nomenclature as nomenclature
+from ecofmaps._codes import warn
+from ecofmaps.measured.cycles import Cycles
+from ecofmaps.measured.quality import (
+    ALL,
+    REASONS,
+    LoopQualityWarning,
+    apply_quality,
+    quality_strings,
+    summary_of_counts,
+)
+from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP, Regime
+
+__all__ = ["Tally", "cycle_results", "strip", "with_loops", "with_read_along_stroke"]
+
+
+#: How the quantities are measured on a loop (the netCDF ``comment`` attribute).
+_COMMENTS = {
+    "slip_amplitude": "half the loop's width at Q = 0",
+    "dissipated_energy": "the loop's area",
+    "stiffness": "slope of the stick segments",
+    "regime": "GROSS_SLIP when the energy ratio exceeds gross_slip_threshold, else NO_GROSS_SLIP "
+    "(partial slip); INVALID where the cycle is refused",
+    "quality": "'ok' or the reasons for NaN, joined by '+' (ecofmaps.measured.quality)",
+}
+
+
+#: Plausible displacement amplitudes: outside this range the unit is probably wrong. [m]
+_AMPLITUDE_RANGE = (0.1e-6, 10e-3)
+
+
+def _attrs(name: str) -> dict:
+    attrs = nomenclature.attrs(name)
+    if name in _COMMENTS:
+        attrs["comment"] = _COMMENTS[name]
+    return attrs
+
+
+def _refusal_hint(flags: dict) -> str:
+    """What the user may do about a recording whose every cycle is refused (``flags``:
+    whether every cycle, or any for ``negative-stiffness``, carries the reason)."""
+    if flags["missing-samples"]:
+        return "Every cycle holds a missing sample (NaN or an empty cell)."
+    if flags["anticlockwise"]:
+        if flags["negative-stiffness"]:
+            return (
+                "The loops run anticlockwise with stick sides sloping down: the force is "
+                "recorded positive against the displacement. If so, read it with the other "
+                "sign: flip_force=True (on the command line, --flip-force)."
+            )
+        return (
+            "The loops run anticlockwise with stick sides sloping up: the recording runs "
+            "backwards in time, or the displacement and force columns are swapped."
+        )
+    if flags["constant-force"]:
+        return "The force does not vary: is the force channel connected?"
+    return (
+        "Is it a recording of fretting loops, with the displacement and the force in their "
+        "own columns?"
+    )
+
+
+def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
+    """``results`` with the centred loops of :func:`measure_cycles` (``keep_loops=True``)."""
+    results["loop_displacement"] = (("cycle", "point"), loops[0], _attrs("loop_displacement"))
+    results["loop_force"] = (("cycle", "point"), loops[1], _attrs("loop_force"))
+    results.coords["point"] = ("point", np.arange(loops[0].shape[1]), _attrs("point"))
+    return results
+
+
+def with_read_along_stroke(results: xr.Dataset) -> xr.Dataset:
+    """``results`` (with its loops) with the values read along the stroke
+    (:data:`ecofmaps.measured.resolved.REPORTED`), and that reading's quality."""
+    from ecofmaps.measured.resolved import resolve_analyzed_loops, with_resolved  # built on this
+
+    return with_resolved(results, resolve_analyzed_loops(results, positions=None))
+
+
+def cycle_results(values: dict, flags: dict, label, load: float, options: dict) -> xr.Dataset:
+    """The per-cycle Dataset of :func:`analyze_loops` for some cycles, without the
+    recording's attributes: ``values`` and ``flags`` from :func:`measure_cycles`.
+
+    The raw amplitudes and whether each cycle is refused ride along as ``_amplitude`` and
+    ``_refused`` until :meth:`Tally.finish` takes them off.
+    """
+    size = label.size
+    quality = quality_strings(flags, size)
+    refused = np.zeros(size, dtype=bool)
+    for reason, flag in flags.items():
+        refused |= flag & (REASONS[reason][1] == ALL)
+    raw_amplitude = values["amplitude"]
+    values = apply_quality(values, flags)
+    sliding = values["energy_ratio"] > options["gross_slip_threshold"]
+    regime = np.where(refused, INVALID, np.where(sliding, GROSS_SLIP, NO_GROSS_SLIP))
+    names = [name for name in values if name != "stick_residual"]
+    data = {name: ("cycle", values[name], _attrs(name)) for name in names}
+    data["regime"] = ("cycle", regime.astype(np.int32), _attrs("regime") | Regime.flag_attrs())
+    data["stick_residual"] = ("cycle", values["stick_residual"], _attrs("stick_residual"))
+    data["quality"] = ("cycle", quality, _attrs("quality"))
+    data["_amplitude"] = ("cycle", raw_amplitude)
+    data["_refused"] = ("cycle", refused)
+    hints = {
+        "missing-samples": flags["missing-samples"],
+        "anticlockwise": flags["anticlockwise"],
+        "constant-force": flags["constant-force"],
+    }
+    for reason, flag in hints.items():
+        data[f"_{reason}"] = ("cycle", flag)
+    data["_negative-stiffness"] = ("cycle", flags["negative-stiffness"])
+    coords = {"cycle": ("cycle", label, _attrs("cycle")), "load": ((), load, _attrs("load"))}
+    return xr.Dataset(data, coords=coords)
+
+
+class Tally:
+    """What :func:`analyze_loops` says about a whole recording, gathered from its parts
+    (:func:`cycle_results`) as they come: the quality summary, whether every cycle was
+    refused, and the typical amplitude."""
+
+    def __init__(self):
+        self.counts: dict = {}
+        self.cycles = self.refused = self.flagged = 0
+        self.every = {"missing-samples": True, "anticlockwise": True, "constant-force": True}
+        self.negative_stiffness = False
+        self.amplitudes: list = []
+
+    def add(self, part: xr.Dataset) -> xr.Dataset:
+        """Count the cycles of ``part``; return it without its riders."""
+        texts, counts = np.unique(part.quality.values, return_counts=True)
+        for text, count in zip(texts.tolist(), counts.tolist(), strict=True):
+            self.counts[text] = self.counts.get(text, 0) + count
+            if text not in ("ok", "not-gross-slip"):
+                self.flagged += count
+        self.cycles += part.cycle.size
+        self.refused += int(part["_refused"].sum())
+        for reason in self.every:
+            self.every[reason] &= bool(part[f"_{reason}"].all())
+        self.negative_stiffness |= bool(part["_negative-stiffness"].any())
+        self.amplitudes.append(part["_amplitude"].values)
+        return strip(part)
+
+    @property
+    def summary(self) -> str:
+        """The one-line quality summary so far."""
+        return summary_of_counts(self.counts)
+
+    def finish(self, results, cycles: Cycles, cycles_from: str, options: dict) -> xr.Dataset:
+        """Check the whole recording and give ``results`` (the parts, joined) its
+        attributes.
+
+        Raises
+        ------
+        ValueError
+            If every cycle was refused.
+        """
+        summary = self.summary
+        _check_units(np.concatenate(self.amplitudes) if self.amplitudes else np.zeros(0))
+        if self.cycles and self.refused == self.cycles:
+            hint = dict(self.every, **{"negative-stiffness": self.negative_stiffness})
+            raise ValueError(
+                f"no plausible cycle in the recording ({summary}). {_refusal_hint(hint)}"
+            )
+        if self.flagged:
+            warn(f"cycles flagged: {summary}", LoopQualityWarning)
+        results = strip(results)
+        results.attrs.update(
+            {
+                "title": "Fretting loops analysed cycle by cycle (ecofmaps.analyze_loops)",
+                "cycles_from": cycles_from,
+                "incomplete_cycles": cycles.incomplete_cycles,
+                "dropped_samples": cycles.dropped_samples,
+                "missing_samples": cycles.missing_samples,
+                "first_missing_sample": cycles.first_missing,
+                "skipped_cycles": int(self.counts_of("missing-samples")),
+                "gross_slip_threshold": options["gross_slip_threshold"],
+                "flip_force": int(options["flip_force"]),
+                "quality_summary": summary,
+            }
+        )
+        return results
+
+    def counts_of(self, reason: str) -> int:
+        """Cycles whose quality lists ``reason``."""
+        return sum(c for text, c in self.counts.items() if reason in text.split("+"))
+
+
+def strip(part: xr.Dataset) -> xr.Dataset:
+    """``part`` without the riders of :func:`cycle_results`."""
+    return part.drop_vars([name for name in part.data_vars if str(name).startswith("_")])
+
+
+def _check_units(amplitude):
+    """Warn when the displacement amplitudes look like another unit than metres."""
+    finite = amplitude[np.isfinite(amplitude)]
+    typical = float(np.median(finite)) if finite.size else np.nan
+    low, high = _AMPLITUDE_RANGE
+    if np.isfinite(typical) and not low <= typical <= high:
+        warn(
+            f"the displacement amplitude is {typical:.3g} m (median over the cycles), outside "
+            "0.1 µm to 10 mm: is the displacement in metres? analyze_loops takes SI units; "
+            "on the command line, --displacement-unit gives the unit of the column",
+            LoopQualityWarning,
+        )

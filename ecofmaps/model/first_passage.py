@@ -1,0 +1,406 @@
+r"""The steady loop on a scar profile, read off the tables of :mod:`ecofmaps.model.profile_core`.
+
+In the units of :mod:`ecofmaps.model.profile_core` (lengths over the stroke
+:math:`A = \Delta^* W/x_o`, the rig through :math:`\lambda = P/(S\Delta^*)`, slip branches
+:math:`F_\pm(\xi) = \xi + \lambda q_\pm(\xi)`): :func:`steady_loop` finds the loop's ends by
+first passage, :func:`jump_area` adds the areas of the jumps, :func:`draw_loop` draws the
+loop, and :func:`simulation_tables` and :func:`simulation_step` run the quasi-static return
+map in time.
+
+The steady loop by first passage
+--------------------------------
+On a stroke from :math:`\xi_s` to :math:`D = 1` the pad stops at the first
+:math:`\xi \ge \xi_s` with :math:`F_+(\xi) \ge 1` (the quasi-static return map; where
+:math:`F_+` falls, the pad jumps ahead at constant :math:`D`). Starting at rest at the scar
+centre, three first passages (forward, backward, forward) reach the steady loop
+:math:`[\xi_-, \xi_+]`: after them the return map is at a fixed point (the forward map is
+monotone, and :math:`F_+ < 1` on :math:`[\xi_-, \xi_+)`, :math:`F_- > -1` on
+:math:`(\xi_-, \xi_+]`). :math:`\delta^* = \Delta^*(\xi_+ - \xi_-)/2`.
+
+The energy is the loop's area, :math:`E_d = \oint Q\,d\Delta = \oint Q\,dx`, with
+:math:`Q = S(\Delta - x)` during a jump; in the units above
+:math:`E_d/(S\Delta^{*2}) = \int_{\xi_-}^{\xi_+} (M_+ - M_-)\,d\xi`, where :math:`M_+` is
+the running maximum of :math:`F_+` from :math:`\xi_-` and :math:`M_-` the running minimum
+of :math:`F_-` from :math:`\xi_+`. Without jumps :math:`M_\pm = F_\pm` and
+
+.. math:: \frac{\mu_E}{\mu} = 1 + \frac{1}{\xi_+ - \xi_-}\int_{\xi_-}^{\xi_+}
+          e\,d\xi, \qquad e = \frac{q_+ - q_-}{2\mu} - 1
+          = \frac{(1 + \mu^2)g^2}{1 - \mu^2 g^2} \ge 0,
+
+so :math:`\mu_E \ge \mu` on every profile; jumps add :math:`\int (M_+ - F_+) -
+\int (M_- - F_-) \ge 0` over :math:`4\lambda d`.
+
+The functions here are pure ``jax.numpy`` and check nothing.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+
+from ecofmaps.model.profile_core import (
+    Side,
+    Tables,
+    _crossing,
+    _levels,
+    _sparse,
+    mean_excess,
+    mean_traction,
+    traction_forward,
+)
+from ecofmaps.model.regimes import BEYOND_PROFILE, GROSS_SLIP, NO_GROSS_SLIP, SELF_LOCKING
+
+__all__ = [
+    "SteadyLoop",
+    "draw_loop",
+    "jump_area",
+    "simulation_step",
+    "simulation_tables",
+    "steady_loop",
+]
+
+
+class SteadyLoop(NamedTuple):
+    """The steady loop of one point, in the units of the module docstring."""
+
+    minus: jax.Array  # xi_-
+    plus: jax.Array  # xi_+
+    ecof_ratio: jax.Array  # 1 + mean excess (without the jumps' share)
+    monotone: jax.Array  # no jumps: F_+ and F_- monotone over [xi_-, xi_+]
+    peak_force: jax.Array  # largest Q/P over the loop
+    regime: jax.Array  # Regime code (GROSS_SLIP, NO_GROSS_SLIP, SELF_LOCKING, BEYOND_PROFILE)
+    ends: tuple  # ((k_-, t_-), (k_+, t_+)) segments and fractions of the ends
+
+
+def _at(table, group, *index):
+    """``table[group, *index]`` as one gather from the flattened table (XLA's gathers with
+    several index dimensions are several times slower on CPU)."""
+    flat = group
+    for size, i in zip(table.shape[1:], index, strict=True):
+        flat = flat * size + i
+    return table.reshape(-1)[flat]
+
+
+def _first_holding(side: Side, group, value, begin, sparse: bool):
+    """First sample index >= ``begin`` whose interval does not hold ``value``, or N."""
+    n = side.position.shape[-1]
+    if sparse:
+        index = begin
+        rows = side.bounds.reshape(-1, 2)
+        levels, columns = side.bounds.shape[1:3]
+        for level in reversed(range(levels)):
+            bounds = rows[(group * levels + level) * columns + jnp.minimum(index, n)]
+            below = (bounds[..., 0] < value) & (value < bounds[..., 1])
+            index = jnp.where(below, index + 2**level, index)
+        return jnp.minimum(index, n)
+    lower, upper = side.bounds[group, 0, :n, 0], side.bounds[group, 0, :n, 1]
+    holds = ~((lower < value) & (value < upper)) & (jnp.arange(n) >= begin)
+    return jnp.where(jnp.any(holds), jnp.argmax(holds), n)
+
+
+def _range(table, group, first, last, combine, identity, sparse: bool):
+    """``combine`` over ``table[group]`` at indices ``first..last`` (identity if empty)."""
+    if sparse:
+        count = jnp.maximum(last - first + 1, 1).astype(jnp.int32)
+        level = 31 - jax.lax.clz(count)
+        a = _at(table, group, level, first)
+        b = _at(table, group, level, jnp.maximum(last - jnp.left_shift(1, level) + 1, 0))
+        return jnp.where(last >= first, combine(a, b), identity)
+    row = table[group, 0]
+    index = jnp.arange(row.size)
+    inside = (index >= first) & (index <= last)
+    values = jnp.where(inside, row, identity)
+    return values.max() if identity == -jnp.inf else values.min()
+
+
+def _normal(segment, fraction, n: int):
+    """``(k, t)`` with ``t < 1`` unless at the last sample."""
+    roll = (fraction >= 1.0) & (segment < n - 2)
+    return segment + roll, jnp.where(roll, 0.0, jnp.minimum(fraction, 1.0))
+
+
+def _mirror(segment, fraction, n: int):
+    """The same position on the mirrored profile."""
+    return _normal(n - 2 - segment, 1.0 - fraction, n)
+
+
+def _point(side: Side, group, segment, fraction):
+    """Position and slope at ``(segment, fraction)``."""
+    p0, p1 = _at(side.position, group, segment), _at(side.position, group, segment + 1)
+    g0, g1 = _at(side.slope, group, segment), _at(side.slope, group, segment + 1)
+    return p0 + fraction * (p1 - p0), g0 + fraction * (g1 - g0)
+
+
+def _passage(side: Side, group, mu, lam, value, level, segment, fraction, sparse: bool):
+    """First passage of ``F_+ >= level`` from ``(segment, fraction)``: new position, ran off."""
+    n = side.position.shape[-1]
+    start, start_slope = _point(side, group, segment, fraction)
+    force = jnp.where(lam > 0.0, lam * traction_forward(start_slope, mu), 0.0)
+    stick = start + force >= level
+    j = _first_holding(side, group, value, segment + 1, sparse)
+    off = (j >= n) & ~stick
+    j = jnp.clip(j, 1, n - 1)
+    same = j - 1 == segment
+    left = _at(side.position, group, j - 1)
+    a = jnp.where(same, start, left)
+    slope_a = jnp.where(same, start_slope, _at(side.slope, group, j - 1))
+    b, slope_b = _at(side.position, group, j), _at(side.slope, group, j)
+    t = _crossing(a, b - a, slope_a, slope_b - slope_a, mu, lam, level)
+    reached = a + t * (b - a)
+    new = _normal(j - 1, (reached - left) / (b - left), n)
+    return jnp.where(stick, segment, new[0]), jnp.where(stick, fraction, new[1]), off
+
+
+def steady_loop(tables: Tables, group, lam, sparse: bool = True) -> SteadyLoop:
+    r"""The steady loop of one point (see module): ends, :math:`\mu_E/\mu`, peak, regime.
+
+    Parameters
+    ----------
+    tables : Tables
+        From :func:`profile_tables` (stacked over groups).
+    group : jax.Array of int, shape ()
+        The point's group (its :math:`\mu` and :math:`A`).
+    lam : jax.Array, shape ()
+        :math:`\lambda = P/(S\Delta^*)` >= 0.
+    sparse : bool
+        Whether ``tables`` were built sparse.
+
+    Returns
+    -------
+    loop : SteadyLoop
+        ``ecof_ratio`` lacks the jumps' share where ``monotone`` is False (:func:`jump_area`).
+    """
+    forward, backward = tables.forward, tables.backward
+    n = forward.position.shape[-1]
+    mu = _at(tables.mu, group)
+    k, t = _at(tables.start_segment, group), _at(tables.start_fraction, group)
+    k, t, off_1 = _passage(forward, group, mu, lam, lam, 1.0, k, t, sparse)
+    k, t, off_2 = _passage(backward, group, mu, lam, lam, 1.0, *_mirror(k, t, n), sparse)
+    k_minus, t_minus = _mirror(k, t, n)
+    k_plus, t_plus, off_3 = _passage(forward, group, mu, lam, lam, 1.0, k_minus, t_minus, sparse)
+    minus, slope_minus = _point(forward, group, k_minus, t_minus)
+    plus, slope_plus = _point(forward, group, k_plus, t_plus)
+    width = plus - minus
+
+    # The integral of e over [xi_-, xi_+]: the table between the samples inside and the end
+    # pieces, each taken from the sample on the loop's side (a locking point, where e is
+    # singular, can lie just beyond either end).
+    def piece(a, slope_a, b, slope_b):
+        return (b - a) * mean_excess(slope_a, slope_b, mu)
+
+    after, slope_after = _point(forward, group, k_minus + 1, 0.0)
+    before, slope_before = _point(forward, group, k_plus, 0.0)
+    table = _at(tables.excess, group, k_plus) - _at(tables.excess, group, k_minus + 1)
+    split = piece(minus, slope_minus, after, slope_after) + table
+    split = split + piece(before, slope_before, plus, slope_plus)
+    integral = jnp.where(k_minus == k_plus, piece(minus, slope_minus, plus, slope_plus), split)
+    stuck = width == 0.0
+    ratio = 1.0 + integral / jnp.where(stuck, 1.0, width)
+    critical = _range(tables.critical, group, k_minus, k_plus, jnp.minimum, jnp.inf, sparse)
+    peak = _range(tables.peak, group, k_minus + 1, k_plus, jnp.maximum, -jnp.inf, sparse)
+    peak = jnp.maximum(
+        peak, jnp.maximum(traction_forward(slope_minus, mu), traction_forward(slope_plus, mu))
+    )
+    trough = _range(tables.trough, group, k_minus + 1, k_plus, jnp.maximum, -jnp.inf, sparse)
+    trough = jnp.maximum(
+        trough, jnp.maximum(traction_forward(-slope_minus, mu), traction_forward(-slope_plus, mu))
+    )
+    # A rigid rig passes a locking point; a rig stiff enough to stop the pad within rounding
+    # of one (lambda ~ 1e-17 of the stroke) gives an infinite force there too.
+    locked = ~(jnp.isfinite(peak) & jnp.isfinite(trough) & jnp.isfinite(integral))
+    stick_force = (1.0 - plus) / jnp.where(lam > 0.0, lam, 1.0)  # the stick line at D = 1
+    off = off_1 | off_2 | off_3
+    regime = jnp.where(
+        off,
+        int(BEYOND_PROFILE),
+        jnp.where(locked, int(SELF_LOCKING), jnp.where(stuck, int(NO_GROSS_SLIP), int(GROSS_SLIP))),
+    ).astype(jnp.int32)
+    return SteadyLoop(
+        minus=minus,
+        plus=plus,
+        ecof_ratio=jnp.where(stuck, jnp.nan, ratio),
+        monotone=stuck | (lam <= critical),
+        peak_force=jnp.where(stuck, stick_force, peak),
+        regime=regime,
+        ends=((k_minus, t_minus), (k_plus, t_plus)),
+    )
+
+
+def _running_levels(side: Side, group, mu, lam, start, end):
+    """Per segment of a forward stroke from ``start`` to ``end`` (``(k, t)`` pairs): the
+    piece ``[a, b]`` it covers, its slopes, and the running maximum ``L`` of :math:`F_+`
+    at ``a`` (from the stroke's start)."""
+    n = side.position.shape[-1]
+    p, g, q = side.position[group], side.slope[group], side.force[group]
+    (k_a, t_a), (k_b, t_b) = start, end
+    xa, ga = _point(side, group, k_a, t_a)
+    xb, gb = _point(side, group, k_b, t_b)
+    values = p + jnp.where(lam > 0.0, lam * q, 0.0)
+    index = jnp.arange(n)
+    inside = (index > k_a) & (index <= k_b)
+    fa = xa + jnp.where(lam > 0.0, lam * traction_forward(ga, mu), 0.0)
+    running = jnp.maximum(fa, jax.lax.cummax(jnp.where(inside, values, -jnp.inf)))
+    segment = jnp.arange(n - 1)
+    first, last = segment == k_a, segment == k_b
+    a = jnp.where(first, xa, p[:-1])
+    slope_a = jnp.where(first, ga, g[:-1])
+    b = jnp.where(last, xb, p[1:])
+    slope_b = jnp.where(last, gb, g[1:])
+    level = jnp.where(first, fa, running[:-1])
+    value_b = jnp.where(
+        last, xb + jnp.where(lam > 0.0, lam * traction_forward(gb, mu), 0.0), values[1:]
+    )
+    active = (segment >= k_a) & (segment <= k_b) & (b > a)
+    return a, b, slope_a, slope_b, level, value_b, active
+
+
+def jump_area(side: Side, group, mu, lam, start, end):
+    r""":math:`\int (M_+ - F_+)\,d\xi` over a forward stroke from ``start`` to ``end``.
+
+    :math:`M_+` is the running maximum of :math:`F_+` from the stroke's start: the actuator
+    position while the pad slips or jumps. On each segment piece :math:`[a, b]`,
+    :math:`F_+` (convex) lies below the level :math:`L = M_+(a)` on :math:`[a, c)`, where
+    :math:`c` is where it climbs back to :math:`L` (:func:`_crossing`), or :math:`b`. The
+    area there is :math:`(c - a)(L - (a + c)/2 - \lambda\bar q_+)`. :math:`O(N)`.
+
+    Parameters
+    ----------
+    side : Tables.forward or Tables.backward
+    group : jax.Array of int
+    mu, lam : jax.Array
+    start, end : tuple of (segment, fraction)
+        The stroke's ends on ``side``.
+
+    Returns
+    -------
+    area : jax.Array
+        >= 0, in units of :math:`A^2` (0 where :math:`F_+` rises all along).
+    """
+    a, b, slope_a, slope_b, level, value_b, active = _running_levels(
+        side, group, mu, lam, start, end
+    )
+    change = slope_b - slope_a
+    t = _crossing(a, b - a, slope_a, change, mu, lam, level)
+    t = jnp.where(value_b >= level, t, 1.0)
+    c = a + t * (b - a)
+    slope_c = slope_a + t * change
+    area = (c - a) * (level - 0.5 * (a + c) - lam * mean_traction(slope_a, slope_c, mu))
+    return jnp.sum(jnp.where(active & (c > a), area, 0.0))
+
+
+def _branch(side: Side, group, mu, lam, start, end, num: int):
+    """``num`` points of a forward stroke from ``start`` to ``end``: actuator D and Q/P."""
+    a, b, slope_a, slope_b, level, _, _ = _running_levels(side, group, mu, lam, start, end)
+    xa, _ = _point(side, group, *start)
+    xb, _ = _point(side, group, *end)
+    xi = xa + (xb - xa) * jnp.linspace(0.0, 1.0, num)
+    xi = xi.at[-1].set(xb)
+    segment = jnp.arange(b.size)
+    ends = jnp.where(segment < start[0], -jnp.inf, jnp.where(segment > end[0], jnp.inf, b))
+    k = jnp.clip(jnp.searchsorted(ends, xi, side="left"), start[0], end[0])
+    fraction = jnp.where(b[k] > a[k], (xi - a[k]) / jnp.where(b[k] > a[k], b[k] - a[k], 1.0), 0.0)
+    slope = slope_a[k] + fraction * (slope_b[k] - slope_a[k])
+    q = traction_forward(slope, mu)
+    value = xi + jnp.where(lam > 0.0, lam * q, 0.0)
+    actuator = jnp.maximum(level[k], value)
+    slipping = value >= level[k]
+    q = jnp.where(slipping, q, (actuator - xi) / jnp.where(lam > 0.0, lam, 1.0))
+    return actuator, q
+
+
+def draw_loop(tables: Tables, group, lam, loop: SteadyLoop, num: int):
+    """The steady loop's actuator positions D and forces Q/P, ``2 num + 1`` points.
+
+    Starts at the reversal (D = -1), slips forward (jumping where :math:`F_+` falls) to
+    D = 1, then back; the stick segments are the straight lines between the branches.
+    With no gross slip the points lie on the stick line through the stuck position.
+    """
+    n = tables.forward.position.shape[-1]
+    mu = tables.mu[group]
+    lower, upper = loop.ends
+    d_forward, q_forward = _branch(tables.forward, group, mu, lam, lower, upper, num)
+    d_back, q_back = _branch(
+        tables.backward, group, mu, lam, _mirror(*upper, n), _mirror(*lower, n), num
+    )
+    actuator = jnp.concatenate([-d_back[-1:], d_forward, -d_back])
+    force = jnp.concatenate([-q_back[-1:], q_forward, -q_back])
+    stuck = loop.regime == int(NO_GROSS_SLIP)
+    line = jnp.linspace(-1.0, 1.0, 2 * num + 1)
+    stick_force = (line - loop.plus) / jnp.where(lam > 0.0, lam, 1.0)
+    return jnp.where(stuck, line, actuator), jnp.where(stuck, stick_force, force)
+
+
+# ---------------------------------------------------------------------------------------
+# Time-domain return map
+# ---------------------------------------------------------------------------------------
+
+
+def simulation_tables(position, slope, mu, lam) -> Tables:
+    r"""Tables for a time history at one :math:`(\mu, \lambda)`: per sample, the actuator
+    positions :math:`D` at which :math:`F_+ \ge D` fails, :math:`(F_+, \infty)`, sparse.
+
+    ``position`` is in the units of the history (the scar's half-width for
+    :func:`ecofmaps.simulate`), ``lam`` the compliance ratio in the same units.
+    """
+
+    def side(p, g):
+        force = traction_forward(g, mu)
+        values = p + jnp.where(lam > 0.0, lam * force, 0.0)
+        levels = _levels(p.size)
+        lower = jnp.concatenate([values, jnp.array([jnp.inf])])
+        upper = jnp.concatenate([jnp.full(p.size, jnp.inf), jnp.array([-jnp.inf])])
+        bounds = jnp.stack(
+            [
+                _sparse(lower, levels, jnp.maximum, jnp.inf),
+                _sparse(upper, levels, jnp.minimum, -jnp.inf),
+            ],
+            axis=-1,
+        )
+        return Side(p, g, force, bounds)
+
+    n = position.size
+    start = jnp.clip(jnp.searchsorted(position, 0.0, side="right") - 1, 0, n - 2)
+    empty = jnp.zeros((1, 1))
+    tables = Tables(
+        forward=side(position, slope),
+        backward=side(-position[::-1], -slope[::-1]),
+        excess=jnp.zeros(1),
+        critical=empty,
+        peak=empty,
+        trough=empty,
+        mu=mu,
+        start_segment=start,
+        start_fraction=(0.0 - position[start]) / (position[start + 1] - position[start]),
+    )
+    return jax.tree.map(lambda leaf: leaf[None], tables)
+
+
+def simulation_step(tables: Tables, lam, state, actuator):
+    """One step of the return map: the pad sticks or slips to the exact equilibrium.
+
+    ``state`` is ``(segment, fraction, q, off)``; returns the new state and Q/P (NaN once
+    the pad has run off the profile or locked on a rigid rig).
+    """
+    forward, backward = tables.forward, tables.backward
+    n = forward.position.shape[-1]
+    mu = tables.mu[0]
+    k, t, q, off = state
+    x, g = _point(forward, 0, k, t)
+    has_lam = lam > 0.0
+    ahead = x + jnp.where(has_lam, lam * traction_forward(g, mu), 0.0)
+    behind = x - jnp.where(has_lam, lam * traction_forward(-g, mu), 0.0)
+    go_forward = actuator > ahead
+    go_back = actuator < behind
+    kf, tf, off_f = _passage(forward, 0, mu, lam, actuator, actuator, k, t, True)
+    kb, tb, off_b = _passage(backward, 0, mu, lam, -actuator, -actuator, *_mirror(k, t, n), True)
+    kb, tb = _mirror(kb, tb, n)
+    k_new = jnp.where(go_forward, kf, jnp.where(go_back, kb, k))
+    t_new = jnp.where(go_forward, tf, jnp.where(go_back, tb, t))
+    _, g_new = _point(forward, 0, k_new, t_new)
+    q_slip = jnp.where(go_forward, traction_forward(g_new, mu), -traction_forward(-g_new, mu))
+    q_stick = jnp.where(has_lam, (actuator - x) / jnp.where(has_lam, lam, 1.0), q)
+    q_new = jnp.where(go_forward | go_back, q_slip, q_stick)
+    off = off | (go_forward & off_f) | (go_back & off_b) | ~jnp.isfinite(q_new)
+    return (k_new, t_new, q_new, off), jnp.where(off, jnp.nan, q_new)
