@@ -36,7 +36,8 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps import _nomenclature as nomenclature
-from ecofmaps.correction.inversion import CorrectionStatus, correct_ecof
+from ecofmaps.correction.inversion import correct_ecof
+from ecofmaps.correction.outcomes import CorrectionStatus
 from ecofmaps.io.files import FileLineError
 
 __all__ = ["ADDED_COLUMNS", "COLUMNS", "SHORTCUT_COLUMN", "TableError", "correct_table"]
