@@ -35,6 +35,7 @@ The functions here are pure ``jax.numpy`` and check nothing.
 
 from __future__ import annotations
 
+import sys
 from typing import NamedTuple
 
 import jax
@@ -53,6 +54,7 @@ from ecofmaps.model.profile_core import (
 from ecofmaps.model.regimes import BEYOND_PROFILE, GROSS_SLIP, NO_GROSS_SLIP, SELF_LOCKING
 
 __all__ = [
+    "JAMMED_TRACTION",
     "SteadyLoop",
     "draw_loop",
     "jump_area",
@@ -60,6 +62,12 @@ __all__ = [
     "simulation_tables",
     "steady_loop",
 ]
+
+#: Peak traction ratio |Q|/P beyond which a steady loop is reported self-locking, 1/sqrt(eps)
+#: (about 6.7e7): the pad stops so close to a locking point (mu g = 1) that the loop's area,
+#: a difference of forces of that size, is left to rounding (at 1e11 its energy CoF is off
+#: by half, at 1e13 by orders of magnitude). No rig is that stiff: lambda below about 1e-11.
+JAMMED_TRACTION = sys.float_info.epsilon**-0.5
 
 
 class SteadyLoop(NamedTuple):
@@ -208,8 +216,11 @@ def steady_loop(tables: Tables, group, lam, sparse: bool = True) -> SteadyLoop:
         trough, jnp.maximum(traction_forward(-slope_minus, mu), traction_forward(-slope_plus, mu))
     )
     # A rigid rig passes a locking point; a rig stiff enough to stop the pad within rounding
-    # of one (lambda ~ 1e-17 of the stroke) gives an infinite force there too.
+    # of one (lambda ~ 1e-17 of the stroke) gives an infinite force there too. Short of
+    # that, a force above JAMMED_TRACTION times the load leaves the loop's area to rounding
+    # (the pad stops within ~1e-8 of the stroke from the locking point): reported jammed.
     locked = ~(jnp.isfinite(peak) & jnp.isfinite(trough) & jnp.isfinite(integral))
+    locked = locked | (jnp.maximum(peak, trough) > JAMMED_TRACTION)
     stick_force = (1.0 - plus) / jnp.where(lam > 0.0, lam, 1.0)  # the stick line at D = 1
     off = off_1 | off_2 | off_3
     regime = jnp.where(

@@ -22,7 +22,9 @@ class Regime(Code):
         :math:`\\mu|g| \\ge 1` somewhere in the stroke): the pad jams on the groove flank
         before the end of the stroke; no solution. With any compliance the pad stops short
         of such a flank instead, where the rig's force balances it (unless the rig is so
-        stiff that it stops within rounding of the locking point, which is then reported).
+        stiff that it stops within rounding of the locking point, or where the force
+        exceeds ``ecofmaps.model.first_passage.JAMMED_TRACTION`` (6.7e7) times the load,
+        where the loop's area is left to rounding: that is then reported).
     INVALID
         An input outside its valid range (or NaN).
     BEYOND_PROFILE

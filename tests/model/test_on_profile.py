@@ -6,11 +6,12 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import ecofmaps
 from ecofmaps import Regime
+from ecofmaps.model.first_passage import JAMMED_TRACTION
 from ecofmaps.model.on_profile import steady_numbers
 from tests.brute_force import ProfileBruteForce
 
@@ -262,6 +263,8 @@ def test_jit_and_vmap_over_mu_and_amplitude():
     mu=st.floats(0.05, 1.5),
     mu_lam=st.floats(0.0, 0.99),
 )
+# a rig so stiff (S = 4e22 N/m) that the pad stops where Q/P = 8e14: the area was rounding
+@example(hump=0.625, ratio=0.3828125, tilt=0.0, mu=1.0, mu_lam=2.220446049250313e-16)
 def test_properties_on_random_w_shapes(hump, ratio, tilt, mu, mu_lam):
     """On any scar: μ_E >= μ (e >= 0, jumps add), 0 < δ* <= Δ*, E_d = 4Pδ*μ_E > 0."""
     profile = ecofmaps.w_shaped_profile(ratio * W, W, hump, tilt=tilt, samples=1000)
@@ -331,3 +334,22 @@ def test_simulate_bad_input():
         ecofmaps.simulate(np.zeros(3), 450.0, 35e6, 0.8, profile=profile)
     with pytest.raises(ValueError, match="simulate with aspect_ratio needs groove_half_width"):
         ecofmaps.simulate(np.zeros(3), 450.0, 35e6, 0.8, 0.2)
+
+
+def test_a_rig_too_stiff_for_float64_is_self_locking():
+    """On a flank where mu g > 1, a stiffer rig pushes the pad closer to the locking point:
+    the force and mu_E grow (mu_E by about 0.35 a decade of S here), until the force exceeds
+    JAMMED_TRACTION times the load, where the loop's area is rounding (at S = 4e22 N/m it
+    came out as -8.9e8): there the regime is SELF_LOCKING and the numbers NaN, with a reason."""
+    profile = ecofmaps.w_shaped_profile(0.3828125e-3, 1e-3, 0.625, samples=1000)
+    rig = dict(amplitude=50e-6, load=450.0, mu=1.0, profile=profile)
+    lams = np.array([1e-3, 1e-6, 1e-8])
+    stiffness = 450.0 / (lams * 50e-6)
+    ecof = ecofmaps.energy_cof(**rig, stiffness=stiffness)
+    peak = ecofmaps.max_force(**rig, stiffness=stiffness) / 450.0
+    assert np.all(np.diff(ecof) > 0.3) and np.all(peak < JAMMED_TRACTION)
+    for lam in (1e-10, 2.220446049250313e-16):
+        point = dict(rig, stiffness=450.0 / (lam * 50e-6))
+        assert int(ecofmaps.slip_regime(**point)) == Regime.SELF_LOCKING
+        with pytest.warns(ecofmaps.RegimeWarning, match="self-locking"):
+            assert np.isnan(ecofmaps.energy_cof(**point))
