@@ -1,7 +1,8 @@
 """Figures (needs matplotlib): the paper's, drawn from Datasets, and those of measured loops.
 
-:mod:`~ecofmaps.figures.model_figures` draws the model's figures (the paper's Figures 5-8
-and 11, and the universal map), :mod:`~ecofmaps.figures.measured_figures` those of measured
+:mod:`~ecofmaps.figures.model_figures` draws the model's loops and curves (the paper's
+Figures 5-8), :mod:`~ecofmaps.figures.map_figures` its maps (Figure 11 and the universal
+map), :mod:`~ecofmaps.figures.measured_figures` those of measured
 loops (Figures 9 and 10, the loops read along the stroke),
 :mod:`~ecofmaps.figures.profile_figures` those of wear-scar profiles (a measured profile,
 and scars of several shapes), :mod:`~ecofmaps.figures.recipes` the set ``ecofmaps figures``
@@ -19,14 +20,13 @@ _PUBLIC = {
         "measured_loops",
         "resolved_loops",
     ),
+    "map_figures": ("ecof_ratio_contours", "universal_ecof_ratio_map"),
     "model_figures": (
         "dissipated_energy_curves",
-        "ecof_ratio_contours",
         "ecof_ratio_curves",
         "loops_by_aspect_ratio",
         "rigid_and_compliant_loops",
         "slip_amplitude_curves",
-        "universal_ecof_ratio_map",
     ),
     "profile_figures": ("scar_profile_figure", "scar_shape_comparison"),
     "recipes": ("FIGURES", "FigureRecipe", "make_figure", "make_figures"),

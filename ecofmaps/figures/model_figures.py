@@ -1,4 +1,5 @@
-r"""The paper's figures of the model, each a pure function of the Dataset that holds its numbers.
+r"""The paper's figures of the model's loops and curves (Figures 5-8), each a pure function of
+the Dataset that holds its numbers (the maps of Figure 11: :mod:`ecofmaps.figures.map_figures`).
 
 One function per figure takes a Dataset of :mod:`ecofmaps.maps` (and, where a figure marks
 points, the points as an argument) and returns a :class:`matplotlib.figure.Figure`. Axes
@@ -8,25 +9,18 @@ the Datasets with the paper's parameters and draws the set ``ecofmaps figures`` 
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Mapping
 
 import numpy as np
 import xarray as xr
 from matplotlib import colormaps
-from matplotlib.colors import BoundaryNorm
 from matplotlib.figure import Figure
-from matplotlib.lines import Line2D
-from matplotlib.patches import Patch
 
 from ecofmaps.figures.style import (
-    ECOF_RATIO_LEVELS,
     FIGSIZE,
-    HIGHLIGHT_LEVEL,
     MEGA,
     MICRO,
     MILLI,
-    PER_MM,
     axis_label,
     force_ratio_axis,
     parameters,
@@ -34,16 +28,13 @@ from ecofmaps.figures.style import (
     stiffness_colors,
     stiffness_label,
 )
-from ecofmaps.model import NO_GROSS_SLIP, compliance_ratio, energy_cof
 
 __all__ = [
     "dissipated_energy_curves",
-    "ecof_ratio_contours",
     "ecof_ratio_curves",
     "loops_by_aspect_ratio",
     "rigid_and_compliant_loops",
     "slip_amplitude_curves",
-    "universal_ecof_ratio_map",
 ]
 
 
@@ -328,210 +319,4 @@ def ecof_ratio_curves(dataset: xr.Dataset, markers: Mapping[str, Mapping] | None
             ),
         )
     _legend_top_down(ax, dataset.sizes["stiffness_ratio"], loc="upper left")
-    return figure
-
-
-# --- Figure 11 and the universal map: contours of μ_E/μ -------------------------------------
-
-
-def _ecof_ratio_contours(ax, x, ratio: xr.DataArray, regime: xr.DataArray) -> list:
-    """Filled and labelled contours of μ_E/μ over (x, z_o/x_o), no-gross-slip area hatched.
-
-    ``ratio`` and ``regime`` have the dims (x dimension, aspect_ratio); ``x`` holds the
-    x values. Returns the legend handles of what was drawn besides the contours.
-    """
-    y = ratio["aspect_ratio"].values
-    values = ratio.transpose(..., "aspect_ratio").values.T
-    top = np.nanmax(values)
-    levels = [level for level in ECOF_RATIO_LEVELS if level <= top]
-    above = [level for level in ECOF_RATIO_LEVELS if level > top]
-    fill_levels = [1.0, *levels, above[0] if above else top]
-    # One colour per band of ECOF_RATIO_LEVELS, whatever the figure's range, so the same
-    # μ_E/μ has the same colour in Figures 11a, 11b and the universal map.
-    cmap = colormaps["YlOrRd"]
-    norm = BoundaryNorm([1.0, *ECOF_RATIO_LEVELS], cmap.N, clip=True)
-    filled = ax.contourf(x, y, values, levels=fill_levels, cmap=cmap, norm=norm, alpha=0.85)
-    widths = [2.4 if level == HIGHLIGHT_LEVEL else 0.9 for level in levels]
-    lines = ax.contour(x, y, values, levels=levels, colors="black", linewidths=widths)
-    ax.clabel(lines, fmt="%.2f", fontsize="small", inline_spacing=3)
-    colorbar = ax.figure.colorbar(filled, ax=ax, ticks=fill_levels, format="%.2f")
-    colorbar.set_label(r"$\mu_E/\mu$ [1]")
-    ax.set_ylabel(axis_label("aspect_ratio"))
-    handles = [
-        Line2D([], [], color="black", linewidth=2.4, label=r"$\mu_E/\mu$ = 1.05 (5 % above $\mu$)")
-    ]
-    stuck = (regime == NO_GROSS_SLIP).transpose(..., "aspect_ratio").values.T.astype(float)
-    if stuck.any():
-        ax.contourf(x, y, stuck, levels=[0.5, 1.5], colors="none", hatches=["//"])
-        ax.contour(x, y, stuck, levels=[0.5], colors="0.3", linewidths=1.0)
-        handles.append(
-            Patch(
-                facecolor="none",
-                edgecolor="0.3",
-                hatch="//",
-                label=r"no gross slip ($\mu P/S \geq \Delta^*$)",
-            )
-        )
-    return handles
-
-
-def ecof_ratio_contours(
-    dataset: xr.Dataset, number: str = "11", markers: Mapping[str, Mapping] | None = None
-) -> Figure:
-    r"""Figure 11: labelled contours of :math:`\mu_E/\mu` over :math:`S/P` and :math:`z_o/x_o`.
-
-    Parameters
-    ----------
-    dataset : xarray.Dataset
-        From :func:`ecofmaps.compute_map` with 1-D ``stiffness_ratio`` and
-        ``aspect_ratio`` and scalar ``amplitude`` and ``mu``.
-    number : str
-        The figure's number in its title (``'11a'``).
-    markers : mapping of str to mapping, optional
-        Test conditions to mark, by legend name: each with ``stiffness`` [N/m], ``load`` [N]
-        and ``aspect_ratio`` [1] (e.g. :data:`ecofmaps.paper.EXAMPLE_2`).
-
-    Returns
-    -------
-    figure : matplotlib.figure.Figure
-        Filled contours with labelled lines at :data:`ECOF_RATIO_LEVELS` (the 5 % line
-        heavier), :math:`S/P` in (MN/m)/kN (= 1/mm); the area with no gross slip hatched;
-        the markers.
-
-    Notes
-    -----
-    Figure 11 of the paper (a: :math:`\Delta^*` = 25 µm, b: 50 µm, :math:`\mu = 0.8`).
-    :math:`\mu_E/\mu` depends on :math:`S/P` and :math:`\Delta^*` only through
-    :math:`\lambda = P/(S\Delta^*)` (eq. 16), so the two panels are one surface read on two
-    scales of :math:`S/P`: see :func:`universal_ecof_ratio_map`.
-    """
-    figure = Figure(figsize=FIGSIZE, layout="constrained")
-    ax = figure.add_subplot()
-    amplitude = scalar(dataset, "amplitude")
-    x = dataset["stiffness_ratio"].values * PER_MM
-    handles = _ecof_ratio_contours(ax, x, dataset["ecof_ratio"], dataset["regime"])
-    ax.set_xlabel(axis_label("stiffness_ratio"))
-    for name, point in (markers or {}).items():
-        handles += ax.plot(
-            point["stiffness"] / point["load"] * PER_MM,
-            point["aspect_ratio"],
-            "o",
-            color="navy",
-            markersize=8,
-            markeredgecolor="white",
-            label=rf"{name} ($S$ = {point['stiffness'] * MEGA:g} MN/m, $P$ = {point['load']:g} N)",
-        )
-    ax.legend(handles=handles, loc="lower right", fontsize="small", framealpha=0.9)
-    ax.set_title(
-        rf"Fig. {number}  $\mu_E/\mu$ over rig stiffness and groove shape"
-        + "\n"
-        + parameters(
-            rf"$x_o = \Delta^*$ = {amplitude * MICRO:g} µm", rf"$\mu$ = {scalar(dataset, 'mu'):g}"
-        ),
-        fontsize="medium",
-    )
-    return figure
-
-
-def universal_ecof_ratio_map(
-    dataset: xr.Dataset,
-    markers: Mapping[str, Mapping] | None = None,
-    windows: Mapping[str, tuple] | None = None,
-) -> Figure:
-    r"""The universal map: :math:`\mu_E/\mu` over :math:`\lambda = P/(S\Delta^*)` and z_o/x_o.
-
-    Parameters
-    ----------
-    dataset : xarray.Dataset
-        From :func:`ecofmaps.compute_universal_map` with 1-D ``compliance_ratio``
-        (positive: the axis is logarithmic) and ``aspect_ratio`` and a scalar ``mu``.
-    markers : mapping of str to mapping, optional
-        Test conditions to mark, by legend name: keyword arguments of
-        :func:`ecofmaps.energy_cof` (``amplitude``, ``load``, ``stiffness``, ``mu``,
-        ``aspect_ratio``), e.g. :data:`ecofmaps.paper.FIGURE_10_FITS`. Each is drawn at its
-        own :math:`\lambda` with its own :math:`\mu_E/\mu` (at its own :math:`\mu`).
-    windows : mapping of str to tuple, optional
-        Spans of :math:`\lambda` to show as bars, by figure name: ``(amplitude,
-        stiffness_ratios)`` [m], [1/m], the span of the ``stiffness_ratios`` at that amplitude.
-
-    Returns
-    -------
-    figure : matplotlib.figure.Figure
-        Labelled contours at :data:`ECOF_RATIO_LEVELS` on a logarithmic :math:`\lambda`
-        axis, the windows, and the markers.
-
-    Notes
-    -----
-    With :math:`x_o = \Delta^*` the slip ratio (eq. 16) and :math:`\mu_E/\mu` (eq. 15,
-    corrected) depend on :math:`\mu`, :math:`z_o/x_o` and :math:`\lambda` only, so every
-    pair (:math:`\Delta^*`, :math:`S/P`) with the same :math:`\lambda` gives the same
-    :math:`\mu_E/\mu`: this one chart holds both panels of Figure 11, which on the
-    logarithmic axis are the same window shifted by a factor 2. Not in the paper.
-    """
-    figure = Figure(figsize=(6.8, 5.6), layout="constrained")
-    ax = figure.add_subplot()
-    mu = scalar(dataset, "mu")
-    x = dataset["compliance_ratio"].values
-    handles = _ecof_ratio_contours(ax, x, dataset["ecof_ratio"], dataset["regime"])
-    ax.set_xscale("log")
-    ticks = [tick for tick in (0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0) if x[0] <= tick <= x[-1]]
-    ax.set_xticks(ticks, [f"{tick:g}" for tick in ticks])
-    ax.set_xticks([], minor=True)
-    ax.set_xlabel(axis_label("compliance_ratio") + r"   ($\lambda \to 0$: rigid rig)")
-    windows = windows or {}
-    for index, (name, (amplitude, stiffness_ratios)) in enumerate(windows.items()):
-        height = 0.008 + 0.014 * (len(windows) - 1 - index)  # stacked near the bottom
-        ratios = np.asarray(stiffness_ratios, dtype=np.float64)
-        span = compliance_ratio(amplitude, 1.0, np.array([ratios.max(), ratios.min()]))
-        ax.annotate(
-            "",
-            (float(span[0]), height),
-            (float(span[1]), height),
-            arrowprops=dict(arrowstyle="|-|", color="0.25", shrinkA=0, shrinkB=0),
-        )
-        ax.text(
-            0.92 * float(span[0]),
-            height,
-            rf"Fig. {name} ($\Delta^*$ = {amplitude * MICRO:g} µm)",
-            ha="right",
-            va="center",
-            fontsize="x-small",
-            color="0.15",
-        )
-    for (name, point), marker in zip((markers or {}).items(), itertools.cycle("soD^v")):
-        lam = float(compliance_ratio(point["amplitude"], point["load"], point["stiffness"]))
-        value = float(energy_cof(**point) / point["mu"])
-        handles += ax.plot(
-            lam,
-            point["aspect_ratio"],
-            marker,
-            color="navy",
-            markersize=8,
-            markeredgecolor="white",
-            zorder=5,
-            label=(
-                rf"{name}: $S$ = {point['stiffness'] * MEGA:g} MN/m, "
-                rf"$z_o/x_o$ = {point['aspect_ratio']:.3g}, "
-                rf"$\mu$ = {point['mu']:g}: $\mu_E/\mu$ = {value:.3f}"
-            ),
-        )
-        ax.annotate(
-            name.replace("Example ", "Ex. ").replace("(Section 3)", "(§3)"),
-            (lam, point["aspect_ratio"]),
-            xytext=(7, -3),
-            textcoords="offset points",
-            fontsize="x-small",
-            color="navy",
-        )
-    figure.legend(handles=handles, loc="outside lower center", fontsize="x-small", ncols=1)
-    title = [
-        rf"Universal map of $\mu_E/\mu$ ($x_o = \Delta^*$, $\mu$ = {mu:g})",
-        r"Any $\Delta^*$ and $S/P$ with the same $\lambda = P/(S\Delta^*)$ give the same "
-        r"$\mu_E/\mu$" + (":" if windows else ""),
-    ]
-    if windows:
-        spans = [f"{name} ({amplitude * MICRO:g} µm)" for name, (amplitude, _) in windows.items()]
-        spans[0] = spans[0].replace("(", r"($\Delta^*$ = ", 1)
-        title.append(f"Fig. {' and '.join(spans)} are windows of this one chart")
-    ax.set_title("\n".join(title), fontsize="medium")
     return figure

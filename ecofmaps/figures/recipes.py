@@ -251,6 +251,7 @@ FIGURES: dict[str, FigureRecipe] = {
             _ecof_ratio_map("11a"),
             "ecof_ratio_contours",
             options={"number": "11a"},
+            module="map_figures",
         ),
         FigureRecipe(
             "fig11b",
@@ -258,12 +259,14 @@ FIGURES: dict[str, FigureRecipe] = {
             _ecof_ratio_map("11b"),
             "ecof_ratio_contours",
             options={"number": "11b", "markers": _EXAMPLE_2},
+            module="map_figures",
         ),
         FigureRecipe(
             "universal",
             "μ_E/μ over λ = P/(SΔ*) and z_o/x_o: Fig. 11a and 11b in one chart",
             _universal_map,
             "universal_ecof_ratio_map",
+            module="map_figures",
             options={
                 "markers": paper.FIGURE_10_FITS,
                 "windows": {

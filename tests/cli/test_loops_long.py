@@ -9,7 +9,8 @@ import pytest
 
 from ecofmaps.cli import loops_long
 from ecofmaps.measured import out_of_core
-from ecofmaps.measured.synthetic import synthetic_recording, write_long_recording
+from ecofmaps.measured.long_test import write_long_recording
+from ecofmaps.measured.synthetic import synthetic_recording
 from tests.cli.test_loops import POINT, run, write_csv
 
 

@@ -27,7 +27,8 @@ MU = 0.8
 def drawn():
     """Every registered figure of the model, drawn once, with the Dataset it was drawn from
     (the scar shapes' figure is tested in test_profile_figures)."""
-    names = [name for name, recipe in figures.FIGURES.items() if recipe.module == "model_figures"]
+    model = ("model_figures", "map_figures")
+    names = [name for name, recipe in figures.FIGURES.items() if recipe.module in model]
     datasets = {name: figures.FIGURES[name].dataset() for name in names}
     return {name: (figure, datasets[name]) for name, figure in figures.make_figures(names)}
 
