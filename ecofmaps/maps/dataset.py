@@ -72,6 +72,16 @@ def _axis(name: str, value, rule: str, unit: str) -> np.ndarray:
     return array
 
 
+def _load(load) -> np.ndarray | None:
+    """The map's normal load (None, or one value) checked, as :func:`_axis` does. [N]"""
+    if load is None:
+        return None
+    load = _axis("load", load, "positive", "N")
+    if load.ndim:
+        raise ValueError(f"load must be a single value, got shape {load.shape}")
+    return load
+
+
 def _dataset(axes: dict, values: dict, title: str, extra=None) -> xr.Dataset:
     """A Dataset of grid ``values`` over ``axes`` (scalars become scalar coordinates).
 

@@ -30,7 +30,7 @@ import xarray as xr
 from ecofmaps import model
 from ecofmaps._inputs import float64
 from ecofmaps.maps.cache import cached_dataset
-from ecofmaps.maps.dataset import _axis, _dataset
+from ecofmaps.maps.dataset import _axis, _dataset, _load
 from ecofmaps.maps.on_profile import compute_profile_map
 from ecofmaps.maps.tiles import MAX_CHUNK, _grid_values
 from ecofmaps.model.simulation import fretting_loop
@@ -255,10 +255,7 @@ def compute_map(
         "amplitude": _axis("amplitude", amplitude, "positive", "m"),
         "mu": _axis("mu", mu, "positive", "1"),
     }
-    if load is not None:
-        load = _axis("load", load, "positive", "N")
-        if load.ndim:
-            raise ValueError(f"load must be a single value, got shape {load.shape}")
+    load = _load(load)
 
     _check_cache(cache, chunks)
 

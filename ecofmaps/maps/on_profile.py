@@ -15,7 +15,7 @@ import xarray as xr
 from ecofmaps import model
 from ecofmaps._inputs import float64
 from ecofmaps.maps.cache import cached_dataset
-from ecofmaps.maps.dataset import _axis, _dataset
+from ecofmaps.maps.dataset import _axis, _dataset, _load
 from ecofmaps.maps.tiles import MAX_CHUNK
 
 __all__ = ["MODEL_ON_PROFILE", "compute_profile_map"]
@@ -98,10 +98,7 @@ def compute_profile_map(stiffness_ratio, amplitude, mu, load=None, *, profile, m
         "amplitude": _axis("amplitude", amplitude, "positive", "m"),
         "mu": _axis("mu", mu, "positive", "1"),
     }
-    if load is not None:
-        load = _axis("load", load, "positive", "N")
-        if load.ndim:
-            raise ValueError(f"load must be a single value, got shape {load.shape}")
+    load = _load(load)
     if not (isinstance(max_chunk, int) and max_chunk >= 1):
         raise ValueError(f"max_chunk must be an integer >= 1, got {max_chunk!r}")
 
