@@ -119,6 +119,9 @@ class Runner:
                     threads_per_worker=1,
                     processes=True,
                     dashboard_address=None,
+                    # the scheduler's small HTTP server (health, metrics) on a free port, not
+                    # 8787: two runs at once would warn that it is taken
+                    scheduler_kwargs={"dashboard_address": ":0"},
                     silence_logs=40,  # errors only
                 )
             self._client = Client(self._cluster, set_as_default=False)

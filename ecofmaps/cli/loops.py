@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import itertools
 import sys
 import textwrap
 import warnings
@@ -167,11 +168,9 @@ def _summary(path, results, recording) -> str:
 
 
 def run(args) -> int:
-    import pandas as pd
-
-    from ecofmaps.io.files import write_text
+    from ecofmaps.io.files import atomic_path
     from ecofmaps.io.recordings import read_recording
-    from ecofmaps.io.tables import results_table
+    from ecofmaps.io.tables import results_csv
     from ecofmaps.maps.cache import write_netcdf
     from ecofmaps.measured.synthetic import EXAMPLE, example_path
 
@@ -211,7 +210,8 @@ def run(args) -> int:
     )
     refuse_to_overwrite([("--out", args.out), ("--resolved", args.resolved), *plots], paths)
     long_run = loops_long.LongRun(args, paths)
-    analyses, recordings = [], []
+    analyses, recordings, texts = [], [], []  # texts: each file's lines, by blocks
+    many = len(paths) > 1
     for index, path in enumerate(paths):
         recording = read_recording(
             path,
@@ -229,15 +229,18 @@ def run(args) -> int:
                     f"--resolved reads every loop along the stroke, which a long recording "
                     f"({path}) analysed out of core does not keep: leave out --resolved"
                 )
-            analyses.append((long_run.analyse(index, path, recording, load), None))
+            results, made = long_run.analyse(index, path, recording, load, many=many)
+            analyses.append((results, None))
         else:
             analyses.append(_analysed(path, recording, load, args, args.resolved is not None))
+            made = None
+        texts.append(made)
         recordings.append(recording)
-    tables = [results_table(results) for results, _ in analyses]
-    if len(paths) > 1:
-        for path, table in zip(paths, tables, strict=True):
-            table.insert(0, "file", str(path))
-    text = pd.concat(tables).to_csv(index=False, float_format="%.6g", lineterminator="\n")
+    header = results_csv(analyses[0][0].isel(cycle=slice(0, 0)), file="" if many else None)
+    for index, (path, (results, _)) in enumerate(zip(paths, analyses, strict=True)):
+        if texts[index] is None:  # analysed in memory
+            texts[index] = [results_csv(results, file=str(path) if many else None, header=False)]
+    lines = [header, *itertools.chain.from_iterable(texts)]  # the table, a block at a time
     if args.plots is not None:
         from ecofmaps.figures import cof_evolution, measured_loops, resolved_loops, save_figure
 
@@ -251,13 +254,17 @@ def run(args) -> int:
     if args.resolved is not None:
         write_netcdf(analyses[0][1], args.resolved)
     if args.out is None:
-        sys.stdout.write(text)
+        sys.stdout.writelines(lines)
         for path, (results, _), recording in zip(paths, analyses, recordings, strict=True):
             print(_summary(path, results, recording).strip(), file=sys.stderr)
         return 0
-    write_text(args.out, text)
+    with (
+        atomic_path(args.out) as temporary,
+        open(temporary, "w", encoding="utf-8", newline="") as stream,
+    ):
+        stream.writelines(lines)
     long_run.finish()
-    print(f"wrote {args.out}: {sum(len(table) for table in tables)} cycles")
+    print(f"wrote {args.out}: {sum(r.cycle.size for r, _ in analyses)} cycles")
     for path, (results, _), recording in zip(paths, analyses, recordings, strict=True):
         print(_summary(path, results, recording))
     if args.resolved is not None:

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import functools
 import inspect
 import json
 import os
@@ -226,13 +227,22 @@ class LongRun:
             return Runner(self.args.workers, cluster=True)
         return Runner()
 
-    def analyse(self, index: int, path: Path, recording, load: float):
+    def analyse(self, index: int, path: Path, recording, load: float, *, many: bool):
         """The results of recording ``index`` (read lazily), as :func:`ecofmaps.analyze_loops`
-        gives them; its blocks kept beside ``--out`` as they complete."""
+        gives them, and their lines of the table (with the file's name in a first column if
+        ``many``, a string per block); its blocks kept beside ``--out`` as they complete.
+        The results are joined after the cluster is closed, so its workers' memory and the
+        joined results are not held at once."""
+        import xarray as xr
+
         with self._runner() as runner:  # a cluster that does not answer: nothing written
             if self.partial is None and self.fingerprint is not None:
                 self.partial = _Partial(self.args.out, self.fingerprint, self.args.resume)
-            return _analyse(index, path, recording, load, self.args, runner, self.partial)
+            analysis, parts, texts = _analyse(
+                index, path, recording, load, self.args, runner, self.partial, many
+            )
+        joined = xr.concat([parts.pop(k) for k in sorted(parts)], "cycle")
+        return analysis.finish(joined), [texts[k] for k in sorted(texts)]
 
     def finish(self) -> None:
         """Remove the kept blocks: the table is written."""
@@ -251,10 +261,10 @@ def skipped(results, recording) -> str:
     return f"; {count} skipped for missing samples (the first at {where})"
 
 
-def _analyse(index, path, recording, load, args, runner, partial):
-    """One long recording, block by block (module notes)."""
-    import xarray as xr
-
+def _analyse(index, path, recording, load, args, runner, partial, many):
+    """One long recording, block by block (module notes): its analysis, and the results and
+    the table's lines (formatted where it ran) of each block."""
+    from ecofmaps.io.tables import results_csv
     from ecofmaps.measured.analysis import analyze_loops, check_options
     from ecofmaps.measured.out_of_core import LongAnalysis
 
@@ -288,13 +298,15 @@ def _analyse(index, path, recording, load, args, runner, partial):
     if partial is not None:
         partial.keep_cycles(index, analysis.cycles)
         done = partial.done(index)
+    lines = functools.partial(results_csv, file=str(path) if many else None, header=False)
     parts = {block: analysis.part(block, *measured) for block, measured in done.items()}
+    texts = {block: lines(part) for block, part in parts.items()}
     bar = _bar(analysis, path, shown, sum(parts[b].cycle.size for b in parts))
     try:
-        for block, values, flags in analysis.measured(skip=done):
+        for block, values, flags, text in analysis.measured(skip=done, then=lines):
             if partial is not None:
                 partial.keep(index, block, values, flags)
-            parts[block] = analysis.part(block, values, flags)
+            parts[block], texts[block] = analysis.part(block, values, flags), text
             bar.update(parts[block].cycle.size)
     except KeyboardInterrupt:
         bar.leave = False
@@ -307,8 +319,7 @@ def _analyse(index, path, recording, load, args, runner, partial):
             )
         raise
     bar.close()
-    joined = xr.concat([parts[k] for k in sorted(parts)], "cycle")
-    return analysis.finish(joined)
+    return analysis, parts, texts
 
 
 def _bar(analysis, path, shown: bool, initial: int):

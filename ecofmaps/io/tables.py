@@ -7,6 +7,9 @@ The columns, their names and their units come from :mod:`ecofmaps._nomenclature`
 
 from __future__ import annotations
 
+import csv
+import io
+
 import numpy as np
 import pandas as pd
 import xarray as xr
@@ -14,7 +17,7 @@ import xarray as xr
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps.model.regimes import Regime
 
-__all__ = ["RESULT_COLUMNS", "results_table"]
+__all__ = ["RESULT_COLUMNS", "csv_text", "results_csv", "results_table"]
 
 #: The quantities of :func:`ecofmaps.analyze_loops` in the results table, in order.
 RESULT_QUANTITIES = (
@@ -61,8 +64,78 @@ def results_table(results: xr.Dataset) -> pd.DataFrame:
             continue
         values = results[name].values
         if name == "regime":  # the codes' labels, as ecofmaps map and model print them
-            columns[column] = [Regime(int(code)).label for code in values]
+            labels = {int(code): code.label for code in Regime}
+            columns[column] = [labels[code] for code in values.tolist()]
             continue
         numeric = np.issubdtype(values.dtype, np.number) and name != "cycle"
         columns[column] = nomenclature.display(name, values) if numeric else values
     return pd.DataFrame(columns)
+
+
+def results_csv(results: xr.Dataset, *, file: str | None = None, header: bool = True) -> str:
+    """The per-cycle results as the text of ``ecofmaps loops --out`` (see :func:`csv_text`).
+
+    Parameters
+    ----------
+    results : xarray.Dataset
+        From :func:`ecofmaps.analyze_loops` (or a stretch of its cycles).
+    file : str, optional
+        The recording's name, written in a first column ``file``.
+    header : bool
+        Begin with the line of column names.
+
+    Returns
+    -------
+    text : str
+        One line per cycle (and the header), each ending in ``\\n``.
+    """
+    table = results_table(results)
+    if file is not None:
+        table.insert(0, "file", file)
+    return csv_text(table, header=header)
+
+
+def csv_text(table: pd.DataFrame, *, header: bool = True) -> str:
+    """``table`` as CSV text, numbers to 6 significant digits.
+
+    The text is what ``table.to_csv(index=False, float_format="%.6g", lineterminator="\\n",
+    header=header)`` writes (an empty field for NaN, text quoted by :mod:`csv` where it
+    must be), in half the time: the floats are formatted a column at a time and the lines
+    are written by :func:`csv.writer`.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        Columns of floats, integers, booleans or text.
+    header : bool
+        Begin with the line of column names.
+
+    Returns
+    -------
+    text : str
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> print(csv_text(pd.DataFrame({"ecof": [0.8123456789, float("nan")], "note": ["a,b", "ok"]})))
+    ecof,note
+    0.812346,"a,b"
+    ,ok
+    <BLANKLINE>
+    """
+    columns = []
+    for name in table.columns:
+        values = table[name].to_numpy()
+        if values.dtype.kind == "f":
+            texts = list(map("%.6g".__mod__, values.tolist()))
+            for k in np.flatnonzero(np.isnan(values)).tolist():
+                texts[k] = ""
+        else:
+            texts = values.tolist()
+        columns.append(texts)
+    stream = io.StringIO()
+    writer = csv.writer(stream, lineterminator="\n")
+    if header:
+        writer.writerow(table.columns)
+    writer.writerows(zip(*columns, strict=True))
+    return stream.getvalue()

@@ -71,12 +71,22 @@ READ = "read:"
 
 
 def _measure(
-    cycles: Cycles, low: int, rows: slice, load: float, options: dict, x, q, resolve: bool
+    cycles: Cycles,
+    low: int,
+    rows: slice,
+    load: float,
+    options: dict,
+    x,
+    q,
+    resolve: bool,
+    then=None,
 ):
     """One task: the cycles ``rows`` of the table ``cycles`` measured on the stretch of the
     recording that begins at sample ``low``; with ``resolve``, also read along the stroke
     (the values :data:`~ecofmaps.measured.resolved.REPORTED` and the reading's quality,
-    named with the prefix :data:`READ`), so the loops never leave the task."""
+    named with the prefix :data:`READ`), so the loops never leave the task; with ``then``,
+    also ``then(results)`` of the task's results (as :meth:`LongAnalysis.part` makes them),
+    so that work on them is done where the task runs too."""
     values, flags, loops = measure_cycles(
         cycles, _Stretch(x, low), _Stretch(q, low), load, rows=rows, keep_loops=resolve, **options
     )
@@ -84,7 +94,23 @@ def _measure(
         part = strip(cycle_results(values, flags, cycles.label[rows], load, options))
         read = with_read_along_stroke(with_loops(part, loops))
         values = values | {f"{READ}{name}": read[name].values for name in (*REPORTED, "quality")}
-    return values, flags, None
+    if then is None:
+        return values, flags, None
+    return values, flags, then(_results(values, flags, cycles.label[rows], load, options)[1])
+
+
+def _results(values: dict, flags: dict, label, load: float, options: dict):
+    """The results of a task from what it measured: as
+    :func:`~ecofmaps.measured.results.cycle_results` gives them (with their riders), and with
+    the reading along the stroke in place of those riders where the task read it."""
+    read = {k[len(READ) :]: v for k, v in values.items() if k.startswith(READ)}
+    values = {k: v for k, v in values.items() if not k.startswith(READ)}
+    counted = cycle_results(values, flags, label, load, options)
+    part = strip(counted)
+    if read:  # as ecofmaps.measured.resolved.with_resolved adds them
+        part = part.assign({k: ("cycle", read[k], _read_attrs(k)) for k in REPORTED})
+        part["quality"] = part["quality"].copy(data=read["quality"])
+    return counted, part
 
 
 class LongAnalysis:
@@ -164,8 +190,8 @@ class LongAnalysis:
         self.tasks = _tasks(cycles.count, samples or TASK_SAMPLES)
         self.tally = Tally()
 
-    def _task(self, rows: slice):
-        """The arguments of the task that measures ``rows``."""
+    def _task(self, rows: slice, then):
+        """The arguments of the task that measures ``rows`` (and calls ``then``)."""
         cycles = self.cycles
         first, stop = rows.start, rows.stop
         if cycles.continuous:  # a halo of whole cycles on either side
@@ -180,15 +206,20 @@ class LongAnalysis:
         high = int(table.start[-1] + table.count[-1])
         x, q = (array[low:high] for array in self.arrays)
         inner = slice(rows.start - first, rows.stop - first)
-        return (table, low, inner, self.load, self.options, x, q, self.resolve)
+        return (table, low, inner, self.load, self.options, x, q, self.resolve, then)
 
-    def measured(self, skip=()):
+    def measured(self, skip=(), then=None):
         """What each task measured, in order, as it comes.
 
         Parameters
         ----------
         skip : collection of int
             Tasks not to run (done before, in a run that is resumed).
+        then : callable, optional
+            A function of a task's results (the Dataset :meth:`part` gives), called where
+            the task runs: a module-level function, or a :func:`functools.partial` of one,
+            for tasks in other processes. The command line formats its table rows so, in
+            parallel.
 
         Yields
         ------
@@ -198,31 +229,27 @@ class LongAnalysis:
             Its cycles' quantities and checks, from
             :func:`~ecofmaps.measured.per_cycle.measure_cycles` (:meth:`part` makes the
             results of them).
+        made
+            What ``then`` returned for the task's results (None without ``then``).
         """
         skip = set(skip)
         wanted = [k for k in range(len(self.tasks)) if k not in skip]
-        results = self.runner.map(_measure, (self._task(self.tasks[k]) for k in wanted))
-        for index, (values, flags, _) in zip(wanted, results, strict=False):
-            yield index, values, flags
+        results = self.runner.map(_measure, (self._task(self.tasks[k], then) for k in wanted))
+        for index, (values, flags, made) in zip(wanted, results, strict=False):
+            yield index, values, flags, made
 
     def part(self, index: int, values: dict, flags: dict) -> xr.Dataset:
         """The per-cycle results of task ``index`` from what it measured, as in
         :func:`ecofmaps.analyze_loops`'s Dataset (without the recording's attributes);
         counted in :attr:`tally`."""
-        read = {k[len(READ) :]: v for k, v in values.items() if k.startswith(READ)}
-        values = {k: v for k, v in values.items() if not k.startswith(READ)}
-        part = cycle_results(
-            values, flags, self.cycles.label[self.tasks[index]], self.load, self.options
-        )
-        self.tally.add(part)
-        if read:  # as ecofmaps.measured.resolved.with_resolved adds them
-            part = part.assign({k: ("cycle", read[k], _read_attrs(k)) for k in REPORTED})
-            part["quality"] = part["quality"].copy(data=read["quality"])
+        labels = self.cycles.label[self.tasks[index]]
+        counted, part = _results(values, flags, labels, self.load, self.options)
+        self.tally.add(counted)
         return part
 
     def parts(self):
         """The results of each task, in order, as they come (see :meth:`part`)."""
-        for index, values, flags in self.measured():
+        for index, values, flags, _ in self.measured():
             yield index, self.part(index, values, flags)
 
     def finish(self, results: xr.Dataset) -> xr.Dataset:

@@ -72,6 +72,18 @@ def test_out_of_core_gives_the_table_in_memory(long_test, tmp_path, capsys, smal
     assert err == ""  # not a terminal: no progress bar
 
 
+def test_several_files_out_of_core(long_test, tmp_path, capsys, small_tasks):
+    """Each file's lines are made where its blocks ran, named in the first column."""
+    files = (long_test[".zarr"], long_test[".tdms"])
+    status, _, err = run(capsys, *files, "--load", "450N", "--out", tmp_path / "memory.csv")
+    assert status == 0, err
+    out = tmp_path / "long.csv"
+    status, _, err = run(capsys, *files, "--load", "450N", "--out", out, "--resume")
+    assert status == 0, err
+    assert out.read_text() == (tmp_path / "memory.csv").read_text()
+    assert out.read_text().startswith("file,cycle,")
+
+
 def test_two_worker_processes(long_test, tmp_path, capsys):
     expected = in_memory_table(capsys, long_test[".tdms"], tmp_path)
     out = tmp_path / "workers.csv"
