@@ -233,16 +233,14 @@ class LongRun:
         ``many``, a string per block); its blocks kept beside ``--out`` as they complete.
         The results are joined after the cluster is closed, so its workers' memory and the
         joined results are not held at once."""
-        import xarray as xr
-
         with self._runner() as runner:  # a cluster that does not answer: nothing written
             if self.partial is None and self.fingerprint is not None:
                 self.partial = _Partial(self.args.out, self.fingerprint, self.args.resume)
             analysis, parts, texts = _analyse(
                 index, path, recording, load, self.args, runner, self.partial, many
             )
-        joined = xr.concat([parts.pop(k) for k in sorted(parts)], "cycle")
-        return analysis.finish(joined), [texts[k] for k in sorted(texts)]
+        results = analysis.finish([parts.pop(k) for k in sorted(parts)])
+        return results, [texts[k] for k in sorted(texts)]
 
     def finish(self) -> None:
         """Remove the kept blocks: the table is written."""

@@ -338,7 +338,7 @@ def analyze_loops(
                 **options,
             )
             parts = [part for _, part in analysis.parts()]
-        return analysis.finish(xr.concat(parts, "cycle") if parts else parts)
+        return analysis.finish(parts)
     if nan_policy == "raise":
         bad = ~np.isfinite(x) | ~np.isfinite(q)
         if label is not None and label.dtype.kind not in "iub":
