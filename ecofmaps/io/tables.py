@@ -38,6 +38,9 @@ RESULT_QUANTITIES = (
     "quality",
 )
 
+#: Rows of a table formatted at once by :func:`csv_text`.
+_ROWS = 1 << 14
+
 #: The table's column names, in order.
 RESULT_COLUMNS = tuple(nomenclature.column(name) for name in RESULT_QUANTITIES)
 
@@ -123,19 +126,20 @@ def csv_text(table: pd.DataFrame, *, header: bool = True) -> str:
     ,ok
     <BLANKLINE>
     """
-    columns = []
-    for name in table.columns:
-        values = table[name].to_numpy()
-        if values.dtype.kind == "f":
-            texts = list(map("%.6g".__mod__, values.tolist()))
-            for k in np.flatnonzero(np.isnan(values)).tolist():
-                texts[k] = ""
-        else:
-            texts = values.tolist()
-        columns.append(texts)
     stream = io.StringIO()
     writer = csv.writer(stream, lineterminator="\n")
     if header:
         writer.writerow(table.columns)
-    writer.writerows(zip(*columns, strict=True))
+    arrays = [table[name].to_numpy() for name in table.columns]
+    for start in range(0, len(table), _ROWS):  # a few MB of Python strings at a time
+        columns = []
+        for values in (array[start : start + _ROWS] for array in arrays):
+            if values.dtype.kind == "f":
+                texts = list(map("%.6g".__mod__, values.tolist()))
+                for k in np.flatnonzero(np.isnan(values)).tolist():
+                    texts[k] = ""
+            else:
+                texts = values.tolist()
+            columns.append(texts)
+        writer.writerows(zip(*columns, strict=True))
     return stream.getvalue()

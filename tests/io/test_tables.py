@@ -70,3 +70,16 @@ def test_a_table_of_blocks_is_the_table_made_whole():
     named = results_table(results)
     named.insert(0, "file", "rig 3, test 7.csv")
     assert results_csv(results, file="rig 3, test 7.csv") == pandas_text(named)
+
+
+def test_rows_formatted_a_few_at_a_time(monkeypatch):
+    """Long tables are formatted a stretch of rows at a time: the same text."""
+    from ecofmaps.io import tables
+
+    monkeypatch.setattr(tables, "_ROWS", 4)
+    values = np.linspace(-1.0, 1.0, 11)
+    values[[2, 4, 5]] = np.nan
+    table = pd.DataFrame(
+        {"cycle": np.arange(11), "ecof": values, "quality": ["ok", "a,b"] * 5 + ["x"]}
+    )
+    assert csv_text(table) == pandas_text(table)
