@@ -8,19 +8,9 @@ import numpy as np
 import pytest
 
 import ecofmaps
-from ecofmaps import cli
+from tests.cli.commands import run
 
 EXAMPLE_2 = ["--amplitude", "50um", "--load", "450N", "--stiffness", "35MN/m"]
-
-
-def run(capsys, *argv):
-    """Run the command in-process; return (exit status, stdout, stderr)."""
-    try:
-        status = cli.main([str(a) for a in argv])
-    except SystemExit as stop:  # argparse errors and --help
-        status = stop.code
-    captured = capsys.readouterr()
-    return status, captured.out, captured.err
 
 
 def printed(out: str, label: str) -> str:

@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from ecofmaps import Regime, cli, compute_map
+from ecofmaps import Regime, compute_map
 from ecofmaps.maps.cache import cache_entries
 from ecofmaps.units import parse_values
+from tests.cli.commands import run
 
 FIG11 = [
     "--stiffness-ratio", "0.02/um:0.2/um:10",
@@ -16,16 +17,6 @@ FIG11 = [
     "--amplitude", "25um,50um",
     "--mu", "0.8",
 ]  # fmt: skip
-
-
-def run(capsys, *argv):
-    """Run the command in-process; return (exit status, stdout, stderr)."""
-    try:
-        status = cli.main(list(argv))
-    except SystemExit as stop:  # argparse errors and --help
-        status = stop.code
-    captured = capsys.readouterr()
-    return status, captured.out, captured.err
 
 
 def test_map_round_trip_is_identical(tmp_path, capsys):

@@ -7,22 +7,12 @@ import numpy as np
 import pytest
 
 import ecofmaps
-from ecofmaps import cli
 from ecofmaps.measured.synthetic import scar_example_path, scar_example_trace
+from tests.cli.commands import run
 
 EXAMPLE = scar_example_path()
 RIG = ["--amplitude", "50um", "--load", "450N", "--stiffness", "35MN/m"]
 POINT = dict(amplitude=50e-6, load=450.0, stiffness=35e6)
-
-
-def run(capsys, *argv):
-    """Run the command in-process; return (exit status, stdout, stderr)."""
-    try:
-        status = cli.main([str(a) for a in argv])
-    except SystemExit as stop:  # argparse errors and --help
-        status = stop.code
-    captured = capsys.readouterr()
-    return status, captured.out, captured.err
 
 
 def values(out: str, label: str) -> list[str]:
