@@ -90,22 +90,27 @@ def _measure(
     values, flags, loops = measure_cycles(
         cycles, _Stretch(x, low), _Stretch(q, low), load, rows=rows, keep_loops=resolve, **options
     )
+    if not resolve and then is None:
+        return values, flags, None
+    label = cycles.label[rows]
+    counted = cycle_results(values, flags, label, load, options)  # once, for both
     if resolve:
-        part = strip(cycle_results(values, flags, cycles.label[rows], load, options))
-        read = with_read_along_stroke(with_loops(part, loops))
+        read = with_read_along_stroke(with_loops(strip(counted), loops))
         values = values | {f"{READ}{name}": read[name].values for name in (*REPORTED, "quality")}
     if then is None:
         return values, flags, None
-    return values, flags, then(_results(values, flags, cycles.label[rows], load, options)[1])
+    return values, flags, then(_results(values, flags, label, load, options, counted)[1])
 
 
-def _results(values: dict, flags: dict, label, load: float, options: dict):
+def _results(values: dict, flags: dict, label, load: float, options: dict, counted=None):
     """The results of a task from what it measured: as
-    :func:`~ecofmaps.measured.results.cycle_results` gives them (with their riders), and with
-    the reading along the stroke in place of those riders where the task read it."""
+    :func:`~ecofmaps.measured.results.cycle_results` gives them (with their riders; or
+    ``counted``, if made from these values before), and with the reading along the stroke
+    in place of those riders where the task read it."""
     read = {k[len(READ) :]: v for k, v in values.items() if k.startswith(READ)}
-    values = {k: v for k, v in values.items() if not k.startswith(READ)}
-    counted = cycle_results(values, flags, label, load, options)
+    if counted is None:
+        values = {k: v for k, v in values.items() if not k.startswith(READ)}
+        counted = cycle_results(values, flags, label, load, options)
     part = strip(counted)
     if read:  # as ecofmaps.measured.resolved.with_resolved adds them
         part = part.assign({k: ("cycle", read[k], _read_attrs(k)) for k in REPORTED})
