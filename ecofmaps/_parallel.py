@@ -14,7 +14,11 @@ they complete):
 - ``Runner(scheduler="tcp://host:8786")``: the workers of an existing dask cluster, which
   must have ecofmaps installed and reach the recording's file at the same path.
 
-Tasks are plain functions of this package (pickled by name for other processes). Between
+Tasks are plain functions of this package (pickled by name for other processes). A stretch
+of a dask array made by ``dask.array.from_array`` over an array-like that reads ranges
+itself (an :class:`ecofmaps.io.binary.Column`, tied to the array by the attribute
+:data:`SOURCE`) is handed to a task as a :class:`Slice` and read by that array-like where the
+task runs, without dask's graph (whose compute copies each block once more). Between
 results :func:`ecofmaps._interrupts.check_interrupted` is called, so Ctrl-C on the command
 line stops the run at the next block without raising inside dask.
 """
@@ -28,7 +32,7 @@ import time
 
 from ecofmaps._interrupts import check_interrupted
 
-__all__ = ["CONNECT_TIMEOUT", "Runner", "SchedulerError"]
+__all__ = ["CONNECT_TIMEOUT", "SOURCE", "Runner", "SchedulerError", "Slice", "stretch"]
 
 #: Seconds to wait for a dask scheduler given by address to answer.
 CONNECT_TIMEOUT = 10.0
@@ -37,12 +41,52 @@ CONNECT_TIMEOUT = 10.0
 _POLL = 0.01
 
 
+#: The attribute of a dask array made by ``dask.array.from_array`` that holds the array-like
+#: it was made of, when that reads a range of samples itself (see :func:`stretch`).
+SOURCE = "ecofmaps_source"
+
+
 class SchedulerError(OSError):
     """A dask scheduler that cannot be reached (the message names its address)."""
 
 
+class Slice:
+    """Samples ``start`` to ``stop - 1`` of ``source`` (an array-like read by a slice),
+    read where the task that receives it runs."""
+
+    __slots__ = ("source", "start", "stop")
+
+    def __init__(self, source, start: int, stop: int):
+        self.source, self.start, self.stop = source, int(start), int(stop)
+
+    def __getstate__(self):
+        return self.source, self.start, self.stop
+
+    def __setstate__(self, state):
+        self.source, self.start, self.stop = state
+
+    def read(self):
+        """The samples, as the source gives them (a NumPy array)."""
+        return self.source[self.start : self.stop]
+
+
+def stretch(array, start: int, stop: int):
+    """``array[start:stop]`` for a task to read where it runs.
+
+    A :class:`Slice` of the array-like a dask array was made of (its attribute
+    :data:`SOURCE`), read directly; any other array as sliced (a dask array is computed
+    in the task, a NumPy array is a view).
+    """
+    source = getattr(array, SOURCE, None)
+    if source is not None:
+        return Slice(source, start, stop)
+    return array[start:stop]
+
+
 def _materialised(arguments):
-    """``arguments`` with every dask collection in them computed here, on this thread."""
+    """``arguments`` with every :class:`Slice` read and every dask collection computed, here
+    on this thread."""
+    arguments = tuple(a.read() if isinstance(a, Slice) else a for a in arguments)
     import dask
 
     if not any(dask.is_dask_collection(value) for value in arguments):

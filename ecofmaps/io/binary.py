@@ -8,17 +8,22 @@ float64 and SI, with CF packing decoded (``scale_factor``, ``add_offset``,
 ``_FillValue``/``missing_value`` -> NaN), and turns any failure into a
 :class:`~ecofmaps.io.recording_types.RecordingError` naming the file, the channel and the
 samples. A large recording is a dask array over such columns (``dask.array.from_array``),
-so it is read block by block; a :class:`Column` pickles without its open file, so the
-blocks can be read by other processes (a dask cluster).
+so it is read block by block; the array holds its column (the attribute
+:data:`ecofmaps._parallel.SOURCE`), so the tasks of a long analysis read their ranges from
+it directly (:func:`ecofmaps._parallel.stretch`). A :class:`Column` pickles without its
+open file, so the blocks can be read by other processes (a dask cluster); there, the copies
+of one column are one object per process (:func:`_column`), which opens the file once.
 """
 
 from __future__ import annotations
 
+import functools
 import threading
 from pathlib import Path
 
 import numpy as np
 
+from ecofmaps._parallel import SOURCE
 from ecofmaps.io.columns import ColumnError, column_scale, matching_columns, split_unit
 from ecofmaps.io.recording_types import Recording, RecordingError
 from ecofmaps.io.recordings import LAZY_SAMPLES
@@ -54,32 +59,34 @@ class Column:
         From the file's values (after CF unpacking) to SI.
     nan_policy : {'propagate', 'raise'}
         Non-finite values become NaN, or raise :class:`RecordingError` naming the sample.
+    stamp : tuple, optional
+        What tells this file from another at the same path (its modification time and
+        size, :func:`read_binary`): a pickled column is unpickled as the same object in a
+        process only while the stamp is the same (:func:`_column`).
 
     Notes
     -----
     Indexing with a slice (step 1) returns a NumPy array; what dask's ``from_array``
     needs (``shape``, ``dtype``, ``ndim``). The open file is kept per process and per
-    column, behind a lock, and is not pickled.
+    column, behind a lock (a TDMS or HDF5 file is read by one thread at a time; a zarr
+    store by any number), and is not pickled.
     """
 
-    def __init__(self, path: Path, kind: str, variable: Variable, factor: float, nan_policy):
+    def __init__(
+        self, path: Path, kind: str, variable: Variable, factor: float, nan_policy, stamp=()
+    ):
         self.path, self.kind, self.variable = path, kind, variable
-        self.factor, self.nan_policy = factor, nan_policy
+        self.factor, self.nan_policy, self.stamp = factor, nan_policy, tuple(stamp)
         self.shape = (variable.size,)
         self.dtype = np.dtype(np.float64)
         self.ndim = 1
         self._handle = None
         self._lock = threading.Lock()
 
-    def __getstate__(self):
-        state = self.__dict__.copy()
-        state["_handle"] = None
-        del state["_lock"]
-        return state
-
-    def __setstate__(self, state):
-        self.__dict__.update(state)
-        self._lock = threading.Lock()
+    def __reduce__(self):
+        """Pickled without the open file; unpickled by :func:`_column`."""
+        return _column, (self.path, self.kind, self.variable, self.factor, self.nan_policy,
+                         self.stamp)  # fmt: skip
 
     def __len__(self) -> int:
         return self.variable.size
@@ -123,7 +130,10 @@ class Column:
         where = f"{_KIND[self.kind]} {self.variable.name!r}, samples {start} to {stop - 1}"
         try:
             with self._lock:
-                raw = np.asarray(self._source()[start:stop])
+                source = self._source()
+                raw = None if self.kind == "zarr" else np.asarray(source[start:stop])
+            if raw is None:  # zarr reads from several threads at once
+                raw = np.asarray(source[start:stop])
         except RecordingError:
             raise
         except Exception as error:
@@ -152,6 +162,16 @@ class Column:
         from ecofmaps.io.text import _to_si
 
         return _to_si(values, self.factor)
+
+
+@functools.lru_cache(maxsize=16)
+def _column(path, kind, variable, factor, nan_policy, stamp) -> Column:
+    """The column of these arguments, one object per process: the tasks of a long analysis
+    that run in one process (a worker of a dask cluster) each receive a pickled copy, and
+    all read through the one file this opens (reopening it cost about 7 ms a task). A
+    stamp that changed (the file rewritten) makes another column; the least recently used
+    of more than 16 are let go."""
+    return Column(path, kind, variable, factor, nan_policy, stamp)
 
 
 def _select(path: Path, kind: str, found: list[Variable], options: dict) -> dict:
@@ -219,6 +239,8 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
         for variable in chosen.values():
             _zarr_complete(path, variable)
     columns, units = {}, {}
+    stat = path.stat()
+    stamp = (stat.st_mtime_ns, stat.st_size)
     for role, variable in chosen.items():
         factor, unit = 1.0, "1"
         if role != "cycle":
@@ -227,7 +249,7 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
                 factor, unit = column_scale(role, options[f"{role}_unit"], carried, variable.name)
             except ColumnError as error:
                 raise RecordingError(path, f"{_KIND[kind]} {variable.name!r}", str(error)) from None
-        columns[role] = Column(path, kind, variable, factor, options["nan_policy"])
+        columns[role] = Column(path, kind, variable, factor, options["nan_policy"], stamp)
         units[role] = unit
     size = chosen["displacement"].size
     if size == 0:
@@ -237,7 +259,6 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
         import dask.array as da
         from dask.base import tokenize
 
-        stat = path.stat()
         native = max(v.chunk for v in chosen.values()) or 1
         block = int(chunks) if chunks else max(native, DEFAULT_CHUNK // native * native)
         token = tokenize(str(path.resolve()), stat.st_mtime_ns, stat.st_size, options, block)
@@ -252,6 +273,8 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
             )
             for role, column in columns.items()
         }
+        for role, column in columns.items():  # read directly by the tasks of an analysis
+            setattr(arrays[role], SOURCE, column)
     else:
         arrays = {}
         for role, column in columns.items():

@@ -31,6 +31,7 @@ import itertools
 import numpy as np
 import xarray as xr
 
+from ecofmaps._parallel import stretch
 from ecofmaps.measured.analysis import MissingSampleError, _missing_error, no_cycle_error
 from ecofmaps.measured.cycles import Cycles, find_cycles
 from ecofmaps.measured.per_cycle import measure_cycles
@@ -209,7 +210,7 @@ class LongAnalysis:
         table = cycles.rows(slice(first, stop))
         low = int(table.start[0])
         high = int(table.start[-1] + table.count[-1])
-        x, q = (array[low:high] for array in self.arrays)
+        x, q = (stretch(array, low, high) for array in self.arrays)
         inner = slice(rows.start - first, rows.stop - first)
         return (table, low, inner, self.load, self.options, x, q, self.resolve, then)
 

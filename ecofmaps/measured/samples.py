@@ -18,6 +18,8 @@ import sys
 
 import numpy as np
 
+from ecofmaps._parallel import stretch
+
 __all__ = ["CHANNELS", "Samples", "is_lazy"]
 
 #: The channels of a recording, in the order a block function receives them.
@@ -126,14 +128,7 @@ class Samples:
         def tasks():
             for a, b in self.blocks():
                 end = min(b + extra, self.size)
-                arrays = (None if s is None else s[a:end] for s in selected)
+                arrays = (None if s is None else stretch(s, a, end) for s in selected)
                 yield (function, a, b, arguments, *arrays)
 
         return list(self.runner.map(_task, tasks()))
-
-    def read(self, start: int, stop: int, channels):
-        """Samples ``start`` to ``stop - 1`` of ``channels``, lazily sliced (for a task to
-        read) or as NumPy views."""
-        return tuple(
-            None if s is None else s[start:stop] for s in (self.channel(n) for n in channels)
-        )

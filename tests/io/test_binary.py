@@ -11,6 +11,7 @@ import xarray as xr
 import zarr
 from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
 
+from ecofmaps._parallel import Slice, stretch
 from ecofmaps.io.binary import Column
 from ecofmaps.io.recording_types import RecordingError
 from ecofmaps.io.recordings import read_recording, recording_blocks, recording_format
@@ -176,18 +177,40 @@ def test_lazy_reading_is_blockwise_and_equal(tmp_path, kind):
 
 
 def test_column_pickles_without_its_file(tmp_path):
-    """A Column keeps its open file per process: a pickled copy opens its own."""
+    """A Column keeps its open file per process: a pickled copy opens its own, and every
+    copy of it unpickled in one process is that one object (one open file for all the
+    tasks a worker runs), until the file's stamp changes."""
     path = write_hdf5(tmp_path / "rig.h5")
     variable = next(v for v in variables(path, "hdf5") if v.short == "force_kN")
-    column = Column(path, "hdf5", variable, 1e3, "propagate")
+    column = Column(path, "hdf5", variable, 1e3, "propagate", stamp=(1, 2))
     np.testing.assert_array_equal(column[10:20], FORCE[10:20] * 1e3)
     copy = pickle.loads(pickle.dumps(column))
     assert copy._handle is None and column._handle is not None
     np.testing.assert_array_equal(copy[(slice(5, 9),)], FORCE[5:9] * 1e3)
+    assert pickle.loads(pickle.dumps(column)) is copy and copy._handle is not None
+    other = Column(path, "hdf5", variable, 1e3, "propagate", stamp=(1, 3))
+    assert pickle.loads(pickle.dumps(other)) is not copy
     with pytest.raises(TypeError, match="slice"):
         column[3]
     column.close()
     copy.close()
+
+
+@pytest.mark.parametrize("kind", ["tdms", "hdf5", "zarr"])
+def test_tasks_read_ranges_from_the_column(tmp_path, kind):
+    """A lazily read channel hands a task a Slice of its Column, read without dask, equal
+    to the dask array's values; an array computed from it is sliced by dask."""
+    path = {"tdms": write_tdms, "hdf5": write_hdf5, "zarr": write_zarr}[kind](tmp_path / kind)
+    options = {"force_column": "ftr"} if kind == "tdms" else {}
+    lazy = read_recording(path, lazy=True, chunks=700, **options)
+    for array in (lazy.displacement, lazy.force):
+        part = stretch(array, 650, 1720)
+        assert isinstance(part, Slice) and isinstance(part.source, Column)
+        read = pickle.loads(pickle.dumps(part)).read()
+        np.testing.assert_array_equal(read, array[650:1720].compute())
+    derived = stretch(lazy.force * 2.0, 650, 1720)
+    assert not isinstance(derived, Slice)
+    np.testing.assert_array_equal(derived.compute(), 2.0 * lazy.force[650:1720].compute())
 
 
 def test_group_choice(tmp_path):
