@@ -301,11 +301,12 @@ def _analyse(index, path, recording, load, args, runner, partial, many):
     texts = {block: lines(part) for block, part in parts.items()}
     bar = _bar(analysis, path, shown, sum(parts[b].cycle.size for b in parts))
     try:
-        for block, values, flags, text in analysis.measured(skip=done, then=lines):
+        kept = analysis.measured(skip=done, then=lines, keep=partial is not None)
+        for block, part, values, flags, text in kept:
             if partial is not None:
                 partial.keep(index, block, values, flags)
-            parts[block], texts[block] = analysis.part(block, values, flags), text
-            bar.update(parts[block].cycle.size)
+            parts[block], texts[block] = part, text
+            bar.update(part.cycle.size)
     except KeyboardInterrupt:
         bar.leave = False
         bar.close()

@@ -81,42 +81,45 @@ def _measure(
     q,
     resolve: bool,
     then=None,
+    keep: bool = False,
 ):
     """One task: the cycles ``rows`` of the table ``cycles`` measured on the stretch of the
     recording that begins at sample ``low``; with ``resolve``, also read along the stroke
-    (the values :data:`~ecofmaps.measured.resolved.REPORTED` and the reading's quality,
-    named with the prefix :data:`READ`), so the loops never leave the task; with ``then``,
-    also ``then(results)`` of the task's results (as :meth:`LongAnalysis.part` makes them),
-    so that work on them is done where the task runs too."""
+    (the values :data:`~ecofmaps.measured.resolved.REPORTED` and the reading's quality), so
+    the loops never leave the task.
+
+    Returns the task's results (as :meth:`LongAnalysis.part` makes them) and a
+    :class:`~ecofmaps.measured.results.Tally` of them, made where the task runs; with
+    ``keep``, what :func:`~ecofmaps.measured.per_cycle.measure_cycles` measured too (with the
+    reading along the stroke named with the prefix :data:`READ`), else None for both; and
+    ``then(results)``, or None without ``then``, so that work on the results is done where
+    the task runs too."""
     values, flags, loops = measure_cycles(
         cycles, _Stretch(x, low), _Stretch(q, low), load, rows=rows, keep_loops=resolve, **options
     )
-    if not resolve and then is None:
-        return values, flags, None
-    label = cycles.label[rows]
-    counted = cycle_results(values, flags, label, load, options)  # once, for both
+    counted = cycle_results(values, flags, cycles.label[rows], load, options)
     if resolve:
         read = with_read_along_stroke(with_loops(strip(counted), loops))
         values = values | {f"{READ}{name}": read[name].values for name in (*REPORTED, "quality")}
-    if then is None:
-        return values, flags, None
-    return values, flags, then(_results(values, flags, label, load, options, counted)[1])
+    part = _part(counted, values)
+    tally = Tally()
+    tally.add(counted)
+    if not keep:
+        values = flags = None
+    return part, tally, values, flags, None if then is None else then(part)
 
 
-def _results(values: dict, flags: dict, label, load: float, options: dict, counted=None):
-    """The results of a task from what it measured: as
-    :func:`~ecofmaps.measured.results.cycle_results` gives them (with their riders; or
-    ``counted``, if made from these values before), and with the reading along the stroke
-    in place of those riders where the task read it."""
-    read = {k[len(READ) :]: v for k, v in values.items() if k.startswith(READ)}
-    if counted is None:
-        values = {k: v for k, v in values.items() if not k.startswith(READ)}
-        counted = cycle_results(values, flags, label, load, options)
+def _part(counted: xr.Dataset, values: dict) -> xr.Dataset:
+    """The results of a task: ``counted`` (from
+    :func:`~ecofmaps.measured.results.cycle_results`) without its riders, with the reading
+    along the stroke in ``values`` (named with the prefix :data:`READ`) where the task read
+    it."""
     part = strip(counted)
+    read = {k[len(READ) :]: v for k, v in values.items() if k.startswith(READ)}
     if read:  # as ecofmaps.measured.resolved.with_resolved adds them
         part = part.assign({k: ("cycle", read[k], _read_attrs(k)) for k in REPORTED})
         part["quality"] = part["quality"].copy(data=read["quality"])
-    return counted, part
+    return part
 
 
 class LongAnalysis:
@@ -195,13 +198,14 @@ class LongAnalysis:
             raise no_cycle_error(int(displacement.shape[0]))
         self.tasks = _tasks(cycles.count, samples or TASK_SAMPLES)
         self.tally = Tally()
+        self._whole = np.flatnonzero(cycles.whole)  # the cycles a halo may hold
 
-    def _task(self, rows: slice, then):
-        """The arguments of the task that measures ``rows`` (and calls ``then``)."""
+    def _task(self, rows: slice, then, keep: bool):
+        """The arguments of the task that measures ``rows`` (see :func:`_measure`)."""
         cycles = self.cycles
         first, stop = rows.start, rows.stop
         if cycles.continuous:  # a halo of whole cycles on either side
-            kept = np.flatnonzero(cycles.whole)
+            kept = self._whole
             begin, end = np.searchsorted(kept, [first, stop])
             if begin > 0:
                 first = min(first, int(kept[max(begin - HALO, 0)]))
@@ -212,10 +216,10 @@ class LongAnalysis:
         high = int(table.start[-1] + table.count[-1])
         x, q = (stretch(array, low, high) for array in self.arrays)
         inner = slice(rows.start - first, rows.stop - first)
-        return (table, low, inner, self.load, self.options, x, q, self.resolve, then)
+        return (table, low, inner, self.load, self.options, x, q, self.resolve, then, keep)
 
-    def measured(self, skip=(), then=None):
-        """What each task measured, in order, as it comes.
+    def measured(self, skip=(), then=None, keep=False):
+        """The results of each task, in order, as they come; counted in :attr:`tally`.
 
         Parameters
         ----------
@@ -226,37 +230,43 @@ class LongAnalysis:
             the task runs: a module-level function, or a :func:`functools.partial` of one,
             for tasks in other processes. The command line formats its table rows so, in
             parallel.
+        keep : bool
+            Also hand back what each task measured (to be kept, and made into its results
+            again by :meth:`part` when a run is resumed).
 
         Yields
         ------
         index : int
             The task (index into :attr:`tasks`).
-        values, flags : dict of str to numpy.ndarray
-            Its cycles' quantities and checks, from
-            :func:`~ecofmaps.measured.per_cycle.measure_cycles` (:meth:`part` makes the
-            results of them).
+        part : xarray.Dataset
+            Its cycles' results, made where it ran (see :meth:`part`).
+        values, flags : dict of str to numpy.ndarray, or None
+            With ``keep``, its cycles' quantities and checks, from
+            :func:`~ecofmaps.measured.per_cycle.measure_cycles`.
         made
             What ``then`` returned for the task's results (None without ``then``).
         """
         skip = set(skip)
         wanted = [k for k in range(len(self.tasks)) if k not in skip]
-        results = self.runner.map(_measure, (self._task(self.tasks[k], then) for k in wanted))
-        for index, (values, flags, made) in zip(wanted, results, strict=False):
-            yield index, values, flags, made
+        results = self.runner.map(_measure, (self._task(self.tasks[k], then, keep) for k in wanted))
+        for index, (part, tally, values, flags, made) in zip(wanted, results, strict=False):
+            self.tally.merge(tally)
+            yield index, part, values, flags, made
 
     def part(self, index: int, values: dict, flags: dict) -> xr.Dataset:
-        """The per-cycle results of task ``index`` from what it measured, as in
-        :func:`ecofmaps.analyze_loops`'s Dataset (without the recording's attributes);
-        counted in :attr:`tally`."""
+        """The per-cycle results of task ``index`` from what it measured (kept by
+        :meth:`measured`), as in :func:`ecofmaps.analyze_loops`'s Dataset (without the
+        recording's attributes); counted in :attr:`tally`."""
         labels = self.cycles.label[self.tasks[index]]
-        counted, part = _results(values, flags, labels, self.load, self.options)
+        measured = {k: v for k, v in values.items() if not k.startswith(READ)}
+        counted = cycle_results(measured, flags, labels, self.load, self.options)
         self.tally.add(counted)
-        return part
+        return _part(counted, values)
 
     def parts(self):
         """The results of each task, in order, as they come (see :meth:`part`)."""
-        for index, values, flags, _ in self.measured():
-            yield index, self.part(index, values, flags)
+        for index, part, *_ in self.measured():
+            yield index, part
 
     def finish(self, parts) -> xr.Dataset:
         """The parts (all of them, in order) joined, with the recording's attributes, after

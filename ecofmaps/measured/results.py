@@ -10,6 +10,8 @@ recording analysed in parts (:mod:`ecofmaps.measured.out_of_core`) gives the sam
 
 from __future__ import annotations
 
+import collections
+
 import numpy as np
 import xarray as xr
 
@@ -140,8 +142,7 @@ class Tally:
 
     def add(self, part: xr.Dataset) -> xr.Dataset:
         """Count the cycles of ``part``; return it without its riders."""
-        texts, counts = np.unique(part.quality.values, return_counts=True)
-        for text, count in zip(texts.tolist(), counts.tolist(), strict=True):
+        for text, count in collections.Counter(part.quality.values.tolist()).items():
             self.counts[text] = self.counts.get(text, 0) + count
             if text not in ("ok", "not-gross-slip"):
                 self.flagged += count
@@ -152,6 +153,18 @@ class Tally:
         self.negative_stiffness |= bool(part["_negative-stiffness"].any())
         self.amplitudes.append(part["_amplitude"].values)
         return strip(part)
+
+    def merge(self, other: Tally) -> None:
+        """Count the parts ``other`` counted (in another process, say) as well."""
+        for text, count in other.counts.items():
+            self.counts[text] = self.counts.get(text, 0) + count
+        self.cycles += other.cycles
+        self.refused += other.refused
+        self.flagged += other.flagged
+        for reason in self.every:
+            self.every[reason] &= other.every[reason]
+        self.negative_stiffness |= other.negative_stiffness
+        self.amplitudes += other.amplitudes
 
     @property
     def summary(self) -> str:

@@ -8,6 +8,7 @@ analysis in memory to 1e-12 of its natural scale (tests/measured/test_equivalenc
 quality and regime strings and the attributes exactly.
 """
 
+import inspect
 import warnings
 
 import dask.array as da
@@ -266,3 +267,39 @@ def test_every_cycle_missing_is_an_error():
     force[100::200] = np.nan
     with pytest.raises(ValueError, match=r"no plausible cycle.*Every cycle holds a missing"):
         analyze_loops(displacement, force, LOAD)
+
+
+def test_tallies_of_parts_merge_into_the_tally_of_the_whole():
+    """Tasks count their parts where they run (Tally.add) and the counts are merged: the
+    same summary, refusals, checks and amplitudes as counting the whole at once."""
+    from ecofmaps.measured.analysis import check_options
+    from ecofmaps.measured.per_cycle import measure_cycles
+    from ecofmaps.measured.results import Tally, cycle_results
+
+    x, q = noisy(EXAMPLE_2, 12, 3)
+    x, q = with_gaps(x, q, [700, 1900])  # skipped cycles besides the flagged ones
+    defaults = inspect.signature(analyze_loops).parameters
+    names = ("hysteresis", "stick_window", "crossing_window", "gross_slip_threshold")
+    options = check_options(LOAD, *(defaults[name].default for name in names), False)
+    found = cycles.find_cycles(x, None, 0.5, force=q)
+    values, flags, _ = measure_cycles(found, x, q, LOAD, **options)
+    whole = Tally()
+    whole.add(cycle_results(values, flags, found.label, LOAD, options))
+    merged = Tally()
+    for rows in (slice(0, 5), slice(5, 6), slice(6, None)):
+        part = Tally()
+        take = {k: v[rows] for k, v in values.items()}
+        checks = {k: v[rows] for k, v in flags.items()}
+        part.add(cycle_results(take, checks, found.label[rows], LOAD, options))
+        merged.merge(part)
+    assert whole.summary == merged.summary and "skipped" in whole.summary
+    assert (whole.cycles, whole.refused, whole.flagged) == (
+        merged.cycles,
+        merged.refused,
+        merged.flagged,
+    )
+    assert whole.every == merged.every and whole.counts == merged.counts
+    assert whole.negative_stiffness == merged.negative_stiffness
+    np.testing.assert_array_equal(
+        np.concatenate(whole.amplitudes), np.concatenate(merged.amplitudes)
+    )
