@@ -59,12 +59,6 @@ class Slice:
     def __init__(self, source, start: int, stop: int):
         self.source, self.start, self.stop = source, int(start), int(stop)
 
-    def __getstate__(self):
-        return self.source, self.start, self.stop
-
-    def __setstate__(self, state):
-        self.source, self.start, self.stop = state
-
     def read(self):
         """The samples, as the source gives them (a NumPy array)."""
         return self.source[self.start : self.stop]
