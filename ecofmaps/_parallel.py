@@ -135,6 +135,12 @@ class Runner:
             return f"cluster at {self.scheduler or self._given.scheduler.address}"
         return "local cluster" if self.cluster else "threads"
 
+    @property
+    def local(self) -> bool:
+        """Whether the tasks run on this machine (threads or a local cluster), where they
+        see its files at the same paths."""
+        return self.scheduler is None and self._given is None
+
     def __enter__(self) -> Runner:
         if self._given is not None:
             self._client = self._given

@@ -6,7 +6,9 @@ samples, or any file with ``--workers``, ``--scheduler`` or ``--resume``) is ana
 ``--workers`` processes or the dask cluster at ``--scheduler``. With ``--out``, each block's
 results are written as it completes into ``<out>.partial/`` (NumPy ``.npz``, one file per block,
 each renamed into place when whole: what its cycles measured, from which the results are
-made again; with the cycles found and what the run was), so an
+made again; with the cycles found and what the run was), by the task that measured it on
+threads or ``--workers`` (which see this machine's files), by this process for a cluster at
+``--scheduler``, so an
 interrupted run keeps what it finished and ``--resume`` continues it; the table is written
 to ``--out`` only at the end, and the folder removed. A progress bar (cycles, rate, time
 left) is shown on a terminal, unless ``--quiet``.
@@ -15,6 +17,7 @@ left) is shown on a terminal, unless ``--quiet``.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import functools
 import inspect
@@ -26,7 +29,7 @@ from pathlib import Path
 
 from ecofmaps.cli._common import CommandError
 
-__all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun", "add_options", "skipped"]
+__all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun", "add_options", "keep_block", "skipped"]
 
 #: The message for a missing sample with ``--nan-policy raise`` (the file and line before it).
 MISSING = (
@@ -148,27 +151,40 @@ class _Partial:
         values["missing"] = np.asarray(False) if cycles.missing is None else cycles.missing
         _write(self.folder / f"file{index}-cycles.npz", lambda path: _savez(path, values))
 
+    def kept(self, index: int) -> dict:
+        """The blocks of file ``index`` kept: block -> its file."""
+        prefix = f"file{index}-block"
+        return {
+            int(path.stem[len(prefix) :]): path
+            for path in self.folder.glob(f"{prefix}*.npz")
+            if path.stem[len(prefix) :].isdigit()
+        }
+
     def done(self, index: int) -> dict:
         """The blocks of file ``index`` kept: block -> (values, flags) as measured."""
         import numpy as np
 
-        prefix = f"file{index}-block"
         kept = {}
-        for path in self.folder.glob(f"{prefix}*.npz"):
-            if path.stem[len(prefix) :].isdigit():
-                with np.load(path) as stored:
-                    values = {k[2:]: stored[k] for k in stored.files if k.startswith("v:")}
-                    flags = {k[2:]: stored[k] for k in stored.files if k.startswith("f:")}
-                kept[int(path.stem[len(prefix) :])] = (values, flags)
+        for block, path in self.kept(index).items():
+            with np.load(path) as stored:
+                values = {k[2:]: stored[k] for k in stored.files if k.startswith("v:")}
+                flags = {k[2:]: stored[k] for k in stored.files if k.startswith("f:")}
+            kept[block] = (values, flags)
         return kept
 
     def keep(self, index: int, block: int, values: dict, flags: dict) -> None:
         """Keep what block ``block`` of file ``index`` measured."""
-        stored = {f"v:{k}": v for k, v in values.items()} | {f"f:{k}": v for k, v in flags.items()}
-        _write(self.folder / f"file{index}-block{block:06d}.npz", lambda p: _savez(p, stored))
+        keep_block(self.folder, index, block, values, flags)
 
     def remove(self) -> None:
         shutil.rmtree(self.folder, ignore_errors=True)
+
+
+def keep_block(folder: Path, index: int, block: int, values: dict, flags: dict) -> None:
+    """Keep in ``folder`` what block ``block`` of file ``index`` measured (a function of the
+    module, so a task can call it where it runs)."""
+    stored = {f"v:{k}": v for k, v in values.items()} | {f"f:{k}": v for k, v in flags.items()}
+    _write(folder / f"file{index}-block{block:06d}.npz", lambda p: _savez(p, stored))
 
 
 def _savez(path: Path, values: dict) -> None:
@@ -233,12 +249,22 @@ class LongRun:
         ``many``, a string per block); its blocks kept beside ``--out`` as they complete.
         The results are joined after the cluster is closed, so its workers' memory and the
         joined results are not held at once."""
-        with self._runner() as runner:  # a cluster that does not answer: nothing written
-            if self.partial is None and self.fingerprint is not None:
-                self.partial = _Partial(self.args.out, self.fingerprint, self.args.resume)
-            analysis, parts, texts = _analyse(
-                index, path, recording, load, self.args, runner, self.partial, many
-            )
+        try:
+            with self._runner() as runner:  # a cluster that does not answer: nothing written
+                if self.partial is None and self.fingerprint is not None:
+                    self.partial = _Partial(self.args.out, self.fingerprint, self.args.resume)
+                analysis, parts, texts = _analyse(
+                    index, path, recording, load, self.args, runner, self.partial, many
+                )
+        except _Interrupted as stop:  # counted once the runner is closed: no task runs
+            if self.partial is not None:
+                print(
+                    f"ecofmaps: {len(self.partial.kept(index))} of {stop.blocks} blocks of "
+                    f"{path} are kept in {self.partial.folder}: run the same command with "
+                    "--resume to continue",
+                    file=sys.stderr,
+                )
+            raise
         results = analysis.finish([parts.pop(k) for k in sorted(parts)])
         return results, [texts[k] for k in sorted(texts)]
 
@@ -300,25 +326,30 @@ def _analyse(index, path, recording, load, args, runner, partial, many):
     parts = {block: analysis.part(block, *measured) for block, measured in done.items()}
     texts = {block: lines(part) for block, part in parts.items()}
     bar = _bar(analysis, path, shown, sum(parts[b].cycle.size for b in parts))
+    keep = partial is not None
+    if keep and runner.local:  # the tasks keep their blocks themselves, where they run
+        keep = functools.partial(keep_block, partial.folder, index)
     try:
-        kept = analysis.measured(skip=done, then=lines, keep=partial is not None)
-        for block, part, values, flags, text in kept:
-            if partial is not None:
-                partial.keep(index, block, values, flags)
-            parts[block], texts[block] = part, text
-            bar.update(part.cycle.size)
+        with contextlib.closing(analysis.measured(skip=done, then=lines, keep=keep)) as kept:
+            for block, part, values, flags, text in kept:
+                if values is not None:
+                    partial.keep(index, block, values, flags)
+                parts[block], texts[block] = part, text
+                bar.update(part.cycle.size)
     except KeyboardInterrupt:
         bar.leave = False
         bar.close()
-        if partial is not None:
-            print(
-                f"ecofmaps: {len(parts)} of {len(analysis.tasks)} blocks of {path} are kept in "
-                f"{partial.folder}: run the same command with --resume to continue",
-                file=sys.stderr,
-            )
-        raise
+        raise _Interrupted(len(analysis.tasks)) from None
     bar.close()
     return analysis, parts, texts
+
+
+class _Interrupted(KeyboardInterrupt):
+    """Ctrl-C while the blocks of a recording of ``blocks`` blocks were measured."""
+
+    def __init__(self, blocks: int):
+        super().__init__(blocks)
+        self.blocks = blocks
 
 
 def _bar(analysis, path, shown: bool, initial: int):

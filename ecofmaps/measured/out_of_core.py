@@ -26,6 +26,7 @@ length of the recording.
 
 from __future__ import annotations
 
+import functools
 import itertools
 
 import numpy as np
@@ -81,7 +82,7 @@ def _measure(
     q,
     resolve: bool,
     then=None,
-    keep: bool = False,
+    keep=False,
 ):
     """One task: the cycles ``rows`` of the table ``cycles`` measured on the stretch of the
     recording that begins at sample ``low``; with ``resolve``, also read along the stroke
@@ -90,8 +91,9 @@ def _measure(
 
     Returns the task's results (as :meth:`LongAnalysis.part` makes them) and a
     :class:`~ecofmaps.measured.results.Tally` of them, made where the task runs; with
-    ``keep``, what :func:`~ecofmaps.measured.per_cycle.measure_cycles` measured too (with the
-    reading along the stroke named with the prefix :data:`READ`), else None for both; and
+    ``keep=True``, what :func:`~ecofmaps.measured.per_cycle.measure_cycles` measured too
+    (with the reading along the stroke named with the prefix :data:`READ`), else None for
+    both (a callable ``keep`` is given them here instead, ``keep(values, flags)``); and
     ``then(results)``, or None without ``then``, so that work on the results is done where
     the task runs too."""
     values, flags, loops = measure_cycles(
@@ -104,7 +106,9 @@ def _measure(
     part = _part(counted, values)
     tally = Tally()
     tally.add(counted)
-    if not keep:
+    if callable(keep):
+        keep(values, flags)
+    if keep is not True:
         values = flags = None
     return part, tally, values, flags, None if then is None else then(part)
 
@@ -200,9 +204,9 @@ class LongAnalysis:
         self.tally = Tally()
         self._whole = np.flatnonzero(cycles.whole)  # the cycles a halo may hold
 
-    def _task(self, rows: slice, then, keep: bool):
-        """The arguments of the task that measures ``rows`` (see :func:`_measure`)."""
-        cycles = self.cycles
+    def _task(self, index: int, then, keep):
+        """The arguments of the task ``index`` (see :func:`_measure`)."""
+        cycles, rows = self.cycles, self.tasks[index]
         first, stop = rows.start, rows.stop
         if cycles.continuous:  # a halo of whole cycles on either side
             kept = self._whole
@@ -216,6 +220,8 @@ class LongAnalysis:
         high = int(table.start[-1] + table.count[-1])
         x, q = (stretch(array, low, high) for array in self.arrays)
         inner = slice(rows.start - first, rows.stop - first)
+        if callable(keep):
+            keep = functools.partial(keep, index)
         return (table, low, inner, self.load, self.options, x, q, self.resolve, then, keep)
 
     def measured(self, skip=(), then=None, keep=False):
@@ -230,9 +236,12 @@ class LongAnalysis:
             the task runs: a module-level function, or a :func:`functools.partial` of one,
             for tasks in other processes. The command line formats its table rows so, in
             parallel.
-        keep : bool
-            Also hand back what each task measured (to be kept, and made into its results
-            again by :meth:`part` when a run is resumed).
+        keep : bool or callable
+            True: also hand back what each task measured (to be kept, and made into its
+            results again by :meth:`part` when a run is resumed). A callable
+            ``keep(index, values, flags)`` is called with it where the task runs instead
+            (picklable as ``then`` is), so that what is kept does not travel: for a runner
+            whose workers share this machine's files.
 
         Yields
         ------
@@ -241,17 +250,20 @@ class LongAnalysis:
         part : xarray.Dataset
             Its cycles' results, made where it ran (see :meth:`part`).
         values, flags : dict of str to numpy.ndarray, or None
-            With ``keep``, its cycles' quantities and checks, from
+            With ``keep=True``, its cycles' quantities and checks, from
             :func:`~ecofmaps.measured.per_cycle.measure_cycles`.
         made
             What ``then`` returned for the task's results (None without ``then``).
         """
         skip = set(skip)
         wanted = [k for k in range(len(self.tasks)) if k not in skip]
-        results = self.runner.map(_measure, (self._task(self.tasks[k], then, keep) for k in wanted))
-        for index, (part, tally, values, flags, made) in zip(wanted, results, strict=False):
-            self.tally.merge(tally)
-            yield index, part, values, flags, made
+        results = self.runner.map(_measure, (self._task(k, then, keep) for k in wanted))
+        try:
+            for index, (part, tally, values, flags, made) in zip(wanted, results, strict=False):
+                self.tally.merge(tally)
+                yield index, part, values, flags, made
+        finally:  # closed with this generator: the tasks left are cancelled now, not later
+            results.close()
 
     def part(self, index: int, values: dict, flags: dict) -> xr.Dataset:
         """The per-cycle results of task ``index`` from what it measured (kept by

@@ -303,3 +303,39 @@ def test_tallies_of_parts_merge_into_the_tally_of_the_whole():
     np.testing.assert_array_equal(
         np.concatenate(whole.amplitudes), np.concatenate(merged.amplitudes)
     )
+
+
+def _kept_here(store, index, values, flags):
+    """A ``keep`` of :meth:`LongAnalysis.measured`: what task ``index`` measured, in ``store``."""
+    store[index] = (values, flags)
+
+
+def test_tasks_keep_what_they_measured_where_they_run(small_blocks):
+    """``keep=True`` hands each task's values and flags back; a callable ``keep`` is given
+    the same, with the task's index, where the task runs, and nothing comes back."""
+    import functools
+
+    from ecofmaps._parallel import Runner
+    from ecofmaps.measured.analysis import check_options
+
+    x, q = noisy(EXAMPLE_2, 12, 3)
+    defaults = inspect.signature(analyze_loops).parameters
+    names = ("hysteresis", "stick_window", "crossing_window", "gross_slip_threshold")
+    options = check_options(LOAD, *(defaults[name].default for name in names), False)
+    x, q = lazily(x, q)
+    store = {}
+    with Runner(2) as runner:
+        analysis = out_of_core.LongAnalysis(x, q, LOAD, runner=runner, samples=900, **options)
+        assert len(analysis.tasks) > 2
+        handed = {k: (v, f) for k, _, v, f, _ in analysis.measured(keep=True)}
+        nothing = [(v, f) for _, _, v, f, _ in analysis.measured()]
+        kept = analysis.measured(keep=functools.partial(_kept_here, store))
+        returned = [(v, f) for _, _, v, f, _ in kept]
+    assert all(v is None and f is None for v, f in nothing + returned)
+    assert sorted(store) == sorted(handed) == list(range(len(analysis.tasks)))
+    for index, (values, flags) in handed.items():
+        assert store[index][0].keys() == values.keys() and store[index][1].keys() == flags.keys()
+        for name in values:
+            np.testing.assert_array_equal(store[index][0][name], values[name])
+        for name in flags:
+            np.testing.assert_array_equal(store[index][1][name], flags[name])
