@@ -7,8 +7,7 @@ The names below are imported on first use, so ``import ecofmaps`` is quick and t
 line starts (and answers Ctrl-C) before JAX, xarray or matplotlib are loaded.
 """
 
-import importlib
-
+from ecofmaps._lazy import lazy_names
 from ecofmaps._version import __version__ as __version__
 
 #: Each public name, by the module that defines it.
@@ -63,23 +62,8 @@ _PUBLIC = {
         "w_shaped_profile",
     ),
 }
-_HOME = {name: module for module, names in _PUBLIC.items() for name in names}
 #: Subpackages reachable as attributes (``ecofmaps.figures`` needs matplotlib).
 _SUBMODULES = ("cli", "correction", "figures", "io", "maps", "measured", "model", "paper")
 
-
-def __getattr__(name: str):
-    if name in _HOME:
-        value = getattr(importlib.import_module(_HOME[name]), name)
-        globals()[name] = value  # imported once
-        return value
-    if name in _SUBMODULES:
-        return importlib.import_module(f"ecofmaps.{name}")
-    raise AttributeError(f"module 'ecofmaps' has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted({*globals(), *__all__})
-
-
-__all__ = sorted([*_HOME, *_SUBMODULES, "__version__"])
+__getattr__, __dir__, __all__ = lazy_names(__name__, _PUBLIC, _SUBMODULES)
+__all__ = sorted([*__all__, "__version__"])

@@ -14,15 +14,20 @@ from __future__ import annotations
 
 import functools
 import inspect
+import sys
 
-import jax
-import jax.numpy as jnp
 import numpy as np
 
 from ecofmaps._nomenclature import QUANTITIES, RANGES
 from ecofmaps.units import DIMENSIONS
 
 __all__ = ["as_float64", "check", "float64", "is_concrete", "si_units", "to_si"]
+
+
+def _is_tracer(value) -> bool:
+    """True for a JAX tracer (without importing JAX: before it is imported there is none)."""
+    jax = sys.modules.get("jax")
+    return jax is not None and isinstance(value, jax.core.Tracer)
 
 
 def _is_quantity(value) -> bool:
@@ -54,7 +59,7 @@ def to_si(name: str, value, quantity: str | None = None):
         For ``None``, a string or a boolean (or an array of them), or a Quantity whose
         dimension is not the parameter's.
     """
-    if isinstance(value, jax.core.Tracer):
+    if _is_tracer(value):
         return value
     described = QUANTITIES.get(quantity or name)
     kind = "dimensionless" if described is None else described.kind
@@ -132,6 +137,8 @@ def float64(function):
     precision the caller's mode has already fixed, so they require the mode on and raise a
     ``ValueError`` that says how, instead of silently computing in float32.
     """
+    import jax
+
     parameters = inspect.signature(function)
 
     @functools.wraps(function)
@@ -155,18 +162,22 @@ def float64(function):
 
 def _to_numpy(leaf):
     """A JAX array as a (read-only, uncopied) NumPy array; anything else as it is."""
-    return np.asarray(leaf) if isinstance(leaf, jax.Array) else leaf
+    return np.asarray(leaf) if isinstance(leaf, sys.modules["jax"].Array) else leaf
 
 
 def is_concrete(*values) -> bool:
     """True when no leaf of ``values`` (pytrees such as a scar profile included) is a JAX
     tracer, so they can be inspected."""
-    leaves = jax.tree_util.tree_leaves(values)
-    return not any(isinstance(leaf, jax.core.Tracer) for leaf in leaves)
+    jax = sys.modules.get("jax")
+    if jax is None:  # no tracer exists before JAX is imported
+        return True
+    return not any(_is_tracer(leaf) for leaf in jax.tree_util.tree_leaves(values))
 
 
 def as_float64(value):
     """``value`` as a float64 JAX array (call inside :func:`float64`)."""
+    import jax.numpy as jnp
+
     return jnp.asarray(value, dtype=jnp.float64)
 
 

@@ -13,7 +13,6 @@ import re
 from decimal import Decimal
 
 import numpy as np
-import pint
 
 __all__ = ["DIMENSIONS", "parse_quantity", "parse_values"]
 
@@ -33,7 +32,10 @@ _NUMBER_AND_UNIT = re.compile(r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*([
 
 
 @functools.cache
-def _registry() -> pint.UnitRegistry:
+def _registry():
+    """pint's unit registry (pint imported on first use: most commands parse no unit)."""
+    import pint
+
     return pint.UnitRegistry()
 
 

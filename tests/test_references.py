@@ -13,7 +13,7 @@ SUBPACKAGES = ("correction", "io", "maps", "measured", "model")
 
 
 def _public():
-    names = {name: getattr(ecofmaps, name) for name in ecofmaps._HOME}
+    names = {name: getattr(ecofmaps, name) for name in ecofmaps.__all__ if name != "__version__"}
     for package in SUBPACKAGES:
         module = importlib.import_module(f"ecofmaps.{package}")
         names.update({f"{package}.{n}": getattr(module, n) for n in module.__all__})

@@ -1,22 +1,16 @@
 """Measured fretting loops: cycles, per-cycle analysis, the stroke-resolved reading, model fits
 and synthetic recordings."""
 
-from ecofmaps.measured.analysis import analyze_loops
-from ecofmaps.measured.fit import LoopFit, fit_loop
-from ecofmaps.measured.long_test import long_recording, write_long_recording
-from ecofmaps.measured.quality import LoopQualityWarning
-from ecofmaps.measured.resolved import resolve_analyzed_loops, resolve_loops
-from ecofmaps.measured.synthetic import scar_example_path, synthetic_recording
+from ecofmaps._lazy import lazy_names
 
-__all__ = [
-    "LoopFit",
-    "LoopQualityWarning",
-    "analyze_loops",
-    "fit_loop",
-    "long_recording",
-    "resolve_analyzed_loops",
-    "resolve_loops",
-    "scar_example_path",
-    "synthetic_recording",
-    "write_long_recording",
-]
+#: Each public name, by the module that defines it (imported on first use).
+_PUBLIC = {
+    "ecofmaps.measured.analysis": ("analyze_loops",),
+    "ecofmaps.measured.fit": ("LoopFit", "fit_loop"),
+    "ecofmaps.measured.long_test": ("long_recording", "write_long_recording"),
+    "ecofmaps.measured.quality": ("LoopQualityWarning",),
+    "ecofmaps.measured.resolved": ("resolve_analyzed_loops", "resolve_loops"),
+    "ecofmaps.measured.synthetic": ("scar_example_path", "synthetic_recording"),
+}
+
+__getattr__, __dir__, __all__ = lazy_names(__name__, _PUBLIC)

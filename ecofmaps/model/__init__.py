@@ -6,70 +6,45 @@
 :mod:`~ecofmaps.model.regimes` the regime codes.
 """
 
-from ecofmaps.model.core import (
-    compliance_ratio,
-    curvature_number,
-    ecof_ratio,
-    locking_margin,
-    normalized_energy,
-    normalized_max_force,
-    regime_code,
-    slip_position,
-    slip_ratio,
-    traction_ratio,
-)
-from ecofmaps.model.profile_families import (
-    flat_bottomed_profile,
-    parabolic_profile,
-    ridged_profile,
-    w_shaped_profile,
-)
-from ecofmaps.model.profiles import ScarProfile, scar_profile
-from ecofmaps.model.regimes import (
-    BEYOND_PROFILE,
-    GROSS_SLIP,
-    INVALID,
-    NO_GROSS_SLIP,
-    SELF_LOCKING,
-    Regime,
-)
-from ecofmaps.model.simulation import fretting_loop, simulate
-from ecofmaps.model.steady_state import (
-    dissipated_energy,
-    energy_cof,
-    max_force,
-    slip_amplitude,
-    slip_regime,
-)
+from ecofmaps._lazy import lazy_names
 
-__all__ = [
-    "BEYOND_PROFILE",
-    "GROSS_SLIP",
-    "INVALID",
-    "NO_GROSS_SLIP",
-    "SELF_LOCKING",
-    "Regime",
-    "ScarProfile",
-    "compliance_ratio",
-    "curvature_number",
-    "dissipated_energy",
-    "ecof_ratio",
-    "energy_cof",
-    "flat_bottomed_profile",
-    "fretting_loop",
-    "locking_margin",
-    "max_force",
-    "normalized_energy",
-    "normalized_max_force",
-    "parabolic_profile",
-    "regime_code",
-    "ridged_profile",
-    "scar_profile",
-    "simulate",
-    "slip_amplitude",
-    "slip_position",
-    "slip_ratio",
-    "slip_regime",
-    "traction_ratio",
-    "w_shaped_profile",
-]
+#: Each public name, by the module that defines it (imported on first use).
+_PUBLIC = {
+    "ecofmaps.model.core": (
+        "compliance_ratio",
+        "curvature_number",
+        "ecof_ratio",
+        "locking_margin",
+        "normalized_energy",
+        "normalized_max_force",
+        "regime_code",
+        "slip_position",
+        "slip_ratio",
+        "traction_ratio",
+    ),
+    "ecofmaps.model.profile_families": (
+        "flat_bottomed_profile",
+        "parabolic_profile",
+        "ridged_profile",
+        "w_shaped_profile",
+    ),
+    "ecofmaps.model.profiles": ("ScarProfile", "scar_profile"),
+    "ecofmaps.model.regimes": (
+        "BEYOND_PROFILE",
+        "GROSS_SLIP",
+        "INVALID",
+        "NO_GROSS_SLIP",
+        "SELF_LOCKING",
+        "Regime",
+    ),
+    "ecofmaps.model.simulation": ("fretting_loop", "simulate"),
+    "ecofmaps.model.steady_state": (
+        "dissipated_energy",
+        "energy_cof",
+        "max_force",
+        "slip_amplitude",
+        "slip_regime",
+    ),
+}
+
+__getattr__, __dir__, __all__ = lazy_names(__name__, _PUBLIC)

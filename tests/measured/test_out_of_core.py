@@ -339,3 +339,24 @@ def test_tasks_keep_what_they_measured_where_they_run(small_blocks):
             np.testing.assert_array_equal(store[index][0][name], values[name])
         for name in flags:
             np.testing.assert_array_equal(store[index][1][name], flags[name])
+
+
+def test_a_worker_reads_and_measures_without_jax_or_pint():
+    """The modules a task of a long analysis loads (reading a rig file's column, the passes,
+    measuring a block, formatting its rows) leave JAX, pint and SciPy unloaded: a worker
+    process starts its first task without them. Names of the packages still import."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys\n"
+        "import ecofmaps.io.binary, ecofmaps.measured.passes, ecofmaps.measured.out_of_core\n"
+        "import ecofmaps.io.tables, ecofmaps.cli.loops_long\n"
+        "loaded = [m for m in ('jax', 'pint', 'scipy') if m in sys.modules]\n"
+        "assert not loaded, loaded\n"
+        "from ecofmaps.measured import analyze_loops, fit_loop\n"
+        "from ecofmaps.model import GROSS_SLIP, fretting_loop\n"
+        "from ecofmaps.io import read_scar_profile\n"
+        "assert 'jax' in sys.modules and callable(fit_loop) and callable(read_scar_profile)\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=120)

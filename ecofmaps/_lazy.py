@@ -1,0 +1,49 @@
+"""The public names of a package, imported from their modules on first use (PEP 562).
+
+A package's ``__init__`` that imported every module at once would load JAX, xarray, pint
+and SciPy for any use of one of them: a worker process that reads a block of a recording
+would pay a second for names it never uses, and the command line would start slower.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+
+__all__ = ["lazy_names"]
+
+
+def lazy_names(package: str, public: dict, submodules=()):
+    """``__getattr__``, ``__dir__`` and ``__all__`` for the package ``package``.
+
+    Parameters
+    ----------
+    package : str
+        The package's name (its ``__name__``, while its ``__init__`` runs).
+    public : dict of str to tuple of str
+        Each public name, by the module that defines it.
+    submodules : sequence of str
+        Subpackages reachable as attributes before they are imported.
+
+    Returns
+    -------
+    __getattr__, __dir__ : callable
+        For the package's namespace: a name is imported on first use and then kept there.
+    __all__ : list of str
+    """
+    home = {name: module for module, names in public.items() for name in names}
+    namespace = sys.modules[package].__dict__
+
+    def __getattr__(name: str):
+        if name in home:
+            value = getattr(importlib.import_module(home[name]), name)
+            namespace[name] = value  # imported once
+            return value
+        if name in submodules:
+            return importlib.import_module(f"{package}.{name}")
+        raise AttributeError(f"module {package!r} has no attribute {name!r}")
+
+    def __dir__():
+        return sorted({*namespace, *home, *submodules})
+
+    return __getattr__, __dir__, sorted([*home, *submodules])
