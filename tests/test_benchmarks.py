@@ -43,3 +43,19 @@ def test_resolved_section(capsys):
     for row in rows:
         assert all(float(value) > 0 for value in row[2:6])  # samples per second
         assert float(row[-2]) < 0.005 and float(row[-1]) < 0.005  # median |μ/0.8 - 1|
+
+
+def test_long_loops_bench_runs(tmp_path, capsys):
+    """``bench_long_loops.py`` on a short test: every run and the ceiling print a time."""
+    path = Path(__file__).parent / "benchmarks" / "bench_long_loops.py"
+    spec = importlib.util.spec_from_file_location("bench_long_loops", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    arguments = ["--samples", "1e5", "--repeat", "1", "--formats", "zarr", "--no-resolve"]
+    assert bench.main([*arguments, "--folder", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    for name in ("memory", "threads", "workers 1", "workers 2"):
+        found = re.search(rf"  {name}\s+(\S+) s\s+(\S+) samples/s\s+peak\s+(\S+) GB", out)
+        assert found and all(float(value) > 0 for value in found.groups()), name
+    ceiling = re.search(r"one process (\S+) s, two (\S+) s: (\S+)x", out)
+    assert ceiling and all(float(value) > 0 for value in ceiling.groups())

@@ -22,7 +22,15 @@ the best time kept. The runs:
 
 Targets (issue 12): peak memory under 2 GB out of core; samples/s of ``workers 1`` within
 20 % of ``memory`` (per core); ``workers 2`` at least 1.6x ``workers 1``. The machine's load
-is printed before and after: numbers taken while other programs run are noisy.
+is printed before and after: numbers taken while other programs run are noisy. The runs
+take turns (each round runs every one once), so a machine that slows down for a while
+slows them all alike; the best round of each is kept.
+
+The machine's own ceiling for two processes is measured beside them (``ceiling``): the
+measuring tasks of the same analysis (most of its time; :mod:`ecofmaps.measured.out_of_core`,
+the cycles found first, not timed) in one plain process, then split between two forked
+processes, without dask. On a machine whose two cores share a memory bus (or are two
+threads of one core) two processes do not run twice as fast, and no scheduler can do better.
 """
 
 from __future__ import annotations
@@ -57,6 +65,39 @@ analysis.analyze_loops = timed
 status = main(["loops", *sys.argv[1:]])
 print("analysed", spent[0], file=sys.stderr)
 sys.exit(status)
+"""
+
+_CEILING_SCRIPT = """
+import functools, inspect, multiprocessing, sys, time
+from ecofmaps._parallel import Runner, _materialised
+from ecofmaps.io import read_recording
+from ecofmaps.io.tables import results_csv
+from ecofmaps.measured.analysis import analyze_loops, check_options
+from ecofmaps.measured.out_of_core import LongAnalysis, _measure
+
+def measure(tasks):
+    start = time.perf_counter()
+    for index in tasks:
+        _measure(*_materialised(ANALYSIS._task(index, LINES, False)))
+    return time.perf_counter() - start
+
+if __name__ == "__main__":
+    recording = read_recording(sys.argv[1], lazy=True)
+    defaults = inspect.signature(analyze_loops).parameters
+    names = ("hysteresis", "stick_window", "crossing_window", "gross_slip_threshold")
+    options = check_options(float(sys.argv[2]), *(defaults[n].default for n in names), False)
+    with Runner() as runner:
+        ANALYSIS = LongAnalysis(recording.displacement, recording.force, float(sys.argv[2]),
+                                recording.cycle, runner=runner, resolve=sys.argv[3] == "resolve",
+                                **options)
+    LINES = functools.partial(results_csv, header=False)
+    tasks = range(len(ANALYSIS.tasks))
+    fork = multiprocessing.get_context("fork")
+    with fork.Pool(1) as pool:
+        one = pool.map(measure, [list(tasks)])[0]
+    with fork.Pool(2) as pool:
+        two = max(pool.map(measure, [list(tasks[0::2]), list(tasks[1::2])]))
+    print(one, two)
 """
 
 
@@ -135,15 +176,18 @@ def main(argv=None) -> int:
             "workers 2": [*ecofmaps, "loops", str(path), "--load", LOAD, "--quiet",
                           "--workers", "2"],
         }  # fmt: skip
-        best = {}
-        for name, command in runs.items():
-            out = folder / "r.csv"
-            for _ in range(args.repeat):
+        ceiling = [sys.executable, "-c", _CEILING_SCRIPT, str(path), LOAD[:-1],
+                   "no-resolve" if args.no_resolve else "resolve"]  # fmt: skip
+        best, alone = {}, []
+        out = folder / "r.csv"
+        for _ in range(args.repeat):  # rounds: each run once per round
+            for name, command in runs.items():
                 out.unlink(missing_ok=True)
                 wall, peak, printed = measured([*command, *extra, "--out", str(out)])
                 if name not in best or wall < best[name][0]:
                     best[name] = (wall, peak, printed)
-            wall, peak, printed = best[name]
+            alone.append([float(t) for t in measured(ceiling)[2].split()[:2]])
+        for name, (wall, peak, printed) in best.items():
             line = (
                 f"  {name:<10} {wall:7.1f} s  {samples / wall:9.3g} samples/s  peak {peak:5.2f} GB"
             )
@@ -152,10 +196,13 @@ def main(argv=None) -> int:
                 line += f"  (analyze_loops {analysing:.1f} s: {samples / analysing:.3g} samples/s)"
             print(line, flush=True)
         memory, one, two = best["memory"][0], best["workers 1"][0], best["workers 2"][0]
+        single, double = min(t[0] for t in alone), min(t[1] for t in alone)
         print(
             f"  workers 1 / memory: {memory / one:.2f} of the speed; "
             f"workers 2 / workers 1: {one / two:.2f}x; threads / workers 1: "
-            f"{one / best['threads'][0]:.2f}x"
+            f"{one / best['threads'][0]:.2f}x\n"
+            f"  ceiling: the measuring tasks alone, no dask: one process {single:.1f} s, two "
+            f"{double:.1f} s: {single / double:.2f}x"
         )
     print(f"\n{load_average()}")
     return 0
