@@ -18,6 +18,7 @@ of one column are one object per process (:func:`_column`), which opens the file
 from __future__ import annotations
 
 import functools
+import os
 import threading
 from pathlib import Path
 
@@ -92,17 +93,24 @@ class Column:
         return self.variable.size
 
     def _source(self):
-        """The open channel or dataset (opened on first use in this process)."""
+        """The open channel or dataset (opened on first use in this process).
+
+        A process forked after the file was opened opens it again: with the parent's file
+        it would share the file's position, and two processes reading at once would read
+        each other's bytes."""
+        if self._handle is not None and self._handle[2] != os.getpid():
+            self._handle = None  # the parent's, left to the parent
         if self._handle is None:
             if self.kind == "tdms":
                 handle = _open_tdms(self.path)
-                self._handle = (handle, handle[self.variable.group][self.variable.short])
+                source = handle[self.variable.group][self.variable.short]
             elif self.kind == "hdf5":
                 handle = _open_hdf5(self.path)
-                self._handle = (handle, handle[self.variable.name])
+                source = handle[self.variable.name]
             else:
-                root = _open_zarr(self.path)
-                self._handle = (root, _zarr_array(root, self.variable))
+                handle = _open_zarr(self.path)
+                source = _zarr_array(handle, self.variable)
+            self._handle = (handle, source, os.getpid())
         return self._handle[1]
 
     def __del__(self):
@@ -114,7 +122,11 @@ class Column:
     def close(self) -> None:
         """Close the file (it is opened again on the next read)."""
         with self._lock:
-            if self._handle is not None and hasattr(self._handle[0], "close"):
+            if (
+                self._handle is not None
+                and self._handle[2] == os.getpid()
+                and hasattr(self._handle[0], "close")
+            ):
                 self._handle[0].close()
             self._handle = None
 

@@ -11,7 +11,7 @@ import xarray as xr
 import zarr
 from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
 
-from ecofmaps._parallel import Slice, stretch
+from ecofmaps._parallel import SOURCE, Slice, stretch
 from ecofmaps.io.binary import Column
 from ecofmaps.io.recording_types import RecordingError
 from ecofmaps.io.recordings import read_recording, recording_blocks, recording_format
@@ -194,6 +194,43 @@ def test_column_pickles_without_its_file(tmp_path):
         column[3]
     column.close()
     copy.close()
+
+
+_FORKED = {}
+
+
+def _read_in_a_fork(start: int) -> tuple:
+    """In a forked process: whether the column opened its own file, and whether 200 reads
+    of samples ``start`` on (while another process reads) gave the file's values."""
+    column, expected = _FORKED["column"], _FORKED["expected"]
+    right = all(
+        np.array_equal(column[start + k : start + k + 500], expected[start + k : start + k + 500])
+        for k in range(0, 2000, 10)
+    )
+    return column._handle[0] is not _FORKED["parent"], right
+
+
+@pytest.mark.parametrize("kind", ["tdms", "hdf5"])
+def test_a_forked_process_opens_the_file_again(tmp_path, kind):
+    """A process forked after a column opened its file reads through a file of its own (a
+    shared one shares its position: two processes reading at once read each other's
+    bytes), and leaves the parent's open."""
+    import multiprocessing
+
+    path = {"tdms": write_tdms, "hdf5": write_hdf5}[kind](tmp_path / kind)
+    options = {"force_column": "ftr"} if kind == "tdms" else {}
+    lazy = read_recording(path, lazy=True, **options)
+    column = getattr(lazy.force, SOURCE)
+    expected = read_recording(path, **options).force
+    np.testing.assert_array_equal(column[0:10], expected[0:10])  # opened here
+    _FORKED.update(column=column, expected=expected, parent=column._handle[0])
+    try:
+        with multiprocessing.get_context("fork").Pool(2) as pool:
+            found = pool.map(_read_in_a_fork, [0, 1000, 2000, 500])
+    finally:
+        _FORKED.clear()
+    assert found == [(True, True)] * 4
+    np.testing.assert_array_equal(column[100:3000], expected[100:3000])  # still open here
 
 
 @pytest.mark.parametrize("kind", ["tdms", "hdf5", "zarr"])
