@@ -11,7 +11,7 @@ import xarray as xr
 import zarr
 from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
 
-from ecofmaps._parallel import SOURCE, Slice, stretch
+from ecofmaps._parallel import Slice, stretch
 from ecofmaps.io.binary import Column
 from ecofmaps.io.recording_types import RecordingError
 from ecofmaps.io.recordings import read_recording, recording_blocks, recording_format
@@ -196,41 +196,46 @@ def test_column_pickles_without_its_file(tmp_path):
     copy.close()
 
 
-_FORKED = {}
+_FORK_SCRIPT = """
+import multiprocessing, sys
+import numpy as np
+from ecofmaps._parallel import SOURCE
+from ecofmaps.io.recordings import read_recording
 
+def read_in_a_fork(start):
+    # whether the column opened its own file, and whether 200 reads gave the file's values
+    right = all(np.array_equal(COLUMN[start + k : start + k + 500],
+                               EXPECTED[start + k : start + k + 500])
+                for k in range(0, 2000, 10))
+    return COLUMN._handle[0] is not PARENT, right
 
-def _read_in_a_fork(start: int) -> tuple:
-    """In a forked process: whether the column opened its own file, and whether 200 reads
-    of samples ``start`` on (while another process reads) gave the file's values."""
-    column, expected = _FORKED["column"], _FORKED["expected"]
-    right = all(
-        np.array_equal(column[start + k : start + k + 500], expected[start + k : start + k + 500])
-        for k in range(0, 2000, 10)
-    )
-    return column._handle[0] is not _FORKED["parent"], right
+if __name__ == "__main__":
+    options = {"force_column": "ftr"} if sys.argv[1].endswith("tdms") else {}
+    COLUMN = getattr(read_recording(sys.argv[1], lazy=True, **options).force, SOURCE)
+    EXPECTED = read_recording(sys.argv[1], **options).force
+    assert np.array_equal(COLUMN[0:10], EXPECTED[0:10])  # opened here
+    PARENT = COLUMN._handle[0]
+    with multiprocessing.get_context("fork").Pool(2) as pool:
+        found = pool.map(read_in_a_fork, [0, 1000, 2000, 500])
+    assert found == [(True, True)] * 4, found
+    assert np.array_equal(COLUMN[100:3000], EXPECTED[100:3000])  # still open here
+"""
 
 
 @pytest.mark.parametrize("kind", ["tdms", "hdf5"])
 def test_a_forked_process_opens_the_file_again(tmp_path, kind):
     """A process forked after a column opened its file reads through a file of its own (a
     shared one shares its position: two processes reading at once read each other's
-    bytes), and leaves the parent's open."""
-    import multiprocessing
+    bytes), and leaves the parent's open. In a fresh process: this one may run JAX's
+    threads, which forking could deadlock."""
+    import subprocess
+    import sys
 
     path = {"tdms": write_tdms, "hdf5": write_hdf5}[kind](tmp_path / kind)
-    options = {"force_column": "ftr"} if kind == "tdms" else {}
-    lazy = read_recording(path, lazy=True, **options)
-    column = getattr(lazy.force, SOURCE)
-    expected = read_recording(path, **options).force
-    np.testing.assert_array_equal(column[0:10], expected[0:10])  # opened here
-    _FORKED.update(column=column, expected=expected, parent=column._handle[0])
-    try:
-        with multiprocessing.get_context("fork").Pool(2) as pool:
-            found = pool.map(_read_in_a_fork, [0, 1000, 2000, 500])
-    finally:
-        _FORKED.clear()
-    assert found == [(True, True)] * 4
-    np.testing.assert_array_equal(column[100:3000], expected[100:3000])  # still open here
+    done = subprocess.run(
+        [sys.executable, "-c", _FORK_SCRIPT, str(path)], capture_output=True, text=True, timeout=120
+    )
+    assert done.returncode == 0, done.stderr
 
 
 @pytest.mark.parametrize("kind", ["tdms", "hdf5", "zarr"])
