@@ -131,7 +131,7 @@ class Runner:
     @property
     def kind(self) -> str:
         """``'threads'``, ``'local cluster'`` or ``'cluster at <address>'``."""
-        if self.scheduler or self._given is not None:
+        if not self.local:
             return f"cluster at {self.scheduler or self._given.scheduler.address}"
         return "local cluster" if self.cluster else "threads"
 

@@ -20,7 +20,6 @@ import argparse
 import contextlib
 import dataclasses
 import functools
-import inspect
 import json
 import os
 import shutil
@@ -172,10 +171,6 @@ class _Partial:
             kept[block] = (values, flags)
         return kept
 
-    def keep(self, index: int, block: int, values: dict, flags: dict) -> None:
-        """Keep what block ``block`` of file ``index`` measured."""
-        keep_block(self.folder, index, block, values, flags)
-
     def remove(self) -> None:
         shutil.rmtree(self.folder, ignore_errors=True)
 
@@ -289,7 +284,7 @@ def _analyse(index, path, recording, load, args, runner, partial, many):
     """One long recording, block by block (module notes): its analysis, and the results and
     the table's lines (formatted where it ran) of each block."""
     from ecofmaps.io.tables import results_csv
-    from ecofmaps.measured.analysis import analyze_loops, check_options
+    from ecofmaps.measured.analysis import default_options
     from ecofmaps.measured.out_of_core import LongAnalysis
 
     if args.plots is not None:
@@ -297,13 +292,7 @@ def _analyse(index, path, recording, load, args, runner, partial, many):
             f"--plots draws every loop, which a long recording ({path}) analysed out of core "
             "does not keep: leave out --plots (or --workers, --scheduler, --resume)"
         )
-    defaults = inspect.signature(analyze_loops).parameters
-    options = check_options(
-        load,
-        *(defaults[name].default for name in ("hysteresis", "stick_window", "crossing_window")),
-        defaults["gross_slip_threshold"].default,
-        getattr(args, "flip_force", False),
-    )
+    options = default_options(load, getattr(args, "flip_force", False))
     shown = not args.quiet and sys.stderr.isatty()
     if shown:
         print(f"{path.name}: finding the cycles of {recording.size} samples", file=sys.stderr)
@@ -332,8 +321,8 @@ def _analyse(index, path, recording, load, args, runner, partial, many):
     try:
         with contextlib.closing(analysis.measured(skip=done, then=lines, keep=keep)) as kept:
             for block, part, values, flags, text in kept:
-                if values is not None:
-                    partial.keep(index, block, values, flags)
+                if values is not None:  # sent here: kept by this process
+                    keep_block(partial.folder, index, block, values, flags)
                 parts[block], texts[block] = part, text
                 bar.update(part.cycle.size)
     except KeyboardInterrupt:

@@ -80,6 +80,8 @@ groove slope at the ends of the slip, :math:`2 z_o \delta^*/x_o^2`, is below :ma
 
 from __future__ import annotations
 
+import inspect
+
 import numpy as np
 import xarray as xr
 
@@ -165,6 +167,14 @@ def check_options(
         "gross_slip_threshold": float(gross_slip_threshold),
         "flip_force": bool(flip_force),
     }
+
+
+def default_options(load, flip_force=False):
+    """:func:`check_options` with :func:`analyze_loops`'s defaults for the others (what the
+    command line and a long analysis use)."""
+    defaults = inspect.signature(analyze_loops).parameters
+    names = ("hysteresis", "stick_window", "crossing_window", "gross_slip_threshold")
+    return check_options(load, *(defaults[name].default for name in names), flip_force)
 
 
 @si_units

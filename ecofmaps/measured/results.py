@@ -134,7 +134,7 @@ class Tally:
     refused, and the typical amplitude."""
 
     def __init__(self):
-        self.counts: dict = {}
+        self.counts = collections.Counter()  # cycles by quality
         self.cycles = self.refused = self.flagged = 0
         self.every = {"missing-samples": True, "anticlockwise": True, "constant-force": True}
         self.negative_stiffness = False
@@ -142,10 +142,11 @@ class Tally:
 
     def add(self, part: xr.Dataset) -> xr.Dataset:
         """Count the cycles of ``part``; return it without its riders."""
-        for text, count in collections.Counter(part.quality.values.tolist()).items():
-            self.counts[text] = self.counts.get(text, 0) + count
-            if text not in ("ok", "not-gross-slip"):
-                self.flagged += count
+        counted = collections.Counter(part.quality.values.tolist())
+        self.counts.update(counted)
+        self.flagged += sum(
+            n for text, n in counted.items() if text not in ("ok", "not-gross-slip")
+        )
         self.cycles += part.cycle.size
         self.refused += int(part["_refused"].sum())
         for reason in self.every:
@@ -156,8 +157,7 @@ class Tally:
 
     def merge(self, other: Tally) -> None:
         """Count the parts ``other`` counted (in another process, say) as well."""
-        for text, count in other.counts.items():
-            self.counts[text] = self.counts.get(text, 0) + count
+        self.counts.update(other.counts)
         self.cycles += other.cycles
         self.refused += other.refused
         self.flagged += other.flagged

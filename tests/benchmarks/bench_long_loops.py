@@ -68,11 +68,11 @@ sys.exit(status)
 """
 
 _CEILING_SCRIPT = """
-import functools, inspect, multiprocessing, sys, time
+import functools, multiprocessing, sys, time
 from ecofmaps._parallel import Runner, _materialised
 from ecofmaps.io import read_recording
 from ecofmaps.io.tables import results_csv
-from ecofmaps.measured.analysis import analyze_loops, check_options
+from ecofmaps.measured.analysis import default_options
 from ecofmaps.measured.out_of_core import LongAnalysis, _measure
 
 def measure(tasks):
@@ -83,9 +83,7 @@ def measure(tasks):
 
 if __name__ == "__main__":
     recording = read_recording(sys.argv[1], lazy=True)
-    defaults = inspect.signature(analyze_loops).parameters
-    names = ("hysteresis", "stick_window", "crossing_window", "gross_slip_threshold")
-    options = check_options(float(sys.argv[2]), *(defaults[n].default for n in names), False)
+    options = default_options(float(sys.argv[2]))
     with Runner() as runner:
         ANALYSIS = LongAnalysis(recording.displacement, recording.force, float(sys.argv[2]),
                                 recording.cycle, runner=runner, resolve=sys.argv[3] == "resolve",

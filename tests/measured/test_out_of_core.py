@@ -8,7 +8,6 @@ analysis in memory to 1e-12 of its natural scale (tests/measured/test_equivalenc
 quality and regime strings and the attributes exactly.
 """
 
-import inspect
 import warnings
 
 import dask.array as da
@@ -272,15 +271,13 @@ def test_every_cycle_missing_is_an_error():
 def test_tallies_of_parts_merge_into_the_tally_of_the_whole():
     """Tasks count their parts where they run (Tally.add) and the counts are merged: the
     same summary, refusals, checks and amplitudes as counting the whole at once."""
-    from ecofmaps.measured.analysis import check_options
+    from ecofmaps.measured.analysis import default_options
     from ecofmaps.measured.per_cycle import measure_cycles
     from ecofmaps.measured.results import Tally, cycle_results
 
     x, q = noisy(EXAMPLE_2, 12, 3)
     x, q = with_gaps(x, q, [700, 1900])  # skipped cycles besides the flagged ones
-    defaults = inspect.signature(analyze_loops).parameters
-    names = ("hysteresis", "stick_window", "crossing_window", "gross_slip_threshold")
-    options = check_options(LOAD, *(defaults[name].default for name in names), False)
+    options = default_options(LOAD)
     found = cycles.find_cycles(x, None, 0.5, force=q)
     values, flags, _ = measure_cycles(found, x, q, LOAD, **options)
     whole = Tally()
@@ -316,12 +313,10 @@ def test_tasks_keep_what_they_measured_where_they_run(small_blocks):
     import functools
 
     from ecofmaps._parallel import Runner
-    from ecofmaps.measured.analysis import check_options
+    from ecofmaps.measured.analysis import default_options
 
     x, q = noisy(EXAMPLE_2, 12, 3)
-    defaults = inspect.signature(analyze_loops).parameters
-    names = ("hysteresis", "stick_window", "crossing_window", "gross_slip_threshold")
-    options = check_options(LOAD, *(defaults[name].default for name in names), False)
+    options = default_options(LOAD)
     x, q = lazily(x, q)
     store = {}
     with Runner(2) as runner:
