@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import argparse
-import itertools
+import contextlib
+import io
 import sys
 import textwrap
 import warnings
@@ -148,6 +149,28 @@ def _analysed(path, recording, load, args, resolved_file: bool):
     return results, resolved
 
 
+#: The variables of a recording's results that its summary line reads (:func:`_summary`):
+#: all that is kept of a long recording's results once their lines are written.
+SUMMARY_VARIABLES = ("regime", "gicof", "mu_resolved", "ecof", "quality")
+
+
+class _Table:
+    """The table of results, written as each block of lines comes, to ``stream`` (or held
+    for the standard output). Each block begins with the header line, written once."""
+
+    def __init__(self, stream=None):
+        self.stream = io.StringIO() if stream is None else stream
+        self.started = False
+
+    def write(self, text: str) -> None:
+        header, _, lines = text.partition("\n")
+        if not self.started:
+            self.stream.write(f"{header}\n")
+            self.started = True
+        self.stream.write(lines)
+        self.stream.flush()  # on disk as it comes: a block is a few MB
+
+
 def _summary(path, results, recording) -> str:
     """One line on a recording's cycles: counts, the quality, the friction over the test."""
     from ecofmaps.model.regimes import GROSS_SLIP
@@ -210,59 +233,58 @@ def run(args) -> int:
     )
     refuse_to_overwrite([("--out", args.out), ("--resolved", args.resolved), *plots], paths)
     long_run = loops_long.LongRun(args, paths)
-    analyses, recordings, texts = [], [], []  # texts: each file's lines, by blocks
+    analyses, recordings = [], []
     many = len(paths) > 1
-    for index, path in enumerate(paths):
-        recording = read_recording(
-            path,
-            displacement_column=args.displacement_col,
-            force_column=args.force_col,
-            cycle_column=args.cycle_col,
-            displacement_unit=args.displacement_unit,
-            force_unit=args.force_unit,
-            group=args.group,
-            lazy=long_run.lazy,
-        )
-        if recording.lazy:
-            if args.resolved is not None:
-                raise CommandError(
-                    f"--resolved reads every loop along the stroke, which a long recording "
-                    f"({path}) analysed out of core does not keep: leave out --resolved"
-                )
-            results, made = long_run.analyse(index, path, recording, load, many=many)
-            analyses.append((results, None))
-        else:
-            analyses.append(_analysed(path, recording, load, args, args.resolved is not None))
-            made = None
-        texts.append(made)
-        recordings.append(recording)
-    header = results_csv(analyses[0][0].isel(cycle=slice(0, 0)), file="" if many else None)
-    for index, (path, (results, _)) in enumerate(zip(paths, analyses, strict=True)):
-        if texts[index] is None:  # analysed in memory
-            texts[index] = [results_csv(results, file=str(path) if many else None, header=False)]
-    lines = [header, *itertools.chain.from_iterable(texts)]  # the table, a block at a time
-    if args.plots is not None:
-        from ecofmaps.figures import cof_evolution, measured_loops, resolved_loops, save_figure
+    with contextlib.ExitStack() as stack:  # the table is written as it comes, renamed at the end
+        table = _Table()
+        if args.out is not None:
+            temporary = stack.enter_context(atomic_path(args.out))
+            table = _Table(stack.enter_context(open(temporary, "w", encoding="utf-8", newline="")))
+        for index, path in enumerate(paths):
+            recording = read_recording(
+                path,
+                displacement_column=args.displacement_col,
+                force_column=args.force_col,
+                cycle_column=args.cycle_col,
+                displacement_unit=args.displacement_unit,
+                force_unit=args.force_unit,
+                group=args.group,
+                lazy=long_run.lazy,
+            )
+            if recording.lazy:
+                if args.resolved is not None:
+                    raise CommandError(
+                        f"--resolved reads every loop along the stroke, which a long recording "
+                        f"({path}) analysed out of core does not keep: leave out --resolved"
+                    )
+                results = long_run.analyse(
+                    index, path, recording, load, many=many, write=table.write,
+                    columns=SUMMARY_VARIABLES,
+                )  # fmt: skip
+                analyses.append((results, None))
+            else:
+                analyses.append(_analysed(path, recording, load, args, args.resolved is not None))
+                table.write(results_csv(analyses[-1][0], file=str(path) if many else None))
+            recordings.append(recording)
+        if args.plots is not None:
+            from ecofmaps.figures import cof_evolution, measured_loops, resolved_loops, save_figure
 
-        folder = Path(args.plots)
-        folder.mkdir(parents=True, exist_ok=True)
-        for name, (results, resolved) in zip(_plot_names(paths), analyses, strict=True):
-            save_figure(measured_loops(results, resolved=resolved), folder / f"{name}_loops.png")
-            save_figure(cof_evolution(results), folder / f"{name}_evolution.png")
-            if resolved is not None:
-                save_figure(resolved_loops(resolved, results), folder / f"{name}_resolved.png")
-    if args.resolved is not None:
-        write_netcdf(analyses[0][1], args.resolved)
+            folder = Path(args.plots)
+            folder.mkdir(parents=True, exist_ok=True)
+            for name, (results, resolved) in zip(_plot_names(paths), analyses, strict=True):
+                save_figure(
+                    measured_loops(results, resolved=resolved), folder / f"{name}_loops.png"
+                )
+                save_figure(cof_evolution(results), folder / f"{name}_evolution.png")
+                if resolved is not None:
+                    save_figure(resolved_loops(resolved, results), folder / f"{name}_resolved.png")
+        if args.resolved is not None:
+            write_netcdf(analyses[0][1], args.resolved)
     if args.out is None:
-        sys.stdout.writelines(lines)
+        sys.stdout.write(table.stream.getvalue())
         for path, (results, _), recording in zip(paths, analyses, recordings, strict=True):
             print(_summary(path, results, recording).strip(), file=sys.stderr)
         return 0
-    with (
-        atomic_path(args.out) as temporary,
-        open(temporary, "w", encoding="utf-8", newline="") as stream,
-    ):
-        stream.writelines(lines)
     long_run.finish()
     print(f"wrote {args.out}: {sum(r.cycle.size for r, _ in analyses)} cycles")
     for path, (results, _), recording in zip(paths, analyses, recordings, strict=True):

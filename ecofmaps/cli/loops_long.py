@@ -8,10 +8,11 @@ results are written as it completes into ``<out>.partial/`` (NumPy ``.npz``, one
 each renamed into place when whole: what its cycles measured, from which the results are
 made again; with the cycles found and what the run was), by the task that measured it on
 threads or ``--workers`` (which see this machine's files), by this process for a cluster at
-``--scheduler``, so an
-interrupted run keeps what it finished and ``--resume`` continues it; the table is written
-to ``--out`` only at the end, and the folder removed. A progress bar (cycles, rate, time
-left) is shown on a terminal, unless ``--quiet``.
+``--scheduler``, so an interrupted run keeps what it finished and ``--resume`` continues it.
+The table's lines are written as the blocks come, in order, into a temporary file beside
+``--out`` that is renamed onto it at the end, when the folder is removed; this process keeps
+of each block's results only what the summary line reads. A progress bar (cycles, rate,
+time left) is shown on a terminal, unless ``--quiet``.
 """
 
 from __future__ import annotations
@@ -238,19 +239,21 @@ class LongRun:
             return Runner(self.args.workers, cluster=True)
         return Runner()
 
-    def analyse(self, index: int, path: Path, recording, load: float, *, many: bool):
+    def analyse(self, index, path, recording, load, *, many: bool, write, columns=None):
         """The results of recording ``index`` (read lazily), as :func:`ecofmaps.analyze_loops`
-        gives them, and their lines of the table (with the file's name in a first column if
-        ``many``, a string per block); its blocks kept beside ``--out`` as they complete.
-        The results are joined after the cluster is closed, so its workers' memory and the
-        joined results are not held at once."""
+        gives them (only the variables ``columns``, if given); its blocks kept beside
+        ``--out`` as they complete, and their lines of the table (with the file's name in a
+        first column if ``many``) given to ``write`` in order, a string per block that
+        begins with the header line. The results are joined after the cluster is closed,
+        so its workers' memory and the joined results are not held at once."""
         try:
             with self._runner() as runner:  # a cluster that does not answer: nothing written
                 if self.partial is None and self.fingerprint is not None:
                     self.partial = _Partial(self.args.out, self.fingerprint, self.args.resume)
-                analysis, parts, texts = _analyse(
-                    index, path, recording, load, self.args, runner, self.partial, many
-                )
+                analysis, parts = _analyse(
+                    index, path, recording, load, self.args, runner, self.partial, many,
+                    write, columns,
+                )  # fmt: skip
         except _Interrupted as stop:  # counted once the runner is closed: no task runs
             if self.partial is not None:
                 print(
@@ -260,8 +263,7 @@ class LongRun:
                     file=sys.stderr,
                 )
             raise
-        results = analysis.finish([parts.pop(k) for k in sorted(parts)])
-        return results, [texts[k] for k in sorted(texts)]
+        return analysis.finish([parts.pop(k) for k in sorted(parts)])
 
     def finish(self) -> None:
         """Remove the kept blocks: the table is written."""
@@ -280,12 +282,13 @@ def skipped(results, recording) -> str:
     return f"; {count} skipped for missing samples (the first at {where})"
 
 
-def _analyse(index, path, recording, load, args, runner, partial, many):
-    """One long recording, block by block (module notes): its analysis, and the results and
-    the table's lines (formatted where it ran) of each block."""
+def _analyse(index, path, recording, load, args, runner, partial, many, write, columns):
+    """One long recording, block by block (module notes): its analysis, and the results of
+    each block (the variables ``columns``); the table's lines of each block (formatted
+    where it ran) given to ``write`` in the order of the blocks."""
     from ecofmaps.io.tables import results_csv
     from ecofmaps.measured.analysis import default_options
-    from ecofmaps.measured.out_of_core import LongAnalysis
+    from ecofmaps.measured.out_of_core import LongAnalysis, only
 
     if args.plots is not None:
         raise CommandError(
@@ -311,26 +314,40 @@ def _analyse(index, path, recording, load, args, runner, partial, many):
     if partial is not None:
         partial.keep_cycles(index, analysis.cycles)
         done = partial.done(index)
-    lines = functools.partial(results_csv, file=str(path) if many else None, header=False)
-    parts = {block: analysis.part(block, *measured) for block, measured in done.items()}
-    texts = {block: lines(part) for block, part in parts.items()}
+    lines = functools.partial(results_csv, file=str(path) if many else None)
+    parts, texts = {}, {}  # texts: the lines of blocks that came before an earlier one
+    for block, measured in done.items():
+        part = analysis.part(block, *measured)
+        parts[block], texts[block] = only(part, columns), lines(part)
+    written = _in_order(texts, write)
     bar = _bar(analysis, path, shown, sum(parts[b].cycle.size for b in parts))
     keep = partial is not None
     if keep and runner.local:  # the tasks keep their blocks themselves, where they run
         keep = functools.partial(keep_block, partial.folder, index)
     try:
-        with contextlib.closing(analysis.measured(skip=done, then=lines, keep=keep)) as kept:
+        measured = analysis.measured(skip=done, then=lines, keep=keep, columns=columns)
+        with contextlib.closing(measured) as kept:
             for block, part, values, flags, text in kept:
                 if values is not None:  # sent here: kept by this process
                     keep_block(partial.folder, index, block, values, flags)
                 parts[block], texts[block] = part, text
+                written = _in_order(texts, write, written)
                 bar.update(part.cycle.size)
     except KeyboardInterrupt:
         bar.leave = False
         bar.close()
         raise _Interrupted(len(analysis.tasks)) from None
     bar.close()
-    return analysis, parts, texts
+    return analysis, parts
+
+
+def _in_order(texts: dict, write, written: int = 0) -> int:
+    """Give ``write`` the texts of blocks ``written``, ``written + 1``, ... that ``texts``
+    holds, in order, taking them out; the number of blocks written so far."""
+    while written in texts:
+        write(texts.pop(written))
+        written += 1
+    return written
 
 
 class _Interrupted(KeyboardInterrupt):

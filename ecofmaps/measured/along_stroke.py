@@ -188,6 +188,8 @@ def _resolve(x, q, valid, load, stiffness, amplitude, quality, given, options):
         flags = (part["mismatch"], ~overlap, few, values[5])
         part["flags"] = np.where(inherited[block], 0, np.select(flags, range(1, 5), 0))
         part["values"] = values
+        if options["positions"] is None:  # the branches are not read again: not held
+            del part["forward"], part["backward"]
         parts.append(part)
 
     def joined(name):

@@ -47,7 +47,7 @@ from ecofmaps.measured.results import (
     with_read_along_stroke,
 )
 
-__all__ = ["HALO", "TASK_SAMPLES", "LongAnalysis", "MissingSampleError"]
+__all__ = ["HALO", "TASK_SAMPLES", "LongAnalysis", "MissingSampleError", "only"]
 
 #: Samples of the recording measured by one task (about; whole cycles).
 TASK_SAMPLES = 1 << 22
@@ -83,6 +83,7 @@ def _measure(
     resolve: bool,
     then=None,
     keep=False,
+    columns=None,
 ):
     """One task: the cycles ``rows`` of the table ``cycles`` measured on the stretch of the
     recording that begins at sample ``low``; with ``resolve``, also read along the stroke
@@ -95,7 +96,8 @@ def _measure(
     (with the reading along the stroke named with the prefix :data:`READ`), else None for
     both (a callable ``keep`` is given them here instead, ``keep(values, flags)``); and
     ``then(results)``, or None without ``then``, so that work on the results is done where
-    the task runs too."""
+    the task runs too. With ``columns``, the results handed back hold only those variables
+    (those of them there are); ``then`` is given them all."""
     values, flags, loops = measure_cycles(
         cycles, _Stretch(x, low), _Stretch(q, low), load, rows=rows, keep_loops=resolve, **options
     )
@@ -110,7 +112,15 @@ def _measure(
         keep(values, flags)
     if keep is not True:
         values = flags = None
-    return part, tally, values, flags, None if then is None else then(part)
+    made = None if then is None else then(part)
+    return only(part, columns), tally, values, flags, made
+
+
+def only(part: xr.Dataset, columns=None) -> xr.Dataset:
+    """``part`` with only the variables ``columns`` that it holds (all of them if None)."""
+    if columns is None:
+        return part
+    return part[[name for name in columns if name in part.data_vars]]
 
 
 def _part(counted: xr.Dataset, values: dict) -> xr.Dataset:
@@ -204,7 +214,7 @@ class LongAnalysis:
         self.tally = Tally()
         self._whole = np.flatnonzero(cycles.whole)  # the cycles a halo may hold
 
-    def _task(self, index: int, then, keep):
+    def _task(self, index: int, then, keep, columns=None):
         """The arguments of the task ``index`` (see :func:`_measure`)."""
         cycles, rows = self.cycles, self.tasks[index]
         first, stop = rows.start, rows.stop
@@ -222,9 +232,10 @@ class LongAnalysis:
         inner = slice(rows.start - first, rows.stop - first)
         if callable(keep):
             keep = functools.partial(keep, index)
-        return (table, low, inner, self.load, self.options, x, q, self.resolve, then, keep)
+        arguments = (table, low, inner, self.load, self.options, x, q, self.resolve, then, keep)
+        return (*arguments, columns)
 
-    def measured(self, skip=(), then=None, keep=False):
+    def measured(self, skip=(), then=None, keep=False, columns=None):
         """The results of each task, in order, as they come; counted in :attr:`tally`.
 
         Parameters
@@ -242,6 +253,10 @@ class LongAnalysis:
             ``keep(index, values, flags)`` is called with it where the task runs instead
             (picklable as ``then`` is), so that what is kept does not travel: for a runner
             whose workers share this machine's files.
+        columns : sequence of str, optional
+            The variables of each task's results to hand back (those of them there are;
+            default all): what the caller keeps of them, so the rest does not travel.
+            ``then`` is given them all.
 
         Yields
         ------
@@ -257,7 +272,8 @@ class LongAnalysis:
         """
         skip = set(skip)
         wanted = [k for k in range(len(self.tasks)) if k not in skip]
-        results = self.runner.map(_measure, (self._task(k, then, keep) for k in wanted))
+        tasks = (self._task(k, then, keep, columns) for k in wanted)
+        results = self.runner.map(_measure, tasks)
         try:
             for index, (part, tally, values, flags, made) in zip(wanted, results, strict=False):
                 self.tally.merge(tally)

@@ -142,10 +142,45 @@ def test_an_interrupted_run_resumes(
     assert status == 2 and "holds an unfinished run: add --resume" in err
     status, _, err = run(capsys, long_test[".zarr"], "--load", "400N", "--out", out, "--resume")
     assert status == 2 and "holds a run of other files or options" in err
+    assert not list(tmp_path.glob(".r.csv.*"))  # nor its temporary
+    (partial / kept[0]).unlink()  # the first block is measured again, after those kept
     status, _, err = run(capsys, long_test[".zarr"], "--load", "450N", "--out", out, "--resume")
     assert status == 0, err
     assert out.read_text() == expected
     assert not partial.exists()
+
+
+def test_the_table_is_written_as_the_blocks_come(long_test, tmp_path, capsys, small_tasks,
+                                                 monkeypatch):  # fmt: skip
+    """Each block's lines are in the temporary file beside --out (in order, after the header)
+    once the block has come back, not held to the end; the file lands whole."""
+    expected = in_memory_table(capsys, long_test[".zarr"], tmp_path)
+    out = tmp_path / "r.csv"
+    progress = loops_long._bar
+    seen = []
+
+    def watching(*args):
+        bar = progress(*args)
+        received = []
+
+        def update(cycles):
+            received.append(cycles)
+            (temporary,) = tmp_path.glob(".r.csv.*.tmp")
+            seen.append((sum(received), temporary.read_text()))
+
+        bar.update = update
+        return bar
+
+    monkeypatch.setattr(loops_long, "_bar", watching)
+    status, _, err = run(
+        capsys, long_test[".zarr"], "--load", "450N", "--out", out, "--resume"
+    )  # --resume: read lazily, though short
+    assert status == 0, err
+    assert out.read_text() == expected
+    assert len(seen) == 6
+    lines = expected.splitlines(keepends=True)
+    for cycles, text in seen:
+        assert text == "".join(lines[: 1 + cycles])
 
 
 def damaged(path, tmp_path):

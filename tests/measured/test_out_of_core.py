@@ -336,6 +336,32 @@ def test_tasks_keep_what_they_measured_where_they_run(small_blocks):
             np.testing.assert_array_equal(store[index][1][name], flags[name])
 
 
+def _variables(part):
+    """A ``then`` of :meth:`LongAnalysis.measured`: the names of the results it is given."""
+    return sorted(part.data_vars)
+
+
+def test_tasks_hand_back_only_the_columns_asked_for(small_blocks):
+    """With ``columns``, each task's results hold only those of them there are, with the
+    same values; ``then`` is given them all."""
+    from ecofmaps._parallel import Runner
+    from ecofmaps.measured.analysis import default_options
+
+    x, q = lazily(*noisy(EXAMPLE_2, 12, 3))
+    columns = ("quality", "ecof", "no_such_variable")
+    with Runner(2) as runner:
+        analysis = out_of_core.LongAnalysis(
+            x, q, LOAD, runner=runner, samples=900, resolve=True, **default_options(LOAD)
+        )
+        whole = [part for _, part, *_ in analysis.measured(then=_variables)]
+        only = list(analysis.measured(then=_variables, columns=columns))
+    assert len(only) == len(whole) == len(analysis.tasks) > 2
+    for (_, part, _, _, made), full in zip(only, whole, strict=True):
+        assert sorted(part.data_vars) == ["ecof", "quality"]
+        assert made == sorted(full.data_vars) and "mu_resolved" in made
+        xr.testing.assert_identical(part, full[["quality", "ecof"]])
+
+
 def test_a_worker_reads_and_measures_without_jax_or_pint():
     """The modules a task of a long analysis loads (reading a rig file's column, the passes,
     measuring a block, formatting its rows) leave JAX, pint and SciPy unloaded: a worker
