@@ -18,6 +18,7 @@ __all__ = [
     "print_rows",
     "quantities",
     "quantity",
+    "recording_options",
     "refuse_to_overwrite",
     "row",
     "unit",
@@ -104,6 +105,19 @@ def unit(kind: str):
 
     parse.__name__ = f"{kind} unit"
     return parse
+
+
+def recording_options(args) -> dict:
+    """The keywords of :func:`ecofmaps.io.recordings.read_recording` given by a command's
+    column, unit and group options (``--displacement-col`` ... ``--group``)."""
+    return {
+        "displacement_column": args.displacement_col,
+        "force_column": args.force_col,
+        "cycle_column": args.cycle_col,
+        "displacement_unit": args.displacement_unit,
+        "force_unit": args.force_unit,
+        "group": args.group,
+    }
 
 
 def refuse_to_overwrite(outputs, inputs) -> None:

@@ -6,7 +6,7 @@ import argparse
 import textwrap
 from pathlib import Path
 
-from ecofmaps.cli._common import CommandError, refuse_to_overwrite, unit
+from ecofmaps.cli._common import CommandError, recording_options, refuse_to_overwrite, unit
 
 __all__ = ["add", "run"]
 
@@ -76,16 +76,12 @@ def run(args) -> int:
     refuse_to_overwrite([("DST", destination)], [source])
     if destination.exists() and not args.overwrite:
         raise CommandError(f"{destination} exists already: --overwrite replaces it")
-    options = dict(
-        displacement_column=args.displacement_col,
-        force_column=args.force_col,
-        cycle_column=args.cycle_col,
-        displacement_unit=args.displacement_unit,
-        force_unit=args.force_unit,
-        group=args.group,
-    )
     convert_recording(
-        source, destination, chunk_samples=args.chunk_samples, overwrite=args.overwrite, **options
+        source,
+        destination,
+        chunk_samples=args.chunk_samples,
+        overwrite=args.overwrite,
+        **recording_options(args),
     )
     written = read_recording(destination, lazy=True)
     print(f"wrote {destination}: {written.size} samples of {', '.join(written.columns)} (SI)")

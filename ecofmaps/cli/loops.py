@@ -11,7 +11,13 @@ import warnings
 from pathlib import Path
 
 from ecofmaps.cli import loops_long
-from ecofmaps.cli._common import CommandError, quantity, refuse_to_overwrite, unit
+from ecofmaps.cli._common import (
+    CommandError,
+    quantity,
+    recording_options,
+    refuse_to_overwrite,
+    unit,
+)
 
 __all__ = ["add", "run"]
 
@@ -155,12 +161,11 @@ SUMMARY_VARIABLES = ("regime", "gicof", "mu_resolved", "ecof", "quality")
 
 
 class _Table:
-    """The table of results, written as each block of lines comes, to ``stream`` (or held
-    for the standard output). Each block begins with the header line, written once."""
+    """The table of results, written to ``stream`` as each block of lines comes. Each block
+    begins with the header line, written once."""
 
-    def __init__(self, stream=None):
-        self.stream = io.StringIO() if stream is None else stream
-        self.started = False
+    def __init__(self, stream):
+        self.stream, self.started = stream, False
 
     def write(self, text: str) -> None:
         header, _, lines = text.partition("\n")
@@ -236,21 +241,14 @@ def run(args) -> int:
     analyses, recordings = [], []
     many = len(paths) > 1
     with contextlib.ExitStack() as stack:  # the table is written as it comes, renamed at the end
-        table = _Table()
-        if args.out is not None:
+        if args.out is None:  # held, and printed once every file is analysed
+            stream = io.StringIO()
+        else:
             temporary = stack.enter_context(atomic_path(args.out))
-            table = _Table(stack.enter_context(open(temporary, "w", encoding="utf-8", newline="")))
+            stream = stack.enter_context(open(temporary, "w", encoding="utf-8", newline=""))
+        table = _Table(stream)
         for index, path in enumerate(paths):
-            recording = read_recording(
-                path,
-                displacement_column=args.displacement_col,
-                force_column=args.force_col,
-                cycle_column=args.cycle_col,
-                displacement_unit=args.displacement_unit,
-                force_unit=args.force_unit,
-                group=args.group,
-                lazy=long_run.lazy,
-            )
+            recording = read_recording(path, lazy=long_run.lazy, **recording_options(args))
             if recording.lazy:
                 if args.resolved is not None:
                     raise CommandError(

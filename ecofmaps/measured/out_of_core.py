@@ -232,8 +232,7 @@ class LongAnalysis:
         inner = slice(rows.start - first, rows.stop - first)
         if callable(keep):
             keep = functools.partial(keep, index)
-        arguments = (table, low, inner, self.load, self.options, x, q, self.resolve, then, keep)
-        return (*arguments, columns)
+        return (table, low, inner, self.load, self.options, x, q, self.resolve, then, keep, columns)
 
     def measured(self, skip=(), then=None, keep=False, columns=None):
         """The results of each task, in order, as they come; counted in :attr:`tally`.
