@@ -265,10 +265,13 @@ def test_jit_and_vmap_over_mu_and_amplitude():
 )
 # a rig so stiff (S = 4e22 N/m) that the pad stops where Q/P = 8e14: the area was rounding
 @example(hump=0.625, ratio=0.3828125, tilt=0.0, mu=1.0, mu_lam=2.220446049250313e-16)
+# a subnormal mu_lam: mu_lam * 50e-6 underflows to 0, a rigid rig (the test divided by it)
+@example(hump=0.0, ratio=0.25, tilt=0.0, mu=1.0, mu_lam=5e-324)
 def test_properties_on_random_w_shapes(hump, ratio, tilt, mu, mu_lam):
     """On any scar: μ_E >= μ (e >= 0, jumps add), 0 < δ* <= Δ*, E_d = 4Pδ*μ_E > 0."""
     profile = ecofmaps.w_shaped_profile(ratio * W, W, hump, tilt=tilt, samples=1000)
-    stiffness = np.inf if mu_lam == 0.0 else 450.0 * mu / (mu_lam * 50e-6)
+    compliance = mu_lam * 50e-6 / (450.0 * mu)  # 1/S [m/N]
+    stiffness = np.inf if compliance == 0.0 else 1.0 / compliance
     rig = dict(amplitude=50e-6, load=450.0, stiffness=stiffness, mu=mu, profile=profile)
     if int(ecofmaps.slip_regime(**rig)) != Regime.GROSS_SLIP:
         return  # a rigid rig may lock on the steepest flanks
