@@ -178,9 +178,11 @@ class _Table:
 
 def _summary(path, results, recording) -> str:
     """One line on a recording's cycles: counts, the quality, the friction over the test."""
+    import numpy as np
+
     from ecofmaps.model.regimes import GROSS_SLIP
 
-    gross = results.where(results.regime == GROSS_SLIP, drop=True)
+    gross = results.isel(cycle=np.flatnonzero(results.regime.values == GROSS_SLIP))
     summary = f"  {path.name}: {results.attrs['quality_summary']}"
     if results.attrs["incomplete_cycles"]:
         summary += f" ({results.attrs['incomplete_cycles']} incomplete dropped)"

@@ -256,3 +256,33 @@ def test_flagged_cycles_are_one_line_warnings_and_nan(tmp_path, capsys, recordin
         line.startswith("ecofmaps loops: warning: stuck.csv: ") for line in warnings
     )
     assert "Traceback" not in stderr and ".py:" not in stderr
+
+
+def test_the_summary_reads_the_gross_slip_cycles_only():
+    """The summary line's medians and first and last ECoF are over the cycles in gross
+    slip (its regime code), with the cycles without a value left out."""
+    from pathlib import Path
+
+    from ecofmaps.cli.loops import _summary
+    from ecofmaps.model.regimes import GROSS_SLIP, NO_GROSS_SLIP
+
+    gross, stuck = int(GROSS_SLIP), int(NO_GROSS_SLIP)
+    results = xr.Dataset(
+        {
+            "regime": ("cycle", np.array([stuck, gross, gross, stuck, gross, gross, stuck])),
+            "gicof": ("cycle", [9.0, 0.7, np.nan, 9.0, 0.9, 0.8, 9.0]),
+            "ecof": ("cycle", [9.0, np.nan, 0.61, 9.0, 0.62, 0.63, 9.0]),
+            "quality": ("cycle", np.array(["ok"] * 7, dtype=object)),
+        },
+        coords={"cycle": np.arange(1, 8)},
+        attrs={"quality_summary": "7 cycles: 7 ok", "incomplete_cycles": 1},
+    )
+    line = _summary(Path("rig.csv"), results, recording=None)
+    assert line == (
+        "  rig.csv: 7 cycles: 7 ok (1 incomplete dropped); GICoF median 0.8000; "
+        "ECoF 0.6100 (first) to 0.6300 (last)"
+    )
+    none = results.assign(regime=results.regime * 0 + stuck)
+    assert (
+        _summary(Path("rig.csv"), none, None) == "  rig.csv: 7 cycles: 7 ok (1 incomplete dropped)"
+    )
