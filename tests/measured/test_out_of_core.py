@@ -170,6 +170,35 @@ def test_a_local_cluster_of_two_processes(small_blocks):
     assert_equal_results(lazy, memory)
 
 
+def _worker_settings():
+    import os
+
+    import dask
+
+    return (
+        os.environ.get("MALLOC_TRIM_THRESHOLD_"),
+        dask.config.get("distributed.worker.profile.enabled"),
+    )
+
+
+def test_the_workers_of_a_local_cluster_run_lean():
+    """A local cluster's workers keep glibc's own mmap threshold and do not sample their
+    tasks' stacks (module notes of ecofmaps._parallel); this process's settings are left as
+    they were."""
+    import copy
+
+    import dask
+    import distributed  # noqa: F401 - its settings are read
+
+    from ecofmaps._parallel import Runner
+
+    before = copy.deepcopy(dask.config.get("distributed"))
+    with Runner(1, cluster=True) as runner:
+        settings = runner._client.run(_worker_settings)
+    assert list(settings.values()) == [(None, False)]
+    assert dask.config.get("distributed") == before
+
+
 def test_a_scheduler_that_does_not_answer():
     from ecofmaps._parallel import Runner, SchedulerError
 
