@@ -20,6 +20,7 @@ from __future__ import annotations
 import functools
 import os
 import threading
+import weakref
 from pathlib import Path
 
 import numpy as np
@@ -70,7 +71,8 @@ class Column:
     Indexing with a slice (step 1) returns a NumPy array; what dask's ``from_array``
     needs (``shape``, ``dtype``, ``ndim``). The open file is kept per process and per
     column, behind a lock (a TDMS or HDF5 file is read by one thread at a time; a zarr
-    store by any number), and is not pickled.
+    store by any number), and is not pickled. A forked process makes every column's lock
+    afresh (:func:`_watch_forks`).
     """
 
     def __init__(
@@ -83,6 +85,8 @@ class Column:
         self.ndim = 1
         self._handle = None
         self._lock = threading.Lock()
+        _watch_forks()
+        _COLUMNS.add(self)
 
     def __reduce__(self):
         """Pickled without the open file; unpickled by :func:`_column`."""
@@ -174,6 +178,25 @@ class Column:
         from ecofmaps.io.text import _to_si
 
         return _to_si(values, self.factor)
+
+
+#: The columns of this process (see :func:`_watch_forks`).
+_COLUMNS = weakref.WeakSet()
+
+
+@functools.cache
+def _watch_forks() -> None:
+    """From the first column on, a forked process gives each column a new lock
+    (:func:`_new_locks`): the lock it inherits is a copy of the parent's, taken for good if
+    one of the parent's threads was reading at the fork (that thread is not in the child)."""
+    if hasattr(os, "register_at_fork"):  # where processes fork
+        os.register_at_fork(after_in_child=_new_locks)
+
+
+def _new_locks() -> None:
+    """In a forked process: a lock of its own for every column."""
+    for column in list(_COLUMNS):
+        column._lock = threading.Lock()
 
 
 @functools.lru_cache(maxsize=16)

@@ -197,7 +197,7 @@ def test_column_pickles_without_its_file(tmp_path):
 
 
 _FORK_SCRIPT = """
-import multiprocessing, sys
+import multiprocessing, sys, threading
 import numpy as np
 from ecofmaps._parallel import SOURCE
 from ecofmaps.io.recordings import read_recording
@@ -209,15 +209,25 @@ def read_in_a_fork(start):
                 for k in range(0, 2000, 10))
     return COLUMN._handle[0] is not PARENT, right
 
+EVENT = threading.Event()
+
+def hold(lock):
+    with lock:
+        EVENT.wait()
+
 if __name__ == "__main__":
     options = {"force_column": "ftr"} if sys.argv[1].endswith("tdms") else {}
     COLUMN = getattr(read_recording(sys.argv[1], lazy=True, **options).force, SOURCE)
     EXPECTED = read_recording(sys.argv[1], **options).force
     assert np.array_equal(COLUMN[0:10], EXPECTED[0:10])  # opened here
     PARENT = COLUMN._handle[0]
+    reading = threading.Thread(target=hold, args=(COLUMN._lock,), daemon=True)
+    reading.start()  # a thread of this process holds the lock while the children fork
     with multiprocessing.get_context("fork").Pool(2) as pool:
-        found = pool.map(read_in_a_fork, [0, 1000, 2000, 500])
+        found = pool.map_async(read_in_a_fork, [0, 1000, 2000, 500]).get(timeout=60)
     assert found == [(True, True)] * 4, found
+    EVENT.set()
+    reading.join()
     assert np.array_equal(COLUMN[100:3000], EXPECTED[100:3000])  # still open here
 """
 
@@ -226,8 +236,9 @@ if __name__ == "__main__":
 def test_a_forked_process_opens_the_file_again(tmp_path, kind):
     """A process forked after a column opened its file reads through a file of its own (a
     shared one shares its position: two processes reading at once read each other's
-    bytes), and leaves the parent's open. In a fresh process: this one may run JAX's
-    threads, which forking could deadlock."""
+    bytes), and leaves the parent's open; it reads while one of the parent's threads holds
+    the column's lock (the child's copy of that lock would never be let go). In a fresh
+    process: this one may run JAX's threads, which forking could deadlock."""
     import subprocess
     import sys
 
