@@ -10,6 +10,8 @@ import textwrap
 import warnings
 from pathlib import Path
 
+import numpy as np
+
 from ecofmaps.cli import loops_long
 from ecofmaps.cli._common import (
     CommandError,
@@ -178,8 +180,6 @@ class _Table:
 
 def _summary(path, results, recording) -> str:
     """One line on a recording's cycles: counts, the quality, the friction over the test."""
-    import numpy as np
-
     from ecofmaps.model.regimes import GROSS_SLIP
 
     gross = results.isel(cycle=np.flatnonzero(results.regime.values == GROSS_SLIP))

@@ -27,6 +27,8 @@ import shutil
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from ecofmaps.cli._common import CommandError
 
 __all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun", "add_options", "keep_block", "skipped"]
@@ -128,8 +130,6 @@ class _Partial:
 
     def cycles(self, index: int):
         """The cycles of file ``index`` found before, or None."""
-        import numpy as np
-
         from ecofmaps.measured.cycles import Cycles
 
         path = self.folder / f"file{index}-cycles.npz"
@@ -145,8 +145,6 @@ class _Partial:
         return Cycles(**fields)
 
     def keep_cycles(self, index: int, cycles) -> None:
-        import numpy as np
-
         values = dataclasses.asdict(cycles)
         values["missing"] = np.asarray(False) if cycles.missing is None else cycles.missing
         _write(self.folder / f"file{index}-cycles.npz", lambda path: _savez(path, values))
@@ -162,8 +160,6 @@ class _Partial:
 
     def done(self, index: int) -> dict:
         """The blocks of file ``index`` kept: block -> (values, flags) as measured."""
-        import numpy as np
-
         kept = {}
         for block, path in self.kept(index).items():
             with np.load(path) as stored:
@@ -184,8 +180,6 @@ def keep_block(folder: Path, index: int, block: int, values: dict, flags: dict) 
 
 
 def _savez(path: Path, values: dict) -> None:
-    import numpy as np
-
     with open(path, "wb") as stream:
         np.savez(stream, **values)
 
