@@ -113,6 +113,8 @@ class Recording:
         [N]; NaN where a sample is missing.
     cycle : numpy.ndarray or dask.array.Array or None
         The cycle number of each sample, if the file has a cycle column. [1]
+    load : numpy.ndarray or dask.array.Array or None
+        The recorded normal load, if a load column was asked for (``load_column``). [N]
     last_line : int or None
         1-based line number of the last sample, for a text file.
     columns : Mapping[str, str]
@@ -128,6 +130,7 @@ class Recording:
     displacement: Any
     force: Any
     cycle: Any = None
+    load: Any = None
     last_line: int | None = None
     columns: Mapping[str, str] = dataclasses.field(default_factory=dict)
     units: Mapping[str, str] = dataclasses.field(default_factory=dict)
@@ -156,7 +159,8 @@ class Recording:
         The lines of the missing samples of a text file:
         ``recording.line(np.flatnonzero(recording.missing))``.
         """
-        arrays = [self.displacement, self.force] + ([] if self.cycle is None else [self.cycle])
+        read = (self.displacement, self.force, self.cycle, self.load)
+        arrays = [array for array in read if array is not None]
         if self.lazy:
             import dask.array as da
 
@@ -197,7 +201,7 @@ class Recording:
             raise TypeError("a Recording is indexed by a slice start:stop")
         first, stop, _ = key.indices(self.size)
         stop = max(stop, first)
-        arrays = [self.displacement, self.force, self.cycle]
+        arrays = [self.displacement, self.force, self.cycle, self.load]
         taken = [None if a is None else a[first:stop] for a in arrays]
         if self.lazy:
             import dask
@@ -211,6 +215,7 @@ class Recording:
             displacement=taken[0],
             force=taken[1],
             cycle=taken[2],
+            load=taken[3],
             last_line=last,
             start=self.start + first,
         )
