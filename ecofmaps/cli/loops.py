@@ -3,23 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import contextlib
-import io
-import sys
 import textwrap
-import warnings
-from pathlib import Path
 
-import numpy as np
-
-from ecofmaps.cli import loops_long
-from ecofmaps.cli._common import (
-    CommandError,
-    quantity,
-    recording_options,
-    refuse_to_overwrite,
-    unit,
-)
+from ecofmaps.cli._common import quantity, unit
 
 __all__ = ["add", "run"]
 
@@ -112,185 +98,54 @@ def add(subparsers) -> None:
         "--group", default=None, metavar="NAME",
         help="TDMS group, or HDF5/netCDF/zarr group, holding the channels (default: any)",
     )  # fmt: skip
-    loops_long.add_options(parser)
+    add_long_options(parser)
     parser.set_defaults(handler=run)
 
 
-def _plot_names(paths) -> list[str]:
-    """A distinct file-name stem for each recording's plots."""
-    stems = [path.stem for path in paths]
-    return [
-        stem if stems.count(stem) == 1 else f"{stem}_{index}"
-        for index, stem in enumerate(stems, start=1)
-    ]
+def _workers(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of workers >= 1")
+    return value
 
 
-def _analysed(path, recording, load, args, resolved_file: bool):
-    """The analysis of one recording, its reading along the stroke, and its warnings."""
-    from ecofmaps.measured.analysis import MissingSampleError, analyze_loops
-    from ecofmaps.measured.resolved import resolve_analyzed_loops, with_resolved
-
-    plots = args.plots is not None
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        try:
-            results = analyze_loops(
-                recording.displacement,
-                recording.force,
-                load,
-                cycle=recording.cycle,
-                flip_force=args.flip_force,
-                keep_loops=plots or not args.no_resolve,
-                nan_policy=args.nan_policy,
-            )
-        except MissingSampleError as error:
-            raise recording.error(loops_long.MISSING, error.sample) from None
-        except ValueError as error:
-            raise recording.error(str(error)) from None
-        resolved = None
-        if not args.no_resolve:
-            positions = 201 if plots or resolved_file else None
-            resolved = resolve_analyzed_loops(results, positions=positions)
-            results = with_resolved(results, resolved)
-    for warning in caught:  # one line each, naming the file, not a Python source line
-        print(f"ecofmaps loops: warning: {path.name}: {warning.message}", file=sys.stderr)
-    return results, resolved
-
-
-#: The variables of a recording's results that its summary line reads (:func:`_summary`):
-#: all that is kept of a long recording's results once their lines are written.
-SUMMARY_VARIABLES = ("regime", "gicof", "mu_resolved", "ecof", "quality")
-
-
-class _Table:
-    """The table of results, written to ``stream`` as each block of lines comes. Each block
-    begins with the header line, written once."""
-
-    def __init__(self, stream):
-        self.stream, self.started = stream, False
-
-    def write(self, text: str) -> None:
-        header, _, lines = text.partition("\n")
-        if not self.started:
-            self.stream.write(f"{header}\n")
-            self.started = True
-        self.stream.write(lines)
-        self.stream.flush()  # on disk as it comes: a block is a few MB
-
-
-def _summary(path, results, recording) -> str:
-    """One line on a recording's cycles: counts, the quality, the friction over the test."""
-    from ecofmaps.model.regimes import GROSS_SLIP
-
-    gross = results.isel(cycle=np.flatnonzero(results.regime.values == GROSS_SLIP))
-    summary = f"  {path.name}: {results.attrs['quality_summary']}"
-    if results.attrs["incomplete_cycles"]:
-        summary += f" ({results.attrs['incomplete_cycles']} incomplete dropped)"
-    summary += loops_long.skipped(results, recording)
-    if gross.cycle.size and gross.gicof.notnull().any():
-        summary += f"; GICoF median {float(gross.gicof.median()):.4f}"
-    if "mu_resolved" in gross and gross.mu_resolved.notnull().any():
-        summary += f", μ read along the stroke median {float(gross.mu_resolved.median()):.4f}"
-    ecof = gross.ecof.dropna("cycle") if gross.cycle.size else gross.ecof
-    if ecof.size:
-        summary += f"; ECoF {float(ecof[0]):.4f} (first) to {float(ecof[-1]):.4f} (last)"
-    return summary
+def add_long_options(parser) -> None:
+    """The options of long runs, for ``ecofmaps loops``."""
+    group = parser.add_argument_group(
+        "long tests",
+        "a rig file of more than 2**24 samples is analysed out of core, a block of whole "
+        "cycles at a time (the numbers are those of the analysis in memory)",
+    )
+    group.add_argument(
+        "--nan-policy", choices=("skip", "raise"), default="skip",
+        help="a cycle with a missing sample (NaN or an empty cell) is skipped and counted "
+        "(skip, the default), or any missing sample stops the command naming its line",
+    )  # fmt: skip
+    group.add_argument(
+        "--workers", type=_workers, default=None, metavar="N",
+        help="analyse out of core on a local dask cluster of N processes",
+    )  # fmt: skip
+    group.add_argument(
+        "--scheduler", default=None, metavar="ADDRESS",
+        help="analyse out of core on the dask cluster at ADDRESS (tcp://host:8786); its "
+        "workers must have ecofmaps and see the files at the same paths",
+    )  # fmt: skip
+    group.add_argument(
+        "--resume", action="store_true",
+        help="continue an interrupted run from the blocks kept in <out>.partial/ (needs "
+        "--out and the same files and options)",
+    )  # fmt: skip
+    group.add_argument(
+        "--quiet", action="store_true", help="no progress bar (none is shown off a terminal)",
+    )  # fmt: skip
 
 
 def run(args) -> int:
-    from ecofmaps.io.files import atomic_path
-    from ecofmaps.io.recordings import read_recording
-    from ecofmaps.io.tables import results_csv
-    from ecofmaps.maps.cache import write_netcdf
-    from ecofmaps.measured.synthetic import EXAMPLE, example_path
+    """Run ``ecofmaps loops``: the work is in :mod:`ecofmaps.cli.loops_run`, loaded only now
+    (the parser of every subcommand is built at start-up)."""
+    from ecofmaps.cli import loops_run  # the subcommand's boundary: heavy imports on use
 
-    if args.example == bool(args.files):
-        raise CommandError("give one or more recording FILEs, or --example (not both)")
-    paths = [example_path()] if args.example else [Path(name) for name in args.files]
-    load = EXAMPLE["load"] if args.example and args.load is None else args.load
-    if load is None:
-        raise CommandError("--load is required: the normal load, e.g. --load 450N")
-    columns = {
-        "--displacement-col": args.displacement_col,
-        "--force-col": args.force_col,
-        "--cycle-col": args.cycle_col,
-    }
-    named = [(option, name.strip().lower()) for option, name in columns.items() if name]
-    for index, (option, name) in enumerate(named):
-        for other, other_name in named[:index]:
-            if name == other_name:
-                raise CommandError(f"{other} and {option} name the same column {name!r}")
-    if args.resolved is not None:
-        if args.no_resolve:
-            raise CommandError("--resolved writes the reading along the stroke; not --no-resolve")
-        if len(paths) > 1:
-            raise CommandError("--resolved writes the reading of one recording: give one FILE")
-    for option, target in (("--out", args.out), ("--resolved", args.resolved)):
-        if target is not None and not Path(target).parent.is_dir():
-            raise CommandError(f"cannot write {target} ({option}): its directory does not exist")
-    kinds = ("loops", "evolution") + (() if args.no_resolve else ("resolved",))
-    plots = (
-        []
-        if args.plots is None
-        else [
-            ("--plots", Path(args.plots) / f"{name}_{kind}.png")
-            for name in _plot_names(paths)
-            for kind in kinds
-        ]
-    )
-    refuse_to_overwrite([("--out", args.out), ("--resolved", args.resolved), *plots], paths)
-    long_run = loops_long.LongRun(args, paths)
-    analyses, recordings = [], []
-    many = len(paths) > 1
-    with contextlib.ExitStack() as stack:  # the table is written as it comes, renamed at the end
-        if args.out is None:  # held, and printed once every file is analysed
-            stream = io.StringIO()
-        else:
-            temporary = stack.enter_context(atomic_path(args.out))
-            stream = stack.enter_context(open(temporary, "w", encoding="utf-8", newline=""))
-        table = _Table(stream)
-        for index, path in enumerate(paths):
-            recording = read_recording(path, lazy=long_run.lazy, **recording_options(args))
-            if recording.lazy:
-                if args.resolved is not None:
-                    raise CommandError(
-                        f"--resolved reads every loop along the stroke, which a long recording "
-                        f"({path}) analysed out of core does not keep: leave out --resolved"
-                    )
-                results = long_run.analyse(
-                    index, path, recording, load, many=many, write=table.write,
-                    columns=SUMMARY_VARIABLES,
-                )  # fmt: skip
-                analyses.append((results, None))
-            else:
-                analyses.append(_analysed(path, recording, load, args, args.resolved is not None))
-                table.write(results_csv(analyses[-1][0], file=str(path) if many else None))
-            recordings.append(recording)
-        if args.plots is not None:
-            from ecofmaps.figures import cof_evolution, measured_loops, resolved_loops, save_figure
-
-            folder = Path(args.plots)
-            folder.mkdir(parents=True, exist_ok=True)
-            for name, (results, resolved) in zip(_plot_names(paths), analyses, strict=True):
-                save_figure(
-                    measured_loops(results, resolved=resolved), folder / f"{name}_loops.png"
-                )
-                save_figure(cof_evolution(results), folder / f"{name}_evolution.png")
-                if resolved is not None:
-                    save_figure(resolved_loops(resolved, results), folder / f"{name}_resolved.png")
-        if args.resolved is not None:
-            write_netcdf(analyses[0][1], args.resolved)
-    if args.out is None:
-        sys.stdout.write(table.stream.getvalue())
-        for path, (results, _), recording in zip(paths, analyses, recordings, strict=True):
-            print(_summary(path, results, recording).strip(), file=sys.stderr)
-        return 0
-    long_run.finish()
-    print(f"wrote {args.out}: {sum(r.cycle.size for r, _ in analyses)} cycles")
-    for path, (results, _), recording in zip(paths, analyses, recordings, strict=True):
-        print(_summary(path, results, recording))
-    if args.resolved is not None:
-        print(f"  the loops read along the stroke in {args.resolved}")
-    if args.plots is not None:
-        print(f"  plots in {args.plots}")
-    return 0
+    return loops_run.run(args)

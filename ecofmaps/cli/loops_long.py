@@ -2,7 +2,7 @@
 
 A recording read lazily (a rig file of more than :data:`ecofmaps.io.recordings.LAZY_SAMPLES`
 samples, or any file with ``--workers``, ``--scheduler`` or ``--resume``) is analysed by
-:class:`ecofmaps.measured.out_of_core.LongAnalysis` on local threads, a local cluster of
+:class:`ecofmaps.measured.pipeline.Analysis` on local threads, a local cluster of
 ``--workers`` processes or the dask cluster at ``--scheduler``. With ``--out``, each block's
 results are written as it completes into ``<out>.partial/`` (NumPy ``.npz``, one file per block,
 each renamed into place when whole: what its cycles measured, from which the results are
@@ -17,7 +17,6 @@ time left) is shown on a terminal, unless ``--quiet``.
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import dataclasses
 import functools
@@ -30,8 +29,12 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps.cli._common import CommandError
+from ecofmaps.io.tables import results_csv
+from ecofmaps.measured.cycles import Cycles
+from ecofmaps.measured.options import MissingSampleError, default_options
+from ecofmaps.measured.pipeline import IN_PROCESS, Analysis, only
 
-__all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun", "add_options", "keep_block", "skipped"]
+__all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun", "keep_block", "skipped"]
 
 #: The message for a missing sample with ``--nan-policy raise`` (the file and line before it).
 MISSING = (
@@ -44,47 +47,6 @@ PARTIAL_SUFFIX = ".partial"
 
 #: Options that change how a run goes, not what it computes (left out of its fingerprint).
 _RUNTIME = ("workers", "scheduler", "resume", "quiet", "out", "plots", "handler", "files")
-
-
-def _workers(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of workers >= 1")
-    return value
-
-
-def add_options(parser) -> None:
-    """The options of long runs, for ``ecofmaps loops``."""
-    group = parser.add_argument_group(
-        "long tests",
-        "a rig file of more than 2**24 samples is analysed out of core, a block of whole "
-        "cycles at a time (the numbers are those of the analysis in memory)",
-    )
-    group.add_argument(
-        "--nan-policy", choices=("skip", "raise"), default="skip",
-        help="a cycle with a missing sample (NaN or an empty cell) is skipped and counted "
-        "(skip, the default), or any missing sample stops the command naming its line",
-    )  # fmt: skip
-    group.add_argument(
-        "--workers", type=_workers, default=None, metavar="N",
-        help="analyse out of core on a local dask cluster of N processes",
-    )  # fmt: skip
-    group.add_argument(
-        "--scheduler", default=None, metavar="ADDRESS",
-        help="analyse out of core on the dask cluster at ADDRESS (tcp://host:8786); its "
-        "workers must have ecofmaps and see the files at the same paths",
-    )  # fmt: skip
-    group.add_argument(
-        "--resume", action="store_true",
-        help="continue an interrupted run from the blocks kept in <out>.partial/ (needs "
-        "--out and the same files and options)",
-    )  # fmt: skip
-    group.add_argument(
-        "--quiet", action="store_true", help="no progress bar (none is shown off a terminal)",
-    )  # fmt: skip
 
 
 def _fingerprint(args, paths) -> dict:
@@ -130,8 +92,6 @@ class _Partial:
 
     def cycles(self, index: int):
         """The cycles of file ``index`` found before, or None."""
-        from ecofmaps.measured.cycles import Cycles
-
         path = self.folder / f"file{index}-cycles.npz"
         if not path.exists():
             return None
@@ -233,20 +193,27 @@ class LongRun:
             return Runner(self.args.workers, cluster=True)
         return Runner()
 
-    def analyse(self, index, path, recording, load, *, many: bool, write, columns=None):
-        """The results of recording ``index`` (read lazily), as :func:`ecofmaps.analyze_loops`
-        gives them (only the variables ``columns``, if given); its blocks kept beside
-        ``--out`` as they complete, and their lines of the table (with the file's name in a
-        first column if ``many``) given to ``write`` in order, a string per block that
-        begins with the header line. The results are joined after the cluster is closed,
-        so its workers' memory and the joined results are not held at once."""
+    def analyse(self, index, path, recording, load, *, many: bool, write, columns=None, reading):
+        """The results of recording ``index``, as :func:`ecofmaps.analyze_loops` gives them
+        (only the variables ``columns``, if given), and its reading along the stroke when
+        ``reading`` (a :class:`ecofmaps.measured.pipeline.Reading`) hands it back. A
+        recording in memory is one chunk, analysed in this process; a lazy one is analysed
+        on the runner of the options, its chunks kept beside ``--out`` as they complete.
+        The table's lines (with the file's name in a first column if ``many``) are given to
+        ``write`` in order, a string per chunk that begins with the header line. The
+        results are joined after the cluster is closed, so its workers' memory and the
+        joined results are not held at once."""
+        runner = self._runner() if recording.lazy else contextlib.nullcontext(IN_PROCESS)
         try:
-            with self._runner() as runner:  # a cluster that does not answer: nothing written
-                if self.partial is None and self.fingerprint is not None:
-                    self.partial = _Partial(self.args.out, self.fingerprint, self.args.resume)
-                analysis, parts = _analyse(
-                    index, path, recording, load, self.args, runner, self.partial, many,
-                    write, columns,
+            with runner as runner:  # a cluster that does not answer: nothing written
+                partial = None
+                if recording.lazy and self.fingerprint is not None:
+                    if self.partial is None:
+                        self.partial = _Partial(self.args.out, self.fingerprint, self.args.resume)
+                    partial = self.partial
+                analysis, parts, resolved = _analyse(
+                    index, path, recording, load, self.args, runner, partial, many,
+                    write, columns, reading,
                 )  # fmt: skip
         except _Interrupted as stop:  # counted once the runner is closed: no task runs
             if self.partial is not None:
@@ -257,7 +224,9 @@ class LongRun:
                     file=sys.stderr,
                 )
             raise
-        return analysis.finish([parts.pop(k) for k in sorted(parts)])
+        except MissingSampleError as error:
+            raise recording.error(MISSING, error.sample) from None
+        return analysis.finish([parts.pop(k) for k in sorted(parts)]), resolved
 
     def finish(self) -> None:
         """Remove the kept blocks: the table is written."""
@@ -276,32 +245,30 @@ def skipped(results, recording) -> str:
     return f"; {count} skipped for missing samples (the first at {where})"
 
 
-def _analyse(index, path, recording, load, args, runner, partial, many, write, columns):
-    """One long recording, block by block (module notes): its analysis, and the results of
-    each block (the variables ``columns``); the table's lines of each block (formatted
-    where it ran) given to ``write`` in the order of the blocks."""
-    from ecofmaps.io.tables import results_csv
-    from ecofmaps.measured.analysis import default_options
-    from ecofmaps.measured.out_of_core import LongAnalysis, only
-
-    if args.plots is not None:
+def _analyse(index, path, recording, load, args, runner, partial, many, write, columns, reading):
+    """One recording through the pipeline, chunk by chunk (module notes): its analysis, the
+    results of each chunk (the variables ``columns``) and the reading along the stroke
+    handed back (or None); the table's lines of each chunk (formatted where it ran) given to
+    ``write`` in the order of the chunks. A recording in memory is one chunk, run here."""
+    if args.plots is not None and recording.lazy:
         raise CommandError(
             f"--plots draws every loop, which a long recording ({path}) analysed out of core "
             "does not keep: leave out --plots (or --workers, --scheduler, --resume)"
         )
     options = default_options(load, getattr(args, "flip_force", False))
-    shown = not args.quiet and sys.stderr.isatty()
+    shown = recording.lazy and not args.quiet and sys.stderr.isatty()
     if shown:
         print(f"{path.name}: finding the cycles of {recording.size} samples", file=sys.stderr)
-    analysis = LongAnalysis(
+    analysis = Analysis(
         recording.displacement,
         recording.force,
         load,
         recording.cycle,
         runner=runner,
         nan_policy=args.nan_policy,
-        resolve=not args.no_resolve,
+        reading=reading,
         cycles=None if partial is None else partial.cycles(index),
+        samples=None if recording.lazy else recording.size,
         **options,
     )
     done = {}
@@ -309,30 +276,33 @@ def _analyse(index, path, recording, load, args, runner, partial, many, write, c
         partial.keep_cycles(index, analysis.cycles)
         done = partial.done(index)
     lines = functools.partial(results_csv, file=str(path) if many else None)
-    parts, texts = {}, {}  # texts: the lines of blocks that came before an earlier one
+    parts, texts = {}, {}  # texts: the lines of chunks that came before an earlier one
     for block, measured in done.items():
         part = analysis.part(block, *measured)
         parts[block], texts[block] = only(part, columns), lines(part)
     written = _in_order(texts, write)
     bar = _bar(analysis, path, shown, sum(parts[b].cycle.size for b in parts))
     keep = partial is not None
-    if keep and runner.local:  # the tasks keep their blocks themselves, where they run
+    if keep and runner.local:  # the chunks keep their blocks themselves, where they run
         keep = functools.partial(keep_block, partial.folder, index)
+    resolved = []
     try:
         measured = analysis.measured(skip=done, then=lines, keep=keep, columns=columns)
         with contextlib.closing(measured) as kept:
-            for block, part, values, flags, text in kept:
-                if values is not None:  # sent here: kept by this process
-                    keep_block(partial.folder, index, block, values, flags)
-                parts[block], texts[block] = part, text
+            for block, chunk in kept:
+                if chunk.values is not None:  # sent here: kept by this process
+                    keep_block(partial.folder, index, block, chunk.values, chunk.flags)
+                parts[block], texts[block] = chunk.part, chunk.made
+                if chunk.resolved is not None:
+                    resolved.append(chunk.resolved)
                 written = _in_order(texts, write, written)
-                bar.update(part.cycle.size)
+                bar.update(chunk.part.cycle.size)
     except KeyboardInterrupt:
         bar.leave = False
         bar.close()
         raise _Interrupted(len(analysis.tasks)) from None
     bar.close()
-    return analysis, parts
+    return analysis, parts, resolved[0] if resolved else None
 
 
 def _in_order(texts: dict, write, written: int = 0) -> int:

@@ -5,11 +5,11 @@ from ecofmaps._lazy import lazy_names
 
 #: Each public name, by the module that defines it (imported on first use).
 _PUBLIC = {
-    "ecofmaps.measured.analysis": ("analyze_loops",),
+    "ecofmaps.measured.analysis": ("analyze_loops", "resolve_loops"),
     "ecofmaps.measured.fit": ("LoopFit", "fit_loop"),
     "ecofmaps.measured.long_test": ("long_recording", "write_long_recording"),
     "ecofmaps.measured.quality": ("LoopQualityWarning",),
-    "ecofmaps.measured.resolved": ("resolve_analyzed_loops", "resolve_loops"),
+    "ecofmaps.measured.resolved": ("resolve_analyzed_loops",),
     "ecofmaps.measured.synthetic": ("scar_example_path", "synthetic_recording"),
 }
 

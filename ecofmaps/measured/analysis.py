@@ -80,44 +80,24 @@ groove slope at the ends of the slip, :math:`2 z_o \delta^*/x_o^2`, is below :ma
 
 from __future__ import annotations
 
-import inspect
-
 import numpy as np
 import xarray as xr
 
-from ecofmaps._inputs import check, si_units
-from ecofmaps.measured.cycles import MIN_SAMPLES, find_cycles
-from ecofmaps.measured.per_cycle import GROSS_SLIP_THRESHOLD, measure_cycles
-from ecofmaps.measured.results import Tally, cycle_results, with_loops, with_read_along_stroke
+from ecofmaps._inputs import si_units
+from ecofmaps._parallel import Runner
+from ecofmaps.measured.cycles import MIN_SAMPLES
+from ecofmaps.measured.options import (
+    DEFAULTS,
+    NAN_POLICIES,
+    check_options,
+    missing_sample_error,
+)
+from ecofmaps.measured.per_cycle import GROSS_SLIP_THRESHOLD
+from ecofmaps.measured.pipeline import Analysis, Reading
+from ecofmaps.measured.resolved import check_reading_options
 from ecofmaps.measured.samples import is_lazy
 
-__all__ = [
-    "NAN_POLICIES",
-    "MissingSampleError",
-    "analyze_loops",
-]
-
-#: What :func:`analyze_loops` does with missing samples: skip their cycles, or raise.
-NAN_POLICIES = ("skip", "raise")
-
-
-# --- the public function ------------------------------------------------------------------
-
-
-class MissingSampleError(ValueError):
-    """A missing sample where ``nan_policy='raise'``: ``sample`` is its 0-based index."""
-
-    def __init__(self, sample: int, message: str):
-        self.sample = int(sample)
-        super().__init__(message)
-
-
-def _missing_error(sample: int) -> MissingSampleError:
-    return MissingSampleError(
-        sample,
-        f"sample {sample} is missing (NaN or empty); nan_policy='skip' analyses the cycles "
-        "without missing samples and reports the others as skipped",
-    )
+__all__ = ["analyze_loops", "resolve_loops"]
 
 
 def _series(name, values, size=None, dtype=np.float64):
@@ -134,47 +114,6 @@ def _series(name, values, size=None, dtype=np.float64):
     if is_lazy(array) and array.dtype.kind not in "fiub":
         raise ValueError(f"{name} must hold numbers; got dtype {array.dtype}")
     return array
-
-
-def check_options(
-    load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
-):
-    """The options of :func:`analyze_loops`, checked (a ValueError naming the one that is
-    not valid), as keyword arguments of :func:`measure_cycles`."""
-    check("load", load, "positive", "N")
-    if np.ndim(load) != 0:
-        raise ValueError("load must be a single value [N]")
-    if not 0.0 < hysteresis < 1.0:
-        raise ValueError(f"hysteresis must satisfy 0 < hysteresis < 1; got {hysteresis!r}")
-    low, high = (float(share) for share in stick_window)
-    if not 0.0 <= low < high <= 1.0:
-        raise ValueError(f"stick_window must satisfy 0 <= low < high <= 1; got {stick_window!r}")
-    if not crossing_window > 0.0:
-        raise ValueError(
-            f"crossing_window must satisfy crossing_window > 0; got {crossing_window!r}"
-        )
-    if not 0.0 < gross_slip_threshold < 1.0:
-        raise ValueError(
-            "gross_slip_threshold must satisfy 0 < gross_slip_threshold < 1; "
-            f"got {gross_slip_threshold!r}"
-        )
-    if not isinstance(flip_force, bool | np.bool_):
-        raise ValueError(f"flip_force must be True or False; got {flip_force!r}")
-    return {
-        "hysteresis": float(hysteresis),
-        "stick_window": (low, high),
-        "crossing_window": float(crossing_window),
-        "gross_slip_threshold": float(gross_slip_threshold),
-        "flip_force": bool(flip_force),
-    }
-
-
-def default_options(load, flip_force=False):
-    """:func:`check_options` with :func:`analyze_loops`'s defaults for the others (what the
-    command line and a long analysis use)."""
-    defaults = inspect.signature(analyze_loops).parameters
-    names = ("hysteresis", "stick_window", "crossing_window", "gross_slip_threshold")
-    return check_options(load, *(defaults[name].default for name in names), flip_force)
 
 
 @si_units
@@ -316,9 +255,22 @@ def analyze_loops(
     options = check_options(
         load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
     )
+    reading = Reading(resolve=bool(resolve), keep_loops=bool(keep_loops))
+    results, _ = _run(
+        displacement, force, load, cycle, missing, options, nan_policy, reading, scheduler, workers
+    )
+    return results
+
+
+def _run(
+    displacement, force, load, cycle, missing, options, nan_policy, reading, scheduler, workers
+):
+    """The recording checked and through the pipeline (:mod:`ecofmaps.measured.pipeline`):
+    in this process as one chunk when it is in memory, else on the runner for
+    ``scheduler`` and ``workers``. Returns the results and the reading along the stroke
+    (or None)."""
     if nan_policy not in NAN_POLICIES:
         raise ValueError(f"nan_policy must be one of {NAN_POLICIES}; got {nan_policy!r}")
-    load = float(load)
     x = _series("displacement", displacement)
     q = _series("force", force, x.shape[0])
     label = None if cycle is None else _series("cycle", cycle, x.shape[0], dtype=None)
@@ -327,72 +279,39 @@ def analyze_loops(
         raise ValueError(
             f"too few samples for one cycle: {x.shape[0]} (a cycle needs at least {MIN_SAMPLES})"
         )
-    if any(is_lazy(a) for a in (x, q, label, mask)):
-        if keep_loops:
-            raise ValueError(
-                "keep_loops needs the recording in memory: give NumPy arrays (a long "
-                "recording's loops would not fit)"
-            )
-        from ecofmaps.measured.out_of_core import LongAnalysis
-
-        with runner_for(scheduler, workers) as runner:
-            analysis = LongAnalysis(
-                x,
-                q,
-                load,
-                label,
-                missing=mask,
-                runner=runner,
-                nan_policy=nan_policy,
-                resolve=resolve,
-                **options,
-            )
-            parts = [part for _, part in analysis.parts()]
-        return analysis.finish(parts)
-    if nan_policy == "raise":
-        bad = ~np.isfinite(x) | ~np.isfinite(q)
-        if label is not None and label.dtype.kind not in "iub":
-            bad |= ~np.isfinite(label)
-        if mask is not None:
-            bad |= mask
-        if bad.any():
-            raise _missing_error(int(np.argmax(bad)))
-    cycles = find_cycles(x, label, hysteresis, force=q, missing=mask)
-    if cycles.label.size == 0:
-        raise no_cycle_error(x.shape[0])
-    kept = keep_loops or resolve  # the reading along the stroke reads the kept loops
-    values, flags, loops = measure_cycles(cycles, x, q, load, keep_loops=kept, **options)
-    results = cycle_results(values, flags, cycles.label, load, options)
-    tally = Tally()
-    tally.add(results)
-    if kept:
-        results = with_loops(results, loops)
-    results = tally.finish(
-        results, cycles, "displacement reversals" if cycle is None else "cycle numbers", options
-    )
-    if resolve:
-        results = with_read_along_stroke(results)
-    if not keep_loops:
-        results = results.drop_vars(["loop_displacement", "loop_force", "point"], errors="ignore")
-    return results
+    arrays = dict(missing=mask, nan_policy=nan_policy, reading=reading, **options)
+    if not any(is_lazy(a) for a in (x, q, label, mask)):
+        if nan_policy == "raise":
+            _raise_at_missing(x, q, label, mask)
+        analysis = Analysis(x, q, float(load), label, samples=x.shape[0], **arrays)
+        return analysis.run()
+    if reading.keep_loops:
+        raise ValueError(
+            "keep_loops needs the recording in memory: give NumPy arrays (a long "
+            "recording's loops would not fit)"
+        )
+    with runner_for(scheduler, workers) as runner:
+        analysis = Analysis(x, q, float(load), label, runner=runner, **arrays)
+        return analysis.run()
 
 
-def no_cycle_error(samples: int) -> ValueError:
-    """The error for a recording without a complete cycle."""
-    return ValueError(
-        f"too few samples for one cycle: no complete cycle in {samples} samples "
-        "(the loop does not close, or the recording does not oscillate)"
-    )
+def _raise_at_missing(x, q, label, mask) -> None:
+    """:class:`MissingSampleError` naming the first missing sample of a recording in memory."""
+    bad = ~np.isfinite(x) | ~np.isfinite(q)
+    if label is not None and label.dtype.kind not in "iub":
+        bad |= ~np.isfinite(label)
+    if mask is not None:
+        bad |= mask
+    if bad.any():
+        raise missing_sample_error(int(np.argmax(bad)))
 
 
-def runner_for(scheduler, workers):
+def runner_for(scheduler, workers) -> Runner:
     """The :class:`ecofmaps._parallel.Runner` for :func:`analyze_loops`' ``scheduler`` and
     ``workers`` (see there)."""
-    from ecofmaps._parallel import Runner
-
     if scheduler is None:
         try:
-            from distributed import default_client
+            from distributed import default_client  # only where dask's cluster is used
 
             return Runner(client=default_client())
         except (ImportError, ValueError):  # no client: threads
@@ -404,3 +323,121 @@ def runner_for(scheduler, workers):
     if isinstance(scheduler, str):
         return Runner(scheduler=scheduler)
     return Runner(client=scheduler)
+
+
+@si_units
+def resolve_loops(
+    displacement,
+    force,
+    load,
+    stiffness=None,
+    cycle=None,
+    *,
+    force_offset=None,
+    positions=201,
+    central=0.8,
+    slip_threshold=4.0,
+    stick_window=(0.05, 0.45),
+    hysteresis=0.5,
+    gross_slip_threshold=GROSS_SLIP_THRESHOLD,
+) -> xr.Dataset:
+    r"""Friction and groove slope read along the whole stroke of every loop of a recording.
+
+    Parameters
+    ----------
+    displacement : array_like
+        Applied displacement :math:`\Delta` at each sample, in time order. Offsets and a
+        slow drift are removed (:func:`ecofmaps.analyze_loops`). [m]
+    force : array_like
+        Tangential force :math:`Q` at each sample. [N]
+    load : float
+        Normal load :math:`P`. [N]
+    stiffness : float, optional
+        Rig stiffness :math:`S` (``numpy.inf`` for a rigid rig); by default measured on
+        each loop. [N/m]
+    cycle : array_like, optional
+        Cycle number of each sample, as for :func:`ecofmaps.analyze_loops`. [1]
+    force_offset : float, optional
+        The force sensor's offset, subtracted from the recorded force. By default each
+        loop is centred on its own force instead, which also takes away the force a
+        tilted groove adds to both branches: give the offset (0 for a zeroed sensor) to
+        read a groove's tilt. [N]
+    positions : int or array_like or None
+        Points of the grid of contact positions common to all cycles, odd (>= 5) so that
+        :math:`\xi = 0` is one, spread over the widest resolved range; or the positions
+        themselves, increasing and with 0 among them (to compare recordings, or blocks of
+        one); or None for the per-cycle values alone (the values along the stroke take
+        8 kB per cycle at 201 positions). [1] or [m]
+    central : float
+        Share of the resolved half-range, about :math:`\xi = 0`, averaged for
+        ``mu_resolved`` and fitted for ``aspect_ratio`` (0 < central <= 1). [1]
+    slip_threshold : float
+        How many noise standard deviations of :math:`\xi` a sample must lie beyond the
+        stick level to count as slipping (> 0). [1]
+    stick_window : tuple of float
+        Shares of a branch's force swing, away from its reversal, that bound the first
+        stick window (0 <= low < high <= 1); also passed to
+        :func:`ecofmaps.analyze_loops`. [1]
+    hysteresis, gross_slip_threshold : float
+        Passed to :func:`ecofmaps.analyze_loops`: the reversal detector's band, and the
+        energy ratio above which a loop is gross slip. [1]
+
+    Returns
+    -------
+    resolved : xarray.Dataset
+        Over ``(cycle, position)``: ``mu`` :math:`\mu(\xi)`, ``slope`` :math:`g(\xi)`,
+        ``felt_profile`` :math:`h(\xi)` [m], ``force_forward`` and ``force_backward``
+        :math:`Q_\pm(\xi)` [N]; NaN outside the range where both branches slip. Over
+        ``cycle``: ``mu_resolved``, ``mu_resolved_se``, ``aspect_ratio``, ``tilt``
+        (:math:`g_0`), ``stiffness`` (the one used) [N/m], ``position_offset`` (where
+        :math:`\xi = 0` lies in the recording's contact position), ``position_min``,
+        ``position_max`` [m], ``amplitude`` (:math:`\Delta^*`, the :math:`x_o` of
+        ``aspect_ratio``) [m] and ``quality`` (``'ok'`` or the reason the values are NaN).
+        With the force centred (``force_offset=None``), ``slope`` and ``felt_profile`` are
+        levelled (``tilt`` taken off). The ``position``
+        coordinate is :math:`\xi` [m], common to all cycles; the load is a scalar
+        coordinate. ``resolved.sel(cycle=...).mu.plot()`` labels itself.
+
+    Raises
+    ------
+    ValueError
+        For bad inputs or options (those of :func:`ecofmaps.analyze_loops` too).
+
+    See Also
+    --------
+    resolve_analyzed_loops : the same from :func:`ecofmaps.analyze_loops`'s result.
+
+    Notes
+    -----
+    The method and the quality flags are in the documentation of
+    :mod:`ecofmaps.measured.resolved`. It rests on eq. 9 (the slip traction at any local
+    groove slope) and eq. 10 (the contact position); the GICoF (eq. 17-18) is its value at
+    :math:`\xi = 0`, and eq. 7 with :math:`x_o = \Delta^*` gives the equivalent
+    parabolic groove.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 7, 9, 10, 17-18.
+
+    Examples
+    --------
+    >>> import numpy as np, ecofmaps
+    >>> displacement, force = ecofmaps.fretting_loop(50e-6, 450.0, 35e6, 0.8, 0.2)
+    >>> resolved = ecofmaps.resolve_loops(np.asarray(displacement), np.asarray(force), 450.0)
+    >>> print(f"{float(resolved.mu_resolved[0]):.9f} {float(resolved.aspect_ratio[0]):.9f}")
+    0.800000000 0.200000000
+    """
+    reading = Reading(
+        resolve=True,
+        along_stroke=check_reading_options(
+            stiffness, force_offset, positions, central, slip_threshold, stick_window
+        ),
+        hand_back=True,
+    )
+    options = check_options(
+        load, hysteresis, stick_window, DEFAULTS["crossing_window"], gross_slip_threshold, False
+    )
+    _, resolved = _run(displacement, force, load, cycle, None, options, "skip", reading, None, None)
+    return resolved

@@ -1,31 +1,39 @@
-r"""The per-cycle analysis of a long recording held as dask arrays, a block of cycles at a time.
+r"""The one pipeline of the analysis of measured loops, whatever the way in.
 
-:class:`LongAnalysis` is what :func:`ecofmaps.analyze_loops` does with a dask recording, in
-steps that a caller can follow (the command line writes each block's results as it comes):
+A recording (NumPy arrays, an xarray Dataset, a file of any supported format, read by
+:mod:`ecofmaps.io`) goes through the same steps, each one function that every caller
+shares, so that a fix lands once:
 
-1. The cycles are found by passes over the recording a block of samples at a time
-   (:func:`ecofmaps.measured.cycles.find_cycles` on :class:`~ecofmaps.measured.samples.Samples`):
-   the straight line through the displacement, its percentiles, the reversals (or the
-   runs of cycle numbers), and the runs of missing samples. Only their results, a few
-   numbers per cycle, are held.
-2. The cycles are cut into tasks of whole cycles, about ``samples`` samples each, so no
-   cycle is cut at a task's edge. Each task reads the stretch of its cycles and of two
-   whole cycles on either side (a *halo*: the centring interpolates each cycle's centre
-   from its neighbours', :mod:`ecofmaps.measured.centring`) and measures its cycles with
-   :func:`ecofmaps.measured.per_cycle.measure_cycles`, with the sample indices of the whole
-   recording. So every number is computed from the same samples, with the same arithmetic,
-   as in memory; only sums over a loop's padded rows may be grouped differently (to the
-   last bits).
-3. :meth:`LongAnalysis.finish` checks the whole recording (every cycle refused, units) and
-   gives the joined results their attributes, as :func:`~ecofmaps.analyze_loops` does.
+1. **cycles**: :func:`ecofmaps.measured.cycles.find_cycles`, by passes over the recording a
+   block of samples at a time (:class:`~ecofmaps.measured.samples.Samples`): the straight
+   line through the displacement, its percentiles, the reversals (or the runs of cycle
+   numbers), the runs of missing samples. Only their results, a few numbers per cycle,
+   are held. The cycles keep the drive's numbering.
+2. **chunks**: the cycles are cut into chunks of whole cycles, about ``samples`` samples
+   each, so no cycle is cut at a chunk's edge. Each chunk reads the stretch of its cycles
+   and of two whole cycles on either side (a *halo*: the centring interpolates each
+   cycle's centre from its neighbours', :mod:`ecofmaps.measured.centring`).
+3. **per-cycle values**: :func:`ecofmaps.measured.per_cycle.measure_cycles`, with the
+   sample indices of the whole recording;
+4. **along the stroke** (``resolve``): :func:`ecofmaps.measured.resolved.resolve_analyzed_loops`
+   on the chunk's own loops, which never leave it;
+5. **quality and table**: :func:`ecofmaps.measured.results.cycle_results` and a
+   :class:`~ecofmaps.measured.results.Tally` of them, made where the chunk ran;
+   :meth:`Analysis.finish` checks the whole recording (every cycle refused, units,
+   scale) and gives the joined results their attributes.
 
-The tasks run on a :class:`ecofmaps._parallel.Runner` (threads, a local cluster of
-processes, or a dask cluster), a few at a time, so memory holds a few blocks whatever the
-length of the recording.
+In memory is the case of one chunk, run in this process; out of core is the case of many;
+workers are a :class:`ecofmaps._parallel.Runner` (threads, a local cluster of processes, or
+a dask cluster), a few chunks at a time, so memory holds a few chunks whatever the length
+of the recording; a resumed run is a store of finished chunks
+(:mod:`ecofmaps.cli.loops_long`) handed back to :meth:`Analysis.part`. Every number is
+computed from the same samples with the same arithmetic in every case; only sums over a
+loop's padded rows may be grouped differently between chunkings (to the last bits).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import itertools
 
@@ -33,27 +41,85 @@ import numpy as np
 import xarray as xr
 
 from ecofmaps._parallel import stretch
-from ecofmaps.measured.analysis import MissingSampleError, _missing_error, no_cycle_error
 from ecofmaps.measured.cycles import Cycles, find_cycles
+from ecofmaps.measured.options import missing_sample_error, no_cycle_error
 from ecofmaps.measured.per_cycle import measure_cycles
 from ecofmaps.measured.quality import quality_summary
-from ecofmaps.measured.resolved import REPORTED
-from ecofmaps.measured.resolved import _attrs as _read_attrs
-from ecofmaps.measured.results import (
-    Tally,
-    cycle_results,
-    strip,
-    with_loops,
-    with_read_along_stroke,
-)
+from ecofmaps.measured.resolved import REPORTED, resolve_analyzed_loops, resolved_attrs
+from ecofmaps.measured.results import Tally, cycle_results, strip, with_loops
 
-__all__ = ["HALO", "TASK_SAMPLES", "LongAnalysis", "MissingSampleError", "only"]
+__all__ = ["HALO", "IN_PROCESS", "TASK_SAMPLES", "Analysis", "Chunk", "Reading", "only"]
 
-#: Samples of the recording measured by one task (about; whole cycles).
+#: Samples of the recording measured by one chunk of a long recording (about; whole cycles).
 TASK_SAMPLES = 1 << 22
 
-#: Whole cycles on either side of a task's cycles that it reads for the centring.
+#: Whole cycles on either side of a chunk's cycles that it reads for the centring.
 HALO = 2
+
+#: The prefix of the names under which a chunk's values hold its reading along the stroke.
+READ = "read:"
+
+
+class _InProcess:
+    """Runs the chunks one after the other in this process (a recording in memory)."""
+
+    workers = 1
+    local = True
+    kind = "this process"
+
+    @staticmethod
+    def map(function, tasks):
+        for arguments in tasks:
+            yield function(*arguments)
+
+
+#: The runner of a recording in memory: its chunks run in this process, in order.
+IN_PROCESS = _InProcess()
+
+
+@dataclasses.dataclass(frozen=True)
+class Reading:
+    """What each chunk reads besides the per-cycle values.
+
+    Attributes
+    ----------
+    resolve : bool
+        Read each loop along the stroke (:func:`~ecofmaps.measured.resolved.resolve_analyzed_loops`)
+        and report :data:`~ecofmaps.measured.resolved.REPORTED` with its quality.
+    keep_loops : bool
+        Keep the centred loops in the results (``loop_displacement``, ``loop_force``).
+    along_stroke : dict, optional
+        Keyword arguments of :func:`~ecofmaps.measured.resolved.resolve_analyzed_loops`
+        (default: the per-cycle values alone, ``positions=None``). A grid of ``positions``
+        given by its number of points is spread over the widest resolved range of all
+        cycles: it needs the recording in one chunk.
+    hand_back : bool
+        Hand back the whole reading along the stroke (:attr:`Chunk.resolved`), not only
+        the values the results report.
+    """
+
+    resolve: bool = False
+    keep_loops: bool = False
+    along_stroke: dict = dataclasses.field(default_factory=lambda: {"positions": None})
+    hand_back: bool = False
+
+    @property
+    def one_grid(self) -> bool:
+        """Whether the grid of positions is made from all cycles (one chunk only)."""
+        positions = self.along_stroke.get("positions")
+        return self.resolve and isinstance(positions, int)
+
+
+@dataclasses.dataclass
+class Chunk:
+    """What one chunk hands back (see :func:`measure_chunk`)."""
+
+    part: xr.Dataset
+    tally: Tally
+    values: dict | None = None
+    flags: dict | None = None
+    made: object = None
+    resolved: xr.Dataset | None = None
 
 
 class _Stretch:
@@ -68,11 +134,7 @@ class _Stretch:
         return self.values[np.asarray(key) - self.low]
 
 
-#: The prefix of the names under which a task's values hold its reading along the stroke.
-READ = "read:"
-
-
-def _measure(
+def measure_chunk(
     cycles: Cycles,
     low: int,
     rows: slice,
@@ -80,32 +142,64 @@ def _measure(
     options: dict,
     x,
     q,
-    resolve: bool,
+    reading: Reading,
     then=None,
     keep=False,
     columns=None,
-):
-    """One task: the cycles ``rows`` of the table ``cycles`` measured on the stretch of the
-    recording that begins at sample ``low``; with ``resolve``, also read along the stroke
-    (the values :data:`~ecofmaps.measured.resolved.REPORTED` and the reading's quality), so
-    the loops never leave the task.
+) -> Chunk:
+    """Steps 3 to 5 of the pipeline for one chunk: the cycles ``rows`` of the table
+    ``cycles`` measured on the stretch of the recording that begins at sample ``low``.
 
-    Returns the task's results (as :meth:`LongAnalysis.part` makes them) and a
-    :class:`~ecofmaps.measured.results.Tally` of them, made where the task runs; with
-    ``keep=True``, what :func:`~ecofmaps.measured.per_cycle.measure_cycles` measured too
-    (with the reading along the stroke named with the prefix :data:`READ`), else None for
-    both (a callable ``keep`` is given them here instead, ``keep(values, flags)``); and
-    ``then(results)``, or None without ``then``, so that work on the results is done where
-    the task runs too. With ``columns``, the results handed back hold only those variables
-    (those of them there are); ``then`` is given them all."""
+    Parameters
+    ----------
+    cycles : Cycles
+        The chunk's cycles and its halo.
+    low : int
+        The first sample of the stretch ``x``, ``q`` in the whole recording.
+    rows : slice
+        The chunk's own cycles among ``cycles`` (the rest is its halo).
+    load : float
+        Normal load. [N]
+    options : dict
+        From :func:`ecofmaps.measured.options.check_options`.
+    x, q : numpy.ndarray
+        The stretch's displacement [m] and force [N].
+    reading : Reading
+        What is read besides the per-cycle values.
+    then : callable, optional
+        Called with the chunk's results where it runs (the command line formats its table
+        rows so); its value is :attr:`Chunk.made`.
+    keep : bool or callable
+        True: hand back what :func:`~ecofmaps.measured.per_cycle.measure_cycles` measured
+        (with the reading along the stroke named with the prefix :data:`READ`), for a
+        store of finished chunks; a callable ``keep(values, flags)`` is given them here
+        instead, so that they do not travel.
+    columns : sequence of str, optional
+        The variables of the results handed back (``then`` is given them all).
+
+    Returns
+    -------
+    chunk : Chunk
+    """
     values, flags, loops = measure_cycles(
-        cycles, _Stretch(x, low), _Stretch(q, low), load, rows=rows, keep_loops=resolve, **options
+        cycles,
+        _Stretch(x, low),
+        _Stretch(q, low),
+        load,
+        rows=rows,
+        keep_loops=reading.resolve or reading.keep_loops,
+        **options,
     )
     counted = cycle_results(values, flags, cycles.label[rows], load, options)
-    if resolve:
-        read = with_read_along_stroke(with_loops(strip(counted), loops))
-        values = values | {f"{READ}{name}": read[name].values for name in (*REPORTED, "quality")}
+    resolved = None
+    if reading.resolve:
+        resolved = resolve_analyzed_loops(with_loops(strip(counted), loops), **reading.along_stroke)
+        values = values | {
+            f"{READ}{name}": resolved[name].values for name in (*REPORTED, "quality")
+        }
     part = _part(counted, values)
+    if reading.keep_loops:
+        part = with_loops(part, loops)
     tally = Tally()
     tally.add(counted)
     if callable(keep):
@@ -113,7 +207,9 @@ def _measure(
     if keep is not True:
         values = flags = None
     made = None if then is None else then(part)
-    return only(part, columns), tally, values, flags, made
+    return Chunk(
+        only(part, columns), tally, values, flags, made, resolved if reading.hand_back else None
+    )
 
 
 def only(part: xr.Dataset, columns=None) -> xr.Dataset:
@@ -124,57 +220,60 @@ def only(part: xr.Dataset, columns=None) -> xr.Dataset:
 
 
 def _part(counted: xr.Dataset, values: dict) -> xr.Dataset:
-    """The results of a task: ``counted`` (from
+    """The results of a chunk: ``counted`` (from
     :func:`~ecofmaps.measured.results.cycle_results`) without its riders, with the reading
-    along the stroke in ``values`` (named with the prefix :data:`READ`) where the task read
-    it."""
+    along the stroke in ``values`` (named with the prefix :data:`READ`) where it was read."""
     part = strip(counted)
     read = {k[len(READ) :]: v for k, v in values.items() if k.startswith(READ)}
-    if read:  # as ecofmaps.measured.resolved.with_resolved adds them
-        part = part.assign({k: ("cycle", read[k], _read_attrs(k)) for k in REPORTED})
+    if read:
+        part = part.assign({k: ("cycle", read[k], resolved_attrs(k)) for k in REPORTED})
         part["quality"] = part["quality"].copy(data=read["quality"])
     return part
 
 
-class LongAnalysis:
-    """:func:`ecofmaps.analyze_loops` of a dask recording, in steps (module notes).
+class Analysis:
+    """The analysis of one recording through the pipeline (module notes), in steps that a
+    caller can follow: the command line writes each chunk's results as it comes.
 
     Parameters
     ----------
-    displacement, force : dask.array.Array
+    displacement, force : numpy.ndarray or dask.array.Array
         [m], [N]
     load : float
         Normal load. [N]
-    cycle : dask.array.Array, optional
+    cycle : numpy.ndarray or dask.array.Array, optional
         Cycle numbers. [1]
-    missing : dask.array.Array of bool, optional
+    missing : array_like of bool, optional
         Samples to treat as missing.
-    runner : ecofmaps._parallel.Runner
-        Where the passes and the tasks run (entered).
+    runner : ecofmaps._parallel.Runner, optional
+        Where the passes and the chunks run (entered); by default this process
+        (:data:`IN_PROCESS`).
     nan_policy : {'skip', 'raise'}
-    resolve : bool
-        Also read each loop along the stroke, as :func:`ecofmaps.analyze_loops` does.
+    reading : Reading, optional
+        What each chunk reads besides the per-cycle values (default: nothing).
     cycles : Cycles, optional
         The cycles, if found before (a resumed run); else they are found here.
     samples : int, optional
-        Samples per task (about; default :data:`TASK_SAMPLES`).
+        Samples per chunk (about; default :data:`TASK_SAMPLES`); a recording in memory is
+        one chunk (``samples`` of its size or more).
     **options
-        The checked options of :func:`ecofmaps.measured.analysis.check_options`.
+        The checked options of :func:`ecofmaps.measured.options.check_options`.
 
     Attributes
     ----------
     cycles : Cycles
     tasks : list of slice
-        The rows (cycles) of each task, in order.
+        The rows (cycles) of each chunk, in order.
     tally : ecofmaps.measured.results.Tally
-        What the parts given out so far add up to.
+        What the chunks handed back so far add up to.
 
     Raises
     ------
     MissingSampleError
         With ``nan_policy='raise'``, naming the first missing sample.
     ValueError
-        If the recording holds no complete cycle.
+        If the recording holds no complete cycle, or a reading along the stroke over a
+        grid of positions made from all cycles is asked of more than one chunk.
     """
 
     def __init__(
@@ -185,15 +284,15 @@ class LongAnalysis:
         cycle=None,
         *,
         missing=None,
-        runner,
+        runner=IN_PROCESS,
         nan_policy="skip",
-        resolve=False,
+        reading=None,
         cycles=None,
         samples=None,
         **options,
     ):
         self.arrays = (displacement, force)
-        self.resolve = bool(resolve)
+        self.reading = Reading() if reading is None else reading
         self.load, self.options, self.runner = float(load), options, runner
         self.cycles_from = "displacement reversals" if cycle is None else "cycle numbers"
         if cycles is None:
@@ -203,19 +302,24 @@ class LongAnalysis:
                 options["hysteresis"],
                 force=force,
                 missing=missing,
-                runner=runner,
+                runner=None if runner is IN_PROCESS else runner,
             )
         self.cycles = cycles
         if nan_policy == "raise" and cycles.first_missing >= 0:
-            raise _missing_error(cycles.first_missing)
+            raise missing_sample_error(cycles.first_missing)
         if cycles.label.size == 0:
             raise no_cycle_error(int(displacement.shape[0]))
         self.tasks = _tasks(cycles.count, samples or TASK_SAMPLES)
+        if self.reading.one_grid and len(self.tasks) > 1:
+            raise ValueError(
+                "the reading along the stroke on a grid of positions common to all cycles "
+                "needs the recording in one chunk (in memory); give the positions themselves"
+            )
         self.tally = Tally()
         self._whole = np.flatnonzero(cycles.whole)  # the cycles a halo may hold
 
     def _task(self, index: int, then, keep, columns=None):
-        """The arguments of the task ``index`` (see :func:`_measure`)."""
+        """The arguments of chunk ``index`` (see :func:`measure_chunk`)."""
         cycles, rows = self.cycles, self.tasks[index]
         first, stop = rows.start, rows.stop
         if cycles.continuous:  # a halo of whole cycles on either side
@@ -232,56 +336,49 @@ class LongAnalysis:
         inner = slice(rows.start - first, rows.stop - first)
         if callable(keep):
             keep = functools.partial(keep, index)
-        return (table, low, inner, self.load, self.options, x, q, self.resolve, then, keep, columns)
+        return (table, low, inner, self.load, self.options, x, q, self.reading, then, keep, columns)
 
     def measured(self, skip=(), then=None, keep=False, columns=None):
-        """The results of each task, in order, as they come; counted in :attr:`tally`.
+        """Each chunk's :class:`Chunk`, in order, as they come; counted in :attr:`tally`.
 
         Parameters
         ----------
         skip : collection of int
-            Tasks not to run (done before, in a run that is resumed).
+            Chunks not to run (done before, in a run that is resumed).
         then : callable, optional
-            A function of a task's results (the Dataset :meth:`part` gives), called where
-            the task runs: a module-level function, or a :func:`functools.partial` of one,
-            for tasks in other processes. The command line formats its table rows so, in
-            parallel.
+            A function of a chunk's results (the Dataset :meth:`part` gives), called where
+            the chunk runs: a module-level function, or a :func:`functools.partial` of one,
+            for chunks in other processes. The command line formats its table rows so.
         keep : bool or callable
-            True: also hand back what each task measured (to be kept, and made into its
+            True: also hand back what each chunk measured (to be kept, and made into its
             results again by :meth:`part` when a run is resumed). A callable
-            ``keep(index, values, flags)`` is called with it where the task runs instead
+            ``keep(index, values, flags)`` is called with it where the chunk runs instead
             (picklable as ``then`` is), so that what is kept does not travel: for a runner
             whose workers share this machine's files.
         columns : sequence of str, optional
-            The variables of each task's results to hand back (those of them there are;
-            default all): what the caller keeps of them, so the rest does not travel.
-            ``then`` is given them all.
+            The variables of each chunk's results to hand back (those of them there are;
+            default all), so the rest does not travel. ``then`` is given them all.
 
         Yields
         ------
         index : int
-            The task (index into :attr:`tasks`).
-        part : xarray.Dataset
-            Its cycles' results, made where it ran (see :meth:`part`).
-        values, flags : dict of str to numpy.ndarray, or None
-            With ``keep=True``, its cycles' quantities and checks, from
-            :func:`~ecofmaps.measured.per_cycle.measure_cycles`.
-        made
-            What ``then`` returned for the task's results (None without ``then``).
+            The chunk (index into :attr:`tasks`).
+        chunk : Chunk
+            What it handed back (see :func:`measure_chunk`).
         """
         skip = set(skip)
         wanted = [k for k in range(len(self.tasks)) if k not in skip]
         tasks = (self._task(k, then, keep, columns) for k in wanted)
-        results = self.runner.map(_measure, tasks)
+        results = self.runner.map(measure_chunk, tasks)
         try:
-            for index, (part, tally, values, flags, made) in zip(wanted, results, strict=False):
-                self.tally.merge(tally)
-                yield index, part, values, flags, made
-        finally:  # closed with this generator: the tasks left are cancelled now, not later
+            for index, chunk in zip(wanted, results, strict=False):
+                self.tally.merge(chunk.tally)
+                yield index, chunk
+        finally:  # closed with this generator: the chunks left are cancelled now, not later
             results.close()
 
     def part(self, index: int, values: dict, flags: dict) -> xr.Dataset:
-        """The per-cycle results of task ``index`` from what it measured (kept by
+        """The per-cycle results of chunk ``index`` from what it measured (kept by
         :meth:`measured`), as in :func:`ecofmaps.analyze_loops`'s Dataset (without the
         recording's attributes); counted in :attr:`tally`."""
         labels = self.cycles.label[self.tasks[index]]
@@ -290,11 +387,6 @@ class LongAnalysis:
         self.tally.add(counted)
         return _part(counted, values)
 
-    def parts(self):
-        """The results of each task, in order, as they come (see :meth:`part`)."""
-        for index, part, *_ in self.measured():
-            yield index, part
-
     def finish(self, parts) -> xr.Dataset:
         """The parts (all of them, in order) joined, with the recording's attributes, after
         the checks of the whole recording (see :meth:`ecofmaps.measured.results.Tally.finish`).
@@ -302,11 +394,30 @@ class LongAnalysis:
         The parts share their variables and the load: they are joined along ``cycle``
         without comparing the rest (six times faster than comparing it, which copied every
         quality string)."""
-        results = xr.concat(list(parts), "cycle", coords="minimal", compat="override")
+        parts = list(parts)
+        if len(parts) == 1:
+            results = parts[0]
+        else:
+            results = xr.concat(parts, "cycle", coords="minimal", compat="override")
         results = self.tally.finish(results, self.cycles, self.cycles_from, self.options)
-        if self.resolve:  # the summary of the reading's quality, as with_resolved gives it
+        if self.reading.resolve:  # the summary of the reading's quality
             results.attrs["quality_summary"] = quality_summary(results["quality"].values)
         return results
+
+    def run(self):
+        """Every chunk, joined (:meth:`finish`); and the reading along the stroke, joined,
+        with :attr:`Reading.hand_back` (else None)."""
+        parts, read = [], []
+        for _, chunk in self.measured():
+            parts.append(chunk.part)
+            if chunk.resolved is not None:
+                read.append(chunk.resolved)
+        resolved = None
+        if len(read) == 1:
+            resolved = read[0]
+        elif read:
+            resolved = xr.concat(read, "cycle", coords="minimal", compat="override")
+        return self.finish(parts), resolved
 
 
 def _tasks(count, samples: int) -> list[slice]:

@@ -12,7 +12,7 @@ slope of whatever groove the pad sits in. Where both branches slip over the same
     g(\xi) = \tan\frac{\arctan(Q_+/P) + \arctan(Q_-/P)}{2},
 
 and :math:`h(\xi) = \int_0^\xi g\,d\xi` is the scar's profile as the pad feels it. The
-GICoF (eq. 17-18) is the special case :math:`\xi = 0`. :func:`resolve_loops` reads them
+GICoF (eq. 17-18) is the special case :math:`\xi = 0`. :func:`ecofmaps.resolve_loops` reads them
 off every cycle of a recording; :func:`resolve_analyzed_loops` does the same from the loops
 that :func:`ecofmaps.analyze_loops` kept (``keep_loops=True``): cycles, centring, offsets
 and a first stiffness come from there. The work is vectorised over blocks of 512 cycles
@@ -120,15 +120,19 @@ import numpy as np
 import xarray as xr
 
 from ecofmaps import _nomenclature as nomenclature
-from ecofmaps._inputs import check, si_units
+from ecofmaps._inputs import check
 from ecofmaps.measured.along_stroke import _resolve
-from ecofmaps.measured.analysis import analyze_loops
-from ecofmaps.measured.per_cycle import GROSS_SLIP_THRESHOLD
 from ecofmaps.measured.quality import (
     quality_summary,
 )
 
-__all__ = ["resolve_analyzed_loops", "resolve_loops"]
+__all__ = [
+    "REPORTED",
+    "check_reading_options",
+    "resolve_analyzed_loops",
+    "resolved_attrs",
+    "with_resolved",
+]
 
 
 # How this module reads the quantities that have a general meaning elsewhere (netCDF comment).
@@ -140,15 +144,19 @@ _COMMENTS = {
 }
 
 
-def _attrs(name: str) -> dict:
+def resolved_attrs(name: str) -> dict:
+    """The attributes of the variable ``name`` of the reading along the stroke."""
     attrs = nomenclature.attrs(name)
     if name in _COMMENTS:
         attrs["comment"] = _COMMENTS[name]
     return attrs
 
 
-def _check_options(stiffness, force_offset, positions, central, slip_threshold, stick_window):
-    """The options as a dict, or a ValueError naming the one out of range."""
+def check_reading_options(
+    stiffness, force_offset, positions, central, slip_threshold, stick_window
+) -> dict:
+    """The options of :func:`resolve_analyzed_loops` as a dict, or a ValueError naming the
+    one out of range."""
     if stiffness is not None:
         check("stiffness", stiffness, "positive_or_inf", "N/m")
         if np.ndim(stiffness) != 0:
@@ -217,7 +225,7 @@ def resolve_analyzed_loops(
 ) -> xr.Dataset:
     r"""Friction and groove slope along the stroke of the loops :func:`analyze_loops` kept.
 
-    The work of :func:`resolve_loops` after its call of :func:`ecofmaps.analyze_loops`:
+    The work of :func:`ecofmaps.resolve_loops` after its call of :func:`ecofmaps.analyze_loops`:
     for a recording already analysed with ``keep_loops=True``.
 
     Parameters
@@ -225,12 +233,12 @@ def resolve_analyzed_loops(
     loops : xarray.Dataset
         The result of :func:`ecofmaps.analyze_loops` with ``keep_loops=True``.
     stiffness, force_offset, positions, central, slip_threshold, stick_window
-        As for :func:`resolve_loops`.
+        As for :func:`ecofmaps.resolve_loops`.
 
     Returns
     -------
     resolved : xarray.Dataset
-        As for :func:`resolve_loops`.
+        As for :func:`ecofmaps.resolve_loops`.
 
     Raises
     ------
@@ -248,7 +256,7 @@ def resolve_analyzed_loops(
             "loops must be the Dataset of analyze_loops(..., keep_loops=True), with "
             + ", ".join(_NEEDED)
         )
-    options = _check_options(
+    options = check_reading_options(
         stiffness, force_offset, positions, central, slip_threshold, stick_window
     )
     load = float(loops["load"])
@@ -277,16 +285,16 @@ def resolve_analyzed_loops(
         )
         per_cycle["amplitude"] = loops["amplitude"].values  # the x_o of aspect_ratio
     dims = ("cycle", "position")
-    data = {name: (dims, value, _attrs(name)) for name, value in per_position.items()}
+    data = {name: (dims, value, resolved_attrs(name)) for name, value in per_position.items()}
     for name, value in per_cycle.items():
-        data[name] = ("cycle", value, _attrs(name))
-    data["quality"] = ("cycle", quality, _attrs("quality"))
+        data[name] = ("cycle", value, resolved_attrs(name))
+    data["quality"] = ("cycle", quality, resolved_attrs("quality"))
     coords = {
-        "cycle": ("cycle", loops["cycle"].values, _attrs("cycle")),
-        "load": ((), load, _attrs("load")),
+        "cycle": ("cycle", loops["cycle"].values, resolved_attrs("cycle")),
+        "load": ((), load, resolved_attrs("load")),
     }
     if grid is not None:
-        coords["position"] = ("position", grid, _attrs("position"))
+        coords["position"] = ("position", grid, resolved_attrs("position"))
     attrs = {
         "title": "Fretting loops read along the stroke (ecofmaps.resolve_loops)",
         "stiffness_from": "given" if given else "the stick sets of each loop",
@@ -324,123 +332,3 @@ def with_resolved(results: xr.Dataset, resolved: xr.Dataset) -> xr.Dataset:
     results["quality"] = results["quality"].copy(data=resolved["quality"].values)
     results.attrs["quality_summary"] = quality_summary(resolved["quality"].values)
     return results
-
-
-@si_units
-def resolve_loops(
-    displacement,
-    force,
-    load,
-    stiffness=None,
-    cycle=None,
-    *,
-    force_offset=None,
-    positions=201,
-    central=0.8,
-    slip_threshold=4.0,
-    stick_window=(0.05, 0.45),
-    hysteresis=0.5,
-    gross_slip_threshold=GROSS_SLIP_THRESHOLD,
-) -> xr.Dataset:
-    r"""Friction and groove slope read along the whole stroke of every loop of a recording.
-
-    Parameters
-    ----------
-    displacement : array_like
-        Applied displacement :math:`\Delta` at each sample, in time order. Offsets and a
-        slow drift are removed (:func:`ecofmaps.analyze_loops`). [m]
-    force : array_like
-        Tangential force :math:`Q` at each sample. [N]
-    load : float
-        Normal load :math:`P`. [N]
-    stiffness : float, optional
-        Rig stiffness :math:`S` (``numpy.inf`` for a rigid rig); by default measured on
-        each loop. [N/m]
-    cycle : array_like, optional
-        Cycle number of each sample, as for :func:`ecofmaps.analyze_loops`. [1]
-    force_offset : float, optional
-        The force sensor's offset, subtracted from the recorded force. By default each
-        loop is centred on its own force instead, which also takes away the force a
-        tilted groove adds to both branches: give the offset (0 for a zeroed sensor) to
-        read a groove's tilt. [N]
-    positions : int or array_like or None
-        Points of the grid of contact positions common to all cycles, odd (>= 5) so that
-        :math:`\xi = 0` is one, spread over the widest resolved range; or the positions
-        themselves, increasing and with 0 among them (to compare recordings, or blocks of
-        one); or None for the per-cycle values alone (the values along the stroke take
-        8 kB per cycle at 201 positions). [1] or [m]
-    central : float
-        Share of the resolved half-range, about :math:`\xi = 0`, averaged for
-        ``mu_resolved`` and fitted for ``aspect_ratio`` (0 < central <= 1). [1]
-    slip_threshold : float
-        How many noise standard deviations of :math:`\xi` a sample must lie beyond the
-        stick level to count as slipping (> 0). [1]
-    stick_window : tuple of float
-        Shares of a branch's force swing, away from its reversal, that bound the first
-        stick window (0 <= low < high <= 1); also passed to
-        :func:`ecofmaps.analyze_loops`. [1]
-    hysteresis, gross_slip_threshold : float
-        Passed to :func:`ecofmaps.analyze_loops`: the reversal detector's band, and the
-        energy ratio above which a loop is gross slip. [1]
-
-    Returns
-    -------
-    resolved : xarray.Dataset
-        Over ``(cycle, position)``: ``mu`` :math:`\mu(\xi)`, ``slope`` :math:`g(\xi)`,
-        ``felt_profile`` :math:`h(\xi)` [m], ``force_forward`` and ``force_backward``
-        :math:`Q_\pm(\xi)` [N]; NaN outside the range where both branches slip. Over
-        ``cycle``: ``mu_resolved``, ``mu_resolved_se``, ``aspect_ratio``, ``tilt``
-        (:math:`g_0`), ``stiffness`` (the one used) [N/m], ``position_offset`` (where
-        :math:`\xi = 0` lies in the recording's contact position), ``position_min``,
-        ``position_max`` [m], ``amplitude`` (:math:`\Delta^*`, the :math:`x_o` of
-        ``aspect_ratio``) [m] and ``quality`` (``'ok'`` or the reason the values are NaN).
-        With the force centred (``force_offset=None``), ``slope`` and ``felt_profile`` are
-        levelled (``tilt`` taken off). The ``position``
-        coordinate is :math:`\xi` [m], common to all cycles; the load is a scalar
-        coordinate. ``resolved.sel(cycle=...).mu.plot()`` labels itself.
-
-    Raises
-    ------
-    ValueError
-        For bad inputs or options (those of :func:`ecofmaps.analyze_loops` too).
-
-    See Also
-    --------
-    resolve_analyzed_loops : the same from :func:`ecofmaps.analyze_loops`'s result.
-
-    Notes
-    -----
-    The method and the quality flags are in the documentation of
-    :mod:`ecofmaps.measured.resolved`. It rests on eq. 9 (the slip traction at any local
-    groove slope) and eq. 10 (the contact position); the GICoF (eq. 17-18) is its value at
-    :math:`\xi = 0`, and eq. 7 with :math:`x_o = \Delta^*` gives the equivalent
-    parabolic groove.
-
-    References
-    ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 7, 9, 10, 17-18.
-
-    Examples
-    --------
-    >>> import numpy as np, ecofmaps
-    >>> displacement, force = ecofmaps.fretting_loop(50e-6, 450.0, 35e6, 0.8, 0.2)
-    >>> resolved = ecofmaps.resolve_loops(np.asarray(displacement), np.asarray(force), 450.0)
-    >>> print(f"{float(resolved.mu_resolved[0]):.9f} {float(resolved.aspect_ratio[0]):.9f}")
-    0.800000000 0.200000000
-    """
-    options = _check_options(
-        stiffness, force_offset, positions, central, slip_threshold, stick_window
-    )
-    loops = analyze_loops(
-        displacement,
-        force,
-        load,
-        cycle,
-        hysteresis=hysteresis,
-        stick_window=stick_window,
-        gross_slip_threshold=gross_slip_threshold,
-        keep_loops=True,
-    )
-    return resolve_analyzed_loops(loops, **options)

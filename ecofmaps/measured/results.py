@@ -5,7 +5,7 @@ r"""The per-cycle results of :func:`~ecofmaps.measured.analysis.analyze_loops` a
 with a reason in ``quality`` where a check fails, the regime codes), and :class:`Tally`
 gathers what is said about a whole recording from its parts as they come (the quality
 summary, the refusal of every cycle with a hint, the check of the amplitude's unit), so a
-recording analysed in parts (:mod:`ecofmaps.measured.out_of_core`) gives the same result.
+recording analysed in chunks (:mod:`ecofmaps.measured.pipeline`) gives the same result.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from ecofmaps.measured.quality import (
 )
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP, Regime
 
-__all__ = ["Tally", "cycle_results", "strip", "with_loops", "with_read_along_stroke"]
+__all__ = ["Tally", "cycle_results", "strip", "with_loops"]
 
 
 #: How the quantities are measured on a loop (the netCDF ``comment`` attribute).
@@ -83,14 +83,6 @@ def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
     results["loop_force"] = (("cycle", "point"), loops[1], _attrs("loop_force"))
     results.coords["point"] = ("point", np.arange(loops[0].shape[1]), _attrs("point"))
     return results
-
-
-def with_read_along_stroke(results: xr.Dataset) -> xr.Dataset:
-    """``results`` (with its loops) with the values read along the stroke
-    (:data:`ecofmaps.measured.resolved.REPORTED`), and that reading's quality."""
-    from ecofmaps.measured.resolved import resolve_analyzed_loops, with_resolved  # built on this
-
-    return with_resolved(results, resolve_analyzed_loops(results, positions=None))
 
 
 def cycle_results(values: dict, flags: dict, label, load: float, options: dict) -> xr.Dataset:

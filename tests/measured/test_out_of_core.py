@@ -16,8 +16,9 @@ import pytest
 import xarray as xr
 
 import ecofmaps
-from ecofmaps.measured import cycles, out_of_core, passes
-from ecofmaps.measured.analysis import MissingSampleError, analyze_loops
+from ecofmaps.measured import cycles, passes, pipeline
+from ecofmaps.measured.analysis import analyze_loops
+from ecofmaps.measured.options import MissingSampleError, default_options
 from ecofmaps.measured.quality import LoopQualityWarning
 from ecofmaps.measured.synthetic import synthetic_recording
 from tests.measured.test_analysis import mindlin_recording
@@ -39,7 +40,7 @@ def small_blocks(monkeypatch):
     """Passes a chunk of 1000 samples at a time, tasks of about 777 samples."""
     monkeypatch.setattr(passes, "_CHUNK", 1000)
     monkeypatch.setattr(passes, "_SAMPLE", 256)
-    monkeypatch.setattr(out_of_core, "TASK_SAMPLES", 777)
+    monkeypatch.setattr(pipeline, "TASK_SAMPLES", 777)
 
 
 def analysed(displacement, force, cycle=None, **options):
@@ -127,8 +128,8 @@ def test_same_numbers_as_in_memory(small_blocks, name, chunks, monkeypatch):
     displacement, force, cycle = RECORDINGS[name]()
     memory = analysed(displacement, force, cycle)
     tasks = []
-    original = out_of_core._tasks
-    monkeypatch.setattr(out_of_core, "_tasks", lambda *a: tasks.append(original(*a)) or tasks[-1])
+    original = pipeline._tasks
+    monkeypatch.setattr(pipeline, "_tasks", lambda *a: tasks.append(original(*a)) or tasks[-1])
     lazy = analysed(*lazily(displacement, force, cycle, chunks=chunks), scheduler="threads")
     assert len(tasks[0]) >= 3  # several tasks, each with its halo
     assert_equal_results(lazy, memory)
@@ -300,7 +301,6 @@ def test_every_cycle_missing_is_an_error():
 def test_tallies_of_parts_merge_into_the_tally_of_the_whole():
     """Tasks count their parts where they run (Tally.add) and the counts are merged: the
     same summary, refusals, checks and amplitudes as counting the whole at once."""
-    from ecofmaps.measured.analysis import default_options
     from ecofmaps.measured.per_cycle import measure_cycles
     from ecofmaps.measured.results import Tally, cycle_results
 
@@ -332,7 +332,7 @@ def test_tallies_of_parts_merge_into_the_tally_of_the_whole():
 
 
 def _kept_here(store, index, values, flags):
-    """A ``keep`` of :meth:`LongAnalysis.measured`: what task ``index`` measured, in ``store``."""
+    """A ``keep`` of :meth:`Analysis.measured`: what task ``index`` measured, in ``store``."""
     store[index] = (values, flags)
 
 
@@ -342,19 +342,18 @@ def test_tasks_keep_what_they_measured_where_they_run(small_blocks):
     import functools
 
     from ecofmaps._parallel import Runner
-    from ecofmaps.measured.analysis import default_options
 
     x, q = noisy(EXAMPLE_2, 12, 3)
     options = default_options(LOAD)
     x, q = lazily(x, q)
     store = {}
     with Runner(2) as runner:
-        analysis = out_of_core.LongAnalysis(x, q, LOAD, runner=runner, samples=900, **options)
+        analysis = pipeline.Analysis(x, q, LOAD, runner=runner, samples=900, **options)
         assert len(analysis.tasks) > 2
-        handed = {k: (v, f) for k, _, v, f, _ in analysis.measured(keep=True)}
-        nothing = [(v, f) for _, _, v, f, _ in analysis.measured()]
+        handed = {k: (c.values, c.flags) for k, c in analysis.measured(keep=True)}
+        nothing = [(c.values, c.flags) for _, c in analysis.measured()]
         kept = analysis.measured(keep=functools.partial(_kept_here, store))
-        returned = [(v, f) for _, _, v, f, _ in kept]
+        returned = [(c.values, c.flags) for _, c in kept]
     assert all(v is None and f is None for v, f in nothing + returned)
     assert sorted(store) == sorted(handed) == list(range(len(analysis.tasks)))
     for index, (values, flags) in handed.items():
@@ -366,7 +365,7 @@ def test_tasks_keep_what_they_measured_where_they_run(small_blocks):
 
 
 def _variables(part):
-    """A ``then`` of :meth:`LongAnalysis.measured`: the names of the results it is given."""
+    """A ``then`` of :meth:`Analysis.measured`: the names of the results it is given."""
     return sorted(part.data_vars)
 
 
@@ -374,18 +373,19 @@ def test_tasks_hand_back_only_the_columns_asked_for(small_blocks):
     """With ``columns``, each task's results hold only those of them there are, with the
     same values; ``then`` is given them all."""
     from ecofmaps._parallel import Runner
-    from ecofmaps.measured.analysis import default_options
 
     x, q = lazily(*noisy(EXAMPLE_2, 12, 3))
     columns = ("quality", "ecof", "no_such_variable")
     with Runner(2) as runner:
-        analysis = out_of_core.LongAnalysis(
-            x, q, LOAD, runner=runner, samples=900, resolve=True, **default_options(LOAD)
+        reading = pipeline.Reading(resolve=True)
+        analysis = pipeline.Analysis(
+            x, q, LOAD, runner=runner, samples=900, reading=reading, **default_options(LOAD)
         )
-        whole = [part for _, part, *_ in analysis.measured(then=_variables)]
+        whole = [chunk.part for _, chunk in analysis.measured(then=_variables)]
         only = list(analysis.measured(then=_variables, columns=columns))
     assert len(only) == len(whole) == len(analysis.tasks) > 2
-    for (_, part, _, _, made), full in zip(only, whole, strict=True):
+    for (_, chunk), full in zip(only, whole, strict=True):
+        part, made = chunk.part, chunk.made
         assert sorted(part.data_vars) == ["ecof", "quality"]
         assert made == sorted(full.data_vars) and "mu_resolved" in made
         xr.testing.assert_identical(part, full[["quality", "ecof"]])
@@ -400,7 +400,7 @@ def test_a_worker_reads_and_measures_without_jax_or_pint():
 
     code = (
         "import sys\n"
-        "import ecofmaps.io.binary, ecofmaps.measured.passes, ecofmaps.measured.out_of_core\n"
+        "import ecofmaps.io.binary, ecofmaps.measured.passes, ecofmaps.measured.pipeline\n"
         "import ecofmaps.io.tables, ecofmaps.cli.loops_long\n"
         "loaded = [m for m in ('jax', 'pint', 'scipy') if m in sys.modules]\n"
         "assert not loaded, loaded\n"

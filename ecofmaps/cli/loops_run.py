@@ -1,0 +1,191 @@
+"""The work of ``ecofmaps loops`` (its options are in :mod:`ecofmaps.cli.loops`): every
+recording through the one pipeline of :mod:`ecofmaps.measured.pipeline`, in memory as one
+chunk, a long one out of core (:mod:`ecofmaps.cli.loops_long`); the table written as the
+chunks come, the summary lines, the plots and the reading along the stroke."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ecofmaps.cli import loops_long
+from ecofmaps.cli._common import CommandError, recording_options, refuse_to_overwrite
+from ecofmaps.io.files import atomic_path
+from ecofmaps.io.recordings import read_recording
+from ecofmaps.maps.cache import write_netcdf
+from ecofmaps.measured.pipeline import Reading
+from ecofmaps.measured.synthetic import EXAMPLE, example_path
+from ecofmaps.model.regimes import GROSS_SLIP
+
+__all__ = ["SUMMARY_VARIABLES", "run"]
+
+
+def _plot_names(paths) -> list[str]:
+    """A distinct file-name stem for each recording's plots."""
+    stems = [path.stem for path in paths]
+    return [
+        stem if stems.count(stem) == 1 else f"{stem}_{index}"
+        for index, stem in enumerate(stems, start=1)
+    ]
+
+
+def _analysed(index, path, recording, load, args, long_run, write, *, many, resolved_file):
+    """One recording through the pipeline: its results (all of them in memory, those the
+    summary reads of a long one), its reading along the stroke over positions (for the
+    plots and ``--resolved``, in memory only) and its warnings, printed one line each."""
+    in_memory = not recording.lazy
+    if not in_memory and resolved_file:
+        raise CommandError(
+            f"--resolved reads every loop along the stroke, which a long recording "
+            f"({path}) analysed out of core does not keep: leave out --resolved"
+        )
+    plots = args.plots is not None and in_memory
+    positions = 201 if plots or resolved_file else None
+    reading = Reading(
+        resolve=not args.no_resolve,
+        keep_loops=plots,
+        along_stroke={"positions": positions},
+        hand_back=positions is not None,
+    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            results, resolved = long_run.analyse(
+                index, path, recording, load, many=many, write=write,
+                columns=None if in_memory else SUMMARY_VARIABLES, reading=reading,
+            )  # fmt: skip
+        except ValueError as error:
+            raise recording.error(str(error)) from None
+    for warning in caught:  # one line each, naming the file, not a Python source line
+        print(f"ecofmaps loops: warning: {path.name}: {warning.message}", file=sys.stderr)
+    return results, resolved
+
+
+#: The variables of a recording's results that its summary line reads (:func:`_summary`):
+#: all that is kept of a long recording's results once their lines are written.
+SUMMARY_VARIABLES = ("regime", "gicof", "mu_resolved", "ecof", "quality")
+
+
+class _Table:
+    """The table of results, written to ``stream`` as each block of lines comes. Each block
+    begins with the header line, written once."""
+
+    def __init__(self, stream):
+        self.stream, self.started = stream, False
+
+    def write(self, text: str) -> None:
+        header, _, lines = text.partition("\n")
+        if not self.started:
+            self.stream.write(f"{header}\n")
+            self.started = True
+        self.stream.write(lines)
+        self.stream.flush()  # on disk as it comes: a block is a few MB
+
+
+def _summary(path, results, recording) -> str:
+    """One line on a recording's cycles: counts, the quality, the friction over the test."""
+    gross = results.isel(cycle=np.flatnonzero(results.regime.values == GROSS_SLIP))
+    summary = f"  {path.name}: {results.attrs['quality_summary']}"
+    if results.attrs["incomplete_cycles"]:
+        summary += f" ({results.attrs['incomplete_cycles']} incomplete dropped)"
+    summary += loops_long.skipped(results, recording)
+    if gross.cycle.size and gross.gicof.notnull().any():
+        summary += f"; GICoF median {float(gross.gicof.median()):.4f}"
+    if "mu_resolved" in gross and gross.mu_resolved.notnull().any():
+        summary += f", μ read along the stroke median {float(gross.mu_resolved.median()):.4f}"
+    ecof = gross.ecof.dropna("cycle") if gross.cycle.size else gross.ecof
+    if ecof.size:
+        summary += f"; ECoF {float(ecof[0]):.4f} (first) to {float(ecof[-1]):.4f} (last)"
+    return summary
+
+
+def run(args) -> int:
+    """Run ``ecofmaps loops`` with the parsed ``args``; the exit status."""
+    if args.example == bool(args.files):
+        raise CommandError("give one or more recording FILEs, or --example (not both)")
+    paths = [example_path()] if args.example else [Path(name) for name in args.files]
+    load = EXAMPLE["load"] if args.example and args.load is None else args.load
+    if load is None:
+        raise CommandError("--load is required: the normal load, e.g. --load 450N")
+    columns = {
+        "--displacement-col": args.displacement_col,
+        "--force-col": args.force_col,
+        "--cycle-col": args.cycle_col,
+    }
+    named = [(option, name.strip().lower()) for option, name in columns.items() if name]
+    for index, (option, name) in enumerate(named):
+        for other, other_name in named[:index]:
+            if name == other_name:
+                raise CommandError(f"{other} and {option} name the same column {name!r}")
+    if args.resolved is not None:
+        if args.no_resolve:
+            raise CommandError("--resolved writes the reading along the stroke; not --no-resolve")
+        if len(paths) > 1:
+            raise CommandError("--resolved writes the reading of one recording: give one FILE")
+    for option, target in (("--out", args.out), ("--resolved", args.resolved)):
+        if target is not None and not Path(target).parent.is_dir():
+            raise CommandError(f"cannot write {target} ({option}): its directory does not exist")
+    kinds = ("loops", "evolution") + (() if args.no_resolve else ("resolved",))
+    plots = (
+        []
+        if args.plots is None
+        else [
+            ("--plots", Path(args.plots) / f"{name}_{kind}.png")
+            for name in _plot_names(paths)
+            for kind in kinds
+        ]
+    )
+    refuse_to_overwrite([("--out", args.out), ("--resolved", args.resolved), *plots], paths)
+    long_run = loops_long.LongRun(args, paths)
+    analyses, recordings = [], []
+    many = len(paths) > 1
+    with contextlib.ExitStack() as stack:  # the table is written as it comes, renamed at the end
+        if args.out is None:  # held, and printed once every file is analysed
+            stream = io.StringIO()
+        else:
+            temporary = stack.enter_context(atomic_path(args.out))
+            stream = stack.enter_context(open(temporary, "w", encoding="utf-8", newline=""))
+        table = _Table(stream)
+        for index, path in enumerate(paths):
+            recording = read_recording(path, lazy=long_run.lazy, **recording_options(args))
+            resolved_file = args.resolved is not None
+            analysed = _analysed(
+                index, path, recording, load, args, long_run, table.write, many=many,
+                resolved_file=resolved_file,
+            )  # fmt: skip
+            analyses.append(analysed)
+            recordings.append(recording)
+        if args.plots is not None:
+            # matplotlib only when plots are asked for
+            from ecofmaps.figures import cof_evolution, measured_loops, resolved_loops, save_figure
+
+            folder = Path(args.plots)
+            folder.mkdir(parents=True, exist_ok=True)
+            for name, (results, resolved) in zip(_plot_names(paths), analyses, strict=True):
+                save_figure(
+                    measured_loops(results, resolved=resolved), folder / f"{name}_loops.png"
+                )
+                save_figure(cof_evolution(results), folder / f"{name}_evolution.png")
+                if resolved is not None:
+                    save_figure(resolved_loops(resolved, results), folder / f"{name}_resolved.png")
+        if args.resolved is not None:
+            write_netcdf(analyses[0][1], args.resolved)
+    if args.out is None:
+        sys.stdout.write(table.stream.getvalue())
+        for path, (results, _), recording in zip(paths, analyses, recordings, strict=True):
+            print(_summary(path, results, recording).strip(), file=sys.stderr)
+        return 0
+    long_run.finish()
+    print(f"wrote {args.out}: {sum(r.cycle.size for r, _ in analyses)} cycles")
+    for path, (results, _), recording in zip(paths, analyses, recordings, strict=True):
+        print(_summary(path, results, recording))
+    if args.resolved is not None:
+        print(f"  the loops read along the stroke in {args.resolved}")
+    if args.plots is not None:
+        print(f"  plots in {args.plots}")
+    return 0
