@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ecofmaps._interrupts import Interrupted
 from ecofmaps.cli._common import CommandError
 from ecofmaps.io.tables import results_csv
 from ecofmaps.measured.cycles import Cycles
@@ -216,14 +217,12 @@ class LongRun:
                     write, columns, reading,
                 )  # fmt: skip
         except _Interrupted as stop:  # counted once the runner is closed: no task runs
-            if self.partial is not None:
-                print(
-                    f"ecofmaps: {len(self.partial.kept(index))} of {stop.blocks} blocks of "
-                    f"{path} are kept in {self.partial.folder}: run the same command with "
-                    "--resume to continue",
-                    file=sys.stderr,
-                )
-            raise
+            if self.partial is None:
+                raise
+            raise Interrupted(
+                f"{len(self.partial.kept(index))} of {stop.blocks} blocks of {path} are kept "
+                f"in {self.partial.folder}: run the same command with --resume to continue"
+            ) from None
         except MissingSampleError as error:
             raise recording.error(MISSING, error.sample) from None
         return analysis.finish([parts.pop(k) for k in sorted(parts)]), resolved
@@ -268,7 +267,7 @@ def _analyse(index, path, recording, load, args, runner, partial, many, write, c
         nan_policy=args.nan_policy,
         reading=reading,
         cycles=None if partial is None else partial.cycles(index),
-        samples=None if recording.lazy else recording.size,
+        one_chunk=not recording.lazy,
         **options,
     )
     done = {}

@@ -283,7 +283,7 @@ def _run(
     if not any(is_lazy(a) for a in (x, q, label, mask)):
         if nan_policy == "raise":
             _raise_at_missing(x, q, label, mask)
-        analysis = Analysis(x, q, float(load), label, samples=x.shape[0], **arrays)
+        analysis = Analysis(x, q, float(load), label, one_chunk=True, **arrays)
         return analysis.run()
     if reading.keep_loops:
         raise ValueError(

@@ -254,8 +254,9 @@ class Analysis:
     cycles : Cycles, optional
         The cycles, if found before (a resumed run); else they are found here.
     samples : int, optional
-        Samples per chunk (about; default :data:`TASK_SAMPLES`); a recording in memory is
-        one chunk (``samples`` of its size or more).
+        Samples per chunk (about; default :data:`TASK_SAMPLES`).
+    one_chunk : bool
+        Analyse the recording as one chunk (a recording in memory).
     **options
         The checked options of :func:`ecofmaps.measured.options.check_options`.
 
@@ -289,6 +290,7 @@ class Analysis:
         reading=None,
         cycles=None,
         samples=None,
+        one_chunk=False,
         **options,
     ):
         self.arrays = (displacement, force)
@@ -309,7 +311,8 @@ class Analysis:
             raise missing_sample_error(cycles.first_missing)
         if cycles.label.size == 0:
             raise no_cycle_error(int(displacement.shape[0]))
-        self.tasks = _tasks(cycles.count, samples or TASK_SAMPLES)
+        whole = [slice(0, cycles.label.size)]
+        self.tasks = whole if one_chunk else _tasks(cycles.count, samples or TASK_SAMPLES)
         if self.reading.one_grid and len(self.tasks) > 1:
             raise ValueError(
                 "the reading along the stroke on a grid of positions common to all cycles "
@@ -398,7 +401,7 @@ class Analysis:
         if len(parts) == 1:
             results = parts[0]
         else:
-            results = xr.concat(parts, "cycle", coords="minimal", compat="override")
+            results = xr.concat(parts, "cycle", coords="minimal", compat="override", join="outer")
         results = self.tally.finish(results, self.cycles, self.cycles_from, self.options)
         if self.reading.resolve:  # the summary of the reading's quality
             results.attrs["quality_summary"] = quality_summary(results["quality"].values)
@@ -416,7 +419,7 @@ class Analysis:
         if len(read) == 1:
             resolved = read[0]
         elif read:
-            resolved = xr.concat(read, "cycle", coords="minimal", compat="override")
+            resolved = xr.concat(read, "cycle", coords="minimal", compat="override", join="outer")
         return self.finish(parts), resolved
 
 
