@@ -1,0 +1,38 @@
+"""Pages for a browser: a test's self-contained HTML report and a live explorer of the model.
+
+Both need the extra ``web`` (Bokeh, Panel): ``pip install "ecofmaps[web]"``. Importing this
+package needs neither; :mod:`ecofmaps.web.report` and :mod:`ecofmaps.web.explorer` do.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+
+__all__ = ["INSTALL_WEB", "missing_web_packages"]
+
+#: The one line that tells how to install what the pages need.
+INSTALL_WEB = 'the web pages need Bokeh and Panel: pip install "ecofmaps[web]"'
+
+#: The packages of the extra ``web``, by import name.
+_WEB_PACKAGES = ("bokeh", "panel")
+
+
+def missing_web_packages(packages=_WEB_PACKAGES) -> list[str]:
+    """The packages of the extra ``web`` that cannot be imported here.
+
+    Parameters
+    ----------
+    packages : sequence of str
+        Import names to look for; by default those of the extra ``web``.
+
+    Returns
+    -------
+    missing : list of str
+        Those not installed, in the order given; empty when the pages can be made.
+
+    Examples
+    --------
+    >>> missing_web_packages(["json", "no_such_package_for_ecofmaps"])
+    ['no_such_package_for_ecofmaps']
+    """
+    return [name for name in packages if importlib.util.find_spec(name) is None]

@@ -1,0 +1,453 @@
+"""A fretting test's results as one HTML page that opens offline (``ecofmaps loops --report``).
+
+The page is Bokeh's, with its JavaScript and CSS written inline (:data:`bokeh.resources.INLINE`),
+so it fetches nothing: it can be sent by e-mail and opened from a disk. It shows
+
+- the ECoF, the GICoF and the friction read along the stroke with its :math:`\\pm 2` se band
+  against the cycle number, and below them the cycles each quality flag marks;
+- the count of every flag and what it means (:data:`ecofmaps.measured.quality.REASONS`);
+- measured loops of a few cycles (first, middle and last; the reader picks others among the
+  cycles the page carries), each with the model's steady loop for the friction and the groove
+  read along the stroke, where the cycle has them;
+- the table of ``ecofmaps loops --out`` with every column, sortable, each number as in the CSV
+  (6 significant digits);
+- the inputs (files, load, units assumed), the ecofmaps version and the date.
+"""
+
+from __future__ import annotations
+
+import datetime
+import html
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+from bokeh.embed import file_html
+from bokeh.layouts import column, row
+from bokeh.models import (
+    ColumnDataSource,
+    CustomJS,
+    DataTable,
+    Div,
+    HoverTool,
+    HTMLTemplateFormatter,
+    MultiChoice,
+    StringFormatter,
+    TableColumn,
+)
+from bokeh.palettes import Category10_10
+from bokeh.plotting import figure
+from bokeh.resources import INLINE
+
+from ecofmaps._nomenclature import QUANTITIES
+from ecofmaps._version import __version__
+from ecofmaps.io.files import atomic_path
+from ecofmaps.io.tables import results_table
+from ecofmaps.measured.quality import REASONS, SEPARATOR
+from ecofmaps.model.simulation import fretting_loop
+
+__all__ = ["LOOPS_CARRIED", "report_document", "write_report"]
+
+#: Cycles whose loops a report carries by default, spread evenly over the test: the reader
+#: picks among them in the page. Their loops are the bulk of a report of a short test.
+LOOPS_CARRIED = 60
+
+#: Loops drawn when the page opens: the first, the middle and the last carried cycle.
+_FIRST_SHOWN = 3
+
+#: Points on each slip branch of a model loop.
+_MODEL_POINTS = 40
+
+#: Width of the page's content, for a laptop screen. [px]
+_WIDTH = 1240
+
+#: The variables a report needs in the results.
+_NEEDED = ("cycle", "ecof", "gicof", "quality", "regime", "load")
+
+#: Shows a number of the table as it is (it was rounded to the CSV's 6 significant digits),
+#: and nothing for NaN, as the CSV's empty field.
+_NUMBER_CELL = (
+    '<div style="text-align: right"><%= (value == null || value !== value) ? "" : value %></div>'
+)
+
+#: Shows the loops of the cycles picked in the page: the measured loop and, where the cycle
+#: has one, the model's, each pair in one colour.
+_PICK_LOOPS = """
+const all = carried.data;
+const measured_data = {xs: [], ys: [], label: [], color: []};
+const model_data = {xs: [], ys: [], color: []};
+choice.value.forEach((name, index) => {
+    const at = all.label.indexOf(name);
+    const color = palette[index % palette.length];
+    measured_data.xs.push(all.xs[at]);
+    measured_data.ys.push(all.ys[at]);
+    measured_data.label.push(name);
+    measured_data.color.push(color);
+    if (all.model_xs[at].length > 0) {
+        model_data.xs.push(all.model_xs[at]);
+        model_data.ys.push(all.model_ys[at]);
+        model_data.color.push(color);
+    }
+});
+measured.data = measured_data;
+model.data = model_data;
+"""
+
+
+def write_report(path, results: xr.Dataset, *, loops=None, inputs=None) -> Path:
+    """Write the results of a fretting test as one HTML page that opens offline.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The HTML file to write (atomically: a temporary file renamed into place); its
+        directory must exist.
+    results : xarray.Dataset
+        From :func:`ecofmaps.analyze_loops`; with ``resolve=True`` the page also shows the
+        friction read along the stroke, and with ``keep_loops=True`` the loops.
+    loops : sequence of int, optional
+        Cycle numbers whose loops the page carries, for the reader to pick from; by
+        default :data:`LOOPS_CARRIED` spread evenly over the test, the first and the last
+        included. Needs ``keep_loops=True``.
+    inputs : mapping of str to str, optional
+        What the results were made from, shown as given (``{"files": "test.csv", "load":
+        "450 N", "units assumed": "displacement um, force N"}``); the ecofmaps version and
+        the date are added.
+
+    Returns
+    -------
+    path : pathlib.Path
+        The file written.
+
+    Raises
+    ------
+    ValueError
+        If ``results`` lack a variable of :func:`ecofmaps.analyze_loops`, ``loops`` names a
+        cycle not in them, or ``loops`` is given for results without loops.
+
+    Examples
+    --------
+    >>> import ecofmaps, tempfile, os
+    >>> displacement, force = ecofmaps.synthetic_recording(
+    ...     50e-6, 450.0, 35e6, 0.8, [0.1, 0.15, 0.2], samples_per_cycle=160)
+    >>> results = ecofmaps.analyze_loops(displacement, force, 450.0, resolve=True,
+    ...                                  keep_loops=True)
+    >>> folder = tempfile.mkdtemp()
+    >>> page = write_report(os.path.join(folder, "report.html"), results,
+    ...                     inputs={"load": "450 N"})
+    >>> page.read_text(encoding="utf-8").count("<script src=")  # nothing fetched
+    0
+    """
+    document = report_document(results, loops=loops, inputs=inputs)
+    title = "ecofmaps report" + (f": {inputs['files']}" if inputs and "files" in inputs else "")
+    text = file_html(document, INLINE, title=title)
+    with atomic_path(path) as temporary:
+        Path(temporary).write_text(text, encoding="utf-8")
+    return Path(path)
+
+
+def report_document(results: xr.Dataset, *, loops=None, inputs=None):
+    """The Bokeh layout of :func:`write_report`'s page (same parameters).
+
+    Returns
+    -------
+    document : bokeh.models.LayoutDOM
+        The page's content, for :func:`bokeh.embed.file_html` or a Bokeh server.
+    """
+    missing = [name for name in _NEEDED if name not in results.variables]
+    if missing:
+        raise ValueError(
+            f"results lack {', '.join(missing)}: give the Dataset of ecofmaps.analyze_loops"
+        )
+    evolution, flags = _evolution_figures(results)
+    parts = [
+        _header(results, inputs or {}),
+        row(column(evolution, flags), _quality_counts(results)),
+    ]
+    if "loop_displacement" in results.variables:
+        parts.append(_loops_panel(results, _carried_cycles(results, loops)))
+    elif loops is not None:
+        raise ValueError("loops needs the loops: call analyze_loops(..., keep_loops=True)")
+    else:
+        parts.append(Div(text="<p>The loops were not kept (keep_loops=False).</p>"))
+    parts.append(_table(results))
+    return column(*parts, styles={"font-family": "sans-serif", "margin": "0 12px"})
+
+
+def _label(name: str) -> str:
+    """An axis label in plain text: words, symbol and display unit, ``Slip amplitude δ* [µm]``."""
+    quantity = QUANTITIES[name]
+    words = quantity.words if quantity.label is None else quantity.label
+    text = " ".join(part for part in (words[:1].upper() + words[1:], quantity.symbol) if part)
+    return f"{text} [{quantity.axis_unit or quantity.display_unit or '1'}]"
+
+
+def _header(results: xr.Dataset, inputs: Mapping) -> Div:
+    """The title, the inputs, the version and date, and the summary of the quality."""
+    rows = dict(inputs)
+    rows["ecofmaps version"] = __version__
+    rows["written"] = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
+    if "quality_summary" in results.attrs:
+        rows["cycles"] = str(results.attrs["quality_summary"])
+    cells = "".join(
+        f"<tr><th style='text-align:left;padding-right:1em'>{html.escape(str(key))}</th>"
+        f"<td>{html.escape(str(value))}</td></tr>"
+        for key, value in rows.items()
+    )
+    return Div(
+        text=(
+            "<h1 style='margin:8px 0 4px 0;font-size:22px'>Fretting test: friction cycle by "
+            "cycle</h1><p style='margin:0 0 6px 0;max-width:1100px'>ECoF μ_E = E_d/(4Pδ*) "
+            "(eq. 1), GICoF = Q/P where the loop crosses Q = SΔ (eq. 17-18), and μ read "
+            "along the stroke, from <code>ecofmaps.analyze_loops</code>. Values that cannot "
+            "be stood behind are left out, and the quality flags say why.</p>"
+            f"<table class='ecofmaps-inputs' style='font-size:14px'>{cells}</table>"
+        ),
+        width=_WIDTH,
+    )
+
+
+def _evolution_figures(results: xr.Dataset):
+    """The coefficients of friction against the cycle, and the cycles each flag marks."""
+    cycle = results["cycle"].values
+    data = {"cycle": cycle, "quality": results["quality"].values.astype(str)}
+    for name in ("ecof", "gicof", "mu_resolved", "mu_resolved_se"):
+        data[name] = results[name].values if name in results else np.full(cycle.size, np.nan)
+    data["mu_low"] = data["mu_resolved"] - 2.0 * data["mu_resolved_se"]
+    data["mu_high"] = data["mu_resolved"] + 2.0 * data["mu_resolved_se"]
+    source = ColumnDataSource(data)
+    plot = figure(
+        width=820, height=340, title="Coefficients of friction over the test",
+        x_axis_label=_label("cycle"), y_axis_label="Coefficient of friction [1]",
+        tools="pan,box_zoom,wheel_zoom,reset,save",
+    )  # fmt: skip
+    if "mu_resolved" in results:
+        plot.varea("cycle", "mu_low", "mu_high", source=source, color="#2ca02c",
+                   alpha=0.2, legend_label="μ ± 2 se")  # fmt: skip
+        plot.line("cycle", "mu_resolved", source=source, color="#2ca02c", line_width=1.5,
+                  legend_label="μ read along the stroke")  # fmt: skip
+    lines = {"ecof": ("#ff7f0e", "ECoF μ_E"), "gicof": ("#1f77b4", "GICoF (Q/P on Q = SΔ)")}
+    for name, (color, legend) in lines.items():
+        plot.line("cycle", name, source=source, color=color, line_width=1.5, legend_label=legend)
+        if cycle.size <= 400:
+            plot.scatter("cycle", name, source=source, color=color, size=3)
+    plot.add_tools(
+        HoverTool(
+            tooltips=[
+                ("cycle", "@cycle"),
+                ("ECoF", "@ecof{0.000000}"),
+                ("GICoF", "@gicof{0.000000}"),
+                ("μ", "@mu_resolved{0.000000}"),
+                ("quality", "@quality"),
+            ],
+            mode="vline",
+            renderers=plot.renderers[-1:],
+        )
+    )
+    plot.legend.click_policy = "hide"
+    plot.add_layout(plot.legend[0], "right")  # beside the plot: the curves stay uncovered
+    return plot, _flags_figure(results, plot)
+
+
+def _flagged_cycles(results: xr.Dataset) -> dict[str, np.ndarray]:
+    """The cycles each quality reason flags, in the order of :data:`REASONS`."""
+    quality = results["quality"].values.astype(str)
+    cycle = results["cycle"].values
+    flagged = {}
+    for reason in REASONS:
+        marked = np.array([reason in text.split(SEPARATOR) for text in quality], dtype=bool)
+        if marked.any():
+            flagged[reason] = cycle[marked]
+    return flagged
+
+
+def _flags_figure(results: xr.Dataset, evolution):
+    """A strip below the coefficients: a mark at each cycle a quality reason flags."""
+    flagged = _flagged_cycles(results)
+    if not flagged:
+        return Div(text="<p>No cycle is flagged: every cycle's quality is 'ok'.</p>")
+    reasons = list(flagged)[::-1]  # the first reason at the top
+    plot = figure(
+        width=800, height=60 + 24 * len(reasons), y_range=reasons, x_range=evolution.x_range,
+        title="Quality flags (the values they leave out are NaN)",
+        x_axis_label=_label("cycle"), tools="xpan,xwheel_zoom,reset",
+    )  # fmt: skip
+    marks = ColumnDataSource(
+        {
+            "cycle": np.concatenate(list(flagged.values())),
+            "reason": [reason for reason, cycles in flagged.items() for _ in cycles],
+        }
+    )
+    plot.scatter("cycle", "reason", source=marks, marker="dash", size=10, line_width=2,
+                 color="#d62728", angle=np.pi / 2)  # fmt: skip
+    plot.add_tools(HoverTool(tooltips=[("cycle", "@cycle"), ("flag", "@reason")]))
+    return plot
+
+
+def _quality_counts(results: xr.Dataset) -> Div:
+    """The number of cycles each quality reason flags, with what it means."""
+    total = results["cycle"].size
+    quality = results["quality"].values.astype(str)
+    rows = [("ok", int(np.sum(quality == "ok")), "every value of the cycle stands")]
+    rows += [
+        (reason, cycles.size, REASONS[reason][0])
+        for reason, cycles in _flagged_cycles(results).items()
+    ]
+    cells = "".join(
+        f"<tr><td><code>{html.escape(name)}</code></td>"
+        f"<td style='text-align:right;padding:0 8px'>{count}</td>"
+        f"<td>{html.escape(meaning)}</td></tr>"
+        for name, count, meaning in rows
+    )
+    return Div(
+        text=(
+            f"<h3 style='margin:4px 0'>Quality of the {total} cycles</h3>"
+            "<table class='ecofmaps-quality' style='font-size:13px;border-collapse:collapse'>"
+            "<tr><th style='text-align:left'>flag</th><th>cycles</th>"
+            f"<th style='text-align:left'>what it means</th></tr>{cells}</table>"
+        ),
+        width=_WIDTH - 820,
+    )
+
+
+def _carried_cycles(results: xr.Dataset, loops) -> np.ndarray:
+    """The cycle numbers whose loops the page carries (see :func:`write_report`)."""
+    labels = results["cycle"].values
+    if loops is None:
+        count = min(LOOPS_CARRIED, labels.size)
+        return labels[np.unique(np.round(np.linspace(0, labels.size - 1, count)).astype(int))]
+    chosen = np.asarray(list(loops)).astype(labels.dtype)
+    unknown = chosen[~np.isin(chosen, labels)]
+    if unknown.size:
+        raise ValueError(
+            f"loops names cycle {unknown[0]}, which the results do not hold "
+            f"(cycles {labels[0]} to {labels[-1]})"
+        )
+    return chosen
+
+
+def _model_loops(results: xr.Dataset) -> tuple[list, list]:
+    """The model's steady loop of each cycle, for its friction and groove read along the
+    stroke, in µm and N; empty where the cycle has no such reading."""
+    empty = np.zeros(0)
+    count = results["cycle"].size
+    if "mu_resolved" not in results or "aspect_ratio" not in results:
+        return [empty] * count, [empty] * count
+    values = {name: results[name].values for name in
+              ("amplitude", "stiffness", "mu_resolved", "aspect_ratio")}  # fmt: skip
+    usable = np.all([np.isfinite(value) for value in values.values()], axis=0)
+    usable &= (values["amplitude"] > 0) & (values["stiffness"] > 0)
+    usable &= (values["mu_resolved"] > 0) & (values["aspect_ratio"] >= 0)
+    xs, ys = [empty] * count, [empty] * count
+    if usable.any():
+        displacement, force = fretting_loop(
+            values["amplitude"][usable], float(results["load"]), values["stiffness"][usable],
+            values["mu_resolved"][usable], values["aspect_ratio"][usable], num=_MODEL_POINTS,
+        )  # fmt: skip
+        displacement = np.round(np.asarray(displacement) * 1e6, 4)
+        force = np.round(np.asarray(force), 3)
+        for row_index, index in enumerate(np.flatnonzero(usable)):
+            xs[index], ys[index] = displacement[row_index], force[row_index]
+    return xs, ys
+
+
+def _loops_panel(results: xr.Dataset, carried: np.ndarray):
+    """The measured loops of the picked cycles with their model loops, and the picker."""
+    chosen = results.sel(cycle=carried)
+    names = [f"cycle {label}" for label in carried]
+    model_xs, model_ys = _model_loops(chosen)
+    measured_x = np.round(chosen["loop_displacement"].values * 1e6, 4)
+    measured_y = np.round(chosen["loop_force"].values, 3)
+    kept = [np.isfinite(x) & np.isfinite(y) for x, y in zip(measured_x, measured_y, strict=True)]
+    all_loops = ColumnDataSource(
+        {
+            "label": names,
+            "xs": [x[keep] for x, keep in zip(measured_x, kept, strict=True)],
+            "ys": [y[keep] for y, keep in zip(measured_y, kept, strict=True)],
+            "model_xs": model_xs,
+            "model_ys": model_ys,
+        }
+    )
+    middle = len(names) // 2
+    first = list(dict.fromkeys([names[0], names[middle], names[-1]]))[:_FIRST_SHOWN]
+    palette = list(Category10_10)
+    measured, model = ColumnDataSource(name="shown-loops"), ColumnDataSource(name="shown-models")
+    plot = figure(
+        width=700, height=460, title="Measured loops (lines) and the model's (dashed)",
+        x_axis_label=_label("displacement"), y_axis_label=_label("force"),
+        tools="pan,box_zoom,wheel_zoom,reset,save",
+    )  # fmt: skip
+    plot.multi_line("xs", "ys", source=measured, color="color", line_width=1.6,
+                    legend_field="label")  # fmt: skip
+    plot.multi_line("xs", "ys", source=model, color="color", line_width=1.4, line_dash="dashed")
+    plot.legend.location = "top_left"
+    choice = MultiChoice(
+        title="Cycles shown (pick others; the page carries the loops of "
+        f"{len(names)} cycles spread over the test)",
+        value=first, options=names, width=480, name="loop-picker",
+    )  # fmt: skip
+    update = CustomJS(
+        args=dict(carried=all_loops, choice=choice, measured=measured, model=model,
+                  palette=palette),
+        code=_PICK_LOOPS,
+    )  # fmt: skip
+    choice.js_on_change("value", update)
+    _fill_shown(all_loops.data, first, palette, measured, model)
+    note = Div(
+        text=(
+            "<p>Each loop is centred (the sensors' offsets removed). The dashed loop is the "
+            "model's steady loop (eq. 9, 10, 16) for the cycle's amplitude, rig stiffness S, "
+            "and the friction μ and groove z_o/x_o read along the stroke; a cycle without "
+            "that reading has none.</p>"
+        ),
+        width=480,
+    )
+    return row(plot, column(choice, note))
+
+
+def _fill_shown(carried: dict, names, palette, measured, model) -> None:
+    """Put the loops of cycles ``names`` into the sources drawn, as :data:`_PICK_LOOPS` does."""
+    indices = [carried["label"].index(name) for name in names]
+    colors = [palette[k % len(palette)] for k in range(len(names))]
+    measured.data = {
+        "xs": [carried["xs"][i] for i in indices],
+        "ys": [carried["ys"][i] for i in indices],
+        "label": list(names),
+        "color": colors,
+    }
+    modelled = [(i, color) for i, color in zip(indices, colors, strict=True)
+                if len(carried["model_xs"][i])]  # fmt: skip
+    model.data = {
+        "xs": [carried["model_xs"][i] for i, _ in modelled],
+        "ys": [carried["model_ys"][i] for i, _ in modelled],
+        "color": [color for _, color in modelled],
+    }
+
+
+def _table(results: xr.Dataset):
+    """The table of ``ecofmaps loops --out``: every column, numbers to 6 significant digits."""
+    table = results_table(results)
+    data, columns = {}, []
+    for name in table.columns:
+        values = table[name].to_numpy()
+        if values.dtype.kind == "f":
+            values = np.array([float(f"{value:.6g}") for value in values])
+            formatter = HTMLTemplateFormatter(template=_NUMBER_CELL)
+        else:
+            formatter = StringFormatter()
+        width = 200 if name == "quality" else max(60, 8 * len(name) + 16)  # the name shows
+        columns.append(TableColumn(field=name, title=name, formatter=formatter, width=width))
+        data[name] = values
+    heading = Div(
+        text=(
+            "<h3 style='margin:12px 0 4px 0'>The table (as <code>ecofmaps loops --out</code> "
+            "writes it; click a column's name to sort)</h3>"
+        ),
+        width=_WIDTH,
+    )
+    grid = DataTable(
+        source=ColumnDataSource(data), columns=columns, width=_WIDTH, height=380,
+        index_position=None, sortable=True, autosize_mode="none", css_classes=["ecofmaps-table"],
+    )  # fmt: skip
+    return column(heading, grid)

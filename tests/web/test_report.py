@@ -1,0 +1,155 @@
+"""The HTML report of a test (ecofmaps.web.report): what it holds, its size, and the page in a
+real browser, opened from file:// with nothing fetched."""
+
+import csv
+import html
+import io
+import re
+
+import numpy as np
+import pytest
+from bokeh.models import Div
+
+import ecofmaps
+from ecofmaps.io.tables import results_csv
+from ecofmaps.measured.quality import REASONS
+from ecofmaps.web.report import LOOPS_CARRIED, report_document, write_report
+from tests.web.pages import CANVAS_INK, console_errors, deep_texts, wait_for
+
+INPUTS = {"files": "test.csv", "load": "450 N", "units assumed": "displacement um, force N"}
+
+
+@pytest.fixture(scope="module")
+def results():
+    """40 cycles of a deepening groove, one of them damaged (its force turned over)."""
+    displacement, force = ecofmaps.synthetic_recording(
+        50e-6, 450.0, 35e6, 0.8, np.linspace(0.02, 0.2, 40), samples_per_cycle=160,
+        force_noise=4.0, displacement_noise=2.5e-7, seed=3,
+    )  # fmt: skip
+    force[160 * 5 : 160 * 5 + 80] *= -1.0
+    with pytest.warns(ecofmaps.measured.quality.LoopQualityWarning):
+        return ecofmaps.analyze_loops(displacement, force, 450.0, resolve=True, keep_loops=True)
+
+
+@pytest.fixture(scope="module")
+def page(results, tmp_path_factory):
+    """The report of ``results``, written."""
+    return write_report(tmp_path_factory.mktemp("report") / "r.html", results, inputs=INPUTS)
+
+
+def test_the_page_fetches_nothing(page):
+    text = page.read_text(encoding="utf-8")
+    assert not re.search(r"<script[^>]*\bsrc=", text)
+    assert not re.search(r"<link[^>]*\bhref=", text)
+    assert "Bokeh" in text  # the library is in the page, inline
+
+
+def test_the_page_gives_the_inputs_version_and_flag_meanings(results):
+    document = report_document(results, inputs=INPUTS)
+    text = html.unescape("".join(div.text for div in document.select({"type": Div})))
+    for label, value in INPUTS.items():
+        assert f"{label}</th><td>{value}<" in text
+    assert ecofmaps.__version__ in text
+    flagged = {r for q in results.quality.values for r in str(q).split("+")} - {"ok"}
+    assert flagged  # the damaged cycle
+    quality = results.quality.values
+    for reason in flagged:
+        count = sum(reason in str(q).split("+") for q in quality)
+        assert (
+            f"<code>{reason}</code></td><td style='text-align:right;padding:0 8px'>{count}<" in text
+        )
+        assert REASONS[reason][0] in text
+
+
+def test_the_page_carries_some_loops_and_the_model(results):
+    document = report_document(results, loops=[1, 7, 40])
+    picker = document.select_one({"name": "loop-picker"})
+    assert picker.options == ["cycle 1", "cycle 7", "cycle 40"]
+    assert picker.value == ["cycle 1", "cycle 7", "cycle 40"]
+    models = document.select_one({"name": "shown-models"})
+    assert len(models.data["xs"]) == 3  # every cycle here has μ and z_o/x_o read
+    default = report_document(results).select_one({"name": "loop-picker"})
+    assert len(default.options) == min(LOOPS_CARRIED, results.cycle.size)
+    assert default.value == ["cycle 1", "cycle 21", "cycle 40"]
+
+
+def test_bad_arguments_say_what_is_wrong(results, tmp_path):
+    with pytest.raises(ValueError, match="loops names cycle 99"):
+        write_report(tmp_path / "r.html", results, loops=[1, 99])
+    with pytest.raises(ValueError, match="keep_loops=True"):
+        write_report(tmp_path / "r.html", results.drop_vars(["loop_displacement", "loop_force"]),
+                     loops=[1])  # fmt: skip
+    with pytest.raises(ValueError, match="results lack quality"):
+        write_report(tmp_path / "r.html", results.drop_vars("quality"))
+    with pytest.raises(OSError):
+        write_report(tmp_path / "no-such-folder" / "r.html", results)
+    assert list(tmp_path.iterdir()) == []  # nothing half written
+
+
+def test_ten_thousand_cycles_stay_under_5_MB(results, tmp_path):
+    """A 1e4-cycle test (the 40 cycles repeated): the table is all there, the loops a subset."""
+    cycles = 10_000
+    long = results.isel(cycle=np.arange(cycles) % results.cycle.size)
+    long = long.assign_coords(cycle=np.arange(1, cycles + 1))
+    page = write_report(tmp_path / "long.html", long, inputs=INPUTS)
+    assert page.stat().st_size < 5e6, page.stat().st_size
+
+
+# --- in the browser ---------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def opened(browser, page):
+    """The report, opened from file:// (its first table rows drawn)."""
+    browser.get(page.as_uri())
+    wait_for(lambda: deep_texts(browser, ".slick-row"))
+    return browser
+
+
+def test_the_page_loads_without_console_errors(opened):
+    assert console_errors(opened) == []
+
+
+def test_the_plots_are_drawn(opened):
+    canvases = wait_for(lambda: [c for c in opened.execute_script(CANVAS_INK) if c[2] > 1000])
+    assert len(canvases) >= 3  # friction over the cycles, the flags, the loops
+
+
+def test_the_table_shows_the_numbers_of_the_csv(opened, results):
+    rows = list(csv.DictReader(io.StringIO(results_csv(results))))
+    columns = list(rows[0])
+    shown = deep_texts(opened, ".slick-row")
+    assert len(shown) >= 5
+    cells = opened.execute_script(
+        """
+        const rows = [];
+        (function visit(root) {
+            root.querySelectorAll('.slick-row').forEach(r =>
+                rows.push(Array.from(r.querySelectorAll('.slick-cell')).map(c => c.textContent)));
+            root.querySelectorAll('*').forEach(e => { if (e.shadowRoot) visit(e.shadowRoot); });
+        })(document);
+        return rows;
+        """
+    )
+    by_cycle = {row["cycle"]: row for row in rows}
+    compared = 0
+    for texts in cells:
+        assert len(texts) == len(columns)
+        expected = by_cycle[texts[0].strip()]
+        for column, text in zip(columns, texts, strict=True):
+            text, wanted = text.strip(), expected[column]
+            try:
+                assert float(text) == float(wanted), (column, text, wanted)
+            except ValueError:  # text columns, and NaN: an empty field in the CSV
+                assert text == wanted, (column, text, wanted)
+            compared += 1
+    assert compared >= 5 * len(columns)
+
+
+def test_picking_a_cycle_shows_its_loop(opened):
+    opened.execute_script(
+        "Bokeh.documents[0].get_model_by_name('loop-picker').value = ['cycle 2', 'cycle 30'];"
+    )
+    shown = "return Bokeh.documents[0].get_model_by_name('shown-loops').data.label;"
+    wait_for(lambda: list(opened.execute_script(shown)) == ["cycle 2", "cycle 30"], timeout=10)
+    assert console_errors(opened) == []
