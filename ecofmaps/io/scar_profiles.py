@@ -5,7 +5,9 @@ the height (``x`` and ``z`` in µm by default), from a comma-, tab- or whitespac
 file with a header line (the columns are read as :func:`ecofmaps.read_recording` reads
 them), levels the trace on the unworn shoulders and returns the
 :class:`~ecofmaps.model.profiles.ScarProfile` the model uses. A damaged file raises
-:class:`ScarProfileError`, which names the file and the 1-based line.
+:class:`ScarProfileError`, which names the file and the 1-based line; what the reading
+decided that the user must see (outliers replaced, ambiguous edges beside pile-up ridges)
+is a :class:`~ecofmaps.model.profiles.ScarProfileWarning` naming the file and the lines.
 """
 
 from __future__ import annotations
@@ -14,8 +16,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ecofmaps._codes import warn
 from ecofmaps.io.files import FileLineError
-from ecofmaps.model.profiles import ScarProfile, scar_profile
+from ecofmaps.io.recording_types import RecordingError
+from ecofmaps.io.text import text_blocks
+from ecofmaps.model.profiles import ScarProfile, ScarProfileWarning, scar_profile_and_findings
 
 __all__ = ["ScarProfileError", "read_scar_profile"]
 
@@ -34,6 +39,7 @@ def read_scar_profile(
     level=True,
     half_width=None,
     smoothing=None,
+    remove_outliers=True,
 ) -> ScarProfile:
     """Read a wear-scar profile (a profilometer trace across the scar) from a text file.
 
@@ -58,11 +64,26 @@ def read_scar_profile(
         The scar's half-width, overriding the detected one. [m]
     smoothing : float, optional
         Smoothing length of the slopes; default 2 % of the half-width, 0 for none. [m]
+    remove_outliers : bool
+        Replace spikes and dropouts (a Hampel filter,
+        :func:`~ecofmaps.model.profiles.outlying_samples`) by linear interpolation between
+        the nearest samples kept (on by default).
 
     Returns
     -------
     profile : ScarProfile
-        In SI units (m), positions relative to the scar's centre.
+        In SI units (m), positions relative to the scar's centre; ``replaced`` marks the
+        samples replaced, ``alternative_half_width`` is the half-width not taken when the
+        edges were ambiguous (else NaN).
+
+    Warns
+    -----
+    ScarProfileWarning
+        Naming the file: for outliers replaced (their count, and each one's line, position
+        and deviation from its neighbours' median), and for ambiguous edges (a band between
+        pile-up ridges wider than the groove below the unworn surface's line: both
+        half-widths, the band's taken; ``half_width=`` chooses). See
+        :func:`ecofmaps.scar_profile`.
 
     Raises
     ------
@@ -85,9 +106,6 @@ def read_scar_profile(
     >>> round(float(p.half_width) * 1e6), round(float(p.aspect_ratio), 3)
     (500, 0.16)
     """
-    from ecofmaps.io.recording_types import RecordingError
-    from ecofmaps.io.text import text_blocks
-
     path = Path(path)
     options = {
         "columns": {"x": x_column, "z": z_column},
@@ -119,8 +137,16 @@ def read_scar_profile(
             "positions)",
         )
     try:
-        return scar_profile(x, z, half_width=half_width, smoothing=smoothing, level=level)
+        profile, findings = scar_profile_and_findings(
+            x, z, half_width=half_width, smoothing=smoothing, level=level,
+            remove_outliers=remove_outliers,
+        )  # fmt: skip
     except ValueError as error:
         raise ScarProfileError(
             path, lines[0], f"the trace (lines {lines[0]}-{lines[-1]}): {error}"
         ) from None
+    for finding in findings:
+        text = finding.text([f"line {lines[i]}" for i in finding.samples])
+        warn(ScarProfileWarning(f"{path}: {text}", alternative=finding.alternative),
+             ScarProfileWarning)  # fmt: skip
+    return profile

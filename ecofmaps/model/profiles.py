@@ -32,22 +32,44 @@ parabola through each sample and its two neighbours. The edges and the worn area
 read on heights smoothed only over one sample spacing (not at all with ``smoothing=0``),
 since heavier smoothing would move an edge where the slope jumps.
 
+*Outliers.* First, spikes and dropouts (a sample far from its neighbours' median; a
+Hampel filter, :func:`outlying_samples`: the 8 nearest other samples, 6 scaled MADs) are
+replaced by linear interpolation between the nearest samples kept, and listed in a
+:class:`ScarProfileWarning` (``remove_outliers=False`` keeps them).
+
 *Reference line (the unworn surface).* A straight line (offset and tilt) fitted by least
-squares to the *shoulders*: the samples farther than 1.5 half-widths from the scar centre
-(1.25 or 1.1 when the trace is too short to leave 5 samples on each side there). It starts
-from the outer fifths of the trace and is refitted with the edges it gives until they
-settle.
+squares to the *shoulders*: the samples beyond the disturbed band (below) and farther than
+1.5 half-widths from the scar centre (1.25 or 1.1 when the trace is too short to leave 5
+samples on each side there), without those farther from the line than the band's
+threshold (debris) if 5 are left on each side. It starts from the outer fifths of the
+trace and is refitted with the edges it gives until they settle.
 
 *Edges.* From the deepest point below the reference line, the first samples on either side
 that reach the line (to within :math:`10^{-9}` of the depth); the edge is where the wall,
 extended by a straight line, reaches it. The straight line runs through two samples of the
 wall beyond the reach of the light smoothing from the last sample below the line (the last
 two without smoothing): exact for a straight wall cut into a flat surface, second order in
-that distance for a curved one. The half-width is half the distance of the two
-edges, the centre their midpoint; ``half_width=`` overrides the half-width (the centre
-stays the detected one). The depth is the largest depth of the smoothed profile below the
-line between the edges, and the worn area the area between the line and the profile
-there. A depression no deeper
+that distance for a curved one. These are the *groove's* edges.
+
+*Pile-up ridges and the disturbed band.* The band around the groove is disturbed: its
+samples lie farther from the line than 5 times the shoulders' noise and than 2 % of the
+depth, with no quiet stretch longer than a quarter of the groove's half-width (and than 10
+sample spacings) between them. Going inwards from the band's outer end, the first crest
+that stands higher than that threshold above the line is a pile-up ridge; the band's edge
+is the foot of its inner flank, where the flank reaches the line or stops falling (rises by
+the threshold again); without a ridge, the band's outermost sample. Where the flank
+reaches the line at the groove's own edge (a scar whose walls run into its ridges), the
+edges are the groove's. When the band between the ridges is wider than the groove by more
+than :data:`AMBIGUOUS_EDGES` (10 %: a shallow groove inside a wider worn track, or a
+roughness valley inside a disturbed band), the edges are ambiguous: the band's are taken,
+and a :class:`ScarProfileWarning` gives both half-widths (``alternative_half_width`` keeps
+the groove's); which one the model needs is the user's judgement (``half_width=``).
+
+The half-width is half the distance of the two edges, the centre their midpoint;
+``half_width=`` overrides the half-width (the centre stays that of the detected edges,
+of the groove or of the band, whichever is nearer in width). The depth is the largest
+depth of the smoothed profile below the line between the edges, and the worn area the area
+between the line and the profile there. A depression no deeper
 than 5 times the shoulders' noise (1.4826 times their median absolute deviation), or than
 5 % of the trace's relief about the line (so a bump is not taken for a scar), is not a scar.
 
@@ -64,17 +86,32 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ecofmaps._codes import warn
+
 __all__ = [
+    "AMBIGUOUS_EDGES",
     "AUTO_SMOOTHING",
     "MIN_SCAR_SAMPLES",
+    "OUTLIER_NEIGHBOURS",
+    "OUTLIER_THRESHOLD",
     "ScarProfile",
+    "ScarProfileWarning",
+    "outlying_samples",
     "scar_profile",
+    "scar_profile_and_findings",
 ]
 
 #: Default smoothing length as a fraction of the scar's half-width. [1]
 AUTO_SMOOTHING = 0.02
 #: Fewest samples a measured profile must have between the scar's edges.
 MIN_SCAR_SAMPLES = 20
+#: Outliers: neighbours on each side of a sample whose median and MAD it is judged by.
+OUTLIER_NEIGHBOURS = 4
+#: Outliers: farther than this many scaled MADs (1.4826 MAD) from the neighbours' median.
+OUTLIER_THRESHOLD = 6.0
+#: The edges are ambiguous when the band between the ridges is wider than the groove below
+#: the unworn surface's line by more than this fraction of the groove's half-width. [1]
+AMBIGUOUS_EDGES = 0.1
 
 # Shoulders for the reference line: farther than these many half-widths from the centre
 # (the first that leaves _MIN_SHOULDER samples on each side).
@@ -84,6 +121,12 @@ _MIN_SHOULDER = 5
 # and than this fraction of the relief (highest minus lowest) about the reference line.
 _NOISE_FACTOR = 5.0
 _MIN_RELIEF = 0.05
+# The disturbed band: samples farther from the line than _NOISE_FACTOR times the noise and
+# than this fraction of the depth, with no quiet stretch longer than this fraction of the
+# groove's half-width and than _BAND_GAP sample spacings between them.
+_BAND_FLOOR = 0.02
+_BAND_GAP_WIDTH = 0.25
+_BAND_GAP = 10
 # Local quadratic fits reach this many standard deviations of their Gaussian weights, which
 # are lowered to reach zero there (so a sample's weight never jumps as positions move).
 _REACH = 4.0
@@ -122,6 +165,14 @@ class ScarProfile(NamedTuple):
         levelled). [m]
     reference_slope : jax.Array, shape ()
         Tilt of the unworn surface, in the frame of ``slope`` (0 when levelled). [1]
+    alternative_half_width : jax.Array, shape ()
+        The other plausible half-width when the edges were ambiguous (the groove below the
+        unworn surface's line when the band between pile-up ridges was taken, see the
+        module docstring), NaN when they were not (or the half-width was given). [m]
+    replaced : jax.Array, shape (N,) or ()
+        1 where the sample was an outlier (a spike or dropout, :func:`outlying_samples`)
+        and its height was interpolated from its neighbours', else 0; a scalar 0 when no
+        sample was tested (the analytic families). [1]
 
     Notes
     -----
@@ -139,6 +190,8 @@ class ScarProfile(NamedTuple):
     centre: jax.Array
     reference_height: jax.Array
     reference_slope: jax.Array
+    alternative_half_width: jax.Array = float("nan")
+    replaced: jax.Array = 0.0
 
     @property
     def aspect_ratio(self):
@@ -152,9 +205,10 @@ class ScarProfile(NamedTuple):
 
 
 def _profile(position, height, slope, depth, half_width, worn_area, centre=0.0,
-             reference_height=0.0, reference_slope=0.0) -> ScarProfile:  # fmt: skip
+             reference_height=0.0, reference_slope=0.0, alternative_half_width=np.nan,
+             replaced=0.0) -> ScarProfile:  # fmt: skip
     values = (position, height, slope, depth, half_width, worn_area, centre,
-              reference_height, reference_slope)  # fmt: skip
+              reference_height, reference_slope, alternative_half_width, replaced)  # fmt: skip
     # JAX's 64-bit mode is on only inside the public entry points (importing ecofmaps does
     # not switch it on): without it these arrays would be float32.
     with jax.enable_x64(True):
@@ -248,6 +302,117 @@ def local_quadratic(x: np.ndarray, z: np.ndarray, smoothing: float):
     return height, slope
 
 
+class ScarProfileWarning(UserWarning):
+    """What reading a measured profile decided that its user must see.
+
+    Outliers replaced (``samples``: their indices in the trace, ``details``: what each
+    shows) or ambiguous edges (``alternative``: the other half-width). Callers that know
+    where the samples came from (a file's lines) name them with :meth:`text`.
+
+    Attributes
+    ----------
+    summary : str
+        The finding, without the samples.
+    samples : tuple of int
+        Indices of the samples concerned in the trace as given.
+    details : tuple of str
+        What each sample shows (its position and deviation), in the order of ``samples``.
+    alternative : float or None
+        For ambiguous edges, the half-width not taken (``half_width=`` takes it). [m]
+    """
+
+    def __init__(self, summary: str, samples=(), details=(), alternative=None):
+        self.summary = summary
+        self.samples = tuple(int(i) for i in samples)
+        self.details = tuple(details)
+        self.alternative = alternative
+        hint = "" if alternative is None else f"; half_width={alternative:.6g} (m) takes the groove"
+        super().__init__(self.text([f"sample {i}" for i in self.samples]) + hint)
+
+    def text(self, labels) -> str:
+        """The finding with each sample named by ``labels`` (at most 10 listed)."""
+        if not self.samples:
+            return self.summary
+        shown = [f"{label} ({detail})" for label, detail in zip(labels, self.details, strict=True)]
+        more = len(shown) - 10
+        listed = "; ".join(shown[:10]) + (f"; and {more} more" if more > 0 else "")
+        return f"{self.summary}: {listed}"
+
+
+def _neighbours(n: int, count: int) -> np.ndarray:
+    """Indices, shape (n, 2 count), of the ``2 count`` nearest other samples of each sample
+    (``count`` each side, shifted inwards at the ends of the trace)."""
+    rows = np.arange(n)
+    start = np.clip(rows - count, 0, n - 2 * count - 1)
+    window = start[:, None] + np.arange(2 * count + 1)[None, :]
+    others = np.where(window < rows[:, None], window, window + 1)
+    return others[:, : 2 * count]
+
+
+def outlying_samples(x, z, neighbours=OUTLIER_NEIGHBOURS, threshold=OUTLIER_THRESHOLD):
+    r"""Which samples of a trace are outliers (spikes, dropouts): a Hampel filter.
+
+    Parameters
+    ----------
+    x, z : array_like, shape (N,)
+        Positions (strictly increasing) and heights. [m]
+    neighbours : int
+        Samples on each side that a sample is judged by (shifted inwards at the ends of the
+        trace). A run of up to ``neighbours - 1`` outliers is found.
+    threshold : float
+        How many scaled MADs from the neighbours' median make an outlier. [1]
+
+    Returns
+    -------
+    outlier : numpy.ndarray of bool, shape (N,)
+
+    Notes
+    -----
+    A sample is an outlier when it is farther from the median :math:`m` of its
+    ``2 neighbours`` nearest neighbours (itself left out) than ``threshold`` times the
+    larger of their scaled median absolute deviation :math:`1.4826\,\mathrm{MAD}` and the
+    trace's noise (:math:`1.4826/\sqrt{1.5}` times the median distance of a sample from the
+    straight line through its two neighbours, the standard deviation of white noise). A
+    spike is far from its neighbours' median; a scar's edge, a kink, a step between
+    two samples or the bottom of a V is not (the median of the neighbours on both sides lies
+    within about 2 MADs of them). With the defaults (8 neighbours, 6 MADs) no sample of
+    white noise was flagged in 2e5.
+    """
+    x, z = _array("x", x), _array("z", z)
+    if neighbours < 1 or 2 * neighbours + 1 > z.size:
+        raise ValueError(f"neighbours must be >= 1 and leave {2 * neighbours + 1} samples")
+    around = z[_neighbours(z.size, int(neighbours))]
+    median = np.median(around, axis=1)
+    spread = 1.4826 * np.median(np.abs(around - median[:, None]), axis=1)
+    between = z[:-2] + (z[2:] - z[:-2]) * (x[1:-1] - x[:-2]) / (x[2:] - x[:-2])
+    noise = 1.4826 / np.sqrt(1.5) * np.median(np.abs(z[1:-1] - between))
+    scale = np.maximum(spread, noise)
+    return np.abs(z - median) > threshold * scale
+
+
+def _without_outliers(x, z):
+    """Heights with their outliers replaced by linear interpolation, the mask of those, and
+    the warning that lists them (or None)."""
+    outlier = outlying_samples(x, z)
+    if not outlier.any():
+        return z, outlier, None
+    kept = ~outlier
+    cleaned = z.copy()
+    cleaned[outlier] = np.interp(x[outlier], x[kept], z[kept])
+    samples = np.flatnonzero(outlier)
+    details = [
+        f"x = {x[i] * 1e6:.6g} µm, {abs(z[i] - cleaned[i]) * 1e6:.3g} µm "
+        f"{'below' if z[i] < cleaned[i] else 'above'} its neighbours"
+        for i in samples
+    ]
+    summary = (
+        f"{samples.size} outlier(s) (a spike or dropout: more than {OUTLIER_THRESHOLD:g} "
+        f"scaled MADs from the median of its {2 * OUTLIER_NEIGHBOURS} neighbours) replaced by "
+        "linear interpolation between the nearest samples kept"
+    )
+    return cleaned, outlier, ScarProfileWarning(summary, samples, details)
+
+
 def _line(x, z, mask):
     """Least-squares offset and tilt of ``z`` over ``x[mask]``, as a function and a pair."""
     xm = x[mask]
@@ -260,8 +425,8 @@ def _crossing(x, r, start, step, tolerance, reach):
     """Where ``r`` first reaches 0 (to ``tolerance``) from index ``start`` in direction
     ``step``: the wall below it, extended by the straight line through two samples at least
     ``reach`` samples short of the first sample reaching it (beyond the smoothing's reach of
-    a kink there), clipped to between the nearer of them and that sample; None if the end
-    of the trace comes first."""
+    a kink there), clipped to between the nearer of them and that sample; and the index of
+    that sample. None if the end of the trace comes first."""
     if step < 0:
         found = np.flatnonzero(r[:start] >= -tolerance)
         if found.size == 0:
@@ -283,55 +448,140 @@ def _crossing(x, r, start, step, tolerance, reach):
         edge = x[inner] - r[inner] / rise
     else:
         edge = x[last] + r[last] / (r[last] - r[outer]) * (x[outer] - x[last])
-    return float(np.clip(edge, *sorted((x[inner], x[outer]))))
+    return float(np.clip(edge, *sorted((x[inner], x[outer])))), int(outer)
 
 
-def _shoulders(x, centre, half_width):
-    """Samples of the unworn surface (see the module docstring), or None if too few."""
-    for factor in _SHOULDER_FACTORS:
-        left = x < centre - factor * half_width
-        right = x > centre + factor * half_width
-        if left.sum() >= _MIN_SHOULDER and right.sum() >= _MIN_SHOULDER:
-            return left | right
+def _band_end(x, r, outer, step, threshold, gap):
+    """Index of the outermost sample of the disturbed band beyond the groove's edge sample
+    ``outer`` in direction ``step``: farther than ``threshold`` from the line, with no quiet
+    stretch longer than ``gap`` before it; ``outer`` if there is none."""
+    if step > 0:
+        index = outer + np.flatnonzero(np.abs(r[outer:]) > threshold)
+    else:
+        index = np.flatnonzero(np.abs(r[: outer + 1]) > threshold)[::-1]
+    gaps = np.abs(np.diff(np.concatenate([[x[outer]], x[index]])))
+    far = np.flatnonzero(gaps > gap)
+    count = int(far[0]) if far.size else index.size
+    return int(index[count - 1]) if count else outer
+
+
+def _band_edge(x, r, outer, end, step, threshold):
+    """The band's edge on one side and the index of its pile-up ridge's crest (or None).
+
+    Inwards from the band's outermost sample ``end``: the first crest higher than
+    ``threshold`` above the line (a ridge), then down its inner flank to where it reaches
+    the line or stops falling (rises by ``threshold`` again); that is the edge. Without a
+    ridge the band ends at ``end``. The edge is None where it is the groove's own (the
+    flank reaches the line at the groove's edge sample ``outer``)."""
+    inward = np.arange(end, outer - step, -step)
+    s = r[inward]
+    above = np.flatnonzero(s > threshold)
+    if above.size == 0:
+        return (float(x[end]) if end != outer else None), None
+    first = int(above[0])
+    fallen = np.flatnonzero(s[first:] < np.maximum.accumulate(s[first:]) - threshold)
+    crest = first + int(np.argmax(s[first : first + fallen[0]] if fallen.size else s[first:]))
+    flank = s[crest:]
+    zero = np.flatnonzero(flank <= 0.0)
+    rise = np.flatnonzero(flank > np.minimum.accumulate(flank) + threshold)
+    stop = min(zero[0] if zero.size else flank.size, rise[0] if rise.size else flank.size)
+    if stop >= flank.size - 1:
+        return None, int(inward[crest])
+    if zero.size and stop == zero[0]:
+        a, b = inward[crest + stop - 1], inward[crest + stop]
+        return float(x[a] + r[a] / (r[a] - r[b]) * (x[b] - x[a])), int(inward[crest])
+    foot = inward[crest + int(np.argmin(flank[:stop]))]
+    return float(x[foot]), int(inward[crest])
+
+
+def _shoulders(x, centre, half_width, band, quiet):
+    """Samples of the unworn surface (see the module docstring), or None if too few.
+
+    Beyond ``band`` (the disturbed band's outer ends) and the half-widths of
+    :data:`_SHOULDER_FACTORS`, without the ``quiet=False`` samples (debris) if enough stay.
+    """
+    for outside in (band, (np.inf, -np.inf)):
+        for factor in _SHOULDER_FACTORS:
+            left = x < min(centre - factor * half_width, outside[0])
+            right = x > max(centre + factor * half_width, outside[1])
+            for keep in (quiet, True):
+                if (left & keep).sum() >= _MIN_SHOULDER and (right & keep).sum() >= _MIN_SHOULDER:
+                    return (left | right) & keep
     return None
 
 
-def _scar_extent(x, zs, half_width, reach=0):
-    """Reference line, centre, half-width and depth of the scar in smoothed heights ``zs``."""
+class _Extent(NamedTuple):
+    """What :func:`_scar_extent` found (see there)."""
+
+    line: object
+    tilt: float
+    centre: float
+    width: float
+    residual: np.ndarray
+    groove: tuple
+    band: tuple
+    ridges: tuple
+
+
+def _edges(x, r, deepest, depth, noise, reach):
+    """The groove's edges, the band's edges (None where the groove's), the ridges' crests
+    (indices or None) and the band's outer ends (positions); ValueError at a trace's end."""
+    tolerance = _LINE_TOLERANCE * depth
+    left = _crossing(x, r, deepest, -1, tolerance, reach)
+    right = _crossing(x, r, deepest + 1, +1, tolerance, reach)
+    if left is None or right is None:
+        side = "left" if left is None else "right"
+        raise ValueError(
+            f"x: the scar reaches the {side} end of the trace (no unworn surface beside "
+            "it): the trace must extend beyond both edges of the scar"
+        )
+    threshold = max(_NOISE_FACTOR * noise, _BAND_FLOOR * depth)
+    gap = max(_BAND_GAP_WIDTH * 0.5 * (right[0] - left[0]), _BAND_GAP * np.median(np.diff(x)))
+    ends = [_band_end(x, r, side[1], step, threshold, gap)
+            for side, step in ((left, -1), (right, +1))]  # fmt: skip
+    found = [_band_edge(x, r, side[1], end, step, threshold)
+             for side, end, step in ((left, ends[0], -1), (right, ends[1], +1))]  # fmt: skip
+    groove = (left[0], right[0])
+    band = tuple(edge if edge is not None else groove[i] for i, (edge, _) in enumerate(found))
+    outer = (min(float(x[ends[0]]), band[0]), max(float(x[ends[1]]), band[1]))
+    return groove, band, tuple(crest for _, crest in found), outer, threshold
+
+
+def _scar_extent(x, zs, half_width, reach=0) -> _Extent:
+    """Reference line, centre, half-width, residual, groove and band edges and ridges of
+    the scar in smoothed heights ``zs``."""
     span = x[-1] - x[0]
     mask = (x < x[0] + span / 5.0) | (x > x[-1] - span / 5.0)
     previous = None
     for _ in range(20):
         line, tilt = _line(x, zs, mask)
         r = zs - line(x)
-        shoulder_noise = 1.4826 * np.median(np.abs(r[mask] - np.median(r[mask])))
+        noise = 1.4826 * np.median(np.abs(r[mask] - np.median(r[mask])))
         deepest = int(np.argmin(r))
         depth = -r[deepest]
-        if not depth > max(_NOISE_FACTOR * shoulder_noise, _MIN_RELIEF * (r.max() - r.min())):
+        if not depth > max(_NOISE_FACTOR * noise, _MIN_RELIEF * (r.max() - r.min())):
             raise ValueError(
                 "z: no depression found: the deepest point is "
                 f"{depth:.3g} m below the unworn surface (a straight line fitted to the "
                 f"trace's ends): not more than {_NOISE_FACTOR:g} times its noise "
-                f"({shoulder_noise:.3g} m) and {_MIN_RELIEF:.0%} of the trace's relief. Heights "
+                f"({noise:.3g} m) and {_MIN_RELIEF:.0%} of the trace's relief. Heights "
                 "must increase upwards (the scar is a depression), in metres."
             )
-        tolerance = _LINE_TOLERANCE * depth
-        left = _crossing(x, r, deepest, -1, tolerance, reach)
-        right = _crossing(x, r, deepest + 1, +1, tolerance, reach)
-        if left is None or right is None:
-            side = "left" if left is None else "right"
-            raise ValueError(
-                f"x: the scar reaches the {side} end of the trace (no unworn surface beside "
-                "it): the trace must extend beyond both edges of the scar"
+        groove, band, ridges, outer, threshold = _edges(x, r, deepest, depth, noise, reach)
+        wide = band[1] - band[0] > (1.0 + AMBIGUOUS_EDGES) * (groove[1] - groove[0])
+        if wide and half_width is not None:  # the centre of the edges nearer that width
+            wide = abs(band[1] - band[0] - 2 * half_width) < abs(
+                groove[1] - groove[0] - 2 * half_width
             )
-        centre = 0.5 * (left + right)
-        width = 0.5 * (right - left) if half_width is None else half_width
+        edges = band if wide else groove
+        centre = 0.5 * (edges[0] + edges[1])
+        width = 0.5 * (edges[1] - edges[0]) if half_width is None else half_width
         if half_width is not None and (centre - width < x[0] or centre + width > x[-1]):
             raise ValueError(
                 f"half_width = {half_width!r} m does not fit the trace: the scar centre is at "
                 f"x = {centre!r} m and the trace spans [{x[0]!r}, {x[-1]!r}] m"
             )
-        mask = _shoulders(x, centre, width)
+        mask = _shoulders(x, centre, width, outer, np.abs(r) <= threshold)
         if mask is None:
             raise ValueError(
                 "x: the trace is too short for levelling: it needs at least "
@@ -339,14 +589,115 @@ def _scar_extent(x, zs, half_width, reach=0):
                 f"scar centre on each side (centre {centre!r} m, half-width {width!r} m, "
                 f"trace [{x[0]!r}, {x[-1]!r}] m)"
             )
-        key = (left, right)
-        if key == previous:
+        if edges == previous:
             break
-        previous = key
-    return line, tilt, centre, width, r
+        previous = edges
+    return _Extent(line, tilt, centre, width, r, groove, band if wide else groove, ridges)
 
 
-def scar_profile(x, z, half_width=None, smoothing=None, level=False) -> ScarProfile:
+def _ambiguity(x, extent: _Extent, given: bool):
+    """The warning of ambiguous edges (None if the band is the groove or a width was given),
+    and the alternative half-width. [m]"""
+    if extent.band == extent.groove or given:
+        return None, np.nan
+    band, groove = (0.5 * (b - a) for a, b in (extent.band, extent.groove))
+    ridges = [i for i in extent.ridges if i is not None]
+    r = extent.residual
+    what = "the band between its pile-up ridges" if ridges else "the disturbed band"
+    crests = "".join(f"; a ridge {r[i] * 1e6:.3g} µm high at x = {x[i] * 1e6:.6g} µm"
+                     for i in ridges)  # fmt: skip
+    summary = (
+        f"ambiguous scar edges: half-width {band * 1e6:.6g} µm for {what} (taken; edges at "
+        f"x = {extent.band[0] * 1e6:.6g} and {extent.band[1] * 1e6:.6g} µm{crests}) or "
+        f"{groove * 1e6:.6g} µm for the groove below the unworn surface's line (edges at "
+        f"x = {extent.groove[0] * 1e6:.6g} and {extent.groove[1] * 1e6:.6g} µm): which "
+        "the model needs is a judgement"
+    )
+    return ScarProfileWarning(summary, alternative=groove), groove
+
+
+def _checked(x, z, half_width, smoothing):
+    """The trace and parameters as float64, checked (see :func:`scar_profile`)."""
+    x = _array("x", x)
+    z = _array("z", z)
+    if x.size != z.size:
+        raise ValueError(f"x and z must have the same length, got {x.size} and {z.size}")
+    if x.size < 2 * MIN_SCAR_SAMPLES:
+        raise ValueError(f"x: a trace needs at least {2 * MIN_SCAR_SAMPLES} samples, got {x.size}")
+    _check_positions(x)
+    if half_width is not None:
+        half_width = float(_array("half_width", [half_width])[0])
+        if half_width <= 0.0:
+            raise ValueError(f"half_width must be > 0, got {half_width!r}")
+    if smoothing is not None:
+        smoothing = float(_array("smoothing", [smoothing])[0])
+        if smoothing < 0.0:
+            raise ValueError(f"smoothing must be >= 0 (0: none), got {smoothing!r}")
+    return x, z, half_width, smoothing
+
+
+def scar_profile_and_findings(x, z, half_width=None, smoothing=None, level=False,
+                              remove_outliers=True):  # fmt: skip
+    """:func:`scar_profile` and its warnings, not issued: ``(profile, findings)``.
+
+    Parameters and Raises are those of :func:`scar_profile`.
+
+    Returns
+    -------
+    profile : ScarProfile
+    findings : list of ScarProfileWarning
+        Outliers replaced (with their sample indices), ambiguous edges.
+    """
+    x, z, half_width, smoothing = _checked(x, z, half_width, smoothing)
+    findings = []
+    replaced = np.zeros(x.size, dtype=bool)
+    if remove_outliers:
+        z, replaced, finding = _without_outliers(x, z)
+        findings += [finding] if finding is not None else []
+    spacing = float(np.median(np.diff(x)))
+    # The edges are found on lightly smoothed heights (a kink at an edge would move under
+    # heavier smoothing); the slopes are smoothed over 2 % of the half-width by default.
+    light = 0.0 if smoothing == 0.0 else _EDGE_SMOOTHING * spacing
+    zs, _ = local_quadratic(x, z, light)
+    reach = int(np.ceil(_REACH * light / spacing))
+    extent = _scar_extent(x, zs, half_width, reach)
+    line, tilt, centre, width, r = extent[:5]
+    finding, alternative = _ambiguity(x, extent, half_width is not None)
+    findings += [finding] if finding is not None else []
+    sigma = AUTO_SMOOTHING * width if smoothing is None else smoothing
+    sigma = 0.0 if sigma == 0.0 else max(sigma, spacing)
+    if sigma > width / 5.0:
+        raise ValueError(
+            f"smoothing = {sigma!r} m is more than a fifth of the scar's half-width "
+            f"({width!r} m): it would flatten the scar; give a smaller smoothing"
+        )
+    smooth, gs = local_quadratic(x, z, sigma)
+    inside = np.abs(x - centre) <= width
+    count = int(inside.sum())
+    if count < MIN_SCAR_SAMPLES:
+        raise ValueError(
+            f"x: only {count} samples across the scar (half-width {width!r} m); at least "
+            f"{MIN_SCAR_SAMPLES} are needed: sample the trace more densely"
+        )
+    depth = float(-np.min(smooth[inside] - line(x[inside])))
+    edges = (centre - width, centre + width)
+    ends = np.interp(edges, x, r)
+    area_x = np.concatenate([[edges[0]], x[inside], [edges[1]]])
+    area_r = np.concatenate([[ends[0]], r[inside], [ends[1]]])
+    worn = float(np.trapezoid(np.maximum(-area_r, 0.0), area_x))
+    if level:
+        height, slope = z - line(x), gs - tilt
+        reference = (0.0, 0.0)
+    else:
+        height, slope = z, gs
+        reference = (float(line(centre)), float(tilt))
+    profile = _profile(x - centre, height, slope, depth, width, worn, centre, *reference,
+                       alternative, replaced.astype(np.float64))  # fmt: skip
+    return profile, findings
+
+
+def scar_profile(x, z, half_width=None, smoothing=None, level=False,
+                 remove_outliers=True) -> ScarProfile:  # fmt: skip
     r"""A wear-scar profile from a measured trace (arrays in metres).
 
     Parameters
@@ -367,12 +718,26 @@ def scar_profile(x, z, half_width=None, smoothing=None, level=False) -> ScarProf
         Subtract the unworn surface's line (tilt and offset fitted on the shoulders) from
         the heights and its tilt from the slopes. Off by default: the arrays are taken as
         the pad feels them, so a genuinely tilted scar stays tilted.
+    remove_outliers : bool
+        Replace outliers (spikes, dropouts: :func:`outlying_samples`) by linear
+        interpolation between the nearest samples kept, before anything else (on by
+        default; ``replaced`` marks them).
 
     Returns
     -------
     profile : ScarProfile
         Positions relative to the detected centre, the heights (levelled if asked), the
-        smoothed slopes, and the depth, half-width, worn area, centre and reference line.
+        smoothed slopes, and the depth, half-width, worn area, centre and reference line;
+        the other plausible half-width if the edges were ambiguous, and the samples
+        replaced.
+
+    Warns
+    -----
+    ScarProfileWarning
+        For outliers replaced (their count, sample indices and positions), and for
+        ambiguous edges: a band between pile-up ridges (or a disturbed band) wider than the
+        groove below the unworn surface's line by more than :data:`AMBIGUOUS_EDGES`; the
+        band is taken, and the message gives both half-widths (``half_width=`` chooses).
 
     Raises
     ------
@@ -403,53 +768,10 @@ def scar_profile(x, z, half_width=None, smoothing=None, level=False) -> ScarProf
     >>> round(float(p.half_width) * 1e6, 6), round(float(p.depth) * 1e6, 6)
     (50.0, 10.0)
     """
-    x = _array("x", x)
-    z = _array("z", z)
-    if x.size != z.size:
-        raise ValueError(f"x and z must have the same length, got {x.size} and {z.size}")
-    if x.size < 2 * MIN_SCAR_SAMPLES:
-        raise ValueError(f"x: a trace needs at least {2 * MIN_SCAR_SAMPLES} samples, got {x.size}")
-    _check_positions(x)
-    if half_width is not None:
-        half_width = float(_array("half_width", [half_width])[0])
-        if half_width <= 0.0:
-            raise ValueError(f"half_width must be > 0, got {half_width!r}")
-    if smoothing is not None:
-        smoothing = float(_array("smoothing", [smoothing])[0])
-        if smoothing < 0.0:
-            raise ValueError(f"smoothing must be >= 0 (0: none), got {smoothing!r}")
-    spacing = float(np.median(np.diff(x)))
-    # The edges are found on lightly smoothed heights (a kink at an edge would move under
-    # heavier smoothing); the slopes are smoothed over 2 % of the half-width by default.
-    light = 0.0 if smoothing == 0.0 else _EDGE_SMOOTHING * spacing
-    zs, _ = local_quadratic(x, z, light)
-    reach = int(np.ceil(_REACH * light / spacing))
-    line, tilt, centre, width, r = _scar_extent(x, zs, half_width, reach)
-    sigma = AUTO_SMOOTHING * width if smoothing is None else smoothing
-    sigma = 0.0 if sigma == 0.0 else max(sigma, spacing)
-    if sigma > width / 5.0:
-        raise ValueError(
-            f"smoothing = {sigma!r} m is more than a fifth of the scar's half-width "
-            f"({width!r} m): it would flatten the scar; give a smaller smoothing"
-        )
-    smooth, gs = local_quadratic(x, z, sigma)
-    inside = np.abs(x - centre) <= width
-    count = int(inside.sum())
-    if count < MIN_SCAR_SAMPLES:
-        raise ValueError(
-            f"x: only {count} samples across the scar (half-width {width!r} m); at least "
-            f"{MIN_SCAR_SAMPLES} are needed: sample the trace more densely"
-        )
-    depth = float(-np.min(smooth[inside] - line(x[inside])))
-    edges = (centre - width, centre + width)
-    ends = np.interp(edges, x, r)
-    area_x = np.concatenate([[edges[0]], x[inside], [edges[1]]])
-    area_r = np.concatenate([[ends[0]], r[inside], [ends[1]]])
-    worn = float(np.trapezoid(np.maximum(-area_r, 0.0), area_x))
-    if level:
-        height, slope = z - line(x), gs - tilt
-        reference = (0.0, 0.0)
-    else:
-        height, slope = z, gs
-        reference = (float(line(centre)), float(tilt))
-    return _profile(x - centre, height, slope, depth, width, worn, centre, *reference)
+    profile, findings = scar_profile_and_findings(
+        x, z, half_width=half_width, smoothing=smoothing, level=level,
+        remove_outliers=remove_outliers,
+    )  # fmt: skip
+    for finding in findings:
+        warn(finding, ScarProfileWarning)
+    return profile
