@@ -1,20 +1,28 @@
 """Column names as labs write them: finding a column, and the unit its name carries.
 
 Rig software and spreadsheets put the unit in the column's name: ``force [N]``,
-``displacement (um)``, ``Displacement/µm``, ``delta_mm``, ``Ftr_kN``. :func:`split_unit`
-separates such a name into its base and its unit; :func:`find_column` finds a column by
-its name or its base (without regard to case), so ``displacement`` finds
+``displacement (um)``, ``Displacement/µm``, ``delta_mm``, ``Ftr_kN``, ``Disp in mm``.
+:func:`split_unit` separates such a name into its base and its unit; :func:`find_column`
+finds a column by its name or its base (without regard to case), so ``displacement`` finds
 ``Displacement [µm]``; :func:`column_scale` decides the factor to SI from the unit given as
 an option, the unit the file carries, or the default (µm and N).
+
+Rigs name the same quantity in many ways (``Disp``, ``delta``, ``stroke``, ``x`` for the
+displacement; ``Fx``, ``Q``, ``Ftr``, ``friction force`` for the tangential force). A
+column asked for by its role's own name (``displacement``, ``force``, ``load``,
+``cycle``: the defaults) is found under any of the usual names of :data:`SYNONYMS` when no
+column bears that name; a name given explicitly is matched only as it is. Two candidates
+are an error naming both, and the option that chooses; none, an error listing the columns
+(with the nearest as a suggestion).
 
 The rules, in order, for a name's unit:
 
 1. A unit in square brackets or parentheses at the end (``force [N]``,
    ``displacement (um)``) is always split off if it reads as a unit (of any kind: ``[V]``
    is a unit, ``(tangential)`` is not and stays part of the name).
-2. A unit after a slash (``Displacement/µm``, ``F / kN``), an underscore (``delta_mm``) or
-   a space (``force N``) is split off only if it is a length or a force, so ``time_s``
-   and ``cycle_no`` keep their names.
+2. A unit after a slash (``Displacement/µm``, ``F / kN``), an underscore (``delta_mm``), a
+   space (``force N``) or the word ``in`` (``Displacement in mm``) is split off only if it
+   is a length or a force, so ``time_s`` and ``cycle_no`` keep their names.
 
 A unit option given explicitly and a unit carried by the file must agree (same factor):
 a disagreement is an error, as one of them is wrong by a factor the analysis cannot see.
@@ -24,6 +32,7 @@ explicit option, and is an error without one.
 
 from __future__ import annotations
 
+import difflib
 import functools
 import math
 import re
@@ -32,6 +41,7 @@ __all__ = [
     "COMMON_UNITS",
     "DEFAULT_UNITS",
     "KINDS",
+    "SYNONYMS",
     "ColumnError",
     "column_scale",
     "find_column",
@@ -40,11 +50,44 @@ __all__ = [
 ]
 
 #: The kind of quantity of each column role, as :func:`ecofmaps.units.parse_quantity` names it:
-#: a recording's displacement and force, a scar profile's position x and height z.
-KINDS = {"displacement": "length", "force": "force", "x": "length", "z": "length"}
+#: a recording's displacement, force and normal load, a scar profile's position x and height z.
+KINDS = {"displacement": "length", "force": "force", "load": "force", "x": "length", "z": "length"}
 
 #: The unit of a column whose name, metadata and options say none.
-DEFAULT_UNITS = {"displacement": "um", "force": "N", "x": "um", "z": "um"}
+DEFAULT_UNITS = {"displacement": "um", "force": "N", "load": "N", "x": "um", "z": "um"}
+
+#: The usual names of a recording's columns by role, compared with a column's base (its
+#: name without unit) without regard to case, blanks and punctuation (``Friction_Force``
+#: is ``friction force``, ``Disp.`` is ``disp``).
+SYNONYMS = {
+    "displacement": (
+        "displacement", "disp", "delta", "stroke", "position", "x", "s", "displ", "dx",
+        "delta x", "Δ", "Δx", "pos", "travel", "relative displacement",
+        "tangential displacement", "sliding displacement",
+    ),
+    "force": (
+        "force", "Fx", "Ft", "Q", "Ftr", "tangential force", "friction force", "F",
+        "tangential", "tangential load", "friction", "Ff", "Fr", "shear force", "traction",
+    ),
+    "load": (
+        "load", "Fz", "Fn", "normal load", "normal force", "P", "normal", "applied load",
+    ),
+    "cycle": (
+        "cycle", "cycles", "n", "cycle number", "cycle no", "cycle nr", "cycle count",
+        "cycle index", "n cycle", "n cycles", "cyc", "number of cycles",
+    ),
+}  # fmt: skip
+
+#: How the user chooses a role's column: the keyword of the Python API and the option of
+#: the command line, for messages.
+_CHOOSE = {
+    "displacement": "displacement_column (--displacement-col)",
+    "force": "force_column (--force-col)",
+    "cycle": "cycle_column (--cycle-col)",
+    "load": "load_column",
+    "x": "x_column (--x-column)",
+    "z": "z_column (--z-column)",
+}
 
 #: The units rigs write most, with their kind and factor to SI, read without starting pint
 #: (whose registry takes a good part of a second to build); any other goes to pint.
@@ -55,14 +98,20 @@ COMMON_UNITS = {
     "µm": ("length", 1e-6),
     "μm": ("length", 1e-6),
     "nm": ("length", 1e-9),
+    "in": ("length", 0.0254),
     "N": ("force", 1.0),
     "kN": ("force", 1e3),
     "mN": ("force", 1e-3),
+    "kip": ("force", 4448.221615260501),
 }
 
 _BRACKETED = re.compile(r"^(?P<base>.*?)\s*(?:\[(?P<square>[^\[\]]*)\]|\((?P<round>[^()]*)\))$")
 _SLASHED = re.compile(r"^(?P<base>[^/]*?)\s*/\s*(?P<unit>[^/]+?)$")
 _SUFFIXED = re.compile(r"^(?P<base>.*?[^_\s])[_\s]+(?P<unit>[^_\s]+)$")
+#: How alike (difflib's ratio, 0 to 1) a column's name must be to the name sought to be
+#: suggested.
+_NEAR = 0.75
+_IN_UNIT = re.compile(r"^(?P<base>.*?\S)\s+in\s+(?P<unit>\S+)$", re.IGNORECASE)
 
 
 class ColumnError(ValueError):
@@ -95,6 +144,14 @@ def _normal(name: str) -> str:
     return " ".join(name.strip().strip("\"'").split()).lower()
 
 
+def _plain(text: str) -> str:
+    """Text without case, blanks or punctuation: ``Friction_Force`` -> ``frictionforce``."""
+    return re.sub(r"[\W_]+", "", text.casefold())
+
+
+_SYNONYM_KEYS = {role: frozenset(map(_plain, names)) for role, names in SYNONYMS.items()}
+
+
 def split_unit(name: str) -> tuple[str, str | None]:
     """A column name's base and the unit it carries.
 
@@ -114,8 +171,8 @@ def split_unit(name: str) -> tuple[str, str | None]:
     --------
     >>> split_unit("force [N]"), split_unit("Displacement/µm"), split_unit("Ftr_kN")
     (('force', 'N'), ('Displacement', 'µm'), ('Ftr', 'kN'))
-    >>> split_unit("time_s"), split_unit("Force (tangential)")
-    (('time_s', None), ('Force (tangential)', None))
+    >>> split_unit("time_s"), split_unit("Force (tangential)"), split_unit("Disp in mm")
+    (('time_s', None), ('Force (tangential)', None), ('Disp', 'mm'))
     """
     text = name.strip().strip("\"'").strip()
     match = _BRACKETED.match(text)
@@ -123,7 +180,7 @@ def split_unit(name: str) -> tuple[str, str | None]:
         unit = (match.group("square") or match.group("round") or "").strip()
         if _unit_kind(unit) is not None:
             return match.group("base").strip(), unit
-    for pattern in (_SLASHED, _SUFFIXED):
+    for pattern in (_SLASHED, _IN_UNIT, _SUFFIXED):
         match = pattern.match(text)
         if match and match.group("base") and _unit_kind(match.group("unit")) in KINDS.values():
             return match.group("base").strip(), match.group("unit").strip()
@@ -139,9 +196,12 @@ def find_column(names, wanted: str, role: str, *, required: bool = True) -> int 
         The names in the file (header cells, channels or variables).
     wanted : str
         The name asked for: matched first against the whole names, then against their
-        bases (:func:`split_unit`), without regard to case or repeated blanks.
+        bases (:func:`split_unit`), without regard to case or repeated blanks. The role's
+        own name (``'displacement'`` for the displacement, the default) also finds the
+        role's usual names (:data:`SYNONYMS`) if no column bears it.
     role : str
-        What the column holds (``'displacement'``, ``'force'``, ``'cycle'``), for messages.
+        What the column holds (``'displacement'``, ``'force'``, ``'load'``, ``'cycle'``,
+        ``'x'``, ``'z'``), for messages and synonyms.
     required : bool
         Whether a missing column is an error; if not, None is returned for it.
 
@@ -152,8 +212,9 @@ def find_column(names, wanted: str, role: str, *, required: bool = True) -> int 
     Raises
     ------
     ColumnError
-        If no name matches (and the column is required), or several match only by their
-        base.
+        If no name matches (and the column is required: the message lists the columns and
+        suggests the nearest), or several do (the message names them and the option that
+        chooses).
 
     Examples
     --------
@@ -161,29 +222,59 @@ def find_column(names, wanted: str, role: str, *, required: bool = True) -> int 
     1
     >>> find_column(["time", "Displacement [µm]", "Ftr_kN"], "FTR", "force")
     2
+    >>> find_column(["t [s]", "stroke_um", "friction_force_N"], "force", "force")
+    2
     """
-    matches = matching_columns(names, wanted)
+    matches = matching_columns(names, wanted, role)
     if len(matches) > 1:
         found = ", ".join(repr(names[k]) for k in matches)
-        raise ColumnError(f"several {role} columns match {wanted!r}: {found}")
+        raise ColumnError(
+            f"several {role} columns match {wanted!r}: {found}; choose one with "
+            f"{_CHOOSE.get(role, role)}"
+        )
     if not matches and not required:
         return None
     if not matches:
-        listed = ", ".join(repr(name) for name in names)
-        raise ColumnError(f"no {role} column {wanted!r} (columns: {listed})")
+        raise ColumnError(_missing_message(names, wanted, role))
     return matches[0]
 
 
-def matching_columns(names, wanted: str) -> list[int]:
+def matching_columns(names, wanted: str, role: str | None = None) -> list[int]:
     """The indices of the names that match ``wanted`` (see :func:`find_column`): the one
-    whole name equal to it, else those whose base is its base."""
+    whole name equal to it, else those whose base is its base, else (for ``wanted`` the
+    name of ``role``) those whose base is one of the role's :data:`SYNONYMS`."""
     target = _normal(wanted)
     whole = [k for k, name in enumerate(names) if _normal(name) == target]
     if len(whole) == 1:
         return whole
     base = _normal(split_unit(wanted)[0])
     by_base = [k for k, name in enumerate(names) if _normal(split_unit(name)[0]) == base]
-    return whole if len(whole) > 1 else by_base
+    if whole or by_base or role not in SYNONYMS or target != role:
+        return whole if len(whole) > 1 else by_base
+    usual = _SYNONYM_KEYS[role]
+    return [k for k, name in enumerate(names) if _plain(split_unit(name)[0]) in usual]
+
+
+def _missing_message(names, wanted: str, role: str) -> str:
+    """The error for a column not found: the columns there are, and the nearest name."""
+    listed = ", ".join(repr(name) for name in names)
+    usual = role in SYNONYMS and _normal(wanted) == role
+    sought = [_plain(split_unit(wanted)[0])]
+    if usual:
+        shown = ", ".join(SYNONYMS[role][1:7])
+        sought += [key for key in _SYNONYM_KEYS[role] if len(key) >= 4]
+    bases = [_plain(split_unit(name)[0]) for name in names]
+    ratios = [
+        max(difflib.SequenceMatcher(None, key, base).ratio() for key in sought) if base else 0.0
+        for base in bases
+    ]
+    message = f"no {role} column {wanted!r}"
+    if usual:
+        message += f" nor one of its usual names ({shown}, ...)"
+    message += f" (columns: {listed})."
+    if ratios and max(ratios) >= _NEAR:
+        message += f" Did you mean {names[ratios.index(max(ratios))]!r}?"
+    return f"{message} Name the column with {_CHOOSE.get(role, role)}"
 
 
 def _factor(unit: str, kind: str, option: str | None) -> float:

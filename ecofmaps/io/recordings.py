@@ -127,6 +127,8 @@ def _options(
     force_unit=None,
     group=None,
     nan_policy="propagate",
+    load_column=None,
+    skip_rows=None,
 ) -> dict:
     """The reading options, checked, as one dict."""
     for name, value in (
@@ -137,6 +139,7 @@ def _options(
             raise ValueError(f"{name} must be a column name; got {value!r}")
     for name, value in (
         ("cycle_column", cycle_column),
+        ("load_column", load_column),
         ("displacement_unit", displacement_unit),
         ("force_unit", force_unit),
         ("group", group),
@@ -145,6 +148,10 @@ def _options(
             raise ValueError(f"{name} must be a non-empty string or None; got {value!r}")
     if nan_policy not in _NAN_POLICIES:
         raise ValueError(f"nan_policy must be one of {_NAN_POLICIES}; got {nan_policy!r}")
+    if skip_rows is not None and (
+        isinstance(skip_rows, bool) or not isinstance(skip_rows, numbers.Integral) or skip_rows < 0
+    ):
+        raise ValueError(f"skip_rows must be a non-negative integer or None; got {skip_rows!r}")
     from ecofmaps.io.columns import column_scale
 
     for role, unit in (("displacement", displacement_unit), ("force", force_unit)):
@@ -158,6 +165,8 @@ def _options(
         "force_unit": force_unit,
         "group": group,
         "nan_policy": nan_policy,
+        "load_column": load_column,
+        "skip_rows": None if skip_rows is None else int(skip_rows),
     }
 
 
@@ -184,6 +193,7 @@ def _read_text(path: Path, options: dict, block_bytes: int) -> Recording:
         displacement=values["displacement"],
         force=values["force"],
         cycle=values.get("cycle"),
+        load=values.get("load"),
         last_line=int(numbers[-1][-1]),
         columns={role: layout.names[k] for role, k in layout.columns.items()},
         units={role: layout.units[role] for role in layout.columns},
@@ -204,6 +214,8 @@ def read_recording(
     lazy=None,
     chunks=None,
     block_bytes=None,
+    load_column=None,
+    skip_rows=None,
 ) -> Recording:
     """Read the displacement and force (and cycle) columns of a recording, in SI units.
 
@@ -216,7 +228,10 @@ def read_recording(
     displacement_column, force_column : str
         Names of the displacement and tangential force columns (channels, variables):
         matched without regard to case, and to a unit in the name
-        (``displacement`` finds ``Displacement [µm]``).
+        (``displacement`` finds ``Displacement [µm]``). In a text file the defaults also
+        find the usual names (``Disp``, ``delta_mm``, ``stroke``, ``x``; ``Fx``, ``Q``,
+        ``Ftr_kN``, ``friction force``: :data:`ecofmaps.io.columns.SYNONYMS`) when no
+        column is named ``displacement`` (``force``); two such columns are an error.
     cycle_column : str, optional
         Name of a column of cycle numbers, which must then exist. By default a column
         named ``cycle`` is used if there is one.
@@ -243,6 +258,16 @@ def read_recording(
         Bytes of a text file parsed at a time (default
         :data:`ecofmaps.io.text.BLOCK_BYTES`, 16 MiB): the memory the parsing needs, beyond
         the arrays, is a small multiple of it.
+    load_column : str, optional
+        Name of a recorded normal-load column of a text file, read into
+        :attr:`Recording.load` [N] (unit from the name, as ``Fz [kN]``, else N);
+        ``'load'`` also finds the usual names (``Fz``, ``Fn``, ``normal load``, ``P``).
+        By default no load is read.
+    skip_rows : int, optional
+        Lines at the start of a text file to skip before its header line (a rig's
+        metadata). By default a preamble of metadata lines is found: the header is the
+        first line naming the columns asked for, among the first
+        :data:`ecofmaps.io.text.PREAMBLE_LINES`.
 
     Returns
     -------
@@ -277,6 +302,8 @@ def read_recording(
         force_unit,
         group,
         nan_policy,
+        load_column,
+        skip_rows,
     )
     if lazy not in (None, True, False):
         raise ValueError(f"lazy must be True, False or None; got {lazy!r}")
@@ -284,6 +311,9 @@ def read_recording(
     _check_count("block_bytes", block_bytes)
     path = Path(path)
     kind = recording_format(path)
+    for name, value in (("load_column", load_column), ("skip_rows", skip_rows)):
+        if kind != "text" and value is not None:
+            raise ValueError(f"{name} applies to text files, not to {kind.upper()}")
     if kind == "text":
         if group is not None:
             raise ValueError("group applies to TDMS, HDF5/netCDF and zarr files, not to text")
@@ -294,10 +324,14 @@ def read_recording(
             import dask.array as da
 
             size = chunks or recording.size
-            arrays = [recording.displacement, recording.force, recording.cycle]
+            arrays = [recording.displacement, recording.force, recording.cycle, recording.load]
             wrapped = [None if a is None else da.from_array(a, chunks=size) for a in arrays]
             recording = dataclasses.replace(
-                recording, displacement=wrapped[0], force=wrapped[1], cycle=wrapped[2]
+                recording,
+                displacement=wrapped[0],
+                force=wrapped[1],
+                cycle=wrapped[2],
+                load=wrapped[3],
             )
         return recording
     from ecofmaps.io.binary import read_binary
@@ -363,6 +397,7 @@ def recording_blocks(path, samples: int = 1 << 20, **options) -> Iterator[Record
                 displacement=joined["displacement"][:count],
                 force=joined["force"][:count],
                 cycle=joined["cycle"][:count] if "cycle" in joined else None,
+                load=joined["load"][:count] if "load" in joined else None,
                 last_line=int(lines[count - 1]),
                 columns=columns,
                 units=units,

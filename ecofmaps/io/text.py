@@ -28,8 +28,11 @@ from __future__ import annotations
 
 import codecs
 import csv
+import gzip
 import io
+import itertools
 import re
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -37,9 +40,15 @@ import pandas as pd
 
 from ecofmaps._codes import warn
 from ecofmaps._interrupts import check_interrupted
-from ecofmaps.io.columns import ColumnError, column_scale, find_column, split_unit
+from ecofmaps.io.columns import (
+    ColumnError,
+    column_scale,
+    find_column,
+    matching_columns,
+    split_unit,
+)
 
-__all__ = ["BLOCK_BYTES", "MISSING", "text_blocks"]
+__all__ = ["BLOCK_BYTES", "MISSING", "PREAMBLE_LINES", "text_blocks"]
 
 #: Bytes of text parsed at a time (cut at the last line end within).
 BLOCK_BYTES = 1 << 24
@@ -47,9 +56,16 @@ BLOCK_BYTES = 1 << 24
 #: Cell contents read as a missing sample (besides an empty cell and infinite values).
 MISSING = ("nan", "NaN", "NAN", "-nan", "-NaN", "NA", "N/A", "n/a", "#N/A", "null", "NULL", "None")
 
+#: Lines (not blank, not comments) among which the header is sought after a preamble.
+PREAMBLE_LINES = 1000
+
 _COMMA_DECIMAL = re.compile(r"(?:^|[;\t \"])[+-]?\d*,\d+(?:[eE][+-]?\d+)?(?=$|[;\t \"])", re.M)
 _POINT_DECIMAL = re.compile(r"\d\.\d|(?:^|[;\t \"])[+-]?\.\d", re.MULTILINE)
+_QUOTED_COMMA_DECIMAL = re.compile(r'"[+-]?\d*,\d+(?:[eE][+-]?\d+)?"')
 _NUMBER = re.compile(r"^[+-]?(?:\d+[.,]?\d*|[.,]\d+)(?:[eE][+-]?\d+)?$")
+_NOT_A_NUMBER = {"", "inf", "+inf", "-inf", "Inf", "-Inf", "infinity", "-infinity", *MISSING}
+_LONE_CR = re.compile(rb"\r(?!\n)")
+_GZIP = b"\x1f\x8b"
 # pandas 3 parses floats exactly by default and deprecates the option; pandas 2 needs it.
 _EXACT = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
 
@@ -60,22 +76,80 @@ def _is_data(line: str) -> bool:
     return bool(stripped) and not stripped.startswith("#")
 
 
-def _raw_blocks(stream, block_bytes: int):
-    """Bytes of whole lines, about ``block_bytes`` at a time (the last may lack a newline)."""
-    rest = b""
-    while True:
-        data = stream.read(block_bytes)
-        if not data:
-            if rest:
-                yield rest
-            return
-        data = rest + data
+def _file_bytes(path: Path, block_bytes: int):
+    """The file's bytes, about ``block_bytes`` at a time: gunzipped if compressed, UTF-16
+    re-encoded as UTF-8, without byte-order mark, a lone carriage return made a line feed."""
+    with open(path, "rb") as raw:
+        compressed = raw.read(2) == _GZIP
+        raw.seek(0)
+        stream = gzip.GzipFile(fileobj=raw, mode="rb") if compressed else raw
+        lines = 0  # line ends given so far, for a damaged compressed file's message
+        try:
+            data = _start(path, stream, compressed)
+            while data := data + stream.read(block_bytes):
+                if data.endswith(b"\r"):  # its line feed may be the next byte
+                    data += stream.read(1)
+                if b"\r" in data and data.count(b"\r") != data.count(b"\r\n"):
+                    data = _LONE_CR.sub(b"\n", data)
+                lines += data.count(b"\n")
+                yield data
+                data = b""
+        except (EOFError, gzip.BadGzipFile, zlib.error) as error:
+            if not compressed:
+                raise
+            from ecofmaps.io.recording_types import RecordingError
+
+            raise RecordingError(
+                path, lines + 1, f"the compressed (gzip) data is truncated or damaged ({error})"
+            ) from None
+
+
+def _start(path: Path, stream, compressed: bool) -> bytes:
+    """The first bytes of the text, without byte-order mark; a UTF-16 file is read whole and
+    its text left in ``stream`` as UTF-8 (``stream`` is then emptied, the bytes returned)."""
+    from ecofmaps.io.recording_types import RecordingError
+
+    head = stream.read(8)
+    if compressed and head.startswith((b"TDSm", b"\x89HDF")):
+        kind = "TDMS" if head.startswith(b"TDSm") else "HDF5"
+        raise RecordingError(
+            path, None, f"a gzip-compressed {kind} file: decompress it first (gunzip)"
+        )
+    if head.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)) and not head.startswith(
+        codecs.BOM_UTF32_LE
+    ):
+        # A spreadsheet's "Unicode text": limited to about a million rows, so decoded whole.
+        data = head + stream.read()
+        try:
+            return data.decode("utf-16").encode("utf-8")
+        except UnicodeDecodeError as error:
+            text = data[: error.start].decode("utf-16", errors="replace")
+            raise RecordingError(
+                path, text.count("\n") + 1, "damaged UTF-16 text (an odd byte)"
+            ) from None
+    return head[len(codecs.BOM_UTF8) :] if head.startswith(codecs.BOM_UTF8) else head
+
+
+def _line_blocks(chunks):
+    """Bytes of whole lines, one block per chunk or more (the last may lack a newline),
+    each with the 1-based number of its first line."""
+    rest, line = b"", 1
+    for chunk in chunks:
+        data = rest + chunk
         cut = data.rfind(b"\n") + 1
-        if cut == 0:
-            rest = data
-            continue
         rest = data[cut:]
-        yield data[:cut]
+        if cut:
+            yield data[:cut], line
+            line += data.count(b"\n", 0, cut)
+    if rest:
+        yield rest, line
+
+
+def _text_lines(text: str) -> list[str]:
+    """The lines of a decoded block, without their ends."""
+    if "\r" in text:
+        text = text.replace("\r\n", "\n")
+    return (text[:-1] if text.endswith("\n") else text).split("\n")
 
 
 class _Decoder:
@@ -102,29 +176,6 @@ class _Decoder:
                 self.encoding = "latin-1"
                 return data[: error.start].decode("utf-8") + data[error.start :].decode("latin-1")
         return data.decode("latin-1")
-
-
-def _open_text(path: Path):
-    """A binary stream of the file's UTF-8 (or Latin-1) bytes, without byte-order mark."""
-    stream = open(path, "rb")  # noqa: SIM115 - closed by the caller
-    head = stream.read(4)
-    if head.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)) and not head.startswith(
-        codecs.BOM_UTF32_LE
-    ):
-        # A spreadsheet's "Unicode text": limited to about a million rows, so decoded whole.
-        with stream:
-            data = head + stream.read()
-        try:
-            return io.BytesIO(data.decode("utf-16").encode("utf-8"))
-        except UnicodeDecodeError as error:
-            from ecofmaps.io.recording_types import RecordingError
-
-            text = data[: error.start].decode("utf-16", errors="replace")
-            raise RecordingError(
-                path, text.count("\n") + 1, "damaged UTF-16 text (an odd byte)"
-            ) from None
-    stream.seek(len(codecs.BOM_UTF8) if head.startswith(codecs.BOM_UTF8) else 0)
-    return stream
 
 
 def _separator(header: str):
@@ -158,6 +209,56 @@ def _header_names(line: str, separator) -> list[str]:
     return [name.lstrip("\ufeff") for name in names]
 
 
+def _numeric(cells) -> bool:
+    """Whether every cell is a number (point or comma) or a missing sample."""
+    return all(_NUMBER.match(cell) or cell in _NOT_A_NUMBER for cell in cells)
+
+
+def _wanted(options: dict) -> dict:
+    """The column asked for by role: a recording's, or those given (a scar profile's x and
+    z); the cycle column only if given (else it is optional)."""
+    if "columns" in options:  # exactly the columns given
+        return dict(options["columns"])
+    wanted = {"displacement": options["displacement_column"], "force": options["force_column"]}
+    for role in ("cycle", "load"):
+        if options.get(f"{role}_column") is not None:
+            wanted[role] = options[f"{role}_column"]
+    return wanted
+
+
+def _is_header(line: str, following: str | None, wanted: dict) -> bool:
+    """Whether ``line`` reads as the header: not all numbers, names in which every column
+    wanted is found, and as many cells as the next line holds (if there is one)."""
+    separator = _separator(line)
+    names = _header_names(line, separator)
+    if _numeric(names):
+        return False
+    if following is not None and len(_fields(following, separator)) != len(names):
+        return False
+    return all(matching_columns(names, name, role) for role, name in wanted.items())
+
+
+def _header_index(lines: list[str], options: dict) -> int | None:
+    """The index in ``lines`` (the file's first lines) of the header line.
+
+    After ``skip_rows`` lines, the first that is not blank or a comment; without it, the
+    first of the first :data:`PREAMBLE_LINES` such lines that reads as the header
+    (:func:`_is_header`), else (for the error it will give) the one before the first line
+    of numbers, or the first."""
+    skip = options.get("skip_rows")
+    found = (k for k in range(skip or 0, len(lines)) if _is_data(lines[k]))
+    data = list(itertools.islice(found, 1 if skip is not None else PREAMBLE_LINES + 1))
+    if skip is not None or not data:
+        return data[0] if data else None
+    wanted = _wanted(options)
+    following = [lines[k] for k in data[1:]] + [None]
+    for k, after in zip(data, following, strict=True):
+        if _is_header(lines[k], after, wanted):
+            return k
+    numbers = [i for i, k in enumerate(data) if _numeric(_fields(lines[k], _separator(lines[k])))]
+    return data[numbers[0] - 1] if numbers and numbers[0] > 0 else data[0]
+
+
 class _Layout:
     """What the header says: separator, names, the columns wanted and their scales."""
 
@@ -175,18 +276,11 @@ class _Layout:
                 "the first line holds numbers, not column names: add a header line "
                 "(e.g. displacement,force)",
             )
-        # The columns by role: a recording's, or those given (a scar profile's x and z).
-        wanted = options.get("columns") or {
-            "displacement": options["displacement_column"],
-            "force": options["force_column"],
-        }
+        wanted = _wanted(options)
         try:
-            if "columns" in options:  # exactly the columns given
-                pass
-            elif options["cycle_column"] is not None:
-                wanted["cycle"] = options["cycle_column"]
-            elif find_column(self.names, "cycle", "cycle", required=False) is not None:
-                wanted["cycle"] = "cycle"
+            optional = "columns" not in options and "cycle" not in wanted
+            if optional and find_column(self.names, "cycle", "cycle", required=False) is not None:
+                wanted["cycle"] = "cycle"  # a cycle column if there is one
             self.columns = {
                 role: find_column(self.names, name, role) for role, name in wanted.items()
             }
@@ -203,18 +297,20 @@ class _Layout:
                 name = self.names[self.columns[role]]
                 carried = [unit for unit in [split_unit(name)[1]] if unit is not None]
                 self.scales[role], self.units[role] = column_scale(
-                    role, options[f"{role}_unit"], carried, name
+                    role, options.get(f"{role}_unit"), carried, name
                 )
         except ColumnError as error:
             raise RecordingError(path, header_line, str(error)) from None
         self.scales["cycle"], self.units["cycle"] = 1.0, "1"
         self.width = len(self.names)
-        self.decimal = "." if self.separator == "," else None
+        self.decimal = None
         self.nan_policy = options["nan_policy"]
 
     def decide_decimal(self, body: str) -> None:
-        """Decimal comma or point, from the first block whose numbers show one."""
-        if _COMMA_DECIMAL.search(body):
+        """Decimal comma or point, from the first block whose numbers show one (with comma
+        separators, a decimal comma only in quoted cells)."""
+        comma = _QUOTED_COMMA_DECIMAL if self.separator == "," else _COMMA_DECIMAL
+        if comma.search(body):
             self.decimal = ","
         elif _POINT_DECIMAL.search(body):
             self.decimal = "."
@@ -345,7 +441,8 @@ def text_blocks(path: Path, options: dict, block_bytes: int = BLOCK_BYTES):
     ----------
     path : pathlib.Path
     options : dict
-        The column, unit and nan_policy options of :func:`ecofmaps.io.read_recording`.
+        The column, unit, ``skip_rows`` and nan_policy options of
+        :func:`ecofmaps.io.read_recording`.
     block_bytes : int
         Bytes of text parsed at a time.
 
@@ -361,50 +458,71 @@ def text_blocks(path: Path, options: dict, block_bytes: int = BLOCK_BYTES):
     ------
     RecordingError
         For a missing or doubtful column, a line with the wrong number of fields, a cell
-        that is not a number (or, with ``nan_policy='raise'``, a missing one), or no data.
+        that is not a number (or, with ``nan_policy='raise'``, a missing one), no data, or
+        damaged compressed data.
     """
-    from ecofmaps.io.recording_types import RecordingError
-
     decoder = _Decoder(path)
-    layout = None
-    line = 1  # number of the first line of the block
-    with _open_text(path) as stream:
-        for raw in _raw_blocks(stream, block_bytes):
+    chunks = _file_bytes(path, block_bytes)
+    blocks = _line_blocks(chunks)
+    try:
+        lines = _head(blocks, decoder, options)
+        header = _header_index(lines, options)
+        if header is None:
+            from ecofmaps.io.recording_types import RecordingError
+
+            raise RecordingError(path, max(len(lines), 1), "no header line and no data")
+        layout = _Layout(path, header + 1, lines[header], options)
+        yield layout
+        yield from _parsed_lines(layout, lines[header + 1 :], header + 2)
+        for raw, start in blocks:
             check_interrupted()
-            start = line
-            line += raw.count(b"\n") + (not raw.endswith(b"\n"))
-            if layout is not None and decoder.encoding == "utf-8" and b"#" not in raw:
+            if decoder.encoding == "utf-8" and b"#" not in raw:
                 # Most blocks hold data lines only: parsed from the bytes as they are.
-                numbers = start + np.arange(line - start, dtype=np.int64)
+                count = raw.count(b"\n") + (not raw.endswith(b"\n"))
+                numbers = start + np.arange(count, dtype=np.int64)
                 values = layout.parse(raw[:-1] if raw.endswith(b"\n") else raw, numbers)
                 if values is not None:
                     yield values, numbers
                     continue
-            # The header, comments, blank lines, or something amiss: line by line.
-            text = decoder(raw, start)
-            if "\r" in text:
-                text = text.replace("\r\n", "\n")
-            lines = (text[:-1] if text.endswith("\n") else text).split("\n")
-            if layout is None:
-                header = next((k for k, text in enumerate(lines) if _is_data(text)), None)
-                if header is None:
-                    continue
-                layout = _Layout(path, start + header, lines[header], options)
-                yield layout
-                start += header + 1
-                lines = lines[header + 1 :]
-                body = "\n".join(lines)
-                if lines and "#" not in body:  # the rest of the first block, as it is
-                    numbers = start + np.arange(len(lines), dtype=np.int64)
-                    values = layout.parse(body, numbers)
-                    if values is not None:
-                        yield values, numbers
-                        continue
-            kept = layout.data_lines(lines)
-            if not kept:
-                continue
-            numbers = start + np.asarray(kept, dtype=np.int64)
-            lines = [lines[k] for k in kept]
-            yield layout.parse("\n".join(lines), numbers, lines=lines), numbers
-    if layout is None:
-        raise RecordingError(path, max(line - 1, 1), "no header line and no data")
+            # Comments, blank lines, or something amiss: line by line.
+            yield from _parsed_lines(layout, _text_lines(decoder(raw, start)), start)
+    finally:
+        blocks.close()
+        chunks.close()
+
+
+def _head(blocks, decoder: _Decoder, options: dict) -> list[str]:
+    """The first lines of the file, decoded: whole blocks, enough to find the header (the
+    first line that is not blank or a comment after ``skip_rows``, or
+    :data:`PREAMBLE_LINES` and one of them)."""
+    skip = options.get("skip_rows")
+    needed = 1 if skip is not None else PREAMBLE_LINES + 1
+    lines: list[str] = []
+    found = 0
+    for raw, start in blocks:
+        check_interrupted()
+        new = _text_lines(decoder(raw, start))
+        first = max((skip or 0) - len(lines), 0)
+        lines += new
+        found += sum(1 for _ in itertools.islice(filter(_is_data, new[first:]), needed))
+        if found >= needed:
+            break
+    return lines
+
+
+def _parsed_lines(layout: _Layout, lines: list[str], start: int):
+    """The values and line numbers of the data in decoded ``lines`` (the first numbered
+    ``start``): parsed as one text if it has no comment (and all goes well), else line by
+    line, raising for the first damaged one."""
+    body = "\n".join(lines)
+    if lines and "#" not in body:
+        numbers = start + np.arange(len(lines), dtype=np.int64)
+        values = layout.parse(body, numbers)
+        if values is not None:
+            yield values, numbers
+            return
+    kept = layout.data_lines(lines)
+    if kept:
+        numbers = start + np.asarray(kept, dtype=np.int64)
+        lines = [lines[k] for k in kept]
+        yield layout.parse("\n".join(lines), numbers, lines=lines), numbers
