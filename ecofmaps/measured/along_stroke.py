@@ -39,6 +39,19 @@ _VARIATION_SIGNIFICANCE = 4.0
 #: Values of μ(ξ) beyond this many robust standard deviations of the median are clipped.
 _WINSOR = 3.0
 
+#: Blocks of the central part whose means give the scatter of μ(ξ) (batch means).
+_SCATTER_BLOCKS = 8
+
+#: The GICoF is flagged where the mean of μ(ξ) over the centre of the central part,
+#: ``|ξ| <= _CENTRE`` times its half-width, differs from mu_resolved by this share of μ
+#: and this many times the noise of the difference.
+_CENTRE = 0.25
+_GICOF_OFF = 0.015
+_GICOF_SIGNIFICANCE = 3.0
+
+#: The largest lag-one autocorrelation of the block means that is believed.
+_R1 = 0.8
+
 #: Cycles analysed together: a block's arrays stay in the processor's cache.
 _BLOCK = 512
 
@@ -106,10 +119,45 @@ def _central_values(forward, backward, central, load):
     mean_g = masked_sum(slope, finite) / points
     dxi = at - mean_xi[:, None]
     k = masked_sum(dxi * (slope - mean_g[:, None]), finite) / masked_sum(dxi**2, finite)
-    # The sensitivity of mu_resolved to the compliance 1/S (module notes).
-    turning = k[:, None] / (1.0 + slope**2) * (q_forward - q_backward)
-    sensitivity = 0.5 * (1.0 + mu_resolved**2) * masked_sum(turning, finite) / points
-    return mu_resolved, variance, k, mean_g - k * mean_xi, sensitivity, varies
+    # The sensitivities of mu_resolved to the compliance 1/S and to a shift of the rising
+    # branch against the falling one along ξ (module notes).
+    turning = k[:, None] / (1.0 + slope**2)
+    factor = 0.5 * (1.0 + mu_resolved**2) / points
+    sensitivity = factor * masked_sum(turning * (q_forward - q_backward), finite)
+    shifting = -factor * masked_sum(turning, finite)
+    # The scatter of μ(ξ) beyond the noise: correlated residuals, the model's misfit.
+    # The GICoF is read near ξ = 0: is μ(ξ) there the mean, up to the noise?
+    centre = finite & (np.abs(unit) <= _CENTRE)
+    off = masked_sum(mu, centre) / np.count_nonzero(centre, axis=1) - mu_resolved
+    noise = np.sqrt(variance * 0.5 / _CENTRE)  # a mean over _CENTRE of the part's points
+    wavers = np.abs(off) > _GICOF_OFF * np.abs(mu_resolved) + _GICOF_SIGNIFICANCE * noise
+    variance = np.maximum(variance, _scatter_variance(mu, finite, unit))
+    tilt = mean_g - k * mean_xi
+    return mu_resolved, variance, k, tilt, sensitivity, varies, shifting, wavers
+
+
+def _scatter_variance(mu, kept, unit):
+    r"""Variance of the mean of ``mu`` over ``kept`` from the scatter of its block means.
+
+    The central part is cut into ``_SCATTER_BLOCKS`` blocks of equal length; the block
+    means' variance about their mean, over their number less one, and times
+    :math:`(1 + r_1)/(1 - r_1)` for the lag-one autocorrelation :math:`r_1 \ge 0` of the
+    block means (friction that varies slowly along the stroke), is the variance of the
+    mean of independent blocks (batch means). NaN for fewer than three blocks.
+    """
+    member = np.minimum((0.5 * (unit + 1.0) * _SCATTER_BLOCKS).astype(int), _SCATTER_BLOCKS - 1)
+    blocks = member[:, None] == np.arange(_SCATTER_BLOCKS)[None, :]
+    counts = kept.astype(np.float64) @ blocks
+    means = (np.where(kept, mu, 0.0) @ blocks) / np.maximum(counts, 1.0)
+    used = counts > 0
+    number = np.count_nonzero(used, axis=1)
+    centre = masked_sum(means, used) / number
+    residual = np.where(used, means - centre[:, None], 0.0)
+    squares = np.sum(residual**2, axis=1)
+    lagged = np.sum(residual[:, 1:] * residual[:, :-1], axis=1)
+    r1 = np.clip(np.divide(lagged, squares, out=np.zeros_like(squares), where=squares > 0), 0, _R1)
+    spread = squares / np.maximum(number - 1, 1) / np.maximum(number, 1)
+    return np.where(number >= 3, spread * (1.0 + r1) / (1.0 - r1), np.nan)
 
 
 def _along_stroke(forward, backward, grid, lowest, highest, tilt, load, level):
@@ -144,6 +192,11 @@ def _reaches_resolved(quality) -> np.ndarray:
         r for r, (_, scope) in REASONS.items() if scope == ALL or set(RESOLVED) & set(scope)
     ]
     return np.logical_or.reduce([has_reason(quality, reason) for reason in reaching])
+
+
+def joined_values(parts, index):
+    """The per-cycle values number ``index`` of :func:`_central_values`, over all blocks."""
+    return np.concatenate([part["values"][index] for part in parts])
 
 
 def _blocks(cycles):
@@ -199,15 +252,22 @@ def _resolve(x, q, valid, load, stiffness, amplitude, quality, given, options):
     for code, reason in enumerate(QUALITY_FLAGS, start=1):
         quality = add_reason(quality, flag == code, reason)
     ok = ~inherited & (flag == 0)
+    wavers = joined_values(parts, 7) & ((flag == 0) | (flag == 4))
+    quality = add_reason(quality, wavers & ~inherited, "gicof-varies")
     lowest, highest = joined("lowest"), joined("highest")
-    mu_resolved, variance, k, tilt, sensitivity = (
-        np.concatenate([part["values"][i] for part in parts]) for i in range(5)
+    mu_resolved, variance, k, tilt, sensitivity, _, shifting = (
+        joined_values(parts, i) for i in range(7)
     )
     nan = np.where(ok, 1.0, np.nan)
     compliance = joined("compliance")
     per_cycle = {
         "mu_resolved": mu_resolved * nan,
-        "mu_resolved_se": np.sqrt(variance + (sensitivity * joined("compliance_se")) ** 2) * nan,
+        "mu_resolved_se": np.sqrt(
+            variance
+            + (sensitivity * joined("compliance_se")) ** 2
+            + (shifting * joined("shift")) ** 2
+        )
+        * nan,
         "aspect_ratio": 0.5 * k * amplitude * nan,
         "tilt": tilt * nan,
         "stiffness": 1.0 / compliance,

@@ -140,6 +140,12 @@ REASONS = {
         "its central part by more than 3 % and four standard errors (not the model's loop)",
         RESOLVED,
     ),
+    "gicof-varies": (
+        "the friction read along the stroke near its centre, where the GICoF is read, "
+        "differs from its mean over the central part by more than 1.5 % and three times the "
+        "noise (chatter, stick-slip): the GICoF is not the contact's mean friction",
+        _GICOF,
+    ),
 }
 
 

@@ -26,6 +26,9 @@ _STICK_MARGIN = 0.05
 #: A sample has moved off the stick level, noise-free, beyond this share of Δ*.
 _ROUNDING = 1e-9
 
+#: Slip samples at the end of a branch whose median ξ is compared with the next stick level.
+_END_SAMPLES = 4
+
 #: The median of |N(0, 6)|, the second difference of white noise of unit variance.
 _SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
 
@@ -92,7 +95,7 @@ def _compliance(x, q, sticks):
 def _stick_and_slip(xi, branches, sticks, floor, slip_threshold):
     """Noise and the slip of each branch (module notes).
 
-    Returns the noise σ of ξ and the two slip masks.
+    Returns the noise σ of ξ, the two slip masks and the two stick levels.
     """
     # σ from the second differences within the stick sets: a smooth trend of ξ (a rounded
     # loop, a wrong stiffness) hardly enters them, white noise does with variance 6σ².
@@ -103,7 +106,7 @@ def _stick_and_slip(xi, branches, sticks, floor, slip_threshold):
     sigma = masked_median(second, triples) / _SECOND_DIFFERENCE
     sigma = np.where(np.isfinite(sigma), sigma, 0.0)
     threshold = slip_threshold * sigma + floor
-    slips = []
+    slips, levels = [], []
     for branch, stick, sign in zip(branches, sticks, (1.0, -1.0), strict=True):
         # The stick level: the set's median, or the reversal's ξ where the set has too few
         # samples to judge (a sparse loop, or the model's loop drawn with straight sides).
@@ -114,7 +117,27 @@ def _stick_and_slip(xi, branches, sticks, floor, slip_threshold):
         beyond = np.where(branch, sign * xi, np.inf)
         least = np.minimum.accumulate(beyond[:, ::-1], axis=1)[:, ::-1]
         slips.append(branch & (least > (sign * level + threshold)[:, None]))
-    return sigma, slips
+        levels.append(level)
+    return sigma, slips, levels
+
+
+def _branch_shift(xi, branches, slips, levels):
+    r"""How far the rising branch's slip lies beyond the falling one's, in ξ, per cycle.
+
+    At each reversal the pad stops where the slip ended: the stick set that follows has
+    the :math:`\xi` of the last slip samples before it. A dead band between the actuator
+    and the pad (backlash), or a drift of the displacement over the cycle, breaks this:
+    the gaps between the median :math:`\xi` of the last ``_END_SAMPLES`` slip samples of a
+    branch and the next stick level, averaged over the two reversals, are the shift of
+    the rising branch against the falling one (zero for the model's loop, up to the
+    noise). NaN where a branch has no slip.
+    """
+    gaps = []
+    for slip, level in zip(slips, levels[::-1], strict=True):
+        # The last slip samples of the branch in time: its slip runs to the reversal.
+        last = slip & (np.cumsum(slip[:, ::-1], axis=1)[:, ::-1] <= _END_SAMPLES)
+        gaps.append(masked_median(xi, last) - level)
+    return 0.5 * (gaps[0] - gaps[1])
 
 
 def _sorted_branch(xi, q, slip):
@@ -149,7 +172,7 @@ def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_t
     # does the slip start?
     start = np.where(np.isinf(stiffness), 0.0, 1.0 / stiffness)
     xi = x - start[:, None] * q
-    _, slips = _stick_and_slip(xi, branches, windows, floor, slip_threshold)
+    _, slips, _ = _stick_and_slip(xi, branches, windows, floor, slip_threshold)
     # The stick sets: from the window's lower share up to a margin before the slip.
     sticks = []
     for share, branch, slip, window in zip(moved, branches, slips, windows, strict=True):
@@ -170,7 +193,7 @@ def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_t
     compliance = np.maximum(compliance, 0.0)
     # Second pass, with the stiffness used and the stick sets.
     xi = x - compliance[:, None] * q
-    sigma, slips = _stick_and_slip(xi, branches, sticks, floor, slip_threshold)
+    sigma, slips, levels = _stick_and_slip(xi, branches, sticks, floor, slip_threshold)
     mismatch = negative
     if given:  # a stiffness that does not fit the stick sides tilts them in ξ
         tilt, _ = _compliance(xi, q, sticks)
@@ -183,6 +206,7 @@ def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_t
         )
         judged = np.all([np.count_nonzero(s, axis=1) >= _STICK_SAMPLES for s in sticks], axis=0)
         mismatch = mismatch | judged & ~(np.abs(tilt) * span <= _TILT_SPREAD * sigma + floor)
+    shift = _branch_shift(xi, branches, slips, levels)
     forward = _sorted_branch(xi, q, slips[0])
     backward = _sorted_branch(xi, q, slips[1])
     ends = []
@@ -193,6 +217,7 @@ def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_t
         "compliance": compliance,
         "compliance_se": compliance_se,
         "mismatch": mismatch,
+        "shift": shift,
         "forward": forward,
         "backward": backward,
         "lowest": np.maximum(ends[0][0], ends[1][0]),
