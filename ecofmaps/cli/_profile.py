@@ -4,12 +4,19 @@ A measured wear-scar profile (a profilometer trace across the scar, read by
 :func:`ecofmaps.read_scar_profile`) replaces the parabolic groove of the paper's eq. 11.
 The reading options are those of :func:`ecofmaps.read_scar_profile`; they apply only with
 ``--scar-profile``, and the groove options of the parabola (``--aspect-ratio``, the scar's
-depth and half-width) cannot be given with it.
+depth and half-width) cannot be given with it. What the reading decided (outliers replaced,
+ambiguous edges beside pile-up ridges) is printed on standard error, one line each naming
+the file, and the rows show the half-width taken beside the alternative.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
+import sys
+import warnings
+
+import numpy as np
 
 from ecofmaps.cli._common import CommandError, quantity, row, unit
 
@@ -76,6 +83,7 @@ def add_profile_options(parser: argparse.ArgumentParser) -> None:
         help="where the pad at slip position x sits on the profile: 'scaled', X = x W/x_o "
         "(eq. 11, the paper's; default), or 'physical', X = x",
     )  # fmt: skip
+    parser.set_defaults(profile_command=parser.prog)
 
 
 def read_profile(args, conflicting=()):
@@ -93,6 +101,12 @@ def read_profile(args, conflicting=()):
         For a groove option given with ``--scar-profile``, or a reading option without it.
     ScarProfileError
         For a damaged file (its name and line).
+
+    Notes
+    -----
+    The reader's :class:`~ecofmaps.model.profiles.ScarProfileWarning` (outliers replaced,
+    ambiguous edges) are printed on standard error, one line each, naming the file; for
+    ambiguous edges the line ends with the ``--profile-half-width`` that takes the groove.
     """
     if args.scar_profile is None:
         given = [name for name in PROFILE_OPTIONS if getattr(args, name) is not None]
@@ -110,18 +124,32 @@ def read_profile(args, conflicting=()):
     for name, value in _DEFAULTS.items():
         if getattr(args, name) is None:
             setattr(args, name, value)
+    # JAX and the readers load with the first profile read, not with the command line
     from ecofmaps.io.scar_profiles import read_scar_profile
+    from ecofmaps.model.profiles import ScarProfileWarning
 
-    return read_scar_profile(
-        args.scar_profile,
-        x_column=args.x_column,
-        z_column=args.z_column,
-        x_unit=args.x_unit,
-        z_unit=args.z_unit,
-        level=not args.no_level,
-        half_width=args.profile_half_width,
-        smoothing=args.smoothing,
-    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ScarProfileWarning)
+        profile = read_scar_profile(
+            args.scar_profile,
+            x_column=args.x_column,
+            z_column=args.z_column,
+            x_unit=args.x_unit,
+            z_unit=args.z_unit,
+            level=not args.no_level,
+            half_width=args.profile_half_width,
+            smoothing=args.smoothing,
+        )
+    for item in caught:
+        if not issubclass(item.category, ScarProfileWarning):
+            warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
+            continue
+        alternative = item.message.alternative
+        hint = "" if alternative is None else (
+            f"; --profile-half-width {alternative * 1e6:.6g}um takes the groove"
+        )  # fmt: skip
+        print(f"{args.profile_command}: warning: {item.message.summary}{hint}", file=sys.stderr)
+    return profile
 
 
 def _options(names) -> str:
@@ -129,18 +157,28 @@ def _options(names) -> str:
 
 
 def profile_rows(args, profile) -> list:
-    """Rows naming the profile: its file and samples, depth D, half-width W, D/W."""
+    """Rows naming the profile: its file and samples, depth D, half-width W (and the
+    alternative when the edges were ambiguous), D/W."""
     samples = int(profile.position.shape[-1])
     reading = [f"{samples} samples", "as given" if args.no_level else "levelled"]
+    replaced = int(np.count_nonzero(np.asarray(profile.replaced)))
+    if replaced:
+        reading.append(f"{replaced} outlier(s) replaced")
     if args.smoothing is not None:
         reading.append(f"slopes smoothed over {args.smoothing * 1e6:.6g} µm")
+    alternative = float(profile.alternative_half_width)
     how = "(given)" if args.profile_half_width is not None else "(detected)"
-    return [
+    if not math.isnan(alternative):
+        how = "(band)"
+    rows = [
         ("scar profile", "", f"{args.scar_profile} ({', '.join(reading)})"),
         row("scar_depth", float(profile.depth)),
         row("scar_half_width", float(profile.half_width), how),
-        ("scar aspect ratio", "D/W", f"{float(profile.aspect_ratio):.6g}"),
     ]
+    if not math.isnan(alternative):
+        rows.append(row("scar_half_width", alternative, "(or groove)"))
+    rows.append(("scar aspect ratio", "D/W", f"{float(profile.aspect_ratio):.6g}"))
+    return rows
 
 
 #: Width of the first value column when a profile's values stand beside the parabola's.
