@@ -114,6 +114,7 @@ def recording_options(args) -> dict:
         "displacement_column": args.displacement_col,
         "force_column": args.force_col,
         "cycle_column": args.cycle_col,
+        "skip_rows": args.skip_rows,
         "displacement_unit": args.displacement_unit,
         "force_unit": args.force_unit,
         "group": args.group,

@@ -43,6 +43,10 @@ def add(subparsers) -> None:
     parser.add_argument("--force-col", default="force", metavar="NAME")
     parser.add_argument("--cycle-col", default=None, metavar="NAME")
     parser.add_argument(
+        "--skip-rows", type=int, default=None, metavar="N",
+        help="lines of a text file to skip before its header (default: found)",
+    )  # fmt: skip
+    parser.add_argument(
         "--displacement-unit", type=unit("length"), default=None, metavar="UNIT",
         help="unit of the displacement column (default: from its name or the file, else um)",
     )  # fmt: skip

@@ -86,6 +86,11 @@ def add(subparsers) -> None:
         "(default: 'cycle' if the file has it; else cycles are cut at the reversals)",
     )  # fmt: skip
     parser.add_argument(
+        "--skip-rows", type=int, default=None, metavar="N",
+        help="lines of a text file to skip before its header line (default: metadata "
+        "lines before the header are found)",
+    )  # fmt: skip
+    parser.add_argument(
         "--displacement-unit", type=unit("length"), default=None, metavar="UNIT",
         help="unit of the displacement column (default: the one its name or the file gives, "
         "as in 'displacement [mm]' or a channel's unit, else um)",
