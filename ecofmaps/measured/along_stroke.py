@@ -42,12 +42,9 @@ _WINSOR = 3.0
 #: Blocks of the central part whose means give the scatter of μ(ξ) (batch means).
 _SCATTER_BLOCKS = 8
 
-#: The GICoF is flagged where the mean of μ(ξ) over the centre of the central part,
-#: ``|ξ| <= _CENTRE`` times its half-width, differs from mu_resolved by this share of μ
-#: and this many times the noise of the difference.
-_CENTRE = 0.25
-_GICOF_OFF = 0.015
-_GICOF_SIGNIFICANCE = 3.0
+#: The GICoF is flagged where the block means of μ(ξ) scatter about a straight line by
+#: this share of μ (standard deviation) beyond the noise.
+_GICOF_WIGGLE = 0.015
 
 #: The largest lag-one autocorrelation of the block means that is believed.
 _R1 = 0.8
@@ -126,12 +123,12 @@ def _central_values(forward, backward, central, load):
     sensitivity = factor * masked_sum(turning * (q_forward - q_backward), finite)
     shifting = -factor * masked_sum(turning, finite)
     # The scatter of μ(ξ) beyond the noise: correlated residuals, the model's misfit.
-    # The GICoF is read near ξ = 0: is μ(ξ) there the mean, up to the noise?
-    centre = finite & (np.abs(unit) <= _CENTRE)
-    off = masked_sum(mu, centre) / np.count_nonzero(centre, axis=1) - mu_resolved
-    noise = np.sqrt(variance * 0.5 / _CENTRE)  # a mean over _CENTRE of the part's points
-    wavers = np.abs(off) > _GICOF_OFF * np.abs(mu_resolved) + _GICOF_SIGNIFICANCE * noise
-    variance = np.maximum(variance, _scatter_variance(mu, finite, unit))
+    scatter, wiggle = _scatter_variance(mu, finite, unit)
+    # μ(ξ) wiggles along the stroke beyond the noise: the GICoF, read at one position,
+    # is not the mean friction (a straight trend is the same at the centre).
+    excess = np.sqrt(np.maximum(wiggle - variance * _SCATTER_BLOCKS, 0.0))
+    wavers = excess > _GICOF_WIGGLE * np.abs(mu_resolved)
+    variance = np.maximum(variance, scatter)
     tilt = mean_g - k * mean_xi
     return mu_resolved, variance, k, tilt, sensitivity, varies, shifting, wavers
 
@@ -144,6 +141,8 @@ def _scatter_variance(mu, kept, unit):
     :math:`(1 + r_1)/(1 - r_1)` for the lag-one autocorrelation :math:`r_1 \ge 0` of the
     block means (friction that varies slowly along the stroke), is the variance of the
     mean of independent blocks (batch means). NaN for fewer than three blocks.
+
+    Also returns the variance of the block means about a straight line through them.
     """
     member = np.minimum((0.5 * (unit + 1.0) * _SCATTER_BLOCKS).astype(int), _SCATTER_BLOCKS - 1)
     blocks = member[:, None] == np.arange(_SCATTER_BLOCKS)[None, :]
@@ -157,7 +156,12 @@ def _scatter_variance(mu, kept, unit):
     lagged = np.sum(residual[:, 1:] * residual[:, :-1], axis=1)
     r1 = np.clip(np.divide(lagged, squares, out=np.zeros_like(squares), where=squares > 0), 0, _R1)
     spread = squares / np.maximum(number - 1, 1) / np.maximum(number, 1)
-    return np.where(number >= 3, spread * (1.0 + r1) / (1.0 - r1), np.nan)
+    place = np.where(used, np.arange(_SCATTER_BLOCKS)[None, :], 0.0)
+    place = np.where(used, place - (masked_sum(place, used) / number)[:, None], 0.0)
+    trend = np.sum(residual * place, axis=1) / np.sum(place**2, axis=1)
+    wiggle = np.sum((residual - trend[:, None] * place) ** 2, axis=1) / (number - 2)
+    few = number < 3
+    return np.where(few, np.nan, spread * (1.0 + r1) / (1.0 - r1)), np.where(few, np.nan, wiggle)
 
 
 def _along_stroke(forward, backward, grid, lowest, highest, tilt, load, level):

@@ -141,9 +141,9 @@ REASONS = {
         RESOLVED,
     ),
     "gicof-varies": (
-        "the friction read along the stroke near its centre, where the GICoF is read, "
-        "differs from its mean over the central part by more than 1.5 % and three times the "
-        "noise (chatter, stick-slip): the GICoF is not the contact's mean friction",
+        "the friction read along the stroke wiggles beyond the noise (its means over eighths "
+        "of the central part scatter about a straight line by more than 1.5 % of μ: chatter, "
+        "stick-slip): the GICoF, read at one position, is not the contact's mean friction",
         _GICOF,
     ),
 }
