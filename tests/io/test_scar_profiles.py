@@ -6,6 +6,7 @@ import pytest
 import ecofmaps
 from ecofmaps.io.scar_profiles import ScarProfileError
 from ecofmaps.measured.synthetic import scar_example_path, scar_example_trace
+from ecofmaps.model.profiles import ScarProfileWarning
 
 
 def write(path, text):
@@ -79,3 +80,73 @@ def test_units_must_be_lengths(tmp_path):
     path = write(tmp_path / "scar.csv", "x,z\n1,2\n")
     with pytest.raises(ValueError, match="z_unit='N' is not a length unit"):
         ecofmaps.read_scar_profile(path, z_unit="N")
+
+
+# --- instruments' exports, outliers and ambiguous edges (issue 23, item 8) ----------------
+
+
+def stylus_export(path, separator, x_mm, z_um, header=('"Distance [mm]"', '"Profile (um)"')):
+    """A stylus export: quoted names with units, quoted values with decimal commas."""
+    rows = [separator.join(header)]
+    pairs = zip(x_mm, z_um, strict=True)
+    rows += [f'"{a:.6f}"{separator}"{b:.5f}"'.replace(".", ",") for a, b in pairs]
+    path.write_text("\n".join(rows) + "\n", encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize("separator", [",", ";"], ids=["comma", "semicolon"])
+def test_quoted_decimal_comma_exports_with_units_in_the_names(tmp_path, separator):
+    """ "Distance [mm]","Profile (um)" / "0,000500","-0,01200": read as the arrays."""
+    x, z = scar_example_trace()
+    path = stylus_export(tmp_path / "stylus.csv", separator, x * 1e3, z * 1e6)
+    profile = ecofmaps.read_scar_profile(path, x_column="Distance", z_column="Profile")
+    expected = ecofmaps.scar_profile(np.round(x * 1e3, 6) / 1e3, np.round(z * 1e6, 5) / 1e6,
+                                     level=True)  # fmt: skip
+    assert float(profile.half_width) == pytest.approx(float(expected.half_width), rel=1e-9)
+    assert float(profile.depth) == pytest.approx(float(expected.depth), rel=1e-9)
+
+
+def test_a_damaged_cell_of_an_export_names_the_file_and_line(tmp_path):
+    x, z = scar_example_trace()
+    path = stylus_export(tmp_path / "stylus.csv", ",", x * 1e3, z * 1e6)
+    lines = path.read_text(encoding="utf-8").splitlines()
+    lines[4] = '"0,008000","-0,0x1"'
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    with pytest.raises(ScarProfileError, match="non-numeric value '-0,0x1' in column") as caught:
+        ecofmaps.read_scar_profile(path, x_column="Distance", z_column="Profile")
+    assert caught.value.path == path and caught.value.line == 5
+
+
+def test_a_dropout_is_replaced_and_its_line_named(tmp_path):
+    """A dropout 30 µm down on line 702 of the file: replaced, the warning names the file
+    and the line, and the profile is the clean trace's."""
+    x, z = scar_example_trace()
+    text = "x,z\n" + "\n".join(f"{a * 1e6:.1f},{b * 1e6:.4f}" for a, b in zip(x, z, strict=True))
+    clean = ecofmaps.read_scar_profile(write(tmp_path / "clean.csv", text))
+    lines = text.splitlines()
+    a, b = (float(v) for v in lines[701].split(","))
+    lines[701] = f"{a:.1f},{b - 30.0:.4f}"
+    path = write(tmp_path / "dropout.csv", "\n".join(lines))
+    where = rf"line 702 \(x = {a:.6g} µm, 30 µm below its neighbours\)$"
+    with pytest.warns(ScarProfileWarning, match=rf"^{path}: 1 outlier\(s\) .*: {where}"):
+        profile = ecofmaps.read_scar_profile(path)
+    assert np.flatnonzero(np.asarray(profile.replaced)).tolist() == [700]
+    assert float(profile.depth) == pytest.approx(float(clean.depth), rel=1e-4)
+    assert float(profile.half_width) == pytest.approx(float(clean.half_width), rel=1e-4)
+
+
+def test_ambiguous_edges_are_a_warning_naming_the_file(tmp_path):
+    """A groove 31 µm in half-width inside a band 170 µm wide between ridges: the band is
+    taken, the warning names the file and gives both half-widths."""
+    x = np.arange(-400.0, 400.01, 0.5)  # µm
+    z = np.where(np.abs(x) < 31, -3 * (1 - (x / 31) ** 2), 0.0)
+    z += np.where((np.abs(x) >= 31) & (np.abs(x) < 85), 0.35 + 0.15 * np.sin(x / 1.75), 0.0)
+    v = (np.abs(x) - 85) / 30
+    z += np.where((v > 0) & (v < 1), 1.5 * np.sin(np.pi * v) ** 2, 0.0)
+    text = "x,z\n" + "\n".join(f"{a:.1f},{b:.5f}" for a, b in zip(x, z, strict=True))
+    path = write(tmp_path / "track.csv", text)
+    with pytest.warns(ScarProfileWarning, match=rf"^{path}: ambiguous scar edges") as caught:
+        profile = ecofmaps.read_scar_profile(path)
+    assert float(profile.half_width) == pytest.approx(85e-6, abs=1e-6)
+    assert float(profile.alternative_half_width) == pytest.approx(31e-6, abs=1e-6)
+    assert caught[0].message.alternative == float(profile.alternative_half_width)

@@ -1,0 +1,186 @@
+"""Measured scar profiles as instruments give them: spikes and dropouts, pile-up ridges,
+debris and roughness beside and in the track, ambiguous edges (issue 23, item 8)."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+import ecofmaps
+from ecofmaps.model.profiles import (
+    OUTLIER_NEIGHBOURS,
+    ScarProfileWarning,
+    outlying_samples,
+    scar_profile,
+)
+
+UM = 1e-6
+W, D = 200 * UM, 10 * UM  # the generated scars' half-width and depth
+X = np.arange(-600.0, 600.01, 1.0) * UM  # a trace every 1 µm over 1.2 mm
+POINT = dict(amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8)
+
+
+def scar(kind, x=X, half_width=W, depth=D):
+    """A parabolic, flat-bottomed (half of the half-width flat) or V scar in a flat surface."""
+    u = np.abs(x) / half_width
+    wall = {"parabola": u * u, "flat": np.clip((u - 0.5) / 0.5, 0, 1) ** 2, "V": u}[kind]
+    return np.where(u < 1.0, -depth * (1.0 - wall), 0.0)
+
+
+def ridges(x, inner, height, width):
+    """Pile-up ridges H sin²(πv) beside |x| = inner, v = (|x| - inner)/width in (0, 1)."""
+    v = (np.abs(x) - inner) / width
+    return np.where((v > 0.0) & (v < 1.0), height * np.sin(np.pi * v) ** 2, 0.0)
+
+
+def bump(x, at, height, sigma):
+    """A Gaussian bump (debris) or, with a negative height, a valley."""
+    return height * np.exp(-0.5 * ((x - at) / sigma) ** 2)
+
+
+def silently(function, *args, **kwargs):
+    """Call ``function``; fail on any ScarProfileWarning."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ScarProfileWarning)
+        return function(*args, **kwargs)
+
+
+def noise(seed, size, sigma=0.05 * UM):
+    return sigma * np.random.default_rng(seed).normal(size=size)
+
+
+# --- outliers ----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("kind", ["parabola", "flat", "V"])
+@pytest.mark.parametrize("seed", [None, 1, 2, 3])
+def test_clean_scars_lose_no_sample(kind, seed):
+    """No false positive on a parabola, a flat bottom, a V (kinks at the edges and the
+    bottom), exact or with noise, nor on a step between two samples."""
+    z = scar(kind) + (0.0 if seed is None else noise(seed, X.size))
+    assert not outlying_samples(X, z).any()
+    profile = silently(scar_profile, X, z)
+    assert not np.any(np.asarray(profile.replaced))
+    step = np.where(X < 0.0, 0.0, -D) + (0.0 if seed is None else noise(seed, X.size))
+    assert not outlying_samples(X, step).any()
+
+
+def test_no_false_positive_in_white_noise():
+    """6 scaled MADs of 8 neighbours: none of 2e5 samples of white noise is an outlier."""
+    rng = np.random.default_rng(20261126)
+    x = np.arange(20_000.0)
+    flagged = sum(int(outlying_samples(x, rng.normal(size=x.size)).sum()) for _ in range(10))
+    assert flagged == 0
+
+
+def test_a_dropout_gives_the_depth_and_ecof_of_the_clean_scar():
+    """One dropout (a spike 40 µm down) inside the scar: replaced, the depth within 0.1 %
+    and the ECoF within 1e-4 of the clean scar's; kept, it moves both by far more."""
+    clean_z = scar("parabola") + ridges(X, W, 2 * UM, 60 * UM) + noise(7, X.size)
+    spiked_z = clean_z.copy()
+    spiked_z[650] -= 40 * UM  # x = +50 µm
+    clean = silently(scar_profile, X, clean_z, level=True)
+    where = r": sample 650 \(x = 50 µm, 39.9 µm below its neighbours\)$"
+    with pytest.warns(ScarProfileWarning, match=r"^1 outlier\(s\) .*" + where):
+        spiked = scar_profile(X, spiked_z, level=True)
+    assert np.flatnonzero(np.asarray(spiked.replaced)).tolist() == [650]
+    assert float(spiked.depth) == pytest.approx(float(clean.depth), rel=1e-3)
+    assert float(spiked.half_width) == pytest.approx(float(clean.half_width), rel=1e-3)
+    ecof = [float(ecofmaps.energy_cof(**POINT, profile=p)) for p in (clean, spiked)]
+    assert ecof[1] == pytest.approx(ecof[0], rel=1e-4)
+    kept = silently(scar_profile, X, spiked_z, level=True, remove_outliers=False)
+    assert float(kept.depth) > 1.5 * float(clean.depth)
+    moved = float(ecofmaps.energy_cof(**POINT, profile=kept)) / ecof[0] - 1.0
+    assert abs(moved) > 1e-2
+
+
+def test_a_run_of_dropouts_and_a_spike_at_the_end_are_replaced():
+    """Up to OUTLIER_NEIGHBOURS - 1 outliers in a row, and one at the trace's first sample."""
+    z = scar("flat") + noise(8, X.size)
+    run = [400, 401, 402][: OUTLIER_NEIGHBOURS - 1]
+    z[run] -= 30 * UM
+    z[0] += 25 * UM
+    with pytest.warns(ScarProfileWarning, match=r"4 outlier\(s\)") as caught:
+        profile = scar_profile(X, z)
+    assert caught[0].message.samples == (0, *run)
+    assert float(profile.depth) == pytest.approx(D, rel=0.01)
+
+
+# --- pile-up ridges, debris, roughness: known truth -----------------------------------------
+
+
+@pytest.mark.parametrize("kind", ["parabola", "flat", "V"])
+def test_ridges_debris_roughness_with_known_truth(kind):
+    """Ridges 2 µm high and 60 µm wide beside the edges, debris in the track and on a
+    shoulder, roughness in the track, tilt, offset and noise: the half-width between the
+    ridges within 1 %, the depth below the shoulders' line within 4 % (the roughness is 0.4
+    µm), the tilt to 1e-5, and no warning (the walls run into the ridges)."""
+    z = scar(kind) + ridges(X, W, 2 * UM, 60 * UM)
+    z += np.where(np.abs(X) < W, 0.4 * UM * np.sin(2 * np.pi * X / (23 * UM)), 0.0)
+    z += bump(X, 60 * UM, 1.5 * UM, 4 * UM) + bump(X, -450 * UM, 2 * UM, 5 * UM)
+    z += 3 * UM + 0.002 * X + noise(9, X.size)
+    profile = silently(scar_profile, X, z)
+    assert float(profile.half_width) == pytest.approx(W, rel=0.01)
+    assert float(profile.depth) == pytest.approx(D, rel=0.04)
+    assert float(profile.reference_slope) == pytest.approx(0.002, abs=1e-5)
+    assert np.isnan(float(profile.alternative_half_width))
+
+
+def test_the_reference_line_comes_from_beyond_wide_ridges():
+    """Ridges half as wide as the scar, 40 % of its depth: the shoulders at 1.5 half-widths
+    would lie on them; the line from beyond them gives the depth and the tilt."""
+    z = scar("parabola") + ridges(X, W, 4 * UM, 150 * UM) + 0.001 * X + noise(10, X.size)
+    profile = silently(scar_profile, X, z)
+    assert float(profile.half_width) == pytest.approx(W, rel=0.005)
+    assert float(profile.depth) == pytest.approx(D, rel=0.005)
+    assert float(profile.reference_slope) == pytest.approx(0.001, abs=2e-5)
+
+
+# --- the two tracks of the issue ---------------------------------------------------------
+
+XI = np.arange(-400.0, 400.01, 0.5) * UM  # every 0.5 µm
+
+
+def rough_band_track():
+    """A disturbed band 200 µm wide (0.6 µm above the surface, rough) between ridges, with
+    one roughness valley 1.8 µm deep inside it: read before as a 6.5 µm half-width."""
+    waves = ((0.25, 17.0, 0.3), (0.2, 9.3, 1.1), (0.15, 31.0, 2.0))
+    rough = sum(a * np.sin(2 * np.pi * XI / (wave * UM) + p) for a, wave, p in waves)
+    z = np.where(np.abs(XI) < 100 * UM, (0.6 + rough) * UM, 0.0)
+    z += ridges(XI, 100 * UM, 1.2 * UM, 25 * UM) + bump(XI, 30 * UM, -1.8 * UM, 4 * UM)
+    return z + noise(11, XI.size, 0.02 * UM)
+
+
+def groove_in_band_track():
+    """A groove 31 µm in half-width, 3 µm deep, in a band 170 µm wide between ridges, its
+    floor rough and 0.35 µm above the surface, with debris: read before as 31 µm."""
+    z = np.where(np.abs(XI) < 31 * UM, -3 * UM * (1 - (XI / (31 * UM)) ** 2), 0.0)
+    floor = (np.abs(XI) >= 31 * UM) & (np.abs(XI) < 85 * UM)
+    rough = 0.15 * np.sin(2 * np.pi * XI / (11 * UM)) + 0.1 * np.sin(2 * np.pi * XI / (4.3 * UM))
+    z += np.where(floor, (0.35 + rough) * UM, 0.0) + ridges(XI, 85 * UM, 1.5 * UM, 30 * UM)
+    z += bump(XI, 55 * UM, 0.8 * UM, 2.5 * UM) + bump(XI, -62 * UM, 0.6 * UM, 2 * UM)
+    return z + noise(12, XI.size, 0.02 * UM)
+
+
+@pytest.mark.parametrize(
+    ("track", "band", "groove", "groove_centre"),
+    [(rough_band_track, 100.0, 6.0, 29.5), (groove_in_band_track, 85.0, 31.0, 0.0)],
+    ids=["rough band, one valley", "groove in a band between ridges"],
+)
+def test_ambiguous_edges_take_the_band_and_warn_with_both(track, band, groove, groove_centre):
+    """The band between the ridges is taken (within 2 µm), never silently the groove; the
+    warning gives both half-widths; half_width= takes the groove, centred on it."""
+    z = track()
+    with pytest.warns(ScarProfileWarning, match="ambiguous scar edges") as caught:
+        profile = scar_profile(XI, z)
+    assert float(profile.half_width) == pytest.approx(band * UM, abs=2 * UM)
+    alternative = float(profile.alternative_half_width)
+    assert alternative == pytest.approx(groove * UM, abs=1 * UM)
+    message = str(caught[0].message)
+    assert f"half-width {float(profile.half_width) * 1e6:.6g} µm for the band" in message
+    assert f"{alternative * 1e6:.6g} µm for the groove" in message
+    assert "pile-up ridges" in message and f"half_width={alternative:.6g} (m)" in message
+    assert caught[0].message.alternative == alternative
+    chosen = silently(scar_profile, XI, z, half_width=alternative)
+    assert float(chosen.centre) == pytest.approx(groove_centre * UM, abs=1 * UM)
+    assert np.isnan(float(chosen.alternative_half_width))
