@@ -93,7 +93,9 @@ class Cycles:
         cycles cut at the reversals). The loop runs through the stretch from there,
         wraps round to its beginning and ends by repeating its first sample.
     label : numpy.ndarray of int64, shape (cycles,)
-        The cycle number: the recorded one, or 1, 2, ... in order of the complete cycles.
+        The cycle number: the recorded one, or the drive's, 1, 2, ... from the first
+        complete cycle, where a stretch with missing samples counts the drive's periods it
+        spans (a gap leaves a hole in the numbering).
     continuous : bool
         True when the cycles follow each other without a gap (cut at the reversals: each
         stretch ends on the sample that begins the next), so a slow drift can be
@@ -195,6 +197,21 @@ def _with_missing(cycles: Cycles, gaps) -> Cycles:
     )
 
 
+def _drive_numbers(cycles: Cycles) -> Cycles:
+    """``cycles`` (cut at the reversals) numbered as the drive made them: a stretch that
+    holds missing samples over more than one period (a gap that swallowed reversals) counts
+    the periods it spans, the median stretch of the cycles without missing samples, so the
+    cycles after a gap keep their numbers and the gap leaves a hole in the numbering."""
+    if cycles.missing is None or cycles.missing.all():
+        return cycles
+    period = float(np.median(cycles.count[~cycles.missing] - 1))
+    spans = np.ones(cycles.count.size, dtype=np.int64)
+    gapped = cycles.missing
+    spans[gapped] = np.maximum(np.rint((cycles.count[gapped] - 1) / period), 1).astype(np.int64)
+    label = 1 + np.concatenate([[0], np.cumsum(spans[:-1])]).astype(np.int64)
+    return dataclasses.replace(cycles, label=label)
+
+
 def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     """:func:`split_cycles` of any :class:`Samples`."""
     n = samples.size
@@ -260,18 +277,16 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     # it is closed even if the displacement drifted in between.
     start = bottoms[:-1]
     leading, trailing = int(bottoms[0]), int(n - 1 - bottoms[-1])
-    return _with_missing(
-        Cycles(
-            start=start,
-            count=bottoms[1:] - start + 1,
-            rotation=np.zeros_like(start),
-            label=np.arange(1, start.size + 1, dtype=np.int64),
-            continuous=True,
-            incomplete_cycles=int(leading > 0) + int(trailing > 0),
-            dropped_samples=leading + trailing,
-        ),
-        gaps,
+    cycles = Cycles(
+        start=start,
+        count=bottoms[1:] - start + 1,
+        rotation=np.zeros_like(start),
+        label=np.arange(1, start.size + 1, dtype=np.int64),
+        continuous=True,
+        incomplete_cycles=int(leading > 0) + int(trailing > 0),
+        dropped_samples=leading + trailing,
     )
+    return _drive_numbers(_with_missing(cycles, gaps))
 
 
 def _labelled(samples: Samples, tolerance: float) -> Cycles:

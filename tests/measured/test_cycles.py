@@ -162,3 +162,27 @@ def test_one_cycle_of_a_long_recording():
         one, _, _ = measure_cycles(found, displacement, force, LOAD, rows=slice(row, row + 1))
         for name, value in one.items():
             np.testing.assert_allclose(value, whole[name][row : row + 1], rtol=1e-12, err_msg=name)
+
+
+@pytest.mark.parametrize("lazy", [False, True])
+def test_a_gap_leaves_a_hole_in_the_drive_numbering(lazy):
+    """A NaN run of 1.7 cycles in a 12-cycle recording: the cycle that holds it is skipped
+    and the cycles after it keep the drive's numbers (issue 23, item 5), in memory and out
+    of core alike."""
+    import warnings
+
+    import dask.array as da
+
+    import ecofmaps
+
+    displacement, force = ecofmaps.synthetic_recording(
+        amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8, aspect_ratio=0.2, cycles=12
+    )
+    displacement[1000:1340] = np.nan  # from the 6th bottom reversal, 1.7 periods of 200
+    if lazy:
+        displacement, force = (da.from_array(a, chunks=700) for a in (displacement, force))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        results = ecofmaps.analyze_loops(displacement, force, 450.0, scheduler="threads")
+    np.testing.assert_array_equal(results.cycle, [1, 2, 3, 4, 5, 8, 9, 10, 11, 12])
+    assert results.quality.values.tolist() == ["ok"] * 4 + ["missing-samples"] + ["ok"] * 5
