@@ -7,9 +7,12 @@ import ecofmaps
 from ecofmaps.io.recordings import read_recording
 from ecofmaps.measured.synthetic import (
     EXAMPLE,
+    UGLY_KINDS,
+    UGLY_RIG,
     example_path,
     example_recording,
     synthetic_recording,
+    ugly_recording,
     write_example,
 )
 
@@ -100,3 +103,100 @@ def test_bad_arguments(options, message):
     arguments = dict(POINT, aspect_ratio=0.2) | options
     with pytest.raises(ValueError, match=message):
         synthetic_recording(**arguments)
+
+
+# ---------------------------------------------------------------------------------------
+# Ugly recordings with a known truth
+# ---------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("kind", list(UGLY_KINDS))
+def test_ugly_recording_shapes_and_seed(kind):
+    """Every kind: one sample per entry, cycles numbered from 1, the same for the same seed."""
+    recording = ugly_recording(kind, cycles=3, seed=5)
+    n = recording.displacement.size // 3
+    assert n in (200, 32)
+    assert recording.force.shape == recording.cycle.shape == (3 * n,)
+    np.testing.assert_array_equal(recording.cycle, np.repeat([1, 2, 3], n))
+    assert recording.mu.shape == recording.gicof.shape == (3,)
+    assert recording.load == UGLY_RIG["load"]
+    again = ugly_recording(kind, cycles=3, seed=5)
+    np.testing.assert_array_equal(again.force, recording.force)
+
+
+def test_ugly_clean_is_the_model():
+    """The sample-by-sample slide is ecofmaps.simulate's loop (eq. 9, 10, 16) plus the noise."""
+    recording = ugly_recording("clean", cycles=4, seed=2)
+    rig = UGLY_RIG
+    t = np.arange(5 * 200) / 200
+    imposed = -rig["amplitude"] * np.cos(2.0 * np.pi * t)
+    model = np.asarray(
+        ecofmaps.simulate(
+            imposed,
+            rig["load"],
+            rig["stiffness"],
+            rig["mu"],
+            rig["aspect_ratio"],
+            rig["groove_half_width"],
+        )
+    )[200:]
+    residual = recording.force - model
+    assert abs(residual.std() / 0.5 - 1.0) < 0.1 and abs(residual.mean()) < 0.05
+    assert abs((recording.displacement - imposed[200:]).std() / 0.05e-6 - 1.0) < 0.1
+    np.testing.assert_allclose(recording.mu, rig["mu"], rtol=1e-14)
+
+
+def test_ugly_chatter_truth_is_the_mean_friction_slid():
+    """The truth of a chattering cycle is within ±30 % of μ, differs from cycle to cycle
+    (the chatter is not locked to the drive) and from seed to seed (its phase)."""
+    truth = ugly_recording("chatter", cycles=20, seed=1).mu
+    assert np.all(np.abs(truth / UGLY_RIG["mu"] - 1.0) < 0.3)
+    assert truth.std() > 1e-3
+    other = ugly_recording("chatter", cycles=20, seed=2).mu
+    assert np.max(np.abs(other - truth)) > 1e-3
+    np.testing.assert_array_equal(ugly_recording("chatter", cycles=20, seed=1).gicof, truth)
+
+
+def test_ugly_backlash_holds_the_force_at_the_reversal():
+    """Through the dead band (±1.5 µm) after the top reversal the force stands still; without
+    it, the rig's spring would change it by S times the displacement."""
+    for kind, moves in (("backlash", False), ("clean", True)):
+        recording = ugly_recording(kind, cycles=1, seed=3)
+        top = np.argmax(recording.displacement)
+        back = recording.displacement[top] - recording.displacement
+        band = (np.arange(back.size) > top) & (back > 0.3e-6) & (back < 2.7e-6)
+        change = np.abs(recording.force[band] - recording.force[top])
+        assert band.any()
+        assert (change.max() > 10.0) == moves, kind
+
+
+def test_ugly_sweep_sparse_ploughing_microslip():
+    """The sweep's amplitude grows, the sparse loop is digitised, ploughing pushes the force up
+    at the ends, and microslip stays below the friction limit with no μ to read."""
+    sweep = ugly_recording("sweep", cycles=10, seed=4)
+    half = np.ptp(sweep.displacement.reshape(10, 200), axis=1) / 2
+    assert 30e-6 < half[0] < 36e-6 and 64e-6 < half[-1] < 70e-6 and np.all(np.diff(half) > 0)
+    sparse = ugly_recording("sparse", cycles=2, seed=4)
+    assert sparse.displacement.size == 64
+    np.testing.assert_allclose(sparse.displacement / 0.5e-6, np.round(sparse.displacement / 0.5e-6))
+    np.testing.assert_allclose(sparse.force / 2.0, np.round(sparse.force / 2.0))
+    clean = ugly_recording("clean", cycles=2, seed=4)
+    ploughing = ugly_recording("ploughing", cycles=2, seed=4)
+    assert ploughing.force.max() > clean.force.max() + 10.0
+    np.testing.assert_allclose(ploughing.mu, UGLY_RIG["mu"], rtol=1e-14)
+    microslip = ugly_recording("microslip", cycles=2, seed=4)
+    assert np.all(np.isnan(microslip.mu)) and np.all(np.isnan(microslip.gicof))
+    assert np.abs(microslip.force).max() < 0.8 * UGLY_RIG["mu"] * UGLY_RIG["load"]
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (dict(kind="chatte"), "did you mean 'chatter'"),
+        (dict(kind="wobble"), "kind must be one of clean, noise"),
+        (dict(kind="clean", cycles=0), "cycles must be >= 1"),
+    ],
+)
+def test_ugly_bad_arguments(arguments, message):
+    with pytest.raises(ValueError, match=message):
+        ugly_recording(**arguments)
