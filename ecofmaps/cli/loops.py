@@ -63,6 +63,12 @@ def add(subparsers) -> None:
         "g(ξ) and the felt profile h(ξ) over (cycle, position), a netCDF file",
     )  # fmt: skip
     parser.add_argument(
+        "--report", default=None, metavar="FILE.html",
+        help="also write the results of one recording as one HTML page that opens offline: "
+        "the friction over the cycles with the quality flags, picked loops with the model's, "
+        'the table (needs pip install "ecofmaps[web]")',
+    )  # fmt: skip
+    parser.add_argument(
         "--no-resolve", action="store_true",
         help="skip the reading along the stroke (about ten times faster; no mu_resolved, "
         "mu_resolved_se, aspect_ratio)",

@@ -21,6 +21,7 @@ from ecofmaps.maps.cache import write_netcdf
 from ecofmaps.measured.pipeline import Reading
 from ecofmaps.measured.synthetic import EXAMPLE, example_path
 from ecofmaps.model.regimes import GROSS_SLIP
+from ecofmaps.web import INSTALL_WEB, missing_web_packages
 
 __all__ = ["SUMMARY_VARIABLES", "run"]
 
@@ -44,11 +45,16 @@ def _analysed(index, path, recording, load, args, long_run, write, *, many, reso
             f"--resolved reads every loop along the stroke, which a long recording "
             f"({path}) analysed out of core does not keep: leave out --resolved"
         )
+    if not in_memory and args.report is not None:
+        raise CommandError(
+            f"--report draws loops and the whole table, which a long recording ({path}) "
+            "analysed out of core does not keep: leave out --report"
+        )
     plots = args.plots is not None and in_memory
     positions = 201 if plots or resolved_file else None
     reading = Reading(
         resolve=not args.no_resolve,
-        keep_loops=plots,
+        keep_loops=plots or args.report is not None,
         along_stroke={"positions": positions},
         hand_back=positions is not None,
     )
@@ -127,7 +133,16 @@ def run(args) -> int:
             raise CommandError("--resolved writes the reading along the stroke; not --no-resolve")
         if len(paths) > 1:
             raise CommandError("--resolved writes the reading of one recording: give one FILE")
-    for option, target in (("--out", args.out), ("--resolved", args.resolved)):
+    if args.report is not None:
+        if len(paths) > 1:
+            raise CommandError("--report writes the page of one recording: give one FILE")
+        if missing_web_packages():
+            raise CommandError(INSTALL_WEB)
+    for option, target in (
+        ("--out", args.out),
+        ("--resolved", args.resolved),
+        ("--report", args.report),
+    ):
         if target is not None and not Path(target).parent.is_dir():
             raise CommandError(f"cannot write {target} ({option}): its directory does not exist")
     kinds = ("loops", "evolution") + (() if args.no_resolve else ("resolved",))
@@ -141,6 +156,7 @@ def run(args) -> int:
         ]
     )
     refuse_to_overwrite([("--out", args.out), ("--resolved", args.resolved), *plots], paths)
+    refuse_to_overwrite([("--report", args.report)], paths)
     long_run = loops_long.LongRun(args, paths)
     analyses, recordings = [], []
     many = len(paths) > 1
@@ -175,6 +191,12 @@ def run(args) -> int:
                     save_figure(resolved_loops(resolved, results), folder / f"{name}_resolved.png")
         if args.resolved is not None:
             write_netcdf(analyses[0][1], args.resolved)
+        if args.report is not None:
+            # Bokeh loads only when a report is asked for (the extra web is optional)
+            from ecofmaps.web.report import recording_inputs, write_report
+
+            inputs = recording_inputs(recordings[0], load, flip_force=args.flip_force)
+            write_report(args.report, analyses[0][0], inputs=inputs)
     if args.out is None:
         sys.stdout.write(table.stream.getvalue())
         for path, (results, _), recording in zip(paths, analyses, recordings, strict=True):
@@ -186,6 +208,8 @@ def run(args) -> int:
         print(_summary(path, results, recording))
     if args.resolved is not None:
         print(f"  the loops read along the stroke in {args.resolved}")
+    if args.report is not None:
+        print(f"  the report in {args.report}")
     if args.plots is not None:
         print(f"  plots in {args.plots}")
     return 0

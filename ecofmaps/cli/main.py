@@ -25,7 +25,7 @@ class CommandError(Exception):
 
 
 #: The subcommands, each a module of :mod:`ecofmaps.cli`, in the order ``--help`` lists them.
-_SUBCOMMANDS = ("model", "figures", "map", "cache", "loops", "convert", "correct")
+_SUBCOMMANDS = ("model", "figures", "map", "cache", "loops", "convert", "correct", "explore")
 
 
 class _Parser(argparse.ArgumentParser):

@@ -47,7 +47,7 @@ from ecofmaps.io.tables import results_table
 from ecofmaps.measured.quality import REASONS, SEPARATOR
 from ecofmaps.model.simulation import fretting_loop
 
-__all__ = ["LOOPS_CARRIED", "report_document", "write_report"]
+__all__ = ["LOOPS_CARRIED", "recording_inputs", "report_document", "write_report"]
 
 #: Cycles whose loops a report carries by default, spread evenly over the test: the reader
 #: picks among them in the page. Their loops are the bulk of a report of a short test.
@@ -145,6 +145,44 @@ def write_report(path, results: xr.Dataset, *, loops=None, inputs=None) -> Path:
     with atomic_path(path) as temporary:
         Path(temporary).write_text(text, encoding="utf-8")
     return Path(path)
+
+
+def recording_inputs(recording, load: float, *, flip_force: bool = False) -> dict[str, str]:
+    """What a report of one recording says it was made from (``inputs`` of :func:`write_report`).
+
+    Parameters
+    ----------
+    recording : ecofmaps.io.recordings.Recording
+        From :func:`ecofmaps.io.recordings.read_recording`.
+    load : float
+        Normal load :math:`P` the recording was analysed with. [N]
+    flip_force : bool
+        Whether the force was read with the other sign.
+
+    Returns
+    -------
+    inputs : dict of str to str
+        The file, the load, and each column read with the unit it was read in.
+
+    Examples
+    --------
+    >>> from ecofmaps.io.recordings import read_recording
+    >>> from ecofmaps.measured.synthetic import example_path
+    >>> recording_inputs(read_recording(example_path()), 450.0)["columns and units assumed"]
+    "displacement: 'displacement' in um; force: 'force' in N; cycle: 'cycle'"
+    """
+    read = []
+    for name, column_name in recording.columns.items():
+        unit = recording.units.get(name, "1")
+        read.append(f"{name}: {column_name!r}" + ("" if unit == "1" else f" in {unit}"))
+    inputs = {
+        "files": str(recording.path),
+        "load": f"{load:g} N",
+        "columns and units assumed": "; ".join(read),
+    }
+    if flip_force:
+        inputs["force sign"] = "read with the other sign (--flip-force)"
+    return inputs
 
 
 def report_document(results: xr.Dataset, *, loops=None, inputs=None):

@@ -1,6 +1,7 @@
 """The HTML report of a test (ecofmaps.web.report): what it holds, its size, and the page in a
 real browser, opened from file:// with nothing fetched."""
 
+import contextlib
 import csv
 import html
 import io
@@ -11,30 +12,58 @@ import pytest
 from bokeh.models import Div
 
 import ecofmaps
+from ecofmaps import cli
+from ecofmaps.cli import loops_run
 from ecofmaps.io.tables import results_csv
-from ecofmaps.measured.quality import REASONS
+from ecofmaps.measured.quality import REASONS, LoopQualityWarning
+from ecofmaps.web import report
 from ecofmaps.web.report import LOOPS_CARRIED, report_document, write_report
+from tests.cli.commands import run
 from tests.web.pages import CANVAS_INK, console_errors, deep_texts, wait_for
 
 INPUTS = {"files": "test.csv", "load": "450 N", "units assumed": "displacement um, force N"}
 
 
-@pytest.fixture(scope="module")
-def results():
-    """40 cycles of a deepening groove, one of them damaged (its force turned over)."""
+def damaged_recording():
+    """40 cycles of a deepening groove, one of them damaged (its force turned over). [m], [N]"""
     displacement, force = ecofmaps.synthetic_recording(
         50e-6, 450.0, 35e6, 0.8, np.linspace(0.02, 0.2, 40), samples_per_cycle=160,
         force_noise=4.0, displacement_noise=2.5e-7, seed=3,
     )  # fmt: skip
     force[160 * 5 : 160 * 5 + 80] *= -1.0
-    with pytest.warns(ecofmaps.measured.quality.LoopQualityWarning):
-        return ecofmaps.analyze_loops(displacement, force, 450.0, resolve=True, keep_loops=True)
+    return displacement, force
 
 
 @pytest.fixture(scope="module")
-def page(results, tmp_path_factory):
-    """The report of ``results``, written."""
-    return write_report(tmp_path_factory.mktemp("report") / "r.html", results, inputs=INPUTS)
+def results():
+    """The analysis of :func:`damaged_recording`."""
+    with pytest.warns(LoopQualityWarning):
+        return ecofmaps.analyze_loops(*damaged_recording(), 450.0, resolve=True, keep_loops=True)
+
+
+@pytest.fixture(scope="module")
+def command(tmp_path_factory):
+    """``ecofmaps loops test.csv --load 450N --out t.csv --report r.html`` on the recording of
+    :func:`damaged_recording`: the paths of the table and of the page, and what it printed."""
+    folder = tmp_path_factory.mktemp("loops")
+    displacement, force = damaged_recording()
+    lines = [f"{x * 1e6:.17g},{q:.17g}" for x, q in zip(displacement, force, strict=True)]
+    (folder / "test.csv").write_text("displacement,force\n" + "\n".join(lines) + "\n")
+    table, page = folder / "t.csv", folder / "r.html"
+    printed, errors = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(printed), contextlib.redirect_stderr(errors):
+        status = cli.main(
+            ["loops", str(folder / "test.csv"), "--load", "450N", "--out", str(table),
+             "--report", str(page)]
+        )  # fmt: skip
+    assert status == 0, errors.getvalue()
+    return table, page, printed.getvalue()
+
+
+@pytest.fixture(scope="module")
+def page(command):
+    """The page the command wrote."""
+    return command[1]
 
 
 def test_the_page_fetches_nothing(page):
@@ -95,6 +124,42 @@ def test_ten_thousand_cycles_stay_under_5_MB(results, tmp_path):
     assert page.stat().st_size < 5e6, page.stat().st_size
 
 
+def test_the_command_reports_the_analysis_it_tabled(command, monkeypatch, tmp_path):
+    """--report draws the results whose table --out wrote: one analysis, not a second one."""
+    table, page, printed = command
+    assert f"the report in {page}" in printed
+    drawn = []
+    monkeypatch.setattr(report, "write_report", lambda path, results, **_: drawn.append(results))
+    recording = table.parent / "test.csv"
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        status = cli.main(
+            ["loops", str(recording), "--load", "450N", "--out", str(tmp_path / "t.csv"),
+             "--report", str(tmp_path / "r.html")]
+        )  # fmt: skip
+    assert status == 0 and len(drawn) == 1
+    assert results_csv(drawn[0]) == (tmp_path / "t.csv").read_text() == table.read_text()
+    assert "loop_displacement" in drawn[0]  # the loops were kept for the page
+
+
+def test_report_errors_are_one_line(command, tmp_path, monkeypatch, capsys):
+    recording = command[0].parent / "test.csv"
+    status, _, err = run(capsys, "loops", recording, recording, "--load", "450N", "--report",
+                         tmp_path / "r.html")  # fmt: skip
+    assert status == 2 and "--report writes the page of one recording" in err
+    status, _, err = run(capsys, "loops", recording, "--load", "450N", "--report",
+                         tmp_path / "no-such-folder" / "r.html")  # fmt: skip
+    assert status == 2 and "its directory does not exist" in err
+    status, _, err = run(capsys, "loops", recording, "--load", "450N", "--report", recording)
+    assert status == 2 and "would write over the input file" in err
+    monkeypatch.setattr(loops_run, "missing_web_packages", lambda: ["bokeh"])
+    status, _, err = run(capsys, "loops", recording, "--load", "450N", "--report",
+                         tmp_path / "r.html")  # fmt: skip
+    assert status == 2 and err == (
+        'ecofmaps: error: the web pages need Bokeh and Panel: pip install "ecofmaps[web]"\n'
+    )
+    assert list(tmp_path.iterdir()) == []
+
+
 # --- in the browser ---------------------------------------------------------------------------
 
 
@@ -115,8 +180,8 @@ def test_the_plots_are_drawn(opened):
     assert len(canvases) >= 3  # friction over the cycles, the flags, the loops
 
 
-def test_the_table_shows_the_numbers_of_the_csv(opened, results):
-    rows = list(csv.DictReader(io.StringIO(results_csv(results))))
+def test_the_table_shows_the_numbers_of_the_csv(opened, command):
+    rows = list(csv.DictReader(io.StringIO(command[0].read_text())))
     columns = list(rows[0])
     shown = deep_texts(opened, ".slick-row")
     assert len(shown) >= 5

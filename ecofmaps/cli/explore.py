@@ -1,0 +1,71 @@
+"""``ecofmaps explore``: a live explorer of the model in the browser, served on this machine."""
+
+from __future__ import annotations
+
+import argparse
+
+from ecofmaps.cli._common import CommandError
+from ecofmaps.web import INSTALL_WEB, missing_web_packages
+
+__all__ = ["DEFAULT_PORT", "add", "run"]
+
+#: The port the explorer listens on unless --port says otherwise.
+DEFAULT_PORT = 5006
+
+
+def _port(text: str) -> int:
+    """An argparse ``type``: a TCP port, 1 to 65535."""
+    try:
+        port = int(text)
+    except ValueError:
+        port = 0
+    if not 1 <= port <= 65535:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a port: give a number from 1 to 65535")
+    return port
+
+
+def add(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "explore",
+        help="explore the model in the browser: δ*, E_d, μ_E/μ, the loop, the map, a correction",
+        description=(
+            "Serve a page at http://127.0.0.1:PORT/ (this machine only) where the amplitude, "
+            "load, rig stiffness, contact CoF and groove aspect ratio are typed with units "
+            "(50um, 450N, 35MN/m), and it shows at that point the slip amplitude, the "
+            "dissipated energy and μ_E/μ, the steady loop, the map of μ_E/μ over S/P and "
+            "z_o/x_o with the point marked, and the contact CoF behind an ECoF you type. The "
+            "URL keeps the inputs (?amplitude=50um&load=450N&stiffness=35MN/m&mu=0.8&"
+            "aspect_ratio=0.2): share a view as a link. Ctrl-C stops the server. Needs the "
+            'extra web: pip install "ecofmaps[web]".'
+        ),
+    )
+    parser.add_argument(
+        "--port", type=_port, default=DEFAULT_PORT, metavar="N",
+        help=f"the port to listen on (default {DEFAULT_PORT})",
+    )  # fmt: skip
+    parser.add_argument(
+        "--no-browser", action="store_true", help="do not open the page in a browser"
+    )
+    parser.set_defaults(handler=run)
+
+
+def run(args) -> int:
+    if missing_web_packages():
+        raise CommandError(INSTALL_WEB)
+    # Panel and Bokeh load only when the explorer runs (the command's lazy boundary).
+    from ecofmaps.web.explorer import serve_explorer
+
+    try:
+        serve_explorer(args.port, open_browser=not args.no_browser, announce=_announce)
+    except OSError as error:
+        raise CommandError(
+            f"cannot listen on 127.0.0.1:{args.port} ({error.strerror or error}): choose "
+            "another --port"
+        ) from None
+    print("ecofmaps explorer stopped")
+    return 0
+
+
+def _announce(line: str) -> None:
+    """Print the server's address at once (a pipe would hold it back)."""
+    print(line, flush=True)

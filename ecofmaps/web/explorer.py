@@ -1,0 +1,415 @@
+"""A live explorer of the model in the browser (``ecofmaps explore``), built with Panel.
+
+One page per browser session: the test's amplitude, load, rig stiffness, contact CoF and
+groove aspect ratio typed with units as on the command line (``50um``, ``35MN/m``; a bare
+number is SI), and it shows at that point the slip amplitude, the dissipated energy and
+:math:`\\mu_E/\\mu` (eq. 16, 12, 1), the steady loop, the map of :math:`\\mu_E/\\mu` over
+:math:`S/P` and :math:`z_o/x_o` with the point marked (:func:`ecofmaps.compute_map`, from its
+disk cache), and the contact CoF behind an ECoF the user types, for a scar known between two
+aspect ratios (:func:`ecofmaps.correct_ecof`). The inputs live in the page's URL query
+(``?amplitude=50um&load=450N&stiffness=35MN/m&mu=0.8&aspect_ratio=0.2``), so a view is
+shared as a link.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import dataclasses
+import functools
+import html
+import math
+import signal
+import warnings
+import webbrowser
+
+import numpy as np
+import panel as pn
+from bokeh.models import ColorBar, ColumnDataSource, HoverTool, LinearColorMapper
+from bokeh.palettes import Viridis256
+from bokeh.plotting import figure
+from panel.io.server import get_server
+
+from ecofmaps._nomenclature import QUANTITIES, RANGES, within
+from ecofmaps.correction.inversion import correct_ecof
+from ecofmaps.maps.grid import compute_map
+from ecofmaps.model.simulation import fretting_loop
+from ecofmaps.model.steady_state import dissipated_energy, energy_cof, slip_amplitude
+from ecofmaps.paper import FIGURE_11_STIFFNESS_RATIOS
+from ecofmaps.units import parse_quantity
+
+__all__ = ["INPUTS", "ExplorerPoint", "explorer_page", "parameter_value", "serve_explorer"]
+
+#: The page's inputs: URL query key -> (quantity of the nomenclature, label, default text).
+INPUTS = {
+    "amplitude": ("amplitude", "Displacement amplitude Δ*", "50um"),
+    "load": ("load", "Normal load P", "450N"),
+    "stiffness": ("stiffness", "Rig stiffness S", "35MN/m"),
+    "mu": ("mu", "Contact CoF μ", "0.8"),
+    "aspect_ratio": ("aspect_ratio", "Groove aspect ratio z_o/x_o", "0.2"),
+    "ecof": ("ecof", "ECoF μ_E to correct", "0.83"),
+    "aspect_ratio_low": ("aspect_ratio", "Scar z_o/x_o from", "0.15"),
+    "aspect_ratio_high": ("aspect_ratio", "Scar z_o/x_o to", "0.25"),
+}
+
+#: The model's inputs among :data:`INPUTS`.
+_MODEL_INPUTS = ("amplitude", "load", "stiffness", "mu", "aspect_ratio")
+
+#: Grid points of the map along S/P and along z_o/x_o.
+_MAP_POINTS = (91, 81)
+
+#: The map's window, widened to hold the point: S/P [1/m] and the largest z_o/x_o [1].
+_MAP_WINDOW = (FIGURE_11_STIFFNESS_RATIOS[0], FIGURE_11_STIFFNESS_RATIOS[-1], 0.4)
+
+#: Steps to which the map's window grows, so that nearby points share a cached map.
+_STEPS = np.array([1.0, 2.0, 5.0])
+
+#: Maps kept in memory by the server, beside the disk cache.
+_MAPS_KEPT = 32
+
+
+def parameter_value(key: str, text: str) -> float:
+    """The SI value of one of the page's inputs, from its text.
+
+    Parameters
+    ----------
+    key : str
+        A key of :data:`INPUTS` (``'amplitude'``, ``'stiffness'``, ...).
+    text : str
+        A number with an optional unit, as on the command line: ``'50um'``, ``'35MN/m'``,
+        ``'inf'``; a bare number is SI.
+
+    Returns
+    -------
+    value : float
+        [SI unit of the quantity: m, N, N/m or 1]
+
+    Raises
+    ------
+    ValueError
+        Naming the input, if the text is not a quantity of its kind or is out of range.
+
+    Examples
+    --------
+    >>> parameter_value("stiffness", "35MN/m")
+    35000000.0
+    >>> parameter_value("amplitude", "5e-5")
+    5e-05
+    """
+    name, label, _ = INPUTS[key]
+    quantity = QUANTITIES[name]
+    try:
+        value = parse_quantity(str(text), quantity.kind)
+    except ValueError as error:
+        raise ValueError(f"{label}: {error}") from None
+    if quantity.valid is not None and not bool(within(name, np.asarray(value))):
+        rule = RANGES[quantity.valid][1].format(name=quantity.symbol or key)
+        raise ValueError(f"{label}: {text!r} is out of range: {rule}")
+    return value
+
+
+@dataclasses.dataclass(frozen=True)
+class ExplorerPoint:
+    """The model at one point of the explorer, in SI units.
+
+    Attributes
+    ----------
+    slip_amplitude : float
+        :math:`\\delta^*` (eq. 16). [m]
+    dissipated_energy : float
+        :math:`E_d` (eq. 12). [J]
+    ecof_ratio : float
+        :math:`\\mu_E/\\mu` (eq. 1); NaN with no gross slip. [1]
+    loop : tuple of numpy.ndarray
+        The steady loop's displacement [m] and force [N].
+    """
+
+    slip_amplitude: float
+    dissipated_energy: float
+    ecof_ratio: float
+    loop: tuple
+
+    @classmethod
+    def at(cls, amplitude, load, stiffness, mu, aspect_ratio) -> ExplorerPoint:
+        """The model's values for one test (parameters in SI, as :func:`ecofmaps.energy_cof`)."""
+        point = (amplitude, load, stiffness, mu, aspect_ratio)
+        with warnings.catch_warnings():  # no gross slip: the page says so instead
+            warnings.simplefilter("ignore")
+            ratio = float(energy_cof(*point)) / mu
+        displacement, force = fretting_loop(*point)
+        return cls(
+            float(slip_amplitude(*point)),
+            float(dissipated_energy(*point)),
+            ratio,
+            (np.asarray(displacement), np.asarray(force)),
+        )
+
+
+def _grown(value: float, upward: bool) -> float:
+    """The nearest of 1, 2, 5 times a power of ten beyond ``value`` (up or down)."""
+    decade = 10.0 ** math.floor(math.log10(value))
+    steps = np.concatenate([_STEPS * decade / 10, _STEPS * decade, _STEPS * decade * 10])
+    return float(steps[steps >= value][0] if upward else steps[steps <= value][-1])
+
+
+def map_window(stiffness_ratio: float, aspect_ratio: float) -> tuple[float, float, float]:
+    """The map's window holding a point: S/P from, S/P to [1/m], and the largest z_o/x_o [1].
+
+    Figure 11's window (20 to 200 (MN/m)/kN, z_o/x_o up to 0.4), grown in steps of 1, 2, 5
+    where the point lies beyond it (a rigid rig, S/P infinite, is not drawn).
+
+    Examples
+    --------
+    >>> map_window(35e6 / 450, 0.2)
+    (20000.0, 200000.0, 0.4)
+    >>> map_window(3e5, 0.45)
+    (20000.0, 500000.0, 0.5)
+    """
+    low, high, deepest = _MAP_WINDOW
+    if math.isfinite(stiffness_ratio):
+        low = min(low, _grown(stiffness_ratio * 0.9, upward=False))
+        high = max(high, _grown(stiffness_ratio * 1.1, upward=True))
+    if aspect_ratio * 1.1 > deepest:
+        deepest = _grown(aspect_ratio * 1.1, upward=True)
+    return float(low), float(high), float(deepest)
+
+
+@functools.lru_cache(maxsize=_MAPS_KEPT)
+def _ecof_ratio_map(amplitude: float, mu: float, window: tuple) -> np.ndarray:
+    """μ_E/μ over (z_o/x_o, S/P) in the window, from :func:`ecofmaps.compute_map`'s cache."""
+    low, high, deepest = window
+    dataset = compute_map(
+        np.linspace(low, high, _MAP_POINTS[0]),
+        np.linspace(0.0, deepest, _MAP_POINTS[1]),
+        amplitude=amplitude,
+        mu=mu,
+        cache=True,
+    )
+    return np.ascontiguousarray(dataset["ecof_ratio"].values.T)
+
+
+def _number(value: float, factor: float = 1.0, form: str = ".3f") -> str:
+    """``value * factor`` formatted, or 'undefined' where it is NaN."""
+    return format(value * factor, form) if math.isfinite(value) else "undefined"
+
+
+def _values_html(point: ExplorerPoint, values: dict) -> str:
+    """The model's numbers at the point, each in a span the page and its tests can find."""
+    gross = math.isfinite(point.ecof_ratio)
+    rows = [
+        ("slip_amplitude", "Slip amplitude δ*", _number(point.slip_amplitude, 1e6), "µm"),
+        ("dissipated_energy", "Dissipated energy E_d",
+         _number(point.dissipated_energy, 1e3), "mJ"),
+        ("ecof_ratio", "μ_E/μ", _number(point.ecof_ratio), ""),
+        ("ecof", "μ_E", _number(point.ecof_ratio * values["mu"]), ""),
+    ]  # fmt: skip
+    cells = "".join(
+        f"<tr><th style='text-align:left;padding-right:1em'>{label}</th>"
+        f"<td><span class='ecofmaps-value' data-quantity='{key}'>{text}</span> {unit}</td></tr>"
+        for key, label, text, unit in rows
+    )
+    regime = "" if gross else "<p><b>No gross slip</b> (μP/S ≥ Δ*): μ_E is undefined.</p>"
+    return f"<table style='font-size:15px'>{cells}</table>{regime}"
+
+
+def _correction_html(values: dict) -> str:
+    """The contact CoF behind the typed ECoF, at the point's z_o/x_o and over the interval."""
+    rig = {key: values[key] for key in ("amplitude", "load", "stiffness")}
+    low, high = values["aspect_ratio_low"], values["aspect_ratio_high"]
+    if low > high:
+        return "<p>The scar's z_o/x_o interval must run from low to high.</p>"
+    try:
+        mu = float(correct_ecof(values["ecof"], **rig, aspect_ratio=values["aspect_ratio"]))
+        interval = correct_ecof(values["ecof"], **rig, aspect_ratio=(low, high))
+    except ValueError as error:
+        return f"<p>Cannot correct: {html.escape(str(error))}</p>"
+    return (
+        f"<p>μ_E = {values['ecof']:g} corrected to the contact CoF: "
+        f"μ = <span class='ecofmaps-value' data-quantity='mu_corrected'>{_number(mu)}</span> "
+        f"at z_o/x_o = {values['aspect_ratio']:g}; for a scar with z_o/x_o from {low:g} to "
+        f"{high:g}, μ from <span class='ecofmaps-value' data-quantity='mu_low'>"
+        f"{_number(float(interval.low))}</span> to <span class='ecofmaps-value' "
+        f"data-quantity='mu_high'>{_number(float(interval.high))}</span>.</p>"
+    )
+
+
+def _loop_figure():
+    """The steady loop's figure and its data source (Q [N] against Δ [µm])."""
+    source = ColumnDataSource({"x": [], "y": []})
+    plot = figure(
+        width=440, height=380, title="Steady fretting loop",
+        x_axis_label="Applied displacement Δ [µm]", y_axis_label="Tangential force Q [N]",
+        tools="pan,box_zoom,wheel_zoom,reset,save",
+    )  # fmt: skip
+    plot.line("x", "y", source=source, line_width=2, color="#1f77b4")
+    return plot, source
+
+
+def _map_figure():
+    """The μ_E/μ map's figure, its image source and the source of the point's marker."""
+    image = ColumnDataSource({"image": [], "x": [], "y": [], "dw": [], "dh": []})
+    marker = ColumnDataSource({"x": [], "y": []})
+    plot = figure(
+        width=560, height=380, title="μ_E/μ over rig stiffness and groove shape (x_o = Δ*)",
+        x_axis_label="Stiffness over load S/P [(MN/m)/kN = 1/mm]",
+        y_axis_label="Groove aspect ratio z_o/x_o [1]", tools="pan,box_zoom,wheel_zoom,reset,save",
+    )  # fmt: skip
+    colors = LinearColorMapper(palette=Viridis256, low=1.0, high=1.2, nan_color=(0, 0, 0, 0))
+    plot.image("image", x="x", y="y", dw="dw", dh="dh", source=image, color_mapper=colors)
+    plot.scatter("x", "y", source=marker, size=13, marker="circle", fill_color="white",
+                 line_color="black", line_width=2)  # fmt: skip
+    plot.add_layout(ColorBar(color_mapper=colors, width=12), "right")
+    plot.add_tools(
+        HoverTool(
+            tooltips=[
+                ("S/P [1/mm]", "$x{0.0}"),
+                ("z_o/x_o", "$y{0.000}"),
+                ("μ_E/μ", "@image{0.000}"),
+            ],
+            renderers=plot.renderers[:1],
+        )
+    )
+    return plot, image, marker, colors
+
+
+def _show_map(values: dict, image, marker, colors) -> None:
+    """Draw the map for the point's amplitude and μ, with the point marked."""
+    ratio = values["stiffness"] / values["load"]
+    window = map_window(ratio, values["aspect_ratio"])
+    grid = _ecof_ratio_map(values["amplitude"], values["mu"], window)
+    finite = grid[np.isfinite(grid)]
+    colors.high = float(max(finite.max(), 1.001)) if finite.size else 1.2
+    image.data = {"image": [grid], "x": [window[0] * 1e-3], "y": [0.0],
+                  "dw": [(window[1] - window[0]) * 1e-3], "dh": [window[2]]}  # fmt: skip
+    shown = math.isfinite(ratio)
+    marker.data = {"x": [ratio * 1e-3] if shown else [],
+                   "y": [values["aspect_ratio"]] if shown else []}  # fmt: skip
+
+
+def explorer_page():
+    """The explorer's page for one browser session (a Panel layout).
+
+    Returns
+    -------
+    page : panel.viewable.Viewable
+        The inputs (synchronised with the URL query), the model's numbers at the point, the
+        steady loop, the map with the point marked and the correction of a typed ECoF.
+    """
+    # The query as typed: Panel's own reading of it turns '0.8' into a float, which a text
+    # input refuses, so the inputs start from the request's text and the sync only writes it.
+    query = {
+        key: values[-1].decode("utf-8", "replace")
+        for key, values in (pn.state.session_args or {}).items()
+        if key in INPUTS and values
+    }
+    inputs = {
+        key: pn.widgets.TextInput(
+            name=label, value=query.get(key, default), width=220 if key in _MODEL_INPUTS else 160
+        )
+        for key, (_, label, default) in INPUTS.items()
+    }
+    if pn.state.location is not None:
+        for key, widget in inputs.items():
+            pn.state.location.sync(widget, {"value": key})
+    values_pane = pn.pane.HTML("", width=240)
+    correction_pane = pn.pane.HTML("", width=900)
+    message = pn.pane.HTML("", width=520, styles={"color": "#b00020"})
+    loop_plot, loop_source = _loop_figure()
+    map_plot, image, marker, colors = _map_figure()
+
+    def update(*_events):
+        try:
+            values = {key: parameter_value(key, widget.value) for key, widget in inputs.items()}
+        except ValueError as error:
+            message.object = f"<p>{html.escape(str(error))}</p>"
+            return
+        message.object = ""
+        point = ExplorerPoint.at(*(values[key] for key in _MODEL_INPUTS))
+        values_pane.object = _values_html(point, values)
+        loop_source.data = {"x": point.loop[0] * 1e6, "y": point.loop[1]}
+        _show_map(values, image, marker, colors)
+        correction_pane.object = _correction_html(values)
+
+    for widget in inputs.values():
+        widget.param.watch(update, "value")
+    update()
+    model_inputs = [inputs[key] for key in _MODEL_INPUTS]
+    correction_inputs = [inputs[key] for key in ("ecof", "aspect_ratio_low", "aspect_ratio_high")]
+    intro = pn.pane.HTML(
+        "<h2 style='margin:4px 0'>ecofmaps explorer: the compliant wear-scar model</h2>"
+        "<p style='margin:0'>Type quantities with units (50um, 35MN/m; a bare number is SI). "
+        "The URL keeps the inputs: copy it to share this view.</p>",
+        width=1100,
+    )
+    return pn.Column(
+        intro,
+        message,
+        pn.Row(
+            pn.Column(*model_inputs, pn.pane.HTML("<h3>At this point</h3>"), values_pane),
+            pn.pane.Bokeh(loop_plot),
+            pn.pane.Bokeh(map_plot),
+        ),
+        pn.pane.HTML("<h3 style='margin:0'>Correct a reported ECoF</h3>"),
+        pn.Row(*correction_inputs),
+        correction_pane,
+    )
+
+
+def warm_up() -> None:
+    """Compile the model's functions and fill the map for the default point, so the first
+    page comes at once."""
+    values = {key: parameter_value(key, default) for key, (_, _, default) in INPUTS.items()}
+    ExplorerPoint.at(*(values[key] for key in _MODEL_INPUTS))
+    window = map_window(values["stiffness"] / values["load"], values["aspect_ratio"])
+    _ecof_ratio_map(values["amplitude"], values["mu"], window)
+    _correction_html(values)
+
+
+def serve_explorer(port: int, *, open_browser: bool = True, announce=print) -> None:
+    """Serve the explorer at ``http://127.0.0.1:<port>/`` until Ctrl-C or SIGTERM.
+
+    Parameters
+    ----------
+    port : int
+        The local port to listen on (only on 127.0.0.1). [1]
+    open_browser : bool
+        Open the page in the default browser once the server listens.
+    announce : callable
+        Called with the line that gives the page's address, once the server listens.
+
+    Raises
+    ------
+    OSError
+        If the port cannot be listened on (in use, or not allowed).
+    """
+    url = f"http://127.0.0.1:{port}/"
+    server = get_server(
+        {"/": explorer_page}, port=port, address="127.0.0.1", show=False, start=False,
+        title="ecofmaps explorer", websocket_origin=[f"127.0.0.1:{port}", f"localhost:{port}"],
+    )  # fmt: skip
+    warm_up()  # the port is taken: a page asked for meanwhile waits for it
+    loop = server.io_loop
+
+    def stop(signum, frame):
+        loop.asyncio_loop.call_soon_threadsafe(loop.stop)
+
+    previous = {number: signal.signal(number, stop) for number in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        server.start()
+        announce(f"ecofmaps explorer at {url} (Ctrl-C stops it)")
+        if open_browser:
+            loop.add_callback(webbrowser.open, url)
+        loop.start()
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+        server.stop()
+        _close(loop.asyncio_loop)
+
+
+def _close(event_loop: asyncio.AbstractEventLoop) -> None:
+    """Cancel what is still pending on the server's event loop (the sessions' tasks)."""
+    pending = [task for task in asyncio.all_tasks(event_loop) if not task.done()]
+    for task in pending:
+        task.cancel()
+    if pending and not event_loop.is_closed():
+        event_loop.run_until_complete(asyncio.gather(*pending, return_exceptions=True))

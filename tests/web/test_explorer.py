@@ -1,0 +1,165 @@
+"""The live explorer (ecofmaps explore, ecofmaps.web.explorer): its inputs, and the server in a
+real browser: the model's numbers for parameters in the URL, an input typed, a clean stop."""
+
+import math
+import selectors
+import signal
+import socket
+import subprocess
+import sys
+import urllib.parse
+
+import pytest
+
+import ecofmaps
+from ecofmaps.cli import explore
+from ecofmaps.web.explorer import map_window, parameter_value
+from tests.cli.commands import run
+from tests.web.pages import CANVAS_INK, console_errors, deep_texts, wait_for
+
+#: Two views, as a user shares them: the paper's Example 2 with units, another in SI numbers.
+VIEWS = {
+    "example 2": {"amplitude": "50um", "load": "450N", "stiffness": "35MN/m", "mu": "0.8",
+                  "aspect_ratio": "0.2"},
+    "SI numbers": {"amplitude": "2.5e-5", "load": "300", "stiffness": "2e7", "mu": "0.6",
+                   "aspect_ratio": "0.3"},
+}  # fmt: skip
+
+
+def expected_ratio(view: dict) -> str:
+    """μ_E/μ of ``ecofmaps.energy_cof`` at a view, to 3 decimals as the page shows it."""
+    values = [parameter_value(key, view[key]) for key in VIEWS["example 2"]]
+    return f"{float(ecofmaps.energy_cof(*values)) / values[3]:.3f}"
+
+
+def test_inputs_are_read_with_units_or_in_si():
+    assert parameter_value("amplitude", "50um") == pytest.approx(50e-6, rel=1e-15)
+    assert parameter_value("amplitude", "5e-5") == 5e-5
+    assert parameter_value("stiffness", "inf") == math.inf
+    with pytest.raises(ValueError, match="Normal load P: '-3N' is out of range"):
+        parameter_value("load", "-3N")
+    with pytest.raises(ValueError, match="Rig stiffness S"):
+        parameter_value("stiffness", "35um")
+
+
+def test_the_map_window_holds_the_point():
+    assert map_window(35e6 / 450, 0.2) == (20e3, 200e3, 0.4)  # Figure 11's
+    low, high, deepest = map_window(1.5e6, 0.9)
+    assert low <= 1.5e6 / 1.1 and high >= 1.5e6 * 1.1 and deepest >= 0.9 * 1.1
+    assert map_window(3e3, 0.0)[0] <= 3e3 * 0.9
+    assert map_window(math.inf, 0.1) == (20e3, 200e3, 0.4)  # a rigid rig is not marked
+
+
+def test_without_the_web_extra_the_command_says_how_to_install_it(capsys, monkeypatch):
+    monkeypatch.setattr(explore, "missing_web_packages", lambda: ["panel"])
+    status, out, err = run(capsys, "explore", "--no-browser")
+    assert status == 2 and out == ""
+    assert (
+        err == 'ecofmaps: error: the web pages need Bokeh and Panel: pip install "ecofmaps[web]"\n'
+    )
+
+
+@pytest.mark.parametrize("port", ["0", "70000", "http"])
+def test_a_bad_port_is_named(capsys, port):
+    status, _, err = run(capsys, "explore", "--port", port)
+    assert status == 2 and f"{port!r} is not a port" in err and err.count("\n") == 1
+
+
+def test_a_port_in_use_is_one_line(capsys):
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        status, _, err = run(capsys, "explore", "--port", port, "--no-browser")
+    assert status == 2 and err.count("\n") == 1
+    assert f"cannot listen on 127.0.0.1:{port}" in err and "choose another --port" in err
+
+
+# --- the server, in the browser ---------------------------------------------------------------
+
+
+def free_port() -> int:
+    """A port nobody listens on now."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def server():
+    """``ecofmaps explore`` on a free port, in a subprocess: (process, its address)."""
+    port = free_port()
+    process = subprocess.Popen(
+        [sys.executable, "-m", "ecofmaps.cli", "explore", "--port", str(port), "--no-browser"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    with selectors.DefaultSelector() as waiting:
+        waiting.register(process.stdout, selectors.EVENT_READ)
+        ready = waiting.select(timeout=180)
+    line = process.stdout.readline() if ready else ""
+    url = f"http://127.0.0.1:{port}/"
+    if url not in line:
+        process.kill()
+        pytest.fail(f"the explorer did not start: {line!r} {process.communicate()[1]!r}")
+    yield process, url
+    if process.poll() is None:
+        process.kill()
+        process.communicate()
+
+
+def shown_values(driver) -> dict:
+    """The model's numbers the page shows, by quantity."""
+    return {data["quantity"]: text for text, data in deep_texts(driver, ".ecofmaps-value")}
+
+
+@pytest.mark.parametrize("view", list(VIEWS))
+def test_the_page_shows_the_model_for_the_parameters_in_its_url(browser, server, view):
+    _, url = server
+    browser.get(url + "?" + urllib.parse.urlencode(VIEWS[view]))
+    wanted = expected_ratio(VIEWS[view])
+    shown = wait_for(
+        lambda: shown_values(browser).get("ecof_ratio") == wanted and shown_values(browser)
+    )
+    assert shown["ecof_ratio"] == wanted
+    values = [parameter_value(key, VIEWS[view][key]) for key in VIEWS["example 2"]]
+    assert shown["slip_amplitude"] == f"{float(ecofmaps.slip_amplitude(*values)) * 1e6:.3f}"
+    assert shown["dissipated_energy"] == f"{float(ecofmaps.dissipated_energy(*values)) * 1e3:.3f}"
+    mu = float(ecofmaps.correct_ecof(0.83, *values[:3], aspect_ratio=values[4]))
+    assert shown["mu_corrected"] == f"{mu:.3f}"
+    wait_for(lambda: len([c for c in browser.execute_script(CANVAS_INK) if c[2] > 1000]) >= 2)
+    assert console_errors(browser) == []
+
+
+def test_a_typed_input_updates_the_page_and_its_url(browser, server):
+    _, url = server
+    view = VIEWS["SI numbers"]
+    browser.get(url + "?" + urllib.parse.urlencode(view))
+    wait_for(lambda: shown_values(browser).get("ecof_ratio") == expected_ratio(view))
+    typed = browser.execute_script(
+        """
+        const inputs = [];
+        (function visit(root) {
+            root.querySelectorAll('input').forEach(e => inputs.push(e));
+            root.querySelectorAll('*').forEach(e => { if (e.shadowRoot) visit(e.shadowRoot); });
+        })(document);
+        const mu = inputs.find(e => e.value === '0.6');
+        mu.value = '0.7';
+        mu.dispatchEvent(new Event('change', {bubbles: true}));
+        return true;
+        """
+    )
+    assert typed
+    changed = dict(view, mu="0.7")
+    wait_for(lambda: shown_values(browser).get("ecof_ratio") == expected_ratio(changed))
+    wait_for(lambda: "mu=0.7" in browser.current_url)
+    assert console_errors(browser) == []
+
+
+def test_sigterm_stops_it_cleanly(server):
+    """Last of the module: the server stops on SIGTERM, exit 0, no traceback."""
+    process, _ = server
+    process.send_signal(signal.SIGTERM)
+    out, err = process.communicate(timeout=60)
+    assert process.returncode == 0, err
+    assert "Traceback" not in err and "Traceback" not in out
+    assert "ecofmaps explorer stopped" in out
