@@ -15,7 +15,7 @@ import numpy as np
 
 from ecofmaps.cli import loops_long
 from ecofmaps.cli._common import CommandError, recording_options, refuse_to_overwrite
-from ecofmaps.io.files import atomic_path
+from ecofmaps.io.files import atomic_path, record_written
 from ecofmaps.io.recordings import read_recording
 from ecofmaps.maps.cache import write_netcdf
 from ecofmaps.measured.pipeline import Reading
@@ -110,8 +110,8 @@ def _summary(path, results, recording) -> str:
     return summary
 
 
-def run(args) -> int:
-    """Run ``ecofmaps loops`` with the parsed ``args``; the exit status."""
+def _checked_inputs(args) -> tuple[list[Path], float]:
+    """The recordings and the load of the command, its options checked against each other."""
     if args.example == bool(args.files):
         raise CommandError("give one or more recording FILEs, or --example (not both)")
     paths = [example_path()] if args.example else [Path(name) for name in args.files]
@@ -138,6 +138,12 @@ def run(args) -> int:
             raise CommandError("--report writes the page of one recording: give one FILE")
         if missing_web_packages():
             raise CommandError(INSTALL_WEB)
+    return paths, load
+
+
+def _checked_outputs(args, paths) -> list:
+    """The command's outputs as ``(option, path)``, refused where they would overwrite a
+    file that ecofmaps did not write (or an input)."""
     for option, target in (
         ("--out", args.out),
         ("--resolved", args.resolved),
@@ -155,61 +161,117 @@ def run(args) -> int:
             for kind in kinds
         ]
     )
-    refuse_to_overwrite([("--out", args.out), ("--resolved", args.resolved), *plots], paths)
+    outputs = [("--out", args.out), ("--resolved", args.resolved), *plots]
+    refuse_to_overwrite(outputs, paths, overwrite=args.overwrite, folders=[("--plots", args.plots)])
     refuse_to_overwrite([("--report", args.report)], paths)
-    long_run = loops_long.LongRun(args, paths)
-    analyses, recordings = [], []
+    return outputs
+
+
+class _NothingAnalysed(Exception):
+    """No recording of a batch could be analysed."""
+
+
+class _Analysed:
+    """A recording analysed: its path, the recording, its results and reading along the
+    stroke, and the name of its plots."""
+
+    def __init__(self, path, recording, results, resolved, plot_name):
+        self.path, self.recording, self.plot_name = path, recording, plot_name
+        self.results, self.resolved = results, resolved
+
+
+def _analyse_each(args, paths, load, long_run, table) -> tuple[list[_Analysed], list[Path]]:
+    """Every recording through the pipeline, its lines written to ``table``. With several
+    recordings, one that cannot be analysed is one error line naming it, and the others go
+    on (a batch); a single recording's error ends the command."""
+    done, failed = [], []
     many = len(paths) > 1
-    with contextlib.ExitStack() as stack:  # the table is written as it comes, renamed at the end
-        if args.out is None:  # held, and printed once every file is analysed
-            stream = io.StringIO()
-        else:
-            temporary = stack.enter_context(atomic_path(args.out))
-            stream = stack.enter_context(open(temporary, "w", encoding="utf-8", newline=""))
-        table = _Table(stream)
-        for index, path in enumerate(paths):
+    for index, (path, plot_name) in enumerate(zip(paths, _plot_names(paths), strict=True)):
+        held = []  # a recording in memory: its lines once its analysis has succeeded
+        try:
             recording = read_recording(path, lazy=long_run.lazy, **recording_options(args))
-            resolved_file = args.resolved is not None
-            analysed = _analysed(
-                index, path, recording, load, args, long_run, table.write, many=many,
-                resolved_file=resolved_file,
+            write = table.write if recording.lazy else held.append
+            results, resolved = _analysed(
+                index, path, recording, load, args, long_run, write, many=many,
+                resolved_file=args.resolved is not None,
             )  # fmt: skip
-            analyses.append(analysed)
-            recordings.append(recording)
-        if args.plots is not None:
-            # matplotlib only when plots are asked for
-            from ecofmaps.figures import cof_evolution, measured_loops, resolved_loops, save_figure
+        except (ValueError, OSError, CommandError) as error:
+            if not many:
+                raise
+            failed.append(path)
+            named = str(error) if str(path) in str(error) else f"{path}: {error}"
+            print(f"ecofmaps loops: error: {named}", file=sys.stderr)
+            continue
+        for text in held:
+            table.write(text)
+        done.append(_Analysed(path, recording, results, resolved, plot_name))
+    return done, failed
 
-            folder = Path(args.plots)
-            folder.mkdir(parents=True, exist_ok=True)
-            for name, (results, resolved) in zip(_plot_names(paths), analyses, strict=True):
-                save_figure(
-                    measured_loops(results, resolved=resolved), folder / f"{name}_loops.png"
-                )
-                save_figure(cof_evolution(results), folder / f"{name}_evolution.png")
-                if resolved is not None:
-                    save_figure(resolved_loops(resolved, results), folder / f"{name}_resolved.png")
-        if args.resolved is not None:
-            write_netcdf(analyses[0][1], args.resolved)
-        if args.report is not None:
-            # Bokeh loads only when a report is asked for (the extra web is optional)
-            from ecofmaps.web.report import recording_inputs, write_report
 
-            inputs = recording_inputs(recordings[0], load, flip_force=args.flip_force)
-            write_report(args.report, analyses[0][0], inputs=inputs)
+def _write_extras(args, done: list[_Analysed], load) -> None:
+    """The plots, the reading along the stroke and the report the options ask for."""
+    if args.plots is not None and done:
+        # matplotlib only when plots are asked for
+        from ecofmaps.figures import cof_evolution, measured_loops, resolved_loops, save_figure
+
+        folder = Path(args.plots)
+        folder.mkdir(parents=True, exist_ok=True)
+        for each in done:
+            name, results, resolved = each.plot_name, each.results, each.resolved
+            save_figure(measured_loops(results, resolved=resolved), folder / f"{name}_loops.png")
+            save_figure(cof_evolution(results), folder / f"{name}_evolution.png")
+            if resolved is not None:
+                save_figure(resolved_loops(resolved, results), folder / f"{name}_resolved.png")
+    if args.resolved is not None and done:
+        write_netcdf(done[0].resolved, args.resolved)
+    if args.report is not None and done:
+        # Bokeh loads only when a report is asked for (the extra web is optional)
+        from ecofmaps.web.report import recording_inputs, write_report
+
+        inputs = recording_inputs(done[0].recording, load, flip_force=args.flip_force)
+        write_report(args.report, done[0].results, inputs=inputs)
+
+
+def run(args) -> int:
+    """Run ``ecofmaps loops`` with the parsed ``args``: 0 when every recording was
+    analysed, 1 when some of several could not be (each named in an error line; the others'
+    rows are written)."""
+    paths, load = _checked_inputs(args)
+    outputs = _checked_outputs(args, paths)
+    long_run = loops_long.LongRun(args, paths)
+    try:
+        with contextlib.ExitStack() as stack:  # the table is written as it comes, renamed last
+            if args.out is None:  # held, and printed once every file is analysed
+                stream = io.StringIO()
+            else:
+                temporary = stack.enter_context(atomic_path(args.out))
+                stream = stack.enter_context(open(temporary, "w", encoding="utf-8", newline=""))
+            table = _Table(stream)
+            done, failed = _analyse_each(args, paths, load, long_run, table)
+            if not done:  # nothing to write: the temporary goes
+                raise _NothingAnalysed
+            _write_extras(args, done, load)
+    except _NothingAnalysed:
+        print(f"ecofmaps loops: none of the {len(paths)} recordings could be analysed; "
+              "nothing written", file=sys.stderr)  # fmt: skip
+        return 1
+    record_written(path for _, path in outputs if path is not None)
+    status = 1 if failed else 0
     if args.out is None:
         sys.stdout.write(table.stream.getvalue())
-        for path, (results, _), recording in zip(paths, analyses, recordings, strict=True):
-            print(_summary(path, results, recording).strip(), file=sys.stderr)
-        return 0
+        for each in done:
+            print(_summary(each.path, each.results, each.recording).strip(), file=sys.stderr)
+        return status
     long_run.finish()
-    print(f"wrote {args.out}: {sum(r.cycle.size for r, _ in analyses)} cycles")
-    for path, (results, _), recording in zip(paths, analyses, recordings, strict=True):
-        print(_summary(path, results, recording))
+    print(f"wrote {args.out}: {sum(each.results.cycle.size for each in done)} cycles")
+    for each in done:
+        print(_summary(each.path, each.results, each.recording))
+    if failed:
+        print(f"  not analysed ({len(failed)}): " + ", ".join(str(path) for path in failed))
     if args.resolved is not None:
         print(f"  the loops read along the stroke in {args.resolved}")
     if args.report is not None:
         print(f"  the report in {args.report}")
     if args.plots is not None:
         print(f"  plots in {args.plots}")
-    return 0
+    return status
