@@ -8,6 +8,7 @@ import pytest
 
 import ecofmaps
 from ecofmaps.measured.synthetic import scar_example_path, scar_example_trace
+from ecofmaps.model.profiles import ScarProfileWarning
 from tests.cli.commands import run
 
 EXAMPLE = scar_example_path()
@@ -268,3 +269,56 @@ def test_correct_with_the_physical_mapping(capsys, example):
     assert status == 0 and "(X = x)" in out.splitlines()[0]
     mu = float(ecofmaps.correct_ecof(0.85, **POINT, profile=example, mapping="physical"))
     assert float(values(out, "contact coefficient")[0]) == pytest.approx(mu, rel=5e-6)
+
+
+# --- what the reading decided, on the command line (issue 23, item 8) ---------------------
+
+
+def groove_in_band(path, dropout_line=None):
+    """A groove 31 µm in half-width, 3 µm deep, in a band 170 µm wide between pile-up
+    ridges (the floor 0.35 µm above the surface, rough), in µm; a dropout 5 µm down on
+    ``dropout_line`` (x = -50 µm on line 702)."""
+    x = np.arange(-400.0, 400.01, 0.5)
+    z = np.where(np.abs(x) < 31, -3 * (1 - (x / 31) ** 2), 0.0)
+    z += np.where((np.abs(x) >= 31) & (np.abs(x) < 85), 0.35 + 0.15 * np.sin(x / 1.75), 0.0)
+    v = (np.abs(x) - 85) / 30
+    z += np.where((v > 0) & (v < 1), 1.5 * np.sin(np.pi * v) ** 2, 0.0)
+    if dropout_line is not None:
+        z[dropout_line - 2] -= 5.0
+    return write_trace(path, x, z)
+
+
+def test_model_prints_each_finding_on_one_line_naming_the_file(capsys, tmp_path):
+    path = groove_in_band(tmp_path / "track.csv", dropout_line=702)
+    status, out, err = run(capsys, "model", "--scar-profile", path)
+    assert status == 0
+    lines = err.strip().splitlines()
+    assert len(lines) == 2, err
+    assert lines[0].startswith(f"ecofmaps model: warning: {path}: 1 outlier(s) ")
+    assert lines[0].endswith("line 702 (x = -50 µm, 5 µm below its neighbours)")
+    with pytest.warns(ScarProfileWarning):
+        profile = ecofmaps.read_scar_profile(path)
+    band = float(profile.half_width) * 1e6
+    groove = float(profile.alternative_half_width) * 1e6
+    assert band == pytest.approx(85.0, abs=1.0) and groove == pytest.approx(31.0, abs=1.0)
+    assert lines[1].startswith(f"ecofmaps model: warning: {path}: ambiguous scar edges: ")
+    assert f"half-width {band:.6g} µm for the band between its pile-up ridges" in lines[1]
+    assert lines[1].endswith(f"; --profile-half-width {groove:.6g}um takes the groove")
+    assert "(1601 samples, levelled, 1 outlier(s) replaced)" in out
+    assert values(out, "wear scar half-width (band)") == [f"{band:.6g}"]
+    assert values(out, "wear scar half-width (or groove)") == [f"{groove:.6g}"]
+    mu_e = float(ecofmaps.energy_cof(**POINT, mu=0.8, profile=profile))
+    assert float(values(out, "energy coefficient")[0]) == pytest.approx(mu_e, rel=5e-6)
+
+
+def test_correct_prints_the_findings_and_the_half_width_taken_stops_them(capsys, tmp_path):
+    path = groove_in_band(tmp_path / "track.csv")
+    argv = ["correct", "--ecof", "0.85", *RIG, "--scar-profile", path]
+    status, out, err = run(capsys, *argv)
+    assert status == 0
+    assert err.startswith(f"ecofmaps correct: warning: {path}: ambiguous scar edges: ")
+    assert len(err.strip().splitlines()) == 1
+    groove = err.strip().rsplit("--profile-half-width ", 1)[1].split()[0]
+    status, out, err = run(capsys, *argv, "--profile-half-width", groove)
+    assert status == 0 and err == ""
+    assert values(out, "wear scar half-width (given)") == [groove.removesuffix("um")]
