@@ -561,54 +561,56 @@ def ugly_recording(kind, *, cycles=30, seed=0):
     if int(cycles) < 1:
         raise ValueError(f"cycles must be >= 1; got {cycles!r}")
     flaw = _UGLY[kind]
-    rig = UGLY_RIG
+    cycles = int(cycles)
     rng = np.random.default_rng(seed)
     n = int(flaw.get("samples_per_cycle", 200))
-    total = (int(cycles) + 1) * n  # one cycle to reach the steady loop, dropped
-    t = np.arange(total) / n
+    t = np.arange((cycles + 1) * n) / n  # one cycle to reach the steady loop, dropped
+    displacement, force, slid, friction = _ugly_loops(flaw, t, rng)
+    # The truth: the friction over each recorded cycle, weighted by the distance slid.
+    slid, friction = (values[n:].reshape(cycles, n) for values in (slid, friction))
+    mu = np.sum(friction * slid, axis=1) / np.sum(slid, axis=1)
+    displacement = (
+        displacement[n:]
+        + flaw.get("displacement_offset", 0.0)
+        + flaw.get("displacement_drift", 0.0) * (t[n:] - 1.0)
+        + rng.normal(size=cycles * n) * flaw.get("displacement_noise", 0.0)
+    )
+    force = (
+        force[n:]
+        + flaw.get("force_offset", 0.0)
+        + rng.normal(size=cycles * n) * flaw.get("force_noise", 0.0)
+    )
+    if "displacement_step" in flaw:  # digitised
+        step = flaw["displacement_step"]
+        displacement = np.round(displacement / step) * step
+        force = np.round(force / flaw["force_step"]) * flaw["force_step"]
+    cycle = np.repeat(np.arange(1, cycles + 1), n)
+    return UglyRecording(displacement, force, cycle, UGLY_RIG["load"], mu, mu.copy())
+
+
+def _ugly_loops(flaw, t, rng):
+    """Displacement, force, distance slid and friction at the instants ``t`` [cycles].
+
+    The friction is NaN where the pad never slides (microslip).
+    """
+    rig = UGLY_RIG
     low, high = flaw.get("sweep", (rig["amplitude"], rig["amplitude"]))
-    amplitude = low + (high - low) * np.clip((t - 1.0) / max(int(cycles), 1), 0.0, 1.0)
+    amplitude = low + (high - low) * np.clip((t - 1.0) / (t[-1] + t[1] - 1.0), 0.0, 1.0)
     imposed = (-amplitude * np.cos(2.0 * np.pi * t))[None, :]
-    friction = np.full(total, rig["mu"])
+    friction = np.full(t.size, rig["mu"])
     if "chatter" in flaw:
         phase = rng.uniform(0.0, 2.0 * np.pi)
         friction *= 1.0 + flaw["chatter"] * np.sin(2.0 * np.pi * _CHATTER_FREQUENCY * t + phase)
     if "stick_slip" in flaw:
         kernel = np.exp(-0.5 * (np.arange(-12, 13) / _STICK_SLIP_SAMPLES) ** 2)
-        smooth = np.convolve(rng.normal(size=total), kernel / np.sqrt(np.sum(kernel**2)), "same")
+        smooth = np.convolve(rng.normal(size=t.size), kernel / np.sqrt(np.sum(kernel**2)), "same")
         friction *= 1.0 + flaw["stick_slip"] * np.clip(smooth, -2.5, 2.5)
     contact = _play(imposed, flaw["backlash"]) if "backlash" in flaw else imposed
-    k = 2.0 * rig["aspect_ratio"] / rig["groove_half_width"]
     if "microslip" in flaw:
         force = _microslip_force(contact, rig["load"], rig["mu"], flaw["microslip"])[0]
-        displacement = imposed[0] + force / rig["stiffness"]
-        truth = np.full(total, np.nan)
-    else:
-        x = _slide(
-            contact, friction[None, :], rig["load"], rig["stiffness"], k, flaw.get("ploughing")
-        )[0]
-        force = rig["stiffness"] * (contact[0] - x)
-        displacement = imposed[0]
-        slid = np.abs(np.diff(x, prepend=0.0))
-        truth = friction
-    per_cycle = (slice(n, None),)
-    weights = slid[per_cycle].reshape(-1, n) if "microslip" not in flaw else np.ones((cycles, n))
-    mu = np.sum(truth[per_cycle].reshape(-1, n) * weights, axis=1) / np.sum(weights, axis=1)
-    displacement = (
-        displacement[n:]
-        + flaw.get("displacement_offset", 0.0)
-        + flaw.get("displacement_drift", 0.0) * (t[n:] - 1.0)
-        + rng.normal(size=total - n) * flaw.get("displacement_noise", 0.0)
-    )
-    force = (
-        force[n:]
-        + flaw.get("force_offset", 0.0)
-        + rng.normal(size=total - n) * flaw.get("force_noise", 0.0)
-    )
-    if "displacement_step" in flaw:
-        displacement = (
-            np.round(displacement / flaw["displacement_step"]) * flaw["displacement_step"]
-        )
-        force = np.round(force / flaw["force_step"]) * flaw["force_step"]
-    cycle = np.repeat(np.arange(1, int(cycles) + 1), n)
-    return UglyRecording(displacement, force, cycle, rig["load"], mu, mu.copy())
+        nowhere = np.full(t.size, np.nan)
+        return imposed[0] + force / rig["stiffness"], force, np.ones(t.size), nowhere
+    k = 2.0 * rig["aspect_ratio"] / rig["groove_half_width"]
+    x = _slide(contact, friction[None, :], rig["load"], rig["stiffness"], k, flaw.get("ploughing"))
+    force = rig["stiffness"] * (contact[0] - x[0])
+    return imposed[0], force, np.abs(np.diff(x[0], prepend=0.0)), friction
