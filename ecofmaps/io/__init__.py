@@ -1,5 +1,8 @@
 """Files: atomic writers, file-and-line errors, recordings of fretting loops (text, TDMS,
-HDF5/netCDF, zarr), read whole, in blocks or lazily, written block by block; scar profiles."""
+HDF5/netCDF, zarr), read whole, in blocks or lazily, or opened as one xarray Dataset
+(:func:`open_recording`), written block by block; scar profiles. TDMS and text recordings
+also open in xarray itself: ``xr.open_dataset(path, engine="ecofmaps-tdms")`` and
+``engine="ecofmaps-text"``."""
 
 from ecofmaps._lazy import lazy_names
 
@@ -7,7 +10,12 @@ from ecofmaps._lazy import lazy_names
 _PUBLIC = {
     "ecofmaps.io.files": ("FileLineError", "atomic_path", "atomic_store"),
     "ecofmaps.io.recording_types": ("Recording", "RecordingError", "RecordingWarning"),
-    "ecofmaps.io.recordings": ("read_recording", "recording_blocks", "recording_format"),
+    "ecofmaps.io.recordings": (
+        "open_recording",
+        "read_recording",
+        "recording_blocks",
+        "recording_format",
+    ),
     "ecofmaps.io.scar_profiles": ("ScarProfileError", "read_scar_profile"),
     "ecofmaps.io.writers": ("RecordingWriter", "convert_recording"),
 }

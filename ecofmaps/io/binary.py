@@ -3,9 +3,10 @@
 The columns asked for are found by name among the file's channels or variables
 (:func:`ecofmaps.io.rig_formats.variables`, which also refuses a truncated file) as in a
 text header (:mod:`ecofmaps.io.columns`), in the group given or in any group. Each is
-wrapped in a :class:`Column`, an array-like that reads a range of samples on demand, in
-float64 and SI, with CF packing decoded (``scale_factor``, ``add_offset``,
-``_FillValue``/``missing_value`` -> NaN), and turns any failure into a
+wrapped in a :class:`Column`, an array-like that reads a range of samples on demand from
+the variable of the group's lazily read xarray Dataset
+(:func:`ecofmaps.io.rig_formats.open_group`: xarray or npTDMS decode CF packing, fill
+values and attributes), in float64 and SI, and turns any failure into a
 :class:`~ecofmaps.io.recording_types.RecordingError` naming the file, the channel and the
 samples. A large recording is a dask array over such columns (``dask.array.from_array``),
 so it is read block by block; the array holds its column (the attribute
@@ -27,18 +28,8 @@ import numpy as np
 
 from ecofmaps._parallel import SOURCE
 from ecofmaps.io.columns import ColumnError, column_scale, matching_columns, split_unit
-from ecofmaps.io.recording_types import Recording, RecordingError
-from ecofmaps.io.recordings import LAZY_SAMPLES
-from ecofmaps.io.rig_formats import (
-    _KIND,
-    Variable,
-    _open_hdf5,
-    _open_tdms,
-    _open_zarr,
-    _zarr_array,
-    _zarr_complete,
-    variables,
-)
+from ecofmaps.io.recording_types import LAZY_SAMPLES, Recording, RecordingError, si_values
+from ecofmaps.io.rig_formats import NOUNS, Variable, check_complete, open_group, variables
 
 __all__ = ["DEFAULT_CHUNK", "Column", "read_binary"]
 
@@ -105,16 +96,8 @@ class Column:
         if self._handle is not None and self._handle[2] != os.getpid():
             self._handle = None  # the parent's, left to the parent
         if self._handle is None:
-            if self.kind == "tdms":
-                handle = _open_tdms(self.path)
-                source = handle[self.variable.group][self.variable.short]
-            elif self.kind == "hdf5":
-                handle = _open_hdf5(self.path)
-                source = handle[self.variable.name]
-            else:
-                handle = _open_zarr(self.path)
-                source = _zarr_array(handle, self.variable)
-            self._handle = (handle, source, os.getpid())
+            dataset = open_group(self.path, self.kind, self.variable.group)
+            self._handle = (dataset, dataset[self.variable.short].variable, os.getpid())
         return self._handle[1]
 
     def __del__(self):
@@ -126,11 +109,7 @@ class Column:
     def close(self) -> None:
         """Close the file (it is opened again on the next read)."""
         with self._lock:
-            if (
-                self._handle is not None
-                and self._handle[2] == os.getpid()
-                and hasattr(self._handle[0], "close")
-            ):
+            if self._handle is not None and self._handle[2] == os.getpid():
                 self._handle[0].close()
             self._handle = None
 
@@ -143,13 +122,14 @@ class Column:
         if step != 1:
             raise TypeError("a Column is read by a slice start:stop (step 1)")
         stop = max(start, stop)
-        where = f"{_KIND[self.kind]} {self.variable.name!r}, samples {start} to {stop - 1}"
+        noun = NOUNS[self.kind]
+        where = f"{noun} {self.variable.name!r}, samples {start} to {stop - 1}"
         try:
             with self._lock:
                 source = self._source()
-                raw = None if self.kind == "zarr" else np.asarray(source[start:stop])
+                raw = None if self.kind == "zarr" else source[start:stop].values
             if raw is None:  # zarr reads from several threads at once
-                raw = np.asarray(source[start:stop])
+                raw = source[start:stop].values
         except RecordingError:
             raise
         except Exception as error:
@@ -159,25 +139,17 @@ class Column:
                 self.path, where, f"read {raw.size} samples where {stop - start} were expected"
             )
         values = raw.astype(np.float64, copy=not raw.flags.writeable)  # a copy, or the new array
-        if self.variable.packing is not None:
-            scale, offset, fills = self.variable.packing
-            for fill in fills:
-                values[raw == fill] = np.nan
-            if scale != 1.0 or offset != 0.0:
-                values = values * scale + offset
         missing = ~np.isfinite(values)
         if missing.any():
             if self.nan_policy == "raise":
                 first = int(np.argmax(missing))
                 raise RecordingError(
                     self.path,
-                    f"{_KIND[self.kind]} {self.variable.name!r}, sample {start + first}",
+                    f"{noun} {self.variable.name!r}, sample {start + first}",
                     f"missing value ({values[first]})",
                 )
             values[missing] = np.nan
-        from ecofmaps.io.text import _to_si
-
-        return _to_si(values, self.factor)
+        return si_values(values, self.factor)
 
 
 #: The columns of this process (see :func:`_watch_forks`).
@@ -211,7 +183,7 @@ def _column(path, kind, variable, factor, nan_policy, stamp) -> Column:
 
 def _select(path: Path, kind: str, found: list[Variable], options: dict) -> dict:
     """The variable for each role, by name (and group)."""
-    noun = _KIND[kind]
+    noun = NOUNS[kind]
     if options["group"] is not None:
         group = options["group"].strip("/")
         groups = sorted({v.group for v in found})
@@ -270,25 +242,26 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
     """A rig file as a :class:`~ecofmaps.io.recording_types.Recording` (see
     :func:`ecofmaps.io.read_recording` for the options)."""
     chosen = _select(path, kind, variables(path, kind), options)
-    if kind == "zarr":
-        for variable in chosen.values():
-            _zarr_complete(path, variable)
-    columns, units = {}, {}
+    for variable in chosen.values():
+        check_complete(path, kind, variable)
+    columns, units, assumed = {}, {}, []
     stat = path.stat()
     stamp = (stat.st_mtime_ns, stat.st_size)
     for role, variable in chosen.items():
         factor, unit = 1.0, "1"
         if role != "cycle":
             carried = [u for u in [split_unit(variable.short)[1], *variable.units] if u]
+            if not carried and options[f"{role}_unit"] is None:
+                assumed.append(role)
             try:
                 factor, unit = column_scale(role, options[f"{role}_unit"], carried, variable.name)
             except ColumnError as error:
-                raise RecordingError(path, f"{_KIND[kind]} {variable.name!r}", str(error)) from None
+                raise RecordingError(path, f"{NOUNS[kind]} {variable.name!r}", str(error)) from None
         columns[role] = Column(path, kind, variable, factor, options["nan_policy"], stamp)
         units[role] = unit
     size = chosen["displacement"].size
     if size == 0:
-        raise RecordingError(path, f"{_KIND[kind]} {chosen['displacement'].name!r}", "no samples")
+        raise RecordingError(path, f"{NOUNS[kind]} {chosen['displacement'].name!r}", "no samples")
     lazy = size > LAZY_SAMPLES if lazy is None else lazy
     if lazy:
         import dask.array as da
@@ -322,4 +295,6 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
         cycle=arrays.get("cycle"),
         columns={role: variable.name for role, variable in chosen.items()},
         units=units,
+        format=kind,
+        assumed_units=tuple(assumed),
     )

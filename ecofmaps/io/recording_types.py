@@ -4,7 +4,8 @@ A :class:`Recording` holds the displacement, force and optional cycle-number sam
 units (NumPy arrays, or dask arrays for a rig file read lazily) with where each sample came
 from (a line of a text file, or a sample of a channel), so a damaged or missing sample is
 reported as a :class:`RecordingError` naming the file and the line. It is built by
-:func:`ecofmaps.io.recordings.read_recording`.
+:func:`ecofmaps.io.recordings.read_recording`, and gives the one xarray Dataset every way in
+shares (:meth:`Recording.to_dataset`, :func:`ecofmaps.io.recordings.open_recording`).
 """
 
 from __future__ import annotations
@@ -16,10 +17,46 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import xarray as xr
 
+from ecofmaps._nomenclature import attrs
 from ecofmaps.io.files import FileLineError
 
-__all__ = ["Recording", "RecordingError", "RecordingWarning"]
+__all__ = ["LAZY_SAMPLES", "Recording", "RecordingError", "RecordingWarning", "si_values"]
+
+#: Rig files with more samples than this are read lazily (dask arrays) by default.
+LAZY_SAMPLES = 1 << 24
+
+#: The SI unit of each role's samples.
+SI_UNITS = {"displacement": "m", "force": "N", "cycle": "1", "load": "N"}
+
+
+def si_values(values: np.ndarray, factor: float) -> np.ndarray:
+    """``values * factor``; for a factor 10^-k, divided by the exact 10^k instead, so that
+    a ``25`` read in µm is the float nearest 25e-6 (one rounding, not two), as a text file's
+    ``25`` is (:mod:`ecofmaps.io.text`).
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        In the file's unit; changed in place where that saves a copy.
+    factor : float
+        From the file's unit to SI.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> bool(si_values(np.array([25.0]), 1e-6)[0] == 25e-6)
+    True
+    """
+    if factor == 1.0:
+        return values
+    inverse = round(1.0 / factor)
+    if factor < 1.0 and inverse == 1.0 / factor and float(inverse) == inverse:
+        values /= float(inverse)
+        return values
+    values *= factor
+    return values
 
 
 class RecordingError(FileLineError):
@@ -124,6 +161,12 @@ class Recording:
         The unit each column was read in (``'um'``, ``'kN'``, ...).
     start : int
         0-based index in the file of the first sample (non-zero for a block).
+    format : str or None
+        The file's format: ``'text'``, ``'tdms'``, ``'hdf5'`` or ``'zarr'``.
+    assumed_units : tuple of str
+        The roles (``'displacement'``, ``'force'``, ``'load'``) whose unit was assumed (the
+        default, µm or N) because neither the file nor an option gave one: the analysis can say
+        "the displacement column has no unit; assumed um".
     """
 
     path: Path
@@ -136,6 +179,8 @@ class Recording:
     units: Mapping[str, str] = dataclasses.field(default_factory=dict)
     start: int = 0
     lines: _LineIndex | None = dataclasses.field(default=None, repr=False)
+    format: str | None = None
+    assumed_units: tuple = ()
 
     @property
     def size(self) -> int:
@@ -223,3 +268,50 @@ class Recording:
     def compute(self) -> Recording:
         """The recording with NumPy arrays (reads a lazy one whole; else itself)."""
         return self[:] if self.lazy else self
+
+    def to_dataset(self) -> xr.Dataset:
+        """The recording as one Dataset over the dimension ``sample`` (dask-backed if lazy).
+
+        Returns
+        -------
+        dataset : xarray.Dataset
+            ``displacement`` [m], ``force`` [N] and, if read, ``cycle`` [1] and ``load``
+            [N], each with the
+            attributes ``units`` (SI), ``long_name``, ``source_column`` (as named in the
+            file), ``source_units`` (the unit read) and ``unit_assumed`` (1 if the file and
+            the options gave no unit and the default was assumed, else 0); the Dataset's
+            attributes ``source`` (the path), ``format`` and ``first_sample`` (the index of
+            the first sample in the file).
+
+        Examples
+        --------
+        >>> from ecofmaps.io import read_recording
+        >>> from ecofmaps.measured.synthetic import example_path
+        >>> dataset = read_recording(example_path()).to_dataset()
+        >>> dataset.displacement.attrs["units"], dataset.attrs["format"], dataset.sizes["sample"]
+        ('m', 'text', 24000)
+        """
+        roles = {
+            "displacement": self.displacement,
+            "force": self.force,
+            "cycle": self.cycle,
+            "load": self.load,
+        }
+        variables = {}
+        for role, data in roles.items():
+            if data is None:
+                continue
+            described = attrs(role) if role != "cycle" else {"long_name": "cycle number"}
+            variables[role] = xr.Variable(
+                ("sample",),
+                data,
+                {
+                    **described,
+                    "units": SI_UNITS[role],
+                    "source_column": self.columns.get(role, role),
+                    "source_units": self.units.get(role, SI_UNITS[role]),
+                    "unit_assumed": int(role in self.assumed_units),
+                },
+            )
+        source = {"source": str(self.path), "format": self.format or "arrays"}
+        return xr.Dataset(variables, attrs={**source, "first_sample": self.start})

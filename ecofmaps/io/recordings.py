@@ -37,18 +37,20 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
+import xarray as xr
 
-from ecofmaps.io.recording_types import Recording, RecordingError, _LineIndex
+from ecofmaps.io.binary import read_binary
+from ecofmaps.io.columns import column_scale, split_unit
+from ecofmaps.io.recording_types import LAZY_SAMPLES, Recording, RecordingError, _LineIndex
+from ecofmaps.io.text import BLOCK_BYTES, text_blocks
 
 __all__ = [
     "LAZY_SAMPLES",
+    "open_recording",
     "read_recording",
     "recording_blocks",
     "recording_format",
 ]
-
-#: Rig files with more samples than this are read lazily (dask arrays) by default.
-LAZY_SAMPLES = 1 << 24
 
 _NAN_POLICIES = ("propagate", "raise")
 _MAGIC = {
@@ -152,8 +154,6 @@ def _options(
         isinstance(skip_rows, bool) or not isinstance(skip_rows, numbers.Integral) or skip_rows < 0
     ):
         raise ValueError(f"skip_rows must be a non-negative integer or None; got {skip_rows!r}")
-    from ecofmaps.io.columns import column_scale
-
     for role, unit in (("displacement", displacement_unit), ("force", force_unit)):
         if unit is not None:
             column_scale(role, unit, [], role)  # a ValueError naming the option
@@ -178,9 +178,18 @@ def _check_count(name: str, value) -> None:
         raise ValueError(f"{name} must be a positive integer; got {value!r}")
 
 
-def _read_text(path: Path, options: dict, block_bytes: int) -> Recording:
-    from ecofmaps.io.text import text_blocks
+def _assumed_units(layout, options: dict) -> tuple:
+    """The roles of a text file whose unit neither the column's name nor an option gave."""
+    return tuple(
+        role
+        for role, index in layout.columns.items()
+        if role != "cycle"
+        and options.get(f"{role}_unit") is None
+        and split_unit(layout.names[index])[1] is None
+    )
 
+
+def _read_text(path: Path, options: dict, block_bytes: int) -> Recording:
     blocks = text_blocks(path, options, block_bytes)
     layout = next(blocks)
     parts = list(blocks)
@@ -198,6 +207,8 @@ def _read_text(path: Path, options: dict, block_bytes: int) -> Recording:
         columns={role: layout.names[k] for role, k in layout.columns.items()},
         units={role: layout.units[role] for role in layout.columns},
         lines=_LineIndex.build(numbers),
+        format="text",
+        assumed_units=_assumed_units(layout, options),
     )
 
 
@@ -317,8 +328,6 @@ def read_recording(
     if kind == "text":
         if group is not None:
             raise ValueError("group applies to TDMS, HDF5/netCDF and zarr files, not to text")
-        from ecofmaps.io.text import BLOCK_BYTES
-
         recording = _read_text(path, options, block_bytes or BLOCK_BYTES)
         if lazy:
             import dask.array as da
@@ -334,9 +343,74 @@ def read_recording(
                 load=wrapped[3],
             )
         return recording
-    from ecofmaps.io.binary import read_binary
-
     return read_binary(path, kind, options, lazy=lazy, chunks=chunks)
+
+
+def open_recording(
+    path,
+    *,
+    displacement_column="displacement",
+    force_column="force",
+    cycle_column=None,
+    displacement_unit=None,
+    force_unit=None,
+    group=None,
+    nan_policy="propagate",
+    lazy=None,
+    chunks=None,
+    block_bytes=None,
+    load_column=None,
+    skip_rows=None,
+) -> xr.Dataset:
+    """A recording as one xarray Dataset over the dimension ``sample``, in SI units.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A text file, a TDMS file, an HDF5 or netCDF-4 file, or a zarr store.
+    displacement_column, force_column, cycle_column, displacement_unit, force_unit, group, \
+nan_policy, lazy, chunks, block_bytes, load_column, skip_rows
+        As for :func:`read_recording`: a rig file of more than :data:`LAZY_SAMPLES` samples
+        gives dask-backed variables by default.
+
+    Returns
+    -------
+    dataset : xarray.Dataset
+        ``displacement`` [m], ``force`` [N] and, if read, ``cycle`` [1] and ``load`` [N], each
+        with the attributes ``units``, ``long_name``, ``source_column``,
+        ``source_units`` and ``unit_assumed``; the Dataset's attributes ``source`` and
+        ``format`` (see :meth:`Recording.to_dataset`).
+
+    Raises
+    ------
+    RecordingError, ValueError, OSError
+        As :func:`read_recording`.
+
+    Examples
+    --------
+    >>> from ecofmaps.io import open_recording
+    >>> from ecofmaps.measured.synthetic import example_path
+    >>> dataset = open_recording(example_path())
+    >>> dataset.displacement.attrs["units"], dataset.displacement.attrs["source_units"]
+    ('m', 'um')
+    >>> dataset.displacement.attrs["unit_assumed"]  # the header gives no unit
+    1
+    """
+    return read_recording(
+        path,
+        displacement_column=displacement_column,
+        force_column=force_column,
+        cycle_column=cycle_column,
+        displacement_unit=displacement_unit,
+        force_unit=force_unit,
+        group=group,
+        nan_policy=nan_policy,
+        lazy=lazy,
+        chunks=chunks,
+        block_bytes=block_bytes,
+        load_column=load_column,
+        skip_rows=skip_rows,
+    ).to_dataset()
 
 
 def recording_blocks(path, samples: int = 1 << 20, **options) -> Iterator[Recording]:
@@ -373,8 +447,6 @@ def recording_blocks(path, samples: int = 1 << 20, **options) -> Iterator[Record
         for first in range(0, recording.size, samples):
             yield recording[first : first + samples]
         return
-    from ecofmaps.io.text import BLOCK_BYTES, text_blocks
-
     checked = _options(**options)
     if checked["group"] is not None:
         raise ValueError("group applies to TDMS, HDF5/netCDF and zarr files, not to text")
@@ -382,6 +454,7 @@ def recording_blocks(path, samples: int = 1 << 20, **options) -> Iterator[Record
     layout = next(parts)
     columns = {role: layout.names[k] for role, k in layout.columns.items()}
     units = {role: layout.units[role] for role in layout.columns}
+    assumed = _assumed_units(layout, checked)
     pending: list = []  # parsed blocks not yet given out: (values by role, line numbers)
     held = first = 0
     for part in itertools.chain(parts, [None]):  # None: the end, give out the rest
@@ -403,6 +476,8 @@ def recording_blocks(path, samples: int = 1 << 20, **options) -> Iterator[Record
                 units=units,
                 start=first,
                 lines=_LineIndex.build([lines[:count]], first),
+                format="text",
+                assumed_units=assumed,
             )
             pending = [({role: joined[role][count:] for role in columns}, lines[count:])]
             held -= count

@@ -1,30 +1,41 @@
-"""The rig formats' channels and variables: TDMS, HDF5 / netCDF-4 and zarr, listed and opened.
+"""The rig formats' channels and variables: TDMS, HDF5 / netCDF-4 and zarr, through xarray.
 
-:func:`variables` lists a rig file's one-dimensional numeric channels (TDMS) or variables
-(HDF5, zarr) as :class:`Variable`: name, group, length, dtype, units (a TDMS channel's
-``unit_string`` or ``NI_UnitDescription``, a variable's ``units`` attribute) and CF packing
-(``scale_factor``, ``add_offset``, ``_FillValue``/``missing_value``). The openers refuse a
-truncated file (HDF5 checks its own length, a TDMS file whose last segment is short is found
-from npTDMS's notice, and a zarr store with missing chunk files from its chunk count).
-:mod:`ecofmaps.io.binary` reads the samples.
+Each format has its module, which opens a file's groups as lazily read
+:class:`xarray.Dataset` objects (:mod:`ecofmaps.io.tdms` through npTDMS,
+:mod:`ecofmaps.io.hdf5` and :mod:`ecofmaps.io.zarr_store` through xarray's ``h5netcdf`` and
+``zarr`` engines, which decode CF packing, fill values and attributes); this module is
+their one face. :func:`variables` lists a file's one-dimensional numeric channels (TDMS) or
+variables (HDF5, zarr) as :class:`Variable`: name, group, length, units (the variable's
+``units`` attribute; a TDMS channel's ``unit_string`` or ``NI_UnitDescription``) and the
+file's chunking. :func:`open_group` opens the group of one for reading, and
+:func:`check_complete` refuses a zarr variable with missing chunk files. The openers refuse
+a truncated file (HDF5 checks its own length, a TDMS file whose last segment is short is
+found from npTDMS's notice). :mod:`ecofmaps.io.binary` reads the samples.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import logging
 from pathlib import Path
 
 import numpy as np
+import xarray as xr
 
+from ecofmaps.io.hdf5 import hdf5_groups, open_hdf5_group
 from ecofmaps.io.recording_types import RecordingError
+from ecofmaps.io.tdms import open_tdms_group, tdms_groups
+from ecofmaps.io.zarr_store import missing_chunks, open_zarr_group, zarr_groups
 
-__all__ = ["Variable", "variables"]
+__all__ = ["NOUNS", "Variable", "check_complete", "open_group", "variables"]
 
-_KIND = {"tdms": "channel", "hdf5": "variable", "zarr": "variable"}
+#: What each rig format calls a column, for messages.
+NOUNS = {"tdms": "channel", "hdf5": "variable", "zarr": "variable"}
 
+#: Attributes that give a variable's unit, in the order they are looked at.
+UNIT_ATTRIBUTES = ("units", "unit", "Units", "Unit", "unit_string", "NI_UnitDescription")
 
-_UNIT_ATTRIBUTES = ("units", "unit", "Units", "Unit", "unit_string", "NI_UnitDescription")
+_GROUPS = {"tdms": tdms_groups, "hdf5": hdf5_groups, "zarr": zarr_groups}
+_GROUP = {"tdms": open_tdms_group, "hdf5": open_hdf5_group, "zarr": open_zarr_group}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -45,8 +56,6 @@ class Variable:
         The units its metadata gives (none, or one).
     chunk : int
         Samples per chunk in the file, or 0 if the file does not say.
-    packing : tuple
-        ``(scale_factor, add_offset, fill_values)`` of CF packing, or None.
     """
 
     name: str
@@ -55,200 +64,35 @@ class Variable:
     size: int
     units: tuple = ()
     chunk: int = 0
-    packing: tuple | None = None
-
-
-def _text(value) -> str | None:
-    """An attribute as text (bytes decoded, arrays of one item unwrapped), or None."""
-    if isinstance(value, np.ndarray) and value.size == 1:
-        value = value.reshape(()).item()
-    if isinstance(value, bytes):
-        value = value.decode("utf-8", errors="replace")
-    if isinstance(value, str) and value.strip():
-        return value.strip()
-    return None
 
 
 def _units(attrs) -> tuple:
-    for key in _UNIT_ATTRIBUTES:
-        if key in attrs:
-            unit = _text(attrs[key])
-            if unit is not None:
-                return (unit,)
+    for key in UNIT_ATTRIBUTES:
+        unit = attrs.get(key)
+        if isinstance(unit, str) and unit.strip():
+            return (unit.strip(),)
     return ()
 
 
-def _packing(attrs):
-    """CF packing from a variable's attributes, or None."""
-    keys = ("scale_factor", "add_offset", "_FillValue", "missing_value")
-    if not any(key in attrs for key in keys):
-        return None
-    fills = tuple(
-        float(np.asarray(attrs[key]).reshape(-1)[0])
-        for key in ("_FillValue", "missing_value")
-        if key in attrs and np.asarray(attrs[key]).size
-    )
-    scale = float(np.asarray(attrs.get("scale_factor", 1.0)).reshape(-1)[0])
-    offset = float(np.asarray(attrs.get("add_offset", 0.0)).reshape(-1)[0])
-    return scale, offset, fills
+def _chunk(variable: xr.Variable) -> int:
+    chunks = variable.encoding.get("chunksizes") or variable.encoding.get("chunks")
+    return int(chunks[0]) if chunks else 0
 
 
-# --- TDMS ------------------------------------------------------------------------------------
-
-
-class _TdmsNotices(logging.Handler):
-    """Collects npTDMS's warnings while a file is opened (a short last segment)."""
-
-    def __init__(self):
-        super().__init__(logging.WARNING)
-        self.messages: list[str] = []
-
-    def emit(self, record):
-        self.messages.append(record.getMessage())
-
-
-def _open_tdms(path: Path):
-    from nptdms import TdmsFile
-
-    logger = logging.getLogger("nptdms")
-    notices = _TdmsNotices()
-    logger.addHandler(notices)
-    propagate, logger.propagate = logger.propagate, False
-    try:
-        handle = TdmsFile.open(path)
-    except Exception as error:
-        raise RecordingError(path, None, f"cannot read as TDMS: {error}") from None
-    finally:
-        logger.removeHandler(notices)
-        logger.propagate = propagate
-    if notices.messages:
-        handle.close()
-        raise RecordingError(
-            path, None, f"truncated or damaged TDMS file ({'; '.join(notices.messages)})"
+def _listed(group: str, dataset: xr.Dataset) -> list[Variable]:
+    group = group.strip("/")
+    return [
+        Variable(
+            name=f"{group}/{name}" if group else str(name),
+            group=group,
+            short=str(name),
+            size=int(item.shape[0]),
+            units=_units(item.attrs),
+            chunk=_chunk(item),
         )
-    return handle
-
-
-def _tdms_variables(path: Path) -> list[Variable]:
-    with _open_tdms(path) as handle:
-        return [
-            Variable(
-                name=f"{group.name}/{channel.name}",
-                group=group.name,
-                short=channel.name,
-                size=len(channel),
-                units=_units(channel.properties),
-            )
-            for group in handle.groups()
-            for channel in group.channels()
-            if len(channel) and np.issubdtype(channel.dtype, np.number)
-        ]
-
-
-# --- HDF5 and netCDF-4 -----------------------------------------------------------------------
-
-
-def _open_hdf5(path: Path):
-    import h5py
-
-    try:
-        return h5py.File(path, "r")
-    except OSError as error:
-        message = f"cannot open as HDF5 (truncated or damaged): {error}"
-        raise RecordingError(path, None, message) from None
-
-
-def _hdf5_variables(path: Path) -> list[Variable]:
-    import h5py
-
-    found = []
-
-    def visit(name, item):
-        if not isinstance(item, h5py.Dataset) or item.ndim != 1:
-            return
-        if not np.issubdtype(item.dtype, np.number):
-            return
-        if "not a netCDF variable" in str(_text(item.attrs.get("NAME", b"")) or ""):
-            return  # a netCDF dimension without values
-        group, _, short = name.rpartition("/")
-        found.append(
-            Variable(
-                name=name,
-                group=group,
-                short=short,
-                size=int(item.shape[0]),
-                units=_units(item.attrs),
-                chunk=int(item.chunks[0]) if item.chunks else 0,
-                packing=_packing(item.attrs),
-            )
-        )
-
-    with _open_hdf5(path) as handle:
-        handle.visititems(visit)
-    return found
-
-
-# --- zarr ------------------------------------------------------------------------------------
-
-
-def _open_zarr(path: Path):
-    import zarr
-
-    try:
-        return zarr.open(store=str(path), mode="r")
-    except Exception as error:
-        raise RecordingError(path, None, f"cannot open as a zarr store: {error}") from None
-
-
-def _zarr_variables(path: Path) -> list[Variable]:
-    import zarr
-
-    root = _open_zarr(path)
-    is_array = isinstance(root, zarr.Array)
-    members = [("", root)] if is_array else list(root.members(max_depth=None))
-    found = []
-    for name, item in members:
-        if not isinstance(item, zarr.Array) or item.ndim != 1:
-            continue
-        if not np.issubdtype(item.dtype, np.number):
-            continue
-        name = name or path.stem
-        group, _, short = name.rpartition("/")
-        found.append(
-            Variable(
-                name=name,
-                group=group,
-                short=short,
-                size=int(item.shape[0]),
-                units=_units(item.attrs),
-                chunk=int(item.chunks[0]),
-                packing=_packing(item.attrs),
-            )
-        )
-    return found
-
-
-def _zarr_array(root, variable: Variable):
-    """The array of ``variable`` in a store opened at ``root`` (which may be the array)."""
-    import zarr
-
-    return root if isinstance(root, zarr.Array) else root[variable.name]
-
-
-def _zarr_complete(path: Path, variable: Variable) -> None:
-    """Refuse a zarr array some of whose chunk files are missing (read as fill values)."""
-    array = _zarr_array(_open_zarr(path), variable)
-    present, expected = array.nchunks_initialized, array.nchunks
-    if present < expected:
-        raise RecordingError(
-            path,
-            f"variable {variable.name!r}",
-            f"{expected - present} of its {expected} chunks are missing "
-            "(a truncated or partly copied store)",
-        )
-
-
-_LISTS = {"tdms": _tdms_variables, "hdf5": _hdf5_variables, "zarr": _zarr_variables}
+        for name, item in dataset.variables.items()
+        if item.ndim == 1 and np.issubdtype(item.dtype, np.number)
+    ]
 
 
 def variables(path, kind: str) -> list[Variable]:
@@ -263,5 +107,42 @@ def variables(path, kind: str) -> list[Variable]:
     Returns
     -------
     variables : list of Variable
+        In the file's order, group by group.
+
+    Raises
+    ------
+    RecordingError
+        If the file cannot be opened as ``kind`` (truncated, damaged).
     """
-    return _LISTS[kind](Path(path))
+    groups = _GROUPS[kind](Path(path))
+    try:
+        return [variable for name, ds in groups.items() for variable in _listed(name, ds)]
+    finally:
+        for dataset in groups.values():
+            dataset.close()
+
+
+def open_group(path, kind: str, group: str) -> xr.Dataset:
+    """The group ``group`` (``''`` for the root) of a rig file, as a lazily read Dataset
+    whose variables are named by :attr:`Variable.short`; close it after reading."""
+    return _GROUP[kind](Path(path), group or None)
+
+
+def check_complete(path, kind: str, variable: Variable) -> None:
+    """Refuse a zarr variable some of whose chunk files are missing (zarr would read them
+    as fill values); other formats check themselves when opened.
+
+    Raises
+    ------
+    RecordingError
+        Naming the variable and how many of its chunks are missing.
+    """
+    if kind != "zarr":
+        return
+    missing, expected = missing_chunks(path, variable.name)
+    if missing:
+        raise RecordingError(
+            path,
+            f"variable {variable.name!r}",
+            f"{missing} of its {expected} chunks are missing (a truncated or partly copied store)",
+        )

@@ -1,0 +1,68 @@
+"""HDF5 and netCDF-4 files as xarray Datasets, through xarray's ``h5netcdf`` engine.
+
+Each group of the file is one lazily read :class:`xarray.Dataset`; xarray decodes the CF
+attributes (``scale_factor``, ``add_offset``, ``_FillValue``/``missing_value`` -> NaN) and
+the text of attributes. A plain HDF5 file, whose datasets have no netCDF dimensions, is read
+with xarray's "phony" dimensions (``phony_dim_0``, ...). Times are left as numbers. A
+truncated or damaged file is refused when it is opened (HDF5 checks its own length), with a
+:class:`~ecofmaps.io.recording_types.RecordingError` naming the file.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import xarray as xr
+
+from ecofmaps.io.recording_types import RecordingError
+
+__all__ = ["hdf5_groups", "open_hdf5_group"]
+
+#: xarray's options for every opening: CF packing and fill values decoded, numbers left as
+#: numbers, no copy of a whole variable kept in memory once read.
+OPTIONS = {
+    "engine": "h5netcdf",
+    "phony_dims": "access",
+    "mask_and_scale": True,
+    "decode_times": False,
+    "decode_timedelta": False,
+    "decode_coords": False,
+    "cache": False,
+}
+
+
+def _refused(path: Path, error: Exception) -> RecordingError:
+    return RecordingError(path, None, f"cannot open as HDF5 (truncated or damaged): {error}")
+
+
+def hdf5_groups(path) -> dict[str, xr.Dataset]:
+    """Every group of an HDF5 / netCDF-4 file as a lazily read Dataset, by its path
+    (``'/'``, ``'/rig/run1'``).
+
+    Raises
+    ------
+    RecordingError
+        If the file cannot be opened as HDF5.
+    """
+    path = Path(path)
+    try:
+        return xr.open_groups(path, **OPTIONS)
+    except OSError as error:
+        raise _refused(path, error) from None
+
+
+def open_hdf5_group(path, group: str | None = None) -> xr.Dataset:
+    """One group of an HDF5 / netCDF-4 file (by default the root) as a lazily read Dataset.
+
+    Raises
+    ------
+    RecordingError
+        If the file cannot be opened as HDF5, or has no such group.
+    """
+    path = Path(path)
+    try:
+        return xr.open_dataset(path, group=group or None, **OPTIONS)
+    except OSError as error:
+        if "not found" in str(error).lower() and group:
+            raise RecordingError(path, None, f"no group {group!r}") from None
+        raise _refused(path, error) from None

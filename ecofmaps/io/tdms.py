@@ -1,0 +1,271 @@
+"""TDMS files (LabVIEW) as xarray Datasets, read through npTDMS, lazily; an xarray backend.
+
+A TDMS file holds groups of channels. :func:`tdms_groups` opens each group as an
+:class:`xarray.Dataset` whose variables are its numeric channels, named as in the file,
+read on demand (npTDMS's streaming reader: a range of samples is read from the file's
+segments without the rest, scaled as the file's ``NI_Scaling_*`` properties say). A
+channel's properties are its variable's attributes, with ``units`` from ``unit_string`` or
+``NI_UnitDescription``; a group's properties (and the root's) are the Dataset's. The
+channels of the most common length share the dimension ``sample``, any other length its
+own (``sample_<length>``).
+
+A file whose last segment is short (a rig that stopped while writing) is refused when it
+is opened, from npTDMS's notice, with a
+:class:`~ecofmaps.io.recording_types.RecordingError` naming the file.
+
+:class:`TdmsBackendEntrypoint` is registered with xarray as the engine ``ecofmaps-tdms``::
+
+    xr.open_dataset("rig.tdms", engine="ecofmaps-tdms", group="Rig")
+    xr.open_datatree("rig.tdms", engine="ecofmaps-tdms")
+"""
+
+from __future__ import annotations
+
+import collections
+import logging
+import os
+import threading
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+from nptdms import TdmsFile
+from xarray.backends import BackendArray, BackendEntrypoint
+from xarray.core import indexing
+
+from ecofmaps.io.recording_types import RecordingError
+
+__all__ = ["TdmsBackendEntrypoint", "TdmsReader", "open_tdms_group", "tdms_groups"]
+
+#: A channel's properties that give its unit, in the order they are looked at.
+UNIT_PROPERTIES = ("unit_string", "NI_UnitDescription")
+
+
+class _Notices(logging.Handler):
+    """Collects npTDMS's warnings while a file is opened (a short last segment)."""
+
+    def __init__(self):
+        super().__init__(logging.WARNING)
+        self.messages: list[str] = []
+
+    def emit(self, record):
+        self.messages.append(record.getMessage())
+
+
+def opened_tdms(path: Path) -> TdmsFile:
+    """The file opened by npTDMS's streaming reader (the data read on demand).
+
+    Raises
+    ------
+    RecordingError
+        If npTDMS cannot read it, or finds it truncated or damaged.
+    """
+    logger = logging.getLogger("nptdms")
+    notices = _Notices()
+    logger.addHandler(notices)
+    propagate, logger.propagate = logger.propagate, False
+    try:
+        handle = TdmsFile.open(path)
+    except Exception as error:
+        raise RecordingError(path, None, f"cannot read as TDMS: {error}") from None
+    finally:
+        logger.removeHandler(notices)
+        logger.propagate = propagate
+    if notices.messages:
+        handle.close()
+        raise RecordingError(
+            path, None, f"truncated or damaged TDMS file ({'; '.join(notices.messages)})"
+        )
+    return handle
+
+
+class TdmsReader:
+    """One TDMS file, opened on first read in each process, read by one thread at a time.
+
+    Pickled by its path only (the copy opens the file again where it is read), and a
+    forked process opens its own: a shared file would share its position.
+    """
+
+    def __init__(self, path):
+        self.path = Path(path)
+        self._handle = None  # (TdmsFile, process id)
+        self._lock = threading.Lock()
+
+    def __getstate__(self):
+        return {"path": self.path}
+
+    def __setstate__(self, state):
+        self.__init__(state["path"])
+
+    def samples(self, group: str, channel: str, start: int, count: int) -> np.ndarray:
+        """``count`` samples of a channel from sample ``start`` (scaled by npTDMS)."""
+        with self._lock:
+            if self._handle is None or self._handle[1] != os.getpid():
+                self._handle = (opened_tdms(self.path), os.getpid())
+            return self._handle[0][group][channel].read_data(offset=start, length=count)
+
+    def close(self) -> None:
+        """Close the file (opened again on the next read)."""
+        with self._lock:
+            if self._handle is not None and self._handle[1] == os.getpid():
+                self._handle[0].close()
+            self._handle = None
+
+
+class TdmsArray(BackendArray):
+    """A channel as a lazily indexed array: a slice or an index reads only its samples."""
+
+    def __init__(self, reader: TdmsReader, group: str, channel: str, size: int, dtype):
+        self.reader, self.group, self.channel = reader, group, channel
+        self.shape, self.dtype = (int(size),), np.dtype(dtype)
+
+    def __getitem__(self, key):
+        return indexing.explicit_indexing_adapter(
+            key, self.shape, indexing.IndexingSupport.BASIC, self._read
+        )
+
+    def _read(self, key: tuple):
+        (index,) = key
+        if isinstance(index, slice):
+            wanted = range(*index.indices(self.shape[0]))
+        else:
+            wanted = range(int(index), int(index) + 1)
+        if not wanted:
+            return np.zeros(0, self.dtype)
+        low, high = min(wanted[0], wanted[-1]), max(wanted[0], wanted[-1]) + 1
+        data = self.reader.samples(self.group, self.channel, low, high - low)
+        if wanted.step != 1:
+            data = data[np.asarray(wanted) - low]
+        return data if isinstance(index, slice) else data[0]
+
+
+def _plain(value):
+    """A property as an attribute value netCDF can hold (a time as ISO text)."""
+    if isinstance(value, str | int | float | np.number):
+        return value
+    return str(value)
+
+
+def _channel_attrs(properties) -> dict:
+    attrs = {key: _plain(value) for key, value in properties.items()}
+    for key in UNIT_PROPERTIES:
+        unit = attrs.get(key)
+        if isinstance(unit, str) and unit.strip() and "units" not in attrs:
+            attrs["units"] = unit.strip()
+    return attrs
+
+
+def _group_dataset(reader: TdmsReader, group) -> xr.Dataset:
+    channels = [c for c in group.channels() if np.issubdtype(c.dtype, np.number)]
+    common = collections.Counter(len(c) for c in channels).most_common(1)
+    variables = {}
+    for channel in channels:
+        size = len(channel)
+        dim = "sample" if common and size == common[0][0] else f"sample_{size}"
+        array = TdmsArray(reader, group.name, channel.name, size, channel.dtype)
+        data = indexing.LazilyIndexedArray(array)
+        variables[channel.name] = xr.Variable((dim,), data, _channel_attrs(channel.properties))
+    dataset = xr.Dataset(variables, attrs={k: _plain(v) for k, v in group.properties.items()})
+    dataset.set_close(reader.close)
+    return dataset
+
+
+def tdms_groups(path) -> dict[str, xr.Dataset]:
+    """Every group of a TDMS file as a lazily read Dataset, by its path (``'/Rig'``; the
+    root, ``'/'``, holds the file's properties and no variables).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    groups : dict of str to xarray.Dataset
+        All read through one :class:`TdmsReader` (closing any of them closes the file,
+        which is opened again on the next read).
+
+    Raises
+    ------
+    RecordingError
+        If the file is not TDMS, or is truncated or damaged.
+    """
+    path = Path(path)
+    reader = TdmsReader(path)
+    with opened_tdms(path) as handle:
+        root = xr.Dataset(attrs={k: _plain(v) for k, v in handle.properties.items()})
+        groups = {"/": root}
+        for group in handle.groups():
+            groups[f"/{group.name}"] = _group_dataset(reader, group)
+    return groups
+
+
+def open_tdms_group(path, group: str | None = None) -> xr.Dataset:
+    """One group of a TDMS file as a lazily read Dataset (see :func:`tdms_groups`).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    group : str, optional
+        The group's name (a leading ``/`` is ignored); by default the file's first group.
+
+    Raises
+    ------
+    RecordingError
+        If the file is not TDMS, is damaged, or has no such group (the message lists them).
+    """
+    path = Path(path)
+    groups = {name: ds for name, ds in tdms_groups(path).items() if name != "/"}
+    if group is None and groups:
+        return next(iter(groups.values()))
+    key = "/" + (group or "").strip("/")
+    if key not in groups:
+        listed = ", ".join(repr(name[1:]) for name in groups) or "none"
+        raise RecordingError(path, None, f"no group {group!r} (groups: {listed})")
+    return groups[key]
+
+
+class TdmsBackendEntrypoint(BackendEntrypoint):
+    """xarray's engine ``ecofmaps-tdms``: a TDMS group as a Dataset (channels as variables,
+    named as in the file, ``units`` from ``unit_string``/``NI_UnitDescription``, read
+    lazily through npTDMS); the whole file as a DataTree.
+
+    Examples
+    --------
+    >>> from ecofmaps.io.tdms import TdmsBackendEntrypoint
+    >>> TdmsBackendEntrypoint().guess_can_open("rig.tdms")
+    True
+    """
+
+    description = "TDMS (LabVIEW) files through npTDMS, one group a Dataset (ecofmaps)"
+    url = "https://github.com/ecofmaps/ecofmaps"
+    open_dataset_parameters = ("filename_or_obj", "drop_variables", "group")
+
+    def open_dataset(self, filename_or_obj, *, drop_variables=None, group=None) -> xr.Dataset:
+        """The group ``group`` (by default the first) of the file."""
+        dataset = open_tdms_group(_file_path(filename_or_obj), group)
+        return dataset.drop_vars(drop_variables or [], errors="ignore")
+
+    def open_groups_as_dict(self, filename_or_obj, *, drop_variables=None) -> dict:
+        """Every group (and the root's properties) by its path."""
+        groups = tdms_groups(_file_path(filename_or_obj))
+        return {k: v.drop_vars(drop_variables or [], errors="ignore") for k, v in groups.items()}
+
+    def open_datatree(self, filename_or_obj, *, drop_variables=None) -> xr.DataTree:
+        """The file as a tree: the root's properties, a node for each group."""
+        groups = self.open_groups_as_dict(filename_or_obj, drop_variables=drop_variables)
+        return xr.DataTree.from_dict(groups)
+
+    def guess_can_open(self, filename_or_obj) -> bool:
+        """A path ending in ``.tdms``."""
+        try:
+            return Path(filename_or_obj).suffix.lower() == ".tdms"
+        except TypeError:
+            return False
+
+
+def _file_path(filename_or_obj) -> Path:
+    if not isinstance(filename_or_obj, str | os.PathLike):
+        raise TypeError(
+            f"the ecofmaps-tdms engine reads a file by its path; got {filename_or_obj!r}"
+        )
+    return Path(filename_or_obj)

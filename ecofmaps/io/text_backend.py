@@ -1,0 +1,108 @@
+"""Text recordings (:mod:`ecofmaps.io.text`'s format) as an xarray backend.
+
+:class:`TextBackendEntrypoint` is registered with xarray as the engine ``ecofmaps-text``::
+
+    xr.open_dataset("loops.csv", engine="ecofmaps-text")
+    xr.open_dataset("rig.tsv", engine="ecofmaps-text", displacement_column="disp",
+                    force_unit="kN")
+
+The Dataset is :func:`ecofmaps.io.recordings.open_recording`'s with its variables named as
+the file's columns (``Displacement [µm]``): the samples in SI units, with the attributes
+``units`` (SI), ``long_name``, ``source_column``, ``source_units`` and ``unit_assumed``. A
+text file has no random access: it is parsed whole, in blocks, when opened.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import xarray as xr
+from xarray.backends import BackendEntrypoint
+
+from ecofmaps.io.recording_types import RecordingError
+from ecofmaps.io.recordings import open_recording, recording_format
+
+__all__ = ["TextBackendEntrypoint"]
+
+#: Suffixes xarray may open with this engine when none is named.
+SUFFIXES = (".csv", ".tsv")
+
+
+class TextBackendEntrypoint(BackendEntrypoint):
+    """xarray's engine ``ecofmaps-text``: a text recording (CSV, TSV, whitespace columns
+    under a header line) as a Dataset over ``sample``, variables named as its columns.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> from ecofmaps.measured.synthetic import example_path
+    >>> dataset = xr.open_dataset(example_path(), engine=TextBackendEntrypoint)
+    >>> [(name, dataset[name].attrs["units"]) for name in dataset.data_vars]
+    [('displacement', 'm'), ('force', 'N'), ('cycle', '1')]
+    """
+
+    description = "Text recordings of fretting loops (CSV, TSV), in SI units (ecofmaps)"
+    url = "https://github.com/ecofmaps/ecofmaps"
+    open_dataset_parameters = (
+        "filename_or_obj",
+        "drop_variables",
+        "displacement_column",
+        "force_column",
+        "cycle_column",
+        "displacement_unit",
+        "force_unit",
+        "nan_policy",
+        "block_bytes",
+    )
+
+    def open_dataset(
+        self,
+        filename_or_obj,
+        *,
+        drop_variables=None,
+        displacement_column="displacement",
+        force_column="force",
+        cycle_column=None,
+        displacement_unit=None,
+        force_unit=None,
+        nan_policy="propagate",
+        block_bytes=None,
+    ) -> xr.Dataset:
+        """The recording's columns (see :func:`ecofmaps.io.read_recording` for the options).
+
+        Raises
+        ------
+        RecordingError
+            For a file that is not a text recording, or a damaged one (naming the line).
+        """
+        if not isinstance(filename_or_obj, str | os.PathLike):
+            raise TypeError(
+                f"the ecofmaps-text engine reads a file by its path; got {filename_or_obj!r}"
+            )
+        path = Path(filename_or_obj)
+        kind = recording_format(path)
+        if kind != "text":
+            engine = "ecofmaps-tdms" if kind == "tdms" else {"hdf5": "h5netcdf"}.get(kind, kind)
+            raise RecordingError(path, None, f"a {kind} file, not text: use engine={engine!r}")
+        dataset = open_recording(
+            path,
+            displacement_column=displacement_column,
+            force_column=force_column,
+            cycle_column=cycle_column,
+            displacement_unit=displacement_unit,
+            force_unit=force_unit,
+            nan_policy=nan_policy,
+            block_bytes=block_bytes,
+        )
+        dataset = dataset.rename_vars(
+            {name: v.attrs["source_column"] for name, v in dataset.items()}
+        )
+        return dataset.drop_vars(drop_variables or [], errors="ignore")
+
+    def guess_can_open(self, filename_or_obj) -> bool:
+        """A path ending in ``.csv`` or ``.tsv``."""
+        try:
+            return Path(filename_or_obj).suffix.lower() in SUFFIXES
+        except TypeError:
+            return False

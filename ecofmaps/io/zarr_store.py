@@ -1,0 +1,142 @@
+"""zarr stores (formats 2 and 3) as xarray Datasets, through xarray's ``zarr`` engine.
+
+Each group of the store is one lazily read :class:`xarray.Dataset`; xarray decodes the
+attributes and the fill value as the store's format keeps them (a format-3 store written
+by ``Dataset.to_zarr`` keeps ``_FillValue`` base64-encoded in its attributes, a format-2
+store in the array's ``fill_value``), and CF packing (``scale_factor``, ``add_offset``).
+
+A store written by zarr alone has no dimension names, which xarray's engine needs: its
+one-dimensional arrays are then read as variables over "phony" dimensions (one for each
+length, ``phony_dim_0``, ...), lazily, and decoded by :func:`xarray.decode_cf` from their
+attributes (zarr's own ``fill_value`` there only stands for chunks never written, which
+:func:`missing_chunks` refuses).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import xarray as xr
+import zarr
+from xarray.backends import BackendArray
+from xarray.core import indexing
+
+from ecofmaps.io.recording_types import RecordingError
+
+__all__ = ["missing_chunks", "open_zarr_group", "zarr_groups"]
+
+#: xarray's options for every opening: CF packing and fill values decoded, numbers left as
+#: numbers, lazily indexed arrays (no dask), no copy of a whole variable kept once read.
+OPTIONS = {
+    "engine": "zarr",
+    "chunks": None,
+    "mask_and_scale": True,
+    "decode_times": False,
+    "decode_timedelta": False,
+    "decode_coords": False,
+    "cache": False,
+}
+
+_NO_DIMENSIONS = ("dimension_names", "_ARRAY_DIMENSIONS")
+
+
+def _opened(path: Path):
+    try:
+        return zarr.open(store=str(path), mode="r")
+    except Exception as error:
+        raise RecordingError(path, None, f"cannot open as a zarr store: {error}") from None
+
+
+def _consolidated(root) -> bool:
+    """Whether the store has consolidated metadata (else xarray is told not to look)."""
+    return isinstance(root, zarr.Group) and root.metadata.consolidated_metadata is not None
+
+
+class _ZarrRange(BackendArray):
+    """A zarr array as a lazily indexed array (slices and indices read only their chunks)."""
+
+    def __init__(self, array):
+        self.array, self.shape, self.dtype = array, array.shape, array.dtype
+
+    def __getitem__(self, key):
+        return indexing.explicit_indexing_adapter(
+            key, self.shape, indexing.IndexingSupport.BASIC, self._read
+        )
+
+    def _read(self, key):
+        return self.array[key]
+
+
+def _plain_groups(path: Path, root) -> dict[str, xr.Dataset]:
+    """The groups of a store without dimension names (see the module's notes)."""
+    is_array = isinstance(root, zarr.Array)
+    members = [("", root)] if is_array else list(root.members(max_depth=None))
+    groups = {"/": {}}
+    groups.update({"/" + name: {} for name, item in members if isinstance(item, zarr.Group)})
+    lengths: list[int] = []
+    for name, item in members:
+        if not isinstance(item, zarr.Array) or item.ndim != 1:
+            continue
+        group, _, short = (name or path.stem).rpartition("/")
+        size = int(item.shape[0])
+        lengths += [] if size in lengths else [size]
+        data = indexing.LazilyIndexedArray(_ZarrRange(item))
+        variable = xr.Variable((f"phony_dim_{lengths.index(size)}",), data, dict(item.attrs))
+        variable.encoding["chunks"] = tuple(item.chunks)
+        groups["/" + group][short] = variable
+    options = {k: v for k, v in OPTIONS.items() if k.startswith(("mask", "decode"))}
+    return {name: xr.decode_cf(xr.Dataset(found), **options) for name, found in groups.items()}
+
+
+def zarr_groups(path) -> dict[str, xr.Dataset]:
+    """Every group of a zarr store as a lazily read Dataset, by its path (``'/'``,
+    ``'/rig/run1'``).
+
+    Raises
+    ------
+    RecordingError
+        If the path is not a zarr store xarray or zarr can open.
+    """
+    path = Path(path)
+    root = _opened(path)
+    try:
+        return xr.open_groups(path, consolidated=_consolidated(root), **OPTIONS)
+    except KeyError as error:
+        if any(key in str(error) for key in _NO_DIMENSIONS):
+            return _plain_groups(path, root)
+        raise RecordingError(path, None, f"cannot open as a zarr store: {error}") from None
+    except Exception as error:
+        raise RecordingError(path, None, f"cannot open as a zarr store: {error}") from None
+
+
+def open_zarr_group(path, group: str | None = None) -> xr.Dataset:
+    """One group of a zarr store (by default the root) as a lazily read Dataset.
+
+    Raises
+    ------
+    RecordingError
+        If the path is not a zarr store, or has no such group.
+    """
+    path = Path(path)
+    key = "/" + (group or "").strip("/")
+    root = _opened(path)
+    try:
+        return xr.open_dataset(path, group=key, consolidated=_consolidated(root), **OPTIONS)
+    except KeyError as error:
+        if not any(name in str(error) for name in _NO_DIMENSIONS):
+            raise RecordingError(path, None, f"cannot open as a zarr store: {error}") from None
+    except Exception as error:
+        raise RecordingError(path, None, f"cannot open as a zarr store: {error}") from None
+    groups = _plain_groups(path, root)
+    if key not in groups:
+        raise RecordingError(path, None, f"no group {group!r}")
+    return groups[key]
+
+
+def missing_chunks(path, name: str) -> tuple[int, int]:
+    """Chunks of array ``name`` (its path in the store) missing, and expected: zarr reads a
+    missing chunk as its fill value, so a truncated or partly copied store would read."""
+    root = _opened(Path(path))
+    array = root if isinstance(root, zarr.Array) else root[name]
+    expected = int(array.nchunks)
+    return expected - int(array.nchunks_initialized), expected
