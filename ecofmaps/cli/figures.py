@@ -1,16 +1,42 @@
-"""``ecofmaps figures``: write the paper's figures (default: into figures/)."""
+"""``ecofmaps figures``: write the paper's figures (default: into figures/), in parallel.
+
+The figures are drawn by groups sharing one Dataset (:func:`ecofmaps.figures.figure_groups`),
+the costliest first, on ``--jobs`` processes (default: one per core). Each drawing process
+keeps JAX's compiled kernels in ``<cache>/jax`` (:data:`JAX_CACHE_FOLDER`), beside the
+cached maps, so a second run compiles nothing it compiled before; this is set for the run
+only, never on importing the library.
+"""
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import multiprocessing
+import os
+import signal
 import sys
 import textwrap
 import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
-__all__ = ["FIGURE_FORMATS", "add", "figure_formats", "run"]
+from ecofmaps._interrupts import check_interrupted, interrupts_stop_writes
+
+__all__ = [
+    "FIGURE_FORMATS",
+    "JAX_CACHE_FOLDER",
+    "add",
+    "figure_formats",
+    "jax_compilation_cache",
+    "run",
+    "usable_cores",
+    "write_figure_group",
+]
 
 FIGURE_FORMATS = ("png", "pdf", "svg")
+
+#: Folder of the ecofmaps cache directory that holds JAX's compiled kernels for this command.
+JAX_CACHE_FOLDER = "jax"
 
 
 def figure_formats(text: str) -> tuple[str, ...]:
@@ -23,6 +49,24 @@ def figure_formats(text: str) -> tuple[str, ...]:
             f"give one or more of {', '.join(FIGURE_FORMATS)}, comma-separated"
         )
     return formats
+
+
+def _jobs(text: str) -> int:
+    """An argparse ``type`` reading a number of processes, >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of processes >= 1")
+    return value
+
+
+def usable_cores() -> int:
+    """The number of cores this process may run on (its affinity, where the system has one)."""
+    if hasattr(os, "sched_getaffinity"):
+        return max(1, len(os.sched_getaffinity(0)))
+    return os.cpu_count() or 1
 
 
 def add(subparsers) -> None:
@@ -38,8 +82,10 @@ def add(subparsers) -> None:
             "the ECoF ratio and the comparison of scar shapes at equal D/W (shapes), one file "
             "per figure and format (fig5.png, ...). Parameters are "
             "the paper's: amplitude 50um (= groove half-width), load 450N, stiffness 35MN/m, "
-            "mu 0.8. Maps are read from the cache when there (see ECOFMAPS_CACHE) and stored "
-            "there otherwise; files are written atomically. Progress goes to stderr.",
+            "mu 0.8. Maps and loops are read from the cache when there (see ECOFMAPS_CACHE) "
+            "and stored there otherwise, with JAX's compiled kernels in its jax/ folder; "
+            "files are written atomically. Figures sharing their numbers are drawn by one "
+            "process, several processes at once (--jobs). Progress goes to stderr.",
             width=80,
         ),
         epilog=f"figures:\n{listing}",
@@ -57,28 +103,162 @@ def add(subparsers) -> None:
         "--format", type=figure_formats, default=("png",), metavar="FORMATS",
         help="comma-separated file formats among png, pdf, svg (default: png)",
     )  # fmt: skip
+    parser.add_argument(
+        "--jobs", type=_jobs, default=None, metavar="N",
+        help="processes drawing at once (default: one per core, at most one per group of "
+        "figures sharing their numbers; 1: all in this process)",
+    )  # fmt: skip
     parser.set_defaults(handler=run)
 
 
-def run(args) -> int:
-    from ecofmaps.figures import FIGURES, make_figures, save_figure
+def _jax_cache_options(directory) -> dict:
+    """JAX's options that keep every compiled kernel in ``directory``."""
+    # Every kernel, however quick its compilation or small its executable: the figures'
+    # kernels each compile in well under JAX's default threshold of one second.
+    return {
+        "jax_compilation_cache_dir": str(directory),
+        "jax_persistent_cache_min_compile_time_secs": 0.0,
+        "jax_persistent_cache_min_entry_size_bytes": 0,
+    }
 
-    names = list(dict.fromkeys(args.only or FIGURES))
+
+def _set_jax_options(options: dict) -> dict:
+    """Set JAX's ``options``; return their values before."""
+    import jax  # the CLI's lazy boundary: other commands start without JAX
+
+    previous = {name: getattr(jax.config, name) for name in options}
+    for name, value in options.items():
+        jax.config.update(name, value)
+    return previous
+
+
+@contextlib.contextmanager
+def jax_compilation_cache(directory):
+    """Within the block, JAX keeps every kernel it compiles in ``directory`` and reuses them.
+
+    Parameters
+    ----------
+    directory : str or os.PathLike
+        JAX's persistent compilation cache (created when first written).
+
+    Notes
+    -----
+    JAX's options are restored on leaving the block. JAX opens its cache once per process:
+    a later block in the same process with another directory still uses the first one.
+    """
+    previous = _set_jax_options(_jax_cache_options(directory))
+    try:
+        yield
+    finally:
+        _set_jax_options(previous)
+
+
+def write_figure_group(names, directory, formats) -> list[tuple[str, list[Path], float]]:
+    """Draw the figures ``names`` (sharing one Dataset) and write each in every format.
+
+    Parameters
+    ----------
+    names : list of str
+        Keys of :data:`ecofmaps.figures.FIGURES`, typically one group of
+        :func:`ecofmaps.figures.figure_groups`.
+    directory : str or os.PathLike
+        Existing directory to write into; files are ``<name>.<format>``, written atomically.
+    formats : sequence of str
+        Among :data:`FIGURE_FORMATS`.
+
+    Returns
+    -------
+    written : list of (str, list of pathlib.Path, float)
+        Each figure's name, its files, and the time it took (its Dataset included when it
+        was the first to need it). [s]
+    """
+    from ecofmaps.figures import make_figures, save_figure  # the CLI's lazy boundary
+
+    written = []
+    start = time.perf_counter()
+    for name, figure in make_figures(names):
+        paths = [save_figure(figure, Path(directory) / f"{name}.{suffix}") for suffix in formats]
+        now = time.perf_counter()
+        written.append((name, paths, now - start))
+        start = now
+    return written
+
+
+def _start_worker() -> None:
+    """Set up a drawing process: Ctrl-C is the parent's to handle; JAX's compilation cache."""
+    from ecofmaps.maps.cache import cache_directory  # the CLI's lazy boundary
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _set_jax_options(_jax_cache_options(cache_directory() / JAX_CACHE_FOLDER))
+
+
+def _worker_group(names, directory, formats) -> list[tuple[str, list[Path], float]]:
+    """:func:`write_figure_group` in a drawing process; nothing once it is told to stop."""
+    try:
+        with interrupts_stop_writes():  # SIGTERM from the parent: stop at a safe point
+            return write_figure_group(names, directory, formats)
+    except KeyboardInterrupt:
+        return []
+
+
+def _written_in_parallel(groups, out: Path, formats, jobs: int):
+    """Yield each group's :func:`write_figure_group` result from ``jobs`` processes."""
+    others = set(multiprocessing.active_children())
+    executor = ProcessPoolExecutor(
+        jobs,
+        mp_context=multiprocessing.get_context("spawn"),  # JAX's threads do not survive a fork
+        initializer=_start_worker,
+    )
+    try:
+        futures = [executor.submit(_worker_group, group, out, formats) for group in groups]
+        for future in as_completed(futures):
+            check_interrupted()
+            yield future.result()
+    except BaseException:  # an error, Ctrl-C or SIGTERM: stop the drawing processes too
+        executor.shutdown(wait=False, cancel_futures=True)
+        for process in set(multiprocessing.active_children()) - others:
+            process.terminate()  # SIGTERM: it stops at its next safe point
+        raise
+    finally:
+        executor.shutdown(wait=True)
+
+
+def _written_here(groups, out: Path, formats):
+    """Yield each group's :func:`write_figure_group` result, drawn in this process."""
+    from ecofmaps.maps.cache import cache_directory  # the CLI's lazy boundary
+
+    with jax_compilation_cache(cache_directory() / JAX_CACHE_FOLDER):
+        for group in groups:
+            yield write_figure_group(group, out, formats)
+
+
+def run(args) -> int:
+    from ecofmaps.figures.recipes import figure_groups
+
+    names = list(dict.fromkeys(args.only or ()))
+    groups = figure_groups(names or None)
+    count = sum(len(group) for group in groups)
+    jobs = min(args.jobs or usable_cores(), len(groups))
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     print(
-        f"ecofmaps figures: {len(names)} figure(s) as {', '.join(args.format)} into {out}",
+        f"ecofmaps figures: {count} figure(s) as {', '.join(args.format)} into {out}"
+        + (f", {jobs} processes" if jobs > 1 else ""),
         file=sys.stderr,
     )
-    begin = start = time.perf_counter()
-    for index, (name, figure) in enumerate(make_figures(names), start=1):
-        paths = [save_figure(figure, out / f"{name}.{suffix}") for suffix in args.format]
-        now = time.perf_counter()
-        print(
-            f"  [{index}/{len(names)}] {name:<10} {now - start:5.1f} s  "
-            + ", ".join(str(path) for path in paths),
-            file=sys.stderr,
-        )
-        start = now
+    begin = time.perf_counter()
+    if jobs > 1:
+        results = _written_in_parallel(groups, out, args.format, jobs)
+    else:
+        results = _written_here(groups, out, args.format)
+    index = 0
+    for written in results:
+        for name, paths, seconds in written:
+            index += 1
+            print(
+                f"  [{index}/{count}] {name:<10} {seconds:5.1f} s  "
+                + ", ".join(str(path) for path in paths),
+                file=sys.stderr,
+            )
     print(f"done in {time.perf_counter() - begin:.1f} s", file=sys.stderr)
     return 0

@@ -29,7 +29,13 @@ _PUBLIC = {
         "slip_amplitude_curves",
     ),
     "ecofmaps.figures.profile_figures": ("scar_profile_figure", "scar_shape_comparison"),
-    "ecofmaps.figures.recipes": ("FIGURES", "FigureRecipe", "make_figure", "make_figures"),
+    "ecofmaps.figures.recipes": (
+        "FIGURES",
+        "FigureRecipe",
+        "figure_groups",
+        "make_figure",
+        "make_figures",
+    ),
     "ecofmaps.figures.style": ("ECOF_RATIO_LEVELS", "save_figure"),
 }
 __getattr__, __dir__, __all__ = lazy_names(__name__, _PUBLIC)

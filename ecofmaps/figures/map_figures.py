@@ -24,12 +24,12 @@ from ecofmaps.figures.style import (
     ECOF_RATIO_LEVELS,
     FIGSIZE,
     HIGHLIGHT_LEVEL,
-    MEGA,
     MICRO,
     PER_MM,
     axis_label,
     parameters,
     scalar,
+    stiffness_label,
 )
 from ecofmaps.model import NO_GROSS_SLIP, compliance_ratio, energy_cof
 
@@ -124,7 +124,7 @@ def ecof_ratio_contours(
             color="navy",
             markersize=8,
             markeredgecolor="white",
-            label=rf"{name} ($S$ = {point['stiffness'] * MEGA:g} MN/m, $P$ = {point['load']:g} N)",
+            label=rf"{name} ({stiffness_label(point['stiffness'])}, $P$ = {point['load']:g} N)",
         )
     ax.legend(handles=handles, loc="lower right", fontsize="small", framealpha=0.9)
     ax.set_title(
@@ -215,7 +215,7 @@ def universal_ecof_ratio_map(
             markeredgecolor="white",
             zorder=5,
             label=(
-                rf"{name}: $S$ = {point['stiffness'] * MEGA:g} MN/m, "
+                rf"{name}: {stiffness_label(point['stiffness'])}, "
                 rf"$z_o/x_o$ = {point['aspect_ratio']:.3g}, "
                 rf"$\mu$ = {point['mu']:g}: $\mu_E/\mu$ = {value:.3f}"
             ),

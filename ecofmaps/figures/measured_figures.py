@@ -14,12 +14,12 @@ from matplotlib import colormaps
 from matplotlib.figure import Figure
 
 from ecofmaps.figures.style import (
-    MEGA,
     MICRO,
     axis_label,
     force_ratio_axis,
     parameters,
     scalar,
+    stiffness_label,
 )
 from ecofmaps.model.regimes import GROSS_SLIP, Regime
 
@@ -122,7 +122,7 @@ def measured_loops(
         quality = str(cycle["quality"].values) if "quality" in cycle else "ok"
         state = Regime(int(cycle["regime"])).label + ("" if quality == "ok" else f"; {quality}")
         ax.set_title(
-            f"cycle {label}: {reading}\nS = {_number(stiffness * MEGA, '.1f')} MN/m, {state}",
+            f"cycle {label}: {reading}\n{stiffness_label(stiffness)}, {state}",
             fontsize="small",
         )
     for ax in axes.flat[len(chosen) :]:
@@ -133,8 +133,9 @@ def measured_loops(
         ax.set_ylabel(axis_label("force"))
     axes.flat[0].legend(loc="upper left", fontsize="x-small")
     figure.suptitle(
-        rf"Measured loops and the line $Q = S\Delta$ (P = {load:g} N): "
-        "the GICoF is Q/P at the crossings",
+        # Two lines: the figure of a single cycle is only one panel wide.
+        rf"Measured loops and the line $Q = S\Delta$ (P = {load:g} N):"
+        "\nthe GICoF is Q/P at the crossings",
         fontsize="medium",
     )
     return figure
@@ -276,7 +277,7 @@ def measured_and_fitted_loops(fits) -> Figure:
             "\n"
             + parameters(
                 rf"fit: $\mu$ = {fit.mu:.3f}",
-                f"S = {fit.stiffness * MEGA:.1f} MN/m",
+                stiffness_label(fit.stiffness),
                 rf"$z_o$ = {fit.groove_depth * MICRO:.2f} µm",
                 f"RMS residual {fit.rms_residual:.2g} N",
             ),
@@ -355,7 +356,11 @@ def resolved_loops(resolved: xr.Dataset, results: xr.Dataset | None = None, cycl
     stroke.set_xlabel(axis_label("position"))
     stroke.set_ylabel(r"Coefficient of friction $\mu(\xi)$ [1]")
     stroke.set_title(r"(a) $\mu$ along the stroke (dashed: its average)", fontsize="medium")
-    stroke.legend(loc="lower center", fontsize="x-small", ncols=2)
+    if chosen:
+        stroke.legend(loc="lower center", fontsize="x-small", ncols=2)
+    else:
+        stroke.text(0.5, 0.5, "no cycle was read along the stroke\n(none has quality 'ok')",
+                    transform=stroke.transAxes, ha="center", va="center", color="0.3")  # fmt: skip
     felt.plot([], [], color="0.4", linestyle=":", label=r"equivalent parabola $k\xi^2/2$")
     felt.set_xlabel(axis_label("position"))
     felt.set_ylabel(r"Felt groove profile $h(\xi)$ [µm]")

@@ -18,7 +18,6 @@ from matplotlib.figure import Figure
 
 from ecofmaps.figures.style import (
     FIGSIZE,
-    MEGA,
     MICRO,
     MILLI,
     axis_label,
@@ -171,7 +170,7 @@ def loops_by_aspect_ratio(loops: xr.Dataset) -> Figure:
         + parameters(
             rf"$x_o = \Delta^*$ = {scalar(loops, 'amplitude') * MICRO:g} µm",
             f"P = {load:g} N",
-            f"S = {stiffness * MEGA:g} MN/m",
+            stiffness_label(stiffness),
             rf"$\mu$ = {mu:g}",
         ),
         fontsize="medium",
@@ -313,7 +312,7 @@ def ecof_ratio_curves(dataset: xr.Dataset, markers: Mapping[str, Mapping] | None
             markersize=9,
             zorder=5,
             label=(
-                rf"{name} ($S$ = {point['stiffness'] * MEGA:g} MN/m, "
+                rf"{name} ({stiffness_label(point['stiffness'])}, "
                 rf"$z_o/x_o$ = {point['aspect_ratio']:g}): $\mu_E/\mu$ = {value:.3f} "
                 rf"(+{(value - 1) * 100:.1f} %)"
             ),

@@ -17,7 +17,6 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 from ecofmaps.figures.style import (
-    MEGA,
     MICRO,
     MILLI,
     PER_MM,
@@ -25,6 +24,7 @@ from ecofmaps.figures.style import (
     force_ratio_axis,
     parameters,
     scalar,
+    stiffness_label,
 )
 
 __all__ = ["scar_profile_figure", "scar_shape_comparison"]
@@ -159,11 +159,6 @@ def scar_shape_comparison(dataset: xr.Dataset) -> Figure:
     middle than the parabola (flat-bottomed, W-shaped) biases :math:`\mu_E` less.
     """
     shapes = list(dataset["shape"].values)
-    others = [shape for shape in shapes if shape != "parabolic"]
-    load, mu = scalar(dataset, "load"), scalar(dataset, "mu")
-    depth, width = scalar(dataset, "scar_depth"), scalar(dataset, "scar_half_width")
-    amplitude, stiffness = scalar(dataset, "amplitude"), scalar(dataset, "stiffness")
-
     figure = Figure(figsize=(15.0, 9.0), layout="constrained")
     grid = figure.add_gridspec(2, 2 * len(shapes), height_ratios=(1.0, 1.05))
     ax_shapes = figure.add_subplot(grid[0, 0:2])
@@ -173,29 +168,52 @@ def scar_shape_comparison(dataset: xr.Dataset) -> Figure:
     half = grid.ncols // 2
     ax_ratio = figure.add_subplot(grid[1, :half])
     ax_error = figure.add_subplot(grid[1, half:])
+    _draw_scar_profiles(ax_shapes, dataset)
+    _draw_shape_loops(loop_axes, dataset)
+    _draw_ratio_and_error(ax_ratio, ax_error, dataset)
+    depth, width = scalar(dataset, "scar_depth"), scalar(dataset, "scar_half_width")
+    figure.suptitle(
+        "Scar shape at equal depth over half-width: how wrong the D/W shortcut is\n"
+        + parameters(
+            rf"$x_o = \Delta^*$ = {scalar(dataset, 'amplitude') * MICRO:g} µm",
+            f"W = {width * MICRO:g} µm, D = {depth * MICRO:g} µm",
+            f"P = {scalar(dataset, 'load'):g} N",
+            f"{stiffness_label(scalar(dataset, 'stiffness'))} (loops)",
+            rf"$\mu$ = {scalar(dataset, 'mu'):g}",
+        ),
+        fontsize="medium",
+    )
+    return figure
 
-    # The profiles, with the reach of the pad on the parabola.
+
+def _draw_scar_profiles(ax, dataset: xr.Dataset) -> None:
+    """The profiles of the ``shapes`` figure, with the reach of the pad on the parabola."""
+    depth, width = scalar(dataset, "scar_depth"), scalar(dataset, "scar_half_width")
     x = dataset["scar_position"].values * MICRO
-    for shape in shapes:  # the parabola on top, thinner: other scars may share parts of it
-        ax_shapes.plot(x, dataset["scar_height"].sel(shape=shape) * MICRO,
-                       color=SHAPE_COLORS.get(shape), label=shape,
-                       **({"linewidth": 1.4, "zorder": 3} if shape == "parabolic" else
-                          {"linewidth": 2.6, "zorder": 2}))  # fmt: skip
+    for shape in dataset["shape"].values:  # the parabola on top, thinner: others share parts
+        ax.plot(x, dataset["scar_height"].sel(shape=shape) * MICRO,
+                color=SHAPE_COLORS.get(shape), label=shape,
+                **({"linewidth": 1.4, "zorder": 3} if shape == "parabolic" else
+                   {"linewidth": 2.6, "zorder": 2}))  # fmt: skip
     reach = float(dataset["slip_amplitude"].sel(shape="parabolic", groove="parabola"))
-    reach *= width / amplitude
-    ax_shapes.axvspan(-reach * MICRO, reach * MICRO, color="0.85", zorder=0,
-                      label=r"reach of the pad, $|X| \leq \delta^* W/\Delta^*$")  # fmt: skip
+    reach *= width / scalar(dataset, "amplitude")
+    ax.axvspan(-reach * MICRO, reach * MICRO, color="0.85", zorder=0,
+               label=r"reach of the pad, $|X| \leq \delta^* W/\Delta^*$")  # fmt: skip
     for edge in (-width, width):
-        ax_shapes.axvline(edge * MICRO, **_EDGE)
-    ax_shapes.set_xlabel(axis_label("scar_position"))
-    ax_shapes.set_ylabel(axis_label("scar_height"))
-    ax_shapes.set_title(f"Scars of equal D/W = {depth / width:g}\n(edges ±W dotted)",
-                        fontsize="medium")  # fmt: skip
-    ax_shapes.set_ylim(-1.25 * depth * MICRO, 2.1 * depth * MICRO)  # the legend above
-    ax_shapes.legend(loc="upper center", fontsize="x-small", ncols=2)
-    ax_shapes.grid(alpha=0.3)
+        ax.axvline(edge * MICRO, **_EDGE)
+    ax.set_xlabel(axis_label("scar_position"))
+    ax.set_ylabel(axis_label("scar_height"))
+    ax.set_title(f"Scars of equal D/W = {depth / width:g}\n(edges ±W dotted)",
+                 fontsize="medium")  # fmt: skip
+    ax.set_ylim(-1.25 * depth * MICRO, 2.1 * depth * MICRO)  # the legend above
+    ax.legend(loc="upper center", fontsize="x-small", ncols=2)
+    ax.grid(alpha=0.3)
 
-    # The loops, each against the parabola's.
+
+def _draw_shape_loops(loop_axes, dataset: xr.Dataset) -> None:
+    """The loop on each non-parabolic scar of the ``shapes`` figure against the parabola's."""
+    load = scalar(dataset, "load")
+    others = [shape for shape in dataset["shape"].values if shape != "parabolic"]
     for ax, shape in zip(loop_axes, others, strict=True):
         own = dict(color=SHAPE_COLORS.get(shape), linewidth=2.0, zorder=2)
         for groove, style in (("profile", own), ("parabola", dict(_SHORTCUT, zorder=3))):
@@ -227,13 +245,17 @@ def scar_shape_comparison(dataset: xr.Dataset) -> Figure:
     peak = float(np.nanmax(np.abs(dataset["force"].values)))
     loop_axes[0].set_ylim(-1.08 * peak, 1.75 * peak)  # room for the legends above the loops
 
-    # μ_E/μ over S/P, and the shortcut's error.
+
+def _draw_ratio_and_error(ax_ratio, ax_error, dataset: xr.Dataset) -> None:
+    """μ_E/μ over S/P for every shape and the parabola, and the D/W shortcut's error."""
+    depth, width = scalar(dataset, "scar_depth"), scalar(dataset, "scar_half_width")
+    stiffness = scalar(dataset, "stiffness")
     ratios = dataset["stiffness_ratio"].values * PER_MM
     shortcut = dataset["ecof_ratio"].sel(shape="parabolic", groove="parabola")
-    same_label = f"parabola, D/W = {depth / width:g}"
-    ax_ratio.plot(ratios, shortcut, **_SHORTCUT, zorder=3, label=same_label)
+    ax_ratio.plot(ratios, shortcut, **_SHORTCUT, zorder=3,
+                  label=f"parabola, D/W = {depth / width:g}")  # fmt: skip
     ax_error.axhline(0.0, **_SHORTCUT, zorder=3, label="no error (the parabola itself)")
-    for shape in shapes:
+    for shape in dataset["shape"].values:
         style = dict(color=SHAPE_COLORS.get(shape), linewidth=2.0, zorder=2)
         if shape == "parabolic":  # on the parabola's closed form: points, so both show
             style = dict(color=SHAPE_COLORS["parabolic"], marker="o", markersize=4,
@@ -243,15 +265,15 @@ def scar_shape_comparison(dataset: xr.Dataset) -> Figure:
         if shape != "parabolic":
             error = dataset["shortcut_error"].sel(shape=shape) * 100.0
             ax_error.plot(ratios, error, label=f"{shape} scar", **style)
-    example = stiffness / load * PER_MM
+    example = stiffness / scalar(dataset, "load") * PER_MM
     for ax in (ax_ratio, ax_error):
         ax.axvline(example, color="crimson", linewidth=1.0, linestyle="-.",
-                   label=f"Example 2, S = {stiffness * MEGA:g} MN/m")  # fmt: skip
+                   label=f"Example 2, {stiffness_label(stiffness)}")  # fmt: skip
         ax.set_xlabel(axis_label("stiffness_ratio"))
         ax.set_xlim(ratios[0], ratios[-1])
         ax.grid(alpha=0.3)
     ax_ratio.set_ylabel(axis_label("ecof_ratio"))
-    ax_ratio.set_title(r"Energy CoF over the contact CoF, $\mu$ = " + f"{mu:g}",
+    ax_ratio.set_title(r"Energy CoF over the contact CoF, $\mu$ = " + f"{scalar(dataset, 'mu'):g}",
                        fontsize="medium")  # fmt: skip
     ax_ratio.legend(loc="upper left", fontsize="small")
     ax_error.set_ylabel(r"Error of $\mu'$ from the D/W shortcut, $\mu'/\mu - 1$ [%]")
@@ -260,15 +282,3 @@ def scar_shape_comparison(dataset: xr.Dataset) -> Figure:
         fontsize="medium",
     )
     ax_error.legend(loc="upper right", fontsize="small")
-    figure.suptitle(
-        "Scar shape at equal depth over half-width: how wrong the D/W shortcut is\n"
-        + parameters(
-            rf"$x_o = \Delta^*$ = {amplitude * MICRO:g} µm",
-            f"W = {width * MICRO:g} µm, D = {depth * MICRO:g} µm",
-            f"P = {load:g} N",
-            f"S = {stiffness * MEGA:g} MN/m (loops)",
-            rf"$\mu$ = {mu:g}",
-        ),
-        fontsize="medium",
-    )
-    return figure

@@ -11,9 +11,11 @@ The paper's parameters (Section 3): :math:`\Delta^* = x_o = 50` µm, :math:`P = 
 
 from __future__ import annotations
 
+import hashlib
 import importlib
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -30,8 +32,11 @@ __all__ = [
     "FIGURES",
     "SCAR_SHAPES",
     "FigureRecipe",
+    "figure_groups",
     "make_figure",
     "make_figures",
+    "scar_shapes_dataset",
+    "source_digest",
 ]
 
 #: Groove aspect ratios z_o/x_o of Figures 7, 8, 11 and the universal map (the paper's 0 to
@@ -65,6 +70,10 @@ class FigureRecipe:
         Keyword arguments of ``draw``: the figure's number, the points it marks.
     module : str
         The module of :mod:`ecofmaps.figures` that holds ``draw``.
+    cost : float
+        Rough time to build the Dataset from an empty cache and draw the figure, relative
+        to a plain figure: the costliest work is started first when figures are drawn in
+        parallel (:func:`figure_groups`). [1]
     """
 
     name: str
@@ -74,6 +83,7 @@ class FigureRecipe:
     selection: dict = field(default_factory=dict)
     options: dict = field(default_factory=dict)
     module: str = "model_figures"
+    cost: float = 1.0
 
     def dataset(self) -> xr.Dataset:
         """The Dataset this figure draws."""
@@ -86,16 +96,23 @@ class FigureRecipe:
 
 
 def _loops() -> xr.Dataset:
-    """The loops of Figures 5 and 6: rigid and 35 MN/m rigs, z_o/x_o = 0, 0.1, 0.2, 0.3."""
+    """The loops of Figures 5 and 6: rigid and 35 MN/m rigs, z_o/x_o = 0, 0.1, 0.2, 0.3.
+
+    Kept in the disk cache like the maps (:func:`ecofmaps.maps.grid.compute_loops` is part
+    of the model's revision, :func:`ecofmaps.maps.cache.model_revision`).
+    """
+    # Imported here, like the map functions below: the registry reads without JAX.
+    from ecofmaps.maps.cache import cached_dataset
     from ecofmaps.maps.grid import compute_loops
 
-    return compute_loops(
+    inputs = dict(
         stiffness=np.array([np.inf, paper.STIFFNESS]),
         aspect_ratio=np.array([0.0, 0.1, 0.2, 0.3]),
         amplitude=paper.AMPLITUDE,
         load=paper.LOAD,
         mu=paper.MU,
     )
+    return cached_dataset("compute_loops", inputs, lambda: compute_loops(**inputs))
 
 
 def _stiffness_curves_data() -> xr.Dataset:
@@ -138,8 +155,54 @@ SCAR_SHAPES = {
 }
 
 
+#: The sources, relative to the package, that decide the ``shapes`` Dataset beyond the
+#: model's revision: this module (the shapes, the grid) and the correction (eq. 11 shortcut).
+_SCAR_SHAPES_SOURCES = ("figures/recipes.py", "correction/*.py")
+
+
+def source_digest(patterns) -> np.ndarray:
+    """SHA-256 of the package's source files matching ``patterns``, as 32 numbers.
+
+    Parameters
+    ----------
+    patterns : iterable of str
+        Glob patterns relative to the package directory (``'correction/*.py'``).
+
+    Returns
+    -------
+    digest : numpy.ndarray
+        32 bytes (uint8) of the hash of the files' names and contents: an input of a cache
+        key (:func:`ecofmaps.maps.cache.cache_key`), so an edit of those files gives another
+        key.
+    """
+    package = Path(__file__).resolve().parents[1]
+    digest = hashlib.sha256()
+    for pattern in patterns:
+        for path in sorted(package.glob(pattern)):
+            digest.update(f"{path.relative_to(package).as_posix()}\0".encode())
+            digest.update(path.read_bytes())
+    return np.frombuffer(digest.digest(), dtype=np.uint8)
+
+
 def _scar_shapes() -> xr.Dataset:
-    """The four scar families at Example 2's D/W: profiles, loops, μ_E/μ over S/P (Fig. 11's)."""
+    """The ``shapes`` figure's Dataset, from the disk cache when there (see
+    :func:`scar_shapes_dataset`); keyed by the model's revision and this module's and the
+    correction's sources."""
+    from ecofmaps.maps.cache import cached_dataset
+
+    inputs = {"sources": source_digest(_SCAR_SHAPES_SOURCES)}
+    return cached_dataset("scar_shapes", inputs, scar_shapes_dataset)
+
+
+def scar_shapes_dataset() -> xr.Dataset:
+    """The four scar families at Example 2's D/W: profiles, loops, μ_E/μ over S/P (Fig. 11's).
+
+    Returns
+    -------
+    dataset : xarray.Dataset
+        The ``shapes`` figure's numbers, computed (not cached): see
+        :func:`ecofmaps.figures.profile_figures.scar_shape_comparison` for its variables.
+    """
     import xarray as xr
 
     import ecofmaps
@@ -218,6 +281,7 @@ FIGURES: dict[str, FigureRecipe] = {
             _loops,
             "rigid_and_compliant_loops",
             {"aspect_ratio": paper.ASPECT_RATIO},
+            cost=2.0,
         ),
         FigureRecipe(
             "fig6",
@@ -282,6 +346,7 @@ FIGURES: dict[str, FigureRecipe] = {
             _scar_shapes,
             "scar_shape_comparison",
             module="profile_figures",
+            cost=8.0,
         ),
     )
 }
@@ -339,3 +404,38 @@ def make_figures(names=None) -> Iterator[tuple[str, Figure]]:
         if recipe.data not in datasets:
             datasets[recipe.data] = recipe.data()
         yield recipe.name, recipe.figure(datasets[recipe.data])
+
+
+def figure_groups(names=None) -> list[list[str]]:
+    """The figures by the Dataset they share, the costliest group first.
+
+    Each group is drawn by one process when figures are drawn in parallel (``ecofmaps
+    figures --jobs``), so its Dataset is built once; starting with the costliest
+    (:attr:`FigureRecipe.cost`) keeps the others' work for the processes that finish first.
+
+    Parameters
+    ----------
+    names : iterable of str, optional
+        Keys of :data:`FIGURES`; default all of them.
+
+    Returns
+    -------
+    groups : list of list of str
+        The names, each once, by shared Dataset; within a group in the order given.
+
+    Raises
+    ------
+    ValueError
+        If a name is not a key of :data:`FIGURES`.
+
+    Examples
+    --------
+    >>> figure_groups(["fig7a", "fig5", "fig8", "fig6", "shapes"])
+    [['shapes'], ['fig5', 'fig6'], ['fig7a', 'fig8']]
+    """
+    groups: dict = {}
+    for name in dict.fromkeys(FIGURES if names is None else names):
+        recipe = _recipe(name)
+        groups.setdefault(recipe.data, []).append(recipe)
+    ordered = sorted(groups.values(), key=lambda group: -sum(recipe.cost for recipe in group))
+    return [[recipe.name for recipe in group] for group in ordered]

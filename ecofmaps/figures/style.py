@@ -16,7 +16,15 @@ from matplotlib.figure import Figure
 from ecofmaps._nomenclature import QUANTITIES, axis_label
 from ecofmaps.io.files import atomic_path
 
-__all__ = ["ECOF_RATIO_LEVELS", "FIGSIZE", "axis_label", "save_figure"]
+__all__ = [
+    "ECOF_RATIO_LEVELS",
+    "FIGSIZE",
+    "axis_label",
+    "number_text",
+    "save_figure",
+    "stiffness_label",
+    "stiffness_text",
+]
 
 #: Contour levels of μ_E/μ shared by Figure 11 and the universal map, so they read alike.
 ECOF_RATIO_LEVELS = (1.01, 1.02, 1.03, 1.04, 1.05, 1.06, 1.08, 1.10, 1.12, 1.14, 1.17, 1.20, 1.25)
@@ -39,11 +47,57 @@ def scalar(dataset: xr.Dataset, name: str) -> float:
     return float(dataset[name].values)
 
 
+def number_text(value: float, digits: int = 3) -> str:
+    """``value`` for a label: ``digits`` significant digits, no exponent, no trailing zeros.
+
+    Parameters
+    ----------
+    value : float
+    digits : int
+        Significant digits at most; whole numbers keep all theirs. [1]
+
+    Returns
+    -------
+    text : str
+        A dash for NaN, ``∞`` for an infinite value.
+
+    Examples
+    --------
+    >>> [number_text(v) for v in (35.0, 0.02, 35.04, 12345.6, 0.0, float("nan"))]
+    ['35', '0.02', '35', '12346', '0', '–']
+    """
+    value = float(value)
+    if np.isnan(value):
+        return "–"
+    if np.isinf(value):
+        return "∞" if value > 0 else "−∞"
+    if value == 0.0:
+        return "0"
+    decimals = max(0, digits - 1 - int(np.floor(np.log10(abs(value)))))
+    text = f"{value:.{decimals}f}"
+    if "." in text:
+        text = text.rstrip("0").rstrip(".")
+    return "0" if text == "-0" else text
+
+
+def stiffness_text(stiffness: float) -> str:
+    """A rig stiffness [N/m] in MN/m for a label: ``'35 MN/m'``, ``'0.02 MN/m'``, ``'rigid'``.
+
+    Examples
+    --------
+    >>> [stiffness_text(s) for s in (35e6, 0.02e6, 35.04e6, float("inf"))]
+    ['35 MN/m', '0.02 MN/m', '35 MN/m', 'rigid']
+    """
+    if np.isinf(stiffness):
+        return "rigid"
+    return f"{number_text(stiffness * MEGA)} MN/m"
+
+
 def stiffness_label(stiffness: float) -> str:
-    """Legend text for a rig stiffness [N/m]."""
+    """Legend text for a rig stiffness [N/m]: ``'S = 35 MN/m'``, or ``'rigid (S = ∞)'``."""
     if np.isinf(stiffness):
         return r"rigid ($S = \infty$)"
-    return f"S = {stiffness * MEGA:g} MN/m"
+    return f"S = {stiffness_text(stiffness)}"
 
 
 def stiffness_colors(stiffnesses) -> list:
