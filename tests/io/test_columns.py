@@ -4,7 +4,14 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from ecofmaps.io.columns import COMMON_UNITS, ColumnError, column_scale, find_column, split_unit
+from ecofmaps.io.columns import (
+    COMMON_UNITS,
+    SYNONYMS,
+    ColumnError,
+    column_scale,
+    find_column,
+    split_unit,
+)
 from ecofmaps.units import parse_quantity
 
 LENGTHS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "micron": 1e-6, "nm": 1e-9}
@@ -96,3 +103,102 @@ def test_common_units_agree_with_pint(unit):
     """The table read without pint gives exactly pint's factor (ecofmaps.units)."""
     kind, factor = COMMON_UNITS[unit]
     assert parse_quantity(f"1 {unit}", kind) == factor
+
+
+@pytest.mark.parametrize(
+    ("name", "expected"),
+    [
+        ("Displacement in mm", ("Displacement", "mm")),
+        ("Force in kN", ("Force", "kN")),
+        ("x_in", ("x", "in")),
+        ("Disp (in)", ("Disp", "in")),
+        ("Fx [kip]", ("Fx", "kip")),
+        ("F_mN", ("F", "mN")),
+        ("Disp [µm]", ("Disp", "µm")),
+        ("Load in N", ("Load", "N")),
+    ],
+)
+def test_split_unit_inches_kips_and_in(name, expected):
+    assert split_unit(name) == expected
+
+
+@pytest.mark.parametrize(
+    ("names", "role", "expected"),
+    [
+        (["delta_mm", "Ftr_kN"], "displacement", 0),
+        (["delta_mm", "Ftr_kN"], "force", 1),
+        (["Disp [um]", "Fx [N]"], "displacement", 0),
+        (["Disp [um]", "Fx [N]"], "force", 1),
+        (["Displacement (mm)", "Tangential force (kN)"], "force", 1),
+        (["stroke_um", "friction_force_N"], "displacement", 0),
+        (["stroke_um", "friction_force_N"], "force", 1),
+        (["time [s]", "Position/µm", "Q / N", "Fz [kN]"], "load", 3),
+        (["t", "X", "Fx", "Fn_N", "Cycle #"], "cycle", 4),
+        (["t", "X", "Fx", "Fn_N", "N° cycle"], "cycle", 4),
+        (["x", "Displacement [um]"], "displacement", 1),  # the role's own name first
+        (["Force", "Fx"], "force", 0),
+    ],
+)
+def test_usual_names_are_found_by_the_role(names, role, expected):
+    assert find_column(names, role, role) == expected
+    assert find_column(names, role.upper(), role) == expected
+
+
+def test_an_explicit_name_finds_no_synonym():
+    assert find_column(["delta_mm", "Ftr_kN"], "disp", "displacement", required=False) is None
+    assert find_column(["t", "n"], "cycle no", "cycle", required=False) is None
+
+
+def test_two_usual_names_are_an_error_naming_both():
+    with pytest.raises(ColumnError) as raised:
+        find_column(["stroke [mm]", "t", "Disp [um]", "Fx"], "displacement", "displacement")
+    message = str(raised.value)
+    assert (
+        "several displacement columns match 'displacement': 'stroke [mm]', 'Disp [um]'" in message
+    )
+    assert "displacement_column (--displacement-col)" in message
+
+
+@pytest.mark.parametrize(
+    ("names", "wanted", "role", "suggested"),
+    [
+        (["Dsplacement [um]", "Fx"], "displacement", "displacement", "Dsplacement [um]"),
+        (["Displ_um", "Frc"], "force", "force", "Frc"),
+        (["t", "Forse_N"], "Force", "force", "Forse_N"),
+        (["t", "Tangential_kN"], "Tangental force", "force", "Tangential_kN"),
+        (["t", "Tangential_kN"], "Q", "force", None),
+        (["a", "b"], "displacement", "displacement", None),
+    ],
+)
+def test_no_match_lists_the_columns_and_suggests_the_nearest(names, wanted, role, suggested):
+    with pytest.raises(ColumnError) as raised:
+        find_column(names, wanted, role)
+    message = str(raised.value)
+    assert f"no {role} column {wanted!r}" in message
+    assert "(columns: " + ", ".join(repr(name) for name in names) + ")" in message
+    assert (f"Did you mean {suggested!r}?" in message) == (suggested is not None)
+    assert ("Did you mean" in message) == (suggested is not None)
+    assert f"{role}_column (--{role}-col)" in message
+
+
+@given(
+    role=st.sampled_from(["displacement", "force", "load", "cycle"]),
+    pick=st.integers(0, 100),
+    style=st.sampled_from(["{base}", *STYLES]),
+    join=st.sampled_from([" ", "_", "-", ""]),
+    upper=st.booleans(),
+    position=st.integers(0, 3),
+)
+def test_every_usual_name_in_every_style_is_found(role, pick, style, join, upper, position):
+    """Any usual name of a role, in any case, words joined any way, with a unit of the
+    role's kind in any style, is found by the role's own name among columns of the other
+    roles (each under its own usual name)."""
+    synonyms = SYNONYMS[role]
+    base = synonyms[pick % len(synonyms)].replace(" ", join)
+    base = base.upper() if upper else base
+    unit = {"displacement": "mm", "force": "kN", "load": "N", "cycle": None}[role]
+    name = base if unit is None or not base.strip("-") else style.format(base=base, unit=unit)
+    others = {"displacement": "Disp [um]", "force": "Ftr_kN", "load": "Fz", "cycle": "Cycle No"}
+    names = [other for key, other in others.items() if key != role]
+    names.insert(position, name)
+    assert find_column(names, role, role) == position
