@@ -87,6 +87,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ecofmaps._codes import warn
+from ecofmaps._inputs import si_units
 
 __all__ = [
     "AMBIGUOUS_EDGES",
@@ -370,23 +371,32 @@ def outlying_samples(x, z, neighbours=OUTLIER_NEIGHBOURS, threshold=OUTLIER_THRE
     -----
     A sample is an outlier when it is farther from the median :math:`m` of its
     ``2 neighbours`` nearest neighbours (itself left out) than ``threshold`` times the
-    larger of their scaled median absolute deviation :math:`1.4826\,\mathrm{MAD}` and the
+    largest of their scaled median absolute deviation :math:`1.4826\,\mathrm{MAD}`, the
     trace's noise (:math:`1.4826/\sqrt{1.5}` times the median distance of a sample from the
-    straight line through its two neighbours, the standard deviation of white noise). A
+    straight line through its two neighbours, the standard deviation of white noise) and
+    its resolution (the smallest step between two samples, so that a quantised trace's
+    one-step blips on an otherwise constant stretch, where the MAD is 0, are not taken). A
     spike is far from its neighbours' median; a scar's edge, a kink, a step between
     two samples or the bottom of a V is not (the median of the neighbours on both sides lies
     within about 2 MADs of them). With the defaults (8 neighbours, 6 MADs) no sample of
     white noise was flagged in 2e5.
     """
     x, z = _array("x", x), _array("z", z)
-    if neighbours < 1 or 2 * neighbours + 1 > z.size:
-        raise ValueError(f"neighbours must be >= 1 and leave {2 * neighbours + 1} samples")
+    if x.size != z.size:
+        raise ValueError(f"x and z must have the same length, got {x.size} and {z.size}")
+    if not (isinstance(neighbours, int | np.integer) and 1 <= neighbours < z.size / 2):
+        raise ValueError(
+            f"neighbours must be an integer >= 1 and less than half the {z.size} samples, "
+            f"got {neighbours!r}"
+        )
     around = z[_neighbours(z.size, int(neighbours))]
     median = np.median(around, axis=1)
     spread = 1.4826 * np.median(np.abs(around - median[:, None]), axis=1)
     between = z[:-2] + (z[2:] - z[:-2]) * (x[1:-1] - x[:-2]) / (x[2:] - x[:-2])
     noise = 1.4826 / np.sqrt(1.5) * np.median(np.abs(z[1:-1] - between))
-    scale = np.maximum(spread, noise)
+    steps = np.abs(np.diff(z))
+    resolution = float(np.min(steps[steps > 0.0])) if steps.any() else 0.0
+    scale = np.maximum(np.maximum(spread, noise), resolution)
     return np.abs(z - median) > threshold * scale
 
 
@@ -696,6 +706,7 @@ def scar_profile_and_findings(x, z, half_width=None, smoothing=None, level=False
     return profile, findings
 
 
+@si_units(x="length", z="length", half_width="length")
 def scar_profile(x, z, half_width=None, smoothing=None, level=False,
                  remove_outliers=True) -> ScarProfile:  # fmt: skip
     r"""A wear-scar profile from a measured trace (arrays in metres).

@@ -73,6 +73,16 @@ def test_no_false_positive_in_white_noise():
     assert flagged == 0
 
 
+def test_a_quantised_trace_loses_no_sample():
+    """Heights in steps of 10 nm with 3 nm noise: constant stretches (their MAD is 0) with
+    one-step blips, none an outlier; a blip of 7 steps is one."""
+    steps = np.round((scar("parabola") + noise(13, X.size, 3e-9)) / 1e-8)
+    assert np.count_nonzero(np.diff(steps)) > 100
+    assert not outlying_samples(X, steps * 1e-8).any()
+    steps[300] -= 7
+    assert np.flatnonzero(outlying_samples(X, steps * 1e-8)).tolist() == [300]
+
+
 def test_a_dropout_gives_the_depth_and_ecof_of_the_clean_scar():
     """One dropout (a spike 40 µm down) inside the scar: replaced, the depth within 0.1 %
     and the ECoF within 1e-4 of the clean scar's; kept, it moves both by far more."""
