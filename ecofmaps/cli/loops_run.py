@@ -74,7 +74,7 @@ def _analysed(index, path, recording, load, args, long_run, write, *, many, reso
 
 #: The variables of a recording's results that its summary line reads (:func:`_summary`):
 #: all that is kept of a long recording's results once their lines are written.
-SUMMARY_VARIABLES = ("regime", "gicof", "mu_resolved", "ecof", "quality")
+SUMMARY_VARIABLES = ("regime", "gicof", "mu_resolved", "ecof", "quality", "amplitude")
 
 
 class _Table:
@@ -97,6 +97,10 @@ def _summary(path, results, recording) -> str:
     """One line on a recording's cycles: counts, the quality, the friction over the test."""
     gross = results.isel(cycle=np.flatnonzero(results.regime.values == GROSS_SLIP))
     summary = f"  {path.name}: {results.attrs['quality_summary']}"
+    if results.attrs.get("motion") == "reciprocating sliding":
+        amplitude = float(np.nanmedian(results.amplitude)) if "amplitude" in results else np.nan
+        stroke = f" (amplitude {amplitude * 1e3:.3g} mm)" if np.isfinite(amplitude) else ""
+        summary += f"; reciprocating sliding{stroke}, not fretting: analysed the same way"
     if results.attrs["incomplete_cycles"]:
         summary += f" ({results.attrs['incomplete_cycles']} incomplete dropped)"
     summary += loops_long.skipped(results, recording)

@@ -203,8 +203,10 @@ def analyze_loops(
         are NaN: :mod:`ecofmaps.measured.quality`); the load is a scalar coordinate. The
         attributes ``incomplete_cycles`` and ``dropped_samples`` count what was dropped,
         ``missing_samples``, ``skipped_cycles`` and ``first_missing_sample`` (or -1) what
-        was missing; ``quality_summary`` is one line on what was flagged and skipped. With
-        ``resolve``, also mu_resolved, mu_resolved_se and aspect_ratio.
+        was missing; ``quality_summary`` is one line on what was flagged and skipped;
+        ``motion`` is ``'fretting'``, or ``'reciprocating sliding'`` for a median amplitude
+        above 300 µm (analysed the same way). With ``resolve``, also mu_resolved,
+        mu_resolved_se and aspect_ratio.
         ``results.to_dataframe()`` gives a table.
 
     Raises
@@ -212,15 +214,17 @@ def analyze_loops(
     ValueError
         For inputs of the wrong shape, a load that is not positive, options out of
         range, a recording without a complete cycle, or one whose every cycle is refused
-        (not a loop that can be read as recorded); :class:`MissingSampleError` for a
+        (not a loop that can be read as recorded, or an amplitude outside 0.5 µm to 50 mm:
+        a displacement not in metres; the message says what to do);
+        :class:`MissingSampleError` for a
         missing sample with ``nan_policy='raise'``.
 
     Warns
     -----
     LoopQualityWarning
         When cycles were flagged (other than for partial slip), with the one-line summary;
-        and when the displacement amplitude is below 0.1 µm or above 10 mm (a displacement
-        not in metres).
+        and when cycles have a coefficient of friction outside 0.01 to 3
+        (``implausible-cof``: the load or the force's unit is wrong), naming the load.
 
     Notes
     -----

@@ -80,6 +80,11 @@ REASONS = {
     ),
     "few-samples": ("fewer samples in the cycle than a loop needs (MIN_SAMPLES)", ALL),
     "constant-force": ("the force does not vary over the cycle (a dead channel)", ALL),
+    "implausible-amplitude": (
+        "the displacement amplitude is below 0.5 µm or above 50 mm: the displacement is not "
+        "in the unit assumed (a column without a unit is read in µm)",
+        ALL,
+    ),
     "several-loops": (
         "the displacement turns back within a branch, by more than the reversal detector's "
         "band (several loops under one cycle number)",
@@ -115,6 +120,11 @@ REASONS = {
         "a branch's crossing with Q = SΔ is not on the measured loop (between its samples, "
         "within their force range)",
         _GICOF,
+    ),
+    "implausible-cof": (
+        "a coefficient of friction outside 0.01 to 3 (the ECoF or GICoF in gross slip, or "
+        "Q*/P): the load given or the force's unit is wrong, not the contact",
+        ("ecof", "cof_max", *_GICOF, *RESOLVED),
     ),
     "not-gross-slip": (
         "partial slip: the energy ratio A is not above the threshold",

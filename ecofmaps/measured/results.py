@@ -42,8 +42,16 @@ _COMMENTS = {
 }
 
 
-#: Plausible displacement amplitudes: outside this range the unit is probably wrong. [m]
-_AMPLITUDE_RANGE = (0.1e-6, 10e-3)
+#: Plausible displacement amplitudes: outside, the unit is wrong (``implausible-amplitude``). [m]
+AMPLITUDE_RANGE = (0.5e-6, 50e-3)
+
+#: Plausible coefficients of friction: outside, the load or the force's unit is wrong
+#: (``implausible-cof``). [1]
+COF_RANGE = (0.01, 3.0)
+
+#: Displacement amplitudes above this are reciprocating sliding rather than fretting (still
+#: analysed the same way; the results' ``motion`` attribute says so). [m]
+FRETTING_AMPLITUDE = 300e-6
 
 
 def _attrs(name: str) -> dict:
@@ -71,6 +79,13 @@ def _refusal_hint(flags: dict) -> str:
         )
     if flags["constant-force"]:
         return "The force does not vary: is the force channel connected?"
+    if flags["implausible-amplitude"]:
+        return (
+            "The displacement amplitude is outside 0.5 µm to 50 mm: the displacement is not "
+            "in the unit assumed. analyze_loops takes metres; on the command line, "
+            "--displacement-unit gives the column's unit (a column without a unit in its "
+            "name or the file is read in µm)."
+        )
     return (
         "Is it a recording of fretting loops, with the displacement and the force in their "
         "own columns?"
@@ -85,6 +100,23 @@ def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
     return results
 
 
+def scale_flags(values: dict, options: dict) -> dict:
+    """The checks of scale of each cycle (reason -> per cycle): an amplitude outside
+    :data:`AMPLITUDE_RANGE`, or a coefficient of friction outside :data:`COF_RANGE` (the
+    ECoF or the GICoF of a gross-slip loop, or :math:`Q^*/P` of any loop). A gross-slip CoF
+    of 361 or 0.001 says that the load or a unit is wrong, not the contact."""
+    amplitude = values["amplitude"]
+    sliding = values["energy_ratio"] > options["gross_slip_threshold"]
+
+    def outside(value, bounds):
+        return np.isfinite(value) & ((value < bounds[0]) | (value > bounds[1]))
+
+    scaled = outside(amplitude, AMPLITUDE_RANGE)
+    cof = sliding & (outside(values["ecof"], COF_RANGE) | outside(values["gicof"], COF_RANGE))
+    cof |= np.isfinite(values["cof_max"]) & (values["cof_max"] > COF_RANGE[1])
+    return {"implausible-amplitude": scaled, "implausible-cof": cof & ~scaled}
+
+
 def cycle_results(values: dict, flags: dict, label, load: float, options: dict) -> xr.Dataset:
     """The per-cycle Dataset of :func:`analyze_loops` for some cycles, without the
     recording's attributes: ``values`` and ``flags`` from :func:`measure_cycles`.
@@ -93,6 +125,7 @@ def cycle_results(values: dict, flags: dict, label, load: float, options: dict) 
     ``_refused`` until :meth:`Tally.finish` takes them off.
     """
     size = label.size
+    flags = flags | scale_flags(values, options)
     quality = quality_strings(flags, size)
     refused = np.zeros(size, dtype=bool)
     for reason, flag in flags.items():
@@ -107,11 +140,13 @@ def cycle_results(values: dict, flags: dict, label, load: float, options: dict) 
     data["stick_residual"] = ("cycle", values["stick_residual"], _attrs("stick_residual"))
     data["quality"] = ("cycle", quality, _attrs("quality"))
     data["_amplitude"] = ("cycle", raw_amplitude)
+    data["_implausible-cof"] = ("cycle", flags["implausible-cof"])
     data["_refused"] = ("cycle", refused)
     hints = {
         "missing-samples": flags["missing-samples"],
         "anticlockwise": flags["anticlockwise"],
         "constant-force": flags["constant-force"],
+        "implausible-amplitude": flags["implausible-amplitude"],
     }
     for reason, flag in hints.items():
         data[f"_{reason}"] = ("cycle", flag)
@@ -128,7 +163,13 @@ class Tally:
     def __init__(self):
         self.counts = collections.Counter()  # cycles by quality
         self.cycles = self.refused = self.flagged = 0
-        self.every = {"missing-samples": True, "anticlockwise": True, "constant-force": True}
+        self.every = {
+            "missing-samples": True,
+            "anticlockwise": True,
+            "constant-force": True,
+            "implausible-amplitude": True,
+        }
+        self.implausible_cof = 0
         self.negative_stiffness = False
         self.amplitudes: list = []
 
@@ -145,6 +186,7 @@ class Tally:
             self.every[reason] &= bool(part[f"_{reason}"].all())
         self.negative_stiffness |= bool(part["_negative-stiffness"].any())
         self.amplitudes.append(part["_amplitude"].values)
+        self.implausible_cof += int(part["_implausible-cof"].sum())
         return strip(part)
 
     def merge(self, other: Tally) -> None:
@@ -157,6 +199,7 @@ class Tally:
             self.every[reason] &= other.every[reason]
         self.negative_stiffness |= other.negative_stiffness
         self.amplitudes += other.amplitudes
+        self.implausible_cof += other.implausible_cof
 
     @property
     def summary(self) -> str:
@@ -173,11 +216,20 @@ class Tally:
             If every cycle was refused.
         """
         summary = self.summary
-        _check_units(np.concatenate(self.amplitudes) if self.amplitudes else np.zeros(0))
+        typical = _typical(np.concatenate(self.amplitudes) if self.amplitudes else np.zeros(0))
         if self.cycles and self.refused == self.cycles:
             hint = dict(self.every, **{"negative-stiffness": self.negative_stiffness})
             raise ValueError(
                 f"no plausible cycle in the recording ({summary}). {_refusal_hint(hint)}"
+            )
+        if self.implausible_cof:
+            warn(
+                f"{self.implausible_cof} cycles have a coefficient of friction outside "
+                f"{COF_RANGE[0]:g} to {COF_RANGE[1]:g} with the load of "
+                f"{float(results['load']):g} N: "
+                "is the load right (load=, on the command line --load) and the force in "
+                "newtons (--force-unit; a column without a unit is read in N)?",
+                LoopQualityWarning,
             )
         if self.flagged:
             warn(f"cycles flagged: {summary}", LoopQualityWarning)
@@ -194,6 +246,7 @@ class Tally:
                 "gross_slip_threshold": options["gross_slip_threshold"],
                 "flip_force": int(options["flip_force"]),
                 "quality_summary": summary,
+                "motion": _motion(typical),
             }
         )
         return results
@@ -208,15 +261,15 @@ def strip(part: xr.Dataset) -> xr.Dataset:
     return part.drop_vars([name for name in part.data_vars if str(name).startswith("_")])
 
 
-def _check_units(amplitude):
-    """Warn when the displacement amplitudes look like another unit than metres."""
+def _typical(amplitude) -> float:
+    """The median of the finite amplitudes (NaN if none). [m]"""
     finite = amplitude[np.isfinite(amplitude)]
-    typical = float(np.median(finite)) if finite.size else np.nan
-    low, high = _AMPLITUDE_RANGE
-    if np.isfinite(typical) and not low <= typical <= high:
-        warn(
-            f"the displacement amplitude is {typical:.3g} m (median over the cycles), outside "
-            "0.1 µm to 10 mm: is the displacement in metres? analyze_loops takes SI units; "
-            "on the command line, --displacement-unit gives the unit of the column",
-            LoopQualityWarning,
-        )
+    return float(np.median(finite)) if finite.size else np.nan
+
+
+def _motion(typical: float) -> str:
+    """``'fretting'``, or ``'reciprocating sliding'`` for a stroke beyond
+    :data:`FRETTING_AMPLITUDE` (analysed the same way)."""
+    if np.isfinite(typical) and typical > FRETTING_AMPLITUDE:
+        return "reciprocating sliding"
+    return "fretting"

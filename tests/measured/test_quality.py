@@ -116,22 +116,46 @@ def test_time_reversed(rig):
 
 
 def test_swapped_columns(rig):
-    """Force read as displacement: the amplitude of hundreds of metres warns of the unit."""
+    """Force read as displacement: an amplitude of hundreds of metres, anticlockwise."""
     displacement, force = rig
-    with (
-        pytest.warns(LoopQualityWarning, match=r"amplitude is 6\d\d m .*--displacement-unit"),
-        pytest.raises(ValueError, match=r"no plausible cycle.*anticlockwise.*columns are swapped"),
+    with pytest.raises(
+        ValueError,
+        match=r"no plausible cycle.*implausible-amplitude.*anticlockwise.*columns are swapped",
     ):
         analyze_loops(force, displacement, LOAD)
 
 
-@pytest.mark.parametrize(("scale", "shown"), [(1e6, r"50\.\d+ m"), (1e-6, r"5\.\d+e-11 m")])
-def test_displacement_in_another_unit_warns(rig, scale, shown):
-    """Micrometres passed as metres, or metres as micrometres: a warning names the unit."""
+@pytest.mark.parametrize("scale", [1e6, 1e-3, 1e-6])
+def test_displacement_in_another_unit_is_refused(rig, scale):
+    """Micrometres passed as metres, or metres as millimetres or micrometres: every cycle
+    is refused (issue 23, item 2), and the error names the unit and the option."""
     displacement, force = rig
-    with pytest.warns(LoopQualityWarning, match=rf"amplitude is {shown} .*metres"):
-        result = analyze_loops(displacement * scale, force, LOAD)
-    assert (result.quality == "ok").all()  # the loops themselves are fine
+    with pytest.raises(ValueError, match=r"implausible-amplitude.*--displacement-unit"):
+        quiet(displacement * scale, force, LOAD)
+
+
+def test_a_millimetre_stroke_is_reciprocating_sliding(rig):
+    """A damper's 12.8 mm stroke: analysed, ok, and called reciprocating sliding."""
+    displacement, force = rig
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", LoopQualityWarning)
+        result = analyze_loops(displacement * 256, force, LOAD)
+    assert (result.quality == "ok").all()
+    assert result.attrs["motion"] == "reciprocating sliding"
+    assert analyze_loops(displacement, force, LOAD).attrs["motion"] == "fretting"
+
+
+@pytest.mark.parametrize(("load", "scale"), [(1.0, 1.0), (LOAD, 1e-3), (LOAD * 1000, 1.0)])
+def test_an_implausible_friction_coefficient_is_not_ok(rig, load, scale):
+    """--load 1N on a 450 N test (a CoF of 360), or the force in kN read as N (a CoF of
+    0.0008): no cycle is ok, the coefficients are NaN, and a warning names the load."""
+    displacement, force = rig
+    with pytest.warns(LoopQualityWarning, match=rf"load of {load:g} N: is the load right"):
+        result = analyze_loops(displacement, force * scale, load, resolve=True)
+    assert (result.quality == "implausible-cof").all()
+    for name in ("ecof", "gicof", "cof_max", "mu_resolved"):
+        assert result[name].isnull().all(), name
+    assert np.isfinite(result.amplitude).all() and np.isfinite(result.stiffness).all()
 
 
 def test_dead_force_channel(rig):

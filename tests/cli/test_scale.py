@@ -1,0 +1,36 @@
+"""Plausibility of scale on the command line (issue 23, item 2): a wrong load or unit is
+flagged or refused with a message that names the assumption and the option."""
+
+import pandas as pd
+
+from ecofmaps.measured.synthetic import synthetic_recording
+from tests.cli.test_loops import POINT, run, write_csv
+
+
+def test_a_wrong_load_flags_every_cycle_and_names_the_load(tmp_path, capsys):
+    path = write_csv(tmp_path / "test.csv", *synthetic_recording(**POINT, cycles=13))
+    out = tmp_path / "r.csv"
+    status, _, err = run(capsys, path, "--load", "1N", "--out", out)
+    assert status == 0, err
+    table = pd.read_csv(out)
+    assert (table.quality == "implausible-cof").all() and table.ecof.isnull().all()
+    assert "test.csv" in err and "load of 1 N: is the load right" in err and "--load" in err
+
+
+def test_millimetres_in_a_column_without_a_unit_are_refused(tmp_path, capsys):
+    displacement, force = synthetic_recording(**POINT, cycles=4)
+    path = tmp_path / "test.csv"
+    # a file written in mm, read in µm (no unit in the header): an amplitude of 0.05 µm
+    write_csv(path, displacement * 1e-3, force)
+    status, _, err = run(capsys, path, "--load", "450N", "--out", tmp_path / "r.csv")
+    assert status == 2
+    assert "implausible-amplitude" in err and "--displacement-unit" in err
+    assert not (tmp_path / "r.csv").exists()
+
+
+def test_a_damper_stroke_of_millimetres_is_reciprocating_sliding(tmp_path, capsys):
+    displacement, force = synthetic_recording(**POINT, cycles=4)
+    path = write_csv(tmp_path / "damper.csv", displacement * 256, force)  # 12.8 mm
+    status, printed, err = run(capsys, path, "--load", "450N", "--out", tmp_path / "r.csv")
+    assert status == 0 and "metres" not in err
+    assert "reciprocating sliding (amplitude 12.8 mm)" in printed
