@@ -44,8 +44,9 @@ def add(subparsers) -> None:
         help="analyse the shipped synthetic example (load 450N) instead of FILEs",
     )  # fmt: skip
     parser.add_argument(
-        "--load", type=quantity("load"), default=None, metavar="P",
-        help="normal load P, e.g. 450N (required unless --example)",
+        "--load", type=_load_or_column, default=None, metavar="P",
+        help="normal load P, e.g. 450N; or the name of the recording's normal-load column "
+        "(e.g. Fz), used sample by sample (required unless --example)",
     )  # fmt: skip
     parser.add_argument(
         "--out", default=None, metavar="FILE.csv",
@@ -56,6 +57,11 @@ def add(subparsers) -> None:
         help="also write, per file, its loops with the line Q = SΔ (<name>_loops.png), "
         "the ECoF and GICoF over the cycles (<name>_evolution.png) and the loops read along "
         "the stroke (<name>_resolved.png) into DIR",
+    )  # fmt: skip
+    parser.add_argument(
+        "--overwrite", action="store_true",
+        help="replace the outputs ecofmaps wrote before (--out, --resolved, the plots in "
+        "--plots); a file or folder ecofmaps did not write is never replaced",
     )  # fmt: skip
     parser.add_argument(
         "--resolved", default=None, metavar="FILE.nc",
@@ -152,6 +158,16 @@ def add_long_options(parser) -> None:
     group.add_argument(
         "--quiet", action="store_true", help="no progress bar (none is shown off a terminal)",
     )  # fmt: skip
+
+
+def _load_or_column(text: str):
+    """``--load``: a load with its unit (a float, [N]), or the name of a column (a str)."""
+    try:
+        return quantity("load")(text)
+    except argparse.ArgumentTypeError:
+        if text.strip() and not text.strip()[0].isdigit() and not text.startswith(("-", ".")):
+            return text.strip()  # a column of the recording, e.g. Fz
+        raise
 
 
 def run(args) -> int:

@@ -33,7 +33,7 @@ from ecofmaps.cli._common import CommandError
 from ecofmaps.io.tables import results_csv
 from ecofmaps.measured.cycles import Cycles
 from ecofmaps.measured.options import MissingSampleError, default_options
-from ecofmaps.measured.pipeline import IN_PROCESS, Analysis, only
+from ecofmaps.measured.pipeline import IN_PROCESS, Analysis, force_at_mean_load, only
 
 __all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun", "keep_block", "skipped"]
 
@@ -254,13 +254,16 @@ def _analyse(index, path, recording, load, args, runner, partial, many, write, c
             f"--plots draws every loop, which a long recording ({path}) analysed out of core "
             "does not keep: leave out --plots (or --workers, --scheduler, --resume)"
         )
+    force = recording.force
+    if isinstance(load, str):  # the load recorded sample by sample (--load COLUMN)
+        force, load = force_at_mean_load(force, recording.load)
     options = default_options(load, getattr(args, "flip_force", False))
     shown = recording.lazy and not args.quiet and sys.stderr.isatty()
     if shown:
         print(f"{path.name}: finding the cycles of {recording.size} samples", file=sys.stderr)
     analysis = Analysis(
         recording.displacement,
-        recording.force,
+        force,
         load,
         recording.cycle,
         runner=runner,

@@ -193,7 +193,10 @@ def _analyse_each(args, paths, load, long_run, table) -> tuple[list[_Analysed], 
     for index, (path, plot_name) in enumerate(zip(paths, _plot_names(paths), strict=True)):
         held = []  # a recording in memory: its lines once its analysis has succeeded
         try:
-            recording = read_recording(path, lazy=long_run.lazy, **recording_options(args))
+            options = recording_options(args)
+            if isinstance(load, str):  # --load names the recording's normal-load column
+                options["load_column"] = load
+            recording = read_recording(path, lazy=long_run.lazy, **options)
             write = table.write if recording.lazy else held.append
             results, resolved = _analysed(
                 index, path, recording, load, args, long_run, write, many=many,
@@ -232,7 +235,8 @@ def _write_extras(args, done: list[_Analysed], load) -> None:
         # Bokeh loads only when a report is asked for (the extra web is optional)
         from ecofmaps.web.report import recording_inputs, write_report
 
-        inputs = recording_inputs(done[0].recording, load, flip_force=args.flip_force)
+        mean_load = float(done[0].results["load"])  # the load given, or a channel's mean
+        inputs = recording_inputs(done[0].recording, mean_load, flip_force=args.flip_force)
         write_report(args.report, done[0].results, inputs=inputs)
 
 

@@ -93,7 +93,7 @@ from ecofmaps.measured.options import (
     missing_sample_error,
 )
 from ecofmaps.measured.per_cycle import GROSS_SLIP_THRESHOLD
-from ecofmaps.measured.pipeline import Analysis, Reading
+from ecofmaps.measured.pipeline import Analysis, Reading, force_at_mean_load
 from ecofmaps.measured.resolved import check_reading_options
 from ecofmaps.measured.samples import is_lazy
 
@@ -146,8 +146,11 @@ def analyze_loops(
     force : array_like, dask.array.Array or xarray.DataArray
         Tangential force :math:`Q` at each sample, positive in the direction of positive
         displacement (the loops then run clockwise); offsets are removed. [N]
-    load : float
-        Normal load :math:`P`. [N]
+    load : float or array_like
+        Normal load :math:`P`; or the load recorded at each sample (a load cell's
+        channel), which scales the force to the mean load, so every coefficient of
+        friction is read with the load of its samples
+        (:func:`ecofmaps.measured.pipeline.force_at_mean_load`). [N]
     cycle : array_like, optional
         Cycle number of each sample: each run of equal numbers is one loop (the loops may
         be recorded now and then during a test). Without it the recording is cut at its
@@ -256,6 +259,7 @@ def analyze_loops(
     >>> print(results.quality.values[0], "|", results.attrs["quality_summary"])
     ok | 1 cycles: 1 ok
     """
+    force, load = _at_mean_load(force, load)
     options = check_options(
         load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
     )
@@ -297,6 +301,16 @@ def _run(
     with runner_for(scheduler, workers) as runner:
         analysis = Analysis(x, q, float(load), label, runner=runner, **arrays)
         return analysis.run()
+
+
+def _at_mean_load(force, load):
+    """``force`` and ``load`` as the pipeline takes them: a load given sample by sample (a
+    recorded channel) scales the force to the mean load (:func:`force_at_mean_load`)."""
+    if np.ndim(load) == 0 and not is_lazy(load):
+        return force, load
+    size = np.shape(force)[0] if not hasattr(force, "dims") else force.shape[0]
+    values = _series("load", load, size)
+    return force_at_mean_load(_series("force", force, size), values)
 
 
 def _raise_at_missing(x, q, label, mask) -> None:

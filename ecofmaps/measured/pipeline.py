@@ -48,7 +48,16 @@ from ecofmaps.measured.quality import quality_summary
 from ecofmaps.measured.resolved import REPORTED, resolve_analyzed_loops, resolved_attrs
 from ecofmaps.measured.results import Tally, cycle_results, strip, with_loops
 
-__all__ = ["HALO", "IN_PROCESS", "TASK_SAMPLES", "Analysis", "Chunk", "Reading", "only"]
+__all__ = [
+    "HALO",
+    "IN_PROCESS",
+    "TASK_SAMPLES",
+    "Analysis",
+    "Chunk",
+    "Reading",
+    "force_at_mean_load",
+    "only",
+]
 
 #: Samples of the recording measured by one chunk of a long recording (about; whole cycles).
 TASK_SAMPLES = 1 << 22
@@ -120,6 +129,49 @@ class Chunk:
     flags: dict | None = None
     made: object = None
     resolved: xr.Dataset | None = None
+
+
+def force_at_mean_load(force, load):
+    r"""The force of a recording whose normal load was recorded sample by sample, as at the
+    mean load: :math:`Q(t)\,\bar P/P(t)`, and :math:`\bar P`.
+
+    Every coefficient of friction the analysis reads (:math:`Q/P` at a point, the ECoF
+    :math:`E_d/(4\bar P\delta^*)`) is then the one of the load at each sample, as a rig
+    with a load cell records it; the forces and the energy are those at the mean load.
+
+    Parameters
+    ----------
+    force : numpy.ndarray or dask.array.Array
+        Tangential force at each sample. [N]
+    load : numpy.ndarray or dask.array.Array
+        Normal load at each sample (NaN where missing, which leaves the force missing). [N]
+
+    Returns
+    -------
+    force : numpy.ndarray or dask.array.Array
+        :math:`Q\,\bar P/P` at each sample. [N]
+    mean_load : float
+        :math:`\bar P`, the mean of the finite loads. [N]
+
+    Raises
+    ------
+    ValueError
+        If no load is finite, or one is not positive.
+    """
+    lazy = not isinstance(load, np.ndarray)
+    finite = load[np.isfinite(load)] if not lazy else None
+    if lazy:
+        import dask.array as da  # only for a lazy recording, read out of core
+
+        mean, lowest = (float(v) for v in da.compute(da.nanmean(load), da.nanmin(load)))
+    else:
+        mean = float(finite.mean()) if finite.size else np.nan
+        lowest = float(finite.min()) if finite.size else np.nan
+    if not np.isfinite(mean):
+        raise ValueError("the recorded normal load holds no value")
+    if not lowest > 0.0:
+        raise ValueError(f"the recorded normal load must be positive; its lowest is {lowest:g} N")
+    return force * (mean / load), mean
 
 
 class _Stretch:

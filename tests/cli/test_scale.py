@@ -34,3 +34,34 @@ def test_a_damper_stroke_of_millimetres_is_reciprocating_sliding(tmp_path, capsy
     status, printed, err = run(capsys, path, "--load", "450N", "--out", tmp_path / "r.csv")
     assert status == 0 and "metres" not in err
     assert "reciprocating sliding (amplitude 12.8 mm)" in printed
+
+
+def test_a_recorded_normal_load_is_used_sample_by_sample(tmp_path, capsys):
+    """``--load Fz``: a load cell's channel that swings by ±20 % gives the contact's μ in
+    every cycle; the same recording with its mean load as one value does not."""
+    import numpy as np
+
+    displacement, force = synthetic_recording(**POINT, cycles=6)
+    load = POINT["load"] * (1.0 + 0.2 * np.sin(2.0 * np.pi * np.arange(force.size) / 777.0))
+    path = tmp_path / "load_cell.csv"
+    lines = ["displacement [m],force [N],Fz [N]"]
+    lines += [
+        f"{float(d)!r},{float(q)!r},{float(p)!r}"
+        for d, q, p in zip(displacement, force * load / POINT["load"], load, strict=True)
+    ]
+    path.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "r.csv"
+    status, _, err = run(capsys, path, "--load", "Fz", "--out", out)
+    assert status == 0, err
+    table = pd.read_csv(out)
+    np.testing.assert_allclose(table.gicof, 0.8, atol=1e-4)
+    np.testing.assert_allclose(table.mu_resolved, 0.8, atol=1e-4)
+    status, _, err = run(capsys, path, "--load", f"{load.mean()}N", "--out", tmp_path / "c.csv")
+    assert status == 0, err
+    assert np.abs(pd.read_csv(tmp_path / "c.csv").gicof - 0.8).max() > 0.05
+
+
+def test_a_load_column_that_is_not_there_is_named(tmp_path, capsys):
+    path = write_csv(tmp_path / "test.csv", *synthetic_recording(**POINT, cycles=4))
+    status, _, err = run(capsys, path, "--load", "Fz", "--out", tmp_path / "r.csv")
+    assert status == 2 and "Fz" in err and "test.csv" in err
