@@ -198,7 +198,7 @@ def _draw_scar_profiles(ax, dataset: xr.Dataset) -> None:
     reach = float(dataset["slip_amplitude"].sel(shape="parabolic", groove="parabola"))
     reach *= width / scalar(dataset, "amplitude")
     ax.axvspan(-reach * MICRO, reach * MICRO, color="0.85", zorder=0,
-               label=r"reach of the pad, $|X| \leq \delta^* W/\Delta^*$")  # fmt: skip
+               label="reach of the pad,\n" + r"$|X| \leq \delta^* W/\Delta^*$")  # fmt: skip
     for edge in (-width, width):
         ax.axvline(edge * MICRO, **_EDGE)
     ax.set_xlabel(axis_label("scar_position"))
