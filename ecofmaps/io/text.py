@@ -7,12 +7,21 @@ it came from, for messages.
 
 What the reader accepts:
 
+- A preamble: metadata lines before the header (``Test: 42``, ``Operator, J. Smith``,
+  blank lines). The header is the first line, among the first :data:`PREAMBLE_LINES`
+  that are not blank or comments, that is not all numbers, names every column asked for
+  (:func:`ecofmaps.io.columns.find_column`, usual names included) and has as many cells
+  as the line after it; with the option ``skip_rows``, the first line after those
+  skipped. Errors name the line in the file, preamble included.
 - Separator: the first of tab, semicolon or comma found in the header line (outside
   quotes), else runs of blanks; whatever the file's suffix.
-- Decimal comma (``1,25;-3,5``) when the separator is not a comma: decided from the
-  first block whose numbers show either a comma or a point.
-- Quoted cells (``"1.25"``), a byte-order mark, CRLF line ends, lines starting with
-  ``#`` and blank lines anywhere (skipped).
+- Decimal comma (``1,25;-3,5``) when the separator is not a comma, or in quoted cells
+  when it is (``"0,5","1,2"``): decided from the first block whose numbers show either a
+  comma or a point.
+- Quoted cells (``"1.25"``), a byte-order mark, LF, CRLF and CR-only line ends, lines
+  starting with ``#`` and blank lines anywhere (skipped).
+- gzip-compressed text (``.csv.gz``, found by its first bytes whatever the suffix),
+  decompressed as it is read.
 - Encoding: UTF-8; a file that is not (a Latin-1 ``µ`` from an old rig PC) is read as
   Latin-1 from its first undecodable line on, with a :class:`RecordingWarning` naming the
   file and the line. Latin-1 decodes every byte, and the digits, signs and separators are
@@ -47,6 +56,7 @@ from ecofmaps.io.columns import (
     matching_columns,
     split_unit,
 )
+from ecofmaps.io.recording_types import RecordingError, RecordingWarning, si_values
 
 __all__ = ["BLOCK_BYTES", "MISSING", "PREAMBLE_LINES", "text_blocks"]
 
@@ -83,7 +93,6 @@ def _file_bytes(path: Path, block_bytes: int):
         compressed = raw.read(2) == _GZIP
         raw.seek(0)
         stream = gzip.GzipFile(fileobj=raw, mode="rb") if compressed else raw
-        lines = 0  # line ends given so far, for a damaged compressed file's message
         try:
             data = _start(path, stream, compressed)
             while data := data + stream.read(block_bytes):
@@ -91,24 +100,19 @@ def _file_bytes(path: Path, block_bytes: int):
                     data += stream.read(1)
                 if b"\r" in data and data.count(b"\r") != data.count(b"\r\n"):
                     data = _LONE_CR.sub(b"\n", data)
-                lines += data.count(b"\n")
                 yield data
                 data = b""
         except (EOFError, gzip.BadGzipFile, zlib.error) as error:
             if not compressed:
                 raise
-            from ecofmaps.io.recording_types import RecordingError
-
-            raise RecordingError(
-                path, lines + 1, f"the compressed (gzip) data is truncated or damaged ({error})"
+            raise _Damaged(
+                f"the compressed (gzip) data is truncated or damaged ({error})"
             ) from None
 
 
 def _start(path: Path, stream, compressed: bool) -> bytes:
     """The first bytes of the text, without byte-order mark; a UTF-16 file is read whole and
     its text left in ``stream`` as UTF-8 (``stream`` is then emptied, the bytes returned)."""
-    from ecofmaps.io.recording_types import RecordingError
-
     head = stream.read(8)
     if compressed and head.startswith((b"TDSm", b"\x89HDF")):
         kind = "TDMS" if head.startswith(b"TDSm") else "HDF5"
@@ -130,19 +134,27 @@ def _start(path: Path, stream, compressed: bool) -> bytes:
     return head[len(codecs.BOM_UTF8) :] if head.startswith(codecs.BOM_UTF8) else head
 
 
-def _line_blocks(chunks):
+class _Damaged(Exception):
+    """Compressed data that cannot be read (the file and line are added by the caller)."""
+
+
+def _line_blocks(path: Path, chunks):
     """Bytes of whole lines, one block per chunk or more (the last may lack a newline),
-    each with the 1-based number of its first line."""
+    each with the 1-based number of its first line and its number of lines."""
     rest, line = b"", 1
-    for chunk in chunks:
-        data = rest + chunk
-        cut = data.rfind(b"\n") + 1
-        rest = data[cut:]
-        if cut:
-            yield data[:cut], line
-            line += data.count(b"\n", 0, cut)
+    try:
+        for chunk in chunks:
+            data = rest + chunk
+            cut = data.rfind(b"\n") + 1
+            rest = data[cut:]
+            if cut:
+                count = data.count(b"\n", 0, cut)
+                yield data[:cut], line, count
+                line += count
+    except _Damaged as error:
+        raise RecordingError(path, line, str(error)) from None
     if rest:
-        yield rest, line
+        yield rest, line, 1
 
 
 def _text_lines(text: str) -> list[str]:
@@ -164,8 +176,6 @@ class _Decoder:
             try:
                 return data.decode("utf-8")
             except UnicodeDecodeError as error:
-                from ecofmaps.io.recording_types import RecordingWarning
-
                 line = first_line + data.count(b"\n", 0, error.start)
                 byte = data[error.start]
                 warn(
@@ -263,8 +273,6 @@ class _Layout:
     """What the header says: separator, names, the columns wanted and their scales."""
 
     def __init__(self, path: Path, header_line: int, header: str, options: dict):
-        from ecofmaps.io.recording_types import RecordingError
-
         self.path = path
         self.header_line = header_line
         self.separator = _separator(header)
@@ -317,8 +325,6 @@ class _Layout:
 
     def field_error(self, lines: list[str], numbers) -> None:
         """Raise for the first line whose number of cells is not the header's."""
-        from ecofmaps.io.recording_types import RecordingError
-
         for line, number in zip(lines, numbers, strict=True):
             count = len(_fields(line, self.separator))
             if count != self.width:
@@ -342,8 +348,6 @@ class _Layout:
         blank, a cell that is not a number, a missing sample to raise for, a byte that is
         not UTF-8), for the caller to drop blank and comment lines and call again with the
         text ``lines`` kept, which are then checked one by one and the error raised."""
-        from ecofmaps.io.recording_types import RecordingError
-
         careful = lines is not None
         raw = isinstance(body, bytes)
         if self.decimal is None:
@@ -418,20 +422,9 @@ class _Layout:
                 self.path, numbers[first], f"{what} value {cell!r} in column {self.names[index]!r}"
             )
         return {
-            role: _to_si(np.where(missing[role], np.nan, data), self.scales[role])
+            role: si_values(np.where(missing[role], np.nan, data), self.scales[role])
             for role, data in values.items()
         }
-
-
-def _to_si(values: np.ndarray, factor: float) -> np.ndarray:
-    """``values * factor``; for a factor 10^-k, divided by the exact 10^k instead, so that a
-    typed ``25`` µm is the float nearest 25e-6 (one rounding, not two)."""
-    if factor == 1.0:
-        return values
-    inverse = round(1.0 / factor)
-    if factor < 1.0 and inverse == 1.0 / factor and float(inverse) == inverse:
-        return values / float(inverse)
-    return values * factor
 
 
 def text_blocks(path: Path, options: dict, block_bytes: int = BLOCK_BYTES):
@@ -463,22 +456,19 @@ def text_blocks(path: Path, options: dict, block_bytes: int = BLOCK_BYTES):
     """
     decoder = _Decoder(path)
     chunks = _file_bytes(path, block_bytes)
-    blocks = _line_blocks(chunks)
+    blocks = _line_blocks(path, chunks)
     try:
         lines = _head(blocks, decoder, options)
         header = _header_index(lines, options)
         if header is None:
-            from ecofmaps.io.recording_types import RecordingError
-
             raise RecordingError(path, max(len(lines), 1), "no header line and no data")
         layout = _Layout(path, header + 1, lines[header], options)
         yield layout
         yield from _parsed_lines(layout, lines[header + 1 :], header + 2)
-        for raw, start in blocks:
+        for raw, start, count in blocks:
             check_interrupted()
             if decoder.encoding == "utf-8" and b"#" not in raw:
                 # Most blocks hold data lines only: parsed from the bytes as they are.
-                count = raw.count(b"\n") + (not raw.endswith(b"\n"))
                 numbers = start + np.arange(count, dtype=np.int64)
                 values = layout.parse(raw[:-1] if raw.endswith(b"\n") else raw, numbers)
                 if values is not None:
@@ -499,7 +489,7 @@ def _head(blocks, decoder: _Decoder, options: dict) -> list[str]:
     needed = 1 if skip is not None else PREAMBLE_LINES + 1
     lines: list[str] = []
     found = 0
-    for raw, start in blocks:
+    for raw, start, _ in blocks:
         check_interrupted()
         new = _text_lines(decoder(raw, start))
         first = max((skip or 0) - len(lines), 0)
