@@ -208,7 +208,7 @@ def _values_html(point: ExplorerPoint, values: dict) -> str:
         for key, label, text, unit in rows
     )
     regime = "" if gross else "<p><b>No gross slip</b> (μP/S ≥ Δ*): μ_E is undefined.</p>"
-    return f"<table style='font-size:15px'>{cells}</table>{regime}"
+    return f"<table style='font-size:14px;white-space:nowrap'>{cells}</table>{regime}"
 
 
 def _correction_html(values: dict) -> str:
@@ -310,8 +310,8 @@ def explorer_page():
     if pn.state.location is not None:
         for key, widget in inputs.items():
             pn.state.location.sync(widget, {"value": key})
-    values_pane = pn.pane.HTML("", width=240)
-    correction_pane = pn.pane.HTML("", width=900)
+    values_pane = pn.pane.HTML("", width=250)
+    correction_pane = pn.pane.HTML("", width=760, margin=(18, 10))
     message = pn.pane.HTML("", width=520, styles={"color": "#b00020"})
     loop_plot, loop_source = _loop_figure()
     map_plot, image, marker, colors = _map_figure()
@@ -344,13 +344,16 @@ def explorer_page():
         intro,
         message,
         pn.Row(
-            pn.Column(*model_inputs, pn.pane.HTML("<h3>At this point</h3>"), values_pane),
+            pn.Column(
+                *model_inputs,
+                pn.pane.HTML("<h3 style='margin:8px 0 0 0'>At this point</h3>"),
+                values_pane,
+            ),
             pn.pane.Bokeh(loop_plot),
             pn.pane.Bokeh(map_plot),
         ),
         pn.pane.HTML("<h3 style='margin:0'>Correct a reported ECoF</h3>"),
-        pn.Row(*correction_inputs),
-        correction_pane,
+        pn.Row(*correction_inputs, correction_pane),
     )
 
 

@@ -23,9 +23,11 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
+from bokeh.core.templates import CSS_RESOURCES, JS_RESOURCES, get_env
 from bokeh.embed import file_html
 from bokeh.layouts import column, row
 from bokeh.models import (
+    BasicTickFormatter,
     ColumnDataSource,
     CustomJS,
     DataTable,
@@ -141,7 +143,19 @@ def write_report(path, results: xr.Dataset, *, loops=None, inputs=None) -> Path:
     """
     document = report_document(results, loops=loops, inputs=inputs)
     title = "ecofmaps report" + (f": {inputs['files']}" if inputs and "files" in inputs else "")
-    text = file_html(document, INLINE, title=title)
+    # Bokeh's own JavaScript and CSS, written in. Not file_html(..., INLINE): that also asks
+    # the page to fetch the external files of every model class imported in this process
+    # (Panel's, once Panel is imported), which a page opened offline cannot.
+    own = INLINE.clone(components=["bokeh", "bokeh-widgets", "bokeh-tables"])
+    page = get_env().from_string(
+        '{% extends "file.html.jinja" %}{% block css_resources %}{{ own_css }}{% endblock %}'
+        "{% block js_resources %}{{ own_js }}{% endblock %}"
+    )
+    resources = {
+        "own_js": JS_RESOURCES.render(js_files=[], js_raw=own.js_raw, hashes={}),
+        "own_css": CSS_RESOURCES.render(css_files=[], css_raw=own.css_raw),
+    }
+    text = file_html(document, None, title=title, template=page, template_variables=resources)
     with atomic_path(path) as temporary:
         Path(temporary).write_text(text, encoding="utf-8")
     return Path(path)
@@ -283,6 +297,7 @@ def _evolution_figures(results: xr.Dataset):
             renderers=plot.renderers[-1:],
         )
     )
+    plot.xaxis.formatter = BasicTickFormatter(use_scientific=False)
     plot.legend.click_policy = "hide"
     plot.add_layout(plot.legend[0], "right")  # beside the plot: the curves stay uncovered
     return plot, _flags_figure(results, plot)
@@ -319,6 +334,7 @@ def _flags_figure(results: xr.Dataset, evolution):
     )
     plot.scatter("cycle", "reason", source=marks, marker="dash", size=10, line_width=2,
                  color="#d62728", angle=np.pi / 2)  # fmt: skip
+    plot.xaxis.formatter = BasicTickFormatter(use_scientific=False)
     plot.add_tools(HoverTool(tooltips=[("cycle", "@cycle"), ("flag", "@reason")]))
     return plot
 
@@ -333,7 +349,7 @@ def _quality_counts(results: xr.Dataset) -> Div:
         for reason, cycles in _flagged_cycles(results).items()
     ]
     cells = "".join(
-        f"<tr><td><code>{html.escape(name)}</code></td>"
+        f"<tr style='vertical-align:top'><td><code>{html.escape(name)}</code></td>"
         f"<td style='text-align:right;padding:0 8px'>{count}</td>"
         f"<td>{html.escape(meaning)}</td></tr>"
         for name, count, meaning in rows
@@ -342,7 +358,7 @@ def _quality_counts(results: xr.Dataset) -> Div:
         text=(
             f"<h3 style='margin:4px 0'>Quality of the {total} cycles</h3>"
             "<table class='ecofmaps-quality' style='font-size:13px;border-collapse:collapse'>"
-            "<tr><th style='text-align:left'>flag</th><th>cycles</th>"
+            "<tr><th style='text-align:left'>flag</th><th style='padding:0 8px'>cycles</th>"
             f"<th style='text-align:left'>what it means</th></tr>{cells}</table>"
         ),
         width=_WIDTH - 820,

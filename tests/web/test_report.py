@@ -73,6 +73,15 @@ def test_the_page_fetches_nothing(page):
     assert "Bokeh" in text  # the library is in the page, inline
 
 
+def test_the_page_fetches_nothing_once_panel_is_imported(results, tmp_path):
+    """Panel's models ask every Bokeh page made in the process to fetch files of theirs."""
+    import panel  # noqa: F401  (the explorer imports it)
+
+    text = write_report(tmp_path / "r.html", results).read_text(encoding="utf-8")
+    assert not re.search(r"<script[^>]*\bsrc=", text)
+    assert not re.search(r"<link[^>]*\bhref=", text)
+
+
 def test_the_page_gives_the_inputs_version_and_flag_meanings(results):
     document = report_document(results, inputs=INPUTS)
     text = html.unescape("".join(div.text for div in document.select({"type": Div})))
