@@ -19,9 +19,13 @@ from ecofmaps.io.recording_types import RecordingError
 __all__ = ["hdf5_groups", "open_hdf5_group"]
 
 #: xarray's options for every opening: CF packing and fill values decoded, numbers left as
-#: numbers, no copy of a whole variable kept in memory once read.
+#: numbers, no copy of a whole variable kept in memory once read, and no lock of xarray's
+#: (one for all HDF5 files of the process: h5py already serialises its calls, each reader
+#: of :mod:`ecofmaps.io.binary` holds a lock of its own, and a forked process could inherit
+#: that one held by a thread of its parent for good).
 OPTIONS = {
     "engine": "h5netcdf",
+    "lock": False,
     "phony_dims": "access",
     "mask_and_scale": True,
     "decode_times": False,

@@ -17,7 +17,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import xarray as xr
-import zarr
 from xarray.backends import BackendArray
 from xarray.core import indexing
 
@@ -41,6 +40,8 @@ _NO_DIMENSIONS = ("dimension_names", "_ARRAY_DIMENSIONS")
 
 
 def _opened(path: Path):
+    import zarr  # here, not on import: xarray loads this module with its engines (0.3-1 s)
+
     try:
         return zarr.open(store=str(path), mode="r")
     except Exception as error:
@@ -49,7 +50,8 @@ def _opened(path: Path):
 
 def _consolidated(root) -> bool:
     """Whether the store has consolidated metadata (else xarray is told not to look)."""
-    return isinstance(root, zarr.Group) and root.metadata.consolidated_metadata is not None
+    is_group = hasattr(root, "members")  # a zarr.Group; an Array has no members
+    return is_group and root.metadata.consolidated_metadata is not None
 
 
 class _ZarrRange(BackendArray):
@@ -69,6 +71,8 @@ class _ZarrRange(BackendArray):
 
 def _plain_groups(path: Path, root) -> dict[str, xr.Dataset]:
     """The groups of a store without dimension names (see the module's notes)."""
+    import zarr  # as in _opened
+
     is_array = isinstance(root, zarr.Array)
     members = [("", root)] if is_array else list(root.members(max_depth=None))
     groups = {"/": {}}
@@ -137,6 +141,6 @@ def missing_chunks(path, name: str) -> tuple[int, int]:
     """Chunks of array ``name`` (its path in the store) missing, and expected: zarr reads a
     missing chunk as its fill value, so a truncated or partly copied store would read."""
     root = _opened(Path(path))
-    array = root if isinstance(root, zarr.Array) else root[name]
+    array = root[name] if hasattr(root, "members") else root
     expected = int(array.nchunks)
     return expected - int(array.nchunks_initialized), expected

@@ -10,6 +10,7 @@ import pytest
 import xarray as xr
 from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
 
+from ecofmaps._parallel import Slice, stretch
 from ecofmaps.cli import main
 from ecofmaps.io import open_recording
 from ecofmaps.io.recordings import read_recording, recording_blocks
@@ -110,6 +111,9 @@ def test_every_format_reads_the_same_numbers(tmp_path, samples, kind):
     np.testing.assert_array_equal(lazy.displacement.compute(), read.displacement)
     dataset = open_recording(path, lazy=True, chunks=300)
     assert dataset.displacement.chunks == ((300, 300, 201),)
+    part = stretch(dataset.force.data, 250, 520)  # a task's range, read by its column
+    assert isinstance(part, Slice)
+    np.testing.assert_array_equal(part.read(), samples[1][250:520])
     np.testing.assert_array_equal(dataset.force.values, samples[1])
     np.testing.assert_array_equal(dataset.displacement.values, samples[0] / 1e6)
 
