@@ -55,14 +55,14 @@ import numpy as np
 
 from ecofmaps.measured import passes
 from ecofmaps.measured.passes import (
-    _ends_of_runs,
-    _first_of_runs,
-    _labelled_runs,
-    _line,
-    _missing_in,
-    _percentiles,
-    _survey_all,
-    _trigger,
+    displacement_line,
+    displacement_percentiles,
+    ends_of_runs,
+    first_of_runs,
+    labelled_runs,
+    missing_in,
+    survey,
+    trigger_runs,
 )
 from ecofmaps.measured.samples import Samples
 
@@ -191,7 +191,7 @@ def _with_missing(cycles: Cycles, gaps) -> Cycles:
         return cycles
     return dataclasses.replace(
         cycles,
-        missing=_missing_in(gaps, cycles.start, cycles.count),
+        missing=missing_in(gaps, cycles.start, cycles.count),
         missing_samples=int((gaps[:, 1] - gaps[:, 0]).sum()),
         first_missing=int(gaps[0, 0]),
     )
@@ -217,17 +217,19 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     n = samples.size
     if n < 2:
         raise ValueError("the displacement does not oscillate: no reversal can be found")
-    sums, gaps, sample_at, sampled, finite, _ = _survey_all(samples)
+    sums, gaps, sample_at, sampled, finite, _ = survey(samples)
     count = int(sums[:, 0].sum())
-    line = _line(sums, n)
-    low, high = _percentiles(samples, gaps, line, sample_at, sampled, count)
+    line = displacement_line(sums, n)
+    low, high = displacement_percentiles(samples, gaps, line, sample_at, sampled, count)
     half_range = 0.5 * (high - low)
     if not half_range > 0.0:
         raise ValueError("the displacement does not oscillate: no reversal can be found")
     centre = 0.5 * (high + low)
     stroke = 2.0 * half_range
     found = samples.map(
-        _trigger, ("displacement",), (passes._CHUNK, gaps, line, (centre, hysteresis * half_range))
+        trigger_runs,
+        ("displacement",),
+        (passes._CHUNK, gaps, line, (centre, hysteresis * half_range)),
     )
     # A run begins where the state (+1 above the band, -1 below it, 0 inside) differs from
     # the last one decided; samples before the first decision take that first one. The 99th
@@ -249,8 +251,8 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     lowest_of_run = np.fmin.reduceat(lowest, first_piece)
     extreme = np.where(
         kind > 0,
-        _first_of_runs(run, highest, top, highest_of_run),
-        _first_of_runs(run, lowest, bottom, lowest_of_run),
+        first_of_runs(run, highest, top, highest_of_run),
+        first_of_runs(run, lowest, bottom, lowest_of_run),
     ).astype(np.int64)
     value = np.where(kind > 0, highest_of_run, lowest_of_run)
     accepted = np.ones(starts.size, dtype=bool)
@@ -292,7 +294,7 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
 def _labelled(samples: Samples, tolerance: float) -> Cycles:
     """:func:`labelled_cycles` of any :class:`Samples` with cycle numbers."""
     n = samples.size
-    _, gaps, _, _, _, labels = _survey_all(samples)
+    _, gaps, _, _, _, labels = survey(samples)
     known = [pair for pair in labels if pair is not None]
     if not known:
         raise ValueError("no cycle number is given: the cycle column is empty")
@@ -303,7 +305,7 @@ def _labelled(samples: Samples, tolerance: float) -> Cycles:
             carry = pair[1]
     pieces = np.concatenate(
         samples.map(
-            _labelled_runs, ("displacement", "cycle"), (passes._CHUNK, gaps, carries), extra=1
+            labelled_runs, ("displacement", "cycle"), (passes._CHUNK, gaps, carries), extra=1
         ),
         axis=1,
     )
@@ -316,10 +318,10 @@ def _labelled(samples: Samples, tolerance: float) -> Cycles:
     top = np.fmax.reduceat(highest, first_piece)
     floor = np.fmin.reduceat(lowest, first_piece)
     has = np.isfinite(floor)
-    lowest_at = _first_of_runs(run, lowest, bottom, floor)
+    lowest_at = first_of_runs(run, lowest, bottom, floor)
     valued = np.isfinite(x_first)
-    begin = _ends_of_runs(run, valued, x_first, starts.size, first=True)
-    end = _ends_of_runs(run, valued, x_last, starts.size, first=False)
+    begin = ends_of_runs(run, valued, x_first, starts.size, first=True)
+    end = ends_of_runs(run, valued, x_last, starts.size, first=False)
     largest = np.fmax.reduceat(step, first_piece)
     stroke = top - floor
     gap = np.abs(end - begin)

@@ -3,10 +3,11 @@ r"""The chunked passes over a recording that find its cycles (:mod:`ecofmaps.mea
 Each pass reads a chunk of ``_CHUNK`` samples at a time (a block of chunks where a dask task
 runs, for a recording held as dask arrays, :mod:`ecofmaps.measured.samples`) and returns what
 it found per chunk, to be joined in order: the sums of the detrending line and the gaps of
-missing samples (:func:`_survey_all`), the percentiles of the detrended displacement
-(:func:`_percentiles`), the Schmitt trigger's runs and their extremes (:func:`_trigger`,
-:func:`_tails`), and the runs of recorded cycle numbers (:func:`_labelled_runs`). Nothing the
-size of the recording is held beyond the recording itself.
+missing samples (:func:`survey`), the percentiles of the detrended displacement
+(:func:`displacement_percentiles`), the Schmitt trigger's runs and their extremes
+(:func:`trigger_runs`, :func:`_tails`), and the runs of recorded cycle numbers
+(:func:`labelled_runs`). Nothing the size of the recording is held beyond the recording
+itself.
 """
 
 from __future__ import annotations
@@ -14,6 +15,17 @@ from __future__ import annotations
 import numpy as np
 
 from ecofmaps.measured.samples import Samples
+
+__all__ = [
+    "displacement_line",
+    "displacement_percentiles",
+    "ends_of_runs",
+    "first_of_runs",
+    "labelled_runs",
+    "missing_in",
+    "survey",
+    "trigger_runs",
+]
 
 #: Samples read at once by the passes over the whole recording.
 _CHUNK = 1 << 18
@@ -54,7 +66,7 @@ def _piece_extremes(x, cuts):
     return found
 
 
-def _first_of_runs(run, value, index, target):
+def first_of_runs(run, value, index, target):
     """The first ``index`` of each run whose piece ``value`` equals the run's ``target``
     (-1 for a run with none).
 
@@ -84,7 +96,7 @@ def _finite_ends(x, cuts):
 def _survey(start, stop, arguments, x, q, cycle, mask):
     """Sums for the straight line through the finite displacements, runs of missing
     samples, the displacement at the percentile sample's indices, and the first and last
-    finite index and cycle number of the block (see :func:`_line`)."""
+    finite index and cycle number of the block (see :func:`displacement_line`)."""
     size, chunk, sample_at = arguments
     middle = 0.5 * (size - 1)
     sums, gaps, finite, labels = [], [], [], []
@@ -141,7 +153,7 @@ def _tails(start, stop, arguments, x):
     return np.concatenate(kept)
 
 
-def _trigger(start, stop, arguments, x):
+def trigger_runs(start, stop, arguments, x):
     """The Schmitt trigger's runs begun in the block, and the extremes of its pieces.
 
     Returns the runs' first samples and kinds (+1 high, -1 low; a run that continues the
@@ -174,7 +186,7 @@ def _trigger(start, stop, arguments, x):
     return np.concatenate(entries), np.concatenate(kinds), np.concatenate(pieces, axis=1)
 
 
-def _labelled_runs(start, stop, arguments, x, cycle):
+def labelled_runs(start, stop, arguments, x, cycle):
     """Pieces of runs of equal cycle numbers in the block, cut at its chunks: first
     sample, cycle number, samples, largest and smallest finite displacement, the first
     sample of the smallest, the first and last finite displacement, and the largest step
@@ -226,7 +238,7 @@ def _detrended(x, a: int, b: int, line):
     return (x - mean) - (np.arange(a - middle, b - middle) - mean_t) * slope
 
 
-def _survey_all(samples: Samples):
+def survey(samples: Samples):
     """Pass one: the straight line, the runs of missing samples, the percentile sample."""
     size = samples.size
     # The sample's order does not matter: its values are sorted.
@@ -247,7 +259,7 @@ def _survey_all(samples: Samples):
     return sums, gaps.astype(np.int64), sample_at, sampled, finite, labels
 
 
-def _line(sums, size: int):
+def displacement_line(sums, size: int):
     """``(mean, mean_t, slope, middle)`` of the least-squares line through the finite
     displacements over t = i - (size - 1)/2 (see :func:`_detrended`)."""
     count = sums[:, 0].sum()
@@ -267,7 +279,7 @@ def _line(sums, size: int):
     return mean, mean_t, (stx - st * mean) / spread if spread > 0 else 0.0, middle
 
 
-def _percentiles(samples: Samples, gaps, line, sample_at, sampled, count: int):
+def displacement_percentiles(samples: Samples, gaps, line, sample_at, sampled, count: int):
     """``np.percentile`` of the finite detrended displacements at the 1st and 99th
     percentile, exactly.
 
@@ -326,7 +338,7 @@ def _percentiles(samples: Samples, gaps, line, sample_at, sampled, count: int):
     return result
 
 
-def _missing_in(gaps, start, count):
+def missing_in(gaps, start, count):
     """True for each stretch ``start``, ``count`` that holds a sample of ``gaps``."""
     if not gaps.size:
         return None
@@ -334,7 +346,7 @@ def _missing_in(gaps, start, count):
     return (after < gaps.shape[0]) & (gaps[np.minimum(after, gaps.shape[0] - 1), 0] < start + count)
 
 
-def _ends_of_runs(run, valued, values, runs: int, first: bool):
+def ends_of_runs(run, valued, values, runs: int, first: bool):
     """The first (or last) of ``values`` over the pieces of each run where ``valued``."""
     result = np.full(runs, np.nan)
     pieces = np.flatnonzero(valued)

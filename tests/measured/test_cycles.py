@@ -39,7 +39,9 @@ def percentiles(values):
     sample_at = np.sort(np.random.default_rng(0).integers(0, values.size, passes._SAMPLE))
     line = (0.0, 0.0, 0.0, 0.5 * (values.size - 1))
     gaps = np.zeros((0, 2), np.int64)
-    return passes._percentiles(samples, gaps, line, sample_at, values[sample_at], values.size)
+    return passes.displacement_percentiles(
+        samples, gaps, line, sample_at, values[sample_at], values.size
+    )
 
 
 @pytest.fixture
