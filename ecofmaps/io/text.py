@@ -94,7 +94,7 @@ def _file_bytes(path: Path, block_bytes: int):
         raw.seek(0)
         stream = gzip.GzipFile(fileobj=raw, mode="rb") if compressed else raw
         try:
-            data = _start(path, stream, compressed)
+            data = _first_bytes(path, stream, compressed)
             while data := data + stream.read(block_bytes):
                 if data.endswith(b"\r"):  # its line feed may be the next byte
                     data += stream.read(1)
@@ -110,9 +110,9 @@ def _file_bytes(path: Path, block_bytes: int):
             ) from None
 
 
-def _start(path: Path, stream, compressed: bool) -> bytes:
-    """The first bytes of the text, without byte-order mark; a UTF-16 file is read whole and
-    its text left in ``stream`` as UTF-8 (``stream`` is then emptied, the bytes returned)."""
+def _first_bytes(path: Path, stream, compressed: bool) -> bytes:
+    """The first bytes of the text read from ``stream``, without byte-order mark; for a
+    UTF-16 file, read whole, all of its text as UTF-8."""
     head = stream.read(8)
     if compressed and head.startswith((b"TDSm", b"\x89HDF")):
         kind = "TDMS" if head.startswith(b"TDSm") else "HDF5"
