@@ -84,11 +84,17 @@ class TdmsReader:
 
     Pickled by its path only (the copy opens the file again where it is read), and a
     forked process opens its own: a shared file would share its position.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    handle : nptdms.TdmsFile, optional
+        The file already opened (:func:`opened_tdms`) in this process, now the reader's.
     """
 
-    def __init__(self, path):
+    def __init__(self, path, handle=None):
         self.path = Path(path)
-        self._handle = None  # (TdmsFile, process id)
+        self._handle = None if handle is None else (handle, os.getpid())
         self._lock = threading.Lock()
 
     def __getstate__(self):
@@ -190,12 +196,13 @@ def tdms_groups(path) -> dict[str, xr.Dataset]:
         If the file is not TDMS, or is truncated or damaged.
     """
     path = Path(path)
-    reader = TdmsReader(path)
-    with opened_tdms(path) as handle:
-        root = xr.Dataset(attrs={k: _plain(v) for k, v in handle.properties.items()})
-        groups = {"/": root}
-        for group in handle.groups():
-            groups[f"/{group.name}"] = _group_dataset(reader, group)
+    handle = opened_tdms(path)
+    reader = TdmsReader(path, handle)  # reads through the file opened to list the groups
+    root = xr.Dataset(attrs={k: _plain(v) for k, v in handle.properties.items()})
+    root.set_close(reader.close)
+    groups = {"/": root}
+    for group in handle.groups():
+        groups[f"/{group.name}"] = _group_dataset(reader, group)
     return groups
 
 
@@ -237,7 +244,6 @@ class TdmsBackendEntrypoint(BackendEntrypoint):
     """
 
     description = "TDMS (LabVIEW) files through npTDMS, one group a Dataset (ecofmaps)"
-    url = "https://github.com/ecofmaps/ecofmaps"
     open_dataset_parameters = ("filename_or_obj", "drop_variables", "group")
 
     def open_dataset(self, filename_or_obj, *, drop_variables=None, group=None) -> xr.Dataset:

@@ -43,7 +43,6 @@ class TextBackendEntrypoint(BackendEntrypoint):
     """
 
     description = "Text recordings of fretting loops (CSV, TSV), in SI units (ecofmaps)"
-    url = "https://github.com/ecofmaps/ecofmaps"
     open_dataset_parameters = (
         "filename_or_obj",
         "drop_variables",
