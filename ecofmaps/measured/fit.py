@@ -292,12 +292,66 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
     coefficient of friction from fretting loops exhibiting non-Coulomb frictional
     behaviour: eq. 9, 10, 16.
     """
+    load, all_x, all_y = _checked_samples(displacement, force, load, hysteresis)
+    index, number, analysis = _measured_cycle(all_x, all_y, load, cycle, cycle_number, hysteresis)
+    # The last point closes the loop (it is the first point of the next cycle, or the
+    # first point again): fit each sample once.
+    x, y = all_x[index[:-1]], all_y[index[:-1]]
+    if x.size < MIN_SAMPLES:
+        raise ValueError(f"a loop needs at least {MIN_SAMPLES} samples, got {x.size}")
+    rising = np.arange(x.size) <= np.argmax(x)
+    length = analysis["amplitude"]
+    centre = analysis["displacement_offset"]
+    offset = analysis["force_offset"]
+    scaled_x = (x - centre) / length
+    scaled_y = (y - offset) / load
+    start = _starting_values(
+        scaled_x,
+        scaled_y,
+        rising,
+        stiffness=analysis["stiffness"] * length / load,
+        slip_half_width=analysis["slip_amplitude"] / length,
+        energy_ratio=analysis["energy_ratio"],
+    )
+    solution = _solution(scaled_x, scaled_y, rising, start)
+    mu, s, a, amplitude, shift, force_shift = (float(v) for v in solution.x)
+    model_force = y + load * solution.fun[: x.size]
+    residual = y - model_force
+    gross_slip = mu / (s * amplitude) < 1.0
+    message = solution.message
+    if not gross_slip:
+        message = f"{message} (but the fitted loop has no gross slip: mu * P / (S Δ*) >= 1)"
+    return LoopFit(
+        mu=mu,
+        stiffness=float(s * load / length),
+        groove_depth=float(a * length),
+        aspect_ratio=a / amplitude,
+        amplitude=float(amplitude * length),
+        displacement_offset=float(centre + shift * length),
+        force_offset=float(offset + force_shift * load),
+        load=load,
+        rms_residual=float(np.sqrt(np.mean(residual**2))),
+        r_squared=float(1.0 - np.sum(residual**2) / np.sum((y - y.mean()) ** 2)),
+        standard_errors=_standard_errors(solution, x.size, load, length),
+        success=bool(solution.success and gross_slip),
+        evaluations=int(solution.nfev),
+        message=message,
+        displacement=x,
+        force=y,
+        model_force=model_force,
+        rising=rising,
+        cycle=number,
+    )
+
+
+def _checked_samples(displacement, force, load, hysteresis):
+    """The load and the samples of :func:`fit_loop`, checked (a ValueError naming the
+    input that is not valid). [N], [m], [N]"""
     check("load", load, "positive", "N")
     if np.ndim(load) != 0:
         raise ValueError(f"load must be a single number [N], got shape {np.shape(load)}")
     if not 0.0 < hysteresis < 1.0:
         raise ValueError(f"hysteresis must satisfy 0 < hysteresis < 1; got {hysteresis!r}")
-    load = float(load)
     all_x = np.asarray(displacement, dtype=np.float64)
     all_y = np.asarray(force, dtype=np.float64)
     for name, values in (("displacement", all_x), ("force", all_y)):
@@ -313,7 +367,13 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
         raise ValueError(f"a loop needs at least {MIN_SAMPLES} samples, got {all_x.size}")
     if not np.ptp(all_x) > 0:
         raise ValueError("displacement does not vary: a loop needs a displacement stroke")
+    return float(load), all_x, all_y
 
+
+def _measured_cycle(all_x, all_y, load, cycle, cycle_number, hysteresis):
+    """The samples of the cycle to fit (indices round its loop), its number, and its
+    per-cycle analysis (the stick window that gives the stiffest stick sides); a
+    ValueError if the cycle is refused."""
     cycles, row = _select_cycle(all_x, cycle, cycle_number, hysteresis)
     index = cycles.indices([row])[0][0]
     number = int(cycles.label[row])
@@ -337,39 +397,24 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
             f"cycle {number} is no fretting loop that can be read as recorded: "
             f"{SEPARATOR.join(refusals)} ({'; '.join(REASONS[r][0] for r in refusals)})"
         )
-    # The last point closes the loop (it is the first point of the next cycle, or the
-    # first point again): fit each sample once.
-    x, y = all_x[index[:-1]], all_y[index[:-1]]
-    if x.size < MIN_SAMPLES:
-        raise ValueError(f"a loop needs at least {MIN_SAMPLES} samples, got {x.size}")
-    rising = np.arange(x.size) <= np.argmax(x)
-    length = analysis["amplitude"]
-    centre = analysis["displacement_offset"]
-    offset = analysis["force_offset"]
-    scaled_x = (x - centre) / length
-    scaled_y = (y - offset) / load
-    start = _starting_values(
-        scaled_x,
-        scaled_y,
-        rising,
-        stiffness=analysis["stiffness"] * length / load,
-        slip_half_width=analysis["slip_amplitude"] / length,
-        energy_ratio=analysis["energy_ratio"],
-    )
+    return index, number, analysis
 
+
+def _solution(scaled_x, scaled_y, rising, start):
+    """The least-squares fit of the model's loop to the scaled samples (scipy's result)."""
     # Padded with zero-weight samples to a multiple of _BUCKET, so that loops of nearly the
     # same length share one compiled residual and Jacobian.
-    size = _BUCKET * -(-x.size // _BUCKET)
-    pad = size - x.size
+    size = _BUCKET * -(-scaled_x.size // _BUCKET)
+    pad = size - scaled_x.size
     arguments = tuple(
         jnp.asarray(np.pad(values, (0, pad)))
-        for values in (scaled_x, scaled_y, rising, np.ones(x.size))
+        for values in (scaled_x, scaled_y, rising, np.ones(scaled_x.size))
     )
     # scipy.optimize costs 0.4 s to import: load it when a fit runs, not with `import ecofmaps`.
     from scipy.optimize import least_squares
 
     tiny = np.finfo(np.float64).tiny
-    solution = least_squares(
+    return least_squares(
         lambda p: np.asarray(_residual_jit(jnp.asarray(p), *arguments)),
         start,
         jac=lambda p: np.asarray(_jacobian_jit(jnp.asarray(p), *arguments)),
@@ -381,18 +426,19 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
         gtol=_TOLERANCE,
         max_nfev=_MAX_EVALUATIONS,
     )
-    mu, s, a, amplitude, shift, force_shift = (float(v) for v in solution.x)
-    model_force = y + load * solution.fun[: x.size]
-    residual = y - model_force
-    gross_slip = mu / (s * amplitude) < 1.0
-    # Linearised standard errors: covariance s^2 (J^T J)^-1 of the scaled parameters, with
-    # s^2 the residual variance, carried to SI units (a ratio by its gradient).
-    jacobian = solution.jac[: x.size]
-    variance = np.sum(solution.fun[: x.size] ** 2) / (x.size - solution.x.size)
+
+
+def _standard_errors(solution, samples: int, load: float, length: float) -> dict:
+    """Linearised standard errors of the fitted parameters: covariance s^2 (J^T J)^-1 of the
+    scaled parameters, with s^2 the residual variance, carried to SI units (a ratio by its
+    gradient)."""
+    _, _, a, amplitude, _, _ = (float(v) for v in solution.x)
+    jacobian = solution.jac[:samples]
+    variance = np.sum(solution.fun[:samples] ** 2) / (samples - solution.x.size)
     covariance = variance * np.linalg.pinv(jacobian.T @ jacobian)
     deviation = np.sqrt(np.diag(covariance))
     ratio_gradient = np.array([0.0, 0.0, 1.0 / amplitude, -a / amplitude**2, 0.0, 0.0])
-    standard_errors = {
+    return {
         "mu": float(deviation[0]),
         "stiffness": float(deviation[1] * load / length),
         "groove_depth": float(deviation[2] * length),
@@ -401,27 +447,3 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
         "displacement_offset": float(deviation[4] * length),
         "force_offset": float(deviation[5] * load),
     }
-    message = solution.message
-    if not gross_slip:
-        message = f"{message} (but the fitted loop has no gross slip: mu * P / (S Δ*) >= 1)"
-    return LoopFit(
-        mu=mu,
-        stiffness=float(s * load / length),
-        groove_depth=float(a * length),
-        aspect_ratio=a / amplitude,
-        amplitude=float(amplitude * length),
-        displacement_offset=float(centre + shift * length),
-        force_offset=float(offset + force_shift * load),
-        load=load,
-        rms_residual=float(np.sqrt(np.mean(residual**2))),
-        r_squared=float(1.0 - np.sum(residual**2) / np.sum((y - y.mean()) ** 2)),
-        standard_errors=standard_errors,
-        success=bool(solution.success and gross_slip),
-        evaluations=int(solution.nfev),
-        message=message,
-        displacement=x,
-        force=y,
-        model_force=model_force,
-        rising=rising,
-        cycle=number,
-    )
