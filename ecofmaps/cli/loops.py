@@ -22,10 +22,12 @@ def add(subparsers) -> None:
             "cof_max, energy_ratio, stiffness_MN_per_m, gicof, regime, then mu_resolved, "
             "mu_resolved_se and aspect_ratio (friction and groove read along the whole "
             "stroke) and quality ('ok', or why values are NaN); first a file column when "
-            "several files are given. By default the columns are 'displacement' and 'force' "
-            "(units from their names or the file, else um and N), with an optional 'cycle'. "
-            "A damaged file stops the command with its name and line number, and nothing is "
-            "written; files are written atomically and never over an input. --example "
+            "several files are given. The columns are found by name as rigs write them "
+            "(displacement, disp, delta, stroke, ...; force, Fx, Ft, Q, friction, ...) with "
+            "units from their names or the file, else um and N, and an optional 'cycle'. "
+            "With several files, one that cannot be analysed is one error line naming it and "
+            "the others are written (exit status 1); files are written atomically and never "
+            "over an input or a file ecofmaps did not write. --example "
             "analyses the synthetic recording shipped with ecofmaps.",
             width=80,
         ),
@@ -84,6 +86,13 @@ def add(subparsers) -> None:
         help="read the force with the other sign (a rig recording it positive against the "
         "displacement: its loops run anticlockwise)",
     )  # fmt: skip
+    _add_column_options(parser)
+    add_long_options(parser)
+    parser.set_defaults(handler=run)
+
+
+def _add_column_options(parser) -> None:
+    """The options that say where the recording's columns are and in which units."""
     parser.add_argument(
         "--displacement-col", default="displacement", metavar="NAME",
         help="name of the displacement column (default: displacement)",
@@ -115,8 +124,6 @@ def add(subparsers) -> None:
         "--group", default=None, metavar="NAME",
         help="TDMS group, or HDF5/netCDF/zarr group, holding the channels (default: any)",
     )  # fmt: skip
-    add_long_options(parser)
-    parser.set_defaults(handler=run)
 
 
 def _workers(text: str) -> int:
