@@ -61,6 +61,9 @@ _FIRST_SHOWN = 3
 #: Points on each slip branch of a model loop.
 _MODEL_POINTS = 40
 
+#: Model loops are computed in batches of a multiple of this many. [1]
+_MODEL_BATCH = 64
+
 #: Width of the page's content, for a laptop screen. [px]
 _WIDTH = 1240
 
@@ -395,9 +398,13 @@ def _model_loops(results: xr.Dataset) -> tuple[list, list]:
     usable &= (values["mu_resolved"] > 0) & (values["aspect_ratio"] >= 0)
     xs, ys = [empty] * count, [empty] * count
     if usable.any():
+        # Padded to a multiple of _MODEL_BATCH loops (repeating them): the compiled model is
+        # then reused by every report, not compiled again for each number of loops.
+        size = -(-int(usable.sum()) // _MODEL_BATCH) * _MODEL_BATCH
+        batch = {name: np.resize(value[usable], size) for name, value in values.items()}
         displacement, force = fretting_loop(
-            values["amplitude"][usable], float(results["load"]), values["stiffness"][usable],
-            values["mu_resolved"][usable], values["aspect_ratio"][usable], num=_MODEL_POINTS,
+            batch["amplitude"], float(results["load"]), batch["stiffness"],
+            batch["mu_resolved"], batch["aspect_ratio"], num=_MODEL_POINTS,
         )  # fmt: skip
         displacement = np.round(np.asarray(displacement) * 1e6, 4)
         force = np.round(np.asarray(force), 3)

@@ -86,25 +86,31 @@ def free_port() -> int:
 
 
 @pytest.fixture(scope="module")
-def server():
+def started():
     """``ecofmaps explore`` on a free port, in a subprocess: (process, its address)."""
     port = free_port()
     process = subprocess.Popen(
         [sys.executable, "-m", "ecofmaps.cli", "explore", "--port", str(port), "--no-browser"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )  # fmt: skip
+    yield process, f"http://127.0.0.1:{port}/"
+    if process.poll() is None:
+        process.kill()
+        process.communicate()
+
+
+@pytest.fixture(scope="module")
+def server(started, browser):
+    """The explorer once it listens (the browser starts while it compiles the model)."""
+    process, url = started
     with selectors.DefaultSelector() as waiting:
         waiting.register(process.stdout, selectors.EVENT_READ)
         ready = waiting.select(timeout=180)
     line = process.stdout.readline() if ready else ""
-    url = f"http://127.0.0.1:{port}/"
     if url not in line:
         process.kill()
         pytest.fail(f"the explorer did not start: {line!r} {process.communicate()[1]!r}")
-    yield process, url
-    if process.poll() is None:
-        process.kill()
-        process.communicate()
+    return process, url
 
 
 def shown_values(driver) -> dict:
