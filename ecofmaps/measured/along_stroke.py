@@ -28,7 +28,9 @@ from ecofmaps.measured.stick_slip import masked_median, masked_sum, slip_branche
 __all__ = ["QUALITY_FLAGS"]
 
 #: Quality flags, in the order they are tested.
-#: The reasons this reading adds to a cycle's ``quality`` (ecofmaps.measured.quality).
+#: The reasons this reading adds to a cycle's ``quality`` (ecofmaps.measured.quality) that
+#: leave its values NaN, the first that applies; ``'gicof-varies'``, which reaches the
+#: GICoF only, is added besides.
 QUALITY_FLAGS = ("stiffness-mismatch", "no-overlap", "few-slip-samples", "mu-varies")
 
 #: μ(ξ) varies along the stroke when the means over the inner and the outer half of the
@@ -67,11 +69,14 @@ _MAD = 1.482602218505602
 
 
 def _central_values(forward, backward, central, load):
-    """mu_resolved, its noise variance, k and g0 of g ≈ g0 + kξ, the sensitivity to 1/S.
+    """mu_resolved, its variance, k and g0 of g ≈ g0 + kξ, the sensitivity to 1/S.
 
     Read on each cycle's own grid over its central part, ``|ξ| <= central``: nothing here
-    depends on the other cycles. Also whether μ(ξ) varies between the inner and the outer
-    half of the part beyond ``_VARIATION`` of μ and beyond its noise.
+    depends on the other cycles. The variance is the noise's, or the scatter's of μ(ξ)
+    along the part where that is larger (:func:`_scatter_variance`). Also whether μ(ξ)
+    varies between the inner and the outer half of the part beyond ``_VARIATION`` of μ and
+    beyond its noise, the sensitivity to a shift of the rising branch against the falling
+    one along ξ, and whether μ(ξ) wiggles about a straight line beyond ``_GICOF_WIGGLE``.
     """
     width = forward[0].shape[1]
     usable = np.isfinite(central)
@@ -128,7 +133,7 @@ def _central_values(forward, backward, central, load):
     # is not the mean friction (a straight trend is the same at the centre).
     excess = np.sqrt(np.maximum(wiggle - variance * _SCATTER_BLOCKS, 0.0))
     wavers = excess > _GICOF_WIGGLE * np.abs(mu_resolved)
-    variance = np.maximum(variance, scatter)
+    variance = np.fmax(variance, scatter)  # the noise alone where too few blocks
     tilt = mean_g - k * mean_xi
     return mu_resolved, variance, k, tilt, sensitivity, varies, shifting, wavers
 
