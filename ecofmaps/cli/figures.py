@@ -17,7 +17,7 @@ import signal
 import sys
 import textwrap
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from pathlib import Path
 
 from ecofmaps._interrupts import check_interrupted, interrupts_stop_writes
@@ -193,12 +193,14 @@ def _start_worker() -> None:
 
 
 def _worker_group(names, directory, formats) -> list[tuple[str, list[Path], float]]:
-    """:func:`write_figure_group` in a drawing process; nothing once it is told to stop."""
+    """:func:`write_figure_group` in a drawing process, which ends when told to stop."""
     try:
         with interrupts_stop_writes():  # SIGTERM from the parent: stop at a safe point
             return write_figure_group(names, directory, formats)
     except KeyboardInterrupt:
-        return []
+        # Its file was removed on the way out; end now, without drawing queued figures (and
+        # without tearing down JAX's threads, like the command itself: cli.main.console).
+        os._exit(128 + signal.SIGTERM)
 
 
 def _written_in_parallel(groups, out: Path, formats, jobs: int):
@@ -210,14 +212,19 @@ def _written_in_parallel(groups, out: Path, formats, jobs: int):
         initializer=_start_worker,
     )
     try:
-        futures = [executor.submit(_worker_group, group, out, formats) for group in groups]
-        for future in as_completed(futures):
+        pending = {executor.submit(_worker_group, group, out, formats) for group in groups}
+        while pending:  # waits of a quarter second, so Ctrl-C is seen at once
+            done, pending = wait(pending, timeout=0.25, return_when=FIRST_COMPLETED)
             check_interrupted()
-            yield future.result()
+            for future in done:
+                yield future.result()
     except BaseException:  # an error, Ctrl-C or SIGTERM: stop the drawing processes too
         executor.shutdown(wait=False, cancel_futures=True)
-        for process in set(multiprocessing.active_children()) - others:
-            process.terminate()  # SIGTERM: it stops at its next safe point
+        ours = set(multiprocessing.active_children()) - others
+        for process in ours:
+            process.terminate()  # SIGTERM: it stops at its next safe point, writing nothing
+        for process in ours:
+            process.join()
         raise
     finally:
         executor.shutdown(wait=True)

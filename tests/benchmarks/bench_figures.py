@@ -5,11 +5,13 @@ collect this file).
     python tests/benchmarks/bench_figures.py --repeat 1 --only fig8 # a few seconds
 
 Cold is a run from an empty cache (a fresh ``ECOFMAPS_CACHE``: no maps, no compiled JAX
-kernels); warm is a run after one that filled that cache. Side by side, the floor: a process
-that imports the figures' style (matplotlib, xarray) and draws one empty figure to PNG, the
-least any run pays. Each row gives the minimum, median and maximum wall time of ``--repeat``
-runs, and the least CPU time (user + system, every process of the run), with the targets and
-the machine's load average: on a shared machine it matters.
+kernels); warm is a run after one that filled that cache; kernels is a run whose numbers were
+removed from the cache but whose JAX kernels were kept (what JAX's compilation cache alone
+saves). Side by side, the floor: a process that imports the figures' style (matplotlib,
+xarray) and draws one empty figure to PNG, the least any run pays. Each row gives the
+minimum, median and maximum wall time of ``--repeat`` runs, and the least CPU time (user +
+system, every process of the run), with the targets and the machine's load average: on a
+shared machine it matters.
 """
 
 from __future__ import annotations
@@ -59,12 +61,16 @@ def figures_command(out: Path, only, jobs) -> list[str]:
 
 def measured_runs(repeat: int, only, jobs, folder: Path) -> dict[str, list[tuple[float, float]]]:
     """``repeat`` cold and warm runs of the command, and of the floor."""
-    runs = {"cold": [], "warm": [], "floor": []}
+    runs = {"cold": [], "warm": [], "kernels": [], "floor": []}
     command = figures_command(folder / "out", only, jobs)
     for index in range(repeat):
-        environment = {**os.environ, "ECOFMAPS_CACHE": str(folder / f"cache-{index}")}
+        cache = folder / f"cache-{index}"
+        environment = {**os.environ, "ECOFMAPS_CACHE": str(cache)}
         runs["cold"].append(timed_process(command, environment))  # an empty cache
         runs["warm"].append(timed_process(command, environment))  # the cache it filled
+        for path in cache.glob("*.nc"):  # the numbers go, JAX's compiled kernels stay
+            path.unlink()
+        runs["kernels"].append(timed_process(command, environment))
         runs["floor"].append(timed_process([sys.executable, "-c", FLOOR], environment))
     return runs
 

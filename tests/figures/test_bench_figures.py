@@ -15,7 +15,7 @@ def test_short_run_prints_cold_warm_and_floor(capsys):
     assert bench.main(["--repeat", "1", "--only", "fig8", "--jobs", "1"]) == 0
     out = capsys.readouterr().out
     assert "== figures: ecofmaps figures (fig8), 1 run(s) each ==" in out
-    for name, target in (("cold", "8.0"), ("warm", "4.0"), ("floor", "")):
+    for name, target in (("cold", "8.0"), ("warm", "4.0"), ("kernels", ""), ("floor", "")):
         row = re.search(rf"^{name}\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s*(\S*)$", out, re.MULTILINE)
         assert row, name
         assert all(float(value) > 0 for value in row.groups()[:4]), row.group(0)
