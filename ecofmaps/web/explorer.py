@@ -303,7 +303,7 @@ def explorer_page():
     }
     inputs = {
         key: pn.widgets.TextInput(
-            name=label, value=query.get(key, default), width=220 if key in _MODEL_INPUTS else 160
+            label=label, value=query.get(key, default), width=220 if key in _MODEL_INPUTS else 160
         )
         for key, (_, label, default) in INPUTS.items()
     }

@@ -9,11 +9,12 @@ import subprocess
 import sys
 import urllib.parse
 
+import panel as pn
 import pytest
 
 import ecofmaps
 from ecofmaps.cli import explore
-from ecofmaps.web.explorer import map_window, parameter_value
+from ecofmaps.web.explorer import explorer_page, map_window, parameter_value
 from tests.cli.commands import run
 from tests.web.pages import CANVAS_INK, console_errors, deep_texts, wait_for
 
@@ -169,3 +170,22 @@ def test_sigterm_stops_it_cleanly(server):
     assert process.returncode == 0, err
     assert "Traceback" not in err and "Traceback" not in out
     assert "ecofmaps explorer stopped" in out
+
+
+def test_the_page_follows_its_inputs():
+    """The page's callbacks, without a server: numbers, no gross slip, a rigid rig, bad input."""
+    page = explorer_page()
+    inputs = {widget.label: widget for widget in page.select(pn.widgets.TextInput)}
+
+    def shown():
+        return " ".join(str(pane.object) for pane in page.select(pn.pane.HTML))
+
+    assert "data-quantity='ecof_ratio'>1.038<" in shown()  # Example 2: about 4 % above μ
+    inputs["Displacement amplitude Δ*"].value = "5um"  # μP/S = 10.3 µm > Δ*
+    assert "No gross slip" in shown() and "data-quantity='ecof_ratio'>undefined<" in shown()
+    inputs["Displacement amplitude Δ*"].value = "50um"
+    inputs["Rig stiffness S"].value = "inf"
+    rigid = float(ecofmaps.energy_cof(50e-6, 450.0, math.inf, 0.8, 0.2)) / 0.8
+    assert f"data-quantity='ecof_ratio'>{rigid:.3f}<" in shown()
+    inputs["Normal load P"].value = "-3N"
+    assert "Normal load P: &#x27;-3N&#x27; is out of range" in shown()
