@@ -111,8 +111,8 @@ def _file_bytes(path: Path, block_bytes: int):
 
 
 def _first_bytes(path: Path, stream, compressed: bool) -> bytes:
-    """The first bytes of the text read from ``stream``, without byte-order mark; for a
-    UTF-16 file, read whole, all of its text as UTF-8."""
+    """For a UTF-16 file, read whole, all of its text as UTF-8; else none (``stream`` is
+    left at the start of the text, after any byte-order mark)."""
     head = stream.read(8)
     if compressed and head.startswith((b"TDSm", b"\x89HDF")):
         kind = "TDMS" if head.startswith(b"TDSm") else "HDF5"
@@ -131,7 +131,8 @@ def _first_bytes(path: Path, stream, compressed: bool) -> bytes:
             raise RecordingError(
                 path, text.count("\n") + 1, "damaged UTF-16 text (an odd byte)"
             ) from None
-    return head[len(codecs.BOM_UTF8) :] if head.startswith(codecs.BOM_UTF8) else head
+    stream.seek(len(codecs.BOM_UTF8) if head.startswith(codecs.BOM_UTF8) else 0)
+    return b""
 
 
 class _Damaged(Exception):
@@ -465,6 +466,7 @@ def text_blocks(path: Path, options: dict, block_bytes: int = BLOCK_BYTES):
         layout = _Layout(path, header + 1, lines[header], options)
         yield layout
         yield from _parsed_lines(layout, lines[header + 1 :], header + 2)
+        del lines  # the first block's text, not held while the others are read
         for raw, start, count in blocks:
             check_interrupted()
             if decoder.encoding == "utf-8" and b"#" not in raw:
@@ -492,9 +494,9 @@ def _head(blocks, decoder: _Decoder, options: dict) -> list[str]:
     for raw, start, _ in blocks:
         check_interrupted()
         new = _text_lines(decoder(raw, start))
-        first = max((skip or 0) - len(lines), 0)
-        lines += new
-        found += sum(1 for _ in itertools.islice(filter(_is_data, new[first:]), needed))
+        after = itertools.islice(new, max((skip or 0) - len(lines), 0), None)
+        found += len(list(itertools.islice(filter(_is_data, after), needed - found)))
+        lines = lines + new if lines else new
         if found >= needed:
             break
     return lines
