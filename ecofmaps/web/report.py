@@ -46,7 +46,7 @@ from ecofmaps._nomenclature import QUANTITIES
 from ecofmaps._version import __version__
 from ecofmaps.io.files import atomic_path
 from ecofmaps.io.tables import results_table
-from ecofmaps.measured.quality import REASONS, SEPARATOR
+from ecofmaps.measured.quality import REASONS, SEPARATOR, quality_summary
 from ecofmaps.model.simulation import fretting_loop
 
 __all__ = ["LOOPS_CARRIED", "recording_inputs", "report_document", "write_report"]
@@ -63,6 +63,10 @@ _MODEL_POINTS = 40
 
 #: Model loops are computed in batches of a multiple of this many. [1]
 _MODEL_BATCH = 64
+
+#: The plots over the cycles: width of their frames, and the room left of it for the axis
+#: labels, the same in both, so that their cycle axes line up. [px]
+_FRAME = (560, 130)
 
 #: Width of the page's content, for a laptop screen. [px]
 _WIDTH = 1240
@@ -243,8 +247,7 @@ def _header(results: xr.Dataset, inputs: Mapping) -> Div:
     rows = dict(inputs)
     rows["ecofmaps version"] = __version__
     rows["written"] = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
-    if "quality_summary" in results.attrs:
-        rows["cycles"] = str(results.attrs["quality_summary"])
+    rows["cycles"] = quality_summary(results["quality"].values)
     cells = "".join(
         f"<tr><th style='text-align:left;padding-right:1em'>{html.escape(str(key))}</th>"
         f"<td>{html.escape(str(value))}</td></tr>"
@@ -273,7 +276,8 @@ def _evolution_figures(results: xr.Dataset):
     data["mu_high"] = data["mu_resolved"] + 2.0 * data["mu_resolved_se"]
     source = ColumnDataSource(data)
     plot = figure(
-        width=820, height=340, title="Coefficients of friction over the test",
+        frame_width=_FRAME[0], frame_height=300, min_border_left=_FRAME[1],
+        title="Coefficients of friction over the test",
         x_axis_label=_label("cycle"), y_axis_label="Coefficient of friction [1]",
         tools="pan,box_zoom,wheel_zoom,reset,save",
     )  # fmt: skip
@@ -325,7 +329,9 @@ def _flags_figure(results: xr.Dataset, evolution):
         return Div(text="<p>No cycle is flagged: every cycle's quality is 'ok'.</p>")
     reasons = list(flagged)[::-1]  # the first reason at the top
     plot = figure(
-        width=800, height=60 + 24 * len(reasons), y_range=reasons, x_range=evolution.x_range,
+        frame_width=_FRAME[0], frame_height=26 * len(reasons), min_border_left=_FRAME[1],
+        y_range=reasons, x_range=evolution.x_range,
+        toolbar_location=None,
         title="Quality flags (the values they leave out are NaN)",
         x_axis_label=_label("cycle"), tools="xpan,xwheel_zoom,reset",
     )  # fmt: skip
@@ -364,7 +370,7 @@ def _quality_counts(results: xr.Dataset) -> Div:
             "<tr><th style='text-align:left'>flag</th><th style='padding:0 8px'>cycles</th>"
             f"<th style='text-align:left'>what it means</th></tr>{cells}</table>"
         ),
-        width=_WIDTH - 820,
+        width=_WIDTH - 880,
     )
 
 
