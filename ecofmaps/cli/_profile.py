@@ -106,7 +106,8 @@ def read_profile(args, conflicting=()):
     -----
     The reader's :class:`~ecofmaps.model.profiles.ScarProfileWarning` (outliers replaced,
     ambiguous edges) are printed on standard error, one line each, naming the file; for
-    ambiguous edges the line ends with the ``--profile-half-width`` that takes the groove.
+    ambiguous edges the line ends with the ``--profile-half-width`` that takes the other
+    half-width (the groove's or the band's).
     """
     if args.scar_profile is None:
         given = [name for name in PROFILE_OPTIONS if getattr(args, name) is not None]
@@ -146,7 +147,8 @@ def read_profile(args, conflicting=()):
             continue
         alternative = item.message.alternative
         hint = "" if alternative is None else (
-            f"; --profile-half-width {alternative * 1e6:.6g}um takes the groove"
+            f"; --profile-half-width {alternative * 1e6:.6g}um takes the "
+            f"{item.message.alternative_name}"
         )  # fmt: skip
         print(f"{args.profile_command}: warning: {item.message.summary}{hint}", file=sys.stderr)
     return profile
@@ -168,15 +170,17 @@ def profile_rows(args, profile) -> list:
         reading.append(f"slopes smoothed over {args.smoothing * 1e6:.6g} µm")
     alternative = float(profile.alternative_half_width)
     how = "(given)" if args.profile_half_width is not None else "(detected)"
+    # the band around the groove is the wider of the two
+    taken, other = ("band", "groove") if alternative < profile.half_width else ("groove", "band")
     if not math.isnan(alternative):
-        how = "(band)"
+        how = f"({taken})"
     rows = [
         ("scar profile", "", f"{args.scar_profile} ({', '.join(reading)})"),
         row("scar_depth", float(profile.depth)),
         row("scar_half_width", float(profile.half_width), how),
     ]
     if not math.isnan(alternative):
-        rows.append(row("scar_half_width", alternative, "(or groove)"))
+        rows.append(row("scar_half_width", alternative, f"(or {other})"))
     rows.append(("scar aspect ratio", "D/W", f"{float(profile.aspect_ratio):.6g}"))
     return rows
 

@@ -82,8 +82,8 @@ def read_scar_profile(
         Naming the file: for outliers replaced (their count, and each one's line, position
         and deviation from its neighbours' median), and for ambiguous edges (a band between
         pile-up ridges wider than the groove below the unworn surface's line: both
-        half-widths, the band's taken; ``half_width=`` chooses). See
-        :func:`ecofmaps.scar_profile`.
+        half-widths; the band's is taken when it reaches beyond both of the groove's edges,
+        ``half_width=`` chooses). See :func:`ecofmaps.scar_profile`.
 
     Raises
     ------
@@ -147,6 +147,7 @@ def read_scar_profile(
         ) from None
     for finding in findings:
         text = finding.text([f"line {lines[i]}" for i in finding.samples])
-        warn(ScarProfileWarning(f"{path}: {text}", alternative=finding.alternative),
-             ScarProfileWarning)  # fmt: skip
+        located = ScarProfileWarning(f"{path}: {text}", alternative=finding.alternative,
+                                     alternative_name=finding.alternative_name)  # fmt: skip
+        warn(located, ScarProfileWarning)
     return profile

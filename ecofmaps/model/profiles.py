@@ -56,14 +56,17 @@ samples lie farther from the line than 5 times the shoulders' noise and than 2 %
 depth, with no quiet stretch longer than a quarter of the groove's half-width (and than 10
 sample spacings) between them. Going inwards from the band's outer end, the first crest
 that stands higher than that threshold above the line is a pile-up ridge; the band's edge
-is the foot of its inner flank, where the flank reaches the line or stops falling (rises by
-the threshold again); without a ridge, the band's outermost sample. Where the flank
-reaches the line at the groove's own edge (a scar whose walls run into its ridges), the
-edges are the groove's. When the band between the ridges is wider than the groove by more
-than :data:`AMBIGUOUS_EDGES` (10 %: a shallow groove inside a wider worn track, or a
-roughness valley inside a disturbed band), the edges are ambiguous: the band's are taken,
-and a :class:`ScarProfileWarning` gives both half-widths (``alternative_half_width`` keeps
-the groove's); which one the model needs is the user's judgement (``half_width=``).
+is the foot of its inner flank, the lowest point before the profile rises by the threshold
+again (a floor above the line, debris, roughness); without a ridge, the band's outermost
+sample. Where the flank falls (to within the threshold) all the way into the groove (a
+scar whose walls run into its ridges, or a quiet floor between them and the groove),
+the edges are the groove's. When an edge of the band lies beyond the groove's by more
+than :data:`AMBIGUOUS_EDGES` of the groove's half-width, the edges are ambiguous, and a
+:class:`ScarProfileWarning` gives both half-widths (``alternative_half_width`` keeps the
+one not taken); which one the model needs is the user's judgement (``half_width=``). The
+band's are taken when both its edges lie beyond (a shallow groove inside a wider worn
+track, or a roughness valley inside a disturbed band), the groove's when only one does
+(most often debris lying beside the groove).
 
 The half-width is half the distance of the two edges, the centre their midpoint;
 ``half_width=`` overrides the half-width (the centre stays that of the detected edges,
@@ -110,8 +113,8 @@ MIN_SCAR_SAMPLES = 20
 OUTLIER_NEIGHBOURS = 4
 #: Outliers: farther than this many scaled MADs (1.4826 MAD) from the neighbours' median.
 OUTLIER_THRESHOLD = 6.0
-#: The edges are ambiguous when the band between the ridges is wider than the groove below
-#: the unworn surface's line by more than this fraction of the groove's half-width. [1]
+#: The edges are ambiguous when an edge of the band between the ridges lies beyond the
+#: groove's by more than this fraction of the groove's half-width. [1]
 AMBIGUOUS_EDGES = 0.1
 
 # Shoulders for the reference line: farther than these many half-widths from the centre
@@ -167,9 +170,10 @@ class ScarProfile(NamedTuple):
     reference_slope : jax.Array, shape ()
         Tilt of the unworn surface, in the frame of ``slope`` (0 when levelled). [1]
     alternative_half_width : jax.Array, shape ()
-        The other plausible half-width when the edges were ambiguous (the groove below the
-        unworn surface's line when the band between pile-up ridges was taken, see the
-        module docstring), NaN when they were not (or the half-width was given). [m]
+        The other plausible half-width when the edges were ambiguous (the groove's below
+        the unworn surface's line, or the band's between pile-up ridges, whichever was not
+        taken; see the module docstring), NaN when they were not (or the half-width was
+        given). [m]
     replaced : jax.Array, shape (N,) or ()
         1 where the sample was an outlier (a spike or dropout, :func:`outlying_samples`)
         and its height was interpolated from its neighbours', else 0; a scalar 0 when no
@@ -320,14 +324,20 @@ class ScarProfileWarning(UserWarning):
         What each sample shows (its position and deviation), in the order of ``samples``.
     alternative : float or None
         For ambiguous edges, the half-width not taken (``half_width=`` takes it). [m]
+    alternative_name : str
+        What that half-width is: ``'groove'`` or ``'band'``.
     """
 
-    def __init__(self, summary: str, samples=(), details=(), alternative=None):
+    def __init__(self, summary: str, samples=(), details=(), alternative=None,
+                 alternative_name=""):  # fmt: skip
         self.summary = summary
         self.samples = tuple(int(i) for i in samples)
         self.details = tuple(details)
         self.alternative = alternative
-        hint = "" if alternative is None else f"; half_width={alternative:.6g} (m) takes the groove"
+        self.alternative_name = alternative_name
+        hint = "" if alternative is None else (
+            f"; half_width={alternative:.6g} (m) takes the {alternative_name}"
+        )  # fmt: skip
         super().__init__(self.text([f"sample {i}" for i in self.samples]) + hint)
 
     def text(self, labels) -> str:
@@ -479,10 +489,11 @@ def _band_edge(x, r, outer, end, step, threshold):
     """The band's edge on one side and the index of its pile-up ridge's crest (or None).
 
     Inwards from the band's outermost sample ``end``: the first crest higher than
-    ``threshold`` above the line (a ridge), then down its inner flank to where it reaches
-    the line or stops falling (rises by ``threshold`` again); that is the edge. Without a
-    ridge the band ends at ``end``. The edge is None where it is the groove's own (the
-    flank reaches the line at the groove's edge sample ``outer``)."""
+    ``threshold`` above the line (a ridge), then down its inner flank to where it stops
+    falling (the lowest sample before it first rises by ``threshold`` again); that is the
+    edge. Without a ridge the band ends at ``end``. The edge is None where it is the
+    groove's own: the flank falls, to within ``threshold``, all the way to the groove's
+    edge sample ``outer``."""
     inward = np.arange(end, outer - step, -step)
     s = r[inward]
     above = np.flatnonzero(s > threshold)
@@ -492,15 +503,10 @@ def _band_edge(x, r, outer, end, step, threshold):
     fallen = np.flatnonzero(s[first:] < np.maximum.accumulate(s[first:]) - threshold)
     crest = first + int(np.argmax(s[first : first + fallen[0]] if fallen.size else s[first:]))
     flank = s[crest:]
-    zero = np.flatnonzero(flank <= 0.0)
     rise = np.flatnonzero(flank > np.minimum.accumulate(flank) + threshold)
-    stop = min(zero[0] if zero.size else flank.size, rise[0] if rise.size else flank.size)
-    if stop >= flank.size - 1:
+    if rise.size == 0:
         return None, int(inward[crest])
-    if zero.size and stop == zero[0]:
-        a, b = inward[crest + stop - 1], inward[crest + stop]
-        return float(x[a] + r[a] / (r[a] - r[b]) * (x[b] - x[a])), int(inward[crest])
-    foot = inward[crest + int(np.argmin(flank[:stop]))]
+    foot = inward[crest + int(np.argmin(flank[: rise[0]]))]
     return float(x[foot]), int(inward[crest])
 
 
@@ -530,6 +536,7 @@ class _Extent(NamedTuple):
     residual: np.ndarray
     groove: tuple
     band: tuple
+    wide: bool
     ridges: tuple
 
 
@@ -578,8 +585,10 @@ def _scar_extent(x, zs, half_width, reach=0) -> _Extent:
                 "must increase upwards (the scar is a depression), in metres."
             )
         groove, band, ridges, outer, threshold = _edges(x, r, deepest, depth, noise, reach)
-        wide = band[1] - band[0] > (1.0 + AMBIGUOUS_EDGES) * (groove[1] - groove[0])
-        if wide and half_width is not None:  # the centre of the edges nearer that width
+        tolerance = AMBIGUOUS_EDGES * 0.5 * (groove[1] - groove[0])
+        apart = [abs(b - g) > tolerance for b, g in zip(band, groove, strict=True)]
+        wide = all(apart)  # one side apart alone is most often debris beside the groove
+        if any(apart) and half_width is not None:  # the centre of the edges nearer that width
             wide = abs(band[1] - band[0] - 2 * half_width) < abs(
                 groove[1] - groove[0] - 2 * half_width
             )
@@ -602,28 +611,41 @@ def _scar_extent(x, zs, half_width, reach=0) -> _Extent:
         if edges == previous:
             break
         previous = edges
-    return _Extent(line, tilt, centre, width, r, groove, band if wide else groove, ridges)
+    band = band if any(apart) else groove
+    return _Extent(line, tilt, centre, width, r, groove, band, wide, ridges)
 
 
 def _ambiguity(x, extent: _Extent, given: bool):
     """The warning of ambiguous edges (None if the band is the groove or a width was given),
-    and the alternative half-width. [m]"""
+    and the half-width not taken. [m]"""
     if extent.band == extent.groove or given:
         return None, np.nan
-    band, groove = (0.5 * (b - a) for a, b in (extent.band, extent.groove))
-    ridges = [i for i in extent.ridges if i is not None]
     r = extent.residual
+    ridges = [i for i in extent.ridges if i is not None]
+    sides = [side for side, b, g in zip(("left", "right"), extent.band, extent.groove,
+                                        strict=True) if b != g]  # fmt: skip
     what = "the band between its pile-up ridges" if ridges else "the disturbed band"
-    crests = "".join(f"; a ridge {r[i] * 1e6:.3g} µm high at x = {x[i] * 1e6:.6g} µm"
+    if len(sides) == 1:
+        what = f"the groove and the disturbed band on its {sides[0]}"
+    crests = "".join(f"; a crest {r[i] * 1e6:.3g} µm high at x = {x[i] * 1e6:.6g} µm"
                      for i in ridges)  # fmt: skip
+
+    def candidate(edges, words, taken):
+        width = 0.5 * (edges[1] - edges[0])
+        where = f"edges at x = {edges[0] * 1e6:.6g} and {edges[1] * 1e6:.6g} µm"
+        return width, f"{width * 1e6:.6g} µm for {words} ({'taken; ' if taken else ''}{where}"
+
+    band = candidate(extent.band, what, extent.wide)
+    groove = candidate(extent.groove, "the groove below the unworn surface's line",
+                       not extent.wide)  # fmt: skip
+    first, second = (band, groove) if extent.wide else (groove, band)
     summary = (
-        f"ambiguous scar edges: half-width {band * 1e6:.6g} µm for {what} (taken; edges at "
-        f"x = {extent.band[0] * 1e6:.6g} and {extent.band[1] * 1e6:.6g} µm{crests}) or "
-        f"{groove * 1e6:.6g} µm for the groove below the unworn surface's line (edges at "
-        f"x = {extent.groove[0] * 1e6:.6g} and {extent.groove[1] * 1e6:.6g} µm): which "
-        "the model needs is a judgement"
+        f"ambiguous scar edges: half-width {first[1]}{crests if extent.wide else ''}) or "
+        f"{second[1]}{'' if extent.wide else crests}): which the model needs is a judgement"
     )
-    return ScarProfileWarning(summary, alternative=groove), groove
+    name = "groove" if extent.wide else "band"
+    finding = ScarProfileWarning(summary, alternative=second[0], alternative_name=name)
+    return finding, second[0]
 
 
 def _checked(x, z, half_width, smoothing):
@@ -747,8 +769,9 @@ def scar_profile(x, z, half_width=None, smoothing=None, level=False,
     ScarProfileWarning
         For outliers replaced (their count, sample indices and positions), and for
         ambiguous edges: a band between pile-up ridges (or a disturbed band) wider than the
-        groove below the unworn surface's line by more than :data:`AMBIGUOUS_EDGES`; the
-        band is taken, and the message gives both half-widths (``half_width=`` chooses).
+        groove below the unworn surface's line by more than :data:`AMBIGUOUS_EDGES` on a
+        side; the band is taken if on both sides, else the groove, and the message gives
+        both half-widths (``half_width=`` chooses).
 
     Raises
     ------

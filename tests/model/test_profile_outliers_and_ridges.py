@@ -194,3 +194,18 @@ def test_ambiguous_edges_take_the_band_and_warn_with_both(track, band, groove, g
     chosen = silently(scar_profile, XI, z, half_width=alternative)
     assert float(chosen.centre) == pytest.approx(groove_centre * UM, abs=1 * UM)
     assert np.isnan(float(chosen.alternative_half_width))
+
+
+def test_debris_beside_one_edge_keeps_the_groove_and_warns_with_the_band():
+    """Debris 1.5 µm high just beyond the right ridge: the band reaches beyond the groove on
+    that side only, so the groove is taken (within 0.5 %) and the warning offers the band."""
+    z = scar("parabola") + ridges(X, W, 2 * UM, 60 * UM) + bump(X, 290 * UM, 1.5 * UM, 4 * UM)
+    z += noise(14, X.size)
+    with pytest.warns(ScarProfileWarning, match="the disturbed band on its right") as caught:
+        profile = scar_profile(X, z)
+    assert float(profile.half_width) == pytest.approx(W, rel=5e-3)
+    alternative = float(profile.alternative_half_width)
+    assert alternative == pytest.approx(0.5 * (266 + 200) * UM, abs=2 * UM)
+    message = caught[0].message
+    assert (message.alternative, message.alternative_name) == (alternative, "band")
+    assert str(message).endswith(f"half_width={alternative:.6g} (m) takes the band")
