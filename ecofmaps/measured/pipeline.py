@@ -44,7 +44,7 @@ from ecofmaps._parallel import stretch
 from ecofmaps.measured.cycles import Cycles, find_cycles
 from ecofmaps.measured.options import missing_sample_error, no_cycle_error
 from ecofmaps.measured.per_cycle import measure_cycles
-from ecofmaps.measured.quality import quality_summary
+from ecofmaps.measured.quality import ALL, REASONS, has_reason, quality_summary
 from ecofmaps.measured.resolved import REPORTED, resolve_analyzed_loops, resolved_attrs
 from ecofmaps.measured.results import Tally, cycle_results, strip, with_loops
 
@@ -280,6 +280,11 @@ def _part(counted: xr.Dataset, values: dict) -> xr.Dataset:
     if read:
         part = part.assign({k: ("cycle", read[k], resolved_attrs(k)) for k in REPORTED})
         part["quality"] = part["quality"].copy(data=read["quality"])
+        for reason, (_, scope) in REASONS.items():  # the reading's reasons empty their scope
+            scope = set() if scope == ALL else set(scope) & set(part.data_vars) - set(REPORTED)
+            if scope:
+                flagged = has_reason(read["quality"], reason)
+                part = part.assign({name: part[name].where(~flagged) for name in sorted(scope)})
     return part
 
 

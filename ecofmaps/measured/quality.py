@@ -122,8 +122,8 @@ REASONS = {
         _GICOF,
     ),
     "implausible-cof": (
-        "a coefficient of friction outside 0.01 to 3 (the ECoF or GICoF in gross slip, or "
-        "Q*/P): the load given or the force's unit is wrong, not the contact",
+        "a coefficient of friction outside 0.01 to 3 (the ECoF or GICoF in gross slip): the "
+        "load given or the force's unit is wrong, not the contact",
         ("ecof", "cof_max", *_GICOF, *RESOLVED),
     ),
     "not-gross-slip": (

@@ -154,16 +154,12 @@ import xarray as xr
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._inputs import check
 from ecofmaps.measured.along_stroke import _resolve
-from ecofmaps.measured.quality import (
-    quality_summary,
-)
 
 __all__ = [
     "REPORTED",
     "check_reading_options",
     "resolve_analyzed_loops",
     "resolved_attrs",
-    "with_resolved",
 ]
 
 
@@ -342,25 +338,3 @@ def resolve_analyzed_loops(
 
 #: The per-cycle values of the reading that :func:`ecofmaps.analyze_loops` reports.
 REPORTED = ("mu_resolved", "mu_resolved_se", "aspect_ratio")
-
-
-def with_resolved(results: xr.Dataset, resolved: xr.Dataset) -> xr.Dataset:
-    """``results`` of :func:`ecofmaps.analyze_loops` with the values ``resolved`` read off them.
-
-    Parameters
-    ----------
-    results : xarray.Dataset
-        From :func:`ecofmaps.analyze_loops`.
-    resolved : xarray.Dataset
-        From :func:`resolve_analyzed_loops` of the same ``results``.
-
-    Returns
-    -------
-    results : xarray.Dataset
-        With ``mu_resolved``, ``mu_resolved_se`` and ``aspect_ratio`` added after the other
-        per-cycle values, and ``quality`` (and its summary) with the reading's reasons.
-    """
-    results = results.assign({name: resolved[name] for name in REPORTED})
-    results["quality"] = results["quality"].copy(data=resolved["quality"].values)
-    results.attrs["quality_summary"] = quality_summary(resolved["quality"].values)
-    return results

@@ -103,8 +103,9 @@ def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
 def scale_flags(values: dict, options: dict) -> dict:
     """The checks of scale of each cycle (reason -> per cycle): an amplitude outside
     :data:`AMPLITUDE_RANGE`, or a coefficient of friction outside :data:`COF_RANGE` (the
-    ECoF or the GICoF of a gross-slip loop, or :math:`Q^*/P` of any loop). A gross-slip CoF
-    of 361 or 0.001 says that the load or a unit is wrong, not the contact."""
+    ECoF or the GICoF of a gross-slip loop; not :math:`Q^*/P`, which a deep groove raises
+    above 3 with any load). A gross-slip CoF of 361 or 0.001 says that the load or a unit is
+    wrong, not the contact."""
     amplitude = values["amplitude"]
     sliding = values["energy_ratio"] > options["gross_slip_threshold"]
 
@@ -113,7 +114,6 @@ def scale_flags(values: dict, options: dict) -> dict:
 
     scaled = outside(amplitude, AMPLITUDE_RANGE)
     cof = sliding & (outside(values["ecof"], COF_RANGE) | outside(values["gicof"], COF_RANGE))
-    cof |= np.isfinite(values["cof_max"]) & (values["cof_max"] > COF_RANGE[1])
     return {"implausible-amplitude": scaled, "implausible-cof": cof & ~scaled}
 
 

@@ -126,3 +126,27 @@ def test_microslip_gives_no_friction_coefficient():
     assert not np.any(table.quality.values == "ok")
     assert np.all(np.isnan(table.mu_resolved.values))
     assert np.all(np.isnan(table.mu_resolved_se.values))
+
+
+def test_a_wavering_friction_empties_the_gicof():
+    """``gicof-varies`` (the reading along the stroke) empties the GICoF values it scopes,
+    as the quality vocabulary says, in the table as in the Dataset."""
+    import warnings
+
+    import numpy as np
+
+    import ecofmaps
+    from ecofmaps.measured.quality import REASONS, has_reason
+    from ecofmaps.measured.synthetic import ugly_recording
+
+    recording = ugly_recording("chatter", cycles=10)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        results = ecofmaps.analyze_loops(
+            recording.displacement, recording.force, recording.load, cycle=recording.cycle,
+            resolve=True,
+        )  # fmt: skip
+    flagged = has_reason(results.quality.values, "gicof-varies")
+    assert flagged.any()
+    for name in REASONS["gicof-varies"][1]:
+        assert np.isnan(results[name].values[flagged]).all(), name
