@@ -3,7 +3,7 @@ r"""The per-cycle kernels of the loop read along the stroke (:mod:`ecofmaps.meas
 On both slip branches at the same contact position :math:`\xi = \Delta - Q/S`,
 :math:`\mu(\xi) = \tan((\arctan q_+ - \arctan q_-)/2)` and
 :math:`g(\xi) = \tan((\arctan q_+ + \arctan q_-)/2)` with :math:`q_\pm = Q_\pm/P` (eq. 9 at
-the local slope). :func:`_resolve` reads them for a block of cycles at a time, vectorised
+the local slope). :func:`along_stroke_values` reads them for a block of cycles at a time, vectorised
 over the cycles: the per-cycle values over each cycle's central part
 (:func:`_central_values`), the values along the stroke on a common grid
 (:func:`_along_stroke`), and the checks of :data:`QUALITY_FLAGS`. The method and its checks
@@ -25,7 +25,7 @@ from ecofmaps.measured.quality import (
 from ecofmaps.measured.resampling import branch_noise, read_branches, sample_weights
 from ecofmaps.measured.stick_slip import masked_median, masked_sum, slip_branches
 
-__all__ = ["QUALITY_FLAGS"]
+__all__ = ["QUALITY_FLAGS", "along_stroke_values"]
 
 #: Quality flags, in the order they are tested.
 #: The reasons this reading adds to a cycle's ``quality`` (ecofmaps.measured.quality) that
@@ -213,7 +213,7 @@ def _blocks(cycles):
     return [slice(start, start + _BLOCK) for start in range(0, max(cycles, 1), _BLOCK)]
 
 
-def _resolve(x, q, valid, load, stiffness, amplitude, quality, given, options):
+def along_stroke_values(x, q, valid, load, stiffness, amplitude, quality, given, options):
     """Every resolved quantity of the centred loops ``x``, ``q`` (module notes).
 
     ``stiffness`` is the given S (``given`` True) or analyze_loops's, per cycle, and

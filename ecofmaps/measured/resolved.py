@@ -153,7 +153,7 @@ import xarray as xr
 
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._inputs import check
-from ecofmaps.measured.along_stroke import _resolve
+from ecofmaps.measured.along_stroke import along_stroke_values
 
 __all__ = [
     "REPORTED",
@@ -297,7 +297,7 @@ def resolve_analyzed_loops(
     given = options["stiffness"] is not None
     rig = np.full(x.shape[0], options["stiffness"]) if given else loops["stiffness"].values
     with np.errstate(divide="ignore", invalid="ignore"):
-        per_position, per_cycle, quality, grid = _resolve(
+        per_position, per_cycle, quality, grid = along_stroke_values(
             x,
             q,
             np.isfinite(x) & np.isfinite(q),
