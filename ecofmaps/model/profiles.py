@@ -541,8 +541,9 @@ class _Extent(NamedTuple):
 
 
 def _edges(x, r, deepest, depth, noise, reach):
-    """The groove's edges, the band's edges (None where the groove's), the ridges' crests
-    (indices or None) and the band's outer ends (positions); ValueError at a trace's end."""
+    """The groove's edges, the band's edges (the groove's where it has none beyond), the
+    ridges' crests (indices or None), the band's outer ends (positions) and the band's
+    threshold (module docstring); ValueError if the groove reaches an end of the trace."""
     tolerance = _LINE_TOLERANCE * depth
     left = _crossing(x, r, deepest, -1, tolerance, reach)
     right = _crossing(x, r, deepest + 1, +1, tolerance, reach)
