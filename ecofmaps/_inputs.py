@@ -7,13 +7,17 @@ registry, which :func:`si_units` converts to SI by the parameter's name (its dim
 ``None`` where a number is expected raises a :class:`ValueError` naming the parameter.
 Concrete inputs are checked by :func:`check`, and bad values raise a :class:`ValueError`
 that names the parameter and its valid range; traced inputs cannot be inspected, so the
-kernels turn them into NaN plus the ``INVALID`` regime code instead.
+kernels turn them into NaN plus the ``INVALID`` regime code instead. Before anything else,
+:func:`check_broadcast_size` refuses, with a ``MemoryError``, inputs whose broadcast would
+not fit in memory (JAX would abort the interpreter).
 """
 
 from __future__ import annotations
 
 import functools
 import inspect
+import math
+import os
 import sys
 
 import numpy as np
@@ -21,7 +25,16 @@ import numpy as np
 from ecofmaps._nomenclature import QUANTITIES, RANGES
 from ecofmaps.units import DIMENSIONS
 
-__all__ = ["as_float64", "check", "float64", "is_concrete", "si_units", "to_si"]
+__all__ = [
+    "as_float64",
+    "available_memory",
+    "check",
+    "check_broadcast_size",
+    "float64",
+    "is_concrete",
+    "si_units",
+    "to_si",
+]
 
 
 def _is_tracer(value) -> bool:
@@ -46,7 +59,8 @@ def to_si(name: str, value, quantity: str | None = None):
         A number, an array (NumPy, JAX, a tracer, a list), or a pint Quantity.
     quantity : str, optional
         The quantity of :data:`ecofmaps._nomenclature.QUANTITIES` whose dimension ``value``
-        must have; by default ``name``.
+        must have, or a kind of :data:`ecofmaps.units.DIMENSIONS` (``'length'``, ...); by
+        default ``name``.
 
     Returns
     -------
@@ -59,10 +73,13 @@ def to_si(name: str, value, quantity: str | None = None):
         For ``None``, a string or a boolean (or an array of them), or a Quantity whose
         dimension is not the parameter's.
     """
-    if _is_tracer(value):
+    if not is_concrete(value):  # a tracer, or a tuple (an interval) holding one
         return value
-    described = QUANTITIES.get(quantity or name)
-    kind = "dimensionless" if described is None else described.kind
+    if quantity in DIMENSIONS:
+        kind = quantity
+    else:
+        described = QUANTITIES.get(quantity or name)
+        kind = "dimensionless" if described is None else described.kind
     _, si_unit, example = DIMENSIONS[kind]
     if _is_quantity(value):
         try:
@@ -99,32 +116,104 @@ def _numeric_objects(value) -> bool:
     )
 
 
-def _converted(parameters: inspect.Signature, args, kwargs):
-    """``args`` and ``kwargs`` with every pint Quantity converted to SI by parameter name."""
+def _converted(function, parameters: inspect.Signature, args, kwargs, kinds):
+    """``args`` and ``kwargs`` with every pint Quantity converted to SI by parameter name,
+    after :func:`check_broadcast_size` of the quantities."""
     bound = parameters.bind_partial(*args, **kwargs)
     for name, value in bound.arguments.items():
+        quantity = kinds.get(name, name)
         if isinstance(value, tuple) and any(_is_quantity(item) for item in value):
-            bound.arguments[name] = tuple(to_si(name, item) for item in value)
-        elif _is_quantity(value) or (name in QUANTITIES and value is not None):
-            bound.arguments[name] = to_si(name, value)
+            bound.arguments[name] = tuple(to_si(name, item, quantity) for item in value)
+        elif _is_quantity(value) or ((name in QUANTITIES or name in kinds) and value is not None):
+            bound.arguments[name] = to_si(name, value, quantity)
+    check_broadcast_size(
+        function.__name__,
+        [v for n, v in bound.arguments.items() if n in QUANTITIES and n not in kinds],
+    )
     return bound.args, bound.kwargs
 
 
-def si_units(function):
+def si_units(function=None, **kinds):
     """Accept pint Quantities for ``function``'s parameters, converted to SI by name.
 
     A parameter named after a quantity of :mod:`ecofmaps._nomenclature` takes a Quantity
-    of that quantity's dimension; strings and booleans are refused there (see
-    :func:`to_si`). Other parameters pass through.
+    of that quantity's dimension, and so does one named in ``kinds``
+    (``@si_units(x="length")``, a kind of :data:`ecofmaps.units.DIMENSIONS`); strings and
+    booleans are refused there (see :func:`to_si`). Other parameters pass through. The
+    quantities are first checked by :func:`check_broadcast_size`.
     """
+    if function is None:
+        return functools.partial(si_units, **kinds)
     parameters = inspect.signature(function)
 
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
-        args, kwargs = _converted(parameters, args, kwargs)
+        args, kwargs = _converted(function, parameters, args, kwargs, kinds)
         return function(*args, **kwargs)
 
     return wrapper
+
+
+def available_memory() -> int | None:
+    """The memory available to a new array: Linux's ``MemAvailable``, else the physical
+    memory; ``None`` where neither is known. [B]"""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
+def check_broadcast_size(caller: str, values) -> None:
+    """Raise ``MemoryError`` before a broadcast of ``values`` that would not fit in memory.
+
+    Only shapes are read (of arrays, lists, tracers, dask or xarray arrays), so nothing is
+    allocated. A broadcast no larger than its largest input adds no point and passes, as do
+    shapes that do not broadcast (the function's own checks report them).
+
+    Parameters
+    ----------
+    caller : str
+        The public function's name, quoted in the message.
+    values : sequence
+        The inputs broadcast together; a tuple among them (an interval) counts item by item.
+
+    Raises
+    ------
+    MemoryError
+        If one float64 array of the broadcast shape is larger than :func:`available_memory`:
+        the message gives the shape, the points and the bytes, and the way out.
+    """
+    shapes = []
+    for value in values:
+        for item in value if isinstance(value, tuple) else (value,):
+            try:
+                shapes.append(tuple(np.shape(item)))
+            except (TypeError, ValueError):  # ragged or not an array: checked elsewhere
+                continue
+    try:
+        shape = np.broadcast_shapes(*shapes)
+    except ValueError:
+        return
+    points = math.prod(shape)
+    if points <= max((math.prod(s) for s in shapes), default=1):
+        return
+    memory = available_memory()
+    size = 8 * points  # one float64 result
+    if memory is None or size <= memory:
+        return
+    raise MemoryError(
+        f"ecofmaps.{caller}: the inputs broadcast to shape {shape}, {points:.3g} points: "
+        f"{size / 1e9:.3g} GB for one float64 result, more than the {memory / 1e9:.3g} GB of "
+        "memory available. Compute such a grid in chunks with "
+        "ecofmaps.compute_map(..., chunks=...), or pass fewer points at a time."
+    )
 
 
 def float64(function):
@@ -143,7 +232,7 @@ def float64(function):
 
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
-        args, kwargs = _converted(parameters, args, kwargs)
+        args, kwargs = _converted(function, parameters, args, kwargs, {})
         if not jax.config.jax_enable_x64 and not is_concrete(*args, *kwargs.values()):
             raise ValueError(
                 f"ecofmaps.{function.__name__} under jax.jit, jax.vmap or jax.grad needs JAX's "

@@ -6,6 +6,7 @@ import pint
 import pytest
 
 import ecofmaps
+from ecofmaps import _inputs
 
 UNITS = pint.UnitRegistry()
 Q_ = UNITS.Quantity
@@ -107,3 +108,70 @@ def test_plain_arrays_still_jit_and_vmap():
     batched = jax.vmap(ecofmaps.energy_cof, in_axes=(0, None, None, None, None))
     values = batched(np.array([25e-6, 50e-6]), 450.0, 35e6, 0.8, 0.2)
     assert values.shape == (2,) and values.dtype == np.float64
+
+
+def test_scar_profiles_keep_units():
+    """Issue 23: a trace in mm and µm is the trace in metres, not 1000 times larger."""
+    x = np.linspace(-100e-6, 100e-6, 401)
+    z = np.where(np.abs(x) < 50e-6, 10e-6 * ((x / 50e-6) ** 2 - 1), 0.0)
+    si = ecofmaps.scar_profile(x, z, smoothing=0)
+    measured = ecofmaps.scar_profile(Q_(x * 1e3, "mm"), Q_(z * 1e6, "um"), smoothing=0)
+    assert float(measured.half_width) == pytest.approx(50e-6, rel=1e-9)
+    assert float(measured.depth) == pytest.approx(10e-6, rel=1e-9)
+    for got, expected in zip(measured, si, strict=True):
+        np.testing.assert_allclose(np.asarray(got), np.asarray(expected), rtol=1e-12, atol=0)
+    wider = ecofmaps.scar_profile(x, z, half_width=Q_(45, "um"), smoothing=Q_(0, "m"))
+    assert float(wider.half_width) == pytest.approx(45e-6, rel=1e-12)
+    with pytest.raises(ValueError, match=r"z must be a length \[m\]"):
+        ecofmaps.scar_profile(x, Q_(z, "N"))
+    with pytest.raises(ValueError, match=r"x must be a real number"):
+        ecofmaps.scar_profile(["a"] * 401, z)
+
+
+@pytest.mark.parametrize(
+    ("function", "lengths"),
+    [
+        (ecofmaps.parabolic_profile, ("depth", "half_width")),
+        (ecofmaps.flat_bottomed_profile, ("depth", "half_width")),
+        (ecofmaps.w_shaped_profile, ("depth", "half_width")),
+        (ecofmaps.ridged_profile, ("depth", "half_width", "ridge_height", "ridge_width")),
+    ],
+)
+def test_profile_families_keep_units(function, lengths):
+    si = dict(zip(lengths, (10e-6, 50e-6, 2e-6, 10e-6), strict=False))
+    in_units = dict(zip(lengths, (Q_(10, "um"), Q_(0.05, "mm"), Q_(2, "um"), Q_(1e-2, "mm")),
+                        strict=False))  # fmt: skip
+    for got, expected in zip(function(**in_units, extent=3.0), function(**si, extent=3.0),
+                             strict=True):  # fmt: skip
+        np.testing.assert_allclose(np.asarray(got), np.asarray(expected), rtol=1e-12)
+    with pytest.raises(ValueError, match=rf"{lengths[-1]} must be a length \[m\]"):
+        function(**{**si, lengths[-1]: Q_(1.0, "N")})
+
+
+def test_a_broadcast_too_large_for_memory_is_refused_before_it_is_made():
+    """Issue 22: (1e5, 1) x (1, 1e5) is 1e10 points, 80 GB; JAX aborted the interpreter."""
+    column, row = np.full((100_000, 1), 50e-6), np.full((1, 100_000), 450.0)
+    assert np.broadcast_shapes(column.shape, row.shape) == (100_000, 100_000)
+    memory = _inputs.available_memory()
+    if memory is not None and memory > 8e10:
+        pytest.skip("this machine has 80 GB free")
+    message = r"energy_cof: .*\(100000, 100000\), 1e\+10 points: 80 GB .* chunks=\.\.\."
+    with pytest.raises(MemoryError, match=message):
+        ecofmaps.energy_cof(column, row, 35e6, 0.8, 0.2)
+    with pytest.raises(MemoryError, match=r"correct_ecof: .*1e\+10 points"):
+        ecofmaps.correct_ecof(0.8, column, row, 35e6, 0.2)
+    with pytest.raises(MemoryError, match=r"slip_amplitude: .*1e\+10 points"):
+        jax.jit(ecofmaps.slip_amplitude)(column, row, 35e6, 0.8, 0.2)  # shapes of tracers
+
+
+def test_the_memory_check_counts_only_new_points(monkeypatch):
+    monkeypatch.setattr(_inputs, "available_memory", lambda: 8 * 1000)
+    with pytest.raises(MemoryError, match=r"\(50, 50\), 2\.5e\+03 points: 2e-05 GB"):
+        ecofmaps.energy_cof(np.full((50, 1), 50e-6), np.full((1, 50), 450.0), 35e6, 0.8, 0.2)
+    # 2000 points of aligned inputs add none: the arrays exist already.
+    values = ecofmaps.energy_cof(np.full(2000, 50e-6), np.full(2000, 450.0), 35e6, 0.8, 0.2)
+    assert values.shape == (2000,)
+    monkeypatch.setattr(_inputs, "available_memory", lambda: None)  # unknown: no check
+    assert ecofmaps.energy_cof(
+        np.full((50, 1), 50e-6), 450.0, 35e6, np.full(50, 0.8), 0.2
+    ).shape == (50, 50)

@@ -53,19 +53,20 @@ import numpy as np
 from ecofmaps import model
 from ecofmaps._codes import warn_nan
 from ecofmaps._inputs import as_float64, check, float64, is_concrete
+from ecofmaps.correction.on_profile import correct_on_profile
 from ecofmaps.correction.outcomes import (
     CorrectionStatus,
     Interval,
-    _ecof_and_slope,
-    _fall_if_needed,
-    _mark_ambiguous,
-    _may_fall,
-    _status,
+    ambiguity_marked,
+    ecof_and_slope,
     ecof_fall,
+    ecof_fall_where_needed,
+    may_fall,
+    reachability_status,
 )
 from ecofmaps.model.steady_state import valid_geometry
 
-__all__ = ["contact_cof", "correct_ecof", "correction_factor"]
+__all__ = ["contact_cof", "correct_ecof", "correction_factor", "groove_aspect_ratio"]
 
 
 # ---------------------------------------------------------------------------------------
@@ -76,6 +77,7 @@ _EPS = float(np.finfo(np.float64).eps)
 _MAX_STEPS = 300  # the bracket [0, mu_E] halves at least every two steps
 
 
+@jax.custom_jvp
 def _root(ecof, kappa, lam):
     """The :math:`\\mu` with :math:`\\mu_E(\\mu) =` ``ecof`` by bracketed Newton (see module).
 
@@ -98,7 +100,7 @@ def _root(ecof, kappa, lam):
 
     def newton(state):
         mu, low, high, previous, done, step = state
-        value, slope = _ecof_and_slope(mu, kappa, lam)
+        value, slope = ecof_and_slope(mu, kappa, lam)
         residual = value - ecof
         above = ~(residual <= 0.0)  # NaN: beyond the gross-slip (or locking) limit
         low = jnp.where(above, low, mu)
@@ -118,10 +120,28 @@ def _root(ecof, kappa, lam):
     return mu
 
 
+@_root.defjvp
+def _root_tangent(primals, tangents):
+    """The root's derivative by the implicit function theorem, not through the iterations.
+
+    :math:`\\mu_E(\\mu, \\kappa, \\lambda) = \\mu_E^{given}` at the root, so
+    :math:`d\\mu = (d\\mu_E^{given} - \\partial_\\kappa\\mu_E\\,d\\kappa -
+    \\partial_\\lambda\\mu_E\\,d\\lambda) / \\partial_\\mu\\mu_E`: linear in the tangents,
+    so ``jax.grad`` (reverse mode) transposes it, and the ``while_loop`` is never
+    differentiated.
+    """
+    ecof, kappa, lam = primals
+    d_ecof, d_kappa, d_lam = tangents
+    mu = _root(ecof, kappa, lam)
+    _, slope = ecof_and_slope(mu, kappa, lam)
+    _, moved = jax.jvp(lambda k, m: mu * model.ecof_ratio(mu, k, m), (kappa, lam), (d_kappa, d_lam))
+    return mu, (d_ecof - moved) / slope
+
+
 def _root_and_status(ecof, kappa, lam):
     """The root and status without the ambiguity check, NaN wherever it is not corrected."""
     ecof, kappa, lam = jnp.broadcast_arrays(ecof, kappa, lam)
-    status = _status(ecof, kappa, lam)
+    status = reachability_status(ecof, kappa, lam)
     corrected = status == int(CorrectionStatus.CORRECTED)
     mu = _root(
         jnp.where(corrected, ecof, 0.5),
@@ -168,7 +188,7 @@ def contact_cof(ecof, kappa, lam):
     """
     ecof, kappa, lam = jnp.broadcast_arrays(*(as_float64(v) for v in (ecof, kappa, lam)))
     mu, status = _root_and_status(ecof, kappa, lam)
-    return _mark_ambiguous(mu, status, ecof, *_fall_if_needed(status, kappa, lam))
+    return ambiguity_marked(mu, status, ecof, *ecof_fall_where_needed(status, kappa, lam))
 
 
 # ---------------------------------------------------------------------------------------
@@ -201,11 +221,11 @@ def _si_correct(ecof, amplitude, load, stiffness, aspect_ratio):
     """μ, status and the fall (high, low) at concrete or traced SI inputs."""
     mu, status, kappa, lam = _si_root(ecof, amplitude, load, stiffness, aspect_ratio)
     if not is_concrete(mu):
-        high, low = _fall_if_needed(status, kappa, lam)
+        high, low = ecof_fall_where_needed(status, kappa, lam)
     else:
         # Only the few points where mu_E(mu) may fall are scanned, in one padded batch.
         where = np.flatnonzero(
-            np.asarray(_may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
+            np.asarray(may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
         )
         high = np.full(mu.size, np.nan)
         low = np.full(mu.size, np.nan)
@@ -216,12 +236,30 @@ def _si_correct(ecof, amplitude, load, stiffness, aspect_ratio):
             high[where], low[where] = (np.asarray(v)[: where.size] for v in fall)
         high, low = high.reshape(mu.shape), low.reshape(mu.shape)
     ecof = jnp.broadcast_to(ecof, mu.shape)
-    mu, status = _mark_ambiguous(mu, status, ecof, jnp.asarray(high), jnp.asarray(low))
+    mu, status = ambiguity_marked(mu, status, ecof, jnp.asarray(high), jnp.asarray(low))
     return mu, status, (kappa, lam, high, low)
 
 
-def _aspect_ratio(aspect_ratio, scar_depth, scar_half_width):
-    """The aspect ratio (or a ``(low, high)`` tuple of them) from either way of giving it."""
+def groove_aspect_ratio(aspect_ratio, scar_depth, scar_half_width):
+    """The groove's aspect ratio from either way of giving it, checked.
+
+    Parameters
+    ----------
+    aspect_ratio : array_like or tuple (low, high) or None
+        :math:`z_o/x_o = D/W` (eq. 11), or an interval of it. [1]
+    scar_depth, scar_half_width : array_like or None
+        :math:`D` and :math:`W`, instead of ``aspect_ratio``. [m]
+
+    Returns
+    -------
+    aspect_ratio : jax.Array or tuple (low, high) of them
+        :math:`z_o/x_o` in float64 (call inside :func:`ecofmaps._inputs.float64`). [1]
+
+    Raises
+    ------
+    ValueError
+        For the ratio given neither or both ways, a bad interval, or a value out of range.
+    """
     if aspect_ratio is not None:
         if scar_depth is not None or scar_half_width is not None:
             raise ValueError(
@@ -273,7 +311,6 @@ def _failure_message(status, ecof, details) -> str:
     )
 
 
-@float64
 def _correct(ecof, amplitude, load, stiffness, aspect_ratio, scar_depth, scar_half_width,
              return_status, factor, caller, profile=None, mapping="scaled"):  # fmt: skip
     if profile is not None:
@@ -282,8 +319,6 @@ def _correct(ecof, amplitude, load, stiffness, aspect_ratio, scar_depth, scar_ha
                 "give the groove one way: aspect_ratio, scar_depth and scar_half_width, or "
                 "profile, not several"
             )
-        from ecofmaps.correction.on_profile import correct_on_profile  # built on this module
-
         return correct_on_profile(ecof, amplitude, load, stiffness, profile, mapping,
                                   return_status, factor, caller)  # fmt: skip
     if mapping != "scaled":
@@ -292,7 +327,7 @@ def _correct(ecof, amplitude, load, stiffness, aspect_ratio, scar_depth, scar_ha
     check("amplitude", amplitude, "positive", "m")
     check("load", load, "positive", "N")
     check("stiffness", stiffness, "positive_or_inf", "N/m")
-    ratio = _aspect_ratio(aspect_ratio, scar_depth, scar_half_width)
+    ratio = groove_aspect_ratio(aspect_ratio, scar_depth, scar_half_width)
     ecof, amplitude, load, stiffness = (as_float64(v) for v in (ecof, amplitude, load, stiffness))
     ends = ratio if isinstance(ratio, tuple) else (ratio,)
     results = [_si_correct(ecof, amplitude, load, stiffness, end) for end in ends]
@@ -305,7 +340,7 @@ def _correct(ecof, amplitude, load, stiffness, aspect_ratio, scar_depth, scar_ha
         values = Interval(*(jnp.where(both, v, jnp.nan) for v in (values[1], values[0])))
     else:
         values = values[0]
-    concrete = is_concrete(status)
+    concrete = is_concrete(status, values)  # under jax.grad the values alone are traced
     if concrete and not return_status:
         codes = np.asarray(status)
         if codes.ndim == 0 and codes != CorrectionStatus.CORRECTED:
@@ -366,6 +401,7 @@ _RAISES = """
 """
 
 
+@float64
 def correct_ecof(ecof, amplitude, load, stiffness, aspect_ratio=None, scar_depth=None,
                  scar_half_width=None, *, profile=None, mapping="scaled",
                  return_status=False):  # fmt: skip
@@ -399,6 +435,13 @@ correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy
     inversion is unique, and why the interval is exact). :math:`\\mu \\le \\mu_E`, with
     equality for a flat scar.
 
+    ``jax.grad`` (and ``jax.jvp``, ``jax.jit``, ``jax.vmap``) works with the aspect ratio
+    given as a number or by the scar's dimensions, not with a profile: the derivative is the
+    implicit function theorem's on :math:`\\mu_E(\\mu) = \\mu_E^{{given}}`, e.g.
+    :math:`d\\mu/d\\mu_E = 1/(d\\mu_E/d\\mu)`, exact at the root returned (the iterations
+    are not differentiated). A point that cannot be corrected is NaN, a constant, whose
+    derivative is 0: check the status (``return_status=True``).
+
     On a profile :math:`\\mu_E(\\mu)` is scanned on a grid of 400 contact CoFs, log-spaced
     from a fiftieth of the smallest ECoF to the largest (:math:`\\mu \\le \\mu_E` on every
     profile), to bracket the root and to find several (``AMBIGUOUS``); then the bracket is
@@ -422,6 +465,7 @@ correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy
 """
 
 
+@float64
 def correction_factor(ecof, amplitude, load, stiffness, aspect_ratio=None, scar_depth=None,
                       scar_half_width=None, *, profile=None, mapping="scaled",
                       return_status=False):  # fmt: skip

@@ -14,7 +14,7 @@ import numpy as np
 
 from ecofmaps._codes import warn_nan
 from ecofmaps._inputs import check, si_units
-from ecofmaps.correction.inversion import _aspect_ratio
+from ecofmaps.correction.inversion import groove_aspect_ratio
 from ecofmaps.correction.outcomes import CorrectionStatus
 
 __all__ = ["lookup_correction"]
@@ -122,7 +122,7 @@ def lookup_correction(map_dataset, ecof, amplitude, load, stiffness, aspect_rati
         ("stiffness", stiffness, "positive_or_inf", "N/m"),
     ):
         check(name, value, rule, unit)
-    ratio = np.asarray(_aspect_ratio(aspect_ratio, scar_depth, scar_half_width))
+    ratio = np.asarray(groove_aspect_ratio(aspect_ratio, scar_depth, scar_half_width))
     ecof, amplitude, load, stiffness, ratio = np.broadcast_arrays(
         *(np.asarray(v, dtype=np.float64) for v in (ecof, amplitude, load, stiffness)), ratio
     )

@@ -14,12 +14,13 @@ import numpy as np
 
 from ecofmaps._codes import warn_nan
 from ecofmaps._inputs import check, is_concrete
-from ecofmaps.correction.inversion import _EPS
 from ecofmaps.correction.outcomes import CorrectionStatus
+from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers
 
 __all__ = ["correct_on_profile"]
 
 
+_EPS = float(np.finfo(np.float64).eps)
 _PROFILE_GRID = 400  # contact CoFs scanned per point
 _PROFILE_SPAN = 0.02  # the grid runs from this fraction of the smallest ECoF ...
 _PROFILE_STEPS = 200  # at most this many Illinois steps (each at least halves every two)
@@ -27,8 +28,6 @@ _PROFILE_STEPS = 200  # at most this many Illinois steps (each at least halves e
 
 def _ecof_on_profile(profile, mu, amplitude, load, stiffness, mapping):
     """mu_E at concrete points (NaN outside gross slip), as a NumPy array."""
-    from ecofmaps.model.on_profile import steady_numbers
-
     numbers = steady_numbers(profile, amplitude, load, stiffness, mu, mapping=mapping)
     return np.asarray(numbers["ecof_ratio"]) * np.asarray(mu)
 
@@ -41,8 +40,6 @@ def correct_on_profile(ecof, amplitude, load, stiffness, profile, mapping, retur
     trace, counts as above); a point whose narrowed bracket still misses the ECoF by more
     than 1e-9 of it lies at a jump of mu_E(mu) (``UNREACHABLE``).
     """
-    from ecofmaps.model.on_profile import as_profile, check_mapping
-
     check_mapping(mapping, None)
     profile = as_profile(profile)
     for name, value, rule, unit in (

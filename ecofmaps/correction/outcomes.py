@@ -20,7 +20,18 @@ from ecofmaps import model
 from ecofmaps._codes import Code
 from ecofmaps._inputs import as_float64
 
-__all__ = ["AMBIGUOUS_ECOF_MIN", "LAMBDA_INFINITY", "CorrectionStatus", "Interval", "ecof_fall"]
+__all__ = [
+    "AMBIGUOUS_ECOF_MIN",
+    "LAMBDA_INFINITY",
+    "CorrectionStatus",
+    "Interval",
+    "ambiguity_marked",
+    "ecof_and_slope",
+    "ecof_fall",
+    "ecof_fall_where_needed",
+    "may_fall",
+    "reachability_status",
+]
 
 #: :math:`\lambda_\infty`: :math:`\mu_E(\mu)` falls over part of its range only where
 #: :math:`\lambda = P/(S\Delta^*)` is below this (its :math:`\kappa \to \infty` limit; the tests
@@ -99,13 +110,43 @@ _FALL_GRID = 256
 _FALL_BISECTIONS = 48
 
 
-def _ecof_and_slope(mu, kappa, lam):
-    """:math:`\\mu_E` and :math:`d\\mu_E/d\\mu` at each point (forward mode, elementwise)."""
+def ecof_and_slope(mu, kappa, lam):
+    """:math:`\\mu_E` and :math:`d\\mu_E/d\\mu` at each point (forward mode, elementwise).
+
+    Parameters
+    ----------
+    mu : array_like
+        Contact coefficient of friction :math:`\\mu`. [1]
+    kappa : array_like
+        Curvature number :math:`\\kappa = 2 z_o/x_o`. [1]
+    lam : array_like
+        Compliance ratio :math:`\\lambda = P/(S\\Delta^*)`. [1]
+
+    Returns
+    -------
+    ecof : jax.Array
+        Energy coefficient of friction :math:`\\mu_E = \\mu\\,(\\mu_E/\\mu)` (eq. 13-16). [1]
+    slope : jax.Array
+        Its derivative :math:`d\\mu_E/d\\mu` at fixed :math:`\\kappa, \\lambda`. [1]
+    """
     return jax.jvp(lambda m: m * model.ecof_ratio(m, kappa, lam), (mu,), (jnp.ones_like(mu),))
 
 
-def _status(ecof, kappa, lam):
-    """``CORRECTED``, ``NO_GROSS_SLIP`` (:math:`\\mu_E \\ge 1/\\lambda`) or ``INVALID``."""
+def reachability_status(ecof, kappa, lam):
+    """The status before the ambiguity check: which ECoFs the model can reach.
+
+    Parameters
+    ----------
+    ecof : array_like
+        Energy coefficient of friction :math:`\\mu_E`. [1]
+    kappa, lam : array_like
+        :math:`\\kappa` and :math:`\\lambda`, as for :func:`ecof_and_slope`. [1]
+
+    Returns
+    -------
+    status : jax.Array of int32
+        ``CORRECTED``, ``NO_GROSS_SLIP`` (:math:`\\mu_E \\ge 1/\\lambda`) or ``INVALID``.
+    """
     valid = (
         (ecof > 0.0)
         & jnp.isfinite(ecof)
@@ -123,9 +164,20 @@ def _status(ecof, kappa, lam):
     return code.astype(jnp.int32)
 
 
-def _may_fall(kappa, lam):
-    """Where :math:`\\mu_E(\\mu)` may fall over part of its range (see
-    :mod:`ecofmaps.correction.inversion`)."""
+def may_fall(kappa, lam):
+    """Where :math:`\\mu_E(\\mu)` may fall over part of its range.
+
+    Parameters
+    ----------
+    kappa, lam : array_like
+        :math:`\\kappa` and :math:`\\lambda`, as for :func:`ecof_and_slope`. [1]
+
+    Returns
+    -------
+    may_fall : jax.Array of bool
+        False where :math:`\\mu_E(\\mu)` surely rises over its whole gross-slip range (the
+        bounds in :mod:`ecofmaps.correction.inversion`).
+    """
     return (kappa > _FALL_KAPPA) & (lam > 0.0) & (lam < _FALL_LAMBDA)
 
 
@@ -166,14 +218,14 @@ def ecof_fall(kappa, lam):
     behaviour: eq. 13-15, 16.
     """
     kappa, lam = jnp.broadcast_arrays(as_float64(kappa), as_float64(lam))
-    may_fall = _may_fall(kappa, lam)
-    kappa = jnp.where(may_fall, kappa, 2.0)[..., None]  # harmless values elsewhere
-    lam = jnp.where(may_fall, lam, 0.01)[..., None]
+    falls = may_fall(kappa, lam)
+    kappa = jnp.where(falls, kappa, 2.0)[..., None]  # harmless values elsewhere
+    lam = jnp.where(falls, lam, 0.01)[..., None]
     fraction = jnp.linspace(0.0, 1.0, _FALL_GRID)
     log_mu = -jnp.log(kappa) * (1.0 - fraction)  # from 1/kappa to 1
-    _, slope = _ecof_and_slope(jnp.exp(log_mu), kappa, lam)
+    _, slope = ecof_and_slope(jnp.exp(log_mu), kappa, lam)
     falling = slope <= 0.0
-    found = may_fall & jnp.any(falling, axis=-1)
+    found = falls & jnp.any(falling, axis=-1)
     first = jnp.clip(jnp.argmax(falling, axis=-1), 1, _FALL_GRID - 2)
     last = jnp.clip(_FALL_GRID - 1 - jnp.argmax(falling[..., ::-1], axis=-1), 1, _FALL_GRID - 2)
 
@@ -187,27 +239,61 @@ def ecof_fall(kappa, lam):
     def halve(_, bracket):
         rise, fall = bracket
         middle = 0.5 * (rise + fall)
-        _, slope = _ecof_and_slope(jnp.exp(middle), kappa, lam)
+        _, slope = ecof_and_slope(jnp.exp(middle), kappa, lam)
         up = slope > 0.0
         return jnp.where(up, middle, rise), jnp.where(up, fall, middle)
 
     rise, fall = jax.lax.fori_loop(0, _FALL_BISECTIONS, halve, (rise, fall))
     extremum = jnp.exp(0.5 * (rise + fall))
-    value, _ = _ecof_and_slope(extremum, kappa, lam)
+    value, _ = ecof_and_slope(extremum, kappa, lam)
     high = jnp.where(found, value[..., 0], jnp.nan)
     low = jnp.where(found, value[..., 1], jnp.nan)
     return high, low
 
 
-def _mark_ambiguous(mu, status, ecof, high, low):
-    """NaN and ``AMBIGUOUS`` where ``ecof`` lies in the fall ``[low, high]``."""
+def ambiguity_marked(mu, status, ecof, high, low):
+    """The contact CoF and status, NaN and ``AMBIGUOUS`` where ``ecof`` lies in the fall.
+
+    Parameters
+    ----------
+    mu : array_like
+        Contact CoF of the inversion. [1]
+    status : array_like of int
+        :class:`CorrectionStatus` codes.
+    ecof : array_like
+        The energy CoF inverted. [1]
+    high, low : array_like
+        The fall of :math:`\\mu_E(\\mu)` from :func:`ecof_fall` (NaN where it rises). [1]
+
+    Returns
+    -------
+    mu : jax.Array
+        ``mu``, NaN where ``low <= ecof <= high`` at a corrected point. [1]
+    status : jax.Array of int32
+        ``status``, ``AMBIGUOUS`` there.
+    """
     ambiguous = (status == int(CorrectionStatus.CORRECTED)) & (ecof >= low) & (ecof <= high)
     status = jnp.where(ambiguous, int(CorrectionStatus.AMBIGUOUS), status).astype(jnp.int32)
     return jnp.where(ambiguous, jnp.nan, mu), status
 
 
-def _fall_if_needed(status, kappa, lam):
-    """:func:`ecof_fall` at every point, scanned only if a corrected point may fall."""
-    needed = jnp.any(_may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
+def ecof_fall_where_needed(status, kappa, lam):
+    """:func:`ecof_fall` at every point, scanned only if a corrected point may fall.
+
+    Parameters
+    ----------
+    status : array_like of int
+        :class:`CorrectionStatus` codes (from :func:`reachability_status`).
+    kappa, lam : array_like
+        :math:`\\kappa` and :math:`\\lambda`, as for :func:`ecof_and_slope`. [1]
+
+    Returns
+    -------
+    high, low : jax.Array
+        As for :func:`ecof_fall`; NaN everywhere when no corrected point may fall. They
+        only decide which points are ambiguous, so no derivative flows through them. [1]
+    """
+    kappa, lam = jax.lax.stop_gradient(kappa), jax.lax.stop_gradient(lam)
+    needed = jnp.any(may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
     nan = jnp.full(status.shape, jnp.nan)
     return jax.lax.cond(needed, lambda: ecof_fall(kappa, lam), lambda: (nan, nan))

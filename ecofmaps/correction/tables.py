@@ -1,7 +1,11 @@
 """Tables of reported ECoF values, corrected row by row to the contact CoF.
 
-The table ``ecofmaps correct TABLE.csv`` reads: comma-separated, a header line naming the
-columns, one test per line. Columns (in any order, names exact, others kept as they are):
+The table ``ecofmaps correct TABLE.csv`` reads: a header line naming the columns, one test
+per line, the cells separated by commas, semicolons or tabs (whichever the header line holds:
+a tab, else a semicolon, else a comma). With semicolons or tabs a number may have a decimal
+comma (``0,83``), as spreadsheets write it in much of Europe. Lines whose first character
+other than spaces is ``#`` are comments, skipped like blank lines. Columns (in any order,
+names exact, others kept as they are):
 
 =====================  ==================================================  =======
 ``ecof``               reported energy coefficient of friction μ_E          [1]
@@ -21,8 +25,9 @@ where it cannot correct the row), beside ``mu`` on the profile.
 
 Each row gives its aspect ratio one way: ``aspect_ratio``, or ``scar_depth_um`` and
 ``scar_half_width_um`` (a table may hold both kinds of rows, with the other cells empty).
-Blank lines are skipped. The output keeps every input column and cell as written and adds
-``mu`` and ``correction_factor`` (μ/μ_E); every corrected row is a gross-slip test (a row
+The output is written with the input's separator (and decimal commas if the input has any);
+it keeps every input column and cell as written, without the comment lines, and adds ``mu``
+and ``correction_factor`` (μ/μ_E); every corrected row is a gross-slip test (a row
 whose ECoF no gross-slip loop gives stops the run). A bad row raises :class:`TableError`,
 naming the file and the 1-based line number in the file (the header is line 1).
 """
@@ -32,6 +37,7 @@ from __future__ import annotations
 import csv
 import io
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -40,7 +46,15 @@ from ecofmaps.correction.inversion import correct_ecof
 from ecofmaps.correction.outcomes import CorrectionStatus
 from ecofmaps.io.files import FileLineError
 
-__all__ = ["ADDED_COLUMNS", "COLUMNS", "SHORTCUT_COLUMN", "TableError", "correct_table"]
+__all__ = [
+    "ADDED_COLUMNS",
+    "COLUMNS",
+    "SHORTCUT_COLUMN",
+    "TableDialect",
+    "TableError",
+    "correct_table",
+    "table_dialect",
+]
 
 #: Input columns: column name -> quantity name (its unit and range in the nomenclature).
 COLUMNS = {
@@ -68,10 +82,37 @@ class TableError(FileLineError):
     """A bad table: the message names the file and the 1-based line number (header: 1)."""
 
 
-def _number(path, line: int, name: str, text: str) -> float:
-    """The cell ``text`` of column ``name`` in SI, range-checked."""
+class TableDialect(NamedTuple):
+    """How a table is written: its separator, and whether its numbers use decimal commas."""
+
+    delimiter: str
+    decimal_comma: bool
+
+
+def table_dialect(header_line: str) -> TableDialect:
+    """The separator the header line uses (tab, else ``;``, else ``,``).
+
+    Parameters
+    ----------
+    header_line : str
+        The table's first line that is neither blank nor a comment.
+
+    Returns
+    -------
+    dialect : TableDialect
+        The separator; ``decimal_comma`` False (it is known after the numbers are read).
+    """
+    delimiter = "\t" if "\t" in header_line else ";" if ";" in header_line else ","
+    return TableDialect(delimiter, False)
+
+
+def _number(path, line: int, name: str, text: str, decimal_comma: bool = False) -> float:
+    """The cell ``text`` of column ``name`` in SI, range-checked (``0,83`` read as 0.83 when
+    the table's separator is not a comma)."""
     quantity = nomenclature.QUANTITIES[COLUMNS[name]]
     unit = f" in {quantity.display_unit}" if quantity.display_unit else ""
+    if decimal_comma and text.count(",") == 1 and "." not in text:
+        text = text.replace(",", ".")
     try:
         value = float(text)
     except ValueError:
@@ -85,13 +126,16 @@ def _number(path, line: int, name: str, text: str) -> float:
 
 
 def _read(path: Path, on_profile: bool = False):
-    """Header, rows (cells as written), their line numbers and the SI columns.
+    """Header, rows (cells as written), their line numbers, the SI columns and the dialect.
 
     On a profile the rows give no aspect ratio (the SI columns have none).
     """
     try:
         with open(path, encoding="utf-8-sig", newline="") as stream:
-            records = list(_records(csv.reader(stream)))
+            lines = ["\n" if _is_comment(line) else line for line in stream]
+        header_line = next((line for line in lines if line.strip()), ",")
+        dialect = table_dialect(header_line)
+        records = list(_records(csv.reader(lines, delimiter=dialect.delimiter)))
     except UnicodeDecodeError as error:
         raise TableError(path, 1, f"not a UTF-8 text file ({error.reason})") from None
     except csv.Error as error:
@@ -105,13 +149,15 @@ def _read(path: Path, on_profile: bool = False):
         raise TableError(path, header_line, "the table has a header but no data rows")
     column = {name: header.index(name) for name in COLUMNS if name in header}
     values = {name: [] for name in (*_REQUIRED, "aspect_ratio")}
+    commas = dialect.delimiter != ","
     for row, line in records:
         if len(row) != len(header):
             raise TableError(
                 path, line, f"{len(row)} fields, but the header has {len(header)} columns"
-            )
+                + _separator_hint(header)
+            )  # fmt: skip
         for name in _REQUIRED:
-            values[name].append(_number(path, line, name, row[column[name]]))
+            values[name].append(_number(path, line, name, row[column[name]], commas))
         if on_profile:
             continue
         given_ratio = "aspect_ratio" in column and row[column["aspect_ratio"]].strip() != ""
@@ -124,14 +170,28 @@ def _read(path: Path, on_profile: bool = False):
                 "scar_half_width_um",
             )
         ratio = (
-            _number(path, line, "aspect_ratio", row[column["aspect_ratio"]])
+            _number(path, line, "aspect_ratio", row[column["aspect_ratio"]], commas)
             if given_ratio
-            else _number(path, line, "scar_depth_um", row[column["scar_depth_um"]])
-            / _number(path, line, "scar_half_width_um", row[column["scar_half_width_um"]])
+            else _number(path, line, "scar_depth_um", row[column["scar_depth_um"]], commas)
+            / _number(path, line, "scar_half_width_um", row[column["scar_half_width_um"]], commas)
         )
         values["aspect_ratio"].append(ratio)
     si = {name: np.asarray(values[name]) for name in values if values[name]}
-    return header, records, si
+    numbers = [row[column[name]] for row, _ in records for name in column]
+    decimal_comma = commas and any("," in cell for cell in numbers)
+    return header, records, si, dialect._replace(decimal_comma=decimal_comma)
+
+
+def _is_comment(line: str) -> bool:
+    """True for a comment line: ``#`` its first character other than spaces."""
+    return line.lstrip().startswith("#")
+
+
+def _separator_hint(header: list[str]) -> str:
+    """A hint when a one-column header suggests the wrong separator was guessed."""
+    if len(header) > 1:
+        return ""
+    return " (the header holds no tab, ';' or ',': separate the columns with one of them)"
 
 
 def _records(reader):
@@ -176,7 +236,7 @@ def correct_table(path, profile=None, mapping="scaled") -> tuple[str, int]:
     Parameters
     ----------
     path : str or os.PathLike
-        The CSV table.
+        The table: separated by commas, semicolons or tabs, with ``#`` comment lines.
     profile : ScarProfile, optional
         A measured wear-scar profile that gives every row's scar (the table then has no
         scar columns).
@@ -186,9 +246,9 @@ def correct_table(path, profile=None, mapping="scaled") -> tuple[str, int]:
     Returns
     -------
     text : str
-        The output table as CSV text: the input columns and cells, then ``mu`` and
-        ``correction_factor`` (both to 10 significant digits), and on a profile
-        ``mu_parabolic``.
+        The output table with the input's separator: the input columns and cells, then
+        ``mu`` and ``correction_factor`` (both to 10 significant digits, with a decimal
+        comma if the input has them), and on a profile ``mu_parabolic``.
     rows : int
         The number of data rows.
 
@@ -202,7 +262,7 @@ def correct_table(path, profile=None, mapping="scaled") -> tuple[str, int]:
         If the file cannot be opened.
     """
     path = Path(path)
-    header, records, si = _read(path, on_profile=profile is not None)
+    header, records, si, dialect = _read(path, on_profile=profile is not None)
     rig = dict(amplitude=si["amplitude_um"], load=si["load_N"], stiffness=si["stiffness_MN_per_m"])
     if profile is None:
         scar = {"aspect_ratio": si["aspect_ratio"]}
@@ -212,7 +272,7 @@ def correct_table(path, profile=None, mapping="scaled") -> tuple[str, int]:
         shortcut, _ = correct_ecof(
             si["ecof"], **rig, aspect_ratio=float(profile.aspect_ratio), return_status=True
         )
-        added = [[f"{value:.10g}"] for value in np.asarray(shortcut)]
+        added = [[_written(value, dialect)] for value in np.asarray(shortcut)]
     mu, status = correct_ecof(si["ecof"], **rig, **scar, return_status=True)
     mu, status = np.asarray(mu), np.asarray(status)
     failed = np.flatnonzero(status != CorrectionStatus.CORRECTED)
@@ -224,8 +284,14 @@ def correct_table(path, profile=None, mapping="scaled") -> tuple[str, int]:
         except ValueError as error:
             raise TableError(path, records[i][1], str(error)) from None
     stream = io.StringIO()
-    writer = csv.writer(stream, lineterminator="\n")
+    writer = csv.writer(stream, delimiter=dialect.delimiter, lineterminator="\n")
     writer.writerow([*header, *ADDED_COLUMNS, *([] if profile is None else [SHORTCUT_COLUMN])])
     for (row, _), value, ecof, more in zip(records, mu, si["ecof"], added, strict=True):
-        writer.writerow([*row, f"{value:.10g}", f"{value / ecof:.10g}", *more])
+        writer.writerow([*row, _written(value, dialect), _written(value / ecof, dialect), *more])
     return stream.getvalue(), len(records)
+
+
+def _written(value: float, dialect: TableDialect) -> str:
+    """A result cell: 10 significant digits, with a decimal comma if the table uses them."""
+    text = f"{value:.10g}"
+    return text.replace(".", ",") if dialect.decimal_comma else text

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ecofmaps._inputs import si_units
 from ecofmaps.model.profiles import MIN_SCAR_SAMPLES, ScarProfile, _profile
 
 __all__ = ["flat_bottomed_profile", "parabolic_profile", "ridged_profile", "w_shaped_profile"]
@@ -74,6 +75,7 @@ def _extent(extent, needed=1.0) -> float:
     return extent
 
 
+@si_units(depth="length", half_width="length")
 def parabolic_profile(depth, half_width, *, tilt=0.0, samples=2001, extent=2.0) -> ScarProfile:
     r"""A parabolic scar, the paper's groove: :math:`z = -D(1 - (X/W)^2)` for :math:`|X| \le W`.
 
@@ -120,6 +122,7 @@ def parabolic_profile(depth, half_width, *, tilt=0.0, samples=2001, extent=2.0) 
     return _family(x, z, g, depth, half_width, tilt)
 
 
+@si_units(depth="length", half_width="length")
 def flat_bottomed_profile(depth, half_width, flat_fraction=0.5, *, tilt=0.0, samples=2001,
                           extent=2.0) -> ScarProfile:  # fmt: skip
     r"""A flat-bottomed (U-shaped) scar: a flat bottom with parabolic walls.
@@ -154,6 +157,7 @@ def flat_bottomed_profile(depth, half_width, flat_fraction=0.5, *, tilt=0.0, sam
     return _family(x, z, g, depth, half_width, tilt)
 
 
+@si_units(depth="length", half_width="length")
 def w_shaped_profile(depth, half_width, hump=0.25, *, tilt=0.0, samples=2001,
                      extent=2.0) -> ScarProfile:  # fmt: skip
     r"""A W-shaped scar: two troughs with a hump between them (the less worn centre).
@@ -192,6 +196,7 @@ def w_shaped_profile(depth, half_width, hump=0.25, *, tilt=0.0, samples=2001,
     return _family(x, z, g, depth, half_width, tilt)
 
 
+@si_units(depth="length", half_width="length", ridge_height="length", ridge_width="length")
 def ridged_profile(depth, half_width, ridge_height, ridge_width, *, tilt=0.0, samples=2001,
                    extent=2.0) -> ScarProfile:  # fmt: skip
     r"""A parabolic scar with ploughing ridges piled up beside its edges (Figure 1b).
