@@ -1,4 +1,5 @@
-"""Ctrl-C that stops the command line cleanly, at the next safe point, writing nothing more.
+"""Ctrl-C and SIGTERM that stop the command line cleanly, at the next safe point, writing
+nothing more.
 
 Standard library only, so the command line can install it before importing anything heavy.
 """
@@ -9,14 +10,49 @@ import contextlib
 import signal
 import threading
 
-__all__ = ["INTERRUPTED", "check_interrupted", "interrupts_stop_writes"]
+__all__ = [
+    "INTERRUPTED",
+    "STOP_SIGNALS",
+    "Interrupted",
+    "Stop",
+    "check_interrupted",
+    "interrupts_stop_writes",
+]
 
-#: Set by the Ctrl-C handler of :func:`interrupts_stop_writes`, only while it is installed.
-INTERRUPTED = threading.Event()
+#: The signals :func:`interrupts_stop_writes` turns into a clean stop: Ctrl-C (SIGINT) and
+#: SIGTERM (``kill``, a batch system ending a job).
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+class Stop(threading.Event):
+    """Set once a stop signal came; :attr:`signal` is the first one (None before)."""
+
+    def __init__(self):
+        super().__init__()
+        self.signal = None
+
+
+#: Set by the handler of :func:`interrupts_stop_writes`, only while it is installed.
+INTERRUPTED = Stop()
+
+
+class Interrupted(KeyboardInterrupt):
+    """A stop by Ctrl-C or SIGTERM that has something to tell: what was kept, how to go on.
+
+    Parameters
+    ----------
+    note : str
+        One sentence for the user, printed after ``interrupted;`` on the same line.
+    """
+
+    def __init__(self, note: str):
+        super().__init__(note)
+        self.note = note
 
 
 def check_interrupted() -> None:
-    """Raise ``KeyboardInterrupt`` if Ctrl-C was pressed under :func:`interrupts_stop_writes`.
+    """Raise ``KeyboardInterrupt`` if Ctrl-C was pressed (or SIGTERM came) under
+    :func:`interrupts_stop_writes`.
 
     Called where stopping is safe: between blocks of work and before a file is renamed into
     place. Outside the block (the library used from Python) it does nothing.
@@ -27,39 +63,48 @@ def check_interrupted() -> None:
 
 @contextlib.contextmanager
 def interrupts_stop_writes():
-    """Within the block, Ctrl-C stops the program at the next safe point, writing nothing more.
+    """Within the block, Ctrl-C or SIGTERM stops the program at the next safe point, writing
+    nothing more.
 
-    The first Ctrl-C only sets a flag; :func:`check_interrupted`, called between blocks of
+    The first signal only sets a flag; :func:`check_interrupted`, called between blocks of
     work and before every :func:`ecofmaps.io.files.atomic_store` renames its file into
     place, then raises ``KeyboardInterrupt``, and so does leaving the block. A
     ``KeyboardInterrupt`` raised at once, anywhere, would land inside JAX's compiled
     extensions (during their import, or in a garbage-collector callback) and crash the
-    process or be swallowed there. A second Ctrl-C raises at once. Only in the main
-    thread; where Ctrl-C is ignored (a background job) it stays ignored.
+    process or be swallowed there. A second signal raises at once. Only in the main
+    thread; a signal that is ignored (Ctrl-C in a background job), or whose handler was
+    not set from Python, is left alone.
 
     Yields
     ------
-    interrupted : threading.Event
-        Set once Ctrl-C was pressed in the block; it stays set after the block, so a caller
-        can tell an interrupt from an error it caused.
+    interrupted : Stop
+        Set once a stop signal came in the block, with the signal's number in its
+        ``signal``; it stays set after the block, so a caller can tell an interrupt from
+        an error it caused, and which signal it was.
     """
-    interrupted = threading.Event()
-    previous = signal.getsignal(signal.SIGINT)
-    if threading.current_thread() is not threading.main_thread() or previous == signal.SIG_IGN:
+    interrupted = Stop()
+    if threading.current_thread() is not threading.main_thread():
         yield interrupted
         return
+    previous = {number: signal.getsignal(number) for number in STOP_SIGNALS}
 
     def handler(signum, frame):
-        if interrupted.is_set():  # the second Ctrl-C: stop now
+        if interrupted.is_set():  # the second signal: stop now
             raise KeyboardInterrupt
+        interrupted.signal = INTERRUPTED.signal = signal.Signals(signum)
         interrupted.set()
         INTERRUPTED.set()
 
     INTERRUPTED.clear()
-    signal.signal(signal.SIGINT, handler)
+    INTERRUPTED.signal = None
+    ours = [number for number, before in previous.items() if before not in (signal.SIG_IGN, None)]
+    for number in ours:
+        signal.signal(number, handler)
     try:
         yield interrupted
         check_interrupted()
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for number in ours:
+            signal.signal(number, previous[number])
         INTERRUPTED.clear()
+        INTERRUPTED.signal = None

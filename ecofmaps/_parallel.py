@@ -20,22 +20,48 @@ itself (an :class:`ecofmaps.io.binary.Column`, tied to the array by the attribut
 :data:`SOURCE`) is handed to a task as a :class:`Slice` and read by that array-like where the
 task runs, without dask's graph (whose compute copies each block once more). Between
 results :func:`ecofmaps._interrupts.check_interrupted` is called, so Ctrl-C on the command
-line stops the run at the next block without raising inside dask.
+line stops the run at the next block without raising inside dask. The worker processes of a
+local cluster ignore Ctrl-C: on a terminal it reaches every process of the command, and the
+workers' own ``KeyboardInterrupt`` printed their tracebacks; this process stops them when it
+closes the cluster.
+
+The number of workers is checked before anything starts (:func:`worker_limit`), and a
+scheduler given by address is asked who it is within :data:`CONNECT_TIMEOUT` seconds before
+a client connects (a client of an address that does not answer, or answers HTTP, waited
+for good).
 """
 
 from __future__ import annotations
 
+import asyncio
 import collections
 import concurrent.futures
+import contextlib
 import os
+import signal
+import threading
 import time
 
 from ecofmaps._interrupts import check_interrupted
 
-__all__ = ["CONNECT_TIMEOUT", "SOURCE", "Runner", "SchedulerError", "Slice", "stretch"]
+__all__ = [
+    "CONNECT_TIMEOUT",
+    "SOURCE",
+    "WORKER_MEMORY",
+    "Runner",
+    "SchedulerError",
+    "Slice",
+    "probe_scheduler",
+    "stretch",
+    "worker_limit",
+]
 
 #: Seconds to wait for a dask scheduler given by address to answer.
-CONNECT_TIMEOUT = 10.0
+CONNECT_TIMEOUT = 5.0
+
+#: Memory a worker process of a local cluster needs: its interpreter with NumPy, JAX and
+#: dask loaded (about 0.35 GB resident, measured) and a few blocks of a recording. [byte]
+WORKER_MEMORY = 512 * 2**20
 
 #: Seconds between looks at a running task (and at Ctrl-C).
 _POLL = 0.01
@@ -123,6 +149,10 @@ class Runner:
             raise ValueError(f"workers must be a positive integer; got {workers!r}")
         if scheduler is not None and cluster:
             raise ValueError("give a scheduler address or start a local cluster, not both")
+        if workers is not None and scheduler is None and client is None:
+            limit, why = worker_limit(processes=cluster)
+            if workers > limit:
+                raise ValueError(f"workers={workers} is more than this machine can run: {why}")
         self.scheduler, self.cluster, self.timeout = scheduler, cluster, timeout
         self.workers = int(workers) if workers else (1 if scheduler else os.cpu_count() or 1)
         self._given = client
@@ -164,7 +194,7 @@ class Runner:
                 "distributed.nanny.pre-spawn-environ": environ,
                 "distributed.worker.profile.enabled": False,
             }
-            with dask.config.set(settings):
+            with dask.config.set(settings), _sigint_ignored():
                 self._cluster = LocalCluster(
                     n_workers=self.workers,
                     threads_per_worker=1,
@@ -244,14 +274,108 @@ class Runner:
                 future.cancel()
 
 
+def worker_limit(processes: bool) -> tuple[int, str]:
+    """The most workers this machine can run at once, and why, in words.
+
+    Parameters
+    ----------
+    processes : bool
+        Worker processes of a local cluster (bounded by the cores and by the memory
+        available, :data:`WORKER_MEMORY` each), or threads of this process (the cores).
+
+    Returns
+    -------
+    limit : int
+        At least 1.
+    why : str
+        The bound in words, e.g. ``'2 cores (os.cpu_count())'``.
+    """
+    cores = os.cpu_count() or 1
+    why = f"{cores} cores (os.cpu_count())"
+    if not processes:
+        return cores, why
+    import psutil  # with distributed, which a cluster needs
+
+    available = psutil.virtual_memory().available
+    by_memory = max(1, available // WORKER_MEMORY)
+    if by_memory < cores:
+        return by_memory, (
+            f"{available / 2**30:.3g} GiB of memory available, for workers of about "
+            f"{WORKER_MEMORY / 2**30:.3g} GiB each"
+        )
+    return cores, f"{why}, each worker a process"
+
+
+@contextlib.contextmanager
+def _sigint_ignored():
+    """Ctrl-C (SIGINT) ignored by this process, and for good by the processes it starts.
+
+    Ctrl-C on a terminal reaches every process of the command's group, and is for this
+    process only: a worker process started while it is ignored keeps ignoring it (an
+    ignored signal stays ignored across ``exec``, and Python leaves it so), while this
+    process's handler is put back on leaving. A Ctrl-C while the block runs (the cluster
+    starting, a few seconds) is lost. Only in the main thread (elsewhere nothing changes).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
+async def _identity(address: str, timeout: float) -> dict:
+    """What the dask scheduler at ``address`` says it is (its ``identity``)."""
+    from distributed.comm import connect
+
+    comm = await connect(address, timeout=timeout)
+    try:
+        await comm.write({"op": "identity", "reply": True})
+        return await comm.read()
+    finally:
+        comm.abort()
+
+
+def probe_scheduler(address: str, timeout: float) -> None:
+    """Raise :class:`SchedulerError` unless a dask scheduler answers at ``address`` within
+    ``timeout`` seconds.
+
+    A client of an address where nothing answers, or something else does (an HTTP server,
+    the scheduler's dashboard), waits for good; this asks the scheduler who it is first,
+    on a loop of its own (a thread, so that it works where a loop already runs).
+    """
+
+    def ask():
+        return asyncio.run(asyncio.wait_for(_identity(address, timeout), timeout))
+
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        try:
+            answer = pool.submit(ask).result()
+        except Exception as error:  # whatever went wrong, no scheduler answered
+            reason = str(error) or f"no answer within {timeout:g} s"
+            answer = (
+                reason if isinstance(error, ValueError) else f"{type(error).__name__}: {reason}"
+            )
+    if not isinstance(answer, dict) or answer.get("type") != "Scheduler":
+        if isinstance(answer, dict):
+            answer = f"it answers as a {answer.get('type', 'something else')}"
+        raise SchedulerError(
+            f"no dask scheduler at {address}: {answer}; is it running, and is the address "
+            "right (tcp://host:8786, not the dashboard's http:// address)?"
+        )
+
+
 def _connect(address: str, timeout: float):
     """A client of the dask scheduler at ``address``, or :class:`SchedulerError`."""
     from distributed import Client
 
+    probe_scheduler(address, timeout)
     try:
         return Client(address, timeout=timeout, set_as_default=False)
     except (OSError, TimeoutError, ValueError) as error:
         raise SchedulerError(
-            f"cannot reach the dask scheduler at {address}: no answer within {timeout:g} s "
+            f"no dask scheduler at {address}: no client within {timeout:g} s "
             f"({type(error).__name__}: {error}); is it running, and is the address right?"
         ) from None

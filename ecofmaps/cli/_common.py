@@ -11,6 +11,7 @@ import numpy as np
 
 from ecofmaps._nomenclature import QUANTITIES, RANGES, within
 from ecofmaps.cli.main import CommandError
+from ecofmaps.io.files import MANIFEST, written_by_ecofmaps
 from ecofmaps.units import DIMENSIONS, parse_quantity, parse_values
 
 __all__ = [
@@ -121,21 +122,32 @@ def recording_options(args) -> dict:
     }
 
 
-def refuse_to_overwrite(outputs, inputs) -> None:
-    """Raise :class:`CommandError` if an output path is one of the input files.
+def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=()) -> None:
+    """Raise :class:`CommandError` unless the command may write its outputs: the one rule.
+
+    An output is never an input file. An output that exists is replaced only with
+    ``--overwrite``, and only if ecofmaps wrote it and it is unchanged since
+    (:func:`ecofmaps.io.files.written_by_ecofmaps`): a user's file, and a folder that is
+    not a store ecofmaps wrote, are never replaced. A folder the command writes files into
+    (``--plots``, ``figures --out``) may exist empty; one that holds anything needs
+    ``--overwrite``, and then only ecofmaps' own files in it are replaced, the others kept.
+    Everything is checked before any work.
 
     Parameters
     ----------
     outputs : iterable of (str, path-like)
-        Each output as (the option that names it, its path).
+        Each output file or store as (the option that names it, its path); a None path is
+        skipped.
     inputs : iterable of path-like
         The files the command reads.
+    overwrite : bool
+        Whether ``--overwrite`` was given.
+    folders : iterable of (str, path-like)
+        Each folder written into as (its option, its path); None is skipped.
     """
+    outputs = [(option, Path(path)) for option, path in outputs if path is not None]
     sources = [Path(path) for path in inputs]
-    for option, output in outputs:
-        if output is None:
-            continue
-        target = Path(output)
+    for option, target in outputs:
         for source in sources:
             same = (
                 os.path.samefile(source, target)
@@ -144,9 +156,29 @@ def refuse_to_overwrite(outputs, inputs) -> None:
             )
             if same:
                 raise CommandError(
-                    f"{option} {output} would write over the input file {source}: "
+                    f"{option} {target} would write over the input file {source}: "
                     "choose another output"
                 )
+    for option, folder in folders:
+        if folder is None or overwrite or not Path(folder).is_dir():
+            continue
+        if any(item.name != MANIFEST for item in Path(folder).iterdir()):
+            raise CommandError(
+                f"{option} {folder} is a folder that is not empty: give a new or empty one, "
+                "or --overwrite to replace the files ecofmaps wrote there (others are kept)"
+            )
+    for option, target in outputs:
+        if not os.path.lexists(target):
+            continue
+        if written_by_ecofmaps(target):
+            if not overwrite:
+                raise CommandError(f"{option} {target} exists already: --overwrite replaces it")
+            continue
+        kind = "a folder" if target.is_dir() else "a file"
+        raise CommandError(
+            f"{option} {target} is {kind} that ecofmaps did not write (or that changed "
+            f"since; see {MANIFEST} in its folder): it is not replaced; choose another name"
+        )
 
 
 def row(name: str, value, note: str = "") -> tuple[str, str, str]:

@@ -7,6 +7,7 @@ import textwrap
 from pathlib import Path
 
 from ecofmaps.cli._common import CommandError, recording_options, refuse_to_overwrite, unit
+from ecofmaps.io.files import record_written
 
 __all__ = ["add", "run"]
 
@@ -60,8 +61,10 @@ def add(subparsers) -> None:
         help="samples per chunk of the store, and per block read (default 1048576)",
     )  # fmt: skip
     parser.add_argument(
-        "--overwrite", action="store_true", help="replace DST (once the new one is complete)"
-    )
+        "--overwrite", action="store_true",
+        help="replace DST if ecofmaps wrote it (once the new one is complete); a file or "
+        "folder ecofmaps did not write is never replaced",
+    )  # fmt: skip
     parser.set_defaults(handler=run)
 
 
@@ -77,9 +80,7 @@ def run(args) -> int:
         )
     if not destination.parent.is_dir():
         raise CommandError(f"cannot write {destination}: its directory does not exist")
-    refuse_to_overwrite([("DST", destination)], [source])
-    if destination.exists() and not args.overwrite:
-        raise CommandError(f"{destination} exists already: --overwrite replaces it")
+    refuse_to_overwrite([("DST", destination)], [source], overwrite=args.overwrite)
     convert_recording(
         source,
         destination,
@@ -87,6 +88,7 @@ def run(args) -> int:
         overwrite=args.overwrite,
         **recording_options(args),
     )
+    record_written([destination])
     written = read_recording(destination, lazy=True)
     print(f"wrote {destination}: {written.size} samples of {', '.join(written.columns)} (SI)")
     return 0

@@ -45,6 +45,10 @@ def add(subparsers) -> None:
         "--out", metavar="OUT", default=None,
         help="write the corrected table here (CSV; default: standard output)",
     )  # fmt: skip
+    parser.add_argument(
+        "--overwrite", action="store_true",
+        help="replace --out if ecofmaps wrote it; a file ecofmaps did not write is never replaced",
+    )  # fmt: skip
     parser.add_argument("--ecof", type=quantity("ecof"), help="reported energy CoF μ_E, e.g. 0.83")
     parser.add_argument(
         "--amplitude", type=quantity("amplitude"), help="displacement amplitude Δ*, e.g. 50um"
@@ -69,7 +73,7 @@ def add(subparsers) -> None:
 def run(args) -> int:
     from ecofmaps.correction.inversion import correct_ecof
     from ecofmaps.correction.tables import correct_table
-    from ecofmaps.io.files import write_text
+    from ecofmaps.io.files import record_written, write_text
 
     given = [name for name in (*_POINT_OPTIONS, *_GROOVE_OPTIONS)
              if getattr(args, name) is not None]  # fmt: skip
@@ -80,13 +84,14 @@ def run(args) -> int:
         if args.out is not None and not Path(args.out).parent.is_dir():
             raise CommandError(f"cannot write {args.out}: its directory does not exist")
         inputs = [path for path in (args.table, args.scar_profile) if path is not None]
-        refuse_to_overwrite([("--out", args.out)], inputs)
+        refuse_to_overwrite([("--out", args.out)], inputs, overwrite=args.overwrite)
         profile = read_profile(args)
         text, rows = correct_table(args.table, profile=profile, mapping=args.mapping)
         if args.out is None:
             sys.stdout.write(text)
             return 0
         write_text(args.out, text)
+        record_written([args.out])
         on = "" if profile is None else f" on the scar profile {args.scar_profile}"
         print(f"wrote {args.out}: {rows} rows corrected{on}")
         return 0

@@ -12,12 +12,20 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import signal
 import sys
 
 from ecofmaps._interrupts import interrupts_stop_writes
 from ecofmaps._version import __version__
 
-__all__ = ["CommandError", "build_parser", "console", "main"]
+__all__ = [
+    "EXIT_INTERRUPTED",
+    "EXIT_TERMINATED",
+    "CommandError",
+    "build_parser",
+    "console",
+    "main",
+]
 
 
 class CommandError(Exception):
@@ -57,13 +65,17 @@ def build_parser() -> argparse.ArgumentParser:
 #: Exit status of a run stopped by Ctrl-C (128 + SIGINT), as shells report it.
 EXIT_INTERRUPTED = 130
 
+#: Exit status of a run stopped by SIGTERM (128 + SIGTERM).
+EXIT_TERMINATED = 143
+
 
 def main(argv=None) -> int:
     """Run the ``ecofmaps`` command; return its exit status.
 
     0 on success; 2 for a user error (bad option, bad file: one line naming it); 130 when
-    interrupted by Ctrl-C (files are written atomically, so nothing is left half written);
-    1 for an unexpected failure (one line; ``ECOFMAPS_DEBUG=1`` shows the traceback).
+    interrupted by Ctrl-C and 143 by SIGTERM (one line: files are written atomically, so
+    nothing is left half written); 1 for an unexpected failure (one line;
+    ``ECOFMAPS_DEBUG=1`` shows the traceback).
     """
     interrupted = None
     try:  # the subcommands import JAX and xarray: an interrupt may come during the imports
@@ -73,11 +85,11 @@ def main(argv=None) -> int:
             except SystemExit as stop:  # a usage error (printed), --help or --version
                 return int(stop.code or 0)
             return args.handler(args)
-    except KeyboardInterrupt:
-        return _report(EXIT_INTERRUPTED, "interrupted; no output was left half written")
+    except KeyboardInterrupt as stop:
+        return _stopped(interrupted, getattr(stop, "note", None))
     except Exception as error:
         if interrupted is not None and interrupted.is_set():  # an interrupt turned into an error
-            return _report(EXIT_INTERRUPTED, "interrupted; no output was left half written")
+            return _stopped(interrupted, None)
         if isinstance(error, (CommandError, ValueError, OSError)):
             return _report(2, f"error: {error}")
         if isinstance(error, MemoryError):
@@ -91,6 +103,14 @@ def main(argv=None) -> int:
         )
 
 
+def _stopped(interrupted, note) -> int:
+    """Report a run stopped by Ctrl-C or SIGTERM in one line; return 130 or 143."""
+    terminated = interrupted is not None and interrupted.signal == signal.SIGTERM
+    words = "terminated (SIGTERM)" if terminated else "interrupted"
+    note = note or "no output was left half written"
+    return _report(EXIT_TERMINATED if terminated else EXIT_INTERRUPTED, f"{words}; {note}")
+
+
 def _report(status: int, message: str) -> int:
     """Print ``ecofmaps: <message>`` on standard error; return ``status``."""
     print(f"ecofmaps: {message}", file=sys.stderr)
@@ -100,13 +120,13 @@ def _report(status: int, message: str) -> int:
 def console() -> None:
     """The ``ecofmaps`` console script: run :func:`main` and exit with its status.
 
-    After Ctrl-C the process ends at once (``os._exit``) once its messages are flushed:
+    After Ctrl-C or SIGTERM the process ends at once (``os._exit``) once its messages are flushed:
     JAX's worker threads may still be busy with the interrupted computation, and tearing
     the interpreter down around them can crash it. Files were already cleaned up, since
     every file is written through a temporary that the interrupt removed.
     """
     status = main()
-    if status == EXIT_INTERRUPTED:
+    if status in (EXIT_INTERRUPTED, EXIT_TERMINATED):
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(status)

@@ -3,6 +3,9 @@
 A grid of more than ``--chunk-points`` points, and any grid written to a zarr store, is
 computed block by block straight into the output (:func:`ecofmaps.maps.write_map`), with a
 progress bar on a terminal; a smaller one is computed at once and kept in the cache.
+Before any work the command states the map's size (points, bytes) and refuses one that
+would not fit on the output's disk, or, computed at once, in memory
+(:func:`ecofmaps.maps.compute_map` refuses that).
 """
 
 from __future__ import annotations
@@ -10,15 +13,17 @@ from __future__ import annotations
 import argparse
 import contextlib
 import math
+import shutil
 import sys
 import textwrap
 from pathlib import Path
 
 import numpy as np
 
-from ecofmaps.cli._common import CommandError, quantities, quantity
+from ecofmaps.cli._common import CommandError, quantities, quantity, refuse_to_overwrite
+from ecofmaps.io.files import record_written
 
-__all__ = ["add", "run"]
+__all__ = ["add", "map_bytes", "run"]
 
 _GRID_HELP = "; one value, a list or a range start:stop:num"
 #: Default of --chunk-points: blocks of 2**22 points (about 220 MB of results with a load).
@@ -45,7 +50,9 @@ def add(subparsers) -> None:
             "energy CoF and its ratio to mu, compliance ratio P/(S*amplitude), regime, and "
             "with --load the dissipated energy and peak force) over a grid, and write them "
             "as an xarray Dataset to a netCDF file, or to a zarr store if --out ends in .zarr "
-            "(atomically: an existing output is replaced only once the new one is complete). "
+            "(atomically; an existing output is replaced only with --overwrite, if ecofmaps "
+            "wrote it, and only once the new one is complete). The map's size is printed "
+            "first, and a map that would not fit on the disk is refused. "
             "The groove half-width equals the amplitude, "
             "as in the paper. Each of --stiffness-ratio, --aspect-ratio, --amplitude and --mu "
             "takes one value (a scalar coordinate of the result), a comma-separated list or a "
@@ -94,6 +101,10 @@ def add(subparsers) -> None:
         "must exist)",
     )  # fmt: skip
     parser.add_argument(
+        "--overwrite", action="store_true",
+        help="replace --out if it exists and ecofmaps wrote it (once the new map is complete)",
+    )  # fmt: skip
+    parser.add_argument(
         "--chunk-points", type=_points, default=_CHUNK_POINTS, metavar="N",
         help=f"grid points per block (default {_CHUNK_POINTS}); a larger grid is computed "
         "block by block into --out",
@@ -115,13 +126,13 @@ def add(subparsers) -> None:
 
 
 def run(args) -> int:
-    from ecofmaps.maps.files import ZARR_SUFFIX, write_map
+    from ecofmaps.maps.files import ZARR_SUFFIX  # JAX and xarray: loaded when the command runs
     from ecofmaps.maps.grid import compute_map
-    from ecofmaps.model import Regime
 
     out = Path(args.out)
     if not out.parent.is_dir():
         raise CommandError(f"cannot write {out}: the directory {out.parent} does not exist")
+    refuse_to_overwrite([("--out", out)], [], overwrite=args.overwrite)
     grid = {
         name: values[0] if values.size == 1 else values
         for name, values in (
@@ -132,19 +143,78 @@ def run(args) -> int:
         )
     }
     points = math.prod(values.size for values in grid.values() if np.ndim(values))
-    print(f"ecofmaps map: {points:,} points into {out}", file=sys.stderr, flush=True)
+    size = map_bytes(grid, args.load)
+    free = shutil.disk_usage(out.parent).free
+    print(
+        f"ecofmaps map: {points:,} points, {_bytes(size)} into {out} ({_bytes(free)} free there)",
+        file=sys.stderr,
+        flush=True,
+    )
+    if size > free:
+        raise CommandError(
+            f"--out {out}: the map of {points:.3g} points needs up to {_bytes(size)} on disk, "
+            f"more than the {_bytes(free)} free in {out.parent.resolve()}: use a smaller grid "
+            "or another disk"
+        )
     chunked = out.suffix == ZARR_SUFFIX or points > args.chunk_points
     if chunked:
         dataset = compute_map(**grid, load=args.load, chunks=args.chunk_points)
-    else:
+    else:  # refused there if it would not fit in memory
         dataset = compute_map(
             **grid, load=args.load, cache=not args.no_cache, cache_dir=args.cache_dir
         )
+    return _write(dataset, out, shown=chunked and not args.quiet and sys.stderr.isatty())
+
+
+def map_bytes(grid: dict, load) -> int:
+    """Bytes of the map of ``grid`` with its coordinates, uncompressed, before computing it.
+
+    The variables' types and dimensions come from the map of at most two values along
+    each axis of ``grid``, chunked (its blocks are not computed).
+
+    Parameters
+    ----------
+    grid : dict
+        ``compute_map``'s keywords ``stiffness_ratio``, ``aspect_ratio``, ``amplitude``,
+        ``mu``: each a value [SI] or a 1-D array of values.
+    load : float or None
+        Normal load. [N]
+
+    Returns
+    -------
+    size : int
+        The map's size in memory, and at most on disk (netCDF and zarr may compress it).
+        [byte]
+    """
+    from ecofmaps.maps.grid import compute_map  # JAX: loaded when the command runs
+
+    small = {name: values[:2] if np.ndim(values) else values for name, values in grid.items()}
+    sample = compute_map(**small, load=load, chunks=1)  # lazy: nothing computed
+    sizes = {name: np.size(values) for name, values in grid.items() if np.ndim(values)}
+    return sum(
+        variable.dtype.itemsize * math.prod(sizes[dim] for dim in variable.dims)
+        for variable in sample.variables.values()
+    )
+
+
+def _bytes(size: float) -> str:
+    """``size`` [byte] in words: ``'88 TB'``, ``'512 kB'`` (decimal units)."""
+    power = min(int(math.log10(max(size, 1)) // 3), 5)
+    return f"{size / 1000**power:.3g} {('B', 'kB', 'MB', 'GB', 'TB', 'PB')[power]}"
+
+
+def _write(dataset, out: Path, shown: bool) -> int:
+    """Write ``dataset`` to ``out`` (a progress bar if ``shown``), record it as written by
+    ecofmaps, and print what was written."""
+    from ecofmaps.maps.files import write_map
+    from ecofmaps.model import Regime
+
     # The summary is computed in the same pass over the blocks as the output.
     summary = [(dataset.regime == code).sum().data for code in Regime]
     summary += [dataset.ecof_ratio.min().data, dataset.ecof_ratio.max().data]
-    with _progress(dataset, shown=chunked and not args.quiet and sys.stderr.isatty()):
+    with _progress(dataset, shown=shown):
         *counts, low, high = write_map(dataset, out, also=summary)
+    record_written([out])
     shape = " x ".join(f"{size} {dim}" for dim, size in dataset.sizes.items()) or "1 point"
     regimes = ", ".join(
         f"{code.label} {int(count)}" for code, count in zip(Regime, counts, strict=True) if count

@@ -3,13 +3,19 @@
 Every file ecofmaps writes (cache entries, figures, result tables) goes through
 :func:`atomic_path`: the data are written to a temporary file in the destination's
 directory, flushed to disk and renamed onto the destination in one step, so a reader never
-sees a half-written file and a failed write leaves an existing file as it was.
+sees a half-written file and a failed write leaves an existing file as it was. A folder is
+never removed to make room: only a store (zarr) is replaced by a store.
+
+The command line writes only over what it wrote itself: each folder it writes into keeps a
+manifest, :data:`MANIFEST`, of the files and stores ecofmaps put there (their sizes and
+times), read by :func:`written_by_ecofmaps` and added to by :func:`record_written`.
 """
 
 from __future__ import annotations
 
 import contextlib
 import errno
+import json
 import os
 import re
 import shutil
@@ -18,10 +24,26 @@ from pathlib import Path
 
 from ecofmaps._interrupts import check_interrupted
 
-__all__ = ["TEMPORARY_NAME", "FileLineError", "atomic_path", "atomic_store", "write_text"]
+__all__ = [
+    "MANIFEST",
+    "TEMPORARY_NAME",
+    "FileLineError",
+    "atomic_path",
+    "atomic_store",
+    "is_store",
+    "record_written",
+    "write_text",
+    "written_by_ecofmaps",
+]
 
 #: Names of the temporary files :func:`atomic_path` writes (left behind only by a crash).
 TEMPORARY_NAME = re.compile(r"^\..+\.[0-9a-f]{32}\.tmp$")
+
+#: The file, in each folder the command line writes into, that lists what it wrote there.
+MANIFEST = ".ecofmaps-manifest.json"
+
+#: Files whose presence makes a directory a zarr store (version 3, then version 2).
+_STORE_MARKERS = ("zarr.json", ".zgroup", ".zarray")
 
 
 @contextlib.contextmanager
@@ -114,16 +136,24 @@ def atomic_store(path, *, overwrite: bool = False):
     ------
     FileExistsError
         If ``path`` exists and ``overwrite`` is false.
+    IsADirectoryError
+        If ``path`` is a directory that is not a store (:func:`is_store`), raised before
+        anything is written, or a store and a file was written: a folder is never removed
+        to make room.
     """
     path = Path(path)
     if os.path.lexists(path) and not overwrite:
         message = "exists already (overwrite=True replaces it)"
         raise FileExistsError(errno.EEXIST, message, str(path))
+    if path.is_dir() and not is_store(path):
+        raise IsADirectoryError(errno.EISDIR, _FOLDER, str(path))
     temporary = _temporary(path)
     try:
         yield temporary
         _sync(temporary)
         check_interrupted()  # after Ctrl-C on the command line, nothing more lands
+        if path.is_dir() and not temporary.is_dir():
+            raise IsADirectoryError(errno.EISDIR, _FOLDER, str(path))
         if temporary.is_dir() or path.is_dir():
             old = _temporary(path)
             if os.path.lexists(path):
@@ -140,6 +170,85 @@ def atomic_store(path, *, overwrite: bool = False):
     except BaseException:
         _remove(temporary)
         raise
+
+
+_FOLDER = "is a folder, not a store written by ecofmaps: it is not replaced"
+
+
+def is_store(path) -> bool:
+    """Whether ``path`` is a directory holding a zarr store (its metadata file at the top).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    store : bool
+    """
+    path = Path(path)
+    return path.is_dir() and any((path / name).is_file() for name in _STORE_MARKERS)
+
+
+def _manifest(folder: Path) -> dict:
+    """The entries of ``folder``'s manifest: name -> what was written (empty if none or
+    unreadable: then nothing there counts as written by ecofmaps)."""
+    try:
+        entries = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))["written"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return {}
+    return entries if isinstance(entries, dict) else {}
+
+
+def _entry(path: Path) -> dict:
+    """What the manifest keeps of ``path``: a store, or a file's size and time."""
+    if path.is_dir():
+        return {"store": True}
+    status = path.stat()
+    return {"size": status.st_size, "mtime_ns": status.st_mtime_ns}
+
+
+def written_by_ecofmaps(path) -> bool:
+    """Whether ``path`` is a file or store that ecofmaps wrote, unchanged since.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    written : bool
+        True if the manifest of its folder (:data:`MANIFEST`) lists it and, for a file,
+        its size and modification time are those recorded; False for anything else (a
+        file edited or replaced since, a folder that is not a store, a symbolic link).
+    """
+    path = Path(path)
+    if path.is_symlink() or not path.exists() or (path.is_dir() and not is_store(path)):
+        return False
+    return _manifest(path.parent).get(path.name) == _entry(path)
+
+
+def record_written(paths) -> None:
+    """Add files and stores just written to the manifests of their folders (atomically).
+
+    Parameters
+    ----------
+    paths : iterable of str or os.PathLike
+        What the command wrote; those that do not exist are left out.
+
+    Notes
+    -----
+    Two commands writing into one folder at the same time may each keep only their own
+    entries (the last manifest written wins); a file left out is only refused later, never
+    replaced.
+    """
+    folders = {}
+    for path in map(Path, paths):
+        if path.exists() and not path.is_symlink():
+            folders.setdefault(path.parent, {})[path.name] = _entry(path)
+    for folder, entries in folders.items():
+        written = _manifest(folder) | entries
+        write_text(folder / MANIFEST, json.dumps({"written": written}, indent=1) + "\n")
 
 
 class FileLineError(ValueError):

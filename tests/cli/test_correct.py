@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import ecofmaps
+from ecofmaps.io.files import MANIFEST, record_written
 from tests.cli.commands import run
 
 EXAMPLE_2 = ["--amplitude", "50um", "--load", "450N", "--stiffness", "35MN/m"]
@@ -176,13 +177,15 @@ def test_bad_table_names_file_and_line(tmp_path, capsys, text, line, message):
     table = write(tmp_path / "bad.csv", text)
     out = write(tmp_path / "out.csv", "previous results\n")
     os.utime(out, (1_000_000_000, 1_000_000_000))
-    status, stdout, err = run(capsys, "correct", table, "--out", out)
+    record_written([out])  # as if ecofmaps had written it: --overwrite may replace it
+    status, stdout, err = run(capsys, "correct", table, "--out", out, "--overwrite")
     assert status == 2 and stdout == ""
     assert f"{table}, line {line}: " in err and message in err
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
     assert out.read_text(encoding="utf-8") == "previous results\n"
     assert out.stat().st_mtime == 1_000_000_000
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.csv", "out.csv"]  # no temp left
+    listed = sorted(p.name for p in tmp_path.iterdir())
+    assert listed == [MANIFEST, "bad.csv", "out.csv"]  # no temp left
 
 
 def test_bad_table_writes_no_new_file(tmp_path, capsys):

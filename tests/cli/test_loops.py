@@ -9,6 +9,7 @@ import xarray as xr
 
 import ecofmaps
 from ecofmaps.cli import main
+from ecofmaps.io.files import MANIFEST, record_written
 from ecofmaps.io.tables import RESULT_COLUMNS, results_table
 from ecofmaps.measured.synthetic import EXAMPLE, example_path, synthetic_recording
 
@@ -138,9 +139,11 @@ def test_damaged_file_writes_nothing(tmp_path, capsys, recording):
     bad.write_text("\n".join(lines) + "\n")
     out = tmp_path / "results.csv"
     out.write_text("previous results\n")
+    record_written([out])  # as if ecofmaps had written it: --overwrite may replace it
     status, stdout, stderr = run(
-        capsys, good, bad, "--load", "450N", "--out", out, "--plots", tmp_path / "plots"
-    )
+        capsys, good, bad, "--load", "450N", "--out", out, "--plots", tmp_path / "plots",
+        "--overwrite",
+    )  # fmt: skip
     assert status == 2
     assert (
         stderr == f"ecofmaps: error: {bad}, line 58: non-numeric value 'oops' in column 'force'\n"
@@ -148,7 +151,8 @@ def test_damaged_file_writes_nothing(tmp_path, capsys, recording):
     assert stdout == ""
     assert out.read_text() == "previous results\n"
     assert not (tmp_path / "plots").exists()
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.csv", "good.csv", "results.csv"]
+    listed = [MANIFEST, "bad.csv", "good.csv", "results.csv"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == listed
 
 
 def test_too_few_samples_names_the_last_line(tmp_path, capsys, recording):

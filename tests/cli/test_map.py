@@ -1,12 +1,14 @@
 """The `ecofmaps map` and `ecofmaps cache` commands: units, ranges, lists, errors, round trip."""
 
 import sys
+import types
 
 import numpy as np
 import pytest
 import xarray as xr
 
 from ecofmaps import Regime, compute_map
+from ecofmaps.io.files import MANIFEST
 from ecofmaps.maps.cache import cache_entries
 from ecofmaps.units import parse_values
 from tests.cli.commands import run
@@ -55,13 +57,28 @@ def test_map_parses_units_lists_and_ranges(tmp_path, capsys):
     assert "dissipated_energy" not in written  # no --load
 
 
-def test_map_replaces_an_existing_file(tmp_path, capsys):
+def test_map_replaces_only_a_file_it_wrote_and_only_with_overwrite(tmp_path, capsys):
     out = tmp_path / "map.nc"
-    out.write_text("old")
+    out.write_text("a user's file")
+    for extra in ([], ["--overwrite"]):  # never replaced, even with --overwrite
+        status, stdout, stderr = run(capsys, "map", *FIG11, "--out", str(out), *extra)
+        assert status == 2 and stdout == ""
+        assert stderr == (
+            f"ecofmaps: error: --out {out} is a file that ecofmaps did not write (or that "
+            f"changed since; see {MANIFEST} in its folder): it is not replaced; choose "
+            "another name\n"
+        )
+        assert out.read_text() == "a user's file"
+    out.unlink()
     assert run(capsys, "map", *FIG11, "--out", str(out))[0] == 0
+    status, _, stderr = run(capsys, "map", *FIG11, "--load", "450N", "--out", str(out))
+    assert status == 2
+    assert stderr == f"ecofmaps: error: --out {out} exists already: --overwrite replaces it\n"
+    assert run(capsys, "map", *FIG11, "--load", "450N", "--out", str(out), "--overwrite")[0] == 0
     with xr.open_dataset(out, engine="h5netcdf") as written:
         assert written.sizes == {"stiffness_ratio": 10, "aspect_ratio": 7, "amplitude": 2}
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["map.nc"]
+        assert "dissipated_energy" in written
+    assert sorted(p.name for p in tmp_path.iterdir()) == [MANIFEST, "map.nc"]
 
 
 def test_map_uses_the_cache_unless_told_not_to(tmp_path, capsys):
@@ -69,7 +86,7 @@ def test_map_uses_the_cache_unless_told_not_to(tmp_path, capsys):
     argv = ["map", *FIG11, "--cache-dir", str(cache_dir), "--out", str(tmp_path / "a.nc")]
     assert run(capsys, *argv, "--no-cache")[0] == 0
     assert cache_entries(cache_dir) == []
-    assert run(capsys, *argv)[0] == 0
+    assert run(capsys, *argv, "--overwrite")[0] == 0
     assert len(cache_entries(cache_dir)) == 1
 
 
@@ -213,8 +230,9 @@ def test_map_block_by_block_round_trip_is_identical(tmp_path, capsys, name):
     argv = ["map", *FIG11, "--load", "450N", "--chunk-points", "30", "--out", str(out)]
     status, stdout, stderr = run(capsys, *argv, "--cache-dir", str(cache_dir))
     assert status == 0
-    assert stderr == f"ecofmaps map: 140 points into {out}\n"  # no progress: not a terminal
     expected = fig11_map(450.0)
+    stated = f"ecofmaps map: 140 points, {expected.nbytes / 1e3:.3g} kB into {out} ("
+    assert stderr.startswith(stated) and stderr.endswith(" free there)\n")  # no progress bar
     regimes = ", ".join(
         f"{code.label} {n}" for code in Regime if (n := int((expected.regime == code).sum()))
     )
@@ -228,23 +246,54 @@ def test_map_block_by_block_round_trip_is_identical(tmp_path, capsys, name):
         with xr.open_dataset(out, engine="h5netcdf") as written:
             written = written.load()
     xr.testing.assert_identical(written, expected)
-    assert sorted(p.name for p in tmp_path.iterdir()) == [name]  # nothing cached
+    assert sorted(p.name for p in tmp_path.iterdir()) == [MANIFEST, name]  # nothing cached
 
 
-def test_map_replaces_an_existing_store_and_refuses_other_directories(tmp_path, capsys):
+def test_map_replaces_a_store_it_wrote_and_refuses_other_directories(tmp_path, capsys):
     out = tmp_path / "m.zarr"
     assert run(capsys, "map", *FIG11, "--out", str(out))[0] == 0
-    assert run(capsys, "map", *FIG11, "--load", "450N", "--out", str(out))[0] == 0
+    argv = ["map", *FIG11, "--load", "450N", "--out", str(out), "--overwrite"]
+    assert run(capsys, *argv)[0] == 0
     with xr.open_zarr(out) as written:
         xr.testing.assert_identical(written.compute(), fig11_map(450.0))
     mine = tmp_path / "mine.zarr"
     mine.mkdir()
-    status, stdout, stderr = run(capsys, "map", *FIG11, "--out", str(mine))
+    (mine / "thesis.txt").write_text("chapter 1")
+    status, stdout, stderr = run(capsys, "map", *FIG11, "--out", str(mine), "--overwrite")
     assert status == 2 and stdout == ""
-    assert stderr.splitlines()[-1] == (
-        f"ecofmaps: error: {mine} is a directory but not a zarr store: it is not replaced"
+    assert stderr.splitlines()[-1].startswith(
+        f"ecofmaps: error: --out {mine} is a folder that ecofmaps did not write"
     )
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.zarr", "mine.zarr"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [MANIFEST, "m.zarr", "mine.zarr"]
+    assert (mine / "thesis.txt").read_text() == "chapter 1"
+
+
+def test_map_states_its_size_and_refuses_one_the_disk_cannot_hold(tmp_path, capsys, monkeypatch):
+    """2e12 points (tens of TB) against the free space of --out's folder: refused at once."""
+    from ecofmaps.cli import map as command
+
+    free = 10**12
+    usage = types.SimpleNamespace(total=2 * free, used=free, free=free)
+    monkeypatch.setattr(command.shutil, "disk_usage", lambda path: usage)
+    out = tmp_path / "big.zarr"
+    argv = [
+        "--stiffness-ratio", "0.01/um:0.3/um:1000000", "--aspect-ratio", "0:0.4:1000000",
+        "--amplitude", "25um,50um", "--mu", "0.8", "--load", "450N", "--out", str(out),
+    ]  # fmt: skip
+    status, stdout, stderr = run(capsys, "map", *argv)
+    assert status == 2 and stdout == ""
+    small = fig11_map(450.0)  # the same variables: bytes per point and per coordinate value
+    per_point = sum(v.nbytes for v in small.data_vars.values() if v.ndim == 3) / small.regime.size
+    size = per_point * 2e12  # the coordinates and compliance_ratio add less than 0.1 %
+    first, second = stderr.splitlines()
+    assert first.startswith("ecofmaps map: 2,000,000,000,000 points, ")
+    assert first.endswith(f" into {out} (1 TB free there)")
+    stated = float(first.split(", ")[1].split()[0])
+    assert stated == pytest.approx(size / 1e12, rel=5e-3)  # in TB, 3 digits
+    assert second.startswith(f"ecofmaps: error: --out {out}: the map of 2e+12 points needs up to ")
+    assert second.endswith(f"more than the 1 TB free in {tmp_path.resolve()}: use a smaller grid "
+                           "or another disk")  # fmt: skip
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_a_grid_block_by_block_is_not_refused_for_memory(tmp_path, capsys, monkeypatch):
@@ -254,7 +303,8 @@ def test_a_grid_block_by_block_is_not_refused_for_memory(tmp_path, capsys, monke
     out = tmp_path / "m.nc"
     status, _, stderr = run(capsys, "map", *FIG11, "--chunk-points", "100", "--out", str(out))
     assert status == 0, stderr
-    status, _, stderr = run(capsys, "map", *FIG11, "--no-cache", "--out", str(out))
+    argv = ["map", *FIG11, "--no-cache", "--out", str(out), "--overwrite"]
+    status, _, stderr = run(capsys, *argv)
     assert status == 2 and "needs about" in stderr and "--chunk-points" in stderr
 
 
@@ -268,7 +318,7 @@ def test_progress_bar_on_a_terminal_only(tmp_path, capsys, monkeypatch, argv, ba
     status, _, stderr = run(capsys, "map", *FIG11, "--chunk-points", "30", *argv, "--out", str(out))
     assert status == 0
     first, *rest = stderr.split("\n", 1)
-    assert first == f"ecofmaps map: 140 points into {out}"
+    assert first.startswith("ecofmaps map: 140 points, ") and first.endswith(" free there)")
     if bar:
         assert "ecofmaps map: 100%" in rest[0] and "140/140" in rest[0]
         assert "5/5 blocks" in rest[0] and "pt/s" in rest[0]

@@ -115,6 +115,7 @@ def test_a_store_is_replaced_whole_and_not_after_ctrl_c(tmp_path):
     """After Ctrl-C on the command line the store is not renamed into place."""
     path = tmp_path / "store"
     path.mkdir()
+    (path / ".zgroup").write_text("{}")  # a zarr store: replaced whole
     (path / "a").write_text("old")
     with pytest.raises(KeyboardInterrupt), interrupts_stop_writes():
         signal.raise_signal(signal.SIGINT)  # the first Ctrl-C: a flag
@@ -123,10 +124,13 @@ def test_a_store_is_replaced_whole_and_not_after_ctrl_c(tmp_path):
             (temporary / "a").write_text("new")
     assert [p.name for p in tmp_path.iterdir()] == ["store"]
     assert (path / "a").read_text() == "old"
-    with atomic_store(path, overwrite=True) as temporary:  # a file by a directory, and back
+    with atomic_store(path, overwrite=True) as temporary:
         temporary.mkdir()
         (temporary / "a").write_text("new")
-    assert (path / "a").read_text() == "new"
-    with atomic_store(path, overwrite=True) as temporary:
+    assert (path / "a").read_text() == "new" and not (path / ".zgroup").exists()
+    with (
+        pytest.raises(IsADirectoryError, match="not a store"),  # a folder is never replaced
+        atomic_store(path, overwrite=True) as temporary,
+    ):
         temporary.write_text("file")
-    assert path.read_text() == "file" and [p.name for p in tmp_path.iterdir()] == ["store"]
+    assert (path / "a").read_text() == "new" and [p.name for p in tmp_path.iterdir()] == ["store"]
