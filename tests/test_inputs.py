@@ -175,3 +175,52 @@ def test_the_memory_check_counts_only_new_points(monkeypatch):
     assert ecofmaps.energy_cof(
         np.full((50, 1), 50e-6), 450.0, 35e6, np.full(50, 0.8), 0.2
     ).shape == (50, 50)
+
+
+LOOP_SI = ecofmaps.fretting_loop(**EXAMPLE_2_SI, num=64)
+
+
+@pytest.mark.parametrize(
+    ("function", "si", "in_units", "wrong"),
+    [
+        (
+            ecofmaps.simulate,
+            dict(displacement=np.linspace(-50e-6, 50e-6, 9), load=450.0, stiffness=35e6,
+                 mu=0.8, aspect_ratio=0.2, groove_half_width=50e-6),
+            dict(displacement=Q_(np.linspace(-50, 50, 9), "um"), load=Q_(0.45, "kN"),
+                 stiffness=Q_(35, "N/um"), groove_half_width=Q_(0.05, "mm")),
+            dict(groove_half_width=Q_(50, "N")),
+        ),
+        (
+            ecofmaps.fit_loop,
+            dict(displacement=np.asarray(LOOP_SI[0]), force=np.asarray(LOOP_SI[1]), load=450.0),
+            dict(displacement=Q_(np.asarray(LOOP_SI[0]) * 1e3, "mm"),
+                 force=Q_(np.asarray(LOOP_SI[1]) * 1e-3, "kN"), load=Q_(450, "N")),
+            dict(force=Q_(np.asarray(LOOP_SI[1]), "m")),
+        ),
+        (
+            ecofmaps.correction_factor,
+            dict(ecof=0.83, amplitude=50e-6, load=450.0, stiffness=35e6, scar_depth=8e-6,
+                 scar_half_width=40e-6),
+            dict(amplitude=Q_(0.05, "mm"), stiffness=Q_(35, "MN/m"), scar_depth=Q_(8, "um"),
+                 scar_half_width=Q_(40e-6, "m")),
+            dict(scar_depth=Q_(8, "N/m")),
+        ),
+    ],
+)  # fmt: skip
+def test_lengths_and_forces_keep_their_units(function, si, in_units, wrong):
+    """Quantities in any unit give the SI result; a wrong dimension names the parameter."""
+
+    def numbers(result):
+        if isinstance(result, ecofmaps.LoopFit):  # fitted: converged to a tolerance
+            return [result.mu, result.stiffness, result.aspect_ratio, result.load]
+        return jax.tree_util.tree_leaves(result)
+
+    expected = numbers(function(**si))
+    got = numbers(function(**{**si, **in_units}))
+    rtol = 1e-6 if function is ecofmaps.fit_loop else 1e-9  # SI values differ by rounding
+    for value, reference in zip(got, expected, strict=True):
+        np.testing.assert_allclose(np.asarray(value), np.asarray(reference), rtol=rtol)
+    (name,) = wrong
+    with pytest.raises(ValueError, match=rf"^{name} must be a"):
+        function(**{**si, **wrong})
