@@ -84,7 +84,7 @@ _CHOOSE = {
     "displacement": "displacement_column (--displacement-col)",
     "force": "force_column (--force-col)",
     "cycle": "cycle_column (--cycle-col)",
-    "load": "load_column",
+    "load": "load_column (--load COLUMN)",
     "x": "x_column (--x-column)",
     "z": "z_column (--z-column)",
 }
