@@ -17,6 +17,7 @@ from ecofmaps._inputs import float64
 from ecofmaps.maps.cache import cached_dataset
 from ecofmaps.maps.dataset import _axis, _dataset, _load
 from ecofmaps.maps.tiles import MAX_CHUNK
+from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers
 
 __all__ = ["MODEL_ON_PROFILE", "compute_profile_map"]
 
@@ -85,8 +86,6 @@ def compute_profile_map(stiffness_ratio, amplitude, mu, load=None, *, profile, m
     >>> m.ecof_ratio.dims
     ('stiffness_ratio',)
     """
-    from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers
-
     if profile is None:
         raise ValueError("compute_map needs aspect_ratio or profile")
     if amplitude is None or mu is None:

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ecofmaps.io.writers import RecordingWriter
 from ecofmaps.measured.synthetic import synthetic_recording
 
 __all__ = ["LONG_TEST", "long_recording", "write_long_recording"]
@@ -156,8 +157,6 @@ def write_long_recording(
     >>> ecofmaps.read_recording(path).size
     1000
     """
-    from ecofmaps.io.writers import RecordingWriter
-
     blocks = long_recording(
         cycles, samples_per_cycle, block_cycles=block_cycles, seed=seed, **parameters
     )

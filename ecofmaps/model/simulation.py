@@ -16,6 +16,7 @@ import jax.numpy as jnp
 
 from ecofmaps._inputs import as_float64, check, float64, is_concrete
 from ecofmaps.model.core import _slip_roots, locking_margin, slip_ratio, traction_ratio
+from ecofmaps.model.on_profile import profile_loop, profile_simulation
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
 from ecofmaps.model.steady_state import check_model_inputs, dimensionless, one_geometry
 
@@ -128,8 +129,6 @@ def fretting_loop(amplitude, load, stiffness, mu, aspect_ratio=None, groove_half
         raise ValueError(f"num must be an integer >= 2, got {num!r}")
     one_geometry(aspect_ratio, profile, mapping)
     if profile is not None:
-        from ecofmaps.model.on_profile import profile_loop
-
         return profile_loop(
             profile, amplitude, load, stiffness, mu, groove_half_width, mapping, num
         )
@@ -230,8 +229,6 @@ def simulate(displacement, load, stiffness, mu, aspect_ratio=None, groove_half_w
         raise ValueError("displacement must have a time axis (at least one dimension)")
     one_geometry(aspect_ratio, profile, mapping)
     if profile is not None:
-        from ecofmaps.model.on_profile import profile_simulation
-
         return profile_simulation(
             profile, displacement, load, stiffness, mu, groove_half_width, mapping
         )

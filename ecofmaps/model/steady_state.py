@@ -22,6 +22,7 @@ from ecofmaps.model.core import (
     regime_code,
     slip_ratio,
 )
+from ecofmaps.model.on_profile import steady_numbers
 from ecofmaps.model.regimes import INVALID, Regime
 
 _ON_PROFILE = {
@@ -125,8 +126,6 @@ def one_geometry(aspect_ratio, profile, mapping="scaled") -> None:
 
 
 def _evaluate_on_profile(quantity, arguments, profile, mapping):
-    from ecofmaps.model.on_profile import steady_numbers
-
     amplitude, load, stiffness, mu, _, groove_half_width = arguments
     numbers = steady_numbers(profile, amplitude, load, stiffness, mu, groove_half_width, mapping)
     result = _profile_quantity(quantity, numbers, *(as_float64(v) for v in (amplitude, load, mu)))
