@@ -7,9 +7,15 @@ the file's format:
 - text: CSV, TSV, spreadsheet exports, whitespace-separated columns with a header line
   (:mod:`ecofmaps.io.text`: separator and decimal comma detected, quotes, encodings,
   missing cells), parsed in blocks;
-- TDMS (LabVIEW), HDF5 and netCDF-4, zarr stores (:mod:`ecofmaps.io.binary`): channels or
-  variables chosen by name (and ``group``), units from their metadata, read lazily as dask
+- TDMS (LabVIEW), HDF5 and netCDF-4, zarr stores of format 2 or 3
+  (:mod:`ecofmaps.io.binary`, opened through npTDMS and xarray by
+  :mod:`ecofmaps.io.rig_formats`): channels or variables chosen by name (and ``group``),
+  units from their metadata, fill values and CF packing decoded, read lazily as dask
   arrays when large.
+
+:func:`open_recording` gives the same recording as one xarray Dataset over ``sample``
+(:meth:`~ecofmaps.io.recording_types.Recording.to_dataset`), with the units and the columns
+read in its attributes.
 
 The format is found from the file's first bytes (a zarr store is a directory), not its
 suffix. Columns are found by name without regard to case, and a unit carried by the name
