@@ -51,6 +51,7 @@ __all__ = [
     "Runner",
     "SchedulerError",
     "Slice",
+    "check_workers",
     "probe_scheduler",
     "stretch",
     "worker_limit",
@@ -143,16 +144,14 @@ class Runner:
     """
 
     def __init__(self, workers=None, *, scheduler=None, cluster=False, client=None, timeout=None):
-        if workers is not None and (
+        if scheduler is not None and cluster:
+            raise ValueError("give a scheduler address or start a local cluster, not both")
+        if scheduler is None and client is None:  # this machine's threads or processes
+            check_workers(workers, processes=cluster)
+        elif workers is not None and (
             isinstance(workers, bool) or int(workers) != workers or workers < 1
         ):
             raise ValueError(f"workers must be a positive integer; got {workers!r}")
-        if scheduler is not None and cluster:
-            raise ValueError("give a scheduler address or start a local cluster, not both")
-        if workers is not None and scheduler is None and client is None:
-            limit, why = worker_limit(processes=cluster)
-            if workers > limit:
-                raise ValueError(f"workers={workers} is more than this machine can run: {why}")
         self.scheduler, self.cluster, self.timeout = scheduler, cluster, timeout
         self.workers = int(workers) if workers else (1 if scheduler else os.cpu_count() or 1)
         self._given = client
@@ -272,6 +271,26 @@ class Runner:
         finally:
             for future in pending:
                 future.cancel()
+
+
+def check_workers(workers, processes: bool) -> None:
+    """Raise ``ValueError`` naming ``workers`` unless it is None or a whole number of
+    workers that this machine can run (:func:`worker_limit`).
+
+    Parameters
+    ----------
+    workers : int or None
+        Threads of this process, or worker processes of a local cluster.
+    processes : bool
+        Whether they are processes.
+    """
+    if workers is None:
+        return
+    if isinstance(workers, bool) or int(workers) != workers or workers < 1:
+        raise ValueError(f"workers must be a positive integer; got {workers!r}")
+    limit, why = worker_limit(processes=processes)
+    if workers > limit:
+        raise ValueError(f"workers={workers} is more than this machine can run: {why}")
 
 
 def worker_limit(processes: bool) -> tuple[int, str]:

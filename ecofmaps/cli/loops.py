@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import textwrap
 
+from ecofmaps._parallel import worker_limit
 from ecofmaps.cli._common import quantity, unit
 
 __all__ = ["add", "run"]
@@ -133,6 +134,9 @@ def _workers(text: str) -> int:
         value = 0
     if value < 1:
         raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of workers >= 1")
+    limit, why = worker_limit(processes=True)
+    if value > limit:
+        raise argparse.ArgumentTypeError(f"{value} is more than this machine can run: {why}")
     return value
 
 

@@ -22,7 +22,6 @@ import dataclasses
 import functools
 import json
 import os
-import shutil
 import sys
 from pathlib import Path
 
@@ -130,7 +129,13 @@ class _Partial:
         return kept
 
     def remove(self) -> None:
-        shutil.rmtree(self.folder, ignore_errors=True)
+        """Remove the files the run kept, then the folder if nothing else is in it (a file
+        someone put there is not removed)."""
+        for pattern in ("file*.npz", "run.json", ".file*.npz.tmp", ".run.json.tmp"):
+            for path in self.folder.glob(pattern):
+                path.unlink(missing_ok=True)
+        with contextlib.suppress(OSError):  # not empty: left as it is
+            self.folder.rmdir()
 
 
 def keep_block(folder: Path, index: int, block: int, values: dict, flags: dict) -> None:

@@ -84,7 +84,7 @@ import numpy as np
 import xarray as xr
 
 from ecofmaps._inputs import si_units
-from ecofmaps._parallel import Runner
+from ecofmaps._parallel import Runner, check_workers
 from ecofmaps.measured.cycles import MIN_SAMPLES
 from ecofmaps.measured.options import (
     DEFAULTS,
@@ -279,6 +279,8 @@ def _run(
     (or None)."""
     if nan_policy not in NAN_POLICIES:
         raise ValueError(f"nan_policy must be one of {NAN_POLICIES}; got {nan_policy!r}")
+    if scheduler in (None, "threads", "processes"):  # on this machine: checked before any work
+        check_workers(workers, processes=scheduler == "processes")
     x = _series("displacement", displacement)
     q = _series("force", force, x.shape[0])
     label = None if cycle is None else _series("cycle", cycle, x.shape[0], dtype=None)
