@@ -176,8 +176,12 @@ def _load_or_column(text: str):
     try:
         return quantity("load")(text)
     except argparse.ArgumentTypeError:
-        if text.strip() and not text.strip()[0].isdigit() and not text.startswith(("-", ".")):
-            return text.strip()  # a column of the recording, e.g. Fz
+        name = text.strip()
+        try:
+            float(name.split()[0] if name else "x")
+        except ValueError:  # not a number at all (inf and nan are numbers): a column's name
+            if name and not name[0].isdigit() and not name.startswith(("-", "+", ".")):
+                return name  # a column of the recording, e.g. Fz
         raise
 
 
