@@ -103,6 +103,8 @@ def zarr_groups(path) -> dict[str, xr.Dataset]:
     """
     path = Path(path)
     root = _opened(path)
+    if not hasattr(root, "members"):  # a store that is one array, which xarray cannot open
+        return _plain_groups(path, root)
     try:
         return xr.open_groups(path, consolidated=_consolidated(root), **OPTIONS)
     except KeyError as error:
@@ -124,6 +126,8 @@ def open_zarr_group(path, group: str | None = None) -> xr.Dataset:
     path = Path(path)
     key = "/" + (group or "").strip("/")
     root = _opened(path)
+    if not hasattr(root, "members"):  # a store that is one array
+        return _plain_groups(path, root)["/"]
     try:
         return xr.open_dataset(path, group=key, consolidated=_consolidated(root), **OPTIONS)
     except KeyError as error:

@@ -265,3 +265,30 @@ def test_binary_does_not_import_recordings():
         "import ecofmaps.io.recordings\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
+
+
+@pytest.mark.parametrize("zarr_format", [2, 3])
+def test_stores_written_by_zarr_alone(tmp_path, zarr_format):
+    """Arrays without dimension names (which xarray's engine needs) are read too, their CF
+    attributes decoded by xarray; a store that is one array is its one variable."""
+    import zarr
+
+    from ecofmaps.io.rig_formats import open_group, variables
+
+    path = tmp_path / "plain.zarr"
+    root = zarr.open_group(str(path), mode="w", zarr_format=zarr_format)
+    counts = np.array([3, -999, 5, 7], dtype=np.int16)
+    for name, attrs in (
+        ("displacement", {"units": "mm", "scale_factor": 0.5, "_FillValue": -999}),
+        ("force", {"units": "N"}),
+    ):
+        array = root.create_array(name, shape=(4,), chunks=(2,), dtype=np.int16)
+        array[:] = counts
+        array.attrs.update(attrs)
+    read = read_recording(path)
+    np.testing.assert_array_equal(read.displacement, [1.5e-3, np.nan, 2.5e-3, 3.5e-3])
+    np.testing.assert_array_equal(read.force, counts)
+    single = zarr.create_array(str(tmp_path / "one.zarr"), shape=(3,), chunks=(3,), dtype="f8")
+    single[:] = [1.0, 2.0, 3.0]
+    assert [v.name for v in variables(tmp_path / "one.zarr", "zarr")] == ["one"]
+    np.testing.assert_array_equal(open_group(tmp_path / "one.zarr", "zarr", "")["one"], [1, 2, 3])
