@@ -1,10 +1,11 @@
 """``ecofmaps figures``: write the paper's figures (default: into figures/), in parallel.
 
 The figures are drawn by groups sharing one Dataset (:func:`ecofmaps.figures.figure_groups`),
-the costliest first, on ``--jobs`` processes (default: one per core). Each drawing process
-keeps JAX's compiled kernels in ``<cache>/jax`` (:data:`JAX_CACHE_FOLDER`), beside the
-cached maps, so a second run compiles nothing it compiled before; this is set for the run
-only, never on importing the library.
+the costliest first, on ``--jobs`` processes (default: one per core); the parts of a costly
+Dataset (:func:`ecofmaps.figures.figure_parts`: the ``shapes`` figure's maps and loops) are
+computed in parallel before it. Each drawing process keeps JAX's compiled kernels in
+``<cache>/jax`` (:data:`JAX_CACHE_FOLDER`), beside the cached maps, so a second run compiles
+nothing it compiled before; this is set for the run only, never on importing the library.
 """
 
 from __future__ import annotations
@@ -21,6 +22,8 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from pathlib import Path
 
 from ecofmaps._interrupts import check_interrupted, interrupts_stop_writes
+from ecofmaps.cli._common import refuse_to_overwrite
+from ecofmaps.io.files import record_written
 
 __all__ = [
     "FIGURE_FORMATS",
@@ -102,6 +105,11 @@ def add(subparsers) -> None:
     parser.add_argument(
         "--format", type=figure_formats, default=("png",), metavar="FORMATS",
         help="comma-separated file formats among png, pdf, svg (default: png)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--overwrite", action="store_true",
+        help="replace the figures ecofmaps wrote in DIR before (a DIR that is not empty needs "
+        "it); files ecofmaps did not write are never replaced",
     )  # fmt: skip
     parser.add_argument(
         "--jobs", type=_jobs, default=None, metavar="N",
@@ -203,8 +211,21 @@ def _worker_group(names, directory, formats) -> list[tuple[str, list[Path], floa
         os._exit(128 + signal.SIGTERM)
 
 
-def _written_in_parallel(groups, out: Path, formats, jobs: int):
-    """Yield each group's :func:`write_figure_group` result from ``jobs`` processes."""
+def _worker_part(part) -> None:
+    """Compute one part of a Dataset in a drawing process, which stores it in the cache."""
+    try:
+        with interrupts_stop_writes():
+            part()
+    except KeyboardInterrupt:
+        os._exit(128 + signal.SIGTERM)  # as _worker_group
+
+
+def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
+    """Yield each group's :func:`write_figure_group` result from ``jobs`` processes.
+
+    The parts of a group's Dataset (:func:`ecofmaps.figures.figure_parts`) are computed
+    first, in parallel; the group is drawn once all its parts are in the cache.
+    """
     others = set(multiprocessing.active_children())
     executor = ProcessPoolExecutor(
         jobs,
@@ -212,12 +233,26 @@ def _written_in_parallel(groups, out: Path, formats, jobs: int):
         initializer=_start_worker,
     )
     try:
-        pending = {executor.submit(_worker_group, group, out, formats) for group in groups}
+        group_of = {}  # the future of a part: the index of its group
+        for index, group_parts in enumerate(parts):
+            group_of.update({executor.submit(_worker_part, part): index for part in group_parts})
+        missing = [len(group_parts) for group_parts in parts]
+        pending = set(group_of)
+        for index, group in enumerate(groups):
+            if not missing[index]:
+                pending.add(executor.submit(_worker_group, group, out, formats))
         while pending:  # waits of a quarter second, so Ctrl-C is seen at once
             done, pending = wait(pending, timeout=0.25, return_when=FIRST_COMPLETED)
             check_interrupted()
             for future in done:
-                yield future.result()
+                written = future.result()
+                if future not in group_of:
+                    yield written
+                    continue
+                index = group_of[future]
+                missing[index] -= 1
+                if not missing[index]:
+                    pending.add(executor.submit(_worker_group, groups[index], out, formats))
     except BaseException:  # an error, Ctrl-C or SIGTERM: stop the drawing processes too
         executor.shutdown(wait=False, cancel_futures=True)
         ours = set(multiprocessing.active_children()) - others
@@ -240,13 +275,17 @@ def _written_here(groups, out: Path, formats):
 
 
 def run(args) -> int:
-    from ecofmaps.figures.recipes import figure_groups
+    from ecofmaps.figures.recipes import figure_groups, figure_parts
 
     names = list(dict.fromkeys(args.only or ()))
     groups = figure_groups(names or None)
+    parts = figure_parts(names or None)
     count = sum(len(group) for group in groups)
-    jobs = min(args.jobs or usable_cores(), len(groups))
+    jobs = min(args.jobs or usable_cores(), max(len(groups), *map(len, parts)))
     out = Path(args.out)
+    drawn = [name for group in groups for name in group]
+    planned = [("--out", out / f"{name}.{suffix}") for name in drawn for suffix in args.format]
+    refuse_to_overwrite(planned, [], overwrite=args.overwrite, folders=[("--out", out)])
     out.mkdir(parents=True, exist_ok=True)
     print(
         f"ecofmaps figures: {count} figure(s) as {', '.join(args.format)} into {out}"
@@ -255,12 +294,13 @@ def run(args) -> int:
     )
     begin = time.perf_counter()
     if jobs > 1:
-        results = _written_in_parallel(groups, out, args.format, jobs)
+        results = _written_in_parallel(groups, parts, out, args.format, jobs)
     else:
         results = _written_here(groups, out, args.format)
     index = 0
     for written in results:
         for name, paths, seconds in written:
+            record_written(paths)
             index += 1
             print(
                 f"  [{index}/{count}] {name:<10} {seconds:5.1f} s  "

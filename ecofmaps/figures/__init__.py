@@ -33,6 +33,7 @@ _PUBLIC = {
         "FIGURES",
         "FigureRecipe",
         "figure_groups",
+        "figure_parts",
         "make_figure",
         "make_figures",
     ),

@@ -33,8 +33,11 @@ __all__ = [
     "SCAR_SHAPES",
     "FigureRecipe",
     "figure_groups",
+    "figure_parts",
     "make_figure",
     "make_figures",
+    "scar_shape_loops_dataset",
+    "scar_shape_maps_dataset",
     "scar_shapes_dataset",
     "source_digest",
 ]
@@ -74,6 +77,10 @@ class FigureRecipe:
         Rough time to build the Dataset from an empty cache and draw the figure, relative
         to a plain figure: the costliest work is started first when figures are drawn in
         parallel (:func:`figure_groups`). [1]
+    parts : tuple of callable
+        Functions that compute and cache independent parts of the Dataset, which ``data``
+        then reads from the cache: ``ecofmaps figures`` runs them in parallel first
+        (:func:`figure_parts`).
     """
 
     name: str
@@ -84,6 +91,7 @@ class FigureRecipe:
     options: dict = field(default_factory=dict)
     module: str = "model_figures"
     cost: float = 1.0
+    parts: tuple = ()
 
     def dataset(self) -> xr.Dataset:
         """The Dataset this figure draws."""
@@ -184,85 +192,162 @@ def source_digest(patterns) -> np.ndarray:
     return np.frombuffer(digest.digest(), dtype=np.uint8)
 
 
-def _scar_shapes() -> xr.Dataset:
-    """The ``shapes`` figure's Dataset, from the disk cache when there (see
-    :func:`scar_shapes_dataset`); keyed by the model's revision and this module's and the
-    correction's sources."""
+def _cached_shapes_part(function: str, compute: Callable[[], xr.Dataset]) -> xr.Dataset:
+    """``compute()`` through the disk cache, keyed by the model's revision and the sources."""
+    # Imported here, like the map functions: the registry reads without JAX.
     from ecofmaps.maps.cache import cached_dataset
 
-    inputs = {"sources": source_digest(_SCAR_SHAPES_SOURCES)}
-    return cached_dataset("scar_shapes", inputs, scar_shapes_dataset)
+    return cached_dataset(function, {"sources": source_digest(_SCAR_SHAPES_SOURCES)}, compute)
+
+
+def _scar_shape_loops() -> xr.Dataset:
+    return _cached_shapes_part("scar_shape_loops", scar_shape_loops_dataset)
+
+
+def _scar_shape_maps() -> xr.Dataset:
+    return _cached_shapes_part("scar_shape_maps", scar_shape_maps_dataset)
+
+
+def _scar_shapes() -> xr.Dataset:
+    """The ``shapes`` figure's Dataset, from the disk cache when there (see
+    :func:`scar_shapes_dataset`)."""
+    return _cached_shapes_part("scar_shapes", scar_shapes_dataset)
+
+
+def _scar_profiles() -> dict:
+    """The scar families of :data:`SCAR_SHAPES` at Example 2's D/W, by name."""
+    import ecofmaps
+
+    depth, width = paper.ASPECT_RATIO * paper.AMPLITUDE, paper.AMPLITUDE
+    scale = {"ridge_height": depth, "ridge_width": width}
+    profiles = {}
+    for name, (family, parameters) in SCAR_SHAPES.items():
+        options = {key: value * scale.get(key, 1.0) for key, value in parameters.items()}
+        profiles[name] = getattr(ecofmaps, family)(depth, width, **options)
+    return profiles
+
+
+def _labelled(variables: dict, coords: dict) -> xr.Dataset:
+    """A Dataset of ``variables`` and ``coords``, each with its nomenclature's attrs."""
+    import xarray as xr
+
+    from ecofmaps._nomenclature import attrs
+
+    return xr.Dataset(
+        {name: (dims, values, attrs(name)) for name, (dims, values) in variables.items()},
+        coords={name: ((name if np.ndim(v) else ()), v, attrs(name)) for name, v in coords.items()},
+    )
+
+
+#: The rig of the ``shapes`` figure's loops: Example 2's.
+_SHAPES_RIG = dict(
+    amplitude=paper.AMPLITUDE, load=paper.LOAD, stiffness=paper.STIFFNESS, mu=paper.MU
+)
+#: Figure 11's S/P with Example 2's among them: its steady values come from the same map. [1/m]
+_SHAPES_STIFFNESS_RATIOS = np.union1d(
+    paper.FIGURE_11_STIFFNESS_RATIOS, [paper.STIFFNESS / paper.LOAD]
+)
+_SHAPES_COORDS = {"shape": list(SCAR_SHAPES), "groove": ["profile", "parabola"]}
+
+
+def scar_shape_loops_dataset() -> xr.Dataset:
+    """The scar families' profiles and steady loops, with the parabola's of the same D/W.
+
+    Returns
+    -------
+    dataset : xarray.Dataset
+        ``scar_height`` over (``shape``, ``scar_position``); ``displacement`` and ``force``
+        over (``shape``, ``groove``, ``point``), Example 2's rig. Computed, not cached.
+    """
+    import ecofmaps
+
+    position = np.linspace(-1.6, 1.6, 321) * paper.AMPLITUDE
+    parabola = np.asarray(ecofmaps.fretting_loop(**_SHAPES_RIG, aspect_ratio=paper.ASPECT_RATIO))
+    heights, loops = [], []
+    for profile in _scar_profiles().values():
+        heights.append(np.interp(position, profile.position, profile.height))
+        loop = np.asarray(ecofmaps.fretting_loop(**_SHAPES_RIG, profile=profile))
+        loops.append(np.stack([loop, parabola]))
+    loops = np.array(loops)
+    groove = ("shape", "groove", "point")
+    variables = {
+        "scar_height": (("shape", "scar_position"), np.array(heights)),
+        "displacement": (groove, loops[:, :, 0]),
+        "force": (groove, loops[:, :, 1]),
+    }
+    return _labelled(variables, {**_SHAPES_COORDS, "scar_position": position})
+
+
+def scar_shape_maps_dataset() -> xr.Dataset:
+    """The steady values over S/P on each scar family and on the parabola of the same D/W.
+
+    Returns
+    -------
+    dataset : xarray.Dataset
+        ``slip_amplitude``, ``dissipated_energy``, ``ecof`` and ``ecof_ratio`` over
+        (``shape``, ``groove``, ``stiffness_ratio``). Computed, not cached.
+    """
+    from ecofmaps.maps.grid import compute_map
+
+    ratios = _SHAPES_STIFFNESS_RATIOS
+    grid = dict(amplitude=paper.AMPLITUDE, mu=paper.MU, load=paper.LOAD)
+    parabola = compute_map(ratios, paper.ASPECT_RATIO, **grid)
+    names = ("slip_amplitude", "dissipated_energy", "ecof", "ecof_ratio")
+    values = {name: [] for name in names}
+    for profile in _scar_profiles().values():
+        on_profile = compute_map(ratios, **grid, profile=profile)
+        for name in names:
+            values[name].append(np.stack([on_profile[name].values, parabola[name].values]))
+    dims = ("shape", "groove", "stiffness_ratio")
+    variables = {name: (dims, np.array(value)) for name, value in values.items()}
+    return _labelled(variables, {**_SHAPES_COORDS, "stiffness_ratio": ratios})
 
 
 def scar_shapes_dataset() -> xr.Dataset:
     """The four scar families at Example 2's D/W: profiles, loops, μ_E/μ over S/P (Fig. 11's).
 
+    Its loops and maps are read from the cache, or computed and stored there
+    (:func:`scar_shape_loops_dataset`, :func:`scar_shape_maps_dataset`: ``ecofmaps figures``
+    computes them in parallel); the D/W shortcut's error is computed here.
+
     Returns
     -------
     dataset : xarray.Dataset
-        The ``shapes`` figure's numbers, computed (not cached): see
+        The ``shapes`` figure's numbers: see
         :func:`ecofmaps.figures.profile_figures.scar_shape_comparison` for its variables.
     """
-    import xarray as xr
-
     import ecofmaps
-    from ecofmaps._nomenclature import attrs
-    from ecofmaps.maps.grid import compute_map
 
-    depth, width = paper.ASPECT_RATIO * paper.AMPLITUDE, paper.AMPLITUDE
-    rig = dict(amplitude=paper.AMPLITUDE, load=paper.LOAD, stiffness=paper.STIFFNESS, mu=paper.MU)
-    example = paper.STIFFNESS / paper.LOAD
-    # Figure 11's S/P with Example 2's among them: its steady values come from the same map.
-    ratios = np.union1d(paper.FIGURE_11_STIFFNESS_RATIOS, [example])
-    at_example = int(np.searchsorted(ratios, example))
-    position = np.linspace(-1.6, 1.6, 321) * width
-    steady = ("slip_amplitude", "dissipated_energy", "ecof")
-    grid = dict(amplitude=paper.AMPLITUDE, mu=paper.MU, load=paper.LOAD)
-    parabola = compute_map(ratios, paper.ASPECT_RATIO, **grid)
-    parabola_loop = np.asarray(ecofmaps.fretting_loop(**rig, aspect_ratio=paper.ASPECT_RATIO))
-    columns = {name: [] for name in ("height", "loop", "steady", "ratio", "error")}
-    for family, parameters in SCAR_SHAPES.values():
-        scale = {"ridge_height": depth, "ridge_width": width}
-        options = {k: v * scale.get(k, 1.0) for k, v in parameters.items()}
-        profile = getattr(ecofmaps, family)(depth, width, **options)
-        columns["height"].append(np.interp(position, profile.position, profile.height))
-        loop = np.asarray(ecofmaps.fretting_loop(**rig, profile=profile))
-        columns["loop"].append(np.stack([loop, parabola_loop]))
-        on_profile = compute_map(ratios, **grid, profile=profile)
-        columns["steady"].append(
-            [[float(m[name][at_example]) for m in (on_profile, parabola)] for name in steady]
-        )
-        ratio = on_profile["ecof_ratio"].values
-        columns["ratio"].append(np.stack([ratio, parabola["ecof_ratio"].values]))
+    loops, maps = _scar_shape_loops(), _scar_shape_maps()
+    ratios = _SHAPES_STIFFNESS_RATIOS
+    at_example = int(np.searchsorted(ratios, paper.STIFFNESS / paper.LOAD))
+    errors = []
+    for ratio in maps["ecof_ratio"].sel(groove="profile").values:
         # μ from the profile's μ_E corrected with the parabola of the same D/W (eq. 11)
         corrected = ecofmaps.correct_ecof(
             paper.MU * ratio, paper.AMPLITUDE, paper.LOAD, ratios * paper.LOAD, paper.ASPECT_RATIO
         )
-        columns["error"].append(np.asarray(corrected) / paper.MU - 1.0)
-    loops = np.array(columns["loop"])
-    steady_values = np.array(columns["steady"])
+        errors.append(np.asarray(corrected) / paper.MU - 1.0)
     groove = ("shape", "groove")
+    steady = ("slip_amplitude", "dissipated_energy", "ecof")
     variables = {
-        "scar_height": (("shape", "scar_position"), np.array(columns["height"])),
-        "displacement": ((*groove, "point"), loops[:, :, 0]),
-        "force": ((*groove, "point"), loops[:, :, 1]),
-        **{name: (groove, steady_values[:, i]) for i, name in enumerate(steady)},
-        "ecof_ratio": ((*groove, "stiffness_ratio"), np.array(columns["ratio"])),
-        "shortcut_error": (("shape", "stiffness_ratio"), np.array(columns["error"])),
+        "scar_height": (("shape", "scar_position"), loops["scar_height"].values),
+        "displacement": ((*groove, "point"), loops["displacement"].values),
+        "force": ((*groove, "point"), loops["force"].values),
+        **{name: (groove, maps[name].values[:, :, at_example]) for name in steady},
+        "ecof_ratio": ((*groove, "stiffness_ratio"), maps["ecof_ratio"].values),
+        "shortcut_error": (("shape", "stiffness_ratio"), np.array(errors)),
     }
+    depth = paper.ASPECT_RATIO * paper.AMPLITUDE
     coords = {
-        "shape": list(SCAR_SHAPES),
-        "groove": ["profile", "parabola"],
-        "scar_position": position,
+        **_SHAPES_COORDS,
+        "scar_position": loops["scar_position"].values,
         "stiffness_ratio": ratios,
-        **rig,
+        **_SHAPES_RIG,
         "scar_depth": depth,
-        "scar_half_width": width,
+        "scar_half_width": paper.AMPLITUDE,
     }
-    dataset = xr.Dataset(
-        {name: (dims, values, attrs(name)) for name, (dims, values) in variables.items()},
-        coords={name: ((name if np.ndim(v) else ()), v, attrs(name)) for name, v in coords.items()},
-    )
+    dataset = _labelled(variables, coords)
     dataset.attrs["title"] = (
         "Scar shapes at equal D/W: the model on each profile against the parabola of the same "
         "D/W (the paper's eq. 11 shortcut)"
@@ -347,6 +432,7 @@ FIGURES: dict[str, FigureRecipe] = {
             "scar_shape_comparison",
             module="profile_figures",
             cost=8.0,
+            parts=(_scar_shape_maps, _scar_shape_loops),
         ),
     )
 }
@@ -439,3 +525,26 @@ def figure_groups(names=None) -> list[list[str]]:
         groups.setdefault(recipe.data, []).append(recipe)
     ordered = sorted(groups.values(), key=lambda group: -sum(recipe.cost for recipe in group))
     return [[recipe.name for recipe in group] for group in ordered]
+
+
+def figure_parts(names=None) -> list[list[Callable[[], xr.Dataset]]]:
+    """The parts of each group's Dataset (:attr:`FigureRecipe.parts`), for parallel work.
+
+    Parameters
+    ----------
+    names : iterable of str, optional
+        Keys of :data:`FIGURES`; default all of them.
+
+    Returns
+    -------
+    parts : list of list of callable
+        One list per group of :func:`figure_groups` (in its order, empty for most): each
+        callable computes one part and stores it in the cache, where the group's Dataset
+        reads it.
+
+    Raises
+    ------
+    ValueError
+        If a name is not a key of :data:`FIGURES`.
+    """
+    return [list(_recipe(group[0]).parts) for group in figure_groups(names)]

@@ -13,6 +13,7 @@ from ecofmaps import figures
 from ecofmaps.cli import main
 from ecofmaps.cli.figures import JAX_CACHE_FOLDER
 from ecofmaps.figures import recipes
+from ecofmaps.io.files import MANIFEST
 from ecofmaps.maps import cache_entries
 
 
@@ -73,7 +74,7 @@ def test_the_loops_of_figures_5_and_6_are_cached(tmp_path, monkeypatch):
 def test_parallel_command_writes_every_figure(tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["figures", "--out", str(out), "--only", "fig8", "fig11a", "--jobs", "2"]) == 0
-    assert sorted(p.name for p in out.iterdir()) == ["fig11a.png", "fig8.png"]
+    assert sorted(p.name for p in out.iterdir()) == [MANIFEST, "fig11a.png", "fig8.png"]
     progress = capsys.readouterr().err.splitlines()
     assert progress[0].endswith(", 2 processes")
     assert sorted(line.split()[1] for line in progress[1:3]) == ["fig11a", "fig8"]
@@ -106,5 +107,15 @@ def test_a_fresh_process_stores_its_compiled_kernels(tmp_path):
     subprocess.run(command, env=environment, check=True, timeout=600, capture_output=True)
     kernels = sorted(p.name for p in (cache / JAX_CACHE_FOLDER).iterdir())
     assert any(name.startswith("jit__universal_kernel") for name in kernels)
+    command.append("--overwrite")  # the figure it wrote: replaced
     subprocess.run(command, env=environment, check=True, timeout=600, capture_output=True)
     assert sorted(p.name for p in (cache / JAX_CACHE_FOLDER).iterdir()) == kernels
+
+
+def test_the_shapes_dataset_has_parts_computed_first():
+    """Its maps and loops, computed (and cached) in parallel before the figure is drawn."""
+    parts = figures.figure_parts()
+    assert len(parts) == len(figures.figure_groups())
+    assert [part.__name__ for part in parts[0]] == ["_scar_shape_maps", "_scar_shape_loops"]
+    assert all(not group_parts for group_parts in parts[1:])
+    assert figures.figure_parts(["fig8", "fig7a"]) == [[]]
