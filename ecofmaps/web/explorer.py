@@ -29,6 +29,7 @@ from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 from panel.io.server import get_server
 
+from ecofmaps._interrupts import check_interrupted
 from ecofmaps._nomenclature import QUANTITIES, RANGES, within
 from ecofmaps.correction.inversion import correct_ecof
 from ecofmaps.maps.grid import compute_map
@@ -389,22 +390,26 @@ def serve_explorer(port: int, *, open_browser: bool = True, announce=print) -> N
         {"/": explorer_page}, port=port, address="127.0.0.1", show=False, start=False,
         title="ecofmaps explorer", websocket_origin=[f"127.0.0.1:{port}", f"localhost:{port}"],
     )  # fmt: skip
-    warm_up()  # the port is taken: a page asked for meanwhile waits for it
     loop = server.io_loop
 
-    def stop(signum, frame):
+    def stop(signum, frame):  # the loop stops as soon as it runs (at once if it runs)
         loop.asyncio_loop.call_soon_threadsafe(loop.stop)
 
-    previous = {number: signal.signal(number, stop) for number in (signal.SIGINT, signal.SIGTERM)}
+    previous = {number: signal.getsignal(number) for number in (signal.SIGINT, signal.SIGTERM)}
+    ours = [number for number, before in previous.items() if before not in (signal.SIG_IGN, None)]
+    for number in ours:  # a signal ignored (Ctrl-C in a background job) stays ignored
+        signal.signal(number, stop)
     try:
+        check_interrupted()  # a Ctrl-C while the command started up stops it here
+        warm_up()  # the port is taken: a page asked for meanwhile waits for it
         server.start()
         announce(f"ecofmaps explorer at {url} (Ctrl-C stops it)")
         if open_browser:
             loop.add_callback(webbrowser.open, url)
         loop.start()
     finally:
-        for number, handler in previous.items():
-            signal.signal(number, handler)
+        for number in ours:
+            signal.signal(number, previous[number])
         server.stop()
         _close(loop.asyncio_loop)
 
