@@ -10,6 +10,7 @@ traceback.
 from __future__ import annotations
 
 import argparse
+import gc
 import importlib
 import os
 import signal
@@ -123,10 +124,14 @@ def console() -> None:
     After Ctrl-C or SIGTERM the process ends at once (``os._exit``) once its messages are flushed:
     JAX's worker threads may still be busy with the interrupted computation, and tearing
     the interpreter down around them can crash it. Files were already cleaned up, since
-    every file is written through a temporary that the interrupt removed.
+    every file is written through a temporary that the interrupt removed. The objects the
+    interrupted run left are collected first, so that their finalizers release what they
+    hold (the semaphores of a process pool, which multiprocessing's resource tracker would
+    otherwise report as leaked, a second line on standard error).
     """
     status = main()
     if status in (EXIT_INTERRUPTED, EXIT_TERMINATED):
+        gc.collect()  # finalizers first: a process pool's semaphores, else reported as leaked
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(status)
