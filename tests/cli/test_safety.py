@@ -191,3 +191,17 @@ def test_a_scheduler_address_that_is_not_one_fails_in_seconds(
     ]
     with pytest.raises(_parallel.SchedulerError, match=f"no dask scheduler at {address}"):
         ecofmaps.analyze_loops(*lazy, 450.0, scheduler=address)
+
+
+def test_figures_into_a_folder_in_use_need_overwrite(tmp_path, capsys):
+    """Refused before any drawing; with --overwrite a user's file of a figure's name is kept."""
+    out = thesis(tmp_path / "figures")
+    status, _, stderr = run(capsys, "figures", "--out", out, "--only", "fig8")
+    assert status == 2 and f"--out {out} is a folder that is not empty" in stderr
+    (out / "fig8.png").write_bytes(b"a user's picture")
+    status, _, stderr = run(capsys, "figures", "--out", out, "--only", "fig8", "--overwrite")
+    assert (
+        status == 2 and f"--out {out / 'fig8.png'} is a file that ecofmaps did not write" in stderr
+    )
+    assert sorted(p.name for p in out.iterdir()) == ["fig8.png", "thesis.txt"]
+    assert (out / "fig8.png").read_bytes() == b"a user's picture"

@@ -4,11 +4,12 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from ecofmaps.io.files import TEMPORARY_NAME, atomic_store
+from ecofmaps.io.files import TEMPORARY_NAME, atomic_path, atomic_store
 from ecofmaps.io.recording_types import RecordingError
 from ecofmaps.io.recordings import read_recording
 from ecofmaps.io.rig_formats import variables
 from ecofmaps.io.writers import RecordingWriter, convert_recording
+from ecofmaps.measured.synthetic import example_path
 
 RNG = np.random.default_rng(3)
 SIZE = 2345
@@ -147,3 +148,18 @@ def test_atomic_store_leaves_only_hidden_names(tmp_path):
         assert not path.exists()
         raise RuntimeError
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_folder_is_never_removed_to_make_room(tmp_path):
+    """A file, or a store, onto a user's folder: refused before anything is written, and the
+    folder with its files left as it was (it was moved aside and deleted before)."""
+    folder = tmp_path / "results"
+    folder.mkdir()
+    (folder / "thesis.txt").write_text("chapter 1")
+    with pytest.raises(IsADirectoryError, match="not a store"), atomic_path(folder):
+        pytest.fail("the block must not run")
+    with pytest.raises(IsADirectoryError, match="not a store"):
+        convert_recording(example_path(), folder, format="zarr", overwrite=True)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["results"]
+    assert [p.name for p in folder.iterdir()] == ["thesis.txt"]
+    assert (folder / "thesis.txt").read_text() == "chapter 1"
