@@ -13,8 +13,8 @@ processes of a local cluster count) are reported; each is repeated ``--repeat`` 
 the best time kept. The runs:
 
 - ``memory``: the in-memory path, the baseline: ``ecofmaps loops`` with the whole
-  recording read into NumPy and ``analyze_loops`` on it, one thread; the time of
-  ``analyze_loops`` alone is printed beside the time of the whole command;
+  recording read into NumPy and analysed as one chunk of the pipeline, one thread; the time of
+  the analysis alone is printed beside the time of the whole command;
 - ``threads``: ``ecofmaps loops FILE --load 450N --out r.csv --quiet``, the default for a
   file this long: out of core on the threads of the process (one per core);
 - ``workers 1``, ``workers 2``: the same with ``--workers 1`` and ``--workers 2`` (a local
@@ -27,7 +27,7 @@ take turns (each round runs every one once), so a machine that slows down for a 
 slows them all alike; the best round of each is kept.
 
 The machine's own ceiling for two processes is measured beside them (``ceiling``): the
-measuring tasks of the same analysis (most of its time; :mod:`ecofmaps.measured.out_of_core`,
+measuring tasks of the same analysis (most of its time; :mod:`ecofmaps.measured.pipeline`,
 the cycles found first, not timed) in one plain process, then split between two forked
 processes, without dask. On a machine whose two cores share a memory bus (or are two
 threads of one core) two processes do not run twice as fast, and no scheduler can do better.
@@ -50,18 +50,18 @@ CHUNK = 1 << 20
 LOAD = "450N"
 _MEMORY_SCRIPT = """
 import sys, time
-import ecofmaps.io.binary, ecofmaps.measured.analysis as analysis
+import ecofmaps.io.binary, ecofmaps.cli.loops_long as analysis
 from ecofmaps.cli import main
 ecofmaps.io.binary.LAZY_SAMPLES = 1 << 62  # read whole, analyse in memory
 spent = []
-inner = analysis.analyze_loops
+inner = analysis._analyse  # the pipeline on one recording (one chunk in memory)
 def timed(*args, **kwargs):
     start = time.perf_counter()
     try:
         return inner(*args, **kwargs)
     finally:
         spent.append(time.perf_counter() - start)
-analysis.analyze_loops = timed
+analysis._analyse = timed
 status = main(["loops", *sys.argv[1:]])
 print("analysed", spent[0], file=sys.stderr)
 sys.exit(status)
@@ -72,22 +72,22 @@ import functools, multiprocessing, sys, time
 from ecofmaps._parallel import Runner, _materialised
 from ecofmaps.io import read_recording
 from ecofmaps.io.tables import results_csv
-from ecofmaps.measured.analysis import default_options
-from ecofmaps.measured.out_of_core import LongAnalysis, _measure
+from ecofmaps.measured.options import default_options
+from ecofmaps.measured.pipeline import Analysis, Reading, measure_chunk
 
 def measure(tasks):
     start = time.perf_counter()
     for index in tasks:
-        _measure(*_materialised(ANALYSIS._task(index, LINES, False)))
+        measure_chunk(*_materialised(ANALYSIS._task(index, LINES, False)))
     return time.perf_counter() - start
 
 if __name__ == "__main__":
     recording = read_recording(sys.argv[1], lazy=True)
     options = default_options(float(sys.argv[2]))
     with Runner() as runner:
-        ANALYSIS = LongAnalysis(recording.displacement, recording.force, float(sys.argv[2]),
-                                recording.cycle, runner=runner, resolve=sys.argv[3] == "resolve",
-                                **options)
+        ANALYSIS = Analysis(recording.displacement, recording.force, float(sys.argv[2]),
+                            recording.cycle, runner=runner,
+                            reading=Reading(resolve=sys.argv[3] == "resolve"), **options)
     LINES = functools.partial(results_csv, header=False)
     tasks = range(len(ANALYSIS.tasks))
     fork = multiprocessing.get_context("fork")
@@ -191,7 +191,7 @@ def main(argv=None) -> int:
             )
             if name == "memory":
                 analysing = float(printed.split()[-1])
-                line += f"  (analyze_loops {analysing:.1f} s: {samples / analysing:.3g} samples/s)"
+                line += f"  (analysis {analysing:.1f} s: {samples / analysing:.3g} samples/s)"
             print(line, flush=True)
         memory, one, two = best["memory"][0], best["workers 1"][0], best["workers 2"][0]
         single, double = min(t[0] for t in alone), min(t[1] for t in alone)
