@@ -31,8 +31,10 @@ def add(subparsers) -> None:
             "wear scar's depth over half-width z_o/x_o = D/W (eq. 11; x_o = Δ*). One point: "
             "--ecof --amplitude --load --stiffness and --aspect-ratio (or --scar-depth and "
             "--scar-half-width). A table: TABLE.csv with columns ecof, amplitude_um, load_N, "
-            "stiffness_MN_per_m and aspect_ratio or scar_depth_um + scar_half_width_um; the "
-            "output keeps every column and adds mu and correction_factor. With "
+            "stiffness_MN_per_m and aspect_ratio or scar_depth_um + scar_half_width_um, "
+            "separated by commas, semicolons (decimal commas allowed) or tabs, '#' lines "
+            "skipped as comments; the output, in the table's own separator, keeps every "
+            "column and adds mu and correction_factor. With "
             "--scar-profile FILE a measured wear-scar profile gives the scar instead (of the "
             "point, or of every row of a table, which then has no scar columns), and the "
             "parabola of the same D/W is given beside it (mu_parabolic in a table). A bad "
@@ -40,10 +42,15 @@ def add(subparsers) -> None:
             "written then."
         ),
     )
-    parser.add_argument("table", nargs="?", metavar="TABLE", help="CSV table of reported ECoFs")
+    parser.add_argument(
+        "table",
+        nargs="?",
+        metavar="TABLE",
+        help="table of reported ECoFs (',', ';' or tab separated)",
+    )
     parser.add_argument(
         "--out", metavar="OUT", default=None,
-        help="write the corrected table here (CSV; default: standard output)",
+        help="write the corrected table here (the table's separator; default: standard output)",
     )  # fmt: skip
     parser.add_argument(
         "--overwrite", action="store_true",

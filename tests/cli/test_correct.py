@@ -142,6 +142,20 @@ def test_table_to_stdout(tmp_path, capsys):
     assert len(read_csv(stdout)) == 3
 
 
+def test_table_as_a_spreadsheet_writes_it(tmp_path, capsys):
+    """';' with decimal commas and '#' comments in, the same separator and commas out."""
+    lab = "# rig 2\n" + TABLE.replace(",", ";").replace('"rigid; deep"', "rigid deep")
+    lab = lab.replace("0.8308", "0,8308").replace("0.9", "0,9").replace("0.2;", "0,2;")
+    _, reference, _ = run(capsys, "correct", write(tmp_path / "ecof.csv", TABLE))
+    status, stdout, err = run(capsys, "correct", write(tmp_path / "lab.csv", lab))
+    assert status == 0 and err == ""
+    expected = [row[-2:] for row in csv.reader(io.StringIO(reference))]
+    got = [row[-2:] for row in csv.reader(io.StringIO(stdout), delimiter=";")]
+    assert got == [[cell.replace(".", ",") for cell in row] for row in expected]
+    status, _, err = run(capsys, "correct", write(tmp_path / "bad.csv", lab + "flat;0,7;x\n"))
+    assert status != 0 and f"{tmp_path / 'bad.csv'}, line 7: " in err
+
+
 BAD_TABLES = [
     # (text, line, message)
     ("", 1, "the file is empty"),
