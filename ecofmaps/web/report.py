@@ -281,16 +281,20 @@ def _evolution_figures(results: xr.Dataset):
         x_axis_label=_label("cycle"), y_axis_label="Coefficient of friction [1]",
         tools="pan,box_zoom,wheel_zoom,reset,save",
     )  # fmt: skip
-    if "mu_resolved" in results:
+    resolved = "mu_resolved" in results
+    if resolved:
         plot.varea("cycle", "mu_low", "mu_high", source=source, color="#2ca02c",
-                   alpha=0.2, legend_label="μ ± 2 se")  # fmt: skip
-        plot.line("cycle", "mu_resolved", source=source, color="#2ca02c", line_width=1.5,
-                  legend_label="μ read along the stroke")  # fmt: skip
+                   alpha=0.25, legend_label="μ ± 2 se")  # fmt: skip
     lines = {"ecof": ("#ff7f0e", "ECoF μ_E"), "gicof": ("#1f77b4", "GICoF (Q/P on Q = SΔ)")}
+    drawn = {}
     for name, (color, legend) in lines.items():
-        plot.line("cycle", name, source=source, color=color, line_width=1.5, legend_label=legend)
+        drawn[name] = plot.line("cycle", name, source=source, color=color, line_width=1.5,
+                                legend_label=legend)  # fmt: skip
         if cycle.size <= 400:
             plot.scatter("cycle", name, source=source, color=color, size=3)
+    if resolved:  # on top: the most precise of the three
+        plot.line("cycle", "mu_resolved", source=source, color="#2ca02c", line_width=1.5,
+                  legend_label="μ read along the stroke")  # fmt: skip
     plot.add_tools(
         HoverTool(
             tooltips=[
@@ -301,7 +305,7 @@ def _evolution_figures(results: xr.Dataset):
                 ("quality", "@quality"),
             ],
             mode="vline",
-            renderers=plot.renderers[-1:],
+            renderers=[drawn["ecof"]],
         )
     )
     plot.xaxis.formatter = BasicTickFormatter(use_scientific=False)
