@@ -71,15 +71,43 @@ def _bracket(before, length):
 
 
 def branch_rows(block, top):
-    """The rising branches (start to top) and falling ones (top to the end) as rows."""
+    """The rising branches (start to top) and falling ones (top to the end) as rows.
+
+    Returns the displacement and force rows, the mask of each row's own points and the
+    number of them.
+    """
     cycles = top.size
     first = np.concatenate([np.zeros_like(top), top])
     last = np.concatenate([top, block.count])
-    j = np.arange(int((last - first).max()) + 1)
-    point = np.minimum(first[:, None] + j, last[:, None])
-    index = block.samples(point, np.tile(np.arange(cycles), 2))
-    valid = j <= (last - first)[:, None]
-    return block.displacement[index], block.force[index], valid, last - first + 1
+    length = last - first + 1
+    j = np.arange(int(length.max()))
+    valid = j < length[:, None]
+    if not block.continuous:  # a loop may begin inside its stretch and wrap round it
+        point = np.minimum(first[:, None] + j, last[:, None])
+        index = block.samples(point, np.tile(np.arange(cycles), 2))
+        return block.displacement[index], block.force[index], valid, length
+    # Each row is a stretch of the samples from its reversal on, up to its last point:
+    # the top of a rising branch; the loop's first sample, which closes a falling one.
+    start = np.tile(block.offset, 2) + first
+    end = np.concatenate([block.offset + top, block.offset])
+    tail = ~(j < (length - 1)[:, None])  # the last point and the padding
+    x, y = (_stretch_rows(values, start, end, tail) for values in (block.displacement, block.force))
+    return x, y, valid, length
+
+
+def _stretch_rows(values, start, end, tail):
+    """Rows of ``values`` from each ``start`` on, with ``values[end]`` where ``tail``."""
+    width = tail.shape[1]
+    over = start + width > values.size  # rows that would run past the samples
+    if values.size >= width:  # a view of every stretch of ``width`` samples, rows copied
+        out = np.lib.stride_tricks.sliding_window_view(values, width)[np.where(over, 0, start)]
+    else:
+        out = np.empty(tail.shape)
+    if over.any():
+        index = np.minimum(start[over, None] + np.arange(width), values.size - 1)
+        out[over] = values[index]
+    np.copyto(out, values[end][:, None], where=tail)
+    return out
 
 
 def _line(mask, u, v, spread=False):

@@ -310,8 +310,8 @@ def _drift(low: int, high: int, points, values, near: slice):
     """``values`` interpolated over ``points`` at the samples ``low`` to ``high - 1``.
 
     Piecewise linear, extended linearly beyond the first and last points;
-    ``points[near]`` bracket every sample that lies between two points. Inside, the
-    arithmetic is that of ``np.interp``, bit for bit, on the segments between points.
+    ``points[near]`` bracket every sample that lies between two points. Inside, it is
+    ``np.interp`` on the segments between points (one pass, no per-sample temporaries).
     """
     xp, fp = points[near], values[near]
     # Sample i lies on segment j when xp[j] <= i < xp[j + 1].
@@ -319,13 +319,9 @@ def _drift(low: int, high: int, points, values, near: slice):
     result = np.empty(high - low)
     result[: edges[0]] = fp[0]
     result[edges[-1] :] = fp[-1]
-    if xp.size > 1:
-        lengths = np.diff(edges)
-        slope = (fp[1:] - fp[:-1]) / (xp[1:] - xp[:-1])
+    if xp.size > 1:  # every sample here lies on a segment between points
         at = np.arange(low + edges[0], low + edges[-1], dtype=np.float64)
-        result[edges[0] : edges[-1]] = np.repeat(slope, lengths) * (
-            at - np.repeat(xp[:-1], lengths)
-        ) + np.repeat(fp[:-1], lengths)
+        result[edges[0] : edges[-1]] = np.interp(at, xp, fp)
     if points.size < 2:
         return result
     if near.start == 0 and edges[0] > 0:
