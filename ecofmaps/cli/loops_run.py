@@ -66,10 +66,25 @@ def _analysed(index, path, recording, load, args, long_run, write, *, many, reso
                 columns=None if in_memory else SUMMARY_VARIABLES, reading=reading,
             )  # fmt: skip
         except ValueError as error:
-            raise recording.error(str(error)) from None
+            raise recording.error(_with_assumptions(str(error), recording)) from None
     for warning in caught:  # one line each, naming the file, not a Python source line
-        print(f"ecofmaps loops: warning: {path.name}: {warning.message}", file=sys.stderr)
+        message = _with_assumptions(str(warning.message), recording)
+        print(f"ecofmaps loops: warning: {path.name}: {message}", file=sys.stderr)
     return results, resolved
+
+
+def _with_assumptions(message: str, recording) -> str:
+    """``message`` with the units the recording's columns were assumed to be in, when it
+    says that the scale is implausible (the assumption is the likely culprit)."""
+    if "implausible" not in message and "is the load right" not in message:
+        return message
+    said = [
+        f"the {role} column {recording.columns[role]!r} has no unit and was read in "
+        f"{recording.units[role]} (--{role}-unit gives it)"
+        for role in ("displacement", "force")
+        if role in recording.assumed_units
+    ]
+    return message if not said else f"{message} Here {'; '.join(said)}."
 
 
 #: The variables of a recording's results that its summary line reads (:func:`_summary`):

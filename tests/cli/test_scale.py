@@ -15,6 +15,7 @@ def test_a_wrong_load_flags_every_cycle_and_names_the_load(tmp_path, capsys):
     table = pd.read_csv(out)
     assert (table.quality == "implausible-cof").all() and table.ecof.isnull().all()
     assert "test.csv" in err and "load of 1 N: is the load right" in err and "--load" in err
+    assert "the force column 'force' has no unit and was read in N" in err
 
 
 def test_millimetres_in_a_column_without_a_unit_are_refused(tmp_path, capsys):
@@ -25,6 +26,7 @@ def test_millimetres_in_a_column_without_a_unit_are_refused(tmp_path, capsys):
     status, _, err = run(capsys, path, "--load", "450N", "--out", tmp_path / "r.csv")
     assert status == 2
     assert "implausible-amplitude" in err and "--displacement-unit" in err
+    assert "the displacement column 'displacement' has no unit and was read in um" in err
     assert not (tmp_path / "r.csv").exists()
 
 
