@@ -62,15 +62,16 @@ def figures_command(out: Path, only, jobs) -> list[str]:
 def measured_runs(repeat: int, only, jobs, folder: Path) -> dict[str, list[tuple[float, float]]]:
     """``repeat`` cold and warm runs of the command, and of the floor."""
     runs = {"cold": [], "warm": [], "kernels": [], "floor": []}
-    command = figures_command(folder / "out", only, jobs)
     for index in range(repeat):
         cache = folder / f"cache-{index}"
         environment = {**os.environ, "ECOFMAPS_CACHE": str(cache)}
-        runs["cold"].append(timed_process(command, environment))  # an empty cache
-        runs["warm"].append(timed_process(command, environment))  # the cache it filled
+        # Each run writes into a folder of its own (the command refuses a non-empty one).
+        run = {kind: figures_command(folder / f"out-{kind}-{index}", only, jobs) for kind in runs}
+        runs["cold"].append(timed_process(run["cold"], environment))  # an empty cache
+        runs["warm"].append(timed_process(run["warm"], environment))  # the cache it filled
         for path in cache.glob("*.nc"):  # the numbers go, JAX's compiled kernels stay
             path.unlink()
-        runs["kernels"].append(timed_process(command, environment))
+        runs["kernels"].append(timed_process(run["kernels"], environment))
         runs["floor"].append(timed_process([sys.executable, "-c", FLOOR], environment))
     return runs
 
