@@ -8,7 +8,7 @@ import textwrap
 from ecofmaps._parallel import worker_limit
 from ecofmaps.cli._common import quantity, unit
 
-__all__ = ["add", "run"]
+__all__ = ["add"]
 
 
 def add(subparsers) -> None:
@@ -89,7 +89,7 @@ def add(subparsers) -> None:
     )  # fmt: skip
     _add_column_options(parser)
     add_long_options(parser)
-    parser.set_defaults(handler=run)
+    parser.set_defaults(handler="ecofmaps.cli.loops_run:run")  # imported when it runs
 
 
 def _add_column_options(parser) -> None:
@@ -183,11 +183,3 @@ def _load_or_column(text: str):
             if name and not name[0].isdigit() and not name.startswith(("-", "+", ".")):
                 return name  # a column of the recording, e.g. Fz
         raise
-
-
-def run(args) -> int:
-    """Run ``ecofmaps loops``: the work is in :mod:`ecofmaps.cli.loops_run`, loaded only now
-    (the parser of every subcommand is built at start-up)."""
-    from ecofmaps.cli import loops_run  # the subcommand's boundary: heavy imports on use
-
-    return loops_run.run(args)

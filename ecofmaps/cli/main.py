@@ -1,7 +1,10 @@
 """The ``ecofmaps`` command: its parser, and the run of one subcommand.
 
 Each subcommand is a module of :mod:`ecofmaps.cli` with ``add(subparsers)``, which declares
-its options, and a ``run(args)`` it sets as the handler, which does the work through the
+its options, and the handler that does the work, ``run(args)``: a function, or the name of
+one, ``"ecofmaps.cli.loops_run:run"``, whose module is imported only when the subcommand
+runs (the one place the command line defers its imports, so ``ecofmaps --help`` starts
+fast and the work's modules import what they use at the top). The handler works through the
 public API. Quantities are read with units (``50um``, ``35MN/m``); a bare number is SI.
 Errors in the input end the command with exit status 2 and a one-line message, never a
 traceback.
@@ -85,7 +88,7 @@ def main(argv=None) -> int:
                 args = build_parser().parse_args(argv)
             except SystemExit as stop:  # a usage error (printed), --help or --version
                 return int(stop.code or 0)
-            return args.handler(args)
+            return handler(args.handler)(args)
     except KeyboardInterrupt as stop:
         return _stopped(interrupted, getattr(stop, "note", None))
     except Exception as error:
@@ -110,6 +113,14 @@ def _stopped(interrupted, note) -> int:
     words = "terminated (SIGTERM)" if terminated else "interrupted"
     note = note or "no output was left half written"
     return _report(EXIT_TERMINATED if terminated else EXIT_INTERRUPTED, f"{words}; {note}")
+
+
+def handler(spec):
+    """The handler a subcommand set: a callable, or ``"module:function"`` imported now."""
+    if callable(spec):
+        return spec
+    module, _, name = spec.partition(":")
+    return getattr(importlib.import_module(module), name)
 
 
 def _report(status: int, message: str) -> int:
