@@ -374,7 +374,7 @@ def probe_scheduler(address: str, timeout: float) -> None:
         try:
             answer = pool.submit(ask).result()
         except Exception as error:  # whatever went wrong, no scheduler answered
-            reason = str(error) or f"no answer within {timeout:g} s"
+            reason = str(error) or f"no answer after {timeout:g} s"
             answer = (
                 reason if isinstance(error, ValueError) else f"{type(error).__name__}: {reason}"
             )
