@@ -68,6 +68,26 @@ def test_a_signal_to_the_whole_group_with_two_workers(tmp_path, recording, sent,
     assert leftovers(tmp_path) == []
 
 
+@pytest.mark.parametrize(("sent", "status"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_a_signal_during_an_analysis_in_memory_leaves_nothing(tmp_path, recording, sent, status):
+    """No workers: the table's temporary file is removed, nothing else was written."""
+    out = tmp_path / "r.csv"
+    command = [sys.executable, "-m", "ecofmaps.cli", "loops", str(recording), "--load", "450N",
+               "--out", str(out)]  # fmt: skip
+    process = started(command, tmp_path)
+    end = time.monotonic() + 240.0
+    while not any(TEMPORARY_NAME.match(p.name) for p in tmp_path.iterdir()):  # the table begun
+        assert process.poll() is None and time.monotonic() < end, process.communicate()
+        time.sleep(0.05)
+    time.sleep(0.5)
+    os.killpg(process.pid, sent)
+    stdout, stderr = process.communicate(timeout=120)
+    assert process.returncode == status, stderr
+    assert stdout == "" and "Traceback" not in stderr and stderr.count("\n") == 1
+    assert stderr.endswith("; no output was left half written\n")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_sigterm_during_a_zarr_map_leaves_no_store(tmp_path):
     out = tmp_path / "big.zarr"
     command = [
