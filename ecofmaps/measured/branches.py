@@ -42,6 +42,11 @@ def _dot(a, b):
     return np.einsum("ij,ij->i", a, b)
 
 
+def _counts(flags):
+    """The number of True along each row of a 2-D boolean array (as np.count_nonzero, faster)."""
+    return np.einsum("ij->i", flags.view(np.uint8), dtype=np.int64)
+
+
 def both(values):
     """A per-cycle array for the rising then the falling branch rows."""
     return np.concatenate([values, values])
@@ -67,7 +72,7 @@ def _bracket(before, length):
     as many samples as the branch has on that side, so a few noisy samples on the wrong
     side do not move it far.
     """
-    return np.clip(np.count_nonzero(before, axis=1), 1, length - 1)
+    return np.clip(_counts(before), 1, length - 1)
 
 
 def branch_rows(block, top):
@@ -114,7 +119,8 @@ def _line(mask, u, v, spread=False):
     """Sums of the least-squares line of ``v`` on ``u`` through each row's masked points.
 
     Returns the count, the means of ``u`` and ``v``, and the sums of du dv and du du
-    (deviations from the means), and of dv dv if ``spread``.
+    (deviations from the means); if ``spread``, also the sum of dv dv, the mask as
+    weights and du (zero off the mask), for :func:`_stick_fit`.
     """
     weight = mask.astype(np.float64)
     count = weight.sum(axis=1)
@@ -125,7 +131,7 @@ def _line(mask, u, v, spread=False):
     sums = (count, mean_u, mean_v, _dot(du, dv), _dot(du, du))
     if spread:
         dv *= weight
-        sums += (_dot(dv, dv),)
+        sums += (_dot(dv, dv), weight, du)
     return sums
 
 
@@ -173,7 +179,7 @@ def stick_lines(x, y, valid, span, window):
         limit = width
     mask = np.zeros((rows, width), dtype=bool)
     mask[:, :limit] = valid[:, :limit] & (moved >= low) & ~_from_first(beyond)
-    sparse = np.flatnonzero(np.count_nonzero(mask[:, :limit], axis=1) < 2)
+    sparse = np.flatnonzero(_counts(mask[:, :limit]) < 2)
     if sparse.size:
         reach = np.argmax(valid[sparse, :limit] & (moved[sparse] >= low), axis=1)
         j = np.arange(width)
@@ -181,16 +187,16 @@ def stick_lines(x, y, valid, span, window):
     reach = _columns(mask[:, :limit]).stop  # the segments end before this column
     compliance, intercept, sums = _common_line(mask[:, :reach], y[:, :reach], x[:, :reach])
     slope = both(compliance)[:, None]
-    residual = x[:, :reach] - intercept[:, None] - slope * y[:, :reach]
-    squares = _dot(residual * mask[:, :reach], residual)
+    # The growth is followed over the first columns, and over all if it reaches their end.
+    end = min(x.shape[1], 2 * reach + 8)
+    residual = x[:, :end] - intercept[:, None] - slope * y[:, :end]
+    segment = residual[:, :reach]
+    squares = _dot(segment * mask[:, :reach], segment)
     cycles = compliance.size
     points = sums[0][:cycles] + sums[0][cycles:]
     spread = np.sqrt((squares[:cycles] + squares[cycles:]) / np.maximum(points - 3, 1))
     tolerance = both(np.maximum(_STICK_SPREAD * spread, 1e-9 * span))[:, None]
-    # The growth is followed over the first columns, and over all if it reaches their end.
-    end = min(x.shape[1], 2 * reach + 8)
     while True:
-        residual = x[:, :end] - intercept[:, None] - slope * y[:, :end]
         after = _from_first(mask[:, :end]) & valid[:, :end]
         outside = after & (np.abs(residual) > tolerance)
         outside[:, :-1] &= outside[:, 1:]  # two in a row; a branch's last sample alone is not
@@ -199,15 +205,19 @@ def stick_lines(x, y, valid, span, window):
         if end == x.shape[1] or not grown[:, -1].any():
             break
         end = x.shape[1]
+        residual = x - intercept[:, None] - slope * y
     end = _columns(grown).stop
     grown = grown[:, :end]
     compliance, intercept, sums = _common_line(grown, y[:, :end], x[:, :end], spread=True)
-    fit = _stick_fit(grown, x[:, :end], y[:, :end], compliance, intercept, sums)
+    fit = _stick_fit(x[:, :end], y[:, :end], compliance, intercept, sums)
     return compliance, intercept, grown, fit
 
 
-def _stick_fit(mask, x, y, compliance, intercept, sums):
-    r"""How well the lines through the stick segments ``mask`` fit, per cycle.
+def _stick_fit(x, y, compliance, intercept, sums):
+    r"""How well the lines through the stick segments fit, per cycle.
+
+    ``sums`` are those of :func:`_common_line` with ``spread``, which hold the segments as
+    weights.
 
     ``residual`` is the root mean square displacement off the lines; ``unexplained`` the
     share of the displacement's variance along the segments that they leave; ``curved``
@@ -216,15 +226,14 @@ def _stick_fit(mask, x, y, compliance, intercept, sums):
     :math:`d\Delta/dQ` from one end of the segment to the other by more than
     ``_CURVATURE_CHANGE`` of the compliance.
     """
-    count, mean_y, _, _, force_variance, variance = sums
+    count, _, _, _, force_variance, variance, weight, deviation = sums
     cycles = compliance.size
-    weight = mask.astype(np.float64)
     residual = (x - intercept[:, None] - both(compliance)[:, None] * y) * weight
     squares = _dot(residual, residual)
     # The residual against the squared force from its mean, sq: each branch's residual
     # sums to zero (its own intercept), so it needs no centring; sq's spread is
     # sum(sq^2) - n mean(sq)^2, with sum(sq) the force's variance.
-    square = ((y - mean_y[:, None]) * weight) ** 2
+    square = np.square(deviation, out=deviation)  # the force from its mean, squared
     spread = _dot(square, square) - force_variance**2 / count
     bend = _dot(residual, square) / spread
     error = np.sqrt(np.maximum(squares - bend * bend * spread, 0.0) / np.maximum(count - 3, 1))
@@ -260,7 +269,7 @@ def zero_force_crossings(x, y, valid, length, max_force, stick, intercept, span)
     before = np.empty_like(valid)
     np.logical_and(negative[:cycles], valid[:cycles], out=before[:cycles])
     np.logical_and(positive[cycles:], valid[cycles:], out=before[cycles:])
-    count = np.count_nonzero(before, axis=1)
+    count = _counts(before)
     after = np.clip(count, 1, length - 1)
     near = valid & (np.abs(y) <= both(_ZERO_FORCE_BAND * max_force)[:, None])
     rows = np.arange(length.size)
@@ -351,7 +360,7 @@ def line_crossings(x, y, valid, length, compliance, half_width, load, scale):
     share = np.divide(v0, change, out=np.full_like(v0, 0.5), where=change != 0.0)
     guess = q0 + share * (q1 - q0)
     window = valid & (np.abs(position) <= half_width[:, None])
-    enough = np.count_nonzero(window, axis=1) >= _FIT_SAMPLES
+    enough = _counts(window) >= _FIT_SAMPLES
     columns = _columns(window)
     scaled = position[:, columns] / half_width[:, None]
     intercept = _curve_intercept(window[:, columns], scaled, y[:, columns], load)

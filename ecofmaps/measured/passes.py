@@ -103,15 +103,15 @@ def _survey(start, stop, arguments, x, q, cycle, mask):
     for a, b in _chunks(start, stop, chunk):
         i, j = a - start, b - start
         xa = x[i:j]
-        bad = ~np.isfinite(xa)
+        good = np.isfinite(xa)
         if q is not None:
-            bad |= ~np.isfinite(q[i:j])
+            good &= np.isfinite(q[i:j])
         if cycle is not None and cycle.dtype.kind not in "iub":
-            bad |= ~np.isfinite(cycle[i:j])
+            good &= np.isfinite(cycle[i:j])
         if mask is not None:
-            bad |= np.asarray(mask[i:j], dtype=bool)
+            good &= ~np.asarray(mask[i:j], dtype=bool)
         t = np.arange(a - middle, b - middle)
-        if not bad.any():
+        if good.all():
             k, u = b - a, a - middle  # sums of t and t² in closed form
             sums.append(
                 (k, np.add.reduce(xa), np.einsum("i,i->", t, xa), k * u + k * (k - 1) / 2,
@@ -119,7 +119,7 @@ def _survey(start, stop, arguments, x, q, cycle, mask):
             )  # fmt: skip
             finite += [a, b - 1]
         else:
-            good = ~bad
+            bad = ~good
             xg, tg = xa[good], t[good]
             sums.append((xg.size, np.add.reduce(xg), np.einsum("i,i->", tg, xg), tg.sum(),
                          np.einsum("i,i->", tg, tg)))  # fmt: skip
@@ -235,7 +235,13 @@ def _detrended(x, a: int, b: int, line):
     """The displacements ``x`` of samples ``a`` to ``b - 1`` less the straight ``line``."""
     mean, mean_t, slope, middle = line
     # Exact: the sample indices less the middle are integers or halves below 2**52.
-    return (x - mean) - (np.arange(a - middle, b - middle) - mean_t) * slope
+    trend = np.arange(a - middle, b - middle)
+    if mean_t != 0.0:  # (it is 0.0 when every sample is finite: t - 0.0 is t)
+        trend -= mean_t
+    trend *= slope
+    detrended = x - mean
+    detrended -= trend
+    return detrended
 
 
 def survey(samples: Samples):

@@ -583,7 +583,10 @@ def loops(quick: bool) -> None:
     Both run alternately on the same recordings (200 samples per cycle, see
     loop_recording), ``repeats`` times each, best wall and CPU times kept. The lean pass
     (lean_loops) only computes each cycle's loop area and amplitude on a reshaped view:
-    the floor for any per-cycle analysis in NumPy. The median GICoF against μ = 0.8 and
+    the floor for any per-cycle analysis in NumPy. The ratios analyze_loops / floor of the
+    CPU and of the wall times are printed side by side (on a shared machine, run with
+    OMP_NUM_THREADS=1 and compare the CPU ratio); --quick includes the 10⁴ cycles (2·10⁶
+    samples). The median GICoF against μ = 0.8 and
     the median difference of the two loop areas check the results. Memory: one call on a
     large recording in a fresh process (loops_peak_memory), above the memory before the call
     ("extra") and in all, relative to the recording's two float64 arrays; the frozen
@@ -592,12 +595,14 @@ def loops(quick: bool) -> None:
     from ecofmaps.measured.analysis import analyze_loops
 
     sizes = [10**3, 10**4] if quick else [10**3, 10**4, 10**5]
-    repeats = 2 if quick else 5
+    repeats = 5
     print(f"analyze_loops vs lean NumPy, {SAMPLES_PER_CYCLE} samples per cycle; {load_average()}")
     header = ("cycles", "samples", "wall", "CPU", "analyze", "analyze", "lean", "lean")
-    print(" ".join(f"{h:>9}" for h in header), f"{'CPU':>7} {'GICoF/μ-1':>10} {'E_d':>8}")
+    extra = f"{'/floor':>7} {'/floor':>7} {'GICoF/μ-1':>10} {'E_d':>8}"
+    print(" ".join(f"{h:>9}" for h in header), extra)
     units = ("", "", "[s]", "[s]", "wall [/s]", "CPU [/s]", "wall [/s]", "CPU [/s]")
-    print(" ".join(f"{u:>9}" for u in units), f"{'ratio':>7} {'median':>10} {'diff':>8}")
+    extra = f"{'CPU':>7} {'wall':>7} {'median':>10} {'diff':>8}"
+    print(" ".join(f"{u:>9}" for u in units), extra)
     for cycles in sizes:
         displacement, force = loop_recording(cycles, seed=cycles)
         size = displacement.size
@@ -615,7 +620,7 @@ def loops(quick: bool) -> None:
         print(
             f"{row[0]:9d} {row[1]:9.2e} {row[2]:9.3f} {row[3]:9.3f} {size / wall:9.3g} "
             f"{size / cpu:9.3g} {size / lean_wall:9.3g} {size / lean_cpu:9.3g} "
-            f"{cpu / lean_cpu:7.1f} {error:+10.1e} {difference:8.1e}"
+            f"{cpu / lean_cpu:7.1f} {wall / lean_wall:7.1f} {error:+10.1e} {difference:8.1e}"
         )
     print("peak resident memory of one call, in a fresh process (reset after the recording)")
     header = ("", "samples", "input", "extra", "extra/", "peak/", "speed")
