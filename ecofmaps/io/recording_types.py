@@ -22,7 +22,14 @@ import xarray as xr
 from ecofmaps._nomenclature import attrs
 from ecofmaps.io.files import FileLineError
 
-__all__ = ["LAZY_SAMPLES", "Recording", "RecordingError", "RecordingWarning", "si_values"]
+__all__ = [
+    "LAZY_SAMPLES",
+    "LineIndex",
+    "Recording",
+    "RecordingError",
+    "RecordingWarning",
+    "si_values",
+]
 
 #: Rig files with more samples than this are read lazily (dask arrays) by default.
 LAZY_SAMPLES = 1 << 24
@@ -98,7 +105,7 @@ class RecordingWarning(UserWarning):
 
 
 @dataclasses.dataclass(frozen=True)
-class _LineIndex:
+class LineIndex:
     """The 1-based line of each sample of a text file, as runs: from sample ``starts[k]`` on,
     line = sample + ``offsets[k]`` (comment and blank lines start new runs)."""
 
@@ -106,7 +113,7 @@ class _LineIndex:
     offsets: np.ndarray
 
     @classmethod
-    def build(cls, blocks, first: int = 0) -> _LineIndex:
+    def build(cls, blocks, first: int = 0) -> LineIndex:
         """From the line numbers of consecutive blocks of samples, the first being sample
         ``first`` of the file."""
         starts, offsets, sample, last = [], [], first, None
@@ -178,7 +185,7 @@ class Recording:
     columns: Mapping[str, str] = dataclasses.field(default_factory=dict)
     units: Mapping[str, str] = dataclasses.field(default_factory=dict)
     start: int = 0
-    lines: _LineIndex | None = dataclasses.field(default=None, repr=False)
+    lines: LineIndex | None = dataclasses.field(default=None, repr=False)
     format: str | None = None
     assumed_units: tuple = ()
 

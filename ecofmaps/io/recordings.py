@@ -47,7 +47,7 @@ import xarray as xr
 
 from ecofmaps.io.binary import read_binary
 from ecofmaps.io.columns import column_scale, split_unit
-from ecofmaps.io.recording_types import LAZY_SAMPLES, Recording, RecordingError, _LineIndex
+from ecofmaps.io.recording_types import LAZY_SAMPLES, LineIndex, Recording, RecordingError
 from ecofmaps.io.text import BLOCK_BYTES, text_blocks
 
 __all__ = [
@@ -212,7 +212,7 @@ def _read_text(path: Path, options: dict, block_bytes: int) -> Recording:
         last_line=int(numbers[-1][-1]),
         columns={role: layout.names[k] for role, k in layout.columns.items()},
         units={role: layout.units[role] for role in layout.columns},
-        lines=_LineIndex.build(numbers),
+        lines=LineIndex.build(numbers),
         format="text",
         assumed_units=_assumed_units(layout, options),
     )
@@ -481,7 +481,7 @@ def recording_blocks(path, samples: int = 1 << 20, **options) -> Iterator[Record
                 columns=columns,
                 units=units,
                 start=first,
-                lines=_LineIndex.build([lines[:count]], first),
+                lines=LineIndex.build([lines[:count]], first),
                 format="text",
                 assumed_units=assumed,
             )

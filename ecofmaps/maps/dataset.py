@@ -17,6 +17,8 @@ from ecofmaps import model, paper
 from ecofmaps._inputs import check
 from ecofmaps._version import __version__
 
+__all__ = ["checked_axis", "checked_load", "grid_dataset"]
+
 # The order of the variables in a Dataset (xarray orders the dimensions as they first appear).
 _VARIABLES = (
     "displacement",
@@ -49,7 +51,7 @@ def _global_attrs(title: str) -> dict:
     }
 
 
-def _axis(name: str, value, rule: str, unit: str) -> np.ndarray:
+def checked_axis(name: str, value, rule: str, unit: str) -> np.ndarray:
     """``value`` checked (``ValueError`` naming ``name``) as a float64 scalar or 1-D array.
 
     A 1-D array is a grid axis: it must hold each value once.
@@ -72,17 +74,17 @@ def _axis(name: str, value, rule: str, unit: str) -> np.ndarray:
     return array
 
 
-def _load(load) -> np.ndarray | None:
-    """The map's normal load (None, or one value) checked, as :func:`_axis` does. [N]"""
+def checked_load(load) -> np.ndarray | None:
+    """The map's normal load (None, or one value) checked, as :func:`checked_axis` does. [N]"""
     if load is None:
         return None
-    load = _axis("load", load, "positive", "N")
+    load = checked_axis("load", load, "positive", "N")
     if load.ndim:
         raise ValueError(f"load must be a single value, got shape {load.shape}")
     return load
 
 
-def _dataset(axes: dict, values: dict, title: str, extra=None) -> xr.Dataset:
+def grid_dataset(axes: dict, values: dict, title: str, extra=None) -> xr.Dataset:
     """A Dataset of grid ``values`` over ``axes`` (scalars become scalar coordinates).
 
     A value is an array over the whole grid (with a length-1 axis for each scalar

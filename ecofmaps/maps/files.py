@@ -45,9 +45,9 @@ def _threads():
     The temporary output is removed only after this, so that no task still writes into
     it (or creates it again) after an interrupt.
     """
-    from ecofmaps.maps.tiles import _workers
+    from ecofmaps.maps.tiles import tile_workers
 
-    pool = concurrent.futures.ThreadPoolExecutor(_workers())
+    pool = concurrent.futures.ThreadPoolExecutor(tile_workers())
     try:
         yield pool
     finally:

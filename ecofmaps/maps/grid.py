@@ -30,9 +30,9 @@ import xarray as xr
 from ecofmaps import model
 from ecofmaps._inputs import float64
 from ecofmaps.maps.cache import cached_dataset
-from ecofmaps.maps.dataset import _axis, _dataset, _load
+from ecofmaps.maps.dataset import checked_axis, checked_load, grid_dataset
 from ecofmaps.maps.on_profile import compute_profile_map
-from ecofmaps.maps.tiles import MAX_CHUNK, _grid_values
+from ecofmaps.maps.tiles import MAX_CHUNK, grid_values
 from ecofmaps.model.simulation import fretting_loop
 from ecofmaps.model.steady_state import dimensionless
 
@@ -250,17 +250,19 @@ def compute_map(
     if amplitude is None or mu is None:
         raise ValueError("compute_map needs amplitude and mu")
     axes = {
-        "stiffness_ratio": _axis("stiffness_ratio", stiffness_ratio, "positive_or_inf", "1/m"),
-        "aspect_ratio": _axis("aspect_ratio", aspect_ratio, "non_negative", "1"),
-        "amplitude": _axis("amplitude", amplitude, "positive", "m"),
-        "mu": _axis("mu", mu, "positive", "1"),
+        "stiffness_ratio": checked_axis(
+            "stiffness_ratio", stiffness_ratio, "positive_or_inf", "1/m"
+        ),
+        "aspect_ratio": checked_axis("aspect_ratio", aspect_ratio, "non_negative", "1"),
+        "amplitude": checked_axis("amplitude", amplitude, "positive", "m"),
+        "mu": checked_axis("mu", mu, "positive", "1"),
     }
-    load = _load(load)
+    load = checked_load(load)
 
     _check_cache(cache, chunks)
 
     def compute() -> xr.Dataset:
-        values = _grid_values(_map_kernel, axes, (load,), max_chunk, chunks)
+        values = grid_values(_map_kernel, axes, (load,), max_chunk, chunks)
         # λ depends on S/P and Δ* only: a variable over those two (eq. 16).
         stiffness, amplitude = axes["stiffness_ratio"], axes["amplitude"]
         lam = model.compliance_ratio(
@@ -270,7 +272,7 @@ def compute_map(
         dims = tuple(n for n in ("stiffness_ratio", "amplitude") if axes[n].ndim == 1)
         values["compliance_ratio"] = (dims, np.squeeze(lam, axis=scalars))
         extra = {} if load is None else {"load": load}
-        return _dataset(axes, values, "ECoF map of the compliant wear-scar model", extra)
+        return grid_dataset(axes, values, "ECoF map of the compliant wear-scar model", extra)
 
     if chunks is not None or cache is False:
         return compute()
@@ -328,16 +330,16 @@ def compute_universal_map(
     behaviour: eq. 13-16.
     """
     axes = {
-        "compliance_ratio": _axis("compliance_ratio", compliance_ratio, "non_negative", "1"),
-        "aspect_ratio": _axis("aspect_ratio", aspect_ratio, "non_negative", "1"),
-        "mu": _axis("mu", mu, "positive", "1"),
+        "compliance_ratio": checked_axis("compliance_ratio", compliance_ratio, "non_negative", "1"),
+        "aspect_ratio": checked_axis("aspect_ratio", aspect_ratio, "non_negative", "1"),
+        "mu": checked_axis("mu", mu, "positive", "1"),
     }
 
     _check_cache(cache, chunks)
 
     def compute() -> xr.Dataset:
-        values = _grid_values(_universal_kernel, axes, (), max_chunk, chunks)
-        return _dataset(axes, values, "Universal ECoF map of the compliant wear-scar model")
+        values = grid_values(_universal_kernel, axes, (), max_chunk, chunks)
+        return grid_dataset(axes, values, "Universal ECoF map of the compliant wear-scar model")
 
     if chunks is not None or cache is False:
         return compute()
@@ -400,11 +402,11 @@ def compute_loops(stiffness, aspect_ratio, amplitude, load, mu, num=201) -> xr.D
     behaviour: eq. 9, 10, 12, 16.
     """
     axes = {
-        "stiffness": _axis("stiffness", stiffness, "positive_or_inf", "N/m"),
-        "aspect_ratio": _axis("aspect_ratio", aspect_ratio, "non_negative", "1"),
-        "amplitude": _axis("amplitude", amplitude, "positive", "m"),
-        "load": _axis("load", load, "positive", "N"),
-        "mu": _axis("mu", mu, "positive", "1"),
+        "stiffness": checked_axis("stiffness", stiffness, "positive_or_inf", "N/m"),
+        "aspect_ratio": checked_axis("aspect_ratio", aspect_ratio, "non_negative", "1"),
+        "amplitude": checked_axis("amplitude", amplitude, "positive", "m"),
+        "load": checked_axis("load", load, "positive", "N"),
+        "mu": checked_axis("mu", mu, "positive", "1"),
     }
     grid = jnp.broadcast_arrays(*_mesh(*(np.atleast_1d(a) for a in axes.values())))
     displacement, force = fretting_loop(
@@ -416,4 +418,4 @@ def compute_loops(stiffness, aspect_ratio, amplitude, load, mu, num=201) -> xr.D
     values["force"] = force
     values = {name: np.asarray(value) for name, value in values.items()}
     point = np.arange(2 * num + 1)
-    return _dataset(axes, values, "Steady fretting loops", extra={"point": point})
+    return grid_dataset(axes, values, "Steady fretting loops", extra={"point": point})

@@ -15,7 +15,7 @@ import xarray as xr
 from ecofmaps import model
 from ecofmaps._inputs import float64
 from ecofmaps.maps.cache import cached_dataset
-from ecofmaps.maps.dataset import _axis, _dataset, _load
+from ecofmaps.maps.dataset import checked_axis, checked_load, grid_dataset
 from ecofmaps.maps.tiles import MAX_CHUNK
 from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers
 
@@ -93,11 +93,13 @@ def compute_profile_map(stiffness_ratio, amplitude, mu, load=None, *, profile, m
     physical = check_mapping(mapping, None)
     profile = as_profile(profile)
     axes = {
-        "stiffness_ratio": _axis("stiffness_ratio", stiffness_ratio, "positive_or_inf", "1/m"),
-        "amplitude": _axis("amplitude", amplitude, "positive", "m"),
-        "mu": _axis("mu", mu, "positive", "1"),
+        "stiffness_ratio": checked_axis(
+            "stiffness_ratio", stiffness_ratio, "positive_or_inf", "1/m"
+        ),
+        "amplitude": checked_axis("amplitude", amplitude, "positive", "m"),
+        "mu": checked_axis("mu", mu, "positive", "1"),
     }
-    load = _load(load)
+    load = checked_load(load)
     if not (isinstance(max_chunk, int) and max_chunk >= 1):
         raise ValueError(f"max_chunk must be an integer >= 1, got {max_chunk!r}")
 
@@ -131,7 +133,7 @@ def compute_profile_map(stiffness_ratio, amplitude, mu, load=None, *, profile, m
         dims = tuple(n for n in ("stiffness_ratio", "amplitude") if axes[n].ndim == 1)
         values["compliance_ratio"] = (dims, np.squeeze(lam, axis=scalars))
         extra = {} if load is None else {"load": load}
-        dataset = _dataset(axes, values, "ECoF map of the compliant wear-scar model on a scar "
+        dataset = grid_dataset(axes, values, "ECoF map of the compliant wear-scar model on a scar "
                            "profile", extra)  # fmt: skip
         dataset.attrs["model"] = MODEL_ON_PROFILE
         dataset.attrs.update(

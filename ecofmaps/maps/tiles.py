@@ -24,7 +24,14 @@ import numpy as np
 
 from ecofmaps._interrupts import check_interrupted
 
-__all__ = ["BLOCK_POINTS", "BLOCK_TASK", "MAX_CHUNK", "available_memory"]
+__all__ = [
+    "BLOCK_POINTS",
+    "BLOCK_TASK",
+    "MAX_CHUNK",
+    "available_memory",
+    "grid_values",
+    "tile_workers",
+]
 
 
 #: Default bound on the number of grid points evaluated in one call of a kernel (a tile):
@@ -83,7 +90,7 @@ def _check_memory(kernel, axes, extra, max_chunk: int) -> None:
     """
     per_point = _bytes_per_point(kernel, len(axes), _signature(extra))
     points = math.prod(axis.size for axis in axes)
-    needed = per_point * (points + 2 * _workers() * min(points, max_chunk))
+    needed = per_point * (points + 2 * tile_workers() * min(points, max_chunk))
     free = available_memory()
     if free is not None and needed > free:
         raise ValueError(
@@ -95,7 +102,7 @@ def _check_memory(kernel, axes, extra, max_chunk: int) -> None:
         )
 
 
-def _workers() -> int:
+def tile_workers() -> int:
     """Threads that evaluate tiles at once: the cores this process may run on."""
     try:
         return len(os.sched_getaffinity(0))
@@ -191,7 +198,7 @@ def _evaluate_grid(kernel, axes, extra, max_chunk: int) -> dict[str, np.ndarray]
         first[split[0]] = axes[split[0]][: split[1]]
         outputs = jax.eval_shape(kernel, *first, *extra)
     out = {name: np.empty(shape, dtype=spec.dtype) for name, spec in outputs.items()}
-    workers = min(_workers(), len(tiles))
+    workers = min(tile_workers(), len(tiles))
     stop = threading.Event()  # set on an error or Ctrl-C: the other threads end early
     with concurrent.futures.ThreadPoolExecutor(workers) as pool:
         futures = [
@@ -297,7 +304,7 @@ def _block(kernel, axes, extra, split, region, tiles) -> dict[str, np.ndarray]:
     return out
 
 
-def _grid_values(kernel, axes: dict, extra: tuple, max_chunk: int, chunks) -> dict:
+def grid_values(kernel, axes: dict, extra: tuple, max_chunk: int, chunks) -> dict:
     """The kernel's results over the grid of ``axes`` (name -> 0-d or 1-D array)."""
     grid = [np.atleast_1d(axis) for axis in axes.values()]
     if chunks is None:

@@ -43,6 +43,7 @@ __all__ = [
     "regime_code",
     "slip_position",
     "slip_ratio",
+    "slip_roots",
     "traction_ratio",
 ]
 
@@ -124,7 +125,7 @@ def traction_ratio(position, mu, kappa, direction=1.0):
     return (direction * mu + slope) / (1.0 - direction * mu * slope)
 
 
-def _slip_roots(target, mu, kappa, lam):
+def slip_roots(target, mu, kappa, lam):
     """Forward-slip equilibrium: the position and its margin to the locking point."""
     a = mu * kappa
     h = a * target + lam * kappa - 1.0
@@ -175,7 +176,7 @@ def slip_position(target, mu, kappa, lam):
     coefficient of friction from fretting loops exhibiting non-Coulomb frictional
     behaviour: eq. 9, 10, 16.
     """
-    return _slip_roots(target, mu, kappa, lam)[0]
+    return slip_roots(target, mu, kappa, lam)[0]
 
 
 def locking_margin(target, mu, kappa, lam):
@@ -206,7 +207,7 @@ def locking_margin(target, mu, kappa, lam):
     coefficient of friction from fretting loops exhibiting non-Coulomb frictional
     behaviour: eq. 9, 16.
     """
-    return _slip_roots(target, mu, kappa, lam)[1]
+    return slip_roots(target, mu, kappa, lam)[1]
 
 
 def regime_code(mu, kappa, lam):

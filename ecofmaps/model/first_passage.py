@@ -44,11 +44,11 @@ import jax.numpy as jnp
 from ecofmaps.model.profile_core import (
     Side,
     Tables,
-    _crossing,
-    _levels,
-    _sparse,
+    crossing_fraction,
     mean_excess,
     mean_traction,
+    sparse_table,
+    table_levels,
     traction_forward,
 )
 from ecofmaps.model.regimes import BEYOND_PROFILE, GROSS_SLIP, NO_GROSS_SLIP, SELF_LOCKING
@@ -155,7 +155,7 @@ def _passage(side: Side, group, mu, lam, value, level, segment, fraction, sparse
     a = jnp.where(same, start, left)
     slope_a = jnp.where(same, start_slope, _at(side.slope, group, j - 1))
     b, slope_b = _at(side.position, group, j), _at(side.slope, group, j)
-    t = _crossing(a, b - a, slope_a, slope_b - slope_a, mu, lam, level)
+    t = crossing_fraction(a, b - a, slope_a, slope_b - slope_a, mu, lam, level)
     reached = a + t * (b - a)
     new = _normal(j - 1, (reached - left) / (b - left), n)
     return jnp.where(stick, segment, new[0]), jnp.where(stick, fraction, new[1]), off
@@ -273,7 +273,7 @@ def jump_area(side: Side, group, mu, lam, start, end):
     :math:`M_+` is the running maximum of :math:`F_+` from the stroke's start: the actuator
     position while the pad slips or jumps. On each segment piece :math:`[a, b]`,
     :math:`F_+` (convex) lies below the level :math:`L = M_+(a)` on :math:`[a, c)`, where
-    :math:`c` is where it climbs back to :math:`L` (:func:`_crossing`), or :math:`b`. The
+    :math:`c` is where it climbs back to :math:`L` (:func:`crossing_fraction`), or :math:`b`. The
     area there is :math:`(c - a)(L - (a + c)/2 - \lambda\bar q_+)`. :math:`O(N)`.
 
     Parameters
@@ -293,7 +293,7 @@ def jump_area(side: Side, group, mu, lam, start, end):
         side, group, mu, lam, start, end
     )
     change = slope_b - slope_a
-    t = _crossing(a, b - a, slope_a, change, mu, lam, level)
+    t = crossing_fraction(a, b - a, slope_a, change, mu, lam, level)
     t = jnp.where(value_b >= level, t, 1.0)
     c = a + t * (b - a)
     slope_c = slope_a + t * change
@@ -359,13 +359,13 @@ def simulation_tables(position, slope, mu, lam) -> Tables:
     def side(p, g):
         force = traction_forward(g, mu)
         values = p + jnp.where(lam > 0.0, lam * force, 0.0)
-        levels = _levels(p.size)
+        levels = table_levels(p.size)
         lower = jnp.concatenate([values, jnp.array([jnp.inf])])
         upper = jnp.concatenate([jnp.full(p.size, jnp.inf), jnp.array([-jnp.inf])])
         bounds = jnp.stack(
             [
-                _sparse(lower, levels, jnp.maximum, jnp.inf),
-                _sparse(upper, levels, jnp.minimum, -jnp.inf),
+                sparse_table(lower, levels, jnp.maximum, jnp.inf),
+                sparse_table(upper, levels, jnp.minimum, -jnp.inf),
             ],
             axis=-1,
         )

@@ -205,7 +205,7 @@ def _shared(profile, unique, group, lam, physical):
     """
     count = unique.shape[1]
     n = profile.position.shape[-1]
-    per_group = 8 * n * (core._levels(n) + 1)
+    per_group = 8 * n * (core.table_levels(n) + 1)
     batch = min(_bucket(count), max(1, 1 << (_TABLE_BUDGET // per_group).bit_length() - 1))
     arguments = (profile.position, profile.slope, profile.half_width)
     unique = np.pad(unique, ((0, 0), (0, -count % batch)), mode="edge")

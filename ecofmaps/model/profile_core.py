@@ -20,7 +20,7 @@ Exactness
 The slope is piecewise linear between samples. On each segment :math:`q_+` is then convex
 and :math:`q_-` concave in :math:`\xi`, so :math:`F_+` cannot exceed a level inside a
 segment unless it does at an end: first passages are found exactly at the samples and the
-crossing inside the segment solves a quadratic (:func:`_crossing`); the integrals of
+crossing inside the segment solves a quadratic (:func:`crossing_fraction`); the integrals of
 :math:`e` and :math:`q_+` over a segment have closed forms (:func:`_mean_excess`,
 :func:`_mean_traction`). Everything is exact up to rounding for the piecewise linear slope.
 
@@ -48,9 +48,12 @@ import numpy as np
 __all__ = [
     "Side",
     "Tables",
+    "crossing_fraction",
     "mean_excess",
     "mean_traction",
     "profile_tables",
+    "sparse_table",
+    "table_levels",
     "traction_forward",
 ]
 
@@ -154,7 +157,7 @@ def mean_traction(slope_a, slope_b, mu):
     return mu + (1.0 + mu * mu) * inner / margin
 
 
-def _crossing(start, length, slope_a, change, mu, lam, level):
+def crossing_fraction(start, length, slope_a, change, mu, lam, level):
     r"""Fraction :math:`t \in [0, 1]` of a segment where :math:`F_+ = \xi + \lambda q_+`
     first reaches ``level`` from below.
 
@@ -188,7 +191,7 @@ def _crossing(start, length, slope_a, change, mu, lam, level):
 # ---------------------------------------------------------------------------------------
 
 
-def _levels(count: int) -> int:
+def table_levels(count: int) -> int:
     """Levels of a first-passage table over ``count`` samples: sum of 2**l >= count."""
     return max(1, int(np.ceil(np.log2(count + 1))))
 
@@ -197,7 +200,7 @@ def _shift(values, step: int, fill):
     return jnp.concatenate([values[step:], jnp.full((step,), fill, values.dtype)])
 
 
-def _sparse(values, levels: int, combine, identity):
+def sparse_table(values, levels: int, combine, identity):
     """Table ``T[l, i] = combine(values[i : i + 2**l])`` with ``identity`` past the end."""
     table = [values]
     for level in range(1, levels):
@@ -228,8 +231,8 @@ def _intervals(position, force, levels: int):
     upper = jnp.concatenate([upper, jnp.array([-jnp.inf])])
     return jnp.stack(
         [
-            _sparse(lower, levels, jnp.maximum, jnp.inf),
-            _sparse(upper, levels, jnp.minimum, -jnp.inf),
+            sparse_table(lower, levels, jnp.maximum, jnp.inf),
+            sparse_table(upper, levels, jnp.minimum, -jnp.inf),
         ],
         axis=-1,
     )
@@ -237,7 +240,7 @@ def _intervals(position, force, levels: int):
 
 def _side(position, slope, mu, sparse: bool) -> Side:
     force = traction_forward(slope, mu)
-    levels = _levels(position.size) if sparse else 1
+    levels = table_levels(position.size) if sparse else 1
     return Side(position, slope, force, _intervals(position, force, levels))
 
 
@@ -293,9 +296,11 @@ def profile_tables(position, slope, mu, length, sparse: bool = True) -> Tables:
         forward=forward,
         backward=backward,
         excess=excess,
-        critical=_sparse(critical, _range_levels(n - 1) if sparse else 1, jnp.minimum, jnp.inf),
-        peak=_sparse(forward.force, levels, jnp.maximum, -jnp.inf),
-        trough=_sparse(trough, levels, jnp.maximum, -jnp.inf),
+        critical=sparse_table(
+            critical, _range_levels(n - 1) if sparse else 1, jnp.minimum, jnp.inf
+        ),
+        peak=sparse_table(forward.force, levels, jnp.maximum, -jnp.inf),
+        trough=sparse_table(trough, levels, jnp.maximum, -jnp.inf),
         mu=mu,
         start_segment=start,
         start_fraction=(0.0 - p[start]) / (p[start + 1] - p[start]),

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ecofmaps._inputs import si_units
-from ecofmaps.model.profiles import MIN_SCAR_SAMPLES, ScarProfile, _profile
+from ecofmaps.model.profiles import MIN_SCAR_SAMPLES, ScarProfile, scar_profile_from_parts
 
 __all__ = ["flat_bottomed_profile", "parabolic_profile", "ridged_profile", "w_shaped_profile"]
 
@@ -64,8 +64,10 @@ def _family(position, height, slope, depth, half_width, tilt):
         raise ValueError(f"tilt must be finite, got {tilt!r}")
     inside = np.abs(position) <= half_width
     worn = np.trapezoid(np.where(inside, -np.minimum(height, 0.0), 0.0), position)
-    return _profile(position, height + tilt * position, slope + tilt, depth, half_width, worn,
-                    reference_slope=tilt)  # fmt: skip
+    return scar_profile_from_parts(
+        position, height + tilt * position, slope + tilt, depth, half_width, worn,
+        reference_slope=tilt,
+    )  # fmt: skip
 
 
 def _extent(extent, needed=1.0) -> float:

@@ -103,6 +103,7 @@ __all__ = [
     "outlying_samples",
     "scar_profile",
     "scar_profile_and_findings",
+    "scar_profile_from_parts",
 ]
 
 #: Default smoothing length as a fraction of the scar's half-width. [1]
@@ -209,7 +210,7 @@ class ScarProfile(NamedTuple):
         return jnp.stack([self.centre - self.half_width, self.centre + self.half_width], -1)
 
 
-def _profile(position, height, slope, depth, half_width, worn_area, centre=0.0,
+def scar_profile_from_parts(position, height, slope, depth, half_width, worn_area, centre=0.0,
              reference_height=0.0, reference_slope=0.0, alternative_half_width=np.nan,
              replaced=0.0) -> ScarProfile:  # fmt: skip
     values = (position, height, slope, depth, half_width, worn_area, centre,
@@ -724,8 +725,10 @@ def scar_profile_and_findings(x, z, half_width=None, smoothing=None, level=False
     else:
         height, slope = z, gs
         reference = (float(line(centre)), float(tilt))
-    profile = _profile(x - centre, height, slope, depth, width, worn, centre, *reference,
-                       alternative, replaced.astype(np.float64))  # fmt: skip
+    profile = scar_profile_from_parts(
+        x - centre, height, slope, depth, width, worn, centre, *reference, alternative,
+        replaced.astype(np.float64),
+    )  # fmt: skip
     return profile, findings
 
 

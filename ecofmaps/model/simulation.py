@@ -15,7 +15,7 @@ import jax
 import jax.numpy as jnp
 
 from ecofmaps._inputs import as_float64, check, float64, is_concrete
-from ecofmaps.model.core import _slip_roots, locking_margin, slip_ratio, traction_ratio
+from ecofmaps.model.core import locking_margin, slip_ratio, slip_roots, traction_ratio
 from ecofmaps.model.on_profile import profile_loop, profile_simulation
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
 from ecofmaps.model.steady_state import check_model_inputs, dimensionless, one_geometry
@@ -148,8 +148,8 @@ def _return_map(displacement, mu, kappa, lam, length):
         gap = d - xi
         forward = gap > lam * traction_ratio(xi, mu, kappa)
         backward = gap < lam * traction_ratio(xi, mu, kappa, -1.0)
-        xi_forward, w_forward = _slip_roots(d, mu, kappa, lam)
-        xi_backward, w_backward = _slip_roots(-d, mu, kappa, lam)
+        xi_forward, w_forward = slip_roots(d, mu, kappa, lam)
+        xi_backward, w_backward = slip_roots(-d, mu, kappa, lam)
         q_forward = (mu + kappa * xi_forward) / w_forward  # eq. 9, digits kept near locking
         q_backward = -(mu + kappa * xi_backward) / w_backward
         xi_backward = -xi_backward
