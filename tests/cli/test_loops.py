@@ -71,8 +71,9 @@ def test_loops_command(tmp_path, capsys, recording):
         if column in ("regime", "quality"):
             assert table[column].tolist() == expected[column].tolist()
             continue
-        if column == "mu_resolved_se":  # noise-free: the rounding of the CSV file's digits
-            assert (table[column] < 1e-4).all() and (expected[column] < 1e-4).all()
+        if column == "mu_resolved_se":  # noise-free: the sampling of the reversals (a branch's
+            # last slip sample short of the next stick level) and the file's digits bound it
+            assert (table[column] < 5e-4).all() and (expected[column] < 5e-4).all()
             continue
         np.testing.assert_allclose(table[column], expected[column], rtol=1e-5, err_msg=column)
     np.testing.assert_allclose(table.mu_resolved, POINT["mu"], rtol=1e-6)
@@ -131,8 +132,7 @@ def test_example(tmp_path, capsys):
 
 
 def test_damaged_file_writes_nothing(tmp_path, capsys, recording):
-    """A bad cell in the second file stops everything: the old output stays as it was."""
-    good = write_csv(tmp_path / "good.csv", *recording)
+    """A bad cell in a single file stops the command: the old output stays as it was."""
     bad = write_csv(tmp_path / "bad.csv", *recording)
     lines = bad.read_text().splitlines()
     lines[57] = "12.5,oops"
@@ -141,9 +141,8 @@ def test_damaged_file_writes_nothing(tmp_path, capsys, recording):
     out.write_text("previous results\n")
     record_written([out])  # as if ecofmaps had written it: --overwrite may replace it
     status, stdout, stderr = run(
-        capsys, good, bad, "--load", "450N", "--out", out, "--plots", tmp_path / "plots",
-        "--overwrite",
-    )  # fmt: skip
+        capsys, bad, "--load", "450N", "--out", out, "--plots", tmp_path / "plots", "--overwrite"
+    )
     assert status == 2
     assert (
         stderr == f"ecofmaps: error: {bad}, line 58: non-numeric value 'oops' in column 'force'\n"
@@ -151,8 +150,29 @@ def test_damaged_file_writes_nothing(tmp_path, capsys, recording):
     assert stdout == ""
     assert out.read_text() == "previous results\n"
     assert not (tmp_path / "plots").exists()
-    listed = [MANIFEST, "bad.csv", "good.csv", "results.csv"]
-    assert sorted(p.name for p in tmp_path.iterdir()) == listed
+    assert sorted(p.name for p in tmp_path.iterdir()) == [MANIFEST, "bad.csv", "results.csv"]
+
+
+def test_a_damaged_file_in_a_batch_is_named_and_the_others_written(tmp_path, capsys, recording):
+    """A bad cell in the second of two files: one error line naming its file and line, the
+    first file's rows and plots written, exit status 1 (issue 23, item 4)."""
+    good = write_csv(tmp_path / "good.csv", *recording)
+    bad = write_csv(tmp_path / "bad.csv", *recording)
+    lines = bad.read_text().splitlines()
+    lines[57] = "12.5,oops"
+    bad.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "results.csv"
+    status, _, stderr = run(
+        capsys, good, bad, "--load", "450N", "--out", out, "--plots", tmp_path / "plots"
+    )
+    assert status == 1
+    assert stderr.strip().splitlines()[-1] == (
+        f"ecofmaps loops: error: {bad}, line 58: non-numeric value 'oops' in column 'force'"
+    )
+    table = pd.read_csv(out)
+    assert set(table.file) == {str(good)} and len(table) == 4
+    plots = sorted(p.name for p in (tmp_path / "plots").glob("*.png"))
+    assert plots and all(name.startswith("good") for name in plots)
 
 
 def test_too_few_samples_names_the_last_line(tmp_path, capsys, recording):
