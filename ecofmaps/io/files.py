@@ -8,13 +8,14 @@ never removed to make room: only a store (zarr) is replaced by a store.
 
 The command line writes only over what it wrote itself: each folder it writes into keeps a
 manifest, :data:`MANIFEST`, of the files and stores ecofmaps put there (their sizes and
-times), read by :func:`written_by_ecofmaps` and added to by :func:`record_written`.
+contents), read by :func:`written_by_ecofmaps` and added to by :func:`record_written`.
 """
 
 from __future__ import annotations
 
 import contextlib
 import errno
+import hashlib
 import json
 import os
 import re
@@ -201,11 +202,16 @@ def _manifest(folder: Path) -> dict:
 
 
 def _entry(path: Path) -> dict:
-    """What the manifest keeps of ``path``: a store, or a file's size and time."""
+    """What the manifest keeps of ``path``: a store, or a file's size and the SHA-256 of its
+    content (not its time, so a file committed to a repository with its folder's manifest
+    is still known as ecofmaps' own in a fresh clone)."""
     if path.is_dir():
         return {"store": True}
-    status = path.stat()
-    return {"size": status.st_size, "mtime_ns": status.st_mtime_ns}
+    digest = hashlib.sha256()
+    with open(path, "rb") as stream:
+        for block in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(block)
+    return {"size": path.stat().st_size, "sha256": digest.hexdigest()}
 
 
 def written_by_ecofmaps(path) -> bool:
@@ -219,13 +225,18 @@ def written_by_ecofmaps(path) -> bool:
     -------
     written : bool
         True if the manifest of its folder (:data:`MANIFEST`) lists it and, for a file,
-        its size and modification time are those recorded; False for anything else (a
+        its size and content (SHA-256) are those recorded; False for anything else (a
         file edited or replaced since, a folder that is not a store, a symbolic link).
     """
     path = Path(path)
     if path.is_symlink() or not path.exists() or (path.is_dir() and not is_store(path)):
         return False
-    return _manifest(path.parent).get(path.name) == _entry(path)
+    recorded = _manifest(path.parent).get(path.name)
+    if not isinstance(recorded, dict):
+        return False
+    if path.is_file() and recorded.get("size") != path.stat().st_size:
+        return False  # not the file recorded: no need to read it
+    return recorded == _entry(path)
 
 
 def record_written(paths) -> None:
