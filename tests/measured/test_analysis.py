@@ -437,7 +437,7 @@ def test_dataset_attributes_and_round_trip(noise_free, tmp_path):
     ("change", "message"),
     [
         (dict(load=0.0), "load must satisfy"),
-        (dict(load=np.array([450.0, 450.0])), "load must be a single value"),
+        (dict(load=np.array([450.0, 450.0])), "load must have one value per sample: 2 values"),
         (dict(force=np.zeros(5)), "force must have one value per sample"),
         (dict(displacement=np.zeros((2, 600))), "displacement must be one-dimensional"),
         (dict(cycle=np.zeros(3)), "cycle must have one value per sample"),
