@@ -41,6 +41,7 @@ import os
 import signal
 import threading
 import time
+import warnings
 
 from ecofmaps._interrupts import check_interrupted
 
@@ -223,7 +224,12 @@ class Runner:
     def _submit(self, function, arguments):
         if self._pool is not None:
             return self._pool.submit(_call, function, arguments)
-        return self._client.submit(_call, function, arguments, pure=False)
+        # A recording parsed into memory (a text file run with --workers) travels with its
+        # tasks: a stretch of samples each, sent once; distributed's advice to load the data
+        # with dask is no news to the user, who gave a text file.
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message="Sending large graph", category=UserWarning)
+            return self._client.submit(_call, function, arguments, pure=False)
 
     def map(self, function, tasks, *, in_flight=None):
         """``function(*arguments)`` for each ``arguments`` of ``tasks``, results in order.
