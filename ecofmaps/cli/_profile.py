@@ -127,7 +127,7 @@ def read_profile(args, conflicting=()):
             setattr(args, name, value)
     # JAX and the readers load with the first profile read, not with the command line
     from ecofmaps.io.scar_profiles import read_scar_profile
-    from ecofmaps.model.profiles import ScarProfileWarning
+    from ecofmaps.model.profiles import ScarProfileWarning  # with the reader, as above
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ScarProfileWarning)

@@ -7,14 +7,6 @@ import textwrap
 __all__ = ["add"]
 
 
-def _size(count: int) -> str:
-    """A byte count for people: 512 B, 12.3 kB, 4.5 MB."""
-    for unit, scale in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
-        if count >= scale:
-            return f"{count / scale:.1f} {unit}"
-    return f"{count} B"
-
-
 def add(subparsers) -> None:
     parser = subparsers.add_parser(
         "cache",
@@ -30,38 +22,12 @@ def add(subparsers) -> None:
     )
     actions = parser.add_subparsers(title="actions", metavar="ACTION", required=True)
     for name, handler, text in (
-        ("list", _run_cache_list, "list the cached maps with their sizes"),
-        ("clear", _run_cache_clear, "remove every cached map"),
+        ("list", "ecofmaps.cli.cache_run:list_cache", "list the cached maps with their sizes"),
+        ("clear", "ecofmaps.cli.cache_run:clear", "remove every cached map"),
     ):
         action = actions.add_parser(name, help=text, description=text + ".")
         action.add_argument(
             "--cache-dir", default=None, metavar="DIR",
             help="cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)",
         )  # fmt: skip
-        action.set_defaults(handler=handler)
-
-
-def _run_cache_list(args) -> int:
-    from ecofmaps.maps.cache import cache_directory, cache_entries
-
-    directory = cache_directory(args.cache_dir)
-    entries = cache_entries(directory)
-    if not entries:
-        print(f"no cached maps in {directory}")
-        return 0
-    print(f"cached maps in {directory}:")
-    for entry in entries:
-        modified = entry.modified.astimezone().strftime("%Y-%m-%d %H:%M:%S")
-        print(f"  {_size(entry.size):>9}  {modified}  {entry.path.name}")
-    total = sum(entry.size for entry in entries)
-    print(f"{len(entries)} file(s), {_size(total)}")
-    return 0
-
-
-def _run_cache_clear(args) -> int:
-    from ecofmaps.maps.cache import cache_directory, clear_cache
-
-    directory = cache_directory(args.cache_dir)
-    count, size = clear_cache(directory)
-    print(f"removed {count} file(s), {_size(size)}, from {directory}")
-    return 0
+        action.set_defaults(handler=handler)  # imported when it runs

@@ -4,12 +4,10 @@ from __future__ import annotations
 
 import argparse
 import textwrap
-from pathlib import Path
 
-from ecofmaps.cli._common import CommandError, recording_options, refuse_to_overwrite, unit
-from ecofmaps.io.files import record_written
+from ecofmaps.cli._common import unit
 
-__all__ = ["add", "run"]
+__all__ = ["add"]
 
 
 def _samples(text: str) -> int:
@@ -65,30 +63,4 @@ def add(subparsers) -> None:
         help="replace DST if ecofmaps wrote it (once the new one is complete); a file or "
         "folder ecofmaps did not write is never replaced",
     )  # fmt: skip
-    parser.set_defaults(handler=run)
-
-
-def run(args) -> int:
-    from ecofmaps.io.recordings import read_recording
-    from ecofmaps.io.writers import WRITE_FORMATS, convert_recording
-
-    source, destination = Path(args.source), Path(args.destination)
-    if destination.suffix.lower() not in WRITE_FORMATS:
-        raise CommandError(
-            f"cannot tell the format of {destination} from its suffix: use one of "
-            f"{', '.join(WRITE_FORMATS)}"
-        )
-    if not destination.parent.is_dir():
-        raise CommandError(f"cannot write {destination}: its directory does not exist")
-    refuse_to_overwrite([("DST", destination)], [source], overwrite=args.overwrite)
-    convert_recording(
-        source,
-        destination,
-        chunk_samples=args.chunk_samples,
-        overwrite=args.overwrite,
-        **recording_options(args),
-    )
-    record_written([destination])
-    written = read_recording(destination, lazy=True)
-    print(f"wrote {destination}: {written.size} samples of {', '.join(written.columns)} (SI)")
-    return 0
+    parser.set_defaults(handler="ecofmaps.cli.convert_run:run")  # imported when it runs

@@ -19,6 +19,7 @@ import sys
 import textwrap
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from multiprocessing import resource_tracker
 from pathlib import Path
 
 from ecofmaps._interrupts import check_interrupted, interrupts_stop_writes
@@ -73,7 +74,7 @@ def usable_cores() -> int:
 
 
 def add(subparsers) -> None:
-    from ecofmaps.figures.recipes import FIGURES
+    from ecofmaps.figures.recipes import FIGURES  # the names for the parser (no JAX)
 
     listing = "\n".join(f"  {name:<10} {recipe.description}" for name, recipe in FIGURES.items())
     parser = subparsers.add_parser(
@@ -220,6 +221,24 @@ def _worker_part(part) -> None:
         os._exit(128 + signal.SIGTERM)  # as _worker_group
 
 
+def _start_resource_tracker_quietly() -> None:
+    """Start multiprocessing's resource tracker with its standard error on the null device.
+
+    Drawing processes stopped by Ctrl-C or SIGTERM while they import leave semaphores that
+    the tracker reports, after the command's one line, as leaked when it ends (they are
+    released by the system all the same); nothing else is printed by it. A tracker already
+    running is left as it is.
+    """
+    saved, null = os.dup(2), os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(null, 2)
+        resource_tracker.ensure_running()
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(null)
+
+
 def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
     """Yield each group's :func:`write_figure_group` result from ``jobs`` processes.
 
@@ -227,6 +246,7 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
     first, in parallel; the group is drawn once all its parts are in the cache.
     """
     others = set(multiprocessing.active_children())
+    _start_resource_tracker_quietly()
     executor = ProcessPoolExecutor(
         jobs,
         mp_context=multiprocessing.get_context("spawn"),  # JAX's threads do not survive a fork
@@ -263,6 +283,10 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
         raise
     finally:
         executor.shutdown(wait=True)
+        # An interrupt's traceback keeps this frame: dropping the executor here lets its
+        # queues' semaphores be released before the process ends (else multiprocessing's
+        # resource tracker prints a line about them after ours).
+        executor = None
 
 
 def _written_here(groups, out: Path, formats):
@@ -275,7 +299,7 @@ def _written_here(groups, out: Path, formats):
 
 
 def run(args) -> int:
-    from ecofmaps.figures.recipes import figure_groups, figure_parts
+    from ecofmaps.figures.recipes import figure_groups, figure_parts  # the CLI's lazy boundary
 
     names = list(dict.fromkeys(args.only or ()))
     groups = figure_groups(names or None)

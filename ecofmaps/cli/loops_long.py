@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps._interrupts import Interrupted
+from ecofmaps._parallel import Runner
 from ecofmaps.cli._common import CommandError
 from ecofmaps.io.tables import results_csv
 from ecofmaps.measured.cycles import Cycles
@@ -191,8 +192,6 @@ class LongRun:
         self.partial = None
 
     def _runner(self):
-        from ecofmaps._parallel import Runner
-
         if self.args.scheduler:
             return Runner(scheduler=self.args.scheduler)
         if self.args.workers:

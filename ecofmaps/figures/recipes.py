@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ecofmaps import paper
+from ecofmaps._nomenclature import attrs
 
 if TYPE_CHECKING:  # imported when a figure is made: the registry reads without them
     import xarray as xr
@@ -124,7 +125,7 @@ def _loops() -> xr.Dataset:
 
 
 def _stiffness_curves_data() -> xr.Dataset:
-    from ecofmaps.maps.grid import compute_map
+    from ecofmaps.maps.grid import compute_map  # JAX: the registry reads without it
 
     return compute_map(
         stiffness_ratio=np.array(paper.FIGURE_7_STIFFNESSES) / paper.LOAD,
@@ -139,7 +140,7 @@ def _ecof_ratio_map(panel: str) -> Callable[[], xr.Dataset]:
     amplitude = paper.FIGURE_11_AMPLITUDES[panel]
 
     def data() -> xr.Dataset:
-        from ecofmaps.maps.grid import compute_map
+        from ecofmaps.maps.grid import compute_map  # JAX: the registry reads without it
 
         return compute_map(paper.FIGURE_11_STIFFNESS_RATIOS, ASPECT_RATIOS, amplitude, paper.MU)
 
@@ -148,7 +149,7 @@ def _ecof_ratio_map(panel: str) -> Callable[[], xr.Dataset]:
 
 
 def _universal_map() -> xr.Dataset:
-    from ecofmaps.maps.grid import compute_universal_map
+    from ecofmaps.maps.grid import compute_universal_map  # JAX: the registry reads without it
 
     return compute_universal_map(COMPLIANCE_RATIOS, ASPECT_RATIOS, paper.MU)
 
@@ -231,8 +232,6 @@ def _labelled(variables: dict, coords: dict) -> xr.Dataset:
     """A Dataset of ``variables`` and ``coords``, each with its nomenclature's attrs."""
     import xarray as xr
 
-    from ecofmaps._nomenclature import attrs
-
     return xr.Dataset(
         {name: (dims, values, attrs(name)) for name, (dims, values) in variables.items()},
         coords={name: ((name if np.ndim(v) else ()), v, attrs(name)) for name, v in coords.items()},
@@ -287,7 +286,7 @@ def scar_shape_maps_dataset() -> xr.Dataset:
         ``slip_amplitude``, ``dissipated_energy``, ``ecof`` and ``ecof_ratio`` over
         (``shape``, ``groove``, ``stiffness_ratio``). Computed, not cached.
     """
-    from ecofmaps.maps.grid import compute_map
+    from ecofmaps.maps.grid import compute_map  # JAX: the registry reads without it
 
     ratios = _SHAPES_STIFFNESS_RATIOS
     grid = dict(amplitude=paper.AMPLITUDE, mu=paper.MU, load=paper.LOAD)

@@ -25,6 +25,7 @@ import numpy as np
 
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps.io.files import atomic_store
+from ecofmaps.io.recordings import recording_blocks
 
 __all__ = ["WRITE_FORMATS", "RecordingWriter", "convert_recording"]
 
@@ -316,8 +317,6 @@ def convert_recording(
     missing samples as NaN; the store's attributes name the source, its columns and the
     units they were read in. Memory stays near a few blocks, whatever the size.
     """
-    from ecofmaps.io.recordings import recording_blocks
-
     source, destination = Path(source), Path(destination)
     if destination.resolve() == source.resolve():
         raise ValueError(f"convert_recording would write over its source {source}")

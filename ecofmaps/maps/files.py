@@ -19,6 +19,7 @@ from pathlib import Path
 import xarray as xr
 
 from ecofmaps.io.files import atomic_store
+from ecofmaps.maps.tiles import tile_workers
 
 __all__ = ["ZARR_SUFFIX", "write_map"]
 
@@ -45,8 +46,6 @@ def _threads():
     The temporary output is removed only after this, so that no task still writes into
     it (or creates it again) after an interrupt.
     """
-    from ecofmaps.maps.tiles import tile_workers
-
     pool = concurrent.futures.ThreadPoolExecutor(tile_workers())
     try:
         yield pool
