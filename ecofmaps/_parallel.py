@@ -37,11 +37,13 @@ import asyncio
 import collections
 import concurrent.futures
 import contextlib
+import logging
 import os
 import signal
 import threading
 import time
 import warnings
+from multiprocessing import resource_tracker
 
 from ecofmaps._interrupts import check_interrupted
 
@@ -54,6 +56,7 @@ __all__ = [
     "Slice",
     "check_workers",
     "probe_scheduler",
+    "start_resource_tracker_quietly",
     "stretch",
     "worker_limit",
 ]
@@ -196,6 +199,7 @@ class Runner:
                 "distributed.worker.profile.enabled": False,
             }
             with dask.config.set(settings), _sigint_ignored():
+                start_resource_tracker_quietly()
                 self._cluster = LocalCluster(
                     n_workers=self.workers,
                     threads_per_worker=1,
@@ -212,6 +216,8 @@ class Runner:
         return self
 
     def __exit__(self, *exc):
+        if exc[0] is not None and issubclass(exc[0], KeyboardInterrupt):
+            _quiet_teardown()  # Ctrl-C or SIGTERM: the cluster's farewells are noise
         if self._pool is not None:
             self._pool.shutdown(wait=True, cancel_futures=True)
         if self._client is not None and self._given is None:
@@ -391,6 +397,32 @@ def probe_scheduler(address: str, timeout: float) -> None:
             f"no dask scheduler at {address}: {answer}; is it running, and is the address "
             "right (tcp://host:8786, not the dashboard's http:// address)?"
         )
+
+
+def start_resource_tracker_quietly() -> None:
+    """Start multiprocessing's resource tracker with its standard error on the null device.
+
+    Processes stopped by Ctrl-C or SIGTERM while they start (a cluster's workers, drawing
+    processes) leave semaphores that the tracker reports as leaked when it ends, after the
+    command's one line (the system releases them all the same); nothing else is printed by
+    it. A tracker already running is left as it is.
+    """
+    saved, null = os.dup(2), os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(null, 2)
+        resource_tracker.ensure_running()
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(null)
+
+
+def _quiet_teardown() -> None:
+    """Silence the loggers of a cluster torn down by an interrupt (distributed, tornado,
+    asyncio): its cancelled tasks and closed connections are expected, and the command has
+    said in one line that it was stopped."""
+    for name in ("distributed", "tornado", "asyncio"):
+        logging.getLogger(name).setLevel(logging.CRITICAL + 1)
 
 
 def _connect(address: str, timeout: float):

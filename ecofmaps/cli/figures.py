@@ -19,10 +19,10 @@ import sys
 import textwrap
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-from multiprocessing import resource_tracker
 from pathlib import Path
 
 from ecofmaps._interrupts import check_interrupted, interrupts_stop_writes
+from ecofmaps._parallel import start_resource_tracker_quietly
 from ecofmaps.cli._common import refuse_to_overwrite
 from ecofmaps.io.files import record_written
 
@@ -221,24 +221,6 @@ def _worker_part(part) -> None:
         os._exit(128 + signal.SIGTERM)  # as _worker_group
 
 
-def _start_resource_tracker_quietly() -> None:
-    """Start multiprocessing's resource tracker with its standard error on the null device.
-
-    Drawing processes stopped by Ctrl-C or SIGTERM while they import leave semaphores that
-    the tracker reports, after the command's one line, as leaked when it ends (they are
-    released by the system all the same); nothing else is printed by it. A tracker already
-    running is left as it is.
-    """
-    saved, null = os.dup(2), os.open(os.devnull, os.O_WRONLY)
-    try:
-        os.dup2(null, 2)
-        resource_tracker.ensure_running()
-    finally:
-        os.dup2(saved, 2)
-        os.close(saved)
-        os.close(null)
-
-
 def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
     """Yield each group's :func:`write_figure_group` result from ``jobs`` processes.
 
@@ -246,7 +228,7 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
     first, in parallel; the group is drawn once all its parts are in the cache.
     """
     others = set(multiprocessing.active_children())
-    _start_resource_tracker_quietly()
+    start_resource_tracker_quietly()
     executor = ProcessPoolExecutor(
         jobs,
         mp_context=multiprocessing.get_context("spawn"),  # JAX's threads do not survive a fork
