@@ -343,9 +343,10 @@ def test_command_writes_the_figures(tmp_path, capsys):
     out = tmp_path / "new" / "figures"
     status = main(["figures", "--out", str(out), "--only", "fig8", "fig11b", "--format", "png,svg"])
     assert status == 0
+    # the manifest lists what ecofmaps wrote there
     assert sorted(p.name for p in out.iterdir()) == [
         ".ecofmaps-manifest.json", "fig11b.png", "fig11b.svg", "fig8.png", "fig8.svg",
-    ]  # fmt: skip (the manifest lists what ecofmaps wrote there)
+    ]  # fmt: skip
     assert (out / "fig8.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "<svg" in (out / "fig11b.svg").read_text()
     captured = capsys.readouterr()
