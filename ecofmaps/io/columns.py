@@ -247,8 +247,9 @@ def matching_columns(names, wanted: str, role: str | None = None) -> list[int]:
     whole = [k for k, name in enumerate(names) if _normal(name) == target]
     if len(whole) == 1:
         return whole
-    base = _normal(split_unit(wanted)[0])
-    by_base = [k for k, name in enumerate(names) if _normal(split_unit(name)[0]) == base]
+    # its base, or the whole name when that ends in a word that reads as a unit ('A N')
+    bases = {_normal(split_unit(wanted)[0]), target}
+    by_base = [k for k, name in enumerate(names) if _normal(split_unit(name)[0]) in bases]
     if whole or by_base or role not in SYNONYMS or target != role:
         return whole if len(whole) > 1 else by_base
     usual = _SYNONYM_KEYS[role]

@@ -1,7 +1,7 @@
 """Column names that carry their unit, finding columns, and deciding a column's unit."""
 
 import pytest
-from hypothesis import given
+from hypothesis import example, given
 from hypothesis import strategies as st
 
 from ecofmaps.io.columns import (
@@ -48,6 +48,7 @@ def test_split_unit(name, expected):
     unit=st.sampled_from(sorted({**LENGTHS, **FORCES})),
     style=st.sampled_from(STYLES),
 )
+@example(base="A N", unit="N", style="{base} [{unit}]")  # a base that ends in a unit's word
 def test_split_unit_finds_every_style(base, unit, style):
     """Any name in any style gives back its base and unit; finding the base finds it."""
     if style.endswith("_{unit}"):
