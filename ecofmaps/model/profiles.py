@@ -54,14 +54,20 @@ that distance for a curved one. These are the *groove's* edges.
 *Pile-up ridges and the disturbed band.* The band around the groove is disturbed: its
 samples lie farther from the line than 5 times the shoulders' noise and than 2 % of the
 depth, with no quiet stretch longer than a quarter of the groove's half-width (and than 10
-sample spacings) between them. Going inwards from the band's outer end, the first crest
-that stands higher than that threshold above the line is a pile-up ridge; the band's edge
-is the foot of its inner flank, the lowest point before the profile rises by the threshold
-again (a floor above the line, debris, roughness); without a ridge, the band's outermost
-sample. Where the flank falls (to within the threshold) all the way into the groove (a
-scar whose walls run into its ridges, or a quiet floor between them and the groove),
-the edges are the groove's. When an edge of the band lies beyond the groove's by more
-than :data:`AMBIGUOUS_EDGES` of the groove's half-width, the edges are ambiguous, and a
+sample spacings) between them. Pile-up ridges come in pairs: when the highest samples on
+either side of the groove, within 5 of its half-widths of its centre, both stand higher
+than the threshold and lie at distances from the centre within a ratio of 1.5, the band
+reaches at least to their outer ends, however quiet the floor between them and the groove.
+Going inwards from the band's outer end, the first crest that stands higher than that
+threshold above the line is a pile-up ridge; the band's edge is the foot of its inner
+flank, whatever its shape (Gaussian, sin², triangular, asymmetric): the lowest point
+before the profile rises by the threshold again (a floor above the line, debris,
+roughness) or, if it first stays level, the first point after which it falls by no more
+than the threshold over a quarter of the groove's half-width (a floor at the line or
+above it); without a ridge, the band's outermost sample. Where the flank falls all the
+way into the groove (a scar whose walls run into its ridges), the edges are the
+groove's. When an edge of the band lies beyond the groove's by more than
+:data:`AMBIGUOUS_EDGES` of the groove's half-width, the edges are ambiguous, and a
 :class:`ScarProfileWarning` gives both half-widths (``alternative_half_width`` keeps the
 one not taken); which one the model needs is the user's judgement (``half_width=``). The
 band's are taken when both its edges lie beyond (a shallow groove inside a wider worn
@@ -132,6 +138,10 @@ _MIN_RELIEF = 0.05
 _BAND_FLOOR = 0.02
 _BAND_GAP_WIDTH = 0.25
 _BAND_GAP = 10
+# Pile-up ridges beyond a quiet floor: a pair, the highest crest on each side within this
+# many groove half-widths of its centre, at distances from it within this ratio.
+_RIDGE_REACH = 5.0
+_RIDGE_PAIR = 1.5
 # Local quadratic fits reach this many standard deviations of their Gaussian weights, which
 # are lowered to reach zero there (so a sample's weight never jumps as positions move).
 _REACH = 4.0
@@ -486,15 +496,29 @@ def _band_end(x, r, outer, step, threshold, gap):
     return int(index[count - 1]) if count else outer
 
 
-def _band_edge(x, r, outer, end, step, threshold):
+def _forward_minimum(values, count):
+    """The minimum of ``values[j : j + count]`` for each ``j`` with a full window (the
+    van Herk-Gil-Werman method: linear in the number of values, whatever ``count``)."""
+    size = values.size - count + 1
+    if size <= 0:
+        return np.empty(0)
+    padded = np.concatenate([values, np.full(-values.size % count, np.inf)]).reshape(-1, count)
+    prefix = np.minimum.accumulate(padded, axis=1).ravel()
+    suffix = np.minimum.accumulate(padded[:, ::-1], axis=1)[:, ::-1].ravel()
+    return np.minimum(suffix[:size], prefix[count - 1 : count - 1 + size])
+
+
+def _band_edge(x, r, outer, end, step, threshold, level):
     """The band's edge on one side and the index of its pile-up ridge's crest (or None).
 
     Inwards from the band's outermost sample ``end``: the first crest higher than
     ``threshold`` above the line (a ridge), then down its inner flank to where it stops
-    falling (the lowest sample before it first rises by ``threshold`` again); that is the
-    edge. Without a ridge the band ends at ``end``. The edge is None where it is the
-    groove's own: the flank falls, to within ``threshold``, all the way to the groove's
-    edge sample ``outer``."""
+    falling: the lowest sample before it first rises by ``threshold`` again, unless it
+    stays level first: then the first sample after which it falls by no more than
+    ``threshold`` over ``level`` samples (a floor, at the line or above it, whatever the
+    ridge's shape); that is the edge. Without a ridge the band ends at ``end``. The edge is
+    None where it is the groove's own: the flank falls, to within ``threshold``, all the
+    way to the groove's edge sample ``outer``."""
     inward = np.arange(end, outer - step, -step)
     s = r[inward]
     above = np.flatnonzero(s > threshold)
@@ -505,10 +529,37 @@ def _band_edge(x, r, outer, end, step, threshold):
     crest = first + int(np.argmax(s[first : first + fallen[0]] if fallen.size else s[first:]))
     flank = s[crest:]
     rise = np.flatnonzero(flank > np.minimum.accumulate(flank) + threshold)
-    if rise.size == 0:
+    lowest = _forward_minimum(flank, level)
+    floor = np.flatnonzero(lowest >= flank[: lowest.size] - threshold)
+    if rise.size and (floor.size == 0 or rise[0] <= floor[0] + level):
+        foot = inward[crest + int(np.argmin(flank[: rise[0]]))]
+    elif floor.size:
+        foot = inward[crest + int(floor[0])]
+    else:
         return None, int(inward[crest])
-    foot = inward[crest + int(np.argmin(flank[: rise[0]]))]
     return float(x[foot]), int(inward[crest])
+
+
+def _paired_ridges(x, r, sides, centre, threshold, gap):
+    """The outer ends (indices) of the disturbed runs around the highest samples above the
+    line beyond the groove's edge samples ``sides`` (left, right) and within
+    :data:`_RIDGE_REACH` groove half-widths of its ``centre``, if both stand higher than
+    ``threshold`` and lie at distances from it within a ratio of :data:`_RIDGE_PAIR`:
+    pile-up ridges come in pairs, however quiet the floor between them and the groove;
+    None if there is no such pair."""
+    reach = _RIDGE_REACH * 0.5 * (x[sides[1]] - x[sides[0]])
+    ends, distances = [], []
+    for outer, step in zip(sides, (-1, +1), strict=True):
+        high = np.flatnonzero((r > threshold) & (np.abs(x - centre) <= reach))
+        high = high[high < outer] if step < 0 else high[high > outer]
+        if high.size == 0:
+            return None
+        crest = int(high[np.argmax(r[high])])
+        ends.append(_band_end(x, r, crest, step, threshold, gap))
+        distances.append(abs(float(x[crest]) - centre))
+    if max(distances) > _RIDGE_PAIR * min(distances):
+        return None
+    return ends
 
 
 def _shoulders(x, centre, half_width, band, quiet):
@@ -558,7 +609,12 @@ def _edges(x, r, deepest, depth, noise, reach):
     gap = max(_BAND_GAP_WIDTH * 0.5 * (right[0] - left[0]), _BAND_GAP * np.median(np.diff(x)))
     ends = [_band_end(x, r, side[1], step, threshold, gap)
             for side, step in ((left, -1), (right, +1))]  # fmt: skip
-    found = [_band_edge(x, r, side[1], end, step, threshold)
+    paired = _paired_ridges(x, r, (left[1], right[1]), 0.5 * (left[0] + right[0]), threshold,
+                            gap)  # fmt: skip
+    if paired is not None:  # the ridges beyond a quiet floor, unless the band reaches farther
+        ends = [min(ends[0], paired[0]), max(ends[1], paired[1])]
+    level = max(int(np.ceil(gap / np.median(np.diff(x)))), 1)
+    found = [_band_edge(x, r, side[1], end, step, threshold, level)
              for side, end, step in ((left, ends[0], -1), (right, ends[1], +1))]  # fmt: skip
     groove = (left[0], right[0])
     band = tuple(edge if edge is not None else groove[i] for i, (edge, _) in enumerate(found))

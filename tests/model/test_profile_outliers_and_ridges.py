@@ -209,3 +209,110 @@ def test_debris_beside_one_edge_keeps_the_groove_and_warns_with_the_band():
     message = caught[0].message
     assert (message.alternative, message.alternative_name) == (alternative, "band")
     assert str(message).endswith(f"half_width={alternative:.6g} (m) takes the band")
+
+
+# --- ridges of any shape (Gaussian, sin², triangular, asymmetric) ---------------------------
+
+
+def gaussian_ridges(x, crest, height, width):
+    """Pile-up ridges H exp(-((|x| - crest)/width)²) with their crests at |x| = crest."""
+    return height * np.exp(-(((np.abs(x) - crest) / width) ** 2))
+
+
+def shaped_ridges(x, shape, crest, height):
+    """Ridges 1.5 µm (``height``) high cresting at |x| = crest, of the given shape."""
+    d = np.abs(x) - crest
+    if shape == "gaussian":
+        return gaussian_ridges(x, crest, height, 12 * UM)
+    if shape == "sin2":
+        return ridges(x, crest - 15 * UM, height, 30 * UM)
+    if shape == "triangular":
+        return height * np.clip(1 - np.abs(d) / (15 * UM), 0, None)
+    # asymmetric: a steep inner flank (6 µm), a long outer one (30 µm)
+    return height * np.where(d < 0, np.clip(1 + d / (6 * UM), 0, None),
+                             np.clip(1 - d / (30 * UM), 0, None))  # fmt: skip
+
+
+def groove_between_ridges(shape, floor, sigma, seed, crest=85 * UM):
+    """The acceptance track: a groove 31 µm in half-width and 3 µm deep, its floor out to
+    the ridges ``floor`` above the surface, ridges 1.5 µm high at ±85 µm, noise ``sigma``."""
+    z = np.where(np.abs(XI) < 31 * UM, -3 * UM * (1 - (XI / (31 * UM)) ** 2), 0.0)
+    z += np.where((np.abs(XI) >= 31 * UM) & (np.abs(XI) < crest), floor, 0.0)
+    return z + shaped_ridges(XI, shape, crest, 1.5 * UM) + noise(seed, XI.size, sigma)
+
+
+@pytest.mark.parametrize("shape", ["gaussian", "sin2", "triangular", "asymmetric"])
+@pytest.mark.parametrize(
+    ("floor", "sigma"),
+    [(0.0, 0.02), (0.15, 0.02), (0.35, 0.02), (0.35, 0.1)],
+    ids=["floor 0", "floor 0.15", "floor 0.35", "floor 0.35, noise 0.1"],
+)
+def test_a_groove_between_ridges_of_any_shape_warns_with_both(shape, floor, sigma):
+    """Ridges of any shape at ±85 µm beyond a floor (quiet or raised) around a groove 31 µm
+    in half-width: never silently the groove. The band is taken, its edges at the ridges'
+    inner feet (between 55 µm, 30 µm inside the crests, and the crests: a Gaussian's flank
+    reaches the floor about 20 µm inside its crest), and the groove offered within 1 µm."""
+    z = groove_between_ridges(shape, floor * UM, sigma * UM, seed=21)
+    with pytest.warns(ScarProfileWarning, match="ambiguous scar edges") as caught:
+        profile = scar_profile(XI, z)
+    assert 55 * UM < float(profile.half_width) <= 86 * UM
+    assert float(profile.alternative_half_width) == pytest.approx(31 * UM, abs=1 * UM)
+    assert "the band between its pile-up ridges" in str(caught[0].message)
+    assert float(profile.centre) == pytest.approx(0.0, abs=3 * UM)
+
+
+def test_a_wide_band_with_debris_between_gaussian_ridges_warns_with_both():
+    """The acceptance track: a band 200 µm wide, wavy (debris) and rough (0.2 µm), Gaussian
+    ridges 4 µm high at ±120 µm, a roughness valley inside: read before as a 32.7 µm
+    half-width, silently. The band is taken (between its edge, 100 µm, and the crests,
+    120 µm) and the valley's groove offered."""
+    rng = np.random.default_rng(1)
+    x = np.arange(-600.0, 600.0, 0.5) * UM
+    z = rng.normal(0, 0.2 * UM, x.size) + gaussian_ridges(x, 120 * UM, 4 * UM, 15 * UM)
+    inside = np.abs(x) < 100 * UM
+    z[inside] += UM * np.sin(x[inside] / (100 * UM) * 7) - 0.5 * UM
+    z[np.abs(x - 10 * UM) < 4 * UM] -= 2 * UM
+    with pytest.warns(ScarProfileWarning, match="ambiguous scar edges") as caught:
+        profile = scar_profile(x, z)
+    assert 95 * UM < float(profile.half_width) < 122 * UM
+    assert float(profile.alternative_half_width) < 50 * UM
+    assert "the band between its pile-up ridges" in str(caught[0].message)
+
+
+@pytest.mark.parametrize("kind", ["parabola", "flat", "V"])
+def test_gaussian_ridges_at_the_edges_with_known_truth(kind):
+    """The known-truth track with Gaussian ridges (2 µm high, crests 2 widths beyond the
+    edges, so the walls run into them): the half-width within 1 %, the depth within 4 %,
+    the tilt to 1e-5, and no warning."""
+    z = scar(kind) + gaussian_ridges(X, W + 30 * UM, 2 * UM, 15 * UM)
+    z += np.where(np.abs(X) < W, 0.4 * UM * np.sin(2 * np.pi * X / (23 * UM)), 0.0)
+    z += bump(X, 60 * UM, 1.5 * UM, 4 * UM) + bump(X, -450 * UM, 2 * UM, 5 * UM)
+    z += 3 * UM + 0.002 * X + noise(9, X.size)
+    profile = silently(scar_profile, X, z)
+    assert float(profile.half_width) == pytest.approx(W, rel=0.01)
+    assert float(profile.depth) == pytest.approx(D, rel=0.04)
+    assert float(profile.reference_slope) == pytest.approx(0.002, abs=1e-5)
+    assert np.isnan(float(profile.alternative_half_width))
+
+
+@pytest.mark.parametrize(
+    "family",
+    [
+        lambda: ecofmaps.parabolic_profile(D, W),
+        lambda: ecofmaps.flat_bottomed_profile(D, W, 0.5),
+        lambda: ecofmaps.w_shaped_profile(D, W, 0.3),
+        lambda: ecofmaps.ridged_profile(D, W, 2 * UM, 20 * UM),
+        lambda: ecofmaps.ridged_profile(10 * UM, 40 * UM, 4 * UM, 30 * UM, extent=3.0),
+    ],
+    ids=["parabolic", "flat", "w", "ridged", "ridged, high"],
+)
+@pytest.mark.parametrize("seed", [None, 15])
+def test_the_families_read_back_without_a_warning(family, seed):
+    """The analytic families, exact or with noise, read back silently with their half-width
+    (within 1 %): ridges whose walls run into the groove are not a band."""
+    profile = family()
+    x, z = np.asarray(profile.position), np.asarray(profile.height)
+    z = z + (0.0 if seed is None else noise(seed, x.size, 1e-3 * float(profile.depth)))
+    read = silently(scar_profile, x, z)
+    assert float(read.half_width) == pytest.approx(float(profile.half_width), rel=0.01)
+    assert np.isnan(float(read.alternative_half_width))
