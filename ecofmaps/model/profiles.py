@@ -56,8 +56,9 @@ samples lie farther from the line than 5 times the shoulders' noise and than 2 %
 depth, with no quiet stretch longer than a quarter of the groove's half-width (and than 10
 sample spacings) between them. Pile-up ridges come in pairs: when the highest samples on
 either side of the groove, within 5 of its half-widths of its centre, both stand higher
-than the threshold and lie at distances from the centre within a ratio of 1.5, the band
-reaches at least to their outer ends, however quiet the floor between them and the groove.
+than the threshold over at least a quarter of its half-width (wider than asperities) and
+lie at distances from the centre within a ratio of 1.5, the band reaches at least to
+their outer ends, however quiet the floor between them and the groove.
 Going inwards from the band's outer end, the first crest that stands higher than that
 threshold above the line is a pile-up ridge; the band's edge is the foot of its inner
 flank, whatever its shape (Gaussian, sin², triangular, asymmetric): the lowest point
@@ -139,7 +140,8 @@ _BAND_FLOOR = 0.02
 _BAND_GAP_WIDTH = 0.25
 _BAND_GAP = 10
 # Pile-up ridges beyond a quiet floor: a pair, the highest crest on each side within this
-# many groove half-widths of its centre, at distances from it within this ratio.
+# many groove half-widths of its centre, at distances from it within this ratio (each
+# higher than the band's threshold over at least the band's longest quiet stretch).
 _RIDGE_REACH = 5.0
 _RIDGE_PAIR = 1.5
 # Local quadratic fits reach this many standard deviations of their Gaussian weights, which
@@ -544,7 +546,8 @@ def _paired_ridges(x, r, sides, centre, threshold, gap):
     """The outer ends (indices) of the disturbed runs around the highest samples above the
     line beyond the groove's edge samples ``sides`` (left, right) and within
     :data:`_RIDGE_REACH` groove half-widths of its ``centre``, if both stand higher than
-    ``threshold`` and lie at distances from it within a ratio of :data:`_RIDGE_PAIR`:
+    ``threshold`` over at least ``gap`` (wider than asperities) and lie at distances from
+    it within a ratio of :data:`_RIDGE_PAIR`:
     pile-up ridges come in pairs, however quiet the floor between them and the groove;
     None if there is no such pair."""
     reach = _RIDGE_REACH * 0.5 * (x[sides[1]] - x[sides[0]])
@@ -555,6 +558,11 @@ def _paired_ridges(x, r, sides, centre, threshold, gap):
         if high.size == 0:
             return None
         crest = int(high[np.argmax(r[high])])
+        low = np.flatnonzero(r <= threshold)
+        foot = np.searchsorted(low, crest)  # the run above the threshold around the crest
+        run = (x[low[foot - 1]] if foot else x[0], x[low[foot]] if foot < low.size else x[-1])
+        if run[1] - run[0] < gap:  # an asperity, not a ridge
+            return None
         ends.append(_band_end(x, r, crest, step, threshold, gap))
         distances.append(abs(float(x[crest]) - centre))
     if max(distances) > _RIDGE_PAIR * min(distances):

@@ -316,3 +316,16 @@ def test_the_families_read_back_without_a_warning(family, seed):
     read = silently(scar_profile, x, z)
     assert float(read.half_width) == pytest.approx(float(profile.half_width), rel=0.01)
     assert np.isnan(float(read.alternative_half_width))
+
+
+def test_two_asperities_beyond_a_quiet_floor_are_not_ridges():
+    """Two narrow asperities (1 µm wide, 0.8 and 1 µm high) at -95 and +80 µm beside a
+    groove 31 µm in half-width on a quiet surface: not a pair of ridges, no warning, the
+    half-width that of the groove without them (to 0.1 %)."""
+    plain = np.where(np.abs(XI) < 31 * UM, -3 * UM * (1 - (XI / (31 * UM)) ** 2), 0.0)
+    plain += noise(21, XI.size, 0.02 * UM)
+    z = plain + bump(XI, 80 * UM, 1.0 * UM, 1 * UM) + bump(XI, -95 * UM, 0.8 * UM, 1 * UM)
+    profile = silently(scar_profile, XI, z)
+    expected = float(silently(scar_profile, XI, plain).half_width)
+    assert float(profile.half_width) == pytest.approx(expected, rel=1e-3)
+    assert expected == pytest.approx(31 * UM, abs=1 * UM)
