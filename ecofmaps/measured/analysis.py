@@ -240,7 +240,7 @@ def analyze_loops(
     held whole: its cycles are found by passes a block at a time
     (:mod:`ecofmaps.measured.cycles`), then measured in tasks of whole cycles, each with
     two whole cycles on either side for the centring's drift
-    (:mod:`ecofmaps.measured.out_of_core`). The results are those of the same recording in
+    (:mod:`ecofmaps.measured.pipeline`). The results are those of the same recording in
     memory.
 
     References
@@ -310,9 +310,8 @@ def _at_mean_load(force, load):
     recorded channel) scales the force to the mean load (:func:`force_at_mean_load`)."""
     if np.ndim(load) == 0 and not is_lazy(load):
         return force, load
-    size = np.shape(force)[0] if not hasattr(force, "dims") else force.shape[0]
-    values = _series("load", load, size)
-    return force_at_mean_load(_series("force", force, size), values)
+    force = _series("force", force)
+    return force_at_mean_load(force, _series("load", load, force.shape[0]))
 
 
 def _raise_at_missing(x, q, label, mask) -> None:

@@ -44,7 +44,7 @@ from ecofmaps._parallel import stretch
 from ecofmaps.measured.cycles import Cycles, find_cycles
 from ecofmaps.measured.options import missing_sample_error, no_cycle_error
 from ecofmaps.measured.per_cycle import measure_cycles
-from ecofmaps.measured.quality import ALL, REASONS, has_reason, quality_summary
+from ecofmaps.measured.quality import ALL, REASONS, SEPARATOR, quality_summary
 from ecofmaps.measured.resolved import REPORTED, resolve_analyzed_loops, resolved_attrs
 from ecofmaps.measured.results import Tally, cycle_results, strip, with_loops
 
@@ -158,15 +158,15 @@ def force_at_mean_load(force, load):
     ValueError
         If no load is finite, or one is not positive.
     """
-    lazy = not isinstance(load, np.ndarray)
-    finite = load[np.isfinite(load)] if not lazy else None
-    if lazy:
+    if isinstance(load, np.ndarray):
+        finite = load[np.isfinite(load)]
+        mean, lowest = (finite.mean(), finite.min()) if finite.size else (np.nan, np.nan)
+    else:
         import dask.array as da  # only for a lazy recording, read out of core
 
-        mean, lowest = (float(v) for v in da.compute(da.nanmean(load), da.nanmin(load)))
-    else:
-        mean = float(finite.mean()) if finite.size else np.nan
-        lowest = float(finite.min()) if finite.size else np.nan
+        finite = da.where(da.isfinite(load), load, np.nan)  # as in memory: inf is missing
+        mean, lowest = da.compute(da.nanmean(finite), da.nanmin(finite))
+    mean, lowest = float(mean), float(lowest)
     if not np.isfinite(mean):
         raise ValueError("the recorded normal load holds no value")
     if not lowest > 0.0:
@@ -280,12 +280,23 @@ def _part(counted: xr.Dataset, values: dict) -> xr.Dataset:
     if read:
         part = part.assign({k: ("cycle", read[k], resolved_attrs(k)) for k in REPORTED})
         part["quality"] = part["quality"].copy(data=read["quality"])
-        for reason, (_, scope) in REASONS.items():  # the reading's reasons empty their scope
-            scope = set() if scope == ALL else set(scope) & set(part.data_vars) - set(REPORTED)
-            if scope:
-                flagged = has_reason(read["quality"], reason)
-                part = part.assign({name: part[name].where(~flagged) for name in sorted(scope)})
+        part = part.assign(_emptied_by_reasons(part, read["quality"]))
     return part
+
+
+def _emptied_by_reasons(part: xr.Dataset, quality) -> dict:
+    """``part``'s values (those not read along the stroke) that a reason of ``quality``
+    leaves NaN, as NaN there: the reading adds reasons whose scope reaches beyond its own
+    values (``gicof-varies`` empties the GICoF). Each distinct quality is read once."""
+    texts, inverse = np.unique(np.asarray(quality, dtype=str), return_inverse=True)
+    emptied = {}  # name -> which distinct texts empty it
+    for row, text in enumerate(texts):
+        for reason in text.split(SEPARATOR):
+            scope = REASONS.get(reason, ("", ()))[1]
+            if scope != ALL:
+                for name in set(scope) & set(part.data_vars) - set(REPORTED):
+                    emptied.setdefault(name, np.zeros(texts.size, dtype=bool))[row] = True
+    return {name: part[name].where(~hit[inverse]) for name, hit in sorted(emptied.items())}
 
 
 class Analysis:
