@@ -76,16 +76,16 @@ def _loop_values(block, load, options):
     first, last = block.offset, block.offset + block.count - 1
     closing = (y[first] + y[last]) * (x[first] - x[last])
     energy = 0.5 * (block.sums((y[1:] + y[:-1]) * np.diff(x)) + closing)
-    bx, by, valid, length = branch_rows(block, block.first_point(x, highest))
-    compliance, intercept, stick, fit = stick_lines(bx, by, valid, span, options["stick_window"])
+    bx, by, length = branch_rows(block, block.first_point(x, highest))
+    compliance, intercept, across, fit = stick_lines(bx, by, length, span, options["stick_window"])
     crossing, zero_on_loop = zero_force_crossings(
-        bx, by, valid, length, max_force, stick, intercept, span
+        bx, by, length, max_force, across, intercept, span
     )
     cycles = block.count.size
     slip = 0.5 * (crossing[cycles:] - crossing[:cycles])
     half_width = options["crossing_window"] * np.abs(slip)
     at, force, on_loop = line_crossings(
-        bx, by, valid, length, both(compliance), both(half_width), load, both(max_force)
+        bx, by, length, both(compliance), both(half_width), load, both(max_force)
     )
     energy_ratio = energy / (4.0 * amplitude * max_force)
     values = {

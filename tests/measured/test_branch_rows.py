@@ -49,9 +49,8 @@ def _gathered(block, top):
 def test_rows_are_the_loops_points(count, top):
     block = _block(count)
     top = np.asarray(top, dtype=np.int64)
-    x, y, valid, length = branch_rows(block, top)
+    x, y, length = branch_rows(block, top)
     expected_x, expected_y, expected_valid = _gathered(block, top)
     np.testing.assert_array_equal(x, expected_x)
     np.testing.assert_array_equal(y, expected_y)
-    np.testing.assert_array_equal(valid, expected_valid)
     np.testing.assert_array_equal(length, expected_valid.sum(axis=1))
