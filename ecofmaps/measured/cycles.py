@@ -42,9 +42,21 @@ Missing samples
 A sample is missing when its displacement, force or cycle number is not finite (an empty
 cell, NaN), or a ``missing`` mask says so. The line, the percentiles and the trigger use the
 other samples only (a missing sample neither starts nor ends a run, nor is an extreme), and
-a missing cycle number takes the one before it. A cycle whose stretch holds a missing
-sample is kept in the table, marked in :attr:`Cycles.missing`: the analysis reports it as
-skipped, with no values, and centres its neighbours without it.
+a missing cycle number takes the one before it.
+
+A gap long enough to hide a whole run of the other kind (at least a quarter of
+``1 - hysteresis`` of the drive's period, the median distance between bottom runs) may have
+swallowed reversals, so the trigger restarts where the samples resume: as at the start of
+the recording it cannot know the phase, and the samples after the gap begin a run of the
+kind they first decide. An extreme next to such a gap is not a reversal (the displacement
+may have gone on beyond it), and of two reversals either side of it closer than half a
+period only the farther out is kept. The first partial cycle after the gap therefore joins
+the skipped stretch that holds the gap, and every complete cycle after it is found. A
+shorter gap cannot hide a run: the trigger goes on over it.
+
+A cycle whose stretch holds a missing sample is kept in the table, marked in
+:attr:`Cycles.missing`: the analysis reports it as skipped, with no values, and centres its
+neighbours without it.
 """
 
 from __future__ import annotations
@@ -182,6 +194,207 @@ class Cycles:
 # --- the passes over the samples, a block at a time ----------------------------------------
 
 
+# --- the trigger restarted after a gap -------------------------------------------------------
+
+
+def _without_missing(x, a: int, b: int, gaps) -> np.ndarray:
+    """``x`` (samples ``a`` to ``b - 1``) with NaN at the samples of ``gaps`` (a copy)."""
+    x = np.array(x, dtype=np.float64)
+    first, last = np.searchsorted(gaps[:, 1], a, side="right"), np.searchsorted(gaps[:, 0], b)
+    for begin, end in gaps[first:last]:
+        x[max(begin, a) - a : min(end, b) - a] = np.nan
+    return x
+
+
+def _extremes_of_parts(start, stop, arguments, x):
+    """The extremes of the parts of runs ``[begin, end)`` that lie in the block, a chunk at a
+    time: one column per piece of a part in a chunk, holding the part's number, its largest
+    finite displacement and the first sample of it, its smallest and the first sample of it,
+    and the largest and smallest detrended displacement (NaN and -1 where none is finite).
+    """
+    chunk, gaps, (mean, mean_t, slope, middle), begin, end = arguments
+    found = [np.empty((7, 0))]
+    for a in range(start, stop, chunk):
+        b = min(a + chunk, stop)
+        first, last = np.searchsorted(end, a, side="right"), np.searchsorted(begin, b)
+        if first >= last:
+            continue
+        part = np.arange(first, last)
+        lower, upper = np.maximum(begin[part], a) - a, np.minimum(end[part], b) - a
+        cuts = np.unique(np.concatenate([[0], lower, upper]))
+        cuts = cuts[cuts < b - a]
+        at = np.searchsorted(cuts, lower)  # the piece of each part
+        xa = _without_missing(x[a - start : b - start], a, b, gaps)
+        # As the trigger detrends: the same operations, so the same bits.
+        trend = np.arange(a - middle, b - middle)
+        if mean_t != 0.0:
+            trend -= mean_t
+        trend *= slope
+        detrended = xa - mean
+        detrended -= trend
+        lengths = np.diff(cuts, append=b - a)
+        columns = [part.astype(np.float64)]
+        for reduce in (np.fmax, np.fmin):
+            value = reduce.reduceat(xa, cuts)
+            index = np.where(xa == np.repeat(value, lengths), np.arange(b - a), b - a)
+            index = np.minimum.reduceat(index, cuts)
+            columns += [value[at], np.where(index[at] < b - a, index[at] + a, -1)]
+        columns += [np.fmax.reduceat(detrended, cuts)[at], np.fmin.reduceat(detrended, cuts)[at]]
+        found.append(np.stack(columns))
+    return np.concatenate(found, axis=1)
+
+
+def _parts_after_gaps(samples, gaps, line, band, runs):
+    """The trigger's runs cut where samples resume after a long gap inside them.
+
+    A long gap inside a run may have hidden whole runs of the
+    other kind: the trigger restarts after it, and the samples after the gap begin a new run
+    of the kind they decide (the run goes on when they decide none before the next run).
+
+    Parameters
+    ----------
+    samples : Samples
+        The recording.
+    gaps : tuple of numpy.ndarray of int64, shape (m, 2)
+        ``[start, stop)`` of each run of missing samples, and of the long ones.
+    line, band : tuple
+        The detrending line and the trigger's ``(centre, level)``.
+    runs : tuple of numpy.ndarray
+        The trigger's runs: first sample, kind, extreme (sample) and its value.
+
+    Returns
+    -------
+    run, extreme, value : numpy.ndarray
+        For each part of a run (in order): the run it belongs to, its extreme and its value.
+    """
+    starts, kind, extreme, value = runs
+    identity = np.arange(starts.size)
+    gaps, long = gaps
+    long = long[long[:, 1] < samples.size]
+    inside = np.searchsorted(starts, long[:, 1], side="right") - 1
+    cut = long[starts[inside] < long[:, 0], 1]
+    if not cut.size:
+        return identity, extreme, value
+    part_start = np.union1d(starts, cut)
+    part_run = np.searchsorted(starts, part_start, side="right") - 1
+    affected = np.isin(part_run, part_run[np.isin(part_start, cut)])
+    begin = part_start[affected]
+    end = np.append(part_start, samples.size)[1:][affected]
+    pieces = np.concatenate(
+        samples.map(
+            _extremes_of_parts,
+            ("displacement",),
+            (passes._CHUNK, gaps, line, begin, end),
+        ),
+        axis=1,
+    )
+    part, highest, top, lowest, bottom, most, least = pieces
+    part = part.astype(np.int64)
+    first_piece = np.searchsorted(part, np.arange(begin.size))
+    high = np.fmax.reduceat(highest, first_piece)
+    low = np.fmin.reduceat(lowest, first_piece)
+    centre, level = band
+    own = kind[part_run[affected]]
+    decided = np.where(
+        own > 0,
+        np.fmax.reduceat(most, first_piece) > centre + level,
+        np.fmin.reduceat(least, first_piece) < centre - level,
+    )
+    # A part that decides nothing (inside the band) joins the part before it in its run,
+    # or the one after it if it comes first.
+    run_of = part_run[affected]
+    before = np.concatenate([[False], run_of[1:] == run_of[:-1]])
+    decided_before = _decided_earlier_in_run(decided, run_of)
+    new_group = ~before | (decided & decided_before)
+    group = np.cumsum(new_group) - 1
+    first_part = np.flatnonzero(new_group)
+    piece_group = group[part]
+    high, low = np.fmax.reduceat(high, first_part), np.fmin.reduceat(low, first_part)
+    group_kind = own[first_part]
+    group_value = np.where(group_kind > 0, high, low)
+    group_extreme = np.where(
+        group_kind > 0,
+        first_of_runs(piece_group, highest, top, high),
+        first_of_runs(piece_group, lowest, bottom, low),
+    )
+    kept = ~affected
+    kept[np.flatnonzero(affected)[first_part]] = True
+    run, extremes, values = part_run[kept], extreme[part_run[kept]], value[part_run[kept]]
+    where = np.isin(np.flatnonzero(kept), np.flatnonzero(affected))
+    extremes[where], values[where] = group_extreme, group_value
+    return run, extremes.astype(np.int64), values
+
+
+def _decided_earlier_in_run(decided, run_of):
+    """For each part, whether a part before it in the same run decided its kind."""
+    count = np.cumsum(decided) - decided
+    first = np.concatenate([[True], run_of[1:] != run_of[:-1]])
+    at_first = count[np.maximum.accumulate(np.where(first, np.arange(first.size), 0))]
+    return count > at_first
+
+
+def _period(starts, kind) -> float:
+    """The drive's period: the median distance between the starts of the bottom runs
+    (NaN with fewer than two). [1]"""
+    low = starts[kind < 0]
+    return float(np.median(np.diff(low))) if low.size > 1 else np.nan
+
+
+def _accepted_reversals(parts, run_value, edges, gaps, scale):
+    """Which extremes of the runs' parts are reversals.
+
+    An extreme on the first or last finite sample of the recording (``edges``) may be where
+    the recording stops rather than where the displacement turns: it is a reversal if it
+    comes within ``scale[0]`` of the extreme of the nearest run of the same kind (two runs
+    away: the runs alternate in kind), as when a recording starts at a reversal. Any other
+    extreme next to a long gap (``gaps``) is not a reversal: the displacement may have gone
+    on beyond it in the gap. Of two reversals of one run either side of a gap closer than
+    ``scale[1]`` samples, the farther out is kept.
+
+    Parameters
+    ----------
+    parts : tuple of numpy.ndarray
+        Per part of a run, in order: its run, its kind (+1 top, -1 bottom), its extreme (a
+        sample) and the extreme's displacement. [1], [1], [1], [m]
+    run_value : numpy.ndarray
+        The extreme displacement of each whole run. [m]
+    edges : tuple of int
+        The first and last finite samples.
+    gaps : numpy.ndarray of int64, shape (m, 2)
+        ``[start, stop)`` of each long run of missing samples.
+    scale : tuple of float
+        The tolerance in displacement [m] and the least distance between the reversals
+        either side of a gap. [1]
+
+    Returns
+    -------
+    accepted : numpy.ndarray of bool
+        True for the parts whose extreme is a reversal.
+    """
+    run, kind, extreme, value = parts
+    tolerance, least = scale
+    runs = run_value.size
+    at_edge = np.isin(extreme, edges)
+    beside_gap = np.isin(extreme + 1, gaps[:, 0]) | np.isin(extreme, gaps[:, 1])
+    near = np.zeros(run.size, dtype=bool)
+    for step in (-2, 2):
+        other = run + step
+        exists = (other >= 0) & (other < runs)
+        gap = np.abs(value - run_value[np.clip(other, 0, runs - 1)])
+        near |= exists & (gap <= tolerance)
+    accepted = np.where(at_edge, near, ~beside_gap)
+    # Twins: the parts of one run either side of a gap, both taken for reversals.
+    twins = np.flatnonzero(
+        (run[1:] == run[:-1])
+        & accepted[1:]
+        & accepted[:-1]
+        & (np.abs(extreme[1:] - extreme[:-1]) < least)
+    )
+    outer = kind[twins] * (value[twins + 1] - value[twins]) > 0
+    accepted[np.where(outer, twins, twins + 1)] = False
+    return accepted
+
+
 # --- joining the passes ----------------------------------------------------------------------
 
 
@@ -255,18 +468,23 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
         first_of_runs(run, lowest, bottom, lowest_of_run),
     ).astype(np.int64)
     value = np.where(kind > 0, highest_of_run, lowest_of_run)
-    accepted = np.ones(starts.size, dtype=bool)
-    runs = starts.size
-    first_finite, last_finite = finite[0][0], finite[-1][1]
-    for edge, boundary, neighbour in ((0, first_finite, 2), (runs - 1, last_finite, runs - 3)):
-        # The runs alternate in kind, so the nearest run of the same kind is two away.
-        if extreme[edge] != boundary:
-            continue
-        if 0 <= neighbour < runs:
-            accepted[edge] = abs(value[edge] - value[neighbour]) <= tolerance * stroke
-        else:
-            accepted[edge] = False
-    bottoms = extreme[(kind < 0) & accepted]
+    # A gap shorter than half the samples beyond the band in a half period of a triangle
+    # wave cannot have hidden a run of the other kind: the trigger goes on over it.
+    period = _period(starts, kind)
+    long_gaps = gaps[gaps[:, 1] - gaps[:, 0] >= 0.25 * (1.0 - hysteresis) * period]
+    run, extreme_of_part, value_of_part = _parts_after_gaps(
+        samples, (gaps, long_gaps), line, (centre, hysteresis * half_range),
+        (starts, kind, extreme, value),
+    )  # fmt: skip
+    kind_of_part = kind[run]
+    accepted = _accepted_reversals(
+        (run, kind_of_part, extreme_of_part, value_of_part),
+        value,
+        (finite[0][0], finite[-1][1]),
+        long_gaps,
+        (tolerance * stroke, 0.5 * period),
+    )
+    bottoms = extreme_of_part[(kind_of_part < 0) & accepted]
     if bottoms.size < 2:
         # Not two bottom reversals: the recording may still be one closed loop that starts
         # and ends elsewhere on the loop.
