@@ -289,7 +289,8 @@ def scar_shape_maps_dataset() -> xr.Dataset:
     from ecofmaps.maps.grid import compute_map  # JAX: the registry reads without it
 
     ratios = _SHAPES_STIFFNESS_RATIOS
-    grid = dict(amplitude=paper.AMPLITUDE, mu=paper.MU, load=paper.LOAD)
+    # Not cached one by one: the figure's part is cached as a whole (_scar_shape_maps).
+    grid = dict(amplitude=paper.AMPLITUDE, mu=paper.MU, load=paper.LOAD, cache=False)
     parabola = compute_map(ratios, paper.ASPECT_RATIO, **grid)
     names = ("slip_amplitude", "dissipated_energy", "ecof", "ecof_ratio")
     values = {name: [] for name in names}

@@ -5,8 +5,9 @@ any broadcast set of points. Points that share :math:`\mu` and the stroke length
 :math:`A = \Delta^*W/x_o` (all of them when :math:`x_o = \Delta^*`, whatever the
 amplitude, load and stiffness) share one set of tables, built once, and cost
 :math:`O(\log N)` each; points where the pad jumps get the jumps' areas in :math:`O(N)`.
-When :math:`\mu` or :math:`A` is traced (under ``jax.jit``/``jax.vmap``), each point
-builds its own :math:`O(N)` tables. The public functions of
+When :math:`\mu` or :math:`A` is traced (under ``jax.jit``/``jax.vmap``), and for a few
+points (at most 256: computing their tables costs less than compiling the shared ones),
+each point builds its own :math:`O(N)` tables. The public functions of
 :mod:`ecofmaps.model.steady_state` and :mod:`ecofmaps.model.simulation` call in here when
 given ``profile=``.
 """
@@ -43,6 +44,10 @@ _TABLE_BUDGET = 2**25
 _POINT_BATCH = 256
 # Points share tables unless there are more groups than this and than a 16th of the points.
 _FEW_GROUPS = 64
+# Up to this many points, each builds its own O(N) tables: computing them (0.2-0.4 ms a
+# point on 2000 samples) costs less than compiling the shared sparse tables' kernels (3-4 s
+# on a 2-core machine, for every new shape), and one kernel serves them all.
+_FEW_POINTS = 256
 
 
 def as_profile(profile) -> ScarProfile:
@@ -310,7 +315,7 @@ def steady_numbers(profile, amplitude, load, stiffness, mu, groove_half_width=No
     values = _inputs(amplitude, load, stiffness, mu, groove_half_width)
     shape = values[0].shape
     mu, key, lam, valid = _prepare(*values, profile.half_width, physical)
-    own = not is_concrete(mu, key, lam)
+    own = not is_concrete(mu, key, lam) or lam.size <= _FEW_POINTS
     if not own:
         unique, group = _groups(np.asarray(mu), np.asarray(key))
         own = unique.shape[1] > max(_FEW_GROUPS, lam.size // 16)
