@@ -18,6 +18,7 @@ from ecofmaps.cli._common import CommandError, recording_options, refuse_to_over
 from ecofmaps.io.files import atomic_path, record_written
 from ecofmaps.io.recordings import read_recording
 from ecofmaps.maps.cache import write_netcdf
+from ecofmaps.measured.options import ImplausibleScaleError, ImplausibleScaleWarning
 from ecofmaps.measured.pipeline import Reading
 from ecofmaps.measured.synthetic import EXAMPLE, example_path
 from ecofmaps.model.regimes import GROSS_SLIP
@@ -65,19 +66,21 @@ def _analysed(index, path, recording, load, args, long_run, write, *, many, reso
                 index, path, recording, load, many=many, write=write,
                 columns=None if in_memory else SUMMARY_VARIABLES, reading=reading,
             )  # fmt: skip
-        except ValueError as error:
+        except ImplausibleScaleError as error:
             raise recording.error(_with_assumptions(str(error), recording)) from None
+        except ValueError as error:
+            raise recording.error(str(error)) from None
     for warning in caught:  # one line each, naming the file, not a Python source line
-        message = _with_assumptions(str(warning.message), recording)
+        message = str(warning.message)
+        if issubclass(warning.category, ImplausibleScaleWarning):
+            message = _with_assumptions(message, recording)
         print(f"ecofmaps loops: warning: {path.name}: {message}", file=sys.stderr)
     return results, resolved
 
 
 def _with_assumptions(message: str, recording) -> str:
-    """``message`` with the units the recording's columns were assumed to be in, when it
-    says that the scale is implausible (the assumption is the likely culprit)."""
-    if "implausible" not in message and "is the load right" not in message:
-        return message
+    """``message`` (of an implausible scale: an assumed unit is the likely culprit) with the
+    units the recording's columns without one were assumed to be in."""
     said = [
         f"the {role} column {recording.columns[role]!r} has no unit and was read in "
         f"{recording.units[role]} (--{role}-unit gives it)"

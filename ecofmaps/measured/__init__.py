@@ -8,6 +8,7 @@ _PUBLIC = {
     "ecofmaps.measured.analysis": ("analyze_loops", "resolve_loops"),
     "ecofmaps.measured.fit": ("LoopFit", "fit_loop"),
     "ecofmaps.measured.long_test": ("long_recording", "write_long_recording"),
+    "ecofmaps.measured.options": ("ImplausibleScaleError", "ImplausibleScaleWarning"),
     "ecofmaps.measured.quality": ("LoopQualityWarning",),
     "ecofmaps.measured.resolved": ("resolve_analyzed_loops",),
     "ecofmaps.measured.synthetic": ("scar_example_path", "synthetic_recording"),

@@ -12,10 +12,13 @@ import numpy as np
 
 from ecofmaps._inputs import check
 from ecofmaps.measured.per_cycle import GROSS_SLIP_THRESHOLD
+from ecofmaps.measured.quality import LoopQualityWarning
 
 __all__ = [
     "DEFAULTS",
     "NAN_POLICIES",
+    "ImplausibleScaleError",
+    "ImplausibleScaleWarning",
     "MissingSampleError",
     "check_options",
     "default_options",
@@ -41,6 +44,22 @@ class MissingSampleError(ValueError):
     def __init__(self, sample: int, message: str):
         self.sample = int(sample)
         super().__init__(message)
+
+
+class ImplausibleScaleWarning(LoopQualityWarning):
+    """Cycles whose amplitude or coefficient of friction is outside what a unit or a load
+    makes plausible (``implausible-amplitude``, ``implausible-cof``): the load given or the
+    unit assumed for a channel is likely wrong.
+
+    A :class:`~ecofmaps.measured.quality.LoopQualityWarning`, so filtering that one filters
+    this one too; ``warnings.filterwarnings("error", category=ImplausibleScaleWarning)``
+    turns only the checks of scale into errors.
+    """
+
+
+class ImplausibleScaleError(ValueError):
+    """Every cycle refused, some for an amplitude outside what the displacement's unit makes
+    plausible (``implausible-amplitude``): the unit assumed is likely wrong."""
 
 
 def missing_sample_error(sample: int) -> MissingSampleError:

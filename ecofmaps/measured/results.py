@@ -18,11 +18,13 @@ import xarray as xr
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._codes import warn
 from ecofmaps.measured.cycles import Cycles
+from ecofmaps.measured.options import ImplausibleScaleError, ImplausibleScaleWarning
 from ecofmaps.measured.quality import (
     ALL,
     REASONS,
     LoopQualityWarning,
     apply_quality,
+    has_reason,
     quality_strings,
     summary_of_counts,
 )
@@ -212,15 +214,26 @@ class Tally:
 
         Raises
         ------
+        ImplausibleScaleError
+            If every cycle was refused, some for an implausible amplitude.
         ValueError
-            If every cycle was refused.
+            If every cycle was refused for other reasons.
         """
         summary = self.summary
         typical = _typical(np.concatenate(self.amplitudes) if self.amplitudes else np.zeros(0))
+        texts = np.array(list(self.counts), dtype=str)
+        counts = np.array(list(self.counts.values()), dtype=np.int64)
+        scaled = int(counts[has_reason(texts, "implausible-amplitude")].sum())
         if self.cycles and self.refused == self.cycles:
             hint = dict(self.every, **{"negative-stiffness": self.negative_stiffness})
-            raise ValueError(
-                f"no plausible cycle in the recording ({summary}). {_refusal_hint(hint)}"
+            error = ImplausibleScaleError if scaled else ValueError
+            raise error(f"no plausible cycle in the recording ({summary}). {_refusal_hint(hint)}")
+        if scaled:
+            warn(
+                f"{scaled} cycles have an amplitude outside {AMPLITUDE_RANGE[0] * 1e6:g} µm to "
+                f"{AMPLITUDE_RANGE[1] * 1e3:g} mm: is the displacement in metres (on the "
+                "command line --displacement-unit; a column without a unit is read in µm)?",
+                ImplausibleScaleWarning,
             )
         if self.implausible_cof:
             warn(
@@ -229,7 +242,7 @@ class Tally:
                 f"{float(results['load']):g} N: "
                 "is the load right (load=, on the command line --load) and the force in "
                 "newtons (--force-unit; a column without a unit is read in N)?",
-                LoopQualityWarning,
+                ImplausibleScaleWarning,
             )
         if self.flagged:
             warn(f"cycles flagged: {summary}", LoopQualityWarning)
