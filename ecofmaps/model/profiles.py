@@ -54,26 +54,48 @@ that distance for a curved one. These are the *groove's* edges.
 *Pile-up ridges and the disturbed band.* The band around the groove is disturbed: its
 samples lie farther from the line than 5 times the shoulders' noise and than 2 % of the
 depth, with no quiet stretch longer than a quarter of the groove's half-width (and than 10
-sample spacings) between them. Pile-up ridges come in pairs: when the highest samples on
-either side of the groove, within 5 of its half-widths of its centre, both stand higher
-than the threshold over at least a quarter of its half-width (wider than asperities) and
-lie at distances from the centre within a ratio of 1.5, the band reaches at least to
-their outer ends, however quiet the floor between them and the groove.
-Going inwards from the band's outer end, the first crest that stands higher than that
-threshold above the line is a pile-up ridge; the band's edge is the foot of its inner
-flank, whatever its shape (Gaussian, sin², triangular, asymmetric): the lowest point
-before the profile rises by the threshold again (a floor above the line, debris,
-roughness) or, if it first stays level, the first point after which it falls by no more
-than the threshold over a quarter of the groove's half-width (a floor at the line or
-above it); without a ridge, the band's outermost sample. Where the flank falls all the
-way into the groove (a scar whose walls run into its ridges), the edges are the
-groove's. When an edge of the band lies beyond the groove's by more than
-:data:`AMBIGUOUS_EDGES` of the groove's half-width, the edges are ambiguous, and a
-:class:`ScarProfileWarning` gives both half-widths (``alternative_half_width`` keeps the
-one not taken); which one the model needs is the user's judgement (``half_width=``). The
-band's are taken when both its edges lie beyond (a shallow groove inside a wider worn
-track, or a roughness valley inside a disturbed band), the groove's when only one does
-(most often debris lying beside the groove).
+sample spacings) between them. Pile-up ridges are material that the counterbody pushed out
+at the ends of the track; it slides up their inner flanks to where it stops, so the track
+lies between the ridges and its edges are their *crests* (the band between the ridges is
+measured crest to crest).
+
+Pile-up ridges come in pairs, however quiet the floor between them and the groove. The
+highest runs above the threshold on either side of the groove, within 5 of its half-widths
+of its centre, are a pair when each is the outstanding feature of its side (all else beyond
+the groove there, apart from its own disturbed stretch, lower than half its height) and
+either both stand above the threshold over at least a quarter of the groove's half-width
+and lie at distances from the centre within a ratio of 1.5, or they are narrow ridges, not
+two asperities: each at least 5 samples wide and higher than twice the threshold (10
+times the shoulders' noise), the two alike (heights and widths within a ratio of 1.5) and
+mirror images about the groove's centre (their crests' distances from it differ by less
+than half the sum of their widths). The band then reaches at least to their outer ends. Two
+asperities that happen to meet all this are taken for ridges, with the warning below: on
+random rough shoulders with one asperity a side, 2 surfaces in 1500; with 1 to 4 a side,
+none in 1500.
+
+Going inwards from the band's outer end, the first crest that stands higher than the
+threshold above the line is a pile-up ridge. Down its inner flank, whatever its shape
+(Gaussian, sin², triangular, asymmetric), its foot is where the flank stops falling: the
+lowest point before the profile rises by the threshold again (a floor above the line,
+debris, roughness) or, if it first stays level, the first point after which it falls by no
+more than the threshold over a quarter of the groove's half-width (a floor at the line or
+above it). When that foot lies beyond the groove's edge by more than
+:data:`AMBIGUOUS_EDGES` of the groove's half-width, the band's edge is the ridge's crest:
+the vertex of the parabola fitted to the samples within the threshold of its top (within
+2 µm of the true crest for ridges 1.5 µm high in noise of 0.02 µm, 4 µm in noise of 0.1 µm).
+Where the flank falls all the way into the groove, or stops nearer its edge (the groove's
+walls run up into the ridges, as in :func:`~ecofmaps.ridged_profile`), the edge is the
+groove's. Without a ridge, the band's edge is its outermost sample.
+
+When an edge of the band lies beyond the groove's by more than :data:`AMBIGUOUS_EDGES` of
+the groove's half-width, the edges are ambiguous, and a :class:`ScarProfileWarning` gives
+both candidates with their half-widths and edges: the groove below the unworn surface's
+line, and the band between the ridges' crests (or the disturbed band); it says which one
+was returned, and ``half_width=`` (``--profile-half-width`` on the command line) takes the
+other, which ``alternative_half_width`` keeps. Which one the model needs is the user's
+judgement. The band is returned when both its edges lie beyond the groove's (a shallow
+groove inside a wider worn track, or a roughness valley inside a disturbed band), the
+groove when only one does (most often debris lying beside the groove).
 
 The half-width is half the distance of the two edges, the centre their midpoint;
 ``half_width=`` overrides the half-width (the centre stays that of the detected edges,
@@ -144,6 +166,17 @@ _BAND_GAP = 10
 # higher than the band's threshold over at least the band's longest quiet stretch).
 _RIDGE_REACH = 5.0
 _RIDGE_PAIR = 1.5
+# Each ridge of a pair is the outstanding feature of its side: all else beyond the groove
+# there lower than this fraction of its height.
+_RIDGE_PROMINENCE = 0.5
+# Narrower ridges (not both as wide as that quiet stretch) are a pair, not asperities, when
+# each is this many samples wide or more and higher than this many times the threshold, the
+# two alike (heights and widths within this ratio) and mirror images about the groove's
+# centre (their crests' distances from it differ by less than this times their widths' sum).
+_NARROW_SAMPLES = 5
+_NARROW_HEIGHT = 2.0
+_NARROW_ALIKE = 1.5
+_NARROW_MIRROR = 0.5
 # Local quadratic fits reach this many standard deviations of their Gaussian weights, which
 # are lowered to reach zero there (so a sample's weight never jumps as positions move).
 _REACH = 4.0
@@ -184,9 +217,9 @@ class ScarProfile(NamedTuple):
         Tilt of the unworn surface, in the frame of ``slope`` (0 when levelled). [1]
     alternative_half_width : jax.Array, shape ()
         The other plausible half-width when the edges were ambiguous (the groove's below
-        the unworn surface's line, or the band's between pile-up ridges, whichever was not
-        taken; see the module docstring), NaN when they were not (or the half-width was
-        given). [m]
+        the unworn surface's line, or the band's between the crests of pile-up ridges,
+        whichever was not returned; see the module docstring), NaN when they were not (or
+        the half-width was given). [m]
     replaced : jax.Array, shape (N,) or ()
         1 where the sample was an outlier (a spike or dropout, :func:`outlying_samples`)
         and its height was interpolated from its neighbours', else 0; a scalar 0 when no
@@ -510,17 +543,35 @@ def _forward_minimum(values, count):
     return np.minimum(suffix[:size], prefix[count - 1 : count - 1 + size])
 
 
+def _crest(x, r, index, drop):
+    """Position of the crest of a ridge whose highest sample is ``index``: the vertex of the
+    least-squares parabola through the samples around it within ``drop`` of its height (the
+    cap, the stretch where the noise could hide the top), clipped to the cap; the sample
+    itself when the cap has fewer than 3 samples. [m]"""
+    low = np.flatnonzero(r < r[index] - drop)
+    after = np.searchsorted(low, index)
+    first = low[after - 1] + 1 if after else 0
+    last = low[after] if after < low.size else x.size
+    if last - first < 3:
+        return float(x[index])
+    u = x[first:last] - x[index]
+    curvature, slope, _ = np.polyfit(u, r[first:last], 2)
+    vertex = -slope / (2.0 * curvature) if curvature < 0.0 else 0.0
+    return float(x[index] + np.clip(vertex, u[0], u[-1]))
+
+
 def _band_edge(x, r, outer, end, step, threshold, level):
-    """The band's edge on one side and the index of its pile-up ridge's crest (or None).
+    """The inner foot of the band's pile-up ridge on one side and the index of its crest.
 
     Inwards from the band's outermost sample ``end``: the first crest higher than
-    ``threshold`` above the line (a ridge), then down its inner flank to where it stops
-    falling: the lowest sample before it first rises by ``threshold`` again, unless it
-    stays level first: then the first sample after which it falls by no more than
-    ``threshold`` over ``level`` samples (a floor, at the line or above it, whatever the
-    ridge's shape); that is the edge. Without a ridge the band ends at ``end``. The edge is
-    None where it is the groove's own: the flank falls, to within ``threshold``, all the
-    way to the groove's edge sample ``outer``."""
+    ``threshold`` above the line is a pile-up ridge; down its inner flank, its foot is where
+    the flank stops falling: the lowest sample before it first rises by ``threshold`` again
+    (debris, roughness), unless it stays level first: then the first sample after which it
+    falls by no more than ``threshold`` over ``level`` samples (a floor, at the line or
+    above it, whatever the ridge's shape). The foot is None where the groove's wall runs up
+    into the ridge: its flank falls, to within ``threshold``, all the way to the groove's
+    edge sample ``outer``. Without a ridge: the position of ``end`` (None if it is
+    ``outer``) and no crest (None)."""
     inward = np.arange(end, outer - step, -step)
     s = r[inward]
     above = np.flatnonzero(s > threshold)
@@ -542,32 +593,90 @@ def _band_edge(x, r, outer, end, step, threshold, level):
     return float(x[foot]), int(inward[crest])
 
 
+class _Ridge(NamedTuple):
+    """The highest run above the band's threshold on one side of the groove."""
+
+    crest: int  # index of its highest sample
+    run: tuple  # indices of its first and last samples above the threshold
+    width: float  # from the last sample below the threshold to the next one [m]
+    distance: float  # of the crest from the groove's centre [m]
+    rest: float  # the highest sample on that side outside its disturbed stretch [m]
+
+
+def _highest_run(x, r, outer, step, centre, reach, threshold, gap):
+    """The :class:`_Ridge` around the highest sample above ``threshold`` beyond the groove's
+    edge sample ``outer`` in direction ``step`` and within ``reach`` of ``centre``, or None.
+    Its disturbed stretch, left out of ``rest``, runs on while the samples above
+    ``threshold`` are less than ``gap`` apart (the ridge's own flanks, broken by noise)."""
+    side = (x < x[outer]) if step < 0 else (x > x[outer])
+    high = np.flatnonzero(side & (r > threshold))
+    near = high[np.abs(x[high] - centre) <= reach]
+    if near.size == 0:
+        return None
+    crest = int(near[np.argmax(r[near])])
+    low = np.flatnonzero(r <= threshold)
+    foot = np.searchsorted(low, crest)  # the run above the threshold around the crest
+    run = (
+        int(low[foot - 1]) + 1 if foot else 0,
+        int(low[foot]) - 1 if foot < low.size else x.size - 1,
+    )
+    width = float(x[min(run[1] + 1, x.size - 1)] - x[max(run[0] - 1, 0)])
+    breaks = np.flatnonzero(np.diff(x[high]) > gap)  # high[k] and high[k + 1] far apart
+    at = int(np.searchsorted(high, crest))
+    first = high[breaks[breaks < at][-1] + 1] if np.any(breaks < at) else high[0]
+    last = high[breaks[breaks >= at][0]] if np.any(breaks >= at) else high[-1]
+    side[first : last + 1] = False
+    rest = float(np.max(r[side])) if side.any() else -np.inf
+    return _Ridge(crest, run, width, abs(float(x[crest]) - centre), rest)
+
+
+def _narrow_pair(ridges, heights, threshold) -> bool:
+    """Whether two outstanding runs, not both as wide as the band's longest quiet stretch,
+    are a pair of narrow pile-up ridges rather than two asperities: each
+    :data:`_NARROW_SAMPLES` samples wide or more and higher than :data:`_NARROW_HEIGHT`
+    times ``threshold``, the two alike (heights and widths within a ratio of
+    :data:`_NARROW_ALIKE`) and mirror images about the groove's centre (their crests'
+    distances from it differ by less than :data:`_NARROW_MIRROR` times their widths' sum).
+    """
+    widths = [ridge.width for ridge in ridges]
+    distances = [ridge.distance for ridge in ridges]
+    return (
+        all(ridge.run[1] - ridge.run[0] + 1 >= _NARROW_SAMPLES for ridge in ridges)
+        and min(heights) > _NARROW_HEIGHT * threshold
+        and max(heights) < _NARROW_ALIKE * min(heights)
+        and max(widths) < _NARROW_ALIKE * min(widths)
+        and abs(distances[1] - distances[0]) < _NARROW_MIRROR * (widths[0] + widths[1])
+    )
+
+
 def _paired_ridges(x, r, sides, centre, threshold, gap):
     """The outer ends (indices) of the disturbed runs around the highest samples above the
     line beyond the groove's edge samples ``sides`` (left, right) and within
-    :data:`_RIDGE_REACH` groove half-widths of its ``centre``, if both stand higher than
-    ``threshold`` over at least ``gap`` (wider than asperities) and lie at distances from
-    it within a ratio of :data:`_RIDGE_PAIR`:
-    pile-up ridges come in pairs, however quiet the floor between them and the groove;
-    None if there is no such pair."""
+    :data:`_RIDGE_REACH` groove half-widths of its ``centre``, if they are a pair of
+    pile-up ridges, however quiet the floor between them and the groove; None if not.
+
+    Each must be the outstanding feature of its side of the trace: all else beyond the
+    groove there lower than :data:`_RIDGE_PROMINENCE` times its height. Then either both
+    stand higher than ``threshold`` over at least ``gap`` and lie at distances from the
+    centre within a ratio of :data:`_RIDGE_PAIR`, or they are a pair of narrow ridges
+    (:func:`_narrow_pair`)."""
     reach = _RIDGE_REACH * 0.5 * (x[sides[1]] - x[sides[0]])
-    ends, distances = [], []
-    for outer, step in zip(sides, (-1, +1), strict=True):
-        high = np.flatnonzero((r > threshold) & (np.abs(x - centre) <= reach))
-        high = high[high < outer] if step < 0 else high[high > outer]
-        if high.size == 0:
-            return None
-        crest = int(high[np.argmax(r[high])])
-        low = np.flatnonzero(r <= threshold)
-        foot = np.searchsorted(low, crest)  # the run above the threshold around the crest
-        run = (x[low[foot - 1]] if foot else x[0], x[low[foot]] if foot < low.size else x[-1])
-        if run[1] - run[0] < gap:  # an asperity, not a ridge
-            return None
-        ends.append(_band_end(x, r, crest, step, threshold, gap))
-        distances.append(abs(float(x[crest]) - centre))
-    if max(distances) > _RIDGE_PAIR * min(distances):
+    ridges = [_highest_run(x, r, outer, step, centre, reach, threshold, gap)
+              for outer, step in zip(sides, (-1, +1), strict=True)]  # fmt: skip
+    if None in ridges:
         return None
-    return ends
+    heights = [float(r[ridge.crest]) for ridge in ridges]
+    if any(ridge.rest >= _RIDGE_PROMINENCE * h for ridge, h in zip(ridges, heights, strict=True)):
+        return None
+    distances = [ridge.distance for ridge in ridges]
+    if all(ridge.width >= gap for ridge in ridges):
+        paired = max(distances) <= _RIDGE_PAIR * min(distances)
+    else:
+        paired = _narrow_pair(ridges, heights, threshold)
+    if not paired:
+        return None
+    return [_band_end(x, r, ridge.crest, step, threshold, gap)
+            for ridge, step in zip(ridges, (-1, +1), strict=True)]  # fmt: skip
 
 
 def _shoulders(x, centre, half_width, band, quiet):
@@ -601,8 +710,9 @@ class _Extent(NamedTuple):
 
 
 def _edges(x, r, deepest, depth, noise, reach):
-    """The groove's edges, the band's edges (the groove's where it has none beyond), the
-    ridges' crests (indices or None), the band's outer ends (positions) and the band's
+    """The groove's edges, the band's edges (the groove's where it has none beyond, else the
+    crest of its pile-up ridge, else its outermost sample), the ridges' crests (indices or
+    None), the band's outer ends (positions) and the band's
     threshold (module docstring); ValueError if the groove reaches an end of the trace."""
     tolerance = _LINE_TOLERANCE * depth
     left = _crossing(x, r, deepest, -1, tolerance, reach)
@@ -625,7 +735,15 @@ def _edges(x, r, deepest, depth, noise, reach):
     found = [_band_edge(x, r, side[1], end, step, threshold, level)
              for side, end, step in ((left, ends[0], -1), (right, ends[1], +1))]  # fmt: skip
     groove = (left[0], right[0])
-    band = tuple(edge if edge is not None else groove[i] for i, (edge, _) in enumerate(found))
+    near = AMBIGUOUS_EDGES * 0.5 * (groove[1] - groove[0])
+    # The track lies between the ridges: the band reaches their crests, where the counterbody
+    # sliding up their inner flanks stopped; the groove's edge where the ridge's foot is not
+    # beyond it (its wall runs up into the ridge).
+    band = tuple(
+        groove[i] if foot is None or abs(foot - groove[i]) <= near
+        else (foot if crest is None else _crest(x, r, crest, threshold))
+        for i, (foot, crest) in enumerate(found)
+    )  # fmt: skip
     outer = (min(float(x[ends[0]]), band[0]), max(float(x[ends[1]]), band[1]))
     return groove, band, tuple(crest for _, crest in found), outer, threshold
 
@@ -687,27 +805,28 @@ def _ambiguity(x, extent: _Extent, given: bool):
     if extent.band == extent.groove or given:
         return None, np.nan
     r = extent.residual
-    ridges = [i for i in extent.ridges if i is not None]
-    sides = [side for side, b, g in zip(("left", "right"), extent.band, extent.groove,
-                                        strict=True) if b != g]  # fmt: skip
-    what = "the band between its pile-up ridges" if ridges else "the disturbed band"
-    if len(sides) == 1:
-        what = f"the groove and the disturbed band on its {sides[0]}"
-    crests = "".join(f"; a crest {r[i] * 1e6:.3g} µm high at x = {x[i] * 1e6:.6g} µm"
-                     for i in ridges)  # fmt: skip
+    apart = [b != g for b, g in zip(extent.band, extent.groove, strict=True)]
+    ridged = [crest is not None and far for crest, far in zip(extent.ridges, apart, strict=True)]
+    what = "the band between its pile-up ridges' crests" if all(ridged) else "the disturbed band"
+    if not all(apart):
+        what = f"the groove and the disturbed band on its {'right' if apart[1] else 'left'}"
+    marks = [f" (a crest {r[crest] * 1e6:.3g} µm high)" if ridge else ""
+             for crest, ridge in zip(extent.ridges, ridged, strict=True)]  # fmt: skip
 
-    def candidate(edges, words, taken):
+    def candidate(edges, words, taken, notes=("", "")):
         width = 0.5 * (edges[1] - edges[0])
-        where = f"edges at x = {edges[0] * 1e6:.6g} and {edges[1] * 1e6:.6g} µm"
-        return width, f"{width * 1e6:.6g} µm for {words} ({'taken; ' if taken else ''}{where}"
+        where = (
+            f"edges at x = {edges[0] * 1e6:.6g} µm{notes[0]} and {edges[1] * 1e6:.6g} µm{notes[1]}"
+        )
+        return width, f"{width * 1e6:.6g} µm for {words} ({'returned; ' if taken else ''}{where})"
 
-    band = candidate(extent.band, what, extent.wide)
+    band = candidate(extent.band, what, extent.wide, marks)
     groove = candidate(extent.groove, "the groove below the unworn surface's line",
                        not extent.wide)  # fmt: skip
     first, second = (band, groove) if extent.wide else (groove, band)
     summary = (
-        f"ambiguous scar edges: half-width {first[1]}{crests if extent.wide else ''}) or "
-        f"{second[1]}{'' if extent.wide else crests}): which the model needs is a judgement"
+        f"ambiguous scar edges: half-width {first[1]} or {second[1]}: which the model needs "
+        "is a judgement"
     )
     name = "groove" if extent.wide else "band"
     finding = ScarProfileWarning(summary, alternative=second[0], alternative_name=name)
@@ -836,10 +955,11 @@ def scar_profile(x, z, half_width=None, smoothing=None, level=False,
     -----
     ScarProfileWarning
         For outliers replaced (their count, sample indices and positions), and for
-        ambiguous edges: a band between pile-up ridges (or a disturbed band) wider than the
-        groove below the unworn surface's line by more than :data:`AMBIGUOUS_EDGES` on a
-        side; the band is taken if on both sides, else the groove, and the message gives
-        both half-widths (``half_width=`` chooses).
+        ambiguous edges: a band between the crests of pile-up ridges (or a disturbed band)
+        wider than the groove below the unworn surface's line by more than
+        :data:`AMBIGUOUS_EDGES` on a side; the band is returned if on both sides, else the
+        groove, and the message gives both half-widths, which one was returned and the
+        ``half_width=`` that takes the other.
 
     Raises
     ------

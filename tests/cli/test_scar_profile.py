@@ -280,8 +280,8 @@ def groove_in_band(path, dropout_line=None):
     ``dropout_line`` (x = -50 µm on line 702)."""
     x = np.arange(-400.0, 400.01, 0.5)
     z = np.where(np.abs(x) < 31, -3 * (1 - (x / 31) ** 2), 0.0)
-    z += np.where((np.abs(x) >= 31) & (np.abs(x) < 85), 0.35 + 0.15 * np.sin(x / 1.75), 0.0)
-    v = (np.abs(x) - 85) / 30
+    z += np.where((np.abs(x) >= 31) & (np.abs(x) < 70), 0.35 + 0.15 * np.sin(x / 1.75), 0.0)
+    v = (np.abs(x) - 70) / 30  # ridges cresting at ±85 µm
     z += np.where((v > 0) & (v < 1), 1.5 * np.sin(np.pi * v) ** 2, 0.0)
     if dropout_line is not None:
         z[dropout_line - 2] -= 5.0

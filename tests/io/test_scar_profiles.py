@@ -140,8 +140,8 @@ def test_ambiguous_edges_are_a_warning_naming_the_file(tmp_path):
     taken, the warning names the file and gives both half-widths."""
     x = np.arange(-400.0, 400.01, 0.5)  # µm
     z = np.where(np.abs(x) < 31, -3 * (1 - (x / 31) ** 2), 0.0)
-    z += np.where((np.abs(x) >= 31) & (np.abs(x) < 85), 0.35 + 0.15 * np.sin(x / 1.75), 0.0)
-    v = (np.abs(x) - 85) / 30
+    z += np.where((np.abs(x) >= 31) & (np.abs(x) < 70), 0.35 + 0.15 * np.sin(x / 1.75), 0.0)
+    v = (np.abs(x) - 70) / 30  # ridges cresting at ±85 µm
     z += np.where((v > 0) & (v < 1), 1.5 * np.sin(np.pi * v) ** 2, 0.0)
     text = "x,z\n" + "\n".join(f"{a:.1f},{b:.5f}" for a, b in zip(x, z, strict=True))
     path = write(tmp_path / "track.csv", text)
