@@ -4,7 +4,8 @@ r"""Measured loops moved to their centres and laid out a block of cycles at a ti
 (:class:`ecofmaps.measured.cycles.Cycles`) a block at a time, about ``_BLOCK`` samples, so
 that its memory does not grow with the recording: each block is the centred samples of its
 cycles, once, in time order, with where each cycle lies among them (:class:`LoopBlock`).
-Sums over each cycle's samples use ``np.add.reduceat`` over the cycles' boundaries.
+Sums over each cycle's samples run in the compiled kernels of
+:mod:`ecofmaps.measured.kernels`, in the order of the samples.
 
 Offsets and drift
 -----------------
@@ -34,6 +35,7 @@ from collections.abc import Iterator
 
 import numpy as np
 
+from ecofmaps.measured import kernels
 from ecofmaps.measured.cycles import Cycles
 
 __all__ = ["LoopBlock", "loop_blocks"]
@@ -98,50 +100,6 @@ class LoopBlock:
             np.where(inside, values[index], np.nan) for values in (self.displacement, self.force)
         )
 
-    def sums(self, values):
-        """Sum of ``values[i]`` over each loop's segments from sample i to i + 1 in its stretch."""
-        return _reduce(np.add, values, self.offset, self.offset + self.count - 1)
-
-    def extremes(self, values):
-        """Largest and smallest of ``values`` over each cycle's samples."""
-        return _extremes(values, self.offset, self.count)
-
-    def first_point(self, values, target):
-        """The first point round each loop where ``values`` equals its ``target``.
-
-        Every loop holds its target (its largest value, say).
-        """
-        tiles = np.diff(self.offset, append=values.size)
-        hits = np.flatnonzero(values == np.repeat(target, tiles))
-        begin = self.offset + self.rotation  # where each loop begins
-        after = np.searchsorted(hits, begin)
-        inside = after < hits.size
-        found = inside & (hits[np.minimum(after, hits.size - 1)] < self.offset + tiles)
-        # Else the loop's first hit lies before its beginning (it wraps round), or, for
-        # cycles cut at the reversals, on the sample it shares with the next cycle.
-        wrapped = hits[np.minimum(np.searchsorted(hits, self.offset), hits.size - 1)]
-        hit = np.where(found, hits[np.minimum(after, hits.size - 1)], wrapped)
-        point = hit - begin
-        point = np.where(point < 0, point + self.count, point)
-        if self.continuous:
-            point = np.where(found, point, self.count - 1)
-        return point
-
-
-def _extremes(values, offset, count):
-    """Largest and smallest of ``values`` over each stretch (``offset``, ``count``)."""
-    stop = offset + count
-    return _reduce(np.maximum, values, offset, stop), _reduce(np.minimum, values, offset, stop)
-
-
-def _reduce(ufunc, values, begin, end):
-    """``ufunc`` reduced over ``values[begin[k]:end[k]]`` for each k (ranges in order)."""
-    cuts = np.empty(2 * begin.size, dtype=np.int64)
-    cuts[0::2], cuts[1::2] = begin, end
-    if cuts[-1] >= values.size:
-        return ufunc.reduceat(values, cuts[:-1])[::2]
-    return ufunc.reduceat(values, cuts)[::2]
-
 
 def loop_blocks(
     cycles: Cycles, displacement, force, rows=None, force_sign=1.0
@@ -198,7 +156,7 @@ def loop_blocks(
         a, b = int(start[block.start]), int(start[block.stop - 1] + count[block.stop - 1])
         near = slice(max(block.start - 1, 0), block.stop + 1)
         offset = start[block] - a
-        swing = np.subtract(*_extremes(force[a:b], offset, count[block]))
+        swing = kernels.stretch_ranges(np.ascontiguousarray(force[a:b]), offset, count[block])
         yield LoopBlock(
             rows=slice(int(kept[block.start]), int(kept[block.stop - 1]) + 1),
             displacement=x[a - low : b - low],
@@ -232,7 +190,7 @@ def _labelled_block(cycles: Cycles, displacement, force, block, sign) -> LoopBlo
     offset = np.concatenate([[0], np.cumsum(count[:-1])])
     index = np.repeat(start - offset, count) + np.arange(int(count.sum()))
     x, q = displacement[index], _signed(force[index], sign)
-    swing = np.subtract(*_extremes(q, offset, count))
+    swing = kernels.stretch_ranges(q, offset, count)
     centre_x = _path_means(x, x, offset, count, closed=True)
     x -= np.repeat(centre_x, count)
     # The force's weights come from the centred displacement, as for drifting loops.
@@ -274,16 +232,8 @@ def _path_means(path, values, offset, count, closed: bool):
     The loops are stretches (``offset``, ``count``) of the flat arrays; ``closed`` adds
     the segment from each stretch's last sample back to its first.
     """
-    weight = np.abs(np.diff(path))
-    weighted = weight * (0.5 * (values[1:] + values[:-1]))
-    stop = offset + count - 1
-    total = _reduce(np.add, weighted, offset, stop)
-    length = _reduce(np.add, weight, offset, stop)
-    if closed:
-        gap = np.abs(path[offset] - path[stop])
-        total += gap * (0.5 * (values[offset] + values[stop]))
-        length += gap
-    return total / length
+    path, values = (np.ascontiguousarray(a, dtype=np.float64) for a in (path, values))
+    return kernels.path_means(path, values, offset, count, closed)
 
 
 def _displacement_centres(start, count, displacement, first: int, stop: int):
@@ -311,7 +261,7 @@ def _drift(low: int, high: int, points, values, near: slice):
 
     Piecewise linear, extended linearly beyond the first and last points;
     ``points[near]`` bracket every sample that lies between two points. Inside, it is
-    ``np.interp`` on the segments between points (one pass, no per-sample temporaries).
+    ``np.interp`` on the segments between points, to the bit (one pass).
     """
     xp, fp = points[near], values[near]
     # Sample i lies on segment j when xp[j] <= i < xp[j + 1].
@@ -320,8 +270,9 @@ def _drift(low: int, high: int, points, values, near: slice):
     result[: edges[0]] = fp[0]
     result[edges[-1] :] = fp[-1]
     if xp.size > 1:  # every sample here lies on a segment between points
-        at = np.arange(low + edges[0], low + edges[-1], dtype=np.float64)
-        result[edges[0] : edges[-1]] = np.interp(at, xp, fp)
+        result[edges[0] : edges[-1]] = kernels.interpolated(
+            low + int(edges[0]), int(edges[-1] - edges[0]), xp, fp
+        )
     if points.size < 2:
         return result
     if near.start == 0 and edges[0] > 0:

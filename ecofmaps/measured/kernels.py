@@ -6,7 +6,8 @@ branch_rows`) and does in one or a few passes along a row what the methods of
 stick segment, the curvature test, the search for a crossing. The rows of a block are the
 rising branches of its cycles, then their falling branches (row ``c`` and row
 ``c + cycles`` belong to cycle ``c``); row ``r`` holds ``length[r]`` points, padded to the
-block's width by repeating its last point.
+block's width by repeating its last point. The values are finite (a cycle with a missing
+sample is not laid out).
 
 A row's numbers depend on that row (and its cycle's other row) alone, not on the block it
 was laid out in. Sums run in the order of the samples.
@@ -24,7 +25,15 @@ import math
 import numba
 import numpy as np
 
-__all__ = ["line_crossings", "stick_lines", "zero_force_crossings"]
+__all__ = [
+    "interpolated",
+    "line_crossings",
+    "loop_measures",
+    "path_means",
+    "stick_lines",
+    "stretch_ranges",
+    "zero_force_crossings",
+]
 
 #: How numba compiles the kernels: cached on disk, NumPy's division by zero, no GIL held.
 _COMPILE = {"cache": True, "error_model": "numpy", "nogil": True}
@@ -56,49 +65,55 @@ def _maximum(a, b):
 
 @numba.njit(**_COMPILE)
 def _first_segment(y, n, low, high, segment):
-    """Mark a row's first stick segment in ``segment`` (cleared first); return its count.
+    """Mark a row's first stick segment in ``segment`` (cleared first); return the column
+    that it ends before.
 
     The samples whose force has moved from the reversal's by ``low`` to ``high`` of the
     row's force swing, up to the first one beyond ``high``; with fewer than two, the
     reversal and the first sample past ``low`` (the reversal alone if there is none).
     """
-    swing = np.max(y) - np.min(y)
+    highest, lowest = y[0], y[0]
+    for j in range(1, n):
+        highest, lowest = max(highest, y[j]), min(lowest, y[j])
+    swing = highest - lowest
     segment[:] = False
-    count = 0
+    count, end = 0, n
     for j in range(n):
         moved = abs(y[j] - y[0]) / swing
         if moved > high:
+            end = j
             break
         if moved >= low:
             segment[j] = True
             count += 1
     if count >= 2:
-        return count
-    segment[:] = False
+        return end
+    segment[:end] = False
     segment[0] = True
     for j in range(n):
         if abs(y[j] - y[0]) / swing >= low:
             segment[j] = True
-            return 2 if j > 0 else 1
+            return j + 1
     return 1
 
 
 @numba.njit(**_COMPILE)
-def _line_sums(u, v, n, segment):
-    """Sums of the least-squares line of ``v`` on ``u`` through the marked points.
+def _line_sums(u, v, end, segment):
+    """Sums of the least-squares line of ``v`` on ``u`` through the marked points (all
+    before column ``end``).
 
     Returns the count, the means of ``u`` and ``v``, and the sums of du dv, du du and
     dv dv (deviations from the means).
     """
     count, sum_u, sum_v = 0.0, 0.0, 0.0
-    for j in range(n):
+    for j in range(end):
         if segment[j]:
             count += 1.0
             sum_u += u[j]
             sum_v += v[j]
     mean_u, mean_v = sum_u / count, sum_v / count
     uv, uu, vv = 0.0, 0.0, 0.0
-    for j in range(n):
+    for j in range(end):
         if segment[j]:
             du, dv = u[j] - mean_u, v[j] - mean_v
             uv += du * dv
@@ -108,10 +123,11 @@ def _line_sums(u, v, n, segment):
 
 
 @numba.njit(**_COMPILE)
-def _squares_off(x, y, n, segment, intercept, slope):
-    """Sum of the squared displacements of the marked points off :math:`\\Delta = c + sQ`."""
+def _squares_off(x, y, end, segment, intercept, slope):
+    """Sum of the squared displacements of the marked points (before column ``end``) off
+    the line :math:`\\Delta = c + sQ`."""
     squares = 0.0
-    for j in range(n):
+    for j in range(end):
         if segment[j]:
             residual = x[j] - intercept - slope * y[j]
             squares += residual * residual
@@ -119,9 +135,10 @@ def _squares_off(x, y, n, segment, intercept, slope):
 
 
 @numba.njit(**_COMPILE)
-def _grow(x, y, n, segment, intercept, slope, tolerance):
-    """Grow a segment along its row until two samples in a row lie off its line by more
-    than ``tolerance`` (a row's last sample alone does not stop it), in place."""
+def _grow(x, y, n, segment, end, intercept, slope, tolerance):
+    """Grow a segment (before column ``end``) along its row of ``n`` points until two
+    samples in a row lie off its line by more than ``tolerance`` (a row's last sample alone
+    does not stop it), in place; return the column that it now ends before."""
     first = 0
     while not segment[first]:
         first += 1
@@ -133,17 +150,18 @@ def _grow(x, y, n, segment, intercept, slope, tolerance):
             break
         outside = off
     segment[first:stop] = True
+    return max(stop, end)
 
 
 @numba.njit(**_COMPILE)
-def _curved(x, y, n, segment, intercept, compliance, line):
+def _curved(x, y, end, segment, intercept, compliance, line):
     """Squared residual of a row's segment off its line, whether it bends (a term
     :math:`bQ^2` significant and changing the slope), and whether it holds forces of both
     signs. ``line`` holds the segment's sums from :func:`_line_sums`."""
     count, mean_y, force_variance = line[0], line[1], line[4]
     squares, fourth, product, largest = 0.0, 0.0, 0.0, 0.0
     negative, positive = False, False
-    for j in range(n):
+    for j in range(end):
         if segment[j]:
             residual = x[j] - intercept - compliance * y[j]
             deviation = y[j] - mean_y
@@ -207,30 +225,31 @@ def stick_lines(x, y, length, span, low, high):
     residual, unexplained = np.empty(cycles), np.empty(cycles)
     across, curved = np.zeros(rows, np.bool_), np.zeros(cycles, np.bool_)
     segments = np.zeros((2, width), np.bool_)
+    ends = np.empty(2, np.int64)  # each segment lies before its column
     lines = np.empty((2, 6))
     for c in range(cycles):
         for k in range(2):
             r = c + k * cycles
-            _first_segment(y[r], length[r], low, high, segments[k])
-            lines[k] = _line_sums(y[r], x[r], length[r], segments[k])
+            ends[k] = _first_segment(y[r], length[r], low, high, segments[k])
+            lines[k] = _line_sums(y[r], x[r], ends[k], segments[k])
         slope = (lines[0, 3] + lines[1, 3]) / (lines[0, 4] + lines[1, 4])
         squares = 0.0
         for k in range(2):
             r, first = c + k * cycles, lines[k, 2] - slope * lines[k, 1]
-            squares += _squares_off(x[r], y[r], length[r], segments[k], first, slope)
+            squares += _squares_off(x[r], y[r], ends[k], segments[k], first, slope)
         spread = math.sqrt(squares / max(lines[0, 0] + lines[1, 0] - 3.0, 1.0))
         tolerance = _maximum(_STICK_SPREAD * spread, 1e-9 * span[c])
         for k in range(2):
             r, first = c + k * cycles, lines[k, 2] - slope * lines[k, 1]
-            _grow(x[r], y[r], length[r], segments[k], first, slope, tolerance)
-            lines[k] = _line_sums(y[r], x[r], length[r], segments[k])
+            ends[k] = _grow(x[r], y[r], length[r], segments[k], ends[k], first, slope, tolerance)
+            lines[k] = _line_sums(y[r], x[r], ends[k], segments[k])
         compliance[c] = (lines[0, 3] + lines[1, 3]) / (lines[0, 4] + lines[1, 4])
         total = 0.0
         for k in range(2):
             r = c + k * cycles
             intercept[r] = lines[k, 2] - compliance[c] * lines[k, 1]
             squares, bends, across[r] = _curved(
-                x[r], y[r], length[r], segments[k], intercept[r], compliance[c], lines[k]
+                x[r], y[r], ends[k], segments[k], intercept[r], compliance[c], lines[k]
             )
             total += squares
             curved[c] |= bends
@@ -417,3 +436,160 @@ def line_crossings(x, y, length, compliance, half_width, load, rounding):
             and force[r] <= highest + rounding[r]
         )
     return force, on_loop
+
+
+@numba.njit(**_COMPILE)
+def _trapezoid(path, values, i):
+    """The length of segment ``i`` to ``i + 1`` of ``path`` and its weighted mean value."""
+    weight = abs(path[i + 1] - path[i])
+    return weight, weight * (0.5 * (values[i + 1] + values[i]))
+
+
+@numba.njit(**_COMPILE)
+def path_means(path, values, offset, count, closed):
+    """Mean of ``values`` round each loop weighted by the distance travelled along ``path``.
+
+    Trapezoids over each segment from sample ``i`` to ``i + 1`` of a stretch, summed in
+    two interleaved partial sums (two chains of additions the processor runs side by side).
+
+    Parameters
+    ----------
+    path, values : numpy.ndarray, shape (samples,)
+        The samples (the path in [m], the values in any unit).
+    offset, count : numpy.ndarray of int64, shape (loops,)
+        First sample and samples of each loop's stretch.
+    closed : bool
+        Add the segment from each stretch's last sample back to its first.
+
+    Returns
+    -------
+    mean : numpy.ndarray, shape (loops,)
+        The weighted means, in the unit of ``values``.
+    """
+    mean = np.empty(offset.size)
+    for k in range(offset.size):
+        first, last = offset[k], offset[k] + count[k] - 1
+        length, total, length_odd, total_odd = 0.0, 0.0, 0.0, 0.0
+        for i in range(first, last - 1, 2):
+            weight, weighted = _trapezoid(path, values, i)
+            weight_odd, weighted_odd = _trapezoid(path, values, i + 1)
+            length, total = length + weight, total + weighted
+            length_odd, total_odd = length_odd + weight_odd, total_odd + weighted_odd
+        if (last - first) % 2:
+            weight, weighted = _trapezoid(path, values, last - 1)
+            length, total = length + weight, total + weighted
+        length, total = length + length_odd, total + total_odd
+        if closed:
+            gap = abs(path[first] - path[last])
+            total += gap * (0.5 * (values[first] + values[last]))
+            length += gap
+        mean[k] = total / length
+    return mean
+
+
+@numba.njit(**_COMPILE)
+def interpolated(first, count, points, values):
+    """``values`` interpolated linearly over ``points`` at the sample indices ``first`` to
+    ``first + count - 1``, to the bit as ``np.interp``.
+
+    Parameters
+    ----------
+    first, count : int
+        The first sample index and the number of them.
+    points, values : numpy.ndarray, shape (points,)
+        Increasing sample positions (every index lies in ``points[0]`` up to, not
+        including, ``points[-1]``) and the values there.
+
+    Returns
+    -------
+    result : numpy.ndarray, shape (count,)
+        The interpolated values, in the unit of ``values``.
+    """
+    result = np.empty(count)
+    j, k = 0, 0
+    while k < count:  # the samples on segment j, from points[j] to before points[j + 1]
+        while points[j + 1] <= first + k:
+            j += 1
+        stop = min(count, math.ceil(points[j + 1]) - first)
+        if points[j] == first + k:
+            result[k] = values[j]
+            k += 1
+        slope = (values[j + 1] - values[j]) / (points[j + 1] - points[j])
+        if math.isfinite(slope) and math.isfinite(values[j]):  # no NaN can come of it
+            for i in range(k, stop):
+                result[i] = slope * ((first + i) - points[j]) + values[j]
+        else:
+            for i in range(k, stop):
+                result[i] = _interpolated_nan(first + i, points, values, j, slope)
+        k = stop
+    return result
+
+
+@numba.njit(**_COMPILE)
+def _interpolated_nan(at, points, values, j, slope):
+    """``np.interp`` at ``at`` on segment ``j`` where the first try may give NaN: try from
+    the other end, and take the value if both ends hold it."""
+    value = slope * (at - points[j]) + values[j]
+    if math.isnan(value):
+        value = slope * (at - points[j + 1]) + values[j + 1]
+        if math.isnan(value) and values[j] == values[j + 1]:
+            value = values[j]
+    return value
+
+
+@numba.njit(**_COMPILE)
+def stretch_ranges(values, offset, count):
+    """Largest less smallest of ``values`` over each stretch ``offset``, ``count`` (in the
+    unit of ``values``)."""
+    ranges = np.empty(offset.size)
+    for k in range(offset.size):
+        highest = lowest = values[offset[k]]
+        for i in range(offset[k] + 1, offset[k] + count[k]):
+            highest, lowest = max(highest, values[i]), min(lowest, values[i])
+        ranges[k] = highest - lowest
+    return ranges
+
+
+@numba.njit(**_COMPILE)
+def loop_measures(x, y, offset, count, rotation):
+    """Extremes, area and top of each centred loop, in one pass over its samples.
+
+    Parameters
+    ----------
+    x, y : numpy.ndarray, shape (samples,)
+        Displacement and force of a block's samples. [m], [N]
+    offset, count, rotation : numpy.ndarray of int64, shape (loops,)
+        Each loop's stretch of the samples and where the loop begins in it
+        (:class:`ecofmaps.measured.centring.LoopBlock`).
+
+    Returns
+    -------
+    highest, lowest : numpy.ndarray, shape (loops,)
+        Largest and smallest displacement. [m]
+    max_force : numpy.ndarray, shape (loops,)
+        Half the force's peak-to-peak range. [N]
+    area : numpy.ndarray, shape (loops,)
+        :math:`\\oint Q\\,d\\Delta` by trapezoids over the stretch's segments and the
+        one that closes the loop. [J]
+    top : numpy.ndarray of int64, shape (loops,)
+        The first point round the loop, from its beginning, at the largest displacement.
+    """
+    loops = offset.size
+    highest, lowest, max_force = np.empty(loops), np.empty(loops), np.empty(loops)
+    area, top = np.empty(loops), np.empty(loops, np.int64)
+    for k in range(loops):
+        first, last = offset[k], offset[k] + count[k] - 1
+        high, low, strongest, weakest = x[first], x[first], y[first], y[first]
+        total = 0.0
+        for i in range(first, last):
+            total += (y[i + 1] + y[i]) * (x[i + 1] - x[i])
+            high, low = max(high, x[i + 1]), min(low, x[i + 1])
+            strongest, weakest = max(strongest, y[i + 1]), min(weakest, y[i + 1])
+        highest[k], lowest[k], max_force[k] = high, low, 0.5 * (strongest - weakest)
+        area[k] = 0.5 * (total + (y[first] + y[last]) * (x[first] - x[last]))
+        for point in range(count[k]):
+            position = rotation[k] + point
+            if x[first + position - (count[k] if position >= count[k] else 0)] == high:
+                top[k] = point
+                break
+    return highest, lowest, max_force, area, top

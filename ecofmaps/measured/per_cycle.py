@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ecofmaps._interrupts import check_interrupted
+from ecofmaps.measured import kernels
 from ecofmaps.measured.branches import (
     both,
     branch_rows,
@@ -67,16 +68,14 @@ def _loop_values(block, load, options):
     Returns the quantities (module notes; not yet NaN where a check fails) and the flags
     of :data:`ecofmaps.measured.quality.REASONS` (reason -> per cycle).
     """
-    x, y = block.displacement, block.force
-    highest, lowest = block.extremes(x)
+    # The extremes, the loop's area by trapezoids (the segment that closes it included)
+    # and its top, where the rising branch ends.
+    highest, lowest, max_force, energy, top = kernels.loop_measures(
+        block.displacement, block.force, block.offset, block.count, block.rotation
+    )
     span = highest - lowest
     amplitude = 0.5 * span
-    max_force = 0.5 * np.subtract(*block.extremes(y))
-    # The loop's area by trapezoids, the segment that closes it included.
-    first, last = block.offset, block.offset + block.count - 1
-    closing = (y[first] + y[last]) * (x[first] - x[last])
-    energy = 0.5 * (block.sums((y[1:] + y[:-1]) * np.diff(x)) + closing)
-    bx, by, length = branch_rows(block, block.first_point(x, highest))
+    bx, by, length = branch_rows(block, top)
     compliance, intercept, across, fit = stick_lines(bx, by, length, span, options["stick_window"])
     crossing, zero_on_loop = zero_force_crossings(
         bx, by, length, max_force, across, intercept, span
