@@ -340,39 +340,55 @@ def zero_force_crossings(x, y, length, band, intercept, across, rounding):
 
 
 @numba.njit(**_COMPILE)
-def _curve_intercept(position, y, n, half_width, load):
-    r"""Intercept :math:`a` of the least-squares :math:`Q = a + b\xi + c\xi Q` through a
-    row's samples with :math:`|\xi|` up to ``half_width``, and their count.
+def _curve_intercept(scaled, product, window, y, begin, end):
+    r"""Intercept :math:`a` of the least-squares :math:`Q = a + b\xi + c\xi Q` through the
+    samples marked in ``window`` (between columns ``begin`` and ``end``), and their count.
 
-    The regressors are centred on their means and :math:`\xi Q` is orthogonalised against
-    :math:`\xi` (Gram-Schmidt), so that :math:`a` stays exact when the two are nearly
-    collinear; where :math:`\xi Q` adds only rounding to :math:`\xi`, :math:`Q = a + b\xi`.
+    ``scaled`` holds their contact position :math:`\xi` over the window's half-width,
+    ``product`` that times :math:`Q/P`. The regressors
+    are centred on their means and :math:`\xi Q` is orthogonalised against :math:`\xi`
+    (Gram-Schmidt), so that :math:`a` stays exact when the two are nearly collinear; where
+    :math:`\xi Q` adds only rounding to :math:`\xi`, :math:`Q = a + b\xi` is fitted.
     """
     count, sum_s, sum_z, sum_q = 0.0, 0.0, 0.0, 0.0
-    for j in range(n):
-        if abs(position[j]) <= half_width:
-            s = position[j] / half_width
+    for j in range(begin, end):
+        if window[j]:
             count += 1.0
-            sum_s += s
-            sum_z += s * y[j] / load
+            sum_s += scaled[j]
+            sum_z += product[j]
             sum_q += y[j]
     mean_s, mean_z, mean_q = sum_s / count, sum_z / count, sum_q / count
     ss, sz, zz, sq = 0.0, 0.0, 0.0, 0.0
-    for j in range(n):
-        if abs(position[j]) <= half_width:
-            s = position[j] / half_width
-            ds, dz, dq = s - mean_s, s * y[j] / load - mean_z, y[j] - mean_q
+    for j in range(begin, end):
+        if window[j]:
+            ds, dz, dq = scaled[j] - mean_s, product[j] - mean_z, y[j] - mean_q
             ss, sz, zz, sq = ss + ds * ds, sz + ds * dz, zz + dz * dz, sq + ds * dq
     ratio = sz / ss
     rr, rq = 0.0, 0.0
-    for j in range(n):
-        if abs(position[j]) <= half_width:
-            s = position[j] / half_width
-            ds, dz, dq = s - mean_s, s * y[j] / load - mean_z, y[j] - mean_q
+    for j in range(begin, end):
+        if window[j]:
+            ds, dz, dq = scaled[j] - mean_s, product[j] - mean_z, y[j] - mean_q
             rest = dz - ratio * ds  # the part of ξQ that ξ does not explain
             rr, rq = rr + rest * rest, rq + rest * dq
     c = rq / rr if rr > _COLLINEAR * zz else 0.0
     return mean_q - sq / ss * mean_s - c * (mean_z - ratio * mean_s), count
+
+
+@numba.njit(**_COMPILE)
+def _window_holds(force, y, before, window, begin, end, pair, with_pair, rounding):
+    """The samples marked in ``window`` (between ``begin`` and ``end``), and the two
+    columns ``pair`` if ``with_pair``, lie on both sides of the crossing (``before`` it and
+    not) and the crossing's ``force`` lies within theirs, to ``rounding``."""
+    sides, lowest, highest = 0, np.inf, -np.inf
+    for j in range(begin, end):
+        if window[j]:
+            sides |= 1 if before[j] else 2
+            lowest, highest = min(lowest, y[j]), max(highest, y[j])
+    if with_pair:
+        for j in pair:
+            sides |= 1 if before[j] else 2
+            lowest, highest = min(lowest, y[j]), max(highest, y[j])
+    return sides == 3 and lowest - rounding <= force <= highest + rounding
 
 
 @numba.njit(**_COMPILE)
@@ -405,36 +421,45 @@ def line_crossings(x, y, length, compliance, half_width, load, rounding):
     """
     rows, width = x.shape
     force, on_loop = np.empty(rows), np.zeros(rows, np.bool_)
-    position = np.empty(width)
+    scaled, product = np.empty(width), np.empty(width)
+    window, before = np.zeros(width, np.bool_), np.zeros(width, np.bool_)
     for r in range(rows):
         n, rising, h = length[r], r < rows // 2, half_width[r]
-        for j in range(width):
-            position[j] = x[r, j] - y[r, j] * compliance[r]  # the contact position (eq. 10)
         count = 0
         for j in range(n):
-            count += _before(position[j], rising)
+            position = x[r, j] - y[r, j] * compliance[r]  # the contact position (eq. 10)
+            side = _before(position, rising)
+            before[j] = side
+            count += side
+            window[j] = abs(position) <= h
+        begin, end = 0, n  # the window lies between these columns
+        while begin < n and not window[begin]:
+            begin += 1
+        while end > begin and not window[end - 1]:
+            end -= 1
+        for j in range(begin, end):
+            if window[j]:
+                scaled[j] = (x[r, j] - y[r, j] * compliance[r]) / h
+                product[j] = scaled[j] * y[r, j] / load
         previous, after = _sample_pair(n, count, width)
-        q0, q1, v0, v1 = y[r, previous], y[r, after], position[previous], position[after]
+        before[previous] &= previous < n  # column -1: padding, never before the crossing
+        v0 = x[r, previous] - y[r, previous] * compliance[r]
+        v1 = x[r, after] - y[r, after] * compliance[r]
+        q0, q1 = y[r, previous], y[r, after]
         share = v0 / (v0 - v1) if v0 - v1 != 0.0 else 0.5
-        intercept, fitted = _curve_intercept(position, y[r], n, h, load)
-        enough = fitted >= _FIT_SAMPLES
-        force[r] = intercept if enough else q0 + share * (q1 - q0)
+        intercept, fitted = _curve_intercept(scaled, product, window, y[r], begin, end)
         # On the loop: the fitted window, or the pair interpolated between, holds samples
         # on both sides of ξ = 0, and the crossing's force lies within theirs.
-        sides, lowest, highest = 0, np.inf, -np.inf
-        for j in range(n):
-            if abs(position[j]) <= h or (not enough and j in (previous, after)):
-                sides |= 1 if _before(position[j], rising) else 2
-                lowest, highest = min(lowest, y[r, j]), max(highest, y[r, j])
-        if not enough and previous >= n:  # column -1: padding, never before the crossing
-            sides |= 2
-            lowest, highest = min(lowest, y[r, previous]), max(highest, y[r, previous])
-        on_loop[r] = (
-            sides == 3
-            and (enough or (share >= 0.0 and share <= 1.0))
-            and force[r] >= lowest - rounding[r]
-            and force[r] <= highest + rounding[r]
-        )
+        if fitted >= _FIT_SAMPLES:
+            force[r] = intercept
+            on_loop[r] = _window_holds(
+                force[r], y[r], before, window, begin, end, (previous, after), False, rounding[r]
+            )
+        else:
+            force[r] = q0 + share * (q1 - q0)
+            on_loop[r] = (share >= 0.0 and share <= 1.0) and _window_holds(
+                force[r], y[r], before, window, begin, end, (previous, after), True, rounding[r]
+            )
     return force, on_loop
 
 
@@ -579,12 +604,24 @@ def loop_measures(x, y, offset, count, rotation):
     area, top = np.empty(loops), np.empty(loops, np.int64)
     for k in range(loops):
         first, last = offset[k], offset[k] + count[k] - 1
-        high, low, strongest, weakest = x[first], x[first], y[first], y[first]
-        total = 0.0
-        for i in range(first, last):
+        # Two interleaved chains (even and odd segments), as in path_means.
+        high = high_odd = low = low_odd = x[first]
+        strongest = strongest_odd = weakest = weakest_odd = y[first]
+        total, total_odd = 0.0, 0.0
+        for i in range(first, last - 1, 2):
             total += (y[i + 1] + y[i]) * (x[i + 1] - x[i])
+            total_odd += (y[i + 2] + y[i + 1]) * (x[i + 2] - x[i + 1])
             high, low = max(high, x[i + 1]), min(low, x[i + 1])
+            high_odd, low_odd = max(high_odd, x[i + 2]), min(low_odd, x[i + 2])
             strongest, weakest = max(strongest, y[i + 1]), min(weakest, y[i + 1])
+            strongest_odd, weakest_odd = max(strongest_odd, y[i + 2]), min(weakest_odd, y[i + 2])
+        if (last - first) % 2:  # the last segment
+            total += (y[last] + y[last - 1]) * (x[last] - x[last - 1])
+            high, low = max(high, x[last]), min(low, x[last])
+            strongest, weakest = max(strongest, y[last]), min(weakest, y[last])
+        total += total_odd
+        high, low = max(high, high_odd), min(low, low_odd)
+        strongest, weakest = max(strongest, strongest_odd), min(weakest, weakest_odd)
         highest[k], lowest[k], max_force[k] = high, low, 0.5 * (strongest - weakest)
         area[k] = 0.5 * (total + (y[first] + y[last]) * (x[first] - x[last]))
         for point in range(count[k]):
