@@ -37,8 +37,8 @@ __all__ = [
     "figure_parts",
     "make_figure",
     "make_figures",
-    "scar_shape_loops_dataset",
-    "scar_shape_maps_dataset",
+    "scar_shape_model_dataset",
+    "scar_shape_parabola_dataset",
     "scar_shapes_dataset",
     "source_digest",
 ]
@@ -201,12 +201,12 @@ def _cached_shapes_part(function: str, compute: Callable[[], xr.Dataset]) -> xr.
     return cached_dataset(function, {"sources": source_digest(_SCAR_SHAPES_SOURCES)}, compute)
 
 
-def _scar_shape_loops() -> xr.Dataset:
-    return _cached_shapes_part("scar_shape_loops", scar_shape_loops_dataset)
+def _scar_shape_model() -> xr.Dataset:
+    return _cached_shapes_part("scar_shape_model", scar_shape_model_dataset)
 
 
-def _scar_shape_maps() -> xr.Dataset:
-    return _cached_shapes_part("scar_shape_maps", scar_shape_maps_dataset)
+def _scar_shape_parabola() -> xr.Dataset:
+    return _cached_shapes_part("scar_shape_parabola", scar_shape_parabola_dataset)
 
 
 def _scar_shapes() -> xr.Dataset:
@@ -249,66 +249,93 @@ _SHAPES_STIFFNESS_RATIOS = np.union1d(
 _SHAPES_COORDS = {"shape": list(SCAR_SHAPES), "groove": ["profile", "parabola"]}
 
 
-def scar_shape_loops_dataset() -> xr.Dataset:
-    """The scar families' profiles and steady loops, with the parabola's of the same D/W.
+def scar_shape_model_dataset() -> xr.Dataset:
+    """The model on each scar family: steady values over S/P and the loop of Example 2's rig.
 
-    Returns
-    -------
-    dataset : xarray.Dataset
-        ``scar_height`` over (``shape``, ``scar_position``); ``displacement`` and ``force``
-        over (``shape``, ``groove``, ``point``), Example 2's rig. Computed, not cached.
-    """
-    import ecofmaps
-
-    position = np.linspace(-1.6, 1.6, 321) * paper.AMPLITUDE
-    parabola = np.asarray(ecofmaps.fretting_loop(**_SHAPES_RIG, aspect_ratio=paper.ASPECT_RATIO))
-    heights, loops = [], []
-    for profile in _scar_profiles().values():
-        heights.append(np.interp(position, profile.position, profile.height))
-        loop = np.asarray(ecofmaps.fretting_loop(**_SHAPES_RIG, profile=profile))
-        loops.append(np.stack([loop, parabola]))
-    loops = np.array(loops)
-    groove = ("shape", "groove", "point")
-    variables = {
-        "scar_height": (("shape", "scar_position"), np.array(heights)),
-        "displacement": (groove, loops[:, :, 0]),
-        "force": (groove, loops[:, :, 1]),
-    }
-    return _labelled(variables, {**_SHAPES_COORDS, "scar_position": position})
-
-
-def scar_shape_maps_dataset() -> xr.Dataset:
-    """The steady values over S/P on each scar family and on the parabola of the same D/W.
+    One compiled kernel gives both, for every scar (their profiles have the same sample
+    count): :func:`ecofmaps.model.on_profile.steady_numbers_and_loops`.
 
     Returns
     -------
     dataset : xarray.Dataset
         ``slip_amplitude``, ``dissipated_energy``, ``ecof`` and ``ecof_ratio`` over
-        (``shape``, ``groove``, ``stiffness_ratio``). Computed, not cached.
+        (``shape``, ``stiffness_ratio``); ``displacement`` and ``force`` over (``shape``,
+        ``point``), Example 2's rig. Computed, not cached.
     """
+    from ecofmaps.model.on_profile import steady_numbers_and_loops  # JAX: as compute_map
+
+    ratios = _SHAPES_STIFFNESS_RATIOS
+    at_example = int(np.searchsorted(ratios, paper.STIFFNESS / paper.LOAD))
+    rig = dict(amplitude=paper.AMPLITUDE, load=paper.LOAD, mu=paper.MU)
+    names = ("slip_amplitude", "dissipated_energy", "ecof", "ecof_ratio")
+    values = {name: [] for name in (*names, "displacement", "force")}
+    for profile in _scar_profiles().values():
+        numbers = {
+            name: np.asarray(value)
+            for name, value in steady_numbers_and_loops(
+                profile, **rig, stiffness=ratios * paper.LOAD
+            ).items()
+        }
+        # As compute_map on a profile: the numbers of the core in SI units.
+        values["slip_amplitude"].append(paper.AMPLITUDE * numbers["slip_ratio"])
+        values["dissipated_energy"].append(
+            paper.LOAD * paper.AMPLITUDE * numbers["normalized_energy"]
+        )
+        values["ecof"].append(paper.MU * numbers["ecof_ratio"])
+        values["ecof_ratio"].append(numbers["ecof_ratio"])
+        for name in ("displacement", "force"):
+            values[name].append(numbers[name][at_example])
+    variables = {
+        **{name: (("shape", "stiffness_ratio"), np.array(values[name])) for name in names},
+        **{
+            name: (("shape", "point"), np.array(values[name])) for name in ("displacement", "force")
+        },
+    }
+    return _labelled(variables, {"shape": _SHAPES_COORDS["shape"], "stiffness_ratio": ratios})
+
+
+def scar_shape_parabola_dataset() -> xr.Dataset:
+    """The parabola of Example 2's D/W (steady values over S/P, the loop of Example 2's rig)
+    and the heights of the scar families.
+
+    Returns
+    -------
+    dataset : xarray.Dataset
+        ``scar_height`` over (``shape``, ``scar_position``); ``slip_amplitude``,
+        ``dissipated_energy``, ``ecof`` and ``ecof_ratio`` over ``stiffness_ratio``;
+        ``displacement`` and ``force`` over ``point``. Computed, not cached.
+    """
+    import ecofmaps
     from ecofmaps.maps.grid import compute_map  # JAX: the registry reads without it
 
     ratios = _SHAPES_STIFFNESS_RATIOS
-    # Not cached one by one: the figure's part is cached as a whole (_scar_shape_maps).
+    position = np.linspace(-1.6, 1.6, 321) * paper.AMPLITUDE
+    heights = [np.interp(position, p.position, p.height) for p in _scar_profiles().values()]
+    # Not cached on its own: the figure's part is cached whole (_scar_shape_parabola).
     grid = dict(amplitude=paper.AMPLITUDE, mu=paper.MU, load=paper.LOAD, cache=False)
     parabola = compute_map(ratios, paper.ASPECT_RATIO, **grid)
+    loop = np.asarray(ecofmaps.fretting_loop(**_SHAPES_RIG, aspect_ratio=paper.ASPECT_RATIO))
     names = ("slip_amplitude", "dissipated_energy", "ecof", "ecof_ratio")
-    values = {name: [] for name in names}
-    for profile in _scar_profiles().values():
-        on_profile = compute_map(ratios, **grid, profile=profile)
-        for name in names:
-            values[name].append(np.stack([on_profile[name].values, parabola[name].values]))
-    dims = ("shape", "groove", "stiffness_ratio")
-    variables = {name: (dims, np.array(value)) for name, value in values.items()}
-    return _labelled(variables, {**_SHAPES_COORDS, "stiffness_ratio": ratios})
+    variables = {
+        "scar_height": (("shape", "scar_position"), np.array(heights)),
+        **{name: ("stiffness_ratio", parabola[name].values) for name in names},
+        "displacement": ("point", loop[0]),
+        "force": ("point", loop[1]),
+    }
+    coords = {
+        "shape": _SHAPES_COORDS["shape"],
+        "scar_position": position,
+        "stiffness_ratio": ratios,
+    }
+    return _labelled(variables, coords)
 
 
 def scar_shapes_dataset() -> xr.Dataset:
     """The four scar families at Example 2's D/W: profiles, loops, μ_E/μ over S/P (Fig. 11's).
 
-    Its loops and maps are read from the cache, or computed and stored there
-    (:func:`scar_shape_loops_dataset`, :func:`scar_shape_maps_dataset`: ``ecofmaps figures``
-    computes them in parallel); the D/W shortcut's error is computed here.
+    Its parts are read from the cache, or computed and stored there
+    (:func:`scar_shape_model_dataset`, :func:`scar_shape_parabola_dataset`: ``ecofmaps
+    figures`` computes them in parallel); the D/W shortcut's error is computed here.
 
     Returns
     -------
@@ -318,30 +345,37 @@ def scar_shapes_dataset() -> xr.Dataset:
     """
     import ecofmaps
 
-    loops, maps = _scar_shape_loops(), _scar_shape_maps()
+    model, parabola = _scar_shape_model(), _scar_shape_parabola()
     ratios = _SHAPES_STIFFNESS_RATIOS
     at_example = int(np.searchsorted(ratios, paper.STIFFNESS / paper.LOAD))
     errors = []
-    for ratio in maps["ecof_ratio"].sel(groove="profile").values:
+    for ratio in model["ecof_ratio"].values:
         # μ from the profile's μ_E corrected with the parabola of the same D/W (eq. 11)
         corrected = ecofmaps.correct_ecof(
             paper.MU * ratio, paper.AMPLITUDE, paper.LOAD, ratios * paper.LOAD, paper.ASPECT_RATIO
         )
         errors.append(np.asarray(corrected) / paper.MU - 1.0)
+
+    def by_groove(name, index=...):
+        """The profile's values and the parabola's, for each shape, over (shape, groove, ...)."""
+        on_profile = model[name].values[:, index]
+        same = np.broadcast_to(parabola[name].values[index], on_profile.shape)
+        return np.stack([on_profile, same], axis=1)
+
     groove = ("shape", "groove")
     steady = ("slip_amplitude", "dissipated_energy", "ecof")
     variables = {
-        "scar_height": (("shape", "scar_position"), loops["scar_height"].values),
-        "displacement": ((*groove, "point"), loops["displacement"].values),
-        "force": ((*groove, "point"), loops["force"].values),
-        **{name: (groove, maps[name].values[:, :, at_example]) for name in steady},
-        "ecof_ratio": ((*groove, "stiffness_ratio"), maps["ecof_ratio"].values),
+        "scar_height": (("shape", "scar_position"), parabola["scar_height"].values),
+        "displacement": ((*groove, "point"), by_groove("displacement")),
+        "force": ((*groove, "point"), by_groove("force")),
+        **{name: (groove, by_groove(name, at_example)) for name in steady},
+        "ecof_ratio": ((*groove, "stiffness_ratio"), by_groove("ecof_ratio")),
         "shortcut_error": (("shape", "stiffness_ratio"), np.array(errors)),
     }
     depth = paper.ASPECT_RATIO * paper.AMPLITUDE
     coords = {
         **_SHAPES_COORDS,
-        "scar_position": loops["scar_position"].values,
+        "scar_position": parabola["scar_position"].values,
         "stiffness_ratio": ratios,
         **_SHAPES_RIG,
         "scar_depth": depth,
@@ -432,7 +466,7 @@ FIGURES: dict[str, FigureRecipe] = {
             "scar_shape_comparison",
             module="profile_figures",
             cost=8.0,
-            parts=(_scar_shape_maps, _scar_shape_loops),
+            parts=(_scar_shape_model, _scar_shape_parabola),
         ),
     )
 }

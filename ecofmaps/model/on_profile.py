@@ -21,7 +21,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ecofmaps._inputs import as_float64, check, is_concrete
+from ecofmaps._inputs import as_float64, check, float64, is_concrete
 from ecofmaps.model import first_passage
 from ecofmaps.model import profile_core as core
 from ecofmaps.model.profiles import ScarProfile
@@ -34,6 +34,7 @@ __all__ = [
     "profile_loop",
     "profile_simulation",
     "steady_numbers",
+    "steady_numbers_and_loops",
 ]
 
 #: How a pad position x maps onto the profile: eq. 11, X = x W/x_o; or X = x.
@@ -166,17 +167,20 @@ def _shared_jumps(tables, group, lam, ends):
     return jax.lax.map(lambda point: one(*point), (group, lam, ends), batch_size=_POINT_BATCH)
 
 
-def _own_loop(position, slope, half_width, physical, point):
-    """One point with its own O(N) tables, jumps included."""
+def _own_loop(position, slope, half_width, physical, point, num=0):
+    """One point with its own O(N) tables, jumps included; with ``num``, its loop drawn too."""
     mu, key, lam = point
     tables = core.profile_tables(position, slope, mu, _stroke(half_width, key, physical), False)
     loop = first_passage.steady_loop(tables, 0, lam, False)
-    return loop, _jumps(tables, 0, lam, loop.ends)
+    jumps = _jumps(tables, 0, lam, loop.ends)
+    if not num:
+        return loop, jumps
+    return loop, jumps, first_passage.draw_loop(tables, 0, lam, loop, num)
 
 
-@partial(jax.jit, static_argnames="physical")
-def _own_loops(position, slope, half_width, mu, key, lam, physical):
-    one = partial(_own_loop, position, slope, half_width, physical)
+@partial(jax.jit, static_argnames=("physical", "num"))
+def _own_loops(position, slope, half_width, mu, key, lam, physical, num=0):
+    one = partial(_own_loop, position, slope, half_width, physical, num=num)
     return jax.lax.map(one, (mu, key, lam), batch_size=_POINT_BATCH)
 
 
@@ -330,6 +334,57 @@ def steady_numbers(profile, amplitude, load, stiffness, mu, groove_half_width=No
     loops = loops._replace(ends=())
     numbers = _finish(loops, jumps, mu, lam, valid)
     return {name: value.reshape(shape) for name, value in numbers.items()}
+
+
+@float64
+def steady_numbers_and_loops(profile, amplitude, load, stiffness, mu, num=201,
+                             groove_half_width=None, mapping="scaled") -> dict:  # fmt: skip
+    r""":func:`steady_numbers` and each point's steady loop drawn, by one compiled kernel.
+
+    For a few points (at most 256 a call is meant for: each builds its own :math:`O(N)`
+    tables) that need both a map and loops, such as a figure's: one kernel to compile
+    instead of two.
+
+    Parameters
+    ----------
+    profile : ScarProfile
+    amplitude, load, stiffness, mu, groove_half_width : array_like
+        As for :func:`ecofmaps.fretting_loop` (SI): amplitude [m], load [N], stiffness
+        [N/m], mu [1], groove half-width :math:`x_o` [m] (default ``amplitude``).
+    num : int
+        Points along each branch of a loop (as :func:`ecofmaps.fretting_loop`).
+    mapping : {'scaled', 'physical'}
+        :math:`X = xW/x_o` (eq. 11) or :math:`X = x`.
+
+    Returns
+    -------
+    numbers : dict of numpy.ndarray
+        Those of :func:`steady_numbers`, and ``displacement`` [m] and ``force`` [N] around
+        each point's steady loop, over (broadcast shape, ``2 num + 1``): NaN outside gross
+        slip and no gross slip. Computed in float64 (JAX's 64-bit mode on for the call).
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016): eq. 9-11 (the loop on the profile's slope).
+    """
+    physical = check_mapping(mapping, groove_half_width)
+    profile = as_profile(profile)
+    values = _inputs(amplitude, load, stiffness, mu, groove_half_width)
+    shape = values[0].shape
+    mu, key, lam, valid = _prepare(*values, profile.half_width, physical)
+    padded = _pad(np.arange(lam.size))
+    loops, jumps, (actuator, force) = _own_loops(
+        profile.position, profile.slope, profile.half_width, mu[padded], key[padded],
+        lam[padded], physical, num,
+    )  # fmt: skip
+    numbers = _finish(loops._replace(ends=()), jumps, mu, lam, valid)
+    settled = (numbers["regime"] == int(GROSS_SLIP)) | (numbers["regime"] == int(NO_GROSS_SLIP))
+    drawn = {"displacement": (actuator, values[0]), "force": (force, values[1])}
+    numbers = {name: value.reshape(shape) for name, value in numbers.items()}
+    for name, (curve, scale) in drawn.items():
+        curve = jnp.where(settled[:, None], curve[: lam.size], jnp.nan) * scale.reshape(-1, 1)
+        numbers[name] = curve.reshape(*shape, -1)
+    return numbers
 
 
 # ---------------------------------------------------------------------------------------

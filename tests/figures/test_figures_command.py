@@ -113,9 +113,10 @@ def test_a_fresh_process_stores_its_compiled_kernels(tmp_path):
 
 
 def test_the_shapes_dataset_has_parts_computed_first():
-    """Its maps and loops, computed (and cached) in parallel before the figure is drawn."""
+    """The model on the scars and the parabola, computed (and cached) in parallel before the
+    figure is drawn."""
     parts = figures.figure_parts()
     assert len(parts) == len(figures.figure_groups())
-    assert [part.__name__ for part in parts[0]] == ["_scar_shape_maps", "_scar_shape_loops"]
+    assert [part.__name__ for part in parts[0]] == ["_scar_shape_model", "_scar_shape_parabola"]
     assert all(not group_parts for group_parts in parts[1:])
     assert figures.figure_parts(["fig8", "fig7a"]) == [[]]

@@ -36,3 +36,23 @@ def test_few_points_have_the_shared_tables_values(profile, monkeypatch):
     for name in NAMES:
         expected = np.asarray(shared[name])[: ratios.size]
         np.testing.assert_allclose(own[name], expected, rtol=1e-12, atol=0, err_msg=name)
+
+
+def test_numbers_and_loops_by_one_kernel():
+    """The steady numbers of steady_numbers and the loops of fretting_loop, at once: on a
+    W-shaped scar (jumps) over rigs, a rigid one among them, and amplitudes."""
+    profile = ecofmaps.w_shaped_profile(D, W, 0.25, samples=401)
+    amplitude = np.array([[40e-6], [50e-6]])
+    stiffness = np.array([10e6, 35e6, 120e6, np.inf])
+    both = on_profile.steady_numbers_and_loops(profile, amplitude, 450.0, stiffness, 0.8, num=51)
+    assert both["displacement"].shape == both["force"].shape == (2, 4, 103)
+    numbers = on_profile.steady_numbers(profile, amplitude, 450.0, stiffness, 0.8)
+    for name in NAMES:
+        np.testing.assert_allclose(both[name], numbers[name], rtol=1e-12, atol=0, err_msg=name)
+    np.testing.assert_array_equal(both["regime"], numbers["regime"])
+    loop = np.asarray(
+        ecofmaps.fretting_loop(amplitude, 450.0, stiffness, 0.8, num=51, profile=profile)
+    )
+    assert np.all(np.isfinite(loop))
+    np.testing.assert_allclose(both["displacement"], loop[0], rtol=1e-12, atol=1e-18)
+    np.testing.assert_allclose(both["force"], loop[1], rtol=1e-12, atol=1e-9)
