@@ -600,14 +600,15 @@ class _Ridge(NamedTuple):
     run: tuple  # indices of its first and last samples above the threshold
     width: float  # from the last sample below the threshold to the next one [m]
     distance: float  # of the crest from the groove's centre [m]
-    rest: float  # the highest sample on that side outside its disturbed stretch [m]
+    rest: float  # the highest sample on that side outside the ridge [m]
 
 
 def _highest_run(x, r, outer, step, centre, reach, threshold, gap):
     """The :class:`_Ridge` around the highest sample above ``threshold`` beyond the groove's
     edge sample ``outer`` in direction ``step`` and within ``reach`` of ``centre``, or None.
-    Its disturbed stretch, left out of ``rest``, runs on while the samples above
-    ``threshold`` are less than ``gap`` apart (the ridge's own flanks, broken by noise)."""
+    The ridge itself is left out of ``rest``: its disturbed stretch, running on while the
+    samples above ``threshold`` are less than ``gap`` apart (its flanks, broken by noise),
+    and its flanks beyond, down to the line."""
     side = (x < x[outer]) if step < 0 else (x > x[outer])
     high = np.flatnonzero(side & (r > threshold))
     near = high[np.abs(x[high] - centre) <= reach]
@@ -625,7 +626,9 @@ def _highest_run(x, r, outer, step, centre, reach, threshold, gap):
     at = int(np.searchsorted(high, crest))
     first = high[breaks[breaks < at][-1] + 1] if np.any(breaks < at) else high[0]
     last = high[breaks[breaks >= at][0]] if np.any(breaks >= at) else high[-1]
-    side[first : last + 1] = False
+    line = np.flatnonzero(r <= 0.0)  # and its flanks down to the line
+    before, after = line[line < first], line[line > last]
+    side[(before[-1] if before.size else 0) : (after[0] if after.size else x.size)] = False
     rest = float(np.max(r[side])) if side.any() else -np.inf
     return _Ridge(crest, run, width, abs(float(x[crest]) - centre), rest)
 

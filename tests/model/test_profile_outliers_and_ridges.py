@@ -374,14 +374,15 @@ def test_narrow_ridges_beyond_a_quiet_floor_are_a_pair(shape, fraction, sigma):
         ((1.5, 3.9), (1.5, 2.0), 0.02),  # not alike: widths 3.9 and 2 µm
         ((1.5, 3.9), (0.8, 3.9), 0.02),  # not alike: heights 1.5 and 0.8 µm
         ((0.4, 3.9), (0.4, 3.9), 0.1),  # not clearly above the noise (0.1 µm)
+        ((0.1, 3.9), (0.1, 3.9), 0.002),  # lower than twice 2 % of the groove's depth
     ],
-    ids=["one alone", "widths", "heights", "low"],
+    ids=["one alone", "widths", "heights", "low", "shallow"],
 )
 def test_narrow_bumps_that_are_not_a_pair_of_ridges_are_not_seen(left, right, sigma):
     """Narrow Gaussian bumps at ±85 µm beyond a quiet floor that are not alike, or one of
-    them alone, or lower than twice the band's threshold (10 times the shoulders' noise,
-    which the light smoothing halves): no warning, the groove's half-width (as without
-    them, to 0.1 %)."""
+    them alone, or not clearly above the shoulders (lower than twice the band's threshold,
+    the larger of 5 times the shoulders' noise and 2 % of the depth, or too few samples
+    above it): no warning, the groove's half-width (as without them, to 0.1 %)."""
     plain = groove() + noise(33, XI.size, sigma * UM)
     z = plain.copy()
     for (height, width), sign in zip((left, right), (-1, 1), strict=True):
