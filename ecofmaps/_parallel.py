@@ -198,8 +198,10 @@ class Runner:
                 "distributed.nanny.pre-spawn-environ": environ,
                 "distributed.worker.profile.enabled": False,
             }
-            with dask.config.set(settings), _sigint_ignored():
-                start_resource_tracker_quietly()
+            check_interrupted()  # stopped before the cluster starts: start none
+            # before Ctrl-C is held: starting the tracker unblocks SIGINT in this thread
+            start_resource_tracker_quietly()
+            with dask.config.set(settings), _sigint_held():
                 self._cluster = LocalCluster(
                     n_workers=self.workers,
                     threads_per_worker=1,
@@ -208,9 +210,17 @@ class Runner:
                     # the scheduler's small HTTP server (health, metrics) on a free port, not
                     # 8787: two runs at once would warn that it is taken
                     scheduler_kwargs={"dashboard_address": ":0"},
-                    silence_logs=40,  # errors only
+                    # nothing: a worker whose scheduler went away at Ctrl-C logs an error
+                    # (a failed heartbeat) on the command's standard error; a task's error
+                    # comes back to this process and is reported in its one line
+                    silence_logs=logging.CRITICAL + 1,
                 )
-            self._client = Client(self._cluster, set_as_default=False)
+                self._client = Client(self._cluster, set_as_default=False)
+            try:
+                check_interrupted()  # a signal held while the cluster started
+            except KeyboardInterrupt:  # no with block runs: close the cluster here
+                self.__exit__(KeyboardInterrupt, None, None)
+                raise
         else:
             self._pool = concurrent.futures.ThreadPoolExecutor(self.workers)
         return self
@@ -339,23 +349,30 @@ def worker_limit(processes: bool) -> tuple[int, str]:
 
 
 @contextlib.contextmanager
-def _sigint_ignored():
-    """Ctrl-C (SIGINT) ignored by this process, and for good by the processes it starts.
+def _sigint_held():
+    """Ctrl-C (SIGINT) held back from this thread while the block runs, and for good from
+    the threads it starts and from the processes those start.
 
     Ctrl-C on a terminal reaches every process of the command's group, and is for this
-    process only: a worker process started while it is ignored keeps ignoring it (an
-    ignored signal stays ignored across ``exec``, and Python leaves it so), while this
-    process's handler is put back on leaving. A Ctrl-C while the block runs (the cluster
-    starting, a few seconds) is lost. Only in the main thread (elsewhere nothing changes).
+    process only. A cluster's event loop and the threads that start its worker processes
+    are started in the block, so they inherit the blocked signal, and so do the worker
+    processes they start, then or later (a worker restarted after it died): a blocked
+    signal stays blocked across ``fork`` and ``exec``, and Python leaves it so, so a worker
+    never sees Ctrl-C, even while it imports. A Ctrl-C that comes during the block is not
+    lost: another thread of this process takes it, or it waits until the block ends, and
+    this process's handler sees it. Only in the main thread, and where threads' signal masks
+    exist (POSIX); elsewhere nothing changes.
     """
-    if threading.current_thread() is not threading.main_thread():
+    if threading.current_thread() is not threading.main_thread() or not hasattr(
+        signal, "pthread_sigmask"
+    ):
         yield
         return
-    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, before)
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
 async def _identity(address: str, timeout: float) -> dict:

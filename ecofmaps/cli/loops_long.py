@@ -75,6 +75,7 @@ class _Partial:
     def __init__(self, out, fingerprint: dict, resume: bool):
         self.folder = Path(f"{out}{PARTIAL_SUFFIX}")
         record = self.folder / "run.json"
+        self.made = not self.folder.exists()
         if self.folder.exists():
             if not resume:
                 raise CommandError(_UNFINISHED.format(folder=self.folder))
@@ -128,6 +129,10 @@ class _Partial:
                 flags = {k[2:]: stored[k] for k in stored.files if k.startswith("f:")}
             kept[block] = (values, flags)
         return kept
+
+    def holds_work(self) -> bool:
+        """Whether the folder holds anything a resumed run would use (cycles or blocks)."""
+        return any(self.folder.glob("file*.npz"))
 
     def remove(self) -> None:
         """Remove the files the run kept, then the folder if nothing else is in it (a file
@@ -220,16 +225,29 @@ class LongRun:
                     index, path, recording, load, self.args, runner, partial, many,
                     write, columns, reading,
                 )  # fmt: skip
-        except _Interrupted as stop:  # counted once the runner is closed: no task runs
-            if self.partial is None:
-                raise
-            raise Interrupted(
-                f"{len(self.partial.kept(index))} of {stop.blocks} blocks of {path} are kept "
-                f"in {self.partial.folder}: run the same command with --resume to continue"
-            ) from None
+        except KeyboardInterrupt as stop:  # counted once the runner is closed: no task runs
+            raise self._stopped(index, path, stop) from None
         except MissingSampleError as error:
             raise recording.error(MISSING, error.sample) from None
         return analysis.finish([parts.pop(k) for k in sorted(parts)]), resolved
+
+    def _stopped(self, index: int, path, stop: KeyboardInterrupt) -> KeyboardInterrupt:
+        """What to raise for ``stop``, an interrupt while recording ``index`` was analysed:
+        an :class:`Interrupted` that tells what is kept beside ``--out`` and how to go on,
+        or ``stop`` itself when nothing is (a folder this run made with nothing in it yet,
+        stopped while the cluster started, say, is removed)."""
+        partial = self.partial
+        if partial is None:
+            return stop
+        if partial.made and not partial.holds_work():
+            partial.remove()
+            self.partial = None
+            return stop
+        blocks = f" of {stop.blocks}" if isinstance(stop, _Interrupted) else ""
+        return Interrupted(
+            f"{len(partial.kept(index))}{blocks} blocks of {path} are kept in {partial.folder}: "
+            "run the same command with --resume to continue"
+        )
 
     def finish(self) -> None:
         """Remove the kept blocks: the table is written."""
