@@ -18,6 +18,7 @@ import signal
 import sys
 import textwrap
 import time
+from collections import deque
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from pathlib import Path
 
@@ -29,6 +30,7 @@ from ecofmaps.io.files import record_written
 __all__ = [
     "FIGURE_FORMATS",
     "JAX_CACHE_FOLDER",
+    "TaskQueue",
     "add",
     "figure_formats",
     "jax_compilation_cache",
@@ -221,11 +223,70 @@ def _worker_part(part) -> None:
         os._exit(128 + signal.SIGTERM)  # as _worker_group
 
 
+class TaskQueue:
+    """The order of the parallel work: parts first, then groups, never more at once than
+    processes, so that a group whose parts are done is drawn next (it is the costliest).
+
+    Parameters
+    ----------
+    groups : list of list of str
+        The figures by shared Dataset (:func:`ecofmaps.figures.figure_groups`).
+    parts : list of list of callable
+        Each group's parts (:func:`ecofmaps.figures.figure_parts`).
+    jobs : int
+        Processes working at once.
+
+    Notes
+    -----
+    A task is ``('part', index, callable)`` or ``('group', index, names)``. :meth:`started`
+    gives the tasks to start at first, :meth:`finished` those to start when one ends.
+
+    Examples
+    --------
+    >>> queue = TaskQueue([["a"], ["b"], ["c"]], [["p", "q"], [], []], jobs=2)
+    >>> [task[2] for task in queue.started()]
+    ['p', 'q']
+    >>> [task[2] for task in queue.finished(("part", 0, "p"))]
+    [['b']]
+    >>> [task[2] for task in queue.finished(("part", 0, "q"))]
+    [['a']]
+    """
+
+    def __init__(self, groups, parts, jobs: int):
+        self.groups = groups
+        self.missing = [len(group_parts) for group_parts in parts]
+        self.ready = deque(("part", index, part) for index, group in enumerate(parts)
+                           for part in group)  # fmt: skip
+        self.ready.extend(("group", index, group) for index, group in enumerate(groups)
+                          if not self.missing[index])  # fmt: skip
+        self.jobs = jobs
+        self.running = 0
+
+    def started(self) -> list:
+        """The tasks to start now, as many as there are idle processes."""
+        tasks = []
+        while self.ready and self.running < self.jobs:
+            tasks.append(self.ready.popleft())
+            self.running += 1
+        return tasks
+
+    def finished(self, task) -> list:
+        """The tasks to start once ``task`` has finished."""
+        self.running -= 1
+        kind, index, _ = task
+        if kind == "part":
+            self.missing[index] -= 1
+            if not self.missing[index]:
+                self.ready.appendleft(("group", index, self.groups[index]))
+        return self.started()
+
+
 def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
     """Yield each group's :func:`write_figure_group` result from ``jobs`` processes.
 
     The parts of a group's Dataset (:func:`ecofmaps.figures.figure_parts`) are computed
-    first, in parallel; the group is drawn once all its parts are in the cache.
+    first, in parallel; the group is drawn as soon as all its parts are in the cache
+    (:class:`TaskQueue`).
     """
     others = set(multiprocessing.active_children())
     start_resource_tracker_quietly()
@@ -234,27 +295,24 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
         mp_context=multiprocessing.get_context("spawn"),  # JAX's threads do not survive a fork
         initializer=_start_worker,
     )
+    queue = TaskQueue(groups, parts, jobs)
+
+    def submitted(tasks) -> dict:
+        calls = {"part": lambda part: (_worker_part, part),
+                 "group": lambda group: (_worker_group, group, out, formats)}  # fmt: skip
+        return {executor.submit(*calls[task[0]](task[2])): task for task in tasks}
+
     try:
-        group_of = {}  # the future of a part: the index of its group
-        for index, group_parts in enumerate(parts):
-            group_of.update({executor.submit(_worker_part, part): index for part in group_parts})
-        missing = [len(group_parts) for group_parts in parts]
-        pending = set(group_of)
-        for index, group in enumerate(groups):
-            if not missing[index]:
-                pending.add(executor.submit(_worker_group, group, out, formats))
+        pending = submitted(queue.started())  # each future: its task
         while pending:  # waits of a quarter second, so Ctrl-C is seen at once
-            done, pending = wait(pending, timeout=0.25, return_when=FIRST_COMPLETED)
+            done, _ = wait(pending, timeout=0.25, return_when=FIRST_COMPLETED)
             check_interrupted()
             for future in done:
+                task = pending.pop(future)
                 written = future.result()
-                if future not in group_of:
+                pending.update(submitted(queue.finished(task)))
+                if task[0] == "group":
                     yield written
-                    continue
-                index = group_of[future]
-                missing[index] -= 1
-                if not missing[index]:
-                    pending.add(executor.submit(_worker_group, groups[index], out, formats))
     except BaseException:  # an error, Ctrl-C or SIGTERM: stop the drawing processes too
         executor.shutdown(wait=False, cancel_futures=True)
         ours = set(multiprocessing.active_children()) - others

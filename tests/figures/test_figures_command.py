@@ -11,7 +11,7 @@ import xarray as xr
 
 from ecofmaps import figures
 from ecofmaps.cli import main
-from ecofmaps.cli.figures import JAX_CACHE_FOLDER
+from ecofmaps.cli.figures import JAX_CACHE_FOLDER, TaskQueue
 from ecofmaps.figures import recipes
 from ecofmaps.io.files import MANIFEST
 from ecofmaps.maps import cache_entries
@@ -120,3 +120,21 @@ def test_the_shapes_dataset_has_parts_computed_first():
     assert [part.__name__ for part in parts[0]] == ["_scar_shape_model", "_scar_shape_parabola"]
     assert all(not group_parts for group_parts in parts[1:])
     assert figures.figure_parts(["fig8", "fig7a"]) == [[]]
+
+
+def test_a_group_whose_parts_are_done_is_drawn_next():
+    """Never more work started than processes: the shapes figure, once its parts are in the
+    cache, is drawn before the groups that were waiting (it was queued behind them)."""
+    groups = figures.figure_groups()
+    queue = TaskQueue(groups, figures.figure_parts(), jobs=2)
+    started = queue.started()
+    assert [task[0] for task in started] == ["part", "part"]
+    after_first = queue.finished(started[0])
+    assert [task[2] for task in after_first] == [groups[1]]
+    assert [task[2] for task in queue.finished(started[1])] == [["shapes"]]
+    rest = []
+    for task in [*after_first, ("group", 0, ["shapes"])]:
+        rest += queue.finished(task)
+    while rest:
+        rest += queue.finished(rest.pop(0))
+    assert queue.running == 0 and not queue.ready
