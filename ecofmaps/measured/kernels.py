@@ -26,6 +26,7 @@ import numba
 import numpy as np
 
 __all__ = [
+    "detrended",
     "interpolated",
     "line_crossings",
     "loop_measures",
@@ -630,3 +631,33 @@ def loop_measures(x, y, offset, count, rotation):
                 top[k] = point
                 break
     return highest, lowest, max_force, area, top
+
+
+@numba.njit(**_COMPILE)
+def detrended(x, first, mean, mean_t, slope, middle):
+    """Displacements less a straight line over the sample index, in one pass.
+
+    Sample ``first + i`` becomes ``(x[i] - mean) - ((t - mean_t) * slope)`` with
+    ``t = first - middle + i``: exactly the numbers of ``np.arange`` and NumPy's
+    operations, so the result is the same to the bit.
+
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (samples,)
+        Displacements of samples ``first`` on. [m]
+    first : int
+        Index of the first sample.
+    mean, mean_t, slope, middle : float
+        The line (:func:`ecofmaps.measured.passes.displacement_line`): the mean
+        displacement [m], the mean of ``t`` [-], the slope [m] and the middle sample [-].
+
+    Returns
+    -------
+    detrended : numpy.ndarray, shape (samples,)
+        The displacements less the line. [m]
+    """
+    result = np.empty(x.size)
+    start = first - middle  # an integer or a half, exact
+    for i in range(x.size):
+        result[i] = (x[i] - mean) - ((start + i) - mean_t) * slope
+    return result

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ecofmaps.measured import kernels
 from ecofmaps.measured.samples import Samples
 
 __all__ = [
@@ -148,7 +149,7 @@ def _tails(start, stop, arguments, x):
     chunk, gaps, line, (upper, lower) = arguments
     kept = []
     for a, b in _chunks(start, stop, chunk):
-        d = _detrended(_blanked(x[a - start : b - start], a, b, gaps), a, b, line)
+        d = _detrended(_blanked(x[a - start : b - start], a, b, gaps), a, line)
         kept.append(d[(d <= upper) | (d >= lower)])
     return np.concatenate(kept)
 
@@ -166,7 +167,7 @@ def trigger_runs(start, stop, arguments, x):
     previous = 0
     for a, b in _chunks(start, stop, chunk):
         xa = _blanked(x[a - start : b - start], a, b, gaps)
-        d = _detrended(xa, a, b, line)
+        d = _detrended(xa, a, line)
         state = (d > centre + level).view(np.int8) - (d < centre - level).view(np.int8)
         entry = np.concatenate([[0], np.flatnonzero(state[1:] != state[:-1]) + 1])
         kind = state[entry]
@@ -231,17 +232,12 @@ _QUANTILES = np.array([1.0, 99.0]) / 100.0
 _SAMPLE = 1 << 16
 
 
-def _detrended(x, a: int, b: int, line):
-    """The displacements ``x`` of samples ``a`` to ``b - 1`` less the straight ``line``."""
-    mean, mean_t, slope, middle = line
-    # Exact: the sample indices less the middle are integers or halves below 2**52.
-    trend = np.arange(a - middle, b - middle)
-    if mean_t != 0.0:  # (it is 0.0 when every sample is finite: t - 0.0 is t)
-        trend -= mean_t
-    trend *= slope
-    detrended = x - mean
-    detrended -= trend
-    return detrended
+def _detrended(x, a: int, line):
+    """The displacements ``x`` of samples ``a`` on less the straight ``line``."""
+    mean, mean_t, slope, middle = (float(value) for value in line)
+    return kernels.detrended(
+        np.ascontiguousarray(x, dtype=np.float64), a, mean, mean_t, slope, middle
+    )
 
 
 def survey(samples: Samples):

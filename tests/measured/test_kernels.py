@@ -356,3 +356,16 @@ def test_stretch_ranges_and_loop_measures():
         shoelace = np.sum((q + np.roll(q, -1)) * (np.roll(d, -1) - d)) / 2
         assert area[k] == pytest.approx(shoelace, rel=1e-12, abs=1e-12 * np.ptp(d) * np.ptp(q))
         assert top[k] == np.argmax(np.roll(d, -rotation[k]))
+
+
+@pytest.mark.parametrize("mean_t", [0.0, 0.37])
+def test_detrended_is_numpy_to_the_bit(mean_t):
+    """The line's numbers as np.arange and NumPy's operations make them (NaN stays NaN)."""
+    rng = np.random.default_rng(10)
+    x = rng.normal(size=1000) * 1e-5
+    x[[3, 500]] = np.nan
+    first, middle, mean, slope = 123457, 0.5 * (2_000_001 - 1), 2e-6, 3e-12
+    trend = (np.arange(first - middle, first + x.size - middle) - mean_t) * slope
+    expected = (x - mean) - trend
+    result = kernels.detrended(x, first, mean, mean_t, slope, middle)
+    np.testing.assert_array_equal(result, expected)
