@@ -99,13 +99,10 @@ def _first_segment(y, n, low, high, segment):
 
 
 @numba.njit(**_COMPILE)
-def _line_sums(u, v, end, segment):
+def _line_sums(u, v, end, segment, sums):
     """Sums of the least-squares line of ``v`` on ``u`` through the marked points (all
-    before column ``end``).
-
-    Returns the count, the means of ``u`` and ``v``, and the sums of du dv, du du and
-    dv dv (deviations from the means).
-    """
+    before column ``end``), into ``sums``: the count, the means of ``u`` and ``v``, and the
+    sums of du dv, du du and dv dv (deviations from the means)."""
     count, sum_u, sum_v = 0.0, 0.0, 0.0
     for j in range(end):
         if segment[j]:
@@ -120,7 +117,7 @@ def _line_sums(u, v, end, segment):
             uv += du * dv
             uu += du * du
             vv += dv * dv
-    return count, mean_u, mean_v, uv, uu, vv
+    sums[0], sums[1], sums[2], sums[3], sums[4], sums[5] = count, mean_u, mean_v, uv, uu, vv
 
 
 @numba.njit(**_COMPILE)
@@ -232,7 +229,7 @@ def stick_lines(x, y, length, span, low, high):
         for k in range(2):
             r = c + k * cycles
             ends[k] = _first_segment(y[r], length[r], low, high, segments[k])
-            lines[k] = _line_sums(y[r], x[r], ends[k], segments[k])
+            _line_sums(y[r], x[r], ends[k], segments[k], lines[k])
         slope = (lines[0, 3] + lines[1, 3]) / (lines[0, 4] + lines[1, 4])
         squares = 0.0
         for k in range(2):
@@ -243,7 +240,7 @@ def stick_lines(x, y, length, span, low, high):
         for k in range(2):
             r, first = c + k * cycles, lines[k, 2] - slope * lines[k, 1]
             ends[k] = _grow(x[r], y[r], length[r], segments[k], ends[k], first, slope, tolerance)
-            lines[k] = _line_sums(y[r], x[r], ends[k], segments[k])
+            _line_sums(y[r], x[r], ends[k], segments[k], lines[k])
         compliance[c] = (lines[0, 3] + lines[1, 3]) / (lines[0, 4] + lines[1, 4])
         total = 0.0
         for k in range(2):
@@ -306,7 +303,7 @@ def zero_force_crossings(x, y, length, band, intercept, across, rounding):
     """
     rows, width = x.shape
     crossing, on_loop = np.empty(rows), np.zeros(rows, np.bool_)
-    near = np.zeros(width, np.bool_)
+    near, line = np.zeros(width, np.bool_), np.empty(6)
     for r in range(rows):
         n, rising = length[r], r < rows // 2
         count = 0
@@ -318,7 +315,7 @@ def zero_force_crossings(x, y, length, band, intercept, across, rounding):
         near[after] = True
         if after >= 1:
             near[previous] = True
-        line = _line_sums(y[r], x[r], n, near)
+        _line_sums(y[r], x[r], n, near, line)
         local = line[2] - line[3] / line[4] * line[1]
         lowest, highest = np.inf, -np.inf
         for j in range(n):
