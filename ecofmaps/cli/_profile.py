@@ -169,15 +169,16 @@ def profile_rows(args, profile) -> list:
     if args.smoothing is not None:
         reading.append(f"slopes smoothed over {args.smoothing * 1e6:.6g} µm")
     alternative = float(profile.alternative_half_width)
+    half_width = float(profile.half_width)  # a float64 number, compared outside JAX's x64
     how = "(given)" if args.profile_half_width is not None else "(detected)"
     # the band around the groove is the wider of the two
-    taken, other = ("band", "groove") if alternative < profile.half_width else ("groove", "band")
+    taken, other = ("band", "groove") if alternative < half_width else ("groove", "band")
     if not math.isnan(alternative):
         how = f"({taken})"
     rows = [
         ("scar profile", "", f"{args.scar_profile} ({', '.join(reading)})"),
         row("scar_depth", float(profile.depth)),
-        row("scar_half_width", float(profile.half_width), how),
+        row("scar_half_width", half_width, how),
     ]
     if not math.isnan(alternative):
         rows.append(row("scar_half_width", alternative, f"(or {other})"))

@@ -322,3 +322,19 @@ def test_correct_prints_the_findings_and_the_half_width_taken_stops_them(capsys,
     status, out, err = run(capsys, *argv, "--profile-half-width", groove)
     assert status == 0 and err == ""
     assert values(out, "wear scar half-width (given)") == [groove.removesuffix("um")]
+
+
+def test_model_on_a_profile_in_a_fresh_process_prints_no_warning():
+    """In a process of its own (without the suite's global float64 switch), the command
+    prints nothing on stderr: no JAX value is compared or computed outside float64, where JAX
+    would truncate it to float32 with a warning."""
+    import subprocess
+    import sys
+
+    done = subprocess.run(
+        [sys.executable, "-m", "ecofmaps.cli", "model", "--scar-profile", str(EXAMPLE)],
+        capture_output=True, text=True, timeout=300, check=False,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert done.stderr == ""
+    assert "energy coefficient of friction" in done.stdout
