@@ -48,11 +48,14 @@ A gap long enough to hide a whole run of the other kind (at least a quarter of
 ``1 - hysteresis`` of the drive's period, the median distance between bottom runs) may have
 swallowed reversals, so the trigger restarts where the samples resume: as at the start of
 the recording it cannot know the phase, and the samples after the gap begin a run of the
-kind they first decide. An extreme next to such a gap is not a reversal (the displacement
-may have gone on beyond it), and of two reversals either side of it closer than half a
-period only the farther out is kept. The first partial cycle after the gap therefore joins
-the skipped stretch that holds the gap, and every complete cycle after it is found. A
-shorter gap cannot hide a run: the trigger goes on over it.
+kind they first decide. An extreme that the displacement does not leave by more than
+``tolerance`` times the stroke before such a gap (or after it, coming out of the gap) is
+not a reversal: the displacement may have gone on beyond it in the gap. Of two reversals
+either side of a gap closer than half a period only the farther out is kept. The first
+partial cycle after the gap therefore joins the skipped stretch that holds the gap, and
+every complete cycle after it is found (unless its reversal lies so close to the gap that
+the displacement there is within the tolerance of it). A shorter gap cannot hide a run:
+the trigger goes on over it.
 
 A cycle whose stretch holds a missing sample is kept in the table, marked in
 :attr:`Cycles.missing`: the analysis reports it as skipped, with no values, and centres its
@@ -264,8 +267,9 @@ def _parts_after_gaps(samples, gaps, line, band, runs):
 
     Returns
     -------
-    run, extreme, value : numpy.ndarray
-        For each part of a run (in order): the run it belongs to, its extreme and its value.
+    run, begin, extreme, value : numpy.ndarray
+        For each part of a run (in order): the run it belongs to, its first sample, its
+        extreme and the extreme's displacement.
     """
     starts, kind, extreme, value = runs
     identity = np.arange(starts.size)
@@ -274,7 +278,7 @@ def _parts_after_gaps(samples, gaps, line, band, runs):
     inside = np.searchsorted(starts, long[:, 1], side="right") - 1
     cut = long[starts[inside] < long[:, 0], 1]
     if not cut.size:
-        return identity, extreme, value
+        return identity, starts, extreme, value
     part_start = np.union1d(starts, cut)
     part_run = np.searchsorted(starts, part_start, side="right") - 1
     affected = np.isin(part_run, part_run[np.isin(part_start, cut)])
@@ -322,7 +326,7 @@ def _parts_after_gaps(samples, gaps, line, band, runs):
     run, extremes, values = part_run[kept], extreme[part_run[kept]], value[part_run[kept]]
     where = np.isin(np.flatnonzero(kept), np.flatnonzero(affected))
     extremes[where], values[where] = group_extreme, group_value
-    return run, extremes.astype(np.int64), values
+    return run, part_start[kept], extremes.astype(np.int64), values
 
 
 def _decided_earlier_in_run(decided, run_of):
@@ -340,28 +344,81 @@ def _period(starts, kind) -> float:
     return float(np.median(np.diff(low))) if low.size > 1 else np.nan
 
 
-def _accepted_reversals(parts, run_value, edges, gaps, scale):
+def _values_at(start, stop, arguments, x):
+    """The displacements at the samples ``at`` (sorted) that lie in the block (NaN where
+    missing)."""
+    gaps, at = arguments
+    at = at[(at >= start) & (at < stop)]
+    if not at.size:
+        return np.empty(0)
+    return _without_missing(x[at[0] - start : at[-1] + 1 - start], at[0], at[-1] + 1, gaps)[
+        at - at[0]
+    ]
+
+
+def _hidden_by_gaps(parts, samples, gaps, margin):
+    """Which extremes of the runs' parts may lie where the samples stop rather than where
+    the displacement turns: within its part, a long gap follows (or precedes) the extreme
+    and the sample next to the gap is within ``margin`` of it, so the displacement may
+    have gone on beyond it in the gap.
+
+    Parameters
+    ----------
+    parts : tuple of numpy.ndarray
+        Per part of a run, in order: its first sample, its extreme (a sample) and the
+        extreme's displacement. [1], [1], [m]
+    samples : Samples
+        The recording.
+    gaps : tuple of numpy.ndarray of int64, shape (m, 2)
+        ``[start, stop)`` of each run of missing samples, and of the long ones.
+    margin : float
+        How far the displacement must turn back from an extreme before a gap. [m]
+    """
+    begin, extreme, value = parts
+    gaps, long = gaps
+    if not long.size:
+        return np.zeros(extreme.size, dtype=bool)
+    end = np.append(begin[1:], samples.size)
+    edges = np.stack([long[:, 0] - 1, long[:, 1]], axis=1).ravel()  # the samples beside
+    inside = (edges >= 0) & (edges < samples.size)
+    at_edges = np.full(edges.size, np.nan)
+    at_edges[inside] = np.concatenate(
+        samples.map(_values_at, ("displacement",), (gaps, edges[inside]))
+    )
+    before_gap, after_gap = at_edges[0::2], at_edges[1::2]
+    hidden = np.zeros(extreme.size, dtype=bool)
+    following = np.searchsorted(long[:, 0], extreme, side="right")
+    has = following < long.shape[0]
+    following = np.minimum(following, long.shape[0] - 1)
+    has &= long[following, 0] < end
+    hidden |= has & (np.abs(before_gap[following] - value) < margin)
+    preceding = np.searchsorted(long[:, 1], extreme, side="right") - 1
+    has = preceding >= 0
+    preceding = np.maximum(preceding, 0)
+    has &= long[preceding, 1] >= begin
+    hidden |= has & (np.abs(after_gap[preceding] - value) < margin)
+    return hidden
+
+
+def _accepted_reversals(parts, hidden, edges, scale):
     """Which extremes of the runs' parts are reversals.
 
     An extreme on the first or last finite sample of the recording (``edges``) may be where
     the recording stops rather than where the displacement turns: it is a reversal if it
-    comes within ``scale[0]`` of the extreme of the nearest run of the same kind (two runs
-    away: the runs alternate in kind), as when a recording starts at a reversal. Any other
-    extreme next to a long gap (``gaps``) is not a reversal: the displacement may have gone
-    on beyond it in the gap. Of two reversals of one run either side of a gap closer than
-    ``scale[1]`` samples, the farther out is kept.
+    comes within ``scale[0]`` of the nearest extreme of the same kind that is neither on
+    an edge nor ``hidden``, as when a recording starts at a reversal. A ``hidden`` extreme
+    (beside a long gap) is not a reversal. Of two reversals of one run either side of a gap
+    closer than ``scale[1]`` samples, the farther out is kept.
 
     Parameters
     ----------
     parts : tuple of numpy.ndarray
         Per part of a run, in order: its run, its kind (+1 top, -1 bottom), its extreme (a
         sample) and the extreme's displacement. [1], [1], [1], [m]
-    run_value : numpy.ndarray
-        The extreme displacement of each whole run. [m]
+    hidden : numpy.ndarray of bool
+        The extremes that a long gap may hide (:func:`_hidden_by_gaps`).
     edges : tuple of int
         The first and last finite samples.
-    gaps : numpy.ndarray of int64, shape (m, 2)
-        ``[start, stop)`` of each long run of missing samples.
     scale : tuple of float
         The tolerance in displacement [m] and the least distance between the reversals
         either side of a gap. [1]
@@ -373,16 +430,18 @@ def _accepted_reversals(parts, run_value, edges, gaps, scale):
     """
     run, kind, extreme, value = parts
     tolerance, least = scale
-    runs = run_value.size
     at_edge = np.isin(extreme, edges)
-    beside_gap = np.isin(extreme + 1, gaps[:, 0]) | np.isin(extreme, gaps[:, 1])
     near = np.zeros(run.size, dtype=bool)
-    for step in (-2, 2):
-        other = run + step
-        exists = (other >= 0) & (other < runs)
-        gap = np.abs(value - run_value[np.clip(other, 0, runs - 1)])
-        near |= exists & (gap <= tolerance)
-    accepted = np.where(at_edge, near, ~beside_gap)
+    for sign in (-1, 1):
+        sure = np.flatnonzero(~at_edge & ~hidden & (kind == sign))
+        mine = np.flatnonzero(at_edge & (kind == sign))
+        if not sure.size or not mine.size:
+            continue
+        after = np.searchsorted(sure, mine)
+        for other, exists in ((after - 1, after > 0), (after, after < sure.size)):
+            other = sure[np.clip(other, 0, sure.size - 1)]
+            near[mine] |= exists & (np.abs(value[mine] - value[other]) <= tolerance)
+    accepted = np.where(at_edge, near, ~hidden)
     # Twins: the parts of one run either side of a gap, both taken for reversals.
     twins = np.flatnonzero(
         (run[1:] == run[:-1])
@@ -472,16 +531,21 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     # wave cannot have hidden a run of the other kind: the trigger goes on over it.
     period = _period(starts, kind)
     long_gaps = gaps[gaps[:, 1] - gaps[:, 0] >= 0.25 * (1.0 - hysteresis) * period]
-    run, extreme_of_part, value_of_part = _parts_after_gaps(
+    run, begin_of_part, extreme_of_part, value_of_part = _parts_after_gaps(
         samples, (gaps, long_gaps), line, (centre, hysteresis * half_range),
         (starts, kind, extreme, value),
     )  # fmt: skip
     kind_of_part = kind[run]
+    # Beside a long gap, as at the ends of the recording: an extreme within the tolerance of
+    # the sample next to the gap may lie where the samples stop.
+    hidden = _hidden_by_gaps(
+        (begin_of_part, extreme_of_part, value_of_part), samples, (gaps, long_gaps),
+        tolerance * stroke,
+    )  # fmt: skip
     accepted = _accepted_reversals(
         (run, kind_of_part, extreme_of_part, value_of_part),
-        value,
+        hidden,
         (finite[0][0], finite[-1][1]),
-        long_gaps,
         (tolerance * stroke, 0.5 * period),
     )
     bottoms = extreme_of_part[(kind_of_part < 0) & accepted]
