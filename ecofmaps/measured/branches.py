@@ -37,33 +37,20 @@ def branch_rows(block, top):
     first = np.concatenate([np.zeros_like(top), top])
     last = np.concatenate([top, block.count])
     length = last - first + 1
-    j = np.arange(int(length.max()))
+    width = int(length.max())
     if not block.continuous:  # a loop may begin inside its stretch and wrap round it
-        point = np.minimum(first[:, None] + j, last[:, None])
+        point = np.minimum(first[:, None] + np.arange(width), last[:, None])
         index = block.samples(point, np.tile(np.arange(cycles), 2))
         return block.displacement[index], block.force[index], length
     # Each row is a stretch of the samples from its reversal on, up to its last point:
     # the top of a rising branch; the loop's first sample, which closes a falling one.
     start = np.tile(block.offset, 2) + first
     end = np.concatenate([block.offset + top, block.offset])
-    tail = ~(j < (length - 1)[:, None])  # the last point and the padding
-    x, y = (_stretch_rows(values, start, end, tail) for values in (block.displacement, block.force))
+    x, y = (
+        kernels.branch_stretches(values, start, end, length, width)
+        for values in (block.displacement, block.force)
+    )
     return x, y, length
-
-
-def _stretch_rows(values, start, end, tail):
-    """Rows of ``values`` from each ``start`` on, with ``values[end]`` where ``tail``."""
-    width = tail.shape[1]
-    over = start + width > values.size  # rows that would run past the samples
-    if values.size >= width:  # a view of every stretch of ``width`` samples, rows copied
-        out = np.lib.stride_tricks.sliding_window_view(values, width)[np.where(over, 0, start)]
-    else:
-        out = np.empty(tail.shape)
-    if over.any():
-        index = np.minimum(start[over, None] + np.arange(width), values.size - 1)
-        out[over] = values[index]
-    np.copyto(out, values[end][:, None], where=tail)
-    return out
 
 
 def stick_lines(x, y, length, span, window):

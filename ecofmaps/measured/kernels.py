@@ -26,6 +26,7 @@ import numba
 import numpy as np
 
 __all__ = [
+    "branch_stretches",
     "detrended",
     "interpolated",
     "line_crossings",
@@ -658,3 +659,30 @@ def detrended(x, first, mean, mean_t, slope, middle):
     for i in range(x.size):
         result[i] = (x[i] - mean) - ((start + i) - mean_t) * slope
     return result
+
+
+@numba.njit(**_COMPILE)
+def branch_stretches(values, start, end, length, width):
+    """Rows of ``width`` points: ``length - 1`` samples of ``values`` from ``start`` on,
+    then ``values[end]`` (a branch's last point) repeated to the row's end.
+
+    Parameters
+    ----------
+    values : numpy.ndarray, shape (samples,)
+        A block's samples (any unit).
+    start, end, length : numpy.ndarray of int64, shape (rows,)
+        Each row's first sample, its last point's sample and its number of points.
+    width : int
+        Points of every row.
+
+    Returns
+    -------
+    rows : numpy.ndarray, shape (rows, width)
+        The rows, in the unit of ``values``.
+    """
+    rows = np.empty((start.size, width))
+    for r in range(start.size):
+        for j in range(length[r] - 1):
+            rows[r, j] = values[start[r] + j]
+        rows[r, length[r] - 1 :] = values[end[r]]
+    return rows
