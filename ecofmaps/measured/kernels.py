@@ -1,21 +1,24 @@
-r"""Compiled kernels for the steps of :func:`ecofmaps.analyze_loops` along each branch row.
+r"""Compiled kernels for the steps of :func:`ecofmaps.analyze_loops` along each loop.
 
-Each kernel loops over the branch rows of a block of loops (:func:`ecofmaps.measured.branches.
-branch_rows`) and does in one or a few passes along a row what the methods of
-:mod:`ecofmaps.measured.branches` describe: the sums of a least-squares line, the growth of a
-stick segment, the curvature test, the search for a crossing. The rows of a block are the
+Each kernel loops over the loops of a block, or over their branch rows, and does in one or a
+few passes what the methods of :mod:`ecofmaps.measured.branches` and
+:mod:`ecofmaps.measured.centring` describe: the sums of a least-squares line, the growth of a
+stick segment, the curvature test, the search for a crossing, a loop's centre, extremes and
+area, the drift between the centres. One more, :func:`detrended`, serves the search for
+cycles (:mod:`ecofmaps.measured.passes`).
+
+Branch rows (:func:`ecofmaps.measured.branches.branch_rows`): the rows of a block are the
 rising branches of its cycles, then their falling branches (row ``c`` and row
 ``c + cycles`` belong to cycle ``c``); row ``r`` holds ``length[r]`` points, padded to the
 block's width by repeating its last point. The values are finite (a cycle with a missing
-sample is not laid out).
-
-A row's numbers depend on that row (and its cycle's other row) alone, not on the block it
-was laid out in. Sums run in the order of the samples.
+sample is not laid out). A row's numbers depend on that row (and its cycle's other row)
+alone, not on the block it was laid out in. Sums run in the order of the samples (in two
+interleaved chains where noted).
 
 The kernels are compiled by numba on first call and cached on disk (``cache=True``); with
 ``error_model="numpy"`` a division by zero gives an infinity or NaN, as in NumPy. Every
-array is float64 (int64 for ``length``, bool for flags), C-contiguous, so each kernel has a
-single compiled signature.
+array is float64 (int64 for indices and counts, bool for flags), C-contiguous, so each
+kernel has a single compiled signature.
 """
 
 from __future__ import annotations

@@ -290,9 +290,10 @@ def brute_line_crossings(x, y, length, compliance, half_width, load, rounding):
     return force, on_loop
 
 
-@pytest.mark.parametrize(("seed", "share"), [(1, 0.7), (2, 0.7), (3, 0.02)])
+@pytest.mark.parametrize(("seed", "share"), [(1, 0.7), (2, 0.7), (3, 0.02), (1, 0.1)])
 def test_line_crossings(seed, share):
-    """Fitted windows (0.7 δ*) and windows of fewer than five samples (interpolated)."""
+    """Fitted windows (0.7 δ*), windows of fewer than five samples (interpolated) and of
+    four or five (0.1 of 30 µm)."""
     x, y, length, span, max_force = model_rows(seed)
     compliance = np.tile(kernels.stick_lines(x, y, length, span, *WINDOW)[0], 2)
     half_width = np.full(length.size, share * 30e-6)
