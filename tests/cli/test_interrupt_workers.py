@@ -2,7 +2,8 @@
 the cluster starts, and after dask restarted a worker killed with SIGKILL (the new worker
 still importing). Exit 130 or 143, exactly one line on standard error (no traceback from the
 workers, no "Task exception was never retrieved"), no temporary file, no process of the
-command left, and the resume folder ``<out>.partial`` only when the line says so."""
+command left, and the resume folder ``<out>.partial`` only when the line says so. (A signal
+to the whole group in the middle of the run is in ``test_signals.py``.)"""
 
 import os
 import signal
