@@ -119,7 +119,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ecofmaps._codes import warn
-from ecofmaps._inputs import si_units
+from ecofmaps._inputs import is_concrete, si_units
 
 __all__ = [
     "AMBIGUOUS_EDGES",
@@ -192,6 +192,10 @@ _CHUNK = 2**21
 class ScarProfile(NamedTuple):
     """A wear-scar profile as the model uses it (a JAX pytree of float64 arrays).
 
+    Made from numbers (:func:`scar_profile`, :func:`ecofmaps.read_scar_profile`, the
+    families) its arrays are NumPy's, so that arithmetic on them stays float64 outside JAX's
+    64-bit mode; made inside a traced function they are JAX's.
+
     Attributes
     ----------
     position : jax.Array, shape (N,)
@@ -252,7 +256,8 @@ class ScarProfile(NamedTuple):
     @property
     def edges(self):
         """The scar's edges ``(left, right)`` in the coordinates of the trace as given. [m]"""
-        return jnp.stack([self.centre - self.half_width, self.centre + self.half_width], -1)
+        stack = np.stack if is_concrete(self) else jnp.stack  # float64 either way
+        return stack([self.centre - self.half_width, self.centre + self.half_width], -1)
 
 
 def scar_profile_from_parts(position, height, slope, depth, half_width, worn_area, centre=0.0,
@@ -260,6 +265,10 @@ def scar_profile_from_parts(position, height, slope, depth, half_width, worn_are
              replaced=0.0) -> ScarProfile:  # fmt: skip
     values = (position, height, slope, depth, half_width, worn_area, centre,
               reference_height, reference_slope, alternative_half_width, replaced)  # fmt: skip
+    if is_concrete(*values):
+        # NumPy arrays: a user's own arithmetic on them (``profile.half_width * 1e6``) stays
+        # float64, where JAX outside its 64-bit mode would truncate it to float32.
+        return ScarProfile(*(np.asarray(v, dtype=np.float64) for v in values))
     # JAX's 64-bit mode is on only inside the public entry points (importing ecofmaps does
     # not switch it on): without it these arrays would be float32.
     with jax.enable_x64(True):
