@@ -313,15 +313,16 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
                 pending.update(submitted(queue.finished(task)))
                 if task[0] == "group":
                     yield written
-    except BaseException:  # an error, Ctrl-C or SIGTERM: stop the drawing processes too
+    finally:
+        # Done, or an error, Ctrl-C or SIGTERM: the drawing processes are stopped rather than
+        # left to tear JAX down (half a second when they are idle). A busy one stops at its
+        # next safe point, writing nothing; an idle one has nothing left to write.
         executor.shutdown(wait=False, cancel_futures=True)
         ours = set(multiprocessing.active_children()) - others
         for process in ours:
-            process.terminate()  # SIGTERM: it stops at its next safe point, writing nothing
+            process.terminate()
         for process in ours:
             process.join()
-        raise
-    finally:
         executor.shutdown(wait=True)
         # An interrupt's traceback keeps this frame: dropping the executor here lets its
         # queues' semaphores be released before the process ends (else multiprocessing's
