@@ -254,3 +254,26 @@ def test_profiles_are_float64_without_jax_64_bit_mode():
     run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     assert run.stdout.split() == ["float64"]
+
+
+def test_a_profile_s_numbers_stay_float64_in_a_user_s_arithmetic():
+    """In a process of its own (JAX's 64-bit mode off, as in a user's script), arithmetic on
+    a read profile's fields stays float64, with no JAX warning: JAX would truncate a
+    float64 JAX array times a Python float to float32."""
+    import subprocess
+    import sys
+
+    script = (
+        "import warnings; warnings.simplefilter('error')\n"
+        "import ecofmaps\n"
+        "profile = ecofmaps.read_scar_profile(ecofmaps.scar_example_path())\n"
+        "width = profile.half_width * 1e6\n"
+        "edges = profile.edges * 1e6\n"
+        "assert width.dtype == 'float64' and edges.dtype == 'float64', (width, edges)\n"
+        "assert abs(width - float(profile.half_width) * 1e6) < 1e-9 * width\n"
+        "print(repr(float(width)))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=300, check=False)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert done.stderr == ""
