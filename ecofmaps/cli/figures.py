@@ -33,6 +33,7 @@ __all__ = [
     "TaskQueue",
     "add",
     "figure_formats",
+    "jax_cache_folder",
     "jax_compilation_cache",
     "run",
     "usable_cores",
@@ -195,12 +196,17 @@ def write_figure_group(names, directory, formats) -> list[tuple[str, list[Path],
     return written
 
 
-def _start_worker() -> None:
-    """Set up a drawing process: Ctrl-C is the parent's to handle; JAX's compilation cache."""
+def jax_cache_folder() -> Path:
+    """The folder of JAX's compilation cache: :data:`JAX_CACHE_FOLDER` in the cache."""
     from ecofmaps.maps.cache import cache_directory  # the CLI's lazy boundary
 
+    return cache_directory() / JAX_CACHE_FOLDER
+
+
+def _start_worker() -> None:
+    """Set up a drawing process: Ctrl-C is the parent's to handle; JAX's compilation cache."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    _set_jax_options(_jax_cache_options(cache_directory() / JAX_CACHE_FOLDER))
+    _set_jax_options(_jax_cache_options(jax_cache_folder()))
 
 
 def _worker_group(names, directory, formats) -> list[tuple[str, list[Path], float]]:
@@ -332,9 +338,7 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
 
 def _written_here(groups, out: Path, formats):
     """Yield each group's :func:`write_figure_group` result, drawn in this process."""
-    from ecofmaps.maps.cache import cache_directory  # the CLI's lazy boundary
-
-    with jax_compilation_cache(cache_directory() / JAX_CACHE_FOLDER):
+    with jax_compilation_cache(jax_cache_folder()):
         for group in groups:
             yield write_figure_group(group, out, formats)
 
