@@ -45,11 +45,16 @@ threshold (debris) if 5 are left on each side. It starts from the outer fifths o
 trace and is refitted with the edges it gives until they settle.
 
 *Edges.* From the deepest point below the reference line, the first samples on either side
-that reach the line (to within :math:`10^{-9}` of the depth); the edge is where the wall,
+that reach the line (to within :math:`10^{-9}` of the depth, or on a rough surface to within
+3 times the shoulders' noise but at most 5 % of the depth, so that a valley of the
+roughness beside the groove does not carry the edge out); the edge is where the wall,
 extended by a straight line, reaches it. The straight line runs through two samples of the
 wall beyond the reach of the light smoothing from the last sample below the line (the last
 two without smoothing): exact for a straight wall cut into a flat surface, second order in
-that distance for a curved one. These are the *groove's* edges.
+that distance for a curved one. On a rough surface it is the least-squares line through
+the wall's samples from there down to 4 times that tolerance below the line, and it may
+reach the line beyond the first sample within the tolerance by as far as it takes to climb
+the tolerance. These are the *groove's* edges.
 
 *Pile-up ridges and the disturbed band.* The band around the groove is disturbed: its
 samples lie farther from the line than 5 times the shoulders' noise and than 2 % of the
@@ -183,8 +188,12 @@ _REACH = 4.0
 _EDGE_WEIGHT = float(np.exp(-0.5 * _REACH**2))
 # Edges and depth are read on heights smoothed over this many sample spacings (at most).
 _EDGE_SMOOTHING = 1.0
-# The profile reaches the reference line when within this fraction of the depth of it.
+# The profile reaches the reference line when within this fraction of the depth of it, or
+# within this many times the shoulders' noise (a rough surface's valleys dip below the
+# line), but not more than this share of the depth.
 _LINE_TOLERANCE = 1e-9
+_LINE_NOISE = 3.0
+_LINE_SHARE = 0.05
 # Elements per block of the local fits (bounds their memory).
 _CHUNK = 2**21
 
@@ -500,8 +509,9 @@ def _crossing(x, r, start, step, tolerance, reach):
     """Where ``r`` first reaches 0 (to ``tolerance``) from index ``start`` in direction
     ``step``: the wall below it, extended by the straight line through two samples at least
     ``reach`` samples short of the first sample reaching it (beyond the smoothing's reach of
-    a kink there), clipped to between the nearer of them and that sample; and the index of
-    that sample. None if the end of the trace comes first."""
+    a kink there), clipped to between the nearer of them and where that line, climbing,
+    has risen by ``tolerance`` beyond that sample; and the index of that sample. None if the
+    end of the trace comes first."""
     if step < 0:
         found = np.flatnonzero(r[:start] >= -tolerance)
         if found.size == 0:
@@ -519,11 +529,36 @@ def _crossing(x, r, start, step, tolerance, reach):
         inner = max(last - reach, start - 1)
         second = max(inner - 1, start - 1)
     rise = (r[inner] - r[second]) / (x[inner] - x[second]) if second != inner else 0.0
+    beyond = x[outer]
     if rise * (x[outer] - x[last]) > 0.0:  # the wall climbs towards the line
         edge = x[inner] - r[inner] / rise
+        if tolerance > 0.0:  # it reached -tolerance, not 0, by ``outer``: the wall's line
+            edge, rise = _wall_line_edge(x, r, start, inner, step, tolerance, edge, rise)
+            beyond = beyond + tolerance / rise
     else:
         edge = x[last] + r[last] / (r[last] - r[outer]) * (x[outer] - x[last])
-    return float(np.clip(edge, *sorted((x[inner], x[outer])))), int(outer)
+    return float(np.clip(edge, *sorted((x[inner], beyond)))), int(outer)
+
+
+def _wall_line_edge(x, r, start, inner, step, tolerance, edge, rise):
+    """Where the wall's least-squares line reaches 0, and its slope, over the wall's samples
+    from ``inner`` inwards down to 4 ``tolerance`` below the line (at least the two of the
+    two-point line ``edge``, ``rise``, which are kept if the fit's slope does not climb)."""
+    deep = r < -4.0 * tolerance
+    if step > 0:
+        below = np.flatnonzero(deep[start : inner + 1])
+        first = start + int(below[-1]) if below.size else start
+        span = slice(first, inner + 1)
+    else:
+        below = np.flatnonzero(deep[inner : start + 1])
+        last = inner + int(below[0]) if below.size else start
+        span = slice(inner, last + 1)
+    if span.stop - span.start < 3:
+        return edge, rise
+    slope, offset = np.polyfit(x[span], r[span], 1)
+    if not slope * rise > 0.0:
+        return edge, rise
+    return -offset / slope, slope
 
 
 def _band_end(x, r, outer, step, threshold, gap):
@@ -726,7 +761,7 @@ def _edges(x, r, deepest, depth, noise, reach):
     crest of its pile-up ridge, else its outermost sample), the ridges' crests (indices or
     None), the band's outer ends (positions) and the band's
     threshold (module docstring); ValueError if the groove reaches an end of the trace."""
-    tolerance = _LINE_TOLERANCE * depth
+    tolerance = max(_LINE_TOLERANCE * depth, min(_LINE_NOISE * noise, _LINE_SHARE * depth))
     left = _crossing(x, r, deepest, -1, tolerance, reach)
     right = _crossing(x, r, deepest + 1, +1, tolerance, reach)
     if left is None or right is None:

@@ -424,3 +424,21 @@ def test_isolated_asperities_on_rough_shoulders_are_not_ridges():
             warnings.simplefilter("always", ScarProfileWarning)
             scar_profile(XI, rough_shoulders_with_asperities(seed))
         assert not [w for w in caught if "pile-up ridge" in str(w.message)], seed
+
+
+def test_a_groove_in_rough_shoulders_keeps_its_edges():
+    """A groove 31 µm in half-width, 3 µm deep, in a surface rough by 0.05 µm (correlated
+    over about 2 µm) with asperities, 60 random surfaces: the edges are where the wall
+    reaches the unworn surface to within the roughness, the half-width within 1 µm (RMS
+    0.3 µm). Read before at the first sample back at or above the line, beyond the valleys
+    next to the groove: 110 of 200 surfaces were off by more than 2 µm, up to 21 µm, with
+    no warning."""
+    widths = []
+    for seed in range(60):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ScarProfileWarning)
+            profile = scar_profile(XI, rough_shoulders_with_asperities(seed))
+        widths.append(float(profile.half_width) / UM)
+    errors = np.array(widths) - 31.0
+    assert np.max(np.abs(errors)) < 1.0, widths
+    assert np.sqrt(np.mean(errors**2)) < 0.45
