@@ -66,7 +66,9 @@ measured crest to crest).
 
 Pile-up ridges come in pairs, however quiet the floor between them and the groove. The
 highest runs above the threshold on either side of the groove, within 5 of its half-widths
-of its centre, are a pair when each is the outstanding feature of its side (all else beyond
+of its centre or a quarter of the trace's span (whichever is farther: a groove that is a
+valley of the roughness inside a wide track must not keep the track's ridges out of
+reach), are a pair when each is the outstanding feature of its side (all else beyond
 the groove there, apart from its own disturbed stretch, lower than half its height) and
 either both stand above the threshold over at least a quarter of the groove's half-width
 and lie at distances from the centre within a ratio of 1.5, or they are narrow ridges, not
@@ -75,8 +77,8 @@ times the shoulders' noise), the two alike (heights and widths within a ratio of
 mirror images about the groove's centre (their crests' distances from it differ by less
 than half the sum of their widths). The band then reaches at least to their outer ends. Two
 asperities that happen to meet all this are taken for ridges, with the warning below: on
-random rough shoulders with one asperity a side, 2 surfaces in 1500; with 1 to 4 a side,
-none in 1500.
+random rough shoulders with one asperity a side, 2 surfaces in 1500 (measured with the
+reach of 5 half-widths alone); with 1 to 4 a side, 3 in 1500 (none with that reach alone).
 
 Going inwards from the band's outer end, the first crest that stands higher than the
 threshold above the line is a pile-up ridge. Down its inner flank, whatever its shape
@@ -170,6 +172,9 @@ _BAND_GAP = 10
 # many groove half-widths of its centre, at distances from it within this ratio (each
 # higher than the band's threshold over at least the band's longest quiet stretch).
 _RIDGE_REACH = 5.0
+# ... or within this share of the trace's span (a groove that is a valley of the roughness
+# inside a wide track would otherwise keep the track's ridges out of reach).
+_RIDGE_SPAN = 0.25
 _RIDGE_PAIR = 1.5
 # Each ridge of a pair is the outstanding feature of its side: all else beyond the groove
 # there lower than this fraction of its height.
@@ -713,7 +718,7 @@ def _paired_ridges(x, r, sides, centre, threshold, gap):
     stand higher than ``threshold`` over at least ``gap`` and lie at distances from the
     centre within a ratio of :data:`_RIDGE_PAIR`, or they are a pair of narrow ridges
     (:func:`_narrow_pair`)."""
-    reach = _RIDGE_REACH * 0.5 * (x[sides[1]] - x[sides[0]])
+    reach = max(_RIDGE_REACH * 0.5 * (x[sides[1]] - x[sides[0]]), _RIDGE_SPAN * (x[-1] - x[0]))
     ridges = [_highest_run(x, r, outer, step, centre, reach, threshold, gap)
               for outer, step in zip(sides, (-1, +1), strict=True)]  # fmt: skip
     if None in ridges:

@@ -457,3 +457,28 @@ def test_correlated_roughness_is_no_outlier_and_a_dropout_in_it_is():
         assert not outlying_samples(XI, z).any(), seed
         z[1200] -= 0.5 * UM
         assert np.flatnonzero(outlying_samples(XI, z)).tolist() == [1200], seed
+
+
+def test_a_stylus_export_of_a_wide_band_with_a_valley_offers_the_band(tmp_path):
+    """The acceptance test's export of the band with debris between Gaussian ridges (x in
+    mm to 10 nm, heights in mm to 0.1 µm, quoted decimal commas): the groove below the line
+    is the roughness valley alone, 4.4 µm in half-width, and its pile-up ridges lie beyond 5
+    of its half-widths but within a quarter of the trace's span. The band between the
+    crests is returned with a warning (read before as a trace sampled too sparsely: "only
+    17 samples across the scar")."""
+    rng = np.random.default_rng(1)
+    x = np.arange(-0.6, 0.6, 0.0005)  # mm
+    z = rng.normal(0, 0.0002, x.size) + 0.004 * np.exp(-(((np.abs(x) - 0.12) / 0.015) ** 2))
+    inside = np.abs(x) < 0.1
+    z[inside] += 0.001 * np.sin(x[inside] / 0.1 * 7) - 0.0005
+    z[np.abs(x - 0.01) < 0.004] -= 0.002
+    rows = "".join(f'"{a:.5f}","{b:.4f}"\n'.replace(".", ",") for a, b in zip(x, z, strict=True))
+    path = tmp_path / "ridges.csv"
+    path.write_text('"Distance","Profile"\n' + rows, encoding="utf-8")
+    with pytest.warns(ScarProfileWarning, match="ambiguous scar edges") as caught:
+        profile = ecofmaps.read_scar_profile(
+            path, x_column="Distance", z_column="Profile", x_unit="mm", z_unit="mm"
+        )
+    np.testing.assert_allclose(profile.edges, [-120 * UM, 120 * UM], rtol=0, atol=2 * UM)
+    assert float(profile.alternative_half_width) < 10 * UM
+    assert "the band between its pile-up ridges' crests (returned" in str(caught[-1].message)
