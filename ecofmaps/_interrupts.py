@@ -15,7 +15,9 @@ __all__ = [
     "STOP_SIGNALS",
     "Interrupted",
     "Stop",
+    "add_stop_note",
     "check_interrupted",
+    "interrupts_deferred",
     "interrupts_stop_writes",
 ]
 
@@ -25,15 +27,29 @@ STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
 class Stop(threading.Event):
-    """Set once a stop signal came; :attr:`signal` is the first one (None before)."""
+    """Set once a stop signal came; :attr:`signal` is the first one (None before), and
+    :attr:`notes` the functions :func:`add_stop_note` gave to tell what a stop left."""
 
     def __init__(self):
         super().__init__()
         self.signal = None
+        self.notes = []
+        self.deferred = 0
+
+    def note(self):
+        """What the stop left, as the first of :attr:`notes` that has something to say
+        tells it now (the sentence after ``interrupted;``), or None."""
+        for note in self.notes:
+            told = note()
+            if told:
+                return told
+        return None
 
 
-#: Set by the handler of :func:`interrupts_stop_writes`, only while it is installed.
+#: Set by the handler of :func:`interrupts_stop_writes`, only while it is installed; its
+#: :attr:`Stop.notes` are the block's while one runs, None outside.
 INTERRUPTED = Stop()
+INTERRUPTED.notes = None
 
 
 class Interrupted(KeyboardInterrupt):
@@ -50,15 +66,51 @@ class Interrupted(KeyboardInterrupt):
         self.note = note
 
 
+def add_stop_note(note) -> None:
+    """Have the line that reports a stop in the running :func:`interrupts_stop_writes`
+    block say what ``note()`` returns when the line is written.
+
+    Asked then, once everything the stop interrupted has unwound, ``note`` tells what is
+    left at that moment (a resume folder kept, say), not what was left when the signal
+    came: a block of work that lands in between cannot make the line untrue. It returns a
+    sentence, or None when it has nothing to say (the line then says that nothing was left
+    half written). Outside such a block (the library used from Python) it is not kept.
+
+    Parameters
+    ----------
+    note : callable
+        Called without arguments; returns str or None.
+    """
+    if INTERRUPTED.notes is not None:
+        INTERRUPTED.notes.append(note)
+
+
 def check_interrupted() -> None:
     """Raise ``KeyboardInterrupt`` if Ctrl-C was pressed (or SIGTERM came) under
     :func:`interrupts_stop_writes`.
 
     Called where stopping is safe: between blocks of work and before a file is renamed into
-    place. Outside the block (the library used from Python) it does nothing.
+    place. Outside the block (the library used from Python), and within
+    :func:`interrupts_deferred`, it does nothing.
     """
-    if INTERRUPTED.is_set():
+    if INTERRUPTED.is_set() and not INTERRUPTED.deferred:
         raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def interrupts_deferred():
+    """Within the block, a stop signal does not stop the work at :func:`check_interrupted`:
+    for what completes an output already in place (the record of the files a command
+    wrote, say), which a stop would leave complete but unrecorded. Leaving the
+    :func:`interrupts_stop_writes` block still raises ``KeyboardInterrupt``, unless the
+    command's work returned (:func:`ecofmaps.cli.main.main`). A second signal still stops
+    at once.
+    """
+    INTERRUPTED.deferred += 1
+    try:
+        yield
+    finally:
+        INTERRUPTED.deferred -= 1
 
 
 @contextlib.contextmanager
@@ -97,6 +149,7 @@ def interrupts_stop_writes():
 
     INTERRUPTED.clear()
     INTERRUPTED.signal = None
+    INTERRUPTED.notes = interrupted.notes
     ours = [number for number, before in previous.items() if before not in (signal.SIG_IGN, None)]
     for number in ours:
         signal.signal(number, handler)
@@ -107,4 +160,4 @@ def interrupts_stop_writes():
         for number in ours:
             signal.signal(number, previous[number])
         INTERRUPTED.clear()
-        INTERRUPTED.signal = None
+        INTERRUPTED.signal = INTERRUPTED.notes = None

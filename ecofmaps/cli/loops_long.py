@@ -13,6 +13,14 @@ The table's lines are written as the blocks come, in order, into a temporary fil
 ``--out`` that is renamed onto it at the end, when the folder is removed; this process keeps
 of each block's results only what the summary line reads. A progress bar (cycles, rate,
 time left) is shown on a terminal, unless ``--quiet``.
+
+Stopped by Ctrl-C or SIGTERM, the command's one line tells what is kept as it is when the
+line is written (:meth:`LongRun.stop_note`, given to
+:func:`ecofmaps._interrupts.add_stop_note`), wherever the stop came from (a block, the
+table's rename, an error the stop caused in a worker): a folder that holds work is kept and
+named with the ``--resume`` hint; one this run made with nothing in it yet is removed, and
+the line says nothing was left. Once the table is renamed onto ``--out`` and the folder
+removed, a signal stops nothing (exit status 0, see :func:`ecofmaps.cli.main.main`).
 """
 
 from __future__ import annotations
@@ -27,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ecofmaps._interrupts import Interrupted
+from ecofmaps._interrupts import INTERRUPTED, Interrupted, add_stop_note
 from ecofmaps._parallel import Runner
 from ecofmaps.cli._common import CommandError
 from ecofmaps.io.tables import results_csv
@@ -134,12 +142,20 @@ class _Partial:
         """Whether the folder holds anything a resumed run would use (cycles or blocks)."""
         return any(self.folder.glob("file*.npz"))
 
+    def remove_temporaries(self) -> None:
+        """Remove the temporaries of files being written (a worker stopped while it wrote
+        a block leaves one): a folder kept to resume from holds only whole files."""
+        for pattern in (".file*.npz.tmp", ".run.json.tmp"):
+            for path in self.folder.glob(pattern):
+                path.unlink(missing_ok=True)
+
     def remove(self) -> None:
         """Remove the files the run kept, then the folder if nothing else is in it (a file
         someone put there is not removed)."""
-        for pattern in ("file*.npz", "run.json", ".file*.npz.tmp", ".run.json.tmp"):
+        for pattern in ("file*.npz", "run.json"):
             for path in self.folder.glob(pattern):
                 path.unlink(missing_ok=True)
+        self.remove_temporaries()
         with contextlib.suppress(OSError):  # not empty: left as it is
             self.folder.rmdir()
 
@@ -195,6 +211,7 @@ class LongRun:
             raise CommandError(_UNFINISHED.format(folder=folder))
         self.fingerprint = _fingerprint(args, paths) if args.out is not None else None
         self.partial = None
+        self.analysed = None  # (index, path, blocks or None) of the recording analysed last
 
     def _runner(self):
         if self.args.scheduler:
@@ -214,38 +231,50 @@ class LongRun:
         results are joined after the cluster is closed, so its workers' memory and the
         joined results are not held at once."""
         runner = self._runner() if recording.lazy else contextlib.nullcontext(IN_PROCESS)
+        self.analysed = (index, path, None)
         try:
             with runner as runner:  # a cluster that does not answer: nothing written
                 partial = None
                 if recording.lazy and self.fingerprint is not None:
                     if self.partial is None:
                         self.partial = _Partial(self.args.out, self.fingerprint, self.args.resume)
+                        add_stop_note(self.stop_note)  # asked when the line is written
                     partial = self.partial
                 analysis, parts, resolved = _analyse(
                     index, path, recording, load, self.args, runner, partial, many,
                     write, columns, reading,
                 )  # fmt: skip
         except KeyboardInterrupt as stop:  # counted once the runner is closed: no task runs
-            raise self._stopped(index, path, stop) from None
+            if isinstance(stop, _Interrupted):
+                self.analysed = (index, path, stop.blocks)
+            note = self.stop_note()
+            raise (stop if note is None else Interrupted(note)) from None
         except MissingSampleError as error:
             raise recording.error(MISSING, error.sample) from None
+        self.analysed = (index, path, len(analysis.tasks))
         return analysis.finish([parts.pop(k) for k in sorted(parts)]), resolved
 
-    def _stopped(self, index: int, path, stop: KeyboardInterrupt) -> KeyboardInterrupt:
-        """What to raise for ``stop``, an interrupt while recording ``index`` was analysed:
-        an :class:`Interrupted` that tells what is kept beside ``--out`` and how to go on,
-        or ``stop`` itself when nothing is (a folder this run made with nothing in it yet,
-        stopped while the cluster started, say, is removed)."""
+    def stop_note(self) -> str | None:
+        """What a stop leaves beside ``--out``, as it is now: the sentence that names the
+        folder kept and tells how to go on, or None when nothing is kept.
+
+        A folder this run made with nothing in it yet (stopped while the cluster started,
+        say) is removed, so that the line saying nothing was left is true; a folder kept
+        loses the temporaries of blocks being written when the stop came. After
+        :meth:`finish` nothing is kept.
+        """
         partial = self.partial
-        if partial is None:
-            return stop
+        if partial is None or not partial.folder.exists():
+            return None
         if partial.made and not partial.holds_work():
             partial.remove()
             self.partial = None
-            return stop
-        blocks = f" of {stop.blocks}" if isinstance(stop, _Interrupted) else ""
-        return Interrupted(
-            f"{len(partial.kept(index))}{blocks} blocks of {path} are kept in {partial.folder}: "
+            return None
+        partial.remove_temporaries()
+        index, path, blocks = self.analysed
+        of = "" if blocks is None else f" of {blocks}"
+        return (
+            f"{len(partial.kept(index))}{of} blocks of {path} are kept in {partial.folder}: "
             "run the same command with --resume to continue"
         )
 
@@ -253,6 +282,7 @@ class LongRun:
         """Remove the kept blocks: the table is written."""
         if self.partial is not None:
             self.partial.remove()
+            self.partial = None
 
 
 def skipped(results, recording) -> str:
@@ -321,6 +351,12 @@ def _analyse(index, path, recording, load, args, runner, partial, many, write, c
                     resolved.append(chunk.resolved)
                 written = _in_order(texts, write, written)
                 bar.update(chunk.part.cycle.size)
+    except Exception as error:  # caused by a stop signal (a worker it stopped): the stop
+        if not INTERRUPTED.is_set():
+            raise
+        bar.leave = False
+        bar.close()
+        raise _Interrupted(len(analysis.tasks)) from error
     except KeyboardInterrupt:
         bar.leave = False
         bar.close()

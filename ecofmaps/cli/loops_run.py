@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ecofmaps._interrupts import interrupts_deferred
 from ecofmaps.cli import loops_long
 from ecofmaps.cli._common import CommandError, recording_options, refuse_to_overwrite
 from ecofmaps.io.files import atomic_path, record_written
@@ -281,7 +282,8 @@ def run(args) -> int:
         print(f"ecofmaps loops: none of the {len(paths)} recordings could be analysed; "
               "nothing written", file=sys.stderr)  # fmt: skip
         return 1
-    record_written(path for _, path in outputs if path is not None)
+    with interrupts_deferred():  # the table is in place: a stop now would leave it unrecorded
+        record_written(path for _, path in outputs if path is not None)
     status = 1 if failed else 0
     if args.out is None:
         sys.stdout.write(table.stream.getvalue())

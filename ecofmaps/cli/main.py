@@ -19,7 +19,7 @@ import os
 import signal
 import sys
 
-from ecofmaps._interrupts import interrupts_stop_writes
+from ecofmaps._interrupts import STOP_SIGNALS, interrupts_stop_writes
 from ecofmaps._version import __version__
 
 __all__ = [
@@ -77,19 +77,29 @@ def main(argv=None) -> int:
     """Run the ``ecofmaps`` command; return its exit status.
 
     0 on success; 2 for a user error (bad option, bad file: one line naming it); 130 when
-    interrupted by Ctrl-C and 143 by SIGTERM (one line: files are written atomically, so
-    nothing is left half written); 1 for an unexpected failure (one line;
-    ``ECOFMAPS_DEBUG=1`` shows the traceback).
+    interrupted by Ctrl-C and 143 by SIGTERM, with one line that tells what was left: files
+    are written atomically, so nothing is left half written, and what a subcommand keeps to
+    go on from (``ecofmaps loops``' resume folder) is named with how to go on, as it is when
+    the line is written (:func:`ecofmaps._interrupts.add_stop_note`); 1 for an unexpected
+    failure (one line; ``ECOFMAPS_DEBUG=1`` shows the traceback).
+
+    A signal that comes once the subcommand has done its work (its output written in full,
+    its lines printed) stops nothing: the command ends as it would have without it, with
+    the subcommand's status (0 on success) and no further line.
     """
-    interrupted = None
+    interrupted = status = None
     try:  # the subcommands import JAX and xarray: an interrupt may come during the imports
         with interrupts_stop_writes() as interrupted:
             try:
                 args = build_parser().parse_args(argv)
             except SystemExit as stop:  # a usage error (printed), --help or --version
-                return int(stop.code or 0)
-            return handler(args.handler)(args)
+                status = int(stop.code or 0)
+                return status
+            status = handler(args.handler)(args)
+            return status
     except KeyboardInterrupt as stop:
+        if status is not None:  # the signal came after the work was done, when leaving
+            return status
         return _stopped(interrupted, getattr(stop, "note", None))
     except Exception as error:
         if interrupted is not None and interrupted.is_set():  # an interrupt turned into an error
@@ -108,9 +118,17 @@ def main(argv=None) -> int:
 
 
 def _stopped(interrupted, note) -> int:
-    """Report a run stopped by Ctrl-C or SIGTERM in one line; return 130 or 143."""
+    """Report a run stopped by Ctrl-C or SIGTERM in one line; return 130 or 143.
+
+    What the line says was left is asked now of the notes the subcommand gave
+    (:meth:`ecofmaps._interrupts.Stop.note`), if it gave any, rather than taken from
+    ``note`` (the stop's own, told when it was raised): everything the stop interrupted has
+    unwound by now, so nothing lands after the line is written.
+    """
     terminated = interrupted is not None and interrupted.signal == signal.SIGTERM
     words = "terminated (SIGTERM)" if terminated else "interrupted"
+    if interrupted is not None and interrupted.notes:
+        note = interrupted.note()
     note = note or "no output was left half written"
     return _report(EXIT_TERMINATED if terminated else EXIT_INTERRUPTED, f"{words}; {note}")
 
@@ -121,6 +139,21 @@ def handler(spec):
         return spec
     module, _, name = spec.partition(":")
     return getattr(importlib.import_module(module), name)
+
+
+def _ignored_after_main() -> list:
+    """The stop signals that :func:`console` ignores once :func:`main` returns (those not
+    ignored already: Ctrl-C in a background job stays ignored), from now on handled by
+    :func:`_nothing_to_stop` until then: the moment between :func:`main`'s block giving
+    their handlers back and :func:`console` ignoring them."""
+    numbers = [n for n in STOP_SIGNALS if signal.getsignal(n) not in (signal.SIG_IGN, None)]
+    for number in numbers:
+        signal.signal(number, _nothing_to_stop)
+    return numbers
+
+
+def _nothing_to_stop(signum, frame) -> None:
+    """A stop signal outside :func:`main`'s block, where there is no work to stop."""
 
 
 def _report(status: int, message: str) -> int:
@@ -139,8 +172,15 @@ def console() -> None:
     interrupted run left are collected first, so that their finalizers release what they
     hold (the semaphores of a process pool, which multiprocessing's resource tracker would
     otherwise report as leaked, a second line on standard error).
+
+    Once :func:`main` has returned, Ctrl-C and SIGTERM are ignored: the run's work is done
+    and its line (if any) written, and a signal killing the interpreter as it exits would
+    turn a complete run into exit status 143 with no line (or a traceback after Ctrl-C).
     """
+    after = _ignored_after_main()
     status = main()
+    for number in after:  # the work is done: a signal now stops nothing, not even the exit
+        signal.signal(number, signal.SIG_IGN)
     if status in (EXIT_INTERRUPTED, EXIT_TERMINATED):
         gc.collect()  # finalizers first: a process pool's semaphores, else reported as leaked
         sys.stdout.flush()
