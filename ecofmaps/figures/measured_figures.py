@@ -12,6 +12,7 @@ import numpy as np
 import xarray as xr
 from matplotlib import colormaps
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from ecofmaps.figures.style import (
     MICRO,
@@ -21,6 +22,7 @@ from ecofmaps.figures.style import (
     scalar,
     stiffness_label,
 )
+from ecofmaps.measured.quality import SEPARATOR
 from ecofmaps.model.regimes import GROSS_SLIP, Regime
 
 __all__ = ["cof_evolution", "measured_and_fitted_loops", "measured_loops", "resolved_loops"]
@@ -57,8 +59,10 @@ def measured_loops(
         the line :math:`Q = S\Delta` with the cycle's stiffness, the crossings whose
         :math:`Q/P` is the GICoF, and, with ``resolved``, the band of contact positions
         :math:`\xi_{min} \le \Delta - Q/S \le \xi_{max}` where both branches were read.
-        The title gives the cycle's GICoF and ECoF (a dash where they are NaN) and its
-        ``quality`` when not ``'ok'``.
+        The title gives the cycle's GICoF and ECoF (a dash where they are NaN) and, on a
+        line of its own, its flags when its ``quality`` is not ``'ok'`` (the first and how
+        many more when they are too long for the panel). Crossings are drawn, and listed
+        in the legend, only where there are any.
 
     Notes
     -----
@@ -94,13 +98,48 @@ def measured_loops(
             )
         if resolved is not None:
             _resolved_band(ax, resolved.sel(cycle=label), q)
-        crossings = np.array(
-            [
-                float(cycle["crossing_displacement_forward"]),
-                float(cycle["crossing_displacement_backward"]),
-            ]
+        _crossings(ax, cycle, load)
+        ax.axhline(0.0, color="0.7", linewidth=0.6)
+        ax.axvline(0.0, color="0.7", linewidth=0.6)
+        ax.grid(alpha=0.3)
+        reading = (
+            f"GICoF {_number(cycle['gicof'])}, ECoF {_number(cycle['ecof'])}"
+            if int(cycle["regime"]) == GROSS_SLIP
+            else "no GICoF or ECoF"
         )
-        ratios = np.array([float(cycle["gicof_forward"]), -float(cycle["gicof_backward"])])
+        quality = str(cycle["quality"].values) if "quality" in cycle else "ok"
+        state = Regime(int(cycle["regime"])).label
+        flags = "" if quality == "ok" else "\nflagged: " + _flags_text(quality)
+        ax.set_title(
+            f"cycle {label}: {reading}\n{stiffness_label(stiffness)}, {state}{flags}",
+            fontsize="small",
+        )
+    for ax in axes.flat[len(chosen) :]:
+        ax.set_visible(False)
+    for ax in axes[-1]:
+        ax.set_xlabel(axis_label("displacement"))
+    for ax in axes[:, 0]:
+        ax.set_ylabel(axis_label("force"))
+    _shared_legend(axes.flat[0], axes.flat[: len(chosen)])
+    figure.suptitle(
+        # Two lines: the figure of a single cycle is only one panel wide.
+        rf"Measured loops and the line $Q = S\Delta$ (P = {load:g} N):"
+        "\nthe GICoF is Q/P at the crossings",
+        fontsize="medium",
+    )
+    return figure
+
+
+def _crossings(ax, cycle: xr.Dataset, load: float) -> None:
+    """Mark the cycle's two crossings of the loop with Q = SΔ, where there are any."""
+    crossings = np.array(
+        [
+            float(cycle["crossing_displacement_forward"]),
+            float(cycle["crossing_displacement_backward"]),
+        ]
+    )
+    ratios = np.array([float(cycle["gicof_forward"]), -float(cycle["gicof_backward"])])
+    if np.isfinite(crossings * ratios).any():
         ax.plot(
             crossings * MICRO,
             ratios * load,
@@ -111,34 +150,31 @@ def measured_loops(
             markeredgecolor="black",
             label="GICoF crossings",
         )
-        ax.axhline(0.0, color="0.7", linewidth=0.6)
-        ax.axvline(0.0, color="0.7", linewidth=0.6)
-        ax.grid(alpha=0.3)
-        reading = (
-            f"GICoF {_number(cycle['gicof'])}, ECoF {_number(cycle['ecof'])}"
-            if int(cycle["regime"]) == GROSS_SLIP
-            else "no GICoF or ECoF"
-        )
-        quality = str(cycle["quality"].values) if "quality" in cycle else "ok"
-        state = Regime(int(cycle["regime"])).label + ("" if quality == "ok" else f"; {quality}")
-        ax.set_title(
-            f"cycle {label}: {reading}\n{stiffness_label(stiffness)}, {state}",
-            fontsize="small",
-        )
-    for ax in axes.flat[len(chosen) :]:
-        ax.set_visible(False)
-    for ax in axes[-1]:
-        ax.set_xlabel(axis_label("displacement"))
-    for ax in axes[:, 0]:
-        ax.set_ylabel(axis_label("force"))
-    axes.flat[0].legend(loc="upper left", fontsize="x-small")
-    figure.suptitle(
-        # Two lines: the figure of a single cycle is only one panel wide.
-        rf"Measured loops and the line $Q = S\Delta$ (P = {load:g} N):"
-        "\nthe GICoF is Q/P at the crossings",
-        fontsize="medium",
-    )
-    return figure
+
+
+def _flags_text(quality: str, width: int = 50) -> str:
+    """A cycle's flags, comma separated, or the first and how many more when they are
+    longer than ``width`` characters."""
+    reasons = quality.split(SEPARATOR)
+    text = ", ".join(reasons)
+    if len(text) <= width or len(reasons) == 1:
+        return text
+    return f"{reasons[0]} and {len(reasons) - 1} more"
+
+
+def _reasons(qualities) -> list[str]:
+    """The distinct reasons in ``qualities``, sorted."""
+    return sorted({reason for text in qualities for reason in str(text).split(SEPARATOR)})
+
+
+def _shared_legend(ax, panels) -> None:
+    """One legend in ``ax`` for every labelled artist drawn in any of ``panels``."""
+    entries = {}
+    for panel in panels:
+        for handle, name in zip(*panel.get_legend_handles_labels(), strict=True):
+            entries.setdefault(name, handle)
+    if entries:
+        ax.legend(list(entries.values()), list(entries), loc="upper left", fontsize="x-small")
 
 
 def _number(value, form: str = ".3f") -> str:
@@ -178,6 +214,9 @@ def cof_evolution(results: xr.Dataset) -> Figure:
     figure : matplotlib.figure.Figure
         Top: :math:`\mu_E` (eq. 1) and the GICoF against the cycle number.
         Bottom: how far the ECoF is above the GICoF, :math:`\mu_E/\text{GICoF} - 1` [%].
+        The cycle axis spans the test with integer ticks; a panel with nothing to draw
+        says why (every cycle flagged, with the count of each reason, or none in gross
+        slip).
 
     Notes
     -----
@@ -189,31 +228,29 @@ def cof_evolution(results: xr.Dataset) -> Figure:
     top, bottom = figure.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
     cycle = results["cycle"].values
     marker = dict(marker="o", markersize=2.5) if cycle.size <= 400 else {}
-    top.plot(
-        cycle,
-        results["ecof"],
-        color="tab:orange",
-        linewidth=1.3,
-        label=r"ECoF $\mu_E = E_d/(4P\delta^*)$",
-        **marker,
-    )
-    top.plot(
-        cycle,
-        results["gicof"],
-        color="tab:blue",
-        linewidth=1.3,
-        label=r"GICoF ($Q/P$ on $Q = S\Delta$)",
-        **marker,
-    )
+    series = {
+        r"ECoF $\mu_E = E_d/(4P\delta^*)$": (results["ecof"].values, "tab:orange"),
+        r"GICoF ($Q/P$ on $Q = S\Delta$)": (results["gicof"].values, "tab:blue"),
+    }
+    for name, (values, color) in series.items():
+        if np.isfinite(values).any():
+            top.plot(cycle, values, color=color, linewidth=1.3, label=name, **marker)
     top.set_ylabel("Coefficient of friction [1]")
     top.grid(alpha=0.3)
-    top.legend(loc="best", fontsize="small")
-    excess = (results["ecof"] / results["gicof"] - 1.0) * 100.0
-    bottom.plot(cycle, excess, color="tab:purple", linewidth=1.2, **marker)
+    if top.get_lines():
+        top.legend(loc="best", fontsize="small")
+    else:
+        _note(top, "no ECoF or GICoF in any cycle:\n" + _why_none(results))
+    excess = (results["ecof"] / results["gicof"] - 1.0).values * 100.0
+    if np.isfinite(excess).any():
+        bottom.plot(cycle, excess, color="tab:purple", linewidth=1.2, **marker)
+    else:
+        _note(bottom, "no cycle with both an ECoF and a GICoF")
     bottom.axhline(0.0, color="0.5", linewidth=0.8)
     bottom.set_ylabel("ECoF / GICoF − 1 [%]")
     bottom.set_xlabel("Cycle")
     bottom.grid(alpha=0.3)
+    _cycle_axis(bottom, cycle)
     amplitude = float(results["amplitude"].median()) * MICRO
     figure.suptitle(
         "Fig. 9  Evolution of the ECoF and the GICoF\n"
@@ -221,6 +258,35 @@ def cof_evolution(results: xr.Dataset) -> Figure:
         fontsize="medium",
     )
     return figure
+
+
+def _note(ax, text: str, height: float = 0.5) -> None:
+    """Write ``text`` across the panel ``ax``, which has nothing else to show, at ``height``
+    (a fraction of the panel's, from the bottom)."""
+    ax.text(0.5, height, text, transform=ax.transAxes, ha="center", va="center", color="0.3",
+            fontsize="small")  # fmt: skip
+
+
+def _why_none(results: xr.Dataset) -> str:
+    """Why no cycle of ``results`` has a value: every cycle flagged (with how many cycles
+    carry each reason, on a second line), or none in gross slip."""
+    if "quality" not in results or (results["quality"].values == "ok").any():
+        return "no cycle in gross slip"
+    counts = {}
+    for text in np.ravel(results["quality"].values):
+        for reason in str(text).split(SEPARATOR):
+            counts[reason] = counts.get(reason, 0) + 1
+    return "every cycle flagged:\n" + ", ".join(f"{reason} {n}" for reason, n in counts.items())
+
+
+def _cycle_axis(ax, cycle) -> None:
+    """Integer ticks on the cycle axis of ``ax``, its limits the cycles' range (with a
+    half-cycle margin), whether or not anything was drawn."""
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True, min_n_ticks=1))
+    if cycle.size:
+        first, last = float(np.min(cycle)), float(np.max(cycle))
+        margin = 0.5 if first == last else 0.02 * (last - first)
+        ax.set_xlim(first - margin, last + margin)
 
 
 # --- Figure 10: measured loops and the fitted model ----------------------------------------
@@ -315,7 +381,8 @@ def resolved_loops(resolved: xr.Dataset, results: xr.Dataset | None = None, cycl
         as the test runs; (d) ``mu_resolved`` :math:`\pm 2` standard errors over the cycles
         (with the ECoF and GICoF when ``results`` is given) and the equivalent
         ``aspect_ratio`` on a right-hand axis; cycles with no resolved value are marked
-        along the bottom with their quality.
+        along the bottom with their quality. A single cycle is a band in (c) and an error
+        bar in (d); a panel with nothing to draw says why.
 
     Notes
     -----
@@ -361,48 +428,84 @@ def resolved_loops(resolved: xr.Dataset, results: xr.Dataset | None = None, cycl
     else:
         stroke.text(0.5, 0.5, "no cycle was read along the stroke\n(none has quality 'ok')",
                     transform=stroke.transAxes, ha="center", va="center", color="0.3")  # fmt: skip
-    felt.plot([], [], color="0.4", linestyle=":", label=r"equivalent parabola $k\xi^2/2$")
     felt.set_xlabel(axis_label("position"))
     felt.set_ylabel(r"Felt groove profile $h(\xi)$ [µm]")
     felt.set_title("(b) the scar as the contact feels it", fontsize="medium")
-    felt.legend(loc="upper center", fontsize="x-small", ncols=2)
+    if chosen:
+        felt.plot([], [], color="0.4", linestyle=":", label=r"equivalent parabola $k\xi^2/2$")
+        felt.legend(loc="upper center", fontsize="x-small", ncols=2)
+    else:
+        _note(felt, "no felt profile: no cycle was read along the stroke")
     for ax in (stroke, felt, test):
         ax.grid(alpha=0.3)
-    profile = resolved["felt_profile"].transpose("cycle", "position").values * MICRO
-    mesh = image.pcolormesh(xi, np.arange(len(labels)), profile, shading="nearest",
-                            cmap="cividis")  # fmt: skip
-    ticks = np.unique(np.linspace(0, len(labels) - 1, min(len(labels), 6)).round().astype(int))
-    image.set_yticks(ticks, [str(labels[i]) for i in ticks])
-    image.set_xlabel(axis_label("position"))
-    image.set_ylabel("Cycle")
-    image.set_title("(c) felt profile over the test", fontsize="medium")
-    figure.colorbar(mesh, ax=image, label=r"$h(\xi)$ [µm]")
-    number = resolved["cycle"].values
-    mu = resolved["mu_resolved"].values
-    error = 2.0 * resolved["mu_resolved_se"].values
-    test.fill_between(number, mu - error, mu + error, color="tab:green", alpha=0.25,
-                      label=r"$\pm$2 standard errors")  # fmt: skip
-    test.plot(number, mu, color="tab:green", linewidth=1.4, label=r"$\mu$ read along the stroke")
-    if results is not None:
-        test.plot(number, results["ecof"], color="tab:orange", linewidth=1.0,
-                  label=r"ECoF $\mu_E$")  # fmt: skip
-        test.plot(number, results["gicof"], color="tab:blue", linewidth=1.0, label="GICoF")
-    missing = resolved["quality"].values != "ok"
-    if missing.any():
-        bottom = np.nanmin(mu - error) if np.isfinite(mu).any() else 0.0
-        test.plot(number[missing], np.full(missing.sum(), bottom), "x", color="crimson",
-                  label="no resolved value: " + ", ".join(
-                      sorted(set(resolved["quality"].values[missing]))))  # fmt: skip
-    test.set_xlabel("Cycle")
-    test.set_ylabel("Coefficient of friction [1]")
-    ratio = test.twinx()
-    ratio.plot(number, resolved["aspect_ratio"], color="0.3", linestyle="--", linewidth=1.0)
-    ratio.set_ylabel(axis_label("aspect_ratio") + " (dashed)")
-    test.set_title(r"(d) $\mu$ over the test, and the equivalent groove", fontsize="medium")
-    test.legend(loc="best", fontsize="x-small")
+    _profile_over_test(figure, image, resolved)
+    _mu_over_test(test, resolved, results)
     figure.suptitle(
         rf"Loops read along the stroke (P = {scalar(resolved, 'load'):g} N): "
         r"$\mu(\xi)$ and $g(\xi)$ from the two slip branches at the same $\xi = \Delta - Q/S$",
         fontsize="medium",
     )
     return figure
+
+
+def _profile_over_test(figure: Figure, image, resolved: xr.Dataset) -> None:
+    """Panel (c): the felt profile h [µm] over (position, cycle), one row per cycle."""
+    labels = resolved["cycle"].values
+    xi = resolved["position"].values * MICRO
+    profile = resolved["felt_profile"].transpose("cycle", "position").values * MICRO
+    image.set_xlabel(axis_label("position"))
+    image.set_ylabel("Cycle")
+    image.set_title("(c) felt profile over the test", fontsize="medium")
+    if not np.isfinite(profile).any():
+        _note(image, "no felt profile:\n" + _why_none(resolved))
+        return
+    # Cell edges halfway between the positions, and between the rows: one cycle is a band.
+    middle = (xi[1:] + xi[:-1]) / 2.0
+    edges = np.concatenate([[2.0 * xi[0] - middle[0]], middle, [2.0 * xi[-1] - middle[-1]]])
+    rows = np.arange(len(labels) + 1) - 0.5
+    mesh = image.pcolormesh(edges, rows, profile, shading="flat", cmap="cividis")
+    ticks = np.unique(np.linspace(0, len(labels) - 1, min(len(labels), 6)).round().astype(int))
+    image.set_yticks(ticks, [str(labels[i]) for i in ticks])
+    figure.colorbar(mesh, ax=image, label=r"$h(\xi)$ [µm]")
+
+
+def _mu_over_test(test, resolved: xr.Dataset, results: xr.Dataset | None) -> None:
+    """Panel (d): mu_resolved ± 2 standard errors over the cycles, the ECoF and GICoF of
+    ``results``, the cycles with no value marked, the aspect ratio on a right-hand axis."""
+    number = resolved["cycle"].values
+    mu = resolved["mu_resolved"].values
+    error = 2.0 * resolved["mu_resolved_se"].values
+    marker = dict(marker="o", markersize=3) if number.size <= 400 else {}
+    if number.size > 1 and np.isfinite(error).any():
+        test.fill_between(number, mu - error, mu + error, color="tab:green", alpha=0.25,
+                          label=r"$\pm$2 standard errors")  # fmt: skip
+    elif np.isfinite(error).any():  # a band over one cycle has no width
+        test.errorbar(number, mu, yerr=error, fmt="none", ecolor="tab:green", capsize=4,
+                      label=r"$\pm$2 standard errors")  # fmt: skip
+    if np.isfinite(mu).any():
+        test.plot(number, mu, color="tab:green", linewidth=1.4,
+                  label=r"$\mu$ read along the stroke", **marker)  # fmt: skip
+    if results is not None:
+        for name, label, color in (("ecof", r"ECoF $\mu_E$", "tab:orange"),
+                                   ("gicof", "GICoF", "tab:blue")):  # fmt: skip
+            values = results[name].values
+            if np.isfinite(values).any():
+                test.plot(number, values, color=color, linewidth=1.0, label=label, **marker)
+    missing = resolved["quality"].values != "ok"
+    if missing.any():
+        bottom = np.nanmin(mu - error) if np.isfinite(mu - error).any() else 0.0
+        reasons = ", ".join(_reasons(resolved["quality"].values[missing]))
+        test.plot(number[missing], np.full(missing.sum(), bottom), "x", color="crimson",
+                  label=f"no resolved value: {reasons}")  # fmt: skip
+    if missing.all():  # below the marks, which are at the middle
+        _note(test, "no cycle read along the stroke:\n" + _why_none(resolved), height=0.3)
+    test.set_xlabel("Cycle")
+    test.set_ylabel("Coefficient of friction [1]")
+    ratio = test.twinx()
+    if np.isfinite(resolved["aspect_ratio"].values).any():
+        ratio.plot(number, resolved["aspect_ratio"], color="0.3", linestyle="--", linewidth=1.0,
+                   **marker)  # fmt: skip
+    ratio.set_ylabel(axis_label("aspect_ratio") + " (dashed)")
+    _cycle_axis(test, number)  # after twinx, which shares the cycle axis's ticker
+    test.set_title(r"(d) $\mu$ over the test, and the equivalent groove", fontsize="medium")
+    test.legend(loc="best", fontsize="x-small")

@@ -1,13 +1,17 @@
 """The figures of measured loops: the loops with Q = SΔ and Figure 9, drawn from the Dataset."""
 
+import warnings
+
 import numpy as np
 import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 from ecofmaps.figures import cof_evolution, measured_loops, resolved_loops, save_figure
 from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.quality import add_reason
 from ecofmaps.measured.resolved import resolve_analyzed_loops
 from ecofmaps.measured.synthetic import synthetic_recording
+from ecofmaps.model.regimes import GROSS_SLIP
 
 LOAD = 450.0
 
@@ -106,3 +110,153 @@ def test_resolved_loops_marks_cycles_without_a_value(results):
     (marks,) = [line for line in test.get_lines() if "no resolved value" in line.get_label()]
     assert "not-gross-slip" in marks.get_label()
     assert 3 in marks.get_xdata()  # the third cycle's number
+
+
+# --- ugly recordings: microslip, a single cycle, every cycle flagged ------------------------
+
+
+def quiet_analysis(displacement, force, load):
+    """analyze_loops with its quality warnings silenced (the figures are under test)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return analyze_loops(displacement, force, load, keep_loops=True)
+
+
+@pytest.fixture(scope="module")
+def microslip():
+    """Six cycles of 5 µm: no gross slip, some flagged three times over."""
+    displacement, force = synthetic_recording(amplitude=5e-6, load=LOAD, stiffness=35e6, mu=0.8,
+        aspect_ratio=0.0, cycles=6, force_noise=3.0, displacement_noise=0.05e-6)  # fmt: skip
+    results = quiet_analysis(displacement, force, LOAD)
+    assert (results.quality != "ok").all() and (results.regime != GROSS_SLIP).all()
+    assert "negative-area+negative-slip+not-gross-slip" in results.quality.values
+    return results
+
+
+@pytest.fixture(scope="module")
+def single():
+    """One gross-slip cycle."""
+    displacement, force = synthetic_recording(
+        amplitude=50e-6, load=LOAD, stiffness=35e6, mu=0.8, aspect_ratio=0.15, cycles=1
+    )
+    results = quiet_analysis(displacement, force, LOAD)
+    assert results.cycle.size == 1 and results.quality.item() == "ok"
+    return results
+
+
+@pytest.fixture(scope="module")
+def flagged():
+    """Four cycles read with a load 450 times too small: every one implausible."""
+    displacement, force = synthetic_recording(
+        amplitude=50e-6, load=LOAD, stiffness=35e6, mu=0.8, aspect_ratio=0.15, cycles=4
+    )
+    results = quiet_analysis(displacement, force, 1.0)
+    assert (results.quality == "implausible-cof").all()
+    return results
+
+
+def rendered(figure):
+    """``figure`` drawn, and its renderer."""
+    canvas = FigureCanvasAgg(figure)
+    canvas.draw()
+    return canvas.get_renderer()
+
+
+def drawn_labels(ax) -> list[str]:
+    """The labels of the artists drawn in ``ax`` that a legend would list."""
+    return ax.get_legend_handles_labels()[1]
+
+
+def integer_ticks(axis) -> np.ndarray:
+    """The tick positions of ``axis`` within its view limits."""
+    low, high = sorted(axis.get_view_interval())
+    ticks = np.asarray(axis.get_majorticklocs())
+    return ticks[(ticks >= low - 1e-9) & (ticks <= high + 1e-9)]
+
+
+@pytest.mark.filterwarnings("error")
+def test_loop_titles_fit_side_by_side_with_flags_on_their_own_line(microslip):
+    """Three flags on one cycle: every panel title inside the figure, none overlapping."""
+    figure = measured_loops(microslip)
+    renderer = rendered(figure)
+    panels = [ax for ax in figure.axes if ax.get_visible()]
+    boxes = [ax.title.get_window_extent(renderer) for ax in panels]
+    inside = figure.bbox
+    for box in boxes:
+        assert inside.x0 - 0.5 <= box.x0 and box.x1 <= inside.x1 + 0.5
+        assert inside.y0 - 0.5 <= box.y0 and box.y1 <= inside.y1 + 0.5
+    for index, box in enumerate(boxes):
+        assert not any(box.overlaps(other) for other in boxes[index + 1 :])
+    titles = [ax.get_title() for ax in panels]
+    assert any("flagged: negative-area, negative-slip, not-gross-slip" in t for t in titles)
+
+
+@pytest.mark.filterwarnings("error")
+def test_loop_legend_lists_only_what_is_drawn(microslip, results):
+    """No GICoF without gross slip: no crossings drawn, and none in the legend."""
+    figure = measured_loops(microslip)
+    rendered(figure)
+    legend = [t.get_text() for t in figure.axes[0].get_legend().get_texts()]
+    assert legend == ["measured loop", r"$Q = S\Delta$"]
+    drawn = {label for ax in figure.axes for label in drawn_labels(ax)}
+    assert set(legend) == drawn
+    gross = measured_loops(results)
+    assert "GICoF crossings" in [t.get_text() for t in gross.axes[0].get_legend().get_texts()]
+
+
+def test_flags_of_a_title_are_shortened_when_long(microslip):
+    """More flags than fit beside each other: the first and how many more."""
+    many = microslip.copy()
+    threefold = many.quality.values == "negative-area+negative-slip+not-gross-slip"
+    many["quality"] = many["quality"].copy(
+        data=add_reason(many["quality"].values, threefold, "implausible-cof")
+    )
+    label = int(many.cycle[threefold][0])
+    (panel,) = measured_loops(many, cycles=[label]).axes
+    assert panel.get_title().endswith("\nflagged: negative-area and 3 more")
+
+
+@pytest.mark.filterwarnings("error")
+def test_single_cycle_figures_show_the_cycle(single):
+    """One cycle: integer cycle ticks, (c) a band of h over the positions, (d) μ ± 2 se."""
+    evolution = cof_evolution(single)
+    rendered(evolution)
+    ticks = integer_ticks(evolution.axes[1].xaxis)
+    assert ticks.size >= 1 and np.all(ticks == np.round(ticks))
+    assert int(single.cycle[0]) in ticks
+    resolved = resolve_analyzed_loops(single)
+    figure = resolved_loops(resolved, single)
+    rendered(figure)
+    image, test = figure.axes[2], figure.axes[3]
+    (mesh,) = image.collections
+    rows = mesh.get_coordinates()[:, 0, 1]
+    assert rows.max() - rows.min() == pytest.approx(1.0)  # one cycle, one row of height 1
+    assert np.isfinite(mesh.get_array()).any()
+    ticks = integer_ticks(test.xaxis)
+    assert ticks.size >= 1 and np.all(ticks == np.round(ticks))
+    (errorbar,) = test.containers
+    low, high = errorbar.lines[2][0].get_segments()[0][:, 1]
+    assert high - low == pytest.approx(4 * resolved.mu_resolved_se.item())
+    (mu,) = [line for line in test.get_lines() if "along the stroke" in line.get_label()]
+    assert mu.get_marker() == "o"
+
+
+@pytest.mark.filterwarnings("error")
+def test_every_cycle_flagged_is_said_in_the_panels(flagged):
+    """Nothing to draw: each empty panel says why, and the cycle axis still spans the test."""
+    evolution = cof_evolution(flagged)
+    rendered(evolution)
+    top, bottom = evolution.axes
+    assert top.get_lines() == [] and top.get_legend() is None
+    (note,) = top.texts
+    assert "every cycle flagged" in note.get_text() and "implausible-cof 4" in note.get_text()
+    assert bottom.get_xlim()[0] <= 1 and bottom.get_xlim()[1] >= 4
+    assert list(integer_ticks(bottom.xaxis)) == [1, 2, 3, 4]
+    figure = resolved_loops(resolve_analyzed_loops(flagged), flagged)
+    rendered(figure)
+    stroke, felt, image, test = figure.axes[:4]
+    for panel in (stroke, felt, image, test):
+        assert panel.texts, panel.get_title()
+    assert "implausible-cof 4" in image.texts[0].get_text()
+    assert drawn_labels(test) == ["no resolved value: implausible-cof"]
+    assert [t.get_text() for t in test.get_legend().get_texts()] == drawn_labels(test)
