@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+import ecofmaps
 from ecofmaps import paper
 from ecofmaps._nomenclature import attrs
 
@@ -217,8 +218,6 @@ def _scar_shapes() -> xr.Dataset:
 
 def _scar_profiles() -> dict:
     """The scar families of :data:`SCAR_SHAPES` at Example 2's D/W, by name."""
-    import ecofmaps
-
     depth, width = paper.ASPECT_RATIO * paper.AMPLITUDE, paper.AMPLITUDE
     scale = {"ridge_height": depth, "ridge_width": width}
     profiles = {}
@@ -305,7 +304,6 @@ def scar_shape_parabola_dataset() -> xr.Dataset:
         ``dissipated_energy``, ``ecof`` and ``ecof_ratio`` over ``stiffness_ratio``;
         ``displacement`` and ``force`` over ``point``. Computed, not cached.
     """
-    import ecofmaps
     from ecofmaps.maps.grid import compute_map  # JAX: the registry reads without it
 
     ratios = _SHAPES_STIFFNESS_RATIOS
@@ -343,8 +341,6 @@ def scar_shapes_dataset() -> xr.Dataset:
         The ``shapes`` figure's numbers: see
         :func:`ecofmaps.figures.profile_figures.scar_shape_comparison` for its variables.
     """
-    import ecofmaps
-
     model, parabola = _scar_shape_model(), _scar_shape_parabola()
     ratios = _SHAPES_STIFFNESS_RATIOS
     at_example = int(np.searchsorted(ratios, paper.STIFFNESS / paper.LOAD))
