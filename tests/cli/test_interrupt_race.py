@@ -19,7 +19,6 @@ import pytest
 from ecofmaps._interrupts import INTERRUPTED, Interrupted, add_stop_note
 from ecofmaps.cli import loops_long, loops_run
 from ecofmaps.io.files import MANIFEST
-from ecofmaps.measured import pipeline
 from ecofmaps.measured.long_test import write_long_recording
 from tests.cli.test_loops import run
 
@@ -29,12 +28,6 @@ command = importlib.import_module("ecofmaps.cli.main")
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="POSIX signals")
 
 SIGNALS = [(signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "terminated (SIGTERM)")]
-
-
-@pytest.fixture
-def small_tasks(monkeypatch):
-    """Tasks of about 1000 samples: a test of 60 cycles of 100 is six blocks."""
-    monkeypatch.setattr(pipeline, "TASK_SAMPLES", 1000)
 
 
 @pytest.fixture(scope="module")

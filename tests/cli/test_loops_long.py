@@ -8,16 +8,9 @@ import numpy as np
 import pytest
 
 from ecofmaps.cli import loops_long
-from ecofmaps.measured import pipeline
 from ecofmaps.measured.long_test import write_long_recording
 from ecofmaps.measured.synthetic import synthetic_recording
 from tests.cli.test_loops import POINT, run, write_csv
-
-
-@pytest.fixture
-def small_tasks(monkeypatch):
-    """Tasks of about 1000 samples: a test of 60 cycles of 100 is six blocks."""
-    monkeypatch.setattr(pipeline, "TASK_SAMPLES", 1000)
 
 
 @pytest.fixture(scope="module")
