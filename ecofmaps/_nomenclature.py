@@ -164,6 +164,9 @@ QUANTITIES: dict[str, Quantity] = {
     "crossing_displacement_backward": _length("displacement where Q = SΔ, falling branch"),
     "displacement_offset": _length("displacement offset removed (loop centre)"),
     "force_offset": _force("force offset removed (loop centre)"),
+    "force_drift_se": _force(
+        "standard error of the offset between the loop's branches left by the drift correction"
+    ),
     "loop_displacement": _length("applied displacement, centred", "Δ", r"\Delta"),
     "loop_force": _force("tangential force, centred", "Q", "Q"),
     "stick_residual": _length("root mean square displacement off the stick lines"),

@@ -76,7 +76,8 @@ def _central_values(forward, backward, central, load):
     along the part where that is larger (:func:`_scatter_variance`). Also whether μ(ξ)
     varies between the inner and the outer half of the part beyond ``_VARIATION`` of μ and
     beyond its noise, the sensitivity to a shift of the rising branch against the falling
-    one along ξ, and whether μ(ξ) wiggles about a straight line beyond ``_GICOF_WIGGLE``.
+    one along ξ, whether μ(ξ) wiggles about a straight line beyond ``_GICOF_WIGGLE``, and
+    the sensitivity to an offset of the falling branch's force against the rising one's.
     """
     width = forward[0].shape[1]
     usable = np.isfinite(central)
@@ -127,6 +128,9 @@ def _central_values(forward, backward, central, load):
     factor = 0.5 * (1.0 + mu_resolved**2) / points
     sensitivity = factor * masked_sum(turning * (q_forward - q_backward), finite)
     shifting = -factor * masked_sum(turning, finite)
+    # An offset ε of the falling branch's force against the rising one's moves Q± by ∓ε/2.
+    lifts = 1.0 / (1.0 + (q_forward / load) ** 2) + 1.0 / (1.0 + (q_backward / load) ** 2)
+    offsetting = 0.5 * factor * masked_sum(lifts, finite) / load
     # The scatter of μ(ξ) beyond the noise: correlated residuals, the model's misfit.
     scatter, wiggle = _scatter_variance(mu, finite, unit)
     # μ(ξ) wiggles along the stroke beyond the noise: the GICoF, read at one position,
@@ -135,7 +139,7 @@ def _central_values(forward, backward, central, load):
     wavers = excess > _GICOF_WIGGLE * np.abs(mu_resolved)
     variance = np.fmax(variance, scatter)  # the noise alone where too few blocks
     tilt = mean_g - k * mean_xi
-    return mu_resolved, variance, k, tilt, sensitivity, varies, shifting, wavers
+    return mu_resolved, variance, k, tilt, sensitivity, varies, shifting, wavers, offsetting
 
 
 def _scatter_variance(mu, kept, unit):
@@ -213,14 +217,15 @@ def _blocks(cycles):
     return [slice(start, start + _BLOCK) for start in range(0, max(cycles, 1), _BLOCK)]
 
 
-def along_stroke_values(x, q, valid, load, stiffness, amplitude, quality, given, options):
+def along_stroke_values(x, q, valid, load, stiffness, amplitude, quality, given, options, drift_se):
     """Every resolved quantity of the centred loops ``x``, ``q`` (module notes).
 
     ``stiffness`` is the given S (``given`` True) or analyze_loops's, per cycle, and
     ``quality`` analyze_loops's: a cycle it flags for a reason that reaches the resolved
-    values is not read. Returns the per-position and per-cycle arrays, the quality (with
-    this reading's reasons added) and the grid. The work is done on blocks of cycles, each
-    block vectorised.
+    values is not read. ``drift_se`` is the standard error of the offset between each
+    loop's branches that its centring left (analyze_loops's ``force_drift_se``) [N].
+    Returns the per-position and per-cycle arrays, the quality (with this reading's reasons
+    added) and the grid. The work is done on blocks of cycles, each block vectorised.
     """
     inherited = _reaches_resolved(quality)
     cycles = x.shape[0]
@@ -264,8 +269,8 @@ def along_stroke_values(x, q, valid, load, stiffness, amplitude, quality, given,
     wavers = joined_values(parts, 7) & ((flag == 0) | (flag == 4))
     quality = add_reason(quality, wavers & ~inherited, "gicof-varies")
     lowest, highest = joined("lowest"), joined("highest")
-    mu_resolved, variance, k, tilt, sensitivity, _, shifting = (
-        joined_values(parts, i) for i in range(7)
+    mu_resolved, variance, k, tilt, sensitivity, _, shifting, _, offsetting = (
+        joined_values(parts, i) for i in range(9)
     )
     nan = np.where(ok, 1.0, np.nan)
     compliance = joined("compliance")
@@ -275,6 +280,7 @@ def along_stroke_values(x, q, valid, load, stiffness, amplitude, quality, given,
             variance
             + (sensitivity * joined("compliance_se")) ** 2
             + (shifting * joined("shift")) ** 2
+            + (offsetting * drift_se) ** 2
         )
         * nan,
         "aspect_ratio": 0.5 * k * amplitude * nan,

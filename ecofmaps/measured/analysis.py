@@ -199,7 +199,9 @@ def analyze_loops(
         dissipated_energy [J], ecof, cof_max, energy_ratio, stiffness [N/m], gicof,
         gicof_forward, gicof_backward, crossing_displacement_forward and
         crossing_displacement_backward [m] (in the centred loop), displacement_offset [m]
-        and force_offset [N] (the centres removed, of the force as read), regime
+        and force_offset [N] (the centres removed, of the force as read),
+        force_drift_se [N] (standard error of the offset between the loop's branches
+        that the drift correction between neighbouring centres leaves), regime
         (:class:`ecofmaps.Regime` codes: GROSS_SLIP, NO_GROSS_SLIP for partial slip, INVALID
         for a refused cycle; int32 with CF flag attributes), stick_residual [m] (root
         mean square displacement off the stick lines) and quality ('ok', or why values

@@ -54,6 +54,7 @@ _PER_CYCLE = (
     "crossing_displacement_backward",
     "displacement_offset",
     "force_offset",
+    "force_drift_se",
     "stick_residual",
 )
 
@@ -103,6 +104,7 @@ def _loop_values(block, load, options):
         "crossing_displacement_backward": at[cycles:],
         "displacement_offset": block.displacement_centre,
         "force_offset": block.force_centre,
+        "force_drift_se": block.force_drift_se,
         "stick_residual": fit["residual"],
     }
     rounding = 1e-9

@@ -11,8 +11,9 @@ shares, so that a fix lands once:
    are held. The cycles keep the drive's numbering.
 2. **chunks**: the cycles are cut into chunks of whole cycles, about ``samples`` samples
    each, so no cycle is cut at a chunk's edge. Each chunk reads the stretch of its cycles
-   and of two whole cycles on either side (a *halo*: the centring interpolates each
-   cycle's centre from its neighbours', :mod:`ecofmaps.measured.centring`).
+   and of five whole cycles on either side (a *halo*: the centring interpolates each
+   cycle's centre from its neighbours', and takes the noise of the centres from four
+   neighbours on either side, :mod:`ecofmaps.measured.centring`).
 3. **per-cycle values**: :func:`ecofmaps.measured.per_cycle.measure_cycles`, with the
    sample indices of the whole recording;
 4. **along the stroke** (``resolve``): :func:`ecofmaps.measured.resolved.resolve_analyzed_loops`
@@ -41,6 +42,7 @@ import numpy as np
 import xarray as xr
 
 from ecofmaps._parallel import stretch
+from ecofmaps.measured.centring import NEIGHBOURS
 from ecofmaps.measured.cycles import Cycles, find_cycles
 from ecofmaps.measured.options import missing_sample_error, no_cycle_error
 from ecofmaps.measured.per_cycle import measure_cycles
@@ -63,7 +65,7 @@ __all__ = [
 TASK_SAMPLES = 1 << 22
 
 #: Whole cycles on either side of a chunk's cycles that it reads for the centring.
-HALO = 2
+HALO = NEIGHBOURS
 
 #: The prefix of the names under which a chunk's values hold its reading along the stroke.
 READ = "read:"

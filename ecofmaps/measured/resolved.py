@@ -92,13 +92,21 @@ and back down the *falling* one.
   over the two reversals of the gap between the median :math:`\xi` of a branch's last four
   slip samples and the next stick level (zero for the model's loop, up to the noise), and
   :math:`|h\,\partial\bar\mu/\partial h|` is added in quadrature: an error the
-  reading cannot remove, whose size it knows.
+  reading cannot remove, whose size it knows. Last, the loop's centring: noise on the
+  displacement and on the force moves each loop's centre, and the drift interpolated
+  between neighbouring centres offsets the falling branch's force against the rising
+  one's by :math:`\varepsilon` over the whole stroke, where the scatter along it cannot
+  see it. Its standard error is :func:`~ecofmaps.analyze_loops`'s ``force_drift_se``
+  (:mod:`ecofmaps.measured.centring`), added through
+  :math:`\partial\bar\mu/\partial\varepsilon = \tfrac14(1 + \bar\mu^2)\,
+  \overline{(1 + q_+^2)^{-1} + (1 + q_-^2)^{-1}}/P`, :math:`1/(2P)` on a flat track.
 
   The standard error is checked on recordings whose truth is known
   (:func:`ecofmaps.measured.synthetic.ugly_recording`: noise, offsets and drift, chatter,
   stick-slip, backlash, an amplitude sweep, sparse digitised loops, ploughing, all
-  together): ±2 se covers the truth on 99 % of the cycles whose ``mu_resolved`` is
-  reported (``tests/measured/test_calibration.py``; it must stay above 80 %).
+  together), and on loops of an independent return map with noise on both channels:
+  ±2 se covers the truth on 95 % to 99 % of the cycles whose ``mu_resolved`` is reported
+  (``tests/measured/test_calibration.py``; it must stay above 80 %).
 * **Along the stroke**, on a grid of positions common to all cycles (``positions``
   points over the widest resolved range, or the positions given): :math:`Q_\pm(\xi)`,
   :math:`\mu(\xi)`, :math:`g(\xi)` and :math:`h(\xi)`, the trapezoidal integral of
@@ -238,6 +246,7 @@ _NEEDED = (
     "regime",
     "displacement_offset",
     "force_offset",
+    "force_drift_se",
 )
 
 
@@ -307,6 +316,7 @@ def resolve_analyzed_loops(
             loops["quality"].values,
             given,
             options,
+            np.asarray(loops["force_drift_se"].values, dtype=np.float64),
         )
         per_cycle["position_offset"] = (
             loops["displacement_offset"].values - removed / per_cycle["stiffness"]

@@ -24,6 +24,7 @@ def _block(count):
         displacement_centre=np.zeros(count.size),
         force_centre=np.zeros(count.size),
         force_swing=np.ones(count.size),
+        force_drift_se=np.zeros(count.size),
     )
 
 

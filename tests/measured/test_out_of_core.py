@@ -61,7 +61,7 @@ def assert_equal_results(lazy, memory):
         np.testing.assert_array_equal(lazy[name].values, memory[name].values)
     amplitude = np.abs(memory.amplitude.values)
     scale = dict.fromkeys(DISPLACEMENTS, amplitude) | {"stick_residual": amplitude}
-    scale |= dict.fromkeys(FORCES, np.abs(memory.max_force.values))
+    scale |= dict.fromkeys((*FORCES, "force_drift_se"), np.abs(memory.max_force.values))
     scale |= dict.fromkeys(COEFFICIENTS, np.abs(memory.cof_max.values))
     scale |= {"dissipated_energy": 4 * amplitude * np.abs(memory.max_force.values)}
     scale |= {"stiffness": np.abs(memory.stiffness.values)}
