@@ -492,8 +492,14 @@ def _mu_over_test(test, resolved: xr.Dataset, results: xr.Dataset | None) -> Non
             if np.isfinite(values).any():
                 test.plot(number, values, color=color, linewidth=1.0, label=label, **marker)
     missing = resolved["quality"].values != "ok"
+    drawn = [mu - error]
+    if results is not None:
+        drawn += [results[name].values for name in ("ecof", "gicof")]
+    drawn = np.concatenate([values[np.isfinite(values)] for values in drawn])
+    if not drawn.size:  # the marks have no height: no scale of friction to read
+        test.set_yticks([])
     if missing.any():
-        bottom = np.nanmin(mu - error) if np.isfinite(mu - error).any() else 0.0
+        bottom = drawn.min() if drawn.size else 0.0
         reasons = ", ".join(_reasons(resolved["quality"].values[missing]))
         test.plot(number[missing], np.full(missing.sum(), bottom), "x", color="crimson",
                   label=f"no resolved value: {reasons}")  # fmt: skip

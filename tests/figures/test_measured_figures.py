@@ -258,5 +258,7 @@ def test_every_cycle_flagged_is_said_in_the_panels(flagged):
     for panel in (stroke, felt, image, test):
         assert panel.texts, panel.get_title()
     assert "implausible-cof 4" in image.texts[0].get_text()
+    # No value at all: the marks of the cycles without one stand on no scale of friction.
+    assert list(test.get_yticks()) == []
     assert drawn_labels(test) == ["no resolved value: implausible-cof"]
     assert [t.get_text() for t in test.get_legend().get_texts()] == drawn_labels(test)
