@@ -54,6 +54,10 @@ MISSING = (
 #: Suffix of the folder that holds an unfinished run's blocks beside ``--out``.
 PARTIAL_SUFFIX = ".partial"
 
+#: The files a run keeps in its ``.partial`` folder, as patterns: each file's cycles and
+#: finished blocks, and the run's record.
+_KEPT = ("file*.npz", "run.json")
+
 #: Options that change how a run goes, not what it computes (left out of its fingerprint).
 _RUNTIME = ("workers", "scheduler", "resume", "quiet", "out", "plots", "handler", "files")
 
@@ -145,14 +149,14 @@ class _Partial:
     def remove_temporaries(self) -> None:
         """Remove the temporaries of files being written (a worker stopped while it wrote
         a block leaves one): a folder kept to resume from holds only whole files."""
-        for pattern in (".file*.npz.tmp", ".run.json.tmp"):
-            for path in self.folder.glob(pattern):
+        for pattern in _KEPT:
+            for path in self.folder.glob(_temporary_name(pattern)):
                 path.unlink(missing_ok=True)
 
     def remove(self) -> None:
         """Remove the files the run kept, then the folder if nothing else is in it (a file
         someone put there is not removed)."""
-        for pattern in ("file*.npz", "run.json"):
+        for pattern in _KEPT:
             for path in self.folder.glob(pattern):
                 path.unlink(missing_ok=True)
         self.remove_temporaries()
@@ -172,9 +176,15 @@ def _savez(path: Path, values: dict) -> None:
         np.savez(stream, **values)
 
 
+def _temporary_name(name: str) -> str:
+    """The name of the temporary that :func:`_write` writes ``name`` to (or a pattern of
+    names, for a pattern)."""
+    return f".{name}.tmp"
+
+
 def _write(path: Path, write) -> None:
     """``write(temporary)``, then rename the temporary onto ``path`` (whole, or nothing)."""
-    temporary = path.with_name(f".{path.name}.tmp")
+    temporary = path.with_name(_temporary_name(path.name))
     try:
         write(temporary)
         os.replace(temporary, path)
