@@ -54,7 +54,19 @@ two without smoothing): exact for a straight wall cut into a flat surface, secon
 that distance for a curved one. On a rough surface it is the least-squares line through
 the wall's samples from there down to 4 times that tolerance below the line, and it may
 reach the line beyond the first sample within the tolerance by as far as it takes to climb
-the tolerance. These are the *groove's* edges.
+the tolerance; the line is fitted down to at least 2 tolerances below that first sample (a
+shorter stretch of wall near the line gives a slope that the roughness tilts, and an edge
+carried out by micrometres). These are the *groove's* edges.
+
+*Uncertain edges.* Where 3 times the shoulders' noise exceeds 5 % of the depth, a valley of
+the roughness beside the groove deeper than the tolerance can still carry an edge out. The
+edges are then also read with the tolerance 3 times the noise, and when that moves an edge
+by more than :data:`UNCERTAIN_EDGES` of the half-width, a :class:`ScarProfileWarning` says
+the edges are uncertain and gives both half-widths (``alternative_half_width`` keeps the
+other; ``half_width=`` takes it). On a groove 31 µm in half-width and 3 µm deep, on 100
+random surfaces rough by 7 % of the depth (correlated over 2 µm), 92 warn, and none of the
+others is off by more than 10 % of the half-width (31 were off by more than 2 µm, up to
+22 µm, silently, before); at 2 % roughness none warns and each edge is within 1.5 µm.
 
 *Pile-up ridges and the disturbed band.* The band around the groove is disturbed: its
 samples lie farther from the line than 5 times the shoulders' noise and than 2 % of the
@@ -134,6 +146,7 @@ __all__ = [
     "MIN_SCAR_SAMPLES",
     "OUTLIER_NEIGHBOURS",
     "OUTLIER_THRESHOLD",
+    "UNCERTAIN_EDGES",
     "ScarProfile",
     "ScarProfileWarning",
     "outlying_samples",
@@ -153,6 +166,10 @@ OUTLIER_THRESHOLD = 6.0
 #: The edges are ambiguous when an edge of the band between the ridges lies beyond the
 #: groove's by more than this fraction of the groove's half-width. [1]
 AMBIGUOUS_EDGES = 0.1
+#: On a rough surface the groove's edges are uncertain when reading them within 3 times the
+#: shoulders' noise of the line, rather than within 5 % of the depth, moves one by more
+#: than this fraction of the groove's half-width. [1]
+UNCERTAIN_EDGES = 0.05
 
 # Shoulders for the reference line: farther than these many half-widths from the centre
 # (the first that leaves _MIN_SHOULDER samples on each side).
@@ -236,8 +253,9 @@ class ScarProfile(NamedTuple):
     alternative_half_width : jax.Array, shape ()
         The other plausible half-width when the edges were ambiguous (the groove's below
         the unworn surface's line, or the band's between the crests of pile-up ridges,
-        whichever was not returned; see the module docstring), NaN when they were not (or
-        the half-width was given). [m]
+        whichever was not returned) or uncertain on a rough surface (read within 3 times
+        the roughness of the line; see the module docstring), NaN when they were neither
+        (or the half-width was given). [m]
     replaced : jax.Array, shape (N,) or ()
         1 where the sample was an outlier (a spike or dropout, :func:`outlying_samples`)
         and its height was interpolated from its neighbours', else 0; a scalar 0 when no
@@ -380,8 +398,9 @@ class ScarProfileWarning(UserWarning):
     """What reading a measured profile decided that its user must see.
 
     Outliers replaced (``samples``: their indices in the trace, ``details``: what each
-    shows) or ambiguous edges (``alternative``: the other half-width). Callers that know
-    where the samples came from (a file's lines) name them with :meth:`text`.
+    shows) or ambiguous or uncertain edges (``alternative``: the other half-width).
+    Callers that know where the samples came from (a file's lines) name them with
+    :meth:`text`.
 
     Attributes
     ----------
@@ -555,7 +574,7 @@ def _wall_line_edge(x, r, start, inner, step, tolerance, edge, rise):
     """Where the wall's least-squares line reaches 0, and its slope, over the wall's samples
     from ``inner`` inwards down to 4 ``tolerance`` below the line (at least the two of the
     two-point line ``edge``, ``rise``, which are kept if the fit's slope does not climb)."""
-    deep = r < -4.0 * tolerance
+    deep = r < min(-4.0 * tolerance, r[inner] - 2.0 * tolerance)
     if step > 0:
         below = np.flatnonzero(deep[start : inner + 1])
         first = start + int(below[-1]) if below.size else start
@@ -765,16 +784,23 @@ class _Extent(NamedTuple):
     band: tuple
     wide: bool
     ridges: tuple
+    rough_groove: tuple | None
 
 
 def _edges(x, r, deepest, depth, noise, reach):
     """The groove's edges, the band's edges (the groove's where it has none beyond, else the
     crest of its pile-up ridge, else its outermost sample), the ridges' crests (indices or
-    None), the band's outer ends (positions) and the band's
-    threshold (module docstring); ValueError if the groove reaches an end of the trace."""
+    None), the band's outer ends (positions), the band's threshold, and on a rough surface
+    the groove's edges read within 3 times the noise of the line (else None) (module
+    docstring); ValueError if the groove reaches an end of the trace."""
     tolerance = max(_LINE_TOLERANCE * depth, min(_LINE_NOISE * noise, _LINE_SHARE * depth))
     left = _crossing(x, r, deepest, -1, tolerance, reach)
     right = _crossing(x, r, deepest + 1, +1, tolerance, reach)
+    rough = None
+    if _LINE_NOISE * noise > tolerance:  # the roughness dips below the tolerance
+        rough = [_crossing(x, r, deepest + (step > 0), step, _LINE_NOISE * noise, reach)
+                 for step in (-1, +1)]  # fmt: skip
+        rough = None if None in rough else (rough[0][0], rough[1][0])
     if left is None or right is None:
         side = "left" if left is None else "right"
         raise ValueError(
@@ -803,7 +829,7 @@ def _edges(x, r, deepest, depth, noise, reach):
         for i, (foot, crest) in enumerate(found)
     )  # fmt: skip
     outer = (min(float(x[ends[0]]), band[0]), max(float(x[ends[1]]), band[1]))
-    return groove, band, tuple(crest for _, crest in found), outer, threshold
+    return groove, band, tuple(crest for _, crest in found), outer, threshold, rough
 
 
 def _scar_extent(x, zs, half_width, reach=0) -> _Extent:
@@ -826,7 +852,7 @@ def _scar_extent(x, zs, half_width, reach=0) -> _Extent:
                 f"({noise:.3g} m) and {_MIN_RELIEF:.0%} of the trace's relief. Heights "
                 "must increase upwards (the scar is a depression), in metres."
             )
-        groove, band, ridges, outer, threshold = _edges(x, r, deepest, depth, noise, reach)
+        groove, band, ridges, outer, threshold, rough = _edges(x, r, deepest, depth, noise, reach)
         tolerance = AMBIGUOUS_EDGES * 0.5 * (groove[1] - groove[0])
         apart = [abs(b - g) > tolerance for b, g in zip(band, groove, strict=True)]
         wide = all(apart)  # one side apart alone is most often debris beside the groove
@@ -854,7 +880,7 @@ def _scar_extent(x, zs, half_width, reach=0) -> _Extent:
             break
         previous = edges
     band = band if any(apart) else groove
-    return _Extent(line, tilt, centre, width, r, groove, band, wide, ridges)
+    return _Extent(line, tilt, centre, width, r, groove, band, wide, ridges, rough)
 
 
 def _ambiguity(x, extent: _Extent, given: bool):
@@ -891,6 +917,29 @@ def _ambiguity(x, extent: _Extent, given: bool):
     return finding, second[0]
 
 
+def _uncertainty(extent: _Extent, given: bool):
+    """The warning of uncertain groove edges on a rough surface (None if they are certain,
+    the band was returned or a width was given), and the other half-width. [m]"""
+    groove, other = extent.groove, extent.rough_groove
+    if given or extent.wide or other is None:
+        return None, np.nan
+    width = 0.5 * (groove[1] - groove[0])
+    moved = max(abs(a - b) for a, b in zip(groove, other, strict=True))
+    if not moved > UNCERTAIN_EDGES * width:
+        return None, np.nan
+    alternative = 0.5 * (other[1] - other[0])
+    summary = (
+        f"uncertain groove edges on a rough surface: half-width {width * 1e6:.6g} µm (returned; "
+        f"edges at x = {groove[0] * 1e6:.6g} and {groove[1] * 1e6:.6g} µm, where the wall "
+        f"reaches the unworn surface's line) or {alternative * 1e6:.6g} µm (edges at x = "
+        f"{other[0] * 1e6:.6g} and {other[1] * 1e6:.6g} µm, where it comes within "
+        f"{_LINE_NOISE:g} times the roughness of it): an edge moves by {moved * 1e6:.3g} µm, "
+        f"more than {UNCERTAIN_EDGES:.0%} of the half-width"
+    )
+    name = "edges read within the roughness"
+    return ScarProfileWarning(summary, alternative=alternative, alternative_name=name), alternative
+
+
 def _checked(x, z, half_width, smoothing):
     """The trace and parameters as float64, checked (see :func:`scar_profile`)."""
     x = _array("x", x)
@@ -921,7 +970,7 @@ def scar_profile_and_findings(x, z, half_width=None, smoothing=None, level=False
     -------
     profile : ScarProfile
     findings : list of ScarProfileWarning
-        Outliers replaced (with their sample indices), ambiguous edges.
+        Outliers replaced (with their sample indices), ambiguous or uncertain edges.
     """
     x, z, half_width, smoothing = _checked(x, z, half_width, smoothing)
     findings = []
@@ -938,6 +987,8 @@ def scar_profile_and_findings(x, z, half_width=None, smoothing=None, level=False
     extent = _scar_extent(x, zs, half_width, reach)
     line, tilt, centre, width, r = extent[:5]
     finding, alternative = _ambiguity(x, extent, half_width is not None)
+    if finding is None:
+        finding, alternative = _uncertainty(extent, half_width is not None)
     findings += [finding] if finding is not None else []
     sigma = AUTO_SMOOTHING * width if smoothing is None else smoothing
     sigma = 0.0 if sigma == 0.0 else max(sigma, spacing)

@@ -12,6 +12,7 @@ from ecofmaps.model.profiles import (
     ScarProfileWarning,
     outlying_samples,
     scar_profile,
+    scar_profile_and_findings,
 )
 
 UM = 1e-6
@@ -482,3 +483,48 @@ def test_a_stylus_export_of_a_wide_band_with_a_valley_offers_the_band(tmp_path):
     np.testing.assert_allclose(profile.edges, [-120 * UM, 120 * UM], rtol=0, atol=2 * UM)
     assert float(profile.alternative_half_width) < 10 * UM
     assert "the band between its pile-up ridges' crests (returned" in str(caught[-1].message)
+
+
+def rough_groove(roughness, correlation, seed):
+    """The groove of :func:`groove` in a surface rough by ``roughness`` µm (standard
+    deviation), correlated over ``correlation`` µm (Gaussian), from ``seed``."""
+    rng = np.random.default_rng(seed)
+    kernel = np.exp(-0.5 * (np.arange(-20, 21) * 0.5 / correlation) ** 2)
+    rough = np.convolve(rng.normal(size=XI.size), kernel / np.linalg.norm(kernel), "same")
+    return groove() + roughness * UM * rough
+
+
+@pytest.mark.parametrize(
+    ("roughness", "correlation", "fewest_warned"),
+    [(0.05, 0.5, 0), (0.1, 0.5, 30), (0.2, 2.0, 80)],
+)
+def test_edges_on_rough_surfaces_are_right_or_said_to_be_uncertain(
+    roughness, correlation, fewest_warned
+):
+    """The groove of 31 µm half-width, 3 µm deep, on 100 random surfaces rough by 2 % to 7 %
+    of its depth: every half-width returned without a warning is within 10 % (3.1 µm) of the
+    truth, each edge within 4.5 µm. Where reading the edges within 3 times the roughness of
+    the surface's line moves one by more than 5 % of the half-width, a warning gives both
+    half-widths, and ``alternative_half_width`` holds the other. Before, at 7 % roughness,
+    31 surfaces were off by more than 2 µm (up to 22 µm) without a warning; at 2 %, a wall
+    line fitted over too short a stretch put 2 edges more than 5 µm out."""
+    warned = 0
+    for seed in range(100):
+        profile, findings = scar_profile_and_findings(
+            XI, rough_groove(roughness, correlation, seed)
+        )
+        width = float(profile.half_width) / UM
+        edges = float(profile.centre) / UM + np.array([-width, width])
+        if not findings:
+            assert abs(width - 31.0) < 3.1, (seed, width)
+            assert np.all(np.abs(edges - [-31.0, 31.0]) < 4.5), (seed, edges)
+            assert np.isnan(float(profile.alternative_half_width))
+            continue
+        warned += 1
+        (finding,) = findings
+        other = float(profile.alternative_half_width)
+        assert finding.summary.startswith("uncertain groove edges on a rough surface")
+        assert finding.alternative == other
+        assert f"{width:.6g} µm (returned" in finding.summary
+        assert f"or {other / UM:.6g} µm" in finding.summary
+    assert warned >= fewest_warned
