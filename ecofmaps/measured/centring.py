@@ -224,8 +224,13 @@ def _drift_se(middle, count, centre, rows: slice):
         )
     window = np.lib.stride_tricks.sliding_window_view(second, 2 * _NOISE_REACH - 1)
     noise = np.full(stop - first, np.nan)  # NaN for a window without a second difference
-    some = np.isfinite(window).any(axis=1)
-    noise[some] = np.nanmedian(window[some], axis=1) / _SECOND_DIFFERENCE
+    finite = np.isfinite(window)
+    full = finite.all(axis=1)  # all but near the ends of the recording: an odd count
+    noise[full] = np.partition(window[full], _NOISE_REACH - 1, axis=1)[:, _NOISE_REACH - 1]
+    partial = np.flatnonzero(~full & finite.any(axis=1))
+    if partial.size:
+        noise[partial] = np.nanmedian(window[partial], axis=1)
+    noise /= _SECOND_DIFFERENCE
     if size == 2:  # no second difference: the one first difference, noise and drift
         noise = np.full(stop - first, abs(centre[1] - centre[0]) / np.sqrt(2.0))
     # The weights a_j of the centres in the offset, in the cycle's own period: a quarter
