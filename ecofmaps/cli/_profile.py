@@ -141,11 +141,14 @@ def read_profile(args, conflicting=()):
             half_width=args.profile_half_width,
             smoothing=args.smoothing,
         )
+    args.profile_alternative = ""  # what the other half-width is, for profile_rows
     for item in caught:
         if not issubclass(item.category, ScarProfileWarning):
             warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
             continue
         alternative = item.message.alternative
+        if alternative is not None:
+            args.profile_alternative = item.message.alternative_name
         hint = "" if alternative is None else (
             f"; --profile-half-width {alternative * 1e6:.6g}um takes the "
             f"{item.message.alternative_name}"
@@ -171,10 +174,11 @@ def profile_rows(args, profile) -> list:
     alternative = float(profile.alternative_half_width)
     half_width = float(profile.half_width)  # a float64 number, compared outside JAX's x64
     how = "(given)" if args.profile_half_width is not None else "(detected)"
-    # the band around the groove is the wider of the two
-    taken, other = ("band", "groove") if alternative < half_width else ("groove", "band")
+    # the other half-width is the groove's, the band's, or that of the edges read within
+    # the roughness (the warning names it)
+    other = args.profile_alternative
     if not math.isnan(alternative):
-        how = f"({taken})"
+        how = "(" + {"groove": "band", "band": "groove"}.get(other, "detected") + ")"
     rows = [
         ("scar profile", "", f"{args.scar_profile} ({', '.join(reading)})"),
         row("scar_depth", float(profile.depth)),

@@ -338,3 +338,30 @@ def test_model_on_a_profile_in_a_fresh_process_prints_no_warning():
     assert done.returncode == 0, done.stderr
     assert done.stderr == ""
     assert "energy coefficient of friction" in done.stdout
+
+
+def test_uncertain_edges_on_a_rough_surface_are_named_as_such(capsys, tmp_path):
+    """A groove 31 µm in half-width, 3 µm deep, in a surface rough by 7 % of its depth: the
+    warning says the edges are uncertain, and the table calls the half-widths what they are
+    (the detected one, and the one of the edges read within the roughness), not the band's
+    and the groove's of pile-up ridges."""
+    x = np.arange(-400.0, 400.01, 0.5)
+    kernel = np.exp(-0.5 * (np.arange(-20, 21) * 0.5 / 2.0) ** 2)
+    noise = np.random.default_rng(0).normal(size=x.size)
+    rough = np.convolve(noise, kernel / np.linalg.norm(kernel), "same")
+    z = np.where(np.abs(x) < 31, -3 * (1 - (x / 31) ** 2), 0.0) + 0.2 * rough
+    path = write_trace(tmp_path / "rough.csv", x, z)
+    status, out, err = run(capsys, "model", "--scar-profile", path)
+    assert status == 0
+    (line,) = err.strip().splitlines()
+    assert "uncertain groove edges on a rough surface" in line
+    assert "takes the edges read within the roughness" in line
+    with pytest.warns(ScarProfileWarning):
+        profile = ecofmaps.read_scar_profile(path)
+    detected = float(profile.half_width) * 1e6
+    other = float(profile.alternative_half_width) * 1e6
+    assert values(out, "wear scar half-width (detected)") == [f"{detected:.6g}"]
+    assert values(out, "wear scar half-width (or edges read within the roughness)") == [
+        f"{other:.6g}"
+    ]
+    assert "(band)" not in out and "groove)" not in out
