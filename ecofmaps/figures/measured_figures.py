@@ -216,7 +216,7 @@ def cof_evolution(results: xr.Dataset) -> Figure:
         Bottom: how far the ECoF is above the GICoF, :math:`\mu_E/\text{GICoF} - 1` [%].
         The cycle axis spans the test with integer ticks; a panel with nothing to draw
         says why (every cycle flagged, with the count of each reason, or none in gross
-        slip).
+        slip) and has no ticks on its value axis.
 
     Notes
     -----
@@ -241,12 +241,14 @@ def cof_evolution(results: xr.Dataset) -> Figure:
         top.legend(loc="best", fontsize="small")
     else:
         _note(top, "no ECoF or GICoF in any cycle:\n" + _why_none(results))
+        top.set_yticks([])
     excess = (results["ecof"] / results["gicof"] - 1.0).values * 100.0
     if np.isfinite(excess).any():
         bottom.plot(cycle, excess, color="tab:purple", linewidth=1.2, **marker)
+        bottom.axhline(0.0, color="0.5", linewidth=0.8)
     else:
         _note(bottom, "no cycle with both an ECoF and a GICoF")
-    bottom.axhline(0.0, color="0.5", linewidth=0.8)
+        bottom.set_yticks([])
     bottom.set_ylabel("ECoF / GICoF − 1 [%]")
     bottom.set_xlabel("Cycle")
     bottom.grid(alpha=0.3)
@@ -265,6 +267,13 @@ def _note(ax, text: str, height: float = 0.5) -> None:
     (a fraction of the panel's, from the bottom)."""
     ax.text(0.5, height, text, transform=ax.transAxes, ha="center", va="center", color="0.3",
             fontsize="small")  # fmt: skip
+
+
+def _no_ticks(ax) -> None:
+    """No ticks or tick labels on either axis of ``ax``, on which nothing was drawn (the
+    axis labels stay: they say what the panel would show)."""
+    ax.set_xticks([])
+    ax.set_yticks([])
 
 
 def _why_none(results: xr.Dataset) -> str:
@@ -380,9 +389,10 @@ def resolved_loops(resolved: xr.Dataset, results: xr.Dataset | None = None, cycl
         :math:`k\xi^2/2` dotted; (c) :math:`h` over (position, cycle), the groove deepening
         as the test runs; (d) ``mu_resolved`` :math:`\pm 2` standard errors over the cycles
         (with the ECoF and GICoF when ``results`` is given) and the equivalent
-        ``aspect_ratio`` on a right-hand axis; cycles with no resolved value are marked
-        along the bottom with their quality. A single cycle is a band in (c) and an error
-        bar in (d); a panel with nothing to draw says why.
+        ``aspect_ratio`` on a right-hand axis (none where no cycle has one); cycles with
+        no resolved value are marked along the bottom with their quality (halfway up when
+        nothing has a value). A single cycle is a band in (c) and an error bar in (d); a
+        panel with nothing to draw says why and has no ticks on its value axes.
 
     Notes
     -----
@@ -428,6 +438,7 @@ def resolved_loops(resolved: xr.Dataset, results: xr.Dataset | None = None, cycl
     else:
         stroke.text(0.5, 0.5, "no cycle was read along the stroke\n(none has quality 'ok')",
                     transform=stroke.transAxes, ha="center", va="center", color="0.3")  # fmt: skip
+        _no_ticks(stroke)
     felt.set_xlabel(axis_label("position"))
     felt.set_ylabel(r"Felt groove profile $h(\xi)$ [µm]")
     felt.set_title("(b) the scar as the contact feels it", fontsize="medium")
@@ -436,6 +447,7 @@ def resolved_loops(resolved: xr.Dataset, results: xr.Dataset | None = None, cycl
         felt.legend(loc="upper center", fontsize="x-small", ncols=2)
     else:
         _note(felt, "no felt profile: no cycle was read along the stroke")
+        _no_ticks(felt)
     for ax in (stroke, felt, test):
         ax.grid(alpha=0.3)
     _profile_over_test(figure, image, resolved)
@@ -456,16 +468,19 @@ def _profile_over_test(figure: Figure, image, resolved: xr.Dataset) -> None:
     image.set_xlabel(axis_label("position"))
     image.set_ylabel("Cycle")
     image.set_title("(c) felt profile over the test", fontsize="medium")
+    # One row per cycle, labelled by its number, whether or not any has a profile.
+    rows = np.arange(len(labels) + 1) - 0.5
+    ticks = np.unique(np.linspace(0, len(labels) - 1, min(len(labels), 6)).round().astype(int))
+    image.set_yticks(ticks, [str(labels[i]) for i in ticks])
+    image.set_ylim(rows[0], rows[-1])
     if not np.isfinite(profile).any():
         _note(image, "no felt profile:\n" + _why_none(resolved))
+        image.set_xticks([])  # no position was read
         return
     # Cell edges halfway between the positions, and between the rows: one cycle is a band.
     middle = (xi[1:] + xi[:-1]) / 2.0
     edges = np.concatenate([[2.0 * xi[0] - middle[0]], middle, [2.0 * xi[-1] - middle[-1]]])
-    rows = np.arange(len(labels) + 1) - 0.5
     mesh = image.pcolormesh(edges, rows, profile, shading="flat", cmap="cividis")
-    ticks = np.unique(np.linspace(0, len(labels) - 1, min(len(labels), 6)).round().astype(int))
-    image.set_yticks(ticks, [str(labels[i]) for i in ticks])
     figure.colorbar(mesh, ax=image, label=r"$h(\xi)$ [µm]")
 
 
@@ -496,22 +511,25 @@ def _mu_over_test(test, resolved: xr.Dataset, results: xr.Dataset | None) -> Non
     if results is not None:
         drawn += [results[name].values for name in ("ecof", "gicof")]
     drawn = np.concatenate([values[np.isfinite(values)] for values in drawn])
+    if missing.any():
+        reasons = ", ".join(_reasons(resolved["quality"].values[missing]))
+        # Along the lowest value drawn; with none, halfway up the panel: no friction scale.
+        height, where = (
+            (drawn.min(), test.transData) if drawn.size else (0.5, test.get_xaxis_transform())
+        )
+        test.plot(number[missing], np.full(missing.sum(), height), "x", color="crimson",
+                  transform=where, label=f"no resolved value: {reasons}")  # fmt: skip
     if not drawn.size:  # the marks have no height: no scale of friction to read
         test.set_yticks([])
-    if missing.any():
-        bottom = drawn.min() if drawn.size else 0.0
-        reasons = ", ".join(_reasons(resolved["quality"].values[missing]))
-        test.plot(number[missing], np.full(missing.sum(), bottom), "x", color="crimson",
-                  label=f"no resolved value: {reasons}")  # fmt: skip
     if missing.all():  # below the marks, which are at the middle
         _note(test, "no cycle read along the stroke:\n" + _why_none(resolved), height=0.3)
     test.set_xlabel("Cycle")
     test.set_ylabel("Coefficient of friction [1]")
-    ratio = test.twinx()
-    if np.isfinite(resolved["aspect_ratio"].values).any():
+    if np.isfinite(resolved["aspect_ratio"].values).any():  # no right-hand axis without a line
+        ratio = test.twinx()
         ratio.plot(number, resolved["aspect_ratio"], color="0.3", linestyle="--", linewidth=1.0,
                    **marker)  # fmt: skip
-    ratio.set_ylabel(axis_label("aspect_ratio") + " (dashed)")
+        ratio.set_ylabel(axis_label("aspect_ratio") + " (dashed)")
     _cycle_axis(test, number)  # after twinx, which shares the cycle axis's ticker
     test.set_title(r"(d) $\mu$ over the test, and the equivalent groove", fontsize="medium")
     test.legend(loc="best", fontsize="x-small")

@@ -262,3 +262,62 @@ def test_every_cycle_flagged_is_said_in_the_panels(flagged):
     assert list(test.get_yticks()) == []
     assert drawn_labels(test) == ["no resolved value: implausible-cof"]
     assert [t.get_text() for t in test.get_legend().get_texts()] == drawn_labels(test)
+
+
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize("name", ["flagged", "microslip"])
+def test_empty_panels_have_no_ticks_on_their_value_axes(name, request):
+    """An axis on which nothing was drawn has no ticks (no 0 to 1 scale in µm, % or of
+    cycles); the cycle axes keep integer ticks over the test's cycles."""
+    recording = request.getfixturevalue(name)
+    cycles = list(recording.cycle.values)
+    evolution = cof_evolution(recording)
+    rendered(evolution)
+    top, bottom = evolution.axes
+    assert list(top.get_yticks()) == [] and list(bottom.get_yticks()) == []
+    assert bottom.get_lines() == []  # no line of 0 % with no value beside it
+    assert list(integer_ticks(bottom.xaxis)) == cycles
+    figure = resolved_loops(resolve_analyzed_loops(recording), recording)
+    rendered(figure)
+    stroke, felt, image = figure.axes[:3]
+    for panel in (stroke, felt):
+        assert list(panel.get_xticks()) == [] and list(panel.get_yticks()) == []
+        assert "[µm]" in panel.get_xlabel()  # the labels say what the panel would show
+    assert list(image.get_xticks()) == []
+    low, high = image.get_ylim()  # one row per cycle, as when there are profiles
+    assert (low, high) == (-0.5, len(cycles) - 0.5)
+    labels = [int(tick.get_text()) for tick in image.get_yticklabels()]
+    assert labels[0] == cycles[0] and labels[-1] == cycles[-1]
+
+
+@pytest.mark.filterwarnings("error")
+def test_marks_without_any_value_sit_halfway_up_above_the_note(flagged):
+    """Panel (d) with no value: the crosses halfway up the panel whatever its friction
+    limits, the note below them and the legend clear of both."""
+    figure = resolved_loops(resolve_analyzed_loops(flagged), flagged)
+    test = figure.axes[3]
+    test.set_ylim(0.2, 3.0)  # the crosses do not hang on a friction scale
+    renderer = rendered(figure)
+    (marks,) = test.get_lines()
+    heights = marks.get_transform().transform(marks.get_xydata())[:, 1]
+    box = test.get_window_extent(renderer)
+    np.testing.assert_allclose(heights, 0.5 * (box.y0 + box.y1))
+    (note,) = test.texts
+    text = note.get_window_extent(renderer)
+    assert text.y1 < heights.min() - 3  # pixels: below the crosses, readable
+    legend = test.get_legend().get_window_extent(renderer)
+    assert not legend.overlaps(text) and legend.y0 > heights.max() + 3
+
+
+@pytest.mark.filterwarnings("error")
+def test_no_aspect_ratio_axis_without_an_aspect_ratio(flagged, results):
+    """The right-hand axis of (d) claims a dashed aspect ratio only where one is drawn."""
+    resolved = resolve_analyzed_loops(flagged)
+    assert not np.isfinite(resolved.aspect_ratio).any()
+    figure = resolved_loops(resolved, flagged)
+    rendered(figure)
+    assert not [ax for ax in figure.axes if "dashed" in ax.get_ylabel()]
+    normal = resolved_loops(resolve_analyzed_loops(results), results)
+    (ratio,) = [ax for ax in normal.axes if "dashed" in ax.get_ylabel()]
+    (line,) = ratio.get_lines()
+    assert line.get_linestyle() == "--" and np.isfinite(line.get_ydata()).all()
