@@ -832,6 +832,36 @@ def _edges(x, r, deepest, depth, noise, reach):
     return groove, band, tuple(crest for _, crest in found), outer, threshold, rough
 
 
+def _micrometres(length) -> str:
+    """``length`` [m] for people: in µm, to 4 significant digits.
+
+    >>> _micrometres(0.00022683321311402322)
+    '226.8 µm'
+    """
+    return f"{float(length) * 1e6 + 0.0:.4g} µm"  # + 0.0: no "-0 µm"
+
+
+def _too_short_message(x, centre, width, given: bool) -> str:
+    """Why the trace ``x`` [m] leaves too little unworn surface beside a scar at ``centre``
+    [m] of half-width ``width`` [m] (``given`` by the caller, or detected), and the remedies."""
+    span = x[-1] - x[0]
+    scar = "given" if given else "detected"
+    message = (
+        f"x: the trace is too short for levelling: the {scar} scar is centred at "
+        f"x = {_micrometres(centre)} with a half-width of {_micrometres(width)} "
+        f"({2 * width / span:.0%} of the trace, which spans {_micrometres(x[0])} to "
+        f"{_micrometres(x[-1])}), and levelling needs at least {_MIN_SHOULDER} samples of "
+        "unworn surface beyond 1.1 half-widths from the scar centre on each side"
+    )
+    if given:
+        return message + ": give a longer trace or a smaller half_width"
+    return message + (
+        ". If the scar is narrower than that (on a rough surface its edges may have been "
+        "read within the roughness), give its half-width: half_width= (on the command line "
+        "--profile-half-width); else give a longer trace"
+    )
+
+
 def _scar_extent(x, zs, half_width, reach=0) -> _Extent:
     """Reference line, centre, half-width, residual, groove and band edges and ridges of
     the scar in smoothed heights ``zs``."""
@@ -847,10 +877,11 @@ def _scar_extent(x, zs, half_width, reach=0) -> _Extent:
         if not depth > max(_NOISE_FACTOR * noise, _MIN_RELIEF * (r.max() - r.min())):
             raise ValueError(
                 "z: no depression found: the deepest point is "
-                f"{depth:.3g} m below the unworn surface (a straight line fitted to the "
-                f"trace's ends): not more than {_NOISE_FACTOR:g} times its noise "
-                f"({noise:.3g} m) and {_MIN_RELIEF:.0%} of the trace's relief. Heights "
-                "must increase upwards (the scar is a depression), in metres."
+                f"{_micrometres(depth)} below the unworn surface (a straight line fitted to "
+                f"the trace's ends): not more than {_NOISE_FACTOR:g} times its noise "
+                f"({_micrometres(noise)}) and {_MIN_RELIEF:.0%} of the trace's relief "
+                f"({_micrometres(r.max() - r.min())}). Heights must increase upwards (the scar "
+                "is a depression), in metres."
             )
         groove, band, ridges, outer, threshold, rough = _edges(x, r, deepest, depth, noise, reach)
         tolerance = AMBIGUOUS_EDGES * 0.5 * (groove[1] - groove[0])
@@ -865,17 +896,13 @@ def _scar_extent(x, zs, half_width, reach=0) -> _Extent:
         width = 0.5 * (edges[1] - edges[0]) if half_width is None else half_width
         if half_width is not None and (centre - width < x[0] or centre + width > x[-1]):
             raise ValueError(
-                f"half_width = {half_width!r} m does not fit the trace: the scar centre is at "
-                f"x = {centre!r} m and the trace spans [{x[0]!r}, {x[-1]!r}] m"
+                f"half_width = {half_width:g} m does not fit the trace: {_micrometres(width)} "
+                f"either side of the scar centre at x = {_micrometres(centre)} reaches beyond "
+                f"the trace, which spans {_micrometres(x[0])} to {_micrometres(x[-1])}"
             )
         mask = _shoulders(x, centre, width, outer, np.abs(r) <= threshold)
         if mask is None:
-            raise ValueError(
-                "x: the trace is too short for levelling: it needs at least "
-                f"{_MIN_SHOULDER} samples of unworn surface beyond 1.1 half-widths from the "
-                f"scar centre on each side (centre {centre!r} m, half-width {width!r} m, "
-                f"trace [{x[0]!r}, {x[-1]!r}] m)"
-            )
+            raise ValueError(_too_short_message(x, centre, width, given=half_width is not None))
         if edges == previous:
             break
         previous = edges

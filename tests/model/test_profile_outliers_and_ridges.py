@@ -528,3 +528,57 @@ def test_edges_on_rough_surfaces_are_right_or_said_to_be_uncertain(
         assert f"{width:.6g} µm (returned" in finding.summary
         assert f"or {other / UM:.6g} µm" in finding.summary
     assert warned >= fewest_warned
+
+
+# --- the errors of a trace that cannot be read, in numbers for people -----------------------
+
+
+def acceptance_rough_groove():
+    """The groove of :func:`groove` in a surface rough by 5 % of its depth, correlated over
+    10 µm, whose roughness was read as a scar 227 µm in half-width (an acceptance run)."""
+    kernel = np.exp(-0.5 * (np.arange(-80, 81) * 0.5 / 10.0) ** 2)
+    rough = np.convolve(np.random.default_rng(53).normal(size=XI.size),
+                        kernel / np.linalg.norm(kernel), "same")  # fmt: skip
+    return groove() + 0.05 * 3.0 * UM * rough / rough.std()
+
+
+def test_too_wide_a_scar_is_said_in_micrometres_with_the_remedies():
+    """The detected scar leaves too little unworn surface: what was detected, in µm, and
+    what to do (give the half-width, or a longer trace)."""
+    with pytest.raises(ValueError, match="too short for levelling") as error:
+        scar_profile(XI, acceptance_rough_groove())
+    message = str(error.value)
+    assert "np.float64" not in message and "e-0" not in message
+    assert "the detected scar is centred at x = 164.3 µm with a half-width of 226.8 µm" in message
+    assert "(57% of the trace, which spans -400 µm to 400 µm)" in message
+    assert "half_width= (on the command line --profile-half-width)" in message
+    assert message.endswith("else give a longer trace")
+    profile = scar_profile(XI, acceptance_rough_groove(), half_width=31 * UM)  # the remedy
+    assert float(profile.half_width) == 31 * UM
+
+
+def test_a_given_half_width_that_leaves_no_unworn_surface_is_said_in_micrometres():
+    with pytest.raises(ValueError, match="too short for levelling") as error:
+        scar_profile(XI, groove(), half_width=np.float64(395 * UM))
+    message = str(error.value)
+    assert "np.float64" not in message
+    assert "the given scar is centred at x = 0 µm with a half-width of 395 µm" in message
+    assert message.endswith(": give a longer trace or a smaller half_width")
+
+
+def test_a_half_width_beyond_the_trace_is_said_in_micrometres():
+    with pytest.raises(ValueError, match=r"half_width = 0\.00045 m does not fit") as error:
+        scar_profile(XI, groove(), half_width=np.float64(450 * UM))
+    assert str(error.value).endswith(
+        "450 µm either side of the scar centre at x = 0 µm reaches beyond the trace, "
+        "which spans -400 µm to 400 µm"
+    )
+
+
+def test_no_depression_is_said_in_micrometres():
+    flat = 1e-9 * np.random.default_rng(0).normal(size=XI.size)
+    with pytest.raises(ValueError, match="z: no depression found") as error:
+        scar_profile(XI, flat)
+    message = str(error.value)
+    assert "np.float64" not in message and " m " not in message
+    assert message.count(" µm") == 3  # depth, noise and relief
