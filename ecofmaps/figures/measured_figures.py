@@ -116,8 +116,10 @@ def measured_loops(
         )
     for ax in axes.flat[len(chosen) :]:
         ax.set_visible(False)
-    for ax in axes[-1]:
-        ax.set_xlabel(axis_label("displacement"))
+    for column in axes.T:  # the lowest panel drawn in each column, above a hidden one or not
+        lowest = [ax for ax in column if ax.get_visible()][-1]
+        lowest.xaxis.set_tick_params(labelbottom=True)
+        lowest.set_xlabel(axis_label("displacement"))
     for ax in axes[:, 0]:
         ax.set_ylabel(axis_label("force"))
     _shared_legend(axes.flat[0], axes.flat[: len(chosen)])

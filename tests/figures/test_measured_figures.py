@@ -204,6 +204,21 @@ def test_loop_legend_lists_only_what_is_drawn(microslip, results):
     assert "GICoF crossings" in [t.get_text() for t in gross.axes[0].get_legend().get_texts()]
 
 
+@pytest.mark.filterwarnings("error")
+def test_loops_above_a_hidden_panel_keep_their_displacement_scale(flagged):
+    """Four cycles in rows of three: the panels of cycles 2 and 3 have none below them, and
+    show their displacement ticks and label; cycle 1's panel, above cycle 4's, does not."""
+    figure = measured_loops(flagged)
+    rendered(figure)
+    panels = [ax for ax in figure.axes if ax.get_visible()]
+    assert len(panels) == 4
+    for panel, lowest in zip(panels, [False, True, True, True], strict=True):
+        labels = [label.get_text() for label in panel.get_xticklabels() if label.get_visible()]
+        assert bool(labels) == lowest and bool(panel.get_xlabel()) == lowest, panel.get_title()
+        if lowest:
+            assert "[µm]" in panel.get_xlabel()
+
+
 def test_flags_of_a_title_are_shortened_when_long(microslip):
     """More flags than fit beside each other: the first and how many more."""
     many = microslip.copy()
