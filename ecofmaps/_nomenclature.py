@@ -164,6 +164,7 @@ QUANTITIES: dict[str, Quantity] = {
     "crossing_displacement_backward": _length("displacement where Q = SΔ, falling branch"),
     "displacement_offset": _length("displacement offset removed (loop centre)"),
     "force_offset": _force("force offset removed (loop centre)"),
+    "normal_load": _force("normal load over the cycle (mean of the recorded load)", "P", "P"),
     "force_drift_se": _force(
         "standard error of the offset between the loop's branches left by the drift correction"
     ),

@@ -316,9 +316,10 @@ def _analyse(index, path, recording, load, args, runner, partial, many, write, c
             f"--plots draws every loop, which a long recording ({path}) analysed out of core "
             "does not keep: leave out --plots (or --workers, --scheduler, --resume)"
         )
-    force = recording.force
+    force, recorded = recording.force, None
     if isinstance(load, str):  # the load recorded sample by sample (--load COLUMN)
         force, load = force_at_mean_load(force, recording.load)
+        recorded = recording.load
     options = default_options(load, getattr(args, "flip_force", False))
     shown = recording.lazy and not args.quiet and sys.stderr.isatty()
     if shown:
@@ -328,6 +329,7 @@ def _analyse(index, path, recording, load, args, runner, partial, many, write, c
         force,
         load,
         recording.cycle,
+        recorded_load=recorded,
         runner=runner,
         nan_policy=args.nan_policy,
         reading=reading,

@@ -150,7 +150,8 @@ def analyze_loops(
         Normal load :math:`P`; or the load recorded at each sample (a load cell's
         channel), which scales the force to the mean load, so every coefficient of
         friction is read with the load of its samples
-        (:func:`ecofmaps.measured.pipeline.force_at_mean_load`). [N]
+        (:func:`ecofmaps.measured.pipeline.force_at_mean_load`); each cycle's forces,
+        energy and stiffness are then given at its own load, ``normal_load``. [N]
     cycle : array_like, optional
         Cycle number of each sample: each run of equal numbers is one loop (the loops may
         be recorded now and then during a test). Without it the recording is cut at its
@@ -211,7 +212,8 @@ def analyze_loops(
         was missing; ``quality_summary`` is one line on what was flagged and skipped;
         ``motion`` is ``'fretting'``, or ``'reciprocating sliding'`` for a median amplitude
         above 300 µm (analysed the same way). With ``resolve``, also mu_resolved,
-        mu_resolved_se and aspect_ratio.
+        mu_resolved_se and aspect_ratio; with a recorded load, normal_load [N] (its mean
+        over the cycle).
         ``results.to_dataframe()`` gives a table.
 
     Raises
@@ -261,24 +263,27 @@ def analyze_loops(
     >>> print(results.quality.values[0], "|", results.attrs["quality_summary"])
     ok | 1 cycles: 1 ok
     """
-    force, load = _at_mean_load(force, load)
+    force, load, recorded = _at_mean_load(force, load)
     options = check_options(
         load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
     )
     reading = Reading(resolve=bool(resolve), keep_loops=bool(keep_loops))
     results, _ = _run(
-        displacement, force, load, cycle, missing, options, nan_policy, reading, scheduler, workers
-    )
+        displacement, force, load, cycle, missing, options, nan_policy, reading, scheduler, workers,
+        recorded_load=recorded,
+    )  # fmt: skip
     return results
 
 
 def _run(
-    displacement, force, load, cycle, missing, options, nan_policy, reading, scheduler, workers
-):
+    displacement, force, load, cycle, missing, options, nan_policy, reading, scheduler, workers,
+    recorded_load=None,
+):  # fmt: skip
     """The recording checked and through the pipeline (:mod:`ecofmaps.measured.pipeline`):
     in this process as one chunk when it is in memory, else on the runner for
-    ``scheduler`` and ``workers``. Returns the results and the reading along the stroke
-    (or None)."""
+    ``scheduler`` and ``workers``; ``recorded_load`` is the load at each sample when it was
+    recorded (``force`` is then at the mean ``load``). Returns the results and the reading
+    along the stroke (or None)."""
     if nan_policy not in NAN_POLICIES:
         raise ValueError(f"nan_policy must be one of {NAN_POLICIES}; got {nan_policy!r}")
     if scheduler in (None, "threads", "processes"):  # on this machine: checked before any work
@@ -291,7 +296,9 @@ def _run(
         raise ValueError(
             f"too few samples for one cycle: {x.shape[0]} (a cycle needs at least {MIN_SAMPLES})"
         )
-    arrays = dict(missing=mask, nan_policy=nan_policy, reading=reading, **options)
+    arrays = dict(
+        missing=mask, recorded_load=recorded_load, nan_policy=nan_policy, reading=reading, **options
+    )
     if not any(is_lazy(a) for a in (x, q, label, mask)):
         if nan_policy == "raise":
             _raise_at_missing(x, q, label, mask)
@@ -308,12 +315,14 @@ def _run(
 
 
 def _at_mean_load(force, load):
-    """``force`` and ``load`` as the pipeline takes them: a load given sample by sample (a
-    recorded channel) scales the force to the mean load (:func:`force_at_mean_load`)."""
+    """``force`` and ``load`` as the pipeline takes them, and the load at each sample (or
+    None): a load given sample by sample (a recorded channel) scales the force to the mean
+    load (:func:`force_at_mean_load`)."""
     if np.ndim(load) == 0 and not is_lazy(load):
-        return force, load
+        return force, load, None
     force = _series("force", force)
-    return force_at_mean_load(force, _series("load", load, force.shape[0]))
+    recorded = _series("load", load, force.shape[0])
+    return *force_at_mean_load(force, recorded), recorded
 
 
 def _raise_at_missing(x, q, label, mask) -> None:
@@ -371,8 +380,10 @@ def resolve_loops(
         slow drift are removed (:func:`ecofmaps.analyze_loops`). [m]
     force : array_like
         Tangential force :math:`Q` at each sample. [N]
-    load : float
-        Normal load :math:`P`. [N]
+    load : float or array_like
+        Normal load :math:`P`, or the load recorded at each sample (as for
+        :func:`analyze_loops`: the forces read along the stroke and the stiffness are then
+        at each cycle's own load). [N]
     stiffness : float, optional
         Rig stiffness :math:`S` (``numpy.inf`` for a rigid rig); by default measured on
         each loop. [N/m]
@@ -457,8 +468,12 @@ def resolve_loops(
         ),
         hand_back=True,
     )
+    force, load, recorded = _at_mean_load(force, load)
     options = check_options(
         load, hysteresis, stick_window, DEFAULTS["crossing_window"], gross_slip_threshold, False
     )
-    _, resolved = _run(displacement, force, load, cycle, None, options, "skip", reading, None, None)
+    _, resolved = _run(
+        displacement, force, load, cycle, None, options, "skip", reading, None, None,
+        recorded_load=recorded,
+    )  # fmt: skip
     return resolved

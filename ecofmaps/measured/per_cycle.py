@@ -157,6 +157,7 @@ def measure_cycles(
     flip_force=False,
     rows=None,
     keep_loops=False,
+    recorded_load=None,
 ):
     """The per-cycle quantities of :func:`analyze_loops` for cycles already found.
 
@@ -175,12 +176,16 @@ def measure_cycles(
         Consecutive cycles to measure; default all.
     keep_loops : bool
         Also return the centred loops as NaN-padded (cycle, point) arrays.
+    recorded_load : numpy.ndarray, optional
+        The normal load at each sample, when it was recorded (indexed as ``force``): its
+        mean over each cycle is ``normal_load``. [N]
 
     Returns
     -------
     values : dict of str to numpy.ndarray
         Each quantity of :func:`analyze_loops` over the cycles, offsets and stick residual
-        included, as measured: not yet NaN where a check fails.
+        included, as measured: not yet NaN where a check fails; and ``normal_load`` with a
+        ``recorded_load``.
     flags : dict of str to numpy.ndarray of bool
         The checks of :data:`ecofmaps.measured.quality.REASONS` each cycle failed.
     loops : tuple of numpy.ndarray or None
@@ -215,4 +220,23 @@ def measure_cycles(
             if keep_loops:
                 for loop, centred in zip(loops, block.loops(loops[0].shape[1]), strict=True):
                     loop[out] = centred
+    if recorded_load is not None:
+        values["normal_load"] = _cycle_means(recorded_load, cycles, first, stop)
     return values, flags, loops
+
+
+def _cycle_means(series, cycles: Cycles, first: int, stop: int) -> np.ndarray:
+    """The mean of the finite values of ``series`` over the samples of each of the cycles
+    ``first`` to ``stop - 1`` (each a stretch of consecutive samples; NaN if none)."""
+    start, count = cycles.start[first:stop], cycles.count[first:stop]
+    if start.size == 0:
+        return np.empty(0)
+    low = int(start.min())
+    values = np.asarray(series[low : int((start + count).max())], dtype=np.float64)
+    finite = np.isfinite(values)
+    sums, counts = (
+        np.concatenate([[0.0], np.cumsum(a)]) for a in (np.where(finite, values, 0.0), finite)
+    )
+    ends, begins = start + count - low, start - low
+    with np.errstate(invalid="ignore"):  # a cycle without a finite value: NaN
+        return (sums[ends] - sums[begins]) / (counts[ends] - counts[begins])

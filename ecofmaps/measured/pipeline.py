@@ -48,7 +48,7 @@ from ecofmaps.measured.options import missing_sample_error, no_cycle_error
 from ecofmaps.measured.per_cycle import measure_cycles
 from ecofmaps.measured.quality import ALL, REASONS, SEPARATOR, quality_summary
 from ecofmaps.measured.resolved import REPORTED, resolve_analyzed_loops, resolved_attrs
-from ecofmaps.measured.results import Tally, cycle_results, strip, with_loops
+from ecofmaps.measured.results import Tally, at_own_load, cycle_results, strip, with_loops
 
 __all__ = [
     "HALO",
@@ -200,6 +200,7 @@ def measure_chunk(
     then=None,
     keep=False,
     columns=None,
+    recorded_load=None,
 ) -> Chunk:
     """Steps 3 to 5 of the pipeline for one chunk: the cycles ``rows`` of the table
     ``cycles`` measured on the stretch of the recording that begins at sample ``low``.
@@ -230,6 +231,10 @@ def measure_chunk(
         instead, so that they do not travel.
     columns : sequence of str, optional
         The variables of the results handed back (``then`` is given them all).
+    recorded_load : numpy.ndarray, optional
+        The stretch's normal load, when it was recorded sample by sample (``q`` is then the
+        force at the mean load ``load``): forces, energy and stiffness are reported at each
+        cycle's own load (:data:`~ecofmaps.measured.results.AT_OWN_LOAD`). [N]
 
     Returns
     -------
@@ -242,6 +247,7 @@ def measure_chunk(
         load,
         rows=rows,
         keep_loops=reading.resolve or reading.keep_loops,
+        recorded_load=None if recorded_load is None else _Stretch(recorded_load, low),
         **options,
     )
     counted = cycle_results(values, flags, cycles.label[rows], load, options)
@@ -251,9 +257,9 @@ def measure_chunk(
         values = values | {
             f"{READ}{name}": resolved[name].values for name in (*REPORTED, "quality")
         }
-    part = _part(counted, values)
-    if reading.keep_loops:
-        part = with_loops(part, loops)
+    part = _part(counted, values, loops if reading.keep_loops else None)
+    if resolved is not None and "normal_load" in values:
+        resolved = at_own_load(resolved, values["normal_load"] / load)
     tally = Tally()
     tally.add(counted)
     if callable(keep):
@@ -273,16 +279,21 @@ def only(part: xr.Dataset, columns=None) -> xr.Dataset:
     return part[[name for name in columns if name in part.data_vars]]
 
 
-def _part(counted: xr.Dataset, values: dict) -> xr.Dataset:
+def _part(counted: xr.Dataset, values: dict, loops=None) -> xr.Dataset:
     """The results of a chunk: ``counted`` (from
     :func:`~ecofmaps.measured.results.cycle_results`) without its riders, with the reading
-    along the stroke in ``values`` (named with the prefix :data:`READ`) where it was read."""
+    along the stroke in ``values`` (named with the prefix :data:`READ`) where it was read,
+    and the centred ``loops`` if given; with a recorded load, at each cycle's own load."""
     part = strip(counted)
     read = {k[len(READ) :]: v for k, v in values.items() if k.startswith(READ)}
     if read:
         part = part.assign({k: ("cycle", read[k], resolved_attrs(k)) for k in REPORTED})
         part["quality"] = part["quality"].copy(data=read["quality"])
         part = part.assign(_emptied_by_reasons(part, read["quality"]))
+    if loops is not None:
+        part = with_loops(part, loops)
+    if "normal_load" in part:
+        part = at_own_load(part, part["normal_load"].values / float(part["load"]))
     return part
 
 
@@ -315,6 +326,10 @@ class Analysis:
         Cycle numbers. [1]
     missing : array_like of bool, optional
         Samples to treat as missing.
+    recorded_load : numpy.ndarray or dask.array.Array, optional
+        The normal load at each sample, when it was recorded (``force`` is then the force
+        at the mean load ``load``, :func:`force_at_mean_load`): forces, energy and stiffness
+        are reported at each cycle's own load, with it (``normal_load``). [N]
     runner : ecofmaps._parallel.Runner, optional
         Where the passes and the chunks run (entered); by default this process
         (:data:`IN_PROCESS`).
@@ -355,6 +370,7 @@ class Analysis:
         cycle=None,
         *,
         missing=None,
+        recorded_load=None,
         runner=IN_PROCESS,
         nan_policy="skip",
         reading=None,
@@ -364,6 +380,7 @@ class Analysis:
         **options,
     ):
         self.arrays = (displacement, force)
+        self.recorded_load = recorded_load
         self.reading = Reading() if reading is None else reading
         self.load, self.options, self.runner = float(load), options, runner
         self.cycles_from = "displacement reversals" if cycle is None else "cycle numbers"
@@ -406,10 +423,24 @@ class Analysis:
         low = int(table.start[0])
         high = int(table.start[-1] + table.count[-1])
         x, q = (stretch(array, low, high) for array in self.arrays)
+        p = None if self.recorded_load is None else stretch(self.recorded_load, low, high)
         inner = slice(rows.start - first, rows.stop - first)
         if callable(keep):
             keep = functools.partial(keep, index)
-        return (table, low, inner, self.load, self.options, x, q, self.reading, then, keep, columns)
+        return (
+            table,
+            low,
+            inner,
+            self.load,
+            self.options,
+            x,
+            q,
+            self.reading,
+            then,
+            keep,
+            columns,
+            p,
+        )
 
     def measured(self, skip=(), then=None, keep=False, columns=None):
         """Each chunk's :class:`Chunk`, in order, as they come; counted in :attr:`tally`.

@@ -30,7 +30,7 @@ from ecofmaps.measured.quality import (
 )
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP, Regime
 
-__all__ = ["Tally", "cycle_results", "strip", "with_loops"]
+__all__ = ["AT_OWN_LOAD", "Tally", "at_own_load", "cycle_results", "strip", "with_loops"]
 
 
 #: How the quantities are measured on a loop (the netCDF ``comment`` attribute).
@@ -94,6 +94,38 @@ def _refusal_hint(flags: dict) -> str:
     )
 
 
+#: The values that scale with the normal load (forces, energy, the rig's stiffness), of the
+#: per-cycle results, their loops and the reading along the stroke. The analysis reads the
+#: force of a recorded load as at the mean load (``force_at_mean_load`` of
+#: :mod:`ecofmaps.measured.pipeline`), so that each coefficient is read with the load of its
+#: own samples; these values are then reported at each cycle's own load, the mean of its
+#: samples (``normal_load``).
+AT_OWN_LOAD = (
+    "max_force",
+    "dissipated_energy",
+    "stiffness",
+    "force_offset",
+    "force_drift_se",
+    "loop_force",
+    "force_forward",
+    "force_backward",
+)
+
+
+def at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
+    """``dataset`` with its variables of :data:`AT_OWN_LOAD` times ``ratio``, each cycle's
+    load over the mean load (over ``cycle``; attributes kept)."""
+    ratio = np.asarray(ratio, dtype=np.float64)
+    scaled = {}
+    for name in AT_OWN_LOAD:
+        if name in dataset:
+            values = dataset[name].values
+            scaled[name] = dataset[name].copy(
+                data=values * ratio.reshape((-1,) + (1,) * (values.ndim - 1))
+            )
+    return dataset.assign(scaled)
+
+
 def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
     """``results`` with the centred loops of :func:`measure_cycles` (``keep_loops=True``)."""
     results["loop_displacement"] = (("cycle", "point"), loops[0], _attrs("loop_displacement"))
@@ -133,13 +165,16 @@ def cycle_results(values: dict, flags: dict, label, load: float, options: dict) 
     for reason, flag in flags.items():
         refused |= flag & (REASONS[reason][1] == ALL)
     raw_amplitude = values["amplitude"]
-    values = apply_quality(values, flags)
+    recorded = {k: values[k] for k in ("normal_load",) if k in values}  # a refused cycle's too
+    values = apply_quality({k: v for k, v in values.items() if k not in recorded}, flags)
     sliding = values["energy_ratio"] > options["gross_slip_threshold"]
     regime = np.where(refused, INVALID, np.where(sliding, GROSS_SLIP, NO_GROSS_SLIP))
     names = [name for name in values if name != "stick_residual"]
     data = {name: ("cycle", values[name], _attrs(name)) for name in names}
     data["regime"] = ("cycle", regime.astype(np.int32), _attrs("regime") | Regime.flag_attrs())
     data["stick_residual"] = ("cycle", values["stick_residual"], _attrs("stick_residual"))
+    for name, value in recorded.items():
+        data[name] = ("cycle", value, _attrs(name))
     data["quality"] = ("cycle", quality, _attrs("quality"))
     data["_amplitude"] = ("cycle", raw_amplitude)
     data["_implausible-cof"] = ("cycle", flags["implausible-cof"])

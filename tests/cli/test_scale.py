@@ -63,6 +63,28 @@ def test_a_recorded_normal_load_is_used_sample_by_sample(tmp_path, capsys):
     assert np.abs(pd.read_csv(tmp_path / "c.csv").gicof - 0.8).max() > 0.05
 
 
+def test_a_recorded_load_that_steps_gives_each_cycle_at_its_own_load(tmp_path, capsys):
+    """``--load Fz`` stepping 300 -> 450 -> 600 N: a ``normal_load_N`` column, and each
+    cycle's forces and stiffness at its own load (the rig's 35 MN/m, not 52 to 26)."""
+    from tests.measured.test_analysis import load_steps
+
+    displacement, force, load = load_steps()
+    path = tmp_path / "steps.csv"
+    rows = zip(displacement, force, load, strict=True)
+    lines = [
+        "displacement [m],force [N],Fz [N]",
+        *(f"{d:.17g},{q:.17g},{p:.17g}" for d, q, p in rows),
+    ]
+    path.write_text("\n".join(lines) + "\n")
+    status, _, err = run(capsys, path, "--load", "Fz", "--out", tmp_path / "r.csv")
+    assert status == 0, err
+    table = pd.read_csv(tmp_path / "r.csv")
+    middle = table.iloc[[1, 5, 9]]  # each step's second cycle of four
+    assert list(middle.normal_load_N) == [300.0, 450.0, 600.0]
+    assert (abs(middle.stiffness_MN_per_m - 35.0) < 1e-3).all()
+    assert (abs(middle.max_force_N / middle.normal_load_N - middle.cof_max) < 1e-5).all()
+
+
 def test_a_load_column_that_is_not_there_is_named(tmp_path, capsys):
     path = write_csv(tmp_path / "test.csv", *synthetic_recording(**POINT, cycles=4))
     status, _, err = run(capsys, path, "--load", "Fz", "--out", tmp_path / "r.csv")

@@ -468,3 +468,70 @@ def test_bad_recordings():
         analyze_loops(np.ones(50), np.ones(50), LOAD)
     with pytest.raises(ValueError, match="too few samples for one cycle: no complete cycle"):
         analyze_loops(displacement[:250], force[:250], LOAD)  # half a loop
+
+
+# --- a normal load recorded sample by sample ------------------------------------------------
+
+
+def load_steps(levels=(300.0, 450.0, 600.0), cycles=4):
+    """Loops at each load of ``levels`` in turn (``cycles`` each), and the load channel."""
+    point = dict(amplitude=50e-6, stiffness=35e6, mu=0.8, aspect_ratio=0.15)
+    parts = [synthetic_recording(load=level, cycles=cycles, **point) for level in levels]
+    displacement = np.concatenate([d for d, _ in parts])
+    force = np.concatenate([q for _, q in parts])
+    load = np.concatenate(
+        [np.full(d.size, level) for (d, _), level in zip(parts, levels, strict=True)]
+    )
+    return displacement, force, load
+
+
+def test_a_recorded_load_gives_each_cycle_at_its_own_load():
+    """The load stepping 300 -> 450 -> 600 N: the cycle in the middle of each step (its
+    neighbours at the same load) has the forces, energy and stiffness of the same loops
+    analysed at that load as one value to 1e-5 (a reversal may be cut a sample apart), the
+    rig's 35 MN/m to 1e-6, its normal_load, and the load's own coefficients. Before, they
+    were all at the mean load (Q* 363 N at 300 N, and a stiffness of 52 MN/m)."""
+    displacement, force, load = load_steps()
+    results = analyze_loops(displacement, force, load, resolve=True, keep_loops=True)
+    assert float(results["load"]) == pytest.approx(load.mean())
+    names = ("max_force", "dissipated_energy", "stiffness", "gicof", "ecof", "mu_resolved")
+    for step, level in enumerate((300.0, 450.0, 600.0)):
+        middle = 4 * step + 1  # the step's second cycle of four
+        alone = analyze_loops(
+            *load_steps((level,), cycles=4)[:2], level, resolve=True, keep_loops=True
+        )
+        assert float(results.normal_load[middle]) == pytest.approx(level, rel=1e-12)
+        assert float(results.stiffness[middle]) == pytest.approx(35e6, rel=1e-6)
+        for name in names:
+            expected = float(alone[name][1])
+            assert float(results[name][middle]) == pytest.approx(expected, rel=1e-5), name
+        peak = np.nanmax(alone.loop_force[1])
+        assert np.nanmax(results.loop_force[middle]) == pytest.approx(peak, rel=1e-5)
+
+
+def test_resolve_loops_takes_a_recorded_load():
+    """resolve_loops with the stepping load: its stiffness and the forces read along the
+    stroke at each cycle's own load, as for the load given as one value (1e-5)."""
+    displacement, force, load = load_steps()
+    grid = np.arange(-25, 26) * 1e-6  # inside every cycle's resolved range, with 0
+    resolved = ecofmaps.resolve_loops(displacement, force, load, positions=grid)
+    for step, level in enumerate((300.0, 450.0, 600.0)):
+        middle = 4 * step + 1
+        recording = load_steps((level,), cycles=4)[:2]
+        alone = ecofmaps.resolve_loops(*recording, level, positions=grid)
+        assert float(resolved.stiffness[middle]) == pytest.approx(35e6, rel=1e-6)
+        for name in ("force_forward", "force_backward", "mu"):
+            np.testing.assert_allclose(
+                resolved[name][middle], alone[name][1], rtol=1e-5, err_msg=name
+            )
+
+
+def test_a_recorded_load_out_of_core_is_the_same():
+    """The recorded load through dask, a chunk of cycles at a time: the same table."""
+    import dask.array as da
+
+    displacement, force, load = load_steps()
+    memory = analyze_loops(displacement, force, load)
+    lazy = analyze_loops(*(da.from_array(a, chunks=1500) for a in (displacement, force, load)))
+    for name in ("normal_load", "max_force", "stiffness", "dissipated_energy", "ecof"):
+        np.testing.assert_allclose(lazy[name], memory[name], rtol=1e-12, err_msg=name)
