@@ -66,7 +66,9 @@ the edges are uncertain and gives both half-widths (``alternative_half_width`` k
 other; ``half_width=`` takes it). On a groove 31 µm in half-width and 3 µm deep, on 100
 random surfaces rough by 7 % of the depth (correlated over 2 µm), 92 warn, and none of the
 others is off by more than 10 % of the half-width (31 were off by more than 2 µm, up to
-22 µm, silently, before); at 2 % roughness none warns and each edge is within 1.5 µm.
+22 µm, silently, before); at 2 % roughness none warns and each edge is within 1.5 µm. Over
+1500 such surfaces rough by 1 % to 10 % of the depth, correlated over 1 to 10 µm, 2 (7 %
+roughness over 3 µm) were off by 11.5 % and 11.8 % without a warning.
 
 *Pile-up ridges and the disturbed band.* The band around the groove is disturbed: its
 samples lie farther from the line than 5 times the shoulders' noise and than 2 % of the
