@@ -472,7 +472,7 @@ def _profile_over_test(figure: Figure, image, resolved: xr.Dataset) -> None:
     image.set_title("(c) felt profile over the test", fontsize="medium")
     # One row per cycle, labelled by its number, whether or not any has a profile.
     rows = np.arange(len(labels) + 1) - 0.5
-    ticks = np.unique(np.linspace(0, len(labels) - 1, min(len(labels), 6)).round().astype(int))
+    ticks = np.arange(0, len(labels), max(1, -(-len(labels) // 6)))  # evenly, at most 6
     image.set_yticks(ticks, [str(labels[i]) for i in ticks])
     image.set_ylim(rows[0], rows[-1])
     if not np.isfinite(profile).any():
