@@ -13,6 +13,7 @@ traceback.
 from __future__ import annotations
 
 import argparse
+import difflib
 import gc
 import importlib
 import os
@@ -63,7 +64,25 @@ def build_parser() -> argparse.ArgumentParser:
     subparsers = parser.add_subparsers(title="commands", metavar="COMMAND", required=True)
     for name in _SUBCOMMANDS:
         importlib.import_module(f"ecofmaps.cli.{name}").add(subparsers)
+    for command in subparsers.choices.values():  # for an unknown argument's error
+        options = [o for action in command._actions for o in action.option_strings]
+        command.set_defaults(command_prog=command.prog, command_options=options)
     return parser
+
+
+def _unknown_arguments(unknown, args) -> str:
+    """The error line of arguments the subcommand ``args`` was given does not know: named
+    with its ``--help``, and an option like one of its own with a did-you-mean."""
+    guesses = [
+        difflib.get_close_matches(word.split("=")[0], args.command_options, n=1)
+        for word in unknown
+        if word.startswith("--")
+    ]
+    hint = "".join(f"; did you mean {guess[0]}?" for guess in guesses if guess)
+    return (
+        f"ecofmaps: error: unrecognized arguments: {' '.join(unknown)}{hint} "
+        f"(see '{args.command_prog} --help')\n"
+    )
 
 
 #: Exit status of a run stopped by Ctrl-C (128 + SIGINT), as shells report it.
@@ -91,7 +110,10 @@ def main(argv=None) -> int:
     try:  # the subcommands import JAX and xarray: an interrupt may come during the imports
         with interrupts_stop_writes() as interrupted:
             try:
-                args = build_parser().parse_args(argv)
+                parser = build_parser()
+                args, unknown = parser.parse_known_args(argv)
+                if unknown:
+                    parser.exit(2, _unknown_arguments(unknown, args))
             except SystemExit as stop:  # a usage error (printed), --help or --version
                 status = int(stop.code or 0)
                 return status

@@ -110,6 +110,25 @@ def test_errors_name_the_option(tmp_path, monkeypatch, capsys, argv, message):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (["loops", "rec.csv", "--lod", "450N"],
+         "--lod 450N; did you mean --load? (see 'ecofmaps loops --help')"),
+        (["correct", "--stifness", "35MN/m"],
+         "did you mean --stiffness? (see 'ecofmaps correct --help')"),
+        (["figures", "--whatever"], "--whatever (see 'ecofmaps figures --help')"),
+    ],
+)  # fmt: skip
+def test_an_unknown_argument_names_the_subcommands_help(capsys, argv, expected):
+    """An argument the subcommand does not know: one line naming that subcommand's --help
+    (not the top level's), with the option like it."""
+    status, out, err = run(capsys, *argv)
+    assert status == 2 and out == ""
+    assert one_line_error(err) and err.startswith("ecofmaps: error: unrecognized arguments: ")
+    assert expected in err
+
+
 def test_a_grid_too_large_for_memory_is_refused_before_allocating(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(tiles, "available_memory", lambda: 5 * 10**8)  # 0.5 GB free
     status, _, err = run(
