@@ -291,7 +291,8 @@ def run(args) -> int:
             print(_summary(each.path, each.results, each.recording).strip(), file=sys.stderr)
         return status
     long_run.finish()
-    print(f"wrote {args.out}: {sum(each.results.cycle.size for each in done)} cycles")
+    written = sum(each.results.cycle.size for each in done)
+    print(f"wrote {args.out}: {written} cycle{'' if written == 1 else 's'}")
     for each in done:
         print(_summary(each.path, each.results, each.recording))
     if failed:

@@ -261,7 +261,7 @@ def analyze_loops(
     >>> print(f"{float(results.gicof[0]):.6f} {float(results.ecof[0]):.3f}")
     0.800000 0.831
     >>> print(results.quality.values[0], "|", results.attrs["quality_summary"])
-    ok | 1 cycles: 1 ok
+    ok | 1 cycle: 1 ok
     """
     force, load, recorded = _at_mean_load(force, load)
     options = check_options(

@@ -264,7 +264,8 @@ def summary_of_counts(counts) -> str:
         f"{reason} {per_reason[reason]}"
         for reason in sorted(per_reason, key=lambda r: order.index(r) if r in order else 99)
     )
-    summary = f"{sum(int(c) for c in counts.values())} cycles: {int(counts.get('ok', 0))} ok"
+    cycles = sum(int(c) for c in counts.values())
+    summary = f"{cycles} cycle{'' if cycles == 1 else 's'}: {int(counts.get('ok', 0))} ok"
     if skipped:
         summary += f", {skipped} skipped (missing samples)"
     return summary + (f"; {flagged}" if flagged else "")
