@@ -214,22 +214,7 @@ def _drift_se(middle, count, centre, rows: slice):
     side of ``rows`` are needed. [N]"""
     size = centre.size
     first, stop = rows.start, rows.stop
-    # The second differences of the centres, each cycle's window of them, their median.
-    low, high = max(first - _NOISE_REACH + 1, 1), min(stop + _NOISE_REACH - 1, size - 1)
-    second = np.full(stop - first + 2 * _NOISE_REACH - 2, np.nan)
-    if high > low:
-        at = slice(low - first + _NOISE_REACH - 1, high - first + _NOISE_REACH - 1)
-        second[at] = np.abs(
-            centre[low - 1 : high - 1] - 2 * centre[low:high] + centre[low + 1 : high + 1]
-        )
-    window = np.lib.stride_tricks.sliding_window_view(second, 2 * _NOISE_REACH - 1)
-    noise = np.full(stop - first, np.nan)  # NaN for a window without a second difference
-    finite = np.isfinite(window)
-    full = finite.all(axis=1)  # all but near the ends of the recording: an odd count
-    noise[full] = np.partition(window[full], _NOISE_REACH - 1, axis=1)[:, _NOISE_REACH - 1]
-    partial = np.flatnonzero(~full & finite.any(axis=1))
-    if partial.size:
-        noise[partial] = np.nanmedian(window[partial], axis=1)
+    noise = kernels.second_difference_medians(centre, first, stop, _NOISE_REACH)
     noise /= _SECOND_DIFFERENCE
     if size == 2:  # no second difference: the one first difference, noise and drift
         noise = np.full(stop - first, abs(centre[1] - centre[0]) / np.sqrt(2.0))

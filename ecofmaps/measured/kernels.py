@@ -4,7 +4,8 @@ Each kernel loops over the loops of a block, or over their branch rows, and does
 few passes what the methods of :mod:`ecofmaps.measured.branches` and
 :mod:`ecofmaps.measured.centring` describe: the sums of a least-squares line, the growth of a
 stick segment, the curvature test, the search for a crossing, a loop's centre, extremes and
-area, the drift between the centres. One more, :func:`detrended`, serves the search for
+area, the drift between the centres, the noise of the centres
+(:func:`second_difference_medians`). One more, :func:`detrended`, serves the search for
 cycles (:mod:`ecofmaps.measured.passes`).
 
 Branch rows (:func:`ecofmaps.measured.branches.branch_rows`): the rows of a block are the
@@ -35,6 +36,7 @@ __all__ = [
     "line_crossings",
     "loop_measures",
     "path_means",
+    "second_difference_medians",
     "stick_lines",
     "stretch_ranges",
     "zero_force_crossings",
@@ -562,6 +564,33 @@ def _interpolated_nan(at, points, values, j, slope):
         if math.isnan(value) and values[j] == values[j + 1]:
             value = values[j]
     return value
+
+
+@numba.njit(**_COMPILE)
+def second_difference_medians(values, first, stop, reach):
+    """The median of the finite :math:`|v_{j-1} - 2v_j + v_{j+1}|` over
+    :math:`|j - i| < ` ``reach`` (``1 <= j <= values.size - 2``), for each ``i`` from
+    ``first`` to ``stop - 1``; NaN where there is none (in the unit of ``values``)."""
+    result = np.empty(stop - first)
+    window = np.empty(2 * reach - 1)
+    for i in range(first, stop):
+        n = 0
+        for j in range(max(i - reach + 1, 1), min(i + reach, values.size - 1)):
+            value = abs(values[j - 1] - 2.0 * values[j] + values[j + 1])
+            if math.isfinite(value):  # sorted in as it comes (a handful of values)
+                k = n
+                while k > 0 and window[k - 1] > value:
+                    window[k] = window[k - 1]
+                    k -= 1
+                window[k] = value
+                n += 1
+        if n == 0:
+            result[i - first] = np.nan
+        elif n % 2:
+            result[i - first] = window[n // 2]
+        else:
+            result[i - first] = 0.5 * (window[n // 2 - 1] + window[n // 2])
+    return result
 
 
 @numba.njit(**_COMPILE)

@@ -370,3 +370,21 @@ def test_detrended_is_numpy_to_the_bit(mean_t):
     expected = (x - mean) - trend
     result = kernels.detrended(x, first, mean, mean_t, slope, middle)
     np.testing.assert_array_equal(result, expected)
+
+
+def test_second_difference_medians_are_numpy_medians():
+    """Each cycle's median of the absolute second differences within ``reach`` of it, NaN
+    ones left out (and NaN where none is left), against np.nanmedian over explicit windows."""
+    rng = np.random.default_rng(4)
+    values = rng.normal(size=40)
+    values[[7, 8, 30]] = np.nan
+    second = np.full(values.size, np.nan)
+    second[1:-1] = np.abs(values[:-2] - 2 * values[1:-1] + values[2:])
+    for reach in (1, 2, 4):
+        expected = []
+        for i in range(3, 37):
+            window = second[max(i - reach + 1, 1) : min(i + reach, values.size - 1)]
+            finite = window[np.isfinite(window)]
+            expected.append(np.median(finite) if finite.size else np.nan)
+        got = kernels.second_difference_medians(values, 3, 37, reach)
+        np.testing.assert_array_equal(got, expected)
