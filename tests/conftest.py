@@ -41,3 +41,30 @@ def _private_cache(tmp_path_factory):
         del os.environ["ECOFMAPS_CACHE"]
     else:
         os.environ["ECOFMAPS_CACHE"] = previous
+
+
+@pytest.fixture
+def on_each_block(monkeypatch):
+    """``on_each_block(hook)``: ``ecofmaps loops`` calls ``hook(received)`` each time a block
+    of a long recording comes back, after its progress bar's update (``received``: the
+    cycles of each block so far, this one last); ``on_each_block(None)`` takes it off."""
+    from ecofmaps.cli import loops_long  # as the tests import ecofmaps: not at collection
+
+    progress = loops_long._bar
+
+    def install(hook):
+        def hooked(*args):
+            bar = progress(*args)
+            update, received = bar.update, []
+
+            def on_block(cycles):
+                update(cycles)
+                received.append(cycles)
+                hook(received)
+
+            bar.update = on_block
+            return bar
+
+        monkeypatch.setattr(loops_long, "_bar", progress if hook is None else hooked)
+
+    return install

@@ -17,7 +17,6 @@ import xarray as xr
 from nptdms import ChannelObject, TdmsWriter
 
 import ecofmaps
-from ecofmaps.cli import loops_long
 from ecofmaps.io.tables import results_csv
 from ecofmaps.measured import pipeline
 from tests.cli.test_loops import POINT, run
@@ -129,32 +128,22 @@ def test_workers_write_the_table_of_the_arrays(
 
 
 def test_a_run_stopped_by_sigterm_and_resumed_writes_the_table_of_the_arrays(
-    files, expected, tmp_path, capsys, small_chunks, monkeypatch
+    files, expected, tmp_path, capsys, small_chunks, on_each_block
 ):
     """SIGTERM after the first chunk has come back: nothing at --out, the chunks done kept;
     ``--resume`` finishes the table, the same as an uninterrupted run."""
     out = tmp_path / "out.csv"
-    progress = loops_long._bar
 
-    def stopping(*args):
-        bar = progress(*args)
-        update, sent = bar.update, []
+    def terminate_after_first(received):
+        if len(received) == 1:
+            os.kill(os.getpid(), signal.SIGTERM)
 
-        def terminate_after_first(cycles):
-            update(cycles)
-            if not sent:
-                sent.append(signal.SIGTERM)
-                os.kill(os.getpid(), signal.SIGTERM)
-
-        bar.update = terminate_after_first
-        return bar
-
-    monkeypatch.setattr(loops_long, "_bar", stopping)
+    on_each_block(terminate_after_first)
     status, _, err = run(capsys, files["tdms"], "--load", "450N", "--out", out, "--workers", "1")
     assert status in (130, 143), err
     assert not out.exists() and "--resume" in err
     assert list((tmp_path / "out.csv.partial").glob("file0-block*.npz"))
-    monkeypatch.setattr(loops_long, "_bar", progress)
+    on_each_block(None)
     status, _, err = run(capsys, files["tdms"], "--load", "450N", "--out", out, "--resume")
     assert status == 0, err
     assert out.read_text() == expected

@@ -62,27 +62,18 @@ def files(folder):
 
 @pytest.mark.parametrize(("sent", "status", "words"), SIGNALS)
 def test_an_error_the_signal_caused_keeps_the_blocks_and_says_so(
-    long_test, tmp_path, capsys, small_tasks, monkeypatch, sent, status, words
+    long_test, tmp_path, capsys, small_tasks, on_each_block, sent, status, words
 ):
     """The signal comes while the third block is measured and stops its worker, whose error
     comes back instead of the block: the two blocks kept are named with the --resume hint
     (the line said that nothing was left before)."""
-    progress = loops_long._bar
 
-    def stopping(*args):
-        bar = progress(*args)
-        received = []
+    def stopping(received):
+        if len(received) == 2:
+            signalled(sent)
+            raise RuntimeError("the worker was stopped by the signal")
 
-        def update(cycles):
-            received.append(cycles)
-            if len(received) == 2:
-                signalled(sent)
-                raise RuntimeError("the worker was stopped by the signal")
-
-        bar.update = update
-        return bar
-
-    monkeypatch.setattr(loops_long, "_bar", stopping)
+    on_each_block(stopping)
     out = tmp_path / "r.csv"
     code, printed, err = run(capsys, long_test, "--load", "450N", "--out", out, "--resume")
     assert code == status and printed == ""

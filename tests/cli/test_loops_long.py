@@ -7,7 +7,6 @@ import re
 import numpy as np
 import pytest
 
-from ecofmaps.cli import loops_long
 from ecofmaps.measured.long_test import write_long_recording
 from ecofmaps.measured.synthetic import synthetic_recording
 from tests.cli.test_loops import POINT, run, write_csv
@@ -100,28 +99,19 @@ def runner_options(request):
 
 
 def test_an_interrupted_run_resumes(
-    long_test, tmp_path, capsys, small_tasks, monkeypatch, runner_options
+    long_test, tmp_path, capsys, small_tasks, on_each_block, runner_options
 ):
     """Ctrl-C after two blocks have come back: nothing at --out, the blocks done kept (two,
     or more that were running) and counted; a rerun must say --resume; with it, the table
     of an uninterrupted run."""
     expected = in_memory_table(capsys, long_test[".zarr"], tmp_path)
     out = tmp_path / "r.csv"
-    progress = loops_long._bar
 
-    def interrupting(*args):
-        bar = progress(*args)
-        received = []
+    def interrupting(received):
+        if len(received) == 2:
+            raise KeyboardInterrupt
 
-        def update(cycles):
-            received.append(cycles)
-            if len(received) == 2:
-                raise KeyboardInterrupt
-
-        bar.update = update
-        return bar
-
-    monkeypatch.setattr(loops_long, "_bar", interrupting)
+    on_each_block(interrupting)
     status, _, err = run(capsys, long_test[".zarr"], "--load", "450N", "--out", out,
                          *runner_options)  # fmt: skip
     assert status == 130
@@ -130,7 +120,7 @@ def test_an_interrupted_run_resumes(
     assert 2 <= len(kept) < 6 and kept[:2] == ["file0-block000000.npz", "file0-block000001.npz"]
     assert f"{len(kept)} of 6 blocks" in err and "--resume" in err
     assert not out.exists()
-    monkeypatch.setattr(loops_long, "_bar", progress)
+    on_each_block(None)
     status, _, err = run(capsys, long_test[".zarr"], "--load", "450N", "--out", out)
     assert status == 2 and "holds an unfinished run: add --resume" in err
     status, _, err = run(capsys, long_test[".zarr"], "--load", "400N", "--out", out, "--resume")
@@ -144,27 +134,18 @@ def test_an_interrupted_run_resumes(
 
 
 def test_the_table_is_written_as_the_blocks_come(long_test, tmp_path, capsys, small_tasks,
-                                                 monkeypatch):  # fmt: skip
+                                                 on_each_block):  # fmt: skip
     """Each block's lines are in the temporary file beside --out (in order, after the header)
     once the block has come back, not held to the end; the file lands whole."""
     expected = in_memory_table(capsys, long_test[".zarr"], tmp_path)
     out = tmp_path / "r.csv"
-    progress = loops_long._bar
     seen = []
 
-    def watching(*args):
-        bar = progress(*args)
-        received = []
+    def watching(received):
+        (temporary,) = tmp_path.glob(".r.csv.*.tmp")
+        seen.append((sum(received), temporary.read_text()))
 
-        def update(cycles):
-            received.append(cycles)
-            (temporary,) = tmp_path.glob(".r.csv.*.tmp")
-            seen.append((sum(received), temporary.read_text()))
-
-        bar.update = update
-        return bar
-
-    monkeypatch.setattr(loops_long, "_bar", watching)
+    on_each_block(watching)
     status, _, err = run(
         capsys, long_test[".zarr"], "--load", "450N", "--out", out, "--resume"
     )  # --resume: read lazily, though short
