@@ -54,9 +54,10 @@ MISSING = (
 #: Suffix of the folder that holds an unfinished run's blocks beside ``--out``.
 PARTIAL_SUFFIX = ".partial"
 
-#: The files a run keeps in its ``.partial`` folder, as patterns: each file's cycles and
-#: finished blocks, and the run's record.
-_KEPT = ("file*.npz", "run.json")
+#: The files of a run's ``.partial`` folder that hold its work (each file's cycles and
+#: finished blocks), and all the files it keeps there (with the run's record), as patterns.
+_WORK = "file*.npz"
+_KEPT = (_WORK, "run.json")
 
 #: Options that change how a run goes, not what it computes (left out of its fingerprint).
 _RUNTIME = ("workers", "scheduler", "resume", "quiet", "out", "plots", "handler", "files")
@@ -144,7 +145,7 @@ class _Partial:
 
     def holds_work(self) -> bool:
         """Whether the folder holds anything a resumed run would use (cycles or blocks)."""
-        return any(self.folder.glob("file*.npz"))
+        return any(self.folder.glob(_WORK))
 
     def remove_temporaries(self) -> None:
         """Remove the temporaries of files being written (a worker stopped while it wrote
@@ -363,16 +364,13 @@ def _analyse(index, path, recording, load, args, runner, partial, many, write, c
                     resolved.append(chunk.resolved)
                 written = _in_order(texts, write, written)
                 bar.update(chunk.part.cycle.size)
-    except Exception as error:  # caused by a stop signal (a worker it stopped): the stop
-        if not INTERRUPTED.is_set():
+    except (Exception, KeyboardInterrupt) as error:
+        stopped = isinstance(error, KeyboardInterrupt)
+        if not (stopped or INTERRUPTED.is_set()):  # not caused by a stop (a worker it stopped)
             raise
         bar.leave = False
         bar.close()
-        raise _Interrupted(len(analysis.tasks)) from error
-    except KeyboardInterrupt:
-        bar.leave = False
-        bar.close()
-        raise _Interrupted(len(analysis.tasks)) from None
+        raise _Interrupted(len(analysis.tasks)) from (None if stopped else error)
     bar.close()
     return analysis, parts, resolved[0] if resolved else None
 
