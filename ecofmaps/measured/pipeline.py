@@ -258,8 +258,9 @@ def measure_chunk(
             f"{READ}{name}": resolved[name].values for name in (*REPORTED, "quality")
         }
     part = _part(counted, values, loops if reading.keep_loops else None)
-    if resolved is not None and "normal_load" in values:
-        resolved = at_own_load(resolved, values["normal_load"] / load)
+    handed = resolved if reading.hand_back else None
+    if handed is not None and "normal_load" in values:  # as the part: at each cycle's load
+        handed = at_own_load(handed, values["normal_load"] / load)
     tally = Tally()
     tally.add(counted)
     if callable(keep):
@@ -267,9 +268,7 @@ def measure_chunk(
     if keep is not True:
         values = flags = None
     made = None if then is None else then(part)
-    return Chunk(
-        only(part, columns), tally, values, flags, made, resolved if reading.hand_back else None
-    )
+    return Chunk(only(part, columns), tally, values, flags, made, handed)
 
 
 def only(part: xr.Dataset, columns=None) -> xr.Dataset:
