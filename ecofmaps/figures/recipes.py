@@ -261,7 +261,10 @@ def scar_shape_model_dataset() -> xr.Dataset:
         (``shape``, ``stiffness_ratio``); ``displacement`` and ``force`` over (``shape``,
         ``point``), Example 2's rig. Computed, not cached.
     """
-    from ecofmaps.model.on_profile import steady_numbers_and_loops  # JAX: as compute_map
+    from ecofmaps.model.on_profile import (  # JAX: as compute_map
+        steady_numbers_and_loops,
+        steady_values,
+    )
 
     ratios = _SHAPES_STIFFNESS_RATIOS
     at_example = int(np.searchsorted(ratios, paper.STIFFNESS / paper.LOAD))
@@ -275,13 +278,9 @@ def scar_shape_model_dataset() -> xr.Dataset:
                 profile, **rig, stiffness=ratios * paper.LOAD
             ).items()
         }
-        # As compute_map on a profile: the numbers of the core in SI units.
-        values["slip_amplitude"].append(paper.AMPLITUDE * numbers["slip_ratio"])
-        values["dissipated_energy"].append(
-            paper.LOAD * paper.AMPLITUDE * numbers["normalized_energy"]
-        )
-        values["ecof"].append(paper.MU * numbers["ecof_ratio"])
-        values["ecof_ratio"].append(numbers["ecof_ratio"])
+        numbers |= steady_values(numbers, paper.AMPLITUDE, paper.LOAD, paper.MU)  # as maps
+        for name in names:
+            values[name].append(numbers[name])
         for name in ("displacement", "force"):
             values[name].append(numbers[name][at_example])
     variables = {

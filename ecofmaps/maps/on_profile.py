@@ -17,7 +17,7 @@ from ecofmaps._inputs import float64
 from ecofmaps.maps.cache import cached_dataset
 from ecofmaps.maps.dataset import checked_axis, checked_load, grid_dataset
 from ecofmaps.maps.tiles import MAX_CHUNK
-from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers
+from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers, steady_values
 
 __all__ = ["MODEL_ON_PROFILE", "compute_profile_map"]
 
@@ -118,12 +118,7 @@ def compute_profile_map(stiffness_ratio, amplitude, mu, load=None, *, profile, m
             for name in names:
                 flat[name][start : start + index[0].size] = np.asarray(numbers[name])
         values = {name: flat[name].reshape(shape) for name in names}
-        amplitude = grid[1][None, :, None]
-        values["slip_amplitude"] = amplitude * values["slip_ratio"]
-        values["ecof"] = grid[2][None, None, :] * values["ecof_ratio"]
-        if load is not None:
-            values["dissipated_energy"] = load * amplitude * values["normalized_energy"]
-            values["max_force"] = load * values["normalized_max_force"]
+        values.update(steady_values(values, grid[1][None, :, None], load, grid[2][None, None, :]))
         del values["normalized_energy"], values["normalized_max_force"]
         stiffness, amplitude = axes["stiffness_ratio"], axes["amplitude"]
         lam = model.compliance_ratio(

@@ -35,6 +35,7 @@ __all__ = [
     "profile_simulation",
     "steady_numbers",
     "steady_numbers_and_loops",
+    "steady_values",
 ]
 
 #: How a pad position x maps onto the profile: eq. 11, X = x W/x_o; or X = x.
@@ -292,6 +293,33 @@ def _finish(loops, jumps, mu, lam, valid) -> dict:
         "minus": jnp.where(settled, loops.minus, jnp.nan),
         "plus": jnp.where(settled, loops.plus, jnp.nan),
     }
+
+
+def steady_values(numbers, amplitude, load, mu) -> dict:
+    r"""The steady loop's values in SI units from the numbers of :func:`steady_numbers` (in
+    the core's units): ``slip_amplitude`` :math:`\delta^*` [m] and ``ecof`` :math:`\mu_E`
+    [1]; with a ``load``, ``dissipated_energy`` :math:`E_d` [J] and ``max_force``
+    :math:`Q^*` [N]. The arguments broadcast (NumPy or JAX arrays).
+
+    Parameters
+    ----------
+    numbers : dict
+        ``slip_ratio``, ``ecof_ratio``, ``normalized_energy`` and ``normalized_max_force``.
+    amplitude : float or array_like
+        Displacement amplitude :math:`\Delta^*`. [m]
+    load : float or array_like or None
+        Normal load :math:`P`. [N]
+    mu : float or array_like
+        Contact coefficient of friction :math:`\mu`. [1]
+    """
+    values = {
+        "slip_amplitude": amplitude * numbers["slip_ratio"],
+        "ecof": mu * numbers["ecof_ratio"],
+    }
+    if load is not None:
+        values["dissipated_energy"] = load * amplitude * numbers["normalized_energy"]
+        values["max_force"] = load * numbers["normalized_max_force"]
+    return values
 
 
 def steady_numbers(profile, amplitude, load, stiffness, mu, groove_half_width=None,

@@ -22,18 +22,11 @@ from ecofmaps.model.core import (
     regime_code,
     slip_ratio,
 )
-from ecofmaps.model.on_profile import steady_numbers
+from ecofmaps.model.on_profile import steady_numbers, steady_values
 from ecofmaps.model.regimes import INVALID, Regime
 
-_ON_PROFILE = {
-    "slip_amplitude": lambda numbers, amplitude, load: amplitude * numbers["slip_ratio"],
-    "dissipated_energy": lambda numbers, amplitude, load: (
-        load * amplitude * numbers["normalized_energy"]
-    ),
-    "energy_cof": lambda numbers, amplitude, load: numbers["mu"] * numbers["ecof_ratio"],
-    "max_force": lambda numbers, amplitude, load: load * numbers["normalized_max_force"],
-    "regime": lambda numbers, amplitude, load: numbers["regime"],
-}
+#: The quantities' names among :func:`ecofmaps.model.on_profile.steady_values`, where other.
+_ON_PROFILE = {"energy_cof": "ecof"}
 
 __all__ = [
     "check_model_inputs",
@@ -136,10 +129,11 @@ def _evaluate_on_profile(quantity, arguments, profile, mapping):
 
 @jax.jit(static_argnames="quantity")
 def _profile_quantity(quantity, numbers, amplitude, load, mu):
-    numbers = {**numbers, "mu": mu}
-    return jnp.broadcast_to(
-        _ON_PROFILE[quantity](numbers, amplitude, load), numbers["regime"].shape
-    )
+    if quantity == "regime":
+        value = numbers["regime"]
+    else:
+        value = steady_values(numbers, amplitude, load, mu)[_ON_PROFILE.get(quantity, quantity)]
+    return jnp.broadcast_to(value, numbers["regime"].shape)
 
 
 def _evaluate(quantity, arguments, profile=None, mapping="scaled"):
