@@ -103,6 +103,11 @@ RANGES = {
     "finite": (lambda a: (a > -math.inf) & (a < math.inf), "-inf < {name} < inf"),
 }
 
+# Units of energy wear: SI, kind, display unit, factor.
+_JOULES = ("J", "energy", "J")
+_PER_JOULE = ("m3 J-1", "wear_rate", "µm³/J", 1e18)
+_PER_NEWTON_METRE = ("m3 N-1 m-1", "archard", "mm³/(N·m)", 1e9)
+
 #: Every quantity by its name in the API.
 QUANTITIES: dict[str, Quantity] = {
     # --- test conditions and the groove -------------------------------------------------
@@ -172,6 +177,28 @@ QUANTITIES: dict[str, Quantity] = {
     "loop_force": _force("tangential force, centred", "Q", "Q"),
     "stick_residual": _length("root mean square displacement off the stick lines"),
     "quality": _number("'ok', or why the values of the cycle are NaN"),
+    # --- a lab's numbers: the sliding condition, the transition, energy wear -------------
+    "opening_ratio": _number("opening ratio", "B = δ*/Δ*", r"B = \delta^*/\Delta^*"),
+    "contact_amplitude": _length("contact displacement amplitude", "Δ* - Q*/S", ""),
+    "contact_energy_ratio": _number("energy ratio on the contact's displacement", "A_c"),
+    "contact_opening_ratio": _number("opening ratio on the contact's displacement", "B_c"),
+    "gross_slip": _number("gross slip (1) or partial slip (0)"),
+    "transition_amplitude": _length("transition displacement amplitude", "Δ_t", r"\Delta_t"),
+    "transition_contact_amplitude": _length("contact's transition amplitude", "δ_t", r"\delta_t"),
+    "transition_mu": _number("coefficient of friction at the transition", "μ_t = Q*/P", r"\mu_t"),
+    "cumulated_energy": Quantity("cumulated dissipated energy", "ΣE_d", r"\Sigma E_d", *_JOULES),
+    "wear_volume": Quantity("wear volume", "V", "V", "m3", "volume", "mm³", 1e9),
+    "energy_wear_coefficient": Quantity(
+        "energy wear coefficient", "α = V/ΣE_d", r"\alpha", *_PER_JOULE
+    ),
+    "archard_slip": Quantity("Archard wear coefficient on the slip", "k", "k", *_PER_NEWTON_METRE),
+    "archard_nominal": Quantity(
+        "Archard wear coefficient on the applied amplitude", "k", "k", *_PER_NEWTON_METRE
+    ),
+    "campaign_energy_wear_coefficient": Quantity(
+        "energy wear coefficient of the campaign", "α", r"\alpha", *_PER_JOULE
+    ),
+    "threshold_energy": Quantity("threshold energy of wear", "E_th", "E_{th}", *_JOULES),
     # --- the loop read along the stroke -------------------------------------------------
     "position": _length("contact position, centred", "ξ = Δ - Q/S", r"\xi = \Delta - Q/S"),
     "slope": _number("groove slope felt by the contact", "g(ξ)", r"g(\xi)"),

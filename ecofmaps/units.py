@@ -23,6 +23,9 @@ DIMENSIONS = {
     "stiffness": ("[force] / [length]", "N/m", "35MN/m"),
     "stiffness_ratio": ("1 / [length]", "1/m", "0.08/um"),
     "energy": ("[energy]", "J", "0.05J"),
+    "volume": ("[length] ** 3", "m**3", "0.01mm**3"),
+    "wear_rate": ("[length] ** 3 / [energy]", "m**3/J", "1e4um**3/J"),
+    "archard": ("[length] / [force]", "m**2/N", "1e-6mm**3/(N*m)"),
     "dimensionless": ("", "1", "0.8"),
 }
 

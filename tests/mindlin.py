@@ -92,8 +92,12 @@ def slip_amplitude_closed(psi, delta_t):
 
 def energy_closed(psi, mu, load, delta_t):
     """Energy dissipated by a steady partial-slip loop of the contact. [J]"""
-    return (24 / 5) * mu * load * delta_t * (
-        1.0 - (1.0 - psi) ** (5 / 3) - (5 * psi / 6) * (1.0 + (1.0 - psi) ** (2 / 3))
+    return (
+        (24 / 5)
+        * mu
+        * load
+        * delta_t
+        * (1.0 - (1.0 - psi) ** (5 / 3) - (5 * psi / 6) * (1.0 + (1.0 - psi) ** (2 / 3)))
     )
 
 

@@ -1,0 +1,478 @@
+"""A fretting lab's daily numbers, read from the results of analysed loops.
+
+From the per-cycle results of :func:`ecofmaps.analyze_loops` (or the tables ``ecofmaps loops``
+writes, :func:`ecofmaps.io.tables.read_results`): the energy and opening ratios on the
+applied and on the contact's displacement and a test's sliding condition
+(:func:`sliding_condition`), the transition to gross slip (:func:`transition`), and energy
+wear with Archard's coefficients (:func:`energy_wear`). The method, its formulas and the
+field's notation are in docs/lab.md.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ecofmaps import _nomenclature as nomenclature
+from ecofmaps._inputs import si_units
+from ecofmaps.model.profiles import ScarProfile
+
+__all__ = [
+    "MINDLIN_ENERGY_RATIO",
+    "MINDLIN_OPENING_RATIO",
+    "energy_wear",
+    "sliding_condition",
+    "transition",
+]
+
+#: Energy ratio A of a sphere on a flat at the transition, on the contact's displacement. [1]
+MINDLIN_ENERGY_RATIO = 0.2
+#: Opening ratio B of a sphere on a flat at the transition, on the contact's displacement. [1]
+MINDLIN_OPENING_RATIO = 2 ** (1 / 3) - 1
+#: Cycles whose amplitudes differ by less than this share are at one amplitude. [1]
+_SAME_AMPLITUDE = 0.01
+_CONDITIONS = ("partial slip", "mixed slip", "gross slip")
+
+
+def _tests(results) -> list:
+    """``results`` as a list of Datasets (one test, or a campaign)."""
+    tests = list(results) if isinstance(results, list | tuple) else [results]
+    for test in tests:
+        if not isinstance(test, xr.Dataset):
+            raise TypeError(
+                "results must be the xarray.Dataset of ecofmaps.analyze_loops (or a list of "
+                f"them), got {type(test).__name__}"
+            )
+    if not tests:
+        raise ValueError("results: an empty list; give at least one test's results")
+    return tests
+
+
+def _cycles(results: xr.Dataset, names) -> dict:
+    """The cycle numbers, the normal load [N] and the variables ``names`` [SI] of a test, as
+    float arrays over its cycles."""
+    if "cycle" not in results.coords and "cycle" not in results:
+        raise ValueError(
+            "results: no cycle numbers (a 'cycle' coordinate or column): give the results of "
+            "ecofmaps.analyze_loops or the table ecofmaps loops writes"
+        )
+    missing = [name for name in names if name not in results]
+    if missing:
+        words = ", ".join(f"'{n}' ({nomenclature.QUANTITIES[n].long_name})" for n in missing)
+        raise ValueError(f"results: no {words}; give the results of ecofmaps.analyze_loops")
+    values = {name: np.asarray(results[name].values, dtype=np.float64) for name in names}
+    values["cycle"] = np.asarray(results["cycle"].values, dtype=np.float64)
+    if "normal_load" in results:
+        values["load"] = np.asarray(results["normal_load"].values, dtype=np.float64)
+    elif "load" in results.coords or "load" in results:
+        values["load"] = np.broadcast_to(float(results["load"]), values["cycle"].shape)
+    elif "cof_max" in results and "max_force" in results:  # a table without the load
+        values["load"] = np.asarray(results.max_force / results.cof_max, dtype=np.float64)
+    else:
+        raise ValueError("results: no normal load ('load', 'normal_load' or 'cof_max')")
+    return values
+
+
+def _ratios(cycles: dict, rig_stiffness) -> dict:
+    """Energy and opening ratios on the applied displacement, and on the contact's when the
+    rig's stiffness is known (else NaN)."""
+    amplitude, force = cycles["amplitude"], cycles["max_force"]
+    contact = amplitude - force / (np.inf if rig_stiffness is None else rig_stiffness)
+    if rig_stiffness is None:
+        contact = np.full_like(amplitude, np.nan)
+    energy, slip = cycles["dissipated_energy"], cycles["slip_amplitude"]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return {
+            "energy_ratio": energy / (4 * amplitude * force),
+            "opening_ratio": slip / amplitude,
+            "contact_amplitude": contact,
+            "contact_energy_ratio": energy / (4 * contact * force),
+            "contact_opening_ratio": slip / contact,
+        }
+
+
+def _gross_slip(ratios: dict, rig_stiffness):
+    """The energy ratio that decides the regime (the contact's when the rig is known), and
+    where it says gross slip."""
+    ratio = ratios["energy_ratio" if rig_stiffness is None else "contact_energy_ratio"]
+    return ratio, ratio > MINDLIN_ENERGY_RATIO
+
+
+_RATIO_VARIABLES = ("amplitude", "max_force", "dissipated_energy", "slip_amplitude")
+
+
+@si_units(rig_stiffness="stiffness")
+def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
+    r"""The energy and opening ratios of each cycle of a test, and its sliding condition.
+
+    Parameters
+    ----------
+    results : xarray.Dataset
+        One test's results from :func:`ecofmaps.analyze_loops`.
+    rig_stiffness : float, optional
+        The rig's own stiffness :math:`S` (not the loops' stick slope, which is the rig and
+        the contact in series). With it the ratios are also read on the contact's
+        displacement :math:`\Delta - Q/S` and the regime is decided there. [N/m]
+
+    Returns
+    -------
+    condition : xarray.Dataset
+        Over ``cycle``: ``energy_ratio`` :math:`A = E_d/(4\Delta^*Q^*)` and
+        ``opening_ratio`` :math:`B = \delta^*/\Delta^*` on the applied displacement;
+        ``contact_amplitude`` :math:`\Delta^* - Q^*/S` [m], ``contact_energy_ratio`` and
+        ``contact_opening_ratio`` on the contact's (NaN without ``rig_stiffness``);
+        ``gross_slip`` (1, 0, or NaN for a cycle without an energy ratio). Attributes
+        ``sliding_condition`` (``'partial slip'``, ``'mixed slip'`` or ``'gross slip'``) and
+        ``changes_at`` (the cycles where the regime changes).
+
+    Notes
+    -----
+    A cycle is in gross slip when its energy ratio exceeds Mindlin's :math:`A_t = 0.2`: on
+    the contact's displacement with ``rig_stiffness`` (exact for a sphere on a flat at any
+    rig), else on the applied one (Fouvry's criterion, which calls a sphere's gross-slip
+    cycles behind a compliant rig partial slip up to :math:`\delta_t + \mu P/S`). A
+    test is mixed when both regimes occur (Zhou & Vincent 1995). See docs/lab.md.
+
+    References
+    ----------
+    S. Fouvry, P. Kapsa, L. Vincent (1995), Analysis of sliding behaviour for fretting
+    loadings: determination of transition criteria, Wear 185, 35-46.
+    L. Vincent, Y. Berthier, M. Godet (1992), Testing methods in fretting fatigue: a critical
+    appraisal, ASTM STP 1159, 33-48.
+    Z.R. Zhou, L. Vincent (1995), Mixed fretting regime, Wear 181-183, 531-536.
+    R.D. Mindlin, H. Deresiewicz (1953), Elastic spheres in contact under varying oblique
+    forces, J. Appl. Mech. 20, 327-344.
+
+    Examples
+    --------
+    >>> import numpy as np, ecofmaps
+    >>> displacement, force = ecofmaps.fretting_loop(50e-6, 450.0, 35e6, 0.8, 0.0)
+    >>> results = ecofmaps.analyze_loops(np.asarray(displacement), np.asarray(force), 450.0)
+    >>> condition = ecofmaps.sliding_condition(results, rig_stiffness=35e6)
+    >>> condition.attrs["sliding_condition"], round(float(condition.contact_energy_ratio[0]), 3)
+    ('gross slip', 1.0)
+    """
+    (results,) = _tests(results)
+    cycles = _cycles(results, _RATIO_VARIABLES)
+    ratios = _ratios(cycles, rig_stiffness)
+    ratio, gross = _gross_slip(ratios, rig_stiffness)
+    known = np.isfinite(ratio)
+    regimes = gross[known]
+    changes = cycles["cycle"][known][1:][regimes[1:] != regimes[:-1]].astype(np.int64)
+    kind = 1 if changes.size else (2 if regimes.all() else 0)
+    data = {name: ("cycle", value, nomenclature.attrs(name)) for name, value in ratios.items()}
+    data["gross_slip"] = ("cycle", np.where(known, gross, np.nan), nomenclature.attrs("gross_slip"))
+    attrs = {"sliding_condition": _CONDITIONS[kind], "changes_at": changes}
+    return xr.Dataset(data, coords={"cycle": results["cycle"].values}, attrs=attrs)
+
+
+def _line(x, y):
+    """Least-squares line ``y = a + b (x - x0)``: (x0, a, b, covariance of a and b), the
+    covariance NaN with fewer than three points."""
+    x0 = float(np.mean(x))
+    design = np.stack([np.ones_like(x), x - x0], axis=-1)
+    (a, b), rss, *_ = np.linalg.lstsq(design, y, rcond=None)
+    dof = x.size - 2
+    scale = float(rss[0]) / dof if dof > 0 and rss.size else np.nan
+    return x0, a, b, scale * np.linalg.inv(design.T @ design)
+
+
+def _root(x0, a, b, cov, level):
+    """Where the line of :func:`_line` reaches ``level``, and its standard error."""
+    u = (level - a) / b
+    variance = (cov[0, 0] + 2 * u * cov[0, 1] + u * u * cov[1, 1]) / (b * b)
+    return x0 + u, float(np.sqrt(variance))
+
+
+@si_units(rig_stiffness="stiffness")
+def transition(results, rig_stiffness=None) -> xr.Dataset:
+    r"""The transition from partial to gross slip, from an amplitude sweep or a campaign.
+
+    Parameters
+    ----------
+    results : xarray.Dataset or list of xarray.Dataset
+        The results of :func:`ecofmaps.analyze_loops` of one test at amplitudes that vary
+        across the transition (the variable-displacement method), or of several tests at
+        one load and several amplitudes.
+    rig_stiffness : float, optional
+        The rig's own stiffness :math:`S`: the energy ratio is then read on the contact's
+        displacement with Mindlin's threshold, and the contact's transition amplitude is
+        given. Without it the applied displacement's ratio is used (biased high for a
+        compliant contact) and ``contact_amplitude`` is NaN. [N/m]
+
+    Returns
+    -------
+    transition : xarray.Dataset
+        ``amplitude`` :math:`\Delta_t` [m], ``contact_amplitude``
+        :math:`\delta_t = \Delta_t - \mu_t P/S` [m] and ``mu``
+        :math:`\mu_t = Q^*/P` at the transition, each with its standard error (``_se``).
+
+    Raises
+    ------
+    ValueError
+        When the cycles never cross the transition (all in partial slip, or all in gross
+        slip), naming the amplitudes they span.
+
+    Notes
+    -----
+    The cycles are sorted by amplitude and split where the fewest fall on the wrong side
+    of :math:`A_t = 0.2`; a straight line fitted to the energy ratio of the cycles at the
+    amplitudes on either side of the split gives :math:`\Delta_t` where it reaches
+    :math:`A_t`; its standard error adds the spacing of those amplitudes over
+    :math:`\sqrt{12}` to the fit's. :math:`\mu_t` is the mean :math:`Q^*/P` of the
+    gross-slip cycles at the first amplitude above the split. See docs/lab.md.
+
+    References
+    ----------
+    S. Fouvry, P. Kapsa, L. Vincent (1995), Analysis of sliding behaviour for fretting
+    loadings: determination of transition criteria, Wear 185, 35-46.
+    L. Vincent, Y. Berthier, M. Godet (1992), Testing methods in fretting fatigue: a critical
+    appraisal, ASTM STP 1159, 33-48.
+    Z.R. Zhou, L. Vincent (1995), Mixed fretting regime, Wear 181-183, 531-536.
+    R.D. Mindlin, H. Deresiewicz (1953), Elastic spheres in contact under varying oblique
+    forces, J. Appl. Mech. 20, 327-344.
+
+    Examples
+    --------
+    Four tests on a sphere (Mindlin: μ = 0.8, δ_t = 6 µm) at 450 N behind a 35 MN/m rig,
+    one cycle each (Δ* [m], Q* [N], E_d [J]); the true Δ_t = δ_t + μP/S is 16.3 µm:
+
+    >>> import xarray as xr, ecofmaps
+    >>> cycles = [(14e-6, 324.7, 0.7016e-3), (15.5e-6, 350.8, 1.194e-3),
+    ...           (17e-6, 360.0, 2.757e-3), (19e-6, 360.0, 5.637e-3)]
+    >>> tests = [xr.Dataset({"amplitude": ("cycle", [a]), "max_force": ("cycle", [q]),
+    ...                      "dissipated_energy": ("cycle", [e])},
+    ...                     coords={"cycle": [1], "load": 450.0}) for a, q, e in cycles]
+    >>> found = ecofmaps.transition(tests, rig_stiffness=35e6)
+    >>> print(f"{float(found.amplitude) * 1e6:.1f} µm, mu_t = {float(found.mu):.2f}")
+    16.0 µm, mu_t = 0.80
+    """
+    names = ("amplitude", "max_force", "dissipated_energy")
+    tests = [_cycles(test, names) for test in _tests(results)]
+    pooled = {name: np.concatenate([t[name] for t in tests]) for name in (*names, "load")}
+    pooled["slip_amplitude"] = np.full_like(pooled["amplitude"], np.nan)  # not needed here
+    ratio, gross = _gross_slip(_ratios(pooled, rig_stiffness), rig_stiffness)
+    known = np.isfinite(ratio) & np.isfinite(pooled["load"])
+    order = np.argsort(pooled["amplitude"][known], kind="stable")
+    amplitude, ratio, gross = (v[known][order] for v in (pooled["amplitude"], ratio, gross))
+    cof = (pooled["max_force"] / pooled["load"])[known][order]
+    load = pooled["load"][known][order]
+    if not gross.size:
+        raise ValueError("results: no cycle with an energy ratio (every cycle refused)")
+    if gross.all() or not gross.any():
+        words = ("gross", "above", "smaller") if gross.any() else ("partial", "at most", "larger")
+        regime, bound, other = words
+        raise ValueError(
+            f"results never cross the transition: every cycle is in {regime} slip (energy "
+            f"ratio {bound} {MINDLIN_ENERGY_RATIO}, amplitudes {amplitude.min() * 1e6:.4g} to "
+            f"{amplitude.max() * 1e6:.4g} µm); test {other} amplitudes"
+        )
+    # the split with the fewest cycles on the wrong side (noise may mix a few)
+    wrong = np.cumsum(gross)[:-1] + np.cumsum((~gross)[::-1])[::-1][1:]
+    split = int(np.argmin(wrong)) + 1
+    level = np.concatenate([[0], np.cumsum(np.diff(amplitude) > _SAME_AMPLITUDE * amplitude[1:])])
+    low, high = level[split - 1], level[split]
+    if low == high:  # the split falls among the cycles at one amplitude: the next ones too
+        low, high = low - 1, high + 1
+    fitted = (level >= low) & (level <= high)
+    at, at_se = _root(*_line(amplitude[fitted], ratio[fitted]), MINDLIN_ENERGY_RATIO)
+    # the ratio's curve between the two amplitudes is not known: the crossing may lie
+    # anywhere between them
+    bracket = (amplitude[level == high].mean() - amplitude[level == low].mean()) / np.sqrt(12)
+    at_se = float(np.hypot(np.nan_to_num(at_se), bracket))
+    first = gross & (level == level[split:][gross[split:]][0])
+    mu = float(np.mean(cof[first]))
+    mu_se = float(np.std(cof[first], ddof=1) / np.sqrt(first.sum())) if first.sum() > 1 else np.nan
+    stiffness = np.nan if rig_stiffness is None else rig_stiffness
+    force = float(np.mean(load[fitted])) / stiffness
+    values = {
+        "amplitude": (at, at_se),
+        "contact_amplitude": (at - mu * force, float(np.hypot(at_se, force * mu_se))),
+        "mu": (mu, mu_se),
+    }
+    data = {}
+    for name, (value, se) in values.items():
+        _with_se(data, name, value, se, quantity=f"transition_{name}")
+    return xr.Dataset(data)
+
+
+def _cycle_sum(cycle, value):
+    """Σ of a per-cycle ``value`` over cycles 1 to the last recorded one, linear between the
+    recorded cycles and held at the first before it, and its standard error from the
+    recorded values' scatter about the straight line through their neighbours."""
+    kept = np.isfinite(value)
+    n, v = cycle[kept], value[kept]
+    if n.size == 0:
+        return np.nan, np.nan
+    if np.any(np.diff(n) <= 0) or n[0] < 1:
+        raise ValueError("results: the cycle numbers must be 1 or more and increasing")
+    gaps = np.diff(n)
+    weight = np.concatenate([gaps, [0.0]]) / 2 + np.concatenate([[0.0], gaps]) / 2
+    weight[[0, -1]] += 0.5  # the end cycles count whole
+    weight[0] += n[0] - 1
+    if n.size < 3:
+        return float(weight @ v), np.nan
+    left, right = gaps[:-1] / (n[2:] - n[:-2]), gaps[1:] / (n[2:] - n[:-2])
+    off = v[1:-1] - (right * v[:-2] + left * v[2:])
+    sigma2 = np.mean(off**2 / (1 + left**2 + right**2))
+    return float(weight @ v), float(np.sqrt(sigma2 * np.sum(weight**2)))
+
+
+def _worn_area_se(profile: ScarProfile) -> float:
+    """Standard error of the worn area [m²]: the shoulders' noise over the scar's samples
+    and through the reference line's offset."""
+    x = np.asarray(profile.position)
+    residual = np.asarray(profile.height) - profile.reference_height - profile.reference_slope * x
+    width = float(profile.half_width)
+    shoulders = residual[np.abs(x) > 2 * width]
+    if shoulders.size < 5:
+        return np.nan
+    noise = 1.4826 * np.median(np.abs(shoulders - np.median(shoulders)))
+    inside = np.abs(x) <= width
+    spacing = float(np.median(np.diff(x)))
+    return float(noise * np.sqrt(inside.sum() * spacing**2 + (2 * width) ** 2 / shoulders.size))
+
+
+def _ratio(top, top_se, bottom, bottom_se):
+    """top/bottom and its standard error (independent relative errors)."""
+    value = top / bottom
+    return value, abs(value) * float(np.hypot(top_se / top, bottom_se / bottom))
+
+
+def _one_test(results, profile, length) -> dict:
+    """Energy wear of one test: each value with its standard error."""
+    if not isinstance(profile, ScarProfile):
+        raise TypeError(
+            "profile must be a ScarProfile (ecofmaps.read_scar_profile or "
+            f"ecofmaps.scar_profile), got {type(profile).__name__}"
+        )
+    area = float(profile.worn_area)
+    if not area > 0.0:
+        raise ValueError(
+            f"profile: no scar (worn area {area:g} m²): the trace shows no groove below the "
+            "unworn surface"
+        )
+    cycles = _cycles(results, ("amplitude", "slip_amplitude", "dissipated_energy"))
+    if not np.isfinite(cycles["dissipated_energy"]).any():
+        raise ValueError("results: no cycle has a dissipated energy ('dissipated_energy')")
+    cycle, load = cycles["cycle"], cycles["load"]
+    energy = _cycle_sum(cycle, cycles["dissipated_energy"])
+    volume = (area * length, _worn_area_se(profile) * length)
+    slip = _cycle_sum(cycle, 4 * load * cycles["slip_amplitude"])
+    nominal = _cycle_sum(cycle, 4 * load * cycles["amplitude"])
+    return {
+        "cumulated_energy": energy,
+        "wear_volume": volume,
+        "energy_wear_coefficient": _ratio(*volume, *energy),
+        "archard_slip": _ratio(*volume, *slip),
+        "archard_nominal": _ratio(*volume, *nominal),
+    }
+
+
+def _campaign(energy, volume):
+    """α and E_th of V = α(ΣE_d - E_th) fitted over the tests, with standard errors."""
+    x0, a, b, cov = _line(energy, volume)
+    threshold, threshold_se = _root(x0, a, b, cov, 0.0)
+    return {"campaign_energy_wear_coefficient": (b, float(np.sqrt(cov[1, 1]))),
+            "threshold_energy": (threshold, threshold_se)}  # fmt: skip
+
+
+def _with_se(data: dict, name: str, value, se, dims=(), quantity=None) -> None:
+    """Put ``name`` and ``name_se`` (its standard error) into ``data`` with their attrs."""
+    attrs = nomenclature.attrs(quantity or name)
+    data[name] = (dims, value, attrs)
+    words = "standard error of the " + attrs["long_name"]
+    data[f"{name}_se"] = (dims, se, {**attrs, "long_name": words})
+
+
+@si_units(length="length")
+def energy_wear(results, profile, length) -> xr.Dataset:
+    r"""Energy wear of a fretting test, or of a campaign: ΣE_d, V, α and Archard's k.
+
+    Parameters
+    ----------
+    results : xarray.Dataset or list of xarray.Dataset
+        Each test's results from :func:`ecofmaps.analyze_loops` over its recorded cycles
+        (a rig may record every N-th cycle: ``cycle`` numbers them as driven).
+    profile : ScarProfile or list of ScarProfile
+        Each test's levelled wear-scar profile across the scar
+        (:func:`ecofmaps.read_scar_profile`): its worn area, the pile-up apart.
+    length : float or list of float
+        Length of the line contact, along which the worn area is the same. [m]
+
+    Returns
+    -------
+    wear : xarray.Dataset
+        ``cumulated_energy`` :math:`\sum E_d` [J], ``wear_volume`` :math:`V` [m³],
+        ``energy_wear_coefficient`` :math:`\alpha = V/\sum E_d` [m³/J], ``archard_slip``
+        :math:`V/\sum 4P\delta^*` and ``archard_nominal`` :math:`V/\sum 4P\Delta^*`
+        [m³/(N·m)], each with its standard error (``_se``); over ``test`` for a campaign,
+        with ``campaign_energy_wear_coefficient`` :math:`\alpha` and
+        ``threshold_energy`` :math:`E_{th}` of :math:`V = \alpha(\sum E_d - E_{th})`.
+
+    Raises
+    ------
+    ValueError
+        For results without cycle numbers, energies or a load, a profile without a scar,
+        a length that is not a line contact's in metres (0 < L < 1 m), or lists of unequal
+        length.
+
+    Notes
+    -----
+    Sums over cycles take each quantity linear between the recorded cycles and at the
+    first recorded value before it; their standard errors come from the recorded values'
+    scatter, the volume's from the profile's noise. A campaign's fit needs three tests
+    for its errors. See docs/lab.md.
+
+    References
+    ----------
+    S. Fouvry, P. Kapsa, L. Vincent (1996), Quantification of fretting damage, Wear 200,
+    186-205.
+    S. Fouvry, T. Liskiewicz, P. Kapsa, S. Hannel, E. Sauger (2003), An energy description
+    of wear mechanisms and its applications to oscillating sliding contacts, Wear 255,
+    287-298.
+    J.F. Archard (1953), Contact and rubbing of flat surfaces, J. Appl. Phys. 24, 981-988.
+
+    Examples
+    --------
+    >>> import numpy as np, xarray as xr, ecofmaps
+    >>> cycles = np.array([1, 500, 1000])  # recorded every 500th cycle
+    >>> results = xr.Dataset(
+    ...     {"amplitude": ("cycle", [50e-6] * 3), "slip_amplitude": ("cycle", [40e-6] * 3),
+    ...      "dissipated_energy": ("cycle", [0.06, 0.06, 0.06])},
+    ...     coords={"cycle": cycles, "load": 450.0})
+    >>> x = np.linspace(-400e-6, 400e-6, 801)
+    >>> z = np.where(np.abs(x) < 100e-6, 3e-6 * ((x / 100e-6) ** 2 - 1), 0.0)
+    >>> profile = ecofmaps.scar_profile(x, z, smoothing=0)
+    >>> wear = ecofmaps.energy_wear(results, profile, length=5e-3)
+    >>> print(f"{float(wear.cumulated_energy):.0f} J, {float(wear.wear_volume) * 1e9:.3f} mm³")
+    60 J, 0.002 mm³
+    >>> print(f"alpha = {float(wear.energy_wear_coefficient) * 1e18:.4g} µm³/J")
+    alpha = 3.333e+04 µm³/J
+    """
+    tests = _tests(results)
+    single = not isinstance(results, list | tuple)
+    profiles = [profile] if single else list(profile)
+    lengths = list(np.broadcast_to(np.asarray(length, dtype=np.float64), (len(tests),)))
+    if len(profiles) != len(tests) or np.ndim(length) > 1 or len(lengths) != len(tests):
+        raise ValueError(
+            f"give one profile and one length per test: {len(tests)} results, "
+            f"{len(profiles)} profiles, {np.size(length)} lengths"
+        )
+    for each in lengths:
+        if not 0.0 < each < 1.0:
+            raise ValueError(
+                f"length = {float(each):g} m: a line contact's length in metres (0 < L < 1 m; "
+                "5 mm is 5e-3, or give a pint Quantity)"
+            )
+    found = [_one_test(*each) for each in zip(tests, profiles, lengths, strict=True)]
+    dims = () if single else ("test",)
+    data = {}
+    for name in found[0]:
+        values = np.array([f[name] for f in found])
+        _with_se(data, name, *(values[0] if single else values.T), dims=dims)
+    if not single:
+        fit = _campaign(data["cumulated_energy"][1], data["wear_volume"][1])
+        for name, (value, se) in fit.items():
+            _with_se(data, name, value, se)
+    return xr.Dataset(data)

@@ -1,0 +1,209 @@
+"""A lab's numbers (ecofmaps.lab) on loops of the Mindlin oracle through analyze_loops: the
+sliding condition, the transition, energy wear; and bad input."""
+
+import warnings
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import ecofmaps
+from tests import mindlin
+
+MU, LOAD, DELTA_T = 0.8, 450.0, 6e-6
+RIGS = (15e6, 35e6, 100e6)
+
+
+def _analysed(amplitudes, stiffness, mu=MU, delta_t=DELTA_T, samples=200):
+    """analyze_loops of the oracle driven through one cycle at each amplitude."""
+    contact = mindlin.Contact(mu, LOAD, delta_t)
+    applied = mindlin.sweep(amplitudes, samples)
+    _, force = mindlin.drive(contact, applied, stiffness)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # a sphere's stick is curved: flagged, as it should
+        return ecofmaps.analyze_loops(applied, force, LOAD)
+
+
+def _campaign(stiffness, factors=(0.5, 0.7, 0.85, 0.95, 1.05, 1.2, 1.5, 1.8)):
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    return [_analysed([f * at] * 3, stiffness) for f in factors]
+
+
+@pytest.mark.parametrize("stiffness", RIGS)
+def test_transition_from_a_campaign(stiffness):
+    found = ecofmaps.transition(_campaign(stiffness), rig_stiffness=stiffness)
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    assert float(found.amplitude) == pytest.approx(at, rel=0.05)
+    assert abs(float(found.amplitude) - at) < 2 * float(found.amplitude_se)
+    assert float(found.mu) == pytest.approx(MU, rel=0.03)
+    contact = float(found.amplitude) - float(found.mu) * LOAD / stiffness
+    assert float(found.contact_amplitude) == pytest.approx(contact)
+    assert found.amplitude.attrs["units"] == "m"
+
+
+def test_transition_on_the_applied_displacement_lands_high():
+    """Without the rig's stiffness, A > 0.2 on the applied displacement calls gross-slip
+    cycles partial slip: the transition lands high and the contact's is unknown."""
+    stiffness = 35e6
+    found = ecofmaps.transition(_campaign(stiffness))
+    assert float(found.amplitude) > 1.1 * mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    assert np.isnan(float(found.contact_amplitude))
+
+
+@pytest.mark.parametrize("stiffness", RIGS)
+def test_transition_from_a_sweep(stiffness):
+    """The variable-displacement method: 0.45 to 1.8 Δ_t, each amplitude held two cycles.
+    analyze_loops reports only the sweep's larger cycles, which still cross Δ_t here."""
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    results = _analysed(np.repeat(np.linspace(0.45, 1.8, 20) * at, 2), stiffness)
+    found = ecofmaps.transition(results, rig_stiffness=stiffness)
+    assert float(found.amplitude) == pytest.approx(at, rel=0.05)
+    assert float(found.mu) == pytest.approx(MU, rel=0.03)
+    condition = ecofmaps.sliding_condition(results, rig_stiffness=stiffness)
+    assert condition.attrs["sliding_condition"] == "mixed slip"
+    assert condition.attrs["changes_at"].size >= 1
+
+
+@pytest.mark.parametrize("factor, condition", [(0.7, "partial slip"), (1.5, "gross slip")])
+def test_sliding_condition_of_a_test(factor, condition):
+    stiffness = 35e6
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    found = ecofmaps.sliding_condition(_analysed([factor * at] * 4, stiffness), stiffness)
+    assert found.attrs["sliding_condition"] == condition
+    assert found.attrs["changes_at"].size == 0
+    assert (found.gross_slip == (factor > 1)).all()
+    if factor > 1:  # a Mindlin gross-slip loop on the contact's displacement
+        energy, slip = mindlin.gross_slip_loop(factor * at, MU, LOAD, DELTA_T, stiffness)
+        contact = factor * at - MU * LOAD / stiffness
+        assert float(found.contact_energy_ratio[1]) == pytest.approx(
+            energy / (4 * contact * MU * LOAD), rel=1e-3
+        )
+        assert float(found.contact_opening_ratio[1]) == pytest.approx(slip / contact, rel=1e-2)
+
+
+def test_a_campaign_that_never_crosses_is_an_error():
+    stiffness = 35e6
+    tests = _campaign(stiffness, factors=(0.5, 0.7, 0.9))
+    with pytest.raises(ValueError, match=r"never cross the transition.*partial slip.*larger"):
+        ecofmaps.transition(tests, rig_stiffness=stiffness)
+
+
+# --- energy wear ---------------------------------------------------------------------------
+
+CYCLES = np.concatenate([[1], np.arange(500, 10001, 500)])  # recorded every 500th cycle
+ALPHA, LENGTH, HALF_WIDTH = 2.5e-14, 5e-3, 150e-6  # m³/J, m, m
+
+
+def _mu(cycle):
+    """Friction rising through the test (the running-in), and the contact's δ_t with it."""
+    return 0.5 + 0.3 * (1.0 - np.exp(-cycle / 3000.0))
+
+
+def _recorded_test(amplitude, stiffness, cycles=CYCLES):
+    """analyze_loops of the recorded cycles of a gross-slip test (one steady loop each,
+    numbered as driven) and the closed-form sums over every cycle driven."""
+    samples = 200
+    pieces, labels = [], []
+    for n in cycles:
+        mu = _mu(n)
+        contact = mindlin.Contact(mu, LOAD, DELTA_T * mu / MU)
+        applied = mindlin.sweep([amplitude], samples)
+        _, force = mindlin.drive(contact, applied, stiffness)
+        span = slice(samples, 2 * samples)
+        pieces.append((applied[span], force[span]))
+        labels.append(np.full(samples, n))
+    applied, force = (np.concatenate(p) for p in zip(*pieces, strict=True))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        results = ecofmaps.analyze_loops(applied, force, LOAD, cycle=np.concatenate(labels))
+    every = np.arange(1, cycles[-1] + 1)
+    mu = _mu(every)
+    energy, slip = mindlin.gross_slip_loop(amplitude, mu, LOAD, DELTA_T * mu / MU, stiffness)
+    sums = {"energy": energy.sum(), "slip": (4 * LOAD * slip).sum(),
+            "nominal": 4 * LOAD * amplitude * every.size}  # fmt: skip
+    return results, sums
+
+
+def _profile(energy, threshold=0.0, noise=0.0, seed=0):
+    x, z, area = mindlin.grown_groove(energy, ALPHA, LENGTH, HALF_WIDTH, threshold, noise, seed)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return ecofmaps.scar_profile(x, z, level=True), area
+
+
+def test_energy_wear_of_a_test_recorded_every_500th_cycle():
+    stiffness = 35e6
+    amplitude = 2.5 * mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    results, sums = _recorded_test(amplitude, stiffness)
+    assert results.cycle.values.tolist() == CYCLES.tolist()
+    profile, area = _profile(sums["energy"], noise=20e-9)
+    wear = ecofmaps.energy_wear(results, profile, length=LENGTH)
+    volume = area * LENGTH
+    assert float(wear.cumulated_energy) == pytest.approx(sums["energy"], rel=0.03)
+    assert float(wear.wear_volume) == pytest.approx(volume, rel=0.03)
+    assert float(wear.energy_wear_coefficient) == pytest.approx(ALPHA, rel=0.05)
+    assert float(wear.archard_slip) == pytest.approx(volume / sums["slip"], rel=0.03)
+    assert float(wear.archard_nominal) == pytest.approx(volume / sums["nominal"], rel=0.03)
+    for name in ("cumulated_energy", "wear_volume", "energy_wear_coefficient", "archard_slip"):
+        assert 0 < float(wear[f"{name}_se"]) < 0.03 * float(wear[name]), name
+    assert wear.energy_wear_coefficient.attrs["units"] == "m3 J-1"
+
+
+def test_the_cycle_sum_is_exact_for_energies_linear_in_the_cycle():
+    energy = 1e-3 * (1 + CYCLES / 1e4)
+    results = xr.Dataset(
+        {"amplitude": ("cycle", np.full(CYCLES.size, 50e-6)),
+         "slip_amplitude": ("cycle", np.full(CYCLES.size, 40e-6)),
+         "dissipated_energy": ("cycle", energy)},
+        coords={"cycle": CYCLES, "load": LOAD},
+    )  # fmt: skip
+    profile, _ = _profile(10.0)
+    wear = ecofmaps.energy_wear(results, profile, length=LENGTH)
+    every = np.arange(1, CYCLES[-1] + 1)
+    assert float(wear.cumulated_energy) == pytest.approx((1e-3 * (1 + every / 1e4)).sum())
+    assert float(wear.cumulated_energy_se) < 1e-9
+
+
+def test_energy_wear_over_a_campaign_finds_alpha_and_the_threshold():
+    """Grooves grown by V = α(ΣE_d - E_th) at four amplitudes, each test recorded every
+    500th cycle; the fit over the campaign gives α and E_th."""
+    stiffness, threshold = 35e6, 5.0
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    tests, profiles = [], []
+    for seed, factor in enumerate((1.5, 2.0, 3.0, 4.0)):
+        results, sums = _recorded_test(factor * at, stiffness, CYCLES[:9])
+        tests.append(results)
+        profiles.append(_profile(sums["energy"], threshold, noise=10e-9, seed=seed)[0])
+    wear = ecofmaps.energy_wear(tests, profiles, length=LENGTH)
+    assert wear.sizes["test"] == 4
+    assert float(wear.campaign_energy_wear_coefficient) == pytest.approx(ALPHA, rel=0.05)
+    assert float(wear.threshold_energy) == pytest.approx(threshold, abs=0.1 * threshold)
+    assert float(wear.threshold_energy_se) > 0
+
+
+# --- bad input -----------------------------------------------------------------------------
+
+
+def _table(**drop):
+    data = {"amplitude": ("cycle", [50e-6, 50e-6]), "slip_amplitude": ("cycle", [4e-5, 4e-5]),
+            "dissipated_energy": ("cycle", [0.06, 0.06])}  # fmt: skip
+    data = {k: v for k, v in data.items() if k not in drop}
+    return xr.Dataset(data, coords={"cycle": [1, 2], "load": LOAD})
+
+
+def test_bad_input_is_named():
+    profile, _ = _profile(10.0)
+    with pytest.raises(ValueError, match="dissipated_energy"):
+        ecofmaps.energy_wear(_table(dissipated_energy=1), profile, length=LENGTH)
+    with pytest.raises(ValueError, match="no cycle numbers"):
+        ecofmaps.energy_wear(_table().drop_vars("cycle"), profile, length=LENGTH)
+    with pytest.raises(ValueError, match="length = 5 m"):
+        ecofmaps.energy_wear(_table(), profile, length=5.0)
+    with pytest.raises(ValueError, match="profile: no scar"):
+        ecofmaps.energy_wear(_table(), profile._replace(worn_area=np.float64(0.0)), length=LENGTH)
+    with pytest.raises(TypeError, match="profile must be a ScarProfile"):
+        ecofmaps.energy_wear(_table(), "scar.csv", length=LENGTH)
+    with pytest.raises(ValueError, match="one profile and one length per test"):
+        ecofmaps.energy_wear([_table(), _table()], [profile], length=LENGTH)
+    with pytest.raises(ValueError, match="no depression found"):  # the profile's own reader
+        ecofmaps.scar_profile(np.linspace(0, 1e-3, 200), np.zeros(200))
