@@ -188,15 +188,13 @@ QUANTITIES: dict[str, Quantity] = {
     "transition_mu": _number("coefficient of friction at the transition", "μ_t = Q*/P", r"\mu_t"),
     "cumulated_energy": Quantity("cumulated dissipated energy", "ΣE_d", r"\Sigma E_d", *_JOULES),
     "wear_volume": Quantity("wear volume", "V", "V", "m3", "volume", "mm³", 1e9),
-    "energy_wear_coefficient": Quantity(
-        "energy wear coefficient", "α = V/ΣE_d", r"\alpha", *_PER_JOULE
-    ),
-    "archard_slip": Quantity("Archard wear coefficient on the slip", "k", "k", *_PER_NEWTON_METRE),
+    "energy_wear_coefficient": Quantity("energy wear coefficient", "α", r"\alpha", *_PER_JOULE),
+    "archard_slip": Quantity("Archard's k on the slip", "k_δ", r"k_\delta", *_PER_NEWTON_METRE),
     "archard_nominal": Quantity(
-        "Archard wear coefficient on the applied amplitude", "k", "k", *_PER_NEWTON_METRE
+        "Archard's k on the amplitude", "k_Δ", r"k_\Delta", *_PER_NEWTON_METRE
     ),
     "campaign_energy_wear_coefficient": Quantity(
-        "energy wear coefficient of the campaign", "α", r"\alpha", *_PER_JOULE
+        "energy wear coefficient, campaign", "α", r"\alpha", *_PER_JOULE
     ),
     "threshold_energy": Quantity("threshold energy of wear", "E_th", "E_{th}", *_JOULES),
     # --- the loop read along the stroke -------------------------------------------------

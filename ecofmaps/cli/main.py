@@ -38,7 +38,17 @@ class CommandError(Exception):
 
 
 #: The subcommands, each a module of :mod:`ecofmaps.cli`, in the order ``--help`` lists them.
-_SUBCOMMANDS = ("model", "figures", "map", "cache", "loops", "convert", "correct", "explore")
+_SUBCOMMANDS = (
+    "model",
+    "figures",
+    "map",
+    "cache",
+    "loops",
+    "convert",
+    "correct",
+    "explore",
+    "wear",
+)
 
 
 class _Parser(argparse.ArgumentParser):

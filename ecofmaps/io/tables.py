@@ -17,7 +17,7 @@ import xarray as xr
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps.model.regimes import Regime
 
-__all__ = ["RESULT_COLUMNS", "csv_text", "results_csv", "results_table"]
+__all__ = ["RESULT_COLUMNS", "csv_text", "read_results", "results_csv", "results_table"]
 
 #: The quantities of :func:`ecofmaps.analyze_loops` in the results table, in order.
 RESULT_QUANTITIES = (
@@ -145,3 +145,48 @@ def csv_text(table: pd.DataFrame, *, header: bool = True) -> str:
             columns.append(texts)
         writer.writerows(zip(*columns, strict=True))
     return stream.getvalue()
+
+
+def read_results(path) -> list[xr.Dataset]:
+    """The per-cycle results in a table that ``ecofmaps loops --out`` wrote, in SI units.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A CSV table (the columns of :data:`RESULT_COLUMNS`, in the tribologist's units), or
+        a netCDF file of :func:`ecofmaps.analyze_loops`' results (``.nc``).
+
+    Returns
+    -------
+    results : list of xarray.Dataset
+        One Dataset over ``cycle`` per recording (a table of several has a ``file``
+        column), with the quantities the table holds under their names in the API; the
+        load is ``normal_load`` when the table has it.
+
+    Raises
+    ------
+    ValueError
+        For a file that is not such a table, naming it.
+    """
+    try:
+        if str(path).endswith(".nc"):
+            with xr.open_dataset(path) as results:
+                return [results.load()]
+        table = pd.read_csv(path, skipinitialspace=True)
+    except (OSError, ValueError, pd.errors.ParserError) as error:
+        raise ValueError(f"{path}: not a results table ({error})") from None
+    columns = dict(zip(RESULT_COLUMNS, RESULT_QUANTITIES, strict=True))
+    known = [c for c in table.columns if c in columns and c not in ("regime", "quality")]
+    if not known:
+        raise ValueError(f"{path}: not a results table (none of the columns of ecofmaps loops)")
+    groups = table.groupby("file", sort=False) if "file" in table else [(None, table)]
+    found = []
+    for name, rows in groups:
+        factor = {c: nomenclature.QUANTITIES[columns[c]].display_factor for c in known}
+        data = {columns[c]: ("row", rows[c].to_numpy() / factor[c]) for c in known if c != "cycle"}
+        results = xr.Dataset(data, attrs={} if name is None else {"file": name})
+        if "cycle" in known:
+            results = results.assign_coords(cycle=("row", rows["cycle"].to_numpy()))
+            results = results.swap_dims(row="cycle")
+        found.append(results)
+    return found

@@ -1,0 +1,84 @@
+"""``ecofmaps wear`` on files: results tables as ``ecofmaps loops --out`` writes them and scar
+profiles as labs have them, against the closed forms of the Mindlin oracle."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from ecofmaps.cli.main import main
+from ecofmaps.io.tables import results_csv
+from tests import mindlin
+from tests.test_lab import ALPHA, CYCLES, DELTA_T, HALF_WIDTH, LENGTH, LOAD, MU, _recorded_test
+
+STIFFNESS, THRESHOLD = 35e6, 5.0
+
+
+@pytest.fixture(scope="module")
+def campaign(tmp_path_factory):
+    """Three tests' tables and profiles (x, z in µm), and their closed forms."""
+    folder = tmp_path_factory.mktemp("wear")
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, STIFFNESS)
+    files, truths = [], []
+    for i, factor in enumerate((1.5, 2.0, 3.0)):
+        results, sums = _recorded_test(factor * at, STIFFNESS, CYCLES[:9])
+        (folder / f"test{i}.csv").write_text(results_csv(results))
+        x, z, area = mindlin.grown_groove(sums["energy"], ALPHA, LENGTH, HALF_WIDTH, THRESHOLD,
+                                          10e-9, seed=i)  # fmt: skip
+        trace = pd.DataFrame({"x_um": x * 1e6, "z_um": z * 1e6})
+        trace.to_csv(folder / f"scar{i}.csv", index=False)
+        files += [folder / f"test{i}.csv", "--profile", folder / f"scar{i}.csv"]
+        truths.append((sums["energy"], area * LENGTH))
+    return folder, files, truths
+
+
+def run(capsys, *arguments):
+    status = main(["wear", *map(str, arguments)])
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def test_wear_of_a_campaign_on_files(campaign, capsys):
+    folder, files, truths = campaign
+    tables = files[::3]
+    profiles = [a for f in files[2::3] for a in ("--profile", f)]
+    out = folder / "wear.csv"
+    status, text, err = run(capsys, *tables, *profiles, "--length", "5mm", "--rig-stiffness",
+                            "35MN/m", "--out", out)  # fmt: skip
+    assert status == 0, err
+    assert "gross slip" in text and "threshold energy" in text and f"wrote {out}" in text
+    table = pd.read_csv(out)
+    energy, volume = np.array(truths).T
+    np.testing.assert_allclose(table.cumulated_energy_J, energy, rtol=0.03)
+    np.testing.assert_allclose(table.wear_volume_mm3 * 1e-9, volume, rtol=0.03)
+    assert (table.sliding_condition == "gross slip").all()
+    again = run(capsys, *tables, *profiles, "--length", "5mm", "--out", out)
+    assert again[0] == 2 and "--overwrite" in again[2]
+
+
+@pytest.mark.parametrize(
+    "arguments, message",
+    [
+        (["--length", "5"], "'5' has no unit"),
+        (["--length", "5mm", "--profile", "{scar}"], "one --profile per test: 1 tests"),
+        (["--length", "5mm", "--out", "{table}"], "would write over the input file"),
+    ],
+)
+def test_bad_input_is_one_line(campaign, capsys, arguments, message):
+    _, files, _ = campaign
+    arguments = [a.format(scar=files[2], table=files[0]) for a in arguments]
+    status, _, err = run(capsys, files[0], "--profile", files[2], *arguments)
+    assert status == 2 and message in err and len(err.splitlines()) == 1
+
+
+def test_a_table_without_energies_or_a_profile_without_a_scar(campaign, capsys, tmp_path):
+    _, files, _ = campaign
+    table = pd.read_csv(files[0]).drop(columns="dissipated_energy_mJ")
+    table.to_csv(tmp_path / "no_energy.csv", index=False)
+    status, _, err = run(
+        capsys, tmp_path / "no_energy.csv", "--profile", files[2], "--length", "5mm"
+    )
+    assert status == 2 and "no_energy.csv: results: no 'dissipated_energy'" in err
+    flat = pd.DataFrame({"x": np.arange(100.0), "z": np.zeros(100)})
+    flat.to_csv(tmp_path / "flat.csv", index=False)
+    status, _, err = run(capsys, files[0], "--profile", tmp_path / "flat.csv", "--length", "5mm")
+    assert status == 2 and "flat.csv" in err and "no depression" in err
