@@ -21,6 +21,7 @@ __all__ = [
     "MINDLIN_ENERGY_RATIO",
     "MINDLIN_OPENING_RATIO",
     "energy_wear",
+    "per_cycle",
     "sliding_condition",
     "transition",
 ]
@@ -48,7 +49,7 @@ def _tests(results) -> list:
     return tests
 
 
-def _cycles(results: xr.Dataset, names) -> dict:
+def per_cycle(results: xr.Dataset, names) -> dict:
     """The cycle numbers, the normal load [N] and the variables ``names`` [SI] of a test, as
     float arrays over its cycles."""
     if "cycle" not in results.coords and "cycle" not in results:
@@ -153,7 +154,7 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
     ('gross slip', 1.0)
     """
     (results,) = _tests(results)
-    cycles = _cycles(results, _RATIO_VARIABLES)
+    cycles = per_cycle(results, _RATIO_VARIABLES)
     ratios = _ratios(cycles, rig_stiffness)
     ratio, gross = _gross_slip(ratios, rig_stiffness)
     known = np.isfinite(ratio)
@@ -248,7 +249,7 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     16.0 µm, mu_t = 0.80
     """
     names = ("amplitude", "max_force", "dissipated_energy")
-    tests = [_cycles(test, names) for test in _tests(results)]
+    tests = [per_cycle(test, names) for test in _tests(results)]
     pooled = {name: np.concatenate([t[name] for t in tests]) for name in (*names, "load")}
     pooled["slip_amplitude"] = np.full_like(pooled["amplitude"], np.nan)  # not needed here
     ratio, gross = _gross_slip(_ratios(pooled, rig_stiffness), rig_stiffness)
@@ -352,7 +353,7 @@ def _one_test(results, profile, length) -> dict:
             f"profile: no scar (worn area {area:g} m²): the trace shows no groove below the "
             "unworn surface"
         )
-    cycles = _cycles(results, ("amplitude", "slip_amplitude", "dissipated_energy"))
+    cycles = per_cycle(results, ("amplitude", "slip_amplitude", "dissipated_energy"))
     if not np.isfinite(cycles["dissipated_energy"]).any():
         raise ValueError("results: no cycle has a dissipated energy ('dissipated_energy')")
     cycle, load = cycles["cycle"], cycles["load"]

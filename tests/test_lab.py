@@ -207,3 +207,19 @@ def test_bad_input_is_named():
         ecofmaps.energy_wear([_table(), _table()], [profile], length=LENGTH)
     with pytest.raises(ValueError, match="no depression found"):  # the profile's own reader
         ecofmaps.scar_profile(np.linspace(0, 1e-3, 200), np.zeros(200))
+
+
+def test_running_condition_map_marks_each_test_and_the_transition():
+    from ecofmaps.figures import running_condition_map
+
+    stiffness = 35e6
+    tests = _campaign(stiffness, factors=(0.6, 0.95, 1.05, 1.5))
+    found = ecofmaps.transition(tests, rig_stiffness=stiffness)
+    figure = running_condition_map(tests, found, stiffness)
+    (ax,) = figure.axes
+    assert ax.get_xlabel().endswith("[µm]") and ax.get_ylabel() == "Normal load $P$ [N]"
+    labels = ax.get_legend_handles_labels()[1]
+    assert labels[:2] == ["partial slip", "gross slip"] and "transition" in labels[2]
+    line = ax.get_lines()[-1]
+    at = np.interp(LOAD, line.get_ydata(), line.get_xdata()) * 1e-6
+    assert at == pytest.approx(float(found.amplitude), rel=1e-6)

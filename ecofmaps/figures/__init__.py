@@ -19,6 +19,7 @@ _PUBLIC = {
         "measured_and_fitted_loops",
         "measured_loops",
         "resolved_loops",
+        "running_condition_map",
     ),
     "ecofmaps.figures.map_figures": ("ecof_ratio_contours", "universal_ecof_ratio_map"),
     "ecofmaps.figures.model_figures": (
