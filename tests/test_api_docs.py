@@ -72,6 +72,9 @@ RECIPES = {
     "cache_entries": None,
     "clear_cache": None,
     "scar_example_path": None,
+    "sliding_condition": None,  # reads a Dataset of results
+    "transition": None,
+    "energy_wear": None,
 }  # fmt: skip
 
 
