@@ -1,7 +1,9 @@
 """A lab's numbers (ecofmaps.lab) on loops of the Mindlin oracle through analyze_loops: the
 sliding condition, the transition, energy wear; and bad input."""
 
+import re
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -223,3 +225,11 @@ def test_running_condition_map_marks_each_test_and_the_transition():
     line = ax.get_lines()[-1]
     at = np.interp(LOAD, line.get_ydata(), line.get_xdata()) * 1e-6
     assert at == pytest.approx(float(found.amplitude), rel=1e-6)
+
+
+def test_the_worked_example_in_the_docs_runs_and_prints_what_they_say(capsys):
+    text = (Path(__file__).parents[1] / "docs" / "lab.md").read_text()
+    (code,) = re.findall(r"```python\n(.*?)```", text, re.S)
+    exec(compile(code, "docs/lab.md", "exec"), {})
+    printed = capsys.readouterr().out
+    assert printed.strip() and printed in re.sub(r"\n    ", "\n", text)
