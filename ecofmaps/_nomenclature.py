@@ -194,7 +194,7 @@ QUANTITIES: dict[str, Quantity] = {
         "Archard's k on the amplitude", "k_Δ", r"k_\Delta", *_PER_NEWTON_METRE
     ),
     "campaign_energy_wear_coefficient": Quantity(
-        "energy wear coefficient, campaign", "α", r"\alpha", *_PER_JOULE
+        "energy wear coefficient (fit)", "α", r"\alpha", *_PER_JOULE
     ),
     "threshold_energy": Quantity("threshold energy of wear", "E_th", "E_{th}", *_JOULES),
     # --- the loop read along the stroke -------------------------------------------------
