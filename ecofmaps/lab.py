@@ -14,7 +14,7 @@ import numpy as np
 import xarray as xr
 
 from ecofmaps import _nomenclature as nomenclature
-from ecofmaps._inputs import si_units
+from ecofmaps._inputs import check, si_units
 from ecofmaps.model.profiles import ScarProfile
 
 __all__ = [
@@ -77,11 +77,11 @@ def per_cycle(results: xr.Dataset, names) -> dict:
 def _ratios(cycles: dict, rig_stiffness) -> dict:
     """Energy and opening ratios on the applied displacement, and on the contact's when the
     rig's stiffness is known (else NaN)."""
-    amplitude, force = cycles["amplitude"], cycles["max_force"]
-    contact = amplitude - force / (np.inf if rig_stiffness is None else rig_stiffness)
-    if rig_stiffness is None:
-        contact = np.full_like(amplitude, np.nan)
-    energy, slip = cycles["dissipated_energy"], cycles["slip_amplitude"]
+    if rig_stiffness is not None:
+        check("rig_stiffness", rig_stiffness, "positive_or_inf", "N/m")
+    amplitude, force, energy = (cycles[n] for n in ("amplitude", "max_force", "dissipated_energy"))
+    contact = amplitude - force / (np.nan if rig_stiffness is None else rig_stiffness)
+    slip = cycles.get("slip_amplitude", np.nan)
     with np.errstate(divide="ignore", invalid="ignore"):
         return {
             "energy_ratio": energy / (4 * amplitude * force),
@@ -251,7 +251,6 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     names = ("amplitude", "max_force", "dissipated_energy")
     tests = [per_cycle(test, names) for test in _tests(results)]
     pooled = {name: np.concatenate([t[name] for t in tests]) for name in (*names, "load")}
-    pooled["slip_amplitude"] = np.full_like(pooled["amplitude"], np.nan)  # not needed here
     ratio, gross = _gross_slip(_ratios(pooled, rig_stiffness), rig_stiffness)
     known = np.isfinite(ratio) & np.isfinite(pooled["load"])
     order = np.argsort(pooled["amplitude"][known], kind="stable")
@@ -271,6 +270,11 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     # the split with the fewest cycles on the wrong side (noise may mix a few)
     wrong = np.cumsum(gross)[:-1] + np.cumsum((~gross)[::-1])[::-1][1:]
     split = int(np.argmin(wrong)) + 1
+    if not gross[split:].any():
+        raise ValueError(
+            "results: the cycles in gross slip are at smaller amplitudes than those in partial "
+            "slip: not a transition (is the rig's stiffness right?)"
+        )
     level = np.concatenate([[0], np.cumsum(np.diff(amplitude) > _SAME_AMPLITUDE * amplitude[1:])])
     low, high = level[split - 1], level[split]
     if low == high:  # the split falls among the cycles at one amplitude: the next ones too
@@ -284,8 +288,7 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     first = gross & (level == level[split:][gross[split:]][0])
     mu = float(np.mean(cof[first]))
     mu_se = float(np.std(cof[first], ddof=1) / np.sqrt(first.sum())) if first.sum() > 1 else np.nan
-    stiffness = np.nan if rig_stiffness is None else rig_stiffness
-    force = float(np.mean(load[fitted])) / stiffness
+    force = float(np.mean(load[fitted])) / (np.nan if rig_stiffness is None else rig_stiffness)
     values = {
         "amplitude": (at, at_se),
         "contact_amplitude": (at - mu * force, float(np.hypot(at_se, force * mu_se))),

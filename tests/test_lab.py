@@ -233,3 +233,8 @@ def test_the_worked_example_in_the_docs_runs_and_prints_what_they_say(capsys):
     exec(compile(code, "docs/lab.md", "exec"), {})
     printed = capsys.readouterr().out
     assert printed.strip() and printed in re.sub(r"\n    ", "\n", text)
+
+
+def test_a_bad_rig_stiffness_is_named():
+    with pytest.raises(ValueError, match="rig_stiffness"):
+        ecofmaps.sliding_condition(_table().assign(max_force=("cycle", [300.0] * 2)), -35e6)
