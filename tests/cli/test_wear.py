@@ -1,6 +1,8 @@
 """``ecofmaps wear`` on files: results tables as ``ecofmaps loops --out`` writes them and scar
 profiles as labs have them, against the closed forms of the Mindlin oracle."""
 
+import re
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -82,3 +84,17 @@ def test_a_table_without_energies_or_a_profile_without_a_scar(campaign, capsys, 
     flat.to_csv(tmp_path / "flat.csv", index=False)
     status, _, err = run(capsys, files[0], "--profile", tmp_path / "flat.csv", "--length", "5mm")
     assert status == 2 and "flat.csv" in err and "no depression" in err
+
+
+def test_a_netcdf_table_reads_as_its_csv(campaign, capsys, tmp_path):
+    _, files, _ = campaign
+    results = _recorded_test(2 * mindlin.transition_amplitude(MU, LOAD, DELTA_T, STIFFNESS),
+                             STIFFNESS, CYCLES[:3])[0]  # fmt: skip
+    results.to_netcdf(tmp_path / "test.nc")
+    (tmp_path / "test.csv").write_text(results_csv(results))
+    outputs = [run(capsys, tmp_path / f"test.{kind}", "--profile", files[2], "--length", "5mm")
+               for kind in ("nc", "csv")]  # fmt: skip
+    assert [status for status, _, _ in outputs] == [0, 0]
+    values = [[float(v) for v in re.findall(r"  ([\d.e+-]+) \S+ ±", out)] for _, out, _ in outputs]
+    assert len(values[0]) == 5
+    np.testing.assert_allclose(values[0], values[1], rtol=1e-5)  # the table's 6 digits
