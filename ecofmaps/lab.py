@@ -456,13 +456,15 @@ def energy_wear(results, profile, length) -> xr.Dataset:
     """
     tests = _tests(results)
     single = not isinstance(results, list | tuple)
-    profiles = [profile] if single else list(profile)
-    lengths = list(np.broadcast_to(np.asarray(length, dtype=np.float64), (len(tests),)))
-    if len(profiles) != len(tests) or np.ndim(length) > 1 or len(lengths) != len(tests):
+    several = isinstance(profile, list | tuple) and not isinstance(profile, ScarProfile)
+    profiles = list(profile) if several else [profile]
+    lengths = np.atleast_1d(np.asarray(length, dtype=np.float64))
+    if len(profiles) != len(tests) or lengths.ndim > 1 or lengths.size not in (1, len(tests)):
         raise ValueError(
             f"give one profile and one length per test: {len(tests)} results, "
-            f"{len(profiles)} profiles, {np.size(length)} lengths"
+            f"{len(profiles)} profiles, {lengths.size} lengths"
         )
+    lengths = np.broadcast_to(lengths, (len(tests),))
     for each in lengths:
         if not 0.0 < each < 1.0:
             raise ValueError(
