@@ -5,7 +5,8 @@ Figures 5-8), :mod:`~ecofmaps.figures.map_figures` its maps (Figure 11 and the u
 map), :mod:`~ecofmaps.figures.measured_figures` those of measured
 loops (Figures 9 and 10, the loops read along the stroke),
 :mod:`~ecofmaps.figures.profile_figures` those of wear-scar profiles (a measured profile,
-and scars of several shapes), :mod:`~ecofmaps.figures.recipes` the set ``ecofmaps figures``
+and scars of several shapes), :mod:`~ecofmaps.figures.lab_figures` a campaign's
+running-condition fretting map, :mod:`~ecofmaps.figures.recipes` the set ``ecofmaps figures``
 writes, and :mod:`~ecofmaps.figures.style` what they share. The names are imported on
 first use: the registry of figures reads without matplotlib.
 """
@@ -19,8 +20,8 @@ _PUBLIC = {
         "measured_and_fitted_loops",
         "measured_loops",
         "resolved_loops",
-        "running_condition_map",
     ),
+    "ecofmaps.figures.lab_figures": ("running_condition_map",),
     "ecofmaps.figures.map_figures": ("ecof_ratio_contours", "universal_ecof_ratio_map"),
     "ecofmaps.figures.model_figures": (
         "dissipated_energy_curves",
