@@ -1,11 +1,6 @@
-"""A fretting lab's daily numbers, read from the results of analysed loops.
-
-From the per-cycle results of :func:`ecofmaps.analyze_loops` (or the tables ``ecofmaps loops``
-writes, :func:`ecofmaps.io.tables.read_results`): the energy and opening ratios on the
-applied and on the contact's displacement and a test's sliding condition
-(:func:`sliding_condition`), the transition to gross slip (:func:`transition`), and energy
-wear with Archard's coefficients (:func:`energy_wear`). The method, its formulas and the
-field's notation are in docs/lab.md.
+"""A fretting lab's daily numbers from the per-cycle results of :func:`ecofmaps.analyze_loops`:
+a test's sliding condition, the transition to gross slip, and energy wear with Archard's
+coefficients. The method, its formulas and the field's notation are in docs/lab.md.
 """
 
 from __future__ import annotations
@@ -128,11 +123,10 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
 
     Notes
     -----
-    A cycle is in gross slip when its energy ratio exceeds Mindlin's :math:`A_t = 0.2`: on
-    the contact's displacement with ``rig_stiffness`` (exact for a sphere on a flat at any
-    rig), else on the applied one (Fouvry's criterion, which calls a sphere's gross-slip
-    cycles behind a compliant rig partial slip up to :math:`\delta_t + \mu P/S`). A
-    test is mixed when both regimes occur (Zhou & Vincent 1995). See docs/lab.md.
+    A cycle is in gross slip when its energy ratio exceeds Mindlin's :math:`A_t = 0.2`, on
+    the contact's displacement with ``rig_stiffness``, else on the applied one (which
+    calls a sphere's first gross-slip cycles behind a compliant rig partial slip). See
+    docs/lab.md.
 
     References
     ----------
