@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import ecofmaps
-from ecofmaps.model.profiles import (
+from ecofmaps.model.profile_edges import (
     OUTLIER_NEIGHBOURS,
     ScarProfileWarning,
     outlying_samples,
