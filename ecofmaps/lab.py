@@ -10,7 +10,7 @@ import xarray as xr
 
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._inputs import check, si_units
-from ecofmaps.model.profile_edges import ScarProfile
+from ecofmaps.model.profiles import ScarProfile
 
 __all__ = [
     "MINDLIN_ENERGY_RATIO",

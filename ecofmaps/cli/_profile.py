@@ -104,7 +104,7 @@ def read_profile(args, conflicting=()):
 
     Notes
     -----
-    The reader's :class:`~ecofmaps.model.profile_edges.ScarProfileWarning` (outliers replaced,
+    The reader's :class:`~ecofmaps.model.profiles.ScarProfileWarning` (outliers replaced,
     ambiguous edges) are printed on standard error, one line each, naming the file; for
     ambiguous edges the line ends with the ``--profile-half-width`` that takes the other
     half-width (the groove's or the band's).
@@ -127,7 +127,7 @@ def read_profile(args, conflicting=()):
             setattr(args, name, value)
     # JAX and the readers load with the first profile read, not with the command line
     from ecofmaps.io.scar_profiles import read_scar_profile
-    from ecofmaps.model.profile_edges import ScarProfileWarning  # with the reader, as above
+    from ecofmaps.model.profiles import ScarProfileWarning  # with the reader, as above
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ScarProfileWarning)

@@ -1,6 +1,6 @@
 r"""Figures of wear-scar profiles: a measured profile as the model reads it, and scar shapes.
 
-:func:`scar_profile_figure` draws one :class:`~ecofmaps.model.profile_edges.ScarProfile`: its
+:func:`scar_profile_figure` draws one :class:`~ecofmaps.model.profiles.ScarProfile`: its
 heights with the unworn surface and the detected edges :math:`\pm W`, and the slope
 :math:`g(X)` the model uses, beside the parabola of the same :math:`D/W`.
 :func:`scar_shape_comparison` draws the ``shapes`` figure of ``ecofmaps figures`` from its

@@ -4,10 +4,10 @@
 the height (``x`` and ``z`` in µm by default), from a comma-, tab- or whitespace-separated
 file with a header line (the columns are read as :func:`ecofmaps.read_recording` reads
 them), levels the trace on the unworn shoulders and returns the
-:class:`~ecofmaps.model.profile_edges.ScarProfile` the model uses. A damaged file raises
+:class:`~ecofmaps.model.profiles.ScarProfile` the model uses. A damaged file raises
 :class:`ScarProfileError`, which names the file and the 1-based line; what the reading
 decided that the user must see (outliers replaced, ambiguous edges beside pile-up ridges)
-is a :class:`~ecofmaps.model.profile_edges.ScarProfileWarning` naming the file and the lines.
+is a :class:`~ecofmaps.model.profiles.ScarProfileWarning` naming the file and the lines.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from ecofmaps._codes import warn
 from ecofmaps.io.files import FileLineError
 from ecofmaps.io.recording_types import RecordingError
 from ecofmaps.io.text import text_blocks
-from ecofmaps.model.profile_edges import ScarProfile, ScarProfileWarning, scar_profile_and_findings
+from ecofmaps.model.profiles import ScarProfile, ScarProfileWarning, scar_profile_and_findings
 
 __all__ = ["ScarProfileError", "read_scar_profile"]
 
@@ -66,7 +66,7 @@ def read_scar_profile(
         Smoothing length of the slopes; default 2 % of the half-width, 0 for none. [m]
     remove_outliers : bool
         Replace spikes and dropouts (a Hampel filter,
-        :func:`~ecofmaps.model.profile_edges.outlying_samples`) by linear interpolation between
+        :func:`~ecofmaps.model.profiles.outlying_samples`) by linear interpolation between
         the nearest samples kept (on by default).
 
     Returns

@@ -28,7 +28,7 @@ _PUBLIC = {
         "ridged_profile",
         "w_shaped_profile",
     ),
-    "ecofmaps.model.profile_edges": ("ScarProfile", "scar_profile"),
+    "ecofmaps.model.profiles": ("ScarProfile", "scar_profile"),
     "ecofmaps.model.regimes": (
         "BEYOND_PROFILE",
         "GROSS_SLIP",

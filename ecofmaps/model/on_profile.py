@@ -24,7 +24,7 @@ import numpy as np
 from ecofmaps._inputs import as_float64, check, float64, is_concrete
 from ecofmaps.model import first_passage
 from ecofmaps.model import profile_core as core
-from ecofmaps.model.profile_edges import ScarProfile
+from ecofmaps.model.profiles import ScarProfile
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
 
 __all__ = [

@@ -2,7 +2,7 @@ r"""Analytic families of wear-scar profiles, for studies of the groove's shape.
 
 Each family is built from the scar's depth :math:`D` and half-width :math:`W` and its shape
 parameters, with an optional tilt, from the exact heights and slopes of the shape, sampled
-with every breakpoint among the samples, as a :class:`~ecofmaps.model.profile_edges.ScarProfile`:
+with every breakpoint among the samples, as a :class:`~ecofmaps.model.profiles.ScarProfile`:
 :func:`parabolic_profile` (the paper's groove), :func:`flat_bottomed_profile` (U-shaped),
 :func:`w_shaped_profile` (a hump between two troughs) and :func:`ridged_profile` (ploughing
 ridges beside the edges, Figure 1b).
@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ecofmaps._inputs import si_units
-from ecofmaps.model.profile_edges import MIN_SCAR_SAMPLES, ScarProfile, scar_profile_from_parts
+from ecofmaps.model.profiles import MIN_SCAR_SAMPLES, ScarProfile, scar_profile_from_parts
 
 __all__ = ["flat_bottomed_profile", "parabolic_profile", "ridged_profile", "w_shaped_profile"]
 

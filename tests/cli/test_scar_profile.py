@@ -8,7 +8,7 @@ import pytest
 
 import ecofmaps
 from ecofmaps.measured.synthetic import scar_example_path, scar_example_trace
-from ecofmaps.model.profile_edges import ScarProfileWarning
+from ecofmaps.model.profiles import ScarProfileWarning
 from tests.cli.commands import run
 
 EXAMPLE = scar_example_path()

@@ -6,7 +6,7 @@ import pytest
 import ecofmaps
 from ecofmaps.io.scar_profiles import ScarProfileError
 from ecofmaps.measured.synthetic import scar_example_path, scar_example_trace
-from ecofmaps.model.profile_edges import ScarProfileWarning
+from ecofmaps.model.profiles import ScarProfileWarning
 
 
 def write(path, text):

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import ecofmaps
-from ecofmaps.model.profile_edges import (
+from ecofmaps.model.profiles import (
     OUTLIER_NEIGHBOURS,
     ScarProfileWarning,
     outlying_samples,

@@ -11,7 +11,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import ecofmaps
-from ecofmaps.model.profile_edges import local_quadratic
+from ecofmaps.model.profiles import local_quadratic
 
 D, W = 10e-6, 50e-6  # the paper's groove at D/W = 0.2 (Figure 5)
 

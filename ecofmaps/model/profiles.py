@@ -1,0 +1,482 @@
+"""The wear-scar profile the model uses, and its construction from a measured trace.
+
+:class:`ScarProfile` holds the groove of any shape the pad slides in (a JAX pytree).
+:func:`scar_profile` builds one from a measured trace: outliers replaced (a Hampel filter),
+heights and slopes smoothed (local quadratic fits), the edges found by
+:mod:`ecofmaps.model.profile_edges`. The method is explained in ``docs/profiles.md``.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from ecofmaps._codes import warn
+from ecofmaps._inputs import is_concrete, si_units
+from ecofmaps.model.profile_edges import (
+    AMBIGUOUS_EDGES,
+    UNCERTAIN_EDGES,
+    ScarProfileWarning,
+    scar_extent,
+)
+
+__all__ = [
+    "AMBIGUOUS_EDGES",
+    "AUTO_SMOOTHING",
+    "MIN_SCAR_SAMPLES",
+    "OUTLIER_NEIGHBOURS",
+    "OUTLIER_THRESHOLD",
+    "UNCERTAIN_EDGES",
+    "ScarProfile",
+    "ScarProfileWarning",
+    "local_quadratic",
+    "outlying_samples",
+    "scar_profile",
+    "scar_profile_and_findings",
+    "scar_profile_from_parts",
+]
+
+#: Fewest samples a measured profile must have between the scar's edges.
+MIN_SCAR_SAMPLES = 20
+#: Outliers: neighbours on each side of a sample whose median and MAD it is judged by.
+OUTLIER_NEIGHBOURS = 4
+#: Outliers: farther than this many scaled MADs (1.4826 MAD) from the neighbours' median.
+OUTLIER_THRESHOLD = 6.0
+#: Default smoothing length as a fraction of the scar's half-width. [1]
+AUTO_SMOOTHING = 0.02
+# Local quadratic fits reach this many standard deviations of their Gaussian weights, which
+# are lowered to reach zero there (so a sample's weight never jumps as positions move).
+_REACH = 4.0
+_EDGE_WEIGHT = float(np.exp(-0.5 * _REACH**2))
+# Edges and depth are read on heights smoothed over this many sample spacings (at most).
+_EDGE_SMOOTHING = 1.0
+# Elements per block of the local fits (bounds their memory).
+_CHUNK = 2**21
+
+
+class ScarProfile(NamedTuple):
+    """A wear-scar profile as the model uses it (a JAX pytree of float64 arrays).
+
+    Made from numbers (:func:`scar_profile`, :func:`ecofmaps.read_scar_profile`, the
+    families) its arrays are NumPy's, so that arithmetic on them stays float64 outside JAX's
+    64-bit mode; made inside a traced function they are JAX's.
+
+    Attributes
+    ----------
+    position : jax.Array, shape (N,)
+        Sample positions :math:`X` along the fretting direction, relative to the scar
+        centre, strictly increasing. [m]
+    height : jax.Array, shape (N,)
+        Heights :math:`z` at the samples (levelled when asked). [m]
+    slope : jax.Array, shape (N,)
+        Slope :math:`g = dz/dX` at the samples, after smoothing; the model takes it
+        piecewise linear between samples. [1]
+    depth : jax.Array, shape ()
+        Scar depth :math:`D` below the unworn surface. [m]
+    half_width : jax.Array, shape ()
+        Scar half-width :math:`W`. [m]
+    worn_area : jax.Array, shape ()
+        Area between the unworn surface and the profile, between the edges. [m²]
+    centre : jax.Array, shape ()
+        Position of the scar centre in the coordinates of the trace as given. [m]
+    reference_height : jax.Array, shape ()
+        Height of the unworn surface at the centre, in the frame of ``height`` (0 when
+        levelled). [m]
+    reference_slope : jax.Array, shape ()
+        Tilt of the unworn surface, in the frame of ``slope`` (0 when levelled). [1]
+    alternative_half_width : jax.Array, shape ()
+        The other plausible half-width when the edges were ambiguous (the groove's below
+        the unworn surface's line, or the band's between the crests of pile-up ridges,
+        whichever was not returned) or uncertain on a rough surface (read within 3 times
+        the roughness of the line; ``docs/profiles.md``), NaN when they were neither
+        (or the half-width was given). [m]
+    replaced : jax.Array, shape (N,) or ()
+        1 where the sample was an outlier (a spike or dropout, :func:`outlying_samples`)
+        and its height was interpolated from its neighbours', else 0; a scalar 0 when no
+        sample was tested (the analytic families). [1]
+
+    Notes
+    -----
+    The scar is ``position`` in ``[-half_width, half_width]``; its edges in the trace's own
+    coordinates are :attr:`edges`. A batch of profiles is a ``ScarProfile`` whose arrays
+    have a leading batch axis (``jax.tree.map(lambda *a: jnp.stack(a), *profiles)``).
+    """
+
+    position: jax.Array
+    height: jax.Array
+    slope: jax.Array
+    depth: jax.Array
+    half_width: jax.Array
+    worn_area: jax.Array
+    centre: jax.Array
+    reference_height: jax.Array
+    reference_slope: jax.Array
+    alternative_half_width: jax.Array = float("nan")
+    replaced: jax.Array = 0.0
+
+    @property
+    def aspect_ratio(self):
+        """Depth over half-width :math:`D/W`, the paper's :math:`z_o/x_o` (eq. 11). [1]"""
+        return self.depth / self.half_width
+
+    @property
+    def edges(self):
+        """The scar's edges ``(left, right)`` in the coordinates of the trace as given. [m]"""
+        stack = np.stack if is_concrete(self) else jnp.stack  # float64 either way
+        return stack([self.centre - self.half_width, self.centre + self.half_width], -1)
+
+
+def scar_profile_from_parts(position, height, slope, depth, half_width, worn_area, centre=0.0,
+             reference_height=0.0, reference_slope=0.0, alternative_half_width=np.nan,
+             replaced=0.0) -> ScarProfile:  # fmt: skip
+    values = (position, height, slope, depth, half_width, worn_area, centre,
+              reference_height, reference_slope, alternative_half_width, replaced)  # fmt: skip
+    if is_concrete(*values):
+        # NumPy arrays: a user's own arithmetic on them (``profile.half_width * 1e6``) stays
+        # float64, where JAX outside its 64-bit mode would truncate it to float32.
+        return ScarProfile(*(np.asarray(v, dtype=np.float64) for v in values))
+    # JAX's 64-bit mode is on only inside the public entry points (importing ecofmaps does
+    # not switch it on): without it these arrays would be float32.
+    with jax.enable_x64(True):
+        return ScarProfile(*(jnp.asarray(v, dtype=jnp.float64) for v in values))
+
+
+def _array(name: str, value) -> np.ndarray:
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a 1-D array of numbers, got {value!r}") from None
+    if array.ndim != 1:
+        raise ValueError(f"{name} must be a 1-D array, got shape {array.shape}")
+    bad = ~np.isfinite(array)
+    if bad.any():
+        index = int(np.argmax(bad))
+        raise ValueError(
+            f"{name} must be finite; {name}[{index}] = {float(array[index])!r} "
+            f"({np.count_nonzero(bad)} of {array.size} values)"
+        )
+    return array
+
+
+def _check_positions(x: np.ndarray) -> None:
+    steps = np.diff(x)
+    if np.any(steps <= 0.0):
+        i = int(np.argmax(steps <= 0.0)) + 1
+        kind = "repeated" if steps[i - 1] == 0.0 else "decreasing"
+        raise ValueError(
+            f"x must be strictly increasing; x[{i}] = {x[i]!r} after x[{i - 1}] = {x[i - 1]!r} "
+            f"({kind}); sort the trace and drop repeated positions"
+        )
+
+
+def _neighbours(n: int, count: int) -> np.ndarray:
+    """Indices of each sample's ``2 count`` nearest other samples, shifted inwards at the ends."""
+    rows = np.arange(n)
+    start = np.clip(rows - count, 0, n - 2 * count - 1)
+    window = start[:, None] + np.arange(2 * count + 1)[None, :]
+    others = np.where(window < rows[:, None], window, window + 1)
+    return others[:, : 2 * count]
+
+
+def outlying_samples(x, z, neighbours=OUTLIER_NEIGHBOURS, threshold=OUTLIER_THRESHOLD):
+    r"""Which samples of a trace are outliers (spikes, dropouts): a Hampel filter.
+
+    Parameters
+    ----------
+    x, z : array_like, shape (N,)
+        Positions (strictly increasing) and heights. [m]
+    neighbours : int
+        Samples on each side that a sample is judged by (shifted inwards at the ends of the
+        trace). A run of up to ``neighbours - 1`` outliers is found.
+    threshold : float
+        How many scaled MADs from the neighbours' median make an outlier. [1]
+
+    Returns
+    -------
+    outlier : numpy.ndarray of bool, shape (N,)
+
+    Notes
+    -----
+    A sample is an outlier when it is farther from the median of its ``2 neighbours``
+    nearest neighbours than ``threshold`` times the largest of their scaled median absolute
+    deviation :math:`1.4826\,\mathrm{MAD}`, the trace's noise, its typical distance from the
+    neighbours' median, and its resolution (``docs/profiles.md``).
+
+    References
+    ----------
+    F.R. Hampel (1974), The influence curve and its role in robust estimation, J. Am. Stat.
+    Assoc. 69, 383-393.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.linspace(0.0, 1e-3, 101)
+    >>> z = 1e-6 * np.sin(x / 1e-4)
+    >>> z[40] += 5e-6
+    >>> np.flatnonzero(outlying_samples(x, z)).tolist()
+    [40]
+    """
+    x, z = _array("x", x), _array("z", z)
+    if x.size != z.size:
+        raise ValueError(f"x and z must have the same length, got {x.size} and {z.size}")
+    if not (isinstance(neighbours, int | np.integer) and 1 <= neighbours < z.size / 2):
+        raise ValueError(
+            f"neighbours must be an integer >= 1 and less than half the {z.size} samples, "
+            f"got {neighbours!r}"
+        )
+    around = z[_neighbours(z.size, int(neighbours))]
+    median = np.median(around, axis=1)
+    spread = 1.4826 * np.median(np.abs(around - median[:, None]), axis=1)
+    between = z[:-2] + (z[2:] - z[:-2]) * (x[1:-1] - x[:-2]) / (x[2:] - x[:-2])
+    noise = 1.4826 / np.sqrt(1.5) * np.median(np.abs(z[1:-1] - between))
+    steps = np.abs(np.diff(z))
+    resolution = float(np.min(steps[steps > 0.0])) if steps.any() else 0.0
+    off = np.abs(z - median)
+    typical = 1.4826 * np.median(off)
+    scale = np.maximum(np.maximum(spread, noise), max(resolution, typical))
+    return off > threshold * scale
+
+
+def _outliers_replaced(x, z):
+    """Heights with their outliers interpolated, the outliers' mask and the warning (or None)."""
+    outlier = outlying_samples(x, z)
+    if not outlier.any():
+        return z, outlier, None
+    kept = ~outlier
+    cleaned = z.copy()
+    cleaned[outlier] = np.interp(x[outlier], x[kept], z[kept])
+    samples = np.flatnonzero(outlier)
+    details = [
+        f"x = {x[i] * 1e6:.6g} µm, {abs(z[i] - cleaned[i]) * 1e6:.3g} µm "
+        f"{'below' if z[i] < cleaned[i] else 'above'} its neighbours"
+        for i in samples
+    ]
+    summary = (
+        f"{samples.size} outlier(s) (a spike or dropout: more than {OUTLIER_THRESHOLD:g} "
+        f"scaled MADs from the median of its {2 * OUTLIER_NEIGHBOURS} neighbours) replaced by "
+        "linear interpolation between the nearest samples kept"
+    )
+    return cleaned, outlier, ScarProfileWarning(summary, samples, details)
+
+
+def _checked_trace(x, z, half_width, smoothing):
+    """The trace and the parameters of :func:`scar_profile` as float64, checked."""
+    x = _array("x", x)
+    z = _array("z", z)
+    if x.size != z.size:
+        raise ValueError(f"x and z must have the same length, got {x.size} and {z.size}")
+    if x.size < 2 * MIN_SCAR_SAMPLES:
+        raise ValueError(f"x: a trace needs at least {2 * MIN_SCAR_SAMPLES} samples, got {x.size}")
+    _check_positions(x)
+    if half_width is not None:
+        half_width = float(_array("half_width", [half_width])[0])
+        if half_width <= 0.0:
+            raise ValueError(f"half_width must be > 0, got {half_width!r}")
+    if smoothing is not None:
+        smoothing = float(_array("smoothing", [smoothing])[0])
+        if smoothing < 0.0:
+            raise ValueError(f"smoothing must be >= 0 (0: none), got {smoothing!r}")
+    return x, z, half_width, smoothing
+
+
+def local_quadratic(x: np.ndarray, z: np.ndarray, smoothing: float):
+    """Heights and slopes of a Gaussian-weighted local quadratic fit at every sample.
+
+    Parameters
+    ----------
+    x, z : numpy.ndarray
+        Positions (strictly increasing) and heights. [m]
+    smoothing : float
+        Standard deviation of the Gaussian weights; 0 returns ``z`` itself and the slope of
+        the parabola through each sample and its neighbours (``numpy.gradient``, second
+        order at the ends). [m]
+
+    Returns
+    -------
+    height, slope : numpy.ndarray
+        [m], [1]
+
+    Notes
+    -----
+    The weights are :math:`e^{-d^2/2} - e^{-8}` for samples within :math:`d = 4` standard
+    deviations (continuous, zero at the reach). Where the samples are sparse the standard
+    deviation is widened so that the nearest two samples on each side (three on one side at
+    the ends) lie within 80 % of the reach: each fit is defined for any spacing. Quadratics
+    are reproduced exactly.
+    """
+    if smoothing == 0.0:
+        return z.copy(), np.gradient(z, x, edge_order=2)
+    n = x.size
+    rows = np.arange(n)
+    # Widen the weights where samples are sparse: the nearest two on each side (three on
+    # one side at the ends) within 80 % of the reach.
+    span = np.maximum(x - x[np.clip(rows - 2, 0, n - 5)], x[np.clip(rows + 2, 4, n - 1)] - x)
+    sigma = np.maximum(smoothing, span / (0.8 * _REACH))
+    left = np.searchsorted(x, x - _REACH * sigma, side="left")
+    right = np.searchsorted(x, x + _REACH * sigma, side="right")
+    width = int(np.max(right - left))
+    height, slope = np.empty(n), np.empty(n)
+    chunk = max(1, _CHUNK // width)
+    for start in range(0, n, chunk):
+        block = slice(start, min(start + chunk, n))
+        index = left[block, None] + np.arange(width)[None, :]
+        valid = index < right[block, None]
+        index = np.minimum(index, n - 1)
+        d = (x[index] - x[block, None]) / sigma[block, None]
+        weight = np.where(valid, np.maximum(np.exp(-0.5 * d * d) - _EDGE_WEIGHT, 0.0), 0.0)
+        # Weighted normal equations of z ~ a + b d + c d^2 (d in units of the smoothing).
+        powers = [np.sum(weight * d**k, axis=1) for k in range(5)]
+        rhs = np.stack([np.sum(weight * z[index] * d**k, axis=1) for k in range(3)], axis=-1)
+        matrix = np.stack([np.stack(powers[i : i + 3], axis=-1) for i in range(3)], axis=-2)
+        solution = np.linalg.solve(matrix, rhs[..., None])[..., 0]
+        height[block], slope[block] = solution[:, 0], solution[:, 1] / sigma[block]
+    return height, slope
+
+
+def scar_profile_and_findings(x, z, half_width=None, smoothing=None, level=False,
+                              remove_outliers=True):  # fmt: skip
+    """:func:`scar_profile` and its warnings, not issued: ``(profile, findings)``.
+
+    Parameters and Raises are those of :func:`scar_profile`.
+
+    Returns
+    -------
+    profile : ScarProfile
+    findings : list of ScarProfileWarning
+        Outliers replaced (with their sample indices), ambiguous or uncertain edges.
+    """
+    x, z, half_width, smoothing = _checked_trace(x, z, half_width, smoothing)
+    findings = []
+    replaced = np.zeros(x.size, dtype=bool)
+    if remove_outliers:
+        z, replaced, finding = _outliers_replaced(x, z)
+        findings += [finding] if finding is not None else []
+    spacing = float(np.median(np.diff(x)))
+    # The edges are found on lightly smoothed heights (a kink at an edge would move under
+    # heavier smoothing).
+    light = 0.0 if smoothing == 0.0 else _EDGE_SMOOTHING * spacing
+    zs, _ = local_quadratic(x, z, light)
+    extent, alternative, edge_findings = scar_extent(
+        x, zs, half_width, int(np.ceil(_REACH * light / spacing))
+    )
+    findings += edge_findings
+    line, tilt, centre, width, r = extent[:5]
+    sigma = AUTO_SMOOTHING * width if smoothing is None else smoothing
+    sigma = 0.0 if sigma == 0.0 else max(sigma, spacing)
+    if sigma > width / 5.0:
+        raise ValueError(
+            f"smoothing = {sigma!r} m is more than a fifth of the scar's half-width "
+            f"({width!r} m): it would flatten the scar; give a smaller smoothing"
+        )
+    smooth, gs = local_quadratic(x, z, sigma)
+    inside = np.abs(x - centre) <= width
+    count = int(inside.sum())
+    if count < MIN_SCAR_SAMPLES:
+        raise ValueError(
+            f"x: only {count} samples across the scar (half-width {width!r} m); at least "
+            f"{MIN_SCAR_SAMPLES} are needed: sample the trace more densely"
+        )
+    depth = float(-np.min(smooth[inside] - line(x[inside])))
+    edges = (centre - width, centre + width)
+    ends = np.interp(edges, x, r)
+    area_x = np.concatenate([[edges[0]], x[inside], [edges[1]]])
+    area_r = np.concatenate([[ends[0]], r[inside], [ends[1]]])
+    worn = float(np.trapezoid(np.maximum(-area_r, 0.0), area_x))
+    if level:
+        height, slope = z - line(x), gs - tilt
+        reference = (0.0, 0.0)
+    else:
+        height, slope = z, gs
+        reference = (float(line(centre)), float(tilt))
+    profile = scar_profile_from_parts(
+        x - centre, height, slope, depth, width, worn, centre, *reference, alternative,
+        replaced.astype(np.float64),
+    )  # fmt: skip
+    return profile, findings
+
+
+@si_units(x="length", z="length", half_width="length")
+def scar_profile(x, z, half_width=None, smoothing=None, level=False,
+                 remove_outliers=True) -> ScarProfile:  # fmt: skip
+    r"""A wear-scar profile from a measured trace (arrays in metres).
+
+    Parameters
+    ----------
+    x : array_like, shape (N,)
+        Positions along the fretting direction, strictly increasing. [m]
+    z : array_like, shape (N,)
+        Heights, increasing upwards (the scar is a depression). [m]
+    half_width : float, optional
+        The scar's half-width :math:`W`, overriding the detected one (the centre stays the
+        detected one). [m]
+    smoothing : float, optional
+        Standard deviation of the Gaussian weights of the local quadratic fits that give
+        the heights and slopes (``docs/profiles.md``); 0 for none. Default:
+        :data:`AUTO_SMOOTHING` times the detected half-width. It is raised to the median
+        sample spacing if smaller, and must not exceed a fifth of the half-width. [m]
+    level : bool
+        Subtract the unworn surface's line (tilt and offset fitted on the shoulders) from
+        the heights and its tilt from the slopes. Off by default: the arrays are taken as
+        the pad feels them, so a genuinely tilted scar stays tilted.
+    remove_outliers : bool
+        Replace outliers (spikes, dropouts: :func:`outlying_samples`) by linear
+        interpolation between the nearest samples kept, before anything else (on by
+        default; ``replaced`` marks them).
+
+    Returns
+    -------
+    profile : ScarProfile
+        Positions relative to the detected centre, the heights (levelled if asked), the
+        smoothed slopes, and the depth, half-width, worn area, centre and reference line;
+        the other plausible half-width if the edges were ambiguous, and the samples
+        replaced.
+
+    Warns
+    -----
+    ScarProfileWarning
+        For outliers replaced (their count, sample indices and positions), and for
+        ambiguous edges: a band between the crests of pile-up ridges (or a disturbed band)
+        wider than the groove below the unworn surface's line by more than
+        :data:`AMBIGUOUS_EDGES` on a side; the band is returned if on both sides, else the
+        groove, and the message gives both half-widths, which one was returned and the
+        ``half_width=`` that takes the other.
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter: ``x`` and ``z`` not 1-D arrays of equal length, NaN or
+        infinite values, ``x`` not strictly increasing (unsorted or repeated positions), no
+        depression deeper than the noise, a scar that reaches an end of the trace or a trace
+        too short to level, fewer than :data:`MIN_SCAR_SAMPLES` samples across the scar, a
+        ``half_width`` that does not fit the trace, or a bad ``smoothing``.
+
+    Notes
+    -----
+    The edges, the reference line and the smoothing follow the rules of
+    ``docs/profiles.md``. The model maps a pad position :math:`x` to :math:`X = xW/x_o` (eq. 11).
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 11.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.linspace(-100e-6, 100e-6, 401)
+    >>> z = np.where(np.abs(x) < 50e-6, 10e-6 * ((x / 50e-6) ** 2 - 1), 0.0)
+    >>> p = scar_profile(x, z, smoothing=0)
+    >>> round(float(p.half_width) * 1e6, 6), round(float(p.depth) * 1e6, 6)
+    (50.0, 10.0)
+    """
+    profile, findings = scar_profile_and_findings(
+        x, z, half_width=half_width, smoothing=smoothing, level=level,
+        remove_outliers=remove_outliers,
+    )  # fmt: skip
+    for finding in findings:
+        warn(finding, ScarProfileWarning)
+    return profile
