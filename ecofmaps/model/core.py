@@ -281,12 +281,7 @@ _SERIES = tuple(1.0 / (2 * n + 1) for n in range(28, 0, -1))
 
 
 def _artanh_excess(u, margin):
-    r""":math:`\operatorname{artanh}(u)/u - 1` for :math:`u = 1 - w` in :math:`[0, 1)`.
-
-    A series at :math:`u < 1/2` (no cancellation as :math:`u \to 0`); above, the logarithm
-    of :math:`(2 - w)/w` with the margin :math:`w` itself, so the digits of :math:`1 - u`
-    are not lost near the locking point.
-    """
+    r""":math:`\operatorname{artanh}(u)/u - 1` for :math:`u = 1 - w` in :math:`[0, 1)`."""
     small = u < _SERIES_LIMIT
     u_small = jnp.where(small, u, 0.0)
     w_large = jnp.where(small, 0.25, margin)

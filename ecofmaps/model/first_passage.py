@@ -83,8 +83,8 @@ class SteadyLoop(NamedTuple):
 
 
 def _at(table, group, *index):
-    """``table[group, *index]`` as one gather from the flattened table (XLA's gathers with
-    several index dimensions are several times slower on CPU)."""
+    """``table[group, *index]`` as one gather from the flattened table (XLA's gathers with several
+    index dimensions are several times slower on CPU)."""
     flat = group
     for size, i in zip(table.shape[1:], index, strict=True):
         flat = flat * size + i
@@ -162,24 +162,7 @@ def _passage(side: Side, group, mu, lam, value, level, segment, fraction, sparse
 
 
 def steady_loop(tables: Tables, group, lam, sparse: bool = True) -> SteadyLoop:
-    r"""The steady loop of one point (see module): ends, :math:`\mu_E/\mu`, peak, regime.
-
-    Parameters
-    ----------
-    tables : Tables
-        From :func:`profile_tables` (stacked over groups).
-    group : jax.Array of int, shape ()
-        The point's group (its :math:`\mu` and :math:`A`).
-    lam : jax.Array, shape ()
-        :math:`\lambda = P/(S\Delta^*)` >= 0.
-    sparse : bool
-        Whether ``tables`` were built sparse.
-
-    Returns
-    -------
-    loop : SteadyLoop
-        ``ecof_ratio`` lacks the jumps' share where ``monotone`` is False (:func:`jump_area`).
-    """
+    r"""The steady loop of one point (see module): ends, :math:`\mu_E/\mu`, peak, regime."""
     forward, backward = tables.forward, tables.backward
     n = forward.position.shape[-1]
     mu = _at(tables.mu, group)
@@ -240,9 +223,7 @@ def steady_loop(tables: Tables, group, lam, sparse: bool = True) -> SteadyLoop:
 
 
 def _running_levels(side: Side, group, mu, lam, start, end):
-    """Per segment of a forward stroke from ``start`` to ``end`` (``(k, t)`` pairs): the
-    piece ``[a, b]`` it covers, its slopes, and the running maximum ``L`` of :math:`F_+`
-    at ``a`` (from the stroke's start)."""
+    """Per segment of a forward stroke from ``start`` to ``end`` (``(k, t)`` pairs)."""
     n = side.position.shape[-1]
     p, g, q = side.position[group], side.slope[group], side.force[group]
     (k_a, t_a), (k_b, t_b) = start, end
@@ -268,27 +249,7 @@ def _running_levels(side: Side, group, mu, lam, start, end):
 
 
 def jump_area(side: Side, group, mu, lam, start, end):
-    r""":math:`\int (M_+ - F_+)\,d\xi` over a forward stroke from ``start`` to ``end``.
-
-    :math:`M_+` is the running maximum of :math:`F_+` from the stroke's start: the actuator
-    position while the pad slips or jumps. On each segment piece :math:`[a, b]`,
-    :math:`F_+` (convex) lies below the level :math:`L = M_+(a)` on :math:`[a, c)`, where
-    :math:`c` is where it climbs back to :math:`L` (:func:`crossing_fraction`), or :math:`b`. The
-    area there is :math:`(c - a)(L - (a + c)/2 - \lambda\bar q_+)`. :math:`O(N)`.
-
-    Parameters
-    ----------
-    side : Tables.forward or Tables.backward
-    group : jax.Array of int
-    mu, lam : jax.Array
-    start, end : tuple of (segment, fraction)
-        The stroke's ends on ``side``.
-
-    Returns
-    -------
-    area : jax.Array
-        >= 0, in units of :math:`A^2` (0 where :math:`F_+` rises all along).
-    """
+    r""":math:`\int (M_+ - F_+)\,d\xi` over a forward stroke from ``start`` to ``end``."""
     a, b, slope_a, slope_b, level, value_b, active = _running_levels(
         side, group, mu, lam, start, end
     )
@@ -322,12 +283,7 @@ def _branch(side: Side, group, mu, lam, start, end, num: int):
 
 
 def draw_loop(tables: Tables, group, lam, loop: SteadyLoop, num: int):
-    """The steady loop's actuator positions D and forces Q/P, ``2 num + 1`` points.
-
-    Starts at the reversal (D = -1), slips forward (jumping where :math:`F_+` falls) to
-    D = 1, then back; the stick segments are the straight lines between the branches.
-    With no gross slip the points lie on the stick line through the stuck position.
-    """
+    """The steady loop's actuator positions D and forces Q/P, ``2 num + 1`` points."""
     n = tables.forward.position.shape[-1]
     mu = tables.mu[group]
     lower, upper = loop.ends
@@ -350,11 +306,7 @@ def draw_loop(tables: Tables, group, lam, loop: SteadyLoop, num: int):
 
 def simulation_tables(position, slope, mu, lam) -> Tables:
     r"""Tables for a time history at one :math:`(\mu, \lambda)`: per sample, the actuator
-    positions :math:`D` at which :math:`F_+ \ge D` fails, :math:`(F_+, \infty)`, sparse.
-
-    ``position`` is in the units of the history (the scar's half-width for
-    :func:`ecofmaps.simulate`), ``lam`` the compliance ratio in the same units.
-    """
+    positions :math:`D` at which :math:`F_+ \ge D` fails, :math:`(F_+, \infty)`, sparse."""
 
     def side(p, g):
         force = traction_forward(g, mu)
@@ -389,11 +341,7 @@ def simulation_tables(position, slope, mu, lam) -> Tables:
 
 
 def simulation_step(tables: Tables, lam, state, actuator):
-    """One step of the return map: the pad sticks or slips to the exact equilibrium.
-
-    ``state`` is ``(segment, fraction, q, off)``; returns the new state and Q/P (NaN once
-    the pad has run off the profile or locked on a rigid rig).
-    """
+    """One step of the return map: the pad sticks or slips to the exact equilibrium."""
     forward, backward = tables.forward, tables.backward
     n = forward.position.shape[-1]
     mu = tables.mu[0]

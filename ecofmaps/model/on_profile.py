@@ -146,11 +146,7 @@ def _jumps(tables, group, lam, ends):
 
 @partial(jax.jit, static_argnames=("physical", "sparse"))
 def _shared_tables(position, slope, half_width, mu, key, physical, sparse):
-    """One set of tables per group (mu, key), stacked.
-
-    Built in a call of their own: inside the points' computation XLA would fuse the
-    tables' construction into every lookup and repeat it per point.
-    """
+    """One set of tables per group (mu, key), stacked."""
     length = _stroke(half_width, key, physical)
     build = jax.vmap(core.profile_tables, in_axes=(None, None, 0, 0, None))
     return _drop_group(build(position, slope, mu, length, sparse))
@@ -209,12 +205,7 @@ def _groups(mu: np.ndarray, key: np.ndarray):
 
 
 def _shared(profile, unique, group, lam, physical):
-    """Loops and jump areas of points in groups ``unique[:, group]`` with shared tables.
-
-    Groups and points are padded to powers of two, so that few shapes are compiled; the
-    results may be longer than the points (padding at the end). With many groups, in
-    batches that bound the tables' memory.
-    """
+    """Loops and jump areas of points in groups ``unique[:, group]`` with shared tables."""
     count = unique.shape[1]
     n = profile.position.shape[-1]
     per_group = 8 * n * (core.table_levels(n) + 1)
@@ -274,8 +265,7 @@ def _prepare(amplitude, load, stiffness, mu, half_width, profile_half_width, phy
 
 @jax.jit
 def _finish(loops, jumps, mu, lam, valid) -> dict:
-    """The steady-loop numbers from the loops and the jumps' areas (module docstring); the
-    loops may be padded beyond the points."""
+    """The steady-loop numbers from the loops and the jumps' areas (module docstring)."""
     loops, jumps = jax.tree.map(lambda leaf: leaf[: mu.shape[0]], (loops, jumps))
     slip = 0.5 * (loops.plus - loops.minus)
     scale = 4.0 * mu * jnp.where(lam > 0.0, lam, 1.0) * jnp.where(slip > 0.0, slip, 1.0)
@@ -299,19 +289,7 @@ def steady_values(numbers, amplitude, load, mu) -> dict:
     r"""The steady loop's values in SI units from the numbers of :func:`steady_numbers` (in
     the core's units): ``slip_amplitude`` :math:`\delta^*` [m] and ``ecof`` :math:`\mu_E`
     [1]; with a ``load``, ``dissipated_energy`` :math:`E_d` [J] and ``max_force``
-    :math:`Q^*` [N]. The arguments broadcast (NumPy or JAX arrays).
-
-    Parameters
-    ----------
-    numbers : dict
-        ``slip_ratio``, ``ecof_ratio``, ``normalized_energy`` and ``normalized_max_force``.
-    amplitude : float or array_like
-        Displacement amplitude :math:`\Delta^*`. [m]
-    load : float or array_like or None
-        Normal load :math:`P`. [N]
-    mu : float or array_like
-        Contact coefficient of friction :math:`\mu`. [1]
-    """
+    :math:`Q^*` [N]. The arguments broadcast (NumPy or JAX arrays)."""
     values = {
         "slip_amplitude": amplitude * numbers["slip_ratio"],
         "ecof": mu * numbers["ecof_ratio"],
@@ -324,26 +302,7 @@ def steady_values(numbers, amplitude, load, mu) -> dict:
 
 def steady_numbers(profile, amplitude, load, stiffness, mu, groove_half_width=None,
                    mapping="scaled") -> dict:  # fmt: skip
-    r"""The steady loop on ``profile`` at every point, in the units of the core.
-
-    Parameters
-    ----------
-    profile : ScarProfile
-    amplitude, load, stiffness, mu, groove_half_width : array_like
-        As for :func:`ecofmaps.slip_amplitude` (SI); ``groove_half_width`` :math:`x_o`
-        defaults to ``amplitude``.
-    mapping : {'scaled', 'physical'}
-        :math:`X = xW/x_o` (eq. 11) or :math:`X = x`.
-
-    Returns
-    -------
-    numbers : dict of jax.Array
-        Over the broadcast shape: ``slip_ratio`` :math:`\delta^*/\Delta^*`, ``ecof_ratio``
-        :math:`\mu_E/\mu`, ``normalized_energy`` :math:`E_d/(P\Delta^*)`,
-        ``normalized_max_force`` :math:`Q^*/P`, ``regime``, and the loop's ends ``minus``
-        and ``plus`` (contact positions over :math:`\Delta^*`). NaN (but the regime) outside
-        gross slip and no gross slip.
-    """
+    r"""The steady loop on ``profile`` at every point, in the units of the core."""
     physical = check_mapping(mapping, groove_half_width)
     profile = as_profile(profile)
     values = _inputs(amplitude, load, stiffness, mu, groove_half_width)
@@ -369,34 +328,7 @@ def steady_numbers(profile, amplitude, load, stiffness, mu, groove_half_width=No
 @float64
 def steady_numbers_and_loops(profile, amplitude, load, stiffness, mu, num=201,
                              groove_half_width=None, mapping="scaled") -> dict:  # fmt: skip
-    r""":func:`steady_numbers` and each point's steady loop drawn, by one compiled kernel.
-
-    For a few points (at most 256 a call is meant for: each builds its own :math:`O(N)`
-    tables) that need both a map and loops, such as a figure's: one kernel to compile
-    instead of two.
-
-    Parameters
-    ----------
-    profile : ScarProfile
-    amplitude, load, stiffness, mu, groove_half_width : array_like
-        As for :func:`ecofmaps.fretting_loop` (SI): amplitude [m], load [N], stiffness
-        [N/m], mu [1], groove half-width :math:`x_o` [m] (default ``amplitude``).
-    num : int
-        Points along each branch of a loop (as :func:`ecofmaps.fretting_loop`).
-    mapping : {'scaled', 'physical'}
-        :math:`X = xW/x_o` (eq. 11) or :math:`X = x`.
-
-    Returns
-    -------
-    numbers : dict of numpy.ndarray
-        Those of :func:`steady_numbers`, and ``displacement`` [m] and ``force`` [N] around
-        each point's steady loop, over (broadcast shape, ``2 num + 1``): NaN outside gross
-        slip and no gross slip. Computed in float64 (JAX's 64-bit mode on for the call).
-
-    References
-    ----------
-    X. Jin, W. Sun, P.H. Shipway (2016): eq. 9-11 (the loop on the profile's slope).
-    """
+    r""":func:`steady_numbers` and each point's steady loop drawn, by one compiled kernel."""
     physical = check_mapping(mapping, groove_half_width)
     profile = as_profile(profile)
     values = _inputs(amplitude, load, stiffness, mu, groove_half_width)

@@ -67,10 +67,7 @@ _E2_SERIES = tuple((-1.0) ** m / (m + 3) for m in range(17, -1, -1))
 
 
 class Side(NamedTuple):
-    """One orientation of a profile: the forward stroke's view, or the mirrored one.
-
-    Every leaf has a leading group axis (one entry per friction coefficient and length).
-    """
+    """One orientation of a profile: the forward stroke's view, or the mirrored one."""
 
     position: jax.Array  # (U, N) sample positions in units of the stroke, increasing
     slope: jax.Array  # (U, N)
@@ -119,14 +116,7 @@ def _log_ratio_excess(r):
 
 def mean_excess(slope_a, slope_b, mu):
     r"""Mean of :math:`e = (1 + \mu^2)g^2/(1 - \mu^2g^2)` over a segment where :math:`g` runs
-    linearly from ``slope_a`` to ``slope_b`` (exact; needs :math:`\mu|g| < 1` on it).
-
-    With :math:`w_\pm = 1 \mp \mu g_a`, :math:`r_\pm = \mp\mu\Delta g/w_\pm` and
-    :math:`E_2(r) = \ln(1+r)/r - 1 + r/2`:
-    :math:`\bar e = \frac{1+\mu^2}{2}\left[\frac{2g_a^2}{w_+w_-} + \frac{2g_a\Delta g}
-    {(w_+w_-)^2} + \frac{E_2(r_+)/w_+ + E_2(r_-)/w_-}{\mu^2}\right]`, the mean of
-    :math:`(q_+ - q_-)/(2\mu) - 1` written so that nothing cancels as :math:`\mu g \to 0`.
-    """
+    linearly from ``slope_a`` to ``slope_b`` (exact; needs :math:`\mu|g| < 1` on it)."""
     w_plus = 1.0 - mu * slope_a
     w_minus = 1.0 + mu * slope_a
     change = slope_b - slope_a
@@ -145,12 +135,7 @@ def mean_excess(slope_a, slope_b, mu):
 
 def mean_traction(slope_a, slope_b, mu):
     r"""Mean of :math:`q_+ = (\mu + g)/(1 - \mu g)` over a segment where :math:`g` runs
-    linearly from ``slope_a`` to ``slope_b`` (exact; needs :math:`\mu g < 1` on it).
-
-    :math:`\bar q_+ = \mu + (1 + \mu^2)\left[\Delta g/(2w) + E_2(r)/\mu + g_a\right]/w`,
-    :math:`w = 1 - \mu g_a`, :math:`r = -\mu\Delta g/w`: the mean of :math:`1/w` over the
-    segment is :math:`\ln(1 + r)/(rw)`.
-    """
+    linearly from ``slope_a`` to ``slope_b`` (exact; needs :math:`\mu g < 1` on it)."""
     margin = 1.0 - mu * slope_a
     change = slope_b - slope_a
     inner = 0.5 * change / margin + _log_ratio_excess(-mu * change / margin) / mu + slope_a
@@ -159,14 +144,7 @@ def mean_traction(slope_a, slope_b, mu):
 
 def crossing_fraction(start, length, slope_a, change, mu, lam, level):
     r"""Fraction :math:`t \in [0, 1]` of a segment where :math:`F_+ = \xi + \lambda q_+`
-    first reaches ``level`` from below.
-
-    The segment runs from ``start`` over ``length`` with the slope going linearly from
-    ``slope_a`` by ``change``. Multiplied by :math:`w = 1 - \mu g > 0`,
-    :math:`F_+ = L` is the quadratic :math:`\varphi(t) = (\xi - L)w + \lambda(\mu + g) = 0`
-    with :math:`\varphi(0) < 0`; its smallest positive root, in the form without
-    cancellation. For a rigid rig (:math:`\lambda = 0`) it is :math:`\xi = L`.
-    """
+    first reaches ``level`` from below."""
     w0 = 1.0 - mu * slope_a
     w1 = -mu * change
     offset = start - level
@@ -210,9 +188,7 @@ def sparse_table(values, levels: int, combine, identity):
 
 
 def _intervals(position, force, levels: int):
-    """Where ``position + lam * force < 1`` over ``lam >= 0``: the open interval
-    (lower, upper) of each sample, sparse in ``levels`` levels, with a sentinel sample that
-    never holds it."""
+    """Where ``position + lam * force < 1`` over ``lam >= 0``."""
     finite = jnp.isfinite(force)
     below = position < 1.0
     nonzero = finite & (force != 0.0)
@@ -249,27 +225,7 @@ def _range_levels(count: int) -> int:
 
 
 def profile_tables(position, slope, mu, length, sparse: bool = True) -> Tables:
-    r"""The tables of one profile for one :math:`\mu` and one stroke length :math:`A`.
-
-    Parameters
-    ----------
-    position : jax.Array, shape (N,)
-        Sample positions :math:`X`, increasing, relative to the scar centre. [m]
-    slope : jax.Array, shape (N,)
-        Slopes :math:`g` at the samples. [1]
-    mu : jax.Array, shape ()
-        Friction coefficient. [1]
-    length : jax.Array, shape ()
-        Stroke length :math:`A = \Delta^* W/x_o` in profile coordinates. [m]
-    sparse : bool
-        Build the :math:`O(N\log N)` tables for :math:`O(\log N)` queries (for many points
-        sharing :math:`\mu` and :math:`A`), or only the :math:`O(N)` ones (one point).
-
-    Returns
-    -------
-    tables : Tables
-        With a leading group axis of length 1.
-    """
+    r"""The tables of one profile for one :math:`\mu` and one stroke length :math:`A`."""
     p = position / length
     g = slope
     n = p.size

@@ -54,25 +54,7 @@ _LINE_SHARE = 0.05
 
 
 class ScarProfileWarning(UserWarning):
-    """What reading a measured profile decided that its user must see.
-
-    Outliers replaced, or ambiguous or uncertain edges. Callers that know where the samples
-    came from (a file's lines) name them with :meth:`text`.
-
-    Attributes
-    ----------
-    summary : str
-        The finding, without the samples.
-    samples : tuple of int
-        Indices of the samples concerned in the trace as given.
-    details : tuple of str
-        What each sample shows (its position and deviation), in the order of ``samples``.
-    alternative : float or None
-        For ambiguous or uncertain edges, the half-width not taken (``half_width=`` takes
-        it). [m]
-    alternative_name : str
-        What that half-width is.
-    """
+    """What reading a measured profile decided that its user must see."""
 
     def __init__(self, summary: str, samples=(), details=(), alternative=None,
                  alternative_name=""):  # fmt: skip
@@ -105,10 +87,7 @@ def _line(x, z, mask):
 
 
 def _crossing(x, r, start, step, tolerance, reach):
-    """Where ``r`` first reaches 0 (to ``tolerance``) from ``start`` in direction ``step``.
-
-    Returns the edge [m] and the index of the first sample reaching it; None at the trace's end.
-    """
+    """Where ``r`` first reaches 0 (to ``tolerance``) from ``start`` in direction ``step``."""
     if step < 0:
         found = np.flatnonzero(r[:start] >= -tolerance)
         if found.size == 0:
@@ -194,11 +173,7 @@ def _crest(x, r, index, drop):
 
 
 def _band_edge(x, r, outer, end, step, threshold, level):
-    """The inner foot of the band's pile-up ridge on one side [m], and its crest's index.
-
-    The foot is None where the groove's wall runs up into the ridge; without a ridge, the
-    position of ``end`` (None if it is ``outer``) and no crest.
-    """
+    """The inner foot of the band's pile-up ridge on one side [m], and its crest's index."""
     inward = np.arange(end, outer - step, -step)
     s = r[inward]
     above = np.flatnonzero(s > threshold)
@@ -318,9 +293,8 @@ class Extent(NamedTuple):
 
 
 def _edges(x, r, deepest, depth, noise, reach):
-    """The groove's and the band's edges, the ridges' crests, the band's outer ends, its
-    threshold and on a rough surface the edges read within the roughness (else None).
-    """
+    """The groove's and the band's edges, the ridges' crests, the band's outer ends, its threshold
+    and on a rough surface the edges read within the roughness (else None)."""
     tolerance = max(_LINE_TOLERANCE * depth, min(_LINE_NOISE * noise, _LINE_SHARE * depth))
     left = _crossing(x, r, deepest, -1, tolerance, reach)
     right = _crossing(x, r, deepest + 1, +1, tolerance, reach)
@@ -488,11 +462,7 @@ def _uncertainty(extent: Extent, given: bool):
 
 
 def scar_extent(x, zs, half_width, reach):
-    """The scar's :class:`Extent`, the half-width not taken [m] (NaN if none) and the warnings.
-
-    ``zs`` are the heights lightly smoothed (outliers replaced), ``reach`` the smoothing's
-    reach in samples; ``half_width`` as :func:`checked_trace` returns it.
-    """
+    """The scar's :class:`Extent`, the half-width not taken [m] (NaN if none) and the warnings."""
     extent = _scar_extent(x, zs, half_width, reach)
     finding, alternative = _ambiguity(x, extent, half_width is not None)
     if finding is None:

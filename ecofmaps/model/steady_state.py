@@ -51,10 +51,7 @@ _CORE = {
 
 
 def dimensionless(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width):
-    """The core numbers ``(mu, kappa, lam)`` of SI inputs, and their regime.
-
-    Any input out of its range (NaN included) gives the ``INVALID`` code.
-    """
+    """The core numbers ``(mu, kappa, lam)`` of SI inputs, and their regime."""
     kappa = curvature_number(amplitude, aspect_ratio, groove_half_width)
     lam = compliance_ratio(amplitude, load, stiffness)
     valid = valid_geometry(amplitude, load, stiffness, aspect_ratio, groove_half_width)
