@@ -79,16 +79,7 @@ _MAX_STEPS = 300  # the bracket [0, mu_E] halves at least every two steps
 
 @jax.custom_jvp
 def _root(ecof, kappa, lam):
-    """The :math:`\\mu` with :math:`\\mu_E(\\mu) =` ``ecof`` by bracketed Newton (see module).
-
-    The bracket starts as :math:`(0, \\min(\\mu_E, \\mu_{max}))`; :math:`\\mu_E - ecof` is
-    negative at its lower end and positive (or NaN, past the gross-slip or locking limit)
-    at its upper one, and every step keeps it so. A Newton step is taken only if it stays
-    inside the bracket and is less than half the step before it; otherwise the bracket is
-    bisected (as in Numerical Recipes' ``rtsafe``), so the bracket at least halves every
-    two steps even where Newton's method would cycle (the steep rise of :math:`\\mu_E`
-    near the locking point of a stiff rig).
-    """
+    r"""The :math:`\mu` with :math:`\mu_E(\mu) =` ``ecof`` by bracketed Newton (see module)."""
     mu_max = jnp.where(lam > 0.0, 1.0 / lam, 1.0 / kappa)
     low = jnp.zeros_like(ecof)
     high = jnp.minimum(ecof, mu_max)
@@ -122,14 +113,7 @@ def _root(ecof, kappa, lam):
 
 @_root.defjvp
 def _root_tangent(primals, tangents):
-    """The root's derivative by the implicit function theorem, not through the iterations.
-
-    :math:`\\mu_E(\\mu, \\kappa, \\lambda) = \\mu_E^{given}` at the root, so
-    :math:`d\\mu = (d\\mu_E^{given} - \\partial_\\kappa\\mu_E\\,d\\kappa -
-    \\partial_\\lambda\\mu_E\\,d\\lambda) / \\partial_\\mu\\mu_E`: linear in the tangents,
-    so ``jax.grad`` (reverse mode) transposes it, and the ``while_loop`` is never
-    differentiated.
-    """
+    """The root's derivative by the implicit function theorem, not through the iterations."""
     ecof, kappa, lam = primals
     d_ecof, d_kappa, d_lam = tangents
     mu = _root(ecof, kappa, lam)
@@ -241,25 +225,7 @@ def _si_correct(ecof, amplitude, load, stiffness, aspect_ratio):
 
 
 def groove_aspect_ratio(aspect_ratio, scar_depth, scar_half_width):
-    """The groove's aspect ratio from either way of giving it, checked.
-
-    Parameters
-    ----------
-    aspect_ratio : array_like or tuple (low, high) or None
-        :math:`z_o/x_o = D/W` (eq. 11), or an interval of it. [1]
-    scar_depth, scar_half_width : array_like or None
-        :math:`D` and :math:`W`, instead of ``aspect_ratio``. [m]
-
-    Returns
-    -------
-    aspect_ratio : jax.Array or tuple (low, high) of them
-        :math:`z_o/x_o` in float64 (call inside :func:`ecofmaps._inputs.float64`). [1]
-
-    Raises
-    ------
-    ValueError
-        For the ratio given neither or both ways, a bad interval, or a value out of range.
-    """
+    """The groove's aspect ratio from either way of giving it, checked."""
     if aspect_ratio is not None:
         if scar_depth is not None or scar_half_width is not None:
             raise ValueError(

@@ -34,12 +34,7 @@ def _ecof_on_profile(profile, mu, amplitude, load, stiffness, mapping):
 
 def correct_on_profile(ecof, amplitude, load, stiffness, profile, mapping, return_status,
                         factor, caller):  # fmt: skip
-    """correct_ecof / correction_factor on a profile (see correct_ecof's Notes).
-
-    The bracket [a, b] keeps mu_E(a) <= ecof < mu_E(b) (NaN, beyond gross slip or the
-    trace, counts as above); a point whose narrowed bracket still misses the ECoF by more
-    than 1e-9 of it lies at a jump of mu_E(mu) (``UNREACHABLE``).
-    """
+    """correct_ecof / correction_factor on a profile (see correct_ecof's Notes)."""
     check_mapping(mapping, None)
     profile = as_profile(profile)
     for name, value, rule, unit in (
@@ -101,10 +96,7 @@ def correct_on_profile(ecof, amplitude, load, stiffness, profile, mapping, retur
 
 
 def _illinois(profile, target, low, high, rig, mapping):
-    """Roots of mu_E(mu) = target in the brackets [low, high] (Illinois method).
-
-    Returns the roots and whether mu_E reaches the target there (within 1e-9 of it).
-    """
+    """Roots of mu_E(mu) = target in the brackets [low, high] (Illinois method)."""
     f_low = np.where(low > 0.0, _residual(profile, low, target, rig, mapping), -target)
     f_high = _residual(profile, high, target, rig, mapping)  # may be NaN: above
     side = np.zeros(target.size, dtype=np.int8)  # which end moved last (-1 low, +1 high)

@@ -111,42 +111,12 @@ _FALL_BISECTIONS = 48
 
 
 def ecof_and_slope(mu, kappa, lam):
-    """:math:`\\mu_E` and :math:`d\\mu_E/d\\mu` at each point (forward mode, elementwise).
-
-    Parameters
-    ----------
-    mu : array_like
-        Contact coefficient of friction :math:`\\mu`. [1]
-    kappa : array_like
-        Curvature number :math:`\\kappa = 2 z_o/x_o`. [1]
-    lam : array_like
-        Compliance ratio :math:`\\lambda = P/(S\\Delta^*)`. [1]
-
-    Returns
-    -------
-    ecof : jax.Array
-        Energy coefficient of friction :math:`\\mu_E = \\mu\\,(\\mu_E/\\mu)` (eq. 13-16). [1]
-    slope : jax.Array
-        Its derivative :math:`d\\mu_E/d\\mu` at fixed :math:`\\kappa, \\lambda`. [1]
-    """
+    """:math:`\\mu_E` and :math:`d\\mu_E/d\\mu` at each point (forward mode, elementwise)."""
     return jax.jvp(lambda m: m * model.ecof_ratio(m, kappa, lam), (mu,), (jnp.ones_like(mu),))
 
 
 def reachability_status(ecof, kappa, lam):
-    """The status before the ambiguity check: which ECoFs the model can reach.
-
-    Parameters
-    ----------
-    ecof : array_like
-        Energy coefficient of friction :math:`\\mu_E`. [1]
-    kappa, lam : array_like
-        :math:`\\kappa` and :math:`\\lambda`, as for :func:`ecof_and_slope`. [1]
-
-    Returns
-    -------
-    status : jax.Array of int32
-        ``CORRECTED``, ``NO_GROSS_SLIP`` (:math:`\\mu_E \\ge 1/\\lambda`) or ``INVALID``.
-    """
+    """The status before the ambiguity check: which ECoFs the model can reach."""
     valid = (
         (ecof > 0.0)
         & jnp.isfinite(ecof)
@@ -165,19 +135,7 @@ def reachability_status(ecof, kappa, lam):
 
 
 def may_fall(kappa, lam):
-    """Where :math:`\\mu_E(\\mu)` may fall over part of its range.
-
-    Parameters
-    ----------
-    kappa, lam : array_like
-        :math:`\\kappa` and :math:`\\lambda`, as for :func:`ecof_and_slope`. [1]
-
-    Returns
-    -------
-    may_fall : jax.Array of bool
-        False where :math:`\\mu_E(\\mu)` surely rises over its whole gross-slip range (the
-        bounds in :mod:`ecofmaps.correction.inversion`).
-    """
+    """Where :math:`\\mu_E(\\mu)` may fall over part of its range."""
     return (kappa > _FALL_KAPPA) & (lam > 0.0) & (lam < _FALL_LAMBDA)
 
 
@@ -252,47 +210,14 @@ def ecof_fall(kappa, lam):
 
 
 def ambiguity_marked(mu, status, ecof, high, low):
-    """The contact CoF and status, NaN and ``AMBIGUOUS`` where ``ecof`` lies in the fall.
-
-    Parameters
-    ----------
-    mu : array_like
-        Contact CoF of the inversion. [1]
-    status : array_like of int
-        :class:`CorrectionStatus` codes.
-    ecof : array_like
-        The energy CoF inverted. [1]
-    high, low : array_like
-        The fall of :math:`\\mu_E(\\mu)` from :func:`ecof_fall` (NaN where it rises). [1]
-
-    Returns
-    -------
-    mu : jax.Array
-        ``mu``, NaN where ``low <= ecof <= high`` at a corrected point. [1]
-    status : jax.Array of int32
-        ``status``, ``AMBIGUOUS`` there.
-    """
+    """The contact CoF and status, NaN and ``AMBIGUOUS`` where ``ecof`` lies in the fall."""
     ambiguous = (status == int(CorrectionStatus.CORRECTED)) & (ecof >= low) & (ecof <= high)
     status = jnp.where(ambiguous, int(CorrectionStatus.AMBIGUOUS), status).astype(jnp.int32)
     return jnp.where(ambiguous, jnp.nan, mu), status
 
 
 def ecof_fall_where_needed(status, kappa, lam):
-    """:func:`ecof_fall` at every point, scanned only if a corrected point may fall.
-
-    Parameters
-    ----------
-    status : array_like of int
-        :class:`CorrectionStatus` codes (from :func:`reachability_status`).
-    kappa, lam : array_like
-        :math:`\\kappa` and :math:`\\lambda`, as for :func:`ecof_and_slope`. [1]
-
-    Returns
-    -------
-    high, low : jax.Array
-        As for :func:`ecof_fall`; NaN everywhere when no corrected point may fall. They
-        only decide which points are ambiguous, so no derivative flows through them. [1]
-    """
+    """:func:`ecof_fall` at every point, scanned only if a corrected point may fall."""
     kappa, lam = jax.lax.stop_gradient(kappa), jax.lax.stop_gradient(lam)
     needed = jnp.any(may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
     nan = jnp.full(status.shape, jnp.nan)

@@ -90,25 +90,14 @@ class TableDialect(NamedTuple):
 
 
 def table_dialect(header_line: str) -> TableDialect:
-    """The separator the header line uses (tab, else ``;``, else ``,``).
-
-    Parameters
-    ----------
-    header_line : str
-        The table's first line that is neither blank nor a comment.
-
-    Returns
-    -------
-    dialect : TableDialect
-        The separator; ``decimal_comma`` False (it is known after the numbers are read).
-    """
+    """The separator the header line uses (tab, else ``;``, else ``,``)."""
     delimiter = "\t" if "\t" in header_line else ";" if ";" in header_line else ","
     return TableDialect(delimiter, False)
 
 
 def _number(path, line: int, name: str, text: str, decimal_comma: bool = False) -> float:
-    """The cell ``text`` of column ``name`` in SI, range-checked (``0,83`` read as 0.83 when
-    the table's separator is not a comma)."""
+    """The cell ``text`` of column ``name`` in SI, range-checked (``0,83`` read as 0.83 when the
+    table's separator is not a comma)."""
     quantity = nomenclature.QUANTITIES[COLUMNS[name]]
     unit = f" in {quantity.display_unit}" if quantity.display_unit else ""
     if decimal_comma and text.count(",") == 1 and "." not in text:
@@ -126,10 +115,7 @@ def _number(path, line: int, name: str, text: str, decimal_comma: bool = False) 
 
 
 def _read(path: Path, on_profile: bool = False):
-    """Header, rows (cells as written), their line numbers, the SI columns and the dialect.
-
-    On a profile the rows give no aspect ratio (the SI columns have none).
-    """
+    """Header, rows (cells as written), their line numbers, the SI columns and the dialect."""
     try:
         with open(path, encoding="utf-8-sig", newline="") as stream:
             lines = ["\n" if _is_comment(line) else line for line in stream]
@@ -231,36 +217,7 @@ def _check_header(path, line: int, header: list[str], on_profile: bool) -> None:
 
 
 def correct_table(path, profile=None, mapping="scaled") -> tuple[str, int]:
-    r"""Correct every row of a table of reported ECoF values (see the module docstring).
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The table: separated by commas, semicolons or tabs, with ``#`` comment lines.
-    profile : ScarProfile, optional
-        A measured wear-scar profile that gives every row's scar (the table then has no
-        scar columns).
-    mapping : {'scaled', 'physical'}
-        On a profile: :math:`X = xW/\Delta^*` (eq. 11) or :math:`X = x`.
-
-    Returns
-    -------
-    text : str
-        The output table with the input's separator: the input columns and cells, then
-        ``mu`` and ``correction_factor`` (both to 10 significant digits, with a decimal
-        comma if the input has them), and on a profile ``mu_parabolic``.
-    rows : int
-        The number of data rows.
-
-    Raises
-    ------
-    TableError
-        For a file that cannot be read as such a table, a bad value, or a row whose ECoF
-        cannot be corrected (the reason, as :func:`ecofmaps.correct_ecof` gives it); the
-        first such row is named by its line.
-    OSError
-        If the file cannot be opened.
-    """
+    r"""Correct every row of a table of reported ECoF values (see the module docstring)."""
     path = Path(path)
     header, records, si, dialect = _read(path, on_profile=profile is not None)
     rig = dict(amplitude=si["amplitude_um"], load=si["load_N"], stiffness=si["stiffness_MN_per_m"])
