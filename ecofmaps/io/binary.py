@@ -41,30 +41,7 @@ DEFAULT_CHUNK = 1 << 22
 
 
 class Column:
-    """One channel or variable as an array-like of float64 in SI, read range by range.
-
-    Parameters
-    ----------
-    path : pathlib.Path
-    kind : {'tdms', 'hdf5', 'zarr'}
-    variable : Variable
-    factor : float
-        From the file's values (after CF unpacking) to SI.
-    nan_policy : {'propagate', 'raise'}
-        Non-finite values become NaN, or raise :class:`RecordingError` naming the sample.
-    stamp : tuple, optional
-        What tells this file from another at the same path (its modification time and
-        size, :func:`read_binary`): a pickled column is unpickled as the same object in a
-        process only while the stamp is the same (:func:`_column`).
-
-    Notes
-    -----
-    Indexing with a slice (step 1) returns a NumPy array; what dask's ``from_array``
-    needs (``shape``, ``dtype``, ``ndim``). The open file is kept per process and per
-    column, behind a lock (a TDMS or HDF5 file is read by one thread at a time; a zarr
-    store by any number), and is not pickled. A forked process makes every column's lock
-    afresh (:func:`_watch_forks`).
-    """
+    """One channel or variable as an array-like of float64 in SI, read range by range."""
 
     def __init__(
         self, path: Path, kind: str, variable: Variable, factor: float, nan_policy, stamp=()
@@ -88,11 +65,7 @@ class Column:
         return self.variable.size
 
     def _source(self):
-        """The open channel or dataset (opened on first use in this process).
-
-        A process forked after the file was opened opens it again: with the parent's file
-        it would share the file's position, and two processes reading at once would read
-        each other's bytes."""
+        """The open channel or dataset (opened on first use in this process)."""
         if self._handle is not None and self._handle[2] != os.getpid():
             self._handle = None  # the parent's, left to the parent
         if self._handle is None:
@@ -158,9 +131,7 @@ _COLUMNS = weakref.WeakSet()
 
 @functools.cache
 def _watch_forks() -> None:
-    """From the first column on, a forked process gives each column a new lock
-    (:func:`_new_locks`): the lock it inherits is a copy of the parent's, taken for good if
-    one of the parent's threads was reading at the fork (that thread is not in the child)."""
+    """From the first column on, a forked process gives each column a new lock."""
     if hasattr(os, "register_at_fork"):  # where processes fork
         os.register_at_fork(after_in_child=_new_locks)
 
@@ -173,11 +144,7 @@ def _new_locks() -> None:
 
 @functools.lru_cache(maxsize=16)
 def _column(path, kind, variable, factor, nan_policy, stamp) -> Column:
-    """The column of these arguments, one object per process: the tasks of a long analysis
-    that run in one process (a worker of a dask cluster) each receive a pickled copy, and
-    all read through the one file this opens (reopening it cost about 7 ms a task). A
-    stamp that changed (the file rewritten) makes another column; the least recently used
-    of more than 16 are let go."""
+    """The column of these arguments, one object per process."""
     return Column(path, kind, variable, factor, nan_policy, stamp)
 
 

@@ -68,18 +68,7 @@ def atomic_path(path):
 
 
 def write_text(path, text: str) -> Path:
-    """Write ``text`` (UTF-8) to ``path`` atomically (a temporary file, then a rename).
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        Destination; its directory must exist.
-    text : str
-
-    Returns
-    -------
-    path : pathlib.Path
-    """
+    """Write ``text`` (UTF-8) to ``path`` atomically (a temporary file, then a rename)."""
     path = Path(path)
     with atomic_path(path) as temporary:
         temporary.write_text(text, encoding="utf-8", newline="")
@@ -177,23 +166,13 @@ _FOLDER = "is a folder, not a store written by ecofmaps: it is not replaced"
 
 
 def is_store(path) -> bool:
-    """Whether ``path`` is a directory holding a zarr store (its metadata file at the top).
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-
-    Returns
-    -------
-    store : bool
-    """
+    """Whether ``path`` is a directory holding a zarr store (its metadata file at the top)."""
     path = Path(path)
     return path.is_dir() and any((path / name).is_file() for name in _STORE_MARKERS)
 
 
 def _manifest(folder: Path) -> dict:
-    """The entries of ``folder``'s manifest: name -> what was written (empty if none or
-    unreadable: then nothing there counts as written by ecofmaps)."""
+    """The entries of ``folder``'s manifest."""
     try:
         entries = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))["written"]
     except (OSError, ValueError, KeyError, TypeError):
@@ -202,9 +181,7 @@ def _manifest(folder: Path) -> dict:
 
 
 def _entry(path: Path) -> dict:
-    """What the manifest keeps of ``path``: a store, or a file's size and the SHA-256 of its
-    content (not its time, so a file committed to a repository with its folder's manifest
-    is still known as ecofmaps' own in a fresh clone)."""
+    """What the manifest keeps of ``path``."""
     if path.is_dir():
         return {"store": True}
     digest = hashlib.sha256()
@@ -215,19 +192,7 @@ def _entry(path: Path) -> dict:
 
 
 def written_by_ecofmaps(path) -> bool:
-    """Whether ``path`` is a file or store that ecofmaps wrote, unchanged since.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-
-    Returns
-    -------
-    written : bool
-        True if the manifest of its folder (:data:`MANIFEST`) lists it and, for a file,
-        its size and content (SHA-256) are those recorded; False for anything else (a
-        file edited or replaced since, a folder that is not a store, a symbolic link).
-    """
+    """Whether ``path`` is a file or store that ecofmaps wrote, unchanged since."""
     path = Path(path)
     if path.is_symlink() or not path.exists() or (path.is_dir() and not is_store(path)):
         return False
@@ -240,19 +205,7 @@ def written_by_ecofmaps(path) -> bool:
 
 
 def record_written(paths) -> None:
-    """Add files and stores just written to the manifests of their folders (atomically).
-
-    Parameters
-    ----------
-    paths : iterable of str or os.PathLike
-        What the command wrote; those that do not exist are left out.
-
-    Notes
-    -----
-    Two commands writing into one folder at the same time may each keep only their own
-    entries (the last manifest written wins); a file left out is only refused later, never
-    replaced.
-    """
+    """Add files and stores just written to the manifests of their folders (atomically)."""
     folders = {}
     for path in map(Path, paths):
         if path.exists() and not path.is_symlink():

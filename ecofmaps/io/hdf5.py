@@ -41,13 +41,7 @@ def _refused(path: Path, error: Exception) -> RecordingError:
 
 def hdf5_groups(path) -> dict[str, xr.Dataset]:
     """Every group of an HDF5 / netCDF-4 file as a lazily read Dataset, by its path
-    (``'/'``, ``'/rig/run1'``).
-
-    Raises
-    ------
-    RecordingError
-        If the file cannot be opened as HDF5.
-    """
+    (``'/'``, ``'/rig/run1'``)."""
     path = Path(path)
     try:
         return xr.open_groups(path, **OPTIONS)
@@ -56,13 +50,7 @@ def hdf5_groups(path) -> dict[str, xr.Dataset]:
 
 
 def open_hdf5_group(path, group: str | None = None) -> xr.Dataset:
-    """One group of an HDF5 / netCDF-4 file (by default the root) as a lazily read Dataset.
-
-    Raises
-    ------
-    RecordingError
-        If the file cannot be opened as HDF5, or has no such group.
-    """
+    """One group of an HDF5 / netCDF-4 file (by default the root) as a lazily read Dataset."""
     path = Path(path)
     try:
         return xr.open_dataset(path, group=group or None, **OPTIONS)

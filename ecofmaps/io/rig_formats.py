@@ -40,23 +40,7 @@ _GROUP = {"tdms": open_tdms_group, "hdf5": open_hdf5_group, "zarr": open_zarr_gr
 
 @dataclasses.dataclass(frozen=True)
 class Variable:
-    """A one-dimensional channel or variable of a rig file.
-
-    Attributes
-    ----------
-    name : str
-        Its full name, ``group/name`` (``Rig/Force``), or ``name`` at the root.
-    group : str
-        The group path (``''`` for the root).
-    short : str
-        Its own name, without the group (a TDMS channel's may hold a ``/``).
-    size : int
-        Number of samples.
-    units : tuple of str
-        The units its metadata gives (none, or one).
-    chunk : int
-        Samples per chunk in the file, or 0 if the file does not say.
-    """
+    """A one-dimensional channel or variable of a rig file."""
 
     name: str
     group: str
@@ -96,24 +80,7 @@ def _listed(group: str, dataset: xr.Dataset) -> list[Variable]:
 
 
 def variables(path, kind: str) -> list[Variable]:
-    """The one-dimensional numeric channels or variables of a rig file.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-    kind : {'tdms', 'hdf5', 'zarr'}
-        The format (see :func:`ecofmaps.io.recordings.recording_format`).
-
-    Returns
-    -------
-    variables : list of Variable
-        In the file's order, group by group.
-
-    Raises
-    ------
-    RecordingError
-        If the file cannot be opened as ``kind`` (truncated, damaged).
-    """
+    """The one-dimensional numeric channels or variables of a rig file."""
     groups = _GROUPS[kind](Path(path))
     try:
         return [variable for name, ds in groups.items() for variable in _listed(name, ds)]
@@ -130,13 +97,7 @@ def open_group(path, kind: str, group: str) -> xr.Dataset:
 
 def check_complete(path, kind: str, variable: Variable) -> None:
     """Refuse a zarr variable some of whose chunk files are missing (zarr would read them
-    as fill values); other formats check themselves when opened.
-
-    Raises
-    ------
-    RecordingError
-        Naming the variable and how many of its chunks are missing.
-    """
+    as fill values); other formats check themselves when opened."""
     if kind != "zarr":
         return
     missing, expected = missing_chunks(path, variable.name)

@@ -53,13 +53,7 @@ class _Notices(logging.Handler):
 
 
 def opened_tdms(path: Path) -> TdmsFile:
-    """The file opened by npTDMS's streaming reader (the data read on demand).
-
-    Raises
-    ------
-    RecordingError
-        If npTDMS cannot read it, or finds it truncated or damaged.
-    """
+    """The file opened by npTDMS's streaming reader (the data read on demand)."""
     logger = logging.getLogger("nptdms")
     notices = _Notices()
     logger.addHandler(notices)
@@ -80,17 +74,7 @@ def opened_tdms(path: Path) -> TdmsFile:
 
 
 class TdmsReader:
-    """One TDMS file, opened on first read in each process, read by one thread at a time.
-
-    Pickled by its path only (the copy opens the file again where it is read), and a
-    forked process opens its own: a shared file would share its position.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-    handle : nptdms.TdmsFile, optional
-        The file already opened (:func:`opened_tdms`) in this process, now the reader's.
-    """
+    """One TDMS file, opened on first read in each process, read by one thread at a time."""
 
     def __init__(self, path, handle=None):
         self.path = Path(path)
@@ -178,23 +162,7 @@ def _group_dataset(reader: TdmsReader, group) -> xr.Dataset:
 
 def tdms_groups(path) -> dict[str, xr.Dataset]:
     """Every group of a TDMS file as a lazily read Dataset, by its path (``'/Rig'``; the
-    root, ``'/'``, holds the file's properties and no variables).
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-
-    Returns
-    -------
-    groups : dict of str to xarray.Dataset
-        All read through one :class:`TdmsReader` (closing any of them closes the file,
-        which is opened again on the next read).
-
-    Raises
-    ------
-    RecordingError
-        If the file is not TDMS, or is truncated or damaged.
-    """
+    root, ``'/'``, holds the file's properties and no variables)."""
     path = Path(path)
     handle = opened_tdms(path)
     reader = TdmsReader(path, handle)  # reads through the file opened to list the groups
@@ -207,19 +175,7 @@ def tdms_groups(path) -> dict[str, xr.Dataset]:
 
 
 def open_tdms_group(path, group: str | None = None) -> xr.Dataset:
-    """One group of a TDMS file as a lazily read Dataset (see :func:`tdms_groups`).
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-    group : str, optional
-        The group's name (a leading ``/`` is ignored); by default the file's first group.
-
-    Raises
-    ------
-    RecordingError
-        If the file is not TDMS, is damaged, or has no such group (the message lists them).
-    """
+    """One group of a TDMS file as a lazily read Dataset (see :func:`tdms_groups`)."""
     path = Path(path)
     groups = {name: ds for name, ds in tdms_groups(path).items() if name != "/"}
     if group is None and groups:
@@ -234,14 +190,7 @@ def open_tdms_group(path, group: str | None = None) -> xr.Dataset:
 class TdmsBackendEntrypoint(BackendEntrypoint):
     """xarray's engine ``ecofmaps-tdms``: a TDMS group as a Dataset (channels as variables,
     named as in the file, ``units`` from ``unit_string``/``NI_UnitDescription``, read
-    lazily through npTDMS); the whole file as a DataTree.
-
-    Examples
-    --------
-    >>> from ecofmaps.io.tdms import TdmsBackendEntrypoint
-    >>> TdmsBackendEntrypoint().guess_can_open("rig.tdms")
-    True
-    """
+    lazily through npTDMS); the whole file as a DataTree."""
 
     description = "TDMS (LabVIEW) files through npTDMS, one group a Dataset (ecofmaps)"
     open_dataset_parameters = ("filename_or_obj", "drop_variables", "group")

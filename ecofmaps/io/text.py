@@ -87,8 +87,7 @@ def _is_data(line: str) -> bool:
 
 
 def _file_bytes(path: Path, block_bytes: int):
-    """The file's bytes, about ``block_bytes`` at a time: gunzipped if compressed, UTF-16
-    re-encoded as UTF-8, without byte-order mark, a lone carriage return made a line feed."""
+    """The file's bytes, about ``block_bytes`` at a time."""
     with open(path, "rb") as raw:
         compressed = raw.read(2) == _GZIP
         raw.seek(0)
@@ -111,8 +110,7 @@ def _file_bytes(path: Path, block_bytes: int):
 
 
 def _first_bytes(path: Path, stream, compressed: bool) -> bytes:
-    """For a UTF-16 file, read whole, all of its text as UTF-8; else none (``stream`` is
-    left at the start of the text, after any byte-order mark)."""
+    """For a UTF-16 file, read whole, all of its text as UTF-8."""
     head = stream.read(8)
     if compressed and head.startswith((b"TDSm", b"\x89HDF")):
         kind = "TDMS" if head.startswith(b"TDSm") else "HDF5"
@@ -140,8 +138,8 @@ class _Damaged(Exception):
 
 
 def _line_blocks(path: Path, chunks):
-    """Bytes of whole lines, one block per chunk or more (the last may lack a newline),
-    each with the 1-based number of its first line and its number of lines."""
+    """Bytes of whole lines, one block per chunk or more (the last may lack a newline), each with
+    the 1-based number of its first line and its number of lines."""
     rest, line = b"", 1
     try:
         for chunk in chunks:
@@ -190,8 +188,7 @@ class _Decoder:
 
 
 def _separator(header: str):
-    """The field separator of the header line: tab, semicolon or comma (outside quotes),
-    else None (runs of blanks)."""
+    """The field separator of the header line."""
     unquoted = re.sub(r'"[^"]*"', "", header)
     for candidate in ("\t", ";", ","):
         if candidate in unquoted:
@@ -226,8 +223,7 @@ def _numeric(cells) -> bool:
 
 
 def _wanted(options: dict) -> dict:
-    """The column asked for by role: a recording's, or those given (a scar profile's x and
-    z); the cycle column only if given (else it is optional)."""
+    """The column asked for by role."""
     if "columns" in options:  # exactly the columns given
         return dict(options["columns"])
     wanted = {"displacement": options["displacement_column"], "force": options["force_column"]}
@@ -238,8 +234,7 @@ def _wanted(options: dict) -> dict:
 
 
 def _is_header(line: str, following: str | None, wanted: dict) -> bool:
-    """Whether ``line`` reads as the header: not all numbers, names in which every column
-    wanted is found, and as many cells as the next line holds (if there is one)."""
+    """Whether ``line`` reads as the header."""
     separator = _separator(line)
     names = _header_names(line, separator)
     if _numeric(names):
@@ -250,12 +245,7 @@ def _is_header(line: str, following: str | None, wanted: dict) -> bool:
 
 
 def _header_index(lines: list[str], options: dict) -> int | None:
-    """The index in ``lines`` (the file's first lines) of the header line.
-
-    After ``skip_rows`` lines, the first that is not blank or a comment; without it, the
-    first of the first :data:`PREAMBLE_LINES` such lines that reads as the header
-    (:func:`_is_header`), else (for the error it will give) the one before the first line
-    of numbers, or the first."""
+    """The index in ``lines`` (the file's first lines) of the header line."""
     skip = options.get("skip_rows")
     found = (k for k in range(skip or 0, len(lines)) if _is_data(lines[k]))
     data = list(itertools.islice(found, 1 if skip is not None else PREAMBLE_LINES + 1))
@@ -342,13 +332,7 @@ class _Layout:
         ]
 
     def parse(self, body, numbers: np.ndarray, lines: list[str] | None = None):
-        """The wanted columns of the data lines ``body``, in SI, by role.
-
-        Without ``lines``, ``body`` is a block as read (UTF-8 bytes, or text), and the
-        result is None if anything is amiss (a line with the wrong number of cells or
-        blank, a cell that is not a number, a missing sample to raise for, a byte that is
-        not UTF-8), for the caller to drop blank and comment lines and call again with the
-        text ``lines`` kept, which are then checked one by one and the error raised."""
+        """The wanted columns of the data lines ``body``, in SI, by role."""
         careful = lines is not None
         raw = isinstance(body, bytes)
         if self.decimal is None:
@@ -429,32 +413,7 @@ class _Layout:
 
 
 def text_blocks(path: Path, options: dict, block_bytes: int = BLOCK_BYTES):
-    """Parse a text recording block by block.
-
-    Parameters
-    ----------
-    path : pathlib.Path
-    options : dict
-        The column, unit, ``skip_rows`` and nan_policy options of
-        :func:`ecofmaps.io.read_recording`.
-    block_bytes : int
-        Bytes of text parsed at a time.
-
-    Yields
-    ------
-    layout : _Layout
-        First, once: the header's layout (names, the columns used, units).
-    values, lines : dict, numpy.ndarray
-        Then per block: the wanted columns in SI by role, and the 1-based line number of
-        each sample.
-
-    Raises
-    ------
-    RecordingError
-        For a missing or doubtful column, a line with the wrong number of fields, a cell
-        that is not a number (or, with ``nan_policy='raise'``, a missing one), no data, or
-        damaged compressed data.
-    """
+    """Parse a text recording block by block."""
     decoder = _Decoder(path)
     chunks = _file_bytes(path, block_bytes)
     blocks = _line_blocks(path, chunks)
@@ -484,9 +443,7 @@ def text_blocks(path: Path, options: dict, block_bytes: int = BLOCK_BYTES):
 
 
 def _head(blocks, decoder: _Decoder, options: dict) -> list[str]:
-    """The first lines of the file, decoded: whole blocks, enough to find the header (the
-    first line that is not blank or a comment after ``skip_rows``, or
-    :data:`PREAMBLE_LINES` and one of them)."""
+    """The first lines of the file, decoded."""
     skip = options.get("skip_rows")
     needed = 1 if skip is not None else PREAMBLE_LINES + 1
     lines: list[str] = []
@@ -503,9 +460,7 @@ def _head(blocks, decoder: _Decoder, options: dict) -> list[str]:
 
 
 def _parsed_lines(layout: _Layout, lines: list[str], start: int):
-    """The values and line numbers of the data in decoded ``lines`` (the first numbered
-    ``start``): parsed as one text if it has no comment (and all goes well), else line by
-    line, raising for the first damaged one."""
+    """The values and line numbers of the data in decoded ``lines`` (the first is ``start``)."""
     body = "\n".join(lines)
     if lines and "#" not in body:
         numbers = start + np.arange(len(lines), dtype=np.int64)

@@ -94,13 +94,7 @@ def _plain_groups(path: Path, root) -> dict[str, xr.Dataset]:
 
 def zarr_groups(path) -> dict[str, xr.Dataset]:
     """Every group of a zarr store as a lazily read Dataset, by its path (``'/'``,
-    ``'/rig/run1'``).
-
-    Raises
-    ------
-    RecordingError
-        If the path is not a zarr store xarray or zarr can open.
-    """
+    ``'/rig/run1'``)."""
     path = Path(path)
     root = _opened(path)
     if not hasattr(root, "members"):  # a store that is one array, which xarray cannot open
@@ -116,13 +110,7 @@ def zarr_groups(path) -> dict[str, xr.Dataset]:
 
 
 def open_zarr_group(path, group: str | None = None) -> xr.Dataset:
-    """One group of a zarr store (by default the root) as a lazily read Dataset.
-
-    Raises
-    ------
-    RecordingError
-        If the path is not a zarr store, or has no such group.
-    """
+    """One group of a zarr store (by default the root) as a lazily read Dataset."""
     path = Path(path)
     key = "/" + (group or "").strip("/")
     root = _opened(path)
