@@ -52,10 +52,7 @@ def _global_attrs(title: str) -> dict:
 
 
 def checked_axis(name: str, value, rule: str, unit: str) -> np.ndarray:
-    """``value`` checked (``ValueError`` naming ``name``) as a float64 scalar or 1-D array.
-
-    A 1-D array is a grid axis: it must hold each value once.
-    """
+    """``value`` checked (``ValueError`` naming ``name``) as a float64 scalar or 1-D array."""
     check(name, value, rule, unit)
     array = np.asarray(value, dtype=np.float64)
     if array.ndim > 1:
@@ -85,13 +82,7 @@ def checked_load(load) -> np.ndarray | None:
 
 
 def grid_dataset(axes: dict, values: dict, title: str, extra=None) -> xr.Dataset:
-    """A Dataset of grid ``values`` over ``axes`` (scalars become scalar coordinates).
-
-    A value is an array over the whole grid (with a length-1 axis for each scalar
-    coordinate), or a ``(dims, array)`` pair for one that depends on fewer parameters.
-    ``extra`` coordinates are not grid axes: 0-d ones are scalar coordinates, 1-D ones
-    trailing dimensions of the values that have more axes than the grid.
-    """
+    """A Dataset of grid ``values`` over ``axes`` (scalars become scalar coordinates)."""
     dims = [name for name, axis in axes.items() if axis.ndim == 1]
     squeeze = tuple(i for i, axis in enumerate(axes.values()) if axis.ndim == 0)
     extra = extra or {}

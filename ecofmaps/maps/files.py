@@ -41,11 +41,7 @@ def _is_zarr_store(path: Path) -> bool:
 
 @contextlib.contextmanager
 def _threads():
-    """A thread per core for dask; on leaving, queued tasks are dropped and running ones end.
-
-    The temporary output is removed only after this, so that no task still writes into
-    it (or creates it again) after an interrupt.
-    """
+    """A thread per core for dask; on leaving, queued tasks are dropped and running ones end."""
     pool = concurrent.futures.ThreadPoolExecutor(tile_workers())
     try:
         yield pool

@@ -65,10 +65,7 @@ def available_memory() -> int | None:
 
 @functools.lru_cache(maxsize=64)
 def _bytes_per_point(kernel, axes: int, extra: tuple) -> int:
-    """Bytes of ``kernel``'s results per grid point, from ``jax.eval_shape`` on one point.
-
-    ``extra`` holds the shapes and dtypes of the extra arguments (``None`` for ``None``).
-    """
+    """Bytes of ``kernel``'s results per grid point, from ``jax.eval_shape`` on one point."""
     point = [jax.ShapeDtypeStruct((1,), np.float64)] * axes
     arguments = [None if e is None else jax.ShapeDtypeStruct(*e) for e in extra]
     with jax.enable_x64(True):
@@ -81,13 +78,7 @@ def _signature(extra) -> tuple:
 
 
 def _check_memory(kernel, axes, extra, max_chunk: int) -> None:
-    """Refuse, before allocating, a grid whose results would not fit in the free memory.
-
-    The results' sizes come from ``jax.eval_shape`` (no computation); the working arrays
-    of the blocks evaluated at once (each taken as twice its results) come on top. The
-    way out is named: a chunked map (``chunks=``) is computed block by block and never
-    needs more than a few blocks in memory.
-    """
+    """Refuse, before allocating, a grid whose results would not fit in the free memory."""
     per_point = _bytes_per_point(kernel, len(axes), _signature(extra))
     points = math.prod(axis.size for axis in axes)
     needed = per_point * (points + 2 * tile_workers() * min(points, max_chunk))
@@ -111,25 +102,14 @@ def tile_workers() -> int:
 
 
 def _split(shape: tuple[int, ...], points: int) -> tuple[int, int]:
-    """How blocks of at most ``points`` points tile ``shape``: split axis ``k`` and ``rows``.
-
-    The split axis is the first one whose trailing axes hold at most ``points`` points
-    together; a block takes one index along the axes before ``k``, ``rows`` consecutive
-    indices along ``k`` and all of the axes after it. The blocks along ``k`` are as even as
-    can be, so the last one (padded up to ``rows`` in a tile) wastes little.
-    """
+    """How blocks of at most ``points`` points tile ``shape``: split axis ``k`` and ``rows``."""
     k = next(i for i in range(len(shape)) if math.prod(shape[i + 1 :]) <= points)
     count = -(-shape[k] // max(1, points // math.prod(shape[k + 1 :])))  # blocks along k
     return k, -(-shape[k] // count)
 
 
 def _tiles(split: tuple[int, int], region):
-    """The tiles (``index``, ``start``) of a grid split by ``split`` that overlap ``region``.
-
-    ``region`` holds a ``(start, stop)`` pair per axis. A tile is the block of
-    :func:`_split` at ``index`` along the axes before the split axis and at rows
-    ``start:start + rows`` along it (the tiles' starts are multiples of ``rows``).
-    """
+    """The tiles (``index``, ``start``) of a grid split by ``split`` that overlap ``region``."""
     k, rows = split
     first = region[k][0] // rows * rows
     for index in itertools.product(*(range(start, stop) for start, stop in region[:k])):
@@ -138,16 +118,7 @@ def _tiles(split: tuple[int, int], region):
 
 
 def _fill(out, kernel, axes, extra, split, region, tiles, stop=None) -> None:
-    """Evaluate ``tiles`` and copy their part inside ``region`` into the arrays ``out``.
-
-    Every tile has the same shape (the last one along the split axis is padded by
-    repeating its last value, and the padding is dropped), so the kernel compiles once
-    and each point's value does not depend on how the grid is cut into blocks: the
-    in-memory and chunked maps are equal to the bit. ``out`` maps each result's name to
-    an array of the region's shape (allocated here on the first tile when empty).
-    ``stop``, a ``threading.Event``, ends the loop at the next tile once it is set; after
-    Ctrl-C on the command line the loop raises ``KeyboardInterrupt`` at the next tile.
-    """
+    """Evaluate ``tiles`` and copy their part inside ``region`` into the arrays ``out``."""
     k, rows = split
     offset = tuple(start for start, _ in region)
     trailing = tuple(slice(start, stop) for start, stop in region[k + 1 :])
@@ -175,15 +146,7 @@ def _fill(out, kernel, axes, extra, split, region, tiles, stop=None) -> None:
 
 
 def _evaluate_grid(kernel, axes, extra, max_chunk: int) -> dict[str, np.ndarray]:
-    """Evaluate ``kernel(*block_axes, *extra)`` over the grid spanned by 1-D ``axes``.
-
-    ``kernel`` is jit-compiled and returns a dict of arrays of the block's full shape. A
-    grid of at most ``max_chunk`` points is one call, and its arrays are XLA's own
-    buffers, read-only, without a copy. A larger grid is cut into tiles of at most
-    ``max_chunk`` points (:func:`_split`), which threads (one per core) evaluate and copy
-    into the result arrays: a tile's working arrays stay in the processor's cache, and
-    the cost grows linearly with the number of points.
-    """
+    """Evaluate ``kernel(*block_axes, *extra)`` over the grid spanned by 1-D ``axes``."""
     if not (isinstance(max_chunk, int) and not isinstance(max_chunk, bool) and max_chunk >= 1):
         raise ValueError(f"max_chunk must be an integer >= 1, got {max_chunk!r}")
     _check_memory(kernel, axes, extra, max_chunk)
@@ -256,13 +219,7 @@ def _block_lengths(chunks, shape, dims, split) -> list[int]:
 
 
 def _chunked_grid(kernel, axes, extra, max_chunk: int, chunks, dims) -> dict:
-    """The results of :func:`_evaluate_grid` as dask arrays, one task per block.
-
-    Each block's task evaluates the tiles that overlap it (the same tiles as in memory,
-    so the values are equal to the bit) and returns its arrays by name; the variables'
-    chunks are taken from it, so a block is evaluated once for all of them. Keys of the
-    block tasks start with :data:`BLOCK_TASK`.
-    """
+    """The results of :func:`_evaluate_grid` as dask arrays, one task per block."""
     import dask.array as da
     from dask.base import tokenize
     from dask.highlevelgraph import HighLevelGraph
