@@ -40,11 +40,7 @@ __all__ = ["ecof_ratio_contours", "universal_ecof_ratio_map"]
 
 
 def _ecof_ratio_contours(ax, x, ratio: xr.DataArray, regime: xr.DataArray) -> list:
-    """Filled and labelled contours of μ_E/μ over (x, z_o/x_o), no-gross-slip area hatched.
-
-    ``ratio`` and ``regime`` have the dims (x dimension, aspect_ratio); ``x`` holds the
-    x values. Returns the legend handles of what was drawn besides the contours.
-    """
+    """Filled and labelled contours of μ_E/μ over (x, z_o/x_o), no-gross-slip area hatched."""
     y = ratio["aspect_ratio"].values
     values = ratio.transpose(..., "aspect_ratio").values.T
     top = np.nanmax(values)

@@ -155,8 +155,8 @@ def _crossings(ax, cycle: xr.Dataset, load: float) -> None:
 
 
 def _flags_text(quality: str, width: int = 50) -> str:
-    """A cycle's flags, comma separated, or the first and how many more when they are
-    longer than ``width`` characters."""
+    """A cycle's flags, comma separated, or the first and how many more when they are longer than
+    ``width`` characters."""
     reasons = quality.split(SEPARATOR)
     text = ", ".join(reasons)
     if len(text) <= width or len(reasons) == 1:
@@ -265,22 +265,21 @@ def cof_evolution(results: xr.Dataset) -> Figure:
 
 
 def _note(ax, text: str, height: float = 0.5) -> None:
-    """Write ``text`` across the panel ``ax``, which has nothing else to show, at ``height``
-    (a fraction of the panel's, from the bottom)."""
+    """Write ``text`` across the panel ``ax``, which has nothing else to show, at ``height`` (a
+    fraction of the panel's, from the bottom)."""
     ax.text(0.5, height, text, transform=ax.transAxes, ha="center", va="center", color="0.3",
             fontsize="small")  # fmt: skip
 
 
 def _no_ticks(ax) -> None:
-    """No ticks or tick labels on either axis of ``ax``, on which nothing was drawn (the
-    axis labels stay: they say what the panel would show)."""
+    """No ticks or tick labels on either axis of ``ax``, on which nothing was drawn (the axis labels
+    stay."""
     ax.set_xticks([])
     ax.set_yticks([])
 
 
 def _why_none(results: xr.Dataset) -> str:
-    """Why no cycle of ``results`` has a value: every cycle flagged (with how many cycles
-    carry each reason, on a second line), or none in gross slip."""
+    """Why no cycle of ``results`` has a value."""
     if "quality" not in results or (results["quality"].values == "ok").any():
         return "no cycle in gross slip"
     counts = {}
@@ -291,8 +290,8 @@ def _why_none(results: xr.Dataset) -> str:
 
 
 def _cycle_axis(ax, cycle) -> None:
-    """Integer ticks on the cycle axis of ``ax``, its limits the cycles' range (with a
-    half-cycle margin), whether or not anything was drawn."""
+    """Integer ticks on the cycle axis of ``ax``, its limits the cycles' range (with a half-cycle
+    margin), whether or not anything was drawn."""
     ax.xaxis.set_major_locator(MaxNLocator(integer=True, min_n_ticks=1))
     if cycle.size:
         first, last = float(np.min(cycle)), float(np.max(cycle))
@@ -487,8 +486,7 @@ def _profile_over_test(figure: Figure, image, resolved: xr.Dataset) -> None:
 
 
 def _mu_over_test(test, resolved: xr.Dataset, results: xr.Dataset | None) -> None:
-    """Panel (d): mu_resolved ± 2 standard errors over the cycles, the ECoF and GICoF of
-    ``results``, the cycles with no value marked, the aspect ratio on a right-hand axis."""
+    """Panel (d)."""
     number = resolved["cycle"].values
     mu = resolved["mu_resolved"].values
     error = 2.0 * resolved["mu_resolved_se"].values

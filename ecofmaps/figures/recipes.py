@@ -106,11 +106,7 @@ class FigureRecipe:
 
 
 def _loops() -> xr.Dataset:
-    """The loops of Figures 5 and 6: rigid and 35 MN/m rigs, z_o/x_o = 0, 0.1, 0.2, 0.3.
-
-    Kept in the disk cache like the maps (:func:`ecofmaps.maps.grid.compute_loops` is part
-    of the model's revision, :func:`ecofmaps.maps.cache.model_revision`).
-    """
+    """The loops of Figures 5 and 6: rigid and 35 MN/m rigs, z_o/x_o = 0, 0.1, 0.2, 0.3."""
     # Imported here, like the map functions below: the registry reads without JAX.
     from ecofmaps.maps.cache import cached_dataset
     from ecofmaps.maps.grid import compute_loops
@@ -171,20 +167,7 @@ _SCAR_SHAPES_SOURCES = ("figures/recipes.py", "correction/*.py")
 
 
 def source_digest(patterns) -> np.ndarray:
-    """SHA-256 of the package's source files matching ``patterns``, as 32 numbers.
-
-    Parameters
-    ----------
-    patterns : iterable of str
-        Glob patterns relative to the package directory (``'correction/*.py'``).
-
-    Returns
-    -------
-    digest : numpy.ndarray
-        32 bytes (uint8) of the hash of the files' names and contents: an input of a cache
-        key (:func:`ecofmaps.maps.cache.cache_key`), so an edit of those files gives another
-        key.
-    """
+    """SHA-256 of the package's source files matching ``patterns``, as 32 numbers."""
     package = Path(__file__).resolve().parents[1]
     digest = hashlib.sha256()
     for pattern in patterns:
@@ -249,18 +232,7 @@ _SHAPES_COORDS = {"shape": list(SCAR_SHAPES), "groove": ["profile", "parabola"]}
 
 
 def scar_shape_model_dataset() -> xr.Dataset:
-    """The model on each scar family: steady values over S/P and the loop of Example 2's rig.
-
-    One compiled kernel gives both, for every scar (their profiles have the same sample
-    count): :func:`ecofmaps.model.on_profile.steady_numbers_and_loops`.
-
-    Returns
-    -------
-    dataset : xarray.Dataset
-        ``slip_amplitude``, ``dissipated_energy``, ``ecof`` and ``ecof_ratio`` over
-        (``shape``, ``stiffness_ratio``); ``displacement`` and ``force`` over (``shape``,
-        ``point``), Example 2's rig. Computed, not cached.
-    """
+    """The model on each scar family: steady values over S/P and the loop of Example 2's rig."""
     from ecofmaps.model.on_profile import (  # JAX: as compute_map
         steady_numbers_and_loops,
         steady_values,
@@ -294,15 +266,7 @@ def scar_shape_model_dataset() -> xr.Dataset:
 
 def scar_shape_parabola_dataset() -> xr.Dataset:
     """The parabola of Example 2's D/W (steady values over S/P, the loop of Example 2's rig)
-    and the heights of the scar families.
-
-    Returns
-    -------
-    dataset : xarray.Dataset
-        ``scar_height`` over (``shape``, ``scar_position``); ``slip_amplitude``,
-        ``dissipated_energy``, ``ecof`` and ``ecof_ratio`` over ``stiffness_ratio``;
-        ``displacement`` and ``force`` over ``point``. Computed, not cached.
-    """
+    and the heights of the scar families."""
     from ecofmaps.maps.grid import compute_map  # JAX: the registry reads without it
 
     ratios = _SHAPES_STIFFNESS_RATIOS
@@ -328,18 +292,7 @@ def scar_shape_parabola_dataset() -> xr.Dataset:
 
 
 def scar_shapes_dataset() -> xr.Dataset:
-    """The four scar families at Example 2's D/W: profiles, loops, μ_E/μ over S/P (Fig. 11's).
-
-    Its parts are read from the cache, or computed and stored there
-    (:func:`scar_shape_model_dataset`, :func:`scar_shape_parabola_dataset`: ``ecofmaps
-    figures`` computes them in parallel); the D/W shortcut's error is computed here.
-
-    Returns
-    -------
-    dataset : xarray.Dataset
-        The ``shapes`` figure's numbers: see
-        :func:`ecofmaps.figures.profile_figures.scar_shape_comparison` for its variables.
-    """
+    """The four scar families at Example 2's D/W: profiles, loops, μ_E/μ over S/P (Fig. 11's)."""
     model, parabola = _scar_shape_model(), _scar_shape_parabola()
     ratios = _SHAPES_STIFFNESS_RATIOS
     at_example = int(np.searchsorted(ratios, paper.STIFFNESS / paper.LOAD))

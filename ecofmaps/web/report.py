@@ -169,29 +169,7 @@ def write_report(path, results: xr.Dataset, *, loops=None, inputs=None) -> Path:
 
 
 def recording_inputs(recording, load: float, *, flip_force: bool = False) -> dict[str, str]:
-    """What a report of one recording says it was made from (``inputs`` of :func:`write_report`).
-
-    Parameters
-    ----------
-    recording : ecofmaps.io.recordings.Recording
-        From :func:`ecofmaps.io.recordings.read_recording`.
-    load : float
-        Normal load :math:`P` the recording was analysed with. [N]
-    flip_force : bool
-        Whether the force was read with the other sign.
-
-    Returns
-    -------
-    inputs : dict of str to str
-        The file, the load, and each column read with the unit it was read in.
-
-    Examples
-    --------
-    >>> from ecofmaps.io.recordings import read_recording
-    >>> from ecofmaps.measured.synthetic import example_path
-    >>> recording_inputs(read_recording(example_path()), 450.0)["columns and units assumed"]
-    "displacement: 'displacement' in um; force: 'force' in N; cycle: 'cycle'"
-    """
+    """What a report of one recording says it was made from (``inputs`` of :func:`write_report`)."""
     read = []
     for name, column_name in recording.columns.items():
         unit = recording.units.get(name, "1")
@@ -207,13 +185,7 @@ def recording_inputs(recording, load: float, *, flip_force: bool = False) -> dic
 
 
 def report_document(results: xr.Dataset, *, loops=None, inputs=None):
-    """The Bokeh layout of :func:`write_report`'s page (same parameters).
-
-    Returns
-    -------
-    document : bokeh.models.LayoutDOM
-        The page's content, for :func:`bokeh.embed.file_html` or a Bokeh server.
-    """
+    """The Bokeh layout of :func:`write_report`'s page (same parameters)."""
     missing = [name for name in _NEEDED if name not in results.variables]
     if missing:
         raise ValueError(
@@ -395,8 +367,8 @@ def _carried_cycles(results: xr.Dataset, loops) -> np.ndarray:
 
 
 def _model_loops(results: xr.Dataset) -> tuple[list, list]:
-    """The model's steady loop of each cycle, for its friction and groove read along the
-    stroke, in µm and N; empty where the cycle has no such reading."""
+    """The model's steady loop of each cycle, for its friction and groove read along the stroke, in
+    µm and N."""
     empty = np.zeros(0)
     count = results["cycle"].size
     if "mu_resolved" not in results or "aspect_ratio" not in results:
