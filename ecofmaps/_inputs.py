@@ -49,30 +49,7 @@ def _is_quantity(value) -> bool:
 
 
 def to_si(name: str, value, quantity: str | None = None):
-    """``value`` in SI units: a pint Quantity converted, plain numbers and arrays as they are.
-
-    Parameters
-    ----------
-    name : str
-        The parameter's name, quoted in messages.
-    value : object
-        A number, an array (NumPy, JAX, a tracer, a list), or a pint Quantity.
-    quantity : str, optional
-        The quantity of :data:`ecofmaps._nomenclature.QUANTITIES` whose dimension ``value``
-        must have, or a kind of :data:`ecofmaps.units.DIMENSIONS` (``'length'``, ...); by
-        default ``name``.
-
-    Returns
-    -------
-    value : object
-        The SI magnitude of a Quantity; anything else unchanged.
-
-    Raises
-    ------
-    ValueError
-        For ``None``, a string or a boolean (or an array of them), or a Quantity whose
-        dimension is not the parameter's.
-    """
+    """``value`` in SI units: a pint Quantity converted, plain numbers and arrays as they are."""
     if not is_concrete(value):  # a tracer, or a tuple (an interval) holding one
         return value
     if quantity in DIMENSIONS:
@@ -117,8 +94,8 @@ def _numeric_objects(value) -> bool:
 
 
 def _converted(function, parameters: inspect.Signature, args, kwargs, kinds):
-    """``args`` and ``kwargs`` with every pint Quantity converted to SI by parameter name,
-    after :func:`check_broadcast_size` of the quantities."""
+    """``args`` and ``kwargs`` with every pint Quantity converted to SI by parameter name, after
+    :func:`check_broadcast_size` of the quantities."""
     bound = parameters.bind_partial(*args, **kwargs)
     for name, value in bound.arguments.items():
         quantity = kinds.get(name, name)
@@ -134,14 +111,7 @@ def _converted(function, parameters: inspect.Signature, args, kwargs, kinds):
 
 
 def si_units(function=None, **kinds):
-    """Accept pint Quantities for ``function``'s parameters, converted to SI by name.
-
-    A parameter named after a quantity of :mod:`ecofmaps._nomenclature` takes a Quantity
-    of that quantity's dimension, and so does one named in ``kinds``
-    (``@si_units(x="length")``, a kind of :data:`ecofmaps.units.DIMENSIONS`); strings and
-    booleans are refused there (see :func:`to_si`). Other parameters pass through. The
-    quantities are first checked by :func:`check_broadcast_size`.
-    """
+    """Accept pint Quantities for ``function``'s parameters, converted to SI by name."""
     if function is None:
         return functools.partial(si_units, **kinds)
     parameters = inspect.signature(function)
@@ -171,25 +141,7 @@ def available_memory() -> int | None:
 
 
 def check_broadcast_size(caller: str, values) -> None:
-    """Raise ``MemoryError`` before a broadcast of ``values`` that would not fit in memory.
-
-    Only shapes are read (of arrays, lists, tracers, dask or xarray arrays), so nothing is
-    allocated. A broadcast no larger than its largest input adds no point and passes, as do
-    shapes that do not broadcast (the function's own checks report them).
-
-    Parameters
-    ----------
-    caller : str
-        The public function's name, quoted in the message.
-    values : sequence
-        The inputs broadcast together; a tuple among them (an interval) counts item by item.
-
-    Raises
-    ------
-    MemoryError
-        If one float64 array of the broadcast shape is larger than :func:`available_memory`:
-        the message gives the shape, the points and the bytes, and the way out.
-    """
+    """Raise ``MemoryError`` before a broadcast of ``values`` that would not fit in memory."""
     shapes = []
     for value in values:
         for item in value if isinstance(value, tuple) else (value,):
@@ -217,15 +169,7 @@ def check_broadcast_size(caller: str, values) -> None:
 
 
 def float64(function):
-    """A public JAX entry point: pint Quantities in SI (:func:`si_units`), then float64.
-
-    Concrete calls compute in float64 whether or not the caller switched JAX's 64-bit mode
-    on (importing ecofmaps does not switch it on), and return NumPy arrays, so the caller's
-    own arithmetic on them stays float64 too. Traced calls (inside the caller's
-    ``jax.jit``, ``jax.vmap`` or ``jax.grad``) return traced arrays; they receive arrays whose
-    precision the caller's mode has already fixed, so they require the mode on and raise a
-    ``ValueError`` that says how, instead of silently computing in float32.
-    """
+    """A public JAX entry point: pint Quantities in SI (:func:`si_units`), then float64."""
     import jax
 
     parameters = inspect.signature(function)
@@ -271,20 +215,7 @@ def as_float64(value):
 
 
 def check(name: str, value, rule: str | None = None, unit: str | None = None) -> None:
-    """Raise ``ValueError`` if a concrete ``value`` breaks ``rule``; do nothing for tracers.
-
-    Parameters
-    ----------
-    name : str
-        The parameter's keyword name, quoted in the message.
-    value : array_like
-        The value to check, in SI units (see :func:`to_si`).
-    rule : {'positive', 'positive_or_inf', 'non_negative', 'finite'}, optional
-        The valid range (:data:`ecofmaps._nomenclature.RANGES`); by default the range of
-        quantity ``name``. Every rule rejects NaN; only ``'positive_or_inf'`` admits +inf.
-    unit : str, optional
-        Unit shown with the range, e.g. ``'m'``; by default quantity ``name``'s SI unit.
-    """
+    """Raise ``ValueError`` if a concrete ``value`` breaks ``rule``; do nothing for tracers."""
     if not is_concrete(value):
         return
     described = QUANTITIES.get(name)

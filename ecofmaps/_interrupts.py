@@ -53,13 +53,7 @@ INTERRUPTED.notes = None
 
 
 class Interrupted(KeyboardInterrupt):
-    """A stop by Ctrl-C or SIGTERM that has something to tell: what was kept, how to go on.
-
-    Parameters
-    ----------
-    note : str
-        One sentence for the user, printed after ``interrupted;`` on the same line.
-    """
+    """A stop by Ctrl-C or SIGTERM that has something to tell: what was kept, how to go on."""
 
     def __init__(self, note: str):
         super().__init__(note)
@@ -68,31 +62,14 @@ class Interrupted(KeyboardInterrupt):
 
 def add_stop_note(note) -> None:
     """Have the line that reports a stop in the running :func:`interrupts_stop_writes`
-    block say what ``note()`` returns when the line is written.
-
-    Asked then, once everything the stop interrupted has unwound, ``note`` tells what is
-    left at that moment (a resume folder kept, say), not what was left when the signal
-    came: a block of work that lands in between cannot make the line untrue. It returns a
-    sentence, or None when it has nothing to say (the line then says that nothing was left
-    half written). Outside such a block (the library used from Python) it is not kept.
-
-    Parameters
-    ----------
-    note : callable
-        Called without arguments; returns str or None.
-    """
+    block say what ``note()`` returns when the line is written."""
     if INTERRUPTED.notes is not None:
         INTERRUPTED.notes.append(note)
 
 
 def check_interrupted() -> None:
     """Raise ``KeyboardInterrupt`` if Ctrl-C was pressed (or SIGTERM came) under
-    :func:`interrupts_stop_writes`.
-
-    Called where stopping is safe: between blocks of work and before a file is renamed into
-    place. Outside the block (the library used from Python), and within
-    :func:`interrupts_deferred`, it does nothing.
-    """
+    :func:`interrupts_stop_writes`."""
     if INTERRUPTED.is_set() and not INTERRUPTED.deferred:
         raise KeyboardInterrupt
 
@@ -116,24 +93,7 @@ def interrupts_deferred():
 @contextlib.contextmanager
 def interrupts_stop_writes():
     """Within the block, Ctrl-C or SIGTERM stops the program at the next safe point, writing
-    nothing more.
-
-    The first signal only sets a flag; :func:`check_interrupted`, called between blocks of
-    work and before every :func:`ecofmaps.io.files.atomic_store` renames its file into
-    place, then raises ``KeyboardInterrupt``, and so does leaving the block. A
-    ``KeyboardInterrupt`` raised at once, anywhere, would land inside JAX's compiled
-    extensions (during their import, or in a garbage-collector callback) and crash the
-    process or be swallowed there. A second signal raises at once. Only in the main
-    thread; a signal that is ignored (Ctrl-C in a background job), or whose handler was
-    not set from Python, is left alone.
-
-    Yields
-    ------
-    interrupted : Stop
-        Set once a stop signal came in the block, with the signal's number in its
-        ``signal``; it stays set after the block, so a caller can tell an interrupt from
-        an error it caused, and which signal it was.
-    """
+    nothing more."""
     interrupted = Stop()
     if threading.current_thread() is not threading.main_thread():
         yield interrupted

@@ -14,23 +14,7 @@ __all__ = ["lazy_names"]
 
 
 def lazy_names(package: str, public: dict, submodules=()):
-    """``__getattr__``, ``__dir__`` and ``__all__`` for the package ``package``.
-
-    Parameters
-    ----------
-    package : str
-        The package's name (its ``__name__``, while its ``__init__`` runs).
-    public : dict of str to tuple of str
-        Each public name, by the module that defines it.
-    submodules : sequence of str
-        Subpackages reachable as attributes before they are imported.
-
-    Returns
-    -------
-    __getattr__, __dir__ : callable
-        For the package's namespace: a name is imported on first use and then kept there.
-    __all__ : list of str
-    """
+    """``__getattr__``, ``__dir__`` and ``__all__`` for the package ``package``."""
     home = {name: module for module, names in public.items() for name in names}
     namespace = sys.modules[package].__dict__
 

@@ -39,31 +39,7 @@ __all__ = [
 
 @dataclasses.dataclass(frozen=True)
 class Quantity:
-    r"""One named quantity.
-
-    Attributes
-    ----------
-    words : str
-        What it is, in words (``'slip amplitude'``).
-    symbol : str
-        Its symbol in plain text (``'δ*'``); empty if it has none.
-    latex : str
-        Its symbol in matplotlib's mathtext (``r'\delta^*'``), for plot labels.
-    units : str
-        SI unit, CF/UDUNITS spelling (``'1'`` for a number).
-    kind : str
-        Its physical dimension, a key of :data:`ecofmaps.units.DIMENSIONS`.
-    display_unit : str
-        The unit people read it in (``'µm'``, ``'MN/m'``); empty for a number.
-    display_factor : float
-        Factor from SI to ``display_unit``.
-    valid : str or None
-        Its valid range as a key of :data:`RANGES`, for the checks of concrete inputs.
-    label : str or None
-        The words of a plot axis when they differ from ``words`` (``''``: the symbol alone).
-    axis_unit : str or None
-        The unit of a plot axis when it differs from ``display_unit``.
-    """
+    r"""One named quantity."""
 
     words: str
     symbol: str
@@ -247,11 +223,7 @@ def axis_label(name: str) -> str:
 
 
 def column(name: str) -> str:
-    """The column name of quantity ``name`` in tables: the name and its display unit.
-
-    ``amplitude_um``, ``max_force_N``, ``stiffness_MN_per_m``, ``dissipated_energy_mJ``;
-    a number keeps its bare name (``ecof``).
-    """
+    """The column name of quantity ``name`` in tables: the name and its display unit."""
     unit = QUANTITIES[name].display_unit
     if not unit:
         return name
@@ -264,9 +236,6 @@ def display(name: str, value) -> np.ndarray:
 
 
 def within(name: str, value, rule: str | None = None):
-    """Boolean array: where ``value`` lies in the valid range of ``name`` (or of ``rule``).
-
-    Works on NumPy and JAX arrays (and tracers) alike; NaN is never within.
-    """
+    """Boolean array: where ``value`` lies in the valid range of ``name`` (or of ``rule``)."""
     test, _ = RANGES[rule or QUANTITIES[name].valid]
     return test(value)

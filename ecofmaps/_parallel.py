@@ -97,12 +97,7 @@ class Slice:
 
 
 def stretch(array, start: int, stop: int):
-    """``array[start:stop]`` for a task to read where it runs.
-
-    A :class:`Slice` of the array-like a dask array was made of (its attribute
-    :data:`SOURCE`), read directly; any other array as sliced (a dask array is computed
-    in the task, a NumPy array is a view).
-    """
+    """``array[start:stop]`` for a task to read where it runs."""
     source = getattr(array, SOURCE, None)
     if source is not None:
         return Slice(source, start, stop)
@@ -110,8 +105,8 @@ def stretch(array, start: int, stop: int):
 
 
 def _materialised(arguments):
-    """``arguments`` with every :class:`Slice` read and every dask collection computed, here
-    on this thread."""
+    """``arguments`` with every :class:`Slice` read and every dask collection computed, here on this
+    thread."""
     arguments = tuple(a.read() if isinstance(a, Slice) else a for a in arguments)
     import dask
 
@@ -126,27 +121,7 @@ def _call(function, arguments):
 
 
 class Runner:
-    """Run tasks on threads or on a dask cluster, a bounded number at a time.
-
-    Parameters
-    ----------
-    workers : int, optional
-        With ``scheduler=None`` and ``cluster=False``: threads (default ``os.cpu_count()``).
-        With ``cluster=True``: worker processes of a new ``LocalCluster``.
-    scheduler : str, optional
-        Address of an existing dask scheduler (``tcp://host:8786``).
-    cluster : bool
-        Start a ``LocalCluster`` of ``workers`` processes (one thread each).
-    client : distributed.Client, optional
-        A client of a cluster already connected (left open).
-    timeout : float, optional
-        Seconds to wait for the scheduler at ``scheduler`` to answer (default
-        :data:`CONNECT_TIMEOUT`).
-
-    Notes
-    -----
-    Use as a context manager: the cluster or thread pool is closed on leaving it.
-    """
+    """Run tasks on threads or on a dask cluster, a bounded number at a time."""
 
     def __init__(self, workers=None, *, scheduler=None, cluster=False, client=None, timeout=None):
         if scheduler is not None and cluster:
@@ -248,25 +223,7 @@ class Runner:
             return self._client.submit(_call, function, arguments, pure=False)
 
     def map(self, function, tasks, *, in_flight=None):
-        """``function(*arguments)`` for each ``arguments`` of ``tasks``, results in order.
-
-        Parameters
-        ----------
-        function : callable
-            A module-level function (picklable by name).
-        tasks : iterable of tuple
-            The arguments of each call; dask collections among them are computed where
-            the call runs, just before it.
-        in_flight : int, optional
-            Calls submitted and not yet handed back at once (default twice the workers):
-            the memory held is about that many blocks.
-
-        Yields
-        ------
-        result
-            Each call's result, in the order of ``tasks``, as soon as it and every earlier
-            one are done.
-        """
+        """``function(*arguments)`` for each ``arguments`` of ``tasks``, results in order."""
         if self._pool is None and self._client is None:
             raise RuntimeError("a Runner is used within a with block")
         limit = in_flight or 2 * self.workers
@@ -298,15 +255,7 @@ class Runner:
 
 def check_workers(workers, processes: bool) -> None:
     """Raise ``ValueError`` naming ``workers`` unless it is None or a whole number of
-    workers that this machine can run (:func:`worker_limit`).
-
-    Parameters
-    ----------
-    workers : int or None
-        Threads of this process, or worker processes of a local cluster.
-    processes : bool
-        Whether they are processes.
-    """
+    workers that this machine can run (:func:`worker_limit`)."""
     if workers is None:
         return
     if isinstance(workers, bool) or int(workers) != workers or workers < 1:
@@ -317,21 +266,7 @@ def check_workers(workers, processes: bool) -> None:
 
 
 def worker_limit(processes: bool) -> tuple[int, str]:
-    """The most workers this machine can run at once, and why, in words.
-
-    Parameters
-    ----------
-    processes : bool
-        Worker processes of a local cluster (bounded by the cores and by the memory
-        available, :data:`WORKER_MEMORY` each), or threads of this process (the cores).
-
-    Returns
-    -------
-    limit : int
-        At least 1.
-    why : str
-        The bound in words, e.g. ``'2 cores (os.cpu_count())'``.
-    """
+    """The most workers this machine can run at once, and why, in words."""
     cores = os.cpu_count() or 1
     why = f"{cores} cores (os.cpu_count())"
     if not processes:
@@ -350,19 +285,8 @@ def worker_limit(processes: bool) -> tuple[int, str]:
 
 @contextlib.contextmanager
 def _sigint_held():
-    """Ctrl-C (SIGINT) held back from this thread while the block runs, and for good from
-    the threads it starts and from the processes those start.
-
-    Ctrl-C on a terminal reaches every process of the command's group, and is for this
-    process only. A cluster's event loop and the threads that start its worker processes
-    are started in the block, so they inherit the blocked signal, and so do the worker
-    processes they start, then or later (a worker restarted after it died): a blocked
-    signal stays blocked across ``fork`` and ``exec``, and Python leaves it so, so a worker
-    never sees Ctrl-C, even while it imports. A Ctrl-C that comes during the block is not
-    lost: another thread of this process takes it, or it waits until the block ends, and
-    this process's handler sees it. Only in the main thread, and where threads' signal masks
-    exist (POSIX); elsewhere nothing changes.
-    """
+    """Ctrl-C (SIGINT) held back from this thread while the block runs, and for good from the
+    threads it starts and from the processes those start."""
     if threading.current_thread() is not threading.main_thread() or not hasattr(
         signal, "pthread_sigmask"
     ):
@@ -389,12 +313,7 @@ async def _identity(address: str, timeout: float) -> dict:
 
 def probe_scheduler(address: str, timeout: float) -> None:
     """Raise :class:`SchedulerError` unless a dask scheduler answers at ``address`` within
-    ``timeout`` seconds.
-
-    A client of an address where nothing answers, or something else does (an HTTP server,
-    the scheduler's dashboard), waits for good; this asks the scheduler who it is first,
-    on a loop of its own (a thread, so that it works where a loop already runs).
-    """
+    ``timeout`` seconds."""
 
     def ask():
         return asyncio.run(asyncio.wait_for(_identity(address, timeout), timeout))
@@ -417,13 +336,7 @@ def probe_scheduler(address: str, timeout: float) -> None:
 
 
 def start_resource_tracker_quietly() -> None:
-    """Start multiprocessing's resource tracker with its standard error on the null device.
-
-    Processes stopped by Ctrl-C or SIGTERM while they start (a cluster's workers, drawing
-    processes) leave semaphores that the tracker reports as leaked when it ends, after the
-    command's one line (the system releases them all the same); nothing else is printed by
-    it. A tracker already running is left as it is.
-    """
+    """Start multiprocessing's resource tracker with its standard error on the null device."""
     saved, null = os.dup(2), os.open(os.devnull, os.O_WRONLY)
     try:
         os.dup2(null, 2)
@@ -435,9 +348,7 @@ def start_resource_tracker_quietly() -> None:
 
 
 def _quiet_teardown() -> None:
-    """Silence the loggers of a cluster torn down by an interrupt (distributed, tornado,
-    asyncio): its cancelled tasks and closed connections are expected, and the command has
-    said in one line that it was stopped."""
+    """Silence the loggers of a cluster torn down by an interrupt."""
     for name in ("distributed", "tornado", "asyncio"):
         logging.getLogger(name).setLevel(logging.CRITICAL + 1)
 

@@ -43,26 +43,7 @@ def _registry():
 
 
 def parse_quantity(text: str, kind: str) -> float:
-    """One quantity as an SI float.
-
-    Parameters
-    ----------
-    text : str
-        A number with an optional unit: ``'50um'``, ``'50 µm'``, ``'35MN/m'``, ``'0.8'``,
-        ``'inf'``. A bare number is SI.
-    kind : str
-        A key of :data:`DIMENSIONS` (``'length'``, ``'force'``, ``'stiffness'``, ...).
-
-    Returns
-    -------
-    value : float
-        The value in the SI unit of ``kind`` (m, N, N/m, 1/m, J or 1).
-
-    Raises
-    ------
-    ValueError
-        If ``text`` is not a number with a unit, or the unit has the wrong dimension.
-    """
+    """One quantity as an SI float."""
     dimension, si_unit, example = DIMENSIONS[kind]
     text = text.strip()
     try:
@@ -98,27 +79,7 @@ def parse_quantity(text: str, kind: str) -> float:
 
 
 def parse_values(text: str, kind: str) -> np.ndarray:
-    """A list or a range of quantities as a 1-D float64 array in SI.
-
-    Parameters
-    ----------
-    text : str
-        Comma-separated quantities (``'25um,50um'``) or a linear range
-        ``'start:stop:num'`` with both ends included (``'0:0.3:61'``,
-        ``'1um:10um:10'``).
-    kind : str
-        A key of :data:`DIMENSIONS`.
-
-    Returns
-    -------
-    values : numpy.ndarray
-        The values in SI units.
-
-    Raises
-    ------
-    ValueError
-        If an item cannot be read, or a range's ``num`` is not an integer >= 2.
-    """
+    """A list or a range of quantities as a 1-D float64 array in SI."""
     if ":" in text and not text.strip().startswith(":"):
         parts = text.split(":")
         if len(parts) != 3:
