@@ -1,30 +1,9 @@
-r"""The compliant wear-scar interaction model: traction, slip amplitude, energy, ECoF.
+r"""The dimensionless core of the model on (μ, κ, λ), and the SI-unit functions over it.
 
-A rigid round-ended pad slides in a parabolic groove :math:`z = z_o (x/x_o)^2` under a
-normal load :math:`P`; a spring of stiffness :math:`S` (the rig's compliance) links it
-to the actuator, which imposes the displacement :math:`\Delta`. Coulomb friction
-:math:`\mu` acts at the contact point.
-
-The dimensionless core
-----------------------
-Lengths are measured in units of a reference length :math:`L` (the displacement
-amplitude :math:`\Delta^*` for the steady loop, the groove half-width :math:`x_o` for a
-time history). Three numbers then fix everything:
-
-* ``mu``: the contact coefficient of friction :math:`\mu`;
-* ``kappa``: the curvature number :math:`\kappa = k L` with :math:`k = 2 z_o/x_o^2`
-  the groove's slope per unit length (eq. 7), so the slope at :math:`\xi = x/L` is
-  :math:`\kappa\xi`;
-* ``lam``: the compliance ratio :math:`\lambda = P/(S L)`, the rig's deflection at
-  :math:`Q = P` over :math:`L` (0 for a rigid rig).
-
-The core functions (:func:`traction_ratio`, :func:`slip_position`, :func:`slip_ratio`,
-:func:`locking_margin`, :func:`ecof_ratio`, :func:`normalized_max_force`, :func:`normalized_energy`,
-:func:`regime_code`) are pure ``jax.numpy`` functions of these numbers that broadcast
-and work under ``jit``, ``vmap`` and ``grad``; they do no input checking. The SI-unit
-functions (:func:`slip_amplitude`, :func:`dissipated_energy`, :func:`energy_cof`,
-:func:`max_force`, :func:`slip_regime`) validate concrete inputs, are jit-compiled, and
-always compute in float64.
+The core functions (:func:`traction_ratio`, :func:`slip_ratio`, :func:`ecof_ratio`, ...)
+are pure ``jax.numpy`` functions of ``mu``, the curvature number ``kappa`` and the
+compliance ratio ``lam``, which broadcast, work under ``jit``, ``vmap`` and ``grad`` and do
+no input checking. The model and the dimensionless core are explained in ``docs/model.md``.
 """
 
 from __future__ import annotations

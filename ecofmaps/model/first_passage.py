@@ -1,36 +1,9 @@
 r"""The steady loop on a scar profile, read off the tables of :mod:`ecofmaps.model.profile_core`.
 
-In the units of :mod:`ecofmaps.model.profile_core` (lengths over the stroke
-:math:`A = \Delta^* W/x_o`, the rig through :math:`\lambda = P/(S\Delta^*)`, slip branches
-:math:`F_\pm(\xi) = \xi + \lambda q_\pm(\xi)`): :func:`steady_loop` finds the loop's ends by
-first passage, :func:`jump_area` adds the areas of the jumps, :func:`draw_loop` draws the
-loop, and :func:`simulation_tables` and :func:`simulation_step` run the quasi-static return
-map in time.
-
-The steady loop by first passage
---------------------------------
-On a stroke from :math:`\xi_s` to :math:`D = 1` the pad stops at the first
-:math:`\xi \ge \xi_s` with :math:`F_+(\xi) \ge 1` (the quasi-static return map; where
-:math:`F_+` falls, the pad jumps ahead at constant :math:`D`). Starting at rest at the scar
-centre, three first passages (forward, backward, forward) reach the steady loop
-:math:`[\xi_-, \xi_+]`: after them the return map is at a fixed point (the forward map is
-monotone, and :math:`F_+ < 1` on :math:`[\xi_-, \xi_+)`, :math:`F_- > -1` on
-:math:`(\xi_-, \xi_+]`). :math:`\delta^* = \Delta^*(\xi_+ - \xi_-)/2`.
-
-The energy is the loop's area, :math:`E_d = \oint Q\,d\Delta = \oint Q\,dx`, with
-:math:`Q = S(\Delta - x)` during a jump; in the units above
-:math:`E_d/(S\Delta^{*2}) = \int_{\xi_-}^{\xi_+} (M_+ - M_-)\,d\xi`, where :math:`M_+` is
-the running maximum of :math:`F_+` from :math:`\xi_-` and :math:`M_-` the running minimum
-of :math:`F_-` from :math:`\xi_+`. Without jumps :math:`M_\pm = F_\pm` and
-
-.. math:: \frac{\mu_E}{\mu} = 1 + \frac{1}{\xi_+ - \xi_-}\int_{\xi_-}^{\xi_+}
-          e\,d\xi, \qquad e = \frac{q_+ - q_-}{2\mu} - 1
-          = \frac{(1 + \mu^2)g^2}{1 - \mu^2 g^2} \ge 0,
-
-so :math:`\mu_E \ge \mu` on every profile; jumps add :math:`\int (M_+ - F_+) -
-\int (M_- - F_-) \ge 0` over :math:`4\lambda d`.
-
-The functions here are pure ``jax.numpy`` and check nothing.
+:func:`steady_loop` finds the loop's ends by first passage, :func:`jump_area` adds the
+areas of the jumps, :func:`draw_loop` draws the loop, and :func:`simulation_tables` and
+:func:`simulation_step` run the quasi-static return map in time. Pure ``jax.numpy``, no
+checks. The method is explained in ``docs/model.md`` (the model on a scar profile).
 """
 
 from __future__ import annotations

@@ -1,15 +1,10 @@
 r"""The model on a scar profile in SI units: steady loops, drawn loops and time histories.
 
 :func:`steady_numbers` evaluates the steady loop of :mod:`ecofmaps.model.first_passage` at
-any broadcast set of points. Points that share :math:`\mu` and the stroke length
-:math:`A = \Delta^*W/x_o` (all of them when :math:`x_o = \Delta^*`, whatever the
-amplitude, load and stiffness) share one set of tables, built once, and cost
-:math:`O(\log N)` each; points where the pad jumps get the jumps' areas in :math:`O(N)`.
-When :math:`\mu` or :math:`A` is traced (under ``jax.jit``/``jax.vmap``), and for a few
-points (at most 256: computing their tables costs less than compiling the shared ones),
-each point builds its own :math:`O(N)` tables. The public functions of
-:mod:`ecofmaps.model.steady_state` and :mod:`ecofmaps.model.simulation` call in here when
-given ``profile=``.
+any broadcast set of points, sharing the tables between points that share :math:`\mu` and
+the stroke. The public functions of :mod:`ecofmaps.model.steady_state` and
+:mod:`ecofmaps.model.simulation` call in here when given ``profile=``. The method is
+explained in ``docs/model.md`` (the model on a scar profile).
 """
 
 from __future__ import annotations

@@ -1,40 +1,10 @@
-r"""The model on a groove of any shape: the dimensionless core on a scar profile.
+r"""The dimensionless core on a scar profile: slip branches and their tables.
 
 The pad at contact position :math:`x` feels the profile's slope :math:`g(X)` at
-:math:`X = xW/x_o` (eq. 11; :math:`x_o = \Delta^*` by default, or :math:`X = x`), and eq. 9
-holds pointwise: :math:`Q_\pm = P(\pm\mu + g)/(1 \mp \mu g)`.
-
-Units
------
-Lengths along the profile are measured in units of :math:`A = \Delta^* W/x_o`, the stroke
-in profile coordinates, so the contact position is :math:`\xi = X/A = x/\Delta^*`, and
-the rig enters through :math:`\lambda = P/(S\Delta^*)`. The slip branches are
-:math:`F_\pm(\xi) = \xi + \lambda q_\pm(\xi)`, :math:`q = Q/P`: the pad slips forward
-where the actuator :math:`D = \Delta/\Delta^*` exceeds :math:`F_+`, backward where it falls
-below :math:`F_-`, and sticks in between (eq. 10). With :math:`x_o = \Delta^*`,
-:math:`A = W` for every amplitude: the steady loop depends on :math:`\Delta^*`, :math:`P`
-and :math:`S` through :math:`\lambda` only.
-
-Exactness
----------
-The slope is piecewise linear between samples. On each segment :math:`q_+` is then convex
-and :math:`q_-` concave in :math:`\xi`, so :math:`F_+` cannot exceed a level inside a
-segment unless it does at an end: first passages are found exactly at the samples and the
-crossing inside the segment solves a quadratic (:func:`crossing_fraction`); the integrals of
-:math:`e` and :math:`q_+` over a segment have closed forms (:func:`_mean_excess`,
-:func:`_mean_traction`). Everything is exact up to rounding for the piecewise linear slope.
-
-Tables
-------
-What depends on the profile, :math:`\mu` and :math:`A` only is computed once
-(:func:`profile_tables`): :math:`q_+` at the samples, the cumulative integral of :math:`e`,
-and for each sample the interval of :math:`\lambda` over which :math:`F_+ < 1` there, kept
-in a sparse table of block intersections, so that a first passage is a descent of
-:math:`\log_2 N` gathers; range tables give the peak force and whether :math:`F_\pm` are
-monotone over the slip (no jumps). A point then costs :math:`O(\log N)` in
-:mod:`ecofmaps.model.first_passage`, which reads the steady loop off these tables.
-
-The functions here are pure ``jax.numpy`` and check nothing.
+:math:`X = xW/x_o`, and eq. 9 holds pointwise. :func:`profile_tables` computes once what
+depends on the profile, :math:`\mu` and the stroke only; :mod:`ecofmaps.model.first_passage`
+reads the steady loop off them. Pure ``jax.numpy``, no checks. The units, the exactness
+and the tables are explained in ``docs/model.md`` (the model on a scar profile).
 """
 
 from __future__ import annotations
