@@ -1,47 +1,10 @@
-r"""Legacy energy coefficients of friction corrected to the contact one.
+r"""Reported energy coefficients of friction corrected to the contact one, exactly.
 
-Much of the fretting literature reports the energy coefficient of friction
-:math:`\mu_E = E_d/(4P\delta^*)` (eq. 1). With the rig's compliance and a wear scar shaped
-like a groove it is not the contact :math:`\mu` (Figures 8 and 11). Given the test
-conditions (:math:`\Delta^*`, :math:`P`, :math:`S`) and the scar's aspect ratio
-:math:`z_o/x_o = D/W` (eq. 11, with :math:`x_o = \Delta^*` as in the paper),
-:func:`correct_ecof` inverts the model's :math:`\mu_E(\mu)` exactly
-(:func:`ecofmaps.correction.lookup.lookup_correction` reads the same inversion off a map).
-
-The inversion, in the dimensionless core of :mod:`ecofmaps.model` (:math:`\mu`,
-:math:`\kappa = 2 z_o/x_o`, :math:`\lambda = P/(S\Delta^*)`):
-
-* :math:`\mu_E(\mu)` is continuous on the gross-slip range :math:`0 < \mu < \mu_{max}`,
-  with :math:`\mu_{max} = 1/\lambda` (:math:`1/\kappa` for a rigid rig, where the pad
-  locks), and :math:`\mu \le \mu_E`. It runs from 0 (:math:`\mu \to 0`) to :math:`1/\lambda`
-  (:math:`\mu \to 1/\lambda`, where :math:`\delta^* \to 0`; to :math:`\infty` for a rigid
-  rig), and :math:`\mu_E < (1 - \delta^*/\Delta^*)/\lambda < 1/\lambda` throughout, since
-  :math:`\mu_E P` is the mean of :math:`Q_+` over the slip and :math:`Q_+` rises to its
-  peak :math:`S(\Delta^* - \delta^*)` (eq. 9, 10, 12). So every ECoF in
-  :math:`(0, S\Delta^*/P)` comes from some :math:`\mu`, and no other does: a larger one
-  would need a contact CoF that stops gross slip (status ``NO_GROSS_SLIP``).
-* :math:`\mu_E(\mu)` rises monotonically unless the groove is deep and the rig stiff:
-  it falls over part of its range only when :math:`\kappa > 1` and
-  :math:`\lambda < \lambda_\infty` (:data:`LAMBDA_INFINITY` :math:`\approx 0.071`, the
-  :math:`\kappa \to \infty` limit of the largest such :math:`\lambda`; at :math:`\kappa = 10`
-  it is 0.0248, and the smallest :math:`\kappa` grows from 1 as :math:`\lambda` grows from
-  0, e.g. 2.5 at :math:`\lambda = 10^{-4}`). The fall lies in :math:`1/\kappa < \mu < 1`,
-  where :math:`\mu_E/\mu > 4`. There, an ECoF between the local minimum and maximum of
-  :math:`\mu_E(\mu)` comes from three contact CoFs (status ``AMBIGUOUS``); the local
-  minimum is above :data:`AMBIGUOUS_ECOF_MIN` = 1.6 (its infimum, reached as
-  :math:`\kappa \to \infty` and :math:`\lambda \to \lambda_\infty`), so no ECoF below
-  1.6 is ever ambiguous. The tests
-  check these bounds on dense grids.
-* :math:`\mu_E` rises with :math:`z_o/x_o` at fixed :math:`\mu` (:math:`\kappa\delta^*`
-  rises with :math:`\kappa`, and :math:`\mu_E` is the mean of a convex function over
-  :math:`[-\kappa\delta^*, \kappa\delta^*]` in the slope), so for an aspect ratio known
-  only to lie in :math:`[a, b]` the contact CoFs the ECoF allows are exactly
-  :math:`[\mu(b), \mu(a)]` wherever the inversion at both ends is unique.
-
-The root is found by Newton's method on :math:`\mu_E(\mu) - \mu_E^{given}` with the slope
-from ``jax.jvp``, kept inside a bracket that shrinks at every step (a bisection when a
-Newton step leaves it), under ``jax.lax.while_loop`` over whole arrays: about five steps
-from the start :math:`\mu = \mu_E^{given}`, an upper bound.
+:func:`correct_ecof` inverts the model's :math:`\mu_E(\mu)` for the test conditions and the
+scar's aspect ratio by a bracketed Newton iteration in the dimensionless core;
+:func:`correction_factor` and :func:`contact_cof` build on it. Where the inversion is
+unique, ambiguous or impossible, and why, is explained in ``docs/model.md`` (correcting a
+reported ECoF).
 """
 
 from __future__ import annotations

@@ -1,11 +1,8 @@
 r"""The correction of a reported ECoF on a wear-scar profile of any shape.
 
-:func:`ecofmaps.correct_ecof` and :func:`ecofmaps.correction_factor` with ``profile=``:
-:math:`\mu_E(\mu)` on a profile (:mod:`ecofmaps.model.on_profile`) is scanned on a grid of
-contact CoFs for each ECoF, which finds every crossing (``AMBIGUOUS`` where there are
-several) and a bracket of the root, then narrowed by the Illinois method. On a profile
-:math:`\mu_E(\mu)` can jump (where the pad starts to jump over a steep flank): an ECoF in a
-jump comes from no contact CoF (``UNREACHABLE``). NumPy on concrete inputs only.
+:func:`ecofmaps.correct_ecof` and :func:`ecofmaps.correction_factor` with ``profile=``: a
+scan of :math:`\mu_E(\mu)` over a grid of contact CoFs, narrowed by the Illinois method.
+NumPy on concrete inputs only; the method is in ``docs/model.md`` (correcting a reported ECoF).
 """
 
 from __future__ import annotations

@@ -1,12 +1,9 @@
 r"""What a correction comes out as: the status codes, the intervals, and where it is ambiguous.
 
 :class:`CorrectionStatus` says per point whether an ECoF was corrected, and why not;
-:class:`Interval` holds the contact CoFs an ECoF allows when the scar's aspect ratio is only
-known to lie in an interval. Where the groove is deep and the rig stiff, :math:`\mu_E(\mu)`
-falls over part of its range (:func:`ecof_fall`, below :data:`LAMBDA_INFINITY`), and an
-ECoF in the fall comes from three contact CoFs: the exact inversion
-(:mod:`ecofmaps.correction.inversion`, whose module docstring gives the bounds) marks it
-``AMBIGUOUS``.
+:class:`Interval` holds the contact CoFs an ECoF allows for an aspect ratio known only within
+an interval; :func:`ecof_fall` says where :math:`\mu_E(\mu)` falls, so that an ECoF comes
+from three contact CoFs (``docs/model.md``, correcting a reported ECoF).
 """
 
 from __future__ import annotations

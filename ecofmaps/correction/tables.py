@@ -1,35 +1,9 @@
 """Tables of reported ECoF values, corrected row by row to the contact CoF.
 
-The table ``ecofmaps correct TABLE.csv`` reads: a header line naming the columns, one test
-per line, the cells separated by commas, semicolons or tabs (whichever the header line holds:
-a tab, else a semicolon, else a comma). With semicolons or tabs a number may have a decimal
-comma (``0,83``), as spreadsheets write it in much of Europe. Lines whose first character
-other than spaces is ``#`` are comments, skipped like blank lines. Columns (in any order,
-names exact, others kept as they are):
-
-=====================  ==================================================  =======
-``ecof``               reported energy coefficient of friction μ_E          [1]
-``amplitude_um``       displacement amplitude Δ*                            [µm]
-``load_N``             normal load P                                        [N]
-``stiffness_MN_per_m`` rig stiffness S (``inf`` for a rigid rig)            [MN/m]
-``aspect_ratio``       wear scar depth over half-width z_o/x_o = D/W        [1]
-``scar_depth_um``      or the scar depth D ...                              [µm]
-``scar_half_width_um`` ... and half-width W (eq. 11)                        [µm]
-=====================  ==================================================  =======
-
-On a measured scar profile (``correct_table(path, profile=...)``, ``ecofmaps correct
-TABLE --scar-profile FILE``) the profile gives every row's scar: the table has no
-``aspect_ratio`` or scar columns, and the output adds ``mu_parabolic``, the contact CoF
-the paper's shortcut gives (the parabola of the profile's :math:`D/W`, eq. 11; ``nan``
-where it cannot correct the row), beside ``mu`` on the profile.
-
-Each row gives its aspect ratio one way: ``aspect_ratio``, or ``scar_depth_um`` and
-``scar_half_width_um`` (a table may hold both kinds of rows, with the other cells empty).
-The output is written with the input's separator (and decimal commas if the input has any);
-it keeps every input column and cell as written, without the comment lines, and adds ``mu``
-and ``correction_factor`` (μ/μ_E); every corrected row is a gross-slip test (a row
-whose ECoF no gross-slip loop gives stops the run). A bad row raises :class:`TableError`,
-naming the file and the 1-based line number in the file (the header is line 1).
+:func:`correct_table` reads the table ``ecofmaps correct`` takes, corrects each row with
+:func:`ecofmaps.correct_ecof` and writes it back with ``mu`` and ``correction_factor`` added;
+a bad row raises :class:`TableError` naming the file and the line. The table's format is
+described in ``docs/formats.md``.
 """
 
 from __future__ import annotations
