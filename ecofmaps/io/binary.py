@@ -1,19 +1,10 @@
 """Recordings in rig formats: TDMS, HDF5 / netCDF-4 and zarr, read lazily.
 
-The columns asked for are found by name among the file's channels or variables
-(:func:`ecofmaps.io.rig_formats.variables`, which also refuses a truncated file) as in a
-text header (:mod:`ecofmaps.io.columns`), in the group given or in any group. Each is
-wrapped in a :class:`Column`, an array-like that reads a range of samples on demand from
-the variable of the group's lazily read xarray Dataset
-(:func:`ecofmaps.io.rig_formats.open_group`: xarray or npTDMS decode CF packing, fill
-values and attributes), in float64 and SI, and turns any failure into a
-:class:`~ecofmaps.io.recording_types.RecordingError` naming the file, the channel and the
-samples. A large recording is a dask array over such columns (``dask.array.from_array``),
-so it is read block by block; the array holds its column (the attribute
-:data:`ecofmaps._parallel.SOURCE`), so the tasks of a long analysis read their ranges from
-it directly (:func:`ecofmaps._parallel.stretch`). A :class:`Column` pickles without its
-open file, so the blocks can be read by other processes (a dask cluster); there, the copies
-of one column are one object per process (:func:`_column`), which opens the file once.
+The columns asked for are found by name (:mod:`ecofmaps.io.columns`) among the variables of
+:mod:`ecofmaps.io.rig_formats`, each wrapped in a :class:`Column`: an array-like that reads a
+range of samples on demand, in float64 and SI, pickles without its open file (so a dask
+cluster's workers read their own blocks) and names the file, channel and samples in any
+error. ``docs/formats.md`` describes the formats.
 """
 
 from __future__ import annotations

@@ -1,33 +1,9 @@
 """Column names as labs write them: finding a column, and the unit its name carries.
 
-Rig software and spreadsheets put the unit in the column's name: ``force [N]``,
-``displacement (um)``, ``Displacement/µm``, ``delta_mm``, ``Ftr_kN``, ``Disp in mm``.
-:func:`split_unit` separates such a name into its base and its unit; :func:`find_column`
-finds a column by its name or its base (without regard to case), so ``displacement`` finds
-``Displacement [µm]``; :func:`column_scale` decides the factor to SI from the unit given as
-an option, the unit the file carries, or the default (µm and N).
-
-Rigs name the same quantity in many ways (``Disp``, ``delta``, ``stroke``, ``x`` for the
-displacement; ``Fx``, ``Q``, ``Ftr``, ``friction force`` for the tangential force). A
-column asked for by its role's own name (``displacement``, ``force``, ``load``,
-``cycle``: the defaults) is found under any of the usual names of :data:`SYNONYMS` when no
-column bears that name; a name given explicitly is matched only as it is. Two candidates
-are an error naming both, and the option that chooses; none, an error listing the columns
-(with the nearest as a suggestion).
-
-The rules, in order, for a name's unit:
-
-1. A unit in square brackets or parentheses at the end (``force [N]``,
-   ``displacement (um)``) is always split off if it reads as a unit (of any kind: ``[V]``
-   is a unit, ``(tangential)`` is not and stays part of the name).
-2. A unit after a slash (``Displacement/µm``, ``F / kN``), an underscore (``delta_mm``), a
-   space (``force N``) or the word ``in`` (``Displacement in mm``) is split off only if it
-   is a length or a force, so ``time_s`` and ``cycle_no`` keep their names.
-
-A unit option given explicitly and a unit carried by the file must agree (same factor):
-a disagreement is an error, as one of them is wrong by a factor the analysis cannot see.
-A carried unit of another kind (``force [V]``, a raw sensor channel) is overruled by an
-explicit option, and is an error without one.
+:func:`split_unit` separates a name such as ``Displacement [µm]`` or ``delta_mm`` into its
+base and its unit; :func:`find_column` finds a column by its name, its base or the usual
+names of :data:`SYNONYMS`; :func:`column_scale` decides the factor to SI from the unit
+option, the unit the file carries, or the default. The rules are in ``docs/formats.md``.
 """
 
 from __future__ import annotations

@@ -1,14 +1,10 @@
 """Writing files safely, and reporting where a file is damaged.
 
-Every file ecofmaps writes (cache entries, figures, result tables) goes through
-:func:`atomic_path`: the data are written to a temporary file in the destination's
-directory, flushed to disk and renamed onto the destination in one step, so a reader never
-sees a half-written file and a failed write leaves an existing file as it was. A folder is
-never removed to make room: only a store (zarr) is replaced by a store.
-
-The command line writes only over what it wrote itself: each folder it writes into keeps a
-manifest, :data:`MANIFEST`, of the files and stores ecofmaps put there (their sizes and
-contents), read by :func:`written_by_ecofmaps` and added to by :func:`record_written`.
+Every file ecofmaps writes goes through :func:`atomic_path`: written to a temporary file
+beside the destination, flushed and renamed onto it in one step, so a reader never sees a
+half-written file. The command line writes only over what it wrote itself: each folder it
+writes into keeps a manifest, :data:`MANIFEST` (:func:`written_by_ecofmaps`,
+:func:`record_written`).
 """
 
 from __future__ import annotations

@@ -1,37 +1,11 @@
-"""Recordings of fretting loops: text files and rig formats, read whole or lazily.
+"""Recordings of fretting loops: text files and rig formats, read whole, in blocks or lazily.
 
-:func:`read_recording` reads the displacement, force and (optional) cycle-number columns of
-a recording into a :class:`~ecofmaps.io.recording_types.Recording`, in SI units, whatever
-the file's format:
-
-- text: CSV, TSV, spreadsheet exports, whitespace-separated columns with a header line
-  (:mod:`ecofmaps.io.text`: separator and decimal comma detected, quotes, encodings,
-  missing cells), parsed in blocks;
-- TDMS (LabVIEW), HDF5 and netCDF-4, zarr stores of format 2 or 3
-  (:mod:`ecofmaps.io.binary`, opened through npTDMS and xarray by
-  :mod:`ecofmaps.io.rig_formats`): channels or variables chosen by name (and ``group``),
-  units from their metadata, fill values and CF packing decoded, read lazily as dask
-  arrays when large.
-
-:func:`open_recording` gives the same recording as one xarray Dataset over ``sample``
-(:meth:`~ecofmaps.io.recording_types.Recording.to_dataset`), with the units and the columns
-read in its attributes.
-
-The format is found from the file's first bytes (a zarr store is a directory), not its
-suffix. Columns are found by name without regard to case, and a unit carried by the name
-(``force [kN]``, ``delta_mm``) or the metadata is used when no unit option is given
-(:mod:`ecofmaps.io.columns`). A damaged file raises
-:class:`~ecofmaps.io.recording_types.RecordingError`, which names the file and the 1-based
-line, or, where a file has no lines, the channel or variable and the 0-based sample index.
-Missing samples (empty cells, NaN) are NaN in the arrays, found by
-:attr:`~ecofmaps.io.recording_types.Recording.missing`, with their lines;
-``nan_policy='raise'`` makes them errors.
-
-:func:`recording_blocks` gives a recording block by block with bounded memory, which
-:func:`ecofmaps.io.writers.convert_recording` uses to turn a large text file into a chunked
-store once. :func:`ecofmaps.io.tables.results_table` turns :func:`ecofmaps.analyze_loops`'s
-Dataset into the table that ``ecofmaps loops`` writes, and
-:func:`ecofmaps.io.files.write_text` writes a file atomically.
+:func:`read_recording` reads the displacement, force and optional cycle-number columns of a
+text file (:mod:`ecofmaps.io.text`) or a rig file (TDMS, HDF5/netCDF-4, zarr:
+:mod:`ecofmaps.io.binary`) into a :class:`~ecofmaps.io.recording_types.Recording` in SI
+units; :func:`open_recording` gives it as one xarray Dataset, :func:`recording_blocks` block
+by block. The format is found from the file's first bytes. ``docs/formats.md`` describes the
+formats, columns and units.
 """
 
 from __future__ import annotations

@@ -1,16 +1,10 @@
 """The rig formats' channels and variables: TDMS, HDF5 / netCDF-4 and zarr, through xarray.
 
-Each format has its module, which opens a file's groups as lazily read
-:class:`xarray.Dataset` objects (:mod:`ecofmaps.io.tdms` through npTDMS,
-:mod:`ecofmaps.io.hdf5` and :mod:`ecofmaps.io.zarr_store` through xarray's ``h5netcdf`` and
-``zarr`` engines, which decode CF packing, fill values and attributes); this module is
-their one face. :func:`variables` lists a file's one-dimensional numeric channels (TDMS) or
-variables (HDF5, zarr) as :class:`Variable`: name, group, length, units (the variable's
-``units`` attribute; a TDMS channel's ``unit_string`` or ``NI_UnitDescription``) and the
-file's chunking. :func:`open_group` opens the group of one for reading, and
-:func:`check_complete` refuses a zarr variable with missing chunk files. The openers refuse
-a truncated file (HDF5 checks its own length, a TDMS file whose last segment is short is
-found from npTDMS's notice). :mod:`ecofmaps.io.binary` reads the samples.
+The one face of :mod:`ecofmaps.io.tdms`, :mod:`ecofmaps.io.hdf5` and
+:mod:`ecofmaps.io.zarr_store`: :func:`variables` lists a file's one-dimensional numeric
+variables as :class:`Variable` (name, group, length, units, chunking), :func:`open_group`
+opens the group of one, and :func:`check_complete` refuses a zarr variable with missing
+chunk files. :mod:`ecofmaps.io.binary` reads the samples.
 """
 
 from __future__ import annotations

@@ -1,13 +1,10 @@
 """Wear-scar profiles in text files: a profilometer trace across the scar.
 
-:func:`read_scar_profile` reads two columns, the position along the fretting direction and
-the height (``x`` and ``z`` in µm by default), from a comma-, tab- or whitespace-separated
-file with a header line (the columns are read as :func:`ecofmaps.read_recording` reads
-them), levels the trace on the unworn shoulders and returns the
+:func:`read_scar_profile` reads the position and height columns (as
+:func:`ecofmaps.read_recording` reads columns) and returns the
 :class:`~ecofmaps.model.profiles.ScarProfile` the model uses. A damaged file raises
-:class:`ScarProfileError`, which names the file and the 1-based line; what the reading
-decided that the user must see (outliers replaced, ambiguous edges beside pile-up ridges)
-is a :class:`~ecofmaps.model.profiles.ScarProfileWarning` naming the file and the lines.
+:class:`ScarProfileError`, naming the file and the line; the reading's findings are
+:class:`~ecofmaps.model.profiles.ScarProfileWarning` naming the file's lines.
 """
 
 from __future__ import annotations

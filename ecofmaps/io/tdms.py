@@ -1,22 +1,9 @@
 """TDMS files (LabVIEW) as xarray Datasets, read through npTDMS, lazily; an xarray backend.
 
-A TDMS file holds groups of channels. :func:`tdms_groups` opens each group as an
-:class:`xarray.Dataset` whose variables are its numeric channels, named as in the file,
-read on demand (npTDMS's streaming reader: a range of samples is read from the file's
-segments without the rest, scaled as the file's ``NI_Scaling_*`` properties say). A
-channel's properties are its variable's attributes, with ``units`` from ``unit_string`` or
-``NI_UnitDescription``; a group's properties (and the root's) are the Dataset's. The
-channels of the most common length share the dimension ``sample``, any other length its
-own (``sample_<length>``).
-
-A file whose last segment is short (a rig that stopped while writing) is refused when it
-is opened, from npTDMS's notice, with a
-:class:`~ecofmaps.io.recording_types.RecordingError` naming the file.
-
-:class:`TdmsBackendEntrypoint` is registered with xarray as the engine ``ecofmaps-tdms``::
-
-    xr.open_dataset("rig.tdms", engine="ecofmaps-tdms", group="Rig")
-    xr.open_datatree("rig.tdms", engine="ecofmaps-tdms")
+:func:`tdms_groups` opens each group of a file as an :class:`xarray.Dataset` of its numeric
+channels, read on demand; a file whose last segment is short is refused. ``docs/formats.md``
+says how channels, properties and units map. :class:`TdmsBackendEntrypoint` is the xarray
+engine ``ecofmaps-tdms``: ``xr.open_dataset("rig.tdms", engine="ecofmaps-tdms", group="Rig")``.
 """
 
 from __future__ import annotations

@@ -1,36 +1,9 @@
 """Recordings in text files (CSV, TSV, spreadsheet exports), read in blocks.
 
-The file is read in blocks of about :data:`BLOCK_BYTES` bytes cut at line ends, so a
-large file is never held whole as text: only the columns asked for are kept, as float64.
-Each block is parsed by pandas' C parser, and every sample keeps the number of the line
-it came from, for messages.
-
-What the reader accepts:
-
-- A preamble: metadata lines before the header (``Test: 42``, ``Operator, J. Smith``,
-  blank lines). The header is the first line, among the first :data:`PREAMBLE_LINES`
-  that are not blank or comments, that is not all numbers, names every column asked for
-  (:func:`ecofmaps.io.columns.find_column`, usual names included) and has as many cells
-  as the line after it; with the option ``skip_rows``, the first line after those
-  skipped. Errors name the line in the file, preamble included.
-- Separator: the first of tab, semicolon or comma found in the header line (outside
-  quotes), else runs of blanks; whatever the file's suffix.
-- Decimal comma (``1,25;-3,5``) when the separator is not a comma, or in quoted cells
-  when it is (``"0,5","1,2"``): decided from the first block whose numbers show either a
-  comma or a point.
-- Quoted cells (``"1.25"``), a byte-order mark, LF, CRLF and CR-only line ends, lines
-  starting with ``#`` and blank lines anywhere (skipped).
-- gzip-compressed text (``.csv.gz``, found by its first bytes whatever the suffix),
-  decompressed as it is read.
-- Encoding: UTF-8; a file that is not (a Latin-1 ``µ`` from an old rig PC) is read as
-  Latin-1 from its first undecodable line on, with a :class:`RecordingWarning` naming the
-  file and the line. Latin-1 decodes every byte, and the digits, signs and separators are
-  the same in both, so no number can change; only names can. A UTF-16 file (a
-  spreadsheet's "Unicode text" export, found by its byte-order mark) is decoded as such.
-- Missing samples: an empty cell, ``nan``, ``NA``, ``N/A``, ``null`` (and a few more,
-  :data:`MISSING`) or an infinite value is a missing sample, NaN in the arrays; with
-  ``nan_policy='raise'`` it is an error naming the line. Any other text in a cell is an
-  error naming the line.
+The file is read in blocks of about :data:`BLOCK_BYTES` bytes cut at line ends and parsed by
+pandas' C parser, keeping only the columns asked for, as float64, and each sample's line
+number for messages. What the reader accepts (preamble, separators, decimal comma, quotes,
+gzip, encodings, missing cells) is described in ``docs/formats.md``.
 """
 
 from __future__ import annotations

@@ -1,15 +1,9 @@
 """Text recordings (:mod:`ecofmaps.io.text`'s format) as an xarray backend.
 
-:class:`TextBackendEntrypoint` is registered with xarray as the engine ``ecofmaps-text``::
-
-    xr.open_dataset("loops.csv", engine="ecofmaps-text")
-    xr.open_dataset("rig.tsv", engine="ecofmaps-text", displacement_column="disp",
-                    force_unit="kN")
-
-The Dataset is :func:`ecofmaps.io.recordings.open_recording`'s with its variables named as
-the file's columns (``Displacement [µm]``): the samples in SI units, with the attributes
-``units`` (SI), ``long_name``, ``source_column``, ``source_units`` and ``unit_assumed``. A
-text file has no random access: it is parsed whole, in blocks, when opened.
+:class:`TextBackendEntrypoint` is the xarray engine ``ecofmaps-text``
+(``xr.open_dataset("loops.csv", engine="ecofmaps-text")``): the Dataset of
+:func:`ecofmaps.io.recordings.open_recording` with its variables named as the file's
+columns. A text file has no random access: it is parsed whole, in blocks, when opened.
 """
 
 from __future__ import annotations

@@ -1,16 +1,9 @@
 """Writing recordings block by block: zarr, HDF5 / netCDF-4, TDMS and CSV; conversion.
 
-:class:`RecordingWriter` appends blocks of samples to a new file or store and makes it
-appear under its name only when it is complete (:func:`ecofmaps.io.files.atomic_store`):
-a failure or an interruption leaves no partial store that looks complete. The samples are
-written in SI units (m, N) as float64, so they read back bit for bit, with ``units`` and
-``long_name`` attributes (a TDMS channel's ``unit_string``), one dimension ``sample``.
-:func:`convert_recording` turns any recording that :func:`ecofmaps.io.read_recording`
-reads (e.g. a large CSV file) into a chunked store once, with bounded memory.
-
-The zarr arrays are not compressed: a rig's float64 samples are mostly noise in their low
-bits, and compression saved 5 % of the size of a noisy synthetic recording while halving
-the reading speed (zstd, measured when this was written).
+:class:`RecordingWriter` appends blocks of samples in SI units to a new file or store that
+appears under its name only when complete (:func:`ecofmaps.io.files.atomic_store`);
+:func:`convert_recording` turns any recording :func:`ecofmaps.io.read_recording` reads into
+a chunked store once, with bounded memory (``docs/formats.md``).
 """
 
 from __future__ import annotations

@@ -1,15 +1,9 @@
 """zarr stores (formats 2 and 3) as xarray Datasets, through xarray's ``zarr`` engine.
 
-Each group of the store is one lazily read :class:`xarray.Dataset`; xarray decodes the
-attributes and the fill value as the store's format keeps them (a format-3 store written
-by ``Dataset.to_zarr`` keeps ``_FillValue`` base64-encoded in its attributes, a format-2
-store in the array's ``fill_value``), and CF packing (``scale_factor``, ``add_offset``).
-
-A store written by zarr alone has no dimension names, which xarray's engine needs: its
-one-dimensional arrays are then read as variables over "phony" dimensions (one for each
-length, ``phony_dim_0``, ...), lazily, and decoded by :func:`xarray.decode_cf` from their
-attributes (zarr's own ``fill_value`` there only stands for chunks never written, which
-:func:`missing_chunks` refuses).
+Each group of the store is one lazily read :class:`xarray.Dataset`, decoded by xarray. A
+store written by zarr alone has no dimension names: its arrays are read over "phony"
+dimensions and decoded by :func:`xarray.decode_cf`; :func:`missing_chunks` refuses a store
+with chunks never written.
 """
 
 from __future__ import annotations
