@@ -1,12 +1,8 @@
 """Maps written to a netCDF file or a zarr store, block by block when they are chunked.
 
-A map in memory is written at once. A chunked map (``compute_map(..., chunks=...)``) is
-evaluated block by block as it is written, on one thread per core, so a grid far larger
-than memory goes to disk with a few blocks in memory at a time. Either way the output is
-written under a temporary name beside its destination and renamed into place only when
-complete (:func:`ecofmaps.io.files.atomic_store`):
-an interrupted or failed write leaves nothing that looks complete, and an existing file
-or store as it was.
+A chunked map is evaluated block by block as it is written, on one thread per core, so a
+grid far larger than memory goes to disk; either way the output appears under its name only
+when complete (:func:`ecofmaps.io.files.atomic_store`).
 """
 
 from __future__ import annotations

@@ -1,23 +1,11 @@
 r"""Parameter maps: the model over whole grids, as labelled xarray Datasets.
 
 Each function takes one value or one 1-D array per parameter; the arrays become the
-Dataset's dimensions (in the order of the arguments), the single values its scalar
-coordinates. The grid is evaluated with the dimensionless core of :mod:`ecofmaps.model`
-by a ``jax.jit``-compiled kernel (broadcasting, float64, no Python loop over points), in
-tiles of at most ``max_chunk`` points small enough for the processor's cache, on every
-core, so the cost grows linearly with the grid and the memory needed is that of the results
-(:mod:`ecofmaps.maps.tiles`). With ``chunks=`` the map is instead a dask-backed Dataset:
-each block is evaluated from the same tiles when it is computed or written
-(:func:`ecofmaps.maps.write_map`), so a grid far beyond memory can be written to disk, and
-its values equal the in-memory map's to the bit. The Datasets are labelled by
-:mod:`ecofmaps.maps.dataset`; maps on a measured scar profile are
-:mod:`ecofmaps.maps.on_profile`'s.
-:func:`compute_map` and :func:`compute_universal_map` keep their in-memory results in the
-disk cache (:mod:`ecofmaps.maps.cache`).
-
-As in the paper, the groove half-width is the displacement amplitude, :math:`x_o = \Delta^*`,
-so the curvature number is :math:`\kappa = 2 z_o/x_o` and the compliance ratio is
-:math:`\lambda = P/(S\Delta^*)`.
+Dataset's dimensions, the single values its scalar coordinates. The grid is evaluated by a
+jit-compiled kernel of the dimensionless core in tiles on every core
+(:mod:`ecofmaps.maps.tiles`), or lazily with ``chunks=`` as a dask-backed Dataset equal to
+the bit. :func:`compute_map` and :func:`compute_universal_map` keep their results in the disk
+cache (:mod:`ecofmaps.maps.cache`). As in the paper, :math:`x_o = \Delta^*`.
 """
 
 from __future__ import annotations

@@ -1,11 +1,8 @@
 """Grid evaluation in tiles (in memory, on every core) and in blocks of tiles (dask).
 
-A jit-compiled kernel of the map functions (:mod:`ecofmaps.maps.grid`) is evaluated over the
-grid spanned by 1-D axes in tiles of at most ``max_chunk`` points, small enough for the
-processor's cache, by one thread per core, so the cost grows linearly with the grid and the
-memory needed is that of the results (checked against the free memory before allocating).
-A chunked map is a dask graph of blocks of the same tiles, so its values equal the
-in-memory map's to the bit.
+A jit-compiled kernel is evaluated over the grid in tiles of at most ``max_chunk`` points by
+one thread per core (memory checked before allocating); a chunked map is a dask graph of
+blocks of the same tiles, so its values equal the in-memory map's to the bit.
 """
 
 from __future__ import annotations
