@@ -1,14 +1,11 @@
 """Figures (needs matplotlib): the paper's, drawn from Datasets, and those of measured loops.
 
-:mod:`~ecofmaps.figures.model_figures` draws the model's loops and curves (the paper's
-Figures 5-8), :mod:`~ecofmaps.figures.map_figures` its maps (Figure 11 and the universal
-map), :mod:`~ecofmaps.figures.measured_figures` those of measured
-loops (Figures 9 and 10, the loops read along the stroke),
-:mod:`~ecofmaps.figures.profile_figures` those of wear-scar profiles (a measured profile,
-and scars of several shapes), :mod:`~ecofmaps.figures.lab_figures` a campaign's
-running-condition fretting map, :mod:`~ecofmaps.figures.recipes` the set ``ecofmaps figures``
-writes, and :mod:`~ecofmaps.figures.style` what they share. The names are imported on
-first use: the registry of figures reads without matplotlib.
+The model's loops and curves (:mod:`~ecofmaps.figures.model_figures`), its maps
+(:mod:`~ecofmaps.figures.map_figures`), measured loops (:mod:`~ecofmaps.figures.measured_figures`),
+scar profiles (:mod:`~ecofmaps.figures.profile_figures`), a campaign's running-condition map
+(:mod:`~ecofmaps.figures.lab_figures`), the set ``ecofmaps figures`` writes
+(:mod:`~ecofmaps.figures.recipes`) and their shared look (:mod:`~ecofmaps.figures.style`).
+The names are imported on first use: the registry of figures reads without matplotlib.
 """
 
 from ecofmaps._lazy import lazy_names

@@ -1,13 +1,9 @@
 r"""Figures of wear-scar profiles: a measured profile as the model reads it, and scar shapes.
 
-:func:`scar_profile_figure` draws one :class:`~ecofmaps.model.profiles.ScarProfile`: its
-heights with the unworn surface and the detected edges :math:`\pm W`, and the slope
-:math:`g(X)` the model uses, beside the parabola of the same :math:`D/W`.
-:func:`scar_shape_comparison` draws the ``shapes`` figure of ``ecofmaps figures`` from its
-Dataset (:mod:`ecofmaps.figures.recipes`): scars of four shapes at one :math:`D/W`, their
-loops and :math:`\mu_E/\mu` over :math:`S/P` against the parabola of that :math:`D/W`,
-and how far the paper's :math:`D/W` shortcut (eq. 11) misses the contact CoF.
-Both are pure functions of their inputs.
+:func:`scar_profile_figure` draws one :class:`~ecofmaps.model.profiles.ScarProfile` with its
+edges and the slope the model uses; :func:`scar_shape_comparison` draws the ``shapes``
+figure: scars of four shapes at one :math:`D/W` against the parabola, and how far the
+paper's :math:`D/W` shortcut (eq. 11) misses the contact CoF.
 """
 
 from __future__ import annotations

@@ -1,12 +1,8 @@
 r"""The figures ``ecofmaps figures`` writes: each one's Dataset, drawing function and markers.
 
 :data:`FIGURES` is the registry: for each figure name, the function that builds its Dataset
-with the paper's parameters (:mod:`ecofmaps.paper`, through the cached map functions), the
-function that draws it, and what it marks. :func:`make_figure` does both for one figure,
-:func:`make_figures` for several (building each shared Dataset once).
-
-The paper's parameters (Section 3): :math:`\Delta^* = x_o = 50` µm, :math:`P = 450` N,
-:math:`S = 35` MN/m, :math:`\mu = 0.8`.
+with the paper's parameters (:mod:`ecofmaps.paper`), the function that draws it, and what it
+marks. :func:`make_figure` does both for one figure, :func:`make_figures` for several.
 """
 
 from __future__ import annotations

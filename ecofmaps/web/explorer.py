@@ -1,14 +1,9 @@
 """A live explorer of the model in the browser (``ecofmaps explore``), built with Panel.
 
-One page per browser session: the test's amplitude, load, rig stiffness, contact CoF and
-groove aspect ratio typed with units as on the command line (``50um``, ``35MN/m``; a bare
-number is SI), and it shows at that point the slip amplitude, the dissipated energy and
-:math:`\\mu_E/\\mu` (eq. 16, 12, 1), the steady loop, the map of :math:`\\mu_E/\\mu` over
-:math:`S/P` and :math:`z_o/x_o` with the point marked (:func:`ecofmaps.compute_map`, from its
-disk cache), and the contact CoF behind an ECoF the user types, for a scar known between two
-aspect ratios (:func:`ecofmaps.correct_ecof`). The inputs live in the page's URL query
-(``?amplitude=50um&load=450N&stiffness=35MN/m&mu=0.8&aspect_ratio=0.2``), so a view is
-shared as a link.
+One page per session: the test's parameters typed with units (``50um``, ``35MN/m``), and at
+that point the slip amplitude, the energy and :math:`\\mu_E/\\mu`, the steady loop, the map
+of :math:`\\mu_E/\\mu` with the point marked, and the contact CoF behind a typed ECoF. The
+inputs live in the page's URL query, so a view is shared as a link.
 """
 
 from __future__ import annotations

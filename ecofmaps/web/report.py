@@ -1,17 +1,9 @@
 """A fretting test's results as one HTML page that opens offline (``ecofmaps loops --report``).
 
-The page is Bokeh's, with its JavaScript and CSS written inline (:data:`bokeh.resources.INLINE`),
-so it fetches nothing: it can be sent by e-mail and opened from a disk. It shows
-
-- the ECoF, the GICoF and the friction read along the stroke with its :math:`\\pm 2` se band
-  against the cycle number, and below them the cycles each quality flag marks;
-- the count of every flag and what it means (:data:`ecofmaps.measured.quality.REASONS`);
-- measured loops of a few cycles (first, middle and last; the reader picks others among the
-  cycles the page carries), each with the model's steady loop for the friction and the groove
-  read along the stroke, where the cycle has them;
-- the table of ``ecofmaps loops --out`` with every column, sortable, each number as in the CSV
-  (6 significant digits);
-- the inputs (files, load, units assumed), the ecofmaps version and the date.
+Bokeh's page with its JavaScript and CSS inline, so it fetches nothing: the ECoF, the GICoF
+and the friction read along the stroke over the cycles with the quality flags and their
+counts, measured loops of a few cycles beside the model's, the table of ``ecofmaps loops``
+(sortable), and the inputs, version and date.
 """
 
 from __future__ import annotations
