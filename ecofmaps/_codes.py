@@ -1,8 +1,7 @@
 """Integer codes that carry their own words: the regimes and statuses results hold per point.
 
 Maps and arrays store the integer; the member knows its ``label`` (how tables and the
-command line print it) and its ``reason`` (why a value is NaN there), so no side table
-repeats them (as optimistix's ``RESULTS`` does).
+command line print it) and its ``reason`` (why a value is NaN there).
 """
 
 from __future__ import annotations

@@ -1,15 +1,9 @@
 """Input handling shared by the public entry points: units, float64 and validation.
 
-The public functions accept anything array-like, including JAX tracers (under
-``jax.jit``, ``jax.vmap`` and ``jax.grad``), in SI units, and pint Quantities of any unit
-registry, which :func:`si_units` converts to SI by the parameter's name (its dimension is in
-:mod:`ecofmaps._nomenclature`): a Quantity of the wrong dimension, a string, a boolean or
-``None`` where a number is expected raises a :class:`ValueError` naming the parameter.
-Concrete inputs are checked by :func:`check`, and bad values raise a :class:`ValueError`
-that names the parameter and its valid range; traced inputs cannot be inspected, so the
-kernels turn them into NaN plus the ``INVALID`` regime code instead. Before anything else,
-:func:`check_broadcast_size` refuses, with a ``MemoryError``, inputs whose broadcast would
-not fit in memory (JAX would abort the interpreter).
+Numbers or pint Quantities (converted to SI by the parameter's name, :func:`si_units`),
+concrete inputs checked with a :class:`ValueError` naming the parameter and its range
+(:func:`check`), traced inputs left to the kernels (NaN and the ``INVALID`` regime), and
+broadcasts too large for memory refused before JAX would abort (:func:`check_broadcast_size`).
 """
 
 from __future__ import annotations

@@ -1,8 +1,6 @@
 """The public names of a package, imported from their modules on first use (PEP 562).
 
-A package's ``__init__`` that imported every module at once would load JAX, xarray, pint
-and SciPy for any use of one of them: a worker process that reads a block of a recording
-would pay a second for names it never uses, and the command line would start slower.
+So ``import ecofmaps`` and the command line start without loading JAX, xarray, pint or SciPy.
 """
 
 from __future__ import annotations

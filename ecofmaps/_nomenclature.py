@@ -1,13 +1,8 @@
 r"""Every quantity ecofmaps names, once: symbol, long name, units, display, range.
 
-Dataset attributes (``long_name``, ``units``), plot axis labels, the column names of the
-tables ecofmaps writes and reads, the rows the command line prints and the range checks of
-concrete inputs all read :data:`QUANTITIES`. A quantity is known by its name in the Python
-API (the keyword argument, the Dataset variable).
-
-Units: ``units`` is the SI unit in CF/UDUNITS spelling (``'N m-1'``), as xarray writes it
-to netCDF; ``display_unit`` and ``display_factor`` are the tribologist's unit (µm, MN/m, mJ)
-and the factor from SI to it, used by figures, tables and the command line.
+Dataset attributes, plot labels, table columns, the command line's rows and the range checks
+all read :data:`QUANTITIES`, keyed by the quantity's name in the Python API. ``units`` is the
+SI unit in CF/UDUNITS spelling; ``display_unit`` and ``display_factor`` the tribologist's.
 
 Examples
 --------

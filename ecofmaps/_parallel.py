@@ -1,34 +1,9 @@
 """Blocks of work run on local threads or on a dask cluster, their results as they come.
 
-A long recording is analysed as many independent tasks, each of which reads its own stretch
-of the recording (a slice of a dask array, so the reading happens where the task runs) and
-returns a small result. :class:`Runner` runs such tasks with a bounded number in flight, so
-that memory holds a few blocks at a time whatever the recording's length, and gives the
-results back in the order of the tasks as soon as each is ready (so they can be written as
-they complete):
-
-- ``Runner()``: threads of this process (``workers``, default one per core); each task's
-  dask graph is computed in its thread;
-- ``Runner(workers=N)``: a ``dask.distributed.LocalCluster`` of N single-threaded worker
-  processes, started here and closed after;
-- ``Runner(scheduler="tcp://host:8786")``: the workers of an existing dask cluster, which
-  must have ecofmaps installed and reach the recording's file at the same path.
-
-Tasks are plain functions of this package (pickled by name for other processes). A stretch
-of a dask array made by ``dask.array.from_array`` over an array-like that reads ranges
-itself (an :class:`ecofmaps.io.binary.Column`, tied to the array by the attribute
-:data:`SOURCE`) is handed to a task as a :class:`Slice` and read by that array-like where the
-task runs, without dask's graph (whose compute copies each block once more). Between
-results :func:`ecofmaps._interrupts.check_interrupted` is called, so Ctrl-C on the command
-line stops the run at the next block without raising inside dask. The worker processes of a
-local cluster ignore Ctrl-C: on a terminal it reaches every process of the command, and the
-workers' own ``KeyboardInterrupt`` printed their tracebacks; this process stops them when it
-closes the cluster.
-
-The number of workers is checked before anything starts (:func:`worker_limit`), and a
-scheduler given by address is asked who it is within :data:`CONNECT_TIMEOUT` seconds before
-a client connects (a client of an address that does not answer, or answers HTTP, waited
-for good).
+:class:`Runner` runs independent tasks (each reading its own stretch of a recording) with a
+bounded number in flight, on threads, a local cluster or an existing one, and gives the
+results back in order as soon as each is ready; Ctrl-C stops it at the next block. How,
+and why, is explained in ``docs/parallel.md``.
 """
 
 from __future__ import annotations

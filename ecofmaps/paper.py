@@ -1,10 +1,8 @@
 r"""The paper ecofmaps implements: its citation, its worked examples and its figures' parameters.
 
-X. Jin, W. Sun and P.H. Shipway extend the wear-scar interaction model of Mulvihill et al. (a
-rigid round-ended pad in a parabolic groove) with the compliance of the fretting rig, map how
-far the energy coefficient of friction drifts from the contact one, and propose the
-geometry-independent CoF. Every value here is the paper's, in SI units, and every other module
-reads it from here.
+Jin, Sun and Shipway (2016) add the rig's compliance to the wear-scar interaction model of
+Mulvihill et al. Every value here is the paper's, in SI units, and every other module reads
+it from here (``docs/model.md``).
 
 Examples
 --------
