@@ -138,12 +138,11 @@ class Runner:
 
             # distributed sets MALLOC_TRIM_THRESHOLD_ in its workers, which stops glibc from
             # raising its mmap threshold: every NumPy temporary above 128 kB is then mapped
-            # afresh and faulted in page by page (measured: the analysis ran 2-3x slower).
+            # afresh and faulted in page by page.
             environ = dask.config.get("distributed.nanny.pre-spawn-environ")
             environ = {k: v for k, v in environ.items() if k != "MALLOC_TRIM_THRESHOLD_"}
-            # Nor does a worker sample its task's stack every 10 ms for the dashboard's
-            # profile (which this cluster does not serve): the sampling takes the GIL from
-            # the task (measured, 2e8 samples on two workers: 5-10 % of the time).
+            # Nor does a worker sample its task's stack for the dashboard's profile (which
+            # this cluster does not serve): the sampling takes the GIL from the task.
             settings = {
                 "distributed.nanny.pre-spawn-environ": environ,
                 "distributed.worker.profile.enabled": False,

@@ -107,7 +107,7 @@ def grid_dataset(axes: dict, values: dict, title: str, extra=None) -> xr.Dataset
             dims + trailing[: value.ndim - len(dims)], value, _attrs(name)
         )
     # What xarray.Dataset(data_vars, coords, attrs) builds, without its merging and alignment
-    # of variables that are consistent by construction (a third of a small map's time).
+    # of variables that are consistent by construction.
     return xr.Dataset._construct_direct(
         variables, set(coords), attrs=_global_attrs(title), indexes=indexes
     )

@@ -41,9 +41,8 @@ _TABLE_BUDGET = 2**25
 _POINT_BATCH = 256
 # Points share tables unless there are more groups than this and than a 16th of the points.
 _FEW_GROUPS = 64
-# Up to this many points, each builds its own O(N) tables: computing them (0.2-0.4 ms a
-# point on 2000 samples) costs less than compiling the shared sparse tables' kernels (3-4 s
-# on a 2-core machine, for every new shape), and one kernel serves them all.
+# Up to this many points, each builds its own O(N) tables: that costs less than compiling
+# the shared sparse tables' kernels for every new shape.
 _FEW_POINTS = 256
 
 
@@ -173,8 +172,7 @@ def _own_loop(position, slope, half_width, physical, point, num=0):
 @partial(jax.jit, static_argnames=("physical", "num"))
 def _own_loops(position, slope, half_width, mu, key, lam, physical, num=0):
     one = partial(_own_loop, position, slope, half_width, physical, num=num)
-    # With loops drawn (a figure's few points) one point at a time: the body compiles in
-    # two thirds of the time of its batched form, and few points need no batches.
+    # With loops drawn (a figure's few points) one point at a time: it compiles faster.
     return jax.lax.map(one, (mu, key, lam), batch_size=None if num else _POINT_BATCH)
 
 
