@@ -42,7 +42,7 @@ _MAX_STEPS = 300  # the bracket [0, mu_E] halves at least every two steps
 
 @jax.custom_jvp
 def _root(ecof, kappa, lam):
-    r"""The :math:`\mu` with :math:`\mu_E(\mu) =` ``ecof`` by bracketed Newton (see module)."""
+    r"""The :math:`\mu` with :math:`\mu_E(\mu) =` ``ecof``, by bracketed Newton."""
     mu_max = jnp.where(lam > 0.0, 1.0 / lam, 1.0 / kappa)
     low = jnp.zeros_like(ecof)
     high = jnp.minimum(ecof, mu_max)
@@ -125,7 +125,7 @@ def contact_cof(ecof, kappa, lam):
 
     Notes
     -----
-    Inverts the corrected eq. 13-15 with eq. 16 (module docstring).
+    Inverts the corrected eq. 13-15 with eq. 16 (``docs/model.md``).
 
     References
     ----------
@@ -262,7 +262,7 @@ def _correct(ecof, amplitude, load, stiffness, aspect_ratio, scar_depth, scar_ha
     results = [_si_correct(ecof, amplitude, load, stiffness, end) for end in ends]
     values = [mu / ecof if factor else mu for mu, _, _ in results]
     status = results[0][1]
-    if len(results) == 2:  # the larger aspect ratio allows the smaller mu (module docstring)
+    if len(results) == 2:  # the larger aspect ratio allows the smaller mu (docs/model.md)
         high_end = results[1][1]
         status = jnp.where(status == int(CorrectionStatus.CORRECTED), high_end, status)
         both = status == int(CorrectionStatus.CORRECTED)

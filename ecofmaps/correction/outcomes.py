@@ -98,8 +98,8 @@ class Interval(NamedTuple):
     high: jax.Array
 
 
-# mu_E(mu) can fall only for kappa > _FALL_KAPPA and 0 < lam < _FALL_LAMBDA (docstring of
-# ecofmaps.correction.inversion); the fall lies in 1/kappa < mu < 1, scanned on _FALL_GRID
+# mu_E(mu) can fall only for kappa > _FALL_KAPPA and 0 < lam < _FALL_LAMBDA (docs/model.md,
+# correcting a reported ECoF); the fall lies in 1/kappa < mu < 1, scanned on _FALL_GRID
 # points in log(mu) and located to _FALL_BISECTIONS halvings of a grid step.
 _FALL_KAPPA = 1.0
 _FALL_LAMBDA = 0.075  # a margin above LAMBDA_INFINITY

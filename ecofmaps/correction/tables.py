@@ -191,7 +191,36 @@ def _check_header(path, line: int, header: list[str], on_profile: bool) -> None:
 
 
 def correct_table(path, profile=None, mapping="scaled") -> tuple[str, int]:
-    r"""Correct every row of a table of reported ECoF values (see the module docstring)."""
+    r"""Correct every row of a table of reported ECoF values (format: ``docs/formats.md``).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The table: separated by commas, semicolons or tabs, with ``#`` comment lines.
+    profile : ScarProfile, optional
+        A measured wear-scar profile that gives every row's scar (the table then has no
+        scar columns).
+    mapping : {'scaled', 'physical'}
+        On a profile: :math:`X = xW/\Delta^*` (eq. 11) or :math:`X = x`.
+
+    Returns
+    -------
+    text : str
+        The output table with the input's separator: the input columns and cells, then
+        ``mu`` and ``correction_factor`` (both to 10 significant digits, with a decimal
+        comma if the input has them), and on a profile ``mu_parabolic``.
+    rows : int
+        The number of data rows.
+
+    Raises
+    ------
+    TableError
+        For a file that cannot be read as such a table, a bad value, or a row whose ECoF
+        cannot be corrected (the reason, as :func:`ecofmaps.correct_ecof` gives it); the
+        first such row is named by its line.
+    OSError
+        If the file cannot be opened.
+    """
     path = Path(path)
     header, records, si, dialect = _read(path, on_profile=profile is not None)
     rig = dict(amplitude=si["amplitude_um"], load=si["load_N"], stiffness=si["stiffness_MN_per_m"])

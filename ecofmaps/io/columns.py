@@ -129,7 +129,27 @@ _SYNONYM_KEYS = {role: frozenset(map(_plain, names)) for role, names in SYNONYMS
 
 
 def split_unit(name: str) -> tuple[str, str | None]:
-    """A column name's base and the unit it carries."""
+    """A column name's base and the unit it carries.
+
+    Parameters
+    ----------
+    name : str
+        A column, channel or variable name, e.g. ``'force [N]'``, ``'delta_mm'``.
+
+    Returns
+    -------
+    base : str
+        The name without its unit, surrounding quotes and blanks.
+    unit : str or None
+        The unit as written (``'N'``, ``'mm'``, ``'µm'``), or None.
+
+    Examples
+    --------
+    >>> split_unit("force [N]"), split_unit("Displacement/µm"), split_unit("Ftr_kN")
+    (('force', 'N'), ('Displacement', 'µm'), ('Ftr', 'kN'))
+    >>> split_unit("time_s"), split_unit("Force (tangential)"), split_unit("Disp in mm")
+    (('time_s', None), ('Force (tangential)', None), ('Disp', 'mm'))
+    """
     text = name.strip().strip("\"'").strip()
     match = _BRACKETED.match(text)
     if match and match.group("base"):
@@ -144,7 +164,43 @@ def split_unit(name: str) -> tuple[str, str | None]:
 
 
 def find_column(names, wanted: str, role: str, *, required: bool = True) -> int | None:
-    """The index of the column ``wanted`` among ``names``."""
+    """The index of the column ``wanted`` among ``names``.
+
+    Parameters
+    ----------
+    names : sequence of str
+        The names in the file (header cells, channels or variables).
+    wanted : str
+        The name asked for: matched first against the whole names, then against their
+        bases (:func:`split_unit`), without regard to case or repeated blanks. The role's
+        own name (``'displacement'`` for the displacement, the default) also finds the
+        role's usual names (:data:`SYNONYMS`) if no column bears it.
+    role : str
+        What the column holds (``'displacement'``, ``'force'``, ``'load'``, ``'cycle'``,
+        ``'x'``, ``'z'``), for messages and synonyms.
+    required : bool
+        Whether a missing column is an error; if not, None is returned for it.
+
+    Returns
+    -------
+    index : int or None
+
+    Raises
+    ------
+    ColumnError
+        If no name matches (and the column is required: the message lists the columns and
+        suggests the nearest), or several do (the message names them and the option that
+        chooses).
+
+    Examples
+    --------
+    >>> find_column(["time", "Displacement [µm]", "Ftr_kN"], "displacement", "displacement")
+    1
+    >>> find_column(["time", "Displacement [µm]", "Ftr_kN"], "FTR", "force")
+    2
+    >>> find_column(["t [s]", "stroke_um", "friction_force_N"], "force", "force")
+    2
+    """
     matches = matching_columns(names, wanted, role)
     if len(matches) > 1:
         found = ", ".join(repr(names[k]) for k in matches)
@@ -212,7 +268,35 @@ def _factor(unit: str, kind: str, option: str | None) -> float:
 
 
 def column_scale(role: str, option_unit, carried, column: str) -> tuple[float, str]:
-    """The factor from a column's values to SI, and the unit it stands for."""
+    """The factor from a column's values to SI, and the unit it stands for.
+
+    Parameters
+    ----------
+    role : str
+        A key of :data:`KINDS`.
+    option_unit : str or None
+        The unit given as the option ``<role>_unit``; None to take the file's.
+    carried : sequence of str
+        The units the file gives for the column (from its name and its metadata), any
+        number of them, each a unit's text.
+    column : str
+        The column's name in the file, for messages.
+
+    Returns
+    -------
+    factor : float
+        Multiply the values by it (or divide by its reciprocal) for SI (m or N).
+    unit : str
+        The unit used.
+
+    Raises
+    ------
+    ValueError
+        If ``option_unit`` is not a unit of the role's kind; the message names the option.
+    ColumnError
+        If units disagree (an option against the file, or two in the file), or the file
+        gives a unit of another kind and no option overrules it.
+    """
     kind = KINDS[role]
     option = f"{role}_unit"
     given = None if option_unit is None else (option_unit, _factor(option_unit, kind, option))

@@ -41,7 +41,21 @@ SI_UNITS = {"displacement": "m", "force": "N", "cycle": "1", "load": "N"}
 def si_values(values: np.ndarray, factor: float) -> np.ndarray:
     """``values * factor``; for a factor 10^-k, divided by the exact 10^k instead, so that
     a ``25`` read in µm is the float nearest 25e-6 (one rounding, not two), as a text file's
-    ``25`` is (:mod:`ecofmaps.io.text`)."""
+    ``25`` is (:mod:`ecofmaps.io.text`).
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        In the file's unit; changed in place where that saves a copy.
+    factor : float
+        From the file's unit to SI.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> bool(si_values(np.array([25.0]), 1e-6)[0] == 25e-6)
+    True
+    """
     if factor == 1.0:
         return values
     inverse = round(1.0 / factor)

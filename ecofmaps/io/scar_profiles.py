@@ -62,9 +62,7 @@ def read_scar_profile(
     smoothing : float, optional
         Smoothing length of the slopes; default 2 % of the half-width, 0 for none. [m]
     remove_outliers : bool
-        Replace spikes and dropouts (a Hampel filter,
-        :func:`~ecofmaps.model.profiles.outlying_samples`) by linear interpolation between
-        the nearest samples kept (on by default).
+        Replace spikes and dropouts by linear interpolation (on by default).
 
     Returns
     -------
@@ -76,20 +74,14 @@ def read_scar_profile(
     Warns
     -----
     ScarProfileWarning
-        Naming the file: for outliers replaced (their count, and each one's line, position
-        and deviation from its neighbours' median), and for ambiguous edges (a band between
-        pile-up ridges wider than the groove below the unworn surface's line: both
-        half-widths; the band's is taken when it reaches beyond both of the groove's edges,
-        ``half_width=`` chooses). See :func:`ecofmaps.scar_profile`.
+        Those of :func:`ecofmaps.scar_profile`, naming the file and the lines.
 
     Raises
     ------
     ScarProfileError
-        For a missing column, a line with the wrong number of fields, a non-numeric or
-        non-finite cell, positions that do not increase strictly (unsorted or repeated),
-        no data, or a trace that is not a usable scar (no depression, a scar reaching the
-        end of the trace, too few samples across it, a half-width that does not fit): the
-        message names the file and the line (for the whole trace, its first data line).
+        For a damaged file (a missing column, a bad line or cell, positions not strictly
+        increasing, no data) or a trace that is not a usable scar (the errors of
+        :func:`ecofmaps.scar_profile`), naming the file and the line.
     ValueError
         For a unit that is not a length.
     OSError

@@ -47,7 +47,22 @@ RESULT_COLUMNS = tuple(nomenclature.column(name) for name in RESULT_QUANTITIES)
 
 
 def results_table(results: xr.Dataset) -> pd.DataFrame:
-    """The per-cycle results in the tribologist's units, one row per cycle."""
+    """The per-cycle results in the tribologist's units, one row per cycle.
+
+    Parameters
+    ----------
+    results : xarray.Dataset
+        From :func:`ecofmaps.analyze_loops`.
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        The columns of :data:`RESULT_COLUMNS` that ``results`` holds: cycle, amplitude_um,
+        slip_amplitude_um, normal_load_N (with a recorded load), max_force_N,
+        dissipated_energy_mJ, ecof, cof_max, energy_ratio, stiffness_MN_per_m, gicof,
+        regime, then (with ``resolve=True``) mu_resolved, mu_resolved_se, aspect_ratio,
+        and quality.
+    """
     columns = {}
     for name, column in zip(RESULT_QUANTITIES, RESULT_COLUMNS, strict=True):
         if name not in results:
@@ -63,7 +78,22 @@ def results_table(results: xr.Dataset) -> pd.DataFrame:
 
 
 def results_csv(results: xr.Dataset, *, file: str | None = None, header: bool = True) -> str:
-    """The per-cycle results as the text of ``ecofmaps loops --out`` (see :func:`csv_text`)."""
+    """The per-cycle results as the text of ``ecofmaps loops --out`` (see :func:`csv_text`).
+
+    Parameters
+    ----------
+    results : xarray.Dataset
+        From :func:`ecofmaps.analyze_loops` (or a stretch of its cycles).
+    file : str, optional
+        The recording's name, written in a first column ``file``.
+    header : bool
+        Begin with the line of column names.
+
+    Returns
+    -------
+    text : str
+        One line per cycle (and the header), each ending in ``\\n``.
+    """
     table = results_table(results)
     if file is not None:
         table.insert(0, "file", file)
@@ -71,7 +101,33 @@ def results_csv(results: xr.Dataset, *, file: str | None = None, header: bool = 
 
 
 def csv_text(table: pd.DataFrame, *, header: bool = True) -> str:
-    """``table`` as CSV text, numbers to 6 significant digits."""
+    """``table`` as CSV text, numbers to 6 significant digits.
+
+    The text is what ``table.to_csv(index=False, float_format="%.6g", lineterminator="\\n",
+    header=header)`` writes (an empty field for NaN, text quoted by :mod:`csv` where it
+    must be), in half the time: the floats are formatted a column at a time and the lines
+    are written by :func:`csv.writer`.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        Columns of floats, integers, booleans or text.
+    header : bool
+        Begin with the line of column names.
+
+    Returns
+    -------
+    text : str
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> print(csv_text(pd.DataFrame({"ecof": [0.8123456789, float("nan")], "note": ["a,b", "ok"]})))
+    ecof,note
+    0.812346,"a,b"
+    ,ok
+    <BLANKLINE>
+    """
     stream = io.StringIO()
     writer = csv.writer(stream, lineterminator="\n")
     if header:

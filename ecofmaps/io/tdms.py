@@ -149,7 +149,23 @@ def _group_dataset(reader: TdmsReader, group) -> xr.Dataset:
 
 def tdms_groups(path) -> dict[str, xr.Dataset]:
     """Every group of a TDMS file as a lazily read Dataset, by its path (``'/Rig'``; the
-    root, ``'/'``, holds the file's properties and no variables)."""
+    root, ``'/'``, holds the file's properties and no variables).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    groups : dict of str to xarray.Dataset
+        All read through one :class:`TdmsReader` (closing any of them closes the file,
+        which is opened again on the next read).
+
+    Raises
+    ------
+    RecordingError
+        If the file is not TDMS, or is truncated or damaged.
+    """
     path = Path(path)
     handle = opened_tdms(path)
     reader = TdmsReader(path, handle)  # reads through the file opened to list the groups
@@ -177,7 +193,14 @@ def open_tdms_group(path, group: str | None = None) -> xr.Dataset:
 class TdmsBackendEntrypoint(BackendEntrypoint):
     """xarray's engine ``ecofmaps-tdms``: a TDMS group as a Dataset (channels as variables,
     named as in the file, ``units`` from ``unit_string``/``NI_UnitDescription``, read
-    lazily through npTDMS); the whole file as a DataTree."""
+    lazily through npTDMS); the whole file as a DataTree.
+
+    Examples
+    --------
+    >>> from ecofmaps.io.tdms import TdmsBackendEntrypoint
+    >>> TdmsBackendEntrypoint().guess_can_open("rig.tdms")
+    True
+    """
 
     description = "TDMS (LabVIEW) files through npTDMS, one group a Dataset (ecofmaps)"
     open_dataset_parameters = ("filename_or_obj", "drop_variables", "group")

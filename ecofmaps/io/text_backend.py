@@ -25,7 +25,16 @@ SUFFIXES = (".csv", ".tsv")
 
 class TextBackendEntrypoint(BackendEntrypoint):
     """xarray's engine ``ecofmaps-text``: a text recording (CSV, TSV, whitespace columns
-    under a header line) as a Dataset over ``sample``, variables named as its columns."""
+    under a header line) as a Dataset over ``sample``, variables named as its columns.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> from ecofmaps.measured.synthetic import example_path
+    >>> dataset = xr.open_dataset(example_path(), engine=TextBackendEntrypoint)
+    >>> [(name, dataset[name].attrs["units"]) for name in dataset.data_vars]
+    [('displacement', 'm'), ('force', 'N'), ('cycle', '1')]
+    """
 
     description = "Text recordings of fretting loops (CSV, TSV), in SI units (ecofmaps)"
     open_dataset_parameters = (
@@ -53,7 +62,13 @@ class TextBackendEntrypoint(BackendEntrypoint):
         nan_policy="propagate",
         block_bytes=None,
     ) -> xr.Dataset:
-        """The recording's columns (see :func:`ecofmaps.io.read_recording` for the options)."""
+        """The recording's columns (see :func:`ecofmaps.io.read_recording` for the options).
+
+        Raises
+        ------
+        RecordingError
+            For a file that is not a text recording, or a damaged one (naming the line).
+        """
         if not isinstance(filename_or_obj, str | os.PathLike):
             raise TypeError(
                 f"the ecofmaps-text engine reads a file by its path; got {filename_or_obj!r}"

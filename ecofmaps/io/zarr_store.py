@@ -64,7 +64,7 @@ class _ZarrRange(BackendArray):
 
 
 def _plain_groups(path: Path, root) -> dict[str, xr.Dataset]:
-    """The groups of a store without dimension names (see the module's notes)."""
+    """The groups of a store without dimension names (read over phony dimensions)."""
     import zarr  # as in _opened
 
     is_array = isinstance(root, zarr.Array)

@@ -44,7 +44,7 @@ JAMMED_TRACTION = sys.float_info.epsilon**-0.5
 
 
 class SteadyLoop(NamedTuple):
-    """The steady loop of one point, in the units of the module docstring."""
+    """The steady loop of one point, in the units of ``docs/model.md``."""
 
     minus: jax.Array  # xi_-
     plus: jax.Array  # xi_+
@@ -135,7 +135,7 @@ def _passage(side: Side, group, mu, lam, value, level, segment, fraction, sparse
 
 
 def steady_loop(tables: Tables, group, lam, sparse: bool = True) -> SteadyLoop:
-    r"""The steady loop of one point (see module): ends, :math:`\mu_E/\mu`, peak, regime."""
+    r"""The steady loop of one point (``docs/model.md``): ends, :math:`\mu_E/\mu`, peak, regime."""
     forward, backward = tables.forward, tables.backward
     n = forward.position.shape[-1]
     mu = _at(tables.mu, group)

@@ -258,7 +258,7 @@ def _prepare(amplitude, load, stiffness, mu, half_width, profile_half_width, phy
 
 @jax.jit
 def _finish(loops, jumps, mu, lam, valid) -> dict:
-    """The steady-loop numbers from the loops and the jumps' areas (module docstring)."""
+    """The steady-loop numbers from the loops and the jumps' areas (``docs/model.md``)."""
     loops, jumps = jax.tree.map(lambda leaf: leaf[: mu.shape[0]], (loops, jumps))
     slip = 0.5 * (loops.plus - loops.minus)
     scale = 4.0 * mu * jnp.where(lam > 0.0, lam, 1.0) * jnp.where(slip > 0.0, slip, 1.0)

@@ -47,7 +47,7 @@ class Side(NamedTuple):
 
 
 class Tables(NamedTuple):
-    """Everything the steady loop needs that does not depend on the rig (see module)."""
+    """Everything the steady loop needs that does not depend on the rig (``docs/model.md``)."""
 
     forward: Side
     backward: Side  # the mirrored profile: position -p[::-1], slope -g[::-1]

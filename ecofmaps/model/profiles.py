@@ -88,15 +88,11 @@ class ScarProfile(NamedTuple):
     reference_slope : jax.Array, shape ()
         Tilt of the unworn surface, in the frame of ``slope`` (0 when levelled). [1]
     alternative_half_width : jax.Array, shape ()
-        The other plausible half-width when the edges were ambiguous (the groove's below
-        the unworn surface's line, or the band's between the crests of pile-up ridges,
-        whichever was not returned) or uncertain on a rough surface (read within 3 times
-        the roughness of the line; ``docs/profiles.md``), NaN when they were neither
-        (or the half-width was given). [m]
+        The other plausible half-width when the edges were ambiguous or uncertain
+        (``docs/profiles.md``), else NaN. [m]
     replaced : jax.Array, shape (N,) or ()
-        1 where the sample was an outlier (a spike or dropout, :func:`outlying_samples`)
-        and its height was interpolated from its neighbours', else 0; a scalar 0 when no
-        sample was tested (the analytic families). [1]
+        1 where the sample was an outlier (:func:`outlying_samples`) and its height was
+        interpolated, else 0; a scalar 0 when no sample was tested (the families). [1]
 
     Notes
     -----
@@ -438,11 +434,8 @@ def scar_profile(x, z, half_width=None, smoothing=None, level=False,
     -----
     ScarProfileWarning
         For outliers replaced (their count, sample indices and positions), and for
-        ambiguous edges: a band between the crests of pile-up ridges (or a disturbed band)
-        wider than the groove below the unworn surface's line by more than
-        :data:`AMBIGUOUS_EDGES` on a side; the band is returned if on both sides, else the
-        groove, and the message gives both half-widths, which one was returned and the
-        ``half_width=`` that takes the other.
+        ambiguous or uncertain edges: both half-widths, which one was returned and the
+        ``half_width=`` that takes the other (``docs/profiles.md``).
 
     Raises
     ------
@@ -455,8 +448,8 @@ def scar_profile(x, z, half_width=None, smoothing=None, level=False,
 
     Notes
     -----
-    The edges, the reference line and the smoothing follow the rules of
-    ``docs/profiles.md``. The model maps a pad position :math:`x` to :math:`X = xW/x_o` (eq. 11).
+    The edges, the reference line and the smoothing follow ``docs/profiles.md``. The model
+    maps a pad position :math:`x` to :math:`X = xW/x_o` (eq. 11).
 
     References
     ----------
