@@ -48,7 +48,24 @@ def scalar(dataset: xr.Dataset, name: str) -> float:
 
 
 def number_text(value: float, digits: int = 3) -> str:
-    """``value`` for a label: ``digits`` significant digits, no exponent, no trailing zeros."""
+    """``value`` for a label: ``digits`` significant digits, no exponent, no trailing zeros.
+
+    Parameters
+    ----------
+    value : float
+    digits : int
+        Significant digits at most; whole numbers keep all theirs. [1]
+
+    Returns
+    -------
+    text : str
+        A dash for NaN, ``∞`` for an infinite value.
+
+    Examples
+    --------
+    >>> [number_text(v) for v in (35.0, 0.02, 35.04, 12345.6, 0.0, float("nan"))]
+    ['35', '0.02', '35', '12346', '0', '–']
+    """
     value = float(value)
     if np.isnan(value):
         return "–"
@@ -64,7 +81,13 @@ def number_text(value: float, digits: int = 3) -> str:
 
 
 def stiffness_text(stiffness: float) -> str:
-    """A rig stiffness [N/m] in MN/m for a label: ``'35 MN/m'``, ``'0.02 MN/m'``, ``'rigid'``."""
+    """A rig stiffness [N/m] in MN/m for a label: ``'35 MN/m'``, ``'0.02 MN/m'``, ``'rigid'``.
+
+    Examples
+    --------
+    >>> [stiffness_text(s) for s in (35e6, 0.02e6, 35.04e6, float("inf"))]
+    ['35 MN/m', '0.02 MN/m', '35 MN/m', 'rigid']
+    """
     if np.isinf(stiffness):
         return "rigid"
     return f"{number_text(stiffness * MEGA)} MN/m"

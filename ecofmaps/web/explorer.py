@@ -64,7 +64,33 @@ _MAPS_KEPT = 32
 
 
 def parameter_value(key: str, text: str) -> float:
-    """The SI value of one of the page's inputs, from its text."""
+    """The SI value of one of the page's inputs, from its text.
+
+    Parameters
+    ----------
+    key : str
+        A key of :data:`INPUTS` (``'amplitude'``, ``'stiffness'``, ...).
+    text : str
+        A number with an optional unit, as on the command line: ``'50um'``, ``'35MN/m'``,
+        ``'inf'``; a bare number is SI.
+
+    Returns
+    -------
+    value : float
+        [SI unit of the quantity: m, N, N/m or 1]
+
+    Raises
+    ------
+    ValueError
+        Naming the input, if the text is not a quantity of its kind or is out of range.
+
+    Examples
+    --------
+    >>> parameter_value("stiffness", "35MN/m")
+    35000000.0
+    >>> parameter_value("amplitude", "5e-5")
+    5e-05
+    """
     name, label, _ = INPUTS[key]
     quantity = QUANTITIES[name]
     try:
@@ -110,7 +136,18 @@ def _grown(value: float, upward: bool) -> float:
 
 
 def map_window(stiffness_ratio: float, aspect_ratio: float) -> tuple[float, float, float]:
-    """The map's window holding a point: S/P from, S/P to [1/m], and the largest z_o/x_o [1]."""
+    """The map's window holding a point: S/P from, S/P to [1/m], and the largest z_o/x_o [1].
+
+    Figure 11's window (20 to 200 (MN/m)/kN, z_o/x_o up to 0.4), grown in steps of 1, 2, 5
+    where the point lies beyond it (a rigid rig, S/P infinite, is not drawn).
+
+    Examples
+    --------
+    >>> map_window(35e6 / 450, 0.2)
+    (20000.0, 200000.0, 0.4)
+    >>> map_window(3e5, 0.45)
+    (20000.0, 500000.0, 0.5)
+    """
     low, high, deepest = _MAP_WINDOW
     if math.isfinite(stiffness_ratio):
         low = min(low, _grown(stiffness_ratio * 0.9, upward=False))

@@ -161,7 +161,29 @@ def write_report(path, results: xr.Dataset, *, loops=None, inputs=None) -> Path:
 
 
 def recording_inputs(recording, load: float, *, flip_force: bool = False) -> dict[str, str]:
-    """What a report of one recording says it was made from (``inputs`` of :func:`write_report`)."""
+    """What a report of one recording says it was made from (``inputs`` of :func:`write_report`).
+
+    Parameters
+    ----------
+    recording : ecofmaps.io.recordings.Recording
+        From :func:`ecofmaps.io.recordings.read_recording`.
+    load : float
+        Normal load :math:`P` the recording was analysed with. [N]
+    flip_force : bool
+        Whether the force was read with the other sign.
+
+    Returns
+    -------
+    inputs : dict of str to str
+        The file, the load, and each column read with the unit it was read in.
+
+    Examples
+    --------
+    >>> from ecofmaps.io.recordings import read_recording
+    >>> from ecofmaps.measured.synthetic import example_path
+    >>> recording_inputs(read_recording(example_path()), 450.0)["columns and units assumed"]
+    "displacement: 'displacement' in um; force: 'force' in N; cycle: 'cycle'"
+    """
     read = []
     for name, column_name in recording.columns.items():
         unit = recording.units.get(name, "1")
