@@ -96,7 +96,27 @@ def _call(function, arguments):
 
 
 class Runner:
-    """Run tasks on threads or on a dask cluster, a bounded number at a time."""
+    """Run tasks on threads or on a dask cluster, a bounded number at a time.
+
+    Parameters
+    ----------
+    workers : int, optional
+        With ``scheduler=None`` and ``cluster=False``: threads (default ``os.cpu_count()``).
+        With ``cluster=True``: worker processes of a new ``LocalCluster``.
+    scheduler : str, optional
+        Address of an existing dask scheduler (``tcp://host:8786``).
+    cluster : bool
+        Start a ``LocalCluster`` of ``workers`` processes (one thread each).
+    client : distributed.Client, optional
+        A client of a cluster already connected (left open).
+    timeout : float, optional
+        Seconds to wait for the scheduler at ``scheduler`` to answer (default
+        :data:`CONNECT_TIMEOUT`).
+
+    Notes
+    -----
+    Use as a context manager: the cluster or thread pool is closed on leaving it.
+    """
 
     def __init__(self, workers=None, *, scheduler=None, cluster=False, client=None, timeout=None):
         if scheduler is not None and cluster:
@@ -197,7 +217,25 @@ class Runner:
             return self._client.submit(_call, function, arguments, pure=False)
 
     def map(self, function, tasks, *, in_flight=None):
-        """``function(*arguments)`` for each ``arguments`` of ``tasks``, results in order."""
+        """``function(*arguments)`` for each ``arguments`` of ``tasks``, results in order.
+
+        Parameters
+        ----------
+        function : callable
+            A module-level function (picklable by name).
+        tasks : iterable of tuple
+            The arguments of each call; dask collections among them are computed where
+            the call runs, just before it.
+        in_flight : int, optional
+            Calls submitted and not yet handed back at once (default twice the workers):
+            the memory held is about that many blocks.
+
+        Yields
+        ------
+        result
+            Each call's result, in the order of ``tasks``, as soon as it and every earlier
+            one are done.
+        """
         if self._pool is None and self._client is None:
             raise RuntimeError("a Runner is used within a with block")
         limit = in_flight or 2 * self.workers
