@@ -19,13 +19,13 @@ from collections.abc import Mapping
 import jax
 import numpy as np
 
+from ecofmaps._inputs import available_memory
 from ecofmaps._interrupts import check_interrupted
 
 __all__ = [
     "BLOCK_POINTS",
     "BLOCK_TASK",
     "MAX_CHUNK",
-    "available_memory",
     "grid_values",
     "tile_workers",
 ]
@@ -43,21 +43,6 @@ BLOCK_POINTS = 2**22
 
 #: Prefix of the dask keys of the tasks that evaluate the blocks of a chunked map.
 BLOCK_TASK = "ecofmaps-block"
-
-
-def available_memory() -> int | None:
-    """Memory the system can give this process now, or None where it cannot tell. [byte]"""
-    try:
-        with open("/proc/meminfo", encoding="ascii") as meminfo:
-            for line in meminfo:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    try:
-        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):
-        return None
 
 
 @functools.lru_cache(maxsize=64)
