@@ -371,8 +371,10 @@ def _campaign(energy, volume):
     """α and E_th of V = α(ΣE_d - E_th) fitted over the tests, with standard errors."""
     x0, a, b, cov = _line(energy, volume)
     threshold, threshold_se = _root(x0, a, b, cov, 0.0)
-    return {"campaign_energy_wear_coefficient": (b, float(np.sqrt(cov[1, 1]))),
-            "threshold_energy": (threshold, threshold_se)}  # fmt: skip
+    return {
+        "campaign_energy_wear_coefficient": (b, float(np.sqrt(cov[1, 1]))),
+        "threshold_energy": (threshold, threshold_se),
+    }
 
 
 def _with_se(data: dict, name: str, value, se, dims=(), quantity=None) -> None:

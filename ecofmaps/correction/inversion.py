@@ -240,16 +240,29 @@ def _failure_message(status, ecof, details) -> str:
     )
 
 
-def _correct(ecof, amplitude, load, stiffness, aspect_ratio, scar_depth, scar_half_width,
-             return_status, factor, caller, profile=None, mapping="scaled"):  # fmt: skip
+def _correct(
+    ecof,
+    amplitude,
+    load,
+    stiffness,
+    aspect_ratio,
+    scar_depth,
+    scar_half_width,
+    return_status,
+    factor,
+    caller,
+    profile=None,
+    mapping="scaled",
+):
     if profile is not None:
         if aspect_ratio is not None or scar_depth is not None or scar_half_width is not None:
             raise ValueError(
                 "give the groove one way: aspect_ratio, scar_depth and scar_half_width, or "
                 "profile, not several"
             )
-        return correct_on_profile(ecof, amplitude, load, stiffness, profile, mapping,
-                                  return_status, factor, caller)  # fmt: skip
+        return correct_on_profile(
+            ecof, amplitude, load, stiffness, profile, mapping, return_status, factor, caller
+        )
     if mapping != "scaled":
         raise ValueError("mapping applies to a profile only (profile=...)")
     check("ecof", ecof, "positive", "1")
@@ -331,12 +344,33 @@ _RAISES = """
 
 
 @float64
-def correct_ecof(ecof, amplitude, load, stiffness, aspect_ratio=None, scar_depth=None,
-                 scar_half_width=None, *, profile=None, mapping="scaled",
-                 return_status=False):  # fmt: skip
-    return _correct(ecof, amplitude, load, stiffness, aspect_ratio, scar_depth,
-                    scar_half_width, return_status, False, "correct_ecof", profile,
-                    mapping)  # fmt: skip
+def correct_ecof(
+    ecof,
+    amplitude,
+    load,
+    stiffness,
+    aspect_ratio=None,
+    scar_depth=None,
+    scar_half_width=None,
+    *,
+    profile=None,
+    mapping="scaled",
+    return_status=False,
+):
+    return _correct(
+        ecof,
+        amplitude,
+        load,
+        stiffness,
+        aspect_ratio,
+        scar_depth,
+        scar_half_width,
+        return_status,
+        False,
+        "correct_ecof",
+        profile,
+        mapping,
+    )
 
 
 correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy CoF :math:`\\mu_E`.
@@ -395,12 +429,33 @@ correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy
 
 
 @float64
-def correction_factor(ecof, amplitude, load, stiffness, aspect_ratio=None, scar_depth=None,
-                      scar_half_width=None, *, profile=None, mapping="scaled",
-                      return_status=False):  # fmt: skip
-    return _correct(ecof, amplitude, load, stiffness, aspect_ratio, scar_depth,
-                    scar_half_width, return_status, True, "correction_factor", profile,
-                    mapping)  # fmt: skip
+def correction_factor(
+    ecof,
+    amplitude,
+    load,
+    stiffness,
+    aspect_ratio=None,
+    scar_depth=None,
+    scar_half_width=None,
+    *,
+    profile=None,
+    mapping="scaled",
+    return_status=False,
+):
+    return _correct(
+        ecof,
+        amplitude,
+        load,
+        stiffness,
+        aspect_ratio,
+        scar_depth,
+        scar_half_width,
+        return_status,
+        True,
+        "correction_factor",
+        profile,
+        mapping,
+    )
 
 
 correction_factor.__doc__ = f"""The ratio :math:`\\mu/\\mu_E` of contact CoF to reported ECoF.

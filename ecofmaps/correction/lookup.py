@@ -56,8 +56,18 @@ def _crossing(curves, mu_grid, ecof):
 
 
 @si_units
-def lookup_correction(map_dataset, ecof, amplitude, load, stiffness, aspect_ratio=None,
-                      scar_depth=None, scar_half_width=None, *, return_status=False):  # fmt: skip
+def lookup_correction(
+    map_dataset,
+    ecof,
+    amplitude,
+    load,
+    stiffness,
+    aspect_ratio=None,
+    scar_depth=None,
+    scar_half_width=None,
+    *,
+    return_status=False,
+):
     r"""The contact CoF behind a reported ECoF, read off a map by interpolation.
 
     The same correction as :func:`correct_ecof`, for users who work from the maps: the

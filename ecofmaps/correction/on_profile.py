@@ -29,8 +29,9 @@ def _ecof_on_profile(profile, mu, amplitude, load, stiffness, mapping):
     return np.asarray(numbers["ecof_ratio"]) * np.asarray(mu)
 
 
-def correct_on_profile(ecof, amplitude, load, stiffness, profile, mapping, return_status,
-                        factor, caller):  # fmt: skip
+def correct_on_profile(
+    ecof, amplitude, load, stiffness, profile, mapping, return_status, factor, caller
+):
     """correct_ecof / correction_factor on a profile (see correct_ecof's Notes)."""
     check_mapping(mapping, None)
     profile = as_profile(profile)
@@ -86,8 +87,9 @@ def correct_on_profile(ecof, amplitude, load, stiffness, profile, mapping, retur
                 detail = f"it is at or above stiffness * amplitude / load = {1.0 / lam[0]:.6g}"
             else:
                 detail = code.reason
-            raise ValueError(f"ecof = {float(ecof[0]):.6g} cannot be corrected on this "
-                             f"profile: {detail}")  # fmt: skip
+            raise ValueError(
+                f"ecof = {float(ecof[0]):.6g} cannot be corrected on this profile: {detail}"
+            )
         warn_nan(values, status, CorrectionStatus, caller)
     return (values, status) if return_status else values
 

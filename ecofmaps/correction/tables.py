@@ -113,9 +113,11 @@ def _read(path: Path, on_profile: bool = False):
     for row, line in records:
         if len(row) != len(header):
             raise TableError(
-                path, line, f"{len(row)} fields, but the header has {len(header)} columns"
-                + _separator_hint(header)
-            )  # fmt: skip
+                path,
+                line,
+                f"{len(row)} fields, but the header has {len(header)} columns"
+                + _separator_hint(header),
+            )
         for name in _REQUIRED:
             values[name].append(_number(path, line, name, row[column[name]], commas))
         if on_profile:
@@ -169,9 +171,11 @@ def _check_header(path, line: int, header: list[str], on_profile: bool) -> None:
         shapes = [name for name in ("aspect_ratio", *_SCAR) if name in header]
         if shapes:
             raise TableError(
-                path, line, f"column(s) {', '.join(shapes)} give the scar, but so does the "
-                "profile: drop the columns, or correct without the profile"
-            )  # fmt: skip
+                path,
+                line,
+                f"column(s) {', '.join(shapes)} give the scar, but so does the "
+                "profile: drop the columns, or correct without the profile",
+            )
     missing = [name for name in _REQUIRED if name not in header]
     if not on_profile and "aspect_ratio" not in header and not all(n in header for n in _SCAR):
         missing.append("aspect_ratio (or " + " + ".join(_SCAR) + ")")

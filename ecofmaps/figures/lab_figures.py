@@ -12,8 +12,11 @@ from ecofmaps.lab import per_cycle, sliding_condition
 __all__ = ["running_condition_map"]
 
 #: How each sliding condition is marked on the running-condition map: marker, face colour.
-_CONDITION_MARKERS = {"partial slip": ("o", "white"), "mixed slip": ("D", "0.6"),
-                      "gross slip": ("s", "black")}  # fmt: skip
+_CONDITION_MARKERS = {
+    "partial slip": ("o", "white"),
+    "mixed slip": ("D", "0.6"),
+    "gross slip": ("s", "black"),
+}
 
 
 def running_condition_map(results, transition: xr.Dataset, rig_stiffness: float) -> Figure:
@@ -48,15 +51,22 @@ def running_condition_map(results, transition: xr.Dataset, rig_stiffness: float)
         cycles = per_cycle(test, ("amplitude",))
         condition = sliding_condition(test, rig_stiffness).attrs["sliding_condition"]
         marker, face = _CONDITION_MARKERS[condition]
-        ax.plot(np.nanmedian(cycles["amplitude"]) * MICRO, np.nanmedian(cycles["load"]),
-                marker=marker, markerfacecolor=face, markeredgecolor="black", linestyle="",
-                label=None if condition in drawn else condition)  # fmt: skip
+        ax.plot(
+            np.nanmedian(cycles["amplitude"]) * MICRO,
+            np.nanmedian(cycles["load"]),
+            marker=marker,
+            markerfacecolor=face,
+            markeredgecolor="black",
+            linestyle="",
+            label=None if condition in drawn else condition,
+        )
         drawn.add(condition)
     top = 1.15 * ax.get_ylim()[1]
     load = np.linspace(0.0, top, 50)
     line = float(transition.contact_amplitude) + float(transition.mu) * load / rig_stiffness
-    ax.plot(line * MICRO, load, color="tab:red",
-            label=r"transition $\Delta_t = \delta_t + \mu_t P/S$")  # fmt: skip
+    ax.plot(
+        line * MICRO, load, color="tab:red", label=r"transition $\Delta_t = \delta_t + \mu_t P/S$"
+    )
     ax.set_xlim(0.0, None)
     ax.set_ylim(0.0, top)
     ax.set_xlabel(axis_label("amplitude"))
@@ -64,9 +74,12 @@ def running_condition_map(results, transition: xr.Dataset, rig_stiffness: float)
     ax.grid(alpha=0.3)
     ax.legend(loc="lower right", fontsize="small")
     ax.set_title(
-        "Running-condition fretting map\n" + parameters(
+        "Running-condition fretting map\n"
+        + parameters(
             rf"$\delta_t$ = {float(transition.contact_amplitude) * MICRO:.3g} µm",
-            rf"$\mu_t$ = {float(transition.mu):.3g}", stiffness_label(rig_stiffness)),
+            rf"$\mu_t$ = {float(transition.mu):.3g}",
+            stiffness_label(rig_stiffness),
+        ),
         fontsize="medium",
-    )  # fmt: skip
+    )
     return figure

@@ -223,9 +223,13 @@ def universal_ecof_ratio_map(
             textcoords="offset points",
             fontsize="x-small",
             color="navy",
-            bbox={"boxstyle": "round,pad=0.1", "facecolor": "white", "alpha": 0.75,
-                  "edgecolor": "none"},  # legible over the contours
-        )  # fmt: skip
+            bbox={
+                "boxstyle": "round,pad=0.1",
+                "facecolor": "white",
+                "alpha": 0.75,
+                "edgecolor": "none",
+            },  # legible over the contours
+        )
     figure.legend(handles=handles, loc="outside lower center", fontsize="x-small", ncols=1)
     title = [
         rf"Universal map of $\mu_E/\mu$ ($x_o = \Delta^*$, $\mu$ = {mu:g})",

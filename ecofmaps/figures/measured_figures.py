@@ -267,8 +267,16 @@ def cof_evolution(results: xr.Dataset) -> Figure:
 def _note(ax, text: str, height: float = 0.5) -> None:
     """Write ``text`` across the panel ``ax``, which has nothing else to show, at ``height`` (a
     fraction of the panel's, from the bottom)."""
-    ax.text(0.5, height, text, transform=ax.transAxes, ha="center", va="center", color="0.3",
-            fontsize="small")  # fmt: skip
+    ax.text(
+        0.5,
+        height,
+        text,
+        transform=ax.transAxes,
+        ha="center",
+        va="center",
+        color="0.3",
+        fontsize="small",
+    )
 
 
 def _no_ticks(ax) -> None:
@@ -330,8 +338,16 @@ def measured_and_fitted_loops(fits) -> Figure:
     axes = figure.subplots(1, len(panels), squeeze=False)[0]
     for index, (ax, (name, fit)) in enumerate(zip(axes, panels.items(), strict=True)):
         displacement, force = fit.model_loop()
-        ax.plot(fit.displacement * MICRO, fit.force, "o", color="0.15", markersize=2.5,
-                alpha=0.7, zorder=3, label="measured")  # fmt: skip
+        ax.plot(
+            fit.displacement * MICRO,
+            fit.force,
+            "o",
+            color="0.15",
+            markersize=2.5,
+            alpha=0.7,
+            zorder=3,
+            label="measured",
+        )
         ax.plot(
             displacement * MICRO,
             force,
@@ -405,8 +421,11 @@ def resolved_loops(resolved: xr.Dataset, results: xr.Dataset | None = None, cycl
     if "position" not in resolved.dims:
         raise ValueError("resolved holds no positions: call resolve_loops(..., positions=201)")
     labels = list(resolved["cycle"].values)
-    ok = [label for label, quality in zip(labels, resolved["quality"].values, strict=True)
-          if quality == "ok"]  # fmt: skip
+    ok = [
+        label
+        for label, quality in zip(labels, resolved["quality"].values, strict=True)
+        if quality == "ok"
+    ]
     chosen = _evenly_spread(ok, 5) if cycles is None else list(cycles)
     figure = Figure(figsize=(11.0, 8.2), layout="constrained")
     (stroke, felt), (image, test) = figure.subplots(2, 2)
@@ -429,16 +448,24 @@ def resolved_loops(resolved: xr.Dataset, results: xr.Dataset | None = None, cycl
             -float(resolved.sel(cycle=chosen)["position_min"].max()),
             float(resolved.sel(cycle=chosen)["position_max"].min()),
         )
-        stroke.axvspan(-reach * MICRO, reach * MICRO, color="0.9", zorder=0,
-                       label="central part averaged")  # fmt: skip
+        stroke.axvspan(
+            -reach * MICRO, reach * MICRO, color="0.9", zorder=0, label="central part averaged"
+        )
     stroke.set_xlabel(axis_label("position"))
     stroke.set_ylabel(r"Coefficient of friction $\mu(\xi)$ [1]")
     stroke.set_title(r"(a) $\mu$ along the stroke (dashed: its average)", fontsize="medium")
     if chosen:
         stroke.legend(loc="lower center", fontsize="x-small", ncols=2)
     else:
-        stroke.text(0.5, 0.5, "no cycle was read along the stroke\n(none has quality 'ok')",
-                    transform=stroke.transAxes, ha="center", va="center", color="0.3")  # fmt: skip
+        stroke.text(
+            0.5,
+            0.5,
+            "no cycle was read along the stroke\n(none has quality 'ok')",
+            transform=stroke.transAxes,
+            ha="center",
+            va="center",
+            color="0.3",
+        )
         _no_ticks(stroke)
     felt.set_xlabel(axis_label("position"))
     felt.set_ylabel(r"Felt groove profile $h(\xi)$ [µm]")
@@ -492,17 +519,38 @@ def _mu_over_test(test, resolved: xr.Dataset, results: xr.Dataset | None) -> Non
     error = 2.0 * resolved["mu_resolved_se"].values
     marker = dict(marker="o", markersize=3) if number.size <= 400 else {}
     if number.size > 1 and np.isfinite(error).any():
-        test.fill_between(number, mu - error, mu + error, color="tab:green", alpha=0.25,
-                          label=r"$\pm$2 standard errors")  # fmt: skip
+        test.fill_between(
+            number,
+            mu - error,
+            mu + error,
+            color="tab:green",
+            alpha=0.25,
+            label=r"$\pm$2 standard errors",
+        )
     elif np.isfinite(error).any():  # a band over one cycle has no width
-        test.errorbar(number, mu, yerr=error, fmt="none", ecolor="tab:green", capsize=4,
-                      label=r"$\pm$2 standard errors")  # fmt: skip
+        test.errorbar(
+            number,
+            mu,
+            yerr=error,
+            fmt="none",
+            ecolor="tab:green",
+            capsize=4,
+            label=r"$\pm$2 standard errors",
+        )
     if np.isfinite(mu).any():
-        test.plot(number, mu, color="tab:green", linewidth=1.4,
-                  label=r"$\mu$ read along the stroke", **marker)  # fmt: skip
+        test.plot(
+            number,
+            mu,
+            color="tab:green",
+            linewidth=1.4,
+            label=r"$\mu$ read along the stroke",
+            **marker,
+        )
     if results is not None:
-        for name, label, color in (("ecof", r"ECoF $\mu_E$", "tab:orange"),
-                                   ("gicof", "GICoF", "tab:blue")):  # fmt: skip
+        for name, label, color in (
+            ("ecof", r"ECoF $\mu_E$", "tab:orange"),
+            ("gicof", "GICoF", "tab:blue"),
+        ):
             values = results[name].values
             if np.isfinite(values).any():
                 test.plot(number, values, color=color, linewidth=1.0, label=label, **marker)
@@ -517,8 +565,14 @@ def _mu_over_test(test, resolved: xr.Dataset, results: xr.Dataset | None) -> Non
         height, where = (
             (drawn.min(), test.transData) if drawn.size else (0.5, test.get_xaxis_transform())
         )
-        test.plot(number[missing], np.full(missing.sum(), height), "x", color="crimson",
-                  transform=where, label=f"no resolved value: {reasons}")  # fmt: skip
+        test.plot(
+            number[missing],
+            np.full(missing.sum(), height),
+            "x",
+            color="crimson",
+            transform=where,
+            label=f"no resolved value: {reasons}",
+        )
     if not drawn.size:  # the marks have no height: no scale of friction to read
         test.set_yticks([])
     if missing.all():  # below the marks, which are at the middle
@@ -527,8 +581,9 @@ def _mu_over_test(test, resolved: xr.Dataset, results: xr.Dataset | None) -> Non
     test.set_ylabel("Coefficient of friction [1]")
     if np.isfinite(resolved["aspect_ratio"].values).any():  # no right-hand axis without a line
         ratio = test.twinx()
-        ratio.plot(number, resolved["aspect_ratio"], color="0.3", linestyle="--", linewidth=1.0,
-                   **marker)  # fmt: skip
+        ratio.plot(
+            number, resolved["aspect_ratio"], color="0.3", linestyle="--", linewidth=1.0, **marker
+        )
         ratio.set_ylabel(axis_label("aspect_ratio") + " (dashed)")
     _cycle_axis(test, number)  # after twinx, which shares the cycle axis's ticker
     test.set_title(r"(d) $\mu$ over the test, and the equivalent groove", fontsize="medium")

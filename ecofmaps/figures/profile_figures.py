@@ -83,22 +83,39 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
     figure = Figure(figsize=(7.4, 6.4), layout="constrained")
     top, bottom = figure.subplots(2, 1, sharex=True, height_ratios=(1.25, 1.0))
     top.plot(x, height, color="tab:blue", linewidth=1.6, label="profile $z(X)$")
-    top.plot(x, surface * MICRO, color="0.3", linewidth=1.0, linestyle="--",
-             label="unworn surface (levelling line)")  # fmt: skip
+    top.plot(
+        x,
+        surface * MICRO,
+        color="0.3",
+        linewidth=1.0,
+        linestyle="--",
+        label="unworn surface (levelling line)",
+    )
     bottom_of_scar = float(profile.reference_height) * MICRO - depth * MICRO
     top.annotate(
-        "", xy=(0.0, bottom_of_scar), xytext=(0.0, float(profile.reference_height) * MICRO),
+        "",
+        xy=(0.0, bottom_of_scar),
+        xytext=(0.0, float(profile.reference_height) * MICRO),
         arrowprops=dict(arrowstyle="<->", color="crimson", linewidth=1.2),
-    )  # fmt: skip
-    top.text(0.02 * width * MICRO, bottom_of_scar + 0.5 * depth * MICRO,
-             f"  D = {depth * MICRO:.4g} µm", color="crimson", va="center")  # fmt: skip
+    )
+    top.text(
+        0.02 * width * MICRO,
+        bottom_of_scar + 0.5 * depth * MICRO,
+        f"  D = {depth * MICRO:.4g} µm",
+        color="crimson",
+        va="center",
+    )
     parabola = 2.0 * depth * position / width**2 + float(profile.reference_slope)
     inside = np.abs(position) <= width
     bowl = surface[inside] - depth * (1.0 - (position[inside] / width) ** 2)
     top.plot(x[inside], bowl * MICRO, **_SHORTCUT, label="parabola of the same D/W")
     bottom.plot(x, slope, color="tab:blue", linewidth=1.6, label="slope the model uses")
-    bottom.plot(x[inside], parabola[inside], **_SHORTCUT,
-                label=f"parabola of the same D/W = {depth / width:.3g}")  # fmt: skip
+    bottom.plot(
+        x[inside],
+        parabola[inside],
+        **_SHORTCUT,
+        label=f"parabola of the same D/W = {depth / width:.3g}",
+    )
     bottom.axhline(0.0, color="0.6", linewidth=0.6)
     for ax in (top, bottom):
         for edge, label in ((-width, "edges $\\pm W$"), (width, None)):
@@ -115,12 +132,16 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
     bottom.set_ylim(-1.15 * reach, 1.15 * reach)
     title = "Wear-scar profile" + (f": {name}" if name else "")
     top.set_title(
-        title + "\n" + parameters(
-            f"D = {depth * MICRO:.4g} µm", f"W = {width * MICRO:.4g} µm",
-            f"D/W = {depth / width:.3g}", f"{position.size} samples",
+        title
+        + "\n"
+        + parameters(
+            f"D = {depth * MICRO:.4g} µm",
+            f"W = {width * MICRO:.4g} µm",
+            f"D/W = {depth / width:.3g}",
+            f"{position.size} samples",
         ),
         fontsize="medium",
-    )  # fmt: skip
+    )
     return figure
 
 
@@ -187,20 +208,31 @@ def _draw_scar_profiles(ax, dataset: xr.Dataset) -> None:
     depth, width = scalar(dataset, "scar_depth"), scalar(dataset, "scar_half_width")
     x = dataset["scar_position"].values * MICRO
     for shape in dataset["shape"].values:  # the parabola on top, thinner: others share parts
-        ax.plot(x, dataset["scar_height"].sel(shape=shape) * MICRO,
-                color=SHAPE_COLORS.get(shape), label=shape,
-                **({"linewidth": 1.4, "zorder": 3} if shape == "parabolic" else
-                   {"linewidth": 2.6, "zorder": 2}))  # fmt: skip
+        ax.plot(
+            x,
+            dataset["scar_height"].sel(shape=shape) * MICRO,
+            color=SHAPE_COLORS.get(shape),
+            label=shape,
+            **(
+                {"linewidth": 1.4, "zorder": 3}
+                if shape == "parabolic"
+                else {"linewidth": 2.6, "zorder": 2}
+            ),
+        )
     reach = float(dataset["slip_amplitude"].sel(shape="parabolic", groove="parabola"))
     reach *= width / scalar(dataset, "amplitude")
-    ax.axvspan(-reach * MICRO, reach * MICRO, color="0.85", zorder=0,
-               label="reach of the pad,\n" + r"$|X| \leq \delta^* W/\Delta^*$")  # fmt: skip
+    ax.axvspan(
+        -reach * MICRO,
+        reach * MICRO,
+        color="0.85",
+        zorder=0,
+        label="reach of the pad,\n" + r"$|X| \leq \delta^* W/\Delta^*$",
+    )
     for edge in (-width, width):
         ax.axvline(edge * MICRO, **_EDGE)
     ax.set_xlabel(axis_label("scar_position"))
     ax.set_ylabel(axis_label("scar_height"))
-    ax.set_title(f"Scars of equal D/W = {depth / width:g}\n(edges ±W dotted)",
-                 fontsize="medium")  # fmt: skip
+    ax.set_title(f"Scars of equal D/W = {depth / width:g}\n(edges ±W dotted)", fontsize="medium")
     ax.set_ylim(-1.25 * depth * MICRO, 2.1 * depth * MICRO)  # the legend above
     ax.legend(loc="upper center", fontsize="x-small", ncols=2)
     ax.grid(alpha=0.3)
@@ -215,19 +247,28 @@ def _draw_shape_loops(loop_axes, dataset: xr.Dataset) -> None:
         for groove, style in (("profile", own), ("parabola", dict(_SHORTCUT, zorder=3))):
             point = dataset.sel(shape=shape, groove=groove)
             ax.plot(
-                point["displacement"] * MICRO, point["force"], **style,
+                point["displacement"] * MICRO,
+                point["force"],
+                **style,
                 label=(
                     f"{shape + ' scar' if groove == 'profile' else 'parabola, same D/W'}\n"
                     rf"$\delta^*$ = {float(point['slip_amplitude']) * MICRO:.1f} µm, "
                     rf"$E_d$ = {float(point['dissipated_energy']) * MILLI:.1f} mJ, "
                     rf"$\mu_E$ = {float(point['ecof']):.3f}"
                 ),
-            )  # fmt: skip
+            )
         loops = dataset["force"].sel(shape=shape).values
         if np.allclose(loops[0], loops[1], rtol=1e-6, atol=1e-9 * load):
-            ax.text(0.97, 0.04, "the parabola's loop: this scar differs\nonly beyond the pad's "
-                    "reach", transform=ax.transAxes, ha="right", va="bottom",
-                    fontsize="small", color=SHAPE_COLORS.get(shape))  # fmt: skip
+            ax.text(
+                0.97,
+                0.04,
+                "the parabola's loop: this scar differs\nonly beyond the pad's reach",
+                transform=ax.transAxes,
+                ha="right",
+                va="bottom",
+                fontsize="small",
+                color=SHAPE_COLORS.get(shape),
+            )
         ax.axhline(0.0, color="0.6", linewidth=0.6)
         ax.axvline(0.0, color="0.6", linewidth=0.6)
         ax.set_xlabel(axis_label("displacement"))
@@ -248,29 +289,47 @@ def _draw_ratio_and_error(ax_ratio, ax_error, dataset: xr.Dataset) -> None:
     stiffness = scalar(dataset, "stiffness")
     ratios = dataset["stiffness_ratio"].values * PER_MM
     shortcut = dataset["ecof_ratio"].sel(shape="parabolic", groove="parabola")
-    ax_ratio.plot(ratios, shortcut, **_SHORTCUT, zorder=3,
-                  label=f"parabola, D/W = {depth / width:g}")  # fmt: skip
+    ax_ratio.plot(
+        ratios, shortcut, **_SHORTCUT, zorder=3, label=f"parabola, D/W = {depth / width:g}"
+    )
     ax_error.axhline(0.0, **_SHORTCUT, zorder=3, label="no error (the parabola itself)")
     for shape in dataset["shape"].values:
         style = dict(color=SHAPE_COLORS.get(shape), linewidth=2.0, zorder=2)
         if shape == "parabolic":  # on the parabola's closed form: points, so both show
-            style = dict(color=SHAPE_COLORS["parabolic"], marker="o", markersize=4,
-                         linestyle="none", markevery=6, zorder=4)  # fmt: skip
-        ax_ratio.plot(ratios, dataset["ecof_ratio"].sel(shape=shape, groove="profile"),
-                      label=f"{shape} scar", **style)  # fmt: skip
+            style = dict(
+                color=SHAPE_COLORS["parabolic"],
+                marker="o",
+                markersize=4,
+                linestyle="none",
+                markevery=6,
+                zorder=4,
+            )
+        ax_ratio.plot(
+            ratios,
+            dataset["ecof_ratio"].sel(shape=shape, groove="profile"),
+            label=f"{shape} scar",
+            **style,
+        )
         if shape != "parabolic":
             error = dataset["shortcut_error"].sel(shape=shape) * 100.0
             ax_error.plot(ratios, error, label=f"{shape} scar", **style)
     example = stiffness / scalar(dataset, "load") * PER_MM
     for ax in (ax_ratio, ax_error):
-        ax.axvline(example, color="crimson", linewidth=1.0, linestyle="-.",
-                   label=f"Example 2, {stiffness_label(stiffness)}")  # fmt: skip
+        ax.axvline(
+            example,
+            color="crimson",
+            linewidth=1.0,
+            linestyle="-.",
+            label=f"Example 2, {stiffness_label(stiffness)}",
+        )
         ax.set_xlabel(axis_label("stiffness_ratio"))
         ax.set_xlim(ratios[0], ratios[-1])
         ax.grid(alpha=0.3)
     ax_ratio.set_ylabel(axis_label("ecof_ratio"))
-    ax_ratio.set_title(r"Energy CoF over the contact CoF, $\mu$ = " + f"{scalar(dataset, 'mu'):g}",
-                       fontsize="medium")  # fmt: skip
+    ax_ratio.set_title(
+        r"Energy CoF over the contact CoF, $\mu$ = " + f"{scalar(dataset, 'mu'):g}",
+        fontsize="medium",
+    )
     ax_ratio.legend(loc="upper left", fontsize="small")
     ax_error.set_ylabel(r"Error of $\mu'$ from the D/W shortcut, $\mu'/\mu - 1$ [%]")
     ax_error.set_title(

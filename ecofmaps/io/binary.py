@@ -49,8 +49,14 @@ class Column:
 
     def __reduce__(self):
         """Pickled without the open file; unpickled by :func:`_column`."""
-        return _column, (self.path, self.kind, self.variable, self.factor, self.nan_policy,
-                         self.stamp)  # fmt: skip
+        return _column, (
+            self.path,
+            self.kind,
+            self.variable,
+            self.factor,
+            self.nan_policy,
+            self.stamp,
+        )
 
     def __len__(self) -> int:
         return self.variable.size

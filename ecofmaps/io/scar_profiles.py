@@ -127,16 +127,23 @@ def read_scar_profile(
         )
     try:
         profile, findings = scar_profile_and_findings(
-            x, z, half_width=half_width, smoothing=smoothing, level=level,
+            x,
+            z,
+            half_width=half_width,
+            smoothing=smoothing,
+            level=level,
             remove_outliers=remove_outliers,
-        )  # fmt: skip
+        )
     except ValueError as error:
         raise ScarProfileError(
             path, lines[0], f"the trace (lines {lines[0]}-{lines[-1]}): {error}"
         ) from None
     for finding in findings:
         text = finding.text([f"line {lines[i]}" for i in finding.samples])
-        located = ScarProfileWarning(f"{path}: {text}", alternative=finding.alternative,
-                                     alternative_name=finding.alternative_name)  # fmt: skip
+        located = ScarProfileWarning(
+            f"{path}: {text}",
+            alternative=finding.alternative,
+            alternative_name=finding.alternative_name,
+        )
         warn(located, ScarProfileWarning)
     return profile

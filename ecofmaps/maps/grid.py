@@ -227,12 +227,21 @@ def compute_map(
         if aspect_ratio is not None:
             raise ValueError("give aspect_ratio or profile, not both")
         if chunks is not None:
-            raise ValueError("chunks is for maps of the parabolic groove; a map on a profile "
-                             "is computed in memory")  # fmt: skip
+            raise ValueError(
+                "chunks is for maps of the parabolic groove; a map on a profile "
+                "is computed in memory"
+            )
         return compute_profile_map(
-            stiffness_ratio, amplitude, mu, load, profile=profile, mapping=mapping,
-            cache=cache is not False, cache_dir=cache_dir, max_chunk=max_chunk,
-        )  # fmt: skip
+            stiffness_ratio,
+            amplitude,
+            mu,
+            load,
+            profile=profile,
+            mapping=mapping,
+            cache=cache is not False,
+            cache_dir=cache_dir,
+            max_chunk=max_chunk,
+        )
     if mapping != "scaled":
         raise ValueError("mapping applies to a profile only (profile=...)")
     if amplitude is None or mu is None:
@@ -398,9 +407,13 @@ def compute_loops(stiffness, aspect_ratio, amplitude, load, mu, num=201) -> xr.D
     }
     grid = jnp.broadcast_arrays(*_mesh(*(np.atleast_1d(a) for a in axes.values())))
     displacement, force = fretting_loop(
-        amplitude=grid[2], load=grid[3], stiffness=grid[0], mu=grid[4], aspect_ratio=grid[1],
+        amplitude=grid[2],
+        load=grid[3],
+        stiffness=grid[0],
+        mu=grid[4],
+        aspect_ratio=grid[1],
         num=num,
-    )  # fmt: skip
+    )
     values = jax.device_get(_loop_kernel(*grid))
     values["displacement"] = displacement
     values["force"] = force

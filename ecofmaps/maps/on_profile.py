@@ -31,8 +31,18 @@ MODEL_ON_PROFILE = (
 
 
 @float64
-def compute_profile_map(stiffness_ratio, amplitude, mu, load=None, *, profile, mapping="scaled",
-                        cache=True, cache_dir=None, max_chunk=MAX_CHUNK) -> xr.Dataset:  # fmt: skip
+def compute_profile_map(
+    stiffness_ratio,
+    amplitude,
+    mu,
+    load=None,
+    *,
+    profile,
+    mapping="scaled",
+    cache=True,
+    cache_dir=None,
+    max_chunk=MAX_CHUNK,
+) -> xr.Dataset:
     r"""The steady-loop quantities on a scar profile over a grid of test conditions.
 
     Parameters
@@ -108,8 +118,10 @@ def compute_profile_map(stiffness_ratio, amplitude, mu, load=None, *, profile, m
         shape = tuple(a.size for a in grid)
         size = math.prod(shape)
         names = ("slip_ratio", "ecof_ratio", "regime", "normalized_energy", "normalized_max_force")
-        flat = {name: np.empty(size, dtype=np.int32 if name == "regime" else np.float64)
-                for name in names}  # fmt: skip
+        flat = {
+            name: np.empty(size, dtype=np.int32 if name == "regime" else np.float64)
+            for name in names
+        }
         for start in range(0, size, max_chunk):
             index = np.unravel_index(np.arange(start, min(start + max_chunk, size)), shape)
             stiffness, amplitude, mu = (axis[i] for axis, i in zip(grid, index, strict=True))
@@ -128,8 +140,9 @@ def compute_profile_map(stiffness_ratio, amplitude, mu, load=None, *, profile, m
         dims = tuple(n for n in ("stiffness_ratio", "amplitude") if axes[n].ndim == 1)
         values["compliance_ratio"] = (dims, np.squeeze(lam, axis=scalars))
         extra = {} if load is None else {"load": load}
-        dataset = grid_dataset(axes, values, "ECoF map of the compliant wear-scar model on a scar "
-                           "profile", extra)  # fmt: skip
+        dataset = grid_dataset(
+            axes, values, "ECoF map of the compliant wear-scar model on a scar profile", extra
+        )
         dataset.attrs["model"] = MODEL_ON_PROFILE
         dataset.attrs.update(
             scar_depth=float(profile.depth),

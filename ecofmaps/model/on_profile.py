@@ -293,8 +293,9 @@ def steady_values(numbers, amplitude, load, mu) -> dict:
     return values
 
 
-def steady_numbers(profile, amplitude, load, stiffness, mu, groove_half_width=None,
-                   mapping="scaled") -> dict:  # fmt: skip
+def steady_numbers(
+    profile, amplitude, load, stiffness, mu, groove_half_width=None, mapping="scaled"
+) -> dict:
     r"""The steady loop on ``profile`` at every point, in the units of the core."""
     physical = check_mapping(mapping, groove_half_width)
     profile = as_profile(profile)
@@ -308,9 +309,14 @@ def steady_numbers(profile, amplitude, load, stiffness, mu, groove_half_width=No
     if own:  # each point its own O(N) tables
         padded = _pad(np.arange(lam.size))
         loops, jumps = _own_loops(
-            profile.position, profile.slope, profile.half_width, mu[padded], key[padded],
-            lam[padded], physical,
-        )  # fmt: skip
+            profile.position,
+            profile.slope,
+            profile.half_width,
+            mu[padded],
+            key[padded],
+            lam[padded],
+            physical,
+        )
     else:
         loops, jumps = _shared(profile, unique, group, lam, physical)
     loops = loops._replace(ends=())
@@ -319,8 +325,9 @@ def steady_numbers(profile, amplitude, load, stiffness, mu, groove_half_width=No
 
 
 @float64
-def steady_numbers_and_loops(profile, amplitude, load, stiffness, mu, num=201,
-                             groove_half_width=None, mapping="scaled") -> dict:  # fmt: skip
+def steady_numbers_and_loops(
+    profile, amplitude, load, stiffness, mu, num=201, groove_half_width=None, mapping="scaled"
+) -> dict:
     r""":func:`steady_numbers` and each point's steady loop drawn, by one compiled kernel."""
     physical = check_mapping(mapping, groove_half_width)
     profile = as_profile(profile)
@@ -329,9 +336,15 @@ def steady_numbers_and_loops(profile, amplitude, load, stiffness, mu, num=201,
     mu, key, lam, valid = _prepare(*values, profile.half_width, physical)
     padded = _pad(np.arange(lam.size))
     loops, jumps, (actuator, force) = _own_loops(
-        profile.position, profile.slope, profile.half_width, mu[padded], key[padded],
-        lam[padded], physical, num,
-    )  # fmt: skip
+        profile.position,
+        profile.slope,
+        profile.half_width,
+        mu[padded],
+        key[padded],
+        lam[padded],
+        physical,
+        num,
+    )
     numbers = _finish(loops._replace(ends=()), jumps, mu, lam, valid)
     settled = (numbers["regime"] == int(GROSS_SLIP)) | (numbers["regime"] == int(NO_GROSS_SLIP))
     drawn = {"displacement": (actuator, values[0]), "force": (force, values[1])}
@@ -415,8 +428,9 @@ def profile_simulation(profile, displacement, load, stiffness, mu, groove_half_w
     displacement = as_float64(displacement)
     load, stiffness, mu = (as_float64(v) for v in (load, stiffness, mu))
     x_o = profile.half_width if physical else as_float64(groove_half_width)
-    batch = jnp.broadcast_shapes(displacement.shape[:-1], load.shape, stiffness.shape, mu.shape,
-                                 x_o.shape)  # fmt: skip
+    batch = jnp.broadcast_shapes(
+        displacement.shape[:-1], load.shape, stiffness.shape, mu.shape, x_o.shape
+    )
     steps = displacement.shape[-1]
     displacement = jnp.broadcast_to(displacement, (*batch, steps))
     load, stiffness, mu, x_o = (jnp.broadcast_to(v, batch) for v in (load, stiffness, mu, x_o))

@@ -56,16 +56,17 @@ _LINE_SHARE = 0.05
 class ScarProfileWarning(UserWarning):
     """What reading a measured profile decided that its user must see."""
 
-    def __init__(self, summary: str, samples=(), details=(), alternative=None,
-                 alternative_name=""):  # fmt: skip
+    def __init__(self, summary: str, samples=(), details=(), alternative=None, alternative_name=""):
         self.summary = summary
         self.samples = tuple(int(i) for i in samples)
         self.details = tuple(details)
         self.alternative = alternative
         self.alternative_name = alternative_name
-        hint = "" if alternative is None else (
-            f"; half_width={alternative:.6g} (m) takes the {alternative_name}"
-        )  # fmt: skip
+        hint = (
+            ""
+            if alternative is None
+            else (f"; half_width={alternative:.6g} (m) takes the {alternative_name}")
+        )
         super().__init__(self.text([f"sample {i}" for i in self.samples]) + hint)
 
     def text(self, labels) -> str:
@@ -247,8 +248,10 @@ def _narrow_pair(ridges, heights, threshold) -> bool:
 def _paired_ridges(x, r, sides, centre, threshold, gap):
     """The band's outer ends (indices) at a pair of pile-up ridges, or None if there is none."""
     reach = max(_RIDGE_REACH * 0.5 * (x[sides[1]] - x[sides[0]]), _RIDGE_SPAN * (x[-1] - x[0]))
-    ridges = [_highest_run(x, r, outer, step, centre, reach, threshold, gap)
-              for outer, step in zip(sides, (-1, +1), strict=True)]  # fmt: skip
+    ridges = [
+        _highest_run(x, r, outer, step, centre, reach, threshold, gap)
+        for outer, step in zip(sides, (-1, +1), strict=True)
+    ]
     if None in ridges:
         return None
     heights = [float(r[ridge.crest]) for ridge in ridges]
@@ -261,8 +264,10 @@ def _paired_ridges(x, r, sides, centre, threshold, gap):
         paired = _narrow_pair(ridges, heights, threshold)
     if not paired:
         return None
-    return [_band_end(x, r, ridge.crest, step, threshold, gap)
-            for ridge, step in zip(ridges, (-1, +1), strict=True)]  # fmt: skip
+    return [
+        _band_end(x, r, ridge.crest, step, threshold, gap)
+        for ridge, step in zip(ridges, (-1, +1), strict=True)
+    ]
 
 
 def _shoulders(x, centre, half_width, band, quiet):
@@ -300,8 +305,10 @@ def _edges(x, r, deepest, depth, noise, reach):
     right = _crossing(x, r, deepest + 1, +1, tolerance, reach)
     rough = None
     if _LINE_NOISE * noise > tolerance:  # the roughness dips below the tolerance
-        rough = [_crossing(x, r, deepest + (step > 0), step, _LINE_NOISE * noise, reach)
-                 for step in (-1, +1)]  # fmt: skip
+        rough = [
+            _crossing(x, r, deepest + (step > 0), step, _LINE_NOISE * noise, reach)
+            for step in (-1, +1)
+        ]
         rough = None if None in rough else (rough[0][0], rough[1][0])
     if left is None or right is None:
         side = "left" if left is None else "right"
@@ -311,25 +318,28 @@ def _edges(x, r, deepest, depth, noise, reach):
         )
     threshold = max(_NOISE_FACTOR * noise, _BAND_FLOOR * depth)
     gap = max(_BAND_GAP_WIDTH * 0.5 * (right[0] - left[0]), _BAND_GAP * np.median(np.diff(x)))
-    ends = [_band_end(x, r, side[1], step, threshold, gap)
-            for side, step in ((left, -1), (right, +1))]  # fmt: skip
-    paired = _paired_ridges(x, r, (left[1], right[1]), 0.5 * (left[0] + right[0]), threshold,
-                            gap)  # fmt: skip
+    ends = [
+        _band_end(x, r, side[1], step, threshold, gap) for side, step in ((left, -1), (right, +1))
+    ]
+    paired = _paired_ridges(x, r, (left[1], right[1]), 0.5 * (left[0] + right[0]), threshold, gap)
     if paired is not None:  # the ridges beyond a quiet floor, unless the band reaches farther
         ends = [min(ends[0], paired[0]), max(ends[1], paired[1])]
     level = max(int(np.ceil(gap / np.median(np.diff(x)))), 1)
-    found = [_band_edge(x, r, side[1], end, step, threshold, level)
-             for side, end, step in ((left, ends[0], -1), (right, ends[1], +1))]  # fmt: skip
+    found = [
+        _band_edge(x, r, side[1], end, step, threshold, level)
+        for side, end, step in ((left, ends[0], -1), (right, ends[1], +1))
+    ]
     groove = (left[0], right[0])
     near = AMBIGUOUS_EDGES * 0.5 * (groove[1] - groove[0])
     # The track lies between the ridges: the band reaches their crests, where the counterbody
     # sliding up their inner flanks stopped; the groove's edge where the ridge's foot is not
     # beyond it (its wall runs up into the ridge).
     band = tuple(
-        groove[i] if foot is None or abs(foot - groove[i]) <= near
+        groove[i]
+        if foot is None or abs(foot - groove[i]) <= near
         else (foot if crest is None else _crest(x, r, crest, threshold))
         for i, (foot, crest) in enumerate(found)
-    )  # fmt: skip
+    )
     outer = (min(float(x[ends[0]]), band[0]), max(float(x[ends[1]]), band[1]))
     return groove, band, tuple(crest for _, crest in found), outer, threshold, rough
 
@@ -416,8 +426,10 @@ def _ambiguity(x, extent: Extent, given: bool):
     what = "the band between its pile-up ridges' crests" if all(ridged) else "the disturbed band"
     if not all(apart):
         what = f"the groove and the disturbed band on its {'right' if apart[1] else 'left'}"
-    marks = [f" (a crest {r[crest] * 1e6:.3g} µm high)" if ridge else ""
-             for crest, ridge in zip(extent.ridges, ridged, strict=True)]  # fmt: skip
+    marks = [
+        f" (a crest {r[crest] * 1e6:.3g} µm high)" if ridge else ""
+        for crest, ridge in zip(extent.ridges, ridged, strict=True)
+    ]
 
     def candidate(edges, words, taken, notes=("", "")):
         width = 0.5 * (edges[1] - edges[0])
@@ -427,8 +439,7 @@ def _ambiguity(x, extent: Extent, given: bool):
         return width, f"{width * 1e6:.6g} µm for {words} ({'returned; ' if taken else ''}{where})"
 
     band = candidate(extent.band, what, extent.wide, marks)
-    groove = candidate(extent.groove, "the groove below the unworn surface's line",
-                       not extent.wide)  # fmt: skip
+    groove = candidate(extent.groove, "the groove below the unworn surface's line", not extent.wide)
     first, second = (band, groove) if extent.wide else (groove, band)
     summary = (
         f"ambiguous scar edges: half-width {first[1]} or {second[1]}: which the model needs "

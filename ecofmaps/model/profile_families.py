@@ -65,9 +65,14 @@ def _family(position, height, slope, depth, half_width, tilt):
     inside = np.abs(position) <= half_width
     worn = np.trapezoid(np.where(inside, -np.minimum(height, 0.0), 0.0), position)
     return scar_profile_from_parts(
-        position, height + tilt * position, slope + tilt, depth, half_width, worn,
+        position,
+        height + tilt * position,
+        slope + tilt,
+        depth,
+        half_width,
+        worn,
         reference_slope=tilt,
-    )  # fmt: skip
+    )
 
 
 def _extent(extent, needed=1.0) -> float:
@@ -125,8 +130,9 @@ def parabolic_profile(depth, half_width, *, tilt=0.0, samples=2001, extent=2.0) 
 
 
 @si_units(depth="length", half_width="length")
-def flat_bottomed_profile(depth, half_width, flat_fraction=0.5, *, tilt=0.0, samples=2001,
-                          extent=2.0) -> ScarProfile:  # fmt: skip
+def flat_bottomed_profile(
+    depth, half_width, flat_fraction=0.5, *, tilt=0.0, samples=2001, extent=2.0
+) -> ScarProfile:
     r"""A flat-bottomed (U-shaped) scar: a flat bottom with parabolic walls.
 
     :math:`z = -D` for :math:`|X| \le a` and :math:`z = -D(1 - s^2)`,
@@ -160,8 +166,9 @@ def flat_bottomed_profile(depth, half_width, flat_fraction=0.5, *, tilt=0.0, sam
 
 
 @si_units(depth="length", half_width="length")
-def w_shaped_profile(depth, half_width, hump=0.25, *, tilt=0.0, samples=2001,
-                     extent=2.0) -> ScarProfile:  # fmt: skip
+def w_shaped_profile(
+    depth, half_width, hump=0.25, *, tilt=0.0, samples=2001, extent=2.0
+) -> ScarProfile:
     r"""A W-shaped scar: two troughs with a hump between them (the less worn centre).
 
     The quartic :math:`z = D\left[(u^2 - m^2)^2/(1 - m^2)^2 - 1\right]`, :math:`u = X/W`,
@@ -187,8 +194,15 @@ def w_shaped_profile(depth, half_width, hump=0.25, *, tilt=0.0, samples=2001,
     extent = _extent(extent)
     m2 = np.sqrt(hump) / (1.0 + np.sqrt(hump))
     trough = np.sqrt(m2) * half_width
-    edges = [-extent * half_width, -half_width, -trough, 0.0, trough, half_width,
-             extent * half_width]  # fmt: skip
+    edges = [
+        -extent * half_width,
+        -half_width,
+        -trough,
+        0.0,
+        trough,
+        half_width,
+        extent * half_width,
+    ]
     x = _grid(edges, samples)
     u = x / half_width
     inside = np.abs(u) <= 1.0
@@ -199,8 +213,9 @@ def w_shaped_profile(depth, half_width, hump=0.25, *, tilt=0.0, samples=2001,
 
 
 @si_units(depth="length", half_width="length", ridge_height="length", ridge_width="length")
-def ridged_profile(depth, half_width, ridge_height, ridge_width, *, tilt=0.0, samples=2001,
-                   extent=2.0) -> ScarProfile:  # fmt: skip
+def ridged_profile(
+    depth, half_width, ridge_height, ridge_width, *, tilt=0.0, samples=2001, extent=2.0
+) -> ScarProfile:
     r"""A parabolic scar with ploughing ridges piled up beside its edges (Figure 1b).
 
     Inside the edges the parabola of :func:`parabolic_profile`; outside them a ridge
@@ -232,8 +247,17 @@ def ridged_profile(depth, half_width, ridge_height, ridge_width, *, tilt=0.0, sa
     extent = _extent(extent, 1.0 + width / half_width)
     crest = half_width + 0.5 * width
     foot = half_width + width
-    edges = [-extent * half_width, -foot, -crest, -half_width, 0.0, half_width, crest, foot,
-             extent * half_width]  # fmt: skip
+    edges = [
+        -extent * half_width,
+        -foot,
+        -crest,
+        -half_width,
+        0.0,
+        half_width,
+        crest,
+        foot,
+        extent * half_width,
+    ]
     x = _grid(edges, samples)
     u = x / half_width
     v = (np.abs(x) - half_width) / width

@@ -125,11 +125,32 @@ class ScarProfile(NamedTuple):
         return stack([self.centre - self.half_width, self.centre + self.half_width], -1)
 
 
-def scar_profile_from_parts(position, height, slope, depth, half_width, worn_area, centre=0.0,
-             reference_height=0.0, reference_slope=0.0, alternative_half_width=np.nan,
-             replaced=0.0) -> ScarProfile:  # fmt: skip
-    values = (position, height, slope, depth, half_width, worn_area, centre,
-              reference_height, reference_slope, alternative_half_width, replaced)  # fmt: skip
+def scar_profile_from_parts(
+    position,
+    height,
+    slope,
+    depth,
+    half_width,
+    worn_area,
+    centre=0.0,
+    reference_height=0.0,
+    reference_slope=0.0,
+    alternative_half_width=np.nan,
+    replaced=0.0,
+) -> ScarProfile:
+    values = (
+        position,
+        height,
+        slope,
+        depth,
+        half_width,
+        worn_area,
+        centre,
+        reference_height,
+        reference_slope,
+        alternative_half_width,
+        replaced,
+    )
     if is_concrete(*values):
         # NumPy arrays: a user's own arithmetic on them (``profile.half_width * 1e6``) stays
         # float64, where JAX outside its 64-bit mode would truncate it to float32.
@@ -332,8 +353,9 @@ def local_quadratic(x: np.ndarray, z: np.ndarray, smoothing: float):
     return height, slope
 
 
-def scar_profile_and_findings(x, z, half_width=None, smoothing=None, level=False,
-                              remove_outliers=True):  # fmt: skip
+def scar_profile_and_findings(
+    x, z, half_width=None, smoothing=None, level=False, remove_outliers=True
+):
     """:func:`scar_profile` and its warnings, not issued: ``(profile, findings)``.
 
     Parameters and Raises are those of :func:`scar_profile`.
@@ -388,15 +410,24 @@ def scar_profile_and_findings(x, z, half_width=None, smoothing=None, level=False
         height, slope = z, gs
         reference = (float(line(centre)), float(tilt))
     profile = scar_profile_from_parts(
-        x - centre, height, slope, depth, width, worn, centre, *reference, alternative,
+        x - centre,
+        height,
+        slope,
+        depth,
+        width,
+        worn,
+        centre,
+        *reference,
+        alternative,
         replaced.astype(np.float64),
-    )  # fmt: skip
+    )
     return profile, findings
 
 
 @si_units(x="length", z="length", half_width="length")
-def scar_profile(x, z, half_width=None, smoothing=None, level=False,
-                 remove_outliers=True) -> ScarProfile:  # fmt: skip
+def scar_profile(
+    x, z, half_width=None, smoothing=None, level=False, remove_outliers=True
+) -> ScarProfile:
     r"""A wear-scar profile from a measured trace (arrays in metres).
 
     Parameters
@@ -467,9 +498,13 @@ def scar_profile(x, z, half_width=None, smoothing=None, level=False,
     (50.0, 10.0)
     """
     profile, findings = scar_profile_and_findings(
-        x, z, half_width=half_width, smoothing=smoothing, level=level,
+        x,
+        z,
+        half_width=half_width,
+        smoothing=smoothing,
+        level=level,
         remove_outliers=remove_outliers,
-    )  # fmt: skip
+    )
     for finding in findings:
         warn(finding, ScarProfileWarning)
     return profile

@@ -62,8 +62,18 @@ def _steady_loop(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width
 
 
 @float64
-def fretting_loop(amplitude, load, stiffness, mu, aspect_ratio=None, groove_half_width=None,
-                  num=201, *, profile=None, mapping="scaled"):  # fmt: skip
+def fretting_loop(
+    amplitude,
+    load,
+    stiffness,
+    mu,
+    aspect_ratio=None,
+    groove_half_width=None,
+    num=201,
+    *,
+    profile=None,
+    mapping="scaled",
+):
     r"""The steady fretting loop: displacement and tangential force around one cycle.
 
     Parameters
@@ -165,8 +175,17 @@ def _return_map(displacement, mu, kappa, lam, length):
 
 
 @float64
-def simulate(displacement, load, stiffness, mu, aspect_ratio=None, groove_half_width=None, *,
-             profile=None, mapping="scaled"):  # fmt: skip
+def simulate(
+    displacement,
+    load,
+    stiffness,
+    mu,
+    aspect_ratio=None,
+    groove_half_width=None,
+    *,
+    profile=None,
+    mapping="scaled",
+):
     r"""Tangential force history for any actuator displacement history :math:`\Delta(t)`.
 
     Parameters

@@ -192,8 +192,17 @@ _PROFILE_NOTES = """
 
 
 @float64
-def slip_amplitude(amplitude, load, stiffness, mu, aspect_ratio=None, groove_half_width=None, *,
-        profile=None, mapping="scaled"):  # fmt: skip
+def slip_amplitude(
+    amplitude,
+    load,
+    stiffness,
+    mu,
+    aspect_ratio=None,
+    groove_half_width=None,
+    *,
+    profile=None,
+    mapping="scaled",
+):
     arguments = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
     return _evaluate("slip_amplitude", arguments, profile, mapping)
 
@@ -226,8 +235,17 @@ slip_amplitude.__doc__ = f"""Slip amplitude :math:`\\delta^*` of the steady fret
 
 
 @float64
-def dissipated_energy(amplitude, load, stiffness, mu, aspect_ratio=None, groove_half_width=None, *,
-        profile=None, mapping="scaled"):  # fmt: skip
+def dissipated_energy(
+    amplitude,
+    load,
+    stiffness,
+    mu,
+    aspect_ratio=None,
+    groove_half_width=None,
+    *,
+    profile=None,
+    mapping="scaled",
+):
     arguments = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
     return _evaluate("dissipated_energy", arguments, profile, mapping)
 
@@ -253,8 +271,17 @@ dissipated_energy.__doc__ = f"""Energy dissipated per cycle :math:`E_d`, the loo
 
 
 @float64
-def energy_cof(amplitude, load, stiffness, mu, aspect_ratio=None, groove_half_width=None, *,
-        profile=None, mapping="scaled"):  # fmt: skip
+def energy_cof(
+    amplitude,
+    load,
+    stiffness,
+    mu,
+    aspect_ratio=None,
+    groove_half_width=None,
+    *,
+    profile=None,
+    mapping="scaled",
+):
     arguments = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
     return _evaluate("energy_cof", arguments, profile, mapping)
 
@@ -283,8 +310,17 @@ energy_cof.__doc__ = f"""Energy coefficient of friction :math:`\\mu_E = E_d/(4P\
 
 
 @float64
-def max_force(amplitude, load, stiffness, mu, aspect_ratio=None, groove_half_width=None, *,
-        profile=None, mapping="scaled"):  # fmt: skip
+def max_force(
+    amplitude,
+    load,
+    stiffness,
+    mu,
+    aspect_ratio=None,
+    groove_half_width=None,
+    *,
+    profile=None,
+    mapping="scaled",
+):
     arguments = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
     return _evaluate("max_force", arguments, profile, mapping)
 
@@ -309,8 +345,17 @@ max_force.__doc__ = f"""Peak tangential force :math:`Q^*` of the steady loop (eq
 
 
 @float64
-def slip_regime(amplitude, load, stiffness, mu, aspect_ratio=None, groove_half_width=None, *,
-        profile=None, mapping="scaled"):  # fmt: skip
+def slip_regime(
+    amplitude,
+    load,
+    stiffness,
+    mu,
+    aspect_ratio=None,
+    groove_half_width=None,
+    *,
+    profile=None,
+    mapping="scaled",
+):
     arguments = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
     return _evaluate("regime", arguments, profile, mapping)
 

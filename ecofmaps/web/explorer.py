@@ -181,11 +181,10 @@ def _values_html(point: ExplorerPoint, values: dict) -> str:
     gross = math.isfinite(point.ecof_ratio)
     rows = [
         ("slip_amplitude", "Slip amplitude δ*", _number(point.slip_amplitude, 1e6), "µm"),
-        ("dissipated_energy", "Dissipated energy E_d",
-         _number(point.dissipated_energy, 1e3), "mJ"),
+        ("dissipated_energy", "Dissipated energy E_d", _number(point.dissipated_energy, 1e3), "mJ"),
         ("ecof_ratio", "μ_E/μ", _number(point.ecof_ratio), ""),
         ("ecof", "μ_E", _number(point.ecof_ratio * values["mu"]), ""),
-    ]  # fmt: skip
+    ]
     cells = "".join(
         f"<tr><th style='text-align:left;padding-right:1em'>{label}</th>"
         f"<td><span class='ecofmaps-value' data-quantity='{key}'>{text}</span> {unit}</td></tr>"
@@ -220,10 +219,13 @@ def _loop_figure():
     """The steady loop's figure and its data source (Q [N] against Δ [µm])."""
     source = ColumnDataSource({"x": [], "y": []})
     plot = figure(
-        width=440, height=380, title="Steady fretting loop",
-        x_axis_label="Applied displacement Δ [µm]", y_axis_label="Tangential force Q [N]",
+        width=440,
+        height=380,
+        title="Steady fretting loop",
+        x_axis_label="Applied displacement Δ [µm]",
+        y_axis_label="Tangential force Q [N]",
         tools="pan,box_zoom,wheel_zoom,reset,save",
-    )  # fmt: skip
+    )
     plot.line("x", "y", source=source, line_width=2, color="#1f77b4")
     return plot, source
 
@@ -233,14 +235,25 @@ def _map_figure():
     image = ColumnDataSource({"image": [], "x": [], "y": [], "dw": [], "dh": []})
     marker = ColumnDataSource({"x": [], "y": []})
     plot = figure(
-        width=560, height=380, title="μ_E/μ over rig stiffness and groove shape (x_o = Δ*)",
+        width=560,
+        height=380,
+        title="μ_E/μ over rig stiffness and groove shape (x_o = Δ*)",
         x_axis_label="Stiffness over load S/P [(MN/m)/kN = 1/mm]",
-        y_axis_label="Groove aspect ratio z_o/x_o [1]", tools="pan,box_zoom,wheel_zoom,reset,save",
-    )  # fmt: skip
+        y_axis_label="Groove aspect ratio z_o/x_o [1]",
+        tools="pan,box_zoom,wheel_zoom,reset,save",
+    )
     colors = LinearColorMapper(palette=Viridis256, low=1.0, high=1.2, nan_color=(0, 0, 0, 0))
     plot.image("image", x="x", y="y", dw="dw", dh="dh", source=image, color_mapper=colors)
-    plot.scatter("x", "y", source=marker, size=13, marker="circle", fill_color="white",
-                 line_color="black", line_width=2)  # fmt: skip
+    plot.scatter(
+        "x",
+        "y",
+        source=marker,
+        size=13,
+        marker="circle",
+        fill_color="white",
+        line_color="black",
+        line_width=2,
+    )
     plot.add_layout(ColorBar(color_mapper=colors, width=12), "right")
     plot.add_tools(
         HoverTool(
@@ -262,11 +275,18 @@ def _show_map(values: dict, image, marker, colors) -> None:
     grid = _ecof_ratio_map(values["amplitude"], values["mu"], window)
     finite = grid[np.isfinite(grid)]
     colors.high = float(max(finite.max(), 1.001)) if finite.size else 1.2
-    image.data = {"image": [grid], "x": [window[0] * 1e-3], "y": [0.0],
-                  "dw": [(window[1] - window[0]) * 1e-3], "dh": [window[2]]}  # fmt: skip
+    image.data = {
+        "image": [grid],
+        "x": [window[0] * 1e-3],
+        "y": [0.0],
+        "dw": [(window[1] - window[0]) * 1e-3],
+        "dh": [window[2]],
+    }
     shown = math.isfinite(ratio)
-    marker.data = {"x": [ratio * 1e-3] if shown else [],
-                   "y": [values["aspect_ratio"]] if shown else []}  # fmt: skip
+    marker.data = {
+        "x": [ratio * 1e-3] if shown else [],
+        "y": [values["aspect_ratio"]] if shown else [],
+    }
 
 
 def explorer_page():
@@ -363,9 +383,14 @@ def serve_explorer(port: int, *, open_browser: bool = True, announce=print) -> N
     """
     url = f"http://127.0.0.1:{port}/"
     server = get_server(
-        {"/": explorer_page}, port=port, address="127.0.0.1", show=False, start=False,
-        title="ecofmaps explorer", websocket_origin=[f"127.0.0.1:{port}", f"localhost:{port}"],
-    )  # fmt: skip
+        {"/": explorer_page},
+        port=port,
+        address="127.0.0.1",
+        show=False,
+        start=False,
+        title="ecofmaps explorer",
+        websocket_origin=[f"127.0.0.1:{port}", f"localhost:{port}"],
+    )
     loop = server.io_loop
 
     def stop(signum, frame):  # the loop stops as soon as it runs (at once if it runs)

@@ -262,25 +262,42 @@ def _evolution_figures(results: xr.Dataset):
     data["mu_high"] = data["mu_resolved"] + 2.0 * data["mu_resolved_se"]
     source = ColumnDataSource(data)
     plot = figure(
-        frame_width=_FRAME[0], frame_height=300, min_border_left=_FRAME[1],
+        frame_width=_FRAME[0],
+        frame_height=300,
+        min_border_left=_FRAME[1],
         title="Coefficients of friction over the test",
-        x_axis_label=_label("cycle"), y_axis_label="Coefficient of friction [1]",
+        x_axis_label=_label("cycle"),
+        y_axis_label="Coefficient of friction [1]",
         tools="pan,box_zoom,wheel_zoom,reset,save",
-    )  # fmt: skip
+    )
     resolved = "mu_resolved" in results
     if resolved:
-        plot.varea("cycle", "mu_low", "mu_high", source=source, color="#2ca02c",
-                   alpha=0.25, legend_label="μ ± 2 se")  # fmt: skip
+        plot.varea(
+            "cycle",
+            "mu_low",
+            "mu_high",
+            source=source,
+            color="#2ca02c",
+            alpha=0.25,
+            legend_label="μ ± 2 se",
+        )
     lines = {"ecof": ("#ff7f0e", "ECoF μ_E"), "gicof": ("#1f77b4", "GICoF (Q/P on Q = SΔ)")}
     drawn = {}
     for name, (color, legend) in lines.items():
-        drawn[name] = plot.line("cycle", name, source=source, color=color, line_width=1.5,
-                                legend_label=legend)  # fmt: skip
+        drawn[name] = plot.line(
+            "cycle", name, source=source, color=color, line_width=1.5, legend_label=legend
+        )
         if cycle.size <= 400:
             plot.scatter("cycle", name, source=source, color=color, size=3)
     if resolved:  # on top: the most precise of the three
-        plot.line("cycle", "mu_resolved", source=source, color="#2ca02c", line_width=1.5,
-                  legend_label="μ read along the stroke")  # fmt: skip
+        plot.line(
+            "cycle",
+            "mu_resolved",
+            source=source,
+            color="#2ca02c",
+            line_width=1.5,
+            legend_label="μ read along the stroke",
+        )
     plot.add_tools(
         HoverTool(
             tooltips=[
@@ -319,20 +336,32 @@ def _flags_figure(results: xr.Dataset, evolution):
         return Div(text="<p>No cycle is flagged: every cycle's quality is 'ok'.</p>")
     reasons = list(flagged)[::-1]  # the first reason at the top
     plot = figure(
-        frame_width=_FRAME[0], frame_height=26 * len(reasons), min_border_left=_FRAME[1],
-        y_range=reasons, x_range=evolution.x_range,
+        frame_width=_FRAME[0],
+        frame_height=26 * len(reasons),
+        min_border_left=_FRAME[1],
+        y_range=reasons,
+        x_range=evolution.x_range,
         toolbar_location=None,
         title="Quality flags (the values they leave out are NaN)",
-        x_axis_label=_label("cycle"), tools="xpan,xwheel_zoom,reset",
-    )  # fmt: skip
+        x_axis_label=_label("cycle"),
+        tools="xpan,xwheel_zoom,reset",
+    )
     marks = ColumnDataSource(
         {
             "cycle": np.concatenate(list(flagged.values())),
             "reason": [reason for reason, cycles in flagged.items() for _ in cycles],
         }
     )
-    plot.scatter("cycle", "reason", source=marks, marker="dash", size=10, line_width=2,
-                 color="#d62728", angle=np.pi / 2)  # fmt: skip
+    plot.scatter(
+        "cycle",
+        "reason",
+        source=marks,
+        marker="dash",
+        size=10,
+        line_width=2,
+        color="#d62728",
+        angle=np.pi / 2,
+    )
     plot.xaxis.formatter = BasicTickFormatter(use_scientific=False)
     plot.add_tools(HoverTool(tooltips=[("cycle", "@cycle"), ("flag", "@reason")]))
     return plot
@@ -387,8 +416,10 @@ def _model_loops(results: xr.Dataset) -> tuple[list, list]:
     count = results["cycle"].size
     if "mu_resolved" not in results or "aspect_ratio" not in results:
         return [empty] * count, [empty] * count
-    values = {name: results[name].values for name in
-              ("amplitude", "stiffness", "mu_resolved", "aspect_ratio")}  # fmt: skip
+    values = {
+        name: results[name].values
+        for name in ("amplitude", "stiffness", "mu_resolved", "aspect_ratio")
+    }
     usable = np.all([np.isfinite(value) for value in values.values()], axis=0)
     usable &= (values["amplitude"] > 0) & (values["stiffness"] > 0)
     usable &= (values["mu_resolved"] > 0) & (values["aspect_ratio"] >= 0)
@@ -399,9 +430,13 @@ def _model_loops(results: xr.Dataset) -> tuple[list, list]:
         size = -(-int(usable.sum()) // _MODEL_BATCH) * _MODEL_BATCH
         batch = {name: np.resize(value[usable], size) for name, value in values.items()}
         displacement, force = fretting_loop(
-            batch["amplitude"], float(results["load"]), batch["stiffness"],
-            batch["mu_resolved"], batch["aspect_ratio"], num=_MODEL_POINTS,
-        )  # fmt: skip
+            batch["amplitude"],
+            float(results["load"]),
+            batch["stiffness"],
+            batch["mu_resolved"],
+            batch["aspect_ratio"],
+            num=_MODEL_POINTS,
+        )
         displacement = np.round(np.asarray(displacement) * 1e6, 4)
         force = np.round(np.asarray(force), 3)
         for row_index, index in enumerate(np.flatnonzero(usable)):
@@ -431,24 +466,32 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
     palette = list(Category10_10)
     measured, model = ColumnDataSource(name="shown-loops"), ColumnDataSource(name="shown-models")
     plot = figure(
-        width=700, height=460, title="Measured loops (lines) and the model's (dashed)",
-        x_axis_label=_label("displacement"), y_axis_label=_label("force"),
+        width=700,
+        height=460,
+        title="Measured loops (lines) and the model's (dashed)",
+        x_axis_label=_label("displacement"),
+        y_axis_label=_label("force"),
         tools="pan,box_zoom,wheel_zoom,reset,save",
-    )  # fmt: skip
-    plot.multi_line("xs", "ys", source=measured, color="color", line_width=1.6,
-                    legend_field="label")  # fmt: skip
+    )
+    plot.multi_line(
+        "xs", "ys", source=measured, color="color", line_width=1.6, legend_field="label"
+    )
     plot.multi_line("xs", "ys", source=model, color="color", line_width=1.4, line_dash="dashed")
     plot.legend.location = "top_left"
     choice = MultiChoice(
         title="Cycles shown (pick others; the page carries the loops of "
         f"{len(names)} cycles spread over the test)",
-        value=first, options=names, width=480, name="loop-picker",
-    )  # fmt: skip
+        value=first,
+        options=names,
+        width=480,
+        name="loop-picker",
+    )
     update = CustomJS(
-        args=dict(carried=all_loops, choice=choice, measured=measured, model=model,
-                  palette=palette),
+        args=dict(
+            carried=all_loops, choice=choice, measured=measured, model=model, palette=palette
+        ),
         code=_PICK_LOOPS,
-    )  # fmt: skip
+    )
     choice.js_on_change("value", update)
     _fill_shown(all_loops.data, first, palette, measured, model)
     note = Div(
@@ -473,8 +516,9 @@ def _fill_shown(carried: dict, names, palette, measured, model) -> None:
         "label": list(names),
         "color": colors,
     }
-    modelled = [(i, color) for i, color in zip(indices, colors, strict=True)
-                if len(carried["model_xs"][i])]  # fmt: skip
+    modelled = [
+        (i, color) for i, color in zip(indices, colors, strict=True) if len(carried["model_xs"][i])
+    ]
     model.data = {
         "xs": [carried["model_xs"][i] for i, _ in modelled],
         "ys": [carried["model_ys"][i] for i, _ in modelled],
@@ -504,7 +548,13 @@ def _table(results: xr.Dataset):
         width=_WIDTH,
     )
     grid = DataTable(
-        source=ColumnDataSource(data), columns=columns, width=_WIDTH, height=380,
-        index_position=None, sortable=True, autosize_mode="none", css_classes=["ecofmaps-table"],
-    )  # fmt: skip
+        source=ColumnDataSource(data),
+        columns=columns,
+        width=_WIDTH,
+        height=380,
+        index_position=None,
+        sortable=True,
+        autosize_mode="none",
+        css_classes=["ecofmaps-table"],
+    )
     return column(heading, grid)
