@@ -1,0 +1,90 @@
+"""Build helpers of the documentation site (mkdocs.yml names them; not a page).
+
+- ``on_page_markdown``, an MkDocs hook: the guide page (guide.md) is the README, its links
+  made relative to docs/.
+- ``RuntimeDocstrings``, a Griffe extension: the docstring a function has at run time. Griffe
+  unwraps a decorated function and reads the docstring of the function inside, which is empty
+  where the docstring is set on the wrapper afterwards (``energy_cof.__doc__ = ...``).
+"""
+
+import inspect
+import re
+import sys
+from pathlib import Path
+
+import griffe
+
+README = Path(__file__).resolve().parents[1] / "README.md"
+
+
+def on_page_markdown(markdown, page, **kwargs):
+    """The README's text for guide.md, every other page as it is."""
+    if page.file.src_uri != "guide.md":
+        return markdown
+    text = re.sub(r"\A# .*", "# Guide (the README)", README.read_text(encoding="utf-8"))
+    return re.sub(r"\]\(docs/", "](", text)
+
+
+#: reStructuredText roles in docstrings (:func:`name`, :math:`x`), shown as code in Markdown.
+ROLE = re.compile(r":(?:func|class|mod|meth|attr|data|exc|obj|math):`~?([^`]+)`")
+
+
+def _source_comment(path, name):
+    """The ``#:`` comment lines just above ``name = ...`` in the file ``path``, or None."""
+    lines = Path(path).read_text(encoding="utf-8").splitlines()
+    for number, line in enumerate(lines):
+        if re.match(rf"{re.escape(name)}\s*(:[^=]*)?=", line):
+            comment = []
+            while number and lines[number - 1].startswith("#:"):
+                number -= 1
+                comment.insert(0, lines[number][2:].strip())
+            return " ".join(comment) or None
+    return None
+
+
+class RuntimeDocstrings(griffe.Extension):
+    """Each public object's docstring as Python and the source hold it.
+
+    - A function takes the docstring it has at run time.
+    - A constant takes its ``#:`` comment, not the docstring of its type (``dict.__doc__``),
+      looked up in its module and, for a name imported on first use, in the module that
+      defines it (the package's ``_PUBLIC``).
+    - reStructuredText roles become code spans.
+    """
+
+    def on_instance(self, *, node, obj, agent, **kwargs):
+        if not isinstance(node, griffe.ObjectNode) or node.parent is None:
+            return
+        text = obj.docstring.value if obj.docstring else None
+        if obj.is_function and text is None:
+            text = getattr(getattr(node.parent.obj, node.name, None), "__doc__", None)
+        elif obj.is_attribute:
+            text = self._constant_comment(node)
+        if text:
+            obj.docstring = griffe.Docstring(
+                ROLE.sub(r"`\1`", inspect.cleandoc(text)),
+                parent=obj,
+                parser=agent.docstring_parser,
+                parser_options=agent.docstring_options,
+            )
+        else:
+            obj.docstring = None
+
+    def on_class_members(self, *, cls, **kwargs):
+        """A class without the attributes Python gives every class (``__doc__``, ...)."""
+        for name, member in list(cls.members.items()):
+            if name.startswith("__") and not member.is_alias and member.is_attribute:
+                del cls.members[name]
+
+    @staticmethod
+    def _constant_comment(node):
+        module = node.parent.obj
+        homes = [module.__name__] if inspect.ismodule(module) else []
+        public = getattr(module, "_PUBLIC", {})
+        homes += [home for home, names in public.items() if node.name in names]
+        for home in homes:
+            path = getattr(sys.modules.get(home), "__file__", None)
+            comment = path and _source_comment(path, node.name)
+            if comment:
+                return comment
+        return None
