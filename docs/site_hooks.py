@@ -10,6 +10,7 @@
 import inspect
 import re
 import sys
+import textwrap
 from pathlib import Path
 
 import griffe
@@ -27,6 +28,20 @@ def on_page_markdown(markdown, page, **kwargs):
 
 #: reStructuredText roles in docstrings (:func:`name`, :math:`x`), shown as code in Markdown.
 ROLE = re.compile(r":(?:func|class|mod|meth|attr|data|exc|obj|math):`~?([^`]+)`")
+#: A reStructuredText ``.. math::`` directive and the lines indented under it.
+MATH = re.compile(r"^( *)\.\. math::[ \t]*(.*)\n((?:\1[ \t]+\S.*\n|[ \t]*\n)*)", re.MULTILINE)
+
+
+def _markdown(text):
+    """A docstring's reStructuredText roles as code spans, its math directives as code blocks."""
+
+    def block(match):
+        indent, first, rest = match.groups()
+        lines = [first.strip(), *textwrap.dedent(rest).strip().splitlines()]
+        body = "\n".join(indent + line for line in lines if line)
+        return f"{indent}```text\n{body}\n{indent}```\n\n"
+
+    return ROLE.sub(r"`\1`", MATH.sub(block, text + "\n")).rstrip("\n")
 
 
 def _source_comment(path, name):
@@ -49,7 +64,7 @@ class RuntimeDocstrings(griffe.Extension):
     - A constant takes its ``#:`` comment, not the docstring of its type (``dict.__doc__``),
       looked up in its module and, for a name imported on first use, in the module that
       defines it (the package's ``_PUBLIC``).
-    - reStructuredText roles become code spans.
+    - reStructuredText roles become code spans, math directives code blocks.
     """
 
     def on_instance(self, *, node, obj, agent, **kwargs):
@@ -62,7 +77,7 @@ class RuntimeDocstrings(griffe.Extension):
             text = self._constant_comment(node)
         if text:
             obj.docstring = griffe.Docstring(
-                ROLE.sub(r"`\1`", inspect.cleandoc(text)),
+                _markdown(inspect.cleandoc(text)),
                 parent=obj,
                 parser=agent.docstring_parser,
                 parser_options=agent.docstring_options,
@@ -70,10 +85,14 @@ class RuntimeDocstrings(griffe.Extension):
         else:
             obj.docstring = None
 
-    def on_class_members(self, *, cls, **kwargs):
-        """A class without the attributes Python gives every class (``__doc__``, ...)."""
+    def on_class_members(self, *, node, cls, **kwargs):
+        """A class without the attributes Python gives every class (``__doc__``, ...), and a
+        named tuple without its fields' accessors (its docstring lists the fields)."""
+        fields = getattr(node.obj, "_fields", ()) if isinstance(node, griffe.ObjectNode) else ()
         for name, member in list(cls.members.items()):
-            if name.startswith("__") and not member.is_alias and member.is_attribute:
+            if member.is_alias:
+                continue
+            if (name.startswith("__") and member.is_attribute) or name in fields:
                 del cls.members[name]
 
     @staticmethod
