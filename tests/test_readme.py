@@ -68,7 +68,11 @@ def test_readme_shell_blocks_run_as_written(tmp_path):
     subprocess.run([sys.executable, "-m", "venv", copy / ".venv"], check=True, timeout=300)
     (site,) = (copy / ".venv" / "lib").glob("python*/site-packages")
     (site / "test-environment.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
+    # A new user's shell: no environment activated, this one's Python not on the PATH.
     environment = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
+    here = str(Path(sys.executable).parent)
+    path = [folder for folder in environment.get("PATH", "").split(os.pathsep) if folder != here]
+    environment["PATH"] = os.pathsep.join(path)
     environment.update(PIP_NO_INPUT="1", PIP_DISABLE_PIP_VERSION_CHECK="1")
     # Then: which ecofmaps the shell runs, and which one Python imports outside the copy.
     script = (
