@@ -1,7 +1,8 @@
 """Build helpers of the documentation site (mkdocs.yml names them; not a page).
 
 - ``on_page_markdown``, an MkDocs hook: the guide page (guide.md) is the README, its links
-  made relative to docs/.
+  made relative to docs/; the reference's first page lists the names of ``ecofmaps``, each
+  linked to its entry in its package's page.
 - ``RuntimeDocstrings``, a Griffe extension: the docstring a function has at run time. Griffe
   unwraps a decorated function and reads the docstring of the function inside, which is empty
   where the docstring is set on the wrapper afterwards (``energy_cof.__doc__ = ...``).
@@ -18,12 +19,34 @@ import griffe
 README = Path(__file__).resolve().parents[1] / "README.md"
 
 
+#: Where the reference's first page lists the names of ``ecofmaps``.
+NAMES = "<!-- the names of ecofmaps: docs/site_hooks.py writes them here -->"
+
+
 def on_page_markdown(markdown, page, **kwargs):
-    """The README's text for guide.md, every other page as it is."""
-    if page.file.src_uri != "guide.md":
-        return markdown
-    text = re.sub(r"\A# .*", "# Guide (the README)", README.read_text(encoding="utf-8"))
-    return re.sub(r"\]\(docs/", "](", text)
+    """The README's text for guide.md, the names of ``ecofmaps`` in reference/index.md."""
+    if page.file.src_uri == "guide.md":
+        text = re.sub(r"\A# .*", "# Guide (the README)", README.read_text(encoding="utf-8"))
+        return re.sub(r"\]\(docs/", "](", text)
+    if page.file.src_uri == "reference/index.md":
+        return markdown.replace(NAMES, _names_of_ecofmaps())
+    return markdown
+
+
+def _names_of_ecofmaps():
+    """A table of each name of ``ecofmaps`` linked to its entry in its package's page, and the
+    entry itself of a name that no public package holds."""
+    import ecofmaps
+
+    rows, entries = ["| name | documented as |", "|---|---|"], []
+    for module, names in sorted(ecofmaps._PUBLIC.items()):
+        package = ".".join(module.split(".")[:2])
+        for name in names:
+            if package.startswith("ecofmaps._"):
+                entries.append(f"::: ecofmaps.{name}")
+            else:
+                rows.append(f"| `{name}` | [`{package}.{name}`][{package}.{name}] |")
+    return "\n".join([*rows, "", *entries])
 
 
 #: reStructuredText roles in docstrings (:func:`name`, :math:`x`), shown as code in Markdown.
