@@ -109,13 +109,15 @@ class RuntimeDocstrings(griffe.Extension):
             obj.docstring = None
 
     def on_class_members(self, *, node, cls, **kwargs):
-        """A class without the attributes Python gives every class (``__doc__``, ...), and a
-        named tuple without its fields' accessors (its docstring lists the fields)."""
+        """A class without the attributes Python gives every class (``__doc__``, ...) nor the
+        special methods a dataclass writes (no docstring), and a named tuple without its
+        fields' accessors (its docstring lists the fields)."""
         fields = getattr(node.obj, "_fields", ()) if isinstance(node, griffe.ObjectNode) else ()
         for name, member in list(cls.members.items()):
             if member.is_alias:
                 continue
-            if (name.startswith("__") and member.is_attribute) or name in fields:
+            special = name.startswith("__") and name != "__init__"
+            if (special and (member.is_attribute or member.docstring is None)) or name in fields:
                 del cls.members[name]
 
     @staticmethod
