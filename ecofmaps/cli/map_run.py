@@ -60,7 +60,7 @@ def run(args) -> int:
         dataset = compute_map(**grid, load=args.load, chunks=args.chunk_points)
     else:  # refused there if it would not fit in memory
         dataset = compute_map(
-            **grid, load=args.load, cache=not args.no_cache, cache_dir=args.cache_dir
+            **grid, load=args.load, cache=False if args.no_cache else None, cache_dir=args.cache_dir
         )
     return _write(dataset, out, shown=chunked and not args.quiet and sys.stderr.isatty())
 
