@@ -299,7 +299,7 @@ def _file_image(dataset: xr.Dataset) -> bytes:
         if _chunked(variable)
     }
     memory = h5py.File(
-        "cache entry", "w", driver="core", backing_store=False, track_order=True, libver="latest"
+        "cache entry", "w", driver="core", backing_store=False, track_order=True, libver="v110"
     )
     try:
         with h5netcdf.File(memory, "w") as netcdf:  # leaves `memory` open
@@ -367,9 +367,9 @@ def _reason(error: BaseException) -> str:
     return f"{type(error).__name__}: {text}"
 
 
-def _store(dataset: xr.Dataset, path: Path, key: str) -> None:
-    """Store ``dataset`` at ``path`` if it fits the bound, then keep the cache within it."""
-    bound = cache_size_bound()
+def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
+    """Store ``dataset`` at ``path`` if it fits in ``bound`` [byte], then keep the cache
+    within it."""
     if dataset.nbytes > bound:
         return
     image = _file_image(dataset.assign_attrs({_KEY_ATTRIBUTE: key}))
@@ -433,6 +433,7 @@ def cached_dataset(
         the same.
     """
     directory = cache_directory(cache_dir)
+    bound = cache_size_bound()  # a bad ECOFMAPS_CACHE_SIZE is refused before any work
     key = cache_key(function, inputs)
     path = directory / f"{function}-{key[:_NAME_DIGITS]}.nc"
     dataset = _stored(path, key) if path.is_file() else None  # not a folder of the user's
@@ -442,9 +443,7 @@ def cached_dataset(
         return dataset
     dataset = compute()
     try:
-        _store(dataset, path, key)
-    except ValueError:  # ECOFMAPS_CACHE_SIZE is not a size: the user's to fix
-        raise
+        _store(dataset, path, key, bound)
     except Exception as error:  # whatever the reason, the result is returned all the same
         warn(f"could not write cache file {path} ({_reason(error)})", CacheWarning)
     return dataset

@@ -342,15 +342,12 @@ def test_a_full_tmpfs_is_one_warning_and_the_command_writes_its_output(tmp_path)
             timeout=600, check=False,
         )  # fmt: skip
         assert done.returncode == 0, done.stderr
-        assert "Traceback" not in done.stderr and "Exception ignored" not in done.stderr
-        warnings_ = [line for line in done.stderr.splitlines() if "CacheWarning" in line]
-        assert len(warnings_) == 1 and "could not write cache file" in warnings_[0]
-        assert "No space left on device" in warnings_[0]
+        assert done.stderr.count("\n") == 1 and done.stderr.startswith("ecofmaps map: ")
         with xr.open_dataset(out, engine="h5netcdf") as written:
             assert written.sizes["stiffness_ratio"] == 40
         assert sorted(p.name for p in (tiny / "cache").iterdir()) == []
-        scripts = ["from ecofmaps import compute_map; compute_map(1e5, [0.1, 0.2], 50e-6, "
-                   "[0.5, 0.8], cache=True); print('computed')"]  # fmt: skip
+        cached = "compute_map(1e5, numpy.linspace(0, 0.4, 1000), 50e-6, 0.8, cache=True)"
+        scripts = [f"import numpy; from ecofmaps import compute_map; {cached}; print('computed')"]
         if importlib.util.find_spec("panel"):
             scripts.append("from ecofmaps.web.explorer import warm_up; warm_up(); print('started')")
         for script in scripts:  # the write fails: one line, the work goes on
