@@ -296,13 +296,22 @@ def test_a_full_disk_is_one_warning(tmp_path, monkeypatch):
 
 
 def test_a_read_only_folder_is_one_warning(tmp_path):
-    if os.geteuid() == 0:
-        pytest.skip("root writes into read-only folders")
-    tmp_path.chmod(0o555)
+    """A folder without write permission, or (for root, who writes there all the same) a
+    read-only file system."""
+    if os.geteuid() != 0:
+        tmp_path.chmod(0o555)
+        try:
+            write_fails(tmp_path, "Permission denied")
+        finally:
+            tmp_path.chmod(0o755)
+        return
+    command = ["mount", "-t", "tmpfs", "-o", "ro,size=64k", "tmpfs", str(tmp_path)]
+    if subprocess.run(command, capture_output=True, check=False).returncode != 0:
+        pytest.skip("cannot mount a read-only tmpfs here")
     try:
-        write_fails(tmp_path, "Permission denied")
+        write_fails(tmp_path, "Read-only file system")
     finally:
-        tmp_path.chmod(0o755)
+        subprocess.run(["umount", str(tmp_path)], check=False)
 
 
 def test_a_folder_where_the_entry_should_be_is_left_alone(tmp_path):
