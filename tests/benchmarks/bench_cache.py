@@ -127,8 +127,10 @@ def main(argv=None) -> int:
                 f"{name:>14} {points:9.2e} {size / 1e6:9.3g} {compute:8.3f} {write:8.3f} "
                 f"{read:8.3f} {write / compute:14.2f} {read / compute:13.2f}"
             )
-    print(f"caching a closed-form map pays if write/compute <= {WRITE_LIMIT} and read/compute "
-          f"<= {READ_LIMIT}")  # fmt: skip
+    print(
+        f"caching a closed-form map pays if write/compute <= {WRITE_LIMIT} and read/compute "
+        f"<= {READ_LIMIT}"
+    )
     print("load average {:.1f} {:.1f} {:.1f} after".format(*os.getloadavg()))
     return 0
 

@@ -218,8 +218,8 @@ def test_metadata_checksum_sees_all_but_the_chunked_values():
         assert cache.metadata_checksum(other) != checksum
     values = dataset.ecof_ratio.values.copy()
     values.flat[0] = 2.0  # in a chunk: Fletcher-32's to check
-    assert cache.metadata_checksum(dataset.assign(ecof_ratio=(dataset.ecof_ratio.dims, values,
-                                   dataset.ecof_ratio.attrs))) == checksum  # fmt: skip
+    in_chunk = (dataset.ecof_ratio.dims, values, dataset.ecof_ratio.attrs)
+    assert cache.metadata_checksum(dataset.assign(ecof_ratio=in_chunk)) == checksum
 
 
 def test_chunks_take_whole_trailing_dimensions_within_the_bound(monkeypatch):
@@ -345,11 +345,12 @@ def test_a_full_tmpfs_is_one_warning_and_the_command_writes_its_output(tmp_path)
         out = tmp_path / "m.nc"
         argv = ["--stiffness-ratio", "1e4:3e5:40", "--aspect-ratio", "0:0.4:40"]
         argv += ["--amplitude", "25um,50um", "--mu", "0.8", "--out", str(out)]
-        command = [sys.executable, "-c", "from ecofmaps.cli.main import console; console()"]
-        done = subprocess.run(
-            [*command, "map", *argv], env=environment, capture_output=True, text=True,
-            timeout=600, check=False,
-        )  # fmt: skip
+
+        def python(*arguments):
+            run = [sys.executable, *arguments]
+            return subprocess.run(run, env=environment, capture_output=True, text=True, timeout=600)
+
+        done = python("-c", "from ecofmaps.cli.main import console; console()", "map", *argv)
         assert done.returncode == 0, done.stderr
         assert done.stderr.count("\n") == 1 and done.stderr.startswith("ecofmaps map: ")
         with xr.open_dataset(out, engine="h5netcdf") as written:
@@ -360,10 +361,7 @@ def test_a_full_tmpfs_is_one_warning_and_the_command_writes_its_output(tmp_path)
         if importlib.util.find_spec("panel"):
             scripts.append("from ecofmaps.web.explorer import warm_up; warm_up(); print('started')")
         for script in scripts:  # the write fails: one line, the work goes on
-            done = subprocess.run(
-                [sys.executable, "-c", script], env=environment, capture_output=True, text=True,
-                timeout=600, check=False,
-            )  # fmt: skip
+            done = python("-c", script)
             assert done.returncode == 0 and done.stdout in ("computed\n", "started\n"), done.stderr
             assert done.stderr.count("\n") == 1 and "CacheWarning: could not write" in done.stderr
             assert "No space left on device" in done.stderr
@@ -401,9 +399,16 @@ def test_the_least_recently_used_entries_go_first(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize(
     ("text", "size"),
-    [("", 10**9), ("0", 0), ("12345", 12345), ("500MB", 5 * 10**8), ("1.5 GB", 1.5e9),
-     ("2GiB", 2**31), ("64kB", 64000)],
-)  # fmt: skip
+    [
+        ("", 10**9),
+        ("0", 0),
+        ("12345", 12345),
+        ("500MB", 5 * 10**8),
+        ("1.5 GB", 1.5e9),
+        ("2GiB", 2**31),
+        ("64kB", 64000),
+    ],
+)
 def test_the_size_bound_is_read_from_the_environment(monkeypatch, text, size):
     monkeypatch.setenv(cache.SIZE_VARIABLE, text)
     assert cache.cache_size_bound() == size
