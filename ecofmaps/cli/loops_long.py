@@ -39,9 +39,14 @@ from ecofmaps._interrupts import INTERRUPTED, Interrupted, add_stop_note
 from ecofmaps._parallel import Runner
 from ecofmaps.cli._common import CommandError
 from ecofmaps.io.tables import results_csv
-from ecofmaps.measured.cycles import Cycles
-from ecofmaps.measured.options import MissingSampleError, default_options
-from ecofmaps.measured.pipeline import IN_PROCESS, Analysis, force_at_mean_load, only
+from ecofmaps.measured.cycles import Cycles, MissingSampleError
+from ecofmaps.measured.pipeline import (
+    IN_PROCESS,
+    Analysis,
+    default_options,
+    force_at_mean_load,
+    only,
+)
 
 __all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun", "keep_block", "skipped"]
 

@@ -3,11 +3,11 @@ r"""Measured fretting loops, cycle by cycle: ECoF, GICoF, rig stiffness and the 
 :func:`analyze_loops` reads a recording of the actuator displacement :math:`\Delta` and the
 tangential force :math:`Q` (many cycles, or a single loop), cuts it into cycles and
 removes the offsets and a slow drift (:mod:`ecofmaps.measured.cycles`), and measures each loop.
-The work is vectorised over a block of cycles at a time (:mod:`ecofmaps.measured.centring`),
+The work is vectorised over a block of cycles at a time (:mod:`ecofmaps.measured.measure`),
 with no Python loop over samples or cycles, and its memory does not grow with the recording
 beyond the per-cycle results: each branch of each loop (from one reversal to the next) is a
 padded row, so that every per-branch step runs once over both branches of every cycle
-(:mod:`ecofmaps.measured.branches`).
+(:mod:`ecofmaps.measured.measure`).
 
 The quantities, per cycle
 -------------------------
@@ -85,16 +85,17 @@ import xarray as xr
 
 from ecofmaps._inputs import si_units
 from ecofmaps._parallel import Runner, check_workers
-from ecofmaps.measured.cycles import MIN_SAMPLES
-from ecofmaps.measured.options import (
+from ecofmaps.measured.cycles import MIN_SAMPLES, missing_sample_error
+from ecofmaps.measured.measure import GROSS_SLIP_THRESHOLD
+from ecofmaps.measured.pipeline import (
     DEFAULTS,
     NAN_POLICIES,
+    Analysis,
+    Reading,
     check_options,
-    missing_sample_error,
+    force_at_mean_load,
 )
-from ecofmaps.measured.per_cycle import GROSS_SLIP_THRESHOLD
-from ecofmaps.measured.pipeline import Analysis, Reading, force_at_mean_load
-from ecofmaps.measured.resolved import check_reading_options
+from ecofmaps.measured.resolve import check_reading_options
 from ecofmaps.measured.samples import is_lazy
 
 __all__ = ["analyze_loops", "resolve_loops"]
@@ -236,7 +237,7 @@ def analyze_loops(
     Notes
     -----
     The methods are in the documentation of :mod:`ecofmaps.measured.analysis`,
-    :mod:`ecofmaps.measured.cycles` and :mod:`ecofmaps.measured.centring`; the checks in
+    :mod:`ecofmaps.measured.cycles` and :mod:`ecofmaps.measured.measure`; the checks in
     :mod:`ecofmaps.measured.quality`. The ECoF is eq. 1; the GICoF is the paper's Section 5
     (eq. 17-18), and equals :math:`\mu` for the model's loop whatever the groove.
 
@@ -442,7 +443,7 @@ def resolve_loops(
     Notes
     -----
     The method and the quality flags are in the documentation of
-    :mod:`ecofmaps.measured.resolved`. It rests on eq. 9 (the slip traction at any local
+    :mod:`ecofmaps.measured.resolve`. It rests on eq. 9 (the slip traction at any local
     groove slope) and eq. 10 (the contact position); the GICoF (eq. 17-18) is its value at
     :math:`\xi = 0`, and eq. 7 with :math:`x_o = \Delta^*` gives the equivalent
     parabolic groove.

@@ -7,14 +7,14 @@ each sample instead; :func:`find_cycles` chooses between the two, for
 :class:`Cycles`: for every complete cycle, the stretch of samples it covers (first sample
 and count) and where in the stretch its loop begins, at its lowest displacement. A loop
 runs once round from there and back to it (the last point closes the loop).
-:mod:`ecofmaps.measured.centring` moves the loops to their centres.
+:mod:`ecofmaps.measured.measure` moves the loops to their centres.
 
 No Python loop runs over samples or over cycles, and nothing the size of the recording is
 held beyond the recording itself: the passes over it (the detrending, its percentiles, the
 Schmitt trigger, the extremes of each run) go a chunk of ``_CHUNK`` samples at a time. A
 long recording held as dask arrays (:mod:`ecofmaps.measured.samples`) goes through the same
 passes a block of chunks at a time, each block where its task runs, and each pass returns
-what it found per chunk (sums, the ends and extremes of runs; :mod:`ecofmaps.measured.passes`),
+what it found per chunk (sums, the ends and extremes of runs; :mod:`ecofmaps.measured.samples`),
 which are joined here in order: the cycles are the same, sample for sample, however the
 recording is held.
 
@@ -68,8 +68,9 @@ import dataclasses
 
 import numpy as np
 
-from ecofmaps.measured import passes
-from ecofmaps.measured.passes import (
+from ecofmaps.measured import samples as passes
+from ecofmaps.measured.samples import (
+    Samples,
     displacement_line,
     displacement_percentiles,
     ends_of_runs,
@@ -79,7 +80,6 @@ from ecofmaps.measured.passes import (
     survey,
     trigger_runs,
 )
-from ecofmaps.measured.samples import Samples
 
 __all__ = ["MIN_SAMPLES", "Cycles", "find_cycles", "labelled_cycles", "split_cycles"]
 
@@ -738,3 +738,28 @@ def find_cycles(
     if cycle is None:
         return _split(samples, hysteresis, 0.01)
     return _labelled(samples, 0.01)
+
+
+class MissingSampleError(ValueError):
+    """A missing sample where ``nan_policy='raise'``: ``sample`` is its 0-based index."""
+
+    def __init__(self, sample: int, message: str):
+        self.sample = int(sample)
+        super().__init__(message)
+
+
+def missing_sample_error(sample: int) -> MissingSampleError:
+    """The error for the missing sample ``sample`` (0-based) with ``nan_policy='raise'``."""
+    return MissingSampleError(
+        sample,
+        f"sample {sample} is missing (NaN or empty); nan_policy='skip' analyses the cycles "
+        "without missing samples and reports the others as skipped",
+    )
+
+
+def no_cycle_error(samples: int) -> ValueError:
+    """The error for a recording of ``samples`` samples without a complete cycle."""
+    return ValueError(
+        f"too few samples for one cycle: no complete cycle in {samples} samples "
+        "(the loop does not close, or the recording does not oscillate)"
+    )

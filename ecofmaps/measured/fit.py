@@ -19,7 +19,7 @@ import numpy as np
 
 from ecofmaps._inputs import check, float64
 from ecofmaps.measured.cycles import MIN_SAMPLES, find_cycles
-from ecofmaps.measured.per_cycle import measure_cycles
+from ecofmaps.measured.measure import measure_cycles
 from ecofmaps.measured.quality import ALL, ANTICLOCKWISE_SHARE, REASONS, SEPARATOR
 from ecofmaps.model.core import slip_position, traction_ratio
 from ecofmaps.model.simulation import fretting_loop

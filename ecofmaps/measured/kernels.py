@@ -1,14 +1,14 @@
 r"""Compiled kernels for the steps of :func:`ecofmaps.analyze_loops` along each loop.
 
 Each kernel loops over the loops of a block, or over their branch rows, and does in one or a
-few passes what the methods of :mod:`ecofmaps.measured.branches` and
-:mod:`ecofmaps.measured.centring` describe: the sums of a least-squares line, the growth of a
+few passes what the methods of :mod:`ecofmaps.measured.measure` and
+:mod:`ecofmaps.measured.measure` describe: the sums of a least-squares line, the growth of a
 stick segment, the curvature test, the search for a crossing, a loop's centre, extremes and
 area, the drift between the centres, the noise of the centres
 (:func:`second_difference_medians`). One more, :func:`detrended`, serves the search for
-cycles (:mod:`ecofmaps.measured.passes`).
+cycles (:mod:`ecofmaps.measured.samples`).
 
-Branch rows (:func:`ecofmaps.measured.branches.branch_rows`): the rows of a block are the
+Branch rows (:func:`ecofmaps.measured.measure.branch_rows`): the rows of a block are the
 rising branches of its cycles, then their falling branches (row ``c`` and row
 ``c + cycles`` belong to cycle ``c``); row ``r`` holds ``length[r]`` points, padded to the
 block's width by repeating its last point. The values are finite (a cycle with a missing
@@ -193,7 +193,7 @@ def _curved(x, y, end, segment, intercept, compliance, line):
 def stick_lines(x, y, length, span, low, high):
     r"""Lines :math:`\Delta = c + Q/S` through the stick segments of each cycle's rows.
 
-    The method of :func:`ecofmaps.measured.branches.stick_lines`: first segments, a first
+    The method of :func:`ecofmaps.measured.measure.stick_lines`: first segments, a first
     line of common slope, each segment grown until two samples in a row lie more than
     three standard deviations off it, the line fitted again, its fit and curvature.
 
@@ -221,7 +221,7 @@ def stick_lines(x, y, length, span, low, high):
     unexplained : numpy.ndarray, shape (cycles,)
         Share of the displacement's variance along the segments left by the lines. [-]
     curved : numpy.ndarray of bool, shape (cycles,)
-        A segment bends (:func:`ecofmaps.measured.branches.stick_lines`).
+        A segment bends (:func:`ecofmaps.measured.measure.stick_lines`).
     """
     rows, width = x.shape
     cycles = rows // 2
@@ -283,7 +283,7 @@ def _sample_pair(length, count, width):
 def zero_force_crossings(x, y, length, band, intercept, across, rounding):
     r"""Displacement where each branch row crosses :math:`Q = 0`, and whether on the loop.
 
-    The method of :func:`ecofmaps.measured.branches.zero_force_crossings`.
+    The method of :func:`ecofmaps.measured.measure.zero_force_crossings`.
 
     Parameters
     ----------
@@ -399,7 +399,7 @@ def _window_holds(force, y, before, window, begin, end, pair, with_pair, roundin
 def line_crossings(x, y, length, compliance, half_width, load, rounding):
     r"""Force where each branch row crosses :math:`Q = S\Delta`, and whether on the loop.
 
-    The method of :func:`ecofmaps.measured.branches.line_crossings`.
+    The method of :func:`ecofmaps.measured.measure.line_crossings`.
 
     Parameters
     ----------
@@ -616,7 +616,7 @@ def loop_measures(x, y, offset, count, rotation):
         Displacement and force of a block's samples. [m], [N]
     offset, count, rotation : numpy.ndarray of int64, shape (loops,)
         Each loop's stretch of the samples and where the loop begins in it
-        (:class:`ecofmaps.measured.centring.LoopBlock`).
+        (:class:`ecofmaps.measured.measure.LoopBlock`).
 
     Returns
     -------
@@ -678,7 +678,7 @@ def detrended(x, first, mean, mean_t, slope, middle):
     first : int
         Index of the first sample.
     mean, mean_t, slope, middle : float
-        The line (:func:`ecofmaps.measured.passes.displacement_line`): the mean
+        The line (:func:`ecofmaps.measured.samples.displacement_line`): the mean
         displacement [m], the mean of ``t`` [-], the slope [m] and the middle sample [-].
 
     Returns

@@ -13,13 +13,13 @@ shares, so that a fix lands once:
    each, so no cycle is cut at a chunk's edge. Each chunk reads the stretch of its cycles
    and of five whole cycles on either side (a *halo*: the centring interpolates each
    cycle's centre from its neighbours', and takes the noise of the centres from four
-   neighbours on either side, :mod:`ecofmaps.measured.centring`).
-3. **per-cycle values**: :func:`ecofmaps.measured.per_cycle.measure_cycles`, with the
+   neighbours on either side, :mod:`ecofmaps.measured.measure`).
+3. **per-cycle values**: :func:`ecofmaps.measured.measure.measure_cycles`, with the
    sample indices of the whole recording;
-4. **along the stroke** (``resolve``): :func:`ecofmaps.measured.resolved.resolve_analyzed_loops`
+4. **along the stroke** (``resolve``): :func:`ecofmaps.measured.resolve.resolve_analyzed_loops`
    on the chunk's own loops, which never leave it;
-5. **quality and table**: :func:`ecofmaps.measured.results.cycle_results` and a
-   :class:`~ecofmaps.measured.results.Tally` of them, made where the chunk ran;
+5. **quality and table**: :func:`ecofmaps.measured.quality.cycle_results` and a
+   :class:`~ecofmaps.measured.quality.Tally` of them, made where the chunk ran;
    :meth:`Analysis.finish` checks the whole recording (every cycle refused, units,
    scale) and gives the joined results their attributes.
 
@@ -41,22 +41,34 @@ import itertools
 import numpy as np
 import xarray as xr
 
+from ecofmaps._inputs import check
 from ecofmaps._parallel import stretch
-from ecofmaps.measured.centring import NEIGHBOURS
-from ecofmaps.measured.cycles import Cycles, find_cycles
-from ecofmaps.measured.options import missing_sample_error, no_cycle_error
-from ecofmaps.measured.per_cycle import measure_cycles
-from ecofmaps.measured.quality import ALL, REASONS, SEPARATOR, quality_summary
-from ecofmaps.measured.resolved import REPORTED, resolve_analyzed_loops, resolved_attrs
-from ecofmaps.measured.results import Tally, at_own_load, cycle_results, strip, with_loops
+from ecofmaps.measured.cycles import Cycles, find_cycles, missing_sample_error, no_cycle_error
+from ecofmaps.measured.measure import GROSS_SLIP_THRESHOLD, NEIGHBOURS, measure_cycles
+from ecofmaps.measured.quality import (
+    ALL,
+    REASONS,
+    SEPARATOR,
+    Tally,
+    at_own_load,
+    cycle_results,
+    quality_summary,
+    strip,
+    with_loops,
+)
+from ecofmaps.measured.resolve import REPORTED, resolve_analyzed_loops, resolved_attrs
 
 __all__ = [
+    "DEFAULTS",
     "HALO",
     "IN_PROCESS",
+    "NAN_POLICIES",
     "TASK_SAMPLES",
     "Analysis",
     "Chunk",
     "Reading",
+    "check_options",
+    "default_options",
     "force_at_mean_load",
     "only",
 ]
@@ -95,12 +107,12 @@ class Reading:
     Attributes
     ----------
     resolve : bool
-        Read each loop along the stroke (:func:`~ecofmaps.measured.resolved.resolve_analyzed_loops`)
-        and report :data:`~ecofmaps.measured.resolved.REPORTED` with its quality.
+        Read each loop along the stroke (:func:`~ecofmaps.measured.resolve.resolve_analyzed_loops`)
+        and report :data:`~ecofmaps.measured.resolve.REPORTED` with its quality.
     keep_loops : bool
         Keep the centred loops in the results (``loop_displacement``, ``loop_force``).
     along_stroke : dict, optional
-        Keyword arguments of :func:`~ecofmaps.measured.resolved.resolve_analyzed_loops`
+        Keyword arguments of :func:`~ecofmaps.measured.resolve.resolve_analyzed_loops`
         (default: the per-cycle values alone, ``positions=None``). A grid of ``positions``
         given by its number of points is spread over the widest resolved range of all
         cycles: it needs the recording in one chunk.
@@ -216,7 +228,7 @@ def measure_chunk(
     load : float
         Normal load. [N]
     options : dict
-        From :func:`ecofmaps.measured.options.check_options`.
+        From :func:`ecofmaps.measured.pipeline.check_options`.
     x, q : numpy.ndarray
         The stretch's displacement [m] and force [N].
     reading : Reading
@@ -225,7 +237,7 @@ def measure_chunk(
         Called with the chunk's results where it runs (the command line formats its table
         rows so); its value is :attr:`Chunk.made`.
     keep : bool or callable
-        True: hand back what :func:`~ecofmaps.measured.per_cycle.measure_cycles` measured
+        True: hand back what :func:`~ecofmaps.measured.measure.measure_cycles` measured
         (with the reading along the stroke named with the prefix :data:`READ`), for a
         store of finished chunks; a callable ``keep(values, flags)`` is given them here
         instead, so that they do not travel.
@@ -234,7 +246,7 @@ def measure_chunk(
     recorded_load : numpy.ndarray, optional
         The stretch's normal load, when it was recorded sample by sample (``q`` is then the
         force at the mean load ``load``): forces, energy and stiffness are reported at each
-        cycle's own load (:data:`~ecofmaps.measured.results.AT_OWN_LOAD`). [N]
+        cycle's own load (:data:`~ecofmaps.measured.quality.AT_OWN_LOAD`). [N]
 
     Returns
     -------
@@ -280,7 +292,7 @@ def only(part: xr.Dataset, columns=None) -> xr.Dataset:
 
 def _part(counted: xr.Dataset, values: dict, loops=None) -> xr.Dataset:
     """The results of a chunk: ``counted`` (from
-    :func:`~ecofmaps.measured.results.cycle_results`) without its riders, with the reading
+    :func:`~ecofmaps.measured.quality.cycle_results`) without its riders, with the reading
     along the stroke in ``values`` (named with the prefix :data:`READ`) where it was read,
     and the centred ``loops`` if given; with a recorded load, at each cycle's own load."""
     part = strip(counted)
@@ -342,14 +354,14 @@ class Analysis:
     one_chunk : bool
         Analyse the recording as one chunk (a recording in memory).
     **options
-        The checked options of :func:`ecofmaps.measured.options.check_options`.
+        The checked options of :func:`ecofmaps.measured.pipeline.check_options`.
 
     Attributes
     ----------
     cycles : Cycles
     tasks : list of slice
         The rows (cycles) of each chunk, in order.
-    tally : ecofmaps.measured.results.Tally
+    tally : ecofmaps.measured.quality.Tally
         What the chunks handed back so far add up to.
 
     Raises
@@ -492,7 +504,7 @@ class Analysis:
 
     def finish(self, parts) -> xr.Dataset:
         """The parts (all of them, in order) joined, with the recording's attributes, after
-        the checks of the whole recording (see :meth:`ecofmaps.measured.results.Tally.finish`).
+        the checks of the whole recording (see :meth:`ecofmaps.measured.quality.Tally.finish`).
 
         The parts share their variables and the load: they are joined along ``cycle``
         without comparing the rest (six times faster than comparing it, which copied every
@@ -529,3 +541,55 @@ def _tasks(count, samples: int) -> list[slice]:
     targets = np.arange(samples, int(ends[-1]), samples)
     bounds = np.unique(np.concatenate([[0], np.searchsorted(ends, targets), [count.size]]))
     return [slice(int(a), int(b)) for a, b in itertools.pairwise(bounds)]
+
+
+#: What the analysis does with missing samples: skip their cycles, or raise.
+NAN_POLICIES = ("skip", "raise")
+
+#: The defaults of :func:`ecofmaps.analyze_loops`' options (see there for their meaning).
+DEFAULTS = {
+    "hysteresis": 0.5,
+    "stick_window": (0.05, 0.45),
+    "crossing_window": 0.7,
+    "gross_slip_threshold": GROSS_SLIP_THRESHOLD,
+}
+
+
+def check_options(
+    load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
+) -> dict:
+    """The options of :func:`ecofmaps.analyze_loops`, checked (a ValueError naming the one
+    that is not valid), as keyword arguments of
+    :func:`ecofmaps.measured.measure.measure_cycles`."""
+    check("load", load, "positive", "N")
+    if np.ndim(load) != 0:
+        raise ValueError("load must be a single value [N]")
+    if not 0.0 < hysteresis < 1.0:
+        raise ValueError(f"hysteresis must satisfy 0 < hysteresis < 1; got {hysteresis!r}")
+    low, high = (float(share) for share in stick_window)
+    if not 0.0 <= low < high <= 1.0:
+        raise ValueError(f"stick_window must satisfy 0 <= low < high <= 1; got {stick_window!r}")
+    if not crossing_window > 0.0:
+        raise ValueError(
+            f"crossing_window must satisfy crossing_window > 0; got {crossing_window!r}"
+        )
+    if not 0.0 < gross_slip_threshold < 1.0:
+        raise ValueError(
+            "gross_slip_threshold must satisfy 0 < gross_slip_threshold < 1; "
+            f"got {gross_slip_threshold!r}"
+        )
+    if not isinstance(flip_force, bool | np.bool_):
+        raise ValueError(f"flip_force must be True or False; got {flip_force!r}")
+    return {
+        "hysteresis": float(hysteresis),
+        "stick_window": (low, high),
+        "crossing_window": float(crossing_window),
+        "gross_slip_threshold": float(gross_slip_threshold),
+        "flip_force": bool(flip_force),
+    }
+
+
+def default_options(load, flip_force=False) -> dict:
+    """:func:`check_options` with the :data:`DEFAULTS` for the others (what the command
+    line and a long analysis use)."""
+    return check_options(load, **DEFAULTS, flip_force=flip_force)

@@ -1,48 +1,338 @@
-r"""Plausibility of measured loops: the ``quality`` of each cycle and what it leaves NaN.
+r"""The per-cycle results of :func:`~ecofmaps.measured.analysis.analyze_loops` as a Dataset.
 
-:func:`ecofmaps.analyze_loops` checks every cycle before it reports a number (issue 9): a
-loop must run clockwise in the :math:`(\Delta, Q)` plane (force positive in the direction
-of positive displacement), have a positive area no larger than its bounding box
-(:math:`0 \le A \le 1`), a slip amplitude :math:`0 < \delta^* \le \Delta^*`, straight stick
-sides of positive slope :math:`S > 0` after its reversals, a force that varies, and its
-crossings (at :math:`Q = 0` and with :math:`Q = S\Delta`) on the measured loop: between
-measured samples of their branch and within the measured range (issue 11; so
-:math:`\delta^* \le \Delta^*` needs no check of its own). A value that cannot be stood
-behind is NaN, and the cycle's ``quality`` says why.
-
-The vocabulary
---------------
-``quality`` is ``'ok'``, or the reasons of :data:`REASONS` that apply, in the order of
-that table, joined by ``'+'`` (``'negative-slip+curved-stick'``): the reasons hold only
-lower-case letters, digits and hyphens, so ``quality.split('+')`` gives them back and the
-column needs no quoting in a CSV file. Each reason names the quantities it leaves NaN
-(its *scope*). A reason whose scope is every quantity (:data:`ALL`) refuses the cycle: it
-is not a loop that can be read as recorded, and its ``regime`` is ``INVALID``. The others
-leave the rest of the cycle's numbers standing; ``'not-gross-slip'`` is the partial-slip
-regime, where the ECoF and the GICoF are not defined. The last four reasons come from the
-reading along the stroke (:func:`ecofmaps.resolve_loops`, or ``analyze_loops(...,
-resolve=True)``), which adds them with :func:`add_reason` and leaves only its own values NaN.
+:func:`cycle_results` turns the measurements of
+:func:`ecofmaps.measured.measure.measure_cycles` into the labelled per-cycle Dataset (NaN
+with a reason in ``quality`` where a check fails, the regime codes), and :class:`Tally`
+gathers what is said about a whole recording from its parts as they come (the quality
+summary, the refusal of every cycle with a hint, the check of the amplitude's unit), so a
+recording analysed in chunks (:mod:`ecofmaps.measured.pipeline`) gives the same result.
 """
 
 from __future__ import annotations
 
+import collections
+
 import numpy as np
+import xarray as xr
+
+from ecofmaps import _nomenclature as nomenclature
+from ecofmaps._codes import warn
+from ecofmaps.measured.cycles import Cycles
+from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP, Regime
 
 __all__ = [
     "ALL",
     "ANTICLOCKWISE_SHARE",
+    "AT_OWN_LOAD",
     "REASONS",
     "RESOLVED",
     "SEPARATOR",
+    "ImplausibleScaleError",
+    "ImplausibleScaleWarning",
     "LoopQualityWarning",
+    "Tally",
     "add_reason",
     "apply_quality",
+    "at_own_load",
+    "cycle_results",
     "has_reason",
     "quality_strings",
     "quality_summary",
     "refused",
+    "strip",
     "summary_of_counts",
+    "with_loops",
 ]
+
+
+#: How the quantities are measured on a loop (the netCDF ``comment`` attribute).
+_COMMENTS = {
+    "slip_amplitude": "half the loop's width at Q = 0",
+    "dissipated_energy": "the loop's area",
+    "stiffness": "slope of the stick segments",
+    "regime": "GROSS_SLIP when the energy ratio exceeds gross_slip_threshold, else NO_GROSS_SLIP "
+    "(partial slip); INVALID where the cycle is refused",
+    "quality": "'ok' or the reasons for NaN, joined by '+' (ecofmaps.measured.quality)",
+}
+
+
+#: Plausible displacement amplitudes: outside, the unit is wrong (``implausible-amplitude``). [m]
+AMPLITUDE_RANGE = (0.5e-6, 50e-3)
+
+#: Plausible coefficients of friction: outside, the load or the force's unit is wrong
+#: (``implausible-cof``). [1]
+COF_RANGE = (0.01, 3.0)
+
+#: Displacement amplitudes above this are reciprocating sliding rather than fretting (still
+#: analysed the same way; the results' ``motion`` attribute says so). [m]
+FRETTING_AMPLITUDE = 300e-6
+
+
+def _attrs(name: str) -> dict:
+    attrs = nomenclature.attrs(name)
+    if name in _COMMENTS:
+        attrs["comment"] = _COMMENTS[name]
+    return attrs
+
+
+def _refusal_hint(flags: dict) -> str:
+    """What the user may do about a recording whose every cycle is refused (``flags``:
+    whether every cycle, or any for ``negative-stiffness``, carries the reason)."""
+    if flags["missing-samples"]:
+        return "Every cycle holds a missing sample (NaN or an empty cell)."
+    if flags["anticlockwise"]:
+        if flags["negative-stiffness"]:
+            return (
+                "The loops run anticlockwise with stick sides sloping down: the force is "
+                "recorded positive against the displacement. If so, read it with the other "
+                "sign: flip_force=True (on the command line, --flip-force)."
+            )
+        return (
+            "The loops run anticlockwise with stick sides sloping up: the recording runs "
+            "backwards in time, or the displacement and force columns are swapped."
+        )
+    if flags["constant-force"]:
+        return "The force does not vary: is the force channel connected?"
+    if flags["implausible-amplitude"]:
+        return (
+            "The displacement amplitude is outside 0.5 µm to 50 mm: the displacement is not "
+            "in the unit assumed. analyze_loops takes metres; on the command line, "
+            "--displacement-unit gives the column's unit (a column without a unit in its "
+            "name or the file is read in µm)."
+        )
+    return (
+        "Is it a recording of fretting loops, with the displacement and the force in their "
+        "own columns?"
+    )
+
+
+#: The values that scale with the normal load (forces, energy, the rig's stiffness), of the
+#: per-cycle results, their loops and the reading along the stroke. The analysis reads the
+#: force of a recorded load as at the mean load (``force_at_mean_load`` of
+#: :mod:`ecofmaps.measured.pipeline`), so that each coefficient is read with the load of its
+#: own samples; these values are then reported at each cycle's own load, the mean of its
+#: samples (``normal_load``).
+AT_OWN_LOAD = (
+    "max_force",
+    "dissipated_energy",
+    "stiffness",
+    "force_offset",
+    "force_drift_se",
+    "loop_force",
+    "force_forward",
+    "force_backward",
+)
+
+
+def at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
+    """``dataset`` with its variables of :data:`AT_OWN_LOAD` times ``ratio``, each cycle's
+    load over the mean load (over ``cycle``; attributes kept)."""
+    ratio = np.asarray(ratio, dtype=np.float64)
+    scaled = {}
+    for name in AT_OWN_LOAD:
+        if name in dataset:
+            values = dataset[name].values
+            scaled[name] = dataset[name].copy(
+                data=values * ratio.reshape((-1,) + (1,) * (values.ndim - 1))
+            )
+    return dataset.assign(scaled)
+
+
+def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
+    """``results`` with the centred loops of :func:`measure_cycles` (``keep_loops=True``)."""
+    results["loop_displacement"] = (("cycle", "point"), loops[0], _attrs("loop_displacement"))
+    results["loop_force"] = (("cycle", "point"), loops[1], _attrs("loop_force"))
+    results.coords["point"] = ("point", np.arange(loops[0].shape[1]), _attrs("point"))
+    return results
+
+
+def scale_flags(values: dict, options: dict) -> dict:
+    """The checks of scale of each cycle (reason -> per cycle): an amplitude outside
+    :data:`AMPLITUDE_RANGE`, or a coefficient of friction outside :data:`COF_RANGE` (the
+    ECoF or the GICoF of a gross-slip loop; not :math:`Q^*/P`, which a deep groove raises
+    above 3 with any load). A gross-slip CoF of 361 or 0.001 says that the load or a unit is
+    wrong, not the contact."""
+    amplitude = values["amplitude"]
+    sliding = values["energy_ratio"] > options["gross_slip_threshold"]
+
+    def outside(value, bounds):
+        return np.isfinite(value) & ((value < bounds[0]) | (value > bounds[1]))
+
+    scaled = outside(amplitude, AMPLITUDE_RANGE)
+    cof = sliding & (outside(values["ecof"], COF_RANGE) | outside(values["gicof"], COF_RANGE))
+    return {"implausible-amplitude": scaled, "implausible-cof": cof & ~scaled}
+
+
+def cycle_results(values: dict, flags: dict, label, load: float, options: dict) -> xr.Dataset:
+    """The per-cycle Dataset of :func:`analyze_loops` for some cycles, without the
+    recording's attributes: ``values`` and ``flags`` from :func:`measure_cycles`.
+
+    The raw amplitudes and whether each cycle is refused ride along as ``_amplitude`` and
+    ``_refused`` until :meth:`Tally.finish` takes them off.
+    """
+    size = label.size
+    flags = flags | scale_flags(values, options)
+    quality = quality_strings(flags, size)
+    refused = np.zeros(size, dtype=bool)
+    for reason, flag in flags.items():
+        refused |= flag & (REASONS[reason][1] == ALL)
+    raw_amplitude = values["amplitude"]
+    recorded = {k: values[k] for k in ("normal_load",) if k in values}  # a refused cycle's too
+    values = apply_quality({k: v for k, v in values.items() if k not in recorded}, flags)
+    sliding = values["energy_ratio"] > options["gross_slip_threshold"]
+    regime = np.where(refused, INVALID, np.where(sliding, GROSS_SLIP, NO_GROSS_SLIP))
+    names = [name for name in values if name != "stick_residual"]
+    data = {name: ("cycle", values[name], _attrs(name)) for name in names}
+    data["regime"] = ("cycle", regime.astype(np.int32), _attrs("regime") | Regime.flag_attrs())
+    data["stick_residual"] = ("cycle", values["stick_residual"], _attrs("stick_residual"))
+    for name, value in recorded.items():
+        data[name] = ("cycle", value, _attrs(name))
+    data["quality"] = ("cycle", quality, _attrs("quality"))
+    data["_amplitude"] = ("cycle", raw_amplitude)
+    data["_implausible-cof"] = ("cycle", flags["implausible-cof"])
+    data["_refused"] = ("cycle", refused)
+    hints = {
+        "missing-samples": flags["missing-samples"],
+        "anticlockwise": flags["anticlockwise"],
+        "constant-force": flags["constant-force"],
+        "implausible-amplitude": flags["implausible-amplitude"],
+    }
+    for reason, flag in hints.items():
+        data[f"_{reason}"] = ("cycle", flag)
+    data["_negative-stiffness"] = ("cycle", flags["negative-stiffness"])
+    coords = {"cycle": ("cycle", label, _attrs("cycle")), "load": ((), load, _attrs("load"))}
+    return xr.Dataset(data, coords=coords)
+
+
+class Tally:
+    """What :func:`analyze_loops` says about a whole recording, gathered from its parts
+    (:func:`cycle_results`) as they come: the quality summary, whether every cycle was
+    refused, and the typical amplitude."""
+
+    def __init__(self):
+        self.counts = collections.Counter()  # cycles by quality
+        self.cycles = self.refused = self.flagged = 0
+        self.every = {
+            "missing-samples": True,
+            "anticlockwise": True,
+            "constant-force": True,
+            "implausible-amplitude": True,
+        }
+        self.implausible_cof = 0
+        self.negative_stiffness = False
+        self.amplitudes: list = []
+
+    def add(self, part: xr.Dataset) -> xr.Dataset:
+        """Count the cycles of ``part``; return it without its riders."""
+        counted = collections.Counter(part.quality.values.tolist())
+        self.counts.update(counted)
+        self.flagged += sum(
+            n for text, n in counted.items() if text not in ("ok", "not-gross-slip")
+        )
+        self.cycles += part.cycle.size
+        self.refused += int(part["_refused"].sum())
+        for reason in self.every:
+            self.every[reason] &= bool(part[f"_{reason}"].all())
+        self.negative_stiffness |= bool(part["_negative-stiffness"].any())
+        self.amplitudes.append(part["_amplitude"].values)
+        self.implausible_cof += int(part["_implausible-cof"].sum())
+        return strip(part)
+
+    def merge(self, other: Tally) -> None:
+        """Count the parts ``other`` counted (in another process, say) as well."""
+        self.counts.update(other.counts)
+        self.cycles += other.cycles
+        self.refused += other.refused
+        self.flagged += other.flagged
+        for reason in self.every:
+            self.every[reason] &= other.every[reason]
+        self.negative_stiffness |= other.negative_stiffness
+        self.amplitudes += other.amplitudes
+        self.implausible_cof += other.implausible_cof
+
+    @property
+    def summary(self) -> str:
+        """The one-line quality summary so far."""
+        return summary_of_counts(self.counts)
+
+    def finish(self, results, cycles: Cycles, cycles_from: str, options: dict) -> xr.Dataset:
+        """Check the whole recording and give ``results`` (the parts, joined) its
+        attributes.
+
+        Raises
+        ------
+        ImplausibleScaleError
+            If every cycle was refused, some for an implausible amplitude.
+        ValueError
+            If every cycle was refused for other reasons.
+        """
+        summary = self.summary
+        typical = _typical(np.concatenate(self.amplitudes) if self.amplitudes else np.zeros(0))
+        texts = np.array(list(self.counts), dtype=str)
+        counts = np.array(list(self.counts.values()), dtype=np.int64)
+        scaled = int(counts[has_reason(texts, "implausible-amplitude")].sum())
+        if self.cycles and self.refused == self.cycles:
+            hint = dict(self.every, **{"negative-stiffness": self.negative_stiffness})
+            error = ImplausibleScaleError if scaled else ValueError
+            raise error(f"no plausible cycle in the recording ({summary}). {_refusal_hint(hint)}")
+        if scaled:
+            warn(
+                f"{scaled} cycles have an amplitude outside {AMPLITUDE_RANGE[0] * 1e6:g} µm to "
+                f"{AMPLITUDE_RANGE[1] * 1e3:g} mm: is the displacement in metres (on the "
+                "command line --displacement-unit; a column without a unit is read in µm)?",
+                ImplausibleScaleWarning,
+            )
+        if self.implausible_cof:
+            warn(
+                f"{self.implausible_cof} cycles have a coefficient of friction outside "
+                f"{COF_RANGE[0]:g} to {COF_RANGE[1]:g} with the load of "
+                f"{float(results['load']):g} N: "
+                "is the load right (load=, on the command line --load) and the force in "
+                "newtons (--force-unit; a column without a unit is read in N)?",
+                ImplausibleScaleWarning,
+            )
+        if self.flagged:
+            warn(f"cycles flagged: {summary}", LoopQualityWarning)
+        results = strip(results)
+        results.attrs.update(
+            {
+                "title": "Fretting loops analysed cycle by cycle (ecofmaps.analyze_loops)",
+                "cycles_from": cycles_from,
+                "incomplete_cycles": cycles.incomplete_cycles,
+                "dropped_samples": cycles.dropped_samples,
+                "missing_samples": cycles.missing_samples,
+                "first_missing_sample": cycles.first_missing,
+                "skipped_cycles": int(self.counts_of("missing-samples")),
+                "gross_slip_threshold": options["gross_slip_threshold"],
+                "flip_force": int(options["flip_force"]),
+                "quality_summary": summary,
+                "motion": _motion(typical),
+            }
+        )
+        return results
+
+    def counts_of(self, reason: str) -> int:
+        """Cycles whose quality lists ``reason``."""
+        return sum(c for text, c in self.counts.items() if reason in text.split("+"))
+
+
+def strip(part: xr.Dataset) -> xr.Dataset:
+    """``part`` without the riders of :func:`cycle_results`."""
+    return part.drop_vars([name for name in part.data_vars if str(name).startswith("_")])
+
+
+def _typical(amplitude) -> float:
+    """The median of the finite amplitudes (NaN if none). [m]"""
+    finite = amplitude[np.isfinite(amplitude)]
+    return float(np.median(finite)) if finite.size else np.nan
+
+
+def _motion(typical: float) -> str:
+    """``'fretting'``, or ``'reciprocating sliding'`` for a stroke beyond
+    :data:`FRETTING_AMPLITUDE` (analysed the same way)."""
+    if np.isfinite(typical) and typical > FRETTING_AMPLITUDE:
+        return "reciprocating sliding"
+    return "fretting"
 
 
 class LoopQualityWarning(UserWarning):
@@ -269,3 +559,19 @@ def summary_of_counts(counts) -> str:
     if skipped:
         summary += f", {skipped} skipped (missing samples)"
     return summary + (f"; {flagged}" if flagged else "")
+
+
+class ImplausibleScaleWarning(LoopQualityWarning):
+    """Cycles whose amplitude or coefficient of friction is outside what a unit or a load
+    makes plausible (``implausible-amplitude``, ``implausible-cof``): the load given or the
+    unit assumed for a channel is likely wrong.
+
+    A :class:`~ecofmaps.measured.quality.LoopQualityWarning`, so filtering that one filters
+    this one too; ``warnings.filterwarnings("error", category=ImplausibleScaleWarning)``
+    turns only the checks of scale into errors.
+    """
+
+
+class ImplausibleScaleError(ValueError):
+    """Every cycle refused, some for an amplitude outside what the displacement's unit makes
+    plausible (``implausible-amplitude``): the unit assumed is likely wrong."""

@@ -16,9 +16,11 @@ import pytest
 import xarray as xr
 
 import ecofmaps
-from ecofmaps.measured import cycles, passes, pipeline
+from ecofmaps.measured import cycles, pipeline
+from ecofmaps.measured import samples as passes
 from ecofmaps.measured.analysis import analyze_loops
-from ecofmaps.measured.options import MissingSampleError, default_options
+from ecofmaps.measured.cycles import MissingSampleError
+from ecofmaps.measured.pipeline import default_options
 from ecofmaps.measured.quality import LoopQualityWarning
 from ecofmaps.measured.synthetic import synthetic_recording
 from tests.measured.test_analysis import mindlin_recording
@@ -301,8 +303,8 @@ def test_every_cycle_missing_is_an_error():
 def test_tallies_of_parts_merge_into_the_tally_of_the_whole():
     """Tasks count their parts where they run (Tally.add) and the counts are merged: the
     same summary, refusals, checks and amplitudes as counting the whole at once."""
-    from ecofmaps.measured.per_cycle import measure_cycles
-    from ecofmaps.measured.results import Tally, cycle_results
+    from ecofmaps.measured.measure import measure_cycles
+    from ecofmaps.measured.quality import Tally, cycle_results
 
     x, q = noisy(EXAMPLE_2, 12, 3)
     x, q = with_gaps(x, q, [700, 1900])  # skipped cycles besides the flagged ones
@@ -403,7 +405,7 @@ def test_a_worker_reads_and_measures_without_jax_or_pint():
 
     code = (
         "import sys\n"
-        "import ecofmaps.io.binary, ecofmaps.measured.passes, ecofmaps.measured.pipeline\n"
+        "import ecofmaps.io.binary, ecofmaps.measured.samples, ecofmaps.measured.pipeline\n"
         "import ecofmaps.io.tables, ecofmaps.cli.loops_long\n"
         "loaded = [m for m in ('jax', 'pint') if m in sys.modules]\n"
         "loaded += [m for m in sys.modules if m.startswith('scipy.')\n"

@@ -1,0 +1,741 @@
+r"""Measured loops moved to their centres and laid out a block of cycles at a time.
+
+:func:`loop_blocks` hands :func:`ecofmaps.analyze_loops` the cycles of a recording
+(:class:`ecofmaps.measured.cycles.Cycles`) a block at a time, about ``_BLOCK`` samples, so
+that its memory does not grow with the recording: each block is the centred samples of its
+cycles, once, in time order, with where each cycle lies among them (:class:`LoopBlock`).
+Sums over each cycle's samples run in the compiled kernels of
+:mod:`ecofmaps.measured.kernels`, in the order of the samples.
+
+Offsets and drift
+-----------------
+Every loop is moved to its centre: the mean of :math:`\Delta` and of :math:`Q` along the
+loop weighted by the displacement travelled, :math:`\oint \Delta\,|d\Delta| / \oint
+|d\Delta|` (trapezoids). For a loop symmetric about a point (the model's steady loop, with
+or without ploughing peaks at both ends of the stroke) that point is the centre, and the
+mean averages the noise of every sample. For cycles cut from one continuous recording, the
+centres are interpolated linearly along the sample index from the middle of one cycle to
+the next and subtracted sample by sample, which also removes a slow drift of
+:math:`\Delta` (or of :math:`Q`) within each cycle; the weights of the force's centre come
+from the displacement so centred. Labelled cycles (possibly recorded far apart) are each
+moved by their own centre.
+
+The drift correction is only as good as the centres: noise on the displacement (through
+the weights) and on the force moves each centre, and a centre's error tilts the drift
+subtracted from its neighbours, which offsets a loop's falling branch against its rising
+one by :math:`\varepsilon = \sum_j a_j c_j` for the centres :math:`c_j` around it. For
+equally spaced cycles :math:`\varepsilon = (c_{i+1} - c_{i-1})/4` (the mean of the linear
+drift over each half of the cycle), and :math:`(c_{i+1} - c_i)/2` at the ends of the
+recording, where the drift is extrapolated. ``force_drift_se`` is the standard error of
+that offset, :math:`\sigma_c (\sum_j a_j^2)^{1/2}`, with the noise :math:`\sigma_c` of the
+centres from their second differences over :data:`_NOISE_REACH` cycles on either side,
+:math:`\operatorname{median}|c_{j-1} - 2c_j + c_{j+1}| / (0.6745\sqrt6)`, which a slow
+drift hardly enters (a real drift that bends from cycle to cycle counts as noise: the
+correction cannot follow it either). On a Coulomb slider recorded with 0.1 µm of
+displacement noise on a 50 µm amplitude the centres scatter by about 1.7 N, and the
+offset is the largest error of :func:`ecofmaps.resolve_loops`'s ``mu_resolved``; its
+standard error counts it (:mod:`ecofmaps.measured.resolve`). Labelled cycles, each moved
+by its own centre, have no such offset (zero).
+
+Cycles that hold a missing sample (:attr:`ecofmaps.measured.cycles.Cycles.missing`) are not
+laid out, and the drift is interpolated between the centres of the whole cycles on either
+side of them. A block's samples are read as ``displacement[a:b]`` (and, for labelled
+cycles, ``displacement[indices]``) with indices into the whole recording, so the arrays may
+be any object that gives a stretch of it by those indices.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+from collections.abc import Iterator
+
+import numpy as np
+
+from ecofmaps._interrupts import check_interrupted
+from ecofmaps.measured import kernels
+from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles
+from ecofmaps.measured.quality import (
+    ANTICLOCKWISE_SHARE,
+    REASONS,
+)
+
+__all__ = [
+    "GROSS_SLIP_THRESHOLD",
+    "NEIGHBOURS",
+    "LoopBlock",
+    "both",
+    "branch_rows",
+    "line_crossings",
+    "loop_blocks",
+    "measure_cycles",
+    "stick_lines",
+    "zero_force_crossings",
+]
+
+#: Samples of the cycles laid out at once by :func:`loop_blocks`.
+_BLOCK = 1 << 17
+
+#: Whole cycles on either side of a cycle whose force centres give their noise (module
+#: notes); its second differences reach one cycle less.
+_NOISE_REACH = 4
+
+#: Whole cycles on either side of a cycle whose samples its centring reads: the force
+#: centres of :data:`_NOISE_REACH` cycles, each centred by the displacement centres of its
+#: own neighbours.
+NEIGHBOURS = _NOISE_REACH + 1
+
+#: The median absolute deviation of a normal distribution over its standard deviation,
+#: times the standard deviation of a second difference of white noise over its own.
+_SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class LoopBlock:
+    """The centred loops of a block of consecutive cycles, from :func:`loop_blocks`.
+
+    Attributes
+    ----------
+    rows : slice
+        The cycles of the block (rows of the :class:`Cycles`).
+    displacement, force : numpy.ndarray, shape (samples,)
+        Centred displacement and force of every sample of the block's cycles, once, in
+        time order: each cycle is a stretch of them (cycles cut at the reversals share the
+        sample between them). [m], [N]
+    offset, count, rotation : numpy.ndarray of int64, shape (cycles,)
+        Where each cycle's stretch begins in ``displacement``, its samples, and where its
+        loop begins in it (as for :class:`Cycles`).
+    continuous : bool
+        As for :class:`Cycles`: the segment that closes each loop is not travelled.
+    displacement_centre, force_centre : numpy.ndarray, shape (cycles,)
+        The centres removed. [m], [N]
+    force_drift_se : numpy.ndarray, shape (cycles,)
+        Standard error of the offset between each loop's two branches that the drift
+        correction leaves (module notes); zero for labelled cycles. [N]
+    force_swing : numpy.ndarray, shape (cycles,)
+        Range of the force as recorded over each cycle, before centring (a dead channel
+        holds still; centred, its drift correction would make it a ramp). [N]
+    """
+
+    rows: slice
+    displacement: np.ndarray
+    force: np.ndarray
+    offset: np.ndarray
+    count: np.ndarray
+    rotation: np.ndarray
+    continuous: bool
+    displacement_centre: np.ndarray
+    force_centre: np.ndarray
+    force_swing: np.ndarray
+    force_drift_se: np.ndarray
+
+    def samples(self, point, rows=slice(None)):
+        """Index into ``displacement`` and ``force`` of points round the loops ``rows``.
+
+        ``point`` (one row per loop) counts from the loop's lowest displacement, 0 to
+        ``count``; ``count`` is the point that closes the loop.
+        """
+        offset, count = self.offset[rows][:, None], self.count[rows][:, None]
+        if self.continuous:  # no rotation: the stretch, then its first sample again
+            return offset + np.where(point < count, point, 0)
+        position = self.rotation[rows][:, None] + point
+        return offset + position - count * (position >= count)
+
+    def loops(self, width: int):
+        """The loops as padded rows (cycle, point) of ``width`` points, NaN past each end."""
+        point = np.minimum(np.arange(width), self.count[:, None])
+        index = self.samples(point)
+        inside = np.arange(width) <= self.count[:, None]
+        return tuple(
+            np.where(inside, values[index], np.nan) for values in (self.displacement, self.force)
+        )
+
+
+def loop_blocks(
+    cycles: Cycles, displacement, force, rows=None, force_sign=1.0
+) -> Iterator[LoopBlock]:
+    """The loops of ``cycles``, each moved to its centre (module notes), block by block.
+
+    Parameters
+    ----------
+    cycles : Cycles
+        The cycles of the recording.
+    displacement, force : numpy.ndarray
+        The recording the cycles were found in, float64. [m], [N]
+    rows : slice, optional
+        Consecutive cycles to lay out (default all). The centring of cycles cut at the
+        reversals still uses their neighbours.
+    force_sign : float
+        +1, or -1 to read the force with the other sign (without copying the recording).
+
+    Yields
+    ------
+    block : LoopBlock
+        Consecutive cycles, about ``_BLOCK`` samples in all, in order.
+    """
+    first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
+    # The whole cycles, by position among them: a block is consecutive whole cycles.
+    kept = np.flatnonzero(cycles.whole)
+    begin, end = (int(p) for p in np.searchsorted(kept, [first, stop]))
+    if not cycles.continuous:
+        for block in _whole_blocks(cycles, kept, begin, end):
+            yield _labelled_block(cycles, displacement, force, kept[block], force_sign)
+        return
+    if begin == end:  # no whole cycle among the rows
+        return
+    start, count = cycles.start[kept], cycles.count[kept]
+    size = kept.size
+    middle, centre_x = _displacement_centres(start, count, displacement, begin, end)
+    centre_q = np.empty(size)
+    ready = max(begin - _NOISE_REACH, 0)  # the force's centres are known below this cycle
+    for block in _whole_blocks(cycles, kept, begin, end):
+        # The centred values depend on the sample index alone. The force's drift within
+        # the block needs the centres of the cycles on both sides of it, their noise
+        # those of _NOISE_REACH cycles.
+        needed = min(block.stop + _NOISE_REACH, size)
+        lower, upper = min(ready, block.start), max(needed, block.stop)
+        low, high = int(start[lower]), int(start[upper - 1] + count[upper - 1])
+        x = displacement[low:high] - _drift(
+            low, high, middle, centre_x, slice(max(lower - 1, 0), upper + 1)
+        )
+        if ready < needed:
+            cut = slice(ready, needed)
+            centre_q[cut] = _path_means(
+                x, _signed(force[low:high], force_sign), start[cut] - low, count[cut], closed=False
+            )
+            ready = needed
+        a, b = int(start[block.start]), int(start[block.stop - 1] + count[block.stop - 1])
+        near = slice(max(block.start - 1, 0), block.stop + 1)
+        offset = start[block] - a
+        swing = kernels.stretch_ranges(np.ascontiguousarray(force[a:b]), offset, count[block])
+        yield LoopBlock(
+            rows=slice(int(kept[block.start]), int(kept[block.stop - 1]) + 1),
+            displacement=x[a - low : b - low],
+            force=_signed(force[a:b], force_sign) - _drift(a, b, middle, centre_q, near),
+            offset=offset,
+            count=count[block],
+            rotation=cycles.rotation[kept[block]],
+            continuous=True,
+            displacement_centre=centre_x[block],
+            force_centre=centre_q[block],
+            force_swing=swing,
+            force_drift_se=_drift_se(middle, count, centre_q, block),
+        )
+
+
+def _drift_se(middle, count, centre, rows: slice):
+    """Standard error of the offset between the branches of the loops ``rows`` that the
+    force's drift correction leaves (module notes), from the ``centre`` of every whole
+    cycle at its ``middle`` sample; the centres of :data:`_NOISE_REACH` cycles on either
+    side of ``rows`` are needed. [N]"""
+    size = centre.size
+    first, stop = rows.start, rows.stop
+    noise = kernels.second_difference_medians(centre, first, stop, _NOISE_REACH)
+    noise /= _SECOND_DIFFERENCE
+    if size == 2:  # no second difference: the one first difference, noise and drift
+        noise = np.full(stop - first, abs(centre[1] - centre[0]) / np.sqrt(2.0))
+    # The weights a_j of the centres in the offset, in the cycle's own period: a quarter
+    # of the slope to each neighbour, or half the one line over the whole cycle at an end.
+    i = np.arange(first, stop)
+    period = count[i].astype(np.float64)
+    has_left, has_right = i > 0, i < size - 1
+    left = (middle[i] - middle[np.maximum(i - 1, 0)]) / period
+    right = (middle[np.minimum(i + 1, size - 1)] - middle[i]) / period
+    share = np.where(has_left & has_right, 0.25, 0.5)
+    a_left = np.where(has_left, -share / np.where(has_left, left, 1.0), 0.0)
+    a_right = np.where(has_right, share / np.where(has_right, right, 1.0), 0.0)
+    squares = a_left**2 + a_right**2 + (a_left + a_right) ** 2
+    return np.where(squares > 0.0, noise * np.sqrt(squares), 0.0)
+
+
+def _whole_blocks(cycles: Cycles, kept, begin: int, end: int) -> Iterator[slice]:
+    """Blocks of consecutive whole cycles ``kept[begin:end]``, as slices of ``kept``."""
+    breaks = np.flatnonzero(np.diff(kept[begin:end]) != 1) + begin + 1
+    for a, b in itertools.pairwise([begin, *breaks.tolist(), end]):
+        yield from _blocks(cycles.count[kept[a:b]] + 1, a)
+
+
+def _signed(values, sign):
+    """``values``, or ``-values`` if ``sign`` is negative."""
+    return values if sign > 0 else -values
+
+
+def _labelled_block(cycles: Cycles, displacement, force, block, sign) -> LoopBlock:
+    """The loops of consecutive labelled cycles (rows ``block``), each moved by its own
+    centre."""
+    start, count = cycles.start[block], cycles.count[block]
+    offset = np.concatenate([[0], np.cumsum(count[:-1])])
+    index = np.repeat(start - offset, count) + np.arange(int(count.sum()))
+    x, q = displacement[index], _signed(force[index], sign)
+    swing = kernels.stretch_ranges(q, offset, count)
+    centre_x = _path_means(x, x, offset, count, closed=True)
+    x -= np.repeat(centre_x, count)
+    # The force's weights come from the centred displacement, as for drifting loops.
+    centre_q = _path_means(x, q, offset, count, closed=True)
+    q -= np.repeat(centre_q, count)
+    return LoopBlock(
+        rows=slice(int(block[0]), int(block[-1]) + 1),
+        displacement=x,
+        force=q,
+        offset=offset,
+        count=count,
+        rotation=cycles.rotation[block],
+        continuous=False,
+        displacement_centre=centre_x,
+        force_centre=centre_q,
+        force_swing=swing,
+        force_drift_se=np.zeros(count.size),
+    )
+
+
+def _blocks(points: np.ndarray, offset: int) -> Iterator[slice]:
+    """Slices of consecutive rows of about ``_BLOCK`` points in all, such that padding
+    each row to the longest does not more than double that (a long loop among short ones
+    gets a block of its own)."""
+    rows = max(1, _BLOCK // max(int(np.median(points)), 1)) if points.size else 1
+    pending = [(a, min(a + rows, points.size)) for a in range(0, points.size, rows)][::-1]
+    while pending:
+        a, b = pending.pop()
+        if b - a > 1 and (b - a) * int(points[a:b].max()) > 2 * _BLOCK:
+            # A long loop among short ones: split the block rather than pad it.
+            middle = (a + b) // 2
+            pending += [(middle, b), (a, middle)]
+        else:
+            yield slice(a + offset, b + offset)
+
+
+def _path_means(path, values, offset, count, closed: bool):
+    """Mean of ``values`` round each loop weighted by the distance along ``path``.
+
+    The loops are stretches (``offset``, ``count``) of the flat arrays; ``closed`` adds
+    the segment from each stretch's last sample back to its first.
+    """
+    path, values = (np.ascontiguousarray(a, dtype=np.float64) for a in (path, values))
+    return kernels.path_means(path, values, offset, count, closed)
+
+
+def _displacement_centres(start, count, displacement, first: int, stop: int):
+    """Middle sample of every cycle cut at the reversals (stretches ``start``, ``count``),
+    and the displacement centres of the cycles from :data:`NEIGHBOURS` before ``first`` to
+    :data:`_NOISE_REACH` after ``stop - 1`` (NaN for the others), a block at a time.
+
+    A cycle's path runs over its stretch only: the segment that closes the loop, from the
+    next reversal back to the first sample, is not travelled.
+    """
+    # The mean sample index round the loop, its closing point included (exact integers).
+    middle = ((count * (2 * start + count - 1)) // 2 + start) / (count + 1)
+    centre = np.full(start.size, np.nan)
+    first, stop = max(first - NEIGHBOURS, 0), min(stop + NEIGHBOURS, start.size)
+    groups = np.flatnonzero(np.diff((start[first:stop] - start[first]) // _BLOCK)) + first + 1
+    for a, b in itertools.pairwise([first, *groups.tolist(), stop]):
+        low, high = int(start[a]), int(start[b - 1] + count[b - 1])
+        x = displacement[low:high]
+        centre[a:b] = _path_means(x, x, start[a:b] - low, count[a:b], closed=False)
+    return middle, centre
+
+
+def _drift(low: int, high: int, points, values, near: slice):
+    """``values`` interpolated over ``points`` at the samples ``low`` to ``high - 1``.
+
+    Piecewise linear, extended linearly beyond the first and last points;
+    ``points[near]`` bracket every sample that lies between two points. Inside, it is
+    ``np.interp`` on the segments between points, to the bit (one pass).
+    """
+    xp, fp = points[near], values[near]
+    # Sample i lies on segment j when xp[j] <= i < xp[j + 1].
+    edges = np.clip(np.ceil(xp).astype(np.int64), low, high) - low
+    result = np.empty(high - low)
+    result[: edges[0]] = fp[0]
+    result[edges[-1] :] = fp[-1]
+    if xp.size > 1:  # every sample here lies on a segment between points
+        result[edges[0] : edges[-1]] = kernels.interpolated(
+            low + int(edges[0]), int(edges[-1] - edges[0]), xp, fp
+        )
+    if points.size < 2:
+        return result
+    if near.start == 0 and edges[0] > 0:
+        at = np.arange(low, low + edges[0], dtype=np.float64)
+        result[: edges[0]] = values[0] + (at - points[0]) * (values[1] - values[0]) / (
+            points[1] - points[0]
+        )
+    if near.stop >= points.size:
+        at = np.arange(low + edges[-1], high, dtype=np.float64)
+        beyond = at > points[-1]
+        result[edges[-1] :][beyond] = values[-1] + (at[beyond] - points[-1]) * (
+            values[-1] - values[-2]
+        ) / (points[-1] - points[-2])
+    return result
+
+
+#: Energy ratio :math:`A = E_d/(4\Delta^* Q^*)` above which a loop is gross slip (the
+#: sliding transition of Fouvry, Kapsa and Vincent).
+GROSS_SLIP_THRESHOLD = 0.2
+
+
+#: The per-cycle quantities, in the Dataset's order.
+_PER_CYCLE = (
+    "amplitude",
+    "slip_amplitude",
+    "max_force",
+    "dissipated_energy",
+    "ecof",
+    "cof_max",
+    "energy_ratio",
+    "stiffness",
+    "gicof",
+    "gicof_forward",
+    "gicof_backward",
+    "crossing_displacement_forward",
+    "crossing_displacement_backward",
+    "displacement_offset",
+    "force_offset",
+    "force_drift_se",
+    "stick_residual",
+)
+
+
+#: A stick segment must explain all but this share of the displacement's variance along it.
+_UNEXPLAINED = 0.2
+
+
+def _loop_values(block, load, options):
+    """Every per-cycle quantity of a block of centred loops, and the checks it failed.
+
+    Returns the quantities (module notes; not yet NaN where a check fails) and the flags
+    of :data:`ecofmaps.measured.quality.REASONS` (reason -> per cycle).
+    """
+    # The extremes, the loop's area by trapezoids (the segment that closes it included)
+    # and its top, where the rising branch ends.
+    highest, lowest, max_force, energy, top = kernels.loop_measures(
+        block.displacement, block.force, block.offset, block.count, block.rotation
+    )
+    span = highest - lowest
+    amplitude = 0.5 * span
+    bx, by, length = branch_rows(block, top)
+    compliance, intercept, across, fit = stick_lines(bx, by, length, span, options["stick_window"])
+    crossing, zero_on_loop = zero_force_crossings(
+        bx, by, length, max_force, across, intercept, span
+    )
+    cycles = block.count.size
+    slip = 0.5 * (crossing[cycles:] - crossing[:cycles])
+    half_width = options["crossing_window"] * np.abs(slip)
+    at, force, on_loop = line_crossings(
+        bx, by, length, both(compliance), both(half_width), load, both(max_force)
+    )
+    energy_ratio = energy / (4.0 * amplitude * max_force)
+    values = {
+        "amplitude": amplitude,
+        "slip_amplitude": slip,
+        "max_force": max_force,
+        "dissipated_energy": energy,
+        "ecof": energy / (4.0 * load * slip),
+        "cof_max": max_force / load,
+        "energy_ratio": energy_ratio,
+        "stiffness": 1.0 / (compliance + 0.0),  # + 0.0: a rigid rig is +inf, not -inf
+        "gicof": (force[:cycles] - force[cycles:]) / (2.0 * load),
+        "gicof_forward": force[:cycles] / load,
+        "gicof_backward": -force[cycles:] / load,
+        "crossing_displacement_forward": at[:cycles],
+        "crossing_displacement_backward": at[cycles:],
+        "displacement_offset": block.displacement_centre,
+        "force_offset": block.force_centre,
+        "force_drift_se": block.force_drift_se,
+        "stick_residual": fit["residual"],
+    }
+    rounding = 1e-9
+    anticlockwise = energy_ratio < -ANTICLOCKWISE_SHARE
+    flags = {
+        "few-samples": block.count < MIN_SAMPLES,
+        "constant-force": ~(block.force_swing > 0.0),
+        # A cycle cut at the reversals cannot turn back by more than the band: that
+        # would have been a reversal.
+        "several-loops": np.zeros(cycles, dtype=bool)
+        if block.continuous
+        else _turns_back(bx, options["hysteresis"] * span),
+        "anticlockwise": anticlockwise,
+        "energy-ratio-above-1": energy_ratio > 1.0 + rounding,
+        "negative-stiffness": compliance < 0.0,
+        "no-stick": (~(fit["unexplained"] <= _UNEXPLAINED) & ~np.isinf(values["stiffness"]))
+        | np.isnan(compliance),  # a rigid rig's vertical stick sides explain all but 0/0
+        "negative-area": (energy_ratio < 0.0) & ~anticlockwise,
+        "negative-slip": ~(slip > 0.0),
+        "no-zero-crossing": ~(zero_on_loop[:cycles] & zero_on_loop[cycles:]),
+        "curved-stick": fit["curved"],
+        "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]),
+        "not-gross-slip": ~(energy_ratio > options["gross_slip_threshold"]),
+    }
+    return values, flags
+
+
+def _turns_back(x, band):
+    """True for the cycles whose displacement turns back within a branch by more than
+    ``band``: the rising branches (the first half of the rows) fall below their running
+    maximum, or the falling ones rise above their running minimum (the rows' padding
+    repeats their last point, which changes neither)."""
+    cycles = band.size
+    rising, falling = x[:cycles], x[cycles:]
+    drop = np.max(np.maximum.accumulate(rising, axis=1) - rising, axis=1)
+    rise = np.max(falling - np.minimum.accumulate(falling, axis=1), axis=1)
+    return np.maximum(drop, rise) > band
+
+
+def measure_cycles(
+    cycles: Cycles,
+    displacement,
+    force,
+    load,
+    *,
+    hysteresis=0.5,
+    stick_window=(0.05, 0.45),
+    crossing_window=0.7,
+    gross_slip_threshold=GROSS_SLIP_THRESHOLD,
+    flip_force=False,
+    rows=None,
+    keep_loops=False,
+    recorded_load=None,
+):
+    """The per-cycle quantities of :func:`analyze_loops` for cycles already found.
+
+    Parameters
+    ----------
+    cycles : Cycles
+        Cycles of the recording (:func:`ecofmaps.measured.cycles.find_cycles`).
+    displacement, force : numpy.ndarray
+        The recording, float64; NaN only in the cycles marked missing. Any object that
+        gives stretches of it by sample index (``displacement[a:b]``) will do. [m], [N]
+    load : float
+        Normal load :math:`P`. [N]
+    hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
+        As for :func:`analyze_loops` (not checked here).
+    rows : slice, optional
+        Consecutive cycles to measure; default all.
+    keep_loops : bool
+        Also return the centred loops as NaN-padded (cycle, point) arrays.
+    recorded_load : numpy.ndarray, optional
+        The normal load at each sample, when it was recorded (indexed as ``force``): its
+        mean over each cycle is ``normal_load``. [N]
+
+    Returns
+    -------
+    values : dict of str to numpy.ndarray
+        Each quantity of :func:`analyze_loops` over the cycles, offsets and stick residual
+        included, as measured: not yet NaN where a check fails; and ``normal_load`` with a
+        ``recorded_load``.
+    flags : dict of str to numpy.ndarray of bool
+        The checks of :data:`ecofmaps.measured.quality.REASONS` each cycle failed.
+    loops : tuple of numpy.ndarray or None
+        Centred displacement and force round each loop, if ``keep_loops``. [m], [N]
+    """
+    first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
+    options = {
+        "hysteresis": hysteresis,
+        "stick_window": stick_window,
+        "crossing_window": crossing_window,
+        "gross_slip_threshold": gross_slip_threshold,
+    }
+    values = {name: np.full(stop - first, np.nan) for name in _PER_CYCLE}
+    flags = {reason: np.zeros(stop - first, dtype=bool) for reason in REASONS}
+    if cycles.missing is not None:  # not measured: their values stay NaN
+        flags["missing-samples"] = cycles.missing[first:stop].copy()
+    loops = None
+    if keep_loops:
+        width = int(cycles.count[first:stop].max()) + 1
+        loops = tuple(np.full((stop - first, width), np.nan) for _ in range(2))
+    sign = -1.0 if flip_force else 1.0
+    blocks = loop_blocks(cycles, displacement, force, slice(first, stop), sign)
+    with np.errstate(divide="ignore", invalid="ignore"):  # degenerate cycles give NaN
+        for block in blocks:
+            check_interrupted()
+            out = slice(block.rows.start - first, block.rows.stop - first)
+            computed, failed = _loop_values(block, load, options)
+            for name, value in computed.items():
+                values[name][out] = value
+            for reason, flag in failed.items():
+                flags[reason][out] = flag
+            if keep_loops:
+                for loop, centred in zip(loops, block.loops(loops[0].shape[1]), strict=True):
+                    loop[out] = centred
+    if recorded_load is not None:
+        values["normal_load"] = _cycle_means(recorded_load, cycles, first, stop)
+    return values, flags, loops
+
+
+def _cycle_means(series, cycles: Cycles, first: int, stop: int) -> np.ndarray:
+    """The mean of the finite values of ``series`` over the samples of each of the cycles
+    ``first`` to ``stop - 1`` (each a stretch of consecutive samples; NaN if none)."""
+    start, count = cycles.start[first:stop], cycles.count[first:stop]
+    if start.size == 0:
+        return np.empty(0)
+    low = int(start.min())
+    values = np.asarray(series[low : int((start + count).max())], dtype=np.float64)
+    finite = np.isfinite(values)
+    sums, counts = (
+        np.concatenate([[0.0], np.cumsum(a)]) for a in (np.where(finite, values, 0.0), finite)
+    )
+    ends, begins = start + count - low, start - low
+    with np.errstate(invalid="ignore"):  # a cycle without a finite value: NaN
+        return (sums[ends] - sums[begins]) / (counts[ends] - counts[begins])
+
+
+#: Samples with :math:`|Q|` below this share of :math:`Q^*` locate a zero-force crossing
+#: that is not on a stick segment.
+_ZERO_FORCE_BAND = 0.25
+
+
+def both(values):
+    """A per-cycle array for the rising then the falling branch rows."""
+    return np.concatenate([values, values])
+
+
+def branch_rows(block, top):
+    """The rising branches (start to top) and falling ones (top to the end) as rows.
+
+    Returns the displacement and force rows and the number of each row's own points
+    (the rest of a row repeats its last point).
+    """
+    cycles = top.size
+    first = np.concatenate([np.zeros_like(top), top])
+    last = np.concatenate([top, block.count])
+    length = last - first + 1
+    width = int(length.max())
+    if not block.continuous:  # a loop may begin inside its stretch and wrap round it
+        point = np.minimum(first[:, None] + np.arange(width), last[:, None])
+        index = block.samples(point, np.tile(np.arange(cycles), 2))
+        return block.displacement[index], block.force[index], length
+    # Each row is a stretch of the samples from its reversal on, up to its last point:
+    # the top of a rising branch; the loop's first sample, which closes a falling one.
+    start = np.tile(block.offset, 2) + first
+    end = np.concatenate([block.offset + top, block.offset])
+    x, y = (
+        kernels.branch_stretches(values, start, end, length, width)
+        for values in (block.displacement, block.force)
+    )
+    return x, y, length
+
+
+def stick_lines(x, y, length, span, window):
+    r"""Lines :math:`\Delta = c + Q/S` through the stick segments after the two reversals.
+
+    A segment starts as the branch's samples whose force has moved away from the
+    reversal's by a share of the branch's force swing within ``window``, up to the first
+    sample beyond it (with fewer than two, the chord from the reversal to the first sample
+    past the lower share). A first line is fitted, with one compliance :math:`1/S` for both
+    branches of a cycle and an intercept for each; each segment then grows along its
+    branch until two samples in a row lie more than three standard deviations (of the
+    first line's residuals, at least :math:`10^{-9}` of the displacement's ``span``) off its
+    line (the slip that follows bends away from it; a single noisy sample does not stop
+    it), and the lines are fitted again to the grown segments.
+
+    A segment is curved where a term :math:`bQ^2` added to its line is significant (more
+    than 8 standard errors) and changes its slope :math:`d\Delta/dQ` from one end of the
+    segment to the other by more than 5 % of the compliance.
+
+    Parameters
+    ----------
+    x, y : numpy.ndarray, shape (rows, width)
+        Displacement and force of the branch rows (:func:`branch_rows`). [m], [N]
+    length : numpy.ndarray of int64, shape (rows,)
+        Points of each row.
+    span : numpy.ndarray, shape (cycles,)
+        Peak-to-peak displacement of each cycle. [m]
+    window : tuple of float
+        Shares of the branch's force swing between which a segment starts. [-]
+
+    Returns
+    -------
+    compliance : numpy.ndarray, shape (cycles,)
+        The common compliance :math:`1/S` of each cycle. [m/N]
+    intercept : numpy.ndarray, shape (rows,)
+        The intercept :math:`c` of each branch row. [m]
+    across : numpy.ndarray of bool, shape (rows,)
+        The grown segment holds forces of both signs (it reaches across zero force).
+    fit : dict of str to numpy.ndarray
+        Per cycle: ``residual``, the root mean square displacement off the lines [m];
+        ``unexplained``, the share of the displacement's variance along the segments that
+        they leave [-]; ``curved``, True where a segment bends.
+    """
+    low, high = (float(share) for share in window)
+    compliance, intercept, across, residual, unexplained, curved = kernels.stick_lines(
+        x, y, length, span, low, high
+    )
+    fit = {"residual": residual, "unexplained": unexplained, "curved": curved}
+    return compliance, intercept, across, fit
+
+
+def zero_force_crossings(x, y, length, max_force, across, intercept, span):
+    r"""Displacement where each branch row crosses :math:`Q = 0`, and whether on the loop.
+
+    Where the stick segment reaches across zero force (``across``), it is the intercept of
+    the line fitted to it, :math:`\Delta = c + Q/S`. Elsewhere a straight line
+    :math:`\Delta = a + bQ` is fitted to the two samples around the crossing and the
+    branch's samples with :math:`|Q|` below ``_ZERO_FORCE_BAND`` times the loop's
+    ``max_force`` :math:`Q^*`, and gives :math:`a`. The crossing is on the loop if the
+    branch has samples of both signs of force and it lies within the displacements of
+    those samples (to rounding of the displacement ``span``). Else it is taken between
+    the two samples around the crossing, if they have forces of both signs: where the
+    stick line crosses zero force between them, or on the chord joining them.
+
+    Parameters
+    ----------
+    x, y : numpy.ndarray, shape (rows, width)
+        Displacement and force of the branch rows (:func:`branch_rows`). [m], [N]
+    length : numpy.ndarray of int64, shape (rows,)
+        Points of each row.
+    max_force, span : numpy.ndarray, shape (cycles,)
+        Half the peak-to-peak force, and the peak-to-peak displacement, of each
+        cycle. [N], [m]
+    across, intercept : numpy.ndarray, shape (rows,)
+        From :func:`stick_lines`. [-], [m]
+
+    Returns
+    -------
+    crossing : numpy.ndarray, shape (rows,)
+        Displacement at :math:`Q = 0`. [m]
+    on_loop : numpy.ndarray of bool, shape (rows,)
+        The crossing lies on the loop.
+    """
+    band = both(_ZERO_FORCE_BAND * max_force)
+    return kernels.zero_force_crossings(x, y, length, band, intercept, across, both(1e-9 * span))
+
+
+def line_crossings(x, y, length, compliance, half_width, load, scale):
+    r"""Where each branch row crosses :math:`Q = S\Delta`: displacement, force, on the loop.
+
+    On the line the contact position :math:`\xi = \Delta - Q/S` (eq. 10) is zero. The
+    branch's samples with :math:`|\xi|` up to ``half_width`` are fitted by least squares
+    with :math:`Q = a + b\xi + c\xi Q`, which is eq. 9 for any groove slope
+    (:math:`a = \mu P`, :math:`b = kP`, :math:`c = \mu k`) and a smooth three-parameter
+    curve otherwise; the crossing is :math:`Q = a`. The regressors are centred and
+    :math:`\xi Q` is orthogonalised against :math:`\xi` (Gram-Schmidt), so that :math:`a`
+    stays exact when the two are nearly collinear; where :math:`\xi Q` adds only rounding
+    to :math:`\xi` (a flat groove), :math:`Q = a + b\xi` is fitted. With fewer than five
+    samples in the window, :math:`Q` is interpolated linearly at :math:`\xi = 0` between
+    the two samples around the crossing.
+
+    The crossing is on the loop if measured samples of the branch lie on both sides of
+    :math:`\xi = 0` (in the window, or the two interpolated between), and its force lies
+    within theirs (to rounding of ``scale``, the loop's :math:`Q^*`).
+
+    Parameters
+    ----------
+    x, y : numpy.ndarray, shape (rows, width)
+        Displacement and force of the branch rows (:func:`branch_rows`). [m], [N]
+    length : numpy.ndarray of int64, shape (rows,)
+        Points of each row.
+    compliance, half_width, scale : numpy.ndarray, shape (rows,)
+        :math:`1/S` of each row's cycle, the window's half-width and :math:`Q^*`.
+        [m/N], [m], [N]
+    load : float
+        Normal load :math:`P`. [N]
+
+    Returns
+    -------
+    displacement, force : numpy.ndarray, shape (rows,)
+        Where each row crosses the line. [m], [N]
+    on_loop : numpy.ndarray of bool, shape (rows,)
+        The crossing lies on the loop.
+    """
+    force, on_loop = kernels.line_crossings(
+        x, y, length, compliance, half_width, float(load), 1e-9 * scale
+    )
+    return force * compliance, force, on_loop
