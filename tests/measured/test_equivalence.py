@@ -15,10 +15,10 @@ import warnings
 
 import numpy as np
 import pytest
-from ecofmaps.measured.measure import _PER_CYCLE
 
 import ecofmaps
 from ecofmaps.measured.analysis import analyze_loops
+from ecofmaps.measured.measure import _PER_CYCLE
 from ecofmaps.measured.quality import ALL, REASONS, SEPARATOR, LoopQualityWarning
 from ecofmaps.measured.synthetic import example_recording, synthetic_recording
 from tests.measured.reference.analysis import analyze_loops as reference_analysis
