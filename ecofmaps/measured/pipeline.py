@@ -46,17 +46,14 @@ from ecofmaps._parallel import stretch
 from ecofmaps.measured.cycles import Cycles, find_cycles, missing_sample_error, no_cycle_error
 from ecofmaps.measured.measure import GROSS_SLIP_THRESHOLD, NEIGHBOURS, measure_cycles
 from ecofmaps.measured.quality import (
-    ALL,
-    REASONS,
-    SEPARATOR,
+    RESOLVED,
     Tally,
     at_own_load,
     cycle_results,
-    quality_summary,
-    strip,
+    scale_flags,
     with_loops,
 )
-from ecofmaps.measured.resolve import REPORTED, resolve_analyzed_loops, resolved_attrs
+from ecofmaps.measured.resolve import check_reading_options, read_along_stroke, resolved_attrs
 
 __all__ = [
     "DEFAULTS",
@@ -78,9 +75,6 @@ TASK_SAMPLES = 1 << 22
 
 #: Whole cycles on either side of a chunk's cycles that it reads for the centring.
 HALO = NEIGHBOURS
-
-#: The prefix of the names under which a chunk's values hold its reading along the stroke.
-READ = "read:"
 
 
 class _InProcess:
@@ -108,7 +102,7 @@ class Reading:
     ----------
     resolve : bool
         Read each loop along the stroke (:func:`~ecofmaps.measured.resolve.resolve_analyzed_loops`)
-        and report :data:`~ecofmaps.measured.resolve.REPORTED` with its quality.
+        and report :data:`~ecofmaps.measured.quality.RESOLVED` with its quality.
     keep_loops : bool
         Keep the centred loops in the results (``loop_displacement``, ``loop_force``).
     along_stroke : dict, optional
@@ -262,19 +256,20 @@ def measure_chunk(
         recorded_load=None if recorded_load is None else _Stretch(recorded_load, low),
         **options,
     )
-    counted = cycle_results(values, flags, cycles.label[rows], load, options)
+    labels = cycles.label[rows]
+    flags |= scale_flags(values, options)
     resolved = None
     if reading.resolve:
-        resolved = resolve_analyzed_loops(with_loops(strip(counted), loops), **reading.along_stroke)
-        values = values | {
-            f"{READ}{name}": resolved[name].values for name in (*REPORTED, "quality")
-        }
-    part = _part(counted, values, loops if reading.keep_loops else None)
+        judged = with_loops(cycle_results(values, flags, labels, load, options), loops)
+        resolved, read = read_along_stroke(judged, check_reading_options(**reading.along_stroke))
+        values = values | {name: resolved[name].values for name in RESOLVED}
+        flags = flags | read
+    part = _part(values, flags, labels, load, options, loops if reading.keep_loops else None)
     handed = resolved if reading.hand_back else None
     if handed is not None and "normal_load" in values:  # as the part: at each cycle's load
         handed = at_own_load(handed, values["normal_load"] / load)
     tally = Tally()
-    tally.add(counted)
+    tally.add(part["quality"].values, flags, values["amplitude"])
     if callable(keep):
         keep(values, flags)
     if keep is not True:
@@ -290,37 +285,19 @@ def only(part: xr.Dataset, columns=None) -> xr.Dataset:
     return part[[name for name in columns if name in part.data_vars]]
 
 
-def _part(counted: xr.Dataset, values: dict, loops=None) -> xr.Dataset:
-    """The results of a chunk: ``counted`` (from
-    :func:`~ecofmaps.measured.quality.cycle_results`) without its riders, with the reading
-    along the stroke in ``values`` (named with the prefix :data:`READ`) where it was read,
-    and the centred ``loops`` if given; with a recorded load, at each cycle's own load."""
-    part = strip(counted)
-    read = {k[len(READ) :]: v for k, v in values.items() if k.startswith(READ)}
-    if read:
-        part = part.assign({k: ("cycle", read[k], resolved_attrs(k)) for k in REPORTED})
-        part["quality"] = part["quality"].copy(data=read["quality"])
-        part = part.assign(_emptied_by_reasons(part, read["quality"]))
+def _part(values: dict, flags: dict, labels, load, options, loops=None) -> xr.Dataset:
+    """The results of a chunk from what it measured, judged once (the values read along
+    the stroke, if any, after the quality), with the centred ``loops`` if given; with a
+    recorded load, at each cycle's own load."""
+    measured = {k: v for k, v in values.items() if k not in RESOLVED}
+    part = cycle_results(measured, flags, labels, load, options)
+    read = [name for name in RESOLVED if name in values]
+    part = part.assign({k: ("cycle", values[k], resolved_attrs(k)) for k in read})
     if loops is not None:
         part = with_loops(part, loops)
     if "normal_load" in part:
         part = at_own_load(part, part["normal_load"].values / float(part["load"]))
     return part
-
-
-def _emptied_by_reasons(part: xr.Dataset, quality) -> dict:
-    """``part``'s values (those not read along the stroke) that a reason of ``quality``
-    leaves NaN, as NaN there: the reading adds reasons whose scope reaches beyond its own
-    values (``gicof-varies`` empties the GICoF). Each distinct quality is read once."""
-    texts, inverse = np.unique(np.asarray(quality, dtype=str), return_inverse=True)
-    emptied = {}  # name -> which distinct texts empty it
-    for row, text in enumerate(texts):
-        for reason in text.split(SEPARATOR):
-            scope = REASONS.get(reason, ("", ()))[1]
-            if scope != ALL:
-                for name in set(scope) & set(part.data_vars) - set(REPORTED):
-                    emptied.setdefault(name, np.zeros(texts.size, dtype=bool))[row] = True
-    return {name: part[name].where(~hit[inverse]) for name, hit in sorted(emptied.items())}
 
 
 class Analysis:
@@ -497,10 +474,9 @@ class Analysis:
         :meth:`measured`), as in :func:`ecofmaps.analyze_loops`'s Dataset (without the
         recording's attributes); counted in :attr:`tally`."""
         labels = self.cycles.label[self.tasks[index]]
-        measured = {k: v for k, v in values.items() if not k.startswith(READ)}
-        counted = cycle_results(measured, flags, labels, self.load, self.options)
-        self.tally.add(counted)
-        return _part(counted, values)
+        part = _part(values, flags, labels, self.load, self.options)
+        self.tally.add(part["quality"].values, flags, values["amplitude"])
+        return part
 
     def finish(self, parts) -> xr.Dataset:
         """The parts (all of them, in order) joined, with the recording's attributes, after
@@ -514,10 +490,7 @@ class Analysis:
             results = parts[0]
         else:
             results = xr.concat(parts, "cycle", coords="minimal", compat="override", join="outer")
-        results = self.tally.finish(results, self.cycles, self.cycles_from, self.options)
-        if self.reading.resolve:  # the summary of the reading's quality
-            results.attrs["quality_summary"] = quality_summary(results["quality"].values)
-        return results
+        return self.tally.finish(results, self.cycles, self.cycles_from, self.options)
 
     def run(self):
         """Every chunk, joined (:meth:`finish`); and the reading along the stroke, joined,

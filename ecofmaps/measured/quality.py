@@ -24,6 +24,7 @@ __all__ = [
     "ALL",
     "ANTICLOCKWISE_SHARE",
     "AT_OWN_LOAD",
+    "READING_REASONS",
     "REASONS",
     "RESOLVED",
     "SEPARATOR",
@@ -36,10 +37,10 @@ __all__ = [
     "at_own_load",
     "cycle_results",
     "has_reason",
+    "judged",
     "quality_strings",
     "quality_summary",
     "refused",
-    "strip",
     "summary_of_counts",
     "with_loops",
 ]
@@ -163,24 +164,24 @@ def scale_flags(values: dict, options: dict) -> dict:
     return {"implausible-amplitude": scaled, "implausible-cof": cof & ~scaled}
 
 
-def cycle_results(values: dict, flags: dict, label, load: float, options: dict) -> xr.Dataset:
-    """The per-cycle Dataset of :func:`analyze_loops` for some cycles, without the
-    recording's attributes: ``values`` and ``flags`` from :func:`measure_cycles`.
-
-    The raw amplitudes and whether each cycle is refused ride along as ``_amplitude`` and
-    ``_refused`` until :meth:`Tally.finish` takes them off.
-    """
-    size = label.size
-    flags = flags | scale_flags(values, options)
-    quality = quality_strings(flags, size)
-    refused = np.zeros(size, dtype=bool)
-    for reason, flag in flags.items():
-        refused |= flag & (REASONS[reason][1] == ALL)
-    raw_amplitude = values["amplitude"]
+def judged(values: dict, flags: dict, options: dict):
+    """The one judgement of a part's cycles: ``values`` (name -> per cycle, as measured)
+    NaN where a flag's scope reaches, the ``quality`` strings, the cycles refused and the
+    regime codes. ``flags`` (reason -> per cycle) are every check's, the scale's included."""
+    size = next(iter(flags.values())).size
+    refused = _refusing(flags, size)
     recorded = {k: values[k] for k in ("normal_load",) if k in values}  # a refused cycle's too
     values = apply_quality({k: v for k, v in values.items() if k not in recorded}, flags)
     sliding = values["energy_ratio"] > options["gross_slip_threshold"]
     regime = np.where(refused, INVALID, np.where(sliding, GROSS_SLIP, NO_GROSS_SLIP))
+    return values | recorded, quality_strings(flags, size), refused, regime
+
+
+def cycle_results(values: dict, flags: dict, label, load: float, options: dict) -> xr.Dataset:
+    """The per-cycle Dataset of :func:`analyze_loops` for some cycles, without the
+    recording's attributes: ``values`` and ``flags`` (the scale's included) judged once."""
+    values, quality, _, regime = judged(values, flags, options)
+    recorded = {k: values.pop(k) for k in ("normal_load",) if k in values}
     names = [name for name in values if name != "stick_residual"]
     data = {name: ("cycle", values[name], _attrs(name)) for name in names}
     data["regime"] = ("cycle", regime.astype(np.int32), _attrs("regime") | Regime.flag_attrs())
@@ -188,55 +189,50 @@ def cycle_results(values: dict, flags: dict, label, load: float, options: dict) 
     for name, value in recorded.items():
         data[name] = ("cycle", value, _attrs(name))
     data["quality"] = ("cycle", quality, _attrs("quality"))
-    data["_amplitude"] = ("cycle", raw_amplitude)
-    data["_implausible-cof"] = ("cycle", flags["implausible-cof"])
-    data["_refused"] = ("cycle", refused)
-    hints = {
-        "missing-samples": flags["missing-samples"],
-        "anticlockwise": flags["anticlockwise"],
-        "constant-force": flags["constant-force"],
-        "implausible-amplitude": flags["implausible-amplitude"],
-    }
-    for reason, flag in hints.items():
-        data[f"_{reason}"] = ("cycle", flag)
-    data["_negative-stiffness"] = ("cycle", flags["negative-stiffness"])
     coords = {"cycle": ("cycle", label, _attrs("cycle")), "load": ((), load, _attrs("load"))}
     return xr.Dataset(data, coords=coords)
 
 
+#: The reasons that the reading along the stroke adds (its flags do not warn).
+READING_REASONS = (
+    "stiffness-mismatch",
+    "no-overlap",
+    "few-slip-samples",
+    "mu-varies",
+    "gicof-varies",
+)
+
+#: The reasons whose presence on every cycle says what to do about a refused recording.
+_HINTS = ("missing-samples", "anticlockwise", "constant-force", "implausible-amplitude")
+
+
 class Tally:
-    """What :func:`analyze_loops` says about a whole recording, gathered from its parts
-    (:func:`cycle_results`) as they come: the quality summary, whether every cycle was
-    refused, and the typical amplitude."""
+    """What :func:`analyze_loops` says about a whole recording, counted from the flags of
+    its parts as they come: the quality summary, whether every cycle was refused, and the
+    typical amplitude."""
 
     def __init__(self):
         self.counts = collections.Counter()  # cycles by quality
-        self.cycles = self.refused = self.flagged = 0
-        self.every = {
-            "missing-samples": True,
-            "anticlockwise": True,
-            "constant-force": True,
-            "implausible-amplitude": True,
-        }
-        self.implausible_cof = 0
+        self.cycles = self.refused = self.flagged = self.implausible_cof = self.scaled = 0
+        self.every = dict.fromkeys(_HINTS, True)
         self.negative_stiffness = False
         self.amplitudes: list = []
 
-    def add(self, part: xr.Dataset) -> xr.Dataset:
-        """Count the cycles of ``part``; return it without its riders."""
-        counted = collections.Counter(part.quality.values.tolist())
-        self.counts.update(counted)
-        self.flagged += sum(
-            n for text, n in counted.items() if text not in ("ok", "not-gross-slip")
+    def add(self, quality, flags: dict, amplitude) -> None:
+        """Count the cycles of a part: their ``quality``, ``flags`` and amplitudes as measured."""
+        self.counts.update(collections.Counter(np.asarray(quality).tolist()))
+        quiet = {"ok", "not-gross-slip", *READING_REASONS}
+        self.flagged += int(
+            _by_text(quality, lambda text: bool(set(text.split(SEPARATOR)) - quiet)).sum()
         )
-        self.cycles += part.cycle.size
-        self.refused += int(part["_refused"].sum())
-        for reason in self.every:
-            self.every[reason] &= bool(part[f"_{reason}"].all())
-        self.negative_stiffness |= bool(part["_negative-stiffness"].any())
-        self.amplitudes.append(part["_amplitude"].values)
-        self.implausible_cof += int(part["_implausible-cof"].sum())
-        return strip(part)
+        self.cycles += amplitude.size
+        self.refused += int(_refusing(flags, amplitude.size).sum())
+        for reason in _HINTS:
+            self.every[reason] &= bool(flags[reason].all())
+        self.negative_stiffness |= bool(flags["negative-stiffness"].any())
+        self.amplitudes.append(amplitude)
+        self.implausible_cof += int(flags["implausible-cof"].sum())
+        self.scaled += int(flags["implausible-amplitude"].sum())
 
     def merge(self, other: Tally) -> None:
         """Count the parts ``other`` counted (in another process, say) as well."""
@@ -244,7 +240,8 @@ class Tally:
         self.cycles += other.cycles
         self.refused += other.refused
         self.flagged += other.flagged
-        for reason in self.every:
+        self.scaled += other.scaled
+        for reason in _HINTS:
             self.every[reason] &= other.every[reason]
         self.negative_stiffness |= other.negative_stiffness
         self.amplitudes += other.amplitudes
@@ -268,9 +265,7 @@ class Tally:
         """
         summary = self.summary
         typical = _typical(np.concatenate(self.amplitudes) if self.amplitudes else np.zeros(0))
-        texts = np.array(list(self.counts), dtype=str)
-        counts = np.array(list(self.counts.values()), dtype=np.int64)
-        scaled = int(counts[has_reason(texts, "implausible-amplitude")].sum())
+        scaled = self.scaled
         if self.cycles and self.refused == self.cycles:
             hint = dict(self.every, **{"negative-stiffness": self.negative_stiffness})
             error = ImplausibleScaleError if scaled else ValueError
@@ -293,7 +288,6 @@ class Tally:
             )
         if self.flagged:
             warn(f"cycles flagged: {summary}", LoopQualityWarning)
-        results = strip(results)
         results.attrs.update(
             {
                 "title": "Fretting loops analysed cycle by cycle (ecofmaps.analyze_loops)",
@@ -314,11 +308,6 @@ class Tally:
     def counts_of(self, reason: str) -> int:
         """Cycles whose quality lists ``reason``."""
         return sum(c for text, c in self.counts.items() if reason in text.split("+"))
-
-
-def strip(part: xr.Dataset) -> xr.Dataset:
-    """``part`` without the riders of :func:`cycle_results`."""
-    return part.drop_vars([name for name in part.data_vars if str(name).startswith("_")])
 
 
 def _typical(amplitude) -> float:

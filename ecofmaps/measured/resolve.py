@@ -164,6 +164,7 @@ from ecofmaps._inputs import check
 from ecofmaps._interrupts import check_interrupted
 from ecofmaps.measured.quality import (
     ALL,
+    READING_REASONS,
     REASONS,
     RESOLVED,
     add_reason,
@@ -180,9 +181,9 @@ from ecofmaps.measured.resolve_branches import (
 
 __all__ = [
     "QUALITY_FLAGS",
-    "REPORTED",
     "along_stroke_values",
     "check_reading_options",
+    "read_along_stroke",
     "resolve_analyzed_loops",
     "resolved_attrs",
 ]
@@ -206,7 +207,12 @@ def resolved_attrs(name: str) -> dict:
 
 
 def check_reading_options(
-    stiffness, force_offset, positions, central, slip_threshold, stick_window
+    stiffness=None,
+    force_offset=None,
+    positions=201,
+    central=0.8,
+    slip_threshold=4.0,
+    stick_window=(0.05, 0.45),
 ) -> dict:
     """The options of :func:`resolve_analyzed_loops` as a dict, or a ValueError naming the
     one out of range."""
@@ -313,6 +319,12 @@ def resolve_analyzed_loops(
     options = check_reading_options(
         stiffness, force_offset, positions, central, slip_threshold, stick_window
     )
+    return read_along_stroke(loops, options)[0]
+
+
+def read_along_stroke(loops: xr.Dataset, options: dict):
+    """:func:`resolve_analyzed_loops` on options checked, and the flags of its reasons
+    (reason -> per cycle) besides the Dataset."""
     load = float(loops["load"])
     x = np.asarray(loops["loop_displacement"].values, dtype=np.float64)
     q = np.asarray(loops["loop_force"].values, dtype=np.float64)
@@ -322,15 +334,16 @@ def resolve_analyzed_loops(
         removed = np.full_like(removed, options["force_offset"])
     given = options["stiffness"] is not None
     rig = np.full(x.shape[0], options["stiffness"]) if given else loops["stiffness"].values
+    quality = loops["quality"].values
     with np.errstate(divide="ignore", invalid="ignore"):
-        per_position, per_cycle, quality, grid = along_stroke_values(
+        per_position, per_cycle, flags, grid = along_stroke_values(
             x,
             q,
             np.isfinite(x) & np.isfinite(q),
             load,
             np.asarray(rig, dtype=np.float64),
             np.asarray(loops["amplitude"].values, dtype=np.float64),
-            loops["quality"].values,
+            _reaches_resolved(quality),
             given,
             options,
             np.asarray(loops["force_drift_se"].values, dtype=np.float64),
@@ -343,6 +356,8 @@ def resolve_analyzed_loops(
     data = {name: (dims, value, resolved_attrs(name)) for name, value in per_position.items()}
     for name, value in per_cycle.items():
         data[name] = ("cycle", value, resolved_attrs(name))
+    for reason, flag in flags.items():
+        quality = add_reason(quality, flag, reason)
     data["quality"] = ("cycle", quality, resolved_attrs("quality"))
     coords = {
         "cycle": ("cycle", loops["cycle"].values, resolved_attrs("cycle")),
@@ -360,18 +375,14 @@ def resolve_analyzed_loops(
         "slip_threshold": options["slip_threshold"],
         "stick_window": list(options["stick_window"]),
     }
-    return xr.Dataset(data, coords=coords, attrs=attrs)
-
-
-#: The per-cycle values of the reading that :func:`ecofmaps.analyze_loops` reports.
-REPORTED = ("mu_resolved", "mu_resolved_se", "aspect_ratio")
+    return xr.Dataset(data, coords=coords, attrs=attrs), flags
 
 
 #: Quality flags, in the order they are tested.
 #: The reasons this reading adds to a cycle's ``quality`` (ecofmaps.measured.quality) that
 #: leave its values NaN, the first that applies; ``'gicof-varies'``, which reaches the
 #: GICoF only, is added besides.
-QUALITY_FLAGS = ("stiffness-mismatch", "no-overlap", "few-slip-samples", "mu-varies")
+QUALITY_FLAGS = READING_REASONS[:4]
 
 #: μ(ξ) varies along the stroke when the means over the inner and the outer half of the
 #: central part differ by this share of μ and by this many standard errors.
@@ -557,7 +568,9 @@ def _blocks(cycles):
     return [slice(start, start + _BLOCK) for start in range(0, max(cycles, 1), _BLOCK)]
 
 
-def along_stroke_values(x, q, valid, load, stiffness, amplitude, quality, given, options, drift_se):
+def along_stroke_values(
+    x, q, valid, load, stiffness, amplitude, inherited, given, options, drift_se
+):
     """Every resolved quantity of the centred loops ``x``, ``q`` (module notes).
 
     ``stiffness`` is the given S (``given`` True) or analyze_loops's, per cycle, and
@@ -567,7 +580,6 @@ def along_stroke_values(x, q, valid, load, stiffness, amplitude, quality, given,
     Returns the per-position and per-cycle arrays, the quality (with this reading's reasons
     added) and the grid. The work is done on blocks of cycles, each block vectorised.
     """
-    inherited = _reaches_resolved(quality)
     cycles = x.shape[0]
     parts = []
     for block in _blocks(cycles):
@@ -603,11 +615,10 @@ def along_stroke_values(x, q, valid, load, stiffness, amplitude, quality, given,
         return np.concatenate([part[name] for part in parts])
 
     flag = joined("flags")
-    for code, reason in enumerate(QUALITY_FLAGS, start=1):
-        quality = add_reason(quality, flag == code, reason)
+    flags = {reason: flag == code for code, reason in enumerate(QUALITY_FLAGS, start=1)}
     ok = ~inherited & (flag == 0)
     wavers = joined_values(parts, 7) & ((flag == 0) | (flag == 4))
-    quality = add_reason(quality, wavers & ~inherited, "gicof-varies")
+    flags["gicof-varies"] = wavers & ~inherited
     lowest, highest = joined("lowest"), joined("highest")
     mu_resolved, variance, k, tilt, sensitivity, _, shifting, _, offsetting = (
         joined_values(parts, i) for i in range(9)
@@ -632,7 +643,7 @@ def along_stroke_values(x, q, valid, load, stiffness, amplitude, quality, given,
     # Over the grid of positions common to all cycles: the values along the stroke.
     grid = options["positions"]
     if grid is None:
-        return {}, per_cycle, quality, None
+        return {}, per_cycle, flags, None
     if np.ndim(grid) == 0:  # over the widest resolved range, or the stroke if none is
         reach = np.maximum(highest, -lowest)[ok]
         half = reach.max() if reach.size else np.max(amplitude, initial=0.0, where=amplitude > 0)
@@ -651,4 +662,4 @@ def along_stroke_values(x, q, valid, load, stiffness, amplitude, quality, given,
         )
         for name in _ALONG:
             per_position[name][block] = along[name]
-    return per_position, per_cycle, quality, grid
+    return per_position, per_cycle, flags, grid

@@ -304,21 +304,22 @@ def test_tallies_of_parts_merge_into_the_tally_of_the_whole():
     """Tasks count their parts where they run (Tally.add) and the counts are merged: the
     same summary, refusals, checks and amplitudes as counting the whole at once."""
     from ecofmaps.measured.measure import measure_cycles
-    from ecofmaps.measured.quality import Tally, cycle_results
+    from ecofmaps.measured.quality import Tally, judged, scale_flags
 
     x, q = noisy(EXAMPLE_2, 12, 3)
     x, q = with_gaps(x, q, [700, 1900])  # skipped cycles besides the flagged ones
     options = default_options(LOAD)
     found = cycles.find_cycles(x, None, 0.5, force=q)
     values, flags, _ = measure_cycles(found, x, q, LOAD, **options)
+    flags |= scale_flags(values, options)
     whole = Tally()
-    whole.add(cycle_results(values, flags, found.label, LOAD, options))
+    whole.add(judged(values, flags, options)[1], flags, values["amplitude"])
     merged = Tally()
     for rows in (slice(0, 5), slice(5, 6), slice(6, None)):
         part = Tally()
         take = {k: v[rows] for k, v in values.items()}
         checks = {k: v[rows] for k, v in flags.items()}
-        part.add(cycle_results(take, checks, found.label[rows], LOAD, options))
+        part.add(judged(take, checks, options)[1], checks, take["amplitude"])
         merged.merge(part)
     assert whole.summary == merged.summary and "skipped" in whole.summary
     assert (whole.cycles, whole.refused, whole.flagged) == (
