@@ -1,47 +1,7 @@
-r"""Measured loops moved to their centres and laid out a block of cycles at a time.
-
-:func:`loop_blocks` hands :func:`ecofmaps.analyze_loops` the cycles of a recording
-(:class:`ecofmaps.measured.cycles.Cycles`) a block at a time, about ``_BLOCK`` samples, so
-that its memory does not grow with the recording: each block is the centred samples of its
-cycles, once, in time order, with where each cycle lies among them (:class:`LoopBlock`).
-Sums over each cycle's samples run in the compiled kernels of
-:mod:`ecofmaps.measured.kernels`, in the order of the samples.
-
-Offsets and drift
------------------
-Every loop is moved to its centre: the mean of :math:`\Delta` and of :math:`Q` along the
-loop weighted by the displacement travelled, :math:`\oint \Delta\,|d\Delta| / \oint
-|d\Delta|` (trapezoids). For a loop symmetric about a point (the model's steady loop, with
-or without ploughing peaks at both ends of the stroke) that point is the centre, and the
-mean averages the noise of every sample. For cycles cut from one continuous recording, the
-centres are interpolated linearly along the sample index from the middle of one cycle to
-the next and subtracted sample by sample, which also removes a slow drift of
-:math:`\Delta` (or of :math:`Q`) within each cycle; the weights of the force's centre come
-from the displacement so centred. Labelled cycles (possibly recorded far apart) are each
-moved by their own centre.
-
-The drift correction is only as good as the centres: noise on the displacement (through
-the weights) and on the force moves each centre, and a centre's error tilts the drift
-subtracted from its neighbours, which offsets a loop's falling branch against its rising
-one by :math:`\varepsilon = \sum_j a_j c_j` for the centres :math:`c_j` around it. For
-equally spaced cycles :math:`\varepsilon = (c_{i+1} - c_{i-1})/4` (the mean of the linear
-drift over each half of the cycle), and :math:`(c_{i+1} - c_i)/2` at the ends of the
-recording, where the drift is extrapolated. ``force_drift_se`` is the standard error of
-that offset, :math:`\sigma_c (\sum_j a_j^2)^{1/2}`, with the noise :math:`\sigma_c` of the
-centres from their second differences over :data:`_NOISE_REACH` cycles on either side,
-:math:`\operatorname{median}|c_{j-1} - 2c_j + c_{j+1}| / (0.6745\sqrt6)`, which a slow
-drift hardly enters (a real drift that bends from cycle to cycle counts as noise: the
-correction cannot follow it either). On a Coulomb slider recorded with 0.1 µm of
-displacement noise on a 50 µm amplitude the centres scatter by about 1.7 N, and the
-offset is the largest error of :func:`ecofmaps.resolve_loops`'s ``mu_resolved``; its
-standard error counts it (:mod:`ecofmaps.measured.resolve`). Labelled cycles, each moved
-by its own centre, have no such offset (zero).
-
-Cycles that hold a missing sample (:attr:`ecofmaps.measured.cycles.Cycles.missing`) are not
-laid out, and the drift is interpolated between the centres of the whole cycles on either
-side of them. A block's samples are read as ``displacement[a:b]`` (and, for labelled
-cycles, ``displacement[indices]``) with indices into the whole recording, so the arrays may
-be any object that gives a stretch of it by those indices.
+r"""Steps 3 and 4 of the loop pipeline: each loop centred (offsets and drift removed, a block of
+cycles at a time) and measured along its branch rows (amplitude, slip amplitude, energy,
+ECoF, stiffness, GICoF ...), with the flags of the checks each cycle failed.
+The method is explained in ``docs/method-loops.md`` ("Centring the loops", "Measuring each loop").
 """
 
 from __future__ import annotations
@@ -92,30 +52,7 @@ _SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class LoopBlock:
-    """The centred loops of a block of consecutive cycles, from :func:`loop_blocks`.
-
-    Attributes
-    ----------
-    rows : slice
-        The cycles of the block (rows of the :class:`Cycles`).
-    displacement, force : numpy.ndarray, shape (samples,)
-        Centred displacement and force of every sample of the block's cycles, once, in
-        time order: each cycle is a stretch of them (cycles cut at the reversals share the
-        sample between them). [m], [N]
-    offset, count, rotation : numpy.ndarray of int64, shape (cycles,)
-        Where each cycle's stretch begins in ``displacement``, its samples, and where its
-        loop begins in it (as for :class:`Cycles`).
-    continuous : bool
-        As for :class:`Cycles`: the segment that closes each loop is not travelled.
-    displacement_centre, force_centre : numpy.ndarray, shape (cycles,)
-        The centres removed. [m], [N]
-    force_drift_se : numpy.ndarray, shape (cycles,)
-        Standard error of the offset between each loop's two branches that the drift
-        correction leaves (module notes); zero for labelled cycles. [N]
-    force_swing : numpy.ndarray, shape (cycles,)
-        Range of the force as recorded over each cycle, before centring (a dead channel
-        holds still; centred, its drift correction would make it a ramp). [N]
-    """
+    """The centred loops of a block of consecutive cycles, from :func:`loop_blocks`."""
 
     rows: slice
     displacement: np.ndarray
@@ -130,11 +67,7 @@ class LoopBlock:
     force_drift_se: np.ndarray
 
     def samples(self, point, rows=slice(None)):
-        """Index into ``displacement`` and ``force`` of points round the loops ``rows``.
-
-        ``point`` (one row per loop) counts from the loop's lowest displacement, 0 to
-        ``count``; ``count`` is the point that closes the loop.
-        """
+        """Index into ``displacement`` and ``force`` of points round the loops ``rows``."""
         offset, count = self.offset[rows][:, None], self.count[rows][:, None]
         if self.continuous:  # no rotation: the stretch, then its first sample again
             return offset + np.where(point < count, point, 0)
@@ -154,25 +87,7 @@ class LoopBlock:
 def loop_blocks(
     cycles: Cycles, displacement, force, rows=None, force_sign=1.0
 ) -> Iterator[LoopBlock]:
-    """The loops of ``cycles``, each moved to its centre (module notes), block by block.
-
-    Parameters
-    ----------
-    cycles : Cycles
-        The cycles of the recording.
-    displacement, force : numpy.ndarray
-        The recording the cycles were found in, float64. [m], [N]
-    rows : slice, optional
-        Consecutive cycles to lay out (default all). The centring of cycles cut at the
-        reversals still uses their neighbours.
-    force_sign : float
-        +1, or -1 to read the force with the other sign (without copying the recording).
-
-    Yields
-    ------
-    block : LoopBlock
-        Consecutive cycles, about ``_BLOCK`` samples in all, in order.
-    """
+    """The loops of ``cycles``, each moved to its centre (module notes), block by block."""
     first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
     # The whole cycles, by position among them: a block is consecutive whole cycles.
     kept = np.flatnonzero(cycles.whole)
@@ -305,11 +220,7 @@ def _blocks(points: np.ndarray, offset: int) -> Iterator[slice]:
 
 
 def _path_means(path, values, offset, count, closed: bool):
-    """Mean of ``values`` round each loop weighted by the distance along ``path``.
-
-    The loops are stretches (``offset``, ``count``) of the flat arrays; ``closed`` adds
-    the segment from each stretch's last sample back to its first.
-    """
+    """Mean of ``values`` round each loop weighted by the distance along ``path``."""
     path, values = (np.ascontiguousarray(a, dtype=np.float64) for a in (path, values))
     return kernels.path_means(path, values, offset, count, closed)
 
@@ -317,11 +228,7 @@ def _path_means(path, values, offset, count, closed: bool):
 def _displacement_centres(start, count, displacement, first: int, stop: int):
     """Middle sample of every cycle cut at the reversals (stretches ``start``, ``count``),
     and the displacement centres of the cycles from :data:`NEIGHBOURS` before ``first`` to
-    :data:`_NOISE_REACH` after ``stop - 1`` (NaN for the others), a block at a time.
-
-    A cycle's path runs over its stretch only: the segment that closes the loop, from the
-    next reversal back to the first sample, is not travelled.
-    """
+    :data:`_NOISE_REACH` after ``stop - 1`` (NaN for the others), a block at a time."""
     # The mean sample index round the loop, its closing point included (exact integers).
     middle = ((count * (2 * start + count - 1)) // 2 + start) / (count + 1)
     centre = np.full(start.size, np.nan)
@@ -335,12 +242,7 @@ def _displacement_centres(start, count, displacement, first: int, stop: int):
 
 
 def _drift(low: int, high: int, points, values, near: slice):
-    """``values`` interpolated over ``points`` at the samples ``low`` to ``high - 1``.
-
-    Piecewise linear, extended linearly beyond the first and last points;
-    ``points[near]`` bracket every sample that lies between two points. Inside, it is
-    ``np.interp`` on the segments between points, to the bit (one pass).
-    """
+    """``values`` interpolated over ``points`` at the samples ``low`` to ``high - 1``."""
     xp, fp = points[near], values[near]
     # Sample i lies on segment j when xp[j] <= i < xp[j + 1].
     edges = np.clip(np.ceil(xp).astype(np.int64), low, high) - low
@@ -399,11 +301,7 @@ _UNEXPLAINED = 0.2
 
 
 def _loop_values(block, load, options):
-    """Every per-cycle quantity of a block of centred loops, and the checks it failed.
-
-    Returns the quantities (module notes; not yet NaN where a check fails) and the flags
-    of :data:`ecofmaps.measured.quality.REASONS` (reason -> per cycle).
-    """
+    """Every per-cycle quantity of a block of centred loops, and the checks it failed."""
     # The extremes, the loop's area by trapezoids (the segment that closes it included)
     # and its top, where the rising branch ends.
     highest, lowest, max_force, energy, top = kernels.loop_measures(
@@ -494,38 +392,7 @@ def measure_cycles(
     keep_loops=False,
     recorded_load=None,
 ):
-    """The per-cycle quantities of :func:`analyze_loops` for cycles already found.
-
-    Parameters
-    ----------
-    cycles : Cycles
-        Cycles of the recording (:func:`ecofmaps.measured.cycles.find_cycles`).
-    displacement, force : numpy.ndarray
-        The recording, float64; NaN only in the cycles marked missing. Any object that
-        gives stretches of it by sample index (``displacement[a:b]``) will do. [m], [N]
-    load : float
-        Normal load :math:`P`. [N]
-    hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
-        As for :func:`analyze_loops` (not checked here).
-    rows : slice, optional
-        Consecutive cycles to measure; default all.
-    keep_loops : bool
-        Also return the centred loops as NaN-padded (cycle, point) arrays.
-    recorded_load : numpy.ndarray, optional
-        The normal load at each sample, when it was recorded (indexed as ``force``): its
-        mean over each cycle is ``normal_load``. [N]
-
-    Returns
-    -------
-    values : dict of str to numpy.ndarray
-        Each quantity of :func:`analyze_loops` over the cycles, offsets and stick residual
-        included, as measured: not yet NaN where a check fails; and ``normal_load`` with a
-        ``recorded_load``.
-    flags : dict of str to numpy.ndarray of bool
-        The checks of :data:`ecofmaps.measured.quality.REASONS` each cycle failed.
-    loops : tuple of numpy.ndarray or None
-        Centred displacement and force round each loop, if ``keep_loops``. [m], [N]
-    """
+    """The per-cycle quantities of :func:`analyze_loops` for cycles already found."""
     first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
     options = {
         "hysteresis": hysteresis,
@@ -588,11 +455,7 @@ def both(values):
 
 
 def branch_rows(block, top):
-    """The rising branches (start to top) and falling ones (top to the end) as rows.
-
-    Returns the displacement and force rows and the number of each row's own points
-    (the rest of a row repeats its last point).
-    """
+    """The rising branches (start to top) and falling ones (top to the end) as rows."""
     cycles = top.size
     first = np.concatenate([np.zeros_like(top), top])
     last = np.concatenate([top, block.count])
@@ -614,46 +477,7 @@ def branch_rows(block, top):
 
 
 def stick_lines(x, y, length, span, window):
-    r"""Lines :math:`\Delta = c + Q/S` through the stick segments after the two reversals.
-
-    A segment starts as the branch's samples whose force has moved away from the
-    reversal's by a share of the branch's force swing within ``window``, up to the first
-    sample beyond it (with fewer than two, the chord from the reversal to the first sample
-    past the lower share). A first line is fitted, with one compliance :math:`1/S` for both
-    branches of a cycle and an intercept for each; each segment then grows along its
-    branch until two samples in a row lie more than three standard deviations (of the
-    first line's residuals, at least :math:`10^{-9}` of the displacement's ``span``) off its
-    line (the slip that follows bends away from it; a single noisy sample does not stop
-    it), and the lines are fitted again to the grown segments.
-
-    A segment is curved where a term :math:`bQ^2` added to its line is significant (more
-    than 8 standard errors) and changes its slope :math:`d\Delta/dQ` from one end of the
-    segment to the other by more than 5 % of the compliance.
-
-    Parameters
-    ----------
-    x, y : numpy.ndarray, shape (rows, width)
-        Displacement and force of the branch rows (:func:`branch_rows`). [m], [N]
-    length : numpy.ndarray of int64, shape (rows,)
-        Points of each row.
-    span : numpy.ndarray, shape (cycles,)
-        Peak-to-peak displacement of each cycle. [m]
-    window : tuple of float
-        Shares of the branch's force swing between which a segment starts. [-]
-
-    Returns
-    -------
-    compliance : numpy.ndarray, shape (cycles,)
-        The common compliance :math:`1/S` of each cycle. [m/N]
-    intercept : numpy.ndarray, shape (rows,)
-        The intercept :math:`c` of each branch row. [m]
-    across : numpy.ndarray of bool, shape (rows,)
-        The grown segment holds forces of both signs (it reaches across zero force).
-    fit : dict of str to numpy.ndarray
-        Per cycle: ``residual``, the root mean square displacement off the lines [m];
-        ``unexplained``, the share of the displacement's variance along the segments that
-        they leave [-]; ``curved``, True where a segment bends.
-    """
+    r"""Lines :math:`\Delta = c + Q/S` through the stick segments after the two reversals."""
     low, high = (float(share) for share in window)
     compliance, intercept, across, residual, unexplained, curved = kernels.stick_lines(
         x, y, length, span, low, high
@@ -663,78 +487,13 @@ def stick_lines(x, y, length, span, window):
 
 
 def zero_force_crossings(x, y, length, max_force, across, intercept, span):
-    r"""Displacement where each branch row crosses :math:`Q = 0`, and whether on the loop.
-
-    Where the stick segment reaches across zero force (``across``), it is the intercept of
-    the line fitted to it, :math:`\Delta = c + Q/S`. Elsewhere a straight line
-    :math:`\Delta = a + bQ` is fitted to the two samples around the crossing and the
-    branch's samples with :math:`|Q|` below ``_ZERO_FORCE_BAND`` times the loop's
-    ``max_force`` :math:`Q^*`, and gives :math:`a`. The crossing is on the loop if the
-    branch has samples of both signs of force and it lies within the displacements of
-    those samples (to rounding of the displacement ``span``). Else it is taken between
-    the two samples around the crossing, if they have forces of both signs: where the
-    stick line crosses zero force between them, or on the chord joining them.
-
-    Parameters
-    ----------
-    x, y : numpy.ndarray, shape (rows, width)
-        Displacement and force of the branch rows (:func:`branch_rows`). [m], [N]
-    length : numpy.ndarray of int64, shape (rows,)
-        Points of each row.
-    max_force, span : numpy.ndarray, shape (cycles,)
-        Half the peak-to-peak force, and the peak-to-peak displacement, of each
-        cycle. [N], [m]
-    across, intercept : numpy.ndarray, shape (rows,)
-        From :func:`stick_lines`. [-], [m]
-
-    Returns
-    -------
-    crossing : numpy.ndarray, shape (rows,)
-        Displacement at :math:`Q = 0`. [m]
-    on_loop : numpy.ndarray of bool, shape (rows,)
-        The crossing lies on the loop.
-    """
+    r"""Displacement where each branch row crosses :math:`Q = 0`, and whether on the loop."""
     band = both(_ZERO_FORCE_BAND * max_force)
     return kernels.zero_force_crossings(x, y, length, band, intercept, across, both(1e-9 * span))
 
 
 def line_crossings(x, y, length, compliance, half_width, load, scale):
-    r"""Where each branch row crosses :math:`Q = S\Delta`: displacement, force, on the loop.
-
-    On the line the contact position :math:`\xi = \Delta - Q/S` (eq. 10) is zero. The
-    branch's samples with :math:`|\xi|` up to ``half_width`` are fitted by least squares
-    with :math:`Q = a + b\xi + c\xi Q`, which is eq. 9 for any groove slope
-    (:math:`a = \mu P`, :math:`b = kP`, :math:`c = \mu k`) and a smooth three-parameter
-    curve otherwise; the crossing is :math:`Q = a`. The regressors are centred and
-    :math:`\xi Q` is orthogonalised against :math:`\xi` (Gram-Schmidt), so that :math:`a`
-    stays exact when the two are nearly collinear; where :math:`\xi Q` adds only rounding
-    to :math:`\xi` (a flat groove), :math:`Q = a + b\xi` is fitted. With fewer than five
-    samples in the window, :math:`Q` is interpolated linearly at :math:`\xi = 0` between
-    the two samples around the crossing.
-
-    The crossing is on the loop if measured samples of the branch lie on both sides of
-    :math:`\xi = 0` (in the window, or the two interpolated between), and its force lies
-    within theirs (to rounding of ``scale``, the loop's :math:`Q^*`).
-
-    Parameters
-    ----------
-    x, y : numpy.ndarray, shape (rows, width)
-        Displacement and force of the branch rows (:func:`branch_rows`). [m], [N]
-    length : numpy.ndarray of int64, shape (rows,)
-        Points of each row.
-    compliance, half_width, scale : numpy.ndarray, shape (rows,)
-        :math:`1/S` of each row's cycle, the window's half-width and :math:`Q^*`.
-        [m/N], [m], [N]
-    load : float
-        Normal load :math:`P`. [N]
-
-    Returns
-    -------
-    displacement, force : numpy.ndarray, shape (rows,)
-        Where each row crosses the line. [m], [N]
-    on_loop : numpy.ndarray of bool, shape (rows,)
-        The crossing lies on the loop.
-    """
+    r"""Where each branch row crosses :math:`Q = S\Delta`: displacement, force, on the loop."""
     force, on_loop = kernels.line_crossings(
         x, y, length, compliance, half_width, float(load), 1e-9 * scale
     )

@@ -1,35 +1,7 @@
-r"""The one pipeline of the analysis of measured loops, whatever the way in.
-
-A recording (NumPy arrays, an xarray Dataset, a file of any supported format, read by
-:mod:`ecofmaps.io`) goes through the same steps, each one function that every caller
-shares, so that a fix lands once:
-
-1. **cycles**: :func:`ecofmaps.measured.cycles.find_cycles`, by passes over the recording a
-   block of samples at a time (:class:`~ecofmaps.measured.samples.Samples`): the straight
-   line through the displacement, its percentiles, the reversals (or the runs of cycle
-   numbers), the runs of missing samples. Only their results, a few numbers per cycle,
-   are held. The cycles keep the drive's numbering.
-2. **chunks**: the cycles are cut into chunks of whole cycles, about ``samples`` samples
-   each, so no cycle is cut at a chunk's edge. Each chunk reads the stretch of its cycles
-   and of five whole cycles on either side (a *halo*: the centring interpolates each
-   cycle's centre from its neighbours', and takes the noise of the centres from four
-   neighbours on either side, :mod:`ecofmaps.measured.measure`).
-3. **per-cycle values**: :func:`ecofmaps.measured.measure.measure_cycles`, with the
-   sample indices of the whole recording;
-4. **along the stroke** (``resolve``): :func:`ecofmaps.measured.resolve.resolve_analyzed_loops`
-   on the chunk's own loops, which never leave it;
-5. **quality and table**: :func:`ecofmaps.measured.quality.cycle_results` and a
-   :class:`~ecofmaps.measured.quality.Tally` of them, made where the chunk ran;
-   :meth:`Analysis.finish` checks the whole recording (every cycle refused, units,
-   scale) and gives the joined results their attributes.
-
-In memory is the case of one chunk, run in this process; out of core is the case of many;
-workers are a :class:`ecofmaps._parallel.Runner` (threads, a local cluster of processes, or
-a dask cluster), a few chunks at a time, so memory holds a few chunks whatever the length
-of the recording; a resumed run is a store of finished chunks
-(:mod:`ecofmaps.cli.loops_long`) handed back to :meth:`Analysis.part`. Every number is
-computed from the same samples with the same arithmetic in every case; only sums over a
-loop's padded rows may be grouped differently between chunkings (to the last bits).
+r"""The driver of the loop pipeline, whatever the way in: the options, the chunks of whole cycles
+(each with a halo for the centring), each chunk measured, read along the stroke and judged
+where it runs, on this process or a dask runner, and the parts joined into the table.
+The method is explained in ``docs/method-loops.md`` ("One pipeline, in memory and out of core").
 """
 
 from __future__ import annotations
@@ -96,24 +68,7 @@ IN_PROCESS = _InProcess()
 
 @dataclasses.dataclass(frozen=True)
 class Reading:
-    """What each chunk reads besides the per-cycle values.
-
-    Attributes
-    ----------
-    resolve : bool
-        Read each loop along the stroke (:func:`~ecofmaps.measured.resolve.resolve_analyzed_loops`)
-        and report :data:`~ecofmaps.measured.quality.RESOLVED` with its quality.
-    keep_loops : bool
-        Keep the centred loops in the results (``loop_displacement``, ``loop_force``).
-    along_stroke : dict, optional
-        Keyword arguments of :func:`~ecofmaps.measured.resolve.resolve_analyzed_loops`
-        (default: the per-cycle values alone, ``positions=None``). A grid of ``positions``
-        given by its number of points is spread over the widest resolved range of all
-        cycles: it needs the recording in one chunk.
-    hand_back : bool
-        Hand back the whole reading along the stroke (:attr:`Chunk.resolved`), not only
-        the values the results report.
-    """
+    """What each chunk reads besides the per-cycle values."""
 
     resolve: bool = False
     keep_loops: bool = False
@@ -209,43 +164,7 @@ def measure_chunk(
     recorded_load=None,
 ) -> Chunk:
     """Steps 3 to 5 of the pipeline for one chunk: the cycles ``rows`` of the table
-    ``cycles`` measured on the stretch of the recording that begins at sample ``low``.
-
-    Parameters
-    ----------
-    cycles : Cycles
-        The chunk's cycles and its halo.
-    low : int
-        The first sample of the stretch ``x``, ``q`` in the whole recording.
-    rows : slice
-        The chunk's own cycles among ``cycles`` (the rest is its halo).
-    load : float
-        Normal load. [N]
-    options : dict
-        From :func:`ecofmaps.measured.pipeline.check_options`.
-    x, q : numpy.ndarray
-        The stretch's displacement [m] and force [N].
-    reading : Reading
-        What is read besides the per-cycle values.
-    then : callable, optional
-        Called with the chunk's results where it runs (the command line formats its table
-        rows so); its value is :attr:`Chunk.made`.
-    keep : bool or callable
-        True: hand back what :func:`~ecofmaps.measured.measure.measure_cycles` measured
-        (with the reading along the stroke named with the prefix :data:`READ`), for a
-        store of finished chunks; a callable ``keep(values, flags)`` is given them here
-        instead, so that they do not travel.
-    columns : sequence of str, optional
-        The variables of the results handed back (``then`` is given them all).
-    recorded_load : numpy.ndarray, optional
-        The stretch's normal load, when it was recorded sample by sample (``q`` is then the
-        force at the mean load ``load``): forces, energy and stiffness are reported at each
-        cycle's own load (:data:`~ecofmaps.measured.quality.AT_OWN_LOAD`). [N]
-
-    Returns
-    -------
-    chunk : Chunk
-    """
+    ``cycles`` measured on the stretch of the recording that begins at sample ``low``."""
     values, flags, loops = measure_cycles(
         cycles,
         _Stretch(x, low),
@@ -302,53 +221,7 @@ def _part(values: dict, flags: dict, labels, load, options, loops=None) -> xr.Da
 
 class Analysis:
     """The analysis of one recording through the pipeline (module notes), in steps that a
-    caller can follow: the command line writes each chunk's results as it comes.
-
-    Parameters
-    ----------
-    displacement, force : numpy.ndarray or dask.array.Array
-        [m], [N]
-    load : float
-        Normal load. [N]
-    cycle : numpy.ndarray or dask.array.Array, optional
-        Cycle numbers. [1]
-    missing : array_like of bool, optional
-        Samples to treat as missing.
-    recorded_load : numpy.ndarray or dask.array.Array, optional
-        The normal load at each sample, when it was recorded (``force`` is then the force
-        at the mean load ``load``, :func:`force_at_mean_load`): forces, energy and stiffness
-        are reported at each cycle's own load, with it (``normal_load``). [N]
-    runner : ecofmaps._parallel.Runner, optional
-        Where the passes and the chunks run (entered); by default this process
-        (:data:`IN_PROCESS`).
-    nan_policy : {'skip', 'raise'}
-    reading : Reading, optional
-        What each chunk reads besides the per-cycle values (default: nothing).
-    cycles : Cycles, optional
-        The cycles, if found before (a resumed run); else they are found here.
-    samples : int, optional
-        Samples per chunk (about; default :data:`TASK_SAMPLES`).
-    one_chunk : bool
-        Analyse the recording as one chunk (a recording in memory).
-    **options
-        The checked options of :func:`ecofmaps.measured.pipeline.check_options`.
-
-    Attributes
-    ----------
-    cycles : Cycles
-    tasks : list of slice
-        The rows (cycles) of each chunk, in order.
-    tally : ecofmaps.measured.quality.Tally
-        What the chunks handed back so far add up to.
-
-    Raises
-    ------
-    MissingSampleError
-        With ``nan_policy='raise'``, naming the first missing sample.
-    ValueError
-        If the recording holds no complete cycle, or a reading along the stroke over a
-        grid of positions made from all cycles is asked of more than one chunk.
-    """
+    caller can follow: the command line writes each chunk's results as it comes."""
 
     def __init__(
         self,
@@ -431,33 +304,7 @@ class Analysis:
         )
 
     def measured(self, skip=(), then=None, keep=False, columns=None):
-        """Each chunk's :class:`Chunk`, in order, as they come; counted in :attr:`tally`.
-
-        Parameters
-        ----------
-        skip : collection of int
-            Chunks not to run (done before, in a run that is resumed).
-        then : callable, optional
-            A function of a chunk's results (the Dataset :meth:`part` gives), called where
-            the chunk runs: a module-level function, or a :func:`functools.partial` of one,
-            for chunks in other processes. The command line formats its table rows so.
-        keep : bool or callable
-            True: also hand back what each chunk measured (to be kept, and made into its
-            results again by :meth:`part` when a run is resumed). A callable
-            ``keep(index, values, flags)`` is called with it where the chunk runs instead
-            (picklable as ``then`` is), so that what is kept does not travel: for a runner
-            whose workers share this machine's files.
-        columns : sequence of str, optional
-            The variables of each chunk's results to hand back (those of them there are;
-            default all), so the rest does not travel. ``then`` is given them all.
-
-        Yields
-        ------
-        index : int
-            The chunk (index into :attr:`tasks`).
-        chunk : Chunk
-            What it handed back (see :func:`measure_chunk`).
-        """
+        """Each chunk's :class:`Chunk`, in order, as they come; counted in :attr:`tally`."""
         skip = set(skip)
         wanted = [k for k in range(len(self.tasks)) if k not in skip]
         tasks = (self._task(k, then, keep, columns) for k in wanted)
@@ -480,11 +327,7 @@ class Analysis:
 
     def finish(self, parts) -> xr.Dataset:
         """The parts (all of them, in order) joined, with the recording's attributes, after
-        the checks of the whole recording (see :meth:`ecofmaps.measured.quality.Tally.finish`).
-
-        The parts share their variables and the load: they are joined along ``cycle``
-        without comparing the rest (six times faster than comparing it, which copied every
-        quality string)."""
+        the checks of the whole recording (see :meth:`ecofmaps.measured.quality.Tally.finish`)."""
         parts = list(parts)
         if len(parts) == 1:
             results = parts[0]

@@ -1,11 +1,7 @@
-r"""The per-cycle results of :func:`~ecofmaps.measured.analysis.analyze_loops` as a Dataset.
-
-:func:`cycle_results` turns the measurements of
-:func:`ecofmaps.measured.measure.measure_cycles` into the labelled per-cycle Dataset (NaN
-with a reason in ``quality`` where a check fails, the regime codes), and :class:`Tally`
-gathers what is said about a whole recording from its parts as they come (the quality
-summary, the refusal of every cycle with a hint, the check of the amplitude's unit), so a
-recording analysed in chunks (:mod:`ecofmaps.measured.pipeline`) gives the same result.
+r"""Steps 6 and 7 of the loop pipeline: the judgement of each cycle (the reasons of
+:data:`REASONS`, flags turned into NaN, ``quality`` strings and refusals, once), the tally of a
+whole recording, and the per-cycle table.
+The vocabulary is explained in ``docs/method-loops.md`` ("Judging each cycle").
 """
 
 from __future__ import annotations
@@ -254,15 +250,7 @@ class Tally:
 
     def finish(self, results, cycles: Cycles, cycles_from: str, options: dict) -> xr.Dataset:
         """Check the whole recording and give ``results`` (the parts, joined) its
-        attributes.
-
-        Raises
-        ------
-        ImplausibleScaleError
-            If every cycle was refused, some for an implausible amplitude.
-        ValueError
-            If every cycle was refused for other reasons.
-        """
+        attributes."""
         summary = self.summary
         typical = _typical(np.concatenate(self.amplitudes) if self.amplitudes else np.zeros(0))
         scaled = self.scaled
@@ -454,11 +442,7 @@ def _by_text(quality, function) -> np.ndarray:
 
 
 def quality_strings(flags: dict, size: int) -> np.ndarray:
-    """The ``quality`` of ``size`` cycles from boolean ``flags`` (reason -> per cycle).
-
-    A refused cycle lists only the reasons that refuse it; a reason whose NaN another of
-    the cycle's reasons covers, and more, is left out (``'no-crossing'`` in partial slip).
-    """
+    """The ``quality`` of ``size`` cycles from boolean ``flags`` (reason -> per cycle)."""
     refusing = _refusing(flags, size)
     code = np.zeros(size, dtype=np.int64)
     for bit, reason in enumerate(REASONS):

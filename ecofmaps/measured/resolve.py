@@ -1,157 +1,7 @@
-r"""Friction and groove slope read along the whole stroke of every measured loop.
-
-At the contact position :math:`\xi = \Delta - Q/S` (eq. 10) the model's two slip branches
-are :math:`Q_+/P = \tan(\alpha + \varphi)` and :math:`Q_-/P = \tan(\alpha - \varphi)`
-(eq. 9), with :math:`\varphi = \arctan\mu` and :math:`\alpha = \arctan g(\xi)` the local
-slope of whatever groove the pad sits in. Where both branches slip over the same
-:math:`\xi`, they give both, exactly:
-
-.. math::
-
-    \mu(\xi) = \tan\frac{\arctan(Q_+/P) - \arctan(Q_-/P)}{2}, \qquad
-    g(\xi) = \tan\frac{\arctan(Q_+/P) + \arctan(Q_-/P)}{2},
-
-and :math:`h(\xi) = \int_0^\xi g\,d\xi` is the scar's profile as the pad feels it. The
-GICoF (eq. 17-18) is the special case :math:`\xi = 0`. :func:`ecofmaps.resolve_loops` reads them
-off every cycle of a recording; :func:`resolve_analyzed_loops` does the same from the loops
-that :func:`ecofmaps.analyze_loops` kept (``keep_loops=True``): cycles, centring, offsets
-and a first stiffness come from there. The work is vectorised over blocks of 512 cycles
-(padded rows, no Python loop over cycles or samples; :mod:`~ecofmaps.measured.resolve_branches`
-and :mod:`~ecofmaps.measured.resolve_branches` hold the kernels).
-
-The method, per cycle
----------------------
-Each centred loop runs from its lowest displacement up the *rising* branch to its highest
-and back down the *falling* one.
-
-* **Stick sets.** A first pass takes the samples whose force has moved away from the
-  reversal's by a share between ``stick_window[0]`` and ``stick_window[1]`` (default 5 %
-  and 45 %) of the branch's force swing, with :func:`~ecofmaps.analyze_loops`'s stiffness
-  (or the given one), and finds where the slip starts (below). The stick set is then every
-  sample from the lower share up to 5 % of the swing before the first slip sample: in the
-  model the contact sticks there, :math:`\xi` stands still, and the samples lie on a
-  vertical line of the :math:`(\xi, Q)` plane.
-* **Stiffness.** Given, or measured: the compliance :math:`1/S` common to the two stick
-  sets, each with its own intercept, by least squares of :math:`\Delta` on :math:`Q`
-  (:math:`\Delta = \xi_s + Q/S`), with its standard error from the residuals. Where a set
-  has fewer than three samples (sparse loops), :func:`~ecofmaps.analyze_loops`'s
-  stiffness is kept.
-* **Noise and stick level.** The noise :math:`\sigma` of :math:`\xi` comes from its
-  second differences within the stick sets,
-  :math:`\operatorname{median}|\xi_{i-1} - 2\xi_i + \xi_{i+1}| / (0.6745\sqrt6)`, which a
-  smooth trend of :math:`\xi` (a rounded loop, a wrong stiffness) hardly enters; it
-  assumes noise that is white from sample to sample. The stick level :math:`\xi_s` is the
-  median of :math:`\xi` over the set (the reversal's :math:`\xi` for a set of fewer than
-  three samples).
-* **Slip.** A sample of the rising branch slips if it and every later sample of the
-  branch lie more than ``slip_threshold`` (default 4) times :math:`\sigma` above the stick
-  level (below it on the falling branch). Only the run of slip up to the next reversal
-  counts, so a noisy stick sample cannot pass for slip; the first samples of slip, within
-  the threshold of the stick level, are left out. Noise-free, :math:`\sigma = 0` and
-  every sample that has moved (by more than :math:`10^{-9}\Delta^*`) slips.
-* **Resampling.** The slip samples of each branch, sorted by :math:`\xi`, are read at
-  given positions inside the range where both branches slip (never beyond a branch's
-  outermost slip samples) by the linear fraction :math:`Q - Q_1 = m d/(1 + c d)`,
-  :math:`d = \xi - \xi_1`, through three samples around the position. It is eq. 9 on a
-  parabolic groove, so the model's branches are read exactly; where it would have a pole
-  near the three samples (noisy samples that do not rise monotonically, a branch flat to
-  rounding), the straight line between the two samples around the position.
-* **Per cycle**, on the cycle's own grid of 201 positions over its central part
-  :math:`|\xi| \le` ``central`` times the shorter half of the resolved range (so that
-  nothing depends on the other cycles): ``mu_resolved``, the mean of :math:`\mu(\xi)` after
-  values beyond three robust standard deviations of the median are clipped to that bound;
-  ``aspect_ratio`` :math:`z_o/x_o = k\Delta^*/2` from the least-squares line
-  :math:`g \approx g_0 + k\xi` (eq. 7 with the paper's :math:`x_o = \Delta^*`), and
-  ``tilt`` :math:`g_0`.
-* **Standard error.** The mean is a linear combination of the samples of the two branches
-  through the resampling (neighbouring positions share samples): each sample's weight is
-  the sum over the positions of :math:`\partial\mu/\partial Q_\pm` times its share in the
-  straight line there. The noise of each branch comes from its samples in the central part,
-  each against the line through its two neighbours (variance
-  :math:`\sigma^2(1 + u^2 + (1-u)^2)` for white noise); the variance of ``mu_resolved`` is
-  the sum of the squared weights times it. That variance holds for white noise only:
-  residuals along a stroke are correlated (chatter, stick-slip, roughness), and the
-  model may not fit (ploughing, a rounded loop). So the central part is also cut into
-  eight blocks of equal length, and the variance of the mean of independent blocks
-  (batch means) is taken from the scatter of the block means of :math:`\mu(\xi)`
-  (before clipping): their variance over their number less one, times
-  :math:`(1 + r_1)/(1 - r_1)` for the lag-one autocorrelation :math:`0 \le r_1 \le 0.8`
-  of the block means (a friction that varies slowly along the stroke). The larger of the
-  two variances is used: the noise alone, or the scatter that the noise and the misfit
-  make together. When the stiffness is measured, its uncertainty is added in quadrature
-  through the sensitivity
-  :math:`\partial\bar\mu/\partial(1/S) = \tfrac12(1 + \bar\mu^2)\,
-  \overline{\alpha'(\xi)(Q_+ - Q_-)}`: an error of :math:`S` moves the two branches in
-  opposite directions along :math:`\xi`, and on a sloping groove that shifts every
-  :math:`\mu(\xi)` the same way (the GICoF equally). A shift :math:`h` of the rising
-  branch against the falling one does the same,
-  :math:`\partial\bar\mu/\partial h = -\tfrac12(1 + \bar\mu^2)\,\overline{\alpha'(\xi)}`:
-  a dead band between the actuator and the pad (backlash) or a drift of the displacement
-  over the cycle. At each reversal the pad stops where its slip ended, so the stick set
-  that follows has the :math:`\xi` of the branch's last slip samples; :math:`h` is the mean
-  over the two reversals of the gap between the median :math:`\xi` of a branch's last four
-  slip samples and the next stick level (zero for the model's loop, up to the noise), and
-  :math:`|h\,\partial\bar\mu/\partial h|` is added in quadrature: an error the
-  reading cannot remove, whose size it knows. Last, the loop's centring: noise on the
-  displacement and on the force moves each loop's centre, and the drift interpolated
-  between neighbouring centres offsets the falling branch's force against the rising
-  one's by :math:`\varepsilon` over the whole stroke, where the scatter along it cannot
-  see it. Its standard error is :func:`~ecofmaps.analyze_loops`'s ``force_drift_se``
-  (:mod:`ecofmaps.measured.measure`), added through
-  :math:`\partial\bar\mu/\partial\varepsilon = \tfrac14(1 + \bar\mu^2)\,
-  \overline{(1 + q_+^2)^{-1} + (1 + q_-^2)^{-1}}/P`, :math:`1/(2P)` on a flat track.
-
-  The standard error is checked on recordings whose truth is known
-  (:func:`ecofmaps.measured.synthetic.ugly_recording`: noise, offsets and drift, chatter,
-  stick-slip, backlash, an amplitude sweep, sparse digitised loops, ploughing, all
-  together), and on loops of an independent return map with noise on both channels:
-  ±2 se covers the truth on 95 % to 99 % of the cycles whose ``mu_resolved`` is reported
-  (``tests/measured/test_calibration.py``; it must stay above 80 %).
-* **Along the stroke**, on a grid of positions common to all cycles (``positions``
-  points over the widest resolved range, or the positions given): :math:`Q_\pm(\xi)`,
-  :math:`\mu(\xi)`, :math:`g(\xi)` and :math:`h(\xi)`, the trapezoidal integral of
-  :math:`g`, zero at :math:`\xi = 0`. The loops' centring removes a force offset that a
-  tilt of the groove cannot be told from; so, unless ``force_offset`` gives the force's
-  zero, :math:`g` and :math:`h` are levelled: :math:`g_0` is taken off :math:`g`. Levelling
-  also takes off the tilt that the noise of the loop's force centre adds.
-
-Quality
--------
-A cycle whose numbers cannot be stood behind has NaN for every resolved value and its
-``quality`` says why. It starts as :func:`~ecofmaps.analyze_loops`'s (see
-:mod:`ecofmaps.measured.quality`): a cycle refused there, in partial slip
-(``'not-gross-slip'``) or with curved stick sides (``'curved-stick'``: a rounded loop, as
-polymers and micro-slip draw) is not read. This reading adds its own reasons (joined with
-``'+'``, in the order of :data:`ecofmaps.measured.quality.REASONS`), the first that applies:
-
-* ``'stiffness-mismatch'``: the given stiffness tilts the stick sets in :math:`\xi` by
-  more than three times the noise :math:`\sigma` over their force span (for Example 2's
-  loops, about 5 % off), or the stiffness measured on them slopes down beyond three
-  standard errors.
-* ``'no-overlap'``: no range of :math:`\xi` around the loop's centre where both branches
-  slip (a slip within the noise, at the onset of gross slip).
-* ``'few-slip-samples'``: fewer than eight slip samples of either branch in the central
-  part (a sparsely sampled or digitised loop): the average would be read off straight
-  lines between samples far apart, and the noise could not be told.
-* ``'mu-varies'``: the means of :math:`\mu(\xi)` over the inner and the outer half of the
-  central part differ by more than 3 % and four standard errors (of white noise). The
-  model's :math:`\mu(\xi)` is constant for any groove; a rounded loop's falls towards the
-  ends of the stroke, also where the noise hides the curvature of its stick sides; a
-  chatter of ±30 % is caught here on most cycles, and on the others its scatter makes
-  the standard error (above) cover the truth.
-
-Otherwise ``'ok'``. Besides, and without touching the values read along the stroke:
-
-* ``'gicof-varies'``: the means of :math:`\mu(\xi)` over the eight blocks scatter about
-  a straight line through them by more than 1.5 % of :math:`\mu` beyond the noise
-  (chatter, stick-slip). The GICoF is read where the loop crosses :math:`Q = S\Delta`, at
-  one position: it then need not be the contact's mean friction. A straight trend (as
-  centring draws on a tilted groove) is the same at the centre and is not flagged.
-
-References
-----------
-X. Jin, W. Sun, P.H. Shipway (2016): eq. 7 (the groove), eq. 9 (the slip traction at the
-local slope), eq. 10 (the contact position), eq. 17-18 (the GICoF, here at :math:`\xi = 0`).
+r"""Step 5 of the loop pipeline: friction and groove slope read along the whole stroke of each
+loop (:func:`resolve_analyzed_loops`), with the flags of its checks; the numerics of the slip
+branches are in :mod:`ecofmaps.measured.resolve_branches`.
+The method is explained in ``docs/method-loops.md`` ("Reading the loop along the stroke").
 """
 
 from __future__ import annotations
@@ -420,16 +270,7 @@ _MAD = 1.482602218505602
 
 
 def _central_values(forward, backward, central, load):
-    """mu_resolved, its variance, k and g0 of g ≈ g0 + kξ, the sensitivity to 1/S.
-
-    Read on each cycle's own grid over its central part, ``|ξ| <= central``: nothing here
-    depends on the other cycles. The variance is the noise's, or the scatter's of μ(ξ)
-    along the part where that is larger (:func:`_scatter_variance`). Also whether μ(ξ)
-    varies between the inner and the outer half of the part beyond ``_VARIATION`` of μ and
-    beyond its noise, the sensitivity to a shift of the rising branch against the falling
-    one along ξ, whether μ(ξ) wiggles about a straight line beyond ``_GICOF_WIGGLE``, and
-    the sensitivity to an offset of the falling branch's force against the rising one's.
-    """
+    """mu_resolved, its variance, k and g0 of g ≈ g0 + kξ, the sensitivity to 1/S."""
     width = forward[0].shape[1]
     usable = np.isfinite(central)
     unit = np.linspace(-1.0, 1.0, _CENTRAL_POINTS)
@@ -494,16 +335,7 @@ def _central_values(forward, backward, central, load):
 
 
 def _scatter_variance(mu, kept, unit):
-    r"""Variance of the mean of ``mu`` over ``kept`` from the scatter of its block means.
-
-    The central part is cut into ``_SCATTER_BLOCKS`` blocks of equal length; the block
-    means' variance about their mean, over their number less one, and times
-    :math:`(1 + r_1)/(1 - r_1)` for the lag-one autocorrelation :math:`r_1 \ge 0` of the
-    block means (friction that varies slowly along the stroke), is the variance of the
-    mean of independent blocks (batch means). NaN for fewer than three blocks.
-
-    Also returns the variance of the block means about a straight line through them.
-    """
+    r"""Variance of the mean of ``mu`` over ``kept`` from the scatter of its block means."""
     member = np.minimum((0.5 * (unit + 1.0) * _SCATTER_BLOCKS).astype(int), _SCATTER_BLOCKS - 1)
     blocks = member[:, None] == np.arange(_SCATTER_BLOCKS)[None, :]
     counts = kept.astype(np.float64) @ blocks
@@ -571,15 +403,7 @@ def _blocks(cycles):
 def along_stroke_values(
     x, q, valid, load, stiffness, amplitude, inherited, given, options, drift_se
 ):
-    """Every resolved quantity of the centred loops ``x``, ``q`` (module notes).
-
-    ``stiffness`` is the given S (``given`` True) or analyze_loops's, per cycle, and
-    ``quality`` analyze_loops's: a cycle it flags for a reason that reaches the resolved
-    values is not read. ``drift_se`` is the standard error of the offset between each
-    loop's branches that its centring left (analyze_loops's ``force_drift_se``) [N].
-    Returns the per-position and per-cycle arrays, the quality (with this reading's reasons
-    added) and the grid. The work is done on blocks of cycles, each block vectorised.
-    """
+    """Every resolved quantity of the centred loops ``x``, ``q`` (module notes)."""
     cycles = x.shape[0]
     parts = []
     for block in _blocks(cycles):

@@ -1,11 +1,6 @@
-r"""Stick and slip along each branch of centred fretting loops, and the rig stiffness.
-
-The arrays hold one loop per row, as :func:`ecofmaps.analyze_loops` keeps them: each row
-runs from the loop's lowest displacement up the *rising* branch to its highest and back
-down the *falling* one, NaN-padded. :func:`slip_branches` finds the stick sets after the
-two reversals, measures the stiffness on them (or checks a given one), and returns the
-samples of each branch that slip, sorted by contact position :math:`\xi = \Delta - Q/S`
-(eq. 10). The method is described in :mod:`ecofmaps.measured.resolve`.
+r"""The numerics of the reading along the stroke (:mod:`ecofmaps.measured.resolve`): the stiffness
+and the slip of each branch, the branches resampled at contact positions, their noise and
+the weights of their samples in the standard errors.
 """
 
 from __future__ import annotations
@@ -77,10 +72,7 @@ def _before(mask, branch):
 
 
 def _compliance(x, q, sticks):
-    """Least-squares compliance common to lines Δ = ξ_s + cQ through each stick set.
-
-    Returns the compliance and its standard error (from the residuals about the lines).
-    """
+    """Least-squares compliance common to lines Δ = ξ_s + cQ through each stick set."""
     covariance = np.zeros(x.shape[0])
     variance = np.zeros(x.shape[0])
     centred = []
@@ -101,10 +93,7 @@ def _compliance(x, q, sticks):
 
 
 def _stick_and_slip(xi, branches, sticks, floor, slip_threshold):
-    """Noise and the slip of each branch (module notes).
-
-    Returns the noise σ of ξ, the two slip masks and the two stick levels.
-    """
+    """Noise and the slip of each branch (module notes)."""
     # σ from the second differences within the stick sets: a smooth trend of ξ (a rounded
     # loop, a wrong stiffness) hardly enters them, white noise does with variance 6σ².
     second = np.abs(xi[:, :-2] - 2.0 * xi[:, 1:-1] + xi[:, 2:])
@@ -130,16 +119,7 @@ def _stick_and_slip(xi, branches, sticks, floor, slip_threshold):
 
 
 def _branch_shift(xi, branches, slips, levels):
-    r"""How far the rising branch's slip lies beyond the falling one's, in ξ, per cycle.
-
-    At each reversal the pad stops where the slip ended: the stick set that follows has
-    the :math:`\xi` of the last slip samples before it. A dead band between the actuator
-    and the pad (backlash), or a drift of the displacement over the cycle, breaks this:
-    the gaps between the median :math:`\xi` of the last ``_END_SAMPLES`` slip samples of a
-    branch and the next stick level, averaged over the two reversals, are the shift of
-    the rising branch against the falling one (zero for the model's loop, up to the
-    noise). NaN where a branch has no slip.
-    """
+    r"""How far the rising branch's slip lies beyond the falling one's, in ξ, per cycle."""
     gaps = []
     for slip, level in zip(slips, levels[::-1], strict=True):
         # The last slip samples of the branch in time: its slip runs to the reversal.
@@ -160,13 +140,7 @@ def _sorted_branch(xi, q, slip):
 
 
 def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_threshold):
-    """The stiffness, the checks of the stick sets, and the two slip branches (module notes).
-
-    Returns a dict with the compliance and its standard error, ``mismatch`` (per cycle: a
-    given stiffness that tilts the stick sets, or a measured one that slopes down), the
-    sorted slip branches ``forward`` and ``backward`` and the range ``lowest`` ..
-    ``highest`` where both slip.
-    """
+    """The stiffness, the checks of the stick sets, and the two slip branches (module notes)."""
     cycles = x.shape[0]
     floor = _ROUNDING * amplitude
     branches = _branches(x, valid)
@@ -234,19 +208,7 @@ def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_t
 
 
 def resample(xs, qs, count, grid, scale, inside):
-    r"""``qs(xs)`` at the positions ``scale * grid`` (one row per cycle), by 3-point fractions.
-
-    ``xs`` rows are sorted, padded with +inf beyond ``count``; ``grid`` is increasing and
-    common to the rows, ``scale`` (one per row) stretches it; positions outside
-    ``inside`` give NaN. The fraction through three samples around a position (the two
-    that bracket it and the one before, or the first three),
-    :math:`Q - Q_1 = m d/(1 + c d)` with :math:`d = \xi - \xi_1`, is used where its
-    denominator stays above 1/2 over the three samples; elsewhere the line through the
-    two samples that bracket the position.
-
-    Returns the values, and the index of the sample before each position and the
-    position's share of the way to the next sample (the weights of the straight line).
-    """
+    r"""``qs(xs)`` at the positions ``scale * grid`` (one row per cycle), by 3-point fractions."""
     cycles, width = xs.shape
     points = grid.size
     at = scale[:, None] * grid[None, :]
@@ -299,12 +261,7 @@ def read_branches(forward, backward, grid, scale, inside, load):
 
 
 def branch_noise(xs, qs, count, central):
-    """Standard deviation of a branch's samples about the branch, in its central part.
-
-    Each sample is compared with the line through its two neighbours; the residual's
-    variance is σ² (1 + u² + (1 - u)²) for white noise of σ, u the sample's share of the
-    way between them.
-    """
+    """Standard deviation of a branch's samples about the branch, in its central part."""
     x0, x1, x2 = xs[:, :-2], xs[:, 1:-1], xs[:, 2:]
     q0, q1, q2 = qs[:, :-2], qs[:, 1:-1], qs[:, 2:]
     u = np.divide(x1 - x0, x2 - x0, out=np.full_like(x0, 0.5), where=x2 > x0)
@@ -316,10 +273,7 @@ def branch_noise(xs, qs, count, central):
 
 
 def sample_weights(left, share, gain, width):
-    """Weight of each sample of a branch in a sum over grid points of ``gain`` times its value.
-
-    The grid value is read as the straight line between samples ``left`` and ``left + 1``.
-    """
+    """Weight of each sample of a branch in a sum over grid points of ``gain`` times its value."""
     cycles = left.shape[0]
     base = (width * np.arange(cycles))[:, None]
     gain = np.where(np.isfinite(gain), gain, 0.0)

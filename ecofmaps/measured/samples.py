@@ -1,13 +1,7 @@
-r"""The chunked passes over a recording that find its cycles (:mod:`ecofmaps.measured.cycles`).
-
-Each pass reads a chunk of ``_CHUNK`` samples at a time (a block of chunks where a dask task
-runs, for a recording held as dask arrays, :mod:`ecofmaps.measured.samples`) and returns what
-it found per chunk, to be joined in order: the sums of the detrending line and the gaps of
-missing samples (:func:`survey`), the percentiles of the detrended displacement
-(:func:`displacement_percentiles`), the Schmitt trigger's runs and their extremes
-(:func:`trigger_runs`, :func:`_tails`), and the runs of recorded cycle numbers
-(:func:`labelled_runs`). Nothing the size of the recording is held beyond the recording
-itself.
+r"""Step 1 of the loop pipeline: the channels of a recording (:class:`Samples`, NumPy or dask),
+read a block at a time, and the passes over them that find the cycles (the straight line, the
+percentiles, the trigger's runs, the runs of cycle numbers).
+The method is explained in ``docs/method-loops.md`` ("Finding the cycles").
 """
 
 from __future__ import annotations
@@ -43,10 +37,7 @@ def _chunks(start: int, stop: int, chunk: int):
 
 
 def _blanked(x, a: int, b: int, gaps) -> np.ndarray:
-    """``x`` (samples ``a`` to ``b - 1``) with NaN at the missing ones (a copy if any).
-
-    ``gaps`` is an (m, 2) array of the ``[start, stop)`` of each run of missing samples.
-    """
+    """``x`` (samples ``a`` to ``b - 1``) with NaN at the missing ones (a copy if any)."""
     first = np.searchsorted(gaps[:, 1], a, side="right")
     last = np.searchsorted(gaps[:, 0], b)
     if first >= last:
@@ -74,10 +65,7 @@ def _piece_extremes(x, cuts):
 
 def first_of_runs(run, value, index, target):
     """The first ``index`` of each run whose piece ``value`` equals the run's ``target``
-    (-1 for a run with none).
-
-    ``run`` numbers the pieces' runs (0, 1, ... in order).
-    """
+    (-1 for a run with none)."""
     hits = np.flatnonzero(value == target[run])
     runs = np.arange(target.size)
     if not hits.size:
@@ -160,13 +148,7 @@ def _tails(start, stop, arguments, x):
 
 
 def trigger_runs(start, stop, arguments, x):
-    """The Schmitt trigger's runs begun in the block, and the extremes of its pieces.
-
-    Returns the runs' first samples and kinds (+1 high, -1 low; a run that continues the
-    block's previous one in kind is left out, but not across blocks), and for each piece
-    (cut at the block's chunks and at those first samples): its first sample, largest and
-    smallest finite displacement and the first sample of each.
-    """
+    """The Schmitt trigger's runs begun in the block, and the extremes of its pieces."""
     chunk, gaps, line, (centre, level) = arguments
     entries, kinds, pieces = [], [], []
     previous = 0
@@ -196,10 +178,7 @@ def labelled_runs(start, stop, arguments, x, cycle):
     """Pieces of runs of equal cycle numbers in the block, cut at its chunks: first
     sample, cycle number, samples, largest and smallest finite displacement, the first
     sample of the smallest, the first and last finite displacement, and the largest step
-    between consecutive samples of the run (to the sample after the block too).
-
-    ``x`` and ``cycle`` hold one sample past the block when there is one.
-    """
+    between consecutive samples of the run (to the sample after the block too)."""
     chunk, gaps, carries = arguments
     carry = carries[start]
     pieces = []
@@ -288,14 +267,7 @@ def displacement_line(sums, size: int):
 
 def displacement_percentiles(samples: Samples, gaps, line, sample_at, sampled, count: int):
     """``np.percentile`` of the finite detrended displacements at the 1st and 99th
-    percentile, exactly.
-
-    A long recording is not held at once: a random sample of it brackets each order
-    statistic needed (by eight standard errors of the sample's quantile), one pass a chunk
-    at a time keeps the values inside the brackets and counts those below, and the order
-    statistics are selected among these. NumPy's linear interpolation between them is
-    repeated operation by operation, so the result is the same to the last bit.
-    """
+    percentile, exactly."""
     mean, mean_t, slope, middle = line
     if count <= _CHUNK:
         tails = np.concatenate(
@@ -393,24 +365,7 @@ def _task(function, start, stop, arguments, *arrays):
 
 
 class Samples:
-    """The channels of one recording (see the module notes).
-
-    Parameters
-    ----------
-    displacement, force : numpy.ndarray or dask.array.Array
-        Float64, one value per sample. [m], [N]
-    cycle : numpy.ndarray or dask.array.Array, optional
-        Cycle number of each sample. [1]
-    missing : numpy.ndarray or dask.array.Array of bool, optional
-        True for samples to treat as missing besides the non-finite ones.
-    runner : ecofmaps._parallel.Runner, optional
-        Where the blocks of a lazy recording run (required for dask arrays).
-    chunk : int
-        The blocks of a lazy recording start at multiples of this many samples.
-    block : int, optional
-        Samples per block of a lazy recording; by default the multiple of ``chunk``
-        nearest the displacement's own dask chunks (or 2**22).
-    """
+    """The channels of one recording (see the module notes)."""
 
     def __init__(
         self, displacement, force, cycle=None, missing=None, *, runner=None, chunk, block=None
@@ -449,26 +404,7 @@ class Samples:
         return [(a, min(a + self.block, self.size)) for a in range(0, self.size, self.block)]
 
     def map(self, function, channels, arguments=(), extra: int = 0) -> list:
-        """``function(start, stop, arguments, *arrays)`` over the recording's blocks.
-
-        Parameters
-        ----------
-        function : callable
-            A module-level function. ``arrays`` are the ``channels`` asked for (None for
-            one the recording lacks) over samples ``start`` to ``stop - 1`` and up to
-            ``extra`` samples beyond, as NumPy arrays.
-        channels : sequence of str
-            Names from :data:`CHANNELS`.
-        arguments : tuple
-            Passed through to every call.
-        extra : int
-            Samples past the block's end to read as well (a look ahead).
-
-        Returns
-        -------
-        results : list
-            One result per block, in order (one block, the whole recording, in memory).
-        """
+        """``function(start, stop, arguments, *arrays)`` over the recording's blocks."""
         selected = [self.channel(name) for name in channels]
         if not self.lazy:
             return [function(0, self.size, arguments, *selected)]

@@ -1,18 +1,7 @@
-r"""Synthetic fretting recordings made with the model, and the example shipped in the package.
-
-:func:`synthetic_recording` imposes a sinusoidal displacement on the model
-(:func:`ecofmaps.simulate`), one cycle per row so that the groove may change from cycle to
-cycle, and adds what a rig's sensors add: offsets, a slow drift, Gaussian noise and, if
-asked, an irregular sampling clock. Each cycle is simulated twice over from rest and the
-second pass kept, so every recorded loop is the steady loop of its own groove.
-
-:func:`example_recording` is the deterministic generator of the recording shipped as
-``ecofmaps/data/synthetic_fretting_test.csv`` (see :func:`example_path`), which
-``ecofmaps loops --example`` analyses. :func:`scar_example_trace` generates the synthetic
-profilometer trace across a wear scar shipped as
-``ecofmaps/data/synthetic_scar_profile.csv`` (see :func:`scar_example_path`).
-
-A long test of 10⁸ samples and more is made by :mod:`ecofmaps.measured.synthetic`.
+r"""Synthetic fretting recordings made with the model: :func:`synthetic_recording`, the
+example shipped in the package (:func:`example_path`, :func:`scar_example_path`), and a long
+test generated and written block by block (:func:`long_recording`,
+:func:`write_long_recording`).
 """
 
 from __future__ import annotations
