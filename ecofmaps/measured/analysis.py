@@ -9,18 +9,17 @@ import numpy as np
 import xarray as xr
 
 from ecofmaps._inputs import si_units
-from ecofmaps._parallel import Runner, check_workers
+from ecofmaps._parallel import check_workers
 from ecofmaps.measured.cycles import MIN_SAMPLES, missing_sample_error
-from ecofmaps.measured.measure import GROSS_SLIP_THRESHOLD
 from ecofmaps.measured.pipeline import (
-    DEFAULTS,
     NAN_POLICIES,
     Analysis,
+    LoopOptions,
     Reading,
-    check_options,
     force_at_mean_load,
+    runner_for,
 )
-from ecofmaps.measured.resolve import check_reading_options
+from ecofmaps.measured.resolve import ReadingOptions
 from ecofmaps.measured.samples import is_lazy
 
 __all__ = ["analyze_loops", "resolve_loops"]
@@ -49,10 +48,10 @@ def analyze_loops(
     load,
     cycle=None,
     *,
-    hysteresis=0.5,
-    stick_window=(0.05, 0.45),
-    crossing_window=0.7,
-    gross_slip_threshold=GROSS_SLIP_THRESHOLD,
+    hysteresis=LoopOptions.hysteresis,
+    stick_window=LoopOptions.stick_window,
+    crossing_window=LoopOptions.crossing_window,
+    gross_slip_threshold=LoopOptions.gross_slip_threshold,
     flip_force=False,
     resolve=False,
     keep_loops=False,
@@ -190,26 +189,41 @@ def analyze_loops(
     ok | 1 cycle: 1 ok
     """
     force, load, recorded = _at_mean_load(force, load)
-    options = check_options(
+    options = LoopOptions(
         load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
     )
     reading = Reading(resolve=bool(resolve), keep_loops=bool(keep_loops))
     results, _ = _run(
-        displacement, force, load, cycle, missing, options, nan_policy, reading, scheduler, workers,
+        displacement,
+        force,
+        cycle,
+        options,
+        reading,
+        missing=missing,
         recorded_load=recorded,
-    )  # fmt: skip
+        nan_policy=nan_policy,
+        scheduler=scheduler,
+        workers=workers,
+    )
     return results
 
 
 def _run(
-    displacement, force, load, cycle, missing, options, nan_policy, reading, scheduler, workers,
+    displacement,
+    force,
+    cycle,
+    options: LoopOptions,
+    reading: Reading,
+    *,
+    missing=None,
     recorded_load=None,
-):  # fmt: skip
-    """The recording checked and through the pipeline (:mod:`ecofmaps.measured.pipeline`):
-    in this process as one chunk when it is in memory, else on the runner for
-    ``scheduler`` and ``workers``; ``recorded_load`` is the load at each sample when it was
-    recorded (``force`` is then at the mean ``load``). Returns the results and the reading
-    along the stroke (or None)."""
+    nan_policy="skip",
+    scheduler=None,
+    workers=None,
+):
+    """The recording checked and through the pipeline: in this process as one chunk when it
+    is in memory, else on the runner of ``scheduler`` and ``workers``. Returns the results
+    and the reading along the stroke handed back (or None)."""
     if nan_policy not in NAN_POLICIES:
         raise ValueError(f"nan_policy must be one of {NAN_POLICIES}; got {nan_policy!r}")
     if scheduler in (None, "threads", "processes"):  # on this machine: checked before any work
@@ -223,12 +237,16 @@ def _run(
             f"too few samples for one cycle: {x.shape[0]} (a cycle needs at least {MIN_SAMPLES})"
         )
     arrays = dict(
-        missing=mask, recorded_load=recorded_load, nan_policy=nan_policy, reading=reading, **options
+        options=options,
+        missing=mask,
+        recorded_load=recorded_load,
+        nan_policy=nan_policy,
+        reading=reading,
     )
     if not any(is_lazy(a) for a in (x, q, label, mask)):
         if nan_policy == "raise":
             _raise_at_missing(x, q, label, mask)
-        analysis = Analysis(x, q, float(load), label, one_chunk=True, **arrays)
+        analysis = Analysis(x, q, label, one_chunk=True, **arrays)
         return analysis.run()
     if reading.keep_loops:
         raise ValueError(
@@ -236,7 +254,7 @@ def _run(
             "recording's loops would not fit)"
         )
     with runner_for(scheduler, workers) as runner:
-        analysis = Analysis(x, q, float(load), label, runner=runner, **arrays)
+        analysis = Analysis(x, q, label, runner=runner, **arrays)
         return analysis.run()
 
 
@@ -262,25 +280,6 @@ def _raise_at_missing(x, q, label, mask) -> None:
         raise missing_sample_error(int(np.argmax(bad)))
 
 
-def runner_for(scheduler, workers) -> Runner:
-    """The :class:`ecofmaps._parallel.Runner` for :func:`analyze_loops`' ``scheduler`` and
-    ``workers`` (see there)."""
-    if scheduler is None:
-        try:
-            from distributed import default_client  # only where dask's cluster is used
-
-            return Runner(client=default_client())
-        except (ImportError, ValueError):  # no client: threads
-            return Runner(workers)
-    if scheduler == "threads":
-        return Runner(workers)
-    if scheduler == "processes":
-        return Runner(workers or 2, cluster=True)
-    if isinstance(scheduler, str):
-        return Runner(scheduler=scheduler)
-    return Runner(client=scheduler)
-
-
 @si_units
 def resolve_loops(
     displacement,
@@ -290,12 +289,12 @@ def resolve_loops(
     cycle=None,
     *,
     force_offset=None,
-    positions=201,
-    central=0.8,
-    slip_threshold=4.0,
-    stick_window=(0.05, 0.45),
-    hysteresis=0.5,
-    gross_slip_threshold=GROSS_SLIP_THRESHOLD,
+    positions=ReadingOptions.positions,
+    central=ReadingOptions.central,
+    slip_threshold=ReadingOptions.slip_threshold,
+    stick_window=ReadingOptions.stick_window,
+    hysteresis=LoopOptions.hysteresis,
+    gross_slip_threshold=LoopOptions.gross_slip_threshold,
 ) -> xr.Dataset:
     r"""Friction and groove slope read along the whole stroke of every loop of a recording.
 
@@ -387,19 +386,10 @@ def resolve_loops(
     >>> print(f"{float(resolved.mu_resolved[0]):.9f} {float(resolved.aspect_ratio[0]):.9f}")
     0.800000000 0.200000000
     """
-    reading = Reading(
-        resolve=True,
-        along_stroke=check_reading_options(
-            stiffness, force_offset, positions, central, slip_threshold, stick_window
-        ),
-        hand_back=True,
+    along_stroke = ReadingOptions(
+        stiffness, force_offset, positions, central, slip_threshold, stick_window
     )
+    reading = Reading(resolve=True, along_stroke=along_stroke, hand_back=True)
     force, load, recorded = _at_mean_load(force, load)
-    options = check_options(
-        load, hysteresis, stick_window, DEFAULTS["crossing_window"], gross_slip_threshold, False
-    )
-    _, resolved = _run(
-        displacement, force, load, cycle, None, options, "skip", reading, None, None,
-        recorded_load=recorded,
-    )  # fmt: skip
-    return resolved
+    options = LoopOptions(load, hysteresis, stick_window, gross_slip_threshold=gross_slip_threshold)
+    return _run(displacement, force, cycle, options, reading, recorded_load=recorded)[1]

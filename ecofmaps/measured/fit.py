@@ -20,6 +20,7 @@ import numpy as np
 from ecofmaps._inputs import check, float64
 from ecofmaps.measured.cycles import MIN_SAMPLES, find_cycles
 from ecofmaps.measured.measure import measure_cycles
+from ecofmaps.measured.pipeline import LoopOptions
 from ecofmaps.measured.quality import ALL, ANTICLOCKWISE_SHARE, REASONS, SEPARATOR
 from ecofmaps.model.core import slip_position, traction_ratio
 from ecofmaps.model.simulation import fretting_loop
@@ -357,7 +358,11 @@ def _measured_cycle(all_x, all_y, load, cycle, cycle_number, hysteresis):
     analysis, flags, _ = max(
         (
             measure_cycles(
-                cycles, all_x, all_y, load, stick_window=window, rows=slice(row, row + 1)
+                cycles,
+                all_x,
+                all_y,
+                LoopOptions(load, stick_window=window),
+                rows=slice(row, row + 1),
             )
             for window in _STICK_WINDOWS
         ),

@@ -17,7 +17,6 @@ from ecofmaps.measured import kernels
 from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles
 from ecofmaps.measured.quality import (
     ANTICLOCKWISE_SHARE,
-    REASONS,
 )
 
 __all__ = [
@@ -296,12 +295,31 @@ _PER_CYCLE = (
 )
 
 
+#: The reasons of :data:`~ecofmaps.measured.quality.REASONS` that this step flags.
+_MEASURED = (
+    "missing-samples",
+    "few-samples",
+    "constant-force",
+    "several-loops",
+    "anticlockwise",
+    "energy-ratio-above-1",
+    "negative-stiffness",
+    "no-stick",
+    "negative-area",
+    "negative-slip",
+    "no-zero-crossing",
+    "curved-stick",
+    "no-crossing",
+    "not-gross-slip",
+)
+
 #: A stick segment must explain all but this share of the displacement's variance along it.
 _UNEXPLAINED = 0.2
 
 
-def _loop_values(block, load, options):
+def _loop_values(block, options):
     """Every per-cycle quantity of a block of centred loops, and the checks it failed."""
+    load = options.load
     # The extremes, the loop's area by trapezoids (the segment that closes it included)
     # and its top, where the rising branch ends.
     highest, lowest, max_force, energy, top = kernels.loop_measures(
@@ -310,13 +328,13 @@ def _loop_values(block, load, options):
     span = highest - lowest
     amplitude = 0.5 * span
     bx, by, length = branch_rows(block, top)
-    compliance, intercept, across, fit = stick_lines(bx, by, length, span, options["stick_window"])
+    compliance, intercept, across, fit = stick_lines(bx, by, length, span, options.stick_window)
     crossing, zero_on_loop = zero_force_crossings(
         bx, by, length, max_force, across, intercept, span
     )
     cycles = block.count.size
     slip = 0.5 * (crossing[cycles:] - crossing[:cycles])
-    half_width = options["crossing_window"] * np.abs(slip)
+    half_width = options.crossing_window * np.abs(slip)
     at, force, on_loop = line_crossings(
         bx, by, length, both(compliance), both(half_width), load, both(max_force)
     )
@@ -349,7 +367,7 @@ def _loop_values(block, load, options):
         # would have been a reversal.
         "several-loops": np.zeros(cycles, dtype=bool)
         if block.continuous
-        else _turns_back(bx, options["hysteresis"] * span),
+        else _turns_back(bx, options.hysteresis * span),
         "anticlockwise": anticlockwise,
         "energy-ratio-above-1": energy_ratio > 1.0 + rounding,
         "negative-stiffness": compliance < 0.0,
@@ -360,7 +378,7 @@ def _loop_values(block, load, options):
         "no-zero-crossing": ~(zero_on_loop[:cycles] & zero_on_loop[cycles:]),
         "curved-stick": fit["curved"],
         "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]),
-        "not-gross-slip": ~(energy_ratio > options["gross_slip_threshold"]),
+        "not-gross-slip": ~(energy_ratio > options.gross_slip_threshold),
     }
     return values, flags
 
@@ -377,44 +395,28 @@ def _turns_back(x, band):
     return np.maximum(drop, rise) > band
 
 
-def measure_cycles(
-    cycles: Cycles,
-    displacement,
-    force,
-    load,
-    *,
-    hysteresis=0.5,
-    stick_window=(0.05, 0.45),
-    crossing_window=0.7,
-    gross_slip_threshold=GROSS_SLIP_THRESHOLD,
-    flip_force=False,
-    rows=None,
-    keep_loops=False,
-    recorded_load=None,
-):
-    """The per-cycle quantities of :func:`analyze_loops` for cycles already found."""
+def measure_cycles(cycles: Cycles, displacement, force, options, *, rows=None, keep_loops=False):
+    """The per-cycle values of :func:`ecofmaps.analyze_loops` for cycles already found, as
+    measured (not yet NaN where a check fails), the flags of the checks each cycle failed
+    (reason -> per cycle), and the centred loops NaN-padded over (cycle, point) if
+    ``keep_loops``. ``displacement`` and ``force`` give stretches by sample index [m], [N];
+    ``options`` is a :class:`~ecofmaps.measured.pipeline.LoopOptions`."""
     first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
-    options = {
-        "hysteresis": hysteresis,
-        "stick_window": stick_window,
-        "crossing_window": crossing_window,
-        "gross_slip_threshold": gross_slip_threshold,
-    }
     values = {name: np.full(stop - first, np.nan) for name in _PER_CYCLE}
-    flags = {reason: np.zeros(stop - first, dtype=bool) for reason in REASONS}
+    flags = {reason: np.zeros(stop - first, dtype=bool) for reason in _MEASURED}
     if cycles.missing is not None:  # not measured: their values stay NaN
         flags["missing-samples"] = cycles.missing[first:stop].copy()
     loops = None
     if keep_loops:
         width = int(cycles.count[first:stop].max()) + 1
         loops = tuple(np.full((stop - first, width), np.nan) for _ in range(2))
-    sign = -1.0 if flip_force else 1.0
+    sign = -1.0 if options.flip_force else 1.0
     blocks = loop_blocks(cycles, displacement, force, slice(first, stop), sign)
     with np.errstate(divide="ignore", invalid="ignore"):  # degenerate cycles give NaN
         for block in blocks:
             check_interrupted()
             out = slice(block.rows.start - first, block.rows.stop - first)
-            computed, failed = _loop_values(block, load, options)
+            computed, failed = _loop_values(block, options)
             for name, value in computed.items():
                 values[name][out] = value
             for reason, flag in failed.items():
@@ -422,26 +424,7 @@ def measure_cycles(
             if keep_loops:
                 for loop, centred in zip(loops, block.loops(loops[0].shape[1]), strict=True):
                     loop[out] = centred
-    if recorded_load is not None:
-        values["normal_load"] = _cycle_means(recorded_load, cycles, first, stop)
     return values, flags, loops
-
-
-def _cycle_means(series, cycles: Cycles, first: int, stop: int) -> np.ndarray:
-    """The mean of the finite values of ``series`` over the samples of each of the cycles
-    ``first`` to ``stop - 1`` (each a stretch of consecutive samples; NaN if none)."""
-    start, count = cycles.start[first:stop], cycles.count[first:stop]
-    if start.size == 0:
-        return np.empty(0)
-    low = int(start.min())
-    values = np.asarray(series[low : int((start + count).max())], dtype=np.float64)
-    finite = np.isfinite(values)
-    sums, counts = (
-        np.concatenate([[0.0], np.cumsum(a)]) for a in (np.where(finite, values, 0.0), finite)
-    )
-    ends, begins = start + count - low, start - low
-    with np.errstate(invalid="ignore"):  # a cycle without a finite value: NaN
-        return (sums[ends] - sums[begins]) / (counts[ends] - counts[begins])
 
 
 #: Samples with :math:`|Q|` below this share of :math:`Q^*` locate a zero-force crossing

@@ -1,6 +1,7 @@
 r"""The driver of the loop pipeline, whatever the way in: the options, the chunks of whole cycles
 (each with a halo for the centring), each chunk measured, read along the stroke and judged
-where it runs, on this process or a dask runner, and the parts joined into the table.
+where it runs, on this process or a dask runner, and the parts joined into the table; a
+recorded load is converted here, to the mean load and back to each cycle's own.
 The method is explained in ``docs/method-loops.md`` ("One pipeline, in memory and out of core").
 """
 
@@ -14,32 +15,28 @@ import numpy as np
 import xarray as xr
 
 from ecofmaps._inputs import check
-from ecofmaps._parallel import stretch
+from ecofmaps._parallel import Runner, stretch
 from ecofmaps.measured.cycles import Cycles, find_cycles, missing_sample_error, no_cycle_error
 from ecofmaps.measured.measure import GROSS_SLIP_THRESHOLD, NEIGHBOURS, measure_cycles
-from ecofmaps.measured.quality import (
-    RESOLVED,
-    Tally,
-    at_own_load,
-    cycle_results,
-    scale_flags,
-    with_loops,
-)
-from ecofmaps.measured.resolve import check_reading_options, read_along_stroke, resolved_attrs
+from ecofmaps.measured.quality import RESOLVED, Tally, cycle_results, scale_flags, with_loops
+from ecofmaps.measured.resolve import ReadingOptions, read_along_stroke, resolved_attrs
 
 __all__ = [
-    "DEFAULTS",
+    "AT_OWN_LOAD",
     "HALO",
     "IN_PROCESS",
     "NAN_POLICIES",
     "TASK_SAMPLES",
     "Analysis",
     "Chunk",
+    "LoopOptions",
     "Reading",
-    "check_options",
-    "default_options",
+    "Task",
+    "at_own_load",
     "force_at_mean_load",
+    "measure_chunk",
     "only",
+    "runner_for",
 ]
 
 #: Samples of the recording measured by one chunk of a long recording (about; whole cycles).
@@ -47,6 +44,55 @@ TASK_SAMPLES = 1 << 22
 
 #: Whole cycles on either side of a chunk's cycles that it reads for the centring.
 HALO = NEIGHBOURS
+
+#: What the analysis does with missing samples: skip their cycles, or raise.
+NAN_POLICIES = ("skip", "raise")
+
+
+@dataclasses.dataclass(frozen=True)
+class LoopOptions:
+    """The load and the options of :func:`ecofmaps.analyze_loops` (see there), checked once:
+    a ValueError names the one that is not valid."""
+
+    load: float
+    hysteresis: float = 0.5
+    stick_window: tuple = (0.05, 0.45)
+    crossing_window: float = 0.7
+    gross_slip_threshold: float = GROSS_SLIP_THRESHOLD
+    flip_force: bool = False
+
+    def __post_init__(self):
+        check("load", self.load, "positive", "N")
+        if np.ndim(self.load) != 0:
+            raise ValueError("load must be a single value [N]")
+        if not 0.0 < self.hysteresis < 1.0:
+            raise ValueError(f"hysteresis must satisfy 0 < hysteresis < 1; got {self.hysteresis!r}")
+        low, high = (float(share) for share in self.stick_window)
+        if not 0.0 <= low < high <= 1.0:
+            raise ValueError(
+                f"stick_window must satisfy 0 <= low < high <= 1; got {self.stick_window!r}"
+            )
+        if not self.crossing_window > 0.0:
+            raise ValueError(
+                f"crossing_window must satisfy crossing_window > 0; got {self.crossing_window!r}"
+            )
+        if not 0.0 < self.gross_slip_threshold < 1.0:
+            raise ValueError(
+                "gross_slip_threshold must satisfy 0 < gross_slip_threshold < 1; "
+                f"got {self.gross_slip_threshold!r}"
+            )
+        if not isinstance(self.flip_force, bool | np.bool_):
+            raise ValueError(f"flip_force must be True or False; got {self.flip_force!r}")
+        checked = {
+            "load": float(self.load),
+            "hysteresis": float(self.hysteresis),
+            "stick_window": (low, high),
+            "crossing_window": float(self.crossing_window),
+            "gross_slip_threshold": float(self.gross_slip_threshold),
+            "flip_force": bool(self.flip_force),
+        }
+        for name, value in checked.items():
+            object.__setattr__(self, name, value)
 
 
 class _InProcess:
@@ -66,20 +112,57 @@ class _InProcess:
 IN_PROCESS = _InProcess()
 
 
+def runner_for(scheduler=None, workers=None):
+    """The runner of :func:`ecofmaps.analyze_loops`' ``scheduler`` and ``workers`` (see
+    there), the one place where it is chosen."""
+    if scheduler is None:
+        try:
+            from distributed import default_client  # only where dask's cluster is used
+
+            return Runner(client=default_client())
+        except (ImportError, ValueError):  # no client: threads
+            return Runner(workers)
+    if scheduler == "threads":
+        return Runner(workers)
+    if scheduler == "processes":
+        return Runner(workers or 2, cluster=True)
+    if isinstance(scheduler, str):
+        return Runner(scheduler=scheduler)
+    return Runner(client=scheduler)
+
+
 @dataclasses.dataclass(frozen=True)
 class Reading:
-    """What each chunk reads besides the per-cycle values."""
+    """What each chunk reads besides the per-cycle values: the reading along the stroke
+    (``resolve``, with its options), the centred loops (``keep_loops``), and whether the
+    whole reading is handed back (``hand_back``)."""
 
     resolve: bool = False
     keep_loops: bool = False
-    along_stroke: dict = dataclasses.field(default_factory=lambda: {"positions": None})
+    along_stroke: ReadingOptions = dataclasses.field(
+        default_factory=lambda: ReadingOptions(positions=None)
+    )
     hand_back: bool = False
 
     @property
     def one_grid(self) -> bool:
         """Whether the grid of positions is made from all cycles (one chunk only)."""
-        positions = self.along_stroke.get("positions")
-        return self.resolve and isinstance(positions, int)
+        return self.resolve and isinstance(self.along_stroke.positions, int)
+
+
+@dataclasses.dataclass(frozen=True)
+class Task:
+    """One chunk's work besides its samples: its cycles with their halo, its own ``rows``
+    among them, the first sample ``low`` of its stretch, and what the analysis asks."""
+
+    cycles: Cycles
+    rows: slice
+    low: int
+    options: LoopOptions
+    reading: Reading
+    then: object = None
+    keep: object = False
+    columns: tuple | None = None
 
 
 @dataclasses.dataclass
@@ -137,6 +220,51 @@ def force_at_mean_load(force, load):
     return force * (mean / load), mean
 
 
+#: The values that scale with the normal load: with a recorded load, they are reported at
+#: each cycle's own load (``normal_load``), the rest being read at the mean load.
+AT_OWN_LOAD = (
+    "max_force",
+    "dissipated_energy",
+    "stiffness",
+    "force_offset",
+    "force_drift_se",
+    "loop_force",
+    "force_forward",
+    "force_backward",
+)
+
+
+def at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
+    """``dataset`` with its variables of :data:`AT_OWN_LOAD` times ``ratio``, each cycle's
+    load over the mean load."""
+    ratio = np.asarray(ratio, dtype=np.float64)
+    scaled = {}
+    for name in AT_OWN_LOAD:
+        if name in dataset:
+            values = dataset[name].values
+            scaled[name] = dataset[name].copy(
+                data=values * ratio.reshape((-1,) + (1,) * (values.ndim - 1))
+            )
+    return dataset.assign(scaled)
+
+
+def _cycle_means(series, cycles: Cycles, rows: slice) -> np.ndarray:
+    """The mean of the finite values of ``series`` over each cycle of ``rows`` (NaN if none)."""
+    first, stop, _ = rows.indices(cycles.label.size)
+    start, count = cycles.start[first:stop], cycles.count[first:stop]
+    if start.size == 0:
+        return np.empty(0)
+    low = int(start.min())
+    values = np.asarray(series[low : int((start + count).max())], dtype=np.float64)
+    finite = np.isfinite(values)
+    sums, counts = (
+        np.concatenate([[0.0], np.cumsum(a)]) for a in (np.where(finite, values, 0.0), finite)
+    )
+    ends, begins = start + count - low, start - low
+    with np.errstate(invalid="ignore"):  # a cycle without a finite value: NaN
+        return (sums[ends] - sums[begins]) / (counts[ends] - counts[begins])
+
+
 class _Stretch:
     """A stretch of a recording (samples ``low`` on) indexed like the whole recording."""
 
@@ -149,52 +277,42 @@ class _Stretch:
         return self.values[np.asarray(key) - self.low]
 
 
-def measure_chunk(
-    cycles: Cycles,
-    low: int,
-    rows: slice,
-    load: float,
-    options: dict,
-    x,
-    q,
-    reading: Reading,
-    then=None,
-    keep=False,
-    columns=None,
-    recorded_load=None,
-) -> Chunk:
-    """Steps 3 to 5 of the pipeline for one chunk: the cycles ``rows`` of the table
-    ``cycles`` measured on the stretch of the recording that begins at sample ``low``."""
+def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
+    """One chunk through the steps: its cycles measured on its stretch ``x``, ``q`` (and the
+    load recorded over it), read along the stroke and judged once."""
+    options, reading, labels = task.options, task.reading, task.cycles.label[task.rows]
     values, flags, loops = measure_cycles(
-        cycles,
-        _Stretch(x, low),
-        _Stretch(q, low),
-        load,
-        rows=rows,
+        task.cycles,
+        _Stretch(x, task.low),
+        _Stretch(q, task.low),
+        options,
+        rows=task.rows,
         keep_loops=reading.resolve or reading.keep_loops,
-        recorded_load=None if recorded_load is None else _Stretch(recorded_load, low),
-        **options,
     )
-    labels = cycles.label[rows]
+    if recorded_load is not None:
+        values["normal_load"] = _cycle_means(
+            _Stretch(recorded_load, task.low), task.cycles, task.rows
+        )
     flags |= scale_flags(values, options)
     resolved = None
     if reading.resolve:
-        judged = with_loops(cycle_results(values, flags, labels, load, options), loops)
-        resolved, read = read_along_stroke(judged, check_reading_options(**reading.along_stroke))
+        judged = with_loops(cycle_results(values, flags, labels, options), loops)
+        resolved, read = read_along_stroke(judged, reading.along_stroke)
         values = values | {name: resolved[name].values for name in RESOLVED}
         flags = flags | read
-    part = _part(values, flags, labels, load, options, loops if reading.keep_loops else None)
+    part = _part(values, flags, labels, options, loops if reading.keep_loops else None)
     handed = resolved if reading.hand_back else None
     if handed is not None and "normal_load" in values:  # as the part: at each cycle's load
-        handed = at_own_load(handed, values["normal_load"] / load)
+        handed = at_own_load(handed, values["normal_load"] / options.load)
     tally = Tally()
     tally.add(part["quality"].values, flags, values["amplitude"])
+    keep = task.keep
     if callable(keep):
         keep(values, flags)
     if keep is not True:
         values = flags = None
-    made = None if then is None else then(part)
-    return Chunk(only(part, columns), tally, values, flags, made, handed)
+    made = None if task.then is None else task.then(part)
+    return Chunk(only(part, task.columns), tally, values, flags, made, handed)
 
 
 def only(part: xr.Dataset, columns=None) -> xr.Dataset:
@@ -204,32 +322,39 @@ def only(part: xr.Dataset, columns=None) -> xr.Dataset:
     return part[[name for name in columns if name in part.data_vars]]
 
 
-def _part(values: dict, flags: dict, labels, load, options, loops=None) -> xr.Dataset:
+def _part(values: dict, flags: dict, labels, options, loops=None) -> xr.Dataset:
     """The results of a chunk from what it measured, judged once (the values read along
     the stroke, if any, after the quality), with the centred ``loops`` if given; with a
     recorded load, at each cycle's own load."""
     measured = {k: v for k, v in values.items() if k not in RESOLVED}
-    part = cycle_results(measured, flags, labels, load, options)
+    part = cycle_results(measured, flags, labels, options)
     read = [name for name in RESOLVED if name in values]
     part = part.assign({k: ("cycle", values[k], resolved_attrs(k)) for k in read})
     if loops is not None:
         part = with_loops(part, loops)
     if "normal_load" in part:
-        part = at_own_load(part, part["normal_load"].values / float(part["load"]))
+        part = at_own_load(part, part["normal_load"].values / options.load)
     return part
 
 
 class Analysis:
-    """The analysis of one recording through the pipeline (module notes), in steps that a
-    caller can follow: the command line writes each chunk's results as it comes."""
+    """The analysis of one recording through the pipeline, in steps that a caller can
+    follow: the command line writes each chunk's results as it comes.
+
+    ``options`` is a :class:`LoopOptions`; ``runner`` where the passes and the chunks run
+    (:func:`runner_for`, entered; by default this process); ``cycles`` those found before
+    (a resumed run); ``samples`` per chunk (about; default :data:`TASK_SAMPLES`);
+    ``one_chunk`` for a recording in memory. With a ``recorded_load`` (the load at each
+    sample), ``force`` is at the mean load ``options.load`` (:func:`force_at_mean_load`).
+    """
 
     def __init__(
         self,
         displacement,
         force,
-        load,
         cycle=None,
         *,
+        options: LoopOptions,
         missing=None,
         recorded_load=None,
         runner=IN_PROCESS,
@@ -238,18 +363,17 @@ class Analysis:
         cycles=None,
         samples=None,
         one_chunk=False,
-        **options,
     ):
         self.arrays = (displacement, force)
         self.recorded_load = recorded_load
         self.reading = Reading() if reading is None else reading
-        self.load, self.options, self.runner = float(load), options, runner
+        self.options, self.runner = options, runner
         self.cycles_from = "displacement reversals" if cycle is None else "cycle numbers"
         if cycles is None:
             cycles = find_cycles(
                 displacement,
                 cycle,
-                options["hysteresis"],
+                options.hysteresis,
                 force=force,
                 missing=missing,
                 runner=None if runner is IN_PROCESS else runner,
@@ -269,8 +393,8 @@ class Analysis:
         self.tally = Tally()
         self._whole = np.flatnonzero(cycles.whole)  # the cycles a halo may hold
 
-    def _task(self, index: int, then, keep, columns=None):
-        """The arguments of chunk ``index`` (see :func:`measure_chunk`)."""
+    def _task(self, index: int, then, keep, columns=None) -> tuple:
+        """The arguments of :func:`measure_chunk` for chunk ``index``."""
         cycles, rows = self.cycles, self.tasks[index]
         first, stop = rows.start, rows.stop
         if cycles.continuous:  # a halo of whole cycles on either side
@@ -285,23 +409,11 @@ class Analysis:
         high = int(table.start[-1] + table.count[-1])
         x, q = (stretch(array, low, high) for array in self.arrays)
         p = None if self.recorded_load is None else stretch(self.recorded_load, low, high)
-        inner = slice(rows.start - first, rows.stop - first)
         if callable(keep):
             keep = functools.partial(keep, index)
-        return (
-            table,
-            low,
-            inner,
-            self.load,
-            self.options,
-            x,
-            q,
-            self.reading,
-            then,
-            keep,
-            columns,
-            p,
-        )
+        inner = slice(rows.start - first, rows.stop - first)
+        task = Task(table, inner, low, self.options, self.reading, then, keep, columns)
+        return task, x, q, p
 
     def measured(self, skip=(), then=None, keep=False, columns=None):
         """Each chunk's :class:`Chunk`, in order, as they come; counted in :attr:`tally`."""
@@ -321,7 +433,7 @@ class Analysis:
         :meth:`measured`), as in :func:`ecofmaps.analyze_loops`'s Dataset (without the
         recording's attributes); counted in :attr:`tally`."""
         labels = self.cycles.label[self.tasks[index]]
-        part = _part(values, flags, labels, self.load, self.options)
+        part = _part(values, flags, labels, self.options)
         self.tally.add(part["quality"].values, flags, values["amplitude"])
         return part
 
@@ -357,55 +469,3 @@ def _tasks(count, samples: int) -> list[slice]:
     targets = np.arange(samples, int(ends[-1]), samples)
     bounds = np.unique(np.concatenate([[0], np.searchsorted(ends, targets), [count.size]]))
     return [slice(int(a), int(b)) for a, b in itertools.pairwise(bounds)]
-
-
-#: What the analysis does with missing samples: skip their cycles, or raise.
-NAN_POLICIES = ("skip", "raise")
-
-#: The defaults of :func:`ecofmaps.analyze_loops`' options (see there for their meaning).
-DEFAULTS = {
-    "hysteresis": 0.5,
-    "stick_window": (0.05, 0.45),
-    "crossing_window": 0.7,
-    "gross_slip_threshold": GROSS_SLIP_THRESHOLD,
-}
-
-
-def check_options(
-    load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
-) -> dict:
-    """The options of :func:`ecofmaps.analyze_loops`, checked (a ValueError naming the one
-    that is not valid), as keyword arguments of
-    :func:`ecofmaps.measured.measure.measure_cycles`."""
-    check("load", load, "positive", "N")
-    if np.ndim(load) != 0:
-        raise ValueError("load must be a single value [N]")
-    if not 0.0 < hysteresis < 1.0:
-        raise ValueError(f"hysteresis must satisfy 0 < hysteresis < 1; got {hysteresis!r}")
-    low, high = (float(share) for share in stick_window)
-    if not 0.0 <= low < high <= 1.0:
-        raise ValueError(f"stick_window must satisfy 0 <= low < high <= 1; got {stick_window!r}")
-    if not crossing_window > 0.0:
-        raise ValueError(
-            f"crossing_window must satisfy crossing_window > 0; got {crossing_window!r}"
-        )
-    if not 0.0 < gross_slip_threshold < 1.0:
-        raise ValueError(
-            "gross_slip_threshold must satisfy 0 < gross_slip_threshold < 1; "
-            f"got {gross_slip_threshold!r}"
-        )
-    if not isinstance(flip_force, bool | np.bool_):
-        raise ValueError(f"flip_force must be True or False; got {flip_force!r}")
-    return {
-        "hysteresis": float(hysteresis),
-        "stick_window": (low, high),
-        "crossing_window": float(crossing_window),
-        "gross_slip_threshold": float(gross_slip_threshold),
-        "flip_force": bool(flip_force),
-    }
-
-
-def default_options(load, flip_force=False) -> dict:
-    """:func:`check_options` with the :data:`DEFAULTS` for the others (what the command
-    line and a long analysis use)."""
-    return check_options(load, **DEFAULTS, flip_force=flip_force)

@@ -19,7 +19,6 @@ from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP, Regime
 __all__ = [
     "ALL",
     "ANTICLOCKWISE_SHARE",
-    "AT_OWN_LOAD",
     "READING_REASONS",
     "REASONS",
     "RESOLVED",
@@ -30,7 +29,6 @@ __all__ = [
     "Tally",
     "add_reason",
     "apply_quality",
-    "at_own_load",
     "cycle_results",
     "has_reason",
     "judged",
@@ -103,38 +101,6 @@ def _refusal_hint(flags: dict) -> str:
     )
 
 
-#: The values that scale with the normal load (forces, energy, the rig's stiffness), of the
-#: per-cycle results, their loops and the reading along the stroke. The analysis reads the
-#: force of a recorded load as at the mean load (``force_at_mean_load`` of
-#: :mod:`ecofmaps.measured.pipeline`), so that each coefficient is read with the load of its
-#: own samples; these values are then reported at each cycle's own load, the mean of its
-#: samples (``normal_load``).
-AT_OWN_LOAD = (
-    "max_force",
-    "dissipated_energy",
-    "stiffness",
-    "force_offset",
-    "force_drift_se",
-    "loop_force",
-    "force_forward",
-    "force_backward",
-)
-
-
-def at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
-    """``dataset`` with its variables of :data:`AT_OWN_LOAD` times ``ratio``, each cycle's
-    load over the mean load (over ``cycle``; attributes kept)."""
-    ratio = np.asarray(ratio, dtype=np.float64)
-    scaled = {}
-    for name in AT_OWN_LOAD:
-        if name in dataset:
-            values = dataset[name].values
-            scaled[name] = dataset[name].copy(
-                data=values * ratio.reshape((-1,) + (1,) * (values.ndim - 1))
-            )
-    return dataset.assign(scaled)
-
-
 def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
     """``results`` with the centred loops of :func:`measure_cycles` (``keep_loops=True``)."""
     results["loop_displacement"] = (("cycle", "point"), loops[0], _attrs("loop_displacement"))
@@ -143,14 +109,14 @@ def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
     return results
 
 
-def scale_flags(values: dict, options: dict) -> dict:
+def scale_flags(values: dict, options) -> dict:
     """The checks of scale of each cycle (reason -> per cycle): an amplitude outside
     :data:`AMPLITUDE_RANGE`, or a coefficient of friction outside :data:`COF_RANGE` (the
     ECoF or the GICoF of a gross-slip loop; not :math:`Q^*/P`, which a deep groove raises
     above 3 with any load). A gross-slip CoF of 361 or 0.001 says that the load or a unit is
     wrong, not the contact."""
     amplitude = values["amplitude"]
-    sliding = values["energy_ratio"] > options["gross_slip_threshold"]
+    sliding = values["energy_ratio"] > options.gross_slip_threshold
 
     def outside(value, bounds):
         return np.isfinite(value) & ((value < bounds[0]) | (value > bounds[1]))
@@ -160,7 +126,7 @@ def scale_flags(values: dict, options: dict) -> dict:
     return {"implausible-amplitude": scaled, "implausible-cof": cof & ~scaled}
 
 
-def judged(values: dict, flags: dict, options: dict):
+def judged(values: dict, flags: dict, options):
     """The one judgement of a part's cycles: ``values`` (name -> per cycle, as measured)
     NaN where a flag's scope reaches, the ``quality`` strings, the cycles refused and the
     regime codes. ``flags`` (reason -> per cycle) are every check's, the scale's included."""
@@ -168,12 +134,12 @@ def judged(values: dict, flags: dict, options: dict):
     refused = _refusing(flags, size)
     recorded = {k: values[k] for k in ("normal_load",) if k in values}  # a refused cycle's too
     values = apply_quality({k: v for k, v in values.items() if k not in recorded}, flags)
-    sliding = values["energy_ratio"] > options["gross_slip_threshold"]
+    sliding = values["energy_ratio"] > options.gross_slip_threshold
     regime = np.where(refused, INVALID, np.where(sliding, GROSS_SLIP, NO_GROSS_SLIP))
     return values | recorded, quality_strings(flags, size), refused, regime
 
 
-def cycle_results(values: dict, flags: dict, label, load: float, options: dict) -> xr.Dataset:
+def cycle_results(values: dict, flags: dict, label, options) -> xr.Dataset:
     """The per-cycle Dataset of :func:`analyze_loops` for some cycles, without the
     recording's attributes: ``values`` and ``flags`` (the scale's included) judged once."""
     values, quality, _, regime = judged(values, flags, options)
@@ -185,7 +151,8 @@ def cycle_results(values: dict, flags: dict, label, load: float, options: dict) 
     for name, value in recorded.items():
         data[name] = ("cycle", value, _attrs(name))
     data["quality"] = ("cycle", quality, _attrs("quality"))
-    coords = {"cycle": ("cycle", label, _attrs("cycle")), "load": ((), load, _attrs("load"))}
+    load = ((), options.load, _attrs("load"))
+    coords = {"cycle": ("cycle", label, _attrs("cycle")), "load": load}
     return xr.Dataset(data, coords=coords)
 
 
@@ -248,7 +215,7 @@ class Tally:
         """The one-line quality summary so far."""
         return summary_of_counts(self.counts)
 
-    def finish(self, results, cycles: Cycles, cycles_from: str, options: dict) -> xr.Dataset:
+    def finish(self, results, cycles: Cycles, cycles_from: str, options) -> xr.Dataset:
         """Check the whole recording and give ``results`` (the parts, joined) its
         attributes."""
         summary = self.summary
@@ -285,8 +252,8 @@ class Tally:
                 "missing_samples": cycles.missing_samples,
                 "first_missing_sample": cycles.first_missing,
                 "skipped_cycles": int(self.counts_of("missing-samples")),
-                "gross_slip_threshold": options["gross_slip_threshold"],
-                "flip_force": int(options["flip_force"]),
+                "gross_slip_threshold": options.gross_slip_threshold,
+                "flip_force": int(options.flip_force),
                 "quality_summary": summary,
                 "motion": _motion(typical),
             }

@@ -6,6 +6,8 @@ The method is explained in ``docs/method-loops.md`` ("Reading the loop along the
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import xarray as xr
 
@@ -31,8 +33,8 @@ from ecofmaps.measured.resolve_branches import (
 
 __all__ = [
     "QUALITY_FLAGS",
+    "ReadingOptions",
     "along_stroke_values",
-    "check_reading_options",
     "read_along_stroke",
     "resolve_analyzed_loops",
     "resolved_attrs",
@@ -56,59 +58,74 @@ def resolved_attrs(name: str) -> dict:
     return attrs
 
 
-def check_reading_options(
-    stiffness=None,
-    force_offset=None,
-    positions=201,
-    central=0.8,
-    slip_threshold=4.0,
-    stick_window=(0.05, 0.45),
-) -> dict:
-    """The options of :func:`resolve_analyzed_loops` as a dict, or a ValueError naming the
-    one out of range."""
-    if stiffness is not None:
-        check("stiffness", stiffness, "positive_or_inf", "N/m")
-        if np.ndim(stiffness) != 0:
-            raise ValueError("stiffness must be a single value [N/m]")
-    if force_offset is not None:
-        check("force_offset", force_offset, "finite", "N")
-        if np.ndim(force_offset) != 0:
-            raise ValueError("force_offset must be a single value [N]")
-    if positions is None:
-        pass
-    elif np.ndim(positions) == 0:
-        if (
-            isinstance(positions, bool)
-            or not isinstance(positions, int | np.integer)
-            or positions < 5
-            or positions % 2 == 0
-        ):
+@dataclasses.dataclass(frozen=True)
+class ReadingOptions:
+    """The options of the reading along the stroke (see :func:`ecofmaps.resolve_loops`),
+    checked: a ValueError names the one out of range."""
+
+    stiffness: float | None = None
+    force_offset: float | None = None
+    positions: object = 201
+    central: float = 0.8
+    slip_threshold: float = 4.0
+    stick_window: tuple = (0.05, 0.45)
+
+    def __post_init__(self):
+        stiffness, force_offset, positions = self.stiffness, self.force_offset, self.positions
+        if stiffness is not None:
+            check("stiffness", stiffness, "positive_or_inf", "N/m")
+            if np.ndim(stiffness) != 0:
+                raise ValueError("stiffness must be a single value [N/m]")
+        if force_offset is not None:
+            check("force_offset", force_offset, "finite", "N")
+            if np.ndim(force_offset) != 0:
+                raise ValueError("force_offset must be a single value [N]")
+        if positions is None:
+            pass
+        elif np.ndim(positions) == 0:
+            if (
+                isinstance(positions, bool)
+                or not isinstance(positions, int | np.integer)
+                or positions < 5
+                or positions % 2 == 0
+            ):
+                raise ValueError(
+                    "positions must be an odd integer >= 5 or an array of positions; "
+                    f"got {positions!r}"
+                )
+            positions = int(positions)
+        else:
+            check("positions", positions, "finite", "m")
+            positions = np.asarray(positions, dtype=np.float64)
+            if positions.ndim != 1 or positions.size < 3 or np.any(np.diff(positions) <= 0.0):
+                raise ValueError(
+                    "positions must be one-dimensional and increasing, >= 3 of them [m]"
+                )
+            if not np.any(positions == 0.0):
+                raise ValueError(
+                    "positions must include 0 (the centre, where the profile is zero) [m]"
+                )
+        if not 0.0 < self.central <= 1.0:
+            raise ValueError(f"central must satisfy 0 < central <= 1; got {self.central!r}")
+        if not self.slip_threshold > 0.0:
             raise ValueError(
-                f"positions must be an odd integer >= 5 or an array of positions; got {positions!r}"
+                f"slip_threshold must satisfy slip_threshold > 0; got {self.slip_threshold!r}"
             )
-        positions = int(positions)
-    else:
-        check("positions", positions, "finite", "m")
-        positions = np.asarray(positions, dtype=np.float64)
-        if positions.ndim != 1 or positions.size < 3 or np.any(np.diff(positions) <= 0.0):
-            raise ValueError("positions must be one-dimensional and increasing, >= 3 of them [m]")
-        if not np.any(positions == 0.0):
-            raise ValueError("positions must include 0 (the centre, where the profile is zero) [m]")
-    if not 0.0 < central <= 1.0:
-        raise ValueError(f"central must satisfy 0 < central <= 1; got {central!r}")
-    if not slip_threshold > 0.0:
-        raise ValueError(f"slip_threshold must satisfy slip_threshold > 0; got {slip_threshold!r}")
-    low, high = (float(share) for share in stick_window)
-    if not 0.0 <= low < high <= 1.0:
-        raise ValueError(f"stick_window must satisfy 0 <= low < high <= 1; got {stick_window!r}")
-    return {
-        "stiffness": None if stiffness is None else float(stiffness),
-        "force_offset": None if force_offset is None else float(force_offset),
-        "positions": positions,
-        "central": float(central),
-        "slip_threshold": float(slip_threshold),
-        "stick_window": (low, high),
-    }
+        low, high = (float(share) for share in self.stick_window)
+        if not 0.0 <= low < high <= 1.0:
+            raise ValueError(
+                f"stick_window must satisfy 0 <= low < high <= 1; got {self.stick_window!r}"
+            )
+        checked = {
+            "stiffness": None if stiffness is None else float(stiffness),
+            "force_offset": None if force_offset is None else float(force_offset),
+            "positions": positions,
+            "central": float(self.central),
+            "slip_threshold": float(self.slip_threshold),
+            "stick_window": (low, high),
+        }
+        for name, value in checked.items():
+            object.__setattr__(self, name, value)
 
 
 _NEEDED = (
@@ -128,10 +145,10 @@ def resolve_analyzed_loops(
     stiffness=None,
     *,
     force_offset=None,
-    positions=201,
-    central=0.8,
-    slip_threshold=4.0,
-    stick_window=(0.05, 0.45),
+    positions=ReadingOptions.positions,
+    central=ReadingOptions.central,
+    slip_threshold=ReadingOptions.slip_threshold,
+    stick_window=ReadingOptions.stick_window,
 ) -> xr.Dataset:
     r"""Friction and groove slope along the stroke of the loops :func:`analyze_loops` kept.
 
@@ -166,24 +183,24 @@ def resolve_analyzed_loops(
             "loops must be the Dataset of analyze_loops(..., keep_loops=True), with "
             + ", ".join(_NEEDED)
         )
-    options = check_reading_options(
+    options = ReadingOptions(
         stiffness, force_offset, positions, central, slip_threshold, stick_window
     )
     return read_along_stroke(loops, options)[0]
 
 
-def read_along_stroke(loops: xr.Dataset, options: dict):
+def read_along_stroke(loops: xr.Dataset, options: ReadingOptions):
     """:func:`resolve_analyzed_loops` on options checked, and the flags of its reasons
     (reason -> per cycle) besides the Dataset."""
     load = float(loops["load"])
     x = np.asarray(loops["loop_displacement"].values, dtype=np.float64)
     q = np.asarray(loops["loop_force"].values, dtype=np.float64)
     removed = np.asarray(loops["force_offset"].values, dtype=np.float64)
-    if options["force_offset"] is not None:  # the force as recorded, less the given offset
-        q = q + (removed - options["force_offset"])[:, None]
-        removed = np.full_like(removed, options["force_offset"])
-    given = options["stiffness"] is not None
-    rig = np.full(x.shape[0], options["stiffness"]) if given else loops["stiffness"].values
+    if options.force_offset is not None:  # the force as recorded, less the given offset
+        q = q + (removed - options.force_offset)[:, None]
+        removed = np.full_like(removed, options.force_offset)
+    given = options.stiffness is not None
+    rig = np.full(x.shape[0], options.stiffness) if given else loops["stiffness"].values
     quality = loops["quality"].values
     with np.errstate(divide="ignore", invalid="ignore"):
         per_position, per_cycle, flags, grid = along_stroke_values(
@@ -218,12 +235,10 @@ def read_along_stroke(loops: xr.Dataset, options: dict):
     attrs = {
         "title": "Fretting loops read along the stroke (ecofmaps.resolve_loops)",
         "stiffness_from": "given" if given else "the stick sets of each loop",
-        "force_from": (
-            "loops centred" if options["force_offset"] is None else "given force offset"
-        ),
-        "central": options["central"],
-        "slip_threshold": options["slip_threshold"],
-        "stick_window": list(options["stick_window"]),
+        "force_from": ("loops centred" if options.force_offset is None else "given force offset"),
+        "central": options.central,
+        "slip_threshold": options.slip_threshold,
+        "stick_window": list(options.stick_window),
     }
     return xr.Dataset(data, coords=coords, attrs=attrs), flags
 
@@ -415,13 +430,13 @@ def along_stroke_values(
             stiffness[block],
             amplitude[block],
             given,
-            options["stick_window"],
-            options["slip_threshold"],
+            options.stick_window,
+            options.slip_threshold,
         )
         lowest, highest = part["lowest"], part["highest"]
         overlap = (lowest < 0.0) & (highest > 0.0)
         usable = ~inherited[block] & ~part["mismatch"] & overlap
-        central = np.where(usable, options["central"] * np.minimum(highest, -lowest), np.nan)
+        central = np.where(usable, options.central * np.minimum(highest, -lowest), np.nan)
         values = _central_values(part["forward"], part["backward"], central, load)
         samples = [
             np.count_nonzero(np.abs(np.where(np.isfinite(xs), xs, np.inf)) <= central[:, None], 1)
@@ -431,7 +446,7 @@ def along_stroke_values(
         flags = (part["mismatch"], ~overlap, few, values[5])
         part["flags"] = np.where(inherited[block], 0, np.select(flags, range(1, 5), 0))
         part["values"] = values
-        if options["positions"] is None:  # the branches are not read again: not held
+        if options.positions is None:  # the branches are not read again: not held
             del part["forward"], part["backward"]
         parts.append(part)
 
@@ -465,7 +480,7 @@ def along_stroke_values(
         "position_max": highest * nan,
     }
     # Over the grid of positions common to all cycles: the values along the stroke.
-    grid = options["positions"]
+    grid = options.positions
     if grid is None:
         return {}, per_cycle, flags, None
     if np.ndim(grid) == 0:  # over the widest resolved range, or the stroke if none is
@@ -482,7 +497,7 @@ def along_stroke_values(
             highest[block],
             per_cycle["tilt"][block],
             load,
-            options["force_offset"] is None,
+            options.force_offset is None,
         )
         for name in _ALONG:
             per_position[name][block] = along[name]

@@ -72,8 +72,7 @@ import functools, multiprocessing, sys, time
 from ecofmaps._parallel import Runner, _materialised
 from ecofmaps.io import read_recording
 from ecofmaps.io.tables import results_csv
-from ecofmaps.measured.pipeline import default_options
-from ecofmaps.measured.pipeline import Analysis, Reading, measure_chunk
+from ecofmaps.measured.pipeline import Analysis, LoopOptions, Reading, measure_chunk
 
 def measure(tasks):
     start = time.perf_counter()
@@ -83,11 +82,11 @@ def measure(tasks):
 
 if __name__ == "__main__":
     recording = read_recording(sys.argv[1], lazy=True)
-    options = default_options(float(sys.argv[2]))
+    options = LoopOptions(float(sys.argv[2]))
     with Runner() as runner:
-        ANALYSIS = Analysis(recording.displacement, recording.force, float(sys.argv[2]),
-                            recording.cycle, runner=runner,
-                            reading=Reading(resolve=sys.argv[3] == "resolve"), **options)
+        ANALYSIS = Analysis(recording.displacement, recording.force, recording.cycle,
+                            options=options, runner=runner,
+                            reading=Reading(resolve=sys.argv[3] == "resolve"))
     LINES = functools.partial(results_csv, header=False)
     tasks = range(len(ANALYSIS.tasks))
     fork = multiprocessing.get_context("fork")

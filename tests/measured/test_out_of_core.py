@@ -20,7 +20,7 @@ from ecofmaps.measured import cycles, pipeline
 from ecofmaps.measured import samples as passes
 from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.cycles import MissingSampleError
-from ecofmaps.measured.pipeline import default_options
+from ecofmaps.measured.pipeline import LoopOptions
 from ecofmaps.measured.quality import LoopQualityWarning
 from ecofmaps.measured.synthetic import synthetic_recording
 from tests.measured.test_analysis import mindlin_recording
@@ -308,9 +308,9 @@ def test_tallies_of_parts_merge_into_the_tally_of_the_whole():
 
     x, q = noisy(EXAMPLE_2, 12, 3)
     x, q = with_gaps(x, q, [700, 1900])  # skipped cycles besides the flagged ones
-    options = default_options(LOAD)
+    options = LoopOptions(LOAD)
     found = cycles.find_cycles(x, None, 0.5, force=q)
-    values, flags, _ = measure_cycles(found, x, q, LOAD, **options)
+    values, flags, _ = measure_cycles(found, x, q, options)
     flags |= scale_flags(values, options)
     whole = Tally()
     whole.add(judged(values, flags, options)[1], flags, values["amplitude"])
@@ -347,11 +347,11 @@ def test_tasks_keep_what_they_measured_where_they_run(small_blocks):
     from ecofmaps._parallel import Runner
 
     x, q = noisy(EXAMPLE_2, 12, 3)
-    options = default_options(LOAD)
+    options = LoopOptions(LOAD)
     x, q = lazily(x, q)
     store = {}
     with Runner(2) as runner:
-        analysis = pipeline.Analysis(x, q, LOAD, runner=runner, samples=900, **options)
+        analysis = pipeline.Analysis(x, q, options=options, runner=runner, samples=900)
         assert len(analysis.tasks) > 2
         handed = {k: (c.values, c.flags) for k, c in analysis.measured(keep=True)}
         nothing = [(c.values, c.flags) for _, c in analysis.measured()]
@@ -382,7 +382,7 @@ def test_tasks_hand_back_only_the_columns_asked_for(small_blocks):
     with Runner(2) as runner:
         reading = pipeline.Reading(resolve=True)
         analysis = pipeline.Analysis(
-            x, q, LOAD, runner=runner, samples=900, reading=reading, **default_options(LOAD)
+            x, q, options=LoopOptions(LOAD), runner=runner, samples=900, reading=reading
         )
         whole = [chunk.part for _, chunk in analysis.measured(then=_variables)]
         only = list(analysis.measured(then=_variables, columns=columns))
