@@ -15,9 +15,7 @@ import numpy as np
 from ecofmaps._interrupts import check_interrupted
 from ecofmaps.measured import kernels
 from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles
-from ecofmaps.measured.quality import (
-    ANTICLOCKWISE_SHARE,
-)
+from ecofmaps.measured.quality import ANTICLOCKWISE_SHARE, UNEXPLAINED_SHARE
 
 __all__ = [
     "GROSS_SLIP_THRESHOLD",
@@ -313,9 +311,6 @@ _MEASURED = (
     "not-gross-slip",
 )
 
-#: A stick segment must explain all but this share of the displacement's variance along it.
-_UNEXPLAINED = 0.2
-
 
 def _loop_values(block, options):
     """Every per-cycle quantity of a block of centred loops, and the checks it failed."""
@@ -371,7 +366,7 @@ def _loop_values(block, options):
         "anticlockwise": anticlockwise,
         "energy-ratio-above-1": energy_ratio > 1.0 + rounding,
         "negative-stiffness": compliance < 0.0,
-        "no-stick": (~(fit["unexplained"] <= _UNEXPLAINED) & ~np.isinf(values["stiffness"]))
+        "no-stick": (~(fit["unexplained"] <= UNEXPLAINED_SHARE) & ~np.isinf(values["stiffness"]))
         | np.isnan(compliance),  # a rigid rig's vertical stick sides explain all but 0/0
         "negative-area": (energy_ratio < 0.0) & ~anticlockwise,
         "negative-slip": ~(slip > 0.0),

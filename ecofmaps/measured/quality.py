@@ -13,7 +13,7 @@ import xarray as xr
 
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._codes import warn
-from ecofmaps.measured.cycles import Cycles
+from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP, Regime
 
 __all__ = [
@@ -90,7 +90,8 @@ def _refusal_hint(flags: dict) -> str:
         return "The force does not vary: is the force channel connected?"
     if flags["implausible-amplitude"]:
         return (
-            "The displacement amplitude is outside 0.5 µm to 50 mm: the displacement is not "
+            f"The displacement amplitude is outside {AMPLITUDE_RANGE[0] * 1e6:g} µm to "
+            f"{AMPLITUDE_RANGE[1] * 1e3:g} mm: the displacement is not "
             "in the unit assumed. analyze_loops takes metres; on the command line, "
             "--displacement-unit gives the column's unit (a column without a unit in its "
             "name or the file is read in µm)."
@@ -291,6 +292,24 @@ SEPARATOR = "+"
 #: without area (the one definition, also for :func:`ecofmaps.fit_loop`).
 ANTICLOCKWISE_SHARE = 0.05
 
+#: A stick segment must explain all but this share of the displacement's variance along it.
+UNEXPLAINED_SHARE = 0.2
+
+#: Fewest slipping samples of each branch in the central part of the stroke.
+SLIP_SAMPLES = 8
+
+#: μ(ξ) varies along the stroke when the means over the inner and the outer half of the
+#: central part differ by this share of μ and by this many standard errors.
+VARIATION = 0.03
+VARIATION_SIGNIFICANCE = 4.0
+
+#: Blocks of the central part whose means give the scatter of μ(ξ) (batch means).
+SCATTER_BLOCKS = 8
+
+#: The GICoF is flagged where the block means of μ(ξ) scatter about a straight line by
+#: this share of μ (standard deviation) beyond the noise.
+GICOF_WIGGLE = 0.015
+
 #: Scope of a reason that refuses the cycle: every per-cycle quantity.
 ALL = "all"
 
@@ -312,11 +331,12 @@ REASONS = {
         "the cycle holds a missing sample (NaN or an empty cell): skipped, not analysed",
         ALL,
     ),
-    "few-samples": ("fewer samples in the cycle than a loop needs (MIN_SAMPLES)", ALL),
+    "few-samples": (f"fewer than {MIN_SAMPLES} samples in the cycle, fewer than a loop needs", ALL),
     "constant-force": ("the force does not vary over the cycle (a dead channel)", ALL),
     "implausible-amplitude": (
-        "the displacement amplitude is below 0.5 µm or above 50 mm: the displacement is not "
-        "in the unit assumed (a column without a unit is read in µm)",
+        f"the displacement amplitude is below {AMPLITUDE_RANGE[0] * 1e6:g} µm or above "
+        f"{AMPLITUDE_RANGE[1] * 1e3:g} mm: the displacement is not in the unit assumed (a "
+        "column without a unit is read in µm)",
         ALL,
     ),
     "several-loops": (
@@ -325,7 +345,8 @@ REASONS = {
         ALL,
     ),
     "anticlockwise": (
-        "the loop runs anticlockwise (area below -5 % of 4Δ*Q*): force and displacement "
+        f"the loop runs anticlockwise (area below -{ANTICLOCKWISE_SHARE * 100:g} % of 4Δ*Q*): "
+        "force and displacement "
         "recorded positive in opposite directions (see flip_force), time reversed, or the "
         "columns swapped",
         ALL,
@@ -333,8 +354,8 @@ REASONS = {
     "energy-ratio-above-1": ("the loop's area exceeds its bounding box 4Δ*Q* (A > 1)", ALL),
     "negative-stiffness": ("the stick sides slope down (S < 0)", ALL),
     "no-stick": (
-        "no straight stick side after the reversals: the stick lines leave more than 20 % "
-        "of the displacement's variance along them unexplained",
+        "no straight stick side after the reversals: the stick lines leave more than "
+        f"{UNEXPLAINED_SHARE * 100:g} % of the displacement's variance along them unexplained",
         ALL,
     ),
     "no-zero-crossing": (
@@ -342,7 +363,7 @@ REASONS = {
         ALL,
     ),
     "negative-area": (
-        "no area within the noise (-5 % of 4Δ*Q* < area < 0)",
+        f"no area within the noise (-{ANTICLOCKWISE_SHARE * 100:g} % of 4Δ*Q* < area < 0)",
         ("dissipated_energy", "energy_ratio", "ecof"),
     ),
     "negative-slip": ("δ* <= 0: the zero-force crossings in the wrong order", _SLIP),
@@ -356,7 +377,8 @@ REASONS = {
         _GICOF,
     ),
     "implausible-cof": (
-        "a coefficient of friction outside 0.01 to 3 (the ECoF or GICoF in gross slip): the "
+        f"a coefficient of friction outside {COF_RANGE[0]:g} to {COF_RANGE[1]:g} (the ECoF or "
+        "GICoF in gross slip): the "
         "load given or the force's unit is wrong, not the contact",
         ("ecof", "cof_max", *_GICOF, *RESOLVED),
     ),
@@ -375,18 +397,22 @@ REASONS = {
         RESOLVED,
     ),
     "few-slip-samples": (
-        "fewer than eight slipping samples of a branch in the central part of the stroke (a "
+        f"fewer than {SLIP_SAMPLES} slipping samples of a branch in the central part of the "
+        "stroke (a "
         "sparse or digitised loop): friction cannot be read along the stroke",
         RESOLVED,
     ),
     "mu-varies": (
         "the friction read along the stroke differs between the inner and the outer half of "
-        "its central part by more than 3 % and four standard errors (not the model's loop)",
+        "its central part by more than "
+        f"{VARIATION * 100:g} % and {VARIATION_SIGNIFICANCE:g} standard errors (not the "
+        "model's loop)",
         RESOLVED,
     ),
     "gicof-varies": (
-        "the friction read along the stroke wiggles beyond the noise (its means over eighths "
-        "of the central part scatter about a straight line by more than 1.5 % of μ: chatter, "
+        "the friction read along the stroke wiggles beyond the noise (its means over "
+        f"{SCATTER_BLOCKS} blocks of the central part scatter about a straight line by more "
+        f"than {GICOF_WIGGLE * 100:g} % of μ: chatter, "
         "stick-slip): the GICoF, read at one position, is not the contact's mean friction",
         _GICOF,
     ),

@@ -16,9 +16,14 @@ from ecofmaps._inputs import check
 from ecofmaps._interrupts import check_interrupted
 from ecofmaps.measured.quality import (
     ALL,
+    GICOF_WIGGLE,
     READING_REASONS,
     REASONS,
     RESOLVED,
+    SCATTER_BLOCKS,
+    SLIP_SAMPLES,
+    VARIATION,
+    VARIATION_SIGNIFICANCE,
     add_reason,
     has_reason,
 )
@@ -249,20 +254,8 @@ def read_along_stroke(loops: xr.Dataset, options: ReadingOptions):
 #: GICoF only, is added besides.
 QUALITY_FLAGS = READING_REASONS[:4]
 
-#: μ(ξ) varies along the stroke when the means over the inner and the outer half of the
-#: central part differ by this share of μ and by this many standard errors.
-_VARIATION = 0.03
-_VARIATION_SIGNIFICANCE = 4.0
-
 #: Values of μ(ξ) beyond this many robust standard deviations of the median are clipped.
 _WINSOR = 3.0
-
-#: Blocks of the central part whose means give the scatter of μ(ξ) (batch means).
-_SCATTER_BLOCKS = 8
-
-#: The GICoF is flagged where the block means of μ(ξ) scatter about a straight line by
-#: this share of μ (standard deviation) beyond the noise.
-_GICOF_WIGGLE = 0.015
 
 #: The largest lag-one autocorrelation of the block means that is believed.
 _R1 = 0.8
@@ -272,9 +265,6 @@ _BLOCK = 512
 
 #: Points of each cycle's own grid over its central part, for the per-cycle values.
 _CENTRAL_POINTS = 201
-
-#: Fewest slip samples of each branch in the central part.
-_SLIP_SAMPLES = 8
 
 #: The median absolute deviation of a normal distribution over its standard deviation.
 _MAD = 1.482602218505602
@@ -322,8 +312,8 @@ def _central_values(forward, backward, central, load):
         variance += noise * np.sum(weight**2, axis=1)
         weight = sample_weights(left, share, gain * contrast, width)
         variation_variance += noise * np.sum(weight**2, axis=1)
-    varies = (np.abs(variation) > _VARIATION * np.abs(mu_resolved)) & (
-        np.abs(variation) > _VARIATION_SIGNIFICANCE * np.sqrt(variation_variance)
+    varies = (np.abs(variation) > VARIATION * np.abs(mu_resolved)) & (
+        np.abs(variation) > VARIATION_SIGNIFICANCE * np.sqrt(variation_variance)
     )
     mean_xi = masked_sum(at, finite) / points
     mean_g = masked_sum(slope, finite) / points
@@ -342,8 +332,8 @@ def _central_values(forward, backward, central, load):
     scatter, wiggle = _scatter_variance(mu, finite, unit)
     # μ(ξ) wiggles along the stroke beyond the noise: the GICoF, read at one position,
     # is not the mean friction (a straight trend is the same at the centre).
-    excess = np.sqrt(np.maximum(wiggle - variance * _SCATTER_BLOCKS, 0.0))
-    wavers = excess > _GICOF_WIGGLE * np.abs(mu_resolved)
+    excess = np.sqrt(np.maximum(wiggle - variance * SCATTER_BLOCKS, 0.0))
+    wavers = excess > GICOF_WIGGLE * np.abs(mu_resolved)
     variance = np.fmax(variance, scatter)  # the noise alone where too few blocks
     tilt = mean_g - k * mean_xi
     return mu_resolved, variance, k, tilt, sensitivity, varies, shifting, wavers, offsetting
@@ -351,8 +341,8 @@ def _central_values(forward, backward, central, load):
 
 def _scatter_variance(mu, kept, unit):
     r"""Variance of the mean of ``mu`` over ``kept`` from the scatter of its block means."""
-    member = np.minimum((0.5 * (unit + 1.0) * _SCATTER_BLOCKS).astype(int), _SCATTER_BLOCKS - 1)
-    blocks = member[:, None] == np.arange(_SCATTER_BLOCKS)[None, :]
+    member = np.minimum((0.5 * (unit + 1.0) * SCATTER_BLOCKS).astype(int), SCATTER_BLOCKS - 1)
+    blocks = member[:, None] == np.arange(SCATTER_BLOCKS)[None, :]
     counts = kept.astype(np.float64) @ blocks
     means = (np.where(kept, mu, 0.0) @ blocks) / np.maximum(counts, 1.0)
     used = counts > 0
@@ -363,7 +353,7 @@ def _scatter_variance(mu, kept, unit):
     lagged = np.sum(residual[:, 1:] * residual[:, :-1], axis=1)
     r1 = np.clip(np.divide(lagged, squares, out=np.zeros_like(squares), where=squares > 0), 0, _R1)
     spread = squares / np.maximum(number - 1, 1) / np.maximum(number, 1)
-    place = np.where(used, np.arange(_SCATTER_BLOCKS)[None, :], 0.0)
+    place = np.where(used, np.arange(SCATTER_BLOCKS)[None, :], 0.0)
     place = np.where(used, place - (masked_sum(place, used) / number)[:, None], 0.0)
     trend = np.sum(residual * place, axis=1) / np.sum(place**2, axis=1)
     wiggle = np.sum((residual - trend[:, None] * place) ** 2, axis=1) / (number - 2)
@@ -442,7 +432,7 @@ def along_stroke_values(
             np.count_nonzero(np.abs(np.where(np.isfinite(xs), xs, np.inf)) <= central[:, None], 1)
             for xs, _, _ in (part["forward"], part["backward"])
         ]
-        few = (np.minimum(*samples) < _SLIP_SAMPLES) | ~np.isfinite(values[0])
+        few = (np.minimum(*samples) < SLIP_SAMPLES) | ~np.isfinite(values[0])
         flags = (part["mismatch"], ~overlap, few, values[5])
         part["flags"] = np.where(inherited[block], 0, np.select(flags, range(1, 5), 0))
         part["values"] = values
