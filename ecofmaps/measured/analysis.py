@@ -160,9 +160,8 @@ def analyze_loops(
 
     Notes
     -----
-    The methods are in the documentation of :mod:`ecofmaps.measured.analysis`,
-    :mod:`ecofmaps.measured.cycles` and :mod:`ecofmaps.measured.measure`; the checks in
-    :mod:`ecofmaps.measured.quality`. The ECoF is eq. 1; the GICoF is the paper's Section 5
+    The method and the checks are explained in ``docs/method-loops.md``. The ECoF is
+    eq. 1; the GICoF is the paper's Section 5
     (eq. 17-18), and equals :math:`\mu` for the model's loop whatever the groove.
 
     A dask recording (a long test read lazily by :func:`ecofmaps.read_recording`) is never
@@ -366,8 +365,8 @@ def resolve_loops(
 
     Notes
     -----
-    The method and the quality flags are in the documentation of
-    :mod:`ecofmaps.measured.resolve`. It rests on eq. 9 (the slip traction at any local
+    The method and the quality flags are explained in ``docs/method-loops.md``. It rests on
+    eq. 9 (the slip traction at any local
     groove slope) and eq. 10 (the contact position); the GICoF (eq. 17-18) is its value at
     :math:`\xi = 0`, and eq. 7 with :math:`x_o = \Delta^*` gives the equivalent
     parabolic groove.

@@ -21,6 +21,7 @@ __all__ = [
     "GROSS_SLIP_THRESHOLD",
     "NEIGHBOURS",
     "LoopBlock",
+    "Stretch",
     "both",
     "branch_rows",
     "line_crossings",
@@ -45,6 +46,18 @@ NEIGHBOURS = _NOISE_REACH + 1
 #: The median absolute deviation of a normal distribution over its standard deviation,
 #: times the standard deviation of a second difference of white noise over its own.
 _SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
+
+
+class Stretch:
+    """A stretch of a recording (samples ``low`` on) indexed like the whole recording."""
+
+    def __init__(self, values, low: int):
+        self.values, self.low = values, low
+
+    def __getitem__(self, key):
+        if isinstance(key, slice):
+            return self.values[key.start - self.low : key.stop - self.low]
+        return self.values[np.asarray(key) - self.low]
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -84,7 +97,7 @@ class LoopBlock:
 def loop_blocks(
     cycles: Cycles, displacement, force, rows=None, force_sign=1.0
 ) -> Iterator[LoopBlock]:
-    """The loops of ``cycles``, each moved to its centre (module notes), block by block."""
+    """The loops of ``cycles``, each moved to its centre, block by block."""
     first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
     # The whole cycles, by position among them: a block is consecutive whole cycles.
     kept = np.flatnonzero(cycles.whole)
@@ -137,7 +150,7 @@ def loop_blocks(
 
 def _drift_se(middle, count, centre, rows: slice):
     """Standard error of the offset between the branches of the loops ``rows`` that the
-    force's drift correction leaves (module notes), from the ``centre`` of every whole
+    force's drift correction leaves, from the ``centre`` of every whole
     cycle at its ``middle`` sample; the centres of :data:`_NOISE_REACH` cycles on either
     side of ``rows`` are needed. [N]"""
     size = centre.size

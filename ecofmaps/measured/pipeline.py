@@ -17,7 +17,7 @@ import xarray as xr
 from ecofmaps._inputs import check
 from ecofmaps._parallel import Runner, stretch
 from ecofmaps.measured.cycles import Cycles, find_cycles, missing_sample_error, no_cycle_error
-from ecofmaps.measured.measure import GROSS_SLIP_THRESHOLD, NEIGHBOURS, measure_cycles
+from ecofmaps.measured.measure import GROSS_SLIP_THRESHOLD, NEIGHBOURS, Stretch, measure_cycles
 from ecofmaps.measured.quality import RESOLVED, Tally, cycle_results, scale_flags, with_loops
 from ecofmaps.measured.resolve import ReadingOptions, read_along_stroke, resolved_attrs
 
@@ -265,33 +265,21 @@ def _cycle_means(series, cycles: Cycles, rows: slice) -> np.ndarray:
         return (sums[ends] - sums[begins]) / (counts[ends] - counts[begins])
 
 
-class _Stretch:
-    """A stretch of a recording (samples ``low`` on) indexed like the whole recording."""
-
-    def __init__(self, values, low: int):
-        self.values, self.low = values, low
-
-    def __getitem__(self, key):
-        if isinstance(key, slice):
-            return self.values[key.start - self.low : key.stop - self.low]
-        return self.values[np.asarray(key) - self.low]
-
-
 def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
     """One chunk through the steps: its cycles measured on its stretch ``x``, ``q`` (and the
     load recorded over it), read along the stroke and judged once."""
     options, reading, labels = task.options, task.reading, task.cycles.label[task.rows]
     values, flags, loops = measure_cycles(
         task.cycles,
-        _Stretch(x, task.low),
-        _Stretch(q, task.low),
+        Stretch(x, task.low),
+        Stretch(q, task.low),
         options,
         rows=task.rows,
         keep_loops=reading.resolve or reading.keep_loops,
     )
     if recorded_load is not None:
         values["normal_load"] = _cycle_means(
-            _Stretch(recorded_load, task.low), task.cycles, task.rows
+            Stretch(recorded_load, task.low), task.cycles, task.rows
         )
     flags |= scale_flags(values, options)
     resolved = None

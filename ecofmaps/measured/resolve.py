@@ -320,7 +320,7 @@ def _central_values(forward, backward, central, load):
     dxi = at - mean_xi[:, None]
     k = masked_sum(dxi * (slope - mean_g[:, None]), finite) / masked_sum(dxi**2, finite)
     # The sensitivities of mu_resolved to the compliance 1/S and to a shift of the rising
-    # branch against the falling one along ξ (module notes).
+    # branch against the falling one along ξ.
     turning = k[:, None] / (1.0 + slope**2)
     factor = 0.5 * (1.0 + mu_resolved**2) / points
     sensitivity = factor * masked_sum(turning * (q_forward - q_backward), finite)
@@ -408,7 +408,7 @@ def _blocks(cycles):
 def along_stroke_values(
     x, q, valid, load, stiffness, amplitude, inherited, given, options, drift_se
 ):
-    """Every resolved quantity of the centred loops ``x``, ``q`` (module notes)."""
+    """Every resolved quantity of the centred loops ``x``, ``q``."""
     cycles = x.shape[0]
     parts = []
     for block in _blocks(cycles):

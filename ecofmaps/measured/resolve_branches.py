@@ -93,7 +93,7 @@ def _compliance(x, q, sticks):
 
 
 def _stick_and_slip(xi, branches, sticks, floor, slip_threshold):
-    """Noise and the slip of each branch (module notes)."""
+    """Noise and the slip of each branch."""
     # σ from the second differences within the stick sets: a smooth trend of ξ (a rounded
     # loop, a wrong stiffness) hardly enters them, white noise does with variance 6σ².
     second = np.abs(xi[:, :-2] - 2.0 * xi[:, 1:-1] + xi[:, 2:])
@@ -140,7 +140,7 @@ def _sorted_branch(xi, q, slip):
 
 
 def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_threshold):
-    """The stiffness, the checks of the stick sets, and the two slip branches (module notes)."""
+    """The stiffness, the checks of the stick sets, and the two slip branches."""
     cycles = x.shape[0]
     floor = _ROUNDING * amplitude
     branches = _branches(x, valid)

@@ -365,7 +365,7 @@ def _task(function, start, stop, arguments, *arrays):
 
 
 class Samples:
-    """The channels of one recording (see the module notes)."""
+    """The channels of one recording."""
 
     def __init__(
         self, displacement, force, cycle=None, missing=None, *, runner=None, chunk, block=None
