@@ -15,7 +15,12 @@ import numpy as np
 from ecofmaps._interrupts import check_interrupted
 from ecofmaps.measured import kernels
 from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles
-from ecofmaps.measured.quality import ANTICLOCKWISE_SHARE, UNEXPLAINED_SHARE
+from ecofmaps.measured.quality import (
+    ANTICLOCKWISE_SHARE,
+    READING_REASONS,
+    REASONS,
+    UNEXPLAINED_SHARE,
+)
 
 __all__ = [
     "GROSS_SLIP_THRESHOLD",
@@ -306,22 +311,10 @@ _PER_CYCLE = (
 )
 
 
-#: The reasons of :data:`~ecofmaps.measured.quality.REASONS` that this step flags.
-_MEASURED = (
-    "missing-samples",
-    "few-samples",
-    "constant-force",
-    "several-loops",
-    "anticlockwise",
-    "energy-ratio-above-1",
-    "negative-stiffness",
-    "no-stick",
-    "negative-area",
-    "negative-slip",
-    "no-zero-crossing",
-    "curved-stick",
-    "no-crossing",
-    "not-gross-slip",
+#: The reasons of :data:`~ecofmaps.measured.quality.REASONS` that this step flags (not the
+#: scale's, :func:`~ecofmaps.measured.quality.scale_flags`, nor the reading's).
+_MEASURED = tuple(
+    r for r in REASONS if r not in ("implausible-amplitude", "implausible-cof", *READING_REASONS)
 )
 
 
