@@ -41,12 +41,17 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps._interrupts import INTERRUPTED, Interrupted, add_stop_note
-from ecofmaps._parallel import Runner
 from ecofmaps.cli._common import CommandError
 from ecofmaps.io.tables import results_csv
-from ecofmaps.measured.cycles import Cycles
-from ecofmaps.measured.options import MissingSampleError, default_options
-from ecofmaps.measured.pipeline import IN_PROCESS, Analysis, force_at_mean_load, only
+from ecofmaps.measured.cycles import Cycles, MissingSampleError
+from ecofmaps.measured.pipeline import (
+    IN_PROCESS,
+    Analysis,
+    LoopOptions,
+    force_at_mean_load,
+    only,
+    runner_for,
+)
 
 __all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun", "keep_block", "skipped"]
 
@@ -316,11 +321,9 @@ class LongRun:
         self.analysed = None  # (index, path, blocks or None) of the recording analysed last
 
     def _runner(self):
-        if self.args.scheduler:
-            return Runner(scheduler=self.args.scheduler)
         if self.args.workers:
-            return Runner(self.args.workers, cluster=True)
-        return Runner()
+            return runner_for("processes", self.args.workers)
+        return runner_for(self.args.scheduler)
 
     def analyse(self, index, path, recording, load, *, many: bool, write, columns=None, reading):
         """The results of recording ``index``, as :func:`ecofmaps.analyze_loops` gives them
@@ -415,22 +418,21 @@ def _analyse(index, path, recording, load, args, runner, partial, many, write, c
     if isinstance(load, str):  # the load recorded sample by sample (--load COLUMN)
         force, load = force_at_mean_load(force, recording.load)
         recorded = recording.load
-    options = default_options(load, getattr(args, "flip_force", False))
+    options = LoopOptions(load, flip_force=getattr(args, "flip_force", False))
     shown = recording.lazy and not args.quiet and sys.stderr.isatty()
     if shown:
         print(f"{path.name}: finding the cycles of {recording.size} samples", file=sys.stderr)
     analysis = Analysis(
         recording.displacement,
         force,
-        load,
         recording.cycle,
+        options=options,
         recorded_load=recorded,
         runner=runner,
         nan_policy=args.nan_policy,
         reading=reading,
         cycles=None if partial is None else partial.cycles(index),
         one_chunk=not recording.lazy,
-        **options,
     )
     done = {}
     if partial is not None:

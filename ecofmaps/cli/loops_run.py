@@ -19,8 +19,9 @@ from ecofmaps.cli._common import CommandError, recording_options, refuse_to_over
 from ecofmaps.io.files import atomic_path, record_written
 from ecofmaps.io.recordings import read_recording
 from ecofmaps.maps.cache import write_netcdf
-from ecofmaps.measured.options import ImplausibleScaleError, ImplausibleScaleWarning
 from ecofmaps.measured.pipeline import Reading
+from ecofmaps.measured.quality import ImplausibleScaleError, ImplausibleScaleWarning
+from ecofmaps.measured.resolve import ReadingOptions
 from ecofmaps.measured.synthetic import EXAMPLE, example_path
 from ecofmaps.model.regimes import GROSS_SLIP
 from ecofmaps.web import INSTALL_WEB, missing_web_packages
@@ -57,7 +58,7 @@ def _analysed(index, path, recording, load, args, long_run, write, *, many, reso
     reading = Reading(
         resolve=not args.no_resolve,
         keep_loops=plots or args.report is not None,
-        along_stroke={"positions": positions},
+        along_stroke=ReadingOptions(positions=positions),
         hand_back=positions is not None,
     )
     with warnings.catch_warnings(record=True) as caught:

@@ -7,11 +7,18 @@ from ecofmaps._lazy import lazy_names
 _PUBLIC = {
     "ecofmaps.measured.analysis": ("analyze_loops", "resolve_loops"),
     "ecofmaps.measured.fit": ("LoopFit", "fit_loop"),
-    "ecofmaps.measured.long_test": ("long_recording", "write_long_recording"),
-    "ecofmaps.measured.options": ("ImplausibleScaleError", "ImplausibleScaleWarning"),
-    "ecofmaps.measured.quality": ("LoopQualityWarning",),
-    "ecofmaps.measured.resolved": ("resolve_analyzed_loops",),
-    "ecofmaps.measured.synthetic": ("scar_example_path", "synthetic_recording"),
+    "ecofmaps.measured.quality": (
+        "ImplausibleScaleError",
+        "ImplausibleScaleWarning",
+        "LoopQualityWarning",
+    ),
+    "ecofmaps.measured.resolve": ("resolve_analyzed_loops",),
+    "ecofmaps.measured.synthetic": (
+        "long_recording",
+        "scar_example_path",
+        "synthetic_recording",
+        "write_long_recording",
+    ),
 }
 
 __getattr__, __dir__, __all__ = lazy_names(__name__, _PUBLIC)

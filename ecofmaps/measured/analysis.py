@@ -1,81 +1,6 @@
-r"""Measured fretting loops, cycle by cycle: ECoF, GICoF, rig stiffness and the rest.
-
-:func:`analyze_loops` reads a recording of the actuator displacement :math:`\Delta` and the
-tangential force :math:`Q` (many cycles, or a single loop), cuts it into cycles and
-removes the offsets and a slow drift (:mod:`ecofmaps.measured.cycles`), and measures each loop.
-The work is vectorised over a block of cycles at a time (:mod:`ecofmaps.measured.centring`),
-with no Python loop over samples or cycles, and its memory does not grow with the recording
-beyond the per-cycle results: each branch of each loop (from one reversal to the next) is a
-padded row, so that every per-branch step runs once over both branches of every cycle
-(:mod:`ecofmaps.measured.branches`).
-
-The quantities, per cycle
--------------------------
-Each loop runs from its lowest displacement up the *rising* branch to its highest and
-back down the *falling* branch.
-
-* amplitude :math:`\Delta^*` and max_force :math:`Q^*`: half the peak-to-peak ranges.
-* stiffness :math:`S`: the slope of the stick segments that follow the two reversals. One
-  compliance :math:`1/S` common to both segments, each with its own intercept, is fitted
-  by least squares of :math:`\Delta` on :math:`Q`, :math:`\Delta = c + Q/S` (eq. 10 with
-  the contact position :math:`c` fixed): the displacement's noise is larger, relative to
-  the segment's span, than the force's, and a rigid rig gives :math:`S = \infty`. A segment
-  starts as the branch's samples whose force has moved away from the reversal's by a share
-  between ``stick_window[0]`` and ``stick_window[1]`` (default 5 % and 45 %) of the
-  branch's force swing, up to the first sample beyond the upper share: in the model the
-  contact sticks after a reversal at least until the force crosses zero whenever the
-  groove slope at the reversal is below :math:`\mu`, and skipping the first 5 % skips the
-  noisy turn of the reversal. Each segment then grows along its branch until two samples
-  in a row lie more than three standard deviations (of the first fit's residuals) off its
-  line, where the slip bends away, and the slope is fitted again to the grown segments.
-  A sparsely sampled loop with fewer than two samples in a window (a model loop draws each
-  stick segment as one straight line) uses the chord from the reversal instead.
-* slip_amplitude :math:`\delta^*`: half the width of the loop at :math:`Q = 0` (Figure 1a).
-  Where a grown stick segment reaches across zero force, the crossing is its fitted line's
-  intercept :math:`c`; otherwise a straight line through the branch's samples with
-  :math:`|Q| < Q^*/4` and the two samples around the crossing.
-* dissipated_energy :math:`E_d = \oint Q\,d\Delta`: the loop's area by the trapezoidal
-  (shoelace) rule; the noise of the samples averages out of it.
-* ecof :math:`\mu_E = E_d/(4P\delta^*)` (eq. 1), cof_max :math:`Q^*/P`, energy_ratio
-  :math:`A = E_d/(4\Delta^* Q^*)`.
-* gicof: :math:`Q/P` where the loop crosses the line :math:`Q = S\Delta` (eq. 17-18, the
-  paper's Figure 6): gicof_forward on the rising branch, gicof_backward (sign reversed) on
-  the falling one, and gicof their mean. On the line the contact position
-  :math:`x = \Delta - Q/S` (eq. 10) is zero. The branch's samples with :math:`|x| <`
-  ``crossing_window`` :math:`\times\,\delta^*` (default 0.7) are fitted by least squares
-  with :math:`Q = a + bx + cxQ`, which is eq. 9 exactly for any groove slope
-  (:math:`a = \mu P`, :math:`b = kP`, :math:`c = \mu k`) and a smooth three-parameter
-  curve for other loops; the crossing is :math:`Q = a`. In the model the window lies
-  inside the slip, away from any ploughing peak at the ends of the stroke. With fewer than
-  five samples in the window, the crossing is interpolated between two samples. A small
-  error in :math:`S` or in the centring moves the two crossings in opposite directions,
-  and most of it cancels from their mean.
-* stick_residual: the root mean square displacement off the stick lines.
-* regime: the :class:`ecofmaps.Regime` code, as in the model and the maps: ``GROSS_SLIP``
-  when the energy ratio :math:`A` exceeds ``gross_slip_threshold`` (default 0.2, the
-  sliding transition of Fouvry, Kapsa and Vincent), else ``NO_GROSS_SLIP`` (partial
-  slip); ``INVALID`` for a refused cycle. ECoF and GICoF describe sliding: they are NaN in
-  partial slip. Like
-  Fouvry's criterion, this also calls partial slip a gross-slip loop that slips over less
-  than about a fifth of the stroke (for the model, :math:`A \approx \delta^*/\Delta^*`
-  times :math:`\mu_E P/Q^*`); lower the threshold to read such loops.
-
-Every cycle is checked before its numbers are reported (:mod:`ecofmaps.measured.quality`):
-a loop that runs anticlockwise, has no area, no straight stick sides, a constant force,
-crossings that are not on the measured loop, ... has the values concerned NaN and the
-reasons in its ``quality``; the stick sides are *curved* when a :math:`Q^2` term is
-significant and changes their slope by more than 5 % from end to end. A crossing with
-:math:`Q = S\Delta` is on the loop when the branch has measured samples on both sides of
-:math:`\xi = 0` in the fitted window (or the two interpolated between) and the crossing's
-force lies within theirs; a zero-force crossing when it lies within the displacements of
-the branch's samples near zero force.
-
-For the model's loop every quantity is exact up to the sampling: :math:`\Delta^*`,
-:math:`Q^*`, :math:`S`, :math:`\delta^*` and the GICoF to rounding when the loop's
-reversals are sampled, :math:`E_d` to the trapezoidal rule's error on the curved slip
-branches. The half-width at :math:`Q = 0` is the model's slip amplitude as long as the
-groove slope at the ends of the slip, :math:`2 z_o \delta^*/x_o^2`, is below :math:`\mu`
-(the force crosses zero while the contact sticks); beyond that it is smaller.
+r"""The public entry points of the loop analysis: :func:`analyze_loops` and :func:`resolve_loops`
+check their inputs and options and run the recording through :mod:`ecofmaps.measured.pipeline`.
+The method is explained in ``docs/method-loops.md``.
 """
 
 from __future__ import annotations
@@ -84,17 +9,17 @@ import numpy as np
 import xarray as xr
 
 from ecofmaps._inputs import si_units
-from ecofmaps._parallel import Runner, check_workers
-from ecofmaps.measured.cycles import MIN_SAMPLES
-from ecofmaps.measured.options import (
-    DEFAULTS,
+from ecofmaps._parallel import check_workers
+from ecofmaps.measured.cycles import MIN_SAMPLES, missing_sample_error
+from ecofmaps.measured.pipeline import (
     NAN_POLICIES,
-    check_options,
-    missing_sample_error,
+    Analysis,
+    LoopOptions,
+    Reading,
+    force_at_mean_load,
+    runner_for,
 )
-from ecofmaps.measured.per_cycle import GROSS_SLIP_THRESHOLD
-from ecofmaps.measured.pipeline import Analysis, Reading, force_at_mean_load
-from ecofmaps.measured.resolved import check_reading_options
+from ecofmaps.measured.resolve import ReadingOptions
 from ecofmaps.measured.samples import is_lazy
 
 __all__ = ["analyze_loops", "resolve_loops"]
@@ -123,10 +48,10 @@ def analyze_loops(
     load,
     cycle=None,
     *,
-    hysteresis=0.5,
-    stick_window=(0.05, 0.45),
-    crossing_window=0.7,
-    gross_slip_threshold=GROSS_SLIP_THRESHOLD,
+    hysteresis=LoopOptions.hysteresis,
+    stick_window=LoopOptions.stick_window,
+    crossing_window=LoopOptions.crossing_window,
+    gross_slip_threshold=LoopOptions.gross_slip_threshold,
     flip_force=False,
     resolve=False,
     keep_loops=False,
@@ -235,9 +160,8 @@ def analyze_loops(
 
     Notes
     -----
-    The methods are in the documentation of :mod:`ecofmaps.measured.analysis`,
-    :mod:`ecofmaps.measured.cycles` and :mod:`ecofmaps.measured.centring`; the checks in
-    :mod:`ecofmaps.measured.quality`. The ECoF is eq. 1; the GICoF is the paper's Section 5
+    The method and the checks are explained in ``docs/method-loops.md``. The ECoF is
+    eq. 1; the GICoF is the paper's Section 5
     (eq. 17-18), and equals :math:`\mu` for the model's loop whatever the groove.
 
     A dask recording (a long test read lazily by :func:`ecofmaps.read_recording`) is never
@@ -264,26 +188,41 @@ def analyze_loops(
     ok | 1 cycle: 1 ok
     """
     force, load, recorded = _at_mean_load(force, load)
-    options = check_options(
+    options = LoopOptions(
         load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
     )
     reading = Reading(resolve=bool(resolve), keep_loops=bool(keep_loops))
     results, _ = _run(
-        displacement, force, load, cycle, missing, options, nan_policy, reading, scheduler, workers,
+        displacement,
+        force,
+        cycle,
+        options,
+        reading,
+        missing=missing,
         recorded_load=recorded,
-    )  # fmt: skip
+        nan_policy=nan_policy,
+        scheduler=scheduler,
+        workers=workers,
+    )
     return results
 
 
 def _run(
-    displacement, force, load, cycle, missing, options, nan_policy, reading, scheduler, workers,
+    displacement,
+    force,
+    cycle,
+    options: LoopOptions,
+    reading: Reading,
+    *,
+    missing=None,
     recorded_load=None,
-):  # fmt: skip
-    """The recording checked and through the pipeline (:mod:`ecofmaps.measured.pipeline`):
-    in this process as one chunk when it is in memory, else on the runner for
-    ``scheduler`` and ``workers``; ``recorded_load`` is the load at each sample when it was
-    recorded (``force`` is then at the mean ``load``). Returns the results and the reading
-    along the stroke (or None)."""
+    nan_policy="skip",
+    scheduler=None,
+    workers=None,
+):
+    """The recording checked and through the pipeline: in this process as one chunk when it
+    is in memory, else on the runner of ``scheduler`` and ``workers``. Returns the results
+    and the reading along the stroke handed back (or None)."""
     if nan_policy not in NAN_POLICIES:
         raise ValueError(f"nan_policy must be one of {NAN_POLICIES}; got {nan_policy!r}")
     if scheduler in (None, "threads", "processes"):  # on this machine: checked before any work
@@ -297,12 +236,16 @@ def _run(
             f"too few samples for one cycle: {x.shape[0]} (a cycle needs at least {MIN_SAMPLES})"
         )
     arrays = dict(
-        missing=mask, recorded_load=recorded_load, nan_policy=nan_policy, reading=reading, **options
+        options=options,
+        missing=mask,
+        recorded_load=recorded_load,
+        nan_policy=nan_policy,
+        reading=reading,
     )
     if not any(is_lazy(a) for a in (x, q, label, mask)):
         if nan_policy == "raise":
             _raise_at_missing(x, q, label, mask)
-        analysis = Analysis(x, q, float(load), label, one_chunk=True, **arrays)
+        analysis = Analysis(x, q, label, one_chunk=True, **arrays)
         return analysis.run()
     if reading.keep_loops:
         raise ValueError(
@@ -310,7 +253,7 @@ def _run(
             "recording's loops would not fit)"
         )
     with runner_for(scheduler, workers) as runner:
-        analysis = Analysis(x, q, float(load), label, runner=runner, **arrays)
+        analysis = Analysis(x, q, label, runner=runner, **arrays)
         return analysis.run()
 
 
@@ -336,25 +279,6 @@ def _raise_at_missing(x, q, label, mask) -> None:
         raise missing_sample_error(int(np.argmax(bad)))
 
 
-def runner_for(scheduler, workers) -> Runner:
-    """The :class:`ecofmaps._parallel.Runner` for :func:`analyze_loops`' ``scheduler`` and
-    ``workers`` (see there)."""
-    if scheduler is None:
-        try:
-            from distributed import default_client  # only where dask's cluster is used
-
-            return Runner(client=default_client())
-        except (ImportError, ValueError):  # no client: threads
-            return Runner(workers)
-    if scheduler == "threads":
-        return Runner(workers)
-    if scheduler == "processes":
-        return Runner(workers or 2, cluster=True)
-    if isinstance(scheduler, str):
-        return Runner(scheduler=scheduler)
-    return Runner(client=scheduler)
-
-
 @si_units
 def resolve_loops(
     displacement,
@@ -364,12 +288,12 @@ def resolve_loops(
     cycle=None,
     *,
     force_offset=None,
-    positions=201,
-    central=0.8,
-    slip_threshold=4.0,
-    stick_window=(0.05, 0.45),
-    hysteresis=0.5,
-    gross_slip_threshold=GROSS_SLIP_THRESHOLD,
+    positions=ReadingOptions.positions,
+    central=ReadingOptions.central,
+    slip_threshold=ReadingOptions.slip_threshold,
+    stick_window=ReadingOptions.stick_window,
+    hysteresis=LoopOptions.hysteresis,
+    gross_slip_threshold=LoopOptions.gross_slip_threshold,
 ) -> xr.Dataset:
     r"""Friction and groove slope read along the whole stroke of every loop of a recording.
 
@@ -441,8 +365,8 @@ def resolve_loops(
 
     Notes
     -----
-    The method and the quality flags are in the documentation of
-    :mod:`ecofmaps.measured.resolved`. It rests on eq. 9 (the slip traction at any local
+    The method and the quality flags are explained in ``docs/method-loops.md``. It rests on
+    eq. 9 (the slip traction at any local
     groove slope) and eq. 10 (the contact position); the GICoF (eq. 17-18) is its value at
     :math:`\xi = 0`, and eq. 7 with :math:`x_o = \Delta^*` gives the equivalent
     parabolic groove.
@@ -461,19 +385,10 @@ def resolve_loops(
     >>> print(f"{float(resolved.mu_resolved[0]):.9f} {float(resolved.aspect_ratio[0]):.9f}")
     0.800000000 0.200000000
     """
-    reading = Reading(
-        resolve=True,
-        along_stroke=check_reading_options(
-            stiffness, force_offset, positions, central, slip_threshold, stick_window
-        ),
-        hand_back=True,
+    along_stroke = ReadingOptions(
+        stiffness, force_offset, positions, central, slip_threshold, stick_window
     )
+    reading = Reading(resolve=True, along_stroke=along_stroke, hand_back=True)
     force, load, recorded = _at_mean_load(force, load)
-    options = check_options(
-        load, hysteresis, stick_window, DEFAULTS["crossing_window"], gross_slip_threshold, False
-    )
-    _, resolved = _run(
-        displacement, force, load, cycle, None, options, "skip", reading, None, None,
-        recorded_load=recorded,
-    )  # fmt: skip
-    return resolved
+    options = LoopOptions(load, hysteresis, stick_window, gross_slip_threshold=gross_slip_threshold)
+    return _run(displacement, force, cycle, options, reading, recorded_load=recorded)[1]

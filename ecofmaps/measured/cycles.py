@@ -1,65 +1,6 @@
-r"""A recording of fretting loops cut into cycles.
-
-A recording is a long series of samples :math:`(\Delta_i, Q_i)`. :func:`split_cycles` cuts
-it at the displacement reversals; :func:`labelled_cycles` uses a cycle number recorded with
-each sample instead; :func:`find_cycles` chooses between the two, for
-:func:`ecofmaps.analyze_loops` and :func:`ecofmaps.fit_loop` alike. They return
-:class:`Cycles`: for every complete cycle, the stretch of samples it covers (first sample
-and count) and where in the stretch its loop begins, at its lowest displacement. A loop
-runs once round from there and back to it (the last point closes the loop).
-:mod:`ecofmaps.measured.centring` moves the loops to their centres.
-
-No Python loop runs over samples or over cycles, and nothing the size of the recording is
-held beyond the recording itself: the passes over it (the detrending, its percentiles, the
-Schmitt trigger, the extremes of each run) go a chunk of ``_CHUNK`` samples at a time. A
-long recording held as dask arrays (:mod:`ecofmaps.measured.samples`) goes through the same
-passes a block of chunks at a time, each block where its task runs, and each pass returns
-what it found per chunk (sums, the ends and extremes of runs; :mod:`ecofmaps.measured.passes`),
-which are joined here in order: the cycles are the same, sample for sample, however the
-recording is held.
-
-Finding the reversals
----------------------
-The displacement is detrended by a straight line fitted over the whole recording (so a
-steady drift does not move it across the thresholds) and passed through a Schmitt trigger:
-it is *high* once it has risen above ``+hysteresis`` times the half-range and stays so
-until it falls below ``-hysteresis`` times the half-range (the half-range is half the
-distance between the 1st and 99th percentiles). Noise smaller than the hysteresis band
-cannot make a false reversal. The top reversal of a cycle is the highest sample of a high
-run, the bottom reversal the lowest sample of a low run. A cycle runs from one bottom
-reversal to the next.
-
-The first and last runs may be cut short by the ends of the recording. Their extreme is a
-reversal if it lies inside the run, or, when it is the recording's first or last sample,
-if it comes within ``tolerance`` of the stroke :math:`2\Delta^*` of the nearest extreme of
-the same kind (a recording that starts or ends exactly at a reversal). The samples before
-the first and after the last bottom reversal are incomplete cycles: they are dropped and
-counted. A recording with fewer than two bottom reversals is read as a single loop if it
-closes (see :func:`labelled_cycles`).
-
-Missing samples
----------------
-A sample is missing when its displacement, force or cycle number is not finite (an empty
-cell, NaN), or a ``missing`` mask says so. The line, the percentiles and the trigger use the
-other samples only (a missing sample neither starts nor ends a run, nor is an extreme), and
-a missing cycle number takes the one before it.
-
-A gap long enough to hide a whole run of the other kind (at least a quarter of
-``1 - hysteresis`` of the drive's period, the median distance between bottom runs) may have
-swallowed reversals, so the trigger restarts where the samples resume: as at the start of
-the recording it cannot know the phase, and the samples after the gap begin a run of the
-kind they first decide. An extreme that the displacement does not leave by more than
-``tolerance`` times the stroke before such a gap (or after it, coming out of the gap) is
-not a reversal: the displacement may have gone on beyond it in the gap. Of two reversals
-either side of a gap closer than half a period only the farther out is kept. The first
-partial cycle after the gap therefore joins the skipped stretch that holds the gap, and
-every complete cycle after it is found (unless its reversal lies so close to the gap that
-the displacement there is within the tolerance of it). A shorter gap cannot hide a run:
-the trigger goes on over it.
-
-A cycle whose stretch holds a missing sample is kept in the table, marked in
-:attr:`Cycles.missing`: the analysis reports it as skipped, with no values, and centres its
-neighbours without it.
+r"""Step 2 of the loop pipeline: the cycles of a recording (at the displacement reversals, or by
+its cycle numbers), found by passes a block at a time, and the runs of missing samples.
+The method is explained in ``docs/method-loops.md`` ("Finding the cycles").
 """
 
 from __future__ import annotations
@@ -68,8 +9,9 @@ import dataclasses
 
 import numpy as np
 
-from ecofmaps.measured import passes
-from ecofmaps.measured.passes import (
+from ecofmaps.measured import samples as passes
+from ecofmaps.measured.samples import (
+    Samples,
     displacement_line,
     displacement_percentiles,
     ends_of_runs,
@@ -79,7 +21,6 @@ from ecofmaps.measured.passes import (
     survey,
     trigger_runs,
 )
-from ecofmaps.measured.samples import Samples
 
 __all__ = ["MIN_SAMPLES", "Cycles", "find_cycles", "labelled_cycles", "split_cycles"]
 
@@ -94,40 +35,7 @@ _ONE_LOOP = 1 << 24
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class Cycles:
-    """Complete cycles of a recording: the stretch of samples of each, and its loop's start.
-
-    Attributes
-    ----------
-    start : numpy.ndarray of int64, shape (cycles,)
-        First sample of each cycle's stretch of the recording.
-    count : numpy.ndarray of int64, shape (cycles,)
-        Samples in the stretch. A cycle cut at the reversals runs from its bottom
-        reversal to the next one, both included.
-    rotation : numpy.ndarray of int64, shape (cycles,)
-        Where the loop begins, counted from ``start``: its lowest displacement (0 for
-        cycles cut at the reversals). The loop runs through the stretch from there,
-        wraps round to its beginning and ends by repeating its first sample.
-    label : numpy.ndarray of int64, shape (cycles,)
-        The cycle number: the recorded one, or the drive's, 1, 2, ... from the first
-        complete cycle, where a stretch with missing samples counts the drive's periods it
-        spans (a gap leaves a hole in the numbering).
-    continuous : bool
-        True when the cycles follow each other without a gap (cut at the reversals: each
-        stretch ends on the sample that begins the next), so a slow drift can be
-        interpolated from one cycle to the next.
-    incomplete_cycles : int
-        Incomplete cycles dropped (at the ends of the recording, or labelled cycles that do
-        not close).
-    dropped_samples : int
-        Samples that belong to no complete cycle.
-    missing : numpy.ndarray of bool, shape (cycles,), or None
-        True for the cycles whose stretch holds a missing sample; None if no sample of the
-        recording is missing.
-    missing_samples : int
-        Missing samples in the whole recording.
-    first_missing : int
-        Index of the first missing sample, or -1.
-    """
+    """Complete cycles of a recording: the stretch of samples of each, and its loop's start."""
 
     start: np.ndarray
     count: np.ndarray
@@ -164,23 +72,7 @@ class Cycles:
         )
 
     def indices(self, rows=slice(None), width=None):
-        """Sample indices round the loops ``rows``, one padded row per loop.
-
-        Parameters
-        ----------
-        rows : slice or array_like of int
-            The cycles (rows of this table).
-        width : int, optional
-            Points per row; default the longest of these loops, closing point included.
-
-        Returns
-        -------
-        samples : numpy.ndarray of int64, shape (rows, width)
-            Row ``k`` lists the samples of loop ``k`` in order round it, from its lowest
-            displacement to the point that closes it, then repeats that closing sample.
-        points : numpy.ndarray of int64, shape (rows,)
-            Points round each loop, the closing one included.
-        """
+        """Sample indices round the loops ``rows``, one padded row per loop."""
         start, count, rotation = self.start[rows], self.count[rows], self.rotation[rows]
         if width is None:
             width = int(count.max()) + 1
@@ -213,8 +105,7 @@ def _extremes_of_parts(start, stop, arguments, x):
     """The extremes of the parts of runs ``[begin, end)`` that lie in the block, a chunk at a
     time: one column per piece of a part in a chunk, holding the part's number, its largest
     finite displacement and the first sample of it, its smallest and the first sample of it,
-    and the largest and smallest detrended displacement (NaN and -1 where none is finite).
-    """
+    and the largest and smallest detrended displacement (NaN and -1 where none is finite)."""
     chunk, gaps, (mean, mean_t, slope, middle), begin, end = arguments
     found = [np.empty((7, 0))]
     for a in range(start, stop, chunk):
@@ -248,29 +139,7 @@ def _extremes_of_parts(start, stop, arguments, x):
 
 
 def _parts_after_gaps(samples, gaps, line, band, runs):
-    """The trigger's runs cut where samples resume after a long gap inside them.
-
-    A long gap inside a run may have hidden whole runs of the
-    other kind: the trigger restarts after it, and the samples after the gap begin a new run
-    of the kind they decide (the run goes on when they decide none before the next run).
-
-    Parameters
-    ----------
-    samples : Samples
-        The recording.
-    gaps : tuple of numpy.ndarray of int64, shape (m, 2)
-        ``[start, stop)`` of each run of missing samples, and of the long ones.
-    line, band : tuple
-        The detrending line and the trigger's ``(centre, level)``.
-    runs : tuple of numpy.ndarray
-        The trigger's runs: first sample, kind, extreme (sample) and its value.
-
-    Returns
-    -------
-    run, begin, extreme, value : numpy.ndarray
-        For each part of a run (in order): the run it belongs to, its first sample, its
-        extreme and the extreme's displacement.
-    """
+    """The trigger's runs cut where samples resume after a long gap inside them."""
     starts, kind, extreme, value = runs
     identity = np.arange(starts.size)
     gaps, long = gaps
@@ -360,20 +229,7 @@ def _hidden_by_gaps(parts, samples, gaps, margin):
     """Which extremes of the runs' parts may lie where the samples stop rather than where
     the displacement turns: within its part, a long gap follows (or precedes) the extreme
     and the sample next to the gap is within ``margin`` of it, so the displacement may
-    have gone on beyond it in the gap.
-
-    Parameters
-    ----------
-    parts : tuple of numpy.ndarray
-        Per part of a run, in order: its first sample, its extreme (a sample) and the
-        extreme's displacement. [1], [1], [m]
-    samples : Samples
-        The recording.
-    gaps : tuple of numpy.ndarray of int64, shape (m, 2)
-        ``[start, stop)`` of each run of missing samples, and of the long ones.
-    margin : float
-        How far the displacement must turn back from an extreme before a gap. [m]
-    """
+    have gone on beyond it in the gap."""
     begin, extreme, value = parts
     gaps, long = gaps
     if not long.size:
@@ -401,33 +257,7 @@ def _hidden_by_gaps(parts, samples, gaps, margin):
 
 
 def _accepted_reversals(parts, hidden, edges, scale):
-    """Which extremes of the runs' parts are reversals.
-
-    An extreme on the first or last finite sample of the recording (``edges``) may be where
-    the recording stops rather than where the displacement turns: it is a reversal if it
-    comes within ``scale[0]`` of the nearest extreme of the same kind that is neither on
-    an edge nor ``hidden``, as when a recording starts at a reversal. A ``hidden`` extreme
-    (beside a long gap) is not a reversal. Of two reversals of one run either side of a gap
-    closer than ``scale[1]`` samples, the farther out is kept.
-
-    Parameters
-    ----------
-    parts : tuple of numpy.ndarray
-        Per part of a run, in order: its run, its kind (+1 top, -1 bottom), its extreme (a
-        sample) and the extreme's displacement. [1], [1], [1], [m]
-    hidden : numpy.ndarray of bool
-        The extremes that a long gap may hide (:func:`_hidden_by_gaps`).
-    edges : tuple of int
-        The first and last finite samples.
-    scale : tuple of float
-        The tolerance in displacement [m] and the least distance between the reversals
-        either side of a gap. [1]
-
-    Returns
-    -------
-    accepted : numpy.ndarray of bool
-        True for the parts whose extreme is a reversal.
-    """
+    """Which extremes of the runs' parts are reversals."""
     run, kind, extreme, value = parts
     tolerance, least = scale
     at_edge = np.isin(extreme, edges)
@@ -630,66 +460,13 @@ def _labelled(samples: Samples, tolerance: float) -> Cycles:
 
 
 def split_cycles(displacement, hysteresis: float = 0.5, tolerance: float = 0.01) -> Cycles:
-    """Cut a continuous recording into complete cycles at its displacement reversals.
-
-    Parameters
-    ----------
-    displacement : numpy.ndarray
-        Displacement at each sample, in time order (NaN where missing). [m]
-    hysteresis : float
-        Half-width of the Schmitt trigger's band, as a fraction of the displacement's
-        half-range (0 < hysteresis < 1). Noise below it makes no false reversal. [1]
-    tolerance : float
-        How close to the neighbouring reversal (as a fraction of the stroke) an extreme
-        at the very start or end of the recording must come to count as a reversal. [1]
-
-    Returns
-    -------
-    cycles : Cycles
-        Complete cycles from each bottom reversal to the next (both included).
-
-    Raises
-    ------
-    ValueError
-        If the displacement does not oscillate.
-
-    Notes
-    -----
-    See the module's documentation for the method.
-    """
+    """Cut a continuous recording into complete cycles at its displacement reversals."""
     x = np.asarray(displacement, dtype=np.float64)
     return _split(Samples(x, None, chunk=passes._CHUNK), hysteresis, tolerance)
 
 
 def labelled_cycles(displacement, cycle, tolerance: float = 0.01) -> Cycles:
-    r"""Complete cycles of a recording whose samples carry their cycle number.
-
-    Parameters
-    ----------
-    displacement : numpy.ndarray
-        Displacement at each sample, in time order (NaN where missing). [m]
-    cycle : numpy.ndarray
-        Cycle number of each sample; each run of equal numbers is one cycle (the cycles
-        may be loops recorded now and then during a long test). A missing (NaN) number
-        takes the one before it. [1]
-    tolerance : float
-        Allowed gap, as a fraction of the cycle's stroke, between its last and first
-        samples on top of 1.5 times its largest step. [1]
-
-    Returns
-    -------
-    cycles : Cycles
-        Each labelled cycle that closes, turned round to start at its lowest displacement
-        and closed by repeating that sample.
-
-    Notes
-    -----
-    A labelled cycle is complete if it has at least :data:`MIN_SAMPLES` samples, its
-    stroke is at least half the median stroke of the recording, and it closes: the gap
-    between its last and first displacements is at most 1.5 times its largest step
-    between samples plus ``tolerance`` times its stroke. A loop cut short by the start or
-    the end of the recording fails the last test.
-    """
+    r"""Complete cycles of a recording whose samples carry their cycle number."""
     x = np.asarray(displacement, dtype=np.float64)
     return _labelled(Samples(x, None, np.asarray(cycle), chunk=passes._CHUNK), tolerance)
 
@@ -697,35 +474,7 @@ def labelled_cycles(displacement, cycle, tolerance: float = 0.01) -> Cycles:
 def find_cycles(
     displacement, cycle=None, hysteresis: float = 0.5, *, force=None, missing=None, runner=None
 ) -> Cycles:
-    """The complete cycles of a recording: numbered ones, or cut at the reversals.
-
-    Parameters
-    ----------
-    displacement : numpy.ndarray or dask.array.Array
-        Displacement at each sample, in time order, float64 (NaN where missing). [m]
-    cycle : array_like, optional
-        Cycle number of each sample (see :func:`labelled_cycles`); without it the
-        recording is cut at its reversals (:func:`split_cycles`). [1]
-    hysteresis : float
-        Band of the reversal detector (see :func:`split_cycles`). [1]
-    force : numpy.ndarray or dask.array.Array, optional
-        The force, whose missing samples are missing samples too. [N]
-    missing : array_like of bool, optional
-        Samples to treat as missing besides the non-finite ones.
-    runner : ecofmaps._parallel.Runner, optional
-        Where the passes over dask arrays run.
-
-    Returns
-    -------
-    cycles : Cycles
-        With :attr:`Cycles.missing` marking the cycles that hold a missing sample.
-
-    Raises
-    ------
-    ValueError
-        If ``cycle`` does not hold one number per sample, or the displacement does not
-        oscillate.
-    """
+    """The complete cycles of a recording: numbered ones, or cut at the reversals."""
     if cycle is not None:
         if getattr(cycle, "ndim", np.ndim(cycle)) != 1:
             raise ValueError("cycle must be one-dimensional (one value per sample)")
@@ -738,3 +487,28 @@ def find_cycles(
     if cycle is None:
         return _split(samples, hysteresis, 0.01)
     return _labelled(samples, 0.01)
+
+
+class MissingSampleError(ValueError):
+    """A missing sample where ``nan_policy='raise'``: ``sample`` is its 0-based index."""
+
+    def __init__(self, sample: int, message: str):
+        self.sample = int(sample)
+        super().__init__(message)
+
+
+def missing_sample_error(sample: int) -> MissingSampleError:
+    """The error for the missing sample ``sample`` (0-based) with ``nan_policy='raise'``."""
+    return MissingSampleError(
+        sample,
+        f"sample {sample} is missing (NaN or empty); nan_policy='skip' analyses the cycles "
+        "without missing samples and reports the others as skipped",
+    )
+
+
+def no_cycle_error(samples: int) -> ValueError:
+    """The error for a recording of ``samples`` samples without a complete cycle."""
+    return ValueError(
+        f"too few samples for one cycle: no complete cycle in {samples} samples "
+        "(the loop does not close, or the recording does not oscillate)"
+    )

@@ -19,7 +19,8 @@ import numpy as np
 
 from ecofmaps._inputs import check, float64
 from ecofmaps.measured.cycles import MIN_SAMPLES, find_cycles
-from ecofmaps.measured.per_cycle import measure_cycles
+from ecofmaps.measured.measure import measure_cycles
+from ecofmaps.measured.pipeline import LoopOptions
 from ecofmaps.measured.quality import ALL, ANTICLOCKWISE_SHARE, REASONS, SEPARATOR
 from ecofmaps.model.core import slip_position, traction_ratio
 from ecofmaps.model.simulation import fretting_loop
@@ -114,18 +115,7 @@ class LoopFit:
     cycle: int
 
     def model_loop(self, num=201):
-        """The fitted steady loop, offsets included, for plotting.
-
-        Parameters
-        ----------
-        num : int
-            Points on each slip branch (see :func:`ecofmaps.fretting_loop`). [1]
-
-        Returns
-        -------
-        displacement, force : numpy.ndarray
-            One closed cycle of the fitted model loop. [m], [N]
-        """
+        """The fitted steady loop, offsets included, for plotting."""
         displacement, force = fretting_loop(
             self.amplitude, self.load, self.stiffness, self.mu, self.aspect_ratio, num=num
         )
@@ -136,12 +126,7 @@ class LoopFit:
 
 
 def _rising_branch(target, mu, kappa, lam):
-    r""":math:`Q/P` of the steady loop's rising branch at actuator position ``target``.
-
-    After the reversal at :math:`(-1, -q^*)` the contact sticks at :math:`\xi = -d`, so
-    :math:`q = (D + d)/\lambda`, until the forward-slip force
-    :math:`Q_+(\xi_+(D))` (eq. 9 at the root of eq. 10) is lower; it is the smaller of the two.
-    """
+    r""":math:`Q/P` of the steady loop's rising branch at actuator position ``target``."""
     d = slip_position(1.0, mu, kappa, lam)
     stick = (target + d) / lam
     slip = traction_ratio(slip_position(target, mu, kappa, lam), mu, kappa)
@@ -168,14 +153,7 @@ _jacobian_jit = jax.jit(jax.jacfwd(_residual))
 
 
 def _starting_values(x, y, rising, stiffness, slip_half_width, energy_ratio):
-    r"""Scaled starting parameters (:math:`\Delta/L`, :math:`Q/P`, centred) from the loop.
-
-    ``stiffness`` (:math:`SL/P`), ``slip_half_width`` (:math:`\delta^*/L`) and
-    ``energy_ratio`` come from :func:`ecofmaps.analyze_loops`. The contact position
-    :math:`x = \Delta - Q/S` (eq. 10) on the slip segments gives :math:`\mu` and the
-    groove slope :math:`k` by least squares on :math:`Q_\pm/P \approx \pm\mu + k(1 +
-    \mu^2) x` (eq. 9 to first order in :math:`x`; at :math:`x = 0` this is the GICoF).
-    """
+    r"""Scaled starting parameters (:math:`\Delta/L`, :math:`Q/P`, centred) from the loop."""
     if energy_ratio < -ANTICLOCKWISE_SHARE:
         raise ValueError(
             "the loop runs anticlockwise (its area ∮Q dΔ is negative): force and "
@@ -380,7 +358,11 @@ def _measured_cycle(all_x, all_y, load, cycle, cycle_number, hysteresis):
     analysis, flags, _ = max(
         (
             measure_cycles(
-                cycles, all_x, all_y, load, stick_window=window, rows=slice(row, row + 1)
+                cycles,
+                all_x,
+                all_y,
+                LoopOptions(load, stick_window=window),
+                rows=slice(row, row + 1),
             )
             for window in _STICK_WINDOWS
         ),

@@ -1,25 +1,7 @@
-r"""Compiled kernels for the steps of :func:`ecofmaps.analyze_loops` along each loop.
-
-Each kernel loops over the loops of a block, or over their branch rows, and does in one or a
-few passes what the methods of :mod:`ecofmaps.measured.branches` and
-:mod:`ecofmaps.measured.centring` describe: the sums of a least-squares line, the growth of a
-stick segment, the curvature test, the search for a crossing, a loop's centre, extremes and
-area, the drift between the centres, the noise of the centres
-(:func:`second_difference_medians`). One more, :func:`detrended`, serves the search for
-cycles (:mod:`ecofmaps.measured.passes`).
-
-Branch rows (:func:`ecofmaps.measured.branches.branch_rows`): the rows of a block are the
-rising branches of its cycles, then their falling branches (row ``c`` and row
-``c + cycles`` belong to cycle ``c``); row ``r`` holds ``length[r]`` points, padded to the
-block's width by repeating its last point. The values are finite (a cycle with a missing
-sample is not laid out). A row's numbers depend on that row (and its cycle's other row)
-alone, not on the block it was laid out in. Sums run in the order of the samples (in two
-interleaved chains where noted).
-
-The kernels are compiled by numba on first call and cached on disk (``cache=True``); with
-``error_model="numpy"`` a division by zero gives an infinity or NaN, as in NumPy. Every
-array is float64 (int64 for indices and counts, bool for flags), C-contiguous, so each
-kernel has a single compiled signature.
+r"""Compiled (numba) kernels of the centring and the measuring steps
+(:mod:`ecofmaps.measured.measure`) and of the passes (:mod:`ecofmaps.measured.samples`), a loop
+or a branch row at a time, cached on disk; every array float64 and C-contiguous.
+The method is explained in ``docs/method-loops.md``.
 """
 
 from __future__ import annotations
@@ -73,12 +55,7 @@ def _maximum(a, b):
 @numba.njit(**_COMPILE)
 def _first_segment(y, n, low, high, segment):
     """Mark a row's first stick segment in ``segment`` (cleared first); return the column
-    that it ends before.
-
-    The samples whose force has moved from the reversal's by ``low`` to ``high`` of the
-    row's force swing, up to the first one beyond ``high``; with fewer than two, the
-    reversal and the first sample past ``low`` (the reversal alone if there is none).
-    """
+    that it ends before."""
     highest, lowest = y[0], y[0]
     for j in range(1, n):
         highest, lowest = max(highest, y[j]), min(lowest, y[j])
@@ -191,38 +168,7 @@ def _curved(x, y, end, segment, intercept, compliance, line):
 
 @numba.njit(**_COMPILE)
 def stick_lines(x, y, length, span, low, high):
-    r"""Lines :math:`\Delta = c + Q/S` through the stick segments of each cycle's rows.
-
-    The method of :func:`ecofmaps.measured.branches.stick_lines`: first segments, a first
-    line of common slope, each segment grown until two samples in a row lie more than
-    three standard deviations off it, the line fitted again, its fit and curvature.
-
-    Parameters
-    ----------
-    x, y : numpy.ndarray, shape (rows, width)
-        Displacement and force of the branch rows. [m], [N]
-    length : numpy.ndarray of int64, shape (rows,)
-        Points of each row.
-    span : numpy.ndarray, shape (cycles,)
-        Peak-to-peak displacement of each cycle (sets the rounding). [m]
-    low, high : float
-        Shares of the row's force swing between which a segment starts. [-]
-
-    Returns
-    -------
-    compliance : numpy.ndarray, shape (cycles,)
-        The slope :math:`1/S` common to a cycle's two lines. [m/N]
-    intercept : numpy.ndarray, shape (rows,)
-        Each row's :math:`c`. [m]
-    across : numpy.ndarray of bool, shape (rows,)
-        The grown segment holds forces of both signs.
-    residual : numpy.ndarray, shape (cycles,)
-        Root mean square displacement off the lines. [m]
-    unexplained : numpy.ndarray, shape (cycles,)
-        Share of the displacement's variance along the segments left by the lines. [-]
-    curved : numpy.ndarray of bool, shape (cycles,)
-        A segment bends (:func:`ecofmaps.measured.branches.stick_lines`).
-    """
+    r"""Lines :math:`\Delta = c + Q/S` through the stick segments of each cycle's rows."""
     rows, width = x.shape
     cycles = rows // 2
     compliance, intercept = np.empty(cycles), np.empty(rows)
@@ -281,32 +227,7 @@ def _sample_pair(length, count, width):
 
 @numba.njit(**_COMPILE)
 def zero_force_crossings(x, y, length, band, intercept, across, rounding):
-    r"""Displacement where each branch row crosses :math:`Q = 0`, and whether on the loop.
-
-    The method of :func:`ecofmaps.measured.branches.zero_force_crossings`.
-
-    Parameters
-    ----------
-    x, y : numpy.ndarray, shape (rows, width)
-        Displacement and force of the branch rows. [m], [N]
-    length : numpy.ndarray of int64, shape (rows,)
-        Points of each row.
-    band : numpy.ndarray, shape (rows,)
-        Samples with :math:`|Q|` up to this are fitted. [N]
-    intercept : numpy.ndarray, shape (rows,)
-        Displacement at zero force on each row's stick line. [m]
-    across : numpy.ndarray of bool, shape (rows,)
-        The row's stick segment reaches across zero force.
-    rounding : numpy.ndarray, shape (rows,)
-        Rounding of the displacement. [m]
-
-    Returns
-    -------
-    crossing : numpy.ndarray, shape (rows,)
-        Displacement at :math:`Q = 0`. [m]
-    on_loop : numpy.ndarray of bool, shape (rows,)
-        The crossing lies on the loop.
-    """
+    r"""Displacement where each branch row crosses :math:`Q = 0`, and whether on the loop."""
     rows, width = x.shape
     crossing, on_loop = np.empty(rows), np.zeros(rows, np.bool_)
     near, line = np.zeros(width, np.bool_), np.empty(6)
@@ -346,14 +267,7 @@ def zero_force_crossings(x, y, length, band, intercept, across, rounding):
 @numba.njit(**_COMPILE)
 def _curve_intercept(scaled, product, window, y, begin, end):
     r"""Intercept :math:`a` of the least-squares :math:`Q = a + b\xi + c\xi Q` through the
-    samples marked in ``window`` (between columns ``begin`` and ``end``), and their count.
-
-    ``scaled`` holds their contact position :math:`\xi` over the window's half-width,
-    ``product`` that times :math:`Q/P`. The regressors
-    are centred on their means and :math:`\xi Q` is orthogonalised against :math:`\xi`
-    (Gram-Schmidt), so that :math:`a` stays exact when the two are nearly collinear; where
-    :math:`\xi Q` adds only rounding to :math:`\xi`, :math:`Q = a + b\xi` is fitted.
-    """
+    samples marked in ``window`` (between columns ``begin`` and ``end``), and their count."""
     count, sum_s, sum_z, sum_q = 0.0, 0.0, 0.0, 0.0
     for j in range(begin, end):
         if window[j]:
@@ -397,32 +311,7 @@ def _window_holds(force, y, before, window, begin, end, pair, with_pair, roundin
 
 @numba.njit(**_COMPILE)
 def line_crossings(x, y, length, compliance, half_width, load, rounding):
-    r"""Force where each branch row crosses :math:`Q = S\Delta`, and whether on the loop.
-
-    The method of :func:`ecofmaps.measured.branches.line_crossings`.
-
-    Parameters
-    ----------
-    x, y : numpy.ndarray, shape (rows, width)
-        Displacement and force of the branch rows. [m], [N]
-    length : numpy.ndarray of int64, shape (rows,)
-        Points of each row.
-    compliance : numpy.ndarray, shape (rows,)
-        :math:`1/S` of each row's cycle. [m/N]
-    half_width : numpy.ndarray, shape (rows,)
-        Samples with a contact position :math:`|\xi|` up to this are fitted. [m]
-    load : float
-        Normal load :math:`P`. [N]
-    rounding : numpy.ndarray, shape (rows,)
-        Rounding of the force. [N]
-
-    Returns
-    -------
-    force : numpy.ndarray, shape (rows,)
-        Force at the crossing. [N]
-    on_loop : numpy.ndarray of bool, shape (rows,)
-        The crossing lies on the loop.
-    """
+    r"""Force where each branch row crosses :math:`Q = S\Delta`, and whether on the loop."""
     rows, width = x.shape
     force, on_loop = np.empty(rows), np.zeros(rows, np.bool_)
     scaled, product = np.empty(width), np.empty(width)
@@ -476,25 +365,7 @@ def _trapezoid(path, values, i):
 
 @numba.njit(**_COMPILE)
 def path_means(path, values, offset, count, closed):
-    """Mean of ``values`` round each loop weighted by the distance travelled along ``path``.
-
-    Trapezoids over each segment from sample ``i`` to ``i + 1`` of a stretch, summed in
-    two interleaved partial sums (two chains of additions the processor runs side by side).
-
-    Parameters
-    ----------
-    path, values : numpy.ndarray, shape (samples,)
-        The samples (the path in [m], the values in any unit).
-    offset, count : numpy.ndarray of int64, shape (loops,)
-        First sample and samples of each loop's stretch.
-    closed : bool
-        Add the segment from each stretch's last sample back to its first.
-
-    Returns
-    -------
-    mean : numpy.ndarray, shape (loops,)
-        The weighted means, in the unit of ``values``.
-    """
+    """Mean of ``values`` round each loop weighted by the distance travelled along ``path``."""
     mean = np.empty(offset.size)
     for k in range(offset.size):
         first, last = offset[k], offset[k] + count[k] - 1
@@ -519,21 +390,7 @@ def path_means(path, values, offset, count, closed):
 @numba.njit(**_COMPILE)
 def interpolated(first, count, points, values):
     """``values`` interpolated linearly over ``points`` at the sample indices ``first`` to
-    ``first + count - 1``, to the bit as ``np.interp``.
-
-    Parameters
-    ----------
-    first, count : int
-        The first sample index and the number of them.
-    points, values : numpy.ndarray, shape (points,)
-        Increasing sample positions (every index lies in ``points[0]`` up to, not
-        including, ``points[-1]``) and the values there.
-
-    Returns
-    -------
-    result : numpy.ndarray, shape (count,)
-        The interpolated values, in the unit of ``values``.
-    """
+    ``first + count - 1``, to the bit as ``np.interp``."""
     result = np.empty(count)
     j, k = 0, 0
     while k < count:  # the samples on segment j, from points[j] to before points[j + 1]
@@ -608,28 +465,7 @@ def stretch_ranges(values, offset, count):
 
 @numba.njit(**_COMPILE)
 def loop_measures(x, y, offset, count, rotation):
-    """Extremes, area and top of each centred loop, in one pass over its samples.
-
-    Parameters
-    ----------
-    x, y : numpy.ndarray, shape (samples,)
-        Displacement and force of a block's samples. [m], [N]
-    offset, count, rotation : numpy.ndarray of int64, shape (loops,)
-        Each loop's stretch of the samples and where the loop begins in it
-        (:class:`ecofmaps.measured.centring.LoopBlock`).
-
-    Returns
-    -------
-    highest, lowest : numpy.ndarray, shape (loops,)
-        Largest and smallest displacement. [m]
-    max_force : numpy.ndarray, shape (loops,)
-        Half the force's peak-to-peak range. [N]
-    area : numpy.ndarray, shape (loops,)
-        :math:`\\oint Q\\,d\\Delta` by trapezoids over the stretch's segments and the
-        one that closes the loop. [J]
-    top : numpy.ndarray of int64, shape (loops,)
-        The first point round the loop, from its beginning, at the largest displacement.
-    """
+    """Extremes, area and top of each centred loop, in one pass over its samples."""
     loops = offset.size
     highest, lowest, max_force = np.empty(loops), np.empty(loops), np.empty(loops)
     area, top = np.empty(loops), np.empty(loops, np.int64)
@@ -665,27 +501,7 @@ def loop_measures(x, y, offset, count, rotation):
 
 @numba.njit(**_COMPILE)
 def detrended(x, first, mean, mean_t, slope, middle):
-    """Displacements less a straight line over the sample index, in one pass.
-
-    Sample ``first + i`` becomes ``(x[i] - mean) - ((t - mean_t) * slope)`` with
-    ``t = first - middle + i``: exactly the numbers of ``np.arange`` and NumPy's
-    operations, so the result is the same to the bit.
-
-    Parameters
-    ----------
-    x : numpy.ndarray, shape (samples,)
-        Displacements of samples ``first`` on. [m]
-    first : int
-        Index of the first sample.
-    mean, mean_t, slope, middle : float
-        The line (:func:`ecofmaps.measured.passes.displacement_line`): the mean
-        displacement [m], the mean of ``t`` [-], the slope [m] and the middle sample [-].
-
-    Returns
-    -------
-    detrended : numpy.ndarray, shape (samples,)
-        The displacements less the line. [m]
-    """
+    """Displacements less a straight line over the sample index, in one pass."""
     result = np.empty(x.size)
     start = first - middle  # an integer or a half, exact
     for i in range(x.size):
@@ -696,22 +512,7 @@ def detrended(x, first, mean, mean_t, slope, middle):
 @numba.njit(**_COMPILE)
 def branch_stretches(values, start, end, length, width):
     """Rows of ``width`` points: ``length - 1`` samples of ``values`` from ``start`` on,
-    then ``values[end]`` (a branch's last point) repeated to the row's end.
-
-    Parameters
-    ----------
-    values : numpy.ndarray, shape (samples,)
-        A block's samples (any unit).
-    start, end, length : numpy.ndarray of int64, shape (rows,)
-        Each row's first sample, its last point's sample and its number of points.
-    width : int
-        Points of every row.
-
-    Returns
-    -------
-    rows : numpy.ndarray, shape (rows, width)
-        The rows, in the unit of ``values``.
-    """
+    then ``values[end]`` (a branch's last point) repeated to the row's end."""
     rows = np.empty((start.size, width))
     for r in range(start.size):
         for j in range(length[r] - 1):

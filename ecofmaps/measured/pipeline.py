@@ -1,35 +1,8 @@
-r"""The one pipeline of the analysis of measured loops, whatever the way in.
-
-A recording (NumPy arrays, an xarray Dataset, a file of any supported format, read by
-:mod:`ecofmaps.io`) goes through the same steps, each one function that every caller
-shares, so that a fix lands once:
-
-1. **cycles**: :func:`ecofmaps.measured.cycles.find_cycles`, by passes over the recording a
-   block of samples at a time (:class:`~ecofmaps.measured.samples.Samples`): the straight
-   line through the displacement, its percentiles, the reversals (or the runs of cycle
-   numbers), the runs of missing samples. Only their results, a few numbers per cycle,
-   are held. The cycles keep the drive's numbering.
-2. **chunks**: the cycles are cut into chunks of whole cycles, about ``samples`` samples
-   each, so no cycle is cut at a chunk's edge. Each chunk reads the stretch of its cycles
-   and of five whole cycles on either side (a *halo*: the centring interpolates each
-   cycle's centre from its neighbours', and takes the noise of the centres from four
-   neighbours on either side, :mod:`ecofmaps.measured.centring`).
-3. **per-cycle values**: :func:`ecofmaps.measured.per_cycle.measure_cycles`, with the
-   sample indices of the whole recording;
-4. **along the stroke** (``resolve``): :func:`ecofmaps.measured.resolved.resolve_analyzed_loops`
-   on the chunk's own loops, which never leave it;
-5. **quality and table**: :func:`ecofmaps.measured.results.cycle_results` and a
-   :class:`~ecofmaps.measured.results.Tally` of them, made where the chunk ran;
-   :meth:`Analysis.finish` checks the whole recording (every cycle refused, units,
-   scale) and gives the joined results their attributes.
-
-In memory is the case of one chunk, run in this process; out of core is the case of many;
-workers are a :class:`ecofmaps._parallel.Runner` (threads, a local cluster of processes, or
-a dask cluster), a few chunks at a time, so memory holds a few chunks whatever the length
-of the recording; a resumed run is a store of finished chunks
-(:mod:`ecofmaps.cli.loops_long`) handed back to :meth:`Analysis.part`. Every number is
-computed from the same samples with the same arithmetic in every case; only sums over a
-loop's padded rows may be grouped differently between chunkings (to the last bits).
+r"""The driver of the loop pipeline, whatever the way in: the options, the chunks of whole cycles
+(each with a halo for the centring), each chunk measured, read along the stroke and judged
+where it runs, on this process or a dask runner, and the parts joined into the table; a
+recorded load is converted here, to the mean load and back to each cycle's own.
+The method is explained in ``docs/method-loops.md`` ("One pipeline, in memory and out of core").
 """
 
 from __future__ import annotations
@@ -41,24 +14,29 @@ import itertools
 import numpy as np
 import xarray as xr
 
-from ecofmaps._parallel import stretch
-from ecofmaps.measured.centring import NEIGHBOURS
-from ecofmaps.measured.cycles import Cycles, find_cycles
-from ecofmaps.measured.options import missing_sample_error, no_cycle_error
-from ecofmaps.measured.per_cycle import measure_cycles
-from ecofmaps.measured.quality import ALL, REASONS, SEPARATOR, quality_summary
-from ecofmaps.measured.resolved import REPORTED, resolve_analyzed_loops, resolved_attrs
-from ecofmaps.measured.results import Tally, at_own_load, cycle_results, strip, with_loops
+from ecofmaps._inputs import check
+from ecofmaps._parallel import Runner, stretch
+from ecofmaps.measured.cycles import Cycles, find_cycles, missing_sample_error, no_cycle_error
+from ecofmaps.measured.measure import GROSS_SLIP_THRESHOLD, NEIGHBOURS, Stretch, measure_cycles
+from ecofmaps.measured.quality import RESOLVED, Tally, cycle_results, scale_flags, with_loops
+from ecofmaps.measured.resolve import ReadingOptions, read_along_stroke, resolved_attrs
 
 __all__ = [
+    "AT_OWN_LOAD",
     "HALO",
     "IN_PROCESS",
+    "NAN_POLICIES",
     "TASK_SAMPLES",
     "Analysis",
     "Chunk",
+    "LoopOptions",
     "Reading",
+    "Task",
+    "at_own_load",
     "force_at_mean_load",
+    "measure_chunk",
     "only",
+    "runner_for",
 ]
 
 #: Samples of the recording measured by one chunk of a long recording (about; whole cycles).
@@ -67,8 +45,54 @@ TASK_SAMPLES = 1 << 22
 #: Whole cycles on either side of a chunk's cycles that it reads for the centring.
 HALO = NEIGHBOURS
 
-#: The prefix of the names under which a chunk's values hold its reading along the stroke.
-READ = "read:"
+#: What the analysis does with missing samples: skip their cycles, or raise.
+NAN_POLICIES = ("skip", "raise")
+
+
+@dataclasses.dataclass(frozen=True)
+class LoopOptions:
+    """The load and the options of :func:`ecofmaps.analyze_loops` (see there), checked once:
+    a ValueError names the one that is not valid."""
+
+    load: float
+    hysteresis: float = 0.5
+    stick_window: tuple = (0.05, 0.45)
+    crossing_window: float = 0.7
+    gross_slip_threshold: float = GROSS_SLIP_THRESHOLD
+    flip_force: bool = False
+
+    def __post_init__(self):
+        check("load", self.load, "positive", "N")
+        if np.ndim(self.load) != 0:
+            raise ValueError("load must be a single value [N]")
+        if not 0.0 < self.hysteresis < 1.0:
+            raise ValueError(f"hysteresis must satisfy 0 < hysteresis < 1; got {self.hysteresis!r}")
+        low, high = (float(share) for share in self.stick_window)
+        if not 0.0 <= low < high <= 1.0:
+            raise ValueError(
+                f"stick_window must satisfy 0 <= low < high <= 1; got {self.stick_window!r}"
+            )
+        if not self.crossing_window > 0.0:
+            raise ValueError(
+                f"crossing_window must satisfy crossing_window > 0; got {self.crossing_window!r}"
+            )
+        if not 0.0 < self.gross_slip_threshold < 1.0:
+            raise ValueError(
+                "gross_slip_threshold must satisfy 0 < gross_slip_threshold < 1; "
+                f"got {self.gross_slip_threshold!r}"
+            )
+        if not isinstance(self.flip_force, bool | np.bool_):
+            raise ValueError(f"flip_force must be True or False; got {self.flip_force!r}")
+        checked = {
+            "load": float(self.load),
+            "hysteresis": float(self.hysteresis),
+            "stick_window": (low, high),
+            "crossing_window": float(self.crossing_window),
+            "gross_slip_threshold": float(self.gross_slip_threshold),
+            "flip_force": bool(self.flip_force),
+        }
+        for name, value in checked.items():
+            object.__setattr__(self, name, value)
 
 
 class _InProcess:
@@ -88,37 +112,57 @@ class _InProcess:
 IN_PROCESS = _InProcess()
 
 
+def runner_for(scheduler=None, workers=None):
+    """The runner of :func:`ecofmaps.analyze_loops`' ``scheduler`` and ``workers`` (see
+    there), the one place where it is chosen."""
+    if scheduler is None:
+        try:
+            from distributed import default_client  # only where dask's cluster is used
+
+            return Runner(client=default_client())
+        except (ImportError, ValueError):  # no client: threads
+            return Runner(workers)
+    if scheduler == "threads":
+        return Runner(workers)
+    if scheduler == "processes":
+        return Runner(workers or 2, cluster=True)
+    if isinstance(scheduler, str):
+        return Runner(scheduler=scheduler)
+    return Runner(client=scheduler)
+
+
 @dataclasses.dataclass(frozen=True)
 class Reading:
-    """What each chunk reads besides the per-cycle values.
-
-    Attributes
-    ----------
-    resolve : bool
-        Read each loop along the stroke (:func:`~ecofmaps.measured.resolved.resolve_analyzed_loops`)
-        and report :data:`~ecofmaps.measured.resolved.REPORTED` with its quality.
-    keep_loops : bool
-        Keep the centred loops in the results (``loop_displacement``, ``loop_force``).
-    along_stroke : dict, optional
-        Keyword arguments of :func:`~ecofmaps.measured.resolved.resolve_analyzed_loops`
-        (default: the per-cycle values alone, ``positions=None``). A grid of ``positions``
-        given by its number of points is spread over the widest resolved range of all
-        cycles: it needs the recording in one chunk.
-    hand_back : bool
-        Hand back the whole reading along the stroke (:attr:`Chunk.resolved`), not only
-        the values the results report.
-    """
+    """What each chunk reads besides the per-cycle values: the reading along the stroke
+    (``resolve``, with its options), the centred loops (``keep_loops``), and whether the
+    whole reading is handed back (``hand_back``)."""
 
     resolve: bool = False
     keep_loops: bool = False
-    along_stroke: dict = dataclasses.field(default_factory=lambda: {"positions": None})
+    along_stroke: ReadingOptions = dataclasses.field(
+        default_factory=lambda: ReadingOptions(positions=None)
+    )
     hand_back: bool = False
 
     @property
     def one_grid(self) -> bool:
         """Whether the grid of positions is made from all cycles (one chunk only)."""
-        positions = self.along_stroke.get("positions")
-        return self.resolve and isinstance(positions, int)
+        return self.resolve and isinstance(self.along_stroke.positions, int)
+
+
+@dataclasses.dataclass(frozen=True)
+class Task:
+    """One chunk's work besides its samples: its cycles with their halo, its own ``rows``
+    among them, the first sample ``low`` of its stretch, and what the analysis asks."""
+
+    cycles: Cycles
+    rows: slice
+    low: int
+    options: LoopOptions
+    reading: Reading
+    then: object = None
+    keep: object = False
+    columns: tuple | None = None
 
 
 @dataclasses.dataclass
@@ -176,99 +220,87 @@ def force_at_mean_load(force, load):
     return force * (mean / load), mean
 
 
-class _Stretch:
-    """A stretch of a recording (samples ``low`` on) indexed like the whole recording."""
+#: The values that scale with the normal load: with a recorded load, they are reported at
+#: each cycle's own load (``normal_load``), the rest being read at the mean load.
+AT_OWN_LOAD = (
+    "max_force",
+    "dissipated_energy",
+    "stiffness",
+    "force_offset",
+    "force_drift_se",
+    "loop_force",
+    "force_forward",
+    "force_backward",
+)
 
-    def __init__(self, values, low: int):
-        self.values, self.low = values, low
 
-    def __getitem__(self, key):
-        if isinstance(key, slice):
-            return self.values[key.start - self.low : key.stop - self.low]
-        return self.values[np.asarray(key) - self.low]
+def at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
+    """``dataset`` with its variables of :data:`AT_OWN_LOAD` times ``ratio``, each cycle's
+    load over the mean load."""
+    ratio = np.asarray(ratio, dtype=np.float64)
+    scaled = {}
+    for name in AT_OWN_LOAD:
+        if name in dataset:
+            values = dataset[name].values
+            scaled[name] = dataset[name].copy(
+                data=values * ratio.reshape((-1,) + (1,) * (values.ndim - 1))
+            )
+    return dataset.assign(scaled)
 
 
-def measure_chunk(
-    cycles: Cycles,
-    low: int,
-    rows: slice,
-    load: float,
-    options: dict,
-    x,
-    q,
-    reading: Reading,
-    then=None,
-    keep=False,
-    columns=None,
-    recorded_load=None,
-) -> Chunk:
-    """Steps 3 to 5 of the pipeline for one chunk: the cycles ``rows`` of the table
-    ``cycles`` measured on the stretch of the recording that begins at sample ``low``.
-
-    Parameters
-    ----------
-    cycles : Cycles
-        The chunk's cycles and its halo.
-    low : int
-        The first sample of the stretch ``x``, ``q`` in the whole recording.
-    rows : slice
-        The chunk's own cycles among ``cycles`` (the rest is its halo).
-    load : float
-        Normal load. [N]
-    options : dict
-        From :func:`ecofmaps.measured.options.check_options`.
-    x, q : numpy.ndarray
-        The stretch's displacement [m] and force [N].
-    reading : Reading
-        What is read besides the per-cycle values.
-    then : callable, optional
-        Called with the chunk's results where it runs (the command line formats its table
-        rows so); its value is :attr:`Chunk.made`.
-    keep : bool or callable
-        True: hand back what :func:`~ecofmaps.measured.per_cycle.measure_cycles` measured
-        (with the reading along the stroke named with the prefix :data:`READ`), for a
-        store of finished chunks; a callable ``keep(values, flags)`` is given them here
-        instead, so that they do not travel.
-    columns : sequence of str, optional
-        The variables of the results handed back (``then`` is given them all).
-    recorded_load : numpy.ndarray, optional
-        The stretch's normal load, when it was recorded sample by sample (``q`` is then the
-        force at the mean load ``load``): forces, energy and stiffness are reported at each
-        cycle's own load (:data:`~ecofmaps.measured.results.AT_OWN_LOAD`). [N]
-
-    Returns
-    -------
-    chunk : Chunk
-    """
-    values, flags, loops = measure_cycles(
-        cycles,
-        _Stretch(x, low),
-        _Stretch(q, low),
-        load,
-        rows=rows,
-        keep_loops=reading.resolve or reading.keep_loops,
-        recorded_load=None if recorded_load is None else _Stretch(recorded_load, low),
-        **options,
+def _cycle_means(series, cycles: Cycles, rows: slice) -> np.ndarray:
+    """The mean of the finite values of ``series`` over each cycle of ``rows`` (NaN if none)."""
+    first, stop, _ = rows.indices(cycles.label.size)
+    start, count = cycles.start[first:stop], cycles.count[first:stop]
+    if start.size == 0:
+        return np.empty(0)
+    low = int(start.min())
+    values = np.asarray(series[low : int((start + count).max())], dtype=np.float64)
+    finite = np.isfinite(values)
+    sums, counts = (
+        np.concatenate([[0.0], np.cumsum(a)]) for a in (np.where(finite, values, 0.0), finite)
     )
-    counted = cycle_results(values, flags, cycles.label[rows], load, options)
+    ends, begins = start + count - low, start - low
+    with np.errstate(invalid="ignore"):  # a cycle without a finite value: NaN
+        return (sums[ends] - sums[begins]) / (counts[ends] - counts[begins])
+
+
+def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
+    """One chunk through the steps: its cycles measured on its stretch ``x``, ``q`` (and the
+    load recorded over it), read along the stroke and judged once."""
+    options, reading, labels = task.options, task.reading, task.cycles.label[task.rows]
+    values, flags, loops = measure_cycles(
+        task.cycles,
+        Stretch(x, task.low),
+        Stretch(q, task.low),
+        options,
+        rows=task.rows,
+        keep_loops=reading.resolve or reading.keep_loops,
+    )
+    if recorded_load is not None:
+        values["normal_load"] = _cycle_means(
+            Stretch(recorded_load, task.low), task.cycles, task.rows
+        )
+    flags |= scale_flags(values, options)
     resolved = None
     if reading.resolve:
-        resolved = resolve_analyzed_loops(with_loops(strip(counted), loops), **reading.along_stroke)
-        values = values | {
-            f"{READ}{name}": resolved[name].values for name in (*REPORTED, "quality")
-        }
-    part = _part(counted, values, loops if reading.keep_loops else None)
+        judged = with_loops(cycle_results(values, flags, labels, options), loops)
+        resolved, read = read_along_stroke(judged, reading.along_stroke)
+        values = values | {name: resolved[name].values for name in RESOLVED}
+        flags = flags | read
+    part = _part(values, flags, labels, options, loops if reading.keep_loops else None)
     handed = resolved if reading.hand_back else None
     if handed is not None and "normal_load" in values:  # as the part: at each cycle's load
-        handed = at_own_load(handed, values["normal_load"] / load)
+        handed = at_own_load(handed, values["normal_load"] / options.load)
     tally = Tally()
-    tally.add(counted)
+    tally.add(part["quality"].values, flags, values["amplitude"])
+    keep = task.keep
     if callable(keep):
         keep(values, flags)
     if keep is not True:
         values = flags = None
-    made = None if then is None else then(part)
-    return Chunk(only(part, columns), tally, values, flags, made, handed)
+    made = None if task.then is None else task.then(part)
+    return Chunk(only(part, task.columns), tally, values, flags, made, handed)
 
 
 def only(part: xr.Dataset, columns=None) -> xr.Dataset:
@@ -278,96 +310,39 @@ def only(part: xr.Dataset, columns=None) -> xr.Dataset:
     return part[[name for name in columns if name in part.data_vars]]
 
 
-def _part(counted: xr.Dataset, values: dict, loops=None) -> xr.Dataset:
-    """The results of a chunk: ``counted`` (from
-    :func:`~ecofmaps.measured.results.cycle_results`) without its riders, with the reading
-    along the stroke in ``values`` (named with the prefix :data:`READ`) where it was read,
-    and the centred ``loops`` if given; with a recorded load, at each cycle's own load."""
-    part = strip(counted)
-    read = {k[len(READ) :]: v for k, v in values.items() if k.startswith(READ)}
-    if read:
-        part = part.assign({k: ("cycle", read[k], resolved_attrs(k)) for k in REPORTED})
-        part["quality"] = part["quality"].copy(data=read["quality"])
-        part = part.assign(_emptied_by_reasons(part, read["quality"]))
+def _part(values: dict, flags: dict, labels, options, loops=None) -> xr.Dataset:
+    """The results of a chunk from what it measured, judged once (the values read along
+    the stroke, if any, after the quality), with the centred ``loops`` if given; with a
+    recorded load, at each cycle's own load."""
+    measured = {k: v for k, v in values.items() if k not in RESOLVED}
+    part = cycle_results(measured, flags, labels, options)
+    read = [name for name in RESOLVED if name in values]
+    part = part.assign({k: ("cycle", values[k], resolved_attrs(k)) for k in read})
     if loops is not None:
         part = with_loops(part, loops)
     if "normal_load" in part:
-        part = at_own_load(part, part["normal_load"].values / float(part["load"]))
+        part = at_own_load(part, part["normal_load"].values / options.load)
     return part
 
 
-def _emptied_by_reasons(part: xr.Dataset, quality) -> dict:
-    """``part``'s values (those not read along the stroke) that a reason of ``quality``
-    leaves NaN, as NaN there: the reading adds reasons whose scope reaches beyond its own
-    values (``gicof-varies`` empties the GICoF). Each distinct quality is read once."""
-    texts, inverse = np.unique(np.asarray(quality, dtype=str), return_inverse=True)
-    emptied = {}  # name -> which distinct texts empty it
-    for row, text in enumerate(texts):
-        for reason in text.split(SEPARATOR):
-            scope = REASONS.get(reason, ("", ()))[1]
-            if scope != ALL:
-                for name in set(scope) & set(part.data_vars) - set(REPORTED):
-                    emptied.setdefault(name, np.zeros(texts.size, dtype=bool))[row] = True
-    return {name: part[name].where(~hit[inverse]) for name, hit in sorted(emptied.items())}
-
-
 class Analysis:
-    """The analysis of one recording through the pipeline (module notes), in steps that a
-    caller can follow: the command line writes each chunk's results as it comes.
+    """The analysis of one recording through the pipeline, in steps that a caller can
+    follow: the command line writes each chunk's results as it comes.
 
-    Parameters
-    ----------
-    displacement, force : numpy.ndarray or dask.array.Array
-        [m], [N]
-    load : float
-        Normal load. [N]
-    cycle : numpy.ndarray or dask.array.Array, optional
-        Cycle numbers. [1]
-    missing : array_like of bool, optional
-        Samples to treat as missing.
-    recorded_load : numpy.ndarray or dask.array.Array, optional
-        The normal load at each sample, when it was recorded (``force`` is then the force
-        at the mean load ``load``, :func:`force_at_mean_load`): forces, energy and stiffness
-        are reported at each cycle's own load, with it (``normal_load``). [N]
-    runner : ecofmaps._parallel.Runner, optional
-        Where the passes and the chunks run (entered); by default this process
-        (:data:`IN_PROCESS`).
-    nan_policy : {'skip', 'raise'}
-    reading : Reading, optional
-        What each chunk reads besides the per-cycle values (default: nothing).
-    cycles : Cycles, optional
-        The cycles, if found before (a resumed run); else they are found here.
-    samples : int, optional
-        Samples per chunk (about; default :data:`TASK_SAMPLES`).
-    one_chunk : bool
-        Analyse the recording as one chunk (a recording in memory).
-    **options
-        The checked options of :func:`ecofmaps.measured.options.check_options`.
-
-    Attributes
-    ----------
-    cycles : Cycles
-    tasks : list of slice
-        The rows (cycles) of each chunk, in order.
-    tally : ecofmaps.measured.results.Tally
-        What the chunks handed back so far add up to.
-
-    Raises
-    ------
-    MissingSampleError
-        With ``nan_policy='raise'``, naming the first missing sample.
-    ValueError
-        If the recording holds no complete cycle, or a reading along the stroke over a
-        grid of positions made from all cycles is asked of more than one chunk.
+    ``options`` is a :class:`LoopOptions`; ``runner`` where the passes and the chunks run
+    (:func:`runner_for`, entered; by default this process); ``cycles`` those found before
+    (a resumed run); ``samples`` per chunk (about; default :data:`TASK_SAMPLES`);
+    ``one_chunk`` for a recording in memory. With a ``recorded_load`` (the load at each
+    sample), ``force`` is at the mean load ``options.load`` (:func:`force_at_mean_load`).
     """
 
     def __init__(
         self,
         displacement,
         force,
-        load,
         cycle=None,
         *,
+        options: LoopOptions,
         missing=None,
         recorded_load=None,
         runner=IN_PROCESS,
@@ -376,18 +351,17 @@ class Analysis:
         cycles=None,
         samples=None,
         one_chunk=False,
-        **options,
     ):
         self.arrays = (displacement, force)
         self.recorded_load = recorded_load
         self.reading = Reading() if reading is None else reading
-        self.load, self.options, self.runner = float(load), options, runner
+        self.options, self.runner = options, runner
         self.cycles_from = "displacement reversals" if cycle is None else "cycle numbers"
         if cycles is None:
             cycles = find_cycles(
                 displacement,
                 cycle,
-                options["hysteresis"],
+                options.hysteresis,
                 force=force,
                 missing=missing,
                 runner=None if runner is IN_PROCESS else runner,
@@ -407,8 +381,8 @@ class Analysis:
         self.tally = Tally()
         self._whole = np.flatnonzero(cycles.whole)  # the cycles a halo may hold
 
-    def _task(self, index: int, then, keep, columns=None):
-        """The arguments of chunk ``index`` (see :func:`measure_chunk`)."""
+    def _task(self, index: int, then, keep, columns=None) -> tuple:
+        """The arguments of :func:`measure_chunk` for chunk ``index``."""
         cycles, rows = self.cycles, self.tasks[index]
         first, stop = rows.start, rows.stop
         if cycles.continuous:  # a halo of whole cycles on either side
@@ -423,52 +397,14 @@ class Analysis:
         high = int(table.start[-1] + table.count[-1])
         x, q = (stretch(array, low, high) for array in self.arrays)
         p = None if self.recorded_load is None else stretch(self.recorded_load, low, high)
-        inner = slice(rows.start - first, rows.stop - first)
         if callable(keep):
             keep = functools.partial(keep, index)
-        return (
-            table,
-            low,
-            inner,
-            self.load,
-            self.options,
-            x,
-            q,
-            self.reading,
-            then,
-            keep,
-            columns,
-            p,
-        )
+        inner = slice(rows.start - first, rows.stop - first)
+        task = Task(table, inner, low, self.options, self.reading, then, keep, columns)
+        return task, x, q, p
 
     def measured(self, skip=(), then=None, keep=False, columns=None):
-        """Each chunk's :class:`Chunk`, in order, as they come; counted in :attr:`tally`.
-
-        Parameters
-        ----------
-        skip : collection of int
-            Chunks not to run (done before, in a run that is resumed).
-        then : callable, optional
-            A function of a chunk's results (the Dataset :meth:`part` gives), called where
-            the chunk runs: a module-level function, or a :func:`functools.partial` of one,
-            for chunks in other processes. The command line formats its table rows so.
-        keep : bool or callable
-            True: also hand back what each chunk measured (to be kept, and made into its
-            results again by :meth:`part` when a run is resumed). A callable
-            ``keep(index, values, flags)`` is called with it where the chunk runs instead
-            (picklable as ``then`` is), so that what is kept does not travel: for a runner
-            whose workers share this machine's files.
-        columns : sequence of str, optional
-            The variables of each chunk's results to hand back (those of them there are;
-            default all), so the rest does not travel. ``then`` is given them all.
-
-        Yields
-        ------
-        index : int
-            The chunk (index into :attr:`tasks`).
-        chunk : Chunk
-            What it handed back (see :func:`measure_chunk`).
-        """
+        """Each chunk's :class:`Chunk`, in order, as they come; counted in :attr:`tally`."""
         skip = set(skip)
         wanted = [k for k in range(len(self.tasks)) if k not in skip]
         tasks = (self._task(k, then, keep, columns) for k in wanted)
@@ -485,27 +421,19 @@ class Analysis:
         :meth:`measured`), as in :func:`ecofmaps.analyze_loops`'s Dataset (without the
         recording's attributes); counted in :attr:`tally`."""
         labels = self.cycles.label[self.tasks[index]]
-        measured = {k: v for k, v in values.items() if not k.startswith(READ)}
-        counted = cycle_results(measured, flags, labels, self.load, self.options)
-        self.tally.add(counted)
-        return _part(counted, values)
+        part = _part(values, flags, labels, self.options)
+        self.tally.add(part["quality"].values, flags, values["amplitude"])
+        return part
 
     def finish(self, parts) -> xr.Dataset:
         """The parts (all of them, in order) joined, with the recording's attributes, after
-        the checks of the whole recording (see :meth:`ecofmaps.measured.results.Tally.finish`).
-
-        The parts share their variables and the load: they are joined along ``cycle``
-        without comparing the rest (six times faster than comparing it, which copied every
-        quality string)."""
+        the checks of the whole recording (see :meth:`ecofmaps.measured.quality.Tally.finish`)."""
         parts = list(parts)
         if len(parts) == 1:
             results = parts[0]
         else:
             results = xr.concat(parts, "cycle", coords="minimal", compat="override", join="outer")
-        results = self.tally.finish(results, self.cycles, self.cycles_from, self.options)
-        if self.reading.resolve:  # the summary of the reading's quality
-            results.attrs["quality_summary"] = quality_summary(results["quality"].values)
-        return results
+        return self.tally.finish(results, self.cycles, self.cycles_from, self.options)
 
     def run(self):
         """Every chunk, joined (:meth:`finish`); and the reading along the stroke, joined,

@@ -1,48 +1,283 @@
-r"""Plausibility of measured loops: the ``quality`` of each cycle and what it leaves NaN.
-
-:func:`ecofmaps.analyze_loops` checks every cycle before it reports a number (issue 9): a
-loop must run clockwise in the :math:`(\Delta, Q)` plane (force positive in the direction
-of positive displacement), have a positive area no larger than its bounding box
-(:math:`0 \le A \le 1`), a slip amplitude :math:`0 < \delta^* \le \Delta^*`, straight stick
-sides of positive slope :math:`S > 0` after its reversals, a force that varies, and its
-crossings (at :math:`Q = 0` and with :math:`Q = S\Delta`) on the measured loop: between
-measured samples of their branch and within the measured range (issue 11; so
-:math:`\delta^* \le \Delta^*` needs no check of its own). A value that cannot be stood
-behind is NaN, and the cycle's ``quality`` says why.
-
-The vocabulary
---------------
-``quality`` is ``'ok'``, or the reasons of :data:`REASONS` that apply, in the order of
-that table, joined by ``'+'`` (``'negative-slip+curved-stick'``): the reasons hold only
-lower-case letters, digits and hyphens, so ``quality.split('+')`` gives them back and the
-column needs no quoting in a CSV file. Each reason names the quantities it leaves NaN
-(its *scope*). A reason whose scope is every quantity (:data:`ALL`) refuses the cycle: it
-is not a loop that can be read as recorded, and its ``regime`` is ``INVALID``. The others
-leave the rest of the cycle's numbers standing; ``'not-gross-slip'`` is the partial-slip
-regime, where the ECoF and the GICoF are not defined. The last four reasons come from the
-reading along the stroke (:func:`ecofmaps.resolve_loops`, or ``analyze_loops(...,
-resolve=True)``), which adds them with :func:`add_reason` and leaves only its own values NaN.
+r"""Steps 6 and 7 of the loop pipeline: the judgement of each cycle (the reasons of
+:data:`REASONS`, flags turned into NaN, ``quality`` strings and refusals, once), the tally of a
+whole recording, and the per-cycle table.
+The vocabulary is explained in ``docs/method-loops.md`` ("Judging each cycle").
 """
 
 from __future__ import annotations
 
+import collections
+
 import numpy as np
+import xarray as xr
+
+from ecofmaps import _nomenclature as nomenclature
+from ecofmaps._codes import warn
+from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles
+from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP, Regime
 
 __all__ = [
     "ALL",
     "ANTICLOCKWISE_SHARE",
+    "READING_REASONS",
     "REASONS",
     "RESOLVED",
     "SEPARATOR",
+    "ImplausibleScaleError",
+    "ImplausibleScaleWarning",
     "LoopQualityWarning",
+    "Tally",
     "add_reason",
     "apply_quality",
+    "cycle_results",
     "has_reason",
+    "judged",
     "quality_strings",
     "quality_summary",
     "refused",
     "summary_of_counts",
+    "with_loops",
 ]
+
+
+#: How the quantities are measured on a loop (the netCDF ``comment`` attribute).
+_COMMENTS = {
+    "slip_amplitude": "half the loop's width at Q = 0",
+    "dissipated_energy": "the loop's area",
+    "stiffness": "slope of the stick segments",
+    "regime": "GROSS_SLIP when the energy ratio exceeds gross_slip_threshold, else NO_GROSS_SLIP "
+    "(partial slip); INVALID where the cycle is refused",
+    "quality": "'ok' or the reasons for NaN, joined by '+' (ecofmaps.measured.quality)",
+}
+
+
+#: Plausible displacement amplitudes: outside, the unit is wrong (``implausible-amplitude``). [m]
+AMPLITUDE_RANGE = (0.5e-6, 50e-3)
+
+#: Plausible coefficients of friction: outside, the load or the force's unit is wrong
+#: (``implausible-cof``). [1]
+COF_RANGE = (0.01, 3.0)
+
+#: Displacement amplitudes above this are reciprocating sliding rather than fretting (still
+#: analysed the same way; the results' ``motion`` attribute says so). [m]
+FRETTING_AMPLITUDE = 300e-6
+
+
+def _attrs(name: str) -> dict:
+    attrs = nomenclature.attrs(name)
+    if name in _COMMENTS:
+        attrs["comment"] = _COMMENTS[name]
+    return attrs
+
+
+def _refusal_hint(flags: dict) -> str:
+    """What the user may do about a recording whose every cycle is refused (``flags``:
+    whether every cycle, or any for ``negative-stiffness``, carries the reason)."""
+    if flags["missing-samples"]:
+        return "Every cycle holds a missing sample (NaN or an empty cell)."
+    if flags["anticlockwise"]:
+        if flags["negative-stiffness"]:
+            return (
+                "The loops run anticlockwise with stick sides sloping down: the force is "
+                "recorded positive against the displacement. If so, read it with the other "
+                "sign: flip_force=True (on the command line, --flip-force)."
+            )
+        return (
+            "The loops run anticlockwise with stick sides sloping up: the recording runs "
+            "backwards in time, or the displacement and force columns are swapped."
+        )
+    if flags["constant-force"]:
+        return "The force does not vary: is the force channel connected?"
+    if flags["implausible-amplitude"]:
+        return (
+            f"The displacement amplitude is outside {AMPLITUDE_RANGE[0] * 1e6:g} µm to "
+            f"{AMPLITUDE_RANGE[1] * 1e3:g} mm: the displacement is not "
+            "in the unit assumed. analyze_loops takes metres; on the command line, "
+            "--displacement-unit gives the column's unit (a column without a unit in its "
+            "name or the file is read in µm)."
+        )
+    return (
+        "Is it a recording of fretting loops, with the displacement and the force in their "
+        "own columns?"
+    )
+
+
+def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
+    """``results`` with the centred loops of :func:`measure_cycles` (``keep_loops=True``)."""
+    results["loop_displacement"] = (("cycle", "point"), loops[0], _attrs("loop_displacement"))
+    results["loop_force"] = (("cycle", "point"), loops[1], _attrs("loop_force"))
+    results.coords["point"] = ("point", np.arange(loops[0].shape[1]), _attrs("point"))
+    return results
+
+
+def scale_flags(values: dict, options) -> dict:
+    """The checks of scale of each cycle (reason -> per cycle): an amplitude outside
+    :data:`AMPLITUDE_RANGE`, or a coefficient of friction outside :data:`COF_RANGE` (the
+    ECoF or the GICoF of a gross-slip loop; not :math:`Q^*/P`, which a deep groove raises
+    above 3 with any load). A gross-slip CoF of 361 or 0.001 says that the load or a unit is
+    wrong, not the contact."""
+    amplitude = values["amplitude"]
+    sliding = values["energy_ratio"] > options.gross_slip_threshold
+
+    def outside(value, bounds):
+        return np.isfinite(value) & ((value < bounds[0]) | (value > bounds[1]))
+
+    scaled = outside(amplitude, AMPLITUDE_RANGE)
+    cof = sliding & (outside(values["ecof"], COF_RANGE) | outside(values["gicof"], COF_RANGE))
+    return {"implausible-amplitude": scaled, "implausible-cof": cof & ~scaled}
+
+
+def judged(values: dict, flags: dict, options):
+    """The one judgement of a part's cycles: ``values`` (name -> per cycle, as measured)
+    NaN where a flag's scope reaches, the ``quality`` strings, the cycles refused and the
+    regime codes. ``flags`` (reason -> per cycle) are every check's, the scale's included."""
+    size = next(iter(flags.values())).size
+    refused = _refusing(flags, size)
+    recorded = {k: values[k] for k in ("normal_load",) if k in values}  # a refused cycle's too
+    values = apply_quality({k: v for k, v in values.items() if k not in recorded}, flags)
+    sliding = values["energy_ratio"] > options.gross_slip_threshold
+    regime = np.where(refused, INVALID, np.where(sliding, GROSS_SLIP, NO_GROSS_SLIP))
+    return values | recorded, quality_strings(flags, size), refused, regime
+
+
+def cycle_results(values: dict, flags: dict, label, options) -> xr.Dataset:
+    """The per-cycle Dataset of :func:`analyze_loops` for some cycles, without the
+    recording's attributes: ``values`` and ``flags`` (the scale's included) judged once."""
+    values, quality, _, regime = judged(values, flags, options)
+    recorded = {k: values.pop(k) for k in ("normal_load",) if k in values}
+    names = [name for name in values if name != "stick_residual"]
+    data = {name: ("cycle", values[name], _attrs(name)) for name in names}
+    data["regime"] = ("cycle", regime.astype(np.int32), _attrs("regime") | Regime.flag_attrs())
+    data["stick_residual"] = ("cycle", values["stick_residual"], _attrs("stick_residual"))
+    for name, value in recorded.items():
+        data[name] = ("cycle", value, _attrs(name))
+    data["quality"] = ("cycle", quality, _attrs("quality"))
+    load = ((), options.load, _attrs("load"))
+    coords = {"cycle": ("cycle", label, _attrs("cycle")), "load": load}
+    return xr.Dataset(data, coords=coords)
+
+
+#: The reasons that the reading along the stroke adds (its flags do not warn).
+READING_REASONS = (
+    "stiffness-mismatch",
+    "no-overlap",
+    "few-slip-samples",
+    "mu-varies",
+    "gicof-varies",
+)
+
+#: The reasons whose presence on every cycle says what to do about a refused recording.
+_HINTS = ("missing-samples", "anticlockwise", "constant-force", "implausible-amplitude")
+
+
+class Tally:
+    """What :func:`analyze_loops` says about a whole recording, counted from the flags of
+    its parts as they come: the quality summary, whether every cycle was refused, and the
+    typical amplitude."""
+
+    def __init__(self):
+        self.counts = collections.Counter()  # cycles by quality
+        self.cycles = self.refused = self.flagged = self.implausible_cof = self.scaled = 0
+        self.every = dict.fromkeys(_HINTS, True)
+        self.negative_stiffness = False
+        self.amplitudes: list = []
+
+    def add(self, quality, flags: dict, amplitude) -> None:
+        """Count the cycles of a part: their ``quality``, ``flags`` and amplitudes as measured."""
+        self.counts.update(collections.Counter(np.asarray(quality).tolist()))
+        quiet = {"ok", "not-gross-slip", *READING_REASONS}
+        self.flagged += int(
+            _by_text(quality, lambda text: bool(set(text.split(SEPARATOR)) - quiet)).sum()
+        )
+        self.cycles += amplitude.size
+        self.refused += int(_refusing(flags, amplitude.size).sum())
+        for reason in _HINTS:
+            self.every[reason] &= bool(flags[reason].all())
+        self.negative_stiffness |= bool(flags["negative-stiffness"].any())
+        self.amplitudes.append(amplitude)
+        self.implausible_cof += int(flags["implausible-cof"].sum())
+        self.scaled += int(flags["implausible-amplitude"].sum())
+
+    def merge(self, other: Tally) -> None:
+        """Count the parts ``other`` counted (in another process, say) as well."""
+        self.counts.update(other.counts)
+        self.cycles += other.cycles
+        self.refused += other.refused
+        self.flagged += other.flagged
+        self.scaled += other.scaled
+        for reason in _HINTS:
+            self.every[reason] &= other.every[reason]
+        self.negative_stiffness |= other.negative_stiffness
+        self.amplitudes += other.amplitudes
+        self.implausible_cof += other.implausible_cof
+
+    @property
+    def summary(self) -> str:
+        """The one-line quality summary so far."""
+        return summary_of_counts(self.counts)
+
+    def finish(self, results, cycles: Cycles, cycles_from: str, options) -> xr.Dataset:
+        """Check the whole recording and give ``results`` (the parts, joined) its
+        attributes."""
+        summary = self.summary
+        typical = _typical(np.concatenate(self.amplitudes) if self.amplitudes else np.zeros(0))
+        scaled = self.scaled
+        if self.cycles and self.refused == self.cycles:
+            hint = dict(self.every, **{"negative-stiffness": self.negative_stiffness})
+            error = ImplausibleScaleError if scaled else ValueError
+            raise error(f"no plausible cycle in the recording ({summary}). {_refusal_hint(hint)}")
+        if scaled:
+            warn(
+                f"{scaled} cycles have an amplitude outside {AMPLITUDE_RANGE[0] * 1e6:g} µm to "
+                f"{AMPLITUDE_RANGE[1] * 1e3:g} mm: is the displacement in metres (on the "
+                "command line --displacement-unit; a column without a unit is read in µm)?",
+                ImplausibleScaleWarning,
+            )
+        if self.implausible_cof:
+            warn(
+                f"{self.implausible_cof} cycles have a coefficient of friction outside "
+                f"{COF_RANGE[0]:g} to {COF_RANGE[1]:g} with the load of "
+                f"{float(results['load']):g} N: "
+                "is the load right (load=, on the command line --load) and the force in "
+                "newtons (--force-unit; a column without a unit is read in N)?",
+                ImplausibleScaleWarning,
+            )
+        if self.flagged:
+            warn(f"cycles flagged: {summary}", LoopQualityWarning)
+        results.attrs.update(
+            {
+                "title": "Fretting loops analysed cycle by cycle (ecofmaps.analyze_loops)",
+                "cycles_from": cycles_from,
+                "incomplete_cycles": cycles.incomplete_cycles,
+                "dropped_samples": cycles.dropped_samples,
+                "missing_samples": cycles.missing_samples,
+                "first_missing_sample": cycles.first_missing,
+                "skipped_cycles": int(self.counts_of("missing-samples")),
+                "gross_slip_threshold": options.gross_slip_threshold,
+                "flip_force": int(options.flip_force),
+                "quality_summary": summary,
+                "motion": _motion(typical),
+            }
+        )
+        return results
+
+    def counts_of(self, reason: str) -> int:
+        """Cycles whose quality lists ``reason``."""
+        return sum(c for text, c in self.counts.items() if reason in text.split("+"))
+
+
+def _typical(amplitude) -> float:
+    """The median of the finite amplitudes (NaN if none). [m]"""
+    finite = amplitude[np.isfinite(amplitude)]
+    return float(np.median(finite)) if finite.size else np.nan
+
+
+def _motion(typical: float) -> str:
+    """``'fretting'``, or ``'reciprocating sliding'`` for a stroke beyond
+    :data:`FRETTING_AMPLITUDE` (analysed the same way)."""
+    if np.isfinite(typical) and typical > FRETTING_AMPLITUDE:
+        return "reciprocating sliding"
+    return "fretting"
 
 
 class LoopQualityWarning(UserWarning):
@@ -56,6 +291,24 @@ SEPARATOR = "+"
 #: :math:`4\Delta^*Q^*` runs anticlockwise; a smaller negative area is noise on a loop
 #: without area (the one definition, also for :func:`ecofmaps.fit_loop`).
 ANTICLOCKWISE_SHARE = 0.05
+
+#: A stick segment must explain all but this share of the displacement's variance along it.
+UNEXPLAINED_SHARE = 0.2
+
+#: Fewest slipping samples of each branch in the central part of the stroke.
+SLIP_SAMPLES = 8
+
+#: μ(ξ) varies along the stroke when the means over the inner and the outer half of the
+#: central part differ by this share of μ and by this many standard errors.
+VARIATION = 0.03
+VARIATION_SIGNIFICANCE = 4.0
+
+#: Blocks of the central part whose means give the scatter of μ(ξ) (batch means).
+SCATTER_BLOCKS = 8
+
+#: The GICoF is flagged where the block means of μ(ξ) scatter about a straight line by
+#: this share of μ (standard deviation) beyond the noise.
+GICOF_WIGGLE = 0.015
 
 #: Scope of a reason that refuses the cycle: every per-cycle quantity.
 ALL = "all"
@@ -78,11 +331,12 @@ REASONS = {
         "the cycle holds a missing sample (NaN or an empty cell): skipped, not analysed",
         ALL,
     ),
-    "few-samples": ("fewer samples in the cycle than a loop needs (MIN_SAMPLES)", ALL),
+    "few-samples": (f"fewer than {MIN_SAMPLES} samples in the cycle, fewer than a loop needs", ALL),
     "constant-force": ("the force does not vary over the cycle (a dead channel)", ALL),
     "implausible-amplitude": (
-        "the displacement amplitude is below 0.5 µm or above 50 mm: the displacement is not "
-        "in the unit assumed (a column without a unit is read in µm)",
+        f"the displacement amplitude is below {AMPLITUDE_RANGE[0] * 1e6:g} µm or above "
+        f"{AMPLITUDE_RANGE[1] * 1e3:g} mm: the displacement is not in the unit assumed (a "
+        "column without a unit is read in µm)",
         ALL,
     ),
     "several-loops": (
@@ -91,7 +345,8 @@ REASONS = {
         ALL,
     ),
     "anticlockwise": (
-        "the loop runs anticlockwise (area below -5 % of 4Δ*Q*): force and displacement "
+        f"the loop runs anticlockwise (area below -{ANTICLOCKWISE_SHARE * 100:g} % of 4Δ*Q*): "
+        "force and displacement "
         "recorded positive in opposite directions (see flip_force), time reversed, or the "
         "columns swapped",
         ALL,
@@ -99,8 +354,8 @@ REASONS = {
     "energy-ratio-above-1": ("the loop's area exceeds its bounding box 4Δ*Q* (A > 1)", ALL),
     "negative-stiffness": ("the stick sides slope down (S < 0)", ALL),
     "no-stick": (
-        "no straight stick side after the reversals: the stick lines leave more than 20 % "
-        "of the displacement's variance along them unexplained",
+        "no straight stick side after the reversals: the stick lines leave more than "
+        f"{UNEXPLAINED_SHARE * 100:g} % of the displacement's variance along them unexplained",
         ALL,
     ),
     "no-zero-crossing": (
@@ -108,7 +363,7 @@ REASONS = {
         ALL,
     ),
     "negative-area": (
-        "no area within the noise (-5 % of 4Δ*Q* < area < 0)",
+        f"no area within the noise (-{ANTICLOCKWISE_SHARE * 100:g} % of 4Δ*Q* < area < 0)",
         ("dissipated_energy", "energy_ratio", "ecof"),
     ),
     "negative-slip": ("δ* <= 0: the zero-force crossings in the wrong order", _SLIP),
@@ -122,7 +377,8 @@ REASONS = {
         _GICOF,
     ),
     "implausible-cof": (
-        "a coefficient of friction outside 0.01 to 3 (the ECoF or GICoF in gross slip): the "
+        f"a coefficient of friction outside {COF_RANGE[0]:g} to {COF_RANGE[1]:g} (the ECoF or "
+        "GICoF in gross slip): the "
         "load given or the force's unit is wrong, not the contact",
         ("ecof", "cof_max", *_GICOF, *RESOLVED),
     ),
@@ -141,18 +397,22 @@ REASONS = {
         RESOLVED,
     ),
     "few-slip-samples": (
-        "fewer than eight slipping samples of a branch in the central part of the stroke (a "
+        f"fewer than {SLIP_SAMPLES} slipping samples of a branch in the central part of the "
+        "stroke (a "
         "sparse or digitised loop): friction cannot be read along the stroke",
         RESOLVED,
     ),
     "mu-varies": (
         "the friction read along the stroke differs between the inner and the outer half of "
-        "its central part by more than 3 % and four standard errors (not the model's loop)",
+        "its central part by more than "
+        f"{VARIATION * 100:g} % and {VARIATION_SIGNIFICANCE:g} standard errors (not the "
+        "model's loop)",
         RESOLVED,
     ),
     "gicof-varies": (
-        "the friction read along the stroke wiggles beyond the noise (its means over eighths "
-        "of the central part scatter about a straight line by more than 1.5 % of μ: chatter, "
+        "the friction read along the stroke wiggles beyond the noise (its means over "
+        f"{SCATTER_BLOCKS} blocks of the central part scatter about a straight line by more "
+        f"than {GICOF_WIGGLE * 100:g} % of μ: chatter, "
         "stick-slip): the GICoF, read at one position, is not the contact's mean friction",
         _GICOF,
     ),
@@ -175,11 +435,7 @@ def _by_text(quality, function) -> np.ndarray:
 
 
 def quality_strings(flags: dict, size: int) -> np.ndarray:
-    """The ``quality`` of ``size`` cycles from boolean ``flags`` (reason -> per cycle).
-
-    A refused cycle lists only the reasons that refuse it; a reason whose NaN another of
-    the cycle's reasons covers, and more, is left out (``'no-crossing'`` in partial slip).
-    """
+    """The ``quality`` of ``size`` cycles from boolean ``flags`` (reason -> per cycle)."""
     refusing = _refusing(flags, size)
     code = np.zeros(size, dtype=np.int64)
     for bit, reason in enumerate(REASONS):
@@ -269,3 +525,19 @@ def summary_of_counts(counts) -> str:
     if skipped:
         summary += f", {skipped} skipped (missing samples)"
     return summary + (f"; {flagged}" if flagged else "")
+
+
+class ImplausibleScaleWarning(LoopQualityWarning):
+    """Cycles whose amplitude or coefficient of friction is outside what a unit or a load
+    makes plausible (``implausible-amplitude``, ``implausible-cof``): the load given or the
+    unit assumed for a channel is likely wrong.
+
+    A :class:`~ecofmaps.measured.quality.LoopQualityWarning`, so filtering that one filters
+    this one too; ``warnings.filterwarnings("error", category=ImplausibleScaleWarning)``
+    turns only the checks of scale into errors.
+    """
+
+
+class ImplausibleScaleError(ValueError):
+    """Every cycle refused, some for an amplitude outside what the displacement's unit makes
+    plausible (``implausible-amplitude``): the unit assumed is likely wrong."""

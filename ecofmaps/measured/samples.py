@@ -1,15 +1,7 @@
-"""The channels of a recording, in memory or out of core, read a block of samples at a time.
-
-:class:`Samples` holds the displacement, force, cycle numbers and a mask of missing samples
-of one recording, as NumPy arrays or as dask arrays (a long test read lazily,
-:func:`ecofmaps.io.read_recording`). Its :meth:`Samples.map` runs a function over blocks of
-consecutive samples: on NumPy arrays, once over the whole recording (the function goes
-through it a chunk at a time itself); on dask arrays, once per block of a grid of
-``block`` samples, each block read where its task runs (:class:`ecofmaps._parallel.Runner`),
-so that no more than a few blocks are in memory at once. The grid's blocks start at
-multiples of ``chunk`` samples, so a function that works a ``chunk`` at a time from its
-block's start goes through the same chunks whichever way it is run, and gives the same
-numbers to the bit.
+r"""Step 1 of the loop pipeline: the channels of a recording (:class:`Samples`, NumPy or dask),
+read a block at a time, and the passes over them that find the cycles (the straight line, the
+percentiles, the trigger's runs, the runs of cycle numbers).
+The method is explained in ``docs/method-loops.md`` ("Finding the cycles").
 """
 
 from __future__ import annotations
@@ -19,8 +11,336 @@ import sys
 import numpy as np
 
 from ecofmaps._parallel import stretch
+from ecofmaps.measured import kernels
 
-__all__ = ["CHANNELS", "Samples", "is_lazy"]
+__all__ = [
+    "CHANNELS",
+    "Samples",
+    "displacement_line",
+    "displacement_percentiles",
+    "ends_of_runs",
+    "first_of_runs",
+    "is_lazy",
+    "labelled_runs",
+    "missing_in",
+    "survey",
+    "trigger_runs",
+]
+
+#: Samples read at once by the passes over the whole recording.
+_CHUNK = 1 << 18
+
+
+def _chunks(start: int, stop: int, chunk: int):
+    """``(a, b)`` bounds of the chunks of samples ``start`` to ``stop - 1``."""
+    return ((a, min(a + chunk, stop)) for a in range(start, stop, chunk))
+
+
+def _blanked(x, a: int, b: int, gaps) -> np.ndarray:
+    """``x`` (samples ``a`` to ``b - 1``) with NaN at the missing ones (a copy if any)."""
+    first = np.searchsorted(gaps[:, 1], a, side="right")
+    last = np.searchsorted(gaps[:, 0], b)
+    if first >= last:
+        return x
+    x = np.array(x, dtype=np.float64)
+    for begin, end in gaps[first:last]:
+        x[max(begin, a) - a : min(end, b) - a] = np.nan
+    return x
+
+
+def _piece_extremes(x, cuts):
+    """Largest and smallest finite value of each piece ``x[cuts[k]:cuts[k + 1]]`` and the
+    first index (in ``x``) of each, -1 where a piece has no finite value."""
+    lengths = np.diff(cuts, append=x.size)
+    found = []
+    for reduce in (np.fmax, np.fmin):
+        value = reduce.reduceat(x, cuts)
+        hits = np.flatnonzero(x == np.repeat(value, lengths))
+        after = np.searchsorted(hits, cuts)
+        index = hits[np.minimum(after, max(hits.size - 1, 0))] if hits.size else cuts
+        inside = (after < hits.size) & (index < cuts + lengths)
+        found += [value, np.where(inside, index, -1)]
+    return found
+
+
+def first_of_runs(run, value, index, target):
+    """The first ``index`` of each run whose piece ``value`` equals the run's ``target``
+    (-1 for a run with none)."""
+    hits = np.flatnonzero(value == target[run])
+    runs = np.arange(target.size)
+    if not hits.size:
+        return np.full(target.size, -1, dtype=np.int64)
+    at = np.minimum(np.searchsorted(run[hits], runs), hits.size - 1)
+    return np.where(run[hits[at]] == runs, index[hits[at]], -1).astype(np.int64)
+
+
+def _finite_ends(x, cuts):
+    """The first and last finite value of each piece ``x[cuts[k]:cuts[k + 1]]`` (NaN for a
+    piece without one)."""
+    finite = np.flatnonzero(np.isfinite(x))
+    ends = np.append(cuts[1:], x.size)
+    if not finite.size:
+        return np.full(cuts.size, np.nan), np.full(cuts.size, np.nan)
+    first = np.minimum(np.searchsorted(finite, cuts), finite.size - 1)
+    last = np.maximum(np.searchsorted(finite, ends) - 1, 0)
+    has = (finite[first] >= cuts) & (finite[first] < ends)
+    return np.where(has, x[finite[first]], np.nan), np.where(has, x[finite[last]], np.nan)
+
+
+def _survey(start, stop, arguments, x, q, cycle, mask):
+    """Sums for the straight line through the finite displacements, runs of missing
+    samples, the displacement at the percentile sample's indices, and the first and last
+    finite index and cycle number of the block (see :func:`displacement_line`)."""
+    size, chunk, sample_at = arguments
+    middle = 0.5 * (size - 1)
+    sums, gaps, finite, labels = [], [], [], []
+    for a, b in _chunks(start, stop, chunk):
+        i, j = a - start, b - start
+        xa = x[i:j]
+        good = np.isfinite(xa)
+        if q is not None:
+            good &= np.isfinite(q[i:j])
+        if cycle is not None and cycle.dtype.kind not in "iub":
+            good &= np.isfinite(cycle[i:j])
+        if mask is not None:
+            good &= ~np.asarray(mask[i:j], dtype=bool)
+        t = np.arange(a - middle, b - middle)
+        if good.all():
+            k, u = b - a, a - middle  # sums of t and t² in closed form
+            sums.append(
+                (k, np.add.reduce(xa), np.einsum("i,i->", t, xa), k * u + k * (k - 1) / 2,
+                 k * u * u + u * k * (k - 1) + (k - 1) * k * (2 * k - 1) / 6)
+            )  # fmt: skip
+            finite += [a, b - 1]
+        else:
+            bad = ~good
+            xg, tg = xa[good], t[good]
+            sums.append((xg.size, np.add.reduce(xg), np.einsum("i,i->", tg, xg), tg.sum(),
+                         np.einsum("i,i->", tg, tg)))  # fmt: skip
+            edges = np.flatnonzero(np.diff(bad.view(np.int8), prepend=0, append=0))
+            gaps.append(edges.reshape(-1, 2) + a)
+            if xg.size:
+                where = np.flatnonzero(good)
+                finite += [a + where[0], a + where[-1]]
+        if cycle is not None:
+            ca = cycle[i:j]
+            ca = ca[np.isfinite(ca)] if ca.dtype.kind not in "iub" else ca
+            if ca.size:
+                labels.append((ca[0], ca[-1]))
+    picked = sample_at[(sample_at >= start) & (sample_at < stop)]
+    return {
+        "sums": np.array(sums, dtype=np.float64).reshape(-1, 5),
+        "gaps": np.concatenate(gaps) if gaps else np.zeros((0, 2), np.int64),
+        "finite": (finite[0], finite[-1]) if finite else None,
+        "labels": (labels[0][0], labels[-1][1]) if labels else None,
+        "sampled": x[picked - start],
+    }
+
+
+def _tails(start, stop, arguments, x):
+    """The detrended displacements of the block within the percentiles' brackets."""
+    chunk, gaps, line, (upper, lower) = arguments
+    kept = []
+    for a, b in _chunks(start, stop, chunk):
+        d = _detrended(_blanked(x[a - start : b - start], a, b, gaps), a, line)
+        kept.append(d[(d <= upper) | (d >= lower)])
+    return np.concatenate(kept)
+
+
+def trigger_runs(start, stop, arguments, x):
+    """The Schmitt trigger's runs begun in the block, and the extremes of its pieces."""
+    chunk, gaps, line, (centre, level) = arguments
+    entries, kinds, pieces = [], [], []
+    previous = 0
+    for a, b in _chunks(start, stop, chunk):
+        xa = _blanked(x[a - start : b - start], a, b, gaps)
+        d = _detrended(xa, a, line)
+        state = (d > centre + level).view(np.int8) - (d < centre - level).view(np.int8)
+        entry = np.concatenate([[0], np.flatnonzero(state[1:] != state[:-1]) + 1])
+        kind = state[entry]
+        entry, kind = entry[kind != 0], kind[kind != 0]  # into a decided state
+        change = kind != np.concatenate([[previous], kind[:-1]])
+        entry, kind = entry[change], kind[change]
+        if kind.size:
+            previous = kind[-1]
+        entries.append(entry + a)
+        kinds.append(kind)
+        cuts = entry if entry.size and entry[0] == 0 else np.concatenate([[0], entry])
+        highest, top, lowest, bottom = _piece_extremes(xa, cuts)
+        pieces.append(
+            np.stack([cuts + a, highest, np.where(top >= 0, top + a, -1), lowest,
+                      np.where(bottom >= 0, bottom + a, -1)])
+        )  # fmt: skip
+    return np.concatenate(entries), np.concatenate(kinds), np.concatenate(pieces, axis=1)
+
+
+def labelled_runs(start, stop, arguments, x, cycle):
+    """Pieces of runs of equal cycle numbers in the block, cut at its chunks: first
+    sample, cycle number, samples, largest and smallest finite displacement, the first
+    sample of the smallest, the first and last finite displacement, and the largest step
+    between consecutive samples of the run (to the sample after the block too)."""
+    chunk, gaps, carries = arguments
+    carry = carries[start]
+    pieces = []
+    for a, b in _chunks(start, stop, chunk):
+        ahead = min(b + 1, start + cycle.size)  # one sample past the chunk, if any
+        label = np.asarray(cycle[a - start : ahead - start])
+        if label.dtype.kind not in "iub":
+            known = np.isfinite(label)
+            if not known.all():  # a missing cycle number takes the one before it
+                last = np.maximum.accumulate(np.where(known, np.arange(label.size), -1))
+                label = np.where(last >= 0, label[np.maximum(last, 0)], carry)
+            carry = label[b - 1 - a]
+        xa = _blanked(x[a - start : ahead - start], a, ahead, gaps)
+        step = np.abs(np.diff(xa))  # step[i]: from sample a + i to the next
+        step[label[1:] != label[:-1]] = np.nan  # no step from a run's last sample
+        label, xa, step = label[: b - a], xa[: b - a], step[: b - a]
+        if step.size < label.size:
+            step = np.append(step, np.nan)
+        cuts = np.concatenate([[0], np.flatnonzero(label[1:] != label[:-1]) + 1])
+        highest, _, lowest, bottom = _piece_extremes(xa, cuts)
+        x_first, x_last = _finite_ends(xa, cuts)
+        pieces.append(
+            np.stack([cuts + a, label[cuts].astype(np.float64), np.diff(np.append(cuts, b - a)),
+                      highest, lowest, np.where(bottom >= 0, bottom + a, -1), x_first, x_last,
+                      np.fmax.reduceat(step, cuts)])
+        )  # fmt: skip
+    return np.concatenate(pieces, axis=1)
+
+
+#: Quantiles of the reversal detector's range (the 1st and 99th percentiles).
+_QUANTILES = np.array([1.0, 99.0]) / 100.0
+
+
+#: Size of the random sample that brackets the percentiles of a long recording.
+_SAMPLE = 1 << 16
+
+
+def _detrended(x, a: int, line):
+    """The displacements ``x`` of samples ``a`` on less the straight ``line``."""
+    mean, mean_t, slope, middle = (float(value) for value in line)
+    return kernels.detrended(
+        np.ascontiguousarray(x, dtype=np.float64), a, mean, mean_t, slope, middle
+    )
+
+
+def survey(samples: Samples):
+    """Pass one: the straight line, the runs of missing samples, the percentile sample."""
+    size = samples.size
+    # The sample's order does not matter: its values are sorted.
+    sample_at = np.sort(np.random.default_rng(0).integers(0, size, _SAMPLE))
+    found = samples.map(
+        _survey, ("displacement", "force", "cycle", "missing"), (size, _CHUNK, sample_at)
+    )
+    sums = np.concatenate([part["sums"] for part in found])
+    gaps = np.concatenate([part["gaps"] for part in found])
+    if gaps.size:  # runs of missing samples that meet at a chunk's edge are one run
+        joined = np.flatnonzero(gaps[1:, 0] != gaps[:-1, 1]) + 1
+        gaps = np.stack(
+            [gaps[np.concatenate([[0], joined]), 0], gaps[np.append(joined - 1, -1), 1]], axis=1
+        )
+    sampled = np.concatenate([part["sampled"] for part in found])
+    finite = [part["finite"] for part in found if part["finite"] is not None]
+    labels = [part["labels"] for part in found]
+    return sums, gaps.astype(np.int64), sample_at, sampled, finite, labels
+
+
+def displacement_line(sums, size: int):
+    """``(mean, mean_t, slope, middle)`` of the least-squares line through the finite
+    displacements over t = i - (size - 1)/2 (see :func:`_detrended`)."""
+    count = sums[:, 0].sum()
+    middle = 0.5 * (size - 1)
+    if count == size:  # every sample: the t sum to 0 and their squares to n(n² - 1)/12
+        return (
+            sum(sums[:, 1].tolist()) / size,
+            0.0,
+            sum(sums[:, 2].tolist()) / ((size * (size * size - 1)) / 12),
+            middle,
+        )
+    if count < 2:
+        raise ValueError("the displacement does not oscillate: no reversal can be found")
+    sx, stx, st, stt = (sum(sums[:, k].tolist()) for k in (1, 2, 3, 4))
+    mean, mean_t = sx / count, st / count
+    spread = stt - st * mean_t
+    return mean, mean_t, (stx - st * mean) / spread if spread > 0 else 0.0, middle
+
+
+def displacement_percentiles(samples: Samples, gaps, line, sample_at, sampled, count: int):
+    """``np.percentile`` of the finite detrended displacements at the 1st and 99th
+    percentile, exactly."""
+    mean, mean_t, slope, middle = line
+    if count <= _CHUNK:
+        tails = np.concatenate(
+            samples.map(_tails, ("displacement",), (_CHUNK, gaps, line, (np.inf, -np.inf)))
+        )
+        return np.percentile(tails, _QUANTILES * 100.0, overwrite_input=True)
+    virtual = (count - 1) * _QUANTILES  # NumPy's virtual index, method "linear"
+    rank = np.floor(virtual).astype(np.int64)
+    missing = np.zeros(sample_at.size, dtype=bool)
+    if gaps.size:
+        run = np.searchsorted(gaps[:, 0], sample_at, side="right") - 1
+        missing = (run >= 0) & (sample_at < gaps[np.maximum(run, 0), 1])
+    sample = (sampled - mean) - ((sample_at - middle) - mean_t) * slope
+    sample = np.sort(sample[~missing & np.isfinite(sample)])
+    drawn = sample.size
+    quantile = _QUANTILES * drawn
+    spread = 8.0 * np.sqrt(_QUANTILES * (1.0 - _QUANTILES) * drawn) + 8.0
+    low = np.floor(quantile - spread).astype(np.int64)
+    high = np.ceil(quantile + spread).astype(np.int64)
+    low = np.where(low > 0, sample[np.clip(low, 0, drawn - 1)], -np.inf)
+    high = np.where(high < drawn - 1, sample[np.clip(high, 0, drawn - 1)], np.inf)
+    tails = np.concatenate(
+        samples.map(_tails, ("displacement",), (_CHUNK, gaps, line, (high[0], low[1])))
+    )
+    result = np.empty(2)
+    for k in range(2):
+        kept = tails[(tails >= low[k]) & (tails <= high[k])]
+        below = (
+            np.count_nonzero(tails < low[k])
+            if k == 0
+            else count - np.count_nonzero(tails >= low[k])
+        )
+        j = rank[k] - below
+        if not 0 <= j < kept.size - 1:  # the sample missed: hold every value once
+            whole = np.concatenate(
+                samples.map(_tails, ("displacement",), (_CHUNK, gaps, line, (np.inf, -np.inf)))
+            )
+            return np.percentile(whole, _QUANTILES * 100.0, overwrite_input=True)
+        previous, following = np.partition(kept, [j, j + 1])[[j, j + 1]]
+        gamma = virtual[k] - rank[k]
+        difference = following - previous
+        result[k] = (
+            following - difference * (1.0 - gamma)
+            if gamma >= 0.5
+            else previous + difference * gamma
+        )
+    return result
+
+
+def missing_in(gaps, start, count):
+    """True for each stretch ``start``, ``count`` that holds a sample of ``gaps``."""
+    if not gaps.size:
+        return None
+    after = np.searchsorted(gaps[:, 1], start, side="right")  # first gap ending after start
+    return (after < gaps.shape[0]) & (gaps[np.minimum(after, gaps.shape[0] - 1), 0] < start + count)
+
+
+def ends_of_runs(run, valued, values, runs: int, first: bool):
+    """The first (or last) of ``values`` over the pieces of each run where ``valued``."""
+    result = np.full(runs, np.nan)
+    pieces = np.flatnonzero(valued)
+    if not pieces.size:
+        return result
+    owner = run[pieces]
+    pick = np.searchsorted(owner, np.arange(runs), side="left" if first else "right")
+    if not first:
+        pick -= 1
+    inside = (pick >= 0) & (pick < pieces.size)
+    pick = np.clip(pick, 0, pieces.size - 1)
+    ok = inside & (owner[pick] == np.arange(runs))
+    result[ok] = values[pieces[pick[ok]]]
+    return result
+
 
 #: The channels of a recording, in the order a block function receives them.
 CHANNELS = ("displacement", "force", "cycle", "missing")
@@ -45,24 +365,7 @@ def _task(function, start, stop, arguments, *arrays):
 
 
 class Samples:
-    """The channels of one recording (see the module notes).
-
-    Parameters
-    ----------
-    displacement, force : numpy.ndarray or dask.array.Array
-        Float64, one value per sample. [m], [N]
-    cycle : numpy.ndarray or dask.array.Array, optional
-        Cycle number of each sample. [1]
-    missing : numpy.ndarray or dask.array.Array of bool, optional
-        True for samples to treat as missing besides the non-finite ones.
-    runner : ecofmaps._parallel.Runner, optional
-        Where the blocks of a lazy recording run (required for dask arrays).
-    chunk : int
-        The blocks of a lazy recording start at multiples of this many samples.
-    block : int, optional
-        Samples per block of a lazy recording; by default the multiple of ``chunk``
-        nearest the displacement's own dask chunks (or 2**22).
-    """
+    """The channels of one recording."""
 
     def __init__(
         self, displacement, force, cycle=None, missing=None, *, runner=None, chunk, block=None
@@ -101,26 +404,7 @@ class Samples:
         return [(a, min(a + self.block, self.size)) for a in range(0, self.size, self.block)]
 
     def map(self, function, channels, arguments=(), extra: int = 0) -> list:
-        """``function(start, stop, arguments, *arrays)`` over the recording's blocks.
-
-        Parameters
-        ----------
-        function : callable
-            A module-level function. ``arrays`` are the ``channels`` asked for (None for
-            one the recording lacks) over samples ``start`` to ``stop - 1`` and up to
-            ``extra`` samples beyond, as NumPy arrays.
-        channels : sequence of str
-            Names from :data:`CHANNELS`.
-        arguments : tuple
-            Passed through to every call.
-        extra : int
-            Samples past the block's end to read as well (a look ahead).
-
-        Returns
-        -------
-        results : list
-            One result per block, in order (one block, the whole recording, in memory).
-        """
+        """``function(start, stop, arguments, *arrays)`` over the recording's blocks."""
         selected = [self.channel(name) for name in channels]
         if not self.lazy:
             return [function(0, self.size, arguments, *selected)]

@@ -1,49 +1,36 @@
-r"""Synthetic fretting recordings made with the model, and the example shipped in the package.
-
-:func:`synthetic_recording` imposes a sinusoidal displacement on the model
-(:func:`ecofmaps.simulate`), one cycle per row so that the groove may change from cycle to
-cycle, and adds what a rig's sensors add: offsets, a slow drift, Gaussian noise and, if
-asked, an irregular sampling clock. Each cycle is simulated twice over from rest and the
-second pass kept, so every recorded loop is the steady loop of its own groove.
-
-:func:`example_recording` is the deterministic generator of the recording shipped as
-``ecofmaps/data/synthetic_fretting_test.csv`` (see :func:`example_path`), which
-``ecofmaps loops --example`` analyses. :func:`scar_example_trace` generates the synthetic
-profilometer trace across a wear scar shipped as
-``ecofmaps/data/synthetic_scar_profile.csv`` (see :func:`scar_example_path`).
-
-A long test of 10⁸ samples and more is made by :mod:`ecofmaps.measured.long_test`.
+r"""Synthetic fretting recordings made with the model: :func:`synthetic_recording`, the
+example shipped in the package (:func:`example_path`, :func:`scar_example_path`), and a long
+test generated and written block by block (:func:`long_recording`,
+:func:`write_long_recording`).
 """
 
 from __future__ import annotations
 
-import difflib
 import importlib.resources
 from pathlib import Path
-from typing import NamedTuple
 
 import numpy as np
 
 from ecofmaps._inputs import si_units
 from ecofmaps.io.files import write_text
+from ecofmaps.io.writers import RecordingWriter
 from ecofmaps.measured.cycles import MIN_SAMPLES
 from ecofmaps.model.simulation import simulate
 
 __all__ = [
     "EXAMPLE",
     "EXAMPLE_FILE",
+    "LONG_TEST",
     "SCAR_EXAMPLE",
     "SCAR_EXAMPLE_FILE",
-    "UGLY_KINDS",
-    "UGLY_RIG",
-    "UglyRecording",
     "example_path",
     "example_recording",
+    "long_recording",
     "scar_example_path",
     "scar_example_trace",
     "synthetic_recording",
-    "ugly_recording",
     "write_example",
+    "write_long_recording",
     "write_scar_example",
 ]
 
@@ -349,268 +336,163 @@ def scar_example_path() -> Path:
 # Ugly recordings with a known truth, for calibrating the analysis
 # ---------------------------------------------------------------------------------------
 
-#: The kinds of :func:`ugly_recording`: name -> what is wrong with it.
-UGLY_KINDS = {
-    "clean": "the model's loops with white noise of 0.05 um and 0.5 N",
-    "noise": "white noise of 0.5 um and 8 N (1 % of the amplitude, 2 % of Q*)",
-    "offsets": "offsets of 5 um and 20 N, a drift of 1 um per cycle, and white noise",
-    "chatter": "friction that chatters +-30 % at 7.37 periods per cycle (not the drive's)",
-    "stick-slip": "friction that jumps at random along the stroke (+-15 %, a few samples long)",
-    "backlash": "a dead band of +-1.5 um between the actuator and the pad at the reversals",
-    "sweep": "the amplitude swept from 30 to 70 um over the recording",
-    "sparse": "a digitised loop: 32 points per cycle, 0.5 um and 2 N steps",
-    "microslip": "partial slip (Mindlin-Masing) that never reaches gross slip: no mu",
-    "ploughing": "friction rising towards the ends of the stroke, beyond 20 um from the centre",
-    "combined": "chatter, backlash, offsets, drift and noise together",
-}
-
-#: The rig and contact of every kind: the paper's Example 2 (Section 3) on a groove of
-#: z_o/x_o = 0.1 with x_o = 50 um.
-UGLY_RIG = {
+#: The default parameters of :func:`long_recording`: the example's rig (the paper's Example 2,
+#: Section 3) and sensors, a groove deepening to z_o/x_o = 0.2 over the test, and a
+#: displacement drift of 2 um over the whole test.
+LONG_TEST = {
     "amplitude": 50e-6,
     "load": 450.0,
     "stiffness": 35e6,
     "mu": 0.8,
-    "aspect_ratio": 0.1,
-    "groove_half_width": 50e-6,
+    "final_aspect_ratio": 0.2,
+    "displacement_noise": 0.25e-6,
+    "force_noise": 4.0,
+    "displacement_offset": 3.0e-6,
+    "force_offset": 6.0,
+    "displacement_drift": 2.0e-6,
 }
 
-#: What each kind adds to the model's loop (missing entries are zero or off).
-_UGLY = {
-    "clean": {"displacement_noise": 0.05e-6, "force_noise": 0.5},
-    "noise": {"displacement_noise": 0.5e-6, "force_noise": 8.0},
-    "offsets": {
-        "displacement_noise": 0.1e-6,
-        "force_noise": 1.0,
-        "displacement_offset": 5e-6,
-        "force_offset": 20.0,
-        "displacement_drift": 1e-6,
-    },
-    "chatter": {"chatter": 0.3, "displacement_noise": 0.05e-6, "force_noise": 0.5},
-    "stick-slip": {"stick_slip": 0.15, "displacement_noise": 0.05e-6, "force_noise": 0.5},
-    "backlash": {"backlash": 1.5e-6, "displacement_noise": 0.05e-6, "force_noise": 0.5},
-    "sweep": {"sweep": (30e-6, 70e-6), "displacement_noise": 0.05e-6, "force_noise": 0.5},
-    "sparse": {"samples_per_cycle": 32, "displacement_step": 0.5e-6, "force_step": 2.0},
-    "microslip": {"microslip": 0.6, "displacement_noise": 0.05e-6, "force_noise": 0.5},
-    "ploughing": {"ploughing": (20e-6, 0.25), "displacement_noise": 0.05e-6, "force_noise": 0.5},
-    "combined": {
-        "chatter": 0.2,
-        "backlash": 1.0e-6,
-        "displacement_noise": 0.2e-6,
-        "force_noise": 3.0,
-        "displacement_offset": 3e-6,
-        "force_offset": 10.0,
-        "displacement_drift": 0.5e-6,
-    },
-}
 
-#: Periods of the chatter per drive cycle: not a ratio of small integers.
-_CHATTER_FREQUENCY = 7.37
-
-#: Correlation length of the random stick-slip, in samples.
-_STICK_SLIP_SAMPLES = 4.0
-
-
-class UglyRecording(NamedTuple):
-    """A recording made by :func:`ugly_recording`, with the truth it was made from."""
-
-    #: The recorded displacement [m] and force [N], one value per sample.
-    displacement: np.ndarray
-    force: np.ndarray
-    #: Cycle number of each sample (each cycle starts at its lowest displacement). [1]
-    cycle: np.ndarray
-    #: Normal load. [N]
-    load: float
-    #: Per cycle: the true contact CoF (NaN where none can be read), and the true GICoF. [1]
-    mu: np.ndarray
-    gicof: np.ndarray
-
-
-def _play(imposed, band):
-    """The pad's side of a dead band of half-width ``band`` (a play operator, along axis 1)."""
-    out = np.empty_like(imposed)
-    state = imposed[:, 0]
-    for j in range(imposed.shape[1]):
-        state = np.clip(state, imposed[:, j] - band, imposed[:, j] + band)
-        out[:, j] = state
-    return out
-
-
-def _slide(imposed, friction, load, stiffness, k, ploughing=None):
-    """Pad position under ``imposed`` (rows of recordings, time along axis 1), eq. 9, 10, 16.
-
-    ``friction`` is μ at each instant; ``ploughing`` = (x_p, p) adds
-    :math:`p\\mu((|x| - x_p)/x_p)^2` beyond :math:`|x| > x_p`. The pad sticks while
-    :math:`Q_-(x) \\le S(\\Delta - x) \\le Q_+(x)`, else slips to the root of
-    :math:`x + Q_\\pm(x)/S = \\Delta` (the cancellation-free root of the quadratic; with
-    ploughing, three fixed-point passes of μ at the new position).
-    """
-    lam = load / stiffness
-    x = np.zeros(imposed.shape[0])
-    positions = np.empty_like(imposed)
-
-    def local(mu, at):
-        if ploughing is None:
-            return mu
-        start, share = ploughing
-        return mu * (1.0 + share * (np.maximum(np.abs(at) - start, 0.0) / start) ** 2)
-
-    def traction(mu, at, s):
-        return (s * mu + k * at) / (1.0 - s * mu * k * at)
-
-    for j in range(imposed.shape[1]):
-        delta, mu = imposed[:, j], friction[:, j]
-        spring = (delta - x) / lam
-        s = np.where(spring > traction(local(mu, x), x, 1.0), 1.0, 0.0)
-        s = np.where(spring < traction(local(mu, x), x, -1.0), -1.0, s)
-        moved = x
-        for _ in range(1 if ploughing is None else 4):
-            m = local(mu, moved) * s
-            b = 1.0 + m * k * delta + lam * k
-            c = delta - lam * m
-            moved = 2.0 * c / (b + np.sqrt(b * b - 4.0 * m * k * c))
-        x = np.where(s != 0.0, moved, x)
-        positions[:, j] = x
-    return positions
-
-
-def _microslip_force(imposed_contact, load, mu, reach):
-    """Tangential force of a Mindlin contact under Masing's rule, never in gross slip.
-
-    The virgin curve :math:`Q = \\mu P (1 - (1 - u/u_s)^{3/2})` (:math:`u_s` the slip
-    displacement, ``reach`` times larger than the amplitude of ``imposed_contact``), each
-    branch the curve doubled in both axes from its reversal.
-    """
-    amplitude = np.max(np.abs(imposed_contact), axis=1, keepdims=True)
-    slip = amplitude / reach
-
-    def virgin(u):
-        return mu * load * np.sign(u) * (1.0 - (1.0 - np.minimum(np.abs(u) / slip, 1.0)) ** 1.5)
-
-    rising = np.gradient(imposed_contact, axis=1) > 0.0
-    top = -amplitude  # branch reversal points: a loop between -amplitude and +amplitude
-    from_low = -virgin(amplitude) + 2.0 * virgin((imposed_contact - top) / 2.0)
-    from_high = virgin(amplitude) - 2.0 * virgin((amplitude - imposed_contact) / 2.0)
-    return np.where(rising, from_low, from_high)
-
-
-def ugly_recording(kind, *, cycles=30, seed=0):
-    r"""A recording whose flaws are known, with the friction it was made from.
-
-    The paper's Example 2 rig (:data:`UGLY_RIG`: :math:`P` = 450 N, :math:`S` = 35 MN/m,
-    :math:`\mu` = 0.8, :math:`\Delta^*` = 50 µm) on a parabolic groove of
-    :math:`z_o/x_o` = 0.1, simulated sample by sample (eq. 9, 10, 16) under
-    :math:`\Delta(t) = -\Delta^*\cos 2\pi t`, 200 samples per cycle, with the flaw of
-    ``kind`` (:data:`UGLY_KINDS`). One cycle before the first is simulated and dropped, so
-    the recording starts on the steady loop.
+def long_recording(cycles, samples_per_cycle=200, *, block_cycles=4096, seed=0, **parameters):
+    r"""A long fretting test, generated block by block with bounded memory.
 
     Parameters
     ----------
-    kind : str
-        One of :data:`UGLY_KINDS`.
     cycles : int
-        Number of cycles recorded (>= 1). [1]
+        Number of cycles of the test (every one recorded). [1]
+    samples_per_cycle : int
+        Samples per cycle (>= 8). [1]
+    block_cycles : int
+        Cycles simulated at a time: the memory used is a few arrays of
+        ``block_cycles * samples_per_cycle`` samples. [1]
     seed : int
-        Seed of the random numbers (noise, the chatter's phase, the stick-slip).
+        Seed of the noise: block ``k`` uses its own stream derived from ``(seed, k)``, so the
+        recording depends on ``seed`` and ``block_cycles`` only.
+    **parameters
+        Any of :data:`LONG_TEST`: ``amplitude`` [m], ``load`` [N], ``stiffness`` [N/m],
+        ``mu``, ``final_aspect_ratio`` (the groove's z_o/x_o at the end of the test),
+        ``displacement_noise`` [m] and ``force_noise`` [N] (standard deviations),
+        ``displacement_offset`` [m], ``force_offset`` [N], ``displacement_drift`` (over the
+        whole test) [m].
 
-    Returns
-    -------
-    UglyRecording
-        ``displacement`` [m], ``force`` [N], ``cycle`` [1], ``load`` [N], and per cycle the
-        true ``mu`` and ``gicof`` [1].
+    Yields
+    ------
+    cycle : numpy.ndarray of int64
+        The 1-based test cycle of each sample of the block. [1]
+    displacement, force : numpy.ndarray
+        The recorded signals of the block. [m], [N]
 
     Notes
     -----
-    The truth comes from the generator's parameters only:
+    Cycle :math:`N` (1-based) has the groove :math:`z_o/x_o = r_f \sqrt{N / N_{total}}`
+    with the groove half-width equal to the amplitude (the paper's :math:`x_o = \Delta^*`),
+    as in :func:`ecofmaps.measured.synthetic.example_recording`; each block is
+    :func:`synthetic_recording`'s steady loops (eq. 9, 10) from zero displacement on the
+    rise, with its offset advanced by the drift so far, so the drift runs on without a step
+    from block to block.
 
-    * A constant friction :math:`\mu` (every kind but those below): ``mu`` and ``gicof``
-      are :math:`\mu`; for the model's loop on any groove the GICoF is :math:`\mu` (eq. 18).
-    * ``'chatter'`` and ``'stick-slip'``: the contact's friction varies in time,
-      :math:`\mu(t) = \mu(1 + a\sin(2\pi f t + \phi))` with :math:`f` = 7.37 periods per
-      cycle and a random phase, or :math:`\mu(1 + a\,n(t))` with :math:`n` Gaussian noise
-      smoothed over about four samples. The truth of a cycle is the mean of the friction
-      over its sliding phase, weighted by the distance slid:
-      :math:`\sum_i \mu(t_i)|x_i - x_{i-1}| / \sum_i |x_i - x_{i-1}|` over the cycle's
-      samples, :math:`x` the pad's position: the constant friction that would dissipate
-      the same energy on a flat groove. The GICoF's truth is the same number.
-    * ``'ploughing'``: the friction rises as
-      :math:`\mu(1 + 0.25((|x| - x_p)/x_p)^2)` beyond :math:`|x| > x_p` = 20 µm; the
-      truth is :math:`\mu` of the central part, :math:`|x| \le x_p`.
-    * ``'backlash'``: the pad's side follows the actuator through a dead band (a play
-      operator) and the actuator's displacement is recorded; the truth is :math:`\mu`.
-    * ``'sweep'``: the amplitude changes linearly in time from 30 to 70 µm over the
-      recording, the groove stays; the truth is :math:`\mu`.
-    * ``'sparse'``: 32 samples per cycle, the displacement rounded to 0.5 µm and the
-      force to 2 N; the truth is :math:`\mu`.
-    * ``'microslip'``: a Mindlin contact under Masing's rule (the pad's displacement
-      60 % of the one at which gross slip would start), in series with the rig's spring;
-      it never slides, so no friction coefficient can be read: ``mu`` and ``gicof`` are
-      NaN.
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 10.
+    """
+    unknown = set(parameters) - set(LONG_TEST)
+    if unknown:
+        raise TypeError(f"unknown parameters: {', '.join(sorted(unknown))}")
+    p = {**LONG_TEST, **parameters}
+    for name, value in (("cycles", cycles), ("block_cycles", block_cycles)):
+        if isinstance(value, bool) or not int(value) == value >= 1:
+            raise ValueError(f"{name} must be an integer >= 1; got {value!r}")
+    cycles, block_cycles, n = int(cycles), int(block_cycles), int(samples_per_cycle)
+    drift = p["displacement_drift"] / cycles  # per cycle
+    for index, first in enumerate(range(0, cycles, block_cycles)):
+        count = min(block_cycles, cycles - first)
+        # Every block is simulated at the full size (one compilation), then cut.
+        number = np.arange(first + 1, first + block_cycles + 1)
+        ratio = p["final_aspect_ratio"] * np.sqrt(np.minimum(number, cycles) / cycles)
+        displacement, force = synthetic_recording(
+            p["amplitude"],
+            p["load"],
+            p["stiffness"],
+            p["mu"],
+            ratio,
+            samples_per_cycle=n,
+            start_phase=0.25,
+            displacement_noise=p["displacement_noise"],
+            force_noise=p["force_noise"],
+            displacement_offset=p["displacement_offset"] + drift * first,
+            force_offset=p["force_offset"],
+            displacement_drift=drift,
+            seed=int(np.random.SeedSequence([seed, index]).generate_state(1)[0]),
+        )
+        yield np.repeat(number[:count], n), displacement[: count * n], force[: count * n]
+
+
+def write_long_recording(
+    path,
+    cycles,
+    samples_per_cycle=200,
+    *,
+    format=None,
+    cycle_numbers=False,
+    chunk_samples=1 << 20,
+    overwrite=False,
+    block_cycles=4096,
+    seed=0,
+    **parameters,
+):
+    """Write :func:`long_recording` to a file or store, block by block.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        ``.tdms``, ``.h5``/``.nc``, ``.zarr`` or ``.csv`` (the format from the suffix, or
+        ``format``).
+    cycles, samples_per_cycle, block_cycles, seed, **parameters
+        As for :func:`long_recording`.
+    format : str, optional
+        See :class:`ecofmaps.io.writers.RecordingWriter`.
+    cycle_numbers : bool
+        Also write the cycle number of each sample (a ``cycle`` column).
+    chunk_samples : int
+        Samples per chunk (zarr, HDF5) or per TDMS segment.
+    overwrite : bool
+        Replace an existing file (only once the new one is complete).
+
+    Returns
+    -------
+    path : pathlib.Path
+        The file, written atomically: displacement [m] and force [N] (SI, float64, with
+        their units), in the TDMS group ``recording`` or at the store's root.
 
     Examples
     --------
-    >>> from ecofmaps.measured.synthetic import ugly_recording
-    >>> recording = ugly_recording("chatter", cycles=3, seed=1)
-    >>> recording.displacement.shape, recording.mu.shape
-    ((600,), (3,))
+    >>> import tempfile, pathlib, ecofmaps
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "test.zarr"
+    >>> _ = write_long_recording(path, cycles=20, samples_per_cycle=50)
+    >>> ecofmaps.read_recording(path).size
+    1000
     """
-    if kind not in UGLY_KINDS:
-        close = difflib.get_close_matches(str(kind), UGLY_KINDS, n=1)
-        hint = f" (did you mean {close[0]!r}?)" if close else ""
-        raise ValueError(f"kind must be one of {', '.join(UGLY_KINDS)}; got {kind!r}{hint}")
-    if int(cycles) < 1:
-        raise ValueError(f"cycles must be >= 1; got {cycles!r}")
-    flaw = _UGLY[kind]
-    cycles = int(cycles)
-    rng = np.random.default_rng(seed)
-    n = int(flaw.get("samples_per_cycle", 200))
-    t = np.arange((cycles + 1) * n) / n  # one cycle to reach the steady loop, dropped
-    displacement, force, slid, friction = _ugly_loops(flaw, t, rng)
-    # The truth: the friction over each recorded cycle, weighted by the distance slid.
-    slid, friction = (values[n:].reshape(cycles, n) for values in (slid, friction))
-    mu = np.sum(friction * slid, axis=1) / np.sum(slid, axis=1)
-    displacement = (
-        displacement[n:]
-        + flaw.get("displacement_offset", 0.0)
-        + flaw.get("displacement_drift", 0.0) * (t[n:] - 1.0)
-        + rng.normal(size=cycles * n) * flaw.get("displacement_noise", 0.0)
+    blocks = long_recording(
+        cycles, samples_per_cycle, block_cycles=block_cycles, seed=seed, **parameters
     )
-    force = (
-        force[n:]
-        + flaw.get("force_offset", 0.0)
-        + rng.normal(size=cycles * n) * flaw.get("force_noise", 0.0)
-    )
-    if "displacement_step" in flaw:  # digitised
-        step = flaw["displacement_step"]
-        displacement = np.round(displacement / step) * step
-        force = np.round(force / flaw["force_step"]) * flaw["force_step"]
-    cycle = np.repeat(np.arange(1, cycles + 1), n)
-    return UglyRecording(displacement, force, cycle, UGLY_RIG["load"], mu, mu.copy())
-
-
-def _ugly_loops(flaw, t, rng):
-    """Displacement, force, distance slid and friction at the instants ``t`` [cycles].
-
-    The friction is NaN where the pad never slides (microslip).
-    """
-    rig = UGLY_RIG
-    low, high = flaw.get("sweep", (rig["amplitude"], rig["amplitude"]))
-    amplitude = low + (high - low) * np.clip((t - 1.0) / (t[-1] + t[1] - 1.0), 0.0, 1.0)
-    imposed = (-amplitude * np.cos(2.0 * np.pi * t))[None, :]
-    friction = np.full(t.size, rig["mu"])
-    if "chatter" in flaw:
-        phase = rng.uniform(0.0, 2.0 * np.pi)
-        friction *= 1.0 + flaw["chatter"] * np.sin(2.0 * np.pi * _CHATTER_FREQUENCY * t + phase)
-    if "stick_slip" in flaw:
-        kernel = np.exp(-0.5 * (np.arange(-12, 13) / _STICK_SLIP_SAMPLES) ** 2)
-        smooth = np.convolve(rng.normal(size=t.size), kernel / np.sqrt(np.sum(kernel**2)), "same")
-        friction *= 1.0 + flaw["stick_slip"] * np.clip(smooth, -2.5, 2.5)
-    contact = _play(imposed, flaw["backlash"]) if "backlash" in flaw else imposed
-    if "microslip" in flaw:
-        force = _microslip_force(contact, rig["load"], rig["mu"], flaw["microslip"])[0]
-        nowhere = np.full(t.size, np.nan)
-        return imposed[0] + force / rig["stiffness"], force, np.ones(t.size), nowhere
-    k = 2.0 * rig["aspect_ratio"] / rig["groove_half_width"]
-    x = _slide(contact, friction[None, :], rig["load"], rig["stiffness"], k, flaw.get("ploughing"))
-    force = rig["stiffness"] * (contact[0] - x[0])
-    return imposed[0], force, np.abs(np.diff(x[0], prepend=0.0)), friction
+    attrs = {
+        "title": "SYNTHETIC DATA, not a measurement: ecofmaps.measured.synthetic.long_recording",
+        "cycles": int(cycles),
+        "samples_per_cycle": int(samples_per_cycle),
+        "block_cycles": int(block_cycles),
+        "seed": int(seed),
+        **{name: float(value) for name, value in {**LONG_TEST, **parameters}.items()},
+    }
+    with RecordingWriter(
+        path,
+        format=format,
+        cycle=cycle_numbers,
+        chunk_samples=chunk_samples,
+        overwrite=overwrite,
+        attrs=attrs,
+    ) as writer:
+        for cycle, displacement, force in blocks:
+            writer.write(displacement, force, cycle if cycle_numbers else None)
+    return Path(path)

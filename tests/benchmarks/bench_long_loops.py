@@ -5,7 +5,7 @@
     python tests/benchmarks/bench_long_loops.py --folder DIR      # keep (and reuse) the files
     python tests/benchmarks/bench_long_loops.py --no-resolve      # the analysis only
 
-A long synthetic test (:func:`ecofmaps.measured.long_test.write_long_recording`: the
+A long synthetic test (:func:`ecofmaps.measured.synthetic.write_long_recording`: the
 example's rig, a deepening groove, noise, offsets and drift; 200 samples a cycle) is written
 once as zarr and converted to TDMS. Each run is a fresh process whose wall time and peak
 resident memory (the sum over it and its children, sampled every 50 ms, so the worker
@@ -72,8 +72,7 @@ import functools, multiprocessing, sys, time
 from ecofmaps._parallel import Runner, _materialised
 from ecofmaps.io import read_recording
 from ecofmaps.io.tables import results_csv
-from ecofmaps.measured.options import default_options
-from ecofmaps.measured.pipeline import Analysis, Reading, measure_chunk
+from ecofmaps.measured.pipeline import Analysis, LoopOptions, Reading, measure_chunk
 
 def measure(tasks):
     start = time.perf_counter()
@@ -83,11 +82,11 @@ def measure(tasks):
 
 if __name__ == "__main__":
     recording = read_recording(sys.argv[1], lazy=True)
-    options = default_options(float(sys.argv[2]))
+    options = LoopOptions(float(sys.argv[2]))
     with Runner() as runner:
-        ANALYSIS = Analysis(recording.displacement, recording.force, float(sys.argv[2]),
-                            recording.cycle, runner=runner,
-                            reading=Reading(resolve=sys.argv[3] == "resolve"), **options)
+        ANALYSIS = Analysis(recording.displacement, recording.force, recording.cycle,
+                            options=options, runner=runner,
+                            reading=Reading(resolve=sys.argv[3] == "resolve"))
     LINES = functools.partial(results_csv, header=False)
     tasks = range(len(ANALYSIS.tasks))
     fork = multiprocessing.get_context("fork")
@@ -127,7 +126,7 @@ def measured(command: list[str]) -> tuple[float, float, str]:
 
 def make_files(folder: Path, samples: int) -> dict:
     from ecofmaps.io import convert_recording
-    from ecofmaps.measured.long_test import write_long_recording
+    from ecofmaps.measured.synthetic import write_long_recording
 
     cycles = samples // SAMPLES_PER_CYCLE
     paths = {"zarr": folder / f"long{samples}.zarr", "tdms": folder / f"long{samples}.tdms"}

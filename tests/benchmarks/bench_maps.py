@@ -714,7 +714,7 @@ def resolved(quick: bool) -> None:
     of the lean NumPy's check the results.
     """
     from ecofmaps.measured.analysis import analyze_loops, resolve_loops
-    from ecofmaps.measured.resolved import resolve_analyzed_loops
+    from ecofmaps.measured.resolve import resolve_analyzed_loops
     from ecofmaps.measured.synthetic import synthetic_recording
 
     point = dict(amplitude=50e-6, load=LOAD, stiffness=35e6, mu=MU, aspect_ratio=0.2)

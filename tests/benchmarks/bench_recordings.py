@@ -5,7 +5,7 @@
     python tests/benchmarks/bench_recordings.py --samples 2e7    # a moderate size
     python tests/benchmarks/bench_recordings.py --quick          # a few seconds
 
-A long synthetic test (:func:`ecofmaps.measured.long_test.write_long_recording`: the
+A long synthetic test (:func:`ecofmaps.measured.synthetic.write_long_recording`: the
 example's rig, a deepening groove, noise and drift) is written once as zarr and converted
 (:func:`ecofmaps.io.convert_recording`, block by block) to TDMS, HDF5 and CSV (the CSV at a
 tenth of the size: text is slow to write). Each format is then read in a fresh process,
@@ -149,7 +149,7 @@ def make_files(folder: Path, samples: int, csv_share: float) -> dict:
     import numpy as np
 
     from ecofmaps.io import convert_recording, recording_blocks
-    from ecofmaps.measured.long_test import write_long_recording
+    from ecofmaps.measured.synthetic import write_long_recording
 
     cycles = max(samples // SAMPLES_PER_CYCLE, 1)
     samples = cycles * SAMPLES_PER_CYCLE

@@ -19,7 +19,7 @@ import pytest
 from ecofmaps._interrupts import INTERRUPTED, Interrupted, add_stop_note
 from ecofmaps.cli import loops_long, loops_run
 from ecofmaps.io.files import MANIFEST
-from ecofmaps.measured.long_test import write_long_recording
+from ecofmaps.measured.synthetic import write_long_recording
 from tests.cli.test_loops import run
 
 #: The module of the command (``ecofmaps.cli.main`` is also the name of its function).

@@ -7,8 +7,7 @@ import re
 import numpy as np
 import pytest
 
-from ecofmaps.measured.long_test import write_long_recording
-from ecofmaps.measured.synthetic import synthetic_recording
+from ecofmaps.measured.synthetic import synthetic_recording, write_long_recording
 from tests.cli.test_loops import POINT, run, write_csv
 
 

@@ -11,7 +11,7 @@ import time
 import pytest
 
 from ecofmaps.io.files import TEMPORARY_NAME
-from ecofmaps.measured.long_test import write_long_recording
+from ecofmaps.measured.synthetic import write_long_recording
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="POSIX signals and process groups")
 

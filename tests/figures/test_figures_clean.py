@@ -27,7 +27,7 @@ from ecofmaps.figures.style import number_text, stiffness_label, stiffness_text
 from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.fit import fit_loop
 from ecofmaps.measured.quality import add_reason
-from ecofmaps.measured.resolved import resolve_analyzed_loops
+from ecofmaps.measured.resolve import resolve_analyzed_loops
 from ecofmaps.measured.synthetic import synthetic_recording
 
 LOAD = 450.0

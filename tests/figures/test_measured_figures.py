@@ -9,7 +9,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from ecofmaps.figures import cof_evolution, measured_loops, resolved_loops, save_figure
 from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.quality import add_reason
-from ecofmaps.measured.resolved import resolve_analyzed_loops
+from ecofmaps.measured.resolve import resolve_analyzed_loops
 from ecofmaps.measured.synthetic import synthetic_recording
 from ecofmaps.model.regimes import GROSS_SLIP
 

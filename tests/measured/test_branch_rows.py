@@ -3,8 +3,7 @@
 import numpy as np
 import pytest
 
-from ecofmaps.measured.branches import branch_rows
-from ecofmaps.measured.centring import LoopBlock
+from ecofmaps.measured.measure import LoopBlock, branch_rows
 
 
 def _block(count):

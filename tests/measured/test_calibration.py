@@ -1,6 +1,6 @@
 """Calibration: on recordings whose truth is known, ±2 se of mu_resolved covers the truth.
 
-Each kind of :func:`ecofmaps.measured.synthetic.ugly_recording` (noise, offsets and drift,
+Each kind of :func:`tests.measured.ugly.ugly_recording` (noise, offsets and drift,
 chatter, random stick-slip, backlash, an amplitude sweep, a sparse digitised loop,
 ploughing, all together) is analysed as users do, with :func:`ecofmaps.analyze_loops`
 (``resolve=True``; the rig's cycle counter gives the cycles). A cycle's ``mu_resolved`` is
@@ -23,7 +23,7 @@ import pytest
 
 import ecofmaps
 from ecofmaps.measured.quality import LoopQualityWarning
-from ecofmaps.measured.synthetic import ugly_recording
+from tests.measured.ugly import ugly_recording
 from tests.return_map import return_map
 
 #: The kinds read for friction, with the seeds of their recordings.
@@ -113,7 +113,7 @@ def slider_loops():
 def test_displacement_noise_is_counted(slider_loops, record_property):
     """0.1 µm of displacement noise (and 1 N on the force) moves each loop's centre, and
     the drift interpolated between neighbouring centres offsets a loop's branches by as
-    much as 0.07 % of mu over the whole stroke (ecofmaps.measured.centring); the se counts
+    much as 0.07 % of mu over the whole stroke (ecofmaps.measured.measure); the se counts
     it (``force_drift_se``): ±2 se covers the truth on >= 80 % of the ok cycles (it was
     33 % before), none is off by more than max(3 %, 3 se), no se exceeds 10 %."""
     displacement, force = slider_loops
@@ -190,7 +190,7 @@ def test_a_wavering_friction_empties_the_gicof():
 
     import ecofmaps
     from ecofmaps.measured.quality import REASONS, has_reason
-    from ecofmaps.measured.synthetic import ugly_recording
+    from tests.measured.ugly import ugly_recording
 
     recording = ugly_recording("chatter", cycles=10)
     with warnings.catch_warnings():

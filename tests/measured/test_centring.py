@@ -1,5 +1,5 @@
 """The offset between a loop's branches that the drift correction leaves, and its standard
-error ``force_drift_se`` (ecofmaps.measured.centring), against a brute force.
+error ``force_drift_se`` (ecofmaps.measured.measure), against a brute force.
 
 The drift subtracted from the force is the centres of the cycles interpolated linearly
 between their middle samples (extended beyond the first and last); an error of the centres
@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 from scipy.stats import norm
 
-from ecofmaps.measured.centring import loop_blocks
 from ecofmaps.measured.cycles import find_cycles
+from ecofmaps.measured.measure import loop_blocks
 from tests.return_map import return_map
 
 LOAD, STIFFNESS, MU = 450.0, 35e6, 0.8

@@ -10,7 +10,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ecofmaps.measured import centring, cycles, passes
+from ecofmaps.measured import cycles
+from ecofmaps.measured import measure as centring
+from ecofmaps.measured import samples as passes
 from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.samples import Samples
 from ecofmaps.measured.synthetic import synthetic_recording
@@ -155,13 +157,16 @@ def test_a_long_loop_gets_a_block_of_its_own():
 
 def test_one_cycle_of_a_long_recording():
     """Measuring one cycle uses its neighbours' centres: as in the whole analysis."""
-    from ecofmaps.measured.per_cycle import measure_cycles
+    from ecofmaps.measured.measure import measure_cycles
+    from ecofmaps.measured.pipeline import LoopOptions
 
     displacement, force = synthetic_recording(**EXAMPLE_2, cycles=8, displacement_drift=1e-6)
     found = cycles.find_cycles(displacement)
-    whole, _, _ = measure_cycles(found, displacement, force, LOAD)
+    whole, _, _ = measure_cycles(found, displacement, force, LoopOptions(LOAD))
     for row in (0, 3, found.label.size - 1):
-        one, _, _ = measure_cycles(found, displacement, force, LOAD, rows=slice(row, row + 1))
+        one, _, _ = measure_cycles(
+            found, displacement, force, LoopOptions(LOAD), rows=slice(row, row + 1)
+        )
         for name, value in one.items():
             np.testing.assert_allclose(value, whole[name][row : row + 1], rtol=1e-12, err_msg=name)
 

@@ -18,7 +18,7 @@ import pytest
 
 import ecofmaps
 from ecofmaps.measured.analysis import analyze_loops
-from ecofmaps.measured.per_cycle import _PER_CYCLE
+from ecofmaps.measured.measure import _PER_CYCLE
 from ecofmaps.measured.quality import ALL, REASONS, SEPARATOR, LoopQualityWarning
 from ecofmaps.measured.synthetic import example_recording, synthetic_recording
 from tests.measured.reference.analysis import analyze_loops as reference_analysis

@@ -14,7 +14,8 @@ import pytest
 
 import ecofmaps
 from ecofmaps._parallel import Runner
-from ecofmaps.measured import cycles, passes, pipeline
+from ecofmaps.measured import cycles, pipeline
+from ecofmaps.measured import samples as passes
 
 PERIOD = 200
 CYCLES = 12

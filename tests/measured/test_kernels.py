@@ -13,9 +13,8 @@ import numpy as np
 import pytest
 
 from ecofmaps.measured import kernels
-from ecofmaps.measured.branches import branch_rows
-from ecofmaps.measured.centring import loop_blocks
 from ecofmaps.measured.cycles import find_cycles
+from ecofmaps.measured.measure import branch_rows, loop_blocks
 from ecofmaps.measured.synthetic import synthetic_recording
 
 LOAD = 450.0

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import ecofmaps
-from ecofmaps.measured.long_test import LONG_TEST, long_recording, write_long_recording
+from ecofmaps.measured.synthetic import LONG_TEST, long_recording, write_long_recording
 
 QUIET = dict(displacement_noise=0.0, force_noise=0.0)
 

@@ -16,9 +16,11 @@ import pytest
 import xarray as xr
 
 import ecofmaps
-from ecofmaps.measured import cycles, passes, pipeline
+from ecofmaps.measured import cycles, pipeline
+from ecofmaps.measured import samples as passes
 from ecofmaps.measured.analysis import analyze_loops
-from ecofmaps.measured.options import MissingSampleError, default_options
+from ecofmaps.measured.cycles import MissingSampleError
+from ecofmaps.measured.pipeline import LoopOptions
 from ecofmaps.measured.quality import LoopQualityWarning
 from ecofmaps.measured.synthetic import synthetic_recording
 from tests.measured.test_analysis import mindlin_recording
@@ -301,22 +303,23 @@ def test_every_cycle_missing_is_an_error():
 def test_tallies_of_parts_merge_into_the_tally_of_the_whole():
     """Tasks count their parts where they run (Tally.add) and the counts are merged: the
     same summary, refusals, checks and amplitudes as counting the whole at once."""
-    from ecofmaps.measured.per_cycle import measure_cycles
-    from ecofmaps.measured.results import Tally, cycle_results
+    from ecofmaps.measured.measure import measure_cycles
+    from ecofmaps.measured.quality import Tally, judged, scale_flags
 
     x, q = noisy(EXAMPLE_2, 12, 3)
     x, q = with_gaps(x, q, [700, 1900])  # skipped cycles besides the flagged ones
-    options = default_options(LOAD)
+    options = LoopOptions(LOAD)
     found = cycles.find_cycles(x, None, 0.5, force=q)
-    values, flags, _ = measure_cycles(found, x, q, LOAD, **options)
+    values, flags, _ = measure_cycles(found, x, q, options)
+    flags |= scale_flags(values, options)
     whole = Tally()
-    whole.add(cycle_results(values, flags, found.label, LOAD, options))
+    whole.add(judged(values, flags, options)[1], flags, values["amplitude"])
     merged = Tally()
     for rows in (slice(0, 5), slice(5, 6), slice(6, None)):
         part = Tally()
         take = {k: v[rows] for k, v in values.items()}
         checks = {k: v[rows] for k, v in flags.items()}
-        part.add(cycle_results(take, checks, found.label[rows], LOAD, options))
+        part.add(judged(take, checks, options)[1], checks, take["amplitude"])
         merged.merge(part)
     assert whole.summary == merged.summary and "skipped" in whole.summary
     assert (whole.cycles, whole.refused, whole.flagged) == (
@@ -344,11 +347,11 @@ def test_tasks_keep_what_they_measured_where_they_run(small_blocks):
     from ecofmaps._parallel import Runner
 
     x, q = noisy(EXAMPLE_2, 12, 3)
-    options = default_options(LOAD)
+    options = LoopOptions(LOAD)
     x, q = lazily(x, q)
     store = {}
     with Runner(2) as runner:
-        analysis = pipeline.Analysis(x, q, LOAD, runner=runner, samples=900, **options)
+        analysis = pipeline.Analysis(x, q, options=options, runner=runner, samples=900)
         assert len(analysis.tasks) > 2
         handed = {k: (c.values, c.flags) for k, c in analysis.measured(keep=True)}
         nothing = [(c.values, c.flags) for _, c in analysis.measured()]
@@ -379,7 +382,7 @@ def test_tasks_hand_back_only_the_columns_asked_for(small_blocks):
     with Runner(2) as runner:
         reading = pipeline.Reading(resolve=True)
         analysis = pipeline.Analysis(
-            x, q, LOAD, runner=runner, samples=900, reading=reading, **default_options(LOAD)
+            x, q, options=LoopOptions(LOAD), runner=runner, samples=900, reading=reading
         )
         whole = [chunk.part for _, chunk in analysis.measured(then=_variables)]
         only = list(analysis.measured(then=_variables, columns=columns))
@@ -403,7 +406,7 @@ def test_a_worker_reads_and_measures_without_jax_or_pint():
 
     code = (
         "import sys\n"
-        "import ecofmaps.io.binary, ecofmaps.measured.passes, ecofmaps.measured.pipeline\n"
+        "import ecofmaps.io.binary, ecofmaps.measured.samples, ecofmaps.measured.pipeline\n"
         "import ecofmaps.io.tables, ecofmaps.cli.loops_long\n"
         "loaded = [m for m in ('jax', 'pint') if m in sys.modules]\n"
         "loaded += [m for m in sys.modules if m.startswith('scipy.')\n"

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 import ecofmaps
 from ecofmaps.measured.analysis import analyze_loops, resolve_loops
 from ecofmaps.measured.quality import REASONS, LoopQualityWarning
-from ecofmaps.measured.resolved import resolve_analyzed_loops
+from ecofmaps.measured.resolve import resolve_analyzed_loops
 from ecofmaps.measured.synthetic import synthetic_recording
 from tests.return_map import return_map
 

@@ -9,8 +9,11 @@ import pytest
 import ecofmaps.measured
 from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.cycles import find_cycles
-from ecofmaps.measured.options import ImplausibleScaleError, ImplausibleScaleWarning
-from ecofmaps.measured.quality import LoopQualityWarning
+from ecofmaps.measured.quality import (
+    ImplausibleScaleError,
+    ImplausibleScaleWarning,
+    LoopQualityWarning,
+)
 from tests.measured.test_equivalence import EXAMPLE_2, LOAD, noisy
 
 

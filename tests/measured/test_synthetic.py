@@ -7,14 +7,12 @@ import ecofmaps
 from ecofmaps.io.recordings import read_recording
 from ecofmaps.measured.synthetic import (
     EXAMPLE,
-    UGLY_KINDS,
-    UGLY_RIG,
     example_path,
     example_recording,
     synthetic_recording,
-    ugly_recording,
     write_example,
 )
+from tests.measured.ugly import UGLY_KINDS, UGLY_RIG, ugly_recording
 
 POINT = dict(amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8)
 

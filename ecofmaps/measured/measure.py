@@ -1,47 +1,7 @@
-r"""Measured loops moved to their centres and laid out a block of cycles at a time.
-
-:func:`loop_blocks` hands :func:`ecofmaps.analyze_loops` the cycles of a recording
-(:class:`ecofmaps.measured.cycles.Cycles`) a block at a time, about ``_BLOCK`` samples, so
-that its memory does not grow with the recording: each block is the centred samples of its
-cycles, once, in time order, with where each cycle lies among them (:class:`LoopBlock`).
-Sums over each cycle's samples run in the compiled kernels of
-:mod:`ecofmaps.measured.kernels`, in the order of the samples.
-
-Offsets and drift
------------------
-Every loop is moved to its centre: the mean of :math:`\Delta` and of :math:`Q` along the
-loop weighted by the displacement travelled, :math:`\oint \Delta\,|d\Delta| / \oint
-|d\Delta|` (trapezoids). For a loop symmetric about a point (the model's steady loop, with
-or without ploughing peaks at both ends of the stroke) that point is the centre, and the
-mean averages the noise of every sample. For cycles cut from one continuous recording, the
-centres are interpolated linearly along the sample index from the middle of one cycle to
-the next and subtracted sample by sample, which also removes a slow drift of
-:math:`\Delta` (or of :math:`Q`) within each cycle; the weights of the force's centre come
-from the displacement so centred. Labelled cycles (possibly recorded far apart) are each
-moved by their own centre.
-
-The drift correction is only as good as the centres: noise on the displacement (through
-the weights) and on the force moves each centre, and a centre's error tilts the drift
-subtracted from its neighbours, which offsets a loop's falling branch against its rising
-one by :math:`\varepsilon = \sum_j a_j c_j` for the centres :math:`c_j` around it. For
-equally spaced cycles :math:`\varepsilon = (c_{i+1} - c_{i-1})/4` (the mean of the linear
-drift over each half of the cycle), and :math:`(c_{i+1} - c_i)/2` at the ends of the
-recording, where the drift is extrapolated. ``force_drift_se`` is the standard error of
-that offset, :math:`\sigma_c (\sum_j a_j^2)^{1/2}`, with the noise :math:`\sigma_c` of the
-centres from their second differences over :data:`_NOISE_REACH` cycles on either side,
-:math:`\operatorname{median}|c_{j-1} - 2c_j + c_{j+1}| / (0.6745\sqrt6)`, which a slow
-drift hardly enters (a real drift that bends from cycle to cycle counts as noise: the
-correction cannot follow it either). On a Coulomb slider recorded with 0.1 µm of
-displacement noise on a 50 µm amplitude the centres scatter by about 1.7 N, and the
-offset is the largest error of :func:`ecofmaps.resolve_loops`'s ``mu_resolved``; its
-standard error counts it (:mod:`ecofmaps.measured.resolved`). Labelled cycles, each moved
-by its own centre, have no such offset (zero).
-
-Cycles that hold a missing sample (:attr:`ecofmaps.measured.cycles.Cycles.missing`) are not
-laid out, and the drift is interpolated between the centres of the whole cycles on either
-side of them. A block's samples are read as ``displacement[a:b]`` (and, for labelled
-cycles, ``displacement[indices]``) with indices into the whole recording, so the arrays may
-be any object that gives a stretch of it by those indices.
+r"""Steps 3 and 4 of the loop pipeline: each loop centred (offsets and drift removed, a block of
+cycles at a time) and measured along its branch rows (amplitude, slip amplitude, energy,
+ECoF, stiffness, GICoF ...), with the flags of the checks each cycle failed.
+The method is explained in ``docs/method-loops.md`` ("Centring the loops", "Measuring each loop").
 """
 
 from __future__ import annotations
@@ -52,10 +12,29 @@ from collections.abc import Iterator
 
 import numpy as np
 
+from ecofmaps._interrupts import check_interrupted
 from ecofmaps.measured import kernels
-from ecofmaps.measured.cycles import Cycles
+from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles
+from ecofmaps.measured.quality import (
+    ANTICLOCKWISE_SHARE,
+    READING_REASONS,
+    REASONS,
+    UNEXPLAINED_SHARE,
+)
 
-__all__ = ["NEIGHBOURS", "LoopBlock", "loop_blocks"]
+__all__ = [
+    "GROSS_SLIP_THRESHOLD",
+    "NEIGHBOURS",
+    "LoopBlock",
+    "Stretch",
+    "both",
+    "branch_rows",
+    "line_crossings",
+    "loop_blocks",
+    "measure_cycles",
+    "stick_lines",
+    "zero_force_crossings",
+]
 
 #: Samples of the cycles laid out at once by :func:`loop_blocks`.
 _BLOCK = 1 << 17
@@ -74,32 +53,21 @@ NEIGHBOURS = _NOISE_REACH + 1
 _SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
 
 
+class Stretch:
+    """A stretch of a recording (samples ``low`` on) indexed like the whole recording."""
+
+    def __init__(self, values, low: int):
+        self.values, self.low = values, low
+
+    def __getitem__(self, key):
+        if isinstance(key, slice):
+            return self.values[key.start - self.low : key.stop - self.low]
+        return self.values[np.asarray(key) - self.low]
+
+
 @dataclasses.dataclass(frozen=True, eq=False)
 class LoopBlock:
-    """The centred loops of a block of consecutive cycles, from :func:`loop_blocks`.
-
-    Attributes
-    ----------
-    rows : slice
-        The cycles of the block (rows of the :class:`Cycles`).
-    displacement, force : numpy.ndarray, shape (samples,)
-        Centred displacement and force of every sample of the block's cycles, once, in
-        time order: each cycle is a stretch of them (cycles cut at the reversals share the
-        sample between them). [m], [N]
-    offset, count, rotation : numpy.ndarray of int64, shape (cycles,)
-        Where each cycle's stretch begins in ``displacement``, its samples, and where its
-        loop begins in it (as for :class:`Cycles`).
-    continuous : bool
-        As for :class:`Cycles`: the segment that closes each loop is not travelled.
-    displacement_centre, force_centre : numpy.ndarray, shape (cycles,)
-        The centres removed. [m], [N]
-    force_drift_se : numpy.ndarray, shape (cycles,)
-        Standard error of the offset between each loop's two branches that the drift
-        correction leaves (module notes); zero for labelled cycles. [N]
-    force_swing : numpy.ndarray, shape (cycles,)
-        Range of the force as recorded over each cycle, before centring (a dead channel
-        holds still; centred, its drift correction would make it a ramp). [N]
-    """
+    """The centred loops of a block of consecutive cycles, from :func:`loop_blocks`."""
 
     rows: slice
     displacement: np.ndarray
@@ -114,11 +82,7 @@ class LoopBlock:
     force_drift_se: np.ndarray
 
     def samples(self, point, rows=slice(None)):
-        """Index into ``displacement`` and ``force`` of points round the loops ``rows``.
-
-        ``point`` (one row per loop) counts from the loop's lowest displacement, 0 to
-        ``count``; ``count`` is the point that closes the loop.
-        """
+        """Index into ``displacement`` and ``force`` of points round the loops ``rows``."""
         offset, count = self.offset[rows][:, None], self.count[rows][:, None]
         if self.continuous:  # no rotation: the stretch, then its first sample again
             return offset + np.where(point < count, point, 0)
@@ -138,25 +102,7 @@ class LoopBlock:
 def loop_blocks(
     cycles: Cycles, displacement, force, rows=None, force_sign=1.0
 ) -> Iterator[LoopBlock]:
-    """The loops of ``cycles``, each moved to its centre (module notes), block by block.
-
-    Parameters
-    ----------
-    cycles : Cycles
-        The cycles of the recording.
-    displacement, force : numpy.ndarray
-        The recording the cycles were found in, float64. [m], [N]
-    rows : slice, optional
-        Consecutive cycles to lay out (default all). The centring of cycles cut at the
-        reversals still uses their neighbours.
-    force_sign : float
-        +1, or -1 to read the force with the other sign (without copying the recording).
-
-    Yields
-    ------
-    block : LoopBlock
-        Consecutive cycles, about ``_BLOCK`` samples in all, in order.
-    """
+    """The loops of ``cycles``, each moved to its centre, block by block."""
     first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
     # The whole cycles, by position among them: a block is consecutive whole cycles.
     kept = np.flatnonzero(cycles.whole)
@@ -209,7 +155,7 @@ def loop_blocks(
 
 def _drift_se(middle, count, centre, rows: slice):
     """Standard error of the offset between the branches of the loops ``rows`` that the
-    force's drift correction leaves (module notes), from the ``centre`` of every whole
+    force's drift correction leaves, from the ``centre`` of every whole
     cycle at its ``middle`` sample; the centres of :data:`_NOISE_REACH` cycles on either
     side of ``rows`` are needed. [N]"""
     size = centre.size
@@ -289,11 +235,7 @@ def _blocks(points: np.ndarray, offset: int) -> Iterator[slice]:
 
 
 def _path_means(path, values, offset, count, closed: bool):
-    """Mean of ``values`` round each loop weighted by the distance along ``path``.
-
-    The loops are stretches (``offset``, ``count``) of the flat arrays; ``closed`` adds
-    the segment from each stretch's last sample back to its first.
-    """
+    """Mean of ``values`` round each loop weighted by the distance along ``path``."""
     path, values = (np.ascontiguousarray(a, dtype=np.float64) for a in (path, values))
     return kernels.path_means(path, values, offset, count, closed)
 
@@ -301,11 +243,7 @@ def _path_means(path, values, offset, count, closed: bool):
 def _displacement_centres(start, count, displacement, first: int, stop: int):
     """Middle sample of every cycle cut at the reversals (stretches ``start``, ``count``),
     and the displacement centres of the cycles from :data:`NEIGHBOURS` before ``first`` to
-    :data:`_NOISE_REACH` after ``stop - 1`` (NaN for the others), a block at a time.
-
-    A cycle's path runs over its stretch only: the segment that closes the loop, from the
-    next reversal back to the first sample, is not travelled.
-    """
+    :data:`_NOISE_REACH` after ``stop - 1`` (NaN for the others), a block at a time."""
     # The mean sample index round the loop, its closing point included (exact integers).
     middle = ((count * (2 * start + count - 1)) // 2 + start) / (count + 1)
     centre = np.full(start.size, np.nan)
@@ -319,12 +257,7 @@ def _displacement_centres(start, count, displacement, first: int, stop: int):
 
 
 def _drift(low: int, high: int, points, values, near: slice):
-    """``values`` interpolated over ``points`` at the samples ``low`` to ``high - 1``.
-
-    Piecewise linear, extended linearly beyond the first and last points;
-    ``points[near]`` bracket every sample that lies between two points. Inside, it is
-    ``np.interp`` on the segments between points, to the bit (one pass).
-    """
+    """``values`` interpolated over ``points`` at the samples ``low`` to ``high - 1``."""
     xp, fp = points[near], values[near]
     # Sample i lies on segment j when xp[j] <= i < xp[j + 1].
     edges = np.clip(np.ceil(xp).astype(np.int64), low, high) - low
@@ -349,3 +282,203 @@ def _drift(low: int, high: int, points, values, near: slice):
             values[-1] - values[-2]
         ) / (points[-1] - points[-2])
     return result
+
+
+#: Energy ratio :math:`A = E_d/(4\Delta^* Q^*)` above which a loop is gross slip (the
+#: sliding transition of Fouvry, Kapsa and Vincent).
+GROSS_SLIP_THRESHOLD = 0.2
+
+
+#: The per-cycle quantities, in the Dataset's order.
+_PER_CYCLE = (
+    "amplitude",
+    "slip_amplitude",
+    "max_force",
+    "dissipated_energy",
+    "ecof",
+    "cof_max",
+    "energy_ratio",
+    "stiffness",
+    "gicof",
+    "gicof_forward",
+    "gicof_backward",
+    "crossing_displacement_forward",
+    "crossing_displacement_backward",
+    "displacement_offset",
+    "force_offset",
+    "force_drift_se",
+    "stick_residual",
+)
+
+
+#: The reasons of :data:`~ecofmaps.measured.quality.REASONS` that this step flags (not the
+#: scale's, :func:`~ecofmaps.measured.quality.scale_flags`, nor the reading's).
+_MEASURED = tuple(
+    r for r in REASONS if r not in ("implausible-amplitude", "implausible-cof", *READING_REASONS)
+)
+
+
+def _loop_values(block, options):
+    """Every per-cycle quantity of a block of centred loops, and the checks it failed."""
+    load = options.load
+    # The extremes, the loop's area by trapezoids (the segment that closes it included)
+    # and its top, where the rising branch ends.
+    highest, lowest, max_force, energy, top = kernels.loop_measures(
+        block.displacement, block.force, block.offset, block.count, block.rotation
+    )
+    span = highest - lowest
+    amplitude = 0.5 * span
+    bx, by, length = branch_rows(block, top)
+    compliance, intercept, across, fit = stick_lines(bx, by, length, span, options.stick_window)
+    crossing, zero_on_loop = zero_force_crossings(
+        bx, by, length, max_force, across, intercept, span
+    )
+    cycles = block.count.size
+    slip = 0.5 * (crossing[cycles:] - crossing[:cycles])
+    half_width = options.crossing_window * np.abs(slip)
+    at, force, on_loop = line_crossings(
+        bx, by, length, both(compliance), both(half_width), load, both(max_force)
+    )
+    energy_ratio = energy / (4.0 * amplitude * max_force)
+    values = {
+        "amplitude": amplitude,
+        "slip_amplitude": slip,
+        "max_force": max_force,
+        "dissipated_energy": energy,
+        "ecof": energy / (4.0 * load * slip),
+        "cof_max": max_force / load,
+        "energy_ratio": energy_ratio,
+        "stiffness": 1.0 / (compliance + 0.0),  # + 0.0: a rigid rig is +inf, not -inf
+        "gicof": (force[:cycles] - force[cycles:]) / (2.0 * load),
+        "gicof_forward": force[:cycles] / load,
+        "gicof_backward": -force[cycles:] / load,
+        "crossing_displacement_forward": at[:cycles],
+        "crossing_displacement_backward": at[cycles:],
+        "displacement_offset": block.displacement_centre,
+        "force_offset": block.force_centre,
+        "force_drift_se": block.force_drift_se,
+        "stick_residual": fit["residual"],
+    }
+    rounding = 1e-9
+    anticlockwise = energy_ratio < -ANTICLOCKWISE_SHARE
+    flags = {
+        "few-samples": block.count < MIN_SAMPLES,
+        "constant-force": ~(block.force_swing > 0.0),
+        # A cycle cut at the reversals cannot turn back by more than the band: that
+        # would have been a reversal.
+        "several-loops": np.zeros(cycles, dtype=bool)
+        if block.continuous
+        else _turns_back(bx, options.hysteresis * span),
+        "anticlockwise": anticlockwise,
+        "energy-ratio-above-1": energy_ratio > 1.0 + rounding,
+        "negative-stiffness": compliance < 0.0,
+        "no-stick": (~(fit["unexplained"] <= UNEXPLAINED_SHARE) & ~np.isinf(values["stiffness"]))
+        | np.isnan(compliance),  # a rigid rig's vertical stick sides explain all but 0/0
+        "negative-area": (energy_ratio < 0.0) & ~anticlockwise,
+        "negative-slip": ~(slip > 0.0),
+        "no-zero-crossing": ~(zero_on_loop[:cycles] & zero_on_loop[cycles:]),
+        "curved-stick": fit["curved"],
+        "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]),
+        "not-gross-slip": ~(energy_ratio > options.gross_slip_threshold),
+    }
+    return values, flags
+
+
+def _turns_back(x, band):
+    """True for the cycles whose displacement turns back within a branch by more than
+    ``band``: the rising branches (the first half of the rows) fall below their running
+    maximum, or the falling ones rise above their running minimum (the rows' padding
+    repeats their last point, which changes neither)."""
+    cycles = band.size
+    rising, falling = x[:cycles], x[cycles:]
+    drop = np.max(np.maximum.accumulate(rising, axis=1) - rising, axis=1)
+    rise = np.max(falling - np.minimum.accumulate(falling, axis=1), axis=1)
+    return np.maximum(drop, rise) > band
+
+
+def measure_cycles(cycles: Cycles, displacement, force, options, *, rows=None, keep_loops=False):
+    """The per-cycle values of :func:`ecofmaps.analyze_loops` for cycles already found, as
+    measured (not yet NaN where a check fails), the flags of the checks each cycle failed
+    (reason -> per cycle), and the centred loops NaN-padded over (cycle, point) if
+    ``keep_loops``. ``displacement`` and ``force`` give stretches by sample index [m], [N];
+    ``options`` is a :class:`~ecofmaps.measured.pipeline.LoopOptions`."""
+    first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
+    values = {name: np.full(stop - first, np.nan) for name in _PER_CYCLE}
+    flags = {reason: np.zeros(stop - first, dtype=bool) for reason in _MEASURED}
+    if cycles.missing is not None:  # not measured: their values stay NaN
+        flags["missing-samples"] = cycles.missing[first:stop].copy()
+    loops = None
+    if keep_loops:
+        width = int(cycles.count[first:stop].max()) + 1
+        loops = tuple(np.full((stop - first, width), np.nan) for _ in range(2))
+    sign = -1.0 if options.flip_force else 1.0
+    blocks = loop_blocks(cycles, displacement, force, slice(first, stop), sign)
+    with np.errstate(divide="ignore", invalid="ignore"):  # degenerate cycles give NaN
+        for block in blocks:
+            check_interrupted()
+            out = slice(block.rows.start - first, block.rows.stop - first)
+            computed, failed = _loop_values(block, options)
+            for name, value in computed.items():
+                values[name][out] = value
+            for reason, flag in failed.items():
+                flags[reason][out] = flag
+            if keep_loops:
+                for loop, centred in zip(loops, block.loops(loops[0].shape[1]), strict=True):
+                    loop[out] = centred
+    return values, flags, loops
+
+
+#: Samples with :math:`|Q|` below this share of :math:`Q^*` locate a zero-force crossing
+#: that is not on a stick segment.
+_ZERO_FORCE_BAND = 0.25
+
+
+def both(values):
+    """A per-cycle array for the rising then the falling branch rows."""
+    return np.concatenate([values, values])
+
+
+def branch_rows(block, top):
+    """The rising branches (start to top) and falling ones (top to the end) as rows."""
+    cycles = top.size
+    first = np.concatenate([np.zeros_like(top), top])
+    last = np.concatenate([top, block.count])
+    length = last - first + 1
+    width = int(length.max())
+    if not block.continuous:  # a loop may begin inside its stretch and wrap round it
+        point = np.minimum(first[:, None] + np.arange(width), last[:, None])
+        index = block.samples(point, np.tile(np.arange(cycles), 2))
+        return block.displacement[index], block.force[index], length
+    # Each row is a stretch of the samples from its reversal on, up to its last point:
+    # the top of a rising branch; the loop's first sample, which closes a falling one.
+    start = np.tile(block.offset, 2) + first
+    end = np.concatenate([block.offset + top, block.offset])
+    x, y = (
+        kernels.branch_stretches(values, start, end, length, width)
+        for values in (block.displacement, block.force)
+    )
+    return x, y, length
+
+
+def stick_lines(x, y, length, span, window):
+    r"""Lines :math:`\Delta = c + Q/S` through the stick segments after the two reversals."""
+    low, high = (float(share) for share in window)
+    compliance, intercept, across, residual, unexplained, curved = kernels.stick_lines(
+        x, y, length, span, low, high
+    )
+    fit = {"residual": residual, "unexplained": unexplained, "curved": curved}
+    return compliance, intercept, across, fit
+
+
+def zero_force_crossings(x, y, length, max_force, across, intercept, span):
+    r"""Displacement where each branch row crosses :math:`Q = 0`, and whether on the loop."""
+    band = both(_ZERO_FORCE_BAND * max_force)
+    return kernels.zero_force_crossings(x, y, length, band, intercept, across, both(1e-9 * span))
+
+
+def line_crossings(x, y, length, compliance, half_width, load, scale):
+    r"""Where each branch row crosses :math:`Q = S\Delta`: displacement, force, on the loop."""
+    force, on_loop = kernels.line_crossings(
+        x, y, length, compliance, half_width, float(load), 1e-9 * scale
+    )
+    return force * compliance, force, on_loop

@@ -1,18 +1,21 @@
-r"""Stick and slip along each branch of centred fretting loops, and the rig stiffness.
-
-The arrays hold one loop per row, as :func:`ecofmaps.analyze_loops` keeps them: each row
-runs from the loop's lowest displacement up the *rising* branch to its highest and back
-down the *falling* one, NaN-padded. :func:`slip_branches` finds the stick sets after the
-two reversals, measures the stiffness on them (or checks a given one), and returns the
-samples of each branch that slip, sorted by contact position :math:`\xi = \Delta - Q/S`
-(eq. 10). The method is described in :mod:`ecofmaps.measured.resolved`.
+r"""The numerics of the reading along the stroke (:mod:`ecofmaps.measured.resolve`): the stiffness
+and the slip of each branch, the branches resampled at contact positions, their noise and
+the weights of their samples in the standard errors.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["masked_median", "masked_sum", "slip_branches"]
+__all__ = [
+    "branch_noise",
+    "masked_median",
+    "masked_sum",
+    "read_branches",
+    "resample",
+    "sample_weights",
+    "slip_branches",
+]
 
 #: A given stiffness does not fit when it tilts the stick sets by this many σ.
 _TILT_SPREAD = 3.0
@@ -69,10 +72,7 @@ def _before(mask, branch):
 
 
 def _compliance(x, q, sticks):
-    """Least-squares compliance common to lines Δ = ξ_s + cQ through each stick set.
-
-    Returns the compliance and its standard error (from the residuals about the lines).
-    """
+    """Least-squares compliance common to lines Δ = ξ_s + cQ through each stick set."""
     covariance = np.zeros(x.shape[0])
     variance = np.zeros(x.shape[0])
     centred = []
@@ -93,10 +93,7 @@ def _compliance(x, q, sticks):
 
 
 def _stick_and_slip(xi, branches, sticks, floor, slip_threshold):
-    """Noise and the slip of each branch (module notes).
-
-    Returns the noise σ of ξ, the two slip masks and the two stick levels.
-    """
+    """Noise and the slip of each branch."""
     # σ from the second differences within the stick sets: a smooth trend of ξ (a rounded
     # loop, a wrong stiffness) hardly enters them, white noise does with variance 6σ².
     second = np.abs(xi[:, :-2] - 2.0 * xi[:, 1:-1] + xi[:, 2:])
@@ -122,16 +119,7 @@ def _stick_and_slip(xi, branches, sticks, floor, slip_threshold):
 
 
 def _branch_shift(xi, branches, slips, levels):
-    r"""How far the rising branch's slip lies beyond the falling one's, in ξ, per cycle.
-
-    At each reversal the pad stops where the slip ended: the stick set that follows has
-    the :math:`\xi` of the last slip samples before it. A dead band between the actuator
-    and the pad (backlash), or a drift of the displacement over the cycle, breaks this:
-    the gaps between the median :math:`\xi` of the last ``_END_SAMPLES`` slip samples of a
-    branch and the next stick level, averaged over the two reversals, are the shift of
-    the rising branch against the falling one (zero for the model's loop, up to the
-    noise). NaN where a branch has no slip.
-    """
+    r"""How far the rising branch's slip lies beyond the falling one's, in ξ, per cycle."""
     gaps = []
     for slip, level in zip(slips, levels[::-1], strict=True):
         # The last slip samples of the branch in time: its slip runs to the reversal.
@@ -152,13 +140,7 @@ def _sorted_branch(xi, q, slip):
 
 
 def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_threshold):
-    """The stiffness, the checks of the stick sets, and the two slip branches (module notes).
-
-    Returns a dict with the compliance and its standard error, ``mismatch`` (per cycle: a
-    given stiffness that tilts the stick sets, or a measured one that slopes down), the
-    sorted slip branches ``forward`` and ``backward`` and the range ``lowest`` ..
-    ``highest`` where both slip.
-    """
+    """The stiffness, the checks of the stick sets, and the two slip branches."""
     cycles = x.shape[0]
     floor = _ROUNDING * amplitude
     branches = _branches(x, valid)
@@ -223,3 +205,80 @@ def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_t
         "lowest": np.maximum(ends[0][0], ends[1][0]),
         "highest": np.minimum(ends[0][1], ends[1][1]),
     }
+
+
+def resample(xs, qs, count, grid, scale, inside):
+    r"""``qs(xs)`` at the positions ``scale * grid`` (one row per cycle), by 3-point fractions."""
+    cycles, width = xs.shape
+    points = grid.size
+    at = scale[:, None] * grid[None, :]
+    # How many samples lie at or below each position: each sample counts from the first
+    # grid point at or above it on (a histogram over the grid, summed).
+    with np.errstate(invalid="ignore", divide="ignore"):
+        bins = np.searchsorted(grid, xs / scale[:, None], side="left")
+    rows = (points + 1) * np.arange(cycles)[:, None]
+    histogram = np.bincount((rows + bins).ravel(), minlength=cycles * (points + 1))
+    right = np.cumsum(histogram.reshape(cycles, points + 1)[:, :points], axis=1)
+    base = width * np.arange(cycles)[:, None]
+    left = np.clip(right - 1, 0, np.maximum(count - 2, 0)[:, None])
+    # The three samples around the position: left - 1, left, left + 1, or 0, 1, 2 at the start.
+    middle = np.clip(left, 1, np.maximum(count - 2, 1)[:, None])
+    last = np.maximum(count - 1, 0)[:, None]
+    flat_x, flat_q = xs.ravel(), qs.ravel()
+    index = [base + np.minimum(middle + k, last) for k in (-1, 0, 1)]
+    xa, xb, xc = (flat_x[i] for i in index)
+    qa, qb, qc = (flat_q[i] for i in index)
+    first = left == middle
+    x0, x1 = np.where(first, xb, xa), np.where(first, xc, xb)
+    q0, q1 = np.where(first, qb, qa), np.where(first, qc, qb)
+    share = np.divide(at - x0, x1 - x0, out=np.zeros_like(x0), where=x1 > x0)
+    linear = q0 + share * (q1 - q0)
+    # The linear fraction through the three samples.
+    da, dc = xa - xb, xc - xb
+    fa, fc = qa - qb, qc - qb
+    slope_a, slope_c = fa / da, fc / dc
+    pole = (slope_c - slope_a) / (fa - fc)
+    d = at - xb
+    fraction = qb + (slope_a + pole * fa) * d / (1.0 + pole * d)
+    safe = (
+        (count[:, None] >= 3)
+        & (np.minimum(1.0 + pole * da, 1.0 + pole * dc) >= 0.5)
+        & np.isfinite(fraction)
+    )
+    value = np.where(safe, fraction, linear)
+    return np.where(inside & (count[:, None] >= 2), value, np.nan), left, share
+
+
+def read_branches(forward, backward, grid, scale, inside, load):
+    """Q+, Q-, μ and g at the positions ``scale * grid``, and the line weights of each branch."""
+    q_forward, *line_forward = resample(*forward, grid, scale, inside)
+    q_backward, *line_backward = resample(*backward, grid, scale, inside)
+    up = np.arctan(q_forward / load)
+    down = np.arctan(q_backward / load)
+    mu = np.tan(0.5 * (up - down))
+    slope = np.tan(0.5 * (up + down))
+    return q_forward, q_backward, mu, slope, (line_forward, line_backward)
+
+
+def branch_noise(xs, qs, count, central):
+    """Standard deviation of a branch's samples about the branch, in its central part."""
+    x0, x1, x2 = xs[:, :-2], xs[:, 1:-1], xs[:, 2:]
+    q0, q1, q2 = qs[:, :-2], qs[:, 1:-1], qs[:, 2:]
+    u = np.divide(x1 - x0, x2 - x0, out=np.full_like(x0, 0.5), where=x2 > x0)
+    residual = q1 - q0 - u * (q2 - q0)
+    use = (np.arange(1, xs.shape[1] - 1)[None, :] < (count - 1)[:, None]) & (
+        np.abs(x1) <= central[:, None]
+    )
+    return np.sqrt(masked_sum(residual**2, use) / masked_sum(1.0 + u**2 + (1.0 - u) ** 2, use))
+
+
+def sample_weights(left, share, gain, width):
+    """Weight of each sample of a branch in a sum over grid points of ``gain`` times its value."""
+    cycles = left.shape[0]
+    base = (width * np.arange(cycles))[:, None]
+    gain = np.where(np.isfinite(gain), gain, 0.0)
+    index = np.concatenate([(base + left).ravel(), (base + left + 1).ravel()])
+    weight = np.concatenate([(gain * (1.0 - share)).ravel(), (gain * share).ravel()])
+    return np.bincount(index, weight, minlength=cycles * width + 1)[: cycles * width].reshape(
+        cycles, width
+    )
