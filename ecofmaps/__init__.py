@@ -21,7 +21,7 @@ _PUBLIC = {
         "lookup_correction",
     ),
     "ecofmaps.io": ("read_recording", "read_scar_profile"),
-    "ecofmaps.lab": ("energy_wear", "sliding_condition", "transition"),
+    "ecofmaps.lab": ("energy_wear", "loop_scar_closure", "sliding_condition", "transition"),
     "ecofmaps.maps": (
         "CacheWarning",
         "cache_entries",

@@ -168,6 +168,10 @@ QUANTITIES: dict[str, Quantity] = {
         "energy wear coefficient (fit)", "α", r"\alpha", *_PER_JOULE
     ),
     "threshold_energy": Quantity("threshold energy of wear", "E_th", "E_{th}", *_JOULES),
+    "loop_residual": _number("root mean square force off the model's loop, over Q*"),
+    "scar_residual": _length("root mean square height of the implied scar off the profile"),
+    "scar_relative_residual": _number("scar residual over the scar depth"),
+    "implied_scar": _length("scar implied by the loops", "h(ξ) = ∫g dξ", r"h(\xi)"),
     # --- the loop read along the stroke -------------------------------------------------
     "position": _length("contact position, centred", "ξ = Δ - Q/S", r"\xi = \Delta - Q/S"),
     "slope": _number("groove slope felt by the contact", "g(ξ)", r"g(\xi)"),

@@ -1,6 +1,7 @@
 """A fretting lab's daily numbers from the per-cycle results of :func:`ecofmaps.analyze_loops`:
-a test's sliding condition, the transition to gross slip, and energy wear with Archard's
-coefficients. The method, its formulas and the field's notation are in docs/lab.md.
+a test's sliding condition, the transition to gross slip, energy wear with Archard's
+coefficients, and the closure of the loops on the scar profile. The method, its formulas and
+the field's notation are in docs/lab.md.
 """
 
 from __future__ import annotations
@@ -11,11 +12,13 @@ import xarray as xr
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._inputs import check, si_units
 from ecofmaps.model.profiles import ScarProfile
+from ecofmaps.model.simulation import fretting_loop
 
 __all__ = [
     "MINDLIN_ENERGY_RATIO",
     "MINDLIN_OPENING_RATIO",
     "energy_wear",
+    "loop_scar_closure",
     "per_cycle",
     "sliding_condition",
     "transition",
@@ -337,8 +340,8 @@ def _ratio(top, top_se, bottom, bottom_se):
     return value, abs(value) * float(np.hypot(top_se / top, bottom_se / bottom))
 
 
-def _one_test(results, profile, length) -> dict:
-    """Energy wear of one test: each value with its standard error."""
+def _scar(profile) -> None:
+    """Raise unless ``profile`` is a ScarProfile with a scar."""
     if not isinstance(profile, ScarProfile):
         raise TypeError(
             "profile must be a ScarProfile (ecofmaps.read_scar_profile or "
@@ -350,6 +353,12 @@ def _one_test(results, profile, length) -> dict:
             f"profile: no scar (worn area {area:g} m²): the trace shows no groove below the "
             "unworn surface"
         )
+
+
+def _one_test(results, profile, length) -> dict:
+    """Energy wear of one test: each value with its standard error."""
+    _scar(profile)
+    area = float(profile.worn_area)
     cycles = per_cycle(results, ("amplitude", "slip_amplitude", "dissipated_energy"))
     if not np.isfinite(cycles["dissipated_energy"]).any():
         raise ValueError("results: no cycle has a dissipated energy ('dissipated_energy')")
@@ -478,3 +487,148 @@ def energy_wear(results, profile, length) -> xr.Dataset:
         for name, (value, se) in fit.items():
             _with_se(data, name, value, se)
     return xr.Dataset(data)
+
+
+def _reading(results, resolved):
+    """The last cycle with a GICoF, a kept loop and a reading along the stroke: its row of
+    ``results`` and of ``resolved``."""
+    (results,) = _tests(results)
+    if "loop_displacement" not in results or "gicof" not in results:
+        raise ValueError(
+            "results: no loops ('loop_displacement', 'loop_force') or no 'gicof': give "
+            "ecofmaps.analyze_loops(displacement, force, load, keep_loops=True)"
+        )
+    if not isinstance(resolved, xr.Dataset) or "felt_profile" not in resolved:
+        raise ValueError(
+            "resolved: no reading along the stroke ('slope', 'felt_profile' over 'position'): "
+            "give ecofmaps.resolve_loops(displacement, force, load, stiffness) of the same "
+            "recording (analyze_loops(..., resolve=True) keeps only its per-cycle values)"
+        )
+    read = resolved.cycle.values[np.isfinite(resolved.felt_profile).sum("position").values > 2]
+    found = results.cycle.values[np.isfinite(results.gicof.values)]
+    common = np.intersect1d(read, found)
+    if not common.size:
+        raise ValueError(
+            "results, resolved: no cycle has both a GICoF and a reading along the stroke "
+            "(see their 'quality'); are they of the same recording?"
+        )
+    return results.sel(cycle=common[-1]), resolved.sel(cycle=common[-1])
+
+
+def _branch_force(displacement, loop_displacement, loop_force):
+    """The force of the loop (Δ, Q) at ``displacement`` on the branch each point moves along
+    (rising or falling Δ, read from the order of the points)."""
+    top = int(np.nanargmax(loop_displacement))
+    rising = np.interp(displacement, loop_displacement[: top + 1], loop_force[: top + 1])
+    falling = np.interp(displacement, loop_displacement[top:][::-1], loop_force[top:][::-1])
+    step = np.diff(displacement, append=displacement[-1] + (displacement[-1] - displacement[-2]))
+    return np.where(step >= 0, rising, falling)
+
+
+@si_units(rig_stiffness="stiffness")
+def loop_scar_closure(results, resolved, profile, rig_stiffness=None) -> xr.Dataset:
+    r"""How well a test's last loop and its loops' felt groove close on the measured scar.
+
+    Parameters
+    ----------
+    results : xarray.Dataset
+        One test's results of :func:`ecofmaps.analyze_loops` with ``keep_loops=True``.
+    resolved : xarray.Dataset
+        The same recording read along the stroke, :func:`ecofmaps.resolve_loops`.
+    profile : ScarProfile
+        The scar's levelled profilometer trace (:func:`ecofmaps.read_scar_profile`), in
+        metres, centred on the scar, which is taken to lie under the loops' centre.
+    rig_stiffness : float, optional
+        The rig's stiffness :math:`S` for the model's loop; by default the stiffness the
+        reading along the stroke used (the loops' stick slope, unless given to it). [N/m]
+
+    Returns
+    -------
+    closure : xarray.Dataset
+        ``loop_residual``: root mean square of the measured loop's force less the model's
+        at the same displacement on the same branch, over :math:`Q^*` [1];
+        ``scar_residual`` [m] and ``scar_relative_residual`` (over the depth :math:`D`) [1]:
+        root mean square height of the implied scar less the profile's over the slip
+        range. The curves: ``loop_displacement``, ``loop_force`` (the measured loop, over
+        ``point``) [m], [N]; ``model_displacement``, ``model_force`` (over
+        ``model_point``) [m], [N]; ``implied_scar`` :math:`h(\xi)` and ``scar_height``
+        :math:`z(\xi)` over ``position`` :math:`\xi` [m]. Scalars ``cycle``, ``mu`` (the
+        GICoF) and ``stiffness`` [N/m].
+
+    Raises
+    ------
+    ValueError
+        For results without kept loops or a GICoF, a ``resolved`` that is not a reading
+        along the stroke, no cycle with both, a profile without a scar or in other units
+        than the loops (a half-width not within 0.1 to 10⁴ slip amplitudes, or a trace
+        that does not span the slip), or a ``rig_stiffness`` below half the loops' stick
+        slope (the rig and the contact in series are softer than the rig).
+
+    Notes
+    -----
+    The closure is read on the last cycle with a GICoF and a reading along the stroke.
+    The model's steady loop (:func:`ecofmaps.fretting_loop`, eq. 9-10 on the profile with
+    :math:`X = x`) has :math:`\mu` = that cycle's GICoF (eq. 17-18), its amplitude and
+    load. The implied scar is :math:`h(\xi) = \int g\,d\xi`, the slope read along the
+    stroke (``felt_profile``), shifted by the constant that best fits the profile: a
+    loop knows the groove's shape, not its height. See docs/lab.md.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 9, 10, 17-18, Fig. 10.
+    """
+    loop, reading = _reading(results, resolved)
+    _scar(profile)
+    slip, width = float(loop.slip_amplitude), float(profile.half_width)
+    trace = np.asarray(profile.position)
+    position = reading.position.values[np.isfinite(reading.felt_profile.values)]
+    if not 0.1 < width / slip < 1e4 or position[0] < trace[0] or position[-1] > trace[-1]:
+        raise ValueError(
+            f"profile: a scar {2 * width:.3g} m wide, traced from {trace[0]:.3g} to "
+            f"{trace[-1]:.3g} m, for loops that slip {2 * slip:.3g} m over "
+            f"{position[0]:.3g} to {position[-1]:.3g} m: give both in metres"
+        )
+    slope = float(loop.stiffness)
+    if rig_stiffness is None:
+        rig_stiffness = float(reading.stiffness)
+    check("rig_stiffness", rig_stiffness, "positive_or_inf", "N/m")
+    if rig_stiffness < slope / 2:
+        raise ValueError(
+            f"rig_stiffness = {rig_stiffness:.4g} N/m is below the loops' stick slope "
+            f"{slope:.4g} N/m, the rig and the contact in series: give it in N/m"
+        )
+    load = float(loop["normal_load" if "normal_load" in loop else "load"])
+    mu, peak = float(loop.gicof), float(loop.max_force)
+    model = fretting_loop(
+        float(loop.amplitude), load, rig_stiffness, mu, profile=profile, mapping="physical"
+    )
+    model_displacement, model_force = (np.asarray(v, dtype=np.float64) for v in model)
+    kept = np.isfinite(loop.loop_displacement.values) & np.isfinite(loop.loop_force.values)
+    displacement, force = loop.loop_displacement.values[kept], loop.loop_force.values[kept]
+    off = force - _branch_force(displacement, model_displacement, model_force)
+    implied = reading.felt_profile.values[np.isfinite(reading.felt_profile.values)]
+    height = np.interp(position, trace, np.asarray(profile.height))
+    implied = implied + np.mean(height - implied)
+    scar = float(np.sqrt(np.mean((implied - height) ** 2)))
+    attrs = nomenclature.attrs
+    data = {
+        "loop_residual": ((), float(np.sqrt(np.mean(off**2))) / peak, attrs("loop_residual")),
+        "scar_residual": ((), scar, attrs("scar_residual")),
+        "scar_relative_residual": (
+            (),
+            scar / float(profile.depth),
+            attrs("scar_relative_residual"),
+        ),
+        "mu": ((), mu, attrs("gicof")),
+        "stiffness": ((), float(rig_stiffness), attrs("stiffness")),
+        "loop_displacement": ("point", displacement, attrs("loop_displacement")),
+        "loop_force": ("point", force, attrs("loop_force")),
+        "model_displacement": ("model_point", model_displacement, attrs("displacement")),
+        "model_force": ("model_point", model_force, attrs("force")),
+        "implied_scar": ("position", implied, attrs("implied_scar")),
+        "scar_height": ("position", height, attrs("scar_height")),
+    }
+    coords = {"cycle": int(loop.cycle), "position": ("position", position, attrs("position"))}
+    return xr.Dataset(data, coords=coords)
