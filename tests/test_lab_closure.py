@@ -94,3 +94,18 @@ def test_bad_input(loops):
     unread["felt_profile"] = unread.felt_profile * np.nan
     with pytest.raises(ValueError, match=r"results, resolved: no cycle"):
         ecofmaps.loop_scar_closure(results, unread, _profile())
+
+
+def test_the_figure_draws_both_comparisons(loops):
+    pytest.importorskip("matplotlib")
+    from ecofmaps.figures import loop_scar_closure_figure
+
+    closure = ecofmaps.loop_scar_closure(*loops, _profile(), rig_stiffness=STIFFNESS)
+    loop, scar = loop_scar_closure_figure(closure).axes
+    assert loop.get_xlabel().endswith("[µm]") and loop.get_ylabel().endswith("[N]")
+    assert scar.get_xlabel().endswith("[µm]") and scar.get_ylabel().endswith("[µm]")
+    for ax in (loop, scar):
+        assert len(ax.get_legend().get_texts()) == len(ax.get_lines()) == 2
+    model = loop.get_lines()[1]
+    np.testing.assert_allclose(model.get_ydata(), closure.model_force)
+    np.testing.assert_allclose(scar.get_lines()[1].get_ydata(), closure.implied_scar * 1e6)

@@ -3,8 +3,9 @@
 The model's loops and curves (:mod:`~ecofmaps.figures.model_figures`), its maps
 (:mod:`~ecofmaps.figures.map_figures`), measured loops (:mod:`~ecofmaps.figures.measured_figures`),
 scar profiles (:mod:`~ecofmaps.figures.profile_figures`), a campaign's running-condition map
-(:mod:`~ecofmaps.figures.lab_figures`), the set ``ecofmaps figures`` writes
-(:mod:`~ecofmaps.figures.recipes`) and their shared look (:mod:`~ecofmaps.figures.style`).
+and a test's loop-scar closure (:mod:`~ecofmaps.figures.lab_figures`), the set
+``ecofmaps figures`` writes (:mod:`~ecofmaps.figures.recipes`) and their shared look
+(:mod:`~ecofmaps.figures.style`).
 The names are imported on first use: the registry of figures reads without matplotlib.
 """
 
@@ -18,7 +19,7 @@ _PUBLIC = {
         "measured_loops",
         "resolved_loops",
     ),
-    "ecofmaps.figures.lab_figures": ("running_condition_map",),
+    "ecofmaps.figures.lab_figures": ("loop_scar_closure_figure", "running_condition_map"),
     "ecofmaps.figures.map_figures": ("ecof_ratio_contours", "universal_ecof_ratio_map"),
     "ecofmaps.figures.model_figures": (
         "dissipated_energy_curves",

@@ -1,4 +1,5 @@
-"""The campaign figure of a fretting lab: the running-condition fretting map (docs/lab.md)."""
+"""A fretting lab's figures: a campaign's running-condition fretting map, and a test's
+loop-scar closure (docs/lab.md)."""
 
 from __future__ import annotations
 
@@ -6,10 +7,17 @@ import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
 
-from ecofmaps.figures.style import FIGSIZE, MICRO, axis_label, parameters, stiffness_label
+from ecofmaps.figures.style import (
+    FIGSIZE,
+    MICRO,
+    axis_label,
+    number_text,
+    parameters,
+    stiffness_label,
+)
 from ecofmaps.lab import per_cycle, sliding_condition
 
-__all__ = ["running_condition_map"]
+__all__ = ["loop_scar_closure_figure", "running_condition_map"]
 
 #: How each sliding condition is marked on the running-condition map: marker, face colour.
 _CONDITION_MARKERS = {
@@ -82,4 +90,75 @@ def running_condition_map(results, transition: xr.Dataset, rig_stiffness: float)
         ),
         fontsize="medium",
     )
+    return figure
+
+
+def loop_scar_closure_figure(closure: xr.Dataset) -> Figure:
+    r"""The loop-scar closure of a test: its last loop and its scar against the model's.
+
+    Parameters
+    ----------
+    closure : xarray.Dataset
+        From :func:`ecofmaps.loop_scar_closure`.
+
+    Returns
+    -------
+    figure : matplotlib.figure.Figure
+        (a) The measured loop and the model's steady loop on the measured profile
+        (:math:`\mu` = the GICoF), force :math:`Q` [N] against the applied displacement
+        :math:`\Delta` [µm]; (b) the profilometer's profile and the scar the loops imply,
+        :math:`\int g\,d\xi`, height [µm] across the scar [µm] over the slip range. Each
+        panel's title gives its root mean square residual.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: Fig. 10.
+    """
+    figure = Figure(figsize=(2 * FIGSIZE[0], FIGSIZE[1]), layout="constrained")
+    loop, scar = figure.subplots(1, 2)
+    loop.plot(
+        closure.loop_displacement * MICRO,
+        closure.loop_force,
+        color="0.55",
+        linewidth=2.5,
+        label=f"measured, cycle {int(closure.cycle)}",
+    )
+    loop.plot(
+        closure.model_displacement * MICRO,
+        closure.model_force,
+        color="tab:red",
+        linewidth=1.2,
+        label=rf"model on the profile, $\mu$ = GICoF = {float(closure.mu):.3g}",
+    )
+    loop.set_xlabel(axis_label("displacement"))
+    loop.set_ylabel(axis_label("force"))
+    loop.set_title(
+        parameters(
+            f"RMS force off the model {number_text(100 * float(closure.loop_residual), 2)} % of Q*",
+            stiffness_label(float(closure.stiffness)),
+        ),
+        fontsize="medium",
+    )
+    position = closure.position * MICRO
+    scar.plot(position, closure.scar_height * MICRO, color="0.55", linewidth=2.5, label="profile")
+    scar.plot(
+        position,
+        closure.implied_scar * MICRO,
+        color="tab:red",
+        linewidth=1.2,
+        label=r"implied by the loops, $\int g\,d\xi$",
+    )
+    scar.set_xlabel(axis_label("scar_position"))
+    scar.set_ylabel(axis_label("scar_height"))
+    scar.set_title(
+        f"RMS height off the profile {number_text(float(closure.scar_residual) * MICRO, 2)} µm"
+        f" ({number_text(100 * float(closure.scar_relative_residual), 2)} % of the depth)",
+        fontsize="medium",
+    )
+    for ax in (loop, scar):
+        ax.grid(alpha=0.3)
+        ax.legend(loc="best", fontsize="small")
+    figure.suptitle("Loop-scar closure")
     return figure
