@@ -75,6 +75,7 @@ RECIPES = {
     "sliding_condition": None,  # reads a Dataset of results
     "transition": None,
     "energy_wear": None,
+    "loop_scar_closure": None,
 }  # fmt: skip
 
 
