@@ -1,4 +1,5 @@
-"""What the subcommands share: quantities read with units, user errors, printed tables."""
+"""What the subcommands share: quantities and counts read with units, the options that find a
+recording's columns, the one rule for writing outputs, printed rows and sizes."""
 
 from __future__ import annotations
 
@@ -16,6 +17,9 @@ from ecofmaps.units import DIMENSIONS, parse_quantity, parse_values
 
 __all__ = [
     "CommandError",
+    "add_recording_options",
+    "byte_size",
+    "count",
     "print_rows",
     "quantities",
     "quantity",
@@ -91,8 +95,8 @@ def unit(kind: str):
 
     def parse(text: str) -> str:
         if not text.strip():
-            raise argparse.ArgumentTypeError(f"an empty unit; give a {kind} unit such as "
-                                             f"{DIMENSIONS[kind][1]}")  # fmt: skip
+            example = DIMENSIONS[kind][1]
+            raise argparse.ArgumentTypeError(f"an empty unit; give a {kind} unit such as {example}")
         try:
             scale = parse_quantity(f"1 {text}", kind)
         except ValueError as error:
@@ -106,6 +110,70 @@ def unit(kind: str):
 
     parse.__name__ = f"{kind} unit"
     return parse
+
+
+def count(what: str):
+    """An argparse ``type`` reading a whole number of ``what`` >= 1 (``4194304``, ``4e6``)."""
+
+    def parse(text: str) -> int:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not (math.isfinite(value) and value.is_integer() and value >= 1):
+            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of {what} >= 1")
+        return int(value)
+
+    parse.__name__ = what
+    return parse
+
+
+def add_recording_options(parser) -> None:
+    """The options that say where a recording's columns are and in which units."""
+    for option, default, help in (
+        (
+            "--displacement-col",
+            "displacement",
+            "name of the displacement column (default: displacement)",
+        ),
+        ("--force-col", "force", "name of the tangential force column (default: force)"),
+        (
+            "--cycle-col",
+            None,
+            "name of a column of cycle numbers, which must exist (default: 'cycle' if the file "
+            "has it; else cycles are cut at the reversals)",
+        ),
+    ):
+        parser.add_argument(option, default=default, metavar="NAME", help=help)
+    parser.add_argument(
+        "--skip-rows",
+        type=int,
+        default=None,
+        metavar="N",
+        help="lines of a text file to skip before its header line (default: metadata lines "
+        "before the header are found)",
+    )
+    parser.add_argument(
+        "--displacement-unit",
+        type=unit("length"),
+        default=None,
+        metavar="UNIT",
+        help="unit of the displacement column (default: the one its name or the file gives, as "
+        "in 'displacement [mm]' or a channel's unit, else um)",
+    )
+    parser.add_argument(
+        "--force-unit",
+        type=unit("force"),
+        default=None,
+        metavar="UNIT",
+        help="unit of the force column (default: from its name or the file, else N)",
+    )
+    parser.add_argument(
+        "--group",
+        default=None,
+        metavar="NAME",
+        help="TDMS group, or HDF5/netCDF/zarr group, holding the channels (default: any)",
+    )
 
 
 def recording_options(args) -> dict:
@@ -204,3 +272,9 @@ def print_rows(title: str, rows) -> None:
     print(title)
     for item in rows:
         print("" if item is None else f"  {item[0]:<32} {item[1]:<8} {item[2]}".rstrip())
+
+
+def byte_size(size: float) -> str:
+    """``size`` [byte] in words: ``'88 TB'``, ``'512 kB'``, ``'12 B'`` (decimal units)."""
+    power = min(int(math.log10(max(size, 1)) // 3), 5)
+    return f"{size / 1000**power:.3g} {('B', 'kB', 'MB', 'GB', 'TB', 'PB')[power]}"

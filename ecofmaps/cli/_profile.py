@@ -31,9 +31,15 @@ __all__ = [
 
 #: The reading options (argparse destinations) that need ``--scar-profile``.
 PROFILE_OPTIONS = (
-    "x_column", "z_column", "x_unit", "z_unit", "no_level", "profile_half_width", "smoothing",
+    "x_column",
+    "z_column",
+    "x_unit",
+    "z_unit",
+    "no_level",
+    "profile_half_width",
+    "smoothing",
     "mapping",
-)  # fmt: skip
+)
 _DEFAULTS = {"x_column": "x", "z_column": "z", "no_level": False, "mapping": "scaled"}
 
 
@@ -46,43 +52,65 @@ def add_profile_options(parser: argparse.ArgumentParser) -> None:
         "the parabolic groove of eq. 11",
     )
     group.add_argument(
-        "--scar-profile", metavar="FILE", default=None,
+        "--scar-profile",
+        metavar="FILE",
+        default=None,
         help="the scar's profile (CSV, TSV or whitespace-separated text)",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--x-column", default=None, metavar="NAME",
+        "--x-column",
+        default=None,
+        metavar="NAME",
         help="name of the position column (default: x)",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--z-column", default=None, metavar="NAME",
+        "--z-column",
+        default=None,
+        metavar="NAME",
         help="name of the height column (default: z)",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--x-unit", type=unit("length"), default=None, metavar="UNIT",
+        "--x-unit",
+        type=unit("length"),
+        default=None,
+        metavar="UNIT",
         help="unit of the positions (default: the one the column's name gives, else um)",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--z-unit", type=unit("length"), default=None, metavar="UNIT",
+        "--z-unit",
+        type=unit("length"),
+        default=None,
+        metavar="UNIT",
         help="unit of the heights (default: the one the column's name gives, else um)",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--no-level", action="store_true", default=None,
+        "--no-level",
+        action="store_true",
+        default=None,
         help="keep the trace's tilt and offset (default: level it on the unworn shoulders)",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--profile-half-width", type=quantity("scar_half_width"), default=None, metavar="W",
+        "--profile-half-width",
+        type=quantity("scar_half_width"),
+        default=None,
+        metavar="W",
         help="the scar's half-width W, e.g. 500um (default: the one detected at the edges)",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--smoothing", type=quantity("smoothing"), default=None, metavar="LENGTH",
+        "--smoothing",
+        type=quantity("smoothing"),
+        default=None,
+        metavar="LENGTH",
         help="length over which the slopes are smoothed, e.g. 10um; 0 for none "
         "(default: 2%% of the half-width)",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--mapping", choices=("scaled", "physical"), default=None,
+        "--mapping",
+        choices=("scaled", "physical"),
+        default=None,
         help="where the pad at slip position x sits on the profile: 'scaled', X = x W/x_o "
         "(eq. 11, the paper's; default), or 'physical', X = x",
-    )  # fmt: skip
+    )
     parser.set_defaults(profile_command=parser.prog)
 
 
@@ -149,10 +177,14 @@ def read_profile(args, conflicting=()):
         alternative = item.message.alternative
         if alternative is not None:
             args.profile_alternative = item.message.alternative_name
-        hint = "" if alternative is None else (
-            f"; --profile-half-width {alternative * 1e6:.6g}um takes the "
-            f"{item.message.alternative_name}"
-        )  # fmt: skip
+        hint = (
+            ""
+            if alternative is None
+            else (
+                f"; --profile-half-width {alternative * 1e6:.6g}um takes the "
+                f"{item.message.alternative_name}"
+            )
+        )
         print(f"{args.profile_command}: warning: {item.message.summary}{hint}", file=sys.stderr)
     return profile
 

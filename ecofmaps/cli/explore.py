@@ -40,13 +40,15 @@ def add(subparsers) -> None:
         ),
     )
     parser.add_argument(
-        "--port", type=_port, default=DEFAULT_PORT, metavar="N",
+        "--port",
+        type=_port,
+        default=DEFAULT_PORT,
+        metavar="N",
         help=f"the port to listen on (default {DEFAULT_PORT})",
-    )  # fmt: skip
+    )
     parser.add_argument(
         "--no-browser", action="store_true", help="do not open the page in a browser"
     )
-    parser.set_defaults(handler=run)
 
 
 def run(args) -> int:

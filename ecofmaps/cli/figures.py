@@ -99,28 +99,39 @@ def add(subparsers) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
-        "--out", default="figures", metavar="DIR",
+        "--out",
+        default="figures",
+        metavar="DIR",
         help="directory to write into, created if missing (default: figures)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--only", nargs="+", choices=list(FIGURES), metavar="NAME",
+        "--only",
+        nargs="+",
+        choices=list(FIGURES),
+        metavar="NAME",
         help=f"write only these figures; NAME is one of: {', '.join(FIGURES)}",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--format", type=figure_formats, default=("png",), metavar="FORMATS",
+        "--format",
+        type=figure_formats,
+        default=("png",),
+        metavar="FORMATS",
         help="comma-separated file formats among png, pdf, svg (default: png)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--overwrite", action="store_true",
+        "--overwrite",
+        action="store_true",
         help="replace the figures ecofmaps wrote in DIR before (a DIR that is not empty needs "
         "it); files ecofmaps did not write are never replaced",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--jobs", type=_jobs, default=None, metavar="N",
+        "--jobs",
+        type=_jobs,
+        default=None,
+        metavar="N",
         help="processes drawing at once (default: one per core, at most one per group of "
         "figures sharing their numbers; 1: all in this process)",
-    )  # fmt: skip
-    parser.set_defaults(handler=run)
+    )
 
 
 def _jax_cache_options(directory) -> dict:
@@ -261,10 +272,12 @@ class TaskQueue:
     def __init__(self, groups, parts, jobs: int):
         self.groups = groups
         self.missing = [len(group_parts) for group_parts in parts]
-        self.ready = deque(("part", index, part) for index, group in enumerate(parts)
-                           for part in group)  # fmt: skip
-        self.ready.extend(("group", index, group) for index, group in enumerate(groups)
-                          if not self.missing[index])  # fmt: skip
+        self.ready = deque(
+            ("part", index, part) for index, group in enumerate(parts) for part in group
+        )
+        self.ready.extend(
+            ("group", index, group) for index, group in enumerate(groups) if not self.missing[index]
+        )
         self.jobs = jobs
         self.running = 0
 
@@ -304,8 +317,10 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
     queue = TaskQueue(groups, parts, jobs)
 
     def submitted(tasks) -> dict:
-        calls = {"part": lambda part: (_worker_part, part),
-                 "group": lambda group: (_worker_group, group, out, formats)}  # fmt: skip
+        calls = {
+            "part": lambda part: (_worker_part, part),
+            "group": lambda group: (_worker_group, group, out, formats),
+        }
         return {executor.submit(*calls[task[0]](task[2])): task for task in tasks}
 
     try:

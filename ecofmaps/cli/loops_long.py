@@ -43,7 +43,7 @@ from ecofmaps.measured.cycles import Cycles
 from ecofmaps.measured.options import MissingSampleError, default_options
 from ecofmaps.measured.pipeline import IN_PROCESS, Analysis, force_at_mean_load, only
 
-__all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun", "keep_block", "skipped"]
+__all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun", "keep_block"]
 
 #: The message for a missing sample with ``--nan-policy raise`` (the file and line before it).
 MISSING = (
@@ -252,9 +252,18 @@ class LongRun:
                         add_stop_note(self.stop_note)  # asked when the line is written
                     partial = self.partial
                 analysis, parts, resolved = _analyse(
-                    index, path, recording, load, self.args, runner, partial, many,
-                    write, columns, reading,
-                )  # fmt: skip
+                    index,
+                    path,
+                    recording,
+                    load,
+                    self.args,
+                    runner,
+                    partial,
+                    many,
+                    write,
+                    columns,
+                    reading,
+                )
         except KeyboardInterrupt as stop:  # counted once the runner is closed: no task runs
             if isinstance(stop, _Interrupted):
                 self.analysed = (index, path, stop.blocks)
@@ -294,17 +303,6 @@ class LongRun:
         if self.partial is not None:
             self.partial.remove()
             self.partial = None
-
-
-def skipped(results, recording) -> str:
-    """For a file's summary line: the cycles skipped for missing samples, and where the
-    first missing sample is (``''`` if none)."""
-    count = results.attrs.get("skipped_cycles", 0)
-    if not count:
-        return ""
-    first = recording.position(results.attrs["first_missing_sample"])
-    where = f"line {first}" if isinstance(first, int) else first
-    return f"; {count} skipped for missing samples (the first at {where})"
 
 
 def _analyse(index, path, recording, load, args, runner, partial, many, write, columns, reading):
@@ -396,7 +394,12 @@ def _bar(analysis, path, shown: bool, initial: int):
     from tqdm import tqdm
 
     return tqdm(
-        total=int(analysis.cycles.label.size), initial=initial, unit=" cycles",
-        desc=path.name, file=sys.stderr, disable=not shown, dynamic_ncols=True,
+        total=int(analysis.cycles.label.size),
+        initial=initial,
+        unit=" cycles",
+        desc=path.name,
+        file=sys.stderr,
+        disable=not shown,
+        dynamic_ncols=True,
         smoothing=0.1,
-    )  # fmt: skip
+    )

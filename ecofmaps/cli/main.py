@@ -1,13 +1,10 @@
 """The ``ecofmaps`` command: its parser, and the run of one subcommand.
 
-Each subcommand is a module of :mod:`ecofmaps.cli` with ``add(subparsers)``, which declares
-its options, and the handler that does the work, ``run(args)``: a function, or the name of
-one, ``"ecofmaps.cli.loops_run:run"``, whose module is imported only when the subcommand
-runs (the one place the command line defers its imports, so ``ecofmaps --help`` starts
-fast and the work's modules import what they use at the top). The handler works through the
-public API. Quantities are read with units (``50um``, ``35MN/m``); a bare number is SI.
-Errors in the input end the command with exit status 2 and a one-line message, never a
-traceback.
+Each subcommand is one module of :mod:`ecofmaps.cli` with ``add(subparsers)``, which declares
+its options, and ``run(args)``, which does the work through the public API and imports JAX,
+xarray, numba, dask and matplotlib only then, so that ``--help`` answers at once. Quantities
+are read with units (``50um``, ``35MN/m``); a bare number is SI. Errors in the input end the
+command with exit status 2 and a one-line message, never a traceback.
 """
 
 from __future__ import annotations
@@ -73,7 +70,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"ecofmaps {__version__}")
     subparsers = parser.add_subparsers(title="commands", metavar="COMMAND", required=True)
     for name in _SUBCOMMANDS:
-        importlib.import_module(f"ecofmaps.cli.{name}").add(subparsers)
+        module = importlib.import_module(f"ecofmaps.cli.{name}")
+        module.add(subparsers)
+        subparsers.choices[name].set_defaults(handler=module.run)
     for command in subparsers.choices.values():  # for an unknown argument's error
         options = [o for action in command._actions for o in action.option_strings]
         command.set_defaults(command_prog=command.prog, command_options=options)
@@ -127,7 +126,7 @@ def main(argv=None) -> int:
             except SystemExit as stop:  # a usage error (printed), --help or --version
                 status = int(stop.code or 0)
                 return status
-            status = handler(args.handler)(args)
+            status = args.handler(args)
             return status
     except KeyboardInterrupt as stop:
         if status is not None:  # the signal came after the work was done, when leaving
@@ -163,14 +162,6 @@ def _stopped(interrupted, note) -> int:
         note = interrupted.note()
     note = note or "no output was left half written"
     return _report(EXIT_TERMINATED if terminated else EXIT_INTERRUPTED, f"{words}; {note}")
-
-
-def handler(spec):
-    """The handler a subcommand set: a callable, or ``"module:function"`` imported now."""
-    if callable(spec):
-        return spec
-    module, _, name = spec.partition(":")
-    return getattr(importlib.import_module(module), name)
 
 
 def _ignored_after_main() -> list:

@@ -154,7 +154,7 @@ def test_a_grid_too_large_for_memory_is_refused_before_allocating(tmp_path, caps
 
 
 def test_an_unexpected_failure_is_one_line_with_status_1(capsys, monkeypatch):
-    from ecofmaps.cli import model_run as model
+    from ecofmaps.cli import model
 
     def broken(args):
         raise KeyError("a bug")

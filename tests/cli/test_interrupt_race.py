@@ -17,7 +17,8 @@ import sys
 import pytest
 
 from ecofmaps._interrupts import INTERRUPTED, Interrupted, add_stop_note
-from ecofmaps.cli import loops_long, loops_run
+from ecofmaps.cli import loops_long
+from ecofmaps.cli import loops as loops_run
 from ecofmaps.io.files import MANIFEST
 from ecofmaps.measured.long_test import write_long_recording
 from tests.cli.test_loops import run

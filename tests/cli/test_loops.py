@@ -287,7 +287,7 @@ def test_the_summary_reads_the_gross_slip_cycles_only():
     slip (its regime code), with the cycles without a value left out."""
     from pathlib import Path
 
-    from ecofmaps.cli.loops_run import _summary
+    from ecofmaps.cli.loops import _summary
     from ecofmaps.model.regimes import GROSS_SLIP, NO_GROSS_SLIP
 
     gross, stuck = int(GROSS_SLIP), int(NO_GROSS_SLIP)

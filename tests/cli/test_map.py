@@ -270,7 +270,7 @@ def test_map_replaces_a_store_it_wrote_and_refuses_other_directories(tmp_path, c
 
 def test_map_states_its_size_and_refuses_one_the_disk_cannot_hold(tmp_path, capsys, monkeypatch):
     """2e12 points (tens of TB) against the free space of --out's folder: refused at once."""
-    from ecofmaps.cli import map_run as command
+    from ecofmaps.cli import map as command
 
     free = 10**12
     usage = types.SimpleNamespace(total=2 * free, used=free, free=free)

@@ -13,7 +13,7 @@ from bokeh.models import Div
 
 import ecofmaps
 from ecofmaps import cli
-from ecofmaps.cli import loops_run
+from ecofmaps.cli import loops as loops_run
 from ecofmaps.io.tables import results_csv
 from ecofmaps.measured.quality import REASONS, LoopQualityWarning
 from ecofmaps.web import report
