@@ -21,7 +21,6 @@ __all__ = [
     "byte_size",
     "count",
     "print_rows",
-    "quantities",
     "quantity",
     "recording_options",
     "refuse_to_overwrite",
@@ -41,46 +40,25 @@ def _in_range(name: str, values: np.ndarray, text: str) -> None:
     raise ValueError(f"{text!r} is out of range: the {described.words} must satisfy {valid}{unit}")
 
 
-def quantity(name: str):
-    """An argparse ``type`` reading one value of quantity ``name`` with units, range-checked.
-
-    The dimension and the valid range are quantity ``name``'s in the nomenclature, so a bad
-    value is reported by argparse with the option the user typed.
-    """
-    kind = QUANTITIES[name].kind
-
-    def parse(text: str) -> float:
-        try:
-            value = parse_quantity(text, kind)
-            _in_range(name, np.asarray(value), text)
-        except ValueError as error:
-            raise argparse.ArgumentTypeError(str(error)) from None
-        return value
-
-    parse.__name__ = kind
-    return parse
-
-
-def quantities(name: str):
-    """An argparse ``type`` reading a list ``a,b,c`` or a range ``start:stop:num`` of ``name``.
-
-    Every value must be in quantity ``name``'s range, and no value may repeat (a grid axis).
-    """
+def quantity(name: str, grid: bool = False):
+    """An argparse ``type`` reading a value of quantity ``name`` with units (with ``grid``, a
+    list ``a,b,c`` or a range ``start:stop:num`` of values that do not repeat), checked against
+    its dimension and valid range in the nomenclature (argparse names the option)."""
     kind = QUANTITIES[name].kind
 
     def parse(text: str):
         try:
-            values = parse_values(text, kind)
-            _in_range(name, values, text)
+            value = parse_values(text, kind) if grid else parse_quantity(text, kind)
+            _in_range(name, np.asarray(value), text)
         except ValueError as error:
             raise argparse.ArgumentTypeError(str(error)) from None
-        unique, counts = np.unique(values, return_counts=True)
+        unique, counts = np.unique(value, return_counts=True)
         if np.any(counts > 1):
             raise argparse.ArgumentTypeError(
                 f"{text!r} repeats the value {unique[counts > 1][0]:g}: a grid axis takes "
                 "each value once"
             )
-        return values
+        return value
 
     parse.__name__ = kind
     return parse
@@ -148,7 +126,6 @@ def add_recording_options(parser) -> None:
     parser.add_argument(
         "--skip-rows",
         type=int,
-        default=None,
         metavar="N",
         help="lines of a text file to skip before its header line (default: metadata lines "
         "before the header are found)",
@@ -156,7 +133,6 @@ def add_recording_options(parser) -> None:
     parser.add_argument(
         "--displacement-unit",
         type=unit("length"),
-        default=None,
         metavar="UNIT",
         help="unit of the displacement column (default: the one its name or the file gives, as "
         "in 'displacement [mm]' or a channel's unit, else um)",
@@ -164,13 +140,11 @@ def add_recording_options(parser) -> None:
     parser.add_argument(
         "--force-unit",
         type=unit("force"),
-        default=None,
         metavar="UNIT",
         help="unit of the force column (default: from its name or the file, else N)",
     )
     parser.add_argument(
         "--group",
-        default=None,
         metavar="NAME",
         help="TDMS group, or HDF5/netCDF/zarr group, holding the channels (default: any)",
     )
@@ -199,19 +173,8 @@ def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=())
     not a store ecofmaps wrote, are never replaced. A folder the command writes files into
     (``--plots``, ``figures --out``) may exist empty; one that holds anything needs
     ``--overwrite``, and then only ecofmaps' own files in it are replaced, the others kept.
-    Everything is checked before any work.
-
-    Parameters
-    ----------
-    outputs : iterable of (str, path-like)
-        Each output file or store as (the option that names it, its path); a None path is
-        skipped.
-    inputs : iterable of path-like
-        The files the command reads.
-    overwrite : bool
-        Whether ``--overwrite`` was given.
-    folders : iterable of (str, path-like)
-        Each folder written into as (its option, its path); None is skipped.
+    Everything is checked before any work. ``outputs`` and ``folders`` are (the option that
+    names it, its path or None); ``inputs`` the files the command reads.
     """
     outputs = [(option, Path(path)) for option, path in outputs if path is not None]
     sources = [Path(path) for path in inputs]

@@ -30,7 +30,6 @@ def add(subparsers) -> None:
         action = actions.add_parser(name, help=text, description=text + ".")
         action.add_argument(
             "--cache-dir",
-            default=None,
             metavar="DIR",
             help="cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)",
         )

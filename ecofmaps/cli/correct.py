@@ -52,7 +52,6 @@ def add(subparsers) -> None:
     parser.add_argument(
         "--out",
         metavar="OUT",
-        default=None,
         help="write the corrected table here (the table's separator; default: standard output)",
     )
     parser.add_argument(

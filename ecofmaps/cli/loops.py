@@ -76,20 +76,17 @@ def add(subparsers) -> None:
     parser.add_argument(
         "--load",
         type=_load_or_column,
-        default=None,
         metavar="P",
         help="normal load P, e.g. 450N; or the name of the recording's normal-load column "
         "(e.g. Fz), used sample by sample (required unless --example)",
     )
     parser.add_argument(
         "--out",
-        default=None,
         metavar="FILE.csv",
         help="CSV file to write (its directory must exist); default: print the table",
     )
     parser.add_argument(
         "--plots",
-        default=None,
         metavar="DIR",
         help="also write, per file, its loops with the line Q = SΔ (<name>_loops.png), "
         "the ECoF and GICoF over the cycles (<name>_evolution.png) and the loops read along "
@@ -103,14 +100,12 @@ def add(subparsers) -> None:
     )
     parser.add_argument(
         "--resolved",
-        default=None,
         metavar="FILE.nc",
         help="also write the loops read along the stroke (one FILE): μ(ξ), the groove slope "
         "g(ξ) and the felt profile h(ξ) over (cycle, position), a netCDF file",
     )
     parser.add_argument(
         "--report",
-        default=None,
         metavar="FILE.html",
         help="also write the results of one recording as one HTML page that opens offline: "
         "the friction over the cycles with the quality flags, picked loops with the model's, "
@@ -156,13 +151,11 @@ def _add_long_options(parser) -> None:
     group.add_argument(
         "--workers",
         type=_workers,
-        default=None,
         metavar="N",
         help="analyse out of core on a local dask cluster of N processes",
     )
     group.add_argument(
         "--scheduler",
-        default=None,
         metavar="ADDRESS",
         help="analyse out of core on the dask cluster at ADDRESS (tcp://host:8786); its "
         "workers must have ecofmaps and see the files at the same paths",

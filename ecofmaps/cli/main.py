@@ -104,16 +104,10 @@ EXIT_TERMINATED = 143
 def main(argv=None) -> int:
     """Run the ``ecofmaps`` command; return its exit status.
 
-    0 on success; 2 for a user error (bad option, bad file: one line naming it); 130 when
-    interrupted by Ctrl-C and 143 by SIGTERM, with one line that tells what was left: files
-    are written atomically, so nothing is left half written, and what a subcommand keeps to
-    go on from (``ecofmaps loops``' resume folder) is named with how to go on, as it is when
-    the line is written (:func:`ecofmaps._interrupts.add_stop_note`); 1 for an unexpected
-    failure (one line; ``ECOFMAPS_DEBUG=1`` shows the traceback).
-
-    A signal that comes once the subcommand has done its work (its output written in full,
-    its lines printed) stops nothing: the command ends as it would have without it, with
-    the subcommand's status (0 on success) and no further line.
+    0 on success; 2 for a user error (one line naming it); 130 after Ctrl-C and 143 after
+    SIGTERM, with one line telling what was left (:func:`ecofmaps._interrupts.add_stop_note`:
+    files are written atomically); 1 for an unexpected failure (``ECOFMAPS_DEBUG=1`` shows the
+    traceback). A signal once the subcommand's work is done stops nothing.
     """
     interrupted = status = None
     try:  # the subcommands import JAX and xarray: an interrupt may come during the imports
@@ -149,13 +143,9 @@ def main(argv=None) -> int:
 
 
 def _stopped(interrupted, note) -> int:
-    """Report a run stopped by Ctrl-C or SIGTERM in one line; return 130 or 143.
-
-    What the line says was left is asked now of the notes the subcommand gave
-    (:meth:`ecofmaps._interrupts.Stop.note`), if it gave any, rather than taken from
-    ``note`` (the stop's own, told when it was raised): everything the stop interrupted has
-    unwound by now, so nothing lands after the line is written.
-    """
+    """Report a run stopped by Ctrl-C or SIGTERM in one line; return 130 or 143. What was
+    left is asked now of the subcommand's notes, if any, rather than taken from the stop's
+    ``note``: everything the stop interrupted has unwound by now."""
     terminated = interrupted is not None and interrupted.signal == signal.SIGTERM
     words = "terminated (SIGTERM)" if terminated else "interrupted"
     if interrupted is not None and interrupted.notes:
@@ -188,17 +178,11 @@ def _report(status: int, message: str) -> int:
 def console() -> None:
     """The ``ecofmaps`` console script: run :func:`main` and exit with its status.
 
-    After Ctrl-C or SIGTERM the process ends at once (``os._exit``) once its messages are flushed:
-    JAX's worker threads may still be busy with the interrupted computation, and tearing
-    the interpreter down around them can crash it. Files were already cleaned up, since
-    every file is written through a temporary that the interrupt removed. The objects the
-    interrupted run left are collected first, so that their finalizers release what they
-    hold (the semaphores of a process pool, which multiprocessing's resource tracker would
-    otherwise report as leaked, a second line on standard error).
-
-    Once :func:`main` has returned, Ctrl-C and SIGTERM are ignored: the run's work is done
-    and its line (if any) written, and a signal killing the interpreter as it exits would
-    turn a complete run into exit status 143 with no line (or a traceback after Ctrl-C).
+    After Ctrl-C or SIGTERM the process ends at once (``os._exit``) once its messages are
+    flushed and the interrupted run's objects collected (their finalizers release a process
+    pool's semaphores): JAX's threads may still be busy, and tearing the interpreter down
+    around them can crash it. Once :func:`main` has returned, Ctrl-C and SIGTERM are ignored,
+    so that a signal as the interpreter exits does not turn a complete run into status 143.
     """
     after = _ignored_after_main()
     status = main()

@@ -22,13 +22,12 @@ from ecofmaps.cli._common import (
     CommandError,
     byte_size,
     count,
-    quantities,
     quantity,
     refuse_to_overwrite,
 )
 from ecofmaps.io.files import record_written
 
-__all__ = ["add", "map_bytes", "run"]
+__all__ = ["add", "run"]
 
 _GRID_HELP = "; one value, a list or a range start:stop:num"
 #: Default of --chunk-points: blocks of 2**22 points (about 220 MB of results with a load).
@@ -71,28 +70,28 @@ def add(subparsers) -> None:
     )
     parser.add_argument(
         "--stiffness-ratio",
-        type=quantities("stiffness_ratio"),
+        type=quantity("stiffness_ratio", grid=True),
         required=True,
         metavar="S/P",
         help="rig stiffness over normal load S/P [1/m], 'inf' for a rigid rig" + _GRID_HELP,
     )
     parser.add_argument(
         "--aspect-ratio",
-        type=quantities("aspect_ratio"),
+        type=quantity("aspect_ratio", grid=True),
         required=True,
         metavar="Z/X",
         help="groove depth over half-width z_o/x_o (>= 0)" + _GRID_HELP,
     )
     parser.add_argument(
         "--amplitude",
-        type=quantities("amplitude"),
+        type=quantity("amplitude", grid=True),
         required=True,
         metavar="DELTA",
         help="displacement amplitude Δ* [m], e.g. 25um,50um" + _GRID_HELP,
     )
     parser.add_argument(
         "--mu",
-        type=quantities("mu"),
+        type=quantity("mu", grid=True),
         required=True,
         metavar="MU",
         help="contact coefficient of friction μ (> 0)" + _GRID_HELP,
@@ -100,7 +99,6 @@ def add(subparsers) -> None:
     parser.add_argument(
         "--load",
         type=quantity("load"),
-        default=None,
         metavar="P",
         help="normal load P [N], one value; adds dissipated_energy [J] and max_force [N]",
     )
@@ -137,7 +135,6 @@ def add(subparsers) -> None:
     )
     parser.add_argument(
         "--cache-dir",
-        default=None,
         metavar="DIR",
         help="cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)",
     )
@@ -162,7 +159,7 @@ def run(args) -> int:
         )
     }
     points = math.prod(values.size for values in grid.values() if np.ndim(values))
-    size = map_bytes(grid, args.load)
+    size = _map_bytes(grid, args.load)
     free = shutil.disk_usage(out.parent).free
     print(
         f"ecofmaps map: {points:,} points, {byte_size(size)} into {out} "
@@ -186,26 +183,10 @@ def run(args) -> int:
     return _write(dataset, out, shown=chunked and not args.quiet and sys.stderr.isatty())
 
 
-def map_bytes(grid: dict, load) -> int:
-    """Bytes of the map of ``grid`` with its coordinates, uncompressed, before computing it.
-
-    The variables' types and dimensions come from the map of at most two values along
-    each axis of ``grid``, chunked (its blocks are not computed).
-
-    Parameters
-    ----------
-    grid : dict
-        ``compute_map``'s keywords ``stiffness_ratio``, ``aspect_ratio``, ``amplitude``,
-        ``mu``: each a value [SI] or a 1-D array of values.
-    load : float or None
-        Normal load. [N]
-
-    Returns
-    -------
-    size : int
-        The map's size in memory, and at most on disk (netCDF and zarr may compress it).
-        [byte]
-    """
+def _map_bytes(grid: dict, load) -> int:
+    """Bytes [byte] of the map of ``grid`` (``compute_map``'s grid keywords) with its
+    coordinates, uncompressed, before computing it: the variables' types and dimensions come
+    from the map of at most two values along each axis, chunked (nothing computed)."""
     from ecofmaps.maps.grid import compute_map
 
     small = {name: values[:2] if np.ndim(values) else values for name, values in grid.items()}

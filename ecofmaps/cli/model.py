@@ -59,13 +59,11 @@ def add(subparsers) -> None:
     parser.add_argument(
         "--aspect-ratio",
         type=quantity("aspect_ratio"),
-        default=None,
         help="groove depth over half-width z_o/x_o of the parabolic groove (default 0.2)",
     )
     parser.add_argument(
         "--groove-half-width",
         type=quantity("groove_half_width"),
-        default=None,
         help="groove half-width x_o (default: the amplitude, as in the paper); with a "
         "profile, the x_o of the mapping X = x W/x_o",
     )
