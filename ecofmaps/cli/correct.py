@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+import warnings
 from pathlib import Path
 
 from ecofmaps._version import __version__
@@ -38,9 +39,11 @@ def add(subparsers) -> None:
             "column and adds mu and correction_factor. With "
             "--scar-profile FILE a measured wear-scar profile gives the scar instead (of the "
             "point, or of every row of a table, which then has no scar columns), and the "
-            "parabola of the same D/W is given beside it (mu_parabolic in a table). A bad "
-            "row stops the run, naming the file and line (the header is line 1); nothing is "
-            "written then."
+            "parabola of the same D/W is given beside it (mu_parabolic in a table). A row "
+            "that cannot be corrected (a cell that is not a number, an ECoF no gross-slip "
+            "loop gives) gets NaN and its reason in a status column, with one error line "
+            "naming the file, line (the header is line 1) and column; the other rows are "
+            "written, and the exit status is 1."
         ),
     )
     parser.add_argument(
@@ -84,7 +87,6 @@ def add(subparsers) -> None:
 def run(args) -> int:
     """Run ``ecofmaps correct`` with the parsed ``args``; the exit status."""
     from ecofmaps.correction.inversion import correct_ecof
-    from ecofmaps.correction.tables import correct_table
 
     given = [name for name in (*POINT_OPTIONS, *GROOVE_OPTIONS) if getattr(args, name) is not None]
     if args.table is not None:
@@ -95,16 +97,7 @@ def run(args) -> int:
             raise CommandError(f"cannot write {args.out}: its directory does not exist")
         inputs = [path for path in (args.table, args.scar_profile) if path is not None]
         refuse_to_overwrite([("--out", args.out)], inputs, overwrite=args.overwrite)
-        profile = read_profile(args)
-        text, rows = correct_table(args.table, profile=profile, mapping=args.mapping)
-        if args.out is None:
-            sys.stdout.write(text)
-            return 0
-        write_text(args.out, text)
-        record_written([args.out])
-        on = "" if profile is None else f" on the scar profile {args.scar_profile}"
-        print(f"wrote {args.out}: {rows} rows corrected{on}")
-        return 0
+        return _table(args, read_profile(args))
     if args.out is not None:
         raise CommandError("--out writes a corrected TABLE; give the TABLE too")
     missing = ["--" + name for name in POINT_OPTIONS if getattr(args, name) is None]
@@ -146,6 +139,37 @@ def run(args) -> int:
         f"ecofmaps {__version__}: reported ECoF corrected to the contact CoF (x_o = Δ*)", rows
     )
     return 0
+
+
+def _table(args, profile) -> int:
+    """Every row of the TABLE corrected that can be: the others NaN, each named in an error
+    line (exit status 1)."""
+    from ecofmaps.correction.tables import TableRowWarning, correct_table
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", TableRowWarning)
+        text, rows = correct_table(args.table, profile, args.mapping, bad_rows="nan")
+    failed = [item for item in caught if issubclass(item.category, TableRowWarning)]
+    for item in caught:
+        if item in failed:
+            print(f"ecofmaps correct: error: {item.message}", file=sys.stderr)
+        else:
+            warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
+    status = 1 if failed else 0
+    if args.out is None:
+        sys.stdout.write(text)
+        return status
+    write_text(args.out, text)
+    record_written([args.out])
+    on = "" if profile is None else f" on the scar profile {args.scar_profile}"
+    if failed:
+        print(
+            f"wrote {args.out}: {rows - len(failed)} of {rows} rows corrected{on}, "
+            f"{len(failed)} not (NaN, the reason in the status column)"
+        )
+        return status
+    print(f"wrote {args.out}: {rows} rows corrected{on}")
+    return status
 
 
 def _point_on_profile(args, profile) -> int:
