@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +14,7 @@ import numpy as np
 from ecofmaps._nomenclature import QUANTITIES, RANGES, within
 from ecofmaps.cli.main import CommandError
 from ecofmaps.io.files import MANIFEST, written_by_ecofmaps
-from ecofmaps.units import DIMENSIONS, parse_quantity, parse_values
+from ecofmaps.units import DIMENSIONS, bare_number_warning, parse_quantity, parse_values
 
 __all__ = [
     "CommandError",
@@ -40,11 +41,14 @@ def _in_range(name: str, values: np.ndarray, text: str) -> None:
     raise ValueError(f"{text!r} is out of range: the {described.words} must satisfy {valid}{unit}")
 
 
-def quantity(name: str, grid: bool = False):
+def quantity(name: str, grid: bool = False, option: str | None = None):
     """An argparse ``type`` reading a value of quantity ``name`` with units (with ``grid``, a
     list ``a,b,c`` or a range ``start:stop:num`` of values that do not repeat), checked against
-    its dimension and valid range in the nomenclature (argparse names the option)."""
+    its dimension and valid range in the nomenclature (argparse names the option). A bare
+    number implausible in SI is warned, naming ``option`` (default ``--name``) and the unit
+    probably meant."""
     kind = QUANTITIES[name].kind
+    option = option or "--" + name.replace("_", "-")
 
     def parse(text: str):
         try:
@@ -58,6 +62,10 @@ def quantity(name: str, grid: bool = False):
                 f"{text!r} repeats the value {unique[counts > 1][0]:g}: a grid axis takes "
                 "each value once"
             )
+        items = text.split(":")[:2] if grid and ":" in text else text.split(",")
+        for item in items if grid else [text]:
+            if said := bare_number_warning(name, item, kind):
+                warnings.warn(f"{option} {said}", stacklevel=2)
         return value
 
     parse.__name__ = kind

@@ -72,7 +72,7 @@ def add_profile_options(parser: argparse.ArgumentParser) -> None:
     )
     group.add_argument(
         "--profile-half-width",
-        type=quantity("scar_half_width"),
+        type=quantity("scar_half_width", option="--profile-half-width"),
         metavar="W",
         help="the scar's half-width W, e.g. 500um (default: the one detected at the edges)",
     )

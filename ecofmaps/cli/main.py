@@ -16,6 +16,7 @@ import importlib
 import os
 import signal
 import sys
+import warnings
 
 from ecofmaps._interrupts import STOP_SIGNALS, interrupts_stop_writes
 from ecofmaps._version import __version__
@@ -107,11 +108,13 @@ def main(argv=None) -> int:
     0 on success; 2 for a user error (one line naming it); 130 after Ctrl-C and 143 after
     SIGTERM, with one line telling what was left (:func:`ecofmaps._interrupts.add_stop_note`:
     files are written atomically); 1 for an unexpected failure (``ECOFMAPS_DEBUG=1`` shows the
-    traceback). A signal once the subcommand's work is done stops nothing.
+    traceback). A signal once the subcommand's work is done stops nothing. Warnings are
+    printed as ``ecofmaps COMMAND: warning: ...``, one line each (those of the options once
+    they are parsed).
     """
     interrupted = status = None
     try:  # the subcommands import JAX and xarray: an interrupt may come during the imports
-        with interrupts_stop_writes() as interrupted:
+        with interrupts_stop_writes() as interrupted, warnings.catch_warnings(record=True) as told:
             try:
                 parser = build_parser()
                 args, unknown = parser.parse_known_args(argv)
@@ -120,6 +123,9 @@ def main(argv=None) -> int:
             except SystemExit as stop:  # a usage error (printed), --help or --version
                 status = int(stop.code or 0)
                 return status
+            warnings.showwarning = _warning_line(getattr(args, "command_prog", "ecofmaps"))
+            for warning in told:
+                warnings.showwarning(warning.message, warning.category, "", 0)
             status = args.handler(args)
             return status
     except KeyboardInterrupt as stop:
@@ -167,6 +173,16 @@ def _ignored_after_main() -> list:
 
 def _nothing_to_stop(signum, frame) -> None:
     """A stop signal outside :func:`main`'s block, where there is no work to stop."""
+
+
+def _warning_line(command: str):
+    """A ``warnings.showwarning`` that prints ``<command>: warning: <message>`` on one line."""
+
+    def show(message, category, filename, lineno, file=None, line=None) -> None:
+        text = " ".join(str(message).strip().splitlines())
+        print(f"{command}: warning: {text}", file=sys.stderr)
+
+    return show
 
 
 def _report(status: int, message: str) -> int:
