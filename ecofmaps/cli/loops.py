@@ -123,6 +123,13 @@ def add(subparsers) -> None:
         help="read the force with the other sign (a rig recording it positive against the "
         "displacement: its loops run anticlockwise)",
     )
+    parser.add_argument(
+        "--nan-policy",
+        choices=("skip", "raise"),
+        default="skip",
+        help="a cycle with a missing sample (NaN or an empty cell) is skipped and counted "
+        "(skip, the default), or any missing sample stops the command naming its line",
+    )
     add_recording_options(parser)
     _add_long_options(parser)
 
@@ -140,13 +147,6 @@ def _add_long_options(parser) -> None:
         "long tests",
         "a rig file of more than 2**24 samples is analysed out of core, a block of whole "
         "cycles at a time (the numbers are those of the analysis in memory)",
-    )
-    group.add_argument(
-        "--nan-policy",
-        choices=("skip", "raise"),
-        default="skip",
-        help="a cycle with a missing sample (NaN or an empty cell) is skipped and counted "
-        "(skip, the default), or any missing sample stops the command naming its line",
     )
     group.add_argument(
         "--workers",

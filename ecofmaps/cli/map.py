@@ -164,8 +164,7 @@ def run(args) -> int:
     print(
         f"ecofmaps map: {points:,} points, {byte_size(size)} into {out} "
         f"({byte_size(free)} free there)",
-        file=sys.stderr,
-        flush=True,
+        flush=True,  # before the summary, also when the two streams are read apart
     )
     if size > free:
         raise CommandError(
