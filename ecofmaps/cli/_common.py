@@ -68,7 +68,7 @@ def quantity(name: str, grid: bool = False, option: str | None = None):
                 warnings.warn(f"{option} {said}", stacklevel=2)
         return value
 
-    parse.__name__ = kind
+    parse.__name__, parse.option = kind, option
     return parse
 
 

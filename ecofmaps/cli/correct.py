@@ -111,19 +111,13 @@ def run(args) -> int:
         raise CommandError("give --aspect-ratio, or both --scar-depth and --scar-half-width")
     point = dict(amplitude=args.amplitude, load=args.load, stiffness=args.stiffness)
     if args.aspect_ratio is not None:
-        ratio = args.aspect_ratio
-        ratio_text = f"{ratio:.6g}"
+        scar, ratio_text = {"aspect_ratio": args.aspect_ratio}, f"{args.aspect_ratio:.6g}"
     else:
-        ratio = args.scar_depth / args.scar_half_width
+        scar = {"scar_depth": args.scar_depth, "scar_half_width": args.scar_half_width}
         ratio_text = (
-            f"{ratio:.6g} (scar {args.scar_depth * 1e6:.6g} µm deep, "
-            f"{args.scar_half_width * 1e6:.6g} µm half-width)"
+            f"{args.scar_depth / args.scar_half_width:.6g} (scar {args.scar_depth * 1e6:.6g} µm "
+            f"deep, {args.scar_half_width * 1e6:.6g} µm half-width)"
         )
-    scar = (
-        {"aspect_ratio": ratio}
-        if args.aspect_ratio is not None
-        else {"scar_depth": args.scar_depth, "scar_half_width": args.scar_half_width}
-    )
     mu = float(correct_ecof(args.ecof, **point, **scar))
     rows = [
         row("ecof", args.ecof, "(reported)"),

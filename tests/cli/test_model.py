@@ -111,6 +111,8 @@ def test_every_option_has_help_in_the_group_it_belongs_to():
     for name, command in commands.items():
         for action in command._actions:
             assert action.help or action.dest == "==SUPPRESS==", (name, action.option_strings)
+            said = getattr(action.type, "option", None)  # the option a bare number's warning names
+            assert said is None or said in action.option_strings, (name, said)
     groups = {g.title: [a.dest for a in g._group_actions] for g in commands["loops"]._action_groups}
     assert "nan_policy" not in groups["long tests"]
     assert "nan_policy" in groups["options"] and "workers" in groups["long tests"]
