@@ -45,9 +45,17 @@ PLAUSIBLE = {
 
 
 def bare_number_warning(name: str, text: str, kind: str) -> str | None:
-    """Why ``text``, a bare number for quantity ``name`` (of ``kind``), is implausible in SI,
-    with the unit probably meant (``'50 is 50 m; did you mean 50um?'``); None if ``text`` has
-    a unit or is plausible (:data:`PLAUSIBLE`)."""
+    """Why ``text``, a bare number for quantity ``name`` (of ``kind``, a key of
+    :data:`DIMENSIONS`), is implausible in SI, with the unit probably meant; None if ``text``
+    has a unit or is plausible (:data:`PLAUSIBLE`).
+
+    Examples
+    --------
+    >>> bare_number_warning("amplitude", "50", "length")
+    '50 is 50 m; did you mean 50um?'
+    >>> bare_number_warning("amplitude", "50um", "length") is None
+    True
+    """
     if name not in PLAUSIBLE:
         return None
     try:
