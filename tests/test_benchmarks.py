@@ -59,3 +59,17 @@ def test_long_loops_bench_runs(tmp_path, capsys):
         assert found and all(float(value) > 0 for value in found.groups()), name
     ceiling = re.search(r"one process (\S+) s, two (\S+) s: (\S+)x", out)
     assert ceiling and all(float(value) > 0 for value in ceiling.groups())
+
+
+def test_cache_bench_runs(tmp_path, capsys):
+    """``bench_cache.py --quick``: each map's compute, write and read times and their ratios."""
+    path = Path(__file__).parent / "benchmarks" / "bench_cache.py"
+    spec = importlib.util.spec_from_file_location("bench_cache", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    assert bench.main(["--quick", "--repeat", "1", "--folder", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    for name in ("closed form", "flat-bottomed", "W-shaped"):
+        found = re.search(rf"{name}\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)", out)
+        assert found and all(float(value) > 0 for value in found.groups()), name
+    assert list(tmp_path.iterdir()) == []  # its cache folder removed

@@ -49,6 +49,15 @@ def add(subparsers) -> None:
     parser.add_argument(
         "--no-browser", action="store_true", help="do not open the page in a browser"
     )
+    parser.add_argument(
+        "--allow-origin",
+        action="append",
+        default=[],
+        metavar="HOST[:PORT]",
+        help="also answer pages of this host (a tunnel or proxy's name; without a port, "
+        "--port's); by default only 127.0.0.1, localhost and [::1] at --port, and any other "
+        "Host or Origin gets 403 (repeat the option for more hosts)",
+    )
 
 
 def run(args) -> int:
@@ -58,7 +67,12 @@ def run(args) -> int:
     from ecofmaps.web.explorer import serve_explorer
 
     try:
-        serve_explorer(args.port, open_browser=not args.no_browser, announce=_announce)
+        serve_explorer(
+            args.port,
+            open_browser=not args.no_browser,
+            announce=_announce,
+            allow_origin=args.allow_origin,
+        )
     except OSError as error:
         raise CommandError(
             f"cannot listen on 127.0.0.1:{args.port} ({error.strerror or error}): choose "

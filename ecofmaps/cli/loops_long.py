@@ -4,9 +4,11 @@ A recording read lazily (a rig file of more than :data:`ecofmaps.io.recordings.L
 samples, or any file with ``--workers``, ``--scheduler`` or ``--resume``) is analysed by
 :class:`ecofmaps.measured.pipeline.Analysis` on local threads, ``--workers`` processes or the
 cluster at ``--scheduler``. With ``--out``, what each block measured is kept as it completes
-in ``<out>.partial/`` (one ``.npz`` per block, renamed into place when whole), so that a stop
-keeps what was finished and ``--resume`` goes on from it; the table's lines are written in
-order as the blocks come. A stop's line names the folder kept (:meth:`LongRun.stop_note`).
+in ``<out>.partial/`` (one ``.npz`` per block, renamed into place when whole; its checksum, and
+a block's cycle rows, in the run's record ``kept.jsonl``), so that a stop keeps what was
+finished and ``--resume`` goes on from it (a file that fails its check is measured again); the
+table's lines are written in order as the blocks come. A stop's line names the folder kept
+(:meth:`LongRun.stop_note`).
 """
 
 from __future__ import annotations
@@ -14,9 +16,11 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import functools
+import hashlib
 import json
 import os
 import sys
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -43,24 +47,43 @@ PARTIAL_SUFFIX = ".partial"
 #: The files of a run's ``.partial`` folder that hold its work (each file's cycles and
 #: finished blocks), and all the files it keeps there (with the run's record), as patterns.
 _WORK = "file*.npz"
-_KEPT = (_WORK, "run.json")
+_KEPT = (_WORK, "run.json", "kept.jsonl")
 
 #: Options that change how a run goes, not what it computes (left out of its fingerprint).
 _RUNTIME = ("workers", "scheduler", "resume", "quiet", "out", "plots", "handler", "files")
 
 
+def _checksums(path: Path) -> list:
+    """[name, size, CRC-32] of a recording's file, or of every file of a store (its arrays'
+    metadata and chunks), by name within it: its content, which in-place writes change."""
+    path = Path(path)
+    files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
+    sums = []
+    for file in files:
+        crc = 0
+        with open(file, "rb") as stream:
+            while block := stream.read(1 << 22):
+                crc = zlib.crc32(block, crc)
+        sums.append(
+            [file.relative_to(path).as_posix() if file != path else "", file.stat().st_size, crc]
+        )
+    return sums
+
+
 def _fingerprint(args, paths) -> dict:
-    """What the run computes: the files as they are now and the options that matter."""
-    files = []
-    for path in paths:
-        stat = Path(path).stat()
-        files.append([str(Path(path).resolve()), stat.st_size, stat.st_mtime_ns])
+    """What the run computes: the files' content as it is now and the options that matter."""
+    files = [[str(Path(path).resolve()), _checksums(path)] for path in paths]
     options = {
         key: value
         for key, value in sorted(vars(args).items())
         if key not in _RUNTIME and isinstance(value, str | int | float | bool | type(None))
     }
-    return {"format": 1, "files": files, "options": options}
+    return {"format": 2, "files": files, "options": options}
+
+
+def _sha256(path: Path) -> str:
+    with open(path, "rb") as stream:
+        return hashlib.file_digest(stream, "sha256").hexdigest()
 
 
 _UNFINISHED = (
@@ -84,17 +107,61 @@ class _Partial:
                 found = None
             if found != fingerprint:
                 raise CommandError(
-                    f"{self.folder} holds a run of other files or options: delete it to start "
-                    "again with these"
+                    f"{self.folder} holds a run of other files or options (or of these files "
+                    "before they changed): delete it to start again with these"
                 )
         else:
             self.folder.mkdir()
             _write(record, lambda path: path.write_text(json.dumps(fingerprint), "utf-8"))
 
+    def _manifest(self) -> dict:
+        """What the run recorded of the files it kept: (file, block or 'cycles') -> entry.
+        A line cut short by a crash is passed over (its file is then not trusted)."""
+        found = {}
+        with (
+            contextlib.suppress(OSError),
+            open(self.folder / "kept.jsonl", encoding="utf-8") as lines,
+        ):
+            for line in lines:
+                with contextlib.suppress(ValueError, TypeError, KeyError):
+                    entry = json.loads(line)
+                    found[(int(entry["file"]), entry["block"])] = entry
+        return found
+
+    def _record(self, path: Path, **entry) -> None:
+        """Record in the manifest the checksum of ``path`` just kept, with ``entry``."""
+        entry["sha256"] = _sha256(path)
+        with open(self.folder / "kept.jsonl", "a", encoding="utf-8") as lines:
+            lines.write(json.dumps(entry) + "\n")
+
+    def _refused(self, path: Path, reason: str) -> None:
+        """Say that the kept ``path`` is not used, and why; remove it."""
+        print(f"ecofmaps loops: warning: {path} {reason}: it is measured again", file=sys.stderr)
+        path.unlink(missing_ok=True)
+
+    def _checked(self, path: Path, entry, rows=None) -> bool:
+        """Whether the kept ``path`` is what the manifest recorded (its checksum, and the
+        cycle rows ``rows`` of a block); if not, it is refused, with a line saying why."""
+        if entry is None:
+            reason = "is not in the run's record (kept.jsonl)"
+        elif rows is not None and entry.get("rows") != rows:
+            reason = f"holds cycles {entry.get('rows')}, not this block's {rows}"
+        elif _sha256(path) != entry.get("sha256"):
+            reason = "changed since it was kept (its checksum is not the one recorded)"
+        else:
+            return True
+        self._refused(path, reason)
+        return False
+
     def cycles(self, index: int):
-        """The cycles of file ``index`` found before, or None."""
+        """The cycles of file ``index`` found before, or None (and the blocks kept of the
+        file are dropped when the cycles kept fail their check)."""
         path = self.folder / f"file{index}-cycles.npz"
         if not path.exists():
+            return None
+        if not self._checked(path, self._manifest().get((index, "cycles"))):
+            for block in self.kept(index).values():
+                self._refused(block, "was measured on the cycles refused")
             return None
         with np.load(path) as stored:
             fields = {f.name: stored[f.name] for f in dataclasses.fields(Cycles)}
@@ -108,7 +175,22 @@ class _Partial:
     def keep_cycles(self, index: int, cycles) -> None:
         values = dataclasses.asdict(cycles)
         values["missing"] = np.asarray(False) if cycles.missing is None else cycles.missing
-        _write(self.folder / f"file{index}-cycles.npz", lambda path: _savez(path, values))
+        path = self.folder / f"file{index}-cycles.npz"
+        _write(path, lambda temporary: _savez(temporary, values))
+        self._record(path, file=index, block="cycles")
+
+    def record_block(self, index: int, block: int, rows: slice) -> None:
+        """Record in the manifest the block kept of file ``index`` and its cycle rows."""
+        path = self.folder / f"file{index}-block{block:06d}.npz"
+        self._record(path, file=index, block=block, rows=[rows.start, rows.stop])
+
+    def record_late(self, index: int, tasks) -> None:
+        """Record the blocks of file ``index`` kept by tasks of this run that had not come
+        back when it stopped (all tasks are over: a resumed run checked those before)."""
+        recorded = self._manifest()
+        for block in self.kept(index):
+            if (index, block) not in recorded and block < len(tasks):
+                self.record_block(index, block, tasks[block])
 
     def kept(self, index: int) -> dict:
         """The blocks of file ``index`` kept: block -> its file."""
@@ -119,10 +201,18 @@ class _Partial:
             if path.stem[len(prefix) :].isdigit()
         }
 
-    def done(self, index: int) -> dict:
-        """The blocks of file ``index`` kept: block -> (values, flags) as measured."""
+    def done(self, index: int, tasks) -> dict:
+        """The blocks of file ``index`` kept, each the block of cycle rows ``tasks[block]``
+        its record says and as it was kept: block -> (values, flags) as measured."""
         kept = {}
+        manifest = self._manifest()
         for block, path in self.kept(index).items():
+            if block >= len(tasks):
+                self._refused(path, f"is beyond the run's {len(tasks)} blocks")
+                continue
+            rows = [tasks[block].start, tasks[block].stop]
+            if not self._checked(path, manifest.get((index, block)), rows):
+                continue
             with np.load(path) as stored:
                 values = {k[2:]: stored[k] for k in stored.files if k.startswith("v:")}
                 flags = {k[2:]: stored[k] for k in stored.files if k.startswith("f:")}
@@ -194,7 +284,7 @@ class LongRun:
         folder = Path(f"{args.out}{PARTIAL_SUFFIX}")
         if args.out is not None and folder.exists() and not args.resume:
             raise CommandError(_UNFINISHED.format(folder=folder))
-        self.fingerprint = _fingerprint(args, paths) if args.out is not None else None
+        self.paths = paths
         self.partial = None
         self.analysed = None  # (index, path, blocks or None) of the recording analysed last
 
@@ -215,9 +305,10 @@ class LongRun:
         try:
             with runner as runner:  # a cluster that does not answer: nothing written
                 partial = None
-                if recording.lazy and self.fingerprint is not None:
-                    if self.partial is None:
-                        self.partial = _Partial(self.args.out, self.fingerprint, self.args.resume)
+                if recording.lazy and self.args.out is not None:
+                    if self.partial is None:  # the files' checksums: read only for this
+                        fingerprint = _fingerprint(self.args, self.paths)
+                        self.partial = _Partial(self.args.out, fingerprint, self.args.resume)
                         add_stop_note(self.stop_note)  # asked when the line is written
                     partial = self.partial
                 analysis, parts, resolved = _analyse(
@@ -235,7 +326,9 @@ class LongRun:
                 )
         except KeyboardInterrupt as stop:  # counted once the runner is closed: no task runs
             if isinstance(stop, _Interrupted):
-                self.analysed = (index, path, stop.blocks)
+                self.analysed = (index, path, len(stop.tasks))
+                if self.partial is not None and self.partial.folder.exists():
+                    self.partial.record_late(index, stop.tasks)
             note = self.stop_note()
             raise (stop if note is None else Interrupted(note)) from None
         except MissingSampleError as error:
@@ -302,7 +395,7 @@ def _analyse(index, path, recording, load, args, runner, partial, many, write, c
     done = {}
     if partial is not None:
         partial.keep_cycles(index, analysis.cycles)
-        done = partial.done(index)
+        done = partial.done(index, analysis.tasks)
     lines = functools.partial(results_csv, file=str(path) if many else None)
     parts, texts = {}, {}  # texts: the lines of chunks that came before an earlier one
     for block, measured in done.items():
@@ -320,6 +413,8 @@ def _analyse(index, path, recording, load, args, runner, partial, many, write, c
             for block, chunk in kept:
                 if chunk.values is not None:  # sent here: kept by this process
                     keep_block(partial.folder, index, block, chunk.values, chunk.flags)
+                if partial is not None:
+                    partial.record_block(index, block, analysis.tasks[block])
                 parts[block], texts[block] = chunk.part, chunk.made
                 if chunk.resolved is not None:
                     resolved.append(chunk.resolved)
@@ -331,7 +426,7 @@ def _analyse(index, path, recording, load, args, runner, partial, many, write, c
             raise
         bar.leave = False
         bar.close()
-        raise _Interrupted(len(analysis.tasks)) from (None if stopped else error)
+        raise _Interrupted(analysis.tasks) from (None if stopped else error)
     bar.close()
     return analysis, parts, resolved[0] if resolved else None
 
@@ -346,11 +441,11 @@ def _in_order(texts: dict, write, written: int = 0) -> int:
 
 
 class _Interrupted(KeyboardInterrupt):
-    """Ctrl-C while the blocks of a recording of ``blocks`` blocks were measured."""
+    """Ctrl-C while the blocks of a recording, its cycle rows ``tasks``, were measured."""
 
-    def __init__(self, blocks: int):
-        super().__init__(blocks)
-        self.blocks = blocks
+    def __init__(self, tasks):
+        super().__init__(len(tasks))
+        self.tasks = tasks
 
 
 def _bar(analysis, path, shown: bool, initial: int):

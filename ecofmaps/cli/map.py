@@ -2,8 +2,9 @@
 
 A grid of more than ``--chunk-points`` points, and any grid written to a zarr store, is
 computed block by block straight into the output (:func:`ecofmaps.maps.write_map`), with a
-progress bar on a terminal; a smaller one is computed at once and kept in the cache. Before
-any work the command states the map's size and refuses one that would not fit on the disk.
+progress bar on a terminal; a smaller one is computed at once (not cached: it computes faster
+than the cache would read it back). Before any work the command states the map's size and
+refuses one that would not fit on the disk.
 """
 
 from __future__ import annotations
@@ -54,8 +55,8 @@ def add(subparsers) -> None:
             "bare number is SI. A grid of more than --chunk-points points, and any zarr "
             "store, is computed block by block straight into the output, with a few blocks "
             "in memory at a time (grids far beyond memory work), and a progress bar on a "
-            "terminal; it is not cached. Smaller grids are kept in the cache (see 'ecofmaps "
-            "cache') unless --no-cache.",
+            "terminal. The map is not cached: it computes faster than the cache would read "
+            "it back, and --out keeps it.",
             width=80,
         ),
         epilog=(
@@ -130,8 +131,8 @@ def add(subparsers) -> None:
     parser.add_argument(
         "--no-cache",
         action="store_true",
-        help="compute afresh and do not store the result in the cache (grids computed "
-        "block by block never are)",
+        help="do not read or store the result in the cache (a map of the parabolic groove "
+        "is not cached anyway: kept for scripts that give it)",
     )
     parser.add_argument(
         "--cache-dir",
@@ -177,7 +178,7 @@ def run(args) -> int:
         dataset = compute_map(**grid, load=args.load, chunks=args.chunk_points)
     else:  # refused there if it would not fit in memory
         dataset = compute_map(
-            **grid, load=args.load, cache=not args.no_cache, cache_dir=args.cache_dir
+            **grid, load=args.load, cache=False if args.no_cache else None, cache_dir=args.cache_dir
         )
     return _write(dataset, out, shown=chunked and not args.quiet and sys.stderr.isatty())
 

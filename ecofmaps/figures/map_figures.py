@@ -12,6 +12,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Mapping
 
+import jax
 import numpy as np
 import xarray as xr
 from matplotlib import colormaps
@@ -183,7 +184,8 @@ def universal_ecof_ratio_map(
     for index, (name, (amplitude, stiffness_ratios)) in enumerate(windows.items()):
         height = 0.008 + 0.014 * (len(windows) - 1 - index)  # stacked near the bottom
         ratios = np.asarray(stiffness_ratios, dtype=np.float64)
-        span = compliance_ratio(amplitude, 1.0, np.array([ratios.max(), ratios.min()]))
+        with jax.enable_x64(True):  # the core's jax.numpy arithmetic, in float64
+            span = compliance_ratio(amplitude, 1.0, np.array([ratios.max(), ratios.min()]))
         ax.annotate(
             "",
             (float(span[0]), height),
@@ -200,7 +202,8 @@ def universal_ecof_ratio_map(
             color="0.15",
         )
     for (name, point), marker in zip((markers or {}).items(), itertools.cycle("soD^v")):
-        lam = float(compliance_ratio(point["amplitude"], point["load"], point["stiffness"]))
+        with jax.enable_x64(True):
+            lam = float(compliance_ratio(point["amplitude"], point["load"], point["stiffness"]))
         value = float(energy_cof(**point) / point["mu"])
         handles += ax.plot(
             lam,

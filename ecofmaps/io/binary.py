@@ -103,7 +103,9 @@ class Column:
         except RecordingError:
             raise
         except Exception as error:
-            raise RecordingError(self.path, where, f"cannot read: {error}") from None
+            raise RecordingError(
+                self.path, where, f"cannot read (a damaged file, or changed while read): {error}"
+            ) from None
         if raw.shape != (stop - start,):
             raise RecordingError(
                 self.path, where, f"read {raw.size} samples where {stop - start} were expected"

@@ -4,14 +4,16 @@ Each group of the file is one lazily read :class:`xarray.Dataset`; xarray decode
 attributes (``scale_factor``, ``add_offset``, ``_FillValue``/``missing_value`` -> NaN) and
 the text of attributes. A plain HDF5 file, whose datasets have no netCDF dimensions, is read
 with xarray's "phony" dimensions (``phony_dim_0``, ...). Times are left as numbers. A
-truncated or damaged file is refused when it is opened (HDF5 checks its own length), with a
-:class:`~ecofmaps.io.recording_types.RecordingError` naming the file.
+truncated or damaged file is refused when it is opened (HDF5 checks its own length and its
+metadata's checksums), with a :class:`~ecofmaps.io.recording_types.RecordingError` naming
+the file as damaged.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
+import h5py
 import xarray as xr
 
 from ecofmaps.io.recording_types import RecordingError
@@ -35,8 +37,27 @@ OPTIONS = {
 }
 
 
+#: What h5py raises for a file whose structure is damaged (a flipped byte in a header).
+_DAMAGE = (OSError, KeyError, RuntimeError, ValueError, TypeError)
+
+
 def _refused(path: Path, error: Exception) -> RecordingError:
-    return RecordingError(path, None, f"cannot open as HDF5 (truncated or damaged): {error}")
+    reason = str(error).strip("'\"")  # a KeyError's text comes quoted
+    return RecordingError(path, None, f"cannot open as HDF5 (truncated or damaged): {reason}")
+
+
+def _check_structure(path: Path) -> None:
+    """Open every group's and variable's header and attribute with h5py, so that a damaged
+    file raises here, cleanly: h5netcdf would raise anything from KeyError to RuntimeError,
+    and its half-made file object print a traceback when it is collected."""
+
+    def visit(_name, item):
+        for name in item.attrs:
+            item.attrs.get_id(name)
+
+    with h5py.File(path, "r") as handle:
+        visit("/", handle)
+        handle.visititems(visit)
 
 
 def hdf5_groups(path) -> dict[str, xr.Dataset]:
@@ -44,14 +65,19 @@ def hdf5_groups(path) -> dict[str, xr.Dataset]:
     (``'/'``, ``'/rig/run1'``)."""
     path = Path(path)
     try:
+        _check_structure(path)
         return xr.open_groups(path, **OPTIONS)
-    except OSError as error:
+    except _DAMAGE as error:
         raise _refused(path, error) from None
 
 
 def open_hdf5_group(path, group: str | None = None) -> xr.Dataset:
     """One group of an HDF5 / netCDF-4 file (by default the root) as a lazily read Dataset."""
     path = Path(path)
+    try:
+        _check_structure(path)
+    except _DAMAGE as error:
+        raise _refused(path, error) from None
     try:
         return xr.open_dataset(path, group=group or None, **OPTIONS)
     except OSError as error:

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import os
+import stat
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -28,8 +30,17 @@ __all__ = [
     "Recording",
     "RecordingError",
     "RecordingWarning",
+    "check_regular_file",
     "si_values",
 ]
+
+#: What a path that is not a regular file is, by ``stat`` test.
+_NOT_FILES = (
+    (stat.S_ISFIFO, "a named pipe (FIFO)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+)
 
 #: Rig files with more samples than this are read lazily (dask arrays) by default.
 LAZY_SAMPLES = 1 << 24
@@ -98,6 +109,21 @@ class RecordingError(FileLineError):
             self.position = f"line {self.line}"
         where = f"{self.path}, {self.position}" if self.position else f"{self.path}"
         ValueError.__init__(self, f"{where}: {message}")
+
+
+def check_regular_file(path) -> None:
+    """Raise :class:`RecordingError` unless ``path`` (a link followed) is a regular file.
+
+    A pipe, a device or a socket never ends, or blocks until another program writes: it
+    is refused by name before it is opened. ``OSError`` if it cannot be looked at.
+    """
+    mode = os.stat(path).st_mode
+    if stat.S_ISREG(mode):
+        return
+    what = next((kind for test, kind in _NOT_FILES if test(mode)), "not a regular file")
+    raise RecordingError(
+        path, None, f"{what}, not a regular file: save the data to a file and read that"
+    )
 
 
 class RecordingWarning(UserWarning):

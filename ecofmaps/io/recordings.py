@@ -21,7 +21,13 @@ import xarray as xr
 
 from ecofmaps.io.binary import read_binary
 from ecofmaps.io.columns import column_scale, split_unit
-from ecofmaps.io.recording_types import LAZY_SAMPLES, LineIndex, Recording, RecordingError
+from ecofmaps.io.recording_types import (
+    LAZY_SAMPLES,
+    LineIndex,
+    Recording,
+    RecordingError,
+    check_regular_file,
+)
 from ecofmaps.io.text import BLOCK_BYTES, text_blocks
 
 __all__ = [
@@ -68,8 +74,9 @@ def recording_format(path) -> str:
     Raises
     ------
     RecordingError
-        For a directory that is not a zarr store, a netCDF-3 file, or a file whose suffix
-        names a rig format its content is not (truncated or mislabelled).
+        For a directory that is not a zarr store, a pipe, device or socket, a netCDF-3
+        file, or a file whose suffix names a rig format its content is not (truncated or
+        mislabelled).
     OSError
         If the file cannot be read.
     """
@@ -78,6 +85,7 @@ def recording_format(path) -> str:
         if any((path / name).exists() for name in _ZARR_METADATA):
             return "zarr"
         raise RecordingError(path, None, "a directory, and not a zarr store (no zarr.json)")
+    check_regular_file(path)
     with open(path, "rb") as stream:
         head = stream.read(8)
     for magic, kind in _MAGIC.items():

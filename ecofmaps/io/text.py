@@ -29,12 +29,20 @@ from ecofmaps.io.columns import (
     matching_columns,
     split_unit,
 )
-from ecofmaps.io.recording_types import RecordingError, RecordingWarning, si_values
+from ecofmaps.io.recording_types import (
+    RecordingError,
+    RecordingWarning,
+    check_regular_file,
+    si_values,
+)
 
-__all__ = ["BLOCK_BYTES", "MISSING", "PREAMBLE_LINES", "text_blocks"]
+__all__ = ["BLOCK_BYTES", "LINE_BYTES", "MISSING", "PREAMBLE_LINES", "text_blocks"]
 
 #: Bytes of text parsed at a time (cut at the last line end within).
 BLOCK_BYTES = 1 << 24
+
+#: The longest line read, in bytes (1 MiB); a longer one is refused at its line, at once.
+LINE_BYTES = 1 << 20
 
 #: Cell contents read as a missing sample (besides an empty cell and infinite values).
 MISSING = ("nan", "NaN", "NAN", "-nan", "-NaN", "NA", "N/A", "n/a", "#N/A", "null", "NULL", "None")
@@ -61,6 +69,7 @@ def _is_data(line: str) -> bool:
 
 def _file_bytes(path: Path, block_bytes: int):
     """The file's bytes, about ``block_bytes`` at a time."""
+    check_regular_file(path)
     with open(path, "rb") as raw:
         compressed = raw.read(2) == _GZIP
         raw.seek(0)
@@ -110,13 +119,39 @@ class _Damaged(Exception):
     """Compressed data that cannot be read (the file and line are added by the caller)."""
 
 
+def _long_line(data: bytes) -> int | None:
+    """The offset in ``data`` of the first line longer than :data:`LINE_BYTES` (the last
+    line may go on beyond ``data``), or None.
+
+    Such a line holds a whole window of ``LINE_BYTES // 2`` bytes aligned on a multiple of
+    it without a line end, and a window with one is passed at its first line end.
+    """
+    step = LINE_BYTES // 2
+    for offset in range(0, len(data) - step + 1, step):
+        if data.find(b"\n", offset, offset + step) == -1:
+            start = data.rfind(b"\n", 0, offset) + 1
+            end = data.find(b"\n", offset + step)
+            if (len(data) if end == -1 else end) - start > LINE_BYTES:
+                return start
+    return None
+
+
 def _line_blocks(path: Path, chunks):
     """Bytes of whole lines, one block per chunk or more (the last may lack a newline), each with
-    the 1-based number of its first line and its number of lines."""
+    the 1-based number of its first line and its number of lines; a line longer than
+    :data:`LINE_BYTES` refused as soon as it is read."""
     rest, line = b"", 1
     try:
         for chunk in chunks:
+            check_interrupted()
             data = rest + chunk
+            if (start := _long_line(data)) is not None:
+                raise RecordingError(
+                    path,
+                    line + data.count(b"\n", 0, start),
+                    f"a line longer than {LINE_BYTES} bytes (1 MiB): a recording's lines hold "
+                    "a few numbers each; is this a text recording?",
+                )
             cut = data.rfind(b"\n") + 1
             rest = data[cut:]
             if cut:
@@ -173,6 +208,8 @@ def _fields(line: str, separator) -> list[str]:
     """The cells of one line, quotes removed."""
     if separator is None:
         return [cell.strip('"') for cell in line.split()]
+    if len(line) > csv.field_size_limit():  # the csv module refuses so long a cell
+        return [cell.strip().strip('"') for cell in line.split(separator)]
     return [cell.strip() for cell in next(csv.reader([line], delimiter=separator))]
 
 

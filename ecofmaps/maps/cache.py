@@ -1,26 +1,25 @@
-"""The disk cache of computed maps: netCDF files keyed by the grid and the model's revision.
+"""The disk cache of results that are expensive to recompute: netCDF files keyed by their inputs.
 
-A map is stored as one netCDF file (engine h5netcdf) named ``<function>-<key>.nc``, where the
-key is a SHA-256 hash of the package version, the model's revision (a hash of the source of
-the modules that compute maps, :func:`model_revision`, so an edited model never serves a
-stale map), the function's name and the exact float64 bytes (and shapes) of every input. The
-directory is, in order of precedence, the ``cache_dir`` argument, the ``ECOFMAPS_CACHE``
-environment variable, or the per-user cache directory (``platformdirs.user_cache_dir``).
-
-Files are written atomically (a temporary file in the same directory, then ``os.replace``),
-so a reader never sees a half-written file and two processes writing the same entry leave one
-valid file. Each file also holds a SHA-256 checksum of its data (every variable's and
-coordinate's values, dtype and shape), verified when it is read. A file that cannot be read,
-that holds another key, or whose data do not match their checksum (damaged on disk) is
-reported with a :class:`CacheWarning`, removed and recomputed.
+A result is one netCDF file ``<function>-<key>.nc`` in :func:`cache_directory`, keyed by
+:func:`cache_key` (the package version, the model's revision, the function, the exact
+inputs). HDF5 guards its arrays: each is stored in chunks with a Fletcher-32 checksum,
+verified as it is read; :func:`metadata_checksum` guards the rest. An entry that fails
+either, or that cannot be read, is removed and recomputed; a write that fails for any reason
+is one :class:`CacheWarning`, and the result is returned all the same. The cache keeps under
+a size bound (:func:`cache_size_bound`) by removing the least recently used entries. What is
+cached, and what a write and a read cost against computing: docs/performance.md, "The cache".
 """
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import gc
 import hashlib
 import os
 import re
+import sys
+import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from datetime import UTC, datetime
@@ -35,15 +34,18 @@ from ecofmaps._version import __version__
 from ecofmaps.io.files import TEMPORARY_NAME, atomic_path
 
 __all__ = [
+    "DEFAULT_SIZE_BOUND",
     "ENVIRONMENT_VARIABLE",
+    "SIZE_VARIABLE",
     "CacheEntry",
     "CacheWarning",
     "cache_directory",
     "cache_entries",
     "cache_key",
+    "cache_size_bound",
     "cached_dataset",
     "clear_cache",
-    "data_checksum",
+    "metadata_checksum",
     "model_revision",
     "write_netcdf",
 ]
@@ -51,9 +53,15 @@ __all__ = [
 #: Environment variable that overrides the per-user cache directory.
 ENVIRONMENT_VARIABLE = "ECOFMAPS_CACHE"
 
-# The global attributes that tie a cache file to its key and to its data; removed on reading.
+#: Environment variable that sets the bound on the cache's size (``500MB``, ``2GB``, ``0``).
+SIZE_VARIABLE = "ECOFMAPS_CACHE_SIZE"
+
+#: The bound on the cache's total size when :data:`SIZE_VARIABLE` is not set. [byte]
+DEFAULT_SIZE_BOUND = 10**9
+
+# The global attributes that tie a cache file to its key and to its metadata; removed on reading.
 _KEY_ATTRIBUTE = "ecofmaps_cache_key"
-_CHECKSUM_ATTRIBUTE = "ecofmaps_data_sha256"
+_CHECKSUM_ATTRIBUTE = "ecofmaps_metadata_sha256"
 # The sources, relative to the package, whose code decides what a cached map holds.
 _MODEL_SOURCES = (
     "model/*.py",
@@ -67,10 +75,19 @@ _MODEL_SOURCES = (
 # Length of the key in file names: 128 bits of the hash.
 _NAME_DIGITS = 32
 _ENTRY = re.compile(rf"^(?P<function>[A-Za-z_][A-Za-z0-9_]*)-[0-9a-f]{{{_NAME_DIGITS}}}\.nc$")
+# Largest chunk of an array, each with its own Fletcher-32 checksum. [byte]
+_CHUNK_BYTES = 2**22
+# Array types whose chunks carry a checksum; the values of the others (text) are hashed.
+_CHUNKED_KINDS = "biufcmM"
+# Sizes in ECOFMAPS_CACHE_SIZE: a number and an optional unit.
+_SIZE = re.compile(r"^\s*(?P<number>[0-9.]+(?:e[0-9]+)?)\s*(?P<unit>[kMGT]i?B|B)?\s*$")
+_UNITS = {"B": 1, "kB": 10**3, "MB": 10**6, "GB": 10**9, "TB": 10**12}
+_UNITS.update({"KiB": 2**10, "kiB": 2**10, "MiB": 2**20, "GiB": 2**30, "TiB": 2**40})
 
 
 class CacheWarning(UserWarning):
-    """A cache file could not be used (unreadable, foreign) or written; the map is recomputed."""
+    """A cache file could not be used (unreadable, damaged, foreign) or written; the result
+    is recomputed, or returned without being stored."""
 
 
 @dataclass(frozen=True)
@@ -87,12 +104,16 @@ class CacheEntry:
         File size. [byte]
     modified : datetime.datetime
         Time of the last write (UTC).
+    used : datetime.datetime
+        Time of the last read or write (UTC): the least recently used entries are removed
+        first when the cache outgrows its bound.
     """
 
     path: Path
     function: str
     size: int
     modified: datetime
+    used: datetime
 
 
 def cache_directory(cache_dir=None) -> Path:
@@ -116,6 +137,34 @@ def cache_directory(cache_dir=None) -> Path:
     return Path(platformdirs.user_cache_dir("ecofmaps"))
 
 
+def cache_size_bound() -> int:
+    """The bound on the cache's total size: ``ECOFMAPS_CACHE_SIZE``, else 1 GB.
+
+    Returns
+    -------
+    bound : int
+        Bytes the cache's entries may take together. [byte] After each write, the least
+        recently used entries are removed until the others fit; a result larger than the
+        bound is not stored; 0 stores nothing.
+
+    Raises
+    ------
+    ValueError
+        If ``ECOFMAPS_CACHE_SIZE`` is not a size: a number of bytes, or a number with one
+        of the units B, kB, MB, GB, TB, KiB, MiB, GiB, TiB (``500MB``).
+    """
+    text = os.environ.get(SIZE_VARIABLE, "").strip()
+    if not text:
+        return DEFAULT_SIZE_BOUND
+    found = _SIZE.match(text)
+    if found is None or found["number"].count(".") > 1:
+        raise ValueError(
+            f"{SIZE_VARIABLE}={text!r} is not a size: give bytes, or a number with a unit "
+            f"among {', '.join(_UNITS)} (e.g. 500MB)"
+        )
+    return int(float(found["number"]) * _UNITS[found["unit"] or "B"])
+
+
 @functools.cache
 def model_revision() -> str:
     """SHA-256 of the source of the modules that compute maps (the model, the grid, the names).
@@ -135,25 +184,43 @@ def model_revision() -> str:
     return digest.hexdigest()
 
 
-def data_checksum(dataset: xr.Dataset) -> str:
-    """SHA-256 of a Dataset's data: every variable's and coordinate's name, dtype, shape, values.
+def _chunked(variable: xr.Variable) -> bool:
+    """Whether ``variable`` is stored in chunks that carry a Fletcher-32 checksum."""
+    return variable.ndim > 0 and variable.size > 0 and variable.dtype.kind in _CHUNKED_KINDS
+
+
+def metadata_checksum(dataset: xr.Dataset) -> str:
+    """SHA-256 of what the chunks' checksums do not cover: every name, dimension, type,
+    shape and attribute, and the values of text and scalar variables.
 
     Parameters
     ----------
     dataset : xarray.Dataset
+        As read from the file (attributes take the types netCDF gives them).
 
     Returns
     -------
     checksum : str
-        64 hexadecimal digits. Attributes are not included.
+        64 hexadecimal digits. The global attribute that holds the checksum is left out.
     """
     digest = hashlib.sha256()
+
+    def add(*parts) -> None:
+        for part in parts:
+            digest.update(f"{part!s}\0".encode())
+
+    def add_attributes(attributes: Mapping) -> None:
+        for name in sorted(map(str, attributes)):
+            if name != _CHECKSUM_ATTRIBUTE:
+                add(name, np.asarray(attributes[name]).tolist())
+
+    add_attributes(dataset.attrs)
     for name in sorted(map(str, dataset.variables)):
-        values = np.asarray(dataset[name].values)
-        if values.dtype.kind in "OUS":  # text: its characters
-            values = np.asarray(values.astype(str), dtype="U")
-        digest.update(f"{name}\0{values.dtype.str}\0{values.shape}\0".encode())
-        digest.update(np.ascontiguousarray(values).tobytes())
+        variable = dataset.variables[name]
+        add(name, variable.dims, variable.dtype.str, variable.shape)
+        add_attributes(variable.attrs)
+        if not _chunked(variable):
+            add(np.asarray(variable.values).tolist())
     return digest.hexdigest()
 
 
@@ -209,17 +276,122 @@ def write_netcdf(dataset: xr.Dataset, path) -> Path:
     return path
 
 
+def _chunks(shape: tuple[int, ...], itemsize: int) -> tuple[int, ...]:
+    """Chunk shape of at most :data:`_CHUNK_BYTES`: whole trailing dimensions, then rows."""
+    room = max(1, _CHUNK_BYTES // itemsize)  # elements a chunk may hold
+    chunks = []
+    for length in reversed(shape):
+        chunks.append(max(1, min(length, room)))
+        room //= length
+    return tuple(reversed(chunks))
+
+
+def _file_image(dataset: xr.Dataset) -> bytes:
+    """The bytes of ``dataset``'s netCDF file, its arrays in checksummed chunks, the checksum
+    of the rest in a global attribute; built in memory, so no half-written file is ever
+    left to the garbage collector."""
+    import h5netcdf
+    import h5py
+
+    encoding = {
+        name: {"fletcher32": True, "chunksizes": _chunks(variable.shape, variable.dtype.itemsize)}
+        for name, variable in dataset.variables.items()
+        if _chunked(variable)
+    }
+    memory = h5py.File(
+        "cache entry", "w", driver="core", backing_store=False, track_order=True, libver="v110"
+    )
+    try:
+        with h5netcdf.File(memory, "w") as netcdf:  # leaves `memory` open
+            store = xr.backends.H5NetCDFStore(netcdf, mode="w")
+            dataset.dump_to_store(store, encoding=encoding)
+            written = xr.open_dataset(xr.backends.H5NetCDFStore(netcdf, mode="r"))
+            netcdf.attrs[_CHECKSUM_ATTRIBUTE] = metadata_checksum(written)
+        memory.flush()
+        return memory.id.get_file_image()
+    finally:
+        memory.close()
+
+
 def _read(path: Path, key: str) -> xr.Dataset:
-    """The dataset stored under ``key`` at ``path``; ``ValueError`` if it holds another key."""
+    """The dataset stored under ``key`` at ``path``; ``ValueError`` if it holds another key
+    or its metadata were damaged (HDF5 raises if its arrays were)."""
     with xr.open_dataset(path, engine="h5netcdf") as stored:
         dataset = stored.load()
     if dataset.attrs.get(_KEY_ATTRIBUTE) != key:
         raise ValueError("it is not the cache entry of this computation (foreign file)")
-    if dataset.attrs.get(_CHECKSUM_ATTRIBUTE) != data_checksum(dataset):
-        raise ValueError("its data do not match their checksum (the file is damaged)")
+    if dataset.attrs.get(_CHECKSUM_ATTRIBUTE) != metadata_checksum(dataset):
+        raise ValueError("its metadata do not match their checksum (the file is damaged)")
     private = (_KEY_ATTRIBUTE, _CHECKSUM_ATTRIBUTE)
     dataset.attrs = {name: v for name, v in dataset.attrs.items() if name not in private}
+    for variable in dataset.variables.values():  # not the cache's storage
+        variable.encoding = {}
     return dataset
+
+
+def _stored(path: Path, key: str) -> xr.Dataset | None:
+    """The dataset stored at ``path``, or None: if it is unusable, it is removed, with a
+    warning. HDF5's complaints about a damaged file are this warning, not lines on standard
+    error from finalizers of half-opened objects."""
+    hook = sys.unraisablehook
+    sys.unraisablehook = _ignored
+    try:
+        try:
+            return _read(path, key)
+        except FileNotFoundError:  # removed meanwhile by another process
+            return None
+        except Exception as error:  # any unreadable file is recomputed, whatever h5py says
+            reason = _reason(error)
+        gc.collect()  # the half-opened objects, while their finalizers are quiet
+    finally:
+        sys.unraisablehook = hook
+    warn(f"removed unusable cache file {path} ({reason}); recomputing", CacheWarning)
+    path.unlink(missing_ok=True)
+    return None
+
+
+def _ignored(unraisable) -> None:
+    """An exception raised where it cannot be (a finalizer): ignored."""
+
+
+def _used(path: Path) -> None:
+    """Mark ``path`` as used now (its access time), for the least-recently-used order."""
+    os.utime(path, ns=(time.time_ns(), path.stat().st_mtime_ns))
+
+
+def _reason(error: BaseException) -> str:
+    """``error`` in one line."""
+    text = " ".join(str(error).split()) or "no reason given"
+    if isinstance(error, OSError) and error.strerror:
+        text = error.strerror  # h5py's messages run over several lines with their buffers
+    return f"{type(error).__name__}: {text}"
+
+
+def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
+    """Store ``dataset`` at ``path`` if it fits in ``bound`` [byte], then keep the cache
+    within it."""
+    if dataset.nbytes > bound:
+        return
+    image = _file_image(dataset.assign_attrs({_KEY_ATTRIBUTE: key}))
+    if len(image) > bound:
+        return
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(path) as temporary:
+        temporary.write_bytes(image)
+    _evict(path.parent, bound, keep=path)
+
+
+def _evict(directory: Path, bound: int, keep: Path) -> None:
+    """Remove the least recently used entries of ``directory`` (not ``keep``) until the
+    entries take at most ``bound`` bytes."""
+    entries = sorted(cache_entries(directory), key=lambda entry: entry.used)
+    total = sum(entry.size for entry in entries)
+    for entry in entries:
+        if total <= bound:
+            break
+        if entry.path != keep:
+            entry.path.unlink(missing_ok=True)
+            total -= entry.size
 
 
 def cached_dataset(
@@ -247,32 +419,33 @@ def cached_dataset(
     dataset : xarray.Dataset
         Identical (``xarray.testing.assert_identical``) whether read or computed.
 
+    Raises
+    ------
+    ValueError
+        If ``ECOFMAPS_CACHE_SIZE`` is set and is not a size (:func:`cache_size_bound`).
+
     Warns
     -----
     CacheWarning
-        When the file is unreadable or foreign (it is removed and the result recomputed),
-        or when the result cannot be written (it is returned all the same).
+        In one line, when the file is unreadable, damaged or foreign (it is removed and the
+        result recomputed), or when the result cannot be stored for any reason (a full
+        disk, a read-only folder, a file where the folder should be): it is returned all
+        the same.
     """
     directory = cache_directory(cache_dir)
+    bound = cache_size_bound()  # a bad ECOFMAPS_CACHE_SIZE is refused before any work
     key = cache_key(function, inputs)
     path = directory / f"{function}-{key[:_NAME_DIGITS]}.nc"
-    if path.exists():
-        try:
-            return _read(path, key)
-        except Exception as error:  # any unreadable file is recomputed, whatever h5py says
-            warn(
-                f"removed unusable cache file {path} ({type(error).__name__}: {error}); "
-                "recomputing",
-                CacheWarning,
-            )
-            path.unlink(missing_ok=True)
+    dataset = _stored(path, key) if path.is_file() else None  # not a folder of the user's
+    if dataset is not None:
+        with contextlib.suppress(OSError):  # removed meanwhile, or read-only: only a hint
+            _used(path)
+        return dataset
     dataset = compute()
     try:
-        directory.mkdir(parents=True, exist_ok=True)
-        stamps = {_KEY_ATTRIBUTE: key, _CHECKSUM_ATTRIBUTE: data_checksum(dataset)}
-        write_netcdf(dataset.assign_attrs(stamps), path)
-    except OSError as error:
-        warn(f"could not write cache file {path}: {error}", CacheWarning)
+        _store(dataset, path, key, bound)
+    except Exception as error:  # whatever the reason, the result is returned all the same
+        warn(f"could not write cache file {path} ({_reason(error)})", CacheWarning)
     return dataset
 
 
@@ -308,6 +481,7 @@ def cache_entries(cache_dir=None) -> list[CacheEntry]:
                 function=_ENTRY.match(path.name)["function"],
                 size=status.st_size,
                 modified=datetime.fromtimestamp(status.st_mtime, tz=UTC),
+                used=datetime.fromtimestamp(max(status.st_atime, status.st_mtime), tz=UTC),
             )
         )
     return entries

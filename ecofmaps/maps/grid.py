@@ -5,7 +5,8 @@ Dataset's dimensions, the single values its scalar coordinates. The grid is eval
 jit-compiled kernel of the dimensionless core in tiles on every core
 (:mod:`ecofmaps.maps.tiles`), or lazily with ``chunks=`` as a dask-backed Dataset equal to
 the bit. :func:`compute_map` and :func:`compute_universal_map` keep their results in the disk
-cache (:mod:`ecofmaps.maps.cache`). As in the paper, :math:`x_o = \Delta^*`.
+cache only when asked (``cache=True``; :mod:`ecofmaps.maps.cache`). As in the paper,
+:math:`x_o = \Delta^*`.
 """
 
 from __future__ import annotations
@@ -146,8 +147,10 @@ def compute_map(
         With a profile: :math:`X = xW/\Delta^*` (eq. 11) or :math:`X = x`.
     cache : bool, optional
         Read the result from the disk cache, and store it there after computing it.
-        Default: yes for a map in memory; a chunked map is never cached (see Notes), so
-        ``cache=True`` with ``chunks`` is an error.
+        Default: only a map on a profile, which is expensive to recompute; the closed
+        forms compute faster than the cache reads them back (docs/performance.md). A
+        chunked map is never cached (see Notes), so ``cache=True`` with ``chunks`` is an
+        error.
     cache_dir : str or os.PathLike, optional
         Cache directory; default ``$ECOFMAPS_CACHE`` or the per-user cache directory.
     max_chunk : int
@@ -271,7 +274,7 @@ def compute_map(
         extra = {} if load is None else {"load": load}
         return grid_dataset(axes, values, "ECoF map of the compliant wear-scar model", extra)
 
-    if chunks is not None or cache is False:
+    if chunks is not None or not cache:
         return compute()
     return cached_dataset("compute_map", {**axes, "load": load}, compute, cache_dir)
 
@@ -338,7 +341,7 @@ def compute_universal_map(
         values = grid_values(_universal_kernel, axes, (), max_chunk, chunks)
         return grid_dataset(axes, values, "Universal ECoF map of the compliant wear-scar model")
 
-    if chunks is not None or cache is False:
+    if chunks is not None or not cache:
         return compute()
     return cached_dataset("compute_universal_map", axes, compute, cache_dir)
 

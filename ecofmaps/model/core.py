@@ -70,7 +70,9 @@ def compliance_ratio(length, load, stiffness):
     lam : jax.Array
         The rig's deflection at :math:`Q = P` in units of :math:`L`. [1]
     """
-    return load / (stiffness * length)
+    # Double where: at S = inf the quotient's derivative would be (load/inf^2) * inf = NaN.
+    rigid = jnp.isposinf(stiffness)
+    return jnp.where(rigid, 0.0, load / (jnp.where(rigid, 1.0, stiffness) * length))
 
 
 def traction_ratio(position, mu, kappa, direction=1.0):

@@ -19,6 +19,7 @@ import numpy as np
 from ecofmaps._inputs import as_float64, check, float64, is_concrete
 from ecofmaps.model import first_passage
 from ecofmaps.model import profile_core as core
+from ecofmaps.model.core import compliance_ratio
 from ecofmaps.model.profiles import ScarProfile
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
 
@@ -250,7 +251,7 @@ def _shared(profile, unique, group, lam, physical):
 def _prepare(amplitude, load, stiffness, mu, half_width, profile_half_width, physical):
     """Flat (mu, key, lam, valid) with harmless stand-ins at invalid points."""
     valid = _valid(amplitude, load, stiffness, mu, half_width)
-    lam = jnp.where(valid, load / (stiffness * amplitude), 0.1)
+    lam = jnp.where(valid, compliance_ratio(amplitude, load, stiffness), 0.1)
     key = amplitude if physical else amplitude / half_width
     key = jnp.where(valid, key, profile_half_width if physical else 1.0)
     return tuple(v.reshape(-1) for v in (jnp.where(valid, mu, 0.5), key, lam, valid))
@@ -384,7 +385,7 @@ def profile_loop(profile, amplitude, load, stiffness, mu, groove_half_width, map
     )
     shape = amplitude.shape
     valid = _valid(amplitude, load, stiffness, mu, half_width).reshape(-1)
-    lam = jnp.where(valid, (load / (stiffness * amplitude)).reshape(-1), 0.1)
+    lam = jnp.where(valid, compliance_ratio(amplitude, load, stiffness).reshape(-1), 0.1)
     key = (amplitude if physical else amplitude / half_width).reshape(-1)
     key = jnp.where(valid, key, profile.half_width if physical else 1.0)
     mu_flat = jnp.where(valid, mu.reshape(-1), 0.5)
@@ -436,7 +437,7 @@ def profile_simulation(profile, displacement, load, stiffness, mu, groove_half_w
     load, stiffness, mu, x_o = (jnp.broadcast_to(v, batch) for v in (load, stiffness, mu, x_o))
     valid = _valid(jnp.ones(batch), load, stiffness, mu, x_o)
     # Units of the scar's half-width W: X/W = x/x_o, D = Δ/x_o, λ = P/(S x_o).
-    lam = jnp.where(valid, load / (stiffness * x_o), 0.1).reshape(-1)
+    lam = jnp.where(valid, compliance_ratio(x_o, load, stiffness), 0.1).reshape(-1)
     targets = (displacement / x_o[..., None]).reshape(-1, steps)
     mu_flat = jnp.where(valid, mu, 0.5).reshape(-1)
     position = profile.position / profile.half_width

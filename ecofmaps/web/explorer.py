@@ -13,7 +13,9 @@ import dataclasses
 import functools
 import html
 import math
+import re
 import signal
+import urllib.parse
 import warnings
 import webbrowser
 
@@ -23,6 +25,8 @@ from bokeh.models import ColorBar, ColumnDataSource, HoverTool, LinearColorMappe
 from bokeh.palettes import Viridis256
 from bokeh.plotting import figure
 from panel.io.server import get_server
+from tornado.routing import Matcher, Rule
+from tornado.web import RequestHandler
 
 from ecofmaps._interrupts import check_interrupted
 from ecofmaps._nomenclature import QUANTITIES, RANGES, within
@@ -31,21 +35,44 @@ from ecofmaps.maps.grid import compute_map
 from ecofmaps.model.simulation import fretting_loop
 from ecofmaps.model.steady_state import dissipated_energy, energy_cof, slip_amplitude
 from ecofmaps.paper import FIGURE_11_STIFFNESS_RATIOS
-from ecofmaps.units import parse_quantity
+from ecofmaps.units import DIMENSIONS, parse_quantity
 
-__all__ = ["INPUTS", "ExplorerPoint", "explorer_page", "parameter_value", "serve_explorer"]
+__all__ = [
+    "INPUTS",
+    "LOCAL_HOSTS",
+    "TEXT_LIMIT",
+    "ExplorerPoint",
+    "explorer_page",
+    "parameter_value",
+    "serve_explorer",
+]
 
-#: The page's inputs: URL query key -> (quantity of the nomenclature, label, default text).
+#: The page's inputs: URL query key -> (quantity of the nomenclature, label, default text,
+#: the physical bounds the explorer takes in SI, a rigid rig's infinite stiffness apart).
 INPUTS = {
-    "amplitude": ("amplitude", "Displacement amplitude Δ*", "50um"),
-    "load": ("load", "Normal load P", "450N"),
-    "stiffness": ("stiffness", "Rig stiffness S", "35MN/m"),
-    "mu": ("mu", "Contact CoF μ", "0.8"),
-    "aspect_ratio": ("aspect_ratio", "Groove aspect ratio z_o/x_o", "0.2"),
-    "ecof": ("ecof", "ECoF μ_E to correct", "0.83"),
-    "aspect_ratio_low": ("aspect_ratio", "Scar z_o/x_o from", "0.15"),
-    "aspect_ratio_high": ("aspect_ratio", "Scar z_o/x_o to", "0.25"),
+    "amplitude": ("amplitude", "Displacement amplitude Δ*", "50um", (1e-9, 1e-2)),
+    "load": ("load", "Normal load P", "450N", (1e-3, 1e6)),
+    "stiffness": ("stiffness", "Rig stiffness S", "35MN/m", (1.0, 1e13)),
+    "mu": ("mu", "Contact CoF μ", "0.8", (1e-3, 10.0)),
+    "aspect_ratio": ("aspect_ratio", "Groove aspect ratio z_o/x_o", "0.2", (0.0, 10.0)),
+    "ecof": ("ecof", "ECoF μ_E to correct", "0.83", (1e-3, 100.0)),
+    "aspect_ratio_low": ("aspect_ratio", "Scar z_o/x_o from", "0.15", (0.0, 10.0)),
+    "aspect_ratio_high": ("aspect_ratio", "Scar z_o/x_o to", "0.25", (0.0, 10.0)),
 }
+
+#: The longest text an input takes. [1]
+TEXT_LIMIT = 64
+
+#: The longest query value let through to Panel, whose reading of the query fails on an
+#: integer of more than 4300 digits; a longer one is cut to ``TEXT_LIMIT + 1``. [1]
+_QUERY_LIMIT = 1000
+
+#: What an input's text may be: a number and a plain unit (no expression for pint to
+#: evaluate: '9**9**9' would take forever).
+_PLAIN = re.compile(r"\s*[+-]?(?:inf|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*[A-Za-zµμ/]*\s*")
+
+#: The hosts whose pages the explorer answers (with its port); others get 403.
+LOCAL_HOSTS = ("127.0.0.1", "localhost", "[::1]")
 
 #: The model's inputs among :data:`INPUTS`.
 _MODEL_INPUTS = ("amplitude", "load", "stiffness", "mu", "aspect_ratio")
@@ -59,7 +86,7 @@ _MAP_WINDOW = (FIGURE_11_STIFFNESS_RATIOS[0], FIGURE_11_STIFFNESS_RATIOS[-1], 0.
 #: Steps to which the map's window grows, so that nearby points share a cached map.
 _STEPS = np.array([1.0, 2.0, 5.0])
 
-#: Maps kept in memory by the server, beside the disk cache.
+#: Maps kept in memory by the server (nothing is written to disk per request).
 _MAPS_KEPT = 32
 
 
@@ -82,7 +109,9 @@ def parameter_value(key: str, text: str) -> float:
     Raises
     ------
     ValueError
-        Naming the input, if the text is not a quantity of its kind or is out of range.
+        Naming the input, if the text is longer than :data:`TEXT_LIMIT`, is not a number
+        with a plain unit, is not a quantity of its kind, or is out of its range or beyond
+        the physical bounds of :data:`INPUTS`.
 
     Examples
     --------
@@ -91,15 +120,27 @@ def parameter_value(key: str, text: str) -> float:
     >>> parameter_value("amplitude", "5e-5")
     5e-05
     """
-    name, label, _ = INPUTS[key]
+    name, label, default, (low, high) = INPUTS[key]
     quantity = QUANTITIES[name]
+    text = str(text)
+    if len(text) > TEXT_LIMIT:
+        raise ValueError(f"{label}: more than {TEXT_LIMIT} characters; type e.g. {default}")
+    if not _PLAIN.fullmatch(text):
+        raise ValueError(f"{label}: {text!r} is not a number with a unit, e.g. {default}")
     try:
-        value = parse_quantity(str(text), quantity.kind)
+        value = parse_quantity(text, quantity.kind)
     except ValueError as error:
         raise ValueError(f"{label}: {error}") from None
     if quantity.valid is not None and not bool(within(name, np.asarray(value))):
         rule = RANGES[quantity.valid][1].format(name=quantity.symbol or key)
         raise ValueError(f"{label}: {text!r} is out of range: {rule}")
+    rigid = key == "stiffness" and "inf" in text.lower()
+    if not (low <= value <= high or rigid):
+        unit = DIMENSIONS[quantity.kind][1]
+        raise ValueError(
+            f"{label}: {text!r} is beyond the explorer's bounds, {low:g} to {high:g} {unit}"
+            + (" (or inf, a rigid rig)" if key == "stiffness" else "")
+        )
     return value
 
 
@@ -159,14 +200,14 @@ def map_window(stiffness_ratio: float, aspect_ratio: float) -> tuple[float, floa
 
 @functools.lru_cache(maxsize=_MAPS_KEPT)
 def _ecof_ratio_map(amplitude: float, mu: float, window: tuple) -> np.ndarray:
-    """μ_E/μ over (z_o/x_o, S/P) in the window, from :func:`ecofmaps.compute_map`'s cache."""
+    """μ_E/μ over (z_o/x_o, S/P) in the window, by :func:`ecofmaps.compute_map`."""
     low, high, deepest = window
     dataset = compute_map(
         np.linspace(low, high, _MAP_POINTS[0]),
         np.linspace(0.0, deepest, _MAP_POINTS[1]),
         amplitude=amplitude,
         mu=mu,
-        cache=True,
+        cache=False,
     )
     return np.ascontiguousarray(dataset["ecof_ratio"].values.T)
 
@@ -294,15 +335,15 @@ def explorer_page():
     # The query as typed: Panel's own reading of it turns '0.8' into a float, which a text
     # input refuses, so the inputs start from the request's text and the sync only writes it.
     query = {
-        key: values[-1].decode("utf-8", "replace")
+        key: values[-1][: TEXT_LIMIT + 1].decode("utf-8", "replace")
         for key, values in (pn.state.session_args or {}).items()
-        if key in INPUTS and values
+        if key in INPUTS and values and isinstance(values[-1], bytes)
     }
     inputs = {
         key: pn.widgets.TextInput(
             label=label, value=query.get(key, default), width=220 if key in _MODEL_INPUTS else 160
         )
-        for key, (_, label, default) in INPUTS.items()
+        for key, (_, label, default, _) in INPUTS.items()
     }
     if pn.state.location is not None:
         for key, widget in inputs.items():
@@ -313,18 +354,27 @@ def explorer_page():
     loop_plot, loop_source = _loop_figure()
     map_plot, image, marker, colors = _map_figure()
 
-    def update(*_events):
-        try:
-            values = {key: parameter_value(key, widget.value) for key, widget in inputs.items()}
-        except ValueError as error:
-            message.object = f"<p>{html.escape(str(error))}</p>"
-            return
-        message.object = ""
+    def show(values):
         point = ExplorerPoint.at(*(values[key] for key in _MODEL_INPUTS))
         values_pane.object = _values_html(point, values)
         loop_source.data = {"x": point.loop[0] * 1e6, "y": point.loop[1]}
         _show_map(values, image, marker, colors)
         correction_pane.object = _correction_html(values)
+
+    def update(*_events):
+        """Show the inputs' point; any failure is a message on the page, never Panel's."""
+        try:
+            values = {key: parameter_value(key, widget.value) for key, widget in inputs.items()}
+        except ValueError as error:
+            message.object = f"<p>{html.escape(str(error))}</p>"
+            return
+        try:
+            show(values)
+        except Exception as error:  # a page must stay up whatever the model says
+            text = f"Cannot show this point ({type(error).__name__}: {error})"
+            message.object = f"<p>{html.escape(text)}</p>"
+            return
+        message.object = ""
 
     for widget in inputs.values():
         widget.param.watch(update, "value")
@@ -357,15 +407,79 @@ def explorer_page():
 def warm_up() -> None:
     """Compile the model's functions and fill the map for the default point, so the first
     page comes at once."""
-    values = {key: parameter_value(key, default) for key, (_, _, default) in INPUTS.items()}
+    values = {key: parameter_value(key, default) for key, (_, _, default, _) in INPUTS.items()}
     ExplorerPoint.at(*(values[key] for key in _MODEL_INPUTS))
     window = map_window(values["stiffness"] / values["load"], values["aspect_ratio"])
     _ecof_ratio_map(values["amplitude"], values["mu"], window)
     _correction_html(values)
 
 
-def serve_explorer(port: int, *, open_browser: bool = True, announce=print) -> None:
+def _allowed_hosts(port: int, allow_origin=()) -> frozenset:
+    """The ``host:port`` the explorer answers: :data:`LOCAL_HOSTS` at ``port``, and each of
+    ``allow_origin`` (``host`` or ``host:port``; without a port, ``port``), in lower case."""
+    hosts = {f"{host}:{port}" for host in LOCAL_HOSTS}
+    for entry in allow_origin:
+        entry = entry.strip().lower()
+        hosts.add(entry if re.fullmatch(r".*:\d+", entry) else f"{entry}:{port}")
+    return frozenset(hosts)
+
+
+class _Foreign(Matcher):
+    """Matches a request whose Host, or Origin if it has one, is not an allowed host."""
+
+    def __init__(self, hosts: frozenset):
+        self.hosts = hosts
+
+    def match(self, request):
+        host = request.headers.get("Host", "").lower()
+        origin = request.headers.get("Origin")
+        if origin is not None:
+            parts = urllib.parse.urlsplit(origin.lower())
+            origin = parts.netloc if parts.scheme == "http" else ""
+        foreign = host not in self.hosts or (origin is not None and origin not in self.hosts)
+        return {} if foreign else None
+
+
+class _Forbidden(RequestHandler):
+    """403 for every request it gets, with the way to allow another host."""
+
+    def initialize(self, url: str):
+        self.url = url
+
+    def prepare(self):
+        self.set_status(403)
+        self.set_header("Content-Type", "text/plain; charset=utf-8")
+        self.finish(
+            f"403 Forbidden: this explorer answers the pages of {self.url} only (the request's "
+            "Host or Origin is another). To open it from another host, start it with "
+            "--allow-origin HOST[:PORT].\n"
+        )
+
+
+class _LongQuery(Matcher):
+    """Matches a request whose query holds a value longer than ``_QUERY_LIMIT``."""
+
+    def match(self, request):
+        pairs = urllib.parse.parse_qsl(request.query, keep_blank_values=True)
+        return {} if any(len(value) > _QUERY_LIMIT for _, value in pairs) else None
+
+
+class _CutQuery(RequestHandler):
+    """See Other: the same page with each overlong query value cut to one character over
+    :data:`TEXT_LIMIT`, so Panel never parses a huge number and the page names the input."""
+
+    def prepare(self):
+        pairs = urllib.parse.parse_qsl(self.request.query, keep_blank_values=True)
+        cut = [(key, v if len(v) <= _QUERY_LIMIT else v[: TEXT_LIMIT + 1]) for key, v in pairs]
+        self.redirect(f"{self.request.path}?{urllib.parse.urlencode(cut)}", status=303)
+
+
+def serve_explorer(port: int, *, open_browser: bool = True, announce=print, allow_origin=()):
     """Serve the explorer at ``http://127.0.0.1:<port>/`` until Ctrl-C or SIGTERM.
+
+    Every HTTP request (the page, its resources, the websocket) whose ``Host`` header, or
+    ``Origin`` header if it has one, is not one of :data:`LOCAL_HOSTS` with ``port`` gets a
+    403: another web page, or a DNS rebinding, cannot make it compute.
 
     Parameters
     ----------
@@ -375,6 +489,9 @@ def serve_explorer(port: int, *, open_browser: bool = True, announce=print) -> N
         Open the page in the default browser once the server listens.
     announce : callable
         Called with the line that gives the page's address, once the server listens.
+    allow_origin : sequence of str
+        More hosts to answer, ``host`` or ``host:port`` (without a port, ``port``): for a
+        page reached through a tunnel or a proxy under another name.
 
     Raises
     ------
@@ -382,6 +499,7 @@ def serve_explorer(port: int, *, open_browser: bool = True, announce=print) -> N
         If the port cannot be listened on (in use, or not allowed).
     """
     url = f"http://127.0.0.1:{port}/"
+    hosts = _allowed_hosts(port, allow_origin)
     server = get_server(
         {"/": explorer_page},
         port=port,
@@ -389,8 +507,14 @@ def serve_explorer(port: int, *, open_browser: bool = True, announce=print) -> N
         show=False,
         start=False,
         title="ecofmaps explorer",
-        websocket_origin=[f"127.0.0.1:{port}", f"localhost:{port}"],
+        # Bokeh cannot parse "[::1]:port"; _Foreign checks every request against all hosts.
+        websocket_origin=sorted(h for h in hosts if not h.startswith("[")),
     )
+    # Before Bokeh's and Panel's routes, for every path: Tornado's documented rule router.
+    server._tornado.default_router.rules[:0] = [
+        Rule(_Foreign(hosts), _Forbidden, {"url": url}),
+        Rule(_LongQuery(), _CutQuery),
+    ]
     loop = server.io_loop
 
     def stop(signum, frame):  # the loop stops as soon as it runs (at once if it runs)

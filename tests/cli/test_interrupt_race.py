@@ -104,7 +104,8 @@ def test_a_signal_after_the_last_block_keeps_them_and_says_so(
     assert files(tmp_path) == ["r.csv.partial"] + [
         f"r.csv.partial/{name}"
         for name in sorted(
-            [f"file0-block{block:06d}.npz" for block in range(6)] + ["file0-cycles.npz", "run.json"]
+            [f"file0-block{block:06d}.npz" for block in range(6)]
+            + ["file0-cycles.npz", "kept.jsonl", "run.json"]
         )
     ]
     monkeypatch.setattr(loops, "_write_extras", extras)

@@ -133,6 +133,85 @@ def test_an_interrupted_run_resumes(
     assert not partial.exists()
 
 
+def interrupted(capsys, on_each_block, path, out):
+    """``ecofmaps loops path --out out --resume`` stopped by Ctrl-C after two blocks."""
+
+    def interrupting(received):
+        if len(received) == 2:
+            raise KeyboardInterrupt
+
+    on_each_block(interrupting)
+    status, _, err = run(capsys, path, "--load", "450N", "--out", out, "--resume")
+    on_each_block(None)
+    assert status == 130, err
+
+
+def test_resume_sees_a_recording_changed_in_place(long_test, tmp_path, capsys, small_tasks,
+                                                  on_each_block):  # fmt: skip
+    """The force scaled in place in the store's chunks (its folder's size and time kept):
+    the run kept is not resumed on it."""
+    import shutil
+
+    import zarr
+
+    store = tmp_path / "test.zarr"
+    shutil.copytree(long_test[".zarr"], store)
+    out = tmp_path / "r.csv"
+    interrupted(capsys, on_each_block, store, out)
+    group = zarr.open_group(store, mode="r+")
+    group["force"][:] = group["force"][:] * 1.5
+    status, _, err = run(capsys, store, "--load", "450N", "--out", out, "--resume")
+    assert status == 2 and "holds a run of other files" in err and "delete it" in err
+    assert not out.exists()
+
+
+def _resaved_doubled(blocks, partial):
+    with np.load(blocks[0]) as stored:
+        values = {k: v * 2 if k.startswith("v:") and v.dtype.kind == "f" else v
+                  for k, v in stored.items()}  # fmt: skip
+    with open(blocks[0], "wb") as stream:
+        np.savez(stream, **values)
+    return {blocks[0].name: "changed since it was kept"}
+
+
+def _swapped(blocks, partial):
+    swap = partial / "swap.npz"
+    blocks[0].rename(swap)
+    blocks[1].rename(blocks[0])
+    swap.rename(blocks[1])
+    return {b.name: "changed since it was kept" for b in blocks[:2]}
+
+
+def _extra(blocks, partial):
+    (partial / "file0-block000042.npz").write_bytes(blocks[0].read_bytes())
+    (partial / "file0-block000005.npz").write_bytes(blocks[1].read_bytes())
+    return {
+        "file0-block000042.npz": "is beyond the run's 6 blocks",
+        "file0-block000005.npz": "is not in the run's record",
+    }
+
+
+@pytest.mark.parametrize("tamper", [_resaved_doubled, _swapped, _extra])
+def test_a_kept_block_that_fails_its_check_is_measured_again(
+    long_test, tmp_path, capsys, small_tasks, on_each_block, tamper
+):
+    """Each kept block is checked against the checksum and the cycle rows the run recorded
+    of it: one re-saved with its values doubled, two swapped, one added are each measured
+    again, with a line that names it, and the table is right."""
+    expected = in_memory_table(capsys, long_test[".zarr"], tmp_path)
+    out = tmp_path / "r.csv"
+    interrupted(capsys, on_each_block, long_test[".zarr"], out)
+    partial = tmp_path / "r.csv.partial"
+    blocks = sorted(partial.glob("file0-block*.npz"))[:2]
+    refused = tamper(blocks, partial)
+    status, _, err = run(capsys, long_test[".zarr"], "--load", "450N", "--out", out, "--resume")
+    assert status == 0, err
+    assert out.read_text() == expected
+    for name, reason in refused.items():
+        assert f"{partial / name} {reason}" in err and "measured again" in err
+    assert err.count("\n") == len(refused)
+
+
 def test_the_table_is_written_as_the_blocks_come(long_test, tmp_path, capsys, small_tasks,
                                                  on_each_block):  # fmt: skip
     """Each block's lines are in the temporary file beside --out (in order, after the header)

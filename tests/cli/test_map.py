@@ -81,13 +81,12 @@ def test_map_replaces_only_a_file_it_wrote_and_only_with_overwrite(tmp_path, cap
     assert sorted(p.name for p in tmp_path.iterdir()) == [MANIFEST, "map.nc"]
 
 
-def test_map_uses_the_cache_unless_told_not_to(tmp_path, capsys):
+def test_map_follows_the_library_and_does_not_cache_a_closed_form_map(tmp_path, capsys):
     cache_dir = tmp_path / "cache"
     argv = ["map", *FIG11, "--cache-dir", str(cache_dir), "--out", str(tmp_path / "a.nc")]
     assert run(capsys, *argv, "--no-cache")[0] == 0
-    assert cache_entries(cache_dir) == []
     assert run(capsys, *argv, "--overwrite")[0] == 0
-    assert len(cache_entries(cache_dir)) == 1
+    assert cache_entries(cache_dir) == []
 
 
 @pytest.mark.parametrize(
@@ -173,8 +172,8 @@ def test_cache_list_and_clear(tmp_path, capsys, monkeypatch):
     monkeypatch.setenv("ECOFMAPS_CACHE", str(tmp_path / "cache"))
     status, stdout, _ = run(capsys, "cache", "list")
     assert status == 0 and stdout == f"no cached maps in {tmp_path / 'cache'}\n"
-    assert run(capsys, "map", *FIG11, "--out", str(tmp_path / "a.nc"))[0] == 0
-    assert run(capsys, "map", *FIG11[:-1], "0.5,0.8", "--out", str(tmp_path / "b.nc"))[0] == 0
+    compute_map(1e5, 0.2, 50e-6, 0.8, cache=True)
+    compute_map(1e5, 0.2, 50e-6, np.array([0.5, 0.8]), cache=True)
     entries = cache_entries()
     status, stdout, _ = run(capsys, "cache", "list")
     assert status == 0

@@ -431,3 +431,34 @@ def test_empty_variables_and_two_chunkings(tmp_path):
     second = read_recording(path, lazy=True, chunks=3000).force
     assert first.name != second.name
     np.testing.assert_array_equal((first - second).compute(), 0.0)
+
+
+@pytest.mark.parametrize("kind", ["hdf5", "netcdf"])
+def test_flipped_bytes_in_the_header_name_the_file_as_damaged(tmp_path, capfd, kind):
+    """A byte flipped at offsets all through the metadata: each file reads as it is (a byte
+    that nothing reads) or is refused as damaged, naming the file; never another error, and
+    nothing on stderr (h5netcdf's half-opened file printed a traceback when collected)."""
+    if kind == "hdf5":
+        path = write_hdf5(tmp_path / "rig.h5")
+    else:
+        path = tmp_path / "rig.nc"
+        xr.Dataset(
+            {"displacement": ("time", DISPLACEMENT, {"units": "um"}),
+             "force": ("time", FORCE, {"units": "kN"})}
+        ).to_netcdf(path, engine="h5netcdf")  # fmt: skip
+    original = path.read_bytes()
+    damaged = tmp_path / f"damaged{path.suffix}"
+    refused = 0
+    for offset in range(8, 4096, 37):
+        flipped = bytearray(original)
+        flipped[offset] ^= 0xFF
+        damaged.write_bytes(bytes(flipped))
+        try:
+            read = read_recording(damaged)
+            np.asarray(read.displacement), np.asarray(read.force)
+        except RecordingError as error:
+            refused += 1
+            assert str(error).startswith(f"{damaged}"), offset
+            assert "(truncated or damaged)" in str(error) or "(a damaged file" in str(error)
+    assert refused >= 10
+    assert capfd.readouterr().err == ""

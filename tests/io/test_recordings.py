@@ -1,13 +1,19 @@
 """Reading recording files: formats, columns, units, damaged files."""
 
+import os
+import signal
+import threading
+
 import numpy as np
 import pandas as pd
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from ecofmaps._interrupts import interrupts_stop_writes
 from ecofmaps.io.recording_types import RecordingError, RecordingWarning
-from ecofmaps.io.recordings import read_recording, recording_blocks
+from ecofmaps.io.recordings import _options, read_recording, recording_blocks
+from ecofmaps.io.text import LINE_BYTES, text_blocks
 from ecofmaps.measured.synthetic import synthetic_recording
 
 POINT = dict(amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8, aspect_ratio=0.2)
@@ -392,3 +398,63 @@ def test_text_round_trip(tmp_path, values, separator, comma, quoted, newline, no
     np.testing.assert_array_equal(read.displacement.view(np.int64), displacement.view(np.int64))
     np.testing.assert_array_equal(read.force.view(np.int64), force.view(np.int64))
     np.testing.assert_array_equal(read.line(np.arange(read.size)), numbers)
+
+
+# --- inputs that never end ---------------------------------------------------------------
+
+
+def read_in_a_thread(path, **options):
+    """What read_recording(path) raises, from a thread given a minute (an unguarded read of a
+    pipe blocks until a writer comes, and would hang the test rather than fail it)."""
+    caught = []
+
+    def reading():
+        try:
+            read_recording(path, **options)
+        except Exception as error:  # the one to check
+            caught.append(error)
+
+    thread = threading.Thread(target=reading, daemon=True)
+    thread.start()
+    thread.join(60)
+    assert not thread.is_alive(), f"reading {path} did not return"
+    return caught[0] if caught else None
+
+
+def test_a_pipe_or_a_device_is_refused_by_name(tmp_path):
+    fifo = tmp_path / "rig.csv"
+    os.mkfifo(fifo)
+    error = read_in_a_thread(fifo)
+    assert isinstance(error, RecordingError)
+    assert str(error).startswith(f"{fifo}: a named pipe (FIFO), not a regular file")
+    error = read_in_a_thread("/dev/null")
+    assert isinstance(error, RecordingError)
+    assert str(error).startswith("/dev/null: a character device, not a regular file")
+
+
+@pytest.mark.parametrize("newline", [True, False])
+def test_a_line_longer_than_the_bound_is_refused_at_that_line(tmp_path, newline):
+    """Refused at its line whether it ends within the block read or goes on past it, and
+    whether it is many blocks long or fits in one."""
+    path = tmp_path / "long.csv"
+    line = b"1" * (LINE_BYTES + 1) + b",2" + (b"\n" if newline else b"")
+    path.write_bytes(b"displacement,force\n1,2\n# a note\n3,4\n" + line + b"5,6\n" * 10)
+    for block_bytes in (1 << 16, 1 << 24):
+        with pytest.raises(RecordingError) as refused:
+            read_recording(path, block_bytes=block_bytes)
+        assert str(refused.value).startswith(f"{path}, line 5: a line longer than 1048576 bytes")
+    path.write_bytes(b"displacement,force\n1,2\n#" + b"-" * (LINE_BYTES - 1) + b"\n3,4\n")
+    assert read_recording(path).size == 2  # a line of the bound itself is read
+
+
+def test_a_stop_signal_is_honoured_between_blocks_while_parsing(tmp_path):
+    path = tmp_path / "rig.csv"
+    path.write_bytes(b"displacement,force\n" + b"1.5,2.5\n" * 20000)
+    blocks = text_blocks(path, _options(), block_bytes=1 << 12)
+    with pytest.raises(KeyboardInterrupt), interrupts_stop_writes():
+        next(blocks)  # the header
+        next(blocks)
+        os.kill(os.getpid(), signal.SIGTERM)
+        for _ in blocks:
+            pass
+    blocks.close()

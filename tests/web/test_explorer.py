@@ -1,7 +1,9 @@
 """The live explorer (ecofmaps explore, ecofmaps.web.explorer): its inputs, and the server in a
 real browser: the model's numbers for parameters in the URL, an input typed, a clean stop."""
 
+import http.client
 import math
+import os
 import selectors
 import signal
 import socket
@@ -14,7 +16,8 @@ import pytest
 
 import ecofmaps
 from ecofmaps.cli import explore
-from ecofmaps.web.explorer import explorer_page, map_window, parameter_value
+from ecofmaps.web import explorer
+from ecofmaps.web.explorer import TEXT_LIMIT, explorer_page, map_window, parameter_value
 from tests.cli.commands import run
 from tests.web.pages import CANVAS_INK, console_errors, deep_texts, wait_for
 
@@ -41,6 +44,24 @@ def test_inputs_are_read_with_units_or_in_si():
         parameter_value("load", "-3N")
     with pytest.raises(ValueError, match="Rig stiffness S"):
         parameter_value("stiffness", "35um")
+
+
+#: Hostile query values: (key, text, what the page's message says).
+HOSTILE = [
+    ("aspect_ratio", "1e308", "Groove aspect ratio z_o/x_o: '1e308' is beyond the explorer's"),
+    ("stiffness", "1.7e308", "Rig stiffness S: '1.7e308' is beyond the explorer's bounds"),
+    ("stiffness", "1e308MN/m", "Rig stiffness S: '1e308MN/m' is beyond the explorer's bounds"),
+    ("amplitude", "1" * 5000, f"Displacement amplitude Δ*: more than {TEXT_LIMIT} characters"),
+    ("load", "9**9**9 N", "Normal load P: '9**9**9 N' is not a number with a unit"),
+    ("mu", "nan", "Contact CoF μ: 'nan' is not a number with a unit"),
+]
+
+
+@pytest.mark.parametrize(("key", "text", "message"), HOSTILE)
+def test_hostile_inputs_are_refused_before_any_arithmetic(key, text, message):
+    with pytest.raises(ValueError) as refused:
+        parameter_value(key, text)
+    assert str(refused.value).startswith(message)
 
 
 def test_the_map_window_holds_the_point():
@@ -101,8 +122,8 @@ def started():
 
 
 @pytest.fixture(scope="module")
-def server(started, browser):
-    """The explorer once it listens (the browser starts while it compiles the model)."""
+def listening(started):
+    """The explorer once it listens."""
     process, url = started
     with selectors.DefaultSelector() as waiting:
         waiting.register(process.stdout, selectors.EVENT_READ)
@@ -112,6 +133,12 @@ def server(started, browser):
         process.kill()
         pytest.fail(f"the explorer did not start: {line!r} {process.communicate()[1]!r}")
     return process, url
+
+
+@pytest.fixture(scope="module")
+def server(started, browser, listening):
+    """The explorer once it listens (the browser starts while it compiles the model)."""
+    return listening
 
 
 def shown_values(driver) -> dict:
@@ -162,9 +189,70 @@ def test_a_typed_input_updates_the_page_and_its_url(browser, server):
     assert console_errors(browser) == []
 
 
-def test_sigterm_stops_it_cleanly(server):
+def answer(url: str, target: str, headers: dict) -> tuple:
+    """(status, Location header) of a GET of ``target`` at the server, with ``headers``."""
+    port = urllib.parse.urlsplit(url).port
+    connection = http.client.HTTPConnection("127.0.0.1", port, timeout=60)
+    try:
+        connection.request("GET", target, headers=headers)
+        response = connection.getresponse()
+        response.read()
+        return response.status, response.getheader("Location")
+    finally:
+        connection.close()
+
+
+def test_only_local_pages_are_answered(listening):
+    """Host and Origin of every request, page and websocket alike; 403 for another's."""
+    _, url = listening
+    port = urllib.parse.urlsplit(url).port
+    local = {"Host": f"localhost:{port}"}
+    assert answer(url, "/", local)[0] == 200
+    assert answer(url, "/", {"Host": f"127.0.0.1:{port}", "Origin": url.rstrip("/")})[0] == 200
+    foreign = [
+        {"Host": f"evil.example:{port}", "Origin": "http://evil.example"},
+        {"Host": f"evil.example:{port}"},  # a DNS rebinding
+        dict(local, Origin="http://evil.example"),
+        dict(local, Origin="null"),
+        {"Host": f"localhost:{port + 1}"},
+    ]
+    for headers in foreign:
+        for target in ("/?mu=0.7", "/ws", "/static/js/bokeh.min.js"):
+            assert answer(url, target, headers)[0] == 403, (headers, target)
+
+
+def test_a_huge_query_value_is_cut_before_panel_reads_it(listening):
+    _, url = listening
+    port = urllib.parse.urlsplit(url).port
+    status, location = answer(
+        url, "/?amplitude=" + "1" * 5000 + "&mu=0.7", {"Host": f"127.0.0.1:{port}"}
+    )
+    assert status == 303
+    assert location == "/?amplitude=" + "1" * (TEXT_LIMIT + 1) + "&mu=0.7"
+
+
+@pytest.mark.parametrize(("key", "text", "message"), [h for h in HOSTILE if h[0] != "load"])
+def test_a_hostile_query_is_a_message_on_the_page(browser, server, key, text, message):
+    _, url = server
+    browser.get(url + "?" + urllib.parse.urlencode({key: text, "load": "1N"}))
+    wait_for(lambda: any(message in t for t, _ in deep_texts(browser, "p")))
+    assert console_errors(browser) == []
+
+
+def test_nothing_is_written_to_disk_per_page(browser, server):
+    cache = os.environ["ECOFMAPS_CACHE"]
+    before = sorted(os.walk(cache))
+    _, url = server
+    for mu in ("0.55", "0.65"):
+        view = dict(VIEWS["example 2"], mu=mu)
+        browser.get(url + "?" + urllib.parse.urlencode(view))
+        wait_for(lambda view=view: shown_values(browser).get("ecof_ratio") == expected_ratio(view))
+    assert sorted(os.walk(cache)) == before
+
+
+def test_sigterm_stops_it_cleanly(listening):
     """Last of the module: the server stops on SIGTERM, exit 0, no traceback."""
-    process, _ = server
+    process, _ = listening
     process.send_signal(signal.SIGTERM)
     out, err = process.communicate(timeout=60)
     assert process.returncode == 0, err
@@ -189,3 +277,19 @@ def test_the_page_follows_its_inputs():
     assert f"data-quantity='ecof_ratio'>{rigid:.3f}<" in shown()
     inputs["Normal load P"].value = "-3N"
     assert "Normal load P: &#x27;-3N&#x27; is out of range" in shown()
+    inputs["Normal load P"].value = "1N"
+    inputs["Rig stiffness S"].value = "1.7e308"
+    assert "Rig stiffness S: &#x27;1.7e308&#x27; is beyond the explorer&#x27;s bounds" in shown()
+
+
+def test_a_failure_while_updating_is_a_message_on_the_page(monkeypatch):
+    page = explorer_page()
+    inputs = {widget.label: widget for widget in page.select(pn.widgets.TextInput)}
+
+    def fails(*args):
+        raise OverflowError("math range error")
+
+    monkeypatch.setattr(explorer.ExplorerPoint, "at", fails)
+    inputs["Contact CoF μ"].value = "0.7"
+    shown = " ".join(str(pane.object) for pane in page.select(pn.pane.HTML))
+    assert "Cannot show this point (OverflowError: math range error)" in shown
