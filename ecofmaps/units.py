@@ -14,7 +14,7 @@ from decimal import Decimal
 
 import numpy as np
 
-__all__ = ["DIMENSIONS", "parse_quantity", "parse_values"]
+__all__ = ["DIMENSIONS", "PLAUSIBLE", "bare_number_warning", "parse_quantity", "parse_values"]
 
 #: Physical dimension of each kind of quantity, with its SI unit and an example.
 DIMENSIONS = {
@@ -28,6 +28,57 @@ DIMENSIONS = {
     "archard": ("[length] / [force]", "m**2/N", "1e-6mm**3/(N*m)"),
     "dimensionless": ("", "1", "0.8"),
 }
+
+
+#: The values [SI] a quantity typed as a bare number (which is SI) plausibly takes in a
+#: fretting test, (low, high; None: no bound), and the units, in the order tried, that such a
+#: number outside them was probably meant in (:func:`bare_number_warning`).
+PLAUSIBLE = {
+    "amplitude": (0.1e-6, 5e-3, ("um", "mm")),
+    "groove_half_width": (0.1e-6, 5e-3, ("um", "mm")),
+    "scar_half_width": (0.1e-6, 5e-3, ("um", "mm")),
+    "scar_depth": (None, 5e-3, ("um",)),
+    "load": (None, 100e3, ("mN",)),
+    "stiffness": (0.1e6, None, ("MN/m", "N/um")),
+    "stiffness_ratio": (100.0, None, ("/um", "/mm")),
+}
+
+
+def bare_number_warning(name: str, text: str, kind: str) -> str | None:
+    """Why ``text``, a bare number for quantity ``name`` (of ``kind``, a key of
+    :data:`DIMENSIONS`), is implausible in SI, with the unit probably meant; None if ``text``
+    has a unit or is plausible (:data:`PLAUSIBLE`).
+
+    Examples
+    --------
+    >>> bare_number_warning("amplitude", "50", "length")
+    '50 is 50 m; did you mean 50um?'
+    >>> bare_number_warning("amplitude", "50um", "length") is None
+    True
+    """
+    if name not in PLAUSIBLE:
+        return None
+    try:
+        value = float(text)
+    except ValueError:  # a unit given
+        return None
+    low, high, meant = PLAUSIBLE[name]
+    plausible = functools.partial(_within, low, high)
+    if not math.isfinite(value) or value == 0 or plausible(value):
+        return None
+    said = f"{text.strip()} is {value:g} {DIMENSIONS[kind][1]}"
+    for unit in meant:
+        if plausible(parse_quantity(f"{text.strip()}{unit}", kind)):
+            return f"{said}; did you mean {text.strip()}{unit}?"
+    if high is None:
+        span = f"at least {low:g}"
+    else:
+        span = f"at most {high:g}" if low is None else f"{low:g} to {high:g}"
+    return f"{said}; a fretting test's is {span} {DIMENSIONS[kind][1]}"
+
+
+def _within(low, high, value: float) -> bool:
+    return (low is None or value >= low) and (high is None or value <= high)
 
 
 # A plain decimal number followed by a unit name, e.g. "25um", "3.3 MN/m", "1e-3 m".

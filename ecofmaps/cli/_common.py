@@ -1,10 +1,12 @@
-"""What the subcommands share: quantities read with units, user errors, printed tables."""
+"""What the subcommands share: quantities and counts read with units, the options that find a
+recording's columns, the one rule for writing outputs, printed rows and sizes."""
 
 from __future__ import annotations
 
 import argparse
 import math
 import os
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -12,12 +14,14 @@ import numpy as np
 from ecofmaps._nomenclature import QUANTITIES, RANGES, within
 from ecofmaps.cli.main import CommandError
 from ecofmaps.io.files import MANIFEST, written_by_ecofmaps
-from ecofmaps.units import DIMENSIONS, parse_quantity, parse_values
+from ecofmaps.units import DIMENSIONS, bare_number_warning, parse_quantity, parse_values
 
 __all__ = [
     "CommandError",
+    "add_recording_options",
+    "byte_size",
+    "count",
     "print_rows",
-    "quantities",
     "quantity",
     "recording_options",
     "refuse_to_overwrite",
@@ -37,48 +41,34 @@ def _in_range(name: str, values: np.ndarray, text: str) -> None:
     raise ValueError(f"{text!r} is out of range: the {described.words} must satisfy {valid}{unit}")
 
 
-def quantity(name: str):
-    """An argparse ``type`` reading one value of quantity ``name`` with units, range-checked.
-
-    The dimension and the valid range are quantity ``name``'s in the nomenclature, so a bad
-    value is reported by argparse with the option the user typed.
-    """
+def quantity(name: str, grid: bool = False, option: str | None = None):
+    """An argparse ``type`` reading a value of quantity ``name`` with units (with ``grid``, a
+    list ``a,b,c`` or a range ``start:stop:num`` of values that do not repeat), checked against
+    its dimension and valid range in the nomenclature (argparse names the option). A bare
+    number implausible in SI is warned, naming ``option`` (default ``--name``) and the unit
+    probably meant."""
     kind = QUANTITIES[name].kind
-
-    def parse(text: str) -> float:
-        try:
-            value = parse_quantity(text, kind)
-            _in_range(name, np.asarray(value), text)
-        except ValueError as error:
-            raise argparse.ArgumentTypeError(str(error)) from None
-        return value
-
-    parse.__name__ = kind
-    return parse
-
-
-def quantities(name: str):
-    """An argparse ``type`` reading a list ``a,b,c`` or a range ``start:stop:num`` of ``name``.
-
-    Every value must be in quantity ``name``'s range, and no value may repeat (a grid axis).
-    """
-    kind = QUANTITIES[name].kind
+    option = option or "--" + name.replace("_", "-")
 
     def parse(text: str):
         try:
-            values = parse_values(text, kind)
-            _in_range(name, values, text)
+            value = parse_values(text, kind) if grid else parse_quantity(text, kind)
+            _in_range(name, np.asarray(value), text)
         except ValueError as error:
             raise argparse.ArgumentTypeError(str(error)) from None
-        unique, counts = np.unique(values, return_counts=True)
+        unique, counts = np.unique(value, return_counts=True)
         if np.any(counts > 1):
             raise argparse.ArgumentTypeError(
                 f"{text!r} repeats the value {unique[counts > 1][0]:g}: a grid axis takes "
                 "each value once"
             )
-        return values
+        items = text.split(":")[:2] if grid and ":" in text else text.split(",")
+        for item in items if grid else [text]:
+            if said := bare_number_warning(name, item, kind):
+                warnings.warn(f"{option} {said}", stacklevel=2)
+        return value
 
-    parse.__name__ = kind
+    parse.__name__, parse.option = kind, option
     return parse
 
 
@@ -91,8 +81,8 @@ def unit(kind: str):
 
     def parse(text: str) -> str:
         if not text.strip():
-            raise argparse.ArgumentTypeError(f"an empty unit; give a {kind} unit such as "
-                                             f"{DIMENSIONS[kind][1]}")  # fmt: skip
+            example = DIMENSIONS[kind][1]
+            raise argparse.ArgumentTypeError(f"an empty unit; give a {kind} unit such as {example}")
         try:
             scale = parse_quantity(f"1 {text}", kind)
         except ValueError as error:
@@ -106,6 +96,66 @@ def unit(kind: str):
 
     parse.__name__ = f"{kind} unit"
     return parse
+
+
+def count(what: str):
+    """An argparse ``type`` reading a whole number of ``what`` >= 1 (``4194304``, ``4e6``)."""
+
+    def parse(text: str) -> int:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not (math.isfinite(value) and value.is_integer() and value >= 1):
+            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of {what} >= 1")
+        return int(value)
+
+    parse.__name__ = what
+    return parse
+
+
+def add_recording_options(parser) -> None:
+    """The options that say where a recording's columns are and in which units."""
+    for option, default, help in (
+        (
+            "--displacement-col",
+            "displacement",
+            "name of the displacement column (default: displacement)",
+        ),
+        ("--force-col", "force", "name of the tangential force column (default: force)"),
+        (
+            "--cycle-col",
+            None,
+            "name of a column of cycle numbers, which must exist (default: 'cycle' if the file "
+            "has it; else cycles are cut at the reversals)",
+        ),
+    ):
+        parser.add_argument(option, default=default, metavar="NAME", help=help)
+    parser.add_argument(
+        "--skip-rows",
+        type=int,
+        metavar="N",
+        help="lines of a text file to skip before its header line (default: metadata lines "
+        "before the header are found)",
+    )
+    parser.add_argument(
+        "--displacement-unit",
+        type=unit("length"),
+        metavar="UNIT",
+        help="unit of the displacement column (default: the one its name or the file gives, as "
+        "in 'displacement [mm]' or a channel's unit, else um)",
+    )
+    parser.add_argument(
+        "--force-unit",
+        type=unit("force"),
+        metavar="UNIT",
+        help="unit of the force column (default: from its name or the file, else N)",
+    )
+    parser.add_argument(
+        "--group",
+        metavar="NAME",
+        help="TDMS group, or HDF5/netCDF/zarr group, holding the channels (default: any)",
+    )
 
 
 def recording_options(args) -> dict:
@@ -131,19 +181,8 @@ def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=())
     not a store ecofmaps wrote, are never replaced. A folder the command writes files into
     (``--plots``, ``figures --out``) may exist empty; one that holds anything needs
     ``--overwrite``, and then only ecofmaps' own files in it are replaced, the others kept.
-    Everything is checked before any work.
-
-    Parameters
-    ----------
-    outputs : iterable of (str, path-like)
-        Each output file or store as (the option that names it, its path); a None path is
-        skipped.
-    inputs : iterable of path-like
-        The files the command reads.
-    overwrite : bool
-        Whether ``--overwrite`` was given.
-    folders : iterable of (str, path-like)
-        Each folder written into as (its option, its path); None is skipped.
+    Everything is checked before any work. ``outputs`` and ``folders`` are (the option that
+    names it, its path or None); ``inputs`` the files the command reads.
     """
     outputs = [(option, Path(path)) for option, path in outputs if path is not None]
     sources = [Path(path) for path in inputs]
@@ -204,3 +243,9 @@ def print_rows(title: str, rows) -> None:
     print(title)
     for item in rows:
         print("" if item is None else f"  {item[0]:<32} {item[1]:<8} {item[2]}".rstrip())
+
+
+def byte_size(size: float) -> str:
+    """``size`` [byte] in words: ``'88 TB'``, ``'512 kB'``, ``'12 B'`` (decimal units)."""
+    power = min(int(math.log10(max(size, 1)) // 3), 5)
+    return f"{size / 1000**power:.3g} {('B', 'kB', 'MB', 'GB', 'TB', 'PB')[power]}"

@@ -1,12 +1,10 @@
 """The ``--scar-profile FILE`` options that ``ecofmaps model`` and ``ecofmaps correct`` share.
 
-A measured wear-scar profile (a profilometer trace across the scar, read by
-:func:`ecofmaps.read_scar_profile`) replaces the parabolic groove of the paper's eq. 11.
-The reading options are those of :func:`ecofmaps.read_scar_profile`; they apply only with
-``--scar-profile``, and the groove options of the parabola (``--aspect-ratio``, the scar's
-depth and half-width) cannot be given with it. What the reading decided (outliers replaced,
-ambiguous edges beside pile-up ridges) is printed on standard error, one line each naming
-the file, and the rows show the half-width taken beside the alternative.
+A measured wear-scar profile (read by :func:`ecofmaps.read_scar_profile`, with its reading
+options, which apply only with ``--scar-profile``) replaces the parabolic groove of eq. 11,
+whose options cannot be given with it. What the reading decided (outliers replaced, ambiguous
+edges) is printed on standard error, one line each, and the rows show the half-width taken
+beside the alternative.
 """
 
 from __future__ import annotations
@@ -21,7 +19,6 @@ import numpy as np
 from ecofmaps.cli._common import CommandError, quantity, row, unit
 
 __all__ = [
-    "PROFILE_OPTIONS",
     "add_profile_options",
     "profile_rows",
     "read_profile",
@@ -29,11 +26,6 @@ __all__ = [
     "two_values",
 ]
 
-#: The reading options (argparse destinations) that need ``--scar-profile``.
-PROFILE_OPTIONS = (
-    "x_column", "z_column", "x_unit", "z_unit", "no_level", "profile_half_width", "smoothing",
-    "mapping",
-)  # fmt: skip
 _DEFAULTS = {"x_column": "x", "z_column": "z", "no_level": False, "mapping": "scaled"}
 
 
@@ -46,71 +38,71 @@ def add_profile_options(parser: argparse.ArgumentParser) -> None:
         "the parabolic groove of eq. 11",
     )
     group.add_argument(
-        "--scar-profile", metavar="FILE", default=None,
+        "--scar-profile",
+        metavar="FILE",
         help="the scar's profile (CSV, TSV or whitespace-separated text)",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--x-column", default=None, metavar="NAME",
+        "--x-column",
+        metavar="NAME",
         help="name of the position column (default: x)",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--z-column", default=None, metavar="NAME",
+        "--z-column",
+        metavar="NAME",
         help="name of the height column (default: z)",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--x-unit", type=unit("length"), default=None, metavar="UNIT",
+        "--x-unit",
+        type=unit("length"),
+        metavar="UNIT",
         help="unit of the positions (default: the one the column's name gives, else um)",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--z-unit", type=unit("length"), default=None, metavar="UNIT",
+        "--z-unit",
+        type=unit("length"),
+        metavar="UNIT",
         help="unit of the heights (default: the one the column's name gives, else um)",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--no-level", action="store_true", default=None,
+        "--no-level",
+        action="store_true",
+        default=None,
         help="keep the trace's tilt and offset (default: level it on the unworn shoulders)",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--profile-half-width", type=quantity("scar_half_width"), default=None, metavar="W",
+        "--profile-half-width",
+        type=quantity("scar_half_width", option="--profile-half-width"),
+        metavar="W",
         help="the scar's half-width W, e.g. 500um (default: the one detected at the edges)",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--smoothing", type=quantity("smoothing"), default=None, metavar="LENGTH",
+        "--smoothing",
+        type=quantity("smoothing"),
+        metavar="LENGTH",
         help="length over which the slopes are smoothed, e.g. 10um; 0 for none "
         "(default: 2%% of the half-width)",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--mapping", choices=("scaled", "physical"), default=None,
+        "--mapping",
+        choices=("scaled", "physical"),
         help="where the pad at slip position x sits on the profile: 'scaled', X = x W/x_o "
         "(eq. 11, the paper's; default), or 'physical', X = x",
-    )  # fmt: skip
-    parser.set_defaults(profile_command=parser.prog)
+    )
+    reading = tuple(action.dest for action in group._group_actions[1:])  # need --scar-profile
+    parser.set_defaults(profile_command=parser.prog, profile_options=reading)
 
 
 def read_profile(args, conflicting=()):
     """The profile ``--scar-profile`` names (read with its options), or ``None``.
 
-    Parameters
-    ----------
-    args : argparse.Namespace
-    conflicting : iterable of str
-        Destinations of the parabola's groove options, which cannot be given with a profile.
-
-    Raises
-    ------
-    CommandError
-        For a groove option given with ``--scar-profile``, or a reading option without it.
-    ScarProfileError
-        For a damaged file (its name and line).
-
-    Notes
-    -----
-    The reader's :class:`~ecofmaps.model.profiles.ScarProfileWarning` (outliers replaced,
-    ambiguous edges) are printed on standard error, one line each, naming the file; for
-    ambiguous edges the line ends with the ``--profile-half-width`` that takes the other
-    half-width (the groove's or the band's).
+    A groove option of the parabola (the destinations ``conflicting``) given with it, or a
+    reading option without it, is a :class:`CommandError`. The reader's warnings are printed
+    one line each, naming the file; for ambiguous edges the line ends with the
+    ``--profile-half-width`` that takes the other half-width (the groove's or the band's).
     """
     if args.scar_profile is None:
-        given = [name for name in PROFILE_OPTIONS if getattr(args, name) is not None]
+        given = [name for name in args.profile_options if getattr(args, name) is not None]
         if given:
             raise CommandError(f"{_options(given)} reads a --scar-profile: give the FILE too")
         for name, value in _DEFAULTS.items():
@@ -149,10 +141,14 @@ def read_profile(args, conflicting=()):
         alternative = item.message.alternative
         if alternative is not None:
             args.profile_alternative = item.message.alternative_name
-        hint = "" if alternative is None else (
-            f"; --profile-half-width {alternative * 1e6:.6g}um takes the "
-            f"{item.message.alternative_name}"
-        )  # fmt: skip
+        hint = (
+            ""
+            if alternative is None
+            else (
+                f"; --profile-half-width {alternative * 1e6:.6g}um takes the "
+                f"{item.message.alternative_name}"
+            )
+        )
         print(f"{args.profile_command}: warning: {item.message.summary}{hint}", file=sys.stderr)
     return profile
 

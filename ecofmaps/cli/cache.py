@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import textwrap
 
-__all__ = ["add"]
+from ecofmaps.cli._common import byte_size
+
+__all__ = ["add", "run"]
 
 
 def add(subparsers) -> None:
@@ -21,13 +23,36 @@ def add(subparsers) -> None:
         ),
     )
     actions = parser.add_subparsers(title="actions", metavar="ACTION", required=True)
-    for name, handler, text in (
-        ("list", "ecofmaps.cli.cache_run:list_cache", "list the cached maps with their sizes"),
-        ("clear", "ecofmaps.cli.cache_run:clear", "remove every cached map"),
+    for name, text in (
+        ("list", "list the cached maps with their sizes"),
+        ("clear", "remove every cached map"),
     ):
         action = actions.add_parser(name, help=text, description=text + ".")
         action.add_argument(
-            "--cache-dir", default=None, metavar="DIR",
+            "--cache-dir",
+            metavar="DIR",
             help="cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)",
-        )  # fmt: skip
-        action.set_defaults(handler=handler)  # imported when it runs
+        )
+        action.set_defaults(action=name)
+
+
+def run(args) -> int:
+    """Run ``ecofmaps cache list`` or ``clear``: the cached maps with their sizes, or every
+    cached map removed; the exit status."""
+    from ecofmaps.maps.cache import cache_directory, cache_entries, clear_cache
+
+    directory = cache_directory(args.cache_dir)
+    if args.action == "clear":
+        files, size = clear_cache(directory)
+        print(f"removed {files} file(s), {byte_size(size)}, from {directory}")
+        return 0
+    entries = cache_entries(directory)
+    if not entries:
+        print(f"no cached maps in {directory}")
+        return 0
+    print(f"cached maps in {directory}:")
+    for entry in entries:
+        modified = entry.modified.astimezone().strftime("%Y-%m-%d %H:%M:%S")
+        print(f"  {byte_size(entry.size):>9}  {modified}  {entry.path.name}")
+    print(f"{len(entries)} file(s), {byte_size(sum(entry.size for entry in entries))}")
+    return 0

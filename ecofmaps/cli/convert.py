@@ -4,20 +4,18 @@ from __future__ import annotations
 
 import argparse
 import textwrap
+from pathlib import Path
 
-from ecofmaps.cli._common import unit
+from ecofmaps.cli._common import (
+    CommandError,
+    add_recording_options,
+    count,
+    recording_options,
+    refuse_to_overwrite,
+)
+from ecofmaps.io.files import record_written
 
-__all__ = ["add"]
-
-
-def _samples(text: str) -> int:
-    try:
-        value = float(text)
-    except ValueError:
-        value = 0.0
-    if not (value >= 1 and value.is_integer()):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of samples >= 1")
-    return int(value)
+__all__ = ["add", "run"]
 
 
 def add(subparsers) -> None:
@@ -38,29 +36,44 @@ def add(subparsers) -> None:
     )
     parser.add_argument("source", metavar="SRC", help="the recording to read")
     parser.add_argument("destination", metavar="DST", help="the file or store to write")
-    parser.add_argument("--displacement-col", default="displacement", metavar="NAME")
-    parser.add_argument("--force-col", default="force", metavar="NAME")
-    parser.add_argument("--cycle-col", default=None, metavar="NAME")
+    add_recording_options(parser)
     parser.add_argument(
-        "--skip-rows", type=int, default=None, metavar="N",
-        help="lines of a text file to skip before its header (default: found)",
-    )  # fmt: skip
-    parser.add_argument(
-        "--displacement-unit", type=unit("length"), default=None, metavar="UNIT",
-        help="unit of the displacement column (default: from its name or the file, else um)",
-    )  # fmt: skip
-    parser.add_argument(
-        "--force-unit", type=unit("force"), default=None, metavar="UNIT",
-        help="unit of the force column (default: from its name or the file, else N)",
-    )  # fmt: skip
-    parser.add_argument("--group", default=None, metavar="NAME", help="TDMS/HDF5/zarr group")
-    parser.add_argument(
-        "--chunk-samples", type=_samples, default=1 << 20, metavar="N",
+        "--chunk-samples",
+        type=count("samples"),
+        default=1 << 20,
+        metavar="N",
         help="samples per chunk of the store, and per block read (default 1048576)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--overwrite", action="store_true",
+        "--overwrite",
+        action="store_true",
         help="replace DST if ecofmaps wrote it (once the new one is complete); a file or "
         "folder ecofmaps did not write is never replaced",
-    )  # fmt: skip
-    parser.set_defaults(handler="ecofmaps.cli.convert_run:run")  # imported when it runs
+    )
+
+
+def run(args) -> int:
+    """Run ``ecofmaps convert`` with the parsed ``args``; the exit status."""
+    from ecofmaps.io.recordings import read_recording
+    from ecofmaps.io.writers import WRITE_FORMATS, convert_recording
+
+    source, destination = Path(args.source), Path(args.destination)
+    if destination.suffix.lower() not in WRITE_FORMATS:
+        raise CommandError(
+            f"cannot tell the format of {destination} from its suffix: use one of "
+            f"{', '.join(WRITE_FORMATS)}"
+        )
+    if not destination.parent.is_dir():
+        raise CommandError(f"cannot write {destination}: its directory does not exist")
+    refuse_to_overwrite([("DST", destination)], [source], overwrite=args.overwrite)
+    convert_recording(
+        source,
+        destination,
+        chunk_samples=args.chunk_samples,
+        overwrite=args.overwrite,
+        **recording_options(args),
+    )
+    record_written([destination])
+    written = read_recording(destination, lazy=True)
+    print(f"wrote {destination}: {written.size} samples of {', '.join(written.columns)} (SI)")
+    return 0

@@ -2,12 +2,22 @@
 
 from __future__ import annotations
 
-from ecofmaps.cli._common import quantity
+import sys
+import warnings
+from pathlib import Path
+
+from ecofmaps._version import __version__
+from ecofmaps.cli._common import CommandError, print_rows, quantity, refuse_to_overwrite, row
 from ecofmaps.cli._profile import (
     add_profile_options,
+    profile_rows,
+    read_profile,
+    two_columns_header,
+    two_values,
 )
+from ecofmaps.io.files import record_written, write_text
 
-__all__ = ["GROOVE_OPTIONS", "POINT_OPTIONS", "add"]
+__all__ = ["add", "run"]
 
 POINT_OPTIONS = ("ecof", "amplitude", "load", "stiffness")
 GROOVE_OPTIONS = ("aspect_ratio", "scar_depth", "scar_half_width")
@@ -29,9 +39,11 @@ def add(subparsers) -> None:
             "column and adds mu and correction_factor. With "
             "--scar-profile FILE a measured wear-scar profile gives the scar instead (of the "
             "point, or of every row of a table, which then has no scar columns), and the "
-            "parabola of the same D/W is given beside it (mu_parabolic in a table). A bad "
-            "row stops the run, naming the file and line (the header is line 1); nothing is "
-            "written then."
+            "parabola of the same D/W is given beside it (mu_parabolic in a table). A row "
+            "that cannot be corrected (a cell that is not a number, an ECoF no gross-slip "
+            "loop gives) gets NaN and its reason in a status column, with one error line "
+            "naming the file, line (the header is line 1) and column; the other rows are "
+            "written, and the exit status is 1."
         ),
     )
     parser.add_argument(
@@ -41,29 +53,143 @@ def add(subparsers) -> None:
         help="table of reported ECoFs (',', ';' or tab separated)",
     )
     parser.add_argument(
-        "--out", metavar="OUT", default=None,
+        "--out",
+        metavar="OUT",
         help="write the corrected table here (the table's separator; default: standard output)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--overwrite", action="store_true",
+        "--overwrite",
+        action="store_true",
         help="replace --out if ecofmaps wrote it; a file ecofmaps did not write is never replaced",
-    )  # fmt: skip
+    )
     parser.add_argument("--ecof", type=quantity("ecof"), help="reported energy CoF μ_E, e.g. 0.83")
     parser.add_argument(
         "--amplitude", type=quantity("amplitude"), help="displacement amplitude Δ*, e.g. 50um"
     )
     parser.add_argument("--load", type=quantity("load"), help="normal load P, e.g. 450N")
     parser.add_argument(
-        "--stiffness", type=quantity("stiffness"),
+        "--stiffness",
+        type=quantity("stiffness"),
         help="rig stiffness S, e.g. 35MN/m ('inf' for a rigid rig)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--aspect-ratio", type=quantity("aspect_ratio"),
+        "--aspect-ratio",
+        type=quantity("aspect_ratio"),
         help="wear scar depth over half-width z_o/x_o = D/W, e.g. 0.2",
-    )  # fmt: skip
+    )
     parser.add_argument("--scar-depth", type=quantity("scar_depth"), help="scar depth D, e.g. 8um")
     parser.add_argument(
         "--scar-half-width", type=quantity("scar_half_width"), help="scar half-width W, e.g. 40um"
     )
     add_profile_options(parser)
-    parser.set_defaults(handler="ecofmaps.cli.correct_run:run")  # imported when it runs
+
+
+def run(args) -> int:
+    """Run ``ecofmaps correct`` with the parsed ``args``; the exit status."""
+    from ecofmaps.correction.inversion import correct_ecof
+
+    given = [name for name in (*POINT_OPTIONS, *GROOVE_OPTIONS) if getattr(args, name) is not None]
+    if args.table is not None:
+        if given:
+            options = ", ".join("--" + name.replace("_", "-") for name in given)
+            raise CommandError(f"give a TABLE or one point's options, not both ({options})")
+        if args.out is not None and not Path(args.out).parent.is_dir():
+            raise CommandError(f"cannot write {args.out}: its directory does not exist")
+        inputs = [path for path in (args.table, args.scar_profile) if path is not None]
+        refuse_to_overwrite([("--out", args.out)], inputs, overwrite=args.overwrite)
+        return _table(args, read_profile(args))
+    if args.out is not None:
+        raise CommandError("--out writes a corrected TABLE; give the TABLE too")
+    missing = ["--" + name for name in POINT_OPTIONS if getattr(args, name) is None]
+    if missing:
+        raise CommandError(f"give {', '.join(missing)} (or a TABLE)")
+    profile = read_profile(args, conflicting=GROOVE_OPTIONS)
+    if profile is not None:
+        return _point_on_profile(args, profile)
+    scar = [value is not None for value in (args.scar_depth, args.scar_half_width)]
+    if (args.aspect_ratio is not None) == any(scar) or any(scar) != all(scar):
+        raise CommandError("give --aspect-ratio, or both --scar-depth and --scar-half-width")
+    point = dict(amplitude=args.amplitude, load=args.load, stiffness=args.stiffness)
+    if args.aspect_ratio is not None:
+        scar, ratio_text = {"aspect_ratio": args.aspect_ratio}, f"{args.aspect_ratio:.6g}"
+    else:
+        scar = {"scar_depth": args.scar_depth, "scar_half_width": args.scar_half_width}
+        ratio_text = (
+            f"{args.scar_depth / args.scar_half_width:.6g} (scar {args.scar_depth * 1e6:.6g} µm "
+            f"deep, {args.scar_half_width * 1e6:.6g} µm half-width)"
+        )
+    mu = float(correct_ecof(args.ecof, **point, **scar))
+    rows = [
+        row("ecof", args.ecof, "(reported)"),
+        row("amplitude", args.amplitude),
+        row("load", args.load),
+        row("stiffness", args.stiffness),
+        row("aspect_ratio", ratio_text),
+        None,
+        row("mu", mu),
+        row("correction_factor", mu / args.ecof),
+    ]
+    print_rows(
+        f"ecofmaps {__version__}: reported ECoF corrected to the contact CoF (x_o = Δ*)", rows
+    )
+    return 0
+
+
+def _table(args, profile) -> int:
+    """Every row of the TABLE corrected that can be: the others NaN, each named in an error
+    line (exit status 1)."""
+    from ecofmaps.correction.tables import TableRowWarning, correct_table
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", TableRowWarning)
+        text, rows = correct_table(args.table, profile, args.mapping, bad_rows="nan")
+    failed = [item for item in caught if issubclass(item.category, TableRowWarning)]
+    for item in caught:
+        if item in failed:
+            print(f"ecofmaps correct: error: {item.message}", file=sys.stderr)
+        else:
+            warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
+    status = 1 if failed else 0
+    if args.out is None:
+        sys.stdout.write(text)
+        return status
+    write_text(args.out, text)
+    record_written([args.out])
+    on = "" if profile is None else f" on the scar profile {args.scar_profile}"
+    if failed:
+        print(
+            f"wrote {args.out}: {rows - len(failed)} of {rows} rows corrected{on}, "
+            f"{len(failed)} not (NaN, the reason in the status column)"
+        )
+        return status
+    print(f"wrote {args.out}: {rows} rows corrected{on}")
+    return status
+
+
+def _point_on_profile(args, profile) -> int:
+    """One ECoF corrected on the measured profile, beside the D/W shortcut (eq. 11)."""
+    from ecofmaps.correction.inversion import correct_ecof
+
+    rig = dict(amplitude=args.amplitude, load=args.load, stiffness=args.stiffness)
+    mu = float(correct_ecof(args.ecof, **rig, profile=profile, mapping=args.mapping))
+    shortcut, _ = correct_ecof(
+        args.ecof, **rig, aspect_ratio=float(profile.aspect_ratio), return_status=True
+    )
+    shortcut = float(shortcut)  # NaN (printed 'undefined') where the parabola cannot
+    rows = [
+        row("ecof", args.ecof, "(reported)"),
+        row("amplitude", args.amplitude),
+        row("load", args.load),
+        row("stiffness", args.stiffness),
+        *profile_rows(args, profile),
+        None,
+        two_columns_header(),
+        two_values("mu", mu, shortcut),
+        two_values("correction_factor", mu / args.ecof, shortcut / args.ecof),
+    ]
+    print_rows(
+        f"ecofmaps {__version__}: reported ECoF corrected to the contact CoF on a measured "
+        f"scar profile ({'X = x' if args.mapping == 'physical' else 'X = x W/Δ*, eq. 11'})",
+        rows,
+    )
+    return 0

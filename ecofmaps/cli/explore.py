@@ -40,19 +40,24 @@ def add(subparsers) -> None:
         ),
     )
     parser.add_argument(
-        "--port", type=_port, default=DEFAULT_PORT, metavar="N",
+        "--port",
+        type=_port,
+        default=DEFAULT_PORT,
+        metavar="N",
         help=f"the port to listen on (default {DEFAULT_PORT})",
-    )  # fmt: skip
+    )
     parser.add_argument(
         "--no-browser", action="store_true", help="do not open the page in a browser"
     )
     parser.add_argument(
-        "--allow-origin", action="append", default=[], metavar="HOST[:PORT]",
+        "--allow-origin",
+        action="append",
+        default=[],
+        metavar="HOST[:PORT]",
         help="also answer pages of this host (a tunnel or proxy's name; without a port, "
         "--port's); by default only 127.0.0.1, localhost and [::1] at --port, and any other "
         "Host or Origin gets 403 (repeat the option for more hosts)",
-    )  # fmt: skip
-    parser.set_defaults(handler=run)
+    )
 
 
 def run(args) -> int:

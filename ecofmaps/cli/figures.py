@@ -1,11 +1,8 @@
-"""``ecofmaps figures``: write the paper's figures (default: into figures/), in parallel.
-
-The figures are drawn by groups sharing one Dataset (:func:`ecofmaps.figures.figure_groups`),
-the costliest first, on ``--jobs`` processes (default: one per core); the parts of a costly
-Dataset (:func:`ecofmaps.figures.figure_parts`: the ``shapes`` figure's maps and loops) are
-computed in parallel before it. Each drawing process keeps JAX's compiled kernels in
-``<cache>/jax`` (:data:`JAX_CACHE_FOLDER`), beside the cached maps, so a second run compiles
-nothing it compiled before; this is set for the run only, never on importing the library.
+"""``ecofmaps figures``: the paper's figures, drawn by groups sharing one Dataset
+(:func:`ecofmaps.figures.figure_groups`), the costliest first, on ``--jobs`` processes; the
+parts of a costly Dataset (:func:`ecofmaps.figures.figure_parts`) are computed in parallel
+before it. JAX keeps its compiled kernels in ``<cache>/jax`` for the run (never on importing
+the library), so a second run compiles nothing it compiled before.
 """
 
 from __future__ import annotations
@@ -24,52 +21,30 @@ from pathlib import Path
 
 from ecofmaps._interrupts import check_interrupted, interrupts_stop_writes
 from ecofmaps._parallel import start_resource_tracker_quietly
-from ecofmaps.cli._common import refuse_to_overwrite
+from ecofmaps.cli._common import count, refuse_to_overwrite
 from ecofmaps.io.files import record_written
 
-__all__ = [
-    "FIGURE_FORMATS",
-    "JAX_CACHE_FOLDER",
-    "TaskQueue",
-    "add",
-    "figure_formats",
-    "jax_cache_folder",
-    "jax_compilation_cache",
-    "run",
-    "usable_cores",
-    "write_figure_group",
-]
+__all__ = ["JAX_CACHE_FOLDER", "TaskQueue", "add", "run"]
 
-FIGURE_FORMATS = ("png", "pdf", "svg")
+_FORMATS = ("png", "pdf", "svg")
 
 #: Folder of the ecofmaps cache directory that holds JAX's compiled kernels for this command.
 JAX_CACHE_FOLDER = "jax"
 
 
-def figure_formats(text: str) -> tuple[str, ...]:
+def _figure_formats(text: str) -> tuple[str, ...]:
     """An argparse ``type`` reading a comma-separated list of figure file formats."""
     formats = tuple(dict.fromkeys(item.strip().lower() for item in text.split(",")))
-    unknown = [item for item in formats if item not in FIGURE_FORMATS]
+    unknown = [item for item in formats if item not in _FORMATS]
     if unknown or not formats:
         raise argparse.ArgumentTypeError(
             f"unknown figure format {', '.join(map(repr, unknown))} in {text!r}; "
-            f"give one or more of {', '.join(FIGURE_FORMATS)}, comma-separated"
+            f"give one or more of {', '.join(_FORMATS)}, comma-separated"
         )
     return formats
 
 
-def _jobs(text: str) -> int:
-    """An argparse ``type`` reading a number of processes, >= 1."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of processes >= 1")
-    return value
-
-
-def usable_cores() -> int:
+def _usable_cores() -> int:
     """The number of cores this process may run on (its affinity, where the system has one)."""
     if hasattr(os, "sched_getaffinity"):
         return max(1, len(os.sched_getaffinity(0)))
@@ -99,28 +74,38 @@ def add(subparsers) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
-        "--out", default="figures", metavar="DIR",
+        "--out",
+        default="figures",
+        metavar="DIR",
         help="directory to write into, created if missing (default: figures)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--only", nargs="+", choices=list(FIGURES), metavar="NAME",
+        "--only",
+        nargs="+",
+        choices=list(FIGURES),
+        metavar="NAME",
         help=f"write only these figures; NAME is one of: {', '.join(FIGURES)}",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--format", type=figure_formats, default=("png",), metavar="FORMATS",
+        "--format",
+        type=_figure_formats,
+        default=("png",),
+        metavar="FORMATS",
         help="comma-separated file formats among png, pdf, svg (default: png)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--overwrite", action="store_true",
+        "--overwrite",
+        action="store_true",
         help="replace the figures ecofmaps wrote in DIR before (a DIR that is not empty needs "
         "it); files ecofmaps did not write are never replaced",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--jobs", type=_jobs, default=None, metavar="N",
+        "--jobs",
+        type=count("processes"),
+        metavar="N",
         help="processes drawing at once (default: one per core, at most one per group of "
         "figures sharing their numbers; 1: all in this process)",
-    )  # fmt: skip
-    parser.set_defaults(handler=run)
+    )
 
 
 def _jax_cache_options(directory) -> dict:
@@ -145,19 +130,10 @@ def _set_jax_options(options: dict) -> dict:
 
 
 @contextlib.contextmanager
-def jax_compilation_cache(directory):
-    """Within the block, JAX keeps every kernel it compiles in ``directory`` and reuses them.
-
-    Parameters
-    ----------
-    directory : str or os.PathLike
-        JAX's persistent compilation cache (created when first written).
-
-    Notes
-    -----
-    JAX's options are restored on leaving the block. JAX opens its cache once per process:
-    a later block in the same process with another directory still uses the first one.
-    """
+def _jax_compilation_cache(directory):
+    """Within the block, JAX keeps every kernel it compiles in ``directory`` and reuses them
+    (JAX opens its cache once per process: a later block with another directory still uses
+    the first one)."""
     previous = _set_jax_options(_jax_cache_options(directory))
     try:
         yield
@@ -165,25 +141,10 @@ def jax_compilation_cache(directory):
         _set_jax_options(previous)
 
 
-def write_figure_group(names, directory, formats) -> list[tuple[str, list[Path], float]]:
-    """Draw the figures ``names`` (sharing one Dataset) and write each in every format.
-
-    Parameters
-    ----------
-    names : list of str
-        Keys of :data:`ecofmaps.figures.FIGURES`, typically one group of
-        :func:`ecofmaps.figures.figure_groups`.
-    directory : str or os.PathLike
-        Existing directory to write into; files are ``<name>.<format>``, written atomically.
-    formats : sequence of str
-        Among :data:`FIGURE_FORMATS`.
-
-    Returns
-    -------
-    written : list of (str, list of pathlib.Path, float)
-        Each figure's name, its files, and the time it took (its Dataset included when it
-        was the first to need it). [s]
-    """
+def _write_figure_group(names, directory, formats) -> list[tuple[str, list[Path], float]]:
+    """Draw the figures ``names`` (one group sharing a Dataset) and write each in every
+    format into ``directory``: each figure's name, its files and its time [s] (its Dataset
+    included when it was the first to need it)."""
     from ecofmaps.figures import make_figures, save_figure  # the CLI's lazy boundary
 
     written = []
@@ -196,7 +157,7 @@ def write_figure_group(names, directory, formats) -> list[tuple[str, list[Path],
     return written
 
 
-def jax_cache_folder() -> Path:
+def _jax_cache_folder() -> Path:
     """The folder of JAX's compilation cache: :data:`JAX_CACHE_FOLDER` in the cache."""
     from ecofmaps.maps.cache import cache_directory  # the CLI's lazy boundary
 
@@ -206,14 +167,14 @@ def jax_cache_folder() -> Path:
 def _start_worker() -> None:
     """Set up a drawing process: Ctrl-C is the parent's to handle; JAX's compilation cache."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    _set_jax_options(_jax_cache_options(jax_cache_folder()))
+    _set_jax_options(_jax_cache_options(_jax_cache_folder()))
 
 
 def _worker_group(names, directory, formats) -> list[tuple[str, list[Path], float]]:
-    """:func:`write_figure_group` in a drawing process, which ends when told to stop."""
+    """:func:`_write_figure_group` in a drawing process, which ends when told to stop."""
     try:
         with interrupts_stop_writes():  # SIGTERM from the parent: stop at a safe point
-            return write_figure_group(names, directory, formats)
+            return _write_figure_group(names, directory, formats)
     except KeyboardInterrupt:
         # Its file was removed on the way out; end now, without drawing queued figures (and
         # without tearing down JAX's threads, like the command itself: cli.main.console).
@@ -231,21 +192,8 @@ def _worker_part(part) -> None:
 
 class TaskQueue:
     """The order of the parallel work: parts first, then groups, never more at once than
-    processes, so that a group whose parts are done is drawn next (it is the costliest).
-
-    Parameters
-    ----------
-    groups : list of list of str
-        The figures by shared Dataset (:func:`ecofmaps.figures.figure_groups`).
-    parts : list of list of callable
-        Each group's parts (:func:`ecofmaps.figures.figure_parts`).
-    jobs : int
-        Processes working at once.
-
-    Notes
-    -----
-    A task is ``('part', index, callable)`` or ``('group', index, names)``. :meth:`started`
-    gives the tasks to start at first, :meth:`finished` those to start when one ends.
+    processes (``jobs``), so that a group whose parts are done is drawn next (it is the
+    costliest). A task is ``('part', index, callable)`` or ``('group', index, names)``.
 
     Examples
     --------
@@ -261,10 +209,12 @@ class TaskQueue:
     def __init__(self, groups, parts, jobs: int):
         self.groups = groups
         self.missing = [len(group_parts) for group_parts in parts]
-        self.ready = deque(("part", index, part) for index, group in enumerate(parts)
-                           for part in group)  # fmt: skip
-        self.ready.extend(("group", index, group) for index, group in enumerate(groups)
-                          if not self.missing[index])  # fmt: skip
+        self.ready = deque(
+            ("part", index, part) for index, group in enumerate(parts) for part in group
+        )
+        self.ready.extend(
+            ("group", index, group) for index, group in enumerate(groups) if not self.missing[index]
+        )
         self.jobs = jobs
         self.running = 0
 
@@ -288,12 +238,8 @@ class TaskQueue:
 
 
 def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
-    """Yield each group's :func:`write_figure_group` result from ``jobs`` processes.
-
-    The parts of a group's Dataset (:func:`ecofmaps.figures.figure_parts`) are computed
-    first, in parallel; the group is drawn as soon as all its parts are in the cache
-    (:class:`TaskQueue`).
-    """
+    """Yield each group's :func:`_write_figure_group` result from ``jobs`` processes, its
+    parts computed first, in parallel (:class:`TaskQueue`)."""
     others = set(multiprocessing.active_children())
     start_resource_tracker_quietly()
     executor = ProcessPoolExecutor(
@@ -304,8 +250,10 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
     queue = TaskQueue(groups, parts, jobs)
 
     def submitted(tasks) -> dict:
-        calls = {"part": lambda part: (_worker_part, part),
-                 "group": lambda group: (_worker_group, group, out, formats)}  # fmt: skip
+        calls = {
+            "part": lambda part: (_worker_part, part),
+            "group": lambda group: (_worker_group, group, out, formats),
+        }
         return {executor.submit(*calls[task[0]](task[2])): task for task in tasks}
 
     try:
@@ -337,10 +285,10 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
 
 
 def _written_here(groups, out: Path, formats):
-    """Yield each group's :func:`write_figure_group` result, drawn in this process."""
-    with jax_compilation_cache(jax_cache_folder()):
+    """Yield each group's :func:`_write_figure_group` result, drawn in this process."""
+    with _jax_compilation_cache(_jax_cache_folder()):
         for group in groups:
-            yield write_figure_group(group, out, formats)
+            yield _write_figure_group(group, out, formats)
 
 
 def run(args) -> int:
@@ -350,7 +298,7 @@ def run(args) -> int:
     groups = figure_groups(names or None)
     parts = figure_parts(names or None)
     count = sum(len(group) for group in groups)
-    jobs = min(args.jobs or usable_cores(), max(len(groups), *map(len, parts)))
+    jobs = min(args.jobs or _usable_cores(), max(len(groups), *map(len, parts)))
     out = Path(args.out)
     drawn = [name for group in groups for name in group]
     planned = [("--out", out / f"{name}.{suffix}") for name in drawn for suffix in args.format]

@@ -1,14 +1,37 @@
-"""``ecofmaps loops``: analyse recorded fretting loops cycle by cycle."""
+"""``ecofmaps loops``: recorded fretting loops analysed cycle by cycle.
+
+Every recording goes through the one pipeline of :mod:`ecofmaps.measured.pipeline`: in
+memory as one chunk, a long one out of core (:mod:`ecofmaps.cli.loops_long`); the table is
+written as the chunks come, then the summary lines, the plots and the reading along the
+stroke. docs/loops.md explains the method.
+"""
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
+import sys
 import textwrap
+import warnings
+from pathlib import Path
 
+import numpy as np
+
+from ecofmaps._interrupts import interrupts_deferred
 from ecofmaps._parallel import worker_limit
-from ecofmaps.cli._common import quantity, unit
+from ecofmaps.cli._common import (
+    CommandError,
+    add_recording_options,
+    count,
+    quantity,
+    recording_options,
+    refuse_to_overwrite,
+)
+from ecofmaps.io.files import atomic_path, record_written
+from ecofmaps.web import INSTALL_WEB, missing_web_packages
 
-__all__ = ["add"]
+__all__ = ["SUMMARY_VARIABLES", "add", "run"]
 
 
 def add(subparsers) -> None:
@@ -40,136 +63,114 @@ def add(subparsers) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
-        "files", nargs="*", metavar="FILE",
+        "files",
+        nargs="*",
+        metavar="FILE",
         help="recording files (CSV, TSV or other text, TDMS, HDF5/netCDF-4, zarr)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--example", action="store_true",
+        "--example",
+        action="store_true",
         help="analyse the shipped synthetic example (load 450N) instead of FILEs",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--load", type=_load_or_column, default=None, metavar="P",
+        "--load",
+        type=_load_or_column,
+        metavar="P",
         help="normal load P, e.g. 450N; or the name of the recording's normal-load column "
         "(e.g. Fz), used sample by sample (required unless --example)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--out", default=None, metavar="FILE.csv",
+        "--out",
+        metavar="FILE.csv",
         help="CSV file to write (its directory must exist); default: print the table",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--plots", default=None, metavar="DIR",
+        "--plots",
+        metavar="DIR",
         help="also write, per file, its loops with the line Q = SΔ (<name>_loops.png), "
         "the ECoF and GICoF over the cycles (<name>_evolution.png) and the loops read along "
         "the stroke (<name>_resolved.png) into DIR",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--overwrite", action="store_true",
+        "--overwrite",
+        action="store_true",
         help="replace the outputs ecofmaps wrote before (--out, --resolved, the plots in "
         "--plots); a file or folder ecofmaps did not write is never replaced",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--resolved", default=None, metavar="FILE.nc",
+        "--resolved",
+        metavar="FILE.nc",
         help="also write the loops read along the stroke (one FILE): μ(ξ), the groove slope "
         "g(ξ) and the felt profile h(ξ) over (cycle, position), a netCDF file",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--report", default=None, metavar="FILE.html",
+        "--report",
+        metavar="FILE.html",
         help="also write the results of one recording as one HTML page that opens offline: "
         "the friction over the cycles with the quality flags, picked loops with the model's, "
         'the table (needs pip install "ecofmaps[web]")',
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--no-resolve", action="store_true",
+        "--no-resolve",
+        action="store_true",
         help="skip the reading along the stroke (about ten times faster; no mu_resolved, "
         "mu_resolved_se, aspect_ratio)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--flip-force", action="store_true",
+        "--flip-force",
+        action="store_true",
         help="read the force with the other sign (a rig recording it positive against the "
         "displacement: its loops run anticlockwise)",
-    )  # fmt: skip
-    _add_column_options(parser)
-    add_long_options(parser)
-    parser.set_defaults(handler="ecofmaps.cli.loops_run:run")  # imported when it runs
-
-
-def _add_column_options(parser) -> None:
-    """The options that say where the recording's columns are and in which units."""
+    )
     parser.add_argument(
-        "--displacement-col", default="displacement", metavar="NAME",
-        help="name of the displacement column (default: displacement)",
-    )  # fmt: skip
-    parser.add_argument(
-        "--force-col", default="force", metavar="NAME",
-        help="name of the tangential force column (default: force)",
-    )  # fmt: skip
-    parser.add_argument(
-        "--cycle-col", default=None, metavar="NAME",
-        help="name of a column of cycle numbers, which must exist "
-        "(default: 'cycle' if the file has it; else cycles are cut at the reversals)",
-    )  # fmt: skip
-    parser.add_argument(
-        "--skip-rows", type=int, default=None, metavar="N",
-        help="lines of a text file to skip before its header line (default: metadata "
-        "lines before the header are found)",
-    )  # fmt: skip
-    parser.add_argument(
-        "--displacement-unit", type=unit("length"), default=None, metavar="UNIT",
-        help="unit of the displacement column (default: the one its name or the file gives, "
-        "as in 'displacement [mm]' or a channel's unit, else um)",
-    )  # fmt: skip
-    parser.add_argument(
-        "--force-unit", type=unit("force"), default=None, metavar="UNIT",
-        help="unit of the force column (default: from its name or the file, else N)",
-    )  # fmt: skip
-    parser.add_argument(
-        "--group", default=None, metavar="NAME",
-        help="TDMS group, or HDF5/netCDF/zarr group, holding the channels (default: any)",
-    )  # fmt: skip
+        "--nan-policy",
+        choices=("skip", "raise"),
+        default="skip",
+        help="a cycle with a missing sample (NaN or an empty cell) is skipped and counted "
+        "(skip, the default), or any missing sample stops the command naming its line",
+    )
+    add_recording_options(parser)
+    _add_long_options(parser)
 
 
 def _workers(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of workers >= 1")
+    value = count("workers")(text)
     limit, why = worker_limit(processes=True)
     if value > limit:
         raise argparse.ArgumentTypeError(f"{value} is more than this machine can run: {why}")
     return value
 
 
-def add_long_options(parser) -> None:
-    """The options of long runs, for ``ecofmaps loops``."""
+def _add_long_options(parser) -> None:
     group = parser.add_argument_group(
         "long tests",
         "a rig file of more than 2**24 samples is analysed out of core, a block of whole "
         "cycles at a time (the numbers are those of the analysis in memory)",
     )
     group.add_argument(
-        "--nan-policy", choices=("skip", "raise"), default="skip",
-        help="a cycle with a missing sample (NaN or an empty cell) is skipped and counted "
-        "(skip, the default), or any missing sample stops the command naming its line",
-    )  # fmt: skip
-    group.add_argument(
-        "--workers", type=_workers, default=None, metavar="N",
+        "--workers",
+        type=_workers,
+        metavar="N",
         help="analyse out of core on a local dask cluster of N processes",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--scheduler", default=None, metavar="ADDRESS",
+        "--scheduler",
+        metavar="ADDRESS",
         help="analyse out of core on the dask cluster at ADDRESS (tcp://host:8786); its "
         "workers must have ecofmaps and see the files at the same paths",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--resume", action="store_true",
+        "--resume",
+        action="store_true",
         help="continue an interrupted run from the blocks kept in <out>.partial/ (needs "
         "--out and the same files and options)",
-    )  # fmt: skip
+    )
     group.add_argument(
-        "--quiet", action="store_true", help="no progress bar (none is shown off a terminal)",
-    )  # fmt: skip
+        "--quiet",
+        action="store_true",
+        help="no progress bar (none is shown off a terminal)",
+    )
 
 
 def _load_or_column(text: str):
@@ -184,3 +185,313 @@ def _load_or_column(text: str):
             if name and not name[0].isdigit() and not name.startswith(("-", "+", ".")):
                 return name  # a column of the recording, e.g. Fz
         raise
+
+
+def _plot_names(paths) -> list[str]:
+    """A distinct file-name stem for each recording's plots."""
+    stems = [path.stem for path in paths]
+    return [
+        stem if stems.count(stem) == 1 else f"{stem}_{index}"
+        for index, stem in enumerate(stems, start=1)
+    ]
+
+
+def _analysed(index, path, recording, load, args, long_run, write, *, many, resolved_file):
+    """One recording through the pipeline: its results (all of them in memory, those the
+    summary reads of a long one), its reading along the stroke over positions (for the
+    plots and ``--resolved``, in memory only) and its warnings, printed one line each."""
+    in_memory = not recording.lazy
+    if not in_memory and resolved_file:
+        raise CommandError(
+            f"--resolved reads every loop along the stroke, which a long recording "
+            f"({path}) analysed out of core does not keep: leave out --resolved"
+        )
+    if not in_memory and args.report is not None:
+        raise CommandError(
+            f"--report draws loops and the whole table, which a long recording ({path}) "
+            "analysed out of core does not keep: leave out --report"
+        )
+    from ecofmaps.measured.options import ImplausibleScaleError, ImplausibleScaleWarning
+    from ecofmaps.measured.pipeline import Reading
+
+    plots = args.plots is not None and in_memory
+    positions = 201 if plots or resolved_file else None
+    reading = Reading(
+        resolve=not args.no_resolve,
+        keep_loops=plots or args.report is not None,
+        along_stroke={"positions": positions},
+        hand_back=positions is not None,
+    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            results, resolved = long_run.analyse(
+                index,
+                path,
+                recording,
+                load,
+                many=many,
+                write=write,
+                columns=None if in_memory else SUMMARY_VARIABLES,
+                reading=reading,
+            )
+        except ImplausibleScaleError as error:
+            raise recording.error(_with_assumptions(str(error), recording)) from None
+        except ValueError as error:
+            raise recording.error(str(error)) from None
+    for warning in caught:  # one line each, naming the file, not a Python source line
+        message = str(warning.message)
+        if issubclass(warning.category, ImplausibleScaleWarning):
+            message = _with_assumptions(message, recording)
+        print(f"ecofmaps loops: warning: {path.name}: {message}", file=sys.stderr)
+    return results, resolved
+
+
+def _with_assumptions(message: str, recording) -> str:
+    """``message`` (of an implausible scale: an assumed unit is the likely culprit) with the
+    units the recording's columns without one were assumed to be in."""
+    said = [
+        f"the {role} column {recording.columns[role]!r} has no unit and was read in "
+        f"{recording.units[role]} (--{role}-unit gives it)"
+        for role in ("displacement", "force")
+        if role in recording.assumed_units
+    ]
+    return message if not said else f"{message} Here {'; '.join(said)}."
+
+
+#: The variables of a recording's results that its summary line reads (:func:`_summary`):
+#: all that is kept of a long recording's results once their lines are written.
+SUMMARY_VARIABLES = ("regime", "gicof", "mu_resolved", "ecof", "quality", "amplitude")
+
+
+class _Table:
+    """The table of results, written to ``stream`` as each block of lines comes. Each block
+    begins with the header line, written once."""
+
+    def __init__(self, stream):
+        self.stream, self.started = stream, False
+
+    def write(self, text: str) -> None:
+        header, _, lines = text.partition("\n")
+        if not self.started:
+            self.stream.write(f"{header}\n")
+            self.started = True
+        self.stream.write(lines)
+        self.stream.flush()  # on disk as it comes: a block is a few MB
+
+
+def _summary(path, results, recording) -> str:
+    """One line on a recording's cycles: counts, the quality, the friction over the test."""
+    from ecofmaps.model.regimes import GROSS_SLIP
+
+    gross = results.isel(cycle=np.flatnonzero(results.regime.values == GROSS_SLIP))
+    summary = f"  {path.name}: {results.attrs['quality_summary']}"
+    if results.attrs.get("motion") == "reciprocating sliding":
+        amplitude = float(np.nanmedian(results.amplitude)) if "amplitude" in results else np.nan
+        stroke = f" (amplitude {amplitude * 1e3:.3g} mm)" if np.isfinite(amplitude) else ""
+        summary += f"; reciprocating sliding{stroke}, not fretting: analysed the same way"
+    if results.attrs["incomplete_cycles"]:
+        summary += f" ({results.attrs['incomplete_cycles']} incomplete dropped)"
+    if skipped := results.attrs.get("skipped_cycles", 0):
+        first = recording.position(results.attrs["first_missing_sample"])
+        where = f"line {first}" if isinstance(first, int) else first
+        summary += f"; {skipped} skipped for missing samples (the first at {where})"
+    if gross.cycle.size and gross.gicof.notnull().any():
+        summary += f"; GICoF median {float(gross.gicof.median()):.4f}"
+    if "mu_resolved" in gross and gross.mu_resolved.notnull().any():
+        summary += f", μ read along the stroke median {float(gross.mu_resolved.median()):.4f}"
+    ecof = gross.ecof.dropna("cycle") if gross.cycle.size else gross.ecof
+    if ecof.size:
+        summary += f"; ECoF {float(ecof[0]):.4f} (first) to {float(ecof[-1]):.4f} (last)"
+    return summary
+
+
+def _checked_inputs(args) -> tuple[list[Path], float]:
+    """The recordings and the load of the command, its options checked against each other."""
+    from ecofmaps.measured.synthetic import EXAMPLE, example_path
+
+    if args.example == bool(args.files):
+        raise CommandError("give one or more recording FILEs, or --example (not both)")
+    paths = [example_path()] if args.example else [Path(name) for name in args.files]
+    load = EXAMPLE["load"] if args.example and args.load is None else args.load
+    if load is None:
+        raise CommandError("--load is required: the normal load, e.g. --load 450N")
+    columns = {
+        "--displacement-col": args.displacement_col,
+        "--force-col": args.force_col,
+        "--cycle-col": args.cycle_col,
+    }
+    named = [(option, name.strip().lower()) for option, name in columns.items() if name]
+    for index, (option, name) in enumerate(named):
+        for other, other_name in named[:index]:
+            if name == other_name:
+                raise CommandError(f"{other} and {option} name the same column {name!r}")
+    if args.resolved is not None:
+        if args.no_resolve:
+            raise CommandError("--resolved writes the reading along the stroke; not --no-resolve")
+        if len(paths) > 1:
+            raise CommandError("--resolved writes the reading of one recording: give one FILE")
+    if args.report is not None:
+        if len(paths) > 1:
+            raise CommandError("--report writes the page of one recording: give one FILE")
+        if missing_web_packages():
+            raise CommandError(INSTALL_WEB)
+    return paths, load
+
+
+def _checked_outputs(args, paths) -> list:
+    """The command's outputs as ``(option, path)``, refused where they would overwrite a
+    file that ecofmaps did not write (or an input)."""
+    for option, target in (
+        ("--out", args.out),
+        ("--resolved", args.resolved),
+        ("--report", args.report),
+    ):
+        if target is not None and not Path(target).parent.is_dir():
+            raise CommandError(f"cannot write {target} ({option}): its directory does not exist")
+    kinds = ("loops", "evolution") + (() if args.no_resolve else ("resolved",))
+    plots = (
+        []
+        if args.plots is None
+        else [
+            ("--plots", Path(args.plots) / f"{name}_{kind}.png")
+            for name in _plot_names(paths)
+            for kind in kinds
+        ]
+    )
+    outputs = [("--out", args.out), ("--resolved", args.resolved), ("--report", args.report)]
+    outputs += plots
+    refuse_to_overwrite(outputs, paths, overwrite=args.overwrite, folders=[("--plots", args.plots)])
+    return outputs
+
+
+class _NothingAnalysed(Exception):
+    """No recording of a batch could be analysed."""
+
+
+class _Analysed:
+    """A recording analysed: its path, the recording, its results and reading along the
+    stroke, and the name of its plots."""
+
+    def __init__(self, path, recording, results, resolved, plot_name):
+        self.path, self.recording, self.plot_name = path, recording, plot_name
+        self.results, self.resolved = results, resolved
+
+
+def _analyse_each(args, paths, load, long_run, table) -> tuple[list[_Analysed], list[Path]]:
+    """Every recording through the pipeline, its lines written to ``table``. With several
+    recordings, one that cannot be analysed is one error line naming it, and the others go
+    on (a batch); a single recording's error ends the command."""
+    from ecofmaps.io.recordings import read_recording
+
+    done, failed = [], []
+    many = len(paths) > 1
+    for index, (path, plot_name) in enumerate(zip(paths, _plot_names(paths), strict=True)):
+        held = []  # a recording in memory: its lines once its analysis has succeeded
+        try:
+            options = recording_options(args)
+            if isinstance(load, str):  # --load names the recording's normal-load column
+                options["load_column"] = load
+            recording = read_recording(path, lazy=long_run.lazy, **options)
+            write = table.write if recording.lazy else held.append
+            results, resolved = _analysed(
+                index,
+                path,
+                recording,
+                load,
+                args,
+                long_run,
+                write,
+                many=many,
+                resolved_file=args.resolved is not None,
+            )
+        except (ValueError, OSError, CommandError) as error:
+            if not many:
+                raise
+            failed.append(path)
+            named = str(error) if str(path) in str(error) else f"{path}: {error}"
+            print(f"ecofmaps loops: error: {named}", file=sys.stderr)
+            continue
+        for text in held:
+            table.write(text)
+        done.append(_Analysed(path, recording, results, resolved, plot_name))
+    return done, failed
+
+
+def _write_extras(args, done: list[_Analysed], load) -> None:
+    """The plots, the reading along the stroke and the report the options ask for."""
+    if args.plots is not None and done:
+        # matplotlib only when plots are asked for
+        from ecofmaps.figures import cof_evolution, measured_loops, resolved_loops, save_figure
+
+        folder = Path(args.plots)
+        folder.mkdir(parents=True, exist_ok=True)
+        for each in done:
+            name, results, resolved = each.plot_name, each.results, each.resolved
+            save_figure(measured_loops(results, resolved=resolved), folder / f"{name}_loops.png")
+            save_figure(cof_evolution(results), folder / f"{name}_evolution.png")
+            if resolved is not None:
+                save_figure(resolved_loops(resolved, results), folder / f"{name}_resolved.png")
+    if args.resolved is not None and done:
+        from ecofmaps.maps.cache import write_netcdf
+
+        write_netcdf(done[0].resolved, args.resolved)
+    if args.report is not None and done:
+        # Bokeh loads only when a report is asked for (the extra web is optional)
+        from ecofmaps.web.report import recording_inputs, write_report
+
+        mean_load = float(done[0].results["load"])  # the load given, or a channel's mean
+        inputs = recording_inputs(done[0].recording, mean_load, flip_force=args.flip_force)
+        write_report(args.report, done[0].results, inputs=inputs)
+
+
+def run(args) -> int:
+    """Run ``ecofmaps loops`` with the parsed ``args``: 0 when every recording was
+    analysed, 1 when some of several could not be (each named in an error line; the others'
+    rows are written)."""
+    from ecofmaps.cli import loops_long
+
+    paths, load = _checked_inputs(args)
+    outputs = _checked_outputs(args, paths)
+    long_run = loops_long.LongRun(args, paths)
+    try:
+        with contextlib.ExitStack() as stack:  # the table is written as it comes, renamed last
+            if args.out is None:  # held, and printed once every file is analysed
+                stream = io.StringIO()
+            else:
+                temporary = stack.enter_context(atomic_path(args.out))
+                stream = stack.enter_context(open(temporary, "w", encoding="utf-8", newline=""))
+            table = _Table(stream)
+            done, failed = _analyse_each(args, paths, load, long_run, table)
+            if not done:  # nothing to write: the temporary goes
+                raise _NothingAnalysed
+            _write_extras(args, done, load)
+    except _NothingAnalysed:
+        print(
+            f"ecofmaps loops: none of the {len(paths)} recordings could be analysed; "
+            "nothing written",
+            file=sys.stderr,
+        )
+        return 1
+    with interrupts_deferred():  # the table is in place: a stop now would leave it unrecorded
+        record_written(path for _, path in outputs if path is not None)
+    status = 1 if failed else 0
+    if args.out is None:
+        sys.stdout.write(table.stream.getvalue())
+        for each in done:
+            print(_summary(each.path, each.results, each.recording).strip(), file=sys.stderr)
+        return status
+    long_run.finish()
+    written = sum(each.results.cycle.size for each in done)
+    print(f"wrote {args.out}: {written} cycle{'' if written == 1 else 's'}")
+    for each in done:
+        print(_summary(each.path, each.results, each.recording))
+    if failed:
+        print(f"  not analysed ({len(failed)}): " + ", ".join(str(path) for path in failed))
+    if args.resolved is not None:
+        print(f"  the loops read along the stroke in {args.resolved}")
+    if args.report is not None:
+        print(f"  the report in {args.report}")
+    if args.plots is not None:
+        print(f"  plots in {args.plots}")
+    return status

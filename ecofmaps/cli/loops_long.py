@@ -2,28 +2,13 @@
 
 A recording read lazily (a rig file of more than :data:`ecofmaps.io.recordings.LAZY_SAMPLES`
 samples, or any file with ``--workers``, ``--scheduler`` or ``--resume``) is analysed by
-:class:`ecofmaps.measured.pipeline.Analysis` on local threads, a local cluster of
-``--workers`` processes or the dask cluster at ``--scheduler``. With ``--out``, each block's
-results are written as it completes into ``<out>.partial/`` (NumPy ``.npz``, one file per block,
-each renamed into place when whole: what its cycles measured, from which the results are
-made again; with the cycles found and what the run was: the options and the files'
-checksums), by the task that measured it on threads or ``--workers`` (which see this
-machine's files), by this process for a cluster at ``--scheduler``, so an interrupted run
-keeps what it finished and ``--resume`` continues it. Each file kept has its checksum (and a
-block its cycle rows) in the run's record, ``kept.jsonl``: one that fails the check is
-measured again, with a line saying so.
-The table's lines are written as the blocks come, in order, into a temporary file beside
-``--out`` that is renamed onto it at the end, when the folder is removed; this process keeps
-of each block's results only what the summary line reads. A progress bar (cycles, rate,
-time left) is shown on a terminal, unless ``--quiet``.
-
-Stopped by Ctrl-C or SIGTERM, the command's one line tells what is kept as it is when the
-line is written (:meth:`LongRun.stop_note`, given to
-:func:`ecofmaps._interrupts.add_stop_note`), wherever the stop came from (a block, the
-table's rename, an error the stop caused in a worker): a folder that holds work is kept and
-named with the ``--resume`` hint; one this run made with nothing in it yet is removed, and
-the line says nothing was left. Once the table is renamed onto ``--out`` and the folder
-removed, a signal stops nothing (exit status 0, see :func:`ecofmaps.cli.main.main`).
+:class:`ecofmaps.measured.pipeline.Analysis` on local threads, ``--workers`` processes or the
+cluster at ``--scheduler``. With ``--out``, what each block measured is kept as it completes
+in ``<out>.partial/`` (one ``.npz`` per block, renamed into place when whole; its checksum, and
+a block's cycle rows, in the run's record ``kept.jsonl``), so that a stop keeps what was
+finished and ``--resume`` goes on from it (a file that fails its check is measured again); the
+table's lines are written in order as the blocks come. A stop's line names the folder kept
+(:meth:`LongRun.stop_note`).
 """
 
 from __future__ import annotations
@@ -53,7 +38,7 @@ from ecofmaps.measured.pipeline import (
     runner_for,
 )
 
-__all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun", "keep_block", "skipped"]
+__all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun", "keep_block"]
 
 #: The message for a missing sample with ``--nan-policy raise`` (the file and line before it).
 MISSING = (
@@ -290,21 +275,9 @@ def _write(path: Path, write) -> None:
 
 
 class LongRun:
-    """The long recordings of one ``ecofmaps loops`` command (module notes).
-
-    Parameters
-    ----------
-    args : argparse.Namespace
-        The command's options.
-    paths : list of pathlib.Path
-        Its recordings.
-
-    Attributes
-    ----------
-    lazy : bool or None
-        ``lazy`` for :func:`ecofmaps.read_recording`: True when a long run was asked for
-        (``--workers``, ``--scheduler``, ``--resume``), else None (large rig files only).
-    """
+    """The long recordings of one ``ecofmaps loops`` command with options ``args`` and
+    recordings ``paths``. ``lazy`` is for :func:`ecofmaps.read_recording`: True when a long
+    run was asked for (``--workers``, ``--scheduler``, ``--resume``), else None."""
 
     def __init__(self, args, paths):
         if args.workers and args.scheduler:
@@ -326,15 +299,10 @@ class LongRun:
         return runner_for(self.args.scheduler)
 
     def analyse(self, index, path, recording, load, *, many: bool, write, columns=None, reading):
-        """The results of recording ``index``, as :func:`ecofmaps.analyze_loops` gives them
-        (only the variables ``columns``, if given), and its reading along the stroke when
-        ``reading`` (a :class:`ecofmaps.measured.pipeline.Reading`) hands it back. A
-        recording in memory is one chunk, analysed in this process; a lazy one is analysed
-        on the runner of the options, its chunks kept beside ``--out`` as they complete.
-        The table's lines (with the file's name in a first column if ``many``) are given to
-        ``write`` in order, a string per chunk that begins with the header line. The
-        results are joined after the cluster is closed, so its workers' memory and the
-        joined results are not held at once."""
+        """The results of recording ``index`` (only the variables ``columns``, if given) and
+        its reading along the stroke when ``reading`` hands it back; the table's lines (a
+        file column if ``many``) given to ``write`` in order, a string per chunk that begins
+        with the header line. The results are joined once the cluster is closed."""
         runner = self._runner() if recording.lazy else contextlib.nullcontext(IN_PROCESS)
         self.analysed = (index, path, None)
         try:
@@ -347,9 +315,18 @@ class LongRun:
                         add_stop_note(self.stop_note)  # asked when the line is written
                     partial = self.partial
                 analysis, parts, resolved = _analyse(
-                    index, path, recording, load, self.args, runner, partial, many,
-                    write, columns, reading,
-                )  # fmt: skip
+                    index,
+                    path,
+                    recording,
+                    load,
+                    self.args,
+                    runner,
+                    partial,
+                    many,
+                    write,
+                    columns,
+                    reading,
+                )
         except KeyboardInterrupt as stop:  # counted once the runner is closed: no task runs
             if isinstance(stop, _Interrupted):
                 self.analysed = (index, path, len(stop.tasks))
@@ -363,14 +340,9 @@ class LongRun:
         return analysis.finish([parts.pop(k) for k in sorted(parts)]), resolved
 
     def stop_note(self) -> str | None:
-        """What a stop leaves beside ``--out``, as it is now: the sentence that names the
-        folder kept and tells how to go on, or None when nothing is kept.
-
-        A folder this run made with nothing in it yet (stopped while the cluster started,
-        say) is removed, so that the line saying nothing was left is true; a folder kept
-        loses the temporaries of blocks being written when the stop came. After
-        :meth:`finish` nothing is kept.
-        """
+        """What a stop leaves beside ``--out``, as it is now: the sentence naming the folder
+        kept and how to go on, or None. A folder this run made with nothing in it yet is
+        removed; a folder kept loses the temporaries of blocks being written."""
         partial = self.partial
         if partial is None or not partial.folder.exists():
             return None
@@ -393,22 +365,10 @@ class LongRun:
             self.partial = None
 
 
-def skipped(results, recording) -> str:
-    """For a file's summary line: the cycles skipped for missing samples, and where the
-    first missing sample is (``''`` if none)."""
-    count = results.attrs.get("skipped_cycles", 0)
-    if not count:
-        return ""
-    first = recording.position(results.attrs["first_missing_sample"])
-    where = f"line {first}" if isinstance(first, int) else first
-    return f"; {count} skipped for missing samples (the first at {where})"
-
-
 def _analyse(index, path, recording, load, args, runner, partial, many, write, columns, reading):
-    """One recording through the pipeline, chunk by chunk (module notes): its analysis, the
-    results of each chunk (the variables ``columns``) and the reading along the stroke
-    handed back (or None); the table's lines of each chunk (formatted where it ran) given to
-    ``write`` in the order of the chunks. A recording in memory is one chunk, run here."""
+    """One recording through the pipeline, chunk by chunk: its analysis, each chunk's results
+    (the variables ``columns``) and the reading along the stroke handed back (or None); each
+    chunk's lines given to ``write`` in order."""
     if args.plots is not None and recording.lazy:
         raise CommandError(
             f"--plots draws every loop, which a long recording ({path}) analysed out of core "
@@ -494,7 +454,12 @@ def _bar(analysis, path, shown: bool, initial: int):
     from tqdm import tqdm
 
     return tqdm(
-        total=int(analysis.cycles.label.size), initial=initial, unit=" cycles",
-        desc=path.name, file=sys.stderr, disable=not shown, dynamic_ncols=True,
+        total=int(analysis.cycles.label.size),
+        initial=initial,
+        unit=" cycles",
+        desc=path.name,
+        file=sys.stderr,
+        disable=not shown,
+        dynamic_ncols=True,
         smoothing=0.1,
-    )  # fmt: skip
+    )

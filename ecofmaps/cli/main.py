@@ -1,13 +1,10 @@
 """The ``ecofmaps`` command: its parser, and the run of one subcommand.
 
-Each subcommand is a module of :mod:`ecofmaps.cli` with ``add(subparsers)``, which declares
-its options, and the handler that does the work, ``run(args)``: a function, or the name of
-one, ``"ecofmaps.cli.loops_run:run"``, whose module is imported only when the subcommand
-runs (the one place the command line defers its imports, so ``ecofmaps --help`` starts
-fast and the work's modules import what they use at the top). The handler works through the
-public API. Quantities are read with units (``50um``, ``35MN/m``); a bare number is SI.
-Errors in the input end the command with exit status 2 and a one-line message, never a
-traceback.
+Each subcommand is one module of :mod:`ecofmaps.cli` with ``add(subparsers)``, which declares
+its options, and ``run(args)``, which does the work through the public API and imports JAX,
+xarray, numba, dask and matplotlib only then, so that ``--help`` answers at once. Quantities
+are read with units (``50um``, ``35MN/m``); a bare number is SI. Errors in the input end the
+command with exit status 2 and a one-line message, never a traceback.
 """
 
 from __future__ import annotations
@@ -19,6 +16,7 @@ import importlib
 import os
 import signal
 import sys
+import warnings
 
 from ecofmaps._interrupts import STOP_SIGNALS, interrupts_stop_writes
 from ecofmaps._version import __version__
@@ -73,7 +71,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"ecofmaps {__version__}")
     subparsers = parser.add_subparsers(title="commands", metavar="COMMAND", required=True)
     for name in _SUBCOMMANDS:
-        importlib.import_module(f"ecofmaps.cli.{name}").add(subparsers)
+        module = importlib.import_module(f"ecofmaps.cli.{name}")
+        module.add(subparsers)
+        subparsers.choices[name].set_defaults(handler=module.run)
     for command in subparsers.choices.values():  # for an unknown argument's error
         options = [o for action in command._actions for o in action.option_strings]
         command.set_defaults(command_prog=command.prog, command_options=options)
@@ -105,20 +105,16 @@ EXIT_TERMINATED = 143
 def main(argv=None) -> int:
     """Run the ``ecofmaps`` command; return its exit status.
 
-    0 on success; 2 for a user error (bad option, bad file: one line naming it); 130 when
-    interrupted by Ctrl-C and 143 by SIGTERM, with one line that tells what was left: files
-    are written atomically, so nothing is left half written, and what a subcommand keeps to
-    go on from (``ecofmaps loops``' resume folder) is named with how to go on, as it is when
-    the line is written (:func:`ecofmaps._interrupts.add_stop_note`); 1 for an unexpected
-    failure (one line; ``ECOFMAPS_DEBUG=1`` shows the traceback).
-
-    A signal that comes once the subcommand has done its work (its output written in full,
-    its lines printed) stops nothing: the command ends as it would have without it, with
-    the subcommand's status (0 on success) and no further line.
+    0 on success; 2 for a user error (one line naming it); 130 after Ctrl-C and 143 after
+    SIGTERM, with one line telling what was left (:func:`ecofmaps._interrupts.add_stop_note`:
+    files are written atomically); 1 for an unexpected failure (``ECOFMAPS_DEBUG=1`` shows the
+    traceback). A signal once the subcommand's work is done stops nothing. Warnings are
+    printed as ``ecofmaps COMMAND: warning: ...``, one line each (those of the options once
+    they are parsed).
     """
     interrupted = status = None
     try:  # the subcommands import JAX and xarray: an interrupt may come during the imports
-        with interrupts_stop_writes() as interrupted:
+        with interrupts_stop_writes() as interrupted, warnings.catch_warnings(record=True) as told:
             try:
                 parser = build_parser()
                 args, unknown = parser.parse_known_args(argv)
@@ -127,7 +123,10 @@ def main(argv=None) -> int:
             except SystemExit as stop:  # a usage error (printed), --help or --version
                 status = int(stop.code or 0)
                 return status
-            status = handler(args.handler)(args)
+            warnings.showwarning = _warning_line(getattr(args, "command_prog", "ecofmaps"))
+            for warning in told:
+                warnings.showwarning(warning.message, warning.category, "", 0)
+            status = args.handler(args)
             return status
     except KeyboardInterrupt as stop:
         if status is not None:  # the signal came after the work was done, when leaving
@@ -150,27 +149,15 @@ def main(argv=None) -> int:
 
 
 def _stopped(interrupted, note) -> int:
-    """Report a run stopped by Ctrl-C or SIGTERM in one line; return 130 or 143.
-
-    What the line says was left is asked now of the notes the subcommand gave
-    (:meth:`ecofmaps._interrupts.Stop.note`), if it gave any, rather than taken from
-    ``note`` (the stop's own, told when it was raised): everything the stop interrupted has
-    unwound by now, so nothing lands after the line is written.
-    """
+    """Report a run stopped by Ctrl-C or SIGTERM in one line; return 130 or 143. What was
+    left is asked now of the subcommand's notes, if any, rather than taken from the stop's
+    ``note``: everything the stop interrupted has unwound by now."""
     terminated = interrupted is not None and interrupted.signal == signal.SIGTERM
     words = "terminated (SIGTERM)" if terminated else "interrupted"
     if interrupted is not None and interrupted.notes:
         note = interrupted.note()
     note = note or "no output was left half written"
     return _report(EXIT_TERMINATED if terminated else EXIT_INTERRUPTED, f"{words}; {note}")
-
-
-def handler(spec):
-    """The handler a subcommand set: a callable, or ``"module:function"`` imported now."""
-    if callable(spec):
-        return spec
-    module, _, name = spec.partition(":")
-    return getattr(importlib.import_module(module), name)
 
 
 def _ignored_after_main() -> list:
@@ -188,6 +175,16 @@ def _nothing_to_stop(signum, frame) -> None:
     """A stop signal outside :func:`main`'s block, where there is no work to stop."""
 
 
+def _warning_line(command: str):
+    """A ``warnings.showwarning`` that prints ``<command>: warning: <message>`` on one line."""
+
+    def show(message, category, filename, lineno, file=None, line=None) -> None:
+        text = " ".join(str(message).strip().splitlines())
+        print(f"{command}: warning: {text}", file=sys.stderr)
+
+    return show
+
+
 def _report(status: int, message: str) -> int:
     """Print ``ecofmaps: <message>`` on standard error; return ``status``."""
     print(f"ecofmaps: {message}", file=sys.stderr)
@@ -197,17 +194,11 @@ def _report(status: int, message: str) -> int:
 def console() -> None:
     """The ``ecofmaps`` console script: run :func:`main` and exit with its status.
 
-    After Ctrl-C or SIGTERM the process ends at once (``os._exit``) once its messages are flushed:
-    JAX's worker threads may still be busy with the interrupted computation, and tearing
-    the interpreter down around them can crash it. Files were already cleaned up, since
-    every file is written through a temporary that the interrupt removed. The objects the
-    interrupted run left are collected first, so that their finalizers release what they
-    hold (the semaphores of a process pool, which multiprocessing's resource tracker would
-    otherwise report as leaked, a second line on standard error).
-
-    Once :func:`main` has returned, Ctrl-C and SIGTERM are ignored: the run's work is done
-    and its line (if any) written, and a signal killing the interpreter as it exits would
-    turn a complete run into exit status 143 with no line (or a traceback after Ctrl-C).
+    After Ctrl-C or SIGTERM the process ends at once (``os._exit``) once its messages are
+    flushed and the interrupted run's objects collected (their finalizers release a process
+    pool's semaphores): JAX's threads may still be busy, and tearing the interpreter down
+    around them can crash it. Once :func:`main` has returned, Ctrl-C and SIGTERM are ignored,
+    so that a signal as the interpreter exits does not turn a complete run into status 143.
     """
     after = _ignored_after_main()
     status = main()

@@ -2,37 +2,37 @@
 
 A grid of more than ``--chunk-points`` points, and any grid written to a zarr store, is
 computed block by block straight into the output (:func:`ecofmaps.maps.write_map`), with a
-progress bar on a terminal; a smaller one is computed at once (not cached: it computes
-faster than the cache would read it back).
-Before any work the command states the map's size (points, bytes) and refuses one that
-would not fit on the output's disk, or, computed at once, in memory
-(:func:`ecofmaps.maps.compute_map` refuses that).
+progress bar on a terminal; a smaller one is computed at once (not cached: it computes faster
+than the cache would read it back). Before any work the command states the map's size and
+refuses one that would not fit on the disk.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
+import shutil
+import sys
 import textwrap
+from pathlib import Path
 
-from ecofmaps.cli._common import quantities, quantity
+import numpy as np
 
-__all__ = ["add"]
+from ecofmaps.cli._common import (
+    CommandError,
+    byte_size,
+    count,
+    quantity,
+    refuse_to_overwrite,
+)
+from ecofmaps.io.files import record_written
+
+__all__ = ["add", "run"]
 
 _GRID_HELP = "; one value, a list or a range start:stop:num"
 #: Default of --chunk-points: blocks of 2**22 points (about 220 MB of results with a load).
 _CHUNK_POINTS = 2**22
-
-
-def _points(text: str) -> int:
-    """An argparse ``type``: a whole number of points >= 1 (``4194304``, ``4e6``)."""
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not (math.isfinite(value) and value.is_integer() and value >= 1):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of points >= 1")
-    return int(value)
 
 
 def add(subparsers) -> None:
@@ -70,50 +70,196 @@ def add(subparsers) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
-        "--stiffness-ratio", type=quantities("stiffness_ratio"), required=True, metavar="S/P",
+        "--stiffness-ratio",
+        type=quantity("stiffness_ratio", grid=True),
+        required=True,
+        metavar="S/P",
         help="rig stiffness over normal load S/P [1/m], 'inf' for a rigid rig" + _GRID_HELP,
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--aspect-ratio", type=quantities("aspect_ratio"), required=True, metavar="Z/X",
+        "--aspect-ratio",
+        type=quantity("aspect_ratio", grid=True),
+        required=True,
+        metavar="Z/X",
         help="groove depth over half-width z_o/x_o (>= 0)" + _GRID_HELP,
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--amplitude", type=quantities("amplitude"), required=True, metavar="DELTA",
+        "--amplitude",
+        type=quantity("amplitude", grid=True),
+        required=True,
+        metavar="DELTA",
         help="displacement amplitude Δ* [m], e.g. 25um,50um" + _GRID_HELP,
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--mu", type=quantities("mu"), required=True, metavar="MU",
+        "--mu",
+        type=quantity("mu", grid=True),
+        required=True,
+        metavar="MU",
         help="contact coefficient of friction μ (> 0)" + _GRID_HELP,
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--load", type=quantity("load"), default=None, metavar="P",
+        "--load",
+        type=quantity("load"),
+        metavar="P",
         help="normal load P [N], one value; adds dissipated_energy [J] and max_force [N]",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--out", required=True, metavar="FILE.nc|FILE.zarr",
+        "--out",
+        required=True,
+        metavar="FILE.nc|FILE.zarr",
         help="netCDF file, or zarr store if the name ends in .zarr, to write (its directory "
         "must exist)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--overwrite", action="store_true",
+        "--overwrite",
+        action="store_true",
         help="replace --out if it exists and ecofmaps wrote it (once the new map is complete)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--chunk-points", type=_points, default=_CHUNK_POINTS, metavar="N",
+        "--chunk-points",
+        type=count("points"),
+        default=_CHUNK_POINTS,
+        metavar="N",
         help=f"grid points per block (default {_CHUNK_POINTS}); a larger grid is computed "
         "block by block into --out",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--quiet", action="store_true",
+        "--quiet",
+        action="store_true",
         help="no progress bar (there is none either when standard error is not a terminal)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--no-cache", action="store_true",
+        "--no-cache",
+        action="store_true",
         help="do not read or store the result in the cache (a map of the parabolic groove "
         "is not cached anyway: kept for scripts that give it)",
-    )  # fmt: skip
+    )
     parser.add_argument(
-        "--cache-dir", default=None, metavar="DIR",
+        "--cache-dir",
+        metavar="DIR",
         help="cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)",
-    )  # fmt: skip
-    parser.set_defaults(handler="ecofmaps.cli.map_run:run")  # imported when it runs
+    )
+
+
+def run(args) -> int:
+    """Run ``ecofmaps map`` with the parsed ``args``; the exit status."""
+    from ecofmaps.maps.files import ZARR_SUFFIX
+    from ecofmaps.maps.grid import compute_map
+
+    out = Path(args.out)
+    if not out.parent.is_dir():
+        raise CommandError(f"cannot write {out}: the directory {out.parent} does not exist")
+    refuse_to_overwrite([("--out", out)], [], overwrite=args.overwrite)
+    grid = {
+        name: values[0] if values.size == 1 else values
+        for name, values in (
+            ("stiffness_ratio", args.stiffness_ratio),
+            ("aspect_ratio", args.aspect_ratio),
+            ("amplitude", args.amplitude),
+            ("mu", args.mu),
+        )
+    }
+    points = math.prod(values.size for values in grid.values() if np.ndim(values))
+    size = _map_bytes(grid, args.load)
+    free = shutil.disk_usage(out.parent).free
+    print(
+        f"ecofmaps map: {points:,} points, {byte_size(size)} into {out} "
+        f"({byte_size(free)} free there)",
+        flush=True,  # before the summary, also when the two streams are read apart
+    )
+    if size > free:
+        raise CommandError(
+            f"--out {out}: the map of {points:.3g} points needs up to {byte_size(size)} on disk, "
+            f"more than the {byte_size(free)} free in {out.parent.resolve()}: use a smaller grid "
+            "or another disk"
+        )
+    chunked = out.suffix == ZARR_SUFFIX or points > args.chunk_points
+    if chunked:
+        dataset = compute_map(**grid, load=args.load, chunks=args.chunk_points)
+    else:  # refused there if it would not fit in memory
+        dataset = compute_map(
+            **grid, load=args.load, cache=False if args.no_cache else None, cache_dir=args.cache_dir
+        )
+    return _write(dataset, out, shown=chunked and not args.quiet and sys.stderr.isatty())
+
+
+def _map_bytes(grid: dict, load) -> int:
+    """Bytes [byte] of the map of ``grid`` (``compute_map``'s grid keywords) with its
+    coordinates, uncompressed, before computing it: the variables' types and dimensions come
+    from the map of at most two values along each axis, chunked (nothing computed)."""
+    from ecofmaps.maps.grid import compute_map
+
+    small = {name: values[:2] if np.ndim(values) else values for name, values in grid.items()}
+    sample = compute_map(**small, load=load, chunks=1)  # lazy: nothing computed
+    sizes = {name: np.size(values) for name, values in grid.items() if np.ndim(values)}
+    return sum(
+        variable.dtype.itemsize * math.prod(sizes[dim] for dim in variable.dims)
+        for variable in sample.variables.values()
+    )
+
+
+def _write(dataset, out: Path, shown: bool) -> int:
+    """Write ``dataset`` to ``out`` (a progress bar if ``shown``), record it as written by
+    ecofmaps, and print what was written."""
+    from ecofmaps.maps.files import write_map
+    from ecofmaps.model import Regime
+
+    summary = [(dataset.regime == code).sum().data for code in Regime]
+    summary += [dataset.ecof_ratio.min().data, dataset.ecof_ratio.max().data]
+    with _progress(dataset, shown=shown):
+        *counts, low, high = write_map(dataset, out, also=summary)
+    record_written([out])
+    shape = " x ".join(f"{size} {dim}" for dim, size in dataset.sizes.items()) or "1 point"
+    regimes = ", ".join(
+        f"{code.label} {int(n)}" for code, n in zip(Regime, counts, strict=True) if n
+    )
+    print(f"wrote {out}: {shape}")
+    print(f"  regimes: {regimes}")
+    if math.isfinite(low := float(low)):  # NaN-skipping
+        print(f"  ECoF / contact CoF: {low:.6g} to {float(high):.6g}")
+    return 0
+
+
+@contextlib.contextmanager
+def _progress(dataset, shown: bool):
+    """A progress bar on standard error (points and blocks done, rate, ETA) while in the block.
+
+    It counts the blocks of a chunked map as their dask tasks finish; on an error or
+    Ctrl-C it is cleared, so the error is the last line.
+    """
+    if not shown:
+        yield
+        return
+    from dask.callbacks import Callback
+    from tqdm import tqdm
+
+    from ecofmaps.maps.tiles import BLOCK_TASK
+
+    blocks = math.prod(len(c) for c in dataset.regime.chunks)
+    bar = tqdm(
+        total=dataset.regime.size,
+        unit="pt",
+        unit_scale=True,
+        desc="ecofmaps map",
+        file=sys.stderr,
+        dynamic_ncols=True,
+        postfix=f"0/{blocks} blocks",
+    )
+    done = 0
+
+    class Blocks(Callback):
+        def _posttask(self, key, result, dsk, state, worker_id):
+            nonlocal done
+            if isinstance(key, tuple) and str(key[0]).startswith(BLOCK_TASK):
+                done += 1
+                bar.set_postfix_str(f"{done}/{blocks} blocks", refresh=False)
+                bar.update(next(iter(result.values())).size)
+
+    try:
+        with Blocks():
+            yield
+    except BaseException:
+        bar.leave = False
+        raise
+    finally:
+        bar.close()

@@ -15,8 +15,13 @@ from ecofmaps.cli._common import quantity, unit
 __all__ = ["add", "run"]
 
 #: The per-test numbers, in the order printed and written.
-_WEAR = ("cumulated_energy", "wear_volume", "energy_wear_coefficient", "archard_slip",
-         "archard_nominal")  # fmt: skip
+_WEAR = (
+    "cumulated_energy",
+    "wear_volume",
+    "energy_wear_coefficient",
+    "archard_slip",
+    "archard_nominal",
+)
 
 
 def _length(text: str) -> float:
@@ -44,19 +49,40 @@ def add(subparsers) -> None:
     )
     option = parser.add_argument
     option("tables", nargs="+", metavar="TABLE", help="results of ecofmaps loops (CSV, or .nc)")
-    option("--profile", action="append", required=True, metavar="FILE",
-        help="a test's wear-scar profile (x and z columns); once per test")  # fmt: skip
-    option("--length", type=_length, required=True, metavar="L",
-        help="length of the line contact, with its unit, e.g. 5mm")  # fmt: skip
-    option("--rig-stiffness", type=quantity("stiffness"), metavar="S",
-        help="the rig's own stiffness, e.g. 35MN/m: regime read on the contact")  # fmt: skip
-    option("--x-unit", type=unit("length"), metavar="UNIT",
-        help="unit of the profiles' positions (default: the column name's, else um)")  # fmt: skip
-    option("--z-unit", type=unit("length"), metavar="UNIT",
-        help="unit of the profiles' heights (default: the column name's, else um)")  # fmt: skip
+    option(
+        "--profile",
+        action="append",
+        required=True,
+        metavar="FILE",
+        help="a test's wear-scar profile (x and z columns); once per test",
+    )
+    option(
+        "--length",
+        type=_length,
+        required=True,
+        metavar="L",
+        help="length of the line contact, with its unit, e.g. 5mm",
+    )
+    option(
+        "--rig-stiffness",
+        type=quantity("stiffness", option="--rig-stiffness"),
+        metavar="S",
+        help="the rig's own stiffness, e.g. 35MN/m: regime read on the contact",
+    )
+    option(
+        "--x-unit",
+        type=unit("length"),
+        metavar="UNIT",
+        help="unit of the profiles' positions (default: the column name's, else um)",
+    )
+    option(
+        "--z-unit",
+        type=unit("length"),
+        metavar="UNIT",
+        help="unit of the profiles' heights (default: the column name's, else um)",
+    )
     option("--out", metavar="OUT", help="write the numbers here (CSV)")
     option("--overwrite", action="store_true", help="replace --out if ecofmaps wrote it")
-    parser.set_defaults(handler=run)
 
 
 def _profile(args, path):
@@ -99,13 +125,20 @@ def run(args) -> int:
         found = read_results(path)
         tests += [(f"{path}:{r.attrs['file']}" if len(found) > 1 else path, r) for r in found]
     if len(args.profile) != len(tests):
-        raise CommandError(f"give one --profile per test: {len(tests)} tests in the tables, "
-                           f"{len(args.profile)} profiles")  # fmt: skip
+        raise CommandError(
+            f"give one --profile per test: {len(tests)} tests in the tables, "
+            f"{len(args.profile)} profiles"
+        )
     profiles = [_profile(args, path) for path in args.profile]
 
     def rows(wear, names):
-        return [(*row(q, float(wear[q]))[:2], f"{row(q, float(wear[q]))[2]} ± "
-                 f"{row(q, float(wear[f'{q}_se']))[2]}") for q in names]  # fmt: skip
+        return [
+            (
+                *row(q, float(wear[q]))[:2],
+                f"{row(q, float(wear[q]))[2]} ± {row(q, float(wear[f'{q}_se']))[2]}",
+            )
+            for q in names
+        ]
 
     table = {"test": [], "profile": [], "sliding_condition": []}
     for (name, results), path, profile in zip(tests, args.profile, profiles, strict=True):

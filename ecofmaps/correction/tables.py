@@ -2,14 +2,15 @@
 
 :func:`correct_table` reads the table ``ecofmaps correct`` takes, corrects each row with
 :func:`ecofmaps.correct_ecof` and writes it back with ``mu`` and ``correction_factor`` added;
-a bad row raises :class:`TableError` naming the file and the line. The table's format is
-described in ``docs/formats.md``.
+a bad row raises :class:`TableError` naming the file and the line (or gets NaN and its
+reason in a ``status`` column). The table's format is described in ``docs/formats.md``.
 """
 
 from __future__ import annotations
 
 import csv
 import io
+import warnings
 from pathlib import Path
 from typing import NamedTuple
 
@@ -24,8 +25,10 @@ __all__ = [
     "ADDED_COLUMNS",
     "COLUMNS",
     "SHORTCUT_COLUMN",
+    "STATUS_COLUMN",
     "TableDialect",
     "TableError",
+    "TableRowWarning",
     "correct_table",
     "table_dialect",
 ]
@@ -47,6 +50,8 @@ COLUMNS = {
 ADDED_COLUMNS = ("mu", "correction_factor")
 #: Column added on a profile: the contact CoF of the parabola of the same D/W (eq. 11).
 SHORTCUT_COLUMN = "mu_parabolic"
+#: Column added when a row could not be corrected: each row's :class:`CorrectionStatus` label.
+STATUS_COLUMN = "status"
 
 _REQUIRED = tuple(nomenclature.column(n) for n in ("ecof", "amplitude", "load", "stiffness"))
 _SCAR = tuple(nomenclature.column(n) for n in ("scar_depth", "scar_half_width"))
@@ -54,6 +59,11 @@ _SCAR = tuple(nomenclature.column(n) for n in ("scar_depth", "scar_half_width"))
 
 class TableError(FileLineError):
     """A bad table: the message names the file and the 1-based line number (header: 1)."""
+
+
+class TableRowWarning(UserWarning):
+    """A row that could not be corrected (``bad_rows="nan"``): the message names the file,
+    the 1-based line number and the column, as :class:`TableError` does."""
 
 
 class TableDialect(NamedTuple):
@@ -88,8 +98,11 @@ def _number(path, line: int, name: str, text: str, decimal_comma: bool = False) 
     return value / quantity.display_factor
 
 
-def _read(path: Path, on_profile: bool = False):
-    """Header, rows (cells as written), their line numbers, the SI columns and the dialect."""
+def _read(path: Path, on_profile: bool = False, keep_bad: bool = False):
+    """Header, rows (cells as written), their line numbers, the SI columns (NaN in a bad
+    row), the dialect, and the :class:`TableError` of each bad row by its index (raised at
+    once unless ``keep_bad``). On a profile the rows give no aspect ratio.
+    """
     try:
         with open(path, encoding="utf-8-sig", newline="") as stream:
             lines = ["\n" if _is_comment(line) else line for line in stream]
@@ -104,13 +117,14 @@ def _read(path: Path, on_profile: bool = False):
         raise TableError(path, 1, "the file is empty; expected a header line")
     (header, header_line), records = records[0], records[1:]
     header = [name.strip() for name in header]
-    _check_header(path, header_line, header, on_profile)
+    _check_header(path, header_line, header, on_profile, keep_bad)
     if not records:
         raise TableError(path, header_line, "the table has a header but no data rows")
     column = {name: header.index(name) for name in COLUMNS if name in header}
     values = {name: [] for name in (*_REQUIRED, "aspect_ratio")}
     commas = dialect.delimiter != ","
-    for row, line in records:
+    bad = {}
+    for index, (row, line) in enumerate(records):
         if len(row) != len(header):
             raise TableError(
                 path,
@@ -118,10 +132,25 @@ def _read(path: Path, on_profile: bool = False):
                 f"{len(row)} fields, but the header has {len(header)} columns"
                 + _separator_hint(header),
             )
-        for name in _REQUIRED:
-            values[name].append(_number(path, line, name, row[column[name]], commas))
-        if on_profile:
-            continue
+        try:
+            numbers = _row_values(path, line, row, column, on_profile, commas)
+        except TableError as error:
+            if not keep_bad:
+                raise
+            bad[index] = error
+            numbers = dict.fromkeys(_REQUIRED if on_profile else values, np.nan)
+        for name, value in numbers.items():
+            values[name].append(value)
+    si = {name: np.asarray(values[name]) for name in values if values[name]}
+    numbers = [row[column[name]] for row, _ in records for name in column]
+    decimal_comma = commas and any("," in cell for cell in numbers)
+    return header, records, si, dialect._replace(decimal_comma=decimal_comma), bad
+
+
+def _row_values(path, line: int, row, column: dict, on_profile: bool, commas: bool) -> dict:
+    """The SI values of one row: the required columns and (not on a profile) its aspect ratio."""
+    values = {name: _number(path, line, name, row[column[name]], commas) for name in _REQUIRED}
+    if not on_profile:
         given_ratio = "aspect_ratio" in column and row[column["aspect_ratio"]].strip() != ""
         given_scar = [name in column and row[column[name]].strip() != "" for name in _SCAR]
         if given_ratio == any(given_scar) or (any(given_scar) and not all(given_scar)):
@@ -131,17 +160,13 @@ def _read(path: Path, on_profile: bool = False):
                 "give the aspect ratio one way: aspect_ratio, or both scar_depth_um and "
                 "scar_half_width_um",
             )
-        ratio = (
+        values["aspect_ratio"] = (
             _number(path, line, "aspect_ratio", row[column["aspect_ratio"]], commas)
             if given_ratio
             else _number(path, line, "scar_depth_um", row[column["scar_depth_um"]], commas)
             / _number(path, line, "scar_half_width_um", row[column["scar_half_width_um"]], commas)
         )
-        values["aspect_ratio"].append(ratio)
-    si = {name: np.asarray(values[name]) for name in values if values[name]}
-    numbers = [row[column[name]] for row, _ in records for name in column]
-    decimal_comma = commas and any("," in cell for cell in numbers)
-    return header, records, si, dialect._replace(decimal_comma=decimal_comma)
+    return values
 
 
 def _is_comment(line: str) -> bool:
@@ -163,7 +188,7 @@ def _records(reader):
             yield row, reader.line_num
 
 
-def _check_header(path, line: int, header: list[str], on_profile: bool) -> None:
+def _check_header(path, line: int, header: list[str], on_profile: bool, keep_bad: bool) -> None:
     duplicates = sorted({name for name in header if header.count(name) > 1})
     if duplicates:
         raise TableError(path, line, f"repeated column(s) {', '.join(duplicates)}")
@@ -186,7 +211,7 @@ def _check_header(path, line: int, header: list[str], on_profile: bool) -> None:
             f"missing column(s) {', '.join(missing)}; the table needs {', '.join(_REQUIRED)} "
             f"and aspect_ratio or {' + '.join(_SCAR)}",
         )
-    added = (*ADDED_COLUMNS, SHORTCUT_COLUMN) if on_profile else ADDED_COLUMNS
+    added = (*ADDED_COLUMNS, *[SHORTCUT_COLUMN] * on_profile, *[STATUS_COLUMN] * keep_bad)
     taken = [name for name in added if name in header]
     if taken:
         raise TableError(
@@ -194,7 +219,7 @@ def _check_header(path, line: int, header: list[str], on_profile: bool) -> None:
         )
 
 
-def correct_table(path, profile=None, mapping="scaled") -> tuple[str, int]:
+def correct_table(path, profile=None, mapping="scaled", bad_rows="raise") -> tuple[str, int]:
     r"""Correct every row of a table of reported ECoF values (format: ``docs/formats.md``).
 
     Parameters
@@ -206,52 +231,78 @@ def correct_table(path, profile=None, mapping="scaled") -> tuple[str, int]:
         scar columns).
     mapping : {'scaled', 'physical'}
         On a profile: :math:`X = xW/\Delta^*` (eq. 11) or :math:`X = x`.
+    bad_rows : {'raise', 'nan'}
+        A row with a bad value or an ECoF that cannot be corrected raises, or (``'nan'``)
+        gets NaN, with a :class:`TableRowWarning` naming it and a ``status`` column.
 
     Returns
     -------
     text : str
         The output table with the input's separator: the input columns and cells, then
         ``mu`` and ``correction_factor`` (both to 10 significant digits, with a decimal
-        comma if the input has them), and on a profile ``mu_parabolic``.
+        comma if the input has them), on a profile ``mu_parabolic``, and when a row could
+        not be corrected ``status`` (each row's :class:`CorrectionStatus` label).
     rows : int
         The number of data rows.
 
     Raises
     ------
     TableError
-        For a file that cannot be read as such a table, a bad value, or a row whose ECoF
-        cannot be corrected (the reason, as :func:`ecofmaps.correct_ecof` gives it); the
-        first such row is named by its line.
+        For a file that cannot be read as such a table, or (``bad_rows='raise'``) a bad
+        value or a row whose ECoF cannot be corrected (the reason, as
+        :func:`ecofmaps.correct_ecof` gives it); the first such row is named by its line.
     OSError
         If the file cannot be opened.
     """
+    if bad_rows not in ("raise", "nan"):
+        raise ValueError(f"bad_rows must be 'raise' or 'nan', got {bad_rows!r}")
     path = Path(path)
-    header, records, si, dialect = _read(path, on_profile=profile is not None)
-    rig = dict(amplitude=si["amplitude_um"], load=si["load_N"], stiffness=si["stiffness_MN_per_m"])
+    header, records, si, dialect, bad = _read(path, profile is not None, bad_rows == "nan")
+    read = np.ones(len(records), bool)
+    read[list(bad)] = False
+    rig = {
+        name: si[column][read]
+        for name, column in (
+            ("amplitude", "amplitude_um"),
+            ("load", "load_N"),
+            ("stiffness", "stiffness_MN_per_m"),
+        )
+    }
+    mu, added = np.full(len(records), np.nan), [[] for _ in records]
+    status = np.full(len(records), int(CorrectionStatus.INVALID))
     if profile is None:
-        scar = {"aspect_ratio": si["aspect_ratio"]}
-        added = [[] for _ in records]
+        scar = {"aspect_ratio": si["aspect_ratio"][read]}
     else:
         scar = {"profile": profile, "mapping": mapping}
-        shortcut, _ = correct_ecof(
-            si["ecof"], **rig, aspect_ratio=float(profile.aspect_ratio), return_status=True
+        shortcut = np.full(len(records), np.nan)
+        shortcut[read], _ = correct_ecof(
+            si["ecof"][read], **rig, aspect_ratio=float(profile.aspect_ratio), return_status=True
         )
-        added = [[_written(value, dialect)] for value in np.asarray(shortcut)]
-    mu, status = correct_ecof(si["ecof"], **rig, **scar, return_status=True)
-    mu, status = np.asarray(mu), np.asarray(status)
-    failed = np.flatnonzero(status != CorrectionStatus.CORRECTED)
-    if failed.size:
-        i = int(failed[0])
-        one = {name: value[i] if name == "aspect_ratio" else value for name, value in scar.items()}
-        try:  # a single point raises with its reason
-            correct_ecof(si["ecof"][i], **{name: value[i] for name, value in rig.items()}, **one)
-        except ValueError as error:
-            raise TableError(path, records[i][1], str(error)) from None
+        added = [[_written(value, dialect)] for value in shortcut]
+    if read.any():
+        mu[read], status[read] = correct_ecof(si["ecof"][read], **rig, **scar, return_status=True)
+    for i, index in enumerate(np.flatnonzero(read)):
+        if status[index] != CorrectionStatus.CORRECTED:
+            one = {k: v[i] if k == "aspect_ratio" else v for k, v in scar.items()}
+            try:  # a single point raises with its reason
+                correct_ecof(si["ecof"][index], **{k: v[i] for k, v in rig.items()}, **one)
+            except ValueError as error:
+                bad[index] = TableError(path, records[index][1], str(error))
+    for index in sorted(bad):
+        if bad_rows == "raise":
+            raise bad[index]
+        warnings.warn(str(bad[index]), TableRowWarning, stacklevel=2)
     stream = io.StringIO()
     writer = csv.writer(stream, delimiter=dialect.delimiter, lineterminator="\n")
-    writer.writerow([*header, *ADDED_COLUMNS, *([] if profile is None else [SHORTCUT_COLUMN])])
-    for (row, _), value, ecof, more in zip(records, mu, si["ecof"], added, strict=True):
-        writer.writerow([*row, _written(value, dialect), _written(value / ecof, dialect), *more])
+    more = ([] if profile is None else [SHORTCUT_COLUMN]) + ([STATUS_COLUMN] if bad else [])
+    writer.writerow([*header, *ADDED_COLUMNS, *more])
+    for (row, _), value, ecof, cells, code in zip(
+        records, mu, si["ecof"], added, status, strict=True
+    ):
+        label = [CorrectionStatus(int(code)).label] if bad else []
+        writer.writerow(
+            [*row, _written(value, dialect), _written(value / ecof, dialect), *cells, *label]
+        )
     return stream.getvalue(), len(records)
 
 

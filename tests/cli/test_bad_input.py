@@ -154,7 +154,7 @@ def test_a_grid_too_large_for_memory_is_refused_before_allocating(tmp_path, caps
 
 
 def test_an_unexpected_failure_is_one_line_with_status_1(capsys, monkeypatch):
-    from ecofmaps.cli import model_run as model
+    from ecofmaps.cli import model
 
     def broken(args):
         raise KeyError("a bug")
@@ -169,11 +169,12 @@ def test_an_unexpected_failure_is_one_line_with_status_1(capsys, monkeypatch):
 
 
 def interrupted_run(command, wait_for: str, delay: float, env=None):
-    """Run ``command``, press Ctrl-C ``delay`` s after it printed ``wait_for`` on stderr."""
+    """Run ``command``, press Ctrl-C ``delay`` s after it printed ``wait_for`` (on standard
+    output for ``ecofmaps map``, else on standard error)."""
     process = subprocess.Popen(
         command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
     )
-    started = process.stderr.readline()
+    started = (process.stdout if "map" in command else process.stderr).readline()
     assert wait_for in started, started
     time.sleep(delay)
     process.send_signal(signal.SIGINT)
@@ -193,7 +194,7 @@ def test_ctrl_c_exits_130_with_one_line_and_leaves_no_output(tmp_path, delay):
     status, stdout, stderr = interrupted_run(command, "ecofmaps map: 4,500,000 points", delay)
     assert status == 130, stderr
     assert stderr == "ecofmaps: interrupted; no output was left half written\n"
-    assert stdout == "" and list(tmp_path.iterdir()) == []
+    assert stdout == "" and list(tmp_path.iterdir()) == []  # the size line read before
 
 
 def test_ctrl_c_during_figures_keeps_whole_files_only(tmp_path):

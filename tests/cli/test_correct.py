@@ -156,32 +156,23 @@ def test_table_as_a_spreadsheet_writes_it(tmp_path, capsys):
     assert status != 0 and f"{tmp_path / 'bad.csv'}, line 7: " in err
 
 
+HEADER = "ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio\n"
+SCARS = "ecof,amplitude_um,load_N,stiffness_MN_per_m,scar_depth_um,scar_half_width_um\n"
 BAD_TABLES = [
-    # (text, line, message)
+    # (text, line, message): the table cannot be read, nothing is written
     ("", 1, "the file is empty"),
-    ("ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio\n", 1, "no data rows"),
+    (HEADER, 1, "no data rows"),
     ("ecof,amplitude_um,stiffness_MN_per_m,aspect_ratio\n0.8,50,35,0.2\n", 1,
      "missing column(s) load_N"),
     ("ecof,amplitude_um,load_N,stiffness_MN_per_m\n0.8,50,450,35\n", 1,
      "missing column(s) aspect_ratio (or scar_depth_um + scar_half_width_um)"),
     ("ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio,mu\n0.8,50,450,35,0.2,1\n", 1,
      "column(s) mu would be overwritten"),
+    (HEADER.replace("aspect_ratio", "aspect_ratio,status") + "0.8,50,450,35,0.2,x\n", 1,
+     "column(s) status would be overwritten"),
     ("ecof,ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio\n", 1,
      "repeated column(s) ecof"),
-    ("ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio\n0.8,50,450,35,0.2\n"
-     "0.8,50,450,35,abc\n", 3, "aspect_ratio = 'abc' is not a number"),
-    ("ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio\n0.8,50,450,35,0.2\n\n"
-     "0.8,50,-450,35,0.2\n", 4, "load_N must satisfy 0 < load_N < inf, got -450"),
-    ("ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio\n0.8,50,450,35\n", 2,
-     "4 fields, but the header has 5 columns"),
-    ("ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio\n0.8,50,450,35,0.2\n"
-     "9,50,450,35,0.2\n", 3, "ecof = 9 cannot be corrected"),
-    ("ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio,scar_depth_um,scar_half_width_um\n"
-     "0.8,50,450,35,0.2,8,40\n", 2, "give the aspect ratio one way"),
-    ("ecof,amplitude_um,load_N,stiffness_MN_per_m,scar_depth_um,scar_half_width_um\n"
-     "0.8,50,450,35,8,\n", 2, "give the aspect ratio one way"),
-    ("ecof,amplitude_um,load_N,stiffness_MN_per_m,scar_depth_um,scar_half_width_um\n"
-     "0.8,50,450,35,8,0\n", 2, "scar_half_width_um must satisfy 0 < scar_half_width_um < inf"),
+    (HEADER + "0.8,50,450,35\n", 2, "4 fields, but the header has 5 columns"),
 ]  # fmt: skip
 
 
@@ -202,14 +193,56 @@ def test_bad_table_names_file_and_line(tmp_path, capsys, text, line, message):
     assert listed == [MANIFEST, "bad.csv", "out.csv"]  # no temp left
 
 
-def test_bad_table_writes_no_new_file(tmp_path, capsys):
+BAD_ROWS = [
+    # (row, message, status): the row gets NaN, the others are corrected
+    ("0.8,50,450,,0.2", "stiffness_MN_per_m = '' is not a number", "invalid"),
+    ("0.8,50,450,35,abc", "aspect_ratio = 'abc' is not a number", "invalid"),
+    ("0.8,50,-450,35,0.2", "load_N must satisfy 0 < load_N < inf, got -450", "invalid"),
+    ("9,50,450,35,0.2", "ecof = 9 cannot be corrected: it is at or above", "no gross slip"),
+]
+
+
+@pytest.mark.parametrize(("row", "message", "label"), BAD_ROWS)
+def test_a_bad_row_gets_nan_and_its_reason_the_others_are_corrected(
+    tmp_path, capsys, row, message, label
+):
     table = write(
-        tmp_path / "bad.csv",
-        "ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio\n0.8,x,1,1,0\n",
+        tmp_path / "lit.csv", HEADER + "0.83,50,450,35,0.2\n" + row + "\n0.7,50,450,35,0\n"
     )
-    status, _, err = run(capsys, "correct", table, "--out", tmp_path / "new.csv")
-    assert status == 2 and "line 2: amplitude_um = 'x'" in err
-    assert not (tmp_path / "new.csv").exists()
+    out = tmp_path / "corrected.csv"
+    status, stdout, err = run(capsys, "correct", table, "--out", out)
+    assert status == 1
+    assert err.startswith(f"ecofmaps correct: error: {table}, line 3: ")
+    assert message in err and len(err.splitlines()) == 1
+    assert f"wrote {out}: 2 of 3 rows corrected, 1 not (NaN, the reason in" in stdout
+    rows = read_csv(out.read_text(encoding="utf-8"))
+    assert [r["status"] for r in rows] == ["corrected", label, "corrected"]
+    assert rows[1]["mu"] == rows[1]["correction_factor"] == "nan"
+    good = ecofmaps.correct_ecof(np.array([0.83, 0.7]), 50e-6, 450.0, 35e6, np.array([0.2, 0.0]))
+    np.testing.assert_allclose([float(rows[0]["mu"]), float(rows[2]["mu"])], good, rtol=1e-9)
+
+
+def test_every_bad_row_is_named_and_a_table_of_good_rows_has_no_status(tmp_path, capsys):
+    rows = ["9,50,450,35,0.2", "0.8,50,450,35,0.2", "0.8,x,450,35,0.2"]
+    table = write(tmp_path / "lit.csv", HEADER + "\n".join(rows) + "\n")
+    status, stdout, err = run(capsys, "correct", table)
+    lines = err.splitlines()
+    assert status == 1 and len(lines) == 2
+    assert lines[0].startswith(f"ecofmaps correct: error: {table}, line 2: ecof = 9 ")
+    assert lines[1].startswith(f"ecofmaps correct: error: {table}, line 4: amplitude_um = 'x'")
+    assert [r["status"] for r in read_csv(stdout)] == ["no gross slip", "corrected", "invalid"]
+    status, stdout, err = run(capsys, "correct", write(tmp_path / "good.csv", HEADER + rows[1]))
+    assert status == 0 and err == "" and "status" not in stdout
+
+
+def test_rows_given_by_the_scar_one_way_only(tmp_path, capsys):
+    rows = ["0.8,50,450,35,8,", "0.8,50,450,35,8,0", "0.83,50,450,35,8,40"]
+    table = write(tmp_path / "scars.csv", SCARS + "\n".join(rows) + "\n")
+    status, stdout, err = run(capsys, "correct", table)
+    assert status == 1 and len(err.splitlines()) == 2
+    assert "line 2: give the aspect ratio one way" in err
+    assert "line 3: scar_half_width_um must satisfy 0 < scar_half_width_um < inf" in err
+    assert [r["status"] for r in read_csv(stdout)] == ["invalid", "invalid", "corrected"]
 
 
 def test_table_command_errors(tmp_path, capsys):

@@ -17,7 +17,7 @@ import sys
 import pytest
 
 from ecofmaps._interrupts import INTERRUPTED, Interrupted, add_stop_note
-from ecofmaps.cli import loops_long, loops_run
+from ecofmaps.cli import loops, loops_long
 from ecofmaps.io.files import MANIFEST
 from ecofmaps.measured.synthetic import write_long_recording
 from tests.cli.test_loops import run
@@ -92,8 +92,8 @@ def test_a_signal_after_the_last_block_keeps_them_and_says_so(
 ):
     """Every block measured, the table not yet renamed onto --out (the rename checks for the
     signal): the folder holds the whole run, and says so; --resume then writes the table."""
-    extras = loops_run._write_extras
-    monkeypatch.setattr(loops_run, "_write_extras", lambda *a: (signalled(sent), extras(*a)))
+    extras = loops._write_extras
+    monkeypatch.setattr(loops, "_write_extras", lambda *a: (signalled(sent), extras(*a)))
     out = tmp_path / "r.csv"
     code, printed, err = run(capsys, long_test, "--load", "450N", "--out", out, "--resume")
     assert code == status and printed == ""
@@ -108,7 +108,7 @@ def test_a_signal_after_the_last_block_keeps_them_and_says_so(
             + ["file0-cycles.npz", "kept.jsonl", "run.json"]
         )
     ]
-    monkeypatch.setattr(loops_run, "_write_extras", extras)
+    monkeypatch.setattr(loops, "_write_extras", extras)
     code, printed, err = run(capsys, long_test, "--load", "450N", "--out", out, "--resume")
     assert code == 0 and err == ""
     assert out.read_text() == expected and files(tmp_path) == ["r.csv"]
@@ -123,14 +123,14 @@ def test_a_signal_once_the_table_is_written_changes_nothing(
     removed, after, or as the summary is printed) stops nothing: exit 0, the summary
     printed in full, no line on standard error, the folder removed."""
     if where == "record_written":
-        written = loops_run.record_written
-        monkeypatch.setattr(loops_run, "record_written", lambda p: (signalled(sent), written(p)))
+        written = loops.record_written
+        monkeypatch.setattr(loops, "record_written", lambda p: (signalled(sent), written(p)))
     elif where == "finish":
         finish = loops_long.LongRun.finish
         monkeypatch.setattr(loops_long.LongRun, "finish", lambda s: (finish(s), signalled(sent)))
     else:
-        summary = loops_run._summary
-        monkeypatch.setattr(loops_run, "_summary", lambda *a: (signalled(sent), summary(*a))[1])
+        summary = loops._summary
+        monkeypatch.setattr(loops, "_summary", lambda *a: (signalled(sent), summary(*a))[1])
     out = tmp_path / "r.csv"
     code, printed, err = run(capsys, long_test, "--load", "450N", "--out", out, "--resume")
     assert (code, err) == (0, "")

@@ -282,12 +282,28 @@ def test_flagged_cycles_are_one_line_warnings_and_nan(tmp_path, capsys, recordin
     assert "Traceback" not in stderr and ".py:" not in stderr
 
 
+def test_a_latin1_export_warns_in_one_line_of_the_command(tmp_path, capsys, recording):
+    """An old rig PC's export (Latin-1): its warning is one line of ``ecofmaps loops``,
+    without Python's source line."""
+    path = write_csv(tmp_path / "old_pc.csv", *recording, header=("displacement [µm]", "force"))
+    path.write_bytes(
+        path.read_text(encoding="utf-8").replace("# a", "# Prüfstand: a").encode("latin-1")
+    )
+    status, _, stderr = run(capsys, path, "--load", "450N", "--no-resolve")
+    assert status == 0
+    assert stderr.splitlines()[0] == (
+        f"ecofmaps loops: warning: {path}, line 1: byte 0xfc is not UTF-8; the file is read "
+        "as Latin-1 from this line on (numbers are the same in both)"
+    )
+    assert "Warning" not in stderr and ".py:" not in stderr
+
+
 def test_the_summary_reads_the_gross_slip_cycles_only():
     """The summary line's medians and first and last ECoF are over the cycles in gross
     slip (its regime code), with the cycles without a value left out."""
     from pathlib import Path
 
-    from ecofmaps.cli.loops_run import _summary
+    from ecofmaps.cli.loops import _summary
     from ecofmaps.model.regimes import GROSS_SLIP, NO_GROSS_SLIP
 
     gross, stuck = int(GROSS_SLIP), int(NO_GROSS_SLIP)

@@ -231,7 +231,8 @@ def test_map_block_by_block_round_trip_is_identical(tmp_path, capsys, name):
     assert status == 0
     expected = fig11_map(450.0)
     stated = f"ecofmaps map: 140 points, {expected.nbytes / 1e3:.3g} kB into {out} ("
-    assert stderr.startswith(stated) and stderr.endswith(" free there)\n")  # no progress bar
+    assert stdout.startswith(stated) and stderr == ""  # no progress bar
+    assert stdout.splitlines()[0].endswith(" free there)")  # the size first, then the summary
     regimes = ", ".join(
         f"{code.label} {n}" for code in Regime if (n := int((expected.regime == code).sum()))
     )
@@ -269,7 +270,7 @@ def test_map_replaces_a_store_it_wrote_and_refuses_other_directories(tmp_path, c
 
 def test_map_states_its_size_and_refuses_one_the_disk_cannot_hold(tmp_path, capsys, monkeypatch):
     """2e12 points (tens of TB) against the free space of --out's folder: refused at once."""
-    from ecofmaps.cli import map_run as command
+    from ecofmaps.cli import map as command
 
     free = 10**12
     usage = types.SimpleNamespace(total=2 * free, used=free, free=free)
@@ -280,11 +281,11 @@ def test_map_states_its_size_and_refuses_one_the_disk_cannot_hold(tmp_path, caps
         "--amplitude", "25um,50um", "--mu", "0.8", "--load", "450N", "--out", str(out),
     ]  # fmt: skip
     status, stdout, stderr = run(capsys, "map", *argv)
-    assert status == 2 and stdout == ""
+    assert status == 2
     small = fig11_map(450.0)  # the same variables: bytes per point and per coordinate value
     per_point = sum(v.nbytes for v in small.data_vars.values() if v.ndim == 3) / small.regime.size
     size = per_point * 2e12  # the coordinates and compliance_ratio add less than 0.1 %
-    first, second = stderr.splitlines()
+    (first,), (second,) = stdout.splitlines(), stderr.splitlines()
     assert first.startswith("ecofmaps map: 2,000,000,000,000 points, ")
     assert first.endswith(f" into {out} (1 TB free there)")
     stated = float(first.split(", ")[1].split()[0])
@@ -314,15 +315,17 @@ def test_a_grid_block_by_block_is_not_refused_for_memory(tmp_path, capsys, monke
 def test_progress_bar_on_a_terminal_only(tmp_path, capsys, monkeypatch, argv, bar):
     monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
     out = tmp_path / "m.nc"
-    status, _, stderr = run(capsys, "map", *FIG11, "--chunk-points", "30", *argv, "--out", str(out))
+    status, stdout, stderr = run(
+        capsys, "map", *FIG11, "--chunk-points", "30", *argv, "--out", str(out)
+    )
     assert status == 0
-    first, *rest = stderr.split("\n", 1)
+    first = stdout.splitlines()[0]
     assert first.startswith("ecofmaps map: 140 points, ") and first.endswith(" free there)")
     if bar:
-        assert "ecofmaps map: 100%" in rest[0] and "140/140" in rest[0]
-        assert "5/5 blocks" in rest[0] and "pt/s" in rest[0]
+        assert "ecofmaps map: 100%" in stderr and "140/140" in stderr
+        assert "5/5 blocks" in stderr and "pt/s" in stderr
     else:
-        assert rest == [""]
+        assert stderr == ""
 
 
 @pytest.mark.parametrize("value", ["0", "-3", "1.5", "many", "inf"])
@@ -347,4 +350,4 @@ def test_ctrl_c_during_a_zarr_write_leaves_no_store(tmp_path):
     status, stdout, stderr = interrupted_run(command, "ecofmaps map: 20,000,000 points", 1.5)
     assert status == 130, stderr
     assert stderr == "ecofmaps: interrupted; no output was left half written\n"
-    assert stdout == "" and list(tmp_path.iterdir()) == []
+    assert stdout == "" and list(tmp_path.iterdir()) == []  # the size line read before

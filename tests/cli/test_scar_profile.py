@@ -169,8 +169,6 @@ def test_correct_refuses_to_overwrite_the_profile(capsys, tmp_path):
          "line 1: column(s) aspect_ratio give the scar, but so does the profile"),
         ("ecof,amplitude_um,load_N,stiffness_MN_per_m,mu_parabolic\n0.85,50,450,35,1\n",
          "line 1: column(s) mu_parabolic would be overwritten"),
-        ("ecof,amplitude_um,load_N,stiffness_MN_per_m\n0.85,50,450,35\n4.0,50,450,35\n",
-         "line 3: ecof = 4 cannot be corrected on this profile"),
     ],
 )  # fmt: skip
 def test_correct_table_errors_on_a_profile(capsys, tmp_path, table, message):
@@ -181,6 +179,18 @@ def test_correct_table_errors_on_a_profile(capsys, tmp_path, table, message):
     assert status == 2 and out == ""
     assert err.startswith(f"ecofmaps: error: {path}, ") and message in err
     assert len(err.strip().splitlines()) == 1 and not out_file.exists()
+
+
+def test_a_row_the_profile_cannot_correct_gets_nan_and_the_others_are_written(capsys, tmp_path):
+    path = tmp_path / "tests.csv"
+    path.write_text("ecof,amplitude_um,load_N,stiffness_MN_per_m\n0.85,50,450,35\n4.0,50,450,35\n")
+    status, out, err = run(capsys, "correct", path, "--scar-profile", EXAMPLE)
+    assert status == 1
+    assert err.startswith(f"ecofmaps correct: error: {path}, line 3: ecof = 4 cannot be corrected")
+    assert "on this profile" in err and len(err.splitlines()) == 1
+    rows = list(csv.DictReader(io.StringIO(out)))
+    assert [r["status"] for r in rows] == ["corrected", "no gross slip"]
+    assert rows[1]["mu"] == rows[1]["mu_parabolic"] == "nan" and float(rows[0]["mu"]) > 0
 
 
 # --- errors --------------------------------------------------------------------------------

@@ -96,11 +96,11 @@ def test_sigterm_during_a_zarr_map_leaves_no_store(tmp_path):
         "450N", "--chunk-points", "100000", "--out", str(out),
     ]  # fmt: skip
     process = started(command, tmp_path)
-    first = process.stderr.readline()
+    first = process.stdout.readline()
     assert first.startswith("ecofmaps map: 20,000,000 points, "), first
     time.sleep(1.5)
     process.send_signal(signal.SIGTERM)
     stdout, stderr = process.communicate(timeout=120)
     assert process.returncode == 143, stderr
     assert stderr == "ecofmaps: terminated (SIGTERM); no output was left half written\n"
-    assert stdout == "" and list(tmp_path.iterdir()) == []
+    assert stdout == "" and list(tmp_path.iterdir()) == []  # the size line read above

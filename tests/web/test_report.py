@@ -13,7 +13,7 @@ from bokeh.models import Div
 
 import ecofmaps
 from ecofmaps import cli
-from ecofmaps.cli import loops_run
+from ecofmaps.cli import loops
 from ecofmaps.io.tables import results_csv
 from ecofmaps.measured.quality import REASONS, LoopQualityWarning
 from ecofmaps.web import report
@@ -160,7 +160,7 @@ def test_report_errors_are_one_line(command, tmp_path, monkeypatch, capsys):
     assert status == 2 and "its directory does not exist" in err
     status, _, err = run(capsys, "loops", recording, "--load", "450N", "--report", recording)
     assert status == 2 and "would write over the input file" in err
-    monkeypatch.setattr(loops_run, "missing_web_packages", lambda: ["bokeh"])
+    monkeypatch.setattr(loops, "missing_web_packages", lambda: ["bokeh"])
     status, _, err = run(capsys, "loops", recording, "--load", "450N", "--report",
                          tmp_path / "r.html")  # fmt: skip
     assert status == 2 and err == (
