@@ -8,7 +8,9 @@ no input checking. The model and the dimensionless core are explained in ``docs/
 
 from __future__ import annotations
 
+import jax
 import jax.numpy as jnp
+import numpy as np
 
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP, SELF_LOCKING
 
@@ -71,8 +73,10 @@ def compliance_ratio(length, load, stiffness):
         The rig's deflection at :math:`Q = P` in units of :math:`L`. [1]
     """
     # Double where: at S = inf the quotient's derivative would be (load/inf^2) * inf = NaN.
-    rigid = jnp.isposinf(stiffness)
-    return jnp.where(rigid, 0.0, load / (jnp.where(rigid, 1.0, stiffness) * length))
+    # NumPy in, NumPy out: concrete float64 stays float64 with JAX's 64-bit mode off.
+    xp = jnp if any(isinstance(v, jax.Array) for v in (length, load, stiffness)) else np
+    rigid = xp.isposinf(stiffness)
+    return xp.where(rigid, 0.0, load / (xp.where(rigid, 1.0, stiffness) * length))
 
 
 def traction_ratio(position, mu, kappa, direction=1.0):
