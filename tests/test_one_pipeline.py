@@ -19,9 +19,10 @@ from nptdms import ChannelObject, TdmsWriter
 import ecofmaps
 from ecofmaps.io.tables import results_csv
 from ecofmaps.measured import pipeline
-from tests.cli.test_loops import POINT, run
+from ecofmaps.paper import EXAMPLE_2 as POINT
+from ecofmaps.paper import LOAD
+from tests.cli.commands import run_loops as run
 
-LOAD = POINT["load"]
 CYCLES = 12
 SAMPLES_PER_CYCLE = 160
 

@@ -4,7 +4,9 @@ import numpy as np
 import pandas as pd
 
 from ecofmaps.measured.synthetic import synthetic_recording
-from tests.cli.test_loops import POINT, run, write_csv
+from ecofmaps.paper import EXAMPLE_2 as POINT
+from tests.cli.commands import run_loops as run
+from tests.recordings import write_csv
 
 
 def _batch(folder, broken):

@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 from ecofmaps.measured.synthetic import synthetic_recording, write_long_recording
-from tests.cli.test_loops import POINT, run, write_csv
+from ecofmaps.paper import EXAMPLE_2 as POINT
+from tests.cli.commands import run_loops as run
+from tests.recordings import write_csv
 
 
 @pytest.fixture(scope="module")

@@ -23,16 +23,9 @@ from ecofmaps.measured.cycles import MissingSampleError
 from ecofmaps.measured.pipeline import LoopOptions
 from ecofmaps.measured.quality import LoopQualityWarning
 from ecofmaps.measured.synthetic import synthetic_recording
-from tests.measured.test_analysis import mindlin_recording
-from tests.measured.test_equivalence import (
-    COEFFICIENTS,
-    DISPLACEMENTS,
-    EXAMPLE_2,
-    FORCES,
-    LOAD,
-    TOLERANCE,
-    noisy,
-)
+from ecofmaps.paper import EXAMPLE_2, LOAD
+from tests.measured.compare import COEFFICIENTS, DISPLACEMENTS, FORCES, TOLERANCE
+from tests.recordings import mindlin_recording, noisy
 
 READ = ("mu_resolved", "mu_resolved_se", "aspect_ratio")
 

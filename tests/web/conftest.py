@@ -2,10 +2,11 @@
 selenium (no browser is ever downloaded). Without a browser the tests skip, saying why, except
 in CI (``CI=true``), where they fail: .ci/run installs the browser."""
 
-import os
 import shutil
 
 import pytest
+
+from tests.web.pages import no_browser
 
 #: Flags that run Debian's Chromium headless in a container, fetching nothing of its own.
 CHROMIUM_FLAGS = (
@@ -19,13 +20,6 @@ CHROMIUM_FLAGS = (
     "--disable-sync",
     "--window-size=1366,900",
 )
-
-
-def no_browser(reason: str):
-    """Skip with ``reason``, or fail in CI, where the browser must be there."""
-    if os.environ.get("CI", "").lower() == "true":
-        pytest.fail(f"{reason}; in CI .ci/run installs chromium and chromium-driver")
-    pytest.skip(reason)
 
 
 @pytest.fixture(scope="module")
