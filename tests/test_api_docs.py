@@ -10,10 +10,11 @@ import numpy as np
 import pytest
 
 import ecofmaps
+from ecofmaps import paper
 
 TABLE = pathlib.Path(__file__).parents[1] / "docs" / "api.md"
 ROW = re.compile(r"^\| `(\w+)` \| (yes|no) \| (yes|no) \| (yes|no) \|", re.MULTILINE)
-RIG = (50e-6, 450.0, 35e6)  # the paper's Example 2: Δ*, P, S
+RIG = (paper.AMPLITUDE, paper.LOAD, paper.STIFFNESS)  # the paper's Example 2: Δ*, P, S
 
 
 def documented():

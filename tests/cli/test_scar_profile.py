@@ -9,11 +9,12 @@ import pytest
 import ecofmaps
 from ecofmaps.measured.synthetic import scar_example_path, scar_example_trace
 from ecofmaps.model.profiles import ScarProfileWarning
+from ecofmaps.paper import AMPLITUDE, LOAD, STIFFNESS
 from tests.cli.commands import run
 
 EXAMPLE = scar_example_path()
 RIG = ["--amplitude", "50um", "--load", "450N", "--stiffness", "35MN/m"]
-POINT = dict(amplitude=50e-6, load=450.0, stiffness=35e6)
+POINT = dict(amplitude=AMPLITUDE, load=LOAD, stiffness=STIFFNESS)
 
 
 def values(out: str, label: str) -> list[str]:

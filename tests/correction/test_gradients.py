@@ -11,8 +11,9 @@ import pytest
 import ecofmaps
 from ecofmaps import model
 from ecofmaps.correction import CorrectionStatus, contact_cof, outcomes
+from ecofmaps.paper import AMPLITUDE, ASPECT_RATIO, LOAD, STIFFNESS
 
-EXAMPLE_2 = (0.8308, 50e-6, 450.0, 35e6, 0.2)  # ecof, amplitude, load, stiffness, z_o/x_o
+EXAMPLE_2 = (0.8308, AMPLITUDE, LOAD, STIFFNESS, ASPECT_RATIO)  # and its μ_E (μ = 0.8)
 NAMES = ("ecof", "amplitude", "load", "stiffness", "aspect_ratio")
 # Central differences with a relative step of 1e-5: truncation ~1e-10 and rounding
 # ~1e-16/1e-5 = 1e-11 of the value, so 1e-7 relative is a tight but safe tolerance.

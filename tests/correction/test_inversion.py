@@ -22,9 +22,10 @@ from ecofmaps.correction import (
     ecof_fall,
     outcomes,
 )
+from ecofmaps.paper import AMPLITUDE, LOAD, STIFFNESS
 from tests.brute_force import steady_loop
 
-EXAMPLE_2 = dict(amplitude=50e-6, load=450.0, stiffness=35e6)  # and mu = 0.8, z_o/x_o = 0.2
+EXAMPLE_2 = dict(amplitude=AMPLITUDE, load=LOAD, stiffness=STIFFNESS)  # and mu, z_o/x_o
 CORRECTED = int(CorrectionStatus.CORRECTED)
 
 
@@ -462,7 +463,7 @@ def test_lookup_agrees_with_the_exact_inversion(fig11_map):
 
 
 def test_lookup_statuses_and_errors(fig11_map):
-    point = dict(amplitude=50e-6, load=450.0, stiffness=35e6)  # S/P = 7.8e4 /m
+    point = EXAMPLE_2  # S/P = 7.8e4 /m
     ecof = np.array([0.83, 0.1, 0.83, 0.83, 5.0])
     mu, status = ecofmaps.lookup_correction(
         fig11_map, ecof, **{**point, "amplitude": [50e-6, 50e-6, 50e-6, 60e-6, 50e-6]},

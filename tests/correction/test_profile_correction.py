@@ -5,8 +5,9 @@ import pytest
 
 import ecofmaps
 from ecofmaps import CorrectionStatus, correct_ecof, correction_factor
+from ecofmaps.paper import AMPLITUDE, LOAD, STIFFNESS
 
-RIG = dict(amplitude=50e-6, load=450.0, stiffness=35e6)  # the paper's Example 2
+RIG = dict(amplitude=AMPLITUDE, load=LOAD, stiffness=STIFFNESS)  # the paper's Example 2
 
 
 def random_rigs(count, seed):

@@ -144,9 +144,7 @@ def test_a_gap_leaves_a_hole_in_the_drive_numbering(lazy):
 
     import ecofmaps
 
-    displacement, force = ecofmaps.synthetic_recording(
-        amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8, aspect_ratio=0.2, cycles=12
-    )
+    displacement, force = ecofmaps.synthetic_recording(**EXAMPLE_2, cycles=12)
     displacement[1000:1340] = np.nan  # from the 6th bottom reversal, 1.7 periods of 200
     if lazy:
         displacement, force = (da.from_array(a, chunks=700) for a in (displacement, force))

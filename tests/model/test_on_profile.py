@@ -13,9 +13,10 @@ import ecofmaps
 from ecofmaps import Regime
 from ecofmaps.model.first_passage import JAMMED_TRACTION
 from ecofmaps.model.on_profile import steady_numbers
+from ecofmaps.paper import AMPLITUDE, LOAD, MU, STIFFNESS
 from tests.brute_force import ProfileBruteForce
 
-EXAMPLE_2 = dict(amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8)  # the paper's rig
+EXAMPLE_2 = dict(amplitude=AMPLITUDE, load=LOAD, stiffness=STIFFNESS, mu=MU)  # without a groove
 D, W = 10e-6, 50e-6  # D/W = 0.2 (Figure 5)
 
 # Families at D/W = 0.2, and the mapping and rigs (amplitude, stiffness) each is checked on.
