@@ -88,6 +88,7 @@ def test_every_public_function_is_in_the_table_once():
     assert [n for n, recipe in RECIPES.items() if recipe is None and documented()[n][2]] == []
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(n for n, (_, _, grad) in documented().items() if grad))
 def test_grad_works_where_the_table_says_yes(name):
     x, recipe = RECIPES[name]

@@ -167,6 +167,7 @@ def test_an_unexpected_failure_is_one_line_with_status_1(capsys, monkeypatch):
 # --- Ctrl-C -----------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("delay", [0.0, 0.2])
 def test_ctrl_c_exits_130_with_one_line_and_leaves_no_output(tmp_path, delay):
     """Ctrl-C during a map run: status 130, one line, no output file."""
@@ -182,6 +183,7 @@ def test_ctrl_c_exits_130_with_one_line_and_leaves_no_output(tmp_path, delay):
     assert stdout == "" and list(tmp_path.iterdir()) == []  # the size line read before
 
 
+@pytest.mark.slow
 def test_ctrl_c_during_figures_keeps_whole_files_only(tmp_path):
     """Ctrl-C after the first figure: status 130; what is there is whole, nothing half written."""
     env = {**os.environ, "ECOFMAPS_CACHE": str(tmp_path / "cache")}

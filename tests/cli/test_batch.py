@@ -2,6 +2,7 @@
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from ecofmaps.measured.synthetic import synthetic_recording
 from ecofmaps.paper import EXAMPLE_2 as POINT
@@ -21,6 +22,7 @@ def _batch(folder, broken):
     return paths
 
 
+@pytest.mark.slow
 def test_one_bad_file_does_not_stop_the_batch(tmp_path, capsys):
     paths = _batch(tmp_path, broken={2})
     out = tmp_path / "results.csv"

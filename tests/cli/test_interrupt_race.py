@@ -60,6 +60,7 @@ def files(folder):
     return sorted(str(path.relative_to(folder)) for path in paths)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("sent", "status", "words"), SIGNALS)
 def test_an_error_the_signal_caused_keeps_the_blocks_and_says_so(
     long_test, tmp_path, capsys, small_tasks, on_each_block, sent, status, words

@@ -69,6 +69,7 @@ def test_loops_command(tmp_path, capsys, recording):
     assert table.regime.tolist() == ["gross slip"] * 4
 
 
+@pytest.mark.slow
 def test_several_files_and_plots(tmp_path, capsys, recording):
     """Several files add a first 'file' column; --plots writes two PNGs per file."""
     first = write_csv(tmp_path / "a.csv", *recording)

@@ -77,6 +77,7 @@ def test_several_files_out_of_core(long_test, tmp_path, capsys, small_tasks):
     assert out.read_text().startswith("file,cycle,")
 
 
+@pytest.mark.slow
 def test_two_worker_processes(long_test, tmp_path, capsys):
     expected = in_memory_table(capsys, long_test[".tdms"], tmp_path)
     out = tmp_path / "workers.csv"
@@ -99,6 +100,7 @@ def runner_options(request):
         yield ["--scheduler", cluster.scheduler_address]
 
 
+@pytest.mark.slow
 def test_an_interrupted_run_resumes(
     long_test, tmp_path, capsys, small_tasks, on_each_block, runner_options
 ):

@@ -46,6 +46,7 @@ def test_an_output_onto_a_users_folder_is_refused_and_the_folder_kept(
     assert (folder / "thesis.txt").read_text() == "chapter 1"
 
 
+@pytest.mark.slow
 def test_plots_into_a_folder_in_use_need_overwrite_and_keep_the_users_files(tmp_path, capsys):
     plots = thesis(tmp_path / "plots")
     argv = ["loops", *SHORT, "--plots", plots]

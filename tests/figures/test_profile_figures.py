@@ -158,6 +158,7 @@ def test_shapes_figure_draws_every_shape(shapes):
     np.testing.assert_allclose(flat, dataset.shortcut_error.sel(shape="flat-bottomed") * 100)
 
 
+@pytest.mark.slow
 def test_shapes_figure_from_the_command(tmp_path, capsys):
     assert main(["figures", "--out", str(tmp_path), "--only", "shapes"]) == 0
     assert (tmp_path / "shapes.png").stat().st_size > 10_000

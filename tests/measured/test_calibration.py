@@ -65,6 +65,7 @@ def readings():
     return {kind: analysed(kind, seed) for kind, seed in KINDS.items()}
 
 
+@pytest.mark.slow
 def test_two_standard_errors_cover_the_truth(readings, record_property):
     """±2 se covers the truth on >= 80 % of the reported cycles (aim: 95 %), of >= 6 kinds."""
     covered, lines = [], []

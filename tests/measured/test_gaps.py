@@ -122,6 +122,7 @@ def tiny_chunks(monkeypatch):
     monkeypatch.setattr(pipeline, "TASK_SAMPLES", 320)
 
 
+@pytest.mark.slow
 def test_out_of_core_finds_the_same_cycles(recording, tiny_chunks):
     displacement, force = recording
     with Runner(2) as runner:

@@ -157,6 +157,7 @@ def test_xarray_and_a_missing_mask(small_blocks):
     assert_equal_results(lazy, memory)
 
 
+@pytest.mark.slow
 def test_a_local_cluster_of_two_processes(small_blocks):
     """The blocks run in two worker processes: the same numbers (the passes' chunk and the
     tasks' cycles travel with the tasks, not as settings of this process)."""
@@ -177,6 +178,7 @@ def _worker_settings():
     )
 
 
+@pytest.mark.slow
 def test_the_workers_of_a_local_cluster_run_lean():
     """A local cluster's workers keep glibc's own mmap threshold and do not sample their
     tasks' stacks (module notes of ecofmaps._parallel); this process's settings are left as
@@ -387,6 +389,7 @@ def test_tasks_hand_back_only_the_columns_asked_for(small_blocks):
         xr.testing.assert_identical(part, full[["quality", "ecof"]])
 
 
+@pytest.mark.slow
 def test_a_worker_reads_and_measures_without_jax_or_pint():
     """The modules a task of a long analysis loads (reading a rig file's column, the passes,
     measuring a block, formatting its rows) leave JAX, pint and SciPy unloaded: a worker

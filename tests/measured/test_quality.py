@@ -481,6 +481,7 @@ def odd_recordings(draw):
     return kind, displacement, force
 
 
+@pytest.mark.slow
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(recording=odd_recordings())
 def test_nothing_implausible_is_reported(recording):

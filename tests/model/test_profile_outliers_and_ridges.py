@@ -85,6 +85,7 @@ def test_a_quantised_trace_loses_no_sample():
     assert np.flatnonzero(outlying_samples(X, steps * 1e-8)).tolist() == [300]
 
 
+@pytest.mark.slow
 def test_a_dropout_gives_the_depth_and_ecof_of_the_clean_scar():
     """One dropout (a spike 40 µm down) inside the scar: replaced, the depth within 0.1 %
     and the ECoF within 1e-4 of the clean scar's; kept, it moves both by far more."""

@@ -245,6 +245,7 @@ def test_simulation_rejects_bad_input(change, message):
         ecofmaps.simulate(**arguments)
 
 
+@pytest.mark.slow
 def test_loop_and_simulation_areas_at_random_points():
     """E_d (closed form) against the area of the steady loop and of a simulated sinusoidal
     cycle at ~600 random points over the tribologically meaningful domain, all in one call.

@@ -22,6 +22,14 @@ CHROMIUM_FLAGS = (
 )
 
 
+def pytest_collection_modifyitems(items):
+    """A test that uses the ``browser`` fixture is marked ``browser`` and ``slow``."""
+    for item in items:
+        if "browser" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.browser)
+            item.add_marker(pytest.mark.slow)
+
+
 @pytest.fixture(scope="module")
 def browser(tmp_path_factory):
     """One headless Chromium session for a test module."""
