@@ -10,10 +10,11 @@ import numpy as np
 import pytest
 
 import ecofmaps
+from ecofmaps import paper
 
 TABLE = pathlib.Path(__file__).parents[1] / "docs" / "api.md"
 ROW = re.compile(r"^\| `(\w+)` \| (yes|no) \| (yes|no) \| (yes|no) \|", re.MULTILINE)
-RIG = (50e-6, 450.0, 35e6)  # the paper's Example 2: Δ*, P, S
+RIG = (paper.AMPLITUDE, paper.LOAD, paper.STIFFNESS)  # the paper's Example 2: Δ*, P, S
 
 
 def documented():
@@ -87,6 +88,7 @@ def test_every_public_function_is_in_the_table_once():
     assert [n for n, recipe in RECIPES.items() if recipe is None and documented()[n][2]] == []
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(n for n, (_, _, grad) in documented().items() if grad))
 def test_grad_works_where_the_table_says_yes(name):
     x, recipe = RECIPES[name]

@@ -4,6 +4,10 @@ import importlib.util
 import re
 from pathlib import Path
 
+import pytest
+
+pytestmark = pytest.mark.slow  # the benchmark scripts' smoke runs
+
 BENCH = Path(__file__).parent / "benchmarks" / "bench_maps.py"
 
 

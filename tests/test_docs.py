@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 import ecofmaps
+from ecofmaps import paper
 from ecofmaps.io.tables import RESULT_COLUMNS
 from ecofmaps.measured.quality import REASONS
 
@@ -46,12 +47,10 @@ def test_every_quality_flag_is_explained(loops_page):
 
 
 def test_every_attribute_and_variable_of_the_results_is_named(loops_page):
-    displacement, force = ecofmaps.synthetic_recording(
-        amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8, aspect_ratio=0.2, cycles=3
-    )
+    displacement, force = ecofmaps.synthetic_recording(**paper.EXAMPLE_2, cycles=3)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        results = ecofmaps.analyze_loops(displacement, force, 450.0, resolve=True)
+        results = ecofmaps.analyze_loops(displacement, force, paper.LOAD, resolve=True)
     named = set(re.findall(r"`([a-z_]+)`", loops_page))
     internal = {"title", "gross_slip_threshold", "flip_force"}  # the options, echoed
     missing = [

@@ -7,11 +7,11 @@ import pytest
 
 import ecofmaps
 from ecofmaps import _inputs
+from ecofmaps.paper import EXAMPLE_2 as EXAMPLE_2_SI
 
 UNITS = pint.UnitRegistry()
 Q_ = UNITS.Quantity
 
-EXAMPLE_2_SI = dict(amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8, aspect_ratio=0.2)
 EXAMPLE_2_UNITS = dict(
     amplitude=Q_(50, "um"),
     load=Q_(0.45, "kN"),

@@ -11,8 +11,8 @@ import xarray as xr
 
 import ecofmaps
 from tests import mindlin
+from tests.lab_cases import ALPHA, CYCLES, DELTA_T, HALF_WIDTH, LENGTH, LOAD, MU, recorded_test
 
-MU, LOAD, DELTA_T = 0.8, 450.0, 6e-6
 RIGS = (15e6, 35e6, 100e6)
 
 
@@ -92,39 +92,6 @@ def test_a_campaign_that_never_crosses_is_an_error():
 
 # --- energy wear ---------------------------------------------------------------------------
 
-CYCLES = np.concatenate([[1], np.arange(500, 10001, 500)])  # recorded every 500th cycle
-ALPHA, LENGTH, HALF_WIDTH = 2.5e-14, 5e-3, 150e-6  # m³/J, m, m
-
-
-def _mu(cycle):
-    """Friction rising through the test (the running-in), and the contact's δ_t with it."""
-    return 0.5 + 0.3 * (1.0 - np.exp(-cycle / 3000.0))
-
-
-def _recorded_test(amplitude, stiffness, cycles=CYCLES):
-    """analyze_loops of the recorded cycles of a gross-slip test (one steady loop each,
-    numbered as driven) and the closed-form sums over every cycle driven."""
-    samples = 200
-    pieces, labels = [], []
-    for n in cycles:
-        mu = _mu(n)
-        contact = mindlin.Contact(mu, LOAD, DELTA_T * mu / MU)
-        applied = mindlin.sweep([amplitude], samples)
-        _, force = mindlin.drive(contact, applied, stiffness)
-        span = slice(samples, 2 * samples)
-        pieces.append((applied[span], force[span]))
-        labels.append(np.full(samples, n))
-    applied, force = (np.concatenate(p) for p in zip(*pieces, strict=True))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        results = ecofmaps.analyze_loops(applied, force, LOAD, cycle=np.concatenate(labels))
-    every = np.arange(1, cycles[-1] + 1)
-    mu = _mu(every)
-    energy, slip = mindlin.gross_slip_loop(amplitude, mu, LOAD, DELTA_T * mu / MU, stiffness)
-    sums = {"energy": energy.sum(), "slip": (4 * LOAD * slip).sum(),
-            "nominal": 4 * LOAD * amplitude * every.size}  # fmt: skip
-    return results, sums
-
 
 def _profile(energy, threshold=0.0, noise=0.0, seed=0):
     x, z, area = mindlin.grown_groove(energy, ALPHA, LENGTH, HALF_WIDTH, threshold, noise, seed)
@@ -136,7 +103,7 @@ def _profile(energy, threshold=0.0, noise=0.0, seed=0):
 def test_energy_wear_of_a_test_recorded_every_500th_cycle():
     stiffness = 35e6
     amplitude = 2.5 * mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
-    results, sums = _recorded_test(amplitude, stiffness)
+    results, sums = recorded_test(amplitude, stiffness)
     assert results.cycle.values.tolist() == CYCLES.tolist()
     profile, area = _profile(sums["energy"], noise=20e-9)
     wear = ecofmaps.energy_wear(results, profile, length=LENGTH)
@@ -173,7 +140,7 @@ def test_energy_wear_over_a_campaign_finds_alpha_and_the_threshold():
     at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
     tests, profiles = [], []
     for seed, factor in enumerate((1.5, 2.0, 3.0, 4.0)):
-        results, sums = _recorded_test(factor * at, stiffness, CYCLES[:9])
+        results, sums = recorded_test(factor * at, stiffness, CYCLES[:9])
         tests.append(results)
         profiles.append(_profile(sums["energy"], threshold, noise=10e-9, seed=seed)[0])
     wear = ecofmaps.energy_wear(tests, profiles, length=LENGTH)

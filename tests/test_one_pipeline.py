@@ -19,9 +19,10 @@ from nptdms import ChannelObject, TdmsWriter
 import ecofmaps
 from ecofmaps.io.tables import results_csv
 from ecofmaps.measured import pipeline
-from tests.cli.test_loops import POINT, run
+from ecofmaps.paper import EXAMPLE_2 as POINT
+from ecofmaps.paper import LOAD
+from tests.cli.commands import run_loops as run
 
-LOAD = POINT["load"]
 CYCLES = 12
 SAMPLES_PER_CYCLE = 160
 
@@ -115,6 +116,7 @@ def small_chunks(monkeypatch):
     monkeypatch.setattr(pipeline, "TASK_SAMPLES", 500)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("workers", ["1", "2"])
 def test_workers_write_the_table_of_the_arrays(
     files, expected, workers, tmp_path, capsys, small_chunks
@@ -127,6 +129,7 @@ def test_workers_write_the_table_of_the_arrays(
     assert out.read_text() == expected
 
 
+@pytest.mark.slow
 def test_a_run_stopped_by_sigterm_and_resumed_writes_the_table_of_the_arrays(
     files, expected, tmp_path, capsys, small_chunks, on_each_block
 ):

@@ -545,17 +545,15 @@ def _status(key: str) -> int:
     raise KeyError(key)
 
 
-def memory_child(samples: int, implementation: str) -> None:
+def memory_child(samples: int) -> None:
     """Run in a fresh process: peak memory of one analyze_loops call, printed as numbers.
 
     The recording is made first; the peak resident size (VmHWM) is then reset (Linux
     ``clear_refs``), so the peak measured is that of the call, on top of the process
     with its recording.
     """
-    if implementation == "reference":
-        from tests.measured.reference.analysis import analyze_loops
-    else:
-        from ecofmaps.measured.analysis import analyze_loops
+    from ecofmaps.measured.analysis import analyze_loops
+
     displacement, force = loop_recording(samples // SAMPLES_PER_CYCLE)
     analyze_loops(displacement[:20_000], force[:20_000], LOAD)  # imports and first calls
     with open("/proc/self/clear_refs", "w") as refs:
@@ -567,11 +565,11 @@ def memory_child(samples: int, implementation: str) -> None:
     print(before, _status("VmHWM:"), displacement.nbytes + force.nbytes, wall)
 
 
-def loops_peak_memory(samples: int, implementation: str = "analyze_loops"):
+def loops_peak_memory(samples: int):
     """Resident memory before and at the peak of analyze_loops in a fresh process. [B]"""
     import subprocess
 
-    command = [sys.executable, __file__, "--memory-child", str(samples), implementation]
+    command = [sys.executable, __file__, "--memory-child", str(samples)]
     done = subprocess.run(command, capture_output=True, text=True, check=True)
     before, peak, size, wall = done.stdout.split()
     return int(before), int(peak), int(size), float(wall)
@@ -589,8 +587,7 @@ def loops(quick: bool) -> None:
     samples). The median GICoF against μ = 0.8 and
     the median difference of the two loop areas check the results. Memory: one call on a
     large recording in a fresh process (loops_peak_memory), above the memory before the call
-    ("extra") and in all, relative to the recording's two float64 arrays; the frozen
-    padded implementation it replaced (tests/measured/reference) alongside, smaller.
+    ("extra") and in all, relative to the recording's two float64 arrays.
     """
     from ecofmaps.measured.analysis import analyze_loops
 
@@ -628,16 +625,12 @@ def loops(quick: bool) -> None:
     units = ("", "", "[MiB]", "[MiB]", "input", "input", "wall [/s]")
     print(f"{units[0]:>20}", " ".join(f"{u:>9}" for u in units[1:]))
     large = 2 * 10**6 if quick else 10**8
-    for name, implementation, samples in (
-        ("analyze_loops", "analyze_loops", large),
-        ("reference (padded)", "reference", large if quick else 2 * 10**7),
-    ):
-        before, peak, size, wall = loops_peak_memory(samples, implementation)
-        extra = peak - before
-        print(
-            f"{name:>20} {samples:9.2e} {size / 2**20:9.0f} {extra / 2**20:9.0f} "
-            f"{extra / size:9.2f} {peak / size:9.2f} {samples / wall:9.3g}"
-        )
+    before, peak, size, wall = loops_peak_memory(large)
+    extra = peak - before
+    print(
+        f"{'analyze_loops':>20} {large:9.2e} {size / 2**20:9.0f} {extra / 2**20:9.0f} "
+        f"{extra / size:9.2f} {peak / size:9.2f} {large / wall:9.3g}"
+    )
 
 
 # ---------------------------------------------------------------------------------------
@@ -976,7 +969,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="small sizes, a few seconds")
     parser.add_argument("--only", nargs="+", choices=list(SECTIONS), help="run only these")
-    parser.add_argument("--memory-child", nargs=2, help=argparse.SUPPRESS)
+    parser.add_argument("--memory-child", type=int, help=argparse.SUPPRESS)
     parser.add_argument(
         "--scratch", type=Path, default=None,
         help="directory for the maps section's zarr stores (default: the system's temporary)",
@@ -984,7 +977,7 @@ def main(argv=None) -> int:
     parser.add_argument("--child", nargs=3, help=argparse.SUPPRESS)  # one_process's work
     args = parser.parse_args(argv)
     if args.memory_child:  # a fresh process of loops_peak_memory
-        memory_child(int(args.memory_child[0]), args.memory_child[1])
+        memory_child(args.memory_child)
         return 0
     if args.child:
         name, points, repeats = args.child

@@ -7,14 +7,13 @@ files unchanged and no output left behind.
 
 import os
 import signal
-import subprocess
 import sys
-import time
 
 import pytest
 
 from ecofmaps.cli import main
 from ecofmaps.maps import tiles
+from tests.cli.commands import interrupted_run
 
 
 def run(capsys, *argv):
@@ -168,20 +167,7 @@ def test_an_unexpected_failure_is_one_line_with_status_1(capsys, monkeypatch):
 # --- Ctrl-C -----------------------------------------------------------------------------------
 
 
-def interrupted_run(command, wait_for: str, delay: float, env=None):
-    """Run ``command``, press Ctrl-C ``delay`` s after it printed ``wait_for`` (on standard
-    output for ``ecofmaps map``, else on standard error)."""
-    process = subprocess.Popen(
-        command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
-    )
-    started = (process.stdout if "map" in command else process.stderr).readline()
-    assert wait_for in started, started
-    time.sleep(delay)
-    process.send_signal(signal.SIGINT)
-    stdout, stderr = process.communicate(timeout=300)
-    return process.returncode, stdout, stderr
-
-
+@pytest.mark.slow
 @pytest.mark.parametrize("delay", [0.0, 0.2])
 def test_ctrl_c_exits_130_with_one_line_and_leaves_no_output(tmp_path, delay):
     """Ctrl-C during a map run: status 130, one line, no output file."""
@@ -197,6 +183,7 @@ def test_ctrl_c_exits_130_with_one_line_and_leaves_no_output(tmp_path, delay):
     assert stdout == "" and list(tmp_path.iterdir()) == []  # the size line read before
 
 
+@pytest.mark.slow
 def test_ctrl_c_during_figures_keeps_whole_files_only(tmp_path):
     """Ctrl-C after the first figure: status 130; what is there is whole, nothing half written."""
     env = {**os.environ, "ECOFMAPS_CACHE": str(tmp_path / "cache")}

@@ -2,9 +2,12 @@
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from ecofmaps.measured.synthetic import synthetic_recording
-from tests.cli.test_loops import POINT, run, write_csv
+from ecofmaps.paper import EXAMPLE_2 as POINT
+from tests.cli.commands import run_loops as run
+from tests.recordings import write_csv
 
 
 def _batch(folder, broken):
@@ -19,6 +22,7 @@ def _batch(folder, broken):
     return paths
 
 
+@pytest.mark.slow
 def test_one_bad_file_does_not_stop_the_batch(tmp_path, capsys):
     paths = _batch(tmp_path, broken={2})
     out = tmp_path / "results.csv"

@@ -20,7 +20,7 @@ from ecofmaps._interrupts import INTERRUPTED, Interrupted, add_stop_note
 from ecofmaps.cli import loops, loops_long
 from ecofmaps.io.files import MANIFEST
 from ecofmaps.measured.synthetic import write_long_recording
-from tests.cli.test_loops import run
+from tests.cli.commands import run_loops as run
 
 #: The module of the command (``ecofmaps.cli.main`` is also the name of its function).
 command = importlib.import_module("ecofmaps.cli.main")
@@ -60,6 +60,7 @@ def files(folder):
     return sorted(str(path.relative_to(folder)) for path in paths)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("sent", "status", "words"), SIGNALS)
 def test_an_error_the_signal_caused_keeps_the_blocks_and_says_so(
     long_test, tmp_path, capsys, small_tasks, on_each_block, sent, status, words

@@ -17,7 +17,10 @@ import pytest
 from ecofmaps.io.files import TEMPORARY_NAME
 from ecofmaps.measured.synthetic import write_long_recording
 
-pytestmark = pytest.mark.skipif(os.name != "posix", reason="POSIX signals and process groups")
+pytestmark = [
+    pytest.mark.slow,  # signals to real worker processes
+    pytest.mark.skipif(os.name != "posix", reason="POSIX signals and process groups"),
+]
 
 WORDS = {signal.SIGINT: (130, "interrupted"), signal.SIGTERM: (143, "terminated (SIGTERM)")}
 

@@ -8,13 +8,14 @@ import pytest
 import xarray as xr
 
 import ecofmaps
-from ecofmaps.cli import main
 from ecofmaps.io.files import MANIFEST, record_written
 from ecofmaps.io.tables import RESULT_COLUMNS, results_table
 from ecofmaps.measured.synthetic import EXAMPLE, example_path, synthetic_recording
+from ecofmaps.paper import EXAMPLE_2 as POINT
+from ecofmaps.paper import LOAD
+from tests.cli.commands import run_loops as run
+from tests.recordings import write_csv
 
-LOAD = 450.0
-POINT = dict(amplitude=50e-6, load=LOAD, stiffness=35e6, mu=0.8, aspect_ratio=0.2)
 COLUMNS = [c for c in RESULT_COLUMNS if c != "normal_load_N"]  # with a recorded load only
 RESOLVED_COLUMNS = ("mu_resolved", "mu_resolved_se", "aspect_ratio")
 
@@ -24,21 +25,6 @@ def recording():
     """Four whole cycles of the model (Example 2), 200 samples each: Δ [m], Q [N]."""
     displacement, force = synthetic_recording(**POINT, cycles=5)
     return displacement[:801], force[:801]
-
-
-def write_csv(path, displacement, force, separator=",", header=("displacement", "force")):
-    """A recording file: displacement in µm, force in N, with a comment line."""
-    lines = [f"# a test recording written by {__name__}", separator.join(header)]
-    lines += [f"{d * 1e6:.9f}{separator}{f:.9f}" for d, f in zip(displacement, force, strict=True)]
-    path.write_text("\n".join(lines) + "\n")
-    return path
-
-
-def run(capsys, *arguments):
-    """``ecofmaps loops ARGS``: exit status, stdout, stderr."""
-    status = main(["loops", *map(str, arguments)])
-    out, err = capsys.readouterr()
-    return status, out, err
 
 
 def test_results_table_units(recording):
@@ -83,6 +69,7 @@ def test_loops_command(tmp_path, capsys, recording):
     assert table.regime.tolist() == ["gross slip"] * 4
 
 
+@pytest.mark.slow
 def test_several_files_and_plots(tmp_path, capsys, recording):
     """Several files add a first 'file' column; --plots writes two PNGs per file."""
     first = write_csv(tmp_path / "a.csv", *recording)

@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 from ecofmaps.measured.synthetic import synthetic_recording, write_long_recording
-from tests.cli.test_loops import POINT, run, write_csv
+from ecofmaps.paper import EXAMPLE_2 as POINT
+from tests.cli.commands import run_loops as run
+from tests.recordings import write_csv
 
 
 @pytest.fixture(scope="module")
@@ -75,6 +77,7 @@ def test_several_files_out_of_core(long_test, tmp_path, capsys, small_tasks):
     assert out.read_text().startswith("file,cycle,")
 
 
+@pytest.mark.slow
 def test_two_worker_processes(long_test, tmp_path, capsys):
     expected = in_memory_table(capsys, long_test[".tdms"], tmp_path)
     out = tmp_path / "workers.csv"
@@ -97,6 +100,7 @@ def runner_options(request):
         yield ["--scheduler", cluster.scheduler_address]
 
 
+@pytest.mark.slow
 def test_an_interrupted_run_resumes(
     long_test, tmp_path, capsys, small_tasks, on_each_block, runner_options
 ):

@@ -337,9 +337,10 @@ def test_bad_chunk_points_are_named(tmp_path, capsys, value):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_ctrl_c_during_a_zarr_write_leaves_no_store(tmp_path):
     """Ctrl-C while blocks are written: status 130, one line, no store and no temporary."""
-    from tests.cli.test_bad_input import interrupted_run
+    from tests.cli.commands import interrupted_run
 
     out = tmp_path / "big.zarr"
     command = [

@@ -15,6 +15,7 @@ import ecofmaps
 from ecofmaps import _parallel
 from ecofmaps.io.files import MANIFEST, record_written, written_by_ecofmaps
 from ecofmaps.measured.synthetic import example_path, synthetic_recording
+from ecofmaps.paper import EXAMPLE_2
 from tests.cli.commands import run
 
 SHORT = ["--example", "--no-resolve"]  # the shipped example, 24000 samples: a few seconds
@@ -45,6 +46,7 @@ def test_an_output_onto_a_users_folder_is_refused_and_the_folder_kept(
     assert (folder / "thesis.txt").read_text() == "chapter 1"
 
 
+@pytest.mark.slow
 def test_plots_into_a_folder_in_use_need_overwrite_and_keep_the_users_files(tmp_path, capsys):
     plots = thesis(tmp_path / "plots")
     argv = ["loops", *SHORT, "--plots", plots]
@@ -131,7 +133,7 @@ def test_too_many_workers_are_refused_naming_the_option_and_the_limit(tmp_path, 
     assert status == 2 and stderr.count("\n") == 1
     limit = f"argument --workers: {cores + 1} is more than this machine can run: {cores} cores"
     assert limit in stderr
-    displacement, force = synthetic_recording(50e-6, 450.0, 35e6, 0.8, 0.2, cycles=3)
+    displacement, force = synthetic_recording(**EXAMPLE_2, cycles=3)
     for scheduler in (None, "threads", "processes"):
         with pytest.raises(ValueError, match=r"^workers=1000 is more than this machine can run"):
             ecofmaps.analyze_loops(displacement, force, 450.0, scheduler=scheduler, workers=1000)
@@ -185,7 +187,7 @@ def test_a_scheduler_address_that_is_not_one_fails_in_seconds(
     assert stderr.startswith(f"ecofmaps: error: no dask scheduler at {address}: ")
     assert stderr.count("\n") == 1
     assert list(tmp_path.iterdir()) == []
-    displacement, force = synthetic_recording(50e-6, 450.0, 35e6, 0.8, 0.2, cycles=3)
+    displacement, force = synthetic_recording(**EXAMPLE_2, cycles=3)
     lazy = [
         dask.array.from_array(np.asarray(series), chunks=200) for series in (displacement, force)
     ]

@@ -4,7 +4,9 @@ flagged or refused with a message that names the assumption and the option."""
 import pandas as pd
 
 from ecofmaps.measured.synthetic import synthetic_recording
-from tests.cli.test_loops import POINT, run, write_csv
+from ecofmaps.paper import EXAMPLE_2 as POINT
+from tests.cli.commands import run_loops as run
+from tests.recordings import write_csv
 
 
 def test_a_wrong_load_flags_every_cycle_and_names_the_load(tmp_path, capsys):
@@ -66,7 +68,7 @@ def test_a_recorded_normal_load_is_used_sample_by_sample(tmp_path, capsys):
 def test_a_recorded_load_that_steps_gives_each_cycle_at_its_own_load(tmp_path, capsys):
     """``--load Fz`` stepping 300 -> 450 -> 600 N: a ``normal_load_N`` column, and each
     cycle's forces and stiffness at its own load (the rig's 35 MN/m, not 52 to 26)."""
-    from tests.measured.test_analysis import load_steps
+    from tests.recordings import load_steps
 
     displacement, force, load = load_steps()
     path = tmp_path / "steps.csv"

@@ -2,7 +2,9 @@
 by their type (ImplausibleScaleWarning, ImplausibleScaleError), not by their words."""
 
 from ecofmaps.measured.synthetic import synthetic_recording
-from tests.cli.test_loops import POINT, run, write_csv
+from ecofmaps.paper import EXAMPLE_2 as POINT
+from tests.cli.commands import run_loops as run
+from tests.recordings import write_csv
 
 ASSUMED = "has no unit and was read in"
 

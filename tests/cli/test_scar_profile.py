@@ -9,11 +9,12 @@ import pytest
 import ecofmaps
 from ecofmaps.measured.synthetic import scar_example_path, scar_example_trace
 from ecofmaps.model.profiles import ScarProfileWarning
+from ecofmaps.paper import AMPLITUDE, LOAD, STIFFNESS
 from tests.cli.commands import run
 
 EXAMPLE = scar_example_path()
 RIG = ["--amplitude", "50um", "--load", "450N", "--stiffness", "35MN/m"]
-POINT = dict(amplitude=50e-6, load=450.0, stiffness=35e6)
+POINT = dict(amplitude=AMPLITUDE, load=LOAD, stiffness=STIFFNESS)
 
 
 def values(out: str, label: str) -> list[str]:
@@ -36,6 +37,7 @@ def write_trace(path, x_um, z_um, header="x,z"):
 # --- ecofmaps model ---------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_model_on_the_example_profile_beside_the_parabola(capsys, example):
     status, out, err = run(capsys, "model", "--scar-profile", EXAMPLE)
     assert status == 0 and err == ""
@@ -68,6 +70,7 @@ def test_model_on_the_example_profile_beside_the_parabola(capsys, example):
     assert out.count("gross slip") == 2
 
 
+@pytest.mark.slow
 def test_model_reading_options_reach_the_reader(capsys, tmp_path):
     x, z = scar_example_trace()  # metres
     path = write_trace(tmp_path / "scar_mm.csv", x * 1e3, z * 1e3, header="pos,height")
@@ -103,6 +106,7 @@ def test_model_beyond_gross_slip_on_a_profile(capsys):
 # --- ecofmaps correct ---------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_correct_one_point_on_the_profile(capsys, example):
     status, out, err = run(capsys, "correct", "--ecof", "0.85", *RIG, "--scar-profile", EXAMPLE)
     assert status == 0 and err == ""
@@ -124,6 +128,7 @@ def test_correct_beyond_gross_slip_on_the_profile(capsys):
     assert "3.88889" in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_correct_a_table_on_the_profile(capsys, tmp_path, example):
     table = tmp_path / "tests.csv"
     table.write_text(
@@ -273,6 +278,7 @@ def test_damaged_profiles_name_file_and_line(capsys, tmp_path, kind, line, messa
         assert message in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_correct_with_the_physical_mapping(capsys, example):
     status, out, _ = run(capsys, "correct", "--ecof", "0.85", *RIG, "--scar-profile", EXAMPLE,
                          "--mapping", "physical")  # fmt: skip
@@ -298,6 +304,7 @@ def groove_in_band(path, dropout_line=None):
     return write_trace(path, x, z)
 
 
+@pytest.mark.slow
 def test_model_prints_each_finding_on_one_line_naming_the_file(capsys, tmp_path):
     path = groove_in_band(tmp_path / "track.csv", dropout_line=702)
     status, out, err = run(capsys, "model", "--scar-profile", path)
@@ -321,6 +328,7 @@ def test_model_prints_each_finding_on_one_line_naming_the_file(capsys, tmp_path)
     assert float(values(out, "energy coefficient")[0]) == pytest.approx(mu_e, rel=5e-6)
 
 
+@pytest.mark.slow
 def test_correct_prints_the_findings_and_the_half_width_taken_stops_them(capsys, tmp_path):
     path = groove_in_band(tmp_path / "track.csv")
     argv = ["correct", "--ecof", "0.85", *RIG, "--scar-profile", path]
@@ -334,6 +342,7 @@ def test_correct_prints_the_findings_and_the_half_width_taken_stops_them(capsys,
     assert values(out, "wear scar half-width (given)") == [groove.removesuffix("um")]
 
 
+@pytest.mark.slow
 def test_model_on_a_profile_in_a_fresh_process_prints_no_warning():
     """In a process of its own (without the suite's global float64 switch), the command
     prints nothing on stderr: no JAX value is compared or computed outside float64, where JAX

@@ -13,7 +13,10 @@ import pytest
 from ecofmaps.io.files import TEMPORARY_NAME
 from ecofmaps.measured.synthetic import write_long_recording
 
-pytestmark = pytest.mark.skipif(os.name != "posix", reason="POSIX signals and process groups")
+pytestmark = [
+    pytest.mark.slow,  # signals to real processes
+    pytest.mark.skipif(os.name != "posix", reason="POSIX signals and process groups"),
+]
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,7 @@ import pytest
 from ecofmaps.cli.main import main
 from ecofmaps.io.tables import results_csv
 from tests import mindlin
-from tests.test_lab import ALPHA, CYCLES, DELTA_T, HALF_WIDTH, LENGTH, LOAD, MU, _recorded_test
+from tests.lab_cases import ALPHA, CYCLES, DELTA_T, HALF_WIDTH, LENGTH, LOAD, MU, recorded_test
 
 STIFFNESS, THRESHOLD = 35e6, 5.0
 
@@ -22,7 +22,7 @@ def campaign(tmp_path_factory):
     at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, STIFFNESS)
     files, truths = [], []
     for i, factor in enumerate((1.5, 2.0, 3.0)):
-        results, sums = _recorded_test(factor * at, STIFFNESS, CYCLES[:9])
+        results, sums = recorded_test(factor * at, STIFFNESS, CYCLES[:9])
         (folder / f"test{i}.csv").write_text(results_csv(results))
         x, z, area = mindlin.grown_groove(sums["energy"], ALPHA, LENGTH, HALF_WIDTH, THRESHOLD,
                                           10e-9, seed=i)  # fmt: skip
@@ -88,7 +88,7 @@ def test_a_table_without_energies_or_a_profile_without_a_scar(campaign, capsys, 
 
 def test_a_netcdf_table_reads_as_its_csv(campaign, capsys, tmp_path):
     _, files, _ = campaign
-    results = _recorded_test(2 * mindlin.transition_amplitude(MU, LOAD, DELTA_T, STIFFNESS),
+    results = recorded_test(2 * mindlin.transition_amplitude(MU, LOAD, DELTA_T, STIFFNESS),
                              STIFFNESS, CYCLES[:3])[0]  # fmt: skip
     results.to_netcdf(tmp_path / "test.nc")
     (tmp_path / "test.csv").write_text(results_csv(results))

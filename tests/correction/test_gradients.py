@@ -11,8 +11,9 @@ import pytest
 import ecofmaps
 from ecofmaps import model
 from ecofmaps.correction import CorrectionStatus, contact_cof, outcomes
+from ecofmaps.paper import AMPLITUDE, ASPECT_RATIO, LOAD, STIFFNESS
 
-EXAMPLE_2 = (0.8308, 50e-6, 450.0, 35e6, 0.2)  # ecof, amplitude, load, stiffness, z_o/x_o
+EXAMPLE_2 = (0.8308, AMPLITUDE, LOAD, STIFFNESS, ASPECT_RATIO)  # and its μ_E (μ = 0.8)
 NAMES = ("ecof", "amplitude", "load", "stiffness", "aspect_ratio")
 # Central differences with a relative step of 1e-5: truncation ~1e-10 and rounding
 # ~1e-16/1e-5 = 1e-11 of the value, so 1e-7 relative is a tight but safe tolerance.
@@ -48,6 +49,7 @@ def test_grad_matches_central_differences(point):
         assert float(gradient[index]) == pytest.approx(expected, rel=RTOL), name
 
 
+@pytest.mark.slow
 def test_grad_is_the_reciprocal_slope_of_the_forward_model():
     """d mu / d mu_E = 1 / (d mu_E / d mu) at fixed test conditions (implicit function)."""
     ecof = jnp.linspace(0.1, 1.5, 8)
@@ -61,6 +63,7 @@ def test_grad_is_the_reciprocal_slope_of_the_forward_model():
     np.testing.assert_allclose(si, 1.0 / slope, rtol=1e-13)
 
 
+@pytest.mark.slow
 def test_grad_of_the_factor_and_of_a_rigid_rig_and_of_scar_dimensions():
     def factor(ecof, depth):
         return ecofmaps.correction_factor(
@@ -75,6 +78,7 @@ def test_grad_of_the_factor_and_of_a_rigid_rig_and_of_scar_dimensions():
         )
 
 
+@pytest.mark.slow
 def test_jit_vmap_and_grad_compose():
     points = [np.array([0.6, 0.8308, 1.0]), 50e-6, 450.0, np.array([20e6, 35e6, 80e6]), 0.2]
     batched = jax.jit(jax.vmap(jax.grad(corrected), in_axes=(0, None, None, 0, None)))
@@ -99,6 +103,7 @@ def test_concrete_calls_still_raise_and_traced_ones_give_nan():
     assert np.isnan(mu) and status == CorrectionStatus.NO_GROSS_SLIP
 
 
+@pytest.mark.slow
 def test_grad_of_an_interval_end():
     """The low end comes from the deeper scar only: no derivative in the shallow end."""
 

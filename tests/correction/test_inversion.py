@@ -22,9 +22,10 @@ from ecofmaps.correction import (
     ecof_fall,
     outcomes,
 )
+from ecofmaps.paper import AMPLITUDE, LOAD, STIFFNESS
 from tests.brute_force import steady_loop
 
-EXAMPLE_2 = dict(amplitude=50e-6, load=450.0, stiffness=35e6)  # and mu = 0.8, z_o/x_o = 0.2
+EXAMPLE_2 = dict(amplitude=AMPLITUDE, load=LOAD, stiffness=STIFFNESS)  # and mu, z_o/x_o
 CORRECTED = int(CorrectionStatus.CORRECTED)
 
 
@@ -114,6 +115,7 @@ def test_round_trip(mu, aspect_ratio, lam, amplitude, load):
     assert again == pytest.approx(ecof, rel=1e-13)
 
 
+@pytest.mark.slow
 def test_round_trip_dense():
     """10^5 random points over μ ∈ [1e-3, 10], z_o/x_o ∈ [0, 1], λ ∈ {0} ∪ [1e-4, 10]."""
     rng = np.random.default_rng(4)
@@ -222,6 +224,7 @@ def dense_extrema(kappa, lam, count=400_000):
     return mu[turns], ecof[turns]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("kappa", "lam"), [(10.0, 1e-3), (10.0, 1e-2), (100.0, 0.05), (2.3, 1e-6), (1000.0, 0.07)]
 )
@@ -233,6 +236,7 @@ def test_fall_against_a_dense_scan(kappa, lam):
     np.testing.assert_allclose([float(high), float(low)], ecof, rtol=1e-9)
 
 
+@pytest.mark.slow
 def test_fall_region():
     """μ_E(μ) rises for κ <= 1 (all λ) and for λ >= λ_∞ (all κ); it falls just inside.
 
@@ -255,6 +259,7 @@ def test_fall_region():
     assert np.isfinite(low).mean() > 0.5 and np.nanmin(low) > AMBIGUOUS_ECOF_MIN
 
 
+@pytest.mark.slow
 def test_ambiguous_ecof():
     """Deep groove (z_o/x_o = 5) and stiff rig (λ = 1e-3): μ_E falls from 9.43 to 5.68."""
     lam, ratio = 1e-3, 5.0
@@ -279,6 +284,7 @@ def test_ambiguous_ecof():
         ecofmaps.correct_ecof(7.0, 50e-6, 450.0, stiffness, ratio)
 
 
+@pytest.mark.slow
 def test_traced_equals_concrete():
     """Under jax.jit and jax.vmap (NaN + status, no exceptions) as for concrete arrays."""
     ecof = jnp.array([0.5, 0.83, 7.0, 5.0, 1.0])
@@ -462,7 +468,7 @@ def test_lookup_agrees_with_the_exact_inversion(fig11_map):
 
 
 def test_lookup_statuses_and_errors(fig11_map):
-    point = dict(amplitude=50e-6, load=450.0, stiffness=35e6)  # S/P = 7.8e4 /m
+    point = EXAMPLE_2  # S/P = 7.8e4 /m
     ecof = np.array([0.83, 0.1, 0.83, 0.83, 5.0])
     mu, status = ecofmaps.lookup_correction(
         fig11_map, ecof, **{**point, "amplitude": [50e-6, 50e-6, 50e-6, 60e-6, 50e-6]},
@@ -504,6 +510,7 @@ def test_lookup_on_a_map_with_scalar_coordinates():
     assert int(status) == int(CorrectionStatus.OUTSIDE_MAP)
 
 
+@pytest.mark.slow
 def test_benchmark_section_agrees_with_scipy(capsys):
     """The 'correction' benchmark (quick): μ recovered, and SciPy's brentq gives the same."""
     import importlib.util

@@ -5,8 +5,9 @@ import pytest
 
 import ecofmaps
 from ecofmaps import CorrectionStatus, correct_ecof, correction_factor
+from ecofmaps.paper import AMPLITUDE, LOAD, STIFFNESS
 
-RIG = dict(amplitude=50e-6, load=450.0, stiffness=35e6)  # the paper's Example 2
+RIG = dict(amplitude=AMPLITUDE, load=LOAD, stiffness=STIFFNESS)  # the paper's Example 2
 
 
 def random_rigs(count, seed):
@@ -20,9 +21,9 @@ def random_rigs(count, seed):
 @pytest.mark.parametrize(
     ("profile", "parabola"),
     [
-        (ecofmaps.parabolic_profile(10e-6, 50e-6), 0.2),
+        pytest.param(ecofmaps.parabolic_profile(10e-6, 50e-6), 0.2, marks=pytest.mark.slow),
         (ecofmaps.flat_bottomed_profile(10e-6, 50e-6, 0.5, tilt=0.05), None),
-        (ecofmaps.w_shaped_profile(10e-6, 50e-6, 0.3), None),
+        pytest.param(ecofmaps.w_shaped_profile(10e-6, 50e-6, 0.3), None, marks=pytest.mark.slow),
     ],
     ids=["parabolic", "flat-tilted", "w"],
 )
@@ -43,6 +44,7 @@ def test_round_trip(profile, parabola):
         np.testing.assert_allclose(got, closed, rtol=1e-12)
 
 
+@pytest.mark.slow
 def test_shipped_example_corrects_less_than_its_parabola():
     """The shipped trace (D/W = 0.16, flat-bottomed with a hump and ridges): the ECoF of
     Example 2 needs a smaller correction than the D/W shortcut of eq. 11 gives."""
@@ -55,6 +57,7 @@ def test_shipped_example_corrects_less_than_its_parabola():
     assert shortcut < on_scar < ecof
 
 
+@pytest.mark.slow
 def test_ambiguous_and_jumps_are_reported():
     """On a ridged scar the pad jumps and μ_E(μ) falls over part of its range: ECoFs there
     are AMBIGUOUS, never a confident number; every CORRECTED point is the true μ."""
@@ -72,6 +75,7 @@ def test_ambiguous_and_jumps_are_reported():
         correct_ecof(ecof, amplitude, 450.0, stiffness, **kw)
 
 
+@pytest.mark.slow
 def test_no_gross_slip_and_bad_input():
     profile = ecofmaps.w_shaped_profile(10e-6, 50e-6, 0.3)
     limit = 35e6 * 50e-6 / 450.0 * (1.0 + 1e-12)  # S Δ*/P: above every gross-slip μ_E

@@ -5,6 +5,10 @@ import importlib.util
 import re
 from pathlib import Path
 
+import pytest
+
+pytestmark = pytest.mark.slow  # the benchmark script's smoke run
+
 BENCH = Path(__file__).parents[1] / "benchmarks" / "bench_figures.py"
 
 

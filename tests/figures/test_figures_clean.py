@@ -86,6 +86,7 @@ def test_the_helper_finds_a_clipped_title():
     assert texts_outside(figure) == []
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(figures.FIGURES))
 def test_registered_figures_are_clean(name):
     recipe = figures.FIGURES[name]

@@ -71,6 +71,7 @@ def test_the_loops_of_figures_5_and_6_are_cached(tmp_path, monkeypatch):
     assert [entry.function for entry in cache_entries()] == ["compute_loops"]
 
 
+@pytest.mark.slow
 def test_parallel_command_writes_every_figure(tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["figures", "--out", str(out), "--only", "fig8", "fig11a", "--jobs", "2"]) == 0
@@ -98,6 +99,7 @@ def test_command_keeps_jax_kernels_in_the_cache_for_the_run_only(tmp_path, capsy
     capsys.readouterr()
 
 
+@pytest.mark.slow
 def test_a_fresh_process_stores_its_compiled_kernels(tmp_path):
     """A run from an empty cache leaves JAX's kernels in <cache>/jax; the second reuses them."""
     cache = tmp_path / "cache"

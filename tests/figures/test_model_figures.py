@@ -339,6 +339,7 @@ def test_save_figure_is_atomic(tmp_path, drawn):
 # --- the command -----------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_command_writes_the_figures(tmp_path, capsys):
     out = tmp_path / "new" / "figures"
     status = main(["figures", "--out", str(out), "--only", "fig8", "fig11b", "--format", "png,svg"])

@@ -120,8 +120,9 @@ def test_shapes_dataset_against_the_model(shapes):
     bias = (dataset.ecof_ratio.sel(**at_example) - 1.0).sel(shape="flat-bottomed")
     assert 0.1 < float(bias.sel(groove="profile") / bias.sel(groove="parabola")) < 0.5
     assert float(flat.ecof.sel(groove="profile")) == pytest.approx(
-        float(ecofmaps.energy_cof(50e-6, 450.0, 35e6, 0.8, profile=ecofmaps.flat_bottomed_profile(
-            10e-6, 50e-6))), rel=1e-12)  # fmt: skip
+        float(ecofmaps.energy_cof(paper.AMPLITUDE, paper.LOAD, paper.STIFFNESS, paper.MU,
+                                  profile=ecofmaps.flat_bottomed_profile(10e-6, 50e-6))),
+        rel=1e-12)  # fmt: skip
     # The ridges lie beyond the pad's reach (δ* < Δ* = x_o): the ridged loop is the parabola's.
     ridged = dataset.sel(shape="ridged")
     np.testing.assert_allclose(ridged.force.sel(groove="profile"),
@@ -157,6 +158,7 @@ def test_shapes_figure_draws_every_shape(shapes):
     np.testing.assert_allclose(flat, dataset.shortcut_error.sel(shape="flat-bottomed") * 100)
 
 
+@pytest.mark.slow
 def test_shapes_figure_from_the_command(tmp_path, capsys):
     assert main(["figures", "--out", str(tmp_path), "--only", "shapes"]) == 0
     assert (tmp_path / "shapes.png").stat().st_size > 10_000

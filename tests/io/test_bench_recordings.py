@@ -7,6 +7,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.slow  # the benchmark script's smoke run
+
 BENCH = Path(__file__).parents[1] / "benchmarks" / "bench_recordings.py"
 
 

@@ -232,6 +232,7 @@ if __name__ == "__main__":
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["tdms", "hdf5"])
 def test_a_forked_process_opens_the_file_again(tmp_path, kind):
     """A process forked after a column opened its file reads through a file of its own (a

@@ -15,23 +15,15 @@ from ecofmaps.io.recording_types import RecordingError, RecordingWarning
 from ecofmaps.io.recordings import _options, read_recording, recording_blocks
 from ecofmaps.io.text import LINE_BYTES, text_blocks
 from ecofmaps.measured.synthetic import synthetic_recording
-
-POINT = dict(amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8, aspect_ratio=0.2)
+from ecofmaps.paper import EXAMPLE_2
+from tests.recordings import write_csv
 
 
 @pytest.fixture(scope="module")
 def recording():
     """Four whole cycles of the model (Example 2), 200 samples each: Δ [m], Q [N]."""
-    displacement, force = synthetic_recording(**POINT, cycles=5)
+    displacement, force = synthetic_recording(**EXAMPLE_2, cycles=5)
     return displacement[:801], force[:801]
-
-
-def write_csv(path, displacement, force, separator=",", header=("displacement", "force")):
-    """A recording file: displacement in µm, force in N, with a comment line."""
-    lines = [f"# a test recording written by {__name__}", separator.join(header)]
-    lines += [f"{d * 1e6:.9f}{separator}{f:.9f}" for d, f in zip(displacement, force, strict=True)]
-    path.write_text("\n".join(lines) + "\n")
-    return path
 
 
 # --- reading files ---------------------------------------------------------------------------

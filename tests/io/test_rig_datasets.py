@@ -16,8 +16,8 @@ from ecofmaps.io import open_recording
 from ecofmaps.io.recordings import read_recording, recording_blocks
 from ecofmaps.io.tdms import TdmsReader
 from ecofmaps.measured.synthetic import synthetic_recording
+from ecofmaps.paper import EXAMPLE_2 as POINT
 
-POINT = dict(amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8, aspect_ratio=0.2)
 SIZE = 801
 DROPPED = (100, 433)  # the displacement's and the force's missing sample
 

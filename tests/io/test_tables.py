@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 from ecofmaps import analyze_loops
 from ecofmaps.io.tables import csv_text, results_csv, results_table
 from ecofmaps.measured.synthetic import synthetic_recording
+from ecofmaps.paper import EXAMPLE_2, LOAD
 
 
 def pandas_text(table, header=True):
@@ -58,10 +59,8 @@ def test_any_floats_and_texts_as_pandas_writes_them(values, texts):
 
 def test_a_table_of_blocks_is_the_table_made_whole():
     """What the long analysis does: the lines of each block, joined, under one header."""
-    displacement, force = synthetic_recording(
-        50e-6, 450.0, 35e6, 0.8, 0.2, cycles=12, force_noise=2.0, seed=5
-    )
-    results = analyze_loops(displacement, force, 450.0)
+    displacement, force = synthetic_recording(**EXAMPLE_2, cycles=12, force_noise=2.0, seed=5)
+    results = analyze_loops(displacement, force, LOAD)
     whole = pandas_text(results_table(results))
     assert results_csv(results) == whole
     blocks = [results.isel(cycle=slice(a, a + 5)) for a in range(0, results.cycle.size, 5)]

@@ -445,6 +445,7 @@ def _write_repeatedly(directory, barrier, repeats):
         compute_map(**GRID, cache=True, cache_dir=directory)
 
 
+@pytest.mark.slow
 def test_two_concurrent_writers_leave_a_valid_file(tmp_path):
     context = multiprocessing.get_context("spawn")  # JAX is multithreaded: no fork
     barrier = context.Barrier(2)

@@ -277,6 +277,7 @@ AXES = dict(
 )
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("given", list(itertools.product([False, True], repeat=4)))
 def test_chunked_equals_in_memory_to_the_bit(given):
     """Every combination of scalar and 1-D axes, awkward blocks and tiles: identical."""

@@ -13,6 +13,7 @@ GRID = dict(stiffness_ratio=np.geomspace(1e4, 3e5, 12), amplitude=np.array([25e-
 PARABOLA = ecofmaps.parabolic_profile(10e-6, 50e-6)
 
 
+@pytest.mark.slow
 def test_parabolic_profile_gives_the_closed_form_map():
     """On a parabola the map is Figure 11's (closed forms, aspect_ratio = D/W): 1e-12."""
     mu = np.array([0.3, 0.8])
@@ -33,6 +34,7 @@ def test_parabolic_profile_gives_the_closed_form_map():
         assert {"long_name", "units"} <= set(on_profile[name].attrs), name
 
 
+@pytest.mark.slow
 def test_chunks_cache_and_netcdf(tmp_path):
     """Blocks of max_chunk points give the same map; the cache returns it identical, and a
     different profile (same D and W) is a different entry."""
@@ -60,6 +62,7 @@ def test_map_depends_on_lambda_only():
     assert float(m.ecof[0, 0]) == pytest.approx(float(m.ecof[1, 1]), rel=1e-14)
 
 
+@pytest.mark.slow
 def test_physical_mapping_runs_off_short_traces():
     profile = ecofmaps.parabolic_profile(10e-6, 50e-6, extent=1.2)
     m = compute_map(1e6, amplitude=[40e-6, 80e-6], mu=0.8, profile=profile, mapping="physical",

@@ -14,13 +14,9 @@ from hypothesis import strategies as st
 import ecofmaps
 from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.synthetic import synthetic_recording
-from ecofmaps.model import traction_ratio
+from ecofmaps.paper import AMPLITUDE, EXAMPLE_2, LOAD
+from tests.recordings import SAMPLES, load_steps, mindlin_recording, ploughing_recording
 
-LOAD = 450.0
-AMPLITUDE = 50e-6
-# The paper's Example 2 (Section 3).
-EXAMPLE_2 = dict(amplitude=AMPLITUDE, load=LOAD, stiffness=35e6, mu=0.8, aspect_ratio=0.2)
-SAMPLES = 200  # per cycle
 EXACT = 1e-10  # relative tolerance where the method is exact for the model
 QUANTITIES = ("amplitude", "slip_amplitude", "max_force", "dissipated_energy", "stiffness")
 
@@ -314,39 +310,6 @@ def test_noise_makes_no_false_reversal():
     assert result.attrs["dropped_samples"] < 20
 
 
-def ploughing_recording(height, cycles, noise, seed=3):
-    """Whole loops with a ploughing peak at each end of the slip (Figure 1b), sampled in time.
-
-    The slip traction is eq. 9 plus a Gaussian bump of ``height`` [N] and width 0.1 δ*
-    centred on the end of the slip, Δ = x + Q/S (eq. 10); the stick sides have slope S.
-    The slip amplitude is set to 32 µm, so the amplitude follows.
-    """
-    point = EXAMPLE_2
-    slip = 32e-6
-    x = np.linspace(-slip, slip, 20001)
-    kappa = 2.0 * point["aspect_ratio"]
-    traction = LOAD * np.asarray(traction_ratio(x / AMPLITUDE, point["mu"], kappa))
-    rising_force = traction + height * np.exp(-(((x - slip) / (0.1 * slip)) ** 2))
-    rising_displacement = x + rising_force / point["stiffness"]
-    amplitude, peak = rising_displacement[-1], rising_force[-1]
-    branch_x = np.concatenate([[-amplitude], rising_displacement])
-    branch_q = np.concatenate([[-peak], rising_force])
-    assert np.all(np.diff(branch_x) > 0)  # the rising branch is a function of Δ
-    phase = np.arange(cycles * SAMPLES + 1) / SAMPLES
-    displacement = -amplitude * np.cos(2 * np.pi * phase)
-    rising = phase % 1 < 0.5
-    force = np.where(
-        rising,
-        np.interp(displacement, branch_x, branch_q),
-        -np.interp(-displacement, branch_x, branch_q),  # the loop is symmetric about 0
-    )
-    if noise:
-        rng = np.random.default_rng(seed)
-        displacement = displacement + 0.005 * amplitude * rng.normal(size=phase.size) + 3e-6
-        force = force + 0.01 * peak * rng.normal(size=phase.size) + 5.0
-    return displacement, force
-
-
 def test_ploughing_peaks_leave_the_gicof():
     """Peaks of 0.3 μP at the stroke ends (Fig. 1b): GICoF within 2.5 %, noise-free 1e-5."""
     mu = EXAMPLE_2["mu"]
@@ -359,27 +322,6 @@ def test_ploughing_peaks_leave_the_gicof():
     noisy = analyze_loops(displacement, force, LOAD)
     assert float(relative(noisy.gicof, mu).max()) < 0.025
     assert float(np.median(relative(noisy.gicof, mu))) < 0.01
-
-
-def mindlin_recording(force_ratio, mu=0.8, cycles=4, compliance=10e-6, stiffness=50e6):
-    """Partial slip: the Cattaneo-Mindlin loop of a sphere (Masing rule) behind a rig spring.
-
-    Contact displacement on the rising branch from (-δ*, -Q*):
-    δ = -δ* + 2c[1 - (1 - (Q + Q*)/(2μP))^(2/3)], with c the displacement at full slip.
-    """
-    peak = force_ratio * mu * LOAD
-    q = np.linspace(-peak, peak, 4001)
-    slip = compliance * (1 - (1 - peak / (mu * LOAD)) ** (2 / 3))
-    contact = -slip + 2 * compliance * (1 - (1 - (q + peak) / (2 * mu * LOAD)) ** (2 / 3))
-    branch = contact + q / stiffness
-    phase = np.arange(cycles * SAMPLES) / SAMPLES
-    displacement = -branch[-1] * np.cos(2 * np.pi * phase)
-    force = np.where(
-        phase % 1 < 0.5,
-        np.interp(displacement, branch, q),
-        -np.interp(-displacement, branch, q),
-    )
-    return displacement, force
 
 
 def test_partial_slip_is_labelled():
@@ -471,18 +413,6 @@ def test_bad_recordings():
 
 
 # --- a normal load recorded sample by sample ------------------------------------------------
-
-
-def load_steps(levels=(300.0, 450.0, 600.0), cycles=4):
-    """Loops at each load of ``levels`` in turn (``cycles`` each), and the load channel."""
-    point = dict(amplitude=50e-6, stiffness=35e6, mu=0.8, aspect_ratio=0.15)
-    parts = [synthetic_recording(load=level, cycles=cycles, **point) for level in levels]
-    displacement = np.concatenate([d for d, _ in parts])
-    force = np.concatenate([q for _, q in parts])
-    load = np.concatenate(
-        [np.full(d.size, level) for (d, _), level in zip(parts, levels, strict=True)]
-    )
-    return displacement, force, load
 
 
 def test_a_recorded_load_gives_each_cycle_at_its_own_load():

@@ -23,6 +23,7 @@ import pytest
 
 import ecofmaps
 from ecofmaps.measured.quality import LoopQualityWarning
+from ecofmaps.paper import AMPLITUDE, LOAD, MU, STIFFNESS
 from tests.measured.ugly import ugly_recording
 from tests.return_map import return_map
 
@@ -64,6 +65,7 @@ def readings():
     return {kind: analysed(kind, seed) for kind, seed in KINDS.items()}
 
 
+@pytest.mark.slow
 def test_two_standard_errors_cover_the_truth(readings, record_property):
     """±2 se covers the truth on >= 80 % of the reported cycles (aim: 95 %), of >= 6 kinds."""
     covered, lines = [], []
@@ -96,7 +98,7 @@ def test_no_reported_cycle_is_far_off(readings):
 
 
 #: The Coulomb slider's contact and rig: 50 µm amplitude, 450 N, 35 MN/m, mu = 0.8.
-SLIDER = {"amplitude": 50e-6, "load": 450.0, "stiffness": 35e6, "mu": 0.8}
+SLIDER = {"amplitude": AMPLITUDE, "load": LOAD, "stiffness": STIFFNESS, "mu": MU}
 
 
 @pytest.fixture(scope="module")

@@ -15,9 +15,8 @@ from scipy.stats import norm
 
 from ecofmaps.measured.cycles import find_cycles
 from ecofmaps.measured.measure import loop_blocks
+from ecofmaps.paper import LOAD, MU, STIFFNESS
 from tests.return_map import return_map
-
-LOAD, STIFFNESS, MU = 450.0, 35e6, 0.8
 
 #: Half-width of the window of second differences of the centres (cycles either side).
 REACH = 3

@@ -1,8 +1,8 @@
-"""Cycles found a chunk at a time and loops centred a block at a time, against the reference.
+"""Cycles found a chunk at a time and loops centred a block at a time, against the outputs of
+the padded implementation (tests/measured/golden).
 
-The reference is the frozen padded implementation (tests/measured/reference). Chunks and
-blocks are made small here, so that runs, cycles and percentile brackets straddle their
-edges; the results must not move.
+Chunks and blocks are made small here, so that runs, cycles and percentile brackets straddle
+their edges; the results must not move.
 """
 
 import numpy as np
@@ -16,23 +16,10 @@ from ecofmaps.measured import samples as passes
 from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.samples import Samples
 from ecofmaps.measured.synthetic import synthetic_recording
-from tests.measured.reference import cycles as reference
-from tests.measured.reference.analysis import analyze_loops as reference_analysis
-from tests.measured.test_equivalence import EXAMPLE_2, LOAD, assert_same, noisy
-
-
-def signal(kind: int, size: int, seed: int):
-    """Noise, a random walk, a clipped noisy sine, rounded noise (ties) or a drifting sine."""
-    rng = np.random.default_rng(seed)
-    period = rng.integers(8, 400)
-    sine = np.sin(2 * np.pi * np.arange(size) / period)
-    return [
-        rng.normal(size=size),
-        np.cumsum(rng.normal(size=size)),
-        np.clip(sine, -0.7, 0.7) + 0.01 * rng.normal(size=size),
-        np.round(rng.normal(size=size), 1),
-        sine + 3.0 * np.arange(size) / size + 0.02 * rng.normal(size=size),
-    ][kind]
+from ecofmaps.paper import EXAMPLE_2, LOAD
+from tests.measured import golden
+from tests.measured.compare import assert_same
+from tests.measured.golden import signal
 
 
 def percentiles(values):
@@ -66,81 +53,56 @@ def test_percentiles_are_numpys_to_the_bit(kind, size, seed):
     np.testing.assert_array_equal(result, np.percentile(values, [1.0, 99.0]))
 
 
-@settings(max_examples=60, deadline=None)
-@given(kind=st.integers(0, 4), size=st.integers(8, 12_000), seed=st.integers(0, 2**16))
-def test_split_cycles_as_the_reference(kind, size, seed):
+def assert_found(found, expected):
+    """Cycles found as the padded implementation found them (``golden.found_cycles``)."""
+    assert found.label.size == expected["label"].size
+    assert found.incomplete_cycles == expected["incomplete_cycles"]
+    assert found.dropped_samples == expected["dropped_samples"]
+    if found.label.size:
+        samples, points = found.indices(width=expected["width"])
+        valid = np.arange(expected["width"]) < expected["points"][:, None]
+        np.testing.assert_array_equal(samples[valid], expected["samples"])
+        np.testing.assert_array_equal(points, expected["points"])
+        np.testing.assert_array_equal(found.label, expected["label"])
+
+
+@pytest.mark.parametrize("number", range(len(golden.SPLIT_CASES)))
+def test_split_cycles_as_the_padded_implementation(number):
     """Reversals, cycles and what is dropped: as the padded implementation, chunk by chunk."""
-    x = signal(kind, size, seed)
+    x = signal(*golden.SPLIT_CASES[number])
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(passes, "_CHUNK", 1000)
         patch.setattr(passes, "_SAMPLE", 256)
-        try:
-            found = cycles.split_cycles(x)
-        except ValueError as error:
-            with pytest.raises(ValueError, match=str(error)):
-                reference.split_cycles(x)
-            return
-    expected = reference.split_cycles(x)
-    assert found.label.size == expected.label.size
-    assert found.incomplete_cycles == expected.incomplete_cycles
-    assert found.dropped_samples == expected.dropped_samples
-    if found.label.size:
-        samples, points = found.indices(width=expected.samples.shape[1])
-        np.testing.assert_array_equal(samples[expected.valid], expected.samples[expected.valid])
-        np.testing.assert_array_equal(points, np.count_nonzero(expected.valid, axis=1))
-        np.testing.assert_array_equal(found.label, expected.label)
+        found = cycles.split_cycles(x)
+    assert_found(found, golden.found_cycles("split", number))
 
 
-@settings(max_examples=40, deadline=None)
-@given(
-    kind=st.integers(0, 4),
-    size=st.integers(8, 8000),
-    length=st.integers(5, 300),
-    seed=st.integers(0, 2**16),
-)
-def test_labelled_cycles_as_the_reference(kind, size, length, seed):
+@pytest.mark.parametrize("number", range(len(golden.LABELLED_CASES)))
+def test_labelled_cycles_as_the_padded_implementation(number):
     """Labelled cycles turned to their lowest sample: as the padded implementation."""
-    x = signal(kind, size, seed)
-    label = np.arange(size) // length * 10
+    x, label = golden.labelled_input(*golden.LABELLED_CASES[number])
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(passes, "_CHUNK", 1000)
         found = cycles.labelled_cycles(x, label)
-    expected = reference.labelled_cycles(x, label)
-    assert found.label.size == expected.label.size
-    assert found.incomplete_cycles == expected.incomplete_cycles
-    assert found.dropped_samples == expected.dropped_samples
-    if found.label.size:
-        samples, _ = found.indices(width=expected.samples.shape[1])
-        np.testing.assert_array_equal(samples[expected.valid], expected.samples[expected.valid])
-        np.testing.assert_array_equal(found.label, expected.label)
+    assert_found(found, golden.found_cycles("labelled", number))
 
 
-@settings(max_examples=60, deadline=None)
-@given(count=st.integers(1, 30), seed=st.integers(0, 2**16), scale=st.integers(-9, 3))
-def test_drift_is_the_reference_interpolation_to_the_bit(count, seed, scale):
-    """The drift on a block's samples is the reference's np.interp plus extrapolation."""
-    rng = np.random.default_rng(seed)
-    starts = np.cumsum(rng.integers(5, 300, count + 1))
-    start, size = starts[:-1], np.diff(starts) + 1
-    middle = ((size * (2 * start + size - 1)) // 2 + start) / (size + 1)
-    centre = rng.normal(size=count) * 10.0**scale
-    first = int(rng.integers(0, count))
-    stop = int(rng.integers(first, count)) + 1
-    low, high = int(start[first]), int(start[stop - 1] + size[stop - 1])
-    drift = centring._drift(low, high, middle, centre, slice(max(first - 1, 0), stop + 1))
-    expected = reference._interpolate(np.arange(low, high, dtype=float), middle, centre)
-    np.testing.assert_array_equal(drift, expected)
+@pytest.mark.parametrize("number", range(len(golden.DRIFT_CASES)))
+def test_drift_is_the_padded_interpolation_to_the_bit(number):
+    """The drift on a block's samples is the padded implementation's np.interp plus
+    extrapolation."""
+    low, high, middle, centre, rows = golden.drift_inputs(*golden.DRIFT_CASES[number])
+    drift = centring._drift(low, high, middle, centre, rows)
+    np.testing.assert_array_equal(drift, golden.drift(number))
 
 
-@pytest.mark.parametrize("labelled", [False, True])
-def test_chunks_and_blocks_change_nothing(small_chunks, labelled):
-    """Tiny chunks and blocks (a few cycles each) give the reference's numbers."""
-    displacement, force = noisy(EXAMPLE_2, 12, 9, sampling_jitter=0.3, start_phase=0.2)
-    label = np.repeat(np.arange(12), 200) if labelled else None
-    assert_same(
-        analyze_loops(displacement, force, LOAD, label),
-        reference_analysis(displacement, force, LOAD, label),
-    )
+@pytest.mark.parametrize("name", golden.CHUNKED)
+def test_chunks_and_blocks_change_nothing(small_chunks, name):
+    """Tiny chunks and blocks (a few cycles each) give the padded implementation's numbers."""
+    make, options = golden.CHUNKED[name]
+    displacement, force, label = make()
+    new = analyze_loops(displacement, force, LOAD, label, **options)
+    assert_same(new, golden.analysis(name, displacement, force))
 
 
 def test_a_long_loop_gets_a_block_of_its_own():
@@ -182,9 +144,7 @@ def test_a_gap_leaves_a_hole_in_the_drive_numbering(lazy):
 
     import ecofmaps
 
-    displacement, force = ecofmaps.synthetic_recording(
-        amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8, aspect_ratio=0.2, cycles=12
-    )
+    displacement, force = ecofmaps.synthetic_recording(**EXAMPLE_2, cycles=12)
     displacement[1000:1340] = np.nan  # from the 6th bottom reversal, 1.7 periods of 200
     if lazy:
         displacement, force = (da.from_array(a, chunks=700) for a in (displacement, force))

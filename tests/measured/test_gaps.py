@@ -16,6 +16,7 @@ import ecofmaps
 from ecofmaps._parallel import Runner
 from ecofmaps.measured import cycles, pipeline
 from ecofmaps.measured import samples as passes
+from ecofmaps.paper import EXAMPLE_2
 
 PERIOD = 200
 CYCLES = 12
@@ -121,6 +122,7 @@ def tiny_chunks(monkeypatch):
     monkeypatch.setattr(pipeline, "TASK_SAMPLES", 320)
 
 
+@pytest.mark.slow
 def test_out_of_core_finds_the_same_cycles(recording, tiny_chunks):
     displacement, force = recording
     with Runner(2) as runner:
@@ -164,8 +166,7 @@ def test_a_gap_in_the_first_cycles_shifts_no_number():
     the first reversal is still one (it is compared with a reversal the gap does not hide),
     so the cycles after the gap keep their numbers."""
     displacement, force = ecofmaps.synthetic_recording(
-        amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8, aspect_ratio=0.2,
-        cycles=CYCLES, samples_per_cycle=PERIOD, displacement_noise=0.2e-6, seed=0,
+        **EXAMPLE_2, cycles=CYCLES, samples_per_cycle=PERIOD, displacement_noise=0.2e-6, seed=0,
     )  # fmt: skip
     drive = drive_cycles(displacement)
     for start, length in [(170, 140), (155, 74), (184, 341), (150, 300)]:

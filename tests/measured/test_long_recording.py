@@ -5,6 +5,7 @@ import pytest
 
 import ecofmaps
 from ecofmaps.measured.synthetic import LONG_TEST, long_recording, write_long_recording
+from ecofmaps.paper import EXAMPLE_2
 
 QUIET = dict(displacement_noise=0.0, force_noise=0.0)
 
@@ -32,7 +33,7 @@ def test_blocks_continue_each_other():
     unshifted = joined(cycles, samples, block_cycles=7, force_offset=0.0, **QUIET)[2]
     np.testing.assert_allclose(force - unshifted, LONG_TEST["force_offset"], rtol=1e-12)
     assert np.all(np.diff(results.ecof) > 0)
-    final = ecofmaps.energy_cof(50e-6, 450.0, 35e6, 0.8, 0.2)
+    final = ecofmaps.energy_cof(**EXAMPLE_2)
     assert abs(float(results.ecof[-1]) / float(final) - 1) < 2e-3
 
 

@@ -23,16 +23,9 @@ from ecofmaps.measured.cycles import MissingSampleError
 from ecofmaps.measured.pipeline import LoopOptions
 from ecofmaps.measured.quality import LoopQualityWarning
 from ecofmaps.measured.synthetic import synthetic_recording
-from tests.measured.test_analysis import mindlin_recording
-from tests.measured.test_equivalence import (
-    COEFFICIENTS,
-    DISPLACEMENTS,
-    EXAMPLE_2,
-    FORCES,
-    LOAD,
-    TOLERANCE,
-    noisy,
-)
+from ecofmaps.paper import EXAMPLE_2, LOAD
+from tests.measured.compare import COEFFICIENTS, DISPLACEMENTS, FORCES, TOLERANCE
+from tests.recordings import mindlin_recording, noisy
 
 READ = ("mu_resolved", "mu_resolved_se", "aspect_ratio")
 
@@ -164,6 +157,7 @@ def test_xarray_and_a_missing_mask(small_blocks):
     assert_equal_results(lazy, memory)
 
 
+@pytest.mark.slow
 def test_a_local_cluster_of_two_processes(small_blocks):
     """The blocks run in two worker processes: the same numbers (the passes' chunk and the
     tasks' cycles travel with the tasks, not as settings of this process)."""
@@ -184,6 +178,7 @@ def _worker_settings():
     )
 
 
+@pytest.mark.slow
 def test_the_workers_of_a_local_cluster_run_lean():
     """A local cluster's workers keep glibc's own mmap threshold and do not sample their
     tasks' stacks (module notes of ecofmaps._parallel); this process's settings are left as
@@ -394,6 +389,7 @@ def test_tasks_hand_back_only_the_columns_asked_for(small_blocks):
         xr.testing.assert_identical(part, full[["quality", "ecof"]])
 
 
+@pytest.mark.slow
 def test_a_worker_reads_and_measures_without_jax_or_pint():
     """The modules a task of a long analysis loads (reading a rig file's column, the passes,
     measuring a block, formatting its rows) leave JAX, pint and SciPy unloaded: a worker

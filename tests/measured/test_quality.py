@@ -30,9 +30,9 @@ from ecofmaps.measured.quality import (
     refused,
 )
 from ecofmaps.measured.synthetic import synthetic_recording
-from tests.measured.reference.analysis import analyze_loops as reference_analysis
-from tests.measured.test_analysis import mindlin_recording
-from tests.measured.test_equivalence import EXAMPLE_2, LOAD, PER_CYCLE, noisy, scope_of
+from ecofmaps.paper import EXAMPLE_2, LOAD
+from tests.measured.compare import PER_CYCLE, scope_of
+from tests.recordings import mindlin_recording, noisy
 
 AMPLITUDE = EXAMPLE_2["amplitude"]
 
@@ -318,8 +318,6 @@ def test_crossing_not_on_the_digitised_loop():
     assert (result.quality == "no-crossing").all()
     assert result.gicof.isnull().all() and result.crossing_displacement_forward.isnull().all()
     assert result.ecof.notnull().all()
-    old = reference_analysis(displacement, force, LOAD)
-    assert old.gicof.notnull().all() and float(np.ptp(old.gicof.values)) > 0.2
 
 
 def test_sparse_loops_read_crossings_on_the_loop():
@@ -327,7 +325,6 @@ def test_sparse_loops_read_crossings_on_the_loop():
     reported lies within its loop's forces (the padded implementation put some at up to
     160 times the largest measured force)."""
     rng = np.random.default_rng(1)
-    worst_old = 0.0
     for _ in range(10):
         count = int(rng.integers(8, 13))
         inner = np.sort(rng.uniform(0.0, 1.0, count))
@@ -335,14 +332,7 @@ def test_sparse_loops_read_crossings_on_the_loop():
         phase = np.concatenate([inner + k for k in range(4)] + [[4.0]])
         displacement = -AMPLITUDE * np.cos(2 * np.pi * phase)
         force = -300.0 * np.cos(2 * np.pi * phase + 0.6) + 3.0 * rng.normal(size=phase.size)
-        try:
-            result = quiet(displacement, force, LOAD, keep_loops=True)
-        except ValueError:
-            continue
-        assert_plausible(result)
-        old = reference_analysis(displacement, force, LOAD)
-        worst_old = max(worst_old, float(np.nanmax(np.abs(old.gicof_forward))) / 0.7)
-    assert worst_old > 2.0  # the old crossings lay far off these loops (|Q| < 0.7 P)
+        assert_plausible(quiet(displacement, force, LOAD, keep_loops=True))
 
 
 # --- the report --------------------------------------------------------------------------------
@@ -491,6 +481,7 @@ def odd_recordings(draw):
     return kind, displacement, force
 
 
+@pytest.mark.slow
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(recording=odd_recordings())
 def test_nothing_implausible_is_reported(recording):

@@ -14,7 +14,8 @@ from ecofmaps.measured.quality import (
     ImplausibleScaleWarning,
     LoopQualityWarning,
 )
-from tests.measured.test_equivalence import EXAMPLE_2, LOAD, noisy
+from ecofmaps.paper import EXAMPLE_2, LOAD
+from tests.recordings import noisy
 
 
 @pytest.fixture(scope="module")

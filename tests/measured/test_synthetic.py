@@ -12,9 +12,10 @@ from ecofmaps.measured.synthetic import (
     synthetic_recording,
     write_example,
 )
+from ecofmaps.paper import AMPLITUDE, LOAD, MU, STIFFNESS
 from tests.measured.ugly import UGLY_KINDS, UGLY_RIG, ugly_recording
 
-POINT = dict(amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8)
+POINT = dict(amplitude=AMPLITUDE, load=LOAD, stiffness=STIFFNESS, mu=MU)
 
 
 def test_shipped_scar_profile_is_regenerated_byte_for_byte(tmp_path):

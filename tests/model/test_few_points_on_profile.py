@@ -13,7 +13,9 @@ NAMES = ("slip_ratio", "ecof_ratio", "normalized_energy", "normalized_max_force"
 @pytest.mark.parametrize(
     "profile",
     [
-        ecofmaps.flat_bottomed_profile(D, W, 0.5, samples=401),
+        pytest.param(
+            ecofmaps.flat_bottomed_profile(D, W, 0.5, samples=401), marks=pytest.mark.slow
+        ),
         ecofmaps.w_shaped_profile(D, W, 0.25, samples=401),  # the pad jumps: jumps' areas
     ],
     ids=["flat-bottomed", "W-shaped"],
@@ -38,6 +40,7 @@ def test_few_points_have_the_shared_tables_values(profile, monkeypatch):
         np.testing.assert_allclose(own[name], expected, rtol=1e-12, atol=0, err_msg=name)
 
 
+@pytest.mark.slow
 def test_numbers_and_loops_by_one_kernel():
     """The steady numbers of steady_numbers and the loops of fretting_loop, at once: on a
     W-shaped scar (jumps) over rigs, a rigid one among them, and amplitudes."""

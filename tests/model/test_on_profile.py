@@ -13,9 +13,10 @@ import ecofmaps
 from ecofmaps import Regime
 from ecofmaps.model.first_passage import JAMMED_TRACTION
 from ecofmaps.model.on_profile import steady_numbers
+from ecofmaps.paper import AMPLITUDE, LOAD, MU, STIFFNESS
 from tests.brute_force import ProfileBruteForce
 
-EXAMPLE_2 = dict(amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8)  # the paper's rig
+EXAMPLE_2 = dict(amplitude=AMPLITUDE, load=LOAD, stiffness=STIFFNESS, mu=MU)  # without a groove
 D, W = 10e-6, 50e-6  # D/W = 0.2 (Figure 5)
 
 # Families at D/W = 0.2, and the mapping and rigs (amplitude, stiffness) each is checked on.
@@ -108,6 +109,7 @@ def test_simulated_loop_area(family, rig):
     assert area == pytest.approx(expected, rel=1e-6)
 
 
+@pytest.mark.slow
 def test_drawn_loop():
     """fretting_loop on a profile: closed, clockwise, its area the steady E_d; on the
     parabola it is the closed-form loop."""
@@ -127,6 +129,7 @@ def test_drawn_loop():
 # --- the closed forms ---------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_parabola_family_reproduces_the_closed_forms():
     """A parabolic profile with aspect_ratio=D/W: every quantity within 1e-10 (eq. 9-16),
     over random rigs (rigid ones included), loads, mu and x_o >= amplitude."""
@@ -156,6 +159,7 @@ def test_parabola_family_reproduces_the_closed_forms():
         )
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("smoothing", [0.0, None])
 def test_sampled_parabola_arrays_match_the_closed_forms(smoothing):
     """A parabola given as 4000 samples (edges, slopes and D/W found from the arrays):
@@ -218,6 +222,7 @@ def test_no_gross_slip():
 # --- batches, jit and vmap -------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_vmap_over_a_batch_of_profiles():
     """jax.vmap over a stacked batch of profiles equals one call per profile."""
     profiles = [
@@ -235,6 +240,7 @@ def test_vmap_over_a_batch_of_profiles():
     np.testing.assert_allclose(mapped, one_by_one, rtol=1e-14)
 
 
+@pytest.mark.slow
 def test_jit_and_vmap_over_mu_and_amplitude():
     """Traced μ (each point its own O(N) tables) gives the concrete path's numbers."""
     profile = FAMILIES["w"][0]

@@ -14,11 +14,12 @@ from ecofmaps.model.profiles import (
     scar_profile,
     scar_profile_and_findings,
 )
+from ecofmaps.paper import AMPLITUDE, LOAD, MU, STIFFNESS
 
 UM = 1e-6
 W, D = 200 * UM, 10 * UM  # the generated scars' half-width and depth
 X = np.arange(-600.0, 600.01, 1.0) * UM  # a trace every 1 µm over 1.2 mm
-POINT = dict(amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8)
+POINT = dict(amplitude=AMPLITUDE, load=LOAD, stiffness=STIFFNESS, mu=MU)  # Example 2's rig
 
 
 def scar(kind, x=X, half_width=W, depth=D):
@@ -84,6 +85,7 @@ def test_a_quantised_trace_loses_no_sample():
     assert np.flatnonzero(outlying_samples(X, steps * 1e-8)).tolist() == [300]
 
 
+@pytest.mark.slow
 def test_a_dropout_gives_the_depth_and_ecof_of_the_clean_scar():
     """One dropout (a spike 40 µm down) inside the scar: replaced, the depth within 0.1 %
     and the ECoF within 1e-4 of the clean scar's; kept, it moves both by far more."""

@@ -240,6 +240,7 @@ def test_bad_trace_parameters():
         ecofmaps.scar_profile(coarse_x, coarse_z)
 
 
+@pytest.mark.slow
 def test_profiles_are_float64_without_jax_64_bit_mode():
     """A fresh process (JAX's 64-bit mode off, as in a script or the command line) still
     gets float64 profiles: the file's positions are not truncated to float32."""
@@ -256,6 +257,7 @@ def test_profiles_are_float64_without_jax_64_bit_mode():
     assert run.stdout.split() == ["float64"]
 
 
+@pytest.mark.slow
 def test_a_profile_s_numbers_stay_float64_in_a_user_s_arithmetic():
     """In a process of its own (JAX's 64-bit mode off, as in a user's script), arithmetic on
     a read profile's fields stays float64, with no JAX warning: JAX would truncate a

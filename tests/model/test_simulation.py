@@ -5,9 +5,12 @@ import numpy as np
 import pytest
 
 import ecofmaps
+from ecofmaps.paper import AMPLITUDE, EXAMPLE_2
 
-EXAMPLE_2 = dict(amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8, aspect_ratio=0.2)
-MATERIAL = dict(load=450.0, stiffness=35e6, mu=0.8, aspect_ratio=0.2, groove_half_width=50e-6)
+#: Example 2 without its amplitude, the groove's half-width x_o = Δ* = 50 µm given instead.
+MATERIAL = {k: v for k, v in EXAMPLE_2.items() if k != "amplitude"} | {
+    "groove_half_width": AMPLITUDE
+}
 
 
 def area(displacement, force):
@@ -199,10 +202,7 @@ def test_amplitude_changes_reach_the_new_steady_loop():
     force = np.asarray(ecofmaps.simulate(displacement, **MATERIAL))
     tops = force[24::100]
     # the groove (x_o = 50 µm) stays while the amplitude changes
-    expected = [
-        float(ecofmaps.max_force(a, 450.0, 35e6, 0.8, 0.2, groove_half_width=50e-6))
-        for a in amplitudes
-    ]
+    expected = [float(ecofmaps.max_force(a, **MATERIAL)) for a in amplitudes]
     np.testing.assert_allclose(tops[[1, 2, 3, 5]], np.array(expected)[[1, 2, 3, 5]], rtol=1e-12)
 
 
@@ -245,6 +245,7 @@ def test_simulation_rejects_bad_input(change, message):
         ecofmaps.simulate(**arguments)
 
 
+@pytest.mark.slow
 def test_loop_and_simulation_areas_at_random_points():
     """E_d (closed form) against the area of the steady loop and of a simulated sinusoidal
     cycle at ~600 random points over the tribologically meaningful domain, all in one call.

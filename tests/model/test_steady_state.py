@@ -15,8 +15,8 @@ from scipy.optimize import brentq
 import ecofmaps
 from ecofmaps import model
 from ecofmaps.model.core import _artanh_excess
+from ecofmaps.paper import EXAMPLE_2
 
-EXAMPLE_2 = dict(amplitude=50e-6, load=450.0, stiffness=35e6, mu=0.8, aspect_ratio=0.2)
 ARGUMENTS = ("amplitude", "load", "stiffness", "mu", "aspect_ratio", "groove_half_width")
 
 
@@ -194,7 +194,7 @@ def test_figure_7_and_8_statements():
 def test_core_collapse_on_compliance_ratio():
     """mu_E/mu depends on (Delta*, S/P) only through lambda = P/(S Delta*) (x_o = Delta*)."""
     small = ecofmaps.energy_cof(25e-6, 450.0, 70e6, 0.8, 0.2)
-    large = ecofmaps.energy_cof(50e-6, 450.0, 35e6, 0.8, 0.2)
+    large = ecofmaps.energy_cof(**EXAMPLE_2)
     assert float(small) == pytest.approx(float(large), rel=1e-14)
     core = model.ecof_ratio(0.8, 0.4, 450.0 / (35e6 * 50e-6))
     assert float(core) * 0.8 == pytest.approx(float(large), rel=1e-14)
@@ -318,7 +318,7 @@ def test_vmap_over_grid_equals_scalar_calls():
 @pytest.mark.parametrize("argument", [0, 1, 2, 3, 4])
 def test_grad_matches_finite_differences(argument):
     """d mu_E / d(each argument) at Example 2 vs a central difference (rel 1e-7)."""
-    values = [50e-6, 450.0, 35e6, 0.8, 0.2]
+    values = [EXAMPLE_2[name] for name in ARGUMENTS[:5]]
     gradient = float(jax.grad(ecofmaps.energy_cof, argnums=argument)(*values))
     step = values[argument] * 1e-5
 
@@ -374,8 +374,8 @@ def test_grad_is_finite_at_a_flat_groove():
 
 def test_results_are_float64_even_with_x64_switched_off():
     with jax.enable_x64(False):
-        result = ecofmaps.energy_cof(50e-6, 450.0, 35e6, 0.8, 0.2)
-        code = ecofmaps.slip_regime(50e-6, 450.0, 35e6, 0.8, 0.2)
+        result = ecofmaps.energy_cof(**EXAMPLE_2)
+        code = ecofmaps.slip_regime(**EXAMPLE_2)
     assert result.dtype == jnp.float64
     assert code.dtype == jnp.int32
     assert float(result) == pytest.approx(0.8307990199151581, rel=1e-15)

@@ -2,10 +2,11 @@
 selenium (no browser is ever downloaded). Without a browser the tests skip, saying why, except
 in CI (``CI=true``), where they fail: .ci/run installs the browser."""
 
-import os
 import shutil
 
 import pytest
+
+from tests.web.pages import no_browser
 
 #: Flags that run Debian's Chromium headless in a container, fetching nothing of its own.
 CHROMIUM_FLAGS = (
@@ -21,11 +22,12 @@ CHROMIUM_FLAGS = (
 )
 
 
-def no_browser(reason: str):
-    """Skip with ``reason``, or fail in CI, where the browser must be there."""
-    if os.environ.get("CI", "").lower() == "true":
-        pytest.fail(f"{reason}; in CI .ci/run installs chromium and chromium-driver")
-    pytest.skip(reason)
+def pytest_collection_modifyitems(items):
+    """A test that uses the ``browser`` fixture is marked ``browser`` and ``slow``."""
+    for item in items:
+        if "browser" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.browser)
+            item.add_marker(pytest.mark.slow)
 
 
 @pytest.fixture(scope="module")

@@ -1,6 +1,18 @@
-"""Reading a page in the browser: its console errors, and text behind shadow roots."""
+"""The browser tests' helpers: no browser (skip, or fail in CI), and reading a page in the
+browser: its console errors, and text behind shadow roots."""
 
+import os
 import time
+
+import pytest
+
+
+def no_browser(reason: str):
+    """Skip with ``reason``, or fail in CI, where the browser must be there."""
+    if os.environ.get("CI", "").lower() == "true":
+        pytest.fail(f"{reason}; in CI .ci/run installs chromium and chromium-driver")
+    pytest.skip(reason)
+
 
 #: JavaScript: every element matching ``arguments[0]``, in the document and in every shadow
 #: root under it (Bokeh and Panel draw into shadow roots), as [text, dataset] pairs.

@@ -2,7 +2,7 @@
 
 import pytest
 
-from tests.web.conftest import no_browser
+from tests.web.pages import no_browser
 
 
 def test_without_a_browser_ci_fails_and_elsewhere_skips(monkeypatch):

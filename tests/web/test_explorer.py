@@ -202,6 +202,7 @@ def answer(url: str, target: str, headers: dict) -> tuple:
         connection.close()
 
 
+@pytest.mark.slow
 def test_only_local_pages_are_answered(listening):
     """Host and Origin of every request, page and websocket alike; 403 for another's."""
     _, url = listening
@@ -221,6 +222,7 @@ def test_only_local_pages_are_answered(listening):
             assert answer(url, target, headers)[0] == 403, (headers, target)
 
 
+@pytest.mark.slow
 def test_a_huge_query_value_is_cut_before_panel_reads_it(listening):
     _, url = listening
     port = urllib.parse.urlsplit(url).port
@@ -250,6 +252,7 @@ def test_nothing_is_written_to_disk_per_page(browser, server):
     assert sorted(os.walk(cache)) == before
 
 
+@pytest.mark.slow
 def test_sigterm_stops_it_cleanly(listening):
     """Last of the module: the server stops on SIGTERM, exit 0, no traceback."""
     process, _ = listening

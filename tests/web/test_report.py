@@ -16,6 +16,7 @@ from ecofmaps import cli
 from ecofmaps.cli import loops
 from ecofmaps.io.tables import results_csv
 from ecofmaps.measured.quality import REASONS, LoopQualityWarning
+from ecofmaps.paper import EXAMPLE_2
 from ecofmaps.web import report
 from ecofmaps.web.report import LOOPS_CARRIED, report_document, write_report
 from tests.cli.commands import run
@@ -27,7 +28,7 @@ INPUTS = {"files": "test.csv", "load": "450 N", "units assumed": "displacement u
 def damaged_recording():
     """40 cycles of a deepening groove, one of them damaged (its force turned over). [m], [N]"""
     displacement, force = ecofmaps.synthetic_recording(
-        50e-6, 450.0, 35e6, 0.8, np.linspace(0.02, 0.2, 40), samples_per_cycle=160,
+        **dict(EXAMPLE_2, aspect_ratio=np.linspace(0.02, 0.2, 40)), samples_per_cycle=160,
         force_noise=4.0, displacement_noise=2.5e-7, seed=3,
     )  # fmt: skip
     force[160 * 5 : 160 * 5 + 80] *= -1.0

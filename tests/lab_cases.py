@@ -1,0 +1,44 @@
+"""The cases of the lab's tests (tests/test_lab.py, tests/cli/test_wear.py): the Mindlin
+contact they share, and a gross-slip test recorded every 500th cycle while its friction runs
+in, with the constants of the groove an energy law grows from it."""
+
+import warnings
+
+import numpy as np
+
+import ecofmaps
+from tests import mindlin
+
+MU, LOAD, DELTA_T = 0.8, 450.0, 6e-6
+CYCLES = np.concatenate([[1], np.arange(500, 10001, 500)])  # recorded every 500th cycle
+ALPHA, LENGTH, HALF_WIDTH = 2.5e-14, 5e-3, 150e-6  # m³/J, m, m
+
+
+def running_in_mu(cycle):
+    """Friction rising through the test (the running-in), and the contact's δ_t with it."""
+    return 0.5 + 0.3 * (1.0 - np.exp(-cycle / 3000.0))
+
+
+def recorded_test(amplitude, stiffness, cycles=CYCLES):
+    """analyze_loops of the recorded cycles of a gross-slip test (one steady loop each,
+    numbered as driven) and the closed-form sums over every cycle driven."""
+    samples = 200
+    pieces, labels = [], []
+    for n in cycles:
+        mu = running_in_mu(n)
+        contact = mindlin.Contact(mu, LOAD, DELTA_T * mu / MU)
+        applied = mindlin.sweep([amplitude], samples)
+        _, force = mindlin.drive(contact, applied, stiffness)
+        span = slice(samples, 2 * samples)
+        pieces.append((applied[span], force[span]))
+        labels.append(np.full(samples, n))
+    applied, force = (np.concatenate(p) for p in zip(*pieces, strict=True))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        results = ecofmaps.analyze_loops(applied, force, LOAD, cycle=np.concatenate(labels))
+    every = np.arange(1, cycles[-1] + 1)
+    mu = running_in_mu(every)
+    energy, slip = mindlin.gross_slip_loop(amplitude, mu, LOAD, DELTA_T * mu / MU, stiffness)
+    sums = {"energy": energy.sum(), "slip": (4 * LOAD * slip).sum(),
+            "nominal": 4 * LOAD * amplitude * every.size}  # fmt: skip
+    return results, sums
