@@ -34,6 +34,9 @@ MIN_SAMPLES = 8
 #: The least local half-band of the reversal detector, as a share of the whole recording's.
 _LEAST_LEVEL = 0.05
 
+#: A stretch between bottom runs within this share of the period is one regular cycle.
+_REGULAR = 0.1
+
 #: A recording longer than this with fewer than two bottom reversals is not read as one loop.
 _ONE_LOOP = 1 << 24
 
@@ -356,8 +359,10 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, half_ran
     """The trigger's half-band against the local amplitude, or None where the whole
     recording's, ``hysteresis`` times its ``half_range`` [m], finds every cycle.
 
-    When a stretch between bottom runs is longer than 1.5 periods (``runs``: the first
-    trigger's starts and kinds, and the period), smaller cycles may lie inside the band.
+    When the drive is periodic (``runs``: the first trigger's starts and kinds, and the
+    period; half the stretches between bottom runs, and at least four, within
+    ``_REGULAR`` of the period) and a stretch is longer than 1.5 periods, smaller cycles
+    may lie inside the band.
     The band is then ``hysteresis`` times the half-range of the displacement over the
     stretch of a period (counted from sample 0) that holds the sample and the stretches
     either side, so over at least a period each side; never more than ``level`` nor less
@@ -365,8 +370,9 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, half_ran
     whole recording's band everywhere.
     """
     starts, kind, period = runs
-    low = starts[kind < 0]
-    if not np.isfinite(period) or np.diff(low).max() <= 1.5 * period:
+    between = np.diff(starts[kind < 0]) / period
+    regular = np.abs(between - 1.0) <= _REGULAR
+    if not (np.count_nonzero(regular) >= 4 and regular.mean() >= 0.5 and between.max() > 1.5):
         return None
     width = max(int(period), MIN_SAMPLES)
     pieces = np.concatenate(
