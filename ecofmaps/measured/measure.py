@@ -363,6 +363,11 @@ _MEASURED = tuple(
 )
 
 
+#: A gross-slip loop whose GICoF lies within this share of Q*/P is crossed by its stick line
+#: where it slides at a constant force: its GICoF is read even if its stick sides are curved.
+_PLATEAU = 0.02
+
+
 def _loop_values(block, options):
     """Every per-cycle quantity of a block of centred loops, and the checks it failed."""
     load = options.load
@@ -409,6 +414,8 @@ def _loop_values(block, options):
         values |= {name: ratios[name] for name in _RIG_RATIOS}
     rounding = 1e-9
     anticlockwise = energy_ratio < -ANTICLOCKWISE_SHARE
+    sliding = gross_slip(values, options)
+    on_plateau = sliding & (np.abs(values["gicof"] / values["cof_max"] - 1.0) <= _PLATEAU)
     flags = {
         "few-samples": block.count < MIN_SAMPLES,
         "constant-force": ~(block.force_swing > 0.0),
@@ -425,9 +432,10 @@ def _loop_values(block, options):
         "negative-area": (energy_ratio < 0.0) & ~anticlockwise,
         "negative-slip": ~(slip > 0.0),
         "no-zero-crossing": ~(zero_on_loop[:cycles] & zero_on_loop[cycles:]),
-        "curved-stick": fit["curved"],
+        "curved-stick": fit["curved"] & ~on_plateau,
+        "curved-stick-sliding": fit["curved"] & on_plateau,
         "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]),
-        "not-gross-slip": ~gross_slip(values, options),
+        "not-gross-slip": ~sliding,
     }
     return values, flags
 

@@ -385,6 +385,11 @@ REASONS = {
         "the stick sides are curved (a polymer, micro-slip): no straight line gives S",
         ("stiffness", *_GICOF, *RESOLVED),
     ),
+    "curved-stick-sliding": (
+        "the stick sides are curved (a sphere's Mindlin stick, micro-slip) but the loop slides "
+        "at Q* where the stick line crosses it: no straight line gives S, the GICoF is read",
+        ("stiffness", *RESOLVED),
+    ),
     "no-crossing": (
         "a branch's crossing with Q = SΔ is not on the measured loop (between its samples, "
         "within their force range)",
