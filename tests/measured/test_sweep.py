@@ -9,7 +9,10 @@ import pytest
 
 import ecofmaps
 from ecofmaps.measured import cycles as cycles_module
+from ecofmaps.measured import pipeline
+from ecofmaps.measured import samples as passes
 from tests import mindlin
+from tests.measured.test_out_of_core import analysed, assert_equal_results, lazily
 
 MU, LOAD, DELTA_T = 0.8, 450.0, 6e-6
 SAMPLES = 200  # per cycle
@@ -84,3 +87,18 @@ def test_a_rig_stiffness_that_is_not_positive_is_refused():
     x = np.sin(np.linspace(0, 6 * np.pi, 301)) * 20e-6
     with pytest.raises(ValueError, match="rig_stiffness"):
         ecofmaps.analyze_loops(x, 3e7 * x, LOAD, rig_stiffness=-1.0)
+
+
+def test_a_sweep_out_of_core_as_in_memory(monkeypatch):
+    """The local band's stretches cut across chunks and tasks: the same cycles and numbers."""
+    monkeypatch.setattr(passes, "_CHUNK", 1000)
+    monkeypatch.setattr(passes, "_SAMPLE", 256)
+    monkeypatch.setattr(pipeline, "TASK_SAMPLES", 777)
+    stiffness = 35e6
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    applied = mindlin.sweep(np.repeat(np.linspace(0.45, 1.8, 10) * at, 2), SAMPLES)
+    _, force = mindlin.drive(mindlin.Contact(MU, LOAD, DELTA_T), applied, stiffness)
+    memory = analysed(applied, force)
+    assert memory.cycle.size == 21
+    lazy = analysed(*lazily(applied, force, chunks=1700), scheduler="threads")
+    assert_equal_results(lazy, memory)
