@@ -361,18 +361,20 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, half_ran
 
     When the drive is periodic (``runs``: the first trigger's starts and kinds, and the
     period; half the stretches between bottom runs, and at least four, within
-    ``_REGULAR`` of the period) and a stretch is longer than 1.5 periods, smaller cycles
-    may lie inside the band.
-    The band is then ``hysteresis`` times the half-range of the displacement over the
+    ``_REGULAR`` of the period) and a stretch between them, or before the first or after
+    the last, is longer than 1.5 periods, smaller cycles may lie inside the band. The band
+    is then ``hysteresis`` times the half-range of the displacement over the
     stretch of a period (counted from sample 0) that holds the sample and the stretches
     either side, so over at least a period each side; never more than ``level`` nor less
     than ``_LEAST_LEVEL`` of the whole recording's. A recording of one amplitude keeps the
     whole recording's band everywhere.
     """
     starts, kind, period = runs
-    between = np.diff(starts[kind < 0]) / period
-    regular = np.abs(between - 1.0) <= _REGULAR
-    if not (np.count_nonzero(regular) >= 4 and regular.mean() >= 0.5 and between.max() > 1.5):
+    bottoms = starts[kind < 0]
+    regular = np.abs(np.diff(bottoms) / period - 1.0) <= _REGULAR
+    if not (np.count_nonzero(regular) >= 4 and regular.mean() >= 0.5):
+        return None
+    if np.diff(bottoms, prepend=0, append=samples.size).max() <= 1.5 * period:
         return None
     width = max(int(period), MIN_SAMPLES)
     pieces = np.concatenate(
