@@ -395,6 +395,38 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, half_ran
     return width, local
 
 
+def _drive_cycles(bottoms, tops, n: int) -> Cycles:
+    """Cycles cut where the drive's cycles meet, for a recording whose amplitude varies.
+
+    A drive that changes its amplitude from one cycle to the next does so between a bottom
+    reversal and the next top (a sine's cycle runs from its upward crossing of the centre);
+    cut at a bottom reversal, the loop would begin a quarter period early, at the previous
+    amplitude. Each cycle runs from the sample half way between a bottom reversal and the
+    next top to the same point of the next pair, both included, and its loop begins at its
+    bottom reversal (``rotation``). A bottom without a top before the next bottom (beside a
+    gap) ends no cycle: the stretch is dropped and counted.
+    """
+    after = np.searchsorted(tops, bottoms)
+    has_top = after < tops.size
+    has_top[:-1] &= tops[np.minimum(after[:-1], tops.size - 1)] < bottoms[1:]
+    cut = np.where(has_top, (bottoms + tops[np.minimum(after, tops.size - 1)]) // 2, -1)
+    pair = (cut[:-1] >= 0) & (cut[1:] >= 0)  # two cuts, one bottom reversal between
+    start, stop, bottom = cut[:-1][pair], cut[1:][pair], bottoms[1:][pair]
+    if not start.size:
+        return Cycles(start, start, start, start, False, 1, n)
+    hole = start[1:] > stop[:-1]
+    leading, trailing = int(start[0]), int(n - 1 - stop[-1])
+    return Cycles(
+        start=start,
+        count=stop - start + 1,
+        rotation=bottom - start,
+        label=np.arange(1, start.size + 1, dtype=np.int64),
+        continuous=False,
+        incomplete_cycles=int(leading > 0) + int(trailing > 0) + int(np.count_nonzero(hole)),
+        dropped_samples=leading + trailing + int((start[1:] - stop[:-1] - 1)[hole].sum()),
+    )
+
+
 def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     """:func:`split_cycles` of any :class:`Samples`."""
     n = samples.size
@@ -413,10 +445,14 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     starts, kind, extreme, value = _trigger(samples, gaps, line, band)
     period = _period(starts, kind)
     level = _local_level(samples, gaps, line, (starts, kind, period), hysteresis, half_range)
-    if level is not None:
-        band = (centre, level)
-        starts, kind, extreme, value = _trigger(samples, gaps, line, band)
-        period = _period(starts, kind)
+    if level is not None:  # kept if it finds smaller cycles (more bottom runs)
+        local = _trigger(samples, gaps, line, (centre, level))
+        if np.count_nonzero(local[1] < 0) > np.count_nonzero(kind < 0):
+            band = (centre, level)
+            starts, kind, extreme, value = local
+            period = _period(starts, kind)
+        else:
+            level = None
     # A gap shorter than half the samples beyond the band in a half period of a triangle
     # wave cannot have hidden a run of the other kind: the trigger goes on over it.
     long_gaps = gaps[gaps[:, 1] - gaps[:, 0] >= 0.25 * (1.0 - hysteresis) * period]
@@ -445,6 +481,9 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
                 f"no complete cycle in {n} samples: fewer than two displacement reversals"
             )
         return _labelled(samples.constant_cycle(), tolerance)
+    if level is not None:  # the amplitude varies: cut where the drive's cycles meet
+        tops = extreme_of_part[(kind_of_part > 0) & accepted]
+        return _drive_numbers(_with_missing(_drive_cycles(bottoms, tops, n), gaps))
     # Each loop runs from its bottom reversal to the next and back to its first sample, so
     # it is closed even if the displacement drifted in between.
     start = bottoms[:-1]

@@ -30,9 +30,8 @@ def sweep(request):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         results = ecofmaps.analyze_loops(applied, force, LOAD, rig_stiffness=stiffness)
-    # cycle k runs from the bottom of drive cycle k - 1 to that of drive cycle k
-    driven = np.concatenate([amplitudes, amplitudes[-1:]])
-    return stiffness, at, applied, driven, results
+    # the recording's first and last cycles (a lead-in and a lead-out) are cut short
+    return stiffness, at, applied, amplitudes, results
 
 
 def test_every_cycle_of_a_sweep_is_reported_numbered_as_driven(sweep):
@@ -40,10 +39,27 @@ def test_every_cycle_of_a_sweep_is_reported_numbered_as_driven(sweep):
     np.testing.assert_array_equal(results.cycle, np.arange(1, driven.size + 1))
     assert results.attrs["incomplete_cycles"] == 2
     found = cycles_module.split_cycles(applied)
-    tops = np.array(
-        [applied[s : s + c].max() for s, c in zip(found.start, found.count, strict=True)]
-    )
-    np.testing.assert_allclose(tops, driven, rtol=1e-3)
+    stretches = [applied[s : s + c] for s, c in zip(found.start, found.count, strict=True)]
+    # each cycle holds the drive's cycle of its number, at one amplitude: both its
+    # reversals, and its ends where the drive's cycles meet (at the centre)
+    np.testing.assert_allclose([x.max() for x in stretches], driven, rtol=1e-3)
+    np.testing.assert_allclose([-x.min() for x in stretches], driven, rtol=1e-3)
+    np.testing.assert_allclose(results.amplitude, driven, rtol=1e-3)
+    ends = np.array([[x[0], x[-1]] for x in stretches])
+    assert np.abs(ends).max() < 0.02 * driven.max()
+
+
+def test_a_falling_sweep_reports_each_cycles_own_amplitude():
+    """Cut at a bottom reversal, the first cycle after a step down would begin at the old
+    amplitude and report the mean of the two."""
+    stiffness = 35e6
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    amplitudes = np.repeat(np.linspace(1.8, 0.45, 8) * at, 2)
+    applied = mindlin.sweep(amplitudes, SAMPLES)
+    _, force = mindlin.drive(mindlin.Contact(MU, LOAD, DELTA_T), applied, stiffness)
+    results = analysed(applied, force)
+    np.testing.assert_array_equal(results.cycle, np.arange(1, amplitudes.size + 1))
+    np.testing.assert_allclose(results.amplitude, amplitudes, rtol=1e-3)
 
 
 def test_the_regime_is_decided_on_the_contacts_displacement(sweep):
@@ -99,6 +115,6 @@ def test_a_sweep_out_of_core_as_in_memory(monkeypatch):
     applied = mindlin.sweep(np.repeat(np.linspace(0.45, 1.8, 10) * at, 2), SAMPLES)
     _, force = mindlin.drive(mindlin.Contact(MU, LOAD, DELTA_T), applied, stiffness)
     memory = analysed(applied, force)
-    assert memory.cycle.size == 21
+    assert memory.cycle.size == 20
     lazy = analysed(*lazily(applied, force, chunks=1700), scheduler="threads")
     assert_equal_results(lazy, memory)
