@@ -273,8 +273,8 @@ class Tally:
                 "motion": _motion(typical),
             }
         )
-        if options["rig_stiffness"] is not None:
-            results.attrs["rig_stiffness"] = options["rig_stiffness"]
+        if options.rig_stiffness is not None:
+            results.attrs["rig_stiffness"] = options.rig_stiffness
         return results
 
     def counts_of(self, reason: str) -> int:
