@@ -406,6 +406,9 @@ def _drive_cycles(bottoms, tops, n: int) -> Cycles:
     bottom reversal (``rotation``). A bottom without a top before the next bottom (beside a
     gap) ends no cycle: the stretch is dropped and counted.
     """
+    none = np.zeros(0, dtype=np.int64)
+    if not tops.size:
+        return Cycles(none, none, none, none, False, 1, n)
     after = np.searchsorted(tops, bottoms)
     has_top = after < tops.size
     has_top[:-1] &= tops[np.minimum(after[:-1], tops.size - 1)] < bottoms[1:]
@@ -413,7 +416,7 @@ def _drive_cycles(bottoms, tops, n: int) -> Cycles:
     pair = (cut[:-1] >= 0) & (cut[1:] >= 0)  # two cuts, one bottom reversal between
     start, stop, bottom = cut[:-1][pair], cut[1:][pair], bottoms[1:][pair]
     if not start.size:
-        return Cycles(start, start, start, start, False, 1, n)
+        return Cycles(none, none, none, none, False, 1, n)
     hole = start[1:] > stop[:-1]
     leading, trailing = int(start[0]), int(n - 1 - stop[-1])
     return Cycles(
