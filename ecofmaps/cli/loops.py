@@ -219,8 +219,8 @@ def _analysed(index, path, recording, load, args, long_run, write, *, many, reso
             f"--report draws loops and the whole table, which a long recording ({path}) "
             "analysed out of core does not keep: leave out --report"
         )
-    from ecofmaps.measured.options import ImplausibleScaleError, ImplausibleScaleWarning
     from ecofmaps.measured.pipeline import Reading
+    from ecofmaps.measured.quality import ImplausibleScaleError, ImplausibleScaleWarning
 
     plots = args.plots is not None and in_memory
     positions = 201 if plots or resolved_file else None
