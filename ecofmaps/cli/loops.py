@@ -221,13 +221,14 @@ def _analysed(index, path, recording, load, args, long_run, write, *, many, reso
         )
     from ecofmaps.measured.pipeline import Reading
     from ecofmaps.measured.quality import ImplausibleScaleError, ImplausibleScaleWarning
+    from ecofmaps.measured.resolve import ReadingOptions
 
     plots = args.plots is not None and in_memory
     positions = 201 if plots or resolved_file else None
     reading = Reading(
         resolve=not args.no_resolve,
         keep_loops=plots or args.report is not None,
-        along_stroke={"positions": positions},
+        along_stroke=ReadingOptions(positions=positions),
         hand_back=positions is not None,
     )
     with warnings.catch_warnings(record=True) as caught:
