@@ -11,6 +11,8 @@ import xarray as xr
 
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._inputs import check, si_units
+from ecofmaps.measured.measure import loop_ratios
+from ecofmaps.measured.quality import regime_ratio
 from ecofmaps.model.profiles import ScarProfile
 from ecofmaps.model.simulation import fretting_loop
 
@@ -77,23 +79,15 @@ def _ratios(cycles: dict, rig_stiffness) -> dict:
     rig's stiffness is known (else NaN)."""
     if rig_stiffness is not None:
         check("rig_stiffness", rig_stiffness, "positive_or_inf", "N/m")
-    amplitude, force, energy = (cycles[n] for n in ("amplitude", "max_force", "dissipated_energy"))
-    contact = amplitude - force / (np.nan if rig_stiffness is None else rig_stiffness)
+    names = ("amplitude", "max_force", "dissipated_energy")
     slip = cycles.get("slip_amplitude", np.nan)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return {
-            "energy_ratio": energy / (4 * amplitude * force),
-            "opening_ratio": slip / amplitude,
-            "contact_amplitude": contact,
-            "contact_energy_ratio": energy / (4 * contact * force),
-            "contact_opening_ratio": slip / contact,
-        }
+    return loop_ratios(*(cycles[n] for n in names), slip, rig_stiffness)
 
 
 def _gross_slip(ratios: dict, rig_stiffness):
     """The energy ratio that decides the regime (the contact's when the rig is known), and
     where it says gross slip."""
-    ratio = ratios["energy_ratio" if rig_stiffness is None else "contact_energy_ratio"]
+    ratio = regime_ratio(ratios, rig_stiffness)
     return ratio, ratio > MINDLIN_ENERGY_RATIO
 
 

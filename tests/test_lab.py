@@ -54,8 +54,7 @@ def test_transition_on_the_applied_displacement_lands_high():
 
 @pytest.mark.parametrize("stiffness", RIGS)
 def test_transition_from_a_sweep(stiffness):
-    """The variable-displacement method: 0.45 to 1.8 Δ_t, each amplitude held two cycles.
-    analyze_loops reports only the sweep's larger cycles, which still cross Δ_t here."""
+    """The variable-displacement method: 0.45 to 1.8 Δ_t, each amplitude held two cycles."""
     at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
     results = _analysed(np.repeat(np.linspace(0.45, 1.8, 20) * at, 2), stiffness)
     found = ecofmaps.transition(results, rig_stiffness=stiffness)

@@ -124,6 +124,14 @@ def add(subparsers) -> None:
         "displacement: its loops run anticlockwise)",
     )
     parser.add_argument(
+        "--rig-stiffness",
+        type=quantity("stiffness"),
+        default=None,
+        metavar="S",
+        help="the rig's own stiffness, e.g. 35MN/m (the loops' stick slope is the rig and the "
+        "contact in series): the ratios also on the contact's displacement, the regime there",
+    )
+    parser.add_argument(
         "--nan-policy",
         choices=("skip", "raise"),
         default="skip",

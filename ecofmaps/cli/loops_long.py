@@ -378,7 +378,11 @@ def _analyse(index, path, recording, load, args, runner, partial, many, write, c
     if isinstance(load, str):  # the load recorded sample by sample (--load COLUMN)
         force, load = force_at_mean_load(force, recording.load)
         recorded = recording.load
-    options = LoopOptions(load, flip_force=getattr(args, "flip_force", False))
+    options = LoopOptions(
+        load,
+        flip_force=getattr(args, "flip_force", False),
+        rig_stiffness=getattr(args, "rig_stiffness", None),
+    )
     shown = recording.lazy and not args.quiet and sys.stderr.isatty()
     if shown:
         print(f"{path.name}: finding the cycles of {recording.size} samples", file=sys.stderr)

@@ -30,6 +30,10 @@ RESULT_QUANTITIES = (
     "ecof",
     "cof_max",
     "energy_ratio",
+    "opening_ratio",
+    "contact_amplitude",
+    "contact_energy_ratio",
+    "contact_opening_ratio",
     "stiffness",
     "gicof",
     "regime",
@@ -59,9 +63,10 @@ def results_table(results: xr.Dataset) -> pd.DataFrame:
     table : pandas.DataFrame
         The columns of :data:`RESULT_COLUMNS` that ``results`` holds: cycle, amplitude_um,
         slip_amplitude_um, normal_load_N (with a recorded load), max_force_N,
-        dissipated_energy_mJ, ecof, cof_max, energy_ratio, stiffness_MN_per_m, gicof,
-        regime, then (with ``resolve=True``) mu_resolved, mu_resolved_se, aspect_ratio,
-        and quality.
+        dissipated_energy_mJ, ecof, cof_max, energy_ratio, (with ``rig_stiffness``)
+        opening_ratio, contact_amplitude_um, contact_energy_ratio, contact_opening_ratio,
+        stiffness_MN_per_m, gicof, regime, then (with ``resolve=True``) mu_resolved,
+        mu_resolved_se, aspect_ratio, and quality.
     """
     columns = {}
     for name, column in zip(RESULT_QUANTITIES, RESULT_COLUMNS, strict=True):

@@ -41,7 +41,7 @@ def _series(name, values, size=None, dtype=np.float64):
     return array
 
 
-@si_units
+@si_units(rig_stiffness="stiffness")
 def analyze_loops(
     displacement,
     force,
@@ -52,6 +52,7 @@ def analyze_loops(
     stick_window=LoopOptions.stick_window,
     crossing_window=LoopOptions.crossing_window,
     gross_slip_threshold=LoopOptions.gross_slip_threshold,
+    rig_stiffness=None,
     flip_force=False,
     resolve=False,
     keep_loops=False,
@@ -91,7 +92,14 @@ def analyze_loops(
         Half-width of the window fitted at each GICoF crossing, in contact position, as a
         share of the slip amplitude (> 0). [1]
     gross_slip_threshold : float
-        Energy ratio :math:`A` above which a loop is gross slip (0 < threshold < 1). [1]
+        Energy ratio :math:`A` above which a loop is gross slip (0 < threshold < 1); on the
+        contact's displacement with ``rig_stiffness``. [1]
+    rig_stiffness : float, optional
+        The rig's own stiffness :math:`S`, when known (the loops' stick slope is the rig and
+        the contact in series). The loops' ratios are then also read on the contact's
+        displacement :math:`\Delta - Q/S` (``opening_ratio``, ``contact_amplitude``,
+        ``contact_energy_ratio``, ``contact_opening_ratio``), and the regime is decided
+        there, where Mindlin's :math:`A_t = 0.2` holds for a sphere on a flat. [N/m]
     flip_force : bool
         Read the force with the other sign: for a rig whose force is recorded positive
         against the displacement (its loops run anticlockwise, with stick sides sloping
@@ -189,8 +197,9 @@ def analyze_loops(
     """
     force, load, recorded = _at_mean_load(force, load)
     options = LoopOptions(
-        load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force
-    )
+        load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force,
+        rig_stiffness,
+    )  # fmt: skip
     reading = Reading(resolve=bool(resolve), keep_loops=bool(keep_loops))
     results, _ = _run(
         displacement,

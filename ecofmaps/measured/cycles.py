@@ -17,6 +17,8 @@ from ecofmaps.measured.samples import (
     ends_of_runs,
     first_of_runs,
     labelled_runs,
+    level_at,
+    local_extremes,
     missing_in,
     survey,
     trigger_runs,
@@ -28,6 +30,12 @@ __all__ = ["MIN_SAMPLES", "Cycles", "find_cycles", "labelled_cycles", "split_cyc
 #: The one definition for the analysis, the fit and the synthetic recordings.
 MIN_SAMPLES = 8
 
+
+#: The least local half-band of the reversal detector, as a share of the whole recording's.
+_LEAST_LEVEL = 0.05
+
+#: A stretch between bottom runs within this share of the period is one regular cycle.
+_REGULAR = 0.1
 
 #: A recording longer than this with fewer than two bottom reversals is not read as one loop.
 _ONE_LOOP = 1 << 24
@@ -167,6 +175,8 @@ def _parts_after_gaps(samples, gaps, line, band, runs):
     high = np.fmax.reduceat(highest, first_piece)
     low = np.fmin.reduceat(lowest, first_piece)
     centre, level = band
+    if isinstance(level, tuple):  # a local band: its level where each part begins
+        level = level_at(level, begin)
     own = kind[part_run[affected]]
     decided = np.where(
         own > 0,
@@ -314,25 +324,10 @@ def _drive_numbers(cycles: Cycles) -> Cycles:
     return dataclasses.replace(cycles, label=label)
 
 
-def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
-    """:func:`split_cycles` of any :class:`Samples`."""
-    n = samples.size
-    if n < 2:
-        raise ValueError("the displacement does not oscillate: no reversal can be found")
-    sums, gaps, sample_at, sampled, finite, _ = survey(samples)
-    count = int(sums[:, 0].sum())
-    line = displacement_line(sums, n)
-    low, high = displacement_percentiles(samples, gaps, line, sample_at, sampled, count)
-    half_range = 0.5 * (high - low)
-    if not half_range > 0.0:
-        raise ValueError("the displacement does not oscillate: no reversal can be found")
-    centre = 0.5 * (high + low)
-    stroke = 2.0 * half_range
-    found = samples.map(
-        trigger_runs,
-        ("displacement",),
-        (passes._CHUNK, gaps, line, (centre, hysteresis * half_range)),
-    )
+def _trigger(samples: Samples, gaps, line, band):
+    """The Schmitt trigger's runs over the recording: first sample, kind (+1 high, -1 low),
+    extreme (a sample) and its displacement."""
+    found = samples.map(trigger_runs, ("displacement",), (passes._CHUNK, gaps, line, band))
     # A run begins where the state (+1 above the band, -1 below it, 0 inside) differs from
     # the last one decided; samples before the first decision take that first one. The 99th
     # percentile lies above the band, so some state is decided.
@@ -357,13 +352,115 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
         first_of_runs(run, lowest, bottom, lowest_of_run),
     ).astype(np.int64)
     value = np.where(kind > 0, highest_of_run, lowest_of_run)
+    return starts, kind, extreme, value
+
+
+def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, half_range: float):
+    """The trigger's half-band against the local amplitude, or None where the whole
+    recording's, ``hysteresis`` times its ``half_range`` [m], finds every cycle.
+
+    When the drive is periodic (``runs``: the first trigger's starts and kinds, and the
+    period; half the stretches between bottom runs, and at least four, within
+    ``_REGULAR`` of the period) and a stretch between them, or before the first or after
+    the last, is longer than 1.5 periods, smaller cycles may lie inside the band. The band
+    is then ``hysteresis`` times the half-range of the displacement over the
+    stretch of a period (counted from sample 0) that holds the sample and the stretches
+    either side, so over at least a period each side; never more than ``level`` nor less
+    than ``_LEAST_LEVEL`` of the whole recording's. A recording of one amplitude keeps the
+    whole recording's band everywhere.
+    """
+    starts, kind, period = runs
+    bottoms = starts[kind < 0]
+    regular = np.abs(np.diff(bottoms) / period - 1.0) <= _REGULAR
+    if not (np.count_nonzero(regular) >= 4 and regular.mean() >= 0.5):
+        return None
+    if np.diff(bottoms, prepend=0, append=samples.size).max() <= 1.5 * period:
+        return None
+    width = max(int(period), MIN_SAMPLES)
+    pieces = np.concatenate(
+        samples.map(local_extremes, ("displacement",), (passes._CHUNK, gaps, line, width)),
+        axis=1,
+    )
+    stretch, highest, lowest = pieces
+    first = np.flatnonzero(np.diff(stretch, prepend=-1.0))
+    highest, lowest = np.fmax.reduceat(highest, first), np.fmin.reduceat(lowest, first)
+    around = [np.pad(v, 1, mode="edge") for v in (highest, lowest)]
+    top = np.fmax(np.fmax(around[0][:-2], around[0][1:-1]), around[0][2:])
+    bottom = np.fmin(np.fmin(around[1][:-2], around[1][1:-1]), around[1][2:])
+    level = hysteresis * half_range
+    local = hysteresis * (0.5 * (top - bottom))
+    local = np.clip(np.where(np.isnan(local), level, local), _LEAST_LEVEL * level, level)
+    if (local >= level).all():
+        return None
+    return width, local
+
+
+def _drive_cycles(bottoms, tops, n: int) -> Cycles:
+    """Cycles cut where the drive's cycles meet, for a recording whose amplitude varies.
+
+    A drive that changes its amplitude from one cycle to the next does so between a bottom
+    reversal and the next top (a sine's cycle runs from its upward crossing of the centre);
+    cut at a bottom reversal, the loop would begin a quarter period early, at the previous
+    amplitude. Each cycle runs from the sample half way between a bottom reversal and the
+    next top to the same point of the next pair, both included, and its loop begins at its
+    bottom reversal (``rotation``). A bottom without a top before the next bottom (beside a
+    gap) ends no cycle: the stretch is dropped and counted.
+    """
+    none = np.zeros(0, dtype=np.int64)
+    if not tops.size:
+        return Cycles(none, none, none, none, False, 1, n)
+    after = np.searchsorted(tops, bottoms)
+    has_top = after < tops.size
+    has_top[:-1] &= tops[np.minimum(after[:-1], tops.size - 1)] < bottoms[1:]
+    cut = np.where(has_top, (bottoms + tops[np.minimum(after, tops.size - 1)]) // 2, -1)
+    pair = (cut[:-1] >= 0) & (cut[1:] >= 0)  # two cuts, one bottom reversal between
+    start, stop, bottom = cut[:-1][pair], cut[1:][pair], bottoms[1:][pair]
+    if not start.size:
+        return Cycles(none, none, none, none, False, 1, n)
+    hole = start[1:] > stop[:-1]
+    leading, trailing = int(start[0]), int(n - 1 - stop[-1])
+    return Cycles(
+        start=start,
+        count=stop - start + 1,
+        rotation=bottom - start,
+        label=np.arange(1, start.size + 1, dtype=np.int64),
+        continuous=False,
+        incomplete_cycles=int(leading > 0) + int(trailing > 0) + int(np.count_nonzero(hole)),
+        dropped_samples=leading + trailing + int((start[1:] - stop[:-1] - 1)[hole].sum()),
+    )
+
+
+def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
+    """:func:`split_cycles` of any :class:`Samples`."""
+    n = samples.size
+    if n < 2:
+        raise ValueError("the displacement does not oscillate: no reversal can be found")
+    sums, gaps, sample_at, sampled, finite, _ = survey(samples)
+    count = int(sums[:, 0].sum())
+    line = displacement_line(sums, n)
+    low, high = displacement_percentiles(samples, gaps, line, sample_at, sampled, count)
+    half_range = 0.5 * (high - low)
+    if not half_range > 0.0:
+        raise ValueError("the displacement does not oscillate: no reversal can be found")
+    centre = 0.5 * (high + low)
+    stroke = 2.0 * half_range
+    band = (centre, hysteresis * half_range)
+    starts, kind, extreme, value = _trigger(samples, gaps, line, band)
+    period = _period(starts, kind)
+    level = _local_level(samples, gaps, line, (starts, kind, period), hysteresis, half_range)
+    if level is not None:  # kept if it finds smaller cycles (more bottom runs)
+        local = _trigger(samples, gaps, line, (centre, level))
+        if np.count_nonzero(local[1] < 0) > np.count_nonzero(kind < 0):
+            band = (centre, level)
+            starts, kind, extreme, value = local
+            period = _period(starts, kind)
+        else:
+            level = None
     # A gap shorter than half the samples beyond the band in a half period of a triangle
     # wave cannot have hidden a run of the other kind: the trigger goes on over it.
-    period = _period(starts, kind)
     long_gaps = gaps[gaps[:, 1] - gaps[:, 0] >= 0.25 * (1.0 - hysteresis) * period]
     run, begin_of_part, extreme_of_part, value_of_part = _parts_after_gaps(
-        samples, (gaps, long_gaps), line, (centre, hysteresis * half_range),
-        (starts, kind, extreme, value),
+        samples, (gaps, long_gaps), line, band, (starts, kind, extreme, value),
     )  # fmt: skip
     kind_of_part = kind[run]
     # Beside a long gap, as at the ends of the recording: an extreme within the tolerance of
@@ -387,6 +484,9 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
                 f"no complete cycle in {n} samples: fewer than two displacement reversals"
             )
         return _labelled(samples.constant_cycle(), tolerance)
+    if level is not None:  # the amplitude varies: cut where the drive's cycles meet
+        tops = extreme_of_part[(kind_of_part > 0) & accepted]
+        return _drive_numbers(_with_missing(_drive_cycles(bottoms, tops, n), gaps))
     # Each loop runs from its bottom reversal to the next and back to its first sample, so
     # it is closed even if the displacement drifted in between.
     start = bottoms[:-1]

@@ -20,6 +20,7 @@ from ecofmaps.measured.quality import (
     READING_REASONS,
     REASONS,
     UNEXPLAINED_SHARE,
+    gross_slip,
 )
 
 __all__ = [
@@ -31,6 +32,7 @@ __all__ = [
     "branch_rows",
     "line_crossings",
     "loop_blocks",
+    "loop_ratios",
     "measure_cycles",
     "stick_lines",
     "zero_force_crossings",
@@ -289,6 +291,49 @@ def _drift(low: int, high: int, points, values, near: slice):
 GROSS_SLIP_THRESHOLD = 0.2
 
 
+def loop_ratios(amplitude, max_force, energy, slip, rig_stiffness=None) -> dict:
+    r"""The energy and opening ratios of loops, on the applied displacement and on the
+    contact's.
+
+    Parameters
+    ----------
+    amplitude, max_force, energy, slip : numpy.ndarray
+        Each loop's displacement amplitude :math:`\Delta^*` [m], force amplitude
+        :math:`Q^*` [N], dissipated energy :math:`E_d` [J] and slip amplitude
+        :math:`\delta^*` [m].
+    rig_stiffness : float, optional
+        The rig's own stiffness :math:`S` (not the loops' stick slope, the rig and the
+        contact in series). [N/m]
+
+    Returns
+    -------
+    ratios : dict of str to numpy.ndarray
+        ``energy_ratio`` :math:`A = E_d/(4\Delta^*Q^*)` and ``opening_ratio``
+        :math:`B = \delta^*/\Delta^*`; ``contact_amplitude`` :math:`\Delta^* - Q^*/S` [m],
+        ``contact_energy_ratio`` and ``contact_opening_ratio``, the same ratios on the
+        contact's displacement (NaN without ``rig_stiffness``). [1]
+
+    References
+    ----------
+    S. Fouvry, P. Kapsa, L. Vincent (1995), Analysis of sliding behaviour for fretting
+    loadings: determination of transition criteria, Wear 185, 35-46.
+    """
+    contact = amplitude - max_force / (np.nan if rig_stiffness is None else rig_stiffness)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return {
+            "energy_ratio": energy / (4.0 * amplitude * max_force),
+            "opening_ratio": slip / amplitude,
+            "contact_amplitude": contact,
+            "contact_energy_ratio": energy / (4.0 * contact * max_force),
+            "contact_opening_ratio": slip / contact,
+        }
+
+
+#: The ratios reported when the rig's stiffness is given: B, and the contact's amplitude,
+#: A and B on the contact's displacement.
+_RIG_RATIOS = ("opening_ratio", "contact_amplitude", "contact_energy_ratio",
+               "contact_opening_ratio")  # fmt: skip
+
 #: The per-cycle quantities, in the Dataset's order.
 _PER_CYCLE = (
     "amplitude",
@@ -318,6 +363,11 @@ _MEASURED = tuple(
 )
 
 
+#: A gross-slip loop whose GICoF lies within this share of Q*/P is crossed by its stick line
+#: where it slides at a constant force: its GICoF is read even if its stick sides are curved.
+_PLATEAU = 0.02
+
+
 def _loop_values(block, options):
     """Every per-cycle quantity of a block of centred loops, and the checks it failed."""
     load = options.load
@@ -339,7 +389,8 @@ def _loop_values(block, options):
     at, force, on_loop = line_crossings(
         bx, by, length, both(compliance), both(half_width), load, both(max_force)
     )
-    energy_ratio = energy / (4.0 * amplitude * max_force)
+    ratios = loop_ratios(amplitude, max_force, energy, slip, options.rig_stiffness)
+    energy_ratio = ratios["energy_ratio"]
     values = {
         "amplitude": amplitude,
         "slip_amplitude": slip,
@@ -359,8 +410,12 @@ def _loop_values(block, options):
         "force_drift_se": block.force_drift_se,
         "stick_residual": fit["residual"],
     }
+    if options.rig_stiffness is not None:
+        values |= {name: ratios[name] for name in _RIG_RATIOS}
     rounding = 1e-9
     anticlockwise = energy_ratio < -ANTICLOCKWISE_SHARE
+    sliding = gross_slip(values, options)
+    on_plateau = sliding & (np.abs(values["gicof"] / values["cof_max"] - 1.0) <= _PLATEAU)
     flags = {
         "few-samples": block.count < MIN_SAMPLES,
         "constant-force": ~(block.force_swing > 0.0),
@@ -377,9 +432,10 @@ def _loop_values(block, options):
         "negative-area": (energy_ratio < 0.0) & ~anticlockwise,
         "negative-slip": ~(slip > 0.0),
         "no-zero-crossing": ~(zero_on_loop[:cycles] & zero_on_loop[cycles:]),
-        "curved-stick": fit["curved"],
+        "curved-stick": fit["curved"] & ~on_plateau,
+        "curved-stick-sliding": fit["curved"] & on_plateau,
         "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]),
-        "not-gross-slip": ~(energy_ratio > options.gross_slip_threshold),
+        "not-gross-slip": ~sliding,
     }
     return values, flags
 
@@ -403,7 +459,8 @@ def measure_cycles(cycles: Cycles, displacement, force, options, *, rows=None, k
     ``keep_loops``. ``displacement`` and ``force`` give stretches by sample index [m], [N];
     ``options`` is a :class:`~ecofmaps.measured.pipeline.LoopOptions`."""
     first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
-    values = {name: np.full(stop - first, np.nan) for name in _PER_CYCLE}
+    names = _PER_CYCLE if options.rig_stiffness is None else _PER_CYCLE + _RIG_RATIOS
+    values = {name: np.full(stop - first, np.nan) for name in names}
     flags = {reason: np.zeros(stop - first, dtype=bool) for reason in _MEASURED}
     if cycles.missing is not None:  # not measured: their values stay NaN
         flags["missing-samples"] = cycles.missing[first:stop].copy()

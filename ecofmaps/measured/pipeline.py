@@ -60,6 +60,7 @@ class LoopOptions:
     crossing_window: float = 0.7
     gross_slip_threshold: float = GROSS_SLIP_THRESHOLD
     flip_force: bool = False
+    rig_stiffness: float | None = None
 
     def __post_init__(self):
         check("load", self.load, "positive", "N")
@@ -83,6 +84,8 @@ class LoopOptions:
             )
         if not isinstance(self.flip_force, bool | np.bool_):
             raise ValueError(f"flip_force must be True or False; got {self.flip_force!r}")
+        if self.rig_stiffness is not None:
+            check("rig_stiffness", self.rig_stiffness, "positive_or_inf", "N/m")
         checked = {
             "load": float(self.load),
             "hysteresis": float(self.hysteresis),
@@ -90,6 +93,7 @@ class LoopOptions:
             "crossing_window": float(self.crossing_window),
             "gross_slip_threshold": float(self.gross_slip_threshold),
             "flip_force": bool(self.flip_force),
+            "rig_stiffness": None if self.rig_stiffness is None else float(self.rig_stiffness),
         }
         for name, value in checked.items():
             object.__setattr__(self, name, value)

@@ -30,11 +30,13 @@ __all__ = [
     "add_reason",
     "apply_quality",
     "cycle_results",
+    "gross_slip",
     "has_reason",
     "judged",
     "quality_strings",
     "quality_summary",
     "refused",
+    "regime_ratio",
     "summary_of_counts",
     "with_loops",
 ]
@@ -110,6 +112,18 @@ def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
     return results
 
 
+def regime_ratio(values: dict, rig_stiffness) -> np.ndarray:
+    """The energy ratio that decides each cycle's regime: on the contact's displacement
+    when the rig's stiffness is known, else on the applied one. [1]"""
+    return values["energy_ratio" if rig_stiffness is None else "contact_energy_ratio"]
+
+
+def gross_slip(values: dict, options) -> np.ndarray:
+    """True for the cycles in gross slip: :func:`regime_ratio` above the options'
+    ``gross_slip_threshold``."""
+    return regime_ratio(values, options.rig_stiffness) > options.gross_slip_threshold
+
+
 def scale_flags(values: dict, options) -> dict:
     """The checks of scale of each cycle (reason -> per cycle): an amplitude outside
     :data:`AMPLITUDE_RANGE`, or a coefficient of friction outside :data:`COF_RANGE` (the
@@ -117,7 +131,7 @@ def scale_flags(values: dict, options) -> dict:
     above 3 with any load). A gross-slip CoF of 361 or 0.001 says that the load or a unit is
     wrong, not the contact."""
     amplitude = values["amplitude"]
-    sliding = values["energy_ratio"] > options.gross_slip_threshold
+    sliding = gross_slip(values, options)
 
     def outside(value, bounds):
         return np.isfinite(value) & ((value < bounds[0]) | (value > bounds[1]))
@@ -135,7 +149,7 @@ def judged(values: dict, flags: dict, options):
     refused = _refusing(flags, size)
     recorded = {k: values[k] for k in ("normal_load",) if k in values}  # a refused cycle's too
     values = apply_quality({k: v for k, v in values.items() if k not in recorded}, flags)
-    sliding = values["energy_ratio"] > options.gross_slip_threshold
+    sliding = gross_slip(values, options)
     regime = np.where(refused, INVALID, np.where(sliding, GROSS_SLIP, NO_GROSS_SLIP))
     return values | recorded, quality_strings(flags, size), refused, regime
 
@@ -259,6 +273,8 @@ class Tally:
                 "motion": _motion(typical),
             }
         )
+        if options.rig_stiffness is not None:
+            results.attrs["rig_stiffness"] = options.rig_stiffness
         return results
 
     def counts_of(self, reason: str) -> int:
@@ -370,6 +386,11 @@ REASONS = {
     "curved-stick": (
         "the stick sides are curved (a polymer, micro-slip): no straight line gives S",
         ("stiffness", *_GICOF, *RESOLVED),
+    ),
+    "curved-stick-sliding": (
+        "the stick sides are curved (a sphere's Mindlin stick, micro-slip) but the loop slides "
+        "at Q* where the stick line crosses it: no straight line gives S, the GICoF is read",
+        ("stiffness", *RESOLVED),
     ),
     "no-crossing": (
         "a branch's crossing with Q = SΔ is not on the measured loop (between its samples, "

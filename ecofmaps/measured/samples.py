@@ -22,6 +22,8 @@ __all__ = [
     "first_of_runs",
     "is_lazy",
     "labelled_runs",
+    "level_at",
+    "local_extremes",
     "missing_in",
     "survey",
     "trigger_runs",
@@ -147,14 +149,39 @@ def _tails(start, stop, arguments, x):
     return np.concatenate(kept)
 
 
+def level_at(level, samples):
+    """The trigger's half-band at ``samples`` [m] when it is local: ``level = (width,
+    levels)``, one level per stretch of ``width`` samples counted from sample 0."""
+    width, levels = level
+    return levels[samples // width]
+
+
+def local_extremes(start, stop, arguments, x):
+    """The largest and smallest detrended displacement of each stretch of ``width``
+    samples (counted from sample 0) that the block's chunks cut: rows of the stretch's
+    number, its largest and its smallest (NaN where none is finite)."""
+    chunk, gaps, line, width = arguments
+    found = [np.empty((3, 0))]
+    for a, b in _chunks(start, stop, chunk):
+        d = _detrended(_blanked(x[a - start : b - start], a, b, gaps), a, line)
+        first = np.arange(a // width, (b - 1) // width + 1)
+        cuts = np.maximum(first * width, a) - a
+        found.append(
+            np.stack([first.astype(np.float64), np.fmax.reduceat(d, cuts),
+                      np.fmin.reduceat(d, cuts)])
+        )  # fmt: skip
+    return np.concatenate(found, axis=1)
+
+
 def trigger_runs(start, stop, arguments, x):
     """The Schmitt trigger's runs begun in the block, and the extremes of its pieces."""
-    chunk, gaps, line, (centre, level) = arguments
+    chunk, gaps, line, (centre, band) = arguments
     entries, kinds, pieces = [], [], []
     previous = 0
     for a, b in _chunks(start, stop, chunk):
         xa = _blanked(x[a - start : b - start], a, b, gaps)
         d = _detrended(xa, a, line)
+        level = level_at(band, np.arange(a, b)) if isinstance(band, tuple) else band
         state = (d > centre + level).view(np.int8) - (d < centre - level).view(np.int8)
         entry = np.concatenate([[0], np.flatnonzero(state[1:] != state[:-1]) + 1])
         kind = state[entry]

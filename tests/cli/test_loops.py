@@ -16,7 +16,14 @@ from ecofmaps.paper import LOAD
 from tests.cli.commands import run_loops as run
 from tests.recordings import write_csv
 
-COLUMNS = [c for c in RESULT_COLUMNS if c != "normal_load_N"]  # with a recorded load only
+CONTACT_COLUMNS = (
+    "opening_ratio",
+    "contact_amplitude_um",
+    "contact_energy_ratio",
+    "contact_opening_ratio",
+)
+# with a recorded load only, with the rig's stiffness only
+COLUMNS = [c for c in RESULT_COLUMNS if c != "normal_load_N" and c not in CONTACT_COLUMNS]
 RESOLVED_COLUMNS = ("mu_resolved", "mu_resolved_se", "aspect_ratio")
 
 
@@ -313,3 +320,31 @@ def test_the_summary_reads_the_gross_slip_cycles_only():
     assert (
         _summary(Path("rig.csv"), none, None) == "  rig.csv: 7 cycles: 7 ok (1 incomplete dropped)"
     )
+
+
+def test_rig_stiffness_reads_the_regime_on_the_contact(tmp_path, capsys):
+    """A sphere (the Mindlin oracle) 10 % beyond its transition behind a 35 MN/m rig: partial
+    slip on the applied displacement, gross slip on the contact's with --rig-stiffness, whose
+    ratios are then columns of the table; a stiffness that is not positive is one line."""
+    from tests import mindlin
+
+    stiffness = 35e6
+    at = mindlin.transition_amplitude(0.8, LOAD, 6e-6, stiffness)
+    applied = mindlin.sweep([1.1 * at] * 3, 200)
+    _, force = mindlin.drive(mindlin.Contact(0.8, LOAD, 6e-6), applied, stiffness)
+    path = write_csv(tmp_path / "sphere.csv", applied, force)
+    status, bare, _ = run(capsys, path, "--load", "450N", "--no-resolve")
+    assert status == 0
+    table = pd.read_csv(io.StringIO(bare))
+    assert table.regime.tolist() == ["no gross slip"] * 4
+    assert not set(CONTACT_COLUMNS) & set(table.columns)
+    status, out, _ = run(capsys, path, "--load", "450N", "--no-resolve", "--rig-stiffness",
+                         "35MN/m")  # fmt: skip
+    assert status == 0
+    table = pd.read_csv(io.StringIO(out))
+    assert table.regime.tolist() == ["gross slip"] * 4
+    contact = table.amplitude_um - table.max_force_N / stiffness * 1e6
+    np.testing.assert_allclose(table.contact_amplitude_um, contact, rtol=1e-5)
+    assert (table.contact_energy_ratio > 0.2).all()
+    status, _, err = run(capsys, path, "--load", "450N", "--rig-stiffness", "-1MN/m")
+    assert status != 0 and "rig_stiffness" in err.replace("-", "_") and "Traceback" not in err

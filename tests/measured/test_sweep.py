@@ -1,0 +1,120 @@
+"""An amplitude sweep of the Mindlin oracle (tests/mindlin.py) through analyze_loops: every
+cycle found and numbered as driven, the regime on the contact's displacement, and the
+GICoF of a sphere's gross-slip loops despite their curved stick."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+import ecofmaps
+from ecofmaps.measured import cycles as cycles_module
+from ecofmaps.measured import pipeline
+from ecofmaps.measured import samples as passes
+from tests import mindlin
+from tests.measured.test_out_of_core import analysed, assert_equal_results, lazily
+
+MU, LOAD, DELTA_T = 0.8, 450.0, 6e-6
+SAMPLES = 200  # per cycle
+
+
+@pytest.fixture(scope="module", params=[15e6, 35e6, 100e6])
+def sweep(request):
+    """A sweep from 0.45 to 1.8 Δ_t, each amplitude held two cycles, behind a rig S; the
+    amplitude of each complete cycle (the recording's first is a lead-in) and its results."""
+    stiffness = request.param
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    amplitudes = np.repeat(np.linspace(0.45, 1.8, 20) * at, 2)
+    applied = mindlin.sweep(amplitudes, SAMPLES)
+    _, force = mindlin.drive(mindlin.Contact(MU, LOAD, DELTA_T), applied, stiffness)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        results = ecofmaps.analyze_loops(applied, force, LOAD, rig_stiffness=stiffness)
+    # the recording's first and last cycles (a lead-in and a lead-out) are cut short
+    return stiffness, at, applied, amplitudes, results
+
+
+def test_every_cycle_of_a_sweep_is_reported_numbered_as_driven(sweep):
+    _, _, applied, driven, results = sweep
+    np.testing.assert_array_equal(results.cycle, np.arange(1, driven.size + 1))
+    assert results.attrs["incomplete_cycles"] == 2
+    found = cycles_module.split_cycles(applied)
+    stretches = [applied[s : s + c] for s, c in zip(found.start, found.count, strict=True)]
+    # each cycle holds the drive's cycle of its number, at one amplitude: both its
+    # reversals, and its ends where the drive's cycles meet (at the centre)
+    np.testing.assert_allclose([x.max() for x in stretches], driven, rtol=1e-3)
+    np.testing.assert_allclose([-x.min() for x in stretches], driven, rtol=1e-3)
+    np.testing.assert_allclose(results.amplitude, driven, rtol=1e-3)
+    ends = np.array([[x[0], x[-1]] for x in stretches])
+    assert np.abs(ends).max() < 0.02 * driven.max()
+
+
+def test_a_falling_sweep_reports_each_cycles_own_amplitude():
+    """Cut at a bottom reversal, the first cycle after a step down would begin at the old
+    amplitude and report the mean of the two."""
+    stiffness = 35e6
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    amplitudes = np.repeat(np.linspace(1.8, 0.45, 8) * at, 2)
+    applied = mindlin.sweep(amplitudes, SAMPLES)
+    _, force = mindlin.drive(mindlin.Contact(MU, LOAD, DELTA_T), applied, stiffness)
+    results = analysed(applied, force)
+    np.testing.assert_array_equal(results.cycle, np.arange(1, amplitudes.size + 1))
+    np.testing.assert_allclose(results.amplitude, amplitudes, rtol=1e-3)
+
+
+def test_the_regime_is_decided_on_the_contacts_displacement(sweep):
+    """At most 5 % of the cycles more than 5 % away from Δ_t in the wrong regime."""
+    _, at, _, driven, results = sweep
+    far = np.abs(driven / at - 1.0) > 0.05
+    gross = results.regime.values == int(ecofmaps.Regime.GROSS_SLIP)
+    wrong = gross[far] != (driven[far] > at)
+    assert np.count_nonzero(wrong) <= 0.05 * np.count_nonzero(far)
+    assert np.isfinite(results.contact_energy_ratio).all()
+    contact = results.amplitude - results.max_force / sweep[0]
+    np.testing.assert_allclose(results.contact_amplitude, contact)
+
+
+def test_a_spheres_gross_slip_cycles_keep_their_gicof(sweep):
+    """The GICoF read within 2 % of μ on at least 80 % of the gross-slip cycles."""
+    _, at, _, driven, results = sweep
+    gross = driven > 1.05 * at
+    read = np.abs(results.gicof.values[gross] / MU - 1.0) <= 0.02
+    assert np.count_nonzero(read) >= 0.8 * np.count_nonzero(gross)
+
+
+def test_without_the_rig_the_regime_is_read_on_the_applied_displacement():
+    """Without rig_stiffness the results carry no contact ratios and the regime is read on
+    the applied displacement, as before."""
+    stiffness = 35e6
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    applied = mindlin.sweep([1.1 * at] * 3, SAMPLES)
+    _, force = mindlin.drive(mindlin.Contact(MU, LOAD, DELTA_T), applied, stiffness)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        bare = ecofmaps.analyze_loops(applied, force, LOAD)
+        rig = ecofmaps.analyze_loops(applied, force, LOAD, rig_stiffness=stiffness)
+    assert "contact_energy_ratio" not in bare
+    assert (bare.regime == int(ecofmaps.Regime.NO_GROSS_SLIP)).all()
+    assert (rig.regime == int(ecofmaps.Regime.GROSS_SLIP)).all()
+    np.testing.assert_array_equal(bare.energy_ratio, rig.energy_ratio)
+
+
+def test_a_rig_stiffness_that_is_not_positive_is_refused():
+    x = np.sin(np.linspace(0, 6 * np.pi, 301)) * 20e-6
+    with pytest.raises(ValueError, match="rig_stiffness"):
+        ecofmaps.analyze_loops(x, 3e7 * x, LOAD, rig_stiffness=-1.0)
+
+
+def test_a_sweep_out_of_core_as_in_memory(monkeypatch):
+    """The local band's stretches cut across chunks and tasks: the same cycles and numbers."""
+    monkeypatch.setattr(passes, "_CHUNK", 1000)
+    monkeypatch.setattr(passes, "_SAMPLE", 256)
+    monkeypatch.setattr(pipeline, "TASK_SAMPLES", 777)
+    stiffness = 35e6
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    applied = mindlin.sweep(np.repeat(np.linspace(0.45, 1.8, 10) * at, 2), SAMPLES)
+    _, force = mindlin.drive(mindlin.Contact(MU, LOAD, DELTA_T), applied, stiffness)
+    memory = analysed(applied, force)
+    assert memory.cycle.size == 20
+    lazy = analysed(*lazily(applied, force, chunks=1700), scheduler="threads")
+    assert_equal_results(lazy, memory)
