@@ -17,7 +17,7 @@ __all__ = [
     "slip_branches",
 ]
 
-#: A given stiffness does not fit when it tilts both stick sets by this many σ.
+#: A given stiffness does not fit when it tilts the stick sets by this many σ.
 _TILT_SPREAD = 3.0
 
 #: Fewest samples in a stick set to measure the stiffness, the stick level and the noise.
@@ -128,23 +128,28 @@ def _branch_shift(xi, branches, slips, levels):
     return 0.5 * (gaps[0] - gaps[1])
 
 
-def _tilted_alike(xi, q, sticks, tolerance):
-    """True where both stick sets tilt in ξ beyond ``tolerance`` over their force span, alike.
+def _tilted_alike(xi, q, sticks, tolerance, floor):
+    """True where the stick sets tilt in ξ beyond ``tolerance`` over their force span, and
+    each of them beyond the rounding ``floor``, in the same sense.
 
-    A compliance off by δc tilts both by δc in ξ against Q; what is left of the centring's
-    drift correction, a ramp in time, tilts them in opposite senses (Q rises in time on one
-    side, falls on the other), or one of them only where the ramp changes at a cycle's middle.
+    A compliance off by δc tilts both sets by δc in ξ against Q; what is left of the
+    centring's drift correction, a ramp in time, tilts them in opposite senses (Q rises in
+    time on one side, falls on the other), or one of them only.
     """
-    rises = []
+    span = np.max(
+        [
+            np.max(np.where(s, q, -np.inf), axis=1) - np.min(np.where(s, q, np.inf), axis=1)
+            for s in sticks
+        ],
+        axis=0,
+    )
+    judged = np.all([np.count_nonzero(s, axis=1) >= _STICK_SAMPLES for s in sticks], axis=0)
+    tilt, _ = _compliance(xi, q, sticks)
+    alike = judged & ~(np.abs(tilt) * span <= tolerance)  # NaN: does not fit
     for stick in sticks:
-        tilt, _ = _compliance(xi, q, [stick])
-        span = np.max(np.where(stick, q, -np.inf), axis=1) - np.min(
-            np.where(stick, q, np.inf), axis=1
-        )
-        judged = np.count_nonzero(stick, axis=1) >= _STICK_SAMPLES
-        rises.append(np.where(judged, tilt * span, 0.0))
-    alike = np.sign(rises[0]) == np.sign(rises[1])
-    return alike & (np.minimum(np.abs(rises[0]), np.abs(rises[1])) > tolerance)
+        own, _ = _compliance(xi, q, [stick])
+        alike &= ~(np.sign(own) * np.sign(tilt) * np.abs(own) * span <= floor)
+    return alike
 
 
 def _sorted_branch(xi, q, slip):
@@ -197,7 +202,7 @@ def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_t
     sigma, slips, levels = _stick_and_slip(xi, branches, sticks, floor, slip_threshold)
     mismatch = negative
     if given:  # a stiffness that does not fit the stick sides tilts both alike in ξ
-        mismatch = mismatch | _tilted_alike(xi, q, sticks, _TILT_SPREAD * sigma + floor)
+        mismatch = mismatch | _tilted_alike(xi, q, sticks, _TILT_SPREAD * sigma + floor, floor)
     shift = _branch_shift(xi, branches, slips, levels)
     forward = _sorted_branch(xi, q, slips[0])
     backward = _sorted_branch(xi, q, slips[1])

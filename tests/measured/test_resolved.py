@@ -402,6 +402,23 @@ def test_wrong_stiffness_is_refused():
     assert (nearly.quality == "ok").all()
 
 
+@pytest.mark.parametrize("cycles", [3, 4, 6])
+@pytest.mark.parametrize("force_noise", [0.0, 0.5])
+def test_given_stiffness_of_a_continuous_recording(cycles, force_noise):
+    """Cycles cut from one recording (the centring's drift correction runs on them): the
+    exact stiffness fits, noise-free too, and one 20 % off either way does not."""
+    displacement, force = synthetic_recording(
+        **dict(EXAMPLE_2, aspect_ratio=0.2), groove_half_width=60e-6, cycles=cycles,
+        samples_per_cycle=400, force_noise=force_noise, seed=1,
+    )  # fmt: skip
+    result = resolve_loops(displacement, force, LOAD, STIFFNESS)
+    assert (result.quality == "ok").all(), result.quality.values
+    for factor in (0.8, 1.25):
+        assert_flagged(
+            resolve_loops(displacement, force, LOAD, factor * STIFFNESS), "stiffness-mismatch"
+        )
+
+
 def rounded_loop(cycles=4, samples=SAMPLES, rounding=15e-6):
     """A rounded loop, as polymers draw: exponential branches (Masing), no stick, no slip.
 
