@@ -408,7 +408,7 @@ def test_given_stiffness_of_a_continuous_recording(cycles, force_noise):
     """Cycles cut from one recording (the centring's drift correction runs on them): the
     exact stiffness fits, noise-free too, and one 20 % off either way does not."""
     displacement, force = synthetic_recording(
-        **dict(EXAMPLE_2, aspect_ratio=0.2), groove_half_width=60e-6, cycles=cycles,
+        **EXAMPLE_2, groove_half_width=60e-6, cycles=cycles,
         samples_per_cycle=400, force_noise=force_noise, seed=1,
     )  # fmt: skip
     result = resolve_loops(displacement, force, LOAD, STIFFNESS)
