@@ -1,8 +1,9 @@
 """Quantities with units, as the command line reads and prints them.
 
 The Python API speaks SI; people type ``50um``, ``35MN/m`` or ``450 N``. These helpers
-turn such text into SI floats with pint, and check the dimension, so ``--amplitude 35MN/m``
-is an error that says what was expected. A bare number is taken as SI.
+turn such text, a plain number and a plain unit (pint evaluates no arithmetic typed), into SI
+floats with pint, and check the dimension, so ``--amplitude 35MN/m`` is an error that says
+what was expected. A bare number is taken as SI. The explorer reads its inputs with them too.
 """
 
 from __future__ import annotations
@@ -10,11 +11,19 @@ from __future__ import annotations
 import functools
 import math
 import re
-from decimal import Decimal
+from decimal import Decimal, localcontext
 
 import numpy as np
 
-__all__ = ["DIMENSIONS", "PLAUSIBLE", "bare_number_warning", "parse_quantity", "parse_values"]
+__all__ = [
+    "DIMENSIONS",
+    "PLAIN_QUANTITY",
+    "PLAUSIBLE",
+    "TEXT_LIMIT",
+    "bare_number_warning",
+    "parse_quantity",
+    "parse_values",
+]
 
 #: Physical dimension of each kind of quantity, with its SI unit and an example.
 DIMENSIONS = {
@@ -81,8 +90,24 @@ def _within(low, high, value: float) -> bool:
     return (low is None or value >= low) and (high is None or value <= high)
 
 
-# A plain decimal number followed by a unit name, e.g. "25um", "3.3 MN/m", "1e-3 m".
-_NUMBER_AND_UNIT = re.compile(r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*([^\d\s(].*)")
+#: A number as typed: a decimal with an optional exponent, inf or nan.
+_NUMBER = r"[+-]?(?:(?i:inf|nan)|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)"
+#: A unit's name (um, MN, parsecs, %) with an optional power of one digit (mm**3, s^-1).
+_NAME = r"[A-Za-zµμ°%_]+(?:\s*(?:\*\*|\^)\s*[+-]?\d)?"
+#: Names joined by '*', '/' or a space (MN/m, parsecs per fortnight).
+_NAMES = rf"{_NAME}(?:(?:\s*[*/]\s*|\s+){_NAME})*"
+#: A unit: names, or names in parentheses, so joined, after an optional '/' (mm**3/(N*m), /um).
+_TERM = rf"(?:{_NAME}|\(\s*{_NAMES}\s*\))"
+_UNIT = rf"/?\s*{_TERM}(?:(?:\s*[*/]\s*|\s+){_TERM})*"
+
+#: The longest text a quantity may be (a unit's name is parsed in a time that grows faster
+#: than its length). [1]
+TEXT_LIMIT = 64
+
+#: What a quantity's text may be: a plain number and an optional plain unit ('25um',
+#: '3.3 MN/m', '0.08/um', 'inf'); no arithmetic for pint to evaluate ('9**9**9 N' would take
+#: forever, '10**400 N' overflows).
+PLAIN_QUANTITY = re.compile(rf"\s*(?P<number>{_NUMBER})\s*(?P<unit>{_UNIT})?\s*")
 
 
 @functools.cache
@@ -94,39 +119,69 @@ def _registry():
 
 
 def parse_quantity(text: str, kind: str) -> float:
-    """One quantity as an SI float."""
+    """One quantity as an SI float, from a plain number and an optional plain unit.
+
+    Parameters
+    ----------
+    text : str
+        A number (``'5e-5'``, ``'inf'``, ``'nan'``), taken as SI, or a number and a unit
+        (``'50um'``, ``'35 MN/m'``, ``'0.08/um'``): :data:`PLAIN_QUANTITY`.
+    kind : str
+        A key of :data:`DIMENSIONS`, the dimension the unit must have.
+
+    Returns
+    -------
+    value : float
+        [SI unit of ``kind``] The float nearest the typed decimal times its unit's factor
+        (``'25um'`` is ``25e-6``).
+
+    Raises
+    ------
+    ValueError
+        If ``text`` is longer than :data:`TEXT_LIMIT`, is not a plain number with a plain
+        unit (an expression such as ``'9**9**9 N'``), names no known unit, has a unit of
+        another dimension, or is finite but beyond the largest float in SI.
+
+    Examples
+    --------
+    >>> parse_quantity("35MN/m", "stiffness")
+    35000000.0
+    """
     dimension, si_unit, example = DIMENSIONS[kind]
-    text = text.strip()
-    try:
-        return float(text)
-    except ValueError:
-        pass
-    registry = _registry()
-    try:
-        quantity = registry.Quantity(text.replace("µ", "u").replace("μ", "u"))
-    except Exception:  # pint raises many kinds of error for bad text
+    if len(text) > TEXT_LIMIT:
         raise ValueError(
-            f"cannot read {text!r} as a {kind} (expected a number with a unit, e.g. {example})"
-        ) from None
-    if not isinstance(quantity, registry.Quantity):
-        return float(quantity)
-    if quantity.dimensionality != registry.Quantity(1, si_unit).dimensionality:
-        raise ValueError(
-            f"{text!r} is not a {kind}: its unit {quantity.units:~} has dimension "
-            f"{quantity.dimensionality}, expected {dimension or 'none'} (e.g. {example})"
+            f"cannot read {text[:TEXT_LIMIT]!r}... as a {kind}: more than {TEXT_LIMIT} "
+            f"characters; give a number with a plain unit, e.g. {example}"
         )
-    # Scale a typed decimal by its unit's factor in decimal arithmetic, so that '25um' is the
-    # float nearest 25e-6 (pint's float product gives 2.4999999999999998e-05). Expressions
-    # such as '(35MN/m)/(450N)' are left to pint's own arithmetic.
-    match = _NUMBER_AND_UNIT.fullmatch(text.replace("µ", "u").replace("μ", "u"))
-    try:
-        unit = registry.parse_units(match.group(2)) if match else None
-    except Exception:  # the rest is not a plain unit
-        unit = None
-    if unit is None or unit != quantity.units:
-        return float(quantity.to(si_unit).magnitude)
-    factor = registry.Quantity(1, unit).to(si_unit).magnitude
-    return float(Decimal(match.group(1)) * Decimal(repr(float(factor))))
+    match = PLAIN_QUANTITY.fullmatch(text)
+    if match is None:
+        raise ValueError(
+            f"cannot read {text!r} as a {kind}: give a number with a plain unit, e.g. {example}"
+        )
+    number = Decimal(match["number"])
+    if match["unit"] is None:
+        value = float(number)
+    else:
+        registry = _registry()
+        try:
+            unit = registry.Quantity("1 " + match["unit"].replace("µ", "u").replace("μ", "u"))
+        except Exception:  # pint raises many kinds of error for an unknown unit
+            raise ValueError(
+                f"cannot read {text!r} as a {kind}: unknown unit {match['unit']!r} (e.g. {example})"
+            ) from None
+        if unit.dimensionality != registry.Quantity(1, si_unit).dimensionality:
+            raise ValueError(
+                f"{text.strip()!r} is not a {kind}: its unit {unit.units:~} has dimension "
+                f"{unit.dimensionality}, expected {dimension or 'none'} (e.g. {example})"
+            )
+        # The typed decimal scaled by the unit's factor in decimal arithmetic, so that '25um'
+        # is the float nearest 25e-6 (pint's float product gives 2.4999999999999998e-05).
+        factor = Decimal(repr(float(unit.to(si_unit).magnitude)))
+        with localcontext(traps=[]):  # beyond Decimal's exponents: inf or 0, as a float
+            value = float(number * factor)
+    if math.isinf(value) and number.is_finite():
+        raise ValueError(f"{text.strip()!r} is beyond the largest number, 1.8e308 {si_unit}")
+    return value
 
 
 def parse_values(text: str, kind: str) -> np.ndarray:
@@ -142,6 +197,8 @@ def parse_values(text: str, kind: str) -> np.ndarray:
             num = -1
         if num < 2:
             raise ValueError(f"the number of points in {text!r} must be an integer >= 2")
+        if not (math.isfinite(start) and math.isfinite(stop)):
+            raise ValueError(f"the range {text!r} must start and stop at finite values")
         return np.linspace(start, stop, num)
     values = [parse_quantity(item, kind) for item in text.split(",") if item.strip()]
     if not values:

@@ -1,9 +1,12 @@
 """Quantities with units on the command line (ecofmaps.units)."""
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
-from ecofmaps.units import parse_quantity, parse_values
+from ecofmaps.units import TEXT_LIMIT, parse_quantity, parse_values
 
 
 @pytest.mark.parametrize(
@@ -22,6 +25,9 @@ from ecofmaps.units import parse_quantity, parse_values
         ("0.08/um", "stiffness_ratio", 8e4),
         ("48.9mJ", "energy", 0.0489),
         ("0.8", "dimensionless", 0.8),
+        ("1e4um**3/J", "wear_rate", 1e-14),
+        ("1e-6 mm**3/(N*m)", "archard", 1e-15),
+        ("1e-400 N", "force", 0.0),
     ],
 )
 def test_parse_quantity(text, kind, expected):
@@ -37,6 +43,10 @@ def test_parse_quantity(text, kind, expected):
         ("50 parsecs per fortnight", "length", "is not a length"),
         ("50 blorgs", "length", "cannot read"),
         ("3 m", "dimensionless", "is not a dimensionless"),
+        ("", "length", "cannot read '' as a length: give a number with a plain unit, e.g. 50um"),
+        ("1" * (TEXT_LIMIT + 1), "length", f"as a length: more than {TEXT_LIMIT} characters"),
+        ("1e400 N", "force", r"'1e400 N' is beyond the largest number, 1.8e308 N"),
+        ("1e999999999999 N", "force", "is beyond the largest number"),
     ],
 )
 def test_parse_quantity_rejects(text, kind, message):
@@ -55,8 +65,36 @@ def test_typed_decimals_are_the_nearest_float(text, kind, expected):
     assert parse_quantity(text, kind) == expected
 
 
-def test_unit_expressions():
-    assert parse_quantity("(35MN/m)/(450N)", "stiffness_ratio") == pytest.approx(35e6 / 450)
+@pytest.mark.parametrize(
+    ("text", "kind"),
+    [
+        ("9**9**9 N", "force"),  # pint would compute 9**387420489
+        ("10**400 N", "force"),  # pint would overflow
+        ("1 m**9**9**9", "volume"),
+        ("(35MN/m)/(450N)", "stiffness_ratio"),
+        ("2*25um", "length"),
+        ("50 um + 1 m", "length"),
+        ("5 (um", "length"),
+    ],
+)
+def test_expressions_are_refused(text, kind):
+    """Only a plain number with a plain unit: pint evaluates nothing typed."""
+    with pytest.raises(ValueError, match="give a number with a plain unit"):
+        parse_quantity(text, kind)
+
+
+@pytest.mark.parametrize("load", ["9**9**9 N", "10**400 N"])
+def test_an_expression_on_the_command_line_is_refused_at_once(load):
+    """One line naming the option, exit 2: no hang, no OverflowError traceback."""
+    done = subprocess.run(
+        [sys.executable, "-m", "ecofmaps.cli", "model", "--load", load],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 2 and done.stdout == ""
+    assert done.stderr.count("\n") == 1 and "Traceback" not in done.stderr
+    assert f"argument --load: cannot read {load!r} as a force: give a number" in done.stderr
 
 
 def test_parse_values_lists_and_ranges():
@@ -74,6 +112,7 @@ def test_parse_values_lists_and_ranges():
         ("0:1:x", "must be an integer >= 2"),
         (",", "no value"),
         ("nan", "holds a NaN"),
+        ("0:inf:3", "must start and stop at finite values"),
     ],
 )
 def test_parse_values_rejects(text, message):

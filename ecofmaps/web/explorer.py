@@ -35,12 +35,11 @@ from ecofmaps.maps.grid import compute_map
 from ecofmaps.model.simulation import fretting_loop
 from ecofmaps.model.steady_state import dissipated_energy, energy_cof, slip_amplitude
 from ecofmaps.paper import FIGURE_11_STIFFNESS_RATIOS
-from ecofmaps.units import DIMENSIONS, parse_quantity
+from ecofmaps.units import DIMENSIONS, TEXT_LIMIT, parse_quantity
 
 __all__ = [
     "INPUTS",
     "LOCAL_HOSTS",
-    "TEXT_LIMIT",
     "ExplorerPoint",
     "explorer_page",
     "parameter_value",
@@ -60,16 +59,10 @@ INPUTS = {
     "aspect_ratio_high": ("aspect_ratio", "Scar z_o/x_o to", "0.25", (0.0, 10.0)),
 }
 
-#: The longest text an input takes. [1]
-TEXT_LIMIT = 64
-
 #: The longest query value let through to Panel, whose reading of the query fails on an
-#: integer of more than 4300 digits; a longer one is cut to ``TEXT_LIMIT + 1``. [1]
+#: integer of more than 4300 digits; a longer one is cut to one character over
+#: :data:`ecofmaps.units.TEXT_LIMIT`. [1]
 _QUERY_LIMIT = 1000
-
-#: What an input's text may be: a number and a plain unit (no expression for pint to
-#: evaluate: '9**9**9' would take forever).
-_PLAIN = re.compile(r"\s*[+-]?(?:inf|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*[A-Za-zµμ/]*\s*")
 
 #: The hosts whose pages the explorer answers (with its port); others get 403.
 LOCAL_HOSTS = ("127.0.0.1", "localhost", "[::1]")
@@ -109,9 +102,9 @@ def parameter_value(key: str, text: str) -> float:
     Raises
     ------
     ValueError
-        Naming the input, if the text is longer than :data:`TEXT_LIMIT`, is not a number
-        with a plain unit, is not a quantity of its kind, or is out of its range or beyond
-        the physical bounds of :data:`INPUTS`.
+        Naming the input, if :func:`ecofmaps.units.parse_quantity` cannot read the text
+        (too long, not a plain number with a plain unit, not a quantity of its kind), or the
+        value is out of its range or beyond the physical bounds of :data:`INPUTS`.
 
     Examples
     --------
@@ -120,13 +113,9 @@ def parameter_value(key: str, text: str) -> float:
     >>> parameter_value("amplitude", "5e-5")
     5e-05
     """
-    name, label, default, (low, high) = INPUTS[key]
+    name, label, _, (low, high) = INPUTS[key]
     quantity = QUANTITIES[name]
     text = str(text)
-    if len(text) > TEXT_LIMIT:
-        raise ValueError(f"{label}: more than {TEXT_LIMIT} characters; type e.g. {default}")
-    if not _PLAIN.fullmatch(text):
-        raise ValueError(f"{label}: {text!r} is not a number with a unit, e.g. {default}")
     try:
         value = parse_quantity(text, quantity.kind)
     except ValueError as error:
@@ -466,7 +455,8 @@ class _LongQuery(Matcher):
 
 class _CutQuery(RequestHandler):
     """See Other: the same page with each overlong query value cut to one character over
-    :data:`TEXT_LIMIT`, so Panel never parses a huge number and the page names the input."""
+    :data:`ecofmaps.units.TEXT_LIMIT`, so Panel never parses a huge number and the page
+    names the input."""
 
     def prepare(self):
         pairs = urllib.parse.parse_qsl(self.request.query, keep_blank_values=True)

@@ -16,8 +16,9 @@ import pytest
 
 import ecofmaps
 from ecofmaps.cli import explore
+from ecofmaps.units import TEXT_LIMIT
 from ecofmaps.web import explorer
-from ecofmaps.web.explorer import TEXT_LIMIT, explorer_page, map_window, parameter_value
+from ecofmaps.web.explorer import explorer_page, map_window, parameter_value
 from tests.cli.commands import run
 from tests.web.pages import CANVAS_INK, console_errors, deep_texts, wait_for
 
@@ -50,10 +51,16 @@ def test_inputs_are_read_with_units_or_in_si():
 HOSTILE = [
     ("aspect_ratio", "1e308", "Groove aspect ratio z_o/x_o: '1e308' is beyond the explorer's"),
     ("stiffness", "1.7e308", "Rig stiffness S: '1.7e308' is beyond the explorer's bounds"),
-    ("stiffness", "1e308MN/m", "Rig stiffness S: '1e308MN/m' is beyond the explorer's bounds"),
-    ("amplitude", "1" * 5000, f"Displacement amplitude Δ*: more than {TEXT_LIMIT} characters"),
-    ("load", "9**9**9 N", "Normal load P: '9**9**9 N' is not a number with a unit"),
-    ("mu", "nan", "Contact CoF μ: 'nan' is not a number with a unit"),
+    ("stiffness", "1e308MN/m", "Rig stiffness S: '1e308MN/m' is beyond the largest number"),
+    (
+        "amplitude",
+        "1" * 5000,
+        f"Displacement amplitude Δ*: cannot read '{'1' * TEXT_LIMIT}'... as a length: more than "
+        f"{TEXT_LIMIT} characters",
+    ),
+    ("load", "9**9**9 N", "Normal load P: cannot read '9**9**9 N' as a force: give a number"),
+    ("load", "10**400 N", "Normal load P: cannot read '10**400 N' as a force: give a number"),
+    ("mu", "nan", "Contact CoF μ: 'nan' is out of range: 0 < μ < inf"),
 ]
 
 
@@ -280,6 +287,8 @@ def test_the_page_follows_its_inputs():
     assert f"data-quantity='ecof_ratio'>{rigid:.3f}<" in shown()
     inputs["Normal load P"].value = "-3N"
     assert "Normal load P: &#x27;-3N&#x27; is out of range" in shown()
+    inputs["Normal load P"].value = "9**9**9 N"  # refused at once: pint evaluates nothing
+    assert "Normal load P: cannot read &#x27;9**9**9 N&#x27; as a force" in shown()
     inputs["Normal load P"].value = "1N"
     inputs["Rig stiffness S"].value = "1.7e308"
     assert "Rig stiffness S: &#x27;1.7e308&#x27; is beyond the explorer&#x27;s bounds" in shown()
