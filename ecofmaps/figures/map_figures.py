@@ -15,8 +15,6 @@ from collections.abc import Mapping
 import jax
 import numpy as np
 import xarray as xr
-from matplotlib import colormaps
-from matplotlib.colors import BoundaryNorm
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
@@ -28,6 +26,7 @@ from ecofmaps.figures.style import (
     MICRO,
     PER_MM,
     axis_label,
+    ecof_ratio_colors,
     parameters,
     scalar,
     stiffness_label,
@@ -48,10 +47,7 @@ def _ecof_ratio_contours(ax, x, ratio: xr.DataArray, regime: xr.DataArray) -> li
     levels = [level for level in ECOF_RATIO_LEVELS if level <= top]
     above = [level for level in ECOF_RATIO_LEVELS if level > top]
     fill_levels = [1.0, *levels, above[0] if above else top]
-    # One colour per band of ECOF_RATIO_LEVELS, whatever the figure's range, so the same
-    # μ_E/μ has the same colour in Figures 11a, 11b and the universal map.
-    cmap = colormaps["YlOrRd"]
-    norm = BoundaryNorm([1.0, *ECOF_RATIO_LEVELS], cmap.N, clip=True)
+    cmap, norm = ecof_ratio_colors()
     filled = ax.contourf(x, y, values, levels=fill_levels, cmap=cmap, norm=norm, alpha=0.85)
     widths = [2.4 if level == HIGHLIGHT_LEVEL else 0.9 for level in levels]
     lines = ax.contour(x, y, values, levels=levels, colors="black", linewidths=widths)

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 from matplotlib import colormaps
+from matplotlib.colors import BoundaryNorm
 from matplotlib.figure import Figure
 
 from ecofmaps._nomenclature import QUANTITIES, axis_label
@@ -31,6 +32,15 @@ ECOF_RATIO_LEVELS = (1.01, 1.02, 1.03, 1.04, 1.05, 1.06, 1.08, 1.10, 1.12, 1.14,
 
 #: The level drawn heavier: the paper's "most tests are within 5 %".
 HIGHLIGHT_LEVEL = 1.05
+
+
+def ecof_ratio_colors() -> tuple:
+    """The colour map of μ_E/μ and its norm: one colour per band between 1 and the
+    :data:`ECOF_RATIO_LEVELS`, whatever a map's range, so the same μ_E/μ has the same colour in
+    Figures 11a and 11b, the universal map and the explorer's map."""
+    cmap = colormaps["YlOrRd"]
+    return cmap, BoundaryNorm([1.0, *ECOF_RATIO_LEVELS], cmap.N, clip=True)
+
 
 #: Size of a one-panel figure. [inch]
 FIGSIZE = (6.4, 4.6)

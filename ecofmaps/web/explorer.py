@@ -2,8 +2,9 @@
 
 One page per session: the test's parameters typed with units (``50um``, ``35MN/m``), and at
 that point the slip amplitude, the energy and :math:`\\mu_E/\\mu`, the steady loop, the map
-of :math:`\\mu_E/\\mu` with the point marked, and the contact CoF behind a typed ECoF. The
-inputs live in the page's URL query, so a view is shared as a link.
+of :math:`\\mu_E/\\mu` (Figure 11's labelled contours, no gross slip hatched) with the point
+marked, and the contact CoF behind a typed ECoF. The inputs live in the page's URL query, so
+a view is shared as a link.
 """
 
 from __future__ import annotations
@@ -21,9 +22,10 @@ import webbrowser
 
 import numpy as np
 import panel as pn
-from bokeh.models import ColorBar, ColumnDataSource, HoverTool, LinearColorMapper
-from bokeh.palettes import Viridis256
+from bokeh.models import ColumnDataSource, HoverTool, Legend, LegendItem, Range1d
 from bokeh.plotting import figure
+from bokeh.plotting.contour import contour_data
+from matplotlib.colors import to_hex
 from panel.io.server import get_server
 from tornado.routing import Matcher, Rule
 from tornado.web import RequestHandler
@@ -31,7 +33,9 @@ from tornado.web import RequestHandler
 from ecofmaps._interrupts import check_interrupted
 from ecofmaps._nomenclature import QUANTITIES, RANGES, within
 from ecofmaps.correction.inversion import correct_ecof
+from ecofmaps.figures.style import ECOF_RATIO_LEVELS, HIGHLIGHT_LEVEL, ecof_ratio_colors
 from ecofmaps.maps.grid import compute_map
+from ecofmaps.model import NO_GROSS_SLIP
 from ecofmaps.model.simulation import fretting_loop
 from ecofmaps.model.steady_state import dissipated_energy, energy_cof, slip_amplitude
 from ecofmaps.paper import FIGURE_11_STIFFNESS_RATIOS
@@ -188,8 +192,9 @@ def map_window(stiffness_ratio: float, aspect_ratio: float) -> tuple[float, floa
 
 
 @functools.lru_cache(maxsize=_MAPS_KEPT)
-def _ecof_ratio_map(amplitude: float, mu: float, window: tuple) -> np.ndarray:
-    """μ_E/μ over (z_o/x_o, S/P) in the window, by :func:`ecofmaps.compute_map`."""
+def _ecof_ratio_map(amplitude: float, mu: float, window: tuple) -> tuple:
+    """μ_E/μ over (z_o/x_o, S/P) in the window, by :func:`ecofmaps.compute_map`, and where
+    there is no gross slip (1.0, else 0.0)."""
     low, high, deepest = window
     dataset = compute_map(
         np.linspace(low, high, _MAP_POINTS[0]),
@@ -198,7 +203,11 @@ def _ecof_ratio_map(amplitude: float, mu: float, window: tuple) -> np.ndarray:
         mu=mu,
         cache=False,
     )
-    return np.ascontiguousarray(dataset["ecof_ratio"].values.T)
+    stuck = (dataset["regime"] == NO_GROSS_SLIP).astype(np.float64)
+    return (
+        np.ascontiguousarray(dataset["ecof_ratio"].values.T),
+        np.ascontiguousarray(stuck.values.T),
+    )
 
 
 def _number(value: float, factor: float = 1.0, form: str = ".3f") -> str:
@@ -260,21 +269,101 @@ def _loop_figure():
     return plot, source
 
 
+def _band_colors(levels) -> list:
+    """The colour of each band between ``levels``, as Figure 11 fills it."""
+    cmap, norm = ecof_ratio_colors()
+    middles = (np.asarray(levels[:-1]) + np.asarray(levels[1:])) / 2
+    return [to_hex(cmap(norm(middle))) for middle in middles]
+
+
+def _fill_levels(top: float) -> list:
+    """The bands' bounds: 1, the levels of Figure 11, and the map's highest μ_E/μ above."""
+    return [1.0, *ECOF_RATIO_LEVELS, max(top, ECOF_RATIO_LEVELS[-1]) + 0.01]
+
+
+def _contour_labels(line_data, scale: tuple) -> dict:
+    """A label for each contour line drawn: its level, at the middle of its longest piece,
+    turned along it; ``scale`` is the plot's pixels per unit of x and of y."""
+    labels = {"x": [], "y": [], "text": [], "angle": []}
+    for level, xs, ys in zip(line_data.levels, line_data.xs, line_data.ys, strict=True):
+        pieces = np.split(np.arange(len(xs)), np.flatnonzero(np.isnan(xs)))
+        piece = max((piece[np.isfinite(xs[piece])] for piece in pieces), key=len)
+        if piece.size < 3:
+            continue
+        before, middle, after = piece[len(piece) // 2 - 1 : len(piece) // 2 + 2]
+        angle = math.atan2((ys[after] - ys[before]) * scale[1], (xs[after] - xs[before]) * scale[0])
+        labels["x"].append(float(xs[middle]))
+        labels["y"].append(float(ys[middle]))
+        labels["text"].append(f"{level:.2f}")
+        labels["angle"].append((angle + math.pi / 2) % math.pi - math.pi / 2)  # upright text
+    return labels
+
+
+#: How the no-gross-slip area is drawn: hatched over a light grey (Bokeh draws no hatch
+#: over a fill of alpha 0).
+_HATCH = {
+    "fill_color": "#d9d9d9",
+    "fill_alpha": 0.5,
+    "hatch_pattern": "/",
+    "hatch_color": "#4d4d4d",
+    "hatch_scale": 10,
+}
+
+#: The map plot's size and the part of it the axes take, roughly. [px]
+_MAP_SIZE = (600, 470)
+_MAP_FRAME = (440, 290)
+
+
 def _map_figure():
-    """The μ_E/μ map's figure, its image source and the source of the point's marker."""
-    image = ColumnDataSource({"image": [], "x": [], "y": [], "dw": [], "dh": []})
-    marker = ColumnDataSource({"x": [], "y": []})
+    """The μ_E/μ map's figure and what an update changes in it, by name: the filled bands,
+    the labelled lines, the hatched no-gross-slip area, the hover's image and the marker."""
     plot = figure(
-        width=560,
-        height=380,
+        width=_MAP_SIZE[0],
+        height=_MAP_SIZE[1],
         title="μ_E/μ over rig stiffness and groove shape (x_o = Δ*)",
         x_axis_label="Stiffness over load S/P [(MN/m)/kN = 1/mm]",
         y_axis_label="Groove aspect ratio z_o/x_o [1]",
         tools="pan,box_zoom,wheel_zoom,reset,save",
+        x_range=Range1d(0.0, 1.0),
+        y_range=Range1d(0.0, 1.0),
     )
-    colors = LinearColorMapper(palette=Viridis256, low=1.0, high=1.2, nan_color=(0, 0, 0, 0))
-    plot.image("image", x="x", y="y", dw="dw", dh="dh", source=image, color_mapper=colors)
-    plot.scatter(
+    empty = np.full((2, 2), np.nan)
+    levels = _fill_levels(ECOF_RATIO_LEVELS[-1])
+    bands = plot.contour([0, 1], [0, 1], empty, levels, fill_color=_band_colors(levels))
+    widths = [3.0 if level == HIGHLIGHT_LEVEL else 1.0 for level in ECOF_RATIO_LEVELS]
+    lines = plot.contour(
+        [0, 1], [0, 1], empty, ECOF_RATIO_LEVELS, line_color="black", line_width=widths
+    )
+    labels = ColumnDataSource({"x": [], "y": [], "text": [], "angle": []})
+    plot.text(
+        "x",
+        "y",
+        text="text",
+        angle="angle",
+        source=labels,
+        name="labels",
+        text_font_size="11px",
+        text_align="center",
+        text_baseline="middle",
+        background_fill_color="white",
+        background_fill_alpha=0.85,
+        padding=1,
+    )
+    stuck = plot.contour(
+        [0, 1],
+        [0, 1],
+        empty,
+        [0.5, 1.5],
+        line_color="#4d4d4d",
+        line_width=1.0,
+        **_HATCH,
+    )
+    image = ColumnDataSource({"image": [], "x": [], "y": [], "dw": [], "dh": []})
+    hover = plot.image(
+        "image", x="x", y="y", dw="dw", dh="dh", source=image, palette=["#000000"], global_alpha=0
+    )
+    marker = ColumnDataSource({"x": [], "y": []})
+    point = plot.scatter(
         "x",
         "y",
         source=marker,
@@ -284,36 +373,78 @@ def _map_figure():
         line_color="black",
         line_width=2,
     )
-    plot.add_layout(ColorBar(color_mapper=colors, width=12), "right")
+    for renderer, name in ((bands, "bands"), (lines, "lines"), (stuck, "no_gross_slip")):
+        renderer.name = name  # found by name by the page's tests
+    colorbar = bands.construct_color_bar(width=12, title="μ_E/μ [1]")
+    plot.add_layout(colorbar, "right")
+    # What the legend shows, by glyphs at no point of the map (a contour's parts have no legend).
+    nowhere = [math.nan]
+    heavy = plot.line(nowhere, nowhere, line_color="black", line_width=3.0)
+    hatched = plot.quad(nowhere, nowhere, nowhere, nowhere, line_color="#4d4d4d", **_HATCH)
+    legend = Legend(
+        items=[
+            LegendItem(label=f"μ_E/μ = {HIGHLIGHT_LEVEL:.2f} (5 % above μ)", renderers=[heavy]),
+            LegendItem(label="no gross slip (μP/S ≥ Δ*): μ_E undefined", renderers=[hatched]),
+            LegendItem(label="this test", renderers=[point]),
+        ],
+        orientation="horizontal",
+        label_text_font_size="11px",
+        spacing=12,
+        margin=4,
+    )
+    plot.add_layout(legend, "below")
     plot.add_tools(
         HoverTool(
             tooltips=[
-                ("S/P [1/mm]", "$x{0.0}"),
+                ("S/P", "$x{0.0} 1/mm"),
                 ("z_o/x_o", "$y{0.000}"),
                 ("μ_E/μ", "@image{0.000}"),
             ],
-            renderers=plot.renderers[:1],
+            renderers=[hover],
         )
     )
-    return plot, image, marker, colors
+    return plot, {
+        "x_range": plot.x_range,
+        "y_range": plot.y_range,
+        "bands": bands,
+        "colorbar": colorbar,
+        "lines": lines,
+        "labels": labels,
+        "stuck": stuck,
+        "image": image,
+        "marker": marker,
+    }
 
 
-def _show_map(values: dict, image, marker, colors) -> None:
+def _show_map(values: dict, parts: dict) -> None:
     """Draw the map for the point's amplitude and μ, with the point marked."""
     ratio = values["stiffness"] / values["load"]
     window = map_window(ratio, values["aspect_ratio"])
-    grid = _ecof_ratio_map(values["amplitude"], values["mu"], window)
+    grid, stuck = _ecof_ratio_map(values["amplitude"], values["mu"], window)
+    x = np.linspace(window[0], window[1], _MAP_POINTS[0]) * 1e-3  # 1/mm
+    y = np.linspace(0.0, window[2], _MAP_POINTS[1])
+    for axis, (start, end) in (("x_range", (x[0], x[-1])), ("y_range", (y[0], y[-1]))):
+        parts[axis].update(start=start, end=end, reset_start=start, reset_end=end)
     finite = grid[np.isfinite(grid)]
-    colors.high = float(max(finite.max(), 1.001)) if finite.size else 1.2
-    image.data = {
+    levels = _fill_levels(float(finite.max()) if finite.size else 1.0)
+    parts["bands"].set_data(contour_data(x, y, grid, levels, want_line=False))
+    parts["bands"].levels = levels
+    parts["colorbar"].levels = levels
+    parts["colorbar"].ticker.ticks = levels[:-1]
+    drawn = contour_data(x, y, grid, ECOF_RATIO_LEVELS, want_fill=False)
+    parts["lines"].set_data(drawn)
+    scale = (_MAP_FRAME[0] / (x[-1] - x[0]), _MAP_FRAME[1] / (y[-1] - y[0]))
+    parts["labels"].data = _contour_labels(drawn.line_data, scale)
+    parts["stuck"].set_data(contour_data(x, y, stuck, [0.5, 1.5]))
+    parts["image"].data = {
         "image": [grid],
-        "x": [window[0] * 1e-3],
+        "x": [x[0]],
         "y": [0.0],
-        "dw": [(window[1] - window[0]) * 1e-3],
-        "dh": [window[2]],
+        "dw": [x[-1] - x[0]],
+        "dh": [y[-1]],
     }
     shown = math.isfinite(ratio)
-    marker.data = {
+    parts["marker"].data = {
         "x": [ratio * 1e-3] if shown else [],
         "y": [values["aspect_ratio"]] if shown else [],
     }
@@ -341,13 +472,13 @@ def explorer_page():
     correction_pane = pn.pane.HTML("", width=760, margin=(18, 10))
     message = pn.pane.HTML("", width=520, styles={"color": "#b00020"})
     loop_plot, loop_source = _loop_figure()
-    map_plot, image, marker, colors = _map_figure()
+    map_plot, map_parts = _map_figure()
 
     def show(values):
         point = ExplorerPoint.at(*(values[key] for key in _MODEL_INPUTS))
         values_pane.object = _values_html(point, values)
         loop_source.data = {"x": point.loop[0] * 1e6, "y": point.loop[1]}
-        _show_map(values, image, marker, colors)
+        _show_map(values, map_parts)
         correction_pane.object = _correction_html(values)
 
     def update(*_events):

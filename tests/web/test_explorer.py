@@ -16,6 +16,7 @@ import pytest
 
 import ecofmaps
 from ecofmaps.cli import explore
+from ecofmaps.figures.style import ECOF_RATIO_LEVELS
 from ecofmaps.units import TEXT_LIMIT
 from ecofmaps.web import explorer
 from ecofmaps.web.explorer import explorer_page, map_window, parameter_value
@@ -292,6 +293,36 @@ def test_the_page_follows_its_inputs():
     inputs["Normal load P"].value = "1N"
     inputs["Rig stiffness S"].value = "1.7e308"
     assert "Rig stiffness S: &#x27;1.7e308&#x27; is beyond the explorer&#x27;s bounds" in shown()
+
+
+def map_of(page):
+    """The page's map: its figure, by the names of its renderers."""
+    plot = page.select(pn.pane.Bokeh)[1].object
+    return plot, {name: plot.select_one({"name": name}) for name in
+                  ("bands", "lines", "labels", "no_gross_slip")}  # fmt: skip
+
+
+def test_the_map_is_labelled_contours_with_no_gross_slip_hatched():
+    """Figure 11's levels, each line drawn labelled; the no-gross-slip area hatched and said."""
+    page = explorer_page()
+    plot, parts = map_of(page)
+    labels = parts["labels"].data_source.data
+    assert labels["text"] == [f"{level:.2f}" for level in ECOF_RATIO_LEVELS if level <= 1.20]
+    assert list(parts["lines"].levels) == list(ECOF_RATIO_LEVELS)
+    stuck = parts["no_gross_slip"]
+    assert stuck.fill_renderer.data_source.data["xs"] == [[]]  # Example 2: gross slip all over
+    assert stuck.fill_renderer.glyph.hatch_pattern == "/"
+    legend = [item.label.value for item in plot.legend[0].items]
+    assert "no gross slip (μP/S ≥ Δ*): μ_E undefined" in legend
+    # Figure 11a: below S/P = μ/Δ* = 32 /mm the rig's deflection takes the whole stroke.
+    inputs = {widget.label: widget for widget in page.select(pn.widgets.TextInput)}
+    inputs["Displacement amplitude Δ*"].value = "25um"
+    (hatched,) = stuck.fill_renderer.data_source.data["xs"]  # the polygons of the one band
+    assert len(hatched) == 1
+    x = hatched[0][0]  # its outer boundary
+    assert x.min() == 20.0 and 32.0 <= x.max() <= 34.0  # S/P [1/mm], one grid step past 32
+    labels = parts["labels"].data_source.data
+    assert all(x > 32.0 for x in labels["x"])  # the lines' labels lie where μ_E is defined
 
 
 def test_a_failure_while_updating_is_a_message_on_the_page(monkeypatch):
