@@ -210,27 +210,47 @@ def _ecof_ratio_map(amplitude: float, mu: float, window: tuple) -> tuple:
     )
 
 
-def _number(value: float, factor: float = 1.0, form: str = ".3f") -> str:
-    """``value * factor`` formatted, or 'undefined' where it is NaN."""
-    return format(value * factor, form) if math.isfinite(value) else "undefined"
+def _number(value: float, factor: float = 1.0) -> str:
+    """``value * factor`` with 3 decimals (6 significant digits from 100000 up), or
+    'undefined' where it is NaN."""
+    if math.isnan(value):
+        return "undefined"
+    shown = value * factor
+    return format(shown, ".3f" if abs(shown) < 1e5 else ".6g")
+
+
+def _inputs_html(values: dict) -> str:
+    """The model's inputs as the page read them, each with its unit (a bare number is SI)."""
+    read = []
+    for key in _MODEL_INPUTS:
+        quantity = QUANTITIES[INPUTS[key][0]]
+        value = values[key] * quantity.display_factor
+        text = "inf (a rigid rig)" if math.isinf(value) else f"{value:g} {quantity.display_unit}"
+        read.append(f"{quantity.symbol} = {text.strip()}")
+    return f"<p style='margin:0 0 6px 0;color:#555'>Read as {', '.join(read)}.</p>"
 
 
 def _values_html(point: ExplorerPoint, values: dict) -> str:
-    """The model's numbers at the point, each in a span the page and its tests can find."""
+    """The inputs as read, and the model's numbers at the point, each with its unit in a span
+    the page and its tests can find."""
     gross = math.isfinite(point.ecof_ratio)
     rows = [
-        ("slip_amplitude", "Slip amplitude δ*", _number(point.slip_amplitude, 1e6), "µm"),
-        ("dissipated_energy", "Dissipated energy E_d", _number(point.dissipated_energy, 1e3), "mJ"),
-        ("ecof_ratio", "μ_E/μ", _number(point.ecof_ratio), ""),
-        ("ecof", "μ_E", _number(point.ecof_ratio * values["mu"]), ""),
+        ("slip_amplitude", "Slip amplitude δ*", point.slip_amplitude),
+        ("dissipated_energy", "Dissipated energy E_d", point.dissipated_energy),
+        ("ecof_ratio", "μ_E/μ", point.ecof_ratio),
+        ("ecof", "μ_E", point.ecof_ratio * values["mu"]),
     ]
-    cells = "".join(
-        f"<tr><th style='text-align:left;padding-right:1em'>{label}</th>"
-        f"<td><span class='ecofmaps-value' data-quantity='{key}'>{text}</span> {unit}</td></tr>"
-        for key, label, text, unit in rows
-    )
+    cells = []
+    for key, label, value in rows:
+        quantity = QUANTITIES[key]
+        unit = quantity.display_unit if math.isfinite(value) else ""
+        cells.append(
+            f"<tr><th style='text-align:left;padding-right:1em'>{label}</th>"
+            f"<td><span class='ecofmaps-value' data-quantity='{key}' data-unit='{unit}'>"
+            f"{_number(value, quantity.display_factor)}</span> {unit}</td></tr>"
+        )
     regime = "" if gross else "<p><b>No gross slip</b> (μP/S ≥ Δ*): μ_E is undefined.</p>"
-    return f"<table style='font-size:14px;white-space:nowrap'>{cells}</table>{regime}"
+    return f"{_inputs_html(values)}<table style='font-size:14px'>{''.join(cells)}</table>{regime}"
 
 
 def _correction_html(values: dict) -> str:
@@ -468,7 +488,7 @@ def explorer_page():
     if pn.state.location is not None:
         for key, widget in inputs.items():
             pn.state.location.sync(widget, {"value": key})
-    values_pane = pn.pane.HTML("", width=250)
+    values_pane = pn.pane.HTML("", width=260)
     correction_pane = pn.pane.HTML("", width=760, margin=(18, 10))
     message = pn.pane.HTML("", width=520, styles={"color": "#b00020"})
     loop_plot, loop_source = _loop_figure()

@@ -279,13 +279,18 @@ def test_the_page_follows_its_inputs():
     def shown():
         return " ".join(str(pane.object) for pane in page.select(pn.pane.HTML))
 
-    assert "data-quantity='ecof_ratio'>1.038<" in shown()  # Example 2: about 4 % above μ
+    assert (
+        "data-quantity='ecof_ratio' data-unit=''>1.038<" in shown()
+    )  # Example 2: about 4 % above μ
     inputs["Displacement amplitude Δ*"].value = "5um"  # μP/S = 10.3 µm > Δ*
-    assert "No gross slip" in shown() and "data-quantity='ecof_ratio'>undefined<" in shown()
+    assert (
+        "No gross slip" in shown()
+        and "data-quantity='ecof_ratio' data-unit=''>undefined<" in shown()
+    )
     inputs["Displacement amplitude Δ*"].value = "50um"
     inputs["Rig stiffness S"].value = "inf"
     rigid = float(ecofmaps.energy_cof(50e-6, 450.0, math.inf, 0.8, 0.2)) / 0.8
-    assert f"data-quantity='ecof_ratio'>{rigid:.3f}<" in shown()
+    assert f"data-quantity='ecof_ratio' data-unit=''>{rigid:.3f}<" in shown()
     inputs["Normal load P"].value = "-3N"
     assert "Normal load P: &#x27;-3N&#x27; is out of range" in shown()
     inputs["Normal load P"].value = "9**9**9 N"  # refused at once: pint evaluates nothing
