@@ -77,7 +77,7 @@ def bare_number_warning(name: str, text: str, kind: str) -> str | None:
         return None
     said = f"{text.strip()} is {value:g} {DIMENSIONS[kind][1]}"
     for unit in meant:
-        if plausible(parse_quantity(f"{text.strip()}{unit}", kind)):
+        if plausible(value * parse_quantity(f"1{unit}", kind)):  # text and unit may be too long
             return f"{said}; did you mean {text.strip()}{unit}?"
     if high is None:
         span = f"at least {low:g}"

@@ -6,7 +6,7 @@ import sys
 import numpy as np
 import pytest
 
-from ecofmaps.units import TEXT_LIMIT, parse_quantity, parse_values
+from ecofmaps.units import TEXT_LIMIT, bare_number_warning, parse_quantity, parse_values
 
 
 @pytest.mark.parametrize(
@@ -118,3 +118,23 @@ def test_parse_values_lists_and_ranges():
 def test_parse_values_rejects(text, message):
     with pytest.raises(ValueError, match=message):
         parse_values(text, "dimensionless")
+
+
+@pytest.mark.parametrize(
+    ("name", "text", "kind", "said"),
+    [
+        ("amplitude", "50", "length", "50 is 50 m; did you mean 50um?"),
+        ("stiffness", "35", "stiffness", "35 is 35 N/m; did you mean 35MN/m?"),
+        ("load", "450000", "force", "450000 is 450000 N; did you mean 450000mN?"),
+        ("amplitude", "50um", "length", None),
+        ("amplitude", "5e-5", "length", None),
+    ],
+)
+def test_bare_number_warning(name, text, kind, said):
+    assert bare_number_warning(name, text, kind) == said
+
+
+def test_bare_number_warning_of_the_longest_text():
+    """The units tried make the text longer than TEXT_LIMIT: still a warning, no error."""
+    warning = bare_number_warning("amplitude", "1" * TEXT_LIMIT, "length")
+    assert warning.endswith("is 1.11111e+63 m; a fretting test's is 1e-07 to 0.005 m")

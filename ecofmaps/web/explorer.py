@@ -39,12 +39,13 @@ from ecofmaps.model import NO_GROSS_SLIP
 from ecofmaps.model.simulation import fretting_loop
 from ecofmaps.model.steady_state import dissipated_energy, energy_cof, slip_amplitude
 from ecofmaps.paper import FIGURE_11_STIFFNESS_RATIOS
-from ecofmaps.units import DIMENSIONS, TEXT_LIMIT, parse_quantity
+from ecofmaps.units import DIMENSIONS, TEXT_LIMIT, bare_number_warning, parse_quantity
 
 __all__ = [
     "INPUTS",
     "LOCAL_HOSTS",
     "ExplorerPoint",
+    "bare_number_warnings",
     "explorer_page",
     "parameter_value",
     "serve_explorer",
@@ -135,6 +136,33 @@ def parameter_value(key: str, text: str) -> float:
             + (" (or inf, a rigid rig)" if key == "stiffness" else "")
         )
     return value
+
+
+def bare_number_warnings(texts: dict) -> list[str]:
+    """The warnings for inputs typed as bare numbers implausible in SI, each naming the input
+    and the unit probably meant (:func:`ecofmaps.units.bare_number_warning`).
+
+    Parameters
+    ----------
+    texts : dict
+        Text typed, by key of :data:`INPUTS`.
+
+    Returns
+    -------
+    warnings : list of str
+
+    Examples
+    --------
+    >>> bare_number_warnings({"amplitude": "50", "stiffness": "35MN/m"})
+    ['Displacement amplitude Δ*: 50 is 50 m; did you mean 50um?']
+    """
+    found = []
+    for key, text in texts.items():
+        name, label = INPUTS[key][:2]
+        warning = bare_number_warning(name, str(text)[:TEXT_LIMIT], QUANTITIES[name].kind)
+        if warning is not None:
+            found.append(f"{label}: {warning}")
+    return found
 
 
 @dataclasses.dataclass(frozen=True)
@@ -490,7 +518,8 @@ def explorer_page():
             pn.state.location.sync(widget, {"value": key})
     values_pane = pn.pane.HTML("", width=260)
     correction_pane = pn.pane.HTML("", width=760, margin=(18, 10))
-    message = pn.pane.HTML("", width=520, styles={"color": "#b00020"})
+    message = pn.pane.HTML("", width=900, styles={"color": "#b00020"})
+    notice = pn.pane.HTML("", width=900, styles={"color": "#8a4b00"})
     loop_plot, loop_source = _loop_figure()
     map_plot, map_parts = _map_figure()
 
@@ -503,6 +532,11 @@ def explorer_page():
 
     def update(*_events):
         """Show the inputs' point; any failure is a message on the page, never Panel's."""
+        texts = {key: widget.value for key, widget in inputs.items()}
+        notice.object = "".join(
+            f"<p style='margin:2px 0'>{html.escape(warning)}</p>"
+            for warning in bare_number_warnings(texts)
+        )
         try:
             values = {key: parameter_value(key, widget.value) for key, widget in inputs.items()}
         except ValueError as error:
@@ -530,6 +564,7 @@ def explorer_page():
     return pn.Column(
         intro,
         message,
+        notice,
         pn.Row(
             pn.Column(
                 *model_inputs,

@@ -249,6 +249,14 @@ def test_a_hostile_query_is_a_message_on_the_page(browser, server, key, text, me
     assert console_errors(browser) == []
 
 
+def test_a_bare_amplitude_is_warned_on_the_page(browser, server):
+    _, url = server
+    browser.get(url + "?" + urllib.parse.urlencode(dict(VIEWS["example 2"], amplitude="50")))
+    warning = "Displacement amplitude Δ*: 50 is 50 m; did you mean 50um?"
+    wait_for(lambda: any(warning in text for text, _ in deep_texts(browser, "p")))
+    assert console_errors(browser) == []
+
+
 def test_nothing_is_written_to_disk_per_page(browser, server):
     cache = os.environ["ECOFMAPS_CACHE"]
     before = sorted(os.walk(cache))
@@ -298,6 +306,28 @@ def test_the_page_follows_its_inputs():
     inputs["Normal load P"].value = "1N"
     inputs["Rig stiffness S"].value = "1.7e308"
     assert "Rig stiffness S: &#x27;1.7e308&#x27; is beyond the explorer&#x27;s bounds" in shown()
+
+
+def test_a_bare_number_implausible_in_si_is_warned_with_the_unit_meant():
+    """A warning beside the result (stiffness) or the refusal (amplitude), each value with its
+    unit; the warning goes once the unit is typed."""
+    page = explorer_page()
+    inputs = {widget.label: widget for widget in page.select(pn.widgets.TextInput)}
+
+    def shown():
+        return " ".join(str(pane.object) for pane in page.select(pn.pane.HTML))
+
+    inputs["Rig stiffness S"].value = "35"
+    assert "Rig stiffness S: 35 is 35 N/m; did you mean 35MN/m?" in shown()
+    assert "S = 3.5e-05 MN/m" in shown()  # computed, as read
+    assert "data-quantity='slip_amplitude' data-unit='µm'>" in shown()
+    inputs["Rig stiffness S"].value = "35MN/m"
+    assert "did you mean" not in shown()
+    inputs["Displacement amplitude Δ*"].value = "50"
+    assert "Displacement amplitude Δ*: 50 is 50 m; did you mean 50um?" in shown()
+    assert (
+        "Displacement amplitude Δ*: &#x27;50&#x27; is beyond the explorer&#x27;s bounds" in shown()
+    )
 
 
 def map_of(page):
