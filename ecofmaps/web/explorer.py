@@ -540,13 +540,13 @@ def explorer_page():
         try:
             values = {key: parameter_value(key, widget.value) for key, widget in inputs.items()}
         except ValueError as error:
-            message.object = f"<p>{html.escape(str(error))}</p>"
+            message.object = f"<p style='margin:2px 0'>{html.escape(str(error))}</p>"
             return
         try:
             show(values)
         except Exception as error:  # a page must stay up whatever the model says
             text = f"Cannot show this point ({type(error).__name__}: {error})"
-            message.object = f"<p>{html.escape(text)}</p>"
+            message.object = f"<p style='margin:2px 0'>{html.escape(text)}</p>"
             return
         message.object = ""
 
