@@ -125,7 +125,7 @@ def add(subparsers) -> None:
     )
     parser.add_argument(
         "--rig-stiffness",
-        type=quantity("stiffness"),
+        type=quantity("stiffness", option="--rig-stiffness"),
         default=None,
         metavar="S",
         help="the rig's own stiffness, e.g. 35MN/m (the loops' stick slope is the rig and the "
