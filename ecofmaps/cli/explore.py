@@ -64,7 +64,7 @@ def run(args) -> int:
     if missing_web_packages():
         raise CommandError(INSTALL_WEB)
     # Panel and Bokeh load only when the explorer runs (the command's lazy boundary).
-    from ecofmaps.web.explorer import serve_explorer
+    from ecofmaps.web.server import serve_explorer
 
     try:
         serve_explorer(

@@ -1,7 +1,8 @@
 """Pages for a browser: a test's self-contained HTML report and a live explorer of the model.
 
 Both need the extra ``web`` (Bokeh, Panel): ``pip install "ecofmaps[web]"``. Importing this
-package needs neither; :mod:`ecofmaps.web.report` and :mod:`ecofmaps.web.explorer` do.
+package needs neither; :mod:`ecofmaps.web.report`, :mod:`ecofmaps.web.explorer` and its server,
+:mod:`ecofmaps.web.server`, do.
 """
 
 from __future__ import annotations

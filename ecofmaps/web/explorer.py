@@ -9,16 +9,11 @@ a view is shared as a link.
 
 from __future__ import annotations
 
-import asyncio
 import dataclasses
 import functools
 import html
 import math
-import re
-import signal
-import urllib.parse
 import warnings
-import webbrowser
 
 import numpy as np
 import panel as pn
@@ -26,11 +21,7 @@ from bokeh.models import ColumnDataSource, HoverTool, Legend, LegendItem, Range1
 from bokeh.plotting import figure
 from bokeh.plotting.contour import contour_data
 from matplotlib.colors import to_hex
-from panel.io.server import get_server
-from tornado.routing import Matcher, Rule
-from tornado.web import RequestHandler
 
-from ecofmaps._interrupts import check_interrupted
 from ecofmaps._nomenclature import QUANTITIES, RANGES, within
 from ecofmaps.correction.inversion import correct_ecof
 from ecofmaps.figures.style import ECOF_RATIO_LEVELS, HIGHLIGHT_LEVEL, ecof_ratio_colors
@@ -43,12 +34,10 @@ from ecofmaps.units import DIMENSIONS, TEXT_LIMIT, bare_number_warning, parse_qu
 
 __all__ = [
     "INPUTS",
-    "LOCAL_HOSTS",
     "ExplorerPoint",
     "bare_number_warnings",
     "explorer_page",
     "parameter_value",
-    "serve_explorer",
 ]
 
 #: The page's inputs: URL query key -> (quantity of the nomenclature, label, default text,
@@ -63,14 +52,6 @@ INPUTS = {
     "aspect_ratio_low": ("aspect_ratio", "Scar z_o/x_o from", "0.15", (0.0, 10.0)),
     "aspect_ratio_high": ("aspect_ratio", "Scar z_o/x_o to", "0.25", (0.0, 10.0)),
 }
-
-#: The longest query value let through to Panel, whose reading of the query fails on an
-#: integer of more than 4300 digits; a longer one is cut to one character over
-#: :data:`ecofmaps.units.TEXT_LIMIT`. [1]
-_QUERY_LIMIT = 1000
-
-#: The hosts whose pages the explorer answers (with its port); others get 403.
-LOCAL_HOSTS = ("127.0.0.1", "localhost", "[::1]")
 
 #: The model's inputs among :data:`INPUTS`.
 _MODEL_INPUTS = ("amplitude", "load", "stiffness", "mu", "aspect_ratio")
@@ -587,138 +568,3 @@ def warm_up() -> None:
     window = map_window(values["stiffness"] / values["load"], values["aspect_ratio"])
     _ecof_ratio_map(values["amplitude"], values["mu"], window)
     _correction_html(values)
-
-
-def _allowed_hosts(port: int, allow_origin=()) -> frozenset:
-    """The ``host:port`` the explorer answers: :data:`LOCAL_HOSTS` at ``port``, and each of
-    ``allow_origin`` (``host`` or ``host:port``; without a port, ``port``), in lower case."""
-    hosts = {f"{host}:{port}" for host in LOCAL_HOSTS}
-    for entry in allow_origin:
-        entry = entry.strip().lower()
-        hosts.add(entry if re.fullmatch(r".*:\d+", entry) else f"{entry}:{port}")
-    return frozenset(hosts)
-
-
-class _Foreign(Matcher):
-    """Matches a request whose Host, or Origin if it has one, is not an allowed host."""
-
-    def __init__(self, hosts: frozenset):
-        self.hosts = hosts
-
-    def match(self, request):
-        host = request.headers.get("Host", "").lower()
-        origin = request.headers.get("Origin")
-        if origin is not None:
-            parts = urllib.parse.urlsplit(origin.lower())
-            origin = parts.netloc if parts.scheme == "http" else ""
-        foreign = host not in self.hosts or (origin is not None and origin not in self.hosts)
-        return {} if foreign else None
-
-
-class _Forbidden(RequestHandler):
-    """403 for every request it gets, with the way to allow another host."""
-
-    def initialize(self, url: str):
-        self.url = url
-
-    def prepare(self):
-        self.set_status(403)
-        self.set_header("Content-Type", "text/plain; charset=utf-8")
-        self.finish(
-            f"403 Forbidden: this explorer answers the pages of {self.url} only (the request's "
-            "Host or Origin is another). To open it from another host, start it with "
-            "--allow-origin HOST[:PORT].\n"
-        )
-
-
-class _LongQuery(Matcher):
-    """Matches a request whose query holds a value longer than ``_QUERY_LIMIT``."""
-
-    def match(self, request):
-        pairs = urllib.parse.parse_qsl(request.query, keep_blank_values=True)
-        return {} if any(len(value) > _QUERY_LIMIT for _, value in pairs) else None
-
-
-class _CutQuery(RequestHandler):
-    """See Other: the same page with each overlong query value cut to one character over
-    :data:`ecofmaps.units.TEXT_LIMIT`, so Panel never parses a huge number and the page
-    names the input."""
-
-    def prepare(self):
-        pairs = urllib.parse.parse_qsl(self.request.query, keep_blank_values=True)
-        cut = [(key, v if len(v) <= _QUERY_LIMIT else v[: TEXT_LIMIT + 1]) for key, v in pairs]
-        self.redirect(f"{self.request.path}?{urllib.parse.urlencode(cut)}", status=303)
-
-
-def serve_explorer(port: int, *, open_browser: bool = True, announce=print, allow_origin=()):
-    """Serve the explorer at ``http://127.0.0.1:<port>/`` until Ctrl-C or SIGTERM.
-
-    Every HTTP request (the page, its resources, the websocket) whose ``Host`` header, or
-    ``Origin`` header if it has one, is not one of :data:`LOCAL_HOSTS` with ``port`` gets a
-    403: another web page, or a DNS rebinding, cannot make it compute.
-
-    Parameters
-    ----------
-    port : int
-        The local port to listen on (only on 127.0.0.1). [1]
-    open_browser : bool
-        Open the page in the default browser once the server listens.
-    announce : callable
-        Called with the line that gives the page's address, once the server listens.
-    allow_origin : sequence of str
-        More hosts to answer, ``host`` or ``host:port`` (without a port, ``port``): for a
-        page reached through a tunnel or a proxy under another name.
-
-    Raises
-    ------
-    OSError
-        If the port cannot be listened on (in use, or not allowed).
-    """
-    url = f"http://127.0.0.1:{port}/"
-    hosts = _allowed_hosts(port, allow_origin)
-    server = get_server(
-        {"/": explorer_page},
-        port=port,
-        address="127.0.0.1",
-        show=False,
-        start=False,
-        title="ecofmaps explorer",
-        # Bokeh cannot parse "[::1]:port"; _Foreign checks every request against all hosts.
-        websocket_origin=sorted(h for h in hosts if not h.startswith("[")),
-    )
-    # Before Bokeh's and Panel's routes, for every path: Tornado's documented rule router.
-    server._tornado.default_router.rules[:0] = [
-        Rule(_Foreign(hosts), _Forbidden, {"url": url}),
-        Rule(_LongQuery(), _CutQuery),
-    ]
-    loop = server.io_loop
-
-    def stop(signum, frame):  # the loop stops as soon as it runs (at once if it runs)
-        loop.asyncio_loop.call_soon_threadsafe(loop.stop)
-
-    previous = {number: signal.getsignal(number) for number in (signal.SIGINT, signal.SIGTERM)}
-    ours = [number for number, before in previous.items() if before not in (signal.SIG_IGN, None)]
-    for number in ours:  # a signal ignored (Ctrl-C in a background job) stays ignored
-        signal.signal(number, stop)
-    try:
-        check_interrupted()  # a Ctrl-C while the command started up stops it here
-        warm_up()  # the port is taken: a page asked for meanwhile waits for it
-        server.start()
-        announce(f"ecofmaps explorer at {url} (Ctrl-C stops it)")
-        if open_browser:
-            loop.add_callback(webbrowser.open, url)
-        loop.start()
-    finally:
-        for number in ours:
-            signal.signal(number, previous[number])
-        server.stop()
-        _close(loop.asyncio_loop)
-
-
-def _close(event_loop: asyncio.AbstractEventLoop) -> None:
-    """Cancel what is still pending on the server's event loop (the sessions' tasks)."""
-    pending = [task for task in asyncio.all_tasks(event_loop) if not task.done()]
-    for task in pending:
-        task.cancel()
-    if pending and not event_loop.is_closed():
-        event_loop.run_until_complete(asyncio.gather(*pending, return_exceptions=True))
