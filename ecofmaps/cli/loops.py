@@ -80,6 +80,39 @@ def add(subparsers) -> None:
         help="normal load P, e.g. 450N; or the name of the recording's normal-load column "
         "(e.g. Fz), used sample by sample (required unless --example)",
     )
+    _add_output_options(parser)
+    parser.add_argument(
+        "--no-resolve",
+        action="store_true",
+        help="skip the reading along the stroke (about ten times faster; no mu_resolved, "
+        "mu_resolved_se, aspect_ratio)",
+    )
+    parser.add_argument(
+        "--flip-force",
+        action="store_true",
+        help="read the force with the other sign (a rig recording it positive against the "
+        "displacement: its loops run anticlockwise)",
+    )
+    parser.add_argument(
+        "--rig-stiffness",
+        type=quantity("stiffness", option="--rig-stiffness"),
+        default=None,
+        metavar="S",
+        help="the rig's own stiffness, e.g. 35MN/m (the loops' stick slope is the rig and the "
+        "contact in series): the ratios also on the contact's displacement, the regime there",
+    )
+    parser.add_argument(
+        "--nan-policy",
+        choices=("skip", "raise"),
+        default="skip",
+        help="a cycle with a missing sample (NaN or an empty cell) is skipped and counted "
+        "(skip, the default), or any missing sample stops the command naming its line",
+    )
+    add_recording_options(parser)
+    _add_long_options(parser)
+
+
+def _add_output_options(parser) -> None:
     parser.add_argument(
         "--out",
         metavar="FILE.csv",
@@ -111,35 +144,6 @@ def add(subparsers) -> None:
         "the friction over the cycles with the quality flags, picked loops with the model's, "
         'the table (needs pip install "ecofmaps[web]")',
     )
-    parser.add_argument(
-        "--no-resolve",
-        action="store_true",
-        help="skip the reading along the stroke (about ten times faster; no mu_resolved, "
-        "mu_resolved_se, aspect_ratio)",
-    )
-    parser.add_argument(
-        "--flip-force",
-        action="store_true",
-        help="read the force with the other sign (a rig recording it positive against the "
-        "displacement: its loops run anticlockwise)",
-    )
-    parser.add_argument(
-        "--rig-stiffness",
-        type=quantity("stiffness", option="--rig-stiffness"),
-        default=None,
-        metavar="S",
-        help="the rig's own stiffness, e.g. 35MN/m (the loops' stick slope is the rig and the "
-        "contact in series): the ratios also on the contact's displacement, the regime there",
-    )
-    parser.add_argument(
-        "--nan-policy",
-        choices=("skip", "raise"),
-        default="skip",
-        help="a cycle with a missing sample (NaN or an empty cell) is skipped and counted "
-        "(skip, the default), or any missing sample stops the command naming its line",
-    )
-    add_recording_options(parser)
-    _add_long_options(parser)
 
 
 def _workers(text: str) -> int:

@@ -31,6 +31,13 @@ from ecofmaps.io.files import record_written
 __all__ = ["add", "run"]
 
 _GRID_HELP = "; one value, a list or a range start:stop:num"
+#: The grid's axes, in the order of the map's dimensions: option, metavar, help.
+_AXES = (
+    ("--stiffness-ratio", "S/P", "rig stiffness over normal load S/P [1/m], 'inf' for a rigid rig"),
+    ("--aspect-ratio", "Z/X", "groove depth over half-width z_o/x_o (>= 0)"),
+    ("--amplitude", "DELTA", "displacement amplitude Δ* [m], e.g. 25um,50um"),
+    ("--mu", "MU", "contact coefficient of friction μ (> 0)"),
+)
 #: Default of --chunk-points: blocks of 2**22 points (about 220 MB of results with a load).
 _CHUNK_POINTS = 2**22
 
@@ -69,34 +76,15 @@ def add(subparsers) -> None:
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument(
-        "--stiffness-ratio",
-        type=quantity("stiffness_ratio", grid=True),
-        required=True,
-        metavar="S/P",
-        help="rig stiffness over normal load S/P [1/m], 'inf' for a rigid rig" + _GRID_HELP,
-    )
-    parser.add_argument(
-        "--aspect-ratio",
-        type=quantity("aspect_ratio", grid=True),
-        required=True,
-        metavar="Z/X",
-        help="groove depth over half-width z_o/x_o (>= 0)" + _GRID_HELP,
-    )
-    parser.add_argument(
-        "--amplitude",
-        type=quantity("amplitude", grid=True),
-        required=True,
-        metavar="DELTA",
-        help="displacement amplitude Δ* [m], e.g. 25um,50um" + _GRID_HELP,
-    )
-    parser.add_argument(
-        "--mu",
-        type=quantity("mu", grid=True),
-        required=True,
-        metavar="MU",
-        help="contact coefficient of friction μ (> 0)" + _GRID_HELP,
-    )
+    for option, metavar, text in _AXES:
+        name = option[2:].replace("-", "_")
+        parser.add_argument(
+            option,
+            type=quantity(name, grid=True),
+            required=True,
+            metavar=metavar,
+            help=text + _GRID_HELP,
+        )
     parser.add_argument(
         "--load",
         type=quantity("load"),
