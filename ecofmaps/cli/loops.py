@@ -431,16 +431,26 @@ def _write_extras(args, done: list[_Analysed], load) -> None:
     """The plots, the reading along the stroke and the report the options ask for."""
     if args.plots is not None and done:
         # matplotlib only when plots are asked for
-        from ecofmaps.figures import cof_evolution, measured_loops, resolved_loops, save_figure
+        from ecofmaps.figures import (
+            RECORDING_DPI,
+            cof_evolution,
+            measured_loops,
+            resolved_loops,
+            save_figure,
+        )
 
         folder = Path(args.plots)
         folder.mkdir(parents=True, exist_ok=True)
         for each in done:
             name, results, resolved = each.plot_name, each.results, each.resolved
-            save_figure(measured_loops(results, resolved=resolved), folder / f"{name}_loops.png")
-            save_figure(cof_evolution(results), folder / f"{name}_evolution.png")
+            figures = {
+                "loops": measured_loops(results, resolved=resolved, source=each.path.name),
+                "evolution": cof_evolution(results, source=each.path.name),
+            }
             if resolved is not None:
-                save_figure(resolved_loops(resolved, results), folder / f"{name}_resolved.png")
+                figures["resolved"] = resolved_loops(resolved, results, source=each.path.name)
+            for kind, figure in figures.items():
+                save_figure(figure, folder / f"{name}_{kind}.png", dpi=RECORDING_DPI)
     if args.resolved is not None and done:
         from ecofmaps.maps.cache import write_netcdf
 
