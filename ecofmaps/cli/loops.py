@@ -289,6 +289,13 @@ class _Table:
         self.stream.flush()  # on disk as it comes: a block is a few MB
 
 
+#: Why cycles are incomplete, by how they were cut (the results' ``cycles_from``).
+_WHY_INCOMPLETE = {
+    "displacement reversals": ": partial, where the recording starts or ends mid-cycle",
+    "cycle numbers": ": too few samples, too short a stroke or not closed",
+}
+
+
 def _summary(path, results, recording) -> str:
     """One line on a recording's cycles: counts, the quality, the friction over the test."""
     from ecofmaps.model.regimes import GROSS_SLIP
@@ -300,7 +307,8 @@ def _summary(path, results, recording) -> str:
         stroke = f" (amplitude {amplitude * 1e3:.3g} mm)" if np.isfinite(amplitude) else ""
         summary += f"; reciprocating sliding{stroke}, not fretting: analysed the same way"
     if results.attrs["incomplete_cycles"]:
-        summary += f" ({results.attrs['incomplete_cycles']} incomplete dropped)"
+        why = _WHY_INCOMPLETE.get(results.attrs.get("cycles_from"), "")
+        summary += f" ({results.attrs['incomplete_cycles']} incomplete dropped{why})"
     if skipped := results.attrs.get("skipped_cycles", 0):
         first = recording.position(results.attrs["first_missing_sample"])
         where = f"line {first}" if isinstance(first, int) else first
