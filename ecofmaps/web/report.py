@@ -84,6 +84,9 @@ _CHARACTER, _CELL_ROOM = 6.5, 10
 #: (its first column frozen when there are more). [px]
 _TABLE_WIDTH = 1350
 
+#: Room the table keeps beside its columns, for its vertical scroll bar. [px]
+_TABLE_ROOM = 20
+
 #: Shows the loops of the cycles picked in the page: the measured loop and, where the cycle
 #: has one, the model's, each pair in one colour.
 _PICK_LOOPS = """
@@ -573,6 +576,9 @@ def _table(results: xr.Dataset):
         width = min(200, max(56, round(_CHARACTER * longest + _CELL_ROOM)))
         columns.append(TableColumn(field=name, title=name, formatter=formatter, width=width))
         data[name] = values
+    # The last column (the quality) as wide as the table leaves it, but never narrower than 90
+    others = sum(column.width for column in columns[:-1])
+    columns[-1].width = min(columns[-1].width, max(90, _TABLE_WIDTH - _TABLE_ROOM - others))
     heading = Div(
         text=(
             "<h3 style='margin:12px 0 4px 0'>The table (as <code>ecofmaps loops --out</code> "
