@@ -409,19 +409,20 @@ def _analyse_each(args, paths, load, long_run, table) -> tuple[list[_Analysed], 
             options = recording_options(args)
             if isinstance(load, str):  # --load names the recording's normal-load column
                 options["load_column"] = load
-            recording = read_recording(path, lazy=long_run.lazy, **options)
-            write = table.write if recording.lazy else held.append
-            results, resolved = _analysed(
-                index,
-                path,
-                recording,
-                load,
-                args,
-                long_run,
-                write,
-                many=many,
-                resolved_file=args.resolved is not None,
-            )
+            # closed once analysed: the report reads only its names and units
+            with read_recording(path, lazy=long_run.lazy, **options) as recording:
+                write = table.write if recording.lazy else held.append
+                results, resolved = _analysed(
+                    index,
+                    path,
+                    recording,
+                    load,
+                    args,
+                    long_run,
+                    write,
+                    many=many,
+                    resolved_file=args.resolved is not None,
+                )
         except (ValueError, OSError, CommandError) as error:
             if not many:
                 raise
