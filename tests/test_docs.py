@@ -2,6 +2,8 @@
 and each attribute of analyze_loops' results), and the site built from docs/ holds every page
 and every public name, in MkDocs' strict mode: the docs cannot fall behind the code."""
 
+import contextlib
+import io
 import os
 import pkgutil
 import re
@@ -121,3 +123,17 @@ def test_site_builds_in_strict_mode_with_every_page_and_name(tmp_path):
         and not re.search(rf'href="[^"]*#ecofmaps\.\w+\.{re.escape(name)}"', index)
     ]
     assert not missing
+
+
+def test_the_deepening_groove_example_shows_the_ecof_rising(loops_page):
+    """The example of a groove that deepens runs as written, and prints what the page says."""
+    example = re.search(r"## A groove that deepens\n.*?```python\n(.*?)```", loops_page, re.S)
+    printed = re.search(r"## A groove that deepens\n.*?```text\n(.*?)```", loops_page, re.S)
+    output = io.StringIO()
+    with warnings.catch_warnings(), contextlib.redirect_stdout(output):
+        warnings.simplefilter("ignore")
+        exec(compile(example.group(1), "docs/loops.md", "exec"), {})
+    assert output.getvalue().split() == printed.group(1).split()
+    first, last = (line.split() for line in printed.group(1).splitlines()[2::2])
+    assert float(last[1]) > float(first[1]) + 0.05  # the ECoF rises ...
+    assert abs(float(last[2]) - float(first[2])) < 0.02  # ... the GICoF stays at μ

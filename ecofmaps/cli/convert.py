@@ -74,6 +74,6 @@ def run(args) -> int:
         **recording_options(args),
     )
     record_written([destination])
-    written = read_recording(destination, lazy=True)
-    print(f"wrote {destination}: {written.size} samples of {', '.join(written.columns)} (SI)")
+    with read_recording(destination, lazy=True) as written:
+        print(f"wrote {destination}: {written.size} samples of {', '.join(written.columns)} (SI)")
     return 0

@@ -293,6 +293,13 @@ class _Table:
         self.stream.flush()  # on disk as it comes: a block is a few MB
 
 
+#: Why cycles are incomplete, by how they were cut (the results' ``cycles_from``).
+_WHY_INCOMPLETE = {
+    "displacement reversals": ": partial, where the recording starts or ends mid-cycle",
+    "cycle numbers": ": too few samples, too short a stroke or not closed",
+}
+
+
 def _summary(path, results, recording) -> str:
     """One line on a recording's cycles: counts, the quality, the friction over the test."""
     from ecofmaps.model.regimes import GROSS_SLIP
@@ -304,7 +311,8 @@ def _summary(path, results, recording) -> str:
         stroke = f" (amplitude {amplitude * 1e3:.3g} mm)" if np.isfinite(amplitude) else ""
         summary += f"; reciprocating sliding{stroke}, not fretting: analysed the same way"
     if results.attrs["incomplete_cycles"]:
-        summary += f" ({results.attrs['incomplete_cycles']} incomplete dropped)"
+        why = _WHY_INCOMPLETE.get(results.attrs.get("cycles_from"), "")
+        summary += f" ({results.attrs['incomplete_cycles']} incomplete dropped{why})"
     if skipped := results.attrs.get("skipped_cycles", 0):
         first = recording.position(results.attrs["first_missing_sample"])
         where = f"line {first}" if isinstance(first, int) else first
@@ -405,19 +413,20 @@ def _analyse_each(args, paths, load, long_run, table) -> tuple[list[_Analysed], 
             options = recording_options(args)
             if isinstance(load, str):  # --load names the recording's normal-load column
                 options["load_column"] = load
-            recording = read_recording(path, lazy=long_run.lazy, **options)
-            write = table.write if recording.lazy else held.append
-            results, resolved = _analysed(
-                index,
-                path,
-                recording,
-                load,
-                args,
-                long_run,
-                write,
-                many=many,
-                resolved_file=args.resolved is not None,
-            )
+            # closed once analysed: the report reads only its names and units
+            with read_recording(path, lazy=long_run.lazy, **options) as recording:
+                write = table.write if recording.lazy else held.append
+                results, resolved = _analysed(
+                    index,
+                    path,
+                    recording,
+                    load,
+                    args,
+                    long_run,
+                    write,
+                    many=many,
+                    resolved_file=args.resolved is not None,
+                )
         except (ValueError, OSError, CommandError) as error:
             if not many:
                 raise
@@ -435,16 +444,26 @@ def _write_extras(args, done: list[_Analysed], load) -> None:
     """The plots, the reading along the stroke and the report the options ask for."""
     if args.plots is not None and done:
         # matplotlib only when plots are asked for
-        from ecofmaps.figures import cof_evolution, measured_loops, resolved_loops, save_figure
+        from ecofmaps.figures import (
+            RECORDING_DPI,
+            cof_evolution,
+            measured_loops,
+            resolved_loops,
+            save_figure,
+        )
 
         folder = Path(args.plots)
         folder.mkdir(parents=True, exist_ok=True)
         for each in done:
             name, results, resolved = each.plot_name, each.results, each.resolved
-            save_figure(measured_loops(results, resolved=resolved), folder / f"{name}_loops.png")
-            save_figure(cof_evolution(results), folder / f"{name}_evolution.png")
+            figures = {
+                "loops": measured_loops(results, resolved=resolved, source=each.path.name),
+                "evolution": cof_evolution(results, source=each.path.name),
+            }
             if resolved is not None:
-                save_figure(resolved_loops(resolved, results), folder / f"{name}_resolved.png")
+                figures["resolved"] = resolved_loops(resolved, results, source=each.path.name)
+            for kind, figure in figures.items():
+                save_figure(figure, folder / f"{name}_{kind}.png", dpi=RECORDING_DPI)
     if args.resolved is not None and done:
         from ecofmaps.maps.cache import write_netcdf
 

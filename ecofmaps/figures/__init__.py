@@ -37,6 +37,6 @@ _PUBLIC = {
         "make_figure",
         "make_figures",
     ),
-    "ecofmaps.figures.style": ("ECOF_RATIO_LEVELS", "save_figure"),
+    "ecofmaps.figures.style": ("ECOF_RATIO_LEVELS", "RECORDING_DPI", "save_figure"),
 }
 __getattr__, __dir__, __all__ = lazy_names(__name__, _PUBLIC)

@@ -1,7 +1,9 @@
-r"""Figures of measured loops: the loops with :math:`Q = S\Delta`, Figure 9 and Figure 10.
+r"""Figures of measured loops: the loops with :math:`Q = S\Delta`, the friction over the test (as
+the paper's Figure 9), the fitted model (as its Figure 10) and the loops read along the stroke.
 
 Each function takes the results of :func:`ecofmaps.analyze_loops` or
-:func:`ecofmaps.fit_loop` and returns a :class:`matplotlib.figure.Figure`.
+:func:`ecofmaps.fit_loop` and returns a :class:`matplotlib.figure.Figure`, titled by the
+recording's name (``source``) and what it shows; legends never cover what is drawn.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ import numpy as np
 import xarray as xr
 from matplotlib import colormaps
 from matplotlib.figure import Figure
+from matplotlib.path import Path
 from matplotlib.ticker import MaxNLocator
 
 from ecofmaps.figures.style import (
@@ -20,12 +23,84 @@ from ecofmaps.figures.style import (
     force_ratio_axis,
     parameters,
     scalar,
-    stiffness_label,
+    stiffness_text,
 )
 from ecofmaps.measured.quality import SEPARATOR
 from ecofmaps.model.regimes import GROSS_SLIP, Regime
 
 __all__ = ["cof_evolution", "measured_and_fitted_loops", "measured_loops", "resolved_loops"]
+
+
+def _title(what: str, source: str | None) -> str:
+    """A figure's title: the recording's name ``source``, when given, and ``what`` it shows."""
+    return f"{source}: {what}" if source else what[:1].upper() + what[1:]
+
+
+def _stiffness(stiffness: float) -> str:
+    """A rig stiffness [N/m] for a title, its symbol italic: ``'$S$ = 35 MN/m'``."""
+    return r"rigid ($S = \infty$)" if np.isinf(stiffness) else f"$S$ = {stiffness_text(stiffness)}"
+
+
+def _load(load: float) -> str:
+    """The normal load [N] for a title, its symbol italic: ``'$P$ = 450 N'``."""
+    return f"$P$ = {load:g} N"
+
+
+#: Room kept between a legend and what is drawn, as a fraction of the panel's height. [1]
+_LEGEND_ROOM = 0.03
+
+#: Where a legend may go inside a panel, in the order tried.
+_CORNERS = (
+    "upper left",
+    "upper right",
+    "lower left",
+    "lower right",
+    "upper center",
+    "lower center",
+)
+
+
+def _legend_clear_of_data(ax, handles=None, labels=None, *, twins=(), **options):
+    """A legend in the first corner of ``ax`` where it covers nothing drawn in ``ax`` or in
+    ``twins`` (its twin axes); with no such corner, the value axes are stretched upwards to
+    make room above everything drawn, and the legend goes in the upper left."""
+    if handles is None:
+        handles, labels = ax.get_legend_handles_labels()
+    legend = ax.legend(handles, labels, loc=_CORNERS[0], **options)
+    ax.figure.draw_without_rendering()  # the layout done: the legend's and the data's places
+    panels = (ax, *twins)
+    for corner in _CORNERS:
+        legend.set_loc(corner)
+        box = legend.get_window_extent().padded(_LEGEND_ROOM * ax.bbox.height)
+        if not any(_covers(panel, box) for panel in panels):
+            return legend
+    legend.set_loc(_CORNERS[0])
+    share = legend.get_window_extent().height / ax.bbox.height + 2.0 * _LEGEND_ROOM
+    for panel in panels:
+        low, high = panel.get_ylim()
+        panel.set_ylim(low, low + (high - low) / max(1.0 - share, 0.2))
+    return legend
+
+
+def _covers(ax, box) -> bool:
+    """Whether anything drawn in ``ax`` (lines, their markers, filled areas, texts) meets the
+    display-space ``box``; spans of the whole panel's height (a shaded background) do not."""
+    for line in ax.get_lines():
+        path = line.get_transform().transform_path(line.get_path()).cleaned(remove_nans=True)
+        points = path.vertices[np.isin(path.codes, (Path.MOVETO, Path.LINETO))]
+        if line.get_marker() not in (None, "None", "", " ") and box.count_contains(points):
+            return True
+        if line.get_linestyle() not in ("None", "", " ") and path.intersects_bbox(
+            box, filled=False
+        ):
+            return True
+    for collection in ax.collections:
+        transform = collection.get_transform()
+        if any(
+            transform.transform_path(path).intersects_bbox(box) for path in collection.get_paths()
+        ):
+            return True
+    return any(text.get_window_extent().overlaps(box) for text in ax.texts)
 
 
 def _evenly_spread(labels, count: int) -> list:
@@ -35,7 +110,12 @@ def _evenly_spread(labels, count: int) -> list:
 
 
 def measured_loops(
-    results: xr.Dataset, cycles=None, columns: int = 3, resolved: xr.Dataset | None = None
+    results: xr.Dataset,
+    cycles=None,
+    columns: int = 3,
+    resolved: xr.Dataset | None = None,
+    *,
+    source: str | None = None,
 ) -> Figure:
     r"""Measured loops, each with the line :math:`Q = S\Delta` and its two GICoF crossings.
 
@@ -51,6 +131,8 @@ def measured_loops(
     resolved : xarray.Dataset, optional
         From :func:`ecofmaps.resolve_analyzed_loops` of the same ``results``: the part of
         the stroke it read is shaded.
+    source : str, optional
+        The recording's name (its file's), which the title begins with.
 
     Returns
     -------
@@ -61,8 +143,8 @@ def measured_loops(
         :math:`\xi_{min} \le \Delta - Q/S \le \xi_{max}` where both branches were read.
         The title gives the cycle's GICoF and ECoF (a dash where they are NaN) and, on a
         line of its own, its flags when its ``quality`` is not ``'ok'`` (the first and how
-        many more when they are too long for the panel). Crossings are drawn, and listed
-        in the legend, only where there are any.
+        many more when they are too long for the panel). One legend, below the panels,
+        lists what is drawn: crossings only where there are any.
 
     Notes
     -----
@@ -111,7 +193,7 @@ def measured_loops(
         state = Regime(int(cycle["regime"])).label
         flags = "" if quality == "ok" else "\nflagged: " + _flags_text(quality)
         ax.set_title(
-            f"cycle {label}: {reading}\n{stiffness_label(stiffness)}, {state}{flags}",
+            f"cycle {label}: {reading}\n{_stiffness(stiffness)}, {state}{flags}",
             fontsize="small",
         )
     for ax in axes.flat[len(chosen) :]:
@@ -122,13 +204,13 @@ def measured_loops(
         lowest.set_xlabel(axis_label("displacement"))
     for ax in axes[:, 0]:
         ax.set_ylabel(axis_label("force"))
-    _shared_legend(axes.flat[0], axes.flat[: len(chosen)])
     figure.suptitle(
         # Two lines: the figure of a single cycle is only one panel wide.
-        rf"Measured loops and the line $Q = S\Delta$ (P = {load:g} N):"
-        "\nthe GICoF is Q/P at the crossings",
+        _title(rf"measured loops and the line $Q = S\Delta$ ({_load(load)}):", source)
+        + "\nthe GICoF is $Q/P$ at the crossings",
         fontsize="medium",
     )
+    _shared_legend(figure, axes.flat[: len(chosen)])
     return figure
 
 
@@ -169,14 +251,21 @@ def _reasons(qualities) -> list[str]:
     return sorted({reason for text in qualities for reason in str(text).split(SEPARATOR)})
 
 
-def _shared_legend(ax, panels) -> None:
-    """One legend in ``ax`` for every labelled artist drawn in any of ``panels``."""
+def _shared_legend(figure: Figure, panels) -> None:
+    """One legend of ``figure``, below its panels, for every labelled artist drawn in any of
+    ``panels``."""
     entries = {}
     for panel in panels:
         for handle, name in zip(*panel.get_legend_handles_labels(), strict=True):
             entries.setdefault(name, handle)
     if entries:
-        ax.legend(list(entries.values()), list(entries), loc="upper left", fontsize="x-small")
+        figure.legend(
+            list(entries.values()),
+            list(entries),
+            loc="outside lower center",
+            ncols=min(len(entries), 2 if len(panels) == 1 else 4),
+            fontsize="x-small",
+        )
 
 
 def _number(value, form: str = ".3f") -> str:
@@ -203,13 +292,15 @@ def _resolved_band(ax, cycle: xr.Dataset, q) -> None:
     )
 
 
-def cof_evolution(results: xr.Dataset) -> Figure:
-    r"""Figure 9: the ECoF and the GICoF over the cycles of a test.
+def cof_evolution(results: xr.Dataset, *, source: str | None = None) -> Figure:
+    r"""The ECoF and the GICoF over the cycles of a test, as the paper's Figure 9.
 
     Parameters
     ----------
     results : xarray.Dataset
         From :func:`ecofmaps.analyze_loops`.
+    source : str, optional
+        The recording's name (its file's), which the title begins with.
 
     Returns
     -------
@@ -239,9 +330,7 @@ def cof_evolution(results: xr.Dataset) -> Figure:
             top.plot(cycle, values, color=color, linewidth=1.3, label=name, **marker)
     top.set_ylabel("Coefficient of friction [1]")
     top.grid(alpha=0.3)
-    if top.get_lines():
-        top.legend(loc="best", fontsize="small")
-    else:
+    if not top.get_lines():
         _note(top, "no ECoF or GICoF in any cycle:\n" + _why_none(results))
         top.set_yticks([])
     excess = (results["ecof"] / results["gicof"] - 1.0).values * 100.0
@@ -257,10 +346,13 @@ def cof_evolution(results: xr.Dataset) -> Figure:
     _cycle_axis(bottom, cycle)
     amplitude = float(results["amplitude"].median()) * MICRO
     figure.suptitle(
-        "Fig. 9  Evolution of the ECoF and the GICoF\n"
-        + parameters(f"P = {scalar(results, 'load'):g} N", rf"$\Delta^*$ ≈ {amplitude:.1f} µm"),
+        _title("the ECoF and the GICoF over the cycles", source)
+        + "\n"
+        + parameters(_load(scalar(results, "load")), rf"$\Delta^*$ ≈ {amplitude:.1f} µm"),
         fontsize="medium",
     )
+    if top.get_lines():  # the layout done with the title: the legend's place
+        _legend_clear_of_data(top, fontsize="small")
     return figure
 
 
@@ -307,17 +399,19 @@ def _cycle_axis(ax, cycle) -> None:
         ax.set_xlim(first - margin, last + margin)
 
 
-# --- Figure 10: measured loops and the fitted model ----------------------------------------
+# --- measured loops and the fitted model, as the paper's Figure 10 -------------------------
 
 
-def measured_and_fitted_loops(fits) -> Figure:
-    r"""Figure 10: measured fretting loops overlaid with the model fitted to them.
+def measured_and_fitted_loops(fits, *, source: str | None = None) -> Figure:
+    r"""Measured fretting loops overlaid with the model fitted to them, as the paper's Figure 10.
 
     Parameters
     ----------
     fits : LoopFit or mapping of str to LoopFit
         From :func:`ecofmaps.fit_loop`. A mapping draws one panel per entry, titled by
         its key, side by side (the paper's Figure 10 has Example 1 and Example 2).
+    source : str, optional
+        The recording's name (its file's), which the title begins with.
 
     Returns
     -------
@@ -364,26 +458,35 @@ def measured_and_fitted_loops(fits) -> Figure:
         panel = f"({chr(ord('a') + index)}) " if len(panels) > 1 else ""
         panel += f"{name}: " if name else ""
         ax.set_title(
-            f"{panel}P = {fit.load:g} N, "
+            f"{panel}{_load(fit.load)}, "
             rf"$x_o = \Delta^*$ = {fit.amplitude * MICRO:.1f} µm"
             "\n"
             + parameters(
                 rf"fit: $\mu$ = {fit.mu:.3f}",
-                stiffness_label(fit.stiffness),
+                _stiffness(fit.stiffness),
                 rf"$z_o$ = {fit.groove_depth * MICRO:.2f} µm",
                 f"RMS residual {fit.rms_residual:.2g} N",
             ),
             fontsize="medium",
         )
-        ax.legend(loc="best", fontsize="small")
-    figure.suptitle("Fig. 10  Measured fretting loops and the fitted model", fontsize="medium")
+    figure.suptitle(
+        _title("measured fretting loops and the fitted model", source), fontsize="medium"
+    )
+    for ax in axes:  # the layout done with the titles: the legends' places
+        _legend_clear_of_data(ax, fontsize="small")
     return figure
 
 
 # --- the loops read along the stroke: ecofmaps.resolve_loops --------------------------------
 
 
-def resolved_loops(resolved: xr.Dataset, results: xr.Dataset | None = None, cycles=None) -> Figure:
+def resolved_loops(
+    resolved: xr.Dataset,
+    results: xr.Dataset | None = None,
+    cycles=None,
+    *,
+    source: str | None = None,
+) -> Figure:
     r"""Friction and felt groove read along the stroke, cycle by cycle, and over the test.
 
     Parameters
@@ -396,6 +499,8 @@ def resolved_loops(resolved: xr.Dataset, results: xr.Dataset | None = None, cycl
     cycles : sequence of int, optional
         Cycle numbers drawn along the stroke; by default up to five cycles whose quality is
         ``'ok'``, spread evenly over the test, the first and the last included.
+    source : str, optional
+        The recording's name (its file's), which the title begins with.
 
     Returns
     -------
@@ -406,10 +511,12 @@ def resolved_loops(resolved: xr.Dataset, results: xr.Dataset | None = None, cycl
         :math:`k\xi^2/2` dotted; (c) :math:`h` over (position, cycle), the groove deepening
         as the test runs; (d) ``mu_resolved`` :math:`\pm 2` standard errors over the cycles
         (with the ECoF and GICoF when ``results`` is given) and the equivalent
-        ``aspect_ratio`` on a right-hand axis (none where no cycle has one); cycles with
+        ``aspect_ratio`` on a right-hand axis, dashed and in the legend (no axis where no
+        cycle has one); cycles with
         no resolved value are marked along the bottom with their quality (halfway up when
         nothing has a value). A single cycle is a band in (c) and an error bar in (d); a
-        panel with nothing to draw says why and has no ticks on its value axes.
+        panel with nothing to draw says why and has no ticks on its value axes. Each legend
+        sits in a corner clear of the panel's data, made above the data when none is.
 
     Notes
     -----
@@ -454,9 +561,7 @@ def resolved_loops(resolved: xr.Dataset, results: xr.Dataset | None = None, cycl
     stroke.set_xlabel(axis_label("position"))
     stroke.set_ylabel(r"Coefficient of friction $\mu(\xi)$ [1]")
     stroke.set_title(r"(a) $\mu$ along the stroke (dashed: its average)", fontsize="medium")
-    if chosen:
-        stroke.legend(loc="lower center", fontsize="x-small", ncols=2)
-    else:
+    if not chosen:
         stroke.text(
             0.5,
             0.5,
@@ -472,19 +577,27 @@ def resolved_loops(resolved: xr.Dataset, results: xr.Dataset | None = None, cycl
     felt.set_title("(b) the scar as the contact feels it", fontsize="medium")
     if chosen:
         felt.plot([], [], color="0.4", linestyle=":", label=r"equivalent parabola $k\xi^2/2$")
-        felt.legend(loc="upper center", fontsize="x-small", ncols=2)
     else:
         _note(felt, "no felt profile: no cycle was read along the stroke")
         _no_ticks(felt)
     for ax in (stroke, felt, test):
         ax.grid(alpha=0.3)
     _profile_over_test(figure, image, resolved)
-    _mu_over_test(test, resolved, results)
+    twins = _mu_over_test(test, resolved, results)
     figure.suptitle(
-        rf"Loops read along the stroke (P = {scalar(resolved, 'load'):g} N): "
-        r"$\mu(\xi)$ and $g(\xi)$ from the two slip branches at the same $\xi = \Delta - Q/S$",
+        _title(f"loops read along the stroke ({_load(scalar(resolved, 'load'))}): ", source)
+        + r"$\mu(\xi)$ and $g(\xi)$ from the two slip branches at the same $\xi = \Delta - Q/S$",
         fontsize="medium",
     )
+    # The layout done with the titles: each legend's place, clear of its panel's data.
+    if chosen:
+        _legend_clear_of_data(stroke, fontsize="x-small", ncols=2)
+        _legend_clear_of_data(felt, fontsize="x-small", ncols=2)
+    handles, labels = test.get_legend_handles_labels()
+    for twin in twins:
+        more = twin.get_legend_handles_labels()
+        handles, labels = handles + more[0], labels + more[1]
+    _legend_clear_of_data(test, handles, labels, twins=twins, fontsize="x-small")
     return figure
 
 
@@ -512,8 +625,8 @@ def _profile_over_test(figure: Figure, image, resolved: xr.Dataset) -> None:
     figure.colorbar(mesh, ax=image, label=r"$h(\xi)$ [µm]")
 
 
-def _mu_over_test(test, resolved: xr.Dataset, results: xr.Dataset | None) -> None:
-    """Panel (d)."""
+def _mu_over_test(test, resolved: xr.Dataset, results: xr.Dataset | None) -> tuple:
+    """Panel (d), without its legend; its right-hand axis, if any, in a tuple."""
     number = resolved["cycle"].values
     mu = resolved["mu_resolved"].values
     error = 2.0 * resolved["mu_resolved_se"].values
@@ -579,12 +692,20 @@ def _mu_over_test(test, resolved: xr.Dataset, results: xr.Dataset | None) -> Non
         _note(test, "no cycle read along the stroke:\n" + _why_none(resolved), height=0.3)
     test.set_xlabel("Cycle")
     test.set_ylabel("Coefficient of friction [1]")
+    twins = ()
     if np.isfinite(resolved["aspect_ratio"].values).any():  # no right-hand axis without a line
         ratio = test.twinx()
         ratio.plot(
-            number, resolved["aspect_ratio"], color="0.3", linestyle="--", linewidth=1.0, **marker
+            number,
+            resolved["aspect_ratio"],
+            color="0.3",
+            linestyle="--",
+            linewidth=1.0,
+            label=r"equivalent groove $z_o/x_o$ (right axis)",
+            **marker,
         )
-        ratio.set_ylabel(axis_label("aspect_ratio") + " (dashed)")
+        ratio.set_ylabel(axis_label("aspect_ratio"))
+        twins = (ratio,)
     _cycle_axis(test, number)  # after twinx, which shares the cycle axis's ticker
     test.set_title(r"(d) $\mu$ over the test, and the equivalent groove", fontsize="medium")
-    test.legend(loc="best", fontsize="x-small")
+    return twins

@@ -20,6 +20,8 @@ from ecofmaps.io.files import atomic_path
 __all__ = [
     "ECOF_RATIO_LEVELS",
     "FIGSIZE",
+    "PAPER_DPI",
+    "RECORDING_DPI",
     "axis_label",
     "number_text",
     "save_figure",
@@ -32,6 +34,12 @@ ECOF_RATIO_LEVELS = (1.01, 1.02, 1.03, 1.04, 1.05, 1.06, 1.08, 1.10, 1.12, 1.14,
 
 #: The level drawn heavier: the paper's "most tests are within 5 %".
 HIGHLIGHT_LEVEL = 1.05
+
+#: Resolution of the paper's figures (``ecofmaps figures``) written as PNG. [1/inch]
+PAPER_DPI = 150
+
+#: Resolution of the plots of a user's recording (``ecofmaps loops --plots``). [1/inch]
+RECORDING_DPI = 300
 
 
 def ecof_ratio_colors() -> tuple:
@@ -133,7 +141,7 @@ def force_ratio_axis(ax, load: float) -> None:
 _METADATA = {"pdf": {"CreationDate": None}, "svg": {"Date": None}}
 
 
-def save_figure(figure: Figure, path, dpi: int = 150) -> Path:
+def save_figure(figure: Figure, path, dpi: int = PAPER_DPI) -> Path:
     """Write ``figure`` to ``path`` atomically; the format follows the file's suffix.
 
     The figure is written to a temporary file in the same directory and renamed over
@@ -145,7 +153,8 @@ def save_figure(figure: Figure, path, dpi: int = 150) -> Path:
     path : str or os.PathLike
         Destination, ending in ``.png``, ``.pdf`` or ``.svg``. Its directory must exist.
     dpi : int
-        Resolution of raster output. [1/inch]
+        Resolution of raster output: :data:`PAPER_DPI` by default, :data:`RECORDING_DPI`
+        for the plots of a recording. [1/inch]
 
     Returns
     -------

@@ -22,6 +22,7 @@ import numpy as np
 import xarray as xr
 
 from ecofmaps._nomenclature import attrs
+from ecofmaps._parallel import SOURCE
 from ecofmaps.io.files import FileLineError
 
 __all__ = [
@@ -297,6 +298,21 @@ class Recording:
             last_line=last,
             start=self.start + first,
         )
+
+    def close(self) -> None:
+        """Close the files a lazy recording reads from (a later read opens them again). A
+        recording is also a context manager that closes them on leaving:
+        ``with read_recording(path) as recording: ...``."""
+        for array in (self.displacement, self.force, self.cycle, self.load):
+            source = getattr(array, SOURCE, None)
+            if source is not None:
+                source.close()
+
+    def __enter__(self) -> Recording:
+        return self
+
+    def __exit__(self, *raised) -> None:
+        self.close()
 
     def compute(self) -> Recording:
         """The recording with NumPy arrays (reads a lazy one whole; else itself)."""

@@ -431,9 +431,9 @@ def recording_blocks(path, samples: int = 1 << 20, **options) -> Iterator[Record
     _check_count("block_bytes", block_bytes)
     path = Path(path)
     if recording_format(path) != "text":
-        recording = read_recording(path, lazy=True, chunks=samples, **options)
-        for first in range(0, recording.size, samples):
-            yield recording[first : first + samples]
+        with read_recording(path, lazy=True, chunks=samples, **options) as recording:
+            for first in range(0, recording.size, samples):
+                yield recording[first : first + samples]
         return
     checked = _options(**options)
     if checked["group"] is not None:

@@ -66,11 +66,26 @@ _WIDTH = 1240
 #: The variables a report needs in the results.
 _NEEDED = ("cycle", "ecof", "gicof", "quality", "regime", "load")
 
-#: Shows a number of the table as it is (it was rounded to the CSV's 6 significant digits),
-#: and nothing for NaN, as the CSV's empty field.
+#: Significant digits of the table's numbers, as the CSV's: each column shows its largest
+#: value with as many, and all its values with the same decimals. [1]
+_DIGITS = 6
+
+#: Shows a number of the table with the column's DECIMALS decimals, and nothing for NaN, as
+#: the CSV's empty field.
 _NUMBER_CELL = (
-    '<div style="text-align: right"><%= (value == null || value !== value) ? "" : value %></div>'
+    '<div style="text-align: right"><%= (value == null || value !== value) ? "" : '
+    "value.toFixed(DECIMALS) %></div>"
 )
+
+#: Width of a character of the table's headers and text, and the room around them. [px]
+_CHARACTER, _CELL_ROOM = 6.5, 10
+
+#: Width of the table: every column of a recording's table visible in a window 1400 px wide
+#: (its first column frozen when there are more). [px]
+_TABLE_WIDTH = 1350
+
+#: Room the table keeps beside its columns, for its vertical scroll bar. [px]
+_TABLE_ROOM = 20
 
 #: Shows the loops of the cycles picked in the page: the measured loop and, where the cycle
 #: has one, the model's, each pair in one colour.
@@ -526,20 +541,44 @@ def _fill_shown(carried: dict, names, palette, measured, model) -> None:
     }
 
 
+def _column_decimals(values, digits: int = _DIGITS) -> int:
+    """The decimals that show the largest of ``values`` with ``digits`` significant digits, the
+    same for every value of a column.
+
+    Examples
+    --------
+    >>> [_column_decimals(values) for values in ([0.80003, 0.806507], [50.1348, 9.5], [])]
+    [6, 4, 0]
+    """
+    values = np.abs(np.asarray(values, dtype=np.float64))
+    values = values[np.isfinite(values) & (values > 0)]
+    if not values.size:
+        return 0
+    return int(max(0, digits - 1 - np.floor(np.log10(values.max()))))
+
+
 def _table(results: xr.Dataset):
-    """The table of ``ecofmaps loops --out``: every column, numbers to 6 significant digits."""
+    """The table of ``ecofmaps loops --out``: every column, numbers to 6 significant digits
+    with the same decimals down each column, the first column frozen while the others scroll."""
     table = results_table(results)
     data, columns = {}, []
     for name in table.columns:
         values = table[name].to_numpy()
         if values.dtype.kind == "f":
-            values = np.array([float(f"{value:.6g}") for value in values])
-            formatter = HTMLTemplateFormatter(template=_NUMBER_CELL)
+            values = np.array([float(f"{value:.{_DIGITS}g}") for value in values])
+            decimals = str(_column_decimals(values))
+            formatter = HTMLTemplateFormatter(template=_NUMBER_CELL.replace("DECIMALS", decimals))
+            longest = len(name)
         else:
             formatter = StringFormatter()
-        width = 200 if name == "quality" else max(60, 8 * len(name) + 16)  # the name shows
+            longest = max([len(name), *(len(str(value)) for value in values)])
+        # The name shows, and the values (a quality with many flags scrolls within its cell)
+        width = min(200, max(56, round(_CHARACTER * longest + _CELL_ROOM)))
         columns.append(TableColumn(field=name, title=name, formatter=formatter, width=width))
         data[name] = values
+    # The last column (the quality) as wide as the table leaves it, but never narrower than 90
+    others = sum(column.width for column in columns[:-1])
+    columns[-1].width = min(columns[-1].width, max(90, _TABLE_WIDTH - _TABLE_ROOM - others))
     heading = Div(
         text=(
             "<h3 style='margin:12px 0 4px 0'>The table (as <code>ecofmaps loops --out</code> "
@@ -550,9 +589,10 @@ def _table(results: xr.Dataset):
     grid = DataTable(
         source=ColumnDataSource(data),
         columns=columns,
-        width=_WIDTH,
+        width=_TABLE_WIDTH,
         height=380,
         index_position=None,
+        frozen_columns=1,
         sortable=True,
         autosize_mode="none",
         css_classes=["ecofmaps-table"],

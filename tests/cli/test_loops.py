@@ -320,6 +320,11 @@ def test_the_summary_reads_the_gross_slip_cycles_only():
     assert (
         _summary(Path("rig.csv"), none, None) == "  rig.csv: 7 cycles: 7 ok (1 incomplete dropped)"
     )
+    none.attrs["cycles_from"] = "displacement reversals"
+    assert _summary(Path("rig.csv"), none, None) == (
+        "  rig.csv: 7 cycles: 7 ok (1 incomplete dropped: partial, where the recording starts "
+        "or ends mid-cycle)"
+    )
 
 
 def test_rig_stiffness_reads_the_regime_on_the_contact(tmp_path, capsys):

@@ -149,11 +149,11 @@ def test_number_text():
 
 
 def test_a_soft_rig_is_labelled_in_its_own_digits(results):
-    """A measured stiffness of 0.02 MN/m read "S = 0.0 MN/m" before."""
+    """A measured stiffness of 0.02 MN/m read "S = 0.0 MN/m" before; S is italic."""
     soft = results.copy()
     soft["stiffness"] = soft["stiffness"] * 0.0 + 0.02e6
     figure = measured_loops(soft, cycles=[int(soft.cycle[0])])
-    assert "S = 0.02 MN/m" in figure.axes[0].get_title()
+    assert "$S$ = 0.02 MN/m" in figure.axes[0].get_title()
     assert stiffness_label(np.inf) == r"rigid ($S = \infty$)"
 
 

@@ -1,5 +1,7 @@
-"""The figures of measured loops: the loops with Q = SΔ and Figure 9, drawn from the Dataset."""
+"""The figures of measured loops: the loops with Q = SΔ and the friction over the test, drawn
+from the Dataset."""
 
+import re
 import warnings
 
 import numpy as np
@@ -49,7 +51,7 @@ def test_measured_loops(results, tmp_path):
         crossings.get_xdata(),
         [last.crossing_displacement_forward * 1e6, last.crossing_displacement_backward * 1e6],
     )
-    assert [t.get_text() for t in panels[0].get_legend().get_texts()] == [
+    assert [t.get_text() for t in figure.legends[0].get_texts()] == [
         "measured loop",
         "$Q = S\\Delta$",
         "GICoF crossings",
@@ -70,7 +72,7 @@ def test_cof_evolution(results):
     np.testing.assert_allclose(excess, (results.ecof / results.gicof - 1) * 100)
     assert excess[-1] > 3.0  # z_o/x_o = 0.3 at S = 35 MN/m: μ_E well above μ
     assert bottom.get_xlabel() == "Cycle" and "[1]" in top.get_ylabel()
-    assert "Fig. 9" in figure.get_suptitle()
+    assert figure.get_suptitle().startswith("The ECoF and the GICoF over the cycles\n")
 
 
 def test_measured_loops_needs_the_loops(results):
@@ -196,12 +198,12 @@ def test_loop_legend_lists_only_what_is_drawn(microslip, results):
     """No GICoF without gross slip: no crossings drawn, and none in the legend."""
     figure = measured_loops(microslip)
     rendered(figure)
-    legend = [t.get_text() for t in figure.axes[0].get_legend().get_texts()]
+    legend = [t.get_text() for t in figure.legends[0].get_texts()]
     assert legend == ["measured loop", r"$Q = S\Delta$"]
     drawn = {label for ax in figure.axes for label in drawn_labels(ax)}
     assert set(legend) == drawn
     gross = measured_loops(results)
-    assert "GICoF crossings" in [t.get_text() for t in gross.axes[0].get_legend().get_texts()]
+    assert "GICoF crossings" in [t.get_text() for t in gross.legends[0].get_texts()]
 
 
 @pytest.mark.filterwarnings("error")
@@ -326,13 +328,145 @@ def test_marks_without_any_value_sit_halfway_up_above_the_note(flagged):
 
 @pytest.mark.filterwarnings("error")
 def test_no_aspect_ratio_axis_without_an_aspect_ratio(flagged, results):
-    """The right-hand axis of (d) claims a dashed aspect ratio only where one is drawn."""
+    """The right-hand axis of (d) shows an aspect ratio only where one is drawn, and the legend
+    of (d) lists its line as drawn (dashed, with its markers)."""
     resolved = resolve_analyzed_loops(flagged)
     assert not np.isfinite(resolved.aspect_ratio).any()
     figure = resolved_loops(resolved, flagged)
     rendered(figure)
-    assert not [ax for ax in figure.axes if "dashed" in ax.get_ylabel()]
+    assert not [ax for ax in figure.axes if "aspect ratio" in ax.get_ylabel()]
     normal = resolved_loops(resolve_analyzed_loops(results), results)
-    (ratio,) = [ax for ax in normal.axes if "dashed" in ax.get_ylabel()]
+    rendered(normal)
+    (ratio,) = [ax for ax in normal.axes if "aspect ratio" in ax.get_ylabel()]
+    assert "dashed" not in ratio.get_ylabel()
     (line,) = ratio.get_lines()
     assert line.get_linestyle() == "--" and np.isfinite(line.get_ydata()).all()
+    legend = normal.axes[3].get_legend()
+    (entry,) = [
+        handle
+        for handle, text in zip(legend.legend_handles, legend.get_texts(), strict=True)
+        if text.get_text() == line.get_label()
+    ]
+    assert entry.get_linestyle() == "--" and entry.get_marker() == line.get_marker()
+
+
+# --- titles, legends and symbols of a user's recording ---------------------------------------
+
+
+def all_figures(results, source=None):
+    """Every figure of a recording's plots, drawn."""
+    resolved = resolve_analyzed_loops(results)
+    figures = [
+        measured_loops(results, resolved=resolved, source=source),
+        cof_evolution(results, source=source),
+        resolved_loops(resolved, results, source=source),
+    ]
+    for figure in figures:
+        rendered(figure)
+    return figures
+
+
+def test_figures_are_titled_by_the_recording_not_the_paper(results):
+    """The title begins with the recording's file and says what the figure shows."""
+    for figure in all_figures(results, source="rig_0042.csv"):
+        title = figure.get_suptitle()
+        assert title.startswith("rig_0042.csv: ") and "Fig." not in title
+    for figure in all_figures(results):
+        assert "Fig." not in figure.get_suptitle() and figure.get_suptitle()[0].isupper()
+
+
+def texts_of(figure) -> list[str]:
+    """Every title, label and legend entry of ``figure``."""
+    texts = [figure.get_suptitle()]
+    legends = list(figure.legends)
+    for ax in figure.axes:
+        texts += [ax.get_title(), ax.get_xlabel(), ax.get_ylabel()]
+        legends.append(ax.get_legend())
+    return texts + [t.get_text() for legend in legends if legend for t in legend.get_texts()]
+
+
+@pytest.mark.parametrize("name", ["results", "flagged", "microslip"])
+def test_quantities_s_and_p_are_italic(name, request):
+    """S and P are written in mathtext ($S$, $P$) wherever a figure names them."""
+    for figure in all_figures(request.getfixturevalue(name), source="t.csv"):
+        for text in texts_of(figure):
+            plain = re.sub(r"\$[^$]*\$", "", text)  # outside mathtext
+            assert not re.search(r"\b[SPQ]\b", plain), text
+
+
+def covered(ax, box) -> list[str]:
+    """What of ``ax`` is drawn inside the display box ``box``: the points of every line (its
+    segments cut into 50 each) and every filled area's outline."""
+    hits = []
+    for line in ax.get_lines():
+        points = line.get_transform().transform(line.get_xydata())
+        points = points[np.isfinite(points).all(axis=1)]
+        if line.get_linestyle() not in ("None", "", " ") and len(points) > 1:
+            steps = np.linspace(0.0, 1.0, 50)[:, None, None]
+            points = (points[:-1] + steps * (points[1:] - points[:-1])).reshape(-1, 2)
+        if box.count_contains(points):
+            hits.append(line.get_label())
+    for collection in ax.collections:
+        for path in collection.get_paths():
+            outline = collection.get_transform().transform(path.vertices)
+            if (
+                box.count_contains(outline)
+                or path.transformed(collection.get_transform())
+                .contains_points([[box.x0, box.y0], [box.x1, box.y1]])
+                .any()
+            ):
+                hits.append(collection.get_label())
+    return hits
+
+
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize("name", ["results", "flagged", "microslip", "single"])
+def test_legends_never_cover_data(name, request):
+    """Every legend inside a panel leaves the panel's lines, markers and areas uncovered, its
+    twin's too; the legend of the loops sits outside every panel."""
+    for figure in all_figures(request.getfixturevalue(name)):
+        for ax in figure.axes:
+            legend = ax.get_legend()
+            if legend is None:
+                continue
+            box = legend.get_window_extent()
+            twins = [
+                other
+                for other in figure.axes
+                if other is not ax and other.bbox.bounds == ax.bbox.bounds
+            ]
+            for panel in (ax, *twins):
+                assert not covered(panel, box), (figure.get_suptitle(), ax.get_title())
+        for legend in figure.legends:
+            box = legend.get_window_extent()
+            assert not any(box.overlaps(ax.bbox) for ax in figure.axes if ax.get_visible())
+
+
+def test_a_legend_with_no_free_corner_gets_room_above_the_data():
+    """Lines through every corner: the value axis is stretched and the legend goes above them."""
+    from matplotlib.figure import Figure
+
+    from ecofmaps.figures.measured_figures import _legend_clear_of_data
+
+    figure = Figure(figsize=(5.0, 3.5), layout="constrained")
+    ax = figure.subplots()
+    x = np.linspace(0.0, 1.0, 101)
+    ax.plot(x, np.where(np.arange(x.size) % 2, 0.0, 1.0), label="zigzag")
+    ax.plot(x, 0.5 + 0.0 * x, label="level")
+    legend = _legend_clear_of_data(ax)
+    rendered(figure)
+    assert not covered(ax, legend.get_window_extent())
+    assert ax.get_ylim()[1] > 1.2
+
+
+def test_recording_plots_are_written_at_300_dpi_and_the_papers_at_150(results, tmp_path):
+    """save_figure's default resolution is the paper figures'; a recording's plots ask for more."""
+    from ecofmaps.figures.style import PAPER_DPI, RECORDING_DPI
+
+    figure = cof_evolution(results)
+    paper = save_figure(figure, tmp_path / "paper.png")
+    recording = save_figure(figure, tmp_path / "recording.png", dpi=RECORDING_DPI)
+    width = {path: int.from_bytes(path.read_bytes()[16:20], "big") for path in (paper, recording)}
+    inches = figure.get_size_inches()[0]
+    assert (PAPER_DPI, RECORDING_DPI) == (150, 300)
+    assert width[paper] == round(inches * 150) and width[recording] == round(inches * 300)

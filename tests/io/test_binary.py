@@ -463,3 +463,74 @@ def test_flipped_bytes_in_the_header_name_the_file_as_damaged(tmp_path, capfd, k
             assert "(truncated or damaged)" in str(error) or "(a damaged file" in str(error)
     assert refused >= 10
     assert capfd.readouterr().err == ""
+
+
+# --- no file left to the garbage collector ----------------------------------------------------
+
+
+def open_hdf5_files() -> list:
+    """The h5netcdf files of this process still open (alive and not closed)."""
+    import gc
+
+    import h5netcdf
+
+    return [f for f in gc.get_objects() if isinstance(f, h5netcdf.File) and not f._closed]
+
+
+def test_a_lazy_recording_closes_its_files_on_leaving_its_block(tmp_path):
+    """A lazy recording read and closed (``with``, or ``close()``) leaves no HDF5 file open
+    for the garbage collector to close, though the recording itself is still alive."""
+    path = write_hdf5(tmp_path / "rig.h5")
+    assert open_hdf5_files() == []
+    with read_recording(path, lazy=True, group="rig/run1") as recording:
+        whole = recording.compute()
+        assert open_hdf5_files()  # open while it is read
+    assert open_hdf5_files() == []
+    np.testing.assert_array_equal(recording.compute().displacement, whole.displacement)
+    recording.close()  # the read above opened it again
+    assert open_hdf5_files() == []
+
+
+@pytest.fixture
+def left_to_gc(monkeypatch):
+    """The files of the rig-file columns that the garbage collector found still open (the
+    collector, not the code that read them, closed them)."""
+    import gc
+
+    left = []
+    collect = Column.__del__
+
+    def watched(column):
+        if column._handle is not None:
+            left.append(str(column.path))
+        collect(column)
+
+    monkeypatch.setattr(Column, "__del__", watched)
+    yield lambda: gc.collect() * 0 or left
+
+
+def test_blocks_of_a_rig_file_close_it_when_done_or_given_up(tmp_path, left_to_gc):
+    path = write_hdf5(tmp_path / "rig.h5")
+    blocks = recording_blocks(path, 1000, group="rig/run1")
+    next(blocks)
+    blocks.close()  # the reader stops early
+    assert sum(block.size for block in recording_blocks(path, 1000, group="rig/run1")) == SIZE
+    assert left_to_gc() == [] and open_hdf5_files() == []
+
+
+def test_the_loops_command_closes_a_lazy_recording_whose_analysis_fails(
+    tmp_path, capsys, monkeypatch, left_to_gc
+):
+    """A lazy rig file that cannot be analysed: the error is reported and the file closed,
+    not left open in the error's traceback for the garbage collector."""
+    from ecofmaps import cli
+    from ecofmaps.io import binary
+
+    monkeypatch.setattr(binary, "LAZY_SAMPLES", 1000)  # read lazily, in this process
+    path = write_hdf5(tmp_path / "rig.h5")  # noise: no fretting cycles in it
+    status = cli.main(
+        ["loops", str(path), "--group", "rig/run1", "--load", "450N", "--out",
+         str(tmp_path / "t.csv")]
+    )  # fmt: skip
+    assert status != 0 and "error" in capsys.readouterr().err
+    assert left_to_gc() == [] and open_hdf5_files() == []

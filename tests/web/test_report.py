@@ -197,13 +197,16 @@ def test_the_table_shows_the_numbers_of_the_csv(opened, command):
     assert len(shown) >= 5
     cells = opened.execute_script(
         """
-        const rows = [];
+        // The frozen first column and the others are drawn as two rows at the same height.
+        const rows = new Map();
         (function visit(root) {
-            root.querySelectorAll('.slick-row').forEach(r =>
-                rows.push(Array.from(r.querySelectorAll('.slick-cell')).map(c => c.textContent)));
+            root.querySelectorAll('.slick-row').forEach(r => {
+                const cells = Array.from(r.querySelectorAll('.slick-cell')).map(c => c.textContent);
+                rows.set(r.style.top, (rows.get(r.style.top) || []).concat(cells));
+            });
             root.querySelectorAll('*').forEach(e => { if (e.shadowRoot) visit(e.shadowRoot); });
         })(document);
-        return rows;
+        return Array.from(rows.values());
         """
     )
     by_cycle = {row["cycle"]: row for row in rows}
@@ -213,12 +216,46 @@ def test_the_table_shows_the_numbers_of_the_csv(opened, command):
         expected = by_cycle[texts[0].strip()]
         for column, text in zip(columns, texts, strict=True):
             text, wanted = text.strip(), expected[column]
-            try:
-                assert float(text) == float(wanted), (column, text, wanted)
+            try:  # the CSV's number to the column's decimals
+                decimals = len(text.partition(".")[2])
+                assert float(text) == round(float(wanted), decimals), (column, text, wanted)
             except ValueError:  # text columns, and NaN: an empty field in the CSV
                 assert text == wanted, (column, text, wanted)
             compared += 1
     assert compared >= 5 * len(columns)
+    for index, column in enumerate(columns):  # the same decimals down each column of numbers
+        decimals = {len(t[index].strip().partition(".")[2]) for t in cells if "." in t[index]}
+        assert len(decimals) <= 1, (column, decimals)
+
+
+def test_every_column_of_the_table_is_visible_at_1400_px(opened):
+    """In a window 1400 px wide the table's columns all fit, and its first column is frozen."""
+    opened.set_window_size(1400, 900)
+    right = opened.execute_script(
+        """
+        let right = 0;
+        (function visit(root) {
+            root.querySelectorAll('.slick-header-column').forEach(h =>
+                right = Math.max(right, h.getBoundingClientRect().right));
+            root.querySelectorAll('*').forEach(e => { if (e.shadowRoot) visit(e.shadowRoot); });
+        })(document);
+        return right;
+        """
+    )
+    assert 0 < right <= opened.execute_script("return document.documentElement.clientWidth;")
+
+
+def test_the_table_has_its_first_column_frozen_and_fixed_decimals(results):
+    """More columns than fit scroll beside the frozen first one; each column of numbers has one
+    number of decimals, that of its largest value with 6 significant digits."""
+    from bokeh.models import DataTable
+
+    (grid,) = report_document(results).select({"type": DataTable})
+    assert grid.frozen_columns == 1 and grid.columns[0].field == "cycle"
+    templates = {c.field: getattr(c.formatter, "template", "") for c in grid.columns}
+    largest = float(np.nanmax(np.abs(results.ecof.values)))
+    assert largest < 1 and "toFixed(6)" in templates["ecof"]  # 0.800030, not 0.80003
+    assert "toFixed(4)" in templates["amplitude_um"]  # 50.1348 µm
 
 
 def test_picking_a_cycle_shows_its_loop(opened):
