@@ -433,8 +433,8 @@ REASONS = {
     "gicof-varies": (
         "the friction read along the stroke wiggles beyond the noise (its means over "
         f"{SCATTER_BLOCKS} blocks of the central part scatter about a straight line by more "
-        f"than {GICOF_WIGGLE * 100:g} % of μ: chatter, "
-        "stick-slip): the GICoF, read at one position, is not the contact's mean friction",
+        f"than {GICOF_WIGGLE * 100:g} % of μ: chatter): "
+        "the GICoF, read at one position, is not the contact's mean friction",
         _GICOF,
     ),
 }

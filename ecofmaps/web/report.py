@@ -258,8 +258,9 @@ def _header(results: xr.Dataset, inputs: Mapping) -> Div:
         text=(
             "<h1 style='margin:8px 0 4px 0;font-size:22px'>Fretting test: friction cycle by "
             "cycle</h1><p style='margin:0 0 6px 0;max-width:1100px'>ECoF μ_E = E_d/(4Pδ*) "
-            "(eq. 1), GICoF = Q/P where the loop crosses Q = SΔ (eq. 17-18), and μ read "
-            "along the stroke, from <code>ecofmaps.analyze_loops</code>. Values that cannot "
+            "(eq. 1), GICoF = Q/P at the centre of the slip, where the loop crosses Q = SΔ "
+            "(eq. 17-18; a fit over its central 70 %), and μ read along the stroke, from "
+            "<code>ecofmaps.analyze_loops</code>. Values that cannot "
             "be stood behind are left out, and the quality flags say why.</p>"
             f"<table class='ecofmaps-inputs' style='font-size:14px'>{cells}</table>"
         ),

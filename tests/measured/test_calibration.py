@@ -1,7 +1,7 @@
 """Calibration: on recordings whose truth is known, ±2 se of mu_resolved covers the truth.
 
 Each kind of :func:`tests.measured.ugly.ugly_recording` (noise, offsets and drift,
-chatter, random stick-slip, backlash, an amplitude sweep, a sparse digitised loop,
+periodic and random chatter, backlash, an amplitude sweep, a sparse digitised loop,
 ploughing, all together) is analysed as users do, with :func:`ecofmaps.analyze_loops`
 (``resolve=True``; the rig's cycle counter gives the cycles). A cycle's ``mu_resolved`` is
 *reported* where no reason in its ``quality`` reaches it (it is finite): ``'ok'``, or a
@@ -33,7 +33,7 @@ KINDS = {
     "noise": 12,
     "offsets": 13,
     "chatter": 14,
-    "stick-slip": 15,
+    "random-chatter": 15,
     "backlash": 16,
     "sweep": 17,
     "sparse": 18,

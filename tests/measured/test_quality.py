@@ -199,7 +199,7 @@ def test_random_walks_are_no_loops(seed):
 
 
 def test_unrelated_clipped_sines_are_refused():
-    """Two clipped sines that are no friction loop (the force is not a stick-slip response).
+    """Two clipped sines that are no friction loop (the force neither sticks nor slips).
 
     The displacement carries a rig's noise: held exactly flat where it is clipped, the
     force ramps at a constant displacement, a rigid rig's vertical stick side whose slope is

@@ -1,5 +1,5 @@
 """Ugly recordings for the tests: the model's loops with what real rigs add (noise, drift,
-chatter, stick-slip, backlash, sweeps, digitising, microslip, ploughing), with the truth."""
+periodic and random chatter, backlash, sweeps, digitising, microslip, ploughing), with the truth."""
 
 import difflib
 from typing import NamedTuple
@@ -12,7 +12,7 @@ UGLY_KINDS = {
     "noise": "white noise of 0.5 um and 8 N (1 % of the amplitude, 2 % of Q*)",
     "offsets": "offsets of 5 um and 20 N, a drift of 1 um per cycle, and white noise",
     "chatter": "friction that chatters +-30 % at 7.37 periods per cycle (not the drive's)",
-    "stick-slip": "friction that jumps at random along the stroke (+-15 %, a few samples long)",
+    "random-chatter": "friction that jumps at random along the stroke (+-15 %, a few samples long)",
     "backlash": "a dead band of +-1.5 um between the actuator and the pad at the reversals",
     "sweep": "the amplitude swept from 30 to 70 um over the recording",
     "sparse": "a digitised loop: 32 points per cycle, 0.5 um and 2 N steps",
@@ -44,7 +44,7 @@ _UGLY = {
         "displacement_drift": 1e-6,
     },
     "chatter": {"chatter": 0.3, "displacement_noise": 0.05e-6, "force_noise": 0.5},
-    "stick-slip": {"stick_slip": 0.15, "displacement_noise": 0.05e-6, "force_noise": 0.5},
+    "random-chatter": {"random_chatter": 0.15, "displacement_noise": 0.05e-6, "force_noise": 0.5},
     "backlash": {"backlash": 1.5e-6, "displacement_noise": 0.05e-6, "force_noise": 0.5},
     "sweep": {"sweep": (30e-6, 70e-6), "displacement_noise": 0.05e-6, "force_noise": 0.5},
     "sparse": {"samples_per_cycle": 32, "displacement_step": 0.5e-6, "force_step": 2.0},
@@ -64,8 +64,8 @@ _UGLY = {
 #: Periods of the chatter per drive cycle: not a ratio of small integers.
 _CHATTER_FREQUENCY = 7.37
 
-#: Correlation length of the random stick-slip, in samples.
-_STICK_SLIP_SAMPLES = 4.0
+#: Correlation length of the random chatter, in samples.
+_RANDOM_CHATTER_SAMPLES = 4.0
 
 
 class UglyRecording(NamedTuple):
@@ -168,7 +168,7 @@ def ugly_recording(kind, *, cycles=30, seed=0):
     cycles : int
         Number of cycles recorded (>= 1). [1]
     seed : int
-        Seed of the random numbers (noise, the chatter's phase, the stick-slip).
+        Seed of the random numbers (noise, the chatter's phase and its random jumps).
 
     Returns
     -------
@@ -182,7 +182,7 @@ def ugly_recording(kind, *, cycles=30, seed=0):
 
     * A constant friction :math:`\mu` (every kind but those below): ``mu`` and ``gicof``
       are :math:`\mu`; for the model's loop on any groove the GICoF is :math:`\mu` (eq. 18).
-    * ``'chatter'`` and ``'stick-slip'``: the contact's friction varies in time,
+    * ``'chatter'`` and ``'random-chatter'``: the contact's friction varies in time,
       :math:`\mu(t) = \mu(1 + a\sin(2\pi f t + \phi))` with :math:`f` = 7.37 periods per
       cycle and a random phase, or :math:`\mu(1 + a\,n(t))` with :math:`n` Gaussian noise
       smoothed over about four samples. The truth of a cycle is the mean of the friction
@@ -258,10 +258,10 @@ def _ugly_loops(flaw, t, rng):
     if "chatter" in flaw:
         phase = rng.uniform(0.0, 2.0 * np.pi)
         friction *= 1.0 + flaw["chatter"] * np.sin(2.0 * np.pi * _CHATTER_FREQUENCY * t + phase)
-    if "stick_slip" in flaw:
-        kernel = np.exp(-0.5 * (np.arange(-12, 13) / _STICK_SLIP_SAMPLES) ** 2)
+    if "random_chatter" in flaw:
+        kernel = np.exp(-0.5 * (np.arange(-12, 13) / _RANDOM_CHATTER_SAMPLES) ** 2)
         smooth = np.convolve(rng.normal(size=t.size), kernel / np.sqrt(np.sum(kernel**2)), "same")
-        friction *= 1.0 + flaw["stick_slip"] * np.clip(smooth, -2.5, 2.5)
+        friction *= 1.0 + flaw["random_chatter"] * np.clip(smooth, -2.5, 2.5)
     contact = _play(imposed, flaw["backlash"]) if "backlash" in flaw else imposed
     if "microslip" in flaw:
         force = _microslip_force(contact, rig["load"], rig["mu"], flaw["microslip"])[0]
