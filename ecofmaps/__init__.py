@@ -46,6 +46,7 @@ _PUBLIC = {
         "GROSS_SLIP",
         "INVALID",
         "NO_GROSS_SLIP",
+        "PARTIAL_SLIP",
         "SELF_LOCKING",
         "Regime",
         "ScarProfile",

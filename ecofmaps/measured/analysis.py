@@ -136,7 +136,7 @@ def analyze_loops(
         and force_offset [N] (the centres removed, of the force as read),
         force_drift_se [N] (standard error of the offset between the loop's branches
         that the drift correction between neighbouring centres leaves), regime
-        (:class:`ecofmaps.Regime` codes: GROSS_SLIP, NO_GROSS_SLIP for partial slip, INVALID
+        (:class:`ecofmaps.Regime` codes: GROSS_SLIP, PARTIAL_SLIP, INVALID
         for a refused cycle; int32 with CF flag attributes), stick_residual [m] (root
         mean square displacement off the stick lines) and quality ('ok', or why values
         are NaN: :mod:`ecofmaps.measured.quality`); the load is a scalar coordinate. The

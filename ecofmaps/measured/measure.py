@@ -435,7 +435,7 @@ def _loop_values(block, options):
         "curved-stick": fit["curved"] & ~on_plateau,
         "curved-stick-sliding": fit["curved"] & on_plateau,
         "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]),
-        "not-gross-slip": ~sliding,
+        "partial-slip": ~sliding,
     }
     return values, flags
 

@@ -14,7 +14,7 @@ import xarray as xr
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._codes import warn
 from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles
-from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP, Regime
+from ecofmaps.model.regimes import GROSS_SLIP, INVALID, PARTIAL_SLIP, Regime
 
 __all__ = [
     "ALL",
@@ -47,8 +47,8 @@ _COMMENTS = {
     "slip_amplitude": "half the loop's width at Q = 0",
     "dissipated_energy": "the loop's area",
     "stiffness": "slope of the stick segments",
-    "regime": "GROSS_SLIP when the energy ratio exceeds gross_slip_threshold, else NO_GROSS_SLIP "
-    "(partial slip); INVALID where the cycle is refused",
+    "regime": "GROSS_SLIP when the energy ratio exceeds gross_slip_threshold, else PARTIAL_SLIP; "
+    "INVALID where the cycle is refused",
     "quality": "'ok' or the reasons for NaN, joined by '+' (ecofmaps.measured.quality)",
 }
 
@@ -150,7 +150,7 @@ def judged(values: dict, flags: dict, options):
     recorded = {k: values[k] for k in ("normal_load",) if k in values}  # a refused cycle's too
     values = apply_quality({k: v for k, v in values.items() if k not in recorded}, flags)
     sliding = gross_slip(values, options)
-    regime = np.where(refused, INVALID, np.where(sliding, GROSS_SLIP, NO_GROSS_SLIP))
+    regime = np.where(refused, INVALID, np.where(sliding, GROSS_SLIP, PARTIAL_SLIP))
     return values | recorded, quality_strings(flags, size), refused, regime
 
 
@@ -199,7 +199,7 @@ class Tally:
     def add(self, quality, flags: dict, amplitude) -> None:
         """Count the cycles of a part: their ``quality``, ``flags`` and amplitudes as measured."""
         self.counts.update(collections.Counter(np.asarray(quality).tolist()))
-        quiet = {"ok", "not-gross-slip", *READING_REASONS}
+        quiet = {"ok", "partial-slip", *READING_REASONS}
         self.flagged += int(
             _by_text(quality, lambda text: bool(set(text.split(SEPARATOR)) - quiet)).sum()
         )
@@ -403,8 +403,9 @@ REASONS = {
         "load given or the force's unit is wrong, not the contact",
         ("ecof", "cof_max", *_GICOF, *RESOLVED),
     ),
-    "not-gross-slip": (
-        "partial slip: the energy ratio A is not above the threshold",
+    "partial-slip": (
+        "partial slip: the energy ratio A is not above the threshold; the contact slips only "
+        "at its edges, and Q*/P (cof_max, kept) is a lower bound of μ",
         ("ecof", *_GICOF, *RESOLVED),
     ),
     "stiffness-mismatch": (

@@ -34,6 +34,7 @@ _PUBLIC = {
         "GROSS_SLIP",
         "INVALID",
         "NO_GROSS_SLIP",
+        "PARTIAL_SLIP",
         "SELF_LOCKING",
         "Regime",
     ),

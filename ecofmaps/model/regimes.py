@@ -1,22 +1,35 @@
-"""The regimes of a fretting contact, as integer codes that maps and results store."""
+"""The regimes of a fretting contact, as integer codes that maps and results store: the
+model's (gross slip, full stick, self-locking, ...) and the measured loops' (gross or partial
+slip). docs/model.md and docs/loops.md say what each means."""
 
 from __future__ import annotations
 
 from ecofmaps._codes import Code
 
-__all__ = ["BEYOND_PROFILE", "GROSS_SLIP", "INVALID", "NO_GROSS_SLIP", "SELF_LOCKING", "Regime"]
+__all__ = [
+    "BEYOND_PROFILE",
+    "GROSS_SLIP",
+    "INVALID",
+    "NO_GROSS_SLIP",
+    "PARTIAL_SLIP",
+    "SELF_LOCKING",
+    "Regime",
+]
 
 
 class Regime(Code):
-    """Regime codes returned by :func:`ecofmaps.slip_regime` and stored in maps.
+    """Regime codes returned by :func:`ecofmaps.slip_regime`, stored in maps and in the
+    results of :func:`ecofmaps.analyze_loops`.
 
     Attributes
     ----------
     GROSS_SLIP
-        :math:`\\mu\\lambda < 1`: the contact slips over part of every cycle.
+        :math:`\\mu\\lambda < 1`: the contact slips over part of every cycle (a measured
+        loop: its energy ratio :math:`A` above the threshold).
     NO_GROSS_SLIP
-        :math:`\\mu\\lambda \\ge 1`: the rig's deflection takes all of the amplitude;
-        the contact sticks, :math:`\\delta^* = 0`, :math:`E_d = 0`, :math:`\\mu_E` undefined.
+        The model's full stick, :math:`\\mu\\lambda \\ge 1`: the rig's deflection takes all
+        of the amplitude; the contact never slides, :math:`\\delta^* = 0`, :math:`E_d = 0`,
+        :math:`\\mu_E` undefined.
     SELF_LOCKING
         Rigid rig (:math:`\\lambda = 0`) and :math:`\\mu\\kappa \\ge 1` (on a scar profile:
         :math:`\\mu|g| \\ge 1` somewhere in the stroke): the pad jams on the groove flank
@@ -30,6 +43,17 @@ class Regime(Code):
     BEYOND_PROFILE
         On a scar profile: the pad slips past an end of the measured trace, whose slope
         there is unknown; the trace is too short for this stroke.
+    PARTIAL_SLIP
+        A measured loop in partial slip (Mindlin's regime, "stick-slip" in Vingsbo and
+        Söderberg's fretting map): its energy ratio :math:`A` at most the threshold; the
+        contact sticks at its centre and slips at its edges, and :math:`Q^*/P` is a lower
+        bound of :math:`\\mu`. The model's flat Coulomb contact has no partial slip.
+
+    References
+    ----------
+    O. Vingsbo, S. Söderberg (1988), On fretting maps, Wear 126, 131-147.
+    S. Fouvry, P. Kapsa, L. Vincent (1995), Analysis of sliding behaviour for fretting
+    loadings: determination of transition criteria, Wear 185, 35-46.
     """
 
     GROSS_SLIP = 0, "gross slip"
@@ -52,6 +76,12 @@ class Regime(Code):
         "beyond the profile",
         "the pad slips beyond an end of the scar profile (the trace is too short for this stroke)",
     )
+    PARTIAL_SLIP = (
+        5,
+        "partial slip",
+        "partial slip (the energy ratio at most the threshold: the contact slips only at its "
+        "edges), so the ECoF and GICoF are not read; Q*/P is a lower bound of mu",
+    )
 
 
 GROSS_SLIP = Regime.GROSS_SLIP
@@ -59,3 +89,4 @@ NO_GROSS_SLIP = Regime.NO_GROSS_SLIP
 SELF_LOCKING = Regime.SELF_LOCKING
 INVALID = Regime.INVALID
 BEYOND_PROFILE = Regime.BEYOND_PROFILE
+PARTIAL_SLIP = Regime.PARTIAL_SLIP

@@ -298,9 +298,9 @@ def test_the_summary_reads_the_gross_slip_cycles_only():
     from pathlib import Path
 
     from ecofmaps.cli.loops import _summary
-    from ecofmaps.model.regimes import GROSS_SLIP, NO_GROSS_SLIP
+    from ecofmaps.model.regimes import GROSS_SLIP, PARTIAL_SLIP
 
-    gross, stuck = int(GROSS_SLIP), int(NO_GROSS_SLIP)
+    gross, stuck = int(GROSS_SLIP), int(PARTIAL_SLIP)
     results = xr.Dataset(
         {
             "regime": ("cycle", np.array([stuck, gross, gross, stuck, gross, gross, stuck])),

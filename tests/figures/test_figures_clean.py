@@ -123,7 +123,7 @@ def test_resolved_loops_without_a_read_cycle_draws_no_empty_legend(results):
     unread = results.copy()
     everywhere = np.ones(unread.cycle.size, dtype=bool)
     unread["quality"] = unread["quality"].copy(
-        data=add_reason(unread["quality"].values, everywhere, "not-gross-slip")
+        data=add_reason(unread["quality"].values, everywhere, "partial-slip")
     )
     figure = drawn_cleanly(lambda: resolved_loops(resolve_analyzed_loops(unread)))
     stroke = figure.axes[0]

@@ -105,12 +105,12 @@ def test_resolved_loops_marks_cycles_without_a_value(results):
     partial = results.copy()
     third = np.arange(partial.cycle.size) == 2
     partial["quality"] = partial["quality"].copy(
-        data=add_reason(partial["quality"].values, third, "not-gross-slip")
+        data=add_reason(partial["quality"].values, third, "partial-slip")
     )
     resolved = resolve_analyzed_loops(partial)
     test = resolved_loops(resolved).axes[3]
     (marks,) = [line for line in test.get_lines() if "no resolved value" in line.get_label()]
-    assert "not-gross-slip" in marks.get_label()
+    assert "partial-slip" in marks.get_label()
     assert 3 in marks.get_xdata()  # the third cycle's number
 
 
@@ -131,7 +131,7 @@ def microslip():
         aspect_ratio=0.0, cycles=6, force_noise=3.0, displacement_noise=0.05e-6)  # fmt: skip
     results = quiet_analysis(displacement, force, LOAD)
     assert (results.quality != "ok").all() and (results.regime != GROSS_SLIP).all()
-    assert "negative-area+negative-slip+not-gross-slip" in results.quality.values
+    assert "negative-area+negative-slip+partial-slip" in results.quality.values
     return results
 
 
@@ -190,7 +190,7 @@ def test_loop_titles_fit_side_by_side_with_flags_on_their_own_line(microslip):
     for index, box in enumerate(boxes):
         assert not any(box.overlaps(other) for other in boxes[index + 1 :])
     titles = [ax.get_title() for ax in panels]
-    assert any("flagged: negative-area, negative-slip, not-gross-slip" in t for t in titles)
+    assert any("flagged: negative-area, negative-slip, partial-slip" in t for t in titles)
 
 
 @pytest.mark.filterwarnings("error")
@@ -224,7 +224,7 @@ def test_loops_above_a_hidden_panel_keep_their_displacement_scale(flagged):
 def test_flags_of_a_title_are_shortened_when_long(microslip):
     """More flags than fit beside each other: the first and how many more."""
     many = microslip.copy()
-    threefold = many.quality.values == "negative-area+negative-slip+not-gross-slip"
+    threefold = many.quality.values == "negative-area+negative-slip+partial-slip"
     many["quality"] = many["quality"].copy(
         data=add_reason(many["quality"].values, threefold, "implausible-cof")
     )

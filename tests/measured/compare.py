@@ -45,7 +45,7 @@ def assert_same(new, old):
     """
     np.testing.assert_array_equal(new.cycle, old.cycle)
     known = new.regime.values != ecofmaps.INVALID  # a refused cycle has no regime
-    codes = {"gross slip": ecofmaps.GROSS_SLIP, "partial slip": ecofmaps.NO_GROSS_SLIP}
+    codes = {"gross slip": ecofmaps.GROSS_SLIP, "partial slip": ecofmaps.PARTIAL_SLIP}
     reference = np.array([codes[text] for text in old.regime.values])
     np.testing.assert_array_equal(new.regime.values[known], reference[known])
     for name in ("incomplete_cycles", "dropped_samples", "cycles_from"):

@@ -325,10 +325,13 @@ def test_ploughing_peaks_leave_the_gicof():
 
 
 def test_partial_slip_is_labelled():
-    """Mindlin's partial-slip loop and the model with μλ >= 1 (no gross slip) are labelled."""
+    """Mindlin's partial-slip loop is labelled partial slip, and so is the model's full stick
+    (μλ >= 1, its regime NO_GROSS_SLIP): a measured loop without slip has A = 0."""
     displacement, force = mindlin_recording(0.9)
     result = analyze_loops(displacement, force, LOAD)
-    assert (result.regime == ecofmaps.NO_GROSS_SLIP).all()
+    assert (result.regime == ecofmaps.PARTIAL_SLIP).all()
+    assert result.regime.attrs["flag_meanings"].split()[ecofmaps.PARTIAL_SLIP] == "partial_slip"
+    assert (result.cof_max < 0.8).all()  # Q*/P, kept: a lower bound of μ
     assert (result.energy_ratio < 0.2).all()
     assert result.gicof.isnull().all() and result.ecof.isnull().all()
     assert result.dissipated_energy.notnull().all()
@@ -339,7 +342,7 @@ def test_partial_slip_is_labelled():
         **point, cycles=6, displacement_noise=0.25e-6, force_noise=2.5, seed=2
     )
     result = analyze_loops(displacement, force, LOAD)
-    assert (result.regime == ecofmaps.NO_GROSS_SLIP).all()
+    assert (result.regime == ecofmaps.PARTIAL_SLIP).all()
     assert float(relative(result.stiffness, point["stiffness"]).max()) < 0.02
     assert float(np.abs(result.energy_ratio).max()) < 0.02
 
@@ -351,7 +354,7 @@ def test_gross_slip_threshold():
     strict = analyze_loops(displacement, force, LOAD, gross_slip_threshold=0.5)
     assert 0.4 < float(default.energy_ratio[0]) < 0.41
     assert default.regime.values.tolist() == [ecofmaps.GROSS_SLIP]
-    assert strict.regime.values.tolist() == [ecofmaps.NO_GROSS_SLIP]
+    assert strict.regime.values.tolist() == [ecofmaps.PARTIAL_SLIP]
     assert np.isnan(strict.gicof[0]) and np.isnan(strict.ecof[0])
 
 

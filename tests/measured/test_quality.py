@@ -261,8 +261,8 @@ def test_rounded_polymer_loop():
 def test_micro_slip_is_curved():
     """Mindlin's partial slip loop: curved stick sides and no gross slip, E_d stands."""
     result = quiet(*mindlin_recording(0.9), LOAD)
-    assert (result.quality == "curved-stick+not-gross-slip").all()
-    assert (result.regime == ecofmaps.NO_GROSS_SLIP).all()
+    assert (result.quality == "curved-stick+partial-slip").all()
+    assert (result.regime == ecofmaps.PARTIAL_SLIP).all()
     assert result.stiffness.isnull().all() and result.dissipated_energy.notnull().all()
 
 
@@ -280,7 +280,7 @@ def test_loop_without_area_or_slip():
     assert result.slip_amplitude[negative_slip].isnull().all()
     assert (result.energy_ratio[~negative_area] >= 0).all()
     np.testing.assert_allclose(result.stiffness, 5e6, rtol=0.02)  # every cycle
-    assert has_reason(result.quality, "not-gross-slip").all()
+    assert has_reason(result.quality, "partial-slip").all()
 
 
 def sparse_digitised_loop(cycles=6, seed=3):
@@ -353,7 +353,7 @@ def test_partial_slip_alone_does_not_warn():
     with warnings.catch_warnings():
         warnings.simplefilter("error", LoopQualityWarning)
         result = analyze_loops(*mindlin_recording(0.5), LOAD)  # straight enough, no slip
-    assert (result.quality == "not-gross-slip").all()
+    assert (result.quality == "partial-slip").all()
 
 
 def test_bad_flip_force(rig):
@@ -370,7 +370,7 @@ def test_vocabulary():
         "negative-slip": np.array([True, False, False, True]),
         "curved-stick": np.array([True, False, True, False]),
         "no-crossing": np.array([False, False, True, True]),  # covered by curved-stick
-        "not-gross-slip": np.array([False, False, False, True]),  # covers no-crossing
+        "partial-slip": np.array([False, False, False, True]),  # covers no-crossing
         "anticlockwise": np.array([False, True, False, False]),
     }
     quality = quality_strings(flags, 4)
@@ -378,15 +378,15 @@ def test_vocabulary():
         "negative-slip+curved-stick",
         "anticlockwise",
         "curved-stick",
-        "negative-slip+not-gross-slip",
+        "negative-slip+partial-slip",
     ]
     assert refused(quality).tolist() == [False, True, False, False]
     assert has_reason(quality, "negative-slip").tolist() == [True, False, False, True]
     assert quality_summary(quality) == (
-        "4 cycles: 0 ok; anticlockwise 1, negative-slip 2, curved-stick 2, not-gross-slip 1"
+        "4 cycles: 0 ok; anticlockwise 1, negative-slip 2, curved-stick 2, partial-slip 1"
     )
-    added = add_reason(np.array(["ok", "not-gross-slip"]), [True, True], "few-slip-samples")
-    assert added.tolist() == ["few-slip-samples", "not-gross-slip+few-slip-samples"]
+    added = add_reason(np.array(["ok", "partial-slip"]), [True, True], "few-slip-samples")
+    assert added.tolist() == ["few-slip-samples", "partial-slip+few-slip-samples"]
     assert all(SEPARATOR not in reason for reason in REASONS)
     with pytest.raises(ValueError, match="unknown quality reason 'bad'"):
         add_reason(quality, True, "bad")

@@ -390,8 +390,8 @@ def test_partial_slip_is_not_read():
     """The model with μλ >= 1: the contact sticks, the loop is the line Q = SΔ with noise."""
     point = dict(EXAMPLE_2, stiffness=5e6)
     displacement, force = synthetic_recording(**point, cycles=6, **NOISE, seed=2)
-    with pytest.warns(LoopQualityWarning, match="not-gross-slip"):
-        assert_flagged(resolve_loops(displacement, force, LOAD), "not-gross-slip")
+    with pytest.warns(LoopQualityWarning, match="partial-slip"):
+        assert_flagged(resolve_loops(displacement, force, LOAD), "partial-slip")
 
 
 def test_wrong_stiffness_is_refused():
