@@ -12,7 +12,7 @@ import xarray as xr
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._inputs import check, si_units
 from ecofmaps.measured.measure import loop_ratios
-from ecofmaps.measured.quality import regime_ratio
+from ecofmaps.measured.quality import regime_ratio, sliding_condition_of
 from ecofmaps.model.profiles import ScarProfile
 from ecofmaps.model.simulation import fretting_loop
 
@@ -32,7 +32,6 @@ MINDLIN_ENERGY_RATIO = 0.2
 MINDLIN_OPENING_RATIO = 2 ** (1 / 3) - 1
 #: Cycles whose amplitudes differ by less than this share are at one amplitude. [1]
 _SAME_AMPLITUDE = 0.01
-_CONDITIONS = ("partial slip", "mixed slip", "gross slip")
 
 
 def _tests(results) -> list:
@@ -116,7 +115,7 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
         ``contact_opening_ratio`` on the contact's (NaN without ``rig_stiffness``);
         ``gross_slip`` (1, 0, or NaN for a cycle without an energy ratio). Attributes
         ``sliding_condition`` (``'partial slip'``, ``'mixed slip'`` or ``'gross slip'``) and
-        ``changes_at`` (the cycles where the regime changes).
+        ``regime_changes_at`` (the cycles where the regime changes).
 
     Notes
     -----
@@ -148,13 +147,11 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
     cycles = per_cycle(results, _RATIO_VARIABLES)
     ratios = _ratios(cycles, rig_stiffness)
     ratio, gross = _gross_slip(ratios, rig_stiffness)
-    known = np.isfinite(ratio)
-    regimes = gross[known]
-    changes = cycles["cycle"][known][1:][regimes[1:] != regimes[:-1]].astype(np.int64)
-    kind = 1 if changes.size else (2 if regimes.all() else 0)
+    gross = np.where(np.isfinite(ratio), gross, np.nan)
+    condition, changes = sliding_condition_of(cycles["cycle"], gross)
     data = {name: ("cycle", value, nomenclature.attrs(name)) for name, value in ratios.items()}
-    data["gross_slip"] = ("cycle", np.where(known, gross, np.nan), nomenclature.attrs("gross_slip"))
-    attrs = {"sliding_condition": _CONDITIONS[kind], "changes_at": changes}
+    data["gross_slip"] = ("cycle", gross, nomenclature.attrs("gross_slip"))
+    attrs = {"sliding_condition": condition, "regime_changes_at": changes}
     return xr.Dataset(data, coords={"cycle": results["cycle"].values}, attrs=attrs)
 
 

@@ -62,7 +62,7 @@ def test_transition_from_a_sweep(stiffness):
     assert float(found.mu) == pytest.approx(MU, rel=0.03)
     condition = ecofmaps.sliding_condition(results, rig_stiffness=stiffness)
     assert condition.attrs["sliding_condition"] == "mixed slip"
-    assert condition.attrs["changes_at"].size >= 1
+    assert condition.attrs["regime_changes_at"].size >= 1
 
 
 @pytest.mark.parametrize("factor, condition", [(0.7, "partial slip"), (1.5, "gross slip")])
@@ -71,7 +71,7 @@ def test_sliding_condition_of_a_test(factor, condition):
     at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
     found = ecofmaps.sliding_condition(_analysed([factor * at] * 4, stiffness), stiffness)
     assert found.attrs["sliding_condition"] == condition
-    assert found.attrs["changes_at"].size == 0
+    assert found.attrs["regime_changes_at"].size == 0
     assert (found.gross_slip == (factor > 1)).all()
     if factor > 1:  # a Mindlin gross-slip loop on the contact's displacement
         energy, slip = mindlin.gross_slip_loop(factor * at, MU, LOAD, DELTA_T, stiffness)

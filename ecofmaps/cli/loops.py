@@ -302,6 +302,7 @@ _WHY_INCOMPLETE = {
 
 def _summary(path, results, recording) -> str:
     """One line on a recording's cycles: counts, the quality, the friction over the test."""
+    from ecofmaps.measured.quality import sliding_condition_line
     from ecofmaps.model.regimes import GROSS_SLIP
 
     gross = results.isel(cycle=np.flatnonzero(results.regime.values == GROSS_SLIP))
@@ -317,6 +318,7 @@ def _summary(path, results, recording) -> str:
         first = recording.position(results.attrs["first_missing_sample"])
         where = f"line {first}" if isinstance(first, int) else first
         summary += f"; {skipped} skipped for missing samples (the first at {where})"
+    summary += f"; {sliding_condition_line(results)}"
     if gross.cycle.size and gross.gicof.notnull().any():
         summary += f"; GICoF median {float(gross.gicof.median()):.4f}"
     if "mu_resolved" in gross and gross.mu_resolved.notnull().any():

@@ -23,6 +23,7 @@ __all__ = [
     "REASONS",
     "RESOLVED",
     "SEPARATOR",
+    "SLIDING_CONDITIONS",
     "ImplausibleScaleError",
     "ImplausibleScaleWarning",
     "LoopQualityWarning",
@@ -36,7 +37,10 @@ __all__ = [
     "quality_strings",
     "quality_summary",
     "refused",
+    "regime_condition",
     "regime_ratio",
+    "sliding_condition_line",
+    "sliding_condition_of",
     "summary_of_counts",
     "with_loops",
 ]
@@ -258,6 +262,7 @@ class Tally:
             )
         if self.flagged:
             warn(f"cycles flagged: {summary}", LoopQualityWarning)
+        condition, changes = regime_condition(results)
         results.attrs.update(
             {
                 "title": "Fretting loops analysed cycle by cycle (ecofmaps.analyze_loops)",
@@ -270,6 +275,8 @@ class Tally:
                 "gross_slip_threshold": options.gross_slip_threshold,
                 "flip_force": int(options.flip_force),
                 "quality_summary": summary,
+                "sliding_condition": condition,
+                "regime_changes_at": changes,
                 "motion": _motion(typical),
             }
         )
@@ -547,6 +554,49 @@ def summary_of_counts(counts) -> str:
     if skipped:
         summary += f", {skipped} skipped (missing samples)"
     return summary + (f"; {flagged}" if flagged else "")
+
+
+#: A test's sliding conditions (Vincent et al. 1992; Zhou & Vincent 1995): every cycle in
+#: partial slip, the regime changing during the test, every cycle in gross slip.
+SLIDING_CONDITIONS = ("partial slip", "mixed slip", "gross slip")
+
+#: Cycles where the regime changes that :func:`sliding_condition_line` names.
+_CHANGES_SHOWN = 5
+
+
+def sliding_condition_of(cycle, gross_slip) -> tuple[str, np.ndarray]:
+    """A test's sliding condition, one of :data:`SLIDING_CONDITIONS` (``'mixed slip'`` when
+    the regime changes during the test), and the cycles where the regime changes (each the
+    first cycle in the new regime), from each cycle's number and ``gross_slip`` (1 or 0, NaN
+    for a cycle without a regime, left out). See docs/lab.md."""
+    gross_slip = np.asarray(gross_slip, dtype=np.float64)
+    known = np.isfinite(gross_slip)
+    if not known.any():
+        raise ValueError("results: no cycle with a regime (every cycle refused)")
+    regimes = gross_slip[known] > 0.5
+    changes = np.asarray(cycle)[known][1:][regimes[1:] != regimes[:-1]].astype(np.int64)
+    kind = 1 if changes.size else (2 if regimes.all() else 0)
+    return SLIDING_CONDITIONS[kind], changes
+
+
+def regime_condition(results: xr.Dataset) -> tuple[str, np.ndarray]:
+    """:func:`sliding_condition_of` the ``regime`` column of :func:`ecofmaps.analyze_loops`'
+    results (a refused cycle left out)."""
+    regime = results["regime"].values
+    gross = np.where(regime == INVALID, np.nan, regime == GROSS_SLIP)
+    return sliding_condition_of(results["cycle"].values, gross)
+
+
+def sliding_condition_line(results: xr.Dataset) -> str:
+    """The sliding condition of :func:`ecofmaps.analyze_loops`' results in words
+    (:func:`regime_condition`), with the first cycles where the regime changes."""
+    condition, changes = regime_condition(results)
+    changes = changes.tolist()
+    if not changes:
+        return condition
+    shown = ", ".join(str(c) for c in changes[:_CHANGES_SHOWN])
+    more = f", ... ({len(changes)} changes)" if len(changes) > _CHANGES_SHOWN else ""
+    return f"{condition} (the regime changes at cycle{'s' * (len(changes) > 1)} {shown}{more})"
 
 
 class ImplausibleScaleWarning(LoopQualityWarning):

@@ -38,7 +38,7 @@ from ecofmaps._nomenclature import QUANTITIES
 from ecofmaps._version import __version__
 from ecofmaps.io.files import atomic_path
 from ecofmaps.io.tables import results_table
-from ecofmaps.measured.quality import REASONS, SEPARATOR, quality_summary
+from ecofmaps.measured.quality import REASONS, SEPARATOR, quality_summary, sliding_condition_line
 from ecofmaps.model.simulation import fretting_loop
 
 __all__ = ["LOOPS_CARRIED", "recording_inputs", "report_document", "write_report"]
@@ -249,6 +249,7 @@ def _header(results: xr.Dataset, inputs: Mapping) -> Div:
     rows["ecofmaps version"] = __version__
     rows["written"] = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
     rows["cycles"] = quality_summary(results["quality"].values)
+    rows["sliding condition"] = sliding_condition_line(results)
     cells = "".join(
         f"<tr><th style='text-align:left;padding-right:1em'>{html.escape(str(key))}</th>"
         f"<td>{html.escape(str(value))}</td></tr>"

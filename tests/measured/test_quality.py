@@ -28,6 +28,8 @@ from ecofmaps.measured.quality import (
     quality_strings,
     quality_summary,
     refused,
+    sliding_condition_line,
+    sliding_condition_of,
 )
 from ecofmaps.measured.synthetic import synthetic_recording
 from ecofmaps.paper import EXAMPLE_2, LOAD
@@ -354,6 +356,36 @@ def test_partial_slip_alone_does_not_warn():
         warnings.simplefilter("error", LoopQualityWarning)
         result = analyze_loops(*mindlin_recording(0.5), LOAD)  # straight enough, no slip
     assert (result.quality == "partial-slip").all()
+
+
+def test_sliding_condition_of_cycles():
+    """Partial, gross or mixed slip, with the first cycle of each new regime; a cycle
+    without a regime (NaN) is left out, and a test without any is an error."""
+    cycle = np.arange(1, 7)
+    assert sliding_condition_of(cycle, [0, 0, 0, 0, 0, 0])[0] == "partial slip"
+    condition, changes = sliding_condition_of(cycle, [1, 1, np.nan, 1, 1, 1])
+    assert condition == "gross slip" and changes.size == 0
+    condition, changes = sliding_condition_of(cycle, [0, np.nan, 1, 1, 0, 0])
+    assert condition == "mixed slip" and changes.tolist() == [3, 5]
+    with pytest.raises(ValueError, match="no cycle with a regime"):
+        sliding_condition_of(cycle, [np.nan] * 6)
+
+
+def test_results_say_their_sliding_condition():
+    """A test whose contact sticks for four cycles and then slides (a stiffer rig) is in
+    mixed slip, its regime changing at cycle 5; in the attributes and in words."""
+    point = dict(amplitude=AMPLITUDE, load=LOAD, mu=0.8, aspect_ratio=0.2, cycles=4, seed=1)
+    parts = [synthetic_recording(**point, stiffness=stiffness) for stiffness in (5e6, 35e6)]
+    displacement, force = (np.concatenate(arrays) for arrays in zip(*parts, strict=True))
+    results = quiet(displacement, force, LOAD)
+    assert results.regime.values.tolist() == [ecofmaps.PARTIAL_SLIP] * 4 + [ecofmaps.GROSS_SLIP] * 4
+    assert results.attrs["sliding_condition"] == "mixed slip"
+    assert results.attrs["regime_changes_at"].tolist() == [5]
+    assert sliding_condition_line(results) == "mixed slip (the regime changes at cycle 5)"
+    gross = quiet(*parts[1], LOAD)
+    assert gross.attrs["sliding_condition"] == sliding_condition_line(gross) == "gross slip"
+    assert gross.attrs["regime_changes_at"].size == 0
+    assert quiet(*parts[0], LOAD).attrs["sliding_condition"] == "partial slip"
 
 
 def test_bad_flip_force(rig):

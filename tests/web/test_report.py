@@ -89,6 +89,9 @@ def test_the_page_gives_the_inputs_version_and_flag_meanings(results):
     for label, value in INPUTS.items():
         assert f"{label}</th><td>{value}<" in text
     assert ecofmaps.__version__ in text
+    condition = results.attrs["sliding_condition"]
+    assert condition == "gross slip"  # the damaged cycle refused, every other slides
+    assert f"sliding condition</th><td>{condition}<" in text
     flagged = {r for q in results.quality.values for r in str(q).split("+")} - {"ok"}
     assert flagged  # the damaged cycle
     quality = results.quality.values
