@@ -8,6 +8,7 @@ the noise, offsets and drift of a rig, must come out 'ok'.
 
 import re
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,6 +18,7 @@ from hypothesis import strategies as st
 
 import ecofmaps
 from ecofmaps.measured.analysis import analyze_loops
+from ecofmaps.measured.pipeline import LoopOptions
 from ecofmaps.measured.quality import (
     ALL,
     REASONS,
@@ -391,6 +393,28 @@ def test_results_say_their_sliding_condition():
 def test_bad_flip_force(rig):
     with pytest.raises(ValueError, match="flip_force must be True or False"):
         analyze_loops(*rig, LOAD, flip_force="yes")
+
+
+def test_the_field_s_words():
+    """In fretting "stick-slip" names the partial-slip regime (Vingsbo & Söderberg 1988):
+    friction that oscillates while sliding is chatter, a measured loop's partial slip has its
+    own reason and regime code, apart from the model's full stick (NO_GROSS_SLIP), and the
+    docs say how the GICoF is computed (over the central crossing_window of the slip)."""
+    assert "partial-slip" in REASONS and "not-gross-slip" not in REASONS
+    assert "lower bound" in REASONS["partial-slip"][0]
+    assert "chatter" in REASONS["gicof-varies"][0]
+    assert not any("stick-slip" in meaning for meaning, _ in REASONS.values())
+    assert ecofmaps.PARTIAL_SLIP != ecofmaps.NO_GROSS_SLIP
+    assert ecofmaps.PARTIAL_SLIP.label == "partial slip"
+    assert "partial" not in ecofmaps.NO_GROSS_SLIP.label
+    docs = Path(__file__).parents[2] / "docs"
+    rows = (docs / "loops.md").read_text(encoding="utf-8").splitlines()
+    (gicof,) = [row for row in rows if row.startswith("| `gicof` |")]
+    window = LoopOptions.crossing_window
+    assert f"central {window * 100:g} % of the slip" in gicof and f"{window:g} δ*" in gicof
+    (partial,) = [row for row in rows if row.startswith("| `partial-slip` |")]
+    assert "lower bound of μ" in partial and "ecofmaps.transition" in partial
+    assert "no friction coefficient" not in "\n".join(rows)
 
 
 def test_vocabulary():
