@@ -83,11 +83,12 @@ def unit(kind: str):
         if not text.strip():
             example = DIMENSIONS[kind][1]
             raise argparse.ArgumentTypeError(f"an empty unit; give a {kind} unit such as {example}")
+        number = text.strip()[0] in "0123456789.+-"
         try:
-            scale = parse_quantity(f"1 {text}", kind)
+            scale = math.nan if number else parse_quantity(f"1 {text}", kind)
         except ValueError as error:
             raise argparse.ArgumentTypeError(str(error).replace("'1 ", "'")) from None
-        if not (0.0 < scale < math.inf) or text.strip()[0] in "0123456789.+-":
+        if not (0.0 < scale < math.inf):
             raise argparse.ArgumentTypeError(
                 f"{text!r} is not a unit (a number in front of it makes a quantity); give a "
                 f"{kind} unit such as {DIMENSIONS[kind][1]}"
