@@ -324,7 +324,7 @@ def test_the_summary_reads_the_gross_slip_cycles_only():
     none.attrs["cycles_from"] = "displacement reversals"
     assert _summary(Path("rig.csv"), none, None) == (
         "  rig.csv: 7 cycles: 7 ok (1 incomplete dropped: partial, where the recording starts "
-        "or ends mid-cycle)"
+        "or ends mid-cycle); partial slip"
     )
 
 
