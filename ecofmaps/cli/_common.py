@@ -191,7 +191,7 @@ def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=())
             same = (
                 os.path.samefile(source, target)
                 if source.exists() and target.exists()
-                else source.resolve() == target.resolve()
+                else _resolved(source) == _resolved(target)
             )
             if same:
                 raise CommandError(
@@ -213,11 +213,26 @@ def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=())
             if not overwrite:
                 raise CommandError(f"{option} {target} exists already: --overwrite replaces it")
             continue
+        if not (target.is_dir() or target.is_file()):
+            raise CommandError(
+                f"{option} {target} is not a regular file (a device, a pipe or a socket): "
+                "ecofmaps writes only regular files; choose a file name"
+            )
         kind = "a folder" if target.is_dir() else "a file"
         raise CommandError(
             f"{option} {target} is {kind} that ecofmaps did not write (or that changed "
             f"since; see {MANIFEST} in its folder): it is not replaced; choose another name"
         )
+
+
+def _resolved(path: Path) -> Path:
+    """``path`` with its links followed, or :class:`CommandError` for links in a loop."""
+    try:
+        return path.resolve()
+    except (RuntimeError, OSError):  # Python before 3.13 raises RuntimeError for a loop
+        raise CommandError(
+            f"{path}: symbolic links that point to each other in a loop: remove or correct the link"
+        ) from None
 
 
 def row(name: str, value, note: str = "") -> tuple[str, str, str]:
