@@ -223,3 +223,16 @@ def test_a_second_ctrl_c_stops_at_once():
         signal.raise_signal(signal.SIGINT)  # the first: a flag
         with pytest.raises(KeyboardInterrupt):
             signal.raise_signal(signal.SIGINT)  # the second: at once
+
+
+def test_a_reading_warning_is_one_line_of_the_command(tmp_path, capsys, recording):
+    """Not Python's two lines ('...: RecordingWarning: ...' and the source line)."""
+    latin = tmp_path / "latin.csv"
+    latin.write_bytes(recording.read_bytes() + "# café\n".encode("latin-1"))
+    status, _, err = run(capsys, "loops", latin, "--load", "450N", "--no-resolve")
+    lines = [line for line in err.splitlines() if "warning" in line or "Warning" in line]
+    assert status == 0 and len(lines) == 1 and "Traceback" not in err, err
+    assert lines[0].startswith(f"ecofmaps loops: warning: {latin}, line ")
+    assert lines[0].endswith(
+        "is not UTF-8; the file is read as Latin-1 from this line on (numbers are the same in both)"
+    )
