@@ -127,7 +127,7 @@ def add_recording_options(parser) -> None:
             "--cycle-col",
             None,
             "name of a column of cycle numbers, which must exist (default: 'cycle' if the file "
-            "has it; else cycles are cut at the reversals)",
+            "has it; else, or with 'none', cycles are cut at the reversals)",
         ),
     ):
         parser.add_argument(option, default=default, metavar="NAME", help=help)
@@ -161,10 +161,15 @@ def add_recording_options(parser) -> None:
 def recording_options(args) -> dict:
     """The keywords of :func:`ecofmaps.io.recordings.read_recording` given by a command's
     column, unit and group options (``--displacement-col`` ... ``--group``)."""
+    if args.cycle_col is not None and not args.cycle_col.strip():
+        raise CommandError(
+            f"--cycle-col {args.cycle_col!r} names no column: give the cycle column's name, "
+            "or none to read no cycle column"
+        )
     return {
         "displacement_column": args.displacement_col,
         "force_column": args.force_col,
-        "cycle_column": args.cycle_col,
+        "cycle_column": False if args.cycle_col == "none" else args.cycle_col,
         "skip_rows": args.skip_rows,
         "displacement_unit": args.displacement_unit,
         "force_unit": args.force_unit,

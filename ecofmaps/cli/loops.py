@@ -28,6 +28,7 @@ from ecofmaps.cli._common import (
     recording_options,
     refuse_to_overwrite,
 )
+from ecofmaps.cli.main import option_names
 from ecofmaps.io.files import atomic_path, record_written
 from ecofmaps.web import INSTALL_WEB, missing_web_packages
 
@@ -431,7 +432,7 @@ def _analyse_each(args, paths, load, long_run, table) -> tuple[list[_Analysed], 
             if not many:
                 raise
             failed.append(path)
-            named = str(error) if str(path) in str(error) else f"{path}: {error}"
+            named = option_names(str(error) if str(path) in str(error) else f"{path}: {error}")
             print(f"ecofmaps loops: error: {named}", file=sys.stderr)
             continue
         for text in held:

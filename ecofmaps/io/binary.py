@@ -167,8 +167,9 @@ def _select(path: Path, kind: str, found: list[Variable], options: dict) -> dict
         raise RecordingError(path, None, f"no one-dimensional numeric {noun} in the file")
     wanted = {"displacement": options["displacement_column"], "force": options["force_column"]}
     required = {"displacement": True, "force": True}
-    wanted["cycle"] = options["cycle_column"] or "cycle"
-    required["cycle"] = options["cycle_column"] is not None
+    if options["cycle_column"] is not False:
+        wanted["cycle"] = options["cycle_column"] or "cycle"
+        required["cycle"] = options["cycle_column"] is not None
     chosen = {}
     for role, name in wanted.items():
         full = [k for k, v in enumerate(found) if v.name.strip("/").lower() == name.lower()]

@@ -239,7 +239,7 @@ def _wanted(options: dict) -> dict:
         return dict(options["columns"])
     wanted = {"displacement": options["displacement_column"], "force": options["force_column"]}
     for role in ("cycle", "load"):
-        if options.get(f"{role}_column") is not None:
+        if options.get(f"{role}_column") not in (None, False):
             wanted[role] = options[f"{role}_column"]
     return wanted
 
@@ -288,7 +288,7 @@ class _Layout:
             )
         wanted = _wanted(options)
         try:
-            optional = "columns" not in options and "cycle" not in wanted
+            optional = "columns" not in options and options.get("cycle_column") is None
             if optional and find_column(self.names, "cycle", "cycle", required=False) is not None:
                 wanted["cycle"] = "cycle"  # a cycle column if there is one
             self.columns = {
