@@ -232,3 +232,20 @@ def test_symbolic_links_in_a_loop_are_named_with_the_remedy(tmp_path, capsys, lo
         f"ecofmaps: error: {tmp_path / 'a.csv'}: symbolic links that point to each other in "
         "a loop: remove or correct the link\n"
     )
+
+
+def test_a_full_disk_names_the_file_and_leaves_no_empty_plots_folder(tmp_path, capsys, monkeypatch):
+    import errno
+
+    from matplotlib.figure import Figure
+
+    def full(self, *args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(Figure, "savefig", full)
+    plots = tmp_path / "plots"
+    status, _, stderr = run(capsys, "loops", *SHORT, "--plots", plots, "--out", tmp_path / "o.csv")
+    assert status == 2
+    loops = plots / f"{example_path().stem}_loops.png"
+    assert stderr == f"ecofmaps: error: [Errno 28] No space left on device: '{loops}'\n"
+    assert not plots.exists()
