@@ -199,8 +199,8 @@ def atomic_store(path, *, overwrite: bool = False):
             os.replace(temporary, path)
     except OSError as error:  # a full disk, say: named by the file asked for
         _remove(temporary)
-        if error.filename not in (None, str(temporary)):
-            raise
+        if error.errno is None or error.filename not in (None, str(temporary)):
+            raise  # not the system's error about this file (a scheduler not answering, say)
         raise type(error)(error.errno, error.strerror, str(path)) from None
     except BaseException:
         _remove(temporary)
