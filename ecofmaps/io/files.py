@@ -48,13 +48,17 @@ _STORE_MARKERS = ("zarr.json", ".zgroup", ".zarray")
 
 
 @contextlib.contextmanager
-def atomic_path(path):
+def atomic_path(path, *, exclusive: bool = True):
     """A temporary path to write, renamed onto ``path`` when the block succeeds.
 
     Parameters
     ----------
     path : str or os.PathLike
         The file to create or replace; its directory must exist.
+    exclusive : bool
+        Whether a ``path`` that did not exist is created, never replaced
+        (:func:`atomic_store`); False for a file any writer may replace with the same
+        content (a cache entry).
 
     Yields
     ------
@@ -62,9 +66,8 @@ def atomic_path(path):
         ``.<name>.<process id>.<32 hex digits>.tmp`` beside ``path``: write the whole file
         there. On leaving the block it is flushed to disk and moved onto ``path``
         (``os.replace``); if the block raises, it is removed and ``path`` is left as it was.
-        A ``path`` that did not exist is created, never replaced (:func:`atomic_store`).
     """
-    with atomic_store(path, overwrite=True) as temporary:
+    with atomic_store(path, overwrite=True, exclusive=exclusive) as temporary:
         yield temporary
 
 
@@ -134,7 +137,7 @@ def _sync(path: Path) -> None:
 
 
 @contextlib.contextmanager
-def atomic_store(path, *, overwrite: bool = False):
+def atomic_store(path, *, overwrite: bool = False, exclusive: bool = True):
     """A temporary path to write a file or a directory store (zarr) at, moved onto ``path``
     when the block succeeds.
 
@@ -145,6 +148,9 @@ def atomic_store(path, *, overwrite: bool = False):
     overwrite : bool
         Replace an existing ``path``; otherwise an existing one is an error, raised before
         anything is written.
+    exclusive : bool
+        Whether a file ``path`` that did not exist when the block began is created
+        exclusively: if another program created it meanwhile, this result is not written.
 
     Yields
     ------
@@ -159,9 +165,9 @@ def atomic_store(path, *, overwrite: bool = False):
     Raises
     ------
     FileExistsError
-        If ``path`` exists and ``overwrite`` is false, or a file ``path`` that did not exist
-        when the block began was created meanwhile (another run writing it): the file is
-        created exclusively, and this result is then not written.
+        If ``path`` exists and ``overwrite`` is false, or (``exclusive``) a file ``path``
+        that did not exist when the block began was created meanwhile (another run writing
+        it).
     IsADirectoryError
         If ``path`` is a directory that is not a store (:func:`is_store`), raised before
         anything is written, or a store and a file was written: a folder is never removed
@@ -173,7 +179,7 @@ def atomic_store(path, *, overwrite: bool = False):
         raise FileExistsError(errno.EEXIST, message, str(path))
     if path.is_dir() and not is_store(path):
         raise IsADirectoryError(errno.EISDIR, _FOLDER, str(path))
-    created = not os.path.lexists(path)  # then created, never replaced
+    created = exclusive and not os.path.lexists(path)  # then created, never replaced
     _remove_dead_temporaries(path)
     temporary = _temporary(path)
     try:
