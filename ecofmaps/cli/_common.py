@@ -128,7 +128,7 @@ def add_recording_options(parser) -> None:
             "--cycle-col",
             None,
             "name of a column of cycle numbers, which must exist (default: 'cycle' if the file "
-            "has it; else cycles are cut at the reversals)",
+            "has it; else, or with 'none', cycles are cut at the reversals)",
         ),
     ):
         parser.add_argument(option, default=default, metavar="NAME", help=help)
@@ -162,10 +162,15 @@ def add_recording_options(parser) -> None:
 def recording_options(args) -> dict:
     """The keywords of :func:`ecofmaps.io.recordings.read_recording` given by a command's
     column, unit and group options (``--displacement-col`` ... ``--group``)."""
+    if args.cycle_col is not None and not args.cycle_col.strip():
+        raise CommandError(
+            f"--cycle-col {args.cycle_col!r} names no column: give the cycle column's name, "
+            "or none to read no cycle column"
+        )
     return {
         "displacement_column": args.displacement_col,
         "force_column": args.force_col,
-        "cycle_column": args.cycle_col,
+        "cycle_column": False if args.cycle_col == "none" else args.cycle_col,
         "skip_rows": args.skip_rows,
         "displacement_unit": args.displacement_unit,
         "force_unit": args.force_unit,
@@ -192,7 +197,7 @@ def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=())
             same = (
                 os.path.samefile(source, target)
                 if source.exists() and target.exists()
-                else source.resolve() == target.resolve()
+                else _resolved(source) == _resolved(target)
             )
             if same:
                 raise CommandError(
@@ -214,11 +219,26 @@ def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=())
             if not overwrite:
                 raise CommandError(f"{option} {target} exists already: --overwrite replaces it")
             continue
+        if not (target.is_dir() or target.is_file()):
+            raise CommandError(
+                f"{option} {target} is not a regular file (a device, a pipe or a socket): "
+                "ecofmaps writes only regular files; choose a file name"
+            )
         kind = "a folder" if target.is_dir() else "a file"
         raise CommandError(
             f"{option} {target} is {kind} that ecofmaps did not write (or that changed "
             f"since; see {MANIFEST} in its folder): it is not replaced; choose another name"
         )
+
+
+def _resolved(path: Path) -> Path:
+    """``path`` with its links followed, or :class:`CommandError` for links in a loop."""
+    try:
+        return path.resolve()
+    except (RuntimeError, OSError):  # Python before 3.13 raises RuntimeError for a loop
+        raise CommandError(
+            f"{path}: symbolic links that point to each other in a loop: remove or correct the link"
+        ) from None
 
 
 def row(name: str, value, note: str = "") -> tuple[str, str, str]:

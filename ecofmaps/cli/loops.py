@@ -28,6 +28,7 @@ from ecofmaps.cli._common import (
     recording_options,
     refuse_to_overwrite,
 )
+from ecofmaps.cli.main import option_names
 from ecofmaps.io.files import atomic_path, record_written
 from ecofmaps.web import INSTALL_WEB, missing_web_packages
 
@@ -433,7 +434,7 @@ def _analyse_each(args, paths, load, long_run, table) -> tuple[list[_Analysed], 
             if not many:
                 raise
             failed.append(path)
-            named = str(error) if str(path) in str(error) else f"{path}: {error}"
+            named = option_names(str(error) if str(path) in str(error) else f"{path}: {error}")
             print(f"ecofmaps loops: error: {named}", file=sys.stderr)
             continue
         for text in held:
@@ -455,17 +456,23 @@ def _write_extras(args, done: list[_Analysed], load) -> None:
         )
 
         folder = Path(args.plots)
+        created = not folder.exists()
         folder.mkdir(parents=True, exist_ok=True)
-        for each in done:
-            name, results, resolved = each.plot_name, each.results, each.resolved
-            figures = {
-                "loops": measured_loops(results, resolved=resolved, source=each.path.name),
-                "evolution": cof_evolution(results, source=each.path.name),
-            }
-            if resolved is not None:
-                figures["resolved"] = resolved_loops(resolved, results, source=each.path.name)
-            for kind, figure in figures.items():
-                save_figure(figure, folder / f"{name}_{kind}.png", dpi=RECORDING_DPI)
+        try:
+            for each in done:
+                name, results, resolved = each.plot_name, each.results, each.resolved
+                figures = {
+                    "loops": measured_loops(results, resolved=resolved, source=each.path.name),
+                    "evolution": cof_evolution(results, source=each.path.name),
+                }
+                if resolved is not None:
+                    figures["resolved"] = resolved_loops(resolved, results, source=each.path.name)
+                for kind, figure in figures.items():
+                    save_figure(figure, folder / f"{name}_{kind}.png", dpi=RECORDING_DPI)
+        except BaseException:  # a full disk, an interrupt: no empty folder left behind
+            if created and not any(folder.iterdir()):
+                folder.rmdir()
+            raise
     if args.resolved is not None and done:
         from ecofmaps.maps.cache import write_netcdf
 

@@ -14,6 +14,7 @@ import difflib
 import gc
 import importlib
 import os
+import re
 import signal
 import sys
 import warnings
@@ -136,7 +137,7 @@ def main(argv=None) -> int:
         if interrupted is not None and interrupted.is_set():  # an interrupt turned into an error
             return _stopped(interrupted, None)
         if isinstance(error, (CommandError, ValueError, OSError)):
-            return _report(2, f"error: {error}")
+            return _report(2, f"error: {option_names(str(error))}")
         if isinstance(error, MemoryError):
             return _report(1, "error: not enough memory for this run")
         if os.environ.get("ECOFMAPS_DEBUG"):
@@ -173,6 +174,34 @@ def _ignored_after_main() -> list:
 
 def _nothing_to_stop(signum, frame) -> None:
     """A stop signal outside :func:`main`'s block, where there is no work to stop."""
+
+
+#: The keywords of the Python API that errors of the reading name, by the option giving them.
+_OPTIONS = {
+    "displacement_column": "--displacement-col",
+    "force_column": "--force-col",
+    "cycle_column": "--cycle-col",
+    "load_column": "--load",
+    "displacement_unit": "--displacement-unit",
+    "force_unit": "--force-unit",
+    "skip_rows": "--skip-rows",
+}
+_KEYWORD = re.compile(
+    rf"(?<![\w./-])({'|'.join(_OPTIONS)})(?:=(\S+))?(?![\w./-])(?: \((--[^()]*)\))?"
+)
+
+
+def option_names(message: str) -> str:
+    """An error of the Python API with the command-line options for its keywords:
+    ``force_column (--force-col)`` and ``force_column`` are ``--force-col``,
+    ``force_unit='foo'`` is ``--force-unit 'foo'``."""
+
+    def option(match) -> str:
+        if match[3]:  # the message names the option already
+            return match[3]
+        return _OPTIONS[match[1]] + (f" {match[2]}" if match[2] else "")
+
+    return _KEYWORD.sub(option, message)
 
 
 def _warning_line(command: str):

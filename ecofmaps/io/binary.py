@@ -18,7 +18,13 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps._parallel import SOURCE
-from ecofmaps.io.columns import ColumnError, column_scale, matching_columns, split_unit
+from ecofmaps.io.columns import (
+    ColumnError,
+    column_scale,
+    listed_names,
+    matching_columns,
+    split_unit,
+)
 from ecofmaps.io.recording_types import LAZY_SAMPLES, Recording, RecordingError, si_values
 from ecofmaps.io.rig_formats import NOUNS, Variable, check_complete, open_group, variables
 
@@ -155,14 +161,15 @@ def _select(path: Path, kind: str, found: list[Variable], options: dict) -> dict
         groups = sorted({v.group for v in found})
         found = [v for v in found if v.group == group]
         if not found:
-            listed = ", ".join(repr(g) for g in groups)
+            listed = listed_names(groups)
             raise RecordingError(path, None, f"no group {group!r} with channels (groups: {listed})")
     if not found:
         raise RecordingError(path, None, f"no one-dimensional numeric {noun} in the file")
     wanted = {"displacement": options["displacement_column"], "force": options["force_column"]}
     required = {"displacement": True, "force": True}
-    wanted["cycle"] = options["cycle_column"] or "cycle"
-    required["cycle"] = options["cycle_column"] is not None
+    if options["cycle_column"] is not False:
+        wanted["cycle"] = options["cycle_column"] or "cycle"
+        required["cycle"] = options["cycle_column"] is not None
     chosen = {}
     for role, name in wanted.items():
         full = [k for k, v in enumerate(found) if v.name.strip("/").lower() == name.lower()]
@@ -173,7 +180,7 @@ def _select(path: Path, kind: str, found: list[Variable], options: dict) -> dict
             beside = [k for k in matches if found[k].group == group]
             matches = beside if len(beside) == 1 or not required[role] else matches
         if len(matches) > 1:
-            names = ", ".join(repr(found[k].name) for k in matches)
+            names = listed_names([found[k].name for k in matches])
             raise RecordingError(
                 path,
                 None,
@@ -183,7 +190,7 @@ def _select(path: Path, kind: str, found: list[Variable], options: dict) -> dict
         if not matches:
             if not required[role]:
                 continue
-            names = ", ".join(repr(v.name) for v in found)
+            names = listed_names([v.name for v in found])
             raise RecordingError(path, None, f"no {role} {noun} {name!r} ({noun}s: {names})")
         chosen[role] = found[matches[0]]
     if chosen["displacement"] == chosen["force"]:

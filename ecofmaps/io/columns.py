@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import difflib
 import functools
+import itertools
 import math
 import re
 
@@ -21,6 +22,7 @@ __all__ = [
     "ColumnError",
     "column_scale",
     "find_column",
+    "listed_names",
     "matching_columns",
     "split_unit",
 ]
@@ -131,6 +133,7 @@ _SUFFIXED = re.compile(r"^(?P<base>.*?[^_\s])[_\s]+(?P<unit>[^_\s]+)$")
 #: How alike (difflib's ratio, 0 to 1) a column's name must be to the name sought to be
 #: suggested.
 _NEAR = 0.75
+_POSITION = re.compile(r"^#(\d+)$")
 _IN_UNIT = re.compile(r"^(?P<base>.*?\S)\s+in\s+(?P<unit>\S+)$", re.IGNORECASE)
 
 
@@ -247,11 +250,12 @@ def find_column(names, wanted: str, role: str, *, required: bool = True) -> int 
     """
     matches = matching_columns(names, wanted, role)
     if len(matches) > 1:
-        found = ", ".join(repr(names[k]) for k in matches)
-        raise ColumnError(
-            f"several {role} columns match {wanted!r}: {found}; choose one with "
-            f"{_CHOOSE.get(role, role)}"
-        )
+        found = listed_names([names[k] for k in matches])
+        choose = f"choose one with {_CHOOSE.get(role, role)}"
+        if len({_normal(names[k]) for k in matches}) < len(matches):  # named alike
+            found = listed_names([f"{names[k]!r} (#{k + 1})" for k in matches], quote=False)
+            choose += f" by its position, e.g. '#{matches[0] + 1}'"
+        raise ColumnError(f"several {role} columns match {wanted!r}: {found}; {choose}")
     if not matches and not required:
         return None
     if not matches:
@@ -267,6 +271,8 @@ def matching_columns(names, wanted: str, role: str | None = None) -> list[int]:
     whole = [k for k, name in enumerate(names) if _normal(name) == target]
     if len(whole) == 1:
         return whole
+    if not whole and (position := _POSITION.match(target)):  # '#3': the third column
+        return [int(position[1]) - 1] if 0 < int(position[1]) <= len(names) else []
     # its base, or the whole name when that ends in a word that reads as a unit ('A N')
     bases = {_normal(split_unit(wanted)[0]), target}
     by_base = [k for k, name in enumerate(names) if _normal(split_unit(name)[0]) in bases]
@@ -278,7 +284,7 @@ def matching_columns(names, wanted: str, role: str | None = None) -> list[int]:
 
 def _missing_message(names, wanted: str, role: str) -> str:
     """The error for a column not found: the columns there are, and the nearest name."""
-    listed = ", ".join(repr(name) for name in names)
+    listed = listed_names(names)
     usual = role in SYNONYMS and _normal(wanted) == role
     sought = [_plain(split_unit(wanted)[0])]
     if usual:
@@ -293,9 +299,41 @@ def _missing_message(names, wanted: str, role: str) -> str:
     if usual:
         message += f" nor one of its usual names ({shown}, ...)"
     message += f" (columns: {listed})."
+    unknown = _unknown_unit(names, sought, role)
+    if unknown is not None:
+        known = ", ".join(unit for unit, (kind, _) in COMMON_UNITS.items() if kind == KINDS[role])
+        return (
+            f"the {role} column {unknown[0]!r} is in {unknown[1]!r}, which is not a known unit "
+            f"(known: {known} and the others pint reads): write a known unit in the header, "
+            f"or name the column with {_CHOOSE[role]} and give its unit with {role}_unit "
+            f"(--{role}-unit)"
+        )
     if ratios and max(ratios) >= _NEAR:
         message += f" Did you mean {names[ratios.index(max(ratios))]!r}?"
     return f"{message} Name the column with {_CHOOSE.get(role, role)}"
+
+
+def _unknown_unit(names, sought, role: str) -> tuple[str, str] | None:
+    """The first name whose base is one ``sought`` (plain) and whose bracketed or slashed
+    unit is not a unit at all, as (name, unit); None if there is none."""
+    for name in names:
+        text = name.strip().strip("\"'").strip()
+        match = _BRACKETED.match(text) or _SLASHED.match(text)
+        if match is None or role not in KINDS or _plain(match["base"] or "") not in sought:
+            continue
+        unit = next(part for part in match.groups()[1:] if part is not None).strip()
+        if _unit_kind(unit) is None:
+            return name, unit
+    return None
+
+
+def listed_names(names, quote: bool = True, count: int = 10, width: int = 40) -> str:
+    """``names`` for a message: the first ``count``, each cut to ``width`` characters
+    (quoted with ``repr`` if ``quote``), and how many more there are."""
+    shown = [repr(name) if quote else name for name in itertools.islice(names, count)]
+    text = ", ".join(name if len(name) <= width else f"{name[: width - 3]}..." for name in shown)
+    more = len(names) - count
+    return f"{text} and {more} more" if more > 0 else text
 
 
 def _factor(unit: str, kind: str, option: str | None) -> float:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import glob
 import hashlib
 import json
 import os
@@ -36,6 +37,9 @@ __all__ = [
 #: Names of the temporary files :func:`atomic_path` writes (left behind only by a crash).
 TEMPORARY_NAME = re.compile(r"^\..+\.[0-9a-f]{32}\.tmp$")
 
+#: A temporary's name: the destination's name, and the process writing it.
+_OURS = re.compile(r"^\.(?P<name>.+)\.(?P<pid>\d+)\.[0-9a-f]{32}\.tmp$")
+
 #: The file, in each folder the command line writes into, that lists what it wrote there.
 MANIFEST = ".ecofmaps-manifest.json"
 
@@ -44,22 +48,26 @@ _STORE_MARKERS = ("zarr.json", ".zgroup", ".zarray")
 
 
 @contextlib.contextmanager
-def atomic_path(path):
+def atomic_path(path, *, exclusive: bool = True):
     """A temporary path to write, renamed onto ``path`` when the block succeeds.
 
     Parameters
     ----------
     path : str or os.PathLike
         The file to create or replace; its directory must exist.
+    exclusive : bool
+        Whether a ``path`` that did not exist is created, never replaced
+        (:func:`atomic_store`); False for a file any writer may replace with the same
+        content (a cache entry).
 
     Yields
     ------
     temporary : pathlib.Path
-        ``.<name>.<32 hex digits>.tmp`` beside ``path``: write the whole file there. On
-        leaving the block it is flushed to disk and moved onto ``path`` (``os.replace``);
-        if the block raises, it is removed and ``path`` is left as it was.
+        ``.<name>.<process id>.<32 hex digits>.tmp`` beside ``path``: write the whole file
+        there. On leaving the block it is flushed to disk and moved onto ``path``
+        (``os.replace``); if the block raises, it is removed and ``path`` is left as it was.
     """
-    with atomic_store(path, overwrite=True) as temporary:
+    with atomic_store(path, overwrite=True, exclusive=exclusive) as temporary:
         yield temporary
 
 
@@ -72,7 +80,39 @@ def write_text(path, text: str) -> Path:
 
 
 def _temporary(path: Path) -> Path:
-    return path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
+    return path.with_name(f".{path.name}.{os.getpid()}.{uuid.uuid4().hex}.tmp")
+
+
+def _remove_dead_temporaries(path: Path) -> None:
+    """Remove the temporaries for ``path`` that processes no longer running left (killed
+    while writing): only names :func:`_temporary` gives, of this destination."""
+    for item in path.parent.glob(f".{glob.escape(path.name)}.*.tmp"):
+        ours = _OURS.match(item.name)
+        if ours is None or ours["name"] != path.name or int(ours["pid"]) == os.getpid():
+            continue
+        try:
+            os.kill(int(ours["pid"]), 0)
+        except ProcessLookupError:
+            _remove(item)
+        except (PermissionError, OverflowError):  # another user's process, or no process id
+            continue
+
+
+def _create(temporary: Path, path: Path) -> None:
+    """Rename ``temporary`` to ``path``, which must not exist by then (a run writing the
+    same new file at the same time): :class:`FileExistsError` if it does."""
+    try:
+        os.link(temporary, path)  # fails if path exists, unlike a rename
+    except FileExistsError:
+        raise FileExistsError(errno.EEXIST, _RACED, str(path)) from None
+    except OSError:  # a file system without hard links: claim the name, then rename
+        try:
+            open(path, "x").close()
+        except FileExistsError:
+            raise FileExistsError(errno.EEXIST, _RACED, str(path)) from None
+        os.replace(temporary, path)
+        return
+    temporary.unlink()
 
 
 def _remove(path: Path) -> None:
@@ -97,7 +137,7 @@ def _sync(path: Path) -> None:
 
 
 @contextlib.contextmanager
-def atomic_store(path, *, overwrite: bool = False):
+def atomic_store(path, *, overwrite: bool = False, exclusive: bool = True):
     """A temporary path to write a file or a directory store (zarr) at, moved onto ``path``
     when the block succeeds.
 
@@ -108,20 +148,26 @@ def atomic_store(path, *, overwrite: bool = False):
     overwrite : bool
         Replace an existing ``path``; otherwise an existing one is an error, raised before
         anything is written.
+    exclusive : bool
+        Whether a file ``path`` that did not exist when the block began is created
+        exclusively: if another program created it meanwhile, this result is not written.
 
     Yields
     ------
     temporary : pathlib.Path
-        ``.<name>.<32 hex digits>.tmp`` beside ``path``, not yet existing: create the file or
-        directory there. On success it is flushed to disk and renamed to ``path`` (an old
-        ``path`` is moved aside first and removed after); if the block raises (or is
-        interrupted), it is removed and ``path`` is left as it was. A crash leaves only a
-        hidden ``.tmp`` name (:data:`TEMPORARY_NAME`), never a store under ``path``.
+        ``.<name>.<process id>.<32 hex digits>.tmp`` beside ``path``, not yet existing:
+        create the file or directory there. On success it is flushed to disk and renamed to
+        ``path`` (an old ``path`` is moved aside first and removed after); if the block
+        raises (or is interrupted), it is removed and ``path`` is left as it was. A crash
+        leaves only a hidden ``.tmp`` name (:data:`TEMPORARY_NAME`), never a store under
+        ``path``; the next write of ``path`` removes those of processes no longer running.
 
     Raises
     ------
     FileExistsError
-        If ``path`` exists and ``overwrite`` is false.
+        If ``path`` exists and ``overwrite`` is false, or (``exclusive``) a file ``path``
+        that did not exist when the block began was created meanwhile (another run writing
+        it).
     IsADirectoryError
         If ``path`` is a directory that is not a store (:func:`is_store`), raised before
         anything is written, or a store and a file was written: a folder is never removed
@@ -133,6 +179,8 @@ def atomic_store(path, *, overwrite: bool = False):
         raise FileExistsError(errno.EEXIST, message, str(path))
     if path.is_dir() and not is_store(path):
         raise IsADirectoryError(errno.EISDIR, _FOLDER, str(path))
+    created = exclusive and not os.path.lexists(path)  # then created, never replaced
+    _remove_dead_temporaries(path)
     temporary = _temporary(path)
     try:
         yield temporary
@@ -151,14 +199,22 @@ def atomic_store(path, *, overwrite: bool = False):
                     os.replace(old, path)
                 raise
             _remove(old)
+        elif created:
+            _create(temporary, path)
         else:
             os.replace(temporary, path)
+    except OSError as error:  # a full disk, say: named by the file asked for
+        _remove(temporary)
+        if error.errno is None or error.filename not in (None, str(temporary)):
+            raise  # not the system's error about this file (a scheduler not answering, say)
+        raise type(error)(error.errno, error.strerror, str(path)) from None
     except BaseException:
         _remove(temporary)
         raise
 
 
 _FOLDER = "is a folder, not a store written by ecofmaps: it is not replaced"
+_RACED = "was written by another program meanwhile: this result is not written over it"
 
 
 def is_store(path) -> bool:
@@ -207,8 +263,14 @@ def record_written(paths) -> None:
         if path.exists() and not path.is_symlink():
             folders.setdefault(path.parent, {})[path.name] = _entry(path)
     for folder, entries in folders.items():
-        written = _manifest(folder) | entries
-        write_text(folder / MANIFEST, json.dumps({"written": written}, indent=1) + "\n")
+        for attempt in range(3):  # a run that created the manifest meanwhile: merge with it
+            written = _manifest(folder) | entries
+            try:
+                write_text(folder / MANIFEST, json.dumps({"written": written}, indent=1) + "\n")
+                break
+            except FileExistsError:
+                if attempt == 2:
+                    raise
 
 
 class FileLineError(ValueError):

@@ -128,7 +128,7 @@ def _options(
         if not isinstance(value, str) or not value.strip():
             raise ValueError(f"{name} must be a column name; got {value!r}")
     for name, value in (
-        ("cycle_column", cycle_column),
+        ("cycle_column", None if cycle_column is False else cycle_column),
         ("load_column", load_column),
         ("displacement_unit", displacement_unit),
         ("force_unit", force_unit),
@@ -185,6 +185,19 @@ def _read_text(path: Path, options: dict, block_bytes: int) -> Recording:
         raise RecordingError(path, layout.header_line, "no data after the header")
     values = {role: np.concatenate([part[0][role] for part in parts]) for role in layout.columns}
     numbers = [part[1] for part in parts]
+    for role, data in values.items():
+        if not np.isfinite(data).any():
+            raise RecordingError(
+                path,
+                layout.header_line,
+                f"the {role} column {layout.names[layout.columns[role]]!r} holds no number: "
+                f"all its {data.size} samples are missing; "
+                + (
+                    "cycle_column=False (--cycle-col none) reads no cycle column"
+                    if role == "cycle"
+                    else "is it the right column?"
+                ),
+            )
     return Recording(
         path=path,
         displacement=values["displacement"],
@@ -231,9 +244,10 @@ def read_recording(
         find the usual names (``Disp``, ``delta_mm``, ``stroke``, ``x``; ``Fx``, ``Q``,
         ``Ftr_kN``, ``friction force``: :data:`ecofmaps.io.columns.SYNONYMS`) when no
         column is named ``displacement`` (``force``); two such columns are an error.
-    cycle_column : str, optional
+    cycle_column : str or False, optional
         Name of a column of cycle numbers, which must then exist. By default a column
-        named ``cycle`` is used if there is one.
+        named ``cycle`` is used if there is one; False reads none (cycles are then cut at
+        the displacement reversals).
     displacement_unit, force_unit : str, optional
         Units of the displacement and force columns (``'um'``, ``'mm'``, ``'N'``,
         ``'kN'``, ...). By default the unit the file gives (in the column's name, or a

@@ -20,7 +20,9 @@ from nptdms import TdmsFile
 from xarray.backends import BackendArray, BackendEntrypoint
 from xarray.core import indexing
 
-from ecofmaps.io.recording_types import RecordingError
+from ecofmaps._codes import warn
+from ecofmaps.io.columns import listed_names
+from ecofmaps.io.recording_types import RecordingError, RecordingWarning
 
 __all__ = ["TdmsBackendEntrypoint", "TdmsReader", "open_tdms_group", "tdms_groups"]
 
@@ -36,7 +38,34 @@ class _Notices(logging.Handler):
         self.messages: list[str] = []
 
     def emit(self, record):
-        self.messages.append(record.getMessage())
+        if record.name == "nptdms.types":  # a text property that is not UTF-8: data intact
+            self.undecoded = True
+        else:
+            self.messages.append(record.getMessage())
+
+    undecoded = False
+
+
+class _Relay(logging.Handler):
+    """npTDMS's warnings outside :func:`opened_tdms`, each as a warning of ecofmaps (npTDMS
+    would print them itself, ``[nptdms.types WARNING] ...``)."""
+
+    def emit(self, record):
+        if not any(isinstance(h, _Notices) for h in logging.getLogger("nptdms").handlers):
+            warn(f"TDMS reader: {record.getMessage()[:200]}", RecordingWarning)
+
+
+def _quiet_nptdms() -> None:
+    """npTDMS's loggers without its own printing handler, through :class:`_Relay`."""
+    from nptdms.log import log_manager
+
+    for logger in log_manager.loggers.values():
+        logger.removeHandler(log_manager.console_handler)
+    logging.getLogger("nptdms").addHandler(_Relay(logging.WARNING))
+    logging.getLogger("nptdms").propagate = False
+
+
+_quiet_nptdms()
 
 
 def opened_tdms(path: Path) -> TdmsFile:
@@ -52,6 +81,12 @@ def opened_tdms(path: Path) -> TdmsFile:
     finally:
         logger.removeHandler(notices)
         logger.propagate = propagate
+    if notices.undecoded:
+        warn(
+            f"{path}: a text property of the file is not UTF-8; read with replacement "
+            "characters (the samples are not affected)",
+            RecordingWarning,
+        )
     if notices.messages:
         handle.close()
         raise RecordingError(
@@ -185,7 +220,7 @@ def open_tdms_group(path, group: str | None = None) -> xr.Dataset:
         return next(iter(groups.values()))
     key = "/" + (group or "").strip("/")
     if key not in groups:
-        listed = ", ".join(repr(name[1:]) for name in groups) or "none"
+        listed = listed_names([name[1:] for name in groups]) or "none"
         raise RecordingError(path, None, f"no group {group!r} (groups: {listed})")
     return groups[key]
 

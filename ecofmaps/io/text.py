@@ -26,6 +26,7 @@ from ecofmaps.io.columns import (
     ColumnError,
     column_scale,
     find_column,
+    listed_names,
     matching_columns,
     split_unit,
 )
@@ -238,7 +239,7 @@ def _wanted(options: dict) -> dict:
         return dict(options["columns"])
     wanted = {"displacement": options["displacement_column"], "force": options["force_column"]}
     for role in ("cycle", "load"):
-        if options.get(f"{role}_column") is not None:
+        if options.get(f"{role}_column") not in (None, False):
             wanted[role] = options[f"{role}_column"]
     return wanted
 
@@ -287,7 +288,7 @@ class _Layout:
             )
         wanted = _wanted(options)
         try:
-            optional = "columns" not in options and "cycle" not in wanted
+            optional = "columns" not in options and options.get("cycle_column") is None
             if optional and find_column(self.names, "cycle", "cycle", required=False) is not None:
                 wanted["cycle"] = "cycle"  # a cycle column if there is one
             self.columns = {
@@ -400,7 +401,8 @@ class _Layout:
                 raise RecordingError(
                     self.path,
                     numbers[first],
-                    f"non-numeric value {column.iloc[first]!r} in column {name!r}",
+                    f"non-numeric value {listed_names([column.iloc[first]])} in column "
+                    f"{listed_names([name])}",
                 )
             values[role] = column.to_numpy(dtype=np.float64)
         missing = {role: ~np.isfinite(data) for role, data in values.items()}
@@ -414,7 +416,9 @@ class _Layout:
             cell = _fields(lines[first], self.separator)[index]
             what = "non-finite" if np.isinf(values[role][first]) else "missing"
             raise RecordingError(
-                self.path, numbers[first], f"{what} value {cell!r} in column {self.names[index]!r}"
+                self.path,
+                numbers[first],
+                f"{what} value {cell!r} in column {listed_names([self.names[index]])}",
             )
         return {
             role: si_values(np.where(missing[role], np.nan, data), self.scales[role])

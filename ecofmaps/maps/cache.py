@@ -252,7 +252,7 @@ def cache_key(function: str, inputs: Mapping[str, object]) -> str:
     return digest.hexdigest()
 
 
-def write_netcdf(dataset: xr.Dataset, path) -> Path:
+def write_netcdf(dataset: xr.Dataset, path, *, exclusive: bool = True) -> Path:
     """Write ``dataset`` to ``path`` (engine h5netcdf) atomically.
 
     The data go to a temporary file in the same directory, are flushed to disk, and the file
@@ -265,13 +265,17 @@ def write_netcdf(dataset: xr.Dataset, path) -> Path:
         The data to write.
     path : str or os.PathLike
         The netCDF file to create or replace; its directory must exist.
+    exclusive : bool
+        Whether a ``path`` that did not exist is created, never replaced: if another
+        program wrote it meanwhile, ``FileExistsError`` and this dataset is not written
+        (:func:`ecofmaps.io.files.atomic_path`). False where any writer writes the same.
 
     Returns
     -------
     path : pathlib.Path
     """
     path = Path(path)
-    with atomic_path(path) as temporary:
+    with atomic_path(path, exclusive=exclusive) as temporary:
         dataset.to_netcdf(temporary, engine="h5netcdf")
     return path
 
@@ -376,7 +380,7 @@ def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
     if len(image) > bound:
         return
     path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as temporary:
+    with atomic_path(path, exclusive=False) as temporary:  # the same entry, whoever wins
         temporary.write_bytes(image)
     _evict(path.parent, bound, keep=path)
 

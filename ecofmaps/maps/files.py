@@ -76,10 +76,10 @@ def write_map(dataset: xr.Dataset, path, *, also: Sequence = ()) -> tuple:
 
     Notes
     -----
-    The output is written under ``.<name>.<32 hex digits>.tmp`` beside ``path`` and renamed
-    onto it once complete; on any failure, Ctrl-C included, the running blocks finish, the
-    temporary output is removed and an existing ``path`` is left as it was. A zarr store's
-    chunks are the map's blocks.
+    The output is written under ``.<name>.<process id>.<32 hex digits>.tmp`` beside ``path``
+    and renamed onto it once complete; on any failure, Ctrl-C included, the running blocks
+    finish, the temporary output is removed and an existing ``path`` is left as it was. A zarr
+    store's chunks are the map's blocks.
 
     Examples
     --------

@@ -29,7 +29,14 @@ def _series(name, values, size=None, dtype=np.float64):
     """``values`` as a 1-D array (NumPy, or dask as it is) of ``size`` samples."""
     if hasattr(values, "dims"):  # an xarray DataArray: its NumPy or dask data
         values = values.data
-    array = values if is_lazy(values) else np.asarray(values, dtype=dtype)
+    if np.ma.isMaskedArray(values):  # masked samples are missing, as NaN is
+        values = values.astype(bool).filled(True) if dtype is bool else values.filled(np.nan)
+    try:
+        array = values if is_lazy(values) else np.asarray(values, dtype=dtype)
+    except (ValueError, TypeError, OverflowError) as error:
+        raise ValueError(f"{name} cannot be read as numbers, one per sample ({error})") from None
+    if array.dtype == object:  # Python integers too large for any integer type, say
+        raise ValueError(f"{name} must hold numbers of at most 64 bits; got {array.dtype}")
     if array.ndim != 1:
         raise ValueError(f"{name} must be one-dimensional (one value per sample)")
     if size is not None and array.shape[0] != size:

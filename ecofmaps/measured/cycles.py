@@ -571,6 +571,29 @@ def labelled_cycles(displacement, cycle, tolerance: float = 0.01) -> Cycles:
     return _labelled(Samples(x, None, np.asarray(cycle), chunk=passes._CHUNK), tolerance)
 
 
+def _check_labels(label: np.ndarray) -> None:
+    """A ValueError naming the first sample whose cycle number is not whole, or the first
+    number given to two runs of samples apart (a counter reset): cycles would share it."""
+    known = np.flatnonzero(np.isfinite(label)) if label.dtype.kind == "f" else None
+    values = label if known is None else label[known]
+    instead = "--cycle-col none, or cycle=None, cuts the cycles at the reversals instead"
+    if known is not None and (split := np.flatnonzero(values != np.floor(values))).size:
+        raise ValueError(
+            f"the cycle number {values[split[0]]:g} of sample {known[split[0]]} is not a whole "
+            f"number: is the cycle column a cycle counter? ({instead})"
+        )
+    starts = np.flatnonzero(np.r_[True, values[1:] != values[:-1]])
+    numbers, first = np.unique(values[starts], return_index=True)
+    if numbers.size < starts.size:
+        again = np.setdiff1d(np.arange(starts.size), first)[0]
+        sample = starts[again] if known is None else known[starts[again]]
+        raise ValueError(
+            f"the cycle number {values[starts[again]]:g} comes again at sample {sample}, after "
+            f"other numbers: two cycles would share it (a counter that restarted?); number the "
+            f"cycles anew ({instead})"
+        )
+
+
 def find_cycles(
     displacement, cycle=None, hysteresis: float = 0.5, *, force=None, missing=None, runner=None
 ) -> Cycles:
@@ -583,6 +606,8 @@ def find_cycles(
                 f"cycle must have one value per sample: {cycle.shape[0]} values for "
                 f"{displacement.shape[0]} samples"
             )
+        if isinstance(cycle, np.ndarray):
+            _check_labels(cycle)
     samples = Samples(displacement, force, cycle, missing, runner=runner, chunk=passes._CHUNK)
     if cycle is None:
         return _split(samples, hysteresis, 0.01)

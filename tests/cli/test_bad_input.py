@@ -9,6 +9,7 @@ import os
 import signal
 import sys
 
+import numpy as np
 import pytest
 
 from ecofmaps.cli import main
@@ -223,3 +224,105 @@ def test_a_second_ctrl_c_stops_at_once():
         signal.raise_signal(signal.SIGINT)  # the first: a flag
         with pytest.raises(KeyboardInterrupt):
             signal.raise_signal(signal.SIGINT)  # the second: at once
+
+
+def test_a_reading_warning_is_one_line_of_the_command(tmp_path, capsys, recording):
+    """Not Python's two lines ('...: RecordingWarning: ...' and the source line)."""
+    latin = tmp_path / "latin.csv"
+    latin.write_bytes(recording.read_bytes() + "# café\n".encode("latin-1"))
+    status, _, err = run(capsys, "loops", latin, "--load", "450N", "--no-resolve")
+    lines = [line for line in err.splitlines() if "warning" in line or "Warning" in line]
+    assert status == 0 and len(lines) == 1 and "Traceback" not in err, err
+    assert lines[0].startswith(f"ecofmaps loops: warning: {latin}, line ")
+    assert lines[0].endswith(
+        "is not UTF-8; the file is read as Latin-1 from this line on (numbers are the same in both)"
+    )
+
+
+def header_file(tmp_path, header, cells=lambda x, q: f"{x},{q}", name="rec.csv"):
+    """A recording of 20 loops under ``header``, each line's cells made by ``cells``."""
+    t = np.linspace(0.0, 40.0 * np.pi, 4000)
+    x, q = 50e-6 * np.sin(t), 300.0 * np.tanh(5.0 * np.sin(t + 0.3))
+    lines = [header, *(cells(a, b) for a, b in zip(x, q, strict=True))]
+    path = tmp_path / name
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.mark.parametrize(
+    ("header", "cells", "options", "message"),
+    [
+        (
+            "displacement [foo],force [N]", None, [],
+            "line 1: the displacement column 'displacement [foo]' is in 'foo', which is not a "
+            "known unit (known: m, mm, um, µm, μm, nm, in and the others pint reads): write a "
+            "known unit in the header, or name the column with --displacement-col and give its "
+            "unit with --displacement-unit",
+        ),
+        (
+            "displacement [m],force [N]", lambda x, q: f"{x},", [],
+            "line 1: the force column 'force [N]' holds no number: all its 4000 samples are "
+            "missing; is it the right column?",
+        ),
+        (
+            "displacement [m],force [N],force [N]", lambda x, q: f"{x},{q},{q}", [],
+            "line 1: several force columns match 'force': 'force [N]' (#2), 'force [N]' (#3); "
+            "choose one with --force-col by its position, e.g. '#2'",
+        ),
+        (
+            "displacement [m],force [N],force [N]", lambda x, q: f"{x},{q},{q}",
+            ["--force-col", "force [N]"],
+            "line 1: several force columns match 'force [N]': 'force [N]' (#2), 'force [N]' "
+            "(#3); choose one with --force-col by its position, e.g. '#2'",
+        ),
+        (
+            "cycle,displacement [m],force [N]", lambda x, q: f",{x},{q}", [],
+            "line 1: the cycle column 'cycle' holds no number: all its 4000 samples are "
+            "missing; --cycle-col none reads no cycle column",
+        ),
+    ],
+)  # fmt: skip
+def test_reading_errors_blame_the_right_thing_and_name_the_options(
+    tmp_path, capsys, header, cells, options, message
+):
+    path = header_file(tmp_path, header, cells or (lambda x, q: f"{x},{q}"))
+    status, out, err = run(capsys, "loops", path, "--load", "450N", "--no-resolve", *options)
+    assert status == 2 and out == "" and one_line_error(err)
+    assert err == f"ecofmaps: error: {path}, {message}\n"
+
+
+def test_columns_named_alike_are_chosen_by_position_and_a_cycle_column_ignored(tmp_path, capsys):
+    path = header_file(tmp_path, "displacement [m],force [N],force [N]", lambda x, q: f"{x},0,{q}")
+    status, out, _ = run(
+        capsys, "loops", path, "--load", "450N", "--no-resolve", "--force-col", "#3"
+    )
+    assert status == 0 and out.count(",gross slip,ok\n") == 19, out  # the force, not zeros
+    labelled = header_file(tmp_path, "cycle,displacement [m],force [N]", lambda x, q: f"7,{x},{q}")
+    status, out, _ = run(
+        capsys, "loops", labelled, "--load", "450N", "--no-resolve", "--cycle-col", "none"
+    )
+    assert status == 0 and out.count(",gross slip,ok\n") == 19, out  # cut at the reversals
+    status, out, err = run(capsys, "loops", labelled, "--load", "450N", "--cycle-col", "")
+    assert status == 2 and err == (
+        "ecofmaps: error: --cycle-col '' names no column: give the cycle column's name, or none "
+        "to read no cycle column\n"
+    )
+
+
+def test_errors_of_the_reading_name_the_options_not_python_keywords():
+    from ecofmaps.cli.main import option_names
+
+    assert option_names("skip_rows must be a non-negative integer; got -1") == (
+        "--skip-rows must be a non-negative integer; got -1"
+    )
+    assert (
+        option_names("force_unit='m' is not a force unit") == "--force-unit 'm' is not a force unit"
+    )
+    assert (
+        option_names("choose one with load_column (--load COLUMN)")
+        == "choose one with --load COLUMN"
+    )
+    assert (
+        option_names("/data/force_unit.csv: cycle_column.x")
+        == "/data/force_unit.csv: cycle_column.x"
+    )

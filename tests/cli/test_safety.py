@@ -207,3 +207,45 @@ def test_figures_into_a_folder_in_use_need_overwrite(tmp_path, capsys):
     )
     assert sorted(p.name for p in out.iterdir()) == ["fig8.png", "thesis.txt"]
     assert (out / "fig8.png").read_bytes() == b"a user's picture"
+
+
+@pytest.mark.parametrize("device", ["/dev/null", "/dev/full"])
+def test_an_output_onto_a_device_is_refused_as_not_a_regular_file(capsys, device):
+    status, stdout, stderr = run(capsys, "loops", *SHORT, "--out", device)
+    assert status == 2 and stdout == ""
+    assert stderr == (
+        f"ecofmaps: error: --out {device} is not a regular file (a device, a pipe or a "
+        "socket): ecofmaps writes only regular files; choose a file name\n"
+    )
+
+
+@pytest.mark.parametrize("looped", ["input", "--out"])
+def test_symbolic_links_in_a_loop_are_named_with_the_remedy(tmp_path, capsys, looped):
+    (tmp_path / "a.csv").symlink_to(tmp_path / "b.csv")
+    (tmp_path / "b.csv").symlink_to(tmp_path / "a.csv")
+    source, out = (tmp_path / "a.csv", tmp_path / "o.csv")
+    if looped == "--out":
+        source, out = example_path(), tmp_path / "a.csv"
+    status, stdout, stderr = run(capsys, "loops", source, "--load", "450N", "--out", out)
+    assert status == 2 and stdout == ""
+    assert stderr == (
+        f"ecofmaps: error: {tmp_path / 'a.csv'}: symbolic links that point to each other in "
+        "a loop: remove or correct the link\n"
+    )
+
+
+def test_a_full_disk_names_the_file_and_leaves_no_empty_plots_folder(tmp_path, capsys, monkeypatch):
+    import errno
+
+    from matplotlib.figure import Figure
+
+    def full(self, *args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(Figure, "savefig", full)
+    plots = tmp_path / "plots"
+    status, _, stderr = run(capsys, "loops", *SHORT, "--plots", plots, "--out", tmp_path / "o.csv")
+    assert status == 2
+    loops = plots / f"{example_path().stem}_loops.png"
+    assert stderr == f"ecofmaps: error: [Errno 28] No space left on device: '{loops}'\n"
+    assert not plots.exists()

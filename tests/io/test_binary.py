@@ -13,7 +13,7 @@ from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
 
 from ecofmaps._parallel import Slice, stretch
 from ecofmaps.io.binary import Column
-from ecofmaps.io.recording_types import RecordingError
+from ecofmaps.io.recording_types import RecordingError, RecordingWarning
 from ecofmaps.io.recordings import read_recording, recording_blocks, recording_format
 from ecofmaps.io.rig_formats import variables
 
@@ -534,3 +534,16 @@ def test_the_loops_command_closes_a_lazy_recording_whose_analysis_fails(
     )  # fmt: skip
     assert status != 0 and "error" in capsys.readouterr().err
     assert left_to_gc() == [] and open_hdf5_files() == []
+
+
+def test_a_tdms_text_property_not_utf8_is_one_warning_and_npTDMS_prints_nothing(tmp_path, capfd):
+    path = write_tdms(tmp_path / "rig.tdms")
+    data = path.read_bytes()
+    path.write_bytes(data.replace(b"test", b"t\xffst", 1))
+    with pytest.warns(RecordingWarning) as caught:
+        check(read_recording(path, force_column="ftr", lazy=False))
+    assert {str(w.message) for w in caught} == {  # the same one each time the file is opened
+        f"{path}: a text property of the file is not UTF-8; read with replacement "
+        "characters (the samples are not affected)"
+    }
+    assert capfd.readouterr().err == ""  # not '[nptdms.types WARNING] ...'

@@ -10,6 +10,7 @@ from ecofmaps.io.columns import (
     ColumnError,
     column_scale,
     find_column,
+    listed_names,
     split_unit,
 )
 from ecofmaps.units import parse_quantity
@@ -203,3 +204,39 @@ def test_every_usual_name_in_every_style_is_found(role, pick, style, join, upper
     names = [other for key, other in others.items() if key != role]
     names.insert(position, name)
     assert find_column(names, role, role) == position
+
+
+def test_columns_named_alike_are_chosen_by_their_position():
+    names = ["displacement [m]", "force [N]", "force [N]"]
+    with pytest.raises(ColumnError) as raised:
+        find_column(names, "force [N]", "force")
+    assert str(raised.value) == (
+        "several force columns match 'force [N]': 'force [N]' (#2), 'force [N]' (#3); choose "
+        "one with force_column (--force-col) by its position, e.g. '#2'"
+    )
+    assert find_column(names, "#3", "force") == 2
+    assert find_column(names, " #2 ", "force") == 1
+    assert find_column(names, "#4", "force", required=False) is None
+    assert find_column(["#2", "x"], "#2", "force") == 0  # a column named so comes first
+
+
+@pytest.mark.parametrize("name", ["displacement [foo]", "Displacement/foo", "disp [qq]"])
+def test_an_unknown_unit_is_named_as_such(name):
+    with pytest.raises(ColumnError) as raised:
+        find_column([name, "force [N]"], "displacement", "displacement")
+    unit = name.split("[")[-1].split("/")[-1].strip("]")
+    assert str(raised.value).startswith(
+        f"the displacement column {name!r} is in {unit!r}, which is not a known unit "
+        "(known: m, mm, um, µm, μm, nm, in and the others pint reads)"
+    )
+    assert "displacement_unit (--displacement-unit)" in str(raised.value)
+
+
+def test_column_lists_in_messages_are_cut():
+    names = ["x" * 200_000, *(f"c{k}" for k in range(30))]
+    with pytest.raises(ColumnError) as raised:
+        find_column(names, "displacement", "displacement")
+    message = str(raised.value)
+    assert len(message) < 600 and "and 21 more" in message
+    assert f"'{'x' * 36}..." in message
+    assert listed_names(["a", "b"]) == "'a', 'b'"

@@ -450,3 +450,19 @@ def test_a_stop_signal_is_honoured_between_blocks_while_parsing(tmp_path):
         for _ in blocks:
             pass
     blocks.close()
+
+
+def test_cells_and_names_beyond_the_csv_field_limit_are_read_or_named_cut(tmp_path):
+    """A cell or a column name longer than the csv module's field limit (131072 characters)
+    is no error of its own: a long name is an extra column, a long cell a value named (cut)
+    at its line."""
+    named = tmp_path / "named.csv"
+    named.write_text('displacement,force,"' + "x" * 200_000 + '"\n1,2,3\n4,5,6\n')
+    assert read_recording(named).force.tolist() == [2.0, 5.0]
+    cell = tmp_path / "cell.csv"
+    cell.write_text('displacement,force\n1,2\n3,"' + "1x" * 250_000 + '"\n')
+    with pytest.raises(RecordingError) as raised:
+        read_recording(cell)
+    assert str(raised.value) == (
+        f"{cell}, line 3: non-numeric value '{'1x' * 18}... in column 'force'"
+    )

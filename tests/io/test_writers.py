@@ -1,5 +1,9 @@
 """Writing recordings block by block, converting them, and never leaving a partial store."""
 
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -163,3 +167,34 @@ def test_a_folder_is_never_removed_to_make_room(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["results"]
     assert [p.name for p in folder.iterdir()] == ["thesis.txt"]
     assert (folder / "thesis.txt").read_text() == "chapter 1"
+
+
+def test_two_writers_of_one_new_file_never_lose_a_result_silently(tmp_path):
+    """The second to finish is refused, naming the file, and the first's file is kept."""
+    path = tmp_path / "table.csv"
+    with pytest.raises(FileExistsError) as raised, atomic_path(path) as late:
+        late.write_text("late")
+        with atomic_path(path) as early:
+            early.write_text("early")
+    assert raised.value.filename == str(path)
+    assert "written by another program meanwhile" in str(raised.value)
+    assert path.read_text() == "early"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["table.csv"]
+    with atomic_path(path) as again:  # an existing file is replaced as before
+        again.write_text("again")
+    assert path.read_text() == "again"
+
+
+def test_temporaries_of_killed_runs_are_removed_by_the_next_write(tmp_path):
+    ended = subprocess.Popen([sys.executable, "-c", ""])
+    ended.wait()
+    hex32 = "a" * 32
+    dead = tmp_path / f".table.csv.{ended.pid}.{hex32}.tmp"
+    living = tmp_path / f".table.csv.{os.getppid()}.{hex32}.tmp"
+    other = tmp_path / f".other.csv.{ended.pid}.{hex32}.tmp"  # another file's
+    users = tmp_path / ".table.csv.notes.tmp"  # not a name ecofmaps gives
+    for item in (dead, living, other, users):
+        item.write_bytes(b"")
+    with atomic_path(tmp_path / "table.csv") as temporary:
+        temporary.write_text("x")
+    assert not dead.exists() and living.exists() and other.exists() and users.exists()

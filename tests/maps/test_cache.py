@@ -441,7 +441,8 @@ def _write_repeatedly(directory, barrier, repeats):
     key = cache.cache_key("race", {"n": 1.0})
     barrier.wait()
     for _ in range(repeats):
-        cache.write_netcdf(dataset.assign_attrs(ecofmaps_cache_key=key), directory / "race.nc")
+        entry = dataset.assign_attrs(ecofmaps_cache_key=key)
+        cache.write_netcdf(entry, directory / "race.nc", exclusive=False)
         compute_map(**GRID, cache=True, cache_dir=directory)
 
 
