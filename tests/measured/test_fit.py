@@ -349,7 +349,7 @@ def test_figure_overlays_measured_and_fitted_loops():
     for ax, letter, (name, fit) in zip(panels, "ab", fits.items(), strict=True):
         assert ax.get_xlabel() == "Applied displacement $\\Delta$ [µm]"
         assert ax.get_ylabel() == "Tangential force $Q$ [N]"
-        assert ax.get_title().startswith(f"({letter}) {name}: P = 450 N")
+        assert ax.get_title().startswith(f"({letter}) {name}: $P$ = 450 N")
         assert f"$\\mu$ = {fit.mu:.3f}" in ax.get_title()
         assert [text.get_text() for text in ax.get_legend().get_texts()] == [
             "measured",
