@@ -2,6 +2,7 @@
 through read_recording, whole and lazily; damaged files name the file and the channel."""
 
 import itertools
+import os
 import pickle
 
 import h5py
@@ -468,27 +469,28 @@ def test_flipped_bytes_in_the_header_name_the_file_as_damaged(tmp_path, capfd, k
 # --- no file left to the garbage collector ----------------------------------------------------
 
 
-def open_hdf5_files() -> list:
-    """The h5netcdf files of this process still open (alive and not closed)."""
+def open_hdf5_files(folder) -> list:
+    """The h5netcdf files in ``folder`` (a test's own) this process still has open."""
     import gc
 
     import h5netcdf
 
-    return [f for f in gc.get_objects() if isinstance(f, h5netcdf.File) and not f._closed]
+    files = [f for f in gc.get_objects() if isinstance(f, h5netcdf.File) and not f._closed]
+    return [f for f in files if os.path.dirname(f.filename) == str(folder)]
 
 
 def test_a_lazy_recording_closes_its_files_on_leaving_its_block(tmp_path):
     """A lazy recording read and closed (``with``, or ``close()``) leaves no HDF5 file open
     for the garbage collector to close, though the recording itself is still alive."""
     path = write_hdf5(tmp_path / "rig.h5")
-    assert open_hdf5_files() == []
+    assert open_hdf5_files(tmp_path) == []
     with read_recording(path, lazy=True, group="rig/run1") as recording:
         whole = recording.compute()
-        assert open_hdf5_files()  # open while it is read
-    assert open_hdf5_files() == []
+        assert open_hdf5_files(tmp_path)  # open while it is read
+    assert open_hdf5_files(tmp_path) == []
     np.testing.assert_array_equal(recording.compute().displacement, whole.displacement)
     recording.close()  # the read above opened it again
-    assert open_hdf5_files() == []
+    assert open_hdf5_files(tmp_path) == []
 
 
 @pytest.fixture
@@ -515,7 +517,7 @@ def test_blocks_of_a_rig_file_close_it_when_done_or_given_up(tmp_path, left_to_g
     next(blocks)
     blocks.close()  # the reader stops early
     assert sum(block.size for block in recording_blocks(path, 1000, group="rig/run1")) == SIZE
-    assert left_to_gc() == [] and open_hdf5_files() == []
+    assert left_to_gc() == [] and open_hdf5_files(tmp_path) == []
 
 
 def test_the_loops_command_closes_a_lazy_recording_whose_analysis_fails(
@@ -533,7 +535,7 @@ def test_the_loops_command_closes_a_lazy_recording_whose_analysis_fails(
          str(tmp_path / "t.csv")]
     )  # fmt: skip
     assert status != 0 and "error" in capsys.readouterr().err
-    assert left_to_gc() == [] and open_hdf5_files() == []
+    assert left_to_gc() == [] and open_hdf5_files(tmp_path) == []
 
 
 def test_a_tdms_text_property_not_utf8_is_one_warning_and_npTDMS_prints_nothing(tmp_path, capfd):
