@@ -392,7 +392,7 @@ def _why_none(results: xr.Dataset) -> str:
 def _cycle_axis(ax, cycle) -> None:
     """Integer ticks on the cycle axis of ``ax``, its limits the cycles' range (with a half-cycle
     margin), whether or not anything was drawn."""
-    ax.xaxis.set_major_locator(MaxNLocator(integer=True, min_n_ticks=1))
+    ax.xaxis.set_major_locator(MaxNLocator(nbins=6, integer=True, min_n_ticks=1))
     if cycle.size:
         first, last = float(np.min(cycle)), float(np.max(cycle))
         margin = 0.5 if first == last else 0.02 * (last - first)
