@@ -44,7 +44,7 @@ _OURS = re.compile(r"^\.(?P<name>.+)\.(?P<pid>\d+)\.[0-9a-f]{32}\.tmp$")
 MANIFEST = ".ecofmaps-manifest.json"
 
 #: Files whose presence makes a directory a zarr store (version 3, then version 2).
-_STORE_MARKERS = ("zarr.json", ".zgroup", ".zarray")
+STORE_MARKERS = ("zarr.json", ".zgroup", ".zarray")
 
 
 @contextlib.contextmanager
@@ -220,7 +220,7 @@ _RACED = "was written by another program meanwhile: this result is not written o
 def is_store(path) -> bool:
     """Whether ``path`` is a directory holding a zarr store (its metadata file at the top)."""
     path = Path(path)
-    return path.is_dir() and any((path / name).is_file() for name in _STORE_MARKERS)
+    return path.is_dir() and any((path / name).is_file() for name in STORE_MARKERS)
 
 
 def _manifest(folder: Path) -> dict:

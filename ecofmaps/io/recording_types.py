@@ -1,11 +1,9 @@
 """A recording of fretting loops as read: :class:`Recording` and the errors that name its lines.
 
-A :class:`Recording` holds the displacement, force and optional cycle-number samples in SI
-units (NumPy arrays, or dask arrays for a rig file read lazily) with where each sample came
-from (a line of a text file, or a sample of a channel), so a damaged or missing sample is
-reported as a :class:`RecordingError` naming the file and the line. It is built by
-:func:`ecofmaps.io.recordings.read_recording`, and gives the one xarray Dataset every way in
-shares (:meth:`Recording.to_dataset`, :func:`ecofmaps.io.recordings.open_recording`).
+A :class:`Recording` holds the samples in SI units with where each came from (a line of a
+text file, or a sample of a channel), so a damaged or missing sample is reported as a
+:class:`RecordingError` naming the file and the line; :meth:`Recording.to_dataset` gives the
+one xarray Dataset every way in shares (``docs/formats.md``).
 """
 
 from __future__ import annotations
@@ -36,12 +34,12 @@ __all__ = [
 ]
 
 #: What a path that is not a regular file is, by ``stat`` test.
-_NOT_FILES = (
-    (stat.S_ISFIFO, "a named pipe (FIFO)"),
-    (stat.S_ISCHR, "a character device"),
-    (stat.S_ISBLK, "a block device"),
-    (stat.S_ISSOCK, "a socket"),
-)
+_NOT_FILES = {
+    stat.S_ISFIFO: "a named pipe (FIFO)",
+    stat.S_ISCHR: "a character device",
+    stat.S_ISBLK: "a block device",
+    stat.S_ISSOCK: "a socket",
+}
 
 #: Rig files with more samples than this are read lazily (dask arrays) by default.
 LAZY_SAMPLES = 1 << 24
@@ -73,8 +71,8 @@ def si_values(values: np.ndarray, factor: float) -> np.ndarray:
     inverse = round(1.0 / factor)
     if factor < 1.0 and inverse == 1.0 / factor and float(inverse) == inverse:
         values /= float(inverse)
-        return values
-    values *= factor
+    else:
+        values *= factor
     return values
 
 
@@ -108,7 +106,7 @@ class RecordingError(FileLineError):
         else:
             self.line = int(line)
             self.position = f"line {self.line}"
-        where = f"{self.path}, {self.position}" if self.position else f"{self.path}"
+        where = f"{self.path}, {self.position}" if self.position else self.path
         ValueError.__init__(self, f"{where}: {message}")
 
 
@@ -121,7 +119,7 @@ def check_regular_file(path) -> None:
     mode = os.stat(path).st_mode
     if stat.S_ISREG(mode):
         return
-    what = next((kind for test, kind in _NOT_FILES if test(mode)), "not a regular file")
+    what = next((kind for test, kind in _NOT_FILES.items() if test(mode)), "not a regular file")
     raise RecordingError(
         path, None, f"{what}, not a regular file: save the data to a file and read that"
     )
@@ -170,10 +168,8 @@ class LineIndex:
 class Recording:
     """The samples read from a recording file, in SI units.
 
-    The arrays are NumPy arrays, or dask arrays for a large rig file read lazily (see
-    ``lazy`` in :func:`read_recording`): ``recording.displacement.chunks`` then gives the
-    blocks, ``recording[start:stop]`` reads one range into memory and
-    :meth:`compute` all of it.
+    The arrays are NumPy arrays, or dask arrays for a rig file read lazily:
+    ``recording[start:stop]`` reads one range into memory and :meth:`compute` all of it.
 
     Attributes
     ----------
@@ -199,8 +195,7 @@ class Recording:
         The file's format: ``'text'``, ``'tdms'``, ``'hdf5'`` or ``'zarr'``.
     assumed_units : tuple of str
         The roles (``'displacement'``, ``'force'``, ``'load'``) whose unit was assumed (the
-        default, µm or N) because neither the file nor an option gave one: the analysis can say
-        "the displacement column has no unit; assumed um".
+        default, µm or N) because neither the file nor an option gave one.
     """
 
     path: Path
@@ -229,6 +224,12 @@ class Recording:
         """Whether the arrays are dask arrays, read when computed."""
         return not isinstance(self.displacement, np.ndarray)
 
+    def arrays(self) -> dict:
+        """The arrays read, by role (displacement, force, then cycle and load if read)."""
+        read = {"displacement": self.displacement, "force": self.force}
+        read |= {"cycle": self.cycle, "load": self.load}
+        return {role: array for role, array in read.items() if array is not None}
+
     @functools.cached_property
     def missing(self):
         """Mask of the missing samples (NaN in any column read): numpy or dask, as the data.
@@ -238,8 +239,7 @@ class Recording:
         The lines of the missing samples of a text file:
         ``recording.line(np.flatnonzero(recording.missing))``.
         """
-        read = (self.displacement, self.force, self.cycle, self.load)
-        arrays = [array for array in read if array is not None]
+        arrays = self.arrays().values()
         if self.lazy:
             import dask.array as da
 
@@ -280,30 +280,21 @@ class Recording:
             raise TypeError("a Recording is indexed by a slice start:stop")
         first, stop, _ = key.indices(self.size)
         stop = max(stop, first)
-        arrays = [self.displacement, self.force, self.cycle, self.load]
-        taken = [None if a is None else a[first:stop] for a in arrays]
+        taken = {role: array[first:stop] for role, array in self.arrays().items()}
         if self.lazy:
             import dask
 
-            taken = list(dask.compute(*taken))
+            taken = dict(zip(taken, dask.compute(*taken.values()), strict=True))
         last = None
         if self.lines is not None and stop > first:
             last = int(self.lines(self.start + stop - 1))
-        return dataclasses.replace(
-            self,
-            displacement=taken[0],
-            force=taken[1],
-            cycle=taken[2],
-            load=taken[3],
-            last_line=last,
-            start=self.start + first,
-        )
+        return dataclasses.replace(self, **taken, last_line=last, start=self.start + first)
 
     def close(self) -> None:
         """Close the files a lazy recording reads from (a later read opens them again). A
         recording is also a context manager that closes them on leaving:
         ``with read_recording(path) as recording: ...``."""
-        for array in (self.displacement, self.force, self.cycle, self.load):
+        for array in self.arrays().values():
             source = getattr(array, SOURCE, None)
             if source is not None:
                 source.close()
@@ -325,12 +316,11 @@ class Recording:
         -------
         dataset : xarray.Dataset
             ``displacement`` [m], ``force`` [N] and, if read, ``cycle`` [1] and ``load``
-            [N], each with the
-            attributes ``units`` (SI), ``long_name``, ``source_column`` (as named in the
-            file), ``source_units`` (the unit read) and ``unit_assumed`` (1 if the file and
-            the options gave no unit and the default was assumed, else 0); the Dataset's
-            attributes ``source`` (the path), ``format`` and ``first_sample`` (the index of
-            the first sample in the file).
+            [N], each with the attributes ``units`` (SI), ``long_name``, ``source_column``
+            (as named in the file), ``source_units`` (the unit read) and ``unit_assumed`` (1
+            if the file and the options gave no unit and the default was assumed, else 0);
+            the Dataset's attributes ``source`` (the path), ``format`` and ``first_sample``
+            (the index of the first sample in the file).
 
         Examples
         --------
@@ -340,16 +330,8 @@ class Recording:
         >>> dataset.displacement.attrs["units"], dataset.attrs["format"], dataset.sizes["sample"]
         ('m', 'text', 24000)
         """
-        roles = {
-            "displacement": self.displacement,
-            "force": self.force,
-            "cycle": self.cycle,
-            "load": self.load,
-        }
         variables = {}
-        for role, data in roles.items():
-            if data is None:
-                continue
+        for role, data in self.arrays().items():
             described = attrs(role) if role != "cycle" else {"long_name": "cycle number"}
             variables[role] = xr.Variable(
                 ("sample",),

@@ -1,11 +1,9 @@
 """Recordings of fretting loops: text files and rig formats, read whole, in blocks or lazily.
 
-:func:`read_recording` reads the displacement, force and optional cycle-number columns of a
-text file (:mod:`ecofmaps.io.text`) or a rig file (TDMS, HDF5/netCDF-4, zarr:
-:mod:`ecofmaps.io.binary`) into a :class:`~ecofmaps.io.recording_types.Recording` in SI
+:func:`read_recording` reads a text file (:mod:`ecofmaps.io.text`) or a rig file
+(:mod:`ecofmaps.io.binary`) into a :class:`~ecofmaps.io.recording_types.Recording` in SI
 units; :func:`open_recording` gives it as one xarray Dataset, :func:`recording_blocks` block
-by block. The format is found from the file's first bytes. ``docs/formats.md`` describes the
-formats, columns and units.
+by block. ``docs/formats.md`` describes the formats, columns and units.
 """
 
 from __future__ import annotations
@@ -21,6 +19,7 @@ import xarray as xr
 
 from ecofmaps.io.binary import read_binary
 from ecofmaps.io.columns import column_scale, split_unit
+from ecofmaps.io.files import STORE_MARKERS
 from ecofmaps.io.recording_types import (
     LAZY_SAMPLES,
     LineIndex,
@@ -46,15 +45,10 @@ _MAGIC = {
     b"CDF\x02": "netcdf3",
 }
 _SUFFIXES = {
+    **dict.fromkeys((".h5", ".hdf5", ".hdf", ".nc", ".nc4"), "hdf5"),
     ".tdms": "tdms",
-    ".h5": "hdf5",
-    ".hdf5": "hdf5",
-    ".hdf": "hdf5",
-    ".nc": "hdf5",
-    ".nc4": "hdf5",
     ".zarr": "zarr",
 }
-_ZARR_METADATA = ("zarr.json", ".zgroup", ".zarray")
 
 
 def recording_format(path) -> str:
@@ -82,7 +76,7 @@ def recording_format(path) -> str:
     """
     path = Path(path)
     if path.is_dir():
-        if any((path / name).exists() for name in _ZARR_METADATA):
+        if any((path / name).exists() for name in STORE_MARKERS):
             return "zarr"
         raise RecordingError(path, None, "a directory, and not a zarr store (no zarr.json)")
     check_regular_file(path)
@@ -121,76 +115,87 @@ def _options(
     skip_rows=None,
 ) -> dict:
     """The reading options, checked, as one dict."""
-    for name, value in (
-        ("displacement_column", displacement_column),
-        ("force_column", force_column),
-    ):
+    options = dict(locals())
+    for name in ("displacement_column", "force_column"):
+        if not isinstance(options[name], str) or not options[name].strip():
+            raise ValueError(f"{name} must be a column name; got {options[name]!r}")
+    for name in ("cycle_column", "load_column", "displacement_unit", "force_unit", "group"):
+        value = options[name]
+        if value is None or (name == "cycle_column" and value is False):
+            continue
         if not isinstance(value, str) or not value.strip():
-            raise ValueError(f"{name} must be a column name; got {value!r}")
-    for name, value in (
-        ("cycle_column", None if cycle_column is False else cycle_column),
-        ("load_column", load_column),
-        ("displacement_unit", displacement_unit),
-        ("force_unit", force_unit),
-        ("group", group),
-    ):
-        if value is not None and (not isinstance(value, str) or not value.strip()):
             raise ValueError(f"{name} must be a non-empty string or None; got {value!r}")
     if nan_policy not in _NAN_POLICIES:
         raise ValueError(f"nan_policy must be one of {_NAN_POLICIES}; got {nan_policy!r}")
-    if skip_rows is not None and (
-        isinstance(skip_rows, bool) or not isinstance(skip_rows, numbers.Integral) or skip_rows < 0
-    ):
-        raise ValueError(f"skip_rows must be a non-negative integer or None; got {skip_rows!r}")
+    _check_count("skip_rows", skip_rows, 0, "a non-negative integer or None")
     for role, unit in (("displacement", displacement_unit), ("force", force_unit)):
         if unit is not None:
             column_scale(role, unit, [], role)  # a ValueError naming the option
-    return {
-        "displacement_column": displacement_column,
-        "force_column": force_column,
-        "cycle_column": cycle_column,
-        "displacement_unit": displacement_unit,
-        "force_unit": force_unit,
-        "group": group,
-        "nan_policy": nan_policy,
-        "load_column": load_column,
-        "skip_rows": None if skip_rows is None else int(skip_rows),
-    }
+    return {**options, "skip_rows": None if skip_rows is None else int(skip_rows)}
 
 
-def _check_count(name: str, value) -> None:
-    """A positive integer option (None allowed), or a ValueError naming it."""
-    if value is None:
-        return
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:
-        raise ValueError(f"{name} must be a positive integer; got {value!r}")
+def _check_count(name: str, value, least: int = 1, what: str = "a positive integer") -> None:
+    """An integer option of at least ``least`` (None allowed), or a ValueError naming it."""
+    if value is not None and (
+        isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < least
+    ):
+        raise ValueError(f"{name} must be {what}; got {value!r}")
 
 
-def _assumed_units(layout, options: dict) -> tuple:
-    """The roles of a text file whose unit neither the column's name nor an option gave."""
-    return tuple(
+def _text_recordings(path: Path, options: dict, block_bytes, samples=None) -> Iterator[Recording]:
+    """A text file's samples as recordings of ``samples`` each (None: one of all of them)."""
+    if options["group"] is not None:
+        raise ValueError("group applies to TDMS, HDF5/netCDF and zarr files, not to text")
+    parts = text_blocks(path, options, block_bytes or BLOCK_BYTES)
+    layout = next(parts)
+    columns = {role: layout.names[k] for role, k in layout.columns.items()}
+    units = {role: layout.units[role] for role in layout.columns}
+    assumed = tuple(
         role
-        for role, index in layout.columns.items()
-        if role != "cycle"
-        and options.get(f"{role}_unit") is None
-        and split_unit(layout.names[index])[1] is None
+        for role, name in columns.items()
+        if role != "cycle" and options.get(f"{role}_unit") is None and split_unit(name)[1] is None
     )
-
-
-def _read_text(path: Path, options: dict, block_bytes: int) -> Recording:
-    blocks = text_blocks(path, options, block_bytes)
-    layout = next(blocks)
-    parts = list(blocks)
-    if not parts:
+    pending: list = []  # parsed blocks not yet given out: (values by role, line numbers)
+    held = first = 0
+    for part in itertools.chain(parts, [None]):  # None: the end, give out the rest
+        if part is not None:
+            pending.append(part)
+            held += part[1].size
+        while held and (part is None or (samples is not None and held >= samples)):
+            joined = {role: np.concatenate([p[0][role] for p in pending]) for role in columns}
+            lines = np.concatenate([p[1] for p in pending])
+            count = held if samples is None else min(samples, held)
+            if samples is None:
+                _check_not_empty(path, layout.header_line, joined, columns)
+            yield Recording(
+                path=path,
+                displacement=joined["displacement"][:count],
+                force=joined["force"][:count],
+                cycle=joined["cycle"][:count] if "cycle" in joined else None,
+                load=joined["load"][:count] if "load" in joined else None,
+                last_line=int(lines[count - 1]),
+                columns=columns,
+                units=units,
+                start=first,
+                lines=LineIndex.build([lines[:count]], first),
+                format="text",
+                assumed_units=assumed,
+            )
+            pending = [({role: joined[role][count:] for role in columns}, lines[count:])]
+            held -= count
+            first += count
+    if first == 0:
         raise RecordingError(path, layout.header_line, "no data after the header")
-    values = {role: np.concatenate([part[0][role] for part in parts]) for role in layout.columns}
-    numbers = [part[1] for part in parts]
+
+
+def _check_not_empty(path: Path, header_line: int, values: dict, columns: dict) -> None:
+    """Refuse a column of which every sample is missing."""
     for role, data in values.items():
         if not np.isfinite(data).any():
             raise RecordingError(
                 path,
-                layout.header_line,
-                f"the {role} column {layout.names[layout.columns[role]]!r} holds no number: "
+                header_line,
+                f"the {role} column {columns[role]!r} holds no number: "
                 f"all its {data.size} samples are missing; "
                 + (
                     "cycle_column=False (--cycle-col none) reads no cycle column"
@@ -198,19 +203,6 @@ def _read_text(path: Path, options: dict, block_bytes: int) -> Recording:
                     else "is it the right column?"
                 ),
             )
-    return Recording(
-        path=path,
-        displacement=values["displacement"],
-        force=values["force"],
-        cycle=values.get("cycle"),
-        load=values.get("load"),
-        last_line=int(numbers[-1][-1]),
-        columns={role: layout.names[k] for role, k in layout.columns.items()},
-        units={role: layout.units[role] for role in layout.columns},
-        lines=LineIndex.build(numbers),
-        format="text",
-        assumed_units=_assumed_units(layout, options),
-    )
 
 
 def read_recording(
@@ -231,35 +223,32 @@ def read_recording(
 ) -> Recording:
     """Read the displacement and force (and cycle) columns of a recording, in SI units.
 
+    How formats, columns and units are found is in ``docs/formats.md``.
+
     Parameters
     ----------
     path : str or os.PathLike
-        A text file (a header line of column names, then one sample per line; see
-        :mod:`ecofmaps.io.text`), a TDMS file, an HDF5 or netCDF-4 file, or a zarr store
-        (a directory). The format is found from the content.
+        A text file (a header line of column names, then one sample per line), a TDMS file,
+        an HDF5 or netCDF-4 file, or a zarr store (a directory); the format is found from
+        the content.
     displacement_column, force_column : str
-        Names of the displacement and tangential force columns (channels, variables):
-        matched without regard to case, and to a unit in the name
-        (``displacement`` finds ``Displacement [µm]``). In a text file the defaults also
-        find the usual names (``Disp``, ``delta_mm``, ``stroke``, ``x``; ``Fx``, ``Q``,
-        ``Ftr_kN``, ``friction force``: :data:`ecofmaps.io.columns.SYNONYMS`) when no
-        column is named ``displacement`` (``force``); two such columns are an error.
+        Names of the displacement and tangential force columns (channels, variables),
+        without regard to case and to a unit in the name; in a text file the defaults also
+        find the usual names (:data:`ecofmaps.io.columns.SYNONYMS`).
     cycle_column : str or False, optional
         Name of a column of cycle numbers, which must then exist. By default a column
         named ``cycle`` is used if there is one; False reads none (cycles are then cut at
         the displacement reversals).
     displacement_unit, force_unit : str, optional
         Units of the displacement and force columns (``'um'``, ``'mm'``, ``'N'``,
-        ``'kN'``, ...). By default the unit the file gives (in the column's name, or a
-        channel's ``unit_string``/``NI_UnitDescription``, a variable's ``units``), else µm
-        and N. A unit given here that disagrees with the file's is an error.
+        ``'kN'``, ...). By default the unit the file gives, else µm and N; one given here
+        that disagrees with the file's is an error.
     group : str, optional
         TDMS group, or HDF5/netCDF/zarr group path, holding the channels. By default the
         channels are sought in all groups (and must be found in only one).
     nan_policy : {'propagate', 'raise'}
-        Missing samples (empty cells, NaN, infinities) are NaN in the arrays and marked by
-        :attr:`Recording.missing` (``'propagate'``), or an error naming the line or sample
-        (``'raise'``; for a lazy recording, raised when the block holding it is read).
+        Missing samples are NaN, marked by :attr:`Recording.missing` (``'propagate'``), or
+        an error naming the line or sample (``'raise'``; when its block is read if lazy).
     lazy : bool, optional
         Return dask arrays read block by block (True), or NumPy arrays (False). By default
         lazy for rig files of more than :data:`LAZY_SAMPLES` samples. A text file is always
@@ -273,12 +262,9 @@ def read_recording(
         the arrays, is a small multiple of it.
     load_column : str, optional
         Name of a recorded normal-load column of a text file, read into
-        :attr:`Recording.load` [N] (unit from the name, as ``Fz [kN]``, else N);
-        ``'load'`` also finds the usual names (``Fz``, ``Fn``, ``normal load``, ``P``).
-        By default no load is read.
+        :attr:`Recording.load` [N]; ``'load'`` also finds the usual names. By default none.
     skip_rows : int, optional
-        Lines at the start of a text file to skip before its header line (a rig's
-        metadata). By default a preamble of metadata lines is found: the header is the
+        Lines of a text file to skip before its header line. By default the header is the
         first line naming the columns asked for, among the first
         :data:`ecofmaps.io.text.PREAMBLE_LINES`.
 
@@ -290,13 +276,11 @@ def read_recording(
     Raises
     ------
     RecordingError
-        For a missing, ambiguous or doubtful column (a unit that disagrees), a line with
-        the wrong number of fields, a cell that is not a number, no data, channels of
-        different lengths, a truncated or damaged file; the message names the file and the
-        line (text) or the channel and sample (other formats).
+        For a missing, ambiguous or doubtful column, a bad line or cell, no data, channels
+        of different lengths, a truncated or damaged file; the message names the file and
+        the line (text) or the channel and sample (other formats).
     ValueError
-        For options of the wrong kind, e.g. a unit that is not a length or a force (the
-        message names the option).
+        For options of the wrong kind (the message names the option).
     OSError
         If the file cannot be read.
 
@@ -324,28 +308,21 @@ def read_recording(
     _check_count("block_bytes", block_bytes)
     path = Path(path)
     kind = recording_format(path)
-    for name, value in (("load_column", load_column), ("skip_rows", skip_rows)):
-        if kind != "text" and value is not None:
-            raise ValueError(f"{name} applies to text files, not to {kind.upper()}")
-    if kind == "text":
-        if group is not None:
-            raise ValueError("group applies to TDMS, HDF5/netCDF and zarr files, not to text")
-        recording = _read_text(path, options, block_bytes or BLOCK_BYTES)
-        if lazy:
-            import dask.array as da
-
-            size = chunks or recording.size
-            arrays = [recording.displacement, recording.force, recording.cycle, recording.load]
-            wrapped = [None if a is None else da.from_array(a, chunks=size) for a in arrays]
-            recording = dataclasses.replace(
-                recording,
-                displacement=wrapped[0],
-                force=wrapped[1],
-                cycle=wrapped[2],
-                load=wrapped[3],
-            )
+    if kind != "text":
+        for name in ("load_column", "skip_rows"):
+            if options[name] is not None:
+                raise ValueError(f"{name} applies to text files, not to {kind.upper()}")
+        return read_binary(path, kind, options, lazy=lazy, chunks=chunks)
+    (recording,) = _text_recordings(path, options, block_bytes)
+    if not lazy:
         return recording
-    return read_binary(path, kind, options, lazy=lazy, chunks=chunks)
+    import dask.array as da
+
+    size = chunks or recording.size
+    return dataclasses.replace(
+        recording,
+        **{role: da.from_array(a, chunks=size) for role, a in recording.arrays().items()},
+    )
 
 
 def open_recording(
@@ -368,20 +345,15 @@ def open_recording(
 
     Parameters
     ----------
-    path : str or os.PathLike
-        A text file, a TDMS file, an HDF5 or netCDF-4 file, or a zarr store.
-    displacement_column, force_column, cycle_column, displacement_unit, force_unit, group, \
-nan_policy, lazy, chunks, block_bytes, load_column, skip_rows
-        As for :func:`read_recording`: a rig file of more than :data:`LAZY_SAMPLES` samples
-        gives dask-backed variables by default.
+    path, displacement_column, force_column, cycle_column, displacement_unit, force_unit, \
+group, nan_policy, lazy, chunks, block_bytes, load_column, skip_rows
+        As for :func:`read_recording`.
 
     Returns
     -------
     dataset : xarray.Dataset
-        ``displacement`` [m], ``force`` [N] and, if read, ``cycle`` [1] and ``load`` [N], each
-        with the attributes ``units``, ``long_name``, ``source_column``,
-        ``source_units`` and ``unit_assumed``; the Dataset's attributes ``source`` and
-        ``format`` (see :meth:`Recording.to_dataset`).
+        As :meth:`Recording.to_dataset` gives it: ``displacement`` [m], ``force`` [N] and,
+        if read, ``cycle`` [1] and ``load`` [N].
 
     Raises
     ------
@@ -398,21 +370,7 @@ nan_policy, lazy, chunks, block_bytes, load_column, skip_rows
     >>> dataset.displacement.attrs["unit_assumed"]  # the header gives no unit
     1
     """
-    return read_recording(
-        path,
-        displacement_column=displacement_column,
-        force_column=force_column,
-        cycle_column=cycle_column,
-        displacement_unit=displacement_unit,
-        force_unit=force_unit,
-        group=group,
-        nan_policy=nan_policy,
-        lazy=lazy,
-        chunks=chunks,
-        block_bytes=block_bytes,
-        load_column=load_column,
-        skip_rows=skip_rows,
-    ).to_dataset()
+    return read_recording(**locals()).to_dataset()  # the parameters, passed on
 
 
 def recording_blocks(path, samples: int = 1 << 20, **options) -> Iterator[Recording]:
@@ -432,57 +390,15 @@ def recording_blocks(path, samples: int = 1 << 20, **options) -> Iterator[Record
     ------
     block : Recording
         NumPy arrays; ``block.start`` is the index of its first sample in the file, and
-        lines and errors name the file's lines.
-
-    Notes
-    -----
-    A text file is parsed block by block (its text is never held whole); a rig file is
-    read range by range.
+        lines and errors name the file's lines. A text file's text is never held whole.
     """
     _check_count("samples", samples)
-    samples = int(samples)
     block_bytes = options.pop("block_bytes", None)
     _check_count("block_bytes", block_bytes)
     path = Path(path)
-    if recording_format(path) != "text":
-        with read_recording(path, lazy=True, chunks=samples, **options) as recording:
-            for first in range(0, recording.size, samples):
-                yield recording[first : first + samples]
+    if recording_format(path) == "text":
+        yield from _text_recordings(path, _options(**options), block_bytes, int(samples))
         return
-    checked = _options(**options)
-    if checked["group"] is not None:
-        raise ValueError("group applies to TDMS, HDF5/netCDF and zarr files, not to text")
-    parts = text_blocks(path, checked, block_bytes or BLOCK_BYTES)
-    layout = next(parts)
-    columns = {role: layout.names[k] for role, k in layout.columns.items()}
-    units = {role: layout.units[role] for role in layout.columns}
-    assumed = _assumed_units(layout, checked)
-    pending: list = []  # parsed blocks not yet given out: (values by role, line numbers)
-    held = first = 0
-    for part in itertools.chain(parts, [None]):  # None: the end, give out the rest
-        if part is not None:
-            pending.append(part)
-            held += part[1].size
-        while held >= samples or (held and part is None):
-            joined = {role: np.concatenate([p[0][role] for p in pending]) for role in columns}
-            lines = np.concatenate([p[1] for p in pending])
-            count = min(samples, held)
-            yield Recording(
-                path=path,
-                displacement=joined["displacement"][:count],
-                force=joined["force"][:count],
-                cycle=joined["cycle"][:count] if "cycle" in joined else None,
-                load=joined["load"][:count] if "load" in joined else None,
-                last_line=int(lines[count - 1]),
-                columns=columns,
-                units=units,
-                start=first,
-                lines=LineIndex.build([lines[:count]], first),
-                format="text",
-                assumed_units=assumed,
-            )
-            pending = [({role: joined[role][count:] for role in columns}, lines[count:])]
-            held -= count
-            first += count
-    if first == 0:
-        raise RecordingError(path, layout.header_line, "no data after the header")
+    with read_recording(path, lazy=True, chunks=int(samples), **options) as recording:
+        for first in range(0, recording.size, int(samples)):
+            yield recording[first : first + int(samples)]
