@@ -34,17 +34,14 @@ __all__ = ["DEFAULT_CHUNK", "Column", "read_binary"]
 DEFAULT_CHUNK = 1 << 22
 
 
-# --- reading ranges --------------------------------------------------------------------------
-
-
 class Column:
     """One channel or variable as an array-like of float64 in SI, read range by range."""
 
     def __init__(
         self, path: Path, kind: str, variable: Variable, factor: float, nan_policy, stamp=()
     ):
-        self.path, self.kind, self.variable = path, kind, variable
-        self.factor, self.nan_policy, self.stamp = factor, nan_policy, tuple(stamp)
+        self.arguments = (path, kind, variable, factor, nan_policy, tuple(stamp))
+        self.path, self.kind, self.variable, self.factor, self.nan_policy, _ = self.arguments
         self.shape = (variable.size,)
         self.dtype = np.dtype(np.float64)
         self.ndim = 1
@@ -55,14 +52,7 @@ class Column:
 
     def __reduce__(self):
         """Pickled without the open file; unpickled by :func:`_column`."""
-        return _column, (
-            self.path,
-            self.kind,
-            self.variable,
-            self.factor,
-            self.nan_policy,
-            self.stamp,
-        )
+        return _column, self.arguments
 
     def __len__(self) -> int:
         return self.variable.size

@@ -130,8 +130,7 @@ COMMON_UNITS = {
 _BRACKETED = re.compile(r"^(?P<base>.*?)\s*(?:\[(?P<square>[^\[\]]*)\]|\((?P<round>[^()]*)\))$")
 _SLASHED = re.compile(r"^(?P<base>[^/]*?)\s*/\s*(?P<unit>[^/]+?)$")
 _SUFFIXED = re.compile(r"^(?P<base>.*?[^_\s])[_\s]+(?P<unit>[^_\s]+)$")
-#: How alike (difflib's ratio, 0 to 1) a column's name must be to the name sought to be
-#: suggested.
+#: How alike (difflib's ratio, 0 to 1) a name must be to the one sought to be suggested.
 _NEAR = 0.75
 _POSITION = re.compile(r"^#(\d+)$")
 _IN_UNIT = re.compile(r"^(?P<base>.*?\S)\s+in\s+(?P<unit>\S+)$", re.IGNORECASE)
@@ -256,11 +255,9 @@ def find_column(names, wanted: str, role: str, *, required: bool = True) -> int 
             found = listed_names([f"{names[k]!r} (#{k + 1})" for k in matches], quote=False)
             choose += f" by its position, e.g. '#{matches[0] + 1}'"
         raise ColumnError(f"several {role} columns match {wanted!r}: {found}; {choose}")
-    if not matches and not required:
-        return None
-    if not matches:
-        raise ColumnError(_missing_message(names, wanted, role))
-    return matches[0]
+    if matches or not required:
+        return matches[0] if matches else None
+    raise ColumnError(_missing_message(names, wanted, role))
 
 
 def matching_columns(names, wanted: str, role: str | None = None) -> list[int]:
@@ -314,8 +311,7 @@ def _missing_message(names, wanted: str, role: str) -> str:
 
 
 def _unknown_unit(names, sought, role: str) -> tuple[str, str] | None:
-    """The first name whose base is one ``sought`` (plain) and whose bracketed or slashed
-    unit is not a unit at all, as (name, unit); None if there is none."""
+    """The first (name, unit) whose base is ``sought`` and whose unit is not a unit at all."""
     for name in names:
         text = name.strip().strip("\"'").strip()
         match = _BRACKETED.match(text) or _SLASHED.match(text)
@@ -382,11 +378,11 @@ def column_scale(role: str, option_unit, carried, column: str) -> tuple[float, s
     kind = KINDS[role]
     option = f"{role}_unit"
     given = None if option_unit is None else (option_unit, _factor(option_unit, kind, option))
-    readable = []
+    readable = [
+        (u, _factor(u, kind, None)) for u in dict.fromkeys(carried) if _unit_kind(u) == kind
+    ]
     for unit in dict.fromkeys(carried):
-        if _unit_kind(unit) == kind:
-            readable.append((unit, _factor(unit, kind, None)))
-        elif given is None:
+        if _unit_kind(unit) != kind and given is None:
             raise ColumnError(
                 f"the {role} column {column!r} is in {unit!r}, which is not a {kind} unit; "
                 f"give {option} to say how to read it"
@@ -399,8 +395,7 @@ def column_scale(role: str, option_unit, carried, column: str) -> tuple[float, s
                     f"the {role} column {column!r} is in {unit!r}, but {told} says otherwise "
                     f"(a factor {factor / other_factor:.6g}); remove one or make them agree"
                 )
-    if given is not None:
-        return given[1], given[0]
-    if readable:
-        return readable[0][1], readable[0][0]
-    return _factor(DEFAULT_UNITS[role], kind, None), DEFAULT_UNITS[role]
+    if given is None and not readable:
+        return _factor(DEFAULT_UNITS[role], kind, None), DEFAULT_UNITS[role]
+    unit, factor = given or readable[0]
+    return factor, unit

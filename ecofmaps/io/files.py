@@ -1,10 +1,9 @@
 """Writing files safely, and reporting where a file is damaged.
 
-Every file ecofmaps writes goes through :func:`atomic_path`: written to a temporary file
-beside the destination, flushed and renamed onto it in one step, so a reader never sees a
-half-written file. The command line writes only over what it wrote itself: each folder it
-writes into keeps a manifest, :data:`MANIFEST` (:func:`written_by_ecofmaps`,
-:func:`record_written`).
+Every file ecofmaps writes goes through :func:`atomic_store`: written beside the destination,
+flushed and renamed onto it, so a reader never sees a half-written file; each folder the
+command line writes into keeps a manifest, :data:`MANIFEST`, of what it wrote
+(``docs/formats.md``).
 """
 
 from __future__ import annotations
@@ -47,7 +46,6 @@ MANIFEST = ".ecofmaps-manifest.json"
 STORE_MARKERS = ("zarr.json", ".zgroup", ".zarray")
 
 
-@contextlib.contextmanager
 def atomic_path(path, *, exclusive: bool = True):
     """A temporary path to write, renamed onto ``path`` when the block succeeds.
 
@@ -56,19 +54,15 @@ def atomic_path(path, *, exclusive: bool = True):
     path : str or os.PathLike
         The file to create or replace; its directory must exist.
     exclusive : bool
-        Whether a ``path`` that did not exist is created, never replaced
-        (:func:`atomic_store`); False for a file any writer may replace with the same
-        content (a cache entry).
+        Whether a ``path`` that did not exist is created, never replaced; False for a file
+        any writer may replace with the same content (a cache entry).
 
-    Yields
-    ------
-    temporary : pathlib.Path
-        ``.<name>.<process id>.<32 hex digits>.tmp`` beside ``path``: write the whole file
-        there. On leaving the block it is flushed to disk and moved onto ``path``
-        (``os.replace``); if the block raises, it is removed and ``path`` is left as it was.
+    Returns
+    -------
+    context : contextlib.AbstractContextManager
+        :func:`atomic_store` with ``overwrite=True``.
     """
-    with atomic_store(path, overwrite=True, exclusive=exclusive) as temporary:
-        yield temporary
+    return atomic_store(path, overwrite=True, exclusive=exclusive)
 
 
 def write_text(path, text: str) -> Path:
@@ -84,8 +78,7 @@ def _temporary(path: Path) -> Path:
 
 
 def _remove_dead_temporaries(path: Path) -> None:
-    """Remove the temporaries for ``path`` that processes no longer running left (killed
-    while writing): only names :func:`_temporary` gives, of this destination."""
+    """Remove the temporaries of ``path`` that processes no longer running left."""
     for item in path.parent.glob(f".{glob.escape(path.name)}.*.tmp"):
         ours = _OURS.match(item.name)
         if ours is None or ours["name"] != path.name or int(ours["pid"]) == os.getpid():
@@ -99,8 +92,7 @@ def _remove_dead_temporaries(path: Path) -> None:
 
 
 def _create(temporary: Path, path: Path) -> None:
-    """Rename ``temporary`` to ``path``, which must not exist by then (a run writing the
-    same new file at the same time): :class:`FileExistsError` if it does."""
+    """Rename ``temporary`` to ``path``, or :class:`FileExistsError` if that exists by now."""
     try:
         os.link(temporary, path)  # fails if path exists, unlike a rename
     except FileExistsError:
@@ -125,9 +117,8 @@ def _remove(path: Path) -> None:
 def _sync(path: Path) -> None:
     """Flush a file, or every file and folder of a directory, to disk."""
     paths = [path]
-    if path.is_dir():
-        for folder, _, names in os.walk(path):
-            paths += [Path(folder)] + [Path(folder) / name for name in names]
+    for folder, _, names in os.walk(path):  # nothing for a file
+        paths += [Path(folder)] + [Path(folder) / name for name in names]
     for item in paths:
         descriptor = os.open(item, os.O_RDONLY)
         try:

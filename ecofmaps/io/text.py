@@ -63,7 +63,7 @@ _EXACT = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "
 
 
 def _is_data(line: str) -> bool:
-    """Whether a line holds data (or the header): not blank, not a ``#`` comment."""
+    """Whether a line is not blank and not a ``#`` comment."""
     stripped = line.strip()
     return bool(stripped) and not stripped.startswith("#")
 
@@ -121,11 +121,8 @@ class _Damaged(Exception):
 
 
 def _long_line(data: bytes) -> int | None:
-    """The offset in ``data`` of the first line longer than :data:`LINE_BYTES` (the last
-    line may go on beyond ``data``), or None.
-
-    Such a line holds a whole window of ``LINE_BYTES // 2`` bytes aligned on a multiple of
-    it without a line end, and a window with one is passed at its first line end.
+    """The offset of the first line longer than :data:`LINE_BYTES` (the last may go on
+    beyond ``data``), or None: it holds a whole aligned window of half that without a line end.
     """
     step = LINE_BYTES // 2
     for offset in range(0, len(data) - step + 1, step):
@@ -138,9 +135,8 @@ def _long_line(data: bytes) -> int | None:
 
 
 def _line_blocks(path: Path, chunks):
-    """Bytes of whole lines, one block per chunk or more (the last may lack a newline), each with
-    the 1-based number of its first line and its number of lines; a line longer than
-    :data:`LINE_BYTES` refused as soon as it is read."""
+    """Blocks of whole lines (the last may lack a newline), each with the 1-based number of
+    its first line and its number of lines; a line longer than :data:`LINE_BYTES` refused."""
     rest, line = b"", 1
     try:
         for chunk in chunks:
@@ -167,8 +163,7 @@ def _line_blocks(path: Path, chunks):
 
 def _text_lines(text: str) -> list[str]:
     """The lines of a decoded block, without their ends."""
-    if "\r" in text:
-        text = text.replace("\r\n", "\n")
+    text = text.replace("\r\n", "\n")
     return (text[:-1] if text.endswith("\n") else text).split("\n")
 
 
@@ -229,7 +224,7 @@ def _header_names(line: str, separator) -> list[str]:
 
 
 def _numeric(cells) -> bool:
-    """Whether every cell is a number (point or comma) or a missing sample."""
+    """Whether every cell is a number or a missing sample."""
     return all(_NUMBER.match(cell) or cell in _NOT_A_NUMBER for cell in cells)
 
 
@@ -317,8 +312,7 @@ class _Layout:
         self.nan_policy = options["nan_policy"]
 
     def decide_decimal(self, body: str) -> None:
-        """Decimal comma or point, from the first block whose numbers show one (with comma
-        separators, a decimal comma only in quoted cells)."""
+        """Decimal comma or point, from the first block whose numbers show one."""
         comma = _QUOTED_COMMA_DECIMAL if self.separator == "," else _COMMA_DECIMAL
         if comma.search(body):
             self.decimal = ","
@@ -335,8 +329,7 @@ class _Layout:
                 )
 
     def data_lines(self, lines: list[str]) -> list[int]:
-        """The indices of the lines that hold data: not blank (blanks other than the
-        separator), not a ``#`` comment."""
+        """The indices of the lines that are not blank (but for the separator) or comments."""
         blanks = " \r" if self.separator == "\t" else " \t\r"
         return [
             k for k, line in enumerate(lines) if (text := line.strip(blanks)) and text[0] != "#"

@@ -97,8 +97,6 @@ class RecordingWriter:
         self._held = 0
         self._stack = contextlib.ExitStack()
 
-    # --- the context -----------------------------------------------------------------
-
     def __enter__(self) -> RecordingWriter:
         with contextlib.ExitStack() as stack:
             self._temporary = stack.enter_context(atomic_store(self.path, overwrite=self.overwrite))
@@ -135,10 +133,9 @@ class RecordingWriter:
         if "cycle" in self.roles:
             if cycle is None:
                 raise ValueError("cycle numbers are required: the writer has a cycle column")
-            arrays["cycle"] = np.asarray(cycle).reshape(-1)
-            if not np.all(np.isfinite(arrays["cycle"])):
+            if not np.all(np.isfinite(cycle := np.asarray(cycle).reshape(-1))):
                 raise ValueError("cycle numbers must be finite")
-            arrays["cycle"] = arrays["cycle"].astype(np.int64)
+            arrays["cycle"] = cycle.astype(np.int64)
         sizes = {role: array.size for role, array in arrays.items()}
         if len(set(sizes.values())) != 1:
             raise ValueError(f"the blocks must have one length; got {sizes}")
@@ -156,8 +153,6 @@ class RecordingWriter:
         self._pending = {role: [array[count:]] for role, array in joined.items()}
         self._held -= count
         self.size += count
-
-    # --- zarr ------------------------------------------------------------------------
 
     def _open_zarr(self, stack) -> None:
         import zarr
@@ -183,33 +178,25 @@ class RecordingWriter:
         for role, array in arrays.items():
             self._arrays[role].append(array)
 
-    # --- HDF5 / netCDF-4 -------------------------------------------------------------
-
     def _open_hdf5(self, stack) -> None:
         import h5netcdf
 
-        handle = stack.enter_context(h5netcdf.File(self._temporary, "w"))
+        self._handle = handle = stack.enter_context(h5netcdf.File(self._temporary, "w"))
         handle.dimensions = {"sample": None}
         handle.attrs.update(self.attrs)
-        self._handle = handle
         self._arrays = {}
         for role in self.roles:
-            variable = handle.create_variable(
-                role,
-                ("sample",),
-                np.int64 if role == "cycle" else np.float64,
-                chunks=(self.chunk,),
+            dtype = np.int64 if role == "cycle" else np.float64
+            self._arrays[role] = handle.create_variable(
+                role, ("sample",), dtype, chunks=(self.chunk,)
             )
-            variable.attrs.update(ATTRS[role])
-            self._arrays[role] = variable
+            self._arrays[role].attrs.update(ATTRS[role])
 
     def _append_hdf5(self, arrays) -> None:
         count = next(iter(arrays.values())).size
         self._handle.resize_dimension("sample", self.size + count)
         for role, array in arrays.items():
             self._arrays[role][self.size : self.size + count] = array
-
-    # --- TDMS ------------------------------------------------------------------------
 
     def _open_tdms(self, stack) -> None:
         from nptdms import TdmsWriter
@@ -221,19 +208,14 @@ class RecordingWriter:
         from nptdms import ChannelObject, GroupObject, RootObject
 
         first = self._segments == 0
-        root = {key: _tdms_value(value) for key, value in self.attrs.items()} if first else {}
-        objects = [RootObject(properties=root), GroupObject(TDMS_GROUP)]
+        root = {k: v if isinstance(v, int | float | str) else str(v) for k, v in self.attrs.items()}
+        objects = [RootObject(properties=root if first else {}), GroupObject(TDMS_GROUP)]
         for role, array in arrays.items():
-            properties = (
-                {"unit_string": ATTRS[role]["units"], "description": ATTRS[role]["long_name"]}
-                if first
-                else {}
-            )
+            units, name = ATTRS[role]["units"], ATTRS[role]["long_name"]
+            properties = {"unit_string": units, "description": name} if first else {}
             objects.append(ChannelObject(TDMS_GROUP, role, array, properties=properties))
         self._handle.write_segment(objects)
         self._segments += 1
-
-    # --- text ------------------------------------------------------------------------
 
     def _open_text(self, stack) -> None:
         self._handle = stack.enter_context(
@@ -247,8 +229,7 @@ class RecordingWriter:
         self._handle.write(",".join(names) + "\n")
 
     def _append_text(self, arrays) -> None:
-        # Each float as its shortest repr, which reads back bit for bit (faster than
-        # pandas' to_csv, which writes the same text).
+        # Each float as its shortest repr, which reads back bit for bit (as to_csv, faster).
         cells = [map(repr, arrays[role].tolist()) for role in self.roles]
         self._handle.write("\n".join(map(",".join, zip(*cells, strict=True))) + "\n")
 
@@ -263,11 +244,6 @@ class RecordingWriter:
             with warnings.catch_warnings():
                 warnings.filterwarnings("ignore", "Consolidated metadata", UserWarning)
                 zarr.consolidate_metadata(str(self._temporary))
-
-
-def _tdms_value(value):
-    """An attribute as a TDMS property value (text, or a number)."""
-    return value if isinstance(value, int | float | str) else str(value)
 
 
 def convert_recording(
@@ -306,9 +282,8 @@ def convert_recording(
 
     Notes
     -----
-    The samples are stored in SI units (m, N) with their ``units`` attributes, and
-    missing samples as NaN; the store's attributes name the source, its columns and the
-    units they were read in. Memory stays near a few blocks, whatever the size.
+    Samples in SI units (m, N), missing ones NaN; the store's attributes name the source,
+    its columns and their units. Memory stays near a few blocks, whatever the size.
     """
     source, destination = Path(source), Path(destination)
     if destination.resolve() == source.resolve():

@@ -43,9 +43,8 @@ def _opened(path: Path):
 
 
 def _consolidated(root) -> bool:
-    """Whether the store has consolidated metadata (else xarray is told not to look)."""
-    is_group = hasattr(root, "members")  # a zarr.Group; an Array has no members
-    return is_group and root.metadata.consolidated_metadata is not None
+    """Whether the store (a group) has consolidated metadata (else xarray is told not to look)."""
+    return root.metadata.consolidated_metadata is not None
 
 
 class _ZarrRange(BackendArray):
@@ -86,21 +85,26 @@ def _plain_groups(path: Path, root) -> dict[str, xr.Dataset]:
     return {name: xr.decode_cf(xr.Dataset(found), **options) for name, found in groups.items()}
 
 
+def _xarray_groups(path: Path, root, key: str | None = None) -> dict | None:
+    """The groups xarray opens (all, or the one at ``key``); None for a store without
+    dimension names."""
+    try:
+        if key is None:
+            return xr.open_groups(path, consolidated=_consolidated(root), **OPTIONS)
+        return {key: xr.open_dataset(path, group=key, consolidated=_consolidated(root), **OPTIONS)}
+    except Exception as error:
+        if isinstance(error, KeyError) and any(name in str(error) for name in _NO_DIMENSIONS):
+            return None
+        raise RecordingError(path, None, f"cannot open as a zarr store: {error}") from None
+
+
 def zarr_groups(path) -> dict[str, xr.Dataset]:
     """Every group of a zarr store as a lazily read Dataset, by its path (``'/'``,
     ``'/rig/run1'``)."""
     path = Path(path)
     root = _opened(path)
-    if not hasattr(root, "members"):  # a store that is one array, which xarray cannot open
-        return _plain_groups(path, root)
-    try:
-        return xr.open_groups(path, consolidated=_consolidated(root), **OPTIONS)
-    except KeyError as error:
-        if any(key in str(error) for key in _NO_DIMENSIONS):
-            return _plain_groups(path, root)
-        raise RecordingError(path, None, f"cannot open as a zarr store: {error}") from None
-    except Exception as error:
-        raise RecordingError(path, None, f"cannot open as a zarr store: {error}") from None
+    groups = _xarray_groups(path, root) if hasattr(root, "members") else None
+    return _plain_groups(path, root) if groups is None else groups
 
 
 def open_zarr_group(path, group: str | None = None) -> xr.Dataset:
@@ -110,13 +114,8 @@ def open_zarr_group(path, group: str | None = None) -> xr.Dataset:
     root = _opened(path)
     if not hasattr(root, "members"):  # a store that is one array
         return _plain_groups(path, root)["/"]
-    try:
-        return xr.open_dataset(path, group=key, consolidated=_consolidated(root), **OPTIONS)
-    except KeyError as error:
-        if not any(name in str(error) for name in _NO_DIMENSIONS):
-            raise RecordingError(path, None, f"cannot open as a zarr store: {error}") from None
-    except Exception as error:
-        raise RecordingError(path, None, f"cannot open as a zarr store: {error}") from None
+    if (opened := _xarray_groups(path, root, key)) is not None:
+        return opened[key]
     groups = _plain_groups(path, root)
     if key not in groups:
         raise RecordingError(path, None, f"no group {group!r}")
