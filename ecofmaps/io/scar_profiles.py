@@ -1,10 +1,6 @@
-"""Wear-scar profiles in text files: a profilometer trace across the scar.
-
-:func:`read_scar_profile` reads the position and height columns (as
-:func:`ecofmaps.read_recording` reads columns) and returns the
-:class:`~ecofmaps.model.profiles.ScarProfile` the model uses. A damaged file raises
-:class:`ScarProfileError`, naming the file and the line; the reading's findings are
-:class:`~ecofmaps.model.profiles.ScarProfileWarning` naming the file's lines.
+"""Wear-scar profiles in text files: a profilometer trace across the scar, read as
+:func:`ecofmaps.read_recording` reads columns, into the model's
+:class:`~ecofmaps.model.profiles.ScarProfile` (``docs/profiles.md``).
 """
 
 from __future__ import annotations
@@ -44,19 +40,15 @@ def read_scar_profile(
     ----------
     path : str or os.PathLike
         A text file: a header line of column names, then one sample per line, in any of
-        the dialects :func:`ecofmaps.read_recording` reads (separators, decimal comma,
-        quotes, comments and encodings; see :mod:`ecofmaps.io.text`).
+        the dialects :func:`ecofmaps.read_recording` reads.
     x_column, z_column : str
         Names of the position and height columns (matched without regard to case or to a
         unit in the name: ``x`` finds ``X [mm]``).
     x_unit, z_unit : str, optional
-        Their units of length (``'um'``, ``'mm'``, ``'nm'``, ``'m'``, ...); by default the
-        unit the column's name gives, else µm. A unit given that disagrees with the name's
-        is an error.
+        Their units of length (``'um'``, ``'mm'``, ...); by default the unit the column's
+        name gives, else µm. A unit given that disagrees with the name's is an error.
     level : bool
-        Remove the tilt and offset of the unworn surface, a line fitted on the shoulders
-        outside the scar (on by default: a specimen is rarely mounted level in the
-        profilometer). See :func:`ecofmaps.scar_profile`.
+        Remove the tilt and offset of the unworn surface (see :func:`ecofmaps.scar_profile`).
     half_width : float, optional
         The scar's half-width, overriding the detected one. [m]
     smoothing : float, optional
@@ -80,8 +72,7 @@ def read_scar_profile(
     ------
     ScarProfileError
         For a damaged file (a missing column, a bad line or cell, positions not strictly
-        increasing, no data) or a trace that is not a usable scar (the errors of
-        :func:`ecofmaps.scar_profile`), naming the file and the line.
+        increasing, no data) or a trace that is not a usable scar, naming the file and line.
     ValueError
         For a unit that is not a length.
     OSError
@@ -120,19 +111,14 @@ def read_scar_profile(
         raise ScarProfileError(
             path,
             lines[i + 1],
-            f"position {float(typed[i + 1])!r} {kind} {float(typed[i])!r} on line "
-            f"{lines[i]}: "
+            f"position {float(typed[i + 1])!r} {kind} {float(typed[i])!r} on line {lines[i]}: "
             f"column {x_column!r} must increase strictly (sort the trace and drop repeated "
             "positions)",
         )
+    options = {"half_width": half_width, "smoothing": smoothing, "level": level}
     try:
         profile, findings = scar_profile_and_findings(
-            x,
-            z,
-            half_width=half_width,
-            smoothing=smoothing,
-            level=level,
-            remove_outliers=remove_outliers,
+            x, z, **options, remove_outliers=remove_outliers
         )
     except ValueError as error:
         raise ScarProfileError(

@@ -76,9 +76,10 @@ def results_table(results: xr.Dataset) -> pd.DataFrame:
         if name == "regime":  # the codes' labels, as ecofmaps map and model print them
             labels = {int(code): code.label for code in Regime}
             columns[column] = [labels[code] for code in values.tolist()]
-            continue
-        numeric = np.issubdtype(values.dtype, np.number) and name != "cycle"
-        columns[column] = nomenclature.display(name, values) if numeric else values
+        elif np.issubdtype(values.dtype, np.number) and name != "cycle":
+            columns[column] = nomenclature.display(name, values)
+        else:
+            columns[column] = values
     return pd.DataFrame(columns)
 
 
@@ -97,7 +98,6 @@ def results_csv(results: xr.Dataset, *, file: str | None = None, header: bool = 
     Returns
     -------
     text : str
-        One line per cycle (and the header), each ending in ``\\n``.
     """
     table = results_table(results)
     if file is not None:
@@ -106,12 +106,8 @@ def results_csv(results: xr.Dataset, *, file: str | None = None, header: bool = 
 
 
 def csv_text(table: pd.DataFrame, *, header: bool = True) -> str:
-    """``table`` as CSV text, numbers to 6 significant digits.
-
-    The text is what ``table.to_csv(index=False, float_format="%.6g", lineterminator="\\n",
-    header=header)`` writes (an empty field for NaN, text quoted by :mod:`csv` where it
-    must be), in half the time: the floats are formatted a column at a time and the lines
-    are written by :func:`csv.writer`.
+    """``table`` as CSV text, numbers to 6 significant digits: what ``table.to_csv(index=False,
+    float_format="%.6g", lineterminator="\\n", header=header)`` writes, in half the time.
 
     Parameters
     ----------

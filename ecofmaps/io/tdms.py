@@ -184,23 +184,9 @@ def _group_dataset(reader: TdmsReader, group) -> xr.Dataset:
 
 def tdms_groups(path) -> dict[str, xr.Dataset]:
     """Every group of a TDMS file as a lazily read Dataset, by its path (``'/Rig'``; the
-    root, ``'/'``, holds the file's properties and no variables).
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-
-    Returns
-    -------
-    groups : dict of str to xarray.Dataset
-        All read through one :class:`TdmsReader` (closing any of them closes the file,
-        which is opened again on the next read).
-
-    Raises
-    ------
-    RecordingError
-        If the file is not TDMS, or is truncated or damaged.
-    """
+    root, ``'/'``, holds the file's properties), all read through one :class:`TdmsReader`
+    (closing any closes the file, opened again on the next read); :class:`RecordingError`
+    for a file that is not TDMS, or is truncated or damaged."""
     path = Path(path)
     handle = opened_tdms(path)
     reader = TdmsReader(path, handle)  # reads through the file opened to list the groups
@@ -242,12 +228,12 @@ class TdmsBackendEntrypoint(BackendEntrypoint):
 
     def open_dataset(self, filename_or_obj, *, drop_variables=None, group=None) -> xr.Dataset:
         """The group ``group`` (by default the first) of the file."""
-        dataset = open_tdms_group(_file_path(filename_or_obj), group)
+        dataset = open_tdms_group(engine_path(filename_or_obj, "ecofmaps-tdms"), group)
         return dataset.drop_vars(drop_variables or [], errors="ignore")
 
     def open_groups_as_dict(self, filename_or_obj, *, drop_variables=None) -> dict:
         """Every group (and the root's properties) by its path."""
-        groups = tdms_groups(_file_path(filename_or_obj))
+        groups = tdms_groups(engine_path(filename_or_obj, "ecofmaps-tdms"))
         return {k: v.drop_vars(drop_variables or [], errors="ignore") for k, v in groups.items()}
 
     def open_datatree(self, filename_or_obj, *, drop_variables=None) -> xr.DataTree:
@@ -257,15 +243,19 @@ class TdmsBackendEntrypoint(BackendEntrypoint):
 
     def guess_can_open(self, filename_or_obj) -> bool:
         """A path ending in ``.tdms``."""
-        try:
-            return Path(filename_or_obj).suffix.lower() == ".tdms"
-        except TypeError:
-            return False
+        return has_suffix(filename_or_obj, (".tdms",))
 
 
-def _file_path(filename_or_obj) -> Path:
+def engine_path(filename_or_obj, engine: str) -> Path:
+    """The path an xarray engine of ecofmaps reads: a TypeError for anything but a path."""
     if not isinstance(filename_or_obj, str | os.PathLike):
-        raise TypeError(
-            f"the ecofmaps-tdms engine reads a file by its path; got {filename_or_obj!r}"
-        )
+        raise TypeError(f"the {engine} engine reads a file by its path; got {filename_or_obj!r}")
     return Path(filename_or_obj)
+
+
+def has_suffix(filename_or_obj, suffixes) -> bool:
+    """Whether xarray's ``filename_or_obj`` is a path ending in one of ``suffixes``."""
+    try:
+        return Path(filename_or_obj).suffix.lower() in suffixes
+    except TypeError:
+        return False

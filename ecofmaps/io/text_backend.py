@@ -8,14 +8,12 @@ columns. A text file has no random access: it is parsed whole, in blocks, when o
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
-
 import xarray as xr
 from xarray.backends import BackendEntrypoint
 
 from ecofmaps.io.recording_types import RecordingError
 from ecofmaps.io.recordings import open_recording, recording_format
+from ecofmaps.io.tdms import engine_path, has_suffix
 
 __all__ = ["TextBackendEntrypoint"]
 
@@ -69,11 +67,7 @@ class TextBackendEntrypoint(BackendEntrypoint):
         RecordingError
             For a file that is not a text recording, or a damaged one (naming the line).
         """
-        if not isinstance(filename_or_obj, str | os.PathLike):
-            raise TypeError(
-                f"the ecofmaps-text engine reads a file by its path; got {filename_or_obj!r}"
-            )
-        path = Path(filename_or_obj)
+        path = engine_path(filename_or_obj, "ecofmaps-text")
         kind = recording_format(path)
         if kind != "text":
             engine = "ecofmaps-tdms" if kind == "tdms" else {"hdf5": "h5netcdf"}.get(kind, kind)
@@ -95,7 +89,4 @@ class TextBackendEntrypoint(BackendEntrypoint):
 
     def guess_can_open(self, filename_or_obj) -> bool:
         """A path ending in ``.csv`` or ``.tsv``."""
-        try:
-            return Path(filename_or_obj).suffix.lower() in SUFFIXES
-        except TypeError:
-            return False
+        return has_suffix(filename_or_obj, SUFFIXES)
