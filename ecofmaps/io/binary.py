@@ -18,13 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps._parallel import SOURCE
-from ecofmaps.io.columns import (
-    ColumnError,
-    column_scale,
-    listed_names,
-    matching_columns,
-    split_unit,
-)
+from ecofmaps.io.columns import ColumnError, listed_names, matching_columns, role_scale
 from ecofmaps.io.recording_types import LAZY_SAMPLES, Recording, RecordingError, si_values
 from ecofmaps.io.rig_formats import NOUNS, Variable, check_complete, open_group, variables
 
@@ -211,15 +205,15 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
     stat = path.stat()
     stamp = (stat.st_mtime_ns, stat.st_size)
     for role, variable in chosen.items():
-        factor, unit = 1.0, "1"
+        factor, unit, unknown = 1.0, "1", False
         if role != "cycle":
-            carried = [u for u in [split_unit(variable.short)[1], *variable.units] if u]
-            if not carried and options[f"{role}_unit"] is None:
-                assumed.append(role)
             try:
-                factor, unit = column_scale(role, options[f"{role}_unit"], carried, variable.name)
+                factor, unit, unknown = role_scale(
+                    role, variable.short, options[f"{role}_unit"], variable.units, variable.name
+                )
             except ColumnError as error:
                 raise RecordingError(path, f"{NOUNS[kind]} {variable.name!r}", str(error)) from None
+        assumed += [role] if unknown else []
         columns[role] = Column(path, kind, variable, factor, options["nan_policy"], stamp)
         units[role] = unit
     size = chosen["displacement"].size

@@ -24,6 +24,7 @@ __all__ = [
     "find_column",
     "listed_names",
     "matching_columns",
+    "role_scale",
     "split_unit",
 ]
 
@@ -343,6 +344,14 @@ def _factor(unit: str, kind: str, option: str | None) -> float:
         if option is None:
             raise
         raise ValueError(f"{option}={unit!r} is not a {kind} unit ({error})") from None
+
+
+def role_scale(role: str, name: str, option_unit, metadata=(), column=None) -> tuple:
+    """:func:`column_scale` of a column from the unit in its ``name`` and the file's
+    ``metadata`` units, and whether its unit was assumed (none given anywhere)."""
+    carried = [unit for unit in [split_unit(name)[1], *metadata] if unit is not None]
+    unknown = not carried and option_unit is None
+    return *column_scale(role, option_unit, carried, column or name), unknown
 
 
 def column_scale(role: str, option_unit, carried, column: str) -> tuple[float, str]:

@@ -46,26 +46,30 @@ def _refused(path: Path, error: Exception) -> RecordingError:
     return RecordingError(path, None, f"cannot open as HDF5 (truncated or damaged): {reason}")
 
 
-def _check_structure(path: Path) -> None:
-    """Open every group's and variable's header and attribute with h5py, so that a damaged
-    file raises here, cleanly: h5netcdf would raise anything from KeyError to RuntimeError,
-    and its half-made file object print a traceback when it is collected."""
+def _checked(path) -> Path:
+    """The path, once every group's and variable's attributes opened with h5py: a damaged
+    file raises here, cleanly (h5netcdf would raise anything from KeyError to RuntimeError,
+    and its half-made file object print a traceback when it is collected)."""
 
     def visit(_name, item):
         for name in item.attrs:
             item.attrs.get_id(name)
 
-    with h5py.File(path, "r") as handle:
-        visit("/", handle)
-        handle.visititems(visit)
+    path = Path(path)
+    try:
+        with h5py.File(path, "r") as handle:
+            visit("/", handle)
+            handle.visititems(visit)
+    except _DAMAGE as error:
+        raise _refused(path, error) from None
+    return path
 
 
 def hdf5_groups(path) -> dict[str, xr.Dataset]:
     """Every group of an HDF5 / netCDF-4 file as a lazily read Dataset, by its path
     (``'/'``, ``'/rig/run1'``)."""
-    path = Path(path)
+    path = _checked(path)
     try:
-        _check_structure(path)
         return xr.open_groups(path, **OPTIONS)
     except _DAMAGE as error:
         raise _refused(path, error) from None
@@ -73,11 +77,7 @@ def hdf5_groups(path) -> dict[str, xr.Dataset]:
 
 def open_hdf5_group(path, group: str | None = None) -> xr.Dataset:
     """One group of an HDF5 / netCDF-4 file (by default the root) as a lazily read Dataset."""
-    path = Path(path)
-    try:
-        _check_structure(path)
-    except _DAMAGE as error:
-        raise _refused(path, error) from None
+    path = _checked(path)
     try:
         return xr.open_dataset(path, group=group or None, **OPTIONS)
     except OSError as error:

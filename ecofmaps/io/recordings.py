@@ -18,7 +18,7 @@ import numpy as np
 import xarray as xr
 
 from ecofmaps.io.binary import read_binary
-from ecofmaps.io.columns import column_scale, split_unit
+from ecofmaps.io.columns import column_scale
 from ecofmaps.io.files import STORE_MARKERS
 from ecofmaps.io.recording_types import (
     LAZY_SAMPLES,
@@ -38,12 +38,8 @@ __all__ = [
 ]
 
 _NAN_POLICIES = ("propagate", "raise")
-_MAGIC = {
-    b"TDSm": "tdms",
-    b"\x89HDF\r\n\x1a\n": "hdf5",
-    b"CDF\x01": "netcdf3",
-    b"CDF\x02": "netcdf3",
-}
+_MAGIC = {b"TDSm": "tdms", b"\x89HDF\r\n\x1a\n": "hdf5"}
+_NETCDF3 = (b"CDF\x01", b"CDF\x02")
 _SUFFIXES = {
     **dict.fromkeys((".h5", ".hdf5", ".hdf", ".nc", ".nc4"), "hdf5"),
     ".tdms": "tdms",
@@ -82,15 +78,15 @@ def recording_format(path) -> str:
     check_regular_file(path)
     with open(path, "rb") as stream:
         head = stream.read(8)
+    if head.startswith(_NETCDF3):
+        raise RecordingError(
+            path,
+            None,
+            "a netCDF-3 (classic) file: save it as netCDF-4 (HDF5), e.g. with xarray: "
+            "xr.open_dataset(path).to_netcdf(new_path, engine='h5netcdf')",
+        )
     for magic, kind in _MAGIC.items():
         if head.startswith(magic):
-            if kind == "netcdf3":
-                raise RecordingError(
-                    path,
-                    None,
-                    "a netCDF-3 (classic) file: save it as netCDF-4 (HDF5), e.g. with xarray: "
-                    "xr.open_dataset(path).to_netcdf(new_path, engine='h5netcdf')",
-                )
             return kind
     expected = _SUFFIXES.get(path.suffix.lower())
     if expected is not None:
@@ -150,11 +146,6 @@ def _text_recordings(path: Path, options: dict, block_bytes, samples=None) -> It
     layout = next(parts)
     columns = {role: layout.names[k] for role, k in layout.columns.items()}
     units = {role: layout.units[role] for role in layout.columns}
-    assumed = tuple(
-        role
-        for role, name in columns.items()
-        if role != "cycle" and options.get(f"{role}_unit") is None and split_unit(name)[1] is None
-    )
     pending: list = []  # parsed blocks not yet given out: (values by role, line numbers)
     held = first = 0
     for part in itertools.chain(parts, [None]):  # None: the end, give out the rest
@@ -179,7 +170,7 @@ def _text_recordings(path: Path, options: dict, block_bytes, samples=None) -> It
                 start=first,
                 lines=LineIndex.build([lines[:count]], first),
                 format="text",
-                assumed_units=assumed,
+                assumed_units=layout.assumed,
             )
             pending = [({role: joined[role][count:] for role in columns}, lines[count:])]
             held -= count

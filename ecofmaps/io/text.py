@@ -22,14 +22,7 @@ import pandas as pd
 
 from ecofmaps._codes import warn
 from ecofmaps._interrupts import check_interrupted
-from ecofmaps.io.columns import (
-    ColumnError,
-    column_scale,
-    find_column,
-    listed_names,
-    matching_columns,
-    split_unit,
-)
+from ecofmaps.io.columns import ColumnError, find_column, listed_names, matching_columns, role_scale
 from ecofmaps.io.recording_types import (
     RecordingError,
     RecordingWarning,
@@ -297,15 +290,16 @@ class _Layout:
                             f"the {other} and {role} columns are the same column "
                             f"{self.names[self.columns[role]]!r}"
                         )
-            self.scales, self.units = {}, {}
+            self.scales, self.units, assumed = {}, {}, []
             for role in (role for role in roles if role != "cycle"):
                 name = self.names[self.columns[role]]
-                carried = [unit for unit in [split_unit(name)[1]] if unit is not None]
-                self.scales[role], self.units[role] = column_scale(
-                    role, options.get(f"{role}_unit"), carried, name
+                self.scales[role], self.units[role], unknown = role_scale(
+                    role, name, options.get(f"{role}_unit")
                 )
+                assumed += [role] if unknown else []
         except ColumnError as error:
             raise RecordingError(path, header_line, str(error)) from None
+        self.assumed = tuple(assumed)
         self.scales["cycle"], self.units["cycle"] = 1.0, "1"
         self.width = len(self.names)
         self.decimal = None
