@@ -61,12 +61,8 @@ def results_table(results: xr.Dataset) -> pd.DataFrame:
     Returns
     -------
     table : pandas.DataFrame
-        The columns of :data:`RESULT_COLUMNS` that ``results`` holds: cycle, amplitude_um,
-        slip_amplitude_um, normal_load_N (with a recorded load), max_force_N,
-        dissipated_energy_mJ, ecof, cof_max, energy_ratio, (with ``rig_stiffness``)
-        opening_ratio, contact_amplitude_um, contact_energy_ratio, contact_opening_ratio,
-        stiffness_MN_per_m, gicof, regime, then (with ``resolve=True``) mu_resolved,
-        mu_resolved_se, aspect_ratio, and quality.
+        The columns of :data:`RESULT_COLUMNS` that ``results`` holds, in order (each
+        explained in ``docs/loops.md``).
     """
     columns = {}
     for name, column in zip(RESULT_QUANTITIES, RESULT_COLUMNS, strict=True):
