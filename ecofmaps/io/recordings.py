@@ -58,15 +58,14 @@ def recording_format(path) -> str:
     Returns
     -------
     format : str
-        Found from the first bytes (``TDSm``, the HDF5 signature) or, for a directory, its
-        zarr metadata; any other file is text.
+        Found from the first bytes or, for a directory, its zarr metadata; any other file
+        is text.
 
     Raises
     ------
     RecordingError
         For a directory that is not a zarr store, a pipe, device or socket, a netCDF-3
-        file, or a file whose suffix names a rig format its content is not (truncated or
-        mislabelled).
+        file, or a file whose suffix names a rig format its content is not.
     OSError
         If the file cannot be read.
     """
@@ -245,12 +244,10 @@ def read_recording(
         lazy for rig files of more than :data:`LAZY_SAMPLES` samples. A text file is always
         parsed whole (in blocks, into memory); ``lazy=True`` then wraps the arrays in dask.
     chunks : int, optional
-        Samples per dask block; by default a multiple of the file's own chunks near
-        2**22 samples.
+        Samples per dask block; by default a multiple of the file's own chunks near 2**22.
     block_bytes : int, optional
-        Bytes of a text file parsed at a time (default
-        :data:`ecofmaps.io.text.BLOCK_BYTES`, 16 MiB): the memory the parsing needs, beyond
-        the arrays, is a small multiple of it.
+        Bytes of a text file parsed at a time (default :data:`ecofmaps.io.text.BLOCK_BYTES`):
+        the memory the parsing needs, beyond the arrays, is a small multiple of it.
     load_column : str, optional
         Name of a recorded normal-load column of a text file, read into
         :attr:`Recording.load` [N]; ``'load'`` also finds the usual names. By default none.
