@@ -218,10 +218,7 @@ def find_column(names, wanted: str, role: str, *, required: bool = True) -> int 
     names : sequence of str
         The names in the file (header cells, channels or variables).
     wanted : str
-        The name asked for: matched first against the whole names, then against their
-        bases (:func:`split_unit`), without regard to case or repeated blanks. The role's
-        own name (``'displacement'`` for the displacement, the default) also finds the
-        role's usual names (:data:`SYNONYMS`) if no column bears it.
+        The name asked for, matched as :func:`matching_columns` says.
     role : str
         What the column holds (``'displacement'``, ``'force'``, ``'load'``, ``'cycle'``,
         ``'x'``, ``'z'``), for messages and synonyms.
@@ -262,9 +259,10 @@ def find_column(names, wanted: str, role: str, *, required: bool = True) -> int 
 
 
 def matching_columns(names, wanted: str, role: str | None = None) -> list[int]:
-    """The indices of the names that match ``wanted`` (see :func:`find_column`): the one
-    whole name equal to it, else those whose base is its base, else (for ``wanted`` the
-    name of ``role``) those whose base is one of the role's :data:`SYNONYMS`."""
+    """The indices of the names that match ``wanted``, without regard to case or repeated
+    blanks: the one whole name equal to it, else those whose base (:func:`split_unit`) is
+    its base, else (for ``wanted`` the name of ``role``) those whose base is one of the
+    role's :data:`SYNONYMS`."""
     target = _normal(wanted)
     whole = [k for k, name in enumerate(names) if _normal(name) == target]
     if len(whole) == 1:

@@ -148,21 +148,18 @@ def atomic_store(path, *, overwrite: bool = False, exclusive: bool = True):
     temporary : pathlib.Path
         ``.<name>.<process id>.<32 hex digits>.tmp`` beside ``path``, not yet existing:
         create the file or directory there. On success it is flushed to disk and renamed to
-        ``path`` (an old ``path`` is moved aside first and removed after); if the block
-        raises (or is interrupted), it is removed and ``path`` is left as it was. A crash
-        leaves only a hidden ``.tmp`` name (:data:`TEMPORARY_NAME`), never a store under
-        ``path``; the next write of ``path`` removes those of processes no longer running.
+        ``path`` (an old ``path`` moved aside first, removed after); if the block raises, it
+        is removed and ``path`` is left as it was. A crash leaves only the temporary
+        (:data:`TEMPORARY_NAME`), which the next write of ``path`` removes.
 
     Raises
     ------
     FileExistsError
         If ``path`` exists and ``overwrite`` is false, or (``exclusive``) a file ``path``
-        that did not exist when the block began was created meanwhile (another run writing
-        it).
+        was created meanwhile (another run writing it).
     IsADirectoryError
-        If ``path`` is a directory that is not a store (:func:`is_store`), raised before
-        anything is written, or a store and a file was written: a folder is never removed
-        to make room.
+        If ``path`` is a directory that is not a store (:func:`is_store`), or a store and
+        a file was written: a folder is never removed to make room.
     """
     path = Path(path)
     if os.path.lexists(path) and not overwrite:

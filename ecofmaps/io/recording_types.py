@@ -49,16 +49,9 @@ SI_UNITS = {"displacement": "m", "force": "N", "cycle": "1", "load": "N"}
 
 
 def si_values(values: np.ndarray, factor: float) -> np.ndarray:
-    """``values * factor``; for a factor 10^-k, divided by the exact 10^k instead, so that
-    a ``25`` read in µm is the float nearest 25e-6 (one rounding, not two), as a text file's
-    ``25`` is (:mod:`ecofmaps.io.text`).
-
-    Parameters
-    ----------
-    values : numpy.ndarray
-        In the file's unit; changed in place where that saves a copy.
-    factor : float
-        From the file's unit to SI.
+    """``values`` (in the file's unit, changed in place) times ``factor`` to SI; for a factor
+    10^-k, divided by the exact 10^k instead, so that a ``25`` read in µm is the float
+    nearest 25e-6 (one rounding, not two).
 
     Examples
     --------
@@ -86,16 +79,9 @@ class RecordingError(FileLineError):
         The 1-based line of a text file; or, in a file without lines, a position such as
         ``"channel 'Rig/force', sample 1200"``; or None for the file as a whole.
     message : str
-
-    Attributes
-    ----------
-    path : pathlib.Path
-    line : int or None
-        The 1-based line, for a text file.
-    position : str
-        ``'line 12'``, the position given, or ``''``.
-    message : str
-        What is wrong, without the file and the position.
+        What is wrong, without the file and the position (kept as the attribute
+        ``message``; ``line`` is the line or None, ``position`` ``'line 12'``, the position
+        given or ``''``).
     """
 
     def __init__(self, path, line, message: str):
