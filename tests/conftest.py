@@ -1,8 +1,18 @@
-"""Shared test set-up: a private cache, a headless matplotlib, hypothesis profiles."""
+"""Shared test set-up: a private cache, a compilation cache, a headless matplotlib,
+hypothesis profiles."""
 
 import os
+from pathlib import Path
 
-import jax
+# JAX keeps what it compiles under .pytest_cache (git ignores it), for the test processes and the
+# commands they start: a second run, or the other worker of this one, does not compile again.
+os.environ.setdefault(
+    "JAX_COMPILATION_CACHE_DIR", str(Path(__file__).parents[1] / ".pytest_cache" / "jax")
+)
+os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS", "0")
+os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_ENTRY_SIZE_BYTES", "-1")
+
+import jax  # reads the variables above
 import pytest
 from hypothesis import HealthCheck, settings
 
