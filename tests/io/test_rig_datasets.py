@@ -18,6 +18,9 @@ from ecofmaps.io.tdms import TdmsReader
 from ecofmaps.measured.synthetic import synthetic_recording
 from ecofmaps.paper import EXAMPLE_2 as POINT
 
+# Zarr format 3 stores are written as xarray writes them by default, which zarr warns about.
+pytestmark = pytest.mark.filterwarnings("ignore:Consolidated metadata:UserWarning")
+
 SIZE = 801
 DROPPED = (100, 433)  # the displacement's and the force's missing sample
 

@@ -12,6 +12,7 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 import ecofmaps
+from ecofmaps.measured import LoopQualityWarning
 from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.synthetic import synthetic_recording
 from ecofmaps.paper import AMPLITUDE, EXAMPLE_2, LOAD
@@ -328,7 +329,8 @@ def test_partial_slip_is_labelled():
     """Mindlin's partial-slip loop is labelled partial slip, and so is the model's full stick
     (μλ >= 1, its regime NO_GROSS_SLIP): a measured loop without slip has A = 0."""
     displacement, force = mindlin_recording(0.9)
-    result = analyze_loops(displacement, force, LOAD)
+    with pytest.warns(LoopQualityWarning, match="0 ok; curved-stick 4, partial-slip 4"):
+        result = analyze_loops(displacement, force, LOAD)
     assert (result.regime == ecofmaps.PARTIAL_SLIP).all()
     assert result.regime.attrs["flag_meanings"].split()[ecofmaps.PARTIAL_SLIP] == "partial_slip"
     assert (result.cof_max < 0.8).all()  # Q*/P, kept: a lower bound of μ
@@ -341,7 +343,8 @@ def test_partial_slip_is_labelled():
     displacement, force = synthetic_recording(
         **point, cycles=6, displacement_noise=0.25e-6, force_noise=2.5, seed=2
     )
-    result = analyze_loops(displacement, force, LOAD)
+    with pytest.warns(LoopQualityWarning, match="partial-slip 6"):
+        result = analyze_loops(displacement, force, LOAD)
     assert (result.regime == ecofmaps.PARTIAL_SLIP).all()
     assert float(relative(result.stiffness, point["stiffness"]).max()) < 0.02
     assert float(np.abs(result.energy_ratio).max()) < 0.02
