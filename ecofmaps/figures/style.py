@@ -1,7 +1,6 @@
-"""The look shared by every figure: sizes, labels from the nomenclature, colours, saving.
-
-Figures are :class:`matplotlib.figure.Figure` objects built without pyplot state, so they
-can be made in a loop or a server; :func:`save_figure` writes one atomically.
+"""The look shared by every figure: sizes, labels from the nomenclature, colours, legends
+clear of the data, saving. Figures are :class:`matplotlib.figure.Figure` objects built without
+pyplot state, so they can be made in a loop or a server.
 """
 
 from __future__ import annotations
@@ -13,6 +12,7 @@ import xarray as xr
 from matplotlib import colormaps
 from matplotlib.colors import BoundaryNorm
 from matplotlib.figure import Figure
+from matplotlib.path import Path as DrawnPath
 
 from ecofmaps._nomenclature import QUANTITIES, axis_label
 from ecofmaps.io.files import atomic_path
@@ -23,6 +23,7 @@ __all__ = [
     "PAPER_DPI",
     "RECORDING_DPI",
     "axis_label",
+    "legend_clear_of_data",
     "number_text",
     "save_figure",
     "stiffness_label",
@@ -43,9 +44,8 @@ RECORDING_DPI = 300
 
 
 def ecof_ratio_colors() -> tuple:
-    """The colour map of μ_E/μ and its norm: one colour per band between 1 and the
-    :data:`ECOF_RATIO_LEVELS`, whatever a map's range, so the same μ_E/μ has the same colour in
-    Figures 11a and 11b, the universal map and the explorer's map."""
+    """The colour map of μ_E/μ and its norm: one colour per band of :data:`ECOF_RATIO_LEVELS`,
+    so that a μ_E/μ has one colour on every map (Figure 11, the universal map, the explorer)."""
     cmap = colormaps["YlOrRd"]
     return cmap, BoundaryNorm([1.0, *ECOF_RATIO_LEVELS], cmap.N, clip=True)
 
@@ -135,6 +135,68 @@ def force_ratio_axis(ax, load: float) -> None:
     """A right-hand axis reading the force axis [N] as :math:`Q/P`."""
     secondary = ax.secondary_yaxis("right", functions=(lambda q: q / load, lambda r: r * load))
     secondary.set_ylabel(axis_label("force_ratio"))
+
+
+def zero_lines(ax, color: str = "0.6", x: float = 0.0, y: float = 0.0) -> None:
+    """Thin lines across ``ax`` at ``y`` and ``x`` (in its data's units)."""
+    ax.axhline(y, color=color, linewidth=0.6)
+    ax.axvline(x, color=color, linewidth=0.6)
+
+
+#: Room kept between a legend and what is drawn, as a fraction of the panel's height. [1]
+_LEGEND_ROOM = 0.03
+#: Where a legend may go inside a panel, in the order tried.
+_CORNERS = (
+    "upper left",
+    "upper right",
+    "lower left",
+    "lower right",
+    "upper center",
+    "lower center",
+)
+
+
+def legend_clear_of_data(ax, *, twins=(), **options):
+    """A legend of ``ax`` and its twin axes ``twins`` in the first corner of ``ax`` where it
+    covers nothing drawn in them; with no such corner, the value axes are stretched upwards to
+    make room above everything drawn, and the legend goes in the upper left."""
+    panels = (ax, *twins)
+    handles, labels = [], []
+    for panel in panels:
+        more = panel.get_legend_handles_labels()
+        handles, labels = handles + more[0], labels + more[1]
+    legend = ax.legend(handles, labels, loc=_CORNERS[0], **options)
+    ax.figure.draw_without_rendering()  # the layout done: the legend's and the data's places
+    for corner in _CORNERS:
+        legend.set_loc(corner)
+        box = legend.get_window_extent().padded(_LEGEND_ROOM * ax.bbox.height)
+        if not any(_covers(panel, box) for panel in panels):
+            return legend
+    legend.set_loc(_CORNERS[0])
+    share = legend.get_window_extent().height / ax.bbox.height + 2.0 * _LEGEND_ROOM
+    for panel in panels:
+        low, high = panel.get_ylim()
+        panel.set_ylim(low, low + (high - low) / max(1.0 - share, 0.2))
+    return legend
+
+
+def _covers(ax, box) -> bool:
+    """Whether anything drawn in ``ax`` (lines, their markers, filled areas, texts) meets the
+    display-space ``box``; spans of the whole panel's height (a shaded background) do not."""
+    for line in ax.get_lines():
+        path = line.get_transform().transform_path(line.get_path()).cleaned(remove_nans=True)
+        points = path.vertices[np.isin(path.codes, (DrawnPath.MOVETO, DrawnPath.LINETO))]
+        if line.get_marker() not in (None, "None", "", " ") and box.count_contains(points):
+            return True
+        if line.get_linestyle() not in ("None", "", " ") and path.intersects_bbox(
+            box, filled=False
+        ):
+            return True
+    for collection in ax.collections:
+        transform = collection.get_transform()
+        if any(transform.transform_path(p).intersects_bbox(box) for p in collection.get_paths()):
+            return True
+    return any(text.get_window_extent().overlaps(box) for text in ax.texts)
 
 
 # No time stamps in the files, so regenerating an unchanged figure gives the same bytes.

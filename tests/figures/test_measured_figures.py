@@ -446,14 +446,14 @@ def test_a_legend_with_no_free_corner_gets_room_above_the_data():
     """Lines through every corner: the value axis is stretched and the legend goes above them."""
     from matplotlib.figure import Figure
 
-    from ecofmaps.figures.measured_figures import _legend_clear_of_data
+    from ecofmaps.figures.style import legend_clear_of_data
 
     figure = Figure(figsize=(5.0, 3.5), layout="constrained")
     ax = figure.subplots()
     x = np.linspace(0.0, 1.0, 101)
     ax.plot(x, np.where(np.arange(x.size) % 2, 0.0, 1.0), label="zigzag")
     ax.plot(x, 0.5 + 0.0 * x, label="level")
-    legend = _legend_clear_of_data(ax)
+    legend = legend_clear_of_data(ax)
     rendered(figure)
     assert not covered(ax, legend.get_window_extent())
     assert ax.get_ylim()[1] > 1.2
