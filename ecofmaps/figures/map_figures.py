@@ -1,10 +1,5 @@
-r"""The maps of μ_E/μ: the paper's Figure 11 and the universal map over λ = P/(SΔ*), each a pure
-function of the Dataset that holds its numbers.
-
-Contours of μ_E/μ over the rig (S/P or λ) and the groove's aspect ratio z_o/x_o, the
-no-gross-slip area hatched; points passed in as markers are drawn on them. Axes speak the
-tribologist's units. :mod:`ecofmaps.figures.recipes` builds the Datasets with the paper's
-parameters.
+r"""The maps of μ_E/μ over the rig (S/P, or λ = P/(SΔ*)) and z_o/x_o: the paper's Figure 11 and
+the universal map, each a pure function of the Dataset that holds its numbers (docs/model.md).
 """
 
 from __future__ import annotations
@@ -36,9 +31,6 @@ from ecofmaps.model import NO_GROSS_SLIP, compliance_ratio, energy_cof
 __all__ = ["ecof_ratio_contours", "universal_ecof_ratio_map"]
 
 
-# --- Figure 11 and the universal map: contours of μ_E/μ -------------------------------------
-
-
 def _ecof_ratio_contours(ax, x, ratio: xr.DataArray, regime: xr.DataArray) -> list:
     """Filled and labelled contours of μ_E/μ over (x, z_o/x_o), no-gross-slip area hatched."""
     y = ratio["aspect_ratio"].values
@@ -55,21 +47,14 @@ def _ecof_ratio_contours(ax, x, ratio: xr.DataArray, regime: xr.DataArray) -> li
     colorbar = ax.figure.colorbar(filled, ax=ax, ticks=fill_levels, format="%.2f")
     colorbar.set_label(r"$\mu_E/\mu$ [1]")
     ax.set_ylabel(axis_label("aspect_ratio"))
-    handles = [
-        Line2D([], [], color="black", linewidth=2.4, label=r"$\mu_E/\mu$ = 1.05 (5 % above $\mu$)")
-    ]
+    label = r"$\mu_E/\mu$ = 1.05 (5 % above $\mu$)"
+    handles = [Line2D([], [], color="black", linewidth=2.4, label=label)]
     stuck = (regime == NO_GROSS_SLIP).transpose(..., "aspect_ratio").values.T.astype(float)
     if stuck.any():
         ax.contourf(x, y, stuck, levels=[0.5, 1.5], colors="none", hatches=["//"])
         ax.contour(x, y, stuck, levels=[0.5], colors="0.3", linewidths=1.0)
-        handles.append(
-            Patch(
-                facecolor="none",
-                edgecolor="0.3",
-                hatch="//",
-                label=r"no gross slip ($\mu P/S \geq \Delta^*$)",
-            )
-        )
+        label = r"no gross slip ($\mu P/S \geq \Delta^*$)"
+        handles.append(Patch(facecolor="none", edgecolor="0.3", hatch="//", label=label))
     return handles
 
 
@@ -98,10 +83,8 @@ def ecof_ratio_contours(
 
     Notes
     -----
-    Figure 11 of the paper (a: :math:`\Delta^*` = 25 µm, b: 50 µm, :math:`\mu = 0.8`).
     :math:`\mu_E/\mu` depends on :math:`S/P` and :math:`\Delta^*` only through
-    :math:`\lambda = P/(S\Delta^*)` (eq. 16), so the two panels are one surface read on two
-    scales of :math:`S/P`: see :func:`universal_ecof_ratio_map`.
+    :math:`\lambda = P/(S\Delta^*)` (eq. 16): see :func:`universal_ecof_ratio_map`.
     """
     figure = Figure(figsize=FIGSIZE, layout="constrained")
     ax = figure.add_subplot()
@@ -110,14 +93,10 @@ def ecof_ratio_contours(
     handles = _ecof_ratio_contours(ax, x, dataset["ecof_ratio"], dataset["regime"])
     ax.set_xlabel(axis_label("stiffness_ratio"))
     for name, point in (markers or {}).items():
+        label = rf"{name} ({stiffness_label(point['stiffness'])}, $P$ = {point['load']:g} N)"
+        dot = dict(color="navy", markersize=8, markeredgecolor="white", label=label)
         handles += ax.plot(
-            point["stiffness"] / point["load"] * PER_MM,
-            point["aspect_ratio"],
-            "o",
-            color="navy",
-            markersize=8,
-            markeredgecolor="white",
-            label=rf"{name} ({stiffness_label(point['stiffness'])}, $P$ = {point['load']:g} N)",
+            point["stiffness"] / point["load"] * PER_MM, point["aspect_ratio"], "o", **dot
         )
     ax.legend(handles=handles, loc="lower right", fontsize="small", framealpha=0.9)
     ax.set_title(
@@ -161,10 +140,8 @@ def universal_ecof_ratio_map(
     Notes
     -----
     With :math:`x_o = \Delta^*` the slip ratio (eq. 16) and :math:`\mu_E/\mu` (eq. 15,
-    corrected) depend on :math:`\mu`, :math:`z_o/x_o` and :math:`\lambda` only, so every
-    pair (:math:`\Delta^*`, :math:`S/P`) with the same :math:`\lambda` gives the same
-    :math:`\mu_E/\mu`: this one chart holds both panels of Figure 11, which on the
-    logarithmic axis are the same window shifted by a factor 2. Not in the paper.
+    corrected) depend on :math:`\mu`, :math:`z_o/x_o` and :math:`\lambda` only: both panels
+    of Figure 11 are windows of this chart, a factor 2 apart. Not in the paper.
     """
     figure = Figure(figsize=(6.8, 5.6), layout="constrained")
     ax = figure.add_subplot()
@@ -182,53 +159,26 @@ def universal_ecof_ratio_map(
         ratios = np.asarray(stiffness_ratios, dtype=np.float64)
         with jax.enable_x64(True):  # the core's jax.numpy arithmetic, in float64
             span = compliance_ratio(amplitude, 1.0, np.array([ratios.max(), ratios.min()]))
-        ax.annotate(
-            "",
-            (float(span[0]), height),
-            (float(span[1]), height),
-            arrowprops=dict(arrowstyle="|-|", color="0.25", shrinkA=0, shrinkB=0),
-        )
-        ax.text(
-            0.92 * float(span[0]),
-            height,
-            rf"Fig. {name} ($\Delta^*$ = {amplitude * MICRO:g} µm)",
-            ha="right",
-            va="center",
-            fontsize="x-small",
-            color="0.15",
-        )
+        bar = dict(arrowstyle="|-|", color="0.25", shrinkA=0, shrinkB=0)
+        ax.annotate("", (float(span[0]), height), (float(span[1]), height), arrowprops=bar)
+        label = rf"Fig. {name} ($\Delta^*$ = {amplitude * MICRO:g} µm)"
+        words = dict(ha="right", va="center", fontsize="x-small", color="0.15")
+        ax.text(0.92 * float(span[0]), height, label, **words)
+    legible = dict(boxstyle="round,pad=0.1", facecolor="white", alpha=0.75, edgecolor="none")
     for (name, point), marker in zip((markers or {}).items(), itertools.cycle("soD^v")):
         with jax.enable_x64(True):
             lam = float(compliance_ratio(point["amplitude"], point["load"], point["stiffness"]))
         value = float(energy_cof(**point) / point["mu"])
-        handles += ax.plot(
-            lam,
-            point["aspect_ratio"],
-            marker,
-            color="navy",
-            markersize=8,
-            markeredgecolor="white",
-            zorder=5,
-            label=(
-                rf"{name}: {stiffness_label(point['stiffness'])}, "
-                rf"$z_o/x_o$ = {point['aspect_ratio']:.3g}, "
-                rf"$\mu$ = {point['mu']:g}: $\mu_E/\mu$ = {value:.3f}"
-            ),
+        label = (
+            rf"{name}: {stiffness_label(point['stiffness'])}, "
+            rf"$z_o/x_o$ = {point['aspect_ratio']:.3g}, "
+            rf"$\mu$ = {point['mu']:g}: $\mu_E/\mu$ = {value:.3f}"
         )
-        ax.annotate(
-            name.replace("Example ", "Ex. ").replace("(Section 3)", "(§3)"),
-            (lam, point["aspect_ratio"]),
-            xytext=(7, -3),
-            textcoords="offset points",
-            fontsize="x-small",
-            color="navy",
-            bbox={
-                "boxstyle": "round,pad=0.1",
-                "facecolor": "white",
-                "alpha": 0.75,
-                "edgecolor": "none",
-            },  # legible over the contours
-        )
+        dot = dict(color="navy", markersize=8, markeredgecolor="white", zorder=5, label=label)
+        handles += ax.plot(lam, point["aspect_ratio"], marker, **dot)
+        short = name.replace("Example ", "Ex. ").replace("(Section 3)", "(§3)")
+        words = dict(textcoords="offset points", fontsize="x-small", color="navy", bbox=legible)
+        ax.annotate(short, (lam, point["aspect_ratio"]), xytext=(7, -3), **words)
     figure.legend(handles=handles, loc="outside lower center", fontsize="x-small", ncols=1)
     title = [
         rf"Universal map of $\mu_E/\mu$ ($x_o = \Delta^*$, $\mu$ = {mu:g})",

@@ -1,10 +1,6 @@
-r"""The paper's figures of the model's loops and curves (Figures 5-8), each a pure function of
-the Dataset that holds its numbers (the maps of Figure 11: :mod:`ecofmaps.figures.map_figures`).
-
-One function per figure takes a Dataset of :mod:`ecofmaps.maps` (and, where a figure marks
-points, the points as an argument) and returns a :class:`matplotlib.figure.Figure`. Axes
-speak the tribologist's units: µm, N, MN/m, mJ. :mod:`ecofmaps.figures.recipes` builds
-the Datasets with the paper's parameters and draws the set ``ecofmaps figures`` writes.
+r"""The paper's figures of the model's loops and curves (Figures 5-8): each a pure function of a
+Dataset of :mod:`ecofmaps.maps` (and of the points it marks), in µm, N, MN/m and mJ.
+:mod:`ecofmaps.figures.recipes` builds the Datasets with the paper's parameters.
 """
 
 from __future__ import annotations
@@ -26,6 +22,7 @@ from ecofmaps.figures.style import (
     scalar,
     stiffness_colors,
     stiffness_label,
+    zero_lines,
 )
 
 __all__ = [
@@ -35,9 +32,6 @@ __all__ = [
     "rigid_and_compliant_loops",
     "slip_amplitude_curves",
 ]
-
-
-# --- Figures 5 and 6: fretting loops --------------------------------------------------------
 
 
 def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
@@ -57,9 +51,7 @@ def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
 
     Notes
     -----
-    Figure 5 of the paper (:math:`x_o = \Delta^* = 50` µm, :math:`P = 450` N,
-    :math:`z_o/x_o = 0.2`, :math:`\mu = 0.8`, :math:`S = \infty` and 35 MN/m). The
-    compliant loop's sides have slope :math:`S` (eq. 10); its slip branches follow eq. 9.
+    The compliant loop's sides have slope :math:`S` (eq. 10); its slip branches follow eq. 9.
     """
     figure = Figure(figsize=FIGSIZE, layout="constrained")
     ax = figure.add_subplot()
@@ -72,13 +64,8 @@ def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
             rf"$\delta^*$ = {float(loop.slip_amplitude) * MICRO:.1f} µm, "
             rf"$E_d$ = {float(loop.dissipated_energy) * MILLI:.1f} mJ"
         )
-        ax.plot(
-            loop.displacement * MICRO,
-            loop.force,
-            color=color,
-            label=label,
-            **styles[bool(np.isinf(stiffness))],
-        )
+        style = styles[bool(np.isinf(stiffness))]
+        ax.plot(loop.displacement * MICRO, loop.force, color=color, label=label, **style)
     _loop_axes(ax, loops)
     ax.set_title(
         "Fig. 5  Fretting loop: rigid rig against a compliant one\n"
@@ -96,10 +83,8 @@ def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
 
 def _loop_axes(ax, loops: xr.Dataset) -> None:
     """Labels, zero lines and the Q/P axis shared by the loop figures."""
-    ax.axhline(0.0, color="0.6", linewidth=0.6)
-    ax.axvline(0.0, color="0.6", linewidth=0.6)
-    ax.set_xlabel(axis_label("displacement"))
-    ax.set_ylabel(axis_label("force"))
+    zero_lines(ax)
+    ax.set(xlabel=axis_label("displacement"), ylabel=axis_label("force"))
     ax.grid(alpha=0.3)
     force_ratio_axis(ax, scalar(loops, "load"))
 
@@ -121,9 +106,8 @@ def loops_by_aspect_ratio(loops: xr.Dataset) -> Figure:
 
     Notes
     -----
-    Figure 6 of the paper. Every loop crosses :math:`Q = S\Delta` where the contact is at
-    the groove centre, :math:`x = 0`, so :math:`Q = \pm\mu P` there whatever the groove
-    (eq. 17-18): the geometry-independent coefficient of friction is read off these points.
+    Every loop crosses :math:`Q = S\Delta` where the contact is at the groove centre, so
+    :math:`Q = \pm\mu P` there whatever the groove (eq. 17-18): the GICoF.
     """
     figure = Figure(figsize=(6.4, 5.6), layout="constrained")
     ax = figure.add_subplot()
@@ -131,39 +115,17 @@ def loops_by_aspect_ratio(loops: xr.Dataset) -> Figure:
     colors = colormaps["viridis"](np.linspace(0.0, 0.85, len(ratios)))
     for ratio, color in zip(ratios, colors, strict=True):
         loop = loops.sel(aspect_ratio=ratio)
-        ax.plot(
-            loop.displacement * MICRO,
-            loop.force,
-            color=color,
-            linewidth=2.0,
-            label=(
-                rf"$z_o/x_o$ = {ratio:g}: "
-                rf"$\delta^*$ = {float(loop.slip_amplitude) * MICRO:.1f} µm"
-            ),
-        )
-    stiffness = scalar(loops, "stiffness")
-    load = scalar(loops, "load")
-    mu = scalar(loops, "mu")
+        label = rf"$z_o/x_o$ = {ratio:g}: $\delta^*$ = {float(loop.slip_amplitude) * MICRO:.1f} µm"
+        ax.plot(loop.displacement * MICRO, loop.force, color=color, linewidth=2.0, label=label)
+    stiffness, load, mu = (scalar(loops, name) for name in ("stiffness", "load", "mu"))
     reach = 1.12 * float(np.abs(loops.force).max())
     ends = np.array([-reach, reach]) / stiffness
-    ax.plot(
-        ends * MICRO,
-        ends * stiffness,
-        color="black",
-        linewidth=1.2,
-        linestyle="--",
-        label=r"$Q = S\Delta$",
-    )
+    line = dict(color="black", linewidth=1.2, linestyle="--", label=r"$Q = S\Delta$")
+    ax.plot(ends * MICRO, ends * stiffness, **line)
     crossings = np.array([-mu * load, mu * load])
-    ax.plot(
-        crossings / stiffness * MICRO,
-        crossings,
-        "o",
-        color="crimson",
-        markersize=8,
-        zorder=5,
-        label=rf"common points $Q = \pm\mu P$ = ±{mu * load:g} N (GICoF)",
-    )
+    label = rf"common points $Q = \pm\mu P$ = ±{mu * load:g} N (GICoF)"
+    dots = dict(color="crimson", markersize=8, zorder=5, label=label)
+    ax.plot(crossings / stiffness * MICRO, crossings, "o", **dots)
     _loop_axes(ax, loops)
     ax.set_title(
         "Fig. 6  Loops for several groove aspect ratios\n"
@@ -179,9 +141,6 @@ def loops_by_aspect_ratio(loops: xr.Dataset) -> Figure:
     return figure
 
 
-# --- Figures 7 and 8: curves against the aspect ratio for several rigs ------------------------
-
-
 def _stiffness_curves(dataset: xr.Dataset, variable: str, scale: float, number: str) -> Figure:
     """One curve of ``dataset[variable] * scale`` against z_o/x_o per rig stiffness."""
     figure = Figure(figsize=FIGSIZE, layout="constrained")
@@ -189,17 +148,11 @@ def _stiffness_curves(dataset: xr.Dataset, variable: str, scale: float, number: 
     load = scalar(dataset, "load")
     stiffnesses = dataset["stiffness_ratio"].values * load
     for index, color in enumerate(stiffness_colors(stiffnesses)):
-        curve = dataset[variable].isel(stiffness_ratio=index)
-        ax.plot(
-            dataset["aspect_ratio"],
-            curve * scale,
-            color=color,
-            linewidth=2.0,
-            linestyle="--" if np.isinf(stiffnesses[index]) else "-",
-            label=stiffness_label(stiffnesses[index]),
-        )
-    ax.set_xlabel(axis_label("aspect_ratio"))
-    ax.set_ylabel(axis_label(variable))
+        curve = dataset[variable].isel(stiffness_ratio=index) * scale
+        style = dict(linestyle="--" if np.isinf(stiffnesses[index]) else "-")
+        label = stiffness_label(stiffnesses[index])
+        ax.plot(dataset["aspect_ratio"], curve, color=color, linewidth=2.0, label=label, **style)
+    ax.set(xlabel=axis_label("aspect_ratio"), ylabel=axis_label(variable))
     ax.set_xlim(float(dataset["aspect_ratio"].min()), float(dataset["aspect_ratio"].max()))
     ax.grid(alpha=0.3)
     ax.set_title(
@@ -236,12 +189,11 @@ def slip_amplitude_curves(dataset: xr.Dataset) -> Figure:
 
     Notes
     -----
-    Figure 7a of the paper: the rigid rig keeps :math:`\delta^* = \Delta^*`; a compliant
-    rig loses more of the stroke to its own deflection as the groove deepens (eq. 16).
+    A rigid rig keeps :math:`\delta^* = \Delta^*`; a compliant one loses more of the stroke
+    to its own deflection as the groove deepens (eq. 16).
     """
-    figure = _stiffness_curves(
-        dataset, "slip_amplitude", MICRO, "7a  Slip amplitude against the groove aspect ratio"
-    )
+    title = "7a  Slip amplitude against the groove aspect ratio"
+    figure = _stiffness_curves(dataset, "slip_amplitude", MICRO, title)
     _legend_top_down(figure.axes[0], dataset.sizes["stiffness_ratio"], loc="lower left")
     return figure
 
@@ -260,15 +212,11 @@ def dissipated_energy_curves(dataset: xr.Dataset) -> Figure:
 
     Notes
     -----
-    Figure 7b of the paper (eq. 12): a stiffer rig always dissipates more; :math:`E_d`
-    rises with :math:`z_o/x_o` for stiff rigs and falls for compliant ones.
+    A stiffer rig always dissipates more (eq. 12); :math:`E_d` rises with :math:`z_o/x_o`
+    for stiff rigs and falls for compliant ones.
     """
-    figure = _stiffness_curves(
-        dataset,
-        "dissipated_energy",
-        MILLI,
-        "7b  Dissipated energy against the groove aspect ratio",
-    )
+    title = "7b  Dissipated energy against the groove aspect ratio"
+    figure = _stiffness_curves(dataset, "dissipated_energy", MILLI, title)
     _legend_top_down(figure.axes[0], dataset.sizes["stiffness_ratio"], loc="upper left")
     return figure
 
@@ -291,31 +239,24 @@ def ecof_ratio_curves(dataset: xr.Dataset, markers: Mapping[str, Mapping] | None
 
     Notes
     -----
-    Figure 8 of the paper (eq. 1, 12-16, with the corrected eq. 13-15): Example 2's
-    :math:`\mu_E` is about 4 % above :math:`\mu`.
+    Eq. 1, 12-16, with the corrected eq. 13-15: Example 2's :math:`\mu_E` is about 4 %
+    above :math:`\mu`.
     """
-    figure = _stiffness_curves(
-        dataset, "ecof_ratio", 1.0, "8  ECoF over the contact CoF against the groove aspect ratio"
-    )
+    title = "8  ECoF over the contact CoF against the groove aspect ratio"
+    figure = _stiffness_curves(dataset, "ecof_ratio", 1.0, title)
     ax = figure.axes[0]
     for name, point in (markers or {}).items():
-        value = float(
-            dataset["ecof_ratio"]
-            .sel(stiffness_ratio=point["stiffness"] / scalar(dataset, "load"))
-            .interp(aspect_ratio=point["aspect_ratio"])
+        curve = dataset["ecof_ratio"].sel(
+            stiffness_ratio=point["stiffness"] / scalar(dataset, "load")
+        )
+        value = float(curve.interp(aspect_ratio=point["aspect_ratio"]))
+        label = (
+            rf"{name} ({stiffness_label(point['stiffness'])}, "
+            rf"$z_o/x_o$ = {point['aspect_ratio']:g}): $\mu_E/\mu$ = {value:.3f} "
+            rf"(+{(value - 1) * 100:.1f} %)"
         )
         ax.plot(
-            point["aspect_ratio"],
-            value,
-            "o",
-            color="crimson",
-            markersize=9,
-            zorder=5,
-            label=(
-                rf"{name} ({stiffness_label(point['stiffness'])}, "
-                rf"$z_o/x_o$ = {point['aspect_ratio']:g}): $\mu_E/\mu$ = {value:.3f} "
-                rf"(+{(value - 1) * 100:.1f} %)"
-            ),
+            point["aspect_ratio"], value, "o", color="crimson", markersize=9, zorder=5, label=label
         )
     _legend_top_down(ax, dataset.sizes["stiffness_ratio"], loc="upper left")
     return figure
