@@ -59,26 +59,23 @@ def running_condition_map(results, transition: xr.Dataset, rig_stiffness: float)
         cycles = per_cycle(test, ("amplitude",))
         condition = sliding_condition(test, rig_stiffness).attrs["sliding_condition"]
         marker, face = _CONDITION_MARKERS[condition]
+        style = dict(marker=marker, markerfacecolor=face, markeredgecolor="black", linestyle="")
+        label = None if condition in drawn else condition
         ax.plot(
             np.nanmedian(cycles["amplitude"]) * MICRO,
             np.nanmedian(cycles["load"]),
-            marker=marker,
-            markerfacecolor=face,
-            markeredgecolor="black",
-            linestyle="",
-            label=None if condition in drawn else condition,
+            **style,
+            label=label,
         )
         drawn.add(condition)
     top = 1.15 * ax.get_ylim()[1]
     load = np.linspace(0.0, top, 50)
     line = float(transition.contact_amplitude) + float(transition.mu) * load / rig_stiffness
-    ax.plot(
-        line * MICRO, load, color="tab:red", label=r"transition $\Delta_t = \delta_t + \mu_t P/S$"
-    )
+    label = r"transition $\Delta_t = \delta_t + \mu_t P/S$"
+    ax.plot(line * MICRO, load, color="tab:red", label=label)
     ax.set_xlim(0.0, None)
     ax.set_ylim(0.0, top)
-    ax.set_xlabel(axis_label("amplitude"))
-    ax.set_ylabel(axis_label("load"))
+    ax.set(xlabel=axis_label("amplitude"), ylabel=axis_label("load"))
     ax.grid(alpha=0.3)
     ax.legend(loc="lower right", fontsize="small")
     ax.set_title(
@@ -118,40 +115,19 @@ def loop_scar_closure_figure(closure: xr.Dataset) -> Figure:
     """
     figure = Figure(figsize=(2 * FIGSIZE[0], FIGSIZE[1]), layout="constrained")
     loop, scar = figure.subplots(1, 2)
-    loop.plot(
-        closure.loop_displacement * MICRO,
-        closure.loop_force,
-        color="0.55",
-        linewidth=2.5,
-        label=f"measured, cycle {int(closure.cycle)}",
-    )
-    loop.plot(
-        closure.model_displacement * MICRO,
-        closure.model_force,
-        color="tab:red",
-        linewidth=1.2,
-        label=rf"model on the profile, $\mu$ = GICoF = {float(closure.mu):.3g}",
-    )
-    loop.set_xlabel(axis_label("displacement"))
-    loop.set_ylabel(axis_label("force"))
-    loop.set_title(
-        parameters(
-            f"RMS force off the model {number_text(100 * float(closure.loop_residual), 2)} % of Q*",
-            stiffness_label(float(closure.stiffness)),
-        ),
-        fontsize="medium",
-    )
+    measured, model = dict(color="0.55", linewidth=2.5), dict(color="tab:red", linewidth=1.2)
+    label = f"measured, cycle {int(closure.cycle)}"
+    loop.plot(closure.loop_displacement * MICRO, closure.loop_force, **measured, label=label)
+    label = rf"model on the profile, $\mu$ = GICoF = {float(closure.mu):.3g}"
+    loop.plot(closure.model_displacement * MICRO, closure.model_force, **model, label=label)
+    loop.set(xlabel=axis_label("displacement"), ylabel=axis_label("force"))
+    off = f"RMS force off the model {number_text(100 * float(closure.loop_residual), 2)} % of Q*"
+    loop.set_title(parameters(off, stiffness_label(float(closure.stiffness))), fontsize="medium")
     position = closure.position * MICRO
-    scar.plot(position, closure.scar_height * MICRO, color="0.55", linewidth=2.5, label="profile")
-    scar.plot(
-        position,
-        closure.implied_scar * MICRO,
-        color="tab:red",
-        linewidth=1.2,
-        label=r"implied by the loops, $\int g\,d\xi$",
-    )
-    scar.set_xlabel(axis_label("scar_position"))
-    scar.set_ylabel(axis_label("scar_height"))
+    scar.plot(position, closure.scar_height * MICRO, **measured, label="profile")
+    label = r"implied by the loops, $\int g\,d\xi$"
+    scar.plot(position, closure.implied_scar * MICRO, **model, label=label)
+    scar.set(xlabel=axis_label("scar_position"), ylabel=axis_label("scar_height"))
     scar.set_title(
         f"RMS height off the profile {number_text(float(closure.scar_residual) * MICRO, 2)} µm"
         f" ({number_text(100 * float(closure.scar_relative_residual), 2)} % of the depth)",

@@ -1,9 +1,5 @@
-r"""Figures of wear-scar profiles: a measured profile as the model reads it, and scar shapes.
-
-:func:`scar_profile_figure` draws one :class:`~ecofmaps.model.profiles.ScarProfile` with its
-edges and the slope the model uses; :func:`scar_shape_comparison` draws the ``shapes``
-figure: scars of four shapes at one :math:`D/W` against the parabola, and how far the
-paper's :math:`D/W` shortcut (eq. 11) misses the contact CoF.
+r"""Figures of wear-scar profiles: a measured profile as the model reads it, and the ``shapes``
+figure, scars of four shapes at one :math:`D/W` against the parabola (docs/profiles.md).
 """
 
 from __future__ import annotations
@@ -21,6 +17,7 @@ from ecofmaps.figures.style import (
     parameters,
     scalar,
     stiffness_label,
+    zero_lines,
 )
 
 __all__ = ["scar_profile_figure", "scar_shape_comparison"]
@@ -59,9 +56,8 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
 
     Notes
     -----
-    The pad at slip position :math:`x` feels the slope at :math:`X = xW/x_o` (eq. 11, with
-    :math:`x_o = \Delta^*` by default), so only the slopes within :math:`|X| \le
-    \delta^* W/\Delta^*` enter a steady loop; eq. 9 holds pointwise there.
+    Only the slopes within :math:`|X| \le \delta^* W/\Delta^*` enter a steady loop (eq. 9
+    pointwise, :math:`X = xW/x_o` of eq. 11): docs/profiles.md.
 
     Examples
     --------
@@ -79,29 +75,22 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
     slope = np.asarray(profile.slope)
     depth, width = float(profile.depth), float(profile.half_width)
     surface = float(profile.reference_height) + float(profile.reference_slope) * position
-
     figure = Figure(figsize=(7.4, 6.4), layout="constrained")
     top, bottom = figure.subplots(2, 1, sharex=True, height_ratios=(1.25, 1.0))
     top.plot(x, height, color="tab:blue", linewidth=1.6, label="profile $z(X)$")
-    top.plot(
-        x,
-        surface * MICRO,
-        color="0.3",
-        linewidth=1.0,
-        linestyle="--",
-        label="unworn surface (levelling line)",
+    unworn = dict(
+        color="0.3", linewidth=1.0, linestyle="--", label="unworn surface (levelling line)"
     )
-    bottom_of_scar = float(profile.reference_height) * MICRO - depth * MICRO
-    top.annotate(
-        "",
-        xy=(0.0, bottom_of_scar),
-        xytext=(0.0, float(profile.reference_height) * MICRO),
-        arrowprops=dict(arrowstyle="<->", color="crimson", linewidth=1.2),
-    )
+    top.plot(x, surface * MICRO, **unworn)
+    level = float(profile.reference_height) * MICRO
+    bottom_of_scar = level - depth * MICRO
+    arrow = dict(arrowstyle="<->", color="crimson", linewidth=1.2)
+    top.annotate("", xy=(0.0, bottom_of_scar), xytext=(0.0, level), arrowprops=arrow)
+    label = f"  D = {depth * MICRO:.4g} µm"
     top.text(
         0.02 * width * MICRO,
         bottom_of_scar + 0.5 * depth * MICRO,
-        f"  D = {depth * MICRO:.4g} µm",
+        label,
         color="crimson",
         va="center",
     )
@@ -110,12 +99,8 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
     bowl = surface[inside] - depth * (1.0 - (position[inside] / width) ** 2)
     top.plot(x[inside], bowl * MICRO, **_SHORTCUT, label="parabola of the same D/W")
     bottom.plot(x, slope, color="tab:blue", linewidth=1.6, label="slope the model uses")
-    bottom.plot(
-        x[inside],
-        parabola[inside],
-        **_SHORTCUT,
-        label=f"parabola of the same D/W = {depth / width:.3g}",
-    )
+    label = f"parabola of the same D/W = {depth / width:.3g}"
+    bottom.plot(x[inside], parabola[inside], **_SHORTCUT, label=label)
     bottom.axhline(0.0, color="0.6", linewidth=0.6)
     for ax in (top, bottom):
         for edge, label in ((-width, "edges $\\pm W$"), (width, None)):
@@ -170,10 +155,9 @@ def scar_shape_comparison(dataset: xr.Dataset) -> Figure:
 
     Notes
     -----
-    The model on a profile (eq. 9 pointwise, :math:`X = xW/x_o` of eq. 11 with
-    :math:`x_o = \Delta^*`). The pad only reaches :math:`|X| \le \delta^* W/\Delta^* < W`,
-    so what lies beyond the edges (the ridges) is never felt, and a scar flatter in its
-    middle than the parabola (flat-bottomed, W-shaped) biases :math:`\mu_E` less.
+    The pad only reaches :math:`|X| \le \delta^* W/\Delta^* < W` (eq. 9, 11): ridges beyond
+    the edges are never felt, and a scar flatter in its middle than the parabola biases
+    :math:`\mu_E` less.
     """
     shapes = list(dataset["shape"].values)
     figure = Figure(figsize=(15.0, 9.0), layout="constrained")
@@ -208,30 +192,18 @@ def _draw_scar_profiles(ax, dataset: xr.Dataset) -> None:
     depth, width = scalar(dataset, "scar_depth"), scalar(dataset, "scar_half_width")
     x = dataset["scar_position"].values * MICRO
     for shape in dataset["shape"].values:  # the parabola on top, thinner: others share parts
-        ax.plot(
-            x,
-            dataset["scar_height"].sel(shape=shape) * MICRO,
-            color=SHAPE_COLORS.get(shape),
-            label=shape,
-            **(
-                {"linewidth": 1.4, "zorder": 3}
-                if shape == "parabolic"
-                else {"linewidth": 2.6, "zorder": 2}
-            ),
+        style = (
+            dict(linewidth=1.4, zorder=3) if shape == "parabolic" else dict(linewidth=2.6, zorder=2)
         )
+        height = dataset["scar_height"].sel(shape=shape) * MICRO
+        ax.plot(x, height, color=SHAPE_COLORS.get(shape), label=shape, **style)
     reach = float(dataset["slip_amplitude"].sel(shape="parabolic", groove="parabola"))
     reach *= width / scalar(dataset, "amplitude")
-    ax.axvspan(
-        -reach * MICRO,
-        reach * MICRO,
-        color="0.85",
-        zorder=0,
-        label="reach of the pad,\n" + r"$|X| \leq \delta^* W/\Delta^*$",
-    )
+    label = "reach of the pad,\n" + r"$|X| \leq \delta^* W/\Delta^*$"
+    ax.axvspan(-reach * MICRO, reach * MICRO, color="0.85", zorder=0, label=label)
     for edge in (-width, width):
         ax.axvline(edge * MICRO, **_EDGE)
-    ax.set_xlabel(axis_label("scar_position"))
-    ax.set_ylabel(axis_label("scar_height"))
+    ax.set(xlabel=axis_label("scar_position"), ylabel=axis_label("scar_height"))
     ax.set_title(f"Scars of equal D/W = {depth / width:g}\n(edges ±W dotted)", fontsize="medium")
     ax.set_ylim(-1.25 * depth * MICRO, 2.1 * depth * MICRO)  # the legend above
     ax.legend(loc="upper center", fontsize="x-small", ncols=2)
@@ -246,31 +218,19 @@ def _draw_shape_loops(loop_axes, dataset: xr.Dataset) -> None:
         own = dict(color=SHAPE_COLORS.get(shape), linewidth=2.0, zorder=2)
         for groove, style in (("profile", own), ("parabola", dict(_SHORTCUT, zorder=3))):
             point = dataset.sel(shape=shape, groove=groove)
-            ax.plot(
-                point["displacement"] * MICRO,
-                point["force"],
-                **style,
-                label=(
-                    f"{shape + ' scar' if groove == 'profile' else 'parabola, same D/W'}\n"
-                    rf"$\delta^*$ = {float(point['slip_amplitude']) * MICRO:.1f} µm, "
-                    rf"$E_d$ = {float(point['dissipated_energy']) * MILLI:.1f} mJ, "
-                    rf"$\mu_E$ = {float(point['ecof']):.3f}"
-                ),
+            label = (
+                f"{shape + ' scar' if groove == 'profile' else 'parabola, same D/W'}\n"
+                rf"$\delta^*$ = {float(point['slip_amplitude']) * MICRO:.1f} µm, "
+                rf"$E_d$ = {float(point['dissipated_energy']) * MILLI:.1f} mJ, "
+                rf"$\mu_E$ = {float(point['ecof']):.3f}"
             )
+            ax.plot(point["displacement"] * MICRO, point["force"], **style, label=label)
         loops = dataset["force"].sel(shape=shape).values
         if np.allclose(loops[0], loops[1], rtol=1e-6, atol=1e-9 * load):
-            ax.text(
-                0.97,
-                0.04,
-                "the parabola's loop: this scar differs\nonly beyond the pad's reach",
-                transform=ax.transAxes,
-                ha="right",
-                va="bottom",
-                fontsize="small",
-                color=SHAPE_COLORS.get(shape),
-            )
-        ax.axhline(0.0, color="0.6", linewidth=0.6)
-        ax.axvline(0.0, color="0.6", linewidth=0.6)
+            text = "the parabola's loop: this scar differs\nonly beyond the pad's reach"
+            where = dict(transform=ax.transAxes, ha="right", va="bottom")
+            ax.text(0.97, 0.04, text, fontsize="small", color=SHAPE_COLORS.get(shape), **where)
+        zero_lines(ax)
         ax.set_xlabel(axis_label("displacement"))
         ax.grid(alpha=0.3)
         ax.set_title(f"{shape} scar", fontsize="medium")
@@ -296,32 +256,17 @@ def _draw_ratio_and_error(ax_ratio, ax_error, dataset: xr.Dataset) -> None:
     for shape in dataset["shape"].values:
         style = dict(color=SHAPE_COLORS.get(shape), linewidth=2.0, zorder=2)
         if shape == "parabolic":  # on the parabola's closed form: points, so both show
-            style = dict(
-                color=SHAPE_COLORS["parabolic"],
-                marker="o",
-                markersize=4,
-                linestyle="none",
-                markevery=6,
-                zorder=4,
-            )
-        ax_ratio.plot(
-            ratios,
-            dataset["ecof_ratio"].sel(shape=shape, groove="profile"),
-            label=f"{shape} scar",
-            **style,
-        )
+            dots = dict(marker="o", markersize=4, linestyle="none", markevery=6, zorder=4)
+            style = dict(color=SHAPE_COLORS["parabolic"], **dots)
+        ratio = dataset["ecof_ratio"].sel(shape=shape, groove="profile")
+        ax_ratio.plot(ratios, ratio, label=f"{shape} scar", **style)
         if shape != "parabolic":
             error = dataset["shortcut_error"].sel(shape=shape) * 100.0
             ax_error.plot(ratios, error, label=f"{shape} scar", **style)
     example = stiffness / scalar(dataset, "load") * PER_MM
+    rig = dict(color="crimson", linewidth=1.0, linestyle="-.")
     for ax in (ax_ratio, ax_error):
-        ax.axvline(
-            example,
-            color="crimson",
-            linewidth=1.0,
-            linestyle="-.",
-            label=f"Example 2, {stiffness_label(stiffness)}",
-        )
+        ax.axvline(example, **rig, label=f"Example 2, {stiffness_label(stiffness)}")
         ax.set_xlabel(axis_label("stiffness_ratio"))
         ax.set_xlim(ratios[0], ratios[-1])
         ax.grid(alpha=0.3)
