@@ -31,12 +31,6 @@ __all__ = [
 ]
 
 
-def _is_tracer(value) -> bool:
-    """True for a JAX tracer (without importing JAX: before it is imported there is none)."""
-    jax = sys.modules.get("jax")
-    return jax is not None and isinstance(value, jax.core.Tracer)
-
-
 def _is_quantity(value) -> bool:
     """True for a pint Quantity of any registry (without importing pint)."""
     return type(value).__module__.split(".")[0] == "pint" and hasattr(value, "magnitude")
@@ -79,17 +73,15 @@ def to_si(name: str, value, quantity: str | None = None):
 def _numeric_objects(value) -> bool:
     """True for an object array (or list) that holds only real numbers."""
     array = np.asarray(value)
-    if array.dtype.kind != "O":
-        return False
-    return all(
+    return array.dtype.kind == "O" and all(
         isinstance(item, (int, float, np.integer, np.floating)) and not isinstance(item, bool)
         for item in array.ravel()
     )
 
 
 def _converted(function, parameters: inspect.Signature, args, kwargs, kinds):
-    """``args`` and ``kwargs`` with every pint Quantity converted to SI by parameter name, after
-    :func:`check_broadcast_size` of the quantities."""
+    """``args`` and ``kwargs`` with every pint Quantity in SI by parameter name, their
+    broadcast checked (:func:`check_broadcast_size`)."""
     bound = parameters.bind_partial(*args, **kwargs)
     for name, value in bound.arguments.items():
         quantity = kinds.get(name, name)
@@ -150,8 +142,7 @@ def check_broadcast_size(caller: str, values) -> None:
     points = math.prod(shape)
     if points <= max((math.prod(s) for s in shapes), default=1):
         return
-    memory = available_memory()
-    size = 8 * points  # one float64 result
+    memory, size = available_memory(), 8 * points  # one float64 result
     if memory is None or size <= memory:
         return
     raise MemoryError(
@@ -198,7 +189,7 @@ def is_concrete(*values) -> bool:
     jax = sys.modules.get("jax")
     if jax is None:  # no tracer exists before JAX is imported
         return True
-    return not any(_is_tracer(leaf) for leaf in jax.tree_util.tree_leaves(values))
+    return not any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree_util.tree_leaves(values))
 
 
 def as_float64(value):

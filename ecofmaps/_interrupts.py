@@ -1,7 +1,5 @@
 """Ctrl-C and SIGTERM that stop the command line cleanly, at the next safe point, writing
-nothing more.
-
-Standard library only, so the command line can install it before importing anything heavy.
+nothing more (standard library only: installed before anything heavy is imported).
 """
 
 from __future__ import annotations
@@ -37,13 +35,9 @@ class Stop(threading.Event):
         self.deferred = 0
 
     def note(self):
-        """What the stop left, as the first of :attr:`notes` that has something to say
-        tells it now (the sentence after ``interrupted;``), or None."""
-        for note in self.notes:
-            told = note()
-            if told:
-                return told
-        return None
+        """What the stop left (the sentence after ``interrupted;``): the first of :attr:`notes`
+        that has something to say, or None."""
+        return next((told for told in (note() for note in self.notes) if told), None)
 
 
 #: Set by the handler of :func:`interrupts_stop_writes`, only while it is installed; its
@@ -77,12 +71,9 @@ def check_interrupted() -> None:
 @contextlib.contextmanager
 def interrupts_deferred():
     """Within the block, a stop signal does not stop the work at :func:`check_interrupted`:
-    for what completes an output already in place (the record of the files a command
-    wrote, say), which a stop would leave complete but unrecorded. Leaving the
-    :func:`interrupts_stop_writes` block still raises ``KeyboardInterrupt``, unless the
-    command's work returned (:func:`ecofmaps.cli.main.main`). A second signal still stops
-    at once.
-    """
+    for what completes an output already in place (the record of the files a command wrote).
+    Leaving :func:`interrupts_stop_writes` still raises ``KeyboardInterrupt`` unless the
+    command's work returned; a second signal still stops at once."""
     INTERRUPTED.deferred += 1
     try:
         yield

@@ -40,13 +40,11 @@ __all__ = [
 CONNECT_TIMEOUT = 5.0
 
 #: Memory a worker process of a local cluster needs: its interpreter with NumPy, JAX and
-#: dask loaded and a block of a recording (peak resident size measured on ``ecofmaps loops
-#: --workers 2`` over 4e6 samples: 141 MiB for the idle worker, 392 MiB for the busy one). [byte]
+#: dask loaded, and a block of a recording. [byte]
 WORKER_MEMORY = 512 * 2**20
 
 #: Seconds between looks at a running task (and at Ctrl-C).
 _POLL = 0.01
-
 
 #: The attribute of a dask array made by ``dask.array.from_array`` that holds the array-like
 #: it was made of, when that reads a range of samples itself (see :func:`stretch`).
@@ -80,8 +78,7 @@ def stretch(array, start: int, stop: int):
 
 
 def _materialised(arguments):
-    """``arguments`` with every :class:`Slice` read and every dask collection computed, here on this
-    thread."""
+    """``arguments`` with every :class:`Slice` read and every dask collection computed, here."""
     arguments = tuple(a.read() if isinstance(a, Slice) else a for a in arguments)
     import dask
 
@@ -121,12 +118,7 @@ class Runner:
     def __init__(self, workers=None, *, scheduler=None, cluster=False, client=None, timeout=None):
         if scheduler is not None and cluster:
             raise ValueError("give a scheduler address or start a local cluster, not both")
-        if scheduler is None and client is None:  # this machine's threads or processes
-            check_workers(workers, processes=cluster)
-        elif workers is not None and (
-            isinstance(workers, bool) or int(workers) != workers or workers < 1
-        ):
-            raise ValueError(f"workers must be a positive integer; got {workers!r}")
+        check_workers(workers, processes=cluster, here=scheduler is None and client is None)
         self.scheduler, self.cluster, self.timeout = scheduler, cluster, timeout
         self.workers = int(workers) if workers else (1 if scheduler else os.cpu_count() or 1)
         self._given = client
@@ -156,13 +148,10 @@ class Runner:
             import dask
             from distributed import Client, LocalCluster
 
-            # distributed sets MALLOC_TRIM_THRESHOLD_ in its workers, which stops glibc from
-            # raising its mmap threshold: every NumPy temporary above 128 kB is then mapped
-            # afresh and faulted in page by page.
+            # No MALLOC_TRIM_THRESHOLD_ (with it glibc maps every NumPy temporary above 128 kB
+            # afresh), no sampling of the task's stack for a dashboard (it takes the GIL).
             environ = dask.config.get("distributed.nanny.pre-spawn-environ")
             environ = {k: v for k, v in environ.items() if k != "MALLOC_TRIM_THRESHOLD_"}
-            # Nor does a worker sample its task's stack for the dashboard's profile (which
-            # this cluster does not serve): the sampling takes the GIL from the task.
             settings = {
                 "distributed.nanny.pre-spawn-environ": environ,
                 "distributed.worker.profile.enabled": False,
@@ -176,12 +165,9 @@ class Runner:
                     threads_per_worker=1,
                     processes=True,
                     dashboard_address=None,
-                    # the scheduler's small HTTP server (health, metrics) on a free port, not
-                    # 8787: two runs at once would warn that it is taken
+                    # the scheduler's HTTP server on a free port: two runs at once, no warning
                     scheduler_kwargs={"dashboard_address": ":0"},
-                    # nothing: a worker whose scheduler went away at Ctrl-C logs an error
-                    # (a failed heartbeat) on the command's standard error; a task's error
-                    # comes back to this process and is reported in its one line
+                    # no log: a task's error comes back here, and Ctrl-C's farewells are noise
                     silence_logs=logging.CRITICAL + 1,
                 )
                 self._client = Client(self._cluster, set_as_default=False)
@@ -196,7 +182,8 @@ class Runner:
 
     def __exit__(self, *exc):
         if exc[0] is not None and issubclass(exc[0], KeyboardInterrupt):
-            _quiet_teardown()  # Ctrl-C or SIGTERM: the cluster's farewells are noise
+            for name in ("distributed", "tornado", "asyncio"):  # the cluster's farewells: noise
+                logging.getLogger(name).setLevel(logging.CRITICAL + 1)
         if self._pool is not None:
             self._pool.shutdown(wait=True, cancel_futures=True)
         if self._client is not None and self._given is None:
@@ -209,9 +196,7 @@ class Runner:
     def _submit(self, function, arguments):
         if self._pool is not None:
             return self._pool.submit(_call, function, arguments)
-        # A recording parsed into memory (a text file run with --workers) travels with its
-        # tasks: a stretch of samples each, sent once; distributed's advice to load the data
-        # with dask is no news to the user, who gave a text file.
+        # A recording parsed into memory travels with its tasks: no advice to load it with dask.
         with warnings.catch_warnings():
             warnings.filterwarnings("ignore", message="Sending large graph", category=UserWarning)
             return self._client.submit(_call, function, arguments, pure=False)
@@ -265,13 +250,15 @@ class Runner:
                 future.cancel()
 
 
-def check_workers(workers, processes: bool) -> None:
+def check_workers(workers, processes: bool, here: bool = True) -> None:
     """Raise ``ValueError`` naming ``workers`` unless it is None or a whole number of
-    workers that this machine can run (:func:`worker_limit`)."""
+    workers, which this machine can run (:func:`worker_limit`) when they run ``here``."""
     if workers is None:
         return
     if isinstance(workers, bool) or int(workers) != workers or workers < 1:
         raise ValueError(f"workers must be a positive integer; got {workers!r}")
+    if not here:
+        return
     limit, why = worker_limit(processes=processes)
     if workers > limit:
         raise ValueError(f"workers={workers} is more than this machine can run: {why}")
@@ -357,12 +344,6 @@ def start_resource_tracker_quietly() -> None:
         os.dup2(saved, 2)
         os.close(saved)
         os.close(null)
-
-
-def _quiet_teardown() -> None:
-    """Silence the loggers of a cluster torn down by an interrupt."""
-    for name in ("distributed", "tornado", "asyncio"):
-        logging.getLogger(name).setLevel(logging.CRITICAL + 1)
 
 
 def _connect(address: str, timeout: float):

@@ -60,8 +60,7 @@ def per_cycle(results: xr.Dataset, names) -> dict:
     if missing:
         words = ", ".join(f"'{n}' ({nomenclature.QUANTITIES[n].long_name})" for n in missing)
         raise ValueError(f"results: no {words}; give the results of ecofmaps.analyze_loops")
-    values = {name: np.asarray(results[name].values, dtype=np.float64) for name in names}
-    values["cycle"] = np.asarray(results["cycle"].values, dtype=np.float64)
+    values = {n: np.asarray(results[n].values, dtype=np.float64) for n in (*names, "cycle")}
     if "normal_load" in results:
         values["load"] = np.asarray(results["normal_load"].values, dtype=np.float64)
     elif "load" in results.coords or "load" in results:
@@ -73,24 +72,16 @@ def per_cycle(results: xr.Dataset, names) -> dict:
     return values
 
 
-def _ratios(cycles: dict, rig_stiffness) -> dict:
-    """Energy and opening ratios on the applied displacement, and on the contact's when the
-    rig's stiffness is known (else NaN)."""
+def _ratios(cycles: dict, rig_stiffness):
+    """The cycles' energy and opening ratios (on the contact's displacement NaN without the
+    rig's stiffness), the energy ratio that decides the regime, and where it says gross slip."""
     if rig_stiffness is not None:
         check("rig_stiffness", rig_stiffness, "positive_or_inf", "N/m")
     names = ("amplitude", "max_force", "dissipated_energy")
     slip = cycles.get("slip_amplitude", np.nan)
-    return loop_ratios(*(cycles[n] for n in names), slip, rig_stiffness)
-
-
-def _gross_slip(ratios: dict, rig_stiffness):
-    """The energy ratio that decides the regime (the contact's when the rig is known), and
-    where it says gross slip."""
+    ratios = loop_ratios(*(cycles[n] for n in names), slip, rig_stiffness)
     ratio = regime_ratio(ratios, rig_stiffness)
-    return ratio, ratio > MINDLIN_ENERGY_RATIO
-
-
-_RATIO_VARIABLES = ("amplitude", "max_force", "dissipated_energy", "slip_amplitude")
+    return ratios, ratio, ratio > MINDLIN_ENERGY_RATIO
 
 
 @si_units(rig_stiffness="stiffness")
@@ -119,10 +110,8 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
 
     Notes
     -----
-    A cycle is in gross slip when its energy ratio exceeds Mindlin's :math:`A_t = 0.2`, on
-    the contact's displacement with ``rig_stiffness``, else on the applied one (which
-    calls a sphere's first gross-slip cycles behind a compliant rig partial slip). See
-    docs/lab.md.
+    Gross slip where the energy ratio exceeds Mindlin's :math:`A_t = 0.2`: docs/lab.md,
+    "Energy and opening ratios, on which displacement".
 
     References
     ----------
@@ -144,9 +133,9 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
     ('gross slip', 1.0)
     """
     (results,) = _tests(results)
-    cycles = per_cycle(results, _RATIO_VARIABLES)
-    ratios = _ratios(cycles, rig_stiffness)
-    ratio, gross = _gross_slip(ratios, rig_stiffness)
+    names = ("amplitude", "max_force", "dissipated_energy", "slip_amplitude")
+    cycles = per_cycle(results, names)
+    ratios, ratio, gross = _ratios(cycles, rig_stiffness)
     gross = np.where(np.isfinite(ratio), gross, np.nan)
     condition, changes = sliding_condition_of(cycles["cycle"], gross)
     data = {name: ("cycle", value, nomenclature.attrs(name)) for name, value in ratios.items()}
@@ -156,8 +145,8 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
 
 
 def _line(x, y):
-    """Least-squares line ``y = a + b (x - x0)``: (x0, a, b, covariance of a and b), the
-    covariance NaN with fewer than three points."""
+    """Least-squares line ``y = a + b (x - x0)``: x0, a, b and their covariance (NaN below
+    three points)."""
     x0 = float(np.mean(x))
     design = np.stack([np.ones_like(x), x - x0], axis=-1)
     (a, b), rss, *_ = np.linalg.lstsq(design, y, rcond=None)
@@ -184,10 +173,8 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
         across the transition (the variable-displacement method), or of several tests at
         one load and several amplitudes.
     rig_stiffness : float, optional
-        The rig's own stiffness :math:`S`: the energy ratio is then read on the contact's
-        displacement with Mindlin's threshold, and the contact's transition amplitude is
-        given. Without it the applied displacement's ratio is used (biased high for a
-        compliant contact) and ``contact_amplitude`` is NaN. [N/m]
+        The rig's own stiffness :math:`S`, as for :func:`sliding_condition`; without it
+        ``contact_amplitude`` is NaN. [N/m]
 
     Returns
     -------
@@ -204,22 +191,13 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
 
     Notes
     -----
-    The cycles are sorted by amplitude and split where the fewest fall on the wrong side
-    of :math:`A_t = 0.2`; a straight line fitted to the energy ratio of the cycles at the
-    amplitudes on either side of the split gives :math:`\Delta_t` where it reaches
-    :math:`A_t`; its standard error adds the spacing of those amplitudes over
-    :math:`\sqrt{12}` to the fit's. :math:`\mu_t` is the mean :math:`Q^*/P` of the
-    gross-slip cycles at the first amplitude above the split. See docs/lab.md.
+    The cycles split by amplitude where the fewest fall on the wrong side of
+    :math:`A_t = 0.2`, and a line through the energy ratios either side: docs/lab.md,
+    "The transition".
 
     References
     ----------
-    S. Fouvry, P. Kapsa, L. Vincent (1995), Analysis of sliding behaviour for fretting
-    loadings: determination of transition criteria, Wear 185, 35-46.
-    L. Vincent, Y. Berthier, M. Godet (1992), Testing methods in fretting fatigue: a critical
-    appraisal, ASTM STP 1159, 33-48.
-    Z.R. Zhou, L. Vincent (1995), Mixed fretting regime, Wear 181-183, 531-536.
-    R.D. Mindlin, H. Deresiewicz (1953), Elastic spheres in contact under varying oblique
-    forces, J. Appl. Mech. 20, 327-344.
+    Those of :func:`sliding_condition`.
 
     Examples
     --------
@@ -239,17 +217,18 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     names = ("amplitude", "max_force", "dissipated_energy")
     tests = [per_cycle(test, names) for test in _tests(results)]
     pooled = {name: np.concatenate([t[name] for t in tests]) for name in (*names, "load")}
-    ratio, gross = _gross_slip(_ratios(pooled, rig_stiffness), rig_stiffness)
+    _, ratio, gross = _ratios(pooled, rig_stiffness)
     known = np.isfinite(ratio) & np.isfinite(pooled["load"])
     order = np.argsort(pooled["amplitude"][known], kind="stable")
-    amplitude, ratio, gross = (v[known][order] for v in (pooled["amplitude"], ratio, gross))
-    cof = (pooled["max_force"] / pooled["load"])[known][order]
-    load = pooled["load"][known][order]
+    cof = pooled["max_force"] / pooled["load"]
+    amplitude, ratio, gross, cof, load = (
+        v[known][order] for v in (pooled["amplitude"], ratio, gross, cof, pooled["load"])
+    )
     if not gross.size:
         raise ValueError("results: no cycle with an energy ratio (every cycle refused)")
     if gross.all() or not gross.any():
-        words = ("gross", "above", "smaller") if gross.any() else ("partial", "at most", "larger")
-        regime, bound, other = words
+        both = ("gross", "above", "smaller") if gross.any() else ("partial", "at most", "larger")
+        regime, bound, other = both
         raise ValueError(
             f"results never cross the transition: every cycle is in {regime} slip (energy "
             f"ratio {bound} {MINDLIN_ENERGY_RATIO}, amplitudes {amplitude.min() * 1e6:.4g} to "
@@ -269,8 +248,7 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
         low, high = low - 1, high + 1
     fitted = (level >= low) & (level <= high)
     at, at_se = _root(*_line(amplitude[fitted], ratio[fitted]), MINDLIN_ENERGY_RATIO)
-    # the ratio's curve between the two amplitudes is not known: the crossing may lie
-    # anywhere between them
+    # the crossing may lie anywhere between the two amplitudes
     bracket = (amplitude[level == high].mean() - amplitude[level == low].mean()) / np.sqrt(12)
     at_se = float(np.hypot(np.nan_to_num(at_se), bracket))
     first = gross & (level == level[split:][gross[split:]][0])
@@ -289,9 +267,8 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
 
 
 def _cycle_sum(cycle, value):
-    """Σ of a per-cycle ``value`` over cycles 1 to the last recorded one, linear between the
-    recorded cycles and held at the first before it, and its standard error from the
-    recorded values' scatter about the straight line through their neighbours."""
+    """Σ of a per-cycle ``value`` over cycles 1 to the last recorded, and its standard error
+    (docs/lab.md, "Energy wear")."""
     kept = np.isfinite(value)
     n, v = cycle[kept], value[kept]
     if n.size == 0:
@@ -311,8 +288,7 @@ def _cycle_sum(cycle, value):
 
 
 def _worn_area_se(profile: ScarProfile) -> float:
-    """Standard error of the worn area [m²]: the shoulders' noise over the scar's samples
-    and through the reference line's offset."""
+    """Standard error of the worn area [m²] from the shoulders' noise."""
     x = np.asarray(profile.position)
     residual = np.asarray(profile.height) - profile.reference_height - profile.reference_slope * x
     width = float(profile.half_width)
@@ -367,16 +343,6 @@ def _one_test(results, profile, length) -> dict:
     }
 
 
-def _campaign(energy, volume):
-    """α and E_th of V = α(ΣE_d - E_th) fitted over the tests, with standard errors."""
-    x0, a, b, cov = _line(energy, volume)
-    threshold, threshold_se = _root(x0, a, b, cov, 0.0)
-    return {
-        "campaign_energy_wear_coefficient": (b, float(np.sqrt(cov[1, 1]))),
-        "threshold_energy": (threshold, threshold_se),
-    }
-
-
 def _with_se(data: dict, name: str, value, se, dims=(), quantity=None) -> None:
     """Put ``name`` and ``name_se`` (its standard error) into ``data`` with their attrs."""
     attrs = nomenclature.attrs(quantity or name)
@@ -413,16 +379,13 @@ def energy_wear(results, profile, length) -> xr.Dataset:
     Raises
     ------
     ValueError
-        For results without cycle numbers, energies or a load, a profile without a scar,
-        a length that is not a line contact's in metres (0 < L < 1 m), or lists of unequal
-        length.
+        For results without cycles, energies or a load, a profile without a scar, a length
+        not in metres (0 < L < 1 m), or lists of unequal length.
 
     Notes
     -----
-    Sums over cycles take each quantity linear between the recorded cycles and at the
-    first recorded value before it; their standard errors come from the recorded values'
-    scatter, the volume's from the profile's noise. A campaign's fit needs three tests
-    for its errors. See docs/lab.md.
+    Sums over the cycles driven, linear between those recorded; a campaign's fit needs
+    three tests for its errors: docs/lab.md, "Energy wear".
 
     References
     ----------
@@ -473,16 +436,16 @@ def energy_wear(results, profile, length) -> xr.Dataset:
     for name in found[0]:
         values = np.array([f[name] for f in found])
         _with_se(data, name, *(values[0] if single else values.T), dims=dims)
-    if not single:
-        fit = _campaign(data["cumulated_energy"][1], data["wear_volume"][1])
-        for name, (value, se) in fit.items():
-            _with_se(data, name, value, se)
+    if not single:  # V = α(ΣE_d - E_th) fitted over the tests
+        x0, a, b, cov = _line(data["cumulated_energy"][1], data["wear_volume"][1])
+        _with_se(data, "campaign_energy_wear_coefficient", b, float(np.sqrt(cov[1, 1])))
+        _with_se(data, "threshold_energy", *_root(x0, a, b, cov, 0.0))
     return xr.Dataset(data)
 
 
 def _reading(results, resolved):
-    """The last cycle with a GICoF, a kept loop and a reading along the stroke: its row of
-    ``results`` and of ``resolved``."""
+    """The rows of ``results`` and ``resolved`` of the last cycle with a GICoF, a kept loop
+    and a reading along the stroke."""
     (results,) = _tests(results)
     if "loop_displacement" not in results or "gicof" not in results:
         raise ValueError(
@@ -507,8 +470,7 @@ def _reading(results, resolved):
 
 
 def _branch_force(displacement, loop_displacement, loop_force):
-    """The force of the loop (Δ, Q) at ``displacement`` on the branch each point moves along
-    (rising or falling Δ, read from the order of the points)."""
+    """The force of the loop (Δ, Q) at ``displacement``, on the branch each point moves along."""
     top = int(np.nanargmax(loop_displacement))
     rising = np.interp(displacement, loop_displacement[: top + 1], loop_force[: top + 1])
     falling = np.interp(displacement, loop_displacement[top:][::-1], loop_force[top:][::-1])
@@ -557,12 +519,8 @@ def loop_scar_closure(results, resolved, profile, rig_stiffness=None) -> xr.Data
 
     Notes
     -----
-    The closure is read on the last cycle with a GICoF and a reading along the stroke.
-    The model's steady loop (:func:`ecofmaps.fretting_loop`, eq. 9-10 on the profile with
-    :math:`X = x`) has :math:`\mu` = that cycle's GICoF (eq. 17-18), its amplitude and
-    load. The implied scar is :math:`h(\xi) = \int g\,d\xi`, the slope read along the
-    stroke (``felt_profile``), shifted by the constant that best fits the profile: a
-    loop knows the groove's shape, not its height. See docs/lab.md.
+    On the last cycle with a GICoF (eq. 17-18) and a reading along the stroke, against the
+    model's loop on the profile (eq. 9-10): docs/lab.md, "Loop-scar closure".
 
     References
     ----------
@@ -603,23 +561,21 @@ def loop_scar_closure(results, resolved, profile, rig_stiffness=None) -> xr.Data
     height = np.interp(position, trace, np.asarray(profile.height))
     implied = implied + np.mean(height - implied)
     scar = float(np.sqrt(np.mean((implied - height) ** 2)))
-    attrs = nomenclature.attrs
-    data = {
-        "loop_residual": ((), float(np.sqrt(np.mean(off**2))) / peak, attrs("loop_residual")),
-        "scar_residual": ((), scar, attrs("scar_residual")),
-        "scar_relative_residual": (
-            (),
-            scar / float(profile.depth),
-            attrs("scar_relative_residual"),
-        ),
-        "mu": ((), mu, attrs("gicof")),
-        "stiffness": ((), float(rig_stiffness), attrs("stiffness")),
-        "loop_displacement": ("point", displacement, attrs("loop_displacement")),
-        "loop_force": ("point", force, attrs("loop_force")),
-        "model_displacement": ("model_point", model_displacement, attrs("displacement")),
-        "model_force": ("model_point", model_force, attrs("force")),
-        "implied_scar": ("position", implied, attrs("implied_scar")),
-        "scar_height": ("position", height, attrs("scar_height")),
+    values = {
+        "loop_residual": ((), float(np.sqrt(np.mean(off**2))) / peak),
+        "scar_residual": ((), scar),
+        "scar_relative_residual": ((), scar / float(profile.depth)),
+        "mu": ((), mu),
+        "stiffness": ((), float(rig_stiffness)),
+        "loop_displacement": ("point", displacement),
+        "loop_force": ("point", force),
+        "model_displacement": ("model_point", model_displacement),
+        "model_force": ("model_point", model_force),
+        "implied_scar": ("position", implied),
+        "scar_height": ("position", height),
+        "position": ("position", position),
     }
-    coords = {"cycle": int(loop.cycle), "position": ("position", position, attrs("position"))}
+    quantity = {"mu": "gicof", "model_displacement": "displacement", "model_force": "force"}
+    data = {n: (*v, nomenclature.attrs(quantity.get(n, n))) for n, v in values.items()}
+    coords = {"cycle": int(loop.cycle), "position": data.pop("position")}
     return xr.Dataset(data, coords=coords)

@@ -1,9 +1,6 @@
-"""Quantities with units, as the command line reads and prints them.
-
-The Python API speaks SI; people type ``50um``, ``35MN/m`` or ``450 N``. These helpers
-turn such text, a plain number and a plain unit (pint evaluates no arithmetic typed), into SI
-floats with pint, and check the dimension, so ``--amplitude 35MN/m`` is an error that says
-what was expected. A bare number is taken as SI. The explorer reads its inputs with them too.
+"""Quantities with units, as the command line and the explorer read them: ``50um``,
+``35MN/m`` or ``450 N`` (a plain number and a plain unit: pint evaluates no arithmetic typed)
+to SI floats with pint, the dimension checked; a bare number is SI.
 """
 
 from __future__ import annotations
@@ -72,7 +69,10 @@ def bare_number_warning(name: str, text: str, kind: str) -> str | None:
     except ValueError:  # a unit given
         return None
     low, high, meant = PLAUSIBLE[name]
-    plausible = functools.partial(_within, low, high)
+
+    def plausible(value: float) -> bool:
+        return (low is None or value >= low) and (high is None or value <= high)
+
     if not math.isfinite(value) or value == 0 or plausible(value):
         return None
     said = f"{text.strip()} is {value:g} {DIMENSIONS[kind][1]}"
@@ -84,10 +84,6 @@ def bare_number_warning(name: str, text: str, kind: str) -> str | None:
     else:
         span = f"at most {high:g}" if low is None else f"{low:g} to {high:g}"
     return f"{said}; a fretting test's is {span} {DIMENSIONS[kind][1]}"
-
-
-def _within(low, high, value: float) -> bool:
-    return (low is None or value >= low) and (high is None or value <= high)
 
 
 #: A number as typed: a decimal with an optional exponent, inf or nan.

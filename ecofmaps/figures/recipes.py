@@ -1,8 +1,6 @@
-r"""The figures ``ecofmaps figures`` writes: each one's Dataset, drawing function and markers.
-
-:data:`FIGURES` is the registry: for each figure name, the function that builds its Dataset
-with the paper's parameters (:mod:`ecofmaps.paper`), the function that draws it, and what it
-marks. :func:`make_figure` does both for one figure, :func:`make_figures` for several.
+r"""The figures ``ecofmaps figures`` writes: :data:`FIGURES`, for each figure the function that
+builds its Dataset with the paper's parameters (:mod:`ecofmaps.paper`), the function that draws
+it and what it marks; :func:`make_figure` does both, :func:`make_figures` for several.
 """
 
 from __future__ import annotations
@@ -54,31 +52,21 @@ class FigureRecipe:
 
     Attributes
     ----------
-    name : str
-        File stem, e.g. ``'fig7a'``.
-    description : str
-        One line saying what the figure shows.
+    name, description : str
+        File stem (``'fig7a'``) and one line saying what the figure shows.
     data : callable
-        ``data() -> xarray.Dataset``, built through the cached map functions. Recipes that
-        share a ``data`` function share its Dataset (see :func:`make_figures`).
-    draw : str
-        The drawing function, ``draw(dataset, **options) -> matplotlib.figure.Figure``, by
-        its name in the module ``module`` of :mod:`ecofmaps.figures` (imported when a figure
-        is made).
-    selection : dict
-        Coordinate values picked from the Dataset with ``.sel`` before drawing.
-    options : dict
-        Keyword arguments of ``draw``: the figure's number, the points it marks.
-    module : str
-        The module of :mod:`ecofmaps.figures` that holds ``draw``.
+        ``data() -> xarray.Dataset`` through the cache; recipes that share it share the Dataset.
+    draw, module : str
+        The drawing function ``draw(dataset, **options) -> Figure`` by its name, and the
+        module of :mod:`ecofmaps.figures` that holds it (imported when a figure is made).
+    selection, options : dict
+        Coordinates picked with ``.sel`` before drawing; keyword arguments of ``draw``.
     cost : float
-        Rough time to build the Dataset from an empty cache and draw the figure, relative
-        to a plain figure: the costliest work is started first when figures are drawn in
-        parallel (:func:`figure_groups`). [1]
+        Rough time of Dataset and figure from an empty cache, relative to a plain figure:
+        the costliest is started first (:func:`figure_groups`). [1]
     parts : tuple of callable
-        Functions that compute and cache independent parts of the Dataset, which ``data``
-        then reads from the cache: ``ecofmaps figures`` runs them in parallel first
-        (:func:`figure_parts`).
+        Each computes and caches a part of the Dataset that ``data`` reads; run in parallel
+        first (:func:`figure_parts`).
     """
 
     name: str
@@ -103,7 +91,7 @@ class FigureRecipe:
 
 def _loops() -> xr.Dataset:
     """The loops of Figures 5 and 6: rigid and 35 MN/m rigs, z_o/x_o = 0, 0.1, 0.2, 0.3."""
-    # Imported here, like the map functions below: the registry reads without JAX.
+    # Imported here, as every map function below: the registry reads without JAX.
     from ecofmaps.maps.cache import cached_dataset
     from ecofmaps.maps.grid import compute_loops
 
@@ -118,7 +106,7 @@ def _loops() -> xr.Dataset:
 
 
 def _stiffness_curves_data() -> xr.Dataset:
-    from ecofmaps.maps.grid import compute_map  # JAX: the registry reads without it
+    from ecofmaps.maps.grid import compute_map
 
     return compute_map(
         stiffness_ratio=np.array(paper.FIGURE_7_STIFFNESSES) / paper.LOAD,
@@ -133,7 +121,7 @@ def _ecof_ratio_map(panel: str) -> Callable[[], xr.Dataset]:
     amplitude = paper.FIGURE_11_AMPLITUDES[panel]
 
     def data() -> xr.Dataset:
-        from ecofmaps.maps.grid import compute_map  # JAX: the registry reads without it
+        from ecofmaps.maps.grid import compute_map
 
         return compute_map(paper.FIGURE_11_STIFFNESS_RATIOS, ASPECT_RATIOS, amplitude, paper.MU)
 
@@ -142,7 +130,7 @@ def _ecof_ratio_map(panel: str) -> Callable[[], xr.Dataset]:
 
 
 def _universal_map() -> xr.Dataset:
-    from ecofmaps.maps.grid import compute_universal_map  # JAX: the registry reads without it
+    from ecofmaps.maps.grid import compute_universal_map
 
     return compute_universal_map(COMPLIANCE_RATIOS, ASPECT_RATIOS, paper.MU)
 
@@ -175,7 +163,6 @@ def source_digest(patterns) -> np.ndarray:
 
 def _cached_shapes_part(function: str, compute: Callable[[], xr.Dataset]) -> xr.Dataset:
     """``compute()`` through the disk cache, keyed by the model's revision and the sources."""
-    # Imported here, like the map functions: the registry reads without JAX.
     from ecofmaps.maps.cache import cached_dataset
 
     return cached_dataset(function, {"sources": source_digest(_SCAR_SHAPES_SOURCES)}, compute)
@@ -190,8 +177,6 @@ def _scar_shape_parabola() -> xr.Dataset:
 
 
 def _scar_shapes() -> xr.Dataset:
-    """The ``shapes`` figure's Dataset, from the disk cache when there (see
-    :func:`scar_shapes_dataset`)."""
     return _cached_shapes_part("scar_shapes", scar_shapes_dataset)
 
 
@@ -217,9 +202,7 @@ def _labelled(variables: dict, coords: dict) -> xr.Dataset:
 
 
 #: The rig of the ``shapes`` figure's loops: Example 2's.
-_SHAPES_RIG = dict(
-    amplitude=paper.AMPLITUDE, load=paper.LOAD, stiffness=paper.STIFFNESS, mu=paper.MU
-)
+_SHAPES_RIG = {name: value for name, value in paper.EXAMPLE_2.items() if name != "aspect_ratio"}
 #: Figure 11's S/P with Example 2's among them: its steady values come from the same map. [1/m]
 _SHAPES_STIFFNESS_RATIOS = np.union1d(
     paper.FIGURE_11_STIFFNESS_RATIOS, [paper.STIFFNESS / paper.LOAD]
@@ -229,33 +212,23 @@ _SHAPES_COORDS = {"shape": list(SCAR_SHAPES), "groove": ["profile", "parabola"]}
 
 def scar_shape_model_dataset() -> xr.Dataset:
     """The model on each scar family: steady values over S/P and the loop of Example 2's rig."""
-    from ecofmaps.model.on_profile import (  # JAX: as compute_map
-        steady_numbers_and_loops,
-        steady_values,
-    )
+    from ecofmaps.model.on_profile import steady_numbers_and_loops, steady_values
 
     ratios = _SHAPES_STIFFNESS_RATIOS
     at_example = int(np.searchsorted(ratios, paper.STIFFNESS / paper.LOAD))
     rig = dict(amplitude=paper.AMPLITUDE, load=paper.LOAD, mu=paper.MU)
     names = ("slip_amplitude", "dissipated_energy", "ecof", "ecof_ratio")
-    values = {name: [] for name in (*names, "displacement", "force")}
+    loop = ("displacement", "force")
+    values = {name: [] for name in (*names, *loop)}
     for profile in _scar_profiles().values():
-        numbers = {
-            name: np.asarray(value)
-            for name, value in steady_numbers_and_loops(
-                profile, **rig, stiffness=ratios * paper.LOAD
-            ).items()
-        }
+        steady = steady_numbers_and_loops(profile, **rig, stiffness=ratios * paper.LOAD)
+        numbers = {name: np.asarray(value) for name, value in steady.items()}
         numbers |= steady_values(numbers, paper.AMPLITUDE, paper.LOAD, paper.MU)  # as maps
-        for name in names:
-            values[name].append(numbers[name])
-        for name in ("displacement", "force"):
-            values[name].append(numbers[name][at_example])
+        for name in values:
+            values[name].append(numbers[name][at_example] if name in loop else numbers[name])
     variables = {
-        **{name: (("shape", "stiffness_ratio"), np.array(values[name])) for name in names},
-        **{
-            name: (("shape", "point"), np.array(values[name])) for name in ("displacement", "force")
-        },
+        name: (("shape", "point" if name in loop else "stiffness_ratio"), np.array(value))
+        for name, value in values.items()
     }
     return _labelled(variables, {"shape": _SHAPES_COORDS["shape"], "stiffness_ratio": ratios})
 
@@ -473,9 +446,8 @@ def make_figures(names=None) -> Iterator[tuple[str, Figure]]:
 def figure_groups(names=None) -> list[list[str]]:
     """The figures by the Dataset they share, the costliest group first.
 
-    Each group is drawn by one process when figures are drawn in parallel (``ecofmaps
-    figures --jobs``), so its Dataset is built once; starting with the costliest
-    (:attr:`FigureRecipe.cost`) keeps the others' work for the processes that finish first.
+    One process draws each group (``ecofmaps figures --jobs``), building its Dataset once;
+    the costliest first (:attr:`FigureRecipe.cost`), the others for whoever finishes first.
 
     Parameters
     ----------
