@@ -218,8 +218,7 @@ class Runner:
         Yields
         ------
         result
-            Each call's result, in the order of ``tasks``, as soon as it and every earlier
-            one are done.
+            Each call's result in the order of ``tasks``, once it and the earlier ones are done.
         """
         if self._pool is None and self._client is None:
             raise RuntimeError("a Runner is used within a with block")

@@ -117,12 +117,9 @@ def measured_loops(
     -------
     figure : matplotlib.figure.Figure
         One panel per cycle: the centred loop, :math:`Q` [N] against :math:`\Delta` [µm],
-        the line :math:`Q = S\Delta` with the cycle's stiffness, the crossings whose
-        :math:`Q/P` is the GICoF (the paper's eq. 17-18) and, with ``resolved``, the band
-        :math:`\xi_{min} \le \Delta - Q/S \le \xi_{max}` where both branches were read.
-        Titles give the GICoF and ECoF (a dash for NaN) and the flags of a cycle whose
-        ``quality`` is not ``'ok'`` (the first and how many more when too long). One
-        legend, below the panels, lists what is drawn.
+        the line :math:`Q = S\Delta`, the crossings whose :math:`Q/P` is the GICoF (the
+        paper's eq. 17-18) and, with ``resolved``, the band of :math:`\Delta - Q/S` where
+        both branches were read; titled by the GICoF, ECoF and flags of the cycle.
     """
     if "loop_displacement" not in results:
         raise ValueError("results hold no loops: call analyze_loops(..., keep_loops=True)")
@@ -222,11 +219,9 @@ def cof_evolution(results: xr.Dataset, *, source: str | None = None) -> Figure:
     Returns
     -------
     figure : matplotlib.figure.Figure
-        Top: :math:`\mu_E` (eq. 1) and the GICoF against the cycle number.
-        Bottom: how far the ECoF is above the GICoF, :math:`\mu_E/\text{GICoF} - 1` [%].
-        The cycle axis spans the test with integer ticks; a panel with nothing to draw
-        says why (every cycle flagged, with the count of each reason, or none in gross
-        slip) and has no ticks on its value axis.
+        Top: :math:`\mu_E` (eq. 1) and the GICoF against the cycle number. Bottom: how far
+        the ECoF is above the GICoF, :math:`\mu_E/\text{GICoF} - 1` [%]. A panel with
+        nothing to draw says why (the count of each flag, or no cycle in gross slip).
 
     Notes
     -----
@@ -357,10 +352,8 @@ def resolved_loops(
         :math:`k\xi^2/2` dotted; (c) :math:`h` over (position, cycle), the groove deepening
         as the test runs; (d) ``mu_resolved`` :math:`\pm 2` standard errors over the cycles
         (with the ECoF and GICoF when ``results`` is given) and the equivalent
-        ``aspect_ratio`` on a right-hand axis where a cycle has one; cycles with no
-        resolved value marked along the bottom with their quality (halfway up when nothing
-        has a value). A single cycle is a band in (c) and an error bar in (d); a panel with
-        nothing to draw says why and has no ticks on its value axes.
+        ``aspect_ratio`` on a right-hand axis, cycles with no resolved value marked along
+        the bottom with their quality. A panel with nothing to draw says why.
 
     Notes
     -----

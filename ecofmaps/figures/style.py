@@ -52,7 +52,6 @@ def ecof_ratio_colors() -> tuple:
 
 #: Size of a one-panel figure. [inch]
 FIGSIZE = (6.4, 4.6)
-
 #: Factors from SI to the units the figures speak.
 MICRO = QUANTITIES["displacement"].display_factor  # m -> µm
 MEGA = QUANTITIES["stiffness"].display_factor  # N/m -> MN/m
@@ -204,10 +203,8 @@ _METADATA = {"pdf": {"CreationDate": None}, "svg": {"Date": None}}
 
 
 def save_figure(figure: Figure, path, dpi: int = PAPER_DPI) -> Path:
-    """Write ``figure`` to ``path`` atomically; the format follows the file's suffix.
-
-    The figure is written to a temporary file in the same directory and renamed over
-    ``path``, so an existing file is never left half written.
+    """Write ``figure`` to ``path`` atomically (a temporary file renamed over it, so a file is
+    never left half written); the format follows the file's suffix.
 
     Parameters
     ----------
