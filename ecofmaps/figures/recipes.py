@@ -207,6 +207,7 @@ _SHAPES_RIG = {name: value for name, value in paper.EXAMPLE_2.items() if name !=
 _SHAPES_STIFFNESS_RATIOS = np.union1d(
     paper.FIGURE_11_STIFFNESS_RATIOS, [paper.STIFFNESS / paper.LOAD]
 )
+_AT_EXAMPLE = int(np.searchsorted(_SHAPES_STIFFNESS_RATIOS, paper.STIFFNESS / paper.LOAD))
 _SHAPES_COORDS = {"shape": list(SCAR_SHAPES), "groove": ["profile", "parabola"]}
 
 
@@ -215,7 +216,6 @@ def scar_shape_model_dataset() -> xr.Dataset:
     from ecofmaps.model.on_profile import steady_numbers_and_loops, steady_values
 
     ratios = _SHAPES_STIFFNESS_RATIOS
-    at_example = int(np.searchsorted(ratios, paper.STIFFNESS / paper.LOAD))
     rig = dict(amplitude=paper.AMPLITUDE, load=paper.LOAD, mu=paper.MU)
     names = ("slip_amplitude", "dissipated_energy", "ecof", "ecof_ratio")
     loop = ("displacement", "force")
@@ -225,7 +225,7 @@ def scar_shape_model_dataset() -> xr.Dataset:
         numbers = {name: np.asarray(value) for name, value in steady.items()}
         numbers |= steady_values(numbers, paper.AMPLITUDE, paper.LOAD, paper.MU)  # as maps
         for name in values:
-            values[name].append(numbers[name][at_example] if name in loop else numbers[name])
+            values[name].append(numbers[name][_AT_EXAMPLE] if name in loop else numbers[name])
     variables = {
         name: (("shape", "point" if name in loop else "stiffness_ratio"), np.array(value))
         for name, value in values.items()
@@ -236,7 +236,7 @@ def scar_shape_model_dataset() -> xr.Dataset:
 def scar_shape_parabola_dataset() -> xr.Dataset:
     """The parabola of Example 2's D/W (steady values over S/P, the loop of Example 2's rig)
     and the heights of the scar families."""
-    from ecofmaps.maps.grid import compute_map  # JAX: the registry reads without it
+    from ecofmaps.maps.grid import compute_map
 
     ratios = _SHAPES_STIFFNESS_RATIOS
     position = np.linspace(-1.6, 1.6, 321) * paper.AMPLITUDE
@@ -264,7 +264,6 @@ def scar_shapes_dataset() -> xr.Dataset:
     """The four scar families at Example 2's D/W: profiles, loops, μ_E/μ over S/P (Fig. 11's)."""
     model, parabola = _scar_shape_model(), _scar_shape_parabola()
     ratios = _SHAPES_STIFFNESS_RATIOS
-    at_example = int(np.searchsorted(ratios, paper.STIFFNESS / paper.LOAD))
     errors = []
     for ratio in model["ecof_ratio"].values:
         # μ from the profile's μ_E corrected with the parabola of the same D/W (eq. 11)
@@ -285,7 +284,7 @@ def scar_shapes_dataset() -> xr.Dataset:
         "scar_height": (("shape", "scar_position"), parabola["scar_height"].values),
         "displacement": ((*groove, "point"), by_groove("displacement")),
         "force": ((*groove, "point"), by_groove("force")),
-        **{name: (groove, by_groove(name, at_example)) for name in steady},
+        **{name: (groove, by_groove(name, _AT_EXAMPLE)) for name in steady},
         "ecof_ratio": ((*groove, "stiffness_ratio"), by_groove("ecof_ratio")),
         "shortcut_error": (("shape", "stiffness_ratio"), np.array(errors)),
     }
