@@ -227,8 +227,8 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     if not gross.size:
         raise ValueError("results: no cycle with an energy ratio (every cycle refused)")
     if gross.all() or not gross.any():
-        both = ("gross", "above", "smaller") if gross.any() else ("partial", "at most", "larger")
-        regime, bound, other = both
+        words = ("gross", "above", "smaller") if gross.any() else ("partial", "at most", "larger")
+        regime, bound, other = words
         raise ValueError(
             f"results never cross the transition: every cycle is in {regime} slip (energy "
             f"ratio {bound} {MINDLIN_ENERGY_RATIO}, amplitudes {amplitude.min() * 1e6:.4g} to "
