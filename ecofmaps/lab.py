@@ -115,13 +115,10 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
 
     References
     ----------
-    S. Fouvry, P. Kapsa, L. Vincent (1995), Analysis of sliding behaviour for fretting
-    loadings: determination of transition criteria, Wear 185, 35-46.
-    L. Vincent, Y. Berthier, M. Godet (1992), Testing methods in fretting fatigue: a critical
-    appraisal, ASTM STP 1159, 33-48.
-    Z.R. Zhou, L. Vincent (1995), Mixed fretting regime, Wear 181-183, 531-536.
-    R.D. Mindlin, H. Deresiewicz (1953), Elastic spheres in contact under varying oblique
-    forces, J. Appl. Mech. 20, 327-344.
+    S. Fouvry, P. Kapsa, L. Vincent (1995), Wear 185, 35-46; L. Vincent, Y. Berthier,
+    M. Godet (1992), ASTM STP 1159, 33-48; Z.R. Zhou, L. Vincent (1995), Wear 181-183,
+    531-536; R.D. Mindlin, H. Deresiewicz (1953), J. Appl. Mech. 20, 327-344 (titles in
+    docs/lab.md).
 
     Examples
     --------
@@ -389,12 +386,9 @@ def energy_wear(results, profile, length) -> xr.Dataset:
 
     References
     ----------
-    S. Fouvry, P. Kapsa, L. Vincent (1996), Quantification of fretting damage, Wear 200,
-    186-205.
-    S. Fouvry, T. Liskiewicz, P. Kapsa, S. Hannel, E. Sauger (2003), An energy description
-    of wear mechanisms and its applications to oscillating sliding contacts, Wear 255,
-    287-298.
-    J.F. Archard (1953), Contact and rubbing of flat surfaces, J. Appl. Phys. 24, 981-988.
+    S. Fouvry, P. Kapsa, L. Vincent (1996), Wear 200, 186-205; S. Fouvry, T. Liskiewicz,
+    P. Kapsa, S. Hannel, E. Sauger (2003), Wear 255, 287-298; J.F. Archard (1953), J. Appl.
+    Phys. 24, 981-988 (titles in docs/lab.md).
 
     Examples
     --------
@@ -512,10 +506,8 @@ def loop_scar_closure(results, resolved, profile, rig_stiffness=None) -> xr.Data
     ------
     ValueError
         For results without kept loops or a GICoF, a ``resolved`` that is not a reading
-        along the stroke, no cycle with both, a profile without a scar or in other units
-        than the loops (a half-width not within 0.1 to 10⁴ slip amplitudes, or a trace
-        that does not span the slip), or a ``rig_stiffness`` below half the loops' stick
-        slope (the rig and the contact in series are softer than the rig).
+        along the stroke, no cycle with both, a profile without a scar or not in the loops'
+        units (metres), or a ``rig_stiffness`` below half the loops' stick slope.
 
     Notes
     -----

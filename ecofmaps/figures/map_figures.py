@@ -22,7 +22,7 @@ from ecofmaps.figures.style import (
     PER_MM,
     axis_label,
     ecof_ratio_colors,
-    parameters,
+    parameters_of,
     scalar,
     stiffness_label,
 )
@@ -88,7 +88,6 @@ def ecof_ratio_contours(
     """
     figure = Figure(figsize=FIGSIZE, layout="constrained")
     ax = figure.add_subplot()
-    amplitude = scalar(dataset, "amplitude")
     x = dataset["stiffness_ratio"].values * PER_MM
     handles = _ecof_ratio_contours(ax, x, dataset["ecof_ratio"], dataset["regime"])
     ax.set_xlabel(axis_label("stiffness_ratio"))
@@ -99,14 +98,9 @@ def ecof_ratio_contours(
             point["stiffness"] / point["load"] * PER_MM, point["aspect_ratio"], "o", **dot
         )
     ax.legend(handles=handles, loc="lower right", fontsize="small", framealpha=0.9)
-    ax.set_title(
-        rf"Fig. {number}  $\mu_E/\mu$ over rig stiffness and groove shape"
-        + "\n"
-        + parameters(
-            rf"$x_o = \Delta^*$ = {amplitude * MICRO:g} µm", rf"$\mu$ = {scalar(dataset, 'mu'):g}"
-        ),
-        fontsize="medium",
-    )
+    rig = parameters_of(dataset, "amplitude", "mu")
+    title = rf"Fig. {number}  $\mu_E/\mu$ over rig stiffness and groove shape" + "\n" + rig
+    ax.set_title(title, fontsize="medium")
     return figure
 
 

@@ -18,7 +18,7 @@ from ecofmaps.figures.style import (
     MILLI,
     axis_label,
     force_ratio_axis,
-    parameters,
+    parameters_of,
     scalar,
     stiffness_colors,
     stiffness_label,
@@ -67,15 +67,9 @@ def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
         style = styles[bool(np.isinf(stiffness))]
         ax.plot(loop.displacement * MICRO, loop.force, color=color, label=label, **style)
     _loop_axes(ax, loops)
+    rig = parameters_of(loops, "amplitude", "load", "aspect_ratio", "mu")
     ax.set_title(
-        "Fig. 5  Fretting loop: rigid rig against a compliant one\n"
-        + parameters(
-            rf"$x_o = \Delta^*$ = {scalar(loops, 'amplitude') * MICRO:g} µm",
-            f"P = {scalar(loops, 'load'):g} N",
-            rf"$z_o/x_o$ = {scalar(loops, 'aspect_ratio'):g}",
-            rf"$\mu$ = {scalar(loops, 'mu'):g}",
-        ),
-        fontsize="medium",
+        f"Fig. 5  Fretting loop: rigid rig against a compliant one\n{rig}", fontsize="medium"
     )
     ax.legend(loc="upper left", fontsize="small")
     return figure
@@ -127,16 +121,8 @@ def loops_by_aspect_ratio(loops: xr.Dataset) -> Figure:
     dots = dict(color="crimson", markersize=8, zorder=5, label=label)
     ax.plot(crossings / stiffness * MICRO, crossings, "o", **dots)
     _loop_axes(ax, loops)
-    ax.set_title(
-        "Fig. 6  Loops for several groove aspect ratios\n"
-        + parameters(
-            rf"$x_o = \Delta^*$ = {scalar(loops, 'amplitude') * MICRO:g} µm",
-            f"P = {load:g} N",
-            stiffness_label(stiffness),
-            rf"$\mu$ = {mu:g}",
-        ),
-        fontsize="medium",
-    )
+    rig = parameters_of(loops, "amplitude", "load", "stiffness", "mu")
+    ax.set_title(f"Fig. 6  Loops for several groove aspect ratios\n{rig}", fontsize="medium")
     figure.legend(loc="outside lower center", fontsize="small", ncols=2)
     return figure
 
@@ -155,15 +141,8 @@ def _stiffness_curves(dataset: xr.Dataset, variable: str, scale: float, number: 
     ax.set(xlabel=axis_label("aspect_ratio"), ylabel=axis_label(variable))
     ax.set_xlim(float(dataset["aspect_ratio"].min()), float(dataset["aspect_ratio"].max()))
     ax.grid(alpha=0.3)
-    ax.set_title(
-        f"Fig. {number}\n"
-        + parameters(
-            rf"$x_o = \Delta^*$ = {scalar(dataset, 'amplitude') * MICRO:g} µm",
-            f"P = {load:g} N",
-            rf"$\mu$ = {scalar(dataset, 'mu'):g}",
-        ),
-        fontsize="medium",
-    )
+    rig = parameters_of(dataset, "amplitude", "load", "mu")
+    ax.set_title(f"Fig. {number}\n{rig}", fontsize="medium")
     return figure
 
 

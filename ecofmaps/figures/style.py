@@ -130,6 +130,28 @@ def parameters(*items: str) -> str:
     return ",  ".join(items)
 
 
+#: The paper's parameters in a subtitle: text, and the factor to its unit.
+_PARAMETERS = {
+    "amplitude": (r"$x_o = \Delta^*$ = {:g} µm", MICRO),
+    "load": ("P = {:g} N", 1.0),
+    "aspect_ratio": (r"$z_o/x_o$ = {:g}", 1.0),
+    "mu": (r"$\mu$ = {:g}", 1.0),
+}
+
+
+def parameters_of(dataset: xr.Dataset, *names: str) -> str:
+    """:func:`parameters` of the scalars ``names`` of ``dataset``, the rig by its stiffness."""
+    texts = []
+    for name in names:
+        value = scalar(dataset, name)
+        if name == "stiffness":
+            texts.append(stiffness_label(value))
+        else:
+            text, factor = _PARAMETERS[name]
+            texts.append(text.format(value * factor))
+    return parameters(*texts)
+
+
 def force_ratio_axis(ax, load: float) -> None:
     """A right-hand axis reading the force axis [N] as :math:`Q/P`."""
     secondary = ax.secondary_yaxis("right", functions=(lambda q: q / load, lambda r: r * load))
