@@ -1,12 +1,7 @@
-"""Figures (needs matplotlib): the paper's, drawn from Datasets, and those of measured loops.
-
-The model's loops and curves (:mod:`~ecofmaps.figures.model_figures`), its maps
-(:mod:`~ecofmaps.figures.map_figures`), measured loops (:mod:`~ecofmaps.figures.measured_figures`),
-scar profiles (:mod:`~ecofmaps.figures.profile_figures`), a campaign's running-condition map
-and a test's loop-scar closure (:mod:`~ecofmaps.figures.lab_figures`), the set
-``ecofmaps figures`` writes (:mod:`~ecofmaps.figures.recipes`) and their shared look
-(:mod:`~ecofmaps.figures.style`).
-The names are imported on first use: the registry of figures reads without matplotlib.
+"""Figures (needs matplotlib): the paper's, drawn from Datasets, and those of measured loops,
+scar profiles and a lab's numbers, one module each; ``ecofmaps figures`` writes the set of
+:mod:`~ecofmaps.figures.recipes`. Names are imported on first use: the registry of figures
+reads without matplotlib.
 """
 
 from ecofmaps._lazy import lazy_names
