@@ -1,10 +1,8 @@
 """ecofmaps: friction from fretting loops, corrected for rig compliance and wear-scar shape.
 
-The public API in SI units (m, N, N/m, J), or pint Quantities. See the README for an
-overview and the paper this package implements (:mod:`ecofmaps.paper`).
-
-The names below are imported on first use, so ``import ecofmaps`` is quick and the command
-line starts (and answers Ctrl-C) before JAX, xarray or matplotlib are loaded.
+The public API in SI units (m, N, N/m, J), or pint Quantities: the README, and the paper it
+implements (:mod:`ecofmaps.paper`). Names are imported on first use, so the command line starts
+(and answers Ctrl-C) before JAX, xarray or matplotlib are loaded.
 """
 
 from ecofmaps._lazy import lazy_names

@@ -1,7 +1,5 @@
-"""Integer codes that carry their own words: the regimes and statuses results hold per point.
-
-Maps and arrays store the integer; the member knows its ``label`` (how tables and the
-command line print it) and its ``reason`` (why a value is NaN there).
+"""Integer codes that carry their own words: the regimes and statuses results hold per point,
+stored as integers, each knowing its ``label`` (as printed) and ``reason`` (why a value is NaN).
 """
 
 from __future__ import annotations
