@@ -98,21 +98,20 @@ class Runner:
     Parameters
     ----------
     workers : int, optional
-        With ``scheduler=None`` and ``cluster=False``: threads (default ``os.cpu_count()``).
-        With ``cluster=True``: worker processes of a new ``LocalCluster``.
+        Threads (default ``os.cpu_count()``), or with ``cluster=True`` the worker processes
+        (one thread each) of a new ``LocalCluster``.
     scheduler : str, optional
         Address of an existing dask scheduler (``tcp://host:8786``).
     cluster : bool
-        Start a ``LocalCluster`` of ``workers`` processes (one thread each).
+        Start a ``LocalCluster``.
     client : distributed.Client, optional
         A client of a cluster already connected (left open).
     timeout : float, optional
-        Seconds to wait for the scheduler at ``scheduler`` to answer (default
-        :data:`CONNECT_TIMEOUT`).
+        Seconds to wait for ``scheduler`` to answer (default :data:`CONNECT_TIMEOUT`).
 
     Notes
     -----
-    Use as a context manager: the cluster or thread pool is closed on leaving it.
+    A context manager: the cluster or thread pool is closed on leaving it.
     """
 
     def __init__(self, workers=None, *, scheduler=None, cluster=False, client=None, timeout=None):

@@ -487,9 +487,8 @@ def figure_parts(names=None) -> list[list[Callable[[], xr.Dataset]]]:
     Returns
     -------
     parts : list of list of callable
-        One list per group of :func:`figure_groups` (in its order, empty for most): each
-        callable computes one part and stores it in the cache, where the group's Dataset
-        reads it.
+        One list per group of :func:`figure_groups`, in its order (empty for most): each
+        computes one part into the cache, where the group's Dataset reads it.
 
     Raises
     ------
