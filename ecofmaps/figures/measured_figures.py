@@ -24,7 +24,7 @@ from ecofmaps.figures.style import (
     legend_clear_of_data,
     parameters,
     scalar,
-    stiffness_text,
+    stiffness_label,
     zero_lines,
 )
 from ecofmaps.measured.quality import SEPARATOR
@@ -36,11 +36,6 @@ __all__ = ["cof_evolution", "measured_and_fitted_loops", "measured_loops", "reso
 def _title(what: str, source: str | None) -> str:
     """A figure's title: the recording's name ``source``, when given, and ``what`` it shows."""
     return f"{source}: {what}" if source else what[:1].upper() + what[1:]
-
-
-def _stiffness(stiffness: float) -> str:
-    """A rig stiffness [N/m] for a title, its symbol italic: ``'$S$ = 35 MN/m'``."""
-    return r"rigid ($S = \infty$)" if np.isinf(stiffness) else f"$S$ = {stiffness_text(stiffness)}"
 
 
 def _load(load: float) -> str:
@@ -149,7 +144,7 @@ def measured_loops(
         reading = reading if regime == GROSS_SLIP else "no GICoF or ECoF"
         quality = str(cycle["quality"].values) if "quality" in cycle else "ok"
         flags = "" if quality == "ok" else "\nflagged: " + _flags_text(quality)
-        title = f"cycle {label}: {reading}\n{_stiffness(stiffness)}, {regime.label}{flags}"
+        title = f"cycle {label}: {reading}\n{stiffness_label(stiffness)}, {regime.label}{flags}"
         ax.set_title(title, fontsize="small")
     for ax in axes.flat[len(chosen) :]:
         ax.set_visible(False)
@@ -308,7 +303,7 @@ def measured_and_fitted_loops(fits, *, source: str | None = None) -> Figure:
             "\n"
             + parameters(
                 rf"fit: $\mu$ = {fit.mu:.3f}",
-                _stiffness(fit.stiffness),
+                stiffness_label(fit.stiffness),
                 rf"$z_o$ = {fit.groove_depth * MICRO:.2f} µm",
                 f"RMS residual {fit.rms_residual:.2g} N",
             ),

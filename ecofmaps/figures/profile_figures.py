@@ -86,7 +86,7 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
     bottom_of_scar = level - depth * MICRO
     arrow = dict(arrowstyle="<->", color="crimson", linewidth=1.2)
     top.annotate("", xy=(0.0, bottom_of_scar), xytext=(0.0, level), arrowprops=arrow)
-    label = f"  D = {depth * MICRO:.4g} µm"
+    label = f"  $D$ = {depth * MICRO:.4g} µm"
     top.text(
         0.02 * width * MICRO,
         bottom_of_scar + 0.5 * depth * MICRO,
@@ -97,9 +97,9 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
     parabola = 2.0 * depth * position / width**2 + float(profile.reference_slope)
     inside = np.abs(position) <= width
     bowl = surface[inside] - depth * (1.0 - (position[inside] / width) ** 2)
-    top.plot(x[inside], bowl * MICRO, **_SHORTCUT, label="parabola of the same D/W")
+    top.plot(x[inside], bowl * MICRO, **_SHORTCUT, label="parabola of the same $D/W$")
     bottom.plot(x, slope, color="tab:blue", linewidth=1.6, label="slope the model uses")
-    label = f"parabola of the same D/W = {depth / width:.3g}"
+    label = f"parabola of the same $D/W$ = {depth / width:.3g}"
     bottom.plot(x[inside], parabola[inside], **_SHORTCUT, label=label)
     bottom.axhline(0.0, color="0.6", linewidth=0.6)
     for ax in (top, bottom):
@@ -120,9 +120,9 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
         title
         + "\n"
         + parameters(
-            f"D = {depth * MICRO:.4g} µm",
-            f"W = {width * MICRO:.4g} µm",
-            f"D/W = {depth / width:.3g}",
+            f"$D$ = {depth * MICRO:.4g} µm",
+            f"$W$ = {width * MICRO:.4g} µm",
+            f"$D/W$ = {depth / width:.3g}",
             f"{position.size} samples",
         ),
         fontsize="medium",
@@ -177,8 +177,8 @@ def scar_shape_comparison(dataset: xr.Dataset) -> Figure:
         "Scar shape at equal depth over half-width: how wrong the D/W shortcut is\n"
         + parameters(
             rf"$x_o = \Delta^*$ = {scalar(dataset, 'amplitude') * MICRO:g} µm",
-            f"W = {width * MICRO:g} µm, D = {depth * MICRO:g} µm",
-            f"P = {scalar(dataset, 'load'):g} N",
+            f"$W$ = {width * MICRO:g} µm, $D$ = {depth * MICRO:g} µm",
+            f"$P$ = {scalar(dataset, 'load'):g} N",
             f"{stiffness_label(scalar(dataset, 'stiffness'))} (loops)",
             rf"$\mu$ = {scalar(dataset, 'mu'):g}",
         ),
@@ -204,7 +204,7 @@ def _draw_scar_profiles(ax, dataset: xr.Dataset) -> None:
     for edge in (-width, width):
         ax.axvline(edge * MICRO, **_EDGE)
     ax.set(xlabel=axis_label("scar_position"), ylabel=axis_label("scar_height"))
-    ax.set_title(f"Scars of equal D/W = {depth / width:g}\n(edges ±W dotted)", fontsize="medium")
+    ax.set_title(f"Scars of equal $D/W$ = {depth / width:g}\n(edges ±W dotted)", fontsize="medium")
     ax.set_ylim(-1.25 * depth * MICRO, 2.1 * depth * MICRO)  # the legend above
     ax.legend(loc="upper center", fontsize="x-small", ncols=2)
     ax.grid(alpha=0.3)
@@ -219,7 +219,7 @@ def _draw_shape_loops(loop_axes, dataset: xr.Dataset) -> None:
         for groove, style in (("profile", own), ("parabola", dict(_SHORTCUT, zorder=3))):
             point = dataset.sel(shape=shape, groove=groove)
             label = (
-                f"{shape + ' scar' if groove == 'profile' else 'parabola, same D/W'}\n"
+                f"{shape + ' scar' if groove == 'profile' else 'parabola, same $D/W$'}\n"
                 rf"$\delta^*$ = {float(point['slip_amplitude']) * MICRO:.1f} µm, "
                 rf"$E_d$ = {float(point['dissipated_energy']) * MILLI:.1f} mJ, "
                 rf"$\mu_E$ = {float(point['ecof']):.3f}"
@@ -250,7 +250,7 @@ def _draw_ratio_and_error(ax_ratio, ax_error, dataset: xr.Dataset) -> None:
     ratios = dataset["stiffness_ratio"].values * PER_MM
     shortcut = dataset["ecof_ratio"].sel(shape="parabolic", groove="parabola")
     ax_ratio.plot(
-        ratios, shortcut, **_SHORTCUT, zorder=3, label=f"parabola, D/W = {depth / width:g}"
+        ratios, shortcut, **_SHORTCUT, zorder=3, label=f"parabola, $D/W$ = {depth / width:g}"
     )
     ax_error.axhline(0.0, **_SHORTCUT, zorder=3, label="no error (the parabola itself)")
     for shape in dataset["shape"].values:

@@ -37,7 +37,7 @@ ECOF_RATIO_LEVELS = (1.01, 1.02, 1.03, 1.04, 1.05, 1.06, 1.08, 1.10, 1.12, 1.14,
 HIGHLIGHT_LEVEL = 1.05
 
 #: Resolution of the paper's figures (``ecofmaps figures``) written as PNG. [1/inch]
-PAPER_DPI = 150
+PAPER_DPI = 300
 
 #: Resolution of the plots of a user's recording (``ecofmaps loops --plots``). [1/inch]
 RECORDING_DPI = 300
@@ -111,10 +111,10 @@ def stiffness_text(stiffness: float) -> str:
 
 
 def stiffness_label(stiffness: float) -> str:
-    """Legend text for a rig stiffness [N/m]: ``'S = 35 MN/m'``, or ``'rigid (S = ∞)'``."""
+    r"""Legend text for a rig stiffness [N/m]: ``'$S$ = 35 MN/m'``, ``'rigid ($S = \infty$)'``."""
     if np.isinf(stiffness):
         return r"rigid ($S = \infty$)"
-    return f"S = {stiffness_text(stiffness)}"
+    return f"$S$ = {stiffness_text(stiffness)}"
 
 
 def stiffness_colors(stiffnesses) -> list:
@@ -133,7 +133,7 @@ def parameters(*items: str) -> str:
 #: The paper's parameters in a subtitle: text, and the factor to its unit.
 _PARAMETERS = {
     "amplitude": (r"$x_o = \Delta^*$ = {:g} µm", MICRO),
-    "load": ("P = {:g} N", 1.0),
+    "load": ("$P$ = {:g} N", 1.0),
     "aspect_ratio": (r"$z_o/x_o$ = {:g}", 1.0),
     "mu": (r"$\mu$ = {:g}", 1.0),
 }

@@ -158,10 +158,10 @@ def test_a_soft_rig_is_labelled_in_its_own_digits(results):
 
 
 def test_figures_label_stiffness_with_the_shared_helper():
-    """Figure 5's legend and Figure 6's title: 35 MN/m, the rigid rig by name."""
+    """Figure 5's legend and Figure 6's title: 35 MN/m with S italic, the rigid rig by name."""
     recipe = figures.FIGURES["fig6"]
     figure = recipe.figure(recipe.data())
-    assert "S = 35 MN/m" in figure.axes[0].get_title()
+    assert "$S$ = 35 MN/m" in figure.axes[0].get_title()
     recipe = figures.FIGURES["fig5"]
     labels = [t.get_text() for t in recipe.figure(recipe.data()).axes[0].get_legend().get_texts()]
-    assert labels[0].startswith("rigid") and labels[1].startswith("S = 35 MN/m:")
+    assert labels[0].startswith("rigid") and labels[1].startswith("$S$ = 35 MN/m:")

@@ -459,8 +459,8 @@ def test_a_legend_with_no_free_corner_gets_room_above_the_data():
     assert ax.get_ylim()[1] > 1.2
 
 
-def test_recording_plots_are_written_at_300_dpi_and_the_papers_at_150(results, tmp_path):
-    """save_figure's default resolution is the paper figures'; a recording's plots ask for more."""
+def test_recording_plots_and_the_papers_are_written_at_300_dpi(results, tmp_path):
+    """save_figure's default is the paper figures' resolution; a recording's plots ask theirs."""
     from ecofmaps.figures.style import PAPER_DPI, RECORDING_DPI
 
     figure = cof_evolution(results)
@@ -468,5 +468,5 @@ def test_recording_plots_are_written_at_300_dpi_and_the_papers_at_150(results, t
     recording = save_figure(figure, tmp_path / "recording.png", dpi=RECORDING_DPI)
     width = {path: int.from_bytes(path.read_bytes()[16:20], "big") for path in (paper, recording)}
     inches = figure.get_size_inches()[0]
-    assert (PAPER_DPI, RECORDING_DPI) == (150, 300)
-    assert width[paper] == round(inches * 150) and width[recording] == round(inches * 300)
+    assert (PAPER_DPI, RECORDING_DPI) == (300, 300)
+    assert width[paper] == width[recording] == round(inches * 300)

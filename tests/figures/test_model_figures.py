@@ -155,9 +155,8 @@ def test_fig7_fig8_one_curve_per_rig(drawn, name, variable, scale, unit):
         expected = dataset[variable].isel(stiffness_ratio=index).values * scale
         np.testing.assert_array_equal(curve.get_ydata(), expected)
     legend = _stiffness_legend(ax)
-    assert legend[:5] == [
-        r"rigid ($S = \infty$)", "S = 100 MN/m", "S = 50 MN/m", "S = 35 MN/m", "S = 20 MN/m",
-    ]  # fmt: skip
+    rigs = ["$S$ = 100 MN/m", "$S$ = 50 MN/m", "$S$ = 35 MN/m", "$S$ = 20 MN/m"]
+    assert legend[:5] == [r"rigid ($S = \infty$)", *rigs]
 
 
 def test_fig7_statements_of_the_paper(drawn):

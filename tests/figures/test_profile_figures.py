@@ -45,11 +45,11 @@ def test_profile_figure_draws_heights_edges_and_slope(example):
     assert bottom.get_ylabel() == "Slope of the scar profile $g = dz/dX$ [1]"
     assert bottom.get_xlabel().startswith("Position across the scar $X$ [µm]")
     title = top.get_title()
-    assert "synthetic_scar_profile.csv" in title and "W = 500.4 µm" in title
-    assert f"D/W = {float(example.aspect_ratio):.3g}" in title
+    assert "synthetic_scar_profile.csv" in title and "$W$ = 500.4 µm" in title
+    assert f"$D/W$ = {float(example.aspect_ratio):.3g}" in title
     labels = [line.get_label() for line in _labelled(top)]
     assert labels[:3] == ["profile $z(X)$", "unworn surface (levelling line)",
-                          "parabola of the same D/W"]  # fmt: skip
+                          "parabola of the same $D/W$"]  # fmt: skip
     x_um = np.asarray(example.position) * 1e6
     profile_line, slope_line = _labelled(top)[0], _labelled(bottom)[0]
     np.testing.assert_allclose(profile_line.get_xdata(), x_um)
