@@ -17,7 +17,7 @@ from ecofmaps import model, paper
 from ecofmaps._inputs import check
 from ecofmaps._version import __version__
 
-__all__ = ["checked_axis", "checked_load", "grid_dataset"]
+__all__ = ["checked_axis", "checked_load", "compliance_values", "grid_dataset"]
 
 # The order of the variables in a Dataset (xarray orders the dimensions as they first appear).
 _VARIABLES = (
@@ -79,6 +79,16 @@ def checked_load(load) -> np.ndarray | None:
     if load.ndim:
         raise ValueError(f"load must be a single value, got shape {load.shape}")
     return load
+
+
+def compliance_values(axes: dict) -> tuple:
+    """λ = P/(SΔ*) = 1/((S/P)Δ*) over the axes ``stiffness_ratio`` and ``amplitude`` (eq. 16),
+    as ``(dims, values)`` for :func:`grid_dataset`."""
+    stiffness, amplitude = axes["stiffness_ratio"], axes["amplitude"]
+    lam = model.compliance_ratio(np.atleast_1d(amplitude), 1.0, np.atleast_1d(stiffness)[:, None])
+    scalars = tuple(i for i, axis in enumerate((stiffness, amplitude)) if axis.ndim == 0)
+    dims = tuple(n for n in ("stiffness_ratio", "amplitude") if axes[n].ndim == 1)
+    return dims, np.squeeze(lam, axis=scalars)
 
 
 def grid_dataset(axes: dict, values: dict, title: str, extra=None) -> xr.Dataset:

@@ -19,7 +19,7 @@ import xarray as xr
 from ecofmaps import model
 from ecofmaps._inputs import float64
 from ecofmaps.maps.cache import cached_dataset
-from ecofmaps.maps.dataset import checked_axis, checked_load, grid_dataset
+from ecofmaps.maps.dataset import checked_axis, checked_load, compliance_values, grid_dataset
 from ecofmaps.maps.on_profile import compute_profile_map
 from ecofmaps.maps.tiles import MAX_CHUNK, grid_values
 from ecofmaps.model.simulation import fretting_loop
@@ -30,11 +30,6 @@ __all__ = [
     "compute_map",
     "compute_universal_map",
 ]
-
-
-# ---------------------------------------------------------------------------------------
-# Kernels
-# ---------------------------------------------------------------------------------------
 
 
 def _mesh(*axes):
@@ -62,28 +57,26 @@ def _steady_state(mu, kappa, lam, amplitude=None, load=None) -> dict:
     return values
 
 
-def _broadcast(values: dict, shape) -> dict:
+def _broadcast(values: dict, axes) -> dict:
+    shape = jnp.broadcast_shapes(*(axis.shape for axis in axes))
     return {name: jnp.broadcast_to(value, shape) for name, value in values.items()}
 
 
 @jax.jit
 def _map_kernel(stiffness_ratio, aspect_ratio, amplitude, mu, load):
-    stiffness_ratio, aspect_ratio, amplitude, mu = _mesh(
-        stiffness_ratio, aspect_ratio, amplitude, mu
-    )
+    axes = _mesh(stiffness_ratio, aspect_ratio, amplitude, mu)
+    stiffness_ratio, aspect_ratio, amplitude, mu = axes
     kappa = model.curvature_number(1.0, aspect_ratio, 1.0)  # x_o = Δ*: κ = 2 z_o/x_o
     lam = model.compliance_ratio(amplitude, 1.0, stiffness_ratio)  # 1/((S/P) Δ*)
-    values = _steady_state(mu, kappa, lam, amplitude, load)
-    shape = jnp.broadcast_shapes(stiffness_ratio.shape, aspect_ratio.shape, amplitude.shape)
-    return _broadcast(values, jnp.broadcast_shapes(shape, mu.shape))
+    return _broadcast(_steady_state(mu, kappa, lam, amplitude, load), axes)
 
 
 @jax.jit
 def _universal_kernel(compliance_ratio, aspect_ratio, mu):
-    lam, aspect_ratio, mu = _mesh(compliance_ratio, aspect_ratio, mu)
+    axes = _mesh(compliance_ratio, aspect_ratio, mu)
+    lam, aspect_ratio, mu = axes
     kappa = model.curvature_number(1.0, aspect_ratio, 1.0)
-    values = _steady_state(mu, kappa, lam)
-    return _broadcast(values, (lam.size, aspect_ratio.size, mu.size))
+    return _broadcast(_steady_state(mu, kappa, lam), axes)
 
 
 def _check_cache(cache, chunks) -> None:
@@ -95,11 +88,6 @@ def _check_cache(cache, chunks) -> None:
             "cache=True with chunks: a chunked map is not cached (it is evaluated block by "
             "block where it is written); leave cache out"
         )
-
-
-# ---------------------------------------------------------------------------------------
-# Public functions
-# ---------------------------------------------------------------------------------------
 
 
 @float64
@@ -147,10 +135,8 @@ def compute_map(
         With a profile: :math:`X = xW/\Delta^*` (eq. 11) or :math:`X = x`.
     cache : bool, optional
         Read the result from the disk cache, and store it there after computing it.
-        Default: only a map on a profile, which is expensive to recompute; the closed
-        forms compute faster than the cache reads them back (docs/performance.md). A
-        chunked map is never cached (see Notes), so ``cache=True`` with ``chunks`` is an
-        error.
+        Default: only a map on a profile; a chunked map is never cached, so ``cache=True``
+        with ``chunks`` is an error (why: docs/performance.md, "The cache").
     cache_dir : str or os.PathLike, optional
         Cache directory; default ``$ECOFMAPS_CACHE`` or the per-user cache directory.
     max_chunk : int
@@ -191,16 +177,10 @@ def compute_map(
 
     Notes
     -----
-    The map depends on :math:`S`, :math:`P` and :math:`\Delta^*` only through
-    :math:`\lambda = P/(S\Delta^*)` (eq. 16): the Figure 11 maps at :math:`\Delta^* = 25` and
-    50 µm are one surface read on two scales of :math:`S/P`. Values come from the closed
-    forms of eq. 16 (slip amplitude), the corrected eq. 13-15 (:math:`\mu_E`), eq. 12
-    (:math:`E_d = 4P\delta^*\mu_E`) and eq. 9 (:math:`Q^*`).
-
-    A chunked map is not cached: it is meant for grids beyond memory, which the cache
-    would have to compute at once (and read back whole to verify its checksum); it would
-    double the disk space of the user's own store; and evaluating a block costs about as
-    much as reading it back from disk.
+    The closed forms of eq. 16 (slip amplitude), the corrected eq. 13-15 (:math:`\mu_E`),
+    eq. 12 (:math:`E_d = 4P\delta^*\mu_E`) and eq. 9 (:math:`Q^*`); through :math:`S`,
+    :math:`P` and :math:`\Delta^*` the map depends on :math:`\lambda` only
+    (:func:`compute_universal_map`).
 
     References
     ----------
@@ -263,14 +243,7 @@ def compute_map(
 
     def compute() -> xr.Dataset:
         values = grid_values(_map_kernel, axes, (load,), max_chunk, chunks)
-        # λ depends on S/P and Δ* only: a variable over those two (eq. 16).
-        stiffness, amplitude = axes["stiffness_ratio"], axes["amplitude"]
-        lam = model.compliance_ratio(
-            np.atleast_1d(amplitude), 1.0, np.atleast_1d(stiffness)[:, None]
-        )
-        scalars = tuple(i for i, axis in enumerate((stiffness, amplitude)) if axis.ndim == 0)
-        dims = tuple(n for n in ("stiffness_ratio", "amplitude") if axes[n].ndim == 1)
-        values["compliance_ratio"] = (dims, np.squeeze(lam, axis=scalars))
+        values["compliance_ratio"] = compliance_values(axes)
         extra = {} if load is None else {"load": load}
         return grid_dataset(axes, values, "ECoF map of the compliant wear-scar model", extra)
 
@@ -318,9 +291,9 @@ def compute_universal_map(
 
     Notes
     -----
-    With :math:`x_o = \Delta^*` the curvature number is :math:`\kappa = 2 z_o/x_o`, and
-    :math:`\mu_E/\mu` depends on :math:`(\mu, z_o/x_o, \lambda)` only (eq. 13-16): this one
-    chart holds both panels of Figure 11, whose axes :math:`S/P` map onto
+    With :math:`x_o = \Delta^*`, :math:`\kappa = 2 z_o/x_o` and :math:`\mu_E/\mu` depends on
+    :math:`(\mu, z_o/x_o, \lambda)` only (eq. 13-16): this one chart holds both panels of
+    Figure 11 (:math:`\Delta^* = 25` and 50 µm), whose axes :math:`S/P` map onto
     :math:`\lambda = 1/((S/P)\Delta^*)`.
 
     References
@@ -409,17 +382,9 @@ def compute_loops(stiffness, aspect_ratio, amplitude, load, mu, num=201) -> xr.D
         "mu": checked_axis("mu", mu, "positive", "1"),
     }
     grid = jnp.broadcast_arrays(*_mesh(*(np.atleast_1d(a) for a in axes.values())))
-    displacement, force = fretting_loop(
-        amplitude=grid[2],
-        load=grid[3],
-        stiffness=grid[0],
-        mu=grid[4],
-        aspect_ratio=grid[1],
-        num=num,
-    )
     values = jax.device_get(_loop_kernel(*grid))
-    values["displacement"] = displacement
-    values["force"] = force
+    loop = fretting_loop(grid[2], grid[3], grid[0], grid[4], grid[1], num=num)
+    values["displacement"], values["force"] = loop
     values = {name: np.asarray(value) for name, value in values.items()}
     point = np.arange(2 * num + 1)
     return grid_dataset(axes, values, "Steady fretting loops", extra={"point": point})

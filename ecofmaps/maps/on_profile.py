@@ -12,10 +12,9 @@ import math
 import numpy as np
 import xarray as xr
 
-from ecofmaps import model
 from ecofmaps._inputs import float64
 from ecofmaps.maps.cache import cached_dataset
-from ecofmaps.maps.dataset import checked_axis, checked_load, grid_dataset
+from ecofmaps.maps.dataset import checked_axis, checked_load, compliance_values, grid_dataset
 from ecofmaps.maps.tiles import MAX_CHUNK
 from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers, steady_values
 
@@ -132,13 +131,7 @@ def compute_profile_map(
         values = {name: flat[name].reshape(shape) for name in names}
         values.update(steady_values(values, grid[1][None, :, None], load, grid[2][None, None, :]))
         del values["normalized_energy"], values["normalized_max_force"]
-        stiffness, amplitude = axes["stiffness_ratio"], axes["amplitude"]
-        lam = model.compliance_ratio(
-            np.atleast_1d(amplitude), 1.0, np.atleast_1d(stiffness)[:, None]
-        )
-        scalars = tuple(i for i, axis in enumerate((stiffness, amplitude)) if axis.ndim == 0)
-        dims = tuple(n for n in ("stiffness_ratio", "amplitude") if axes[n].ndim == 1)
-        values["compliance_ratio"] = (dims, np.squeeze(lam, axis=scalars))
+        values["compliance_ratio"] = compliance_values(axes)
         extra = {} if load is None else {"load": load}
         dataset = grid_dataset(
             axes, values, "ECoF map of the compliant wear-scar model on a scar profile", extra
