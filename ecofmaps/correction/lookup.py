@@ -13,9 +13,9 @@ import math
 import numpy as np
 
 from ecofmaps._codes import warn_nan
-from ecofmaps._inputs import check, si_units
+from ecofmaps._inputs import si_units
 from ecofmaps.correction.inversion import groove_aspect_ratio
-from ecofmaps.correction.outcomes import CorrectionStatus
+from ecofmaps.correction.outcomes import CorrectionStatus, check_test
 
 __all__ = ["lookup_correction"]
 
@@ -125,13 +125,7 @@ def lookup_correction(
 
     if isinstance(aspect_ratio, tuple):
         raise ValueError("lookup_correction takes no aspect_ratio interval; use correct_ecof")
-    for name, value, rule, unit in (
-        ("ecof", ecof, "positive", "1"),
-        ("amplitude", amplitude, "positive", "m"),
-        ("load", load, "positive", "N"),
-        ("stiffness", stiffness, "positive_or_inf", "N/m"),
-    ):
-        check(name, value, rule, unit)
+    check_test(ecof, amplitude, load, stiffness)
     ratio = np.asarray(groove_aspect_ratio(aspect_ratio, scar_depth, scar_half_width))
     ecof, amplitude, load, stiffness, ratio = np.broadcast_arrays(
         *(np.asarray(v, dtype=np.float64) for v in (ecof, amplitude, load, stiffness)), ratio

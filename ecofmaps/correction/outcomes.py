@@ -15,7 +15,7 @@ import jax.numpy as jnp
 
 from ecofmaps import model
 from ecofmaps._codes import Code
-from ecofmaps._inputs import as_float64
+from ecofmaps._inputs import as_float64, check
 
 __all__ = [
     "AMBIGUOUS_ECOF_MIN",
@@ -23,6 +23,7 @@ __all__ = [
     "CorrectionStatus",
     "Interval",
     "ambiguity_marked",
+    "check_test",
     "ecof_and_slope",
     "ecof_fall",
     "ecof_fall_where_needed",
@@ -105,6 +106,14 @@ _FALL_KAPPA = 1.0
 _FALL_LAMBDA = 0.075  # a margin above LAMBDA_INFINITY
 _FALL_GRID = 256
 _FALL_BISECTIONS = 48
+
+
+def check_test(ecof, amplitude, load, stiffness) -> None:
+    """``ValueError`` for a concrete ECoF or test condition out of its range."""
+    check("ecof", ecof, "positive", "1")
+    check("amplitude", amplitude, "positive", "m")
+    check("load", load, "positive", "N")
+    check("stiffness", stiffness, "positive_or_inf", "N/m")
 
 
 def ecof_and_slope(mu, kappa, lam):

@@ -1,13 +1,9 @@
 """The disk cache of results that are expensive to recompute: netCDF files keyed by their inputs.
 
 A result is one netCDF file ``<function>-<key>.nc`` in :func:`cache_directory`, keyed by
-:func:`cache_key` (the package version, the model's revision, the function, the exact
-inputs). HDF5 guards its arrays: each is stored in chunks with a Fletcher-32 checksum,
-verified as it is read; :func:`metadata_checksum` guards the rest. An entry that fails
-either, or that cannot be read, is removed and recomputed; a write that fails for any reason
-is one :class:`CacheWarning`, and the result is returned all the same. The cache keeps under
-a size bound (:func:`cache_size_bound`) by removing the least recently used entries. What is
-cached, and what a write and a read cost against computing: docs/performance.md, "The cache".
+:func:`cache_key`, its arrays in Fletcher-32 checksummed chunks and the rest under
+:func:`metadata_checksum`. What is cached, how entries are checked, written and evicted, and
+what a write and a read cost against computing: docs/performance.md, "The cache".
 """
 
 from __future__ import annotations
@@ -59,7 +55,7 @@ SIZE_VARIABLE = "ECOFMAPS_CACHE_SIZE"
 #: The bound on the cache's total size when :data:`SIZE_VARIABLE` is not set. [byte]
 DEFAULT_SIZE_BOUND = 10**9
 
-# The global attributes that tie a cache file to its key and to its metadata; removed on reading.
+# Global attributes that tie a cache file to its key and its metadata; removed on reading.
 _KEY_ATTRIBUTE = "ecofmaps_cache_key"
 _CHECKSUM_ATTRIBUTE = "ecofmaps_metadata_sha256"
 # The sources, relative to the package, whose code decides what a cached map holds.
@@ -185,7 +181,6 @@ def model_revision() -> str:
 
 
 def _chunked(variable: xr.Variable) -> bool:
-    """Whether ``variable`` is stored in chunks that carry a Fletcher-32 checksum."""
     return variable.ndim > 0 and variable.size > 0 and variable.dtype.kind in _CHUNKED_KINDS
 
 
@@ -253,11 +248,8 @@ def cache_key(function: str, inputs: Mapping[str, object]) -> str:
 
 
 def write_netcdf(dataset: xr.Dataset, path, *, exclusive: bool = True) -> Path:
-    """Write ``dataset`` to ``path`` (engine h5netcdf) atomically.
-
-    The data go to a temporary file in the same directory, are flushed to disk, and the file
-    is then renamed onto ``path`` (``os.replace``). On any failure the temporary file is
-    removed and ``path`` is left as it was.
+    """Write ``dataset`` to ``path`` (engine h5netcdf) atomically: to a temporary file beside it,
+    flushed, then renamed onto it; on any failure ``path`` is left as it was.
 
     Parameters
     ----------
@@ -291,9 +283,7 @@ def _chunks(shape: tuple[int, ...], itemsize: int) -> tuple[int, ...]:
 
 
 def _file_image(dataset: xr.Dataset) -> bytes:
-    """The bytes of ``dataset``'s netCDF file, its arrays in checksummed chunks, the checksum
-    of the rest in a global attribute; built in memory, so no half-written file is ever
-    left to the garbage collector."""
+    """``dataset``'s checksummed netCDF file, built in memory (no half-written file is left)."""
     import h5netcdf
     import h5py
 
@@ -318,8 +308,7 @@ def _file_image(dataset: xr.Dataset) -> bytes:
 
 
 def _read(path: Path, key: str) -> xr.Dataset:
-    """The dataset stored under ``key`` at ``path``; ``ValueError`` if it holds another key
-    or its metadata were damaged (HDF5 raises if its arrays were)."""
+    """The dataset stored under ``key`` at ``path``; ``ValueError`` if foreign or damaged."""
     with xr.open_dataset(path, engine="h5netcdf") as stored:
         dataset = stored.load()
     if dataset.attrs.get(_KEY_ATTRIBUTE) != key:
@@ -334,9 +323,8 @@ def _read(path: Path, key: str) -> xr.Dataset:
 
 
 def _stored(path: Path, key: str) -> xr.Dataset | None:
-    """The dataset stored at ``path``, or None: if it is unusable, it is removed, with a
-    warning. HDF5's complaints about a damaged file are this warning, not lines on standard
-    error from finalizers of half-opened objects."""
+    """The dataset stored at ``path``, or None: an unusable one is removed, with one warning
+    (and no lines on standard error from finalizers of half-opened HDF5 objects)."""
     hook = sys.unraisablehook
     sys.unraisablehook = _ignored
     try:
@@ -355,11 +343,11 @@ def _stored(path: Path, key: str) -> xr.Dataset | None:
 
 
 def _ignored(unraisable) -> None:
-    """An exception raised where it cannot be (a finalizer): ignored."""
+    """An exception raised in a finalizer: ignored."""
 
 
 def _used(path: Path) -> None:
-    """Mark ``path`` as used now (its access time), for the least-recently-used order."""
+    """Set ``path``'s access time to now, for the least-recently-used order."""
     os.utime(path, ns=(time.time_ns(), path.stat().st_mtime_ns))
 
 
@@ -372,8 +360,7 @@ def _reason(error: BaseException) -> str:
 
 
 def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
-    """Store ``dataset`` at ``path`` if it fits in ``bound`` [byte], then keep the cache
-    within it."""
+    """Store ``dataset`` at ``path`` if it fits in ``bound`` [byte]; keep the cache within it."""
     if dataset.nbytes > bound:
         return
     image = _file_image(dataset.assign_attrs({_KEY_ATTRIBUTE: key}))
@@ -386,8 +373,7 @@ def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
 
 
 def _evict(directory: Path, bound: int, keep: Path) -> None:
-    """Remove the least recently used entries of ``directory`` (not ``keep``) until the
-    entries take at most ``bound`` bytes."""
+    """Remove least recently used entries but ``keep`` until they take at most ``bound``."""
     entries = sorted(cache_entries(directory), key=lambda entry: entry.used)
     total = sum(entry.size for entry in entries)
     for entry in entries:
@@ -492,7 +478,7 @@ def cache_entries(cache_dir=None) -> list[CacheEntry]:
 
 
 def clear_cache(cache_dir=None) -> tuple[int, int]:
-    """Remove every cache entry, and temporary files left by interrupted writes.
+    """Remove every cache entry, and temporary files left by interrupted writes (no other file).
 
     Parameters
     ----------
@@ -505,10 +491,6 @@ def clear_cache(cache_dir=None) -> tuple[int, int]:
         Number of files removed.
     size : int
         Their total size. [byte]
-
-    Notes
-    -----
-    Other files in the directory (not named like cache entries) are left alone.
     """
     directory = cache_directory(cache_dir)
     count = size = 0
