@@ -121,13 +121,10 @@ def compute_map(
         Normal load :math:`P`; when given, the map also holds ``dissipated_energy`` and
         ``max_force`` and a scalar coordinate ``load``. [N]
     chunks : 'auto', int or dict, optional
-        Return a chunked map: its variables are dask arrays, evaluated block by block
-        when they are computed or written (:func:`ecofmaps.maps.write_map`), so the grid
-        need not fit in memory. An int is the largest number of grid points in a block
-        (blocks then take whole trailing dimensions, like the tiles below); ``'auto'`` is
-        :data:`BLOCK_POINTS`; a dict gives the block length by dimension name (-1 or
-        None: the whole dimension; dimensions not named are whole). By default the map
-        is computed at once, in memory.
+        Return a chunked map, of dask arrays evaluated block by block when computed or
+        written (:func:`ecofmaps.maps.write_map`): an int is the most grid points in a
+        block, ``'auto'`` :data:`ecofmaps.maps.tiles.BLOCK_POINTS`, a dict the block
+        length by dimension name (-1 or None, or not named: whole). Default: in memory.
     profile : ScarProfile, optional
         A wear-scar profile of any shape instead of ``aspect_ratio``: see
         :func:`compute_profile_map`.
@@ -140,9 +137,8 @@ def compute_map(
     cache_dir : str or os.PathLike, optional
         Cache directory; default ``$ECOFMAPS_CACHE`` or the per-user cache directory.
     max_chunk : int
-        Largest number of grid points evaluated in one call of the jit-compiled kernel (a
-        tile); a bigger grid is evaluated tile by tile, on every core, and copied into
-        place. The default keeps a tile's working arrays in the processor's cache. [1]
+        Most grid points evaluated in one call of the compiled kernel (a tile; tiles run on
+        every core). [1]
 
     Returns
     -------
@@ -154,21 +150,17 @@ def compute_map(
         ``stiffness_ratio`` and ``amplitude`` only) and, with a load, ``dissipated_energy``
         [J] and ``max_force`` [N]. Every variable and coordinate has ``long_name`` and
         ``units``. ECoF values are NaN where there is no gross slip; every value but the
-        regime is NaN when self-locking (rigid rig, :math:`\mu\kappa \ge 1`). Freshly
-        computed arrays of a grid of at most ``max_chunk`` points are read-only (they are
-        the computation's buffers, not copies): ``.copy()`` the Dataset to write into them.
-        With ``chunks``, the variables over the whole grid are dask arrays; computed,
-        they equal the map in memory to the bit (``xarray.testing.assert_identical``).
+        regime is NaN when self-locking (rigid rig, :math:`\mu\kappa \ge 1`). A chunked
+        map, computed, is identical to the map in memory. Arrays of a single tile are
+        read-only (docs/performance.md, "Maps").
 
     Raises
     ------
     ValueError
         If a parameter is not a scalar or a non-empty 1-D array, or is out of range:
         stiffness_ratio > 0 (inf allowed); aspect_ratio >= 0; amplitude, mu, load > 0;
-        all finite except stiffness_ratio, none NaN. If ``chunks`` is not one of its
-        forms, or names a parameter that is not a dimension. If a map in memory would
-        not fit in the memory available (before allocating it; a chunked map is not
-        refused).
+        all finite except stiffness_ratio, none NaN. For a bad ``chunks``, and for a map
+        in memory that would not fit in the memory available (before allocating it).
 
     Warns
     -----
@@ -197,10 +189,8 @@ def compute_map(
 
     The same map in blocks of 2 values of S/P, evaluated when it is computed or written:
 
-    >>> lazy = compute_map(
-    ...     np.geomspace(2e4, 2e5, 5), np.linspace(0, 0.3, 4), 50e-6, 0.8,
-    ...     chunks={"stiffness_ratio": 2},
-    ... )
+    >>> lazy = compute_map(np.geomspace(2e4, 2e5, 5), np.linspace(0, 0.3, 4), 50e-6, 0.8,
+    ...                    chunks={"stiffness_ratio": 2})
     >>> lazy.ecof_ratio.chunks
     ((2, 2, 1), (4,))
     >>> lazy.compute().identical(m)

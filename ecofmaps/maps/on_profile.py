@@ -15,7 +15,7 @@ import xarray as xr
 from ecofmaps._inputs import float64
 from ecofmaps.maps.cache import cached_dataset
 from ecofmaps.maps.dataset import checked_axis, checked_load, compliance_values, grid_dataset
-from ecofmaps.maps.tiles import MAX_CHUNK
+from ecofmaps.maps.tiles import MAX_CHUNK, check_max_chunk
 from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers, steady_values
 
 __all__ = ["MODEL_ON_PROFILE", "compute_profile_map"]
@@ -109,8 +109,7 @@ def compute_profile_map(
         "mu": checked_axis("mu", mu, "positive", "1"),
     }
     load = checked_load(load)
-    if not (isinstance(max_chunk, int) and max_chunk >= 1):
-        raise ValueError(f"max_chunk must be an integer >= 1, got {max_chunk!r}")
+    check_max_chunk(max_chunk)
 
     def compute() -> xr.Dataset:
         grid = [np.atleast_1d(a) for a in axes.values()]

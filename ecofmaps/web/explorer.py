@@ -53,19 +53,12 @@ INPUTS = {
     "aspect_ratio_high": ("aspect_ratio", "Scar z_o/x_o to", "0.25", (0.0, 10.0)),
 }
 
-#: The model's inputs among :data:`INPUTS`.
 _MODEL_INPUTS = ("amplitude", "load", "stiffness", "mu", "aspect_ratio")
-
-#: Grid points of the map along S/P and along z_o/x_o.
-_MAP_POINTS = (91, 81)
-
-#: The map's window, widened to hold the point: S/P [1/m] and the largest z_o/x_o [1].
+_MAP_POINTS = (91, 81)  # grid points of the map along S/P and along z_o/x_o
+# The map's window, widened to hold the point: S/P [1/m] and the largest z_o/x_o [1]; the
+# steps it grows by, so that nearby points share a map; the maps the server keeps in memory.
 _MAP_WINDOW = (FIGURE_11_STIFFNESS_RATIOS[0], FIGURE_11_STIFFNESS_RATIOS[-1], 0.4)
-
-#: Steps to which the map's window grows, so that nearby points share a cached map.
 _STEPS = np.array([1.0, 2.0, 5.0])
-
-#: Maps kept in memory by the server (nothing is written to disk per request).
 _MAPS_KEPT = 32
 
 
@@ -159,8 +152,7 @@ class ExplorerPoint:
     def at(cls, amplitude, load, stiffness, mu, aspect_ratio) -> ExplorerPoint:
         """The model's values for one test (parameters in SI, as :func:`ecofmaps.energy_cof`)."""
         point = (amplitude, load, stiffness, mu, aspect_ratio)
-        with warnings.catch_warnings():  # no gross slip: the page says so instead
-            warnings.simplefilter("ignore")
+        with warnings.catch_warnings(action="ignore"):  # no gross slip: the page says so
             ratio = float(energy_cof(*point)) / mu
         displacement, force = fretting_loop(*point)
         return cls(
@@ -328,9 +320,10 @@ def _contour_labels(line_data, scale: tuple) -> dict:
     return labels
 
 
-#: How the no-gross-slip area is drawn: hatched over a light grey (Bokeh draws no hatch
-#: over a fill of alpha 0).
+# How the no-gross-slip area is drawn: hatched over a light grey (Bokeh draws no hatch
+# over a fill of alpha 0).
 _HATCH = {
+    "line_color": "#4d4d4d",
     "fill_color": "#d9d9d9",
     "fill_alpha": 0.5,
     "hatch_pattern": "/",
@@ -338,7 +331,7 @@ _HATCH = {
     "hatch_scale": 10,
 }
 
-#: The map plot's size and the part of it the axes take, roughly. [px]
+# The map plot's size and the part of it the axes take, roughly. [px]
 _MAP_SIZE = (600, 470)
 _MAP_FRAME = (440, 290)
 
@@ -356,13 +349,11 @@ def _map_figure():
         x_range=Range1d(0.0, 1.0),
         y_range=Range1d(0.0, 1.0),
     )
-    empty = np.full((2, 2), np.nan)
+    empty = ([0, 1], [0, 1], np.full((2, 2), np.nan))
     levels = _fill_levels(ECOF_RATIO_LEVELS[-1])
-    bands = plot.contour([0, 1], [0, 1], empty, levels, fill_color=_band_colors(levels))
+    bands = plot.contour(*empty, levels, fill_color=_band_colors(levels))
     widths = [3.0 if level == HIGHLIGHT_LEVEL else 1.0 for level in ECOF_RATIO_LEVELS]
-    lines = plot.contour(
-        [0, 1], [0, 1], empty, ECOF_RATIO_LEVELS, line_color="black", line_width=widths
-    )
+    lines = plot.contour(*empty, ECOF_RATIO_LEVELS, line_color="black", line_width=widths)
     labels = ColumnDataSource({"x": [], "y": [], "text": [], "angle": []})
     plot.text(
         "x",
@@ -378,30 +369,14 @@ def _map_figure():
         background_fill_alpha=0.85,
         padding=1,
     )
-    stuck = plot.contour(
-        [0, 1],
-        [0, 1],
-        empty,
-        [0.5, 1.5],
-        line_color="#4d4d4d",
-        line_width=1.0,
-        **_HATCH,
-    )
+    stuck = plot.contour(*empty, [0.5, 1.5], line_width=1.0, **_HATCH)
     image = ColumnDataSource({"image": [], "x": [], "y": [], "dw": [], "dh": []})
     hover = plot.image(
         "image", x="x", y="y", dw="dw", dh="dh", source=image, palette=["#000000"], global_alpha=0
     )
     marker = ColumnDataSource({"x": [], "y": []})
-    point = plot.scatter(
-        "x",
-        "y",
-        source=marker,
-        size=13,
-        marker="circle",
-        fill_color="white",
-        line_color="black",
-        line_width=2,
-    )
+    circle = {"marker": "circle", "fill_color": "white", "line_color": "black", "line_width": 2}
+    point = plot.scatter("x", "y", source=marker, size=13, **circle)
     for renderer, name in ((bands, "bands"), (lines, "lines"), (stuck, "no_gross_slip")):
         renderer.name = name  # found by name by the page's tests
     colorbar = bands.construct_color_bar(width=12, title="μ_E/μ [1]")
@@ -409,7 +384,7 @@ def _map_figure():
     # What the legend shows, by glyphs at no point of the map (a contour's parts have no legend).
     nowhere = [math.nan]
     heavy = plot.line(nowhere, nowhere, line_color="black", line_width=3.0)
-    hatched = plot.quad(nowhere, nowhere, nowhere, nowhere, line_color="#4d4d4d", **_HATCH)
+    hatched = plot.quad(nowhere, nowhere, nowhere, nowhere, **_HATCH)
     legend = Legend(
         items=[
             LegendItem(label=f"μ_E/μ = {HIGHLIGHT_LEVEL:.2f} (5 % above μ)", renderers=[heavy]),
@@ -422,16 +397,8 @@ def _map_figure():
         margin=4,
     )
     plot.add_layout(legend, "below")
-    plot.add_tools(
-        HoverTool(
-            tooltips=[
-                ("S/P", "$x{0.0} 1/mm"),
-                ("z_o/x_o", "$y{0.000}"),
-                ("μ_E/μ", "@image{0.000}"),
-            ],
-            renderers=[hover],
-        )
-    )
+    tips = [("S/P", "$x{0.0} 1/mm"), ("z_o/x_o", "$y{0.000}"), ("μ_E/μ", "@image{0.000}")]
+    plot.add_tools(HoverTool(tooltips=tips, renderers=[hover]))
     return plot, {
         "x_range": plot.x_range,
         "y_range": plot.y_range,

@@ -47,48 +47,27 @@ __all__ = ["LOOPS_CARRIED", "recording_inputs", "report_document", "write_report
 #: picks among them in the page. Their loops are the bulk of a report of a short test.
 LOOPS_CARRIED = 60
 
-#: Loops drawn when the page opens: the first, the middle and the last carried cycle.
-_FIRST_SHOWN = 3
-
-#: Points on each slip branch of a model loop.
-_MODEL_POINTS = 40
-
-#: Model loops are computed in batches of a multiple of this many. [1]
-_MODEL_BATCH = 64
-
-#: The plots over the cycles: width of their frames, and the room left of it for the axis
-#: labels, the same in both, so that their cycle axes line up. [px]
+_MODEL_POINTS = 40  # points on each slip branch of a model loop
+_MODEL_BATCH = 64  # model loops are computed in batches of a multiple of this many
+# The plots over the cycles: width of their frames, and the room left of them for the axis
+# labels, the same in both so that their cycle axes line up; the page's width. [px]
 _FRAME = (560, 130)
-
-#: Width of the page's content, for a laptop screen. [px]
 _WIDTH = 1240
-
-#: The variables a report needs in the results.
 _NEEDED = ("cycle", "ecof", "gicof", "quality", "regime", "load")
-
-#: Significant digits of the table's numbers, as the CSV's: each column shows its largest
-#: value with as many, and all its values with the same decimals. [1]
+# The table: significant digits as the CSV's (each column with the decimals of its largest
+# value), a number cell (nothing for NaN, as the CSV's empty field), the width of a character
+# and the room around it, the table's width (every column of a recording's table in a window
+# 1400 px wide) and the room for its scroll bar. [px]
 _DIGITS = 6
-
-#: Shows a number of the table with the column's DECIMALS decimals, and nothing for NaN, as
-#: the CSV's empty field.
 _NUMBER_CELL = (
     '<div style="text-align: right"><%= (value == null || value !== value) ? "" : '
     "value.toFixed(DECIMALS) %></div>"
 )
-
-#: Width of a character of the table's headers and text, and the room around them. [px]
 _CHARACTER, _CELL_ROOM = 6.5, 10
+_TABLE_WIDTH, _TABLE_ROOM = 1350, 20
 
-#: Width of the table: every column of a recording's table visible in a window 1400 px wide
-#: (its first column frozen when there are more). [px]
-_TABLE_WIDTH = 1350
-
-#: Room the table keeps beside its columns, for its vertical scroll bar. [px]
-_TABLE_ROOM = 20
-
-#: Shows the loops of the cycles picked in the page: the measured loop and, where the cycle
-#: has one, the model's, each pair in one colour.
+# Shows the loops of the cycles picked in the page: the measured loop and, where the cycle
+# has one, the model's, each pair in one colour.
 _PICK_LOOPS = """
 const all = carried.data;
 const measured_data = {xs: [], ys: [], label: [], color: []};
@@ -287,34 +266,22 @@ def _evolution_figures(results: xr.Dataset):
         y_axis_label="Coefficient of friction [1]",
         tools="pan,box_zoom,wheel_zoom,reset,save",
     )
-    resolved = "mu_resolved" in results
-    if resolved:
-        plot.varea(
-            "cycle",
-            "mu_low",
-            "mu_high",
-            source=source,
-            color="#2ca02c",
-            alpha=0.25,
-            legend_label="μ ± 2 se",
-        )
-    lines = {"ecof": ("#ff7f0e", "ECoF μ_E"), "gicof": ("#1f77b4", "GICoF (Q/P on Q = SΔ)")}
+    if "mu_resolved" in results:
+        band = {"color": "#2ca02c", "alpha": 0.25, "legend_label": "μ ± 2 se"}
+        plot.varea("cycle", "mu_low", "mu_high", source=source, **band)
+    lines = {  # μ on top: the most precise of the three
+        "ecof": ("#ff7f0e", "ECoF μ_E"),
+        "gicof": ("#1f77b4", "GICoF (Q/P on Q = SΔ)"),
+        "mu_resolved": ("#2ca02c", "μ read along the stroke"),
+    }
     drawn = {}
     for name, (color, legend) in lines.items():
-        drawn[name] = plot.line(
-            "cycle", name, source=source, color=color, line_width=1.5, legend_label=legend
-        )
-        if cycle.size <= 400:
+        if name in results:
+            drawn[name] = plot.line(
+                "cycle", name, source=source, color=color, line_width=1.5, legend_label=legend
+            )
+        if cycle.size <= 400 and name != "mu_resolved":
             plot.scatter("cycle", name, source=source, color=color, size=3)
-    if resolved:  # on top: the most precise of the three
-        plot.line(
-            "cycle",
-            "mu_resolved",
-            source=source,
-            color="#2ca02c",
-            line_width=1.5,
-            legend_label="μ read along the stroke",
-        )
     plot.add_tools(
         HoverTool(
             tooltips=[
@@ -369,16 +336,8 @@ def _flags_figure(results: xr.Dataset, evolution):
             "reason": [reason for reason, cycles in flagged.items() for _ in cycles],
         }
     )
-    plot.scatter(
-        "cycle",
-        "reason",
-        source=marks,
-        marker="dash",
-        size=10,
-        line_width=2,
-        color="#d62728",
-        angle=np.pi / 2,
-    )
+    mark = {"marker": "dash", "size": 10, "line_width": 2, "color": "#d62728"}
+    plot.scatter("cycle", "reason", source=marks, angle=np.pi / 2, **mark)
     plot.xaxis.formatter = BasicTickFormatter(use_scientific=False)
     plot.add_tools(HoverTool(tooltips=[("cycle", "@cycle"), ("flag", "@reason")]))
     return plot
@@ -478,8 +437,7 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
             "model_ys": model_ys,
         }
     )
-    middle = len(names) // 2
-    first = list(dict.fromkeys([names[0], names[middle], names[-1]]))[:_FIRST_SHOWN]
+    first = list(dict.fromkeys([names[0], names[len(names) // 2], names[-1]]))
     palette = list(Category10_10)
     measured, model = ColumnDataSource(name="shown-loops"), ColumnDataSource(name="shown-models")
     plot = figure(
