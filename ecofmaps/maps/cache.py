@@ -82,28 +82,14 @@ _UNITS.update({"KiB": 2**10, "kiB": 2**10, "MiB": 2**20, "GiB": 2**30, "TiB": 2*
 
 
 class CacheWarning(UserWarning):
-    """A cache file could not be used (unreadable, damaged, foreign) or written; the result
-    is recomputed, or returned without being stored."""
+    """A cache file could not be used or written; the result is recomputed, or not stored."""
 
 
 @dataclass(frozen=True)
 class CacheEntry:
-    """One file of the cache.
-
-    Attributes
-    ----------
-    path : pathlib.Path
-        The netCDF file.
-    function : str
-        The function whose result it holds (``compute_map``, ...).
-    size : int
-        File size. [byte]
-    modified : datetime.datetime
-        Time of the last write (UTC).
-    used : datetime.datetime
-        Time of the last read or write (UTC): the least recently used entries are removed
-        first when the cache outgrows its bound.
-    """
+    """One file of the cache: its path, the function whose result it holds (``compute_map``,
+    ...), its size [byte], and the times (UTC) of its last write and its last use (read or
+    write; the least recently used entries are removed first)."""
 
     path: Path
     function: str
@@ -139,9 +125,7 @@ def cache_size_bound() -> int:
     Returns
     -------
     bound : int
-        Bytes the cache's entries may take together. [byte] After each write, the least
-        recently used entries are removed until the others fit; a result larger than the
-        bound is not stored; 0 stores nothing.
+        Bytes the cache's entries may take together; 0 stores nothing. [byte]
 
     Raises
     ------
@@ -163,14 +147,8 @@ def cache_size_bound() -> int:
 
 @functools.cache
 def model_revision() -> str:
-    """SHA-256 of the source of the modules that compute maps (the model, the grid, the names).
-
-    Returns
-    -------
-    revision : str
-        64 hexadecimal digits; any edit of those files gives another revision, and so other
-        cache keys.
-    """
+    """SHA-256 (64 hex digits) of the source of the modules that compute maps: any edit of
+    them gives other cache keys."""
     package = Path(__file__).resolve().parents[1]
     digest = hashlib.sha256()
     for pattern in _MODEL_SOURCES:
@@ -185,19 +163,9 @@ def _chunked(variable: xr.Variable) -> bool:
 
 
 def metadata_checksum(dataset: xr.Dataset) -> str:
-    """SHA-256 of what the chunks' checksums do not cover: every name, dimension, type,
-    shape and attribute, and the values of text and scalar variables.
-
-    Parameters
-    ----------
-    dataset : xarray.Dataset
-        As read from the file (attributes take the types netCDF gives them).
-
-    Returns
-    -------
-    checksum : str
-        64 hexadecimal digits. The global attribute that holds the checksum is left out.
-    """
+    """SHA-256 (64 hex digits) of what the chunks' checksums do not cover: every name,
+    dimension, type, shape and attribute (but the checksum's own), and the values of text and
+    scalar variables, of ``dataset`` as read from the file."""
     digest = hashlib.sha256()
 
     def add(*parts) -> None:
@@ -220,21 +188,9 @@ def metadata_checksum(dataset: xr.Dataset) -> str:
 
 
 def cache_key(function: str, inputs: Mapping[str, object]) -> str:
-    """SHA-256 key of a computation: version, model revision, function, exact input values.
-
-    Parameters
-    ----------
-    function : str
-        Name of the function computing the result.
-    inputs : mapping of str to array_like or None
-        Every input that the result depends on, by name. Values are hashed as little-endian
-        float64 bytes together with their shape, so a scalar and a one-element array differ.
-
-    Returns
-    -------
-    key : str
-        64 hexadecimal digits.
-    """
+    """SHA-256 key (64 hex digits) of a computation: version, model revision, ``function``,
+    and each of ``inputs`` by name as little-endian float64 bytes with its shape (so a scalar
+    and a one-element array differ)."""
     digest = hashlib.sha256(f"ecofmaps {__version__}\0{model_revision()}\0{function}\0".encode())
     for name, value in inputs.items():
         digest.update(f"{name}\0".encode())
@@ -248,24 +204,9 @@ def cache_key(function: str, inputs: Mapping[str, object]) -> str:
 
 
 def write_netcdf(dataset: xr.Dataset, path, *, exclusive: bool = True) -> Path:
-    """Write ``dataset`` to ``path`` (engine h5netcdf) atomically: to a temporary file beside it,
-    flushed, then renamed onto it; on any failure ``path`` is left as it was.
-
-    Parameters
-    ----------
-    dataset : xarray.Dataset
-        The data to write.
-    path : str or os.PathLike
-        The netCDF file to create or replace; its directory must exist.
-    exclusive : bool
-        Whether a ``path`` that did not exist is created, never replaced: if another
-        program wrote it meanwhile, ``FileExistsError`` and this dataset is not written
-        (:func:`ecofmaps.io.files.atomic_path`). False where any writer writes the same.
-
-    Returns
-    -------
-    path : pathlib.Path
-    """
+    """Write ``dataset`` to the netCDF file ``path`` (engine h5netcdf; its directory must
+    exist) atomically, as :func:`ecofmaps.io.files.atomic_path` with ``exclusive``: on any
+    failure ``path`` is left as it was. Returns ``path`` as a :class:`pathlib.Path`."""
     path = Path(path)
     with atomic_path(path, exclusive=exclusive) as temporary:
         dataset.to_netcdf(temporary, engine="h5netcdf")
@@ -395,8 +336,7 @@ def cached_dataset(
     Parameters
     ----------
     function : str
-        Name of the computing function (a valid Python identifier), part of the key and
-        of the file name.
+        Name of the computing function (a Python identifier): in the key and file name.
     inputs : mapping of str to array_like or None
         Everything the result depends on (see :func:`cache_key`).
     compute : callable
@@ -407,20 +347,18 @@ def cached_dataset(
     Returns
     -------
     dataset : xarray.Dataset
-        Identical (``xarray.testing.assert_identical``) whether read or computed.
+        Identical whether read or computed.
 
     Raises
     ------
     ValueError
-        If ``ECOFMAPS_CACHE_SIZE`` is set and is not a size (:func:`cache_size_bound`).
+        If ``ECOFMAPS_CACHE_SIZE`` is not a size (:func:`cache_size_bound`).
 
     Warns
     -----
     CacheWarning
-        In one line, when the file is unreadable, damaged or foreign (it is removed and the
-        result recomputed), or when the result cannot be stored for any reason (a full
-        disk, a read-only folder, a file where the folder should be): it is returned all
-        the same.
+        In one line, when the file is unusable (removed, the result recomputed) or the
+        result cannot be stored for any reason (it is returned all the same).
     """
     directory = cache_directory(cache_dir)
     bound = cache_size_bound()  # a bad ECOFMAPS_CACHE_SIZE is refused before any work
