@@ -123,21 +123,13 @@ def ecof_and_slope(mu, kappa, lam):
 
 def reachability_status(ecof, kappa, lam):
     """The status before the ambiguity check: which ECoFs the model can reach."""
-    valid = (
-        (ecof > 0.0)
-        & jnp.isfinite(ecof)
-        & (kappa >= 0.0)
-        & jnp.isfinite(kappa)
-        & (lam >= 0.0)
-        & jnp.isfinite(lam)
-    )
-    reachable = ecof * lam < 1.0
+    valid = (ecof > 0.0) & jnp.isfinite(ecof)
+    for value in (kappa, lam):
+        valid &= (value >= 0.0) & jnp.isfinite(value)
     code = jnp.where(
-        valid,
-        jnp.where(reachable, int(CorrectionStatus.CORRECTED), int(CorrectionStatus.NO_GROSS_SLIP)),
-        int(CorrectionStatus.INVALID),
+        ecof * lam < 1.0, int(CorrectionStatus.CORRECTED), int(CorrectionStatus.NO_GROSS_SLIP)
     )
-    return code.astype(jnp.int32)
+    return jnp.where(valid, code, int(CorrectionStatus.INVALID)).astype(jnp.int32)
 
 
 def may_fall(kappa, lam):
@@ -166,14 +158,8 @@ def ecof_fall(kappa, lam):
 
     Notes
     -----
-    The fall exists only for :math:`\kappa > 1` and :math:`0 < \lambda <` :data:`LAMBDA_INFINITY`
-    and lies in
-    :math:`1/\kappa < \mu < 1` (:mod:`ecofmaps.correction.inversion`); there the slope
-    :math:`d\mu_E/d\mu` (``jax.jvp`` of the corrected eq. 13-15 with eq. 16) is sampled at
-    256 points evenly spaced in :math:`\log\mu`, and its two sign changes are bisected. A
-    fall narrower than one grid step (:math:`\ln\kappa/255` in :math:`\log\mu`), at the very
-    edge of the region where it exists, is not seen: the contact CoFs it would make
-    ambiguous then lie within about two grid steps of each other.
+    The fall exists only for :math:`\kappa > 1` and :math:`0 < \lambda <` :data:`LAMBDA_INFINITY`;
+    how it is found, and what it can miss: ``docs/model.md`` (correcting a reported ECoF).
 
     References
     ----------
