@@ -182,11 +182,8 @@ def recording_inputs(recording, load: float, *, flip_force: bool = False) -> dic
     for name, column_name in recording.columns.items():
         unit = recording.units.get(name, "1")
         read.append(f"{name}: {column_name!r}" + ("" if unit == "1" else f" in {unit}"))
-    inputs = {
-        "files": str(recording.path),
-        "load": f"{load:g} N",
-        "columns and units assumed": "; ".join(read),
-    }
+    inputs = {"files": str(recording.path), "load": f"{load:g} N"}
+    inputs["columns and units assumed"] = "; ".join(read)
     if flip_force:
         inputs["force sign"] = "read with the other sign (--flip-force)"
     return inputs
@@ -235,15 +232,13 @@ def _header(results: xr.Dataset, inputs: Mapping) -> Div:
         for key, value in rows.items()
     )
     return Div(
-        text=(
-            "<h1 style='margin:8px 0 4px 0;font-size:22px'>Fretting test: friction cycle by "
-            "cycle</h1><p style='margin:0 0 6px 0;max-width:1100px'>ECoF μ_E = E_d/(4Pδ*) "
-            "(eq. 1), GICoF = Q/P at the centre of the slip, where the loop crosses Q = SΔ "
-            "(eq. 17-18; a fit over its central 70 %), and μ read along the stroke, from "
-            "<code>ecofmaps.analyze_loops</code>. Values that cannot "
-            "be stood behind are left out, and the quality flags say why.</p>"
-            f"<table class='ecofmaps-inputs' style='font-size:14px'>{cells}</table>"
-        ),
+        text="<h1 style='margin:8px 0 4px 0;font-size:22px'>Fretting test: friction cycle by "
+        "cycle</h1><p style='margin:0 0 6px 0;max-width:1100px'>ECoF μ_E = E_d/(4Pδ*) "
+        "(eq. 1), GICoF = Q/P at the centre of the slip, where the loop crosses Q = SΔ "
+        "(eq. 17-18; a fit over its central 70 %), and μ read along the stroke, from "
+        "<code>ecofmaps.analyze_loops</code>. Values that cannot be stood behind are left "
+        "out, and the quality flags say why.</p>"
+        f"<table class='ecofmaps-inputs' style='font-size:14px'>{cells}</table>",
         width=_WIDTH,
     )
 
@@ -359,12 +354,10 @@ def _quality_counts(results: xr.Dataset) -> Div:
         for name, count, meaning in rows
     )
     return Div(
-        text=(
-            f"<h3 style='margin:4px 0'>Quality of the {total} cycles</h3>"
-            "<table class='ecofmaps-quality' style='font-size:13px;border-collapse:collapse'>"
-            "<tr><th style='text-align:left'>flag</th><th style='padding:0 8px'>cycles</th>"
-            f"<th style='text-align:left'>what it means</th></tr>{cells}</table>"
-        ),
+        text=f"<h3 style='margin:4px 0'>Quality of the {total} cycles</h3>"
+        "<table class='ecofmaps-quality' style='font-size:13px;border-collapse:collapse'>"
+        "<tr><th style='text-align:left'>flag</th><th style='padding:0 8px'>cycles</th>"
+        f"<th style='text-align:left'>what it means</th></tr>{cells}</table>",
         width=_WIDTH - 880,
     )
 
@@ -404,17 +397,12 @@ def _model_loops(results: xr.Dataset) -> tuple[list, list]:
         # Padded to a multiple of _MODEL_BATCH loops (repeating them): the compiled model is
         # then reused by every report, not compiled again for each number of loops.
         size = -(-int(usable.sum()) // _MODEL_BATCH) * _MODEL_BATCH
-        batch = {name: np.resize(value[usable], size) for name, value in values.items()}
-        displacement, force = fretting_loop(
-            batch["amplitude"],
-            float(results["load"]),
-            batch["stiffness"],
-            batch["mu_resolved"],
-            batch["aspect_ratio"],
-            num=_MODEL_POINTS,
+        amplitude, stiffness, mu, ratio = (np.resize(v[usable], size) for v in values.values())
+        loop = fretting_loop(
+            amplitude, float(results["load"]), stiffness, mu, ratio, num=_MODEL_POINTS
         )
-        displacement = np.round(np.asarray(displacement) * 1e6, 4)
-        force = np.round(np.asarray(force), 3)
+        displacement = np.round(np.asarray(loop[0]) * 1e6, 4)
+        force = np.round(np.asarray(loop[1]), 3)
         for row_index, index in enumerate(np.flatnonzero(usable)):
             xs[index], ys[index] = displacement[row_index], force[row_index]
     return xs, ys
@@ -461,21 +449,14 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
         width=480,
         name="loop-picker",
     )
-    update = CustomJS(
-        args=dict(
-            carried=all_loops, choice=choice, measured=measured, model=model, palette=palette
-        ),
-        code=_PICK_LOOPS,
-    )
-    choice.js_on_change("value", update)
+    shown = dict(carried=all_loops, choice=choice, measured=measured, model=model, palette=palette)
+    choice.js_on_change("value", CustomJS(args=shown, code=_PICK_LOOPS))
     _fill_shown(all_loops.data, first, palette, measured, model)
     note = Div(
-        text=(
-            "<p>Each loop is centred (the sensors' offsets removed). The dashed loop is the "
-            "model's steady loop (eq. 9, 10, 16) for the cycle's amplitude, rig stiffness S, "
-            "and the friction μ and groove z_o/x_o read along the stroke; a cycle without "
-            "that reading has none.</p>"
-        ),
+        text="<p>Each loop is centred (the sensors' offsets removed). The dashed loop is the "
+        "model's steady loop (eq. 9, 10, 16) for the cycle's amplitude, rig stiffness S, "
+        "and the friction μ and groove z_o/x_o read along the stroke; a cycle without "
+        "that reading has none.</p>",
         width=480,
     )
     return row(plot, column(choice, note))
@@ -540,10 +521,8 @@ def _table(results: xr.Dataset):
     others = sum(column.width for column in columns[:-1])
     columns[-1].width = min(columns[-1].width, max(90, _TABLE_WIDTH - _TABLE_ROOM - others))
     heading = Div(
-        text=(
-            "<h3 style='margin:12px 0 4px 0'>The table (as <code>ecofmaps loops --out</code> "
-            "writes it; click a column's name to sort)</h3>"
-        ),
+        text="<h3 style='margin:12px 0 4px 0'>The table (as <code>ecofmaps loops --out</code> "
+        "writes it; click a column's name to sort)</h3>",
         width=_WIDTH,
     )
     grid = DataTable(
