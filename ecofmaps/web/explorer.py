@@ -399,17 +399,8 @@ def _map_figure():
     plot.add_layout(legend, "below")
     tips = [("S/P", "$x{0.0} 1/mm"), ("z_o/x_o", "$y{0.000}"), ("μ_E/μ", "@image{0.000}")]
     plot.add_tools(HoverTool(tooltips=tips, renderers=[hover]))
-    return plot, {
-        "x_range": plot.x_range,
-        "y_range": plot.y_range,
-        "bands": bands,
-        "colorbar": colorbar,
-        "lines": lines,
-        "labels": labels,
-        "stuck": stuck,
-        "image": image,
-        "marker": marker,
-    }
+    parts = dict(x_range=plot.x_range, y_range=plot.y_range, bands=bands, colorbar=colorbar)
+    return plot, parts | dict(lines=lines, labels=labels, stuck=stuck, image=image, marker=marker)
 
 
 def _show_map(values: dict, parts: dict) -> None:
@@ -432,18 +423,9 @@ def _show_map(values: dict, parts: dict) -> None:
     scale = (_MAP_FRAME[0] / (x[-1] - x[0]), _MAP_FRAME[1] / (y[-1] - y[0]))
     parts["labels"].data = _contour_labels(drawn.line_data, scale)
     parts["stuck"].set_data(contour_data(x, y, stuck, [0.5, 1.5]))
-    parts["image"].data = {
-        "image": [grid],
-        "x": [x[0]],
-        "y": [0.0],
-        "dw": [x[-1] - x[0]],
-        "dh": [y[-1]],
-    }
-    shown = math.isfinite(ratio)
-    parts["marker"].data = {
-        "x": [ratio * 1e-3] if shown else [],
-        "y": [values["aspect_ratio"]] if shown else [],
-    }
+    parts["image"].data = dict(image=[grid], x=[x[0]], y=[0.0], dw=[x[-1] - x[0]], dh=[y[-1]])
+    shown = int(math.isfinite(ratio))  # a rigid rig's point is not drawn
+    parts["marker"].data = {"x": [ratio * 1e-3][:shown], "y": [values["aspect_ratio"]][:shown]}
 
 
 def explorer_page():
