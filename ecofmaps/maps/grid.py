@@ -19,7 +19,7 @@ import xarray as xr
 from ecofmaps import model
 from ecofmaps._inputs import float64
 from ecofmaps.maps.cache import cached_dataset
-from ecofmaps.maps.dataset import checked_axis, checked_load, compliance_values, grid_dataset
+from ecofmaps.maps.dataset import checked_axes, checked_load, compliance_values, grid_dataset
 from ecofmaps.maps.on_profile import compute_profile_map
 from ecofmaps.maps.tiles import MAX_CHUNK, grid_values
 from ecofmaps.model.simulation import fretting_loop
@@ -219,14 +219,9 @@ def compute_map(
         raise ValueError("mapping applies to a profile only (profile=...)")
     if amplitude is None or mu is None:
         raise ValueError("compute_map needs amplitude and mu")
-    axes = {
-        "stiffness_ratio": checked_axis(
-            "stiffness_ratio", stiffness_ratio, "positive_or_inf", "1/m"
-        ),
-        "aspect_ratio": checked_axis("aspect_ratio", aspect_ratio, "non_negative", "1"),
-        "amplitude": checked_axis("amplitude", amplitude, "positive", "m"),
-        "mu": checked_axis("mu", mu, "positive", "1"),
-    }
+    axes = checked_axes(
+        stiffness_ratio=stiffness_ratio, aspect_ratio=aspect_ratio, amplitude=amplitude, mu=mu
+    )
     load = checked_load(load)
 
     _check_cache(cache, chunks)
@@ -292,11 +287,7 @@ def compute_universal_map(
     coefficient of friction from fretting loops exhibiting non-Coulomb frictional
     behaviour: eq. 13-16.
     """
-    axes = {
-        "compliance_ratio": checked_axis("compliance_ratio", compliance_ratio, "non_negative", "1"),
-        "aspect_ratio": checked_axis("aspect_ratio", aspect_ratio, "non_negative", "1"),
-        "mu": checked_axis("mu", mu, "positive", "1"),
-    }
+    axes = checked_axes(compliance_ratio=compliance_ratio, aspect_ratio=aspect_ratio, mu=mu)
 
     _check_cache(cache, chunks)
 
@@ -364,13 +355,9 @@ def compute_loops(stiffness, aspect_ratio, amplitude, load, mu, num=201) -> xr.D
     coefficient of friction from fretting loops exhibiting non-Coulomb frictional
     behaviour: eq. 9, 10, 12, 16.
     """
-    axes = {
-        "stiffness": checked_axis("stiffness", stiffness, "positive_or_inf", "N/m"),
-        "aspect_ratio": checked_axis("aspect_ratio", aspect_ratio, "non_negative", "1"),
-        "amplitude": checked_axis("amplitude", amplitude, "positive", "m"),
-        "load": checked_axis("load", load, "positive", "N"),
-        "mu": checked_axis("mu", mu, "positive", "1"),
-    }
+    axes = checked_axes(
+        stiffness=stiffness, aspect_ratio=aspect_ratio, amplitude=amplitude, load=load, mu=mu
+    )
     grid = jnp.broadcast_arrays(*_mesh(*(np.atleast_1d(a) for a in axes.values())))
     values = jax.device_get(_loop_kernel(*grid))
     loop = fretting_loop(grid[2], grid[3], grid[0], grid[4], grid[1], num=num)

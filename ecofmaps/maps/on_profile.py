@@ -14,7 +14,7 @@ import xarray as xr
 
 from ecofmaps._inputs import float64
 from ecofmaps.maps.cache import cached_dataset
-from ecofmaps.maps.dataset import checked_axis, checked_load, compliance_values, grid_dataset
+from ecofmaps.maps.dataset import checked_axes, checked_load, compliance_values, grid_dataset
 from ecofmaps.maps.tiles import MAX_CHUNK, check_max_chunk
 from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers, steady_values
 
@@ -101,13 +101,7 @@ def compute_profile_map(
         raise ValueError("compute_map needs amplitude and mu")
     physical = check_mapping(mapping, None)
     profile = as_profile(profile)
-    axes = {
-        "stiffness_ratio": checked_axis(
-            "stiffness_ratio", stiffness_ratio, "positive_or_inf", "1/m"
-        ),
-        "amplitude": checked_axis("amplitude", amplitude, "positive", "m"),
-        "mu": checked_axis("mu", mu, "positive", "1"),
-    }
+    axes = checked_axes(stiffness_ratio=stiffness_ratio, amplitude=amplitude, mu=mu)
     load = checked_load(load)
     check_max_chunk(max_chunk)
 
@@ -135,8 +129,8 @@ def compute_profile_map(
         dataset = grid_dataset(
             axes, values, "ECoF map of the compliant wear-scar model on a scar profile", extra
         )
-        dataset.attrs["model"] = MODEL_ON_PROFILE
         dataset.attrs.update(
+            model=MODEL_ON_PROFILE,
             scar_depth=float(profile.depth),
             scar_half_width=float(profile.half_width),
             scar_aspect_ratio=float(profile.aspect_ratio),
