@@ -1,8 +1,7 @@
 r"""Maps on a scar profile: the steady-loop quantities of a groove of any shape over a grid.
 
-The pad feels the profile's local slope (eq. 9 pointwise, :mod:`ecofmaps.model.on_profile`);
-the Dataset has the variables of :func:`ecofmaps.maps.compute_map` and the profile's
-dimensions as global attributes.
+The pad feels the profile's local slope (eq. 9 pointwise): docs/model.md, "The model on a
+scar profile".
 """
 
 from __future__ import annotations
@@ -46,14 +45,8 @@ def compute_profile_map(
 
     Parameters
     ----------
-    stiffness_ratio : float or 1-D array_like
-        Rig stiffness over normal load :math:`S/P`; ``numpy.inf`` for a rigid rig. [1/m]
-    amplitude : float or 1-D array_like
-        Displacement amplitude :math:`\Delta^*`. [m]
-    mu : float or 1-D array_like
-        Contact coefficient of friction :math:`\mu`. [1]
-    load : float, optional
-        Normal load :math:`P`, for ``dissipated_energy`` and ``max_force``. [N]
+    stiffness_ratio, amplitude, mu, load
+        As for :func:`compute_map`. [1/m], [m], [1], [N]
     profile : ScarProfile
         The scar (:func:`ecofmaps.scar_profile`, :func:`ecofmaps.read_scar_profile`, a
         profile family).
