@@ -133,18 +133,12 @@ def contact_cof(ecof, kappa, lam):
     return ambiguity_marked(mu, status, ecof, *ecof_fall_where_needed(status, kappa, lam))
 
 
-def _core_numbers(amplitude, load, stiffness, aspect_ratio):
-    """:math:`\\kappa` and :math:`\\lambda` with :math:`x_o = \\Delta^*`, and SI validity."""
-    kappa = model.curvature_number(1.0, aspect_ratio, 1.0)  # x_o = Δ*: κ = 2 z_o/x_o
-    lam = model.compliance_ratio(amplitude, load, stiffness)
-    valid = valid_geometry(amplitude, load, stiffness, aspect_ratio, amplitude)
-    return kappa, lam, valid
-
-
 @jax.jit
 def _si_root(ecof, amplitude, load, stiffness, aspect_ratio):
     """Root, status, kappa and lam over the broadcast shape; no ambiguity check."""
-    kappa, lam, valid = _core_numbers(amplitude, load, stiffness, aspect_ratio)
+    kappa = model.curvature_number(1.0, aspect_ratio, 1.0)  # x_o = Δ*: κ = 2 z_o/x_o
+    lam = model.compliance_ratio(amplitude, load, stiffness)
+    valid = valid_geometry(amplitude, load, stiffness, aspect_ratio, amplitude)
     mu, status = _root_and_status(ecof, kappa, lam)
     status = jnp.where(valid, status, int(CorrectionStatus.INVALID)).astype(jnp.int32)
     mu = jnp.where(valid, mu, jnp.nan)
@@ -164,8 +158,7 @@ def _si_correct(ecof, amplitude, load, stiffness, aspect_ratio):
         where = np.flatnonzero(
             np.asarray(may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
         )
-        high = np.full(mu.size, np.nan)
-        low = np.full(mu.size, np.nan)
+        high, low = np.full((2, mu.size), np.nan)
         if where.size:
             size = max(8, 1 << (where.size - 1).bit_length())  # few distinct shapes to compile
             padded = np.pad(where, (0, size - where.size), mode="edge")
@@ -358,18 +351,10 @@ correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy
 {_RAISES}
     Notes
     -----
-    Inverts the corrected eq. 13-15 with eq. 16 by bracketed Newton steps (see
-    :mod:`ecofmaps.correction` for the domain: which ECoFs can be reached, where the
-    inversion is unique, and why the interval is exact). :math:`\\mu \\le \\mu_E`, with
-    equality for a flat scar.
-
-    ``jax.grad`` (and ``jax.jvp``, ``jax.jit``, ``jax.vmap``) works with the aspect ratio
-    given as a number or by the scar's dimensions, not with a profile: the derivative is the
-    implicit function theorem's on :math:`\\mu_E(\\mu) = \\mu_E^{{given}}`, e.g.
-    :math:`d\\mu/d\\mu_E = 1/(d\\mu_E/d\\mu)`, exact at the root returned (the iterations
-    are not differentiated). A point that cannot be corrected is NaN, a constant, whose
-    derivative is 0: check the status (``return_status=True``). On a profile, the scan and
-    what it can miss: ``docs/model.md``.
+    Inverts the corrected eq. 13-15 with eq. 16 by bracketed Newton steps; which ECoFs can
+    be reached, where the inversion is unique, why the interval is exact, and the scan on a
+    profile: ``docs/model.md``. :math:`\\mu \\le \\mu_E`, with equality for a flat scar.
+    ``jax.grad``, ``jax.jit`` and ``jax.vmap`` work without a profile (``docs/api.md``).
 
     References
     ----------
