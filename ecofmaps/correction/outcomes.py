@@ -51,9 +51,8 @@ class CorrectionStatus(Code):
         One contact CoF gives the ECoF; it is returned.
     NO_GROSS_SLIP
         The ECoF is at or above :math:`S\\Delta^*/P`, above every gross-slip
-        :math:`\\mu_E` of these test conditions: a contact CoF high enough to give it would
-        stop gross slip (:math:`\\mu P \\ge S\\Delta^*`), and with no gross slip there is
-        no ECoF. The value cannot come from the model with these conditions.
+        :math:`\\mu_E` of these test conditions: a contact CoF that high would stop gross
+        slip (:math:`\\mu P \\ge S\\Delta^*`).
     AMBIGUOUS
         Several contact CoFs give the ECoF (deep groove, :math:`\\kappa > 1`, and stiff rig,
         :math:`\\lambda <` :data:`LAMBDA_INFINITY`, where :math:`\\mu_E(\\mu)` falls over
@@ -65,8 +64,7 @@ class CorrectionStatus(Code):
         :func:`lookup_correction` only: the point, or the ECoF, is outside the map.
     UNREACHABLE
         On a scar profile only: no contact CoF gives the ECoF although it is below
-        :math:`S\\Delta^*/P`: it falls in a jump of :math:`\\mu_E(\\mu)` (the loop's ends
-        jump where the pad starts to jump) or would need the pad to slip off the trace.
+        :math:`S\\Delta^*/P` (a jump of :math:`\\mu_E(\\mu)`, or a slip off the trace).
     """
 
     CORRECTED = 0, "corrected"
@@ -99,9 +97,8 @@ class Interval(NamedTuple):
     high: jax.Array
 
 
-# mu_E(mu) can fall only for kappa > _FALL_KAPPA and 0 < lam < _FALL_LAMBDA (docs/model.md,
-# correcting a reported ECoF); the fall lies in 1/kappa < mu < 1, scanned on _FALL_GRID
-# points in log(mu) and located to _FALL_BISECTIONS halvings of a grid step.
+# mu_E(mu) can fall only for kappa > _FALL_KAPPA and 0 < lam < _FALL_LAMBDA; the fall is
+# scanned on _FALL_GRID points and located to _FALL_BISECTIONS halvings of a grid step.
 _FALL_KAPPA = 1.0
 _FALL_LAMBDA = 0.075  # a margin above LAMBDA_INFINITY
 _FALL_GRID = 256
