@@ -197,18 +197,10 @@ def _ecof_ratio_map(amplitude: float, mu: float, window: tuple) -> tuple:
     """μ_E/μ over (z_o/x_o, S/P) in the window, by :func:`ecofmaps.compute_map`, and where
     there is no gross slip (1.0, else 0.0)."""
     low, high, deepest = window
-    dataset = compute_map(
-        np.linspace(low, high, _MAP_POINTS[0]),
-        np.linspace(0.0, deepest, _MAP_POINTS[1]),
-        amplitude=amplitude,
-        mu=mu,
-        cache=False,
-    )
+    x, y = np.linspace(low, high, _MAP_POINTS[0]), np.linspace(0.0, deepest, _MAP_POINTS[1])
+    dataset = compute_map(x, y, amplitude=amplitude, mu=mu, cache=False)
     stuck = (dataset["regime"] == NO_GROSS_SLIP).astype(np.float64)
-    return (
-        np.ascontiguousarray(dataset["ecof_ratio"].values.T),
-        np.ascontiguousarray(stuck.values.T),
-    )
+    return tuple(np.ascontiguousarray(grid.values.T) for grid in (dataset["ecof_ratio"], stuck))
 
 
 def _number(value: float, factor: float = 1.0) -> str:
@@ -234,7 +226,6 @@ def _inputs_html(values: dict) -> str:
 def _values_html(point: ExplorerPoint, values: dict) -> str:
     """The inputs as read, and the model's numbers at the point, each with its unit in a span
     the page and its tests can find."""
-    gross = math.isfinite(point.ecof_ratio)
     rows = [
         ("slip_amplitude", "Slip amplitude δ*", point.slip_amplitude),
         ("dissipated_energy", "Dissipated energy E_d", point.dissipated_energy),
@@ -250,6 +241,7 @@ def _values_html(point: ExplorerPoint, values: dict) -> str:
             f"<td><span class='ecofmaps-value' data-quantity='{key}' data-unit='{unit}'>"
             f"{_number(value, quantity.display_factor)}</span> {unit}</td></tr>"
         )
+    gross = math.isfinite(point.ecof_ratio)
     regime = "" if gross else "<p><b>No gross slip</b> (μP/S ≥ Δ*): μ_E is undefined.</p>"
     return f"{_inputs_html(values)}<table style='font-size:14px'>{''.join(cells)}</table>{regime}"
 

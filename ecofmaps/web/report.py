@@ -252,12 +252,9 @@ def _evolution_figures(results: xr.Dataset):
     data["mu_low"] = data["mu_resolved"] - 2.0 * data["mu_resolved_se"]
     data["mu_high"] = data["mu_resolved"] + 2.0 * data["mu_resolved_se"]
     source = ColumnDataSource(data)
-    plot = figure(
-        frame_width=_FRAME[0],
+    plot = _cycle_figure(
         frame_height=300,
-        min_border_left=_FRAME[1],
         title="Coefficients of friction over the test",
-        x_axis_label=_label("cycle"),
         y_axis_label="Coefficient of friction [1]",
         tools="pan,box_zoom,wheel_zoom,reset,save",
     )
@@ -290,10 +287,18 @@ def _evolution_figures(results: xr.Dataset):
             renderers=[drawn["ecof"]],
         )
     )
-    plot.xaxis.formatter = BasicTickFormatter(use_scientific=False)
     plot.legend.click_policy = "hide"
     plot.add_layout(plot.legend[0], "right")  # beside the plot: the curves stay uncovered
     return plot, _flags_figure(results, plot)
+
+
+def _cycle_figure(**options):
+    """A plot over the cycles, its frame lined up with the other's."""
+    plot = figure(
+        frame_width=_FRAME[0], min_border_left=_FRAME[1], x_axis_label=_label("cycle"), **options
+    )
+    plot.xaxis.formatter = BasicTickFormatter(use_scientific=False)
+    return plot
 
 
 def _flagged_cycles(results: xr.Dataset) -> dict[str, np.ndarray]:
@@ -314,26 +319,18 @@ def _flags_figure(results: xr.Dataset, evolution):
     if not flagged:
         return Div(text="<p>No cycle is flagged: every cycle's quality is 'ok'.</p>")
     reasons = list(flagged)[::-1]  # the first reason at the top
-    plot = figure(
-        frame_width=_FRAME[0],
+    plot = _cycle_figure(
         frame_height=26 * len(reasons),
-        min_border_left=_FRAME[1],
         y_range=reasons,
         x_range=evolution.x_range,
         toolbar_location=None,
         title="Quality flags (the values they leave out are NaN)",
-        x_axis_label=_label("cycle"),
         tools="xpan,xwheel_zoom,reset",
     )
-    marks = ColumnDataSource(
-        {
-            "cycle": np.concatenate(list(flagged.values())),
-            "reason": [reason for reason, cycles in flagged.items() for _ in cycles],
-        }
-    )
+    reason = [reason for reason, cycles in flagged.items() for _ in cycles]
+    marks = ColumnDataSource({"cycle": np.concatenate(list(flagged.values())), "reason": reason})
     mark = {"marker": "dash", "size": 10, "line_width": 2, "color": "#d62728"}
     plot.scatter("cycle", "reason", source=marks, angle=np.pi / 2, **mark)
-    plot.xaxis.formatter = BasicTickFormatter(use_scientific=False)
     plot.add_tools(HoverTool(tooltips=[("cycle", "@cycle"), ("flag", "@reason")]))
     return plot
 
