@@ -148,7 +148,11 @@ def _read(path: Path, on_profile: bool = False, keep_bad: bool = False):
 
 def _row_values(path, line: int, row, column: dict, on_profile: bool, commas: bool) -> dict:
     """The SI values of one row: the required columns and (not on a profile) its aspect ratio."""
-    values = {name: _number(path, line, name, row[column[name]], commas) for name in _REQUIRED}
+
+    def number(name: str) -> float:
+        return _number(path, line, name, row[column[name]], commas)
+
+    values = {name: number(name) for name in _REQUIRED}
     if not on_profile:
         given_ratio = "aspect_ratio" in column and row[column["aspect_ratio"]].strip() != ""
         given_scar = [name in column and row[column[name]].strip() != "" for name in _SCAR]
@@ -159,11 +163,9 @@ def _row_values(path, line: int, row, column: dict, on_profile: bool, commas: bo
                 "give the aspect ratio one way: aspect_ratio, or both scar_depth_um and "
                 "scar_half_width_um",
             )
+        depth, width = _SCAR
         values["aspect_ratio"] = (
-            _number(path, line, "aspect_ratio", row[column["aspect_ratio"]], commas)
-            if given_ratio
-            else _number(path, line, "scar_depth_um", row[column["scar_depth_um"]], commas)
-            / _number(path, line, "scar_half_width_um", row[column["scar_half_width_um"]], commas)
+            number("aspect_ratio") if given_ratio else number(depth) / number(width)
         )
     return values
 
