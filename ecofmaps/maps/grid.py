@@ -204,16 +204,9 @@ def compute_map(
                 "chunks is for maps of the parabolic groove; a map on a profile "
                 "is computed in memory"
             )
+        options = dict(mapping=mapping, cache=cache is not False, cache_dir=cache_dir)
         return compute_profile_map(
-            stiffness_ratio,
-            amplitude,
-            mu,
-            load,
-            profile=profile,
-            mapping=mapping,
-            cache=cache is not False,
-            cache_dir=cache_dir,
-            max_chunk=max_chunk,
+            stiffness_ratio, amplitude, mu, load, profile=profile, max_chunk=max_chunk, **options
         )
     if mapping != "scaled":
         raise ValueError("mapping applies to a profile only (profile=...)")
