@@ -137,11 +137,8 @@ def lookup_correction(
     if ecof_map.sizes["mu"] < 2:
         raise ValueError("map_dataset's 'mu' dimension must have at least 2 values")
     axes, fixed = _map_axes(ecof_map)
-    query = {
-        "stiffness_ratio": (stiffness / load).ravel(),
-        "aspect_ratio": ratio.ravel(),
-        "amplitude": amplitude.ravel(),
-    }
+    query = {"stiffness_ratio": stiffness / load, "aspect_ratio": ratio, "amplitude": amplitude}
+    query = {name: value.ravel() for name, value in query.items()}
     inside = np.ones(ecof.size, dtype=bool)
     for name, value in fixed.items():
         if math.isfinite(value):
@@ -163,8 +160,7 @@ def lookup_correction(
         table = np.take(table, order, axis=axis)
     table = np.take(table, mu_order, axis=-1).astype(np.float64)
     if axes:
-        interpolate = RegularGridInterpolator([v for _, v, _ in axes], table)
-        curves = interpolate(np.stack(points, axis=-1))
+        curves = RegularGridInterpolator([v for _, v, _ in axes], table)(np.stack(points, axis=-1))
     else:
         curves = np.broadcast_to(table, (ecof.size, mu_grid.size))
     mu, count = _crossing(curves, mu_grid[mu_order], ecof.ravel())
