@@ -113,10 +113,7 @@ def cache_directory(cache_dir=None) -> Path:
     """
     if cache_dir is not None:
         return Path(cache_dir)
-    environment = os.environ.get(ENVIRONMENT_VARIABLE)
-    if environment:
-        return Path(environment)
-    return Path(platformdirs.user_cache_dir("ecofmaps"))
+    return Path(os.environ.get(ENVIRONMENT_VARIABLE) or platformdirs.user_cache_dir("ecofmaps"))
 
 
 def cache_size_bound() -> int:
