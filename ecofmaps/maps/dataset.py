@@ -1,9 +1,5 @@
-"""The labelled xarray Dataset of a map: checked grid axes, variables and attributes.
-
-Every coordinate and variable takes its ``long_name`` and ``units`` from
-:mod:`ecofmaps._nomenclature` (the regime codes their CF flag attributes), and every map
-carries the paper's model and citation as global attributes.
-"""
+"""The labelled xarray Dataset of a map: checked grid axes, variables and attributes (names
+and units from :mod:`ecofmaps._nomenclature`, the paper's model and citation)."""
 
 from __future__ import annotations
 

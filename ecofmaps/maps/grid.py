@@ -1,12 +1,8 @@
 r"""Parameter maps: the model over whole grids, as labelled xarray Datasets.
 
 Each function takes one value or one 1-D array per parameter; the arrays become the
-Dataset's dimensions, the single values its scalar coordinates. The grid is evaluated by a
-jit-compiled kernel of the dimensionless core in tiles on every core
-(:mod:`ecofmaps.maps.tiles`), or lazily with ``chunks=`` as a dask-backed Dataset equal to
-the bit. :func:`compute_map` and :func:`compute_universal_map` keep their results in the disk
-cache only when asked (``cache=True``; :mod:`ecofmaps.maps.cache`). As in the paper,
-:math:`x_o = \Delta^*`.
+Dataset's dimensions, the single values its scalar coordinates. As in the paper,
+:math:`x_o = \Delta^*`. Tiles, blocks and the cache: docs/performance.md.
 """
 
 from __future__ import annotations

@@ -1,8 +1,5 @@
-"""Grid evaluation in tiles (in memory, on every core) and in blocks of tiles (dask).
-
-A jit-compiled kernel is evaluated over the grid in tiles of at most ``max_chunk`` points by
-one thread per core (memory checked before allocating); a chunked map is a dask graph of
-blocks of the same tiles, so its values equal the in-memory map's to the bit.
+"""Grid evaluation in tiles (in memory, on every core) and in blocks of tiles (dask), so that
+both give the same values to the bit: docs/performance.md, "Maps".
 """
 
 from __future__ import annotations

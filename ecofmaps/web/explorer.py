@@ -1,10 +1,8 @@
 """A live explorer of the model in the browser (``ecofmaps explore``), built with Panel.
 
-One page per session: the test's parameters typed with units (``50um``, ``35MN/m``), and at
-that point the slip amplitude, the energy and :math:`\\mu_E/\\mu`, the steady loop, the map
-of :math:`\\mu_E/\\mu` (Figure 11's labelled contours, no gross slip hatched) with the point
-marked, and the contact CoF behind a typed ECoF. The inputs live in the page's URL query, so
-a view is shared as a link.
+One page per session: the parameters typed with units, the model's numbers and steady loop at
+that point, Figure 11's map with the point marked, and the contact CoF behind a typed ECoF.
+The inputs live in the page's URL query, so a view is shared as a link.
 """
 
 from __future__ import annotations
