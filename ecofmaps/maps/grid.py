@@ -21,11 +21,7 @@ from ecofmaps.maps.tiles import MAX_CHUNK, grid_values
 from ecofmaps.model.simulation import fretting_loop
 from ecofmaps.model.steady_state import dimensionless
 
-__all__ = [
-    "compute_loops",
-    "compute_map",
-    "compute_universal_map",
-]
+__all__ = ["compute_loops", "compute_map", "compute_universal_map"]
 
 
 def _mesh(*axes):

@@ -30,13 +30,7 @@ from ecofmaps.model.steady_state import dissipated_energy, energy_cof, slip_ampl
 from ecofmaps.paper import FIGURE_11_STIFFNESS_RATIOS
 from ecofmaps.units import DIMENSIONS, TEXT_LIMIT, bare_number_warning, parse_quantity
 
-__all__ = [
-    "INPUTS",
-    "ExplorerPoint",
-    "bare_number_warnings",
-    "explorer_page",
-    "parameter_value",
-]
+__all__ = ["INPUTS", "ExplorerPoint", "bare_number_warnings", "explorer_page", "parameter_value"]
 
 #: The page's inputs: URL query key -> (quantity of the nomenclature, label, default text,
 #: the physical bounds the explorer takes in SI, a rigid rig's infinite stiffness apart).
