@@ -284,11 +284,6 @@ def _ignored(unraisable) -> None:
     """An exception raised in a finalizer: ignored."""
 
 
-def _used(path: Path) -> None:
-    """Set ``path``'s access time to now, for the least-recently-used order."""
-    os.utime(path, ns=(time.time_ns(), path.stat().st_mtime_ns))
-
-
 def _reason(error: BaseException) -> str:
     """``error`` in one line."""
     text = " ".join(str(error).split()) or "no reason given"
@@ -323,10 +318,7 @@ def _evict(directory: Path, bound: int, keep: Path) -> None:
 
 
 def cached_dataset(
-    function: str,
-    inputs: Mapping[str, object],
-    compute: Callable[[], xr.Dataset],
-    cache_dir=None,
+    function: str, inputs: Mapping[str, object], compute: Callable[[], xr.Dataset], cache_dir=None
 ) -> xr.Dataset:
     """The cached result of ``compute()``, computing and storing it on a miss.
 
@@ -363,8 +355,8 @@ def cached_dataset(
     path = directory / f"{function}-{key[:_NAME_DIGITS]}.nc"
     dataset = _stored(path, key) if path.is_file() else None  # not a folder of the user's
     if dataset is not None:
-        with contextlib.suppress(OSError):  # removed meanwhile, or read-only: only a hint
-            _used(path)
+        with contextlib.suppress(OSError):  # the access time orders eviction; only a hint
+            os.utime(path, ns=(time.time_ns(), path.stat().st_mtime_ns))
         return dataset
     dataset = compute()
     try:
