@@ -146,13 +146,8 @@ class ExplorerPoint:
         point = (amplitude, load, stiffness, mu, aspect_ratio)
         with warnings.catch_warnings(action="ignore"):  # no gross slip: the page says so
             ratio = float(energy_cof(*point)) / mu
-        displacement, force = fretting_loop(*point)
-        return cls(
-            float(slip_amplitude(*point)),
-            float(dissipated_energy(*point)),
-            ratio,
-            (np.asarray(displacement), np.asarray(force)),
-        )
+        loop = tuple(np.asarray(values) for values in fretting_loop(*point))
+        return cls(float(slip_amplitude(*point)), float(dissipated_energy(*point)), ratio, loop)
 
 
 def _grown(value: float, upward: bool) -> float:
@@ -467,7 +462,11 @@ def explorer_page():
     for widget in inputs.values():
         widget.param.watch(update, "value")
     update()
-    model_inputs = [inputs[key] for key in _MODEL_INPUTS]
+    at_point = pn.Column(
+        *(inputs[key] for key in _MODEL_INPUTS),
+        pn.pane.HTML("<h3 style='margin:8px 0 0 0'>At this point</h3>"),
+        values_pane,
+    )
     correction_inputs = [inputs[key] for key in ("ecof", "aspect_ratio_low", "aspect_ratio_high")]
     intro = pn.pane.HTML(
         "<h2 style='margin:4px 0'>ecofmaps explorer: the compliant wear-scar model</h2>"
@@ -479,15 +478,7 @@ def explorer_page():
         intro,
         message,
         notice,
-        pn.Row(
-            pn.Column(
-                *model_inputs,
-                pn.pane.HTML("<h3 style='margin:8px 0 0 0'>At this point</h3>"),
-                values_pane,
-            ),
-            pn.pane.Bokeh(loop_plot),
-            pn.pane.Bokeh(map_plot),
-        ),
+        pn.Row(at_point, pn.pane.Bokeh(loop_plot), pn.pane.Bokeh(map_plot)),
         pn.pane.HTML("<h3 style='margin:0'>Correct a reported ECoF</h3>"),
         pn.Row(*correction_inputs, correction_pane),
     )

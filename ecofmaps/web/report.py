@@ -413,14 +413,10 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
     measured_x = np.round(chosen["loop_displacement"].values * 1e6, 4)
     measured_y = np.round(chosen["loop_force"].values, 3)
     kept = [np.isfinite(x) & np.isfinite(y) for x, y in zip(measured_x, measured_y, strict=True)]
+    xs = [x[keep] for x, keep in zip(measured_x, kept, strict=True)]
+    ys = [y[keep] for y, keep in zip(measured_y, kept, strict=True)]
     all_loops = ColumnDataSource(
-        {
-            "label": names,
-            "xs": [x[keep] for x, keep in zip(measured_x, kept, strict=True)],
-            "ys": [y[keep] for y, keep in zip(measured_y, kept, strict=True)],
-            "model_xs": model_xs,
-            "model_ys": model_ys,
-        }
+        dict(label=names, xs=xs, ys=ys, model_xs=model_xs, model_ys=model_ys)
     )
     first = list(dict.fromkeys([names[0], names[len(names) // 2], names[-1]]))
     palette = list(Category10_10)
