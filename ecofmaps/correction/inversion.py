@@ -21,6 +21,7 @@ from ecofmaps.correction.outcomes import (
     CorrectionStatus,
     Interval,
     ambiguity_marked,
+    check_test,
     ecof_and_slope,
     ecof_fall,
     ecof_fall_where_needed,
@@ -31,10 +32,6 @@ from ecofmaps.model.steady_state import valid_geometry
 
 __all__ = ["contact_cof", "correct_ecof", "correction_factor", "groove_aspect_ratio"]
 
-
-# ---------------------------------------------------------------------------------------
-# The dimensionless core: mu from mu_E at (kappa, lam)
-# ---------------------------------------------------------------------------------------
 
 _EPS = float(np.finfo(np.float64).eps)
 _MAX_STEPS = 300  # the bracket [0, mu_E] halves at least every two steps
@@ -116,10 +113,8 @@ def contact_cof(ecof, kappa, lam):
     Returns
     -------
     mu : jax.Array
-        The contact CoF, within a few ulp of the exact root: :math:`|\mu_E(\mu) -
-        \mu_E^{given}| \le 10^{-12}\mu_E^{given}` wherever one ulp of :math:`\mu` moves
-        :math:`\mu_E` by less (everywhere but a rigid rig next to locking,
-        :math:`1 - \mu\kappa < 10^{-5}`); NaN unless the status is ``CORRECTED``. [1]
+        The contact CoF, within a few ulp of the exact root (as :func:`correct_ecof`); NaN
+        unless the status is ``CORRECTED``. [1]
     status : jax.Array of int32
         :class:`CorrectionStatus` codes.
 
@@ -138,23 +133,12 @@ def contact_cof(ecof, kappa, lam):
     return ambiguity_marked(mu, status, ecof, *ecof_fall_where_needed(status, kappa, lam))
 
 
-# ---------------------------------------------------------------------------------------
-# SI-unit API
-# ---------------------------------------------------------------------------------------
-
-
-def _core_numbers(amplitude, load, stiffness, aspect_ratio):
-    """:math:`\\kappa` and :math:`\\lambda` with :math:`x_o = \\Delta^*`, and SI validity."""
-    kappa = model.curvature_number(1.0, aspect_ratio, 1.0)  # x_o = Δ*: κ = 2 z_o/x_o
-    lam = model.compliance_ratio(amplitude, load, stiffness)
-    valid = valid_geometry(amplitude, load, stiffness, aspect_ratio, amplitude)
-    return kappa, lam, valid
-
-
 @jax.jit
 def _si_root(ecof, amplitude, load, stiffness, aspect_ratio):
     """Root, status, kappa and lam over the broadcast shape; no ambiguity check."""
-    kappa, lam, valid = _core_numbers(amplitude, load, stiffness, aspect_ratio)
+    kappa = model.curvature_number(1.0, aspect_ratio, 1.0)  # x_o = Δ*: κ = 2 z_o/x_o
+    lam = model.compliance_ratio(amplitude, load, stiffness)
+    valid = valid_geometry(amplitude, load, stiffness, aspect_ratio, amplitude)
     mu, status = _root_and_status(ecof, kappa, lam)
     status = jnp.where(valid, status, int(CorrectionStatus.INVALID)).astype(jnp.int32)
     mu = jnp.where(valid, mu, jnp.nan)
@@ -174,8 +158,7 @@ def _si_correct(ecof, amplitude, load, stiffness, aspect_ratio):
         where = np.flatnonzero(
             np.asarray(may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
         )
-        high = np.full(mu.size, np.nan)
-        low = np.full(mu.size, np.nan)
+        high, low = np.full((2, mu.size), np.nan)
         if where.size:
             size = max(8, 1 << (where.size - 1).bit_length())  # few distinct shapes to compile
             padded = np.pad(where, (0, size - where.size), mode="edge")
@@ -203,8 +186,8 @@ def groove_aspect_ratio(aspect_ratio, scar_depth, scar_half_width):
                     "per-point values)"
                 )
             low, high = aspect_ratio
-            check("aspect_ratio low", low, "non_negative", "1")
-            check("aspect_ratio high", high, "non_negative", "1")
+            for end, value in (("low", low), ("high", high)):
+                check(f"aspect_ratio {end}", value, "non_negative", "1")
             if is_concrete(low, high) and np.any(np.asarray(low) > np.asarray(high)):
                 raise ValueError(
                     f"aspect_ratio interval must have low <= high, got ({low!r}, {high!r})"
@@ -240,22 +223,12 @@ def _failure_message(status, ecof, details) -> str:
     )
 
 
-def _correct(
-    ecof,
-    amplitude,
-    load,
-    stiffness,
-    aspect_ratio,
-    scar_depth,
-    scar_half_width,
-    return_status,
-    factor,
-    caller,
-    profile=None,
-    mapping="scaled",
-):
+def _correct(factor, ecof, amplitude, load, stiffness, scar, profile, mapping, return_status):
+    """correct_ecof, or correction_factor if ``factor``; ``scar`` is (aspect_ratio, scar_depth,
+    scar_half_width)."""
+    caller = "correction_factor" if factor else "correct_ecof"
     if profile is not None:
-        if aspect_ratio is not None or scar_depth is not None or scar_half_width is not None:
+        if any(value is not None for value in scar):
             raise ValueError(
                 "give the groove one way: aspect_ratio, scar_depth and scar_half_width, or "
                 "profile, not several"
@@ -265,11 +238,8 @@ def _correct(
         )
     if mapping != "scaled":
         raise ValueError("mapping applies to a profile only (profile=...)")
-    check("ecof", ecof, "positive", "1")
-    check("amplitude", amplitude, "positive", "m")
-    check("load", load, "positive", "N")
-    check("stiffness", stiffness, "positive_or_inf", "N/m")
-    ratio = groove_aspect_ratio(aspect_ratio, scar_depth, scar_half_width)
+    check_test(ecof, amplitude, load, stiffness)
+    ratio = groove_aspect_ratio(*scar)
     ecof, amplitude, load, stiffness = (as_float64(v) for v in (ecof, amplitude, load, stiffness))
     ends = ratio if isinstance(ratio, tuple) else (ratio,)
     results = [_si_correct(ecof, amplitude, load, stiffness, end) for end in ends]
@@ -357,20 +327,8 @@ def correct_ecof(
     mapping="scaled",
     return_status=False,
 ):
-    return _correct(
-        ecof,
-        amplitude,
-        load,
-        stiffness,
-        aspect_ratio,
-        scar_depth,
-        scar_half_width,
-        return_status,
-        False,
-        "correct_ecof",
-        profile,
-        mapping,
-    )
+    scar = (aspect_ratio, scar_depth, scar_half_width)
+    return _correct(False, ecof, amplitude, load, stiffness, scar, profile, mapping, return_status)
 
 
 correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy CoF :math:`\\mu_E`.
@@ -393,24 +351,10 @@ correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy
 {_RAISES}
     Notes
     -----
-    Inverts the corrected eq. 13-15 with eq. 16 by bracketed Newton steps (see
-    :mod:`ecofmaps.correction` for the domain: which ECoFs can be reached, where the
-    inversion is unique, and why the interval is exact). :math:`\\mu \\le \\mu_E`, with
-    equality for a flat scar.
-
-    ``jax.grad`` (and ``jax.jvp``, ``jax.jit``, ``jax.vmap``) works with the aspect ratio
-    given as a number or by the scar's dimensions, not with a profile: the derivative is the
-    implicit function theorem's on :math:`\\mu_E(\\mu) = \\mu_E^{{given}}`, e.g.
-    :math:`d\\mu/d\\mu_E = 1/(d\\mu_E/d\\mu)`, exact at the root returned (the iterations
-    are not differentiated). A point that cannot be corrected is NaN, a constant, whose
-    derivative is 0: check the status (``return_status=True``).
-
-    On a profile :math:`\\mu_E(\\mu)` is scanned on a grid of 400 contact CoFs, log-spaced
-    from a fiftieth of the smallest ECoF to the largest (:math:`\\mu \\le \\mu_E` on every
-    profile), to bracket the root and to find several (``AMBIGUOUS``); then the bracket is
-    narrowed by the Illinois method to a few ulp. A fall of :math:`\\mu_E(\\mu)` narrower
-    than one grid step (1 % of :math:`\\mu` for one ECoF; the steps widen with the spread of
-    the ECoFs corrected together), or below the grid, is not seen.
+    Inverts the corrected eq. 13-15 with eq. 16 by bracketed Newton steps; which ECoFs can
+    be reached, where the inversion is unique, why the interval is exact, and the scan on a
+    profile: ``docs/model.md``. :math:`\\mu \\le \\mu_E`, with equality for a flat scar.
+    ``jax.grad``, ``jax.jit`` and ``jax.vmap`` work without a profile (``docs/api.md``).
 
     References
     ----------
@@ -442,20 +386,8 @@ def correction_factor(
     mapping="scaled",
     return_status=False,
 ):
-    return _correct(
-        ecof,
-        amplitude,
-        load,
-        stiffness,
-        aspect_ratio,
-        scar_depth,
-        scar_half_width,
-        return_status,
-        True,
-        "correction_factor",
-        profile,
-        mapping,
-    )
+    scar = (aspect_ratio, scar_depth, scar_half_width)
+    return _correct(True, ecof, amplitude, load, stiffness, scar, profile, mapping, return_status)
 
 
 correction_factor.__doc__ = f"""The ratio :math:`\\mu/\\mu_E` of contact CoF to reported ECoF.

@@ -13,9 +13,9 @@ import math
 import numpy as np
 
 from ecofmaps._codes import warn_nan
-from ecofmaps._inputs import check, si_units
+from ecofmaps._inputs import si_units
 from ecofmaps.correction.inversion import groove_aspect_ratio
-from ecofmaps.correction.outcomes import CorrectionStatus
+from ecofmaps.correction.outcomes import CorrectionStatus, check_test
 
 __all__ = ["lookup_correction"]
 
@@ -125,13 +125,7 @@ def lookup_correction(
 
     if isinstance(aspect_ratio, tuple):
         raise ValueError("lookup_correction takes no aspect_ratio interval; use correct_ecof")
-    for name, value, rule, unit in (
-        ("ecof", ecof, "positive", "1"),
-        ("amplitude", amplitude, "positive", "m"),
-        ("load", load, "positive", "N"),
-        ("stiffness", stiffness, "positive_or_inf", "N/m"),
-    ):
-        check(name, value, rule, unit)
+    check_test(ecof, amplitude, load, stiffness)
     ratio = np.asarray(groove_aspect_ratio(aspect_ratio, scar_depth, scar_half_width))
     ecof, amplitude, load, stiffness, ratio = np.broadcast_arrays(
         *(np.asarray(v, dtype=np.float64) for v in (ecof, amplitude, load, stiffness)), ratio
@@ -143,11 +137,8 @@ def lookup_correction(
     if ecof_map.sizes["mu"] < 2:
         raise ValueError("map_dataset's 'mu' dimension must have at least 2 values")
     axes, fixed = _map_axes(ecof_map)
-    query = {
-        "stiffness_ratio": (stiffness / load).ravel(),
-        "aspect_ratio": ratio.ravel(),
-        "amplitude": amplitude.ravel(),
-    }
+    query = {"stiffness_ratio": stiffness / load, "aspect_ratio": ratio, "amplitude": amplitude}
+    query = {name: value.ravel() for name, value in query.items()}
     inside = np.ones(ecof.size, dtype=bool)
     for name, value in fixed.items():
         if math.isfinite(value):
@@ -169,8 +160,7 @@ def lookup_correction(
         table = np.take(table, order, axis=axis)
     table = np.take(table, mu_order, axis=-1).astype(np.float64)
     if axes:
-        interpolate = RegularGridInterpolator([v for _, v, _ in axes], table)
-        curves = interpolate(np.stack(points, axis=-1))
+        curves = RegularGridInterpolator([v for _, v, _ in axes], table)(np.stack(points, axis=-1))
     else:
         curves = np.broadcast_to(table, (ecof.size, mu_grid.size))
     mu, count = _crossing(curves, mu_grid[mu_order], ecof.ravel())

@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 
 from ecofmaps._codes import warn_nan
-from ecofmaps._inputs import check, is_concrete
-from ecofmaps.correction.outcomes import CorrectionStatus
+from ecofmaps._inputs import is_concrete
+from ecofmaps.correction.outcomes import CorrectionStatus, check_test
 from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers
 
 __all__ = ["correct_on_profile"]
@@ -35,13 +35,7 @@ def correct_on_profile(
     """correct_ecof / correction_factor on a profile (see correct_ecof's Notes)."""
     check_mapping(mapping, None)
     profile = as_profile(profile)
-    for name, value, rule, unit in (
-        ("ecof", ecof, "positive", "1"),
-        ("amplitude", amplitude, "positive", "m"),
-        ("load", load, "positive", "N"),
-        ("stiffness", stiffness, "positive_or_inf", "N/m"),
-    ):
-        check(name, value, rule, unit)
+    check_test(ecof, amplitude, load, stiffness)
     if not is_concrete(ecof, amplitude, load, stiffness, *profile):
         raise ValueError(
             f"{caller} on a profile needs concrete inputs: it does not run under "

@@ -15,7 +15,7 @@ import jax.numpy as jnp
 
 from ecofmaps import model
 from ecofmaps._codes import Code
-from ecofmaps._inputs import as_float64
+from ecofmaps._inputs import as_float64, check
 
 __all__ = [
     "AMBIGUOUS_ECOF_MIN",
@@ -23,6 +23,7 @@ __all__ = [
     "CorrectionStatus",
     "Interval",
     "ambiguity_marked",
+    "check_test",
     "ecof_and_slope",
     "ecof_fall",
     "ecof_fall_where_needed",
@@ -50,9 +51,8 @@ class CorrectionStatus(Code):
         One contact CoF gives the ECoF; it is returned.
     NO_GROSS_SLIP
         The ECoF is at or above :math:`S\\Delta^*/P`, above every gross-slip
-        :math:`\\mu_E` of these test conditions: a contact CoF high enough to give it would
-        stop gross slip (:math:`\\mu P \\ge S\\Delta^*`), and with no gross slip there is
-        no ECoF. The value cannot come from the model with these conditions.
+        :math:`\\mu_E` of these test conditions: a contact CoF that high would stop gross
+        slip (:math:`\\mu P \\ge S\\Delta^*`).
     AMBIGUOUS
         Several contact CoFs give the ECoF (deep groove, :math:`\\kappa > 1`, and stiff rig,
         :math:`\\lambda <` :data:`LAMBDA_INFINITY`, where :math:`\\mu_E(\\mu)` falls over
@@ -64,8 +64,7 @@ class CorrectionStatus(Code):
         :func:`lookup_correction` only: the point, or the ECoF, is outside the map.
     UNREACHABLE
         On a scar profile only: no contact CoF gives the ECoF although it is below
-        :math:`S\\Delta^*/P`: it falls in a jump of :math:`\\mu_E(\\mu)` (the loop's ends
-        jump where the pad starts to jump) or would need the pad to slip off the trace.
+        :math:`S\\Delta^*/P` (a jump of :math:`\\mu_E(\\mu)`, or a slip off the trace).
     """
 
     CORRECTED = 0, "corrected"
@@ -98,13 +97,20 @@ class Interval(NamedTuple):
     high: jax.Array
 
 
-# mu_E(mu) can fall only for kappa > _FALL_KAPPA and 0 < lam < _FALL_LAMBDA (docs/model.md,
-# correcting a reported ECoF); the fall lies in 1/kappa < mu < 1, scanned on _FALL_GRID
-# points in log(mu) and located to _FALL_BISECTIONS halvings of a grid step.
+# mu_E(mu) can fall only for kappa > _FALL_KAPPA and 0 < lam < _FALL_LAMBDA; the fall is
+# scanned on _FALL_GRID points and located to _FALL_BISECTIONS halvings of a grid step.
 _FALL_KAPPA = 1.0
 _FALL_LAMBDA = 0.075  # a margin above LAMBDA_INFINITY
 _FALL_GRID = 256
 _FALL_BISECTIONS = 48
+
+
+def check_test(ecof, amplitude, load, stiffness) -> None:
+    """``ValueError`` for a concrete ECoF or test condition out of its range."""
+    check("ecof", ecof, "positive", "1")
+    check("amplitude", amplitude, "positive", "m")
+    check("load", load, "positive", "N")
+    check("stiffness", stiffness, "positive_or_inf", "N/m")
 
 
 def ecof_and_slope(mu, kappa, lam):
@@ -114,21 +120,13 @@ def ecof_and_slope(mu, kappa, lam):
 
 def reachability_status(ecof, kappa, lam):
     """The status before the ambiguity check: which ECoFs the model can reach."""
-    valid = (
-        (ecof > 0.0)
-        & jnp.isfinite(ecof)
-        & (kappa >= 0.0)
-        & jnp.isfinite(kappa)
-        & (lam >= 0.0)
-        & jnp.isfinite(lam)
-    )
-    reachable = ecof * lam < 1.0
+    valid = (ecof > 0.0) & jnp.isfinite(ecof)
+    for value in (kappa, lam):
+        valid &= (value >= 0.0) & jnp.isfinite(value)
     code = jnp.where(
-        valid,
-        jnp.where(reachable, int(CorrectionStatus.CORRECTED), int(CorrectionStatus.NO_GROSS_SLIP)),
-        int(CorrectionStatus.INVALID),
+        ecof * lam < 1.0, int(CorrectionStatus.CORRECTED), int(CorrectionStatus.NO_GROSS_SLIP)
     )
-    return code.astype(jnp.int32)
+    return jnp.where(valid, code, int(CorrectionStatus.INVALID)).astype(jnp.int32)
 
 
 def may_fall(kappa, lam):
@@ -157,14 +155,8 @@ def ecof_fall(kappa, lam):
 
     Notes
     -----
-    The fall exists only for :math:`\kappa > 1` and :math:`0 < \lambda <` :data:`LAMBDA_INFINITY`
-    and lies in
-    :math:`1/\kappa < \mu < 1` (:mod:`ecofmaps.correction.inversion`); there the slope
-    :math:`d\mu_E/d\mu` (``jax.jvp`` of the corrected eq. 13-15 with eq. 16) is sampled at
-    256 points evenly spaced in :math:`\log\mu`, and its two sign changes are bisected. A
-    fall narrower than one grid step (:math:`\ln\kappa/255` in :math:`\log\mu`), at the very
-    edge of the region where it exists, is not seen: the contact CoFs it would make
-    ambiguous then lie within about two grid steps of each other.
+    The fall exists only for :math:`\kappa > 1` and :math:`0 < \lambda <` :data:`LAMBDA_INFINITY`;
+    how it is found, and what it can miss: ``docs/model.md`` (correcting a reported ECoF).
 
     References
     ----------

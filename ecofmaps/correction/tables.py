@@ -55,6 +55,8 @@ STATUS_COLUMN = "status"
 
 _REQUIRED = tuple(nomenclature.column(n) for n in ("ecof", "amplitude", "load", "stiffness"))
 _SCAR = tuple(nomenclature.column(n) for n in ("scar_depth", "scar_half_width"))
+# When a one-column header suggests the wrong separator was guessed.
+_SEPARATOR_HINT = " (the header holds no tab, ';' or ',': separate the columns with one of them)"
 
 
 class TableError(FileLineError):
@@ -105,7 +107,7 @@ def _read(path: Path, on_profile: bool = False, keep_bad: bool = False):
     """
     try:
         with open(path, encoding="utf-8-sig", newline="") as stream:
-            lines = ["\n" if _is_comment(line) else line for line in stream]
+            lines = ["\n" if line.lstrip().startswith("#") else line for line in stream]
         header_line = next((line for line in lines if line.strip()), ",")
         dialect = table_dialect(header_line)
         records = list(_records(csv.reader(lines, delimiter=dialect.delimiter)))
@@ -126,12 +128,9 @@ def _read(path: Path, on_profile: bool = False, keep_bad: bool = False):
     bad = {}
     for index, (row, line) in enumerate(records):
         if len(row) != len(header):
-            raise TableError(
-                path,
-                line,
-                f"{len(row)} fields, but the header has {len(header)} columns"
-                + _separator_hint(header),
-            )
+            hint = "" if len(header) > 1 else _SEPARATOR_HINT
+            message = f"{len(row)} fields, but the header has {len(header)} columns{hint}"
+            raise TableError(path, line, message)
         try:
             numbers = _row_values(path, line, row, column, on_profile, commas)
         except TableError as error:
@@ -149,7 +148,11 @@ def _read(path: Path, on_profile: bool = False, keep_bad: bool = False):
 
 def _row_values(path, line: int, row, column: dict, on_profile: bool, commas: bool) -> dict:
     """The SI values of one row: the required columns and (not on a profile) its aspect ratio."""
-    values = {name: _number(path, line, name, row[column[name]], commas) for name in _REQUIRED}
+
+    def number(name: str) -> float:
+        return _number(path, line, name, row[column[name]], commas)
+
+    values = {name: number(name) for name in _REQUIRED}
     if not on_profile:
         given_ratio = "aspect_ratio" in column and row[column["aspect_ratio"]].strip() != ""
         given_scar = [name in column and row[column[name]].strip() != "" for name in _SCAR]
@@ -160,25 +163,11 @@ def _row_values(path, line: int, row, column: dict, on_profile: bool, commas: bo
                 "give the aspect ratio one way: aspect_ratio, or both scar_depth_um and "
                 "scar_half_width_um",
             )
+        depth, width = _SCAR
         values["aspect_ratio"] = (
-            _number(path, line, "aspect_ratio", row[column["aspect_ratio"]], commas)
-            if given_ratio
-            else _number(path, line, "scar_depth_um", row[column["scar_depth_um"]], commas)
-            / _number(path, line, "scar_half_width_um", row[column["scar_half_width_um"]], commas)
+            number("aspect_ratio") if given_ratio else number(depth) / number(width)
         )
     return values
-
-
-def _is_comment(line: str) -> bool:
-    """True for a comment line: ``#`` its first character other than spaces."""
-    return line.lstrip().startswith("#")
-
-
-def _separator_hint(header: list[str]) -> str:
-    """A hint when a one-column header suggests the wrong separator was guessed."""
-    if len(header) > 1:
-        return ""
-    return " (the header holds no tab, ';' or ',': separate the columns with one of them)"
 
 
 def _records(reader):
@@ -260,14 +249,7 @@ def correct_table(path, profile=None, mapping="scaled", bad_rows="raise") -> tup
     header, records, si, dialect, bad = _read(path, profile is not None, bad_rows == "nan")
     read = np.ones(len(records), bool)
     read[list(bad)] = False
-    rig = {
-        name: si[column][read]
-        for name, column in (
-            ("amplitude", "amplitude_um"),
-            ("load", "load_N"),
-            ("stiffness", "stiffness_MN_per_m"),
-        )
-    }
+    rig = {name: si[nomenclature.column(name)][read] for name in ("amplitude", "load", "stiffness")}
     mu, added = np.full(len(records), np.nan), [[] for _ in records]
     status = np.full(len(records), int(CorrectionStatus.INVALID))
     if profile is None:

@@ -1,13 +1,9 @@
 """The disk cache of results that are expensive to recompute: netCDF files keyed by their inputs.
 
 A result is one netCDF file ``<function>-<key>.nc`` in :func:`cache_directory`, keyed by
-:func:`cache_key` (the package version, the model's revision, the function, the exact
-inputs). HDF5 guards its arrays: each is stored in chunks with a Fletcher-32 checksum,
-verified as it is read; :func:`metadata_checksum` guards the rest. An entry that fails
-either, or that cannot be read, is removed and recomputed; a write that fails for any reason
-is one :class:`CacheWarning`, and the result is returned all the same. The cache keeps under
-a size bound (:func:`cache_size_bound`) by removing the least recently used entries. What is
-cached, and what a write and a read cost against computing: docs/performance.md, "The cache".
+:func:`cache_key`, its arrays in Fletcher-32 checksummed chunks and the rest under
+:func:`metadata_checksum`. What is cached, how entries are checked, written and evicted, and
+what a write and a read cost against computing: docs/performance.md, "The cache".
 """
 
 from __future__ import annotations
@@ -59,7 +55,7 @@ SIZE_VARIABLE = "ECOFMAPS_CACHE_SIZE"
 #: The bound on the cache's total size when :data:`SIZE_VARIABLE` is not set. [byte]
 DEFAULT_SIZE_BOUND = 10**9
 
-# The global attributes that tie a cache file to its key and to its metadata; removed on reading.
+# Global attributes that tie a cache file to its key and its metadata; removed on reading.
 _KEY_ATTRIBUTE = "ecofmaps_cache_key"
 _CHECKSUM_ATTRIBUTE = "ecofmaps_metadata_sha256"
 # The sources, relative to the package, whose code decides what a cached map holds.
@@ -86,28 +82,14 @@ _UNITS.update({"KiB": 2**10, "kiB": 2**10, "MiB": 2**20, "GiB": 2**30, "TiB": 2*
 
 
 class CacheWarning(UserWarning):
-    """A cache file could not be used (unreadable, damaged, foreign) or written; the result
-    is recomputed, or returned without being stored."""
+    """A cache file could not be used or written; the result is recomputed, or not stored."""
 
 
 @dataclass(frozen=True)
 class CacheEntry:
-    """One file of the cache.
-
-    Attributes
-    ----------
-    path : pathlib.Path
-        The netCDF file.
-    function : str
-        The function whose result it holds (``compute_map``, ...).
-    size : int
-        File size. [byte]
-    modified : datetime.datetime
-        Time of the last write (UTC).
-    used : datetime.datetime
-        Time of the last read or write (UTC): the least recently used entries are removed
-        first when the cache outgrows its bound.
-    """
+    """One file of the cache: its path, the function whose result it holds (``compute_map``,
+    ...), its size [byte], and the times (UTC) of its last write and its last use (read or
+    write; the least recently used entries are removed first)."""
 
     path: Path
     function: str
@@ -131,10 +113,7 @@ def cache_directory(cache_dir=None) -> Path:
     """
     if cache_dir is not None:
         return Path(cache_dir)
-    environment = os.environ.get(ENVIRONMENT_VARIABLE)
-    if environment:
-        return Path(environment)
-    return Path(platformdirs.user_cache_dir("ecofmaps"))
+    return Path(os.environ.get(ENVIRONMENT_VARIABLE) or platformdirs.user_cache_dir("ecofmaps"))
 
 
 def cache_size_bound() -> int:
@@ -143,9 +122,7 @@ def cache_size_bound() -> int:
     Returns
     -------
     bound : int
-        Bytes the cache's entries may take together. [byte] After each write, the least
-        recently used entries are removed until the others fit; a result larger than the
-        bound is not stored; 0 stores nothing.
+        Bytes the cache's entries may take together; 0 stores nothing. [byte]
 
     Raises
     ------
@@ -167,14 +144,8 @@ def cache_size_bound() -> int:
 
 @functools.cache
 def model_revision() -> str:
-    """SHA-256 of the source of the modules that compute maps (the model, the grid, the names).
-
-    Returns
-    -------
-    revision : str
-        64 hexadecimal digits; any edit of those files gives another revision, and so other
-        cache keys.
-    """
+    """SHA-256 (64 hex digits) of the source of the modules that compute maps: any edit of
+    them gives other cache keys."""
     package = Path(__file__).resolve().parents[1]
     digest = hashlib.sha256()
     for pattern in _MODEL_SOURCES:
@@ -185,24 +156,13 @@ def model_revision() -> str:
 
 
 def _chunked(variable: xr.Variable) -> bool:
-    """Whether ``variable`` is stored in chunks that carry a Fletcher-32 checksum."""
     return variable.ndim > 0 and variable.size > 0 and variable.dtype.kind in _CHUNKED_KINDS
 
 
 def metadata_checksum(dataset: xr.Dataset) -> str:
-    """SHA-256 of what the chunks' checksums do not cover: every name, dimension, type,
-    shape and attribute, and the values of text and scalar variables.
-
-    Parameters
-    ----------
-    dataset : xarray.Dataset
-        As read from the file (attributes take the types netCDF gives them).
-
-    Returns
-    -------
-    checksum : str
-        64 hexadecimal digits. The global attribute that holds the checksum is left out.
-    """
+    """SHA-256 (64 hex digits) of what the chunks' checksums do not cover: every name,
+    dimension, type, shape and attribute (but the checksum's own), and the values of text and
+    scalar variables, of ``dataset`` as read from the file."""
     digest = hashlib.sha256()
 
     def add(*parts) -> None:
@@ -225,21 +185,9 @@ def metadata_checksum(dataset: xr.Dataset) -> str:
 
 
 def cache_key(function: str, inputs: Mapping[str, object]) -> str:
-    """SHA-256 key of a computation: version, model revision, function, exact input values.
-
-    Parameters
-    ----------
-    function : str
-        Name of the function computing the result.
-    inputs : mapping of str to array_like or None
-        Every input that the result depends on, by name. Values are hashed as little-endian
-        float64 bytes together with their shape, so a scalar and a one-element array differ.
-
-    Returns
-    -------
-    key : str
-        64 hexadecimal digits.
-    """
+    """SHA-256 key (64 hex digits) of a computation: version, model revision, ``function``,
+    and each of ``inputs`` by name as little-endian float64 bytes with its shape (so a scalar
+    and a one-element array differ)."""
     digest = hashlib.sha256(f"ecofmaps {__version__}\0{model_revision()}\0{function}\0".encode())
     for name, value in inputs.items():
         digest.update(f"{name}\0".encode())
@@ -253,27 +201,9 @@ def cache_key(function: str, inputs: Mapping[str, object]) -> str:
 
 
 def write_netcdf(dataset: xr.Dataset, path, *, exclusive: bool = True) -> Path:
-    """Write ``dataset`` to ``path`` (engine h5netcdf) atomically.
-
-    The data go to a temporary file in the same directory, are flushed to disk, and the file
-    is then renamed onto ``path`` (``os.replace``). On any failure the temporary file is
-    removed and ``path`` is left as it was.
-
-    Parameters
-    ----------
-    dataset : xarray.Dataset
-        The data to write.
-    path : str or os.PathLike
-        The netCDF file to create or replace; its directory must exist.
-    exclusive : bool
-        Whether a ``path`` that did not exist is created, never replaced: if another
-        program wrote it meanwhile, ``FileExistsError`` and this dataset is not written
-        (:func:`ecofmaps.io.files.atomic_path`). False where any writer writes the same.
-
-    Returns
-    -------
-    path : pathlib.Path
-    """
+    """Write ``dataset`` to the netCDF file ``path`` (engine h5netcdf; its directory must
+    exist) atomically, as :func:`ecofmaps.io.files.atomic_path` with ``exclusive``: on any
+    failure ``path`` is left as it was. Returns ``path`` as a :class:`pathlib.Path`."""
     path = Path(path)
     with atomic_path(path, exclusive=exclusive) as temporary:
         dataset.to_netcdf(temporary, engine="h5netcdf")
@@ -291,9 +221,7 @@ def _chunks(shape: tuple[int, ...], itemsize: int) -> tuple[int, ...]:
 
 
 def _file_image(dataset: xr.Dataset) -> bytes:
-    """The bytes of ``dataset``'s netCDF file, its arrays in checksummed chunks, the checksum
-    of the rest in a global attribute; built in memory, so no half-written file is ever
-    left to the garbage collector."""
+    """``dataset``'s checksummed netCDF file, built in memory (no half-written file is left)."""
     import h5netcdf
     import h5py
 
@@ -318,8 +246,7 @@ def _file_image(dataset: xr.Dataset) -> bytes:
 
 
 def _read(path: Path, key: str) -> xr.Dataset:
-    """The dataset stored under ``key`` at ``path``; ``ValueError`` if it holds another key
-    or its metadata were damaged (HDF5 raises if its arrays were)."""
+    """The dataset stored under ``key`` at ``path``; ``ValueError`` if foreign or damaged."""
     with xr.open_dataset(path, engine="h5netcdf") as stored:
         dataset = stored.load()
     if dataset.attrs.get(_KEY_ATTRIBUTE) != key:
@@ -334,9 +261,8 @@ def _read(path: Path, key: str) -> xr.Dataset:
 
 
 def _stored(path: Path, key: str) -> xr.Dataset | None:
-    """The dataset stored at ``path``, or None: if it is unusable, it is removed, with a
-    warning. HDF5's complaints about a damaged file are this warning, not lines on standard
-    error from finalizers of half-opened objects."""
+    """The dataset stored at ``path``, or None: an unusable one is removed, with one warning
+    (and no lines on standard error from finalizers of half-opened HDF5 objects)."""
     hook = sys.unraisablehook
     sys.unraisablehook = _ignored
     try:
@@ -355,12 +281,7 @@ def _stored(path: Path, key: str) -> xr.Dataset | None:
 
 
 def _ignored(unraisable) -> None:
-    """An exception raised where it cannot be (a finalizer): ignored."""
-
-
-def _used(path: Path) -> None:
-    """Mark ``path`` as used now (its access time), for the least-recently-used order."""
-    os.utime(path, ns=(time.time_ns(), path.stat().st_mtime_ns))
+    """An exception raised in a finalizer: ignored."""
 
 
 def _reason(error: BaseException) -> str:
@@ -372,8 +293,7 @@ def _reason(error: BaseException) -> str:
 
 
 def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
-    """Store ``dataset`` at ``path`` if it fits in ``bound`` [byte], then keep the cache
-    within it."""
+    """Store ``dataset`` at ``path`` if it fits in ``bound`` [byte]; keep the cache within it."""
     if dataset.nbytes > bound:
         return
     image = _file_image(dataset.assign_attrs({_KEY_ATTRIBUTE: key}))
@@ -386,8 +306,7 @@ def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
 
 
 def _evict(directory: Path, bound: int, keep: Path) -> None:
-    """Remove the least recently used entries of ``directory`` (not ``keep``) until the
-    entries take at most ``bound`` bytes."""
+    """Remove least recently used entries but ``keep`` until they take at most ``bound``."""
     entries = sorted(cache_entries(directory), key=lambda entry: entry.used)
     total = sum(entry.size for entry in entries)
     for entry in entries:
@@ -399,18 +318,14 @@ def _evict(directory: Path, bound: int, keep: Path) -> None:
 
 
 def cached_dataset(
-    function: str,
-    inputs: Mapping[str, object],
-    compute: Callable[[], xr.Dataset],
-    cache_dir=None,
+    function: str, inputs: Mapping[str, object], compute: Callable[[], xr.Dataset], cache_dir=None
 ) -> xr.Dataset:
     """The cached result of ``compute()``, computing and storing it on a miss.
 
     Parameters
     ----------
     function : str
-        Name of the computing function (a valid Python identifier), part of the key and
-        of the file name.
+        Name of the computing function (a Python identifier): in the key and file name.
     inputs : mapping of str to array_like or None
         Everything the result depends on (see :func:`cache_key`).
     compute : callable
@@ -421,20 +336,18 @@ def cached_dataset(
     Returns
     -------
     dataset : xarray.Dataset
-        Identical (``xarray.testing.assert_identical``) whether read or computed.
+        Identical whether read or computed.
 
     Raises
     ------
     ValueError
-        If ``ECOFMAPS_CACHE_SIZE`` is set and is not a size (:func:`cache_size_bound`).
+        If ``ECOFMAPS_CACHE_SIZE`` is not a size (:func:`cache_size_bound`).
 
     Warns
     -----
     CacheWarning
-        In one line, when the file is unreadable, damaged or foreign (it is removed and the
-        result recomputed), or when the result cannot be stored for any reason (a full
-        disk, a read-only folder, a file where the folder should be): it is returned all
-        the same.
+        In one line, when the file is unusable (removed, the result recomputed) or the
+        result cannot be stored for any reason (it is returned all the same).
     """
     directory = cache_directory(cache_dir)
     bound = cache_size_bound()  # a bad ECOFMAPS_CACHE_SIZE is refused before any work
@@ -442,8 +355,8 @@ def cached_dataset(
     path = directory / f"{function}-{key[:_NAME_DIGITS]}.nc"
     dataset = _stored(path, key) if path.is_file() else None  # not a folder of the user's
     if dataset is not None:
-        with contextlib.suppress(OSError):  # removed meanwhile, or read-only: only a hint
-            _used(path)
+        with contextlib.suppress(OSError):  # the access time orders eviction; only a hint
+            os.utime(path, ns=(time.time_ns(), path.stat().st_mtime_ns))
         return dataset
     dataset = compute()
     try:
@@ -492,7 +405,7 @@ def cache_entries(cache_dir=None) -> list[CacheEntry]:
 
 
 def clear_cache(cache_dir=None) -> tuple[int, int]:
-    """Remove every cache entry, and temporary files left by interrupted writes.
+    """Remove every cache entry, and temporary files left by interrupted writes (no other file).
 
     Parameters
     ----------
@@ -505,10 +418,6 @@ def clear_cache(cache_dir=None) -> tuple[int, int]:
         Number of files removed.
     size : int
         Their total size. [byte]
-
-    Notes
-    -----
-    Other files in the directory (not named like cache entries) are left alone.
     """
     directory = cache_directory(cache_dir)
     count = size = 0

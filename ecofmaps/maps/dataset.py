@@ -1,9 +1,5 @@
-"""The labelled xarray Dataset of a map: checked grid axes, variables and attributes.
-
-Every coordinate and variable takes its ``long_name`` and ``units`` from
-:mod:`ecofmaps._nomenclature` (the regime codes their CF flag attributes), and every map
-carries the paper's model and citation as global attributes.
-"""
+"""The labelled xarray Dataset of a map: checked grid axes, variables and attributes (names
+and units from :mod:`ecofmaps._nomenclature`, the paper's model and citation)."""
 
 from __future__ import annotations
 
@@ -17,7 +13,7 @@ from ecofmaps import model, paper
 from ecofmaps._inputs import check
 from ecofmaps._version import __version__
 
-__all__ = ["checked_axis", "checked_load", "grid_dataset"]
+__all__ = ["checked_axes", "checked_axis", "checked_load", "compliance_values", "grid_dataset"]
 
 # The order of the variables in a Dataset (xarray orders the dimensions as they first appear).
 _VARIABLES = (
@@ -51,9 +47,26 @@ def _global_attrs(title: str) -> dict:
     }
 
 
-def checked_axis(name: str, value, rule: str, unit: str) -> np.ndarray:
+# The range rule and unit of each grid axis.
+_AXES = {
+    "stiffness_ratio": ("positive_or_inf", "1/m"),
+    "stiffness": ("positive_or_inf", "N/m"),
+    "compliance_ratio": ("non_negative", "1"),
+    "aspect_ratio": ("non_negative", "1"),
+    "amplitude": ("positive", "m"),
+    "load": ("positive", "N"),
+    "mu": ("positive", "1"),
+}
+
+
+def checked_axes(**values) -> dict:
+    """Each of ``values`` checked by :func:`checked_axis`, by name."""
+    return {name: checked_axis(name, value) for name, value in values.items()}
+
+
+def checked_axis(name: str, value) -> np.ndarray:
     """``value`` checked (``ValueError`` naming ``name``) as a float64 scalar or 1-D array."""
-    check(name, value, rule, unit)
+    check(name, value, *_AXES[name])
     array = np.asarray(value, dtype=np.float64)
     if array.ndim > 1:
         raise ValueError(f"{name} must be a single value or a 1-D array, got shape {array.shape}")
@@ -75,10 +88,20 @@ def checked_load(load) -> np.ndarray | None:
     """The map's normal load (None, or one value) checked, as :func:`checked_axis` does. [N]"""
     if load is None:
         return None
-    load = checked_axis("load", load, "positive", "N")
+    load = checked_axis("load", load)
     if load.ndim:
         raise ValueError(f"load must be a single value, got shape {load.shape}")
     return load
+
+
+def compliance_values(axes: dict) -> tuple:
+    """λ = P/(SΔ*) = 1/((S/P)Δ*) over the axes ``stiffness_ratio`` and ``amplitude`` (eq. 16),
+    as ``(dims, values)`` for :func:`grid_dataset`."""
+    stiffness, amplitude = axes["stiffness_ratio"], axes["amplitude"]
+    lam = model.compliance_ratio(np.atleast_1d(amplitude), 1.0, np.atleast_1d(stiffness)[:, None])
+    scalars = tuple(i for i, axis in enumerate((stiffness, amplitude)) if axis.ndim == 0)
+    dims = tuple(n for n in ("stiffness_ratio", "amplitude") if axes[n].ndim == 1)
+    return dims, np.squeeze(lam, axis=scalars)
 
 
 def grid_dataset(axes: dict, values: dict, title: str, extra=None) -> xr.Dataset:

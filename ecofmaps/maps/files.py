@@ -1,9 +1,5 @@
-"""Maps written to a netCDF file or a zarr store, block by block when they are chunked.
-
-A chunked map is evaluated block by block as it is written, on one thread per core, so a
-grid far larger than memory goes to disk; either way the output appears under its name only
-when complete (:func:`ecofmaps.io.files.atomic_store`).
-"""
+"""Maps written to a netCDF file or a zarr store, block by block when they are chunked
+(docs/performance.md, "Maps")."""
 
 from __future__ import annotations
 
@@ -21,18 +17,6 @@ __all__ = ["ZARR_SUFFIX", "write_map"]
 
 #: The suffix of the paths that :func:`write_map` writes as zarr stores.
 ZARR_SUFFIX = ".zarr"
-
-
-def _check_destination(path: Path, zarr: bool) -> None:
-    """Refuse, before any work, a destination that would be replaced by mistake."""
-    if zarr and path.is_dir() and not _is_zarr_store(path):
-        raise ValueError(f"{path} is a directory but not a zarr store: it is not replaced")
-    if not zarr and path.is_dir():
-        raise ValueError(f"{path} is a directory: a netCDF file cannot replace it")
-
-
-def _is_zarr_store(path: Path) -> bool:
-    return any((path / name).is_file() for name in ("zarr.json", ".zgroup", ".zarray"))
 
 
 @contextlib.contextmanager
@@ -76,10 +60,9 @@ def write_map(dataset: xr.Dataset, path, *, also: Sequence = ()) -> tuple:
 
     Notes
     -----
-    The output is written under ``.<name>.<process id>.<32 hex digits>.tmp`` beside ``path``
-    and renamed onto it once complete; on any failure, Ctrl-C included, the running blocks
-    finish, the temporary output is removed and an existing ``path`` is left as it was. A zarr
-    store's chunks are the map's blocks.
+    The output appears under its name only when complete; on any failure, Ctrl-C included,
+    the running blocks finish and an existing ``path`` is left as it was. A zarr store's
+    chunks are the map's blocks.
 
     Examples
     --------
@@ -97,7 +80,10 @@ def write_map(dataset: xr.Dataset, path, *, also: Sequence = ()) -> tuple:
 
     path = Path(path)
     zarr = path.suffix == ZARR_SUFFIX
-    _check_destination(path, zarr)
+    if path.is_dir() and not zarr:
+        raise ValueError(f"{path} is a directory: a netCDF file cannot replace it")
+    if path.is_dir() and not any((path / n).is_file() for n in ("zarr.json", ".zgroup", ".zarray")):
+        raise ValueError(f"{path} is a directory but not a zarr store: it is not replaced")
     with atomic_store(path, overwrite=True) as temporary, _threads() as pool:
         if zarr:
             written = dataset.to_zarr(temporary, compute=False, zarr_format=2, consolidated=True)

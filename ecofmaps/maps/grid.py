@@ -1,12 +1,8 @@
 r"""Parameter maps: the model over whole grids, as labelled xarray Datasets.
 
 Each function takes one value or one 1-D array per parameter; the arrays become the
-Dataset's dimensions, the single values its scalar coordinates. The grid is evaluated by a
-jit-compiled kernel of the dimensionless core in tiles on every core
-(:mod:`ecofmaps.maps.tiles`), or lazily with ``chunks=`` as a dask-backed Dataset equal to
-the bit. :func:`compute_map` and :func:`compute_universal_map` keep their results in the disk
-cache only when asked (``cache=True``; :mod:`ecofmaps.maps.cache`). As in the paper,
-:math:`x_o = \Delta^*`.
+Dataset's dimensions, the single values its scalar coordinates. As in the paper,
+:math:`x_o = \Delta^*`. Tiles, blocks and the cache: docs/performance.md.
 """
 
 from __future__ import annotations
@@ -19,22 +15,13 @@ import xarray as xr
 from ecofmaps import model
 from ecofmaps._inputs import float64
 from ecofmaps.maps.cache import cached_dataset
-from ecofmaps.maps.dataset import checked_axis, checked_load, grid_dataset
+from ecofmaps.maps.dataset import checked_axes, checked_load, compliance_values, grid_dataset
 from ecofmaps.maps.on_profile import compute_profile_map
 from ecofmaps.maps.tiles import MAX_CHUNK, grid_values
 from ecofmaps.model.simulation import fretting_loop
 from ecofmaps.model.steady_state import dimensionless
 
-__all__ = [
-    "compute_loops",
-    "compute_map",
-    "compute_universal_map",
-]
-
-
-# ---------------------------------------------------------------------------------------
-# Kernels
-# ---------------------------------------------------------------------------------------
+__all__ = ["compute_loops", "compute_map", "compute_universal_map"]
 
 
 def _mesh(*axes):
@@ -62,28 +49,26 @@ def _steady_state(mu, kappa, lam, amplitude=None, load=None) -> dict:
     return values
 
 
-def _broadcast(values: dict, shape) -> dict:
+def _broadcast(values: dict, axes) -> dict:
+    shape = jnp.broadcast_shapes(*(axis.shape for axis in axes))
     return {name: jnp.broadcast_to(value, shape) for name, value in values.items()}
 
 
 @jax.jit
 def _map_kernel(stiffness_ratio, aspect_ratio, amplitude, mu, load):
-    stiffness_ratio, aspect_ratio, amplitude, mu = _mesh(
-        stiffness_ratio, aspect_ratio, amplitude, mu
-    )
+    axes = _mesh(stiffness_ratio, aspect_ratio, amplitude, mu)
+    stiffness_ratio, aspect_ratio, amplitude, mu = axes
     kappa = model.curvature_number(1.0, aspect_ratio, 1.0)  # x_o = Δ*: κ = 2 z_o/x_o
     lam = model.compliance_ratio(amplitude, 1.0, stiffness_ratio)  # 1/((S/P) Δ*)
-    values = _steady_state(mu, kappa, lam, amplitude, load)
-    shape = jnp.broadcast_shapes(stiffness_ratio.shape, aspect_ratio.shape, amplitude.shape)
-    return _broadcast(values, jnp.broadcast_shapes(shape, mu.shape))
+    return _broadcast(_steady_state(mu, kappa, lam, amplitude, load), axes)
 
 
 @jax.jit
 def _universal_kernel(compliance_ratio, aspect_ratio, mu):
-    lam, aspect_ratio, mu = _mesh(compliance_ratio, aspect_ratio, mu)
+    axes = _mesh(compliance_ratio, aspect_ratio, mu)
+    lam, aspect_ratio, mu = axes
     kappa = model.curvature_number(1.0, aspect_ratio, 1.0)
-    values = _steady_state(mu, kappa, lam)
-    return _broadcast(values, (lam.size, aspect_ratio.size, mu.size))
+    return _broadcast(_steady_state(mu, kappa, lam), axes)
 
 
 def _check_cache(cache, chunks) -> None:
@@ -95,11 +80,6 @@ def _check_cache(cache, chunks) -> None:
             "cache=True with chunks: a chunked map is not cached (it is evaluated block by "
             "block where it is written); leave cache out"
         )
-
-
-# ---------------------------------------------------------------------------------------
-# Public functions
-# ---------------------------------------------------------------------------------------
 
 
 @float64
@@ -133,13 +113,10 @@ def compute_map(
         Normal load :math:`P`; when given, the map also holds ``dissipated_energy`` and
         ``max_force`` and a scalar coordinate ``load``. [N]
     chunks : 'auto', int or dict, optional
-        Return a chunked map: its variables are dask arrays, evaluated block by block
-        when they are computed or written (:func:`ecofmaps.maps.write_map`), so the grid
-        need not fit in memory. An int is the largest number of grid points in a block
-        (blocks then take whole trailing dimensions, like the tiles below); ``'auto'`` is
-        :data:`BLOCK_POINTS`; a dict gives the block length by dimension name (-1 or
-        None: the whole dimension; dimensions not named are whole). By default the map
-        is computed at once, in memory.
+        Return a chunked map, of dask arrays evaluated block by block when computed or
+        written (:func:`ecofmaps.maps.write_map`): an int is the most grid points in a
+        block, ``'auto'`` :data:`ecofmaps.maps.tiles.BLOCK_POINTS`, a dict the block
+        length by dimension name (-1 or None, or not named: whole). Default: in memory.
     profile : ScarProfile, optional
         A wear-scar profile of any shape instead of ``aspect_ratio``: see
         :func:`compute_profile_map`.
@@ -147,16 +124,13 @@ def compute_map(
         With a profile: :math:`X = xW/\Delta^*` (eq. 11) or :math:`X = x`.
     cache : bool, optional
         Read the result from the disk cache, and store it there after computing it.
-        Default: only a map on a profile, which is expensive to recompute; the closed
-        forms compute faster than the cache reads them back (docs/performance.md). A
-        chunked map is never cached (see Notes), so ``cache=True`` with ``chunks`` is an
-        error.
+        Default: only a map on a profile; a chunked map is never cached, so ``cache=True``
+        with ``chunks`` is an error (why: docs/performance.md, "The cache").
     cache_dir : str or os.PathLike, optional
         Cache directory; default ``$ECOFMAPS_CACHE`` or the per-user cache directory.
     max_chunk : int
-        Largest number of grid points evaluated in one call of the jit-compiled kernel (a
-        tile); a bigger grid is evaluated tile by tile, on every core, and copied into
-        place. The default keeps a tile's working arrays in the processor's cache. [1]
+        Most grid points evaluated in one call of the compiled kernel (a tile; tiles run on
+        every core). [1]
 
     Returns
     -------
@@ -168,21 +142,17 @@ def compute_map(
         ``stiffness_ratio`` and ``amplitude`` only) and, with a load, ``dissipated_energy``
         [J] and ``max_force`` [N]. Every variable and coordinate has ``long_name`` and
         ``units``. ECoF values are NaN where there is no gross slip; every value but the
-        regime is NaN when self-locking (rigid rig, :math:`\mu\kappa \ge 1`). Freshly
-        computed arrays of a grid of at most ``max_chunk`` points are read-only (they are
-        the computation's buffers, not copies): ``.copy()`` the Dataset to write into them.
-        With ``chunks``, the variables over the whole grid are dask arrays; computed,
-        they equal the map in memory to the bit (``xarray.testing.assert_identical``).
+        regime is NaN when self-locking (rigid rig, :math:`\mu\kappa \ge 1`). A chunked
+        map, computed, is identical to the map in memory. Arrays of a single tile are
+        read-only (docs/performance.md, "Maps").
 
     Raises
     ------
     ValueError
         If a parameter is not a scalar or a non-empty 1-D array, or is out of range:
         stiffness_ratio > 0 (inf allowed); aspect_ratio >= 0; amplitude, mu, load > 0;
-        all finite except stiffness_ratio, none NaN. If ``chunks`` is not one of its
-        forms, or names a parameter that is not a dimension. If a map in memory would
-        not fit in the memory available (before allocating it; a chunked map is not
-        refused).
+        all finite except stiffness_ratio, none NaN. For a bad ``chunks``, and for a map
+        in memory that would not fit in the memory available (before allocating it).
 
     Warns
     -----
@@ -191,16 +161,10 @@ def compute_map(
 
     Notes
     -----
-    The map depends on :math:`S`, :math:`P` and :math:`\Delta^*` only through
-    :math:`\lambda = P/(S\Delta^*)` (eq. 16): the Figure 11 maps at :math:`\Delta^* = 25` and
-    50 µm are one surface read on two scales of :math:`S/P`. Values come from the closed
-    forms of eq. 16 (slip amplitude), the corrected eq. 13-15 (:math:`\mu_E`), eq. 12
-    (:math:`E_d = 4P\delta^*\mu_E`) and eq. 9 (:math:`Q^*`).
-
-    A chunked map is not cached: it is meant for grids beyond memory, which the cache
-    would have to compute at once (and read back whole to verify its checksum); it would
-    double the disk space of the user's own store; and evaluating a block costs about as
-    much as reading it back from disk.
+    The closed forms of eq. 16 (slip amplitude), the corrected eq. 13-15 (:math:`\mu_E`),
+    eq. 12 (:math:`E_d = 4P\delta^*\mu_E`) and eq. 9 (:math:`Q^*`); through :math:`S`,
+    :math:`P` and :math:`\Delta^*` the map depends on :math:`\lambda` only
+    (:func:`compute_universal_map`).
 
     References
     ----------
@@ -217,10 +181,8 @@ def compute_map(
 
     The same map in blocks of 2 values of S/P, evaluated when it is computed or written:
 
-    >>> lazy = compute_map(
-    ...     np.geomspace(2e4, 2e5, 5), np.linspace(0, 0.3, 4), 50e-6, 0.8,
-    ...     chunks={"stiffness_ratio": 2},
-    ... )
+    >>> lazy = compute_map(np.geomspace(2e4, 2e5, 5), np.linspace(0, 0.3, 4), 50e-6, 0.8,
+    ...                    chunks={"stiffness_ratio": 2})
     >>> lazy.ecof_ratio.chunks
     ((2, 2, 1), (4,))
     >>> lazy.compute().identical(m)
@@ -234,43 +196,24 @@ def compute_map(
                 "chunks is for maps of the parabolic groove; a map on a profile "
                 "is computed in memory"
             )
+        options = dict(mapping=mapping, cache=cache is not False, cache_dir=cache_dir)
         return compute_profile_map(
-            stiffness_ratio,
-            amplitude,
-            mu,
-            load,
-            profile=profile,
-            mapping=mapping,
-            cache=cache is not False,
-            cache_dir=cache_dir,
-            max_chunk=max_chunk,
+            stiffness_ratio, amplitude, mu, load, profile=profile, max_chunk=max_chunk, **options
         )
     if mapping != "scaled":
         raise ValueError("mapping applies to a profile only (profile=...)")
     if amplitude is None or mu is None:
         raise ValueError("compute_map needs amplitude and mu")
-    axes = {
-        "stiffness_ratio": checked_axis(
-            "stiffness_ratio", stiffness_ratio, "positive_or_inf", "1/m"
-        ),
-        "aspect_ratio": checked_axis("aspect_ratio", aspect_ratio, "non_negative", "1"),
-        "amplitude": checked_axis("amplitude", amplitude, "positive", "m"),
-        "mu": checked_axis("mu", mu, "positive", "1"),
-    }
+    axes = checked_axes(
+        stiffness_ratio=stiffness_ratio, aspect_ratio=aspect_ratio, amplitude=amplitude, mu=mu
+    )
     load = checked_load(load)
 
     _check_cache(cache, chunks)
 
     def compute() -> xr.Dataset:
         values = grid_values(_map_kernel, axes, (load,), max_chunk, chunks)
-        # λ depends on S/P and Δ* only: a variable over those two (eq. 16).
-        stiffness, amplitude = axes["stiffness_ratio"], axes["amplitude"]
-        lam = model.compliance_ratio(
-            np.atleast_1d(amplitude), 1.0, np.atleast_1d(stiffness)[:, None]
-        )
-        scalars = tuple(i for i, axis in enumerate((stiffness, amplitude)) if axis.ndim == 0)
-        dims = tuple(n for n in ("stiffness_ratio", "amplitude") if axes[n].ndim == 1)
-        values["compliance_ratio"] = (dims, np.squeeze(lam, axis=scalars))
+        values["compliance_ratio"] = compliance_values(axes)
         extra = {} if load is None else {"load": load}
         return grid_dataset(axes, values, "ECoF map of the compliant wear-scar model", extra)
 
@@ -318,9 +261,9 @@ def compute_universal_map(
 
     Notes
     -----
-    With :math:`x_o = \Delta^*` the curvature number is :math:`\kappa = 2 z_o/x_o`, and
-    :math:`\mu_E/\mu` depends on :math:`(\mu, z_o/x_o, \lambda)` only (eq. 13-16): this one
-    chart holds both panels of Figure 11, whose axes :math:`S/P` map onto
+    With :math:`x_o = \Delta^*`, :math:`\kappa = 2 z_o/x_o` and :math:`\mu_E/\mu` depends on
+    :math:`(\mu, z_o/x_o, \lambda)` only (eq. 13-16): this one chart holds both panels of
+    Figure 11 (:math:`\Delta^* = 25` and 50 µm), whose axes :math:`S/P` map onto
     :math:`\lambda = 1/((S/P)\Delta^*)`.
 
     References
@@ -329,11 +272,7 @@ def compute_universal_map(
     coefficient of friction from fretting loops exhibiting non-Coulomb frictional
     behaviour: eq. 13-16.
     """
-    axes = {
-        "compliance_ratio": checked_axis("compliance_ratio", compliance_ratio, "non_negative", "1"),
-        "aspect_ratio": checked_axis("aspect_ratio", aspect_ratio, "non_negative", "1"),
-        "mu": checked_axis("mu", mu, "positive", "1"),
-    }
+    axes = checked_axes(compliance_ratio=compliance_ratio, aspect_ratio=aspect_ratio, mu=mu)
 
     _check_cache(cache, chunks)
 
@@ -401,25 +340,13 @@ def compute_loops(stiffness, aspect_ratio, amplitude, load, mu, num=201) -> xr.D
     coefficient of friction from fretting loops exhibiting non-Coulomb frictional
     behaviour: eq. 9, 10, 12, 16.
     """
-    axes = {
-        "stiffness": checked_axis("stiffness", stiffness, "positive_or_inf", "N/m"),
-        "aspect_ratio": checked_axis("aspect_ratio", aspect_ratio, "non_negative", "1"),
-        "amplitude": checked_axis("amplitude", amplitude, "positive", "m"),
-        "load": checked_axis("load", load, "positive", "N"),
-        "mu": checked_axis("mu", mu, "positive", "1"),
-    }
-    grid = jnp.broadcast_arrays(*_mesh(*(np.atleast_1d(a) for a in axes.values())))
-    displacement, force = fretting_loop(
-        amplitude=grid[2],
-        load=grid[3],
-        stiffness=grid[0],
-        mu=grid[4],
-        aspect_ratio=grid[1],
-        num=num,
+    axes = checked_axes(
+        stiffness=stiffness, aspect_ratio=aspect_ratio, amplitude=amplitude, load=load, mu=mu
     )
+    grid = jnp.broadcast_arrays(*_mesh(*(np.atleast_1d(a) for a in axes.values())))
     values = jax.device_get(_loop_kernel(*grid))
-    values["displacement"] = displacement
-    values["force"] = force
+    loop = fretting_loop(grid[2], grid[3], grid[0], grid[4], grid[1], num=num)
+    values["displacement"], values["force"] = loop
     values = {name: np.asarray(value) for name, value in values.items()}
     point = np.arange(2 * num + 1)
     return grid_dataset(axes, values, "Steady fretting loops", extra={"point": point})

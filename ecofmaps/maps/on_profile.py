@@ -1,8 +1,7 @@
 r"""Maps on a scar profile: the steady-loop quantities of a groove of any shape over a grid.
 
-The pad feels the profile's local slope (eq. 9 pointwise, :mod:`ecofmaps.model.on_profile`);
-the Dataset has the variables of :func:`ecofmaps.maps.compute_map` and the profile's
-dimensions as global attributes.
+The pad feels the profile's local slope (eq. 9 pointwise): docs/model.md, "The model on a
+scar profile".
 """
 
 from __future__ import annotations
@@ -12,11 +11,10 @@ import math
 import numpy as np
 import xarray as xr
 
-from ecofmaps import model
 from ecofmaps._inputs import float64
 from ecofmaps.maps.cache import cached_dataset
-from ecofmaps.maps.dataset import checked_axis, checked_load, grid_dataset
-from ecofmaps.maps.tiles import MAX_CHUNK
+from ecofmaps.maps.dataset import checked_axes, checked_load, compliance_values, grid_dataset
+from ecofmaps.maps.tiles import MAX_CHUNK, check_max_chunk
 from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers, steady_values
 
 __all__ = ["MODEL_ON_PROFILE", "compute_profile_map"]
@@ -47,14 +45,8 @@ def compute_profile_map(
 
     Parameters
     ----------
-    stiffness_ratio : float or 1-D array_like
-        Rig stiffness over normal load :math:`S/P`; ``numpy.inf`` for a rigid rig. [1/m]
-    amplitude : float or 1-D array_like
-        Displacement amplitude :math:`\Delta^*`. [m]
-    mu : float or 1-D array_like
-        Contact coefficient of friction :math:`\mu`. [1]
-    load : float, optional
-        Normal load :math:`P`, for ``dissipated_energy`` and ``max_force``. [N]
+    stiffness_ratio, amplitude, mu, load
+        As for :func:`compute_map`. [1/m], [m], [1], [N]
     profile : ScarProfile
         The scar (:func:`ecofmaps.scar_profile`, :func:`ecofmaps.read_scar_profile`, a
         profile family).
@@ -102,16 +94,9 @@ def compute_profile_map(
         raise ValueError("compute_map needs amplitude and mu")
     physical = check_mapping(mapping, None)
     profile = as_profile(profile)
-    axes = {
-        "stiffness_ratio": checked_axis(
-            "stiffness_ratio", stiffness_ratio, "positive_or_inf", "1/m"
-        ),
-        "amplitude": checked_axis("amplitude", amplitude, "positive", "m"),
-        "mu": checked_axis("mu", mu, "positive", "1"),
-    }
+    axes = checked_axes(stiffness_ratio=stiffness_ratio, amplitude=amplitude, mu=mu)
     load = checked_load(load)
-    if not (isinstance(max_chunk, int) and max_chunk >= 1):
-        raise ValueError(f"max_chunk must be an integer >= 1, got {max_chunk!r}")
+    check_max_chunk(max_chunk)
 
     def compute() -> xr.Dataset:
         grid = [np.atleast_1d(a) for a in axes.values()]
@@ -132,19 +117,13 @@ def compute_profile_map(
         values = {name: flat[name].reshape(shape) for name in names}
         values.update(steady_values(values, grid[1][None, :, None], load, grid[2][None, None, :]))
         del values["normalized_energy"], values["normalized_max_force"]
-        stiffness, amplitude = axes["stiffness_ratio"], axes["amplitude"]
-        lam = model.compliance_ratio(
-            np.atleast_1d(amplitude), 1.0, np.atleast_1d(stiffness)[:, None]
-        )
-        scalars = tuple(i for i, axis in enumerate((stiffness, amplitude)) if axis.ndim == 0)
-        dims = tuple(n for n in ("stiffness_ratio", "amplitude") if axes[n].ndim == 1)
-        values["compliance_ratio"] = (dims, np.squeeze(lam, axis=scalars))
+        values["compliance_ratio"] = compliance_values(axes)
         extra = {} if load is None else {"load": load}
         dataset = grid_dataset(
             axes, values, "ECoF map of the compliant wear-scar model on a scar profile", extra
         )
-        dataset.attrs["model"] = MODEL_ON_PROFILE
         dataset.attrs.update(
+            model=MODEL_ON_PROFILE,
             scar_depth=float(profile.depth),
             scar_half_width=float(profile.half_width),
             scar_aspect_ratio=float(profile.aspect_ratio),

@@ -1,8 +1,5 @@
-"""Grid evaluation in tiles (in memory, on every core) and in blocks of tiles (dask).
-
-A jit-compiled kernel is evaluated over the grid in tiles of at most ``max_chunk`` points by
-one thread per core (memory checked before allocating); a chunked map is a dask graph of
-blocks of the same tiles, so its values equal the in-memory map's to the bit.
+"""Grid evaluation in tiles (in memory, on every core) and in blocks of tiles (dask), so that
+both give the same values to the bit: docs/performance.md, "Maps".
 """
 
 from __future__ import annotations
@@ -26,20 +23,18 @@ __all__ = [
     "BLOCK_POINTS",
     "BLOCK_TASK",
     "MAX_CHUNK",
+    "check_max_chunk",
     "grid_values",
     "tile_workers",
 ]
 
 
-#: Default bound on the number of grid points evaluated in one call of a kernel (a tile):
-#: its working arrays (about 1.4 MB) stay in the processor's cache.
+#: Default bound on the grid points evaluated in one call of a kernel (a tile; its working
+#: arrays stay in the processor's cache: docs/performance.md, "Maps").
 MAX_CHUNK = 2**14
 
-
-#: Grid points in one block of a chunked map with ``chunks='auto'`` (results of about
-#: 220 MB for :func:`compute_map` with a load).
+#: Grid points in one block of a chunked map with ``chunks='auto'``.
 BLOCK_POINTS = 2**22
-
 
 #: Prefix of the dask keys of the tasks that evaluate the blocks of a chunked map.
 BLOCK_TASK = "ecofmaps-block"
@@ -55,13 +50,10 @@ def _bytes_per_point(kernel, axes: int, extra: tuple) -> int:
     return sum(out.dtype.itemsize * out.size for out in jax.tree_util.tree_leaves(outputs))
 
 
-def _signature(extra) -> tuple:
-    return tuple(None if e is None else (np.shape(e), np.result_type(e)) for e in extra)
-
-
 def _check_memory(kernel, axes, extra, max_chunk: int) -> None:
     """Refuse, before allocating, a grid whose results would not fit in the free memory."""
-    per_point = _bytes_per_point(kernel, len(axes), _signature(extra))
+    signature = tuple(None if e is None else (np.shape(e), np.result_type(e)) for e in extra)
+    per_point = _bytes_per_point(kernel, len(axes), signature)
     points = math.prod(axis.size for axis in axes)
     needed = per_point * (points + 2 * tile_workers() * min(points, max_chunk))
     free = available_memory()
@@ -129,8 +121,6 @@ def _fill(out, kernel, axes, extra, split, region, tiles, stop=None) -> None:
 
 def _evaluate_grid(kernel, axes, extra, max_chunk: int) -> dict[str, np.ndarray]:
     """Evaluate ``kernel(*block_axes, *extra)`` over the grid spanned by 1-D ``axes``."""
-    if not (isinstance(max_chunk, int) and not isinstance(max_chunk, bool) and max_chunk >= 1):
-        raise ValueError(f"max_chunk must be an integer >= 1, got {max_chunk!r}")
     _check_memory(kernel, axes, extra, max_chunk)
     shape = tuple(axis.size for axis in axes)
     if math.prod(shape) <= max_chunk:
@@ -206,8 +196,6 @@ def _chunked_grid(kernel, axes, extra, max_chunk: int, chunks, dims) -> dict:
     from dask.base import tokenize
     from dask.highlevelgraph import HighLevelGraph
 
-    if not (isinstance(max_chunk, int) and not isinstance(max_chunk, bool) and max_chunk >= 1):
-        raise ValueError(f"max_chunk must be an integer >= 1, got {max_chunk!r}")
     shape = tuple(axis.size for axis in axes)
     split = _split(shape, max_chunk)
     lengths = _block_lengths(chunks, shape, dims, split)
@@ -243,8 +231,14 @@ def _block(kernel, axes, extra, split, region, tiles) -> dict[str, np.ndarray]:
     return out
 
 
+def check_max_chunk(max_chunk) -> None:
+    if not (isinstance(max_chunk, int) and not isinstance(max_chunk, bool) and max_chunk >= 1):
+        raise ValueError(f"max_chunk must be an integer >= 1, got {max_chunk!r}")
+
+
 def grid_values(kernel, axes: dict, extra: tuple, max_chunk: int, chunks) -> dict:
     """The kernel's results over the grid of ``axes`` (name -> 0-d or 1-D array)."""
+    check_max_chunk(max_chunk)
     grid = [np.atleast_1d(axis) for axis in axes.values()]
     if chunks is None:
         return _evaluate_grid(kernel, grid, extra, max_chunk)

@@ -1,10 +1,8 @@
 """A live explorer of the model in the browser (``ecofmaps explore``), built with Panel.
 
-One page per session: the test's parameters typed with units (``50um``, ``35MN/m``), and at
-that point the slip amplitude, the energy and :math:`\\mu_E/\\mu`, the steady loop, the map
-of :math:`\\mu_E/\\mu` (Figure 11's labelled contours, no gross slip hatched) with the point
-marked, and the contact CoF behind a typed ECoF. The inputs live in the page's URL query, so
-a view is shared as a link.
+One page per session: the parameters typed with units, the model's numbers and steady loop at
+that point, Figure 11's map with the point marked, and the contact CoF behind a typed ECoF.
+The inputs live in the page's URL query, so a view is shared as a link.
 """
 
 from __future__ import annotations
@@ -32,13 +30,7 @@ from ecofmaps.model.steady_state import dissipated_energy, energy_cof, slip_ampl
 from ecofmaps.paper import FIGURE_11_STIFFNESS_RATIOS
 from ecofmaps.units import DIMENSIONS, TEXT_LIMIT, bare_number_warning, parse_quantity
 
-__all__ = [
-    "INPUTS",
-    "ExplorerPoint",
-    "bare_number_warnings",
-    "explorer_page",
-    "parameter_value",
-]
+__all__ = ["INPUTS", "ExplorerPoint", "bare_number_warnings", "explorer_page", "parameter_value"]
 
 #: The page's inputs: URL query key -> (quantity of the nomenclature, label, default text,
 #: the physical bounds the explorer takes in SI, a rigid rig's infinite stiffness apart).
@@ -53,19 +45,12 @@ INPUTS = {
     "aspect_ratio_high": ("aspect_ratio", "Scar z_o/x_o to", "0.25", (0.0, 10.0)),
 }
 
-#: The model's inputs among :data:`INPUTS`.
 _MODEL_INPUTS = ("amplitude", "load", "stiffness", "mu", "aspect_ratio")
-
-#: Grid points of the map along S/P and along z_o/x_o.
-_MAP_POINTS = (91, 81)
-
-#: The map's window, widened to hold the point: S/P [1/m] and the largest z_o/x_o [1].
+_MAP_POINTS = (91, 81)  # grid points of the map along S/P and along z_o/x_o
+# The map's window, widened to hold the point: S/P [1/m] and the largest z_o/x_o [1]; the
+# steps it grows by, so that nearby points share a map; the maps the server keeps in memory.
 _MAP_WINDOW = (FIGURE_11_STIFFNESS_RATIOS[0], FIGURE_11_STIFFNESS_RATIOS[-1], 0.4)
-
-#: Steps to which the map's window grows, so that nearby points share a cached map.
 _STEPS = np.array([1.0, 2.0, 5.0])
-
-#: Maps kept in memory by the server (nothing is written to disk per request).
 _MAPS_KEPT = 32
 
 
@@ -159,16 +144,10 @@ class ExplorerPoint:
     def at(cls, amplitude, load, stiffness, mu, aspect_ratio) -> ExplorerPoint:
         """The model's values for one test (parameters in SI, as :func:`ecofmaps.energy_cof`)."""
         point = (amplitude, load, stiffness, mu, aspect_ratio)
-        with warnings.catch_warnings():  # no gross slip: the page says so instead
-            warnings.simplefilter("ignore")
+        with warnings.catch_warnings(action="ignore"):  # no gross slip: the page says so
             ratio = float(energy_cof(*point)) / mu
-        displacement, force = fretting_loop(*point)
-        return cls(
-            float(slip_amplitude(*point)),
-            float(dissipated_energy(*point)),
-            ratio,
-            (np.asarray(displacement), np.asarray(force)),
-        )
+        loop = tuple(np.asarray(values) for values in fretting_loop(*point))
+        return cls(float(slip_amplitude(*point)), float(dissipated_energy(*point)), ratio, loop)
 
 
 def _grown(value: float, upward: bool) -> float:
@@ -205,18 +184,10 @@ def _ecof_ratio_map(amplitude: float, mu: float, window: tuple) -> tuple:
     """μ_E/μ over (z_o/x_o, S/P) in the window, by :func:`ecofmaps.compute_map`, and where
     there is no gross slip (1.0, else 0.0)."""
     low, high, deepest = window
-    dataset = compute_map(
-        np.linspace(low, high, _MAP_POINTS[0]),
-        np.linspace(0.0, deepest, _MAP_POINTS[1]),
-        amplitude=amplitude,
-        mu=mu,
-        cache=False,
-    )
+    x, y = np.linspace(low, high, _MAP_POINTS[0]), np.linspace(0.0, deepest, _MAP_POINTS[1])
+    dataset = compute_map(x, y, amplitude=amplitude, mu=mu, cache=False)
     stuck = (dataset["regime"] == NO_GROSS_SLIP).astype(np.float64)
-    return (
-        np.ascontiguousarray(dataset["ecof_ratio"].values.T),
-        np.ascontiguousarray(stuck.values.T),
-    )
+    return tuple(np.ascontiguousarray(grid.values.T) for grid in (dataset["ecof_ratio"], stuck))
 
 
 def _number(value: float, factor: float = 1.0) -> str:
@@ -242,7 +213,6 @@ def _inputs_html(values: dict) -> str:
 def _values_html(point: ExplorerPoint, values: dict) -> str:
     """The inputs as read, and the model's numbers at the point, each with its unit in a span
     the page and its tests can find."""
-    gross = math.isfinite(point.ecof_ratio)
     rows = [
         ("slip_amplitude", "Slip amplitude δ*", point.slip_amplitude),
         ("dissipated_energy", "Dissipated energy E_d", point.dissipated_energy),
@@ -258,6 +228,7 @@ def _values_html(point: ExplorerPoint, values: dict) -> str:
             f"<td><span class='ecofmaps-value' data-quantity='{key}' data-unit='{unit}'>"
             f"{_number(value, quantity.display_factor)}</span> {unit}</td></tr>"
         )
+    gross = math.isfinite(point.ecof_ratio)
     regime = "" if gross else "<p><b>No gross slip</b> (μP/S ≥ Δ*): μ_E is undefined.</p>"
     return f"{_inputs_html(values)}<table style='font-size:14px'>{''.join(cells)}</table>{regime}"
 
@@ -328,9 +299,10 @@ def _contour_labels(line_data, scale: tuple) -> dict:
     return labels
 
 
-#: How the no-gross-slip area is drawn: hatched over a light grey (Bokeh draws no hatch
-#: over a fill of alpha 0).
+# How the no-gross-slip area is drawn: hatched over a light grey (Bokeh draws no hatch
+# over a fill of alpha 0).
 _HATCH = {
+    "line_color": "#4d4d4d",
     "fill_color": "#d9d9d9",
     "fill_alpha": 0.5,
     "hatch_pattern": "/",
@@ -338,7 +310,7 @@ _HATCH = {
     "hatch_scale": 10,
 }
 
-#: The map plot's size and the part of it the axes take, roughly. [px]
+# The map plot's size and the part of it the axes take, roughly. [px]
 _MAP_SIZE = (600, 470)
 _MAP_FRAME = (440, 290)
 
@@ -356,13 +328,11 @@ def _map_figure():
         x_range=Range1d(0.0, 1.0),
         y_range=Range1d(0.0, 1.0),
     )
-    empty = np.full((2, 2), np.nan)
+    empty = ([0, 1], [0, 1], np.full((2, 2), np.nan))
     levels = _fill_levels(ECOF_RATIO_LEVELS[-1])
-    bands = plot.contour([0, 1], [0, 1], empty, levels, fill_color=_band_colors(levels))
+    bands = plot.contour(*empty, levels, fill_color=_band_colors(levels))
     widths = [3.0 if level == HIGHLIGHT_LEVEL else 1.0 for level in ECOF_RATIO_LEVELS]
-    lines = plot.contour(
-        [0, 1], [0, 1], empty, ECOF_RATIO_LEVELS, line_color="black", line_width=widths
-    )
+    lines = plot.contour(*empty, ECOF_RATIO_LEVELS, line_color="black", line_width=widths)
     labels = ColumnDataSource({"x": [], "y": [], "text": [], "angle": []})
     plot.text(
         "x",
@@ -378,30 +348,14 @@ def _map_figure():
         background_fill_alpha=0.85,
         padding=1,
     )
-    stuck = plot.contour(
-        [0, 1],
-        [0, 1],
-        empty,
-        [0.5, 1.5],
-        line_color="#4d4d4d",
-        line_width=1.0,
-        **_HATCH,
-    )
+    stuck = plot.contour(*empty, [0.5, 1.5], line_width=1.0, **_HATCH)
     image = ColumnDataSource({"image": [], "x": [], "y": [], "dw": [], "dh": []})
     hover = plot.image(
         "image", x="x", y="y", dw="dw", dh="dh", source=image, palette=["#000000"], global_alpha=0
     )
     marker = ColumnDataSource({"x": [], "y": []})
-    point = plot.scatter(
-        "x",
-        "y",
-        source=marker,
-        size=13,
-        marker="circle",
-        fill_color="white",
-        line_color="black",
-        line_width=2,
-    )
+    circle = {"marker": "circle", "fill_color": "white", "line_color": "black", "line_width": 2}
+    point = plot.scatter("x", "y", source=marker, size=13, **circle)
     for renderer, name in ((bands, "bands"), (lines, "lines"), (stuck, "no_gross_slip")):
         renderer.name = name  # found by name by the page's tests
     colorbar = bands.construct_color_bar(width=12, title="μ_E/μ [1]")
@@ -409,7 +363,7 @@ def _map_figure():
     # What the legend shows, by glyphs at no point of the map (a contour's parts have no legend).
     nowhere = [math.nan]
     heavy = plot.line(nowhere, nowhere, line_color="black", line_width=3.0)
-    hatched = plot.quad(nowhere, nowhere, nowhere, nowhere, line_color="#4d4d4d", **_HATCH)
+    hatched = plot.quad(nowhere, nowhere, nowhere, nowhere, **_HATCH)
     legend = Legend(
         items=[
             LegendItem(label=f"μ_E/μ = {HIGHLIGHT_LEVEL:.2f} (5 % above μ)", renderers=[heavy]),
@@ -422,27 +376,10 @@ def _map_figure():
         margin=4,
     )
     plot.add_layout(legend, "below")
-    plot.add_tools(
-        HoverTool(
-            tooltips=[
-                ("S/P", "$x{0.0} 1/mm"),
-                ("z_o/x_o", "$y{0.000}"),
-                ("μ_E/μ", "@image{0.000}"),
-            ],
-            renderers=[hover],
-        )
-    )
-    return plot, {
-        "x_range": plot.x_range,
-        "y_range": plot.y_range,
-        "bands": bands,
-        "colorbar": colorbar,
-        "lines": lines,
-        "labels": labels,
-        "stuck": stuck,
-        "image": image,
-        "marker": marker,
-    }
+    tips = [("S/P", "$x{0.0} 1/mm"), ("z_o/x_o", "$y{0.000}"), ("μ_E/μ", "@image{0.000}")]
+    plot.add_tools(HoverTool(tooltips=tips, renderers=[hover]))
+    parts = dict(x_range=plot.x_range, y_range=plot.y_range, bands=bands, colorbar=colorbar)
+    return plot, parts | dict(lines=lines, labels=labels, stuck=stuck, image=image, marker=marker)
 
 
 def _show_map(values: dict, parts: dict) -> None:
@@ -465,18 +402,9 @@ def _show_map(values: dict, parts: dict) -> None:
     scale = (_MAP_FRAME[0] / (x[-1] - x[0]), _MAP_FRAME[1] / (y[-1] - y[0]))
     parts["labels"].data = _contour_labels(drawn.line_data, scale)
     parts["stuck"].set_data(contour_data(x, y, stuck, [0.5, 1.5]))
-    parts["image"].data = {
-        "image": [grid],
-        "x": [x[0]],
-        "y": [0.0],
-        "dw": [x[-1] - x[0]],
-        "dh": [y[-1]],
-    }
-    shown = math.isfinite(ratio)
-    parts["marker"].data = {
-        "x": [ratio * 1e-3] if shown else [],
-        "y": [values["aspect_ratio"]] if shown else [],
-    }
+    parts["image"].data = dict(image=[grid], x=[x[0]], y=[0.0], dw=[x[-1] - x[0]], dh=[y[-1]])
+    shown = int(math.isfinite(ratio))  # a rigid rig's point is not drawn
+    parts["marker"].data = {"x": [ratio * 1e-3][:shown], "y": [values["aspect_ratio"]][:shown]}
 
 
 def explorer_page():
@@ -534,7 +462,11 @@ def explorer_page():
     for widget in inputs.values():
         widget.param.watch(update, "value")
     update()
-    model_inputs = [inputs[key] for key in _MODEL_INPUTS]
+    at_point = pn.Column(
+        *(inputs[key] for key in _MODEL_INPUTS),
+        pn.pane.HTML("<h3 style='margin:8px 0 0 0'>At this point</h3>"),
+        values_pane,
+    )
     correction_inputs = [inputs[key] for key in ("ecof", "aspect_ratio_low", "aspect_ratio_high")]
     intro = pn.pane.HTML(
         "<h2 style='margin:4px 0'>ecofmaps explorer: the compliant wear-scar model</h2>"
@@ -546,15 +478,7 @@ def explorer_page():
         intro,
         message,
         notice,
-        pn.Row(
-            pn.Column(
-                *model_inputs,
-                pn.pane.HTML("<h3 style='margin:8px 0 0 0'>At this point</h3>"),
-                values_pane,
-            ),
-            pn.pane.Bokeh(loop_plot),
-            pn.pane.Bokeh(map_plot),
-        ),
+        pn.Row(at_point, pn.pane.Bokeh(loop_plot), pn.pane.Bokeh(map_plot)),
         pn.pane.HTML("<h3 style='margin:0'>Correct a reported ECoF</h3>"),
         pn.Row(*correction_inputs, correction_pane),
     )

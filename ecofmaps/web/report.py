@@ -47,48 +47,27 @@ __all__ = ["LOOPS_CARRIED", "recording_inputs", "report_document", "write_report
 #: picks among them in the page. Their loops are the bulk of a report of a short test.
 LOOPS_CARRIED = 60
 
-#: Loops drawn when the page opens: the first, the middle and the last carried cycle.
-_FIRST_SHOWN = 3
-
-#: Points on each slip branch of a model loop.
-_MODEL_POINTS = 40
-
-#: Model loops are computed in batches of a multiple of this many. [1]
-_MODEL_BATCH = 64
-
-#: The plots over the cycles: width of their frames, and the room left of it for the axis
-#: labels, the same in both, so that their cycle axes line up. [px]
+_MODEL_POINTS = 40  # points on each slip branch of a model loop
+_MODEL_BATCH = 64  # model loops are computed in batches of a multiple of this many
+# The plots over the cycles: width of their frames, and the room left of them for the axis
+# labels, the same in both so that their cycle axes line up; the page's width. [px]
 _FRAME = (560, 130)
-
-#: Width of the page's content, for a laptop screen. [px]
 _WIDTH = 1240
-
-#: The variables a report needs in the results.
 _NEEDED = ("cycle", "ecof", "gicof", "quality", "regime", "load")
-
-#: Significant digits of the table's numbers, as the CSV's: each column shows its largest
-#: value with as many, and all its values with the same decimals. [1]
+# The table: significant digits as the CSV's (each column with the decimals of its largest
+# value), a number cell (nothing for NaN, as the CSV's empty field), the width of a character
+# and the room around it, the table's width (every column of a recording's table in a window
+# 1400 px wide) and the room for its scroll bar. [px]
 _DIGITS = 6
-
-#: Shows a number of the table with the column's DECIMALS decimals, and nothing for NaN, as
-#: the CSV's empty field.
 _NUMBER_CELL = (
     '<div style="text-align: right"><%= (value == null || value !== value) ? "" : '
     "value.toFixed(DECIMALS) %></div>"
 )
-
-#: Width of a character of the table's headers and text, and the room around them. [px]
 _CHARACTER, _CELL_ROOM = 6.5, 10
+_TABLE_WIDTH, _TABLE_ROOM = 1350, 20
 
-#: Width of the table: every column of a recording's table visible in a window 1400 px wide
-#: (its first column frozen when there are more). [px]
-_TABLE_WIDTH = 1350
-
-#: Room the table keeps beside its columns, for its vertical scroll bar. [px]
-_TABLE_ROOM = 20
-
-#: Shows the loops of the cycles picked in the page: the measured loop and, where the cycle
-#: has one, the model's, each pair in one colour.
+# Shows the loops of the cycles picked in the page: the measured loop and, where the cycle
+# has one, the model's, each pair in one colour.
 _PICK_LOOPS = """
 const all = carried.data;
 const measured_data = {xs: [], ys: [], label: [], color: []};
@@ -203,11 +182,8 @@ def recording_inputs(recording, load: float, *, flip_force: bool = False) -> dic
     for name, column_name in recording.columns.items():
         unit = recording.units.get(name, "1")
         read.append(f"{name}: {column_name!r}" + ("" if unit == "1" else f" in {unit}"))
-    inputs = {
-        "files": str(recording.path),
-        "load": f"{load:g} N",
-        "columns and units assumed": "; ".join(read),
-    }
+    inputs = {"files": str(recording.path), "load": f"{load:g} N"}
+    inputs["columns and units assumed"] = "; ".join(read)
     if flip_force:
         inputs["force sign"] = "read with the other sign (--flip-force)"
     return inputs
@@ -256,15 +232,13 @@ def _header(results: xr.Dataset, inputs: Mapping) -> Div:
         for key, value in rows.items()
     )
     return Div(
-        text=(
-            "<h1 style='margin:8px 0 4px 0;font-size:22px'>Fretting test: friction cycle by "
-            "cycle</h1><p style='margin:0 0 6px 0;max-width:1100px'>ECoF μ_E = E_d/(4Pδ*) "
-            "(eq. 1), GICoF = Q/P at the centre of the slip, where the loop crosses Q = SΔ "
-            "(eq. 17-18; a fit over its central 70 %), and μ read along the stroke, from "
-            "<code>ecofmaps.analyze_loops</code>. Values that cannot "
-            "be stood behind are left out, and the quality flags say why.</p>"
-            f"<table class='ecofmaps-inputs' style='font-size:14px'>{cells}</table>"
-        ),
+        text="<h1 style='margin:8px 0 4px 0;font-size:22px'>Fretting test: friction cycle by "
+        "cycle</h1><p style='margin:0 0 6px 0;max-width:1100px'>ECoF μ_E = E_d/(4Pδ*) "
+        "(eq. 1), GICoF = Q/P at the centre of the slip, where the loop crosses Q = SΔ "
+        "(eq. 17-18; a fit over its central 70 %), and μ read along the stroke, from "
+        "<code>ecofmaps.analyze_loops</code>. Values that cannot be stood behind are left "
+        "out, and the quality flags say why.</p>"
+        f"<table class='ecofmaps-inputs' style='font-size:14px'>{cells}</table>",
         width=_WIDTH,
     )
 
@@ -278,43 +252,28 @@ def _evolution_figures(results: xr.Dataset):
     data["mu_low"] = data["mu_resolved"] - 2.0 * data["mu_resolved_se"]
     data["mu_high"] = data["mu_resolved"] + 2.0 * data["mu_resolved_se"]
     source = ColumnDataSource(data)
-    plot = figure(
-        frame_width=_FRAME[0],
+    plot = _cycle_figure(
         frame_height=300,
-        min_border_left=_FRAME[1],
         title="Coefficients of friction over the test",
-        x_axis_label=_label("cycle"),
         y_axis_label="Coefficient of friction [1]",
         tools="pan,box_zoom,wheel_zoom,reset,save",
     )
-    resolved = "mu_resolved" in results
-    if resolved:
-        plot.varea(
-            "cycle",
-            "mu_low",
-            "mu_high",
-            source=source,
-            color="#2ca02c",
-            alpha=0.25,
-            legend_label="μ ± 2 se",
-        )
-    lines = {"ecof": ("#ff7f0e", "ECoF μ_E"), "gicof": ("#1f77b4", "GICoF (Q/P on Q = SΔ)")}
+    if "mu_resolved" in results:
+        band = {"color": "#2ca02c", "alpha": 0.25, "legend_label": "μ ± 2 se"}
+        plot.varea("cycle", "mu_low", "mu_high", source=source, **band)
+    lines = {  # μ on top: the most precise of the three
+        "ecof": ("#ff7f0e", "ECoF μ_E"),
+        "gicof": ("#1f77b4", "GICoF (Q/P on Q = SΔ)"),
+        "mu_resolved": ("#2ca02c", "μ read along the stroke"),
+    }
     drawn = {}
     for name, (color, legend) in lines.items():
-        drawn[name] = plot.line(
-            "cycle", name, source=source, color=color, line_width=1.5, legend_label=legend
-        )
-        if cycle.size <= 400:
+        if name in results:
+            drawn[name] = plot.line(
+                "cycle", name, source=source, color=color, line_width=1.5, legend_label=legend
+            )
+        if cycle.size <= 400 and name != "mu_resolved":
             plot.scatter("cycle", name, source=source, color=color, size=3)
-    if resolved:  # on top: the most precise of the three
-        plot.line(
-            "cycle",
-            "mu_resolved",
-            source=source,
-            color="#2ca02c",
-            line_width=1.5,
-            legend_label="μ read along the stroke",
-        )
     plot.add_tools(
         HoverTool(
             tooltips=[
@@ -328,10 +287,18 @@ def _evolution_figures(results: xr.Dataset):
             renderers=[drawn["ecof"]],
         )
     )
-    plot.xaxis.formatter = BasicTickFormatter(use_scientific=False)
     plot.legend.click_policy = "hide"
     plot.add_layout(plot.legend[0], "right")  # beside the plot: the curves stay uncovered
     return plot, _flags_figure(results, plot)
+
+
+def _cycle_figure(**options):
+    """A plot over the cycles, its frame lined up with the other's."""
+    plot = figure(
+        frame_width=_FRAME[0], min_border_left=_FRAME[1], x_axis_label=_label("cycle"), **options
+    )
+    plot.xaxis.formatter = BasicTickFormatter(use_scientific=False)
+    return plot
 
 
 def _flagged_cycles(results: xr.Dataset) -> dict[str, np.ndarray]:
@@ -352,34 +319,18 @@ def _flags_figure(results: xr.Dataset, evolution):
     if not flagged:
         return Div(text="<p>No cycle is flagged: every cycle's quality is 'ok'.</p>")
     reasons = list(flagged)[::-1]  # the first reason at the top
-    plot = figure(
-        frame_width=_FRAME[0],
+    plot = _cycle_figure(
         frame_height=26 * len(reasons),
-        min_border_left=_FRAME[1],
         y_range=reasons,
         x_range=evolution.x_range,
         toolbar_location=None,
         title="Quality flags (the values they leave out are NaN)",
-        x_axis_label=_label("cycle"),
         tools="xpan,xwheel_zoom,reset",
     )
-    marks = ColumnDataSource(
-        {
-            "cycle": np.concatenate(list(flagged.values())),
-            "reason": [reason for reason, cycles in flagged.items() for _ in cycles],
-        }
-    )
-    plot.scatter(
-        "cycle",
-        "reason",
-        source=marks,
-        marker="dash",
-        size=10,
-        line_width=2,
-        color="#d62728",
-        angle=np.pi / 2,
-    )
-    plot.xaxis.formatter = BasicTickFormatter(use_scientific=False)
+    reason = [reason for reason, cycles in flagged.items() for _ in cycles]
+    marks = ColumnDataSource({"cycle": np.concatenate(list(flagged.values())), "reason": reason})
+    mark = {"marker": "dash", "size": 10, "line_width": 2, "color": "#d62728"}
+    plot.scatter("cycle", "reason", source=marks, angle=np.pi / 2, **mark)
     plot.add_tools(HoverTool(tooltips=[("cycle", "@cycle"), ("flag", "@reason")]))
     return plot
 
@@ -400,12 +351,10 @@ def _quality_counts(results: xr.Dataset) -> Div:
         for name, count, meaning in rows
     )
     return Div(
-        text=(
-            f"<h3 style='margin:4px 0'>Quality of the {total} cycles</h3>"
-            "<table class='ecofmaps-quality' style='font-size:13px;border-collapse:collapse'>"
-            "<tr><th style='text-align:left'>flag</th><th style='padding:0 8px'>cycles</th>"
-            f"<th style='text-align:left'>what it means</th></tr>{cells}</table>"
-        ),
+        text=f"<h3 style='margin:4px 0'>Quality of the {total} cycles</h3>"
+        "<table class='ecofmaps-quality' style='font-size:13px;border-collapse:collapse'>"
+        "<tr><th style='text-align:left'>flag</th><th style='padding:0 8px'>cycles</th>"
+        f"<th style='text-align:left'>what it means</th></tr>{cells}</table>",
         width=_WIDTH - 880,
     )
 
@@ -445,17 +394,12 @@ def _model_loops(results: xr.Dataset) -> tuple[list, list]:
         # Padded to a multiple of _MODEL_BATCH loops (repeating them): the compiled model is
         # then reused by every report, not compiled again for each number of loops.
         size = -(-int(usable.sum()) // _MODEL_BATCH) * _MODEL_BATCH
-        batch = {name: np.resize(value[usable], size) for name, value in values.items()}
-        displacement, force = fretting_loop(
-            batch["amplitude"],
-            float(results["load"]),
-            batch["stiffness"],
-            batch["mu_resolved"],
-            batch["aspect_ratio"],
-            num=_MODEL_POINTS,
+        amplitude, stiffness, mu, ratio = (np.resize(v[usable], size) for v in values.values())
+        loop = fretting_loop(
+            amplitude, float(results["load"]), stiffness, mu, ratio, num=_MODEL_POINTS
         )
-        displacement = np.round(np.asarray(displacement) * 1e6, 4)
-        force = np.round(np.asarray(force), 3)
+        displacement = np.round(np.asarray(loop[0]) * 1e6, 4)
+        force = np.round(np.asarray(loop[1]), 3)
         for row_index, index in enumerate(np.flatnonzero(usable)):
             xs[index], ys[index] = displacement[row_index], force[row_index]
     return xs, ys
@@ -469,17 +413,12 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
     measured_x = np.round(chosen["loop_displacement"].values * 1e6, 4)
     measured_y = np.round(chosen["loop_force"].values, 3)
     kept = [np.isfinite(x) & np.isfinite(y) for x, y in zip(measured_x, measured_y, strict=True)]
+    xs = [x[keep] for x, keep in zip(measured_x, kept, strict=True)]
+    ys = [y[keep] for y, keep in zip(measured_y, kept, strict=True)]
     all_loops = ColumnDataSource(
-        {
-            "label": names,
-            "xs": [x[keep] for x, keep in zip(measured_x, kept, strict=True)],
-            "ys": [y[keep] for y, keep in zip(measured_y, kept, strict=True)],
-            "model_xs": model_xs,
-            "model_ys": model_ys,
-        }
+        dict(label=names, xs=xs, ys=ys, model_xs=model_xs, model_ys=model_ys)
     )
-    middle = len(names) // 2
-    first = list(dict.fromkeys([names[0], names[middle], names[-1]]))[:_FIRST_SHOWN]
+    first = list(dict.fromkeys([names[0], names[len(names) // 2], names[-1]]))
     palette = list(Category10_10)
     measured, model = ColumnDataSource(name="shown-loops"), ColumnDataSource(name="shown-models")
     plot = figure(
@@ -503,21 +442,14 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
         width=480,
         name="loop-picker",
     )
-    update = CustomJS(
-        args=dict(
-            carried=all_loops, choice=choice, measured=measured, model=model, palette=palette
-        ),
-        code=_PICK_LOOPS,
-    )
-    choice.js_on_change("value", update)
+    shown = dict(carried=all_loops, choice=choice, measured=measured, model=model, palette=palette)
+    choice.js_on_change("value", CustomJS(args=shown, code=_PICK_LOOPS))
     _fill_shown(all_loops.data, first, palette, measured, model)
     note = Div(
-        text=(
-            "<p>Each loop is centred (the sensors' offsets removed). The dashed loop is the "
-            "model's steady loop (eq. 9, 10, 16) for the cycle's amplitude, rig stiffness S, "
-            "and the friction μ and groove z_o/x_o read along the stroke; a cycle without "
-            "that reading has none.</p>"
-        ),
+        text="<p>Each loop is centred (the sensors' offsets removed). The dashed loop is the "
+        "model's steady loop (eq. 9, 10, 16) for the cycle's amplitude, rig stiffness S, "
+        "and the friction μ and groove z_o/x_o read along the stroke; a cycle without "
+        "that reading has none.</p>",
         width=480,
     )
     return row(plot, column(choice, note))
@@ -582,10 +514,8 @@ def _table(results: xr.Dataset):
     others = sum(column.width for column in columns[:-1])
     columns[-1].width = min(columns[-1].width, max(90, _TABLE_WIDTH - _TABLE_ROOM - others))
     heading = Div(
-        text=(
-            "<h3 style='margin:12px 0 4px 0'>The table (as <code>ecofmaps loops --out</code> "
-            "writes it; click a column's name to sort)</h3>"
-        ),
+        text="<h3 style='margin:12px 0 4px 0'>The table (as <code>ecofmaps loops --out</code> "
+        "writes it; click a column's name to sort)</h3>",
         width=_WIDTH,
     )
     grid = DataTable(

@@ -19,9 +19,8 @@ from ecofmaps.web.explorer import explorer_page, warm_up
 
 __all__ = ["LOCAL_HOSTS", "serve_explorer"]
 
-#: The longest query value let through to Panel, whose reading of the query fails on an
-#: integer of more than 4300 digits; a longer one is cut to one character over
-#: :data:`ecofmaps.units.TEXT_LIMIT`. [1]
+# The longest query value let through to Panel, whose reading of the query fails on an
+# integer of more than 4300 digits; a longer one is cut to one character over TEXT_LIMIT.
 _QUERY_LIMIT = 1000
 
 #: The hosts whose pages the explorer answers (with its port); others get 403.
@@ -71,17 +70,14 @@ class _Forbidden(RequestHandler):
 
 
 class _LongQuery(Matcher):
-    """Matches a request whose query holds a value longer than ``_QUERY_LIMIT``."""
-
     def match(self, request):
         pairs = urllib.parse.parse_qsl(request.query, keep_blank_values=True)
         return {} if any(len(value) > _QUERY_LIMIT for _, value in pairs) else None
 
 
 class _CutQuery(RequestHandler):
-    """See Other: the same page with each overlong query value cut to one character over
-    :data:`ecofmaps.units.TEXT_LIMIT`, so Panel never parses a huge number and the page
-    names the input."""
+    """See Other: the same page with each overlong query value cut, so Panel never parses a
+    huge number and the page names the input."""
 
     def prepare(self):
         pairs = urllib.parse.parse_qsl(self.request.query, keep_blank_values=True)
