@@ -16,10 +16,10 @@ import xarray as xr
 
 from ecofmaps._inputs import check
 from ecofmaps._parallel import Runner, stretch
+from ecofmaps.measured import resolve
 from ecofmaps.measured.cycles import Cycles, find_cycles, missing_sample_error, no_cycle_error
 from ecofmaps.measured.measure import GROSS_SLIP_THRESHOLD, NEIGHBOURS, Stretch, measure_cycles
 from ecofmaps.measured.quality import RESOLVED, Tally, cycle_results, scale_flags, with_loops
-from ecofmaps.measured.resolve import ReadingOptions, read_along_stroke, resolved_attrs
 
 __all__ = [
     "AT_OWN_LOAD",
@@ -63,40 +63,19 @@ class LoopOptions:
     rig_stiffness: float | None = None
 
     def __post_init__(self):
-        check("load", self.load, "positive", "N")
-        if np.ndim(self.load) != 0:
-            raise ValueError("load must be a single value [N]")
-        if not 0.0 < self.hysteresis < 1.0:
-            raise ValueError(f"hysteresis must satisfy 0 < hysteresis < 1; got {self.hysteresis!r}")
-        low, high = (float(share) for share in self.stick_window)
-        if not 0.0 <= low < high <= 1.0:
-            raise ValueError(
-                f"stick_window must satisfy 0 <= low < high <= 1; got {self.stick_window!r}"
-            )
-        if not self.crossing_window > 0.0:
-            raise ValueError(
-                f"crossing_window must satisfy crossing_window > 0; got {self.crossing_window!r}"
-            )
-        if not 0.0 < self.gross_slip_threshold < 1.0:
-            raise ValueError(
-                "gross_slip_threshold must satisfy 0 < gross_slip_threshold < 1; "
-                f"got {self.gross_slip_threshold!r}"
-            )
+        load = resolve.single_value("load", self.load, "positive", "N")
+        hysteresis = resolve.within("hysteresis", self.hysteresis, 1.0)
+        window = resolve.checked_stick_window(self.stick_window)
+        crossing = resolve.within("crossing_window", self.crossing_window)
+        threshold = resolve.within("gross_slip_threshold", self.gross_slip_threshold, 1.0)
         if not isinstance(self.flip_force, bool | np.bool_):
             raise ValueError(f"flip_force must be True or False; got {self.flip_force!r}")
-        if self.rig_stiffness is not None:
-            check("rig_stiffness", self.rig_stiffness, "positive_or_inf", "N/m")
-        checked = {
-            "load": float(self.load),
-            "hysteresis": float(self.hysteresis),
-            "stick_window": (low, high),
-            "crossing_window": float(self.crossing_window),
-            "gross_slip_threshold": float(self.gross_slip_threshold),
-            "flip_force": bool(self.flip_force),
-            "rig_stiffness": None if self.rig_stiffness is None else float(self.rig_stiffness),
-        }
-        for name, value in checked.items():
-            object.__setattr__(self, name, value)
+        rig = self.rig_stiffness
+        if rig is not None:
+            check("rig_stiffness", rig, "positive_or_inf", "N/m")
+            rig = float(rig)
+        flip = bool(self.flip_force)
+        resolve.settle(self, load, hysteresis, window, crossing, threshold, flip, rig)
 
 
 class _InProcess:
@@ -143,8 +122,8 @@ class Reading:
 
     resolve: bool = False
     keep_loops: bool = False
-    along_stroke: ReadingOptions = dataclasses.field(
-        default_factory=lambda: ReadingOptions(positions=None)
+    along_stroke: resolve.ReadingOptions = dataclasses.field(
+        default_factory=lambda: resolve.ReadingOptions(positions=None)
     )
     hand_back: bool = False
 
@@ -289,7 +268,7 @@ def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
     resolved = None
     if reading.resolve:
         judged = with_loops(cycle_results(values, flags, labels, options), loops)
-        resolved, read = read_along_stroke(judged, reading.along_stroke)
+        resolved, read = resolve.read_along_stroke(judged, reading.along_stroke)
         values = values | {name: resolved[name].values for name in RESOLVED}
         flags = flags | read
     part = _part(values, flags, labels, options, loops if reading.keep_loops else None)
@@ -321,7 +300,7 @@ def _part(values: dict, flags: dict, labels, options, loops=None) -> xr.Dataset:
     measured = {k: v for k, v in values.items() if k not in RESOLVED}
     part = cycle_results(measured, flags, labels, options)
     read = [name for name in RESOLVED if name in values]
-    part = part.assign({k: ("cycle", values[k], resolved_attrs(k)) for k in read})
+    part = part.assign({k: ("cycle", values[k], resolve.resolved_attrs(k)) for k in read})
     if loops is not None:
         part = with_loops(part, loops)
     if "normal_load" in part:

@@ -40,9 +40,13 @@ __all__ = [
     "QUALITY_FLAGS",
     "ReadingOptions",
     "along_stroke_values",
+    "checked_stick_window",
     "read_along_stroke",
     "resolve_analyzed_loops",
     "resolved_attrs",
+    "settle",
+    "single_value",
+    "within",
 ]
 
 
@@ -63,6 +67,65 @@ def resolved_attrs(name: str) -> dict:
     return attrs
 
 
+def single_value(name: str, value, kind: str, unit: str) -> float:
+    """``value`` checked as one number of ``kind`` (:func:`ecofmaps._inputs.check`)."""
+    check(name, value, kind, unit)
+    if np.ndim(value) != 0:
+        raise ValueError(f"{name} must be a single value [{unit}]")
+    return float(value)
+
+
+def within(name: str, value, high=None, *, inclusive=False) -> float:
+    """``value`` as a float if ``0 < value`` (and ``< high``, or ``<= high`` if ``inclusive``),
+    else a ValueError that says so."""
+    if high is None:
+        holds, condition = value > 0.0, f"{name} > 0"
+    else:
+        holds = 0.0 < value <= high if inclusive else 0.0 < value < high
+        condition = f"0 < {name} {'<=' if inclusive else '<'} {high:g}"
+    if not holds:
+        raise ValueError(f"{name} must satisfy {condition}; got {value!r}")
+    return float(value)
+
+
+def checked_stick_window(window) -> tuple:
+    """The shares ``(low, high)`` of a stick window, checked."""
+    low, high = (float(share) for share in window)
+    if not 0.0 <= low < high <= 1.0:
+        raise ValueError(f"stick_window must satisfy 0 <= low < high <= 1; got {window!r}")
+    return low, high
+
+
+def settle(options, *checked) -> None:
+    """Set the ``checked`` values of the fields of the frozen dataclass ``options``, in order."""
+    for field, value in zip(dataclasses.fields(options), checked, strict=True):
+        object.__setattr__(options, field.name, value)
+
+
+def _grid_positions(positions):
+    """``positions`` checked: None, an odd count >= 5, or increasing positions with 0. [m]"""
+    if positions is None:
+        return None
+    if np.ndim(positions) == 0:
+        if (
+            isinstance(positions, bool)
+            or not isinstance(positions, int | np.integer)
+            or positions < 5
+            or positions % 2 == 0
+        ):
+            raise ValueError(
+                f"positions must be an odd integer >= 5 or an array of positions; got {positions!r}"
+            )
+        return int(positions)
+    check("positions", positions, "finite", "m")
+    positions = np.asarray(positions, dtype=np.float64)
+    if positions.ndim != 1 or positions.size < 3 or np.any(np.diff(positions) <= 0.0):
+        raise ValueError("positions must be one-dimensional and increasing, >= 3 of them [m]")
+    if not np.any(positions == 0.0):
+        raise ValueError("positions must include 0 (the centre, where the profile is zero) [m]")
+    return positions
+
+
 @dataclasses.dataclass(frozen=True)
 class ReadingOptions:
     """The options of the reading along the stroke (see :func:`ecofmaps.resolve_loops`),
@@ -76,61 +139,16 @@ class ReadingOptions:
     stick_window: tuple = (0.05, 0.45)
 
     def __post_init__(self):
-        stiffness, force_offset, positions = self.stiffness, self.force_offset, self.positions
+        stiffness, force_offset = self.stiffness, self.force_offset
         if stiffness is not None:
-            check("stiffness", stiffness, "positive_or_inf", "N/m")
-            if np.ndim(stiffness) != 0:
-                raise ValueError("stiffness must be a single value [N/m]")
+            stiffness = single_value("stiffness", stiffness, "positive_or_inf", "N/m")
         if force_offset is not None:
-            check("force_offset", force_offset, "finite", "N")
-            if np.ndim(force_offset) != 0:
-                raise ValueError("force_offset must be a single value [N]")
-        if positions is None:
-            pass
-        elif np.ndim(positions) == 0:
-            if (
-                isinstance(positions, bool)
-                or not isinstance(positions, int | np.integer)
-                or positions < 5
-                or positions % 2 == 0
-            ):
-                raise ValueError(
-                    "positions must be an odd integer >= 5 or an array of positions; "
-                    f"got {positions!r}"
-                )
-            positions = int(positions)
-        else:
-            check("positions", positions, "finite", "m")
-            positions = np.asarray(positions, dtype=np.float64)
-            if positions.ndim != 1 or positions.size < 3 or np.any(np.diff(positions) <= 0.0):
-                raise ValueError(
-                    "positions must be one-dimensional and increasing, >= 3 of them [m]"
-                )
-            if not np.any(positions == 0.0):
-                raise ValueError(
-                    "positions must include 0 (the centre, where the profile is zero) [m]"
-                )
-        if not 0.0 < self.central <= 1.0:
-            raise ValueError(f"central must satisfy 0 < central <= 1; got {self.central!r}")
-        if not self.slip_threshold > 0.0:
-            raise ValueError(
-                f"slip_threshold must satisfy slip_threshold > 0; got {self.slip_threshold!r}"
-            )
-        low, high = (float(share) for share in self.stick_window)
-        if not 0.0 <= low < high <= 1.0:
-            raise ValueError(
-                f"stick_window must satisfy 0 <= low < high <= 1; got {self.stick_window!r}"
-            )
-        checked = {
-            "stiffness": None if stiffness is None else float(stiffness),
-            "force_offset": None if force_offset is None else float(force_offset),
-            "positions": positions,
-            "central": float(self.central),
-            "slip_threshold": float(self.slip_threshold),
-            "stick_window": (low, high),
-        }
-        for name, value in checked.items():
-            object.__setattr__(self, name, value)
+            force_offset = single_value("force_offset", force_offset, "finite", "N")
+        positions = _grid_positions(self.positions)
+        central = within("central", self.central, 1.0, inclusive=True)
+        threshold = within("slip_threshold", self.slip_threshold)
+        window = checked_stick_window(self.stick_window)
+        settle(self, stiffness, force_offset, positions, central, threshold, window)
 
 
 _NEEDED = (
@@ -197,46 +215,39 @@ def resolve_analyzed_loops(
 def read_along_stroke(loops: xr.Dataset, options: ReadingOptions):
     """:func:`resolve_analyzed_loops` on options checked, and the flags of its reasons
     (reason -> per cycle) besides the Dataset."""
+
+    def values(name):
+        return np.asarray(loops[name].values, dtype=np.float64)
+
     load = float(loops["load"])
-    x = np.asarray(loops["loop_displacement"].values, dtype=np.float64)
-    q = np.asarray(loops["loop_force"].values, dtype=np.float64)
-    removed = np.asarray(loops["force_offset"].values, dtype=np.float64)
+    x, q, removed = map(values, ("loop_displacement", "loop_force", "force_offset"))
     if options.force_offset is not None:  # the force as recorded, less the given offset
         q = q + (removed - options.force_offset)[:, None]
         removed = np.full_like(removed, options.force_offset)
     given = options.stiffness is not None
-    rig = np.full(x.shape[0], options.stiffness) if given else loops["stiffness"].values
-    quality = loops["quality"].values
+    rig = np.full(x.shape[0], options.stiffness) if given else values("stiffness")
+    quality, amplitude = loops["quality"].values, values("amplitude")
+    inherited = _reaches_resolved(quality)
     with np.errstate(divide="ignore", invalid="ignore"):
         per_position, per_cycle, flags, grid = along_stroke_values(
-            x,
-            q,
-            np.isfinite(x) & np.isfinite(q),
-            load,
-            np.asarray(rig, dtype=np.float64),
-            np.asarray(loops["amplitude"].values, dtype=np.float64),
-            _reaches_resolved(quality),
-            given,
-            options,
-            np.asarray(loops["force_drift_se"].values, dtype=np.float64),
+            x, q, load, rig, amplitude, inherited, given, options, values("force_drift_se")
         )
         per_cycle["position_offset"] = (
             loops["displacement_offset"].values - removed / per_cycle["stiffness"]
         )
         per_cycle["amplitude"] = loops["amplitude"].values  # the x_o of aspect_ratio
-    dims = ("cycle", "position")
-    data = {name: (dims, value, resolved_attrs(name)) for name, value in per_position.items()}
-    for name, value in per_cycle.items():
-        data[name] = ("cycle", value, resolved_attrs(name))
+    data = {name: (("cycle", "position"), value) for name, value in per_position.items()}
+    data |= {name: ("cycle", value) for name, value in per_cycle.items()}
     for reason, flag in flags.items():
         quality = add_reason(quality, flag, reason)
-    data["quality"] = ("cycle", quality, resolved_attrs("quality"))
-    coords = {
-        "cycle": ("cycle", loops["cycle"].values, resolved_attrs("cycle")),
-        "load": ((), load, resolved_attrs("load")),
-    }
+    data["quality"] = ("cycle", quality)
+    coords = {"cycle": ("cycle", loops["cycle"].values), "load": ((), load)}
     if grid is not None:
-        coords["position"] = ("position", grid, resolved_attrs("position"))
+        coords["position"] = ("position", grid)
+    data, coords = (
+        {name: (*value, resolved_attrs(name)) for name, value in mapping.items()}
+        for mapping in (data, coords)
+    )
     attrs = {
         "title": "Fretting loops read along the stroke (ecofmaps.resolve_loops)",
         "stiffness_from": "given" if given else "the stick sets of each loop",
@@ -395,21 +406,14 @@ def _reaches_resolved(quality) -> np.ndarray:
     return np.logical_or.reduce([has_reason(quality, reason) for reason in reaching])
 
 
-def joined_values(parts, index):
-    """The per-cycle values number ``index`` of :func:`_central_values`, over all blocks."""
-    return np.concatenate([part["values"][index] for part in parts])
-
-
 def _blocks(cycles):
     """Slices of at most ``_BLOCK`` cycles: the arrays of a block stay in the cache."""
     return [slice(start, start + _BLOCK) for start in range(0, max(cycles, 1), _BLOCK)]
 
 
-def along_stroke_values(
-    x, q, valid, load, stiffness, amplitude, inherited, given, options, drift_se
-):
+def along_stroke_values(x, q, load, stiffness, amplitude, inherited, given, options, drift_se):
     """Every resolved quantity of the centred loops ``x``, ``q``."""
-    cycles = x.shape[0]
+    cycles, valid = x.shape[0], np.isfinite(x) & np.isfinite(q)
     parts = []
     for block in _blocks(cycles):
         check_interrupted()
@@ -446,12 +450,11 @@ def along_stroke_values(
     flag = joined("flags")
     flags = {reason: flag == code for code, reason in enumerate(QUALITY_FLAGS, start=1)}
     ok = ~inherited & (flag == 0)
-    wavers = joined_values(parts, 7) & ((flag == 0) | (flag == 4))
-    flags["gicof-varies"] = wavers & ~inherited
-    lowest, highest = joined("lowest"), joined("highest")
-    mu_resolved, variance, k, tilt, sensitivity, _, shifting, _, offsetting = (
-        joined_values(parts, i) for i in range(9)
+    mu_resolved, variance, k, tilt, sensitivity, _, shifting, wavers, offsetting = (
+        np.concatenate(values) for values in zip(*(part["values"] for part in parts), strict=True)
     )
+    flags["gicof-varies"] = wavers & ((flag == 0) | (flag == 4)) & ~inherited
+    lowest, highest = joined("lowest"), joined("highest")
     nan = np.where(ok, 1.0, np.nan)
     compliance = joined("compliance")
     per_cycle = {
