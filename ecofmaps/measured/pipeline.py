@@ -23,7 +23,6 @@ from ecofmaps.measured.quality import RESOLVED, Tally, cycle_results, scale_flag
 
 __all__ = [
     "AT_OWN_LOAD",
-    "HALO",
     "IN_PROCESS",
     "NAN_POLICIES",
     "TASK_SAMPLES",
@@ -41,10 +40,6 @@ __all__ = [
 
 #: Samples of the recording measured by one chunk of a long recording (about; whole cycles).
 TASK_SAMPLES = 1 << 22
-
-#: Whole cycles on either side of a chunk's cycles that it reads for the centring.
-HALO = NEIGHBOURS
-
 #: What the analysis does with missing samples: skip their cycles, or raise.
 NAN_POLICIES = ("skip", "raise")
 
@@ -162,11 +157,7 @@ class Chunk:
 
 def force_at_mean_load(force, load):
     r"""The force of a recording whose normal load was recorded sample by sample, as at the
-    mean load: :math:`Q(t)\,\bar P/P(t)`, and :math:`\bar P`.
-
-    Every coefficient of friction the analysis reads (:math:`Q/P` at a point, the ECoF
-    :math:`E_d/(4\bar P\delta^*)`) is then the one of the load at each sample, as a rig
-    with a load cell records it; the forces and the energy are those at the mean load.
+    mean load: :math:`Q(t)\,\bar P/P(t)`, and :math:`\bar P` (see ``docs/loops.md``).
 
     Parameters
     ----------
@@ -221,14 +212,13 @@ def at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
     """``dataset`` with its variables of :data:`AT_OWN_LOAD` times ``ratio``, each cycle's
     load over the mean load."""
     ratio = np.asarray(ratio, dtype=np.float64)
-    scaled = {}
-    for name in AT_OWN_LOAD:
-        if name in dataset:
-            values = dataset[name].values
-            scaled[name] = dataset[name].copy(
-                data=values * ratio.reshape((-1,) + (1,) * (values.ndim - 1))
-            )
-    return dataset.assign(scaled)
+    return dataset.assign(
+        {
+            name: dataset[name].copy(data=(dataset[name].values.T * ratio).T)
+            for name in AT_OWN_LOAD
+            if name in dataset
+        }
+    )
 
 
 def _cycle_means(series, cycles: Cycles, rows: slice) -> np.ndarray:
@@ -368,13 +358,13 @@ class Analysis:
         """The arguments of :func:`measure_chunk` for chunk ``index``."""
         cycles, rows = self.cycles, self.tasks[index]
         first, stop = rows.start, rows.stop
-        if cycles.continuous:  # a halo of whole cycles on either side
+        if cycles.continuous:  # a halo of NEIGHBOURS whole cycles on either side
             kept = self._whole
             begin, end = np.searchsorted(kept, [first, stop])
             if begin > 0:
-                first = min(first, int(kept[max(begin - HALO, 0)]))
+                first = min(first, int(kept[max(begin - NEIGHBOURS, 0)]))
             if end < kept.size:
-                stop = max(stop, int(kept[min(end + HALO, kept.size) - 1]) + 1)
+                stop = max(stop, int(kept[min(end + NEIGHBOURS, kept.size) - 1]) + 1)
         table = cycles.rows(slice(first, stop))
         low = int(table.start[0])
         high = int(table.start[-1] + table.count[-1])
@@ -411,12 +401,7 @@ class Analysis:
     def finish(self, parts) -> xr.Dataset:
         """The parts (all of them, in order) joined, with the recording's attributes, after
         the checks of the whole recording (see :meth:`ecofmaps.measured.quality.Tally.finish`)."""
-        parts = list(parts)
-        if len(parts) == 1:
-            results = parts[0]
-        else:
-            results = xr.concat(parts, "cycle", coords="minimal", compat="override", join="outer")
-        return self.tally.finish(results, self.cycles, self.cycles_from, self.options)
+        return self.tally.finish(_joined(list(parts)), self.cycles, self.cycles_from, self.options)
 
     def run(self):
         """Every chunk, joined (:meth:`finish`); and the reading along the stroke, joined,
@@ -426,12 +411,14 @@ class Analysis:
             parts.append(chunk.part)
             if chunk.resolved is not None:
                 read.append(chunk.resolved)
-        resolved = None
-        if len(read) == 1:
-            resolved = read[0]
-        elif read:
-            resolved = xr.concat(read, "cycle", coords="minimal", compat="override", join="outer")
-        return self.finish(parts), resolved
+        return self.finish(parts), _joined(read) if read else None
+
+
+def _joined(parts: list) -> xr.Dataset:
+    """The parts of a recording, over ``cycle``, joined."""
+    if len(parts) == 1:
+        return parts[0]
+    return xr.concat(parts, "cycle", coords="minimal", compat="override", join="outer")
 
 
 def _tasks(count, samples: int) -> list[slice]:

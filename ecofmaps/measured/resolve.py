@@ -259,24 +259,17 @@ def read_along_stroke(loops: xr.Dataset, options: ReadingOptions):
     return xr.Dataset(data, coords=coords, attrs=attrs), flags
 
 
-#: Quality flags, in the order they are tested.
-#: The reasons this reading adds to a cycle's ``quality`` (ecofmaps.measured.quality) that
-#: leave its values NaN, the first that applies; ``'gicof-varies'``, which reaches the
-#: GICoF only, is added besides.
+#: The reasons this reading adds to a cycle's ``quality`` that leave its values NaN, in the
+#: order they are tested (``'gicof-varies'``, which reaches the GICoF only, comes besides).
 QUALITY_FLAGS = READING_REASONS[:4]
-
 #: Values of μ(ξ) beyond this many robust standard deviations of the median are clipped.
 _WINSOR = 3.0
-
 #: The largest lag-one autocorrelation of the block means that is believed.
 _R1 = 0.8
-
 #: Cycles analysed together: a block's arrays stay in the processor's cache.
 _BLOCK = 512
-
 #: Points of each cycle's own grid over its central part, for the per-cycle values.
 _CENTRAL_POINTS = 201
-
 #: The median absolute deviation of a normal distribution over its standard deviation.
 _MAD = 1.482602218505602
 

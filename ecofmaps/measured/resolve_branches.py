@@ -19,19 +19,14 @@ __all__ = [
 
 #: A given stiffness does not fit when it tilts the stick sets by this many σ.
 _TILT_SPREAD = 3.0
-
 #: Fewest samples in a stick set to measure the stiffness, the stick level and the noise.
 _STICK_SAMPLES = 3
-
 #: The stick set ends this share of the force swing before the first slip sample.
 _STICK_MARGIN = 0.05
-
 #: A sample has moved off the stick level, noise-free, beyond this share of Δ*.
 _ROUNDING = 1e-9
-
 #: Slip samples at the end of a branch whose median ξ is compared with the next stick level.
 _END_SAMPLES = 4
-
 #: The median of |N(0, 6)|, the second difference of white noise of unit variance.
 _SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
 
