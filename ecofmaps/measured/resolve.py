@@ -378,13 +378,8 @@ def _along_stroke(forward, backward, grid, lowest, highest, tilt, load, level):
     pieces = np.nan_to_num(0.5 * (slope[:, 1:] + slope[:, :-1]) * np.diff(grid))
     profile = np.concatenate([np.zeros((cycles, 1)), np.cumsum(pieces, axis=1)], axis=1)
     profile -= profile[:, np.searchsorted(grid, 0.0)][:, None]
-    return {
-        "mu": mu,
-        "slope": slope,
-        "felt_profile": np.where(inside, profile, np.nan),
-        "force_forward": q_forward,
-        "force_backward": q_backward,
-    }
+    felt = np.where(inside, profile, np.nan)
+    return dict(zip(_ALONG, (mu, slope, felt, q_forward, q_backward), strict=True))
 
 
 #: The values along the stroke, over (cycle, position).

@@ -365,11 +365,9 @@ def long_recording(cycles, samples_per_cycle=200, *, block_cycles=4096, seed=0, 
         Seed of the noise: block ``k`` uses its own stream derived from ``(seed, k)``, so the
         recording depends on ``seed`` and ``block_cycles`` only.
     **parameters
-        Any of :data:`LONG_TEST`: ``amplitude`` [m], ``load`` [N], ``stiffness`` [N/m],
-        ``mu``, ``final_aspect_ratio`` (the groove's z_o/x_o at the end of the test),
-        ``displacement_noise`` [m] and ``force_noise`` [N] (standard deviations),
-        ``displacement_offset`` [m], ``force_offset`` [N], ``displacement_drift`` (over the
-        whole test) [m].
+        Any of :data:`LONG_TEST`, in SI units as for :func:`synthetic_recording`:
+        ``final_aspect_ratio`` is the groove's z_o/x_o at the end of the test [1],
+        ``displacement_drift`` the drift over the whole test [m].
 
     Yields
     ------
@@ -380,12 +378,10 @@ def long_recording(cycles, samples_per_cycle=200, *, block_cycles=4096, seed=0, 
 
     Notes
     -----
-    Cycle :math:`N` (1-based) has the groove :math:`z_o/x_o = r_f \sqrt{N / N_{total}}`
-    with the groove half-width equal to the amplitude (the paper's :math:`x_o = \Delta^*`),
-    as in :func:`ecofmaps.measured.synthetic.example_recording`; each block is
-    :func:`synthetic_recording`'s steady loops (eq. 9, 10) from zero displacement on the
-    rise, with its offset advanced by the drift so far, so the drift runs on without a step
-    from block to block.
+    Cycle :math:`N` (1-based) has the groove :math:`z_o/x_o = r_f \sqrt{N / N_{total}}`,
+    :math:`x_o = \Delta^*`, as in :func:`example_recording`; each block is
+    :func:`synthetic_recording`'s steady loops (eq. 9, 10), its offset advanced by the drift
+    so far, so the drift runs on without a step from block to block.
 
     References
     ----------
