@@ -325,8 +325,7 @@ class Analysis:
         samples=None,
         one_chunk=False,
     ):
-        self.arrays = (displacement, force)
-        self.recorded_load = recorded_load
+        self.arrays = (displacement, force, recorded_load)
         self.reading = Reading() if reading is None else reading
         self.options, self.runner = options, runner
         self.cycles_from = "displacement reversals" if cycle is None else "cycle numbers"
@@ -366,10 +365,8 @@ class Analysis:
             if end < kept.size:
                 stop = max(stop, int(kept[min(end + NEIGHBOURS, kept.size) - 1]) + 1)
         table = cycles.rows(slice(first, stop))
-        low = int(table.start[0])
-        high = int(table.start[-1] + table.count[-1])
-        x, q = (stretch(array, low, high) for array in self.arrays)
-        p = None if self.recorded_load is None else stretch(self.recorded_load, low, high)
+        low, high = int(table.start[0]), int(table.start[-1] + table.count[-1])
+        x, q, p = (None if a is None else stretch(a, low, high) for a in self.arrays)
         if callable(keep):
             keep = functools.partial(keep, index)
         inner = slice(rows.start - first, rows.stop - first)

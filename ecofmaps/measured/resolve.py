@@ -173,10 +173,8 @@ def resolve_analyzed_loops(
     slip_threshold=ReadingOptions.slip_threshold,
     stick_window=ReadingOptions.stick_window,
 ) -> xr.Dataset:
-    r"""Friction and groove slope along the stroke of the loops :func:`analyze_loops` kept.
-
-    The work of :func:`ecofmaps.resolve_loops` after its call of :func:`ecofmaps.analyze_loops`:
-    for a recording already analysed with ``keep_loops=True``.
+    r"""Friction and groove slope along the stroke of the loops :func:`analyze_loops` kept:
+    :func:`ecofmaps.resolve_loops` for a recording already analysed.
 
     Parameters
     ----------
@@ -281,10 +279,9 @@ _MAD = 1.482602218505602
 def _central_values(forward, backward, central, load):
     """mu_resolved, its variance, k and g0 of g ≈ g0 + kξ, the sensitivity to 1/S."""
     width = forward[0].shape[1]
-    usable = np.isfinite(central)
     unit = np.linspace(-1.0, 1.0, _CENTRAL_POINTS)
     at = central[:, None] * unit[None, :]
-    inside = np.broadcast_to(usable[:, None], at.shape)
+    inside = np.broadcast_to(np.isfinite(central)[:, None], at.shape)
     q_forward, q_backward, mu, slope, lines = read_branches(
         forward, backward, unit, central, inside, load
     )
@@ -304,11 +301,9 @@ def _central_values(forward, backward, central, load):
     contrast = np.where(inner, 1.0 / inner_points, np.where(outer, -1.0 / outer_points, 0.0))
     variation = masked_sum(mu * contrast, kept)
     factor = 0.5 * (1.0 + mu**2) / load
-    variance = np.zeros(central.size)
-    variation_variance = np.zeros(central.size)
-    for branch, force, (left, share), sign in (
-        (forward, q_forward, lines[0], 1.0),
-        (backward, q_backward, lines[1], -1.0),
+    variance, variation_variance = np.zeros((2, central.size))
+    for branch, force, (left, share), sign in zip(
+        (forward, backward), (q_forward, q_backward), lines, (1.0, -1.0), strict=True
     ):
         gain = np.where(kept, sign * factor / (1.0 + (force / load) ** 2), 0.0)
         noise = branch_noise(*branch, central) ** 2
@@ -365,12 +360,13 @@ def _scatter_variance(mu, kept, unit):
     return np.where(few, np.nan, spread * (1.0 + r1) / (1.0 - r1)), np.where(few, np.nan, wiggle)
 
 
-def _along_stroke(forward, backward, grid, lowest, highest, tilt, load, level):
-    """Q±, μ, g (levelled by ``tilt`` if ``level``) and h over the common ``grid``."""
-    cycles = lowest.size
-    inside = np.isfinite(tilt)[:, None] & (grid >= lowest[:, None]) & (grid <= highest[:, None])
+def _along_stroke(part, grid, tilt, load, level):
+    """Q±, μ, g (levelled by ``tilt`` if ``level``) and h of a block over the common ``grid``."""
+    lowest, highest = part["lowest"][:, None], part["highest"][:, None]
+    cycles = tilt.size
+    inside = np.isfinite(tilt)[:, None] & (grid >= lowest) & (grid <= highest)
     q_forward, q_backward, mu, slope, _ = read_branches(
-        forward, backward, grid, np.ones(cycles), inside, load
+        part["forward"], part["backward"], grid, np.ones(cycles), inside, load
     )
     if level:
         slope = slope - tilt[:, None]
@@ -406,14 +402,7 @@ def along_stroke_values(x, q, load, stiffness, amplitude, inherited, given, opti
     for block in _blocks(cycles):
         check_interrupted()
         part = slip_branches(
-            x[block],
-            q[block],
-            valid[block],
-            stiffness[block],
-            amplitude[block],
-            given,
-            options.stick_window,
-            options.slip_threshold,
+            *(a[block] for a in (x, q, valid, stiffness, amplitude)), given, options
         )
         lowest, highest = part["lowest"], part["highest"]
         overlap = (lowest < 0.0) & (highest > 0.0)
@@ -469,17 +458,9 @@ def along_stroke_values(x, q, load, stiffness, amplitude, inherited, given, opti
         half = reach.max() if reach.size else np.max(amplitude, initial=0.0, where=amplitude > 0)
         grid = np.linspace(-1.0, 1.0, grid) * (half if half > 0.0 else 1.0)
     per_position = {name: np.empty((cycles, grid.size)) for name in _ALONG}
+    level = options.force_offset is None
     for part, block in zip(parts, _blocks(cycles), strict=True):
-        along = _along_stroke(
-            part["forward"],
-            part["backward"],
-            grid,
-            lowest[block],
-            highest[block],
-            per_cycle["tilt"][block],
-            load,
-            options.force_offset is None,
-        )
+        along = _along_stroke(part, grid, per_cycle["tilt"][block], load, level)
         for name in _ALONG:
             per_position[name][block] = along[name]
     return per_position, per_cycle, flags, grid

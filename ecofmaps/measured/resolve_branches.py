@@ -157,13 +157,14 @@ def _sorted_branch(xi, q, slip):
     )
 
 
-def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_threshold):
-    """The stiffness, the checks of the stick sets, and the two slip branches."""
+def slip_branches(x, q, valid, stiffness, amplitude, given, options):
+    """The stiffness, the checks of the stick sets, and the two slip branches, with the
+    ``stick_window`` and ``slip_threshold`` of ``options``."""
     cycles = x.shape[0]
     floor = _ROUNDING * amplitude
     branches = _branches(x, valid)
     moved = [_moved(q, branch) for branch in branches]
-    low, high = stick_window
+    (low, high), slip_threshold = options.stick_window, options.slip_threshold
     windows = [
         _before(share > high, branch) & (share >= low)
         for share, branch in zip(moved, branches, strict=True)
@@ -186,17 +187,15 @@ def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_t
         measured = np.all([_enough(stick) for stick in sticks], axis=0) & np.isfinite(fitted)
         compliance = np.where(measured, fitted, start)
         compliance_se = np.where(measured, fitted_se, 0.0)
-    negative = compliance < -3.0 * compliance_se
+    mismatch = compliance < -3.0 * compliance_se  # the stick sides slope down
     compliance = np.maximum(compliance, 0.0)
     # Second pass, with the stiffness used and the stick sets.
     xi = x - compliance[:, None] * q
     sigma, slips, levels = _stick_and_slip(xi, branches, sticks, floor, slip_threshold)
-    mismatch = negative
     if given:  # a stiffness that does not fit the stick sides tilts both alike in ξ
         mismatch = mismatch | _tilted_alike(xi, q, sticks, _TILT_SPREAD * sigma + floor, floor)
     shift = _branch_shift(xi, branches, slips, levels)
-    forward = _sorted_branch(xi, q, slips[0])
-    backward = _sorted_branch(xi, q, slips[1])
+    forward, backward = (_sorted_branch(xi, q, slip) for slip in slips)
     ends = []
     for xs, _, count in (forward, backward):
         last = np.take_along_axis(xs, np.maximum(count - 1, 0)[:, None], axis=1)[:, 0]
