@@ -306,16 +306,11 @@ def _measured_cycle(all_x, all_y, load, cycle, cycle_number, hysteresis):
                 f"complete cycles are numbered {cycles.label[0]} to {cycles.label[-1]}"
             )
         row = int(rows[0])
-    index = cycles.indices([row])[0][0]
-    number = int(cycles.label[row])
+    index, number, chosen = cycles.indices([row])[0][0], int(cycles.label[row]), slice(row, row + 1)
     analysis, flags, _ = max(
         (
             measure_cycles(
-                cycles,
-                all_x,
-                all_y,
-                LoopOptions(load, stick_window=window),
-                rows=slice(row, row + 1),
+                cycles, all_x, all_y, LoopOptions(load, stick_window=window), rows=chosen
             )
             for window in _STICK_WINDOWS
         ),
