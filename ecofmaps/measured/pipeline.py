@@ -242,13 +242,9 @@ def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
     """One chunk through the steps: its cycles measured on its stretch ``x``, ``q`` (and the
     load recorded over it), read along the stroke and judged once."""
     options, reading, labels = task.options, task.reading, task.cycles.label[task.rows]
+    x, q, kept = Stretch(x, task.low), Stretch(q, task.low), reading.resolve or reading.keep_loops
     values, flags, loops = measure_cycles(
-        task.cycles,
-        Stretch(x, task.low),
-        Stretch(q, task.low),
-        options,
-        rows=task.rows,
-        keep_loops=reading.resolve or reading.keep_loops,
+        task.cycles, x, q, options, rows=task.rows, keep_loops=kept
     )
     if recorded_load is not None:
         values["normal_load"] = _cycle_means(
@@ -267,10 +263,9 @@ def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
         handed = at_own_load(handed, values["normal_load"] / options.load)
     tally = Tally()
     tally.add(part["quality"].values, flags, values["amplitude"])
-    keep = task.keep
-    if callable(keep):
-        keep(values, flags)
-    if keep is not True:
+    if callable(task.keep):
+        task.keep(values, flags)
+    if task.keep is not True:
         values = flags = None
     made = None if task.then is None else task.then(part)
     return Chunk(only(part, task.columns), tally, values, flags, made, handed)

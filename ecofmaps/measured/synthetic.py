@@ -197,9 +197,8 @@ def example_recording():
 
 
 def _on_rig(p, ratio, samples_per_cycle, offset, drift, seed):
-    """:func:`synthetic_recording` with the rig and sensors of ``p`` (:data:`EXAMPLE` or
-    :data:`LONG_TEST`) from zero displacement on the rise, its displacement offset by
-    ``offset`` more. [m]"""
+    """:func:`synthetic_recording` on the rig and sensors of ``p``, from zero displacement on
+    the rise, its displacement offset by ``offset`` [m] more."""
     return synthetic_recording(
         p["amplitude"],
         p["load"],
