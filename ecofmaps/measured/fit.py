@@ -1,12 +1,6 @@
-r"""The model's steady loop fitted to a measured fretting loop (the paper's Figure 10).
-
-:func:`fit_loop` finds the contact coefficient of friction :math:`\mu`, the rig stiffness
-:math:`S` and the groove depth :math:`z_o` (with the paper's choice :math:`x_o = \Delta^*`)
-whose steady loop passes closest, in the least-squares sense, to the measured samples
-:math:`(\Delta_i, Q_i)`. The model force at each sample is the steady loop's force at the
-same actuator displacement on the same branch (rising or falling :math:`\Delta`), in closed
-form, so the residual has exact JAX derivatives; SciPy's trust-region least squares uses
-them with bounds :math:`\mu > 0`, :math:`S > 0`, :math:`z_o \ge 0`.
+r"""The model's steady loop fitted to a measured fretting loop (the paper's Figure 10):
+:func:`fit_loop`. The method is explained in ``docs/method-loops.md`` ("Fitting the model's
+loop").
 """
 
 from __future__ import annotations
@@ -27,17 +21,13 @@ from ecofmaps.model.simulation import fretting_loop
 
 __all__ = ["LoopFit", "fit_loop"]
 
-# Force windows after each reversal where analyze_loops starts the stick segments (it then
-# grows them along the stick line): its default, and a narrow one that holds only stick
-# also when the groove slope at the reversal exceeds mu and the stick is short. Slip in a
-# window only lowers its slope, so the steeper of the two is the start.
+#: The stick windows of the loop's own analysis: the one with the steeper stick sides starts.
 _STICK_WINDOWS = ((0.05, 0.45), (0.0, 0.15))
-# Contact positions within this share of the slip amplitude are read as slipping for the
-# starting mu and groove slope.
+#: Contact positions within this share of the slip amplitude slip, for the starting values.
 _SLIP_SHARE = 0.6
-# A slip amplitude below this share of the amplitude is rounding: the loop does not slip.
+#: A slip amplitude below this share of the amplitude is rounding: the loop does not slip.
 _NO_SLIP = 1e-9
-# Samples are padded to a multiple of this for the compiled residual.
+#: Samples are padded to a multiple of this for the compiled residual.
 _BUCKET = 64
 _TOLERANCE = 1e-12
 _MAX_EVALUATIONS = 200
@@ -58,13 +48,10 @@ class LoopFit:
     aspect_ratio : float
         Groove aspect ratio :math:`z_o/x_o` with :math:`x_o = \Delta^*`. [1]
     amplitude : float
-        Displacement amplitude :math:`\Delta^*` of the fitted loop, which is also the groove
-        half-width :math:`x_o`. [m]
-    displacement_offset : float
-        Centre of the fitted loop in displacement (a sensor offset), fitted with the
-        rest. [m]
-    force_offset : float
-        Centre of the fitted loop in force (a load-cell offset), fitted with the rest. [N]
+        Displacement amplitude :math:`\Delta^*` of the fitted loop, also the groove's
+        :math:`x_o`. [m]
+    displacement_offset, force_offset : float
+        Centre of the fitted loop in displacement [m] and in force [N] (sensor offsets).
     load : float
         Normal load :math:`P`, as given. [N]
     rms_residual : float
@@ -72,11 +59,8 @@ class LoopFit:
     r_squared : float
         Coefficient of determination :math:`1 - \sum r_i^2 / \sum (Q_i - \bar Q)^2`. [1]
     standard_errors : dict of str to float
-        Standard error of each fitted quantity (keys ``mu``, ``stiffness``,
-        ``groove_depth``, ``aspect_ratio``, ``amplitude``, ``displacement_offset``,
-        ``force_offset``), in its unit, from the Jacobian at the solution and the residual
-        variance (a linearisation that treats the residuals as independent and alike;
-        meaningless for a parameter held at its bound, such as a flat groove).
+        Standard error of each fitted quantity above, by its name, in its unit (linearised:
+        see ``docs/method-loops.md``).
     success : bool
         True when the least squares converged to a loop in gross slip.
     evaluations : int
@@ -90,8 +74,7 @@ class LoopFit:
     rising : numpy.ndarray of bool
         True for samples on the rising-displacement branch.
     cycle : int
-        Number of the cycle fitted: the recorded one, or 1, 2, ... over the complete
-        cycles found at the reversals (as in :func:`ecofmaps.analyze_loops`). [1]
+        Number of the cycle fitted, as in :func:`ecofmaps.analyze_loops`. [1]
     """
 
     mu: float
@@ -152,9 +135,12 @@ _residual_jit = jax.jit(_residual)
 _jacobian_jit = jax.jit(jax.jacfwd(_residual))
 
 
-def _starting_values(x, y, rising, stiffness, slip_half_width, energy_ratio):
-    r"""Scaled starting parameters (:math:`\Delta/L`, :math:`Q/P`, centred) from the loop."""
-    if energy_ratio < -ANTICLOCKWISE_SHARE:
+def _starting_values(x, y, rising, analysis, length, load):
+    r"""Scaled starting parameters (:math:`\Delta/L`, :math:`Q/P`, centred) from the loop's
+    ``analysis``."""
+    stiffness = analysis["stiffness"] * length / load
+    slip_half_width = analysis["slip_amplitude"] / length
+    if analysis["energy_ratio"] < -ANTICLOCKWISE_SHARE:
         raise ValueError(
             "the loop runs anticlockwise (its area ∮Q dΔ is negative): force and "
             "displacement must be positive in the same direction"
@@ -180,25 +166,6 @@ def _starting_values(x, y, rising, stiffness, slip_half_width, energy_ratio):
         raise ValueError("the loop's slip segments give mu <= 0: it is not a fretting loop")
     groove_slope = max(slope, 0.0) / (1.0 + mu * mu)
     return np.array([mu, stiffness, groove_slope / 2.0, 1.0, 0.0, 0.0])
-
-
-def _select_cycle(x, cycle, cycle_number, hysteresis):
-    """The complete cycles of the recording and the row of the one to fit."""
-    cycles = find_cycles(x, cycle, hysteresis)
-    if cycles.label.size == 0:
-        raise ValueError(
-            f"no complete cycle in {x.size} samples: too few samples for one cycle, or the "
-            "loop does not close"
-        )
-    if cycle_number is None:
-        return cycles, cycles.label.size - 1
-    (rows,) = np.nonzero(cycles.label == cycle_number)
-    if rows.size == 0:
-        raise ValueError(
-            f"cycle_number {cycle_number!r} is not a complete cycle of the recording; "
-            f"complete cycles are numbered {cycles.label[0]} to {cycles.label[-1]}"
-        )
-    return cycles, int(rows[0])
 
 
 @float64
@@ -243,26 +210,7 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
 
     Notes
     -----
-    The cycle runs from its lowest displacement to its highest (the rising branch) and
-    back (the falling branch). On the rising branch of the steady loop the contact sticks
-    at :math:`x = -\delta^*` after the reversal, :math:`Q = S(\Delta + \delta^*)`, until it
-    slips forward with :math:`Q = Q_+(x)` and :math:`x + Q_+(x)/S = \Delta` (eq. 9, 10,
-    16); the falling branch is its image under :math:`(\Delta, Q) \to (-\Delta, -Q)`. So
-    each sample has a model force in closed form, at its own displacement on its own
-    branch, whatever the sampling or the waveform.
-
-    Six parameters are fitted: :math:`\mu`, :math:`S`, :math:`z_o`, :math:`\Delta^*` (which
-    sets the reversals, and :math:`x_o = \Delta^*` as in the paper) and the loop's centre
-    in displacement and in force (sensor offsets). They are scaled by :math:`P` and by
-    :math:`L`, half the cycle's peak-to-peak displacement, and found by
-    ``scipy.optimize.least_squares`` (trust region reflective, bounds :math:`\mu > 0`,
-    :math:`S > 0`, :math:`z_o \ge 0`, :math:`\Delta^* > 0`) with the Jacobian from
-    ``jax.jacfwd``. The starting point is the loop's own analysis
-    (:func:`ecofmaps.analyze_loops`: centre, amplitude, stick stiffness, slip amplitude)
-    and a straight-line fit of :math:`Q/P` against the contact position
-    :math:`\Delta - Q/S` on the slip segments for :math:`\mu` and the groove slope.
-    The paper sets :math:`\mu` to the loop's GICoF and reads :math:`S` off the loop
-    (Section 4.2, Figure 10); for a loop of the model both equal the fitted values.
+    The method is explained in ``docs/method-loops.md`` ("Fitting the model's loop").
 
     References
     ----------
@@ -278,19 +226,11 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
     if x.size < MIN_SAMPLES:
         raise ValueError(f"a loop needs at least {MIN_SAMPLES} samples, got {x.size}")
     rising = np.arange(x.size) <= np.argmax(x)
-    length = analysis["amplitude"]
-    centre = analysis["displacement_offset"]
-    offset = analysis["force_offset"]
-    scaled_x = (x - centre) / length
-    scaled_y = (y - offset) / load
-    start = _starting_values(
-        scaled_x,
-        scaled_y,
-        rising,
-        stiffness=analysis["stiffness"] * length / load,
-        slip_half_width=analysis["slip_amplitude"] / length,
-        energy_ratio=analysis["energy_ratio"],
+    length, centre, offset = (
+        analysis[k] for k in ("amplitude", "displacement_offset", "force_offset")
     )
+    scaled_x, scaled_y = (x - centre) / length, (y - offset) / load
+    start = _starting_values(scaled_x, scaled_y, rising, analysis, length, load)
     solution = _solution(scaled_x, scaled_y, rising, start)
     mu, s, a, amplitude, shift, force_shift = (float(v) for v in solution.x)
     model_force = y + load * solution.fun[: x.size]
@@ -323,8 +263,7 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
 
 
 def _checked_samples(displacement, force, load, hysteresis):
-    """The load and the samples of :func:`fit_loop`, checked (a ValueError naming the
-    input that is not valid). [N], [m], [N]"""
+    """The load and the samples of :func:`fit_loop`, checked. [N], [m], [N]"""
     check("load", load, "positive", "N")
     if np.ndim(load) != 0:
         raise ValueError(f"load must be a single number [N], got shape {np.shape(load)}")
@@ -352,17 +291,26 @@ def _measured_cycle(all_x, all_y, load, cycle, cycle_number, hysteresis):
     """The samples of the cycle to fit (indices round its loop), its number, and its
     per-cycle analysis (the stick window that gives the stiffest stick sides); a
     ValueError if the cycle is refused."""
-    cycles, row = _select_cycle(all_x, cycle, cycle_number, hysteresis)
-    index = cycles.indices([row])[0][0]
-    number = int(cycles.label[row])
+    cycles = find_cycles(all_x, cycle, hysteresis)
+    if cycles.label.size == 0:
+        raise ValueError(
+            f"no complete cycle in {all_x.size} samples: too few samples for one cycle, or the "
+            "loop does not close"
+        )
+    row = cycles.label.size - 1
+    if cycle_number is not None:
+        (rows,) = np.nonzero(cycles.label == cycle_number)
+        if rows.size == 0:
+            raise ValueError(
+                f"cycle_number {cycle_number!r} is not a complete cycle of the recording; "
+                f"complete cycles are numbered {cycles.label[0]} to {cycles.label[-1]}"
+            )
+        row = int(rows[0])
+    index, number, chosen = cycles.indices([row])[0][0], int(cycles.label[row]), slice(row, row + 1)
     analysis, flags, _ = max(
         (
             measure_cycles(
-                cycles,
-                all_x,
-                all_y,
-                LoopOptions(load, stick_window=window),
-                rows=slice(row, row + 1),
+                cycles, all_x, all_y, LoopOptions(load, stick_window=window), rows=chosen
             )
             for window in _STICK_WINDOWS
         ),
@@ -411,9 +359,8 @@ def _solution(scaled_x, scaled_y, rising, start):
 
 
 def _standard_errors(solution, samples: int, load: float, length: float) -> dict:
-    """Linearised standard errors of the fitted parameters: covariance s^2 (J^T J)^-1 of the
-    scaled parameters, with s^2 the residual variance, carried to SI units (a ratio by its
-    gradient)."""
+    """Standard errors of the fitted parameters in SI units, from the covariance s^2 (J^T J)^-1
+    of the scaled ones (s^2 the residual variance)."""
     _, _, a, amplitude, _, _ = (float(v) for v in solution.x)
     jacobian = solution.jac[:samples]
     variance = np.sum(solution.fun[:samples] ** 2) / (samples - solution.x.size)

@@ -16,14 +16,13 @@ import xarray as xr
 
 from ecofmaps._inputs import check
 from ecofmaps._parallel import Runner, stretch
+from ecofmaps.measured import resolve
 from ecofmaps.measured.cycles import Cycles, find_cycles, missing_sample_error, no_cycle_error
 from ecofmaps.measured.measure import GROSS_SLIP_THRESHOLD, NEIGHBOURS, Stretch, measure_cycles
 from ecofmaps.measured.quality import RESOLVED, Tally, cycle_results, scale_flags, with_loops
-from ecofmaps.measured.resolve import ReadingOptions, read_along_stroke, resolved_attrs
 
 __all__ = [
     "AT_OWN_LOAD",
-    "HALO",
     "IN_PROCESS",
     "NAN_POLICIES",
     "TASK_SAMPLES",
@@ -41,10 +40,6 @@ __all__ = [
 
 #: Samples of the recording measured by one chunk of a long recording (about; whole cycles).
 TASK_SAMPLES = 1 << 22
-
-#: Whole cycles on either side of a chunk's cycles that it reads for the centring.
-HALO = NEIGHBOURS
-
 #: What the analysis does with missing samples: skip their cycles, or raise.
 NAN_POLICIES = ("skip", "raise")
 
@@ -63,40 +58,19 @@ class LoopOptions:
     rig_stiffness: float | None = None
 
     def __post_init__(self):
-        check("load", self.load, "positive", "N")
-        if np.ndim(self.load) != 0:
-            raise ValueError("load must be a single value [N]")
-        if not 0.0 < self.hysteresis < 1.0:
-            raise ValueError(f"hysteresis must satisfy 0 < hysteresis < 1; got {self.hysteresis!r}")
-        low, high = (float(share) for share in self.stick_window)
-        if not 0.0 <= low < high <= 1.0:
-            raise ValueError(
-                f"stick_window must satisfy 0 <= low < high <= 1; got {self.stick_window!r}"
-            )
-        if not self.crossing_window > 0.0:
-            raise ValueError(
-                f"crossing_window must satisfy crossing_window > 0; got {self.crossing_window!r}"
-            )
-        if not 0.0 < self.gross_slip_threshold < 1.0:
-            raise ValueError(
-                "gross_slip_threshold must satisfy 0 < gross_slip_threshold < 1; "
-                f"got {self.gross_slip_threshold!r}"
-            )
+        load = resolve.single_value("load", self.load, "positive", "N")
+        hysteresis = resolve.within("hysteresis", self.hysteresis, 1.0)
+        window = resolve.checked_stick_window(self.stick_window)
+        crossing = resolve.within("crossing_window", self.crossing_window)
+        threshold = resolve.within("gross_slip_threshold", self.gross_slip_threshold, 1.0)
         if not isinstance(self.flip_force, bool | np.bool_):
             raise ValueError(f"flip_force must be True or False; got {self.flip_force!r}")
-        if self.rig_stiffness is not None:
-            check("rig_stiffness", self.rig_stiffness, "positive_or_inf", "N/m")
-        checked = {
-            "load": float(self.load),
-            "hysteresis": float(self.hysteresis),
-            "stick_window": (low, high),
-            "crossing_window": float(self.crossing_window),
-            "gross_slip_threshold": float(self.gross_slip_threshold),
-            "flip_force": bool(self.flip_force),
-            "rig_stiffness": None if self.rig_stiffness is None else float(self.rig_stiffness),
-        }
-        for name, value in checked.items():
-            object.__setattr__(self, name, value)
+        rig = self.rig_stiffness
+        if rig is not None:
+            check("rig_stiffness", rig, "positive_or_inf", "N/m")
+            rig = float(rig)
+        flip = bool(self.flip_force)
+        resolve.settle(self, load, hysteresis, window, crossing, threshold, flip, rig)
 
 
 class _InProcess:
@@ -143,8 +117,8 @@ class Reading:
 
     resolve: bool = False
     keep_loops: bool = False
-    along_stroke: ReadingOptions = dataclasses.field(
-        default_factory=lambda: ReadingOptions(positions=None)
+    along_stroke: resolve.ReadingOptions = dataclasses.field(
+        default_factory=lambda: resolve.ReadingOptions(positions=None)
     )
     hand_back: bool = False
 
@@ -183,11 +157,7 @@ class Chunk:
 
 def force_at_mean_load(force, load):
     r"""The force of a recording whose normal load was recorded sample by sample, as at the
-    mean load: :math:`Q(t)\,\bar P/P(t)`, and :math:`\bar P`.
-
-    Every coefficient of friction the analysis reads (:math:`Q/P` at a point, the ECoF
-    :math:`E_d/(4\bar P\delta^*)`) is then the one of the load at each sample, as a rig
-    with a load cell records it; the forces and the energy are those at the mean load.
+    mean load: :math:`Q(t)\,\bar P/P(t)`, and :math:`\bar P` (see ``docs/loops.md``).
 
     Parameters
     ----------
@@ -242,14 +212,13 @@ def at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
     """``dataset`` with its variables of :data:`AT_OWN_LOAD` times ``ratio``, each cycle's
     load over the mean load."""
     ratio = np.asarray(ratio, dtype=np.float64)
-    scaled = {}
-    for name in AT_OWN_LOAD:
-        if name in dataset:
-            values = dataset[name].values
-            scaled[name] = dataset[name].copy(
-                data=values * ratio.reshape((-1,) + (1,) * (values.ndim - 1))
-            )
-    return dataset.assign(scaled)
+    return dataset.assign(
+        {
+            name: dataset[name].copy(data=(dataset[name].values.T * ratio).T)
+            for name in AT_OWN_LOAD
+            if name in dataset
+        }
+    )
 
 
 def _cycle_means(series, cycles: Cycles, rows: slice) -> np.ndarray:
@@ -273,13 +242,9 @@ def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
     """One chunk through the steps: its cycles measured on its stretch ``x``, ``q`` (and the
     load recorded over it), read along the stroke and judged once."""
     options, reading, labels = task.options, task.reading, task.cycles.label[task.rows]
+    x, q, kept = Stretch(x, task.low), Stretch(q, task.low), reading.resolve or reading.keep_loops
     values, flags, loops = measure_cycles(
-        task.cycles,
-        Stretch(x, task.low),
-        Stretch(q, task.low),
-        options,
-        rows=task.rows,
-        keep_loops=reading.resolve or reading.keep_loops,
+        task.cycles, x, q, options, rows=task.rows, keep_loops=kept
     )
     if recorded_load is not None:
         values["normal_load"] = _cycle_means(
@@ -289,7 +254,7 @@ def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
     resolved = None
     if reading.resolve:
         judged = with_loops(cycle_results(values, flags, labels, options), loops)
-        resolved, read = read_along_stroke(judged, reading.along_stroke)
+        resolved, read = resolve.read_along_stroke(judged, reading.along_stroke)
         values = values | {name: resolved[name].values for name in RESOLVED}
         flags = flags | read
     part = _part(values, flags, labels, options, loops if reading.keep_loops else None)
@@ -298,10 +263,9 @@ def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
         handed = at_own_load(handed, values["normal_load"] / options.load)
     tally = Tally()
     tally.add(part["quality"].values, flags, values["amplitude"])
-    keep = task.keep
-    if callable(keep):
-        keep(values, flags)
-    if keep is not True:
+    if callable(task.keep):
+        task.keep(values, flags)
+    if task.keep is not True:
         values = flags = None
     made = None if task.then is None else task.then(part)
     return Chunk(only(part, task.columns), tally, values, flags, made, handed)
@@ -321,7 +285,7 @@ def _part(values: dict, flags: dict, labels, options, loops=None) -> xr.Dataset:
     measured = {k: v for k, v in values.items() if k not in RESOLVED}
     part = cycle_results(measured, flags, labels, options)
     read = [name for name in RESOLVED if name in values]
-    part = part.assign({k: ("cycle", values[k], resolved_attrs(k)) for k in read})
+    part = part.assign({k: ("cycle", values[k], resolve.resolved_attrs(k)) for k in read})
     if loops is not None:
         part = with_loops(part, loops)
     if "normal_load" in part:
@@ -356,8 +320,7 @@ class Analysis:
         samples=None,
         one_chunk=False,
     ):
-        self.arrays = (displacement, force)
-        self.recorded_load = recorded_load
+        self.arrays = (displacement, force, recorded_load)
         self.reading = Reading() if reading is None else reading
         self.options, self.runner = options, runner
         self.cycles_from = "displacement reversals" if cycle is None else "cycle numbers"
@@ -389,18 +352,16 @@ class Analysis:
         """The arguments of :func:`measure_chunk` for chunk ``index``."""
         cycles, rows = self.cycles, self.tasks[index]
         first, stop = rows.start, rows.stop
-        if cycles.continuous:  # a halo of whole cycles on either side
+        if cycles.continuous:  # a halo of NEIGHBOURS whole cycles on either side
             kept = self._whole
             begin, end = np.searchsorted(kept, [first, stop])
             if begin > 0:
-                first = min(first, int(kept[max(begin - HALO, 0)]))
+                first = min(first, int(kept[max(begin - NEIGHBOURS, 0)]))
             if end < kept.size:
-                stop = max(stop, int(kept[min(end + HALO, kept.size) - 1]) + 1)
+                stop = max(stop, int(kept[min(end + NEIGHBOURS, kept.size) - 1]) + 1)
         table = cycles.rows(slice(first, stop))
-        low = int(table.start[0])
-        high = int(table.start[-1] + table.count[-1])
-        x, q = (stretch(array, low, high) for array in self.arrays)
-        p = None if self.recorded_load is None else stretch(self.recorded_load, low, high)
+        low, high = int(table.start[0]), int(table.start[-1] + table.count[-1])
+        x, q, p = (None if a is None else stretch(a, low, high) for a in self.arrays)
         if callable(keep):
             keep = functools.partial(keep, index)
         inner = slice(rows.start - first, rows.stop - first)
@@ -432,12 +393,7 @@ class Analysis:
     def finish(self, parts) -> xr.Dataset:
         """The parts (all of them, in order) joined, with the recording's attributes, after
         the checks of the whole recording (see :meth:`ecofmaps.measured.quality.Tally.finish`)."""
-        parts = list(parts)
-        if len(parts) == 1:
-            results = parts[0]
-        else:
-            results = xr.concat(parts, "cycle", coords="minimal", compat="override", join="outer")
-        return self.tally.finish(results, self.cycles, self.cycles_from, self.options)
+        return self.tally.finish(_joined(list(parts)), self.cycles, self.cycles_from, self.options)
 
     def run(self):
         """Every chunk, joined (:meth:`finish`); and the reading along the stroke, joined,
@@ -447,12 +403,14 @@ class Analysis:
             parts.append(chunk.part)
             if chunk.resolved is not None:
                 read.append(chunk.resolved)
-        resolved = None
-        if len(read) == 1:
-            resolved = read[0]
-        elif read:
-            resolved = xr.concat(read, "cycle", coords="minimal", compat="override", join="outer")
-        return self.finish(parts), resolved
+        return self.finish(parts), _joined(read) if read else None
+
+
+def _joined(parts: list) -> xr.Dataset:
+    """The parts of a recording, over ``cycle``, joined."""
+    if len(parts) == 1:
+        return parts[0]
+    return xr.concat(parts, "cycle", coords="minimal", compat="override", join="outer")
 
 
 def _tasks(count, samples: int) -> list[slice]:

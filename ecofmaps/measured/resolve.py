@@ -40,9 +40,13 @@ __all__ = [
     "QUALITY_FLAGS",
     "ReadingOptions",
     "along_stroke_values",
+    "checked_stick_window",
     "read_along_stroke",
     "resolve_analyzed_loops",
     "resolved_attrs",
+    "settle",
+    "single_value",
+    "within",
 ]
 
 
@@ -63,6 +67,65 @@ def resolved_attrs(name: str) -> dict:
     return attrs
 
 
+def single_value(name: str, value, kind: str, unit: str) -> float:
+    """``value`` checked as one number of ``kind`` (:func:`ecofmaps._inputs.check`)."""
+    check(name, value, kind, unit)
+    if np.ndim(value) != 0:
+        raise ValueError(f"{name} must be a single value [{unit}]")
+    return float(value)
+
+
+def within(name: str, value, high=None, *, inclusive=False) -> float:
+    """``value`` as a float if ``0 < value`` (and ``< high``, or ``<= high`` if ``inclusive``),
+    else a ValueError that says so."""
+    if high is None:
+        holds, condition = value > 0.0, f"{name} > 0"
+    else:
+        holds = 0.0 < value <= high if inclusive else 0.0 < value < high
+        condition = f"0 < {name} {'<=' if inclusive else '<'} {high:g}"
+    if not holds:
+        raise ValueError(f"{name} must satisfy {condition}; got {value!r}")
+    return float(value)
+
+
+def checked_stick_window(window) -> tuple:
+    """The shares ``(low, high)`` of a stick window, checked."""
+    low, high = (float(share) for share in window)
+    if not 0.0 <= low < high <= 1.0:
+        raise ValueError(f"stick_window must satisfy 0 <= low < high <= 1; got {window!r}")
+    return low, high
+
+
+def settle(options, *checked) -> None:
+    """Set the ``checked`` values of the fields of the frozen dataclass ``options``, in order."""
+    for field, value in zip(dataclasses.fields(options), checked, strict=True):
+        object.__setattr__(options, field.name, value)
+
+
+def _grid_positions(positions):
+    """``positions`` checked: None, an odd count >= 5, or increasing positions with 0. [m]"""
+    if positions is None:
+        return None
+    if np.ndim(positions) == 0:
+        if (
+            isinstance(positions, bool)
+            or not isinstance(positions, int | np.integer)
+            or positions < 5
+            or positions % 2 == 0
+        ):
+            raise ValueError(
+                f"positions must be an odd integer >= 5 or an array of positions; got {positions!r}"
+            )
+        return int(positions)
+    check("positions", positions, "finite", "m")
+    positions = np.asarray(positions, dtype=np.float64)
+    if positions.ndim != 1 or positions.size < 3 or np.any(np.diff(positions) <= 0.0):
+        raise ValueError("positions must be one-dimensional and increasing, >= 3 of them [m]")
+    if not np.any(positions == 0.0):
+        raise ValueError("positions must include 0 (the centre, where the profile is zero) [m]")
+    return positions
+
+
 @dataclasses.dataclass(frozen=True)
 class ReadingOptions:
     """The options of the reading along the stroke (see :func:`ecofmaps.resolve_loops`),
@@ -76,61 +139,16 @@ class ReadingOptions:
     stick_window: tuple = (0.05, 0.45)
 
     def __post_init__(self):
-        stiffness, force_offset, positions = self.stiffness, self.force_offset, self.positions
+        stiffness, force_offset = self.stiffness, self.force_offset
         if stiffness is not None:
-            check("stiffness", stiffness, "positive_or_inf", "N/m")
-            if np.ndim(stiffness) != 0:
-                raise ValueError("stiffness must be a single value [N/m]")
+            stiffness = single_value("stiffness", stiffness, "positive_or_inf", "N/m")
         if force_offset is not None:
-            check("force_offset", force_offset, "finite", "N")
-            if np.ndim(force_offset) != 0:
-                raise ValueError("force_offset must be a single value [N]")
-        if positions is None:
-            pass
-        elif np.ndim(positions) == 0:
-            if (
-                isinstance(positions, bool)
-                or not isinstance(positions, int | np.integer)
-                or positions < 5
-                or positions % 2 == 0
-            ):
-                raise ValueError(
-                    "positions must be an odd integer >= 5 or an array of positions; "
-                    f"got {positions!r}"
-                )
-            positions = int(positions)
-        else:
-            check("positions", positions, "finite", "m")
-            positions = np.asarray(positions, dtype=np.float64)
-            if positions.ndim != 1 or positions.size < 3 or np.any(np.diff(positions) <= 0.0):
-                raise ValueError(
-                    "positions must be one-dimensional and increasing, >= 3 of them [m]"
-                )
-            if not np.any(positions == 0.0):
-                raise ValueError(
-                    "positions must include 0 (the centre, where the profile is zero) [m]"
-                )
-        if not 0.0 < self.central <= 1.0:
-            raise ValueError(f"central must satisfy 0 < central <= 1; got {self.central!r}")
-        if not self.slip_threshold > 0.0:
-            raise ValueError(
-                f"slip_threshold must satisfy slip_threshold > 0; got {self.slip_threshold!r}"
-            )
-        low, high = (float(share) for share in self.stick_window)
-        if not 0.0 <= low < high <= 1.0:
-            raise ValueError(
-                f"stick_window must satisfy 0 <= low < high <= 1; got {self.stick_window!r}"
-            )
-        checked = {
-            "stiffness": None if stiffness is None else float(stiffness),
-            "force_offset": None if force_offset is None else float(force_offset),
-            "positions": positions,
-            "central": float(self.central),
-            "slip_threshold": float(self.slip_threshold),
-            "stick_window": (low, high),
-        }
-        for name, value in checked.items():
-            object.__setattr__(self, name, value)
+            force_offset = single_value("force_offset", force_offset, "finite", "N")
+        positions = _grid_positions(self.positions)
+        central = within("central", self.central, 1.0, inclusive=True)
+        threshold = within("slip_threshold", self.slip_threshold)
+        window = checked_stick_window(self.stick_window)
+        settle(self, stiffness, force_offset, positions, central, threshold, window)
 
 
 _NEEDED = (
@@ -155,10 +173,8 @@ def resolve_analyzed_loops(
     slip_threshold=ReadingOptions.slip_threshold,
     stick_window=ReadingOptions.stick_window,
 ) -> xr.Dataset:
-    r"""Friction and groove slope along the stroke of the loops :func:`analyze_loops` kept.
-
-    The work of :func:`ecofmaps.resolve_loops` after its call of :func:`ecofmaps.analyze_loops`:
-    for a recording already analysed with ``keep_loops=True``.
+    r"""Friction and groove slope along the stroke of the loops :func:`analyze_loops` kept:
+    :func:`ecofmaps.resolve_loops` for a recording already analysed.
 
     Parameters
     ----------
@@ -197,46 +213,39 @@ def resolve_analyzed_loops(
 def read_along_stroke(loops: xr.Dataset, options: ReadingOptions):
     """:func:`resolve_analyzed_loops` on options checked, and the flags of its reasons
     (reason -> per cycle) besides the Dataset."""
+
+    def values(name):
+        return np.asarray(loops[name].values, dtype=np.float64)
+
     load = float(loops["load"])
-    x = np.asarray(loops["loop_displacement"].values, dtype=np.float64)
-    q = np.asarray(loops["loop_force"].values, dtype=np.float64)
-    removed = np.asarray(loops["force_offset"].values, dtype=np.float64)
+    x, q, removed = map(values, ("loop_displacement", "loop_force", "force_offset"))
     if options.force_offset is not None:  # the force as recorded, less the given offset
         q = q + (removed - options.force_offset)[:, None]
         removed = np.full_like(removed, options.force_offset)
     given = options.stiffness is not None
-    rig = np.full(x.shape[0], options.stiffness) if given else loops["stiffness"].values
-    quality = loops["quality"].values
+    rig = np.full(x.shape[0], options.stiffness) if given else values("stiffness")
+    quality, amplitude = loops["quality"].values, values("amplitude")
+    inherited = _reaches_resolved(quality)
     with np.errstate(divide="ignore", invalid="ignore"):
         per_position, per_cycle, flags, grid = along_stroke_values(
-            x,
-            q,
-            np.isfinite(x) & np.isfinite(q),
-            load,
-            np.asarray(rig, dtype=np.float64),
-            np.asarray(loops["amplitude"].values, dtype=np.float64),
-            _reaches_resolved(quality),
-            given,
-            options,
-            np.asarray(loops["force_drift_se"].values, dtype=np.float64),
+            x, q, load, rig, amplitude, inherited, given, options, values("force_drift_se")
         )
         per_cycle["position_offset"] = (
             loops["displacement_offset"].values - removed / per_cycle["stiffness"]
         )
         per_cycle["amplitude"] = loops["amplitude"].values  # the x_o of aspect_ratio
-    dims = ("cycle", "position")
-    data = {name: (dims, value, resolved_attrs(name)) for name, value in per_position.items()}
-    for name, value in per_cycle.items():
-        data[name] = ("cycle", value, resolved_attrs(name))
+    data = {name: (("cycle", "position"), value) for name, value in per_position.items()}
+    data |= {name: ("cycle", value) for name, value in per_cycle.items()}
     for reason, flag in flags.items():
         quality = add_reason(quality, flag, reason)
-    data["quality"] = ("cycle", quality, resolved_attrs("quality"))
-    coords = {
-        "cycle": ("cycle", loops["cycle"].values, resolved_attrs("cycle")),
-        "load": ((), load, resolved_attrs("load")),
-    }
+    data["quality"] = ("cycle", quality)
+    coords = {"cycle": ("cycle", loops["cycle"].values), "load": ((), load)}
     if grid is not None:
-        coords["position"] = ("position", grid, resolved_attrs("position"))
+        coords["position"] = ("position", grid)
+    data, coords = (
+        {name: (*value, resolved_attrs(name)) for name, value in mapping.items()}
+        for mapping in (data, coords)
+    )
     attrs = {
         "title": "Fretting loops read along the stroke (ecofmaps.resolve_loops)",
         "stiffness_from": "given" if given else "the stick sets of each loop",
@@ -248,24 +257,17 @@ def read_along_stroke(loops: xr.Dataset, options: ReadingOptions):
     return xr.Dataset(data, coords=coords, attrs=attrs), flags
 
 
-#: Quality flags, in the order they are tested.
-#: The reasons this reading adds to a cycle's ``quality`` (ecofmaps.measured.quality) that
-#: leave its values NaN, the first that applies; ``'gicof-varies'``, which reaches the
-#: GICoF only, is added besides.
+#: The reasons this reading adds to a cycle's ``quality`` that leave its values NaN, in the
+#: order they are tested (``'gicof-varies'``, which reaches the GICoF only, comes besides).
 QUALITY_FLAGS = READING_REASONS[:4]
-
 #: Values of μ(ξ) beyond this many robust standard deviations of the median are clipped.
 _WINSOR = 3.0
-
 #: The largest lag-one autocorrelation of the block means that is believed.
 _R1 = 0.8
-
 #: Cycles analysed together: a block's arrays stay in the processor's cache.
 _BLOCK = 512
-
 #: Points of each cycle's own grid over its central part, for the per-cycle values.
 _CENTRAL_POINTS = 201
-
 #: The median absolute deviation of a normal distribution over its standard deviation.
 _MAD = 1.482602218505602
 
@@ -277,10 +279,9 @@ _MAD = 1.482602218505602
 def _central_values(forward, backward, central, load):
     """mu_resolved, its variance, k and g0 of g ≈ g0 + kξ, the sensitivity to 1/S."""
     width = forward[0].shape[1]
-    usable = np.isfinite(central)
     unit = np.linspace(-1.0, 1.0, _CENTRAL_POINTS)
     at = central[:, None] * unit[None, :]
-    inside = np.broadcast_to(usable[:, None], at.shape)
+    inside = np.broadcast_to(np.isfinite(central)[:, None], at.shape)
     q_forward, q_backward, mu, slope, lines = read_branches(
         forward, backward, unit, central, inside, load
     )
@@ -300,11 +301,9 @@ def _central_values(forward, backward, central, load):
     contrast = np.where(inner, 1.0 / inner_points, np.where(outer, -1.0 / outer_points, 0.0))
     variation = masked_sum(mu * contrast, kept)
     factor = 0.5 * (1.0 + mu**2) / load
-    variance = np.zeros(central.size)
-    variation_variance = np.zeros(central.size)
-    for branch, force, (left, share), sign in (
-        (forward, q_forward, lines[0], 1.0),
-        (backward, q_backward, lines[1], -1.0),
+    variance, variation_variance = np.zeros((2, central.size))
+    for branch, force, (left, share), sign in zip(
+        (forward, backward), (q_forward, q_backward), lines, (1.0, -1.0), strict=True
     ):
         gain = np.where(kept, sign * factor / (1.0 + (force / load) ** 2), 0.0)
         noise = branch_noise(*branch, central) ** 2
@@ -361,12 +360,13 @@ def _scatter_variance(mu, kept, unit):
     return np.where(few, np.nan, spread * (1.0 + r1) / (1.0 - r1)), np.where(few, np.nan, wiggle)
 
 
-def _along_stroke(forward, backward, grid, lowest, highest, tilt, load, level):
-    """Q±, μ, g (levelled by ``tilt`` if ``level``) and h over the common ``grid``."""
-    cycles = lowest.size
-    inside = np.isfinite(tilt)[:, None] & (grid >= lowest[:, None]) & (grid <= highest[:, None])
+def _along_stroke(part, grid, tilt, load, level):
+    """Q±, μ, g (levelled by ``tilt`` if ``level``) and h of a block over the common ``grid``."""
+    lowest, highest = part["lowest"][:, None], part["highest"][:, None]
+    cycles = tilt.size
+    inside = np.isfinite(tilt)[:, None] & (grid >= lowest) & (grid <= highest)
     q_forward, q_backward, mu, slope, _ = read_branches(
-        forward, backward, grid, np.ones(cycles), inside, load
+        part["forward"], part["backward"], grid, np.ones(cycles), inside, load
     )
     if level:
         slope = slope - tilt[:, None]
@@ -374,13 +374,8 @@ def _along_stroke(forward, backward, grid, lowest, highest, tilt, load, level):
     pieces = np.nan_to_num(0.5 * (slope[:, 1:] + slope[:, :-1]) * np.diff(grid))
     profile = np.concatenate([np.zeros((cycles, 1)), np.cumsum(pieces, axis=1)], axis=1)
     profile -= profile[:, np.searchsorted(grid, 0.0)][:, None]
-    return {
-        "mu": mu,
-        "slope": slope,
-        "felt_profile": np.where(inside, profile, np.nan),
-        "force_forward": q_forward,
-        "force_backward": q_backward,
-    }
+    felt = np.where(inside, profile, np.nan)
+    return dict(zip(_ALONG, (mu, slope, felt, q_forward, q_backward), strict=True))
 
 
 #: The values along the stroke, over (cycle, position).
@@ -395,33 +390,19 @@ def _reaches_resolved(quality) -> np.ndarray:
     return np.logical_or.reduce([has_reason(quality, reason) for reason in reaching])
 
 
-def joined_values(parts, index):
-    """The per-cycle values number ``index`` of :func:`_central_values`, over all blocks."""
-    return np.concatenate([part["values"][index] for part in parts])
-
-
 def _blocks(cycles):
     """Slices of at most ``_BLOCK`` cycles: the arrays of a block stay in the cache."""
     return [slice(start, start + _BLOCK) for start in range(0, max(cycles, 1), _BLOCK)]
 
 
-def along_stroke_values(
-    x, q, valid, load, stiffness, amplitude, inherited, given, options, drift_se
-):
+def along_stroke_values(x, q, load, stiffness, amplitude, inherited, given, options, drift_se):
     """Every resolved quantity of the centred loops ``x``, ``q``."""
-    cycles = x.shape[0]
+    cycles, valid = x.shape[0], np.isfinite(x) & np.isfinite(q)
     parts = []
     for block in _blocks(cycles):
         check_interrupted()
         part = slip_branches(
-            x[block],
-            q[block],
-            valid[block],
-            stiffness[block],
-            amplitude[block],
-            given,
-            options.stick_window,
-            options.slip_threshold,
+            *(a[block] for a in (x, q, valid, stiffness, amplitude)), given, options
         )
         lowest, highest = part["lowest"], part["highest"]
         overlap = (lowest < 0.0) & (highest > 0.0)
@@ -446,12 +427,11 @@ def along_stroke_values(
     flag = joined("flags")
     flags = {reason: flag == code for code, reason in enumerate(QUALITY_FLAGS, start=1)}
     ok = ~inherited & (flag == 0)
-    wavers = joined_values(parts, 7) & ((flag == 0) | (flag == 4))
-    flags["gicof-varies"] = wavers & ~inherited
-    lowest, highest = joined("lowest"), joined("highest")
-    mu_resolved, variance, k, tilt, sensitivity, _, shifting, _, offsetting = (
-        joined_values(parts, i) for i in range(9)
+    mu_resolved, variance, k, tilt, sensitivity, _, shifting, wavers, offsetting = (
+        np.concatenate(values) for values in zip(*(part["values"] for part in parts), strict=True)
     )
+    flags["gicof-varies"] = wavers & ((flag == 0) | (flag == 4)) & ~inherited
+    lowest, highest = joined("lowest"), joined("highest")
     nan = np.where(ok, 1.0, np.nan)
     compliance = joined("compliance")
     per_cycle = {
@@ -478,17 +458,9 @@ def along_stroke_values(
         half = reach.max() if reach.size else np.max(amplitude, initial=0.0, where=amplitude > 0)
         grid = np.linspace(-1.0, 1.0, grid) * (half if half > 0.0 else 1.0)
     per_position = {name: np.empty((cycles, grid.size)) for name in _ALONG}
+    level = options.force_offset is None
     for part, block in zip(parts, _blocks(cycles), strict=True):
-        along = _along_stroke(
-            part["forward"],
-            part["backward"],
-            grid,
-            lowest[block],
-            highest[block],
-            per_cycle["tilt"][block],
-            load,
-            options.force_offset is None,
-        )
+        along = _along_stroke(part, grid, per_cycle["tilt"][block], load, level)
         for name in _ALONG:
             per_position[name][block] = along[name]
     return per_position, per_cycle, flags, grid

@@ -1,6 +1,6 @@
 r"""The numerics of the reading along the stroke (:mod:`ecofmaps.measured.resolve`): the stiffness
-and the slip of each branch, the branches resampled at contact positions, their noise and
-the weights of their samples in the standard errors.
+and the slip of each branch, the branches resampled at contact positions, their noise and the
+weights of their samples in the standard errors; explained in ``docs/method-loops.md``.
 """
 
 from __future__ import annotations
@@ -19,19 +19,14 @@ __all__ = [
 
 #: A given stiffness does not fit when it tilts the stick sets by this many σ.
 _TILT_SPREAD = 3.0
-
 #: Fewest samples in a stick set to measure the stiffness, the stick level and the noise.
 _STICK_SAMPLES = 3
-
 #: The stick set ends this share of the force swing before the first slip sample.
 _STICK_MARGIN = 0.05
-
 #: A sample has moved off the stick level, noise-free, beyond this share of Δ*.
 _ROUNDING = 1e-9
-
 #: Slip samples at the end of a branch whose median ξ is compared with the next stick level.
 _END_SAMPLES = 4
-
 #: The median of |N(0, 6)|, the second difference of white noise of unit variance.
 _SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
 
@@ -57,13 +52,24 @@ def _branches(x, valid):
     return valid & (j <= top[:, None]), valid & (j >= top[:, None])
 
 
+def _span(q, mask):
+    """Range of ``q`` over ``mask``, per row."""
+    return np.max(np.where(mask, q, -np.inf), axis=1) - np.min(np.where(mask, q, np.inf), axis=1)
+
+
+def _at_first(values, mask):
+    """``values`` at the first sample of ``mask``, per row (a column)."""
+    return np.take_along_axis(values, np.argmax(mask, axis=1)[:, None], axis=1)
+
+
+def _enough(stick):
+    """True for the rows of ``stick`` with samples enough to judge."""
+    return np.count_nonzero(stick, axis=1) >= _STICK_SAMPLES
+
+
 def _moved(q, branch):
     """Share of the branch's force swing by which each sample has moved from its reversal."""
-    span = np.max(np.where(branch, q, -np.inf), axis=1) - np.min(
-        np.where(branch, q, np.inf), axis=1
-    )
-    start = np.take_along_axis(q, np.argmax(branch, axis=1)[:, None], axis=1)
-    return np.abs(q - start) / span[:, None]
+    return np.abs(q - _at_first(q, branch)) / _span(q, branch)[:, None]
 
 
 def _before(mask, branch):
@@ -107,9 +113,7 @@ def _stick_and_slip(xi, branches, sticks, floor, slip_threshold):
     for branch, stick, sign in zip(branches, sticks, (1.0, -1.0), strict=True):
         # The stick level: the set's median, or the reversal's ξ where the set has too few
         # samples to judge (a sparse loop, or the model's loop drawn with straight sides).
-        judged = np.count_nonzero(stick, axis=1) >= _STICK_SAMPLES
-        reversal = np.take_along_axis(xi, np.argmax(branch, axis=1)[:, None], axis=1)[:, 0]
-        level = np.where(judged, masked_median(xi, stick), reversal)
+        level = np.where(_enough(stick), masked_median(xi, stick), _at_first(xi, branch)[:, 0])
         # Slip: beyond the threshold, and every later sample of the branch too.
         beyond = np.where(branch, sign * xi, np.inf)
         least = np.minimum.accumulate(beyond[:, ::-1], axis=1)[:, ::-1]
@@ -130,20 +134,10 @@ def _branch_shift(xi, branches, slips, levels):
 
 def _tilted_alike(xi, q, sticks, tolerance, floor):
     """True where the stick sets tilt in ξ beyond ``tolerance`` over their force span, and
-    each of them beyond the rounding ``floor``, in the same sense.
-
-    A compliance off by δc tilts both sets by δc in ξ against Q; what is left of the
-    centring's drift correction, a ramp in time, tilts them in opposite senses (Q rises in
-    time on one side, falls on the other), or one of them only.
-    """
-    span = np.max(
-        [
-            np.max(np.where(s, q, -np.inf), axis=1) - np.min(np.where(s, q, np.inf), axis=1)
-            for s in sticks
-        ],
-        axis=0,
-    )
-    judged = np.all([np.count_nonzero(s, axis=1) >= _STICK_SAMPLES for s in sticks], axis=0)
+    each of them beyond the rounding ``floor``, in the same sense (a wrong compliance; see
+    ``docs/method-loops.md``, 'stiffness-mismatch')."""
+    span = np.max([_span(q, stick) for stick in sticks], axis=0)
+    judged = np.all([_enough(stick) for stick in sticks], axis=0)
     tilt, _ = _compliance(xi, q, sticks)
     alike = judged & ~(np.abs(tilt) * span <= tolerance)  # NaN: does not fit
     for stick in sticks:
@@ -163,13 +157,14 @@ def _sorted_branch(xi, q, slip):
     )
 
 
-def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_threshold):
-    """The stiffness, the checks of the stick sets, and the two slip branches."""
+def slip_branches(x, q, valid, stiffness, amplitude, given, options):
+    """The stiffness, the checks of the stick sets, and the two slip branches, with the
+    ``stick_window`` and ``slip_threshold`` of ``options``."""
     cycles = x.shape[0]
     floor = _ROUNDING * amplitude
     branches = _branches(x, valid)
     moved = [_moved(q, branch) for branch in branches]
-    low, high = stick_window
+    (low, high), slip_threshold = options.stick_window, options.slip_threshold
     windows = [
         _before(share > high, branch) & (share >= low)
         for share, branch in zip(moved, branches, strict=True)
@@ -182,30 +177,25 @@ def slip_branches(x, q, valid, stiffness, amplitude, given, stick_window, slip_t
     # The stick sets: from the window's lower share up to a margin before the slip.
     sticks = []
     for share, branch, slip, window in zip(moved, branches, slips, windows, strict=True):
-        onset = np.take_along_axis(share, np.argmax(slip, axis=1)[:, None], axis=1)
-        onset = np.where(slip.any(axis=1)[:, None], onset, high + _STICK_MARGIN)
+        onset = np.where(slip.any(axis=1)[:, None], _at_first(share, slip), high + _STICK_MARGIN)
         stick = _before(slip, branch) & (share >= low) & (share <= onset - _STICK_MARGIN)
-        enough = np.count_nonzero(stick, axis=1) >= _STICK_SAMPLES
-        sticks.append(np.where(enough[:, None], stick, window))
+        sticks.append(np.where(_enough(stick)[:, None], stick, window))
     if given:
         compliance, compliance_se = start, np.zeros(cycles)
     else:
         fitted, fitted_se = _compliance(x, q, sticks)
-        enough = np.all([np.count_nonzero(s, axis=1) >= _STICK_SAMPLES for s in sticks], axis=0)
-        measured = enough & np.isfinite(fitted)
+        measured = np.all([_enough(stick) for stick in sticks], axis=0) & np.isfinite(fitted)
         compliance = np.where(measured, fitted, start)
         compliance_se = np.where(measured, fitted_se, 0.0)
-    negative = compliance < -3.0 * compliance_se
+    mismatch = compliance < -3.0 * compliance_se  # the stick sides slope down
     compliance = np.maximum(compliance, 0.0)
     # Second pass, with the stiffness used and the stick sets.
     xi = x - compliance[:, None] * q
     sigma, slips, levels = _stick_and_slip(xi, branches, sticks, floor, slip_threshold)
-    mismatch = negative
     if given:  # a stiffness that does not fit the stick sides tilts both alike in ξ
         mismatch = mismatch | _tilted_alike(xi, q, sticks, _TILT_SPREAD * sigma + floor, floor)
     shift = _branch_shift(xi, branches, slips, levels)
-    forward = _sorted_branch(xi, q, slips[0])
-    backward = _sorted_branch(xi, q, slips[1])
+    forward, backward = (_sorted_branch(xi, q, slip) for slip in slips)
     ends = []
     for xs, _, count in (forward, backward):
         last = np.take_along_axis(xs, np.maximum(count - 1, 0)[:, None], axis=1)[:, 0]

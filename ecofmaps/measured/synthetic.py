@@ -191,23 +191,29 @@ def example_recording():
     p = EXAMPLE
     recorded = np.arange(1, p["test_cycles"] // p["recorded_every"] + 1) * p["recorded_every"]
     ratio = p["final_aspect_ratio"] * np.sqrt(recorded / p["test_cycles"])
-    displacement, force = synthetic_recording(
+    drift = p["displacement_drift"] / recorded.size
+    displacement, force = _on_rig(p, ratio, p["samples_per_cycle"], 0.0, drift, p["seed"])
+    return np.repeat(recorded, p["samples_per_cycle"]), displacement, force
+
+
+def _on_rig(p, ratio, samples_per_cycle, offset, drift, seed):
+    """:func:`synthetic_recording` on the rig and sensors of ``p``, from zero displacement on
+    the rise, its displacement offset by ``offset`` [m] more."""
+    return synthetic_recording(
         p["amplitude"],
         p["load"],
         p["stiffness"],
         p["mu"],
         ratio,
-        samples_per_cycle=p["samples_per_cycle"],
+        samples_per_cycle=samples_per_cycle,
         start_phase=0.25,
         displacement_noise=p["displacement_noise"],
         force_noise=p["force_noise"],
-        displacement_offset=p["displacement_offset"],
+        displacement_offset=p["displacement_offset"] + offset,
         force_offset=p["force_offset"],
-        displacement_drift=p["displacement_drift"] / recorded.size,
-        seed=p["seed"],
+        displacement_drift=drift,
+        seed=seed,
     )
-    cycle = np.repeat(recorded, p["samples_per_cycle"])
-    return cycle, displacement, force
 
 
 def write_example(path):
@@ -234,9 +240,7 @@ def example_path() -> Path:
     return Path(str(importlib.resources.files("ecofmaps") / "data" / EXAMPLE_FILE))
 
 
-# ---------------------------------------------------------------------------------------
 # The shipped example scar profile
-# ---------------------------------------------------------------------------------------
 
 #: Parameters of the shipped example scar profile (SI units).
 SCAR_EXAMPLE = {
@@ -332,24 +336,15 @@ def scar_example_path() -> Path:
     return Path(str(importlib.resources.files("ecofmaps") / "data" / SCAR_EXAMPLE_FILE))
 
 
-# ---------------------------------------------------------------------------------------
 # Ugly recordings with a known truth, for calibrating the analysis
-# ---------------------------------------------------------------------------------------
 
 #: The default parameters of :func:`long_recording`: the example's rig (the paper's Example 2,
 #: Section 3) and sensors, a groove deepening to z_o/x_o = 0.2 over the test, and a
 #: displacement drift of 2 um over the whole test.
 LONG_TEST = {
-    "amplitude": 50e-6,
-    "load": 450.0,
-    "stiffness": 35e6,
-    "mu": 0.8,
-    "final_aspect_ratio": 0.2,
-    "displacement_noise": 0.25e-6,
-    "force_noise": 4.0,
-    "displacement_offset": 3.0e-6,
-    "force_offset": 6.0,
-    "displacement_drift": 2.0e-6,
+    name: value
+    for name, value in EXAMPLE.items()
+    if name not in ("test_cycles", "recorded_every", "samples_per_cycle", "seed")
 }
 
 
@@ -369,11 +364,9 @@ def long_recording(cycles, samples_per_cycle=200, *, block_cycles=4096, seed=0, 
         Seed of the noise: block ``k`` uses its own stream derived from ``(seed, k)``, so the
         recording depends on ``seed`` and ``block_cycles`` only.
     **parameters
-        Any of :data:`LONG_TEST`: ``amplitude`` [m], ``load`` [N], ``stiffness`` [N/m],
-        ``mu``, ``final_aspect_ratio`` (the groove's z_o/x_o at the end of the test),
-        ``displacement_noise`` [m] and ``force_noise`` [N] (standard deviations),
-        ``displacement_offset`` [m], ``force_offset`` [N], ``displacement_drift`` (over the
-        whole test) [m].
+        Any of :data:`LONG_TEST`, in SI units as for :func:`synthetic_recording`:
+        ``final_aspect_ratio`` is the groove's z_o/x_o at the end of the test [1],
+        ``displacement_drift`` the drift over the whole test [m].
 
     Yields
     ------
@@ -384,12 +377,10 @@ def long_recording(cycles, samples_per_cycle=200, *, block_cycles=4096, seed=0, 
 
     Notes
     -----
-    Cycle :math:`N` (1-based) has the groove :math:`z_o/x_o = r_f \sqrt{N / N_{total}}`
-    with the groove half-width equal to the amplitude (the paper's :math:`x_o = \Delta^*`),
-    as in :func:`ecofmaps.measured.synthetic.example_recording`; each block is
-    :func:`synthetic_recording`'s steady loops (eq. 9, 10) from zero displacement on the
-    rise, with its offset advanced by the drift so far, so the drift runs on without a step
-    from block to block.
+    Cycle :math:`N` (1-based) has the groove :math:`z_o/x_o = r_f \sqrt{N / N_{total}}`,
+    :math:`x_o = \Delta^*`, as in :func:`example_recording`; each block is
+    :func:`synthetic_recording`'s steady loops (eq. 9, 10), its offset advanced by the drift
+    so far, so the drift runs on without a step from block to block.
 
     References
     ----------
@@ -411,21 +402,8 @@ def long_recording(cycles, samples_per_cycle=200, *, block_cycles=4096, seed=0, 
         # Every block is simulated at the full size (one compilation), then cut.
         number = np.arange(first + 1, first + block_cycles + 1)
         ratio = p["final_aspect_ratio"] * np.sqrt(np.minimum(number, cycles) / cycles)
-        displacement, force = synthetic_recording(
-            p["amplitude"],
-            p["load"],
-            p["stiffness"],
-            p["mu"],
-            ratio,
-            samples_per_cycle=n,
-            start_phase=0.25,
-            displacement_noise=p["displacement_noise"],
-            force_noise=p["force_noise"],
-            displacement_offset=p["displacement_offset"] + drift * first,
-            force_offset=p["force_offset"],
-            displacement_drift=drift,
-            seed=int(np.random.SeedSequence([seed, index]).generate_state(1)[0]),
-        )
+        block_seed = int(np.random.SeedSequence([seed, index]).generate_state(1)[0])
+        displacement, force = _on_rig(p, ratio, n, drift * first, drift, block_seed)
         yield np.repeat(number[:count], n), displacement[: count * n], force[: count * n]
 
 
