@@ -12,9 +12,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ecofmaps._inputs import as_float64, check
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP, SELF_LOCKING
 
 __all__ = [
+    "checked",
     "compliance_ratio",
     "curvature_number",
     "ecof_ratio",
@@ -26,7 +28,44 @@ __all__ = [
     "slip_ratio",
     "slip_roots",
     "traction_ratio",
+    "valid_geometry",
 ]
+
+#: The rule and unit of each SI input, for :func:`ecofmaps._inputs.check`.
+_RULES = {
+    "amplitude": ("positive", "m"),
+    "load": ("positive", "N"),
+    "stiffness": ("positive_or_inf", "N/m"),
+    "mu": ("positive", "1"),
+    "aspect_ratio": ("non_negative", "1"),
+    "groove_half_width": ("positive", "m"),
+}
+
+
+def checked(**inputs) -> list:
+    """The SI inputs given (not None) as float64; ``ValueError`` for a concrete one out of range."""
+    for name, value in inputs.items():
+        if value is not None:
+            check(name, value, *_RULES[name])
+    return [as_float64(value) for value in inputs.values() if value is not None]
+
+
+def _positive(value):
+    return (value > 0.0) & jnp.isfinite(value)
+
+
+def valid_geometry(amplitude, load, stiffness, aspect_ratio, groove_half_width):
+    """True where the SI inputs other than mu are in range (traced-input counterpart of
+    :func:`checked`): all finite and > 0, stiffness may be inf, aspect ratio >= 0."""
+    return (
+        _positive(amplitude)
+        & _positive(load)
+        & (stiffness > 0.0)
+        & ~jnp.isnan(stiffness)
+        & (aspect_ratio >= 0.0)
+        & jnp.isfinite(aspect_ratio)
+        & _positive(groove_half_width)
+    )
 
 
 def curvature_number(length, aspect_ratio, groove_half_width):
@@ -216,14 +255,7 @@ def regime_code(mu, kappa, lam):
     coefficient of friction from fretting loops exhibiting non-Coulomb frictional
     behaviour: eq. 9, 16.
     """
-    valid = (
-        (mu > 0.0)
-        & jnp.isfinite(mu)
-        & (kappa >= 0.0)
-        & jnp.isfinite(kappa)
-        & (lam >= 0.0)
-        & jnp.isfinite(lam)
-    )
+    valid = _positive(mu) & (kappa >= 0.0) & jnp.isfinite(kappa) & (lam >= 0.0) & jnp.isfinite(lam)
     code = jnp.where(
         mu * lam >= 1.0,
         int(NO_GROSS_SLIP),

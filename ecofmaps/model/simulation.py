@@ -15,10 +15,10 @@ import jax
 import jax.numpy as jnp
 
 from ecofmaps._inputs import as_float64, check, float64, is_concrete
-from ecofmaps.model.core import locking_margin, slip_ratio, slip_roots, traction_ratio
+from ecofmaps.model.core import checked, locking_margin, slip_ratio, slip_roots, traction_ratio
 from ecofmaps.model.on_profile import profile_loop, profile_simulation
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
-from ecofmaps.model.steady_state import check_model_inputs, dimensionless, one_geometry
+from ecofmaps.model.steady_state import dimensionless, groove_inputs, one_geometry
 
 __all__ = ["fretting_loop", "simulate"]
 
@@ -142,9 +142,8 @@ def fretting_loop(
         return profile_loop(
             profile, amplitude, load, stiffness, mu, groove_half_width, mapping, num
         )
-    values = check_model_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
-    values = jnp.broadcast_arrays(*values)
-    return _steady_loop(*values, num=num)
+    values = groove_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
+    return _steady_loop(*jnp.broadcast_arrays(*values), num=num)
 
 
 @jax.jit
@@ -253,13 +252,17 @@ def simulate(
         )
     if groove_half_width is None:
         raise ValueError("simulate with aspect_ratio needs groove_half_width (x_o) [m]")
-    values = check_model_inputs(1.0, load, stiffness, mu, aspect_ratio, groove_half_width)
-    _, load, stiffness, mu, aspect_ratio, groove_half_width = values
-    length = groove_half_width
+    load, stiffness, mu, aspect_ratio, length = checked(
+        load=load,
+        stiffness=stiffness,
+        mu=mu,
+        aspect_ratio=aspect_ratio,
+        groove_half_width=groove_half_width,
+    )
     mu, kappa, lam, code = dimensionless(length, load, stiffness, mu, aspect_ratio, length)
     displacement = as_float64(displacement)
-    batch = jnp.broadcast_shapes(displacement.shape[:-1], jnp.shape(mu), jnp.shape(kappa))
-    batch = jnp.broadcast_shapes(batch, jnp.shape(lam), jnp.shape(code))
+    shapes = (jnp.shape(x) for x in (mu, kappa, lam, code))
+    batch = jnp.broadcast_shapes(displacement.shape[:-1], *shapes)
     displacement = jnp.broadcast_to(displacement, batch + displacement.shape[-1:])
     mu, kappa, lam, length, load, code = (
         jnp.broadcast_to(x, batch) for x in (mu, kappa, lam, length, load, code)
