@@ -34,9 +34,9 @@ __all__ = [
     "ScarProfileWarning",
     "local_quadratic",
     "outlying_samples",
+    "profile_of",
     "scar_profile",
     "scar_profile_and_findings",
-    "scar_profile_from_parts",
 ]
 
 #: Fewest samples a measured profile must have between the scar's edges.
@@ -125,40 +125,10 @@ class ScarProfile(NamedTuple):
         return stack([self.centre - self.half_width, self.centre + self.half_width], -1)
 
 
-def scar_profile_from_parts(
-    position,
-    height,
-    slope,
-    depth,
-    half_width,
-    worn_area,
-    centre=0.0,
-    reference_height=0.0,
-    reference_slope=0.0,
-    alternative_half_width=np.nan,
-    replaced=0.0,
-) -> ScarProfile:
-    values = (
-        position,
-        height,
-        slope,
-        depth,
-        half_width,
-        worn_area,
-        centre,
-        reference_height,
-        reference_slope,
-        alternative_half_width,
-        replaced,
-    )
-    if is_concrete(*values):
-        # NumPy arrays: a user's own arithmetic on them (``profile.half_width * 1e6``) stays
-        # float64, where JAX outside its 64-bit mode would truncate it to float32.
-        return ScarProfile(*(np.asarray(v, dtype=np.float64) for v in values))
-    # JAX's 64-bit mode is on only inside the public entry points (importing ecofmaps does
-    # not switch it on): without it these arrays would be float32.
-    with jax.enable_x64(True):
-        return ScarProfile(*(jnp.asarray(v, dtype=jnp.float64) for v in values))
+def profile_of(*parts) -> ScarProfile:
+    """A :class:`ScarProfile` of ``parts`` (its defaults after them) as NumPy float64 arrays, so
+    that a user's arithmetic on them (``profile.half_width * 1e6``) stays float64."""
+    return ScarProfile(*(np.asarray(part, dtype=np.float64) for part in ScarProfile(*parts)))
 
 
 def _array(name: str, value) -> np.ndarray:
@@ -328,8 +298,6 @@ def local_quadratic(x: np.ndarray, z: np.ndarray, smoothing: float):
         return z.copy(), np.gradient(z, x, edge_order=2)
     n = x.size
     rows = np.arange(n)
-    # Widen the weights where samples are sparse: the nearest two on each side (three on
-    # one side at the ends) within 80 % of the reach.
     span = np.maximum(x - x[np.clip(rows - 2, 0, n - 5)], x[np.clip(rows + 2, 4, n - 1)] - x)
     sigma = np.maximum(smoothing, span / (0.8 * _REACH))
     left = np.searchsorted(x, x - _REACH * sigma, side="left")
@@ -409,19 +377,8 @@ def scar_profile_and_findings(
     else:
         height, slope = z, gs
         reference = (float(line(centre)), float(tilt))
-    profile = scar_profile_from_parts(
-        x - centre,
-        height,
-        slope,
-        depth,
-        width,
-        worn,
-        centre,
-        *reference,
-        alternative,
-        replaced.astype(np.float64),
-    )
-    return profile, findings
+    parts = (depth, width, worn, centre, *reference, alternative, replaced)
+    return profile_of(x - centre, height, slope, *parts), findings
 
 
 @si_units(x="length", z="length", half_width="length")
