@@ -174,12 +174,8 @@ def slip_position(target, mu, kappa, lam):
     r"""Contact position reached by forward slip when the actuator is at ``target``.
 
     Solves :math:`\xi + \lambda\, Q_+(\xi)/P = D` (eq. 9 with eq. 10) for the root below
-    the locking point :math:`\mu\kappa\xi = 1`; with :math:`D = 1` this is eq. 16.
-    Multiplying out gives :math:`a\xi^2 - b\xi + c = 0` with :math:`a = \mu\kappa`,
-    :math:`b = 1 + \mu\kappa D + \lambda\kappa`, :math:`c = D - \lambda\mu`. The root is
-    taken as :math:`2c/(b + \sqrt{b^2 - 4ac})` (no cancellation when :math:`b > 0`, finite
-    as :math:`\kappa \to 0`), and the discriminant is summed from non-negative terms,
-    :math:`b^2 - 4ac = (aD + \lambda\kappa - 1)^2 + 4\lambda\kappa(1 + \mu^2)`.
+    the locking point :math:`\mu\kappa\xi = 1`; with :math:`D = 1` this is eq. 16. The
+    quadratic's root is taken without cancellation (``docs/model.md``).
 
     Parameters
     ----------
@@ -206,12 +202,9 @@ def slip_position(target, mu, kappa, lam):
 def locking_margin(target, mu, kappa, lam):
     r"""Margin :math:`w = 1 - \mu\kappa\xi` of the forward-slip position to the locking point.
 
-    The denominator of eq. 9 at the position :func:`slip_position` returns, computed
-    without cancellation: :math:`w` solves :math:`w^2 + (aD + \lambda\kappa - 1)w -
-    \lambda\kappa(1 + \mu^2) = 0` (the quadratic of eq. 16 in :math:`w`), whose positive
-    root is taken in the form that never subtracts nearly equal numbers. It keeps its
-    relative accuracy when a stiff rig drives a deep groove close to locking, where
-    :math:`1 - \mu\kappa\xi` computed from :math:`\xi` would lose every digit.
+    The denominator of eq. 9 at the position :func:`slip_position` returns, as the positive
+    root of the quadratic of eq. 16 in :math:`w`: it keeps its digits close to locking, where
+    :math:`1 - \mu\kappa\xi` would lose them all (``docs/model.md``).
 
     Parameters
     ----------

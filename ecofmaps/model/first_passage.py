@@ -18,9 +18,9 @@ from ecofmaps.model.profile_core import (
     Side,
     Tables,
     crossing_fraction,
+    interval_table,
     mean_excess,
     mean_traction,
-    sparse_table,
     table_levels,
     traction_forward,
 )
@@ -284,16 +284,7 @@ def simulation_tables(position, slope, mu, lam) -> Tables:
     def side(p, g):
         force = traction_forward(g, mu)
         values = p + jnp.where(lam > 0.0, lam * force, 0.0)
-        levels = table_levels(p.size)
-        lower = jnp.concatenate([values, jnp.array([jnp.inf])])
-        upper = jnp.concatenate([jnp.full(p.size, jnp.inf), jnp.array([-jnp.inf])])
-        bounds = jnp.stack(
-            [
-                sparse_table(lower, levels, jnp.maximum, jnp.inf),
-                sparse_table(upper, levels, jnp.minimum, -jnp.inf),
-            ],
-            axis=-1,
-        )
+        bounds = interval_table(values, jnp.full(p.size, jnp.inf), table_levels(p.size))
         return Side(p, g, force, bounds)
 
     n = position.size

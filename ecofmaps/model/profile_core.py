@@ -19,6 +19,7 @@ __all__ = [
     "Side",
     "Tables",
     "crossing_fraction",
+    "interval_table",
     "mean_excess",
     "mean_traction",
     "profile_tables",
@@ -172,7 +173,11 @@ def _intervals(position, force, levels: int):
             jnp.where(force == 0.0, jnp.where(below, jnp.inf, -jnp.inf), jnp.inf),
         ),
     )
-    lower = jnp.where(finite & (force < 0.0), ratio, -jnp.inf)
+    return interval_table(jnp.where(finite & (force < 0.0), ratio, -jnp.inf), upper, levels)
+
+
+def interval_table(lower, upper, levels: int):
+    """The sparse tables of the intervals ``(lower, upper)`` per sample, and a sentinel."""
     lower = jnp.concatenate([lower, jnp.array([jnp.inf])])
     upper = jnp.concatenate([upper, jnp.array([-jnp.inf])])
     return jnp.stack(

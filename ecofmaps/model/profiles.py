@@ -148,6 +148,14 @@ def _array(name: str, value) -> np.ndarray:
     return array
 
 
+def _trace(x, z):
+    """``x`` and ``z`` as float64 arrays of one length, checked."""
+    x, z = _array("x", x), _array("z", z)
+    if x.size != z.size:
+        raise ValueError(f"x and z must have the same length, got {x.size} and {z.size}")
+    return x, z
+
+
 def _check_positions(x: np.ndarray) -> None:
     steps = np.diff(x)
     if np.any(steps <= 0.0):
@@ -206,9 +214,7 @@ def outlying_samples(x, z, neighbours=OUTLIER_NEIGHBOURS, threshold=OUTLIER_THRE
     >>> np.flatnonzero(outlying_samples(x, z)).tolist()
     [40]
     """
-    x, z = _array("x", x), _array("z", z)
-    if x.size != z.size:
-        raise ValueError(f"x and z must have the same length, got {x.size} and {z.size}")
+    x, z = _trace(x, z)
     if not (isinstance(neighbours, int | np.integer) and 1 <= neighbours < z.size / 2):
         raise ValueError(
             f"neighbours must be an integer >= 1 and less than half the {z.size} samples, "
@@ -251,10 +257,7 @@ def _outliers_replaced(x, z):
 
 def _checked_trace(x, z, half_width, smoothing):
     """The trace and the parameters of :func:`scar_profile` as float64, checked."""
-    x = _array("x", x)
-    z = _array("z", z)
-    if x.size != z.size:
-        raise ValueError(f"x and z must have the same length, got {x.size} and {z.size}")
+    x, z = _trace(x, z)
     if x.size < 2 * MIN_SCAR_SAMPLES:
         raise ValueError(f"x: a trace needs at least {2 * MIN_SCAR_SAMPLES} samples, got {x.size}")
     _check_positions(x)
@@ -455,12 +458,7 @@ def scar_profile(
     (50.0, 10.0)
     """
     profile, findings = scar_profile_and_findings(
-        x,
-        z,
-        half_width=half_width,
-        smoothing=smoothing,
-        level=level,
-        remove_outliers=remove_outliers,
+        x, z, half_width, smoothing, level, remove_outliers
     )
     for finding in findings:
         warn(finding, ScarProfileWarning)
