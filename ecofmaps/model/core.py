@@ -87,9 +87,8 @@ def curvature_number(length, aspect_ratio, groove_half_width):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 7.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 7.
     """
     return 2.0 * aspect_ratio * length / groove_half_width
 
@@ -141,9 +140,8 @@ def traction_ratio(position, mu, kappa, direction=1.0):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 9.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 9.
     """
     slope = kappa * position
     return (direction * mu + slope) / (1.0 - direction * mu * slope)
@@ -192,9 +190,8 @@ def slip_position(target, mu, kappa, lam):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 9, 10, 16.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 9, 10, 16.
     """
     return slip_roots(target, mu, kappa, lam)[0]
 
@@ -220,9 +217,8 @@ def locking_margin(target, mu, kappa, lam):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 9, 16.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 9, 16.
     """
     return slip_roots(target, mu, kappa, lam)[1]
 
@@ -244,9 +240,8 @@ def regime_code(mu, kappa, lam):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 9, 16.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 9, 16.
     """
     valid = _positive(mu) & (kappa >= 0.0) & jnp.isfinite(kappa) & (lam >= 0.0) & jnp.isfinite(lam)
     code = jnp.where(
@@ -274,9 +269,8 @@ def slip_ratio(mu, kappa, lam):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 16.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 16.
     """
     code = regime_code(mu, kappa, lam)
     d = slip_position(1.0, mu, kappa, lam)
@@ -325,9 +319,8 @@ def ecof_ratio(mu, kappa, lam):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 1, 13-15, 16.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 1, 13-15, 16.
     """
     d = slip_ratio(mu, kappa, lam)
     excess = _artanh_excess(mu * kappa * d, locking_margin(1.0, mu, kappa, lam))
@@ -351,9 +344,8 @@ def normalized_max_force(mu, kappa, lam):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 9, 16.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 9, 16.
     """
     d = slip_ratio(mu, kappa, lam)
     stick = d == 0.0
@@ -376,9 +368,8 @@ def normalized_energy(mu, kappa, lam):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 1, 12.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 1, 12.
     """
     d = slip_ratio(mu, kappa, lam)
     energy = 4.0 * d * mu * ecof_ratio(mu, kappa, lam)

@@ -116,24 +116,15 @@ def fretting_loop(
 
     Notes
     -----
-    The slip branches are eq. 9 with eq. 10, :math:`\Delta = x + Q_\pm(x)/S`, sampled
-    uniformly in :math:`x` for a shallow groove (:math:`\mu k\delta^* < 1/2`), and for a
-    deeper one so that the margin to the locking point :math:`1 - \mu k x` falls
-    geometrically along the branch (dense where the force rises steeply); the stick
-    segments are the straight lines of slope :math:`S`. With no gross slip the loop
-    collapses onto :math:`Q = S\Delta`.
-    Self-locking points give NaN.
-
-    On a profile each slip branch is sampled uniformly in :math:`x` between the loop's ends;
-    where the pad jumps (:math:`x + Q_+/S` falls) its points lie on the vertical
-    :math:`\Delta = \text{const}`, :math:`Q = S(\Delta - x)`; the branches are not
-    mirror images of each other on an asymmetric scar. Points off the trace are NaN.
+    The slip branches are eq. 9 with eq. 10, :math:`\Delta = x + Q_\pm(x)/S`, the stick
+    segments lines of slope :math:`S`; with no gross slip the loop collapses onto
+    :math:`Q = S\Delta`. Self-locking points and points off a profile's trace give NaN. The
+    sampling of the branches is explained in ``docs/model.md``.
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 9, 10, 11.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 9, 10, 11.
     """
     if not isinstance(num, int) or num < 2:
         raise ValueError(f"num must be an integer >= 2, got {num!r}")
@@ -224,23 +215,16 @@ def simulate(
 
     Notes
     -----
-    The pad starts at rest at the groove centre (:math:`x = 0`, :math:`Q = 0`, at
-    :math:`\Delta = 0`). At each new :math:`\Delta` it sticks while
+    The pad starts at rest at the groove centre. At each new :math:`\Delta` it sticks while
     :math:`Q_-(x) \le S(\Delta - x) \le Q_+(x)` (eq. 9, 10); otherwise it slips to the exact
-    equilibrium :math:`x' + Q_\pm(x')/S = \Delta` (the quadratic of eq. 16), so the result
-    does not depend on the sampling. A rigid rig (:math:`S = \infty`) has :math:`x = \Delta`
-    in slip and keeps its last force while :math:`\Delta` stands still.
-
-    On a profile the pad starts at rest at the scar centre, and a slip goes to the first
-    equilibrium :math:`x' + Q_\pm(x')/S = \Delta` beyond the pad (first passage; where
-    :math:`x + Q_+/S` falls the pad jumps), found exactly on the piecewise linear slope
-    (:mod:`ecofmaps.model.first_passage`). A pad that runs off the trace gives NaN.
+    equilibrium :math:`x' + Q_\pm(x')/S = \Delta` (the quadratic of eq. 16; on a profile the
+    first one beyond the pad), so the result does not depend on the sampling
+    (``docs/model.md``). A pad that runs off a profile's trace gives NaN.
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 9, 10, 11, 16.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 9, 10, 11, 16.
     """
     check("displacement", displacement, "finite", "m")
     if is_concrete(displacement) and jnp.ndim(displacement) == 0:

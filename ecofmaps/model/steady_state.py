@@ -190,9 +190,8 @@ def _steady_quantity(quantity: str, summary: str, returns: str, notes: str, equa
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. {equations}.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. {equations}.
 """
     return float64(steady_quantity)
 
