@@ -196,9 +196,7 @@ def outlying_samples(x, z, neighbours=OUTLIER_NEIGHBOURS, threshold=OUTLIER_THRE
     Notes
     -----
     A sample is an outlier when it is farther from the median of its ``2 neighbours``
-    nearest neighbours than ``threshold`` times the largest of their scaled median absolute
-    deviation :math:`1.4826\,\mathrm{MAD}`, the trace's noise, its typical distance from the
-    neighbours' median, and its resolution (``docs/profiles.md``).
+    nearest neighbours than ``threshold`` times a robust scale (``docs/profiles.md``).
 
     References
     ----------
@@ -291,11 +289,7 @@ def local_quadratic(x: np.ndarray, z: np.ndarray, smoothing: float):
 
     Notes
     -----
-    The weights are :math:`e^{-d^2/2} - e^{-8}` for samples within :math:`d = 4` standard
-    deviations (continuous, zero at the reach). Where the samples are sparse the standard
-    deviation is widened so that the nearest two samples on each side (three on one side at
-    the ends) lie within 80 % of the reach: each fit is defined for any spacing. Quadratics
-    are reproduced exactly.
+    The weights, and their widening where the samples are sparse, follow ``docs/profiles.md``.
     """
     if smoothing == 0.0:
         return z.copy(), np.gradient(z, x, edge_order=2)
