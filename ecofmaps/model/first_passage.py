@@ -30,7 +30,7 @@ __all__ = [
     "JAMMED_TRACTION",
     "SteadyLoop",
     "draw_loop",
-    "jump_area",
+    "jump_areas",
     "simulation_step",
     "simulation_tables",
     "steady_loop",
@@ -163,14 +163,14 @@ def steady_loop(tables: Tables, group, lam, sparse: bool = True) -> SteadyLoop:
     stuck = width == 0.0
     ratio = 1.0 + integral / jnp.where(stuck, 1.0, width)
     critical = _range(tables.critical, group, k_minus, k_plus, jnp.minimum, jnp.inf, sparse)
-    peak = _range(tables.peak, group, k_minus + 1, k_plus, jnp.maximum, -jnp.inf, sparse)
-    peak = jnp.maximum(
-        peak, jnp.maximum(traction_forward(slope_minus, mu), traction_forward(slope_plus, mu))
-    )
-    trough = _range(tables.trough, group, k_minus + 1, k_plus, jnp.maximum, -jnp.inf, sparse)
-    trough = jnp.maximum(
-        trough, jnp.maximum(traction_forward(-slope_minus, mu), traction_forward(-slope_plus, mu))
-    )
+
+    def largest(table, slope_a, slope_b):
+        inside = _range(table, group, k_minus + 1, k_plus, jnp.maximum, -jnp.inf, sparse)
+        ends = jnp.maximum(traction_forward(slope_a, mu), traction_forward(slope_b, mu))
+        return jnp.maximum(inside, ends)
+
+    peak = largest(tables.peak, slope_minus, slope_plus)
+    trough = largest(tables.trough, -slope_minus, -slope_plus)
     # A rigid rig passes a locking point; a rig stiff enough to stop the pad within rounding
     # of one (lambda ~ 1e-17 of the stroke) gives an infinite force there too. Short of
     # that, a force above JAMMED_TRACTION times the load leaves the loop's area to rounding
@@ -221,7 +221,7 @@ def _running_levels(side: Side, group, mu, lam, start, end):
     return a, b, slope_a, slope_b, level, value_b, active
 
 
-def jump_area(side: Side, group, mu, lam, start, end):
+def _jump_area(side: Side, group, mu, lam, start, end):
     r""":math:`\int (M_+ - F_+)\,d\xi` over a forward stroke from ``start`` to ``end``."""
     a, b, slope_a, slope_b, level, value_b, active = _running_levels(
         side, group, mu, lam, start, end
@@ -255,26 +255,32 @@ def _branch(side: Side, group, mu, lam, start, end, num: int):
     return actuator, q
 
 
-def draw_loop(tables: Tables, group, lam, loop: SteadyLoop, num: int):
-    """The steady loop's actuator positions D and forces Q/P, ``2 num + 1`` points."""
+def _both_strokes(stroke, tables: Tables, group, lam, ends, *args):
+    """``stroke`` forward from the lower end to the upper one, and back on the mirrored profile."""
     n = tables.forward.position.shape[-1]
     mu = tables.mu[group]
-    lower, upper = loop.ends
-    d_forward, q_forward = _branch(tables.forward, group, mu, lam, lower, upper, num)
-    d_back, q_back = _branch(
-        tables.backward, group, mu, lam, _mirror(*upper, n), _mirror(*lower, n), num
-    )
+    lower, upper = ends
+    forward = stroke(tables.forward, group, mu, lam, lower, upper, *args)
+    mirrored = (_mirror(*upper, n), _mirror(*lower, n))
+    return forward, stroke(tables.backward, group, mu, lam, *mirrored, *args)
+
+
+def jump_areas(tables: Tables, group, lam, ends):
+    """The jumps' areas of both strokes of the steady loop with ``ends``."""
+    forward, backward = _both_strokes(_jump_area, tables, group, lam, ends)
+    return forward + backward
+
+
+def draw_loop(tables: Tables, group, lam, loop: SteadyLoop, num: int):
+    """The steady loop's actuator positions D and forces Q/P, ``2 num + 1`` points."""
+    forward, backward = _both_strokes(_branch, tables, group, lam, loop.ends, num)
+    (d_forward, q_forward), (d_back, q_back) = forward, backward
     actuator = jnp.concatenate([-d_back[-1:], d_forward, -d_back])
     force = jnp.concatenate([-q_back[-1:], q_forward, -q_back])
     stuck = loop.regime == int(NO_GROSS_SLIP)
     line = jnp.linspace(-1.0, 1.0, 2 * num + 1)
     stick_force = (line - loop.plus) / jnp.where(lam > 0.0, lam, 1.0)
     return jnp.where(stuck, line, actuator), jnp.where(stuck, stick_force, force)
-
-
-# ---------------------------------------------------------------------------------------
-# Time-domain return map
-# ---------------------------------------------------------------------------------------
 
 
 def simulation_tables(position, slope, mu, lam) -> Tables:

@@ -108,28 +108,9 @@ def _valid(amplitude, load, stiffness, mu, half_width):
     )
 
 
-# ---------------------------------------------------------------------------------------
-# Kernels
-# ---------------------------------------------------------------------------------------
-
-
 def _stroke(half_width, key, physical: bool):
     """The stroke length A from the grouping key (Δ*/x_o, or Δ* for the physical mapping)."""
     return key if physical else half_width * key
-
-
-def _drop_group(tables):
-    return jax.tree.map(lambda leaf: leaf[:, 0], tables)
-
-
-def _jumps(tables, group, lam, ends):
-    """The jumps' areas of both strokes (backward on the mirrored profile)."""
-    n = tables.forward.position.shape[-1]
-    mu = tables.mu[group]
-    lower, upper = ends
-    forward = first_passage.jump_area(tables.forward, group, mu, lam, lower, upper)
-    mirrored = (first_passage._mirror(*upper, n), first_passage._mirror(*lower, n))
-    return forward + first_passage.jump_area(tables.backward, group, mu, lam, *mirrored)
 
 
 @partial(jax.jit, static_argnames=("physical", "sparse"))
@@ -137,7 +118,7 @@ def _shared_tables(position, slope, half_width, mu, key, physical, sparse):
     """One set of tables per group (mu, key), stacked."""
     length = _stroke(half_width, key, physical)
     build = jax.vmap(core.profile_tables, in_axes=(None, None, 0, 0, None))
-    return _drop_group(build(position, slope, mu, length, sparse))
+    return jax.tree.map(lambda leaf: leaf[:, 0], build(position, slope, mu, length, sparse))
 
 
 @jax.jit
@@ -148,7 +129,7 @@ def _shared_loops(tables, group, lam):
 
 @jax.jit
 def _shared_jumps(tables, group, lam, ends):
-    one = partial(_jumps, tables)
+    one = partial(first_passage.jump_areas, tables)
     return jax.lax.map(lambda point: one(*point), (group, lam, ends), batch_size=_POINT_BATCH)
 
 
@@ -157,7 +138,7 @@ def _own_loop(position, slope, half_width, physical, point, num=0):
     mu, key, lam = point
     tables = core.profile_tables(position, slope, mu, _stroke(half_width, key, physical), False)
     loop = first_passage.steady_loop(tables, 0, lam, False)
-    jumps = _jumps(tables, 0, lam, loop.ends)
+    jumps = first_passage.jump_areas(tables, 0, lam, loop.ends)
     if not num:
         return loop, jumps
     return loop, jumps, first_passage.draw_loop(tables, 0, lam, loop, num)
@@ -343,11 +324,6 @@ def steady_numbers_and_loops(
     numbers["displacement"] = _scaled(actuator, settled, values[0], shape)
     numbers["force"] = _scaled(force, settled, values[1], shape)
     return numbers
-
-
-# ---------------------------------------------------------------------------------------
-# Drawn loops and time histories
-# ---------------------------------------------------------------------------------------
 
 
 def _drawn(position, slope, half_width, physical, num, point):

@@ -61,11 +61,6 @@ class Tables(NamedTuple):
     start_fraction: jax.Array  # (U,)
 
 
-# ---------------------------------------------------------------------------------------
-# Pointwise formulae
-# ---------------------------------------------------------------------------------------
-
-
 def traction_forward(slope, mu):
     """:math:`q_+ = (\\mu + g)/(1 - \\mu g)` (eq. 9), +inf at and beyond locking."""
     margin = 1.0 - mu * slope
@@ -133,11 +128,6 @@ def crossing_fraction(start, length, slope_a, change, mu, lam, level):
     t = jnp.where(~b_positive & linear, 1.0, t)
     t = jnp.where(lam == 0.0, (level - start) / length, t)
     return jnp.clip(t, 0.0, 1.0)
-
-
-# ---------------------------------------------------------------------------------------
-# Tables
-# ---------------------------------------------------------------------------------------
 
 
 def table_levels(count: int) -> int:
