@@ -58,47 +58,32 @@ _CHUNK = 2**21
 
 
 class ScarProfile(NamedTuple):
-    """A wear-scar profile as the model uses it (a JAX pytree of float64 arrays).
-
-    Made from numbers (:func:`scar_profile`, :func:`ecofmaps.read_scar_profile`, the
-    families) its arrays are NumPy's, so that arithmetic on them stays float64 outside JAX's
-    64-bit mode; made inside a traced function they are JAX's.
+    """A wear-scar profile as the model uses it (a JAX pytree of float64 arrays: NumPy's when
+    made from numbers, so that arithmetic on them stays float64; JAX's inside a traced
+    function). A batch of profiles has a leading batch axis on every array.
 
     Attributes
     ----------
-    position : jax.Array, shape (N,)
-        Sample positions :math:`X` along the fretting direction, relative to the scar
-        centre, strictly increasing. [m]
-    height : jax.Array, shape (N,)
-        Heights :math:`z` at the samples (levelled when asked). [m]
-    slope : jax.Array, shape (N,)
-        Slope :math:`g = dz/dX` at the samples, after smoothing; the model takes it
-        piecewise linear between samples. [1]
-    depth : jax.Array, shape ()
-        Scar depth :math:`D` below the unworn surface. [m]
-    half_width : jax.Array, shape ()
-        Scar half-width :math:`W`. [m]
+    position, height, slope : jax.Array, shape (N,)
+        Sample positions :math:`X` relative to the scar centre, strictly increasing [m];
+        heights :math:`z` (levelled when asked) [m]; smoothed slopes :math:`g = dz/dX`,
+        taken piecewise linear between samples [1].
+    depth, half_width : jax.Array, shape ()
+        Scar depth :math:`D` below the unworn surface and half-width :math:`W`: the scar is
+        ``position`` in ``[-half_width, half_width]``. [m]
     worn_area : jax.Array, shape ()
         Area between the unworn surface and the profile, between the edges. [m²]
     centre : jax.Array, shape ()
         Position of the scar centre in the coordinates of the trace as given. [m]
-    reference_height : jax.Array, shape ()
-        Height of the unworn surface at the centre, in the frame of ``height`` (0 when
-        levelled). [m]
-    reference_slope : jax.Array, shape ()
-        Tilt of the unworn surface, in the frame of ``slope`` (0 when levelled). [1]
+    reference_height, reference_slope : jax.Array, shape ()
+        Height at the centre [m] and tilt [1] of the unworn surface, in the frame of
+        ``height`` and ``slope`` (0 when levelled).
     alternative_half_width : jax.Array, shape ()
         The other plausible half-width when the edges were ambiguous or uncertain
         (``docs/profiles.md``), else NaN. [m]
     replaced : jax.Array, shape (N,) or ()
         1 where the sample was an outlier (:func:`outlying_samples`) and its height was
         interpolated, else 0; a scalar 0 when no sample was tested (the families). [1]
-
-    Notes
-    -----
-    The scar is ``position`` in ``[-half_width, half_width]``; its edges in the trace's own
-    coordinates are :attr:`edges`. A batch of profiles is a ``ScarProfile`` whose arrays
-    have a leading batch axis (``jax.tree.map(lambda *a: jnp.stack(a), *profiles)``).
     """
 
     position: jax.Array
