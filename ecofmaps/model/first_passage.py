@@ -17,6 +17,7 @@ import jax.numpy as jnp
 from ecofmaps.model.profile_core import (
     Side,
     Tables,
+    centre_segment,
     crossing_fraction,
     interval_table,
     mean_excess,
@@ -293,8 +294,6 @@ def simulation_tables(position, slope, mu, lam) -> Tables:
         bounds = interval_table(values, jnp.full(p.size, jnp.inf), table_levels(p.size))
         return Side(p, g, force, bounds)
 
-    n = position.size
-    start = jnp.clip(jnp.searchsorted(position, 0.0, side="right") - 1, 0, n - 2)
     empty = jnp.zeros((1, 1))
     tables = Tables(
         forward=side(position, slope),
@@ -304,8 +303,7 @@ def simulation_tables(position, slope, mu, lam) -> Tables:
         peak=empty,
         trough=empty,
         mu=mu,
-        start_segment=start,
-        start_fraction=(0.0 - position[start]) / (position[start + 1] - position[start]),
+        **centre_segment(position),
     )
     return jax.tree.map(lambda leaf: leaf[None], tables)
 

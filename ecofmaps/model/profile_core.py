@@ -18,6 +18,7 @@ import numpy as np
 __all__ = [
     "Side",
     "Tables",
+    "centre_segment",
     "crossing_fraction",
     "interval_table",
     "mean_excess",
@@ -130,6 +131,13 @@ def crossing_fraction(start, length, slope_a, change, mu, lam, level):
     return jnp.clip(t, 0.0, 1.0)
 
 
+def centre_segment(position) -> dict:
+    """The segment holding the scar centre, and the centre's fraction along it."""
+    start = jnp.clip(jnp.searchsorted(position, 0.0, side="right") - 1, 0, position.size - 2)
+    fraction = (0.0 - position[start]) / (position[start + 1] - position[start])
+    return {"start_segment": start, "start_fraction": fraction}
+
+
 def table_levels(count: int) -> int:
     """Levels of a first-passage table over ``count`` samples: sum of 2**l >= count."""
     return max(1, int(np.ceil(np.log2(count + 1))))
@@ -212,7 +220,6 @@ def profile_tables(position, slope, mu, length, sparse: bool = True) -> Tables:
     )
     trough = backward.force[::-1]  # -q_- at the samples, in the original order
     levels = _range_levels(n) if sparse else 1
-    start = jnp.clip(jnp.searchsorted(p, 0.0, side="right") - 1, 0, n - 2)
     tables = Tables(
         forward=forward,
         backward=backward,
@@ -223,7 +230,6 @@ def profile_tables(position, slope, mu, length, sparse: bool = True) -> Tables:
         peak=sparse_table(forward.force, levels, jnp.maximum, -jnp.inf),
         trough=sparse_table(trough, levels, jnp.maximum, -jnp.inf),
         mu=mu,
-        start_segment=start,
-        start_fraction=(0.0 - p[start]) / (p[start + 1] - p[start]),
+        **centre_segment(p),
     )
     return jax.tree.map(lambda leaf: leaf[None], tables)
