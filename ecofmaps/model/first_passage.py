@@ -115,12 +115,17 @@ def _point(side: Side, group, segment, fraction):
     return p0 + fraction * (p1 - p0), g0 + fraction * (g1 - g0)
 
 
+def _actuator(position, force, lam):
+    """The actuator position :math:`F = \\xi + \\lambda q` at which the pad at ``position``
+    slips with ``force`` :math:`q = Q/P` (:math:`\\xi` on a rigid rig)."""
+    return position + jnp.where(lam > 0.0, lam * force, 0.0)
+
+
 def _passage(side: Side, group, mu, lam, value, level, segment, fraction, sparse: bool):
     """First passage of ``F_+ >= level`` from ``(segment, fraction)``: new position, ran off."""
     n = side.position.shape[-1]
     start, start_slope = _point(side, group, segment, fraction)
-    force = jnp.where(lam > 0.0, lam * traction_forward(start_slope, mu), 0.0)
-    stick = start + force >= level
+    stick = _actuator(start, traction_forward(start_slope, mu), lam) >= level
     j = _first_holding(side, group, value, segment + 1, sparse)
     off = (j >= n) & ~stick
     j = jnp.clip(j, 1, n - 1)
@@ -203,10 +208,10 @@ def _running_levels(side: Side, group, mu, lam, start, end):
     (k_a, t_a), (k_b, t_b) = start, end
     xa, ga = _point(side, group, k_a, t_a)
     xb, gb = _point(side, group, k_b, t_b)
-    values = p + jnp.where(lam > 0.0, lam * q, 0.0)
+    values = _actuator(p, q, lam)
     index = jnp.arange(n)
     inside = (index > k_a) & (index <= k_b)
-    fa = xa + jnp.where(lam > 0.0, lam * traction_forward(ga, mu), 0.0)
+    fa = _actuator(xa, traction_forward(ga, mu), lam)
     running = jnp.maximum(fa, jax.lax.cummax(jnp.where(inside, values, -jnp.inf)))
     segment = jnp.arange(n - 1)
     first, last = segment == k_a, segment == k_b
@@ -215,9 +220,7 @@ def _running_levels(side: Side, group, mu, lam, start, end):
     b = jnp.where(last, xb, p[1:])
     slope_b = jnp.where(last, gb, g[1:])
     level = jnp.where(first, fa, running[:-1])
-    value_b = jnp.where(
-        last, xb + jnp.where(lam > 0.0, lam * traction_forward(gb, mu), 0.0), values[1:]
-    )
+    value_b = jnp.where(last, _actuator(xb, traction_forward(gb, mu), lam), values[1:])
     active = (segment >= k_a) & (segment <= k_b) & (b > a)
     return a, b, slope_a, slope_b, level, value_b, active
 
@@ -249,7 +252,7 @@ def _branch(side: Side, group, mu, lam, start, end, num: int):
     fraction = jnp.where(b[k] > a[k], (xi - a[k]) / jnp.where(b[k] > a[k], b[k] - a[k], 1.0), 0.0)
     slope = slope_a[k] + fraction * (slope_b[k] - slope_a[k])
     q = traction_forward(slope, mu)
-    value = xi + jnp.where(lam > 0.0, lam * q, 0.0)
+    value = _actuator(xi, q, lam)
     actuator = jnp.maximum(level[k], value)
     slipping = value >= level[k]
     q = jnp.where(slipping, q, (actuator - xi) / jnp.where(lam > 0.0, lam, 1.0))
@@ -290,7 +293,7 @@ def simulation_tables(position, slope, mu, lam) -> Tables:
 
     def side(p, g):
         force = traction_forward(g, mu)
-        values = p + jnp.where(lam > 0.0, lam * force, 0.0)
+        values = _actuator(p, force, lam)
         bounds = interval_table(values, jnp.full(p.size, jnp.inf), table_levels(p.size))
         return Side(p, g, force, bounds)
 
@@ -316,7 +319,7 @@ def simulation_step(tables: Tables, lam, state, actuator):
     k, t, q, off = state
     x, g = _point(forward, 0, k, t)
     has_lam = lam > 0.0
-    ahead = x + jnp.where(has_lam, lam * traction_forward(g, mu), 0.0)
+    ahead = _actuator(x, traction_forward(g, mu), lam)
     behind = x - jnp.where(has_lam, lam * traction_forward(-g, mu), 0.0)
     go_forward = actuator > ahead
     go_back = actuator < behind
