@@ -12,9 +12,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from ecofmaps._inputs import as_float64, check
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP, SELF_LOCKING
 
 __all__ = [
+    "checked",
     "compliance_ratio",
     "curvature_number",
     "ecof_ratio",
@@ -26,7 +28,44 @@ __all__ = [
     "slip_ratio",
     "slip_roots",
     "traction_ratio",
+    "valid_geometry",
 ]
+
+#: The rule and unit of each SI input, for :func:`ecofmaps._inputs.check`.
+_RULES = {
+    "amplitude": ("positive", "m"),
+    "load": ("positive", "N"),
+    "stiffness": ("positive_or_inf", "N/m"),
+    "mu": ("positive", "1"),
+    "aspect_ratio": ("non_negative", "1"),
+    "groove_half_width": ("positive", "m"),
+}
+
+
+def checked(**inputs) -> list:
+    """The SI inputs given (not None) as float64; ``ValueError`` for a concrete one out of range."""
+    for name, value in inputs.items():
+        if value is not None:
+            check(name, value, *_RULES[name])
+    return [as_float64(value) for value in inputs.values() if value is not None]
+
+
+def _positive(value):
+    return (value > 0.0) & jnp.isfinite(value)
+
+
+def valid_geometry(amplitude, load, stiffness, aspect_ratio, groove_half_width):
+    """True where the SI inputs other than mu are in range (traced-input counterpart of
+    :func:`checked`): all finite and > 0, stiffness may be inf, aspect ratio >= 0."""
+    return (
+        _positive(amplitude)
+        & _positive(load)
+        & (stiffness > 0.0)
+        & ~jnp.isnan(stiffness)
+        & (aspect_ratio >= 0.0)
+        & jnp.isfinite(aspect_ratio)
+        & _positive(groove_half_width)
+    )
 
 
 def curvature_number(length, aspect_ratio, groove_half_width):
@@ -48,9 +87,8 @@ def curvature_number(length, aspect_ratio, groove_half_width):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 7.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 7.
     """
     return 2.0 * aspect_ratio * length / groove_half_width
 
@@ -102,9 +140,8 @@ def traction_ratio(position, mu, kappa, direction=1.0):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 9.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 9.
     """
     slope = kappa * position
     return (direction * mu + slope) / (1.0 - direction * mu * slope)
@@ -135,12 +172,8 @@ def slip_position(target, mu, kappa, lam):
     r"""Contact position reached by forward slip when the actuator is at ``target``.
 
     Solves :math:`\xi + \lambda\, Q_+(\xi)/P = D` (eq. 9 with eq. 10) for the root below
-    the locking point :math:`\mu\kappa\xi = 1`; with :math:`D = 1` this is eq. 16.
-    Multiplying out gives :math:`a\xi^2 - b\xi + c = 0` with :math:`a = \mu\kappa`,
-    :math:`b = 1 + \mu\kappa D + \lambda\kappa`, :math:`c = D - \lambda\mu`. The root is
-    taken as :math:`2c/(b + \sqrt{b^2 - 4ac})` (no cancellation when :math:`b > 0`, finite
-    as :math:`\kappa \to 0`), and the discriminant is summed from non-negative terms,
-    :math:`b^2 - 4ac = (aD + \lambda\kappa - 1)^2 + 4\lambda\kappa(1 + \mu^2)`.
+    the locking point :math:`\mu\kappa\xi = 1`; with :math:`D = 1` this is eq. 16. The
+    quadratic's root is taken without cancellation (``docs/model.md``).
 
     Parameters
     ----------
@@ -157,9 +190,8 @@ def slip_position(target, mu, kappa, lam):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 9, 10, 16.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 9, 10, 16.
     """
     return slip_roots(target, mu, kappa, lam)[0]
 
@@ -167,12 +199,9 @@ def slip_position(target, mu, kappa, lam):
 def locking_margin(target, mu, kappa, lam):
     r"""Margin :math:`w = 1 - \mu\kappa\xi` of the forward-slip position to the locking point.
 
-    The denominator of eq. 9 at the position :func:`slip_position` returns, computed
-    without cancellation: :math:`w` solves :math:`w^2 + (aD + \lambda\kappa - 1)w -
-    \lambda\kappa(1 + \mu^2) = 0` (the quadratic of eq. 16 in :math:`w`), whose positive
-    root is taken in the form that never subtracts nearly equal numbers. It keeps its
-    relative accuracy when a stiff rig drives a deep groove close to locking, where
-    :math:`1 - \mu\kappa\xi` computed from :math:`\xi` would lose every digit.
+    The denominator of eq. 9 at the position :func:`slip_position` returns, as the positive
+    root of the quadratic of eq. 16 in :math:`w`: it keeps its digits close to locking, where
+    :math:`1 - \mu\kappa\xi` would lose them all (``docs/model.md``).
 
     Parameters
     ----------
@@ -188,9 +217,8 @@ def locking_margin(target, mu, kappa, lam):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 9, 16.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 9, 16.
     """
     return slip_roots(target, mu, kappa, lam)[1]
 
@@ -212,18 +240,10 @@ def regime_code(mu, kappa, lam):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 9, 16.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 9, 16.
     """
-    valid = (
-        (mu > 0.0)
-        & jnp.isfinite(mu)
-        & (kappa >= 0.0)
-        & jnp.isfinite(kappa)
-        & (lam >= 0.0)
-        & jnp.isfinite(lam)
-    )
+    valid = _positive(mu) & (kappa >= 0.0) & jnp.isfinite(kappa) & (lam >= 0.0) & jnp.isfinite(lam)
     code = jnp.where(
         mu * lam >= 1.0,
         int(NO_GROSS_SLIP),
@@ -249,9 +269,8 @@ def slip_ratio(mu, kappa, lam):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 16.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 16.
     """
     code = regime_code(mu, kappa, lam)
     d = slip_position(1.0, mu, kappa, lam)
@@ -300,9 +319,8 @@ def ecof_ratio(mu, kappa, lam):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 1, 13-15, 16.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 1, 13-15, 16.
     """
     d = slip_ratio(mu, kappa, lam)
     excess = _artanh_excess(mu * kappa * d, locking_margin(1.0, mu, kappa, lam))
@@ -326,9 +344,8 @@ def normalized_max_force(mu, kappa, lam):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 9, 16.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 9, 16.
     """
     d = slip_ratio(mu, kappa, lam)
     stick = d == 0.0
@@ -351,9 +368,8 @@ def normalized_energy(mu, kappa, lam):
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 1, 12.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 1, 12.
     """
     d = slip_ratio(mu, kappa, lam)
     energy = 4.0 * d * mu * ecof_ratio(mu, kappa, lam)

@@ -17,10 +17,11 @@ import jax.numpy as jnp
 from ecofmaps.model.profile_core import (
     Side,
     Tables,
+    centre_segment,
     crossing_fraction,
+    interval_table,
     mean_excess,
     mean_traction,
-    sparse_table,
     table_levels,
     traction_forward,
 )
@@ -30,7 +31,7 @@ __all__ = [
     "JAMMED_TRACTION",
     "SteadyLoop",
     "draw_loop",
-    "jump_area",
+    "jump_areas",
     "simulation_step",
     "simulation_tables",
     "steady_loop",
@@ -114,12 +115,17 @@ def _point(side: Side, group, segment, fraction):
     return p0 + fraction * (p1 - p0), g0 + fraction * (g1 - g0)
 
 
+def _actuator(position, force, lam):
+    """The actuator position :math:`F = \\xi + \\lambda q` at which the pad at ``position``
+    slips with ``force`` :math:`q = Q/P` (:math:`\\xi` on a rigid rig)."""
+    return position + jnp.where(lam > 0.0, lam * force, 0.0)
+
+
 def _passage(side: Side, group, mu, lam, value, level, segment, fraction, sparse: bool):
     """First passage of ``F_+ >= level`` from ``(segment, fraction)``: new position, ran off."""
     n = side.position.shape[-1]
     start, start_slope = _point(side, group, segment, fraction)
-    force = jnp.where(lam > 0.0, lam * traction_forward(start_slope, mu), 0.0)
-    stick = start + force >= level
+    stick = _actuator(start, traction_forward(start_slope, mu), lam) >= level
     j = _first_holding(side, group, value, segment + 1, sparse)
     off = (j >= n) & ~stick
     j = jnp.clip(j, 1, n - 1)
@@ -163,14 +169,14 @@ def steady_loop(tables: Tables, group, lam, sparse: bool = True) -> SteadyLoop:
     stuck = width == 0.0
     ratio = 1.0 + integral / jnp.where(stuck, 1.0, width)
     critical = _range(tables.critical, group, k_minus, k_plus, jnp.minimum, jnp.inf, sparse)
-    peak = _range(tables.peak, group, k_minus + 1, k_plus, jnp.maximum, -jnp.inf, sparse)
-    peak = jnp.maximum(
-        peak, jnp.maximum(traction_forward(slope_minus, mu), traction_forward(slope_plus, mu))
-    )
-    trough = _range(tables.trough, group, k_minus + 1, k_plus, jnp.maximum, -jnp.inf, sparse)
-    trough = jnp.maximum(
-        trough, jnp.maximum(traction_forward(-slope_minus, mu), traction_forward(-slope_plus, mu))
-    )
+
+    def largest(table, slope_a, slope_b):
+        inside = _range(table, group, k_minus + 1, k_plus, jnp.maximum, -jnp.inf, sparse)
+        ends = jnp.maximum(traction_forward(slope_a, mu), traction_forward(slope_b, mu))
+        return jnp.maximum(inside, ends)
+
+    peak = largest(tables.peak, slope_minus, slope_plus)
+    trough = largest(tables.trough, -slope_minus, -slope_plus)
     # A rigid rig passes a locking point; a rig stiff enough to stop the pad within rounding
     # of one (lambda ~ 1e-17 of the stroke) gives an infinite force there too. Short of
     # that, a force above JAMMED_TRACTION times the load leaves the loop's area to rounding
@@ -202,10 +208,10 @@ def _running_levels(side: Side, group, mu, lam, start, end):
     (k_a, t_a), (k_b, t_b) = start, end
     xa, ga = _point(side, group, k_a, t_a)
     xb, gb = _point(side, group, k_b, t_b)
-    values = p + jnp.where(lam > 0.0, lam * q, 0.0)
+    values = _actuator(p, q, lam)
     index = jnp.arange(n)
     inside = (index > k_a) & (index <= k_b)
-    fa = xa + jnp.where(lam > 0.0, lam * traction_forward(ga, mu), 0.0)
+    fa = _actuator(xa, traction_forward(ga, mu), lam)
     running = jnp.maximum(fa, jax.lax.cummax(jnp.where(inside, values, -jnp.inf)))
     segment = jnp.arange(n - 1)
     first, last = segment == k_a, segment == k_b
@@ -214,14 +220,12 @@ def _running_levels(side: Side, group, mu, lam, start, end):
     b = jnp.where(last, xb, p[1:])
     slope_b = jnp.where(last, gb, g[1:])
     level = jnp.where(first, fa, running[:-1])
-    value_b = jnp.where(
-        last, xb + jnp.where(lam > 0.0, lam * traction_forward(gb, mu), 0.0), values[1:]
-    )
+    value_b = jnp.where(last, _actuator(xb, traction_forward(gb, mu), lam), values[1:])
     active = (segment >= k_a) & (segment <= k_b) & (b > a)
     return a, b, slope_a, slope_b, level, value_b, active
 
 
-def jump_area(side: Side, group, mu, lam, start, end):
+def _jump_area(side: Side, group, mu, lam, start, end):
     r""":math:`\int (M_+ - F_+)\,d\xi` over a forward stroke from ``start`` to ``end``."""
     a, b, slope_a, slope_b, level, value_b, active = _running_levels(
         side, group, mu, lam, start, end
@@ -248,22 +252,33 @@ def _branch(side: Side, group, mu, lam, start, end, num: int):
     fraction = jnp.where(b[k] > a[k], (xi - a[k]) / jnp.where(b[k] > a[k], b[k] - a[k], 1.0), 0.0)
     slope = slope_a[k] + fraction * (slope_b[k] - slope_a[k])
     q = traction_forward(slope, mu)
-    value = xi + jnp.where(lam > 0.0, lam * q, 0.0)
+    value = _actuator(xi, q, lam)
     actuator = jnp.maximum(level[k], value)
     slipping = value >= level[k]
     q = jnp.where(slipping, q, (actuator - xi) / jnp.where(lam > 0.0, lam, 1.0))
     return actuator, q
 
 
-def draw_loop(tables: Tables, group, lam, loop: SteadyLoop, num: int):
-    """The steady loop's actuator positions D and forces Q/P, ``2 num + 1`` points."""
+def _both_strokes(stroke, tables: Tables, group, lam, ends, *args):
+    """``stroke`` forward from the lower end to the upper one, and back on the mirrored profile."""
     n = tables.forward.position.shape[-1]
     mu = tables.mu[group]
-    lower, upper = loop.ends
-    d_forward, q_forward = _branch(tables.forward, group, mu, lam, lower, upper, num)
-    d_back, q_back = _branch(
-        tables.backward, group, mu, lam, _mirror(*upper, n), _mirror(*lower, n), num
-    )
+    lower, upper = ends
+    forward = stroke(tables.forward, group, mu, lam, lower, upper, *args)
+    mirrored = (_mirror(*upper, n), _mirror(*lower, n))
+    return forward, stroke(tables.backward, group, mu, lam, *mirrored, *args)
+
+
+def jump_areas(tables: Tables, group, lam, ends):
+    """The jumps' areas of both strokes of the steady loop with ``ends``."""
+    forward, backward = _both_strokes(_jump_area, tables, group, lam, ends)
+    return forward + backward
+
+
+def draw_loop(tables: Tables, group, lam, loop: SteadyLoop, num: int):
+    """The steady loop's actuator positions D and forces Q/P, ``2 num + 1`` points."""
+    forward, backward = _both_strokes(_branch, tables, group, lam, loop.ends, num)
+    (d_forward, q_forward), (d_back, q_back) = forward, backward
     actuator = jnp.concatenate([-d_back[-1:], d_forward, -d_back])
     force = jnp.concatenate([-q_back[-1:], q_forward, -q_back])
     stuck = loop.regime == int(NO_GROSS_SLIP)
@@ -272,32 +287,16 @@ def draw_loop(tables: Tables, group, lam, loop: SteadyLoop, num: int):
     return jnp.where(stuck, line, actuator), jnp.where(stuck, stick_force, force)
 
 
-# ---------------------------------------------------------------------------------------
-# Time-domain return map
-# ---------------------------------------------------------------------------------------
-
-
 def simulation_tables(position, slope, mu, lam) -> Tables:
     r"""Tables for a time history at one :math:`(\mu, \lambda)`: per sample, the actuator
     positions :math:`D` at which :math:`F_+ \ge D` fails, :math:`(F_+, \infty)`, sparse."""
 
     def side(p, g):
         force = traction_forward(g, mu)
-        values = p + jnp.where(lam > 0.0, lam * force, 0.0)
-        levels = table_levels(p.size)
-        lower = jnp.concatenate([values, jnp.array([jnp.inf])])
-        upper = jnp.concatenate([jnp.full(p.size, jnp.inf), jnp.array([-jnp.inf])])
-        bounds = jnp.stack(
-            [
-                sparse_table(lower, levels, jnp.maximum, jnp.inf),
-                sparse_table(upper, levels, jnp.minimum, -jnp.inf),
-            ],
-            axis=-1,
-        )
+        values = _actuator(p, force, lam)
+        bounds = interval_table(values, jnp.full(p.size, jnp.inf), table_levels(p.size))
         return Side(p, g, force, bounds)
 
-    n = position.size
-    start = jnp.clip(jnp.searchsorted(position, 0.0, side="right") - 1, 0, n - 2)
     empty = jnp.zeros((1, 1))
     tables = Tables(
         forward=side(position, slope),
@@ -307,8 +306,7 @@ def simulation_tables(position, slope, mu, lam) -> Tables:
         peak=empty,
         trough=empty,
         mu=mu,
-        start_segment=start,
-        start_fraction=(0.0 - position[start]) / (position[start + 1] - position[start]),
+        **centre_segment(position),
     )
     return jax.tree.map(lambda leaf: leaf[None], tables)
 
@@ -321,7 +319,7 @@ def simulation_step(tables: Tables, lam, state, actuator):
     k, t, q, off = state
     x, g = _point(forward, 0, k, t)
     has_lam = lam > 0.0
-    ahead = x + jnp.where(has_lam, lam * traction_forward(g, mu), 0.0)
+    ahead = _actuator(x, traction_forward(g, mu), lam)
     behind = x - jnp.where(has_lam, lam * traction_forward(-g, mu), 0.0)
     go_forward = actuator > ahead
     go_back = actuator < behind

@@ -16,10 +16,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from ecofmaps._inputs import as_float64, check, float64, is_concrete
+from ecofmaps._inputs import as_float64, float64, is_concrete
 from ecofmaps.model import first_passage
 from ecofmaps.model import profile_core as core
-from ecofmaps.model.core import compliance_ratio
+from ecofmaps.model.core import checked, compliance_ratio, valid_geometry
 from ecofmaps.model.profiles import ScarProfile
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
 
@@ -89,35 +89,23 @@ def check_mapping(mapping, groove_half_width) -> bool:
 
 
 def _inputs(amplitude, load, stiffness, mu, groove_half_width):
-    check("amplitude", amplitude, "positive", "m")
-    check("load", load, "positive", "N")
-    check("stiffness", stiffness, "positive_or_inf", "N/m")
-    check("mu", mu, "positive", "1")
-    if groove_half_width is not None:
-        check("groove_half_width", groove_half_width, "positive", "m")
-    values = [as_float64(v) for v in (amplitude, load, stiffness, mu)]
-    values.append(values[0] if groove_half_width is None else as_float64(groove_half_width))
+    """The SI inputs, checked, as broadcast float64 arrays; x_o defaults to the amplitude."""
+    values = checked(
+        amplitude=amplitude,
+        load=load,
+        stiffness=stiffness,
+        mu=mu,
+        groove_half_width=groove_half_width,
+    )
+    if groove_half_width is None:
+        values.append(values[0])
     return jnp.broadcast_arrays(*values)
 
 
 def _valid(amplitude, load, stiffness, mu, half_width):
     return (
-        (amplitude > 0.0)
-        & jnp.isfinite(amplitude)
-        & (load > 0.0)
-        & jnp.isfinite(load)
-        & (stiffness > 0.0)
-        & ~jnp.isnan(stiffness)
-        & (mu > 0.0)
-        & jnp.isfinite(mu)
-        & (half_width > 0.0)
-        & jnp.isfinite(half_width)
+        valid_geometry(amplitude, load, stiffness, 0.0, half_width) & (mu > 0.0) & jnp.isfinite(mu)
     )
-
-
-# ---------------------------------------------------------------------------------------
-# Kernels
-# ---------------------------------------------------------------------------------------
 
 
 def _stroke(half_width, key, physical: bool):
@@ -125,26 +113,12 @@ def _stroke(half_width, key, physical: bool):
     return key if physical else half_width * key
 
 
-def _drop_group(tables):
-    return jax.tree.map(lambda leaf: leaf[:, 0], tables)
-
-
-def _jumps(tables, group, lam, ends):
-    """The jumps' areas of both strokes (backward on the mirrored profile)."""
-    n = tables.forward.position.shape[-1]
-    mu = tables.mu[group]
-    lower, upper = ends
-    forward = first_passage.jump_area(tables.forward, group, mu, lam, lower, upper)
-    mirrored = (first_passage._mirror(*upper, n), first_passage._mirror(*lower, n))
-    return forward + first_passage.jump_area(tables.backward, group, mu, lam, *mirrored)
-
-
 @partial(jax.jit, static_argnames=("physical", "sparse"))
 def _shared_tables(position, slope, half_width, mu, key, physical, sparse):
     """One set of tables per group (mu, key), stacked."""
     length = _stroke(half_width, key, physical)
     build = jax.vmap(core.profile_tables, in_axes=(None, None, 0, 0, None))
-    return _drop_group(build(position, slope, mu, length, sparse))
+    return jax.tree.map(lambda leaf: leaf[:, 0], build(position, slope, mu, length, sparse))
 
 
 @jax.jit
@@ -155,7 +129,7 @@ def _shared_loops(tables, group, lam):
 
 @jax.jit
 def _shared_jumps(tables, group, lam, ends):
-    one = partial(_jumps, tables)
+    one = partial(first_passage.jump_areas, tables)
     return jax.lax.map(lambda point: one(*point), (group, lam, ends), batch_size=_POINT_BATCH)
 
 
@@ -164,7 +138,7 @@ def _own_loop(position, slope, half_width, physical, point, num=0):
     mu, key, lam = point
     tables = core.profile_tables(position, slope, mu, _stroke(half_width, key, physical), False)
     loop = first_passage.steady_loop(tables, 0, lam, False)
-    jumps = _jumps(tables, 0, lam, loop.ends)
+    jumps = first_passage.jump_areas(tables, 0, lam, loop.ends)
     if not num:
         return loop, jumps
     return loop, jumps, first_passage.draw_loop(tables, 0, lam, loop, num)
@@ -294,35 +268,44 @@ def steady_values(numbers, amplitude, load, mu) -> dict:
     return values
 
 
+def _points(profile, amplitude, load, stiffness, mu, groove_half_width, mapping):
+    """The checked profile, the SI inputs broadcast, the mapping and :func:`_prepare`'s values."""
+    physical = check_mapping(mapping, groove_half_width)
+    profile = as_profile(profile)
+    values = _inputs(amplitude, load, stiffness, mu, groove_half_width)
+    return profile, values, physical, _prepare(*values, profile.half_width, physical)
+
+
+def _each_own(profile, physical, mu, key, lam, num=0):
+    """:func:`_own_loops` of the points padded to a power of two."""
+    padded = _pad(np.arange(lam.size))
+    arguments = (profile.position, profile.slope, profile.half_width)
+    return _own_loops(*arguments, mu[padded], key[padded], lam[padded], physical, num)
+
+
+def _scaled(curve, ok, scale, shape):
+    """A drawn curve per point, NaN where not ``ok``, times ``scale`` [SI], in ``shape``."""
+    curve = jnp.where(ok[:, None], curve[: ok.size], jnp.nan) * scale.reshape(-1, 1)
+    return curve.reshape(*shape, -1)
+
+
 def steady_numbers(
     profile, amplitude, load, stiffness, mu, groove_half_width=None, mapping="scaled"
 ) -> dict:
     r"""The steady loop on ``profile`` at every point, in the units of the core."""
-    physical = check_mapping(mapping, groove_half_width)
-    profile = as_profile(profile)
-    values = _inputs(amplitude, load, stiffness, mu, groove_half_width)
-    shape = values[0].shape
-    mu, key, lam, valid = _prepare(*values, profile.half_width, physical)
+    profile, values, physical, (mu, key, lam, valid) = _points(
+        profile, amplitude, load, stiffness, mu, groove_half_width, mapping
+    )
     own = not is_concrete(mu, key, lam) or lam.size <= _FEW_POINTS
     if not own:
         unique, group = _groups(np.asarray(mu), np.asarray(key))
         own = unique.shape[1] > max(_FEW_GROUPS, lam.size // 16)
     if own:  # each point its own O(N) tables
-        padded = _pad(np.arange(lam.size))
-        loops, jumps = _own_loops(
-            profile.position,
-            profile.slope,
-            profile.half_width,
-            mu[padded],
-            key[padded],
-            lam[padded],
-            physical,
-        )
+        loops, jumps = _each_own(profile, physical, mu, key, lam)
     else:
         loops, jumps = _shared(profile, unique, group, lam, physical)
-    loops = loops._replace(ends=())
-    numbers = _finish(loops, jumps, mu, lam, valid)
-    return {name: value.reshape(shape) for name, value in numbers.items()}
+    numbers = _finish(loops._replace(ends=()), jumps, mu, lam, valid)
+    return {name: value.reshape(values[0].shape) for name, value in numbers.items()}
 
 
 @float64
@@ -330,35 +313,17 @@ def steady_numbers_and_loops(
     profile, amplitude, load, stiffness, mu, num=201, groove_half_width=None, mapping="scaled"
 ) -> dict:
     r""":func:`steady_numbers` and each point's steady loop drawn, by one compiled kernel."""
-    physical = check_mapping(mapping, groove_half_width)
-    profile = as_profile(profile)
-    values = _inputs(amplitude, load, stiffness, mu, groove_half_width)
-    shape = values[0].shape
-    mu, key, lam, valid = _prepare(*values, profile.half_width, physical)
-    padded = _pad(np.arange(lam.size))
-    loops, jumps, (actuator, force) = _own_loops(
-        profile.position,
-        profile.slope,
-        profile.half_width,
-        mu[padded],
-        key[padded],
-        lam[padded],
-        physical,
-        num,
+    profile, values, physical, (mu, key, lam, valid) = _points(
+        profile, amplitude, load, stiffness, mu, groove_half_width, mapping
     )
+    loops, jumps, (actuator, force) = _each_own(profile, physical, mu, key, lam, num)
     numbers = _finish(loops._replace(ends=()), jumps, mu, lam, valid)
     settled = (numbers["regime"] == int(GROSS_SLIP)) | (numbers["regime"] == int(NO_GROSS_SLIP))
-    drawn = {"displacement": (actuator, values[0]), "force": (force, values[1])}
+    shape = values[0].shape
     numbers = {name: value.reshape(shape) for name, value in numbers.items()}
-    for name, (curve, scale) in drawn.items():
-        curve = jnp.where(settled[:, None], curve[: lam.size], jnp.nan) * scale.reshape(-1, 1)
-        numbers[name] = curve.reshape(*shape, -1)
+    numbers["displacement"] = _scaled(actuator, settled, values[0], shape)
+    numbers["force"] = _scaled(force, settled, values[1], shape)
     return numbers
-
-
-# ---------------------------------------------------------------------------------------
-# Drawn loops and time histories
-# ---------------------------------------------------------------------------------------
 
 
 def _drawn(position, slope, half_width, physical, num, point):
@@ -378,23 +343,13 @@ def _drawn_loops(position, slope, half_width, mu, key, lam, physical, num):
 
 def profile_loop(profile, amplitude, load, stiffness, mu, groove_half_width, mapping, num):
     """Displacement and force around the steady loop on ``profile`` (see fretting_loop)."""
-    physical = check_mapping(mapping, groove_half_width)
-    profile = as_profile(profile)
-    amplitude, load, stiffness, mu, half_width = _inputs(
-        amplitude, load, stiffness, mu, groove_half_width
+    profile, values, physical, (mu, key, lam, valid) = _points(
+        profile, amplitude, load, stiffness, mu, groove_half_width, mapping
     )
-    shape = amplitude.shape
-    valid = _valid(amplitude, load, stiffness, mu, half_width).reshape(-1)
-    lam = jnp.where(valid, compliance_ratio(amplitude, load, stiffness).reshape(-1), 0.1)
-    key = (amplitude if physical else amplitude / half_width).reshape(-1)
-    key = jnp.where(valid, key, profile.half_width if physical else 1.0)
-    mu_flat = jnp.where(valid, mu.reshape(-1), 0.5)
-    actuator, force = _drawn_loops(
-        profile.position, profile.slope, profile.half_width, mu_flat, key, lam, physical, num
-    )
-    actuator = jnp.where(valid[:, None], actuator, jnp.nan) * amplitude.reshape(-1, 1)
-    force = jnp.where(valid[:, None], force, jnp.nan) * load.reshape(-1, 1)
-    return actuator.reshape(*shape, -1), force.reshape(*shape, -1)
+    arguments = (profile.position, profile.slope, profile.half_width)
+    actuator, force = _drawn_loops(*arguments, mu, key, lam, physical, num)
+    shape = values[0].shape
+    return _scaled(actuator, valid, values[0], shape), _scaled(force, valid, values[1], shape)
 
 
 def _history(position, slope, history):
@@ -421,14 +376,11 @@ def profile_simulation(profile, displacement, load, stiffness, mu, groove_half_w
             "groove_half_width = x_o (the steady loop uses x_o = amplitude); or give "
             "mapping='physical'"
         )
-    check("load", load, "positive", "N")
-    check("stiffness", stiffness, "positive_or_inf", "N/m")
-    check("mu", mu, "positive", "1")
-    if groove_half_width is not None:
-        check("groove_half_width", groove_half_width, "positive", "m")
+    load, stiffness, mu, *x_o = checked(
+        load=load, stiffness=stiffness, mu=mu, groove_half_width=groove_half_width
+    )
+    x_o = profile.half_width if physical else x_o[0]
     displacement = as_float64(displacement)
-    load, stiffness, mu = (as_float64(v) for v in (load, stiffness, mu))
-    x_o = profile.half_width if physical else as_float64(groove_half_width)
     batch = jnp.broadcast_shapes(
         displacement.shape[:-1], load.shape, stiffness.shape, mu.shape, x_o.shape
     )

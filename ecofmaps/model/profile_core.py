@@ -18,7 +18,9 @@ import numpy as np
 __all__ = [
     "Side",
     "Tables",
+    "centre_segment",
     "crossing_fraction",
+    "interval_table",
     "mean_excess",
     "mean_traction",
     "profile_tables",
@@ -58,11 +60,6 @@ class Tables(NamedTuple):
     mu: jax.Array  # (U,)
     start_segment: jax.Array  # (U,) segment holding the scar centre
     start_fraction: jax.Array  # (U,)
-
-
-# ---------------------------------------------------------------------------------------
-# Pointwise formulae
-# ---------------------------------------------------------------------------------------
 
 
 def traction_forward(slope, mu):
@@ -134,9 +131,11 @@ def crossing_fraction(start, length, slope_a, change, mu, lam, level):
     return jnp.clip(t, 0.0, 1.0)
 
 
-# ---------------------------------------------------------------------------------------
-# Tables
-# ---------------------------------------------------------------------------------------
+def centre_segment(position) -> dict:
+    """The segment holding the scar centre, and the centre's fraction along it."""
+    start = jnp.clip(jnp.searchsorted(position, 0.0, side="right") - 1, 0, position.size - 2)
+    fraction = (0.0 - position[start]) / (position[start + 1] - position[start])
+    return {"start_segment": start, "start_fraction": fraction}
 
 
 def table_levels(count: int) -> int:
@@ -172,7 +171,11 @@ def _intervals(position, force, levels: int):
             jnp.where(force == 0.0, jnp.where(below, jnp.inf, -jnp.inf), jnp.inf),
         ),
     )
-    lower = jnp.where(finite & (force < 0.0), ratio, -jnp.inf)
+    return interval_table(jnp.where(finite & (force < 0.0), ratio, -jnp.inf), upper, levels)
+
+
+def interval_table(lower, upper, levels: int):
+    """The sparse tables of the intervals ``(lower, upper)`` per sample, and a sentinel."""
     lower = jnp.concatenate([lower, jnp.array([jnp.inf])])
     upper = jnp.concatenate([upper, jnp.array([-jnp.inf])])
     return jnp.stack(
@@ -217,7 +220,6 @@ def profile_tables(position, slope, mu, length, sparse: bool = True) -> Tables:
     )
     trough = backward.force[::-1]  # -q_- at the samples, in the original order
     levels = _range_levels(n) if sparse else 1
-    start = jnp.clip(jnp.searchsorted(p, 0.0, side="right") - 1, 0, n - 2)
     tables = Tables(
         forward=forward,
         backward=backward,
@@ -228,7 +230,6 @@ def profile_tables(position, slope, mu, length, sparse: bool = True) -> Tables:
         peak=sparse_table(forward.force, levels, jnp.maximum, -jnp.inf),
         trough=sparse_table(trough, levels, jnp.maximum, -jnp.inf),
         mu=mu,
-        start_segment=start,
-        start_fraction=(0.0 - p[start]) / (p[start + 1] - p[start]),
+        **centre_segment(p),
     )
     return jax.tree.map(lambda leaf: leaf[None], tables)

@@ -89,22 +89,14 @@ def _line(x, z, mask):
 
 def _crossing(x, r, start, step, tolerance, reach):
     """Where ``r`` first reaches 0 (to ``tolerance``) from ``start`` in direction ``step``."""
-    if step < 0:
-        found = np.flatnonzero(r[:start] >= -tolerance)
-        if found.size == 0:
-            return None
-        outer = found[-1]
-        last = outer + 1
-        inner = min(last + reach, start)
-        second = min(inner + 1, start)
-    else:
-        found = np.flatnonzero(r[start:] >= -tolerance)
-        if found.size == 0:
-            return None
-        outer = start + found[0]
-        last = outer - 1
-        inner = max(last - reach, start - 1)
-        second = max(inner - 1, start - 1)
+    found = np.flatnonzero((r[:start] if step < 0 else r[start:]) >= -tolerance)
+    if found.size == 0:
+        return None
+    outer = found[-1] if step < 0 else start + found[0]
+    last = outer - step  # the sample inside next to it
+    bound, wall = (min, start) if step < 0 else (max, start - 1)
+    inner = bound(last - step * reach, wall)
+    second = bound(inner - step, wall)
     rise = (r[inner] - r[second]) / (x[inner] - x[second]) if second != inner else 0.0
     beyond = x[outer]
     if rise * (x[outer] - x[last]) > 0.0:  # the wall climbs towards the line
@@ -416,7 +408,7 @@ def _scar_extent(x, zs, half_width, reach=0) -> Extent:
     return Extent(line, tilt, centre, width, r, groove, band, wide, ridges, rough)
 
 
-def _ambiguity(x, extent: Extent, given: bool):
+def _ambiguity(extent: Extent, given: bool):
     """The warning of ambiguous edges (or None) and the half-width not taken. [m]"""
     if extent.band == extent.groove or given:
         return None, np.nan
@@ -475,7 +467,7 @@ def _uncertainty(extent: Extent, given: bool):
 def scar_extent(x, zs, half_width, reach):
     """The scar's :class:`Extent`, the half-width not taken [m] (NaN if none) and the warnings."""
     extent = _scar_extent(x, zs, half_width, reach)
-    finding, alternative = _ambiguity(x, extent, half_width is not None)
+    finding, alternative = _ambiguity(extent, half_width is not None)
     if finding is None:
         finding, alternative = _uncertainty(extent, half_width is not None)
     return extent, alternative, [] if finding is None else [finding]

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ecofmaps._inputs import si_units
-from ecofmaps.model.profiles import MIN_SCAR_SAMPLES, ScarProfile, scar_profile_from_parts
+from ecofmaps.model.profiles import MIN_SCAR_SAMPLES, ScarProfile, profile_of
 
 __all__ = ["flat_bottomed_profile", "parabolic_profile", "ridged_profile", "w_shaped_profile"]
 
@@ -33,10 +33,12 @@ def _fraction(name: str, value, low=0.0, high=1.0) -> float:
 
 
 def _grid(breakpoints, samples: int) -> np.ndarray:
-    """Exactly ``samples`` positions, about evenly spread, with every breakpoint among them."""
+    """Exactly ``samples`` positions, about evenly spread, with 0 and every breakpoint (> 0)
+    and its mirror image among them."""
     if not (isinstance(samples, int | np.integer) and samples >= 2 * MIN_SCAR_SAMPLES):
         raise ValueError(f"samples must be an integer >= {2 * MIN_SCAR_SAMPLES}, got {samples!r}")
-    breakpoints = np.unique(np.asarray(breakpoints, dtype=np.float64))
+    breakpoints = np.asarray(breakpoints, dtype=np.float64)
+    breakpoints = np.unique(np.concatenate([-breakpoints, [0.0], breakpoints]))
     # Breakpoints closer than 1e-9 of the span (a flat bottom of nearly zero width) merge.
     tolerance = 1e-9 * (breakpoints[-1] - breakpoints[0])
     kept = [breakpoints[0]]
@@ -64,14 +66,8 @@ def _family(position, height, slope, depth, half_width, tilt):
         raise ValueError(f"tilt must be finite, got {tilt!r}")
     inside = np.abs(position) <= half_width
     worn = np.trapezoid(np.where(inside, -np.minimum(height, 0.0), 0.0), position)
-    return scar_profile_from_parts(
-        position,
-        height + tilt * position,
-        slope + tilt,
-        depth,
-        half_width,
-        worn,
-        reference_slope=tilt,
+    return profile_of(
+        position, height + tilt * position, slope + tilt, depth, half_width, worn, 0.0, 0.0, tilt
     )
 
 
@@ -109,9 +105,8 @@ def parabolic_profile(depth, half_width, *, tilt=0.0, samples=2001, extent=2.0) 
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 7, 11.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 7, 11.
 
     Examples
     --------
@@ -121,7 +116,7 @@ def parabolic_profile(depth, half_width, *, tilt=0.0, samples=2001, extent=2.0) 
     """
     depth, half_width = _positive("depth", depth), _positive("half_width", half_width)
     extent = _extent(extent)
-    x = _grid([-extent * half_width, -half_width, 0.0, half_width, extent * half_width], samples)
+    x = _grid([half_width, extent * half_width], samples)
     inside = np.abs(x) <= half_width
     u = x / half_width
     z = np.where(inside, -depth * (1.0 - u * u), 0.0)
@@ -156,8 +151,7 @@ def flat_bottomed_profile(
     depth, half_width = _positive("depth", depth), _positive("half_width", half_width)
     flat = _fraction("flat_fraction", flat_fraction) * half_width
     extent = _extent(extent)
-    edges = [-extent * half_width, -half_width, -flat, 0.0, flat, half_width, extent * half_width]
-    x = _grid(edges, samples)
+    x = _grid([flat, half_width, extent * half_width], samples)
     s = np.clip((np.abs(x) - flat) / (half_width - flat), 0.0, None)
     inside = np.abs(x) <= half_width
     z = np.where(inside, -depth * (1.0 - s * s), 0.0)
@@ -194,16 +188,7 @@ def w_shaped_profile(
     extent = _extent(extent)
     m2 = np.sqrt(hump) / (1.0 + np.sqrt(hump))
     trough = np.sqrt(m2) * half_width
-    edges = [
-        -extent * half_width,
-        -half_width,
-        -trough,
-        0.0,
-        trough,
-        half_width,
-        extent * half_width,
-    ]
-    x = _grid(edges, samples)
+    x = _grid([trough, half_width, extent * half_width], samples)
     u = x / half_width
     inside = np.abs(u) <= 1.0
     scale = depth / (1.0 - m2) ** 2
@@ -245,19 +230,7 @@ def ridged_profile(
     height = _positive("ridge_height", ridge_height)
     width = _positive("ridge_width", ridge_width)
     extent = _extent(extent, 1.0 + width / half_width)
-    crest = half_width + 0.5 * width
-    foot = half_width + width
-    edges = [
-        -extent * half_width,
-        -foot,
-        -crest,
-        -half_width,
-        0.0,
-        half_width,
-        crest,
-        foot,
-        extent * half_width,
-    ]
+    edges = [half_width, half_width + 0.5 * width, half_width + width, extent * half_width]
     x = _grid(edges, samples)
     u = x / half_width
     v = (np.abs(x) - half_width) / width

@@ -34,9 +34,9 @@ __all__ = [
     "ScarProfileWarning",
     "local_quadratic",
     "outlying_samples",
+    "profile_of",
     "scar_profile",
     "scar_profile_and_findings",
-    "scar_profile_from_parts",
 ]
 
 #: Fewest samples a measured profile must have between the scar's edges.
@@ -58,47 +58,32 @@ _CHUNK = 2**21
 
 
 class ScarProfile(NamedTuple):
-    """A wear-scar profile as the model uses it (a JAX pytree of float64 arrays).
-
-    Made from numbers (:func:`scar_profile`, :func:`ecofmaps.read_scar_profile`, the
-    families) its arrays are NumPy's, so that arithmetic on them stays float64 outside JAX's
-    64-bit mode; made inside a traced function they are JAX's.
+    """A wear-scar profile as the model uses it (a JAX pytree of float64 arrays: NumPy's when
+    made from numbers, so that arithmetic on them stays float64; JAX's inside a traced
+    function). A batch of profiles has a leading batch axis on every array.
 
     Attributes
     ----------
-    position : jax.Array, shape (N,)
-        Sample positions :math:`X` along the fretting direction, relative to the scar
-        centre, strictly increasing. [m]
-    height : jax.Array, shape (N,)
-        Heights :math:`z` at the samples (levelled when asked). [m]
-    slope : jax.Array, shape (N,)
-        Slope :math:`g = dz/dX` at the samples, after smoothing; the model takes it
-        piecewise linear between samples. [1]
-    depth : jax.Array, shape ()
-        Scar depth :math:`D` below the unworn surface. [m]
-    half_width : jax.Array, shape ()
-        Scar half-width :math:`W`. [m]
+    position, height, slope : jax.Array, shape (N,)
+        Sample positions :math:`X` relative to the scar centre, strictly increasing [m];
+        heights :math:`z` (levelled when asked) [m]; smoothed slopes :math:`g = dz/dX`,
+        taken piecewise linear between samples [1].
+    depth, half_width : jax.Array, shape ()
+        Scar depth :math:`D` below the unworn surface and half-width :math:`W`: the scar is
+        ``position`` in ``[-half_width, half_width]``. [m]
     worn_area : jax.Array, shape ()
         Area between the unworn surface and the profile, between the edges. [m²]
     centre : jax.Array, shape ()
         Position of the scar centre in the coordinates of the trace as given. [m]
-    reference_height : jax.Array, shape ()
-        Height of the unworn surface at the centre, in the frame of ``height`` (0 when
-        levelled). [m]
-    reference_slope : jax.Array, shape ()
-        Tilt of the unworn surface, in the frame of ``slope`` (0 when levelled). [1]
+    reference_height, reference_slope : jax.Array, shape ()
+        Height at the centre [m] and tilt [1] of the unworn surface, in the frame of
+        ``height`` and ``slope`` (0 when levelled).
     alternative_half_width : jax.Array, shape ()
         The other plausible half-width when the edges were ambiguous or uncertain
         (``docs/profiles.md``), else NaN. [m]
     replaced : jax.Array, shape (N,) or ()
         1 where the sample was an outlier (:func:`outlying_samples`) and its height was
         interpolated, else 0; a scalar 0 when no sample was tested (the families). [1]
-
-    Notes
-    -----
-    The scar is ``position`` in ``[-half_width, half_width]``; its edges in the trace's own
-    coordinates are :attr:`edges`. A batch of profiles is a ``ScarProfile`` whose arrays
-    have a leading batch axis (``jax.tree.map(lambda *a: jnp.stack(a), *profiles)``).
     """
 
     position: jax.Array
@@ -125,40 +110,10 @@ class ScarProfile(NamedTuple):
         return stack([self.centre - self.half_width, self.centre + self.half_width], -1)
 
 
-def scar_profile_from_parts(
-    position,
-    height,
-    slope,
-    depth,
-    half_width,
-    worn_area,
-    centre=0.0,
-    reference_height=0.0,
-    reference_slope=0.0,
-    alternative_half_width=np.nan,
-    replaced=0.0,
-) -> ScarProfile:
-    values = (
-        position,
-        height,
-        slope,
-        depth,
-        half_width,
-        worn_area,
-        centre,
-        reference_height,
-        reference_slope,
-        alternative_half_width,
-        replaced,
-    )
-    if is_concrete(*values):
-        # NumPy arrays: a user's own arithmetic on them (``profile.half_width * 1e6``) stays
-        # float64, where JAX outside its 64-bit mode would truncate it to float32.
-        return ScarProfile(*(np.asarray(v, dtype=np.float64) for v in values))
-    # JAX's 64-bit mode is on only inside the public entry points (importing ecofmaps does
-    # not switch it on): without it these arrays would be float32.
-    with jax.enable_x64(True):
-        return ScarProfile(*(jnp.asarray(v, dtype=jnp.float64) for v in values))
+def profile_of(*parts) -> ScarProfile:
+    """A :class:`ScarProfile` of ``parts`` (its defaults after them) as NumPy float64 arrays, so
+    that a user's arithmetic on them (``profile.half_width * 1e6``) stays float64."""
+    return ScarProfile(*(np.asarray(part, dtype=np.float64) for part in ScarProfile(*parts)))
 
 
 def _array(name: str, value) -> np.ndarray:
@@ -176,6 +131,14 @@ def _array(name: str, value) -> np.ndarray:
             f"({np.count_nonzero(bad)} of {array.size} values)"
         )
     return array
+
+
+def _trace(x, z):
+    """``x`` and ``z`` as float64 arrays of one length, checked."""
+    x, z = _array("x", x), _array("z", z)
+    if x.size != z.size:
+        raise ValueError(f"x and z must have the same length, got {x.size} and {z.size}")
+    return x, z
 
 
 def _check_positions(x: np.ndarray) -> None:
@@ -218,9 +181,7 @@ def outlying_samples(x, z, neighbours=OUTLIER_NEIGHBOURS, threshold=OUTLIER_THRE
     Notes
     -----
     A sample is an outlier when it is farther from the median of its ``2 neighbours``
-    nearest neighbours than ``threshold`` times the largest of their scaled median absolute
-    deviation :math:`1.4826\,\mathrm{MAD}`, the trace's noise, its typical distance from the
-    neighbours' median, and its resolution (``docs/profiles.md``).
+    nearest neighbours than ``threshold`` times a robust scale (``docs/profiles.md``).
 
     References
     ----------
@@ -236,9 +197,7 @@ def outlying_samples(x, z, neighbours=OUTLIER_NEIGHBOURS, threshold=OUTLIER_THRE
     >>> np.flatnonzero(outlying_samples(x, z)).tolist()
     [40]
     """
-    x, z = _array("x", x), _array("z", z)
-    if x.size != z.size:
-        raise ValueError(f"x and z must have the same length, got {x.size} and {z.size}")
+    x, z = _trace(x, z)
     if not (isinstance(neighbours, int | np.integer) and 1 <= neighbours < z.size / 2):
         raise ValueError(
             f"neighbours must be an integer >= 1 and less than half the {z.size} samples, "
@@ -281,10 +240,7 @@ def _outliers_replaced(x, z):
 
 def _checked_trace(x, z, half_width, smoothing):
     """The trace and the parameters of :func:`scar_profile` as float64, checked."""
-    x = _array("x", x)
-    z = _array("z", z)
-    if x.size != z.size:
-        raise ValueError(f"x and z must have the same length, got {x.size} and {z.size}")
+    x, z = _trace(x, z)
     if x.size < 2 * MIN_SCAR_SAMPLES:
         raise ValueError(f"x: a trace needs at least {2 * MIN_SCAR_SAMPLES} samples, got {x.size}")
     _check_positions(x)
@@ -318,18 +274,12 @@ def local_quadratic(x: np.ndarray, z: np.ndarray, smoothing: float):
 
     Notes
     -----
-    The weights are :math:`e^{-d^2/2} - e^{-8}` for samples within :math:`d = 4` standard
-    deviations (continuous, zero at the reach). Where the samples are sparse the standard
-    deviation is widened so that the nearest two samples on each side (three on one side at
-    the ends) lie within 80 % of the reach: each fit is defined for any spacing. Quadratics
-    are reproduced exactly.
+    The weights, and their widening where the samples are sparse, follow ``docs/profiles.md``.
     """
     if smoothing == 0.0:
         return z.copy(), np.gradient(z, x, edge_order=2)
     n = x.size
     rows = np.arange(n)
-    # Widen the weights where samples are sparse: the nearest two on each side (three on
-    # one side at the ends) within 80 % of the reach.
     span = np.maximum(x - x[np.clip(rows - 2, 0, n - 5)], x[np.clip(rows + 2, 4, n - 1)] - x)
     sigma = np.maximum(smoothing, span / (0.8 * _REACH))
     left = np.searchsorted(x, x - _REACH * sigma, side="left")
@@ -409,19 +359,8 @@ def scar_profile_and_findings(
     else:
         height, slope = z, gs
         reference = (float(line(centre)), float(tilt))
-    profile = scar_profile_from_parts(
-        x - centre,
-        height,
-        slope,
-        depth,
-        width,
-        worn,
-        centre,
-        *reference,
-        alternative,
-        replaced.astype(np.float64),
-    )
-    return profile, findings
+    parts = (depth, width, worn, centre, *reference, alternative, replaced)
+    return profile_of(x - centre, height, slope, *parts), findings
 
 
 @si_units(x="length", z="length", half_width="length")
@@ -484,9 +423,8 @@ def scar_profile(
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 11.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 11.
 
     Examples
     --------
@@ -498,12 +436,7 @@ def scar_profile(
     (50.0, 10.0)
     """
     profile, findings = scar_profile_and_findings(
-        x,
-        z,
-        half_width=half_width,
-        smoothing=smoothing,
-        level=level,
-        remove_outliers=remove_outliers,
+        x, z, half_width, smoothing, level, remove_outliers
     )
     for finding in findings:
         warn(finding, ScarProfileWarning)

@@ -19,7 +19,7 @@ __all__ = [
 
 class Regime(Code):
     """Regime codes returned by :func:`ecofmaps.slip_regime`, stored in maps and in the
-    results of :func:`ecofmaps.analyze_loops`.
+    results of :func:`ecofmaps.analyze_loops` (``docs/model.md``, ``docs/loops.md``).
 
     Attributes
     ----------
@@ -27,27 +27,19 @@ class Regime(Code):
         :math:`\\mu\\lambda < 1`: the contact slips over part of every cycle (a measured
         loop: its energy ratio :math:`A` above the threshold).
     NO_GROSS_SLIP
-        The model's full stick, :math:`\\mu\\lambda \\ge 1`: the rig's deflection takes all
-        of the amplitude; the contact never slides, :math:`\\delta^* = 0`, :math:`E_d = 0`,
-        :math:`\\mu_E` undefined.
+        The model's full stick, :math:`\\mu\\lambda \\ge 1`: :math:`\\delta^* = 0`,
+        :math:`E_d = 0`, :math:`\\mu_E` undefined.
     SELF_LOCKING
-        Rigid rig (:math:`\\lambda = 0`) and :math:`\\mu\\kappa \\ge 1` (on a scar profile:
-        :math:`\\mu|g| \\ge 1` somewhere in the stroke): the pad jams on the groove flank
-        before the end of the stroke; no solution. With any compliance the pad stops short
-        of such a flank instead, where the rig's force balances it (unless the rig is so
-        stiff that it stops within rounding of the locking point, or where the force
-        exceeds ``ecofmaps.model.first_passage.JAMMED_TRACTION`` (6.7e7) times the load,
-        where the loop's area is left to rounding: that is then reported).
+        Rigid rig and :math:`\\mu\\kappa \\ge 1` (on a scar profile :math:`\\mu|g| \\ge 1`
+        in the stroke), or a force above ``first_passage.JAMMED_TRACTION`` times the load:
+        the pad jams on the groove flank.
     INVALID
         An input outside its valid range (or NaN).
     BEYOND_PROFILE
-        On a scar profile: the pad slips past an end of the measured trace, whose slope
-        there is unknown; the trace is too short for this stroke.
+        On a scar profile: the pad slips past an end of the measured trace.
     PARTIAL_SLIP
-        A measured loop in partial slip (Mindlin's regime, "stick-slip" in Vingsbo and
-        Söderberg's fretting map): its energy ratio :math:`A` at most the threshold; the
-        contact sticks at its centre and slips at its edges, and :math:`Q^*/P` is a lower
-        bound of :math:`\\mu`. The model's flat Coulomb contact has no partial slip.
+        A measured loop in partial slip (Mindlin's regime): its energy ratio :math:`A` at
+        most the threshold; :math:`Q^*/P` is a lower bound of :math:`\\mu`.
 
     References
     ----------

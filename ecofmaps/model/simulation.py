@@ -15,10 +15,10 @@ import jax
 import jax.numpy as jnp
 
 from ecofmaps._inputs import as_float64, check, float64, is_concrete
-from ecofmaps.model.core import locking_margin, slip_ratio, slip_roots, traction_ratio
+from ecofmaps.model.core import checked, locking_margin, slip_ratio, slip_roots, traction_ratio
 from ecofmaps.model.on_profile import profile_loop, profile_simulation
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
-from ecofmaps.model.steady_state import check_model_inputs, dimensionless, one_geometry
+from ecofmaps.model.steady_state import dimensionless, groove_inputs, one_geometry
 
 __all__ = ["fretting_loop", "simulate"]
 
@@ -116,24 +116,15 @@ def fretting_loop(
 
     Notes
     -----
-    The slip branches are eq. 9 with eq. 10, :math:`\Delta = x + Q_\pm(x)/S`, sampled
-    uniformly in :math:`x` for a shallow groove (:math:`\mu k\delta^* < 1/2`), and for a
-    deeper one so that the margin to the locking point :math:`1 - \mu k x` falls
-    geometrically along the branch (dense where the force rises steeply); the stick
-    segments are the straight lines of slope :math:`S`. With no gross slip the loop
-    collapses onto :math:`Q = S\Delta`.
-    Self-locking points give NaN.
-
-    On a profile each slip branch is sampled uniformly in :math:`x` between the loop's ends;
-    where the pad jumps (:math:`x + Q_+/S` falls) its points lie on the vertical
-    :math:`\Delta = \text{const}`, :math:`Q = S(\Delta - x)`; the branches are not
-    mirror images of each other on an asymmetric scar. Points off the trace are NaN.
+    The slip branches are eq. 9 with eq. 10, :math:`\Delta = x + Q_\pm(x)/S`, the stick
+    segments lines of slope :math:`S`; with no gross slip the loop collapses onto
+    :math:`Q = S\Delta`. Self-locking points and points off a profile's trace give NaN. The
+    sampling of the branches is explained in ``docs/model.md``.
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 9, 10, 11.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 9, 10, 11.
     """
     if not isinstance(num, int) or num < 2:
         raise ValueError(f"num must be an integer >= 2, got {num!r}")
@@ -142,9 +133,8 @@ def fretting_loop(
         return profile_loop(
             profile, amplitude, load, stiffness, mu, groove_half_width, mapping, num
         )
-    values = check_model_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
-    values = jnp.broadcast_arrays(*values)
-    return _steady_loop(*values, num=num)
+    values = groove_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
+    return _steady_loop(*jnp.broadcast_arrays(*values), num=num)
 
 
 @jax.jit
@@ -225,23 +215,16 @@ def simulate(
 
     Notes
     -----
-    The pad starts at rest at the groove centre (:math:`x = 0`, :math:`Q = 0`, at
-    :math:`\Delta = 0`). At each new :math:`\Delta` it sticks while
+    The pad starts at rest at the groove centre. At each new :math:`\Delta` it sticks while
     :math:`Q_-(x) \le S(\Delta - x) \le Q_+(x)` (eq. 9, 10); otherwise it slips to the exact
-    equilibrium :math:`x' + Q_\pm(x')/S = \Delta` (the quadratic of eq. 16), so the result
-    does not depend on the sampling. A rigid rig (:math:`S = \infty`) has :math:`x = \Delta`
-    in slip and keeps its last force while :math:`\Delta` stands still.
-
-    On a profile the pad starts at rest at the scar centre, and a slip goes to the first
-    equilibrium :math:`x' + Q_\pm(x')/S = \Delta` beyond the pad (first passage; where
-    :math:`x + Q_+/S` falls the pad jumps), found exactly on the piecewise linear slope
-    (:mod:`ecofmaps.model.first_passage`). A pad that runs off the trace gives NaN.
+    equilibrium :math:`x' + Q_\pm(x')/S = \Delta` (the quadratic of eq. 16; on a profile the
+    first one beyond the pad), so the result does not depend on the sampling
+    (``docs/model.md``). A pad that runs off a profile's trace gives NaN.
 
     References
     ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 9, 10, 11, 16.
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent coefficient
+    of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 9, 10, 11, 16.
     """
     check("displacement", displacement, "finite", "m")
     if is_concrete(displacement) and jnp.ndim(displacement) == 0:
@@ -253,13 +236,17 @@ def simulate(
         )
     if groove_half_width is None:
         raise ValueError("simulate with aspect_ratio needs groove_half_width (x_o) [m]")
-    values = check_model_inputs(1.0, load, stiffness, mu, aspect_ratio, groove_half_width)
-    _, load, stiffness, mu, aspect_ratio, groove_half_width = values
-    length = groove_half_width
+    load, stiffness, mu, aspect_ratio, length = checked(
+        load=load,
+        stiffness=stiffness,
+        mu=mu,
+        aspect_ratio=aspect_ratio,
+        groove_half_width=groove_half_width,
+    )
     mu, kappa, lam, code = dimensionless(length, load, stiffness, mu, aspect_ratio, length)
     displacement = as_float64(displacement)
-    batch = jnp.broadcast_shapes(displacement.shape[:-1], jnp.shape(mu), jnp.shape(kappa))
-    batch = jnp.broadcast_shapes(batch, jnp.shape(lam), jnp.shape(code))
+    shapes = (jnp.shape(x) for x in (mu, kappa, lam, code))
+    batch = jnp.broadcast_shapes(displacement.shape[:-1], *shapes)
     displacement = jnp.broadcast_to(displacement, batch + displacement.shape[-1:])
     mu, kappa, lam, length, load, code = (
         jnp.broadcast_to(x, batch) for x in (mu, kappa, lam, length, load, code)
