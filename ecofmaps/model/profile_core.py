@@ -118,7 +118,11 @@ def crossing_fraction(start, length, slope_a, change, mu, lam, level):
     a = length * w1
     b = offset * w1 + length * w0 + lam * change
     c = offset * w0 + lam * (mu + slope_a)
-    root = jnp.sqrt(jnp.maximum(b * b - 4.0 * a * c, 0.0))
+    # Each branch sees safe inputs where it is not taken, so that its derivative is finite
+    # there too (a NaN times the zero weight of the branch not taken is still NaN).
+    discriminant = b * b - 4.0 * a * c
+    real = discriminant > 0.0
+    root = jnp.where(real, jnp.sqrt(jnp.where(real, discriminant, 1.0)), 0.0)
     b_positive = b > 0.0
     linear = a == 0.0
     t = jnp.where(
@@ -127,7 +131,8 @@ def crossing_fraction(start, length, slope_a, change, mu, lam, level):
         (root - b) / (2.0 * jnp.where(linear, 1.0, a)),
     )
     t = jnp.where(~b_positive & linear, 1.0, t)
-    t = jnp.where(lam == 0.0, (level - start) / length, t)
+    rigid = (lam == 0.0) & (length != 0.0)
+    t = jnp.where(rigid, (level - start) / jnp.where(rigid, length, 1.0), t)
     return jnp.clip(t, 0.0, 1.0)
 
 

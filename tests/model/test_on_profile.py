@@ -362,3 +362,27 @@ def test_a_rig_too_stiff_for_float64_is_self_locking():
         assert int(ecofmaps.slip_regime(**point)) == Regime.SELF_LOCKING
         with pytest.warns(ecofmaps.RegimeWarning, match="self-locking"):
             assert np.isnan(ecofmaps.energy_cof(**point))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("stiffness", [np.inf, STIFFNESS])
+@pytest.mark.parametrize("name", ["energy_cof", "dissipated_energy", "slip_amplitude"])
+def test_grad_on_a_profile_matches_central_differences(name, stiffness):
+    """jax.grad of the model on a W-shaped scar, with respect to the amplitude and μ, is the
+    central difference (relative step 1e-5: truncation and rounding below 1e-8 of the
+    value), on a rigid rig as on a compliant one: finite where the rig takes no deflection."""
+    profile, _ = FAMILIES["w"]
+    function = getattr(ecofmaps, name)
+
+    def value(amplitude, mu):
+        return function(amplitude, LOAD, stiffness, mu, profile=profile)
+
+    gradient = jax.grad(value, argnums=(0, 1))(AMPLITUDE, MU)
+    for index, point in enumerate((AMPLITUDE, MU)):
+        step = 1e-5 * point
+        up, down = [AMPLITUDE, MU], [AMPLITUDE, MU]
+        up[index] += step
+        down[index] -= step
+        expected = (float(value(*up)) - float(value(*down))) / (2.0 * step)
+        scale = abs(float(value(AMPLITUDE, MU))) / point
+        assert float(gradient[index]) == pytest.approx(expected, rel=1e-5, abs=1e-9 * scale)
