@@ -131,10 +131,18 @@ def _new_locks() -> None:
         column._lock = threading.Lock()
 
 
-@functools.lru_cache(maxsize=16)
+#: The columns unpickled in this process, by their arguments: held weakly, so that a column
+#: (and its open file) goes with the last task or recording that holds it.
+_UNPICKLED = weakref.WeakValueDictionary()
+
+
 def _column(path, kind, variable, factor, nan_policy, stamp) -> Column:
-    """The column of these arguments, one object per process."""
-    return Column(path, kind, variable, factor, nan_policy, stamp)
+    """The column of these arguments, one object per process while any copy is held."""
+    arguments = (path, kind, variable, factor, nan_policy, stamp)
+    column = _UNPICKLED.get(arguments)
+    if column is None:
+        column = _UNPICKLED[arguments] = Column(*arguments)
+    return column
 
 
 def _select(path: Path, kind: str, found: list[Variable], options: dict) -> dict:

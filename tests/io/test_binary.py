@@ -1,6 +1,8 @@
 """Rig formats: TDMS, HDF5 / netCDF-4 and zarr files written by their own libraries, read
 through read_recording, whole and lazily; damaged files name the file and the channel."""
 
+import contextlib
+import gc
 import itertools
 import os
 import pickle
@@ -175,12 +177,29 @@ def test_lazy_reading_is_blockwise_and_equal(tmp_path, kind):
     np.testing.assert_array_equal(np.concatenate([b.force for b in blocks]), eager.force)
     copy = pickle.loads(pickle.dumps(lazy.force))
     np.testing.assert_array_equal(copy[100:110].compute(), eager.force[100:110])
+    if kind != "zarr":  # a zarr store keeps no file open
+        assert opened_by_this_process(path)
+    del lazy, part, copy
+    gc.collect()
+    assert not opened_by_this_process(path), "the file is still open once nothing holds it"
+
+
+def opened_by_this_process(path) -> bool:
+    """Whether this process has ``path``, or a file in it, open (its descriptors are listed
+    in /proc/self/fd, as on Linux)."""
+    path = str(path.resolve())
+    for descriptor in os.listdir("/proc/self/fd"):
+        with contextlib.suppress(OSError):  # the listing's own descriptor, closed meanwhile
+            target = os.readlink(f"/proc/self/fd/{descriptor}")
+            if target == path or target.startswith(path + os.sep):
+                return True
+    return False
 
 
 def test_column_pickles_without_its_file(tmp_path):
     """A Column keeps its open file per process: a pickled copy opens its own, and every
-    copy of it unpickled in one process is that one object (one open file for all the
-    tasks a worker runs), until the file's stamp changes."""
+    copy of it unpickled in one process while one is held is that one object (one open
+    file for the tasks a worker holds), until the file's stamp changes."""
     path = write_hdf5(tmp_path / "rig.h5")
     variable = next(v for v in variables(path, "hdf5") if v.short == "force_kN")
     column = Column(path, "hdf5", variable, 1e3, "propagate", stamp=(1, 2))
