@@ -38,6 +38,10 @@ ATTRS = {role: nomenclature.attrs(role) for role in ("displacement", "force", "c
 #: The TDMS group that holds the channels written.
 TDMS_GROUP = "recording"
 
+#: The most bytes of one chunk of a zarr or HDF5 variable: HDF5 keeps a chunk this size in
+#: its cache (1 MiB per variable by default), so reads of parts of a chunk read it once.
+CHUNK_BYTES = 1 << 20
+
 
 class RecordingWriter:
     """Append blocks of samples to a new recording file or store; complete it atomically.
@@ -52,7 +56,8 @@ class RecordingWriter:
         Whether a ``cycle`` column (int64) is written too.
     chunk_samples : int
         Samples per chunk (zarr, HDF5) or per segment (TDMS); the data are written a
-        chunk at a time.
+        chunk at a time. A chunk of zarr or HDF5 holds at most :data:`CHUNK_BYTES`, and no
+        more samples than the recording, so a short recording takes the room of its samples.
     overwrite : bool
         Replace an existing ``path`` (only once the new one is complete).
     attrs : dict, optional
@@ -89,6 +94,8 @@ class RecordingWriter:
         if isinstance(chunk_samples, bool) or not int(chunk_samples) == chunk_samples > 0:
             raise ValueError(f"chunk_samples must be a positive integer; got {chunk_samples!r}")
         self.chunk = int(chunk_samples)
+        if self.format in ("zarr", "hdf5"):
+            self.chunk = min(self.chunk, CHUNK_BYTES // 8)  # float64 and int64
         self.roles = ["displacement", "force"] + (["cycle"] if cycle else [])
         self.attrs = dict(attrs or {})
         self.overwrite = overwrite
@@ -154,45 +161,52 @@ class RecordingWriter:
         self._held -= count
         self.size += count
 
+    def _first_chunks(self, arrays) -> tuple[int]:
+        """The variables' chunks, chosen at the first write: the recording's samples if fewer
+        than a chunk (the first write is then the last)."""
+        return (max(1, min(self.chunk, next(iter(arrays.values())).size)),)
+
     def _open_zarr(self, stack) -> None:
         import zarr
 
-        group = zarr.open_group(str(self._temporary), mode="w-")
-        group.attrs.update(self.attrs)
-        self._arrays = {
-            role: group.create_array(
-                role,
-                shape=(0,),
-                chunks=(self.chunk,),
-                dtype=np.int64 if role == "cycle" else np.float64,
-                fill_value=-1 if role == "cycle" else np.nan,
-                dimension_names=["sample"],
-                compressors=None,
-                attributes=ATTRS[role],
-                config={"write_empty_chunks": True},
-            )
-            for role in self.roles
-        }
+        self._handle = zarr.open_group(str(self._temporary), mode="w-")
+        self._handle.attrs.update(self.attrs)
 
     def _append_zarr(self, arrays) -> None:
+        if self.size == 0:
+            self._arrays = {
+                role: self._handle.create_array(
+                    role,
+                    shape=(0,),
+                    chunks=self._first_chunks(arrays),
+                    dtype=np.int64 if role == "cycle" else np.float64,
+                    fill_value=-1 if role == "cycle" else np.nan,
+                    dimension_names=["sample"],
+                    compressors=None,
+                    attributes=ATTRS[role],
+                    config={"write_empty_chunks": True},
+                )
+                for role in self.roles
+            }
         for role, array in arrays.items():
             self._arrays[role].append(array)
 
     def _open_hdf5(self, stack) -> None:
         import h5netcdf
 
-        self._handle = handle = stack.enter_context(h5netcdf.File(self._temporary, "w"))
-        handle.dimensions = {"sample": None}
-        handle.attrs.update(self.attrs)
-        self._arrays = {}
-        for role in self.roles:
-            dtype = np.int64 if role == "cycle" else np.float64
-            self._arrays[role] = handle.create_variable(
-                role, ("sample",), dtype, chunks=(self.chunk,)
-            )
-            self._arrays[role].attrs.update(ATTRS[role])
+        self._handle = stack.enter_context(h5netcdf.File(self._temporary, "w"))
+        self._handle.dimensions = {"sample": None}
+        self._handle.attrs.update(self.attrs)
 
     def _append_hdf5(self, arrays) -> None:
+        if self.size == 0:
+            self._arrays = {}
+            for role in self.roles:
+                dtype = np.int64 if role == "cycle" else np.float64
+                self._arrays[role] = self._handle.create_variable(
+                    role, ("sample",), dtype, chunks=self._first_chunks(arrays)
+                )
+                self._arrays[role].attrs.update(ATTRS[role])
         count = next(iter(arrays.values())).size
         self._handle.resize_dimension("sample", self.size + count)
         for role, array in arrays.items():
@@ -202,12 +216,11 @@ class RecordingWriter:
         from nptdms import TdmsWriter
 
         self._handle = stack.enter_context(TdmsWriter(str(self._temporary)))
-        self._segments = 0
 
     def _append_tdms(self, arrays) -> None:
         from nptdms import ChannelObject, GroupObject, RootObject
 
-        first = self._segments == 0
+        first = self.size == 0
         root = {k: v if isinstance(v, int | float | str) else str(v) for k, v in self.attrs.items()}
         objects = [RootObject(properties=root if first else {}), GroupObject(TDMS_GROUP)]
         for role, array in arrays.items():
@@ -215,7 +228,6 @@ class RecordingWriter:
             properties = {"unit_string": units, "description": name} if first else {}
             objects.append(ChannelObject(TDMS_GROUP, role, array, properties=properties))
         self._handle.write_segment(objects)
-        self._segments += 1
 
     def _open_text(self, stack) -> None:
         self._handle = stack.enter_context(
@@ -234,8 +246,8 @@ class RecordingWriter:
         self._handle.write("\n".join(map(",".join, zip(*cells, strict=True))) + "\n")
 
     def _finish(self) -> None:
-        if self.format == "tdms" and self._segments == 0:
-            self._append_tdms({role: np.zeros(0) for role in self.roles})
+        if self.size == 0 and self.format != "text":  # the variables or channels, empty
+            getattr(self, f"_append_{self.format}")({role: np.zeros(0) for role in self.roles})
         if self.format == "zarr":
             import zarr
 
@@ -260,7 +272,7 @@ def convert_recording(
     format : str, optional
         See :class:`RecordingWriter`; by default from the suffix.
     chunk_samples : int
-        Samples per chunk, and per block read from ``source``.
+        Samples per block read from ``source``, and per chunk (see :class:`RecordingWriter`).
     overwrite : bool
         Replace an existing ``destination`` (only once the new one is complete).
     **options

@@ -12,7 +12,7 @@ from ecofmaps.io.files import TEMPORARY_NAME, atomic_path, atomic_store
 from ecofmaps.io.recording_types import RecordingError
 from ecofmaps.io.recordings import read_recording
 from ecofmaps.io.rig_formats import variables
-from ecofmaps.io.writers import RecordingWriter, convert_recording
+from ecofmaps.io.writers import CHUNK_BYTES, RecordingWriter, convert_recording
 from ecofmaps.measured.synthetic import example_path
 
 RNG = np.random.default_rng(3)
@@ -124,6 +124,37 @@ def test_convert_csv(tmp_path, suffix):
         with xr.open_zarr(destination) as dataset:
             assert dataset.attrs["source_units"] == "displacement: µm, force: kN, cycle: 1"
             assert dataset.force.chunks[0][0] == 400
+
+
+def stored_bytes(path) -> int:
+    """The bytes of a file, or of the files of a store."""
+    if path.is_file():
+        return path.stat().st_size
+    return sum(item.stat().st_size for item in path.rglob("*") if item.is_file())
+
+
+#: Bytes a converted store may take besides its chunks: names, attributes, indexes.
+METADATA_BYTES = 64 * 1024
+
+
+@pytest.mark.parametrize("size", [8000, 300_000])
+def test_converted_stores_take_the_room_of_their_samples(tmp_path, size):
+    """Converted with the default chunks, a short recording is one chunk of its own length;
+    a long one is chunks of CHUNK_BYTES, the last one part filled. Both read back the
+    source's values."""
+    source = tmp_path / "source.tdms"
+    with RecordingWriter(source, cycle=True) as writer:
+        writer.write(RNG.normal(0.0, 3e-5, size), RNG.normal(0.0, 300.0, size), np.arange(size))
+    expected = read_recording(source)
+    chunk = min(size, CHUNK_BYTES // 8)
+    allocated = -(-size // chunk) * chunk * 3 * 8  # three columns of 8-byte numbers
+    for suffix, kind in [(".h5", "hdf5"), (".nc", "hdf5"), (".zarr", "zarr")]:
+        destination = convert_recording(source, tmp_path / f"out{suffix}")
+        assert {v.chunk for v in variables(destination, kind)} == {chunk}
+        assert stored_bytes(destination) <= allocated + METADATA_BYTES
+        read = read_recording(destination)
+        for role in ("displacement", "force", "cycle"):
+            np.testing.assert_array_equal(getattr(read, role), getattr(expected, role))
 
 
 def test_convert_failure_midway_leaves_nothing(tmp_path):
