@@ -72,6 +72,15 @@ def per_cycle(results: xr.Dataset, names) -> dict:
     return values
 
 
+def _rig(tests: list, rig_stiffness):
+    """``rig_stiffness``, else the one the tests were analysed with (``rig_stiffness`` in their
+    attrs, all the same), else None."""
+    if rig_stiffness is not None:
+        return rig_stiffness
+    given = {test.attrs.get("rig_stiffness") for test in tests}
+    return given.pop() if len(given) == 1 else None
+
+
 def _ratios(cycles: dict, rig_stiffness):
     """The cycles' energy and opening ratios (on the contact's displacement NaN without the
     rig's stiffness), the energy ratio that decides the regime, and where it says gross slip."""
@@ -95,7 +104,9 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
     rig_stiffness : float, optional
         The rig's own stiffness :math:`S` (not the loops' stick slope, which is the rig and
         the contact in series). With it the ratios are also read on the contact's
-        displacement :math:`\Delta - Q/S` and the regime is decided there. [N/m]
+        displacement :math:`\Delta - Q/S` and the regime is decided there. By default the
+        one ``results`` were analysed with (``results.attrs["rig_stiffness"]``, from
+        ``analyze_loops(..., rig_stiffness=)`` or ``--rig-stiffness``), if any. [N/m]
 
     Returns
     -------
@@ -132,7 +143,7 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
     (results,) = _tests(results)
     names = ("amplitude", "max_force", "dissipated_energy", "slip_amplitude")
     cycles = per_cycle(results, names)
-    ratios, ratio, gross = _ratios(cycles, rig_stiffness)
+    ratios, ratio, gross = _ratios(cycles, _rig([results], rig_stiffness))
     gross = np.where(np.isfinite(ratio), gross, np.nan)
     condition, changes = sliding_condition_of(cycles["cycle"], gross)
     data = {name: ("cycle", value, nomenclature.attrs(name)) for name, value in ratios.items()}
@@ -170,8 +181,8 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
         across the transition (the variable-displacement method), or of several tests at
         one load and several amplitudes.
     rig_stiffness : float, optional
-        The rig's own stiffness :math:`S`, as for :func:`sliding_condition`; without it
-        ``contact_amplitude`` is NaN. [N/m]
+        The rig's own stiffness :math:`S`, as for :func:`sliding_condition` (by default the
+        one every test was analysed with); without it ``contact_amplitude`` is NaN. [N/m]
 
     Returns
     -------
@@ -212,8 +223,10 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     16.0 µm, mu_t = 0.80
     """
     names = ("amplitude", "max_force", "dissipated_energy")
-    tests = [per_cycle(test, names) for test in _tests(results)]
-    pooled = {name: np.concatenate([t[name] for t in tests]) for name in (*names, "load")}
+    tests = _tests(results)
+    rig_stiffness = _rig(tests, rig_stiffness)
+    cycles = [per_cycle(test, names) for test in tests]
+    pooled = {name: np.concatenate([c[name] for c in cycles]) for name in (*names, "load")}
     _, ratio, gross = _ratios(pooled, rig_stiffness)
     known = np.isfinite(ratio) & np.isfinite(pooled["load"])
     order = np.argsort(pooled["amplitude"][known], kind="stable")
@@ -263,7 +276,7 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     return xr.Dataset(data)
 
 
-def _cycle_sum(cycle, value):
+def cycle_sum(cycle, value):
     """Σ of a per-cycle ``value`` over cycles 1 to the last recorded, and its standard error
     (docs/lab.md, "Energy wear")."""
     kept = np.isfinite(value)
@@ -327,10 +340,10 @@ def _one_test(results, profile, length) -> dict:
     if not np.isfinite(cycles["dissipated_energy"]).any():
         raise ValueError("results: no cycle has a dissipated energy ('dissipated_energy')")
     cycle, load = cycles["cycle"], cycles["load"]
-    energy = _cycle_sum(cycle, cycles["dissipated_energy"])
+    energy = cycle_sum(cycle, cycles["dissipated_energy"])
     volume = (area * length, _worn_area_se(profile) * length)
-    slip = _cycle_sum(cycle, 4 * load * cycles["slip_amplitude"])
-    nominal = _cycle_sum(cycle, 4 * load * cycles["amplitude"])
+    slip = cycle_sum(cycle, 4 * load * cycles["slip_amplitude"])
+    nominal = cycle_sum(cycle, 4 * load * cycles["amplitude"])
     return {
         "cumulated_energy": energy,
         "wear_volume": volume,
@@ -486,8 +499,9 @@ def loop_scar_closure(results, resolved, profile, rig_stiffness=None) -> xr.Data
         The scar's levelled profilometer trace (:func:`ecofmaps.read_scar_profile`), in
         metres, centred on the scar, which is taken to lie under the loops' centre.
     rig_stiffness : float, optional
-        The rig's stiffness :math:`S` for the model's loop; by default the stiffness the
-        reading along the stroke used (the loops' stick slope, unless given to it). [N/m]
+        The rig's stiffness :math:`S` for the model's loop; by default the one ``results``
+        were analysed with, as for :func:`sliding_condition`, else the stiffness the reading
+        along the stroke used (the loops' stick slope, unless given to it). [N/m]
 
     Returns
     -------
@@ -521,6 +535,7 @@ def loop_scar_closure(results, resolved, profile, rig_stiffness=None) -> xr.Data
     behaviour: eq. 9, 10, 17-18, Fig. 10.
     """
     loop, reading = _reading(results, resolved)
+    rig_stiffness = _rig([loop], rig_stiffness)
     _scar(profile)
     slip, width = float(loop.slip_amplitude), float(profile.half_width)
     trace = np.asarray(profile.position)

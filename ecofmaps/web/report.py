@@ -2,8 +2,9 @@
 
 Bokeh's page with its JavaScript and CSS inline, so it fetches nothing: the ECoF, the GICoF
 and the friction read along the stroke over the cycles with the quality flags and their
-counts, measured loops of a few cycles beside the model's, the table of ``ecofmaps loops``
-(sortable), and the inputs, version and date.
+counts, the lab's numbers (ΣE_d, the transition of a sweep: docs/lab.md), measured loops of
+a few cycles beside the model's, the table of ``ecofmaps loops`` (sortable), and the inputs,
+version and date.
 """
 
 from __future__ import annotations
@@ -38,6 +39,7 @@ from ecofmaps._nomenclature import QUANTITIES
 from ecofmaps._version import __version__
 from ecofmaps.io.files import atomic_path
 from ecofmaps.io.tables import results_table
+from ecofmaps.lab import cycle_sum, transition
 from ecofmaps.measured.quality import REASONS, SEPARATOR, quality_summary, sliding_condition_line
 from ecofmaps.model.simulation import fretting_loop
 
@@ -199,6 +201,7 @@ def report_document(results: xr.Dataset, *, loops=None, inputs=None):
     evolution, flags = _evolution_figures(results)
     parts = [
         _header(results, inputs or {}),
+        _lab_numbers(results),
         row(column(evolution, flags), _quality_counts(results)),
     ]
     if "loop_displacement" in results.variables:
@@ -239,6 +242,49 @@ def _header(results: xr.Dataset, inputs: Mapping) -> Div:
         "<code>ecofmaps.analyze_loops</code>. Values that cannot be stood behind are left "
         "out, and the quality flags say why.</p>"
         f"<table class='ecofmaps-inputs' style='font-size:14px'>{cells}</table>",
+        width=_WIDTH,
+    )
+
+
+def _with_se(name: str, value: float, se: float) -> tuple[str, str]:
+    """Quantity ``name``'s long name, and ``value ± se`` in its display unit: 4 significant
+    digits, the standard error 2."""
+    quantity = QUANTITIES[name]
+    value, se = value * quantity.display_factor, se * quantity.display_factor
+    shown = f"{value:#.4g}".rstrip(".") + (f" ± {se:.2g}" if np.isfinite(se) else "")
+    return quantity.long_name, f"{shown} {quantity.display_unit}".rstrip()
+
+
+def _lab_numbers(results: xr.Dataset) -> Div:
+    """The test's cumulated dissipated energy, and its transition if it crosses one."""
+    cycle = results["cycle"].values.astype(np.float64)
+    try:
+        words, energy = _with_se(
+            "cumulated_energy", *cycle_sum(cycle, results["dissipated_energy"].values)
+        )
+        rows = {words: f"{energy} over cycles 1 to {cycle[-1]:.0f}"}
+    except ValueError as error:
+        rows = {QUANTITIES["cumulated_energy"].long_name: str(error)}
+    try:
+        found = transition(results)
+    except ValueError as error:
+        rows["transition to gross slip"] = f"none: {error}"
+    else:
+        for name in ("amplitude", "contact_amplitude", "mu"):
+            values = (float(found[n]) for n in (name, f"{name}_se"))
+            words, shown = _with_se(f"transition_{name}", *values)
+            unknown = "unknown without the rig's own stiffness (--rig-stiffness)"
+            rows[words] = shown if np.isfinite(float(found[name])) else unknown
+    cells = "".join(
+        f"<tr><th style='text-align:left;padding-right:1em'>{html.escape(key)}</th>"
+        f"<td>{html.escape(value)}</td></tr>"
+        for key, value in rows.items()
+    )
+    return Div(
+        text="<h3 style='margin:8px 0 4px 0'>The lab's numbers (<code>ecofmaps.transition"
+        "</code>, <code>ecofmaps.energy_wear</code>; with a scar profile, <code>ecofmaps wear"
+        "</code> gives the wear volume)</h3>"
+        f"<table class='ecofmaps-lab' style='font-size:14px'>{cells}</table>",
         width=_WIDTH,
     )
 
