@@ -16,14 +16,20 @@ from tests.lab_cases import ALPHA, CYCLES, DELTA_T, HALF_WIDTH, LENGTH, LOAD, MU
 RIGS = (15e6, 35e6, 100e6)
 
 
-def _analysed(amplitudes, stiffness, mu=MU, delta_t=DELTA_T, samples=200):
+def _analysed(amplitudes, stiffness, mu=MU, delta_t=DELTA_T, samples=200, **options):
     """analyze_loops of the oracle driven through one cycle at each amplitude."""
     contact = mindlin.Contact(mu, LOAD, delta_t)
     applied = mindlin.sweep(amplitudes, samples)
     _, force = mindlin.drive(contact, applied, stiffness)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # a sphere's stick is curved: flagged, as it should
-        return ecofmaps.analyze_loops(applied, force, LOAD)
+        return ecofmaps.analyze_loops(applied, force, LOAD, **options)
+
+
+def _sweep(stiffness, **options):
+    """The variable-displacement method: 0.45 to 1.8 Δ_t, each amplitude held two cycles."""
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    return _analysed(np.repeat(np.linspace(0.45, 1.8, 20) * at, 2), stiffness, **options)
 
 
 def _campaign(stiffness, factors=(0.5, 0.7, 0.85, 0.95, 1.05, 1.2, 1.5, 1.8)):
@@ -54,15 +60,32 @@ def test_transition_on_the_applied_displacement_lands_high():
 
 @pytest.mark.parametrize("stiffness", RIGS)
 def test_transition_from_a_sweep(stiffness):
-    """The variable-displacement method: 0.45 to 1.8 Δ_t, each amplitude held two cycles."""
     at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
-    results = _analysed(np.repeat(np.linspace(0.45, 1.8, 20) * at, 2), stiffness)
+    results = _sweep(stiffness)
     found = ecofmaps.transition(results, rig_stiffness=stiffness)
     assert float(found.amplitude) == pytest.approx(at, rel=0.05)
     assert float(found.mu) == pytest.approx(MU, rel=0.03)
     condition = ecofmaps.sliding_condition(results, rig_stiffness=stiffness)
     assert condition.attrs["sliding_condition"] == "mixed slip"
     assert condition.attrs["regime_changes_at"].size >= 1
+
+
+def test_the_rig_stiffness_the_results_were_analysed_with_is_the_default():
+    """analyze_loops(..., rig_stiffness=S) keeps S in the attrs; an argument overrides it."""
+    stiffness = 35e6
+    results = _sweep(stiffness, rig_stiffness=stiffness)
+    assert results.attrs["rig_stiffness"] == stiffness
+    bare = results.drop_attrs(deep=False)
+    for lab in (ecofmaps.sliding_condition, ecofmaps.transition):
+        xr.testing.assert_identical(lab(results), lab(bare, stiffness))
+        xr.testing.assert_identical(lab(results, 100e6), lab(bare, 100e6))
+    found = ecofmaps.transition(results)
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    assert float(found.amplitude) == pytest.approx(at, rel=0.05)
+    assert float(found.contact_amplitude) == pytest.approx(DELTA_T, rel=0.1)
+    # none given, none recorded: on the applied displacement, as it always was
+    assert np.isnan(float(ecofmaps.transition(bare).contact_amplitude))
+    assert np.isnan(ecofmaps.sliding_condition(bare).contact_energy_ratio).all()
 
 
 @pytest.mark.parametrize("factor, condition", [(0.7, "partial slip"), (1.5, "gross slip")])

@@ -5,6 +5,7 @@ import warnings
 
 import numpy as np
 import pytest
+import xarray as xr
 
 import ecofmaps
 
@@ -54,6 +55,15 @@ def test_the_measured_stick_slope_closes_too(loops):
     closure = ecofmaps.loop_scar_closure(*loops, _profile())
     assert float(closure.stiffness) == STIFFNESS
     assert float(closure.loop_residual) < 5e-3
+
+
+def test_the_rig_stiffness_the_results_were_analysed_with_is_the_default(loops):
+    results, resolved = loops
+    analysed = results.assign_attrs(rig_stiffness=2 * STIFFNESS)
+    wrong = ecofmaps.loop_scar_closure(results, resolved, _profile(), rig_stiffness=2 * STIFFNESS)
+    xr.testing.assert_identical(ecofmaps.loop_scar_closure(analysed, resolved, _profile()), wrong)
+    given = ecofmaps.loop_scar_closure(analysed, resolved, _profile(), rig_stiffness=STIFFNESS)
+    assert float(given.stiffness) == STIFFNESS and float(given.loop_residual) < 5e-3
 
 
 @pytest.mark.parametrize(
