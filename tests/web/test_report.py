@@ -6,6 +6,7 @@ import csv
 import html
 import io
 import re
+import warnings
 
 import numpy as np
 import pytest
@@ -84,8 +85,7 @@ def test_the_page_fetches_nothing_once_panel_is_imported(results, tmp_path):
 
 
 def test_the_page_gives_the_inputs_version_and_flag_meanings(results):
-    document = report_document(results, inputs=INPUTS)
-    text = html.unescape("".join(div.text for div in document.select({"type": Div})))
+    text = _texts(report_document(results, inputs=INPUTS))
     for label, value in INPUTS.items():
         assert f"{label}</th><td>{value}<" in text
     assert ecofmaps.__version__ in text
@@ -101,6 +101,44 @@ def test_the_page_gives_the_inputs_version_and_flag_meanings(results):
             f"<code>{reason}</code></td><td style='text-align:right;padding:0 8px'>{count}<" in text
         )
         assert REASONS[reason][0] in text
+
+
+def _texts(document) -> str:
+    return html.unescape("".join(div.text for div in document.select({"type": Div})))
+
+
+def test_a_sweep_across_the_transition_shows_it():
+    """A Mindlin sphere swept from 0.45 to 1.8 Δ_t on a rig whose stiffness was given."""
+    from tests import mindlin
+    from tests.lab_cases import DELTA_T, LOAD, MU
+
+    stiffness = 35e6
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    applied = mindlin.sweep(np.repeat(np.linspace(0.45, 1.8, 20) * at, 2))
+    _, force = mindlin.drive(mindlin.Contact(MU, LOAD, DELTA_T), applied, stiffness)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        sweep = ecofmaps.analyze_loops(applied, force, LOAD, rig_stiffness=stiffness)
+    text = _texts(report_document(sweep))
+    number = r"(\d+\.\d+) ± \d\.?\d*"
+    shown = {
+        "Δ_t": (at * 1e6, rf"transition displacement amplitude Δ_t</th><td>{number} µm<"),
+        "δ_t": (DELTA_T * 1e6, rf"contact's transition amplitude δ_t</th><td>{number} µm<"),
+        "μ_t": (MU, rf"at the transition μ_t = Q\*/P</th><td>{number}<"),
+    }
+    for symbol, (truth, pattern) in shown.items():
+        assert float(re.search(pattern, text)[1]) == pytest.approx(truth, rel=0.05), symbol
+    assert "cumulated dissipated energy ΣE_d</th><td>" in text and "mixed slip" in text
+
+
+def test_a_constant_amplitude_says_there_is_no_transition(results):
+    text = _texts(report_document(results))
+    assert "transition to gross slip</th><td>none: results never cross the transition" in text
+    energy = re.search(r"ΣE_d</th><td>(\d\.\d+) ± [\d.e-]+ J over cycles 1 to 40<", text)
+    cycle, energy_per_cycle = results.cycle.values, results.dissipated_energy.values
+    kept = np.isfinite(energy_per_cycle)  # the damaged cycle's refused: read between its two
+    total = np.interp(cycle, cycle[kept], energy_per_cycle[kept]).sum()
+    assert float(energy[1]) == pytest.approx(total, rel=1e-3)
 
 
 def test_the_page_carries_some_loops_and_the_model(results):
