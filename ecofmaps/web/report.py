@@ -222,6 +222,16 @@ def _label(name: str) -> str:
     return f"{text} [{quantity.axis_unit or quantity.display_unit or '1'}]"
 
 
+def _rows_table(rows: Mapping, css_class: str) -> str:
+    """An HTML table of ``rows``, a name and its value on each row."""
+    cells = "".join(
+        f"<tr><th style='text-align:left;padding-right:1em'>{html.escape(str(key))}</th>"
+        f"<td>{html.escape(str(value))}</td></tr>"
+        for key, value in rows.items()
+    )
+    return f"<table class='{css_class}' style='font-size:14px'>{cells}</table>"
+
+
 def _header(results: xr.Dataset, inputs: Mapping) -> Div:
     """The title, the inputs, the version and date, and the summary of the quality."""
     rows = dict(inputs)
@@ -229,29 +239,28 @@ def _header(results: xr.Dataset, inputs: Mapping) -> Div:
     rows["written"] = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
     rows["cycles"] = quality_summary(results["quality"].values)
     rows["sliding condition"] = sliding_condition_line(results)
-    cells = "".join(
-        f"<tr><th style='text-align:left;padding-right:1em'>{html.escape(str(key))}</th>"
-        f"<td>{html.escape(str(value))}</td></tr>"
-        for key, value in rows.items()
-    )
     return Div(
         text="<h1 style='margin:8px 0 4px 0;font-size:22px'>Fretting test: friction cycle by "
         "cycle</h1><p style='margin:0 0 6px 0;max-width:1100px'>ECoF μ_E = E_d/(4Pδ*) "
         "(eq. 1), GICoF = Q/P at the centre of the slip, where the loop crosses Q = SΔ "
         "(eq. 17-18; a fit over its central 70 %), and μ read along the stroke, from "
         "<code>ecofmaps.analyze_loops</code>. Values that cannot be stood behind are left "
-        "out, and the quality flags say why.</p>"
-        f"<table class='ecofmaps-inputs' style='font-size:14px'>{cells}</table>",
+        "out, and the quality flags say why.</p>" + _rows_table(rows, "ecofmaps-inputs"),
         width=_WIDTH,
     )
 
 
 def _with_se(name: str, value: float, se: float) -> tuple[str, str]:
     """Quantity ``name``'s long name, and ``value ± se`` in its display unit: 4 significant
-    digits, the standard error 2."""
+    digits, the standard error 2, never in powers of ten."""
     quantity = QUANTITIES[name]
-    value, se = value * quantity.display_factor, se * quantity.display_factor
-    shown = f"{value:#.4g}".rstrip(".") + (f" ± {se:.2g}" if np.isfinite(se) else "")
+    value, se = (
+        np.format_float_positional(
+            number * quantity.display_factor, digits, unique=False, fractional=False, trim=trim
+        )
+        for number, digits, trim in ((value, 4, "k"), (se, 2, "-"))
+    )
+    shown = value.rstrip(".") + ("" if se == "nan" else f" ± {se}")
     return quantity.long_name, f"{shown} {quantity.display_unit}".rstrip()
 
 
@@ -273,18 +282,15 @@ def _lab_numbers(results: xr.Dataset) -> Div:
         for name in ("amplitude", "contact_amplitude", "mu"):
             values = (float(found[n]) for n in (name, f"{name}_se"))
             words, shown = _with_se(f"transition_{name}", *values)
-            unknown = "unknown without the rig's own stiffness (--rig-stiffness)"
+            unknown = (
+                "unknown without the rig's own stiffness (--rig-stiffness), without which Δ_t "
+                "is read on the applied displacement, and lands high"
+            )
             rows[words] = shown if np.isfinite(float(found[name])) else unknown
-    cells = "".join(
-        f"<tr><th style='text-align:left;padding-right:1em'>{html.escape(key)}</th>"
-        f"<td>{html.escape(value)}</td></tr>"
-        for key, value in rows.items()
-    )
     return Div(
         text="<h3 style='margin:8px 0 4px 0'>The lab's numbers (<code>ecofmaps.transition"
         "</code>, <code>ecofmaps.energy_wear</code>; with a scar profile, <code>ecofmaps wear"
-        "</code> gives the wear volume)</h3>"
-        f"<table class='ecofmaps-lab' style='font-size:14px'>{cells}</table>",
+        "</code> gives the wear volume)</h3>" + _rows_table(rows, "ecofmaps-lab"),
         width=_WIDTH,
     )
 
