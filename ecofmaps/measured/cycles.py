@@ -12,6 +12,8 @@ import numpy as np
 from ecofmaps.measured import samples as passes
 from ecofmaps.measured.samples import (
     Samples,
+    blanked,
+    detrended,
     displacement_line,
     displacement_percentiles,
     ends_of_runs,
@@ -20,6 +22,7 @@ from ecofmaps.measured.samples import (
     level_at,
     local_extremes,
     missing_in,
+    piece_extremes,
     survey,
     trigger_runs,
 )
@@ -30,13 +33,10 @@ __all__ = ["MIN_SAMPLES", "Cycles", "find_cycles", "labelled_cycles", "split_cyc
 #: The one definition for the analysis, the fit and the synthetic recordings.
 MIN_SAMPLES = 8
 
-
 #: The least local half-band of the reversal detector, as a share of the whole recording's.
 _LEAST_LEVEL = 0.05
-
 #: A stretch between bottom runs within this share of the period is one regular cycle.
 _REGULAR = 0.1
-
 #: A recording longer than this with fewer than two bottom reversals is not read as one loop.
 _ONE_LOOP = 1 << 24
 
@@ -94,27 +94,10 @@ class Cycles:
         return start[:, None] + position, self.count[rows] + 1
 
 
-# --- the passes over the samples, a block at a time ----------------------------------------
-
-
-# --- the trigger restarted after a gap -------------------------------------------------------
-
-
-def _without_missing(x, a: int, b: int, gaps) -> np.ndarray:
-    """``x`` (samples ``a`` to ``b - 1``) with NaN at the samples of ``gaps`` (a copy)."""
-    x = np.array(x, dtype=np.float64)
-    first, last = np.searchsorted(gaps[:, 1], a, side="right"), np.searchsorted(gaps[:, 0], b)
-    for begin, end in gaps[first:last]:
-        x[max(begin, a) - a : min(end, b) - a] = np.nan
-    return x
-
-
 def _extremes_of_parts(start, stop, arguments, x):
-    """The extremes of the parts of runs ``[begin, end)`` that lie in the block, a chunk at a
-    time: one column per piece of a part in a chunk, holding the part's number, its largest
-    finite displacement and the first sample of it, its smallest and the first sample of it,
-    and the largest and smallest detrended displacement (NaN and -1 where none is finite)."""
-    chunk, gaps, (mean, mean_t, slope, middle), begin, end = arguments
+    """Per piece of a part ``[begin, end)`` in a chunk: the part, its highest and lowest
+    displacement with their first samples, and its highest and lowest detrended one."""
+    chunk, gaps, line, begin, end = arguments
     found = [np.empty((7, 0))]
     for a in range(start, stop, chunk):
         b = min(a + chunk, stop)
@@ -126,23 +109,11 @@ def _extremes_of_parts(start, stop, arguments, x):
         cuts = np.unique(np.concatenate([[0], lower, upper]))
         cuts = cuts[cuts < b - a]
         at = np.searchsorted(cuts, lower)  # the piece of each part
-        xa = _without_missing(x[a - start : b - start], a, b, gaps)
-        # As the trigger detrends: the same operations, so the same bits.
-        trend = np.arange(a - middle, b - middle)
-        if mean_t != 0.0:
-            trend -= mean_t
-        trend *= slope
-        detrended = xa - mean
-        detrended -= trend
-        lengths = np.diff(cuts, append=b - a)
-        columns = [part.astype(np.float64)]
-        for reduce in (np.fmax, np.fmin):
-            value = reduce.reduceat(xa, cuts)
-            index = np.where(xa == np.repeat(value, lengths), np.arange(b - a), b - a)
-            index = np.minimum.reduceat(index, cuts)
-            columns += [value[at], np.where(index[at] < b - a, index[at] + a, -1)]
-        columns += [np.fmax.reduceat(detrended, cuts)[at], np.fmin.reduceat(detrended, cuts)[at]]
-        found.append(np.stack(columns))
+        xa = blanked(np.asarray(x[a - start : b - start], dtype=np.float64), a, b, gaps)
+        d = detrended(xa, a, line)
+        extremes = [e[at] for e in piece_extremes(xa, cuts, a)]
+        ranges = [np.fmax.reduceat(d, cuts)[at], np.fmin.reduceat(d, cuts)[at]]
+        found.append(np.stack([part.astype(np.float64), *extremes, *ranges]))
     return np.concatenate(found, axis=1)
 
 
@@ -217,29 +188,24 @@ def _decided_earlier_in_run(decided, run_of):
 
 
 def _period(starts, kind) -> float:
-    """The drive's period: the median distance between the starts of the bottom runs
-    (NaN with fewer than two). [1]"""
+    """The median distance between the starts of the bottom runs (NaN with fewer than two)."""
     low = starts[kind < 0]
     return float(np.median(np.diff(low))) if low.size > 1 else np.nan
 
 
 def _values_at(start, stop, arguments, x):
-    """The displacements at the samples ``at`` (sorted) that lie in the block (NaN where
-    missing)."""
+    """The displacements at the samples ``at`` (sorted) in the block (NaN where missing)."""
     gaps, at = arguments
     at = at[(at >= start) & (at < stop)]
     if not at.size:
         return np.empty(0)
-    return _without_missing(x[at[0] - start : at[-1] + 1 - start], at[0], at[-1] + 1, gaps)[
-        at - at[0]
-    ]
+    stretch = np.asarray(x[at[0] - start : at[-1] + 1 - start], dtype=np.float64)
+    return blanked(stretch, at[0], at[-1] + 1, gaps)[at - at[0]]
 
 
 def _hidden_by_gaps(parts, samples, gaps, margin):
-    """Which extremes of the runs' parts may lie where the samples stop rather than where
-    the displacement turns: within its part, a long gap follows (or precedes) the extreme
-    and the sample next to the gap is within ``margin`` of it, so the displacement may
-    have gone on beyond it in the gap."""
+    """Which extremes of the runs' parts lie within ``margin`` of a sample beside a long gap
+    in their part (the displacement may have gone on beyond them in the gap)."""
     begin, extreme, value = parts
     gaps, long = gaps
     if not long.size:
@@ -310,10 +276,7 @@ def _with_missing(cycles: Cycles, gaps) -> Cycles:
 
 
 def _drive_numbers(cycles: Cycles) -> Cycles:
-    """``cycles`` (cut at the reversals) numbered as the drive made them: a stretch that
-    holds missing samples over more than one period (a gap that swallowed reversals) counts
-    the periods it spans, the median stretch of the cycles without missing samples, so the
-    cycles after a gap keep their numbers and the gap leaves a hole in the numbering."""
+    """``cycles`` numbered as the drive made them: a gapped stretch counts its periods."""
     if cycles.missing is None or cycles.missing.all():
         return cycles
     period = float(np.median(cycles.count[~cycles.missing] - 1))
@@ -325,8 +288,7 @@ def _drive_numbers(cycles: Cycles) -> Cycles:
 
 
 def _trigger(samples: Samples, gaps, line, band):
-    """The Schmitt trigger's runs over the recording: first sample, kind (+1 high, -1 low),
-    extreme (a sample) and its displacement."""
+    """The trigger's runs: first sample, kind (+1 high, -1 low), extreme and its value."""
     found = samples.map(trigger_runs, ("displacement",), (passes._CHUNK, gaps, line, band))
     # A run begins where the state (+1 above the band, -1 below it, 0 inside) differs from
     # the last one decided; samples before the first decision take that first one. The 99th
@@ -356,19 +318,8 @@ def _trigger(samples: Samples, gaps, line, band):
 
 
 def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, half_range: float):
-    """The trigger's half-band against the local amplitude, or None where the whole
-    recording's, ``hysteresis`` times its ``half_range`` [m], finds every cycle.
-
-    When the drive is periodic (``runs``: the first trigger's starts and kinds, and the
-    period; half the stretches between bottom runs, and at least four, within
-    ``_REGULAR`` of the period) and a stretch between them, or before the first or after
-    the last, is longer than 1.5 periods, smaller cycles may lie inside the band. The band
-    is then ``hysteresis`` times the half-range of the displacement over the
-    stretch of a period (counted from sample 0) that holds the sample and the stretches
-    either side, so over at least a period each side; never more than ``level`` nor less
-    than ``_LEAST_LEVEL`` of the whole recording's. A recording of one amplitude keeps the
-    whole recording's band everywhere.
-    """
+    """The trigger's local half-band ``(width, levels)``, or None where the whole
+    recording's finds every cycle."""
     starts, kind, period = runs
     bottoms = starts[kind < 0]
     regular = np.abs(np.diff(bottoms) / period - 1.0) <= _REGULAR
@@ -396,16 +347,7 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, half_ran
 
 
 def _drive_cycles(bottoms, tops, n: int) -> Cycles:
-    """Cycles cut where the drive's cycles meet, for a recording whose amplitude varies.
-
-    A drive that changes its amplitude from one cycle to the next does so between a bottom
-    reversal and the next top (a sine's cycle runs from its upward crossing of the centre);
-    cut at a bottom reversal, the loop would begin a quarter period early, at the previous
-    amplitude. Each cycle runs from the sample half way between a bottom reversal and the
-    next top to the same point of the next pair, both included, and its loop begins at its
-    bottom reversal (``rotation``). A bottom without a top before the next bottom (beside a
-    gap) ends no cycle: the stretch is dropped and counted.
-    """
+    """Cycles cut half way between a bottom reversal and the next top (the amplitude varies)."""
     none = np.zeros(0, dtype=np.int64)
     if not tops.size:
         return Cycles(none, none, none, none, False, 1, n)
@@ -572,8 +514,7 @@ def labelled_cycles(displacement, cycle, tolerance: float = 0.01) -> Cycles:
 
 
 def _check_labels(label: np.ndarray) -> None:
-    """A ValueError naming the first sample whose cycle number is not whole, or the first
-    number given to two runs of samples apart (a counter reset): cycles would share it."""
+    """Raise for a cycle number that is not whole, or given to two runs of samples apart."""
     known = np.flatnonzero(np.isfinite(label)) if label.dtype.kind == "f" else None
     values = label if known is None else label[known]
     instead = "--cycle-col none, or cycle=None, cuts the cycles at the reversals instead"
