@@ -94,6 +94,11 @@ class Cycles:
         return start[:, None] + position, self.count[rows] + 1
 
 
+def _joined(samples: Samples, function, arguments, channels=("displacement",), extra=0):
+    """What ``function`` found in each block of ``samples``, joined in order."""
+    return np.concatenate(samples.map(function, channels, arguments, extra), axis=-1)
+
+
 def _extremes_of_parts(start, stop, arguments, x):
     """Per piece of a part ``[begin, end)`` in a chunk: the part, its highest and lowest
     displacement with their first samples, and its highest and lowest detrended one."""
@@ -120,35 +125,27 @@ def _extremes_of_parts(start, stop, arguments, x):
 def _parts_after_gaps(samples, gaps, line, band, runs):
     """The trigger's runs cut where samples resume after a long gap inside them."""
     starts, kind, extreme, value = runs
-    identity = np.arange(starts.size)
     gaps, long = gaps
     long = long[long[:, 1] < samples.size]
     inside = np.searchsorted(starts, long[:, 1], side="right") - 1
     cut = long[starts[inside] < long[:, 0], 1]
     if not cut.size:
-        return identity, starts, extreme, value
+        return np.arange(starts.size), starts, extreme, value
     part_start = np.union1d(starts, cut)
     part_run = np.searchsorted(starts, part_start, side="right") - 1
     affected = np.isin(part_run, part_run[np.isin(part_start, cut)])
-    begin = part_start[affected]
+    begin, run_of = part_start[affected], part_run[affected]
     end = np.append(part_start, samples.size)[1:][affected]
-    pieces = np.concatenate(
-        samples.map(
-            _extremes_of_parts,
-            ("displacement",),
-            (passes._CHUNK, gaps, line, begin, end),
-        ),
-        axis=1,
+    arguments = (passes._CHUNK, gaps, line, begin, end)
+    part, highest, top, lowest, bottom, most, least = _joined(
+        samples, _extremes_of_parts, arguments
     )
-    part, highest, top, lowest, bottom, most, least = pieces
     part = part.astype(np.int64)
     first_piece = np.searchsorted(part, np.arange(begin.size))
-    high = np.fmax.reduceat(highest, first_piece)
-    low = np.fmin.reduceat(lowest, first_piece)
     centre, level = band
     if isinstance(level, tuple):  # a local band: its level where each part begins
         level = level_at(level, begin)
-    own = kind[part_run[affected]]
+    own = kind[run_of]
     decided = np.where(
         own > 0,
         np.fmax.reduceat(most, first_piece) > centre + level,
@@ -156,18 +153,16 @@ def _parts_after_gaps(samples, gaps, line, band, runs):
     )
     # A part that decides nothing (inside the band) joins the part before it in its run,
     # or the one after it if it comes first.
-    run_of = part_run[affected]
     before = np.concatenate([[False], run_of[1:] == run_of[:-1]])
-    decided_before = _decided_earlier_in_run(decided, run_of)
-    new_group = ~before | (decided & decided_before)
-    group = np.cumsum(new_group) - 1
+    new_group = ~before | (decided & _decided_earlier_in_run(decided, run_of))
     first_part = np.flatnonzero(new_group)
-    piece_group = group[part]
-    high, low = np.fmax.reduceat(high, first_part), np.fmin.reduceat(low, first_part)
-    group_kind = own[first_part]
-    group_value = np.where(group_kind > 0, high, low)
+    piece_group = (np.cumsum(new_group) - 1)[part]
+    high = np.fmax.reduceat(np.fmax.reduceat(highest, first_piece), first_part)
+    low = np.fmin.reduceat(np.fmin.reduceat(lowest, first_piece), first_part)
+    rising = own[first_part] > 0
+    group_value = np.where(rising, high, low)
     group_extreme = np.where(
-        group_kind > 0,
+        rising,
         first_of_runs(piece_group, highest, top, high),
         first_of_runs(piece_group, lowest, bottom, low),
     )
@@ -214,9 +209,7 @@ def _hidden_by_gaps(parts, samples, gaps, margin):
     edges = np.stack([long[:, 0] - 1, long[:, 1]], axis=1).ravel()  # the samples beside
     inside = (edges >= 0) & (edges < samples.size)
     at_edges = np.full(edges.size, np.nan)
-    at_edges[inside] = np.concatenate(
-        samples.map(_values_at, ("displacement",), (gaps, edges[inside]))
-    )
+    at_edges[inside] = _joined(samples, _values_at, (gaps, edges[inside]))
     before_gap, after_gap = at_edges[0::2], at_edges[1::2]
     hidden = np.zeros(extreme.size, dtype=bool)
     following = np.searchsorted(long[:, 0], extreme, side="right")
@@ -258,9 +251,6 @@ def _accepted_reversals(parts, hidden, edges, scale):
     outer = kind[twins] * (value[twins + 1] - value[twins]) > 0
     accepted[np.where(outer, twins, twins + 1)] = False
     return accepted
-
-
-# --- joining the passes ----------------------------------------------------------------------
 
 
 def _with_missing(cycles: Cycles, gaps) -> Cycles:
@@ -328,11 +318,8 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, half_ran
     if np.diff(bottoms, prepend=0, append=samples.size).max() <= 1.5 * period:
         return None
     width = max(int(period), MIN_SAMPLES)
-    pieces = np.concatenate(
-        samples.map(local_extremes, ("displacement",), (passes._CHUNK, gaps, line, width)),
-        axis=1,
-    )
-    stretch, highest, lowest = pieces
+    arguments = (passes._CHUNK, gaps, line, width)
+    stretch, highest, lowest = _joined(samples, local_extremes, arguments)
     first = np.flatnonzero(np.diff(stretch, prepend=-1.0))
     highest, lowest = np.fmax.reduceat(highest, first), np.fmin.reduceat(lowest, first)
     around = [np.pad(v, 1, mode="edge") for v in (highest, lowest)]
@@ -401,22 +388,14 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     # A gap shorter than half the samples beyond the band in a half period of a triangle
     # wave cannot have hidden a run of the other kind: the trigger goes on over it.
     long_gaps = gaps[gaps[:, 1] - gaps[:, 0] >= 0.25 * (1.0 - hysteresis) * period]
-    run, begin_of_part, extreme_of_part, value_of_part = _parts_after_gaps(
-        samples, (gaps, long_gaps), line, band, (starts, kind, extreme, value),
-    )  # fmt: skip
-    kind_of_part = kind[run]
+    gapped, margin = (gaps, long_gaps), tolerance * stroke
+    parts = _parts_after_gaps(samples, gapped, line, band, (starts, kind, extreme, value))
+    kind_of_part, extreme_of_part = kind[parts[0]], parts[2]
     # Beside a long gap, as at the ends of the recording: an extreme within the tolerance of
     # the sample next to the gap may lie where the samples stop.
-    hidden = _hidden_by_gaps(
-        (begin_of_part, extreme_of_part, value_of_part), samples, (gaps, long_gaps),
-        tolerance * stroke,
-    )  # fmt: skip
-    accepted = _accepted_reversals(
-        (run, kind_of_part, extreme_of_part, value_of_part),
-        hidden,
-        (finite[0][0], finite[-1][1]),
-        (tolerance * stroke, 0.5 * period),
-    )
+    hidden = _hidden_by_gaps(parts[1:], samples, gapped, margin)
+    edges, scale = (finite[0][0], finite[-1][1]), (margin, 0.5 * period)
+    accepted = _accepted_reversals((parts[0], kind_of_part, *parts[2:]), hidden, edges, scale)
     bottoms = extreme_of_part[(kind_of_part < 0) & accepted]
     if bottoms.size < 2:
         # Not two bottom reversals: the recording may still be one closed loop that starts
@@ -457,12 +436,8 @@ def _labelled(samples: Samples, tolerance: float) -> Cycles:
         carries[a] = carry
         if pair is not None:
             carry = pair[1]
-    pieces = np.concatenate(
-        samples.map(
-            labelled_runs, ("displacement", "cycle"), (passes._CHUNK, gaps, carries), extra=1
-        ),
-        axis=1,
-    )
+    arguments, channels = (passes._CHUNK, gaps, carries), ("displacement", "cycle")
+    pieces = _joined(samples, labelled_runs, arguments, channels, extra=1)
     piece_start, label, size, highest, lowest, bottom, x_first, x_last, step = pieces
     new = np.concatenate([[True], label[1:] != label[:-1]])
     first_piece = np.flatnonzero(new)
@@ -471,7 +446,6 @@ def _labelled(samples: Samples, tolerance: float) -> Cycles:
     count = np.add.reduceat(size, first_piece).astype(np.int64)
     top = np.fmax.reduceat(highest, first_piece)
     floor = np.fmin.reduceat(lowest, first_piece)
-    has = np.isfinite(floor)
     lowest_at = first_of_runs(run, lowest, bottom, floor)
     valued = np.isfinite(x_first)
     begin = ends_of_runs(run, valued, x_first, starts.size, first=True)
@@ -479,7 +453,7 @@ def _labelled(samples: Samples, tolerance: float) -> Cycles:
     largest = np.fmax.reduceat(step, first_piece)
     stroke = top - floor
     gap = np.abs(end - begin)
-    typical = np.nanmedian(stroke) if has.any() else np.nan
+    typical = np.nanmedian(stroke) if np.isfinite(floor).any() else np.nan
     complete = (
         (count >= MIN_SAMPLES)
         & (stroke >= 0.5 * typical)
