@@ -57,11 +57,6 @@ class Cycles:
     first_missing: int = -1
 
     @property
-    def width(self) -> int:
-        """Points round the longest loop, the closing point included. [1]"""
-        return int(self.count.max()) + 1 if self.count.size else 1
-
-    @property
     def whole(self) -> np.ndarray:
         """True for the cycles without a missing sample."""
         if self.missing is None:
@@ -79,12 +74,10 @@ class Cycles:
             missing=None if self.missing is None else self.missing[rows],
         )
 
-    def indices(self, rows=slice(None), width=None):
+    def indices(self, rows=slice(None)):
         """Sample indices round the loops ``rows``, one padded row per loop."""
         start, count, rotation = self.start[rows], self.count[rows], self.rotation[rows]
-        if width is None:
-            width = int(count.max()) + 1
-        j = np.arange(width)[None, :]
+        j = np.arange(int(count.max()) + 1)[None, :]
         if self.continuous:  # no rotation: the stretch, then its first sample again
             return start[:, None] + np.where(j < count[:, None], j, 0), count + 1
         count, rotation = count[:, None], rotation[:, None]
