@@ -10,22 +10,7 @@ import dataclasses
 import numpy as np
 
 from ecofmaps.measured import samples as passes
-from ecofmaps.measured.samples import (
-    Samples,
-    blanked,
-    detrended,
-    displacement_line,
-    displacement_percentiles,
-    ends_of_runs,
-    first_of_runs,
-    labelled_runs,
-    level_at,
-    local_extremes,
-    missing_in,
-    piece_extremes,
-    survey,
-    trigger_runs,
-)
+from ecofmaps.measured.samples import Samples
 
 __all__ = ["MIN_SAMPLES", "Cycles", "find_cycles", "labelled_cycles", "split_cycles"]
 
@@ -107,9 +92,9 @@ def _extremes_of_parts(start, stop, arguments, x):
         cuts = np.unique(np.concatenate([[0], lower, upper]))
         cuts = cuts[cuts < b - a]
         at = np.searchsorted(cuts, lower)  # the piece of each part
-        xa = blanked(np.asarray(x[a - start : b - start], dtype=np.float64), a, b, gaps)
-        d = detrended(xa, a, line)
-        extremes = [e[at] for e in piece_extremes(xa, cuts, a)]
+        xa = passes.blanked(np.asarray(x[a - start : b - start], dtype=np.float64), a, b, gaps)
+        d = passes.detrended(xa, a, line)
+        extremes = [e[at] for e in passes.piece_extremes(xa, cuts, a)]
         ranges = [np.fmax.reduceat(d, cuts)[at], np.fmin.reduceat(d, cuts)[at]]
         found.append(np.stack([part.astype(np.float64), *extremes, *ranges]))
     return np.concatenate(found, axis=1)
@@ -137,7 +122,7 @@ def _parts_after_gaps(samples, gaps, line, band, runs):
     first_piece = np.searchsorted(part, np.arange(begin.size))
     centre, level = band
     if isinstance(level, tuple):  # a local band: its level where each part begins
-        level = level_at(level, begin)
+        level = passes.level_at(level, begin)
     own = kind[run_of]
     decided = np.where(
         own > 0,
@@ -156,8 +141,8 @@ def _parts_after_gaps(samples, gaps, line, band, runs):
     group_value = np.where(rising, high, low)
     group_extreme = np.where(
         rising,
-        first_of_runs(piece_group, highest, top, high),
-        first_of_runs(piece_group, lowest, bottom, low),
+        passes.first_of_runs(piece_group, highest, top, high),
+        passes.first_of_runs(piece_group, lowest, bottom, low),
     )
     kept = ~affected
     kept[np.flatnonzero(affected)[first_part]] = True
@@ -188,7 +173,7 @@ def _values_at(start, stop, arguments, x):
     if not at.size:
         return np.empty(0)
     stretch = np.asarray(x[at[0] - start : at[-1] + 1 - start], dtype=np.float64)
-    return blanked(stretch, at[0], at[-1] + 1, gaps)[at - at[0]]
+    return passes.blanked(stretch, at[0], at[-1] + 1, gaps)[at - at[0]]
 
 
 def _hidden_by_gaps(parts, samples, gaps, margin):
@@ -204,18 +189,13 @@ def _hidden_by_gaps(parts, samples, gaps, margin):
     at_edges = np.full(edges.size, np.nan)
     at_edges[inside] = _joined(samples, _values_at, (gaps, edges[inside]))
     before_gap, after_gap = at_edges[0::2], at_edges[1::2]
-    hidden = np.zeros(extreme.size, dtype=bool)
-    following = np.searchsorted(long[:, 0], extreme, side="right")
-    has = following < long.shape[0]
-    following = np.minimum(following, long.shape[0] - 1)
-    has &= long[following, 0] < end
-    hidden |= has & (np.abs(before_gap[following] - value) < margin)
-    preceding = np.searchsorted(long[:, 1], extreme, side="right") - 1
-    has = preceding >= 0
-    preceding = np.maximum(preceding, 0)
-    has &= long[preceding, 1] >= begin
-    hidden |= has & (np.abs(after_gap[preceding] - value) < margin)
-    return hidden
+    after = np.searchsorted(long[:, 0], extreme, side="right")
+    before = np.searchsorted(long[:, 1], extreme, side="right") - 1
+    following, preceding = np.minimum(after, long.shape[0] - 1), np.maximum(before, 0)
+    hidden = (after < long.shape[0]) & (long[following, 0] < end)
+    hidden &= np.abs(before_gap[following] - value) < margin
+    beside = (before >= 0) & (long[preceding, 1] >= begin)
+    return hidden | (beside & (np.abs(after_gap[preceding] - value) < margin))
 
 
 def _accepted_reversals(parts, hidden, edges, scale):
@@ -252,7 +232,7 @@ def _with_missing(cycles: Cycles, gaps) -> Cycles:
         return cycles
     return dataclasses.replace(
         cycles,
-        missing=missing_in(gaps, cycles.start, cycles.count),
+        missing=passes.missing_in(gaps, cycles.start, cycles.count),
         missing_samples=int((gaps[:, 1] - gaps[:, 0]).sum()),
         first_missing=int(gaps[0, 0]),
     )
@@ -272,7 +252,7 @@ def _drive_numbers(cycles: Cycles) -> Cycles:
 
 def _trigger(samples: Samples, gaps, line, band):
     """The trigger's runs: first sample, kind (+1 high, -1 low), extreme and its value."""
-    found = samples.map(trigger_runs, ("displacement",), (passes._CHUNK, gaps, line, band))
+    found = samples.map(passes.trigger_runs, ("displacement",), (passes._CHUNK, gaps, line, band))
     # A run begins where the state (+1 above the band, -1 below it, 0 inside) differs from
     # the last one decided; samples before the first decision take that first one. The 99th
     # percentile lies above the band, so some state is decided.
@@ -293,8 +273,8 @@ def _trigger(samples: Samples, gaps, line, band):
     lowest_of_run = np.fmin.reduceat(lowest, first_piece)
     extreme = np.where(
         kind > 0,
-        first_of_runs(run, highest, top, highest_of_run),
-        first_of_runs(run, lowest, bottom, lowest_of_run),
+        passes.first_of_runs(run, highest, top, highest_of_run),
+        passes.first_of_runs(run, lowest, bottom, lowest_of_run),
     ).astype(np.int64)
     value = np.where(kind > 0, highest_of_run, lowest_of_run)
     return starts, kind, extreme, value
@@ -312,7 +292,7 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, half_ran
         return None
     width = max(int(period), MIN_SAMPLES)
     arguments = (passes._CHUNK, gaps, line, width)
-    stretch, highest, lowest = _joined(samples, local_extremes, arguments)
+    stretch, highest, lowest = _joined(samples, passes.local_extremes, arguments)
     first = np.flatnonzero(np.diff(stretch, prepend=-1.0))
     highest, lowest = np.fmax.reduceat(highest, first), np.fmin.reduceat(lowest, first)
     around = [np.pad(v, 1, mode="edge") for v in (highest, lowest)]
@@ -357,10 +337,10 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     n = samples.size
     if n < 2:
         raise ValueError("the displacement does not oscillate: no reversal can be found")
-    sums, gaps, sample_at, sampled, finite, _ = survey(samples)
+    sums, gaps, sample_at, sampled, finite, _ = passes.survey(samples)
     count = int(sums[:, 0].sum())
-    line = displacement_line(sums, n)
-    low, high = displacement_percentiles(samples, gaps, line, sample_at, sampled, count)
+    line = passes.displacement_line(sums, n)
+    low, high = passes.displacement_percentiles(samples, gaps, line, sample_at, sampled, count)
     half_range = 0.5 * (high - low)
     if not half_range > 0.0:
         raise ValueError("the displacement does not oscillate: no reversal can be found")
@@ -420,7 +400,7 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
 def _labelled(samples: Samples, tolerance: float) -> Cycles:
     """:func:`labelled_cycles` of any :class:`Samples` with cycle numbers."""
     n = samples.size
-    _, gaps, _, _, _, labels = survey(samples)
+    _, gaps, _, _, _, labels = passes.survey(samples)
     known = [pair for pair in labels if pair is not None]
     if not known:
         raise ValueError("no cycle number is given: the cycle column is empty")
@@ -430,7 +410,7 @@ def _labelled(samples: Samples, tolerance: float) -> Cycles:
         if pair is not None:
             carry = pair[1]
     arguments, channels = (passes._CHUNK, gaps, carries), ("displacement", "cycle")
-    pieces = _joined(samples, labelled_runs, arguments, channels, extra=1)
+    pieces = _joined(samples, passes.labelled_runs, arguments, channels, extra=1)
     piece_start, label, size, highest, lowest, bottom, x_first, x_last, step = pieces
     new = np.concatenate([[True], label[1:] != label[:-1]])
     first_piece = np.flatnonzero(new)
@@ -439,10 +419,10 @@ def _labelled(samples: Samples, tolerance: float) -> Cycles:
     count = np.add.reduceat(size, first_piece).astype(np.int64)
     top = np.fmax.reduceat(highest, first_piece)
     floor = np.fmin.reduceat(lowest, first_piece)
-    lowest_at = first_of_runs(run, lowest, bottom, floor)
+    lowest_at = passes.first_of_runs(run, lowest, bottom, floor)
     valued = np.isfinite(x_first)
-    begin = ends_of_runs(run, valued, x_first, starts.size, first=True)
-    end = ends_of_runs(run, valued, x_last, starts.size, first=False)
+    begin = passes.ends_of_runs(run, valued, x_first, starts.size, first=True)
+    end = passes.ends_of_runs(run, valued, x_last, starts.size, first=False)
     largest = np.fmax.reduceat(step, first_piece)
     stroke = top - floor
     gap = np.abs(end - begin)
