@@ -411,7 +411,6 @@ def _loop_values(block, options):
     }
     if options.rig_stiffness is not None:
         values |= {name: ratios[name] for name in _RIG_RATIOS}
-    rounding = 1e-9
     anticlockwise = energy_ratio < -ANTICLOCKWISE_SHARE
     sliding = gross_slip(values, options)
     on_plateau = sliding & (np.abs(values["gicof"] / values["cof_max"] - 1.0) <= _PLATEAU)
@@ -424,7 +423,7 @@ def _loop_values(block, options):
         if block.continuous
         else _turns_back(rows[0], options.hysteresis * span),
         "anticlockwise": anticlockwise,
-        "energy-ratio-above-1": energy_ratio > 1.0 + rounding,
+        "energy-ratio-above-1": energy_ratio > 1.0 + 1e-9,  # beyond rounding
         "negative-stiffness": compliance < 0.0,
         "no-stick": (~(unexplained <= UNEXPLAINED_SHARE) & ~np.isinf(values["stiffness"]))
         | np.isnan(compliance),  # a rigid rig's vertical stick sides explain all but 0/0

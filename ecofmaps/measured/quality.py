@@ -55,6 +55,9 @@ ALL = "all"
 #: Plausible displacement amplitudes: outside, the unit is wrong (``implausible-amplitude``). [m]
 AMPLITUDE_RANGE = (0.5e-6, 50e-3)
 
+#: The amplitudes that :data:`AMPLITUDE_RANGE` allows, in words.
+_AMPLITUDES = f"{AMPLITUDE_RANGE[0] * 1e6:g} µm to {AMPLITUDE_RANGE[1] * 1e3:g} mm"
+
 #: Plausible coefficients of friction: outside, the load or the force's unit is wrong
 #: (``implausible-cof``). [1]
 COF_RANGE = (0.01, 3.0)
@@ -219,14 +222,29 @@ READING_REASONS = (
     "gicof-varies",
 )
 
-#: The reasons whose presence on every cycle says what to do about a refused recording.
-_HINTS = ("missing-samples", "anticlockwise", "constant-force", "implausible-amplitude")
+#: What to do about a recording whose every cycle is refused for a reason, the first that
+#: applies; with loops anticlockwise and stick sides sloping down, :data:`_FLIP_HINT`.
+_HINTS = {
+    "missing-samples": "Every cycle holds a missing sample (NaN or an empty cell).",
+    "anticlockwise": "The loops run anticlockwise with stick sides sloping up: the recording "
+    "runs backwards in time, or the displacement and force columns are swapped.",
+    "constant-force": "The force does not vary: is the force channel connected?",
+    "implausible-amplitude": f"The displacement amplitude is outside {_AMPLITUDES}: the "
+    "displacement is not in the unit assumed. analyze_loops takes metres; on the command "
+    "line, --displacement-unit gives the column's unit (a column without a unit in its name "
+    "or the file is read in µm).",
+}
+_FLIP_HINT = (
+    "The loops run anticlockwise with stick sides sloping down: the force is recorded "
+    "positive against the displacement. If so, read it with the other sign: "
+    "flip_force=True (on the command line, --flip-force)."
+)
+_LAST_HINT = (
+    "Is it a recording of fretting loops, with the displacement and the force in their own columns?"
+)
 
 #: The recorded values that a refused cycle keeps.
 _RECORDED = ("normal_load",)
-
-#: The amplitudes that :data:`AMPLITUDE_RANGE` allows, in words.
-_AMPLITUDES = f"{AMPLITUDE_RANGE[0] * 1e6:g} µm to {AMPLITUDE_RANGE[1] * 1e3:g} mm"
 
 #: The counts of :class:`Tally` that parts add up.
 _SUMS = ("cycles", "refused", "flagged", "implausible_cof", "scaled")
@@ -257,32 +275,9 @@ def _attrs(name: str) -> dict:
 def _refusal_hint(flags: dict) -> str:
     """What to do about a recording whose every cycle is refused (``flags``: the reasons
     every cycle carries, ``negative-stiffness`` if any does)."""
-    if flags["missing-samples"]:
-        return "Every cycle holds a missing sample (NaN or an empty cell)."
-    if flags["anticlockwise"] and flags["negative-stiffness"]:
-        return (
-            "The loops run anticlockwise with stick sides sloping down: the force is recorded "
-            "positive against the displacement. If so, read it with the other sign: "
-            "flip_force=True (on the command line, --flip-force)."
-        )
-    if flags["anticlockwise"]:
-        return (
-            "The loops run anticlockwise with stick sides sloping up: the recording runs "
-            "backwards in time, or the displacement and force columns are swapped."
-        )
-    if flags["constant-force"]:
-        return "The force does not vary: is the force channel connected?"
-    if flags["implausible-amplitude"]:
-        return (
-            f"The displacement amplitude is outside {_AMPLITUDES}: the displacement is not in "
-            "the unit assumed. analyze_loops takes metres; on the command line, "
-            "--displacement-unit gives the column's unit (a column without a unit in its "
-            "name or the file is read in µm)."
-        )
-    return (
-        "Is it a recording of fretting loops, with the displacement and the force in their "
-        "own columns?"
-    )
+    if flags["anticlockwise"] and flags["negative-stiffness"] and not flags["missing-samples"]:
+        return _FLIP_HINT
+    return next((hint for reason, hint in _HINTS.items() if flags[reason]), _LAST_HINT)
 
 
 def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
