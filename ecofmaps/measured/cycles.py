@@ -451,13 +451,13 @@ def _labelled(samples: Samples, tolerance: float) -> Cycles:
 def split_cycles(displacement, hysteresis: float = 0.5, tolerance: float = 0.01) -> Cycles:
     """Cut a continuous recording into complete cycles at its displacement reversals."""
     x = np.asarray(displacement, dtype=np.float64)
-    return _split(Samples(x, None, chunk=passes._CHUNK), hysteresis, tolerance)
+    return _split(Samples(x, None), hysteresis, tolerance)
 
 
 def labelled_cycles(displacement, cycle, tolerance: float = 0.01) -> Cycles:
     r"""Complete cycles of a recording whose samples carry their cycle number."""
     x = np.asarray(displacement, dtype=np.float64)
-    return _labelled(Samples(x, None, np.asarray(cycle), chunk=passes._CHUNK), tolerance)
+    return _labelled(Samples(x, None, np.asarray(cycle)), tolerance)
 
 
 def _check_labels(label: np.ndarray) -> None:
@@ -496,7 +496,7 @@ def find_cycles(
             )
         if isinstance(cycle, np.ndarray):
             _check_labels(cycle)
-    samples = Samples(displacement, force, cycle, missing, runner=runner, chunk=passes._CHUNK)
+    samples = Samples(displacement, force, cycle, missing, runner=runner)
     if cycle is None:
         return _split(samples, hysteresis, 0.01)
     return _labelled(samples, 0.01)

@@ -328,13 +328,11 @@ def displacement_percentiles(samples: Samples, gaps, line, sample_at, sampled, c
         if not 0 <= j < kept.size - 1:  # the sample missed: hold every value once
             return _percentiles(samples, gaps, line)
         previous, following = np.partition(kept, [j, j + 1])[[j, j + 1]]
-        gamma = virtual[k] - rank[k]
-        difference = following - previous
-        result[k] = (
-            following - difference * (1.0 - gamma)
-            if gamma >= 0.5
-            else previous + difference * gamma
-        )
+        gamma, difference = virtual[k] - rank[k], following - previous
+        if gamma >= 0.5:
+            result[k] = following - difference * (1.0 - gamma)
+        else:
+            result[k] = previous + difference * gamma
     return result
 
 
@@ -374,19 +372,16 @@ def is_lazy(value) -> bool:
 class Samples:
     """The channels of one recording."""
 
-    def __init__(
-        self, displacement, force, cycle=None, missing=None, *, runner=None, chunk, block=None
-    ):
+    def __init__(self, displacement, force, cycle=None, missing=None, *, runner=None):
         self.arrays = (displacement, force, cycle, missing)
         self.size = int(displacement.shape[0])
         self.lazy = any(is_lazy(a) for a in self.arrays if a is not None)
         self.runner = runner
         if self.lazy and runner is None:
             raise ValueError("a lazy recording needs a runner")
-        if block is None:
-            chunks = getattr(displacement, "chunks", None)
-            block = int(chunks[0][0]) if chunks and chunks[0] else _BLOCK
-        self.block = max(1, round(block / chunk)) * chunk
+        chunks = getattr(displacement, "chunks", None)
+        block = int(chunks[0][0]) if chunks and chunks[0] else _BLOCK
+        self.block = max(1, round(block / _CHUNK)) * _CHUNK  # whole chunks of the passes
 
     def constant_cycle(self) -> Samples:
         """These samples with every cycle number 0 (the whole recording one cycle)."""

@@ -24,7 +24,7 @@ from tests.measured.golden import signal
 
 def percentiles(values):
     """The reversal detector's percentiles of ``values`` (taken as detrended already)."""
-    samples = Samples(values, None, chunk=passes._CHUNK)
+    samples = Samples(values, None)
     sample_at = np.sort(np.random.default_rng(0).integers(0, values.size, passes._SAMPLE))
     line = (0.0, 0.0, 0.0, 0.5 * (values.size - 1))
     gaps = np.zeros((0, 2), np.int64)
