@@ -391,19 +391,15 @@ def interpolated(first, count, points, values):
             result[k] = values[j]
             k += 1
         slope = (values[j + 1] - values[j]) / (points[j + 1] - points[j])
-        if math.isfinite(slope) and math.isfinite(values[j]):  # no NaN can come of it
-            for i in range(k, stop):
-                result[i] = slope * ((first + i) - points[j]) + values[j]
-        else:
-            for i in range(k, stop):
-                result[i] = _interpolated_nan(first + i, points, values, j, slope)
+        for i in range(k, stop):
+            result[i] = _interpolated_at(first + i, points, values, j, slope)
         k = stop
     return result
 
 
 @numba.njit(**_COMPILE)
-def _interpolated_nan(at, points, values, j, slope):
-    """``np.interp`` at ``at`` on segment ``j`` where the first try may give NaN."""
+def _interpolated_at(at, points, values, j, slope):
+    """``np.interp`` at ``at`` on segment ``j``: from its other end where the first try is NaN."""
     value = slope * (at - points[j]) + values[j]
     if math.isnan(value):
         value = slope * (at - points[j + 1]) + values[j + 1]
