@@ -444,10 +444,10 @@ def _refusing(flags: dict, size: int) -> np.ndarray:
     return refusing
 
 
-def _by_text(quality, function) -> np.ndarray:
+def _by_text(quality, function, dtype=bool) -> np.ndarray:
     """``function(text)`` for each cycle's ``quality``, computed once per distinct text."""
     texts, inverse = np.unique(np.ravel(quality), return_inverse=True)
-    return np.array([function(text) for text in texts], dtype=bool)[inverse]
+    return np.array([function(text) for text in texts], dtype=dtype)[inverse]
 
 
 def quality_strings(flags: dict, size: int) -> np.ndarray:
@@ -465,9 +465,8 @@ def quality_strings(flags: dict, size: int) -> np.ndarray:
                     keep = keep & ~flag
             code |= (flags[reason] & keep).astype(np.int64) << bit
     codes, inverse = np.unique(code, return_inverse=True)
-    names = list(REASONS)
     texts = [
-        SEPARATOR.join(names[bit] for bit in range(len(names)) if value >> bit & 1) or "ok"
+        SEPARATOR.join(name for bit, name in enumerate(REASONS) if value >> bit & 1) or "ok"
         for value in codes
     ]
     # One shared str per distinct quality: 8 bytes a cycle, however long the reasons.
@@ -485,9 +484,7 @@ def add_reason(quality, where, reason: str) -> np.ndarray:
         reasons = {reason} | (set() if text == "ok" else set(text.split(SEPARATOR)))
         return SEPARATOR.join(sorted(reasons, key=order.index))
 
-    texts, inverse = np.unique(quality, return_inverse=True)
-    updated = np.array([added(text) for text in texts], dtype=str)[inverse].reshape(quality.shape)
-    return np.where(where, updated, quality)
+    return np.where(where, _by_text(quality, added, str).reshape(quality.shape), quality)
 
 
 def has_reason(quality, reason: str) -> np.ndarray:
