@@ -337,7 +337,7 @@ def displacement_percentiles(samples: Samples, gaps, line, sample_at, sampled, c
 
 
 def missing_in(gaps, start, count):
-    """True for each stretch ``start``, ``count`` that holds a sample of ``gaps`` (not empty)."""
+    """True for each stretch ``start``, ``count`` that holds a sample of ``gaps`` (some)."""
     after = np.searchsorted(gaps[:, 1], start, side="right")  # first gap ending after start
     return (after < gaps.shape[0]) & (gaps[np.minimum(after, gaps.shape[0] - 1), 0] < start + count)
 
