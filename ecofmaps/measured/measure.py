@@ -171,14 +171,11 @@ def loop_blocks(
         needed = min(block.stop + _NOISE_REACH, size)
         lower, upper = min(ready, block.start), max(needed, block.stop)
         low, high = int(start[lower]), int(start[upper - 1] + count[upper - 1])
-        x = displacement[low:high] - _drift(
-            low, high, middle, centre_x, slice(max(lower - 1, 0), upper + 1)
-        )
+        around = slice(max(lower - 1, 0), upper + 1)
+        x = displacement[low:high] - _drift(low, high, middle, centre_x, around)
         if ready < needed:
-            cut = slice(ready, needed)
-            centre_q[cut] = _path_means(
-                x, _signed(force[low:high], force_sign), start[cut] - low, count[cut], closed=False
-            )
+            cut, q = slice(ready, needed), _signed(force[low:high], force_sign)
+            centre_q[cut] = _path_means(x, q, start[cut] - low, count[cut], closed=False)
             ready = needed
         a, b = int(start[block.start]), int(start[block.stop - 1] + count[block.stop - 1])
         near = slice(max(block.start - 1, 0), block.stop + 1)

@@ -272,12 +272,8 @@ def displacement_line(sums, size: int):
     count = sums[:, 0].sum()
     middle = 0.5 * (size - 1)
     if count == size:  # every sample: the t sum to 0 and their squares to n(n² - 1)/12
-        return (
-            sum(sums[:, 1].tolist()) / size,
-            0.0,
-            sum(sums[:, 2].tolist()) / ((size * (size * size - 1)) / 12),
-            middle,
-        )
+        sx, stx = sum(sums[:, 1].tolist()), sum(sums[:, 2].tolist())
+        return sx / size, 0.0, stx / ((size * (size * size - 1)) / 12), middle
     if count < 2:
         raise ValueError("the displacement does not oscillate: no reversal can be found")
     sx, stx, st, stt = (sum(sums[:, k].tolist()) for k in (1, 2, 3, 4))
@@ -313,17 +309,15 @@ def displacement_percentiles(samples: Samples, gaps, line, sample_at, sampled, c
     high = np.ceil(quantile + spread).astype(np.int64)
     low = np.where(low > 0, sample[np.clip(low, 0, drawn - 1)], -np.inf)
     high = np.where(high < drawn - 1, sample[np.clip(high, 0, drawn - 1)], np.inf)
-    tails = np.concatenate(
-        samples.map(_tails, ("displacement",), (_CHUNK, gaps, line, (high[0], low[1])))
-    )
+    brackets = (_CHUNK, gaps, line, (high[0], low[1]))
+    tails = np.concatenate(samples.map(_tails, ("displacement",), brackets))
     result = np.empty(2)
     for k in range(2):
         kept = tails[(tails >= low[k]) & (tails <= high[k])]
-        below = (
-            np.count_nonzero(tails < low[k])
-            if k == 0
-            else count - np.count_nonzero(tails >= low[k])
-        )
+        if k == 0:
+            below = np.count_nonzero(tails < low[k])
+        else:
+            below = count - np.count_nonzero(tails >= low[k])
         j = rank[k] - below
         if not 0 <= j < kept.size - 1:  # the sample missed: hold every value once
             return _percentiles(samples, gaps, line)
