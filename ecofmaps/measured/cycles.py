@@ -10,19 +10,7 @@ import dataclasses
 import numpy as np
 
 from ecofmaps.measured import samples as passes
-from ecofmaps.measured.samples import (
-    Samples,
-    displacement_line,
-    displacement_percentiles,
-    ends_of_runs,
-    first_of_runs,
-    labelled_runs,
-    level_at,
-    local_extremes,
-    missing_in,
-    survey,
-    trigger_runs,
-)
+from ecofmaps.measured.samples import Samples
 
 __all__ = ["MIN_SAMPLES", "Cycles", "find_cycles", "labelled_cycles", "split_cycles"]
 
@@ -30,13 +18,10 @@ __all__ = ["MIN_SAMPLES", "Cycles", "find_cycles", "labelled_cycles", "split_cyc
 #: The one definition for the analysis, the fit and the synthetic recordings.
 MIN_SAMPLES = 8
 
-
 #: The least local half-band of the reversal detector, as a share of the whole recording's.
 _LEAST_LEVEL = 0.05
-
 #: A stretch between bottom runs within this share of the period is one regular cycle.
 _REGULAR = 0.1
-
 #: A recording longer than this with fewer than two bottom reversals is not read as one loop.
 _ONE_LOOP = 1 << 24
 
@@ -57,11 +42,6 @@ class Cycles:
     first_missing: int = -1
 
     @property
-    def width(self) -> int:
-        """Points round the longest loop, the closing point included. [1]"""
-        return int(self.count.max()) + 1 if self.count.size else 1
-
-    @property
     def whole(self) -> np.ndarray:
         """True for the cycles without a missing sample."""
         if self.missing is None:
@@ -79,12 +59,10 @@ class Cycles:
             missing=None if self.missing is None else self.missing[rows],
         )
 
-    def indices(self, rows=slice(None), width=None):
+    def indices(self, rows=slice(None)):
         """Sample indices round the loops ``rows``, one padded row per loop."""
         start, count, rotation = self.start[rows], self.count[rows], self.rotation[rows]
-        if width is None:
-            width = int(count.max()) + 1
-        j = np.arange(width)[None, :]
+        j = np.arange(int(count.max()) + 1)[None, :]
         if self.continuous:  # no rotation: the stretch, then its first sample again
             return start[:, None] + np.where(j < count[:, None], j, 0), count + 1
         count, rotation = count[:, None], rotation[:, None]
@@ -94,27 +72,15 @@ class Cycles:
         return start[:, None] + position, self.count[rows] + 1
 
 
-# --- the passes over the samples, a block at a time ----------------------------------------
-
-
-# --- the trigger restarted after a gap -------------------------------------------------------
-
-
-def _without_missing(x, a: int, b: int, gaps) -> np.ndarray:
-    """``x`` (samples ``a`` to ``b - 1``) with NaN at the samples of ``gaps`` (a copy)."""
-    x = np.array(x, dtype=np.float64)
-    first, last = np.searchsorted(gaps[:, 1], a, side="right"), np.searchsorted(gaps[:, 0], b)
-    for begin, end in gaps[first:last]:
-        x[max(begin, a) - a : min(end, b) - a] = np.nan
-    return x
+def _joined(samples: Samples, function, arguments, channels=("displacement",), extra=0):
+    """What ``function`` found in each block of ``samples``, joined in order."""
+    return np.concatenate(samples.map(function, channels, arguments, extra), axis=-1)
 
 
 def _extremes_of_parts(start, stop, arguments, x):
-    """The extremes of the parts of runs ``[begin, end)`` that lie in the block, a chunk at a
-    time: one column per piece of a part in a chunk, holding the part's number, its largest
-    finite displacement and the first sample of it, its smallest and the first sample of it,
-    and the largest and smallest detrended displacement (NaN and -1 where none is finite)."""
-    chunk, gaps, (mean, mean_t, slope, middle), begin, end = arguments
+    """Per piece of a part ``[begin, end)`` in a chunk: the part, its highest and lowest
+    displacement with their first samples, and its highest and lowest detrended one."""
+    chunk, gaps, line, begin, end = arguments
     found = [np.empty((7, 0))]
     for a in range(start, stop, chunk):
         b = min(a + chunk, stop)
@@ -126,58 +92,38 @@ def _extremes_of_parts(start, stop, arguments, x):
         cuts = np.unique(np.concatenate([[0], lower, upper]))
         cuts = cuts[cuts < b - a]
         at = np.searchsorted(cuts, lower)  # the piece of each part
-        xa = _without_missing(x[a - start : b - start], a, b, gaps)
-        # As the trigger detrends: the same operations, so the same bits.
-        trend = np.arange(a - middle, b - middle)
-        if mean_t != 0.0:
-            trend -= mean_t
-        trend *= slope
-        detrended = xa - mean
-        detrended -= trend
-        lengths = np.diff(cuts, append=b - a)
-        columns = [part.astype(np.float64)]
-        for reduce in (np.fmax, np.fmin):
-            value = reduce.reduceat(xa, cuts)
-            index = np.where(xa == np.repeat(value, lengths), np.arange(b - a), b - a)
-            index = np.minimum.reduceat(index, cuts)
-            columns += [value[at], np.where(index[at] < b - a, index[at] + a, -1)]
-        columns += [np.fmax.reduceat(detrended, cuts)[at], np.fmin.reduceat(detrended, cuts)[at]]
-        found.append(np.stack(columns))
+        xa = passes.blanked(np.asarray(x[a - start : b - start], dtype=np.float64), a, b, gaps)
+        d = passes.detrended(xa, a, line)
+        extremes = [e[at] for e in passes.piece_extremes(xa, cuts, a)]
+        ranges = [np.fmax.reduceat(d, cuts)[at], np.fmin.reduceat(d, cuts)[at]]
+        found.append(np.stack([part.astype(np.float64), *extremes, *ranges]))
     return np.concatenate(found, axis=1)
 
 
 def _parts_after_gaps(samples, gaps, line, band, runs):
     """The trigger's runs cut where samples resume after a long gap inside them."""
     starts, kind, extreme, value = runs
-    identity = np.arange(starts.size)
     gaps, long = gaps
     long = long[long[:, 1] < samples.size]
     inside = np.searchsorted(starts, long[:, 1], side="right") - 1
     cut = long[starts[inside] < long[:, 0], 1]
     if not cut.size:
-        return identity, starts, extreme, value
+        return np.arange(starts.size), starts, extreme, value
     part_start = np.union1d(starts, cut)
     part_run = np.searchsorted(starts, part_start, side="right") - 1
     affected = np.isin(part_run, part_run[np.isin(part_start, cut)])
-    begin = part_start[affected]
+    begin, run_of = part_start[affected], part_run[affected]
     end = np.append(part_start, samples.size)[1:][affected]
-    pieces = np.concatenate(
-        samples.map(
-            _extremes_of_parts,
-            ("displacement",),
-            (passes._CHUNK, gaps, line, begin, end),
-        ),
-        axis=1,
+    arguments = (passes._CHUNK, gaps, line, begin, end)
+    part, highest, top, lowest, bottom, most, least = _joined(
+        samples, _extremes_of_parts, arguments
     )
-    part, highest, top, lowest, bottom, most, least = pieces
     part = part.astype(np.int64)
     first_piece = np.searchsorted(part, np.arange(begin.size))
-    high = np.fmax.reduceat(highest, first_piece)
-    low = np.fmin.reduceat(lowest, first_piece)
     centre, level = band
     if isinstance(level, tuple):  # a local band: its level where each part begins
-        level = level_at(level, begin)
-    own = kind[part_run[affected]]
+        level = passes.level_at(level, begin)
+    own = kind[run_of]
     decided = np.where(
         own > 0,
         np.fmax.reduceat(most, first_piece) > centre + level,
@@ -185,20 +131,18 @@ def _parts_after_gaps(samples, gaps, line, band, runs):
     )
     # A part that decides nothing (inside the band) joins the part before it in its run,
     # or the one after it if it comes first.
-    run_of = part_run[affected]
     before = np.concatenate([[False], run_of[1:] == run_of[:-1]])
-    decided_before = _decided_earlier_in_run(decided, run_of)
-    new_group = ~before | (decided & decided_before)
-    group = np.cumsum(new_group) - 1
+    new_group = ~before | (decided & _decided_earlier_in_run(decided, run_of))
     first_part = np.flatnonzero(new_group)
-    piece_group = group[part]
-    high, low = np.fmax.reduceat(high, first_part), np.fmin.reduceat(low, first_part)
-    group_kind = own[first_part]
-    group_value = np.where(group_kind > 0, high, low)
+    piece_group = (np.cumsum(new_group) - 1)[part]
+    high = np.fmax.reduceat(np.fmax.reduceat(highest, first_piece), first_part)
+    low = np.fmin.reduceat(np.fmin.reduceat(lowest, first_piece), first_part)
+    rising = own[first_part] > 0
+    group_value = np.where(rising, high, low)
     group_extreme = np.where(
-        group_kind > 0,
-        first_of_runs(piece_group, highest, top, high),
-        first_of_runs(piece_group, lowest, bottom, low),
+        rising,
+        passes.first_of_runs(piece_group, highest, top, high),
+        passes.first_of_runs(piece_group, lowest, bottom, low),
     )
     kept = ~affected
     kept[np.flatnonzero(affected)[first_part]] = True
@@ -217,29 +161,24 @@ def _decided_earlier_in_run(decided, run_of):
 
 
 def _period(starts, kind) -> float:
-    """The drive's period: the median distance between the starts of the bottom runs
-    (NaN with fewer than two). [1]"""
+    """The median distance between the starts of the bottom runs (NaN with fewer than two)."""
     low = starts[kind < 0]
     return float(np.median(np.diff(low))) if low.size > 1 else np.nan
 
 
 def _values_at(start, stop, arguments, x):
-    """The displacements at the samples ``at`` (sorted) that lie in the block (NaN where
-    missing)."""
+    """The displacements at the samples ``at`` (sorted) in the block (NaN where missing)."""
     gaps, at = arguments
     at = at[(at >= start) & (at < stop)]
     if not at.size:
         return np.empty(0)
-    return _without_missing(x[at[0] - start : at[-1] + 1 - start], at[0], at[-1] + 1, gaps)[
-        at - at[0]
-    ]
+    stretch = np.asarray(x[at[0] - start : at[-1] + 1 - start], dtype=np.float64)
+    return passes.blanked(stretch, at[0], at[-1] + 1, gaps)[at - at[0]]
 
 
 def _hidden_by_gaps(parts, samples, gaps, margin):
-    """Which extremes of the runs' parts may lie where the samples stop rather than where
-    the displacement turns: within its part, a long gap follows (or precedes) the extreme
-    and the sample next to the gap is within ``margin`` of it, so the displacement may
-    have gone on beyond it in the gap."""
+    """Which extremes of the runs' parts lie within ``margin`` of a sample beside a long gap
+    in their part (the displacement may have gone on beyond them in the gap)."""
     begin, extreme, value = parts
     gaps, long = gaps
     if not long.size:
@@ -248,22 +187,15 @@ def _hidden_by_gaps(parts, samples, gaps, margin):
     edges = np.stack([long[:, 0] - 1, long[:, 1]], axis=1).ravel()  # the samples beside
     inside = (edges >= 0) & (edges < samples.size)
     at_edges = np.full(edges.size, np.nan)
-    at_edges[inside] = np.concatenate(
-        samples.map(_values_at, ("displacement",), (gaps, edges[inside]))
-    )
+    at_edges[inside] = _joined(samples, _values_at, (gaps, edges[inside]))
     before_gap, after_gap = at_edges[0::2], at_edges[1::2]
-    hidden = np.zeros(extreme.size, dtype=bool)
-    following = np.searchsorted(long[:, 0], extreme, side="right")
-    has = following < long.shape[0]
-    following = np.minimum(following, long.shape[0] - 1)
-    has &= long[following, 0] < end
-    hidden |= has & (np.abs(before_gap[following] - value) < margin)
-    preceding = np.searchsorted(long[:, 1], extreme, side="right") - 1
-    has = preceding >= 0
-    preceding = np.maximum(preceding, 0)
-    has &= long[preceding, 1] >= begin
-    hidden |= has & (np.abs(after_gap[preceding] - value) < margin)
-    return hidden
+    after = np.searchsorted(long[:, 0], extreme, side="right")
+    before = np.searchsorted(long[:, 1], extreme, side="right") - 1
+    following, preceding = np.minimum(after, long.shape[0] - 1), np.maximum(before, 0)
+    hidden = (after < long.shape[0]) & (long[following, 0] < end)
+    hidden &= np.abs(before_gap[following] - value) < margin
+    beside = (before >= 0) & (long[preceding, 1] >= begin)
+    return hidden | (beside & (np.abs(after_gap[preceding] - value) < margin))
 
 
 def _accepted_reversals(parts, hidden, edges, scale):
@@ -294,26 +226,20 @@ def _accepted_reversals(parts, hidden, edges, scale):
     return accepted
 
 
-# --- joining the passes ----------------------------------------------------------------------
-
-
 def _with_missing(cycles: Cycles, gaps) -> Cycles:
     """``cycles`` with the cycles that hold a sample of ``gaps`` marked."""
     if not gaps.size:
         return cycles
     return dataclasses.replace(
         cycles,
-        missing=missing_in(gaps, cycles.start, cycles.count),
+        missing=passes.missing_in(gaps, cycles.start, cycles.count),
         missing_samples=int((gaps[:, 1] - gaps[:, 0]).sum()),
         first_missing=int(gaps[0, 0]),
     )
 
 
 def _drive_numbers(cycles: Cycles) -> Cycles:
-    """``cycles`` (cut at the reversals) numbered as the drive made them: a stretch that
-    holds missing samples over more than one period (a gap that swallowed reversals) counts
-    the periods it spans, the median stretch of the cycles without missing samples, so the
-    cycles after a gap keep their numbers and the gap leaves a hole in the numbering."""
+    """``cycles`` numbered as the drive made them: a gapped stretch counts its periods."""
     if cycles.missing is None or cycles.missing.all():
         return cycles
     period = float(np.median(cycles.count[~cycles.missing] - 1))
@@ -325,9 +251,8 @@ def _drive_numbers(cycles: Cycles) -> Cycles:
 
 
 def _trigger(samples: Samples, gaps, line, band):
-    """The Schmitt trigger's runs over the recording: first sample, kind (+1 high, -1 low),
-    extreme (a sample) and its displacement."""
-    found = samples.map(trigger_runs, ("displacement",), (passes._CHUNK, gaps, line, band))
+    """The trigger's runs: first sample, kind (+1 high, -1 low), extreme and its value."""
+    found = samples.map(passes.trigger_runs, ("displacement",), (passes._CHUNK, gaps, line, band))
     # A run begins where the state (+1 above the band, -1 below it, 0 inside) differs from
     # the last one decided; samples before the first decision take that first one. The 99th
     # percentile lies above the band, so some state is decided.
@@ -348,27 +273,16 @@ def _trigger(samples: Samples, gaps, line, band):
     lowest_of_run = np.fmin.reduceat(lowest, first_piece)
     extreme = np.where(
         kind > 0,
-        first_of_runs(run, highest, top, highest_of_run),
-        first_of_runs(run, lowest, bottom, lowest_of_run),
+        passes.first_of_runs(run, highest, top, highest_of_run),
+        passes.first_of_runs(run, lowest, bottom, lowest_of_run),
     ).astype(np.int64)
     value = np.where(kind > 0, highest_of_run, lowest_of_run)
     return starts, kind, extreme, value
 
 
 def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, half_range: float):
-    """The trigger's half-band against the local amplitude, or None where the whole
-    recording's, ``hysteresis`` times its ``half_range`` [m], finds every cycle.
-
-    When the drive is periodic (``runs``: the first trigger's starts and kinds, and the
-    period; half the stretches between bottom runs, and at least four, within
-    ``_REGULAR`` of the period) and a stretch between them, or before the first or after
-    the last, is longer than 1.5 periods, smaller cycles may lie inside the band. The band
-    is then ``hysteresis`` times the half-range of the displacement over the
-    stretch of a period (counted from sample 0) that holds the sample and the stretches
-    either side, so over at least a period each side; never more than ``level`` nor less
-    than ``_LEAST_LEVEL`` of the whole recording's. A recording of one amplitude keeps the
-    whole recording's band everywhere.
-    """
+    """The trigger's local half-band ``(width, levels)``, or None where the whole
+    recording's finds every cycle."""
     starts, kind, period = runs
     bottoms = starts[kind < 0]
     regular = np.abs(np.diff(bottoms) / period - 1.0) <= _REGULAR
@@ -377,11 +291,8 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, half_ran
     if np.diff(bottoms, prepend=0, append=samples.size).max() <= 1.5 * period:
         return None
     width = max(int(period), MIN_SAMPLES)
-    pieces = np.concatenate(
-        samples.map(local_extremes, ("displacement",), (passes._CHUNK, gaps, line, width)),
-        axis=1,
-    )
-    stretch, highest, lowest = pieces
+    arguments = (passes._CHUNK, gaps, line, width)
+    stretch, highest, lowest = _joined(samples, passes.local_extremes, arguments)
     first = np.flatnonzero(np.diff(stretch, prepend=-1.0))
     highest, lowest = np.fmax.reduceat(highest, first), np.fmin.reduceat(lowest, first)
     around = [np.pad(v, 1, mode="edge") for v in (highest, lowest)]
@@ -396,16 +307,7 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, half_ran
 
 
 def _drive_cycles(bottoms, tops, n: int) -> Cycles:
-    """Cycles cut where the drive's cycles meet, for a recording whose amplitude varies.
-
-    A drive that changes its amplitude from one cycle to the next does so between a bottom
-    reversal and the next top (a sine's cycle runs from its upward crossing of the centre);
-    cut at a bottom reversal, the loop would begin a quarter period early, at the previous
-    amplitude. Each cycle runs from the sample half way between a bottom reversal and the
-    next top to the same point of the next pair, both included, and its loop begins at its
-    bottom reversal (``rotation``). A bottom without a top before the next bottom (beside a
-    gap) ends no cycle: the stretch is dropped and counted.
-    """
+    """Cycles cut half way between a bottom reversal and the next top (the amplitude varies)."""
     none = np.zeros(0, dtype=np.int64)
     if not tops.size:
         return Cycles(none, none, none, none, False, 1, n)
@@ -435,10 +337,10 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     n = samples.size
     if n < 2:
         raise ValueError("the displacement does not oscillate: no reversal can be found")
-    sums, gaps, sample_at, sampled, finite, _ = survey(samples)
+    sums, gaps, sample_at, sampled, finite, _ = passes.survey(samples)
     count = int(sums[:, 0].sum())
-    line = displacement_line(sums, n)
-    low, high = displacement_percentiles(samples, gaps, line, sample_at, sampled, count)
+    line = passes.displacement_line(sums, n)
+    low, high = passes.displacement_percentiles(samples, gaps, line, sample_at, sampled, count)
     half_range = 0.5 * (high - low)
     if not half_range > 0.0:
         raise ValueError("the displacement does not oscillate: no reversal can be found")
@@ -459,22 +361,14 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     # A gap shorter than half the samples beyond the band in a half period of a triangle
     # wave cannot have hidden a run of the other kind: the trigger goes on over it.
     long_gaps = gaps[gaps[:, 1] - gaps[:, 0] >= 0.25 * (1.0 - hysteresis) * period]
-    run, begin_of_part, extreme_of_part, value_of_part = _parts_after_gaps(
-        samples, (gaps, long_gaps), line, band, (starts, kind, extreme, value),
-    )  # fmt: skip
-    kind_of_part = kind[run]
+    gapped, margin = (gaps, long_gaps), tolerance * stroke
+    parts = _parts_after_gaps(samples, gapped, line, band, (starts, kind, extreme, value))
+    kind_of_part, extreme_of_part = kind[parts[0]], parts[2]
     # Beside a long gap, as at the ends of the recording: an extreme within the tolerance of
     # the sample next to the gap may lie where the samples stop.
-    hidden = _hidden_by_gaps(
-        (begin_of_part, extreme_of_part, value_of_part), samples, (gaps, long_gaps),
-        tolerance * stroke,
-    )  # fmt: skip
-    accepted = _accepted_reversals(
-        (run, kind_of_part, extreme_of_part, value_of_part),
-        hidden,
-        (finite[0][0], finite[-1][1]),
-        (tolerance * stroke, 0.5 * period),
-    )
+    hidden = _hidden_by_gaps(parts[1:], samples, gapped, margin)
+    edges, scale = (finite[0][0], finite[-1][1]), (margin, 0.5 * period)
+    accepted = _accepted_reversals((parts[0], kind_of_part, *parts[2:]), hidden, edges, scale)
     bottoms = extreme_of_part[(kind_of_part < 0) & accepted]
     if bottoms.size < 2:
         # Not two bottom reversals: the recording may still be one closed loop that starts
@@ -506,7 +400,7 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
 def _labelled(samples: Samples, tolerance: float) -> Cycles:
     """:func:`labelled_cycles` of any :class:`Samples` with cycle numbers."""
     n = samples.size
-    _, gaps, _, _, _, labels = survey(samples)
+    _, gaps, _, _, _, labels = passes.survey(samples)
     known = [pair for pair in labels if pair is not None]
     if not known:
         raise ValueError("no cycle number is given: the cycle column is empty")
@@ -515,12 +409,8 @@ def _labelled(samples: Samples, tolerance: float) -> Cycles:
         carries[a] = carry
         if pair is not None:
             carry = pair[1]
-    pieces = np.concatenate(
-        samples.map(
-            labelled_runs, ("displacement", "cycle"), (passes._CHUNK, gaps, carries), extra=1
-        ),
-        axis=1,
-    )
+    arguments, channels = (passes._CHUNK, gaps, carries), ("displacement", "cycle")
+    pieces = _joined(samples, passes.labelled_runs, arguments, channels, extra=1)
     piece_start, label, size, highest, lowest, bottom, x_first, x_last, step = pieces
     new = np.concatenate([[True], label[1:] != label[:-1]])
     first_piece = np.flatnonzero(new)
@@ -529,15 +419,14 @@ def _labelled(samples: Samples, tolerance: float) -> Cycles:
     count = np.add.reduceat(size, first_piece).astype(np.int64)
     top = np.fmax.reduceat(highest, first_piece)
     floor = np.fmin.reduceat(lowest, first_piece)
-    has = np.isfinite(floor)
-    lowest_at = first_of_runs(run, lowest, bottom, floor)
+    lowest_at = passes.first_of_runs(run, lowest, bottom, floor)
     valued = np.isfinite(x_first)
-    begin = ends_of_runs(run, valued, x_first, starts.size, first=True)
-    end = ends_of_runs(run, valued, x_last, starts.size, first=False)
+    begin = passes.ends_of_runs(run, valued, x_first, starts.size, first=True)
+    end = passes.ends_of_runs(run, valued, x_last, starts.size, first=False)
     largest = np.fmax.reduceat(step, first_piece)
     stroke = top - floor
     gap = np.abs(end - begin)
-    typical = np.nanmedian(stroke) if has.any() else np.nan
+    typical = np.nanmedian(stroke) if np.isfinite(floor).any() else np.nan
     complete = (
         (count >= MIN_SAMPLES)
         & (stroke >= 0.5 * typical)
@@ -562,18 +451,17 @@ def _labelled(samples: Samples, tolerance: float) -> Cycles:
 def split_cycles(displacement, hysteresis: float = 0.5, tolerance: float = 0.01) -> Cycles:
     """Cut a continuous recording into complete cycles at its displacement reversals."""
     x = np.asarray(displacement, dtype=np.float64)
-    return _split(Samples(x, None, chunk=passes._CHUNK), hysteresis, tolerance)
+    return _split(Samples(x, None), hysteresis, tolerance)
 
 
 def labelled_cycles(displacement, cycle, tolerance: float = 0.01) -> Cycles:
     r"""Complete cycles of a recording whose samples carry their cycle number."""
     x = np.asarray(displacement, dtype=np.float64)
-    return _labelled(Samples(x, None, np.asarray(cycle), chunk=passes._CHUNK), tolerance)
+    return _labelled(Samples(x, None, np.asarray(cycle)), tolerance)
 
 
 def _check_labels(label: np.ndarray) -> None:
-    """A ValueError naming the first sample whose cycle number is not whole, or the first
-    number given to two runs of samples apart (a counter reset): cycles would share it."""
+    """Raise for a cycle number that is not whole, or given to two runs of samples apart."""
     known = np.flatnonzero(np.isfinite(label)) if label.dtype.kind == "f" else None
     values = label if known is None else label[known]
     instead = "--cycle-col none, or cycle=None, cuts the cycles at the reversals instead"
@@ -608,7 +496,7 @@ def find_cycles(
             )
         if isinstance(cycle, np.ndarray):
             _check_labels(cycle)
-    samples = Samples(displacement, force, cycle, missing, runner=runner, chunk=passes._CHUNK)
+    samples = Samples(displacement, force, cycle, missing, runner=runner)
     if cycle is None:
         return _split(samples, hysteresis, 0.01)
     return _labelled(samples, 0.01)

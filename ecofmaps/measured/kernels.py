@@ -54,8 +54,7 @@ def _maximum(a, b):
 
 @numba.njit(**_COMPILE)
 def _first_segment(y, n, low, high, segment):
-    """Mark a row's first stick segment in ``segment`` (cleared first); return the column
-    that it ends before."""
+    """Mark a row's first stick segment in ``segment``; return the column it ends before."""
     highest, lowest = y[0], y[0]
     for j in range(1, n):
         highest, lowest = max(highest, y[j]), min(lowest, y[j])
@@ -83,9 +82,8 @@ def _first_segment(y, n, low, high, segment):
 
 @numba.njit(**_COMPILE)
 def _line_sums(u, v, end, segment, sums):
-    """Sums of the least-squares line of ``v`` on ``u`` through the marked points (all
-    before column ``end``), into ``sums``: the count, the means of ``u`` and ``v``, and the
-    sums of du dv, du du and dv dv (deviations from the means)."""
+    """Into ``sums``: count, means of ``u`` and ``v``, and the sums of du dv, du du and dv dv
+    over the marked points before column ``end`` (least squares of ``v`` on ``u``)."""
     count, sum_u, sum_v = 0.0, 0.0, 0.0
     for j in range(end):
         if segment[j]:
@@ -105,8 +103,7 @@ def _line_sums(u, v, end, segment, sums):
 
 @numba.njit(**_COMPILE)
 def _squares_off(x, y, end, segment, intercept, slope):
-    """Sum of the squared displacements of the marked points (before column ``end``) off
-    the line :math:`\\Delta = c + sQ`."""
+    """Sum of the squared displacements of the marked points off :math:`\\Delta = c + sQ`."""
     squares = 0.0
     for j in range(end):
         if segment[j]:
@@ -117,9 +114,8 @@ def _squares_off(x, y, end, segment, intercept, slope):
 
 @numba.njit(**_COMPILE)
 def _grow(x, y, n, segment, end, intercept, slope, tolerance):
-    """Grow a segment (before column ``end``) along its row of ``n`` points until two
-    samples in a row lie off its line by more than ``tolerance`` (a row's last sample alone
-    does not stop it), in place; return the column that it now ends before."""
+    """Grow a segment until two samples in a row lie off its line by more than ``tolerance``;
+    return the column it now ends before."""
     first = 0
     while not segment[first]:
         first += 1
@@ -136,9 +132,8 @@ def _grow(x, y, n, segment, end, intercept, slope, tolerance):
 
 @numba.njit(**_COMPILE)
 def _curved(x, y, end, segment, intercept, compliance, line):
-    """Squared residual of a row's segment off its line, whether it bends (a term
-    :math:`bQ^2` significant and changing the slope), and whether it holds forces of both
-    signs. ``line`` holds the segment's sums from :func:`_line_sums`."""
+    """Squared residual of a segment off its line, whether it bends (a significant
+    :math:`bQ^2`), and whether it holds forces of both signs."""
     count, mean_y, force_variance = line[0], line[1], line[4]
     squares, fourth, product, largest = 0.0, 0.0, 0.0, 0.0
     negative, positive = False, False
@@ -210,16 +205,13 @@ def stick_lines(x, y, length, span, low, high):
 
 @numba.njit(**_COMPILE)
 def _before(value, rising):
-    """A sample lies before the crossing: ``value`` below zero on a rising row, above on a
-    falling one."""
+    """Whether a sample lies before the crossing (below zero rising, above falling)."""
     return value < 0.0 if rising else value > 0.0
 
 
 @numba.njit(**_COMPILE)
 def _sample_pair(length, count, width):
-    """The columns of the two samples around a row's crossing: the one just past the
-    ``count`` samples before it (clipped to 1 to ``length - 1``), and the one before that
-    (the last column, the row's padding, if that is column -1, as NumPy indexes)."""
+    """The columns of the two samples around a row's crossing (-1 read as NumPy does)."""
     after = min(max(count, 1), length - 1)
     previous = after - 1
     return (previous + width if previous < 0 else previous), after
@@ -266,8 +258,7 @@ def zero_force_crossings(x, y, length, band, intercept, across, rounding):
 
 @numba.njit(**_COMPILE)
 def _curve_intercept(scaled, product, window, y, begin, end):
-    r"""Intercept :math:`a` of the least-squares :math:`Q = a + b\xi + c\xi Q` through the
-    samples marked in ``window`` (between columns ``begin`` and ``end``), and their count."""
+    r"""Intercept :math:`a` of :math:`Q = a + b\xi + c\xi Q` through the window, and its count."""
     count, sum_s, sum_z, sum_q = 0.0, 0.0, 0.0, 0.0
     for j in range(begin, end):
         if window[j]:
@@ -294,9 +285,8 @@ def _curve_intercept(scaled, product, window, y, begin, end):
 
 @numba.njit(**_COMPILE)
 def _window_holds(force, y, before, window, begin, end, pair, with_pair, rounding):
-    """The samples marked in ``window`` (between ``begin`` and ``end``), and the two
-    columns ``pair`` if ``with_pair``, lie on both sides of the crossing (``before`` it and
-    not) and the crossing's ``force`` lies within theirs, to ``rounding``."""
+    """Whether the window (and ``pair`` if ``with_pair``) has samples on both sides of the
+    crossing and holds its ``force`` within their range, to ``rounding``."""
     sides, lowest, highest = 0, np.inf, -np.inf
     for j in range(begin, end):
         if window[j]:
@@ -401,20 +391,15 @@ def interpolated(first, count, points, values):
             result[k] = values[j]
             k += 1
         slope = (values[j + 1] - values[j]) / (points[j + 1] - points[j])
-        if math.isfinite(slope) and math.isfinite(values[j]):  # no NaN can come of it
-            for i in range(k, stop):
-                result[i] = slope * ((first + i) - points[j]) + values[j]
-        else:
-            for i in range(k, stop):
-                result[i] = _interpolated_nan(first + i, points, values, j, slope)
+        for i in range(k, stop):
+            result[i] = _interpolated_at(first + i, points, values, j, slope)
         k = stop
     return result
 
 
 @numba.njit(**_COMPILE)
-def _interpolated_nan(at, points, values, j, slope):
-    """``np.interp`` at ``at`` on segment ``j`` where the first try may give NaN: try from
-    the other end, and take the value if both ends hold it."""
+def _interpolated_at(at, points, values, j, slope):
+    """``np.interp`` at ``at`` on segment ``j``: from its other end where the first try is NaN."""
     value = slope * (at - points[j]) + values[j]
     if math.isnan(value):
         value = slope * (at - points[j + 1]) + values[j + 1]

@@ -28,21 +28,17 @@ __all__ = [
     "NEIGHBOURS",
     "LoopBlock",
     "Stretch",
-    "both",
     "branch_rows",
-    "line_crossings",
     "loop_blocks",
     "loop_ratios",
     "measure_cycles",
-    "stick_lines",
-    "zero_force_crossings",
 ]
 
 #: Samples of the cycles laid out at once by :func:`loop_blocks`.
 _BLOCK = 1 << 17
 
-#: Whole cycles on either side of a cycle whose force centres give their noise (module
-#: notes); its second differences reach one cycle less.
+#: Whole cycles on either side of a cycle whose force centres give their noise; its second
+#: differences reach one cycle less.
 _NOISE_REACH = 4
 
 #: Whole cycles on either side of a cycle whose samples its centring reads: the force
@@ -53,6 +49,54 @@ NEIGHBOURS = _NOISE_REACH + 1
 #: The median absolute deviation of a normal distribution over its standard deviation,
 #: times the standard deviation of a second difference of white noise over its own.
 _SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
+
+#: Energy ratio :math:`A = E_d/(4\Delta^* Q^*)` above which a loop is gross slip (the
+#: sliding transition of Fouvry, Kapsa and Vincent).
+GROSS_SLIP_THRESHOLD = 0.2
+
+#: The ratios reported when the rig's stiffness is given: B, and the contact's amplitude,
+#: A and B on the contact's displacement.
+_RIG_RATIOS = (
+    "opening_ratio",
+    "contact_amplitude",
+    "contact_energy_ratio",
+    "contact_opening_ratio",
+)
+
+#: The per-cycle quantities, in the Dataset's order.
+_PER_CYCLE = (
+    "amplitude",
+    "slip_amplitude",
+    "max_force",
+    "dissipated_energy",
+    "ecof",
+    "cof_max",
+    "energy_ratio",
+    "stiffness",
+    "gicof",
+    "gicof_forward",
+    "gicof_backward",
+    "crossing_displacement_forward",
+    "crossing_displacement_backward",
+    "displacement_offset",
+    "force_offset",
+    "force_drift_se",
+    "stick_residual",
+)
+
+#: The reasons of :data:`~ecofmaps.measured.quality.REASONS` that this step flags (not the
+#: scale's, :func:`~ecofmaps.measured.quality.scale_flags`, nor the reading's).
+_MEASURED = tuple(
+    r for r in REASONS if r not in ("implausible-amplitude", "implausible-cof", *READING_REASONS)
+)
+
+#: A gross-slip loop whose GICoF lies within this share of Q*/P is crossed by its stick line
+#: where it slides at a constant force: its GICoF is read even if its stick sides are curved.
+_PLATEAU = 0.02
+
+#: Samples with :math:`|Q|` below this share of :math:`Q^*` locate a zero-force crossing
+#: that is not on a stick segment.
+_ZERO_FORCE_BAND = 0.25
 
 
 class Stretch:
@@ -127,14 +171,11 @@ def loop_blocks(
         needed = min(block.stop + _NOISE_REACH, size)
         lower, upper = min(ready, block.start), max(needed, block.stop)
         low, high = int(start[lower]), int(start[upper - 1] + count[upper - 1])
-        x = displacement[low:high] - _drift(
-            low, high, middle, centre_x, slice(max(lower - 1, 0), upper + 1)
-        )
+        around = slice(max(lower - 1, 0), upper + 1)
+        x = displacement[low:high] - _drift(low, high, middle, centre_x, around)
         if ready < needed:
-            cut = slice(ready, needed)
-            centre_q[cut] = _path_means(
-                x, _signed(force[low:high], force_sign), start[cut] - low, count[cut], closed=False
-            )
+            cut, q = slice(ready, needed), _signed(force[low:high], force_sign)
+            centre_q[cut] = _path_means(x, q, start[cut] - low, count[cut], closed=False)
             ready = needed
         a, b = int(start[block.start]), int(start[block.stop - 1] + count[block.stop - 1])
         near = slice(max(block.start - 1, 0), block.stop + 1)
@@ -156,10 +197,8 @@ def loop_blocks(
 
 
 def _drift_se(middle, count, centre, rows: slice):
-    """Standard error of the offset between the branches of the loops ``rows`` that the
-    force's drift correction leaves, from the ``centre`` of every whole
-    cycle at its ``middle`` sample; the centres of :data:`_NOISE_REACH` cycles on either
-    side of ``rows`` are needed. [N]"""
+    """Standard error of the offset between the branches of the loops ``rows`` left by the
+    force's drift correction (``force_drift_se``). [N]"""
     size = centre.size
     first, stop = rows.start, rows.stop
     noise = kernels.second_difference_medians(centre, first, stop, _NOISE_REACH)
@@ -193,8 +232,7 @@ def _signed(values, sign):
 
 
 def _labelled_block(cycles: Cycles, displacement, force, block, sign) -> LoopBlock:
-    """The loops of consecutive labelled cycles (rows ``block``), each moved by its own
-    centre."""
+    """The loops of consecutive labelled cycles (rows ``block``), each by its own centre."""
     start, count = cycles.start[block], cycles.count[block]
     offset = np.concatenate([[0], np.cumsum(count[:-1])])
     index = np.repeat(start - offset, count) + np.arange(int(count.sum()))
@@ -221,9 +259,7 @@ def _labelled_block(cycles: Cycles, displacement, force, block, sign) -> LoopBlo
 
 
 def _blocks(points: np.ndarray, offset: int) -> Iterator[slice]:
-    """Slices of consecutive rows of about ``_BLOCK`` points in all, such that padding
-    each row to the longest does not more than double that (a long loop among short ones
-    gets a block of its own)."""
+    """Slices of consecutive rows of about ``_BLOCK`` points, padded to at most twice that."""
     rows = max(1, _BLOCK // max(int(np.median(points)), 1)) if points.size else 1
     pending = [(a, min(a + rows, points.size)) for a in range(0, points.size, rows)][::-1]
     while pending:
@@ -243,9 +279,8 @@ def _path_means(path, values, offset, count, closed: bool):
 
 
 def _displacement_centres(start, count, displacement, first: int, stop: int):
-    """Middle sample of every cycle cut at the reversals (stretches ``start``, ``count``),
-    and the displacement centres of the cycles from :data:`NEIGHBOURS` before ``first`` to
-    :data:`_NOISE_REACH` after ``stop - 1`` (NaN for the others), a block at a time."""
+    """Middle sample of every cycle, and the displacement centres of those within
+    :data:`NEIGHBOURS` of rows ``first`` to ``stop - 1`` (NaN for the others)."""
     # The mean sample index round the loop, its closing point included (exact integers).
     middle = ((count * (2 * start + count - 1)) // 2 + start) / (count + 1)
     centre = np.full(start.size, np.nan)
@@ -286,11 +321,6 @@ def _drift(low: int, high: int, points, values, near: slice):
     return result
 
 
-#: Energy ratio :math:`A = E_d/(4\Delta^* Q^*)` above which a loop is gross slip (the
-#: sliding transition of Fouvry, Kapsa and Vincent).
-GROSS_SLIP_THRESHOLD = 0.2
-
-
 def loop_ratios(amplitude, max_force, energy, slip, rig_stiffness=None) -> dict:
     r"""The energy and opening ratios of loops, on the applied displacement and on the
     contact's.
@@ -329,45 +359,6 @@ def loop_ratios(amplitude, max_force, energy, slip, rig_stiffness=None) -> dict:
         }
 
 
-#: The ratios reported when the rig's stiffness is given: B, and the contact's amplitude,
-#: A and B on the contact's displacement.
-_RIG_RATIOS = ("opening_ratio", "contact_amplitude", "contact_energy_ratio",
-               "contact_opening_ratio")  # fmt: skip
-
-#: The per-cycle quantities, in the Dataset's order.
-_PER_CYCLE = (
-    "amplitude",
-    "slip_amplitude",
-    "max_force",
-    "dissipated_energy",
-    "ecof",
-    "cof_max",
-    "energy_ratio",
-    "stiffness",
-    "gicof",
-    "gicof_forward",
-    "gicof_backward",
-    "crossing_displacement_forward",
-    "crossing_displacement_backward",
-    "displacement_offset",
-    "force_offset",
-    "force_drift_se",
-    "stick_residual",
-)
-
-
-#: The reasons of :data:`~ecofmaps.measured.quality.REASONS` that this step flags (not the
-#: scale's, :func:`~ecofmaps.measured.quality.scale_flags`, nor the reading's).
-_MEASURED = tuple(
-    r for r in REASONS if r not in ("implausible-amplitude", "implausible-cof", *READING_REASONS)
-)
-
-
-#: A gross-slip loop whose GICoF lies within this share of Q*/P is crossed by its stick line
-#: where it slides at a constant force: its GICoF is read even if its stick sides are curved.
-_PLATEAU = 0.02
-
-
 def _loop_values(block, options):
     """Every per-cycle quantity of a block of centred loops, and the checks it failed."""
     load = options.load
@@ -378,17 +369,22 @@ def _loop_values(block, options):
     )
     span = highest - lowest
     amplitude = 0.5 * span
-    bx, by, length = branch_rows(block, top)
-    compliance, intercept, across, fit = stick_lines(bx, by, length, span, options.stick_window)
-    crossing, zero_on_loop = zero_force_crossings(
-        bx, by, length, max_force, across, intercept, span
+    rows = branch_rows(block, top)
+    low, high = (float(share) for share in options.stick_window)
+    # Lines Δ = c + Q/S through the stick segments after the two reversals.
+    compliance, intercept, across, residual, unexplained, curved = kernels.stick_lines(
+        *rows, span, low, high
     )
+    band, rounding = _both(_ZERO_FORCE_BAND * max_force), _both(1e-9 * span)
+    crossing, zero_on_loop = kernels.zero_force_crossings(*rows, band, intercept, across, rounding)
     cycles = block.count.size
     slip = 0.5 * (crossing[cycles:] - crossing[:cycles])
-    half_width = options.crossing_window * np.abs(slip)
-    at, force, on_loop = line_crossings(
-        bx, by, length, both(compliance), both(half_width), load, both(max_force)
+    slope, half_width = _both(compliance), _both(options.crossing_window * np.abs(slip))
+    # Where each branch row crosses Q = SΔ: force, whether on the loop, displacement.
+    force, on_loop = kernels.line_crossings(
+        *rows, slope, half_width, float(load), 1e-9 * _both(max_force)
     )
+    at = force * slope
     ratios = loop_ratios(amplitude, max_force, energy, slip, options.rig_stiffness)
     energy_ratio = ratios["energy_ratio"]
     values = {
@@ -408,11 +404,10 @@ def _loop_values(block, options):
         "displacement_offset": block.displacement_centre,
         "force_offset": block.force_centre,
         "force_drift_se": block.force_drift_se,
-        "stick_residual": fit["residual"],
+        "stick_residual": residual,
     }
     if options.rig_stiffness is not None:
         values |= {name: ratios[name] for name in _RIG_RATIOS}
-    rounding = 1e-9
     anticlockwise = energy_ratio < -ANTICLOCKWISE_SHARE
     sliding = gross_slip(values, options)
     on_plateau = sliding & (np.abs(values["gicof"] / values["cof_max"] - 1.0) <= _PLATEAU)
@@ -423,17 +418,17 @@ def _loop_values(block, options):
         # would have been a reversal.
         "several-loops": np.zeros(cycles, dtype=bool)
         if block.continuous
-        else _turns_back(bx, options.hysteresis * span),
+        else _turns_back(rows[0], options.hysteresis * span),
         "anticlockwise": anticlockwise,
-        "energy-ratio-above-1": energy_ratio > 1.0 + rounding,
+        "energy-ratio-above-1": energy_ratio > 1.0 + 1e-9,  # beyond rounding
         "negative-stiffness": compliance < 0.0,
-        "no-stick": (~(fit["unexplained"] <= UNEXPLAINED_SHARE) & ~np.isinf(values["stiffness"]))
+        "no-stick": (~(unexplained <= UNEXPLAINED_SHARE) & ~np.isinf(values["stiffness"]))
         | np.isnan(compliance),  # a rigid rig's vertical stick sides explain all but 0/0
         "negative-area": (energy_ratio < 0.0) & ~anticlockwise,
         "negative-slip": ~(slip > 0.0),
         "no-zero-crossing": ~(zero_on_loop[:cycles] & zero_on_loop[cycles:]),
-        "curved-stick": fit["curved"] & ~on_plateau,
-        "curved-stick-sliding": fit["curved"] & on_plateau,
+        "curved-stick": curved & ~on_plateau,
+        "curved-stick-sliding": curved & on_plateau,
         "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]),
         "partial-slip": ~sliding,
     }
@@ -441,10 +436,8 @@ def _loop_values(block, options):
 
 
 def _turns_back(x, band):
-    """True for the cycles whose displacement turns back within a branch by more than
-    ``band``: the rising branches (the first half of the rows) fall below their running
-    maximum, or the falling ones rise above their running minimum (the rows' padding
-    repeats their last point, which changes neither)."""
+    """True for the cycles whose displacement turns back within a branch row by more than
+    ``band`` (the rows' padding repeats their last point, which changes nothing)."""
     cycles = band.size
     rising, falling = x[:cycles], x[cycles:]
     drop = np.max(np.maximum.accumulate(rising, axis=1) - rising, axis=1)
@@ -485,12 +478,7 @@ def measure_cycles(cycles: Cycles, displacement, force, options, *, rows=None, k
     return values, flags, loops
 
 
-#: Samples with :math:`|Q|` below this share of :math:`Q^*` locate a zero-force crossing
-#: that is not on a stick segment.
-_ZERO_FORCE_BAND = 0.25
-
-
-def both(values):
+def _both(values):
     """A per-cycle array for the rising then the falling branch rows."""
     return np.concatenate([values, values])
 
@@ -515,27 +503,3 @@ def branch_rows(block, top):
         for values in (block.displacement, block.force)
     )
     return x, y, length
-
-
-def stick_lines(x, y, length, span, window):
-    r"""Lines :math:`\Delta = c + Q/S` through the stick segments after the two reversals."""
-    low, high = (float(share) for share in window)
-    compliance, intercept, across, residual, unexplained, curved = kernels.stick_lines(
-        x, y, length, span, low, high
-    )
-    fit = {"residual": residual, "unexplained": unexplained, "curved": curved}
-    return compliance, intercept, across, fit
-
-
-def zero_force_crossings(x, y, length, max_force, across, intercept, span):
-    r"""Displacement where each branch row crosses :math:`Q = 0`, and whether on the loop."""
-    band = both(_ZERO_FORCE_BAND * max_force)
-    return kernels.zero_force_crossings(x, y, length, band, intercept, across, both(1e-9 * span))
-
-
-def line_crossings(x, y, length, compliance, half_width, load, scale):
-    r"""Where each branch row crosses :math:`Q = S\Delta`: displacement, force, on the loop."""
-    force, on_loop = kernels.line_crossings(
-        x, y, length, compliance, half_width, float(load), 1e-9 * scale
-    )
-    return force * compliance, force, on_loop

@@ -46,19 +46,17 @@ __all__ = [
 ]
 
 
-#: How the quantities are measured on a loop (the netCDF ``comment`` attribute).
-_COMMENTS = {
-    "slip_amplitude": "half the loop's width at Q = 0",
-    "dissipated_energy": "the loop's area",
-    "stiffness": "slope of the stick segments",
-    "regime": "GROSS_SLIP when the energy ratio exceeds gross_slip_threshold, else PARTIAL_SLIP; "
-    "INVALID where the cycle is refused",
-    "quality": "'ok' or the reasons for NaN, joined by '+' (ecofmaps.measured.quality)",
-}
+#: Joins the reasons of one cycle in ``quality``.
+SEPARATOR = "+"
 
+#: Scope of a reason that refuses the cycle: every per-cycle quantity.
+ALL = "all"
 
 #: Plausible displacement amplitudes: outside, the unit is wrong (``implausible-amplitude``). [m]
 AMPLITUDE_RANGE = (0.5e-6, 50e-3)
+
+#: The amplitudes that :data:`AMPLITUDE_RANGE` allows, in words.
+_AMPLITUDES = f"{AMPLITUDE_RANGE[0] * 1e6:g} µm to {AMPLITUDE_RANGE[1] * 1e3:g} mm"
 
 #: Plausible coefficients of friction: outside, the load or the force's unit is wrong
 #: (``implausible-cof``). [1]
@@ -67,248 +65,6 @@ COF_RANGE = (0.01, 3.0)
 #: Displacement amplitudes above this are reciprocating sliding rather than fretting (still
 #: analysed the same way; the results' ``motion`` attribute says so). [m]
 FRETTING_AMPLITUDE = 300e-6
-
-
-def _attrs(name: str) -> dict:
-    attrs = nomenclature.attrs(name)
-    if name in _COMMENTS:
-        attrs["comment"] = _COMMENTS[name]
-    return attrs
-
-
-def _refusal_hint(flags: dict) -> str:
-    """What the user may do about a recording whose every cycle is refused (``flags``:
-    whether every cycle, or any for ``negative-stiffness``, carries the reason)."""
-    if flags["missing-samples"]:
-        return "Every cycle holds a missing sample (NaN or an empty cell)."
-    if flags["anticlockwise"]:
-        if flags["negative-stiffness"]:
-            return (
-                "The loops run anticlockwise with stick sides sloping down: the force is "
-                "recorded positive against the displacement. If so, read it with the other "
-                "sign: flip_force=True (on the command line, --flip-force)."
-            )
-        return (
-            "The loops run anticlockwise with stick sides sloping up: the recording runs "
-            "backwards in time, or the displacement and force columns are swapped."
-        )
-    if flags["constant-force"]:
-        return "The force does not vary: is the force channel connected?"
-    if flags["implausible-amplitude"]:
-        return (
-            f"The displacement amplitude is outside {AMPLITUDE_RANGE[0] * 1e6:g} µm to "
-            f"{AMPLITUDE_RANGE[1] * 1e3:g} mm: the displacement is not "
-            "in the unit assumed. analyze_loops takes metres; on the command line, "
-            "--displacement-unit gives the column's unit (a column without a unit in its "
-            "name or the file is read in µm)."
-        )
-    return (
-        "Is it a recording of fretting loops, with the displacement and the force in their "
-        "own columns?"
-    )
-
-
-def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
-    """``results`` with the centred loops of :func:`measure_cycles` (``keep_loops=True``)."""
-    results["loop_displacement"] = (("cycle", "point"), loops[0], _attrs("loop_displacement"))
-    results["loop_force"] = (("cycle", "point"), loops[1], _attrs("loop_force"))
-    results.coords["point"] = ("point", np.arange(loops[0].shape[1]), _attrs("point"))
-    return results
-
-
-def regime_ratio(values: dict, rig_stiffness) -> np.ndarray:
-    """The energy ratio that decides each cycle's regime: on the contact's displacement
-    when the rig's stiffness is known, else on the applied one. [1]"""
-    return values["energy_ratio" if rig_stiffness is None else "contact_energy_ratio"]
-
-
-def gross_slip(values: dict, options) -> np.ndarray:
-    """True for the cycles in gross slip: :func:`regime_ratio` above the options'
-    ``gross_slip_threshold``."""
-    return regime_ratio(values, options.rig_stiffness) > options.gross_slip_threshold
-
-
-def scale_flags(values: dict, options) -> dict:
-    """The checks of scale of each cycle (reason -> per cycle): an amplitude outside
-    :data:`AMPLITUDE_RANGE`, or a coefficient of friction outside :data:`COF_RANGE` (the
-    ECoF or the GICoF of a gross-slip loop; not :math:`Q^*/P`, which a deep groove raises
-    above 3 with any load). A gross-slip CoF of 361 or 0.001 says that the load or a unit is
-    wrong, not the contact."""
-    amplitude = values["amplitude"]
-    sliding = gross_slip(values, options)
-
-    def outside(value, bounds):
-        return np.isfinite(value) & ((value < bounds[0]) | (value > bounds[1]))
-
-    scaled = outside(amplitude, AMPLITUDE_RANGE)
-    cof = sliding & (outside(values["ecof"], COF_RANGE) | outside(values["gicof"], COF_RANGE))
-    return {"implausible-amplitude": scaled, "implausible-cof": cof & ~scaled}
-
-
-def judged(values: dict, flags: dict, options):
-    """The one judgement of a part's cycles: ``values`` (name -> per cycle, as measured)
-    NaN where a flag's scope reaches, the ``quality`` strings, the cycles refused and the
-    regime codes. ``flags`` (reason -> per cycle) are every check's, the scale's included."""
-    size = next(iter(flags.values())).size
-    refused = _refusing(flags, size)
-    recorded = {k: values[k] for k in ("normal_load",) if k in values}  # a refused cycle's too
-    values = apply_quality({k: v for k, v in values.items() if k not in recorded}, flags)
-    sliding = gross_slip(values, options)
-    regime = np.where(refused, INVALID, np.where(sliding, GROSS_SLIP, PARTIAL_SLIP))
-    return values | recorded, quality_strings(flags, size), refused, regime
-
-
-def cycle_results(values: dict, flags: dict, label, options) -> xr.Dataset:
-    """The per-cycle Dataset of :func:`analyze_loops` for some cycles, without the
-    recording's attributes: ``values`` and ``flags`` (the scale's included) judged once."""
-    values, quality, _, regime = judged(values, flags, options)
-    recorded = {k: values.pop(k) for k in ("normal_load",) if k in values}
-    names = [name for name in values if name != "stick_residual"]
-    data = {name: ("cycle", values[name], _attrs(name)) for name in names}
-    data["regime"] = ("cycle", regime.astype(np.int32), _attrs("regime") | Regime.flag_attrs())
-    data["stick_residual"] = ("cycle", values["stick_residual"], _attrs("stick_residual"))
-    for name, value in recorded.items():
-        data[name] = ("cycle", value, _attrs(name))
-    data["quality"] = ("cycle", quality, _attrs("quality"))
-    load = ((), options.load, _attrs("load"))
-    coords = {"cycle": ("cycle", label, _attrs("cycle")), "load": load}
-    return xr.Dataset(data, coords=coords)
-
-
-#: The reasons that the reading along the stroke adds (its flags do not warn).
-READING_REASONS = (
-    "stiffness-mismatch",
-    "no-overlap",
-    "few-slip-samples",
-    "mu-varies",
-    "gicof-varies",
-)
-
-#: The reasons whose presence on every cycle says what to do about a refused recording.
-_HINTS = ("missing-samples", "anticlockwise", "constant-force", "implausible-amplitude")
-
-
-class Tally:
-    """What :func:`analyze_loops` says about a whole recording, counted from the flags of
-    its parts as they come: the quality summary, whether every cycle was refused, and the
-    typical amplitude."""
-
-    def __init__(self):
-        self.counts = collections.Counter()  # cycles by quality
-        self.cycles = self.refused = self.flagged = self.implausible_cof = self.scaled = 0
-        self.every = dict.fromkeys(_HINTS, True)
-        self.negative_stiffness = False
-        self.amplitudes: list = []
-
-    def add(self, quality, flags: dict, amplitude) -> None:
-        """Count the cycles of a part: their ``quality``, ``flags`` and amplitudes as measured."""
-        self.counts.update(collections.Counter(np.asarray(quality).tolist()))
-        quiet = {"ok", "partial-slip", *READING_REASONS}
-        self.flagged += int(
-            _by_text(quality, lambda text: bool(set(text.split(SEPARATOR)) - quiet)).sum()
-        )
-        self.cycles += amplitude.size
-        self.refused += int(_refusing(flags, amplitude.size).sum())
-        for reason in _HINTS:
-            self.every[reason] &= bool(flags[reason].all())
-        self.negative_stiffness |= bool(flags["negative-stiffness"].any())
-        self.amplitudes.append(amplitude)
-        self.implausible_cof += int(flags["implausible-cof"].sum())
-        self.scaled += int(flags["implausible-amplitude"].sum())
-
-    def merge(self, other: Tally) -> None:
-        """Count the parts ``other`` counted (in another process, say) as well."""
-        self.counts.update(other.counts)
-        self.cycles += other.cycles
-        self.refused += other.refused
-        self.flagged += other.flagged
-        self.scaled += other.scaled
-        for reason in _HINTS:
-            self.every[reason] &= other.every[reason]
-        self.negative_stiffness |= other.negative_stiffness
-        self.amplitudes += other.amplitudes
-        self.implausible_cof += other.implausible_cof
-
-    @property
-    def summary(self) -> str:
-        """The one-line quality summary so far."""
-        return summary_of_counts(self.counts)
-
-    def finish(self, results, cycles: Cycles, cycles_from: str, options) -> xr.Dataset:
-        """Check the whole recording and give ``results`` (the parts, joined) its
-        attributes."""
-        summary = self.summary
-        typical = _typical(np.concatenate(self.amplitudes) if self.amplitudes else np.zeros(0))
-        scaled = self.scaled
-        if self.cycles and self.refused == self.cycles:
-            hint = dict(self.every, **{"negative-stiffness": self.negative_stiffness})
-            error = ImplausibleScaleError if scaled else ValueError
-            raise error(f"no plausible cycle in the recording ({summary}). {_refusal_hint(hint)}")
-        if scaled:
-            warn(
-                f"{scaled} cycles have an amplitude outside {AMPLITUDE_RANGE[0] * 1e6:g} µm to "
-                f"{AMPLITUDE_RANGE[1] * 1e3:g} mm: is the displacement in metres (on the "
-                "command line --displacement-unit; a column without a unit is read in µm)?",
-                ImplausibleScaleWarning,
-            )
-        if self.implausible_cof:
-            warn(
-                f"{self.implausible_cof} cycles have a coefficient of friction outside "
-                f"{COF_RANGE[0]:g} to {COF_RANGE[1]:g} with the load of "
-                f"{float(results['load']):g} N: "
-                "is the load right (load=, on the command line --load) and the force in "
-                "newtons (--force-unit; a column without a unit is read in N)?",
-                ImplausibleScaleWarning,
-            )
-        if self.flagged:
-            warn(f"cycles flagged: {summary}", LoopQualityWarning)
-        condition, changes = regime_condition(results)
-        results.attrs.update(
-            {
-                "title": "Fretting loops analysed cycle by cycle (ecofmaps.analyze_loops)",
-                "cycles_from": cycles_from,
-                "incomplete_cycles": cycles.incomplete_cycles,
-                "dropped_samples": cycles.dropped_samples,
-                "missing_samples": cycles.missing_samples,
-                "first_missing_sample": cycles.first_missing,
-                "skipped_cycles": int(self.counts_of("missing-samples")),
-                "gross_slip_threshold": options.gross_slip_threshold,
-                "flip_force": int(options.flip_force),
-                "quality_summary": summary,
-                "sliding_condition": condition,
-                "regime_changes_at": changes,
-                "motion": _motion(typical),
-            }
-        )
-        if options.rig_stiffness is not None:
-            results.attrs["rig_stiffness"] = options.rig_stiffness
-        return results
-
-    def counts_of(self, reason: str) -> int:
-        """Cycles whose quality lists ``reason``."""
-        return sum(c for text, c in self.counts.items() if reason in text.split("+"))
-
-
-def _typical(amplitude) -> float:
-    """The median of the finite amplitudes (NaN if none). [m]"""
-    finite = amplitude[np.isfinite(amplitude)]
-    return float(np.median(finite)) if finite.size else np.nan
-
-
-def _motion(typical: float) -> str:
-    """``'fretting'``, or ``'reciprocating sliding'`` for a stroke beyond
-    :data:`FRETTING_AMPLITUDE` (analysed the same way)."""
-    if np.isfinite(typical) and typical > FRETTING_AMPLITUDE:
-        return "reciprocating sliding"
-    return "fretting"
-
-
-class LoopQualityWarning(UserWarning):
-    """Cycles of a recording were flagged in ``quality``, or its units look wrong."""
-
-
-#: Joins the reasons of one cycle in ``quality``.
-SEPARATOR = "+"
 
 #: A loop whose area :math:`\oint Q\,d\Delta` is below minus this share of
 #: :math:`4\Delta^*Q^*` runs anticlockwise; a smaller negative area is noise on a loop
@@ -333,8 +89,22 @@ SCATTER_BLOCKS = 8
 #: this share of μ (standard deviation) beyond the noise.
 GICOF_WIGGLE = 0.015
 
-#: Scope of a reason that refuses the cycle: every per-cycle quantity.
-ALL = "all"
+#: A test's sliding conditions (Vincent et al. 1992; Zhou & Vincent 1995): every cycle in
+#: partial slip, the regime changing during the test, every cycle in gross slip.
+SLIDING_CONDITIONS = ("partial slip", "mixed slip", "gross slip")
+
+#: Cycles where the regime changes that :func:`sliding_condition_line` names.
+_CHANGES_SHOWN = 5
+
+#: How the quantities are measured on a loop (the netCDF ``comment`` attribute).
+_COMMENTS = {
+    "slip_amplitude": "half the loop's width at Q = 0",
+    "dissipated_energy": "the loop's area",
+    "stiffness": "slope of the stick segments",
+    "regime": "GROSS_SLIP when the energy ratio exceeds gross_slip_threshold, else PARTIAL_SLIP; "
+    "INVALID where the cycle is refused",
+    "quality": "'ok' or the reasons for NaN, joined by '+' (ecofmaps.measured.quality)",
+}
 
 _GICOF = (
     "gicof",
@@ -369,9 +139,8 @@ REASONS = {
     ),
     "anticlockwise": (
         f"the loop runs anticlockwise (area below -{ANTICLOCKWISE_SHARE * 100:g} % of 4Δ*Q*): "
-        "force and displacement "
-        "recorded positive in opposite directions (see flip_force), time reversed, or the "
-        "columns swapped",
+        "force and displacement recorded positive in opposite directions (see flip_force), "
+        "time reversed, or the columns swapped",
         ALL,
     ),
     "energy-ratio-above-1": ("the loop's area exceeds its bounding box 4Δ*Q* (A > 1)", ALL),
@@ -406,8 +175,7 @@ REASONS = {
     ),
     "implausible-cof": (
         f"a coefficient of friction outside {COF_RANGE[0]:g} to {COF_RANGE[1]:g} (the ECoF or "
-        "GICoF in gross slip): the "
-        "load given or the force's unit is wrong, not the contact",
+        "GICoF in gross slip): the load given or the force's unit is wrong, not the contact",
         ("ecof", "cof_max", *_GICOF, *RESOLVED),
     ),
     "partial-slip": (
@@ -427,25 +195,244 @@ REASONS = {
     ),
     "few-slip-samples": (
         f"fewer than {SLIP_SAMPLES} slipping samples of a branch in the central part of the "
-        "stroke (a "
-        "sparse or digitised loop): friction cannot be read along the stroke",
+        "stroke (a sparse or digitised loop): friction cannot be read along the stroke",
         RESOLVED,
     ),
     "mu-varies": (
         "the friction read along the stroke differs between the inner and the outer half of "
-        "its central part by more than "
-        f"{VARIATION * 100:g} % and {VARIATION_SIGNIFICANCE:g} standard errors (not the "
-        "model's loop)",
+        f"its central part by more than {VARIATION * 100:g} % and {VARIATION_SIGNIFICANCE:g} "
+        "standard errors (not the model's loop)",
         RESOLVED,
     ),
     "gicof-varies": (
         "the friction read along the stroke wiggles beyond the noise (its means over "
         f"{SCATTER_BLOCKS} blocks of the central part scatter about a straight line by more "
-        f"than {GICOF_WIGGLE * 100:g} % of μ: chatter): "
-        "the GICoF, read at one position, is not the contact's mean friction",
+        f"than {GICOF_WIGGLE * 100:g} % of μ: chatter): the GICoF, read at one position, is "
+        "not the contact's mean friction",
         _GICOF,
     ),
 }
+
+#: The reasons that the reading along the stroke adds (its flags do not warn).
+READING_REASONS = (
+    "stiffness-mismatch",
+    "no-overlap",
+    "few-slip-samples",
+    "mu-varies",
+    "gicof-varies",
+)
+
+#: What to do about a recording whose every cycle is refused for a reason, the first that
+#: applies; with loops anticlockwise and stick sides sloping down, :data:`_FLIP_HINT`.
+_HINTS = {
+    "missing-samples": "Every cycle holds a missing sample (NaN or an empty cell).",
+    "anticlockwise": "The loops run anticlockwise with stick sides sloping up: the recording "
+    "runs backwards in time, or the displacement and force columns are swapped.",
+    "constant-force": "The force does not vary: is the force channel connected?",
+    "implausible-amplitude": f"The displacement amplitude is outside {_AMPLITUDES}: the "
+    "displacement is not in the unit assumed. analyze_loops takes metres; on the command "
+    "line, --displacement-unit gives the column's unit (a column without a unit in its name "
+    "or the file is read in µm).",
+}
+_FLIP_HINT = (
+    "The loops run anticlockwise with stick sides sloping down: the force is recorded "
+    "positive against the displacement. If so, read it with the other sign: "
+    "flip_force=True (on the command line, --flip-force)."
+)
+_LAST_HINT = (
+    "Is it a recording of fretting loops, with the displacement and the force in their own columns?"
+)
+
+#: The recorded values that a refused cycle keeps.
+_RECORDED = ("normal_load",)
+
+#: The counts of :class:`Tally` that parts add up.
+_SUMS = ("cycles", "refused", "flagged", "implausible_cof", "scaled")
+
+
+class LoopQualityWarning(UserWarning):
+    """Cycles of a recording were flagged in ``quality``, or its units look wrong."""
+
+
+class ImplausibleScaleWarning(LoopQualityWarning):
+    """Cycles whose amplitude or coefficient of friction is outside what a unit or a load
+    makes plausible (``implausible-amplitude``, ``implausible-cof``): a
+    :class:`LoopQualityWarning` that ``warnings.filterwarnings`` can turn alone into errors."""
+
+
+class ImplausibleScaleError(ValueError):
+    """Every cycle refused, some for an amplitude outside what the displacement's unit makes
+    plausible (``implausible-amplitude``): the unit assumed is likely wrong."""
+
+
+def _attrs(name: str) -> dict:
+    attrs = nomenclature.attrs(name)
+    if name in _COMMENTS:
+        attrs["comment"] = _COMMENTS[name]
+    return attrs
+
+
+def _refusal_hint(flags: dict) -> str:
+    """What to do about a recording whose every cycle is refused (``flags``: the reasons
+    every cycle carries, ``negative-stiffness`` if any does)."""
+    if flags["anticlockwise"] and flags["negative-stiffness"] and not flags["missing-samples"]:
+        return _FLIP_HINT
+    return next((hint for reason, hint in _HINTS.items() if flags[reason]), _LAST_HINT)
+
+
+def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
+    """``results`` with the centred loops of :func:`measure_cycles` (``keep_loops=True``)."""
+    results["loop_displacement"] = (("cycle", "point"), loops[0], _attrs("loop_displacement"))
+    results["loop_force"] = (("cycle", "point"), loops[1], _attrs("loop_force"))
+    results.coords["point"] = ("point", np.arange(loops[0].shape[1]), _attrs("point"))
+    return results
+
+
+def regime_ratio(values: dict, rig_stiffness) -> np.ndarray:
+    """The energy ratio that decides each cycle's regime: on the contact's displacement
+    when the rig's stiffness is known, else on the applied one. [1]"""
+    return values["energy_ratio" if rig_stiffness is None else "contact_energy_ratio"]
+
+
+def gross_slip(values: dict, options) -> np.ndarray:
+    """True for the cycles whose :func:`regime_ratio` exceeds ``gross_slip_threshold``."""
+    return regime_ratio(values, options.rig_stiffness) > options.gross_slip_threshold
+
+
+def _outside(value, bounds):
+    return np.isfinite(value) & ((value < bounds[0]) | (value > bounds[1]))
+
+
+def scale_flags(values: dict, options) -> dict:
+    """The checks of scale of each cycle (reason -> per cycle): an amplitude outside
+    :data:`AMPLITUDE_RANGE`, or the ECoF or GICoF of a gross-slip loop outside
+    :data:`COF_RANGE` (not :math:`Q^*/P`, which a deep groove raises above 3)."""
+    scaled = _outside(values["amplitude"], AMPLITUDE_RANGE)
+    cof = _outside(values["ecof"], COF_RANGE) | _outside(values["gicof"], COF_RANGE)
+    return {
+        "implausible-amplitude": scaled,
+        "implausible-cof": gross_slip(values, options) & cof & ~scaled,
+    }
+
+
+def judged(values: dict, flags: dict, options):
+    """The one judgement of a part's cycles: ``values`` (name -> per cycle, as measured)
+    NaN where a flag's scope reaches, the ``quality`` strings, the cycles refused and the
+    regime codes. ``flags`` (reason -> per cycle) are every check's, the scale's included."""
+    size = next(iter(flags.values())).size
+    refused = _refusing(flags, size)
+    recorded = {k: values[k] for k in _RECORDED if k in values}  # a refused cycle's too
+    values = apply_quality({k: v for k, v in values.items() if k not in recorded}, flags)
+    sliding = gross_slip(values, options)
+    regime = np.where(refused, INVALID, np.where(sliding, GROSS_SLIP, PARTIAL_SLIP))
+    return values | recorded, quality_strings(flags, size), refused, regime
+
+
+def cycle_results(values: dict, flags: dict, label, options) -> xr.Dataset:
+    """The per-cycle Dataset of :func:`analyze_loops` for some cycles, without the
+    recording's attributes: ``values`` and ``flags`` (the scale's included) judged once."""
+    values, quality, _, regime = judged(values, flags, options)
+    last = ("stick_residual", *_RECORDED)
+    data = {k: ("cycle", v, _attrs(k)) for k, v in values.items() if k not in last}
+    data["regime"] = ("cycle", regime.astype(np.int32), _attrs("regime") | Regime.flag_attrs())
+    data |= {k: ("cycle", values[k], _attrs(k)) for k in last if k in values}
+    data["quality"] = ("cycle", quality, _attrs("quality"))
+    load = ((), options.load, _attrs("load"))
+    return xr.Dataset(data, coords={"cycle": ("cycle", label, _attrs("cycle")), "load": load})
+
+
+class Tally:
+    """What :func:`analyze_loops` says about a whole recording, counted from the flags of
+    its parts as they come."""
+
+    def __init__(self):
+        self.counts = collections.Counter()  # cycles by quality
+        self.cycles = self.refused = self.flagged = self.implausible_cof = self.scaled = 0
+        self.every = dict.fromkeys(_HINTS, True)
+        self.negative_stiffness = False
+        self.amplitudes: list = []
+
+    def add(self, quality, flags: dict, amplitude) -> None:
+        """Count the cycles of a part: their ``quality``, ``flags`` and amplitudes as measured."""
+        part = Tally()
+        part.counts.update(np.asarray(quality).tolist())
+        quiet = {"ok", "partial-slip", *READING_REASONS}
+        loud = _by_text(quality, lambda text: bool(set(text.split(SEPARATOR)) - quiet))
+        part.flagged, part.cycles = int(loud.sum()), amplitude.size
+        part.refused = int(_refusing(flags, amplitude.size).sum())
+        part.every = {reason: bool(flags[reason].all()) for reason in _HINTS}
+        part.negative_stiffness = bool(flags["negative-stiffness"].any())
+        part.amplitudes = [amplitude]
+        part.implausible_cof = int(flags["implausible-cof"].sum())
+        part.scaled = int(flags["implausible-amplitude"].sum())
+        self.merge(part)
+
+    def merge(self, other: Tally) -> None:
+        """Count the parts ``other`` counted (in another process, say) as well."""
+        self.counts.update(other.counts)
+        for name in _SUMS:
+            setattr(self, name, getattr(self, name) + getattr(other, name))
+        for reason in _HINTS:
+            self.every[reason] &= other.every[reason]
+        self.negative_stiffness |= other.negative_stiffness
+        self.amplitudes += other.amplitudes
+
+    @property
+    def summary(self) -> str:
+        """The one-line quality summary so far."""
+        return summary_of_counts(self.counts)
+
+    def finish(self, results, cycles: Cycles, cycles_from: str, options) -> xr.Dataset:
+        """Check the whole recording and give ``results`` (the parts, joined) its attributes."""
+        summary, scaled = self.summary, self.scaled
+        if self.cycles and self.refused == self.cycles:
+            hint = _refusal_hint(self.every | {"negative-stiffness": self.negative_stiffness})
+            error = ImplausibleScaleError if scaled else ValueError
+            raise error(f"no plausible cycle in the recording ({summary}). {hint}")
+        if scaled:
+            warn(
+                f"{scaled} cycles have an amplitude outside {_AMPLITUDES}: is the displacement "
+                "in metres (on the command line --displacement-unit; a column without a unit "
+                "is read in µm)?",
+                ImplausibleScaleWarning,
+            )
+        if self.implausible_cof:
+            warn(
+                f"{self.implausible_cof} cycles have a coefficient of friction outside "
+                f"{COF_RANGE[0]:g} to {COF_RANGE[1]:g} with the load of "
+                f"{float(results['load']):g} N: is the load right (load=, on the command line "
+                "--load) and the force in newtons (--force-unit; a column without a unit is "
+                "read in N)?",
+                ImplausibleScaleWarning,
+            )
+        if self.flagged:
+            warn(f"cycles flagged: {summary}", LoopQualityWarning)
+        condition, changes = regime_condition(results)
+        amplitude = np.concatenate(self.amplitudes) if self.amplitudes else np.zeros(0)
+        amplitude = amplitude[np.isfinite(amplitude)]
+        sliding = amplitude.size and float(np.median(amplitude)) > FRETTING_AMPLITUDE
+        results.attrs.update(
+            {
+                "title": "Fretting loops analysed cycle by cycle (ecofmaps.analyze_loops)",
+                "cycles_from": cycles_from,
+                "incomplete_cycles": cycles.incomplete_cycles,
+                "dropped_samples": cycles.dropped_samples,
+                "missing_samples": cycles.missing_samples,
+                "first_missing_sample": cycles.first_missing,
+                "skipped_cycles": sum(
+                    c for text, c in self.counts.items() if "missing-samples" in text.split("+")
+                ),
+                "gross_slip_threshold": options.gross_slip_threshold,
+                "flip_force": int(options.flip_force),
+                "quality_summary": summary,
+                "sliding_condition": condition,
+                "regime_changes_at": changes,
+                "motion": "reciprocating sliding" if sliding else "fretting",
+            }
+        )
+        if options.rig_stiffness is not None:
+            results.attrs["rig_stiffness"] = options.rig_stiffness
+        return results
 
 
 def _refusing(flags: dict, size: int) -> np.ndarray:
@@ -457,10 +444,10 @@ def _refusing(flags: dict, size: int) -> np.ndarray:
     return refusing
 
 
-def _by_text(quality, function) -> np.ndarray:
+def _by_text(quality, function, dtype=bool) -> np.ndarray:
     """``function(text)`` for each cycle's ``quality``, computed once per distinct text."""
     texts, inverse = np.unique(np.ravel(quality), return_inverse=True)
-    return np.array([function(text) for text in texts], dtype=bool)[inverse]
+    return np.array([function(text) for text in texts], dtype=dtype)[inverse]
 
 
 def quality_strings(flags: dict, size: int) -> np.ndarray:
@@ -478,9 +465,8 @@ def quality_strings(flags: dict, size: int) -> np.ndarray:
                     keep = keep & ~flag
             code |= (flags[reason] & keep).astype(np.int64) << bit
     codes, inverse = np.unique(code, return_inverse=True)
-    names = list(REASONS)
     texts = [
-        SEPARATOR.join(names[bit] for bit in range(len(names)) if value >> bit & 1) or "ok"
+        SEPARATOR.join(name for bit, name in enumerate(REASONS) if value >> bit & 1) or "ok"
         for value in codes
     ]
     # One shared str per distinct quality: 8 bytes a cycle, however long the reasons.
@@ -498,9 +484,7 @@ def add_reason(quality, where, reason: str) -> np.ndarray:
         reasons = {reason} | (set() if text == "ok" else set(text.split(SEPARATOR)))
         return SEPARATOR.join(sorted(reasons, key=order.index))
 
-    texts, inverse = np.unique(quality, return_inverse=True)
-    updated = np.array([added(text) for text in texts], dtype=str)[inverse].reshape(quality.shape)
-    return np.where(where, updated, quality)
+    return np.where(where, _by_text(quality, added, str).reshape(quality.shape), quality)
 
 
 def has_reason(quality, reason: str) -> np.ndarray:
@@ -556,14 +540,6 @@ def summary_of_counts(counts) -> str:
     return summary + (f"; {flagged}" if flagged else "")
 
 
-#: A test's sliding conditions (Vincent et al. 1992; Zhou & Vincent 1995): every cycle in
-#: partial slip, the regime changing during the test, every cycle in gross slip.
-SLIDING_CONDITIONS = ("partial slip", "mixed slip", "gross slip")
-
-#: Cycles where the regime changes that :func:`sliding_condition_line` names.
-_CHANGES_SHOWN = 5
-
-
 def sliding_condition_of(cycle, gross_slip) -> tuple[str, np.ndarray]:
     """A test's sliding condition, one of :data:`SLIDING_CONDITIONS` (``'mixed slip'`` when
     the regime changes during the test), and the cycles where the regime changes (each the
@@ -597,19 +573,3 @@ def sliding_condition_line(results: xr.Dataset) -> str:
     shown = ", ".join(str(c) for c in changes[:_CHANGES_SHOWN])
     more = f", ... ({len(changes)} changes)" if len(changes) > _CHANGES_SHOWN else ""
     return f"{condition} (the regime changes at cycle{'s' * (len(changes) > 1)} {shown}{more})"
-
-
-class ImplausibleScaleWarning(LoopQualityWarning):
-    """Cycles whose amplitude or coefficient of friction is outside what a unit or a load
-    makes plausible (``implausible-amplitude``, ``implausible-cof``): the load given or the
-    unit assumed for a channel is likely wrong.
-
-    A :class:`~ecofmaps.measured.quality.LoopQualityWarning`, so filtering that one filters
-    this one too; ``warnings.filterwarnings("error", category=ImplausibleScaleWarning)``
-    turns only the checks of scale into errors.
-    """
-
-
-class ImplausibleScaleError(ValueError):
-    """Every cycle refused, some for an amplitude outside what the displacement's unit makes
-    plausible (``implausible-amplitude``): the unit assumed is likely wrong."""

@@ -6,6 +6,7 @@ The method is explained in ``docs/method-loops.md`` ("Finding the cycles").
 
 from __future__ import annotations
 
+import copy
 import sys
 
 import numpy as np
@@ -16,6 +17,8 @@ from ecofmaps.measured import kernels
 __all__ = [
     "CHANNELS",
     "Samples",
+    "blanked",
+    "detrended",
     "displacement_line",
     "displacement_percentiles",
     "ends_of_runs",
@@ -25,12 +28,21 @@ __all__ = [
     "level_at",
     "local_extremes",
     "missing_in",
+    "piece_extremes",
     "survey",
     "trigger_runs",
 ]
 
 #: Samples read at once by the passes over the whole recording.
 _CHUNK = 1 << 18
+#: Samples per block of a lazy recording when its own chunks do not say.
+_BLOCK = 1 << 22
+#: Quantiles of the reversal detector's range (the 1st and 99th percentiles).
+_QUANTILES = np.array([1.0, 99.0]) / 100.0
+#: Size of the random sample that brackets the percentiles of a long recording.
+_SAMPLE = 1 << 16
+#: The channels of a recording, in the order a block function receives them.
+CHANNELS = ("displacement", "force", "cycle", "missing")
 
 
 def _chunks(start: int, stop: int, chunk: int):
@@ -38,10 +50,9 @@ def _chunks(start: int, stop: int, chunk: int):
     return ((a, min(a + chunk, stop)) for a in range(start, stop, chunk))
 
 
-def _blanked(x, a: int, b: int, gaps) -> np.ndarray:
+def blanked(x, a: int, b: int, gaps) -> np.ndarray:
     """``x`` (samples ``a`` to ``b - 1``) with NaN at the missing ones (a copy if any)."""
-    first = np.searchsorted(gaps[:, 1], a, side="right")
-    last = np.searchsorted(gaps[:, 0], b)
+    first, last = np.searchsorted(gaps[:, 1], a, side="right"), np.searchsorted(gaps[:, 0], b)
     if first >= last:
         return x
     x = np.array(x, dtype=np.float64)
@@ -50,9 +61,9 @@ def _blanked(x, a: int, b: int, gaps) -> np.ndarray:
     return x
 
 
-def _piece_extremes(x, cuts):
-    """Largest and smallest finite value of each piece ``x[cuts[k]:cuts[k + 1]]`` and the
-    first index (in ``x``) of each, -1 where a piece has no finite value."""
+def piece_extremes(x, cuts, a: int):
+    """Largest and smallest finite value of each piece ``x[cuts[k]:cuts[k + 1]]`` (``x``
+    holds samples ``a`` on), each with the first sample of it, -1 where none is finite."""
     lengths = np.diff(cuts, append=x.size)
     found = []
     for reduce in (np.fmax, np.fmin):
@@ -61,7 +72,7 @@ def _piece_extremes(x, cuts):
         after = np.searchsorted(hits, cuts)
         index = hits[np.minimum(after, max(hits.size - 1, 0))] if hits.size else cuts
         inside = (after < hits.size) & (index < cuts + lengths)
-        found += [value, np.where(inside, index, -1)]
+        found += [value, np.where(inside, index + a, -1)]
     return found
 
 
@@ -109,17 +120,15 @@ def _survey(start, stop, arguments, x, q, cycle, mask):
         t = np.arange(a - middle, b - middle)
         if good.all():
             k, u = b - a, a - middle  # sums of t and t² in closed form
-            sums.append(
-                (k, np.add.reduce(xa), np.einsum("i,i->", t, xa), k * u + k * (k - 1) / 2,
-                 k * u * u + u * k * (k - 1) + (k - 1) * k * (2 * k - 1) / 6)
-            )  # fmt: skip
+            st = k * u + k * (k - 1) / 2
+            stt = k * u * u + u * k * (k - 1) + (k - 1) * k * (2 * k - 1) / 6
+            sums.append((k, np.add.reduce(xa), np.einsum("i,i->", t, xa), st, stt))
             finite += [a, b - 1]
         else:
-            bad = ~good
             xg, tg = xa[good], t[good]
-            sums.append((xg.size, np.add.reduce(xg), np.einsum("i,i->", tg, xg), tg.sum(),
-                         np.einsum("i,i->", tg, tg)))  # fmt: skip
-            edges = np.flatnonzero(np.diff(bad.view(np.int8), prepend=0, append=0))
+            stt = np.einsum("i,i->", tg, tg)
+            sums.append((xg.size, np.add.reduce(xg), np.einsum("i,i->", tg, xg), tg.sum(), stt))
+            edges = np.flatnonzero(np.diff((~good).view(np.int8), prepend=0, append=0))
             gaps.append(edges.reshape(-1, 2) + a)
             if xg.size:
                 where = np.flatnonzero(good)
@@ -144,7 +153,7 @@ def _tails(start, stop, arguments, x):
     chunk, gaps, line, (upper, lower) = arguments
     kept = []
     for a, b in _chunks(start, stop, chunk):
-        d = _detrended(_blanked(x[a - start : b - start], a, b, gaps), a, line)
+        d = detrended(blanked(x[a - start : b - start], a, b, gaps), a, line)
         kept.append(d[(d <= upper) | (d >= lower)])
     return np.concatenate(kept)
 
@@ -163,13 +172,11 @@ def local_extremes(start, stop, arguments, x):
     chunk, gaps, line, width = arguments
     found = [np.empty((3, 0))]
     for a, b in _chunks(start, stop, chunk):
-        d = _detrended(_blanked(x[a - start : b - start], a, b, gaps), a, line)
+        d = detrended(blanked(x[a - start : b - start], a, b, gaps), a, line)
         first = np.arange(a // width, (b - 1) // width + 1)
         cuts = np.maximum(first * width, a) - a
-        found.append(
-            np.stack([first.astype(np.float64), np.fmax.reduceat(d, cuts),
-                      np.fmin.reduceat(d, cuts)])
-        )  # fmt: skip
+        highest, lowest = np.fmax.reduceat(d, cuts), np.fmin.reduceat(d, cuts)
+        found.append(np.stack([first.astype(np.float64), highest, lowest]))
     return np.concatenate(found, axis=1)
 
 
@@ -179,8 +186,8 @@ def trigger_runs(start, stop, arguments, x):
     entries, kinds, pieces = [], [], []
     previous = 0
     for a, b in _chunks(start, stop, chunk):
-        xa = _blanked(x[a - start : b - start], a, b, gaps)
-        d = _detrended(xa, a, line)
+        xa = blanked(x[a - start : b - start], a, b, gaps)
+        d = detrended(xa, a, line)
         level = level_at(band, np.arange(a, b)) if isinstance(band, tuple) else band
         state = (d > centre + level).view(np.int8) - (d < centre - level).view(np.int8)
         entry = np.concatenate([[0], np.flatnonzero(state[1:] != state[:-1]) + 1])
@@ -193,11 +200,7 @@ def trigger_runs(start, stop, arguments, x):
         entries.append(entry + a)
         kinds.append(kind)
         cuts = entry if entry.size and entry[0] == 0 else np.concatenate([[0], entry])
-        highest, top, lowest, bottom = _piece_extremes(xa, cuts)
-        pieces.append(
-            np.stack([cuts + a, highest, np.where(top >= 0, top + a, -1), lowest,
-                      np.where(bottom >= 0, bottom + a, -1)])
-        )  # fmt: skip
+        pieces.append(np.stack([cuts + a, *piece_extremes(xa, cuts, a)]))
     return np.concatenate(entries), np.concatenate(kinds), np.concatenate(pieces, axis=1)
 
 
@@ -218,32 +221,23 @@ def labelled_runs(start, stop, arguments, x, cycle):
                 last = np.maximum.accumulate(np.where(known, np.arange(label.size), -1))
                 label = np.where(last >= 0, label[np.maximum(last, 0)], carry)
             carry = label[b - 1 - a]
-        xa = _blanked(x[a - start : ahead - start], a, ahead, gaps)
+        xa = blanked(x[a - start : ahead - start], a, ahead, gaps)
         step = np.abs(np.diff(xa))  # step[i]: from sample a + i to the next
         step[label[1:] != label[:-1]] = np.nan  # no step from a run's last sample
         label, xa, step = label[: b - a], xa[: b - a], step[: b - a]
         if step.size < label.size:
             step = np.append(step, np.nan)
         cuts = np.concatenate([[0], np.flatnonzero(label[1:] != label[:-1]) + 1])
-        highest, _, lowest, bottom = _piece_extremes(xa, cuts)
-        x_first, x_last = _finite_ends(xa, cuts)
+        highest, _, lowest, bottom = piece_extremes(xa, cuts, a)
+        runs = [cuts + a, label[cuts].astype(np.float64), np.diff(np.append(cuts, b - a))]
+        ends = _finite_ends(xa, cuts)
         pieces.append(
-            np.stack([cuts + a, label[cuts].astype(np.float64), np.diff(np.append(cuts, b - a)),
-                      highest, lowest, np.where(bottom >= 0, bottom + a, -1), x_first, x_last,
-                      np.fmax.reduceat(step, cuts)])
-        )  # fmt: skip
+            np.stack([*runs, highest, lowest, bottom, *ends, np.fmax.reduceat(step, cuts)])
+        )
     return np.concatenate(pieces, axis=1)
 
 
-#: Quantiles of the reversal detector's range (the 1st and 99th percentiles).
-_QUANTILES = np.array([1.0, 99.0]) / 100.0
-
-
-#: Size of the random sample that brackets the percentiles of a long recording.
-_SAMPLE = 1 << 16
-
-
-def _detrended(x, a: int, line):
+def detrended(x, a: int, line):
     """The displacements ``x`` of samples ``a`` on less the straight ``line``."""
     mean, mean_t, slope, middle = (float(value) for value in line)
     return kernels.detrended(
@@ -274,16 +268,12 @@ def survey(samples: Samples):
 
 def displacement_line(sums, size: int):
     """``(mean, mean_t, slope, middle)`` of the least-squares line through the finite
-    displacements over t = i - (size - 1)/2 (see :func:`_detrended`)."""
+    displacements over t = i - (size - 1)/2 (see :func:`detrended`)."""
     count = sums[:, 0].sum()
     middle = 0.5 * (size - 1)
     if count == size:  # every sample: the t sum to 0 and their squares to n(n² - 1)/12
-        return (
-            sum(sums[:, 1].tolist()) / size,
-            0.0,
-            sum(sums[:, 2].tolist()) / ((size * (size * size - 1)) / 12),
-            middle,
-        )
+        sx, stx = sum(sums[:, 1].tolist()), sum(sums[:, 2].tolist())
+        return sx / size, 0.0, stx / ((size * (size * size - 1)) / 12), middle
     if count < 2:
         raise ValueError("the displacement does not oscillate: no reversal can be found")
     sx, stx, st, stt = (sum(sums[:, k].tolist()) for k in (1, 2, 3, 4))
@@ -292,15 +282,18 @@ def displacement_line(sums, size: int):
     return mean, mean_t, (stx - st * mean) / spread if spread > 0 else 0.0, middle
 
 
+def _percentiles(samples: Samples, gaps, line):
+    """The percentiles of every finite detrended displacement, held at once."""
+    every = samples.map(_tails, ("displacement",), (_CHUNK, gaps, line, (np.inf, -np.inf)))
+    return np.percentile(np.concatenate(every), _QUANTILES * 100.0, overwrite_input=True)
+
+
 def displacement_percentiles(samples: Samples, gaps, line, sample_at, sampled, count: int):
     """``np.percentile`` of the finite detrended displacements at the 1st and 99th
     percentile, exactly."""
     mean, mean_t, slope, middle = line
     if count <= _CHUNK:
-        tails = np.concatenate(
-            samples.map(_tails, ("displacement",), (_CHUNK, gaps, line, (np.inf, -np.inf)))
-        )
-        return np.percentile(tails, _QUANTILES * 100.0, overwrite_input=True)
+        return _percentiles(samples, gaps, line)
     virtual = (count - 1) * _QUANTILES  # NumPy's virtual index, method "linear"
     rank = np.floor(virtual).astype(np.int64)
     missing = np.zeros(sample_at.size, dtype=bool)
@@ -316,38 +309,29 @@ def displacement_percentiles(samples: Samples, gaps, line, sample_at, sampled, c
     high = np.ceil(quantile + spread).astype(np.int64)
     low = np.where(low > 0, sample[np.clip(low, 0, drawn - 1)], -np.inf)
     high = np.where(high < drawn - 1, sample[np.clip(high, 0, drawn - 1)], np.inf)
-    tails = np.concatenate(
-        samples.map(_tails, ("displacement",), (_CHUNK, gaps, line, (high[0], low[1])))
-    )
+    brackets = (_CHUNK, gaps, line, (high[0], low[1]))
+    tails = np.concatenate(samples.map(_tails, ("displacement",), brackets))
     result = np.empty(2)
     for k in range(2):
         kept = tails[(tails >= low[k]) & (tails <= high[k])]
-        below = (
-            np.count_nonzero(tails < low[k])
-            if k == 0
-            else count - np.count_nonzero(tails >= low[k])
-        )
+        if k == 0:
+            below = np.count_nonzero(tails < low[k])
+        else:
+            below = count - np.count_nonzero(tails >= low[k])
         j = rank[k] - below
         if not 0 <= j < kept.size - 1:  # the sample missed: hold every value once
-            whole = np.concatenate(
-                samples.map(_tails, ("displacement",), (_CHUNK, gaps, line, (np.inf, -np.inf)))
-            )
-            return np.percentile(whole, _QUANTILES * 100.0, overwrite_input=True)
+            return _percentiles(samples, gaps, line)
         previous, following = np.partition(kept, [j, j + 1])[[j, j + 1]]
-        gamma = virtual[k] - rank[k]
-        difference = following - previous
-        result[k] = (
-            following - difference * (1.0 - gamma)
-            if gamma >= 0.5
-            else previous + difference * gamma
-        )
+        gamma, difference = virtual[k] - rank[k], following - previous
+        if gamma >= 0.5:
+            result[k] = following - difference * (1.0 - gamma)
+        else:
+            result[k] = previous + difference * gamma
     return result
 
 
 def missing_in(gaps, start, count):
-    """True for each stretch ``start``, ``count`` that holds a sample of ``gaps``."""
-    if not gaps.size:
-        return None
+    """True for each stretch ``start``, ``count`` that holds a sample of ``gaps`` (some)."""
     after = np.searchsorted(gaps[:, 1], start, side="right")  # first gap ending after start
     return (after < gaps.shape[0]) & (gaps[np.minimum(after, gaps.shape[0] - 1), 0] < start + count)
 
@@ -369,13 +353,6 @@ def ends_of_runs(run, valued, values, runs: int, first: bool):
     return result
 
 
-#: The channels of a recording, in the order a block function receives them.
-CHANNELS = ("displacement", "force", "cycle", "missing")
-
-#: Samples per block of a lazy recording when its own chunks do not say.
-_BLOCK = 1 << 22
-
-
 def is_lazy(value) -> bool:
     """Whether ``value`` is a dask collection, or an xarray object backed by one."""
     if "dask" not in sys.modules:  # nothing can be lazy before dask is imported
@@ -386,45 +363,31 @@ def is_lazy(value) -> bool:
     return dask.is_dask_collection(data)
 
 
-def _task(function, start, stop, arguments, *arrays):
-    """A block of :meth:`Samples.map` as run in a task (the arrays read by then)."""
-    return function(start, stop, arguments, *arrays)
-
-
 class Samples:
     """The channels of one recording."""
 
-    def __init__(
-        self, displacement, force, cycle=None, missing=None, *, runner=None, chunk, block=None
-    ):
+    def __init__(self, displacement, force, cycle=None, missing=None, *, runner=None):
         self.arrays = (displacement, force, cycle, missing)
         self.size = int(displacement.shape[0])
         self.lazy = any(is_lazy(a) for a in self.arrays if a is not None)
         self.runner = runner
         if self.lazy and runner is None:
             raise ValueError("a lazy recording needs a runner")
-        if block is None:
-            chunks = getattr(displacement, "chunks", None)
-            block = int(chunks[0][0]) if chunks and chunks[0] else _BLOCK
-        self.block = max(1, round(block / chunk)) * chunk
+        chunks = getattr(displacement, "chunks", None)
+        block = int(chunks[0][0]) if chunks and chunks[0] else _BLOCK
+        self.block = max(1, round(block / _CHUNK)) * _CHUNK  # whole chunks of the passes
 
     def constant_cycle(self) -> Samples:
         """These samples with every cycle number 0 (the whole recording one cycle)."""
-        x = self.arrays[0]
         if self.lazy:
             import dask.array as da
 
-            cycle = da.zeros(self.size, dtype=np.int64, chunks=x.chunks)
+            cycle = da.zeros(self.size, dtype=np.int64, chunks=self.arrays[0].chunks)
         else:
             cycle = np.zeros(self.size, dtype=np.int64)
-        copy = object.__new__(Samples)
-        copy.__dict__.update(self.__dict__)
-        copy.arrays = (self.arrays[0], self.arrays[1], cycle, self.arrays[3])
-        return copy
-
-    def channel(self, name: str):
-        """The channel ``name`` (one of :data:`CHANNELS`), or None."""
-        return self.arrays[CHANNELS.index(name)]
+        constant = copy.copy(self)
+        constant.arrays = (*self.arrays[:2], cycle, self.arrays[3])
+        return constant
 
     def blocks(self):
         """``(start, stop)`` of each block of a lazy recording (the grid)."""
@@ -432,7 +395,7 @@ class Samples:
 
     def map(self, function, channels, arguments=(), extra: int = 0) -> list:
         """``function(start, stop, arguments, *arrays)`` over the recording's blocks."""
-        selected = [self.channel(name) for name in channels]
+        selected = [self.arrays[CHANNELS.index(name)] for name in channels]
         if not self.lazy:
             return [function(0, self.size, arguments, *selected)]
 
@@ -440,6 +403,6 @@ class Samples:
             for a, b in self.blocks():
                 end = min(b + extra, self.size)
                 arrays = (None if s is None else stretch(s, a, end) for s in selected)
-                yield (function, a, b, arguments, *arrays)
+                yield (a, b, arguments, *arrays)
 
-        return list(self.runner.map(_task, tasks()))
+        return list(self.runner.map(function, tasks()))

@@ -24,7 +24,7 @@ from tests.measured.golden import signal
 
 def percentiles(values):
     """The reversal detector's percentiles of ``values`` (taken as detrended already)."""
-    samples = Samples(values, None, chunk=passes._CHUNK)
+    samples = Samples(values, None)
     sample_at = np.sort(np.random.default_rng(0).integers(0, values.size, passes._SAMPLE))
     line = (0.0, 0.0, 0.0, 0.5 * (values.size - 1))
     gaps = np.zeros((0, 2), np.int64)
@@ -59,8 +59,8 @@ def assert_found(found, expected):
     assert found.incomplete_cycles == expected["incomplete_cycles"]
     assert found.dropped_samples == expected["dropped_samples"]
     if found.label.size:
-        samples, points = found.indices(width=expected["width"])
-        valid = np.arange(expected["width"]) < expected["points"][:, None]
+        samples, points = found.indices()
+        valid = np.arange(samples.shape[1]) < expected["points"][:, None]
         np.testing.assert_array_equal(samples[valid], expected["samples"])
         np.testing.assert_array_equal(points, expected["points"])
         np.testing.assert_array_equal(found.label, expected["label"])
