@@ -21,6 +21,7 @@ __all__ = [
     "add_recording_options",
     "byte_size",
     "count",
+    "option_adder",
     "print_rows",
     "quantity",
     "recording_options",
@@ -43,10 +44,8 @@ def _in_range(name: str, values: np.ndarray, text: str) -> None:
 
 def quantity(name: str, grid: bool = False, option: str | None = None):
     """An argparse ``type`` reading a value of quantity ``name`` with units (with ``grid``, a
-    list ``a,b,c`` or a range ``start:stop:num`` of values that do not repeat), checked against
-    its dimension and valid range in the nomenclature (argparse names the option). A bare
-    number implausible in SI is warned, naming ``option`` (default ``--name``) and the unit
-    probably meant."""
+    list ``a,b,c`` or a range ``start:stop:num``), checked against its dimension and valid
+    range; a bare number implausible in SI is warned of, naming ``option`` (``--name``)."""
     kind = QUANTITIES[name].kind
     option = option or "--" + name.replace("_", "-")
 
@@ -73,11 +72,8 @@ def quantity(name: str, grid: bool = False, option: str | None = None):
 
 
 def unit(kind: str):
-    """An argparse ``type`` reading a unit of ``kind`` (``'um'``, ``'kN'``): kept as text.
-
-    The text must name a unit of that dimension whose size is positive and finite: an empty
-    text, a number (``'0um'``) or a unit of another kind is an error naming the option.
-    """
+    """An argparse ``type`` reading a unit of ``kind`` (``'um'``, ``'kN'``), kept as text: a
+    unit of that dimension whose size is positive and finite (not a number, ``'0um'``)."""
 
     def parse(text: str) -> str:
         if not text.strip():
@@ -115,53 +111,44 @@ def count(what: str):
     return parse
 
 
+#: The help of each option of :func:`add_recording_options`.
+_RECORDING_HELP = {
+    "--displacement-col": "name of the displacement column (default: displacement)",
+    "--force-col": "name of the tangential force column (default: force)",
+    "--cycle-col": "name of a column of cycle numbers, which must exist (default: 'cycle' if "
+    "the file has it; else, or with 'none', cycles are cut at the reversals)",
+    "--skip-rows": "lines of a text file to skip before its header line (default: metadata "
+    "lines before the header are found)",
+    "--displacement-unit": "unit of the displacement column (default: the one its name or the "
+    "file gives, as in 'displacement [mm]' or a channel's unit, else um)",
+    "--force-unit": "unit of the force column (default: from its name or the file, else N)",
+    "--group": "TDMS group, or HDF5/netCDF/zarr group, holding the channels (default: any)",
+}
+
+
+def option_adder(parser, helps: dict):
+    """``add(name, **keywords)``: add option ``name`` to ``parser``, its help ``helps[name]``."""
+
+    def add(name: str, **keywords) -> None:
+        parser.add_argument(name, help=helps[name], **keywords)
+
+    return add
+
+
 def add_recording_options(parser) -> None:
     """The options that say where a recording's columns are and in which units."""
-    for option, default, help in (
-        (
-            "--displacement-col",
-            "displacement",
-            "name of the displacement column (default: displacement)",
-        ),
-        ("--force-col", "force", "name of the tangential force column (default: force)"),
-        (
-            "--cycle-col",
-            None,
-            "name of a column of cycle numbers, which must exist (default: 'cycle' if the file "
-            "has it; else, or with 'none', cycles are cut at the reversals)",
-        ),
-    ):
-        parser.add_argument(option, default=default, metavar="NAME", help=help)
-    parser.add_argument(
-        "--skip-rows",
-        type=int,
-        metavar="N",
-        help="lines of a text file to skip before its header line (default: metadata lines "
-        "before the header are found)",
-    )
-    parser.add_argument(
-        "--displacement-unit",
-        type=unit("length"),
-        metavar="UNIT",
-        help="unit of the displacement column (default: the one its name or the file gives, as "
-        "in 'displacement [mm]' or a channel's unit, else um)",
-    )
-    parser.add_argument(
-        "--force-unit",
-        type=unit("force"),
-        metavar="UNIT",
-        help="unit of the force column (default: from its name or the file, else N)",
-    )
-    parser.add_argument(
-        "--group",
-        metavar="NAME",
-        help="TDMS group, or HDF5/netCDF/zarr group, holding the channels (default: any)",
-    )
+    option = option_adder(parser, _RECORDING_HELP)
+    option("--displacement-col", default="displacement", metavar="NAME")
+    option("--force-col", default="force", metavar="NAME")
+    option("--cycle-col", metavar="NAME")
+    option("--skip-rows", type=int, metavar="N")
+    option("--displacement-unit", type=unit("length"), metavar="UNIT")
+    option("--force-unit", type=unit("force"), metavar="UNIT")
+    option("--group", metavar="NAME")
 
 
 def recording_options(args) -> dict:
-    """The keywords of :func:`ecofmaps.io.recordings.read_recording` given by a command's
-    column, unit and group options (``--displacement-col`` ... ``--group``)."""
+    """The keywords of :func:`ecofmaps.io.recordings.read_recording` the options give."""
     if args.cycle_col is not None and not args.cycle_col.strip():
         raise CommandError(
             f"--cycle-col {args.cycle_col!r} names no column: give the cycle column's name, "
@@ -181,14 +168,10 @@ def recording_options(args) -> dict:
 def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=()) -> None:
     """Raise :class:`CommandError` unless the command may write its outputs: the one rule.
 
-    An output is never an input file. An output that exists is replaced only with
-    ``--overwrite``, and only if ecofmaps wrote it and it is unchanged since
-    (:func:`ecofmaps.io.files.written_by_ecofmaps`): a user's file, and a folder that is
-    not a store ecofmaps wrote, are never replaced. A folder the command writes files into
-    (``--plots``, ``figures --out``) may exist empty; one that holds anything needs
-    ``--overwrite``, and then only ecofmaps' own files in it are replaced, the others kept.
-    Everything is checked before any work. ``outputs`` and ``folders`` are (the option that
-    names it, its path or None); ``inputs`` the files the command reads.
+    An output is never an input; one that exists is replaced only with ``overwrite`` and only
+    if ecofmaps wrote it, unchanged since (:func:`ecofmaps.io.files.written_by_ecofmaps`). A
+    folder written into (``--plots``) may exist empty; one holding anything needs
+    ``overwrite``. ``outputs`` and ``folders`` are (option, path or None); ``inputs`` paths.
     """
     outputs = [(option, Path(path)) for option, path in outputs if path is not None]
     sources = [Path(path) for path in inputs]
@@ -242,11 +225,8 @@ def _resolved(path: Path) -> Path:
 
 
 def row(name: str, value, note: str = "") -> tuple[str, str, str]:
-    """One printed row: the quantity's words and symbol, and ``value`` [SI] in its display unit.
-
-    ``value`` may be text (printed as it is); a NaN prints as ``undefined``, an infinite
-    stiffness as ``inf (rigid)``. ``note`` follows the words, e.g. ``'(reported)'``.
-    """
+    """One printed row: the quantity's words (then ``note``) and symbol, and ``value`` [SI] in
+    its display unit (text as it is; NaN ``undefined``; an infinite stiffness ``inf (rigid)``)."""
     quantity = QUANTITIES[name]
     words = f"{quantity.words} {note}".strip()
     if isinstance(value, str):

@@ -22,14 +22,7 @@ import warnings
 from ecofmaps._interrupts import STOP_SIGNALS, interrupts_stop_writes
 from ecofmaps._version import __version__
 
-__all__ = [
-    "EXIT_INTERRUPTED",
-    "EXIT_TERMINATED",
-    "CommandError",
-    "build_parser",
-    "console",
-    "main",
-]
+__all__ = ["EXIT_INTERRUPTED", "EXIT_TERMINATED", "CommandError", "build_parser", "console", "main"]
 
 
 class CommandError(Exception):
@@ -37,17 +30,7 @@ class CommandError(Exception):
 
 
 #: The subcommands, each a module of :mod:`ecofmaps.cli`, in the order ``--help`` lists them.
-_SUBCOMMANDS = (
-    "model",
-    "figures",
-    "map",
-    "cache",
-    "loops",
-    "convert",
-    "correct",
-    "explore",
-    "wear",
-)
+_COMMANDS = ("model", "figures", "map", "cache", "loops", "convert", "correct", "explore", "wear")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -71,7 +54,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"ecofmaps {__version__}")
     subparsers = parser.add_subparsers(title="commands", metavar="COMMAND", required=True)
-    for name in _SUBCOMMANDS:
+    for name in _COMMANDS:
         module = importlib.import_module(f"ecofmaps.cli.{name}")
         module.add(subparsers)
         subparsers.choices[name].set_defaults(handler=module.run)
@@ -82,8 +65,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _unknown_arguments(unknown, args) -> str:
-    """The error line of arguments the subcommand ``args`` was given does not know: named
-    with its ``--help``, and an option like one of its own with a did-you-mean."""
+    """The error line of arguments unknown to the subcommand, with did-you-means."""
     guesses = [
         difflib.get_close_matches(word.split("=")[0], args.command_options, n=1)
         for word in unknown
@@ -150,9 +132,7 @@ def main(argv=None) -> int:
 
 
 def _stopped(interrupted, note) -> int:
-    """Report a run stopped by Ctrl-C or SIGTERM in one line; return 130 or 143. What was
-    left is asked now of the subcommand's notes, if any, rather than taken from the stop's
-    ``note``: everything the stop interrupted has unwound by now."""
+    """Report a stopped run in one line (what was left asked of the notes now); 130 or 143."""
     terminated = interrupted is not None and interrupted.signal == signal.SIGTERM
     words = "terminated (SIGTERM)" if terminated else "interrupted"
     if interrupted is not None and interrupted.notes:
@@ -162,10 +142,7 @@ def _stopped(interrupted, note) -> int:
 
 
 def _ignored_after_main() -> list:
-    """The stop signals that :func:`console` ignores once :func:`main` returns (those not
-    ignored already: Ctrl-C in a background job stays ignored), from now on handled by
-    :func:`_nothing_to_stop` until then: the moment between :func:`main`'s block giving
-    their handlers back and :func:`console` ignoring them."""
+    """The stop signals not ignored already, handled by :func:`_nothing_to_stop` from now on."""
     numbers = [n for n in STOP_SIGNALS if signal.getsignal(n) not in (signal.SIG_IGN, None)]
     for number in numbers:
         signal.signal(number, _nothing_to_stop)
