@@ -17,6 +17,7 @@ from ecofmaps.io.files import MANIFEST, written_by_ecofmaps
 from ecofmaps.units import DIMENSIONS, bare_number_warning, parse_quantity, parse_values
 
 __all__ = [
+    "CACHE_DIR_HELP",
     "CommandError",
     "add_recording_options",
     "byte_size",
@@ -110,6 +111,9 @@ def count(what: str):
     parse.__name__ = what
     return parse
 
+
+#: The help of ``--cache-dir`` (``ecofmaps map``, ``cache``).
+CACHE_DIR_HELP = "cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)"
 
 #: The help of each option of :func:`add_recording_options`.
 _RECORDING_HELP = {

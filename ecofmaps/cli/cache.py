@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import textwrap
 
-from ecofmaps.cli._common import byte_size
+from ecofmaps.cli._common import CACHE_DIR_HELP, byte_size
 
 __all__ = ["add", "run"]
 
@@ -28,11 +28,7 @@ def add(subparsers) -> None:
         ("clear", "remove every cached map"),
     ):
         action = actions.add_parser(name, help=text, description=text + ".")
-        action.add_argument(
-            "--cache-dir",
-            metavar="DIR",
-            help="cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)",
-        )
+        action.add_argument("--cache-dir", metavar="DIR", help=CACHE_DIR_HELP)
         action.set_defaults(action=name)
 
 

@@ -10,12 +10,21 @@ from ecofmaps.cli._common import (
     CommandError,
     add_recording_options,
     count,
+    option_adder,
     recording_options,
     refuse_to_overwrite,
 )
 from ecofmaps.io.files import record_written
 
 __all__ = ["add", "run"]
+
+_HELP = {
+    "source": "the recording to read",
+    "destination": "the file or store to write",
+    "--chunk-samples": "samples per chunk of the store, and per block read (default 1048576)",
+    "--overwrite": "replace DST if ecofmaps wrote it (once the new one is complete); a file or "
+    "folder ecofmaps did not write is never replaced",
+}
 
 
 def add(subparsers) -> None:
@@ -34,22 +43,12 @@ def add(subparsers) -> None:
         epilog="example:\n  ecofmaps convert test.csv test.zarr --displacement-unit um",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("source", metavar="SRC", help="the recording to read")
-    parser.add_argument("destination", metavar="DST", help="the file or store to write")
+    option = option_adder(parser, _HELP)
+    option("source", metavar="SRC")
+    option("destination", metavar="DST")
     add_recording_options(parser)
-    parser.add_argument(
-        "--chunk-samples",
-        type=count("samples"),
-        default=1 << 20,
-        metavar="N",
-        help="samples per chunk of the store, and per block read (default 1048576)",
-    )
-    parser.add_argument(
-        "--overwrite",
-        action="store_true",
-        help="replace DST if ecofmaps wrote it (once the new one is complete); a file or "
-        "folder ecofmaps did not write is never replaced",
-    )
+    option("--chunk-samples", type=count("samples"), default=1 << 20, metavar="N")
+    option("--overwrite", action="store_true")
 
 
 def run(args) -> int:
@@ -66,12 +65,9 @@ def run(args) -> int:
     if not destination.parent.is_dir():
         raise CommandError(f"cannot write {destination}: its directory does not exist")
     refuse_to_overwrite([("DST", destination)], [source], overwrite=args.overwrite)
+    options = recording_options(args)
     convert_recording(
-        source,
-        destination,
-        chunk_samples=args.chunk_samples,
-        overwrite=args.overwrite,
-        **recording_options(args),
+        source, destination, chunk_samples=args.chunk_samples, overwrite=args.overwrite, **options
     )
     record_written([destination])
     with read_recording(destination, lazy=True) as written:

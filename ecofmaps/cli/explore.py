@@ -4,13 +4,21 @@ from __future__ import annotations
 
 import argparse
 
-from ecofmaps.cli._common import CommandError
+from ecofmaps.cli._common import CommandError, option_adder
 from ecofmaps.web import INSTALL_WEB, missing_web_packages
 
 __all__ = ["DEFAULT_PORT", "add", "run"]
 
 #: The port the explorer listens on unless --port says otherwise.
 DEFAULT_PORT = 5006
+
+_HELP = {
+    "--port": f"the port to listen on (default {DEFAULT_PORT})",
+    "--no-browser": "do not open the page in a browser",
+    "--allow-origin": "also answer pages of this host (a tunnel or proxy's name; without a port, "
+    "--port's); by default only 127.0.0.1, localhost and [::1] at --port, and any other Host "
+    "or Origin gets 403 (repeat the option for more hosts)",
+}
 
 
 def _port(text: str) -> int:
@@ -39,25 +47,10 @@ def add(subparsers) -> None:
             'extra web: pip install "ecofmaps[web]".'
         ),
     )
-    parser.add_argument(
-        "--port",
-        type=_port,
-        default=DEFAULT_PORT,
-        metavar="N",
-        help=f"the port to listen on (default {DEFAULT_PORT})",
-    )
-    parser.add_argument(
-        "--no-browser", action="store_true", help="do not open the page in a browser"
-    )
-    parser.add_argument(
-        "--allow-origin",
-        action="append",
-        default=[],
-        metavar="HOST[:PORT]",
-        help="also answer pages of this host (a tunnel or proxy's name; without a port, "
-        "--port's); by default only 127.0.0.1, localhost and [::1] at --port, and any other "
-        "Host or Origin gets 403 (repeat the option for more hosts)",
-    )
+    option = option_adder(parser, _HELP)
+    option("--port", type=_port, default=DEFAULT_PORT, metavar="N")
+    option("--no-browser", action="store_true")
+    option("--allow-origin", action="append", default=[], metavar="HOST[:PORT]")
 
 
 def run(args) -> int:

@@ -8,7 +8,6 @@ the library), so a second run compiles nothing it compiled before.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import multiprocessing
 import os
 import signal
@@ -21,12 +20,21 @@ from pathlib import Path
 
 from ecofmaps._interrupts import check_interrupted, interrupts_stop_writes
 from ecofmaps._parallel import start_resource_tracker_quietly
-from ecofmaps.cli._common import count, refuse_to_overwrite
+from ecofmaps.cli._common import count, option_adder, refuse_to_overwrite
 from ecofmaps.io.files import record_written
 
 __all__ = ["JAX_CACHE_FOLDER", "TaskQueue", "add", "run"]
 
 _FORMATS = ("png", "pdf", "svg")
+
+_HELP = {
+    "--out": "directory to write into, created if missing (default: figures)",
+    "--format": "comma-separated file formats among png, pdf, svg (default: png)",
+    "--overwrite": "replace the figures ecofmaps wrote in DIR before (a DIR that is not empty "
+    "needs it); files ecofmaps did not write are never replaced",
+    "--jobs": "processes drawing at once (default: one per core, at most one per group of "
+    "figures sharing their numbers; 1: all in this process)",
+}
 
 #: Folder of the ecofmaps cache directory that holds JAX's compiled kernels for this command.
 JAX_CACHE_FOLDER = "jax"
@@ -73,72 +81,34 @@ def add(subparsers) -> None:
         epilog=f"figures:\n{listing}",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument(
-        "--out",
-        default="figures",
-        metavar="DIR",
-        help="directory to write into, created if missing (default: figures)",
-    )
-    parser.add_argument(
-        "--only",
-        nargs="+",
-        choices=list(FIGURES),
-        metavar="NAME",
-        help=f"write only these figures; NAME is one of: {', '.join(FIGURES)}",
-    )
-    parser.add_argument(
-        "--format",
-        type=_figure_formats,
-        default=("png",),
-        metavar="FORMATS",
-        help="comma-separated file formats among png, pdf, svg (default: png)",
-    )
-    parser.add_argument(
-        "--overwrite",
-        action="store_true",
-        help="replace the figures ecofmaps wrote in DIR before (a DIR that is not empty needs "
-        "it); files ecofmaps did not write are never replaced",
-    )
-    parser.add_argument(
-        "--jobs",
-        type=count("processes"),
-        metavar="N",
-        help="processes drawing at once (default: one per core, at most one per group of "
-        "figures sharing their numbers; 1: all in this process)",
-    )
+    only = f"write only these figures; NAME is one of: {', '.join(FIGURES)}"
+    option = option_adder(parser, {**_HELP, "--only": only})
+    option("--out", default="figures", metavar="DIR")
+    option("--only", nargs="+", choices=list(FIGURES), metavar="NAME")
+    option("--format", type=_figure_formats, default=("png",), metavar="FORMATS")
+    option("--overwrite", action="store_true")
+    option("--jobs", type=count("processes"), metavar="N")
 
 
-def _jax_cache_options(directory) -> dict:
-    """JAX's options that keep every compiled kernel in ``directory``."""
-    # Every kernel, however quick its compilation or small its executable: the figures'
-    # kernels each compile in well under JAX's default threshold of one second.
-    return {
-        "jax_compilation_cache_dir": str(directory),
-        "jax_persistent_cache_min_compile_time_secs": 0.0,
-        "jax_persistent_cache_min_entry_size_bytes": 0,
-    }
-
-
-def _set_jax_options(options: dict) -> dict:
-    """Set JAX's ``options``; return their values before."""
+def _set_jax_options(options: dict | None = None) -> dict:
+    """Set JAX's ``options``; return their values before. By default: keep every compiled
+    kernel in the cache's :data:`JAX_CACHE_FOLDER`, however quick its compilation or small
+    its executable (the figures' kernels each compile in well under JAX's default threshold
+    of one second)."""
     import jax  # the CLI's lazy boundary: other commands start without JAX
 
+    if options is None:
+        from ecofmaps.maps.cache import cache_directory
+
+        options = {
+            "jax_compilation_cache_dir": str(cache_directory() / JAX_CACHE_FOLDER),
+            "jax_persistent_cache_min_compile_time_secs": 0.0,
+            "jax_persistent_cache_min_entry_size_bytes": 0,
+        }
     previous = {name: getattr(jax.config, name) for name in options}
     for name, value in options.items():
         jax.config.update(name, value)
     return previous
-
-
-@contextlib.contextmanager
-def _jax_compilation_cache(directory):
-    """Within the block, JAX keeps every kernel it compiles in ``directory`` and reuses them
-    (JAX opens its cache once per process: a later block with another directory still uses
-    the first one)."""
-    previous = _set_jax_options(_jax_cache_options(directory))
-    try:
-        yield
-    finally:
-        _set_jax_options(previous)
 
 
 def _write_figure_group(names, directory, formats) -> list[tuple[str, list[Path], float]]:
@@ -157,37 +127,21 @@ def _write_figure_group(names, directory, formats) -> list[tuple[str, list[Path]
     return written
 
 
-def _jax_cache_folder() -> Path:
-    """The folder of JAX's compilation cache: :data:`JAX_CACHE_FOLDER` in the cache."""
-    from ecofmaps.maps.cache import cache_directory  # the CLI's lazy boundary
-
-    return cache_directory() / JAX_CACHE_FOLDER
-
-
 def _start_worker() -> None:
     """Set up a drawing process: Ctrl-C is the parent's to handle; JAX's compilation cache."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    _set_jax_options(_jax_cache_options(_jax_cache_folder()))
+    _set_jax_options()
 
 
-def _worker_group(names, directory, formats) -> list[tuple[str, list[Path], float]]:
-    """:func:`_write_figure_group` in a drawing process, which ends when told to stop."""
+def _in_worker(work, *arguments):
+    """``work(*arguments)`` in a drawing process, which ends when told to stop."""
     try:
         with interrupts_stop_writes():  # SIGTERM from the parent: stop at a safe point
-            return _write_figure_group(names, directory, formats)
+            return work(*arguments)
     except KeyboardInterrupt:
         # Its file was removed on the way out; end now, without drawing queued figures (and
         # without tearing down JAX's threads, like the command itself: cli.main.console).
         os._exit(128 + signal.SIGTERM)
-
-
-def _worker_part(part) -> None:
-    """Compute one part of a Dataset in a drawing process, which stores it in the cache."""
-    try:
-        with interrupts_stop_writes():
-            part()
-    except KeyboardInterrupt:
-        os._exit(128 + signal.SIGTERM)  # as _worker_group
 
 
 class TaskQueue:
@@ -250,11 +204,12 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
     queue = TaskQueue(groups, parts, jobs)
 
     def submitted(tasks) -> dict:
-        calls = {
-            "part": lambda part: (_worker_part, part),
-            "group": lambda group: (_worker_group, group, out, formats),
-        }
-        return {executor.submit(*calls[task[0]](task[2])): task for task in tasks}
+        futures = {}
+        for task in tasks:
+            kind, _, work = task
+            call = (work,) if kind == "part" else (_write_figure_group, work, out, formats)
+            futures[executor.submit(_in_worker, *call)] = task
+        return futures
 
     try:
         pending = submitted(queue.started())  # each future: its task
@@ -286,9 +241,12 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
 
 def _written_here(groups, out: Path, formats):
     """Yield each group's :func:`_write_figure_group` result, drawn in this process."""
-    with _jax_compilation_cache(_jax_cache_folder()):
+    previous = _set_jax_options()
+    try:
         for group in groups:
             yield _write_figure_group(group, out, formats)
+    finally:
+        _set_jax_options(previous)
 
 
 def run(args) -> int:
@@ -297,7 +255,7 @@ def run(args) -> int:
     names = list(dict.fromkeys(args.only or ()))
     groups = figure_groups(names or None)
     parts = figure_parts(names or None)
-    count = sum(len(group) for group in groups)
+    total = sum(len(group) for group in groups)
     jobs = min(args.jobs or _usable_cores(), max(len(groups), *map(len, parts)))
     out = Path(args.out)
     drawn = [name for group in groups for name in group]
@@ -305,7 +263,7 @@ def run(args) -> int:
     refuse_to_overwrite(planned, [], overwrite=args.overwrite, folders=[("--out", out)])
     out.mkdir(parents=True, exist_ok=True)
     print(
-        f"ecofmaps figures: {count} figure(s) as {', '.join(args.format)} into {out}"
+        f"ecofmaps figures: {total} figure(s) as {', '.join(args.format)} into {out}"
         + (f", {jobs} processes" if jobs > 1 else ""),
         file=sys.stderr,
     )
@@ -320,7 +278,7 @@ def run(args) -> int:
             record_written(paths)
             index += 1
             print(
-                f"  [{index}/{count}] {name:<10} {seconds:5.1f} s  "
+                f"  [{index}/{total}] {name:<10} {seconds:5.1f} s  "
                 + ", ".join(str(path) for path in paths),
                 file=sys.stderr,
             )

@@ -2,9 +2,8 @@
 
 A grid of more than ``--chunk-points`` points, and any grid written to a zarr store, is
 computed block by block straight into the output (:func:`ecofmaps.maps.write_map`), with a
-progress bar on a terminal; a smaller one is computed at once (not cached: it computes faster
-than the cache would read it back). Before any work the command states the map's size and
-refuses one that would not fit on the disk.
+progress bar on a terminal; a smaller one at once. The map's size is stated before any work,
+and a map that would not fit on the disk refused.
 """
 
 from __future__ import annotations
@@ -20,9 +19,11 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps.cli._common import (
+    CACHE_DIR_HELP,
     CommandError,
     byte_size,
     count,
+    option_adder,
     quantity,
     refuse_to_overwrite,
 )
@@ -30,16 +31,29 @@ from ecofmaps.io.files import record_written
 
 __all__ = ["add", "run"]
 
+#: The grid's axes, in the order of the map's dimensions, and their metavars.
+_AXES = {"stiffness_ratio": "S/P", "aspect_ratio": "Z/X", "amplitude": "DELTA", "mu": "MU"}
 _GRID_HELP = "; one value, a list or a range start:stop:num"
-#: The grid's axes, in the order of the map's dimensions: option, metavar, help.
-_AXES = (
-    ("--stiffness-ratio", "S/P", "rig stiffness over normal load S/P [1/m], 'inf' for a rigid rig"),
-    ("--aspect-ratio", "Z/X", "groove depth over half-width z_o/x_o (>= 0)"),
-    ("--amplitude", "DELTA", "displacement amplitude Δ* [m], e.g. 25um,50um"),
-    ("--mu", "MU", "contact coefficient of friction μ (> 0)"),
-)
 #: Default of --chunk-points: blocks of 2**22 points (about 220 MB of results with a load).
 _CHUNK_POINTS = 2**22
+_HELP = {
+    "--stiffness-ratio": "rig stiffness over normal load S/P [1/m], 'inf' for a rigid rig"
+    + _GRID_HELP,
+    "--aspect-ratio": "groove depth over half-width z_o/x_o (>= 0)" + _GRID_HELP,
+    "--amplitude": "displacement amplitude Δ* [m], e.g. 25um,50um" + _GRID_HELP,
+    "--mu": "contact coefficient of friction μ (> 0)" + _GRID_HELP,
+    "--load": "normal load P [N], one value; adds dissipated_energy [J] and max_force [N]",
+    "--out": "netCDF file, or zarr store if the name ends in .zarr, to write (its directory must "
+    "exist)",
+    "--overwrite": "replace --out if it exists and ecofmaps wrote it (once the new map is "
+    "complete)",
+    "--chunk-points": f"grid points per block (default {_CHUNK_POINTS}); a larger grid is "
+    "computed block by block into --out",
+    "--quiet": "no progress bar (there is none either when standard error is not a terminal)",
+    "--no-cache": "do not read or store the result in the cache (a map of the parabolic groove "
+    "is not cached anyway: kept for scripts that give it)",
+    "--cache-dir": CACHE_DIR_HELP,
+}
 
 
 def add(subparsers) -> None:
@@ -76,57 +90,17 @@ def add(subparsers) -> None:
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    for option, metavar, text in _AXES:
-        name = option[2:].replace("-", "_")
-        parser.add_argument(
-            option,
-            type=quantity(name, grid=True),
-            required=True,
-            metavar=metavar,
-            help=text + _GRID_HELP,
-        )
-    parser.add_argument(
-        "--load",
-        type=quantity("load"),
-        metavar="P",
-        help="normal load P [N], one value; adds dissipated_energy [J] and max_force [N]",
-    )
-    parser.add_argument(
-        "--out",
-        required=True,
-        metavar="FILE.nc|FILE.zarr",
-        help="netCDF file, or zarr store if the name ends in .zarr, to write (its directory "
-        "must exist)",
-    )
-    parser.add_argument(
-        "--overwrite",
-        action="store_true",
-        help="replace --out if it exists and ecofmaps wrote it (once the new map is complete)",
-    )
-    parser.add_argument(
-        "--chunk-points",
-        type=count("points"),
-        default=_CHUNK_POINTS,
-        metavar="N",
-        help=f"grid points per block (default {_CHUNK_POINTS}); a larger grid is computed "
-        "block by block into --out",
-    )
-    parser.add_argument(
-        "--quiet",
-        action="store_true",
-        help="no progress bar (there is none either when standard error is not a terminal)",
-    )
-    parser.add_argument(
-        "--no-cache",
-        action="store_true",
-        help="do not read or store the result in the cache (a map of the parabolic groove "
-        "is not cached anyway: kept for scripts that give it)",
-    )
-    parser.add_argument(
-        "--cache-dir",
-        metavar="DIR",
-        help="cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)",
-    )
+    option = option_adder(parser, _HELP)
+    for name, metavar in _AXES.items():
+        values = quantity(name, grid=True)
+        option(f"--{name.replace('_', '-')}", type=values, required=True, metavar=metavar)
+    option("--load", type=quantity("load"), metavar="P")
+    option("--out", required=True, metavar="FILE.nc|FILE.zarr")
+    option("--overwrite", action="store_true")
+    option("--chunk-points", type=count("points"), default=_CHUNK_POINTS, metavar="N")
+    option("--quiet", action="store_true")
+    option("--no-cache", action="store_true")
+    option("--cache-dir", metavar="DIR")
 
 
 def run(args) -> int:
@@ -138,15 +112,8 @@ def run(args) -> int:
     if not out.parent.is_dir():
         raise CommandError(f"cannot write {out}: the directory {out.parent} does not exist")
     refuse_to_overwrite([("--out", out)], [], overwrite=args.overwrite)
-    grid = {
-        name: values[0] if values.size == 1 else values
-        for name, values in (
-            ("stiffness_ratio", args.stiffness_ratio),
-            ("aspect_ratio", args.aspect_ratio),
-            ("amplitude", args.amplitude),
-            ("mu", args.mu),
-        )
-    }
+    axes = {name: getattr(args, name) for name in _AXES}
+    grid = {name: values[0] if values.size == 1 else values for name, values in axes.items()}
     points = math.prod(values.size for values in grid.values() if np.ndim(values))
     size = _map_bytes(grid, args.load)
     free = shutil.disk_usage(out.parent).free
@@ -172,9 +139,8 @@ def run(args) -> int:
 
 
 def _map_bytes(grid: dict, load) -> int:
-    """Bytes [byte] of the map of ``grid`` (``compute_map``'s grid keywords) with its
-    coordinates, uncompressed, before computing it: the variables' types and dimensions come
-    from the map of at most two values along each axis, chunked (nothing computed)."""
+    """Bytes [byte] of the map of ``grid`` with its coordinates, uncompressed, from the lazy
+    map of at most two values along each axis (nothing computed)."""
     from ecofmaps.maps.grid import compute_map
 
     small = {name: values[:2] if np.ndim(values) else values for name, values in grid.items()}
@@ -187,8 +153,7 @@ def _map_bytes(grid: dict, load) -> int:
 
 
 def _write(dataset, out: Path, shown: bool) -> int:
-    """Write ``dataset`` to ``out`` (a progress bar if ``shown``), record it as written by
-    ecofmaps, and print what was written."""
+    """Write ``dataset`` to ``out`` (a progress bar if ``shown``); print what was written."""
     from ecofmaps.maps.files import write_map
     from ecofmaps.model import Regime
 
@@ -210,11 +175,8 @@ def _write(dataset, out: Path, shown: bool) -> int:
 
 @contextlib.contextmanager
 def _progress(dataset, shown: bool):
-    """A progress bar on standard error (points and blocks done, rate, ETA) while in the block.
-
-    It counts the blocks of a chunked map as their dask tasks finish; on an error or
-    Ctrl-C it is cleared, so the error is the last line.
-    """
+    """A progress bar on standard error while in the block, counting the blocks of a chunked
+    map as their dask tasks finish; cleared on an error or Ctrl-C (the error is the last line)."""
     if not shown:
         yield
         return
