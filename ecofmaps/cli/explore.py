@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import functools
 
 from ecofmaps.cli._common import CommandError, option_adder
 from ecofmaps.web import INSTALL_WEB, missing_web_packages
@@ -59,11 +60,12 @@ def run(args) -> int:
     # Panel and Bokeh load only when the explorer runs (the command's lazy boundary).
     from ecofmaps.web.server import serve_explorer
 
+    announce = functools.partial(print, flush=True)  # the address at once, also in a pipe
     try:
         serve_explorer(
             args.port,
             open_browser=not args.no_browser,
-            announce=_announce,
+            announce=announce,
             allow_origin=args.allow_origin,
         )
     except OSError as error:
@@ -73,8 +75,3 @@ def run(args) -> int:
         ) from None
     print("ecofmaps explorer stopped")
     return 0
-
-
-def _announce(line: str) -> None:
-    """Print the server's address at once (a pipe would hold it back)."""
-    print(line, flush=True)

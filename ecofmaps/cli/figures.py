@@ -1,9 +1,8 @@
 """``ecofmaps figures``: the paper's figures, drawn by groups sharing one Dataset
-(:func:`ecofmaps.figures.figure_groups`), the costliest first, on ``--jobs`` processes; the
-parts of a costly Dataset (:func:`ecofmaps.figures.figure_parts`) are computed in parallel
-before it. JAX keeps its compiled kernels in ``<cache>/jax`` for the run (never on importing
-the library), so a second run compiles nothing it compiled before.
-"""
+(:func:`ecofmaps.figures.figure_groups`), the costliest first, on ``--jobs`` processes, the
+parts of a costly Dataset (:func:`ecofmaps.figures.figure_parts`) computed in parallel before
+it; JAX keeps its compiled kernels in ``<cache>/jax`` for the run (never on importing the
+library)."""
 
 from __future__ import annotations
 
@@ -91,10 +90,8 @@ def add(subparsers) -> None:
 
 
 def _set_jax_options(options: dict | None = None) -> dict:
-    """Set JAX's ``options``; return their values before. By default: keep every compiled
-    kernel in the cache's :data:`JAX_CACHE_FOLDER`, however quick its compilation or small
-    its executable (the figures' kernels each compile in well under JAX's default threshold
-    of one second)."""
+    """Set JAX's ``options`` (default: keep every compiled kernel in :data:`JAX_CACHE_FOLDER`,
+    however quick: the figures' compile in under JAX's threshold of 1 s); their values before."""
     import jax  # the CLI's lazy boundary: other commands start without JAX
 
     if options is None:
@@ -112,9 +109,8 @@ def _set_jax_options(options: dict | None = None) -> dict:
 
 
 def _write_figure_group(names, directory, formats) -> list[tuple[str, list[Path], float]]:
-    """Draw the figures ``names`` (one group sharing a Dataset) and write each in every
-    format into ``directory``: each figure's name, its files and its time [s] (its Dataset
-    included when it was the first to need it)."""
+    """Draw the figures ``names`` (a group sharing a Dataset) into ``directory`` in every
+    format: each one's name, files and time [s] (its Dataset's if it needed it first)."""
     from ecofmaps.figures import make_figures, save_figure  # the CLI's lazy boundary
 
     written = []
@@ -223,9 +219,8 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
                 if task[0] == "group":
                     yield written
     finally:
-        # Done, or an error, Ctrl-C or SIGTERM: the drawing processes are stopped rather than
-        # left to tear JAX down (half a second when they are idle). A busy one stops at its
-        # next safe point, writing nothing; an idle one has nothing left to write.
+        # The drawing processes are stopped rather than left to tear JAX down (half a second
+        # when idle); a busy one stops at its next safe point, writing nothing.
         executor.shutdown(wait=False, cancel_futures=True)
         ours = set(multiprocessing.active_children()) - others
         for process in ours:
@@ -233,9 +228,8 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
         for process in ours:
             process.join()
         executor.shutdown(wait=True)
-        # An interrupt's traceback keeps this frame: dropping the executor here lets its
-        # queues' semaphores be released before the process ends (else multiprocessing's
-        # resource tracker prints a line about them after ours).
+        # An interrupt's traceback keeps this frame: its queues' semaphores are released now
+        # (else multiprocessing's resource tracker prints a line about them after ours).
         executor = None
 
 
@@ -252,10 +246,8 @@ def _written_here(groups, out: Path, formats):
 def run(args) -> int:
     from ecofmaps.figures.recipes import figure_groups, figure_parts  # the CLI's lazy boundary
 
-    names = list(dict.fromkeys(args.only or ()))
-    groups = figure_groups(names or None)
-    parts = figure_parts(names or None)
-    total = sum(len(group) for group in groups)
+    names = list(dict.fromkeys(args.only or ())) or None
+    groups, parts = figure_groups(names), figure_parts(names)
     jobs = min(args.jobs or _usable_cores(), max(len(groups), *map(len, parts)))
     out = Path(args.out)
     drawn = [name for group in groups for name in group]
@@ -263,7 +255,7 @@ def run(args) -> int:
     refuse_to_overwrite(planned, [], overwrite=args.overwrite, folders=[("--out", out)])
     out.mkdir(parents=True, exist_ok=True)
     print(
-        f"ecofmaps figures: {total} figure(s) as {', '.join(args.format)} into {out}"
+        f"ecofmaps figures: {len(drawn)} figure(s) as {', '.join(args.format)} into {out}"
         + (f", {jobs} processes" if jobs > 1 else ""),
         file=sys.stderr,
     )
@@ -272,15 +264,10 @@ def run(args) -> int:
         results = _written_in_parallel(groups, parts, out, args.format, jobs)
     else:
         results = _written_here(groups, out, args.format)
-    index = 0
-    for written in results:
-        for name, paths, seconds in written:
-            record_written(paths)
-            index += 1
-            print(
-                f"  [{index}/{total}] {name:<10} {seconds:5.1f} s  "
-                + ", ".join(str(path) for path in paths),
-                file=sys.stderr,
-            )
+    written = (figure for group in results for figure in group)
+    for index, (name, paths, seconds) in enumerate(written, start=1):
+        record_written(paths)
+        files = ", ".join(str(path) for path in paths)
+        print(f"  [{index}/{len(drawn)}] {name:<10} {seconds:5.1f} s  {files}", file=sys.stderr)
     print(f"done in {time.perf_counter() - begin:.1f} s", file=sys.stderr)
     return 0

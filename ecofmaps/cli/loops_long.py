@@ -102,7 +102,7 @@ class _Partial:
         self.made = not self.folder.exists()  # else --resume: LongRun checked it
         if self.made:
             self.folder.mkdir()
-            _write(record, lambda path: path.write_text(json.dumps(fingerprint), "utf-8"))
+            _write(record, json.dumps(fingerprint))
             return
         try:
             found = json.loads(record.read_text(encoding="utf-8"))
@@ -173,7 +173,7 @@ class _Partial:
         values = dataclasses.asdict(cycles)
         values["missing"] = np.asarray(False) if cycles.missing is None else cycles.missing
         path = self.folder / f"file{index}-cycles.npz"
-        _write(path, lambda temporary: _savez(temporary, values))
+        _write(path, values)
         self._record(path, file=index, block="cycles")
 
     def record_block(self, index: int, block: int, rows: slice) -> None:
@@ -233,12 +233,7 @@ class _Partial:
 def keep_block(folder: Path, index: int, block: int, values: dict, flags: dict) -> None:
     """Keep in ``folder`` what block ``block`` of file ``index`` measured (where a task runs)."""
     stored = {f"v:{k}": v for k, v in values.items()} | {f"f:{k}": v for k, v in flags.items()}
-    _write(folder / f"file{index}-block{block:06d}.npz", lambda p: _savez(p, stored))
-
-
-def _savez(path: Path, values: dict) -> None:
-    with open(path, "wb") as stream:
-        np.savez(stream, **values)
+    _write(folder / f"file{index}-block{block:06d}.npz", stored)
 
 
 def _temporary_name(name: str) -> str:
@@ -246,11 +241,16 @@ def _temporary_name(name: str) -> str:
     return f".{name}.tmp"
 
 
-def _write(path: Path, write) -> None:
-    """``write(temporary)``, then rename the temporary onto ``path`` (whole, or nothing)."""
+def _write(path: Path, content) -> None:
+    """Write ``content`` (text, or arrays by name: ``.npz``) to a temporary, then rename it
+    onto ``path`` (whole, or nothing)."""
     temporary = path.with_name(_temporary_name(path.name))
     try:
-        write(temporary)
+        if isinstance(content, str):
+            temporary.write_text(content, "utf-8")
+        else:
+            with open(temporary, "wb") as stream:
+                np.savez(stream, **content)
         os.replace(temporary, path)
     finally:
         temporary.unlink(missing_ok=True)

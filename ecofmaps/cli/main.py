@@ -86,15 +86,11 @@ EXIT_TERMINATED = 143
 
 
 def main(argv=None) -> int:
-    """Run the ``ecofmaps`` command; return its exit status.
-
-    0 on success; 2 for a user error (one line naming it); 130 after Ctrl-C and 143 after
-    SIGTERM, with one line telling what was left (:func:`ecofmaps._interrupts.add_stop_note`:
-    files are written atomically); 1 for an unexpected failure (``ECOFMAPS_DEBUG=1`` shows the
-    traceback). A signal once the subcommand's work is done stops nothing. Warnings are
-    printed as ``ecofmaps COMMAND: warning: ...``, one line each (those of the options once
-    they are parsed).
-    """
+    """Run the ``ecofmaps`` command; return its exit status: 0 on success; 2 for a user error
+    (one line naming it); 130 after Ctrl-C and 143 after SIGTERM, with one line telling what
+    was left (:func:`ecofmaps._interrupts.add_stop_note`), but not once the work is done; 1
+    for an unexpected failure (``ECOFMAPS_DEBUG=1`` shows the traceback). Warnings are printed
+    as ``ecofmaps COMMAND: warning: ...``, one line each."""
     interrupted = status = None
     try:  # the subcommands import JAX and xarray: an interrupt may come during the imports
         with interrupts_stop_writes() as interrupted, warnings.catch_warnings(record=True) as told:
@@ -111,10 +107,8 @@ def main(argv=None) -> int:
                 warnings.showwarning(warning.message, warning.category, "", 0)
             status = args.handler(args)
             return status
-    except KeyboardInterrupt as stop:
-        if status is not None:  # the signal came after the work was done, when leaving
-            return status
-        return _stopped(interrupted, getattr(stop, "note", None))
+    except KeyboardInterrupt as stop:  # after the work was done (when leaving), it stops nothing
+        return status if status is not None else _stopped(interrupted, getattr(stop, "note", None))
     except Exception as error:
         if interrupted is not None and interrupted.is_set():  # an interrupt turned into an error
             return _stopped(interrupted, None)
@@ -198,14 +192,10 @@ def _report(status: int, message: str) -> int:
 
 
 def console() -> None:
-    """The ``ecofmaps`` console script: run :func:`main` and exit with its status.
-
-    After Ctrl-C or SIGTERM the process ends at once (``os._exit``) once its messages are
-    flushed and the interrupted run's objects collected (their finalizers release a process
-    pool's semaphores): JAX's threads may still be busy, and tearing the interpreter down
-    around them can crash it. Once :func:`main` has returned, Ctrl-C and SIGTERM are ignored,
-    so that a signal as the interpreter exits does not turn a complete run into status 143.
-    """
+    """The ``ecofmaps`` console script: run :func:`main` and exit with its status. After a
+    stop the process ends at once (``os._exit``), its messages flushed and the run's objects
+    collected: tearing the interpreter down around JAX's busy threads can crash it. Once
+    :func:`main` has returned, a stop signal is ignored: a complete run stays complete."""
     after = _ignored_after_main()
     status = main()
     for number in after:  # the work is done: a signal now stops nothing, not even the exit
