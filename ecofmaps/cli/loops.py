@@ -166,9 +166,8 @@ _NOT_KEPT = (
 
 
 def _analysed(index, path, recording, load, args, long_run, write):
-    """One recording through the pipeline: its results (all of them in memory, those the
-    summary reads of a long one), its reading along the stroke over positions (for the
-    plots and ``--resolved``, in memory only) and its warnings, printed one line each."""
+    """One recording's results (of a long one, those the summary reads) and reading along the
+    stroke (for the plots and ``--resolved``), its warnings printed one line each."""
     from ecofmaps.measured.pipeline import Reading
     from ecofmaps.measured.quality import ImplausibleScaleError, ImplausibleScaleWarning
     from ecofmaps.measured.resolve import ReadingOptions
@@ -204,8 +203,7 @@ def _analysed(index, path, recording, load, args, long_run, write):
 
 
 def _with_assumptions(message: str, recording) -> str:
-    """``message`` (of an implausible scale: an assumed unit is the likely culprit) with the
-    units the recording's columns without one were assumed to be in."""
+    """``message`` (of an implausible scale) with the units assumed for columns without one."""
     said = [
         f"the {role} column {recording.columns[role]!r} has no unit and was read in "
         f"{recording.units[role]} (--{role}-unit gives it)"
@@ -261,12 +259,11 @@ def _summary(path, results, recording) -> str:
         where = f"line {first}" if isinstance(first, int) else first
         summary += f"; {skipped} skipped for missing samples (the first at {where})"
     summary += f"; {sliding_condition_line(results)}"
-    if gross.cycle.size and gross.gicof.notnull().any():
+    if gross.gicof.notnull().any():
         summary += f"; GICoF median {float(gross.gicof.median()):.4f}"
     if "mu_resolved" in gross and gross.mu_resolved.notnull().any():
         summary += f", μ read along the stroke median {float(gross.mu_resolved.median()):.4f}"
-    ecof = gross.ecof.dropna("cycle") if gross.cycle.size else gross.ecof
-    if ecof.size:
+    if (ecof := gross.ecof.dropna("cycle")).size:
         summary += f"; ECoF {float(ecof[0]):.4f} (first) to {float(ecof[-1]):.4f} (last)"
     return summary
 
@@ -298,8 +295,7 @@ def _checked_inputs(args) -> tuple[list[Path], float]:
 
 
 def _checked_outputs(args, paths) -> list:
-    """The command's outputs as ``(option, path)``, refused where they would overwrite a
-    file that ecofmaps did not write (or an input)."""
+    """The command's outputs as ``(option, path)``, checked by :func:`refuse_to_overwrite`."""
     outputs = [("--out", args.out), ("--resolved", args.resolved), ("--report", args.report)]
     for option, target in outputs:
         if target is not None and not Path(target).parent.is_dir():
@@ -325,9 +321,8 @@ _Analysed = collections.namedtuple("_Analysed", "path recording results resolved
 
 
 def _analyse_each(args, paths, load, long_run, table) -> tuple[list[_Analysed], list[Path]]:
-    """Every recording through the pipeline, its lines written to ``table``. With several
-    recordings, one that cannot be analysed is one error line naming it, and the others go
-    on (a batch); a single recording's error ends the command."""
+    """Every recording through the pipeline, its lines written to ``table``; with several, one
+    that cannot be analysed is one error line naming it, and the others go on."""
     from ecofmaps.io.recordings import read_recording
 
     done, failed = [], []
@@ -431,10 +426,8 @@ def run(args) -> int:
         print(_summary(each.path, each.results, each.recording))
     if failed:
         print(f"  not analysed ({len(failed)}): " + ", ".join(str(path) for path in failed))
-    if args.resolved is not None:
-        print(f"  the loops read along the stroke in {args.resolved}")
-    if args.report is not None:
-        print(f"  the report in {args.report}")
-    if args.plots is not None:
-        print(f"  plots in {args.plots}")
+    extras = (("the loops read along the stroke", args.resolved), ("the report", args.report))
+    for what, where in (*extras, ("plots", args.plots)):
+        if where is not None:
+            print(f"  {what} in {where}")
     return status

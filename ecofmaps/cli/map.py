@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import itertools
 import math
 import shutil
 import sys
@@ -159,7 +160,7 @@ def _write(dataset, out: Path, shown: bool) -> int:
 
     summary = [(dataset.regime == code).sum().data for code in Regime]
     summary += [dataset.ecof_ratio.min().data, dataset.ecof_ratio.max().data]
-    with _progress(dataset, shown=shown):
+    with _progress(dataset) if shown else contextlib.nullcontext():
         *counts, low, high = write_map(dataset, out, also=summary)
     record_written([out])
     shape = " x ".join(f"{size} {dim}" for dim, size in dataset.sizes.items()) or "1 point"
@@ -174,12 +175,9 @@ def _write(dataset, out: Path, shown: bool) -> int:
 
 
 @contextlib.contextmanager
-def _progress(dataset, shown: bool):
+def _progress(dataset):
     """A progress bar on standard error while in the block, counting the blocks of a chunked
     map as their dask tasks finish; cleared on an error or Ctrl-C (the error is the last line)."""
-    if not shown:
-        yield
-        return
     from dask.callbacks import Callback
     from tqdm import tqdm
 
@@ -195,18 +193,15 @@ def _progress(dataset, shown: bool):
         dynamic_ncols=True,
         postfix=f"0/{blocks} blocks",
     )
-    done = 0
+    done = itertools.count(1)
 
-    class Blocks(Callback):
-        def _posttask(self, key, result, dsk, state, worker_id):
-            nonlocal done
-            if isinstance(key, tuple) and str(key[0]).startswith(BLOCK_TASK):
-                done += 1
-                bar.set_postfix_str(f"{done}/{blocks} blocks", refresh=False)
-                bar.update(next(iter(result.values())).size)
+    def on_task(key, result, dsk, state, worker_id) -> None:
+        if isinstance(key, tuple) and str(key[0]).startswith(BLOCK_TASK):
+            bar.set_postfix_str(f"{next(done)}/{blocks} blocks", refresh=False)
+            bar.update(next(iter(result.values())).size)
 
     try:
-        with Blocks():
+        with Callback(posttask=on_task):
             yield
     except BaseException:
         bar.leave = False
