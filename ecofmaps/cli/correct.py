@@ -9,16 +9,14 @@ from pathlib import Path
 from ecofmaps._version import __version__
 from ecofmaps.cli._common import (
     CommandError,
+    add_profile_options,
     option_adder,
     print_rows,
+    profile_rows,
     quantity,
+    read_profile,
     refuse_to_overwrite,
     row,
-)
-from ecofmaps.cli._profile import (
-    add_profile_options,
-    profile_rows,
-    read_profile,
     two_columns_header,
     two_values,
 )

@@ -1,10 +1,6 @@
-"""``ecofmaps loops``: recorded fretting loops analysed cycle by cycle.
-
-Every recording goes through the one pipeline of :mod:`ecofmaps.measured.pipeline`: in
-memory as one chunk, a long one out of core (:mod:`ecofmaps.cli.loops_long`); the table is
-written as the chunks come, then the summary lines, the plots and the reading along the
-stroke. docs/loops.md explains the method.
-"""
+"""``ecofmaps loops``: recorded fretting loops analysed cycle by cycle through the one pipeline
+of :mod:`ecofmaps.measured.pipeline` (a long recording out of core: :mod:`.loops_long`), the
+table written as the chunks come, then the summary lines and the extras (docs/loops.md)."""
 
 from __future__ import annotations
 
@@ -385,9 +381,8 @@ def _write_extras(args, done: list[_Analysed]) -> None:
 
 
 def run(args) -> int:
-    """Run ``ecofmaps loops`` with the parsed ``args``: 0 when every recording was
-    analysed, 1 when some of several could not be (each named in an error line; the others'
-    rows are written)."""
+    """Run ``ecofmaps loops`` with the parsed ``args``: 0, or 1 when some of several
+    recordings could not be analysed (each named in an error line; the others written)."""
     from ecofmaps.cli.loops_long import LongRun
 
     paths, load = _checked_inputs(args)

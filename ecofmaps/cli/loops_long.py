@@ -92,9 +92,8 @@ _UNFINISHED = (
 
 
 class _Partial:
-    """The folder ``<out>.partial`` of an unfinished run: its record ``run.json`` (what the
-    run computes), its files (each one's cycles and finished blocks, ``.npz``) and their
-    checksums, with a block's cycle rows, in ``kept.jsonl``."""
+    """The folder ``<out>.partial`` of an unfinished run: ``run.json`` (what it computes), each
+    file's cycles and finished blocks (``.npz``), their checksums in ``kept.jsonl``."""
 
     def __init__(self, out, fingerprint: dict):
         self.folder = Path(f"{out}{PARTIAL_SUFFIX}")
@@ -274,10 +273,9 @@ class LongRun:
         self.analysed = None  # (index, path, blocks or None) of the recording analysed last
 
     def analyse(self, index, path, recording, load, write, columns, reading):
-        """The results of recording ``index`` (only the variables ``columns``, if given) and
-        its reading along the stroke when ``reading`` hands it back; the table's lines given
-        to ``write`` in order, a string per chunk that begins with the header line. The
-        results are joined once the cluster is closed."""
+        """The results of recording ``index`` (the variables ``columns``, if given) and its
+        reading along the stroke if handed back; each chunk's lines (a header line first)
+        given to ``write`` in order."""
         args, runner = self.args, contextlib.nullcontext(IN_PROCESS)
         if recording.lazy:
             runner = runner_for("processes" if args.workers else args.scheduler, args.workers)
@@ -304,9 +302,8 @@ class LongRun:
         return analysis.finish([parts.pop(k) for k in sorted(parts)]), resolved
 
     def stop_note(self) -> str | None:
-        """What a stop leaves beside ``--out``, as it is now: the sentence naming the folder
-        kept and how to go on, or None. A folder this run made with nothing in it yet is
-        removed; a folder kept loses the temporaries of blocks being written."""
+        """The sentence naming the folder a stop leaves beside ``--out`` as it is now, or None
+        (a folder this run made that holds no work yet is removed)."""
         partial = self.partial
         if partial is None or not partial.folder.exists():
             return None
@@ -330,9 +327,8 @@ class LongRun:
 
 
 def _analyse(run, index, path, recording, load, runner, write, columns, reading):
-    """One recording of ``run`` through the pipeline, chunk by chunk: its analysis, each
-    chunk's results (the variables ``columns``) and the reading along the stroke handed back
-    (or None); each chunk's lines given to ``write`` in order."""
+    """One recording through the pipeline, chunk by chunk: its analysis, each chunk's results
+    and the reading along the stroke handed back (or None); see :meth:`LongRun.analyse`."""
     args, partial = run.args, run.partial if recording.lazy else None
     force, recorded = recording.force, None
     if isinstance(load, str):  # the load recorded sample by sample (--load COLUMN)
@@ -394,8 +390,8 @@ def _analyse(run, index, path, recording, load, runner, write, columns, reading)
 
 
 def _in_order(texts: dict, write, written: int = 0) -> int:
-    """Give ``write`` the texts of blocks ``written``, ``written + 1``, ... that ``texts``
-    holds, in order, taking them out; the number of blocks written so far."""
+    """Give ``write`` the texts of blocks ``written``, ``written + 1``, ... that ``texts`` holds
+    (taken out); the number of blocks written so far."""
     while written in texts:
         write(texts.pop(written))
         written += 1

@@ -176,8 +176,8 @@ def _write(dataset, out: Path, shown: bool) -> int:
 
 @contextlib.contextmanager
 def _progress(dataset):
-    """A progress bar on standard error while in the block, counting the blocks of a chunked
-    map as their dask tasks finish; cleared on an error or Ctrl-C (the error is the last line)."""
+    """A progress bar on standard error counting the map's blocks as their dask tasks finish
+    while in the block; cleared on an error or Ctrl-C, so the error is the last line."""
     from dask.callbacks import Callback
     from tqdm import tqdm
 

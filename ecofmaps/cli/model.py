@@ -7,11 +7,14 @@ import warnings
 
 from ecofmaps import paper
 from ecofmaps._version import __version__
-from ecofmaps.cli._common import option_adder, print_rows, quantity, row
-from ecofmaps.cli._profile import (
+from ecofmaps.cli._common import (
     add_profile_options,
+    option_adder,
+    print_rows,
     profile_rows,
+    quantity,
     read_profile,
+    row,
     two_columns_header,
     two_values,
 )

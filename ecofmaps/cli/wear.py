@@ -1,10 +1,7 @@
-"""``ecofmaps wear``: energy wear of fretting tests from their results tables and scar profiles.
-
-Each test's per-cycle table (as ``ecofmaps loops --out`` writes it, CSV or netCDF) and its
-wear-scar profile (a profilometer trace, read as ``ecofmaps model --scar-profile`` reads it)
-give ΣE_d, the wear volume of a line contact, α and Archard's k with the test's sliding
-condition; over three tests or more, α and E_th (:func:`ecofmaps.energy_wear`, docs/lab.md).
-"""
+"""``ecofmaps wear``: energy wear of fretting tests from their results tables (``ecofmaps
+loops --out``) and scar profiles: ΣE_d, the wear volume of a line contact, α and Archard's k
+with the sliding condition; over three tests or more, α and E_th (:func:`ecofmaps.energy_wear`,
+docs/lab.md)."""
 
 from __future__ import annotations
 
