@@ -38,30 +38,24 @@ __all__ = [
 ]
 
 
-def _in_range(name: str, values: np.ndarray, text: str) -> None:
-    """Raise ``ValueError`` if ``values`` [SI] leave the valid range of quantity ``name``."""
-    described = QUANTITIES[name]
-    if described.valid is None or np.all(within(name, values)):
-        return
-    symbol = described.symbol or name
-    unit = f" [{described.units}]" if described.units != "1" else ""
-    valid = RANGES[described.valid][1].format(name=symbol)
-    raise ValueError(f"{text!r} is out of range: the {described.words} must satisfy {valid}{unit}")
-
-
 def quantity(name: str, grid: bool = False, option: str | None = None):
     """An argparse ``type`` reading a value of quantity ``name`` with units (with ``grid``, a
     list ``a,b,c`` or a range ``start:stop:num``), checked against its dimension and valid
     range; a bare number implausible in SI is warned of, naming ``option`` (``--name``)."""
-    kind = QUANTITIES[name].kind
-    option = option or "--" + name.replace("_", "-")
+    described = QUANTITIES[name]
+    kind, option = described.kind, option or "--" + name.replace("_", "-")
 
     def parse(text: str):
         try:
             value = parse_values(text, kind) if grid else parse_quantity(text, kind)
-            _in_range(name, np.asarray(value), text)
         except ValueError as error:
             raise argparse.ArgumentTypeError(str(error)) from None
+        if described.valid is not None and not np.all(within(name, np.asarray(value))):
+            valid = RANGES[described.valid][1].format(name=described.symbol or name)
+            unit = f" [{described.units}]" if described.units != "1" else ""
+            raise argparse.ArgumentTypeError(
+                f"{text!r} is out of range: the {described.words} must satisfy {valid}{unit}"
+            )
         unique, counts = np.unique(value, return_counts=True)
         if np.any(counts > 1):
             raise argparse.ArgumentTypeError(
@@ -82,9 +76,10 @@ def unit(kind: str):
     """An argparse ``type`` reading a unit of ``kind`` (``'um'``, ``'kN'``), kept as text: a
     unit of that dimension whose size is positive and finite (not a number, ``'0um'``)."""
 
+    example = DIMENSIONS[kind][1]
+
     def parse(text: str) -> str:
         if not text.strip():
-            example = DIMENSIONS[kind][1]
             raise argparse.ArgumentTypeError(f"an empty unit; give a {kind} unit such as {example}")
         number = text.strip()[0] in "0123456789.+-"
         try:
@@ -94,7 +89,7 @@ def unit(kind: str):
         if not (0.0 < scale < math.inf):
             raise argparse.ArgumentTypeError(
                 f"{text!r} is not a unit (a number in front of it makes a quantity); give a "
-                f"{kind} unit such as {DIMENSIONS[kind][1]}"
+                f"{kind} unit such as {example}"
             )
         return text
 
