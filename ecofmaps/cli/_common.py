@@ -7,6 +7,7 @@ import argparse
 import math
 import os
 import sys
+import textwrap
 import warnings
 from pathlib import Path
 
@@ -23,6 +24,7 @@ __all__ = [
     "add_profile_options",
     "add_recording_options",
     "byte_size",
+    "command_parser",
     "count",
     "option_adder",
     "print_rows",
@@ -131,6 +133,14 @@ _RECORDING_HELP = {
 }
 
 
+def command_parser(subparsers, name: str, **texts) -> argparse.ArgumentParser:
+    """The parser of subcommand ``name``, its ``description`` filled to 80 columns and its
+    ``epilog`` kept as written (``texts``: ``help``, ``description``, ``epilog``)."""
+    texts["description"] = textwrap.fill(texts["description"], width=80)
+    formatter = argparse.RawDescriptionHelpFormatter
+    return subparsers.add_parser(name, formatter_class=formatter, **texts)
+
+
 def option_adder(parser, helps: dict):
     """``add(name, **keywords)``: add option ``name`` to ``parser``, its help ``helps[name]``."""
 
@@ -186,8 +196,6 @@ _PROFILE_HELP = {
     "--mapping": "where the pad at slip position x sits on the profile: 'scaled', X = x W/x_o "
     "(eq. 11, the paper's; default), or 'physical', X = x",
 }
-
-
 _PROFILE_DEFAULTS = {"x_column": "x", "z_column": "z", "no_level": False, "mapping": "scaled"}
 
 

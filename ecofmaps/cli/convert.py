@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import argparse
-import textwrap
 from pathlib import Path
 
 from ecofmaps.cli._common import (
     CommandError,
     add_recording_options,
+    command_parser,
     count,
     option_adder,
     recording_options,
@@ -28,20 +27,17 @@ _HELP = {
 
 
 def add(subparsers) -> None:
-    parser = subparsers.add_parser(
+    parser = command_parser(
+        subparsers,
         "convert",
         help="copy a recording (e.g. a large CSV file) into a chunked zarr, HDF5 or TDMS file",
-        description=textwrap.fill(
-            "Copy the displacement, force (and cycle) columns of a recording that 'ecofmaps "
-            "loops' reads (text, TDMS, HDF5/netCDF-4, zarr) into a new file whose format is "
-            "given by its suffix: .zarr, .h5/.nc, .tdms or .csv. The samples are stored in SI "
-            "units (m, N) with their units, missing ones as NaN, a block at a time (memory "
-            "stays near a few blocks whatever the size), and DST appears only once complete. "
-            "A large text file converted once is read lazily, in parallel, by 'ecofmaps loops'.",
-            width=80,
-        ),
+        description="Copy the displacement, force (and cycle) columns of a recording that "
+        "'ecofmaps loops' reads (text, TDMS, HDF5/netCDF-4, zarr) into a new file whose format is "
+        "given by its suffix: .zarr, .h5/.nc, .tdms or .csv. The samples are stored in SI "
+        "units (m, N) with their units, missing ones as NaN, a block at a time (memory "
+        "stays near a few blocks whatever the size), and DST appears only once complete. "
+        "A large text file converted once is read lazily, in parallel, by 'ecofmaps loops'.",
         epilog="example:\n  ecofmaps convert test.csv test.zarr --displacement-unit um",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     option = option_adder(parser, _HELP)
     option("source", metavar="SRC")

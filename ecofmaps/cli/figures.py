@@ -11,7 +11,6 @@ import multiprocessing
 import os
 import signal
 import sys
-import textwrap
 import time
 from collections import deque
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -19,7 +18,7 @@ from pathlib import Path
 
 from ecofmaps._interrupts import check_interrupted, interrupts_stop_writes
 from ecofmaps._parallel import start_resource_tracker_quietly
-from ecofmaps.cli._common import count, option_adder, refuse_to_overwrite
+from ecofmaps.cli._common import command_parser, count, option_adder, refuse_to_overwrite
 from ecofmaps.io.files import record_written
 
 __all__ = ["JAX_CACHE_FOLDER", "TaskQueue", "add", "run"]
@@ -62,23 +61,19 @@ def add(subparsers) -> None:
     from ecofmaps.figures.recipes import FIGURES  # the names for the parser (no JAX)
 
     listing = "\n".join(f"  {name:<10} {recipe.description}" for name, recipe in FIGURES.items())
-    parser = subparsers.add_parser(
+    parser = command_parser(
+        subparsers,
         "figures",
         help="write the paper's Figures 5-8 and 11, the universal map and the scar shapes "
         "(default: figures/)",
-        description=textwrap.fill(
-            "Write the paper's Figures 5, 6, 7a, 7b, 8, 11a, 11b, the universal map of "
-            "the ECoF ratio and the comparison of scar shapes at equal D/W (shapes), one file "
-            "per figure and format (fig5.png, ...). Parameters are "
-            "the paper's: amplitude 50um (= groove half-width), load 450N, stiffness 35MN/m, "
-            "mu 0.8. Maps and loops are read from the cache when there (see ECOFMAPS_CACHE) "
-            "and stored there otherwise, with JAX's compiled kernels in its jax/ folder; "
-            "files are written atomically. Figures sharing their numbers are drawn by one "
-            "process, several processes at once (--jobs). Progress goes to stderr.",
-            width=80,
-        ),
+        description="Write the paper's Figures 5, 6, 7a, 7b, 8, 11a, 11b, the universal map of the "
+        "ECoF ratio and the comparison of scar shapes at equal D/W (shapes), one file per figure "
+        "and format (fig5.png, ...). Parameters are the paper's: amplitude 50um (= groove "
+        "half-width), load 450N, stiffness 35MN/m, mu 0.8. Maps and loops are read from the cache "
+        "when there (see ECOFMAPS_CACHE) and stored there otherwise, with JAX's compiled kernels "
+        "in its jax/ folder; files are written atomically. Figures sharing their numbers are drawn "
+        "by one process, several processes at once (--jobs). Progress goes to stderr.",
         epilog=f"figures:\n{listing}",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     only = f"write only these figures; NAME is one of: {', '.join(FIGURES)}"
     option = option_adder(parser, {**_HELP, "--only": only})

@@ -9,7 +9,6 @@ import collections
 import contextlib
 import io
 import sys
-import textwrap
 import warnings
 from pathlib import Path
 
@@ -20,6 +19,7 @@ from ecofmaps._parallel import worker_limit
 from ecofmaps.cli._common import (
     CommandError,
     add_recording_options,
+    command_parser,
     count,
     option_adder,
     quantity,
@@ -66,32 +66,25 @@ _HELP = {
 
 
 def add(subparsers) -> None:
-    parser = subparsers.add_parser(
+    parser = command_parser(
+        subparsers,
         "loops",
         help="analyse recorded fretting loops cycle by cycle: ECoF, GICoF, stiffness, ...",
-        description=textwrap.fill(
-            "Read recordings of fretting loops (text with a header line in any common "
-            "dialect, TDMS, HDF5/netCDF-4 or zarr), cut them into cycles at the displacement "
-            "reversals or by a cycle column, check every loop, and write one row per cycle: "
-            "cycle, amplitude_um, slip_amplitude_um, normal_load_N (with a recorded load, "
-            "--load COLUMN), max_force_N, dissipated_energy_mJ, ecof, "
-            "cof_max, energy_ratio, stiffness_MN_per_m, gicof, regime, then mu_resolved, "
-            "mu_resolved_se and aspect_ratio (friction and groove read along the whole "
-            "stroke) and quality ('ok', or why values are NaN); first a file column when "
-            "several files are given. The columns are found by name as rigs write them "
-            "(displacement, disp, delta, stroke, ...; force, Fx, Ft, Q, friction, ...) with "
-            "units from their names or the file, else um and N, and an optional 'cycle'. "
-            "With several files, one that cannot be analysed is one error line naming it and "
-            "the others are written (exit status 1); files are written atomically and never "
-            "over an input or a file ecofmaps did not write. --example "
-            "analyses the synthetic recording shipped with ecofmaps.",
-            width=80,
-        ),
-        epilog=(
-            "examples:\n  ecofmaps loops test.csv --load 450N --out results.csv --plots plots\n"
-            "  ecofmaps loops --example --out results.csv --plots plots"
-        ),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Read recordings of fretting loops (text with a header line in any common "
+        "dialect, TDMS, HDF5/netCDF-4 or zarr), cut them into cycles at the displacement reversals "
+        "or by a cycle column, check every loop, and write one row per cycle: cycle, amplitude_um, "
+        "slip_amplitude_um, normal_load_N (with a recorded load, --load COLUMN), max_force_N, "
+        "dissipated_energy_mJ, ecof, cof_max, energy_ratio, stiffness_MN_per_m, gicof, regime, "
+        "then mu_resolved, mu_resolved_se and aspect_ratio (friction and groove read along the "
+        "whole stroke) and quality ('ok', or why values are NaN); first a file column when several "
+        "files are given. The columns are found by name as rigs write them (displacement, disp, "
+        "delta, stroke, ...; force, Fx, Ft, Q, friction, ...) with units from their names or the "
+        "file, else um and N, and an optional 'cycle'. With several files, one that cannot be "
+        "analysed is one error line naming it and the others are written (exit status 1); files "
+        "are written atomically and never over an input or a file ecofmaps did not write. "
+        "--example analyses the synthetic recording shipped with ecofmaps.",
+        epilog="examples:\n  ecofmaps loops test.csv --load 450N --out results.csv --plots plots\n"
+        "  ecofmaps loops --example --out results.csv --plots plots",
     )
     option = option_adder(parser, _HELP)
     option("files", nargs="*", metavar="FILE")

@@ -45,11 +45,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="ecofmaps",
         description=(
-            "Fretting friction maps: how far the energy coefficient of friction drifts "
-            "from the contact one with rig stiffness and wear-scar shape, the paper's "
-            "figures, corrections of reported ECoF values, and the per-cycle analysis of "
-            "measured loops (ECoF, GICoF, rig stiffness). Quantities take units: 50um, "
-            "450N, 35MN/m."
+            "Fretting friction maps: how far the energy coefficient of friction drifts from the "
+            "contact one with rig stiffness and wear-scar shape, the paper's figures, corrections "
+            "of reported ECoF values, and the per-cycle analysis of measured loops (ECoF, GICoF, "
+            "rig stiffness). Quantities take units: 50um, 450N, 35MN/m."
         ),
     )
     parser.add_argument("--version", action="version", version=f"ecofmaps {__version__}")

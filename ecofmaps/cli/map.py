@@ -8,13 +8,11 @@ and a map that would not fit on the disk refused.
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import itertools
 import math
 import shutil
 import sys
-import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +21,7 @@ from ecofmaps.cli._common import (
     CACHE_DIR_HELP,
     CommandError,
     byte_size,
+    command_parser,
     count,
     option_adder,
     quantity,
@@ -58,38 +57,31 @@ _HELP = {
 
 
 def add(subparsers) -> None:
-    parser = subparsers.add_parser(
+    parser = command_parser(
+        subparsers,
         "map",
         help="compute the model over a grid of test conditions into a netCDF file or zarr store",
-        description=textwrap.fill(
-            "Compute the steady-loop quantities of the model (slip amplitude and slip ratio, "
-            "energy CoF and its ratio to mu, compliance ratio P/(S*amplitude), regime, and "
-            "with --load the dissipated energy and peak force) over a grid, and write them "
-            "as an xarray Dataset to a netCDF file, or to a zarr store if --out ends in .zarr "
-            "(atomically; an existing output is replaced only with --overwrite, if ecofmaps "
-            "wrote it, and only once the new one is complete). The map's size is printed "
-            "first, and a map that would not fit on the disk is refused. "
-            "The groove half-width equals the amplitude, "
-            "as in the paper. Each of --stiffness-ratio, --aspect-ratio, --amplitude and --mu "
-            "takes one value (a scalar coordinate of the result), a comma-separated list or a "
-            "range start:stop:num (num evenly spaced points, both ends included); each list or "
-            "range is a dimension, in this order. Values take units (50um, 0.08/um, 450N); a "
-            "bare number is SI. A grid of more than --chunk-points points, and any zarr "
-            "store, is computed block by block straight into the output, with a few blocks "
-            "in memory at a time (grids far beyond memory work), and a progress bar on a "
-            "terminal. The map is not cached: it computes faster than the cache would read "
-            "it back, and --out keeps it.",
-            width=80,
-        ),
-        epilog=(
-            "example (the grid of Figure 11):\n  ecofmaps map --stiffness-ratio 0.01/um:0.3/um:30 "
-            "--aspect-ratio 0:0.3:31 \\\n      --amplitude 25um,50um --mu 0.8 --load 450N "
-            "--out fig11.nc\n"
-            "a billion points, block by block into a zarr store:\n"
-            "  ecofmaps map --stiffness-ratio 0.01/um:0.3/um:25000 --aspect-ratio 0:0.4:20000 "
-            "\\\n      --amplitude 25um,50um --mu 0.8 --out big.zarr"
-        ),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Compute the steady-loop quantities of the model (slip amplitude and slip "
+        "ratio, energy CoF and its ratio to mu, compliance ratio P/(S*amplitude), regime, and with "
+        "--load the dissipated energy and peak force) over a grid, and write them as an xarray "
+        "Dataset to a netCDF file, or to a zarr store if --out ends in .zarr (atomically; an "
+        "existing output is replaced only with --overwrite, if ecofmaps wrote it, and only once "
+        "the new one is complete). The map's size is printed first, and a map that would not fit "
+        "on the disk is refused. The groove half-width equals the amplitude, as in the paper. Each "
+        "of --stiffness-ratio, --aspect-ratio, --amplitude and --mu takes one value (a scalar "
+        "coordinate of the result), a comma-separated list or a range start:stop:num (num evenly "
+        "spaced points, both ends included); each list or range is a dimension, in this order. "
+        "Values take units (50um, 0.08/um, 450N); a bare number is SI. A grid of more than "
+        "--chunk-points points, and any zarr store, is computed block by block straight into the "
+        "output, with a few blocks in memory at a time (grids far beyond memory work), and a "
+        "progress bar on a terminal. The map is not cached: it computes faster than the cache "
+        "would read it back, and --out keeps it.",
+        epilog="example (the grid of Figure 11):\n  ecofmaps map "
+        "--stiffness-ratio 0.01/um:0.3/um:30 --aspect-ratio 0:0.3:31 \\\n      --amplitude "
+        "25um,50um --mu 0.8 --load 450N --out fig11.nc\n"
+        "a billion points, block by block into a zarr store:\n"
+        "  ecofmaps map --stiffness-ratio 0.01/um:0.3/um:25000 --aspect-ratio 0:0.4:20000 "
+        "\\\n      --amplitude 25um,50um --mu 0.8 --out big.zarr",
     )
     option = option_adder(parser, _HELP)
     for name, metavar in _AXES.items():
