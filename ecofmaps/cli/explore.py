@@ -37,15 +37,13 @@ def add(subparsers) -> None:
     parser = subparsers.add_parser(
         "explore",
         help="explore the model in the browser: δ*, E_d, μ_E/μ, the loop, the map, a correction",
-        description=(
-            "Serve a page at http://127.0.0.1:PORT/ (this machine only) where the amplitude, load, "
-            "rig stiffness, contact CoF and groove aspect ratio are typed with units (50um, 450N, "
-            "35MN/m), and it shows at that point the slip amplitude, the dissipated energy and "
-            "μ_E/μ, the steady loop, the map of μ_E/μ over S/P and z_o/x_o with the point marked, "
-            "and the contact CoF behind an ECoF you type. The URL keeps the inputs "
-            "(?amplitude=50um&load=450N&stiffness=35MN/m&mu=0.8&aspect_ratio=0.2): share a view as "
-            'a link. Ctrl-C stops the server. Needs the extra web: pip install "ecofmaps[web]".'
-        ),
+        description="Serve a page at http://127.0.0.1:PORT/ (this machine only) where the "
+        "amplitude, load, rig stiffness, contact CoF and groove aspect ratio are typed with units "
+        "(50um, 450N, 35MN/m), and it shows at that point the slip amplitude, the dissipated "
+        "energy and μ_E/μ, the steady loop, the map of μ_E/μ over S/P and z_o/x_o with the point "
+        "marked, and the contact CoF behind an ECoF you type. The URL keeps the inputs "
+        "(?amplitude=50um&load=450N&stiffness=35MN/m&mu=0.8&aspect_ratio=0.2): share a view as a "
+        'link. Ctrl-C stops the server. Needs the extra web: pip install "ecofmaps[web]".',
     )
     option = option_adder(parser, _HELP)
     option("--port", type=_port, default=DEFAULT_PORT, metavar="N")

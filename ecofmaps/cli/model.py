@@ -39,13 +39,11 @@ def add(subparsers) -> None:
     parser = subparsers.add_parser(
         "model",
         help="evaluate the model at one point (default: the paper's Example 2)",
-        description=(
-            "Evaluate the compliant wear-scar interaction model at one point and print the slip "
-            "amplitude, peak force, dissipated energy, energy CoF and regime. Defaults are the "
-            "paper's Example 2: amplitude 50um, load 450N, stiffness 35MN/m, mu 0.8, aspect ratio "
-            "0.2. With --scar-profile FILE the groove is a measured wear-scar profile instead, and "
-            "the parabola of the same depth over half-width D/W is printed beside it."
-        ),
+        description="Evaluate the compliant wear-scar interaction model at one point and print the "
+        "slip amplitude, peak force, dissipated energy, energy CoF and regime. Defaults are the "
+        "paper's Example 2: amplitude 50um, load 450N, stiffness 35MN/m, mu 0.8, aspect ratio 0.2. "
+        "With --scar-profile FILE the groove is a measured wear-scar profile instead, and the "
+        "parabola of the same depth over half-width D/W is printed beside it.",
     )
     option = option_adder(parser, _HELP)
     for name in ("amplitude", "load", "stiffness", "mu"):

@@ -57,15 +57,13 @@ def add(subparsers) -> None:
     parser = subparsers.add_parser(
         "wear",
         help="energy wear coefficient and Archard's k from results tables and scar profiles",
-        description=(
-            "Energy wear of fretting tests: for each test, the dissipated energy summed over "
-            "every cycle (a rig records every N-th), the wear volume of a line contact (the "
-            "scar's worn area times --length, the pile-up apart), α = V/ΣE_d and Archard's k "
-            "on the slip and on the applied amplitude, each with its standard error, and the "
-            "sliding condition; over three tests or more, α and the threshold energy E_th of "
-            "V = α(ΣE_d - E_th). One --profile per test, in the order of the tests (a table "
-            "of several recordings holds several tests)."
-        ),
+        description="Energy wear of fretting tests: for each test, the dissipated energy summed "
+        "over every cycle (a rig records every N-th), the wear volume of a line contact (the "
+        "scar's worn area times --length, the pile-up apart), α = V/ΣE_d and Archard's k on the "
+        "slip and on the applied amplitude, each with its standard error, and the sliding "
+        "condition; over three tests or more, α and the threshold energy E_th of V = α(ΣE_d - "
+        "E_th). One --profile per test, in the order of the tests (a table of several recordings "
+        "holds several tests).",
     )
     option = option_adder(parser, _HELP)
     option("tables", nargs="+", metavar="TABLE")
