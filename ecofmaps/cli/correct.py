@@ -139,15 +139,11 @@ def _table(args, profile) -> int:
             warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
     if args.out is None:
         sys.stdout.write(text)
-        return 1 if failed else 0
+        return 1 if failed else 0  # the rows are on standard output
     write_text(args.out, text)
     record_written([args.out])
     on = "" if profile is None else f" on the scar profile {args.scar_profile}"
-    if failed:
-        print(
-            f"wrote {args.out}: {rows - len(failed)} of {rows} rows corrected{on}, "
-            f"{len(failed)} not (NaN, the reason in the status column)"
-        )
-        return 1
-    print(f"wrote {args.out}: {rows} rows corrected{on}")
-    return 0
+    corrected = f"{rows - len(failed)} of {rows}" if failed else rows
+    others = f", {len(failed)} not (NaN, the reason in the status column)" if failed else ""
+    print(f"wrote {args.out}: {corrected} rows corrected{on}{others}")
+    return 1 if failed else 0

@@ -308,8 +308,7 @@ class LongRun:
         if partial is None or not partial.folder.exists():
             return None
         if partial.made and not any(partial.folder.glob(_WORK)):
-            partial.remove()
-            self.partial = None
+            self.finish()  # nothing worth keeping
             return None
         partial.remove_temporaries()
         index, path, blocks = self.analysed
@@ -320,7 +319,7 @@ class LongRun:
         )
 
     def finish(self) -> None:
-        """Remove the kept blocks: the table is written."""
+        """Remove the kept blocks (the table is written, or nothing was kept yet)."""
         if self.partial is not None:
             self.partial.remove()
             self.partial = None

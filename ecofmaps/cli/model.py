@@ -58,7 +58,6 @@ def run(args) -> int:
     profile, the values on the parabola of the same D/W (eq. 11) are printed beside."""
     from ecofmaps import model
     from ecofmaps._codes import RegimeWarning
-    from ecofmaps.model import Regime
 
     profile = read_profile(args, conflicting=("aspect_ratio",))
     rig = dict(amplitude=args.amplitude, load=args.load, stiffness=args.stiffness, mu=args.mu)
@@ -91,7 +90,9 @@ def run(args) -> int:
         show, title = two_values, " on a measured scar profile"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RegimeWarning)
-        rows.append(show("regime", *(Regime(int(model.slip_regime(**p))).label for p in points)))
+        rows.append(
+            show("regime", *(model.Regime(int(model.slip_regime(**p))).label for p in points))
+        )
         values = {name: [float(getattr(model, name)(**p)) for p in points] for name in _RESULTS}
     ecof = values.pop("energy_cof")
     rows += [show(name, *value) for name, value in values.items()]
