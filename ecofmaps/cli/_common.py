@@ -383,8 +383,7 @@ _COLUMN = 18
 def two_values(name: str, on_profile, on_parabola, note: str = "") -> tuple[str, str, str]:
     """One row of :func:`ecofmaps.cli._common.row` with two values: profile, parabola."""
     words, symbol, first = row(name, on_profile, note)
-    second = row(name, on_parabola)[2]
-    return words, symbol, f"{first:<{_COLUMN}} {second}"
+    return words, symbol, f"{first:<{_COLUMN}} {row(name, on_parabola)[2]}"
 
 
 def two_columns_header() -> tuple[str, str, str]:

@@ -145,8 +145,7 @@ def _plot_names(paths) -> list[str]:
     ]
 
 
-#: What a long recording analysed out of core does not keep: the option that needs it, what
-#: it does with it, and the other options to leave out.
+#: The options that need what a long recording analysed out of core does not keep.
 _NOT_KEPT = (
     ("--resolved", "reads every loop along the stroke", ""),
     ("--report", "draws loops and the whole table", ""),
