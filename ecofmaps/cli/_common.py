@@ -1,11 +1,13 @@
 """What the subcommands share: quantities and counts read with units, the options that find a
-recording's columns, the one rule for writing outputs, printed rows and sizes."""
+recording's columns or read a scar profile, the one rule for writing outputs, printed rows."""
 
 from __future__ import annotations
 
 import argparse
 import math
 import os
+import sys
+import textwrap
 import warnings
 from pathlib import Path
 
@@ -17,45 +19,45 @@ from ecofmaps.io.files import MANIFEST, written_by_ecofmaps
 from ecofmaps.units import DIMENSIONS, bare_number_warning, parse_quantity, parse_values
 
 __all__ = [
+    "CACHE_DIR_HELP",
     "CommandError",
+    "add_profile_options",
     "add_recording_options",
     "byte_size",
+    "command_parser",
     "count",
+    "option_adder",
     "print_rows",
+    "profile_rows",
     "quantity",
+    "read_profile",
     "recording_options",
     "refuse_to_overwrite",
     "row",
+    "two_columns_header",
+    "two_values",
     "unit",
 ]
 
 
-def _in_range(name: str, values: np.ndarray, text: str) -> None:
-    """Raise ``ValueError`` if ``values`` [SI] leave the valid range of quantity ``name``."""
-    described = QUANTITIES[name]
-    if described.valid is None or np.all(within(name, values)):
-        return
-    symbol = described.symbol or name
-    unit = f" [{described.units}]" if described.units != "1" else ""
-    valid = RANGES[described.valid][1].format(name=symbol)
-    raise ValueError(f"{text!r} is out of range: the {described.words} must satisfy {valid}{unit}")
-
-
 def quantity(name: str, grid: bool = False, option: str | None = None):
     """An argparse ``type`` reading a value of quantity ``name`` with units (with ``grid``, a
-    list ``a,b,c`` or a range ``start:stop:num`` of values that do not repeat), checked against
-    its dimension and valid range in the nomenclature (argparse names the option). A bare
-    number implausible in SI is warned, naming ``option`` (default ``--name``) and the unit
-    probably meant."""
-    kind = QUANTITIES[name].kind
-    option = option or "--" + name.replace("_", "-")
+    list ``a,b,c`` or a range ``start:stop:num``), checked against its dimension and valid
+    range; a bare number implausible in SI is warned of, naming ``option`` (``--name``)."""
+    described = QUANTITIES[name]
+    kind, option = described.kind, option or "--" + name.replace("_", "-")
 
     def parse(text: str):
         try:
             value = parse_values(text, kind) if grid else parse_quantity(text, kind)
-            _in_range(name, np.asarray(value), text)
         except ValueError as error:
             raise argparse.ArgumentTypeError(str(error)) from None
+        if described.valid is not None and not np.all(within(name, np.asarray(value))):
+            valid = RANGES[described.valid][1].format(name=described.symbol or name)
+            unit = f" [{described.units}]" if described.units != "1" else ""
+            raise argparse.ArgumentTypeError(
+                f"{text!r} is out of range: the {described.words} must satisfy {valid}{unit}"
+            )
         unique, counts = np.unique(value, return_counts=True)
         if np.any(counts > 1):
             raise argparse.ArgumentTypeError(
@@ -68,20 +70,18 @@ def quantity(name: str, grid: bool = False, option: str | None = None):
                 warnings.warn(f"{option} {said}", stacklevel=2)
         return value
 
-    parse.__name__, parse.option = kind, option
+    parse.__name__ = kind
     return parse
 
 
 def unit(kind: str):
-    """An argparse ``type`` reading a unit of ``kind`` (``'um'``, ``'kN'``): kept as text.
+    """An argparse ``type`` reading a unit of ``kind`` (``'um'``, ``'kN'``), kept as text: a
+    unit of that dimension whose size is positive and finite (not a number, ``'0um'``)."""
 
-    The text must name a unit of that dimension whose size is positive and finite: an empty
-    text, a number (``'0um'``) or a unit of another kind is an error naming the option.
-    """
+    example = DIMENSIONS[kind][1]
 
     def parse(text: str) -> str:
         if not text.strip():
-            example = DIMENSIONS[kind][1]
             raise argparse.ArgumentTypeError(f"an empty unit; give a {kind} unit such as {example}")
         number = text.strip()[0] in "0123456789.+-"
         try:
@@ -91,7 +91,7 @@ def unit(kind: str):
         if not (0.0 < scale < math.inf):
             raise argparse.ArgumentTypeError(
                 f"{text!r} is not a unit (a number in front of it makes a quantity); give a "
-                f"{kind} unit such as {DIMENSIONS[kind][1]}"
+                f"{kind} unit such as {example}"
             )
         return text
 
@@ -115,53 +115,55 @@ def count(what: str):
     return parse
 
 
+#: The help of ``--cache-dir`` (``ecofmaps map``, ``cache``).
+CACHE_DIR_HELP = "cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)"
+
+#: The help of each option of :func:`add_recording_options`.
+_RECORDING_HELP = {
+    "--displacement-col": "name of the displacement column (default: displacement)",
+    "--force-col": "name of the tangential force column (default: force)",
+    "--cycle-col": "name of a column of cycle numbers, which must exist (default: 'cycle' if "
+    "the file has it; else, or with 'none', cycles are cut at the reversals)",
+    "--skip-rows": "lines of a text file to skip before its header line (default: metadata "
+    "lines before the header are found)",
+    "--displacement-unit": "unit of the displacement column (default: the one its name or the "
+    "file gives, as in 'displacement [mm]' or a channel's unit, else um)",
+    "--force-unit": "unit of the force column (default: from its name or the file, else N)",
+    "--group": "TDMS group, or HDF5/netCDF/zarr group, holding the channels (default: any)",
+}
+
+
+def command_parser(subparsers, name: str, **texts) -> argparse.ArgumentParser:
+    """The parser of subcommand ``name``, its ``description`` filled to 80 columns and its
+    ``epilog`` kept as written (``texts``: ``help``, ``description``, ``epilog``)."""
+    texts["description"] = textwrap.fill(texts["description"], width=80)
+    formatter = argparse.RawDescriptionHelpFormatter
+    return subparsers.add_parser(name, formatter_class=formatter, **texts)
+
+
+def option_adder(parser, helps: dict):
+    """``add(name, **keywords)``: add option ``name`` to ``parser``, its help ``helps[name]``."""
+
+    def add(name: str, **keywords) -> None:
+        parser.add_argument(name, help=helps[name], **keywords)
+
+    return add
+
+
 def add_recording_options(parser) -> None:
     """The options that say where a recording's columns are and in which units."""
-    for option, default, help in (
-        (
-            "--displacement-col",
-            "displacement",
-            "name of the displacement column (default: displacement)",
-        ),
-        ("--force-col", "force", "name of the tangential force column (default: force)"),
-        (
-            "--cycle-col",
-            None,
-            "name of a column of cycle numbers, which must exist (default: 'cycle' if the file "
-            "has it; else, or with 'none', cycles are cut at the reversals)",
-        ),
-    ):
-        parser.add_argument(option, default=default, metavar="NAME", help=help)
-    parser.add_argument(
-        "--skip-rows",
-        type=int,
-        metavar="N",
-        help="lines of a text file to skip before its header line (default: metadata lines "
-        "before the header are found)",
-    )
-    parser.add_argument(
-        "--displacement-unit",
-        type=unit("length"),
-        metavar="UNIT",
-        help="unit of the displacement column (default: the one its name or the file gives, as "
-        "in 'displacement [mm]' or a channel's unit, else um)",
-    )
-    parser.add_argument(
-        "--force-unit",
-        type=unit("force"),
-        metavar="UNIT",
-        help="unit of the force column (default: from its name or the file, else N)",
-    )
-    parser.add_argument(
-        "--group",
-        metavar="NAME",
-        help="TDMS group, or HDF5/netCDF/zarr group, holding the channels (default: any)",
-    )
+    option = option_adder(parser, _RECORDING_HELP)
+    option("--displacement-col", default="displacement", metavar="NAME")
+    option("--force-col", default="force", metavar="NAME")
+    option("--cycle-col", metavar="NAME")
+    option("--skip-rows", type=int, metavar="N")
+    option("--displacement-unit", type=unit("length"), metavar="UNIT")
+    option("--force-unit", type=unit("force"), metavar="UNIT")
+    option("--group", metavar="NAME")
 
 
 def recording_options(args) -> dict:
-    """The keywords of :func:`ecofmaps.io.recordings.read_recording` given by a command's
-    column, unit and group options (``--displacement-col`` ... ``--group``)."""
+    """The keywords of :func:`ecofmaps.io.recordings.read_recording` the options give."""
     if args.cycle_col is not None and not args.cycle_col.strip():
         raise CommandError(
             f"--cycle-col {args.cycle_col!r} names no column: give the cycle column's name, "
@@ -178,18 +180,129 @@ def recording_options(args) -> dict:
     }
 
 
-def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=()) -> None:
-    """Raise :class:`CommandError` unless the command may write its outputs: the one rule.
+#: The ``--scar-profile`` options that ``ecofmaps model`` and ``ecofmaps correct`` share: a
+#: measured wear-scar profile instead of the parabolic groove of eq. 11 (docs/profiles.md).
+_PROFILE_HELP = {
+    "--scar-profile": "the scar's profile (CSV, TSV or whitespace-separated text)",
+    "--x-column": "name of the position column (default: x)",
+    "--z-column": "name of the height column (default: z)",
+    "--x-unit": "unit of the positions (default: the one the column's name gives, else um)",
+    "--z-unit": "unit of the heights (default: the one the column's name gives, else um)",
+    "--no-level": "keep the trace's tilt and offset (default: level it on the unworn shoulders)",
+    "--profile-half-width": "the scar's half-width W, e.g. 500um (default: the one detected at "
+    "the edges)",
+    "--smoothing": "length over which the slopes are smoothed, e.g. 10um; 0 for none (default: "
+    "2%% of the half-width)",
+    "--mapping": "where the pad at slip position x sits on the profile: 'scaled', X = x W/x_o "
+    "(eq. 11, the paper's; default), or 'physical', X = x",
+}
+_PROFILE_DEFAULTS = {"x_column": "x", "z_column": "z", "no_level": False, "mapping": "scaled"}
 
-    An output is never an input file. An output that exists is replaced only with
-    ``--overwrite``, and only if ecofmaps wrote it and it is unchanged since
-    (:func:`ecofmaps.io.files.written_by_ecofmaps`): a user's file, and a folder that is
-    not a store ecofmaps wrote, are never replaced. A folder the command writes files into
-    (``--plots``, ``figures --out``) may exist empty; one that holds anything needs
-    ``--overwrite``, and then only ecofmaps' own files in it are replaced, the others kept.
-    Everything is checked before any work. ``outputs`` and ``folders`` are (the option that
-    names it, its path or None); ``inputs`` the files the command reads.
-    """
+
+def add_profile_options(parser: argparse.ArgumentParser) -> None:
+    """Add ``--scar-profile FILE`` and its reading options, in a group of their own."""
+    group = parser.add_argument_group(
+        "measured scar profile",
+        "a profilometer trace across the wear scar (text: a header line, then x and z per "
+        "line, in um unless the names or --x-unit/--z-unit say otherwise), used instead of "
+        "the parabolic groove of eq. 11",
+    )
+    option = option_adder(group, _PROFILE_HELP)
+    option("--scar-profile", metavar="FILE")
+    option("--x-column", metavar="NAME")
+    option("--z-column", metavar="NAME")
+    option("--x-unit", type=unit("length"), metavar="UNIT")
+    option("--z-unit", type=unit("length"), metavar="UNIT")
+    option("--no-level", action="store_true", default=None)
+    half_width = quantity("scar_half_width", option="--profile-half-width")
+    option("--profile-half-width", type=half_width, metavar="W")
+    option("--smoothing", type=quantity("smoothing"), metavar="LENGTH")
+    option("--mapping", choices=("scaled", "physical"))
+    reading = tuple(action.dest for action in group._group_actions[1:])  # need --scar-profile
+    parser.set_defaults(profile_command=parser.prog, profile_options=reading)
+
+
+def read_profile(args, conflicting=()):
+    """The profile ``--scar-profile`` names (read with its options), or ``None``; an option
+    of the parabola (the destinations ``conflicting``) with it, or of the reading without it,
+    is a :class:`CommandError`. The reader's warnings are printed one line each, naming the
+    ``--profile-half-width`` of the other half-width for ambiguous edges."""
+    given = [name for name in args.profile_options if getattr(args, name) is not None]
+    if args.scar_profile is None and given:
+        raise CommandError(f"{_options(given)} reads a --scar-profile: give the FILE too")
+    for name, value in _PROFILE_DEFAULTS.items():
+        if getattr(args, name) is None:
+            setattr(args, name, value)
+    if args.scar_profile is None:
+        return None
+    if given := [name for name in conflicting if getattr(args, name) is not None]:
+        raise CommandError(
+            f"give --scar-profile or {_options(given)}, not both (the profile gives the "
+            "scar's shape, and its D/W)"
+        )
+    # JAX and the readers load with the first profile read, not with the command line
+    from ecofmaps.io.scar_profiles import read_scar_profile
+    from ecofmaps.model.profiles import ScarProfileWarning  # with the reader, as above
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ScarProfileWarning)
+        profile = read_scar_profile(
+            args.scar_profile,
+            x_column=args.x_column,
+            z_column=args.z_column,
+            x_unit=args.x_unit,
+            z_unit=args.z_unit,
+            level=not args.no_level,
+            half_width=args.profile_half_width,
+            smoothing=args.smoothing,
+        )
+    args.profile_alternative = ""  # what the other half-width is, for profile_rows
+    for item in caught:
+        if not issubclass(item.category, ScarProfileWarning):
+            warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
+            continue
+        said, hint = item.message, ""
+        if said.alternative is not None:
+            args.profile_alternative = said.alternative_name
+            hint = f"; --profile-half-width {said.alternative * 1e6:.6g}um takes the "
+            hint += said.alternative_name
+        print(f"{args.profile_command}: warning: {said.summary}{hint}", file=sys.stderr)
+    return profile
+
+
+def _options(names) -> str:
+    return ", ".join("--" + name.replace("_", "-") for name in names)
+
+
+def profile_rows(args, profile) -> list:
+    """Rows naming the profile: its file and samples, depth D, half-width W (and the
+    alternative when the edges were ambiguous), D/W."""
+    reading = [f"{profile.position.shape[-1]} samples", "as given" if args.no_level else "levelled"]
+    if replaced := int(np.count_nonzero(np.asarray(profile.replaced))):
+        reading.append(f"{replaced} outlier(s) replaced")
+    if args.smoothing is not None:
+        reading.append(f"slopes smoothed over {args.smoothing * 1e6:.6g} µm")
+    # the other half-width is the groove's, the band's, or that of the edges read within
+    # the roughness (the warning names it)
+    other, alternative = args.profile_alternative, float(profile.alternative_half_width)
+    how = "(given)" if args.profile_half_width is not None else "(detected)"
+    if not math.isnan(alternative):
+        how = "(" + {"groove": "band", "band": "groove"}.get(other, "detected") + ")"
+    rows = [
+        ("scar profile", "", f"{args.scar_profile} ({', '.join(reading)})"),
+        row("scar_depth", float(profile.depth)),
+        row("scar_half_width", float(profile.half_width), how),
+    ]
+    if not math.isnan(alternative):
+        rows.append(row("scar_half_width", alternative, f"(or {other})"))
+    return [*rows, ("scar aspect ratio", "D/W", f"{float(profile.aspect_ratio):.6g}")]
+
+
+def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=()) -> None:
+    """Raise :class:`CommandError` unless the command may write its ``outputs`` and into its
+    ``folders`` (each (option, path or None)), the one rule: never over an input; over a file
+    only with ``overwrite`` if ecofmaps wrote it, unchanged since; into a folder holding
+    anything only with ``overwrite`` (:func:`ecofmaps.io.files.written_by_ecofmaps`)."""
     outputs = [(option, Path(path)) for option, path in outputs if path is not None]
     sources = [Path(path) for path in inputs]
     for option, target in outputs:
@@ -242,11 +355,8 @@ def _resolved(path: Path) -> Path:
 
 
 def row(name: str, value, note: str = "") -> tuple[str, str, str]:
-    """One printed row: the quantity's words and symbol, and ``value`` [SI] in its display unit.
-
-    ``value`` may be text (printed as it is); a NaN prints as ``undefined``, an infinite
-    stiffness as ``inf (rigid)``. ``note`` follows the words, e.g. ``'(reported)'``.
-    """
+    """One printed row: the quantity's words (then ``note``) and symbol, and ``value`` [SI] in
+    its display unit (text as it is; NaN ``undefined``; an infinite stiffness ``inf (rigid)``)."""
     quantity = QUANTITIES[name]
     words = f"{quantity.words} {note}".strip()
     if isinstance(value, str):
@@ -264,6 +374,21 @@ def print_rows(title: str, rows) -> None:
     print(title)
     for item in rows:
         print("" if item is None else f"  {item[0]:<32} {item[1]:<8} {item[2]}".rstrip())
+
+
+#: Width of the first value column when a profile's values stand beside the parabola's.
+_COLUMN = 18
+
+
+def two_values(name: str, on_profile, on_parabola, note: str = "") -> tuple[str, str, str]:
+    """One row of :func:`ecofmaps.cli._common.row` with two values: profile, parabola."""
+    words, symbol, first = row(name, on_profile, note)
+    return words, symbol, f"{first:<{_COLUMN}} {row(name, on_parabola)[2]}"
+
+
+def two_columns_header() -> tuple[str, str, str]:
+    """The header row over :func:`two_values`."""
+    return "", "", f"{'on the profile':<{_COLUMN}} parabola of the same D/W (eq. 11 shortcut)"
 
 
 def byte_size(size: float) -> str:

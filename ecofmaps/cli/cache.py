@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import textwrap
-
-from ecofmaps.cli._common import byte_size
+from ecofmaps.cli._common import CACHE_DIR_HELP, byte_size
 
 __all__ = ["add", "run"]
 
@@ -13,14 +11,10 @@ def add(subparsers) -> None:
     parser = subparsers.add_parser(
         "cache",
         help="list or clear the cache of computed maps",
-        description=textwrap.fill(
-            "Computed maps are kept as netCDF files, one per grid and package version, in the "
-            "directory given by --cache-dir, else the ECOFMAPS_CACHE environment variable, "
-            "else the per-user cache directory. 'list' shows them with their sizes; 'clear' "
-            "removes them (and temporary files of interrupted writes; other files are left "
-            "alone).",
-            width=80,
-        ),
+        description="Computed maps are kept as netCDF files, one per grid and package version, in "
+        "the directory given by --cache-dir, else the ECOFMAPS_CACHE environment variable, else "
+        "the per-user cache directory. 'list' shows them with their sizes; 'clear' removes them "
+        "(and temporary files of interrupted writes; other files are left alone).",
     )
     actions = parser.add_subparsers(title="actions", metavar="ACTION", required=True)
     for name, text in (
@@ -28,11 +22,7 @@ def add(subparsers) -> None:
         ("clear", "remove every cached map"),
     ):
         action = actions.add_parser(name, help=text, description=text + ".")
-        action.add_argument(
-            "--cache-dir",
-            metavar="DIR",
-            help="cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)",
-        )
+        action.add_argument("--cache-dir", metavar="DIR", help=CACHE_DIR_HELP)
         action.set_defaults(action=name)
 
 

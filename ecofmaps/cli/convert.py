@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-import argparse
-import textwrap
 from pathlib import Path
 
 from ecofmaps.cli._common import (
     CommandError,
     add_recording_options,
+    command_parser,
     count,
+    option_adder,
     recording_options,
     refuse_to_overwrite,
 )
@@ -17,39 +17,34 @@ from ecofmaps.io.files import record_written
 
 __all__ = ["add", "run"]
 
+_HELP = {
+    "source": "the recording to read",
+    "destination": "the file or store to write",
+    "--chunk-samples": "samples per chunk of the store, and per block read (default 1048576)",
+    "--overwrite": "replace DST if ecofmaps wrote it (once the new one is complete); a file or "
+    "folder ecofmaps did not write is never replaced",
+}
+
 
 def add(subparsers) -> None:
-    parser = subparsers.add_parser(
+    parser = command_parser(
+        subparsers,
         "convert",
         help="copy a recording (e.g. a large CSV file) into a chunked zarr, HDF5 or TDMS file",
-        description=textwrap.fill(
-            "Copy the displacement, force (and cycle) columns of a recording that 'ecofmaps "
-            "loops' reads (text, TDMS, HDF5/netCDF-4, zarr) into a new file whose format is "
-            "given by its suffix: .zarr, .h5/.nc, .tdms or .csv. The samples are stored in SI "
-            "units (m, N) with their units, missing ones as NaN, a block at a time (memory "
-            "stays near a few blocks whatever the size), and DST appears only once complete. "
-            "A large text file converted once is read lazily, in parallel, by 'ecofmaps loops'.",
-            width=80,
-        ),
+        description="Copy the displacement, force (and cycle) columns of a recording that "
+        "'ecofmaps loops' reads (text, TDMS, HDF5/netCDF-4, zarr) into a new file whose format is "
+        "given by its suffix: .zarr, .h5/.nc, .tdms or .csv. The samples are stored in SI "
+        "units (m, N) with their units, missing ones as NaN, a block at a time (memory "
+        "stays near a few blocks whatever the size), and DST appears only once complete. "
+        "A large text file converted once is read lazily, in parallel, by 'ecofmaps loops'.",
         epilog="example:\n  ecofmaps convert test.csv test.zarr --displacement-unit um",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("source", metavar="SRC", help="the recording to read")
-    parser.add_argument("destination", metavar="DST", help="the file or store to write")
+    option = option_adder(parser, _HELP)
+    option("source", metavar="SRC")
+    option("destination", metavar="DST")
     add_recording_options(parser)
-    parser.add_argument(
-        "--chunk-samples",
-        type=count("samples"),
-        default=1 << 20,
-        metavar="N",
-        help="samples per chunk of the store, and per block read (default 1048576)",
-    )
-    parser.add_argument(
-        "--overwrite",
-        action="store_true",
-        help="replace DST if ecofmaps wrote it (once the new one is complete); a file or "
-        "folder ecofmaps did not write is never replaced",
-    )
+    option("--chunk-samples", type=count("samples"), default=1 << 20, metavar="N")
+    option("--overwrite", action="store_true")
 
 
 def run(args) -> int:
@@ -66,12 +61,9 @@ def run(args) -> int:
     if not destination.parent.is_dir():
         raise CommandError(f"cannot write {destination}: its directory does not exist")
     refuse_to_overwrite([("DST", destination)], [source], overwrite=args.overwrite)
+    options = recording_options(args)
     convert_recording(
-        source,
-        destination,
-        chunk_samples=args.chunk_samples,
-        overwrite=args.overwrite,
-        **recording_options(args),
+        source, destination, chunk_samples=args.chunk_samples, overwrite=args.overwrite, **options
     )
     record_written([destination])
     with read_recording(destination, lazy=True) as written:

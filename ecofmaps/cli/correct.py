@@ -7,11 +7,16 @@ import warnings
 from pathlib import Path
 
 from ecofmaps._version import __version__
-from ecofmaps.cli._common import CommandError, print_rows, quantity, refuse_to_overwrite, row
-from ecofmaps.cli._profile import (
+from ecofmaps.cli._common import (
+    CommandError,
     add_profile_options,
+    option_adder,
+    print_rows,
     profile_rows,
+    quantity,
     read_profile,
+    refuse_to_overwrite,
+    row,
     two_columns_header,
     two_values,
 )
@@ -22,65 +27,46 @@ __all__ = ["add", "run"]
 POINT_OPTIONS = ("ecof", "amplitude", "load", "stiffness")
 GROOVE_OPTIONS = ("aspect_ratio", "scar_depth", "scar_half_width")
 
+_HELP = {
+    "table": "table of reported ECoFs (',', ';' or tab separated)",
+    "--out": "write the corrected table here (the table's separator; default: standard output)",
+    "--overwrite": "replace --out if ecofmaps wrote it; a file ecofmaps did not write is never "
+    "replaced",
+    "--ecof": "reported energy CoF μ_E, e.g. 0.83",
+    "--amplitude": "displacement amplitude Δ*, e.g. 50um",
+    "--load": "normal load P, e.g. 450N",
+    "--stiffness": "rig stiffness S, e.g. 35MN/m ('inf' for a rigid rig)",
+    "--aspect-ratio": "wear scar depth over half-width z_o/x_o = D/W, e.g. 0.2",
+    "--scar-depth": "scar depth D, e.g. 8um",
+    "--scar-half-width": "scar half-width W, e.g. 40um",
+}
+
 
 def add(subparsers) -> None:
     parser = subparsers.add_parser(
         "correct",
         help="correct reported ECoF values to the contact CoF (one point or a CSV table)",
-        description=(
-            "Correct a reported energy coefficient of friction μ_E to the contact CoF μ the "
-            "model puts behind it, given the test's amplitude, load and rig stiffness and the "
-            "wear scar's depth over half-width z_o/x_o = D/W (eq. 11; x_o = Δ*). One point: "
-            "--ecof --amplitude --load --stiffness and --aspect-ratio (or --scar-depth and "
-            "--scar-half-width). A table: TABLE.csv with columns ecof, amplitude_um, load_N, "
-            "stiffness_MN_per_m and aspect_ratio or scar_depth_um + scar_half_width_um, "
-            "separated by commas, semicolons (decimal commas allowed) or tabs, '#' lines "
-            "skipped as comments; the output, in the table's own separator, keeps every "
-            "column and adds mu and correction_factor. With "
-            "--scar-profile FILE a measured wear-scar profile gives the scar instead (of the "
-            "point, or of every row of a table, which then has no scar columns), and the "
-            "parabola of the same D/W is given beside it (mu_parabolic in a table). A row "
-            "that cannot be corrected (a cell that is not a number, an ECoF no gross-slip "
-            "loop gives) gets NaN and its reason in a status column, with one error line "
-            "naming the file, line (the header is line 1) and column; the other rows are "
-            "written, and the exit status is 1."
-        ),
+        description="Correct a reported energy coefficient of friction μ_E to the contact CoF μ "
+        "the model puts behind it, given the test's amplitude, load and rig stiffness and the wear "
+        "scar's depth over half-width z_o/x_o = D/W (eq. 11; x_o = Δ*). One point: --ecof "
+        "--amplitude --load --stiffness and --aspect-ratio (or --scar-depth and "
+        "--scar-half-width). A table: TABLE.csv with columns ecof, amplitude_um, load_N, "
+        "stiffness_MN_per_m and aspect_ratio or scar_depth_um + scar_half_width_um, separated by "
+        "commas, semicolons (decimal commas allowed) or tabs, '#' lines skipped as comments; the "
+        "output, in the table's own separator, keeps every column and adds mu and "
+        "correction_factor. With --scar-profile FILE a measured wear-scar profile gives the scar "
+        "instead (of the point, or of every row of a table, which then has no scar columns), and "
+        "the parabola of the same D/W is given beside it (mu_parabolic in a table). A row that "
+        "cannot be corrected (a cell that is not a number, an ECoF no gross-slip loop gives) gets "
+        "NaN and its reason in a status column, with one error line naming the file, line (the "
+        "header is line 1) and column; the other rows are written, and the exit status is 1.",
     )
-    parser.add_argument(
-        "table",
-        nargs="?",
-        metavar="TABLE",
-        help="table of reported ECoFs (',', ';' or tab separated)",
-    )
-    parser.add_argument(
-        "--out",
-        metavar="OUT",
-        help="write the corrected table here (the table's separator; default: standard output)",
-    )
-    parser.add_argument(
-        "--overwrite",
-        action="store_true",
-        help="replace --out if ecofmaps wrote it; a file ecofmaps did not write is never replaced",
-    )
-    parser.add_argument("--ecof", type=quantity("ecof"), help="reported energy CoF μ_E, e.g. 0.83")
-    parser.add_argument(
-        "--amplitude", type=quantity("amplitude"), help="displacement amplitude Δ*, e.g. 50um"
-    )
-    parser.add_argument("--load", type=quantity("load"), help="normal load P, e.g. 450N")
-    parser.add_argument(
-        "--stiffness",
-        type=quantity("stiffness"),
-        help="rig stiffness S, e.g. 35MN/m ('inf' for a rigid rig)",
-    )
-    parser.add_argument(
-        "--aspect-ratio",
-        type=quantity("aspect_ratio"),
-        help="wear scar depth over half-width z_o/x_o = D/W, e.g. 0.2",
-    )
-    parser.add_argument("--scar-depth", type=quantity("scar_depth"), help="scar depth D, e.g. 8um")
-    parser.add_argument(
-        "--scar-half-width", type=quantity("scar_half_width"), help="scar half-width W, e.g. 40um"
-    )
+    option = option_adder(parser, _HELP)
+    option("table", nargs="?", metavar="TABLE")
+    option("--out", metavar="OUT")
+    option("--overwrite", action="store_true")
+    for name in (*POINT_OPTIONS, *GROOVE_OPTIONS):
+        option("--" + name.replace("_", "-"), type=quantity(name))
     add_profile_options(parser)
 
 
@@ -100,16 +86,29 @@ def run(args) -> int:
         return _table(args, read_profile(args))
     if args.out is not None:
         raise CommandError("--out writes a corrected TABLE; give the TABLE too")
-    missing = ["--" + name for name in POINT_OPTIONS if getattr(args, name) is None]
-    if missing:
+    if missing := ["--" + name for name in POINT_OPTIONS if getattr(args, name) is None]:
         raise CommandError(f"give {', '.join(missing)} (or a TABLE)")
     profile = read_profile(args, conflicting=GROOVE_OPTIONS)
-    if profile is not None:
-        return _point_on_profile(args, profile)
+    rig = dict(amplitude=args.amplitude, load=args.load, stiffness=args.stiffness)
+    rows = [row("ecof", args.ecof, "(reported)"), *(row(name, rig[name]) for name in rig)]
+    title = f"ecofmaps {__version__}: reported ECoF corrected to the contact CoF"
+    if profile is not None:  # beside the D/W shortcut (eq. 11)
+        mu = float(correct_ecof(args.ecof, **rig, profile=profile, mapping=args.mapping))
+        shortcut, _ = correct_ecof(
+            args.ecof, **rig, aspect_ratio=float(profile.aspect_ratio), return_status=True
+        )
+        shortcut = float(shortcut)  # NaN (printed 'undefined') where the parabola cannot
+        rows += [*profile_rows(args, profile), None, two_columns_header()]
+        rows += [
+            two_values("mu", mu, shortcut),
+            two_values("correction_factor", mu / args.ecof, shortcut / args.ecof),
+        ]
+        mapping = "X = x" if args.mapping == "physical" else "X = x W/Δ*, eq. 11"
+        print_rows(f"{title} on a measured scar profile ({mapping})", rows)
+        return 0
     scar = [value is not None for value in (args.scar_depth, args.scar_half_width)]
     if (args.aspect_ratio is not None) == any(scar) or any(scar) != all(scar):
         raise CommandError("give --aspect-ratio, or both --scar-depth and --scar-half-width")
-    point = dict(amplitude=args.amplitude, load=args.load, stiffness=args.stiffness)
     if args.aspect_ratio is not None:
         scar, ratio_text = {"aspect_ratio": args.aspect_ratio}, f"{args.aspect_ratio:.6g}"
     else:
@@ -118,20 +117,9 @@ def run(args) -> int:
             f"{args.scar_depth / args.scar_half_width:.6g} (scar {args.scar_depth * 1e6:.6g} µm "
             f"deep, {args.scar_half_width * 1e6:.6g} µm half-width)"
         )
-    mu = float(correct_ecof(args.ecof, **point, **scar))
-    rows = [
-        row("ecof", args.ecof, "(reported)"),
-        row("amplitude", args.amplitude),
-        row("load", args.load),
-        row("stiffness", args.stiffness),
-        row("aspect_ratio", ratio_text),
-        None,
-        row("mu", mu),
-        row("correction_factor", mu / args.ecof),
-    ]
-    print_rows(
-        f"ecofmaps {__version__}: reported ECoF corrected to the contact CoF (x_o = Δ*)", rows
-    )
+    mu = float(correct_ecof(args.ecof, **rig, **scar))
+    rows += [row("aspect_ratio", ratio_text), None, row("mu", mu)]
+    print_rows(f"{title} (x_o = Δ*)", [*rows, row("correction_factor", mu / args.ecof)])
     return 0
 
 
@@ -149,47 +137,13 @@ def _table(args, profile) -> int:
             print(f"ecofmaps correct: error: {item.message}", file=sys.stderr)
         else:
             warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
-    status = 1 if failed else 0
     if args.out is None:
         sys.stdout.write(text)
-        return status
+        return 1 if failed else 0  # the rows are on standard output
     write_text(args.out, text)
     record_written([args.out])
     on = "" if profile is None else f" on the scar profile {args.scar_profile}"
-    if failed:
-        print(
-            f"wrote {args.out}: {rows - len(failed)} of {rows} rows corrected{on}, "
-            f"{len(failed)} not (NaN, the reason in the status column)"
-        )
-        return status
-    print(f"wrote {args.out}: {rows} rows corrected{on}")
-    return status
-
-
-def _point_on_profile(args, profile) -> int:
-    """One ECoF corrected on the measured profile, beside the D/W shortcut (eq. 11)."""
-    from ecofmaps.correction.inversion import correct_ecof
-
-    rig = dict(amplitude=args.amplitude, load=args.load, stiffness=args.stiffness)
-    mu = float(correct_ecof(args.ecof, **rig, profile=profile, mapping=args.mapping))
-    shortcut, _ = correct_ecof(
-        args.ecof, **rig, aspect_ratio=float(profile.aspect_ratio), return_status=True
-    )
-    shortcut = float(shortcut)  # NaN (printed 'undefined') where the parabola cannot
-    rows = [
-        row("ecof", args.ecof, "(reported)"),
-        row("amplitude", args.amplitude),
-        row("load", args.load),
-        row("stiffness", args.stiffness),
-        *profile_rows(args, profile),
-        None,
-        two_columns_header(),
-        two_values("mu", mu, shortcut),
-        two_values("correction_factor", mu / args.ecof, shortcut / args.ecof),
-    ]
-    print_rows(
-        f"ecofmaps {__version__}: reported ECoF corrected to the contact CoF on a measured "
-        f"scar profile ({'X = x' if args.mapping == 'physical' else 'X = x W/Δ*, eq. 11'})",
-        rows,
-    )
-    return 0
+    corrected = f"{rows - len(failed)} of {rows}" if failed else rows
+    others = f", {len(failed)} not (NaN, the reason in the status column)" if failed else ""
+    print(f"wrote {args.out}: {corrected} rows corrected{on}{others}")
+    return 1 if failed else 0

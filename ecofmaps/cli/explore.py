@@ -3,14 +3,23 @@
 from __future__ import annotations
 
 import argparse
+import functools
 
-from ecofmaps.cli._common import CommandError
+from ecofmaps.cli._common import CommandError, option_adder
 from ecofmaps.web import INSTALL_WEB, missing_web_packages
 
 __all__ = ["DEFAULT_PORT", "add", "run"]
 
 #: The port the explorer listens on unless --port says otherwise.
 DEFAULT_PORT = 5006
+
+_HELP = {
+    "--port": f"the port to listen on (default {DEFAULT_PORT})",
+    "--no-browser": "do not open the page in a browser",
+    "--allow-origin": "also answer pages of this host (a tunnel or proxy's name; without a port, "
+    "--port's); by default only 127.0.0.1, localhost and [::1] at --port, and any other Host "
+    "or Origin gets 403 (repeat the option for more hosts)",
+}
 
 
 def _port(text: str) -> int:
@@ -28,36 +37,18 @@ def add(subparsers) -> None:
     parser = subparsers.add_parser(
         "explore",
         help="explore the model in the browser: δ*, E_d, μ_E/μ, the loop, the map, a correction",
-        description=(
-            "Serve a page at http://127.0.0.1:PORT/ (this machine only) where the amplitude, "
-            "load, rig stiffness, contact CoF and groove aspect ratio are typed with units "
-            "(50um, 450N, 35MN/m), and it shows at that point the slip amplitude, the "
-            "dissipated energy and μ_E/μ, the steady loop, the map of μ_E/μ over S/P and "
-            "z_o/x_o with the point marked, and the contact CoF behind an ECoF you type. The "
-            "URL keeps the inputs (?amplitude=50um&load=450N&stiffness=35MN/m&mu=0.8&"
-            "aspect_ratio=0.2): share a view as a link. Ctrl-C stops the server. Needs the "
-            'extra web: pip install "ecofmaps[web]".'
-        ),
+        description="Serve a page at http://127.0.0.1:PORT/ (this machine only) where the "
+        "amplitude, load, rig stiffness, contact CoF and groove aspect ratio are typed with units "
+        "(50um, 450N, 35MN/m), and it shows at that point the slip amplitude, the dissipated "
+        "energy and μ_E/μ, the steady loop, the map of μ_E/μ over S/P and z_o/x_o with the point "
+        "marked, and the contact CoF behind an ECoF you type. The URL keeps the inputs "
+        "(?amplitude=50um&load=450N&stiffness=35MN/m&mu=0.8&aspect_ratio=0.2): share a view as a "
+        'link. Ctrl-C stops the server. Needs the extra web: pip install "ecofmaps[web]".',
     )
-    parser.add_argument(
-        "--port",
-        type=_port,
-        default=DEFAULT_PORT,
-        metavar="N",
-        help=f"the port to listen on (default {DEFAULT_PORT})",
-    )
-    parser.add_argument(
-        "--no-browser", action="store_true", help="do not open the page in a browser"
-    )
-    parser.add_argument(
-        "--allow-origin",
-        action="append",
-        default=[],
-        metavar="HOST[:PORT]",
-        help="also answer pages of this host (a tunnel or proxy's name; without a port, "
-        "--port's); by default only 127.0.0.1, localhost and [::1] at --port, and any other "
-        "Host or Origin gets 403 (repeat the option for more hosts)",
-    )
+    option = option_adder(parser, _HELP)
+    option("--port", type=_port, default=DEFAULT_PORT, metavar="N")
+    option("--no-browser", action="store_true")
+    option("--allow-origin", action="append", default=[], metavar="HOST[:PORT]")
 
 
 def run(args) -> int:
@@ -66,11 +57,12 @@ def run(args) -> int:
     # Panel and Bokeh load only when the explorer runs (the command's lazy boundary).
     from ecofmaps.web.server import serve_explorer
 
+    announce = functools.partial(print, flush=True)  # the address at once, also in a pipe
     try:
         serve_explorer(
             args.port,
             open_browser=not args.no_browser,
-            announce=_announce,
+            announce=announce,
             allow_origin=args.allow_origin,
         )
     except OSError as error:
@@ -80,8 +72,3 @@ def run(args) -> int:
         ) from None
     print("ecofmaps explorer stopped")
     return 0
-
-
-def _announce(line: str) -> None:
-    """Print the server's address at once (a pipe would hold it back)."""
-    print(line, flush=True)

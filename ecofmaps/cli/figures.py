@@ -1,19 +1,16 @@
 """``ecofmaps figures``: the paper's figures, drawn by groups sharing one Dataset
-(:func:`ecofmaps.figures.figure_groups`), the costliest first, on ``--jobs`` processes; the
-parts of a costly Dataset (:func:`ecofmaps.figures.figure_parts`) are computed in parallel
-before it. JAX keeps its compiled kernels in ``<cache>/jax`` for the run (never on importing
-the library), so a second run compiles nothing it compiled before.
-"""
+(:func:`ecofmaps.figures.figure_groups`), the costliest first, on ``--jobs`` processes, the
+parts of a costly Dataset (:func:`ecofmaps.figures.figure_parts`) computed in parallel before
+it; JAX keeps its compiled kernels in ``<cache>/jax`` for the run (never on importing the
+library)."""
 
 from __future__ import annotations
 
 import argparse
-import contextlib
 import multiprocessing
 import os
 import signal
 import sys
-import textwrap
 import time
 from collections import deque
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -21,12 +18,21 @@ from pathlib import Path
 
 from ecofmaps._interrupts import check_interrupted, interrupts_stop_writes
 from ecofmaps._parallel import start_resource_tracker_quietly
-from ecofmaps.cli._common import count, refuse_to_overwrite
+from ecofmaps.cli._common import command_parser, count, option_adder, refuse_to_overwrite
 from ecofmaps.io.files import record_written
 
 __all__ = ["JAX_CACHE_FOLDER", "TaskQueue", "add", "run"]
 
 _FORMATS = ("png", "pdf", "svg")
+
+_HELP = {
+    "--out": "directory to write into, created if missing (default: figures)",
+    "--format": "comma-separated file formats among png, pdf, svg (default: png)",
+    "--overwrite": "replace the figures ecofmaps wrote in DIR before (a DIR that is not empty "
+    "needs it); files ecofmaps did not write are never replaced",
+    "--jobs": "processes drawing at once (default: one per core, at most one per group of "
+    "figures sharing their numbers; 1: all in this process)",
+}
 
 #: Folder of the ecofmaps cache directory that holds JAX's compiled kernels for this command.
 JAX_CACHE_FOLDER = "jax"
@@ -55,96 +61,51 @@ def add(subparsers) -> None:
     from ecofmaps.figures.recipes import FIGURES  # the names for the parser (no JAX)
 
     listing = "\n".join(f"  {name:<10} {recipe.description}" for name, recipe in FIGURES.items())
-    parser = subparsers.add_parser(
+    parser = command_parser(
+        subparsers,
         "figures",
         help="write the paper's Figures 5-8 and 11, the universal map and the scar shapes "
         "(default: figures/)",
-        description=textwrap.fill(
-            "Write the paper's Figures 5, 6, 7a, 7b, 8, 11a, 11b, the universal map of "
-            "the ECoF ratio and the comparison of scar shapes at equal D/W (shapes), one file "
-            "per figure and format (fig5.png, ...). Parameters are "
-            "the paper's: amplitude 50um (= groove half-width), load 450N, stiffness 35MN/m, "
-            "mu 0.8. Maps and loops are read from the cache when there (see ECOFMAPS_CACHE) "
-            "and stored there otherwise, with JAX's compiled kernels in its jax/ folder; "
-            "files are written atomically. Figures sharing their numbers are drawn by one "
-            "process, several processes at once (--jobs). Progress goes to stderr.",
-            width=80,
-        ),
+        description="Write the paper's Figures 5, 6, 7a, 7b, 8, 11a, 11b, the universal map of the "
+        "ECoF ratio and the comparison of scar shapes at equal D/W (shapes), one file per figure "
+        "and format (fig5.png, ...). Parameters are the paper's: amplitude 50um (= groove "
+        "half-width), load 450N, stiffness 35MN/m, mu 0.8. Maps and loops are read from the cache "
+        "when there (see ECOFMAPS_CACHE) and stored there otherwise, with JAX's compiled kernels "
+        "in its jax/ folder; files are written atomically. Figures sharing their numbers are drawn "
+        "by one process, several processes at once (--jobs). Progress goes to stderr.",
         epilog=f"figures:\n{listing}",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument(
-        "--out",
-        default="figures",
-        metavar="DIR",
-        help="directory to write into, created if missing (default: figures)",
-    )
-    parser.add_argument(
-        "--only",
-        nargs="+",
-        choices=list(FIGURES),
-        metavar="NAME",
-        help=f"write only these figures; NAME is one of: {', '.join(FIGURES)}",
-    )
-    parser.add_argument(
-        "--format",
-        type=_figure_formats,
-        default=("png",),
-        metavar="FORMATS",
-        help="comma-separated file formats among png, pdf, svg (default: png)",
-    )
-    parser.add_argument(
-        "--overwrite",
-        action="store_true",
-        help="replace the figures ecofmaps wrote in DIR before (a DIR that is not empty needs "
-        "it); files ecofmaps did not write are never replaced",
-    )
-    parser.add_argument(
-        "--jobs",
-        type=count("processes"),
-        metavar="N",
-        help="processes drawing at once (default: one per core, at most one per group of "
-        "figures sharing their numbers; 1: all in this process)",
-    )
+    only = f"write only these figures; NAME is one of: {', '.join(FIGURES)}"
+    option = option_adder(parser, {**_HELP, "--only": only})
+    option("--out", default="figures", metavar="DIR")
+    option("--only", nargs="+", choices=list(FIGURES), metavar="NAME")
+    option("--format", type=_figure_formats, default=("png",), metavar="FORMATS")
+    option("--overwrite", action="store_true")
+    option("--jobs", type=count("processes"), metavar="N")
 
 
-def _jax_cache_options(directory) -> dict:
-    """JAX's options that keep every compiled kernel in ``directory``."""
-    # Every kernel, however quick its compilation or small its executable: the figures'
-    # kernels each compile in well under JAX's default threshold of one second.
-    return {
-        "jax_compilation_cache_dir": str(directory),
-        "jax_persistent_cache_min_compile_time_secs": 0.0,
-        "jax_persistent_cache_min_entry_size_bytes": 0,
-    }
-
-
-def _set_jax_options(options: dict) -> dict:
-    """Set JAX's ``options``; return their values before."""
+def _set_jax_options(options: dict | None = None) -> dict:
+    """Set JAX's ``options`` (default: keep every compiled kernel in :data:`JAX_CACHE_FOLDER`,
+    however quick: the figures' compile in under JAX's threshold of 1 s); their values before."""
     import jax  # the CLI's lazy boundary: other commands start without JAX
 
+    if options is None:
+        from ecofmaps.maps.cache import cache_directory
+
+        options = {
+            "jax_compilation_cache_dir": str(cache_directory() / JAX_CACHE_FOLDER),
+            "jax_persistent_cache_min_compile_time_secs": 0.0,
+            "jax_persistent_cache_min_entry_size_bytes": 0,
+        }
     previous = {name: getattr(jax.config, name) for name in options}
     for name, value in options.items():
         jax.config.update(name, value)
     return previous
 
 
-@contextlib.contextmanager
-def _jax_compilation_cache(directory):
-    """Within the block, JAX keeps every kernel it compiles in ``directory`` and reuses them
-    (JAX opens its cache once per process: a later block with another directory still uses
-    the first one)."""
-    previous = _set_jax_options(_jax_cache_options(directory))
-    try:
-        yield
-    finally:
-        _set_jax_options(previous)
-
-
 def _write_figure_group(names, directory, formats) -> list[tuple[str, list[Path], float]]:
-    """Draw the figures ``names`` (one group sharing a Dataset) and write each in every
-    format into ``directory``: each figure's name, its files and its time [s] (its Dataset
-    included when it was the first to need it)."""
+    """Draw the figures ``names`` (a group sharing a Dataset) into ``directory`` in every
+    format: each one's name, files and time [s] (its Dataset's if it needed it first)."""
     from ecofmaps.figures import make_figures, save_figure  # the CLI's lazy boundary
 
     written = []
@@ -157,37 +118,21 @@ def _write_figure_group(names, directory, formats) -> list[tuple[str, list[Path]
     return written
 
 
-def _jax_cache_folder() -> Path:
-    """The folder of JAX's compilation cache: :data:`JAX_CACHE_FOLDER` in the cache."""
-    from ecofmaps.maps.cache import cache_directory  # the CLI's lazy boundary
-
-    return cache_directory() / JAX_CACHE_FOLDER
-
-
 def _start_worker() -> None:
     """Set up a drawing process: Ctrl-C is the parent's to handle; JAX's compilation cache."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    _set_jax_options(_jax_cache_options(_jax_cache_folder()))
+    _set_jax_options()
 
 
-def _worker_group(names, directory, formats) -> list[tuple[str, list[Path], float]]:
-    """:func:`_write_figure_group` in a drawing process, which ends when told to stop."""
+def _in_worker(work, *arguments):
+    """``work(*arguments)`` in a drawing process, which ends when told to stop."""
     try:
         with interrupts_stop_writes():  # SIGTERM from the parent: stop at a safe point
-            return _write_figure_group(names, directory, formats)
+            return work(*arguments)
     except KeyboardInterrupt:
         # Its file was removed on the way out; end now, without drawing queued figures (and
         # without tearing down JAX's threads, like the command itself: cli.main.console).
         os._exit(128 + signal.SIGTERM)
-
-
-def _worker_part(part) -> None:
-    """Compute one part of a Dataset in a drawing process, which stores it in the cache."""
-    try:
-        with interrupts_stop_writes():
-            part()
-    except KeyboardInterrupt:
-        os._exit(128 + signal.SIGTERM)  # as _worker_group
 
 
 class TaskQueue:
@@ -250,11 +195,12 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
     queue = TaskQueue(groups, parts, jobs)
 
     def submitted(tasks) -> dict:
-        calls = {
-            "part": lambda part: (_worker_part, part),
-            "group": lambda group: (_worker_group, group, out, formats),
-        }
-        return {executor.submit(*calls[task[0]](task[2])): task for task in tasks}
+        futures = {}
+        for task in tasks:
+            kind, _, work = task
+            call = (work,) if kind == "part" else (_write_figure_group, work, out, formats)
+            futures[executor.submit(_in_worker, *call)] = task
+        return futures
 
     try:
         pending = submitted(queue.started())  # each future: its task
@@ -268,9 +214,8 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
                 if task[0] == "group":
                     yield written
     finally:
-        # Done, or an error, Ctrl-C or SIGTERM: the drawing processes are stopped rather than
-        # left to tear JAX down (half a second when they are idle). A busy one stops at its
-        # next safe point, writing nothing; an idle one has nothing left to write.
+        # The drawing processes are stopped rather than left to tear JAX down (half a second
+        # when idle); a busy one stops at its next safe point, writing nothing.
         executor.shutdown(wait=False, cancel_futures=True)
         ours = set(multiprocessing.active_children()) - others
         for process in ours:
@@ -278,26 +223,26 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
         for process in ours:
             process.join()
         executor.shutdown(wait=True)
-        # An interrupt's traceback keeps this frame: dropping the executor here lets its
-        # queues' semaphores be released before the process ends (else multiprocessing's
-        # resource tracker prints a line about them after ours).
+        # An interrupt's traceback keeps this frame: its queues' semaphores are released now
+        # (else multiprocessing's resource tracker prints a line about them after ours).
         executor = None
 
 
 def _written_here(groups, out: Path, formats):
     """Yield each group's :func:`_write_figure_group` result, drawn in this process."""
-    with _jax_compilation_cache(_jax_cache_folder()):
+    previous = _set_jax_options()
+    try:
         for group in groups:
             yield _write_figure_group(group, out, formats)
+    finally:
+        _set_jax_options(previous)
 
 
 def run(args) -> int:
     from ecofmaps.figures.recipes import figure_groups, figure_parts  # the CLI's lazy boundary
 
-    names = list(dict.fromkeys(args.only or ()))
-    groups = figure_groups(names or None)
-    parts = figure_parts(names or None)
-    count = sum(len(group) for group in groups)
+    names = list(dict.fromkeys(args.only or ())) or None
+    groups, parts = figure_groups(names), figure_parts(names)
     jobs = min(args.jobs or _usable_cores(), max(len(groups), *map(len, parts)))
     out = Path(args.out)
     drawn = [name for group in groups for name in group]
@@ -305,7 +250,7 @@ def run(args) -> int:
     refuse_to_overwrite(planned, [], overwrite=args.overwrite, folders=[("--out", out)])
     out.mkdir(parents=True, exist_ok=True)
     print(
-        f"ecofmaps figures: {count} figure(s) as {', '.join(args.format)} into {out}"
+        f"ecofmaps figures: {len(drawn)} figure(s) as {', '.join(args.format)} into {out}"
         + (f", {jobs} processes" if jobs > 1 else ""),
         file=sys.stderr,
     )
@@ -314,15 +259,10 @@ def run(args) -> int:
         results = _written_in_parallel(groups, parts, out, args.format, jobs)
     else:
         results = _written_here(groups, out, args.format)
-    index = 0
-    for written in results:
-        for name, paths, seconds in written:
-            record_written(paths)
-            index += 1
-            print(
-                f"  [{index}/{count}] {name:<10} {seconds:5.1f} s  "
-                + ", ".join(str(path) for path in paths),
-                file=sys.stderr,
-            )
+    written = (figure for group in results for figure in group)
+    for index, (name, paths, seconds) in enumerate(written, start=1):
+        record_written(paths)
+        files = ", ".join(str(path) for path in paths)
+        print(f"  [{index}/{len(drawn)}] {name:<10} {seconds:5.1f} s  {files}", file=sys.stderr)
     print(f"done in {time.perf_counter() - begin:.1f} s", file=sys.stderr)
     return 0

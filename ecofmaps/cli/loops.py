@@ -1,18 +1,14 @@
-"""``ecofmaps loops``: recorded fretting loops analysed cycle by cycle.
-
-Every recording goes through the one pipeline of :mod:`ecofmaps.measured.pipeline`: in
-memory as one chunk, a long one out of core (:mod:`ecofmaps.cli.loops_long`); the table is
-written as the chunks come, then the summary lines, the plots and the reading along the
-stroke. docs/loops.md explains the method.
-"""
+"""``ecofmaps loops``: recorded fretting loops analysed cycle by cycle through the one pipeline
+of :mod:`ecofmaps.measured.pipeline` (a long recording out of core: :mod:`.loops_long`), the
+table written as the chunks come, then the summary lines and the extras (docs/loops.md)."""
 
 from __future__ import annotations
 
 import argparse
+import collections
 import contextlib
 import io
 import sys
-import textwrap
 import warnings
 from pathlib import Path
 
@@ -23,7 +19,9 @@ from ecofmaps._parallel import worker_limit
 from ecofmaps.cli._common import (
     CommandError,
     add_recording_options,
+    command_parser,
     count,
+    option_adder,
     quantity,
     recording_options,
     refuse_to_overwrite,
@@ -34,117 +32,86 @@ from ecofmaps.web import INSTALL_WEB, missing_web_packages
 
 __all__ = ["SUMMARY_VARIABLES", "add", "run"]
 
+_HELP = {
+    "files": "recording files (CSV, TSV or other text, TDMS, HDF5/netCDF-4, zarr)",
+    "--example": "analyse the shipped synthetic example (load 450N) instead of FILEs",
+    "--load": "normal load P, e.g. 450N; or the name of the recording's normal-load column "
+    "(e.g. Fz), used sample by sample (required unless --example)",
+    "--out": "CSV file to write (its directory must exist); default: print the table",
+    "--plots": "also write, per file, its loops with the line Q = SΔ (<name>_loops.png), the "
+    "ECoF and GICoF over the cycles (<name>_evolution.png) and the loops read along the "
+    "stroke (<name>_resolved.png) into DIR",
+    "--overwrite": "replace the outputs ecofmaps wrote before (--out, --resolved, the plots in "
+    "--plots); a file or folder ecofmaps did not write is never replaced",
+    "--resolved": "also write the loops read along the stroke (one FILE): μ(ξ), the groove "
+    "slope g(ξ) and the felt profile h(ξ) over (cycle, position), a netCDF file",
+    "--report": "also write the results of one recording as one HTML page that opens offline: "
+    "the friction over the cycles with the quality flags, picked loops with the model's, the "
+    'table (needs pip install "ecofmaps[web]")',
+    "--no-resolve": "skip the reading along the stroke (about ten times faster; no "
+    "mu_resolved, mu_resolved_se, aspect_ratio)",
+    "--flip-force": "read the force with the other sign (a rig recording it positive against "
+    "the displacement: its loops run anticlockwise)",
+    "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m (the loops' stick slope is the rig "
+    "and the contact in series): the ratios also on the contact's displacement, the regime there",
+    "--nan-policy": "a cycle with a missing sample (NaN or an empty cell) is skipped and counted "
+    "(skip, the default), or any missing sample stops the command naming its line",
+    "--workers": "analyse out of core on a local dask cluster of N processes",
+    "--scheduler": "analyse out of core on the dask cluster at ADDRESS (tcp://host:8786); its "
+    "workers must have ecofmaps and see the files at the same paths",
+    "--resume": "continue an interrupted run from the blocks kept in <out>.partial/ (needs "
+    "--out and the same files and options)",
+    "--quiet": "no progress bar (none is shown off a terminal)",
+}
+
 
 def add(subparsers) -> None:
-    parser = subparsers.add_parser(
+    parser = command_parser(
+        subparsers,
         "loops",
         help="analyse recorded fretting loops cycle by cycle: ECoF, GICoF, stiffness, ...",
-        description=textwrap.fill(
-            "Read recordings of fretting loops (text with a header line in any common "
-            "dialect, TDMS, HDF5/netCDF-4 or zarr), cut them into cycles at the displacement "
-            "reversals or by a cycle column, check every loop, and write one row per cycle: "
-            "cycle, amplitude_um, slip_amplitude_um, normal_load_N (with a recorded load, "
-            "--load COLUMN), max_force_N, dissipated_energy_mJ, ecof, "
-            "cof_max, energy_ratio, stiffness_MN_per_m, gicof, regime, then mu_resolved, "
-            "mu_resolved_se and aspect_ratio (friction and groove read along the whole "
-            "stroke) and quality ('ok', or why values are NaN); first a file column when "
-            "several files are given. The columns are found by name as rigs write them "
-            "(displacement, disp, delta, stroke, ...; force, Fx, Ft, Q, friction, ...) with "
-            "units from their names or the file, else um and N, and an optional 'cycle'. "
-            "With several files, one that cannot be analysed is one error line naming it and "
-            "the others are written (exit status 1); files are written atomically and never "
-            "over an input or a file ecofmaps did not write. --example "
-            "analyses the synthetic recording shipped with ecofmaps.",
-            width=80,
-        ),
-        epilog=(
-            "examples:\n  ecofmaps loops test.csv --load 450N --out results.csv --plots plots\n"
-            "  ecofmaps loops --example --out results.csv --plots plots"
-        ),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Read recordings of fretting loops (text with a header line in any common "
+        "dialect, TDMS, HDF5/netCDF-4 or zarr), cut them into cycles at the displacement reversals "
+        "or by a cycle column, check every loop, and write one row per cycle: cycle, amplitude_um, "
+        "slip_amplitude_um, normal_load_N (with a recorded load, --load COLUMN), max_force_N, "
+        "dissipated_energy_mJ, ecof, cof_max, energy_ratio, stiffness_MN_per_m, gicof, regime, "
+        "then mu_resolved, mu_resolved_se and aspect_ratio (friction and groove read along the "
+        "whole stroke) and quality ('ok', or why values are NaN); first a file column when several "
+        "files are given. The columns are found by name as rigs write them (displacement, disp, "
+        "delta, stroke, ...; force, Fx, Ft, Q, friction, ...) with units from their names or the "
+        "file, else um and N, and an optional 'cycle'. With several files, one that cannot be "
+        "analysed is one error line naming it and the others are written (exit status 1); files "
+        "are written atomically and never over an input or a file ecofmaps did not write. "
+        "--example analyses the synthetic recording shipped with ecofmaps.",
+        epilog="examples:\n  ecofmaps loops test.csv --load 450N --out results.csv --plots plots\n"
+        "  ecofmaps loops --example --out results.csv --plots plots",
     )
-    parser.add_argument(
-        "files",
-        nargs="*",
-        metavar="FILE",
-        help="recording files (CSV, TSV or other text, TDMS, HDF5/netCDF-4, zarr)",
-    )
-    parser.add_argument(
-        "--example",
-        action="store_true",
-        help="analyse the shipped synthetic example (load 450N) instead of FILEs",
-    )
-    parser.add_argument(
-        "--load",
-        type=_load_or_column,
-        metavar="P",
-        help="normal load P, e.g. 450N; or the name of the recording's normal-load column "
-        "(e.g. Fz), used sample by sample (required unless --example)",
-    )
-    _add_output_options(parser)
-    parser.add_argument(
-        "--no-resolve",
-        action="store_true",
-        help="skip the reading along the stroke (about ten times faster; no mu_resolved, "
-        "mu_resolved_se, aspect_ratio)",
-    )
-    parser.add_argument(
-        "--flip-force",
-        action="store_true",
-        help="read the force with the other sign (a rig recording it positive against the "
-        "displacement: its loops run anticlockwise)",
-    )
-    parser.add_argument(
-        "--rig-stiffness",
-        type=quantity("stiffness", option="--rig-stiffness"),
-        default=None,
-        metavar="S",
-        help="the rig's own stiffness, e.g. 35MN/m (the loops' stick slope is the rig and the "
-        "contact in series): the ratios also on the contact's displacement, the regime there",
-    )
-    parser.add_argument(
-        "--nan-policy",
-        choices=("skip", "raise"),
-        default="skip",
-        help="a cycle with a missing sample (NaN or an empty cell) is skipped and counted "
-        "(skip, the default), or any missing sample stops the command naming its line",
-    )
+    option = option_adder(parser, _HELP)
+    option("files", nargs="*", metavar="FILE")
+    option("--example", action="store_true")
+    option("--load", type=_load_or_column, metavar="P")
+    option("--out", metavar="FILE.csv")
+    option("--plots", metavar="DIR")
+    option("--overwrite", action="store_true")
+    option("--resolved", metavar="FILE.nc")
+    option("--report", metavar="FILE.html")
+    option("--no-resolve", action="store_true")
+    option("--flip-force", action="store_true")
+    option("--rig-stiffness", type=quantity("stiffness", option="--rig-stiffness"), metavar="S")
+    option("--nan-policy", choices=("skip", "raise"), default="skip")
     add_recording_options(parser)
-    _add_long_options(parser)
-
-
-def _add_output_options(parser) -> None:
-    parser.add_argument(
-        "--out",
-        metavar="FILE.csv",
-        help="CSV file to write (its directory must exist); default: print the table",
+    option = option_adder(
+        parser.add_argument_group(
+            "long tests",
+            "a rig file of more than 2**24 samples is analysed out of core, a block of whole "
+            "cycles at a time (the numbers are those of the analysis in memory)",
+        ),
+        _HELP,
     )
-    parser.add_argument(
-        "--plots",
-        metavar="DIR",
-        help="also write, per file, its loops with the line Q = SΔ (<name>_loops.png), "
-        "the ECoF and GICoF over the cycles (<name>_evolution.png) and the loops read along "
-        "the stroke (<name>_resolved.png) into DIR",
-    )
-    parser.add_argument(
-        "--overwrite",
-        action="store_true",
-        help="replace the outputs ecofmaps wrote before (--out, --resolved, the plots in "
-        "--plots); a file or folder ecofmaps did not write is never replaced",
-    )
-    parser.add_argument(
-        "--resolved",
-        metavar="FILE.nc",
-        help="also write the loops read along the stroke (one FILE): μ(ξ), the groove slope "
-        "g(ξ) and the felt profile h(ξ) over (cycle, position), a netCDF file",
-    )
-    parser.add_argument(
-        "--report",
-        metavar="FILE.html",
-        help="also write the results of one recording as one HTML page that opens offline: "
-        "the friction over the cycles with the quality flags, picked loops with the model's, "
-        'the table (needs pip install "ecofmaps[web]")',
-    )
+    option("--workers", type=_workers, metavar="N")
+    option("--scheduler", metavar="ADDRESS")
+    option("--resume", action="store_true")
+    option("--quiet", action="store_true")
 
 
 def _workers(text: str) -> int:
@@ -153,37 +120,6 @@ def _workers(text: str) -> int:
     if value > limit:
         raise argparse.ArgumentTypeError(f"{value} is more than this machine can run: {why}")
     return value
-
-
-def _add_long_options(parser) -> None:
-    group = parser.add_argument_group(
-        "long tests",
-        "a rig file of more than 2**24 samples is analysed out of core, a block of whole "
-        "cycles at a time (the numbers are those of the analysis in memory)",
-    )
-    group.add_argument(
-        "--workers",
-        type=_workers,
-        metavar="N",
-        help="analyse out of core on a local dask cluster of N processes",
-    )
-    group.add_argument(
-        "--scheduler",
-        metavar="ADDRESS",
-        help="analyse out of core on the dask cluster at ADDRESS (tcp://host:8786); its "
-        "workers must have ecofmaps and see the files at the same paths",
-    )
-    group.add_argument(
-        "--resume",
-        action="store_true",
-        help="continue an interrupted run from the blocks kept in <out>.partial/ (needs "
-        "--out and the same files and options)",
-    )
-    group.add_argument(
-        "--quiet",
-        action="store_true",
-        help="no progress bar (none is shown off a terminal)",
-    )
 
 
 def _load_or_column(text: str):
@@ -209,46 +145,39 @@ def _plot_names(paths) -> list[str]:
     ]
 
 
-def _analysed(index, path, recording, load, args, long_run, write, *, many, resolved_file):
-    """One recording through the pipeline: its results (all of them in memory, those the
-    summary reads of a long one), its reading along the stroke over positions (for the
-    plots and ``--resolved``, in memory only) and its warnings, printed one line each."""
-    in_memory = not recording.lazy
-    if not in_memory and resolved_file:
-        raise CommandError(
-            f"--resolved reads every loop along the stroke, which a long recording "
-            f"({path}) analysed out of core does not keep: leave out --resolved"
-        )
-    if not in_memory and args.report is not None:
-        raise CommandError(
-            f"--report draws loops and the whole table, which a long recording ({path}) "
-            "analysed out of core does not keep: leave out --report"
-        )
+#: The options that need what a long recording analysed out of core does not keep.
+_NOT_KEPT = (
+    ("--resolved", "reads every loop along the stroke", ""),
+    ("--report", "draws loops and the whole table", ""),
+    ("--plots", "draws every loop", " (or --workers, --scheduler, --resume)"),
+)
+
+
+def _analysed(index, path, recording, load, args, long_run, write):
+    """One recording's results (of a long one, those the summary reads) and reading along the
+    stroke (for the plots and ``--resolved``), its warnings printed one line each."""
     from ecofmaps.measured.pipeline import Reading
     from ecofmaps.measured.quality import ImplausibleScaleError, ImplausibleScaleWarning
     from ecofmaps.measured.resolve import ReadingOptions
 
-    plots = args.plots is not None and in_memory
-    positions = 201 if plots or resolved_file else None
+    for option, does, others in _NOT_KEPT:
+        if recording.lazy and getattr(args, option[2:]) is not None:
+            raise CommandError(
+                f"{option} {does}, which a long recording ({path}) analysed out of core does "
+                f"not keep: leave out {option}{others}"
+            )
+    positions = 201 if args.plots is not None or args.resolved is not None else None
     reading = Reading(
         resolve=not args.no_resolve,
-        keep_loops=plots or args.report is not None,
+        keep_loops=args.plots is not None or args.report is not None,
         along_stroke=ReadingOptions(positions=positions),
         hand_back=positions is not None,
     )
+    columns = SUMMARY_VARIABLES if recording.lazy else None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            results, resolved = long_run.analyse(
-                index,
-                path,
-                recording,
-                load,
-                many=many,
-                write=write,
-                columns=None if in_memory else SUMMARY_VARIABLES,
-                reading=reading,
-            )
+            analysed = long_run.analyse(index, path, recording, load, write, columns, reading)
         except ImplausibleScaleError as error:
             raise recording.error(_with_assumptions(str(error), recording)) from None
         except ValueError as error:
@@ -258,12 +187,11 @@ def _analysed(index, path, recording, load, args, long_run, write, *, many, reso
         if issubclass(warning.category, ImplausibleScaleWarning):
             message = _with_assumptions(message, recording)
         print(f"ecofmaps loops: warning: {path.name}: {message}", file=sys.stderr)
-    return results, resolved
+    return analysed
 
 
 def _with_assumptions(message: str, recording) -> str:
-    """``message`` (of an implausible scale: an assumed unit is the likely culprit) with the
-    units the recording's columns without one were assumed to be in."""
+    """``message`` (of an implausible scale) with the units assumed for columns without one."""
     said = [
         f"the {role} column {recording.columns[role]!r} has no unit and was read in "
         f"{recording.units[role]} (--{role}-unit gives it)"
@@ -279,8 +207,7 @@ SUMMARY_VARIABLES = ("regime", "gicof", "mu_resolved", "ecof", "quality", "ampli
 
 
 class _Table:
-    """The table of results, written to ``stream`` as each block of lines comes. Each block
-    begins with the header line, written once."""
+    """The table, written to ``stream`` as each block of lines comes (its header line once)."""
 
     def __init__(self, stream):
         self.stream, self.started = stream, False
@@ -320,12 +247,11 @@ def _summary(path, results, recording) -> str:
         where = f"line {first}" if isinstance(first, int) else first
         summary += f"; {skipped} skipped for missing samples (the first at {where})"
     summary += f"; {sliding_condition_line(results)}"
-    if gross.cycle.size and gross.gicof.notnull().any():
+    if gross.gicof.notnull().any():
         summary += f"; GICoF median {float(gross.gicof.median()):.4f}"
     if "mu_resolved" in gross and gross.mu_resolved.notnull().any():
         summary += f", μ read along the stroke median {float(gross.mu_resolved.median()):.4f}"
-    ecof = gross.ecof.dropna("cycle") if gross.cycle.size else gross.ecof
-    if ecof.size:
+    if (ecof := gross.ecof.dropna("cycle")).size:
         summary += f"; ECoF {float(ecof[0]):.4f} (first) to {float(ecof[-1]):.4f} (last)"
     return summary
 
@@ -340,51 +266,36 @@ def _checked_inputs(args) -> tuple[list[Path], float]:
     load = EXAMPLE["load"] if args.example and args.load is None else args.load
     if load is None:
         raise CommandError("--load is required: the normal load, e.g. --load 450N")
-    columns = {
-        "--displacement-col": args.displacement_col,
-        "--force-col": args.force_col,
-        "--cycle-col": args.cycle_col,
-    }
-    named = [(option, name.strip().lower()) for option, name in columns.items() if name]
-    for index, (option, name) in enumerate(named):
-        for other, other_name in named[:index]:
-            if name == other_name:
-                raise CommandError(f"{other} and {option} name the same column {name!r}")
-    if args.resolved is not None:
-        if args.no_resolve:
-            raise CommandError("--resolved writes the reading along the stroke; not --no-resolve")
-        if len(paths) > 1:
-            raise CommandError("--resolved writes the reading of one recording: give one FILE")
-    if args.report is not None:
-        if len(paths) > 1:
-            raise CommandError("--report writes the page of one recording: give one FILE")
-        if missing_web_packages():
-            raise CommandError(INSTALL_WEB)
+    named = {}  # a column's name: the first option naming it
+    for option in ("--displacement-col", "--force-col", "--cycle-col"):
+        if value := getattr(args, option[2:].replace("-", "_")):
+            name = value.strip().lower()
+            if named.setdefault(name, option) != option:
+                raise CommandError(f"{named[name]} and {option} name the same column {name!r}")
+    if args.resolved is not None and args.no_resolve:
+        raise CommandError("--resolved writes the reading along the stroke; not --no-resolve")
+    for option, what in (("--resolved", "the reading"), ("--report", "the page")):
+        if getattr(args, option[2:]) is not None and len(paths) > 1:
+            raise CommandError(f"{option} writes {what} of one recording: give one FILE")
+    if args.report is not None and missing_web_packages():
+        raise CommandError(INSTALL_WEB)
     return paths, load
 
 
 def _checked_outputs(args, paths) -> list:
-    """The command's outputs as ``(option, path)``, refused where they would overwrite a
-    file that ecofmaps did not write (or an input)."""
-    for option, target in (
-        ("--out", args.out),
-        ("--resolved", args.resolved),
-        ("--report", args.report),
-    ):
+    """The command's outputs as ``(option, path)``, checked by :func:`refuse_to_overwrite`."""
+    outputs = [("--out", args.out), ("--resolved", args.resolved), ("--report", args.report)]
+    for option, target in outputs:
         if target is not None and not Path(target).parent.is_dir():
             raise CommandError(f"cannot write {target} ({option}): its directory does not exist")
-    kinds = ("loops", "evolution") + (() if args.no_resolve else ("resolved",))
-    plots = (
-        []
-        if args.plots is None
-        else [
-            ("--plots", Path(args.plots) / f"{name}_{kind}.png")
+    if args.plots is not None:
+        kinds = ("loops", "evolution") + (() if args.no_resolve else ("resolved",))
+        folder = Path(args.plots)
+        outputs += [
+            ("--plots", folder / f"{name}_{kind}.png")
             for name in _plot_names(paths)
             for kind in kinds
         ]
-    )
-    outputs = [("--out", args.out), ("--resolved", args.resolved), ("--report", args.report)]
-    outputs += plots
     refuse_to_overwrite(outputs, paths, overwrite=args.overwrite, folders=[("--plots", args.plots)])
     return outputs
 
@@ -393,45 +304,27 @@ class _NothingAnalysed(Exception):
     """No recording of a batch could be analysed."""
 
 
-class _Analysed:
-    """A recording analysed: its path, the recording, its results and reading along the
-    stroke, and the name of its plots."""
-
-    def __init__(self, path, recording, results, resolved, plot_name):
-        self.path, self.recording, self.plot_name = path, recording, plot_name
-        self.results, self.resolved = results, resolved
+#: A recording analysed: its results and reading along the stroke, and the name of its plots.
+_Analysed = collections.namedtuple("_Analysed", "path recording results resolved plot_name")
 
 
 def _analyse_each(args, paths, load, long_run, table) -> tuple[list[_Analysed], list[Path]]:
-    """Every recording through the pipeline, its lines written to ``table``. With several
-    recordings, one that cannot be analysed is one error line naming it, and the others go
-    on (a batch); a single recording's error ends the command."""
+    """Every recording through the pipeline, its lines written to ``table``; with several, one
+    that cannot be analysed is one error line naming it, and the others go on."""
     from ecofmaps.io.recordings import read_recording
 
     done, failed = [], []
-    many = len(paths) > 1
     for index, (path, plot_name) in enumerate(zip(paths, _plot_names(paths), strict=True)):
         held = []  # a recording in memory: its lines once its analysis has succeeded
         try:
             options = recording_options(args)
-            if isinstance(load, str):  # --load names the recording's normal-load column
-                options["load_column"] = load
+            options["load_column"] = load if isinstance(load, str) else None  # --load COLUMN
             # closed once analysed: the report reads only its names and units
             with read_recording(path, lazy=long_run.lazy, **options) as recording:
                 write = table.write if recording.lazy else held.append
-                results, resolved = _analysed(
-                    index,
-                    path,
-                    recording,
-                    load,
-                    args,
-                    long_run,
-                    write,
-                    many=many,
-                    resolved_file=args.resolved is not None,
-                )
+                results, resolved = _analysed(index, path, recording, load, args, long_run, write)
         except (ValueError, OSError, CommandError) as error:
-            if not many:
+            if len(paths) == 1:
                 raise
             failed.append(path)
             named = option_names(str(error) if str(path) in str(error) else f"{path}: {error}")
@@ -443,42 +336,35 @@ def _analyse_each(args, paths, load, long_run, table) -> tuple[list[_Analysed], 
     return done, failed
 
 
-def _write_extras(args, done: list[_Analysed], load) -> None:
+def _write_extras(args, done: list[_Analysed]) -> None:
     """The plots, the reading along the stroke and the report the options ask for."""
-    if args.plots is not None and done:
-        # matplotlib only when plots are asked for
-        from ecofmaps.figures import (
-            RECORDING_DPI,
-            cof_evolution,
-            measured_loops,
-            resolved_loops,
-            save_figure,
-        )
+    if args.plots is not None:
+        from ecofmaps import figures  # matplotlib only when plots are asked for
 
         folder = Path(args.plots)
         created = not folder.exists()
         folder.mkdir(parents=True, exist_ok=True)
         try:
             for each in done:
-                name, results, resolved = each.plot_name, each.results, each.resolved
-                figures = {
-                    "loops": measured_loops(results, resolved=resolved, source=each.path.name),
-                    "evolution": cof_evolution(results, source=each.path.name),
+                results, resolved, source = each.results, each.resolved, each.path.name
+                drawn = {
+                    "loops": figures.measured_loops(results, resolved=resolved, source=source),
+                    "evolution": figures.cof_evolution(results, source=source),
                 }
                 if resolved is not None:
-                    figures["resolved"] = resolved_loops(resolved, results, source=each.path.name)
-                for kind, figure in figures.items():
-                    save_figure(figure, folder / f"{name}_{kind}.png", dpi=RECORDING_DPI)
+                    drawn["resolved"] = figures.resolved_loops(resolved, results, source=source)
+                for kind, figure in drawn.items():
+                    path = folder / f"{each.plot_name}_{kind}.png"
+                    figures.save_figure(figure, path, dpi=figures.RECORDING_DPI)
         except BaseException:  # a full disk, an interrupt: no empty folder left behind
             if created and not any(folder.iterdir()):
                 folder.rmdir()
             raise
-    if args.resolved is not None and done:
+    if args.resolved is not None:
         from ecofmaps.maps.cache import write_netcdf
 
         write_netcdf(done[0].resolved, args.resolved)
-    if args.report is not None and done:
-        # Bokeh loads only when a report is asked for (the extra web is optional)
+    if args.report is not None:  # Bokeh loads only when a report is asked for
         from ecofmaps.web.report import recording_inputs, write_report
 
         mean_load = float(done[0].results["load"])  # the load given, or a channel's mean
@@ -487,14 +373,13 @@ def _write_extras(args, done: list[_Analysed], load) -> None:
 
 
 def run(args) -> int:
-    """Run ``ecofmaps loops`` with the parsed ``args``: 0 when every recording was
-    analysed, 1 when some of several could not be (each named in an error line; the others'
-    rows are written)."""
-    from ecofmaps.cli import loops_long
+    """Run ``ecofmaps loops`` with the parsed ``args``: 0, or 1 when some of several
+    recordings could not be analysed (each named in an error line; the others written)."""
+    from ecofmaps.cli.loops_long import LongRun
 
     paths, load = _checked_inputs(args)
     outputs = _checked_outputs(args, paths)
-    long_run = loops_long.LongRun(args, paths)
+    long_run = LongRun(args, paths)
     try:
         with contextlib.ExitStack() as stack:  # the table is written as it comes, renamed last
             if args.out is None:  # held, and printed once every file is analysed
@@ -502,11 +387,10 @@ def run(args) -> int:
             else:
                 temporary = stack.enter_context(atomic_path(args.out))
                 stream = stack.enter_context(open(temporary, "w", encoding="utf-8", newline=""))
-            table = _Table(stream)
-            done, failed = _analyse_each(args, paths, load, long_run, table)
+            done, failed = _analyse_each(args, paths, load, long_run, _Table(stream))
             if not done:  # nothing to write: the temporary goes
                 raise _NothingAnalysed
-            _write_extras(args, done, load)
+            _write_extras(args, done)
     except _NothingAnalysed:
         print(
             f"ecofmaps loops: none of the {len(paths)} recordings could be analysed; "
@@ -518,7 +402,7 @@ def run(args) -> int:
         record_written(path for _, path in outputs if path is not None)
     status = 1 if failed else 0
     if args.out is None:
-        sys.stdout.write(table.stream.getvalue())
+        sys.stdout.write(stream.getvalue())
         for each in done:
             print(_summary(each.path, each.results, each.recording).strip(), file=sys.stderr)
         return status
@@ -529,10 +413,8 @@ def run(args) -> int:
         print(_summary(each.path, each.results, each.recording))
     if failed:
         print(f"  not analysed ({len(failed)}): " + ", ".join(str(path) for path in failed))
-    if args.resolved is not None:
-        print(f"  the loops read along the stroke in {args.resolved}")
-    if args.report is not None:
-        print(f"  the report in {args.report}")
-    if args.plots is not None:
-        print(f"  plots in {args.plots}")
+    extras = (("the loops read along the stroke", args.resolved), ("the report", args.report))
+    for what, where in (*extras, ("plots", args.plots)):
+        if where is not None:
+            print(f"  {what} in {where}")
     return status

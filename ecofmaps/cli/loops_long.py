@@ -3,12 +3,9 @@
 A recording read lazily (a rig file of more than :data:`ecofmaps.io.recordings.LAZY_SAMPLES`
 samples, or any file with ``--workers``, ``--scheduler`` or ``--resume``) is analysed by
 :class:`ecofmaps.measured.pipeline.Analysis` on local threads, ``--workers`` processes or the
-cluster at ``--scheduler``. With ``--out``, what each block measured is kept as it completes
-in ``<out>.partial/`` (one ``.npz`` per block, renamed into place when whole; its checksum, and
-a block's cycle rows, in the run's record ``kept.jsonl``), so that a stop keeps what was
-finished and ``--resume`` goes on from it (a file that fails its check is measured again); the
-table's lines are written in order as the blocks come. A stop's line names the folder kept
-(:meth:`LongRun.stop_note`).
+cluster at ``--scheduler``, its lines written in order as the blocks come. With ``--out``, each
+block measured is kept as it completes in ``<out>.partial/``, so that a stop keeps what was
+finished and ``--resume`` goes on from it (docs/parallel.md).
 """
 
 from __future__ import annotations
@@ -59,8 +56,7 @@ _RUNTIME = ("workers", "scheduler", "resume", "quiet", "out", "plots", "handler"
 
 
 def _checksums(path: Path) -> list:
-    """[name, size, CRC-32] of a recording's file, or of every file of a store (its arrays'
-    metadata and chunks), by name within it: its content, which in-place writes change."""
+    """[name, size, CRC-32] of a recording's file, or of every file of a store by its name."""
     path = Path(path)
     files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
     sums = []
@@ -69,9 +65,8 @@ def _checksums(path: Path) -> list:
         with open(file, "rb") as stream:
             while block := stream.read(1 << 22):
                 crc = zlib.crc32(block, crc)
-        sums.append(
-            [file.relative_to(path).as_posix() if file != path else "", file.stat().st_size, crc]
-        )
+        name = file.relative_to(path).as_posix() if file != path else ""
+        sums.append([name, file.stat().st_size, crc])
     return sums
 
 
@@ -97,31 +92,30 @@ _UNFINISHED = (
 
 
 class _Partial:
-    """The folder ``<out>.partial`` of an unfinished run (see the module notes)."""
+    """The folder ``<out>.partial`` of an unfinished run: ``run.json`` (what it computes), each
+    file's cycles and finished blocks (``.npz``), their checksums in ``kept.jsonl``."""
 
-    def __init__(self, out, fingerprint: dict, resume: bool):
+    def __init__(self, out, fingerprint: dict):
         self.folder = Path(f"{out}{PARTIAL_SUFFIX}")
         record = self.folder / "run.json"
-        self.made = not self.folder.exists()
-        if self.folder.exists():
-            if not resume:
-                raise CommandError(_UNFINISHED.format(folder=self.folder))
-            try:
-                found = json.loads(record.read_text(encoding="utf-8"))
-            except (OSError, ValueError):
-                found = None
-            if found != fingerprint:
-                raise CommandError(
-                    f"{self.folder} holds a run of other files or options (or of these files "
-                    "before they changed): delete it to start again with these"
-                )
-        else:
+        self.made = not self.folder.exists()  # else --resume: LongRun checked it
+        if self.made:
             self.folder.mkdir()
-            _write(record, lambda path: path.write_text(json.dumps(fingerprint), "utf-8"))
+            _write(record, json.dumps(fingerprint))
+            return
+        try:
+            found = json.loads(record.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            found = None
+        if found != fingerprint:
+            raise CommandError(
+                f"{self.folder} holds a run of other files or options (or of these files "
+                "before they changed): delete it to start again with these"
+            )
 
     def _manifest(self) -> dict:
-        """What the run recorded of the files it kept: (file, block or 'cycles') -> entry.
-        A line cut short by a crash is passed over (its file is then not trusted)."""
+        """(file, block or 'cycles') -> what the run recorded of the file it kept (a line cut
+        short by a crash is passed over: its file is then not trusted)."""
         found = {}
         with (
             contextlib.suppress(OSError),
@@ -145,8 +139,7 @@ class _Partial:
         path.unlink(missing_ok=True)
 
     def _checked(self, path: Path, entry, rows=None) -> bool:
-        """Whether the kept ``path`` is what the manifest recorded (its checksum, and the
-        cycle rows ``rows`` of a block); if not, it is refused, with a line saying why."""
+        """Whether the kept ``path`` is as recorded (checksum, a block's ``rows``); else refused."""
         if entry is None:
             reason = "is not in the run's record (kept.jsonl)"
         elif rows is not None and entry.get("rows") != rows:
@@ -159,8 +152,7 @@ class _Partial:
         return False
 
     def cycles(self, index: int):
-        """The cycles of file ``index`` found before, or None (and the blocks kept of the
-        file are dropped when the cycles kept fail their check)."""
+        """The cycles of file ``index`` found before, or None (its blocks dropped if they fail)."""
         path = self.folder / f"file{index}-cycles.npz"
         if not path.exists():
             return None
@@ -171,8 +163,7 @@ class _Partial:
         with np.load(path) as stored:
             fields = {f.name: stored[f.name] for f in dataclasses.fields(Cycles)}
         fields["missing"] = None if fields["missing"].ndim == 0 else fields["missing"]
-        for name in ("continuous",):
-            fields[name] = bool(fields[name])
+        fields["continuous"] = bool(fields["continuous"])
         for name in ("incomplete_cycles", "dropped_samples", "missing_samples", "first_missing"):
             fields[name] = int(fields[name])
         return Cycles(**fields)
@@ -181,7 +172,7 @@ class _Partial:
         values = dataclasses.asdict(cycles)
         values["missing"] = np.asarray(False) if cycles.missing is None else cycles.missing
         path = self.folder / f"file{index}-cycles.npz"
-        _write(path, lambda temporary: _savez(temporary, values))
+        _write(path, values)
         self._record(path, file=index, block="cycles")
 
     def record_block(self, index: int, block: int, rows: slice) -> None:
@@ -190,8 +181,7 @@ class _Partial:
         self._record(path, file=index, block=block, rows=[rows.start, rows.stop])
 
     def record_late(self, index: int, tasks) -> None:
-        """Record the blocks of file ``index`` kept by tasks of this run that had not come
-        back when it stopped (all tasks are over: a resumed run checked those before)."""
+        """Record the blocks of file ``index`` kept by tasks that had not come back at a stop."""
         recorded = self._manifest()
         for block in self.kept(index):
             if (index, block) not in recorded and block < len(tasks):
@@ -207,8 +197,7 @@ class _Partial:
         }
 
     def done(self, index: int, tasks) -> dict:
-        """The blocks of file ``index`` kept, each the block of cycle rows ``tasks[block]``
-        its record says and as it was kept: block -> (values, flags) as measured."""
+        """The blocks of file ``index`` kept and checked: block -> (values, flags) measured."""
         kept = {}
         manifest = self._manifest()
         for block, path in self.kept(index).items():
@@ -224,20 +213,14 @@ class _Partial:
             kept[block] = (values, flags)
         return kept
 
-    def holds_work(self) -> bool:
-        """Whether the folder holds anything a resumed run would use (cycles or blocks)."""
-        return any(self.folder.glob(_WORK))
-
     def remove_temporaries(self) -> None:
-        """Remove the temporaries of files being written (a worker stopped while it wrote
-        a block leaves one): a folder kept to resume from holds only whole files."""
+        """Remove the temporaries of files being written: a folder kept holds whole files."""
         for pattern in _KEPT:
             for path in self.folder.glob(_temporary_name(pattern)):
                 path.unlink(missing_ok=True)
 
     def remove(self) -> None:
-        """Remove the files the run kept, then the folder if nothing else is in it (a file
-        someone put there is not removed)."""
+        """Remove the files the run kept, then the folder if nothing else is in it."""
         for pattern in _KEPT:
             for path in self.folder.glob(pattern):
                 path.unlink(missing_ok=True)
@@ -247,28 +230,26 @@ class _Partial:
 
 
 def keep_block(folder: Path, index: int, block: int, values: dict, flags: dict) -> None:
-    """Keep in ``folder`` what block ``block`` of file ``index`` measured (a function of the
-    module, so a task can call it where it runs)."""
+    """Keep in ``folder`` what block ``block`` of file ``index`` measured (where a task runs)."""
     stored = {f"v:{k}": v for k, v in values.items()} | {f"f:{k}": v for k, v in flags.items()}
-    _write(folder / f"file{index}-block{block:06d}.npz", lambda p: _savez(p, stored))
-
-
-def _savez(path: Path, values: dict) -> None:
-    with open(path, "wb") as stream:
-        np.savez(stream, **values)
+    _write(folder / f"file{index}-block{block:06d}.npz", stored)
 
 
 def _temporary_name(name: str) -> str:
-    """The name of the temporary that :func:`_write` writes ``name`` to (or a pattern of
-    names, for a pattern)."""
+    """The temporary :func:`_write` writes ``name`` to (a pattern for a pattern)."""
     return f".{name}.tmp"
 
 
-def _write(path: Path, write) -> None:
-    """``write(temporary)``, then rename the temporary onto ``path`` (whole, or nothing)."""
+def _write(path: Path, content) -> None:
+    """Write ``content`` (text, or arrays by name: ``.npz``) to a temporary, then rename it
+    onto ``path`` (whole, or nothing)."""
     temporary = path.with_name(_temporary_name(path.name))
     try:
-        write(temporary)
+        if isinstance(content, str):
+            temporary.write_text(content, "utf-8")
+        else:
+            with open(temporary, "wb") as stream:
+                np.savez(stream, **content)
         os.replace(temporary, path)
     finally:
         temporary.unlink(missing_ok=True)
@@ -284,48 +265,29 @@ class LongRun:
             raise CommandError("give --workers or --scheduler, not both")
         if args.resume and args.out is None:
             raise CommandError("--resume continues the run kept beside --out: give --out")
-        self.args = args
-        self.lazy = True if (args.workers or args.scheduler or args.resume) else None
         folder = Path(f"{args.out}{PARTIAL_SUFFIX}")
         if args.out is not None and folder.exists() and not args.resume:
             raise CommandError(_UNFINISHED.format(folder=folder))
-        self.paths = paths
-        self.partial = None
+        self.args, self.paths, self.partial = args, paths, None
+        self.lazy = True if (args.workers or args.scheduler or args.resume) else None
         self.analysed = None  # (index, path, blocks or None) of the recording analysed last
 
-    def _runner(self):
-        if self.args.workers:
-            return runner_for("processes", self.args.workers)
-        return runner_for(self.args.scheduler)
-
-    def analyse(self, index, path, recording, load, *, many: bool, write, columns=None, reading):
-        """The results of recording ``index`` (only the variables ``columns``, if given) and
-        its reading along the stroke when ``reading`` hands it back; the table's lines (a
-        file column if ``many``) given to ``write`` in order, a string per chunk that begins
-        with the header line. The results are joined once the cluster is closed."""
-        runner = self._runner() if recording.lazy else contextlib.nullcontext(IN_PROCESS)
+    def analyse(self, index, path, recording, load, write, columns, reading):
+        """The results of recording ``index`` (the variables ``columns``, if given) and its
+        reading along the stroke if handed back; each chunk's lines (a header line first)
+        given to ``write`` in order."""
+        args, runner = self.args, contextlib.nullcontext(IN_PROCESS)
+        if recording.lazy:
+            runner = runner_for("processes" if args.workers else args.scheduler, args.workers)
         self.analysed = (index, path, None)
         try:
             with runner as runner:  # a cluster that does not answer: nothing written
-                partial = None
-                if recording.lazy and self.args.out is not None:
-                    if self.partial is None:  # the files' checksums: read only for this
-                        fingerprint = _fingerprint(self.args, self.paths)
-                        self.partial = _Partial(self.args.out, fingerprint, self.args.resume)
-                        add_stop_note(self.stop_note)  # asked when the line is written
-                    partial = self.partial
+                if recording.lazy and args.out is not None and self.partial is None:
+                    # the files' checksums are read only for this
+                    self.partial = _Partial(args.out, _fingerprint(args, self.paths))
+                    add_stop_note(self.stop_note)  # asked when the line is written
                 analysis, parts, resolved = _analyse(
-                    index,
-                    path,
-                    recording,
-                    load,
-                    self.args,
-                    runner,
-                    partial,
-                    many,
-                    write,
-                    columns,
-                    reading,
+                    self, index, path, recording, load, runner, write, columns, reading
                 )
         except KeyboardInterrupt as stop:  # counted once the runner is closed: no task runs
             if isinstance(stop, _Interrupted):
@@ -340,15 +302,13 @@ class LongRun:
         return analysis.finish([parts.pop(k) for k in sorted(parts)]), resolved
 
     def stop_note(self) -> str | None:
-        """What a stop leaves beside ``--out``, as it is now: the sentence naming the folder
-        kept and how to go on, or None. A folder this run made with nothing in it yet is
-        removed; a folder kept loses the temporaries of blocks being written."""
+        """The sentence naming the folder a stop leaves beside ``--out`` as it is now, or None
+        (a folder this run made that holds no work yet is removed)."""
         partial = self.partial
         if partial is None or not partial.folder.exists():
             return None
-        if partial.made and not partial.holds_work():
-            partial.remove()
-            self.partial = None
+        if partial.made and not any(partial.folder.glob(_WORK)):
+            self.finish()  # nothing worth keeping
             return None
         partial.remove_temporaries()
         index, path, blocks = self.analysed
@@ -359,30 +319,21 @@ class LongRun:
         )
 
     def finish(self) -> None:
-        """Remove the kept blocks: the table is written."""
+        """Remove the kept blocks (the table is written, or nothing was kept yet)."""
         if self.partial is not None:
             self.partial.remove()
             self.partial = None
 
 
-def _analyse(index, path, recording, load, args, runner, partial, many, write, columns, reading):
+def _analyse(run, index, path, recording, load, runner, write, columns, reading):
     """One recording through the pipeline, chunk by chunk: its analysis, each chunk's results
-    (the variables ``columns``) and the reading along the stroke handed back (or None); each
-    chunk's lines given to ``write`` in order."""
-    if args.plots is not None and recording.lazy:
-        raise CommandError(
-            f"--plots draws every loop, which a long recording ({path}) analysed out of core "
-            "does not keep: leave out --plots (or --workers, --scheduler, --resume)"
-        )
+    and the reading along the stroke handed back (or None); see :meth:`LongRun.analyse`."""
+    args, partial = run.args, run.partial if recording.lazy else None
     force, recorded = recording.force, None
     if isinstance(load, str):  # the load recorded sample by sample (--load COLUMN)
         force, load = force_at_mean_load(force, recording.load)
         recorded = recording.load
-    options = LoopOptions(
-        load,
-        flip_force=getattr(args, "flip_force", False),
-        rig_stiffness=getattr(args, "rig_stiffness", None),
-    )
+    options = LoopOptions(load, flip_force=args.flip_force, rig_stiffness=args.rig_stiffness)
     shown = recording.lazy and not args.quiet and sys.stderr.isatty()
     if shown:
         print(f"{path.name}: finding the cycles of {recording.size} samples", file=sys.stderr)
@@ -402,7 +353,7 @@ def _analyse(index, path, recording, load, args, runner, partial, many, write, c
     if partial is not None:
         partial.keep_cycles(index, analysis.cycles)
         done = partial.done(index, analysis.tasks)
-    lines = functools.partial(results_csv, file=str(path) if many else None)
+    lines = functools.partial(results_csv, file=str(path) if len(run.paths) > 1 else None)
     parts, texts = {}, {}  # texts: the lines of chunks that came before an earlier one
     for block, measured in done.items():
         part = analysis.part(block, *measured)
@@ -431,15 +382,15 @@ def _analyse(index, path, recording, load, args, runner, partial, many, write, c
         if not (stopped or INTERRUPTED.is_set()):  # not caused by a stop (a worker it stopped)
             raise
         bar.leave = False
-        bar.close()
         raise _Interrupted(analysis.tasks) from (None if stopped else error)
-    bar.close()
+    finally:
+        bar.close()
     return analysis, parts, resolved[0] if resolved else None
 
 
 def _in_order(texts: dict, write, written: int = 0) -> int:
-    """Give ``write`` the texts of blocks ``written``, ``written + 1``, ... that ``texts``
-    holds, in order, taking them out; the number of blocks written so far."""
+    """Give ``write`` the texts of blocks ``written``, ``written + 1``, ... that ``texts`` holds
+    (taken out); the number of blocks written so far."""
     while written in texts:
         write(texts.pop(written))
         written += 1

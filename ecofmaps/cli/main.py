@@ -22,14 +22,7 @@ import warnings
 from ecofmaps._interrupts import STOP_SIGNALS, interrupts_stop_writes
 from ecofmaps._version import __version__
 
-__all__ = [
-    "EXIT_INTERRUPTED",
-    "EXIT_TERMINATED",
-    "CommandError",
-    "build_parser",
-    "console",
-    "main",
-]
+__all__ = ["EXIT_INTERRUPTED", "EXIT_TERMINATED", "CommandError", "build_parser", "console", "main"]
 
 
 class CommandError(Exception):
@@ -37,17 +30,7 @@ class CommandError(Exception):
 
 
 #: The subcommands, each a module of :mod:`ecofmaps.cli`, in the order ``--help`` lists them.
-_SUBCOMMANDS = (
-    "model",
-    "figures",
-    "map",
-    "cache",
-    "loops",
-    "convert",
-    "correct",
-    "explore",
-    "wear",
-)
+_COMMANDS = ("model", "figures", "map", "cache", "loops", "convert", "correct", "explore", "wear")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -61,17 +44,14 @@ def build_parser() -> argparse.ArgumentParser:
     """The ``ecofmaps`` argument parser with every subcommand."""
     parser = _Parser(
         prog="ecofmaps",
-        description=(
-            "Fretting friction maps: how far the energy coefficient of friction drifts "
-            "from the contact one with rig stiffness and wear-scar shape, the paper's "
-            "figures, corrections of reported ECoF values, and the per-cycle analysis of "
-            "measured loops (ECoF, GICoF, rig stiffness). Quantities take units: 50um, "
-            "450N, 35MN/m."
-        ),
+        description="Fretting friction maps: how far the energy coefficient of friction drifts "
+        "from the contact one with rig stiffness and wear-scar shape, the paper's figures, "
+        "corrections of reported ECoF values, and the per-cycle analysis of measured loops (ECoF, "
+        "GICoF, rig stiffness). Quantities take units: 50um, 450N, 35MN/m.",
     )
     parser.add_argument("--version", action="version", version=f"ecofmaps {__version__}")
     subparsers = parser.add_subparsers(title="commands", metavar="COMMAND", required=True)
-    for name in _SUBCOMMANDS:
+    for name in _COMMANDS:
         module = importlib.import_module(f"ecofmaps.cli.{name}")
         module.add(subparsers)
         subparsers.choices[name].set_defaults(handler=module.run)
@@ -82,8 +62,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _unknown_arguments(unknown, args) -> str:
-    """The error line of arguments the subcommand ``args`` was given does not know: named
-    with its ``--help``, and an option like one of its own with a did-you-mean."""
+    """The error line of arguments unknown to the subcommand, with did-you-means."""
     guesses = [
         difflib.get_close_matches(word.split("=")[0], args.command_options, n=1)
         for word in unknown
@@ -104,15 +83,11 @@ EXIT_TERMINATED = 143
 
 
 def main(argv=None) -> int:
-    """Run the ``ecofmaps`` command; return its exit status.
-
-    0 on success; 2 for a user error (one line naming it); 130 after Ctrl-C and 143 after
-    SIGTERM, with one line telling what was left (:func:`ecofmaps._interrupts.add_stop_note`:
-    files are written atomically); 1 for an unexpected failure (``ECOFMAPS_DEBUG=1`` shows the
-    traceback). A signal once the subcommand's work is done stops nothing. Warnings are
-    printed as ``ecofmaps COMMAND: warning: ...``, one line each (those of the options once
-    they are parsed).
-    """
+    """Run the ``ecofmaps`` command; return its exit status: 0 on success; 2 for a user error
+    (one line naming it); 130 after Ctrl-C and 143 after SIGTERM, with one line telling what
+    was left (:func:`ecofmaps._interrupts.add_stop_note`), but not once the work is done; 1
+    for an unexpected failure (``ECOFMAPS_DEBUG=1`` shows the traceback). Warnings are printed
+    as ``ecofmaps COMMAND: warning: ...``, one line each."""
     interrupted = status = None
     try:  # the subcommands import JAX and xarray: an interrupt may come during the imports
         with interrupts_stop_writes() as interrupted, warnings.catch_warnings(record=True) as told:
@@ -129,10 +104,8 @@ def main(argv=None) -> int:
                 warnings.showwarning(warning.message, warning.category, "", 0)
             status = args.handler(args)
             return status
-    except KeyboardInterrupt as stop:
-        if status is not None:  # the signal came after the work was done, when leaving
-            return status
-        return _stopped(interrupted, getattr(stop, "note", None))
+    except KeyboardInterrupt as stop:  # after the work was done (when leaving), it stops nothing
+        return status if status is not None else _stopped(interrupted, getattr(stop, "note", None))
     except Exception as error:
         if interrupted is not None and interrupted.is_set():  # an interrupt turned into an error
             return _stopped(interrupted, None)
@@ -150,9 +123,7 @@ def main(argv=None) -> int:
 
 
 def _stopped(interrupted, note) -> int:
-    """Report a run stopped by Ctrl-C or SIGTERM in one line; return 130 or 143. What was
-    left is asked now of the subcommand's notes, if any, rather than taken from the stop's
-    ``note``: everything the stop interrupted has unwound by now."""
+    """Report a stopped run in one line (what was left asked of the notes now); 130 or 143."""
     terminated = interrupted is not None and interrupted.signal == signal.SIGTERM
     words = "terminated (SIGTERM)" if terminated else "interrupted"
     if interrupted is not None and interrupted.notes:
@@ -162,10 +133,7 @@ def _stopped(interrupted, note) -> int:
 
 
 def _ignored_after_main() -> list:
-    """The stop signals that :func:`console` ignores once :func:`main` returns (those not
-    ignored already: Ctrl-C in a background job stays ignored), from now on handled by
-    :func:`_nothing_to_stop` until then: the moment between :func:`main`'s block giving
-    their handlers back and :func:`console` ignoring them."""
+    """The stop signals not ignored already, handled by :func:`_nothing_to_stop` from now on."""
     numbers = [n for n in STOP_SIGNALS if signal.getsignal(n) not in (signal.SIG_IGN, None)]
     for number in numbers:
         signal.signal(number, _nothing_to_stop)
@@ -221,14 +189,10 @@ def _report(status: int, message: str) -> int:
 
 
 def console() -> None:
-    """The ``ecofmaps`` console script: run :func:`main` and exit with its status.
-
-    After Ctrl-C or SIGTERM the process ends at once (``os._exit``) once its messages are
-    flushed and the interrupted run's objects collected (their finalizers release a process
-    pool's semaphores): JAX's threads may still be busy, and tearing the interpreter down
-    around them can crash it. Once :func:`main` has returned, Ctrl-C and SIGTERM are ignored,
-    so that a signal as the interpreter exits does not turn a complete run into status 143.
-    """
+    """The ``ecofmaps`` console script: run :func:`main` and exit with its status. After a
+    stop the process ends at once (``os._exit``), its messages flushed and the run's objects
+    collected: tearing the interpreter down around JAX's busy threads can crash it. Once
+    :func:`main` has returned, a stop signal is ignored: a complete run stays complete."""
     after = _ignored_after_main()
     status = main()
     for number in after:  # the work is done: a signal now stops nothing, not even the exit

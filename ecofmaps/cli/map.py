@@ -2,27 +2,28 @@
 
 A grid of more than ``--chunk-points`` points, and any grid written to a zarr store, is
 computed block by block straight into the output (:func:`ecofmaps.maps.write_map`), with a
-progress bar on a terminal; a smaller one is computed at once (not cached: it computes faster
-than the cache would read it back). Before any work the command states the map's size and
-refuses one that would not fit on the disk.
+progress bar on a terminal; a smaller one at once. The map's size is stated before any work,
+and a map that would not fit on the disk refused.
 """
 
 from __future__ import annotations
 
-import argparse
 import contextlib
+import itertools
 import math
 import shutil
 import sys
-import textwrap
 from pathlib import Path
 
 import numpy as np
 
 from ecofmaps.cli._common import (
+    CACHE_DIR_HELP,
     CommandError,
     byte_size,
+    command_parser,
     count,
+    option_adder,
     quantity,
     refuse_to_overwrite,
 )
@@ -30,103 +31,69 @@ from ecofmaps.io.files import record_written
 
 __all__ = ["add", "run"]
 
+#: The grid's axes, in the order of the map's dimensions, and their metavars.
+_AXES = {"stiffness_ratio": "S/P", "aspect_ratio": "Z/X", "amplitude": "DELTA", "mu": "MU"}
 _GRID_HELP = "; one value, a list or a range start:stop:num"
-#: The grid's axes, in the order of the map's dimensions: option, metavar, help.
-_AXES = (
-    ("--stiffness-ratio", "S/P", "rig stiffness over normal load S/P [1/m], 'inf' for a rigid rig"),
-    ("--aspect-ratio", "Z/X", "groove depth over half-width z_o/x_o (>= 0)"),
-    ("--amplitude", "DELTA", "displacement amplitude Δ* [m], e.g. 25um,50um"),
-    ("--mu", "MU", "contact coefficient of friction μ (> 0)"),
-)
 #: Default of --chunk-points: blocks of 2**22 points (about 220 MB of results with a load).
 _CHUNK_POINTS = 2**22
+_HELP = {
+    "--stiffness-ratio": "rig stiffness over normal load S/P [1/m], 'inf' for a rigid rig"
+    + _GRID_HELP,
+    "--aspect-ratio": "groove depth over half-width z_o/x_o (>= 0)" + _GRID_HELP,
+    "--amplitude": "displacement amplitude Δ* [m], e.g. 25um,50um" + _GRID_HELP,
+    "--mu": "contact coefficient of friction μ (> 0)" + _GRID_HELP,
+    "--load": "normal load P [N], one value; adds dissipated_energy [J] and max_force [N]",
+    "--out": "netCDF file, or zarr store if the name ends in .zarr, to write (its directory must "
+    "exist)",
+    "--overwrite": "replace --out if it exists and ecofmaps wrote it (once the new map is "
+    "complete)",
+    "--chunk-points": f"grid points per block (default {_CHUNK_POINTS}); a larger grid is "
+    "computed block by block into --out",
+    "--quiet": "no progress bar (there is none either when standard error is not a terminal)",
+    "--no-cache": "do not read or store the result in the cache (a map of the parabolic groove "
+    "is not cached anyway: kept for scripts that give it)",
+    "--cache-dir": CACHE_DIR_HELP,
+}
 
 
 def add(subparsers) -> None:
-    parser = subparsers.add_parser(
+    parser = command_parser(
+        subparsers,
         "map",
         help="compute the model over a grid of test conditions into a netCDF file or zarr store",
-        description=textwrap.fill(
-            "Compute the steady-loop quantities of the model (slip amplitude and slip ratio, "
-            "energy CoF and its ratio to mu, compliance ratio P/(S*amplitude), regime, and "
-            "with --load the dissipated energy and peak force) over a grid, and write them "
-            "as an xarray Dataset to a netCDF file, or to a zarr store if --out ends in .zarr "
-            "(atomically; an existing output is replaced only with --overwrite, if ecofmaps "
-            "wrote it, and only once the new one is complete). The map's size is printed "
-            "first, and a map that would not fit on the disk is refused. "
-            "The groove half-width equals the amplitude, "
-            "as in the paper. Each of --stiffness-ratio, --aspect-ratio, --amplitude and --mu "
-            "takes one value (a scalar coordinate of the result), a comma-separated list or a "
-            "range start:stop:num (num evenly spaced points, both ends included); each list or "
-            "range is a dimension, in this order. Values take units (50um, 0.08/um, 450N); a "
-            "bare number is SI. A grid of more than --chunk-points points, and any zarr "
-            "store, is computed block by block straight into the output, with a few blocks "
-            "in memory at a time (grids far beyond memory work), and a progress bar on a "
-            "terminal. The map is not cached: it computes faster than the cache would read "
-            "it back, and --out keeps it.",
-            width=80,
-        ),
-        epilog=(
-            "example (the grid of Figure 11):\n  ecofmaps map --stiffness-ratio 0.01/um:0.3/um:30 "
-            "--aspect-ratio 0:0.3:31 \\\n      --amplitude 25um,50um --mu 0.8 --load 450N "
-            "--out fig11.nc\n"
-            "a billion points, block by block into a zarr store:\n"
-            "  ecofmaps map --stiffness-ratio 0.01/um:0.3/um:25000 --aspect-ratio 0:0.4:20000 "
-            "\\\n      --amplitude 25um,50um --mu 0.8 --out big.zarr"
-        ),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Compute the steady-loop quantities of the model (slip amplitude and slip "
+        "ratio, energy CoF and its ratio to mu, compliance ratio P/(S*amplitude), regime, and with "
+        "--load the dissipated energy and peak force) over a grid, and write them as an xarray "
+        "Dataset to a netCDF file, or to a zarr store if --out ends in .zarr (atomically; an "
+        "existing output is replaced only with --overwrite, if ecofmaps wrote it, and only once "
+        "the new one is complete). The map's size is printed first, and a map that would not fit "
+        "on the disk is refused. The groove half-width equals the amplitude, as in the paper. Each "
+        "of --stiffness-ratio, --aspect-ratio, --amplitude and --mu takes one value (a scalar "
+        "coordinate of the result), a comma-separated list or a range start:stop:num (num evenly "
+        "spaced points, both ends included); each list or range is a dimension, in this order. "
+        "Values take units (50um, 0.08/um, 450N); a bare number is SI. A grid of more than "
+        "--chunk-points points, and any zarr store, is computed block by block straight into the "
+        "output, with a few blocks in memory at a time (grids far beyond memory work), and a "
+        "progress bar on a terminal. The map is not cached: it computes faster than the cache "
+        "would read it back, and --out keeps it.",
+        epilog="example (the grid of Figure 11):\n  ecofmaps map "
+        "--stiffness-ratio 0.01/um:0.3/um:30 --aspect-ratio 0:0.3:31 \\\n      --amplitude "
+        "25um,50um --mu 0.8 --load 450N --out fig11.nc\n"
+        "a billion points, block by block into a zarr store:\n"
+        "  ecofmaps map --stiffness-ratio 0.01/um:0.3/um:25000 --aspect-ratio 0:0.4:20000 "
+        "\\\n      --amplitude 25um,50um --mu 0.8 --out big.zarr",
     )
-    for option, metavar, text in _AXES:
-        name = option[2:].replace("-", "_")
-        parser.add_argument(
-            option,
-            type=quantity(name, grid=True),
-            required=True,
-            metavar=metavar,
-            help=text + _GRID_HELP,
-        )
-    parser.add_argument(
-        "--load",
-        type=quantity("load"),
-        metavar="P",
-        help="normal load P [N], one value; adds dissipated_energy [J] and max_force [N]",
-    )
-    parser.add_argument(
-        "--out",
-        required=True,
-        metavar="FILE.nc|FILE.zarr",
-        help="netCDF file, or zarr store if the name ends in .zarr, to write (its directory "
-        "must exist)",
-    )
-    parser.add_argument(
-        "--overwrite",
-        action="store_true",
-        help="replace --out if it exists and ecofmaps wrote it (once the new map is complete)",
-    )
-    parser.add_argument(
-        "--chunk-points",
-        type=count("points"),
-        default=_CHUNK_POINTS,
-        metavar="N",
-        help=f"grid points per block (default {_CHUNK_POINTS}); a larger grid is computed "
-        "block by block into --out",
-    )
-    parser.add_argument(
-        "--quiet",
-        action="store_true",
-        help="no progress bar (there is none either when standard error is not a terminal)",
-    )
-    parser.add_argument(
-        "--no-cache",
-        action="store_true",
-        help="do not read or store the result in the cache (a map of the parabolic groove "
-        "is not cached anyway: kept for scripts that give it)",
-    )
-    parser.add_argument(
-        "--cache-dir",
-        metavar="DIR",
-        help="cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)",
-    )
+    option = option_adder(parser, _HELP)
+    for name, metavar in _AXES.items():
+        values = quantity(name, grid=True)
+        option(f"--{name.replace('_', '-')}", type=values, required=True, metavar=metavar)
+    option("--load", type=quantity("load"), metavar="P")
+    option("--out", required=True, metavar="FILE.nc|FILE.zarr")
+    option("--overwrite", action="store_true")
+    option("--chunk-points", type=count("points"), default=_CHUNK_POINTS, metavar="N")
+    option("--quiet", action="store_true")
+    option("--no-cache", action="store_true")
+    option("--cache-dir", metavar="DIR")
 
 
 def run(args) -> int:
@@ -138,15 +105,8 @@ def run(args) -> int:
     if not out.parent.is_dir():
         raise CommandError(f"cannot write {out}: the directory {out.parent} does not exist")
     refuse_to_overwrite([("--out", out)], [], overwrite=args.overwrite)
-    grid = {
-        name: values[0] if values.size == 1 else values
-        for name, values in (
-            ("stiffness_ratio", args.stiffness_ratio),
-            ("aspect_ratio", args.aspect_ratio),
-            ("amplitude", args.amplitude),
-            ("mu", args.mu),
-        )
-    }
+    axes = {name: getattr(args, name) for name in _AXES}
+    grid = {name: values[0] if values.size == 1 else values for name, values in axes.items()}
     points = math.prod(values.size for values in grid.values() if np.ndim(values))
     size = _map_bytes(grid, args.load)
     free = shutil.disk_usage(out.parent).free
@@ -172,9 +132,8 @@ def run(args) -> int:
 
 
 def _map_bytes(grid: dict, load) -> int:
-    """Bytes [byte] of the map of ``grid`` (``compute_map``'s grid keywords) with its
-    coordinates, uncompressed, before computing it: the variables' types and dimensions come
-    from the map of at most two values along each axis, chunked (nothing computed)."""
+    """Bytes [byte] of the map of ``grid`` with its coordinates, uncompressed, from the lazy
+    map of at most two values along each axis (nothing computed)."""
     from ecofmaps.maps.grid import compute_map
 
     small = {name: values[:2] if np.ndim(values) else values for name, values in grid.items()}
@@ -187,14 +146,13 @@ def _map_bytes(grid: dict, load) -> int:
 
 
 def _write(dataset, out: Path, shown: bool) -> int:
-    """Write ``dataset`` to ``out`` (a progress bar if ``shown``), record it as written by
-    ecofmaps, and print what was written."""
+    """Write ``dataset`` to ``out`` (a progress bar if ``shown``); print what was written."""
     from ecofmaps.maps.files import write_map
     from ecofmaps.model import Regime
 
     summary = [(dataset.regime == code).sum().data for code in Regime]
     summary += [dataset.ecof_ratio.min().data, dataset.ecof_ratio.max().data]
-    with _progress(dataset, shown=shown):
+    with _progress(dataset) if shown else contextlib.nullcontext():
         *counts, low, high = write_map(dataset, out, also=summary)
     record_written([out])
     shape = " x ".join(f"{size} {dim}" for dim, size in dataset.sizes.items()) or "1 point"
@@ -209,15 +167,9 @@ def _write(dataset, out: Path, shown: bool) -> int:
 
 
 @contextlib.contextmanager
-def _progress(dataset, shown: bool):
-    """A progress bar on standard error (points and blocks done, rate, ETA) while in the block.
-
-    It counts the blocks of a chunked map as their dask tasks finish; on an error or
-    Ctrl-C it is cleared, so the error is the last line.
-    """
-    if not shown:
-        yield
-        return
+def _progress(dataset):
+    """A progress bar on standard error counting the map's blocks as their dask tasks finish
+    while in the block; cleared on an error or Ctrl-C, so the error is the last line."""
     from dask.callbacks import Callback
     from tqdm import tqdm
 
@@ -233,18 +185,15 @@ def _progress(dataset, shown: bool):
         dynamic_ncols=True,
         postfix=f"0/{blocks} blocks",
     )
-    done = 0
+    done = itertools.count(1)
 
-    class Blocks(Callback):
-        def _posttask(self, key, result, dsk, state, worker_id):
-            nonlocal done
-            if isinstance(key, tuple) and str(key[0]).startswith(BLOCK_TASK):
-                done += 1
-                bar.set_postfix_str(f"{done}/{blocks} blocks", refresh=False)
-                bar.update(next(iter(result.values())).size)
+    def on_task(key, result, dsk, state, worker_id) -> None:
+        if isinstance(key, tuple) and str(key[0]).startswith(BLOCK_TASK):
+            bar.set_postfix_str(f"{next(done)}/{blocks} blocks", refresh=False)
+            bar.update(next(iter(result.values())).size)
 
     try:
-        with Blocks():
+        with Callback(posttask=on_task):
             yield
     except BaseException:
         bar.leave = False

@@ -1,16 +1,25 @@
-"""``ecofmaps wear``: energy wear of fretting tests from their results tables and scar profiles.
-
-Each test's per-cycle table (as ``ecofmaps loops --out`` writes it, CSV or netCDF) and its
-wear-scar profile (a profilometer trace, read as ``ecofmaps model --scar-profile`` reads it)
-give ΣE_d, the wear volume of a line contact, α and Archard's k with the test's sliding
-condition; over three tests or more, α and E_th (:func:`ecofmaps.energy_wear`, docs/lab.md).
-"""
+"""``ecofmaps wear``: energy wear of fretting tests from their results tables (``ecofmaps
+loops --out``) and scar profiles: ΣE_d, the wear volume of a line contact, α and Archard's k
+with the sliding condition; over three tests or more, α and E_th (:func:`ecofmaps.energy_wear`,
+docs/lab.md)."""
 
 from __future__ import annotations
 
 import argparse
+import sys
+import warnings
+from pathlib import Path
 
-from ecofmaps.cli._common import quantity, unit
+from ecofmaps.cli._common import (
+    CommandError,
+    option_adder,
+    print_rows,
+    quantity,
+    refuse_to_overwrite,
+    row,
+    unit,
+)
+from ecofmaps.io.files import record_written, write_text
 
 __all__ = ["add", "run"]
 
@@ -22,6 +31,17 @@ _WEAR = (
     "archard_slip",
     "archard_nominal",
 )
+
+_HELP = {
+    "tables": "results of ecofmaps loops (CSV, or .nc)",
+    "--profile": "a test's wear-scar profile (x and z columns); once per test",
+    "--length": "length of the line contact, with its unit, e.g. 5mm",
+    "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m: regime read on the contact",
+    "--x-unit": "unit of the profiles' positions (default: the column name's, else um)",
+    "--z-unit": "unit of the profiles' heights (default: the column name's, else um)",
+    "--out": "write the numbers here (CSV)",
+    "--overwrite": "replace --out if ecofmaps wrote it",
+}
 
 
 def _length(text: str) -> float:
@@ -37,59 +57,27 @@ def add(subparsers) -> None:
     parser = subparsers.add_parser(
         "wear",
         help="energy wear coefficient and Archard's k from results tables and scar profiles",
-        description=(
-            "Energy wear of fretting tests: for each test, the dissipated energy summed over "
-            "every cycle (a rig records every N-th), the wear volume of a line contact (the "
-            "scar's worn area times --length, the pile-up apart), α = V/ΣE_d and Archard's k "
-            "on the slip and on the applied amplitude, each with its standard error, and the "
-            "sliding condition; over three tests or more, α and the threshold energy E_th of "
-            "V = α(ΣE_d - E_th). One --profile per test, in the order of the tests (a table "
-            "of several recordings holds several tests)."
-        ),
+        description="Energy wear of fretting tests: for each test, the dissipated energy summed "
+        "over every cycle (a rig records every N-th), the wear volume of a line contact (the "
+        "scar's worn area times --length, the pile-up apart), α = V/ΣE_d and Archard's k on the "
+        "slip and on the applied amplitude, each with its standard error, and the sliding "
+        "condition; over three tests or more, α and the threshold energy E_th of V = α(ΣE_d - "
+        "E_th). One --profile per test, in the order of the tests (a table of several recordings "
+        "holds several tests).",
     )
-    option = parser.add_argument
-    option("tables", nargs="+", metavar="TABLE", help="results of ecofmaps loops (CSV, or .nc)")
-    option(
-        "--profile",
-        action="append",
-        required=True,
-        metavar="FILE",
-        help="a test's wear-scar profile (x and z columns); once per test",
-    )
-    option(
-        "--length",
-        type=_length,
-        required=True,
-        metavar="L",
-        help="length of the line contact, with its unit, e.g. 5mm",
-    )
-    option(
-        "--rig-stiffness",
-        type=quantity("stiffness", option="--rig-stiffness"),
-        metavar="S",
-        help="the rig's own stiffness, e.g. 35MN/m: regime read on the contact",
-    )
-    option(
-        "--x-unit",
-        type=unit("length"),
-        metavar="UNIT",
-        help="unit of the profiles' positions (default: the column name's, else um)",
-    )
-    option(
-        "--z-unit",
-        type=unit("length"),
-        metavar="UNIT",
-        help="unit of the profiles' heights (default: the column name's, else um)",
-    )
-    option("--out", metavar="OUT", help="write the numbers here (CSV)")
-    option("--overwrite", action="store_true", help="replace --out if ecofmaps wrote it")
+    option = option_adder(parser, _HELP)
+    option("tables", nargs="+", metavar="TABLE")
+    option("--profile", action="append", required=True, metavar="FILE")
+    option("--length", type=_length, required=True, metavar="L")
+    option("--rig-stiffness", type=quantity("stiffness", option="--rig-stiffness"), metavar="S")
+    option("--x-unit", type=unit("length"), metavar="UNIT")
+    option("--z-unit", type=unit("length"), metavar="UNIT")
+    option("--out", metavar="OUT")
+    option("--overwrite", action="store_true")
 
 
 def _profile(args, path):
     """The levelled profile in ``path``; what the reading decided printed on standard error."""
-    import sys
-    import warnings
-
     from ecofmaps.io.scar_profiles import read_scar_profile
 
     with warnings.catch_warnings(record=True) as caught:
@@ -104,15 +92,20 @@ def _profile(args, path):
     return profile
 
 
+def _rows(wear, names) -> list:
+    """The printed rows of ``names``, each value ± its standard error."""
+    rows = []
+    for name in names:
+        words, symbol, value = row(name, float(wear[name]))
+        rows.append((words, symbol, f"{value} ± {row(name, float(wear[f'{name}_se']))[2]}"))
+    return rows
+
+
 def run(args) -> int:
     """Run ``ecofmaps wear`` with the parsed ``args``; the exit status."""
-    from pathlib import Path
-
     import pandas as pd
 
     from ecofmaps._nomenclature import QUANTITIES, column
-    from ecofmaps.cli._common import CommandError, print_rows, refuse_to_overwrite, row
-    from ecofmaps.io.files import record_written, write_text
     from ecofmaps.io.tables import csv_text, read_results
     from ecofmaps.lab import energy_wear, sliding_condition
 
@@ -130,17 +123,7 @@ def run(args) -> int:
             f"{len(args.profile)} profiles"
         )
     profiles = [_profile(args, path) for path in args.profile]
-
-    def rows(wear, names):
-        return [
-            (
-                *row(q, float(wear[q]))[:2],
-                f"{row(q, float(wear[q]))[2]} ± {row(q, float(wear[f'{q}_se']))[2]}",
-            )
-            for q in names
-        ]
-
-    table = {"test": [], "profile": [], "sliding_condition": []}
+    table = []
     for (name, results), path, profile in zip(tests, args.profile, profiles, strict=True):
         try:
             wear = energy_wear(results, profile, length=args.length)
@@ -148,17 +131,17 @@ def run(args) -> int:
         except ValueError as error:
             raise CommandError(f"{name}: {error}") from None
         slip = condition.attrs["sliding_condition"]
-        print_rows(f"{name} (scar profile {path}, {slip})", rows(wear, _WEAR))
-        for key, value in (("test", name), ("profile", path), ("sliding_condition", slip)):
-            table[key].append(str(value))
+        print_rows(f"{name} (scar profile {path}, {slip})", _rows(wear, _WEAR))
+        line = {"test": str(name), "profile": str(path), "sliding_condition": str(slip)}
         for q in _WEAR:  # in the display units, ASCII
             label = column(q).replace("³", "3").replace("·", "").replace("(", "").replace(")", "")
             for key, v in ((label, q), (label.replace(q, f"{q}_se"), f"{q}_se")):
-                table.setdefault(key, []).append(float(wear[v]) * QUANTITIES[q].display_factor)
+                line[key] = float(wear[v]) * QUANTITIES[q].display_factor
+        table.append(line)
     if len(tests) > 2:
         fit = energy_wear([r for _, r in tests], profiles, length=args.length)
         names = ("campaign_energy_wear_coefficient", "threshold_energy")
-        print_rows("campaign: V = α(ΣE_d - E_th)", rows(fit, names))
+        print_rows("campaign: V = α(ΣE_d - E_th)", _rows(fit, names))
     if args.out is not None:
         write_text(args.out, csv_text(pd.DataFrame(table)))
         record_written([args.out])
