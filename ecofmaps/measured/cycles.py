@@ -414,6 +414,7 @@ def _labelled(samples: Samples, tolerance: float) -> Cycles:
     piece_start, label, size, highest, lowest, bottom, x_first, x_last, step = pieces
     new = np.concatenate([[True], label[1:] != label[:-1]])
     first_piece = np.flatnonzero(new)
+    _check_labels(label[first_piece], piece_start[first_piece])
     run = np.cumsum(new) - 1
     starts = piece_start[first_piece].astype(np.int64)
     count = np.add.reduceat(size, first_piece).astype(np.int64)
@@ -448,6 +449,25 @@ def _labelled(samples: Samples, tolerance: float) -> Cycles:
     )
 
 
+def _check_labels(number, start) -> None:
+    """Raise for a run of samples (from ``start``) whose cycle ``number`` is not whole, or
+    comes again after other numbers."""
+    instead = "--cycle-col none, or cycle=None, cuts the cycles at the reversals instead"
+    if (split := np.flatnonzero(number != np.floor(number))).size:
+        raise ValueError(
+            f"the cycle number {number[split[0]]:g} of sample {start[split[0]]:.0f} is not a "
+            f"whole number: is the cycle column a cycle counter? ({instead})"
+        )
+    _, first = np.unique(number, return_index=True)
+    if first.size < number.size:
+        again = np.setdiff1d(np.arange(number.size), first)[0]
+        raise ValueError(
+            f"the cycle number {number[again]:g} comes again at sample {start[again]:.0f}, after "
+            f"other numbers: two cycles would share it (a counter that restarted?); number the "
+            f"cycles anew ({instead})"
+        )
+
+
 def split_cycles(displacement, hysteresis: float = 0.5, tolerance: float = 0.01) -> Cycles:
     """Cut a continuous recording into complete cycles at its displacement reversals."""
     x = np.asarray(displacement, dtype=np.float64)
@@ -458,28 +478,6 @@ def labelled_cycles(displacement, cycle, tolerance: float = 0.01) -> Cycles:
     r"""Complete cycles of a recording whose samples carry their cycle number."""
     x = np.asarray(displacement, dtype=np.float64)
     return _labelled(Samples(x, None, np.asarray(cycle)), tolerance)
-
-
-def _check_labels(label: np.ndarray) -> None:
-    """Raise for a cycle number that is not whole, or given to two runs of samples apart."""
-    known = np.flatnonzero(np.isfinite(label)) if label.dtype.kind == "f" else None
-    values = label if known is None else label[known]
-    instead = "--cycle-col none, or cycle=None, cuts the cycles at the reversals instead"
-    if known is not None and (split := np.flatnonzero(values != np.floor(values))).size:
-        raise ValueError(
-            f"the cycle number {values[split[0]]:g} of sample {known[split[0]]} is not a whole "
-            f"number: is the cycle column a cycle counter? ({instead})"
-        )
-    starts = np.flatnonzero(np.r_[True, values[1:] != values[:-1]])
-    numbers, first = np.unique(values[starts], return_index=True)
-    if numbers.size < starts.size:
-        again = np.setdiff1d(np.arange(starts.size), first)[0]
-        sample = starts[again] if known is None else known[starts[again]]
-        raise ValueError(
-            f"the cycle number {values[starts[again]]:g} comes again at sample {sample}, after "
-            f"other numbers: two cycles would share it (a counter that restarted?); number the "
-            f"cycles anew ({instead})"
-        )
 
 
 def find_cycles(
@@ -494,8 +492,6 @@ def find_cycles(
                 f"cycle must have one value per sample: {cycle.shape[0]} values for "
                 f"{displacement.shape[0]} samples"
             )
-        if isinstance(cycle, np.ndarray):
-            _check_labels(cycle)
     samples = Samples(displacement, force, cycle, missing, runner=runner)
     if cycle is None:
         return _split(samples, hysteresis, 0.01)

@@ -19,7 +19,15 @@ from ecofmaps._parallel import Runner, stretch
 from ecofmaps.measured import resolve
 from ecofmaps.measured.cycles import Cycles, find_cycles, missing_sample_error, no_cycle_error
 from ecofmaps.measured.measure import GROSS_SLIP_THRESHOLD, NEIGHBOURS, Stretch, measure_cycles
-from ecofmaps.measured.quality import RESOLVED, Tally, cycle_results, scale_flags, with_loops
+from ecofmaps.measured.quality import (
+    LOAD_SCALED,
+    RESOLVED,
+    Tally,
+    cycle_results,
+    load_flags,
+    scale_flags,
+    with_loops,
+)
 
 __all__ = [
     "AT_OWN_LOAD",
@@ -164,44 +172,51 @@ def force_at_mean_load(force, load):
     force : numpy.ndarray or dask.array.Array
         Tangential force at each sample. [N]
     load : numpy.ndarray or dask.array.Array
-        Normal load at each sample (NaN where missing, which leaves the force missing). [N]
+        Normal load at each sample (NaN where missing; a load that is not positive is
+        missing too, and its cycle flagged ``load-not-positive``). [N]
 
     Returns
     -------
     force : numpy.ndarray or dask.array.Array
-        :math:`Q\,\bar P/P` at each sample. [N]
+        :math:`Q\,\bar P/P` at each sample, NaN where the load is missing. [N]
     mean_load : float
-        :math:`\bar P`, the mean of the finite loads. [N]
+        :math:`\bar P`, the mean of the finite positive loads. [N]
 
     Raises
     ------
     ValueError
-        If no load is finite, or one is not positive.
+        If no load is finite, or none is positive.
     """
     if isinstance(load, np.ndarray):
         finite = load[np.isfinite(load)]
-        mean, lowest = (finite.mean(), finite.min()) if finite.size else (np.nan, np.nan)
+        usable = np.where(np.isfinite(load) & (load > 0.0), load, np.nan)
+        positive = finite[finite > 0.0]
+        mean = positive.mean() if positive.size else np.nan
+        lowest, highest = (finite.min(), finite.max()) if finite.size else (np.nan, np.nan)
     else:
         import dask.array as da  # only for a lazy recording, read out of core
 
         finite = da.where(da.isfinite(load), load, np.nan)  # as in memory: inf is missing
-        mean, lowest = da.compute(da.nanmean(finite), da.nanmin(finite))
-    mean, lowest = float(mean), float(lowest)
-    if not np.isfinite(mean):
+        usable = da.where(finite > 0.0, finite, np.nan)
+        mean, lowest, highest = da.compute(da.nanmean(usable), da.nanmin(finite), da.nanmax(finite))
+    mean, lowest, highest = float(mean), float(lowest), float(highest)
+    if np.isnan(lowest):
         raise ValueError("the recorded normal load holds no value")
-    if not lowest > 0.0:
-        raise ValueError(f"the recorded normal load must be positive; its lowest is {lowest:g} N")
-    return force * (mean / load), mean
+    if np.isnan(mean):
+        hint = "is it the normal load?"
+        if lowest < 0.0:
+            hint = "is it recorded negative in compression? Give it with the other sign (-Fz)."
+        raise ValueError(
+            f"the recorded normal load is nowhere positive (from {lowest:g} N to "
+            f"{highest + 0.0:g} N): {hint}"
+        )
+    return force * (mean / usable), mean
 
 
 #: The values that scale with the normal load: with a recorded load, they are reported at
 #: each cycle's own load (``normal_load``), the rest being read at the mean load.
 AT_OWN_LOAD = (
-    "max_force",
-    "dissipated_energy",
-    "stiffness",
-    "force_offset",
-    "force_drift_se",
+    *LOAD_SCALED,
     "loop_force",
     "force_forward",
     "force_backward",
@@ -221,12 +236,13 @@ def at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
     )
 
 
-def _cycle_means(series, cycles: Cycles, rows: slice) -> np.ndarray:
-    """The mean of the finite values of ``series`` over each cycle of ``rows`` (NaN if none)."""
+def _cycle_loads(series, cycles: Cycles, rows: slice) -> tuple:
+    """The mean, lowest and highest finite value of ``series`` over each cycle of ``rows``
+    (NaN if none)."""
     first, stop, _ = rows.indices(cycles.label.size)
     start, count = cycles.start[first:stop], cycles.count[first:stop]
     if start.size == 0:
-        return np.empty(0)
+        return np.empty(0), np.empty(0), np.empty(0)
     low = int(start.min())
     values = np.asarray(series[low : int((start + count).max())], dtype=np.float64)
     finite = np.isfinite(values)
@@ -235,7 +251,10 @@ def _cycle_means(series, cycles: Cycles, rows: slice) -> np.ndarray:
     )
     ends, begins = start + count - low, start - low
     with np.errstate(invalid="ignore"):  # a cycle without a finite value: NaN
-        return (sums[ends] - sums[begins]) / (counts[ends] - counts[begins])
+        mean = (sums[ends] - sums[begins]) / (counts[ends] - counts[begins])
+    padded = np.append(np.where(finite, values, np.nan), np.nan)  # an end may be the last
+    bounds = np.ravel([begins, ends], order="F")
+    return mean, *(f.reduceat(padded, bounds)[::2] for f in (np.fmin, np.fmax))
 
 
 def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
@@ -247,9 +266,11 @@ def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
         task.cycles, x, q, options, rows=task.rows, keep_loops=kept
     )
     if recorded_load is not None:
-        values["normal_load"] = _cycle_means(
+        mean, lowest, highest = _cycle_loads(
             Stretch(recorded_load, task.low), task.cycles, task.rows
         )
+        values["normal_load"] = mean
+        flags |= load_flags(flags["missing-samples"], mean, lowest, highest)
     flags |= scale_flags(values, options)
     resolved = None
     if reading.resolve:

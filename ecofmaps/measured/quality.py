@@ -19,6 +19,8 @@ from ecofmaps.model.regimes import GROSS_SLIP, INVALID, PARTIAL_SLIP, Regime
 __all__ = [
     "ALL",
     "ANTICLOCKWISE_SHARE",
+    "LOAD_SCALED",
+    "LOAD_SWING",
     "READING_REASONS",
     "REASONS",
     "RESOLVED",
@@ -34,6 +36,7 @@ __all__ = [
     "gross_slip",
     "has_reason",
     "judged",
+    "load_flags",
     "quality_strings",
     "quality_summary",
     "refused",
@@ -65,6 +68,13 @@ COF_RANGE = (0.01, 3.0)
 #: Displacement amplitudes above this are reciprocating sliding rather than fretting (still
 #: analysed the same way; the results' ``motion`` attribute says so). [m]
 FRETTING_AMPLITUDE = 300e-6
+
+#: A recorded normal load that swings by more than this share of its mean within a cycle
+#: (highest less lowest) leaves the values given at the cycle's mean load off (``load-swing``).
+LOAD_SWING = 0.2
+
+#: The per-cycle values that scale with the normal load (given at each cycle's own load).
+LOAD_SCALED = ("max_force", "dissipated_energy", "stiffness", "force_offset", "force_drift_se")
 
 #: A loop whose area :math:`\oint Q\,d\Delta` is below minus this share of
 #: :math:`4\Delta^*Q^*` runs anticlockwise; a smaller negative area is noise on a loop
@@ -124,6 +134,11 @@ REASONS = {
         "the cycle holds a missing sample (NaN or an empty cell): skipped, not analysed",
         ALL,
     ),
+    "load-not-positive": (
+        "the recorded normal load is zero or negative at a sample of the cycle (its samples "
+        "are missing to the force's scaling): not analysed",
+        ALL,
+    ),
     "few-samples": (f"fewer than {MIN_SAMPLES} samples in the cycle, fewer than a loop needs", ALL),
     "constant-force": ("the force does not vary over the cycle (a dead channel)", ALL),
     "implausible-amplitude": (
@@ -178,6 +193,11 @@ REASONS = {
         "GICoF in gross slip): the load given or the force's unit is wrong, not the contact",
         ("ecof", "cof_max", *_GICOF, *RESOLVED),
     ),
+    "load-swing": (
+        f"the recorded normal load swings by more than {LOAD_SWING * 100:g} % of its mean "
+        "within the cycle: the values that scale with the load, given at its mean, are off",
+        LOAD_SCALED,
+    ),
     "partial-slip": (
         "partial slip: the energy ratio A is not above the threshold; the contact slips only "
         "at its edges, and Q*/P (cof_max, kept) is a lower bound of μ",
@@ -226,6 +246,8 @@ READING_REASONS = (
 #: applies; with loops anticlockwise and stick sides sloping down, :data:`_FLIP_HINT`.
 _HINTS = {
     "missing-samples": "Every cycle holds a missing sample (NaN or an empty cell).",
+    "load-not-positive": "The recorded normal load is zero or negative in every cycle: is it "
+    "recorded negative in compression? Give it with the other sign (-Fz).",
     "anticlockwise": "The loops run anticlockwise with stick sides sloping up: the recording "
     "runs backwards in time, or the displacement and force columns are swapped.",
     "constant-force": "The force does not vary: is the force channel connected?",
@@ -315,6 +337,16 @@ def scale_flags(values: dict, options) -> dict:
     }
 
 
+def load_flags(missing, mean, lowest, highest) -> dict:
+    """The checks of each cycle's recorded normal load (reason -> per cycle) from its mean,
+    lowest and highest finite value [N]; ``missing`` (``missing-samples``) kept only where
+    the load is positive, the samples where it is not being missing by design."""
+    bad = lowest <= 0.0  # and so the mean, if it is not positive
+    with np.errstate(divide="ignore", invalid="ignore"):
+        swing = (highest - lowest) / mean > LOAD_SWING
+    return {"missing-samples": missing & ~bad, "load-not-positive": bad, "load-swing": swing & ~bad}
+
+
 def judged(values: dict, flags: dict, options):
     """The one judgement of a part's cycles: ``values`` (name -> per cycle, as measured)
     NaN where a flag's scope reaches, the ``quality`` strings, the cycles refused and the
@@ -360,7 +392,7 @@ class Tally:
         loud = _by_text(quality, lambda text: bool(set(text.split(SEPARATOR)) - quiet))
         part.flagged, part.cycles = int(loud.sum()), amplitude.size
         part.refused = int(_refusing(flags, amplitude.size).sum())
-        part.every = {reason: bool(flags[reason].all()) for reason in _HINTS}
+        part.every = {reason: reason in flags and bool(flags[reason].all()) for reason in _HINTS}
         part.negative_stiffness = bool(flags["negative-stiffness"].any())
         part.amplitudes = [amplitude]
         part.implausible_cof = int(flags["implausible-cof"].sum())
