@@ -471,3 +471,66 @@ def test_a_recorded_load_out_of_core_is_the_same():
     lazy = analyze_loops(*(da.from_array(a, chunks=1500) for a in (displacement, force, load)))
     for name in ("normal_load", "max_force", "stiffness", "dissipated_energy", "ecof"):
         np.testing.assert_allclose(lazy[name], memory[name], rtol=1e-12, err_msg=name)
+
+
+def _bad_loads():
+    """The stepping load with a zero sample in cycle 5, a negative one in cycle 10, and a
+    load swinging ±200 N about 450 N over cycle 6 (12 cycles of 200 samples)."""
+    displacement, force, load = load_steps()
+    load[5 * 200 + 100], load[10 * 200 + 50] = 0.0, -3.0
+    load[6 * 200 : 7 * 200] = 450.0 + 200.0 * np.sin(np.arange(200) / 200 * 2 * np.pi)
+    force[6 * 200 : 7 * 200] *= load[6 * 200 : 7 * 200] / 450.0  # the force follows the load
+    return displacement, force, load
+
+
+@pytest.mark.filterwarnings("ignore::ecofmaps.measured.LoopQualityWarning")
+@pytest.mark.parametrize("chunks", [None, 1500, 700])
+def test_a_recorded_load_is_judged_cycle_by_cycle(chunks):
+    """A load not positive at one sample refuses its cycle alone; one swinging by more than
+    LOAD_SWING of its mean empties the values at its load and keeps the coefficients; the
+    cycles across a step of the load swing too. The same in memory and out of core."""
+    import dask.array as da
+
+    from ecofmaps.measured.quality import LOAD_SCALED, LOAD_SWING
+
+    assert LOAD_SWING == 0.2
+    arrays = _bad_loads()
+    if chunks is not None:
+        arrays = [da.from_array(a, chunks=chunks) for a in arrays]
+    results = analyze_loops(*arrays)
+    memory = analyze_loops(*_bad_loads())
+    quality = results.quality.values
+    assert list(quality[[5, 10]]) == ["load-not-positive"] * 2
+    assert np.isnan(results.max_force[[5, 10]]).all() and np.isnan(results.ecof[[5, 10]]).all()
+    assert list(np.flatnonzero(quality == "load-swing")) == [3, 6, 7]  # a step: 300 -> 450 N
+    for name in LOAD_SCALED:
+        assert np.isnan(results[name][[3, 6, 7]]).all(), name
+    assert np.isfinite(results.ecof[[3, 6, 7]]).all()
+    assert (quality[[0, 1, 2, 4, 8, 9, 11]] == "ok").all()
+    assert results.attrs["quality_summary"] == "12 cycles: 7 ok; load-not-positive 2, load-swing 3"
+    np.testing.assert_array_equal(quality, memory.quality.values)
+    for name in ("normal_load", "max_force", "stiffness", "dissipated_energy", "ecof", "gicof"):
+        np.testing.assert_allclose(results[name], memory[name], rtol=1e-12, err_msg=name)
+    displacement, force, load = _bad_loads()  # as if the load were missing at those samples
+    missing = analyze_loops(displacement, force, np.where(load > 0.0, load, np.nan))
+    assert list(missing.quality[[5, 10]]) == ["missing-samples"] * 2
+    recorded = ["quality", "normal_load"]  # a refused cycle's mean load: as recorded
+    xr.testing.assert_equal(memory.drop_vars(recorded), missing.drop_vars(recorded))
+
+
+@pytest.mark.parametrize("lazy", [False, True])
+def test_a_recorded_load_nowhere_positive_says_why(lazy):
+    """A load recorded negative (compression) asks for the other sign; one without a value
+    names the load; in memory and out of core alike."""
+    import dask.array as da
+
+    displacement, force, load = load_steps()
+    wrap = (lambda a: da.from_array(a, chunks=1500)) if lazy else np.asarray
+    with pytest.raises(ValueError, match=r"nowhere positive \(from -600 N to -300 N\): is it "):
+        analyze_loops(wrap(displacement), wrap(force), wrap(-load))
+    with pytest.raises(ValueError, match=r"compression\? Give it with the other sign \(-Fz\)"):
+        analyze_loops(wrap(displacement), wrap(force), wrap(-load))
+    with pytest.raises(ValueError, match=r"\(from 0 N to 0 N\): is it the normal load\?"):
+        analyze_loops(wrap(displacement), wrap(force), wrap(0.0 * load))
+    with pytest.raises(ValueError, match="the recorded normal load holds no value"):
+        analyze_loops(wrap(displacement), wrap(force), wrap(np.full(load.size, np.nan)))

@@ -6,7 +6,6 @@ import pytest
 
 from ecofmaps.io import read_recording
 from ecofmaps.measured import analyze_loops
-from ecofmaps.measured.cycles import find_cycles
 from ecofmaps.measured.synthetic import EXAMPLE, example_path
 
 
@@ -28,17 +27,25 @@ def test_masked_samples_are_missing_samples(example):
     assert analyze_loops(x, masked, EXAMPLE["load"], resolve=False).equals(expected)
 
 
+@pytest.mark.parametrize("chunks", [None, 1700])
 @pytest.mark.parametrize(
     ("labels", "message"),
     [
         (lambda n: np.arange(n) // 200 + 0.5, "the cycle number 0.5 of sample 0 is not a whole"),
         (lambda n: (np.arange(n) // 200) % 50, "the cycle number 0 comes again at sample 10000"),
+        (lambda n: np.where(np.arange(n) < 3000, np.arange(n) // 200, 7.25), "7.25 of sample 3000"),
     ],
 )
-def test_cycle_numbers_that_cycles_would_share_are_refused(example, labels, message):
-    x, _ = example
+def test_cycle_numbers_that_cycles_would_share_are_refused(example, labels, message, chunks):
+    """In memory and out of core (dask blocks that cut the runs) alike."""
+    x, q = example
+    arrays = (x, q, labels(x.size))
+    if chunks is not None:
+        import dask.array as da
+
+        arrays = [da.from_array(a, chunks=chunks) for a in arrays]
     with pytest.raises(ValueError, match=message) as raised:
-        find_cycles(x, labels(x.size))
+        analyze_loops(arrays[0], arrays[1], EXAMPLE["load"], arrays[2])
     assert "--cycle-col none, or cycle=None, cuts the cycles at the reversals" in str(raised.value)
 
 
