@@ -156,3 +156,27 @@ def test_a_run_stopped_by_sigterm_and_resumed_writes_the_table_of_the_arrays(
     status, _, err = run(capsys, files["tdms"], "--load", "450N", "--out", out, "--resume")
     assert status == 0, err
     assert out.read_text() == expected
+
+
+@pytest.mark.parametrize("workers", [[], ["--workers", "2"]])
+def test_a_recorded_load_not_positive_refuses_its_cycles_alone(
+    samples, tmp_path, capsys, small_chunks, workers
+):
+    """``--load Fz`` zero at a sample of one cycle and negative at one of another: those two
+    cycles ``load-not-positive``, the others analysed; the table of the arrays."""
+    displacement, force = samples
+    load = np.full(displacement.size, LOAD)
+    load[400], load[1400] = 0.0, -5.0
+    with pytest.warns(LoopQualityWarning, match="load-not-positive 2"):
+        results = ecofmaps.analyze_loops(displacement, force, load, resolve=True)
+    lines = [
+        ",".join(repr(float(value)) for value in row).replace("nan", "")
+        for row in zip(displacement, force, load, strict=True)
+    ]
+    recording = tmp_path / "fz.csv"
+    recording.write_text("\n".join(["displacement [m],force [N],Fz [N]", *lines]) + "\n")
+    out = tmp_path / "out.csv"
+    status, _, err = run(capsys, recording, "--load", "Fz", "--out", out, *workers)
+    assert status == 0, err
+    assert out.read_text() == results_csv(results)
+    assert out.read_text().count(",load-not-positive\n") == 2
