@@ -134,10 +134,10 @@ def analyze_loops(
     Raises
     ------
     ValueError
-        For inputs of the wrong shape, a load that is not positive, options out of
-        range, a recording without a complete cycle, or one whose every cycle is refused
-        (the message says what to do); :class:`MissingSampleError` for a missing sample
-        with ``nan_policy='raise'``.
+        For inputs of the wrong shape, a load that is not positive (a recorded one:
+        nowhere), options out of range, a recording without a complete cycle, or one whose
+        every cycle is refused (the message says what to do); :class:`MissingSampleError`
+        for a missing sample with ``nan_policy='raise'``.
 
     Warns
     -----
