@@ -534,3 +534,6 @@ def test_a_recorded_load_nowhere_positive_says_why(lazy):
         analyze_loops(wrap(displacement), wrap(force), wrap(0.0 * load))
     with pytest.raises(ValueError, match="the recorded normal load holds no value"):
         analyze_loops(wrap(displacement), wrap(force), wrap(np.full(load.size, np.nan)))
+    spiked = np.where(np.arange(load.size) % 50 == 7, -load, load)  # in every cycle
+    with pytest.raises(ValueError, match=r"load-not-positive 12\). The recorded normal load is"):
+        analyze_loops(wrap(displacement), wrap(force), wrap(spiked))
