@@ -4,6 +4,7 @@ recording's columns or read a scar profile, the one rule for writing outputs, pr
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import sys
@@ -26,6 +27,7 @@ __all__ = [
     "byte_size",
     "command_parser",
     "count",
+    "made_folder",
     "option_adder",
     "print_rows",
     "profile_rows",
@@ -99,16 +101,17 @@ def unit(kind: str):
     return parse
 
 
-def count(what: str):
-    """An argparse ``type`` reading a whole number of ``what`` >= 1 (``4194304``, ``4e6``)."""
+def count(what: str, least: int = 1):
+    """An argparse ``type`` reading a whole number of ``what`` >= ``least`` (``4194304``,
+    ``4e6``)."""
 
     def parse(text: str) -> int:
         try:
             value = float(text)
         except ValueError:
             value = math.nan
-        if not (math.isfinite(value) and value.is_integer() and value >= 1):
-            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of {what} >= 1")
+        if not (math.isfinite(value) and value.is_integer() and value >= least):
+            raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of {what} >= {least}")
         return int(value)
 
     parse.__name__ = what
@@ -156,7 +159,7 @@ def add_recording_options(parser) -> None:
     option("--displacement-col", default="displacement", metavar="NAME")
     option("--force-col", default="force", metavar="NAME")
     option("--cycle-col", metavar="NAME")
-    option("--skip-rows", type=int, metavar="N")
+    option("--skip-rows", type=count("lines", least=0), metavar="N")
     option("--displacement-unit", type=unit("length"), metavar="UNIT")
     option("--force-unit", type=unit("force"), metavar="UNIT")
     option("--group", metavar="NAME")
@@ -342,6 +345,21 @@ def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=())
             f"{option} {target} is {kind} that ecofmaps did not write (or that changed "
             f"since; see {MANIFEST} in its folder): it is not replaced; choose another name"
         )
+
+
+@contextlib.contextmanager
+def made_folder(folder: Path):
+    """Create ``folder`` and its missing parents for the block; if the block fails (a full
+    disk, an interrupt), remove those it created that are still empty, and only those."""
+    missing = [path for path in (folder, *folder.parents) if not path.exists()]
+    folder.mkdir(parents=True, exist_ok=True)
+    try:
+        yield folder
+    except BaseException:
+        for path in missing:  # the deepest first; a folder holding anything stays
+            with contextlib.suppress(OSError):
+                path.rmdir()
+        raise
 
 
 def _resolved(path: Path) -> Path:

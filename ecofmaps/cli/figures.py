@@ -18,7 +18,13 @@ from pathlib import Path
 
 from ecofmaps._interrupts import check_interrupted, interrupts_stop_writes
 from ecofmaps._parallel import start_resource_tracker_quietly
-from ecofmaps.cli._common import command_parser, count, option_adder, refuse_to_overwrite
+from ecofmaps.cli._common import (
+    command_parser,
+    count,
+    made_folder,
+    option_adder,
+    refuse_to_overwrite,
+)
 from ecofmaps.io.files import record_written
 
 __all__ = ["JAX_CACHE_FOLDER", "TaskQueue", "add", "run"]
@@ -248,21 +254,21 @@ def run(args) -> int:
     drawn = [name for group in groups for name in group]
     planned = [("--out", out / f"{name}.{suffix}") for name in drawn for suffix in args.format]
     refuse_to_overwrite(planned, [], overwrite=args.overwrite, folders=[("--out", out)])
-    out.mkdir(parents=True, exist_ok=True)
-    print(
-        f"ecofmaps figures: {len(drawn)} figure(s) as {', '.join(args.format)} into {out}"
-        + (f", {jobs} processes" if jobs > 1 else ""),
-        file=sys.stderr,
-    )
-    begin = time.perf_counter()
-    if jobs > 1:
-        results = _written_in_parallel(groups, parts, out, args.format, jobs)
-    else:
-        results = _written_here(groups, out, args.format)
-    written = (figure for group in results for figure in group)
-    for index, (name, paths, seconds) in enumerate(written, start=1):
-        record_written(paths)
-        files = ", ".join(str(path) for path in paths)
-        print(f"  [{index}/{len(drawn)}] {name:<10} {seconds:5.1f} s  {files}", file=sys.stderr)
+    with made_folder(out):
+        print(
+            f"ecofmaps figures: {len(drawn)} figure(s) as {', '.join(args.format)} into {out}"
+            + (f", {jobs} processes" if jobs > 1 else ""),
+            file=sys.stderr,
+        )
+        begin = time.perf_counter()
+        if jobs > 1:
+            results = _written_in_parallel(groups, parts, out, args.format, jobs)
+        else:
+            results = _written_here(groups, out, args.format)
+        written = (figure for group in results for figure in group)
+        for index, (name, paths, seconds) in enumerate(written, start=1):
+            record_written(paths)
+            files = ", ".join(str(path) for path in paths)
+            print(f"  [{index}/{len(drawn)}] {name:<10} {seconds:5.1f} s  {files}", file=sys.stderr)
     print(f"done in {time.perf_counter() - begin:.1f} s", file=sys.stderr)
     return 0

@@ -22,7 +22,15 @@ import warnings
 from ecofmaps._interrupts import STOP_SIGNALS, interrupts_stop_writes
 from ecofmaps._version import __version__
 
-__all__ = ["EXIT_INTERRUPTED", "EXIT_TERMINATED", "CommandError", "build_parser", "console", "main"]
+__all__ = [
+    "EXIT_BROKEN_PIPE",
+    "EXIT_INTERRUPTED",
+    "EXIT_TERMINATED",
+    "CommandError",
+    "build_parser",
+    "console",
+    "main",
+]
 
 
 class CommandError(Exception):
@@ -81,6 +89,10 @@ EXIT_INTERRUPTED = 130
 #: Exit status of a run stopped by SIGTERM (128 + SIGTERM).
 EXIT_TERMINATED = 143
 
+#: Exit status once the reader of the output has gone (``| head``): 128 + SIGPIPE, as Unix
+#: tools end.
+EXIT_BROKEN_PIPE = 141
+
 
 def main(argv=None) -> int:
     """Run the ``ecofmaps`` command; return its exit status: 0 on success; 2 for a user error
@@ -106,6 +118,8 @@ def main(argv=None) -> int:
             return status
     except KeyboardInterrupt as stop:  # after the work was done (when leaving), it stops nothing
         return status if status is not None else _stopped(interrupted, getattr(stop, "note", None))
+    except BrokenPipeError:  # the reader of standard output has gone: console ends quietly
+        raise
     except Exception as error:
         if interrupted is not None and interrupted.is_set():  # an interrupt turned into an error
             return _stopped(interrupted, None)
@@ -192,9 +206,16 @@ def console() -> None:
     """The ``ecofmaps`` console script: run :func:`main` and exit with its status. After a
     stop the process ends at once (``os._exit``), its messages flushed and the run's objects
     collected: tearing the interpreter down around JAX's busy threads can crash it. Once
-    :func:`main` has returned, a stop signal is ignored: a complete run stays complete."""
+    :func:`main` has returned, a stop signal is ignored: a complete run stays complete. If
+    the reader of the output goes (``| head``), the command ends at once, quietly, with
+    :data:`EXIT_BROKEN_PIPE`."""
     after = _ignored_after_main()
-    status = main()
+    try:
+        status = main()
+        sys.stdout.flush()
+    except BrokenPipeError:  # what is still buffered goes nowhere, not into a second error
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        status = EXIT_BROKEN_PIPE
     for number in after:  # the work is done: a signal now stops nothing, not even the exit
         signal.signal(number, signal.SIG_IGN)
     if status in (EXIT_INTERRUPTED, EXIT_TERMINATED):

@@ -109,6 +109,8 @@ def serve_explorer(port: int, *, open_browser: bool = True, announce=print, allo
     OSError
         If the port cannot be listened on (in use, or not allowed).
     """
+    previous = {number: signal.getsignal(number) for number in (signal.SIGINT, signal.SIGTERM)}
+    ours = [number for number, before in previous.items() if before not in (signal.SIG_IGN, None)]
     url = f"http://127.0.0.1:{port}/"
     hosts = _allowed_hosts(port, allow_origin)
     server = get_server(
@@ -121,6 +123,7 @@ def serve_explorer(port: int, *, open_browser: bool = True, announce=print, allo
         # Bokeh cannot parse "[::1]:port"; _Foreign checks every request against all hosts.
         websocket_origin=sorted(h for h in hosts if not h.startswith("[")),
     )
+    signal.signal(signal.SIGINT, previous[signal.SIGINT])  # Panel's would stop at once
     # Before Bokeh's and Panel's routes, for every path: Tornado's documented rule router.
     server._tornado.default_router.rules[:0] = [
         Rule(_Foreign(hosts), _Forbidden, {"url": url}),
@@ -131,14 +134,13 @@ def serve_explorer(port: int, *, open_browser: bool = True, announce=print, allo
     def stop(signum, frame):  # the loop stops as soon as it runs (at once if it runs)
         loop.asyncio_loop.call_soon_threadsafe(loop.stop)
 
-    previous = {number: signal.getsignal(number) for number in (signal.SIGINT, signal.SIGTERM)}
-    ours = [number for number, before in previous.items() if before not in (signal.SIG_IGN, None)]
-    for number in ours:  # a signal ignored (Ctrl-C in a background job) stays ignored
-        signal.signal(number, stop)
     try:
-        check_interrupted()  # a Ctrl-C while the command started up stops it here
+        check_interrupted()  # a stop while the command started up ends it here
         warm_up()  # the port is taken: a page asked for meanwhile waits for it
         server.start()
+        for number in ours:  # a signal ignored (Ctrl-C in a background job) stays ignored
+            signal.signal(number, stop)
+        check_interrupted()  # or while the model compiled: the URL is never given
         announce(f"ecofmaps explorer at {url} (Ctrl-C stops it)")
         if open_browser:
             loop.add_callback(webbrowser.open, url)

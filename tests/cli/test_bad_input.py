@@ -7,6 +7,7 @@ files unchanged and no output left behind.
 
 import os
 import signal
+import subprocess
 import sys
 
 import numpy as np
@@ -93,6 +94,8 @@ def test_the_same_file_by_another_name_is_refused(tmp_path, capsys, recording):
          "argument --scar-depth: '-8um' is out of range"),
         (["loops", "--example", "--load", "inf"], "argument --load: 'inf' is out of range"),
         (["loops", "--example", "--force-unit", ""], "argument --force-unit: an empty unit"),
+        (["loops", "--example", "--load", "450N", "--skip-rows", "-1"],
+         "argument --skip-rows: '-1' is not a whole number of lines >= 0"),
         (["loops", "--example", "--force-unit", "0N"], "'0N' is not a unit"),
         (["loops", "--example", "--force-unit", "um"], "--force-unit: 'um' is not a force"),
         (["loops", "--example", "--cycle-col", "Force"],
@@ -193,7 +196,8 @@ def test_ctrl_c_during_figures_keeps_whole_files_only(tmp_path):
     assert status == 130, stderr
     assert stderr.splitlines()[-1] == "ecofmaps: interrupted; no output was left half written"
     assert "Traceback" not in stderr
-    for path in (tmp_path / "figs").iterdir():
+    figs = tmp_path / "figs"  # removed if the Ctrl-C came before the first figure
+    for path in figs.iterdir() if figs.exists() else ():
         assert path.suffix == ".png" and path.read_bytes().endswith(b"IEND\xaeB`\x82")
 
 
@@ -326,3 +330,30 @@ def test_errors_of_the_reading_name_the_options_not_python_keywords():
         option_names("/data/force_unit.csv: cycle_column.x")
         == "/data/force_unit.csv: cycle_column.x"
     )
+
+
+# --- the help, and a reader of the output that goes ------------------------------------------
+
+
+def test_the_help_of_convert_gives_the_largest_chunk_of_a_store(capsys):
+    status, out, _ = run(capsys, "convert", "--help")
+    assert status == 0 and (
+        "--chunk-samples N samples per block read, and per chunk of the store (at most 131072, "
+        "and no more than the recording) (default 1048576)"
+    ) in " ".join(out.split())
+
+
+@pytest.mark.parametrize(
+    "argv", [["--help"], ["model", "--amplitude", "50um"], ["loops", "--example", "--load", "450N"]]
+)
+def test_a_reader_that_goes_ends_the_command_quietly(argv):
+    """``ecofmaps ... | head``: the pipe closes before the output comes; no traceback, no
+    line about the pipe, the status of Unix tools (141, or 0 if nothing was lost)."""
+    process = subprocess.Popen(
+        [sys.executable, "-m", "ecofmaps.cli", *argv],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    process.stdout.close()
+    stderr = process.communicate(timeout=300)[1]
+    assert process.returncode in (0, 141) and stderr == b""

@@ -2,6 +2,7 @@
 ``--overwrite`` replaces only what ecofmaps wrote, and too many workers or a scheduler that is
 not one are refused at once, naming the option."""
 
+import errno
 import http.server
 import os
 import socket
@@ -13,6 +14,7 @@ import pytest
 
 import ecofmaps
 from ecofmaps import _parallel
+from ecofmaps.cli import figures
 from ecofmaps.io.files import MANIFEST, record_written, written_by_ecofmaps
 from ecofmaps.measured.synthetic import example_path, synthetic_recording
 from ecofmaps.paper import EXAMPLE_2
@@ -207,6 +209,25 @@ def test_figures_into_a_folder_in_use_need_overwrite(tmp_path, capsys):
     )
     assert sorted(p.name for p in out.iterdir()) == ["fig8.png", "thesis.txt"]
     assert (out / "fig8.png").read_bytes() == b"a user's picture"
+
+
+@pytest.mark.parametrize("failure", [OSError(errno.ENOSPC, "No space left"), KeyboardInterrupt()])
+def test_figures_that_fail_remove_only_the_empty_folders_they_made(
+    tmp_path, capsys, monkeypatch, failure
+):
+    """A full disk or Ctrl-C before the first file, or a bad --format: no folder made is left,
+    a folder that was there is kept."""
+
+    def fails(*args):
+        raise failure
+
+    monkeypatch.setattr(figures, "_write_figure_group", fails)
+    made, there = tmp_path / "new" / "figures", tmp_path / "there"
+    there.mkdir()
+    for out, more in [(made, []), (there, []), (made, ["--format", "bmp"])]:
+        status, _, _ = run(capsys, "figures", "--out", out, "--only", "fig8", "--jobs", 1, *more)
+        assert status in (2, 130)
+    assert list(tmp_path.iterdir()) == [there] and list(there.iterdir()) == []
 
 
 @pytest.mark.parametrize("device", ["/dev/null", "/dev/full"])

@@ -279,6 +279,33 @@ def test_sigterm_stops_it_cleanly(listening):
     assert "ecofmaps explorer stopped" in out
 
 
+#: ``ecofmaps explore`` whose model compiles once a signal has come (sent by the process itself).
+SIGNALLED_IN_WARM_UP = """
+import os, signal
+from ecofmaps.cli.main import console
+from ecofmaps.web import server
+warm_up = server.warm_up
+def signalled():
+    os.kill(os.getpid(), signal.Signals[os.environ["SENT"]])
+    warm_up()
+server.warm_up = signalled
+console()
+"""
+
+
+@pytest.mark.parametrize(("sent", "status"), [("SIGTERM", 143), ("SIGINT", 130)])
+def test_a_stop_during_the_start_up_gives_no_address(sent, status):
+    """The signal comes before the server answers: one line, the run's stop status, no URL."""
+    command = [sys.executable, "-c", SIGNALLED_IN_WARM_UP, "explore", "--no-browser", "--port"]
+    environment = {**os.environ, "SENT": sent}
+    done = subprocess.run(
+        [*command, str(free_port())], capture_output=True, text=True, timeout=300, env=environment
+    )
+    words = "terminated (SIGTERM)" if sent == "SIGTERM" else "interrupted"
+    assert (done.returncode, done.stdout) == (status, "")
+    assert done.stderr == f"ecofmaps: {words}; no output was left half written\n"
+
+
 def test_the_page_follows_its_inputs():
     """The page's callbacks, without a server: numbers, no gross slip, a rigid rig, bad input."""
     page = explorer_page()
