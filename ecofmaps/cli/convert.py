@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 from ecofmaps.cli._common import (
@@ -14,37 +13,18 @@ from ecofmaps.cli._common import (
     recording_options,
     refuse_to_overwrite,
 )
-from ecofmaps.io.files import record_written
+from ecofmaps.io.files import CHUNK_BYTES, record_written
 
 __all__ = ["add", "run"]
 
 _HELP = {
     "source": "the recording to read",
     "destination": "the file or store to write",
+    "--chunk-samples": "samples per block read, and per chunk of the store (at most "
+    f"{CHUNK_BYTES // 8}, and no more than the recording) (default %(default)s)",
     "--overwrite": "replace DST if ecofmaps wrote it (once the new one is complete); a file or "
     "folder ecofmaps did not write is never replaced",
 }
-
-
-class _ChunkSamples(argparse.Action):
-    """Stores ``--chunk-samples``; its help gives the writers' largest chunk, read (with the
-    writers and xarray) only when the help is shown."""
-
-    def __call__(self, parser, namespace, values, option_string=None):
-        setattr(namespace, self.dest, values)
-
-    @property
-    def help(self) -> str:
-        from ecofmaps.io.writers import CHUNK_BYTES
-
-        return (
-            f"samples per block read, and per chunk of the store (at most {CHUNK_BYTES // 8}, "
-            "and no more than the recording) (default %(default)s)"
-        )
-
-    @help.setter
-    def help(self, text) -> None:
-        """The help is the property's, whatever argparse sets."""
 
 
 def add(subparsers) -> None:
@@ -64,9 +44,7 @@ def add(subparsers) -> None:
     option("source", metavar="SRC")
     option("destination", metavar="DST")
     add_recording_options(parser)
-    parser.add_argument(
-        "--chunk-samples", action=_ChunkSamples, type=count("samples"), default=1 << 20, metavar="N"
-    )
+    option("--chunk-samples", type=count("samples"), default=1 << 20, metavar="N")
     option("--overwrite", action="store_true")
 
 

@@ -22,6 +22,7 @@ from pathlib import Path
 from ecofmaps._interrupts import check_interrupted
 
 __all__ = [
+    "CHUNK_BYTES",
     "MANIFEST",
     "TEMPORARY_NAME",
     "FileLineError",
@@ -32,6 +33,10 @@ __all__ = [
     "write_text",
     "written_by_ecofmaps",
 ]
+
+#: The most bytes of one chunk of a zarr or HDF5 variable: HDF5 keeps a chunk this size in
+#: its cache (1 MiB per variable by default), so reads of parts of a chunk read it once.
+CHUNK_BYTES = 1 << 20
 
 #: Names of the temporary files :func:`atomic_path` writes (left behind only by a crash).
 TEMPORARY_NAME = re.compile(r"^\..+\.[0-9a-f]{32}\.tmp$")

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps import _nomenclature as nomenclature
-from ecofmaps.io.files import atomic_store
+from ecofmaps.io.files import CHUNK_BYTES, atomic_store
 from ecofmaps.io.recordings import recording_blocks
 
 __all__ = ["WRITE_FORMATS", "RecordingWriter", "convert_recording"]
@@ -37,10 +37,6 @@ ATTRS = {role: nomenclature.attrs(role) for role in ("displacement", "force", "c
 
 #: The TDMS group that holds the channels written.
 TDMS_GROUP = "recording"
-
-#: The most bytes of one chunk of a zarr or HDF5 variable: HDF5 keeps a chunk this size in
-#: its cache (1 MiB per variable by default), so reads of parts of a chunk read it once.
-CHUNK_BYTES = 1 << 20
 
 
 class RecordingWriter:
