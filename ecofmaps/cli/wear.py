@@ -180,7 +180,10 @@ def run(args) -> int:
             print(f"campaign: no transition to gross slip: {error}")
         else:
             print_rows("campaign: transition to gross slip", transition_rows(found))
-            table.append({"test": "campaign"} | _columns(found, _TRANSITION, "transition_{}"))
+            table.append(
+                {"test": "campaign", "profile": "", "sliding_condition": ""}
+                | _columns(found, _TRANSITION, "transition_{}")
+            )
     if args.out is not None:
         write_text(args.out, csv_text(pd.DataFrame(table)))
         record_written([args.out])

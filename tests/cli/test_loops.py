@@ -390,4 +390,5 @@ def test_a_sweep_prints_its_transition(tmp_path, capsys, rig):
         assert float(amplitude) > 1.1 * at * 1e6 and contact.startswith("needs --rig-stiffness")
         return
     assert float(amplitude) == pytest.approx(at * 1e6, rel=0.05)
-    assert float(contact.split()[0]) == pytest.approx(6.0, rel=0.1)
+    contact_at = float(amplitude) - float(mu) * LOAD / 35e6 * 1e6  # δ_t = Δ_t - μ_t P/S
+    assert float(contact.split()[0]) == pytest.approx(contact_at, rel=1e-5)
