@@ -2,6 +2,7 @@
 
 import io
 import re
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -304,7 +305,6 @@ def test_a_latin1_export_warns_in_one_line_of_the_command(tmp_path, capsys, reco
 def test_the_summary_reads_the_gross_slip_cycles_only():
     """The summary line's medians and first and last ECoF are over the cycles in gross
     slip (its regime code), with the cycles without a value left out."""
-    from pathlib import Path
 
     from ecofmaps.cli.loops import _summary
     from ecofmaps.model.regimes import GROSS_SLIP, PARTIAL_SLIP
@@ -392,3 +392,5 @@ def test_a_sweep_prints_its_transition(tmp_path, capsys, rig):
     assert float(amplitude) == pytest.approx(at * 1e6, rel=0.05)
     contact_at = float(amplitude) - float(mu) * LOAD / 35e6 * 1e6  # δ_t = Δ_t - μ_t P/S
     assert float(contact.split()[0]) == pytest.approx(contact_at, rel=1e-5)
+    docs = (Path(__file__).parents[2] / "docs" / "lab.md").read_text()
+    assert "".join(f"    {line.strip()}\n" for line in err.splitlines()[-2:]) in docs
