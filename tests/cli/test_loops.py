@@ -305,7 +305,6 @@ def test_a_latin1_export_warns_in_one_line_of_the_command(tmp_path, capsys, reco
 def test_the_summary_reads_the_gross_slip_cycles_only():
     """The summary line's medians and first and last ECoF are over the cycles in gross
     slip (its regime code), with the cycles without a value left out."""
-
     from ecofmaps.cli.loops import _summary
     from ecofmaps.model.regimes import GROSS_SLIP, PARTIAL_SLIP
 
