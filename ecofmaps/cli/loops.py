@@ -53,7 +53,8 @@ _HELP = {
     "--flip-force": "read the force with the other sign (a rig recording it positive against "
     "the displacement: its loops run anticlockwise)",
     "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m (the loops' stick slope is the rig "
-    "and the contact in series): the ratios also on the contact's displacement, the regime there",
+    "and the contact in series): the ratios also on the contact's displacement, the regime there, "
+    "a sweep's δ_t",
     "--nan-policy": "a cycle with a missing sample (NaN or an empty cell) is skipped and counted "
     "(skip, the default), or any missing sample stops the command naming its line",
     "--workers": "analyse out of core on a local dask cluster of N processes",
@@ -201,8 +202,9 @@ def _with_assumptions(message: str, recording) -> str:
     return message if not said else f"{message} Here {'; '.join(said)}."
 
 
-#: The variables of a recording's results that its summary line reads (:func:`_summary`):
-#: all that is kept of a long recording's results once their lines are written.
+#: The variables of a recording's results that its summary lines read (:func:`_summary`,
+#: :func:`_lab_lines`): all that is kept of a long recording's results once their lines are
+#: written.
 SUMMARY_VARIABLES = (
     *("regime", "gicof", "mu_resolved", "ecof", "quality", "amplitude"),
     *("max_force", "dissipated_energy", "normal_load"),
