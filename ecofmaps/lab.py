@@ -195,7 +195,7 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     ------
     ValueError
         When the cycles never cross the transition (all in partial slip, or all in gross
-        slip), naming the amplitudes they span.
+        slip), naming the amplitudes they span, or are all at one amplitude.
 
     Notes
     -----
@@ -244,6 +244,13 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
             f"ratio {bound} {MINDLIN_ENERGY_RATIO}, amplitudes {amplitude.min() * 1e6:.4g} to "
             f"{amplitude.max() * 1e6:.4g} µm); test {other} amplitudes"
         )
+    level = np.concatenate([[0], np.cumsum(np.diff(amplitude) > _SAME_AMPLITUDE * amplitude[1:])])
+    if not level[-1]:
+        raise ValueError(
+            f"results: every cycle is at one amplitude ({amplitude.mean() * 1e6:.4g} µm): the "
+            "regime changes during the test, not across amplitudes; a transition needs a sweep "
+            "or tests at several amplitudes"
+        )
     # the split with the fewest cycles on the wrong side (noise may mix a few)
     wrong = np.cumsum(gross)[:-1] + np.cumsum((~gross)[::-1])[::-1][1:]
     split = int(np.argmin(wrong)) + 1
@@ -252,7 +259,6 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
             "results: the cycles in gross slip are at smaller amplitudes than those in partial "
             "slip: not a transition (is the rig's stiffness right?)"
         )
-    level = np.concatenate([[0], np.cumsum(np.diff(amplitude) > _SAME_AMPLITUDE * amplitude[1:])])
     low, high = level[split - 1], level[split]
     if low == high:  # the split falls among the cycles at one amplitude: the next ones too
         low, high = low - 1, high + 1

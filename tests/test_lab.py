@@ -112,6 +112,14 @@ def test_a_campaign_that_never_crosses_is_an_error():
         ecofmaps.transition(tests, rig_stiffness=stiffness)
 
 
+def test_a_regime_that_changes_at_one_amplitude_is_no_transition():
+    """A test whose friction runs in at one amplitude: partial slip, then gross slip."""
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, 35e6)
+    tests = [_analysed([1.1 * at] * 3, 35e6, mu=mu) for mu in (1.2, MU)]
+    with pytest.raises(ValueError, match=r"every cycle is at one amplitude \(17\.9"):
+        ecofmaps.transition(tests, rig_stiffness=35e6)
+
+
 # --- energy wear ---------------------------------------------------------------------------
 
 

@@ -53,7 +53,8 @@ _HELP = {
     "--flip-force": "read the force with the other sign (a rig recording it positive against "
     "the displacement: its loops run anticlockwise)",
     "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m (the loops' stick slope is the rig "
-    "and the contact in series): the ratios also on the contact's displacement, the regime there",
+    "and the contact in series): the ratios also on the contact's displacement, the regime there, "
+    "a sweep's δ_t",
     "--nan-policy": "a cycle with a missing sample (NaN or an empty cell) is skipped and counted "
     "(skip, the default), or any missing sample stops the command naming its line",
     "--workers": "analyse out of core on a local dask cluster of N processes",
@@ -201,9 +202,13 @@ def _with_assumptions(message: str, recording) -> str:
     return message if not said else f"{message} Here {'; '.join(said)}."
 
 
-#: The variables of a recording's results that its summary line reads (:func:`_summary`):
-#: all that is kept of a long recording's results once their lines are written.
-SUMMARY_VARIABLES = ("regime", "gicof", "mu_resolved", "ecof", "quality", "amplitude")
+#: The variables of a recording's results that its summary lines read (:func:`_summary`,
+#: :func:`_lab_lines`): all that is kept of a long recording's results once their lines are
+#: written.
+SUMMARY_VARIABLES = (
+    *("regime", "gicof", "mu_resolved", "ecof", "quality", "amplitude"),
+    *("max_force", "dissipated_energy", "normal_load"),
+)
 
 
 class _Table:
@@ -254,6 +259,26 @@ def _summary(path, results, recording) -> str:
     if (ecof := gross.ecof.dropna("cycle")).size:
         summary += f"; ECoF {float(ecof[0]):.4f} (first) to {float(ecof[-1]):.4f} (last)"
     return summary
+
+
+def _lab_lines(results, rig_stiffness) -> list[str]:
+    """ΣE_d over a recording's cycles and, when it crosses one (a sweep), its transition to
+    gross slip (docs/lab.md)."""
+    from ecofmaps.cli.wear import plus_minus, transition_rows
+    from ecofmaps.lab import cycle_sum, transition
+
+    cycle = results["cycle"].values.astype(np.float64)
+    try:
+        energy = plus_minus("cumulated_energy", *cycle_sum(cycle, results.dissipated_energy.values))
+        lines = [f"ΣE_d = {energy} over cycles 1 to {cycle[-1]:.0f}"]
+    except ValueError as error:
+        lines = [f"ΣE_d: {error}"]
+    try:
+        found = transition(results, rig_stiffness=rig_stiffness)
+    except ValueError:  # never crosses: nothing to say
+        return lines
+    shown = ", ".join(f"{symbol} = {value}" for _, symbol, value in transition_rows(found))
+    return [*lines, f"transition to gross slip: {shown}"]
 
 
 def _checked_inputs(args) -> tuple[list[Path], float]:
@@ -405,12 +430,16 @@ def run(args) -> int:
         sys.stdout.write(stream.getvalue())
         for each in done:
             print(_summary(each.path, each.results, each.recording).strip(), file=sys.stderr)
+            for line in _lab_lines(each.results, args.rig_stiffness):
+                print(f"  {line}", file=sys.stderr)
         return status
     long_run.finish()
     written = sum(each.results.cycle.size for each in done)
     print(f"wrote {args.out}: {written} cycle{'' if written == 1 else 's'}")
     for each in done:
         print(_summary(each.path, each.results, each.recording))
+        for line in _lab_lines(each.results, args.rig_stiffness):
+            print(f"    {line}")
     if failed:
         print(f"  not analysed ({len(failed)}): " + ", ".join(str(path) for path in failed))
     extras = (("the loops read along the stroke", args.resolved), ("the report", args.report))

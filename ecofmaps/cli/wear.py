@@ -1,7 +1,7 @@
 """``ecofmaps wear``: energy wear of fretting tests from their results tables (``ecofmaps
 loops --out``) and scar profiles: ΣE_d, the wear volume of a line contact, α and Archard's k
-with the sliding condition; over three tests or more, α and E_th (:func:`ecofmaps.energy_wear`,
-docs/lab.md)."""
+with the sliding condition; over three tests or more, α and E_th (:func:`ecofmaps.energy_wear`)
+and the transition to gross slip if they span it (:func:`ecofmaps.transition`, docs/lab.md)."""
 
 from __future__ import annotations
 
@@ -9,6 +9,8 @@ import argparse
 import sys
 import warnings
 from pathlib import Path
+
+import numpy as np
 
 from ecofmaps.cli._common import (
     CommandError,
@@ -30,6 +32,13 @@ _WEAR = (
     "energy_wear_coefficient",
     "archard_slip",
     "archard_nominal",
+)
+
+#: The transition's numbers (of quantities ``transition_<name>``), in the order printed.
+_TRANSITION = ("amplitude", "contact_amplitude", "mu")
+_NEEDS_RIG = (
+    "needs --rig-stiffness (the rig's own; without it Δ_t is read on the applied displacement, "
+    "and lands high)"
 )
 
 _HELP = {
@@ -62,8 +71,9 @@ def add(subparsers) -> None:
         "scar's worn area times --length, the pile-up apart), α = V/ΣE_d and Archard's k on the "
         "slip and on the applied amplitude, each with its standard error, and the sliding "
         "condition; over three tests or more, α and the threshold energy E_th of V = α(ΣE_d - "
-        "E_th). One --profile per test, in the order of the tests (a table of several recordings "
-        "holds several tests).",
+        "E_th), and the transition to gross slip Δ_t, δ_t and μ_t when they span it (a last row "
+        "'campaign' of --out). One --profile per test, in the order of the tests (a table of "
+        "several recordings holds several tests).",
     )
     option = option_adder(parser, _HELP)
     option("tables", nargs="+", metavar="TABLE")
@@ -92,22 +102,48 @@ def _profile(args, path):
     return profile
 
 
-def _rows(wear, names) -> list:
-    """The printed rows of ``names``, each value ± its standard error."""
+def plus_minus(name: str, value: float, se: float) -> str:
+    """``value ± se`` of quantity ``name`` [SI], each in its display unit (:func:`row`)."""
+    return f"{row(name, value)[2]} ± {row(name, se)[2]}"
+
+
+def _rows(found, names, quantity="{}") -> list:
+    """The printed rows of ``names`` (of ``quantity``), each value ± its standard error."""
     rows = []
     for name in names:
-        words, symbol, value = row(name, float(wear[name]))
-        rows.append((words, symbol, f"{value} ± {row(name, float(wear[f'{name}_se']))[2]}"))
+        q = quantity.format(name)
+        rows.append(row(q, plus_minus(q, float(found[name]), float(found[f"{name}_se"]))))
     return rows
+
+
+def transition_rows(found) -> list:
+    """The printed rows of :func:`ecofmaps.transition`'s ``found``: Δ_t, δ_t and μ_t."""
+    rows = _rows(found, _TRANSITION, "transition_{}")
+    if np.isnan(float(found.contact_amplitude)):
+        rows[1] = (*rows[1][:2], _NEEDS_RIG)
+    return rows
+
+
+def _columns(found, names, quantity="{}") -> dict:
+    """The written columns of ``names`` (of ``quantity``) and their standard errors, in the
+    display units, ASCII."""
+    from ecofmaps._nomenclature import QUANTITIES, column
+
+    line = {}
+    for name in names:
+        q = quantity.format(name)
+        label = column(q).replace("³", "3").replace("·", "").replace("(", "").replace(")", "")
+        for key, v in ((label, name), (label.replace(q, f"{q}_se"), f"{name}_se")):
+            line[key] = float(found[v]) * QUANTITIES[q].display_factor
+    return line
 
 
 def run(args) -> int:
     """Run ``ecofmaps wear`` with the parsed ``args``; the exit status."""
     import pandas as pd
 
-    from ecofmaps._nomenclature import QUANTITIES, column
     from ecofmaps.io.tables import csv_text, read_results
-    from ecofmaps.lab import energy_wear, sliding_condition
+    from ecofmaps.lab import energy_wear, sliding_condition, transition
 
     if args.out is not None and not Path(args.out).parent.is_dir():
         raise CommandError(f"cannot write {args.out}: its directory does not exist")
@@ -133,15 +169,21 @@ def run(args) -> int:
         slip = condition.attrs["sliding_condition"]
         print_rows(f"{name} (scar profile {path}, {slip})", _rows(wear, _WEAR))
         line = {"test": str(name), "profile": str(path), "sliding_condition": str(slip)}
-        for q in _WEAR:  # in the display units, ASCII
-            label = column(q).replace("³", "3").replace("·", "").replace("(", "").replace(")", "")
-            for key, v in ((label, q), (label.replace(q, f"{q}_se"), f"{q}_se")):
-                line[key] = float(wear[v]) * QUANTITIES[q].display_factor
-        table.append(line)
+        table.append(line | _columns(wear, _WEAR))
     if len(tests) > 2:
         fit = energy_wear([r for _, r in tests], profiles, length=args.length)
         names = ("campaign_energy_wear_coefficient", "threshold_energy")
         print_rows("campaign: V = α(ΣE_d - E_th)", _rows(fit, names))
+        try:
+            found = transition([r for _, r in tests], rig_stiffness=args.rig_stiffness)
+        except ValueError as error:
+            print(f"campaign: no transition to gross slip: {error}")
+        else:
+            print_rows("campaign: transition to gross slip", transition_rows(found))
+            table.append(
+                {"test": "campaign", "profile": "", "sliding_condition": ""}
+                | _columns(found, _TRANSITION, "transition_{}")
+            )
     if args.out is not None:
         write_text(args.out, csv_text(pd.DataFrame(table)))
         record_written([args.out])

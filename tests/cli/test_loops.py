@@ -1,6 +1,8 @@
 """Recording files and ``ecofmaps loops``: formats, columns, units, damaged files, output."""
 
 import io
+import re
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -123,6 +125,14 @@ def test_example(tmp_path, capsys):
     )
     assert abs(last / final - 1) < 0.005
     assert example_path().is_file()
+    # a constant amplitude: ΣE_d added under the summary, nothing about a transition
+    lines = stdout.splitlines()
+    assert len(lines) == 3 and lines[1].startswith("  synthetic_fretting_test.csv: 150 cycles")
+    energy = float(re.fullmatch(r"    ΣE_d = (\S+) J ± \S+ J over cycles 1 to 300000", lines[2])[1])
+    every = np.interp(
+        np.arange(1, table.cycle.iloc[-1] + 1), table.cycle, table.dissipated_energy_mJ
+    )
+    assert energy == pytest.approx(every.sum() * 1e-3, rel=1e-5)
 
 
 def test_damaged_file_writes_nothing(tmp_path, capsys, recording):
@@ -295,8 +305,6 @@ def test_a_latin1_export_warns_in_one_line_of_the_command(tmp_path, capsys, reco
 def test_the_summary_reads_the_gross_slip_cycles_only():
     """The summary line's medians and first and last ECoF are over the cycles in gross
     slip (its regime code), with the cycles without a value left out."""
-    from pathlib import Path
-
     from ecofmaps.cli.loops import _summary
     from ecofmaps.model.regimes import GROSS_SLIP, PARTIAL_SLIP
 
@@ -354,3 +362,34 @@ def test_rig_stiffness_reads_the_regime_on_the_contact(tmp_path, capsys):
     assert (table.contact_energy_ratio > 0.2).all()
     status, _, err = run(capsys, path, "--load", "450N", "--rig-stiffness", "-1MN/m")
     assert status != 0 and "rig_stiffness" in err.replace("-", "_") and "Traceback" not in err
+
+
+@pytest.mark.parametrize("rig", [None, 35e6])
+def test_a_sweep_prints_its_transition(tmp_path, capsys, rig):
+    """The Mindlin oracle swept from 0.45 to 1.8 Δ_t, two cycles at each amplitude, as a CSV
+    file: the summary gives Δ_t within 5 % and μ_t within 3 % with the rig's stiffness; δ_t
+    needs it. Without it Δ_t is read on the applied displacement, and lands high."""
+    from tests import mindlin
+
+    at = mindlin.transition_amplitude(0.8, LOAD, 6e-6, 35e6)
+    applied = mindlin.sweep(np.repeat(np.linspace(0.45, 1.8, 20) * at, 2), 200)
+    _, force = mindlin.drive(mindlin.Contact(0.8, LOAD, 6e-6), applied, 35e6)
+    path = write_csv(tmp_path / "sweep.csv", applied, force)
+    options = [] if rig is None else ["--rig-stiffness", "35MN/m"]
+    status, _, err = run(capsys, path, "--load", "450N", "--no-resolve", *options)
+    assert status == 0, err
+    found = re.search(
+        r"\n  transition to gross slip: Δ_t = (\S+) µm ± \S+ µm, δ_t = (.+), "
+        r"μ_t = Q\*/P = (\S+) ± ",
+        err,
+    )
+    amplitude, contact, mu = found.groups()
+    assert float(mu) == pytest.approx(0.8, rel=0.03)
+    if rig is None:
+        assert float(amplitude) > 1.1 * at * 1e6 and contact.startswith("needs --rig-stiffness")
+        return
+    assert float(amplitude) == pytest.approx(at * 1e6, rel=0.05)
+    contact_at = float(amplitude) - float(mu) * LOAD / 35e6 * 1e6  # δ_t = Δ_t - μ_t P/S
+    assert float(contact.split()[0]) == pytest.approx(contact_at, rel=1e-5)
+    docs = (Path(__file__).parents[2] / "docs" / "lab.md").read_text()
+    assert "".join(f"    {line.strip()}\n" for line in err.splitlines()[-2:]) in docs

@@ -26,9 +26,10 @@ def long_test(tmp_path_factory):
 
 
 def in_memory_table(capsys, path, tmp_path):
-    status, _, err = run(capsys, path, "--load", "450N", "--out", tmp_path / "memory.csv")
+    """The table of ``path`` analysed in memory, and the summary printed under 'wrote'."""
+    status, printed, err = run(capsys, path, "--load", "450N", "--out", tmp_path / "memory.csv")
     assert status == 0, err
-    return (tmp_path / "memory.csv").read_text()
+    return (tmp_path / "memory.csv").read_text(), printed.splitlines()[1:]
 
 
 def test_missing_cells_are_skipped_and_named(tmp_path, capsys):
@@ -55,12 +56,13 @@ def test_missing_cells_are_skipped_and_named(tmp_path, capsys):
 
 @pytest.mark.parametrize("suffix", [".zarr", ".tdms"])
 def test_out_of_core_gives_the_table_in_memory(long_test, tmp_path, capsys, small_tasks, suffix):
-    expected = in_memory_table(capsys, long_test[suffix], tmp_path)
+    expected, summary = in_memory_table(capsys, long_test[suffix], tmp_path)
     out = tmp_path / "long.csv"
     status, printed, err = run(capsys, long_test[suffix], "--load", "450N", "--out", out,
                                "--resume")  # fmt: skip
     assert status == 0, err
     assert out.read_text() == expected
+    assert printed.splitlines()[1:] == summary and "ΣE_d = " in summary[1]
     assert "wrote" in printed and not (tmp_path / "long.csv.partial").exists()
     assert err == ""  # not a terminal: no progress bar
 
@@ -79,7 +81,7 @@ def test_several_files_out_of_core(long_test, tmp_path, capsys, small_tasks):
 
 @pytest.mark.slow
 def test_two_worker_processes(long_test, tmp_path, capsys):
-    expected = in_memory_table(capsys, long_test[".tdms"], tmp_path)
+    expected, _ = in_memory_table(capsys, long_test[".tdms"], tmp_path)
     out = tmp_path / "workers.csv"
     status, _, err = run(capsys, long_test[".tdms"], "--load", "450N", "--out", out,
                          "--workers", "2")  # fmt: skip
@@ -107,7 +109,7 @@ def test_an_interrupted_run_resumes(
     """Ctrl-C after two blocks have come back: nothing at --out, the blocks done kept (two,
     or more that were running) and counted; a rerun must say --resume; with it, the table
     of an uninterrupted run."""
-    expected = in_memory_table(capsys, long_test[".zarr"], tmp_path)
+    expected, _ = in_memory_table(capsys, long_test[".zarr"], tmp_path)
     out = tmp_path / "r.csv"
 
     def interrupting(received):
@@ -201,7 +203,7 @@ def test_a_kept_block_that_fails_its_check_is_measured_again(
     """Each kept block is checked against the checksum and the cycle rows the run recorded
     of it: one re-saved with its values doubled, two swapped, one added are each measured
     again, with a line that names it, and the table is right."""
-    expected = in_memory_table(capsys, long_test[".zarr"], tmp_path)
+    expected, _ = in_memory_table(capsys, long_test[".zarr"], tmp_path)
     out = tmp_path / "r.csv"
     interrupted(capsys, on_each_block, long_test[".zarr"], out)
     partial = tmp_path / "r.csv.partial"
@@ -219,7 +221,7 @@ def test_the_table_is_written_as_the_blocks_come(long_test, tmp_path, capsys, sm
                                                  on_each_block):  # fmt: skip
     """Each block's lines are in the temporary file beside --out (in order, after the header)
     once the block has come back, not held to the end; the file lands whole."""
-    expected = in_memory_table(capsys, long_test[".zarr"], tmp_path)
+    expected, _ = in_memory_table(capsys, long_test[".zarr"], tmp_path)
     out = tmp_path / "r.csv"
     seen = []
 

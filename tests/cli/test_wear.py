@@ -2,11 +2,13 @@
 profiles as labs have them, against the closed forms of the Mindlin oracle."""
 
 import re
+import warnings
 
 import numpy as np
 import pandas as pd
 import pytest
 
+import ecofmaps
 from ecofmaps.cli.main import main
 from ecofmaps.io.tables import results_csv
 from tests import mindlin
@@ -53,6 +55,7 @@ def test_wear_of_a_campaign_on_files(campaign, capsys):
     np.testing.assert_allclose(table.cumulated_energy_J, energy, rtol=0.03)
     np.testing.assert_allclose(table.wear_volume_mm3 * 1e-9, volume, rtol=0.03)
     assert (table.sliding_condition == "gross slip").all()
+    assert "campaign: no transition to gross slip: results never cross" in text
     again = run(capsys, *tables, *profiles, "--length", "5mm", "--out", out)
     assert again[0] == 2 and "--overwrite" in again[2]
 
@@ -98,3 +101,31 @@ def test_a_netcdf_table_reads_as_its_csv(campaign, capsys, tmp_path):
     values = [[float(v) for v in re.findall(r"  ([\d.e+-]+) \S+ ±", out)] for _, out, _ in outputs]
     assert len(values[0]) == 5
     np.testing.assert_allclose(values[0], values[1], rtol=1e-5)  # the table's 6 digits
+
+
+def test_a_campaign_across_the_transition(tmp_path, capsys):
+    """Four tests from 0.7 to 1.4 Δ_t: Δ_t, δ_t and μ_t printed and in a last row of --out."""
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, STIFFNESS)
+    tables, profiles = [], []
+    for i, factor in enumerate((0.7, 0.9, 1.1, 1.4)):
+        applied = mindlin.sweep([factor * at] * 3)
+        _, force = mindlin.drive(mindlin.Contact(MU, LOAD, DELTA_T), applied, STIFFNESS)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # a sphere's stick is curved
+            results = ecofmaps.analyze_loops(applied, force, LOAD)
+        (tmp_path / f"test{i}.csv").write_text(results_csv(results))
+        x, z, _ = mindlin.grown_groove(1e4, ALPHA, LENGTH, HALF_WIDTH, noise=10e-9, seed=i)
+        pd.DataFrame({"x_um": x * 1e6, "z_um": z * 1e6}).to_csv(tmp_path / f"scar{i}.csv")
+        tables.append(tmp_path / f"test{i}.csv")
+        profiles += ["--profile", tmp_path / f"scar{i}.csv"]
+    out = tmp_path / "wear.csv"
+    status, text, err = run(capsys, *tables, *profiles, "--length", "5mm", "--rig-stiffness",
+                            "35MN/m", "--out", out)  # fmt: skip
+    assert status == 0, err
+    assert "campaign: transition to gross slip" in text
+    campaign = pd.read_csv(out).set_index("test").loc["campaign"]
+    assert campaign.transition_amplitude_um == pytest.approx(at * 1e6, rel=0.05)
+    assert campaign.transition_mu == pytest.approx(MU, rel=0.03)
+    contact = campaign.transition_amplitude_um - campaign.transition_mu * LOAD / STIFFNESS * 1e6
+    assert campaign.transition_contact_amplitude_um == pytest.approx(contact, rel=1e-4)
+    assert campaign.transition_amplitude_se_um > 0
