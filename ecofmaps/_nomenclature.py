@@ -28,6 +28,7 @@ __all__ = [
     "axis_label",
     "column",
     "display",
+    "with_se",
     "within",
 ]
 
@@ -232,6 +233,25 @@ def column(name: str) -> str:
 def display(name: str, value) -> np.ndarray:
     """``value`` [SI] of quantity ``name`` in its display unit."""
     return np.asarray(value) * QUANTITIES[name].display_factor
+
+
+def with_se(name: str, value: float, se: float) -> str:
+    """``value ± se`` of quantity ``name`` [SI] in its display unit, as a measurement is written:
+    the standard error to two significant digits and the value to the same decimal place (to
+    four significant digits where the error is zero or unknown).
+
+    >>> with_se("transition_amplitude", 16.1959e-6, 0.347947e-6), with_se("mu", 0.8, 0.0)
+    ('16.20 ± 0.35 µm', '0.8000 ± 0')
+    """
+    quantity = QUANTITIES[name]
+    value, se = value * quantity.display_factor, se * quantity.display_factor
+    if np.isfinite(se) and se > 0:
+        decimals = max(0, 1 - math.floor(math.log10(se)))
+        shown = f"{value:.{decimals}f} ± {se:.{decimals}f}"
+    else:
+        shown = np.format_float_positional(value, 4, unique=False, fractional=False, trim="k")
+        shown = shown.rstrip(".") + (" ± 0" if se == 0 else "")
+    return f"{shown} {quantity.display_unit}".rstrip()
 
 
 def within(name: str, value, rule: str | None = None):

@@ -264,12 +264,13 @@ def _summary(path, results, recording) -> str:
 def _lab_lines(results, rig_stiffness) -> list[str]:
     """ΣE_d over a recording's cycles and, when it crosses one (a sweep), its transition to
     gross slip (docs/lab.md)."""
-    from ecofmaps.cli.wear import plus_minus, transition_rows
+    from ecofmaps._nomenclature import with_se
+    from ecofmaps.cli.wear import transition_rows
     from ecofmaps.lab import cycle_sum, transition
 
     cycle = results["cycle"].values.astype(np.float64)
     try:
-        energy = plus_minus("cumulated_energy", *cycle_sum(cycle, results.dissipated_energy.values))
+        energy = with_se("cumulated_energy", *cycle_sum(cycle, results.dissipated_energy.values))
         lines = [f"ΣE_d = {energy} over cycles 1 to {cycle[-1]:.0f}"]
     except ValueError as error:
         lines = [f"ΣE_d: {error}"]

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ecofmaps._nomenclature import with_se
 from ecofmaps.cli._common import (
     CommandError,
     option_adder,
@@ -102,17 +103,12 @@ def _profile(args, path):
     return profile
 
 
-def plus_minus(name: str, value: float, se: float) -> str:
-    """``value ± se`` of quantity ``name`` [SI], each in its display unit (:func:`row`)."""
-    return f"{row(name, value)[2]} ± {row(name, se)[2]}"
-
-
 def _rows(found, names, quantity="{}") -> list:
     """The printed rows of ``names`` (of ``quantity``), each value ± its standard error."""
     rows = []
     for name in names:
         q = quantity.format(name)
-        rows.append(row(q, plus_minus(q, float(found[name]), float(found[f"{name}_se"]))))
+        rows.append(row(q, with_se(q, float(found[name]), float(found[f"{name}_se"]))))
     return rows
 
 

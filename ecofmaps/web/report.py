@@ -35,7 +35,7 @@ from bokeh.palettes import Category10_10
 from bokeh.plotting import figure
 from bokeh.resources import INLINE
 
-from ecofmaps._nomenclature import QUANTITIES
+from ecofmaps._nomenclature import QUANTITIES, with_se
 from ecofmaps._version import __version__
 from ecofmaps.io.files import atomic_path
 from ecofmaps.io.tables import results_table
@@ -250,28 +250,14 @@ def _header(results: xr.Dataset, inputs: Mapping) -> Div:
     )
 
 
-def _with_se(name: str, value: float, se: float) -> tuple[str, str]:
-    """Quantity ``name``'s long name, and ``value ± se`` in its display unit: 4 significant
-    digits, the standard error 2, never in powers of ten."""
-    quantity = QUANTITIES[name]
-    value, se = (
-        np.format_float_positional(
-            number * quantity.display_factor, digits, unique=False, fractional=False, trim=trim
-        )
-        for number, digits, trim in ((value, 4, "k"), (se, 2, "-"))
-    )
-    shown = value.rstrip(".") + ("" if se == "nan" else f" ± {se}")
-    return quantity.long_name, f"{shown} {quantity.display_unit}".rstrip()
-
-
 def _lab_numbers(results: xr.Dataset) -> Div:
     """The test's cumulated dissipated energy, and its transition if it crosses one."""
     cycle = results["cycle"].values.astype(np.float64)
     try:
-        words, energy = _with_se(
-            "cumulated_energy", *cycle_sum(cycle, results["dissipated_energy"].values)
-        )
-        rows = {words: f"{energy} over cycles 1 to {cycle[-1]:.0f}"}
+        energy = with_se("cumulated_energy", *cycle_sum(cycle, results["dissipated_energy"].values))
+        rows = {
+            QUANTITIES["cumulated_energy"].long_name: f"{energy} over cycles 1 to {cycle[-1]:.0f}"
+        }
     except ValueError as error:
         rows = {QUANTITIES["cumulated_energy"].long_name: str(error)}
     try:
@@ -280,8 +266,9 @@ def _lab_numbers(results: xr.Dataset) -> Div:
         rows["transition to gross slip"] = f"none: {error}"
     else:
         for name in ("amplitude", "contact_amplitude", "mu"):
-            values = (float(found[n]) for n in (name, f"{name}_se"))
-            words, shown = _with_se(f"transition_{name}", *values)
+            quantity = f"transition_{name}"
+            shown = with_se(quantity, *(float(found[n]) for n in (name, f"{name}_se")))
+            words = QUANTITIES[quantity].long_name
             unknown = (
                 "unknown without the rig's own stiffness (--rig-stiffness), without which Δ_t "
                 "is read on the applied displacement, and lands high"

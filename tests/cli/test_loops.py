@@ -128,7 +128,7 @@ def test_example(tmp_path, capsys):
     # a constant amplitude: ΣE_d added under the summary, nothing about a transition
     lines = stdout.splitlines()
     assert len(lines) == 3 and lines[1].startswith("  synthetic_fretting_test.csv: 150 cycles")
-    energy = float(re.fullmatch(r"    ΣE_d = (\S+) J ± \S+ J over cycles 1 to 300000", lines[2])[1])
+    energy = float(re.fullmatch(r"    ΣE_d = (\S+) ± \S+ J over cycles 1 to 300000", lines[2])[1])
     every = np.interp(
         np.arange(1, table.cycle.iloc[-1] + 1), table.cycle, table.dissipated_energy_mJ
     )
@@ -379,8 +379,8 @@ def test_a_sweep_prints_its_transition(tmp_path, capsys, rig):
     status, _, err = run(capsys, path, "--load", "450N", "--no-resolve", *options)
     assert status == 0, err
     found = re.search(
-        r"\n  transition to gross slip: Δ_t = (\S+) µm ± \S+ µm, δ_t = (.+), "
-        r"μ_t = Q\*/P = (\S+) ± ",
+        r"\n  transition to gross slip: Δ_t = (\S+) ± \S+ µm, δ_t = (.+), "
+        r"μ_t = Q\*/P = (\S+)",
         err,
     )
     amplitude, contact, mu = found.groups()
@@ -390,6 +390,6 @@ def test_a_sweep_prints_its_transition(tmp_path, capsys, rig):
         return
     assert float(amplitude) == pytest.approx(at * 1e6, rel=0.05)
     contact_at = float(amplitude) - float(mu) * LOAD / 35e6 * 1e6  # δ_t = Δ_t - μ_t P/S
-    assert float(contact.split()[0]) == pytest.approx(contact_at, rel=1e-5)
+    assert float(contact.split()[0]) == pytest.approx(contact_at, abs=0.01)  # printed to 0.01
     docs = (Path(__file__).parents[2] / "docs" / "lab.md").read_text()
     assert "".join(f"    {line.strip()}\n" for line in err.splitlines()[-2:]) in docs
