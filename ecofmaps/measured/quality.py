@@ -277,14 +277,12 @@ class LoopQualityWarning(UserWarning):
 
 
 class ImplausibleScaleWarning(LoopQualityWarning):
-    """Cycles whose amplitude or coefficient of friction is outside what a unit or a load
-    makes plausible (``implausible-amplitude``, ``implausible-cof``): a
-    :class:`LoopQualityWarning` that ``warnings.filterwarnings`` can turn alone into errors."""
+    """Cycles of an implausible amplitude or coefficient of friction (a wrong unit or load):
+    a :class:`LoopQualityWarning` that ``warnings.filterwarnings`` can turn alone into errors."""
 
 
 class ImplausibleScaleError(ValueError):
-    """Every cycle refused, some for an amplitude outside what the displacement's unit makes
-    plausible (``implausible-amplitude``): the unit assumed is likely wrong."""
+    """Every cycle refused, some for an implausible amplitude: the unit assumed is wrong."""
 
 
 def _attrs(name: str) -> dict:
@@ -295,8 +293,7 @@ def _attrs(name: str) -> dict:
 
 
 def _refusal_hint(flags: dict) -> str:
-    """What to do about a recording whose every cycle is refused (``flags``: the reasons
-    every cycle carries, ``negative-stiffness`` if any does)."""
+    """What to do about a recording whose every cycle is refused for ``flags``."""
     if flags["anticlockwise"] and flags["negative-stiffness"] and not flags["missing-samples"]:
         return _FLIP_HINT
     return next((hint for reason, hint in _HINTS.items() if flags[reason]), _LAST_HINT)
@@ -311,8 +308,8 @@ def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
 
 
 def regime_ratio(values: dict, rig_stiffness) -> np.ndarray:
-    """The energy ratio that decides each cycle's regime: on the contact's displacement
-    when the rig's stiffness is known, else on the applied one. [1]"""
+    """The energy ratio deciding each cycle's regime: on the contact's displacement if
+    the rig's stiffness is known. [1]"""
     return values["energy_ratio" if rig_stiffness is None else "contact_energy_ratio"]
 
 
@@ -326,9 +323,8 @@ def _outside(value, bounds):
 
 
 def scale_flags(values: dict, options) -> dict:
-    """The checks of scale of each cycle (reason -> per cycle): an amplitude outside
-    :data:`AMPLITUDE_RANGE`, or the ECoF or GICoF of a gross-slip loop outside
-    :data:`COF_RANGE` (not :math:`Q^*/P`, which a deep groove raises above 3)."""
+    """The checks of scale (reason -> per cycle): an amplitude outside :data:`AMPLITUDE_RANGE`,
+    a gross-slip ECoF or GICoF outside :data:`COF_RANGE` (not Q*/P: a deep groove raises it)."""
     scaled = _outside(values["amplitude"], AMPLITUDE_RANGE)
     cof = _outside(values["ecof"], COF_RANGE) | _outside(values["gicof"], COF_RANGE)
     return {
@@ -338,9 +334,8 @@ def scale_flags(values: dict, options) -> dict:
 
 
 def load_flags(missing, mean, lowest, highest) -> dict:
-    """The checks of each cycle's recorded normal load (reason -> per cycle) from its mean,
-    lowest and highest finite value [N]; ``missing`` (``missing-samples``) kept only where
-    the load is positive, the samples where it is not being missing by design."""
+    """The checks of each cycle's recorded load (reason -> per cycle) from its mean, lowest and
+    highest [N]; ``missing`` kept where the load is positive (elsewhere missing by design)."""
     bad = lowest <= 0.0  # and so the mean, if it is not positive
     with np.errstate(divide="ignore", invalid="ignore"):
         swing = (highest - lowest) / mean > LOAD_SWING
@@ -348,9 +343,8 @@ def load_flags(missing, mean, lowest, highest) -> dict:
 
 
 def judged(values: dict, flags: dict, options):
-    """The one judgement of a part's cycles: ``values`` (name -> per cycle, as measured)
-    NaN where a flag's scope reaches, the ``quality`` strings, the cycles refused and the
-    regime codes. ``flags`` (reason -> per cycle) are every check's, the scale's included."""
+    """The one judgement of a part's cycles: ``values`` (name -> per cycle) NaN where a flag
+    (reason -> per cycle) reaches, the ``quality`` strings, the cycles refused and regimes."""
     size = next(iter(flags.values())).size
     refused = _refusing(flags, size)
     recorded = {k: values[k] for k in _RECORDED if k in values}  # a refused cycle's too
@@ -361,8 +355,7 @@ def judged(values: dict, flags: dict, options):
 
 
 def cycle_results(values: dict, flags: dict, label, options) -> xr.Dataset:
-    """The per-cycle Dataset of :func:`analyze_loops` for some cycles, without the
-    recording's attributes: ``values`` and ``flags`` (the scale's included) judged once."""
+    """The per-cycle Dataset of some cycles, ``values`` and ``flags`` judged once."""
     values, quality, _, regime = judged(values, flags, options)
     last = ("stick_residual", *_RECORDED)
     data = {k: ("cycle", v, _attrs(k)) for k, v in values.items() if k not in last}
@@ -374,8 +367,7 @@ def cycle_results(values: dict, flags: dict, label, options) -> xr.Dataset:
 
 
 class Tally:
-    """What :func:`analyze_loops` says about a whole recording, counted from the flags of
-    its parts as they come."""
+    """What :func:`analyze_loops` says about a whole recording, from its parts' flags."""
 
     def __init__(self):
         self.counts = collections.Counter()  # cycles by quality
