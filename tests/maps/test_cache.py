@@ -164,6 +164,7 @@ def test_damaged_metadata_are_reported_removed_and_recomputed(tmp_path):
         path.write_bytes(original)
 
 
+@pytest.mark.slow
 def test_any_flipped_byte_gives_the_map_or_a_warning(tmp_path):
     """Bytes flipped all over the file (headers, indexes, chunks, free space): each read gives
     the map itself, read or recomputed, never other values; in a child process, so that a
@@ -324,6 +325,7 @@ def test_a_folder_where_the_entry_should_be_is_left_alone(tmp_path):
     assert (path / "thesis.txt").read_text() == "chapter 1"
 
 
+@pytest.mark.slow
 def test_a_full_tmpfs_is_one_warning_and_the_command_writes_its_output(tmp_path):
     """A real full disk: the cache on a 64 kB tmpfs with 20 kB free. ``ecofmaps map`` writes
     its output; a cached map and the explorer's start-up, whose writes fail, go on after one
