@@ -245,7 +245,7 @@ def cof_evolution(results: xr.Dataset, *, source: str | None = None) -> Figure:
     else:
         _note(bottom, "no cycle with both an ECoF and a GICoF")
         bottom.set_yticks([])
-    bottom.set(ylabel="ECoF / GICoF − 1 [%]", xlabel="Cycle")
+    bottom.set(ylabel="ECoF / GICoF − 1 [%]", xlabel=axis_label("cycle"))
     bottom.grid(alpha=0.3)
     _cycle_axis(bottom, cycle)
     amplitude = float(results["amplitude"].median()) * MICRO
@@ -415,7 +415,7 @@ def _profile_over_test(figure: Figure, image, resolved: xr.Dataset) -> None:
     labels = resolved["cycle"].values
     xi = resolved["position"].values * MICRO
     profile = resolved["felt_profile"].transpose("cycle", "position").values * MICRO
-    image.set(xlabel=axis_label("position"), ylabel="Cycle")
+    image.set(xlabel=axis_label("position"), ylabel=axis_label("cycle"))
     image.set_title("(c) felt profile over the test", fontsize="medium")
     # One row per cycle, labelled by its number, whether or not any has a profile.
     rows = np.arange(len(labels) + 1) - 0.5
@@ -471,7 +471,7 @@ def _mu_over_test(test, resolved: xr.Dataset, results: xr.Dataset | None) -> tup
         test.set_yticks([])
     if missing.all():  # below the marks, which are at the middle
         _note(test, "no cycle read along the stroke:\n" + _why_none(resolved), height=0.3)
-    test.set(xlabel="Cycle", ylabel="Coefficient of friction [1]")
+    test.set(xlabel=axis_label("cycle"), ylabel="Coefficient of friction [1]")
     twins = ()
     if np.isfinite(resolved["aspect_ratio"].values).any():  # no right-hand axis without a line
         ratio = test.twinx()

@@ -71,7 +71,7 @@ def test_cof_evolution(results):
     excess = bottom.get_lines()[0].get_ydata()
     np.testing.assert_allclose(excess, (results.ecof / results.gicof - 1) * 100)
     assert excess[-1] > 3.0  # z_o/x_o = 0.3 at S = 35 MN/m: μ_E well above μ
-    assert bottom.get_xlabel() == "Cycle" and "[1]" in top.get_ylabel()
+    assert bottom.get_xlabel() == "Cycle number [1]" and "[1]" in top.get_ylabel()
     assert figure.get_suptitle().startswith("The ECoF and the GICoF over the cycles\n")
 
 
@@ -93,7 +93,7 @@ def test_resolved_loops_draws_the_datasets_numbers(results, tmp_path):
     (profile,) = [line for line in felt.get_lines() if line.get_label() == name]
     np.testing.assert_allclose(profile.get_ydata(), last.felt_profile * 1e6)
     assert "[µm]" in stroke.get_xlabel() and "[µm]" in felt.get_ylabel()
-    assert image.get_ylabel() == "Cycle"
+    assert image.get_ylabel() == "Cycle number [1]"
     series = {line.get_label(): line for line in test.get_lines()}
     np.testing.assert_allclose(series["GICoF"].get_ydata(), results.gicof)
     np.testing.assert_allclose(series[r"$\mu$ read along the stroke"].get_ydata(),
