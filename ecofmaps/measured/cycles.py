@@ -280,26 +280,25 @@ def _trigger(samples: Samples, gaps, line, band):
     return starts, kind, extreme, value
 
 
-def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, half_range: float):
+def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
     """The trigger's local half-band ``(width, levels)``, or None where the whole
-    recording's finds every cycle."""
+    recording's finds every cycle: ``hysteresis`` × the least amplitude about ``centre``
+    over three stretches of half a period (one holds a peak of each cycle)."""
     starts, kind, period = runs
+    centre, level = band
     bottoms = starts[kind < 0]
     regular = np.abs(np.diff(bottoms) / period - 1.0) <= _REGULAR
-    if not (np.count_nonzero(regular) >= 4 and regular.mean() >= 0.5):
+    if not (np.count_nonzero(regular) >= 2 and regular.mean() >= 0.5):
         return None
     if np.diff(bottoms, prepend=0, append=samples.size).max() <= 1.5 * period:
         return None
-    width = max(int(period), MIN_SAMPLES)
+    width = max(int(period) // 2, MIN_SAMPLES)
     arguments = (passes._CHUNK, gaps, line, width)
     stretch, highest, lowest = _joined(samples, passes.local_extremes, arguments)
     first = np.flatnonzero(np.diff(stretch, prepend=-1.0))
     highest, lowest = np.fmax.reduceat(highest, first), np.fmin.reduceat(lowest, first)
-    around = [np.pad(v, 1, mode="edge") for v in (highest, lowest)]
-    top = np.fmax(np.fmax(around[0][:-2], around[0][1:-1]), around[0][2:])
-    bottom = np.fmin(np.fmin(around[1][:-2], around[1][1:-1]), around[1][2:])
-    level = hysteresis * half_range
-    local = hysteresis * (0.5 * (top - bottom))
+    amplitude = np.pad(np.fmax(highest - centre, centre - lowest), 1, mode="edge")
+    local = hysteresis * np.fmin(np.fmin(amplitude[:-2], amplitude[1:-1]), amplitude[2:])
     local = np.clip(np.where(np.isnan(local), level, local), _LEAST_LEVEL * level, level)
     if (local >= level).all():
         return None
@@ -349,7 +348,7 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     band = (centre, hysteresis * half_range)
     starts, kind, extreme, value = _trigger(samples, gaps, line, band)
     period = _period(starts, kind)
-    level = _local_level(samples, gaps, line, (starts, kind, period), hysteresis, half_range)
+    level = _local_level(samples, gaps, line, (starts, kind, period), hysteresis, band)
     if level is not None:  # kept if it finds smaller cycles (more bottom runs)
         local = _trigger(samples, gaps, line, (centre, level))
         if np.count_nonzero(local[1] < 0) > np.count_nonzero(kind < 0):
