@@ -238,15 +238,20 @@ def _with_missing(cycles: Cycles, gaps) -> Cycles:
     )
 
 
-def _drive_numbers(cycles: Cycles) -> Cycles:
-    """``cycles`` numbered as the drive made them: a gapped stretch counts its periods."""
-    if cycles.missing is None or cycles.missing.all():
+def _drive_numbers(cycles: Cycles, merged: bool = False) -> Cycles:
+    """``cycles`` numbered as the drive made them: a gapped stretch counts its periods; if
+    ``merged`` (cycles under the local band's floor may join one), so does the stretch
+    between consecutive bottom reversals."""
+    whole = cycles.whole
+    if not whole.any() or (whole.all() and not merged):
         return cycles
-    period = float(np.median(cycles.count[~cycles.missing] - 1))
-    spans = np.ones(cycles.count.size, dtype=np.int64)
-    gapped = cycles.missing
-    spans[gapped] = np.maximum(np.rint((cycles.count[gapped] - 1) / period), 1).astype(np.int64)
-    label = 1 + np.concatenate([[0], np.cumsum(spans[:-1])]).astype(np.int64)
+    period = float(np.median(cycles.count[whole] - 1))
+    if merged:
+        stretch = np.diff(cycles.start + cycles.rotation)  # from each to the next
+    else:
+        stretch = np.where(whole, period, cycles.count - 1)[:-1]
+    spans = np.maximum(np.rint(stretch / period), 1).astype(np.int64)
+    label = 1 + np.concatenate([[0], np.cumsum(spans)]).astype(np.int64)
     return dataclasses.replace(cycles, label=label)
 
 
@@ -379,7 +384,7 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
         return _labelled(samples.constant_cycle(), tolerance)
     if level is not None:  # the amplitude varies: cut where the drive's cycles meet
         tops = extreme_of_part[(kind_of_part > 0) & accepted]
-        return _drive_numbers(_with_missing(_drive_cycles(bottoms, tops, n), gaps))
+        return _drive_numbers(_with_missing(_drive_cycles(bottoms, tops, n), gaps), merged=True)
     # Each loop runs from its bottom reversal to the next and back to its first sample, so
     # it is closed even if the displacement drifted in between.
     start = bottoms[:-1]

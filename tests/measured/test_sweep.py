@@ -118,3 +118,58 @@ def test_a_sweep_out_of_core_as_in_memory(monkeypatch):
     assert memory.cycle.size == 20
     lazy = analysed(*lazily(applied, force, chunks=1700), scheduler="threads")
     assert_equal_results(lazy, memory)
+
+
+# held amplitudes (× Δ_t), three cycles each: steps of ×3, ×4 (40 µm to 10 µm), ×5 and ×10
+STEEP = {
+    "x3-rising": [0.5, 1.5, 4.5],
+    "x3-falling": [4.5, 1.5, 0.5],
+    "x4-down-and-up": [2.46, 0.615, 2.46, 0.615],
+    "x5-rising": [0.4, 2.0],
+    "x5-falling": [2.0, 0.4],
+    "x10-dip": [2.0, 0.2, 2.0],
+}
+
+
+def steep_sweep(steps):
+    """The applied displacement and force of a sweep holding each of ``steps`` × Δ_t three
+    cycles at 35 MN/m, and the amplitude of each drive cycle."""
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, 35e6)
+    amplitudes = np.repeat(np.asarray(steps) * at, 3)
+    applied = mindlin.sweep(amplitudes, SAMPLES)
+    _, force = mindlin.drive(mindlin.Contact(MU, LOAD, DELTA_T), applied, 35e6)
+    return applied, force, amplitudes
+
+
+@pytest.mark.parametrize("steps", STEEP.values(), ids=STEEP.keys())
+def test_every_cycle_after_a_steep_step_is_reported_with_values(steps):
+    """The local band is set by the least amplitude near each sample: a cycle right after
+    (or before) one several times larger crosses it."""
+    applied, force, amplitudes = steep_sweep(steps)
+    results = analysed(applied, force)
+    np.testing.assert_array_equal(results.cycle, np.arange(1, amplitudes.size + 1))
+    np.testing.assert_allclose(results.amplitude, amplitudes, rtol=1e-3)
+    assert np.isfinite(results.dissipated_energy).all()
+
+
+def test_cycles_under_the_bands_floor_keep_the_drives_numbers():
+    """Cycles under 5 % of the band (×30 smaller) join in rows of their own neighbours, one
+    flagged several-loops and numbered as the drive cycle of its bottom reversal; the large
+    cycles keep their numbers."""
+    applied, force, amplitudes = steep_sweep([3.0, 0.1, 3.0])
+    results = analysed(applied, force)
+    np.testing.assert_array_equal(results.cycle, [1, 2, 3, 5, 7, 8, 9])
+    assert results.quality.values[3] == "several-loops"
+    big = results.cycle.values[results.cycle.values != 5]
+    np.testing.assert_allclose(results.amplitude.sel(cycle=big), amplitudes[big - 1], rtol=1e-3)
+
+
+def test_a_steep_sweep_out_of_core_as_in_memory(monkeypatch):
+    monkeypatch.setattr(passes, "_CHUNK", 1000)
+    monkeypatch.setattr(passes, "_SAMPLE", 256)
+    monkeypatch.setattr(pipeline, "TASK_SAMPLES", 777)
+    applied, force, amplitudes = steep_sweep(STEEP["x4-down-and-up"])
+    memory = analysed(applied, force)
+    assert memory.cycle.size == amplitudes.size
+    lazy = analysed(*lazily(applied, force, chunks=1700), scheduler="threads")
+    assert_equal_results(lazy, memory)
