@@ -287,7 +287,7 @@ def _trigger(samples: Samples, gaps, line, band):
 
 def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
     """The trigger's local half-band ``(width, levels)``, or None where the whole
-    recording's finds every cycle: ``hysteresis`` × the least amplitude about ``centre``
+    recording's finds every cycle: ``hysteresis`` × the least amplitude about the centre
     over three stretches of half a period (one holds a peak of each cycle)."""
     starts, kind, period = runs
     centre, level = band
@@ -299,10 +299,13 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
         return None
     width = max(int(period) // 2, MIN_SAMPLES)
     arguments = (passes._CHUNK, gaps, line, width)
-    stretch, highest, lowest = _joined(samples, passes.local_extremes, arguments)
+    stretch, highest, lowest, finite = _joined(samples, passes.local_extremes, arguments)
     first = np.flatnonzero(np.diff(stretch, prepend=-1.0))
     highest, lowest = np.fmax.reduceat(highest, first), np.fmin.reduceat(lowest, first)
-    amplitude = np.pad(np.fmax(highest - centre, centre - lowest), 1, mode="edge")
+    amplitude = np.fmax(highest - centre, centre - lowest)
+    # a stretch cut short (by a gap or the end) may miss its peak: its neighbours' instead
+    amplitude[np.add.reduceat(finite, first) < width] = np.nan
+    amplitude = np.pad(amplitude, 1, mode="edge")
     local = hysteresis * np.fmin(np.fmin(amplitude[:-2], amplitude[1:-1]), amplitude[2:])
     local = np.clip(np.where(np.isnan(local), level, local), _LEAST_LEVEL * level, level)
     if (local >= level).all():
@@ -372,6 +375,8 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     # the sample next to the gap may lie where the samples stop.
     hidden = _hidden_by_gaps(parts[1:], samples, gapped, margin)
     edges, scale = (finite[0][0], finite[-1][1]), (margin, 0.5 * period)
+    if level is not None:  # a sweep's first and last runs, cut short, must match a neighbour's
+        edges += (extreme_of_part[0], extreme_of_part[-1])
     accepted = _accepted_reversals((parts[0], kind_of_part, *parts[2:]), hidden, edges, scale)
     bottoms = extreme_of_part[(kind_of_part < 0) & accepted]
     if bottoms.size < 2:

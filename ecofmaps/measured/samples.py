@@ -168,15 +168,16 @@ def level_at(level, samples):
 def local_extremes(start, stop, arguments, x):
     """The largest and smallest detrended displacement of each stretch of ``width``
     samples (counted from sample 0) that the block's chunks cut: rows of the stretch's
-    number, its largest and its smallest (NaN where none is finite)."""
+    number, its largest, its smallest (NaN where none is finite) and its finite samples."""
     chunk, gaps, line, width = arguments
-    found = [np.empty((3, 0))]
+    found = [np.empty((4, 0))]
     for a, b in _chunks(start, stop, chunk):
         d = detrended(blanked(x[a - start : b - start], a, b, gaps), a, line)
         first = np.arange(a // width, (b - 1) // width + 1)
         cuts = np.maximum(first * width, a) - a
         highest, lowest = np.fmax.reduceat(d, cuts), np.fmin.reduceat(d, cuts)
-        found.append(np.stack([first.astype(np.float64), highest, lowest]))
+        finite = np.add.reduceat(np.isfinite(d), cuts)
+        found.append(np.stack([first.astype(np.float64), highest, lowest, finite]))
     return np.concatenate(found, axis=1)
 
 
