@@ -226,6 +226,20 @@ def _accepted_reversals(parts, hidden, edges, scale):
     return accepted
 
 
+def _deep_ends(value, accepted):
+    """False for a sweep's first or last run (cut short by the recording's end) whose extreme
+    lies less than ¾ as far from the next reversal as the one after it: a narrow band at a
+    small lead-in or lead-out is crossed by noise near the centre."""
+    deep = np.ones(value.size, dtype=bool)
+    reversals = np.flatnonzero(accepted)
+    for first, next_, after in ((0, 1, 2), (-1, -2, -3)):
+        if reversals.size < 3 or reversals[first] != (0 if first == 0 else value.size - 1):
+            continue
+        end, near, far = value[reversals[[first, next_, after]]]
+        deep[reversals[first]] = abs(end - near) >= 0.75 * abs(far - near)
+    return deep
+
+
 def _with_missing(cycles: Cycles, gaps) -> Cycles:
     """``cycles`` with the cycles that hold a sample of ``gaps`` marked."""
     if not gaps.size:
@@ -375,9 +389,9 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     # the sample next to the gap may lie where the samples stop.
     hidden = _hidden_by_gaps(parts[1:], samples, gapped, margin)
     edges, scale = (finite[0][0], finite[-1][1]), (margin, 0.5 * period)
-    if level is not None:  # a sweep's first and last runs, cut short, must match a neighbour's
-        edges += (extreme_of_part[0], extreme_of_part[-1])
     accepted = _accepted_reversals((parts[0], kind_of_part, *parts[2:]), hidden, edges, scale)
+    if level is not None:
+        accepted &= _deep_ends(parts[3], accepted)
     bottoms = extreme_of_part[(kind_of_part < 0) & accepted]
     if bottoms.size < 2:
         # Not two bottom reversals: the recording may still be one closed loop that starts
