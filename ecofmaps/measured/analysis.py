@@ -33,8 +33,8 @@ def _series(name, values, size=None, dtype=np.float64):
         values = values.data
     if np.ma.isMaskedArray(getattr(values, "_meta", values)):  # masked: missing, as NaN is
         ma = sys.modules["dask.array"].ma if is_lazy(values) else np.ma
-        bad = dtype is bool
-        values = ma.filled(values.astype(bool if bad else np.float64), bad or np.nan)
+        kind, fill = (bool, True) if dtype is bool else (np.float64, np.nan)
+        values = ma.filled(values.astype(kind), fill)
     try:
         array = values if is_lazy(values) else np.asarray(values, dtype=dtype)
     except (ValueError, TypeError, OverflowError) as error:
