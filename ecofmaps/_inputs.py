@@ -8,8 +8,10 @@ broadcasts too large for memory refused before JAX would abort (:func:`check_bro
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import inspect
+import itertools
 import math
 import os
 import sys
@@ -67,6 +69,13 @@ def to_si(name: str, value, quantity: str | None = None):
             f"{name} must be a real number or array of them [{si_unit}] (or a pint "
             f"Quantity), got {value!r}"
         )
+    if kind_of == "O":  # Python integers, which may be beyond float64
+        try:
+            np.asarray(value, dtype=np.float64)
+        except OverflowError:
+            raise ValueError(
+                f"{name} holds an integer beyond float64's largest number, 1.8e308 [{si_unit}]"
+            ) from None
     return value
 
 
@@ -81,7 +90,7 @@ def _numeric_objects(value) -> bool:
 
 def _converted(function, parameters: inspect.Signature, args, kwargs, kinds):
     """``args`` and ``kwargs`` with every pint Quantity in SI by parameter name, their
-    broadcast checked (:func:`check_broadcast_size`)."""
+    broadcast checked (:func:`check_broadcast_size`), and their (name, shape) pairs."""
     bound = parameters.bind_partial(*args, **kwargs)
     for name, value in bound.arguments.items():
         quantity = kinds.get(name, name)
@@ -89,11 +98,39 @@ def _converted(function, parameters: inspect.Signature, args, kwargs, kinds):
             bound.arguments[name] = tuple(to_si(name, item, quantity) for item in value)
         elif _is_quantity(value) or ((name in QUANTITIES or name in kinds) and value is not None):
             bound.arguments[name] = to_si(name, value, quantity)
-    check_broadcast_size(
-        function.__name__,
-        [v for n, v in bound.arguments.items() if n in QUANTITIES and n not in kinds],
-    )
-    return bound.args, bound.kwargs
+    shapes = []
+    for name, value in bound.arguments.items():
+        if name not in QUANTITIES or name in kinds:
+            continue
+        for item in value if isinstance(value, tuple) else (value,):
+            with contextlib.suppress(TypeError, ValueError):  # ragged: checked elsewhere
+                shapes.append((name, tuple(np.shape(item))))
+    check_broadcast_size(function.__name__, [shape for _, shape in shapes])
+    return bound.args, bound.kwargs, shapes
+
+
+@contextlib.contextmanager
+def _shapes_named(caller: str, shapes: list):
+    """A broadcast of the inputs failing inside as a ``ValueError`` naming the first two of
+    ``shapes`` (name, shape) that clash (grids of axes that need not broadcast never fail)."""
+    try:
+        yield
+    except (TypeError, ValueError) as error:
+        clash = "broadcast" in str(error) and next(_clashes(shapes), None)
+        if not clash:
+            raise
+        raise ValueError(
+            f"ecofmaps.{caller}: the shapes of {clash} do not broadcast together: give arrays "
+            "of one shape, or shapes NumPy broadcasts (equal or 1 in each trailing axis)"
+        ) from None
+
+
+def _clashes(shapes: list):
+    for (first, one), (second, other) in itertools.combinations(shapes, 2):
+        try:
+            np.broadcast_shapes(one, other)
+        except ValueError:
+            yield f"{first} {one} and {second} {other}"
 
 
 def si_units(function=None, **kinds):
@@ -104,8 +141,9 @@ def si_units(function=None, **kinds):
 
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
-        args, kwargs = _converted(function, parameters, args, kwargs, kinds)
-        return function(*args, **kwargs)
+        args, kwargs, shapes = _converted(function, parameters, args, kwargs, kinds)
+        with _shapes_named(function.__name__, shapes):
+            return function(*args, **kwargs)
 
     return wrapper
 
@@ -126,18 +164,11 @@ def available_memory() -> int | None:
         return None
 
 
-def check_broadcast_size(caller: str, values) -> None:
-    """Raise ``MemoryError`` before a broadcast of ``values`` that would not fit in memory."""
-    shapes = []
-    for value in values:
-        for item in value if isinstance(value, tuple) else (value,):
-            try:
-                shapes.append(tuple(np.shape(item)))
-            except (TypeError, ValueError):  # ragged or not an array: checked elsewhere
-                continue
+def check_broadcast_size(caller: str, shapes: list) -> None:
+    """Raise ``MemoryError`` before a broadcast of ``shapes`` that would not fit in memory."""
     try:
         shape = np.broadcast_shapes(*shapes)
-    except ValueError:
+    except ValueError:  # axes of a grid, or a clash the function reports
         return
     points = math.prod(shape)
     if points <= max((math.prod(s) for s in shapes), default=1):
@@ -161,7 +192,7 @@ def float64(function):
 
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
-        args, kwargs = _converted(function, parameters, args, kwargs, {})
+        args, kwargs, shapes = _converted(function, parameters, args, kwargs, {})
         if not jax.config.jax_enable_x64 and not is_concrete(*args, *kwargs.values()):
             raise ValueError(
                 f"ecofmaps.{function.__name__} under jax.jit, jax.vmap or jax.grad needs JAX's "
@@ -169,7 +200,7 @@ def float64(function):
                 "jax.config.update('jax_enable_x64', True) at start-up, or trace inside "
                 "'with jax.enable_x64(True):'"
             )
-        with jax.enable_x64(True):
+        with jax.enable_x64(True), _shapes_named(function.__name__, shapes):
             result = function(*args, **kwargs)
             if is_concrete(*args, *kwargs.values()):
                 return jax.tree_util.tree_map(_to_numpy, result)

@@ -14,6 +14,7 @@ import numpy as np
 
 __all__ = [
     "DIMENSIONS",
+    "DOMAIN",
     "PLAIN_QUANTITY",
     "PLAUSIBLE",
     "TEXT_LIMIT",
@@ -47,6 +48,19 @@ PLAUSIBLE = {
     "load": (None, 100e3, ("mN",)),
     "stiffness": (0.1e6, None, ("MN/m", "N/um")),
     "stiffness_ratio": (100.0, None, ("/um", "/mm")),
+}
+
+#: The values [SI] the command line takes, (low, high), a rigid rig's inf apart: far wider
+#: than any fretting test, and narrow enough that the model's products of them stay finite.
+DOMAIN = {
+    **dict.fromkeys(("amplitude", "groove_half_width", "scar_half_width"), (1e-12, 1e3)),
+    **dict.fromkeys(("scar_depth", "smoothing"), (0.0, 1e3)),
+    "load": (1e-9, 1e9),
+    "stiffness": (1e-3, 1e18),
+    "stiffness_ratio": (1e-12, 1e24),
+    "mu": (1e-6, 1e3),
+    "ecof": (1e-6, 1e3),
+    "aspect_ratio": (0.0, 1e6),
 }
 
 

@@ -177,6 +177,26 @@ def test_the_memory_check_counts_only_new_points(monkeypatch):
     ).shape == (50, 50)
 
 
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: ecofmaps.energy_cof(np.ones(3), 450.0, 35e6, 0.8, np.ones(4)),
+         r"energy_cof: the shapes of amplitude \(3,\) and aspect_ratio \(4,\) do not broadcast"),
+        (lambda: ecofmaps.slip_regime(np.ones((2, 3)), 450.0, np.ones((3, 2)), 0.8, 0.2),
+         r"slip_regime: the shapes of amplitude \(2, 3\) and stiffness \(3, 2\)"),
+        (lambda: ecofmaps.correct_ecof(np.ones(3), 50e-6, 450.0, np.full(2, 35e6), 0.2),
+         r"correct_ecof: the shapes of ecof \(3,\) and stiffness \(2,\)"),
+        (lambda: ecofmaps.energy_cof(50e-6, [450.0, 10**400], 35e6, 0.8, 0.2),
+         r"load holds an integer beyond float64's largest number, 1.8e308 \[N\]"),
+        (lambda: ecofmaps.correct_ecof(0.83, 50e-6, 450.0, 35e6, 10**400),
+         r"aspect_ratio holds an integer beyond float64's"),
+    ],
+)  # fmt: skip
+def test_shape_and_overflow_errors_name_the_arguments(call, message):
+    with pytest.raises(ValueError, match=message):
+        call()
+
+
 LOOP_SI = ecofmaps.fretting_loop(**EXAMPLE_2_SI, num=64)
 
 

@@ -17,7 +17,13 @@ import numpy as np
 from ecofmaps._nomenclature import QUANTITIES, RANGES, within
 from ecofmaps.cli.main import CommandError
 from ecofmaps.io.files import MANIFEST, written_by_ecofmaps
-from ecofmaps.units import DIMENSIONS, bare_number_warning, parse_quantity, parse_values
+from ecofmaps.units import (
+    DIMENSIONS,
+    DOMAIN,
+    bare_number_warning,
+    parse_quantity,
+    parse_values,
+)
 
 __all__ = [
     "CACHE_DIR_HELP",
@@ -44,8 +50,9 @@ __all__ = [
 
 def quantity(name: str, grid: bool = False, option: str | None = None):
     """An argparse ``type`` reading a value of quantity ``name`` with units (with ``grid``, a
-    list ``a,b,c`` or a range ``start:stop:num``), checked against its dimension and valid
-    range; a bare number implausible in SI is warned of, naming ``option`` (``--name``)."""
+    list ``a,b,c`` or a range ``start:stop:num``), checked against its dimension, valid
+    range and the model's domain (:data:`ecofmaps.units.DOMAIN`); a bare number implausible
+    in SI is warned of, naming ``option`` (``--name``)."""
     described = QUANTITIES[name]
     kind, option = described.kind, option or "--" + name.replace("_", "-")
 
@@ -54,11 +61,18 @@ def quantity(name: str, grid: bool = False, option: str | None = None):
             value = parse_values(text, kind) if grid else parse_quantity(text, kind)
         except ValueError as error:
             raise argparse.ArgumentTypeError(str(error)) from None
+        unit = f" [{described.units}]" if described.units != "1" else ""
         if described.valid is not None and not np.all(within(name, np.asarray(value))):
             valid = RANGES[described.valid][1].format(name=described.symbol or name)
-            unit = f" [{described.units}]" if described.units != "1" else ""
             raise argparse.ArgumentTypeError(
                 f"{text!r} is out of range: the {described.words} must satisfy {valid}{unit}"
+            )
+        low, high = DOMAIN.get(name, (-math.inf, math.inf))
+        if np.any(((value < low) | (value > high)) & (value != math.inf)):
+            rigid = " (or inf, a rigid rig)" if described.valid == "positive_or_inf" else ""
+            raise argparse.ArgumentTypeError(
+                f"{text!r} is beyond the model's domain: the {described.words} must be "
+                f"{low:g} to {high:g}{unit}{rigid}"
             )
         unique, counts = np.unique(value, return_counts=True)
         if np.any(counts > 1):

@@ -9,6 +9,7 @@ engine ``ecofmaps-tdms``: ``xr.open_dataset("rig.tdms", engine="ecofmaps-tdms", 
 from __future__ import annotations
 
 import collections
+import contextlib
 import logging
 import os
 import threading
@@ -30,57 +31,67 @@ __all__ = ["TdmsBackendEntrypoint", "TdmsReader", "open_tdms_group", "tdms_group
 UNIT_PROPERTIES = ("unit_string", "NI_UnitDescription")
 
 
-class _Notices(logging.Handler):
-    """Collects npTDMS's warnings while a file is opened (a short last segment)."""
+class _Log(logging.Handler):
+    """npTDMS's warnings in this thread: kept while a file is opened (a short last segment, a
+    text property not UTF-8), else each a warning of ecofmaps."""
 
-    def __init__(self):
+    def __init__(self, keep: bool):
         super().__init__(logging.WARNING)
+        self.keep, self.thread = keep, threading.get_ident()
         self.messages: list[str] = []
+        self.undecoded = False
 
     def emit(self, record):
-        if record.name == "nptdms.types":  # a text property that is not UTF-8: data intact
+        if record.thread != self.thread:
+            return
+        if not self.keep:
+            warn(f"TDMS reader: {record.getMessage()[:200]}", RecordingWarning)
+        elif record.name == "nptdms.types":  # a text property that is not UTF-8: data intact
             self.undecoded = True
         else:
             self.messages.append(record.getMessage())
 
-    undecoded = False
+
+def _silenced(record) -> bool:
+    return False
 
 
-class _Relay(logging.Handler):
-    """npTDMS's warnings outside :func:`opened_tdms`, each as a warning of ecofmaps (npTDMS
-    would print them itself, ``[nptdms.types WARNING] ...``)."""
+class _Quiet:
+    """While npTDMS reads, its log records go to a :class:`_Log` only: not printed by npTDMS
+    itself (``[nptdms.types WARNING] ...``), nor passed on; as they were after the last read."""
 
-    def emit(self, record):
-        if not any(isinstance(h, _Notices) for h in logging.getLogger("nptdms").handlers):
-            warn(f"TDMS reader: {record.getMessage()[:200]}", RecordingWarning)
+    lock, readers, propagate = threading.Lock(), 0, True
 
+    @classmethod
+    @contextlib.contextmanager
+    def reading(cls, keep: bool = False):
+        from nptdms.log import log_manager
 
-def _quiet_nptdms() -> None:
-    """npTDMS's loggers without its own printing handler, through :class:`_Relay`."""
-    from nptdms.log import log_manager
-
-    for logger in log_manager.loggers.values():
-        logger.removeHandler(log_manager.console_handler)
-    logging.getLogger("nptdms").addHandler(_Relay(logging.WARNING))
-    logging.getLogger("nptdms").propagate = False
-
-
-_quiet_nptdms()
+        logger, log = logging.getLogger("nptdms"), _Log(keep)
+        with cls.lock:
+            if cls.readers == 0:
+                cls.propagate, logger.propagate = logger.propagate, False
+                log_manager.console_handler.addFilter(_silenced)
+            cls.readers += 1
+            logger.addHandler(log)
+        try:
+            yield log
+        finally:
+            with cls.lock:
+                logger.removeHandler(log)
+                cls.readers -= 1
+                if cls.readers == 0:
+                    logger.propagate = cls.propagate
+                    log_manager.console_handler.removeFilter(_silenced)
 
 
 def opened_tdms(path: Path) -> TdmsFile:
     """The file opened by npTDMS's streaming reader (the data read on demand)."""
-    logger = logging.getLogger("nptdms")
-    notices = _Notices()
-    logger.addHandler(notices)
-    propagate, logger.propagate = logger.propagate, False
-    try:
-        handle = TdmsFile.open(path)
-    except Exception as error:
-        raise RecordingError(path, None, f"cannot read as TDMS: {error}") from None
-    finally:
-        logger.removeHandler(notices)
-        logger.propagate = propagate
+    with _Quiet.reading(keep=True) as notices:
+        try:
+            handle = TdmsFile.open(path)
+        except Exception as error:
+            raise RecordingError(path, None, f"cannot read as TDMS: {error}") from None
     if notices.undecoded:
         warn(
             f"{path}: a text property of the file is not UTF-8; read with replacement "
@@ -114,7 +125,8 @@ class TdmsReader:
         with self._lock:
             if self._handle is None or self._handle[1] != os.getpid():
                 self._handle = (opened_tdms(self.path), os.getpid())
-            return self._handle[0][group][channel].read_data(offset=start, length=count)
+            with _Quiet.reading():
+                return self._handle[0][group][channel].read_data(offset=start, length=count)
 
     def close(self) -> None:
         """Close the file (opened again on the next read)."""

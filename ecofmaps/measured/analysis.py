@@ -5,6 +5,8 @@ The method is explained in ``docs/method-loops.md``.
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 import xarray as xr
 
@@ -29,8 +31,10 @@ def _series(name, values, size=None, dtype=np.float64):
     """``values`` as a 1-D array (NumPy, or dask as it is) of ``size`` samples."""
     if hasattr(values, "dims"):  # an xarray DataArray: its NumPy or dask data
         values = values.data
-    if np.ma.isMaskedArray(values):  # masked samples are missing, as NaN is
-        values = values.astype(bool).filled(True) if dtype is bool else values.filled(np.nan)
+    if np.ma.isMaskedArray(getattr(values, "_meta", values)):  # masked: missing, as NaN is
+        ma = sys.modules["dask.array"].ma if is_lazy(values) else np.ma
+        kind, fill = (bool, True) if dtype is bool else (np.float64, np.nan)
+        values = ma.filled(values.astype(kind), fill)
     try:
         array = values if is_lazy(values) else np.asarray(values, dtype=dtype)
     except (ValueError, TypeError, OverflowError) as error:

@@ -113,6 +113,36 @@ def test_errors_name_the_option(tmp_path, monkeypatch, capsys, argv, message):
     assert list(tmp_path.iterdir()) == []
 
 
+_DOMAIN_OPTIONS = {
+    "model": ["--amplitude", "--load", "--stiffness", "--mu", "--aspect-ratio",
+              "--groove-half-width"],
+    "correct": ["--ecof", "--amplitude", "--load", "--stiffness", "--aspect-ratio",
+                "--scar-depth", "--scar-half-width"],
+    "map": ["--stiffness-ratio", "--aspect-ratio", "--amplitude", "--mu", "--load"],
+}  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("command", "option", "value"),
+    [
+        (command, option, value)
+        for command, options in _DOMAIN_OPTIONS.items()
+        for option in options
+        for value in ("1e308", "1e-300")
+        if value == "1e308" or option not in ("--aspect-ratio", "--scar-depth")  # 0: flat
+    ],
+)
+def test_values_beyond_the_models_domain_are_refused(tmp_path, capsys, command, option, value):
+    """Not 'regime invalid' or 'inf µm' with exit 0: the option, its bounds and unit."""
+    argv = [command, f"{option}={value}", "--out", tmp_path / "m.nc"][
+        : 4 if command == "map" else 2
+    ]
+    status, out, err = run(capsys, *argv)
+    assert status == 2 and out == "" and one_line_error(err), err
+    assert f"argument {option}: '{value}' is beyond the model's domain: the " in err
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize(
     ("argv", "expected"),
     [

@@ -568,3 +568,27 @@ def test_a_tdms_text_property_not_utf8_is_one_warning_and_npTDMS_prints_nothing(
         "characters (the samples are not affected)"
     }
     assert capfd.readouterr().err == ""  # not '[nptdms.types WARNING] ...'
+
+
+def test_npTDMS_logging_is_as_it_was_outside_the_reads(tmp_path, capfd):
+    """Quieted while a file is read only: importing ecofmaps or reading changes no logging;
+    what npTDMS logs while it reads is a warning, not a line it prints."""
+    import logging
+
+    from nptdms.log import log_manager
+
+    from ecofmaps.io import tdms
+
+    def state():
+        loggers = [logging.getLogger("nptdms"), *log_manager.loggers.values()]
+        return [(lg.propagate, list(lg.handlers)) for lg in loggers], console.filters[:]
+
+    console = log_manager.console_handler
+    before = state()
+    assert all(console in handlers for _, handlers in before[0][1:]) and before[1] == []
+    path = write_tdms(tmp_path / "rig.tdms")
+    check(read_recording(path, force_column="ftr", lazy=False))
+    assert state() == before
+    with pytest.warns(RecordingWarning, match="^TDMS reader: a note$"), tdms._Quiet.reading():
+        logging.getLogger("nptdms.types").warning("a note")
+    assert capfd.readouterr().err == "" and state() == before

@@ -12,19 +12,46 @@ from ecofmaps.measured.synthetic import EXAMPLE, example_path
 @pytest.fixture(scope="module")
 def example():
     recording = read_recording(example_path())
-    return recording.displacement, recording.force
+    return recording.displacement, recording.force, np.asarray(recording.cycle).astype(np.int64)
+
+
+def _masked(values, lazy=False):
+    """``values`` with samples 5000 to 5099 masked (and, under the mask, absurd)."""
+    mask = np.zeros(values.size, bool)
+    mask[5000:5100] = True
+    hidden = np.where(mask, 10**6, values).astype(values.dtype)
+    if lazy:
+        import dask.array as da
+
+        return da.ma.masked_array(da.from_array(hidden, 1700), da.from_array(mask, 1700))
+    return np.ma.masked_array(hidden, mask)
+
+
+def _nan(values):
+    values = values.astype(np.float64)
+    values[5000:5100] = np.nan
+    return values
 
 
 @pytest.mark.filterwarnings("ignore::UserWarning")
-def test_masked_samples_are_missing_samples(example):
-    x, q = example
-    masked = np.ma.masked_array(q.copy(), mask=np.zeros(q.size, bool))
-    masked[5000:5100] = 1e6  # what the mask hides
-    masked[5000:5100] = np.ma.masked
-    nan = q.copy()
-    nan[5000:5100] = np.nan
-    expected = analyze_loops(x, nan, EXAMPLE["load"], resolve=False)
-    assert analyze_loops(x, masked, EXAMPLE["load"], resolve=False).equals(expected)
+@pytest.mark.parametrize("argument", ["displacement", "force", "load", "cycle", "missing", "lazy"])
+def test_masked_samples_are_missing_samples(example, argument):
+    x, q, cycle = example
+    load = np.full(x.size, EXAMPLE["load"])
+    given = dict(displacement=x, force=q, load=load, cycle=cycle)
+    expected = dict(given)
+    if argument == "missing":
+        given["missing"] = _masked(np.zeros(x.size, bool))
+        expected["displacement"] = _nan(x)
+    elif argument == "lazy":
+        import dask.array as da
+
+        given["displacement"] = _masked(x, lazy=True)
+        expected["displacement"] = da.from_array(_nan(x), 1700)
+    else:
+        given[argument] = _masked(given[argument])
+        expected[argument] = _nan(expected[argument])
+    assert analyze_loops(**given, resolve=False).equals(analyze_loops(**expected, resolve=False))
 
 
 @pytest.mark.parametrize("chunks", [None, 1700])
@@ -38,7 +65,7 @@ def test_masked_samples_are_missing_samples(example):
 )
 def test_cycle_numbers_that_cycles_would_share_are_refused(example, labels, message, chunks):
     """In memory and out of core (dask blocks that cut the runs) alike."""
-    x, q = example
+    x, q, _ = example
     arrays = (x, q, labels(x.size))
     if chunks is not None:
         import dask.array as da
@@ -50,7 +77,7 @@ def test_cycle_numbers_that_cycles_would_share_are_refused(example, labels, mess
 
 
 def test_values_numpy_cannot_read_name_the_argument(example):
-    x, q = example
+    x, q, _ = example
     with pytest.raises(ValueError, match=r"^displacement cannot be read as numbers"):
         analyze_loops([[1.0, 2.0], [3.0]], q[:2], EXAMPLE["load"])
     with pytest.raises(ValueError, match=r"^cycle must hold numbers of at most 64 bits"):
