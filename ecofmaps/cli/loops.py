@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps._interrupts import interrupts_deferred
+from ecofmaps._nomenclature import with_se
 from ecofmaps._parallel import worker_limit
 from ecofmaps.cli._common import (
     CommandError,
@@ -25,6 +26,7 @@ from ecofmaps.cli._common import (
     quantity,
     recording_options,
     refuse_to_overwrite,
+    transition_rows,
 )
 from ecofmaps.cli.main import option_names
 from ecofmaps.io.files import atomic_path, record_written
@@ -264,8 +266,6 @@ def _summary(path, results, recording) -> str:
 def _lab_lines(results, rig_stiffness) -> list[str]:
     """ΣE_d over a recording's cycles and, when it crosses one (a sweep), its transition to
     gross slip (docs/lab.md)."""
-    from ecofmaps._nomenclature import with_se
-    from ecofmaps.cli.wear import transition_rows
     from ecofmaps.lab import cycle_sum, transition
 
     cycle = results["cycle"].values.astype(np.float64)

@@ -10,16 +10,15 @@ import sys
 import warnings
 from pathlib import Path
 
-import numpy as np
-
-from ecofmaps._nomenclature import with_se
 from ecofmaps.cli._common import (
+    TRANSITION,
     CommandError,
     option_adder,
     print_rows,
     quantity,
     refuse_to_overwrite,
-    row,
+    se_rows,
+    transition_rows,
     unit,
 )
 from ecofmaps.io.files import record_written, write_text
@@ -33,13 +32,6 @@ _WEAR = (
     "energy_wear_coefficient",
     "archard_slip",
     "archard_nominal",
-)
-
-#: The transition's numbers (of quantities ``transition_<name>``), in the order printed.
-_TRANSITION = ("amplitude", "contact_amplitude", "mu")
-_NEEDS_RIG = (
-    "needs --rig-stiffness (the rig's own; without it Δ_t is read on the applied displacement, "
-    "and lands high)"
 )
 
 _HELP = {
@@ -103,23 +95,6 @@ def _profile(args, path):
     return profile
 
 
-def _rows(found, names, quantity="{}") -> list:
-    """The printed rows of ``names`` (of ``quantity``), each value ± its standard error."""
-    rows = []
-    for name in names:
-        q = quantity.format(name)
-        rows.append(row(q, with_se(q, float(found[name]), float(found[f"{name}_se"]))))
-    return rows
-
-
-def transition_rows(found) -> list:
-    """The printed rows of :func:`ecofmaps.transition`'s ``found``: Δ_t, δ_t and μ_t."""
-    rows = _rows(found, _TRANSITION, "transition_{}")
-    if np.isnan(float(found.contact_amplitude)):
-        rows[1] = (*rows[1][:2], _NEEDS_RIG)
-    return rows
-
-
 def _columns(found, names, quantity="{}") -> dict:
     """The written columns of ``names`` (of ``quantity``) and their standard errors, in the
     display units, ASCII."""
@@ -163,13 +138,13 @@ def run(args) -> int:
         except ValueError as error:
             raise CommandError(f"{name}: {error}") from None
         slip = condition.attrs["sliding_condition"]
-        print_rows(f"{name} (scar profile {path}, {slip})", _rows(wear, _WEAR))
+        print_rows(f"{name} (scar profile {path}, {slip})", se_rows(wear, _WEAR))
         line = {"test": str(name), "profile": str(path), "sliding_condition": str(slip)}
         table.append(line | _columns(wear, _WEAR))
     if len(tests) > 2:
         fit = energy_wear([r for _, r in tests], profiles, length=args.length)
         names = ("campaign_energy_wear_coefficient", "threshold_energy")
-        print_rows("campaign: V = α(ΣE_d - E_th)", _rows(fit, names))
+        print_rows("campaign: V = α(ΣE_d - E_th)", se_rows(fit, names))
         try:
             found = transition([r for _, r in tests], rig_stiffness=args.rig_stiffness)
         except ValueError as error:
@@ -178,7 +153,7 @@ def run(args) -> int:
             print_rows("campaign: transition to gross slip", transition_rows(found))
             table.append(
                 {"test": "campaign", "profile": "", "sliding_condition": ""}
-                | _columns(found, _TRANSITION, "transition_{}")
+                | _columns(found, TRANSITION, "transition_{}")
             )
     if args.out is not None:
         write_text(args.out, csv_text(pd.DataFrame(table)))
