@@ -22,6 +22,7 @@ from ecofmaps.figures.style import (
     PER_MM,
     axis_label,
     ecof_ratio_colors,
+    load_label,
     parameters_of,
     scalar,
     stiffness_label,
@@ -92,7 +93,7 @@ def ecof_ratio_contours(
     handles = _ecof_ratio_contours(ax, x, dataset["ecof_ratio"], dataset["regime"])
     ax.set_xlabel(axis_label("stiffness_ratio"))
     for name, point in (markers or {}).items():
-        label = rf"{name} ({stiffness_label(point['stiffness'])}, $P$ = {point['load']:g} N)"
+        label = f"{name} ({stiffness_label(point['stiffness'])}, {load_label(point['load'])})"
         dot = dict(color="navy", markersize=8, markeredgecolor="white", label=label)
         handles += ax.plot(
             point["stiffness"] / point["load"] * PER_MM, point["aspect_ratio"], "o", **dot

@@ -22,6 +22,7 @@ from ecofmaps.figures.style import (
     axis_label,
     force_ratio_axis,
     legend_clear_of_data,
+    load_label,
     parameters,
     scalar,
     stiffness_label,
@@ -36,11 +37,6 @@ __all__ = ["cof_evolution", "measured_and_fitted_loops", "measured_loops", "reso
 def _title(what: str, source: str | None) -> str:
     """A figure's title: the recording's name ``source``, when given, and ``what`` it shows."""
     return f"{source}: {what}" if source else what[:1].upper() + what[1:]
-
-
-def _load(load: float) -> str:
-    """The normal load [N] for a title, its symbol italic: ``'$P$ = 450 N'``."""
-    return f"$P$ = {load:g} N"
 
 
 def _evenly_spread(labels, count: int) -> list:
@@ -155,7 +151,7 @@ def measured_loops(
     for ax in axes[:, 0]:
         ax.set_ylabel(axis_label("force"))
     figure.suptitle(  # two lines: the figure of a single cycle is only one panel wide
-        _title(rf"measured loops and the line $Q = S\Delta$ ({_load(load)}):", source)
+        _title(rf"measured loops and the line $Q = S\Delta$ ({load_label(load)}):", source)
         + "\nthe GICoF is $Q/P$ at the crossings",
         fontsize="medium",
     )
@@ -252,7 +248,7 @@ def cof_evolution(results: xr.Dataset, *, source: str | None = None) -> Figure:
     figure.suptitle(
         _title("the ECoF and the GICoF over the cycles", source)
         + "\n"
-        + parameters(_load(scalar(results, "load")), rf"$\Delta^*$ ≈ {amplitude:.1f} µm"),
+        + parameters(load_label(scalar(results, "load")), rf"$\Delta^*$ ≈ {amplitude:.1f} µm"),
         fontsize="medium",
     )
     if top.get_lines():  # the layout done with the title: the legend's place
@@ -298,7 +294,7 @@ def measured_and_fitted_loops(fits, *, source: str | None = None) -> Figure:
         panel = f"({chr(ord('a') + index)}) " if len(panels) > 1 else ""
         panel += f"{name}: " if name else ""
         ax.set_title(
-            f"{panel}{_load(fit.load)}, "
+            f"{panel}{load_label(fit.load)}, "
             rf"$x_o = \Delta^*$ = {fit.amplitude * MICRO:.1f} µm"
             "\n"
             + parameters(
@@ -398,7 +394,7 @@ def resolved_loops(
     _profile_over_test(figure, image, resolved)
     twins = _mu_over_test(test, resolved, results)
     figure.suptitle(
-        _title(f"loops read along the stroke ({_load(scalar(resolved, 'load'))}): ", source)
+        _title(f"loops read along the stroke ({load_label(scalar(resolved, 'load'))}): ", source)
         + r"$\mu(\xi)$ and $g(\xi)$ from the two slip branches at the same $\xi = \Delta - Q/S$",
         fontsize="medium",
     )

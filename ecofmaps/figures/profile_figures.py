@@ -14,6 +14,7 @@ from ecofmaps.figures.style import (
     PER_MM,
     axis_label,
     force_ratio_axis,
+    load_label,
     parameters,
     scalar,
     stiffness_label,
@@ -178,7 +179,7 @@ def scar_shape_comparison(dataset: xr.Dataset) -> Figure:
         + parameters(
             rf"$x_o = \Delta^*$ = {scalar(dataset, 'amplitude') * MICRO:g} µm",
             f"$W$ = {width * MICRO:g} µm, $D$ = {depth * MICRO:g} µm",
-            f"$P$ = {scalar(dataset, 'load'):g} N",
+            load_label(scalar(dataset, "load")),
             f"{stiffness_label(scalar(dataset, 'stiffness'))} (loops)",
             rf"$\mu$ = {scalar(dataset, 'mu'):g}",
         ),

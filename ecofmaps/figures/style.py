@@ -24,6 +24,7 @@ __all__ = [
     "RECORDING_DPI",
     "axis_label",
     "legend_clear_of_data",
+    "load_label",
     "number_text",
     "save_figure",
     "stiffness_label",
@@ -117,6 +118,11 @@ def stiffness_label(stiffness: float) -> str:
     return f"$S$ = {stiffness_text(stiffness)}"
 
 
+def load_label(load: float) -> str:
+    """The normal load [N] for a title or legend, its symbol italic: ``'$P$ = 450 N'``."""
+    return f"$P$ = {load:g} N"
+
+
 def stiffness_colors(stiffnesses) -> list:
     """One colour per stiffness: a sequential map for finite rigs, black for the rigid one."""
     finite = [s for s in stiffnesses if np.isfinite(s)]
@@ -133,10 +139,13 @@ def parameters(*items: str) -> str:
 #: The paper's parameters in a subtitle: text, and the factor to its unit.
 _PARAMETERS = {
     "amplitude": (r"$x_o = \Delta^*$ = {:g} µm", MICRO),
-    "load": ("$P$ = {:g} N", 1.0),
     "aspect_ratio": (r"$z_o/x_o$ = {:g}", 1.0),
     "mu": (r"$\mu$ = {:g}", 1.0),
 }
+
+
+#: The parameters a subtitle gives through their own label.
+_LABELS = {"stiffness": stiffness_label, "load": load_label}
 
 
 def parameters_of(dataset: xr.Dataset, *names: str) -> str:
@@ -144,8 +153,8 @@ def parameters_of(dataset: xr.Dataset, *names: str) -> str:
     texts = []
     for name in names:
         value = scalar(dataset, name)
-        if name == "stiffness":
-            texts.append(stiffness_label(value))
+        if name in _LABELS:
+            texts.append(_LABELS[name](value))
         else:
             text, factor = _PARAMETERS[name]
             texts.append(text.format(value * factor))
