@@ -303,18 +303,29 @@ def cycle_sum(cycle, value):
     return float(weight @ v), float(np.sqrt(sigma2 * np.sum(weight**2)))
 
 
-def _worn_area_se(profile: ScarProfile) -> float:
-    """Standard error of the worn area [m²] from the shoulders' noise."""
+def _worn_volume(profile: ScarProfile, length) -> tuple[float, float]:
+    """Worn volume [m³] of a line contact of ``length``, or of a round scar (``length`` None),
+    and its standard error from the shoulders' noise."""
     x = np.asarray(profile.position)
     residual = np.asarray(profile.height) - profile.reference_height - profile.reference_slope * x
     width = float(profile.half_width)
+    inside = np.abs(x) <= width
+    if length is not None:
+        weight, total, volume = np.ones(x.size), 2 * width, float(profile.worn_area)
+    else:  # the volume of revolution of each side's depth, the two averaged
+        edge = np.interp([-width, width], x, residual)
+        at = np.concatenate([[-width], x[inside], [width]])
+        depth = np.maximum(-np.concatenate([edge[:1], residual[inside], edge[1:]]), 0.0)
+        weight, total = np.pi * np.abs(x), np.pi * width**2
+        volume = float(np.pi * np.trapezoid(np.abs(at) * depth, at))
     shoulders = residual[np.abs(x) > 2 * width]
     if shoulders.size < 5:
-        return np.nan
+        return volume * (length or 1.0), np.nan
     noise = 1.4826 * np.median(np.abs(shoulders - np.median(shoulders)))
-    inside = np.abs(x) <= width
     spacing = float(np.median(np.diff(x)))
-    return float(noise * np.sqrt(inside.sum() * spacing**2 + (2 * width) ** 2 / shoulders.size))
+    terms = np.sum(weight[inside] ** 2) * spacing**2 + total**2 / shoulders.size
+    se = float(noise * np.sqrt(terms))
+    return (volume, se) if length is None else (volume * length, se * length)
 
 
 def _ratio(top, top_se, bottom, bottom_se):
@@ -341,13 +352,12 @@ def _scar(profile) -> None:
 def _one_test(results, profile, length) -> dict:
     """Energy wear of one test: each value with its standard error."""
     _scar(profile)
-    area = float(profile.worn_area)
     cycles = per_cycle(results, ("amplitude", "slip_amplitude", "dissipated_energy"))
     if not np.isfinite(cycles["dissipated_energy"]).any():
         raise ValueError("results: no cycle has a dissipated energy ('dissipated_energy')")
     cycle, load = cycles["cycle"], cycles["load"]
     energy = cycle_sum(cycle, cycles["dissipated_energy"])
-    volume = (area * length, _worn_area_se(profile) * length)
+    volume = _worn_volume(profile, length)
     slip = cycle_sum(cycle, 4 * load * cycles["slip_amplitude"])
     nominal = cycle_sum(cycle, 4 * load * cycles["amplitude"])
     return {
@@ -368,7 +378,7 @@ def _with_se(data: dict, name: str, value, se, dims=(), quantity=None) -> None:
 
 
 @si_units(length="length")
-def energy_wear(results, profile, length) -> xr.Dataset:
+def energy_wear(results, profile, length=None, contact="line") -> xr.Dataset:
     r"""Energy wear of a fretting test, or of a campaign: ΣE_d, V, α and Archard's k.
 
     Parameters
@@ -378,9 +388,14 @@ def energy_wear(results, profile, length) -> xr.Dataset:
         (a rig may record every N-th cycle: ``cycle`` numbers them as driven).
     profile : ScarProfile or list of ScarProfile
         Each test's levelled wear-scar profile across the scar
-        (:func:`ecofmaps.read_scar_profile`): its worn area, the pile-up apart.
+        (:func:`ecofmaps.read_scar_profile`); of a sphere's, through its centre.
     length : float or list of float
-        Length of the line contact, along which the worn area is the same. [m]
+        Length of the line contact, along which the worn area is the same; none for a
+        sphere. [m]
+    contact : {'line', 'sphere'}
+        ``'line'``: :math:`V = L\int d\,dx`, the worn area times ``length``; ``'sphere'``
+        (a round scar): :math:`V = \pi\int_{-W}^{W}|x|\,d(x)\,dx`, the volume of
+        revolution of the worn depth :math:`d`, the two sides averaged. The pile-up apart.
 
     Returns
     -------
@@ -396,18 +411,20 @@ def energy_wear(results, profile, length) -> xr.Dataset:
     ------
     ValueError
         For results without cycles, energies or a load, a profile without a scar, a length
-        not in metres (0 < L < 1 m), or lists of unequal length.
+        not in metres (0 < L < 1 m), a line without a length or a sphere with one, or lists
+        of unequal length.
 
     Notes
     -----
-    Sums over the cycles driven, linear between those recorded; a campaign's fit needs
-    three tests for its errors: docs/lab.md, "Energy wear".
+    Sums over the cycles driven, linear between those recorded; a round scar's volume by
+    Pappus's theorem; a campaign's fit needs three tests for its errors: docs/lab.md,
+    "Energy wear".
 
     References
     ----------
     S. Fouvry, P. Kapsa, L. Vincent (1996), Wear 200, 186-205; S. Fouvry, T. Liskiewicz,
     P. Kapsa, S. Hannel, E. Sauger (2003), Wear 255, 287-298; J.F. Archard (1953), J. Appl.
-    Phys. 24, 981-988 (titles in docs/lab.md).
+    Phys. 24, 981-988; Pappus's centroid theorem (titles in docs/lab.md).
 
     Examples
     --------
@@ -430,7 +447,16 @@ def energy_wear(results, profile, length) -> xr.Dataset:
     single = not isinstance(results, list | tuple)
     several = isinstance(profile, list | tuple) and not isinstance(profile, ScarProfile)
     profiles = list(profile) if several else [profile]
-    lengths = np.atleast_1d(np.asarray(length, dtype=np.float64))
+    if contact not in ("line", "sphere"):
+        raise ValueError(f"contact = {contact!r}: 'line' or 'sphere' (a round scar)")
+    if (length is None) == (contact == "line"):
+        raise ValueError(
+            "length: a line contact's length in metres, e.g. length=5e-3"
+            if length is None
+            else "length: a sphere's round scar has no length (give contact='line' for a line)"
+        )
+    kind = object if length is None else np.float64  # a sphere's None for each test
+    lengths = np.atleast_1d(np.asarray(length, dtype=kind))
     if len(profiles) != len(tests) or lengths.ndim > 1 or lengths.size not in (1, len(tests)):
         raise ValueError(
             f"give one profile and one length per test: {len(tests)} results, "
@@ -438,7 +464,7 @@ def energy_wear(results, profile, length) -> xr.Dataset:
         )
     lengths = np.broadcast_to(lengths, (len(tests),))
     for each in lengths:
-        if not 0.0 < each < 1.0:
+        if each is not None and not 0.0 < each < 1.0:
             raise ValueError(
                 f"length = {float(each):g} m: a line contact's length in metres (0 < L < 1 m; "
                 "5 mm is 5e-3, or give a pint Quantity)"
