@@ -42,3 +42,19 @@ def recorded_test(amplitude, stiffness, cycles=CYCLES):
     sums = {"energy": energy.sum(), "slip": (4 * LOAD * slip).sum(),
             "nominal": 4 * LOAD * amplitude * every.size}  # fmt: skip
     return results, sums
+
+
+def round_scar(volume, radius, noise=0.0, seed=0):
+    """A profilometer trace (x, z) [m] through the centre of a sphere's round scar of
+    ``volume`` [m³], W-shaped (shallower at its centre), off the trace's zero and tilted,
+    with a pile-up rim (not worn) and white noise; and the scar's depth at radius r."""
+
+    def depth(r):  # ∫ 2πr d dr = π a² D ∫(1 - u)(1/2 + 2u) du = π a² D 7/12
+        u = (r / radius) ** 2
+        return np.where(u < 1, volume / (np.pi * radius**2 * 7 / 12) * (1 - u) * (0.5 + 2 * u), 0)
+
+    x = np.linspace(-4 * radius, 4 * radius, 1601)
+    r = np.abs(x - 37e-6)
+    rim = 0.05 * depth(0.0) * np.exp(-50 * (r / radius - 1.3) ** 2)
+    noise = noise * np.random.default_rng(seed).standard_normal(x.size)
+    return x, -depth(r) + rim + 2e-4 * x + 1e-6 + noise, depth

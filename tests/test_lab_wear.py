@@ -9,7 +9,7 @@ import pytest
 
 import ecofmaps
 from tests import mindlin
-from tests.lab_cases import ALPHA, DELTA_T, LOAD, MU, recorded_test
+from tests.lab_cases import ALPHA, DELTA_T, LOAD, MU, recorded_test, round_scar
 
 RADIUS = 500e-6  # the round scar's radius a [m]
 
@@ -20,22 +20,9 @@ def recorded():
     return recorded_test(2.5 * mindlin.transition_amplitude(MU, LOAD, DELTA_T, 35e6), 35e6)
 
 
-def _depth(r, volume):
-    """A W-shaped round scar (shallower at its centre) of ``volume`` [m³]: depth at radius r."""
-    u = (r / RADIUS) ** 2
-    # ∫ 2πr d dr = π a² D ∫(1 - u)(1/2 + 2u) du = π a² D 7/12
-    depth = volume / (np.pi * RADIUS**2 * 7 / 12)
-    return np.where(u < 1, depth * (1 - u) * (0.5 + 2 * u), 0.0)
-
-
 def _trace(volume, noise=0.0, seed=0):
-    """A profile through the scar's centre (off the trace's zero, tilted, with pile-up rims),
-    levelled by the reader."""
-    x = np.linspace(-4 * RADIUS, 4 * RADIUS, 1601)
-    r = np.abs(x - 37e-6)
-    rim = 0.05 * float(_depth(0.0, volume)) * np.exp(-50 * (r / RADIUS - 1.3) ** 2)
-    z = -_depth(r, volume) + rim + 2e-4 * x + 1e-6
-    z = z + noise * np.random.default_rng(seed).standard_normal(x.size)
+    """The levelled profile of :func:`round_scar`."""
+    x, z, _ = round_scar(volume, RADIUS, noise, seed)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return ecofmaps.scar_profile(x, z, level=True)
@@ -44,7 +31,8 @@ def _trace(volume, noise=0.0, seed=0):
 def test_a_round_scar_volume_is_the_plane_integral_of_its_depth(recorded):
     n = 2001  # midpoints of an n × n grid over the scar
     grid = (np.arange(n) + 0.5) / n * 2 * RADIUS - RADIUS
-    plane = _depth(np.hypot(*np.meshgrid(grid, grid)), 1.0).sum() * (2 * RADIUS / n) ** 2
+    depth = round_scar(1.0, RADIUS)[2]
+    plane = depth(np.hypot(*np.meshgrid(grid, grid))).sum() * (2 * RADIUS / n) ** 2
     assert plane == pytest.approx(1.0, rel=1e-6)  # the grid against the closed form
     wear = ecofmaps.energy_wear(recorded[0], _trace(1e-12), contact="sphere")
     assert float(wear.wear_volume) == pytest.approx(plane * 1e-12, rel=2e-4)

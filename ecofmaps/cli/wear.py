@@ -1,5 +1,6 @@
 """``ecofmaps wear``: energy wear of fretting tests from their results tables (``ecofmaps
-loops --out``) and scar profiles: ΣE_d, the wear volume of a line contact, α and Archard's k
+loops --out``) and scar profiles: ΣE_d, the wear volume of a line contact or a sphere's round
+scar, α and Archard's k
 with the sliding condition; over three tests or more, α and E_th (:func:`ecofmaps.energy_wear`)
 and the transition to gross slip if they span it (:func:`ecofmaps.transition`, docs/lab.md)."""
 
@@ -38,6 +39,7 @@ _HELP = {
     "tables": "results of ecofmaps loops (CSV, or .nc)",
     "--profile": "a test's wear-scar profile (x and z columns); once per test",
     "--length": "length of the line contact, with its unit, e.g. 5mm",
+    "--sphere": "a sphere on a flat: the scar is round, each profile traced through its centre",
     "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m: regime read on the contact",
     "--x-unit": "unit of the profiles' positions (default: the column name's, else um)",
     "--z-unit": "unit of the profiles' heights (default: the column name's, else um)",
@@ -60,18 +62,21 @@ def add(subparsers) -> None:
         "wear",
         help="energy wear coefficient and Archard's k from results tables and scar profiles",
         description="Energy wear of fretting tests: for each test, the dissipated energy summed "
-        "over every cycle (a rig records every N-th), the wear volume of a line contact (the "
-        "scar's worn area times --length, the pile-up apart), α = V/ΣE_d and Archard's k on the "
-        "slip and on the applied amplitude, each with its standard error, and the sliding "
+        "over every cycle (a rig records every N-th), the wear volume (of a line contact the "
+        "scar's worn area times --length; of a sphere's round scar, --sphere, the volume of revolution of "
+        "the worn depth, both sides averaged; the pile-up apart), α = V/ΣE_d and Archard's k on"
+        " the slip and on the applied amplitude, each with its standard error, and the sliding "
         "condition; over three tests or more, α and the threshold energy E_th of V = α(ΣE_d - "
-        "E_th), and the transition to gross slip Δ_t, δ_t and μ_t when they span it (a last row "
-        "'campaign' of --out). One --profile per test, in the order of the tests (a table of "
+        "E_th), and the transition to gross slip Δ_t, δ_t and μ_t when they span it (a last row"
+        " 'campaign' of --out). One --profile per test, in the order of the tests (a table of "
         "several recordings holds several tests).",
     )
     option = option_adder(parser, _HELP)
     option("tables", nargs="+", metavar="TABLE")
     option("--profile", action="append", required=True, metavar="FILE")
-    option("--length", type=_length, required=True, metavar="L")
+    contact = option_adder(parser.add_mutually_exclusive_group(required=True), _HELP)
+    contact("--length", type=_length, metavar="L")
+    contact("--sphere", action="store_true")
     option("--rig-stiffness", type=quantity("stiffness", option="--rig-stiffness"), metavar="S")
     option("--x-unit", type=unit("length"), metavar="UNIT")
     option("--z-unit", type=unit("length"), metavar="UNIT")
@@ -109,6 +114,11 @@ def _columns(found, names, quantity="{}") -> dict:
     return line
 
 
+def _contact(args) -> str:
+    """The contact :func:`ecofmaps.energy_wear` takes: ``'sphere'`` or ``'line'``."""
+    return "sphere" if args.sphere else "line"
+
+
 def run(args) -> int:
     """Run ``ecofmaps wear`` with the parsed ``args``; the exit status."""
     import pandas as pd
@@ -133,7 +143,7 @@ def run(args) -> int:
     table = []
     for (name, results), path, profile in zip(tests, args.profile, profiles, strict=True):
         try:
-            wear = energy_wear(results, profile, length=args.length)
+            wear = energy_wear(results, profile, args.length, _contact(args))
             condition = sliding_condition(results, rig_stiffness=args.rig_stiffness)
         except ValueError as error:
             raise CommandError(f"{name}: {error}") from None
@@ -142,7 +152,7 @@ def run(args) -> int:
         line = {"test": str(name), "profile": str(path), "sliding_condition": str(slip)}
         table.append(line | _columns(wear, _WEAR))
     if len(tests) > 2:
-        fit = energy_wear([r for _, r in tests], profiles, length=args.length)
+        fit = energy_wear([r for _, r in tests], profiles, args.length, _contact(args))
         names = ("campaign_energy_wear_coefficient", "threshold_energy")
         print_rows("campaign: V = α(ΣE_d - E_th)", se_rows(fit, names))
         try:
