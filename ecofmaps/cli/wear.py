@@ -63,13 +63,13 @@ def add(subparsers) -> None:
         help="energy wear coefficient and Archard's k from results tables and scar profiles",
         description="Energy wear of fretting tests: for each test, the dissipated energy summed "
         "over every cycle (a rig records every N-th), the wear volume (of a line contact the "
-        "scar's worn area times --length; of a sphere's round scar, --sphere, the volume of revolution of "
-        "the worn depth, both sides averaged; the pile-up apart), α = V/ΣE_d and Archard's k on"
-        " the slip and on the applied amplitude, each with its standard error, and the sliding "
-        "condition; over three tests or more, α and the threshold energy E_th of V = α(ΣE_d - "
-        "E_th), and the transition to gross slip Δ_t, δ_t and μ_t when they span it (a last row"
-        " 'campaign' of --out). One --profile per test, in the order of the tests (a table of "
-        "several recordings holds several tests).",
+        "scar's worn area times --length; of a sphere's round scar, --sphere, the volume of "
+        "revolution of the worn depth, both sides averaged; the pile-up apart), α = V/ΣE_d and "
+        "Archard's k on the slip and on the applied amplitude, each with its standard error, "
+        "and the sliding condition; over three tests or more, α and the threshold energy E_th "
+        "of V = α(ΣE_d - E_th), and the transition to gross slip Δ_t, δ_t and μ_t when they "
+        "span it (a last row 'campaign' of --out). One --profile per test, in the order of the "
+        "tests (a table of several recordings holds several tests).",
     )
     option = option_adder(parser, _HELP)
     option("tables", nargs="+", metavar="TABLE")
