@@ -23,11 +23,14 @@ import numpy as np
 __all__ = [
     "QUANTITIES",
     "RANGES",
+    "TRANSITION",
     "Quantity",
     "attrs",
     "axis_label",
     "column",
     "display",
+    "texts_with_se",
+    "transition_texts",
     "with_se",
     "within",
 ]
@@ -252,6 +255,33 @@ def with_se(name: str, value: float, se: float) -> str:
         shown = np.format_float_positional(value, 4, unique=False, fractional=False, trim="k")
         shown = shown.rstrip(".") + (" ± 0" if se == 0 else "")
     return f"{shown} {quantity.display_unit}".rstrip()
+
+
+def texts_with_se(found, names, quantity: str = "{}") -> list[tuple[str, str]]:
+    """Each of ``names`` in ``found`` as (its quantity ``quantity.format(name)``, its
+    :func:`with_se` text with ``found[name + '_se']``)."""
+    texts = []
+    for name in names:
+        q = quantity.format(name)
+        texts.append((q, with_se(q, float(found[name]), float(found[f"{name}_se"]))))
+    return texts
+
+
+#: The numbers of :func:`ecofmaps.transition` (quantities ``transition_<name>``), in order.
+TRANSITION = ("amplitude", "contact_amplitude", "mu")
+
+
+def transition_texts(found) -> list[tuple[str, str]]:
+    """:func:`texts_with_se` of :func:`ecofmaps.transition`'s ``found``: Δ_t, δ_t (without the
+    rig's stiffness, what it needs) and μ_t."""
+    texts = texts_with_se(found, TRANSITION, "transition_{}")
+    if np.isnan(float(found.contact_amplitude)):
+        texts[1] = (
+            texts[1][0],
+            "needs --rig-stiffness (the rig's own; without it Δ_t is read on the applied "
+            "displacement, and lands high)",
+        )
+    return texts
 
 
 def within(name: str, value, rule: str | None = None):

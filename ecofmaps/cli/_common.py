@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ecofmaps._nomenclature import QUANTITIES, RANGES, with_se, within
+from ecofmaps._nomenclature import QUANTITIES, RANGES, texts_with_se, transition_texts, within
 from ecofmaps.cli.main import CommandError
 from ecofmaps.io.files import MANIFEST, written_by_ecofmaps
 from ecofmaps.units import (
@@ -27,7 +27,6 @@ from ecofmaps.units import (
 
 __all__ = [
     "CACHE_DIR_HELP",
-    "TRANSITION",
     "CommandError",
     "add_profile_options",
     "add_recording_options",
@@ -404,29 +403,14 @@ def row(name: str, value, note: str = "") -> tuple[str, str, str]:
     return words, quantity.symbol, f"{shown} {quantity.display_unit}".strip()
 
 
-#: The numbers of :func:`ecofmaps.transition` (quantities ``transition_<name>``), in order.
-TRANSITION = ("amplitude", "contact_amplitude", "mu")
-_NEEDS_RIG = (
-    "needs --rig-stiffness (the rig's own; without it Δ_t is read on the applied displacement, "
-    "and lands high)"
-)
-
-
 def se_rows(found, names, quantity="{}") -> list:
     """The printed rows of ``names`` (of ``quantity``), each value ± its standard error."""
-    rows = []
-    for name in names:
-        q = quantity.format(name)
-        rows.append(row(q, with_se(q, float(found[name]), float(found[f"{name}_se"]))))
-    return rows
+    return [row(q, text) for q, text in texts_with_se(found, names, quantity)]
 
 
 def transition_rows(found) -> list:
     """The printed rows of :func:`ecofmaps.transition`'s ``found``: Δ_t, δ_t and μ_t."""
-    rows = se_rows(found, TRANSITION, "transition_{}")
-    if np.isnan(float(found.contact_amplitude)):
-        rows[1] = (*rows[1][:2], _NEEDS_RIG)
-    return rows
+    return [row(q, text) for q, text in transition_texts(found)]
 
 
 def print_rows(title: str, rows) -> None:

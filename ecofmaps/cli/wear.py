@@ -11,8 +11,8 @@ import sys
 import warnings
 from pathlib import Path
 
+from ecofmaps._nomenclature import TRANSITION
 from ecofmaps.cli._common import (
-    TRANSITION,
     CommandError,
     option_adder,
     print_rows,

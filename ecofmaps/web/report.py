@@ -35,7 +35,7 @@ from bokeh.palettes import Category10_10
 from bokeh.plotting import figure
 from bokeh.resources import INLINE
 
-from ecofmaps._nomenclature import QUANTITIES, with_se
+from ecofmaps._nomenclature import QUANTITIES, transition_texts, with_se
 from ecofmaps._version import __version__
 from ecofmaps.io.files import atomic_path
 from ecofmaps.io.tables import results_table
@@ -265,15 +265,7 @@ def _lab_numbers(results: xr.Dataset) -> Div:
     except ValueError as error:
         rows["transition to gross slip"] = f"none: {error}"
     else:
-        for name in ("amplitude", "contact_amplitude", "mu"):
-            quantity = f"transition_{name}"
-            shown = with_se(quantity, *(float(found[n]) for n in (name, f"{name}_se")))
-            words = QUANTITIES[quantity].long_name
-            unknown = (
-                "unknown without the rig's own stiffness (--rig-stiffness), without which Δ_t "
-                "is read on the applied displacement, and lands high"
-            )
-            rows[words] = shown if np.isfinite(float(found[name])) else unknown
+        rows |= {QUANTITIES[q].long_name: text for q, text in transition_texts(found)}
     return Div(
         text="<h3 style='margin:8px 0 4px 0'>The lab's numbers (<code>ecofmaps.transition"
         "</code>, <code>ecofmaps.energy_wear</code>; with a scar profile, <code>ecofmaps wear"

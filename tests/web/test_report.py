@@ -129,7 +129,7 @@ def test_a_sweep_across_the_transition_shows_it():
     for symbol, (truth, pattern) in shown.items():
         assert float(re.search(pattern, text)[1]) == pytest.approx(truth, rel=0.05), symbol
     assert "cumulated dissipated energy ΣE_d</th><td>" in text and "mixed slip" in text
-    unknown = "transition amplitude δ_t</th><td>unknown without the rig's own stiffness"
+    unknown = "transition amplitude δ_t</th><td>needs --rig-stiffness (the rig's own; without it"
     assert unknown in _texts(report_document(sweep.drop_attrs(deep=False)))
 
 
