@@ -28,10 +28,12 @@ from ecofmaps.units import (
 __all__ = [
     "CACHE_DIR_HELP",
     "CommandError",
+    "add_contact_options",
     "add_profile_options",
     "add_recording_options",
     "byte_size",
     "command_parser",
+    "contact",
     "count",
     "made_folder",
     "option_adder",
@@ -39,6 +41,7 @@ __all__ = [
     "profile_rows",
     "quantity",
     "read_profile",
+    "read_scar_file",
     "recording_options",
     "refuse_to_overwrite",
     "row",
@@ -315,6 +318,51 @@ def profile_rows(args, profile) -> list:
     if not math.isnan(alternative):
         rows.append(row("scar_half_width", alternative, f"(or {other})"))
     return [*rows, ("scar aspect ratio", "D/W", f"{float(profile.aspect_ratio):.6g}")]
+
+
+_CONTACT_HELP = {
+    "--length": "length of the line contact, with its unit, e.g. 5mm",
+    "--sphere": "a sphere on a flat: the scar is round, its profile traced through its centre",
+}
+
+
+def _length(text: str) -> float:
+    """``--length``: a length that must carry its unit (``5mm``)."""
+    try:
+        float(text)
+    except ValueError:
+        return quantity("scar_half_width")(text)
+    raise argparse.ArgumentTypeError(f"{text!r} has no unit: give the contact's length as 5mm")
+
+
+def add_contact_options(parser, required: bool) -> None:
+    """``--length L`` (a line contact) or ``--sphere`` (a round scar), one of them: the contact
+    whose wear volume :func:`ecofmaps.energy_wear` reads on a scar profile."""
+    option = option_adder(parser.add_mutually_exclusive_group(required=required), _CONTACT_HELP)
+    option("--length", type=_length, metavar="L")
+    option("--sphere", action="store_true")
+
+
+def contact(args) -> str | None:
+    """The contact :func:`add_contact_options` named: ``'sphere'``, ``'line'`` or None."""
+    return "sphere" if args.sphere else None if args.length is None else "line"
+
+
+def read_scar_file(path, command: str, x_unit=None, z_unit=None):
+    """The levelled profile in ``path``; what the reading decided printed on standard error as
+    a warning of ``command``, an error naming ``path``."""
+    from ecofmaps.io.scar_profiles import read_scar_profile
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            profile = read_scar_profile(path, x_unit=x_unit, z_unit=z_unit)
+        except ValueError as error:
+            text = str(error)
+            raise ValueError(text if text.startswith(str(path)) else f"{path}: {text}") from None
+    for item in caught:
+        print(f"ecofmaps {command}: warning: {path}: {item.message}", file=sys.stderr)
+    return profile
 
 
 def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=()) -> None:

@@ -15,15 +15,18 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps._interrupts import interrupts_deferred
-from ecofmaps._nomenclature import with_se
+from ecofmaps._nomenclature import QUANTITIES, texts_with_se, with_se
 from ecofmaps._parallel import worker_limit
 from ecofmaps.cli._common import (
     CommandError,
+    add_contact_options,
     add_recording_options,
     command_parser,
+    contact,
     count,
     option_adder,
     quantity,
+    read_scar_file,
     recording_options,
     refuse_to_overwrite,
     transition_rows,
@@ -57,6 +60,9 @@ _HELP = {
     "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m (the loops' stick slope is the rig "
     "and the contact in series): the ratios also on the contact's displacement, the regime there, "
     "a sweep's δ_t",
+    "--scar-profile": "the scar's profile after the test (x and z columns, in um unless their "
+    "names say): the loop-scar closure of its last loop with a GICoF, printed, in the report "
+    "and with --plots (<name>_closure.png); with --length or --sphere, its energy wear",
     "--nan-policy": "a cycle with a missing sample (NaN or an empty cell) is skipped and counted "
     "(skip, the default), or any missing sample stops the command naming its line",
     "--workers": "analyse out of core on a local dask cluster of N processes",
@@ -101,6 +107,8 @@ def add(subparsers) -> None:
     option("--no-resolve", action="store_true")
     option("--flip-force", action="store_true")
     option("--rig-stiffness", type=quantity("stiffness", option="--rig-stiffness"), metavar="S")
+    option("--scar-profile", metavar="FILE")
+    add_contact_options(parser, required=False)
     option("--nan-policy", choices=("skip", "raise"), default="skip")
     add_recording_options(parser)
     option = option_adder(
@@ -152,6 +160,7 @@ def _plot_names(paths) -> list[str]:
 _NOT_KEPT = (
     ("--resolved", "reads every loop along the stroke", ""),
     ("--report", "draws loops and the whole table", ""),
+    ("--scar-profile", "closes the last loops on the scar", ""),
     ("--plots", "draws every loop", " (or --workers, --scheduler, --resume)"),
 )
 
@@ -164,15 +173,16 @@ def _analysed(index, path, recording, load, args, long_run, write):
     from ecofmaps.measured.resolve import ReadingOptions
 
     for option, does, others in _NOT_KEPT:
-        if recording.lazy and getattr(args, option[2:]) is not None:
+        if recording.lazy and getattr(args, option[2:].replace("-", "_")) is not None:
             raise CommandError(
                 f"{option} {does}, which a long recording ({path}) analysed out of core does "
                 f"not keep: leave out {option}{others}"
             )
-    positions = 201 if args.plots is not None or args.resolved is not None else None
+    scar = args.scar_profile is not None
+    positions = 201 if args.plots is not None or args.resolved is not None or scar else None
     reading = Reading(
         resolve=not args.no_resolve,
-        keep_loops=args.plots is not None or args.report is not None,
+        keep_loops=args.plots is not None or args.report is not None or scar,
         along_stroke=ReadingOptions(positions=positions),
         hand_back=positions is not None,
     )
@@ -263,6 +273,41 @@ def _summary(path, results, recording) -> str:
     return summary
 
 
+def _scar_numbers(args, each, profile) -> tuple[dict, object]:
+    """The energy wear (with a contact) and the loop-scar closure of a recording on its scar
+    ``profile``, as rows of text (an error said in its row), and the closure or None."""
+    from ecofmaps.lab import energy_wear, loop_scar_closure
+
+    rows, closure, names = {}, None, ("wear_volume", "energy_wear_coefficient", "archard_slip")
+    if (kind := contact(args)) is not None:
+        try:
+            wear = energy_wear(each.results, profile, args.length, kind)
+        except ValueError as error:
+            shown = f"none: {error}"
+        else:
+            texts = texts_with_se(wear, (*names, "archard_nominal"))
+            shown = ", ".join(f"{QUANTITIES[q].symbol} = {text}" for q, text in texts)
+        rows[f"energy wear ({kind}, {args.scar_profile})"] = shown
+    try:
+        closure = loop_scar_closure(each.results, each.resolved, profile, args.rig_stiffness)
+    except ValueError as error:
+        shown = f"none: {error}"
+    else:
+        shown = (
+            f"cycle {int(closure.cycle)}, μ = GICoF {float(closure.mu):.4f}: the loop "
+            f"{float(closure.loop_residual):.2%} of Q* off the model's, the scar "
+            f"{float(closure.scar_residual) * 1e6:.3g} µm "
+            f"({float(closure.scar_relative_residual):.2%} of its depth) off the profile's"
+        )
+    rows[f"loop-scar closure ({args.scar_profile})"] = shown
+    return rows, closure
+
+
+def _said(rows: dict) -> list[str]:
+    """``rows`` as lines ``name: text``."""
+    return [f"{name}: {text}" for name, text in rows.items()]
+
+
 def _lab_lines(results, rig_stiffness) -> list[str]:
     """ΣE_d over a recording's cycles and, when it crosses one (a sweep), its transition to
     gross slip (docs/lab.md)."""
@@ -303,6 +348,13 @@ def _checked_inputs(args) -> tuple[list[Path], float]:
     for option, what in (("--resolved", "the reading"), ("--report", "the page")):
         if getattr(args, option[2:]) is not None and len(paths) > 1:
             raise CommandError(f"{option} writes {what} of one recording: give one FILE")
+    if args.scar_profile is not None and (len(paths) > 1 or args.no_resolve):
+        raise CommandError(
+            "--scar-profile is the scar of one recording, closed on its loops read along the "
+            "stroke: give one FILE, without --no-resolve"
+        )
+    if args.scar_profile is None and contact(args) is not None:
+        raise CommandError("--length or --sphere reads the wear on a --scar-profile: give it")
     if args.report is not None and missing_web_packages():
         raise CommandError(INSTALL_WEB)
     return paths, load
@@ -316,13 +368,17 @@ def _checked_outputs(args, paths) -> list:
             raise CommandError(f"cannot write {target} ({option}): its directory does not exist")
     if args.plots is not None:
         kinds = ("loops", "evolution") + (() if args.no_resolve else ("resolved",))
+        kinds += ("closure",) if args.scar_profile is not None else ()
         folder = Path(args.plots)
         outputs += [
             ("--plots", folder / f"{name}_{kind}.png")
             for name in _plot_names(paths)
             for kind in kinds
         ]
-    refuse_to_overwrite(outputs, paths, overwrite=args.overwrite, folders=[("--plots", args.plots)])
+    inputs = [*paths, *([args.scar_profile] if args.scar_profile is not None else [])]
+    refuse_to_overwrite(
+        outputs, inputs, overwrite=args.overwrite, folders=[("--plots", args.plots)]
+    )
     return outputs
 
 
@@ -362,8 +418,9 @@ def _analyse_each(args, paths, load, long_run, table) -> tuple[list[_Analysed], 
     return done, failed
 
 
-def _write_extras(args, done: list[_Analysed]) -> None:
-    """The plots, the reading along the stroke and the report the options ask for."""
+def _write_extras(args, done: list[_Analysed], lab: dict, closure) -> None:
+    """The plots, the reading along the stroke and the report the options ask for, with the
+    ``lab`` rows and ``closure`` of a scar profile."""
     if args.plots is not None:
         from ecofmaps import figures  # matplotlib only when plots are asked for
 
@@ -379,6 +436,8 @@ def _write_extras(args, done: list[_Analysed]) -> None:
                 }
                 if resolved is not None:
                     drawn["resolved"] = figures.resolved_loops(resolved, results, source=source)
+                if closure is not None:
+                    drawn["closure"] = figures.loop_scar_closure_figure(closure)
                 for kind, figure in drawn.items():
                     path = folder / f"{each.plot_name}_{kind}.png"
                     figures.save_figure(figure, path, dpi=figures.RECORDING_DPI)
@@ -395,7 +454,7 @@ def _write_extras(args, done: list[_Analysed]) -> None:
 
         mean_load = float(done[0].results["load"])  # the load given, or a channel's mean
         inputs = recording_inputs(done[0].recording, mean_load, flip_force=args.flip_force)
-        write_report(args.report, done[0].results, inputs=inputs)
+        write_report(args.report, done[0].results, inputs=inputs, lab=lab)
 
 
 def run(args) -> int:
@@ -405,6 +464,7 @@ def run(args) -> int:
 
     paths, load = _checked_inputs(args)
     outputs = _checked_outputs(args, paths)
+    scar = args.scar_profile and read_scar_file(args.scar_profile, "loops")
     long_run = LongRun(args, paths)
     try:
         with contextlib.ExitStack() as stack:  # the table is written as it comes, renamed last
@@ -416,7 +476,8 @@ def run(args) -> int:
             done, failed = _analyse_each(args, paths, load, long_run, _Table(stream))
             if not done:  # nothing to write: the temporary goes
                 raise _NothingAnalysed
-            _write_extras(args, done)
+            lab, closure = _scar_numbers(args, done[0], scar) if scar else ({}, None)
+            _write_extras(args, done, lab, closure)
     except _NothingAnalysed:
         print(
             f"ecofmaps loops: none of the {len(paths)} recordings could be analysed; "
@@ -431,7 +492,7 @@ def run(args) -> int:
         sys.stdout.write(stream.getvalue())
         for each in done:
             print(_summary(each.path, each.results, each.recording).strip(), file=sys.stderr)
-            for line in _lab_lines(each.results, args.rig_stiffness):
+            for line in [*_lab_lines(each.results, args.rig_stiffness), *_said(lab)]:
                 print(f"  {line}", file=sys.stderr)
         return status
     long_run.finish()
@@ -439,7 +500,7 @@ def run(args) -> int:
     print(f"wrote {args.out}: {written} cycle{'' if written == 1 else 's'}")
     for each in done:
         print(_summary(each.path, each.results, each.recording))
-        for line in _lab_lines(each.results, args.rig_stiffness):
+        for line in [*_lab_lines(each.results, args.rig_stiffness), *_said(lab)]:
             print(f"    {line}")
     if failed:
         print(f"  not analysed ({len(failed)}): " + ", ".join(str(path) for path in failed))

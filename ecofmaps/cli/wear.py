@@ -6,17 +6,17 @@ and the transition to gross slip if they span it (:func:`ecofmaps.transition`, d
 
 from __future__ import annotations
 
-import argparse
-import sys
-import warnings
 from pathlib import Path
 
 from ecofmaps._nomenclature import TRANSITION
 from ecofmaps.cli._common import (
     CommandError,
+    add_contact_options,
+    contact,
     option_adder,
     print_rows,
     quantity,
+    read_scar_file,
     refuse_to_overwrite,
     se_rows,
     transition_rows,
@@ -38,23 +38,12 @@ _WEAR = (
 _HELP = {
     "tables": "results of ecofmaps loops (CSV, or .nc)",
     "--profile": "a test's wear-scar profile (x and z columns); once per test",
-    "--length": "length of the line contact, with its unit, e.g. 5mm",
-    "--sphere": "a sphere on a flat: the scar is round, each profile traced through its centre",
     "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m: regime read on the contact",
     "--x-unit": "unit of the profiles' positions (default: the column name's, else um)",
     "--z-unit": "unit of the profiles' heights (default: the column name's, else um)",
     "--out": "write the numbers here (CSV)",
     "--overwrite": "replace --out if ecofmaps wrote it",
 }
-
-
-def _length(text: str) -> float:
-    """``--length``: a length that must carry its unit (``5mm``)."""
-    try:
-        float(text)
-    except ValueError:
-        return quantity("scar_half_width")(text)
-    raise argparse.ArgumentTypeError(f"{text!r} has no unit: give the contact's length as 5mm")
 
 
 def add(subparsers) -> None:
@@ -74,30 +63,12 @@ def add(subparsers) -> None:
     option = option_adder(parser, _HELP)
     option("tables", nargs="+", metavar="TABLE")
     option("--profile", action="append", required=True, metavar="FILE")
-    contact = option_adder(parser.add_mutually_exclusive_group(required=True), _HELP)
-    contact("--length", type=_length, metavar="L")
-    contact("--sphere", action="store_true")
+    add_contact_options(parser, required=True)
     option("--rig-stiffness", type=quantity("stiffness", option="--rig-stiffness"), metavar="S")
     option("--x-unit", type=unit("length"), metavar="UNIT")
     option("--z-unit", type=unit("length"), metavar="UNIT")
     option("--out", metavar="OUT")
     option("--overwrite", action="store_true")
-
-
-def _profile(args, path):
-    """The levelled profile in ``path``; what the reading decided printed on standard error."""
-    from ecofmaps.io.scar_profiles import read_scar_profile
-
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        try:
-            profile = read_scar_profile(path, x_unit=args.x_unit, z_unit=args.z_unit)
-        except ValueError as error:
-            text = str(error)
-            raise ValueError(text if text.startswith(str(path)) else f"{path}: {text}") from None
-    for item in caught:
-        print(f"ecofmaps wear: warning: {path}: {item.message}", file=sys.stderr)
-    return profile
 
 
 def _columns(found, names, quantity="{}") -> dict:
@@ -112,11 +83,6 @@ def _columns(found, names, quantity="{}") -> dict:
         for key, v in ((label, name), (label.replace(q, f"{q}_se"), f"{name}_se")):
             line[key] = float(found[v]) * QUANTITIES[q].display_factor
     return line
-
-
-def _contact(args) -> str:
-    """The contact :func:`ecofmaps.energy_wear` takes: ``'sphere'`` or ``'line'``."""
-    return "sphere" if args.sphere else "line"
 
 
 def run(args) -> int:
@@ -139,11 +105,11 @@ def run(args) -> int:
             f"give one --profile per test: {len(tests)} tests in the tables, "
             f"{len(args.profile)} profiles"
         )
-    profiles = [_profile(args, path) for path in args.profile]
+    profiles = [read_scar_file(path, "wear", args.x_unit, args.z_unit) for path in args.profile]
     table = []
     for (name, results), path, profile in zip(tests, args.profile, profiles, strict=True):
         try:
-            wear = energy_wear(results, profile, args.length, _contact(args))
+            wear = energy_wear(results, profile, args.length, contact(args))
             condition = sliding_condition(results, rig_stiffness=args.rig_stiffness)
         except ValueError as error:
             raise CommandError(f"{name}: {error}") from None
@@ -152,7 +118,7 @@ def run(args) -> int:
         line = {"test": str(name), "profile": str(path), "sliding_condition": str(slip)}
         table.append(line | _columns(wear, _WEAR))
     if len(tests) > 2:
-        fit = energy_wear([r for _, r in tests], profiles, args.length, _contact(args))
+        fit = energy_wear([r for _, r in tests], profiles, args.length, contact(args))
         names = ("campaign_energy_wear_coefficient", "threshold_energy")
         print_rows("campaign: V = α(ΣE_d - E_th)", se_rows(fit, names))
         try:

@@ -92,7 +92,7 @@ model.data = model_data;
 """
 
 
-def write_report(path, results: xr.Dataset, *, loops=None, inputs=None) -> Path:
+def write_report(path, results: xr.Dataset, *, loops=None, inputs=None, lab=None) -> Path:
     """Write the results of a fretting test as one HTML page that opens offline.
 
     Parameters
@@ -111,6 +111,9 @@ def write_report(path, results: xr.Dataset, *, loops=None, inputs=None) -> Path:
         What the results were made from, shown as given (``{"files": "test.csv", "load":
         "450 N", "units assumed": "displacement um, force N"}``); the ecofmaps version and
         the date are added.
+    lab : mapping of str to str, optional
+        More of the lab's numbers, shown as given under theirs (the energy wear and the
+        loop-scar closure ``ecofmaps loops --scar-profile`` reads).
 
     Returns
     -------
@@ -136,7 +139,7 @@ def write_report(path, results: xr.Dataset, *, loops=None, inputs=None) -> Path:
     >>> page.read_text(encoding="utf-8").count("<script src=")  # nothing fetched
     0
     """
-    document = report_document(results, loops=loops, inputs=inputs)
+    document = report_document(results, loops=loops, inputs=inputs, lab=lab)
     title = "ecofmaps report" + (f": {inputs['files']}" if inputs and "files" in inputs else "")
     # Bokeh's own JavaScript and CSS, written in. Not file_html(..., INLINE): that also asks
     # the page to fetch the external files of every model class imported in this process
@@ -191,7 +194,7 @@ def recording_inputs(recording, load: float, *, flip_force: bool = False) -> dic
     return inputs
 
 
-def report_document(results: xr.Dataset, *, loops=None, inputs=None):
+def report_document(results: xr.Dataset, *, loops=None, inputs=None, lab=None):
     """The Bokeh layout of :func:`write_report`'s page (same parameters)."""
     missing = [name for name in _NEEDED if name not in results.variables]
     if missing:
@@ -201,7 +204,7 @@ def report_document(results: xr.Dataset, *, loops=None, inputs=None):
     evolution, flags = _evolution_figures(results)
     parts = [
         _header(results, inputs or {}),
-        _lab_numbers(results),
+        _lab_numbers(results, lab or {}),
         row(column(evolution, flags), _quality_counts(results)),
     ]
     if "loop_displacement" in results.variables:
@@ -250,8 +253,8 @@ def _header(results: xr.Dataset, inputs: Mapping) -> Div:
     )
 
 
-def _lab_numbers(results: xr.Dataset) -> Div:
-    """The test's cumulated dissipated energy, and its transition if it crosses one."""
+def _lab_numbers(results: xr.Dataset, lab: Mapping) -> Div:
+    """The test's cumulated dissipated energy, its transition if it crosses one, and ``lab``."""
     cycle = results["cycle"].values.astype(np.float64)
     try:
         energy = with_se("cumulated_energy", *cycle_sum(cycle, results["dissipated_energy"].values))
@@ -266,10 +269,12 @@ def _lab_numbers(results: xr.Dataset) -> Div:
         rows["transition to gross slip"] = f"none: {error}"
     else:
         rows |= {QUANTITIES[q].long_name: text for q, text in transition_texts(found)}
+    rows |= lab
     return Div(
         text="<h3 style='margin:8px 0 4px 0'>The lab's numbers (<code>ecofmaps.transition"
-        "</code>, <code>ecofmaps.energy_wear</code>; with a scar profile, <code>ecofmaps wear"
-        "</code> gives the wear volume)</h3>" + _rows_table(rows, "ecofmaps-lab"),
+        "</code>, <code>ecofmaps.energy_wear</code>, <code>ecofmaps.loop_scar_closure</code>: "
+        "with a scar profile, <code>ecofmaps loops --scar-profile</code> or <code>ecofmaps wear"
+        "</code>)</h3>" + _rows_table(rows, "ecofmaps-lab"),
         width=_WIDTH,
     )
 
