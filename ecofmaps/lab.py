@@ -417,14 +417,15 @@ def energy_wear(results, profile, length=None, contact="line") -> xr.Dataset:
     Notes
     -----
     Sums over the cycles driven, linear between those recorded; a round scar's volume by
-    Pappus's theorem; a campaign's fit needs three tests for its errors: docs/lab.md,
+    cylindrical shells; a campaign's fit needs three tests for its errors: docs/lab.md,
     "Energy wear".
 
     References
     ----------
     S. Fouvry, P. Kapsa, L. Vincent (1996), Wear 200, 186-205; S. Fouvry, T. Liskiewicz,
     P. Kapsa, S. Hannel, E. Sauger (2003), Wear 255, 287-298; J.F. Archard (1953), J. Appl.
-    Phys. 24, 981-988; Pappus's centroid theorem (titles in docs/lab.md).
+    Phys. 24, 981-988; G.B. Thomas et al. (2010), Thomas' Calculus, §6.2 (titles in
+    docs/lab.md).
 
     Examples
     --------
