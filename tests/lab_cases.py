@@ -19,23 +19,28 @@ def running_in_mu(cycle):
     return 0.5 + 0.3 * (1.0 - np.exp(-cycle / 3000.0))
 
 
-def recorded_test(amplitude, stiffness, cycles=CYCLES):
-    """analyze_loops of the recorded cycles of a gross-slip test (one steady loop each,
-    numbered as driven) and the closed-form sums over every cycle driven."""
+def recorded_cycles(amplitude, stiffness, cycles=CYCLES):
+    """The applied displacement [m], force [N] and cycle number of each sample of the recorded
+    cycles of a gross-slip test: one steady loop each, numbered as driven."""
     samples = 200
-    pieces, labels = [], []
+    pieces = []
     for n in cycles:
         mu = running_in_mu(n)
         contact = mindlin.Contact(mu, LOAD, DELTA_T * mu / MU)
         applied = mindlin.sweep([amplitude], samples)
         _, force = mindlin.drive(contact, applied, stiffness)
         span = slice(samples, 2 * samples)
-        pieces.append((applied[span], force[span]))
-        labels.append(np.full(samples, n))
-    applied, force = (np.concatenate(p) for p in zip(*pieces, strict=True))
+        pieces.append((applied[span], force[span], np.full(samples, n)))
+    return tuple(np.concatenate(p) for p in zip(*pieces, strict=True))
+
+
+def recorded_test(amplitude, stiffness, cycles=CYCLES):
+    """analyze_loops of :func:`recorded_cycles` and the closed-form sums over every cycle
+    driven."""
+    applied, force, cycle = recorded_cycles(amplitude, stiffness, cycles)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        results = ecofmaps.analyze_loops(applied, force, LOAD, cycle=np.concatenate(labels))
+        results = ecofmaps.analyze_loops(applied, force, LOAD, cycle=cycle)
     every = np.arange(1, cycles[-1] + 1)
     mu = running_in_mu(every)
     energy, slip = mindlin.gross_slip_loop(amplitude, mu, LOAD, DELTA_T * mu / MU, stiffness)

@@ -11,8 +11,11 @@ import pytest
 
 import ecofmaps
 from ecofmaps.cli.main import main
+from tests import mindlin
+from tests.lab_cases import ALPHA, DELTA_T, LOAD, MU, recorded_cycles, recorded_test
 
-DEPTH, HALF_WIDTH, LENGTH = 12e-6, 60e-6, 5e-3  # z_o/x_o = 0.2
+DEPTH, HALF_WIDTH = 12e-6, 60e-6  # z_o/x_o = 0.2
+LENGTH = 5e-3
 
 
 @pytest.fixture(scope="module")
@@ -86,3 +89,31 @@ def test_bad_input_is_one_line(files, capsys, arguments, message):
     arguments = [a.format(**named) for a in arguments]
     status, _, err = run(capsys, files / "test.csv", *arguments, "--load", "450N")
     assert status == 2 and message in err and len(err.splitlines()) == 1, err
+
+
+def test_the_wear_of_a_test_recorded_every_500th_cycle_printed_and_in_the_report(tmp_path, capsys):
+    """A gross-slip test on a sphere recorded every 500th cycle (a cycle column) and a groove
+    grown by V = α ΣE_d: ΣE_d, V, α and both k within 3 % of their closed forms, printed and
+    in the report."""
+    stiffness = 35e6
+    amplitude = 2.5 * mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    applied, force, cycle = recorded_cycles(amplitude, stiffness)
+    recording = {"displacement_um": applied * 1e6, "force_N": force, "cycle": cycle}
+    pd.DataFrame(recording).to_csv(tmp_path / "test.csv", index=False)
+    sums = recorded_test(amplitude, stiffness)[1]
+    x, z, area = mindlin.grown_groove(sums["energy"], ALPHA, LENGTH, 150e-6, noise=20e-9)
+    pd.DataFrame({"x_um": x * 1e6, "z_um": z * 1e6}).to_csv(tmp_path / "scar.csv", index=False)
+    status, out, err = run(capsys, tmp_path / "test.csv", "--load", "450N", "--cycle-col",
+                           "cycle", "--scar-profile", tmp_path / "scar.csv", "--length", "5mm",
+                           "--out", tmp_path / "t.csv", "--report", tmp_path / "r.html",
+                           )  # fmt: skip
+    assert status == 0, err
+    volume = area * LENGTH
+    archard = {"k_δ": volume / sums["slip"] * 1e9, "k_Δ": volume / sums["nominal"] * 1e9}
+    truths = {"ΣE_d": sums["energy"], "V": volume * 1e9, "α": ALPHA * 1e18, **archard}
+    page = html.unescape((tmp_path / "r.html").read_text(encoding="utf-8"))
+    page = re.sub(r"\\u([0-9a-f]{4})", lambda code: chr(int(code[1], 16)), page)  # JSON's
+    for text in (out, page):
+        for symbol, truth in truths.items():
+            found = re.search(rf"{symbol}(?:</th><td>| = )([\d.]+) ± ", text)
+            assert float(found[1]) == pytest.approx(truth, rel=0.03), symbol

@@ -41,7 +41,7 @@ def campaign(tmp_path_factory):
         trace = pd.DataFrame({"x_um": x * 1e6, "z_um": z * 1e6})
         trace.to_csv(folder / f"scar{i}.csv", index=False)
         files += [folder / f"test{i}.csv", "--profile", folder / f"scar{i}.csv"]
-        truths.append((sums["energy"], area * LENGTH))
+        truths.append((sums["energy"], area * LENGTH, sums["slip"], sums["nominal"]))
     return folder, files, truths
 
 
@@ -61,9 +61,13 @@ def test_wear_of_a_campaign_on_files(campaign, capsys):
     assert status == 0, err
     assert "gross slip" in text and "threshold energy" in text and f"wrote {out}" in text
     table = pd.read_csv(out)
-    energy, volume = np.array(truths).T
+    energy, volume, slip, nominal = np.array(truths).T
     np.testing.assert_allclose(table.cumulated_energy_J, energy, rtol=0.03)
     np.testing.assert_allclose(table.wear_volume_mm3 * 1e-9, volume, rtol=0.03)
+    alpha = table.energy_wear_coefficient_um3_per_J * 1e-18
+    np.testing.assert_allclose(alpha, volume / energy, rtol=0.03)
+    np.testing.assert_allclose(table.archard_slip_mm3_per_Nm * 1e-9, volume / slip, rtol=0.03)
+    np.testing.assert_allclose(table.archard_nominal_mm3_per_Nm * 1e-9, volume / nominal, rtol=0.03)
     assert (table.sliding_condition == "gross slip").all()
     assert "campaign: no transition to gross slip: results never cross" in text
     again = run(capsys, *tables, *profiles, "--length", "5mm", "--out", out)
