@@ -278,14 +278,15 @@ def _scar_numbers(args, each, profile) -> tuple[dict, object]:
     ``profile``, as rows of text (an error said in its row), and the closure or None."""
     from ecofmaps.lab import energy_wear, loop_scar_closure
 
-    rows, closure, names = {}, None, ("wear_volume", "energy_wear_coefficient", "archard_slip")
+    rows, closure = {}, None
     if (kind := contact(args)) is not None:
         try:
             wear = energy_wear(each.results, profile, args.length, kind)
         except ValueError as error:
             shown = f"none: {error}"
         else:
-            texts = texts_with_se(wear, (*names, "archard_nominal"))
+            names = ("wear_volume", "energy_wear_coefficient", "archard_slip", "archard_nominal")
+            texts = texts_with_se(wear, names)
             shown = ", ".join(f"{QUANTITIES[q].symbol} = {text}" for q, text in texts)
         rows[f"energy wear ({kind}, {args.scar_profile})"] = shown
     try:
@@ -464,7 +465,7 @@ def run(args) -> int:
 
     paths, load = _checked_inputs(args)
     outputs = _checked_outputs(args, paths)
-    scar = args.scar_profile and read_scar_file(args.scar_profile, "loops")
+    scar = None if args.scar_profile is None else read_scar_file(args.scar_profile, "loops")
     long_run = LongRun(args, paths)
     try:
         with contextlib.ExitStack() as stack:  # the table is written as it comes, renamed last
@@ -476,7 +477,7 @@ def run(args) -> int:
             done, failed = _analyse_each(args, paths, load, long_run, _Table(stream))
             if not done:  # nothing to write: the temporary goes
                 raise _NothingAnalysed
-            lab, closure = _scar_numbers(args, done[0], scar) if scar else ({}, None)
+            lab, closure = ({}, None) if scar is None else _scar_numbers(args, done[0], scar)
             _write_extras(args, done, lab, closure)
     except _NothingAnalysed:
         print(
