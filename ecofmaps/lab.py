@@ -443,6 +443,13 @@ def energy_wear(results, profile, length=None, contact="line") -> xr.Dataset:
     60 J, 0.002 mm³
     >>> print(f"alpha = {float(wear.energy_wear_coefficient) * 1e18:.4g} µm³/J")
     alpha = 3.333e+04 µm³/J
+
+    The same trace through the centre of a sphere's round scar, a paraboloid of volume
+    :math:`\pi D W^2/2` = 47 124 µm³:
+
+    >>> round_scar = ecofmaps.energy_wear(results, profile, contact="sphere")
+    >>> print(f"{float(round_scar.wear_volume) * 1e18:.0f} µm³")
+    47119 µm³
     """
     tests = _tests(results)
     single = not isinstance(results, list | tuple)
