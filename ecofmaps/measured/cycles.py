@@ -12,14 +12,22 @@ import numpy as np
 from ecofmaps.measured import samples as passes
 from ecofmaps.measured.samples import Samples
 
-__all__ = ["MIN_SAMPLES", "Cycles", "find_cycles", "labelled_cycles", "split_cycles"]
+__all__ = [
+    "LEAST_LEVEL",
+    "MIN_SAMPLES",
+    "NOISE_LEVEL",
+    "Cycles", "find_cycles", "labelled_cycles", "split_cycles"]
 
 #: Fewest samples in one complete cycle: two branches, each with a stick and a slip part.
 #: The one definition for the analysis, the fit and the synthetic recordings.
 MIN_SAMPLES = 8
 
 #: The least local half-band of the reversal detector, as a share of the whole recording's.
-_LEAST_LEVEL = 0.05
+LEAST_LEVEL = 0.05
+#: The least local half-band in standard deviations of the displacement's white noise.
+NOISE_LEVEL = 5.0
+#: The mean absolute second difference of white noise over its standard deviation.
+_MEAN_SECOND_DIFFERENCE = np.sqrt(6.0 * 2.0 / np.pi)
 #: A stretch between bottom runs within this share of the period is one regular cycle.
 _REGULAR = 0.1
 #: A recording longer than this with fewer than two bottom reversals is not read as one loop.
@@ -40,13 +48,14 @@ class Cycles:
     missing: np.ndarray | None = None
     missing_samples: int = 0
     first_missing: int = -1
+    #: True for a drive's period in which no reversal was found (empty: none).
+    hidden: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0, dtype=bool))
 
     @property
     def whole(self) -> np.ndarray:
-        """True for the cycles without a missing sample."""
-        if self.missing is None:
-            return np.ones(self.start.size, dtype=bool)
-        return ~self.missing
+        """True for the cycles without a missing sample, found at their reversals."""
+        whole = np.ones(self.start.size, dtype=bool) if self.missing is None else ~self.missing
+        return whole & ~self.hidden if self.hidden.size else whole
 
     def rows(self, rows: slice) -> Cycles:
         """The cycles ``rows`` (a slice of consecutive rows) as a table of their own."""
@@ -57,6 +66,7 @@ class Cycles:
             rotation=self.rotation[rows],
             label=self.label[rows],
             missing=None if self.missing is None else self.missing[rows],
+            hidden=self.hidden[rows] if self.hidden.size else self.hidden,
         )
 
     def indices(self, rows=slice(None)):
@@ -121,8 +131,8 @@ def _parts_after_gaps(samples, gaps, line, band, runs):
     part = part.astype(np.int64)
     first_piece = np.searchsorted(part, np.arange(begin.size))
     centre, level = band
-    if isinstance(level, tuple):  # a local band: its level where each part begins
-        level = passes.level_at(level, begin)
+    if isinstance(level, tuple):  # a local band: its centre and level where each part begins
+        centre, level = passes.level_at(centre, begin), passes.level_at(level, begin)
     own = kind[run_of]
     decided = np.where(
         own > 0,
@@ -300,9 +310,10 @@ def _trigger(samples: Samples, gaps, line, band):
 
 
 def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
-    """The trigger's local half-band ``(width, levels)``, or None where the whole
-    recording's finds every cycle: ``hysteresis`` × the least amplitude about the centre
-    over three stretches of half a period (one holds a peak of each cycle)."""
+    """The trigger's local centres and half-bands ``((width, centres), (width, levels))``,
+    or None where the whole recording's finds every cycle: ``hysteresis`` × the least
+    amplitude about the local centre over three stretches of half a period (one holds a
+    peak of each cycle)."""
     starts, kind, period = runs
     centre, level = band
     bottoms = starts[kind < 0]
@@ -313,43 +324,93 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
         return None
     width = max(int(period) // 2, MIN_SAMPLES)
     arguments = (passes._CHUNK, gaps, line, width)
-    stretch, highest, lowest, finite = _joined(samples, passes.local_extremes, arguments)
+    found = _joined(samples, passes.local_extremes, arguments)
+    stretch, highest, lowest, finite, rough, counted = found
     first = np.flatnonzero(np.diff(stretch, prepend=-1.0))
+    # the noise: the median stretch's mean absolute second difference (a cycle's own are
+    # small beside white noise's, √6 σ, at tens of samples a period)
+    rough, counted = np.add.reduceat(rough, first), np.add.reduceat(counted, first)
+    noise = np.nanmedian(np.where(counted > 0, rough / np.maximum(counted, 1), np.nan))
+    least = max(LEAST_LEVEL * level, NOISE_LEVEL * noise / _MEAN_SECOND_DIFFERENCE)
     highest, lowest = np.fmax.reduceat(highest, first), np.fmin.reduceat(lowest, first)
-    amplitude = np.fmax(highest - centre, centre - lowest)
     # a stretch cut short (by a gap or the end) may miss its peak: its neighbours' instead
-    amplitude[np.add.reduceat(finite, first) < width] = np.nan
-    amplitude = np.pad(amplitude, 1, mode="edge")
+    short = np.add.reduceat(finite, first) < width
+    highest[short], lowest[short] = np.nan, np.nan
+    middle = _local_centre(np.pad(highest, 1, mode="edge"), np.pad(lowest, 1, mode="edge"))
+    middle = np.where(np.isnan(middle), centre, middle)
+    amplitude = np.pad(np.fmax(highest - middle, middle - lowest), 1, mode="edge")
     local = hysteresis * np.fmin(np.fmin(amplitude[:-2], amplitude[1:-1]), amplitude[2:])
-    local = np.clip(np.where(np.isnan(local), level, local), _LEAST_LEVEL * level, level)
+    local = np.clip(np.where(np.isnan(local), level, local), min(least, level), level)
     if (local >= level).all():
         return None
-    return width, local
+    return (width, middle), (width, local)
 
 
-def _drive_cycles(bottoms, tops, n: int) -> Cycles:
-    """Cycles cut half way between a bottom reversal and the next top (the amplitude varies)."""
+def _local_centre(highest, lowest):
+    """Per stretch, the middle of the narrower of the two periods (it and the stretch
+    before, or after) that hold it: a drifting or tilted small cycle's own centre, not
+    one from a larger neighbour (``highest`` and ``lowest`` padded by one each side)."""
+    top = np.fmax(highest[:-1], highest[1:])
+    bottom = np.fmin(lowest[:-1], lowest[1:])
+    before = (top - bottom)[:-1] <= (top - bottom)[1:]
+    return 0.5 * np.where(before, top[:-1] + bottom[:-1], top[1:] + bottom[1:])
+
+
+def _drive_cycles(bottoms, tops, n: int, period: float) -> Cycles:
+    """Cycles cut half way between a bottom reversal and the next top (the amplitude
+    varies), a quarter period from them where that is more than three quarters away; the
+    drive's periods between, before and after them without a reversal are hidden rows."""
     none = np.zeros(0, dtype=np.int64)
     if not tops.size:
         return Cycles(none, none, none, none, False, 1, n)
     after = np.searchsorted(tops, bottoms)
     has_top = after < tops.size
     has_top[:-1] &= tops[np.minimum(after[:-1], tops.size - 1)] < bottoms[1:]
-    cut = np.where(has_top, (bottoms + tops[np.minimum(after, tops.size - 1)]) // 2, -1)
-    pair = (cut[:-1] >= 0) & (cut[1:] >= 0)  # two cuts, one bottom reversal between
-    start, stop, bottom = cut[:-1][pair], cut[1:][pair], bottoms[1:][pair]
+    top = tops[np.minimum(after, tops.size - 1)]
+    quarter = int(period) // 4
+    wide = top - bottoms > 3 * quarter  # hidden cycles between
+    # a last bottom without a top after it, or a first without a bottom before its top,
+    # is a cycle if a hidden drive period lies beyond it
+    last = ~has_top & (n - 1 - bottoms - quarter >= 1.5 * period)
+    end = np.where(has_top, np.where(wide, bottoms + quarter, (bottoms + top) // 2), -1)
+    end = np.where(last, bottoms + quarter, end)
+    begin = np.where(wide, top - quarter, end)  # of the next cycle
+    lead = tops[0] - quarter if tops[0] < bottoms[0] and tops[0] - quarter >= 1.5 * period else -1
+    begin = np.concatenate([[lead], begin[:-1]])  # of each bottom's cycle
+    pair = (begin >= 0) & (end >= 0)  # two cuts, one bottom reversal between
+    start, stop, bottom = begin[pair], end[pair], bottoms[pair]
     if not start.size:
         return Cycles(none, none, none, none, False, 1, n)
-    hole = start[1:] > stop[:-1]
-    leading, trailing = int(start[0]), int(n - 1 - stop[-1])
+    # the drive's periods in each hole, and before and after (less a lead-in or lead-out)
+    head, inner, tail = start[0], start[1:] - stop[:-1], n - 1 - stop[-1]
+    ends = np.rint(np.array([head, tail]) / period) - 1
+    hidden = np.concatenate([ends[:1], np.rint(inner / period), ends[1:]]).clip(0)
+    hidden = hidden.astype(np.int64)
+    length = np.concatenate([[period], inner / np.maximum(hidden[1:-1], 1), [period]])
+    hole = np.repeat(np.arange(hidden.size), hidden)
+    j = np.arange(hole.size) - np.repeat(np.cumsum(hidden) - hidden, hidden)
+    j -= np.where(hole == 0, hidden[0], 0)  # the head's run back from the first cycle
+    at = np.concatenate([[start[0]], stop])  # each hole's end next to a cycle
+    hidden_start = np.rint(at[hole] + length[hole] * j).astype(np.int64)
+    rows = np.argsort(np.concatenate([start, hidden_start]), kind="stable")
+    size = np.rint(length[hole]).astype(np.int64)
+    first = np.concatenate([start, hidden_start])[rows]
+    count = np.concatenate([stop - start, size])[rows] + 1
+    rotation = np.concatenate([bottom - start, np.rint(0.75 * size)])[rows].astype(np.int64)
+    is_hidden = np.concatenate([np.zeros(start.size, bool), np.ones(size.size, bool)])[rows]
+    gap = first[1:] > first[:-1] + count[:-1] - 1
+    leading, trailing = int(first[0]), int(n - first[-1] - count[-1])
     return Cycles(
-        start=start,
-        count=stop - start + 1,
-        rotation=bottom - start,
-        label=np.arange(1, start.size + 1, dtype=np.int64),
+        start=first,
+        count=count,
+        rotation=rotation,
+        label=np.arange(1, first.size + 1, dtype=np.int64),
         continuous=False,
-        incomplete_cycles=int(leading > 0) + int(trailing > 0) + int(np.count_nonzero(hole)),
-        dropped_samples=leading + trailing + int((start[1:] - stop[:-1] - 1)[hole].sum()),
+        incomplete_cycles=int(leading > 0) + int(trailing > 0) + int(np.count_nonzero(gap)),
+        dropped_samples=leading
+        + trailing
+        + int((first[1:] - first[:-1] - count[:-1])[gap].sum()),
+        hidden=is_hidden if is_hidden.any() else np.zeros(0, dtype=bool),
     )
 
 
@@ -372,9 +433,9 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     period = _period(starts, kind)
     level = _local_level(samples, gaps, line, (starts, kind, period), hysteresis, band)
     if level is not None:  # kept if it finds smaller cycles (more bottom runs)
-        local = _trigger(samples, gaps, line, (centre, level))
+        local = _trigger(samples, gaps, line, level)
         if np.count_nonzero(local[1] < 0) > np.count_nonzero(kind < 0):
-            band = (centre, level)
+            band = level
             starts, kind, extreme, value = local
             period = _period(starts, kind)
         else:
@@ -403,7 +464,8 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
         return _labelled(samples.constant_cycle(), tolerance)
     if level is not None:  # the amplitude varies: cut where the drive's cycles meet
         tops = extreme_of_part[(kind_of_part > 0) & accepted]
-        return _drive_numbers(_with_missing(_drive_cycles(bottoms, tops, n), gaps), merged=True)
+        found = _drive_cycles(bottoms, tops, n, float(np.median(np.diff(bottoms))))
+        return _drive_numbers(_with_missing(found, gaps), merged=True)
     # Each loop runs from its bottom reversal to the next and back to its first sample, so
     # it is closed even if the displacement drifted in between.
     start = bottoms[:-1]

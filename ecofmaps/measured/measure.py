@@ -457,6 +457,8 @@ def measure_cycles(cycles: Cycles, displacement, force, options, *, rows=None, k
     flags = {reason: np.zeros(stop - first, dtype=bool) for reason in _MEASURED}
     if cycles.missing is not None:  # not measured: their values stay NaN
         flags["missing-samples"] = cycles.missing[first:stop].copy()
+    if cycles.hidden.size:
+        flags["no-reversal"] = cycles.hidden[first:stop].copy()
     loops = None
     if keep_loops:
         width = int(cycles.count[first:stop].max()) + 1

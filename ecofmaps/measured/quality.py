@@ -13,7 +13,7 @@ import xarray as xr
 
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._codes import warn
-from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles
+from ecofmaps.measured.cycles import LEAST_LEVEL, MIN_SAMPLES, NOISE_LEVEL, Cycles
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, PARTIAL_SLIP, Regime
 
 __all__ = [
@@ -132,6 +132,13 @@ RESOLVED = ("mu_resolved", "mu_resolved_se", "aspect_ratio")
 REASONS = {
     "missing-samples": (
         "the cycle holds a missing sample (NaN or an empty cell): skipped, not analysed",
+        ALL,
+    ),
+    "no-reversal": (
+        "no reversal where the drive's period puts this cycle: smaller than the reversal "
+        f"detector's least band ({LEAST_LEVEL * 100:g} % of the whole recording's, and "
+        f"{NOISE_LEVEL:g} standard deviations of the displacement's noise), or none (the rig "
+        "at rest): not analysed",
         ALL,
     ),
     "load-not-positive": (

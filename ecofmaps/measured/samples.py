@@ -159,8 +159,8 @@ def _tails(start, stop, arguments, x):
 
 
 def level_at(level, samples):
-    """The trigger's half-band at ``samples`` [m] when it is local: ``level = (width,
-    levels)``, one level per stretch of ``width`` samples counted from sample 0."""
+    """The trigger's half-band (or centre) at ``samples`` [m] when it is local: ``level =
+    (width, levels)``, one level per stretch of ``width`` samples counted from sample 0."""
     width, levels = level
     return levels[samples // width]
 
@@ -168,16 +168,20 @@ def level_at(level, samples):
 def local_extremes(start, stop, arguments, x):
     """The largest and smallest detrended displacement of each stretch of ``width``
     samples (counted from sample 0) that the block's chunks cut: rows of the stretch's
-    number, its largest, its smallest (NaN where none is finite) and its finite samples."""
+    number, its largest, its smallest (NaN where none is finite), its finite samples, and
+    the sum and number of the finite absolute second differences within the chunk."""
     chunk, gaps, line, width = arguments
-    found = [np.empty((4, 0))]
+    found = [np.empty((6, 0))]
     for a, b in _chunks(start, stop, chunk):
         d = detrended(blanked(x[a - start : b - start], a, b, gaps), a, line)
         first = np.arange(a // width, (b - 1) // width + 1)
         cuts = np.maximum(first * width, a) - a
         highest, lowest = np.fmax.reduceat(d, cuts), np.fmin.reduceat(d, cuts)
         finite = np.add.reduceat(np.isfinite(d), cuts)
-        found.append(np.stack([first.astype(np.float64), highest, lowest, finite]))
+        second = np.abs(np.diff(d, 2, prepend=np.nan, append=np.nan))
+        rough = np.add.reduceat(np.nan_to_num(second), cuts)
+        counted = np.add.reduceat(np.isfinite(second), cuts)
+        found.append(np.stack([first.astype(np.float64), highest, lowest, finite, rough, counted]))
     return np.concatenate(found, axis=1)
 
 
@@ -190,7 +194,8 @@ def trigger_runs(start, stop, arguments, x):
         xa = blanked(x[a - start : b - start], a, b, gaps)
         d = detrended(xa, a, line)
         level = level_at(band, np.arange(a, b)) if isinstance(band, tuple) else band
-        state = (d > centre + level).view(np.int8) - (d < centre - level).view(np.int8)
+        middle = level_at(centre, np.arange(a, b)) if isinstance(centre, tuple) else centre
+        state = (d > middle + level).view(np.int8) - (d < middle - level).view(np.int8)
         entry = np.concatenate([[0], np.flatnonzero(state[1:] != state[:-1]) + 1])
         kind = state[entry]
         entry, kind = entry[kind != 0], kind[kind != 0]  # into a decided state
