@@ -16,7 +16,11 @@ __all__ = [
     "LEAST_LEVEL",
     "MIN_SAMPLES",
     "NOISE_LEVEL",
-    "Cycles", "find_cycles", "labelled_cycles", "split_cycles"]
+    "Cycles",
+    "find_cycles",
+    "labelled_cycles",
+    "split_cycles",
+]
 
 #: Fewest samples in one complete cycle: two branches, each with a stick and a slip part.
 #: The one definition for the analysis, the fit and the synthetic recordings.
@@ -170,6 +174,15 @@ def _decided_earlier_in_run(decided, run_of):
     return count > at_first
 
 
+def _half_period(kind, extreme) -> float:
+    """The lesser of the median distances from a top reversal to the next bottom and back."""
+    gone = np.diff(extreme)
+    falling, rising = gone[kind[:-1] > 0], gone[kind[:-1] < 0]
+    if not (falling.size and rising.size):
+        return np.nan
+    return float(min(np.median(falling), np.median(rising)))
+
+
 def _period(starts, kind) -> float:
     """The median distance between the starts of the bottom runs (NaN with fewer than two)."""
     low = starts[kind < 0]
@@ -314,10 +327,10 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
     or None where the whole recording's finds every cycle: ``hysteresis`` × the least
     amplitude about the local centre over three stretches of half a period (one holds a
     peak of each cycle)."""
-    starts, kind, period = runs
+    starts, kind, period, step = runs
     centre, level = band
     bottoms = starts[kind < 0]
-    regular = np.abs(np.diff(bottoms) / period - 1.0) <= _REGULAR
+    regular = np.abs(np.diff(bottoms) / (step * period) - 1.0) <= _REGULAR
     if not (np.count_nonzero(regular) >= 2 and regular.mean() >= 0.5):
         return None
     if np.diff(bottoms, prepend=0, append=samples.size).max() <= 1.5 * period:
@@ -348,12 +361,17 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
 
 def _local_centre(highest, lowest):
     """Per stretch, the middle of the narrower of the two periods (it and the stretch
-    before, or after) that hold it: a drifting or tilted small cycle's own centre, not
-    one from a larger neighbour (``highest`` and ``lowest`` padded by one each side)."""
+    before, or after) that hold it, where that spans at most 2.5 times the least of the
+    three stretches' own (a held amplitude: a drifting or tilted small cycle's own
+    centre), else NaN (``highest`` and ``lowest`` padded by one each side)."""
     top = np.fmax(highest[:-1], highest[1:])
     bottom = np.fmin(lowest[:-1], lowest[1:])
-    before = (top - bottom)[:-1] <= (top - bottom)[1:]
-    return 0.5 * np.where(before, top[:-1] + bottom[:-1], top[1:] + bottom[1:])
+    span, own = top - bottom, highest - lowest
+    before = span[:-1] <= span[1:]
+    least = np.fmin(np.fmin(own[:-2], own[1:-1]), own[2:])
+    held = np.fmin(span[:-1], span[1:]) <= 2.5 * least
+    middle = 0.5 * np.where(before, top[:-1] + bottom[:-1], top[1:] + bottom[1:])
+    return np.where(held, middle, np.nan)
 
 
 def _drive_cycles(bottoms, tops, n: int, period: float) -> Cycles:
@@ -407,9 +425,7 @@ def _drive_cycles(bottoms, tops, n: int, period: float) -> Cycles:
         label=np.arange(1, first.size + 1, dtype=np.int64),
         continuous=False,
         incomplete_cycles=int(leading > 0) + int(trailing > 0) + int(np.count_nonzero(gap)),
-        dropped_samples=leading
-        + trailing
-        + int((first[1:] - first[:-1] - count[:-1])[gap].sum()),
+        dropped_samples=leading + trailing + int((first[1:] - first[:-1] - count[:-1])[gap].sum()),
         hidden=is_hidden if is_hidden.any() else np.zeros(0, dtype=bool),
     )
 
@@ -431,7 +447,12 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     band = (centre, hysteresis * half_range)
     starts, kind, extreme, value = _trigger(samples, gaps, line, band)
     period = _period(starts, kind)
-    level = _local_level(samples, gaps, line, (starts, kind, period), hysteresis, band)
+    # every other cycle under the band: the bottom runs two periods apart, half a period
+    # from a top to the next bottom (or back) still
+    half = _half_period(kind, extreme)
+    step = 2 if 2 * half < 0.75 * period else 1
+    runs = (starts, kind, period / step, step)
+    level = _local_level(samples, gaps, line, runs, hysteresis, band)
     if level is not None:  # kept if it finds smaller cycles (more bottom runs)
         local = _trigger(samples, gaps, line, level)
         if np.count_nonzero(local[1] < 0) > np.count_nonzero(kind < 0):
