@@ -34,6 +34,9 @@ NOISE_LEVEL = 5.0
 _MEAN_SECOND_DIFFERENCE = np.sqrt(6.0 * 2.0 / np.pi)
 #: A stretch between bottom runs within this share of the period is one regular cycle.
 _REGULAR = 0.1
+#: Strokes between reversals in a row that differ by more than this share of the larger
+#: are a step of the drive's amplitude (its cycles are cut where they meet).
+_STEP = 0.05
 #: A recording longer than this with fewer than two bottom reversals is not read as one loop.
 _ONE_LOOP = 1 << 24
 
@@ -263,6 +266,16 @@ def _deep_ends(value, accepted):
     return deep
 
 
+def _steps(kind, value) -> bool:
+    """Whether the drive's amplitude steps: two strokes between alternate reversals (of
+    ``kind``, at ``value``) in a row differ by more than :data:`_STEP` of the larger."""
+    stroke = np.abs(np.diff(value))
+    turns = kind[1:] != kind[:-1]
+    both = turns[1:] & turns[:-1]
+    change = np.abs(np.diff(stroke)) > _STEP * np.fmax(stroke[1:], stroke[:-1])
+    return bool((both & change).any())
+
+
 def _with_missing(cycles: Cycles, gaps) -> Cycles:
     """``cycles`` with the cycles that hold a sample of ``gaps`` marked."""
     if not gaps.size:
@@ -483,7 +496,8 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
                 f"no complete cycle in {n} samples: fewer than two displacement reversals"
             )
         return _labelled(samples.constant_cycle(), tolerance)
-    if level is not None:  # the amplitude varies: cut where the drive's cycles meet
+    # the amplitude varies: cut where the drive's cycles meet
+    if level is not None or _steps(kind_of_part[accepted], parts[3][accepted]):
         tops = extreme_of_part[(kind_of_part > 0) & accepted]
         found = _drive_cycles(bottoms, tops, n, float(np.median(np.diff(bottoms))))
         return _drive_numbers(_with_missing(found, gaps), merged=True)

@@ -2,9 +2,11 @@
 cycle found and numbered as driven, the regime on the contact's displacement, and the
 GICoF of a sphere's gross-slip loops despite their curved stick."""
 
+import io
 import warnings
 
 import numpy as np
+import pandas as pd
 import pytest
 
 import ecofmaps
@@ -12,7 +14,9 @@ from ecofmaps.measured import cycles as cycles_module
 from ecofmaps.measured import pipeline
 from ecofmaps.measured import samples as passes
 from tests import mindlin
+from tests.cli.commands import run_loops
 from tests.measured.test_out_of_core import analysed, assert_equal_results, lazily
+from tests.recordings import write_csv
 
 MU, LOAD, DELTA_T = 0.8, 450.0, 6e-6
 SAMPLES = 200  # per cycle
@@ -120,8 +124,11 @@ def test_a_sweep_out_of_core_as_in_memory(monkeypatch):
     assert_equal_results(lazy, memory)
 
 
-# held amplitudes (× Δ_t), three cycles each: steps of ×3, ×4 (40 µm to 10 µm), ×5 and ×10
+# held amplitudes (× Δ_t), three cycles each: steps of ×1.3 and ×1.8 (every cycle crosses
+# the whole recording's band), ×3, ×4 (40 µm to 10 µm), ×5 and ×10
 STEEP = {
+    "x1.3-falling": [1.3, 1.0],
+    "x1.8-rising": [0.55, 1.0],
     "x3-rising": [0.5, 1.5, 4.5],
     "x3-falling": [4.5, 1.5, 0.5],
     "x4-down-and-up": [2.46, 0.615, 2.46, 0.615],
@@ -160,24 +167,133 @@ def test_every_cycle_after_a_steep_step_is_reported_with_values(steps, noise):
         np.testing.assert_allclose(results.amplitude, amplitudes, rtol=1e-3)
 
 
-def test_cycles_under_the_bands_floor_keep_the_drives_numbers():
-    """Cycles under 5 % of the band (×30 smaller) join in rows of their own neighbours, one
-    flagged several-loops and numbered as the drive cycle of its bottom reversal; the large
-    cycles keep their numbers."""
+def test_cycles_under_the_bands_floor_are_rows_of_their_own():
+    """Cycles ×30 smaller than their neighbours: analysed when clean; with 1 % noise (a
+    third of their amplitude) each is a row still, NaN and flagged no-reversal where no
+    reversal stands above the noise; every number as driven."""
     applied, force, amplitudes = steep_sweep([3.0, 0.1, 3.0])
     results = analysed(applied, force)
-    np.testing.assert_array_equal(results.cycle, [1, 2, 3, 5, 7, 8, 9])
-    assert results.quality.values[3] == "several-loops"
-    big = results.cycle.values[results.cycle.values != 5]
-    np.testing.assert_allclose(results.amplitude.sel(cycle=big), amplitudes[big - 1], rtol=1e-3)
+    np.testing.assert_array_equal(results.cycle, np.arange(1, 10))
+    np.testing.assert_allclose(results.amplitude, amplitudes, rtol=1e-3)
+    noisy = analysed(*steep_sweep([3.0, 0.1, 3.0], noise=0.01)[:2])
+    np.testing.assert_array_equal(noisy.cycle, np.arange(1, 10))
+    hidden = noisy.quality.values == "no-reversal"
+    assert hidden.any() and not hidden[[0, 1, 2, 6, 7, 8]].any()
+    assert noisy.amplitude.values[hidden].size and np.isnan(noisy.amplitude.values[hidden]).all()
+    assert np.isfinite(noisy.dissipated_energy.values[[0, 1, 2, 6, 7, 8]]).all()
 
 
-def test_a_steep_sweep_out_of_core_as_in_memory(monkeypatch):
+# amplitudes (× Δ_t) of one cycle each: alternating ×5, log-spaced ×20, ramps
+SINGLE = {
+    "x5-alternating": [0.4, 2.0] * 4,
+    "log-spaced": np.geomspace(0.2, 4.0, 12),
+    "ramp-up": np.linspace(0.45, 1.8, 20),
+    "ramp-down": np.linspace(1.8, 0.45, 20),
+}
+
+
+def one_cycle_sweep(steps, noise=0.0, stiffness=35e6):
+    """As :func:`steep_sweep`, each amplitude held one cycle (behind a rig ``stiffness``)."""
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    amplitudes = np.asarray(steps) * at
+    applied = mindlin.sweep(amplitudes, SAMPLES)
+    _, force = mindlin.drive(mindlin.Contact(MU, LOAD, DELTA_T), applied, stiffness)
+    rng = np.random.default_rng(1)
+    applied += noise * amplitudes.max() * rng.standard_normal(applied.size)
+    force += noise * MU * LOAD * rng.standard_normal(force.size)
+    return applied, force, amplitudes
+
+
+@pytest.mark.parametrize("noise", [0.0, 0.01])
+@pytest.mark.parametrize("steps", SINGLE.values(), ids=SINGLE.keys())
+def test_a_new_amplitude_every_cycle_reports_every_cycle(steps, noise):
+    applied, force, amplitudes = one_cycle_sweep(steps, noise)
+    results = analysed(applied, force)
+    np.testing.assert_array_equal(results.cycle, np.arange(1, amplitudes.size + 1))
+    assert results.attrs["incomplete_cycles"] == 2
+    if not noise:
+        np.testing.assert_allclose(results.amplitude, amplitudes, rtol=1e-3)
+
+
+@pytest.mark.parametrize("noise", [0.0, 0.01])
+@pytest.mark.parametrize("steps", [[0.1, 3.0], [3.0, 0.1]], ids=["up", "down"])
+def test_a_x30_jump_at_either_end_reports_every_cycle(steps, noise):
+    """The small cycles before the first large one, or after the last, are rows too."""
+    applied, force, amplitudes = steep_sweep(steps, noise)
+    results = analysed(applied, force)
+    np.testing.assert_array_equal(results.cycle, np.arange(1, 7))
+    big = amplitudes > amplitudes.min()
+    np.testing.assert_allclose(results.amplitude.values[big], amplitudes[big], rtol=2e-2)
+    small = results.amplitude.values[~big]
+    if not noise:
+        np.testing.assert_allclose(small, amplitudes[~big], rtol=1e-3)
+    else:  # NaN where not found: never a value from noise alone
+        assert np.isnan(small[results.quality.values[~big] == "no-reversal"]).all()
+
+
+def test_a_rest_between_blocks_makes_no_cycle_of_noise():
+    """The rig at rest (1 % noise) for five periods between two blocks of three cycles:
+    no value from the rest, its periods NaN rows flagged no-reversal, the blocks' cycles
+    analysed."""
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, 35e6)
+    block = mindlin.sweep([at] * 3, SAMPLES)[:-1]
+    applied = np.concatenate([block[: 4 * SAMPLES], np.zeros(5 * SAMPLES), block[SAMPLES:], [0]])
+    _, force = mindlin.drive(mindlin.Contact(MU, LOAD, DELTA_T), applied, 35e6)
+    rng = np.random.default_rng(2)
+    applied += 0.01 * at * rng.standard_normal(applied.size)
+    results = analysed(applied, force)
+    hidden = results.quality.values == "no-reversal"
+    assert np.isnan(results.amplitude.values[hidden]).all()
+    np.testing.assert_allclose(results.amplitude.values[~hidden], at, rtol=0.05)
+    assert np.count_nonzero(~hidden) == 6
+
+
+OUT_OF_CORE = {
+    "x4-down-and-up": lambda: steep_sweep(STEEP["x4-down-and-up"]),
+    "x30-dip-noisy": lambda: steep_sweep([3.0, 0.1, 3.0], noise=0.01),
+    "x30-jump-up-noisy": lambda: steep_sweep([0.1, 3.0], noise=0.01),
+    "x5-alternating": lambda: one_cycle_sweep(SINGLE["x5-alternating"]),
+}
+
+
+@pytest.mark.parametrize("make", OUT_OF_CORE.values(), ids=OUT_OF_CORE.keys())
+def test_a_steep_sweep_out_of_core_as_in_memory(monkeypatch, make):
+    """Rows without a reversal too: the same rows, numbers and flags however it is held."""
     monkeypatch.setattr(passes, "_CHUNK", 1000)
     monkeypatch.setattr(passes, "_SAMPLE", 256)
     monkeypatch.setattr(pipeline, "TASK_SAMPLES", 777)
-    applied, force, amplitudes = steep_sweep(STEEP["x4-down-and-up"])
+    applied, force, amplitudes = make()
     memory = analysed(applied, force)
-    assert memory.cycle.size == amplitudes.size
+    np.testing.assert_array_equal(memory.cycle, np.arange(1, amplitudes.size + 1))
     lazy = analysed(*lazily(applied, force, chunks=1700), scheduler="threads")
     assert_equal_results(lazy, memory)
+
+
+@pytest.mark.parametrize("stiffness", [15e6, 35e6, 100e6])
+@pytest.mark.parametrize("noise", [0.0, 0.01])
+def test_every_cycle_of_a_sweep_with_noise_out_of_core(monkeypatch, noise, stiffness):
+    """The sweep of 40 cycles from 0.45 to 1.8 Δ_t (each amplitude held two cycles) with
+    and without 1 % noise, in memory and out of core: every cycle, numbered as driven."""
+    monkeypatch.setattr(passes, "_CHUNK", 1000)
+    monkeypatch.setattr(pipeline, "TASK_SAMPLES", 777)
+    steps = np.repeat(np.linspace(0.45, 1.8, 20), 2)
+    applied, force, amplitudes = one_cycle_sweep(steps, noise, stiffness)
+    memory = analysed(applied, force)
+    np.testing.assert_array_equal(memory.cycle, np.arange(1, 41))
+    assert np.isfinite(memory.dissipated_energy).all()
+    np.testing.assert_allclose(memory.amplitude, amplitudes, rtol=0.1 if noise else 1e-3)
+    lazy = analysed(*lazily(applied, force, chunks=1700), scheduler="threads")
+    assert_equal_results(lazy, memory)
+
+
+def test_ecofmaps_loops_reports_every_cycle_of_a_csv(tmp_path, capsys):
+    """The ×30 dip with 1 % noise through the command line: a row for each driven cycle,
+    those without a reversal flagged no-reversal with empty values."""
+    applied, force, _ = steep_sweep([3.0, 0.1, 3.0], noise=0.01)
+    path = write_csv(tmp_path / "dip.csv", applied, force)
+    status, out, err = run_loops(capsys, path, "--load", "450N", "--no-resolve")
+    assert status == 0, err
+    table = pd.read_csv(io.StringIO(out))
+    assert table.cycle.tolist() == list(range(1, 10))
+    hidden = table.quality == "no-reversal"
+    assert hidden.any() and table.amplitude_um[hidden].isna().all()
