@@ -266,14 +266,21 @@ def _deep_ends(value, accepted):
     return deep
 
 
-def _steps(kind, value) -> bool:
-    """Whether the drive's amplitude steps: two strokes between alternate reversals (of
-    ``kind``, at ``value``) in a row differ by more than :data:`_STEP` of the larger."""
+def _steps(kind, extreme, value) -> bool:
+    """Whether the drive's amplitude steps: reversals (of ``kind``, at samples ``extreme``
+    and ``value``) periodic, and a stroke between alternate ones differing from the last
+    in its direction (a drift cancels) by more than :data:`_STEP` of the larger, the next
+    within it of its own (held)."""
+    bottoms = extreme[kind < 0]
+    if bottoms.size < 3:
+        return False
+    regular = np.abs(np.diff(bottoms) / np.median(np.diff(bottoms)) - 1.0) <= _REGULAR
     stroke = np.abs(np.diff(value))
     turns = kind[1:] != kind[:-1]
-    both = turns[1:] & turns[:-1]
-    change = np.abs(np.diff(stroke)) > _STEP * np.fmax(stroke[1:], stroke[:-1])
-    return bool((both & change).any())
+    alternate = turns[4:] & turns[3:-1] & turns[2:-2] & turns[1:-3] & turns[:-4]
+    differ = np.abs(stroke[2:] - stroke[:-2]) > _STEP * np.fmax(stroke[2:], stroke[:-2])
+    step = differ[:-2] & ~differ[2:]  # stroke k+2 differs from k, k+4 agrees with k+2
+    return bool(regular.mean() >= 0.5 and (alternate & step).any())
 
 
 def _with_missing(cycles: Cycles, gaps) -> Cycles:
@@ -497,7 +504,7 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
             )
         return _labelled(samples.constant_cycle(), tolerance)
     # the amplitude varies: cut where the drive's cycles meet
-    if level is not None or _steps(kind_of_part[accepted], parts[3][accepted]):
+    if level is not None or _steps(kind_of_part[accepted], *(p[accepted] for p in parts[2:])):
         tops = extreme_of_part[(kind_of_part > 0) & accepted]
         found = _drive_cycles(bottoms, tops, n, float(np.median(np.diff(bottoms))))
         return _drive_numbers(_with_missing(found, gaps), merged=True)
