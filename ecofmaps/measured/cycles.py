@@ -384,10 +384,10 @@ def _local_centre(highest, lowest):
     before, or after) that hold it, where that spans at most 2.5 times the least of the
     three stretches' own (a held amplitude: a drifting or tilted small cycle's own
     centre), else NaN (``highest`` and ``lowest`` padded by one each side)."""
-    top = np.fmax(highest[:-1], highest[1:])
-    bottom = np.fmin(lowest[:-1], lowest[1:])
+    top = np.maximum(highest[:-1], highest[1:])  # NaN with a stretch cut short
+    bottom = np.minimum(lowest[:-1], lowest[1:])
     span, own = top - bottom, highest - lowest
-    before = span[:-1] <= span[1:]
+    before = np.fmin(span[:-1], span[1:]) == span[:-1]
     least = np.fmin(np.fmin(own[:-2], own[1:-1]), own[2:])
     held = np.fmin(span[:-1], span[1:]) <= 2.5 * least
     middle = 0.5 * np.where(before, top[:-1] + bottom[:-1], top[1:] + bottom[1:])
@@ -406,15 +406,18 @@ def _drive_cycles(bottoms, tops, n: int, period: float) -> Cycles:
     has_top[:-1] &= tops[np.minimum(after[:-1], tops.size - 1)] < bottoms[1:]
     top = tops[np.minimum(after, tops.size - 1)]
     quarter = int(period) // 4
-    wide = top - bottoms > 3 * quarter  # hidden cycles between
+    wide = has_top & (top - bottoms > 3 * quarter)  # hidden cycles between
     # a last bottom without a top after it, or a first without a bottom before its top,
     # is a cycle if a hidden drive period lies beyond it
-    last = ~has_top & (n - 1 - bottoms - quarter >= 1.5 * period)
+    last = np.zeros(bottoms.size, dtype=bool)
+    last[-1] = not has_top[-1] and n - 1 - bottoms[-1] - quarter >= 1.5 * period
     end = np.where(has_top, np.where(wide, bottoms + quarter, (bottoms + top) // 2), -1)
     end = np.where(last, bottoms + quarter, end)
     begin = np.where(wide, top - quarter, end)  # of the next cycle
     lead = tops[0] - quarter if tops[0] < bottoms[0] and tops[0] - quarter >= 1.5 * period else -1
     begin = np.concatenate([[lead], begin[:-1]])  # of each bottom's cycle
+    # or three quarters before its bottom if the top before lies beyond hidden cycles
+    begin = np.where(bottoms - begin > 5 * quarter, bottoms - 3 * quarter, begin)
     pair = (begin >= 0) & (end >= 0)  # two cuts, one bottom reversal between
     start, stop, bottom = begin[pair], end[pair], bottoms[pair]
     if not start.size:

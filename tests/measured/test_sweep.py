@@ -269,6 +269,26 @@ def test_a_steep_sweep_out_of_core_as_in_memory(monkeypatch, make):
     assert_equal_results(lazy, memory)
 
 
+@pytest.mark.parametrize("gap", [(200, 300), (1000, 1340), (1100, 1500), (990, 1700), (4000, 4401)])
+def test_a_gap_in_a_sweep_leaves_each_cycle_its_row(monkeypatch, gap):
+    """Missing samples (NaN) in a sweep of 20 cycles, at its start, over one to three
+    cycles, and to its end: every cycle a row numbered as driven, those with a missing
+    sample flagged, the others measured; out of core as in memory."""
+    monkeypatch.setattr(passes, "_CHUNK", 1000)
+    monkeypatch.setattr(pipeline, "TASK_SAMPLES", 777)
+    applied, force, amplitudes = one_cycle_sweep(np.repeat(np.linspace(0.45, 1.8, 10), 2))
+    applied[slice(*gap)] = np.nan
+    memory = analysed(applied, force)
+    np.testing.assert_array_equal(memory.cycle, np.arange(1, 21))
+    skipped = np.char.startswith(memory.quality.values.astype(str), "missing-samples")
+    driven = np.arange(1, 21) * SAMPLES  # where each drive cycle begins
+    holds = (driven + SAMPLES >= gap[0]) & (driven <= gap[1])  # a sample of the gap, or beside
+    assert skipped.any() and not (skipped & ~holds).any()
+    np.testing.assert_allclose(memory.amplitude[~skipped], amplitudes[~skipped], rtol=1e-3)
+    lazy = analysed(*lazily(applied, force, chunks=1700), scheduler="threads")
+    assert_equal_results(lazy, memory)
+
+
 @pytest.mark.parametrize("stiffness", [15e6, 35e6, 100e6])
 @pytest.mark.parametrize("noise", [0.0, 0.01])
 def test_every_cycle_of_a_sweep_with_noise_out_of_core(monkeypatch, noise, stiffness):
