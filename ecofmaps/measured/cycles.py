@@ -356,12 +356,13 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
     if np.diff(bottoms, prepend=0, append=samples.size).max() <= 1.5 * period:
         return None
     width = max(int(period) // 2, MIN_SAMPLES)
-    arguments = (passes._CHUNK, gaps, line, width)
+    sine = (centre, 4.0 * np.sin(np.pi / period) ** 2)  # Δ²x = -4 sin²(π/T) x
+    arguments = (passes._CHUNK, gaps, line, width, sine)
     found = _joined(samples, passes.local_extremes, arguments)
     stretch, highest, lowest, finite, rough, counted = found
     first = np.flatnonzero(np.diff(stretch, prepend=-1.0))
-    # the noise: the median stretch's mean absolute second difference (a cycle's own are
-    # small beside white noise's, √6 σ, at tens of samples a period)
+    # the noise: the median stretch's mean absolute second difference less a sine's own
+    # (white noise's is √6 σ)
     rough, counted = np.add.reduceat(rough, first), np.add.reduceat(counted, first)
     noise = np.nanmedian(np.where(counted > 0, rough / np.maximum(counted, 1), np.nan))
     least = max(LEAST_LEVEL * level, NOISE_LEVEL * noise / _MEAN_SECOND_DIFFERENCE)
@@ -417,28 +418,27 @@ def _drive_cycles(bottoms, tops, n: int, period: float) -> Cycles:
     lead = tops[0] - quarter if tops[0] < bottoms[0] and tops[0] - quarter >= 1.5 * period else -1
     begin = np.concatenate([[lead], begin[:-1]])  # of each bottom's cycle
     # or three quarters before its bottom if the top before lies beyond hidden cycles
-    begin = np.where(bottoms - begin > 5 * quarter, bottoms - 3 * quarter, begin)
+    begin = np.where((begin >= 0) & (bottoms - begin > 5 * quarter), bottoms - 3 * quarter, begin)
     pair = (begin >= 0) & (end >= 0)  # two cuts, one bottom reversal between
     start, stop, bottom = begin[pair], end[pair], bottoms[pair]
     if not start.size:
         return Cycles(none, none, none, none, False, 1, n)
-    # the drive's periods in each hole, and before and after (less a lead-in or lead-out)
+    # the drive's periods in each hole, and before and after (less a lead-in or lead-out);
+    # a hidden row's bottom three quarters in, as a cycle's, for its number
     head, inner, tail = start[0], start[1:] - stop[:-1], n - 1 - stop[-1]
     ends = np.rint(np.array([head, tail]) / period) - 1
-    hidden = np.concatenate([ends[:1], np.rint(inner / period), ends[1:]]).clip(0)
-    hidden = hidden.astype(np.int64)
+    hidden = np.concatenate([ends[:1], np.rint(inner / period), ends[1:]]).clip(0).astype(int)
     length = np.concatenate([[period], inner / np.maximum(hidden[1:-1], 1), [period]])
     hole = np.repeat(np.arange(hidden.size), hidden)
     j = np.arange(hole.size) - np.repeat(np.cumsum(hidden) - hidden, hidden)
     j -= np.where(hole == 0, hidden[0], 0)  # the head's run back from the first cycle
     at = np.concatenate([[start[0]], stop])  # each hole's end next to a cycle
-    hidden_start = np.rint(at[hole] + length[hole] * j).astype(np.int64)
-    rows = np.argsort(np.concatenate([start, hidden_start]), kind="stable")
     size = np.rint(length[hole]).astype(np.int64)
-    first = np.concatenate([start, hidden_start])[rows]
+    first = np.concatenate([start, np.rint(at[hole] + length[hole] * j).astype(np.int64)])
+    rows = np.argsort(first, kind="stable")
+    first, is_hidden = first[rows], rows >= start.size
     count = np.concatenate([stop - start, size])[rows] + 1
-    rotation = np.concatenate([bottom - start, np.rint(0.75 * size)])[rows].astype(np.int64)
-    is_hidden = np.concatenate([np.zeros(start.size, bool), np.ones(size.size, bool)])[rows]
+    rotation = np.concatenate([bottom - start, (3 * size) // 4])[rows]
     gap = first[1:] > first[:-1] + count[:-1] - 1
     leading, trailing = int(first[0]), int(n - first[-1] - count[-1])
     return Cycles(

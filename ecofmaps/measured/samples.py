@@ -169,8 +169,9 @@ def local_extremes(start, stop, arguments, x):
     """The largest and smallest detrended displacement of each stretch of ``width``
     samples (counted from sample 0) that the block's chunks cut: rows of the stretch's
     number, its largest, its smallest (NaN where none is finite), its finite samples, and
-    the sum and number of the finite absolute second differences within the chunk."""
-    chunk, gaps, line, width = arguments
+    the sum and number of the finite absolute second differences within the chunk, each
+    less a sine's own, ``-curvature`` × the displacement about ``centre``."""
+    chunk, gaps, line, width, (centre, curvature) = arguments
     found = [np.empty((6, 0))]
     for a, b in _chunks(start, stop, chunk):
         d = detrended(blanked(x[a - start : b - start], a, b, gaps), a, line)
@@ -178,7 +179,7 @@ def local_extremes(start, stop, arguments, x):
         cuts = np.maximum(first * width, a) - a
         highest, lowest = np.fmax.reduceat(d, cuts), np.fmin.reduceat(d, cuts)
         finite = np.add.reduceat(np.isfinite(d), cuts)
-        second = np.abs(np.diff(d, 2, prepend=np.nan, append=np.nan))
+        second = np.abs(np.diff(d, 2, prepend=np.nan, append=np.nan) + curvature * (d - centre))
         rough = np.add.reduceat(np.nan_to_num(second), cuts)
         counted = np.add.reduceat(np.isfinite(second), cuts)
         found.append(np.stack([first.astype(np.float64), highest, lowest, finite, rough, counted]))

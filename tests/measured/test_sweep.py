@@ -138,13 +138,13 @@ STEEP = {
 }
 
 
-def steep_sweep(steps, noise=0.0):
+def steep_sweep(steps, noise=0.0, samples=SAMPLES):
     """The applied displacement and force of a sweep holding each of ``steps`` × Δ_t three
-    cycles at 35 MN/m, with white noise of ``noise`` × their largest amplitude and force,
-    and the amplitude of each drive cycle."""
+    cycles at 35 MN/m (``samples`` a cycle), with white noise of ``noise`` × their largest
+    amplitude and force, and the amplitude of each drive cycle."""
     at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, 35e6)
     amplitudes = np.repeat(np.asarray(steps) * at, 3)
-    applied = mindlin.sweep(amplitudes, SAMPLES)
+    applied = mindlin.sweep(amplitudes, samples)
     _, force = mindlin.drive(mindlin.Contact(MU, LOAD, DELTA_T), applied, 35e6)
     rng = np.random.default_rng(1)
     applied += noise * amplitudes.max() * rng.standard_normal(applied.size)
@@ -167,15 +167,17 @@ def test_every_cycle_after_a_steep_step_is_reported_with_values(steps, noise):
         np.testing.assert_allclose(results.amplitude, amplitudes, rtol=1e-3)
 
 
-def test_cycles_under_the_bands_floor_are_rows_of_their_own():
-    """Cycles ×30 smaller than their neighbours: analysed when clean; with 1 % noise (a
-    third of their amplitude) each is a row still, NaN and flagged no-reversal where no
-    reversal stands above the noise; every number as driven."""
-    applied, force, amplitudes = steep_sweep([3.0, 0.1, 3.0])
+@pytest.mark.parametrize("samples", [20, SAMPLES])
+def test_cycles_under_the_bands_floor_are_rows_of_their_own(samples):
+    """Cycles ×30 smaller than their neighbours: analysed when clean, at 20 samples a cycle
+    too (a sine's own second differences are not noise); with 1 % noise (a third of their
+    amplitude) each is a row still, NaN and flagged no-reversal where no reversal stands
+    above the noise; every number as driven."""
+    applied, force, amplitudes = steep_sweep([3.0, 0.1, 3.0], samples=samples)
     results = analysed(applied, force)
     np.testing.assert_array_equal(results.cycle, np.arange(1, 10))
-    np.testing.assert_allclose(results.amplitude, amplitudes, rtol=1e-3)
-    noisy = analysed(*steep_sweep([3.0, 0.1, 3.0], noise=0.01)[:2])
+    np.testing.assert_allclose(results.amplitude, amplitudes, rtol=1e-3 if samples > 20 else 0.02)
+    noisy = analysed(*steep_sweep([3.0, 0.1, 3.0], noise=0.01, samples=samples)[:2])
     np.testing.assert_array_equal(noisy.cycle, np.arange(1, 10))
     hidden = noisy.quality.values == "no-reversal"
     assert hidden.any() and not hidden[[0, 1, 2, 6, 7, 8]].any()
