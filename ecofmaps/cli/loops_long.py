@@ -78,7 +78,7 @@ def _fingerprint(args, paths) -> dict:
         for key, value in sorted(vars(args).items())
         if key not in _RUNTIME and isinstance(value, str | int | float | bool | type(None))
     }
-    return {"format": 2, "files": files, "options": options}
+    return {"format": 3, "files": files, "options": options}
 
 
 def _sha256(path: Path) -> str:
@@ -110,7 +110,7 @@ class _Partial:
         if found != fingerprint:
             raise CommandError(
                 f"{self.folder} holds a run of other files or options (or of these files "
-                "before they changed): delete it to start again with these"
+                "before they changed, or of another ecofmaps): delete it to start again with these"
             )
 
     def _manifest(self) -> dict:

@@ -170,6 +170,25 @@ def test_resume_sees_a_recording_changed_in_place(long_test, tmp_path, capsys, s
     assert not out.exists()
 
 
+def test_resume_refuses_a_run_of_another_format(long_test, tmp_path, capsys, small_tasks,
+                                               on_each_block):  # fmt: skip
+    """A run folder written by an ecofmaps whose stored cycles lack a field of today's is
+    named as a run of another ecofmaps, not loaded (a KeyError, 'a bug')."""
+    import json
+
+    out = tmp_path / "r.csv"
+    interrupted(capsys, on_each_block, long_test[".zarr"], out)
+    partial = tmp_path / "r.csv.partial"
+    record = json.loads((partial / "run.json").read_text())
+    (partial / "run.json").write_text(json.dumps({**record, "format": 2}))
+    with np.load(partial / "file0-cycles.npz") as stored:
+        older = {k: v for k, v in stored.items() if k != "hidden"}
+    np.savez(partial / "file0-cycles.npz", **older)
+    status, _, err = run(capsys, long_test[".zarr"], "--load", "450N", "--out", out, "--resume")
+    assert status == 2 and "of another ecofmaps" in err and "delete it" in err
+    assert "bug" not in err and not out.exists()
+
+
 def _resaved_doubled(blocks, partial):
     with np.load(blocks[0]) as stored:
         values = {k: v * 2 if k.startswith("v:") and v.dtype.kind == "f" else v
