@@ -94,6 +94,16 @@ _MEASURED = tuple(
 #: where it slides at a constant force: its GICoF is read even if its stick sides are curved.
 _PLATEAU = 0.02
 
+#: A sphere's stick part is fitted with Mindlin's law where the force has risen by less than
+#: this share of the way to its sliding value (the law is steep beyond), ...
+_MINDLIN_STICK = 0.9
+
+#: ... and follows it when the fit leaves no more than this many times the displacement's
+#: noise, or this share of the stroke, and each branch slides over this many samples; its
+#: curved part must be this share of the stick's extent and this many standard errors.
+_MINDLIN_SPREAD, _MINDLIN_ROUNDING, _MINDLIN_SLIDING = 3.0, 1e-3, 3
+_MINDLIN_SHARE, _MINDLIN_T = 0.05, 8.0
+
 #: Samples with :math:`|Q|` below this share of :math:`Q^*` locate a zero-force crossing
 #: that is not on a stick segment.
 _ZERO_FORCE_BAND = 0.25
@@ -410,7 +420,13 @@ def _loop_values(block, options):
         values |= {name: ratios[name] for name in _RIG_RATIOS}
     anticlockwise = energy_ratio < -ANTICLOCKWISE_SHARE
     sliding = gross_slip(values, options)
-    on_plateau = sliding & (np.abs(values["gicof"] / values["cof_max"] - 1.0) <= _PLATEAU)
+    forward, backward = _mindlin_sliding(rows, max_force, span, sliding) / load
+    mindlin = np.isfinite(forward)
+    for name, value in (("forward", forward), ("backward", backward)):
+        values[f"gicof_{name}"] = np.where(mindlin, value, values[f"gicof_{name}"])
+    values["gicof"] = np.where(mindlin, 0.5 * (forward + backward), values["gicof"])
+    plateau = np.abs(values["gicof"] / values["cof_max"] - 1.0) <= _PLATEAU
+    on_plateau = sliding & (mindlin | plateau)
     flags = {
         "few-samples": block.count < MIN_SAMPLES,
         "constant-force": ~(block.force_swing > 0.0),
@@ -433,6 +449,50 @@ def _loop_values(block, options):
         "partial-slip": ~sliding,
     }
     return values, flags
+
+
+def _mindlin_sliding(rows, max_force, span, candidates):
+    """The force on each branch's sliding part (rising, falling) of the ``candidates``' loops
+    whose stick part follows Mindlin's law behind a spring, else NaN. [N]"""
+    x, y, length = rows
+    cycles = max_force.size
+    found = np.full((2, cycles), np.nan)
+    pick = np.flatnonzero(candidates & (max_force > 0.0))
+    if not pick.size:
+        return found
+    row = np.concatenate([pick, pick + cycles])
+    sign = np.repeat([1.0, -1.0], pick.size)[:, None]  # the falling branches turned round
+    u, q = sign * x[row], sign * y[row]
+    valid = np.arange(x.shape[1]) < length[row][:, None]
+    sliding_force = np.tile(max_force[pick], 2)[:, None]
+    for _ in range(3):  # the sliding force, the stick fitted below it, and where it ends
+        rise = (q + sliding_force) / (2.0 * sliding_force)
+        stick = valid & (rise < _MINDLIN_STICK)
+        design = np.stack([np.ones_like(u), 1.0 - np.cbrt(1.0 - np.minimum(rise, 1.0)) ** 2, q])
+        fitted = np.where(stick, design, 0.0)
+        inverse = np.linalg.pinv(np.einsum("irj,krj->rik", fitted, fitted))
+        line = np.einsum("rik,krj,rj->ri", inverse, fitted, u)
+        end = line[:, :1] + line[:, 1:2] + line[:, 2:] * sliding_force
+        sliding = valid & (u > end)
+        count = sliding.sum(axis=1)
+        each = np.where(count > 0, (q * sliding).sum(axis=1) / count, sliding_force[:, 0])
+        sliding_force = np.tile(0.5 * (each[: pick.size] + each[pick.size :]), 2)[:, None]
+    off = np.where(stick, u - np.einsum("irj,ri->rj", fitted, line), 0.0)
+    spread = np.sqrt((off**2).sum(axis=1) / np.maximum(stick.sum(axis=1) - 3, 1))
+    second = np.sort(np.where(valid[:, 2:], np.abs(np.diff(u, 2)), np.inf), axis=1)
+    middle = np.maximum(valid[:, 2:].sum(axis=1) - 1, 0) // 2  # NaN-free: inf if none
+    noise = np.take_along_axis(second, middle[:, None], axis=1)[:, 0] / _SECOND_DIFFERENCE
+    tolerance = np.maximum(_MINDLIN_SPREAD * noise, _MINDLIN_ROUNDING * np.tile(span[pick], 2))
+    mindlin, stroke = line[:, 1], line[:, 1] + 2.0 * line[:, 2] * sliding_force[:, 0]
+    significant = mindlin > _MINDLIN_T * spread * np.sqrt(inverse[:, 1, 1])
+    # curved by a share of the stick's extent, behind a spring not less stiff than rigid
+    share = mindlin / stroke
+    follows = (spread <= tolerance) & significant & (share > _MINDLIN_SHARE)
+    follows &= share < 1.0 / (1.0 - _MINDLIN_SHARE)
+    follows &= count >= _MINDLIN_SLIDING
+    follows = follows[: pick.size] & follows[pick.size :]
+    found[:, pick[follows]] = each.reshape(2, -1)[:, follows]
+    return found
 
 
 def _turns_back(x, band):
