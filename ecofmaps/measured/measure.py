@@ -420,13 +420,14 @@ def _loop_values(block, options):
         values |= {name: ratios[name] for name in _RIG_RATIOS}
     anticlockwise = energy_ratio < -ANTICLOCKWISE_SHARE
     sliding = gross_slip(values, options)
-    forward, backward = _mindlin_sliding(rows, max_force, span, sliding) / load
+    forward, backward, spring = _mindlin_sliding(rows, max_force, span, sliding)
     mindlin = np.isfinite(forward)
-    for name, value in (("forward", forward), ("backward", backward)):
-        values[f"gicof_{name}"] = np.where(mindlin, value, values[f"gicof_{name}"])
-    values["gicof"] = np.where(mindlin, 0.5 * (forward + backward), values["gicof"])
+    read = {"gicof_forward": forward / load, "gicof_backward": backward / load}
+    read |= {"gicof": (forward + backward) / (2.0 * load), "stiffness": spring}
+    for name, value in read.items():
+        values[name] = np.where(mindlin, value, values[name])
     plateau = np.abs(values["gicof"] / values["cof_max"] - 1.0) <= _PLATEAU
-    on_plateau = sliding & (mindlin | plateau)
+    on_plateau = sliding & plateau
     flags = {
         "few-samples": block.count < MIN_SAMPLES,
         "constant-force": ~(block.force_swing > 0.0),
@@ -438,25 +439,30 @@ def _loop_values(block, options):
         "anticlockwise": anticlockwise,
         "energy-ratio-above-1": energy_ratio > 1.0 + 1e-9,  # beyond rounding
         "negative-stiffness": compliance < 0.0,
-        "no-stick": (~(unexplained <= UNEXPLAINED_SHARE) & ~np.isinf(values["stiffness"]))
-        | np.isnan(compliance),  # a rigid rig's vertical stick sides explain all but 0/0
+        "no-stick": (
+            (~(unexplained <= UNEXPLAINED_SHARE) & ~np.isinf(values["stiffness"]))
+            | np.isnan(compliance)
+        )  # a rigid rig's vertical stick sides explain all but 0/0
+        & ~mindlin,
         "negative-area": (energy_ratio < 0.0) & ~anticlockwise,
         "negative-slip": ~(slip > 0.0),
         "no-zero-crossing": ~(zero_on_loop[:cycles] & zero_on_loop[cycles:]),
-        "curved-stick": curved & ~on_plateau,
-        "curved-stick-sliding": curved & on_plateau,
-        "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]),
+        "curved-stick": curved & ~on_plateau & ~mindlin,
+        "curved-stick-sliding": curved & on_plateau & ~mindlin,
+        "mindlin-stick": mindlin,
+        "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]) & ~mindlin,
         "partial-slip": ~sliding,
     }
     return values, flags
 
 
 def _mindlin_sliding(rows, max_force, span, candidates):
-    """The force on each branch's sliding part (rising, falling) of the ``candidates``' loops
-    whose stick part follows Mindlin's law behind a spring, else NaN. [N]"""
+    """The force on each branch's sliding part (rising, falling) [N] and the spring's
+    stiffness [N/m] of the ``candidates``' loops whose stick part follows Mindlin's law behind
+    a spring, else NaN."""
     x, y, length = rows
     cycles = max_force.size
-    found = np.full((2, cycles), np.nan)
+    found = np.full((3, cycles), np.nan)
     pick = np.flatnonzero(candidates & (max_force > 0.0))
     if not pick.size:
         return found
@@ -491,7 +497,9 @@ def _mindlin_sliding(rows, max_force, span, candidates):
     follows &= share < 1.0 / (1.0 - _MINDLIN_SHARE)
     follows &= count >= _MINDLIN_SLIDING
     follows = follows[: pick.size] & follows[pick.size :]
-    found[:, pick[follows]] = each.reshape(2, -1)[:, follows]
+    found[:2, pick[follows]] = each.reshape(2, -1)[:, follows]
+    compliance = 0.5 * (line[: pick.size, 2] + line[pick.size :, 2])
+    found[2, pick[follows]] = 1.0 / np.maximum(compliance[follows], 0.0)  # + inf if rigid
     return found
 
 

@@ -190,6 +190,11 @@ REASONS = {
         "at Q* where the stick line crosses it: no straight line gives S, the GICoF is read",
         ("stiffness", *RESOLVED),
     ),
+    "mindlin-stick": (
+        "the stick sides follow Mindlin's law behind a spring (a sphere): the stiffness is the "
+        "spring's, the GICoF Q/P on the sliding part; not read along the stroke",
+        ("crossing_displacement_forward", "crossing_displacement_backward", *RESOLVED),
+    ),
     "no-crossing": (
         "a branch's crossing with Q = SΔ is not on the measured loop (between its samples, "
         "within their force range)",
@@ -387,7 +392,7 @@ class Tally:
         """Count the cycles of a part: their ``quality``, ``flags`` and amplitudes as measured."""
         part = Tally()
         part.counts.update(np.asarray(quality).tolist())
-        quiet = {"ok", "partial-slip", *READING_REASONS}
+        quiet = {"ok", "partial-slip", "mindlin-stick", *READING_REASONS}
         loud = _by_text(quality, lambda text: bool(set(text.split(SEPARATOR)) - quiet))
         part.flagged, part.cycles = int(loud.sum()), amplitude.size
         part.refused = int(_refusing(flags, amplitude.size).sum())
