@@ -12,7 +12,7 @@ import xarray as xr
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._inputs import check, si_units
 from ecofmaps.measured.measure import loop_ratios
-from ecofmaps.measured.quality import regime_ratio, sliding_condition_of
+from ecofmaps.measured.quality import has_reason, regime_ratio, sliding_condition_of
 from ecofmaps.model.profiles import ScarProfile
 from ecofmaps.model.simulation import fretting_loop
 
@@ -32,6 +32,13 @@ MINDLIN_ENERGY_RATIO = 0.2
 MINDLIN_OPENING_RATIO = 2 ** (1 / 3) - 1
 #: Cycles whose amplitudes differ by less than this share are at one amplitude. [1]
 _SAME_AMPLITUDE = 0.01
+#: Fewest ``mindlin-stick`` cycles whose spring stands for an unknown rig's stiffness.
+_SPRINGS = 3
+#: Why μ_t from Q*/P has no standard error.
+_PEAK_BIASED = (
+    "no GICoF in the results: mu is Q*/P of the first gross-slip cycles, a peak that the "
+    "force's noise biases up by an amount the results do not hold"
+)
 
 
 def _tests(results) -> list:
@@ -79,6 +86,18 @@ def _rig(tests: list, rig_stiffness):
         return rig_stiffness
     given = {test.attrs.get("rig_stiffness") for test in tests}
     return given.pop() if len(given) == 1 else None
+
+
+def _spring(tests: list, rig_stiffness):
+    """:func:`_rig`, else the median spring behind the stick of the tests' ``mindlin-stick``
+    cycles (three or more: a sphere's gross-slip loops), else None. [N/m]"""
+    rig_stiffness = _rig(tests, rig_stiffness)
+    if rig_stiffness is not None or not all("quality" in t and "stiffness" in t for t in tests):
+        return rig_stiffness
+    springs = np.concatenate(
+        [t["stiffness"].values[has_reason(t["quality"].values, "mindlin-stick")] for t in tests]
+    )
+    return float(np.median(springs)) if springs.size >= _SPRINGS else None
 
 
 def _ratios(cycles: dict, rig_stiffness):
@@ -143,7 +162,7 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
     (results,) = _tests(results)
     names = ("amplitude", "max_force", "dissipated_energy", "slip_amplitude")
     cycles = per_cycle(results, names)
-    ratios, ratio, gross = _ratios(cycles, _rig([results], rig_stiffness))
+    ratios, ratio, gross = _ratios(cycles, _spring([results], rig_stiffness))
     gross = np.where(np.isfinite(ratio), gross, np.nan)
     condition, changes = sliding_condition_of(cycles["cycle"], gross)
     data = {name: ("cycle", value, nomenclature.attrs(name)) for name, value in ratios.items()}
@@ -224,15 +243,20 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     """
     names = ("amplitude", "max_force", "dissipated_energy")
     tests = _tests(results)
-    rig_stiffness = _rig(tests, rig_stiffness)
+    rig_stiffness = _spring(tests, rig_stiffness)
+    names += ("gicof",) * all("gicof" in test for test in tests)
     cycles = [per_cycle(test, names) for test in tests]
     pooled = {name: np.concatenate([c[name] for c in cycles]) for name in (*names, "load")}
     _, ratio, gross = _ratios(pooled, rig_stiffness)
     known = np.isfinite(ratio) & np.isfinite(pooled["load"])
     order = np.argsort(pooled["amplitude"][known], kind="stable")
     cof = pooled["max_force"] / pooled["load"]
-    amplitude, ratio, gross, cof, load = (
-        v[known][order] for v in (pooled["amplitude"], ratio, gross, cof, pooled["load"])
+    friction = pooled.get("gicof", np.full(cof.size, np.nan))
+    if all("quality" in test for test in tests):  # not read where the stick line meets a curve
+        curved = [has_reason(t["quality"].values, "curved-stick-sliding") for t in tests]
+        friction = np.where(np.concatenate(curved), np.nan, friction)
+    amplitude, ratio, gross, cof, friction, load = (
+        v[known][order] for v in (pooled["amplitude"], ratio, gross, cof, friction, pooled["load"])
     )
     if not gross.size:
         raise ValueError("results: no cycle with an energy ratio (every cycle refused)")
@@ -267,9 +291,7 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     # the crossing may lie anywhere between the two amplitudes
     bracket = (amplitude[level == high].mean() - amplitude[level == low].mean()) / np.sqrt(12)
     at_se = float(np.hypot(np.nan_to_num(at_se), bracket))
-    first = gross & (level == level[split:][gross[split:]][0])
-    mu = float(np.mean(cof[first]))
-    mu_se = float(np.std(cof[first], ddof=1) / np.sqrt(first.sum())) if first.sum() > 1 else np.nan
+    mu, mu_se = _sliding_friction(gross, level, split, cof, friction)
     force = float(np.mean(load[fitted])) / (np.nan if rig_stiffness is None else rig_stiffness)
     values = {
         "amplitude": (at, at_se),
@@ -279,7 +301,29 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     data = {}
     for name, (value, se) in values.items():
         _with_se(data, name, value, se, quantity=f"transition_{name}")
+    if not np.isfinite(friction[gross]).any():
+        data["mu_se"][2]["comment"] = _PEAK_BIASED
     return xr.Dataset(data)
+
+
+def _sliding_friction(gross, level, split, cof, friction):
+    """μ_t and its standard error: the mean GICoF of each amplitude in the upper half of the
+    gross-slip cycles', averaged; else Q*/P above the ``split`` (se NaN: :data:`_PEAK_BIASED`)."""
+    sliding = gross & np.isfinite(friction)
+    if not sliding.any():
+        first = gross & (level == level[split:][gross[split:]][0])
+        return float(np.mean(cof[first])), np.nan
+    # the upper half: a sphere's loops just above the transition slide too little to read
+    sliding &= level >= np.median(level[sliding])
+    # each amplitude's mean: a trend with the amplitude is scatter, not averaged away
+    means = np.array([np.mean(friction[sliding & (level == k)]) for k in np.unique(level[sliding])])
+    if means.size < 2:
+        return float(means[0]), np.nan
+    from scipy.stats import t  # 0.4 s to import: when a transition is sought
+
+    # ±2 se: Student's 95 % interval of the mean of n
+    widen = float(t.ppf(0.975, means.size - 1)) / 2.0
+    return float(np.mean(means)), float(widen * np.std(means, ddof=1) / np.sqrt(means.size))
 
 
 def cycle_sum(cycle, value):

@@ -102,7 +102,7 @@ _MINDLIN_STICK = 0.9
 #: noise, or this share of the stroke, and each branch slides over this many samples; its
 #: curved part must be this share of the stick's extent and this many standard errors.
 _MINDLIN_SPREAD, _MINDLIN_ROUNDING, _MINDLIN_SLIDING = 3.0, 1e-3, 3
-_MINDLIN_SHARE, _MINDLIN_T = 0.05, 8.0
+_MINDLIN_SHARE, _MINDLIN_T = 0.05, 5.0
 
 #: Samples with :math:`|Q|` below this share of :math:`Q^*` locate a zero-force crossing
 #: that is not on a stick segment.
