@@ -125,7 +125,9 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
         the contact in series). With it the ratios are also read on the contact's
         displacement :math:`\Delta - Q/S` and the regime is decided there. By default the
         one ``results`` were analysed with (``results.attrs["rig_stiffness"]``, from
-        ``analyze_loops(..., rig_stiffness=)`` or ``--rig-stiffness``), if any. [N/m]
+        ``analyze_loops(..., rig_stiffness=)`` or ``--rig-stiffness``), else the median
+        spring behind the stick of three ``mindlin-stick`` cycles or more (a sphere's), if
+        any. [N/m]
 
     Returns
     -------
@@ -208,7 +210,9 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     transition : xarray.Dataset
         ``amplitude`` :math:`\Delta_t` [m], ``contact_amplitude``
         :math:`\delta_t = \Delta_t - \mu_t P/S` [m] and ``mu``
-        :math:`\mu_t = Q^*/P` at the transition, each with its standard error (``_se``).
+        :math:`\mu_t = Q^*/P` at the transition (read as the gross-slip cycles' GICoF), each
+        with its standard error (``_se``; ``mu_se`` NaN, its ``comment`` saying why, for
+        results without a GICoF).
 
     Raises
     ------
