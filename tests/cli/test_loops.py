@@ -368,7 +368,7 @@ def test_rig_stiffness_reads_the_regime_on_the_contact(tmp_path, capsys):
 def test_a_sweep_prints_its_transition(tmp_path, capsys, rig):
     """The Mindlin oracle swept from 0.45 to 1.8 Δ_t, two cycles at each amplitude, as a CSV
     file: the summary gives Δ_t within 5 % and μ_t within 3 % with the rig's stiffness; δ_t
-    needs it. Without it Δ_t is read on the applied displacement, and lands high."""
+    needs it, or the spring fitted behind the sphere's stick, which stands for it."""
     from tests import mindlin
 
     at = mindlin.transition_amplitude(0.8, LOAD, 6e-6, 35e6)
@@ -385,10 +385,9 @@ def test_a_sweep_prints_its_transition(tmp_path, capsys, rig):
     )
     amplitude, contact, mu = found.groups()
     assert float(mu) == pytest.approx(0.8, rel=0.03)
-    if rig is None:
-        assert float(amplitude) > 1.1 * at * 1e6 and contact.startswith("needs --rig-stiffness")
-        return
     assert float(amplitude) == pytest.approx(at * 1e6, rel=0.05)
+    if rig is None:
+        return
     contact_at = float(amplitude) - float(mu) * LOAD / 35e6 * 1e6  # δ_t = Δ_t - μ_t P/S
     assert float(contact.split()[0]) == pytest.approx(contact_at, abs=0.01)  # printed to 0.01
     docs = (Path(__file__).parents[2] / "docs" / "lab.md").read_text()
