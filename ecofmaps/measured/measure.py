@@ -104,6 +104,9 @@ _MINDLIN_STICK = 0.9
 _MINDLIN_SPREAD, _MINDLIN_ROUNDING, _MINDLIN_SLIDING = 3.0, 1e-3, 3
 _MINDLIN_SHARE, _MINDLIN_T = 0.05, 5.0
 
+#: The samples of a branch of which the first pass of the fit reads about this many.
+_MINDLIN_SIFT = 32
+
 #: Samples with :math:`|Q|` below this share of :math:`Q^*` locate a zero-force crossing
 #: that is not on a stick segment.
 _ZERO_FORCE_BAND = 0.25
@@ -464,43 +467,59 @@ def _mindlin_sliding(rows, max_force, span, candidates):
     cycles = max_force.size
     found = np.full((3, cycles), np.nan)
     pick = np.flatnonzero(candidates & (max_force > 0.0))
-    if not pick.size:
-        return found
-    row = np.concatenate([pick, pick + cycles])
-    sign = np.repeat([1.0, -1.0], pick.size)[:, None]  # the falling branches turned round
-    u, q = sign * x[row], sign * y[row]
-    valid = np.arange(x.shape[1]) < length[row][:, None]
-    sliding_force = np.tile(max_force[pick], 2)[:, None]
-    for _ in range(3):  # the sliding force, the stick fitted below it, and where it ends
-        rise = (q + sliding_force) / (2.0 * sliding_force)
+    sliding_force = max_force[pick]
+    for passes in range(3):  # the sliding force, the stick fitted below it, where it ends
+        # the first pass, which only sifts out straight sticks, on every few samples
+        every = max(x.shape[1] // _MINDLIN_SIFT, 1) if passes == 0 else 1
+        row = np.concatenate([pick, pick + cycles])
+        sign = np.repeat([1.0, -1.0], pick.size)[:, None]  # the falling branches turned round
+        u, q = sign * x[row, ::every], sign * y[row, ::every]
+        valid = np.arange(0, x.shape[1], every) < length[row][:, None]
+        force = np.tile(sliding_force, 2)[:, None]
+        rise = (q + force) / (2.0 * force)
         stick = valid & (rise < _MINDLIN_STICK)
-        design = np.stack([np.ones_like(u), 1.0 - np.cbrt(1.0 - np.minimum(rise, 1.0)) ** 2, q])
-        fitted = np.where(stick, design, 0.0)
-        inverse = np.linalg.pinv(np.einsum("irj,krj->rik", fitted, fitted))
-        line = np.einsum("rik,krj,rj->ri", inverse, fitted, u)
-        end = line[:, :1] + line[:, 1:2] + line[:, 2:] * sliding_force
+        curve = 1.0 - np.cbrt(1.0 - np.minimum(rise, 1.0)) ** 2
+        line, inverse = _stick_line(u, (curve, q), stick)
+        share = line[:, 1] / (line[:, 1] + 2.0 * line[:, 2] * force[:, 0])
+        # curved by a share of the stick's extent, its spring's compliance not below zero by
+        # more: else not a sphere's (a flat contact's straight stick), and not fitted further
+        curved = (share > _MINDLIN_SHARE) & (share < 1.0 / (1.0 - _MINDLIN_SHARE))
+        kept = curved[: pick.size] & curved[pick.size :]
+        both = np.tile(kept, 2)
+        pick, line, inverse, u, q, valid, stick, curve, force = (
+            v[both] for v in (np.tile(pick, 2), line, inverse, u, q, valid, stick, curve, force)
+        )
+        pick = pick[: pick.size // 2]
+        end = line[:, :1] + line[:, 1:2] + line[:, 2:] * force
         sliding = valid & (u > end)
         count = sliding.sum(axis=1)
-        each = np.where(count > 0, (q * sliding).sum(axis=1) / count, sliding_force[:, 0])
-        sliding_force = np.tile(0.5 * (each[: pick.size] + each[pick.size :]), 2)[:, None]
-    off = np.where(stick, u - np.einsum("irj,ri->rj", fitted, line), 0.0)
+        each = np.where(count > 0, (q * sliding).sum(axis=1) / count, force[:, 0])
+        sliding_force = 0.5 * (each[: pick.size] + each[pick.size :])
+    off = np.where(stick, u - line[:, :1] - line[:, 1:2] * curve - line[:, 2:] * q, 0.0)
     spread = np.sqrt((off**2).sum(axis=1) / np.maximum(stick.sum(axis=1) - 3, 1))
     second = np.sort(np.where(valid[:, 2:], np.abs(np.diff(u, 2)), np.inf), axis=1)
     middle = np.maximum(valid[:, 2:].sum(axis=1) - 1, 0) // 2  # NaN-free: inf if none
     noise = np.take_along_axis(second, middle[:, None], axis=1)[:, 0] / _SECOND_DIFFERENCE
     tolerance = np.maximum(_MINDLIN_SPREAD * noise, _MINDLIN_ROUNDING * np.tile(span[pick], 2))
-    mindlin, stroke = line[:, 1], line[:, 1] + 2.0 * line[:, 2] * sliding_force[:, 0]
-    significant = mindlin > _MINDLIN_T * spread * np.sqrt(inverse[:, 1, 1])
-    # curved by a share of the stick's extent, behind a spring not less stiff than rigid
-    share = mindlin / stroke
-    follows = (spread <= tolerance) & significant & (share > _MINDLIN_SHARE)
-    follows &= share < 1.0 / (1.0 - _MINDLIN_SHARE)
-    follows &= count >= _MINDLIN_SLIDING
+    significant = line[:, 1] > _MINDLIN_T * spread * np.sqrt(inverse[:, 1, 1])
+    follows = (spread <= tolerance) & significant & (count >= _MINDLIN_SLIDING)
     follows = follows[: pick.size] & follows[pick.size :]
     found[:2, pick[follows]] = each.reshape(2, -1)[:, follows]
     compliance = 0.5 * (line[: pick.size, 2] + line[pick.size :, 2])
     found[2, pick[follows]] = 1.0 / np.maximum(compliance[follows], 0.0)  # + inf if rigid
     return found
+
+
+def _stick_line(u, regressors, stick):
+    """Least squares of ``u`` on 1 and ``regressors`` over the ``stick`` samples of each row:
+    the coefficients and the inverse of the normal matrix (identity below four samples)."""
+    columns = [stick.astype(np.float64), *(np.where(stick, r, 0.0) for r in regressors)]
+    normal = np.stack([np.stack([(a * b).sum(axis=1) for b in columns], -1) for a in columns], -2)
+    normal[stick.sum(axis=1) < 4] = np.eye(len(columns))
+    inverse = np.linalg.inv(normal)
+    return np.einsum(
+        "rik,rk->ri", inverse, np.stack([(a * u).sum(axis=1) for a in columns], -1)
+    ), inverse
 
 
 def _turns_back(x, band):
