@@ -516,7 +516,10 @@ def _stick_line(u, regressors, stick):
     columns = [stick.astype(np.float64), *(np.where(stick, r, 0.0) for r in regressors)]
     normal = np.stack([np.stack([(a * b).sum(axis=1) for b in columns], -1) for a in columns], -2)
     normal[stick.sum(axis=1) < 4] = np.eye(len(columns))
-    inverse = np.linalg.inv(normal)
+    try:
+        inverse = np.linalg.inv(normal)
+    except np.linalg.LinAlgError:  # a degenerate loop (a constant force): least norm
+        inverse = np.linalg.pinv(normal)
     return np.einsum(
         "rik,rk->ri", inverse, np.stack([(a * u).sum(axis=1) for a in columns], -1)
     ), inverse
