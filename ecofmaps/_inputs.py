@@ -1,8 +1,8 @@
 """Input handling shared by the public entry points: units, float64 and validation.
 
 Numbers or pint Quantities (converted to SI by the parameter's name, :func:`si_units`),
-concrete inputs checked with a :class:`ValueError` naming the parameter and its range
-(:func:`check`), traced inputs left to the kernels (NaN and the ``INVALID`` regime), and
+concrete inputs checked with a :class:`ValueError` naming the parameter and its range or
+domain (:func:`check`), traced inputs left to the kernels (NaN and the ``INVALID`` regime), and
 broadcasts too large for memory refused before JAX would abort (:func:`check_broadcast_size`).
 """
 
@@ -19,7 +19,7 @@ import sys
 import numpy as np
 
 from ecofmaps._nomenclature import QUANTITIES, RANGES
-from ecofmaps.units import DIMENSIONS
+from ecofmaps.units import DIMENSIONS, DOMAIN
 
 __all__ = [
     "as_float64",
@@ -231,7 +231,9 @@ def as_float64(value):
 
 
 def check(name: str, value, rule: str | None = None, unit: str | None = None) -> None:
-    """Raise ``ValueError`` if a concrete ``value`` breaks ``rule``; do nothing for tracers."""
+    """Raise ``ValueError`` if a concrete ``value`` breaks ``rule`` or, for a quantity of
+    :data:`ecofmaps.units.DOMAIN` (``name``'s first word), lies beyond the model's domain;
+    do nothing for tracers (a traced value cannot be looked at)."""
     if not is_concrete(value):
         return
     described = QUANTITIES.get(name)
@@ -243,14 +245,20 @@ def check(name: str, value, rule: str | None = None, unit: str | None = None) ->
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a real number or array of them, got {value!r}") from None
     test, valid = RANGES[rule]
-    ok = test(array)
-    if np.all(ok):
-        return
+    ok, domain = test(array), ""
+    if np.all(ok):  # in range: within the domain too (inf, where the rule allows it)
+        low, high = DOMAIN.get(name.partition(" ")[0], (-math.inf, math.inf))
+        ok = ((array >= low) & (array <= high)) | (array == math.inf)
+        if np.all(ok):
+            return
+        valid = f"{low:g} <= {{name}} <= {high:g}"
+        rigid = ", or inf: a rigid rig" if rule == "positive_or_inf" else ""
+        domain = f" (the model's domain{rigid})"
     bad = np.argwhere(~ok)[0] if array.ndim else ()
     where = f" at index {tuple(int(i) for i in bad)}" if array.ndim else ""
     count = "" if array.size <= 1 else f" ({np.count_nonzero(~ok)} of {array.size} values)"
     suffix = f" [{unit}]" if unit else ""
     raise ValueError(
-        f"{name} must satisfy {valid.format(name=name)}{suffix}; "
+        f"{name} must satisfy {valid.format(name=name)}{suffix}{domain}; "
         f"got {array[tuple(bad)].item()!r}{where}{count}"
     )

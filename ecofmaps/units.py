@@ -50,14 +50,16 @@ PLAUSIBLE = {
     "stiffness_ratio": (100.0, None, ("/um", "/mm")),
 }
 
-#: The values [SI] the command line takes, (low, high), a rigid rig's inf apart: far wider
-#: than any fretting test, and narrow enough that the model's products of them stay finite.
+#: The values [SI] the model takes (low, high), a rigid rig's inf apart: far wider than any
+#: fretting test, and narrow enough that the model's products of them stay finite (a stiffness
+#: beyond any rig's is only nearer a rigid one). The command line, the explorer and the
+#: Python API (concrete values: :func:`ecofmaps._inputs.check`) refuse a value beyond them.
 DOMAIN = {
     **dict.fromkeys(("amplitude", "groove_half_width", "scar_half_width"), (1e-12, 1e3)),
     **dict.fromkeys(("scar_depth", "smoothing"), (0.0, 1e3)),
     "load": (1e-9, 1e9),
-    "stiffness": (1e-3, 1e18),
-    "stiffness_ratio": (1e-12, 1e24),
+    "stiffness": (1e-3, 1e290),
+    "stiffness_ratio": (1e-12, 1e290),
     "mu": (1e-6, 1e3),
     "ecof": (1e-6, 1e3),
     "aspect_ratio": (0.0, 1e6),

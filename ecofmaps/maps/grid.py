@@ -151,7 +151,8 @@ def compute_map(
     ValueError
         If a parameter is not a scalar or a non-empty 1-D array, or is out of range:
         stiffness_ratio > 0 (inf allowed); aspect_ratio >= 0; amplitude, mu, load > 0;
-        all finite except stiffness_ratio, none NaN. For a bad ``chunks``, and for a map
+        all finite except stiffness_ratio, none NaN, each within the model's domain
+        (:data:`ecofmaps.units.DOMAIN`). For a bad ``chunks``, and for a map
         in memory that would not fit in the memory available (before allocating it).
 
     Warns

@@ -176,9 +176,10 @@ def _steady_quantity(quantity: str, summary: str, returns: str, notes: str, equa
     ------
     ValueError
         For a concrete input out of its range: amplitude, load, mu and groove_half_width
-        must be finite and > 0, stiffness > 0 (inf allowed), aspect_ratio finite and >= 0;
-        for both or neither of aspect_ratio and profile, or a bad mapping. Under
-        ``jax.jit``/``jax.vmap`` such points give NaN and the ``INVALID`` regime.
+        must be finite and > 0, stiffness > 0 (inf allowed), aspect_ratio finite and >= 0,
+        each within the model's domain (:data:`ecofmaps.units.DOMAIN`); for both or
+        neither of aspect_ratio and profile, or a bad mapping. Under ``jax.jit``/``jax.vmap``
+        a traced value is not checked: out of range, it gives NaN and the ``INVALID`` regime.
 
     Notes
     -----

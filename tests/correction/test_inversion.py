@@ -377,6 +377,12 @@ GOOD = dict(ecof=0.83, **EXAMPLE_2, aspect_ratio=0.2)
         (dict(aspect_ratio=(0.1, 0.2, 0.3)), r"interval \(low, high\) of two values"),
         (dict(aspect_ratio=(0.3, 0.1)), r"low <= high"),
         (dict(aspect_ratio=(-0.1, 0.1)), r"aspect_ratio low must satisfy"),
+        (dict(ecof=1e308), r"ecof must satisfy 1e-06 <= ecof <= 1000 \[1\] \(the model's domain"),
+        (dict(aspect_ratio=(0.1, 1e308)), r"aspect_ratio high must satisfy 0 <= aspect_ratio"),
+        (
+            dict(stiffness=[35e6, 1e308]),
+            r"\(the model's domain, or inf: a rigid rig\); got 1e\+308 at",
+        ),
     ],
 )
 def test_bad_input_is_named(change, message):

@@ -249,6 +249,11 @@ def test_loops():
         (dict(load=-450.0), "load must satisfy 0 < load < inf"),
         (dict(load=np.array([1.0, 2.0])), "load must be a single value"),
         (dict(max_chunk=0), "max_chunk must be an integer >= 1"),
+        (
+            dict(aspect_ratio=[0.1, 1e308]),
+            "aspect_ratio must satisfy 0 <= aspect_ratio <= 1e",
+        ),
+        (dict(stiffness_ratio=1e-300), "stiffness_ratio must satisfy 1e-12 <= stiffness_ratio <="),
     ],
 )
 def test_bad_input_is_named(arguments, message):

@@ -1,7 +1,9 @@
 """The steady-loop model (ecofmaps.model) against brute force, limits and the paper."""
 
+import itertools
 import subprocess
 import sys
+import warnings
 
 import jax
 import jax.numpy as jnp
@@ -16,6 +18,7 @@ import ecofmaps
 from ecofmaps import model
 from ecofmaps.model.core import _artanh_excess
 from ecofmaps.paper import EXAMPLE_2
+from ecofmaps.units import DOMAIN
 
 ARGUMENTS = ("amplitude", "load", "stiffness", "mu", "aspect_ratio", "groove_half_width")
 
@@ -278,6 +281,62 @@ def test_bad_input_raises(function, name, value, message):
 def test_bad_array_input_names_the_index():
     with pytest.raises(ValueError, match=r"at index \(2,\) \(1 of 3 values\)"):
         ecofmaps.energy_cof(50e-6, 450.0, 35e6, np.array([0.5, 0.8, -1.0]), 0.2)
+
+
+#: Finite values just beyond each argument's bound in ecofmaps.units.DOMAIN, and far beyond.
+BEYOND_THE_DOMAIN = [
+    (name, value)
+    for name in ARGUMENTS
+    for value in (DOMAIN[name][1] * 10, 1e308, DOMAIN[name][0] / 10)
+    if value > 0
+]
+
+
+@pytest.mark.parametrize(("name", "value"), BEYOND_THE_DOMAIN)
+@pytest.mark.parametrize("function", ["slip_amplitude", "energy_cof", "dissipated_energy"])
+def test_a_finite_value_beyond_the_domain_is_named(function, name, value):
+    """Not NaN with 'invalid input': the argument, its bounds (the command line's) and value."""
+    low, high = DOMAIN[name]
+    rigid = ", or inf: a rigid rig" if name == "stiffness" else ""
+    said = f"{name} must satisfy {low:g} <= {name} <= {high:g} ["
+    point = {**EXAMPLE_2, "groove_half_width": 50e-6, name: value}
+    with pytest.raises(ValueError) as refused:
+        getattr(ecofmaps, function)(**point)
+    assert str(refused.value).startswith(said)
+    assert str(refused.value).endswith(f"] (the model's domain{rigid}); got {value!r}")
+    with pytest.raises(ValueError) as refused:  # one element of an array: named, not NaN
+        ecofmaps.max_force(**{**point, name: np.array([EXAMPLE_2.get(name, 50e-6), value])})
+    assert str(refused.value).endswith(f"; got {value!r} at index (1,) (1 of 2 values)")
+
+
+def test_the_model_is_defined_at_every_corner_of_its_domain():
+    """Each combination of the domain's bounds (and a rigid rig): a regime, never 'invalid',
+    and finite numbers in gross slip: the bounds keep the model's products finite."""
+    ends = [(*DOMAIN[name], *((np.inf,) if name == "stiffness" else ())) for name in ARGUMENTS]
+    corners = np.array(list(itertools.product(*ends))).T
+    regime = np.asarray(ecofmaps.slip_regime(*corners))
+    assert set(regime.tolist()) == {
+        ecofmaps.GROSS_SLIP,
+        ecofmaps.NO_GROSS_SLIP,
+        ecofmaps.SELF_LOCKING,
+    }
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ecofmaps.RegimeWarning)  # NaN when stuck or locked
+        for function in ("slip_amplitude", "dissipated_energy", "energy_cof", "max_force"):
+            values = np.asarray(getattr(ecofmaps, function)(*corners))
+            assert np.isfinite(values[regime == ecofmaps.GROSS_SLIP]).all(), function
+
+
+def test_a_traced_value_beyond_the_domain_is_not_checked():
+    """A tracer has no value to look at: under jit the formulas run (NaN with the INVALID
+    code where they overflow); a concrete argument of a traced call is still checked."""
+    ecof = jax.jit(ecofmaps.energy_cof)(50e-6, 450.0, 35e6, 0.8, 1e308)
+    assert (
+        np.isnan(ecof)
+        and int(jax.jit(ecofmaps.slip_regime)(50e-6, 450.0, 35e6, 0.8, 1e308)) == ecofmaps.INVALID
+    )
+    with pytest.raises(ValueError, match="aspect_ratio must satisfy 0 <= aspect_ratio <= 1e"):
+        jax.jit(lambda mu: ecofmaps.energy_cof(50e-6, 450.0, 35e6, mu, 1e308))(0.8)
 
 
 def test_invalid_inside_jit_is_nan_with_regime_code():
