@@ -59,7 +59,7 @@ DOMAIN = {
     **dict.fromkeys(("scar_depth", "smoothing"), (0.0, 1e3)),
     "load": (1e-9, 1e9),
     "stiffness": (1e-3, 1e290),
-    "stiffness_ratio": (1e-12, 1e290),
+    "stiffness_ratio": (1e-12, 1e299),  # the stiffness's over the load's
     "mu": (1e-6, 1e3),
     "ecof": (1e-6, 1e3),
     "aspect_ratio": (0.0, 1e6),

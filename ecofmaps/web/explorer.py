@@ -28,21 +28,21 @@ from ecofmaps.model import NO_GROSS_SLIP
 from ecofmaps.model.simulation import fretting_loop
 from ecofmaps.model.steady_state import dissipated_energy, energy_cof, slip_amplitude
 from ecofmaps.paper import FIGURE_11_STIFFNESS_RATIOS
-from ecofmaps.units import DIMENSIONS, TEXT_LIMIT, bare_number_warning, parse_quantity
+from ecofmaps.units import DIMENSIONS, DOMAIN, TEXT_LIMIT, bare_number_warning, parse_quantity
 
 __all__ = ["INPUTS", "ExplorerPoint", "bare_number_warnings", "explorer_page", "parameter_value"]
 
-#: The page's inputs: URL query key -> (quantity of the nomenclature, label, default text,
-#: the physical bounds the explorer takes in SI, a rigid rig's infinite stiffness apart).
+#: The page's inputs: URL query key -> (quantity of the nomenclature, label, default text);
+#: each takes the values of its quantity in the model's domain, :data:`ecofmaps.units.DOMAIN`.
 INPUTS = {
-    "amplitude": ("amplitude", "Displacement amplitude Δ*", "50um", (1e-9, 1e-2)),
-    "load": ("load", "Normal load P", "450N", (1e-3, 1e6)),
-    "stiffness": ("stiffness", "Rig stiffness S", "35MN/m", (1.0, 1e13)),
-    "mu": ("mu", "Contact CoF μ", "0.8", (1e-3, 10.0)),
-    "aspect_ratio": ("aspect_ratio", "Groove aspect ratio z_o/x_o", "0.2", (0.0, 10.0)),
-    "ecof": ("ecof", "ECoF μ_E to correct", "0.83", (1e-3, 100.0)),
-    "aspect_ratio_low": ("aspect_ratio", "Scar z_o/x_o from", "0.15", (0.0, 10.0)),
-    "aspect_ratio_high": ("aspect_ratio", "Scar z_o/x_o to", "0.25", (0.0, 10.0)),
+    "amplitude": ("amplitude", "Displacement amplitude Δ*", "50um"),
+    "load": ("load", "Normal load P", "450N"),
+    "stiffness": ("stiffness", "Rig stiffness S", "35MN/m"),
+    "mu": ("mu", "Contact CoF μ", "0.8"),
+    "aspect_ratio": ("aspect_ratio", "Groove aspect ratio z_o/x_o", "0.2"),
+    "ecof": ("ecof", "ECoF μ_E to correct", "0.83"),
+    "aspect_ratio_low": ("aspect_ratio", "Scar z_o/x_o from", "0.15"),
+    "aspect_ratio_high": ("aspect_ratio", "Scar z_o/x_o to", "0.25"),
 }
 
 _MODEL_INPUTS = ("amplitude", "load", "stiffness", "mu", "aspect_ratio")
@@ -75,7 +75,7 @@ def parameter_value(key: str, text: str) -> float:
     ValueError
         Naming the input, if :func:`ecofmaps.units.parse_quantity` cannot read the text
         (too long, not a plain number with a plain unit, not a quantity of its kind), or the
-        value is out of its range or beyond the physical bounds of :data:`INPUTS`.
+        value is out of its range or beyond the model's domain (:data:`ecofmaps.units.DOMAIN`).
 
     Examples
     --------
@@ -84,8 +84,8 @@ def parameter_value(key: str, text: str) -> float:
     >>> parameter_value("amplitude", "5e-5")
     5e-05
     """
-    name, label, _, (low, high) = INPUTS[key]
-    quantity = QUANTITIES[name]
+    name, label, _ = INPUTS[key]
+    quantity, (low, high) = QUANTITIES[name], DOMAIN[name]
     text = str(text)
     try:
         value = parse_quantity(text, quantity.kind)
@@ -94,11 +94,10 @@ def parameter_value(key: str, text: str) -> float:
     if quantity.valid is not None and not bool(within(name, np.asarray(value))):
         rule = RANGES[quantity.valid][1].format(name=quantity.symbol or key)
         raise ValueError(f"{label}: {text!r} is out of range: {rule}")
-    rigid = key == "stiffness" and "inf" in text.lower()
-    if not (low <= value <= high or rigid):
+    if not (low <= value <= high or value == math.inf):  # inf: a rigid rig, in range
         unit = DIMENSIONS[quantity.kind][1]
         raise ValueError(
-            f"{label}: {text!r} is beyond the explorer's bounds, {low:g} to {high:g} {unit}"
+            f"{label}: {text!r} is beyond the model's domain, {low:g} to {high:g} {unit}"
             + (" (or inf, a rigid rig)" if key == "stiffness" else "")
         )
     return value
@@ -161,7 +160,8 @@ def map_window(stiffness_ratio: float, aspect_ratio: float) -> tuple[float, floa
     """The map's window holding a point: S/P from, S/P to [1/m], and the largest z_o/x_o [1].
 
     Figure 11's window (20 to 200 (MN/m)/kN, z_o/x_o up to 0.4), grown in steps of 1, 2, 5
-    where the point lies beyond it (a rigid rig, S/P infinite, is not drawn).
+    where the point lies beyond it (a rigid rig, S/P infinite, is not drawn), within the
+    model's domain (:data:`ecofmaps.units.DOMAIN`).
 
     Examples
     --------
@@ -176,7 +176,8 @@ def map_window(stiffness_ratio: float, aspect_ratio: float) -> tuple[float, floa
         high = max(high, _grown(stiffness_ratio * 1.1, upward=True))
     if aspect_ratio * 1.1 > deepest:
         deepest = _grown(aspect_ratio * 1.1, upward=True)
-    return float(low), float(high), float(deepest)
+    (least, most), top = DOMAIN["stiffness_ratio"], DOMAIN["aspect_ratio"][1]
+    return float(max(low, least)), float(min(high, most)), float(min(deepest, top))
 
 
 @functools.lru_cache(maxsize=_MAPS_KEPT)
@@ -420,7 +421,7 @@ def explorer_page():
         key: pn.widgets.TextInput(
             label=label, value=query.get(key, default), width=220 if key in _MODEL_INPUTS else 160
         )
-        for key, (_, label, default, _) in INPUTS.items()
+        for key, (_, label, default) in INPUTS.items()
     }
     if pn.state.location is not None:
         for key, widget in inputs.items():
@@ -487,7 +488,7 @@ def explorer_page():
 def warm_up() -> None:
     """Compile the model's functions and fill the map for the default point, so the first
     page comes at once."""
-    values = {key: parameter_value(key, default) for key, (_, _, default, _) in INPUTS.items()}
+    values = {key: parameter_value(key, default) for key, (_, _, default) in INPUTS.items()}
     ExplorerPoint.at(*(values[key] for key in _MODEL_INPUTS))
     window = map_window(values["stiffness"] / values["load"], values["aspect_ratio"])
     _ecof_ratio_map(values["amplitude"], values["mu"], window)

@@ -1,6 +1,7 @@
 """The live explorer (ecofmaps explore, ecofmaps.web.explorer): its inputs, and the server in a
 real browser: the model's numbers for parameters in the URL, an input typed, a clean stop."""
 
+import html
 import http.client
 import math
 import os
@@ -17,7 +18,7 @@ import pytest
 import ecofmaps
 from ecofmaps.cli import explore
 from ecofmaps.figures.style import ECOF_RATIO_LEVELS
-from ecofmaps.units import TEXT_LIMIT
+from ecofmaps.units import DOMAIN, TEXT_LIMIT
 from ecofmaps.web import explorer
 from ecofmaps.web.explorer import explorer_page, map_window, parameter_value
 from tests.cli.commands import run
@@ -50,8 +51,8 @@ def test_inputs_are_read_with_units_or_in_si():
 
 #: Hostile query values: (key, text, what the page's message says).
 HOSTILE = [
-    ("aspect_ratio", "1e308", "Groove aspect ratio z_o/x_o: '1e308' is beyond the explorer's"),
-    ("stiffness", "1.7e308", "Rig stiffness S: '1.7e308' is beyond the explorer's bounds"),
+    ("aspect_ratio", "1e308", "Groove aspect ratio z_o/x_o: '1e308' is beyond the model's domain"),
+    ("stiffness", "1.7e308", "Rig stiffness S: '1.7e308' is beyond the model's domain, 0.001 to"),
     ("stiffness", "1e308MN/m", "Rig stiffness S: '1e308MN/m' is beyond the largest number"),
     (
         "amplitude",
@@ -332,7 +333,27 @@ def test_the_page_follows_its_inputs():
     assert "Normal load P: cannot read &#x27;9**9**9 N&#x27; as a force" in shown()
     inputs["Normal load P"].value = "1N"
     inputs["Rig stiffness S"].value = "1.7e308"
-    assert "Rig stiffness S: &#x27;1.7e308&#x27; is beyond the explorer&#x27;s bounds" in shown()
+    assert "Rig stiffness S: &#x27;1.7e308&#x27; is beyond the model&#x27;s domain" in shown()
+
+
+def test_the_page_takes_the_models_domain():
+    """Each input at either bound of ecofmaps.units.DOMAIN (the command line's and the API's):
+    the point shown, map and loop too; a tenth beyond a bound: refused, naming it."""
+    page = explorer_page()
+    inputs = {widget.label: widget for widget in page.select(pn.widgets.TextInput)}
+    message = page.objects[1]
+    for key, (name, label, default) in explorer.INPUTS.items():
+        low, high = DOMAIN[name]
+        for value in (low, high):
+            inputs[label].value = repr(value)
+            assert message.object == "", (key, value, message.object)
+        for value in (high * 1.1, low * 0.9):
+            if value != low:  # a lower bound of 0 is the rule's (z_o/x_o >= 0)
+                inputs[label].value = repr(value)
+                said = f"{label}: '{value!r}' is beyond the model's domain, {low:g} to {high:g}"
+                assert said in html.unescape(message.object), (key, message.object)
+        inputs[label].value = default
+    assert message.object == ""
 
 
 def test_a_bare_number_implausible_in_si_is_warned_with_the_unit_meant():
@@ -350,11 +371,9 @@ def test_a_bare_number_implausible_in_si_is_warned_with_the_unit_meant():
     assert "data-quantity='slip_amplitude' data-unit='µm'>" in shown()
     inputs["Rig stiffness S"].value = "35MN/m"
     assert "did you mean" not in shown()
-    inputs["Displacement amplitude Δ*"].value = "50"
+    inputs["Displacement amplitude Δ*"].value = "50"  # in the domain: computed as read
     assert "Displacement amplitude Δ*: 50 is 50 m; did you mean 50um?" in shown()
-    assert (
-        "Displacement amplitude Δ*: &#x27;50&#x27; is beyond the explorer&#x27;s bounds" in shown()
-    )
+    assert "Δ* = 5e+07 µm" in shown() and page.objects[1].object == ""
 
 
 def map_of(page):
