@@ -222,7 +222,7 @@ def _run(
     )
     if not any(is_lazy(a) for a in (x, q, label, mask)):
         if nan_policy == "raise":
-            _raise_at_missing(x, q, label, mask)
+            _raise_at_missing(x, q, label, mask, recorded_load)
         return Analysis(x, q, label, one_chunk=True, **arrays).run()
     if reading.keep_loops:
         raise ValueError(
@@ -242,15 +242,17 @@ def _at_mean_load(force, load):
     return *force_at_mean_load(force, recorded), recorded
 
 
-def _raise_at_missing(x, q, label, mask) -> None:
-    """:class:`MissingSampleError` naming the first missing sample of a recording in memory."""
+def _raise_at_missing(x, q, label, mask, load=None) -> None:
+    """:class:`MissingSampleError` naming the first missing sample of a recording in memory
+    (one missing to a recorded ``load`` not positive is named once its cycle is found)."""
     bad = ~np.isfinite(x) | ~np.isfinite(q)
     if label is not None and label.dtype.kind not in "iub":
         bad |= ~np.isfinite(label)
     if mask is not None:
         bad |= mask
-    if bad.any():
-        raise missing_sample_error(int(np.argmax(bad)))
+    sample = int(np.argmax(bad))
+    if bad[sample] and not (load is not None and load[sample] <= 0.0):
+        raise missing_sample_error(sample)
 
 
 @si_units

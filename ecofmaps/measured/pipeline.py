@@ -17,9 +17,16 @@ import xarray as xr
 from ecofmaps._inputs import check
 from ecofmaps._parallel import Runner, stretch
 from ecofmaps.measured import resolve
-from ecofmaps.measured.cycles import Cycles, find_cycles, missing_sample_error, no_cycle_error
+from ecofmaps.measured.cycles import (
+    Cycles,
+    MissingSampleError,
+    find_cycles,
+    missing_sample_error,
+    no_cycle_error,
+)
 from ecofmaps.measured.measure import GROSS_SLIP_THRESHOLD, NEIGHBOURS, Stretch, measure_cycles
 from ecofmaps.measured.quality import (
+    COMPRESSION,
     LOAD_SCALED,
     RESOLVED,
     Tally,
@@ -41,6 +48,7 @@ __all__ = [
     "Task",
     "at_own_load",
     "force_at_mean_load",
+    "load_sample_error",
     "measure_chunk",
     "only",
     "runner_for",
@@ -205,12 +213,24 @@ def force_at_mean_load(force, load):
     if np.isnan(mean):
         hint = "is it the normal load?"
         if lowest < 0.0:
-            hint = "is it recorded negative in compression? Give it with the other sign (-Fz)."
+            hint = COMPRESSION
         raise ValueError(
             f"the recorded normal load is nowhere positive (from {lowest:g} N to "
             f"{highest + 0.0:g} N): {hint}"
         )
     return force * (mean / usable), mean
+
+
+def load_sample_error(sample: int, load: float, cycle=None) -> MissingSampleError:
+    """The error for sample ``sample`` (0-based, of ``cycle`` if known) whose recorded normal
+    ``load`` [N] is not positive, with ``nan_policy='raise'``."""
+    at = f"sample {sample}" + ("" if cycle is None else f" (cycle {cycle})")
+    return MissingSampleError(
+        sample,
+        f"the recorded normal load at {at} is {load:g} N, not positive, and the force is "
+        "scaled by it; nan_policy='skip' flags its cycle load-not-positive and analyses the "
+        "others" + (f": {COMPRESSION}" if load < 0 else ""),
+    )
 
 
 #: The values that scale with the normal load: with a recorded load, they are reported at
@@ -356,7 +376,13 @@ class Analysis:
             )
         self.cycles = cycles
         if nan_policy == "raise" and cycles.first_missing >= 0:
-            raise missing_sample_error(cycles.first_missing)
+            first = cycles.first_missing
+            load = np.nan if recorded_load is None else float(recorded_load[first])
+            if load <= 0.0:
+                row = np.searchsorted(cycles.start, first, side="right") - 1
+                within = row >= 0 and first < cycles.start[row] + cycles.count[row]
+                raise load_sample_error(first, load, cycles.label[row] if within else None)
+            raise missing_sample_error(first)
         if cycles.label.size == 0:
             raise no_cycle_error(int(displacement.shape[0]))
         whole = [slice(0, cycles.label.size)]

@@ -19,6 +19,7 @@ from ecofmaps.model.regimes import GROSS_SLIP, INVALID, PARTIAL_SLIP, Regime
 __all__ = [
     "ALL",
     "ANTICLOCKWISE_SHARE",
+    "COMPRESSION",
     "LOAD_SCALED",
     "LOAD_SWING",
     "READING_REASONS",
@@ -254,12 +255,15 @@ READING_REASONS = (
     "gicof-varies",
 )
 
+#: What to do about a recorded normal load that is negative.
+COMPRESSION = "is it recorded negative in compression? Give it with the other sign (-Fz)."
+
 #: What to do about a recording whose every cycle is refused for a reason, the first that
 #: applies; with loops anticlockwise and stick sides sloping down, :data:`_FLIP_HINT`.
 _HINTS = {
     "missing-samples": "Every cycle holds a missing sample (NaN or an empty cell).",
-    "load-not-positive": "The recorded normal load is zero or negative in every cycle: is it "
-    "recorded negative in compression? Give it with the other sign (-Fz).",
+    "load-not-positive": "The recorded normal load is zero or negative in every cycle: "
+    + COMPRESSION,
     "anticlockwise": "The loops run anticlockwise with stick sides sloping up: the recording "
     "runs backwards in time, or the displacement and force columns are swapped.",
     "constant-force": "The force does not vary: is the force channel connected?",

@@ -526,6 +526,34 @@ def test_a_recorded_load_is_judged_cycle_by_cycle(chunks):
     xr.testing.assert_equal(memory.drop_vars(recorded), missing.drop_vars(recorded))
 
 
+@pytest.mark.filterwarnings("ignore::ecofmaps.measured.LoopQualityWarning")
+@pytest.mark.parametrize("chunks", [None, 700])
+def test_a_load_not_positive_is_named_with_nan_policy_raise(chunks):
+    """Not 'sample 1100 is missing': the recorded load there, its cycle as the table numbers
+    it, and for a negative load the hint of compression, in memory and out of core."""
+    import dask.array as da
+
+    from ecofmaps.measured.cycles import MissingSampleError
+    from ecofmaps.measured.quality import COMPRESSION
+
+    labels = analyze_loops(*_bad_loads()).cycle.values
+    displacement, force, load = _bad_loads()
+    for sample, value, row in ((1100, "0", 5), (2050, "-3", 10)):
+        arrays = (displacement, force, load)
+        if chunks is not None:
+            arrays = [da.from_array(a, chunks=chunks) for a in arrays]
+        with pytest.raises(MissingSampleError) as raised:
+            analyze_loops(*arrays, nan_policy="raise")
+        assert raised.value.sample == sample
+        assert str(raised.value) == (
+            f"the recorded normal load at sample {sample} (cycle {labels[row]}) is {value} N, "
+            "not positive, and the force is scaled by it; nan_policy='skip' flags its cycle "
+            "load-not-positive and analyses the others"
+            + (f": {COMPRESSION}" if value != "0" else "")
+        )
+        load[sample] = 450.0  # the next one
+
+
 @pytest.mark.parametrize("lazy", [False, True])
 def test_a_recorded_load_nowhere_positive_says_why(lazy):
     """A load recorded negative (compression) asks for the other sign; one without a value
