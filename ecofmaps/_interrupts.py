@@ -15,6 +15,7 @@ __all__ = [
     "Stop",
     "add_stop_note",
     "check_interrupted",
+    "interrupted_waiting",
     "interrupts_deferred",
     "interrupts_stop_writes",
 ]
@@ -66,6 +67,32 @@ def check_interrupted() -> None:
     :func:`interrupts_stop_writes`."""
     if INTERRUPTED.is_set() and not INTERRUPTED.deferred:
         raise KeyboardInterrupt
+
+
+def interrupted_waiting(function):
+    """``function()`` run in a thread of its own while this one waits, acting on a stop signal
+    of :func:`interrupts_stop_writes` within 0.1 s: Python runs a signal's handler only once
+    a call into a C library returns, which for XLA compiling takes seconds. On a stop the
+    thread is left running (the command line ends its process at once); its exception, if
+    any, is raised here."""
+    check_interrupted()
+    outcome = []
+
+    def run():
+        try:
+            outcome.append((function(), None))
+        except BaseException as error:  # raised in the waiting thread
+            outcome.append((None, error))
+
+    thread = threading.Thread(target=run)
+    thread.start()
+    while thread.is_alive():
+        thread.join(0.1)
+        check_interrupted()
+    result, error = outcome[0]
+    if error is not None:
+        raise error
+    return result
 
 
 @contextlib.contextmanager

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import argparse
 import functools
+import importlib
 
+from ecofmaps._interrupts import interrupted_waiting
 from ecofmaps.cli._common import CommandError, option_adder
 from ecofmaps.web import INSTALL_WEB, missing_web_packages
 
@@ -54,12 +56,13 @@ def add(subparsers) -> None:
 def run(args) -> int:
     if missing_web_packages():
         raise CommandError(INSTALL_WEB)
-    # Panel and Bokeh load only when the explorer runs (the command's lazy boundary).
-    from ecofmaps.web.server import serve_explorer
+    # Panel and Bokeh load only when the explorer runs (the command's lazy boundary), in a
+    # thread: a stop while they load (seconds) is acted on at once.
+    server = interrupted_waiting(functools.partial(importlib.import_module, "ecofmaps.web.server"))
 
     announce = functools.partial(print, flush=True)  # the address at once, also in a pipe
     try:
-        serve_explorer(
+        server.serve_explorer(
             args.port,
             open_browser=not args.no_browser,
             announce=announce,

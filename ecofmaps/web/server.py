@@ -13,7 +13,7 @@ from panel.io.server import get_server
 from tornado.routing import Matcher, Rule
 from tornado.web import RequestHandler
 
-from ecofmaps._interrupts import check_interrupted
+from ecofmaps._interrupts import check_interrupted, interrupted_waiting
 from ecofmaps.units import TEXT_LIMIT
 from ecofmaps.web.explorer import explorer_page, warm_up
 
@@ -135,8 +135,7 @@ def serve_explorer(port: int, *, open_browser: bool = True, announce=print, allo
         loop.asyncio_loop.call_soon_threadsafe(loop.stop)
 
     try:
-        check_interrupted()  # a stop while the command started up ends it here
-        warm_up()  # the port is taken: a page asked for meanwhile waits for it
+        interrupted_waiting(warm_up)  # the port is taken: a page asked for meanwhile waits
         server.start()
         for number in ours:  # a signal ignored (Ctrl-C in a background job) stays ignored
             signal.signal(number, stop)
