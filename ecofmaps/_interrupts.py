@@ -73,8 +73,8 @@ def interrupted_waiting(function):
     """``function()`` run in a thread of its own while this one waits, acting on a stop signal
     of :func:`interrupts_stop_writes` within 0.1 s: Python runs a signal's handler only once
     a call into a C library returns, which for XLA compiling takes seconds. On a stop the
-    thread is left running (the command line ends its process at once); its exception, if
-    any, is raised here."""
+    thread is left running (the command line ends its process at once with ``os._exit``;
+    elsewhere Python waits for it at exit); its exception, if any, is raised here."""
     check_interrupted()
     outcome = []
 

@@ -106,6 +106,18 @@ def test_a_port_in_use_is_one_line(capsys):
     assert f"cannot listen on 127.0.0.1:{port}" in err and "choose another --port" in err
 
 
+def test_a_failure_of_the_warm_up_is_the_commands(capsys, monkeypatch):
+    """The warm-up runs in a thread while the command waits: its error comes back here."""
+    from ecofmaps.web import server
+
+    def fails():
+        raise ValueError("the model would not compile")
+
+    monkeypatch.setattr(server, "warm_up", fails)
+    status, out, err = run(capsys, "explore", "--no-browser", "--port", free_port())
+    assert (status, out, err) == (2, "", "ecofmaps: error: the model would not compile\n")
+
+
 # --- the server, in the browser ---------------------------------------------------------------
 
 
