@@ -32,7 +32,7 @@ from ecofmaps.cli._common import (
     transition_rows,
 )
 from ecofmaps.cli.main import option_names
-from ecofmaps.io.files import atomic_path, record_written
+from ecofmaps.io.files import FileLineError, atomic_path, record_written
 from ecofmaps.web import INSTALL_WEB, missing_web_packages
 
 __all__ = ["SUMMARY_VARIABLES", "add", "run"]
@@ -193,6 +193,8 @@ def _analysed(index, path, recording, load, args, long_run, write):
             analysed = long_run.analyse(index, path, recording, load, write, columns, reading)
         except ImplausibleScaleError as error:
             raise recording.error(_with_assumptions(str(error), recording)) from None
+        except FileLineError:  # names its file and line already
+            raise
         except ValueError as error:
             raise recording.error(str(error)) from None
     for warning in caught:  # one line each, naming the file, not a Python source line

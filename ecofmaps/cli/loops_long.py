@@ -37,11 +37,8 @@ from ecofmaps.measured.pipeline import (
 
 __all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun", "keep_block"]
 
-#: The message for a missing sample with ``--nan-policy raise`` (the file and line before it).
-MISSING = (
-    "missing sample (an empty cell or NaN); --nan-policy skip analyses the cycles without "
-    "missing samples and reports the others as skipped"
-)
+#: What a missing sample is, with ``--nan-policy raise`` (the file and line before it).
+MISSING = "missing sample (an empty cell or NaN)"
 
 #: Suffix of the folder that holds an unfinished run's blocks beside ``--out``.
 PARTIAL_SUFFIX = ".partial"
@@ -297,7 +294,10 @@ class LongRun:
             note = self.stop_note()
             raise (stop if note is None else Interrupted(note)) from None
         except MissingSampleError as error:
-            raise recording.error(MISSING, error.sample) from None
+            what = error.what or MISSING
+            raise recording.error(
+                f"{what}; --nan-policy skip {error.skips}", error.sample
+            ) from None
         self.analysed = (index, path, len(analysis.tasks))
         return analysis.finish([parts.pop(k) for k in sorted(parts)]), resolved
 

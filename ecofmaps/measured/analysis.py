@@ -12,7 +12,7 @@ import xarray as xr
 
 from ecofmaps._inputs import si_units
 from ecofmaps._parallel import check_workers
-from ecofmaps.measured.cycles import MIN_SAMPLES, missing_sample_error
+from ecofmaps.measured.cycles import MIN_SAMPLES, MissingSampleError
 from ecofmaps.measured.pipeline import (
     NAN_POLICIES,
     Analysis,
@@ -252,7 +252,7 @@ def _raise_at_missing(x, q, label, mask, load=None) -> None:
         bad |= mask
     sample = int(np.argmax(bad))
     if bad[sample] and not (load is not None and load[sample] <= 0.0):
-        raise missing_sample_error(sample)
+        raise MissingSampleError(sample)
 
 
 @si_units

@@ -629,20 +629,17 @@ def find_cycles(
 
 
 class MissingSampleError(ValueError):
-    """A missing sample where ``nan_policy='raise'``: ``sample`` is its 0-based index."""
+    """A missing sample where ``nan_policy='raise'``: ``sample`` is its 0-based index, ``what``
+    is wrong with it (None: it is NaN or empty) and ``skips`` is what ``nan_policy='skip'``
+    does instead."""
 
-    def __init__(self, sample: int, message: str):
-        self.sample = int(sample)
-        super().__init__(message)
-
-
-def missing_sample_error(sample: int) -> MissingSampleError:
-    """The error for the missing sample ``sample`` (0-based) with ``nan_policy='raise'``."""
-    return MissingSampleError(
-        sample,
-        f"sample {sample} is missing (NaN or empty); nan_policy='skip' analyses the cycles "
-        "without missing samples and reports the others as skipped",
-    )
+    def __init__(self, sample: int, what=None, skips=None):
+        self.sample, self.what = int(sample), what
+        self.skips = skips or (
+            "analyses the cycles without missing samples and reports the others as skipped"
+        )
+        what = what or f"sample {self.sample} is missing (NaN or empty)"
+        super().__init__(f"{what}; nan_policy='skip' {self.skips}")
 
 
 def no_cycle_error(samples: int) -> ValueError:

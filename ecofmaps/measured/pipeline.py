@@ -21,7 +21,6 @@ from ecofmaps.measured.cycles import (
     Cycles,
     MissingSampleError,
     find_cycles,
-    missing_sample_error,
     no_cycle_error,
 )
 from ecofmaps.measured.measure import GROSS_SLIP_THRESHOLD, NEIGHBOURS, Stretch, measure_cycles
@@ -228,8 +227,9 @@ def load_sample_error(sample: int, load: float, cycle=None) -> MissingSampleErro
     return MissingSampleError(
         sample,
         f"the recorded normal load at {at} is {load:g} N, not positive, and the force is "
-        "scaled by it; nan_policy='skip' flags its cycle load-not-positive and analyses the "
-        "others" + (f": {COMPRESSION}" if load < 0 else ""),
+        "scaled by it",
+        "flags its cycle load-not-positive and analyses the others"
+        + (f": {COMPRESSION}" if load < 0 else ""),
     )
 
 
@@ -382,7 +382,7 @@ class Analysis:
                 row = np.searchsorted(cycles.start, first, side="right") - 1
                 within = row >= 0 and first < cycles.start[row] + cycles.count[row]
                 raise load_sample_error(first, load, cycles.label[row] if within else None)
-            raise missing_sample_error(first)
+            raise MissingSampleError(first)
         if cycles.label.size == 0:
             raise no_cycle_error(int(displacement.shape[0]))
         whole = [slice(0, cycles.label.size)]

@@ -91,3 +91,20 @@ def test_a_load_column_that_is_not_there_is_named(tmp_path, capsys):
     path = write_csv(tmp_path / "test.csv", *synthetic_recording(**POINT, cycles=4))
     status, _, err = run(capsys, path, "--load", "Fz", "--out", tmp_path / "r.csv")
     assert status == 2 and "Fz" in err and "test.csv" in err
+
+
+def test_a_negative_load_sample_with_nan_policy_raise_is_named_once(tmp_path, capsys):
+    """``--load Fz --nan-policy raise`` and one sample of Fz negative: the error names the load,
+    its sample and cycle, the hint of compression, and the file and line once."""
+    displacement, force = synthetic_recording(**POINT, cycles=4)
+    lines = ["displacement [m],force [N],Fz [N]"]
+    lines += [f"{float(d)!r},{float(q)!r},450.0" for d, q in zip(displacement, force, strict=True)]
+    lines[1 + 500] = lines[1 + 500].rsplit(",", 1)[0] + ",-450.0"
+    path = tmp_path / "fz.csv"
+    path.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "r.csv"
+    status, _, err = run(capsys, path, "--load", "Fz", "--nan-policy", "raise", "--out", out)
+    assert status == 2 and not out.exists()
+    assert f"{path}, line 502: the recorded normal load at sample 500 (cycle" in err
+    assert "is -450 N, not positive" in err and "--nan-policy skip flags its cycle" in err
+    assert "-Fz" in err and err.count("line ") == 1
