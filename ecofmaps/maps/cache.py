@@ -27,7 +27,7 @@ import xarray as xr
 
 from ecofmaps._codes import warn
 from ecofmaps._version import __version__
-from ecofmaps.io.files import TEMPORARY_NAME, atomic_path
+from ecofmaps.io.files import TEMPORARY_NAME, atomic_path, check_room
 
 __all__ = [
     "DEFAULT_SIZE_BOUND",
@@ -206,6 +206,7 @@ def write_netcdf(dataset: xr.Dataset, path, *, exclusive: bool = True) -> Path:
     failure ``path`` is left as it was. Returns ``path`` as a :class:`pathlib.Path`."""
     path = Path(path)
     with atomic_path(path, exclusive=exclusive) as temporary:
+        check_room(temporary, dataset.nbytes)
         dataset.to_netcdf(temporary, engine="h5netcdf")
     return path
 
