@@ -13,6 +13,7 @@ import sys
 import numpy as np
 import pytest
 
+from ecofmaps import read_recording
 from ecofmaps.cli import main
 from ecofmaps.maps import tiles
 from tests.cli.commands import interrupted_run
@@ -323,6 +324,22 @@ def test_reading_errors_blame_the_right_thing_and_name_the_options(
     status, out, err = run(capsys, "loops", path, "--load", "450N", "--no-resolve", *options)
     assert status == 2 and out == "" and one_line_error(err)
     assert err == f"ecofmaps: error: {path}, {message}\n"
+
+
+def test_a_missing_file_is_named_with_the_nearest_name_and_group_with_its_option(
+    tmp_path, capsys, recording
+):
+    status, out, err = run(capsys, "loops", tmp_path / "rec.cs", "--load", "450N")
+    assert status == 2 and out == "" and one_line_error(err)
+    assert err == f"ecofmaps: error: {tmp_path / 'rec.cs'}: no such file: did you mean " \
+        f"'{recording}'?\n"  # fmt: skip
+    with pytest.raises(FileNotFoundError, match="no such file: did you mean"):  # an OSError
+        read_recording(tmp_path / "rec.cs")
+    status, _, err = run(capsys, "convert", tmp_path / "other.csv", tmp_path / "o.zarr")
+    assert status == 2 and err == f"ecofmaps: error: {tmp_path / 'other.csv'}: no such file\n"
+    status, _, err = run(capsys, "loops", recording, "--load", "450N", "--group", "Rig")
+    assert status == 2 and one_line_error(err) and "group (--group) applies to TDMS" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rec.csv"]
 
 
 def test_columns_named_alike_are_chosen_by_position_and_a_cycle_column_ignored(tmp_path, capsys):
