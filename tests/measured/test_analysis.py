@@ -526,6 +526,25 @@ def test_a_recorded_load_is_judged_cycle_by_cycle(chunks):
     xr.testing.assert_equal(memory.drop_vars(recorded), missing.drop_vars(recorded))
 
 
+@pytest.mark.filterwarnings("ignore::ecofmaps.measured.LoopQualityWarning")
+@pytest.mark.parametrize("chunks", [None, 700])
+def test_cycles_cut_by_their_numbers_keep_those_with_missing_samples(chunks):
+    """Cut by cycle numbers, a cycle whose load is not positive, or with a long gap in its
+    displacement, is flagged as when cut at the reversals, not dropped as incomplete."""
+    import dask.array as da
+
+    displacement, force, load = _bad_loads()
+    load[5 * 200 : 6 * 200] = 0.0  # all of cycle 6
+    displacement[9 * 200 : 9 * 200 + 120] = np.nan  # most of cycle 10
+    arrays = [displacement, force, load, np.repeat(np.arange(1, 13), 200)]
+    if chunks is not None:
+        arrays = [da.from_array(a, chunks=chunks) for a in arrays]
+    results = analyze_loops(*arrays[:3], cycle=arrays[3])
+    assert list(results.cycle.values) == list(range(1, 13))
+    refused, gapped = "load-not-positive", "missing-samples"
+    assert list(results.quality.values[[5, 9, 10]]) == [refused, gapped, refused]
+
+
 @pytest.mark.parametrize("lazy", [False, True])
 def test_a_recorded_load_nowhere_positive_says_why(lazy):
     """A load recorded negative (compression) asks for the other sign; one without a value
