@@ -94,6 +94,8 @@ def test_the_same_file_by_another_name_is_refused(tmp_path, capsys, recording):
           "35MN/m", "--scar-depth=-8um", "--scar-half-width", "40um"],
          "argument --scar-depth: '-8um' is out of range"),
         (["loops", "--example", "--load", "inf"], "argument --load: 'inf' is out of range"),
+        (["loops", "--example", "--load", "-450N"], "argument --load: expected one argument (a "
+         "value that begins with '-' is written --load=VALUE)"),
         (["loops", "--example", "--force-unit", ""], "argument --force-unit: an empty unit"),
         (["loops", "--example", "--load", "450N", "--skip-rows", "-1"],
          "argument --skip-rows: '-1' is not a whole number of lines >= 0"),
