@@ -548,7 +548,7 @@ def test_cycles_cut_by_their_numbers_keep_those_with_missing_samples(chunks):
 @pytest.mark.parametrize("lazy", [False, True])
 def test_a_recorded_load_nowhere_positive_says_why(lazy):
     """A load recorded negative (compression) asks for the other sign; one without a value
-    names the load; in memory and out of core alike."""
+    names the load; one swinging in every cycle refused says so; in memory and out of core."""
     import dask.array as da
 
     displacement, force, load = load_steps()
@@ -564,3 +564,6 @@ def test_a_recorded_load_nowhere_positive_says_why(lazy):
     spiked = np.where(np.arange(load.size) % 50 == 7, -load, load)  # in every cycle
     with pytest.raises(ValueError, match=r"load-not-positive 12\). The recorded normal load is"):
         analyze_loops(wrap(displacement), wrap(force), wrap(spiked))
+    swinging = np.where(np.arange(load.size) % 200 < 100, 2.0, 600.0)  # every cycle refused
+    with pytest.raises(ValueError, match=r"\). The recorded normal load swings by more than 20%"):
+        analyze_loops(wrap(displacement), wrap(force), wrap(swinging))
