@@ -332,11 +332,11 @@ def _sliding_friction(gross, level, split, cof, friction):
 
 def cycle_sum(cycle, value):
     """Σ of a per-cycle ``value`` over cycles 1 to the last recorded, and its standard error
-    (docs/lab.md, "Energy wear")."""
+    (docs/lab.md, "Energy wear"); ``ValueError`` if no cycle has a value."""
     kept = np.isfinite(value)
     n, v = cycle[kept], value[kept]
     if n.size == 0:
-        return np.nan, np.nan
+        raise ValueError("no cycle has a value to sum: every one is NaN (skipped or flagged)")
     if np.any(np.diff(n) <= 0) or n[0] < 1:
         raise ValueError("results: the cycle numbers must be 1 or more and increasing")
     gaps = np.diff(n)
@@ -458,9 +458,9 @@ def energy_wear(results, profile, length=None, contact="line") -> xr.Dataset:
     Raises
     ------
     ValueError
-        For results without cycles, energies or a load, a profile without a scar, a length
-        not in metres (0 < L < 1 m), a line without a length or a sphere with one, or lists
-        of unequal length.
+        For results without cycles, energies (or all NaN) or a load, a profile without a
+        scar, a length not in metres (0 < L < 1 m), a line without a length or a sphere with
+        one, or lists of unequal length.
 
     Notes
     -----

@@ -11,6 +11,7 @@ import pytest
 import xarray as xr
 
 import ecofmaps
+from ecofmaps.lab import cycle_sum
 from tests import mindlin
 from tests.lab_cases import ALPHA, CYCLES, DELTA_T, HALF_WIDTH, LENGTH, LOAD, MU, recorded_test
 
@@ -286,6 +287,12 @@ def test_the_cycle_sum_is_exact_for_energies_linear_in_the_cycle():
     every = np.arange(1, CYCLES[-1] + 1)
     assert float(wear.cumulated_energy) == pytest.approx((1e-3 * (1 + every / 1e4)).sum())
     assert float(wear.cumulated_energy_se) < 1e-9
+
+
+def test_a_sum_over_no_cycle_with_a_value_says_so():
+    """Every cycle NaN (all flagged): a ValueError saying why, not a bare NaN."""
+    with pytest.raises(ValueError, match="no cycle has a value to sum: every one is NaN"):
+        cycle_sum(CYCLES.astype(float), np.full(CYCLES.size, np.nan))
 
 
 def test_energy_wear_over_a_campaign_finds_alpha_and_the_threshold():

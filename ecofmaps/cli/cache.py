@@ -14,7 +14,8 @@ def add(subparsers) -> None:
         description="Computed maps are kept as netCDF files, one per grid and package version, in "
         "the directory given by --cache-dir, else the ECOFMAPS_CACHE environment variable, else "
         "the per-user cache directory. 'list' shows them with their sizes; 'clear' removes them "
-        "(and temporary files of interrupted writes; other files are left alone).",
+        "(with the kernels JAX compiled for ecofmaps figures, in its jax/ folder, and temporary "
+        "files of interrupted writes; other files are left alone).",
     )
     actions = parser.add_subparsers(title="actions", metavar="ACTION", required=True)
     for name, text in (

@@ -27,7 +27,7 @@ from ecofmaps.cli._common import (
 )
 from ecofmaps.io.files import record_written
 
-__all__ = ["JAX_CACHE_FOLDER", "TaskQueue", "add", "run"]
+__all__ = ["TaskQueue", "add", "run"]
 
 _FORMATS = ("png", "pdf", "svg")
 
@@ -39,9 +39,6 @@ _HELP = {
     "--jobs": "processes drawing at once (default: one per core, at most one per group of "
     "figures sharing their numbers; 1: all in this process)",
 }
-
-#: Folder of the ecofmaps cache directory that holds JAX's compiled kernels for this command.
-JAX_CACHE_FOLDER = "jax"
 
 
 def _figure_formats(text: str) -> tuple[str, ...]:
@@ -96,7 +93,7 @@ def _set_jax_options(options: dict | None = None) -> dict:
     import jax  # the CLI's lazy boundary: other commands start without JAX
 
     if options is None:
-        from ecofmaps.maps.cache import cache_directory
+        from ecofmaps.maps.cache import JAX_CACHE_FOLDER, cache_directory
 
         options = {
             "jax_compilation_cache_dir": str(cache_directory() / JAX_CACHE_FOLDER),

@@ -102,8 +102,11 @@ class _Partial:
             return
         try:
             found = json.loads(record.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            found = None
+        except (OSError, ValueError, RecursionError) as error:  # deep nesting: RecursionError
+            raise CommandError(
+                f"{record} is missing or damaged ({type(error).__name__}): the run kept in "
+                f"{self.folder} cannot be resumed; delete the folder to start again"
+            ) from None
         if found != fingerprint:
             raise CommandError(
                 f"{self.folder} holds a run of other files or options (or of these files "
@@ -119,7 +122,7 @@ class _Partial:
             open(self.folder / "kept.jsonl", encoding="utf-8") as lines,
         ):
             for line in lines:
-                with contextlib.suppress(ValueError, TypeError, KeyError):
+                with contextlib.suppress(ValueError, TypeError, KeyError, RecursionError):
                     entry = json.loads(line)
                     found[(int(entry["file"]), entry["block"])] = entry
         return found

@@ -45,6 +45,9 @@ class _Parser(argparse.ArgumentParser):
     """An argument parser whose usage errors are one line, like every other error."""
 
     def error(self, message):
+        if message.endswith("expected one argument"):  # or its value is taken for an option
+            option = message.removeprefix("argument ").split(":")[0].split("/")[0]
+            message += f" (a value that begins with '-' is written {option}=VALUE)"
         self.exit(2, f"ecofmaps: error: {message} (see '{self.prog} --help')\n")
 
 

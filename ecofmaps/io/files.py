@@ -28,6 +28,7 @@ __all__ = [
     "FileLineError",
     "atomic_path",
     "atomic_store",
+    "check_room",
     "is_store",
     "record_written",
     "write_text",
@@ -204,6 +205,16 @@ def atomic_store(path, *, overwrite: bool = False, exclusive: bool = True):
     except BaseException:
         _remove(temporary)
         raise
+
+
+def check_room(path, size: int) -> None:
+    """Raise ``OSError`` (ENOSPC) naming ``path`` unless its disk has ``size`` bytes free and a
+    few chunks to spare [byte]: asked before HDF5 writes, as HDF5 cannot recover from a failed
+    write (the half-written file then crashes the process when it is closed)."""
+    free = shutil.disk_usage(Path(path).parent).free
+    if free < size + 4 * CHUNK_BYTES:
+        message = f"No space left on device: {size:,} bytes to write, {free:,} free"
+        raise OSError(errno.ENOSPC, message, str(path))
 
 
 _FOLDER = "is a folder, not a store written by ecofmaps: it is not replaced"

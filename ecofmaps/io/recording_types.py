@@ -9,6 +9,8 @@ one xarray Dataset every way in shares (``docs/formats.md``).
 from __future__ import annotations
 
 import dataclasses
+import difflib
+import errno
 import functools
 import os
 import stat
@@ -96,13 +98,28 @@ class RecordingError(FileLineError):
         ValueError.__init__(self, f"{where}: {message}")
 
 
+class _MissingFile(FileNotFoundError):
+    """A file that is not there, said as ``<path>: no such file[: did you mean ...]``."""
+
+    def __str__(self) -> str:
+        return f"{self.filename}: {self.strerror}"
+
+
 def check_regular_file(path) -> None:
     """Raise :class:`RecordingError` unless ``path`` (a link followed) is a regular file.
 
     A pipe, a device or a socket never ends, or blocks until another program writes: it
-    is refused by name before it is opened. ``OSError`` if it cannot be looked at.
+    is refused by name before it is opened. ``FileNotFoundError`` for a missing one, with
+    the nearest name in its folder; ``OSError`` if it cannot be looked at.
     """
-    mode = os.stat(path).st_mode
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        folder = Path(path).parent
+        names = [p.name for p in folder.iterdir()] if folder.is_dir() else []
+        near = difflib.get_close_matches(Path(path).name, names, n=1, cutoff=0.8)
+        hint = f": did you mean {str(folder / near[0])!r}?" if near else ""
+        raise _MissingFile(errno.ENOENT, f"no such file{hint}", str(path)) from None
     if stat.S_ISREG(mode):
         return
     what = next((kind for test, kind in _NOT_FILES.items() if test(mode)), "not a regular file")

@@ -140,7 +140,9 @@ def _check_count(name: str, value, least: int = 1, what: str = "a positive integ
 def _text_recordings(path: Path, options: dict, block_bytes, samples=None) -> Iterator[Recording]:
     """A text file's samples as recordings of ``samples`` each (None: one of all of them)."""
     if options["group"] is not None:
-        raise ValueError("group applies to TDMS, HDF5/netCDF and zarr files, not to text")
+        raise ValueError(
+            f"group (--group) applies to TDMS, HDF5/netCDF and zarr files, not to text: {path}"
+        )
     parts = text_blocks(path, options, block_bytes or BLOCK_BYTES)
     layout = next(parts)
     columns = {role: layout.names[k] for role, k in layout.columns.items()}

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps import _nomenclature as nomenclature
-from ecofmaps.io.files import CHUNK_BYTES, atomic_store
+from ecofmaps.io.files import CHUNK_BYTES, atomic_store, check_room
 from ecofmaps.io.recordings import recording_blocks
 
 __all__ = ["WRITE_FORMATS", "RecordingWriter", "convert_recording"]
@@ -152,6 +152,8 @@ class RecordingWriter:
         if count == 0:
             return
         joined = {role: np.concatenate(parts) for role, parts in self._pending.items()}
+        if self.format == "hdf5":
+            check_room(self._temporary, count * 8 * len(self.roles))
         getattr(self, f"_append_{self.format}")({role: a[:count] for role, a in joined.items()})
         self._pending = {role: [array[count:]] for role, array in joined.items()}
         self._held -= count

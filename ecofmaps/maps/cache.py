@@ -27,11 +27,12 @@ import xarray as xr
 
 from ecofmaps._codes import warn
 from ecofmaps._version import __version__
-from ecofmaps.io.files import TEMPORARY_NAME, atomic_path
+from ecofmaps.io.files import TEMPORARY_NAME, atomic_path, check_room
 
 __all__ = [
     "DEFAULT_SIZE_BOUND",
     "ENVIRONMENT_VARIABLE",
+    "JAX_CACHE_FOLDER",
     "SIZE_VARIABLE",
     "CacheEntry",
     "CacheWarning",
@@ -48,6 +49,9 @@ __all__ = [
 
 #: Environment variable that overrides the per-user cache directory.
 ENVIRONMENT_VARIABLE = "ECOFMAPS_CACHE"
+
+#: The folder of the cache where ``ecofmaps figures`` has JAX keep its compiled kernels.
+JAX_CACHE_FOLDER = "jax"
 
 #: Environment variable that sets the bound on the cache's size (``500MB``, ``2GB``, ``0``).
 SIZE_VARIABLE = "ECOFMAPS_CACHE_SIZE"
@@ -71,6 +75,8 @@ _MODEL_SOURCES = (
 # Length of the key in file names: 128 bits of the hash.
 _NAME_DIGITS = 32
 _ENTRY = re.compile(rf"^(?P<function>[A-Za-z_][A-Za-z0-9_]*)-[0-9a-f]{{{_NAME_DIGITS}}}\.nc$")
+# JAX's files of a compiled kernel: <name>-<sha256>-cache, and its last use, -atime.
+_JAX_ENTRY = re.compile(r"^.+-[0-9a-f]{64}-(cache|atime)$")
 # Largest chunk of an array, each with its own Fletcher-32 checksum. [byte]
 _CHUNK_BYTES = 2**22
 # Array types whose chunks carry a checksum; the values of the others (text) are hashed.
@@ -206,6 +212,7 @@ def write_netcdf(dataset: xr.Dataset, path, *, exclusive: bool = True) -> Path:
     failure ``path`` is left as it was. Returns ``path`` as a :class:`pathlib.Path`."""
     path = Path(path)
     with atomic_path(path, exclusive=exclusive) as temporary:
+        check_room(temporary, dataset.nbytes)
         dataset.to_netcdf(temporary, engine="h5netcdf")
     return path
 
@@ -405,7 +412,8 @@ def cache_entries(cache_dir=None) -> list[CacheEntry]:
 
 
 def clear_cache(cache_dir=None) -> tuple[int, int]:
-    """Remove every cache entry, and temporary files left by interrupted writes (no other file).
+    """Remove every cache entry, JAX's compiled kernels (a write cut short by a full disk is
+    never repaired by JAX), and temporary files left by interrupted writes (no other file).
 
     Parameters
     ----------
@@ -421,7 +429,8 @@ def clear_cache(cache_dir=None) -> tuple[int, int]:
     """
     directory = cache_directory(cache_dir)
     count = size = 0
-    for path in _files(directory, _ENTRY) + _files(directory, TEMPORARY_NAME):
+    kernels = _files(directory / JAX_CACHE_FOLDER, _JAX_ENTRY)
+    for path in _files(directory, _ENTRY) + _files(directory, TEMPORARY_NAME) + kernels:
         try:
             file_size = path.stat().st_size
             path.unlink()

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import xarray as xr
 
-from ecofmaps.io.files import atomic_store
+from ecofmaps.io.files import atomic_store, check_room
 from ecofmaps.maps.tiles import tile_workers
 
 __all__ = ["ZARR_SUFFIX", "write_map"]
@@ -88,6 +88,7 @@ def write_map(dataset: xr.Dataset, path, *, also: Sequence = ()) -> tuple:
         if zarr:
             written = dataset.to_zarr(temporary, compute=False, zarr_format=2, consolidated=True)
         else:
+            check_room(temporary, dataset.nbytes)
             written = dataset.to_netcdf(temporary, engine="h5netcdf", compute=False)
         _, *values = dask.compute(written, *also, scheduler="threads", pool=pool)
     return tuple(values)

@@ -558,9 +558,11 @@ def _labelled(samples: Samples, tolerance: float) -> Cycles:
     stroke = top - floor
     gap = np.abs(end - begin)
     typical = np.nanmedian(stroke) if np.isfinite(floor).any() else np.nan
-    complete = (
-        (count >= MIN_SAMPLES)
-        & (stroke >= 0.5 * typical)
+    # A cycle with missing samples is kept whatever its shape: skipped as missing, not dropped.
+    gapped = passes.missing_in(gaps, starts, count) if gaps.size else False
+    complete = (count >= MIN_SAMPLES) & (
+        gapped
+        | (stroke >= 0.5 * typical)
         & (stroke > 0.0)
         & (gap <= 1.5 * np.where(np.isnan(largest), 0.0, largest) + tolerance * stroke)
     )

@@ -264,6 +264,8 @@ _HINTS = {
     "missing-samples": "Every cycle holds a missing sample (NaN or an empty cell).",
     "load-not-positive": "The recorded normal load is zero or negative in every cycle: "
     + COMPRESSION,
+    "load-swing": f"The recorded normal load swings by more than {LOAD_SWING:.0%} of its mean "
+    "within every cycle: is the load column the normal load, and is it held steady?",
     "anticlockwise": "The loops run anticlockwise with stick sides sloping up: the recording "
     "runs backwards in time, or the displacement and force columns are swapped.",
     "constant-force": "The force does not vary: is the force channel connected?",

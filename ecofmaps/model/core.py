@@ -323,9 +323,13 @@ def ecof_ratio(mu, kappa, lam):
     of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 1, 13-15, 16.
     """
     d = slip_ratio(mu, kappa, lam)
+    return jnp.where(d > 0.0, _ratio_at(d, mu, kappa, lam), jnp.nan)
+
+
+def _ratio_at(d, mu, kappa, lam):
+    r""":math:`\mu_E/\mu` at slip ratio ``d``: finite, its gradient too, also at d = 0."""
     excess = _artanh_excess(mu * kappa * d, locking_margin(1.0, mu, kappa, lam))
-    ratio = 1.0 + (1.0 + mu * mu) / (mu * mu) * excess
-    return jnp.where(d > 0.0, ratio, jnp.nan)
+    return 1.0 + (1.0 + mu * mu) / (mu * mu) * excess
 
 
 def normalized_max_force(mu, kappa, lam):
@@ -372,5 +376,5 @@ def normalized_energy(mu, kappa, lam):
     of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 1, 12.
     """
     d = slip_ratio(mu, kappa, lam)
-    energy = 4.0 * d * mu * ecof_ratio(mu, kappa, lam)
+    energy = 4.0 * d * mu * _ratio_at(d, mu, kappa, lam)  # no NaN for where's gradient at d = 0
     return jnp.where(d == 0.0, 0.0, energy)

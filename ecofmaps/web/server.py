@@ -23,8 +23,9 @@ __all__ = ["LOCAL_HOSTS", "serve_explorer"]
 # integer of more than 4300 digits; a longer one is cut to one character over TEXT_LIMIT.
 _QUERY_LIMIT = 1000
 
-#: The hosts whose pages the explorer answers (with its port); others get 403.
-LOCAL_HOSTS = ("127.0.0.1", "localhost", "[::1]")
+#: The hosts whose pages the explorer answers (with its port); others get 403. Not [::1]: the
+#: server listens on 127.0.0.1 only, and Panel cannot read a bracketed Host (an HTTP 500).
+LOCAL_HOSTS = ("127.0.0.1", "localhost")
 
 
 def _allowed_hosts(port: int, allow_origin=()) -> frozenset:
@@ -120,7 +121,7 @@ def serve_explorer(port: int, *, open_browser: bool = True, announce=print, allo
         show=False,
         start=False,
         title="ecofmaps explorer",
-        # Bokeh cannot parse "[::1]:port"; _Foreign checks every request against all hosts.
+        # Bokeh cannot parse a bracketed host ([::1]:port); _Foreign checks every request.
         websocket_origin=sorted(h for h in hosts if not h.startswith("[")),
     )
     signal.signal(signal.SIGINT, previous[signal.SIGINT])  # Panel's would stop at once

@@ -13,6 +13,7 @@ import sys
 import numpy as np
 import pytest
 
+from ecofmaps import read_recording
 from ecofmaps.cli import main
 from ecofmaps.maps import tiles
 from tests.cli.commands import interrupted_run
@@ -93,6 +94,8 @@ def test_the_same_file_by_another_name_is_refused(tmp_path, capsys, recording):
           "35MN/m", "--scar-depth=-8um", "--scar-half-width", "40um"],
          "argument --scar-depth: '-8um' is out of range"),
         (["loops", "--example", "--load", "inf"], "argument --load: 'inf' is out of range"),
+        (["loops", "--example", "--load", "-450N"], "argument --load: expected one argument (a "
+         "value that begins with '-' is written --load=VALUE)"),
         (["loops", "--example", "--force-unit", ""], "argument --force-unit: an empty unit"),
         (["loops", "--example", "--load", "450N", "--skip-rows", "-1"],
          "argument --skip-rows: '-1' is not a whole number of lines >= 0"),
@@ -323,6 +326,22 @@ def test_reading_errors_blame_the_right_thing_and_name_the_options(
     status, out, err = run(capsys, "loops", path, "--load", "450N", "--no-resolve", *options)
     assert status == 2 and out == "" and one_line_error(err)
     assert err == f"ecofmaps: error: {path}, {message}\n"
+
+
+def test_a_missing_file_is_named_with_the_nearest_name_and_group_with_its_option(
+    tmp_path, capsys, recording
+):
+    status, out, err = run(capsys, "loops", tmp_path / "rec.cs", "--load", "450N")
+    assert status == 2 and out == "" and one_line_error(err)
+    assert err == f"ecofmaps: error: {tmp_path / 'rec.cs'}: no such file: did you mean " \
+        f"'{recording}'?\n"  # fmt: skip
+    with pytest.raises(FileNotFoundError, match="no such file: did you mean"):  # an OSError
+        read_recording(tmp_path / "rec.cs")
+    status, _, err = run(capsys, "convert", tmp_path / "other.csv", tmp_path / "o.zarr")
+    assert status == 2 and err == f"ecofmaps: error: {tmp_path / 'other.csv'}: no such file\n"
+    status, _, err = run(capsys, "loops", recording, "--load", "450N", "--group", "Rig")
+    assert status == 2 and one_line_error(err) and "group (--group) applies to TDMS" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rec.csv"]
 
 
 def test_columns_named_alike_are_chosen_by_position_and_a_cycle_column_ignored(tmp_path, capsys):

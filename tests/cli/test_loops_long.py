@@ -236,6 +236,29 @@ def test_a_kept_block_that_fails_its_check_is_measured_again(
     assert err.count("\n") == len(refused)
 
 
+@pytest.mark.parametrize("damage", ["not json", "[" * 100_000 + "]" * 100_000])
+def test_a_damaged_record_of_the_run_is_named_as_such(
+    long_test, tmp_path, capsys, small_tasks, on_each_block, damage
+):
+    """run.json garbled or nested 100,000 deep: the record is named as damaged, with the
+    remedy (not a bug, nor a run of other files); a deep line in kept.jsonl is passed over."""
+    out = tmp_path / "r.csv"
+    interrupted(capsys, on_each_block, long_test[".zarr"], out)
+    partial = tmp_path / "r.csv.partial"
+    with open(partial / "kept.jsonl", "a") as kept:
+        kept.write(damage + "\n")
+    expected, _ = in_memory_table(capsys, long_test[".zarr"], tmp_path)
+    status, _, err = run(capsys, long_test[".zarr"], "--load", "450N", "--out", out, "--resume")
+    assert status == 0, err
+    assert out.read_text() == expected
+    out.unlink()
+    interrupted(capsys, on_each_block, long_test[".zarr"], out)
+    (partial / "run.json").write_text(damage)
+    status, _, err = run(capsys, long_test[".zarr"], "--load", "450N", "--out", out, "--resume")
+    assert status == 2
+    assert f"{partial / 'run.json'} is missing or damaged" in err and "delete the folder" in err
+
+
 def test_the_table_is_written_as_the_blocks_come(long_test, tmp_path, capsys, small_tasks,
                                                  on_each_block):  # fmt: skip
     """Each block's lines are in the temporary file beside --out (in order, after the header)

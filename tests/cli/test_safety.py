@@ -18,7 +18,7 @@ from ecofmaps.cli import figures
 from ecofmaps.io.files import MANIFEST, record_written, written_by_ecofmaps
 from ecofmaps.measured.synthetic import example_path, synthetic_recording
 from ecofmaps.paper import EXAMPLE_2
-from tests.cli.commands import run
+from tests.cli.commands import on_a_full_disk, run
 
 SHORT = ["--example", "--no-resolve"]  # the shipped example, 24000 samples: a few seconds
 
@@ -270,3 +270,20 @@ def test_a_full_disk_names_the_file_and_leaves_no_empty_plots_folder(tmp_path, c
     loops = plots / f"{example_path().stem}_loops.png"
     assert stderr == f"ecofmaps: error: [Errno 28] No space left on device: '{loops}'\n"
     assert not plots.exists()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("command", ["loops", "convert"])
+def test_an_hdf5_output_on_a_full_disk_is_one_line_naming_it(tmp_path, command):
+    """A real full disk under a netCDF or HDF5 output: one line naming the file, nothing left
+    (HDF5 cannot recover from a failed write: its half-written file crashed the process)."""
+    full = tmp_path / "full"
+    output = full / ("r.nc" if command == "loops" else "c.h5")
+    argv = ["loops", "--example", "--out", tmp_path / "r.csv", "--resolved", output]
+    if command == "convert":
+        argv = ["convert", example_path(), output]
+    status, stderr, left = on_a_full_disk(full, *argv)
+    assert status == 2, stderr
+    assert stderr.startswith("ecofmaps: error: [Errno 28] No space left on device: ")
+    assert stderr.endswith(f"free: '{output}'\n") and stderr.count("\n") == 1
+    assert left[-1:] == ["filler"] and not any(name.endswith(".tmp") for name in left)

@@ -11,10 +11,11 @@ import xarray as xr
 
 from ecofmaps import figures
 from ecofmaps.cli import main
-from ecofmaps.cli.figures import JAX_CACHE_FOLDER, TaskQueue
+from ecofmaps.cli.figures import TaskQueue
 from ecofmaps.figures import recipes
 from ecofmaps.io.files import MANIFEST
 from ecofmaps.maps import cache_entries
+from ecofmaps.maps.cache import JAX_CACHE_FOLDER
 
 
 def test_groups_share_a_dataset_costliest_first():

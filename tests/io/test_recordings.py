@@ -248,7 +248,7 @@ def test_the_same_column_twice(tmp_path):
         ("force_unit", "", "force_unit must be a non-empty string"),
         ("nan_policy", "omit", "nan_policy must be one of"),
         ("displacement_column", None, "displacement_column must be a column name"),
-        ("group", "Rig", "group applies to TDMS"),
+        ("group", "Rig", r"group \(--group\) applies to TDMS, .*, not to text: .*loops.csv"),
         ("lazy", "yes", "lazy must be True, False or None"),
         ("chunks", 0, "chunks must be a positive integer"),
         ("chunks", 2.5, "chunks must be a positive integer"),

@@ -476,11 +476,15 @@ def test_clear_removes_entries_and_leftovers_only(tmp_path):
     leftover.write_bytes(b"half")
     unrelated = tmp_path / "notes.nc"
     unrelated.write_text("keep me")
-    sizes = sum(e.size for e in cache_entries(tmp_path)) + 4
+    (tmp_path / "jax").mkdir()  # JAX's kernels, one cut short by a full disk: never repaired
+    (tmp_path / "jax" / f"jit__map_kernel-{'0' * 64}-cache").write_bytes(b"cut")
+    (tmp_path / "jax" / "notes.txt").write_text("keep me")
+    sizes = sum(e.size for e in cache_entries(tmp_path)) + 4 + 3
     assert [e.function for e in cache_entries(tmp_path)] == ["compute_map", "compute_universal_map"]
-    assert clear_cache(tmp_path) == (3, sizes)
+    assert clear_cache(tmp_path) == (4, sizes)
     assert cache_entries(tmp_path) == []
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.nc"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["jax", "notes.nc"]
+    assert [p.name for p in (tmp_path / "jax").iterdir()] == ["notes.txt"]
     assert clear_cache(tmp_path) == (0, 0)
     assert clear_cache(tmp_path / "missing") == (0, 0)
     assert cache_entries(tmp_path / "missing") == []

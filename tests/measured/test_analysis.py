@@ -554,10 +554,29 @@ def test_a_load_not_positive_is_named_with_nan_policy_raise(chunks):
         load[sample] = 450.0  # the next one
 
 
+@pytest.mark.filterwarnings("ignore::ecofmaps.measured.LoopQualityWarning")
+@pytest.mark.parametrize("chunks", [None, 700])
+def test_cycles_cut_by_their_numbers_keep_those_with_missing_samples(chunks):
+    """Cut by cycle numbers, a cycle whose load is not positive, or with a long gap in its
+    displacement, is flagged as when cut at the reversals, not dropped as incomplete."""
+    import dask.array as da
+
+    displacement, force, load = _bad_loads()
+    load[5 * 200 : 6 * 200] = 0.0  # all of cycle 6
+    displacement[9 * 200 : 9 * 200 + 120] = np.nan  # most of cycle 10
+    arrays = [displacement, force, load, np.repeat(np.arange(1, 13), 200)]
+    if chunks is not None:
+        arrays = [da.from_array(a, chunks=chunks) for a in arrays]
+    results = analyze_loops(*arrays[:3], cycle=arrays[3])
+    assert list(results.cycle.values) == list(range(1, 13))
+    refused, gapped = "load-not-positive", "missing-samples"
+    assert list(results.quality.values[[5, 9, 10]]) == [refused, gapped, refused]
+
+
 @pytest.mark.parametrize("lazy", [False, True])
 def test_a_recorded_load_nowhere_positive_says_why(lazy):
     """A load recorded negative (compression) asks for the other sign; one without a value
-    names the load; in memory and out of core alike."""
+    names the load; one swinging in every cycle refused says so; in memory and out of core."""
     import dask.array as da
 
     displacement, force, load = load_steps()
@@ -573,3 +592,6 @@ def test_a_recorded_load_nowhere_positive_says_why(lazy):
     spiked = np.where(np.arange(load.size) % 50 == 7, -load, load)  # in every cycle
     with pytest.raises(ValueError, match=r"load-not-positive 12\). The recorded normal load is"):
         analyze_loops(wrap(displacement), wrap(force), wrap(spiked))
+    swinging = np.where(np.arange(load.size) % 200 < 100, 2.0, 600.0)  # every cycle refused
+    with pytest.raises(ValueError, match=r"\). The recorded normal load swings by more than 20%"):
+        analyze_loops(wrap(displacement), wrap(force), wrap(swinging))

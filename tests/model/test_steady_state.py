@@ -425,6 +425,23 @@ def test_grad_matches_finite_differences_over_the_domain(domain, function):
         assert np.all(error < 1e-6), f"{function.__name__}: d/d {name} off by {error.max():.2g}"
 
 
+@pytest.mark.parametrize(
+    "function", [ecofmaps.slip_amplitude, ecofmaps.dissipated_energy, ecofmaps.max_force]
+)
+def test_grad_is_finite_and_right_with_no_gross_slip(function):
+    """With no gross slip (muP/S >= amplitude) slip and E_d are 0 and Q* = S amplitude: each
+    partial derivative equals a central difference (rel 1e-7), none NaN (d E_d/d mu was: the
+    NaN of mu_E, undefined there, times where's zero)."""
+    values = [0.5e-6, 450.0, 35e6, 0.8, 0.2, 50e-6]
+    assert int(ecofmaps.slip_regime(*values)) == int(ecofmaps.Regime.NO_GROSS_SLIP)
+    gradients = jax.grad(function, argnums=tuple(range(6)))(*values)
+    for index, gradient in enumerate(gradients):
+        step = values[index] * 1e-6
+        moved = [[v + sign * step * (k == index) for k, v in enumerate(values)] for sign in (1, -1)]
+        difference = (float(function(*moved[0])) - float(function(*moved[1]))) / (2 * step)
+        assert float(gradient) == pytest.approx(difference, rel=1e-7, abs=1e-12), index
+
+
 def test_grad_is_finite_at_a_flat_groove():
     """The series branch keeps gradients finite at z_o = 0 (d mu_E/d r = 0 there)."""
     gradient = jax.grad(ecofmaps.energy_cof, argnums=(3, 4))(50e-6, 450.0, 35e6, 0.8, 0.0)

@@ -237,6 +237,7 @@ def test_only_local_pages_are_answered(listening):
         dict(local, Origin="http://evil.example"),
         dict(local, Origin="null"),
         {"Host": f"localhost:{port + 1}"},
+        {"Host": f"[::1]:{port}"},  # not listened on; Panel cannot read it (was a 500)
     ]
     for headers in foreign:
         for target in ("/?mu=0.7", "/ws", "/static/js/bokeh.min.js"):
