@@ -11,7 +11,7 @@ import pytest
 import xarray as xr
 
 import ecofmaps
-from ecofmaps.lab import cycle_sum
+from ecofmaps.lab.wear import cycle_sum
 from tests import mindlin
 from tests.lab_cases import ALPHA, CYCLES, DELTA_T, HALF_WIDTH, LENGTH, LOAD, MU, recorded_test
 

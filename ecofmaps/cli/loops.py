@@ -314,7 +314,8 @@ def _said(rows: dict) -> list[str]:
 def _lab_lines(results, rig_stiffness) -> list[str]:
     """ΣE_d over a recording's cycles and, when it crosses one (a sweep), its transition to
     gross slip (docs/lab.md)."""
-    from ecofmaps.lab import cycle_sum, transition
+    from ecofmaps.lab import transition
+    from ecofmaps.lab.wear import cycle_sum
 
     cycle = results["cycle"].values.astype(np.float64)
     try:

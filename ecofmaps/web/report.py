@@ -39,7 +39,8 @@ from ecofmaps._nomenclature import QUANTITIES, transition_texts, with_se
 from ecofmaps._version import __version__
 from ecofmaps.io.files import atomic_path
 from ecofmaps.io.tables import results_table
-from ecofmaps.lab import cycle_sum, transition
+from ecofmaps.lab import transition
+from ecofmaps.lab.wear import cycle_sum
 from ecofmaps.measured.quality import REASONS, SEPARATOR, quality_summary, sliding_condition_line
 from ecofmaps.model.simulation import fretting_loop
 

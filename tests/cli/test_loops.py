@@ -202,7 +202,7 @@ def test_too_few_samples_names_the_last_line(tmp_path, capsys, recording):
             ["--example", "--force-col", "displacement"],
             "--displacement-col and --force-col name the same column 'displacement'",
         ),
-        (["missing.csv", "--load", "450N"], "No such file"),
+        (["missing.csv", "--load", "450N"], "missing.csv: no such file"),
         (["--example", "--out", "no/such/dir/r.csv"], "its directory does not exist"),
         (["--example", "--displacement-unit", "N"], "is not a length"),
     ],
