@@ -97,10 +97,11 @@ def parameter_value(key: str, text: str) -> float:
     if not (low <= value <= high or value == math.inf):  # inf: a rigid rig, in range
         unit = DIMENSIONS[quantity.kind][1]
         raise ValueError(
-            f"{label}: {text!r} is beyond the model's domain, {low:g} to {high:g} {unit}"
+            f"{label}: {text!r} is beyond the model's domain, {low:g} to {high:g}"
+            + ("" if unit == "1" else f" {unit}")
             + (" (or inf, a rigid rig)" if key == "stiffness" else "")
         )
-    return value
+    return value + 0.0  # -0 shown as 0
 
 
 def bare_number_warnings(texts: dict) -> list[str]:
