@@ -61,7 +61,7 @@ def run(args) -> int:
         )
     if not destination.parent.is_dir():
         raise CommandError(f"cannot write {destination}: its directory does not exist")
-    refuse_to_overwrite([("DST", destination)], [source], overwrite=args.overwrite)
+    refuse_to_overwrite([("the destination", destination)], [source], overwrite=args.overwrite)
     options = recording_options(args)
     convert_recording(
         source, destination, chunk_samples=args.chunk_samples, overwrite=args.overwrite, **options

@@ -93,7 +93,8 @@ def test_convert_and_correct_follow_the_same_rule(tmp_path, capsys):
     store.mkdir()
     (store / "notes.txt").write_text("mine")
     status, _, stderr = run(capsys, "convert", example_path(), store, "--overwrite")
-    assert status == 2 and f"DST {store} is a folder that ecofmaps did not write" in stderr
+    assert status == 2
+    assert f"the destination {store} is a folder that ecofmaps did not write" in stderr
     assert [p.name for p in store.iterdir()] == ["notes.txt"]
     store = tmp_path / "mine.zarr"
     assert run(capsys, "convert", example_path(), store)[0] == 0
