@@ -17,6 +17,7 @@ from ecofmaps.measured import kernels
 from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles
 from ecofmaps.measured.quality import (
     ANTICLOCKWISE_SHARE,
+    NOISE_SHARE,
     READING_REASONS,
     REASONS,
     UNEXPLAINED_SHARE,
@@ -49,6 +50,15 @@ NEIGHBOURS = _NOISE_REACH + 1
 #: The median absolute deviation of a normal distribution over its standard deviation,
 #: times the standard deviation of a second difference of white noise over its own.
 _SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
+
+#: The lower quartile of the absolute value of a normal distribution over its standard
+#: deviation (the normal's 62.5th percentile), times the standard deviation of a second
+#: difference of white noise over its own.
+_QUARTILE_SECOND_DIFFERENCE = 0.3186393639643752 * np.sqrt(6.0)
+
+#: Fewest samples of a cycle whose noise is read from its second differences: in fewer,
+#: a loop's corners (or a digitised loop's uneven points) are most of them.
+_NOISE_SAMPLES = 4 * MIN_SAMPLES
 
 #: Energy ratio :math:`A = E_d/(4\Delta^* Q^*)` above which a loop is gross slip (the
 #: sliding transition of Fouvry, Kapsa and Vincent).
@@ -456,6 +466,9 @@ def _loop_values(block, options):
         "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]) & ~mindlin,
         "partial-slip": ~sliding,
     }
+    flags["noise-amplitude"] = (_noise_bias(block, block.displacement) > amplitude) | (
+        _noise_bias(block, block.force) > max_force
+    )
     return values, flags
 
 
@@ -523,6 +536,34 @@ def _stick_line(u, regressors, stick):
     return np.einsum(
         "rik,rk->ri", inverse, np.stack([(a * u).sum(axis=1) for a in columns], -1)
     ), inverse
+
+
+def _noise_bias(block, values):
+    """Per cycle of ``block``, the highest the white noise on ``values`` lifts an extreme
+    over the cycle's n samples, σ√(2 ln n), over :data:`NOISE_SHARE` (NaN for fewer than
+    :data:`_NOISE_SAMPLES`); σ from the lower quartile of the absolute second differences,
+    less a sine's own (-4 sin²(π/n) x, the loops centred) or as they are (a force sliding
+    at a constant value), whichever is less: the reversals and the stick do not reach
+    it. [m] or [N]"""
+    bias = np.full(block.count.size, np.nan)
+    (rows,) = np.nonzero(block.count >= _NOISE_SAMPLES)
+    if not rows.size:
+        return bias
+    count = block.count[rows]
+    j = np.arange(1, int(count.max()) - 1)
+    inside = j < count[:, None] - 1
+    at = block.offset[rows, None] + np.where(inside, j, 1)
+    middle = values[at]
+    second = values[at + 1] - 2.0 * middle + values[at - 1]
+    sine = 4.0 * np.sin(np.pi / (count - 1.0))[:, None] ** 2
+    rank = (np.arange(rows.size), (count - 3) // 4)
+    quartiles = [
+        np.sort(np.where(inside, np.abs(d), np.nan), axis=1)[rank]
+        for d in (second, second + sine * middle)
+    ]
+    sigma = np.fmin(*quartiles) / _QUARTILE_SECOND_DIFFERENCE
+    bias[rows] = sigma * np.sqrt(2.0 * np.log(count)) / NOISE_SHARE
+    return bias
 
 
 def _turns_back(x, band):

@@ -22,6 +22,7 @@ __all__ = [
     "COMPRESSION",
     "LOAD_SCALED",
     "LOAD_SWING",
+    "NOISE_SHARE",
     "READING_REASONS",
     "REASONS",
     "RESOLVED",
@@ -81,6 +82,12 @@ LOAD_SCALED = ("max_force", "dissipated_energy", "stiffness", "force_offset", "f
 #: :math:`4\Delta^*Q^*` runs anticlockwise; a smaller negative area is noise on a loop
 #: without area (the one definition, also for :func:`ecofmaps.fit_loop`).
 ANTICLOCKWISE_SHARE = 0.05
+
+#: A cycle's amplitude of displacement or force stands clear of the noise when the bound
+#: σ√(2 ln n) on the lift of an extreme by white noise of its n samples is below this share
+#: of it (the lift itself is less, the sine falling away from its peak: half the
+#: peak-to-peak then reads the amplitude about 10 % too large at most).
+NOISE_SHARE = 0.15
 
 #: A stick segment must explain all but this share of the displacement's variance along it.
 UNEXPLAINED_SHARE = 0.2
@@ -153,6 +160,13 @@ REASONS = {
         f"the displacement amplitude is below {AMPLITUDE_RANGE[0] * 1e6:g} µm or above "
         f"{AMPLITUDE_RANGE[1] * 1e3:g} mm: the displacement is not in the unit assumed (a "
         "column without a unit is read in µm)",
+        ALL,
+    ),
+    "noise-amplitude": (
+        "the displacement or force amplitude does not stand clear of the noise: the highest "
+        "that the noise of the cycle's n samples is expected to lift an extreme, σ√(2 ln n) "
+        "(σ from the second differences), exceeds "
+        f"{NOISE_SHARE * 100:g} % of half the peak-to-peak, which reads the amplitude too large",
         ALL,
     ),
     "several-loops": (
@@ -267,6 +281,8 @@ _HINTS = {
     + COMPRESSION,
     "load-swing": f"The recorded normal load swings by more than {LOAD_SWING:.0%} of its mean "
     "within every cycle: is the load column the normal load, and is it held steady?",
+    "noise-amplitude": "The amplitudes do not stand clear of the noise: is the rig moving, "
+    "and the displacement and force recorded with less noise than the loop?",
     "anticlockwise": "The loops run anticlockwise with stick sides sloping up: the recording "
     "runs backwards in time, or the displacement and force columns are swapped.",
     "constant-force": "The force does not vary: is the force channel connected?",

@@ -13,6 +13,7 @@ import ecofmaps
 from ecofmaps.measured import cycles as cycles_module
 from ecofmaps.measured import pipeline
 from ecofmaps.measured import samples as passes
+from ecofmaps.measured.quality import has_reason
 from tests import mindlin
 from tests.cli.commands import run_loops
 from tests.measured.test_out_of_core import analysed, assert_equal_results, lazily
@@ -162,7 +163,10 @@ def test_every_cycle_after_a_steep_step_is_reported_with_values(steps, noise):
     results = analysed(applied, force)
     np.testing.assert_array_equal(results.cycle, np.arange(1, amplitudes.size + 1))
     assert results.attrs["incomplete_cycles"] == 2
-    assert np.isfinite(results.dissipated_energy).all()
+    # a cycle whose amplitude the noise's extremes would read too large has no values
+    unclear = has_reason(results.quality.values, "noise-amplitude")
+    assert np.isfinite(results.dissipated_energy.values[~unclear]).all()
+    assert (noise * amplitudes.max() / amplitudes[unclear] > 0.03).all()
     if not noise:
         np.testing.assert_allclose(results.amplitude, amplitudes, rtol=1e-3)
 
