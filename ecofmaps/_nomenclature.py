@@ -208,10 +208,12 @@ QUANTITIES: dict[str, Quantity] = {
 }
 
 
-def attrs(name: str) -> dict:
-    """The netCDF attributes ``long_name`` and ``units`` of quantity ``name``."""
+def attrs(name: str, comments=None) -> dict:
+    """The netCDF attributes ``long_name`` and ``units`` of quantity ``name``, and its
+    ``comment`` if ``comments`` (name -> how a module reads it) holds one."""
     quantity = QUANTITIES[name]
-    return {"long_name": quantity.long_name, "units": quantity.units}
+    comment = {} if comments is None or name not in comments else {"comment": comments[name]}
+    return {"long_name": quantity.long_name, "units": quantity.units} | comment
 
 
 def axis_label(name: str) -> str:

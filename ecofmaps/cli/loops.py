@@ -249,7 +249,7 @@ _WHY_INCOMPLETE = {
 
 def _summary(path, results, recording) -> str:
     """One line on a recording's cycles: counts, the quality, the friction over the test."""
-    from ecofmaps.measured.quality import sliding_condition_line
+    from ecofmaps.lab.regime import sliding_condition_line
     from ecofmaps.model.regimes import GROSS_SLIP
 
     gross = results.isel(cycle=np.flatnonzero(results.regime.values == GROSS_SLIP))

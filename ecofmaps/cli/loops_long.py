@@ -25,7 +25,7 @@ import numpy as np
 from ecofmaps._interrupts import INTERRUPTED, Interrupted, add_stop_note
 from ecofmaps.cli._common import CommandError
 from ecofmaps.io.tables import results_csv
-from ecofmaps.measured.cycles import Cycles, MissingSampleError
+from ecofmaps.measured.cycles import Cycles
 from ecofmaps.measured.pipeline import (
     IN_PROCESS,
     Analysis,
@@ -34,6 +34,7 @@ from ecofmaps.measured.pipeline import (
     only,
     runner_for,
 )
+from ecofmaps.measured.samples import MissingSampleError
 
 __all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun", "keep_block"]
 

@@ -9,7 +9,8 @@ import xarray as xr
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._inputs import check, si_units
 from ecofmaps.measured.measure import loop_ratios
-from ecofmaps.measured.quality import has_reason, regime_ratio, sliding_condition_of
+from ecofmaps.measured.quality import has_reason, regime_ratio
+from ecofmaps.model.regimes import regime_condition, sliding_condition_of
 
 __all__ = [
     "MINDLIN_ENERGY_RATIO",
@@ -20,6 +21,7 @@ __all__ = [
     "rig_of",
     "set_with_se",
     "sliding_condition",
+    "sliding_condition_line",
     "tests_of",
     "transition",
 ]
@@ -30,6 +32,8 @@ MINDLIN_ENERGY_RATIO = 0.2
 MINDLIN_OPENING_RATIO = 2 ** (1 / 3) - 1
 #: Cycles whose amplitudes differ by less than this share are at one amplitude. [1]
 _SAME_AMPLITUDE = 0.01
+#: Cycles where the regime changes that :func:`sliding_condition_line` names.
+_CHANGES_SHOWN = 5
 #: Fewest ``mindlin-stick`` cycles whose spring stands for an unknown rig's stiffness.
 _SPRINGS = 3
 #: Why μ_t from Q*/P has no standard error.
@@ -334,3 +338,15 @@ def set_with_se(data: dict, name: str, value, se, dims=(), quantity=None) -> Non
     data[name] = (dims, value, attrs)
     words = "standard error of the " + attrs["long_name"]
     data[f"{name}_se"] = (dims, se, {**attrs, "long_name": words})
+
+
+def sliding_condition_line(results: xr.Dataset) -> str:
+    """The sliding condition of :func:`ecofmaps.analyze_loops`' results in words
+    (:func:`regime_condition`), with the first cycles where the regime changes."""
+    condition, changes = regime_condition(results)
+    changes = changes.tolist()
+    if not changes:
+        return condition
+    shown = ", ".join(str(c) for c in changes[:_CHANGES_SHOWN])
+    more = f", ... ({len(changes)} changes)" if len(changes) > _CHANGES_SHOWN else ""
+    return f"{condition} (the regime changes at cycle{'s' * (len(changes) > 1)} {shown}{more})"

@@ -12,7 +12,7 @@ import xarray as xr
 
 from ecofmaps._inputs import si_units
 from ecofmaps._parallel import check_workers
-from ecofmaps.measured.cycles import MIN_SAMPLES, MissingSampleError
+from ecofmaps.measured.cycles import MIN_SAMPLES
 from ecofmaps.measured.pipeline import (
     NAN_POLICIES,
     Analysis,
@@ -22,7 +22,7 @@ from ecofmaps.measured.pipeline import (
     runner_for,
 )
 from ecofmaps.measured.resolve import ReadingOptions
-from ecofmaps.measured.samples import is_lazy
+from ecofmaps.measured.samples import MissingSampleError, is_lazy
 
 __all__ = ["analyze_loops", "resolve_loops"]
 

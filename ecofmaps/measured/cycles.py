@@ -94,29 +94,6 @@ def _joined(samples: Samples, function, arguments, channels=("displacement",), e
     return np.concatenate(samples.map(function, channels, arguments, extra), axis=-1)
 
 
-def _extremes_of_parts(start, stop, arguments, x):
-    """Per piece of a part ``[begin, end)`` in a chunk: the part, its highest and lowest
-    displacement with their first samples, and its highest and lowest detrended one."""
-    chunk, gaps, line, begin, end = arguments
-    found = [np.empty((7, 0))]
-    for a in range(start, stop, chunk):
-        b = min(a + chunk, stop)
-        first, last = np.searchsorted(end, a, side="right"), np.searchsorted(begin, b)
-        if first >= last:
-            continue
-        part = np.arange(first, last)
-        lower, upper = np.maximum(begin[part], a) - a, np.minimum(end[part], b) - a
-        cuts = np.unique(np.concatenate([[0], lower, upper]))
-        cuts = cuts[cuts < b - a]
-        at = np.searchsorted(cuts, lower)  # the piece of each part
-        xa = passes.blanked(np.asarray(x[a - start : b - start], dtype=np.float64), a, b, gaps)
-        d = passes.detrended(xa, a, line)
-        extremes = [e[at] for e in passes.piece_extremes(xa, cuts, a)]
-        ranges = [np.fmax.reduceat(d, cuts)[at], np.fmin.reduceat(d, cuts)[at]]
-        found.append(np.stack([part.astype(np.float64), *extremes, *ranges]))
-    return np.concatenate(found, axis=1)
-
-
 def _parts_after_gaps(samples, gaps, line, band, runs):
     """The trigger's runs cut where samples resume after a long gap inside them."""
     starts, kind, extreme, value = runs
@@ -133,7 +110,7 @@ def _parts_after_gaps(samples, gaps, line, band, runs):
     end = np.append(part_start, samples.size)[1:][affected]
     arguments = (passes._CHUNK, gaps, line, begin, end)
     part, highest, top, lowest, bottom, most, least = _joined(
-        samples, _extremes_of_parts, arguments
+        samples, passes.part_extremes, arguments
     )
     part = part.astype(np.int64)
     first_piece = np.searchsorted(part, np.arange(begin.size))
@@ -192,16 +169,6 @@ def _period(starts, kind) -> float:
     return float(np.median(np.diff(low))) if low.size > 1 else np.nan
 
 
-def _values_at(start, stop, arguments, x):
-    """The displacements at the samples ``at`` (sorted) in the block (NaN where missing)."""
-    gaps, at = arguments
-    at = at[(at >= start) & (at < stop)]
-    if not at.size:
-        return np.empty(0)
-    stretch = np.asarray(x[at[0] - start : at[-1] + 1 - start], dtype=np.float64)
-    return passes.blanked(stretch, at[0], at[-1] + 1, gaps)[at - at[0]]
-
-
 def _hidden_by_gaps(parts, samples, gaps, margin):
     """Which extremes of the runs' parts lie within ``margin`` of a sample beside a long gap
     in their part (the displacement may have gone on beyond them in the gap)."""
@@ -213,7 +180,7 @@ def _hidden_by_gaps(parts, samples, gaps, margin):
     edges = np.stack([long[:, 0] - 1, long[:, 1]], axis=1).ravel()  # the samples beside
     inside = (edges >= 0) & (edges < samples.size)
     at_edges = np.full(edges.size, np.nan)
-    at_edges[inside] = _joined(samples, _values_at, (gaps, edges[inside]))
+    at_edges[inside] = _joined(samples, passes.values_at, (gaps, edges[inside]))
     before_gap, after_gap = at_edges[0::2], at_edges[1::2]
     after = np.searchsorted(long[:, 0], extreme, side="right")
     before = np.searchsorted(long[:, 1], extreme, side="right") - 1
@@ -628,25 +595,3 @@ def find_cycles(
     if cycle is None:
         return _split(samples, hysteresis, 0.01)
     return _labelled(samples, 0.01)
-
-
-class MissingSampleError(ValueError):
-    """A missing sample where ``nan_policy='raise'``: ``sample`` is its 0-based index, ``what``
-    is wrong with it (None: it is NaN or empty) and ``skips`` is what ``nan_policy='skip'``
-    does instead."""
-
-    def __init__(self, sample: int, what=None, skips=None):
-        self.sample, self.what = int(sample), what
-        self.skips = skips or (
-            "analyses the cycles without missing samples and reports the others as skipped"
-        )
-        what = what or f"sample {self.sample} is missing (NaN or empty)"
-        super().__init__(f"{what}; nan_policy='skip' {self.skips}")
-
-
-def no_cycle_error(samples: int) -> ValueError:
-    """The error for a recording of ``samples`` samples without a complete cycle."""
-    return ValueError(
-        f"too few samples for one cycle: no complete cycle in {samples} samples "
-        "(the loop does not close, or the recording does not oscillate)"
-    )

@@ -17,8 +17,10 @@ __all__ = [
     "interpolated",
     "line_crossings",
     "loop_measures",
+    "noise_lift",
     "path_means",
     "second_difference_medians",
+    "stick_line_fit",
     "stick_lines",
     "stretch_ranges",
     "zero_force_crossings",
@@ -26,6 +28,11 @@ __all__ = [
 
 #: How numba compiles the kernels: cached on disk, NumPy's division by zero, no GIL held.
 _COMPILE = {"cache": True, "error_model": "numpy", "nogil": True}
+
+#: The lower quartile of the absolute value of a normal distribution over its standard
+#: deviation (the normal's 62.5th percentile), times the standard deviation of a second
+#: difference of white noise over its own.
+_QUARTILE_SECOND_DIFFERENCE = 0.3186393639643752 * np.sqrt(6.0)
 
 #: A stick segment grows until two samples in a row are this many standard deviations off.
 _STICK_SPREAD = 3.0
@@ -504,3 +511,45 @@ def branch_stretches(values, start, end, length, width):
             rows[r, j] = values[start[r] + j]
         rows[r, length[r] - 1 :] = values[end[r]]
     return rows
+
+
+def stick_line_fit(u, regressors, stick):
+    """Least squares of ``u`` on 1 and ``regressors`` over the ``stick`` samples of each row:
+    the coefficients and the inverse of the normal matrix (identity below four samples)."""
+    columns = [stick.astype(np.float64), *(np.where(stick, r, 0.0) for r in regressors)]
+    normal = np.stack([np.stack([(a * b).sum(axis=1) for b in columns], -1) for a in columns], -2)
+    normal[stick.sum(axis=1) < 4] = np.eye(len(columns))
+    try:
+        inverse = np.linalg.inv(normal)
+    except np.linalg.LinAlgError:  # a degenerate loop (a constant force): least norm
+        inverse = np.linalg.pinv(normal)
+    return np.einsum(
+        "rik,rk->ri", inverse, np.stack([(a * u).sum(axis=1) for a in columns], -1)
+    ), inverse
+
+
+def noise_lift(count, offset, values, least):
+    """Per cycle of ``count`` samples from ``offset`` in ``values``, the highest the white
+    noise on them lifts an extreme over the cycle's n samples, σ√(2 ln n) (NaN for fewer than
+    ``least``); σ from the lower quartile of the absolute second differences, less a sine's
+    own (-4 sin²(π/n) x, the loops centred) or as they are (a force sliding at a constant
+    value), whichever is less: the reversals and the stick do not reach it. [m] or [N]"""
+    lift = np.full(count.size, np.nan)
+    (rows,) = np.nonzero(count >= least)
+    if not rows.size:
+        return lift
+    offset, count = offset[rows], count[rows]
+    j = np.arange(1, int(count.max()) - 1)
+    inside = j < count[:, None] - 1
+    at = offset[:, None] + np.where(inside, j, 1)
+    middle = values[at]
+    second = values[at + 1] - 2.0 * middle + values[at - 1]
+    sine = 4.0 * np.sin(np.pi / (count - 1.0))[:, None] ** 2
+    rank = (np.arange(rows.size), (count - 3) // 4)
+    quartiles = [
+        np.sort(np.where(inside, np.abs(d), np.nan), axis=1)[rank]
+        for d in (second, second + sine * middle)
+    ]
+    sigma = np.fmin(*quartiles) / _QUARTILE_SECOND_DIFFERENCE
+    lift[rows] = sigma * np.sqrt(2.0 * np.log(count))
+    return lift

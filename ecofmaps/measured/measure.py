@@ -51,11 +51,6 @@ NEIGHBOURS = _NOISE_REACH + 1
 #: times the standard deviation of a second difference of white noise over its own.
 _SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
 
-#: The lower quartile of the absolute value of a normal distribution over its standard
-#: deviation (the normal's 62.5th percentile), times the standard deviation of a second
-#: difference of white noise over its own.
-_QUARTILE_SECOND_DIFFERENCE = 0.3186393639643752 * np.sqrt(6.0)
-
 #: Fewest samples of a cycle whose noise is read from its second differences: in fewer,
 #: a loop's corners (or a digitised loop's uneven points) are most of them.
 _NOISE_SAMPLES = 4 * MIN_SAMPLES
@@ -466,8 +461,8 @@ def _loop_values(block, options):
         "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]) & ~mindlin,
         "partial-slip": ~sliding,
     }
-    flags["noise-amplitude"] = (_noise_bias(block, block.displacement) > amplitude) | (
-        _noise_bias(block, block.force) > max_force
+    flags["noise-amplitude"] = (_noise_lift(block, block.displacement) > amplitude) | (
+        _noise_lift(block, block.force) > max_force
     )
     return values, flags
 
@@ -492,7 +487,7 @@ def _mindlin_sliding(rows, max_force, span, candidates):
         rise = (q + force) / (2.0 * force)
         stick = valid & (rise < _MINDLIN_STICK)
         curve = 1.0 - np.cbrt(1.0 - np.minimum(rise, 1.0)) ** 2
-        line, inverse = _stick_line(u, (curve, q), stick)
+        line, inverse = kernels.stick_line_fit(u, (curve, q), stick)
         share = line[:, 1] / (line[:, 1] + 2.0 * line[:, 2] * force[:, 0])
         # curved by a share of the stick's extent, its spring's compliance not below zero by
         # more: else not a sphere's (a flat contact's straight stick), and not fitted further
@@ -523,47 +518,10 @@ def _mindlin_sliding(rows, max_force, span, candidates):
     return found
 
 
-def _stick_line(u, regressors, stick):
-    """Least squares of ``u`` on 1 and ``regressors`` over the ``stick`` samples of each row:
-    the coefficients and the inverse of the normal matrix (identity below four samples)."""
-    columns = [stick.astype(np.float64), *(np.where(stick, r, 0.0) for r in regressors)]
-    normal = np.stack([np.stack([(a * b).sum(axis=1) for b in columns], -1) for a in columns], -2)
-    normal[stick.sum(axis=1) < 4] = np.eye(len(columns))
-    try:
-        inverse = np.linalg.inv(normal)
-    except np.linalg.LinAlgError:  # a degenerate loop (a constant force): least norm
-        inverse = np.linalg.pinv(normal)
-    return np.einsum(
-        "rik,rk->ri", inverse, np.stack([(a * u).sum(axis=1) for a in columns], -1)
-    ), inverse
-
-
-def _noise_bias(block, values):
-    """Per cycle of ``block``, the highest the white noise on ``values`` lifts an extreme
-    over the cycle's n samples, σ√(2 ln n), over :data:`NOISE_SHARE` (NaN for fewer than
-    :data:`_NOISE_SAMPLES`); σ from the lower quartile of the absolute second differences,
-    less a sine's own (-4 sin²(π/n) x, the loops centred) or as they are (a force sliding
-    at a constant value), whichever is less: the reversals and the stick do not reach
-    it. [m] or [N]"""
-    bias = np.full(block.count.size, np.nan)
-    (rows,) = np.nonzero(block.count >= _NOISE_SAMPLES)
-    if not rows.size:
-        return bias
-    count = block.count[rows]
-    j = np.arange(1, int(count.max()) - 1)
-    inside = j < count[:, None] - 1
-    at = block.offset[rows, None] + np.where(inside, j, 1)
-    middle = values[at]
-    second = values[at + 1] - 2.0 * middle + values[at - 1]
-    sine = 4.0 * np.sin(np.pi / (count - 1.0))[:, None] ** 2
-    rank = (np.arange(rows.size), (count - 3) // 4)
-    quartiles = [
-        np.sort(np.where(inside, np.abs(d), np.nan), axis=1)[rank]
-        for d in (second, second + sine * middle)
-    ]
-    sigma = np.fmin(*quartiles) / _QUARTILE_SECOND_DIFFERENCE
-    bias[rows] = sigma * np.sqrt(2.0 * np.log(count)) / NOISE_SHARE
-    return bias
+def _noise_lift(block, values):
+    """:func:`kernels.noise_lift` of ``values`` in each cycle of ``block`` over
+    :data:`NOISE_SHARE` (NaN for fewer than :data:`_NOISE_SAMPLES` samples). [m] or [N]"""
+    return kernels.noise_lift(block.count, block.offset, values, _NOISE_SAMPLES) / NOISE_SHARE
 
 
 def _turns_back(x, band):

@@ -14,15 +14,11 @@ import itertools
 import numpy as np
 import xarray as xr
 
+from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._inputs import check
 from ecofmaps._parallel import Runner, stretch
 from ecofmaps.measured import resolve
-from ecofmaps.measured.cycles import (
-    Cycles,
-    MissingSampleError,
-    find_cycles,
-    no_cycle_error,
-)
+from ecofmaps.measured.cycles import Cycles, find_cycles
 from ecofmaps.measured.measure import GROSS_SLIP_THRESHOLD, NEIGHBOURS, Stretch, measure_cycles
 from ecofmaps.measured.quality import (
     COMPRESSION,
@@ -32,8 +28,8 @@ from ecofmaps.measured.quality import (
     cycle_results,
     load_flags,
     scale_flags,
-    with_loops,
 )
+from ecofmaps.measured.samples import MissingSampleError, no_cycle_error
 
 __all__ = [
     "AT_OWN_LOAD",
@@ -218,6 +214,18 @@ def force_at_mean_load(force, load):
             f"{highest + 0.0:g} N): {hint}"
         )
     return force * (mean / usable), mean
+
+
+def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
+    """``results`` with the centred loops of :func:`measure_cycles` (``keep_loops=True``)."""
+    results["loop_displacement"] = (
+        ("cycle", "point"),
+        loops[0],
+        nomenclature.attrs("loop_displacement"),
+    )
+    results["loop_force"] = (("cycle", "point"), loops[1], nomenclature.attrs("loop_force"))
+    results.coords["point"] = ("point", np.arange(loops[0].shape[1]), nomenclature.attrs("point"))
+    return results
 
 
 def load_sample_error(sample: int, load: float, cycle=None) -> MissingSampleError:

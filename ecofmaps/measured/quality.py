@@ -14,7 +14,7 @@ import xarray as xr
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._codes import warn
 from ecofmaps.measured.cycles import LEAST_LEVEL, MIN_SAMPLES, NOISE_LEVEL, Cycles
-from ecofmaps.model.regimes import GROSS_SLIP, INVALID, PARTIAL_SLIP, Regime
+from ecofmaps.model.regimes import GROSS_SLIP, INVALID, PARTIAL_SLIP, Regime, regime_condition
 
 __all__ = [
     "ALL",
@@ -27,7 +27,6 @@ __all__ = [
     "REASONS",
     "RESOLVED",
     "SEPARATOR",
-    "SLIDING_CONDITIONS",
     "ImplausibleScaleError",
     "ImplausibleScaleWarning",
     "LoopQualityWarning",
@@ -42,12 +41,8 @@ __all__ = [
     "quality_strings",
     "quality_summary",
     "refused",
-    "regime_condition",
     "regime_ratio",
-    "sliding_condition_line",
-    "sliding_condition_of",
     "summary_of_counts",
-    "with_loops",
 ]
 
 
@@ -106,13 +101,6 @@ SCATTER_BLOCKS = 8
 #: The GICoF is flagged where the block means of μ(ξ) scatter about a straight line by
 #: this share of μ (standard deviation) beyond the noise.
 GICOF_WIGGLE = 0.015
-
-#: A test's sliding conditions (Vincent et al. 1992; Zhou & Vincent 1995): every cycle in
-#: partial slip, the regime changing during the test, every cycle in gross slip.
-SLIDING_CONDITIONS = ("partial slip", "mixed slip", "gross slip")
-
-#: Cycles where the regime changes that :func:`sliding_condition_line` names.
-_CHANGES_SHOWN = 5
 
 #: How the quantities are measured on a loop (the netCDF ``comment`` attribute).
 _COMMENTS = {
@@ -321,10 +309,7 @@ class ImplausibleScaleError(ValueError):
 
 
 def _attrs(name: str) -> dict:
-    attrs = nomenclature.attrs(name)
-    if name in _COMMENTS:
-        attrs["comment"] = _COMMENTS[name]
-    return attrs
+    return nomenclature.attrs(name, _COMMENTS)
 
 
 def _refusal_hint(flags: dict) -> str:
@@ -332,14 +317,6 @@ def _refusal_hint(flags: dict) -> str:
     if flags["anticlockwise"] and flags["negative-stiffness"] and not flags["missing-samples"]:
         return _FLIP_HINT
     return next((hint for reason, hint in _HINTS.items() if flags[reason]), _LAST_HINT)
-
-
-def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
-    """``results`` with the centred loops of :func:`measure_cycles` (``keep_loops=True``)."""
-    results["loop_displacement"] = (("cycle", "point"), loops[0], _attrs("loop_displacement"))
-    results["loop_force"] = (("cycle", "point"), loops[1], _attrs("loop_force"))
-    results.coords["point"] = ("point", np.arange(loops[0].shape[1]), _attrs("point"))
-    return results
 
 
 def regime_ratio(values: dict, rig_stiffness) -> np.ndarray:
@@ -394,11 +371,18 @@ def cycle_results(values: dict, flags: dict, label, options) -> xr.Dataset:
     values, quality, _, regime = judged(values, flags, options)
     last = ("stick_residual", *_RECORDED)
     data = {k: ("cycle", v, _attrs(k)) for k, v in values.items() if k not in last}
-    data["regime"] = ("cycle", regime.astype(np.int32), _attrs("regime") | Regime.flag_attrs())
+    data["regime"] = (
+        "cycle",
+        regime.astype(np.int32),
+        _attrs("regime") | Regime.flag_attrs(),
+    )
     data |= {k: ("cycle", values[k], _attrs(k)) for k in last if k in values}
     data["quality"] = ("cycle", quality, _attrs("quality"))
     load = ((), options.load, _attrs("load"))
-    return xr.Dataset(data, coords={"cycle": ("cycle", label, _attrs("cycle")), "load": load})
+    return xr.Dataset(
+        data,
+        coords={"cycle": ("cycle", label, _attrs("cycle")), "load": load},
+    )
 
 
 class Tally:
@@ -597,38 +581,3 @@ def summary_of_counts(counts) -> str:
     if skipped:
         summary += f", {skipped} skipped (missing samples)"
     return summary + (f"; {flagged}" if flagged else "")
-
-
-def sliding_condition_of(cycle, gross_slip) -> tuple[str, np.ndarray]:
-    """A test's sliding condition, one of :data:`SLIDING_CONDITIONS` (``'mixed slip'`` when
-    the regime changes during the test), and the cycles where the regime changes (each the
-    first cycle in the new regime), from each cycle's number and ``gross_slip`` (1 or 0, NaN
-    for a cycle without a regime, left out). See docs/lab.md."""
-    gross_slip = np.asarray(gross_slip, dtype=np.float64)
-    known = np.isfinite(gross_slip)
-    if not known.any():
-        raise ValueError("results: no cycle with a regime (every cycle refused)")
-    regimes = gross_slip[known] > 0.5
-    changes = np.asarray(cycle)[known][1:][regimes[1:] != regimes[:-1]].astype(np.int64)
-    kind = 1 if changes.size else (2 if regimes.all() else 0)
-    return SLIDING_CONDITIONS[kind], changes
-
-
-def regime_condition(results: xr.Dataset) -> tuple[str, np.ndarray]:
-    """:func:`sliding_condition_of` the ``regime`` column of :func:`ecofmaps.analyze_loops`'
-    results (a refused cycle left out)."""
-    regime = results["regime"].values
-    gross = np.where(regime == INVALID, np.nan, regime == GROSS_SLIP)
-    return sliding_condition_of(results["cycle"].values, gross)
-
-
-def sliding_condition_line(results: xr.Dataset) -> str:
-    """The sliding condition of :func:`ecofmaps.analyze_loops`' results in words
-    (:func:`regime_condition`), with the first cycles where the regime changes."""
-    condition, changes = regime_condition(results)
-    changes = changes.tolist()
-    if not changes:
-        return condition
-    shown = ", ".join(str(c) for c in changes[:_CHANGES_SHOWN])
-    more = f", ... ({len(changes)} changes)" if len(changes) > _CHANGES_SHOWN else ""
-    return f"{condition} (the regime changes at cycle{'s' * (len(changes) > 1)} {shown}{more})"

@@ -61,10 +61,7 @@ _COMMENTS = {
 
 def resolved_attrs(name: str) -> dict:
     """The attributes of the variable ``name`` of the reading along the stroke."""
-    attrs = nomenclature.attrs(name)
-    if name in _COMMENTS:
-        attrs["comment"] = _COMMENTS[name]
-    return attrs
+    return nomenclature.attrs(name, _COMMENTS)
 
 
 def single_value(name: str, value, kind: str, unit: str) -> float:

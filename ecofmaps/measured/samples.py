@@ -16,6 +16,7 @@ from ecofmaps.measured import kernels
 
 __all__ = [
     "CHANNELS",
+    "MissingSampleError",
     "Samples",
     "blanked",
     "detrended",
@@ -28,9 +29,12 @@ __all__ = [
     "level_at",
     "local_extremes",
     "missing_in",
+    "no_cycle_error",
+    "part_extremes",
     "piece_extremes",
     "survey",
     "trigger_runs",
+    "values_at",
 ]
 
 #: Samples read at once by the passes over the whole recording.
@@ -360,6 +364,39 @@ def ends_of_runs(run, valued, values, runs: int, first: bool):
     return result
 
 
+def part_extremes(start, stop, arguments, x):
+    """Per piece of a part ``[begin, end)`` in a chunk: the part, its highest and lowest
+    displacement with their first samples, and its highest and lowest detrended one."""
+    chunk, gaps, line, begin, end = arguments
+    found = [np.empty((7, 0))]
+    for a in range(start, stop, chunk):
+        b = min(a + chunk, stop)
+        first, last = np.searchsorted(end, a, side="right"), np.searchsorted(begin, b)
+        if first >= last:
+            continue
+        part = np.arange(first, last)
+        lower, upper = np.maximum(begin[part], a) - a, np.minimum(end[part], b) - a
+        cuts = np.unique(np.concatenate([[0], lower, upper]))
+        cuts = cuts[cuts < b - a]
+        at = np.searchsorted(cuts, lower)  # the piece of each part
+        xa = blanked(np.asarray(x[a - start : b - start], dtype=np.float64), a, b, gaps)
+        d = detrended(xa, a, line)
+        extremes = [e[at] for e in piece_extremes(xa, cuts, a)]
+        ranges = [np.fmax.reduceat(d, cuts)[at], np.fmin.reduceat(d, cuts)[at]]
+        found.append(np.stack([part.astype(np.float64), *extremes, *ranges]))
+    return np.concatenate(found, axis=1)
+
+
+def values_at(start, stop, arguments, x):
+    """The displacements at the samples ``at`` (sorted) in the block (NaN where missing)."""
+    gaps, at = arguments
+    at = at[(at >= start) & (at < stop)]
+    if not at.size:
+        return np.empty(0)
+    stretch = np.asarray(x[at[0] - start : at[-1] + 1 - start], dtype=np.float64)
+    return blanked(stretch, at[0], at[-1] + 1, gaps)[at - at[0]]
+
+
 def is_lazy(value) -> bool:
     """Whether ``value`` is a dask collection, or an xarray object backed by one."""
     if "dask" not in sys.modules:  # nothing can be lazy before dask is imported
@@ -413,3 +450,25 @@ class Samples:
                 yield (a, b, arguments, *arrays)
 
         return list(self.runner.map(function, tasks()))
+
+
+class MissingSampleError(ValueError):
+    """A missing sample where ``nan_policy='raise'``: ``sample`` is its 0-based index, ``what``
+    is wrong with it (None: it is NaN or empty) and ``skips`` is what ``nan_policy='skip'``
+    does instead."""
+
+    def __init__(self, sample: int, what=None, skips=None):
+        self.sample, self.what = int(sample), what
+        self.skips = skips or (
+            "analyses the cycles without missing samples and reports the others as skipped"
+        )
+        what = what or f"sample {self.sample} is missing (NaN or empty)"
+        super().__init__(f"{what}; nan_policy='skip' {self.skips}")
+
+
+def no_cycle_error(samples: int) -> ValueError:
+    """The error for a recording of ``samples`` samples without a complete cycle."""
+    return ValueError(
+        f"too few samples for one cycle: no complete cycle in {samples} samples "
+        "(the loop does not close, or the recording does not oscillate)"
+    )

@@ -4,6 +4,8 @@ slip). docs/model.md and docs/loops.md say what each means."""
 
 from __future__ import annotations
 
+import numpy as np
+
 from ecofmaps._codes import Code
 
 __all__ = [
@@ -13,7 +15,10 @@ __all__ = [
     "NO_GROSS_SLIP",
     "PARTIAL_SLIP",
     "SELF_LOCKING",
+    "SLIDING_CONDITIONS",
     "Regime",
+    "regime_condition",
+    "sliding_condition_of",
 ]
 
 
@@ -82,3 +87,30 @@ SELF_LOCKING = Regime.SELF_LOCKING
 INVALID = Regime.INVALID
 BEYOND_PROFILE = Regime.BEYOND_PROFILE
 PARTIAL_SLIP = Regime.PARTIAL_SLIP
+
+#: A test's sliding conditions (Vincent et al. 1992; Zhou & Vincent 1995): every cycle in
+#: partial slip, the regime changing during the test, every cycle in gross slip.
+SLIDING_CONDITIONS = ("partial slip", "mixed slip", "gross slip")
+
+
+def sliding_condition_of(cycle, gross_slip) -> tuple[str, np.ndarray]:
+    """A test's sliding condition, one of :data:`SLIDING_CONDITIONS` (``'mixed slip'`` when
+    the regime changes during the test), and the cycles where the regime changes (each the
+    first cycle in the new regime), from each cycle's number and ``gross_slip`` (1 or 0, NaN
+    for a cycle without a regime, left out). See docs/lab.md."""
+    gross_slip = np.asarray(gross_slip, dtype=np.float64)
+    known = np.isfinite(gross_slip)
+    if not known.any():
+        raise ValueError("results: no cycle with a regime (every cycle refused)")
+    regimes = gross_slip[known] > 0.5
+    changes = np.asarray(cycle)[known][1:][regimes[1:] != regimes[:-1]].astype(np.int64)
+    kind = 1 if changes.size else (2 if regimes.all() else 0)
+    return SLIDING_CONDITIONS[kind], changes
+
+
+def regime_condition(results) -> tuple[str, np.ndarray]:
+    """:func:`sliding_condition_of` the ``regime`` column of :func:`ecofmaps.analyze_loops`'
+    results (a refused cycle left out)."""
+    regime = results["regime"].values
+    gross = np.where(regime == INVALID, np.nan, regime == GROSS_SLIP)
+    return sliding_condition_of(results["cycle"].values, gross)

@@ -40,8 +40,9 @@ from ecofmaps._version import __version__
 from ecofmaps.io.files import atomic_path
 from ecofmaps.io.tables import results_table
 from ecofmaps.lab import transition
+from ecofmaps.lab.regime import sliding_condition_line
 from ecofmaps.lab.wear import cycle_sum
-from ecofmaps.measured.quality import REASONS, SEPARATOR, quality_summary, sliding_condition_line
+from ecofmaps.measured.quality import REASONS, SEPARATOR, quality_summary
 from ecofmaps.model.simulation import fretting_loop
 
 __all__ = ["LOOPS_CARRIED", "recording_inputs", "report_document", "write_report"]

@@ -300,8 +300,10 @@ def test_accuracy_with_noise_offsets_and_drift(point, jitter):
         assert float(relative(result[name], expected[name]).max()) < 0.02, name
 
 
+@pytest.mark.filterwarnings("ignore:cycles flagged:ecofmaps.measured.LoopQualityWarning")
 def test_noise_makes_no_false_reversal():
-    """Displacement noise of 5 % of Δ* (10 times the issue's) still gives one cycle per cycle."""
+    """Displacement noise of 5 % of Δ* (10 times the issue's) still gives one cycle per cycle
+    (some flagged noise-amplitude: the noise lifts their peaks by about 16 % of Δ*)."""
     displacement, force = closed_recording(
         EXAMPLE_2, 6, displacement_noise=0.05 * AMPLITUDE, force_noise=6.0, seed=3
     )
@@ -533,8 +535,8 @@ def test_a_load_not_positive_is_named_with_nan_policy_raise(chunks):
     it, and for a negative load the hint of compression, in memory and out of core."""
     import dask.array as da
 
-    from ecofmaps.measured.cycles import MissingSampleError
     from ecofmaps.measured.quality import COMPRESSION
+    from ecofmaps.measured.samples import MissingSampleError
 
     labels = analyze_loops(*_bad_loads()).cycle.values
     displacement, force, load = _bad_loads()

@@ -19,9 +19,9 @@ import ecofmaps
 from ecofmaps.measured import cycles, pipeline
 from ecofmaps.measured import samples as passes
 from ecofmaps.measured.analysis import analyze_loops
-from ecofmaps.measured.cycles import MissingSampleError
 from ecofmaps.measured.pipeline import LoopOptions
 from ecofmaps.measured.quality import LoopQualityWarning
+from ecofmaps.measured.samples import MissingSampleError
 from ecofmaps.measured.synthetic import synthetic_recording
 from ecofmaps.paper import EXAMPLE_2, LOAD
 from tests.measured.compare import COEFFICIENTS, DISPLACEMENTS, FORCES, TOLERANCE

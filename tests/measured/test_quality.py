@@ -17,6 +17,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import ecofmaps
+from ecofmaps.lab.regime import sliding_condition_line
 from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.pipeline import LoopOptions
 from ecofmaps.measured.quality import (
@@ -30,10 +31,9 @@ from ecofmaps.measured.quality import (
     quality_strings,
     quality_summary,
     refused,
-    sliding_condition_line,
-    sliding_condition_of,
 )
 from ecofmaps.measured.synthetic import synthetic_recording
+from ecofmaps.model.regimes import sliding_condition_of
 from ecofmaps.paper import EXAMPLE_2, LOAD
 from tests.measured.compare import PER_CYCLE, scope_of
 from tests.recordings import mindlin_recording, noisy
