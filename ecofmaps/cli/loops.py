@@ -253,7 +253,7 @@ def _summary(path, results, recording) -> str:
     from ecofmaps.model.regimes import GROSS_SLIP
 
     gross = results.isel(cycle=np.flatnonzero(results.regime.values == GROSS_SLIP))
-    summary = f"  {path.name}: {results.attrs['quality_summary']}"
+    summary = f"{path.name}: {results.attrs['quality_summary']}"
     if results.attrs.get("motion") == "reciprocating sliding":
         amplitude = float(np.nanmedian(results.amplitude)) if "amplitude" in results else np.nan
         stroke = f" (amplitude {amplitude * 1e3:.3g} mm)" if np.isfinite(amplitude) else ""
@@ -491,25 +491,23 @@ def run(args) -> int:
         return 1
     with interrupts_deferred():  # the table is in place: a stop now would leave it unrecorded
         record_written(path for _, path in outputs if path is not None)
-    status = 1 if failed else 0
-    if args.out is None:
+    if args.out is None:  # the table on standard output, the summaries on standard error
         sys.stdout.write(stream.getvalue())
-        for each in done:
-            print(_summary(each.path, each.results, each.recording).strip(), file=sys.stderr)
-            for line in [*_lab_lines(each.results, args.rig_stiffness), *_said(lab)]:
-                print(f"  {line}", file=sys.stderr)
-        return status
-    long_run.finish()
-    written = sum(each.results.cycle.size for each in done)
-    print(f"wrote {args.out}: {written} cycle{'' if written == 1 else 's'}")
+        told, indent = sys.stderr, ""
+    else:
+        long_run.finish()
+        written = sum(each.results.cycle.size for each in done)
+        print(f"wrote {args.out}: {written} cycle{'' if written == 1 else 's'}")
+        told, indent = sys.stdout, "  "
     for each in done:
-        print(_summary(each.path, each.results, each.recording))
+        print(indent + _summary(each.path, each.results, each.recording), file=told)
         for line in [*_lab_lines(each.results, args.rig_stiffness), *_said(lab)]:
-            print(f"    {line}")
-    if failed:
-        print(f"  not analysed ({len(failed)}): " + ", ".join(str(path) for path in failed))
-    extras = (("the loops read along the stroke", args.resolved), ("the report", args.report))
-    for what, where in (*extras, ("plots", args.plots)):
-        if where is not None:
-            print(f"  {what} in {where}")
-    return status
+            print(f"{indent}  {line}", file=told)
+    if args.out is not None:
+        if failed:
+            print(f"  not analysed ({len(failed)}): " + ", ".join(str(path) for path in failed))
+        extras = (("the loops read along the stroke", args.resolved), ("the report", args.report))
+        for what, where in (*extras, ("plots", args.plots)):
+            if where is not None:
+                print(f"  {what} in {where}")
+    return 1 if failed else 0

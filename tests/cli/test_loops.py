@@ -321,17 +321,17 @@ def test_the_summary_reads_the_gross_slip_cycles_only():
     )
     line = _summary(Path("rig.csv"), results, recording=None)
     assert line == (
-        "  rig.csv: 7 cycles: 7 ok (1 incomplete dropped); mixed slip (the regime changes at "
+        "rig.csv: 7 cycles: 7 ok (1 incomplete dropped); mixed slip (the regime changes at "
         "cycles 2, 4, 5, 7); GICoF median 0.8000; "
         "ECoF 0.6100 (first) to 0.6300 (last)"
     )
     none = results.assign(regime=results.regime * 0 + stuck)
     assert _summary(Path("rig.csv"), none, None) == (
-        "  rig.csv: 7 cycles: 7 ok (1 incomplete dropped); partial slip"
+        "rig.csv: 7 cycles: 7 ok (1 incomplete dropped); partial slip"
     )
     none.attrs["cycles_from"] = "displacement reversals"
     assert _summary(Path("rig.csv"), none, None) == (
-        "  rig.csv: 7 cycles: 7 ok (1 incomplete dropped: partial, where the recording starts "
+        "rig.csv: 7 cycles: 7 ok (1 incomplete dropped: partial, where the recording starts "
         "or ends mid-cycle); partial slip"
     )
 

@@ -22,7 +22,11 @@ def random_rigs(count, seed):
     ("profile", "parabola"),
     [
         pytest.param(ecofmaps.parabolic_profile(10e-6, 50e-6), 0.2, marks=pytest.mark.slow),
-        (ecofmaps.flat_bottomed_profile(10e-6, 50e-6, 0.5, tilt=0.05), None),
+        pytest.param(
+            ecofmaps.flat_bottomed_profile(10e-6, 50e-6, 0.5, tilt=0.05),
+            None,
+            marks=pytest.mark.slow,
+        ),
         pytest.param(ecofmaps.w_shaped_profile(10e-6, 50e-6, 0.3), None, marks=pytest.mark.slow),
     ],
     ids=["parabolic", "flat-tilted", "w"],

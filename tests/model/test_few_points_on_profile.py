@@ -16,7 +16,9 @@ NAMES = ("slip_ratio", "ecof_ratio", "normalized_energy", "normalized_max_force"
         pytest.param(
             ecofmaps.flat_bottomed_profile(D, W, 0.5, samples=401), marks=pytest.mark.slow
         ),
-        ecofmaps.w_shaped_profile(D, W, 0.25, samples=401),  # the pad jumps: jumps' areas
+        pytest.param(  # the pad jumps: jumps' areas
+            ecofmaps.w_shaped_profile(D, W, 0.25, samples=401), marks=pytest.mark.slow
+        ),
     ],
     ids=["flat-bottomed", "W-shaped"],
 )
