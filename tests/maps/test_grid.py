@@ -8,7 +8,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 import xarray as xr
-from hypothesis import given
+from hypothesis import example, given
 from hypothesis import strategies as st
 
 import ecofmaps
@@ -120,18 +120,24 @@ def test_map_equals_the_si_api(grid):
     amplitude=st.floats(1e-6, 2e-4),
     mu=st.floats(0.05, 2.0),
 )
+@example(math.inf, 0.99999, 6.78e-5, 0.5)
+@example(math.inf, 0.999999, 3.3e-5, 0.5)
 def test_single_points_equal_the_si_api(stiffness_ratio, aspect_ratio, amplitude, mu):
-    """Over the whole valid domain; load 1 N so that S = S/P exactly (same λ bits)."""
+    """Over the whole valid domain; load 1 N so that S = S/P exactly (same λ bits). The two
+    paths round differently where 1 - z_o/x_o cancels (about ε/(1 - z_o/x_o) apart at
+    z_o/x_o = 0.99999): 1e-12 plus four times that."""
     point = compute_map(stiffness_ratio, aspect_ratio, amplitude, mu, 1.0, cache=False)
     si = dict(amplitude=amplitude, load=1.0, stiffness=stiffness_ratio, mu=mu)
     si["aspect_ratio"] = aspect_ratio
+    eps = np.finfo(np.float64).eps
+    rtol = 1e-12 + 4.0 * eps / max(1.0 - aspect_ratio, eps)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ecofmaps.RegimeWarning)
         assert int(point.regime) == int(ecofmaps.slip_regime(**si))
-        assert_close(point.slip_amplitude, ecofmaps.slip_amplitude(**si), rtol=1e-12)
-        assert_close(point.ecof, ecofmaps.energy_cof(**si), rtol=1e-12)
-        assert_close(point.dissipated_energy, ecofmaps.dissipated_energy(**si), rtol=1e-12)
-        assert_close(point.max_force, ecofmaps.max_force(**si), rtol=1e-12)
+        assert_close(point.slip_amplitude, ecofmaps.slip_amplitude(**si), rtol=rtol)
+        assert_close(point.ecof, ecofmaps.energy_cof(**si), rtol=rtol)
+        assert_close(point.dissipated_energy, ecofmaps.dissipated_energy(**si), rtol=rtol)
+        assert_close(point.max_force, ecofmaps.max_force(**si), rtol=rtol)
 
 
 def test_figure_11_against_brute_force():
