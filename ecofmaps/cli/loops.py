@@ -315,11 +315,11 @@ def _lab_lines(results, rig_stiffness) -> list[str]:
     """ΣE_d over a recording's cycles and, when it crosses one (a sweep), its transition to
     gross slip (docs/lab.md)."""
     from ecofmaps.lab import transition
-    from ecofmaps.lab.wear import cycle_sum
+    from ecofmaps.lab.wear import cumulated_energy
 
     cycle = results["cycle"].values.astype(np.float64)
     try:
-        energy = with_se("cumulated_energy", *cycle_sum(cycle, results.dissipated_energy.values))
+        energy = with_se("cumulated_energy", *cumulated_energy(results))
         lines = [f"ΣE_d = {energy} over cycles 1 to {cycle[-1]:.0f}"]
     except ValueError as error:
         lines = [f"ΣE_d: {error}"]

@@ -316,11 +316,9 @@ class LongRun:
             return None
         partial.remove_temporaries()
         index, path, blocks = self.analysed
-        of = "" if blocks is None else f" of {blocks}"
-        return (
-            f"{len(partial.kept(index))}{of} blocks of {path} are kept in {partial.folder}: "
-            "run the same command with --resume to continue"
-        )
+        kept, of = len(partial.kept(index)), "" if blocks is None else f" of {blocks}"
+        what = f"{kept}{of} blocks of {path} are" if kept else f"the cycles found in {path} are"
+        return f"{what} kept in {partial.folder}: run the same command with --resume to continue"
 
     def finish(self) -> None:
         """Remove the kept blocks (the table is written, or nothing was kept yet)."""

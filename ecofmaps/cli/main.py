@@ -126,8 +126,9 @@ def main(argv=None) -> int:
     except Exception as error:
         if interrupted is not None and interrupted.is_set():  # an interrupt turned into an error
             return _stopped(interrupted, None)
-        if isinstance(error, (CommandError, ValueError, OSError)):
-            return _report(2, f"error: {option_names(str(error))}")
+        if isinstance(error, (CommandError, ValueError, OSError)):  # and what the run left
+            left = interrupted.note() if interrupted is not None and interrupted.notes else None
+            return _report(2, f"error: {option_names(str(error))}" + (f"; {left}" * bool(left)))
         if isinstance(error, MemoryError):
             return _report(1, "error: not enough memory for this run")
         if os.environ.get("ECOFMAPS_DEBUG"):

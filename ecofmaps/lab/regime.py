@@ -59,7 +59,8 @@ def tests_of(results) -> list:
 
 def per_cycle(results: xr.Dataset, names) -> dict:
     """The cycle numbers, the normal load [N] and the variables ``names`` [SI] of a test, as
-    float arrays over its cycles."""
+    float arrays over its cycles; the forces and energies of cycles flagged ``implausible-cof``
+    NaN where they are fewer than half (a force sample gone wild, not a wrong load)."""
     if "cycle" not in results.coords and "cycle" not in results:
         raise ValueError(
             "results: no cycle numbers (a 'cycle' coordinate or column): give the results of "
@@ -70,6 +71,11 @@ def per_cycle(results: xr.Dataset, names) -> dict:
         words = ", ".join(f"'{n}' ({nomenclature.QUANTITIES[n].long_name})" for n in missing)
         raise ValueError(f"results: no {words}; give the results of ecofmaps.analyze_loops")
     values = {n: np.asarray(results[n].values, dtype=np.float64) for n in (*names, "cycle")}
+    if "quality" in results:  # a force gone wild in a few cycles: not the contact's forces
+        wild = has_reason(results["quality"].values, "implausible-cof")
+        if wild.sum() < 0.5 * wild.size:
+            for name in set(names) & {"dissipated_energy", "max_force"}:
+                values[name] = np.where(wild, np.nan, values[name])
     if "normal_load" in results:
         values["load"] = np.asarray(results["normal_load"].values, dtype=np.float64)
     elif "load" in results.coords or "load" in results:

@@ -20,7 +20,7 @@ from ecofmaps.lab.regime import (
 from ecofmaps.model.profiles import ScarProfile
 from ecofmaps.model.simulation import fretting_loop
 
-__all__ = ["cycle_sum", "energy_wear", "loop_scar_closure"]
+__all__ = ["cumulated_energy", "cycle_sum", "energy_wear", "loop_scar_closure"]
 
 
 def cycle_sum(cycle, value):
@@ -42,6 +42,13 @@ def cycle_sum(cycle, value):
     off = v[1:-1] - (right * v[:-2] + left * v[2:])
     sigma2 = np.mean(off**2 / (1 + left**2 + right**2))
     return float(weight @ v), float(np.sqrt(sigma2 * np.sum(weight**2)))
+
+
+def cumulated_energy(results) -> tuple[float, float]:
+    """ΣE_d [J] of a test over cycles 1 to the last recorded, and its standard error
+    (:func:`cycle_sum` of :func:`~ecofmaps.lab.regime.per_cycle`'s energies)."""
+    cycles = per_cycle(results, ("dissipated_energy",))
+    return cycle_sum(cycles["cycle"], cycles["dissipated_energy"])
 
 
 def _worn_volume(profile: ScarProfile, length) -> tuple[float, float]:
@@ -97,7 +104,7 @@ def _one_test(results, profile, length) -> dict:
     if not np.isfinite(cycles["dissipated_energy"]).any():
         raise ValueError("results: no cycle has a dissipated energy ('dissipated_energy')")
     cycle, load = cycles["cycle"], cycles["load"]
-    energy = cycle_sum(cycle, cycles["dissipated_energy"])
+    energy = cumulated_energy(results)
     volume = _worn_volume(profile, length)
     slip = cycle_sum(cycle, 4 * load * cycles["slip_amplitude"])
     nominal = cycle_sum(cycle, 4 * load * cycles["amplitude"])

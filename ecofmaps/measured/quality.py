@@ -205,9 +205,8 @@ REASONS = {
     ),
     "implausible-cof": (
         f"a coefficient of friction outside {COF_RANGE[0]:g} to {COF_RANGE[1]:g} (the ECoF or "
-        "GICoF in gross slip): the load given, the force's unit or a force sample is wrong, not "
-        "the contact",
-        ("ecof", "cof_max", "max_force", "dissipated_energy", *_GICOF, *RESOLVED),
+        "GICoF in gross slip): the load given or the force's unit is wrong, not the contact",
+        ("ecof", "cof_max", *_GICOF, *RESOLVED),
     ),
     "load-swing": (
         f"the recorded normal load swings by more than {LOAD_SWING * 100:g} % of its mean "

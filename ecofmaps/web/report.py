@@ -41,7 +41,7 @@ from ecofmaps.io.files import atomic_path
 from ecofmaps.io.tables import results_table
 from ecofmaps.lab import transition
 from ecofmaps.lab.regime import sliding_condition_line
-from ecofmaps.lab.wear import cycle_sum
+from ecofmaps.lab.wear import cumulated_energy
 from ecofmaps.measured.quality import REASONS, SEPARATOR, quality_summary
 from ecofmaps.model.simulation import fretting_loop
 
@@ -259,7 +259,7 @@ def _lab_numbers(results: xr.Dataset, lab: Mapping) -> Div:
     """The test's cumulated dissipated energy, its transition if it crosses one, and ``lab``."""
     cycle = results["cycle"].values.astype(np.float64)
     try:
-        energy = with_se("cumulated_energy", *cycle_sum(cycle, results["dissipated_energy"].values))
+        energy = with_se("cumulated_energy", *cumulated_energy(results))
         rows = {
             QUANTITIES["cumulated_energy"].long_name: f"{energy} over cycles 1 to {cycle[-1]:.0f}"
         }

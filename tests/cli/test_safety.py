@@ -288,3 +288,21 @@ def test_an_hdf5_output_on_a_full_disk_is_one_line_naming_it(tmp_path, command):
     assert stderr.startswith("ecofmaps: error: [Errno 28] No space left on device: ")
     assert stderr.endswith(f"free: '{output}'\n") and stderr.count("\n") == 1
     assert left[-1:] == ["filler"] and not any(name.endswith(".tmp") for name in left)
+
+
+@pytest.mark.slow
+def test_a_full_disk_under_a_long_run_says_what_it_left(tmp_path):
+    """``--workers 2 --out`` onto a full disk: one line naming the error and the folder kept
+    beside --out with what it holds, to go on with --resume (it was said nowhere)."""
+    from ecofmaps.measured.synthetic import example_path
+    from tests.cli.commands import on_a_full_disk
+
+    out = tmp_path / "full" / "o.csv"
+    argv = ("loops", example_path(), "--load", "450N", "--workers", "2", "--out", out)
+    status, err, names = on_a_full_disk(tmp_path / "full", *argv)
+    assert status == 2 and err.count("\n") == 1 and "No space left on device" in err
+    if "o.csv.partial" in names:
+        assert f"kept in {out}.partial: run the same command with --resume" in err
+    else:
+        assert "kept in" not in err
+    assert "o.csv" not in names
