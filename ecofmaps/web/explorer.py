@@ -124,8 +124,10 @@ def bare_number_warnings(texts: dict) -> list[str]:
     """
     found = []
     for key, text in texts.items():
+        if len(str(text)) > TEXT_LIMIT:  # refused as too long: not read as a number here
+            continue
         name, label = INPUTS[key][:2]
-        warning = bare_number_warning(name, str(text)[:TEXT_LIMIT], QUANTITIES[name].kind)
+        warning = bare_number_warning(name, str(text), QUANTITIES[name].kind)
         if warning is not None:
             found.append(f"{label}: {warning}")
     return found

@@ -20,7 +20,12 @@ from ecofmaps.cli import explore
 from ecofmaps.figures.style import ECOF_RATIO_LEVELS
 from ecofmaps.units import DOMAIN, TEXT_LIMIT
 from ecofmaps.web import explorer
-from ecofmaps.web.explorer import explorer_page, map_window, parameter_value
+from ecofmaps.web.explorer import (
+    bare_number_warnings,
+    explorer_page,
+    map_window,
+    parameter_value,
+)
 from tests.cli.commands import run
 from tests.web.pages import CANVAS_INK, console_errors, deep_texts, wait_for
 
@@ -48,6 +53,7 @@ def test_inputs_are_read_with_units_or_in_si():
     with pytest.raises(ValueError, match="Rig stiffness S"):
         parameter_value("stiffness", "35um")
     assert math.copysign(1.0, parameter_value("aspect_ratio", "-0")) == 1.0  # shown as 0
+    assert bare_number_warnings({"amplitude": "9" * 5000}) == []  # refused, not also warned of
     with pytest.raises(ValueError) as refused:
         parameter_value("aspect_ratio", "1e7")
     assert str(refused.value).endswith("beyond the model's domain, 0 to 1e+06")  # a ratio: no unit
