@@ -139,14 +139,14 @@ STEEP = {
 }
 
 
-def steep_sweep(steps, noise=0.0, samples=SAMPLES):
-    """The applied displacement and force of a sweep holding each of ``steps`` × Δ_t three
-    cycles at 35 MN/m (``samples`` a cycle), with white noise of ``noise`` × their largest
-    amplitude and force, and the amplitude of each drive cycle."""
-    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, 35e6)
-    amplitudes = np.repeat(np.asarray(steps) * at, 3)
+def steep_sweep(steps, noise=0.0, samples=SAMPLES, held=3, stiffness=35e6):
+    """The applied displacement and force of a sweep holding each of ``steps`` × Δ_t ``held``
+    cycles behind a rig ``stiffness`` (``samples`` a cycle), with white noise of ``noise`` ×
+    their largest amplitude and force, and the amplitude of each drive cycle."""
+    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
+    amplitudes = np.repeat(np.asarray(steps) * at, held)
     applied = mindlin.sweep(amplitudes, samples)
-    _, force = mindlin.drive(mindlin.Contact(MU, LOAD, DELTA_T), applied, 35e6)
+    _, force = mindlin.drive(mindlin.Contact(MU, LOAD, DELTA_T), applied, stiffness)
     rng = np.random.default_rng(1)
     applied += noise * amplitudes.max() * rng.standard_normal(applied.size)
     force += noise * MU * LOAD * rng.standard_normal(force.size)
@@ -200,14 +200,7 @@ SINGLE = {
 
 def one_cycle_sweep(steps, noise=0.0, stiffness=35e6):
     """As :func:`steep_sweep`, each amplitude held one cycle (behind a rig ``stiffness``)."""
-    at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
-    amplitudes = np.asarray(steps) * at
-    applied = mindlin.sweep(amplitudes, SAMPLES)
-    _, force = mindlin.drive(mindlin.Contact(MU, LOAD, DELTA_T), applied, stiffness)
-    rng = np.random.default_rng(1)
-    applied += noise * amplitudes.max() * rng.standard_normal(applied.size)
-    force += noise * MU * LOAD * rng.standard_normal(force.size)
-    return applied, force, amplitudes
+    return steep_sweep(steps, noise, held=1, stiffness=stiffness)
 
 
 @pytest.mark.parametrize("noise", [0.0, 0.01])
