@@ -370,18 +370,11 @@ def cycle_results(values: dict, flags: dict, label, options) -> xr.Dataset:
     values, quality, _, regime = judged(values, flags, options)
     last = ("stick_residual", *_RECORDED)
     data = {k: ("cycle", v, _attrs(k)) for k, v in values.items() if k not in last}
-    data["regime"] = (
-        "cycle",
-        regime.astype(np.int32),
-        _attrs("regime") | Regime.flag_attrs(),
-    )
+    data["regime"] = ("cycle", regime.astype(np.int32), _attrs("regime") | Regime.flag_attrs())
     data |= {k: ("cycle", values[k], _attrs(k)) for k in last if k in values}
     data["quality"] = ("cycle", quality, _attrs("quality"))
     load = ((), options.load, _attrs("load"))
-    return xr.Dataset(
-        data,
-        coords={"cycle": ("cycle", label, _attrs("cycle")), "load": load},
-    )
+    return xr.Dataset(data, coords={"cycle": ("cycle", label, _attrs("cycle")), "load": load})
 
 
 class Tally:
