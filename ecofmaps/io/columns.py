@@ -176,19 +176,8 @@ _SYNONYM_KEYS = {role: frozenset(map(_plain, names)) for role, names in SYNONYMS
 
 
 def split_unit(name: str) -> tuple[str, str | None]:
-    """A column name's base and the unit it carries.
-
-    Parameters
-    ----------
-    name : str
-        A column, channel or variable name, e.g. ``'force [N]'``, ``'delta_mm'``.
-
-    Returns
-    -------
-    base : str
-        The name without its unit, surrounding quotes and blanks.
-    unit : str or None
-        The unit as written (``'N'``, ``'mm'``, ``'µm'``), or None.
+    """A column, channel or variable name's base (without its unit, surrounding quotes and
+    blanks) and the unit it carries as written (``'N'``, ``'mm'``, ``'µm'``), or None.
 
     Examples
     --------
@@ -211,30 +200,13 @@ def split_unit(name: str) -> tuple[str, str | None]:
 
 
 def find_column(names, wanted: str, role: str, *, required: bool = True) -> int | None:
-    """The index of the column ``wanted`` among ``names``.
+    """The index of the column ``wanted`` (matched as :func:`matching_columns` says) among
+    ``names``, the file's header cells, channels or variables; None for one not found and
+    not ``required``. The ``role`` (``'displacement'``, ``'force'``, ``'load'``,
+    ``'cycle'``, ``'x'``, ``'z'``) gives the synonyms and the messages.
 
-    Parameters
-    ----------
-    names : sequence of str
-        The names in the file (header cells, channels or variables).
-    wanted : str
-        The name asked for, matched as :func:`matching_columns` says.
-    role : str
-        What the column holds (``'displacement'``, ``'force'``, ``'load'``, ``'cycle'``,
-        ``'x'``, ``'z'``), for messages and synonyms.
-    required : bool
-        Whether a missing column is an error; if not, None is returned for it.
-
-    Returns
-    -------
-    index : int or None
-
-    Raises
-    ------
-    ColumnError
-        If no name matches (and the column is required: the message lists the columns and
-        suggests the nearest), or several do (the message names them and the option that
-        chooses).
+    A :class:`ColumnError` if no name matches (the message lists the columns and suggests
+    the nearest), or several do (it names them and the option that chooses).
 
     Examples
     --------
@@ -353,34 +325,14 @@ def role_scale(role: str, name: str, option_unit, metadata=(), column=None) -> t
 
 
 def column_scale(role: str, option_unit, carried, column: str) -> tuple[float, str]:
-    """The factor from a column's values to SI, and the unit it stands for.
+    """The factor from a column's values to SI (m or N), and the unit it stands for: the
+    unit ``option_unit`` (the option ``<role>_unit``; None to take the file's), else the
+    units ``carried`` by the file (its name and metadata), else :data:`DEFAULT_UNITS`.
 
-    Parameters
-    ----------
-    role : str
-        A key of :data:`KINDS`.
-    option_unit : str or None
-        The unit given as the option ``<role>_unit``; None to take the file's.
-    carried : sequence of str
-        The units the file gives for the column (from its name and its metadata), any
-        number of them, each a unit's text.
-    column : str
-        The column's name in the file, for messages.
-
-    Returns
-    -------
-    factor : float
-        Multiply the values by it (or divide by its reciprocal) for SI (m or N).
-    unit : str
-        The unit used.
-
-    Raises
-    ------
-    ValueError
-        If ``option_unit`` is not a unit of the role's kind; the message names the option.
-    ColumnError
-        If units disagree (an option against the file, or two in the file), or the file
-        gives a unit of another kind and no option overrules it.
+    A ValueError naming the option if ``option_unit`` is not a unit of the role's kind; a
+    :class:`ColumnError` naming the ``column`` if units disagree (an option against the
+    file, or two in the file), or the file gives a unit of another kind and no option
+    overrules it.
     """
     kind = KINDS[role]
     option = f"{role}_unit"

@@ -229,8 +229,7 @@ class Recording:
 
     def arrays(self) -> dict:
         """The arrays read, by role (displacement, force, then cycle and load if read)."""
-        read = {"displacement": self.displacement, "force": self.force}
-        read |= {"cycle": self.cycle, "load": self.load}
+        read = {role: getattr(self, role) for role in SI_UNITS}
         return {role: array for role, array in read.items() if array is not None}
 
     @functools.cached_property
@@ -242,12 +241,7 @@ class Recording:
         The lines of the missing samples of a text file:
         ``recording.line(np.flatnonzero(recording.missing))``.
         """
-        arrays = self.arrays().values()
-        if self.lazy:
-            import dask.array as da
-
-            return ~functools.reduce(da.logical_and, [da.isfinite(a) for a in arrays])
-        return ~functools.reduce(np.logical_and, [np.isfinite(a) for a in arrays])
+        return ~functools.reduce(np.logical_and, map(np.isfinite, self.arrays().values()))
 
     def line(self, index):
         """1-based line numbers of samples in a text file (None for other formats).

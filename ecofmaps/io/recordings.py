@@ -161,10 +161,7 @@ def _text_recordings(path: Path, options: dict, block_bytes, samples=None) -> It
                 _check_not_empty(path, layout.header_line, joined, columns)
             yield Recording(
                 path=path,
-                displacement=joined["displacement"][:count],
-                force=joined["force"][:count],
-                cycle=joined["cycle"][:count] if "cycle" in joined else None,
-                load=joined["load"][:count] if "load" in joined else None,
+                **{role: values[:count] for role, values in joined.items()},
                 last_line=int(lines[count - 1]),
                 columns=columns,
                 units=units,
@@ -184,16 +181,14 @@ def _check_not_empty(path: Path, header_line: int, values: dict, columns: dict) 
     """Refuse a column of which every sample is missing."""
     for role, data in values.items():
         if not np.isfinite(data).any():
+            hint = "is it the right column?"
+            if role == "cycle":
+                hint = "cycle_column=False (--cycle-col none) reads no cycle column"
             raise RecordingError(
                 path,
                 header_line,
                 f"the {role} column {columns[role]!r} holds no number: "
-                f"all its {data.size} samples are missing; "
-                + (
-                    "cycle_column=False (--cycle-col none) reads no cycle column"
-                    if role == "cycle"
-                    else "is it the right column?"
-                ),
+                f"all its {data.size} samples are missing; {hint}",
             )
 
 

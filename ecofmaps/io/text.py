@@ -187,10 +187,7 @@ class _Decoder:
 def _separator(header: str):
     """The field separator of the header line."""
     unquoted = re.sub(r'"[^"]*"', "", header)
-    for candidate in ("\t", ";", ","):
-        if candidate in unquoted:
-            return candidate
-    return None
+    return next((candidate for candidate in ("\t", ";", ",") if candidate in unquoted), None)
 
 
 def _fields(line: str, separator) -> list[str]:
@@ -282,16 +279,14 @@ class _Layout:
             self.columns = {
                 role: find_column(self.names, name, role) for role, name in wanted.items()
             }
-            roles = list(self.columns)
-            for index, role in enumerate(roles):
-                for other in roles[:index]:
-                    if self.columns[role] == self.columns[other]:
-                        raise ColumnError(
-                            f"the {other} and {role} columns are the same column "
-                            f"{self.names[self.columns[role]]!r}"
-                        )
+            for other, role in itertools.combinations(self.columns, 2):
+                if self.columns[role] == self.columns[other]:
+                    raise ColumnError(
+                        f"the {other} and {role} columns are the same column "
+                        f"{self.names[self.columns[role]]!r}"
+                    )
             self.scales, self.units, assumed = {}, {}, []
-            for role in (role for role in roles if role != "cycle"):
+            for role in (role for role in self.columns if role != "cycle"):
                 name = self.names[self.columns[role]]
                 self.scales[role], self.units[role], unknown = role_scale(
                     role, name, options.get(f"{role}_unit")
@@ -302,16 +297,8 @@ class _Layout:
         self.assumed = tuple(assumed)
         self.scales["cycle"], self.units["cycle"] = 1.0, "1"
         self.width = len(self.names)
-        self.decimal = None
+        self.decimal = None  # comma or point: from the first block whose numbers show one
         self.nan_policy = options["nan_policy"]
-
-    def decide_decimal(self, body: str) -> None:
-        """Decimal comma or point, from the first block whose numbers show one."""
-        comma = _QUOTED_COMMA_DECIMAL if self.separator == "," else _COMMA_DECIMAL
-        if comma.search(body):
-            self.decimal = ","
-        elif _POINT_DECIMAL.search(body):
-            self.decimal = "."
 
     def field_error(self, lines: list[str], numbers) -> None:
         """Raise for the first line whose number of cells is not the header's."""
@@ -322,19 +309,18 @@ class _Layout:
                     self.path, number, f"{count} fields where the header has {self.width}"
                 )
 
-    def data_lines(self, lines: list[str]) -> list[int]:
-        """The indices of the lines that are not blank (but for the separator) or comments."""
-        blanks = " \r" if self.separator == "\t" else " \t\r"
-        return [
-            k for k, line in enumerate(lines) if (text := line.strip(blanks)) and text[0] != "#"
-        ]
-
     def parse(self, body, numbers: np.ndarray, lines: list[str] | None = None):
-        """The wanted columns of the data lines ``body``, in SI, by role."""
+        """The wanted columns of the data lines ``body`` (text or UTF-8), in SI, by role;
+        without their ``lines``, None for anything amiss (to be parsed again with them)."""
         careful = lines is not None
         raw = isinstance(body, bytes)
         if self.decimal is None:
-            self.decide_decimal(body.decode("utf-8", errors="replace") if raw else body)
+            text = body.decode("utf-8", errors="replace") if raw else body
+            comma = _QUOTED_COMMA_DECIMAL if self.separator == "," else _COMMA_DECIMAL
+            if comma.search(text):
+                self.decimal = ","
+            elif _POINT_DECIMAL.search(text):
+                self.decimal = "."
         count = numbers.size
         separator = self.separator.encode() if raw and self.separator else self.separator
         counted = (
@@ -469,7 +455,8 @@ def _parsed_lines(layout: _Layout, lines: list[str], start: int):
         if values is not None:
             yield values, numbers
             return
-    kept = layout.data_lines(lines)
+    blanks = " \r" if layout.separator == "\t" else " \t\r"  # not the separator
+    kept = [k for k, line in enumerate(lines) if (text := line.strip(blanks)) and text[0] != "#"]
     if kept:
         numbers = start + np.asarray(kept, dtype=np.int64)
         lines = [lines[k] for k in kept]
