@@ -9,7 +9,6 @@ error. ``docs/formats.md`` describes the formats.
 
 from __future__ import annotations
 
-import functools
 import os
 import threading
 import weakref
@@ -41,7 +40,6 @@ class Column:
         self.ndim = 1
         self._handle = None
         self._lock = threading.Lock()
-        _watch_forks()
         _COLUMNS.add(self)
 
     def __reduce__(self):
@@ -114,21 +112,17 @@ class Column:
         return si_values(values, self.factor)
 
 
-#: The columns of this process (see :func:`_watch_forks`).
+#: The columns of this process, each given a new lock in a forked process.
 _COLUMNS = weakref.WeakSet()
 
 
-@functools.cache
-def _watch_forks() -> None:
-    """From the first column on, a forked process gives each column a new lock."""
-    if hasattr(os, "register_at_fork"):  # where processes fork
-        os.register_at_fork(after_in_child=_new_locks)
-
-
 def _new_locks() -> None:
-    """In a forked process: a lock of its own for every column."""
     for column in list(_COLUMNS):
         column._lock = threading.Lock()
+
+
+if hasattr(os, "register_at_fork"):  # where processes fork
+    os.register_at_fork(after_in_child=_new_locks)
 
 
 #: The columns unpickled in this process, by their arguments: held weakly, so that a column
@@ -136,9 +130,8 @@ def _new_locks() -> None:
 _UNPICKLED = weakref.WeakValueDictionary()
 
 
-def _column(path, kind, variable, factor, nan_policy, stamp) -> Column:
+def _column(*arguments) -> Column:
     """The column of these arguments, one object per process while any copy is held."""
-    arguments = (path, kind, variable, factor, nan_policy, stamp)
     column = _UNPICKLED.get(arguments)
     if column is None:
         column = _UNPICKLED[arguments] = Column(*arguments)
