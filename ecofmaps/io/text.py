@@ -9,6 +9,7 @@ gzip, encodings, missing cells) is described in ``docs/formats.md``.
 from __future__ import annotations
 
 import codecs
+import contextlib
 import csv
 import gzip
 import io
@@ -61,30 +62,6 @@ def _is_data(line: str) -> bool:
     return bool(stripped) and not stripped.startswith("#")
 
 
-def _file_bytes(path: Path, block_bytes: int):
-    """The file's bytes, about ``block_bytes`` at a time."""
-    check_regular_file(path)
-    with open(path, "rb") as raw:
-        compressed = raw.read(2) == _GZIP
-        raw.seek(0)
-        stream = gzip.GzipFile(fileobj=raw, mode="rb") if compressed else raw
-        try:
-            data = _first_bytes(path, stream, compressed)
-            while data := data + stream.read(block_bytes):
-                if data.endswith(b"\r"):  # its line feed may be the next byte
-                    data += stream.read(1)
-                if b"\r" in data and data.count(b"\r") != data.count(b"\r\n"):
-                    data = _LONE_CR.sub(b"\n", data)
-                yield data
-                data = b""
-        except (EOFError, gzip.BadGzipFile, zlib.error) as error:
-            if not compressed:
-                raise
-            raise _Damaged(
-                f"the compressed (gzip) data is truncated or damaged ({error})"
-            ) from None
-
-
 def _first_bytes(path: Path, stream, compressed: bool) -> bytes:
     """For a UTF-16 file, read whole, all of its text as UTF-8."""
     head = stream.read(8)
@@ -109,10 +86,6 @@ def _first_bytes(path: Path, stream, compressed: bool) -> bytes:
     return b""
 
 
-class _Damaged(Exception):
-    """Compressed data that cannot be read (the file and line are added by the caller)."""
-
-
 def _long_line(data: bytes) -> int | None:
     """The offset of the first line longer than :data:`LINE_BYTES` (the last may go on
     beyond ``data``), or None: it holds a whole aligned window of half that without a line end.
@@ -127,29 +100,43 @@ def _long_line(data: bytes) -> int | None:
     return None
 
 
-def _line_blocks(path: Path, chunks):
-    """Blocks of whole lines (the last may lack a newline), each with the 1-based number of
-    its first line and its number of lines; a line longer than :data:`LINE_BYTES` refused."""
+def _line_blocks(path: Path, block_bytes: int):
+    """The file's bytes in blocks of whole lines of about ``block_bytes`` (the last may lack a
+    newline), each with the 1-based number of its first line and its number of lines; a line
+    longer than :data:`LINE_BYTES` refused."""
+    check_regular_file(path)
     rest, line = b"", 1
-    try:
-        for chunk in chunks:
-            check_interrupted()
-            data = rest + chunk
-            if (start := _long_line(data)) is not None:
-                raise RecordingError(
-                    path,
-                    line + data.count(b"\n", 0, start),
-                    f"a line longer than {LINE_BYTES} bytes (1 MiB): a recording's lines hold "
-                    "a few numbers each; is this a text recording?",
-                )
-            cut = data.rfind(b"\n") + 1
-            rest = data[cut:]
-            if cut:
-                count = data.count(b"\n", 0, cut)
-                yield data[:cut], line, count
-                line += count
-    except _Damaged as error:
-        raise RecordingError(path, line, str(error)) from None
+    with open(path, "rb") as raw:
+        compressed = raw.read(2) == _GZIP
+        raw.seek(0)
+        stream = gzip.GzipFile(fileobj=raw, mode="rb") if compressed else raw
+        try:
+            chunk = _first_bytes(path, stream, compressed)
+            while chunk := chunk + stream.read(block_bytes):
+                if chunk.endswith(b"\r"):  # its line feed may be the next byte
+                    chunk += stream.read(1)
+                if b"\r" in chunk and chunk.count(b"\r") != chunk.count(b"\r\n"):
+                    chunk = _LONE_CR.sub(b"\n", chunk)
+                check_interrupted()
+                data, chunk = rest + chunk, b""
+                if (start := _long_line(data)) is not None:
+                    raise RecordingError(
+                        path,
+                        line + data.count(b"\n", 0, start),
+                        f"a line longer than {LINE_BYTES} bytes (1 MiB): a recording's lines "
+                        "hold a few numbers each; is this a text recording?",
+                    )
+                cut = data.rfind(b"\n") + 1
+                rest = data[cut:]
+                if cut:
+                    count = data.count(b"\n", 0, cut)
+                    yield data[:cut], line, count
+                    line += count
+        except (EOFError, gzip.BadGzipFile, zlib.error) as error:
+            if not compressed:
+                raise
+            message = f"the compressed (gzip) data is truncated or damaged ({error})"
+            raise RecordingError(path, line, message) from None
     if rest:
         yield rest, line, 1
 
@@ -285,17 +272,15 @@ class _Layout:
                         f"the {other} and {role} columns are the same column "
                         f"{self.names[self.columns[role]]!r}"
                     )
-            self.scales, self.units, assumed = {}, {}, []
-            for role in (role for role in self.columns if role != "cycle"):
-                name = self.names[self.columns[role]]
-                self.scales[role], self.units[role], unknown = role_scale(
-                    role, name, options.get(f"{role}_unit")
-                )
-                assumed += [role] if unknown else []
+            self.scales, self.units, self.assumed = {"cycle": 1.0}, {"cycle": "1"}, ()
+            for role, index in self.columns.items():
+                if role != "cycle":
+                    self.scales[role], self.units[role], unknown = role_scale(
+                        role, self.names[index], options.get(f"{role}_unit")
+                    )
+                    self.assumed += (role,) if unknown else ()
         except ColumnError as error:
             raise RecordingError(path, header_line, str(error)) from None
-        self.assumed = tuple(assumed)
-        self.scales["cycle"], self.units["cycle"] = 1.0, "1"
         self.width = len(self.names)
         self.decimal = None  # comma or point: from the first block whose numbers show one
         self.nan_policy = options["nan_policy"]
@@ -402,9 +387,7 @@ class _Layout:
 def text_blocks(path: Path, options: dict, block_bytes: int = BLOCK_BYTES):
     """Parse a text recording block by block."""
     decoder = _Decoder(path)
-    chunks = _file_bytes(path, block_bytes)
-    blocks = _line_blocks(path, chunks)
-    try:
+    with contextlib.closing(_line_blocks(path, block_bytes)) as blocks:
         lines = _head(blocks, decoder, options)
         header = _header_index(lines, options)
         if header is None:
@@ -424,9 +407,6 @@ def text_blocks(path: Path, options: dict, block_bytes: int = BLOCK_BYTES):
                     continue
             # Comments, blank lines, or something amiss: line by line.
             yield from _parsed_lines(layout, _text_lines(decoder(raw, start)), start)
-    finally:
-        blocks.close()
-        chunks.close()
 
 
 def _head(blocks, decoder: _Decoder, options: dict) -> list[str]:
