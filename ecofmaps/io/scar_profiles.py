@@ -47,14 +47,8 @@ def read_scar_profile(
     x_unit, z_unit : str, optional
         Their units of length (``'um'``, ``'mm'``, ...); by default the unit the column's
         name gives, else µm. A unit given that disagrees with the name's is an error.
-    level : bool
-        Remove the tilt and offset of the unworn surface (see :func:`ecofmaps.scar_profile`).
-    half_width : float, optional
-        The scar's half-width, overriding the detected one. [m]
-    smoothing : float, optional
-        Smoothing length of the slopes; default 2 % of the half-width, 0 for none. [m]
-    remove_outliers : bool
-        Replace spikes and dropouts by linear interpolation (on by default).
+    level, half_width, smoothing, remove_outliers
+        As for :func:`ecofmaps.scar_profile` (lengths in m), but levelled by default.
 
     Returns
     -------

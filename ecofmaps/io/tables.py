@@ -51,19 +51,9 @@ RESULT_COLUMNS = tuple(nomenclature.column(name) for name in RESULT_QUANTITIES)
 
 
 def results_table(results: xr.Dataset) -> pd.DataFrame:
-    """The per-cycle results in the tribologist's units, one row per cycle.
-
-    Parameters
-    ----------
-    results : xarray.Dataset
-        From :func:`ecofmaps.analyze_loops`.
-
-    Returns
-    -------
-    table : pandas.DataFrame
-        The columns of :data:`RESULT_COLUMNS` that ``results`` holds, in order (each
-        explained in ``docs/loops.md``).
-    """
+    """The per-cycle results of :func:`ecofmaps.analyze_loops` in the tribologist's units, one
+    row per cycle: the columns of :data:`RESULT_COLUMNS` it holds, in order (each explained
+    in ``docs/loops.md``)."""
     columns = {}
     for name, column in zip(RESULT_QUANTITIES, RESULT_COLUMNS, strict=True):
         if name not in results:
@@ -80,21 +70,8 @@ def results_table(results: xr.Dataset) -> pd.DataFrame:
 
 
 def results_csv(results: xr.Dataset, *, file: str | None = None, header: bool = True) -> str:
-    """The per-cycle results as the text of ``ecofmaps loops --out`` (see :func:`csv_text`).
-
-    Parameters
-    ----------
-    results : xarray.Dataset
-        From :func:`ecofmaps.analyze_loops` (or a stretch of its cycles).
-    file : str, optional
-        The recording's name, written in a first column ``file``.
-    header : bool
-        Begin with the line of column names.
-
-    Returns
-    -------
-    text : str
-    """
+    """The per-cycle results (or a stretch of their cycles) as the text of ``ecofmaps loops
+    --out``, with a first column ``file`` naming the recording if given."""
     table = results_table(results)
     if file is not None:
         table.insert(0, "file", file)
@@ -102,19 +79,9 @@ def results_csv(results: xr.Dataset, *, file: str | None = None, header: bool = 
 
 
 def csv_text(table: pd.DataFrame, *, header: bool = True) -> str:
-    """``table`` as CSV text, numbers to 6 significant digits: what ``table.to_csv(index=False,
-    float_format="%.6g", lineterminator="\\n", header=header)`` writes, in half the time.
-
-    Parameters
-    ----------
-    table : pandas.DataFrame
-        Columns of floats, integers, booleans or text.
-    header : bool
-        Begin with the line of column names.
-
-    Returns
-    -------
-    text : str
+    """``table`` (columns of floats, integers, booleans or text) as CSV text, numbers to 6
+    significant digits: what ``table.to_csv(index=False, float_format="%.6g",
+    lineterminator="\\n", header=header)`` writes, in half the time.
 
     Examples
     --------
@@ -145,25 +112,12 @@ def csv_text(table: pd.DataFrame, *, header: bool = True) -> str:
 
 
 def read_results(path) -> list[xr.Dataset]:
-    """The per-cycle results in a table that ``ecofmaps loops --out`` wrote, in SI units.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        A CSV table (the columns of :data:`RESULT_COLUMNS`, in the tribologist's units), or
-        a netCDF file of :func:`ecofmaps.analyze_loops`' results (``.nc``).
-
-    Returns
-    -------
-    results : list of xarray.Dataset
-        One Dataset over ``cycle`` per recording (a table of several has a ``file``
-        column), with the quantities the table holds under their names in the API; the
-        load is ``normal_load`` when the table has it.
-
-    Raises
-    ------
-    ValueError
-        For a file that is not such a table, naming it.
+    """The per-cycle results, in SI units, of a CSV table that ``ecofmaps loops --out`` wrote
+    (in the tribologist's units) or of a netCDF file of :func:`ecofmaps.analyze_loops`'
+    results (``.nc``): one Dataset over ``cycle`` per recording (a table of several has a
+    ``file`` column), the quantities under their names in the API (the load is
+    ``normal_load`` when the table has it); a ValueError naming a file that is not such a
+    table.
     """
     try:
         if str(path).endswith(".nc"):
