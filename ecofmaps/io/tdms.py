@@ -204,10 +204,9 @@ def tdms_groups(path) -> dict[str, xr.Dataset]:
     reader = TdmsReader(path, handle)  # reads through the file opened to list the groups
     root = xr.Dataset(attrs={k: _plain(v) for k, v in handle.properties.items()})
     root.set_close(reader.close)
-    groups = {"/": root}
-    for group in handle.groups():
-        groups[f"/{group.name}"] = _group_dataset(reader, group)
-    return groups
+    return {"/": root} | {
+        f"/{group.name}": _group_dataset(reader, group) for group in handle.groups()
+    }
 
 
 def open_tdms_group(path, group: str | None = None) -> xr.Dataset:
