@@ -202,21 +202,20 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
     chosen = _select(path, kind, variables(path, kind), options)
     for variable in chosen.values():
         check_complete(path, kind, variable)
-    columns, units, assumed = {}, {}, []
+    columns, units, assumed = {}, {}, ()
     stat = path.stat()
     stamp = (stat.st_mtime_ns, stat.st_size)
     for role, variable in chosen.items():
-        factor, unit, unknown = 1.0, "1", False
+        factor, units[role], unknown = 1.0, "1", False
         if role != "cycle":
             try:
-                factor, unit, unknown = role_scale(
+                factor, units[role], unknown = role_scale(
                     role, variable.short, options[f"{role}_unit"], variable.units, variable.name
                 )
             except ColumnError as error:
                 raise RecordingError(path, f"{NOUNS[kind]} {variable.name!r}", str(error)) from None
-        assumed += [role] if unknown else []
+        assumed += (role,) if unknown else ()
         columns[role] = Column(path, kind, variable, factor, options["nan_policy"], stamp)
-        units[role] = unit
     size = chosen["displacement"].size
     if size == 0:
         raise RecordingError(path, f"{NOUNS[kind]} {chosen['displacement'].name!r}", "no samples")
@@ -227,11 +226,11 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
 
         native = max(v.chunk for v in chosen.values()) or 1
         block = int(chunks) if chunks else max(native, DEFAULT_CHUNK // native * native)
-        token = tokenize(str(path.resolve()), stat.st_mtime_ns, stat.st_size, options, block)
+        token = tokenize(str(path.resolve()), *stamp, options, block)
         arrays = {
             role: da.from_array(
                 column,
-                chunks=(min(block, max(size, 1)),),
+                chunks=(min(block, size),),
                 asarray=False,
                 lock=False,
                 name=f"ecofmaps-{kind}-{role}-{token}",
@@ -248,11 +247,9 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
             column.close()
     return Recording(
         path=path,
-        displacement=arrays["displacement"],
-        force=arrays["force"],
-        cycle=arrays.get("cycle"),
+        **arrays,
         columns={role: variable.name for role, variable in chosen.items()},
         units=units,
         format=kind,
-        assumed_units=tuple(assumed),
+        assumed_units=assumed,
     )
