@@ -1,10 +1,7 @@
-"""Recordings in rig formats: TDMS, HDF5 / netCDF-4 and zarr, read lazily.
-
-The columns asked for are found by name (:mod:`ecofmaps.io.columns`) among the variables of
-:mod:`ecofmaps.io.rig_formats`, each wrapped in a :class:`Column`: an array-like that reads a
-range of samples on demand, in float64 and SI, pickles without its open file (so a dask
-cluster's workers read their own blocks) and names the file, channel and samples in any
-error. ``docs/formats.md`` describes the formats.
+"""Recordings in rig formats (TDMS, HDF5 / netCDF-4, zarr), read lazily through :class:`Column`:
+a range of samples on demand, in float64 and SI, pickled without its open file (so a dask
+cluster's workers read their own blocks), any error naming the file, channel and samples.
+``docs/formats.md`` describes the formats.
 """
 
 from __future__ import annotations

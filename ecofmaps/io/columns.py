@@ -1,9 +1,6 @@
-"""Column names as labs write them: finding a column, and the unit its name carries.
-
-:func:`split_unit` separates a name such as ``Displacement [µm]`` or ``delta_mm`` into its
-base and its unit; :func:`find_column` finds a column by its name, its base or the usual
-names of :data:`SYNONYMS`; :func:`column_scale` decides the factor to SI from the unit
-option, the unit the file carries, or the default. The rules are in ``docs/formats.md``.
+"""Column names as labs write them: the unit a name carries (:func:`split_unit`), a column
+found by its name, its base or the usual names of :data:`SYNONYMS` (:func:`find_column`), and
+the factor to SI (:func:`column_scale`). The rules are in ``docs/formats.md``.
 """
 
 from __future__ import annotations

@@ -1,9 +1,8 @@
-"""Writing files safely, and reporting where a file is damaged.
+"""Writing files safely, and reporting where a file is damaged (:class:`FileLineError`).
 
-Every file ecofmaps writes goes through :func:`atomic_store`: written beside the destination,
-flushed and renamed onto it, so a reader never sees a half-written file; each folder the
-command line writes into keeps a manifest, :data:`MANIFEST`, of what it wrote
-(``docs/formats.md``).
+Every file ecofmaps writes goes through :func:`atomic_store` (written beside the destination,
+flushed and renamed onto it); each folder the command line writes into keeps a manifest,
+:data:`MANIFEST`, of what it wrote (``docs/formats.md``).
 """
 
 from __future__ import annotations

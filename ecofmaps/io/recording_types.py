@@ -1,9 +1,6 @@
-"""A recording of fretting loops as read: :class:`Recording` and the errors that name its lines.
-
-A :class:`Recording` holds the samples in SI units with where each came from (a line of a
-text file, or a sample of a channel), so a damaged or missing sample is reported as a
-:class:`RecordingError` naming the file and the line; :meth:`Recording.to_dataset` gives the
-one xarray Dataset every way in shares (``docs/formats.md``).
+"""A recording as read: :class:`Recording`, its samples in SI units with where each came from
+(a line of a text file, or a sample of a channel), and :class:`RecordingError`, which names
+them; :meth:`Recording.to_dataset` is the one Dataset every way in shares (``docs/formats.md``).
 """
 
 from __future__ import annotations

@@ -1,9 +1,6 @@
-"""Recordings of fretting loops: text files and rig formats, read whole, in blocks or lazily.
-
-:func:`read_recording` reads a text file (:mod:`ecofmaps.io.text`) or a rig file
-(:mod:`ecofmaps.io.binary`) into a :class:`~ecofmaps.io.recording_types.Recording` in SI
-units; :func:`open_recording` gives it as one xarray Dataset, :func:`recording_blocks` block
-by block. ``docs/formats.md`` describes the formats, columns and units.
+"""Recordings of fretting loops, text (:mod:`ecofmaps.io.text`) or rig files
+(:mod:`ecofmaps.io.binary`), read whole, in blocks or lazily, in SI units; ``docs/formats.md``
+describes the formats, columns and units.
 """
 
 from __future__ import annotations

@@ -1,13 +1,8 @@
-"""The rig formats' channels and variables: TDMS, HDF5 / netCDF-4 and zarr, through xarray.
-
-Each group of a file is one lazily read :class:`xarray.Dataset`: TDMS through
-:mod:`ecofmaps.io.tdms`, HDF5 and netCDF-4 through xarray's ``h5netcdf`` engine, zarr
-(formats 2 and 3) through its ``zarr`` engine. xarray decodes the CF attributes
-(``scale_factor``, ``add_offset``, ``_FillValue``/``missing_value`` -> NaN); times are left
-as numbers; arrays without dimension names are read over "phony" dimensions. A damaged file
-is refused when opened. :func:`variables` lists a file's one-dimensional numeric variables
-as :class:`Variable`, :func:`open_group` opens the group of one; :mod:`ecofmaps.io.binary`
-reads the samples. ``docs/formats.md`` describes the formats.
+"""The rig formats' channels and variables: TDMS (:mod:`ecofmaps.io.tdms`), HDF5 / netCDF-4
+and zarr (through xarray's ``h5netcdf`` and ``zarr`` engines), each group a lazily read
+Dataset, CF attributes decoded, times left as numbers, arrays without dimension names read
+over "phony" dimensions, a damaged file refused when opened. :mod:`ecofmaps.io.binary` reads
+the samples; ``docs/formats.md`` describes the formats.
 """
 
 from __future__ import annotations

@@ -1,8 +1,6 @@
-"""The per-cycle results of measured loops as a table, in the tribologist's units.
-
-The columns, their names and their units come from :mod:`ecofmaps._nomenclature`: a quantity
-``name`` in SI becomes the column ``name_<unit>`` in its display unit (``amplitude_um``,
-``stiffness_MN_per_m``); numbers keep their names; the regime is written as its label.
+"""The per-cycle results of measured loops as a table, in the tribologist's units: a quantity
+``name`` in SI becomes the column ``name_<unit>`` (:mod:`ecofmaps._nomenclature`), numbers
+keep their names, the regime is written as its label.
 """
 
 from __future__ import annotations

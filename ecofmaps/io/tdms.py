@@ -1,9 +1,6 @@
-"""TDMS files (LabVIEW) as xarray Datasets, read through npTDMS, lazily; an xarray backend.
-
-:func:`tdms_groups` opens each group of a file as an :class:`xarray.Dataset` of its numeric
-channels, read on demand; a file whose last segment is short is refused. ``docs/formats.md``
-says how channels, properties and units map. :class:`TdmsBackendEntrypoint` is the xarray
-engine ``ecofmaps-tdms``: ``xr.open_dataset("rig.tdms", engine="ecofmaps-tdms", group="Rig")``.
+"""TDMS files (LabVIEW) as lazily read xarray Datasets through npTDMS, one per group, a file
+whose last segment is short refused; :class:`TdmsBackendEntrypoint` is the xarray engine
+``ecofmaps-tdms``. ``docs/formats.md`` says how channels, properties and units map.
 """
 
 from __future__ import annotations

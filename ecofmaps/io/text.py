@@ -1,9 +1,7 @@
-"""Recordings in text files (CSV, TSV, spreadsheet exports), read in blocks.
-
-The file is read in blocks of about :data:`BLOCK_BYTES` bytes cut at line ends and parsed by
-pandas' C parser, keeping only the columns asked for, as float64, and each sample's line
-number for messages. What the reader accepts (preamble, separators, decimal comma, quotes,
-gzip, encodings, missing cells) is described in ``docs/formats.md``.
+"""Recordings in text files (CSV, TSV, spreadsheet exports), read in blocks of about
+:data:`BLOCK_BYTES` cut at line ends by pandas' C parser, only the columns asked for, with each
+sample's line number for messages. What the reader accepts (preamble, separators, decimal
+comma, quotes, gzip, encodings, missing cells) is in ``docs/formats.md``.
 """
 
 from __future__ import annotations

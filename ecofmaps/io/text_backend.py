@@ -1,9 +1,6 @@
-"""Text recordings (:mod:`ecofmaps.io.text`'s format) as an xarray backend.
-
-:class:`TextBackendEntrypoint` is the xarray engine ``ecofmaps-text``
-(``xr.open_dataset("loops.csv", engine="ecofmaps-text")``): the Dataset of
-:func:`ecofmaps.io.recordings.open_recording` with its variables named as the file's
-columns. A text file has no random access: it is parsed whole, in blocks, when opened.
+"""Text recordings as the xarray engine ``ecofmaps-text``: the Dataset of
+:func:`ecofmaps.io.recordings.open_recording`, variables named as the file's columns, the file
+parsed whole (in blocks) when opened: a text file has no random access.
 """
 
 from __future__ import annotations

@@ -1,9 +1,6 @@
-"""Writing recordings block by block: zarr, HDF5 / netCDF-4, TDMS and CSV; conversion.
-
-:class:`RecordingWriter` appends blocks of samples in SI units to a new file or store that
-appears under its name only when complete (:func:`ecofmaps.io.files.atomic_store`);
-:func:`convert_recording` turns any recording :func:`ecofmaps.io.read_recording` reads into
-a chunked store once, with bounded memory (``docs/formats.md``).
+"""Writing recordings block by block (zarr, HDF5 / netCDF-4, TDMS, CSV) to a file or store that
+appears under its name only when complete (:func:`ecofmaps.io.files.atomic_store`), and
+converting any recording into a chunked store once, with bounded memory (``docs/formats.md``).
 """
 
 from __future__ import annotations
