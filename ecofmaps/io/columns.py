@@ -249,23 +249,11 @@ def matching_columns(names, wanted: str, role: str | None = None) -> list[int]:
 
 def _missing_message(names, wanted: str, role: str) -> str:
     """The error for a column not found: the columns there are, and the nearest name."""
-    listed = listed_names(names)
     usual = role in SYNONYMS and _normal(wanted) == role
     sought = [_plain(split_unit(wanted)[0])]
     if usual:
-        shown = ", ".join(SYNONYMS[role][1:7])
         sought += [key for key in _SYNONYM_KEYS[role] if len(key) >= 4]
-    bases = [_plain(split_unit(name)[0]) for name in names]
-    ratios = [
-        max(difflib.SequenceMatcher(None, key, base).ratio() for key in sought) if base else 0.0
-        for base in bases
-    ]
-    message = f"no {role} column {wanted!r}"
-    if usual:
-        message += f" nor one of its usual names ({shown}, ...)"
-    message += f" (columns: {listed})."
-    unknown = _unknown_unit(names, sought, role)
-    if unknown is not None:
+    if (unknown := _unknown_unit(names, sought, role)) is not None:
         known = ", ".join(unit for unit, (kind, _) in COMMON_UNITS.items() if kind == KINDS[role])
         return (
             f"the {role} column {unknown[0]!r} is in {unknown[1]!r}, which is not a known unit "
@@ -273,6 +261,15 @@ def _missing_message(names, wanted: str, role: str) -> str:
             f"or name the column with {_CHOOSE[role]} and give its unit with {role}_unit "
             f"(--{role}-unit)"
         )
+    message = f"no {role} column {wanted!r}"
+    if usual:
+        message += f" nor one of its usual names ({', '.join(SYNONYMS[role][1:7])}, ...)"
+    message += f" (columns: {listed_names(names)})."
+    bases = [_plain(split_unit(name)[0]) for name in names]
+    ratios = [
+        max(difflib.SequenceMatcher(None, key, base).ratio() for key in sought) if base else 0.0
+        for base in bases
+    ]
     if ratios and max(ratios) >= _NEAR:
         message += f" Did you mean {names[ratios.index(max(ratios))]!r}?"
     return f"{message} Name the column with {_CHOOSE.get(role, role)}"

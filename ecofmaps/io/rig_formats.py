@@ -158,20 +158,16 @@ def _xarray_zarr_groups(path: Path, root, key: str | None = None) -> dict | None
         raise RecordingError(path, None, f"cannot open as a zarr store: {error}") from None
 
 
-def _zarr_groups(path: Path) -> dict[str, xr.Dataset]:
+def _zarr_groups(path: Path, key: str | None = None) -> dict[str, xr.Dataset]:
+    """The groups of a store (all, or the one at ``key``), by path (``'/'``, ``'/rig/run1'``)."""
     root = _zarr_root(path)
-    groups = _xarray_zarr_groups(path, root) if hasattr(root, "members") else None
+    groups = _xarray_zarr_groups(path, root, key) if hasattr(root, "members") else None
     return _plain_zarr_groups(path, root) if groups is None else groups
 
 
 def _zarr_group(path: Path, group: str | None) -> xr.Dataset:
     key = "/" + (group or "").strip("/")
-    root = _zarr_root(path)
-    if not hasattr(root, "members"):  # a store that is one array
-        return _plain_zarr_groups(path, root)["/"]
-    if (opened := _xarray_zarr_groups(path, root, key)) is not None:
-        return opened[key]
-    groups = _plain_zarr_groups(path, root)
+    groups = _zarr_groups(path, key)
     if key not in groups:
         raise RecordingError(path, None, f"no group {group!r}")
     return groups[key]
