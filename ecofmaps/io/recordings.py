@@ -334,8 +334,7 @@ group, nan_policy, lazy, chunks, block_bytes, load_column, skip_rows
     Returns
     -------
     dataset : xarray.Dataset
-        As :meth:`Recording.to_dataset` gives it: ``displacement`` [m], ``force`` [N] and,
-        if read, ``cycle`` [1] and ``load`` [N].
+        As :meth:`Recording.to_dataset` gives it.
 
     Raises
     ------
