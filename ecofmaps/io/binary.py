@@ -148,19 +148,18 @@ def _select(path: Path, kind: str, found: list[Variable], options: dict) -> dict
     if not found:
         raise RecordingError(path, None, f"no one-dimensional numeric {noun} in the file")
     wanted = {"displacement": options["displacement_column"], "force": options["force_column"]}
-    required = {"displacement": True, "force": True}
     if options["cycle_column"] is not False:
         wanted["cycle"] = options["cycle_column"] or "cycle"
-        required["cycle"] = options["cycle_column"] is not None
     chosen = {}
     for role, name in wanted.items():
+        required = role != "cycle" or options["cycle_column"] is not None
         full = [k for k, v in enumerate(found) if v.name.strip("/").lower() == name.lower()]
         matches = full or matching_columns([v.short for v in found], name)
-        if role != "displacement" and len(matches) != 1 and "displacement" in chosen:
+        if role != "displacement" and len(matches) != 1:
             # The force and cycle channels are sought in the displacement's group first.
             group = chosen["displacement"].group
             beside = [k for k in matches if found[k].group == group]
-            matches = beside if len(beside) == 1 or not required[role] else matches
+            matches = beside if len(beside) == 1 or not required else matches
         if len(matches) > 1:
             names = listed_names([found[k].name for k in matches])
             raise RecordingError(
@@ -170,7 +169,7 @@ def _select(path: Path, kind: str, found: list[Variable], options: dict) -> dict
                 "name or with group",
             )
         if not matches:
-            if not required[role]:
+            if not required:
                 continue
             names = listed_names([v.name for v in found])
             raise RecordingError(path, None, f"no {role} {noun} {name!r} ({noun}s: {names})")

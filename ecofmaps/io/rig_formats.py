@@ -28,12 +28,9 @@ NOUNS = {"tdms": "channel", "hdf5": "variable", "zarr": "variable"}
 UNIT_ATTRIBUTES = ("units", "unit", "Units", "Unit", "unit_string", "NI_UnitDescription")
 
 #: xarray's decoding: CF packing and fill values decoded, numbers left as numbers.
-_DECODING = {
-    "mask_and_scale": True,
-    "decode_times": False,
-    "decode_timedelta": False,
-    "decode_coords": False,
-}
+_DECODING = dict(
+    mask_and_scale=True, decode_times=False, decode_timedelta=False, decode_coords=False
+)
 
 #: xarray's options for HDF5: no copy of a whole variable kept in memory once read, and no
 #: lock of xarray's (one for all HDF5 files of the process: h5py already serialises its

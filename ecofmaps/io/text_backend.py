@@ -14,9 +14,6 @@ from ecofmaps.io.tdms import engine_path, has_suffix
 
 __all__ = ["TextBackendEntrypoint"]
 
-#: Suffixes xarray may open with this engine when none is named.
-SUFFIXES = (".csv", ".tsv")
-
 
 class TextBackendEntrypoint(BackendEntrypoint):
     """xarray's engine ``ecofmaps-text``: a text recording (CSV, TSV, whitespace columns
@@ -86,4 +83,4 @@ class TextBackendEntrypoint(BackendEntrypoint):
 
     def guess_can_open(self, filename_or_obj) -> bool:
         """A path ending in ``.csv`` or ``.tsv``."""
-        return has_suffix(filename_or_obj, SUFFIXES)
+        return has_suffix(filename_or_obj, (".csv", ".tsv"))
