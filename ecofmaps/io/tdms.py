@@ -111,11 +111,8 @@ class TdmsReader:
         self._handle = None if handle is None else (handle, os.getpid())
         self._lock = threading.Lock()
 
-    def __getstate__(self):
-        return {"path": self.path}
-
-    def __setstate__(self, state):
-        self.__init__(state["path"])
+    def __reduce__(self):
+        return TdmsReader, (self.path,)  # without the open file
 
     def samples(self, group: str, channel: str, start: int, count: int) -> np.ndarray:
         """``count`` samples of a channel from sample ``start`` (scaled by npTDMS)."""
