@@ -138,25 +138,11 @@ class LineIndex:
     offsets: np.ndarray
 
     @classmethod
-    def build(cls, blocks, first: int = 0) -> LineIndex:
-        """From the line numbers of consecutive blocks of samples, the first being sample
-        ``first`` of the file."""
-        starts, offsets, sample, last = [], [], first, None
-        for lines in blocks:
-            if lines.size == 0:
-                continue
-            offset = lines - np.arange(sample, sample + lines.size)
-            runs = np.concatenate([[0], np.flatnonzero(np.diff(offset)) + 1])
-            if last == offset[0]:
-                runs = runs[1:]
-            starts.append(runs + sample)
-            offsets.append(offset[runs])
-            sample += lines.size
-            last = offset[-1]
-        return cls(
-            np.concatenate(starts or [np.zeros(0, np.int64)]).astype(np.int64),
-            np.concatenate(offsets or [np.zeros(0, np.int64)]).astype(np.int64),
-        )
+    def build(cls, lines: np.ndarray, first: int = 0) -> LineIndex:
+        """From the line numbers of consecutive samples, the first being sample ``first``."""
+        offset = lines - np.arange(first, first + lines.size)
+        runs = np.concatenate([[0], np.flatnonzero(np.diff(offset)) + 1])
+        return cls(runs + first, offset[runs])
 
     def __call__(self, index):
         index = np.asarray(index, dtype=np.int64)

@@ -163,7 +163,7 @@ def _text_recordings(path: Path, options: dict, block_bytes, samples=None) -> It
                 columns=columns,
                 units=units,
                 start=first,
-                lines=LineIndex.build([lines[:count]], first),
+                lines=LineIndex.build(lines[:count], first),
                 format="text",
                 assumed_units=layout.assumed,
             )
