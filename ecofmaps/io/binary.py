@@ -27,10 +27,8 @@ DEFAULT_CHUNK = 1 << 22
 class Column:
     """One channel or variable as an array-like of float64 in SI, read range by range."""
 
-    def __init__(
-        self, path: Path, kind: str, variable: Variable, factor: float, nan_policy, stamp=()
-    ):
-        self.arguments = (path, kind, variable, factor, nan_policy, tuple(stamp))
+    def __init__(self, path: Path, kind: str, variable: Variable, factor: float, nan_policy, stamp):
+        self.arguments = (path, kind, variable, factor, nan_policy, stamp)
         self.path, self.kind, self.variable, self.factor, self.nan_policy, _ = self.arguments
         self.shape = (variable.size,)
         self.dtype = np.dtype(np.float64)
