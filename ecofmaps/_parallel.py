@@ -2,8 +2,8 @@
 
 :class:`Runner` runs independent tasks (each reading its own stretch of a recording) with a
 bounded number in flight, on threads, a local cluster or an existing one, and gives the
-results back in order as soon as each is ready; Ctrl-C stops it at the next block. How,
-and why, is explained in ``docs/parallel.md``.
+results back in order as soon as each is ready; Ctrl-C stops it at the next block
+(``docs/parallel.md``).
 """
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ import asyncio
 import collections
 import concurrent.futures
 import contextlib
+import itertools
 import logging
 import os
 import signal
@@ -30,7 +31,6 @@ __all__ = [
     "SchedulerError",
     "Slice",
     "check_workers",
-    "probe_scheduler",
     "start_resource_tracker_quietly",
     "stretch",
     "worker_limit",
@@ -72,28 +72,23 @@ class Slice:
 def stretch(array, start: int, stop: int):
     """``array[start:stop]`` for a task to read where it runs."""
     source = getattr(array, SOURCE, None)
-    if source is not None:
-        return Slice(source, start, stop)
-    return array[start:stop]
-
-
-def _materialised(arguments):
-    """``arguments`` with every :class:`Slice` read and every dask collection computed, here."""
-    arguments = tuple(a.read() if isinstance(a, Slice) else a for a in arguments)
-    import dask
-
-    if not any(dask.is_dask_collection(value) for value in arguments):
-        return arguments
-    return dask.compute(*arguments, scheduler="sync")
+    return array[start:stop] if source is None else Slice(source, start, stop)
 
 
 def _call(function, arguments):
-    """Run one task: read its dask inputs where it runs, then call ``function``."""
-    return function(*_materialised(arguments))
+    """``function(*arguments)``, each :class:`Slice` read and dask collection computed here,
+    where the task runs."""
+    import dask
+
+    arguments = tuple(a.read() if isinstance(a, Slice) else a for a in arguments)
+    if any(dask.is_dask_collection(value) for value in arguments):
+        arguments = dask.compute(*arguments, scheduler="sync")
+    return function(*arguments)
 
 
 class Runner:
-    """Run tasks on threads or on a dask cluster, a bounded number at a time.
+    """Run tasks on threads or on a dask cluster, a bounded number at a time, in a ``with``
+    block (which closes the cluster or thread pool).
 
     Parameters
     ----------
@@ -108,10 +103,6 @@ class Runner:
         A client of a cluster already connected (left open).
     timeout : float, optional
         Seconds to wait for ``scheduler`` to answer (default :data:`CONNECT_TIMEOUT`).
-
-    Notes
-    -----
-    A context manager: the cluster or thread pool is closed on leaving it.
     """
 
     def __init__(self, workers=None, *, scheduler=None, cluster=False, client=None, timeout=None):
@@ -124,24 +115,15 @@ class Runner:
         self._client = self._cluster = self._pool = None
 
     @property
-    def kind(self) -> str:
-        """``'threads'``, ``'local cluster'`` or ``'cluster at <address>'``."""
-        if not self.local:
-            return f"cluster at {self.scheduler or self._given.scheduler.address}"
-        return "local cluster" if self.cluster else "threads"
-
-    @property
     def local(self) -> bool:
-        """Whether the tasks run on this machine (threads or a local cluster), where they
-        see its files at the same paths."""
+        """Whether the tasks run on this machine, where they see its files at the same paths."""
         return self.scheduler is None and self._given is None
 
     def __enter__(self) -> Runner:
-        if self._given is not None:
+        if not self.local:
             self._client = self._given
-            self.workers = max(len(self._client.scheduler_info()["workers"]), 1)
-        elif self.scheduler is not None:
-            self._client = _connect(self.scheduler, self.timeout or CONNECT_TIMEOUT)
+            if self._client is None:
+                self._client = _connect(self.scheduler, self.timeout or CONNECT_TIMEOUT)
             self.workers = max(len(self._client.scheduler_info()["workers"]), 1)
         elif self.cluster:
             import dask
@@ -200,8 +182,11 @@ class Runner:
             warnings.filterwarnings("ignore", message="Sending large graph", category=UserWarning)
             return self._client.submit(_call, function, arguments, pure=False)
 
-    def map(self, function, tasks, *, in_flight=None):
+    def map(self, function, tasks):
         """``function(*arguments)`` for each ``arguments`` of ``tasks``, results in order.
+
+        Twice as many calls as workers are submitted and not yet handed back at once: the
+        memory held is about that many blocks.
 
         Parameters
         ----------
@@ -210,9 +195,6 @@ class Runner:
         tasks : iterable of tuple
             The arguments of each call; dask collections among them are computed where
             the call runs, just before it.
-        in_flight : int, optional
-            Calls submitted and not yet handed back at once (default twice the workers):
-            the memory held is about that many blocks.
 
         Yields
         ------
@@ -221,18 +203,12 @@ class Runner:
         """
         if self._pool is None and self._client is None:
             raise RuntimeError("a Runner is used within a with block")
-        limit = in_flight or 2 * self.workers
         pending = collections.deque()
         tasks = iter(tasks)
-        exhausted = False
         try:
             while True:
-                while not exhausted and len(pending) < limit:
-                    arguments = next(tasks, None)
-                    if arguments is None:
-                        exhausted = True
-                    else:
-                        pending.append(self._submit(function, arguments))
+                more = itertools.islice(tasks, 2 * self.workers - len(pending))
+                pending.extend(self._submit(function, arguments) for arguments in more)
                 if not pending:
                     return
                 future = pending.popleft()
@@ -296,42 +272,6 @@ def _sigint_held():
         signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
-async def _identity(address: str, timeout: float) -> dict:
-    """What the dask scheduler at ``address`` says it is (its ``identity``)."""
-    from distributed.comm import connect
-
-    comm = await connect(address, timeout=timeout)
-    try:
-        await comm.write({"op": "identity", "reply": True})
-        return await comm.read()
-    finally:
-        comm.abort()
-
-
-def probe_scheduler(address: str, timeout: float) -> None:
-    """Raise :class:`SchedulerError` unless a dask scheduler answers at ``address`` within
-    ``timeout`` seconds."""
-
-    def ask():
-        return asyncio.run(asyncio.wait_for(_identity(address, timeout), timeout))
-
-    with concurrent.futures.ThreadPoolExecutor(1) as pool:
-        try:
-            answer = pool.submit(ask).result()
-        except Exception as error:  # whatever went wrong, no scheduler answered
-            reason = str(error) or f"no answer after {timeout:g} s"
-            answer = (
-                reason if isinstance(error, ValueError) else f"{type(error).__name__}: {reason}"
-            )
-    if not isinstance(answer, dict) or answer.get("type") != "Scheduler":
-        if isinstance(answer, dict):
-            answer = f"it answers as a {answer.get('type', 'something else')}"
-        raise SchedulerError(
-            f"no dask scheduler at {address}: {answer}; is it running, and is the address "
-            "right (tcp://host:8786, not the dashboard's http:// address)?"
-        )
-
-
 def start_resource_tracker_quietly() -> None:
     """Start multiprocessing's resource tracker with its standard error on the null device."""
     saved, null = os.dup(2), os.open(os.devnull, os.O_WRONLY)
@@ -345,10 +285,34 @@ def start_resource_tracker_quietly() -> None:
 
 
 def _connect(address: str, timeout: float):
-    """A client of the dask scheduler at ``address``, or :class:`SchedulerError`."""
+    """A client of the dask scheduler at ``address``, once it answers as one within
+    ``timeout`` seconds, or :class:`SchedulerError`."""
     from distributed import Client
+    from distributed.comm import connect
 
-    probe_scheduler(address, timeout)
+    async def identity() -> dict:
+        comm = await connect(address, timeout=timeout)
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:
+        try:
+            answer = pool.submit(asyncio.run, asyncio.wait_for(identity(), timeout)).result()
+        except Exception as error:  # whatever went wrong, no scheduler answered
+            reason = str(error) or f"no answer after {timeout:g} s"
+            answer = (
+                reason if isinstance(error, ValueError) else f"{type(error).__name__}: {reason}"
+            )
+    if not isinstance(answer, dict) or answer.get("type") != "Scheduler":
+        if isinstance(answer, dict):
+            answer = f"it answers as a {answer.get('type', 'something else')}"
+        raise SchedulerError(
+            f"no dask scheduler at {address}: {answer}; is it running, and is the address "
+            "right (tcp://host:8786, not the dashboard's http:// address)?"
+        )
     try:
         return Client(address, timeout=timeout, set_as_default=False)
     except (OSError, TimeoutError, ValueError) as error:

@@ -69,7 +69,7 @@ sys.exit(status)
 
 _CEILING_SCRIPT = """
 import functools, multiprocessing, sys, time
-from ecofmaps._parallel import Runner, _materialised
+from ecofmaps._parallel import Runner, _call
 from ecofmaps.io import read_recording
 from ecofmaps.io.tables import results_csv
 from ecofmaps.measured.pipeline import Analysis, LoopOptions, Reading, measure_chunk
@@ -77,7 +77,7 @@ from ecofmaps.measured.pipeline import Analysis, LoopOptions, Reading, measure_c
 def measure(tasks):
     start = time.perf_counter()
     for index in tasks:
-        measure_chunk(*_materialised(ANALYSIS._task(index, LINES, False)))
+        _call(measure_chunk, ANALYSIS._task(index, LINES, False))
     return time.perf_counter() - start
 
 if __name__ == "__main__":
