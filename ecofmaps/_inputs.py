@@ -42,11 +42,8 @@ def to_si(name: str, value, quantity: str | None = None):
     """``value`` in SI units: a pint Quantity converted, plain numbers and arrays as they are."""
     if not is_concrete(value):  # a tracer, or a tuple (an interval) holding one
         return value
-    if quantity in DIMENSIONS:
-        kind = quantity
-    else:
-        described = QUANTITIES.get(quantity or name)
-        kind = "dimensionless" if described is None else described.kind
+    described = QUANTITIES.get(quantity or name)
+    kind = quantity if quantity in DIMENSIONS else getattr(described, "kind", "dimensionless")
     _, si_unit, example = DIMENSIONS[kind]
     if _is_quantity(value):
         try:
@@ -57,56 +54,25 @@ def to_si(name: str, value, quantity: str | None = None):
                 f"{value!r} of dimension {value.dimensionality}"
             ) from None
     try:
-        kind_of = "U" if isinstance(value, str) else np.asarray(value).dtype.kind
+        array = np.asarray(value)
     except ValueError:  # a ragged sequence: left to the function's own checks
         return value
-    if (
-        value is None
-        or isinstance(value, bool)
-        or (kind_of in "bUSO" and not _numeric_objects(value))
+    if array.dtype.kind == "O" and all(
+        isinstance(item, int | float | np.integer | np.floating) and not isinstance(item, bool)
+        for item in array.ravel()
     ):
-        raise ValueError(
-            f"{name} must be a real number or array of them [{si_unit}] (or a pint "
-            f"Quantity), got {value!r}"
-        )
-    if kind_of == "O":  # Python integers, which may be beyond float64
-        try:
-            np.asarray(value, dtype=np.float64)
+        try:  # Python integers, which may be beyond float64
+            array.astype(np.float64)
         except OverflowError:
             raise ValueError(
                 f"{name} holds an integer beyond float64's largest number, 1.8e308 [{si_unit}]"
             ) from None
+    elif array.dtype.kind in "bUSO":  # booleans, text, None
+        raise ValueError(
+            f"{name} must be a real number or array of them [{si_unit}] (or a pint "
+            f"Quantity), got {value!r}"
+        )
     return value
-
-
-def _numeric_objects(value) -> bool:
-    """True for an object array (or list) that holds only real numbers."""
-    array = np.asarray(value)
-    return array.dtype.kind == "O" and all(
-        isinstance(item, (int, float, np.integer, np.floating)) and not isinstance(item, bool)
-        for item in array.ravel()
-    )
-
-
-def _converted(function, parameters: inspect.Signature, args, kwargs, kinds):
-    """``args`` and ``kwargs`` with every pint Quantity in SI by parameter name, their
-    broadcast checked (:func:`check_broadcast_size`), and their (name, shape) pairs."""
-    bound = parameters.bind_partial(*args, **kwargs)
-    for name, value in bound.arguments.items():
-        quantity = kinds.get(name, name)
-        if isinstance(value, tuple) and any(_is_quantity(item) for item in value):
-            bound.arguments[name] = tuple(to_si(name, item, quantity) for item in value)
-        elif _is_quantity(value) or ((name in QUANTITIES or name in kinds) and value is not None):
-            bound.arguments[name] = to_si(name, value, quantity)
-    shapes = []
-    for name, value in bound.arguments.items():
-        if name not in QUANTITIES or name in kinds:
-            continue
-        for item in value if isinstance(value, tuple) else (value,):
-            with contextlib.suppress(TypeError, ValueError):  # ragged: checked elsewhere
-                shapes.append((name, tuple(np.shape(item))))
-    check_broadcast_size(function.__name__, [shape for _, shape in shapes])
-    return bound.args, bound.kwargs, shapes
 
 
 @contextlib.contextmanager
@@ -134,16 +100,29 @@ def _clashes(shapes: list):
 
 
 def si_units(function=None, **kinds):
-    """Accept pint Quantities for ``function``'s parameters, converted to SI by name."""
+    """Accept pint Quantities for ``function``'s parameters, converted to SI by name (or by
+    the quantity ``kinds`` names), and refuse a broadcast of them too large for memory."""
     if function is None:
         return functools.partial(si_units, **kinds)
     parameters = inspect.signature(function)
 
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
-        args, kwargs, shapes = _converted(function, parameters, args, kwargs, kinds)
+        bound = parameters.bind_partial(*args, **kwargs)
+        shapes = []  # (name, shape) of each quantity of QUANTITIES
+        for name, value in bound.arguments.items():
+            quantity = kinds.get(name, name)
+            if isinstance(value, tuple) and any(_is_quantity(item) for item in value):
+                value = bound.arguments[name] = tuple(to_si(name, i, quantity) for i in value)
+            elif value is not None and (_is_quantity(value) or name in QUANTITIES or name in kinds):
+                value = bound.arguments[name] = to_si(name, value, quantity)
+            if name in QUANTITIES and name not in kinds:
+                for item in value if isinstance(value, tuple) else (value,):
+                    with contextlib.suppress(TypeError, ValueError):  # ragged: checked elsewhere
+                        shapes.append((name, tuple(np.shape(item))))
+        check_broadcast_size(function.__name__, [shape for _, shape in shapes])
         with _shapes_named(function.__name__, shapes):
-            return function(*args, **kwargs)
+            return function(*bound.args, **bound.kwargs)
 
     return wrapper
 
@@ -188,23 +167,20 @@ def float64(function):
     """A public JAX entry point: pint Quantities in SI (:func:`si_units`), then float64."""
     import jax
 
-    parameters = inspect.signature(function)
-
+    @si_units
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
-        args, kwargs, shapes = _converted(function, parameters, args, kwargs, {})
-        if not jax.config.jax_enable_x64 and not is_concrete(*args, *kwargs.values()):
+        concrete = is_concrete(*args, *kwargs.values())
+        if not concrete and not jax.config.jax_enable_x64:
             raise ValueError(
                 f"ecofmaps.{function.__name__} under jax.jit, jax.vmap or jax.grad needs JAX's "
                 "64-bit mode (the model needs float64): call "
                 "jax.config.update('jax_enable_x64', True) at start-up, or trace inside "
                 "'with jax.enable_x64(True):'"
             )
-        with jax.enable_x64(True), _shapes_named(function.__name__, shapes):
+        with jax.enable_x64(True):
             result = function(*args, **kwargs)
-            if is_concrete(*args, *kwargs.values()):
-                return jax.tree_util.tree_map(_to_numpy, result)
-            return result
+            return jax.tree_util.tree_map(_to_numpy, result) if concrete else result
 
     return wrapper
 

@@ -288,9 +288,10 @@ def _connect(address: str, timeout: float):
     """A client of the dask scheduler at ``address``, once it answers as one within
     ``timeout`` seconds, or :class:`SchedulerError`."""
     from distributed import Client
-    from distributed.comm import connect
 
     async def identity() -> dict:
+        from distributed.comm import connect
+
         comm = await connect(address, timeout=timeout)
         try:
             await comm.write({"op": "identity", "reply": True})
