@@ -50,15 +50,13 @@ def warn(message: str, category: type[Warning]) -> None:
 
 def warn_nan(values, codes, kind: type[Code], quantity: str) -> None:
     """Warn when a concrete result holds NaN for a reason its code gives, naming the reason."""
-    values = np.asarray(values)
-    codes = np.asarray(codes)
-    nan = np.isnan(values)
+    nan = np.isnan(np.asarray(values))
     if not nan.any():
         return
+    codes = np.asarray(codes)
     for code in kind:
         count = int(np.count_nonzero(nan & (codes == code)))
         if count and code.reason:
             warn(
-                f"{quantity} is NaN at {count} of {values.size} point(s): {code.reason}",
-                RegimeWarning,
+                f"{quantity} is NaN at {count} of {nan.size} point(s): {code.reason}", RegimeWarning
             )

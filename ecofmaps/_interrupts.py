@@ -70,11 +70,9 @@ def check_interrupted() -> None:
 
 
 def interrupted_waiting(function):
-    """``function()`` run in a thread of its own while this one waits, acting on a stop signal
-    of :func:`interrupts_stop_writes` within 0.1 s: Python runs a signal's handler only once
-    a call into a C library returns, which for XLA compiling takes seconds. On a stop the
-    thread is left running (the command line ends its process at once with ``os._exit``;
-    elsewhere Python waits for it at exit); its exception, if any, is raised here."""
+    """``function()`` run in a thread of its own, its exception raised here, while this one
+    acts on a stop within 0.1 s (a signal's handler waits for a call into C, such as XLA's
+    compiling, to return); on a stop the thread is left running."""
     check_interrupted()
     outcome = []
 
@@ -97,10 +95,8 @@ def interrupted_waiting(function):
 
 @contextlib.contextmanager
 def interrupts_deferred():
-    """Within the block, a stop signal does not stop the work at :func:`check_interrupted`:
-    for what completes an output already in place (the record of the files a command wrote).
-    Leaving :func:`interrupts_stop_writes` still raises ``KeyboardInterrupt`` unless the
-    command's work returned; a second signal still stops at once."""
+    """Within the block, :func:`check_interrupted` lets a first stop signal pass: for what
+    completes an output already in place (the record of the files a command wrote)."""
     INTERRUPTED.deferred += 1
     try:
         yield

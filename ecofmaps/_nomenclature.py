@@ -211,9 +211,8 @@ QUANTITIES: dict[str, Quantity] = {
 def attrs(name: str, comments=None) -> dict:
     """The netCDF attributes ``long_name`` and ``units`` of quantity ``name``, and its
     ``comment`` if ``comments`` (name -> how a module reads it) holds one."""
-    quantity = QUANTITIES[name]
-    comment = {} if comments is None or name not in comments else {"comment": comments[name]}
-    return {"long_name": quantity.long_name, "units": quantity.units} | comment
+    described = {"long_name": QUANTITIES[name].long_name, "units": QUANTITIES[name].units}
+    return described | ({"comment": comments[name]} if name in (comments or {}) else {})
 
 
 def axis_label(name: str) -> str:
@@ -286,7 +285,7 @@ def transition_texts(found) -> list[tuple[str, str]]:
     return texts
 
 
-def within(name: str, value, rule: str | None = None):
-    """Boolean array: where ``value`` lies in the valid range of ``name`` (or of ``rule``)."""
-    test, _ = RANGES[rule or QUANTITIES[name].valid]
+def within(name: str, value):
+    """Boolean array: where ``value`` lies in the valid range of ``name``."""
+    test, _ = RANGES[QUANTITIES[name].valid]
     return test(value)

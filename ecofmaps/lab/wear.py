@@ -58,6 +58,7 @@ def _worn_volume(profile: ScarProfile, length) -> tuple[float, float]:
     residual = np.asarray(profile.height) - profile.reference_height - profile.reference_slope * x
     width = float(profile.half_width)
     inside = np.abs(x) <= width
+    scale = 1.0 if length is None else length
     if length is not None:
         weight, total, volume = np.ones(x.size), 2 * width, float(profile.worn_area)
     else:  # the volume of revolution of each side's depth, the two averaged
@@ -68,12 +69,11 @@ def _worn_volume(profile: ScarProfile, length) -> tuple[float, float]:
         volume = float(np.pi * np.trapezoid(np.abs(at) * depth, at))
     shoulders = residual[np.abs(x) > 2 * width]
     if shoulders.size < 5:
-        return volume * (length or 1.0), np.nan
+        return volume * scale, np.nan
     noise = 1.4826 * np.median(np.abs(shoulders - np.median(shoulders)))
     spacing = float(np.median(np.diff(x)))
     terms = np.sum(weight[inside] ** 2) * spacing**2 + total**2 / shoulders.size
-    se = float(noise * np.sqrt(terms))
-    return (volume, se) if length is None else (volume * length, se * length)
+    return volume * scale, float(noise * np.sqrt(terms)) * scale
 
 
 def _ratio(top, top_se, bottom, bottom_se):
@@ -104,7 +104,7 @@ def _one_test(results, profile, length) -> dict:
     if not np.isfinite(cycles["dissipated_energy"]).any():
         raise ValueError("results: no cycle has a dissipated energy ('dissipated_energy')")
     cycle, load = cycles["cycle"], cycles["load"]
-    energy = cumulated_energy(results)
+    energy = cycle_sum(cycle, cycles["dissipated_energy"])
     volume = _worn_volume(profile, length)
     slip = cycle_sum(cycle, 4 * load * cycles["slip_amplitude"])
     nominal = cycle_sum(cycle, 4 * load * cycles["amplitude"])
