@@ -11,8 +11,6 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Code", "RegimeWarning", "warn", "warn_nan"]
-
 # Warnings point at the first line outside the package: the caller's call.
 _PACKAGE = str(Path(__file__).resolve().parent)
 

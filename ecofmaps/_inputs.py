@@ -21,17 +21,6 @@ import numpy as np
 from ecofmaps._nomenclature import QUANTITIES, RANGES
 from ecofmaps.units import DIMENSIONS, DOMAIN
 
-__all__ = [
-    "as_float64",
-    "available_memory",
-    "check",
-    "check_broadcast_size",
-    "float64",
-    "is_concrete",
-    "si_units",
-    "to_si",
-]
-
 
 def _is_quantity(value) -> bool:
     """True for a pint Quantity of any registry (without importing pint)."""

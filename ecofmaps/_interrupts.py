@@ -8,18 +8,6 @@ import contextlib
 import signal
 import threading
 
-__all__ = [
-    "INTERRUPTED",
-    "STOP_SIGNALS",
-    "Interrupted",
-    "Stop",
-    "add_stop_note",
-    "check_interrupted",
-    "interrupted_waiting",
-    "interrupts_deferred",
-    "interrupts_stop_writes",
-]
-
 #: The signals :func:`interrupts_stop_writes` turns into a clean stop: Ctrl-C (SIGINT) and
 #: SIGTERM (``kill``, a batch system ending a job).
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)

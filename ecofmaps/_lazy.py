@@ -7,8 +7,6 @@ from __future__ import annotations
 import importlib
 import sys
 
-__all__ = ["lazy_names"]
-
 
 def lazy_names(package: str, public: dict, submodules=()):
     """``__getattr__``, ``__dir__`` and ``__all__`` for the package ``package``."""

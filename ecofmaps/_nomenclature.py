@@ -20,21 +20,6 @@ import math
 
 import numpy as np
 
-__all__ = [
-    "QUANTITIES",
-    "RANGES",
-    "TRANSITION",
-    "Quantity",
-    "attrs",
-    "axis_label",
-    "column",
-    "display",
-    "texts_with_se",
-    "transition_texts",
-    "with_se",
-    "within",
-]
-
 
 @dataclasses.dataclass(frozen=True)
 class Quantity:

@@ -23,19 +23,6 @@ from multiprocessing import resource_tracker
 
 from ecofmaps._interrupts import check_interrupted
 
-__all__ = [
-    "CONNECT_TIMEOUT",
-    "SOURCE",
-    "WORKER_MEMORY",
-    "Runner",
-    "SchedulerError",
-    "Slice",
-    "check_workers",
-    "start_resource_tracker_quietly",
-    "stretch",
-    "worker_limit",
-]
-
 #: Seconds to wait for a dask scheduler given by address to answer.
 CONNECT_TIMEOUT = 5.0
 
