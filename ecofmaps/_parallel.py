@@ -170,24 +170,10 @@ class Runner:
             return self._client.submit(_call, function, arguments, pure=False)
 
     def map(self, function, tasks):
-        """``function(*arguments)`` for each ``arguments`` of ``tasks``, results in order.
-
-        Twice as many calls as workers are submitted and not yet handed back at once: the
-        memory held is about that many blocks.
-
-        Parameters
-        ----------
-        function : callable
-            A module-level function (picklable by name).
-        tasks : iterable of tuple
-            The arguments of each call; dask collections among them are computed where
-            the call runs, just before it.
-
-        Yields
-        ------
-        result
-            Each call's result in the order of ``tasks``, once it and the earlier ones are done.
-        """
+        """``function(*arguments)`` (a module-level function, picklable by name) for each tuple
+        of ``tasks``, its dask collections computed where it runs: the results in order, each
+        once it and the earlier ones are done, with twice as many calls in flight as workers
+        (about as many blocks in memory)."""
         if self._pool is None and self._client is None:
             raise RuntimeError("a Runner is used within a with block")
         pending = collections.deque()
