@@ -14,10 +14,9 @@ def lazy_names(package: str, public: dict, submodules=()):
     namespace = sys.modules[package].__dict__
 
     def __getattr__(name: str):
-        if name in home:
-            value = getattr(importlib.import_module(home[name]), name)
-            namespace[name] = value  # imported once
-            return value
+        if name in home:  # imported once: a name of the package from then on
+            namespace[name] = getattr(importlib.import_module(home[name]), name)
+            return namespace[name]
         if name in submodules:
             return importlib.import_module(f"{package}.{name}")
         raise AttributeError(f"module {package!r} has no attribute {name!r}")

@@ -159,7 +159,6 @@ class Runner:
         if self._cluster is not None:
             self._cluster.close()
         self._client = self._cluster = self._pool = None
-        return False
 
     def _submit(self, function, arguments):
         if self._pool is not None:
