@@ -66,8 +66,7 @@ def to_si(name: str, value, quantity: str | None = None):
 
 @contextlib.contextmanager
 def _shapes_named(caller: str, shapes: list):
-    """A broadcast of the inputs failing inside as a ``ValueError`` naming the first two of
-    ``shapes`` (name, shape) that clash (grids of axes that need not broadcast never fail)."""
+    """A failed broadcast inside as a ``ValueError`` naming the first two ``shapes`` that clash."""
     try:
         yield
     except (TypeError, ValueError) as error:

@@ -63,8 +63,7 @@ def stretch(array, start: int, stop: int):
 
 
 def _call(function, arguments):
-    """``function(*arguments)``, each :class:`Slice` read and dask collection computed here,
-    where the task runs."""
+    """``function(*arguments)`` where the task runs, its Slices read, dask collections computed."""
     import dask
 
     arguments = tuple(a.read() if isinstance(a, Slice) else a for a in arguments)
@@ -74,23 +73,11 @@ def _call(function, arguments):
 
 
 class Runner:
-    """Run tasks on threads or on a dask cluster, a bounded number at a time, in a ``with``
-    block (which closes the cluster or thread pool).
-
-    Parameters
-    ----------
-    workers : int, optional
-        Threads (default ``os.cpu_count()``), or with ``cluster=True`` the worker processes
-        (one thread each) of a new ``LocalCluster``.
-    scheduler : str, optional
-        Address of an existing dask scheduler (``tcp://host:8786``).
-    cluster : bool
-        Start a ``LocalCluster``.
-    client : distributed.Client, optional
-        A client of a cluster already connected (left open).
-    timeout : float, optional
-        Seconds to wait for ``scheduler`` to answer (default :data:`CONNECT_TIMEOUT`).
-    """
+    """Run tasks, a bounded number at a time, in a ``with`` block (which closes what it
+    started): on ``workers`` threads (default one per core); with ``cluster=True`` on the
+    ``workers`` one-thread processes of a new ``LocalCluster``; or on the cluster of the
+    scheduler at the address ``scheduler`` (``tcp://host:8786``; ``timeout`` seconds for it to
+    answer, default :data:`CONNECT_TIMEOUT`) or of the connected ``client`` (left open)."""
 
     def __init__(self, workers=None, *, scheduler=None, cluster=False, client=None, timeout=None):
         if scheduler is not None and cluster:
@@ -257,8 +244,7 @@ def start_resource_tracker_quietly() -> None:
 
 
 def _connect(address: str, timeout: float):
-    """A client of the dask scheduler at ``address``, once it answers as one within
-    ``timeout`` seconds, or :class:`SchedulerError`."""
+    """A client of the dask scheduler at ``address`` once it answers in ``timeout`` seconds."""
     from distributed import Client
 
     async def identity() -> dict:

@@ -231,8 +231,7 @@ def energy_wear(results, profile, length=None, contact="line") -> xr.Dataset:
 
 
 def _reading(results, resolved):
-    """The rows of ``results`` and ``resolved`` of the last cycle with a GICoF, a kept loop
-    and a reading along the stroke."""
+    """The rows of the last cycle with a GICoF, a kept loop and a reading along the stroke."""
     (results,) = tests_of(results)
     if "loop_displacement" not in results or "gicof" not in results:
         raise ValueError(
