@@ -23,7 +23,6 @@ __all__ = [
 ]
 
 #: Fewest samples in one complete cycle: two branches, each with a stick and a slip part.
-#: The one definition for the analysis, the fit and the synthetic recordings.
 MIN_SAMPLES = 8
 
 #: The least local half-band of the reversal detector, as a share of the whole recording's.
@@ -43,7 +42,9 @@ _ONE_LOOP = 1 << 24
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class Cycles:
-    """Complete cycles of a recording: the stretch of samples of each, and its loop's start."""
+    """Complete cycles of a recording: the stretch of samples of each, and its loop's start.
+    ``missing`` (the cycle holds a missing sample) and ``hidden`` (a drive's period in which
+    no reversal was found) are one flag per cycle, all False unless given."""
 
     start: np.ndarray
     count: np.ndarray
@@ -55,26 +56,22 @@ class Cycles:
     missing: np.ndarray | None = None
     missing_samples: int = 0
     first_missing: int = -1
-    #: True for a drive's period in which no reversal was found (empty: none).
-    hidden: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0, dtype=bool))
+    hidden: np.ndarray | None = None
+
+    def __post_init__(self):
+        for name in ("missing", "hidden"):
+            if getattr(self, name) is None:
+                object.__setattr__(self, name, np.zeros(self.start.size, dtype=bool))
 
     @property
     def whole(self) -> np.ndarray:
         """True for the cycles without a missing sample, found at their reversals."""
-        whole = np.ones(self.start.size, dtype=bool) if self.missing is None else ~self.missing
-        return whole & ~self.hidden if self.hidden.size else whole
+        return ~(self.missing | self.hidden)
 
     def rows(self, rows: slice) -> Cycles:
         """The cycles ``rows`` (a slice of consecutive rows) as a table of their own."""
-        return dataclasses.replace(
-            self,
-            start=self.start[rows],
-            count=self.count[rows],
-            rotation=self.rotation[rows],
-            label=self.label[rows],
-            missing=None if self.missing is None else self.missing[rows],
-            hidden=self.hidden[rows] if self.hidden.size else self.hidden,
-        )
+        per_cycle = ("start", "count", "rotation", "label", "missing", "hidden")
+        return dataclasses.replace(self, **{name: getattr(self, name)[rows] for name in per_cycle})
 
     def indices(self, rows=slice(None)):
         """Sample indices round the loops ``rows``, one padded row per loop."""
@@ -129,14 +126,8 @@ def _parts_after_gaps(samples, gaps, line, band, runs):
     new_group = ~before | (decided & _decided_earlier_in_run(decided, run_of))
     first_part = np.flatnonzero(new_group)
     piece_group = (np.cumsum(new_group) - 1)[part]
-    high = np.fmax.reduceat(np.fmax.reduceat(highest, first_piece), first_part)
-    low = np.fmin.reduceat(np.fmin.reduceat(lowest, first_piece), first_part)
-    rising = own[first_part] > 0
-    group_value = np.where(rising, high, low)
-    group_extreme = np.where(
-        rising,
-        passes.first_of_runs(piece_group, highest, top, high),
-        passes.first_of_runs(piece_group, lowest, bottom, low),
+    group_extreme, group_value = _run_extremes(
+        piece_group, first_piece[first_part], own[first_part] > 0, (highest, top, lowest, bottom)
     )
     kept = ~affected
     kept[np.flatnonzero(affected)[first_part]] = True
@@ -144,6 +135,18 @@ def _parts_after_gaps(samples, gaps, line, band, runs):
     where = np.isin(np.flatnonzero(kept), np.flatnonzero(affected))
     extremes[where], values[where] = group_extreme, group_value
     return run, part_start[kept], extremes.astype(np.int64), values
+
+
+def _run_extremes(run, first, rising, pieces):
+    """Each run's extreme (its pieces' highest if ``rising``, else lowest): sample and value."""
+    highest, top, lowest, bottom = pieces
+    high, low = np.fmax.reduceat(highest, first), np.fmin.reduceat(lowest, first)
+    extreme = np.where(
+        rising,
+        passes.first_of_runs(run, highest, top, high),
+        passes.first_of_runs(run, lowest, bottom, low),
+    )
+    return extreme.astype(np.int64), np.where(rising, high, low)
 
 
 def _decided_earlier_in_run(decided, run_of):
@@ -170,8 +173,7 @@ def _period(starts, kind) -> float:
 
 
 def _hidden_by_gaps(parts, samples, gaps, margin):
-    """Which extremes of the runs' parts lie within ``margin`` of a sample beside a long gap
-    in their part (the displacement may have gone on beyond them in the gap)."""
+    """Which extremes of the runs' parts lie within ``margin`` of a sample beside a long gap."""
     begin, extreme, value = parts
     gaps, long = gaps
     if not long.size:
@@ -220,9 +222,8 @@ def _accepted_reversals(parts, hidden, edges, scale):
 
 
 def _deep_ends(value, accepted):
-    """False for a sweep's first or last run (cut short by the recording's end) whose extreme
-    lies less than ¾ as far from the next reversal as the one after it: a narrow band at a
-    small lead-in or lead-out is crossed by noise near the centre."""
+    """False for a sweep's first or last run whose extreme lies under ¾ as far from the next
+    reversal as the one after it (noise crossing a narrow band at a lead-in or lead-out)."""
     deep = np.ones(value.size, dtype=bool)
     reversals = np.flatnonzero(accepted)
     for first, next_, after in ((0, 1, 2), (-1, -2, -3)):
@@ -234,10 +235,8 @@ def _deep_ends(value, accepted):
 
 
 def _steps(kind, extreme, value) -> bool:
-    """Whether the drive's amplitude steps: reversals (of ``kind``, at samples ``extreme``
-    and ``value``) periodic, and a stroke between alternate ones differing from the last
-    in its direction (a drift cancels) by more than :data:`_STEP` of the larger, the next
-    within it of its own (held)."""
+    """Whether the drive's amplitude steps: periodic reversals whose stroke changes by more
+    than :data:`_STEP` from the last in its direction, and is then held."""
     bottoms = extreme[kind < 0]
     if bottoms.size < 3:
         return False
@@ -263,9 +262,8 @@ def _with_missing(cycles: Cycles, gaps) -> Cycles:
 
 
 def _drive_numbers(cycles: Cycles, merged: bool = False) -> Cycles:
-    """``cycles`` numbered as the drive made them: a gapped stretch counts its periods; if
-    ``merged`` (cycles under the local band's floor may join one), so does the stretch
-    between consecutive bottom reversals."""
+    """``cycles`` numbered as the drive made them: a gapped stretch (or, if ``merged``, each
+    stretch between bottom reversals) counts its periods."""
     whole = cycles.whole
     if not whole.any() or (whole.all() and not merged):
         return cycles
@@ -298,15 +296,8 @@ def _trigger(samples: Samples, gaps, line, band):
     piece_start, highest, top, lowest, bottom = np.concatenate([f[2] for f in found], axis=1)
     run = np.searchsorted(starts, piece_start.astype(np.int64), side="right") - 1
     first_piece = np.searchsorted(run, np.arange(starts.size))
-    highest_of_run = np.fmax.reduceat(highest, first_piece)
-    lowest_of_run = np.fmin.reduceat(lowest, first_piece)
-    extreme = np.where(
-        kind > 0,
-        passes.first_of_runs(run, highest, top, highest_of_run),
-        passes.first_of_runs(run, lowest, bottom, lowest_of_run),
-    ).astype(np.int64)
-    value = np.where(kind > 0, highest_of_run, lowest_of_run)
-    return starts, kind, extreme, value
+    pieces = (highest, top, lowest, bottom)
+    return starts, kind, *_run_extremes(run, first_piece, kind > 0, pieces)
 
 
 def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
@@ -348,10 +339,8 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
 
 
 def _local_centre(highest, lowest):
-    """Per stretch, the middle of the narrower of the two periods (it and the stretch
-    before, or after) that hold it, where that spans at most 2.5 times the least of the
-    three stretches' own (a held amplitude: a drifting or tilted small cycle's own
-    centre), else NaN (``highest`` and ``lowest`` padded by one each side)."""
+    """Per stretch, the middle of the narrower of the two periods holding it where that spans
+    at most 2.5 times the least of the three stretches' own (a held amplitude), else NaN."""
     top = np.maximum(highest[:-1], highest[1:])  # NaN with a stretch cut short
     bottom = np.minimum(lowest[:-1], lowest[1:])
     span, own = top - bottom, highest - lowest
@@ -363,9 +352,8 @@ def _local_centre(highest, lowest):
 
 
 def _drive_cycles(bottoms, tops, n: int, period: float) -> Cycles:
-    """Cycles cut half way between a bottom reversal and the next top (the amplitude
-    varies), a quarter period from them where that is more than three quarters away; the
-    drive's periods between, before and after them without a reversal are hidden rows."""
+    """Cycles cut half way from each bottom reversal to the next top, or a quarter period from
+    them if farther; the drive's periods without a reversal are hidden rows."""
     none = np.zeros(0, dtype=np.int64)
     if not tops.size:
         return Cycles(none, none, none, none, False, 1, n)
@@ -416,7 +404,7 @@ def _drive_cycles(bottoms, tops, n: int, period: float) -> Cycles:
         continuous=False,
         incomplete_cycles=int(leading > 0) + int(trailing > 0) + int(np.count_nonzero(gap)),
         dropped_samples=leading + trailing + int((first[1:] - first[:-1] - count[:-1])[gap].sum()),
-        hidden=is_hidden if is_hidden.any() else np.zeros(0, dtype=bool),
+        hidden=is_hidden,
     )
 
 
@@ -549,8 +537,7 @@ def _labelled(samples: Samples, tolerance: float) -> Cycles:
 
 
 def _check_labels(number, start) -> None:
-    """Raise for a run of samples (from ``start``) whose cycle ``number`` is not whole, or
-    comes again after other numbers."""
+    """Raise for a cycle ``number`` (of a run from ``start``) not whole, or seen before."""
     instead = "--cycle-col none, or cycle=None, cuts the cycles at the reversals instead"
     if (split := np.flatnonzero(number != np.floor(number))).size:
         raise ValueError(

@@ -27,6 +27,7 @@ from ecofmaps.measured.quality import (
 __all__ = [
     "GROSS_SLIP_THRESHOLD",
     "NEIGHBOURS",
+    "SECOND_DIFFERENCE",
     "LoopBlock",
     "Stretch",
     "branch_rows",
@@ -47,9 +48,8 @@ _NOISE_REACH = 4
 #: own neighbours.
 NEIGHBOURS = _NOISE_REACH + 1
 
-#: The median absolute deviation of a normal distribution over its standard deviation,
-#: times the standard deviation of a second difference of white noise over its own.
-_SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
+#: The median of the absolute second difference of white noise over its standard deviation.
+SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
 
 #: Fewest samples of a cycle whose noise is read from its second differences: in fewer,
 #: a loop's corners (or a digitised loop's uneven points) are most of them.
@@ -215,12 +215,11 @@ def loop_blocks(
 
 
 def _drift_se(middle, count, centre, rows: slice):
-    """Standard error of the offset between the branches of the loops ``rows`` left by the
-    force's drift correction (``force_drift_se``). [N]"""
+    """``force_drift_se`` of the loops ``rows``: the branch offset the drift correction leaves."""
     size = centre.size
     first, stop = rows.start, rows.stop
     noise = kernels.second_difference_medians(centre, first, stop, _NOISE_REACH)
-    noise /= _SECOND_DIFFERENCE
+    noise /= SECOND_DIFFERENCE
     if size == 2:  # no second difference: the one first difference, noise and drift
         noise = np.full(stop - first, abs(centre[1] - centre[0]) / np.sqrt(2.0))
     # The weights a_j of the centres in the offset, in the cycle's own period: a quarter
@@ -297,8 +296,7 @@ def _path_means(path, values, offset, count, closed: bool):
 
 
 def _displacement_centres(start, count, displacement, first: int, stop: int):
-    """Middle sample of every cycle, and the displacement centres of those within
-    :data:`NEIGHBOURS` of rows ``first`` to ``stop - 1`` (NaN for the others)."""
+    """Middle sample of every cycle, and the displacement centres within reach of the rows."""
     # The mean sample index round the loop, its closing point included (exact integers).
     middle = ((count * (2 * start + count - 1)) // 2 + start) / (count + 1)
     centre = np.full(start.size, np.nan)
@@ -461,16 +459,17 @@ def _loop_values(block, options):
         "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]) & ~mindlin,
         "partial-slip": ~sliding,
     }
-    flags["noise-amplitude"] = (_noise_lift(block, block.displacement) > amplitude) | (
-        _noise_lift(block, block.force) > max_force
+    lift_x, lift_q = (
+        kernels.noise_lift(block.count, block.offset, signal, _NOISE_SAMPLES) / NOISE_SHARE
+        for signal in (block.displacement, block.force)
     )
+    flags["noise-amplitude"] = (lift_x > amplitude) | (lift_q > max_force)
     return values, flags
 
 
 def _mindlin_sliding(rows, max_force, span, candidates):
-    """The force on each branch's sliding part (rising, falling) [N] and the spring's
-    stiffness [N/m] of the ``candidates``' loops whose stick part follows Mindlin's law behind
-    a spring, else NaN."""
+    """Force on the sliding parts (rising, falling) [N] and spring stiffness [N/m] of the
+    ``candidates`` whose stick follows Mindlin's law behind a spring, else NaN."""
     x, y, length = rows
     cycles = max_force.size
     found = np.full((3, cycles), np.nan)
@@ -507,7 +506,7 @@ def _mindlin_sliding(rows, max_force, span, candidates):
     spread = np.sqrt((off**2).sum(axis=1) / np.maximum(stick.sum(axis=1) - 3, 1))
     second = np.sort(np.where(valid[:, 2:], np.abs(np.diff(u, 2)), np.inf), axis=1)
     middle = np.maximum(valid[:, 2:].sum(axis=1) - 1, 0) // 2  # NaN-free: inf if none
-    noise = np.take_along_axis(second, middle[:, None], axis=1)[:, 0] / _SECOND_DIFFERENCE
+    noise = np.take_along_axis(second, middle[:, None], axis=1)[:, 0] / SECOND_DIFFERENCE
     tolerance = np.maximum(_MINDLIN_SPREAD * noise, _MINDLIN_ROUNDING * np.tile(span[pick], 2))
     significant = line[:, 1] > _MINDLIN_T * spread * np.sqrt(inverse[:, 1, 1])
     follows = (spread <= tolerance) & significant & (count >= _MINDLIN_SLIDING)
@@ -518,15 +517,8 @@ def _mindlin_sliding(rows, max_force, span, candidates):
     return found
 
 
-def _noise_lift(block, values):
-    """:func:`kernels.noise_lift` of ``values`` in each cycle of ``block`` over
-    :data:`NOISE_SHARE` (NaN for fewer than :data:`_NOISE_SAMPLES` samples). [m] or [N]"""
-    return kernels.noise_lift(block.count, block.offset, values, _NOISE_SAMPLES) / NOISE_SHARE
-
-
 def _turns_back(x, band):
-    """True for the cycles whose displacement turns back within a branch row by more than
-    ``band`` (the rows' padding repeats their last point, which changes nothing)."""
+    """True for the cycles whose displacement turns back within a branch row by over ``band``."""
     cycles = band.size
     rising, falling = x[:cycles], x[cycles:]
     drop = np.max(np.maximum.accumulate(rising, axis=1) - rising, axis=1)
@@ -544,10 +536,8 @@ def measure_cycles(cycles: Cycles, displacement, force, options, *, rows=None, k
     names = _PER_CYCLE if options.rig_stiffness is None else _PER_CYCLE + _RIG_RATIOS
     values = {name: np.full(stop - first, np.nan) for name in names}
     flags = {reason: np.zeros(stop - first, dtype=bool) for reason in _MEASURED}
-    if cycles.missing is not None:  # not measured: their values stay NaN
-        flags["missing-samples"] = cycles.missing[first:stop].copy()
-    if cycles.hidden.size:
-        flags["no-reversal"] = cycles.hidden[first:stop].copy()
+    flags["missing-samples"] = cycles.missing[first:stop].copy()  # not measured: NaN
+    flags["no-reversal"] = cycles.hidden[first:stop].copy()
     loops = None
     if keep_loops:
         width = int(cycles.count[first:stop].max()) + 1

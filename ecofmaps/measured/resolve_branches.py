@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ecofmaps.measured.measure import SECOND_DIFFERENCE
+
 __all__ = [
     "branch_noise",
     "masked_median",
@@ -27,8 +29,6 @@ _STICK_MARGIN = 0.05
 _ROUNDING = 1e-9
 #: Slip samples at the end of a branch whose median ξ is compared with the next stick level.
 _END_SAMPLES = 4
-#: The median of |N(0, 6)|, the second difference of white noise of unit variance.
-_SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
 
 
 def masked_sum(values, mask):
@@ -106,7 +106,7 @@ def _stick_and_slip(xi, branches, sticks, floor, slip_threshold):
     triples = np.zeros_like(second, dtype=bool)
     for stick in sticks:
         triples |= stick[:, :-2] & stick[:, 1:-1] & stick[:, 2:]
-    sigma = masked_median(second, triples) / _SECOND_DIFFERENCE
+    sigma = masked_median(second, triples) / SECOND_DIFFERENCE
     sigma = np.where(np.isfinite(sigma), sigma, 0.0)
     threshold = slip_threshold * sigma + floor
     slips, levels = [], []
