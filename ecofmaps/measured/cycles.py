@@ -33,8 +33,7 @@ NOISE_LEVEL = 5.0
 _MEAN_SECOND_DIFFERENCE = np.sqrt(6.0 * 2.0 / np.pi)
 #: A stretch between bottom runs within this share of the period is one regular cycle.
 _REGULAR = 0.1
-#: Strokes between reversals in a row that differ by more than this share of the larger
-#: are a step of the drive's amplitude (its cycles are cut where they meet).
+#: Strokes in a row differing by more than this share of the larger: the amplitude steps.
 _STEP = 0.05
 #: A recording longer than this with fewer than two bottom reversals is not read as one loop.
 _ONE_LOOP = 1 << 24
@@ -301,10 +300,8 @@ def _trigger(samples: Samples, gaps, line, band):
 
 
 def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
-    """The trigger's local centres and half-bands ``((width, centres), (width, levels))``,
-    or None where the whole recording's finds every cycle: ``hysteresis`` × the least
-    amplitude about the local centre over three stretches of half a period (one holds a
-    peak of each cycle)."""
+    """The trigger's local ``((width, centres), (width, half-bands))``, or None where the whole
+    recording's band finds every cycle."""
     starts, kind, period, step = runs
     centre, level = band
     bottoms = starts[kind < 0]

@@ -28,28 +28,21 @@ __all__ = [
 
 #: How numba compiles the kernels: cached on disk, NumPy's division by zero, no GIL held.
 _COMPILE = {"cache": True, "error_model": "numpy", "nogil": True}
-
-#: The lower quartile of the absolute value of a normal distribution over its standard
-#: deviation (the normal's 62.5th percentile), times the standard deviation of a second
-#: difference of white noise over its own.
+#: The lower quartile of the absolute second difference of white noise over its standard
+#: deviation.
 _QUARTILE_SECOND_DIFFERENCE = 0.3186393639643752 * np.sqrt(6.0)
-
 #: A stick segment grows until two samples in a row are this many standard deviations off.
 _STICK_SPREAD = 3.0
-
 #: A stick segment is curved when a term in the squared force, added to its line, is
 #: significant by more than this many standard errors ...
 _CURVATURE_T = 8.0
-
 #: ... and changes its slope from one end to the other by more than this share.
 _CURVATURE_CHANGE = 0.05
-
 #: Fewest samples in the window of the curve fitted at a GICoF crossing.
 _FIT_SAMPLES = 5
-
-#: In a GICoF window where the variance of :math:`\xi Q` not explained by :math:`\xi` is
-#: below this share of its own (rounding: the force is constant along the slip), the line
-#: :math:`Q = a + b\xi` is fitted.
+#: In a GICoF window where the part of :math:`\xi Q` that :math:`\xi` does not explain has
+#: below this share of its variance (a constant sliding force), the line :math:`Q = a + b\xi`
+#: is fitted.
 _COLLINEAR = 1e-24
 
 
@@ -89,8 +82,7 @@ def _first_segment(y, n, low, high, segment):
 
 @numba.njit(**_COMPILE)
 def _line_sums(u, v, end, segment, sums):
-    """Into ``sums``: count, means of ``u`` and ``v``, and the sums of du dv, du du and dv dv
-    over the marked points before column ``end`` (least squares of ``v`` on ``u``)."""
+    """Into ``sums``: count, means of ``u``, ``v``, sums of du dv, du du, dv dv (marked points)."""
     count, sum_u, sum_v = 0.0, 0.0, 0.0
     for j in range(end):
         if segment[j]:
@@ -121,8 +113,7 @@ def _squares_off(x, y, end, segment, intercept, slope):
 
 @numba.njit(**_COMPILE)
 def _grow(x, y, n, segment, end, intercept, slope, tolerance):
-    """Grow a segment until two samples in a row lie off its line by more than ``tolerance``;
-    return the column it now ends before."""
+    """Grow a segment until two samples in a row lie off its line; return its end column."""
     first = 0
     while not segment[first]:
         first += 1
@@ -139,8 +130,7 @@ def _grow(x, y, n, segment, end, intercept, slope, tolerance):
 
 @numba.njit(**_COMPILE)
 def _curved(x, y, end, segment, intercept, compliance, line):
-    """Squared residual of a segment off its line, whether it bends (a significant
-    :math:`bQ^2`), and whether it holds forces of both signs."""
+    """Squared residual of a segment off its line, whether it bends, whether Q changes sign."""
     count, mean_y, force_variance = line[0], line[1], line[4]
     squares, fourth, product, largest = 0.0, 0.0, 0.0, 0.0
     negative, positive = False, False
@@ -292,8 +282,7 @@ def _curve_intercept(scaled, product, window, y, begin, end):
 
 @numba.njit(**_COMPILE)
 def _window_holds(force, y, before, window, begin, end, pair, with_pair, rounding):
-    """Whether the window (and ``pair`` if ``with_pair``) has samples on both sides of the
-    crossing and holds its ``force`` within their range, to ``rounding``."""
+    """Whether the window (and ``pair``) has samples both sides of the crossing, force within."""
     sides, lowest, highest = 0, np.inf, -np.inf
     for j in range(begin, end):
         if window[j]:

@@ -38,36 +38,26 @@ __all__ = [
 
 #: Samples of the cycles laid out at once by :func:`loop_blocks`.
 _BLOCK = 1 << 17
-
-#: Whole cycles on either side of a cycle whose force centres give their noise; its second
-#: differences reach one cycle less.
+#: Whole cycles on either side of a cycle whose force centres give their noise.
 _NOISE_REACH = 4
-
 #: Whole cycles on either side of a cycle whose samples its centring reads: the force
-#: centres of :data:`_NOISE_REACH` cycles, each centred by the displacement centres of its
-#: own neighbours.
+#: centres of :data:`_NOISE_REACH` cycles, each centred by its neighbours' displacement.
 NEIGHBOURS = _NOISE_REACH + 1
-
 #: The median of the absolute second difference of white noise over its standard deviation.
 SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
-
-#: Fewest samples of a cycle whose noise is read from its second differences: in fewer,
-#: a loop's corners (or a digitised loop's uneven points) are most of them.
+#: Fewest samples of a cycle whose noise is read from its second differences (in fewer, a
+#: loop's corners are most of them).
 _NOISE_SAMPLES = 4 * MIN_SAMPLES
-
 #: Energy ratio :math:`A = E_d/(4\Delta^* Q^*)` above which a loop is gross slip (the
 #: sliding transition of Fouvry, Kapsa and Vincent).
 GROSS_SLIP_THRESHOLD = 0.2
-
-#: The ratios reported when the rig's stiffness is given: B, and the contact's amplitude,
-#: A and B on the contact's displacement.
+#: The ratios of :func:`loop_ratios` reported when the rig's stiffness is given.
 _RIG_RATIOS = (
     "opening_ratio",
     "contact_amplitude",
     "contact_energy_ratio",
     "contact_opening_ratio",
 )
-
 #: The per-cycle quantities, in the Dataset's order.
 _PER_CYCLE = (
     "amplitude",
@@ -88,30 +78,23 @@ _PER_CYCLE = (
     "force_drift_se",
     "stick_residual",
 )
-
-#: The reasons of :data:`~ecofmaps.measured.quality.REASONS` that this step flags (not the
-#: scale's, :func:`~ecofmaps.measured.quality.scale_flags`, nor the reading's).
+#: The reasons this step flags (not those of the scale or of the reading along the stroke).
 _MEASURED = tuple(
     r for r in REASONS if r not in ("implausible-amplitude", "implausible-cof", *READING_REASONS)
 )
-
 #: A gross-slip loop whose GICoF lies within this share of Q*/P is crossed by its stick line
 #: where it slides at a constant force: its GICoF is read even if its stick sides are curved.
 _PLATEAU = 0.02
-
 #: A sphere's stick part is fitted with Mindlin's law where the force has risen by less than
 #: this share of the way to its sliding value (the law is steep beyond), ...
 _MINDLIN_STICK = 0.9
-
 #: ... and follows it when the fit leaves no more than this many times the displacement's
 #: noise, or this share of the stroke, and each branch slides over this many samples; its
 #: curved part must be this share of the stick's extent and this many standard errors.
 _MINDLIN_SPREAD, _MINDLIN_ROUNDING, _MINDLIN_SLIDING = 3.0, 1e-3, 3
 _MINDLIN_SHARE, _MINDLIN_T = 0.05, 5.0
-
 #: The samples of a branch of which the first pass of the fit reads about this many.
 _MINDLIN_SIFT = 32
-
 #: Samples with :math:`|Q|` below this share of :math:`Q^*` locate a zero-force crossing
 #: that is not on a stick segment.
 _ZERO_FORCE_BAND = 0.25

@@ -32,7 +32,6 @@ __all__ = [
     "LoopQualityWarning",
     "Tally",
     "add_reason",
-    "apply_quality",
     "cycle_results",
     "gross_slip",
     "has_reason",
@@ -40,9 +39,7 @@ __all__ = [
     "load_flags",
     "quality_strings",
     "quality_summary",
-    "refused",
     "regime_ratio",
-    "summary_of_counts",
 ]
 
 
@@ -359,7 +356,7 @@ def judged(values: dict, flags: dict, options):
     size = next(iter(flags.values())).size
     refused = _refusing(flags, size)
     recorded = {k: values[k] for k in _RECORDED if k in values}  # a refused cycle's too
-    values = apply_quality({k: v for k, v in values.items() if k not in recorded}, flags)
+    values = _apply_quality({k: v for k, v in values.items() if k not in recorded}, flags)
     sliding = gross_slip(values, options)
     regime = np.where(refused, INVALID, np.where(sliding, GROSS_SLIP, PARTIAL_SLIP))
     return values | recorded, quality_strings(flags, size), refused, regime
@@ -415,7 +412,7 @@ class Tally:
     @property
     def summary(self) -> str:
         """The one-line quality summary so far."""
-        return summary_of_counts(self.counts)
+        return _summary_of_counts(self.counts)
 
     def finish(self, results, cycles: Cycles, cycles_from: str, options) -> xr.Dataset:
         """Check the whole recording and give ``results`` (the parts, joined) its attributes."""
@@ -454,9 +451,7 @@ class Tally:
                 "dropped_samples": cycles.dropped_samples,
                 "missing_samples": cycles.missing_samples,
                 "first_missing_sample": cycles.first_missing,
-                "skipped_cycles": sum(
-                    c for text, c in self.counts.items() if "missing-samples" in text.split("+")
-                ),
+                "skipped_cycles": _per_reason(self.counts)["missing-samples"],
                 "gross_slip_threshold": options.gross_slip_threshold,
                 "flip_force": int(options.flip_force),
                 "quality_summary": summary,
@@ -527,15 +522,7 @@ def has_reason(quality, reason: str) -> np.ndarray:
     return _by_text(quality, lambda text: reason in text.split(SEPARATOR))
 
 
-def refused(quality) -> np.ndarray:
-    """True for the cycles refused (a reason whose scope is every quantity)."""
-    return _by_text(
-        quality,
-        lambda text: any(REASONS.get(r, ("", ()))[1] == ALL for r in text.split(SEPARATOR)),
-    )
-
-
-def apply_quality(values: dict, flags: dict) -> dict:
+def _apply_quality(values: dict, flags: dict) -> dict:
     """``values`` (name -> per-cycle array) with NaN where a flag's scope reaches."""
     size = next(iter(values.values())).size
     refusing = _refusing(flags, size)
@@ -552,16 +539,21 @@ def quality_summary(quality) -> str:
     """One line: how many cycles are ``'ok'``, how many were skipped for missing samples,
     and how many carry each other reason."""
     texts, counts = np.unique(np.ravel(quality), return_counts=True)
-    return summary_of_counts(dict(zip(texts.tolist(), counts.tolist(), strict=True)))
+    return _summary_of_counts(dict(zip(texts.tolist(), counts.tolist(), strict=True)))
 
 
-def summary_of_counts(counts) -> str:
-    """:func:`quality_summary` from the number of cycles of each distinct ``quality``."""
-    per_reason = {}
+def _per_reason(counts) -> collections.Counter:
+    """The cycles flagged for each reason, from the number of each distinct ``quality``."""
+    per_reason = collections.Counter()
     for text, count in counts.items():
         if text != "ok":
-            for reason in text.split(SEPARATOR):
-                per_reason[reason] = per_reason.get(reason, 0) + int(count)
+            per_reason.update(dict.fromkeys(text.split(SEPARATOR), int(count)))
+    return per_reason
+
+
+def _summary_of_counts(counts) -> str:
+    """:func:`quality_summary` from the number of cycles of each distinct ``quality``."""
+    per_reason = _per_reason(counts)
     skipped = per_reason.pop("missing-samples", 0)
     order = list(REASONS)
     flagged = ", ".join(
