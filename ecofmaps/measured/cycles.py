@@ -18,8 +18,7 @@ __all__ = [
     "NOISE_LEVEL",
     "Cycles",
     "find_cycles",
-    "labelled_cycles",
-    "split_cycles",
+    "loop_points",
 ]
 
 #: Fewest samples in one complete cycle: two branches, each with a stick and a slip part.
@@ -37,6 +36,9 @@ _REGULAR = 0.1
 _STEP = 0.05
 #: A recording longer than this with fewer than two bottom reversals is not read as one loop.
 _ONE_LOOP = 1 << 24
+#: Share of the stroke within which two displacements are one (a loop's ends, an extreme and
+#: the sample beside a gap).
+_TOLERANCE = 0.01
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -73,16 +75,21 @@ class Cycles:
         return dataclasses.replace(self, **{name: getattr(self, name)[rows] for name in per_cycle})
 
     def indices(self, rows=slice(None)):
-        """Sample indices round the loops ``rows``, one padded row per loop."""
-        start, count, rotation = self.start[rows], self.count[rows], self.rotation[rows]
-        j = np.arange(int(count.max()) + 1)[None, :]
-        if self.continuous:  # no rotation: the stretch, then its first sample again
-            return start[:, None] + np.where(j < count[:, None], j, 0), count + 1
-        count, rotation = count[:, None], rotation[:, None]
-        position = rotation + j
-        position = np.where(position >= count, position - count, position)
-        position = np.where(j < count, position, rotation)
-        return start[:, None] + position, self.count[rows] + 1
+        """Sample indices round the loops ``rows``, one row per loop padded with its last, and
+        the number of points of each."""
+        count = self.count[rows][:, None]
+        point = np.minimum(np.arange(int(count.max()) + 1), count)
+        first, rotation = self.start[rows][:, None], self.rotation[rows][:, None]
+        return loop_points(first, count, rotation, self.continuous, point), count[:, 0] + 1
+
+
+def loop_points(first, count, rotation, continuous: bool, point):
+    """Index of the points ``point`` (0 to ``count``) round loops of ``count`` samples from
+    ``first``, begun ``rotation`` samples in (a continuous one at its first, which closes it)."""
+    if continuous:
+        return first + np.where(point < count, point, 0)
+    position = rotation + point
+    return first + position - count * (position >= count)
 
 
 def _joined(samples: Samples, function, arguments, channels=("displacement",), extra=0):
@@ -405,8 +412,8 @@ def _drive_cycles(bottoms, tops, n: int, period: float) -> Cycles:
     )
 
 
-def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
-    """:func:`split_cycles` of any :class:`Samples`."""
+def _split(samples: Samples, hysteresis: float) -> Cycles:
+    """The cycles of ``samples`` cut at the displacement reversals."""
     n = samples.size
     if n < 2:
         raise ValueError("the displacement does not oscillate: no reversal can be found")
@@ -439,7 +446,7 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     # A gap shorter than half the samples beyond the band in a half period of a triangle
     # wave cannot have hidden a run of the other kind: the trigger goes on over it.
     long_gaps = gaps[gaps[:, 1] - gaps[:, 0] >= 0.25 * (1.0 - hysteresis) * period]
-    gapped, margin = (gaps, long_gaps), tolerance * stroke
+    gapped, margin = (gaps, long_gaps), _TOLERANCE * stroke
     parts = _parts_after_gaps(samples, gapped, line, band, (starts, kind, extreme, value))
     kind_of_part, extreme_of_part = kind[parts[0]], parts[2]
     # Beside a long gap, as at the ends of the recording: an extreme within the tolerance of
@@ -457,7 +464,7 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
             raise ValueError(
                 f"no complete cycle in {n} samples: fewer than two displacement reversals"
             )
-        return _labelled(samples.constant_cycle(), tolerance)
+        return _labelled(samples.constant_cycle())
     # the amplitude varies: cut where the drive's cycles meet
     if level is not None or _steps(kind_of_part[accepted], *(p[accepted] for p in parts[2:])):
         tops = extreme_of_part[(kind_of_part > 0) & accepted]
@@ -479,8 +486,8 @@ def _split(samples: Samples, hysteresis: float, tolerance: float) -> Cycles:
     return _drive_numbers(_with_missing(cycles, gaps))
 
 
-def _labelled(samples: Samples, tolerance: float) -> Cycles:
-    """:func:`labelled_cycles` of any :class:`Samples` with cycle numbers."""
+def _labelled(samples: Samples) -> Cycles:
+    """The cycles of ``samples`` by their cycle numbers."""
     n = samples.size
     _, gaps, _, _, _, labels = passes.survey(samples)
     known = [pair for pair in labels if pair is not None]
@@ -516,7 +523,7 @@ def _labelled(samples: Samples, tolerance: float) -> Cycles:
         gapped
         | (stroke >= 0.5 * typical)
         & (stroke > 0.0)
-        & (gap <= 1.5 * np.where(np.isnan(largest), 0.0, largest) + tolerance * stroke)
+        & (gap <= 1.5 * np.where(np.isnan(largest), 0.0, largest) + _TOLERANCE * stroke)
     )
     start, count = starts[complete], count[complete]
     return _with_missing(
@@ -551,18 +558,6 @@ def _check_labels(number, start) -> None:
         )
 
 
-def split_cycles(displacement, hysteresis: float = 0.5, tolerance: float = 0.01) -> Cycles:
-    """Cut a continuous recording into complete cycles at its displacement reversals."""
-    x = np.asarray(displacement, dtype=np.float64)
-    return _split(Samples(x, None), hysteresis, tolerance)
-
-
-def labelled_cycles(displacement, cycle, tolerance: float = 0.01) -> Cycles:
-    r"""Complete cycles of a recording whose samples carry their cycle number."""
-    x = np.asarray(displacement, dtype=np.float64)
-    return _labelled(Samples(x, None, np.asarray(cycle)), tolerance)
-
-
 def find_cycles(
     displacement, cycle=None, hysteresis: float = 0.5, *, force=None, missing=None, runner=None
 ) -> Cycles:
@@ -576,6 +571,4 @@ def find_cycles(
                 f"{displacement.shape[0]} samples"
             )
     samples = Samples(displacement, force, cycle, missing, runner=runner)
-    if cycle is None:
-        return _split(samples, hysteresis, 0.01)
-    return _labelled(samples, 0.01)
+    return _split(samples, hysteresis) if cycle is None else _labelled(samples)

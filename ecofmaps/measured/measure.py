@@ -14,7 +14,7 @@ import numpy as np
 
 from ecofmaps._interrupts import check_interrupted
 from ecofmaps.measured import kernels
-from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles
+from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles, loop_points
 from ecofmaps.measured.quality import (
     ANTICLOCKWISE_SHARE,
     NOISE_SHARE,
@@ -130,11 +130,8 @@ class LoopBlock:
 
     def samples(self, point, rows=slice(None)):
         """Index into ``displacement`` and ``force`` of points round the loops ``rows``."""
-        offset, count = self.offset[rows][:, None], self.count[rows][:, None]
-        if self.continuous:  # no rotation: the stretch, then its first sample again
-            return offset + np.where(point < count, point, 0)
-        position = self.rotation[rows][:, None] + point
-        return offset + position - count * (position >= count)
+        first, count, turn = (a[rows][:, None] for a in (self.offset, self.count, self.rotation))
+        return loop_points(first, count, turn, self.continuous, point)
 
     def loops(self, width: int):
         """The loops as padded rows (cycle, point) of ``width`` points, NaN past each end."""

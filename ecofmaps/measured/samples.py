@@ -15,10 +15,8 @@ from ecofmaps._parallel import stretch
 from ecofmaps.measured import kernels
 
 __all__ = [
-    "CHANNELS",
     "MissingSampleError",
     "Samples",
-    "blanked",
     "detrended",
     "displacement_line",
     "displacement_percentiles",
@@ -31,7 +29,6 @@ __all__ = [
     "missing_in",
     "no_cycle_error",
     "part_extremes",
-    "piece_extremes",
     "survey",
     "trigger_runs",
     "values_at",
@@ -46,7 +43,7 @@ _QUANTILES = np.array([1.0, 99.0]) / 100.0
 #: Size of the random sample that brackets the percentiles of a long recording.
 _SAMPLE = 1 << 16
 #: The channels of a recording, in the order a block function receives them.
-CHANNELS = ("displacement", "force", "cycle", "missing")
+_CHANNELS = ("displacement", "force", "cycle", "missing")
 
 
 def _chunks(start: int, stop: int, chunk: int):
@@ -54,7 +51,7 @@ def _chunks(start: int, stop: int, chunk: int):
     return ((a, min(a + chunk, stop)) for a in range(start, stop, chunk))
 
 
-def blanked(x, a: int, b: int, gaps) -> np.ndarray:
+def _blanked(x, a: int, b: int, gaps) -> np.ndarray:
     """``x`` (samples ``a`` to ``b - 1``) with NaN at the missing ones (a copy if any)."""
     first, last = np.searchsorted(gaps[:, 1], a, side="right"), np.searchsorted(gaps[:, 0], b)
     if first >= last:
@@ -65,7 +62,7 @@ def blanked(x, a: int, b: int, gaps) -> np.ndarray:
     return x
 
 
-def piece_extremes(x, cuts, a: int):
+def _piece_extremes(x, cuts, a: int):
     """Largest and smallest finite value of each piece ``x[cuts[k]:cuts[k + 1]]`` (``x``
     holds samples ``a`` on), each with the first sample of it, -1 where none is finite."""
     lengths = np.diff(cuts, append=x.size)
@@ -92,8 +89,7 @@ def first_of_runs(run, value, index, target):
 
 
 def _finite_ends(x, cuts):
-    """The first and last finite value of each piece ``x[cuts[k]:cuts[k + 1]]`` (NaN for a
-    piece without one)."""
+    """The first and last finite value of each piece ``x[cuts[k]:cuts[k + 1]]``, or NaN."""
     finite = np.flatnonzero(np.isfinite(x))
     ends = np.append(cuts[1:], x.size)
     if not finite.size:
@@ -105,9 +101,7 @@ def _finite_ends(x, cuts):
 
 
 def _survey(start, stop, arguments, x, q, cycle, mask):
-    """Sums for the straight line through the finite displacements, runs of missing
-    samples, the displacement at the percentile sample's indices, and the first and last
-    finite index and cycle number of the block (see :func:`displacement_line`)."""
+    """The block's part of :func:`survey`: line sums, gaps, sample, finite ends, labels."""
     size, chunk, sample_at = arguments
     middle = 0.5 * (size - 1)
     sums, gaps, finite, labels = [], [], [], []
@@ -157,7 +151,7 @@ def _tails(start, stop, arguments, x):
     chunk, gaps, line, (upper, lower) = arguments
     kept = []
     for a, b in _chunks(start, stop, chunk):
-        d = detrended(blanked(x[a - start : b - start], a, b, gaps), a, line)
+        d = detrended(_blanked(x[a - start : b - start], a, b, gaps), a, line)
         kept.append(d[(d <= upper) | (d >= lower)])
     return np.concatenate(kept)
 
@@ -178,7 +172,7 @@ def local_extremes(start, stop, arguments, x):
     chunk, gaps, line, width, (centre, curvature) = arguments
     found = [np.empty((6, 0))]
     for a, b in _chunks(start, stop, chunk):
-        d = detrended(blanked(x[a - start : b - start], a, b, gaps), a, line)
+        d = detrended(_blanked(x[a - start : b - start], a, b, gaps), a, line)
         first = np.arange(a // width, (b - 1) // width + 1)
         cuts = np.maximum(first * width, a) - a
         highest, lowest = np.fmax.reduceat(d, cuts), np.fmin.reduceat(d, cuts)
@@ -196,7 +190,7 @@ def trigger_runs(start, stop, arguments, x):
     entries, kinds, pieces = [], [], []
     previous = 0
     for a, b in _chunks(start, stop, chunk):
-        xa = blanked(x[a - start : b - start], a, b, gaps)
+        xa = _blanked(x[a - start : b - start], a, b, gaps)
         d = detrended(xa, a, line)
         level = level_at(band, np.arange(a, b)) if isinstance(band, tuple) else band
         middle = level_at(centre, np.arange(a, b)) if isinstance(centre, tuple) else centre
@@ -211,7 +205,7 @@ def trigger_runs(start, stop, arguments, x):
         entries.append(entry + a)
         kinds.append(kind)
         cuts = entry if entry.size and entry[0] == 0 else np.concatenate([[0], entry])
-        pieces.append(np.stack([cuts + a, *piece_extremes(xa, cuts, a)]))
+        pieces.append(np.stack([cuts + a, *_piece_extremes(xa, cuts, a)]))
     return np.concatenate(entries), np.concatenate(kinds), np.concatenate(pieces, axis=1)
 
 
@@ -232,14 +226,14 @@ def labelled_runs(start, stop, arguments, x, cycle):
                 last = np.maximum.accumulate(np.where(known, np.arange(label.size), -1))
                 label = np.where(last >= 0, label[np.maximum(last, 0)], carry)
             carry = label[b - 1 - a]
-        xa = blanked(x[a - start : ahead - start], a, ahead, gaps)
+        xa = _blanked(x[a - start : ahead - start], a, ahead, gaps)
         step = np.abs(np.diff(xa))  # step[i]: from sample a + i to the next
         step[label[1:] != label[:-1]] = np.nan  # no step from a run's last sample
         label, xa, step = label[: b - a], xa[: b - a], step[: b - a]
         if step.size < label.size:
             step = np.append(step, np.nan)
         cuts = np.concatenate([[0], np.flatnonzero(label[1:] != label[:-1]) + 1])
-        highest, _, lowest, bottom = piece_extremes(xa, cuts, a)
+        highest, _, lowest, bottom = _piece_extremes(xa, cuts, a)
         runs = [cuts + a, label[cuts].astype(np.float64), np.diff(np.append(cuts, b - a))]
         ends = _finite_ends(xa, cuts)
         pieces.append(
@@ -261,9 +255,7 @@ def survey(samples: Samples):
     size = samples.size
     # The sample's order does not matter: its values are sorted.
     sample_at = np.sort(np.random.default_rng(0).integers(0, size, _SAMPLE))
-    found = samples.map(
-        _survey, ("displacement", "force", "cycle", "missing"), (size, _CHUNK, sample_at)
-    )
+    found = samples.map(_survey, _CHANNELS, (size, _CHUNK, sample_at))
     sums = np.concatenate([part["sums"] for part in found])
     gaps = np.concatenate([part["gaps"] for part in found])
     if gaps.size:  # runs of missing samples that meet at a chunk's edge are one run
@@ -379,9 +371,9 @@ def part_extremes(start, stop, arguments, x):
         cuts = np.unique(np.concatenate([[0], lower, upper]))
         cuts = cuts[cuts < b - a]
         at = np.searchsorted(cuts, lower)  # the piece of each part
-        xa = blanked(np.asarray(x[a - start : b - start], dtype=np.float64), a, b, gaps)
+        xa = _blanked(np.asarray(x[a - start : b - start], dtype=np.float64), a, b, gaps)
         d = detrended(xa, a, line)
-        extremes = [e[at] for e in piece_extremes(xa, cuts, a)]
+        extremes = [e[at] for e in _piece_extremes(xa, cuts, a)]
         ranges = [np.fmax.reduceat(d, cuts)[at], np.fmin.reduceat(d, cuts)[at]]
         found.append(np.stack([part.astype(np.float64), *extremes, *ranges]))
     return np.concatenate(found, axis=1)
@@ -394,7 +386,7 @@ def values_at(start, stop, arguments, x):
     if not at.size:
         return np.empty(0)
     stretch = np.asarray(x[at[0] - start : at[-1] + 1 - start], dtype=np.float64)
-    return blanked(stretch, at[0], at[-1] + 1, gaps)[at - at[0]]
+    return _blanked(stretch, at[0], at[-1] + 1, gaps)[at - at[0]]
 
 
 def is_lazy(value) -> bool:
@@ -439,7 +431,7 @@ class Samples:
 
     def map(self, function, channels, arguments=(), extra: int = 0) -> list:
         """``function(start, stop, arguments, *arrays)`` over the recording's blocks."""
-        selected = [self.arrays[CHANNELS.index(name)] for name in channels]
+        selected = [self.arrays[_CHANNELS.index(name)] for name in channels]
         if not self.lazy:
             return [function(0, self.size, arguments, *selected)]
 

@@ -73,7 +73,7 @@ def test_split_cycles_as_the_padded_implementation(number):
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(passes, "_CHUNK", 1000)
         patch.setattr(passes, "_SAMPLE", 256)
-        found = cycles.split_cycles(x)
+        found = cycles.find_cycles(x)
     assert_found(found, golden.found_cycles("split", number))
 
 
@@ -83,7 +83,7 @@ def test_labelled_cycles_as_the_padded_implementation(number):
     x, label = golden.labelled_input(*golden.LABELLED_CASES[number])
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(passes, "_CHUNK", 1000)
-        found = cycles.labelled_cycles(x, label)
+        found = cycles.find_cycles(x, label)
     assert_found(found, golden.found_cycles("labelled", number))
 
 

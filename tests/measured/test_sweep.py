@@ -43,7 +43,7 @@ def test_every_cycle_of_a_sweep_is_reported_numbered_as_driven(sweep):
     _, _, applied, driven, results = sweep
     np.testing.assert_array_equal(results.cycle, np.arange(1, driven.size + 1))
     assert results.attrs["incomplete_cycles"] == 2
-    found = cycles_module.split_cycles(applied)
+    found = cycles_module.find_cycles(applied)
     stretches = [applied[s : s + c] for s, c in zip(found.start, found.count, strict=True)]
     # each cycle holds the drive's cycle of its number, at one amplitude: both its
     # reversals, and its ends where the drive's cycles meet (at the centre)

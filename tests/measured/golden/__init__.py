@@ -2,7 +2,8 @@
 
 The recordings and signals of each case are made here; what the padded implementation
 returned for them is in ``analysis.npz`` (``analyze_loops``: per-cycle quantities, regimes,
-counts) and ``cycles.npz`` (``split_cycles``, ``labelled_cycles`` and the centres' drift).
+counts) and ``cycles.npz`` (``find_cycles`` without and with cycle numbers, and the centres'
+drift).
 README.md says how they were made.
 """
 
@@ -83,13 +84,13 @@ CHUNKED = {
     "in small chunks, labelled": (lambda: _chunked(True), {}),
 }
 
-#: (kind of signal, samples, seed) of ``split_cycles``.
+#: (kind of signal, samples, seed) of ``find_cycles`` at the reversals.
 SPLIT_CASES = [
     (kind, size, 1000 * kind + number)
     for kind in range(5)
     for number, size in enumerate((8, 40, 333, 1000, 1001, 2500, 5000, 12_000))
 ]
-#: (kind of signal, samples, samples per label, seed) of ``labelled_cycles``.
+#: (kind of signal, samples, samples per label, seed) of ``find_cycles`` by cycle numbers.
 LABELLED_CASES = [
     (kind, size, length, 2000 + 100 * kind + number)
     for kind in range(5)
@@ -177,7 +178,7 @@ def analysis(name, displacement, force):
 
 
 def found_cycles(kind, number):
-    """What ``split_cycles`` (``kind`` 'split') or ``labelled_cycles`` ('labelled') found
+    """What ``find_cycles`` at the reversals (``kind`` 'split') or by numbers ('labelled') found
     in case ``number``: the samples of the cycles one after the other, the count of each
     cycle's samples, the width of its rows, labels, incomplete cycles, dropped samples."""
     arrays = _under(_stored("cycles.npz"), f"{kind}/{number}/")
