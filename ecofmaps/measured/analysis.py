@@ -198,9 +198,8 @@ def _run(
     scheduler=None,
     workers=None,
 ):
-    """The recording checked and through the pipeline (in this process when it is in memory,
-    else on the runner of ``scheduler`` and ``workers``): the results, and the reading along
-    the stroke handed back (or None)."""
+    """The results of the recording, checked, through the pipeline (in this process if it is in
+    memory), and the reading along the stroke handed back (or None)."""
     if nan_policy not in NAN_POLICIES:
         raise ValueError(f"nan_policy must be one of {NAN_POLICIES}; got {nan_policy!r}")
     if scheduler in (None, "threads", "processes"):  # on this machine: checked before any work
@@ -243,8 +242,7 @@ def _at_mean_load(force, load):
 
 
 def _raise_at_missing(x, q, label, mask, load=None) -> None:
-    """:class:`MissingSampleError` naming the first missing sample of a recording in memory
-    (one missing to a recorded ``load`` not positive is named once its cycle is found)."""
+    """Raise for the first missing sample in memory (one of a load not positive: at its cycle)."""
     bad = ~np.isfinite(x) | ~np.isfinite(q)
     if label is not None and label.dtype.kind not in "iub":
         bad |= ~np.isfinite(label)

@@ -16,6 +16,7 @@ from ecofmaps.measured.cycles import MIN_SAMPLES, find_cycles
 from ecofmaps.measured.measure import measure_cycles
 from ecofmaps.measured.pipeline import LoopOptions
 from ecofmaps.measured.quality import ALL, ANTICLOCKWISE_SHARE, REASONS, SEPARATOR
+from ecofmaps.measured.resolve import within
 from ecofmaps.model.core import slip_position, traction_ratio
 from ecofmaps.model.simulation import fretting_loop
 
@@ -136,8 +137,7 @@ _jacobian_jit = jax.jit(jax.jacfwd(_residual))
 
 
 def _starting_values(x, y, rising, analysis, length, load):
-    r"""Scaled starting parameters (:math:`\Delta/L`, :math:`Q/P`, centred) from the loop's
-    ``analysis``."""
+    """Scaled starting parameters (Δ/L, Q/P, centred) from the loop's ``analysis``."""
     stiffness = analysis["stiffness"] * length / load
     slip_half_width = analysis["slip_amplitude"] / length
     if analysis["energy_ratio"] < -ANTICLOCKWISE_SHARE:
@@ -267,8 +267,7 @@ def _checked_samples(displacement, force, load, hysteresis):
     check("load", load, "positive", "N")
     if np.ndim(load) != 0:
         raise ValueError(f"load must be a single number [N], got shape {np.shape(load)}")
-    if not 0.0 < hysteresis < 1.0:
-        raise ValueError(f"hysteresis must satisfy 0 < hysteresis < 1; got {hysteresis!r}")
+    within("hysteresis", hysteresis, 1.0)
     all_x = np.asarray(displacement, dtype=np.float64)
     all_y = np.asarray(force, dtype=np.float64)
     for name, values in (("displacement", all_x), ("force", all_y)):
@@ -288,9 +287,8 @@ def _checked_samples(displacement, force, load, hysteresis):
 
 
 def _measured_cycle(all_x, all_y, load, cycle, cycle_number, hysteresis):
-    """The samples of the cycle to fit (indices round its loop), its number, and its
-    per-cycle analysis (the stick window that gives the stiffest stick sides); a
-    ValueError if the cycle is refused."""
+    """The indices round the loop to fit, its number, and its analysis with the stick window
+    that gives the stiffest sides; a ValueError if the cycle is refused."""
     cycles = find_cycles(all_x, cycle, hysteresis)
     if cycles.label.size == 0:
         raise ValueError(
@@ -359,8 +357,7 @@ def _solution(scaled_x, scaled_y, rising, start):
 
 
 def _standard_errors(solution, samples: int, load: float, length: float) -> dict:
-    """Standard errors of the fitted parameters in SI units, from the covariance s^2 (J^T J)^-1
-    of the scaled ones (s^2 the residual variance)."""
+    """Standard errors of the fitted parameters in SI units, from the covariance s² (JᵀJ)⁻¹."""
     _, _, a, amplitude, _, _ = (float(v) for v in solution.x)
     jacobian = solution.jac[:samples]
     variance = np.sum(solution.fun[:samples] ** 2) / (samples - solution.x.size)

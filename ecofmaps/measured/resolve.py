@@ -225,7 +225,7 @@ def read_along_stroke(loops: xr.Dataset, options: ReadingOptions):
     inherited = _reaches_resolved(quality)
     with np.errstate(divide="ignore", invalid="ignore"):
         per_position, per_cycle, flags, grid = along_stroke_values(
-            x, q, load, rig, amplitude, inherited, given, options, values("force_drift_se")
+            x, q, load, rig, amplitude, inherited, options, values("force_drift_se")
         )
         per_cycle["position_offset"] = (
             loops["displacement_offset"].values - removed / per_cycle["stiffness"]
@@ -392,15 +392,13 @@ def _blocks(cycles):
     return [slice(start, start + _BLOCK) for start in range(0, max(cycles, 1), _BLOCK)]
 
 
-def along_stroke_values(x, q, load, stiffness, amplitude, inherited, given, options, drift_se):
+def along_stroke_values(x, q, load, stiffness, amplitude, inherited, options, drift_se):
     """Every resolved quantity of the centred loops ``x``, ``q``."""
     cycles, valid = x.shape[0], np.isfinite(x) & np.isfinite(q)
     parts = []
     for block in _blocks(cycles):
         check_interrupted()
-        part = slip_branches(
-            *(a[block] for a in (x, q, valid, stiffness, amplitude)), given, options
-        )
+        part = slip_branches(*(a[block] for a in (x, q, valid, stiffness, amplitude)), options)
         lowest, highest = part["lowest"], part["highest"]
         overlap = (lowest < 0.0) & (highest > 0.0)
         usable = ~inherited[block] & ~part["mismatch"] & overlap

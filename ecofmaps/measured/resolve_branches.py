@@ -157,10 +157,10 @@ def _sorted_branch(xi, q, slip):
     )
 
 
-def slip_branches(x, q, valid, stiffness, amplitude, given, options):
-    """The stiffness, the checks of the stick sets, and the two slip branches, with the
-    ``stick_window`` and ``slip_threshold`` of ``options``."""
-    cycles = x.shape[0]
+def slip_branches(x, q, valid, stiffness, amplitude, options):
+    """The stiffness (given in ``options``, else fitted), the checks of the stick sets, and the
+    two slip branches."""
+    cycles, given = x.shape[0], options.stiffness is not None
     floor = _ROUNDING * amplitude
     branches = _branches(x, valid)
     moved = [_moved(q, branch) for branch in branches]

@@ -240,8 +240,6 @@ def example_path() -> Path:
     return Path(str(importlib.resources.files("ecofmaps") / "data" / EXAMPLE_FILE))
 
 
-# The shipped example scar profile
-
 #: Parameters of the shipped example scar profile (SI units).
 SCAR_EXAMPLE = {
     "depth": 80e-6,  # of the flat bottom below the unworn surface [m]
@@ -335,8 +333,6 @@ def scar_example_path() -> Path:
     """Path of the shipped example scar profile (see :func:`scar_example_trace`)."""
     return Path(str(importlib.resources.files("ecofmaps") / "data" / SCAR_EXAMPLE_FILE))
 
-
-# Ugly recordings with a known truth, for calibrating the analysis
 
 #: The default parameters of :func:`long_recording`: the example's rig (the paper's Example 2,
 #: Section 3) and sensors, a groove deepening to z_o/x_o = 0.2 over the test, and a
