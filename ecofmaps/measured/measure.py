@@ -366,19 +366,19 @@ def _loop_values(block, options):
     span = highest - lowest
     amplitude = 0.5 * span
     rows = branch_rows(block, top)
-    low, high = (float(share) for share in options.stick_window)
     # Lines Δ = c + Q/S through the stick segments after the two reversals.
     compliance, intercept, across, residual, unexplained, curved = kernels.stick_lines(
-        *rows, span, low, high
+        *rows, span, *options.stick_window
     )
-    band, rounding = _both(_ZERO_FORCE_BAND * max_force), _both(1e-9 * span)
+    # Per branch row, the rising ones then the falling ones:
+    band, rounding = np.tile(_ZERO_FORCE_BAND * max_force, 2), np.tile(1e-9 * span, 2)
     crossing, zero_on_loop = kernels.zero_force_crossings(*rows, band, intercept, across, rounding)
     cycles = block.count.size
     slip = 0.5 * (crossing[cycles:] - crossing[:cycles])
-    slope, half_width = _both(compliance), _both(options.crossing_window * np.abs(slip))
+    slope, half_width = np.tile(compliance, 2), np.tile(options.crossing_window * np.abs(slip), 2)
     # Where each branch row crosses Q = SΔ: force, whether on the loop, displacement.
     force, on_loop = kernels.line_crossings(
-        *rows, slope, half_width, float(load), 1e-9 * _both(max_force)
+        *rows, slope, half_width, float(load), 1e-9 * np.tile(max_force, 2)
     )
     at = force * slope
     ratios = loop_ratios(amplitude, max_force, energy, slip, options.rig_stiffness)
@@ -537,11 +537,6 @@ def measure_cycles(cycles: Cycles, displacement, force, options, *, rows=None, k
                 for loop, centred in zip(loops, block.loops(loops[0].shape[1]), strict=True):
                     loop[out] = centred
     return values, flags, loops
-
-
-def _both(values):
-    """A per-cycle array for the rising then the falling branch rows."""
-    return np.concatenate([values, values])
 
 
 def branch_rows(block, top):

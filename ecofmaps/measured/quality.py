@@ -39,6 +39,7 @@ __all__ = [
     "load_flags",
     "quality_strings",
     "quality_summary",
+    "refused",
     "regime_ratio",
 ]
 
@@ -308,13 +309,6 @@ def _attrs(name: str) -> dict:
     return nomenclature.attrs(name, _COMMENTS)
 
 
-def _refusal_hint(flags: dict) -> str:
-    """What to do about a recording whose every cycle is refused for ``flags``."""
-    if flags["anticlockwise"] and flags["negative-stiffness"] and not flags["missing-samples"]:
-        return _FLIP_HINT
-    return next((hint for reason, hint in _HINTS.items() if flags[reason]), _LAST_HINT)
-
-
 def regime_ratio(values: dict, rig_stiffness) -> np.ndarray:
     """The energy ratio deciding each cycle's regime: on the contact's displacement if
     the rig's stiffness is known. [1]"""
@@ -418,7 +412,10 @@ class Tally:
         """Check the whole recording and give ``results`` (the parts, joined) its attributes."""
         summary, scaled = self.summary, self.scaled
         if self.cycles and self.refused == self.cycles:
-            hint = _refusal_hint(self.every | {"negative-stiffness": self.negative_stiffness})
+            every = self.every  # the reasons that refuse every cycle
+            hint = next((hint for reason, hint in _HINTS.items() if every[reason]), _LAST_HINT)
+            if every["anticlockwise"] and self.negative_stiffness and not every["missing-samples"]:
+                hint = _FLIP_HINT
             error = ImplausibleScaleError if scaled else ValueError
             raise error(f"no plausible cycle in the recording ({summary}). {hint}")
         if scaled:
@@ -520,6 +517,14 @@ def add_reason(quality, where, reason: str) -> np.ndarray:
 def has_reason(quality, reason: str) -> np.ndarray:
     """True for the cycles whose ``quality`` lists ``reason``."""
     return _by_text(quality, lambda text: reason in text.split(SEPARATOR))
+
+
+def refused(quality) -> np.ndarray:
+    """True for the cycles refused (a reason whose scope is every quantity)."""
+    return _by_text(
+        quality,
+        lambda text: any(REASONS.get(r, ("", ()))[1] == ALL for r in text.split(SEPARATOR)),
+    )
 
 
 def _apply_quality(values: dict, flags: dict) -> dict:
