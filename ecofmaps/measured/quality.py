@@ -46,56 +46,40 @@ __all__ = [
 
 #: Joins the reasons of one cycle in ``quality``.
 SEPARATOR = "+"
-
 #: Scope of a reason that refuses the cycle: every per-cycle quantity.
 ALL = "all"
-
 #: Plausible displacement amplitudes: outside, the unit is wrong (``implausible-amplitude``). [m]
 AMPLITUDE_RANGE = (0.5e-6, 50e-3)
-
 #: The amplitudes that :data:`AMPLITUDE_RANGE` allows, in words.
 _AMPLITUDES = f"{AMPLITUDE_RANGE[0] * 1e6:g} µm to {AMPLITUDE_RANGE[1] * 1e3:g} mm"
-
 #: Plausible coefficients of friction: outside, the load or the force's unit is wrong
 #: (``implausible-cof``). [1]
 COF_RANGE = (0.01, 3.0)
-
 #: Displacement amplitudes above this are reciprocating sliding rather than fretting (still
 #: analysed the same way; the results' ``motion`` attribute says so). [m]
 FRETTING_AMPLITUDE = 300e-6
-
 #: A recorded normal load that swings by more than this share of its mean within a cycle
 #: (highest less lowest) leaves the values given at the cycle's mean load off (``load-swing``).
 LOAD_SWING = 0.2
-
 #: The per-cycle values that scale with the normal load (given at each cycle's own load).
 LOAD_SCALED = ("max_force", "dissipated_energy", "stiffness", "force_offset", "force_drift_se")
-
 #: A loop whose area :math:`\oint Q\,d\Delta` is below minus this share of
-#: :math:`4\Delta^*Q^*` runs anticlockwise; a smaller negative area is noise on a loop
-#: without area (the one definition, also for :func:`ecofmaps.fit_loop`).
+#: :math:`4\Delta^*Q^*` runs anticlockwise; a smaller negative area is noise.
 ANTICLOCKWISE_SHARE = 0.05
-
 #: A cycle's amplitude of displacement or force stands clear of the noise when the bound
 #: σ√(2 ln n) on the lift of an extreme by white noise of its n samples is below this share
-#: of it (the lift itself is less, the sine falling away from its peak: half the
-#: peak-to-peak then reads the amplitude about 10 % too large at most).
+#: of it (half the peak-to-peak then reads the amplitude about 10 % too large at most).
 NOISE_SHARE = 0.15
-
 #: A stick segment must explain all but this share of the displacement's variance along it.
 UNEXPLAINED_SHARE = 0.2
-
 #: Fewest slipping samples of each branch in the central part of the stroke.
 SLIP_SAMPLES = 8
-
 #: μ(ξ) varies along the stroke when the means over the inner and the outer half of the
 #: central part differ by this share of μ and by this many standard errors.
 VARIATION = 0.03
 VARIATION_SIGNIFICANCE = 4.0
-
 #: Blocks of the central part whose means give the scatter of μ(ξ) (batch means).
 SCATTER_BLOCKS = 8
-
 #: The GICoF is flagged where the block means of μ(ξ) scatter about a straight line by
 #: this share of μ (standard deviation) beyond the noise.
 GICOF_WIGGLE = 0.015
@@ -109,7 +93,7 @@ _COMMENTS = {
     "INVALID where the cycle is refused",
     "quality": "'ok' or the reasons for NaN, joined by '+' (ecofmaps.measured.quality)",
 }
-
+#: The GICoF and the crossings it is read at; the slip and what it gives.
 _GICOF = (
     "gicof",
     "gicof_forward",

@@ -37,9 +37,7 @@ from ecofmaps.measured.resolve_branches import (
 )
 
 __all__ = [
-    "QUALITY_FLAGS",
     "ReadingOptions",
-    "along_stroke_values",
     "checked_stick_window",
     "read_along_stroke",
     "resolve_analyzed_loops",
@@ -104,12 +102,8 @@ def _grid_positions(positions):
     if positions is None:
         return None
     if np.ndim(positions) == 0:
-        if (
-            isinstance(positions, bool)
-            or not isinstance(positions, int | np.integer)
-            or positions < 5
-            or positions % 2 == 0
-        ):
+        count = isinstance(positions, int | np.integer) and not isinstance(positions, bool)
+        if not (count and positions >= 5 and positions % 2):
             raise ValueError(
                 f"positions must be an odd integer >= 5 or an array of positions; got {positions!r}"
             )
@@ -224,7 +218,7 @@ def read_along_stroke(loops: xr.Dataset, options: ReadingOptions):
     quality, amplitude = loops["quality"].values, values("amplitude")
     inherited = _reaches_resolved(quality)
     with np.errstate(divide="ignore", invalid="ignore"):
-        per_position, per_cycle, flags, grid = along_stroke_values(
+        per_position, per_cycle, flags, grid = _along_stroke_values(
             x, q, load, rig, amplitude, inherited, options, values("force_drift_se")
         )
         per_cycle["position_offset"] = (
@@ -256,7 +250,7 @@ def read_along_stroke(loops: xr.Dataset, options: ReadingOptions):
 
 #: The reasons this reading adds to a cycle's ``quality`` that leave its values NaN, in the
 #: order they are tested (``'gicof-varies'``, which reaches the GICoF only, comes besides).
-QUALITY_FLAGS = READING_REASONS[:4]
+_QUALITY_FLAGS = READING_REASONS[:4]
 #: Values of μ(ξ) beyond this many robust standard deviations of the median are clipped.
 _WINSOR = 3.0
 #: The largest lag-one autocorrelation of the block means that is believed.
@@ -392,7 +386,7 @@ def _blocks(cycles):
     return [slice(start, start + _BLOCK) for start in range(0, max(cycles, 1), _BLOCK)]
 
 
-def along_stroke_values(x, q, load, stiffness, amplitude, inherited, options, drift_se):
+def _along_stroke_values(x, q, load, stiffness, amplitude, inherited, options, drift_se):
     """Every resolved quantity of the centred loops ``x``, ``q``."""
     cycles, valid = x.shape[0], np.isfinite(x) & np.isfinite(q)
     parts = []
@@ -420,7 +414,7 @@ def along_stroke_values(x, q, load, stiffness, amplitude, inherited, options, dr
         return np.concatenate([part[name] for part in parts])
 
     flag = joined("flags")
-    flags = {reason: flag == code for code, reason in enumerate(QUALITY_FLAGS, start=1)}
+    flags = {reason: flag == code for code, reason in enumerate(_QUALITY_FLAGS, start=1)}
     ok = ~inherited & (flag == 0)
     mu_resolved, variance, k, tilt, sensitivity, _, shifting, wavers, offsetting = (
         np.concatenate(values) for values in zip(*(part["values"] for part in parts), strict=True)

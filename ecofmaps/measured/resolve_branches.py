@@ -14,7 +14,6 @@ __all__ = [
     "masked_median",
     "masked_sum",
     "read_branches",
-    "resample",
     "sample_weights",
     "slip_branches",
 ]
@@ -212,7 +211,7 @@ def slip_branches(x, q, valid, stiffness, amplitude, options):
     }
 
 
-def resample(xs, qs, count, grid, scale, inside):
+def _resample(xs, qs, count, grid, scale, inside):
     r"""``qs(xs)`` at the positions ``scale * grid`` (one row per cycle), by 3-point fractions."""
     cycles, width = xs.shape
     points = grid.size
@@ -256,8 +255,8 @@ def resample(xs, qs, count, grid, scale, inside):
 
 def read_branches(forward, backward, grid, scale, inside, load):
     """Q+, Q-, μ and g at the positions ``scale * grid``, and the line weights of each branch."""
-    q_forward, *line_forward = resample(*forward, grid, scale, inside)
-    q_backward, *line_backward = resample(*backward, grid, scale, inside)
+    q_forward, *line_forward = _resample(*forward, grid, scale, inside)
+    q_backward, *line_backward = _resample(*backward, grid, scale, inside)
     up = np.arctan(q_forward / load)
     down = np.arctan(q_backward / load)
     mu = np.tan(0.5 * (up - down))
