@@ -198,8 +198,7 @@ def _run(
     scheduler=None,
     workers=None,
 ):
-    """The results of the recording, checked, through the pipeline (in this process if it is in
-    memory), and the reading along the stroke handed back (or None)."""
+    """The recording checked, through the pipeline: the results and the reading handed back."""
     if nan_policy not in NAN_POLICIES:
         raise ValueError(f"nan_policy must be one of {NAN_POLICIES}; got {nan_policy!r}")
     if scheduler in (None, "threads", "processes"):  # on this machine: checked before any work

@@ -228,8 +228,7 @@ def _accepted_reversals(parts, hidden, edges, scale):
 
 
 def _deep_ends(value, accepted):
-    """False for a sweep's first or last run whose extreme lies under ¾ as far from the next
-    reversal as the one after it (noise crossing a narrow band at a lead-in or lead-out)."""
+    """False for a sweep's end run nearer the next reversal than ¾ of the stroke after it."""
     deep = np.ones(value.size, dtype=bool)
     reversals = np.flatnonzero(accepted)
     for first, next_, after in ((0, 1, 2), (-1, -2, -3)):
@@ -241,8 +240,7 @@ def _deep_ends(value, accepted):
 
 
 def _steps(kind, extreme, value) -> bool:
-    """Whether the drive's amplitude steps: periodic reversals whose stroke changes by more
-    than :data:`_STEP` from the last in its direction, and is then held."""
+    """Whether the drive's amplitude steps: periodic reversals, a stroke changing, then held."""
     bottoms = extreme[kind < 0]
     if bottoms.size < 3:
         return False
@@ -268,8 +266,7 @@ def _with_missing(cycles: Cycles, gaps) -> Cycles:
 
 
 def _drive_numbers(cycles: Cycles, merged: bool = False) -> Cycles:
-    """``cycles`` numbered as the drive made them: a gapped stretch (or, if ``merged``, each
-    stretch between bottom reversals) counts its periods."""
+    """``cycles`` numbered as the drive made them: a gapped (or ``merged``) stretch's periods."""
     whole = cycles.whole
     if not whole.any() or (whole.all() and not merged):
         return cycles
@@ -307,8 +304,7 @@ def _trigger(samples: Samples, gaps, line, band):
 
 
 def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
-    """The trigger's local ``((width, centres), (width, half-bands))``, or None where the whole
-    recording's band finds every cycle."""
+    """The trigger's local ``((width, centres), (width, half-bands))``, or None if not needed."""
     starts, kind, period, step = runs
     centre, level = band
     bottoms = starts[kind < 0]
@@ -343,8 +339,7 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
 
 
 def _local_centre(highest, lowest):
-    """Per stretch, the middle of the narrower of the two periods holding it where that spans
-    at most 2.5 times the least of the three stretches' own (a held amplitude), else NaN."""
+    """Per stretch, the middle of the narrower period holding it if the amplitude is held."""
     top = np.maximum(highest[:-1], highest[1:])  # NaN with a stretch cut short
     bottom = np.minimum(lowest[:-1], lowest[1:])
     span, own = top - bottom, highest - lowest
@@ -356,8 +351,7 @@ def _local_centre(highest, lowest):
 
 
 def _drive_cycles(bottoms, tops, n: int, period: float) -> Cycles:
-    """Cycles cut half way from each bottom reversal to the next top, or a quarter period from
-    them if farther; the drive's periods without a reversal are hidden rows."""
+    """Cycles cut between bottom and top reversals, and hidden rows for periods without one."""
     none = np.zeros(0, dtype=np.int64)
     if not tops.size:
         return Cycles(none, none, none, none, False, 1, n)

@@ -287,8 +287,7 @@ def _checked_samples(displacement, force, load, hysteresis):
 
 
 def _measured_cycle(all_x, all_y, load, cycle, cycle_number, hysteresis):
-    """The indices round the loop to fit, its number, and its analysis with the stick window
-    that gives the stiffest sides; a ValueError if the cycle is refused."""
+    """The indices round the loop to fit, its number and its analysis (stiffest stick window)."""
     cycles = find_cycles(all_x, cycle, hysteresis)
     if cycles.label.size == 0:
         raise ValueError(

@@ -448,8 +448,7 @@ def _loop_values(block, options):
 
 
 def _mindlin_sliding(rows, max_force, span, candidates):
-    """Force on the sliding parts (rising, falling) [N] and spring stiffness [N/m] of the
-    ``candidates`` whose stick follows Mindlin's law behind a spring, else NaN."""
+    """Sliding forces (rising, falling) [N] and spring stiffness [N/m] of Mindlin sticks, or NaN."""
     x, y, length = rows
     cycles = max_force.size
     found = np.full((3, cycles), np.nan)

@@ -66,11 +66,6 @@ def _enough(stick):
     return np.count_nonzero(stick, axis=1) >= _STICK_SAMPLES
 
 
-def _moved(q, branch):
-    """Share of the branch's force swing by which each sample has moved from its reversal."""
-    return np.abs(q - _at_first(q, branch)) / _span(q, branch)[:, None]
-
-
 def _before(mask, branch):
     """The samples of ``branch`` before the first sample of ``mask``."""
     return branch & ~np.maximum.accumulate(branch & mask, axis=1)
@@ -132,9 +127,7 @@ def _branch_shift(xi, branches, slips, levels):
 
 
 def _tilted_alike(xi, q, sticks, tolerance, floor):
-    """True where the stick sets tilt in ξ beyond ``tolerance`` over their force span, and
-    each of them beyond the rounding ``floor``, in the same sense (a wrong compliance; see
-    ``docs/method-loops.md``, 'stiffness-mismatch')."""
+    """True where the stick sets tilt alike in ξ beyond ``tolerance`` (a wrong compliance)."""
     span = np.max([_span(q, stick) for stick in sticks], axis=0)
     judged = np.all([_enough(stick) for stick in sticks], axis=0)
     tilt, _ = _compliance(xi, q, sticks)
@@ -162,7 +155,8 @@ def slip_branches(x, q, valid, stiffness, amplitude, options):
     cycles, given = x.shape[0], options.stiffness is not None
     floor = _ROUNDING * amplitude
     branches = _branches(x, valid)
-    moved = [_moved(q, branch) for branch in branches]
+    # The share of its branch's force swing by which each sample has moved from the reversal.
+    moved = [np.abs(q - _at_first(q, branch)) / _span(q, branch)[:, None] for branch in branches]
     (low, high), slip_threshold = options.stick_window, options.slip_threshold
     windows = [
         _before(share > high, branch) & (share >= low)

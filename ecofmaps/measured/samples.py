@@ -63,8 +63,7 @@ def _blanked(x, a: int, b: int, gaps) -> np.ndarray:
 
 
 def _piece_extremes(x, cuts, a: int):
-    """Largest and smallest finite value of each piece ``x[cuts[k]:cuts[k + 1]]`` (``x``
-    holds samples ``a`` on), each with the first sample of it, -1 where none is finite."""
+    """Largest and smallest finite value of each piece of ``x`` and its first sample (or -1)."""
     lengths = np.diff(cuts, append=x.size)
     found = []
     for reduce in (np.fmax, np.fmin):

@@ -197,8 +197,7 @@ def example_recording():
 
 
 def _on_rig(p, ratio, samples_per_cycle, offset, drift, seed):
-    """:func:`synthetic_recording` on the rig and sensors of ``p``, from zero displacement on
-    the rise, its displacement offset by ``offset`` [m] more."""
+    """:func:`synthetic_recording` on the rig of ``p`` from zero on the rise, offset more."""
     return synthetic_recording(
         p["amplitude"],
         p["load"],
