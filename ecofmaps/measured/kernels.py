@@ -225,9 +225,8 @@ def zero_force_crossings(x, y, length, band, intercept, across, rounding):
         count = 0
         for j in range(n):
             count += _before(y[r, j], rising)
-        previous, after = _sample_pair(n, count, width)
-        for j in range(n):
             near[j] = abs(y[r, j]) <= band[r]
+        previous, after = _sample_pair(n, count, width)
         near[after] = True
         if after >= 1:
             near[previous] = True

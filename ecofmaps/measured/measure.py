@@ -439,11 +439,9 @@ def _loop_values(block, options):
         "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]) & ~mindlin,
         "partial-slip": ~sliding,
     }
-    lift_x, lift_q = (
-        kernels.noise_lift(block.count, block.offset, signal, _NOISE_SAMPLES) / NOISE_SHARE
-        for signal in (block.displacement, block.force)
+    flags["noise-amplitude"] = (_noise_lift(block, block.displacement) > amplitude) | (
+        _noise_lift(block, block.force) > max_force
     )
-    flags["noise-amplitude"] = (lift_x > amplitude) | (lift_q > max_force)
     return values, flags
 
 
@@ -494,6 +492,12 @@ def _mindlin_sliding(rows, max_force, span, candidates):
     compliance = 0.5 * (line[: pick.size, 2] + line[pick.size :, 2])
     found[2, pick[follows]] = 1.0 / np.maximum(compliance[follows], 0.0)  # + inf if rigid
     return found
+
+
+def _noise_lift(block, values):
+    """:func:`kernels.noise_lift` of ``values`` in each cycle of ``block`` over
+    :data:`NOISE_SHARE` (NaN for fewer than :data:`_NOISE_SAMPLES` samples). [m] or [N]"""
+    return kernels.noise_lift(block.count, block.offset, values, _NOISE_SAMPLES) / NOISE_SHARE
 
 
 def _turns_back(x, band):

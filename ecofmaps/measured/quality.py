@@ -68,7 +68,8 @@ LOAD_SCALED = ("max_force", "dissipated_energy", "stiffness", "force_offset", "f
 ANTICLOCKWISE_SHARE = 0.05
 #: A cycle's amplitude of displacement or force stands clear of the noise when the bound
 #: σ√(2 ln n) on the lift of an extreme by white noise of its n samples is below this share
-#: of it (half the peak-to-peak then reads the amplitude about 10 % too large at most).
+#: of it (the lift itself is less, the sine falling away from its peak: half the
+#: peak-to-peak then reads the amplitude about 10 % too large at most).
 NOISE_SHARE = 0.15
 #: A stick segment must explain all but this share of the displacement's variance along it.
 UNEXPLAINED_SHARE = 0.2
