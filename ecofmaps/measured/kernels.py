@@ -328,16 +328,12 @@ def line_crossings(x, y, length, compliance, half_width, load, rounding):
         intercept, fitted = _curve_intercept(scaled, product, window, y[r], begin, end)
         # On the loop: the fitted window, or the pair interpolated between, holds samples
         # on both sides of ξ = 0, and the crossing's force lies within theirs.
-        if fitted >= _FIT_SAMPLES:
-            force[r] = intercept
-            on_loop[r] = _window_holds(
-                force[r], y[r], before, window, begin, end, (previous, after), False, rounding[r]
-            )
-        else:
-            force[r] = q0 + share * (q1 - q0)
-            on_loop[r] = (share >= 0.0 and share <= 1.0) and _window_holds(
-                force[r], y[r], before, window, begin, end, (previous, after), True, rounding[r]
-            )
+        fits = fitted >= _FIT_SAMPLES
+        force[r] = intercept if fits else q0 + share * (q1 - q0)
+        holds = _window_holds(
+            force[r], y[r], before, window, begin, end, (previous, after), not fits, rounding[r]
+        )
+        on_loop[r] = holds and (fits or (share >= 0.0 and share <= 1.0))
     return force, on_loop
 
 

@@ -324,11 +324,8 @@ def displacement_percentiles(samples: Samples, gaps, line, sample_at, sampled, c
         if not 0 <= j < kept.size - 1:  # the sample missed: hold every value once
             return _percentiles(samples, gaps, line)
         previous, following = np.partition(kept, [j, j + 1])[[j, j + 1]]
-        gamma, difference = virtual[k] - rank[k], following - previous
-        if gamma >= 0.5:
-            result[k] = following - difference * (1.0 - gamma)
-        else:
-            result[k] = previous + difference * gamma
+        gamma, step = virtual[k] - rank[k], following - previous
+        result[k] = following - step * (1.0 - gamma) if gamma >= 0.5 else previous + step * gamma
     return result
 
 
