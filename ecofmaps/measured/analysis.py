@@ -211,7 +211,7 @@ def _run(
         raise ValueError(
             f"too few samples for one cycle: {x.shape[0]} (a cycle needs at least {MIN_SAMPLES})"
         )
-    arrays = dict(
+    settings = dict(
         options=options,
         missing=mask,
         recorded_load=recorded_load,
@@ -221,14 +221,14 @@ def _run(
     if not any(is_lazy(a) for a in (x, q, label, mask)):
         if nan_policy == "raise":
             _raise_at_missing(x, q, label, mask, recorded_load)
-        return Analysis(x, q, label, one_chunk=True, **arrays).run()
+        return Analysis(x, q, label, one_chunk=True, **settings).run()
     if reading.keep_loops:
         raise ValueError(
             "keep_loops needs the recording in memory: give NumPy arrays (a long "
             "recording's loops would not fit)"
         )
     with runner_for(scheduler, workers) as runner:
-        return Analysis(x, q, label, runner=runner, **arrays).run()
+        return Analysis(x, q, label, runner=runner, **settings).run()
 
 
 def _at_mean_load(force, load):

@@ -531,11 +531,9 @@ def measure_cycles(cycles: Cycles, displacement, force, options, *, rows=None, k
         for block in blocks:
             check_interrupted()
             out = slice(block.rows.start - first, block.rows.stop - first)
-            computed, failed = _loop_values(block, options)
-            for name, value in computed.items():
-                values[name][out] = value
-            for reason, flag in failed.items():
-                flags[reason][out] = flag
+            for table, part in zip((values, flags), _loop_values(block, options), strict=True):
+                for name, value in part.items():
+                    table[name][out] = value
             if keep_loops:
                 for loop, centred in zip(loops, block.loops(loops[0].shape[1]), strict=True):
                     loop[out] = centred

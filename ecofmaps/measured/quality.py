@@ -335,7 +335,7 @@ def judged(values: dict, flags: dict, options):
     size = next(iter(flags.values())).size
     refused = _refusing(flags, size)
     recorded = {k: values[k] for k in _RECORDED if k in values}  # a refused cycle's too
-    values = _apply_quality({k: v for k, v in values.items() if k not in recorded}, flags)
+    values = _apply_quality({k: v for k, v in values.items() if k not in recorded}, flags, refused)
     sliding = gross_slip(values, options)
     regime = np.where(refused, INVALID, np.where(sliding, GROSS_SLIP, PARTIAL_SLIP))
     return values | recorded, quality_strings(flags, size), refused, regime
@@ -512,10 +512,8 @@ def refused(quality) -> np.ndarray:
     )
 
 
-def _apply_quality(values: dict, flags: dict) -> dict:
+def _apply_quality(values: dict, flags: dict, refusing) -> dict:
     """``values`` (name -> per-cycle array) with NaN where a flag's scope reaches."""
-    size = next(iter(values.values())).size
-    refusing = _refusing(flags, size)
     result = {name: np.where(refusing, np.nan, value) for name, value in values.items()}
     for reason, flag in flags.items():
         scope = REASONS[reason][1]
