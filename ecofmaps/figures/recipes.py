@@ -38,8 +38,7 @@ __all__ = [
     "source_digest",
 ]
 
-#: Groove aspect ratios z_o/x_o of Figures 7, 8, 11 and the universal map (the paper's 0 to
-#: 0.3, finely). [1]
+#: Groove aspect ratios z_o/x_o of Figures 7, 8, 11 and the universal map. [1]
 ASPECT_RATIOS = np.linspace(0.0, 0.3, 61)
 #: λ of the universal map, on a logarithmic scale: near-rigid rigs to well past the end of
 #: gross slip at μλ = 1, covering Figure 11 at both amplitudes. [1]
@@ -57,16 +56,14 @@ class FigureRecipe:
     data : callable
         ``data() -> xarray.Dataset`` through the cache; recipes that share it share the Dataset.
     draw, module : str
-        The drawing function ``draw(dataset, **options) -> Figure`` by its name, and the
-        module of :mod:`ecofmaps.figures` that holds it (imported when a figure is made).
+        The function ``draw(dataset, **options) -> Figure`` and its module of
+        :mod:`ecofmaps.figures` (imported when a figure is made), by name.
     selection, options : dict
         Coordinates picked with ``.sel`` before drawing; keyword arguments of ``draw``.
     cost : float
-        Rough time of Dataset and figure from an empty cache, relative to a plain figure:
-        the costliest is started first (:func:`figure_groups`). [1]
+        Rough time from an empty cache, relative to a plain figure (:func:`figure_groups`). [1]
     parts : tuple of callable
-        Each computes and caches a part of the Dataset that ``data`` reads; run in parallel
-        first (:func:`figure_parts`).
+        Each caches a part of the Dataset ``data`` reads, in parallel first (:func:`figure_parts`).
     """
 
     name: str
@@ -90,8 +87,7 @@ class FigureRecipe:
 
 
 def _loops() -> xr.Dataset:
-    """The loops of Figures 5 and 6: rigid and 35 MN/m rigs, z_o/x_o = 0, 0.1, 0.2, 0.3."""
-    # Imported here, as every map function below: the registry reads without JAX.
+    """The loops of Figures 5 and 6 (imports inside, as below: the registry reads without JAX)."""
     from ecofmaps.maps.cache import cached_dataset
     from ecofmaps.maps.grid import compute_loops
 
@@ -135,8 +131,8 @@ def _universal_map() -> xr.Dataset:
     return compute_universal_map(COMPLIANCE_RATIOS, ASPECT_RATIOS, paper.MU)
 
 
-#: Shape parameters of the analytic scar families of the ``shapes`` figure, beside depth and
-#: half-width (the paper's Example 2: D/W = 0.2, W = x_o = Δ*). [1] (fractions of D or W)
+#: The ``shapes`` figure's scar families at Example 2's D/W = 0.2, W = x_o = Δ*: the function
+#: and its shape parameters (fractions of D or W). [1]
 SCAR_SHAPES = {
     "parabolic": ("parabolic_profile", {}),
     "flat-bottomed": ("flat_bottomed_profile", {"flat_fraction": 0.5}),
@@ -145,8 +141,7 @@ SCAR_SHAPES = {
 }
 
 
-#: The sources, relative to the package, that decide the ``shapes`` Dataset beyond the
-#: model's revision: this module (the shapes, the grid) and the correction (eq. 11 shortcut).
+#: The sources beside the model's revision that decide the ``shapes`` Dataset.
 _SCAR_SHAPES_SOURCES = ("figures/recipes.py", "correction/*.py")
 
 
@@ -162,7 +157,6 @@ def source_digest(patterns) -> np.ndarray:
 
 
 def _cached_shapes_part(function: str, compute: Callable[[], xr.Dataset]) -> xr.Dataset:
-    """``compute()`` through the disk cache, keyed by the model's revision and the sources."""
     from ecofmaps.maps.cache import cached_dataset
 
     return cached_dataset(function, {"sources": source_digest(_SCAR_SHAPES_SOURCES)}, compute)
@@ -180,19 +174,19 @@ def _scar_shapes() -> xr.Dataset:
     return _cached_shapes_part("scar_shapes", scar_shapes_dataset)
 
 
-def _scar_profiles() -> dict:
-    """The scar families of :data:`SCAR_SHAPES` at Example 2's D/W, by name."""
+def _scar_profiles() -> list:
+    """The scar families of :data:`SCAR_SHAPES`, in order."""
     depth, width = paper.ASPECT_RATIO * paper.AMPLITUDE, paper.AMPLITUDE
     scale = {"ridge_height": depth, "ridge_width": width}
-    profiles = {}
-    for name, (family, parameters) in SCAR_SHAPES.items():
-        options = {key: value * scale.get(key, 1.0) for key, value in parameters.items()}
-        profiles[name] = getattr(ecofmaps, family)(depth, width, **options)
-    return profiles
+    return [
+        getattr(ecofmaps, family)(
+            depth, width, **{k: v * scale.get(k, 1.0) for k, v in shape.items()}
+        )
+        for family, shape in SCAR_SHAPES.values()
+    ]
 
 
 def _labelled(variables: dict, coords: dict) -> xr.Dataset:
-    """A Dataset of ``variables`` and ``coords``, each with its nomenclature's attrs."""
     import xarray as xr
 
     return xr.Dataset(
@@ -208,7 +202,8 @@ _SHAPES_STIFFNESS_RATIOS = np.union1d(
     paper.FIGURE_11_STIFFNESS_RATIOS, [paper.STIFFNESS / paper.LOAD]
 )
 _AT_EXAMPLE = int(np.searchsorted(_SHAPES_STIFFNESS_RATIOS, paper.STIFFNESS / paper.LOAD))
-_SHAPES_COORDS = {"shape": list(SCAR_SHAPES), "groove": ["profile", "parabola"]}
+#: The steady values of a loop, over S/P.
+_STEADY = ("slip_amplitude", "dissipated_energy", "ecof", "ecof_ratio")
 
 
 def scar_shape_model_dataset() -> xr.Dataset:
@@ -217,10 +212,9 @@ def scar_shape_model_dataset() -> xr.Dataset:
 
     ratios = _SHAPES_STIFFNESS_RATIOS
     rig = dict(amplitude=paper.AMPLITUDE, load=paper.LOAD, mu=paper.MU)
-    names = ("slip_amplitude", "dissipated_energy", "ecof", "ecof_ratio")
     loop = ("displacement", "force")
-    values = {name: [] for name in (*names, *loop)}
-    for profile in _scar_profiles().values():
+    values = {name: [] for name in (*_STEADY, *loop)}
+    for profile in _scar_profiles():
         steady = steady_numbers_and_loops(profile, **rig, stiffness=ratios * paper.LOAD)
         numbers = {name: np.asarray(value) for name, value in steady.items()}
         numbers |= steady_values(numbers, paper.AMPLITUDE, paper.LOAD, paper.MU)  # as maps
@@ -230,7 +224,7 @@ def scar_shape_model_dataset() -> xr.Dataset:
         name: (("shape", "point" if name in loop else "stiffness_ratio"), np.array(value))
         for name, value in values.items()
     }
-    return _labelled(variables, {"shape": _SHAPES_COORDS["shape"], "stiffness_ratio": ratios})
+    return _labelled(variables, {"shape": list(SCAR_SHAPES), "stiffness_ratio": ratios})
 
 
 def scar_shape_parabola_dataset() -> xr.Dataset:
@@ -240,23 +234,18 @@ def scar_shape_parabola_dataset() -> xr.Dataset:
 
     ratios = _SHAPES_STIFFNESS_RATIOS
     position = np.linspace(-1.6, 1.6, 321) * paper.AMPLITUDE
-    heights = [np.interp(position, p.position, p.height) for p in _scar_profiles().values()]
+    heights = [np.interp(position, p.position, p.height) for p in _scar_profiles()]
     # Not cached on its own: the figure's part is cached whole (_scar_shape_parabola).
     grid = dict(amplitude=paper.AMPLITUDE, mu=paper.MU, load=paper.LOAD, cache=False)
     parabola = compute_map(ratios, paper.ASPECT_RATIO, **grid)
     loop = np.asarray(ecofmaps.fretting_loop(**_SHAPES_RIG, aspect_ratio=paper.ASPECT_RATIO))
-    names = ("slip_amplitude", "dissipated_energy", "ecof", "ecof_ratio")
     variables = {
         "scar_height": (("shape", "scar_position"), np.array(heights)),
-        **{name: ("stiffness_ratio", parabola[name].values) for name in names},
+        **{name: ("stiffness_ratio", parabola[name].values) for name in _STEADY},
         "displacement": ("point", loop[0]),
         "force": ("point", loop[1]),
     }
-    coords = {
-        "shape": _SHAPES_COORDS["shape"],
-        "scar_position": position,
-        "stiffness_ratio": ratios,
-    }
+    coords = {"shape": list(SCAR_SHAPES), "scar_position": position, "stiffness_ratio": ratios}
     return _labelled(variables, coords)
 
 
@@ -273,24 +262,24 @@ def scar_shapes_dataset() -> xr.Dataset:
         errors.append(np.asarray(corrected) / paper.MU - 1.0)
 
     def by_groove(name, index=...):
-        """The profile's values and the parabola's, for each shape, over (shape, groove, ...)."""
+        """The profile's values and the parabola's over (shape, groove, ...)."""
         on_profile = model[name].values[:, index]
         same = np.broadcast_to(parabola[name].values[index], on_profile.shape)
         return np.stack([on_profile, same], axis=1)
 
     groove = ("shape", "groove")
-    steady = ("slip_amplitude", "dissipated_energy", "ecof")
     variables = {
         "scar_height": (("shape", "scar_position"), parabola["scar_height"].values),
         "displacement": ((*groove, "point"), by_groove("displacement")),
         "force": ((*groove, "point"), by_groove("force")),
-        **{name: (groove, by_groove(name, _AT_EXAMPLE)) for name in steady},
+        **{name: (groove, by_groove(name, _AT_EXAMPLE)) for name in _STEADY[:3]},
         "ecof_ratio": ((*groove, "stiffness_ratio"), by_groove("ecof_ratio")),
         "shortcut_error": (("shape", "stiffness_ratio"), np.array(errors)),
     }
     depth = paper.ASPECT_RATIO * paper.AMPLITUDE
     coords = {
-        **_SHAPES_COORDS,
+        "shape": list(SCAR_SHAPES),
+        "groove": ["profile", "parabola"],
         "scar_position": parabola["scar_position"].values,
         "stiffness_ratio": ratios,
         **_SHAPES_RIG,

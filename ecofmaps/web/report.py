@@ -42,7 +42,7 @@ from ecofmaps.io.tables import results_table
 from ecofmaps.lab import transition
 from ecofmaps.lab.regime import sliding_condition_line
 from ecofmaps.lab.wear import cumulated_energy
-from ecofmaps.measured.quality import REASONS, SEPARATOR, quality_summary
+from ecofmaps.measured.quality import REASONS, has_reason, quality_summary
 from ecofmaps.model.simulation import fretting_loop
 
 __all__ = ["LOOPS_CARRIED", "recording_inputs", "report_document", "write_report"]
@@ -257,14 +257,12 @@ def _header(results: xr.Dataset, inputs: Mapping) -> Div:
 
 def _lab_numbers(results: xr.Dataset, lab: Mapping) -> Div:
     """The test's cumulated dissipated energy, its transition if it crosses one, and ``lab``."""
-    cycle = results["cycle"].values.astype(np.float64)
+    name, last = QUANTITIES["cumulated_energy"].long_name, float(results["cycle"][-1])
     try:
         energy = with_se("cumulated_energy", *cumulated_energy(results))
-        rows = {
-            QUANTITIES["cumulated_energy"].long_name: f"{energy} over cycles 1 to {cycle[-1]:.0f}"
-        }
+        rows = {name: f"{energy} over cycles 1 to {last:.0f}"}
     except ValueError as error:
-        rows = {QUANTITIES["cumulated_energy"].long_name: str(error)}
+        rows = {name: str(error)}
     try:
         found = transition(results)
     except ValueError as error:
@@ -341,14 +339,9 @@ def _cycle_figure(**options):
 
 def _flagged_cycles(results: xr.Dataset) -> dict[str, np.ndarray]:
     """The cycles each quality reason flags, in the order of :data:`REASONS`."""
-    quality = results["quality"].values.astype(str)
     cycle = results["cycle"].values
-    flagged = {}
-    for reason in REASONS:
-        marked = np.array([reason in text.split(SEPARATOR) for text in quality], dtype=bool)
-        if marked.any():
-            flagged[reason] = cycle[marked]
-    return flagged
+    flagged = {reason: cycle[has_reason(results["quality"].values, reason)] for reason in REASONS}
+    return {reason: cycles for reason, cycles in flagged.items() if cycles.size}
 
 
 def _flags_figure(results: xr.Dataset, evolution):
@@ -414,32 +407,24 @@ def _carried_cycles(results: xr.Dataset, loops) -> np.ndarray:
 
 
 def _model_loops(results: xr.Dataset) -> tuple[list, list]:
-    """The model's steady loop of each cycle, for its friction and groove read along the stroke, in
-    µm and N."""
-    empty = np.zeros(0)
-    count = results["cycle"].size
+    """The model's steady loop of each cycle for its μ and z_o/x_o read along the stroke [µm, N]."""
+    xs, ys = [np.zeros(0)] * results["cycle"].size, [np.zeros(0)] * results["cycle"].size
     if "mu_resolved" not in results or "aspect_ratio" not in results:
-        return [empty] * count, [empty] * count
-    values = {
-        name: results[name].values
-        for name in ("amplitude", "stiffness", "mu_resolved", "aspect_ratio")
-    }
-    usable = np.all([np.isfinite(value) for value in values.values()], axis=0)
-    usable &= (values["amplitude"] > 0) & (values["stiffness"] > 0)
-    usable &= (values["mu_resolved"] > 0) & (values["aspect_ratio"] >= 0)
-    xs, ys = [empty] * count, [empty] * count
-    if usable.any():
-        # Padded to a multiple of _MODEL_BATCH loops (repeating them): the compiled model is
-        # then reused by every report, not compiled again for each number of loops.
-        size = -(-int(usable.sum()) // _MODEL_BATCH) * _MODEL_BATCH
-        amplitude, stiffness, mu, ratio = (np.resize(v[usable], size) for v in values.values())
-        loop = fretting_loop(
-            amplitude, float(results["load"]), stiffness, mu, ratio, num=_MODEL_POINTS
-        )
-        displacement = np.round(np.asarray(loop[0]) * 1e6, 4)
-        force = np.round(np.asarray(loop[1]), 3)
-        for row_index, index in enumerate(np.flatnonzero(usable)):
-            xs[index], ys[index] = displacement[row_index], force[row_index]
+        return xs, ys
+    names = ("amplitude", "stiffness", "mu_resolved", "aspect_ratio")
+    amplitude, stiffness, mu, ratio = values = [results[name].values for name in names]
+    usable = np.isfinite(values).all(axis=0) & (ratio >= 0)
+    usable &= (amplitude > 0) & (stiffness > 0) & (mu > 0)
+    if not usable.any():
+        return xs, ys
+    # Padded to a multiple of _MODEL_BATCH loops (repeating them): the compiled model is then
+    # reused by every report, not compiled again for each number of loops.
+    size = -(-int(usable.sum()) // _MODEL_BATCH) * _MODEL_BATCH
+    amplitude, stiffness, mu, ratio = (np.resize(v[usable], size) for v in values)
+    loop = fretting_loop(amplitude, float(results["load"]), stiffness, mu, ratio, num=_MODEL_POINTS)
+    displacement, force = np.round(np.asarray(loop[0]) * 1e6, 4), np.round(np.asarray(loop[1]), 3)
+    for row_index, index in enumerate(np.flatnonzero(usable)):
+        xs[index], ys[index] = displacement[row_index], force[row_index]
     return xs, ys
 
 
@@ -450,7 +435,7 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
     model_xs, model_ys = _model_loops(chosen)
     measured_x = np.round(chosen["loop_displacement"].values * 1e6, 4)
     measured_y = np.round(chosen["loop_force"].values, 3)
-    kept = [np.isfinite(x) & np.isfinite(y) for x, y in zip(measured_x, measured_y, strict=True)]
+    kept = np.isfinite(measured_x) & np.isfinite(measured_y)
     xs = [x[keep] for x, keep in zip(measured_x, kept, strict=True)]
     ys = [y[keep] for y, keep in zip(measured_y, kept, strict=True)]
     all_loops = ColumnDataSource(
@@ -458,7 +443,22 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
     )
     first = list(dict.fromkeys([names[0], names[len(names) // 2], names[-1]]))
     palette = list(Category10_10)
-    measured, model = ColumnDataSource(name="shown-loops"), ColumnDataSource(name="shown-models")
+    # The loops first shown, as _PICK_LOOPS shows those picked (at most three: a colour each)
+    at = [names.index(name) for name in first]
+    colors = palette[: len(first)]
+    measured = ColumnDataSource(
+        {"xs": [xs[i] for i in at], "ys": [ys[i] for i in at], "label": first, "color": colors},
+        name="shown-loops",
+    )
+    modelled = [(i, color) for i, color in zip(at, colors, strict=True) if len(model_xs[i])]
+    model = ColumnDataSource(
+        {
+            "xs": [model_xs[i] for i, _ in modelled],
+            "ys": [model_ys[i] for i, _ in modelled],
+            "color": [color for _, color in modelled],
+        },
+        name="shown-models",
+    )
     plot = figure(
         width=700,
         height=460,
@@ -482,7 +482,6 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
     )
     shown = dict(carried=all_loops, choice=choice, measured=measured, model=model, palette=palette)
     choice.js_on_change("value", CustomJS(args=shown, code=_PICK_LOOPS))
-    _fill_shown(all_loops.data, first, palette, measured, model)
     note = Div(
         text="<p>Each loop is centred (the sensors' offsets removed). The dashed loop is the "
         "model's steady loop (eq. 9, 10, 16) for the cycle's amplitude, rig stiffness S, "
@@ -491,26 +490,6 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
         width=480,
     )
     return row(plot, column(choice, note))
-
-
-def _fill_shown(carried: dict, names, palette, measured, model) -> None:
-    """Put the loops of cycles ``names`` into the sources drawn, as :data:`_PICK_LOOPS` does."""
-    indices = [carried["label"].index(name) for name in names]
-    colors = [palette[k % len(palette)] for k in range(len(names))]
-    measured.data = {
-        "xs": [carried["xs"][i] for i in indices],
-        "ys": [carried["ys"][i] for i in indices],
-        "label": list(names),
-        "color": colors,
-    }
-    modelled = [
-        (i, color) for i, color in zip(indices, colors, strict=True) if len(carried["model_xs"][i])
-    ]
-    model.data = {
-        "xs": [carried["model_xs"][i] for i, _ in modelled],
-        "ys": [carried["model_ys"][i] for i, _ in modelled],
-        "color": [color for _, color in modelled],
-    }
 
 
 def _column_decimals(values, digits: int = _DIGITS) -> int:
