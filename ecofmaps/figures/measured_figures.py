@@ -1,9 +1,6 @@
 r"""Figures of measured loops: the loops with :math:`Q = S\Delta`, the friction over the test (as
-the paper's Figure 9), the fitted model (as its Figure 10) and the loops read along the stroke.
-
-Each takes the results of :func:`ecofmaps.analyze_loops` or :func:`ecofmaps.fit_loop` and
-returns a :class:`matplotlib.figure.Figure`, titled by the recording's name (``source``) and
-what it shows; legends never cover what is drawn.
+the paper's Figure 9), the fitted model (as its Figure 10) and the loops read along the stroke,
+titled by the recording's name (``source``), legends clear of the data (docs/loops.md).
 """
 
 from __future__ import annotations
@@ -121,8 +118,7 @@ def measured_loops(
     load = scalar(results, "load")
     for ax, label in zip(axes.flat, chosen, strict=False):
         cycle = results.sel(cycle=label)
-        x = cycle["loop_displacement"].values * MICRO
-        q = cycle["loop_force"].values
+        x, q = cycle["loop_displacement"].values * MICRO, cycle["loop_force"].values
         ax.plot(x, q, color="tab:blue", linewidth=1.2, label="measured loop")
         stiffness = float(cycle["stiffness"])
         if np.isfinite(stiffness) and stiffness > 0:  # across the loop's height, within its width
@@ -176,11 +172,11 @@ def _crossings(ax, cycle: xr.Dataset, load: float) -> None:
         ax.plot(crossings * MICRO, ratios * load, linestyle="none", label="GICoF crossings", **dots)
 
 
-def _flags_text(quality: str, width: int = 50) -> str:
-    """A cycle's flags, comma separated, or the first and how many more beyond ``width``."""
+def _flags_text(quality: str) -> str:
+    """A cycle's flags, comma separated, or the first and how many more beyond 50 characters."""
     reasons = quality.split(SEPARATOR)
     text = ", ".join(reasons)
-    if len(text) <= width or len(reasons) == 1:
+    if len(text) <= 50 or len(reasons) == 1:
         return text
     return f"{reasons[0]} and {len(reasons) - 1} more"
 
@@ -188,13 +184,12 @@ def _flags_text(quality: str, width: int = 50) -> str:
 def _resolved_band(ax, cycle: xr.Dataset, q) -> None:
     """Shade the contact positions ξ_min <= Δ - Q/S <= ξ_max that were read along the stroke."""
     low, high = float(cycle["position_min"]), float(cycle["position_max"])
-    if not (np.isfinite(low) and np.isfinite(high)):
-        return
-    force = np.linspace(np.nanmin(q), np.nanmax(q), 2)
-    compliance = 1.0 / float(cycle["stiffness"])
-    low, high = (low + compliance * force) * MICRO, (high + compliance * force) * MICRO
-    band = dict(color="tab:green", alpha=0.12, linewidth=0, label="read along the stroke")
-    ax.fill_betweenx(force, low, high, **band)
+    if np.isfinite(low) and np.isfinite(high):
+        force = np.linspace(np.nanmin(q), np.nanmax(q), 2)
+        compliance = 1.0 / float(cycle["stiffness"])
+        low, high = (low + compliance * force) * MICRO, (high + compliance * force) * MICRO
+        band = dict(color="tab:green", alpha=0.12, linewidth=0, label="read along the stroke")
+        ax.fill_betweenx(force, low, high, **band)
 
 
 def cof_evolution(results: xr.Dataset, *, source: str | None = None) -> Figure:

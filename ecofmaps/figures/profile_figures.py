@@ -71,30 +71,21 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
     position = np.asarray(profile.position)
     if position.ndim != 1:
         raise ValueError("scar_profile_figure draws one profile, not a batch")
-    x = position * MICRO
-    height = np.asarray(profile.height) * MICRO
-    slope = np.asarray(profile.slope)
+    x, slope = position * MICRO, np.asarray(profile.slope)
     depth, width = float(profile.depth), float(profile.half_width)
     surface = float(profile.reference_height) + float(profile.reference_slope) * position
     figure = Figure(figsize=(7.4, 6.4), layout="constrained")
     top, bottom = figure.subplots(2, 1, sharex=True, height_ratios=(1.25, 1.0))
+    height = np.asarray(profile.height) * MICRO
     top.plot(x, height, color="tab:blue", linewidth=1.6, label="profile $z(X)$")
-    unworn = dict(
-        color="0.3", linewidth=1.0, linestyle="--", label="unworn surface (levelling line)"
-    )
-    top.plot(x, surface * MICRO, **unworn)
+    unworn = dict(color="0.3", linewidth=1.0, linestyle="--")
+    top.plot(x, surface * MICRO, **unworn, label="unworn surface (levelling line)")
     level = float(profile.reference_height) * MICRO
     bottom_of_scar = level - depth * MICRO
     arrow = dict(arrowstyle="<->", color="crimson", linewidth=1.2)
     top.annotate("", xy=(0.0, bottom_of_scar), xytext=(0.0, level), arrowprops=arrow)
-    label = f"  $D$ = {depth * MICRO:.4g} µm"
-    top.text(
-        0.02 * width * MICRO,
-        bottom_of_scar + 0.5 * depth * MICRO,
-        label,
-        color="crimson",
-        va="center",
-    )
+    label, where = f"  $D$ = {depth * MICRO:.4g} µm", bottom_of_scar + 0.5 * depth * MICRO
+    top.text(0.02 * width * MICRO, where, label, color="crimson", va="center")
     parabola = 2.0 * depth * position / width**2 + float(profile.reference_slope)
     inside = np.abs(position) <= width
     bowl = surface[inside] - depth * (1.0 - (position[inside] / width) ** 2)
@@ -111,14 +102,13 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
     top.set_ylabel(axis_label("scar_height"))
     bottom.set_ylabel(axis_label("scar_slope"))
     bottom.set_xlabel(axis_label("scar_position") + " from the scar centre")
-    # The slopes outside the scar can dwarf those inside (steep walls, ridges): show the
-    # scar's range, with a margin.
+    # The slopes outside the scar can dwarf those inside (steep walls, ridges): the scar's.
     within = np.abs(position) <= 1.5 * width
     reach = max(float(np.max(np.abs(slope[within]))), 2.0 * depth / width)
     bottom.set_ylim(-1.15 * reach, 1.15 * reach)
-    title = "Wear-scar profile" + (f": {name}" if name else "")
     top.set_title(
-        title
+        "Wear-scar profile"
+        + (f": {name}" if name else "")
         + "\n"
         + parameters(
             f"$D$ = {depth * MICRO:.4g} µm",

@@ -203,20 +203,15 @@ def _number(value: float, factor: float = 1.0) -> str:
     return format(shown, ".3f" if abs(shown) < 1e5 else ".6g")
 
 
-def _inputs_html(values: dict) -> str:
-    """The model's inputs as the page read them, each with its unit (a bare number is SI)."""
+def _values_html(point: ExplorerPoint, values: dict) -> str:
+    """The inputs as read (a bare number is SI) and the model's numbers at the point, each with
+    its unit in a span the page and its tests can find."""
     read = []
     for key in _MODEL_INPUTS:
         quantity = QUANTITIES[INPUTS[key][0]]
         value = values[key] * quantity.display_factor
         text = "inf (a rigid rig)" if math.isinf(value) else f"{value:g} {quantity.display_unit}"
         read.append(f"{quantity.symbol} = {text.strip()}")
-    return f"<p style='margin:0 0 6px 0;color:#555'>Read as {', '.join(read)}.</p>"
-
-
-def _values_html(point: ExplorerPoint, values: dict) -> str:
-    """The inputs as read, and the model's numbers at the point, each with its unit in a span
-    the page and its tests can find."""
     rows = [
         ("slip_amplitude", "Slip amplitude δ*", point.slip_amplitude),
         ("dissipated_energy", "Dissipated energy E_d", point.dissipated_energy),
@@ -232,9 +227,10 @@ def _values_html(point: ExplorerPoint, values: dict) -> str:
             f"<td><span class='ecofmaps-value' data-quantity='{key}' data-unit='{unit}'>"
             f"{_number(value, quantity.display_factor)}</span> {unit}</td></tr>"
         )
+    inputs = f"<p style='margin:0 0 6px 0;color:#555'>Read as {', '.join(read)}.</p>"
     gross = math.isfinite(point.ecof_ratio)
     regime = "" if gross else "<p><b>No gross slip</b> (μP/S ≥ Δ*): μ_E is undefined.</p>"
-    return f"{_inputs_html(values)}<table style='font-size:14px'>{''.join(cells)}</table>{regime}"
+    return f"{inputs}<table style='font-size:14px'>{''.join(cells)}</table>{regime}"
 
 
 def _correction_html(values: dict) -> str:
@@ -256,28 +252,6 @@ def _correction_html(values: dict) -> str:
         f"{_number(float(interval.low))}</span> to <span class='ecofmaps-value' "
         f"data-quantity='mu_high'>{_number(float(interval.high))}</span>.</p>"
     )
-
-
-def _loop_figure():
-    """The steady loop's figure and its data source (Q [N] against Δ [µm])."""
-    source = ColumnDataSource({"x": [], "y": []})
-    plot = figure(
-        width=440,
-        height=380,
-        title="Steady fretting loop",
-        x_axis_label="Applied displacement Δ [µm]",
-        y_axis_label="Tangential force Q [N]",
-        tools="pan,box_zoom,wheel_zoom,reset,save",
-    )
-    plot.line("x", "y", source=source, line_width=2, color="#1f77b4")
-    return plot, source
-
-
-def _band_colors(levels) -> list:
-    """The colour of each band between ``levels``, as Figure 11 fills it."""
-    cmap, norm = ecof_ratio_colors()
-    middles = (np.asarray(levels[:-1]) + np.asarray(levels[1:])) / 2
-    return [to_hex(cmap(norm(middle))) for middle in middles]
 
 
 def _fill_levels(top: float) -> list:
@@ -314,8 +288,7 @@ _HATCH = {
     "hatch_scale": 10,
 }
 
-# The map plot's size and the part of it the axes take, roughly. [px]
-_MAP_SIZE = (600, 470)
+#: The part of the map plot (600 × 470) its axes take, roughly. [px]
 _MAP_FRAME = (440, 290)
 
 
@@ -323,8 +296,8 @@ def _map_figure():
     """The μ_E/μ map's figure and what an update changes in it, by name: the filled bands,
     the labelled lines, the hatched no-gross-slip area, the hover's image and the marker."""
     plot = figure(
-        width=_MAP_SIZE[0],
-        height=_MAP_SIZE[1],
+        width=600,
+        height=470,
         title="μ_E/μ over rig stiffness and groove shape (x_o = Δ*)",
         x_axis_label="Stiffness over load S/P [(MN/m)/kN = 1/mm]",
         y_axis_label="Groove aspect ratio z_o/x_o [1]",
@@ -334,7 +307,9 @@ def _map_figure():
     )
     empty = ([0, 1], [0, 1], np.full((2, 2), np.nan))
     levels = _fill_levels(ECOF_RATIO_LEVELS[-1])
-    bands = plot.contour(*empty, levels, fill_color=_band_colors(levels))
+    cmap, norm = ecof_ratio_colors()  # each band in Figure 11's colour of its middle
+    middles = (np.asarray(levels[:-1]) + np.asarray(levels[1:])) / 2
+    bands = plot.contour(*empty, levels, fill_color=[to_hex(cmap(norm(m))) for m in middles])
     widths = [3.0 if level == HIGHLIGHT_LEVEL else 1.0 for level in ECOF_RATIO_LEVELS]
     lines = plot.contour(*empty, ECOF_RATIO_LEVELS, line_color="black", line_width=widths)
     labels = ColumnDataSource({"x": [], "y": [], "text": [], "angle": []})
@@ -433,7 +408,16 @@ def explorer_page():
     correction_pane = pn.pane.HTML("", width=760, margin=(18, 10))
     message = pn.pane.HTML("", width=900, styles={"color": "#b00020"})
     notice = pn.pane.HTML("", width=900, styles={"color": "#8a4b00"})
-    loop_plot, loop_source = _loop_figure()
+    loop_source = ColumnDataSource({"x": [], "y": []})
+    loop_plot = figure(
+        width=440,
+        height=380,
+        title="Steady fretting loop",
+        x_axis_label="Applied displacement Δ [µm]",
+        y_axis_label="Tangential force Q [N]",
+        tools="pan,box_zoom,wheel_zoom,reset,save",
+    )
+    loop_plot.line("x", "y", source=loop_source, line_width=2, color="#1f77b4")
     map_plot, map_parts = _map_figure()
 
     def show(values):

@@ -28,20 +28,10 @@ _QUERY_LIMIT = 1000
 LOCAL_HOSTS = ("127.0.0.1", "localhost")
 
 
-def _allowed_hosts(port: int, allow_origin=()) -> frozenset:
-    """The ``host:port`` the explorer answers: :data:`LOCAL_HOSTS` at ``port``, and each of
-    ``allow_origin`` (``host`` or ``host:port``; without a port, ``port``), in lower case."""
-    hosts = {f"{host}:{port}" for host in LOCAL_HOSTS}
-    for entry in allow_origin:
-        entry = entry.strip().lower()
-        hosts.add(entry if re.fullmatch(r".*:\d+", entry) else f"{entry}:{port}")
-    return frozenset(hosts)
-
-
 class _Foreign(Matcher):
     """Matches a request whose Host, or Origin if it has one, is not an allowed host."""
 
-    def __init__(self, hosts: frozenset):
+    def __init__(self, hosts: set):
         self.hosts = hosts
 
     def match(self, request):
@@ -113,7 +103,9 @@ def serve_explorer(port: int, *, open_browser: bool = True, announce=print, allo
     previous = {number: signal.getsignal(number) for number in (signal.SIGINT, signal.SIGTERM)}
     ours = [number for number, before in previous.items() if before not in (signal.SIG_IGN, None)]
     url = f"http://127.0.0.1:{port}/"
-    hosts = _allowed_hosts(port, allow_origin)
+    hosts = {f"{host}:{port}" for host in LOCAL_HOSTS}  # and each allowed, at port if none
+    for entry in (entry.strip().lower() for entry in allow_origin):
+        hosts.add(entry if re.fullmatch(r".*:\d+", entry) else f"{entry}:{port}")
     server = get_server(
         {"/": explorer_page},
         port=port,
@@ -149,13 +141,9 @@ def serve_explorer(port: int, *, open_browser: bool = True, announce=print, allo
         for number in ours:
             signal.signal(number, previous[number])
         server.stop()
-        _close(loop.asyncio_loop)
-
-
-def _close(event_loop: asyncio.AbstractEventLoop) -> None:
-    """Cancel what is still pending on the server's event loop (the sessions' tasks)."""
-    pending = [task for task in asyncio.all_tasks(event_loop) if not task.done()]
-    for task in pending:
-        task.cancel()
-    if pending and not event_loop.is_closed():
-        event_loop.run_until_complete(asyncio.gather(*pending, return_exceptions=True))
+        # What is still pending on the event loop (the sessions' tasks) cancelled.
+        pending = [task for task in asyncio.all_tasks(loop.asyncio_loop) if not task.done()]
+        for task in pending:
+            task.cancel()
+        if pending and not loop.asyncio_loop.is_closed():
+            loop.asyncio_loop.run_until_complete(asyncio.gather(*pending, return_exceptions=True))
