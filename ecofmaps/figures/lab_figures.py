@@ -60,13 +60,8 @@ def running_condition_map(results, transition: xr.Dataset, rig_stiffness: float)
         condition = sliding_condition(test, rig_stiffness).attrs["sliding_condition"]
         marker, face = _CONDITION_MARKERS[condition]
         style = dict(marker=marker, markerfacecolor=face, markeredgecolor="black", linestyle="")
-        label = None if condition in drawn else condition
-        ax.plot(
-            np.nanmedian(cycles["amplitude"]) * MICRO,
-            np.nanmedian(cycles["load"]),
-            **style,
-            label=label,
-        )
+        style["label"] = None if condition in drawn else condition
+        ax.plot(np.nanmedian(cycles["amplitude"]) * MICRO, np.nanmedian(cycles["load"]), **style)
         drawn.add(condition)
     top = 1.15 * ax.get_ylim()[1]
     load = np.linspace(0.0, top, 50)

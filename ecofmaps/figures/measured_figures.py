@@ -368,11 +368,11 @@ def resolved_loops(
     central = float(resolved.attrs.get("central", np.nan))
     if chosen and np.isfinite(central):
         picked = resolved.sel(cycle=chosen)
-        reach = central * min(
-            -float(picked["position_min"].max()), float(picked["position_max"].min())
+        low, high = -float(picked["position_min"].max()), float(picked["position_max"].min())
+        reach = central * min(low, high)
+        stroke.axvspan(
+            -reach * MICRO, reach * MICRO, color="0.9", zorder=0, label="central part averaged"
         )
-        averaged = dict(color="0.9", zorder=0, label="central part averaged")
-        stroke.axvspan(-reach * MICRO, reach * MICRO, **averaged)
     stroke.set(xlabel=axis_label("position"), ylabel=r"Coefficient of friction $\mu(\xi)$ [1]")
     stroke.set_title(r"(a) $\mu$ along the stroke (dashed: its average)", fontsize="medium")
     felt.set(xlabel=axis_label("position"), ylabel=r"Felt groove profile $h(\xi)$ [µm]")
@@ -394,17 +394,15 @@ def resolved_loops(
         fontsize="medium",
     )
     # The layout done with the titles: each legend's place, clear of its panel's data.
-    if chosen:
-        legend_clear_of_data(stroke, fontsize="x-small", ncols=2)
-        legend_clear_of_data(felt, fontsize="x-small", ncols=2)
+    for ax in (stroke, felt) if chosen else ():
+        legend_clear_of_data(ax, fontsize="x-small", ncols=2)
     legend_clear_of_data(test, twins=twins, fontsize="x-small")
     return figure
 
 
 def _profile_over_test(figure: Figure, image, resolved: xr.Dataset) -> None:
     """Panel (c): the felt profile h [µm] over (position, cycle), one row per cycle."""
-    labels = resolved["cycle"].values
-    xi = resolved["position"].values * MICRO
+    labels, xi = resolved["cycle"].values, resolved["position"].values * MICRO
     profile = resolved["felt_profile"].transpose("cycle", "position").values * MICRO
     image.set(xlabel=axis_label("position"), ylabel=axis_label("cycle"))
     image.set_title("(c) felt profile over the test", fontsize="medium")
@@ -426,8 +424,7 @@ def _profile_over_test(figure: Figure, image, resolved: xr.Dataset) -> None:
 
 def _mu_over_test(test, resolved: xr.Dataset, results: xr.Dataset | None) -> tuple:
     """Panel (d), without its legend; its right-hand axis, if any, in a tuple."""
-    number = resolved["cycle"].values
-    mu = resolved["mu_resolved"].values
+    number, mu = resolved["cycle"].values, resolved["mu_resolved"].values
     error = 2.0 * resolved["mu_resolved_se"].values
     marker = dict(marker="o", markersize=3) if number.size <= 400 else {}
     band = dict(label=r"$\pm$2 standard errors")
@@ -448,10 +445,9 @@ def _mu_over_test(test, resolved: xr.Dataset, results: xr.Dataset | None) -> tup
             if np.isfinite(drawn[-1]).any():
                 test.plot(number, drawn[-1], color=color, linewidth=1.0, label=label, **marker)
     drawn = np.concatenate([values[np.isfinite(values)] for values in drawn])
-    quality = resolved["quality"].values
-    missing = quality != "ok"
+    missing = resolved["quality"].values != "ok"
     if missing.any():
-        reasons = ", ".join(sorted(set(_reasons(quality[missing]))))
+        reasons = ", ".join(sorted(set(_reasons(resolved["quality"].values[missing]))))
         # Along the lowest value drawn; with none, halfway up the panel: no friction scale.
         height, where = (
             (drawn.min(), test.transData) if drawn.size else (0.5, test.get_xaxis_transform())

@@ -68,9 +68,8 @@ def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
         ax.plot(loop.displacement * MICRO, loop.force, color=color, label=label, **style)
     _loop_axes(ax, loops)
     rig = parameters_of(loops, "amplitude", "load", "aspect_ratio", "mu")
-    ax.set_title(
-        f"Fig. 5  Fretting loop: rigid rig against a compliant one\n{rig}", fontsize="medium"
-    )
+    title = f"Fig. 5  Fretting loop: rigid rig against a compliant one\n{rig}"
+    ax.set_title(title, fontsize="medium")
     ax.legend(loc="upper left", fontsize="small")
     return figure
 
@@ -127,8 +126,11 @@ def loops_by_aspect_ratio(loops: xr.Dataset) -> Figure:
     return figure
 
 
-def _stiffness_curves(dataset: xr.Dataset, variable: str, scale: float, number: str) -> Figure:
-    """One curve of ``dataset[variable] * scale`` against z_o/x_o per rig stiffness."""
+def _stiffness_curves(
+    dataset: xr.Dataset, variable: str, scale: float, number: str, loc: str, markers=None
+) -> Figure:
+    """One curve of ``dataset[variable] * scale`` against z_o/x_o per rig stiffness, the
+    ``markers`` of :func:`ecof_ratio_curves`, a legend at ``loc`` listing the stiffest first."""
     figure = Figure(figsize=FIGSIZE, layout="constrained")
     ax = figure.add_subplot()
     load = scalar(dataset, "load")
@@ -143,14 +145,20 @@ def _stiffness_curves(dataset: xr.Dataset, variable: str, scale: float, number: 
     ax.grid(alpha=0.3)
     rig = parameters_of(dataset, "amplitude", "load", "mu")
     ax.set_title(f"Fig. {number}\n{rig}", fontsize="medium")
-    return figure
-
-
-def _legend_top_down(ax, rigs: int, loc: str) -> None:
-    """A legend listing the ``rigs`` curves stiffest first, as they stack, then the rest."""
-    handles, labels = ax.get_legend_handles_labels()
-    order = [*reversed(range(rigs)), *range(rigs, len(labels))]
+    for name, point in (markers or {}).items():
+        curve = dataset["ecof_ratio"].sel(stiffness_ratio=point["stiffness"] / load)
+        value = float(curve.interp(aspect_ratio=point["aspect_ratio"]))
+        label = (
+            rf"{name} ({stiffness_label(point['stiffness'])}, "
+            rf"$z_o/x_o$ = {point['aspect_ratio']:g}): $\mu_E/\mu$ = {value:.3f} "
+            rf"(+{(value - 1) * 100:.1f} %)"
+        )
+        dot = dict(color="crimson", markersize=9, zorder=5, label=label)
+        ax.plot(point["aspect_ratio"], value, "o", **dot)
+    handles, labels = ax.get_legend_handles_labels()  # the curves as they stack, then the rest
+    order = [*reversed(range(stiffnesses.size)), *range(stiffnesses.size, len(labels))]
     ax.legend([handles[i] for i in order], [labels[i] for i in order], loc=loc, fontsize="small")
+    return figure
 
 
 def slip_amplitude_curves(dataset: xr.Dataset) -> Figure:
@@ -172,9 +180,7 @@ def slip_amplitude_curves(dataset: xr.Dataset) -> Figure:
     to its own deflection as the groove deepens (eq. 16).
     """
     title = "7a  Slip amplitude against the groove aspect ratio"
-    figure = _stiffness_curves(dataset, "slip_amplitude", MICRO, title)
-    _legend_top_down(figure.axes[0], dataset.sizes["stiffness_ratio"], loc="lower left")
-    return figure
+    return _stiffness_curves(dataset, "slip_amplitude", MICRO, title, "lower left")
 
 
 def dissipated_energy_curves(dataset: xr.Dataset) -> Figure:
@@ -195,9 +201,7 @@ def dissipated_energy_curves(dataset: xr.Dataset) -> Figure:
     for stiff rigs and falls for compliant ones.
     """
     title = "7b  Dissipated energy against the groove aspect ratio"
-    figure = _stiffness_curves(dataset, "dissipated_energy", MILLI, title)
-    _legend_top_down(figure.axes[0], dataset.sizes["stiffness_ratio"], loc="upper left")
-    return figure
+    return _stiffness_curves(dataset, "dissipated_energy", MILLI, title, "upper left")
 
 
 def ecof_ratio_curves(dataset: xr.Dataset, markers: Mapping[str, Mapping] | None = None) -> Figure:
@@ -222,20 +226,4 @@ def ecof_ratio_curves(dataset: xr.Dataset, markers: Mapping[str, Mapping] | None
     above :math:`\mu`.
     """
     title = "8  ECoF over the contact CoF against the groove aspect ratio"
-    figure = _stiffness_curves(dataset, "ecof_ratio", 1.0, title)
-    ax = figure.axes[0]
-    for name, point in (markers or {}).items():
-        curve = dataset["ecof_ratio"].sel(
-            stiffness_ratio=point["stiffness"] / scalar(dataset, "load")
-        )
-        value = float(curve.interp(aspect_ratio=point["aspect_ratio"]))
-        label = (
-            rf"{name} ({stiffness_label(point['stiffness'])}, "
-            rf"$z_o/x_o$ = {point['aspect_ratio']:g}): $\mu_E/\mu$ = {value:.3f} "
-            rf"(+{(value - 1) * 100:.1f} %)"
-        )
-        ax.plot(
-            point["aspect_ratio"], value, "o", color="crimson", markersize=9, zorder=5, label=label
-        )
-    _legend_top_down(ax, dataset.sizes["stiffness_ratio"], loc="upper left")
-    return figure
+    return _stiffness_curves(dataset, "ecof_ratio", 1.0, title, "upper left", markers)

@@ -45,8 +45,7 @@ RECORDING_DPI = 300
 
 
 def ecof_ratio_colors() -> tuple:
-    """The colour map of μ_E/μ and its norm: one colour per band of :data:`ECOF_RATIO_LEVELS`,
-    so that a μ_E/μ has one colour on every map (Figure 11, the universal map, the explorer)."""
+    """The colour map of μ_E/μ and its norm: a colour per band of :data:`ECOF_RATIO_LEVELS`."""
     cmap = colormaps["YlOrRd"]
     return cmap, BoundaryNorm([1.0, *ECOF_RATIO_LEVELS], cmap.N, clip=True)
 
@@ -191,10 +190,9 @@ def legend_clear_of_data(ax, *, twins=(), **options):
     covers nothing drawn in them; with no such corner, the value axes are stretched upwards to
     make room above everything drawn, and the legend goes in the upper left."""
     panels = (ax, *twins)
-    handles, labels = [], []
-    for panel in panels:
-        more = panel.get_legend_handles_labels()
-        handles, labels = handles + more[0], labels + more[1]
+    entries = [panel.get_legend_handles_labels() for panel in panels]
+    handles = [handle for more, _ in entries for handle in more]
+    labels = [label for _, more in entries for label in more]
     legend = ax.legend(handles, labels, loc=_CORNERS[0], **options)
     ax.figure.draw_without_rendering()  # the layout done: the legend's and the data's places
     for corner in _CORNERS:
