@@ -313,20 +313,9 @@ def _map_figure():
     widths = [3.0 if level == HIGHLIGHT_LEVEL else 1.0 for level in ECOF_RATIO_LEVELS]
     lines = plot.contour(*empty, ECOF_RATIO_LEVELS, line_color="black", line_width=widths)
     labels = ColumnDataSource({"x": [], "y": [], "text": [], "angle": []})
-    plot.text(
-        "x",
-        "y",
-        text="text",
-        angle="angle",
-        source=labels,
-        name="labels",
-        text_font_size="11px",
-        text_align="center",
-        text_baseline="middle",
-        background_fill_color="white",
-        background_fill_alpha=0.85,
-        padding=1,
-    )
+    text = dict(text_font_size="11px", text_align="center", text_baseline="middle", padding=1)
+    box = dict(background_fill_color="white", background_fill_alpha=0.85)
+    plot.text("x", "y", text="text", angle="angle", source=labels, name="labels", **text, **box)
     stuck = plot.contour(*empty, [0.5, 1.5], line_width=1.0, **_HATCH)
     image = ColumnDataSource({"image": [], "x": [], "y": [], "dw": [], "dh": []})
     hover = plot.image(

@@ -310,19 +310,9 @@ def _evolution_figures(results: xr.Dataset):
             )
         if cycle.size <= 400 and name != "mu_resolved":
             plot.scatter("cycle", name, source=source, color=color, size=3)
-    plot.add_tools(
-        HoverTool(
-            tooltips=[
-                ("cycle", "@cycle"),
-                ("ECoF", "@ecof{0.000000}"),
-                ("GICoF", "@gicof{0.000000}"),
-                ("μ", "@mu_resolved{0.000000}"),
-                ("quality", "@quality"),
-            ],
-            mode="vline",
-            renderers=[drawn["ecof"]],
-        )
-    )
+    tips = [("cycle", "@cycle"), ("ECoF", "@ecof{0.000000}"), ("GICoF", "@gicof{0.000000}")]
+    tips += [("μ", "@mu_resolved{0.000000}"), ("quality", "@quality")]
+    plot.add_tools(HoverTool(tooltips=tips, mode="vline", renderers=[drawn["ecof"]]))
     plot.legend.click_policy = "hide"
     plot.add_layout(plot.legend[0], "right")  # beside the plot: the curves stay uncovered
     return plot, _flags_figure(results, plot)
@@ -492,20 +482,11 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
     return row(plot, column(choice, note))
 
 
-def _column_decimals(values, digits: int = _DIGITS) -> int:
-    """The decimals that show the largest of ``values`` with ``digits`` significant digits, the
-    same for every value of a column.
-
-    Examples
-    --------
-    >>> [_column_decimals(values) for values in ([0.80003, 0.806507], [50.1348, 9.5], [])]
-    [6, 4, 0]
-    """
+def _column_decimals(values) -> int:
+    """The decimals that show the largest of ``values`` with :data:`_DIGITS` significant digits."""
     values = np.abs(np.asarray(values, dtype=np.float64))
     values = values[np.isfinite(values) & (values > 0)]
-    if not values.size:
-        return 0
-    return int(max(0, digits - 1 - np.floor(np.log10(values.max()))))
+    return int(max(0, _DIGITS - 1 - np.floor(np.log10(values.max())))) if values.size else 0
 
 
 def _table(results: xr.Dataset):

@@ -68,6 +68,11 @@ def page(command):
     return command[1]
 
 
+def test_a_column_shows_its_largest_value_to_six_significant_digits():
+    columns = ([0.80003, 0.806507], [50.1348, 9.5], [], [np.nan, 0.0])
+    assert [report._column_decimals(values) for values in columns] == [6, 4, 0, 0]
+
+
 def test_the_page_fetches_nothing(page):
     text = page.read_text(encoding="utf-8")
     assert not re.search(r"<script[^>]*\bsrc=", text)
