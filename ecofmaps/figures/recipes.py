@@ -432,10 +432,8 @@ def make_figures(names=None) -> Iterator[tuple[str, Figure]]:
 
 
 def figure_groups(names=None) -> list[list[str]]:
-    """The figures by the Dataset they share, the costliest group first.
-
-    One process draws each group (``ecofmaps figures --jobs``), building its Dataset once;
-    the costliest first (:attr:`FigureRecipe.cost`), the others for whoever finishes first.
+    """The figures by the Dataset they share, the costliest group (:attr:`FigureRecipe.cost`)
+    first: one process draws each group (``ecofmaps figures --jobs``), building its Dataset once.
 
     Parameters
     ----------
