@@ -332,18 +332,13 @@ def _map_figure():
     nowhere = [math.nan]
     heavy = plot.line(nowhere, nowhere, line_color="black", line_width=3.0)
     hatched = plot.quad(nowhere, nowhere, nowhere, nowhere, **_HATCH)
-    legend = Legend(
-        items=[
-            LegendItem(label=f"μ_E/μ = {HIGHLIGHT_LEVEL:.2f} (5 % above μ)", renderers=[heavy]),
-            LegendItem(label="no gross slip (μP/S ≥ Δ*): μ_E undefined", renderers=[hatched]),
-            LegendItem(label="this test", renderers=[point]),
-        ],
-        orientation="horizontal",
-        label_text_font_size="11px",
-        spacing=12,
-        margin=4,
-    )
-    plot.add_layout(legend, "below")
+    items = [
+        LegendItem(label=f"μ_E/μ = {HIGHLIGHT_LEVEL:.2f} (5 % above μ)", renderers=[heavy]),
+        LegendItem(label="no gross slip (μP/S ≥ Δ*): μ_E undefined", renderers=[hatched]),
+        LegendItem(label="this test", renderers=[point]),
+    ]
+    style = dict(orientation="horizontal", label_text_font_size="11px", spacing=12, margin=4)
+    plot.add_layout(Legend(items=items, **style), "below")
     tips = [("S/P", "$x{0.0} 1/mm"), ("z_o/x_o", "$y{0.000}"), ("μ_E/μ", "@image{0.000}")]
     plot.add_tools(HoverTool(tooltips=tips, renderers=[hover]))
     parts = dict(x_range=plot.x_range, y_range=plot.y_range, bands=bands, colorbar=colorbar)
@@ -409,13 +404,6 @@ def explorer_page():
     loop_plot.line("x", "y", source=loop_source, line_width=2, color="#1f77b4")
     map_plot, map_parts = _map_figure()
 
-    def show(values):
-        point = ExplorerPoint.at(*(values[key] for key in _MODEL_INPUTS))
-        values_pane.object = _values_html(point, values)
-        loop_source.data = {"x": point.loop[0] * 1e6, "y": point.loop[1]}
-        _show_map(values, map_parts)
-        correction_pane.object = _correction_html(values)
-
     def update(*_events):
         """Show the inputs' point; any failure is a message on the page, never Panel's."""
         texts = {key: widget.value for key, widget in inputs.items()}
@@ -429,7 +417,11 @@ def explorer_page():
             message.object = f"<p style='margin:2px 0'>{html.escape(str(error))}</p>"
             return
         try:
-            show(values)
+            point = ExplorerPoint.at(*(values[key] for key in _MODEL_INPUTS))
+            values_pane.object = _values_html(point, values)
+            loop_source.data = {"x": point.loop[0] * 1e6, "y": point.loop[1]}
+            _show_map(values, map_parts)
+            correction_pane.object = _correction_html(values)
         except Exception as error:  # a page must stay up whatever the model says
             text = f"Cannot show this point ({type(error).__name__}: {error})"
             message.object = f"<p style='margin:2px 0'>{html.escape(text)}</p>"
