@@ -73,15 +73,9 @@ def running_condition_map(results, transition: xr.Dataset, rig_stiffness: float)
     ax.set(xlabel=axis_label("amplitude"), ylabel=axis_label("load"))
     ax.grid(alpha=0.3)
     ax.legend(loc="lower right", fontsize="small")
-    ax.set_title(
-        "Running-condition fretting map\n"
-        + parameters(
-            rf"$\delta_t$ = {float(transition.contact_amplitude) * MICRO:.3g} µm",
-            rf"$\mu_t$ = {float(transition.mu):.3g}",
-            stiffness_label(rig_stiffness),
-        ),
-        fontsize="medium",
-    )
+    contact = [rf"$\delta_t$ = {float(transition.contact_amplitude) * MICRO:.3g} µm"]
+    contact += [rf"$\mu_t$ = {float(transition.mu):.3g}", stiffness_label(rig_stiffness)]
+    ax.set_title(f"Running-condition fretting map\n{parameters(*contact)}", fontsize="medium")
     return figure
 
 

@@ -240,12 +240,9 @@ def cof_evolution(results: xr.Dataset, *, source: str | None = None) -> Figure:
     bottom.grid(alpha=0.3)
     _cycle_axis(bottom, cycle)
     amplitude = float(results["amplitude"].median()) * MICRO
-    figure.suptitle(
-        _title("the ECoF and the GICoF over the cycles", source)
-        + "\n"
-        + parameters(load_label(scalar(results, "load")), rf"$\Delta^*$ ≈ {amplitude:.1f} µm"),
-        fontsize="medium",
-    )
+    test = parameters(load_label(scalar(results, "load")), rf"$\Delta^*$ ≈ {amplitude:.1f} µm")
+    title = _title("the ECoF and the GICoF over the cycles", source)
+    figure.suptitle(f"{title}\n{test}", fontsize="medium")
     if top.get_lines():  # the layout done with the title: the legend's place
         legend_clear_of_data(top, fontsize="small")
     return figure
@@ -288,18 +285,14 @@ def measured_and_fitted_loops(fits, *, source: str | None = None) -> Figure:
         force_ratio_axis(ax, fit.load)
         panel = f"({chr(ord('a') + index)}) " if len(panels) > 1 else ""
         panel += f"{name}: " if name else ""
-        ax.set_title(
-            f"{panel}{load_label(fit.load)}, "
-            rf"$x_o = \Delta^*$ = {fit.amplitude * MICRO:.1f} µm"
-            "\n"
-            + parameters(
-                rf"fit: $\mu$ = {fit.mu:.3f}",
-                stiffness_label(fit.stiffness),
-                rf"$z_o$ = {fit.groove_depth * MICRO:.2f} µm",
-                f"RMS residual {fit.rms_residual:.2g} N",
-            ),
-            fontsize="medium",
+        test = rf"{panel}{load_label(fit.load)}, $x_o = \Delta^*$ = {fit.amplitude * MICRO:.1f} µm"
+        fitted = parameters(
+            rf"fit: $\mu$ = {fit.mu:.3f}",
+            stiffness_label(fit.stiffness),
+            rf"$z_o$ = {fit.groove_depth * MICRO:.2f} µm",
+            f"RMS residual {fit.rms_residual:.2g} N",
         )
+        ax.set_title(f"{test}\n{fitted}", fontsize="medium")
     title = _title("measured fretting loops and the fitted model", source)
     figure.suptitle(title, fontsize="medium")
     for ax in axes:  # the layout done with the titles: the legends' places
@@ -370,9 +363,8 @@ def resolved_loops(
         picked = resolved.sel(cycle=chosen)
         low, high = -float(picked["position_min"].max()), float(picked["position_max"].min())
         reach = central * min(low, high)
-        stroke.axvspan(
-            -reach * MICRO, reach * MICRO, color="0.9", zorder=0, label="central part averaged"
-        )
+        averaged = dict(color="0.9", zorder=0, label="central part averaged")
+        stroke.axvspan(-reach * MICRO, reach * MICRO, **averaged)
     stroke.set(xlabel=axis_label("position"), ylabel=r"Coefficient of friction $\mu(\xi)$ [1]")
     stroke.set_title(r"(a) $\mu$ along the stroke (dashed: its average)", fontsize="medium")
     felt.set(xlabel=axis_label("position"), ylabel=r"Felt groove profile $h(\xi)$ [µm]")

@@ -106,18 +106,10 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
     within = np.abs(position) <= 1.5 * width
     reach = max(float(np.max(np.abs(slope[within]))), 2.0 * depth / width)
     bottom.set_ylim(-1.15 * reach, 1.15 * reach)
-    top.set_title(
-        "Wear-scar profile"
-        + (f": {name}" if name else "")
-        + "\n"
-        + parameters(
-            f"$D$ = {depth * MICRO:.4g} µm",
-            f"$W$ = {width * MICRO:.4g} µm",
-            f"$D/W$ = {depth / width:.3g}",
-            f"{position.size} samples",
-        ),
-        fontsize="medium",
-    )
+    title = "Wear-scar profile" + (f": {name}" if name else "")
+    sizes = [f"$D$ = {depth * MICRO:.4g} µm", f"$W$ = {width * MICRO:.4g} µm"]
+    sizes += [f"$D/W$ = {depth / width:.3g}", f"{position.size} samples"]
+    top.set_title(f"{title}\n{parameters(*sizes)}", fontsize="medium")
     return figure
 
 
@@ -164,17 +156,15 @@ def scar_shape_comparison(dataset: xr.Dataset) -> Figure:
     _draw_shape_loops(loop_axes, dataset)
     _draw_ratio_and_error(ax_ratio, ax_error, dataset)
     depth, width = scalar(dataset, "scar_depth"), scalar(dataset, "scar_half_width")
-    figure.suptitle(
-        "Scar shape at equal depth over half-width: how wrong the D/W shortcut is\n"
-        + parameters(
-            rf"$x_o = \Delta^*$ = {scalar(dataset, 'amplitude') * MICRO:g} µm",
-            f"$W$ = {width * MICRO:g} µm, $D$ = {depth * MICRO:g} µm",
-            load_label(scalar(dataset, "load")),
-            f"{stiffness_label(scalar(dataset, 'stiffness'))} (loops)",
-            rf"$\mu$ = {scalar(dataset, 'mu'):g}",
-        ),
-        fontsize="medium",
+    rig = parameters(
+        rf"$x_o = \Delta^*$ = {scalar(dataset, 'amplitude') * MICRO:g} µm",
+        f"$W$ = {width * MICRO:g} µm, $D$ = {depth * MICRO:g} µm",
+        load_label(scalar(dataset, "load")),
+        f"{stiffness_label(scalar(dataset, 'stiffness'))} (loops)",
+        rf"$\mu$ = {scalar(dataset, 'mu'):g}",
     )
+    title = "Scar shape at equal depth over half-width: how wrong the D/W shortcut is"
+    figure.suptitle(f"{title}\n{rig}", fontsize="medium")
     return figure
 
 
@@ -240,9 +230,8 @@ def _draw_ratio_and_error(ax_ratio, ax_error, dataset: xr.Dataset) -> None:
     stiffness = scalar(dataset, "stiffness")
     ratios = dataset["stiffness_ratio"].values * PER_MM
     shortcut = dataset["ecof_ratio"].sel(shape="parabolic", groove="parabola")
-    ax_ratio.plot(
-        ratios, shortcut, **_SHORTCUT, zorder=3, label=f"parabola, $D/W$ = {depth / width:g}"
-    )
+    label = f"parabola, $D/W$ = {depth / width:g}"
+    ax_ratio.plot(ratios, shortcut, **_SHORTCUT, zorder=3, label=label)
     ax_error.axhline(0.0, **_SHORTCUT, zorder=3, label="no error (the parabola itself)")
     for shape in dataset["shape"].values:
         style = dict(color=SHAPE_COLORS.get(shape), linewidth=2.0, zorder=2)
@@ -262,10 +251,8 @@ def _draw_ratio_and_error(ax_ratio, ax_error, dataset: xr.Dataset) -> None:
         ax.set_xlim(ratios[0], ratios[-1])
         ax.grid(alpha=0.3)
     ax_ratio.set_ylabel(axis_label("ecof_ratio"))
-    ax_ratio.set_title(
-        r"Energy CoF over the contact CoF, $\mu$ = " + f"{scalar(dataset, 'mu'):g}",
-        fontsize="medium",
-    )
+    title = rf"Energy CoF over the contact CoF, $\mu$ = {scalar(dataset, 'mu'):g}"
+    ax_ratio.set_title(title, fontsize="medium")
     ax_ratio.legend(loc="upper left", fontsize="small")
     ax_error.set_ylabel(r"Error of $\mu'$ from the D/W shortcut, $\mu'/\mu - 1$ [%]")
     ax_error.set_title(

@@ -203,11 +203,12 @@ def report_document(results: xr.Dataset, *, loops=None, inputs=None, lab=None):
         raise ValueError(
             f"results lack {', '.join(missing)}: give the Dataset of ecofmaps.analyze_loops"
         )
-    evolution, flags = _evolution_figures(results)
+    flagged = _flagged_cycles(results)
+    evolution, flags = _evolution_figures(results, flagged)
     parts = [
         _header(results, inputs or {}),
         _lab_numbers(results, lab or {}),
-        row(column(evolution, flags), _quality_counts(results)),
+        row(column(evolution, flags), _quality_counts(results, flagged)),
     ]
     if "loop_displacement" in results.variables:
         parts.append(_loops_panel(results, _carried_cycles(results, loops)))
@@ -279,7 +280,7 @@ def _lab_numbers(results: xr.Dataset, lab: Mapping) -> Div:
     )
 
 
-def _evolution_figures(results: xr.Dataset):
+def _evolution_figures(results: xr.Dataset, flagged: dict):
     """The coefficients of friction against the cycle, and the cycles each flag marks."""
     cycle = results["cycle"].values
     data = {"cycle": cycle, "quality": results["quality"].values.astype(str)}
@@ -315,7 +316,7 @@ def _evolution_figures(results: xr.Dataset):
     plot.add_tools(HoverTool(tooltips=tips, mode="vline", renderers=[drawn["ecof"]]))
     plot.legend.click_policy = "hide"
     plot.add_layout(plot.legend[0], "right")  # beside the plot: the curves stay uncovered
-    return plot, _flags_figure(results, plot)
+    return plot, _flags_figure(flagged, plot)
 
 
 def _cycle_figure(**options):
@@ -334,9 +335,8 @@ def _flagged_cycles(results: xr.Dataset) -> dict[str, np.ndarray]:
     return {reason: cycles for reason, cycles in flagged.items() if cycles.size}
 
 
-def _flags_figure(results: xr.Dataset, evolution):
+def _flags_figure(flagged: dict, evolution):
     """A strip below the coefficients: a mark at each cycle a quality reason flags."""
-    flagged = _flagged_cycles(results)
     if not flagged:
         return Div(text="<p>No cycle is flagged: every cycle's quality is 'ok'.</p>")
     reasons = list(flagged)[::-1]  # the first reason at the top
@@ -356,15 +356,11 @@ def _flags_figure(results: xr.Dataset, evolution):
     return plot
 
 
-def _quality_counts(results: xr.Dataset) -> Div:
+def _quality_counts(results: xr.Dataset, flagged: dict) -> Div:
     """The number of cycles each quality reason flags, with what it means."""
-    total = results["cycle"].size
-    quality = results["quality"].values.astype(str)
-    rows = [("ok", int(np.sum(quality == "ok")), "every value of the cycle stands")]
-    rows += [
-        (reason, cycles.size, REASONS[reason][0])
-        for reason, cycles in _flagged_cycles(results).items()
-    ]
+    ok = int(np.sum(results["quality"].values.astype(str) == "ok"))
+    rows = [("ok", ok, "every value of the cycle stands")]
+    rows += [(reason, cycles.size, REASONS[reason][0]) for reason, cycles in flagged.items()]
     cells = "".join(
         f"<tr style='vertical-align:top'><td><code>{html.escape(name)}</code></td>"
         f"<td style='text-align:right;padding:0 8px'>{count}</td>"
@@ -372,7 +368,7 @@ def _quality_counts(results: xr.Dataset) -> Div:
         for name, count, meaning in rows
     )
     return Div(
-        text=f"<h3 style='margin:4px 0'>Quality of the {total} cycles</h3>"
+        text=f"<h3 style='margin:4px 0'>Quality of the {results['cycle'].size} cycles</h3>"
         "<table class='ecofmaps-quality' style='font-size:13px;border-collapse:collapse'>"
         "<tr><th style='text-align:left'>flag</th><th style='padding:0 8px'>cycles</th>"
         f"<th style='text-align:left'>what it means</th></tr>{cells}</table>",
