@@ -24,6 +24,7 @@ from ecofmaps.cli._common import (
     command_parser,
     contact,
     count,
+    made_folder,
     option_adder,
     quantity,
     read_scar_file,
@@ -168,9 +169,7 @@ _NOT_KEPT = (
 def _analysed(index, path, recording, load, args, long_run, write):
     """One recording's results (of a long one, those the summary reads) and reading along the
     stroke (for the plots and ``--resolved``), its warnings printed one line each."""
-    from ecofmaps.measured.pipeline import Reading
     from ecofmaps.measured.quality import ImplausibleScaleError, ImplausibleScaleWarning
-    from ecofmaps.measured.resolve import ReadingOptions
 
     for option, does, others in _NOT_KEPT:
         if recording.lazy and getattr(args, option[2:].replace("-", "_")) is not None:
@@ -178,19 +177,11 @@ def _analysed(index, path, recording, load, args, long_run, write):
                 f"{option} {does}, which a long recording ({path}) analysed out of core does "
                 f"not keep: leave out {option}{others}"
             )
-    scar = args.scar_profile is not None
-    positions = 201 if args.plots is not None or args.resolved is not None or scar else None
-    reading = Reading(
-        resolve=not args.no_resolve,
-        keep_loops=args.plots is not None or args.report is not None or scar,
-        along_stroke=ReadingOptions(positions=positions),
-        hand_back=positions is not None,
-    )
     columns = SUMMARY_VARIABLES if recording.lazy else None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            analysed = long_run.analyse(index, path, recording, load, write, columns, reading)
+            analysed = long_run.analyse(index, path, recording, load, write, columns)
         except ImplausibleScaleError as error:
             raise recording.error(_with_assumptions(str(error), recording)) from None
         except FileLineError:  # names its file and line already
@@ -304,11 +295,6 @@ def _scar_numbers(args, each, profile) -> tuple[dict, object]:
         )
     rows[f"loop-scar closure ({args.scar_profile})"] = shown
     return rows, closure
-
-
-def _said(rows: dict) -> list[str]:
-    """``rows`` as lines ``name: text``."""
-    return [f"{name}: {text}" for name, text in rows.items()]
 
 
 def _lab_lines(results, rig_stiffness) -> list[str]:
@@ -428,10 +414,7 @@ def _write_extras(args, done: list[_Analysed], lab: dict, closure) -> None:
     if args.plots is not None:
         from ecofmaps import figures  # matplotlib only when plots are asked for
 
-        folder = Path(args.plots)
-        created = not folder.exists()
-        folder.mkdir(parents=True, exist_ok=True)
-        try:
+        with made_folder(Path(args.plots)) as folder:  # none left empty behind
             for each in done:
                 results, resolved, source = each.results, each.resolved, each.path.name
                 drawn = {
@@ -445,10 +428,6 @@ def _write_extras(args, done: list[_Analysed], lab: dict, closure) -> None:
                 for kind, figure in drawn.items():
                     path = folder / f"{each.plot_name}_{kind}.png"
                     figures.save_figure(figure, path, dpi=figures.RECORDING_DPI)
-        except BaseException:  # a full disk, an interrupt: no empty folder left behind
-            if created and not any(folder.iterdir()):
-                folder.rmdir()
-            raise
     if args.resolved is not None:
         from ecofmaps.maps.cache import write_netcdf
 
@@ -501,7 +480,8 @@ def run(args) -> int:
         told, indent = sys.stdout, "  "
     for each in done:
         print(indent + _summary(each.path, each.results, each.recording), file=told)
-        for line in [*_lab_lines(each.results, args.rig_stiffness), *_said(lab)]:
+        said = [f"{name}: {text}" for name, text in lab.items()]
+        for line in [*_lab_lines(each.results, args.rig_stiffness), *said]:
             print(f"{indent}  {line}", file=told)
     if args.out is not None:
         if failed:
