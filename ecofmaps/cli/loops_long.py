@@ -265,13 +265,13 @@ class LongRun:
         self.args, self.paths, self.partial = args, paths, None
         self.lazy = True if (args.workers or args.scheduler or args.resume) else None
         self.analysed = None  # (index, path, blocks or None) of the recording analysed last
-        scar = args.scar_profile is not None  # the plots, --resolved and the closure need
-        positions = 201 if args.plots is not None or args.resolved is not None or scar else None
+        scar = args.scar_profile is not None
+        handed = args.plots is not None or args.resolved is not None or scar  # on 201 positions
         self.reading = Reading(
             resolve=not args.no_resolve,
             keep_loops=args.plots is not None or args.report is not None or scar,
-            along_stroke=ReadingOptions(positions=positions),
-            hand_back=positions is not None,
+            along_stroke=ReadingOptions(positions=201 if handed else None),
+            hand_back=handed,
         )
 
     def analyse(self, index, path, recording, load, write, columns):

@@ -8,6 +8,7 @@ import warnings
 from ecofmaps import paper
 from ecofmaps._version import __version__
 from ecofmaps.cli._common import (
+    TWO_COLUMNS,
     add_profile_options,
     option_adder,
     print_rows,
@@ -15,7 +16,6 @@ from ecofmaps.cli._common import (
     quantity,
     read_profile,
     row,
-    two_columns_header,
     two_values,
 )
 
@@ -86,7 +86,7 @@ def run(args) -> int:
             x_o = args.groove_half_width or args.amplitude
             mapping = f"X = x W/x_o, x_o = {x_o * 1e6:.6g} µm (eq. 11)"
         rows += [*profile_rows(args, profile), ("position on the profile", "X", mapping), None]
-        rows.append(two_columns_header())
+        rows.append(TWO_COLUMNS)
         show, title = two_values, " on a measured scar profile"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RegimeWarning)

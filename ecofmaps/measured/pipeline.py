@@ -136,11 +136,6 @@ class Reading:
     )
     hand_back: bool = False
 
-    @property
-    def one_grid(self) -> bool:
-        """Whether the grid of positions is made from all cycles (one chunk only)."""
-        return self.resolve and isinstance(self.along_stroke.positions, int)
-
 
 @dataclasses.dataclass(frozen=True)
 class Task:
@@ -421,7 +416,8 @@ class Analysis:
             raise no_cycle_error(int(displacement.shape[0]))
         whole = [slice(0, cycles.label.size)]
         self.tasks = whole if one_chunk else _tasks(cycles.count, samples or TASK_SAMPLES)
-        if self.reading.one_grid and len(self.tasks) > 1:
+        grid = self.reading.resolve and isinstance(self.reading.along_stroke.positions, int)
+        if grid and len(self.tasks) > 1:  # a grid made from all the cycles
             raise ValueError(
                 "the reading along the stroke on a grid of positions common to all cycles "
                 "needs the recording in one chunk (in memory); give the positions themselves"
