@@ -124,8 +124,7 @@ def run(args) -> int:
 
 
 def _table(args, profile) -> int:
-    """Every row of the TABLE corrected that can be: the others NaN, each named in an error
-    line (exit status 1)."""
+    """The TABLE corrected; a row that cannot be is NaN and an error line (exit status 1)."""
     from ecofmaps.correction.tables import TableRowWarning, correct_table
 
     with warnings.catch_warnings(record=True) as caught:

@@ -167,8 +167,7 @@ _NOT_KEPT = (
 
 
 def _analysed(index, path, recording, load, args, long_run, write):
-    """One recording's results (of a long one, those the summary reads) and reading along the
-    stroke (for the plots and ``--resolved``), its warnings printed one line each."""
+    """One recording's results and reading along the stroke; its warnings one line each."""
     from ecofmaps.measured.quality import ImplausibleScaleError, ImplausibleScaleWarning
 
     for option, does, others in _NOT_KEPT:
@@ -267,8 +266,7 @@ def _summary(path, results, recording) -> str:
 
 
 def _scar_numbers(args, each, profile) -> tuple[dict, object]:
-    """The energy wear (with a contact) and the loop-scar closure of a recording on its scar
-    ``profile``, as rows of text (an error said in its row), and the closure or None."""
+    """Rows of text of the energy wear and loop-scar closure on ``profile``; the closure."""
     from ecofmaps.lab import energy_wear, loop_scar_closure
 
     rows, closure = {}, None
@@ -298,8 +296,7 @@ def _scar_numbers(args, each, profile) -> tuple[dict, object]:
 
 
 def _lab_lines(results, rig_stiffness) -> list[str]:
-    """ΣE_d over a recording's cycles and, when it crosses one (a sweep), its transition to
-    gross slip (docs/lab.md)."""
+    """ΣE_d over a recording's cycles, and its transition to gross slip if it crosses one."""
     from ecofmaps.lab import transition
     from ecofmaps.lab.wear import cumulated_energy
 
@@ -381,8 +378,7 @@ _Analysed = collections.namedtuple("_Analysed", "path recording results resolved
 
 
 def _analyse_each(args, paths, load, long_run, table) -> tuple[list[_Analysed], list[Path]]:
-    """Every recording through the pipeline, its lines written to ``table``; with several, one
-    that cannot be analysed is one error line naming it, and the others go on."""
+    """Every recording analysed into ``table``; of several, one that fails is an error line."""
     from ecofmaps.io.recordings import read_recording
 
     done, failed = [], []
@@ -409,8 +405,7 @@ def _analyse_each(args, paths, load, long_run, table) -> tuple[list[_Analysed], 
 
 
 def _write_extras(args, done: list[_Analysed], lab: dict, closure) -> None:
-    """The plots, the reading along the stroke and the report the options ask for, with the
-    ``lab`` rows and ``closure`` of a scar profile."""
+    """The plots, the reading along the stroke and the report the options ask for."""
     if args.plots is not None:
         from ecofmaps import figures  # matplotlib only when plots are asked for
 

@@ -90,8 +90,7 @@ def _sha256(path: Path) -> str:
 
 
 class _Partial:
-    """The folder ``<out>.partial`` of an unfinished run: ``run.json`` (what it computes), each
-    file's cycles and finished blocks (``.npz``), their checksums in ``kept.jsonl``."""
+    """``<out>.partial``: ``run.json``, each file's cycles and blocks, ``kept.jsonl``'s sums."""
 
     def __init__(self, out, fingerprint: dict):
         self.folder = Path(f"{out}{PARTIAL_SUFFIX}")
@@ -115,8 +114,7 @@ class _Partial:
             )
 
     def _manifest(self) -> dict:
-        """(file, block or 'cycles') -> what the run recorded of the file it kept (a line cut
-        short by a crash is passed over: its file is then not trusted)."""
+        """(file, block or 'cycles') -> its line in ``kept.jsonl`` (a line cut short: none)."""
         found = {}
         with (
             contextlib.suppress(OSError),
@@ -231,8 +229,7 @@ class _Partial:
 
 
 def _write(path: Path, content) -> None:
-    """Write ``content`` (text, or arrays by name: ``.npz``) to a temporary, then rename it
-    onto ``path`` (whole, or nothing)."""
+    """Write ``content`` (text, or arrays by name: ``.npz``) to ``path``, whole or nothing."""
     temporary = temporary_file(path)
     try:
         if isinstance(content, str):
@@ -329,8 +326,7 @@ class LongRun:
 
 
 def _analyse(run, index, path, recording, load, runner, write, columns):
-    """One recording through the pipeline, chunk by chunk: its analysis, each chunk's results
-    and the reading along the stroke handed back (or None); see :meth:`LongRun.analyse`."""
+    """One recording chunk by chunk (:meth:`LongRun.analyse`): analysis, parts, reading."""
     args, partial = run.args, run.partial if recording.lazy else None
     force, recorded = recording.force, None
     if isinstance(load, str):  # the load recorded sample by sample (--load COLUMN)
@@ -388,8 +384,7 @@ def _analyse(run, index, path, recording, load, runner, write, columns):
 
 
 def _in_order(texts: dict, write, written: int = 0) -> int:
-    """Give ``write`` the texts of blocks ``written``, ``written + 1``, ... that ``texts`` holds
-    (taken out); the number of blocks written so far."""
+    """Write the next blocks' ``texts`` that have come, in order; the blocks written so far."""
     while written in texts:
         write(texts.pop(written))
         written += 1

@@ -62,23 +62,18 @@ def run(args) -> int:
     profile = read_profile(args, conflicting=("aspect_ratio",))
     rig = dict(amplitude=args.amplitude, load=args.load, stiffness=args.stiffness, mu=args.mu)
     rows = [row(name, value) for name, value in rig.items()]
+    point = dict(rig, groove_half_width=args.groove_half_width)
     if profile is None:
         ratio = paper.EXAMPLE_2["aspect_ratio"] if args.aspect_ratio is None else args.aspect_ratio
-        points = [dict(rig, aspect_ratio=ratio, groove_half_width=args.groove_half_width)]
+        points = [dict(point, aspect_ratio=ratio)]
         x_o = args.groove_half_width or args.amplitude
         rows += [row("aspect_ratio", ratio), row("groove_half_width", x_o), None]
         show, title = row, ""
     else:
         points = [
-            dict(
-                rig, groove_half_width=args.groove_half_width, profile=profile, mapping=args.mapping
-            ),
+            dict(point, profile=profile, mapping=args.mapping),
             # the paper's shortcut z_o/x_o = D/W (eq. 11), x_o as given whatever the mapping
-            dict(
-                rig,
-                aspect_ratio=float(profile.aspect_ratio),
-                groove_half_width=args.groove_half_width,
-            ),
+            dict(point, aspect_ratio=float(profile.aspect_ratio)),
         ]
         if args.mapping == "physical":
             mapping = "X = x (physical)"

@@ -256,8 +256,7 @@ def at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
 
 
 def _cycle_loads(series, cycles: Cycles, rows: slice) -> tuple:
-    """The mean, lowest and highest finite value of ``series`` over each cycle of ``rows``
-    (NaN if none)."""
+    """The mean, lowest and highest finite value of ``series`` over each cycle of ``rows``."""
     first, stop, _ = rows.indices(cycles.label.size)
     start, count = cycles.start[first:stop], cycles.count[first:stop]
     if start.size == 0:
@@ -349,9 +348,7 @@ def only(part: xr.Dataset, columns=None) -> xr.Dataset:
 
 
 def _part(values: dict, flags: dict, labels, options, loops=None) -> xr.Dataset:
-    """The results of a chunk from what it measured, judged once (the values read along
-    the stroke, if any, after the quality), with the centred ``loops`` if given; with a
-    recorded load, at each cycle's own load."""
+    """A chunk's results from what it measured, judged once, at each cycle's recorded load."""
     measured = {k: v for k, v in values.items() if k not in RESOLVED}
     part = cycle_results(measured, flags, labels, options)
     read = [name for name in RESOLVED if name in values]
@@ -426,8 +423,7 @@ class Analysis:
         self._whole = np.flatnonzero(cycles.whole)  # the cycles a halo may hold
 
     def _task(self, index: int, then, keep, columns=None) -> tuple:
-        """The arguments of :func:`measure_chunk` for chunk ``index``; ``keep`` as in
-        :meth:`measured`, a chunk running elsewhere handing its values back."""
+        """The arguments of :func:`measure_chunk` for chunk ``index`` (see :meth:`measured`)."""
         cycles, rows = self.cycles, self.tasks[index]
         first, stop = rows.start, rows.stop
         if cycles.continuous:  # a halo of NEIGHBOURS whole cycles on either side
