@@ -473,9 +473,9 @@ def run(args) -> int:
         written = sum(each.results.cycle.size for each in done)
         print(f"wrote {args.out}: {written} cycle{'' if written == 1 else 's'}")
         told, indent = sys.stdout, "  "
+    said = [f"{name}: {text}" for name, text in lab.items()]
     for each in done:
         print(indent + _summary(each.path, each.results, each.recording), file=told)
-        said = [f"{name}: {text}" for name, text in lab.items()]
         for line in [*_lab_lines(each.results, args.rig_stiffness), *said]:
             print(f"{indent}  {line}", file=told)
     if args.out is not None:
