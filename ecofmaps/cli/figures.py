@@ -53,6 +53,13 @@ def _figure_formats(text: str) -> tuple[str, ...]:
     return formats
 
 
+def _usable_cores() -> int:
+    """The number of cores this process may run on (its affinity, where the system has one)."""
+    if hasattr(os, "sched_getaffinity"):
+        return max(1, len(os.sched_getaffinity(0)))
+    return os.cpu_count() or 1
+
+
 def add(subparsers) -> None:
     from ecofmaps.figures.recipes import FIGURES  # the names for the parser (no JAX)
 
@@ -233,11 +240,10 @@ def _written_here(groups, out: Path, formats):
 
 def run(args) -> int:
     from ecofmaps.figures.recipes import figure_groups, figure_parts  # the CLI's lazy boundary
-    from ecofmaps.maps.tiles import tile_workers  # the cores this process may run on
 
     names = list(dict.fromkeys(args.only or ())) or None
     groups, parts = figure_groups(names), figure_parts(names)
-    jobs = min(args.jobs or tile_workers(), max(len(groups), *map(len, parts)))
+    jobs = min(args.jobs or _usable_cores(), max(len(groups), *map(len, parts)))
     out = Path(args.out)
     drawn = [name for group in groups for name in group]
     planned = [("--out", out / f"{name}.{suffix}") for name in drawn for suffix in args.format]
