@@ -92,7 +92,9 @@ class LoopOptions:
 class _InProcess:
     """Runs the chunks one after the other in this process (a recording in memory)."""
 
-    workers, local, kind = 1, True, "this process"
+    workers = 1
+    local = True
+    kind = "this process"
 
     @staticmethod
     def map(function, tasks):
