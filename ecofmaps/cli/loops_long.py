@@ -90,7 +90,7 @@ def _sha256(path: Path) -> str:
 
 
 class _Partial:
-    """``<out>.partial``: ``run.json``, each file's cycles and blocks, ``kept.jsonl``'s sums."""
+    """The folder ``<out>.partial`` of an unfinished run: its record, cycles, blocks, sums."""
 
     def __init__(self, out, fingerprint: dict):
         self.folder = Path(f"{out}{PARTIAL_SUFFIX}")
@@ -114,7 +114,7 @@ class _Partial:
             )
 
     def _manifest(self) -> dict:
-        """(file, block or 'cycles') -> its line in ``kept.jsonl`` (a line cut short: none)."""
+        """(file, block or 'cycles') -> its line in ``kept.jsonl`` (one cut short passed over)."""
         found = {}
         with (
             contextlib.suppress(OSError),
