@@ -27,6 +27,7 @@ from ecofmaps.units import (
 
 __all__ = [
     "CACHE_DIR_HELP",
+    "TWO_COLUMNS",
     "CommandError",
     "add_contact_options",
     "add_profile_options",
@@ -47,7 +48,6 @@ __all__ = [
     "row",
     "se_rows",
     "transition_rows",
-    "two_columns_header",
     "two_values",
     "unit",
 ]
@@ -468,19 +468,16 @@ def print_rows(title: str, rows) -> None:
         print("" if item is None else f"  {item[0]:<32} {item[1]:<8} {item[2]}".rstrip())
 
 
-#: Width of the first value column when a profile's values stand beside the parabola's.
+#: Width of the first value column when a profile's values stand beside the parabola's, and
+#: the header row over them (:func:`two_values`).
 _COLUMN = 18
+TWO_COLUMNS = ("", "", f"{'on the profile':<{_COLUMN}} parabola of the same D/W (eq. 11 shortcut)")
 
 
 def two_values(name: str, on_profile, on_parabola, note: str = "") -> tuple[str, str, str]:
     """One row of :func:`ecofmaps.cli._common.row` with two values: profile, parabola."""
     words, symbol, first = row(name, on_profile, note)
     return words, symbol, f"{first:<{_COLUMN}} {row(name, on_parabola)[2]}"
-
-
-def two_columns_header() -> tuple[str, str, str]:
-    """The header row over :func:`two_values`."""
-    return "", "", f"{'on the profile':<{_COLUMN}} parabola of the same D/W (eq. 11 shortcut)"
 
 
 def byte_size(size: float) -> str:

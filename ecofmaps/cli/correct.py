@@ -8,6 +8,7 @@ from pathlib import Path
 
 from ecofmaps._version import __version__
 from ecofmaps.cli._common import (
+    TWO_COLUMNS,
     CommandError,
     add_profile_options,
     option_adder,
@@ -17,7 +18,6 @@ from ecofmaps.cli._common import (
     read_profile,
     refuse_to_overwrite,
     row,
-    two_columns_header,
     two_values,
 )
 from ecofmaps.io.files import record_written, write_text
@@ -98,7 +98,7 @@ def run(args) -> int:
             args.ecof, **rig, aspect_ratio=float(profile.aspect_ratio), return_status=True
         )
         shortcut = float(shortcut)  # NaN (printed 'undefined') where the parabola cannot
-        rows += [*profile_rows(args, profile), None, two_columns_header()]
+        rows += [*profile_rows(args, profile), None, TWO_COLUMNS]
         rows += [
             two_values("mu", mu, shortcut),
             two_values("correction_factor", mu / args.ecof, shortcut / args.ecof),
@@ -124,8 +124,7 @@ def run(args) -> int:
 
 
 def _table(args, profile) -> int:
-    """Every row of the TABLE corrected that can be: the others NaN, each named in an error
-    line (exit status 1)."""
+    """The TABLE corrected; a row that cannot be is NaN and an error line (exit status 1)."""
     from ecofmaps.correction.tables import TableRowWarning, correct_table
 
     with warnings.catch_warnings(record=True) as caught:

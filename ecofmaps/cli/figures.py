@@ -88,8 +88,7 @@ def add(subparsers) -> None:
 
 
 def _set_jax_options(options: dict | None = None) -> dict:
-    """Set JAX's ``options`` (default: keep every compiled kernel in :data:`JAX_CACHE_FOLDER`,
-    however quick: the figures' compile in under JAX's threshold of 1 s); their values before."""
+    """Set JAX's ``options`` (default: cache every kernel, however quick); their values before."""
     import jax  # the CLI's lazy boundary: other commands start without JAX
 
     if options is None:
@@ -107,8 +106,7 @@ def _set_jax_options(options: dict | None = None) -> dict:
 
 
 def _write_figure_group(names, directory, formats) -> list[tuple[str, list[Path], float]]:
-    """Draw the figures ``names`` (a group sharing a Dataset) into ``directory`` in every
-    format: each one's name, files and time [s] (its Dataset's if it needed it first)."""
+    """Each figure of the group ``names`` drawn into ``directory``: its name, files, time [s]."""
     from ecofmaps.figures import make_figures, save_figure  # the CLI's lazy boundary
 
     written = []
@@ -186,8 +184,7 @@ class TaskQueue:
 
 
 def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
-    """Yield each group's :func:`_write_figure_group` result from ``jobs`` processes, its
-    parts computed first, in parallel (:class:`TaskQueue`)."""
+    """Each group's :func:`_write_figure_group` from ``jobs`` processes (:class:`TaskQueue`)."""
     others = set(multiprocessing.active_children())
     start_resource_tracker_quietly()
     executor = ProcessPoolExecutor(

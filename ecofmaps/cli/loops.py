@@ -24,6 +24,7 @@ from ecofmaps.cli._common import (
     command_parser,
     contact,
     count,
+    made_folder,
     option_adder,
     quantity,
     read_scar_file,
@@ -166,11 +167,8 @@ _NOT_KEPT = (
 
 
 def _analysed(index, path, recording, load, args, long_run, write):
-    """One recording's results (of a long one, those the summary reads) and reading along the
-    stroke (for the plots and ``--resolved``), its warnings printed one line each."""
-    from ecofmaps.measured.pipeline import Reading
+    """One recording's results and reading along the stroke; its warnings one line each."""
     from ecofmaps.measured.quality import ImplausibleScaleError, ImplausibleScaleWarning
-    from ecofmaps.measured.resolve import ReadingOptions
 
     for option, does, others in _NOT_KEPT:
         if recording.lazy and getattr(args, option[2:].replace("-", "_")) is not None:
@@ -178,19 +176,11 @@ def _analysed(index, path, recording, load, args, long_run, write):
                 f"{option} {does}, which a long recording ({path}) analysed out of core does "
                 f"not keep: leave out {option}{others}"
             )
-    scar = args.scar_profile is not None
-    positions = 201 if args.plots is not None or args.resolved is not None or scar else None
-    reading = Reading(
-        resolve=not args.no_resolve,
-        keep_loops=args.plots is not None or args.report is not None or scar,
-        along_stroke=ReadingOptions(positions=positions),
-        hand_back=positions is not None,
-    )
     columns = SUMMARY_VARIABLES if recording.lazy else None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            analysed = long_run.analyse(index, path, recording, load, write, columns, reading)
+            analysed = long_run.analyse(index, path, recording, load, write, columns)
         except ImplausibleScaleError as error:
             raise recording.error(_with_assumptions(str(error), recording)) from None
         except FileLineError:  # names its file and line already
@@ -276,8 +266,7 @@ def _summary(path, results, recording) -> str:
 
 
 def _scar_numbers(args, each, profile) -> tuple[dict, object]:
-    """The energy wear (with a contact) and the loop-scar closure of a recording on its scar
-    ``profile``, as rows of text (an error said in its row), and the closure or None."""
+    """Rows of text of the energy wear and loop-scar closure on ``profile``; the closure."""
     from ecofmaps.lab import energy_wear, loop_scar_closure
 
     rows, closure = {}, None
@@ -306,14 +295,8 @@ def _scar_numbers(args, each, profile) -> tuple[dict, object]:
     return rows, closure
 
 
-def _said(rows: dict) -> list[str]:
-    """``rows`` as lines ``name: text``."""
-    return [f"{name}: {text}" for name, text in rows.items()]
-
-
 def _lab_lines(results, rig_stiffness) -> list[str]:
-    """ΣE_d over a recording's cycles and, when it crosses one (a sweep), its transition to
-    gross slip (docs/lab.md)."""
+    """ΣE_d over a recording's cycles, and its transition to gross slip if it crosses one."""
     from ecofmaps.lab import transition
     from ecofmaps.lab.wear import cumulated_energy
 
@@ -395,8 +378,7 @@ _Analysed = collections.namedtuple("_Analysed", "path recording results resolved
 
 
 def _analyse_each(args, paths, load, long_run, table) -> tuple[list[_Analysed], list[Path]]:
-    """Every recording through the pipeline, its lines written to ``table``; with several, one
-    that cannot be analysed is one error line naming it, and the others go on."""
+    """Every recording analysed into ``table``; of several, one that fails is an error line."""
     from ecofmaps.io.recordings import read_recording
 
     done, failed = [], []
@@ -423,15 +405,11 @@ def _analyse_each(args, paths, load, long_run, table) -> tuple[list[_Analysed], 
 
 
 def _write_extras(args, done: list[_Analysed], lab: dict, closure) -> None:
-    """The plots, the reading along the stroke and the report the options ask for, with the
-    ``lab`` rows and ``closure`` of a scar profile."""
+    """The plots, the reading along the stroke and the report the options ask for."""
     if args.plots is not None:
         from ecofmaps import figures  # matplotlib only when plots are asked for
 
-        folder = Path(args.plots)
-        created = not folder.exists()
-        folder.mkdir(parents=True, exist_ok=True)
-        try:
+        with made_folder(Path(args.plots)) as folder:  # none left empty behind
             for each in done:
                 results, resolved, source = each.results, each.resolved, each.path.name
                 drawn = {
@@ -445,10 +423,6 @@ def _write_extras(args, done: list[_Analysed], lab: dict, closure) -> None:
                 for kind, figure in drawn.items():
                     path = folder / f"{each.plot_name}_{kind}.png"
                     figures.save_figure(figure, path, dpi=figures.RECORDING_DPI)
-        except BaseException:  # a full disk, an interrupt: no empty folder left behind
-            if created and not any(folder.iterdir()):
-                folder.rmdir()
-            raise
     if args.resolved is not None:
         from ecofmaps.maps.cache import write_netcdf
 
@@ -499,9 +473,10 @@ def run(args) -> int:
         written = sum(each.results.cycle.size for each in done)
         print(f"wrote {args.out}: {written} cycle{'' if written == 1 else 's'}")
         told, indent = sys.stdout, "  "
+    said = [f"{name}: {text}" for name, text in lab.items()]
     for each in done:
         print(indent + _summary(each.path, each.results, each.recording), file=told)
-        for line in [*_lab_lines(each.results, args.rig_stiffness), *_said(lab)]:
+        for line in [*_lab_lines(each.results, args.rig_stiffness), *said]:
             print(f"{indent}  {line}", file=told)
     if args.out is not None:
         if failed:

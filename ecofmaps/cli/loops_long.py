@@ -30,13 +30,18 @@ from ecofmaps.measured.pipeline import (
     IN_PROCESS,
     Analysis,
     LoopOptions,
+    Reading,
+    block_file,
     force_at_mean_load,
+    kept_block,
     only,
     runner_for,
+    temporary_file,
 )
+from ecofmaps.measured.resolve import ReadingOptions
 from ecofmaps.measured.samples import MissingSampleError
 
-__all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun", "keep_block"]
+__all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun"]
 
 #: What a missing sample is, with ``--nan-policy raise`` (the file and line before it).
 MISSING = "missing sample (an empty cell or NaN)"
@@ -84,14 +89,8 @@ def _sha256(path: Path) -> str:
         return hashlib.file_digest(stream, "sha256").hexdigest()
 
 
-_UNFINISHED = (
-    "{folder} holds an unfinished run: add --resume to continue it, or delete it to start again"
-)
-
-
 class _Partial:
-    """The folder ``<out>.partial`` of an unfinished run: ``run.json`` (what it computes), each
-    file's cycles and finished blocks (``.npz``), their checksums in ``kept.jsonl``."""
+    """The folder ``<out>.partial`` of an unfinished run: its record, cycles, blocks, sums."""
 
     def __init__(self, out, fingerprint: dict):
         self.folder = Path(f"{out}{PARTIAL_SUFFIX}")
@@ -115,8 +114,7 @@ class _Partial:
             )
 
     def _manifest(self) -> dict:
-        """(file, block or 'cycles') -> what the run recorded of the file it kept (a line cut
-        short by a crash is passed over: its file is then not trusted)."""
+        """(file, block or 'cycles') -> its line in ``kept.jsonl`` (one cut short passed over)."""
         found = {}
         with (
             contextlib.suppress(OSError),
@@ -176,9 +174,13 @@ class _Partial:
         _write(path, values)
         self._record(path, file=index, block="cycles")
 
+    def blocks(self, index: int) -> Path:
+        """Where the blocks of file ``index`` are kept (:func:`block_file`)."""
+        return self.folder / f"file{index}-block"
+
     def record_block(self, index: int, block: int, rows: slice) -> None:
         """Record in the manifest the block kept of file ``index`` and its cycle rows."""
-        path = self.folder / f"file{index}-block{block:06d}.npz"
+        path = block_file(self.blocks(index), block)
         self._record(path, file=index, block=block, rows=[rows.start, rows.stop])
 
     def record_late(self, index: int, tasks) -> None:
@@ -190,7 +192,7 @@ class _Partial:
 
     def kept(self, index: int) -> dict:
         """The blocks of file ``index`` kept: block -> its file."""
-        prefix = f"file{index}-block"
+        prefix = self.blocks(index).name
         return {
             int(path.stem[len(prefix) :]): path
             for path in self.folder.glob(f"{prefix}*.npz")
@@ -206,18 +208,14 @@ class _Partial:
                 self._refused(path, f"is beyond the run's {len(tasks)} blocks")
                 continue
             rows = [tasks[block].start, tasks[block].stop]
-            if not self._checked(path, manifest.get((index, block)), rows):
-                continue
-            with np.load(path) as stored:
-                values = {k[2:]: stored[k] for k in stored.files if k.startswith("v:")}
-                flags = {k[2:]: stored[k] for k in stored.files if k.startswith("f:")}
-            kept[block] = (values, flags)
+            if self._checked(path, manifest.get((index, block)), rows):
+                kept[block] = kept_block(path)
         return kept
 
     def remove_temporaries(self) -> None:
         """Remove the temporaries of files being written: a folder kept holds whole files."""
         for pattern in _KEPT:
-            for path in self.folder.glob(_temporary_name(pattern)):
+            for path in self.folder.glob(temporary_file(Path(pattern)).name):
                 path.unlink(missing_ok=True)
 
     def remove(self) -> None:
@@ -230,21 +228,9 @@ class _Partial:
             self.folder.rmdir()
 
 
-def keep_block(folder: Path, index: int, block: int, values: dict, flags: dict) -> None:
-    """Keep in ``folder`` what block ``block`` of file ``index`` measured (where a task runs)."""
-    stored = {f"v:{k}": v for k, v in values.items()} | {f"f:{k}": v for k, v in flags.items()}
-    _write(folder / f"file{index}-block{block:06d}.npz", stored)
-
-
-def _temporary_name(name: str) -> str:
-    """The temporary :func:`_write` writes ``name`` to (a pattern for a pattern)."""
-    return f".{name}.tmp"
-
-
 def _write(path: Path, content) -> None:
-    """Write ``content`` (text, or arrays by name: ``.npz``) to a temporary, then rename it
-    onto ``path`` (whole, or nothing)."""
-    temporary = path.with_name(_temporary_name(path.name))
+    """Write ``content`` (text, or arrays by name: ``.npz``) to ``path``, whole or nothing."""
+    temporary = temporary_file(path)
     try:
         if isinstance(content, str):
             temporary.write_text(content, "utf-8")
@@ -257,9 +243,10 @@ def _write(path: Path, content) -> None:
 
 
 class LongRun:
-    """The long recordings of one ``ecofmaps loops`` command with options ``args`` and
-    recordings ``paths``. ``lazy`` is for :func:`ecofmaps.read_recording`: True when a long
-    run was asked for (``--workers``, ``--scheduler``, ``--resume``), else None."""
+    """The recordings ``paths`` of one ``ecofmaps loops`` command with options ``args``
+    through the pipeline, what each chunk reads (:attr:`reading`) decided once. ``lazy`` is
+    for :func:`ecofmaps.read_recording`: True when a long run was asked for (``--workers``,
+    ``--scheduler``, ``--resume``), else None."""
 
     def __init__(self, args, paths):
         if args.workers and args.scheduler:
@@ -268,12 +255,23 @@ class LongRun:
             raise CommandError("--resume continues the run kept beside --out: give --out")
         folder = Path(f"{args.out}{PARTIAL_SUFFIX}")
         if args.out is not None and folder.exists() and not args.resume:
-            raise CommandError(_UNFINISHED.format(folder=folder))
+            raise CommandError(
+                f"{folder} holds an unfinished run: add --resume to continue it, or delete it "
+                "to start again"
+            )
         self.args, self.paths, self.partial = args, paths, None
         self.lazy = True if (args.workers or args.scheduler or args.resume) else None
         self.analysed = None  # (index, path, blocks or None) of the recording analysed last
+        scar = args.scar_profile is not None
+        handed = args.plots is not None or args.resolved is not None or scar  # on 201 positions
+        self.reading = Reading(
+            resolve=not args.no_resolve,
+            keep_loops=args.plots is not None or args.report is not None or scar,
+            along_stroke=ReadingOptions(positions=201 if handed else None),
+            hand_back=handed,
+        )
 
-    def analyse(self, index, path, recording, load, write, columns, reading):
+    def analyse(self, index, path, recording, load, write, columns):
         """The results of recording ``index`` (the variables ``columns``, if given) and its
         reading along the stroke if handed back; each chunk's lines (a header line first)
         given to ``write`` in order."""
@@ -288,7 +286,7 @@ class LongRun:
                     self.partial = _Partial(args.out, _fingerprint(args, self.paths))
                     add_stop_note(self.stop_note)  # asked when the line is written
                 analysis, parts, resolved = _analyse(
-                    self, index, path, recording, load, runner, write, columns, reading
+                    self, index, path, recording, load, runner, write, columns
                 )
         except KeyboardInterrupt as stop:  # counted once the runner is closed: no task runs
             if isinstance(stop, _Interrupted):
@@ -327,9 +325,8 @@ class LongRun:
             self.partial = None
 
 
-def _analyse(run, index, path, recording, load, runner, write, columns, reading):
-    """One recording through the pipeline, chunk by chunk: its analysis, each chunk's results
-    and the reading along the stroke handed back (or None); see :meth:`LongRun.analyse`."""
+def _analyse(run, index, path, recording, load, runner, write, columns):
+    """One recording chunk by chunk (:meth:`LongRun.analyse`): analysis, parts, reading."""
     args, partial = run.args, run.partial if recording.lazy else None
     force, recorded = recording.force, None
     if isinstance(load, str):  # the load recorded sample by sample (--load COLUMN)
@@ -347,7 +344,7 @@ def _analyse(run, index, path, recording, load, runner, write, columns, reading)
         recorded_load=recorded,
         runner=runner,
         nan_policy=args.nan_policy,
-        reading=reading,
+        reading=run.reading,
         cycles=None if partial is None else partial.cycles(index),
         one_chunk=not recording.lazy,
     )
@@ -362,16 +359,12 @@ def _analyse(run, index, path, recording, load, runner, write, columns, reading)
         parts[block], texts[block] = only(part, columns), lines(part)
     written = _in_order(texts, write)
     bar = _bar(analysis, path, shown, sum(parts[b].cycle.size for b in parts))
-    keep = partial is not None
-    if keep and runner.local:  # the chunks keep their blocks themselves, where they run
-        keep = functools.partial(keep_block, partial.folder, index)
+    keep = False if partial is None else partial.blocks(index)
     resolved = []
     try:
         measured = analysis.measured(skip=done, then=lines, keep=keep, columns=columns)
         with contextlib.closing(measured) as kept:
             for block, chunk in kept:
-                if chunk.values is not None:  # sent here: kept by this process
-                    keep_block(partial.folder, index, block, chunk.values, chunk.flags)
                 if partial is not None:
                     partial.record_block(index, block, analysis.tasks[block])
                 parts[block], texts[block] = chunk.part, chunk.made
@@ -391,8 +384,7 @@ def _analyse(run, index, path, recording, load, runner, write, columns, reading)
 
 
 def _in_order(texts: dict, write, written: int = 0) -> int:
-    """Give ``write`` the texts of blocks ``written``, ``written + 1``, ... that ``texts`` holds
-    (taken out); the number of blocks written so far."""
+    """Write the next blocks' ``texts`` that have come, in order; the blocks written so far."""
     while written in texts:
         write(texts.pop(written))
         written += 1

@@ -150,14 +150,6 @@ def _stopped(interrupted, note) -> int:
     return _report(EXIT_TERMINATED if terminated else EXIT_INTERRUPTED, f"{words}; {note}")
 
 
-def _ignored_after_main() -> list:
-    """The stop signals not ignored already, handled by :func:`_nothing_to_stop` from now on."""
-    numbers = [n for n in STOP_SIGNALS if signal.getsignal(n) not in (signal.SIG_IGN, None)]
-    for number in numbers:
-        signal.signal(number, _nothing_to_stop)
-    return numbers
-
-
 def _nothing_to_stop(signum, frame) -> None:
     """A stop signal outside :func:`main`'s block, where there is no work to stop."""
 
@@ -213,7 +205,9 @@ def console() -> None:
     :func:`main` has returned, a stop signal is ignored: a complete run stays complete. If
     the reader of the output goes (``| head``), the command ends at once, quietly, with
     :data:`EXIT_BROKEN_PIPE`."""
-    after = _ignored_after_main()
+    after = [n for n in STOP_SIGNALS if signal.getsignal(n) not in (signal.SIG_IGN, None)]
+    for number in after:  # ignored once main has returned; until then main's to handle
+        signal.signal(number, _nothing_to_stop)
     try:
         status = main()
         sys.stdout.flush()

@@ -132,8 +132,7 @@ def run(args) -> int:
 
 
 def _map_bytes(grid: dict, load) -> int:
-    """Bytes [byte] of the map of ``grid`` with its coordinates, uncompressed, from the lazy
-    map of at most two values along each axis (nothing computed)."""
+    """Bytes [byte] of the map of ``grid``, uncompressed, from a lazy map (nothing computed)."""
     from ecofmaps.maps.grid import compute_map
 
     small = {name: values[:2] if np.ndim(values) else values for name, values in grid.items()}
@@ -168,8 +167,7 @@ def _write(dataset, out: Path, shown: bool) -> int:
 
 @contextlib.contextmanager
 def _progress(dataset):
-    """A progress bar on standard error counting the map's blocks as their dask tasks finish
-    while in the block; cleared on an error or Ctrl-C, so the error is the last line."""
+    """A progress bar of the map's blocks as their dask tasks finish; cleared on an error."""
     from dask.callbacks import Callback
     from tqdm import tqdm
 

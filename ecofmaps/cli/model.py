@@ -8,6 +8,7 @@ import warnings
 from ecofmaps import paper
 from ecofmaps._version import __version__
 from ecofmaps.cli._common import (
+    TWO_COLUMNS,
     add_profile_options,
     option_adder,
     print_rows,
@@ -15,7 +16,6 @@ from ecofmaps.cli._common import (
     quantity,
     read_profile,
     row,
-    two_columns_header,
     two_values,
 )
 
@@ -62,23 +62,18 @@ def run(args) -> int:
     profile = read_profile(args, conflicting=("aspect_ratio",))
     rig = dict(amplitude=args.amplitude, load=args.load, stiffness=args.stiffness, mu=args.mu)
     rows = [row(name, value) for name, value in rig.items()]
+    point = dict(rig, groove_half_width=args.groove_half_width)
     if profile is None:
         ratio = paper.EXAMPLE_2["aspect_ratio"] if args.aspect_ratio is None else args.aspect_ratio
-        points = [dict(rig, aspect_ratio=ratio, groove_half_width=args.groove_half_width)]
+        points = [dict(point, aspect_ratio=ratio)]
         x_o = args.groove_half_width or args.amplitude
         rows += [row("aspect_ratio", ratio), row("groove_half_width", x_o), None]
         show, title = row, ""
     else:
         points = [
-            dict(
-                rig, groove_half_width=args.groove_half_width, profile=profile, mapping=args.mapping
-            ),
+            dict(point, profile=profile, mapping=args.mapping),
             # the paper's shortcut z_o/x_o = D/W (eq. 11), x_o as given whatever the mapping
-            dict(
-                rig,
-                aspect_ratio=float(profile.aspect_ratio),
-                groove_half_width=args.groove_half_width,
-            ),
+            dict(point, aspect_ratio=float(profile.aspect_ratio)),
         ]
         if args.mapping == "physical":
             mapping = "X = x (physical)"
@@ -86,7 +81,7 @@ def run(args) -> int:
             x_o = args.groove_half_width or args.amplitude
             mapping = f"X = x W/x_o, x_o = {x_o * 1e6:.6g} µm (eq. 11)"
         rows += [*profile_rows(args, profile), ("position on the profile", "X", mapping), None]
-        rows.append(two_columns_header())
+        rows.append(TWO_COLUMNS)
         show, title = two_values, " on a measured scar profile"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RegimeWarning)

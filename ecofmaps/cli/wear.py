@@ -72,8 +72,7 @@ def add(subparsers) -> None:
 
 
 def _columns(found, names, quantity="{}") -> dict:
-    """The written columns of ``names`` (of ``quantity``) and their standard errors, in the
-    display units, ASCII."""
+    """Columns of ``names`` and their standard errors, in the display units, ASCII names."""
     from ecofmaps._nomenclature import QUANTITIES, column
 
     line = {}

@@ -8,8 +8,9 @@ The method is explained in ``docs/method-loops.md`` ("One pipeline, in memory an
 from __future__ import annotations
 
 import dataclasses
-import functools
 import itertools
+import os
+from pathlib import Path
 
 import numpy as np
 import xarray as xr
@@ -42,11 +43,15 @@ __all__ = [
     "Reading",
     "Task",
     "at_own_load",
+    "block_file",
     "force_at_mean_load",
+    "keep_block",
+    "kept_block",
     "load_sample_error",
     "measure_chunk",
     "only",
     "runner_for",
+    "temporary_file",
 ]
 
 #: Samples of the recording measured by one chunk of a long recording (about; whole cycles).
@@ -133,16 +138,13 @@ class Reading:
     )
     hand_back: bool = False
 
-    @property
-    def one_grid(self) -> bool:
-        """Whether the grid of positions is made from all cycles (one chunk only)."""
-        return self.resolve and isinstance(self.along_stroke.positions, int)
-
 
 @dataclasses.dataclass(frozen=True)
 class Task:
     """One chunk's work besides its samples: its cycles with their halo, its own ``rows``
-    among them, the first sample ``low`` of its stretch, and what the analysis asks."""
+    among them, the first sample ``low`` of its stretch, and what the analysis asks: ``then``
+    made of its results, the file to ``keep`` its values and flags in (:func:`keep_block`) or
+    True to hand them back, and the ``columns`` of its results handed back."""
 
     cycles: Cycles
     rows: slice
@@ -150,7 +152,7 @@ class Task:
     options: LoopOptions
     reading: Reading
     then: object = None
-    keep: object = False
+    keep: Path | bool = False
     columns: tuple | None = None
 
 
@@ -216,14 +218,10 @@ def force_at_mean_load(force, load):
     return force * (mean / usable), mean
 
 
-def with_loops(results: xr.Dataset, loops) -> xr.Dataset:
+def _with_loops(results: xr.Dataset, loops) -> xr.Dataset:
     """``results`` with the centred loops of :func:`measure_cycles` (``keep_loops=True``)."""
-    results["loop_displacement"] = (
-        ("cycle", "point"),
-        loops[0],
-        nomenclature.attrs("loop_displacement"),
-    )
-    results["loop_force"] = (("cycle", "point"), loops[1], nomenclature.attrs("loop_force"))
+    for name, values in zip(("loop_displacement", "loop_force"), loops[:2], strict=True):
+        results[name] = (("cycle", "point"), values, nomenclature.attrs(name))
     results.coords["point"] = ("point", np.arange(loops[0].shape[1]), nomenclature.attrs("point"))
     return results
 
@@ -243,12 +241,7 @@ def load_sample_error(sample: int, load: float, cycle=None) -> MissingSampleErro
 
 #: The values that scale with the normal load: with a recorded load, they are reported at
 #: each cycle's own load (``normal_load``), the rest being read at the mean load.
-AT_OWN_LOAD = (
-    *LOAD_SCALED,
-    "loop_force",
-    "force_forward",
-    "force_backward",
-)
+AT_OWN_LOAD = (*LOAD_SCALED, "loop_force", "force_forward", "force_backward")
 
 
 def at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
@@ -265,8 +258,7 @@ def at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
 
 
 def _cycle_loads(series, cycles: Cycles, rows: slice) -> tuple:
-    """The mean, lowest and highest finite value of ``series`` over each cycle of ``rows``
-    (NaN if none)."""
+    """The mean, lowest and highest finite value of ``series`` over each cycle of ``rows``."""
     first, stop, _ = rows.indices(cycles.label.size)
     start, count = cycles.start[first:stop], cycles.count[first:stop]
     if start.size == 0:
@@ -302,7 +294,7 @@ def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
     flags |= scale_flags(values, options)
     resolved = None
     if reading.resolve:
-        judged = with_loops(cycle_results(values, flags, labels, options), loops)
+        judged = _with_loops(cycle_results(values, flags, labels, options), loops)
         resolved, read = resolve.read_along_stroke(judged, reading.along_stroke)
         values = values | {name: resolved[name].values for name in RESOLVED}
         flags = flags | read
@@ -312,12 +304,42 @@ def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
         handed = at_own_load(handed, values["normal_load"] / options.load)
     tally = Tally()
     tally.add(part["quality"].values, flags, values["amplitude"])
-    if callable(task.keep):
-        task.keep(values, flags)
+    if isinstance(task.keep, Path):
+        keep_block(task.keep, values, flags)
     if task.keep is not True:
         values = flags = None
     made = None if task.then is None else task.then(part)
     return Chunk(only(part, task.columns), tally, values, flags, made, handed)
+
+
+def block_file(prefix: Path, index: int) -> Path:
+    """The file of chunk ``index`` kept at ``prefix`` (:func:`keep_block`)."""
+    return prefix.with_name(f"{prefix.name}{index:06d}.npz")
+
+
+def temporary_file(path: Path) -> Path:
+    """The temporary that :func:`keep_block` writes before renaming it onto ``path``."""
+    return path.with_name(f".{path.name}.tmp")
+
+
+def keep_block(path: Path, values: dict, flags: dict) -> None:
+    """Keep what a chunk measured, its ``values`` and ``flags``, in ``path`` (``.npz``), whole
+    or not at all."""
+    stored = {f"v:{k}": v for k, v in values.items()} | {f"f:{k}": v for k, v in flags.items()}
+    temporary = temporary_file(path)
+    try:
+        with open(temporary, "wb") as stream:
+            np.savez(stream, **stored)
+        os.replace(temporary, path)
+    finally:
+        temporary.unlink(missing_ok=True)
+
+
+def kept_block(path: Path) -> tuple[dict, dict]:
+    """The values and flags :func:`keep_block` kept in ``path``."""
+    with np.load(path) as stored:
+        values = {k[2:]: stored[k] for k in stored.files if k.startswith("v:")}
+        return values, {k[2:]: stored[k] for k in stored.files if k.startswith("f:")}
 
 
 def only(part: xr.Dataset, columns=None) -> xr.Dataset:
@@ -328,15 +350,13 @@ def only(part: xr.Dataset, columns=None) -> xr.Dataset:
 
 
 def _part(values: dict, flags: dict, labels, options, loops=None) -> xr.Dataset:
-    """The results of a chunk from what it measured, judged once (the values read along
-    the stroke, if any, after the quality), with the centred ``loops`` if given; with a
-    recorded load, at each cycle's own load."""
+    """A chunk's results from what it measured, judged once, at each cycle's recorded load."""
     measured = {k: v for k, v in values.items() if k not in RESOLVED}
     part = cycle_results(measured, flags, labels, options)
     read = [name for name in RESOLVED if name in values]
     part = part.assign({k: ("cycle", values[k], resolve.resolved_attrs(k)) for k in read})
     if loops is not None:
-        part = with_loops(part, loops)
+        part = _with_loops(part, loops)
     if "normal_load" in part:
         part = at_own_load(part, part["normal_load"].values / options.load)
     return part
@@ -395,7 +415,8 @@ class Analysis:
             raise no_cycle_error(int(displacement.shape[0]))
         whole = [slice(0, cycles.label.size)]
         self.tasks = whole if one_chunk else _tasks(cycles.count, samples or TASK_SAMPLES)
-        if self.reading.one_grid and len(self.tasks) > 1:
+        grid = self.reading.resolve and isinstance(self.reading.along_stroke.positions, int)
+        if grid and len(self.tasks) > 1:  # a grid made from all the cycles
             raise ValueError(
                 "the reading along the stroke on a grid of positions common to all cycles "
                 "needs the recording in one chunk (in memory); give the positions themselves"
@@ -404,7 +425,7 @@ class Analysis:
         self._whole = np.flatnonzero(cycles.whole)  # the cycles a halo may hold
 
     def _task(self, index: int, then, keep, columns=None) -> tuple:
-        """The arguments of :func:`measure_chunk` for chunk ``index``."""
+        """The arguments of :func:`measure_chunk` for chunk ``index`` (see :meth:`measured`)."""
         cycles, rows = self.cycles, self.tasks[index]
         first, stop = rows.start, rows.stop
         if cycles.continuous:  # a halo of NEIGHBOURS whole cycles on either side
@@ -417,14 +438,17 @@ class Analysis:
         table = cycles.rows(slice(first, stop))
         low, high = int(table.start[0]), int(table.start[-1] + table.count[-1])
         x, q, p = (None if a is None else stretch(a, low, high) for a in self.arrays)
-        if callable(keep):
-            keep = functools.partial(keep, index)
+        if isinstance(keep, Path):
+            keep = block_file(keep, index) if self.runner.local else True
         inner = slice(rows.start - first, rows.stop - first)
         task = Task(table, inner, low, self.options, self.reading, then, keep, columns)
         return task, x, q, p
 
     def measured(self, skip=(), then=None, keep=False, columns=None):
-        """Each chunk's :class:`Chunk`, in order, as they come; counted in :attr:`tally`."""
+        """Each chunk's :class:`Chunk`, in order, as they come; counted in :attr:`tally`.
+        ``keep``: True to hand back each chunk's values and flags, or the path (a prefix) to
+        keep them at (:func:`block_file`), where the chunk runs if the runner is local, else
+        here as it comes."""
         skip = set(skip)
         wanted = [k for k in range(len(self.tasks)) if k not in skip]
         tasks = (self._task(k, then, keep, columns) for k in wanted)
@@ -432,6 +456,9 @@ class Analysis:
         try:
             for index, chunk in zip(wanted, results, strict=False):
                 self.tally.merge(chunk.tally)
+                if isinstance(keep, Path) and chunk.values is not None:  # measured elsewhere
+                    keep_block(block_file(keep, index), chunk.values, chunk.flags)
+                    chunk.values = chunk.flags = None
                 yield index, chunk
         finally:  # closed with this generator: the chunks left are cancelled now, not later
             results.close()

@@ -331,37 +331,31 @@ def test_tallies_of_parts_merge_into_the_tally_of_the_whole():
     )
 
 
-def _kept_here(store, index, values, flags):
-    """A ``keep`` of :meth:`Analysis.measured`: what task ``index`` measured, in ``store``."""
-    store[index] = (values, flags)
-
-
-def test_tasks_keep_what_they_measured_where_they_run(small_blocks):
-    """``keep=True`` hands each task's values and flags back; a callable ``keep`` is given
-    the same, with the task's index, where the task runs, and nothing comes back."""
-    import functools
-
+def test_tasks_keep_what_they_measured_where_they_run(small_blocks, tmp_path):
+    """``keep=True`` hands each task's values and flags back; a ``keep`` path has each task
+    keep the same in its file there (:func:`pipeline.block_file`), and nothing comes back."""
     from ecofmaps._parallel import Runner
 
     x, q = noisy(EXAMPLE_2, 12, 3)
     options = LoopOptions(LOAD)
     x, q = lazily(x, q)
-    store = {}
+    prefix = tmp_path / "block"
     with Runner(2) as runner:
         analysis = pipeline.Analysis(x, q, options=options, runner=runner, samples=900)
         assert len(analysis.tasks) > 2
         handed = {k: (c.values, c.flags) for k, c in analysis.measured(keep=True)}
         nothing = [(c.values, c.flags) for _, c in analysis.measured()]
-        kept = analysis.measured(keep=functools.partial(_kept_here, store))
-        returned = [(c.values, c.flags) for _, c in kept]
+        returned = [(c.values, c.flags) for _, c in analysis.measured(keep=prefix)]
     assert all(v is None and f is None for v, f in nothing + returned)
-    assert sorted(store) == sorted(handed) == list(range(len(analysis.tasks)))
+    assert sorted(handed) == list(range(len(analysis.tasks)))
+    assert sorted(tmp_path.iterdir()) == [pipeline.block_file(prefix, k) for k in handed]
     for index, (values, flags) in handed.items():
-        assert store[index][0].keys() == values.keys() and store[index][1].keys() == flags.keys()
+        kept = pipeline.kept_block(pipeline.block_file(prefix, index))
+        assert kept[0].keys() == values.keys() and kept[1].keys() == flags.keys()
         for name in values:
-            np.testing.assert_array_equal(store[index][0][name], values[name])
+            np.testing.assert_array_equal(kept[0][name], values[name])
         for name in flags:
-            np.testing.assert_array_equal(store[index][1][name], flags[name])
+            np.testing.assert_array_equal(kept[1][name], flags[name])
 
 
 def _variables(part):
