@@ -81,7 +81,7 @@ def _fingerprint(args, paths) -> dict:
         for key, value in sorted(vars(args).items())
         if key not in _RUNTIME and isinstance(value, str | int | float | bool | type(None))
     }
-    return {"format": 3, "files": files, "options": options}
+    return {"format": 4, "files": files, "options": options}
 
 
 def _sha256(path: Path) -> str:
@@ -161,17 +161,14 @@ class _Partial:
             return None
         with np.load(path) as stored:
             fields = {f.name: stored[f.name] for f in dataclasses.fields(Cycles)}
-        fields["missing"] = None if fields["missing"].ndim == 0 else fields["missing"]
         fields["continuous"] = bool(fields["continuous"])
         for name in ("incomplete_cycles", "dropped_samples", "missing_samples", "first_missing"):
             fields[name] = int(fields[name])
         return Cycles(**fields)
 
     def keep_cycles(self, index: int, cycles) -> None:
-        values = dataclasses.asdict(cycles)
-        values["missing"] = np.asarray(False) if cycles.missing is None else cycles.missing
         path = self.folder / f"file{index}-cycles.npz"
-        _write(path, values)
+        _write(path, dataclasses.asdict(cycles))
         self._record(path, file=index, block="cycles")
 
     def blocks(self, index: int) -> Path:

@@ -180,7 +180,7 @@ def test_resume_refuses_a_run_of_another_format(long_test, tmp_path, capsys, sma
     interrupted(capsys, on_each_block, long_test[".zarr"], out)
     partial = tmp_path / "r.csv.partial"
     record = json.loads((partial / "run.json").read_text())
-    (partial / "run.json").write_text(json.dumps({**record, "format": 2}))
+    (partial / "run.json").write_text(json.dumps({**record, "format": 3}))
     with np.load(partial / "file0-cycles.npz") as stored:
         older = {k: v for k, v in stored.items() if k != "hidden"}
     np.savez(partial / "file0-cycles.npz", **older)
