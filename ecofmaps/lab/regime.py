@@ -38,8 +38,9 @@ _CHANGES_SHOWN = 5
 _SPRINGS = 3
 #: Why μ_t from Q*/P has no standard error.
 _PEAK_BIASED = (
-    "no GICoF in the results: mu is Q*/P of the first gross-slip cycles, a peak that the "
-    "force's noise biases up by an amount the results do not hold"
+    "no GICoF in the results: mu is Q*/P of the first gross-slip cycles, a peak read through "
+    "white noise but not through chatter or a force that rises along the stroke, by amounts "
+    "the results do not hold"
 )
 
 

@@ -14,6 +14,7 @@ import numpy as np
 __all__ = [
     "branch_stretches",
     "detrended",
+    "fitted_extremes",
     "interpolated",
     "line_crossings",
     "loop_measures",
@@ -31,6 +32,15 @@ _COMPILE = {"cache": True, "error_model": "numpy", "nogil": True}
 #: The lower quartile of the absolute second difference of white noise over its standard
 #: deviation.
 _QUARTILE_SECOND_DIFFERENCE = 0.3186393639643752 * np.sqrt(6.0)
+#: The same of a sixth difference (its standard deviation is √924 times the noise's): the
+#: difference of a smooth loop sampled a few dozen times a cycle or more is far below it.
+_QUARTILE_SIXTH_DIFFERENCE = 0.3186393639643752 * np.sqrt(924.0)
+#: A loop's extreme is read from the parabola fitted over the samples within this many
+#: noise standard deviations of it ...
+_EXTREME_DEPTH = 3.0
+#: ... where the noise exceeds this share of the loop's range (below, it is rounding); a
+#: step between the loop's last samples and its first counts beyond this many standard errors.
+_NOISE_FREE, _STEP_T = 1e-6, 3.0
 #: A stick segment grows until two samples in a row are this many standard deviations off.
 _STICK_SPREAD = 3.0
 #: A stick segment is curved when a term in the squared force, added to its line, is
@@ -473,6 +483,79 @@ def loop_measures(x, y, offset, count, rotation):
                 top[k] = point
                 break
     return highest, lowest, max_force, area, top
+
+
+@numba.njit(**_COMPILE)
+def _fitted_peak(values, first, n, at, sixth, span, sign):
+    """The value at the loop's sample ``at`` of the parabola fitted by least squares to
+    ``sign`` times its samples round it (taken as closed, with a step where it closes if
+    significant: a loop need not end where it began), on each side up to the last within
+    :data:`_EXTREME_DEPTH` noise sd of it before three in a row are not (a quarter cycle at
+    most, one sample at least), less the sample's; 0 if none is, or if the noise (from the
+    lower quartile of the loop's absolute ``sixth`` differences within an eighth of a cycle)
+    is below :data:`_NOISE_FREE` of the loop's ``span``."""
+    peak, reach, eighth = sign * values[first + at], n // 4, n // 8
+    local = np.empty(2 * eighth + 1)
+    for j in range(-eighth, eighth + 1):  # sixth[i] is centred on sample i + 3
+        local[j + eighth] = sixth[(at + j - 3) % n]
+    sd = np.sort(local)[eighth // 2] / _QUARTILE_SIXTH_DIFFERENCE
+    if not sd > _NOISE_FREE * span:
+        return 0.0
+    ends, near = np.ones(2, np.int64), False
+    for side in range(2):
+        step = 1 - 2 * side
+        for j in range(1, reach + 1):
+            if sign * values[first + (at + step * j) % n] >= peak - _EXTREME_DEPTH * sd:
+                ends[side], near = j, True
+            elif j > ends[side] + 2:
+                break
+    if not near:  # no other sample near it: the noise hardly lifts it
+        return 0.0
+    lo, hi = -ends[1], ends[0]
+    design, target = np.ones((hi - lo + 1, 4)), np.empty(hi - lo + 1)
+    for j in range(lo, hi + 1):
+        beyond = at + j < 0 or at + j >= n  # past where the loop closes
+        design[j - lo, 1], design[j - lo, 2], design[j - lo, 3] = j, j * j, beyond
+        target[j - lo] = sign * values[first + (at + j) % n] - peak
+    value = np.linalg.lstsq(np.ascontiguousarray(design[:, :3]), target)[0][0]
+    if 0.0 < design[:, 3].sum() < hi - lo - 2:  # a step where it closes, if significant
+        fit = np.linalg.lstsq(design, target)[0]
+        spread = np.linalg.inv(design.T @ design)[3, 3]
+        if abs(fit[3]) > _STEP_T * sd * np.sqrt(spread):
+            value = fit[0]
+    return value
+
+
+@numba.njit(**_COMPILE)
+def fitted_extremes(values, offset, count, least):
+    r"""Highest and lowest of each loop of ``count`` samples from ``offset``: the samples',
+    or, where white noise lifts them (``least`` samples or more), the values there of
+    parabolas fitted round them (:func:`_fitted_peak`; docs/method-loops.md). [m] or [N]"""
+    highest, lowest = np.empty(offset.size), np.empty(offset.size)
+    for k in range(offset.size):
+        first, n = offset[k], count[k]
+        top = bottom = 0
+        for i in range(1, n):
+            top = i if values[first + i] > values[first + top] else top
+            bottom = i if values[first + i] < values[first + bottom] else bottom
+        highest[k], lowest[k] = values[first + top], values[first + bottom]
+        if n < least:
+            continue
+        sixth = np.empty(n)
+        for i in range(n):
+            sixth[i] = abs(
+                values[first + i]
+                - 6.0 * values[first + (i + 1) % n]
+                + 15.0 * values[first + (i + 2) % n]
+                - 20.0 * values[first + (i + 3) % n]
+                + 15.0 * values[first + (i + 4) % n]
+                - 6.0 * values[first + (i + 5) % n]
+                + values[first + (i + 6) % n]
+            )
+        span = highest[k] - lowest[k]
+        highest[k] += _fitted_peak(values, first, n, top, sixth, span, 1.0)
+        lowest[k] -= _fitted_peak(values, first, n, bottom, sixth, span, -1.0)
+    return highest, lowest
 
 
 @numba.njit(**_COMPILE)

@@ -48,6 +48,9 @@ SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
 #: Fewest samples of a cycle whose noise is read from its second differences (in fewer, a
 #: loop's corners are most of them).
 _NOISE_SAMPLES = 4 * MIN_SAMPLES
+#: Fewest samples of a cycle whose extremes are read through its noise: in fewer, the
+#: parabola round a peak follows its few samples' shape more than it averages the noise.
+_EXTREME_SAMPLES = 8 * MIN_SAMPLES
 #: Energy ratio :math:`A = E_d/(4\Delta^* Q^*)` above which a loop is gross slip (the
 #: sliding transition of Fouvry, Kapsa and Vincent).
 GROSS_SLIP_THRESHOLD = 0.2
@@ -360,25 +363,29 @@ def _loop_values(block, options):
     load = options.load
     # The extremes, the loop's area by trapezoids (the segment that closes it included)
     # and its top, where the rising branch ends.
-    highest, lowest, max_force, energy, top = kernels.loop_measures(
+    highest, lowest, peak_force, energy, top = kernels.loop_measures(
         block.displacement, block.force, block.offset, block.count, block.rotation
     )
     span = highest - lowest
-    amplitude = 0.5 * span
+    # Δ* and Q*: half the range between the extremes, read through the noise if any
+    amplitude, max_force = (
+        0.5 * np.subtract(*kernels.fitted_extremes(v, block.offset, block.count, _EXTREME_SAMPLES))
+        for v in (block.displacement, block.force)
+    )
     rows = branch_rows(block, top)
     # Lines Δ = c + Q/S through the stick segments after the two reversals.
     compliance, intercept, across, residual, unexplained, curved = kernels.stick_lines(
         *rows, span, *options.stick_window
     )
     # Per branch row, the rising ones then the falling ones:
-    band, rounding = np.tile(_ZERO_FORCE_BAND * max_force, 2), np.tile(1e-9 * span, 2)
+    band, rounding = np.tile(_ZERO_FORCE_BAND * peak_force, 2), np.tile(1e-9 * span, 2)
     crossing, zero_on_loop = kernels.zero_force_crossings(*rows, band, intercept, across, rounding)
     cycles = block.count.size
     slip = 0.5 * (crossing[cycles:] - crossing[:cycles])
     slope, half_width = np.tile(compliance, 2), np.tile(options.crossing_window * np.abs(slip), 2)
     # Where each branch row crosses Q = SΔ: force, whether on the loop, displacement.
     force, on_loop = kernels.line_crossings(
-        *rows, slope, half_width, float(load), 1e-9 * np.tile(max_force, 2)
+        *rows, slope, half_width, float(load), 1e-9 * np.tile(peak_force, 2)
     )
     at = force * slope
     ratios = loop_ratios(amplitude, max_force, energy, slip, options.rig_stiffness)
@@ -406,7 +413,7 @@ def _loop_values(block, options):
         values |= {name: ratios[name] for name in _RIG_RATIOS}
     anticlockwise = energy_ratio < -ANTICLOCKWISE_SHARE
     sliding = gross_slip(values, options)
-    forward, backward, spring = _mindlin_sliding(rows, max_force, span, sliding)
+    forward, backward, spring = _mindlin_sliding(rows, peak_force, span, sliding)
     mindlin = np.isfinite(forward)
     read = {"gicof_forward": forward / load, "gicof_backward": backward / load}
     read |= {"gicof": (forward + backward) / (2.0 * load), "stiffness": spring}
@@ -439,8 +446,8 @@ def _loop_values(block, options):
         "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]) & ~mindlin,
         "partial-slip": ~sliding,
     }
-    flags["noise-amplitude"] = (_noise_lift(block, block.displacement) > amplitude) | (
-        _noise_lift(block, block.force) > max_force
+    flags["noise-amplitude"] = (_noise_lift(block, block.displacement) > 0.5 * span) | (
+        _noise_lift(block, block.force) > peak_force
     )
     return values, flags
 

@@ -24,6 +24,9 @@ DISPLACEMENTS = (
 FORCES = ("max_force", "force_offset")
 COEFFICIENTS = ("ecof", "cof_max", "energy_ratio", "gicof", "gicof_forward", "gicof_backward")
 PER_CYCLE = list(_PER_CYCLE)
+#: Read through the noise since the padded implementation kept the samples' half ranges
+#: (docs/method-loops.md): on its noisy recordings, within the noise's lift of them.
+THROUGH_NOISE = {"amplitude": 0.02, "max_force": 0.03, "cof_max": 0.03, "energy_ratio": 0.04}
 
 
 def scope_of(quality: str) -> set:
@@ -62,6 +65,6 @@ def assert_same(new, old):
         assert not np.any(np.isnan(a) & ~np.isnan(b) & ~explained), name
         assert not np.any(~np.isnan(a) & np.isnan(b)), name
         both = ~np.isnan(a) & ~np.isnan(b)
-        allowed = TOLERANCE * np.maximum(np.abs(b), natural)[both]
+        allowed = THROUGH_NOISE.get(name, TOLERANCE) * np.maximum(np.abs(b), natural)[both]
         difference = np.abs(a[both] - b[both])
         assert np.all(difference <= allowed), (name, float(np.max(difference / allowed)))

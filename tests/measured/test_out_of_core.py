@@ -219,7 +219,9 @@ def test_a_few_missing_samples_skip_their_cycles_only():
     one are measured as in the recording without gaps (to rounding): the centring reaches no
     further (a neighbour's displacement drift is interpolated across the gap, which moves
     its force centre, which the next cycle's force drift uses). Those nearer move by less
-    than the rig's noise moves them (1 % of the force here)."""
+    than the rig's noise moves them (1 % of the force here; Δ* and Q*, read through the
+    noise round the extremes, by 2 %: the fit follows the extreme sample when another
+    takes its place)."""
     displacement, force = noisy(EXAMPLE_2, 20, 4)
     clean = analysed(displacement, force)
     gaps = [430, 2250, 2251, 3615]
@@ -240,7 +242,8 @@ def test_a_few_missing_samples_skip_their_cycles_only():
     for name in ("gicof", "ecof", "stiffness", "displacement_offset", "force_offset"):
         np.testing.assert_allclose(result[name].values[far], clean[name].values[far], rtol=1e-12)
     for name in ("gicof", "ecof", "stiffness", "amplitude", "max_force"):
-        np.testing.assert_allclose(result[name].values[near], clean[name].values[near], rtol=1e-2)
+        rtol = 2e-2 if name in ("amplitude", "max_force") else 1e-2
+        np.testing.assert_allclose(result[name].values[near], clean[name].values[near], rtol=rtol)
 
 
 def test_missing_at_a_reversal_and_at_the_ends():
