@@ -486,44 +486,84 @@ def loop_measures(x, y, offset, count, rotation):
 
 
 @numba.njit(**_COMPILE)
-def _fitted_peak(values, first, n, at, sixth, span, sign):
+def _fitted_peak(values, first, n, at, span, sign):
     """The value at the loop's sample ``at`` of the parabola fitted by least squares to
     ``sign`` times its samples round it (taken as closed, with a step where it closes if
     significant: a loop need not end where it began), on each side up to the last within
     :data:`_EXTREME_DEPTH` noise sd of it before three in a row are not (a quarter cycle at
     most, one sample at least), less the sample's; 0 if none is, or if the noise (from the
-    lower quartile of the loop's absolute ``sixth`` differences within an eighth of a cycle)
+    lower quartile of the loop's absolute sixth differences within an eighth of a cycle)
     is below :data:`_NOISE_FREE` of the loop's ``span``."""
-    peak, reach, eighth = sign * values[first + at], n // 4, n // 8
-    local = np.empty(2 * eighth + 1)
-    for j in range(-eighth, eighth + 1):  # sixth[i] is centred on sample i + 3
-        local[j + eighth] = sixth[(at + j - 3) % n]
-    sd = np.sort(local)[eighth // 2] / _QUARTILE_SIXTH_DIFFERENCE
+    reach, eighth = n // 4, n // 8
+    half = max(reach, eighth + 3)
+    near_at = np.empty(2 * half + 1)  # sign times the samples at + j, the loop taken as closed
+    for j in range(-half, half + 1):
+        near_at[half + j] = sign * values[first + (at + j) % n]
+    peak, local = near_at[half], np.empty(2 * eighth + 1)
+    for j in range(half - eighth, half + eighth + 1):  # the sixth difference centred on j
+        local[j - half + eighth] = abs(
+            near_at[j - 3]
+            - 6.0 * near_at[j - 2]
+            + 15.0 * near_at[j - 1]
+            - 20.0 * near_at[j]
+            + 15.0 * near_at[j + 1]
+            - 6.0 * near_at[j + 2]
+            + near_at[j + 3]
+        )
+    sd = np.partition(local, eighth // 2)[eighth // 2] / _QUARTILE_SIXTH_DIFFERENCE
     if not sd > _NOISE_FREE * span:
         return 0.0
     ends, near = np.ones(2, np.int64), False
     for side in range(2):
         step = 1 - 2 * side
         for j in range(1, reach + 1):
-            if sign * values[first + (at + step * j) % n] >= peak - _EXTREME_DEPTH * sd:
+            if near_at[half + step * j] >= peak - _EXTREME_DEPTH * sd:
                 ends[side], near = j, True
             elif j > ends[side] + 2:
                 break
     if not near:  # no other sample near it: the noise hardly lifts it
         return 0.0
-    lo, hi = -ends[1], ends[0]
-    design, target = np.ones((hi - lo + 1, 4)), np.empty(hi - lo + 1)
-    for j in range(lo, hi + 1):
-        beyond = at + j < 0 or at + j >= n  # past where the loop closes
-        design[j - lo, 1], design[j - lo, 2], design[j - lo, 3] = j, j * j, beyond
-        target[j - lo] = sign * values[first + (at + j) % n] - peak
-    value = np.linalg.lstsq(np.ascontiguousarray(design[:, :3]), target)[0][0]
-    if 0.0 < design[:, 3].sum() < hi - lo - 2:  # a step where it closes, if significant
-        fit = np.linalg.lstsq(design, target)[0]
-        spread = np.linalg.inv(design.T @ design)[3, 3]
+    # The normal equations of the parabola in j / half, and of a step where the loop closes
+    normal, sums, row = np.zeros((4, 4)), np.zeros(4), np.ones(4)
+    for j in range(-ends[1], ends[0] + 1):
+        row[1] = j / half
+        row[2] = row[1] * row[1]
+        row[3] = 1.0 if at + j < 0 or at + j >= n else 0.0
+        for r in range(4):
+            sums[r] += row[r] * (near_at[half + j] - peak)
+            for c in range(4):
+                normal[r, c] += row[r] * row[c]
+    value = _solution(normal, sums, 3)[0]
+    steps = normal[3, 3]
+    if 0.0 < steps < ends[0] + ends[1] - 2:  # a step where it closes, if significant
+        fit, spread = _solution(normal, sums, 4), _solution(normal, np.eye(4)[3], 4)[3]
         if abs(fit[3]) > _STEP_T * sd * np.sqrt(spread):
             value = fit[0]
     return value
+
+
+@numba.njit(**_COMPILE)
+def _solution(matrix, right, m):
+    """The solution of the small linear system ``matrix[:m, :m] @ x = right[:m]`` (Gaussian
+    elimination with partial pivoting)."""
+    a, b = matrix.copy(), right.copy()
+    for col in range(m):
+        pivot = col
+        for row in range(col + 1, m):
+            pivot = row if abs(a[row, col]) > abs(a[pivot, col]) else pivot
+        for k in range(m):
+            a[col, k], a[pivot, k] = a[pivot, k], a[col, k]
+        b[col], b[pivot] = b[pivot], b[col]
+        for row in range(col + 1, m):
+            factor = a[row, col] / a[col, col]
+            for k in range(col, m):
+                a[row, k] -= factor * a[col, k]
+            b[row] -= factor * b[col]
+    for col in range(m - 1, -1, -1):
+        for k in range(col + 1, m):
+            b[col] -= a[col, k] * b[k]
+        b[col] /= a[col, col]
+    return b[:m]
 
 
 @numba.njit(**_COMPILE)
@@ -541,20 +581,9 @@ def fitted_extremes(values, offset, count, least):
         highest[k], lowest[k] = values[first + top], values[first + bottom]
         if n < least:
             continue
-        sixth = np.empty(n)
-        for i in range(n):
-            sixth[i] = abs(
-                values[first + i]
-                - 6.0 * values[first + (i + 1) % n]
-                + 15.0 * values[first + (i + 2) % n]
-                - 20.0 * values[first + (i + 3) % n]
-                + 15.0 * values[first + (i + 4) % n]
-                - 6.0 * values[first + (i + 5) % n]
-                + values[first + (i + 6) % n]
-            )
         span = highest[k] - lowest[k]
-        highest[k] += _fitted_peak(values, first, n, top, sixth, span, 1.0)
-        lowest[k] -= _fitted_peak(values, first, n, bottom, sixth, span, -1.0)
+        highest[k] += _fitted_peak(values, first, n, top, span, 1.0)
+        lowest[k] -= _fitted_peak(values, first, n, bottom, span, -1.0)
     return highest, lowest
 
 
