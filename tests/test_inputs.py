@@ -1,4 +1,4 @@
-"""Inputs of the public API: pint Quantities in any unit, refused types, float64 (issue 9)."""
+"""Inputs of the public API: pint Quantities in any unit, refused types, float64."""
 
 import jax
 import numpy as np
@@ -111,7 +111,7 @@ def test_plain_arrays_still_jit_and_vmap():
 
 
 def test_scar_profiles_keep_units():
-    """Issue 23: a trace in mm and µm is the trace in metres, not 1000 times larger."""
+    """A trace in mm and µm is the trace in metres, not 1000 times larger."""
     x = np.linspace(-100e-6, 100e-6, 401)
     z = np.where(np.abs(x) < 50e-6, 10e-6 * ((x / 50e-6) ** 2 - 1), 0.0)
     si = ecofmaps.scar_profile(x, z, smoothing=0)
@@ -149,7 +149,7 @@ def test_profile_families_keep_units(function, lengths):
 
 
 def test_a_broadcast_too_large_for_memory_is_refused_before_it_is_made():
-    """Issue 22: (1e5, 1) x (1, 1e5) is 1e10 points, 80 GB; JAX aborted the interpreter."""
+    """(1e5, 1) x (1, 1e5) is 1e10 points, 80 GB; JAX aborted the interpreter."""
     column, row = np.full((100_000, 1), 50e-6), np.full((1, 100_000), 450.0)
     assert np.broadcast_shapes(column.shape, row.shape) == (100_000, 100_000)
     memory = _inputs.available_memory()

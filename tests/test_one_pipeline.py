@@ -1,4 +1,4 @@
-"""One pipeline behind every way in (issue 22, item 1): the same table, byte for byte.
+"""One pipeline behind every way in: the same table, byte for byte.
 
 A small recording with drift, noise and a NaN dropout is analysed through the Python API
 (``analyze_loops`` and ``resolve_loops`` on the arrays), and through ``ecofmaps loops`` from

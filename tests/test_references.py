@@ -1,4 +1,4 @@
-"""Every public name whose docstring cites an equation of the paper says which paper (issue 8)."""
+"""Every public name whose docstring cites an equation of the paper says which paper."""
 
 import importlib
 import inspect

@@ -26,7 +26,7 @@ import tempfile
 import time
 from pathlib import Path
 
-#: Targets of issue 22 on a 2-core machine. [s]
+#: Targets on a 2-core machine. [s]
 TARGETS = {"cold": 8.0, "warm": 4.0}
 
 FLOOR = (

@@ -1,6 +1,6 @@
 """``ecofmaps loops`` on a long test: peak memory and samples/s, out of core against in memory.
 
-    python tests/benchmarks/bench_long_loops.py                   # 2e8 samples (issue 12)
+    python tests/benchmarks/bench_long_loops.py                   # 2e8 samples
     python tests/benchmarks/bench_long_loops.py --samples 2e7     # a moderate size
     python tests/benchmarks/bench_long_loops.py --folder DIR      # keep (and reuse) the files
     python tests/benchmarks/bench_long_loops.py --no-resolve      # the analysis only
@@ -20,7 +20,7 @@ the best time kept. The runs:
 - ``workers 1``, ``workers 2``: the same with ``--workers 1`` and ``--workers 2`` (a local
   dask cluster of that many single-threaded processes).
 
-Targets (issue 12): peak memory under 2 GB out of core; samples/s of ``workers 1`` within
+Targets: peak memory under 2 GB out of core; samples/s of ``workers 1`` within
 20 % of ``memory`` (per core); ``workers 2`` at least 1.6x ``workers 1``. The machine's load
 is printed before and after: numbers taken while other programs run are noisy. The runs
 take turns (each round runs every one once), so a machine that slows down for a while

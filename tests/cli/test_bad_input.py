@@ -1,4 +1,4 @@
-"""Odd and bad input through the command line (issue 9): one line, status != 0, inputs kept.
+"""Odd and bad input through the command line: one line, status != 0, inputs kept.
 
 Each case drives the ``ecofmaps`` command with an input a new user might give and checks
 the outcome: the exit status, the one-line message naming the option or file, the input

@@ -1,4 +1,4 @@
-"""A batch of recordings goes on past one that cannot be analysed (issue 23, item 4)."""
+"""A batch of recordings goes on past one that cannot be analysed."""
 
 import numpy as np
 import pandas as pd

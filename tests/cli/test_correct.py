@@ -27,7 +27,7 @@ def test_one_point(capsys):
     assert float(printed(out, "contact coefficient")) == pytest.approx(mu, rel=5e-6)  # 6 digits
     assert float(printed(out, "contact CoF over energy CoF")) == pytest.approx(mu / 0.83, rel=5e-6)
     assert len(printed(out, "contact coefficient").replace("0.", "", 1)) >= 4
-    assert "regime" not in out  # a corrected value is a gross-slip loop (issue 8, defect 3)
+    assert "regime" not in out  # a corrected value is a gross-slip loop
 
 
 def test_one_point_from_the_scar(capsys):

@@ -1,5 +1,5 @@
 """Ctrl-C and SIGTERM at each point of the end of a long ``ecofmaps loops`` run, made
-deterministic: the signal is raised in this process at a chosen point (issue 23 item 6).
+deterministic: the signal is raised in this process at a chosen point.
 
 The line must tell the truth as it is when written: a ``.partial`` folder kept is named with
 the ``--resume`` hint, also when the stop came as an error the signal caused (a worker

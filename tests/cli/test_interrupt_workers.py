@@ -1,4 +1,4 @@
-"""Ctrl-C and SIGTERM with ``--workers 2`` at the awkward moments (issue 23, item 6): while
+"""Ctrl-C and SIGTERM with ``--workers 2`` at the awkward moments: while
 the cluster starts, and after dask restarted a worker killed with SIGKILL (the new worker
 still importing). Exit 130 or 143, exactly one line on standard error (no traceback from the
 workers, no "Task exception was never retrieved"), no temporary file, no process of the

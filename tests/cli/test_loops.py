@@ -159,7 +159,7 @@ def test_damaged_file_writes_nothing(tmp_path, capsys, recording):
 
 def test_a_damaged_file_in_a_batch_is_named_and_the_others_written(tmp_path, capsys, recording):
     """A bad cell in the second of two files: one error line naming its file and line, the
-    first file's rows and plots written, exit status 1 (issue 23, item 4)."""
+    first file's rows and plots written, exit status 1."""
     good = write_csv(tmp_path / "good.csv", *recording)
     bad = write_csv(tmp_path / "bad.csv", *recording)
     lines = bad.read_text().splitlines()

@@ -1,6 +1,6 @@
 """``ecofmaps loops`` on long tests: missing samples, out of core (threads, two worker
 processes), blocks kept as they complete and a resumed run, damaged files and clusters that
-do not answer (issue 11 item 5, issue 12 items 2, 3 and Bad input)."""
+do not answer."""
 
 import re
 

@@ -1,4 +1,4 @@
-"""Plausibility of scale on the command line (issue 23, item 2): a wrong load or unit is
+"""Plausibility of scale on the command line: a wrong load or unit is
 flagged or refused with a message that names the assumption and the option."""
 
 import pandas as pd

@@ -287,7 +287,7 @@ def test_correct_with_the_physical_mapping(capsys, example):
     assert float(values(out, "contact coefficient")[0]) == pytest.approx(mu, rel=5e-6)
 
 
-# --- what the reading decided, on the command line (issue 23, item 8) ---------------------
+# --- what the reading decided, on the command line ---------------------
 
 
 def groove_in_band(path, dropout_line=None):

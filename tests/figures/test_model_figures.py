@@ -299,7 +299,7 @@ def test_universal_map_matches_fig11(drawn):
 
 
 def test_figures_draw_what_they_are_given_and_nothing_else(drawn):
-    """Pure functions of their Dataset and arguments (issue 8): no marker guessed from the data."""
+    """Pure functions of their Dataset and arguments: no marker guessed from the data."""
     _, dataset = drawn["fig11b"]
     ax = figures.ecof_ratio_contours(dataset).axes[0]
     assert _markers(ax) == [] and ax.get_title().startswith("Fig. 11 ")

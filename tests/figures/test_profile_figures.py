@@ -100,7 +100,7 @@ def test_shapes_dataset_against_the_model(shapes):
     for name in dataset.variables:  # attrs from the nomenclature
         assert {"long_name", "units"} <= set(dataset[name].attrs), name
     assert float(dataset.scar_depth / dataset.scar_half_width) == paper.ASPECT_RATIO
-    # The parabolic family is the parabola (analytic family: within 1e-10, issue 10).
+    # The parabolic family is the parabola (analytic family: within 1e-10).
     parabolic = dataset.sel(shape="parabolic")
     np.testing.assert_allclose(parabolic.ecof_ratio.sel(groove="profile"),
                                parabolic.ecof_ratio.sel(groove="parabola"), rtol=1e-10)  # fmt: skip
@@ -115,7 +115,7 @@ def test_shapes_dataset_against_the_model(shapes):
     ratio = dataset.stiffness_ratio.values
     mu = ecofmaps.correct_ecof(ecof, paper.AMPLITUDE, paper.LOAD, ratio * paper.LOAD, 0.2)
     np.testing.assert_allclose(flat.shortcut_error, mu / paper.MU - 1.0, rtol=1e-12)
-    # A flat bottom biases μ_E less than the parabola (issue 10: about half at Example 2).
+    # A flat bottom biases μ_E less than the parabola (about half at Example 2).
     at_example = dict(stiffness_ratio=paper.STIFFNESS / paper.LOAD)
     bias = (dataset.ecof_ratio.sel(**at_example) - 1.0).sel(shape="flat-bottomed")
     assert 0.1 < float(bias.sel(groove="profile") / bias.sel(groove="parabola")) < 0.5

@@ -82,7 +82,7 @@ def test_units_must_be_lengths(tmp_path):
         ecofmaps.read_scar_profile(path, z_unit="N")
 
 
-# --- instruments' exports, outliers and ambiguous edges (issue 23, item 8) ----------------
+# --- instruments' exports, outliers and ambiguous edges ----------------
 
 
 def stylus_export(path, separator, x_mm, z_um, header=('"Distance [mm]"', '"Profile (um)"')):

@@ -1,5 +1,5 @@
 """Text exports as instruments write them: preambles, quotes, decimal commas, separators,
-gzip, line ends, a recorded normal load, and the usual column names (issue 23)."""
+gzip, line ends, a recorded normal load, and the usual column names."""
 
 import gzip
 

@@ -136,7 +136,7 @@ def test_one_cycle_of_a_long_recording():
 @pytest.mark.parametrize("lazy", [False, True])
 def test_a_gap_leaves_a_hole_in_the_drive_numbering(lazy):
     """A NaN run of 1.7 cycles in a 12-cycle recording: the cycle that holds it is skipped
-    and the cycles after it keep the drive's numbers (issue 23, item 5), in memory and out
+    and the cycles after it keep the drive's numbers, in memory and out
     of core alike."""
     import warnings
 

@@ -1,4 +1,4 @@
-"""The drive's cycles after a gap (issue 23, item 5): a NaN run of any length at any place
+"""The drive's cycles after a gap: a NaN run of any length at any place
 leaves a hole in the numbering only where samples are missing.
 
 The trigger restarts where the samples resume after a long gap, so a complete cycle just

@@ -1,5 +1,5 @@
 """A recording held as dask arrays, analysed block by block: the numbers of the same
-recording in memory; and recordings with missing samples (issue 11 item 5, issue 12 item 2).
+recording in memory; and recordings with missing samples.
 
 Chunks of the passes over the recording, dask blocks and the tasks of cycles are made small
 and awkward here (1000, 1700 and 777 samples), so that runs, cycles, percentile brackets,

@@ -1,4 +1,4 @@
-"""Plausibility of measured loops (issue 9 item 1, issue 11 item 3): every flag of ``quality``
+"""Plausibility of measured loops: every flag of ``quality``
 driven by the input that causes it in a lab, and no implausible number ever reported.
 
 A recording is checked cycle by cycle; a value that cannot be stood behind is NaN and the
@@ -132,7 +132,7 @@ def test_swapped_columns(rig):
 @pytest.mark.parametrize("scale", [1e6, 1e-3, 1e-6])
 def test_displacement_in_another_unit_is_refused(rig, scale):
     """Micrometres passed as metres, or metres as millimetres or micrometres: every cycle
-    is refused (issue 23, item 2), and the error names the unit and the option."""
+    is refused, and the error names the unit and the option."""
     displacement, force = rig
     with pytest.raises(ValueError, match=r"implausible-amplitude.*--displacement-unit"):
         quiet(displacement * scale, force, LOAD)
@@ -451,7 +451,7 @@ def test_vocabulary():
         add_reason(quality, True, "bad")
 
 
-# --- no implausible number, whatever the input (issue 9's property) -------------------------
+# --- no implausible number, whatever the input -------------------------
 
 DENSE = np.asarray(ecofmaps.fretting_loop(**EXAMPLE_2, num=401))
 REFUSALS = (
@@ -544,7 +544,7 @@ def odd_recordings(draw):
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(recording=odd_recordings())
 def test_nothing_implausible_is_reported(recording):
-    """Any recording: a ValueError with a message, or only plausible numbers (issue 9)."""
+    """Any recording: a ValueError with a message, or only plausible numbers."""
     _, displacement, force = recording
     try:
         result = quiet(displacement, force, LOAD, keep_loops=True)

@@ -27,7 +27,7 @@ MU = 0.8
 EXAMPLE_2 = dict(amplitude=AMPLITUDE, load=LOAD, stiffness=STIFFNESS, mu=MU, aspect_ratio=0.2)
 SAMPLES = 200  # per cycle
 EXACT = 1e-9  # where the method is exact for the model (the issue's bound)
-# Issue 5's sensors: 0.5 % of Δ* and about 1 % of Q* of noise, offsets, a drift.
+# A rig's sensors: 0.5 % of Δ* and about 1 % of Q* of noise, offsets, a drift.
 NOISE = dict(
     displacement_noise=0.25e-6,
     force_noise=4.0,

@@ -1,4 +1,4 @@
-"""The checks of scale speak through their own types (issue 23, item 2): an API user filters
+"""The checks of scale speak through their own types: an API user filters
 ``ImplausibleScaleWarning`` or catches ``ImplausibleScaleError`` without reading messages."""
 
 import warnings

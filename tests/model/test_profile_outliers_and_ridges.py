@@ -1,5 +1,5 @@
 """Measured scar profiles as instruments give them: spikes and dropouts, pile-up ridges,
-debris and roughness beside and in the track, ambiguous edges (issue 23, item 8)."""
+debris and roughness beside and in the track, ambiguous edges."""
 
 import warnings
 

@@ -462,7 +462,7 @@ def test_results_are_float64_even_with_x64_switched_off():
 
 
 def test_import_leaves_jax_configuration_alone():
-    """A library must not change its host's global state (issue 8): 64-bit mode stays off."""
+    """A library must not change its host's global state: 64-bit mode stays off."""
     script = (
         "import jax, ecofmaps; "
         "print(jax.config.jax_enable_x64, ecofmaps.energy_cof(5e-5, 450.0, 35e6, 0.8, 0.2).dtype, "
