@@ -13,7 +13,7 @@ from ecofmaps import model, paper
 from ecofmaps._inputs import check
 from ecofmaps._version import __version__
 
-__all__ = ["checked_axes", "checked_axis", "checked_load", "compliance_values", "grid_dataset"]
+__all__ = ["checked_axes", "checked_axis", "checked_load", "grid_dataset", "map_dataset"]
 
 # The order of the variables in a Dataset (xarray orders the dimensions as they first appear).
 _VARIABLES = (
@@ -28,25 +28,6 @@ _VARIABLES = (
     "dissipated_energy",
     "max_force",
 )
-
-
-def _attrs(name: str) -> dict:
-    attrs = nomenclature.attrs(name)
-    if name == "regime":
-        attrs.update(model.Regime.flag_attrs())
-    return attrs
-
-
-def _global_attrs(title: str) -> dict:
-    return {
-        "title": title,
-        "model": paper.MODEL,
-        "references": paper.CITATION,
-        "source": f"ecofmaps {__version__}",
-        "ecofmaps_version": __version__,
-    }
-
-
 # The range rule and unit of each grid axis.
 _AXES = {
     "stiffness_ratio": ("positive_or_inf", "1/m"),
@@ -57,6 +38,13 @@ _AXES = {
     "load": ("positive", "N"),
     "mu": ("positive", "1"),
 }
+
+
+def _attrs(name: str) -> dict:
+    attrs = nomenclature.attrs(name)
+    if name == "regime":
+        attrs.update(model.Regime.flag_attrs())
+    return attrs
 
 
 def checked_axes(**values) -> dict:
@@ -72,9 +60,8 @@ def checked_axis(name: str, value) -> np.ndarray:
         raise ValueError(f"{name} must be a single value or a 1-D array, got shape {array.shape}")
     if array.size == 0:
         raise ValueError(f"{name} must hold at least one value, got an empty array")
-    ordered = np.sort(array, axis=None)
-    if np.any(ordered[1:] == ordered[:-1]):
-        unique, counts = np.unique(array, return_counts=True)
+    unique, counts = np.unique(array, return_counts=True)
+    if np.any(counts > 1):
         repeated = unique[counts > 1][0]
         where = np.flatnonzero(array == repeated)
         raise ValueError(
@@ -94,43 +81,47 @@ def checked_load(load) -> np.ndarray | None:
     return load
 
 
-def compliance_values(axes: dict) -> tuple:
-    """λ = P/(SΔ*) = 1/((S/P)Δ*) over the axes ``stiffness_ratio`` and ``amplitude`` (eq. 16),
-    as ``(dims, values)`` for :func:`grid_dataset`."""
-    stiffness, amplitude = axes["stiffness_ratio"], axes["amplitude"]
-    lam = model.compliance_ratio(np.atleast_1d(amplitude), 1.0, np.atleast_1d(stiffness)[:, None])
-    scalars = tuple(i for i, axis in enumerate((stiffness, amplitude)) if axis.ndim == 0)
-    dims = tuple(n for n in ("stiffness_ratio", "amplitude") if axes[n].ndim == 1)
-    return dims, np.squeeze(lam, axis=scalars)
-
-
 def grid_dataset(axes: dict, values: dict, title: str, extra=None) -> xr.Dataset:
-    """A Dataset of grid ``values`` over ``axes`` (scalars become scalar coordinates)."""
+    """A Dataset of grid ``values`` over ``axes`` (scalars become scalar coordinates), with
+    the coordinates ``extra``; a value ``(dims, array)`` is taken as it is."""
+    extra = extra or {}
     dims = [name for name, axis in axes.items() if axis.ndim == 1]
     squeeze = tuple(i for i, axis in enumerate(axes.values()) if axis.ndim == 0)
-    extra = extra or {}
     trailing = [name for name, coordinate in extra.items() if coordinate.ndim == 1]
-    coords = {
-        name: ((name,) if axis.ndim == 1 else (), axis, _attrs(name))
-        for name, axis in {**axes, **extra}.items()
-    }
     variables, indexes = {}, {}
-    for name, (dim, value, attrs) in coords.items():
-        if dim:  # a dimension coordinate, indexed as xarray.Dataset would index it
+    for name, value in {**axes, **extra}.items():
+        variable = xr.Variable((name,) * value.ndim, value, _attrs(name))
+        if value.ndim:  # a dimension coordinate, indexed as xarray.Dataset would index it
             indexes[name] = PandasIndex(pd.Index(value), name)
-            variables.update(indexes[name].create_variables({name: xr.Variable(dim, value, attrs)}))
+            variables.update(indexes[name].create_variables({name: variable}))
         else:
-            variables[name] = xr.Variable(dim, value, attrs)
+            variables[name] = variable
+    coords = set(variables)
     for name in sorted(values, key=_VARIABLES.index):
-        if isinstance(values[name], tuple):
-            variables[name] = xr.Variable(*values[name], _attrs(name))
-            continue
-        value = np.squeeze(values[name], axis=squeeze)
-        variables[name] = xr.Variable(
-            dims + trailing[: value.ndim - len(dims)], value, _attrs(name)
-        )
+        value = values[name]
+        if not isinstance(value, tuple):  # over the grid, but its scalar axes
+            value = np.squeeze(value, axis=squeeze)
+            value = dims + trailing[: value.ndim - len(dims)], value
+        variables[name] = xr.Variable(*value, _attrs(name))
+    attrs = {
+        "title": title,
+        "model": paper.MODEL,
+        "references": paper.CITATION,
+        "source": f"ecofmaps {__version__}",
+        "ecofmaps_version": __version__,
+    }
     # What xarray.Dataset(data_vars, coords, attrs) builds, without its merging and alignment
     # of variables that are consistent by construction.
-    return xr.Dataset._construct_direct(
-        variables, set(coords), attrs=_global_attrs(title), indexes=indexes
+    return xr.Dataset._construct_direct(variables, coords, attrs=attrs, indexes=indexes)
+
+
+def map_dataset(axes: dict, values: dict, load, title: str) -> xr.Dataset:
+    """The Dataset of a map of :func:`compute_map`: ``values``, the load as a coordinate, and
+    λ = P/(SΔ*) = 1/((S/P)Δ*) over the axes ``stiffness_ratio`` and ``amplitude`` (eq. 16)."""
+    stiffness, amplitude = axes["stiffness_ratio"], axes["amplitude"]
+    lam = model.compliance_ratio(
+        amplitude, 1.0, stiffness[..., None] if amplitude.ndim else stiffness
     )
+    dims = tuple(name for name in ("stiffness_ratio", "amplitude") if axes[name].ndim)
+    values = {**values, "compliance_ratio": (dims, lam)}
+    return grid_dataset(axes, values, title, {} if load is None else {"load": load})

@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import concurrent.futures
-import contextlib
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -17,16 +16,6 @@ __all__ = ["ZARR_SUFFIX", "write_map"]
 
 #: The suffix of the paths that :func:`write_map` writes as zarr stores.
 ZARR_SUFFIX = ".zarr"
-
-
-@contextlib.contextmanager
-def _threads():
-    """A thread per core for dask; on leaving, queued tasks are dropped and running ones end."""
-    pool = concurrent.futures.ThreadPoolExecutor(tile_workers())
-    try:
-        yield pool
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
 
 
 def write_map(dataset: xr.Dataset, path, *, also: Sequence = ()) -> tuple:
@@ -84,11 +73,15 @@ def write_map(dataset: xr.Dataset, path, *, also: Sequence = ()) -> tuple:
         raise ValueError(f"{path} is a directory: a netCDF file cannot replace it")
     if path.is_dir() and not any((path / n).is_file() for n in ("zarr.json", ".zgroup", ".zarray")):
         raise ValueError(f"{path} is a directory but not a zarr store: it is not replaced")
-    with atomic_store(path, overwrite=True) as temporary, _threads() as pool:
+    with atomic_store(path, overwrite=True) as temporary:
         if zarr:
             written = dataset.to_zarr(temporary, compute=False, zarr_format=2, consolidated=True)
         else:
             check_room(temporary, dataset.nbytes)
             written = dataset.to_netcdf(temporary, engine="h5netcdf", compute=False)
-        _, *values = dask.compute(written, *also, scheduler="threads", pool=pool)
+        pool = concurrent.futures.ThreadPoolExecutor(tile_workers())
+        try:
+            _, *values = dask.compute(written, *also, scheduler="threads", pool=pool)
+        finally:  # queued blocks are dropped, running ones end before the output is removed
+            pool.shutdown(wait=True, cancel_futures=True)
     return tuple(values)

@@ -15,7 +15,7 @@ import xarray as xr
 from ecofmaps import model
 from ecofmaps._inputs import float64
 from ecofmaps.maps.cache import cached_dataset
-from ecofmaps.maps.dataset import checked_axes, checked_load, compliance_values, grid_dataset
+from ecofmaps.maps.dataset import checked_axes, checked_load, grid_dataset, map_dataset
 from ecofmaps.maps.on_profile import compute_profile_map
 from ecofmaps.maps.tiles import MAX_CHUNK, grid_values
 from ecofmaps.model.simulation import fretting_loop
@@ -71,8 +71,8 @@ def _universal_kernel(compliance_ratio, aspect_ratio, mu):
     return _broadcast(_steady_state(mu, kappa, lam), axes)
 
 
-def _check_cache(cache, chunks) -> None:
-    """Refuse ``cache=True`` for a chunked map (it is never cached)."""
+def _cached(cache, chunks) -> bool:
+    """Whether a closed-form map is cached; ``cache=True`` for a chunked map is refused."""
     if cache not in (None, True, False):
         raise ValueError(f"cache must be True, False or None, got {cache!r}")
     if cache and chunks is not None:
@@ -80,6 +80,7 @@ def _check_cache(cache, chunks) -> None:
             "cache=True with chunks: a chunked map is not cached (it is evaluated block by "
             "block where it is written); leave cache out"
         )
+    return bool(cache)
 
 
 @float64
@@ -210,15 +211,11 @@ def compute_map(
     )
     load = checked_load(load)
 
-    _check_cache(cache, chunks)
-
     def compute() -> xr.Dataset:
         values = grid_values(_map_kernel, axes, (load,), max_chunk, chunks)
-        values["compliance_ratio"] = compliance_values(axes)
-        extra = {} if load is None else {"load": load}
-        return grid_dataset(axes, values, "ECoF map of the compliant wear-scar model", extra)
+        return map_dataset(axes, values, load, "ECoF map of the compliant wear-scar model")
 
-    if chunks is not None or not cache:
+    if not _cached(cache, chunks):
         return compute()
     return cached_dataset("compute_map", {**axes, "load": load}, compute, cache_dir)
 
@@ -275,13 +272,11 @@ def compute_universal_map(
     """
     axes = checked_axes(compliance_ratio=compliance_ratio, aspect_ratio=aspect_ratio, mu=mu)
 
-    _check_cache(cache, chunks)
-
     def compute() -> xr.Dataset:
         values = grid_values(_universal_kernel, axes, (), max_chunk, chunks)
         return grid_dataset(axes, values, "Universal ECoF map of the compliant wear-scar model")
 
-    if chunks is not None or not cache:
+    if not _cached(cache, chunks):
         return compute()
     return cached_dataset("compute_universal_map", axes, compute, cache_dir)
 
@@ -349,5 +344,4 @@ def compute_loops(stiffness, aspect_ratio, amplitude, load, mu, num=201) -> xr.D
     loop = fretting_loop(grid[2], grid[3], grid[0], grid[4], grid[1], num=num)
     values["displacement"], values["force"] = loop
     values = {name: np.asarray(value) for name, value in values.items()}
-    point = np.arange(2 * num + 1)
-    return grid_dataset(axes, values, "Steady fretting loops", extra={"point": point})
+    return grid_dataset(axes, values, "Steady fretting loops", {"point": np.arange(2 * num + 1)})

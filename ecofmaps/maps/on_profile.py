@@ -13,7 +13,7 @@ import xarray as xr
 
 from ecofmaps._inputs import float64
 from ecofmaps.maps.cache import cached_dataset
-from ecofmaps.maps.dataset import checked_axes, checked_load, compliance_values, grid_dataset
+from ecofmaps.maps.dataset import checked_axes, checked_load, map_dataset
 from ecofmaps.maps.tiles import MAX_CHUNK, check_max_chunk
 from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers, steady_values
 
@@ -110,18 +110,15 @@ def compute_profile_map(
         for start in range(0, size, max_chunk):
             index = np.unravel_index(np.arange(start, min(start + max_chunk, size)), shape)
             stiffness, amplitude, mu = (axis[i] for axis, i in zip(grid, index, strict=True))
-            # λ = P/(S Δ*) = 1/((S/P) Δ*): a unit load and the stiffness ratio.
+            # λ = P/(S Δ*) = 1/((S/P) Δ*): a unit load and the stiffness ratio
             numbers = steady_numbers(profile, amplitude, 1.0, stiffness, mu, mapping=mapping)
             for name in names:
                 flat[name][start : start + index[0].size] = np.asarray(numbers[name])
         values = {name: flat[name].reshape(shape) for name in names}
         values.update(steady_values(values, grid[1][None, :, None], load, grid[2][None, None, :]))
         del values["normalized_energy"], values["normalized_max_force"]
-        values["compliance_ratio"] = compliance_values(axes)
-        extra = {} if load is None else {"load": load}
-        dataset = grid_dataset(
-            axes, values, "ECoF map of the compliant wear-scar model on a scar profile", extra
-        )
+        title = "ECoF map of the compliant wear-scar model on a scar profile"
+        dataset = map_dataset(axes, values, load, title)
         dataset.attrs.update(
             model=MODEL_ON_PROFILE,
             scar_depth=float(profile.depth),

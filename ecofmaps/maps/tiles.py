@@ -40,20 +40,21 @@ BLOCK_POINTS = 2**22
 BLOCK_TASK = "ecofmaps-block"
 
 
-@functools.lru_cache(maxsize=64)
-def _bytes_per_point(kernel, axes: int, extra: tuple) -> int:
-    """Bytes of ``kernel``'s results per grid point, from ``jax.eval_shape`` on one point."""
-    point = [jax.ShapeDtypeStruct((1,), np.float64)] * axes
-    arguments = [None if e is None else jax.ShapeDtypeStruct(*e) for e in extra]
+def _dtypes(kernel, axes, extra) -> dict:
+    """The type of each of ``kernel``'s results, by name (traced on one grid point)."""
     with jax.enable_x64(True):
-        outputs = jax.eval_shape(kernel, *point, *arguments)
-    return sum(out.dtype.itemsize * out.size for out in jax.tree_util.tree_leaves(outputs))
+        outputs = jax.eval_shape(kernel, *(axis[:1] for axis in axes), *extra)
+    return {name: spec.dtype for name, spec in outputs.items()}
+
+
+def _empty(dtypes: dict, region) -> dict[str, np.ndarray]:
+    shape = tuple(stop - start for start, stop in region)
+    return {name: np.empty(shape, dtype=dtype) for name, dtype in dtypes.items()}
 
 
 def _check_memory(kernel, axes, extra, max_chunk: int) -> None:
     """Refuse, before allocating, a grid whose results would not fit in the free memory."""
-    signature = tuple(None if e is None else (np.shape(e), np.result_type(e)) for e in extra)
-    per_point = _bytes_per_point(kernel, len(axes), signature)
+    per_point = sum(dtype.itemsize for dtype in _dtypes(kernel, axes, extra).values())
     points = math.prod(axis.size for axis in axes)
     needed = per_point * (points + 2 * tile_workers() * min(points, max_chunk))
     free = available_memory()
@@ -92,7 +93,8 @@ def _tiles(split: tuple[int, int], region):
 
 
 def _fill(out, kernel, axes, extra, split, region, tiles, stop=None) -> None:
-    """Evaluate ``tiles`` and copy their part inside ``region`` into the arrays ``out``."""
+    """Evaluate ``tiles`` and copy their part inside ``region`` into the arrays ``out``; end
+    early once ``stop`` (a ``threading.Event``) is set."""
     k, rows = split
     offset = tuple(start for start, _ in region)
     trailing = tuple(slice(start, stop) for start, stop in region[k + 1 :])
@@ -113,9 +115,6 @@ def _fill(out, kernel, axes, extra, split, region, tiles, stop=None) -> None:
                 slice(low - offset[k], high - offset[k]),
             )
             for name, value in values.items():
-                if name not in out:
-                    shape = tuple(stop - start for start, stop in region)
-                    out[name] = np.empty(shape, dtype=value.dtype)
                 out[name][target] = np.asarray(value)[source]
 
 
@@ -128,11 +127,7 @@ def _evaluate_grid(kernel, axes, extra, max_chunk: int) -> dict[str, np.ndarray]
     split = _split(shape, max_chunk)
     region = tuple((0, size) for size in shape)
     tiles = list(_tiles(split, region))
-    with jax.enable_x64(True):
-        first = [axis[:1] for axis in axes]
-        first[split[0]] = axes[split[0]][: split[1]]
-        outputs = jax.eval_shape(kernel, *first, *extra)
-    out = {name: np.empty(shape, dtype=spec.dtype) for name, spec in outputs.items()}
+    out = _empty(_dtypes(kernel, axes, extra), region)
     workers = min(tile_workers(), len(tiles))
     stop = threading.Event()  # set on an error or Ctrl-C: the other threads end early
     with concurrent.futures.ThreadPoolExecutor(workers) as pool:
@@ -198,36 +193,27 @@ def _chunked_grid(kernel, axes, extra, max_chunk: int, chunks, dims) -> dict:
 
     shape = tuple(axis.size for axis in axes)
     split = _split(shape, max_chunk)
-    lengths = _block_lengths(chunks, shape, dims, split)
-    block_chunks = tuple(
-        (length,) * (size // length) + ((size % length,) if size % length else ())
-        for size, length in zip(shape, lengths, strict=True)
-    )
+    block_chunks = da.core.normalize_chunks(_block_lengths(chunks, shape, dims, split), shape)
     starts = [np.cumsum((0, *c)) for c in block_chunks]
-    with jax.enable_x64(True):
-        outputs = jax.eval_shape(kernel, *(axis[:1] for axis in axes), *extra)
     token = tokenize(kernel.__name__, *axes, *extra, max_chunk, block_chunks)
     name = f"{BLOCK_TASK}-{token}"
     blocks = {}
     for index in itertools.product(*(range(len(c)) for c in block_chunks)):
         region = tuple((int(s[i]), int(s[i + 1])) for s, i in zip(starts, index, strict=True))
-        tiles = functools.partial(_tiles, split, region)
-        blocks[(name, *index)] = (
-            functools.partial(_block, kernel, axes, extra, split, region, tiles),
-        )
+        blocks[(name, *index)] = (functools.partial(_block, kernel, axes, extra, split, region),)
     arrays = {}
-    for variable, spec in outputs.items():
+    for variable, dtype in _dtypes(kernel, axes, extra).items():
         layer = f"{variable}-{token}"
         getters = {(layer, *key[1:]): (operator.getitem, key, variable) for key in blocks}
         graph = HighLevelGraph({name: blocks, layer: getters}, {name: set(), layer: {name}})
-        arrays[variable] = da.Array(graph, layer, chunks=block_chunks, dtype=spec.dtype)
+        arrays[variable] = da.Array(graph, layer, chunks=block_chunks, dtype=dtype)
     return arrays
 
 
-def _block(kernel, axes, extra, split, region, tiles) -> dict[str, np.ndarray]:
+def _block(kernel, axes, extra, split, region) -> dict[str, np.ndarray]:
     """One block of a chunked map: its arrays by name (a dask task)."""
-    out: dict[str, np.ndarray] = {}
-    _fill(out, kernel, axes, extra, split, region, tiles())
+    out = _empty(_dtypes(kernel, axes, extra), region)
+    _fill(out, kernel, axes, extra, split, region, _tiles(split, region))
     return out
 
 
