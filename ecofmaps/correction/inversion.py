@@ -1,10 +1,6 @@
-r"""Reported energy coefficients of friction corrected to the contact one, exactly.
-
-:func:`correct_ecof` inverts the model's :math:`\mu_E(\mu)` for the test conditions and the
-scar's aspect ratio by a bracketed Newton iteration in the dimensionless core;
-:func:`correction_factor` and :func:`contact_cof` build on it. Where the inversion is
-unique, ambiguous or impossible, and why, is explained in ``docs/model.md`` (correcting a
-reported ECoF).
+r"""Reported energy coefficients of friction corrected to the contact one, exactly: the model's
+:math:`\mu_E(\mu)` inverted by a bracketed Newton iteration in the dimensionless core. Where
+the inversion is unique, ambiguous or impossible: ``docs/model.md`` (correcting a reported ECoF).
 """
 
 from __future__ import annotations
@@ -153,8 +149,7 @@ def _si_correct(ecof, amplitude, load, stiffness, aspect_ratio):
     mu, status, kappa, lam = _si_root(ecof, amplitude, load, stiffness, aspect_ratio)
     if not is_concrete(mu):
         high, low = ecof_fall_where_needed(status, kappa, lam)
-    else:
-        # Only the few points where mu_E(mu) may fall are scanned, in one padded batch.
+    else:  # only the few points where mu_E(mu) may fall are scanned, in one padded batch
         where = np.flatnonzero(
             np.asarray(may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
         )
@@ -224,8 +219,7 @@ def _failure_message(status, ecof, details) -> str:
 
 
 def _correct(factor, ecof, amplitude, load, stiffness, scar, profile, mapping, return_status):
-    """correct_ecof, or correction_factor if ``factor``; ``scar`` is (aspect_ratio, scar_depth,
-    scar_half_width)."""
+    """correct_ecof, or correction_factor if ``factor``; ``scar``: the three ways to give it."""
     caller = "correction_factor" if factor else "correct_ecof"
     if profile is not None:
         if any(value is not None for value in scar):

@@ -1,10 +1,5 @@
-r"""The correction of a reported ECoF read off a map of :func:`ecofmaps.compute_map`.
-
-For users who work from the maps: the map's :math:`\mu_E` is interpolated to the test
-conditions and the resulting curve :math:`\mu_E(\mu)` inverted, the same correction as
-:func:`ecofmaps.correct_ecof` (exact) up to the interpolation error. NumPy and SciPy, not
-JAX: it reads a Dataset.
-"""
+"""The correction of a reported ECoF read off a map of :func:`ecofmaps.compute_map`, in NumPy
+and SciPy: docs/model.md, "Correcting a reported ECoF"."""
 
 from __future__ import annotations
 
@@ -109,11 +104,8 @@ def lookup_correction(
 
     Notes
     -----
-    The interpolation is multilinear in :math:`P/S` (so a rigid rig, :math:`S/P = \infty`,
-    is a grid point like any other), :math:`z_o/x_o` and :math:`\Delta^*`, then linear in
-    :math:`\mu`: its error is second order in the grid steps, about
-    :math:`\sum_i h_i^2 |\partial_i^2\mu_E|/8` in :math:`\mu_E`, divided by
-    :math:`d\mu_E/d\mu` in :math:`\mu`.
+    Multilinear in :math:`P/S`, :math:`z_o/x_o` and :math:`\Delta^*`, then linear in
+    :math:`\mu`; its error: ``docs/model.md`` (correcting a reported ECoF).
 
     References
     ----------
@@ -130,7 +122,6 @@ def lookup_correction(
     ecof, amplitude, load, stiffness, ratio = np.broadcast_arrays(
         *(np.asarray(v, dtype=np.float64) for v in (ecof, amplitude, load, stiffness)), ratio
     )
-    shape = ecof.shape
     if "ecof" not in map_dataset or "mu" not in map_dataset["ecof"].dims:
         raise ValueError("map_dataset must hold the variable 'ecof' over a 'mu' dimension")
     ecof_map = map_dataset["ecof"]
@@ -150,20 +141,17 @@ def lookup_correction(
         coordinate = 1.0 / query[name] if name == "stiffness_ratio" else query[name]
         inside &= (coordinate >= values[0]) & (coordinate <= values[-1])
         points.append(np.clip(coordinate, values[0], values[-1]))
+    mu_order = np.argsort(np.asarray(ecof_map["mu"], dtype=np.float64))
+    ecof_map = ecof_map.isel({name: order for name, _, order in axes} | {"mu": mu_order})
     mu_grid = np.asarray(ecof_map["mu"], dtype=np.float64)
-    mu_order = np.argsort(mu_grid)
     names = [name for name, _, _ in axes]
-    table = ecof_map.transpose(*names, "mu", ...).values.reshape(
-        [ecof_map.sizes[n] for n in names] + [mu_grid.size]
-    )
-    for axis, (_, _, order) in enumerate(axes):
-        table = np.take(table, order, axis=axis)
-    table = np.take(table, mu_order, axis=-1).astype(np.float64)
+    shape = [ecof_map.sizes[n] for n in names] + [mu_grid.size]
+    table = ecof_map.transpose(*names, "mu", ...).values.reshape(shape).astype(np.float64)
     if axes:
         curves = RegularGridInterpolator([v for _, v, _ in axes], table)(np.stack(points, axis=-1))
     else:
         curves = np.broadcast_to(table, (ecof.size, mu_grid.size))
-    mu, count = _crossing(curves, mu_grid[mu_order], ecof.ravel())
+    mu, count = _crossing(curves, mu_grid, ecof.ravel())
     lam = load.ravel() / (stiffness.ravel() * amplitude.ravel())
     status = np.select(
         [ecof.ravel() * lam >= 1.0, ~inside | (count == 0), count > 1],
@@ -171,7 +159,7 @@ def lookup_correction(
         CorrectionStatus.CORRECTED,
     ).astype(np.int32)
     mu = np.where(status == CorrectionStatus.CORRECTED, mu, np.nan)
-    mu, status = mu.reshape(shape), status.reshape(shape)
+    mu, status = mu.reshape(ecof.shape), status.reshape(ecof.shape)
     if not return_status:
         if status.ndim == 0 and status != CorrectionStatus.CORRECTED:
             reason = CorrectionStatus(int(status)).reason

@@ -23,10 +23,11 @@ _PROFILE_SPAN = 0.02  # the grid runs from this fraction of the smallest ECoF ..
 _PROFILE_STEPS = 200  # at most this many Illinois steps (each at least halves every two)
 
 
-def _ecof_on_profile(profile, mu, amplitude, load, stiffness, mapping):
-    """mu_E at concrete points (NaN outside gross slip), as a NumPy array."""
-    numbers = steady_numbers(profile, amplitude, load, stiffness, mu, mapping=mapping)
-    return np.asarray(numbers["ecof_ratio"]) * np.asarray(mu)
+def _residual(profile, mu, target, rig, mapping):
+    """mu_E(mu) - target at concrete points; NaN beyond gross slip or the trace."""
+    with np.errstate(invalid="ignore"):
+        numbers = steady_numbers(profile, *rig, mu, mapping=mapping)
+        return np.asarray(numbers["ecof_ratio"]) * np.asarray(mu) - target
 
 
 def correct_on_profile(
@@ -56,9 +57,7 @@ def correct_on_profile(
         rig = (amplitude[todo, None], load[todo, None], stiffness[todo, None])
         top = target.max() * (1.0 + 1e-9)  # mu_E(mu) >= mu: every root is below the largest ECoF
         grid = np.geomspace(_PROFILE_SPAN * target.min(), top, _PROFILE_GRID)
-        with np.errstate(invalid="ignore"):
-            values = _ecof_on_profile(profile, grid[None, :], *rig, mapping)
-        above = ~(values <= target[:, None])  # NaN: beyond gross slip or the trace
+        above = ~(_residual(profile, grid[None, :], target[:, None], rig, mapping) <= 0.0)
         rises = ~above[:, :-1] & above[:, 1:]
         count = rises.sum(axis=1) + above[:, 0]
         ambiguous = count > 1
@@ -117,8 +116,3 @@ def _illinois(profile, target, low, high, rig, mapping):
     check_value = _residual(profile, root, target, rig, mapping) + target
     reached = np.abs(check_value - target) <= 1e-9 * target
     return root, reached
-
-
-def _residual(profile, mu, target, rig, mapping):
-    with np.errstate(invalid="ignore"):
-        return _ecof_on_profile(profile, mu, *rig, mapping) - target

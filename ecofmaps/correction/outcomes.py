@@ -1,10 +1,6 @@
-r"""What a correction comes out as: the status codes, the intervals, and where it is ambiguous.
-
-:class:`CorrectionStatus` says per point whether an ECoF was corrected, and why not;
-:class:`Interval` holds the contact CoFs an ECoF allows for an aspect ratio known only within
-an interval; :func:`ecof_fall` says where :math:`\mu_E(\mu)` falls, so that an ECoF comes
-from three contact CoFs (``docs/model.md``, correcting a reported ECoF).
-"""
+r"""What a correction comes out as: the status of each point, the interval of contact CoFs of an
+aspect-ratio interval, and where :math:`\mu_E(\mu)` falls so that an ECoF comes from three
+contact CoFs (``docs/model.md``, correcting a reported ECoF)."""
 
 from __future__ import annotations
 
@@ -50,13 +46,11 @@ class CorrectionStatus(Code):
     CORRECTED
         One contact CoF gives the ECoF; it is returned.
     NO_GROSS_SLIP
-        The ECoF is at or above :math:`S\\Delta^*/P`, above every gross-slip
-        :math:`\\mu_E` of these test conditions: a contact CoF that high would stop gross
-        slip (:math:`\\mu P \\ge S\\Delta^*`).
+        The ECoF is at or above :math:`S\\Delta^*/P`: a contact CoF that high would stop
+        gross slip (:math:`\\mu P \\ge S\\Delta^*`).
     AMBIGUOUS
-        Several contact CoFs give the ECoF (deep groove, :math:`\\kappa > 1`, and stiff rig,
-        :math:`\\lambda <` :data:`LAMBDA_INFINITY`, where :math:`\\mu_E(\\mu)` falls over
-        part of its range).
+        Several contact CoFs give the ECoF (:math:`\\kappa > 1` and :math:`\\lambda <`
+        :data:`LAMBDA_INFINITY`, where :math:`\\mu_E(\\mu)` falls over part of its range).
     INVALID
         An input out of its range or NaN (only under ``jax.jit``/``jax.vmap``: concrete
         inputs raise ``ValueError``).

@@ -1,10 +1,5 @@
-"""Tables of reported ECoF values, corrected row by row to the contact CoF.
-
-:func:`correct_table` reads the table ``ecofmaps correct`` takes, corrects each row with
-:func:`ecofmaps.correct_ecof` and writes it back with ``mu`` and ``correction_factor`` added;
-a bad row raises :class:`TableError` naming the file and the line (or gets NaN and its
-reason in a ``status`` column). The table's format is described in ``docs/formats.md``.
-"""
+"""Tables of reported ECoF values (the input of ``ecofmaps correct``, described in
+``docs/formats.md``) corrected row by row to the contact CoF."""
 
 from __future__ import annotations
 
@@ -110,7 +105,9 @@ def _read(path: Path, on_profile: bool = False, keep_bad: bool = False):
             lines = ["\n" if line.lstrip().startswith("#") else line for line in stream]
         header_line = next((line for line in lines if line.strip()), ",")
         dialect = table_dialect(header_line)
-        records = list(_records(csv.reader(lines, delimiter=dialect.delimiter)))
+        reader = csv.reader(lines, delimiter=dialect.delimiter)
+        # each non-blank row with the file line it ends on (csv counts the lines it reads)
+        records = [(row, reader.line_num) for row in reader if any(cell.strip() for cell in row)]
     except UnicodeDecodeError as error:
         raise TableError(path, 1, f"not a UTF-8 text file ({error.reason})") from None
     except csv.Error as error:
@@ -123,26 +120,24 @@ def _read(path: Path, on_profile: bool = False, keep_bad: bool = False):
     if not records:
         raise TableError(path, header_line, "the table has a header but no data rows")
     column = {name: header.index(name) for name in COLUMNS if name in header}
-    values = {name: [] for name in (*_REQUIRED, "aspect_ratio")}
     commas = dialect.delimiter != ","
-    bad = {}
+    names = _REQUIRED if on_profile else (*_REQUIRED, "aspect_ratio")
+    rows, bad = [], {}
     for index, (row, line) in enumerate(records):
         if len(row) != len(header):
             hint = "" if len(header) > 1 else _SEPARATOR_HINT
             message = f"{len(row)} fields, but the header has {len(header)} columns{hint}"
             raise TableError(path, line, message)
         try:
-            numbers = _row_values(path, line, row, column, on_profile, commas)
+            rows.append(_row_values(path, line, row, column, on_profile, commas))
         except TableError as error:
             if not keep_bad:
                 raise
             bad[index] = error
-            numbers = dict.fromkeys(_REQUIRED if on_profile else values, np.nan)
-        for name, value in numbers.items():
-            values[name].append(value)
-    si = {name: np.asarray(values[name]) for name in values if values[name]}
-    numbers = [row[column[name]] for row, _ in records for name in column]
-    decimal_comma = commas and any("," in cell for cell in numbers)
+            rows.append(dict.fromkeys(names, np.nan))
+    si = {name: np.asarray([values[name] for values in rows]) for name in names}
+    cells = [row[column[name]] for row, _ in records for name in column]
+    decimal_comma = commas and any("," in cell for cell in cells)
     return header, records, si, dialect._replace(decimal_comma=decimal_comma), bad
 
 
@@ -168,13 +163,6 @@ def _row_values(path, line: int, row, column: dict, on_profile: bool, commas: bo
             number("aspect_ratio") if given_ratio else number(depth) / number(width)
         )
     return values
-
-
-def _records(reader):
-    """Non-blank rows with the file line each ends on (csv counts the lines it reads)."""
-    for row in reader:
-        if any(cell.strip() for cell in row):
-            yield row, reader.line_num
 
 
 def _check_header(path, line: int, header: list[str], on_profile: bool, keep_bad: bool) -> None:

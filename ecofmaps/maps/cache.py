@@ -105,37 +105,17 @@ class CacheEntry:
 
 
 def cache_directory(cache_dir=None) -> Path:
-    """The cache directory in use (it need not exist yet).
-
-    Parameters
-    ----------
-    cache_dir : str or os.PathLike, optional
-        An explicit directory; by default the ``ECOFMAPS_CACHE`` environment variable, else
-        ``platformdirs.user_cache_dir("ecofmaps")``.
-
-    Returns
-    -------
-    directory : pathlib.Path
-    """
+    """The cache directory in use (it need not exist yet): ``cache_dir`` if given, else the
+    ``ECOFMAPS_CACHE`` environment variable, else ``platformdirs.user_cache_dir("ecofmaps")``."""
     if cache_dir is not None:
         return Path(cache_dir)
     return Path(os.environ.get(ENVIRONMENT_VARIABLE) or platformdirs.user_cache_dir("ecofmaps"))
 
 
 def cache_size_bound() -> int:
-    """The bound on the cache's total size: ``ECOFMAPS_CACHE_SIZE``, else 1 GB.
-
-    Returns
-    -------
-    bound : int
-        Bytes the cache's entries may take together; 0 stores nothing. [byte]
-
-    Raises
-    ------
-    ValueError
-        If ``ECOFMAPS_CACHE_SIZE`` is not a size: a number of bytes, or a number with one
-        of the units B, kB, MB, GB, TB, KiB, MiB, GiB, TiB (``500MB``).
-    """
+    """The bytes the cache's entries may take together (0 stores nothing):
+    ``ECOFMAPS_CACHE_SIZE``, else 1 GB; ``ValueError`` if that is not a size (bytes, or a
+    number with a unit among B, kB, MB, GB, TB, KiB, MiB, GiB, TiB: ``500MB``)."""
     text = os.environ.get(SIZE_VARIABLE, "").strip()
     if not text:
         return DEFAULT_SIZE_BOUND
@@ -288,7 +268,7 @@ def _stored(path: Path, key: str) -> xr.Dataset | None:
 
 
 def _ignored(unraisable) -> None:
-    """An exception raised in a finalizer: ignored."""
+    """Ignore an exception raised in a finalizer."""
 
 
 def _reason(error: BaseException) -> str:
@@ -300,7 +280,8 @@ def _reason(error: BaseException) -> str:
 
 
 def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
-    """Store ``dataset`` at ``path`` if it fits in ``bound`` [byte]; keep the cache within it."""
+    """Store ``dataset`` at ``path`` if it fits in ``bound`` [byte], then remove the least
+    recently used other entries until they all take at most ``bound``."""
     if dataset.nbytes > bound:
         return
     image = _file_image(dataset.assign_attrs({_KEY_ATTRIBUTE: key}))
@@ -309,17 +290,12 @@ def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(path, exclusive=False) as temporary:  # the same entry, whoever wins
         temporary.write_bytes(image)
-    _evict(path.parent, bound, keep=path)
-
-
-def _evict(directory: Path, bound: int, keep: Path) -> None:
-    """Remove least recently used entries but ``keep`` until they take at most ``bound``."""
-    entries = sorted(cache_entries(directory), key=lambda entry: entry.used)
+    entries = sorted(cache_entries(path.parent), key=lambda entry: entry.used)
     total = sum(entry.size for entry in entries)
     for entry in entries:
         if total <= bound:
             break
-        if entry.path != keep:
+        if entry.path != path:
             entry.path.unlink(missing_ok=True)
             total -= entry.size
 

@@ -124,9 +124,8 @@ def compute_map(
     mapping : {'scaled', 'physical'}
         With a profile: :math:`X = xW/\Delta^*` (eq. 11) or :math:`X = x`.
     cache : bool, optional
-        Read the result from the disk cache, and store it there after computing it.
-        Default: only a map on a profile; a chunked map is never cached, so ``cache=True``
-        with ``chunks`` is an error (why: docs/performance.md, "The cache").
+        Read the result from the disk cache, or store it there. Default: only a map on a
+        profile; a chunked map is never cached (docs/performance.md, "The cache").
     cache_dir : str or os.PathLike, optional
         Cache directory; default ``$ECOFMAPS_CACHE`` or the per-user cache directory.
     max_chunk : int
@@ -152,9 +151,9 @@ def compute_map(
     ValueError
         If a parameter is not a scalar or a non-empty 1-D array, or is out of range:
         stiffness_ratio > 0 (inf allowed); aspect_ratio >= 0; amplitude, mu, load > 0;
-        all finite except stiffness_ratio, none NaN, each within the model's domain
-        (:data:`ecofmaps.units.DOMAIN`). For a bad ``chunks``, and for a map
-        in memory that would not fit in the memory available (before allocating it).
+        all finite except stiffness_ratio, each within :data:`ecofmaps.units.DOMAIN`. For
+        a bad ``chunks``, ``cache=True`` with ``chunks``, and a map in memory that would
+        not fit in the memory available (before allocating it).
 
     Warns
     -----
@@ -259,9 +258,8 @@ def compute_universal_map(
 
     Notes
     -----
-    With :math:`x_o = \Delta^*`, :math:`\kappa = 2 z_o/x_o` and :math:`\mu_E/\mu` depends on
-    :math:`(\mu, z_o/x_o, \lambda)` only (eq. 13-16): this one chart holds both panels of
-    Figure 11 (:math:`\Delta^* = 25` and 50 µm), whose axes :math:`S/P` map onto
+    :math:`\mu_E/\mu` depends on :math:`(\mu, z_o/x_o, \lambda)` only (eq. 13-16): this one
+    chart holds both panels of Figure 11, whose axes :math:`S/P` map onto
     :math:`\lambda = 1/((S/P)\Delta^*)`.
 
     References
