@@ -3,8 +3,12 @@ or chunked (dask), written to netCDF or zarr."""
 
 from ecofmaps.maps.cache import CacheWarning, cache_entries, clear_cache
 from ecofmaps.maps.files import write_map
-from ecofmaps.maps.grid import compute_loops, compute_map, compute_universal_map
-from ecofmaps.maps.on_profile import compute_profile_map
+from ecofmaps.maps.grid import (
+    compute_loops,
+    compute_map,
+    compute_profile_map,
+    compute_universal_map,
+)
 
 __all__ = [
     "CacheWarning",

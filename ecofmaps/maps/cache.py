@@ -68,7 +68,6 @@ _MODEL_SOURCES = (
     "maps/grid.py",
     "maps/tiles.py",
     "maps/dataset.py",
-    "maps/on_profile.py",
     "_nomenclature.py",
     "paper.py",
 )
