@@ -302,35 +302,13 @@ def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
 def cached_dataset(
     function: str, inputs: Mapping[str, object], compute: Callable[[], xr.Dataset], cache_dir=None
 ) -> xr.Dataset:
-    """The cached result of ``compute()``, computing and storing it on a miss.
-
-    Parameters
-    ----------
-    function : str
-        Name of the computing function (a Python identifier): in the key and file name.
-    inputs : mapping of str to array_like or None
-        Everything the result depends on (see :func:`cache_key`).
-    compute : callable
-        Called without arguments on a miss; returns the dataset.
-    cache_dir : str or os.PathLike, optional
-        See :func:`cache_directory`.
-
-    Returns
-    -------
-    dataset : xarray.Dataset
-        Identical whether read or computed.
-
-    Raises
-    ------
-    ValueError
-        If ``ECOFMAPS_CACHE_SIZE`` is not a size (:func:`cache_size_bound`).
-
-    Warns
-    -----
-    CacheWarning
-        In one line, when the file is unusable (removed, the result recomputed) or the
-        result cannot be stored for any reason (it is returned all the same).
-    """
+    """The result of ``compute()`` (called without arguments), read from the cache, else
+    computed and stored: identical either way. ``function`` (a Python identifier) and
+    ``inputs`` (everything the result depends on) make the key (:func:`cache_key`); the cache
+    is :func:`cache_directory` ``(cache_dir)``. ``ValueError`` if ``ECOFMAPS_CACHE_SIZE`` is
+    not a size (:func:`cache_size_bound`); a :class:`CacheWarning` in one line when the file
+    is unusable (it is removed, the result recomputed) or the result cannot be stored for any
+    reason (it is returned all the same)."""
     directory = cache_directory(cache_dir)
     bound = cache_size_bound()  # a bad ECOFMAPS_CACHE_SIZE is refused before any work
     key = cache_key(function, inputs)
