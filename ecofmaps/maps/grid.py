@@ -8,8 +8,6 @@ profile: docs/model.md, "The model on a scar profile".
 
 from __future__ import annotations
 
-import math
-
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -433,21 +431,20 @@ def compute_profile_map(
 
     def compute() -> xr.Dataset:
         grid = [np.atleast_1d(a) for a in axes.values()]
-        shape = tuple(a.size for a in grid)
-        size = math.prod(shape)
+        points = [axis.ravel() for axis in np.meshgrid(*grid, indexing="ij")]
         names = ("slip_ratio", "ecof_ratio", "regime", "normalized_energy", "normalized_max_force")
-        flat = {
-            name: np.empty(size, dtype=np.int32 if name == "regime" else np.float64)
+        values = {
+            name: np.empty(points[0].shape, dtype=np.int32 if name == "regime" else np.float64)
             for name in names
         }
-        for start in range(0, size, max_chunk):
-            index = np.unravel_index(np.arange(start, min(start + max_chunk, size)), shape)
-            stiffness, amplitude, mu = (axis[i] for axis, i in zip(grid, index, strict=True))
+        for start in range(0, points[0].size, max_chunk):
+            stiffness, amplitude, mu = (p[start : start + max_chunk] for p in points)
             # λ = P/(S Δ*) = 1/((S/P) Δ*): a unit load and the stiffness ratio
             numbers = steady_numbers(profile, amplitude, 1.0, stiffness, mu, mapping=mapping)
             for name in names:
-                flat[name][start : start + index[0].size] = np.asarray(numbers[name])
-        values = {name: flat[name].reshape(shape) for name in names}
+                values[name][start : start + max_chunk] = np.asarray(numbers[name])
+        shape = tuple(axis.size for axis in grid)
+        values = {name: value.reshape(shape) for name, value in values.items()}
         values.update(steady_values(values, grid[1][None, :, None], load, grid[2][None, None, :]))
         del values["normalized_energy"], values["normalized_max_force"]
         title = "ECoF map of the compliant wear-scar model on a scar profile"

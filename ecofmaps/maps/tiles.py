@@ -47,9 +47,10 @@ def _dtypes(kernel, axes, extra) -> dict:
     return {name: spec.dtype for name, spec in outputs.items()}
 
 
-def _empty(dtypes: dict, region) -> dict[str, np.ndarray]:
+def _empty(kernel, axes, extra, region) -> dict[str, np.ndarray]:
+    """Arrays for ``kernel``'s results over ``region`` of the grid, by name."""
     shape = tuple(stop - start for start, stop in region)
-    return {name: np.empty(shape, dtype=dtype) for name, dtype in dtypes.items()}
+    return {name: np.empty(shape, dtype) for name, dtype in _dtypes(kernel, axes, extra).items()}
 
 
 def _check_memory(kernel, axes, extra, max_chunk: int) -> None:
@@ -127,7 +128,7 @@ def _evaluate_grid(kernel, axes, extra, max_chunk: int) -> dict[str, np.ndarray]
     split = _split(shape, max_chunk)
     region = tuple((0, size) for size in shape)
     tiles = list(_tiles(split, region))
-    out = _empty(_dtypes(kernel, axes, extra), region)
+    out = _empty(kernel, axes, extra, region)
     workers = min(tile_workers(), len(tiles))
     stop = threading.Event()  # set on an error or Ctrl-C: the other threads end early
     with concurrent.futures.ThreadPoolExecutor(workers) as pool:
@@ -149,15 +150,12 @@ def _block_lengths(chunks, shape, dims, split) -> list[int]:
         "chunks must be 'auto', an integer >= 1 (grid points per block) or a dict of block "
         "lengths by dimension name"
     )
-    if isinstance(chunks, str):
-        if chunks != "auto":
-            raise ValueError(f"{usage}, got {chunks!r}")
+    if isinstance(chunks, str) and chunks == "auto":
         chunks = BLOCK_POINTS
-    if isinstance(chunks, bool) or not isinstance(chunks, (int, np.integer, Mapping)):
+    whole = isinstance(chunks, (int, np.integer)) and not isinstance(chunks, bool)
+    if not ((whole and chunks >= 1) or isinstance(chunks, Mapping)):
         raise ValueError(f"{usage}, got {chunks!r}")
-    if not isinstance(chunks, Mapping):
-        if chunks < 1:
-            raise ValueError(f"{usage}, got {chunks!r}")
+    if whole:
         k, rows = _split(shape, int(chunks))
         if k == split[0] and rows > split[1]:  # whole tiles: none is evaluated twice
             tiles = -(-shape[k] // split[1])
@@ -212,7 +210,7 @@ def _chunked_grid(kernel, axes, extra, max_chunk: int, chunks, dims) -> dict:
 
 def _block(kernel, axes, extra, split, region) -> dict[str, np.ndarray]:
     """One block of a chunked map: its arrays by name (a dask task)."""
-    out = _empty(_dtypes(kernel, axes, extra), region)
+    out = _empty(kernel, axes, extra, region)
     _fill(out, kernel, axes, extra, split, region, _tiles(split, region))
     return out
 
