@@ -394,10 +394,9 @@ _RAISES = """
         For a concrete input out of its range (ecof, amplitude, load and scar_half_width
         finite and > 0, stiffness > 0 with inf allowed, aspect_ratio and scar_depth finite
         and >= 0, an interval with low <= high; each within :data:`ecofmaps.units.DOMAIN`),
-        for the aspect ratio given neither or both
-        ways, and, without ``return_status``, for a single point that cannot be corrected
-        (the message says why). Under ``jax.jit``/``jax.vmap`` such points are NaN with the
-        status ``INVALID``.
+        for the aspect ratio given neither or both ways, and, without ``return_status``,
+        for a single point that cannot be corrected (the message says why). Under
+        ``jax.jit``/``jax.vmap`` such points are NaN with the status ``INVALID``.
 
     Warns
     -----
