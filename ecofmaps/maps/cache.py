@@ -1,10 +1,8 @@
-"""The disk cache of results that are expensive to recompute: netCDF files keyed by their inputs.
-
-A result is one netCDF file ``<function>-<key>.nc`` in :func:`cache_directory`, keyed by
-:func:`cache_key`, its arrays in Fletcher-32 checksummed chunks and the rest under
-:func:`metadata_checksum`. What is cached, how entries are checked, written and evicted, and
-what a write and a read cost against computing: docs/performance.md, "The cache".
-"""
+"""The disk cache of results that are expensive to recompute: one netCDF file
+``<function>-<key>.nc`` per result in :func:`cache_directory`, keyed by :func:`cache_key`, its
+arrays in Fletcher-32 checksummed chunks and the rest under :func:`metadata_checksum`. What is
+cached, how entries are checked, written and evicted, and what that costs against computing:
+docs/performance.md, "The cache"."""
 
 from __future__ import annotations
 

@@ -1,6 +1,5 @@
 """Grid evaluation in tiles (in memory, on every core) and in blocks of tiles (dask), so that
-both give the same values to the bit: docs/performance.md, "Maps".
-"""
+both give the same values to the bit: docs/performance.md, "Maps"."""
 
 from __future__ import annotations
 
