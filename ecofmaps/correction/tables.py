@@ -96,10 +96,8 @@ def _number(path, line: int, name: str, text: str, decimal_comma: bool = False) 
 
 
 def _read(path: Path, on_profile: bool = False, keep_bad: bool = False):
-    """Header, rows (cells as written), their line numbers, the SI columns (NaN in a bad
-    row), the dialect, and the :class:`TableError` of each bad row by its index (raised at
-    once unless ``keep_bad``). On a profile the rows give no aspect ratio.
-    """
+    """Header, (row, line) records, SI columns (NaN in a bad row), dialect, and the errors of
+    the bad rows by index (raised at once unless ``keep_bad``)."""
     try:
         with open(path, encoding="utf-8-sig", newline="") as stream:
             lines = ["\n" if line.lstrip().startswith("#") else line for line in stream]
