@@ -18,7 +18,6 @@ __all__ = [
     "interpolated",
     "line_crossings",
     "loop_measures",
-    "noise_lift",
     "path_means",
     "second_difference_medians",
     "stick_line_fit",
@@ -29,12 +28,11 @@ __all__ = [
 
 #: How numba compiles the kernels: cached on disk, NumPy's division by zero, no GIL held.
 _COMPILE = {"cache": True, "error_model": "numpy", "nogil": True}
-#: The lower quartile of the absolute second difference of white noise over its standard
-#: deviation.
-_QUARTILE_SECOND_DIFFERENCE = 0.3186393639643752 * np.sqrt(6.0)
-#: The same of a sixth difference (its standard deviation is √924 times the noise's): the
-#: difference of a smooth loop sampled a few dozen times a cycle or more is far below it.
+#: The lower quartile of the absolute sixth difference of white noise over its standard
+#: deviation (√924 times the noise's): a smooth loop's, sampled a few dozen times a cycle or
+#: more, is far below it.
 _QUARTILE_SIXTH_DIFFERENCE = 0.3186393639643752 * np.sqrt(924.0)
+_SIXTH = np.array([1.0, -6.0, 15.0, -20.0, 15.0, -6.0, 1.0])
 #: A loop's extreme is read from the parabola fitted over the samples within this many
 #: noise standard deviations of it ...
 _EXTREME_DEPTH = 3.0
@@ -487,83 +485,58 @@ def loop_measures(x, y, offset, count, rotation):
 
 @numba.njit(**_COMPILE)
 def _fitted_peak(values, first, n, at, span, sign):
-    """The value at the loop's sample ``at`` of the parabola fitted by least squares to
-    ``sign`` times its samples round it (taken as closed, with a step where it closes if
-    significant: a loop need not end where it began), on each side up to the last within
-    :data:`_EXTREME_DEPTH` noise sd of it before three in a row are not (a quarter cycle at
-    most, one sample at least), less the sample's; 0 if none is, or if the noise (from the
-    lower quartile of the loop's absolute sixth differences within an eighth of a cycle)
-    is below :data:`_NOISE_FREE` of the loop's ``span``."""
+    """How far the parabola fitted to ``sign`` times the loop's samples round its sample ``at``
+    lies below that sample there (docs/method-loops.md, "The quantities, per cycle")."""
     reach, eighth = n // 4, n // 8
     half = max(reach, eighth + 3)
-    near_at = np.empty(2 * half + 1)  # sign times the samples at + j, the loop taken as closed
+    near = np.empty(2 * half + 1)  # sign times the samples at + j, the loop taken as closed
     for j in range(-half, half + 1):
-        near_at[half + j] = sign * values[first + (at + j) % n]
-    peak, local = near_at[half], np.empty(2 * eighth + 1)
-    for j in range(half - eighth, half + eighth + 1):  # the sixth difference centred on j
-        local[j - half + eighth] = abs(
-            near_at[j - 3]
-            - 6.0 * near_at[j - 2]
-            + 15.0 * near_at[j - 1]
-            - 20.0 * near_at[j]
-            + 15.0 * near_at[j + 1]
-            - 6.0 * near_at[j + 2]
-            + near_at[j + 3]
-        )
-    sd = np.partition(local, eighth // 2)[eighth // 2] / _QUARTILE_SIXTH_DIFFERENCE
+        near[half + j] = sign * values[first + (at + j) % n]
+    sixth = np.zeros(2 * eighth + 1)  # the sixth differences centred within an eighth cycle
+    for j in range(sixth.size):
+        for k in range(7):
+            sixth[j] += _SIXTH[k] * near[half - eighth + j + k - 3]
+    sd = np.partition(np.abs(sixth), eighth // 2)[eighth // 2] / _QUARTILE_SIXTH_DIFFERENCE
     if not sd > _NOISE_FREE * span:
         return 0.0
-    ends, near = np.ones(2, np.int64), False
+    ends = np.ones(2, np.int64)  # the last sample within the depth each side, before 3 are not
     for side in range(2):
-        step = 1 - 2 * side
         for j in range(1, reach + 1):
-            if near_at[half + step * j] >= peak - _EXTREME_DEPTH * sd:
-                ends[side], near = j, True
+            if near[half + (1 - 2 * side) * j] >= near[half] - _EXTREME_DEPTH * sd:
+                ends[side] = j
             elif j > ends[side] + 2:
                 break
-    if not near:  # no other sample near it: the noise hardly lifts it
-        return 0.0
-    # The normal equations of the parabola in j / half, and of a step where the loop closes
-    normal, sums, row = np.zeros((4, 4)), np.zeros(4), np.ones(4)
+    if near[half - ends[1]] < near[half] - _EXTREME_DEPTH * sd > near[half + ends[0]]:
+        return 0.0  # no other sample near it: the noise hardly lifts it
+    # The normal equations of 1, j/half, (j/half)² and a step where the loop closes
+    normal, sums, row, steps = np.zeros((4, 4)), np.zeros(4), np.ones(4), 0
     for j in range(-ends[1], ends[0] + 1):
         row[1] = j / half
         row[2] = row[1] * row[1]
         row[3] = 1.0 if at + j < 0 or at + j >= n else 0.0
+        steps += row[3] > 0.0
         for r in range(4):
-            sums[r] += row[r] * (near_at[half + j] - peak)
+            sums[r] += row[r] * (near[half + j] - near[half])
             for c in range(4):
                 normal[r, c] += row[r] * row[c]
-    value = _solution(normal, sums, 3)[0]
-    steps = normal[3, 3]
-    if 0.0 < steps < ends[0] + ends[1] - 2:  # a step where it closes, if significant
-        fit, spread = _solution(normal, sums, 4), _solution(normal, np.eye(4)[3], 4)[3]
-        if abs(fit[3]) > _STEP_T * sd * np.sqrt(spread):
-            value = fit[0]
-    return value
+    for col in range(3):  # Gaussian elimination (positive definite: no pivoting)
+        for r in range(col + 1, 4):
+            factor = normal[r, col] / normal[col, col]
+            normal[r, col:] -= factor * normal[col, col:]
+            sums[r] -= factor * sums[col]
+    step = abs(sums[3]) > _STEP_T * sd * np.sqrt(normal[3, 3])  # its t over its standard error
+    return _intercept(normal, sums, 4 if 0 < steps < ends[0] + ends[1] - 2 and step else 3)
 
 
 @numba.njit(**_COMPILE)
-def _solution(matrix, right, m):
-    """The solution of the small linear system ``matrix[:m, :m] @ x = right[:m]`` (Gaussian
-    elimination with partial pivoting)."""
-    a, b = matrix.copy(), right.copy()
-    for col in range(m):
-        pivot = col
-        for row in range(col + 1, m):
-            pivot = row if abs(a[row, col]) > abs(a[pivot, col]) else pivot
-        for k in range(m):
-            a[col, k], a[pivot, k] = a[pivot, k], a[col, k]
-        b[col], b[pivot] = b[pivot], b[col]
-        for row in range(col + 1, m):
-            factor = a[row, col] / a[col, col]
-            for k in range(col, m):
-                a[row, k] -= factor * a[col, k]
-            b[row] -= factor * b[col]
-    for col in range(m - 1, -1, -1):
-        for k in range(col + 1, m):
-            b[col] -= a[col, k] * b[k]
-        b[col] /= a[col, col]
-    return b[:m]
+def _intercept(upper, right, m):
+    """The first unknown of the upper triangular system ``upper[:m, :m] x = right[:m]``."""
+    x = right[:m].copy()
+    for r in range(m - 1, -1, -1):
+        for k in range(r + 1, m):
+            x[r] -= upper[r, k] * x[k]
+        x[r] /= upper[r, r]
+    return x[0]
 
 
 @numba.njit(**_COMPILE)
@@ -622,30 +595,3 @@ def stick_line_fit(u, regressors, stick):
     return np.einsum(
         "rik,rk->ri", inverse, np.stack([(a * u).sum(axis=1) for a in columns], -1)
     ), inverse
-
-
-def noise_lift(count, offset, values, least):
-    """Per cycle of ``count`` samples from ``offset`` in ``values``, the highest the white
-    noise on them lifts an extreme over the cycle's n samples, σ√(2 ln n) (NaN for fewer than
-    ``least``); σ from the lower quartile of the absolute second differences, less a sine's
-    own (-4 sin²(π/n) x, the loops centred) or as they are (a force sliding at a constant
-    value), whichever is less: the reversals and the stick do not reach it. [m] or [N]"""
-    lift = np.full(count.size, np.nan)
-    (rows,) = np.nonzero(count >= least)
-    if not rows.size:
-        return lift
-    offset, count = offset[rows], count[rows]
-    j = np.arange(1, int(count.max()) - 1)
-    inside = j < count[:, None] - 1
-    at = offset[:, None] + np.where(inside, j, 1)
-    middle = values[at]
-    second = values[at + 1] - 2.0 * middle + values[at - 1]
-    sine = 4.0 * np.sin(np.pi / (count - 1.0))[:, None] ** 2
-    rank = (np.arange(rows.size), (count - 3) // 4)
-    quartiles = [
-        np.sort(np.where(inside, np.abs(d), np.nan), axis=1)[rank]
-        for d in (second, second + sine * middle)
-    ]
-    sigma = np.fmin(*quartiles) / _QUARTILE_SECOND_DIFFERENCE
-    lift[rows] = sigma * np.sqrt(2.0 * np.log(count))
-    return lift

@@ -45,6 +45,7 @@ _NOISE_REACH = 4
 NEIGHBOURS = _NOISE_REACH + 1
 #: The median of the absolute second difference of white noise over its standard deviation.
 SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
+_QUARTILE_SECOND_DIFFERENCE = 0.3186393639643752 * np.sqrt(6.0)  # the lower quartile
 #: Fewest samples of a cycle whose noise is read from its second differences (in fewer, a
 #: loop's corners are most of them).
 _NOISE_SAMPLES = 4 * MIN_SAMPLES
@@ -502,9 +503,32 @@ def _mindlin_sliding(rows, max_force, span, candidates):
 
 
 def _noise_lift(block, values):
-    """:func:`kernels.noise_lift` of ``values`` in each cycle of ``block`` over
-    :data:`NOISE_SHARE` (NaN for fewer than :data:`_NOISE_SAMPLES` samples). [m] or [N]"""
-    return kernels.noise_lift(block.count, block.offset, values, _NOISE_SAMPLES) / NOISE_SHARE
+    """Per cycle of ``block``, the highest the white noise on its ``values`` lifts an extreme
+    over the cycle's n samples, σ√(2 ln n), over :data:`NOISE_SHARE` (NaN for fewer than
+    :data:`_NOISE_SAMPLES` samples); σ from the lower quartile of the absolute second
+    differences, less a sine's own (-4 sin²(π/n) x, the loops centred) or as they are (a force
+    sliding at a constant value), whichever is less: the reversals and the stick do not reach
+    it. [m] or [N]"""
+    count, offset = block.count, block.offset
+    lift = np.full(count.size, np.nan)
+    (rows,) = np.nonzero(count >= _NOISE_SAMPLES)
+    if not rows.size:
+        return lift
+    offset, count = offset[rows], count[rows]
+    j = np.arange(1, int(count.max()) - 1)
+    inside = j < count[:, None] - 1
+    at = offset[:, None] + np.where(inside, j, 1)
+    middle = values[at]
+    second = values[at + 1] - 2.0 * middle + values[at - 1]
+    sine = 4.0 * np.sin(np.pi / (count - 1.0))[:, None] ** 2
+    rank = (np.arange(rows.size), (count - 3) // 4)
+    quartiles = [
+        np.sort(np.where(inside, np.abs(d), np.nan), axis=1)[rank]
+        for d in (second, second + sine * middle)
+    ]
+    sigma = np.fmin(*quartiles) / _QUARTILE_SECOND_DIFFERENCE
+    lift[rows] = sigma * np.sqrt(2.0 * np.log(count)) / NOISE_SHARE
+    return lift
 
 
 def _turns_back(x, band):
