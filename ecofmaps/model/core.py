@@ -27,6 +27,7 @@ __all__ = [
     "slip_position",
     "slip_ratio",
     "slip_roots",
+    "steady_inputs",
     "traction_ratio",
     "valid_geometry",
 ]
@@ -48,6 +49,20 @@ def checked(**inputs) -> list:
         if value is not None:
             check(name, value, *_RULES[name])
     return [as_float64(value) for value in inputs.values() if value is not None]
+
+
+def steady_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width) -> list:
+    """:func:`checked` inputs of a steady loop (no aspect ratio on a profile); x_o defaults to
+    the amplitude."""
+    values = checked(
+        amplitude=amplitude,
+        load=load,
+        stiffness=stiffness,
+        mu=mu,
+        aspect_ratio=aspect_ratio,
+        groove_half_width=groove_half_width,
+    )
+    return values if groove_half_width is not None else [*values, values[0]]
 
 
 def _positive(value):

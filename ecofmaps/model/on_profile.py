@@ -19,7 +19,7 @@ import numpy as np
 from ecofmaps._inputs import as_float64, float64, is_concrete
 from ecofmaps.model import first_passage
 from ecofmaps.model import profile_core as core
-from ecofmaps.model.core import checked, compliance_ratio, valid_geometry
+from ecofmaps.model.core import checked, compliance_ratio, steady_inputs, valid_geometry
 from ecofmaps.model.profiles import ScarProfile
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
 
@@ -86,20 +86,6 @@ def check_mapping(mapping, groove_half_width) -> bool:
             "mapping='physical' (X = x) takes none"
         )
     return mapping == "physical"
-
-
-def _inputs(amplitude, load, stiffness, mu, groove_half_width):
-    """The SI inputs, checked, as broadcast float64 arrays; x_o defaults to the amplitude."""
-    values = checked(
-        amplitude=amplitude,
-        load=load,
-        stiffness=stiffness,
-        mu=mu,
-        groove_half_width=groove_half_width,
-    )
-    if groove_half_width is None:
-        values.append(values[0])
-    return jnp.broadcast_arrays(*values)
 
 
 def _valid(amplitude, load, stiffness, mu, half_width):
@@ -272,7 +258,9 @@ def _points(profile, amplitude, load, stiffness, mu, groove_half_width, mapping)
     """The checked profile, the SI inputs broadcast, the mapping and :func:`_prepare`'s values."""
     physical = check_mapping(mapping, groove_half_width)
     profile = as_profile(profile)
-    values = _inputs(amplitude, load, stiffness, mu, groove_half_width)
+    values = jnp.broadcast_arrays(
+        *steady_inputs(amplitude, load, stiffness, mu, None, groove_half_width)
+    )
     return profile, values, physical, _prepare(*values, profile.half_width, physical)
 
 
@@ -366,6 +354,14 @@ def _histories(position, slope, mu, lam, targets):
     return jax.lax.map(partial(_history, position, slope), (mu, lam, targets))
 
 
+def broadcast_history(displacement, *values):
+    """``displacement`` (time last) as float64 and ``values`` broadcast to one batch shape."""
+    displacement = as_float64(displacement)
+    batch = jnp.broadcast_shapes(displacement.shape[:-1], *(jnp.shape(v) for v in values))
+    values = [jnp.broadcast_to(v, batch) for v in values]
+    return jnp.broadcast_to(displacement, batch + displacement.shape[-1:]), values
+
+
 def profile_simulation(profile, displacement, load, stiffness, mu, groove_half_width, mapping):
     """Tangential force history on ``profile`` (see simulate); displacement has time last."""
     physical = check_mapping(mapping, groove_half_width)
@@ -380,13 +376,10 @@ def profile_simulation(profile, displacement, load, stiffness, mu, groove_half_w
         load=load, stiffness=stiffness, mu=mu, groove_half_width=groove_half_width
     )
     x_o = profile.half_width if physical else x_o[0]
-    displacement = as_float64(displacement)
-    batch = jnp.broadcast_shapes(
-        displacement.shape[:-1], load.shape, stiffness.shape, mu.shape, x_o.shape
+    displacement, (load, stiffness, mu, x_o) = broadcast_history(
+        displacement, load, stiffness, mu, x_o
     )
-    steps = displacement.shape[-1]
-    displacement = jnp.broadcast_to(displacement, (*batch, steps))
-    load, stiffness, mu, x_o = (jnp.broadcast_to(v, batch) for v in (load, stiffness, mu, x_o))
+    batch, steps = load.shape, displacement.shape[-1]
     valid = _valid(jnp.ones(batch), load, stiffness, mu, x_o)
     # Units of the scar's half-width W: X/W = x/x_o, D = Δ/x_o, λ = P/(S x_o).
     lam = jnp.where(valid, compliance_ratio(x_o, load, stiffness), 0.1).reshape(-1)

@@ -14,7 +14,6 @@ import jax.numpy as jnp
 from ecofmaps._codes import warn_nan
 from ecofmaps._inputs import as_float64, float64, is_concrete
 from ecofmaps.model.core import (
-    checked,
     compliance_ratio,
     curvature_number,
     ecof_ratio,
@@ -22,6 +21,7 @@ from ecofmaps.model.core import (
     normalized_max_force,
     regime_code,
     slip_ratio,
+    steady_inputs,
     valid_geometry,
 )
 from ecofmaps.model.on_profile import steady_numbers, steady_values
@@ -58,19 +58,6 @@ def dimensionless(amplitude, load, stiffness, mu, aspect_ratio, groove_half_widt
     return mu, kappa, lam, code
 
 
-def groove_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width) -> list:
-    """The inputs of a parabolic groove, checked, as float64; x_o defaults to the amplitude."""
-    values = checked(
-        amplitude=amplitude,
-        load=load,
-        stiffness=stiffness,
-        mu=mu,
-        aspect_ratio=aspect_ratio,
-        groove_half_width=groove_half_width,
-    )
-    return values if groove_half_width is not None else [*values, values[0]]
-
-
 @jax.jit(static_argnames="quantity")
 def _steady_state(quantity, amplitude, load, stiffness, mu, aspect_ratio, groove_half_width):
     """One steady-loop quantity and the regime, NaN where the input is invalid."""
@@ -104,24 +91,6 @@ def _profile_quantity(quantity, numbers, amplitude, load, mu):
     return jnp.broadcast_to(value, numbers["regime"].shape)
 
 
-def _evaluate(quantity, arguments, profile, mapping):
-    one_geometry(arguments[4], profile, mapping)
-    if profile is None:
-        result, code = _steady_state(quantity, *groove_inputs(*arguments))
-        concrete = is_concrete(*arguments)
-    else:
-        amplitude, load, stiffness, mu, _, groove_half_width = arguments
-        numbers = steady_numbers(
-            profile, amplitude, load, stiffness, mu, groove_half_width, mapping
-        )
-        si = (as_float64(v) for v in (amplitude, load, mu))
-        result, code = _profile_quantity(quantity, numbers, *si), numbers["regime"]
-        concrete = is_concrete(result)
-    if concrete and quantity != "slip_regime":
-        warn_nan(result, code, Regime, quantity)
-    return result
-
-
 def _steady_quantity(quantity: str, summary: str, returns: str, notes: str, equations: str):
     """The public function ``quantity`` of the steady loop, with its docstring."""
 
@@ -136,8 +105,21 @@ def _steady_quantity(quantity: str, summary: str, returns: str, notes: str, equa
         profile=None,
         mapping="scaled",
     ):
-        arguments = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
-        return _evaluate(quantity, arguments, profile, mapping)
+        one_geometry(aspect_ratio, profile, mapping)
+        if profile is None:
+            arguments = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
+            result, code = _steady_state(quantity, *steady_inputs(*arguments))
+            concrete = is_concrete(*arguments)
+        else:
+            numbers = steady_numbers(
+                profile, amplitude, load, stiffness, mu, groove_half_width, mapping
+            )
+            si = (as_float64(v) for v in (amplitude, load, mu))
+            result, code = _profile_quantity(quantity, numbers, *si), numbers["regime"]
+            concrete = is_concrete(result)
+        if concrete and quantity != "slip_regime":
+            warn_nan(result, code, Regime, quantity)
+        return result
 
     steady_quantity.__name__ = steady_quantity.__qualname__ = quantity
     steady_quantity.__doc__ = f"""{summary}
