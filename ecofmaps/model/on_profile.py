@@ -1,10 +1,6 @@
-r"""The model on a scar profile in SI units: steady loops, drawn loops and time histories.
-
-:func:`steady_numbers` evaluates the steady loop of :mod:`ecofmaps.model.first_passage` at
-any broadcast set of points, sharing the tables between points that share :math:`\mu` and
-the stroke. The public functions of :mod:`ecofmaps.model.steady_state` and
-:mod:`ecofmaps.model.simulation` call in here when given ``profile=``. The method is
-explained in ``docs/model.md`` (the model on a scar profile).
+r"""The model on a scar profile in SI units (``profile=`` of the public functions): steady loops
+at any broadcast set of points, the tables shared between points of one :math:`\mu` and
+stroke; drawn loops and time histories. The method is explained in ``docs/model.md``.
 """
 
 from __future__ import annotations

@@ -56,9 +56,8 @@ _CHUNK = 2**21
 
 
 class ScarProfile(NamedTuple):
-    """A wear-scar profile as the model uses it (a JAX pytree of float64 arrays: NumPy's when
-    made from numbers, so that arithmetic on them stays float64; JAX's inside a traced
-    function). A batch of profiles has a leading batch axis on every array.
+    """A wear-scar profile as the model uses it: a JAX pytree of float64 arrays (NumPy's when
+    made from numbers, JAX's inside a traced function; a batch has a leading axis on each).
 
     Attributes
     ----------
@@ -109,8 +108,7 @@ class ScarProfile(NamedTuple):
 
 
 def profile_of(*parts) -> ScarProfile:
-    """A :class:`ScarProfile` of ``parts`` (its defaults after them) as NumPy float64 arrays, so
-    that a user's arithmetic on them (``profile.half_width * 1e6``) stays float64."""
+    """A :class:`ScarProfile` of ``parts`` (its defaults after them) as NumPy float64 arrays."""
     return ScarProfile(*(np.asarray(part, dtype=np.float64) for part in ScarProfile(*parts)))
 
 
@@ -380,10 +378,7 @@ def scar_profile(
     Returns
     -------
     profile : ScarProfile
-        Positions relative to the detected centre, the heights (levelled if asked), the
-        smoothed slopes, and the depth, half-width, worn area, centre and reference line;
-        the other plausible half-width if the edges were ambiguous, and the samples
-        replaced.
+        Positions relative to the detected centre; heights levelled if asked.
 
     Warns
     -----

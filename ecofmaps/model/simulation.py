@@ -1,10 +1,6 @@
-r"""Fretting loops from the model: the steady loop and a time-domain simulation.
-
-:func:`fretting_loop` draws the steady loop of a sinusoid-like stroke between
-:math:`\pm\Delta^*` in closed form (Figures 5 and 6 of the paper). :func:`simulate` runs
-the stick/slip return map over any displacement history :math:`\Delta(t)` with
-``jax.lax.scan``, solving the slip exactly at each step, so it has no time-step error
-and follows any change of amplitude.
+r"""Fretting loops from the model: :func:`fretting_loop` draws the steady loop in closed form
+(Figures 5 and 6 of the paper); :func:`simulate` runs the stick/slip return map over any
+displacement history, exactly at each step (``docs/model.md``).
 """
 
 from __future__ import annotations
@@ -37,10 +33,8 @@ def _steady_loop(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width
     mu, kappa, lam, code = (x[..., None] for x in (mu, kappa, lam, code))
     d = slip_ratio(mu, kappa, lam)
     t = jnp.linspace(-1.0, 1.0, num)
-    # Forward-slip branch from -d to d (eq. 9, 10). A shallow groove (u = mu*kappa*d < 1/2)
-    # is sampled uniformly in position; a deep one so that the margin to the locking
-    # point, w = 1 - mu*kappa*xi, falls geometrically from 1 + u to its end value, which
-    # puts the points where the force rises steeply and keeps the digits of w there.
+    # Forward-slip branch from -d to d (eq. 9, 10), sampled as docs/model.md explains: the
+    # margin w = 1 - mu*kappa*xi falls geometrically on a deep groove (u = mu*kappa*d >= 1/2).
     a = mu * kappa
     u = a * d
     shallow = u < 0.5
@@ -108,10 +102,8 @@ def fretting_loop(
 
     Notes
     -----
-    The slip branches are eq. 9 with eq. 10, :math:`\Delta = x + Q_\pm(x)/S`, the stick
-    segments lines of slope :math:`S`; with no gross slip the loop collapses onto
-    :math:`Q = S\Delta`. Self-locking points and points off a profile's trace give NaN. The
-    sampling of the branches is explained in ``docs/model.md``.
+    The slip branches are :math:`\Delta = x + Q_\pm(x)/S` (eq. 9, 10), sampled as
+    ``docs/model.md`` explains. Self-locking points and points off a profile's trace give NaN.
 
     References
     ----------
@@ -199,11 +191,8 @@ def simulate(
 
     Notes
     -----
-    The pad starts at rest at the groove centre. At each new :math:`\Delta` it sticks while
-    :math:`Q_-(x) \le S(\Delta - x) \le Q_+(x)` (eq. 9, 10); otherwise it slips to the exact
-    equilibrium :math:`x' + Q_\pm(x')/S = \Delta` (the quadratic of eq. 16; on a profile the
-    first one beyond the pad), so the result does not depend on the sampling
-    (``docs/model.md``). A pad that runs off a profile's trace gives NaN.
+    From rest at the groove centre, the pad sticks or slips to the exact equilibrium at each
+    step (eq. 9, 10, 16; ``docs/model.md``). A pad that runs off a profile's trace gives NaN.
 
     References
     ----------

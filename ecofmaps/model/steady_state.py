@@ -1,9 +1,6 @@
-r"""The model in SI units: slip amplitude, energy, ECoF, peak force and regime of the steady loop.
-
-Each function validates concrete inputs (a ``ValueError`` names the parameter and its
-range), is jit-compiled and always computes in float64; under ``jit``/``vmap`` invalid
-points are NaN with the ``INVALID`` regime. The numbers come from the dimensionless core
-(:mod:`ecofmaps.model.core`) with :math:`L = \Delta^*`.
+r"""The model in SI units: slip amplitude, energy, ECoF, peak force and regime of the steady loop,
+from the dimensionless core (:mod:`ecofmaps.model.core`) with :math:`L = \Delta^*`, or on a scar
+profile (:mod:`ecofmaps.model.on_profile`).
 """
 
 from __future__ import annotations
@@ -141,11 +138,9 @@ def _steady_quantity(quantity: str, summary: str, returns: str, notes: str, equa
         Groove half-width :math:`x_o`; defaults to ``amplitude`` as in the paper. On a
         profile it sets the mapping :math:`X = xW/x_o` of eq. 11. [m]
     profile : ScarProfile, optional
-        A wear-scar profile of any shape (:func:`ecofmaps.scar_profile`,
-        :func:`ecofmaps.read_scar_profile`, the profile families), instead of
-        ``aspect_ratio``: the pad at contact position :math:`x` feels its slope at
-        :math:`X = xW/x_o` (eq. 9 pointwise). A parabolic profile reproduces the closed
-        forms with ``aspect_ratio=D/W``.
+        A wear-scar profile of any shape (:func:`ecofmaps.scar_profile`, the families),
+        instead of ``aspect_ratio``: the pad at :math:`x` feels its slope at :math:`X` (eq. 9
+        pointwise). A parabolic profile reproduces the closed forms with ``aspect_ratio=D/W``.
     mapping : {{'scaled', 'physical'}}
         On a profile: ``'scaled'``, :math:`X = xW/x_o` (eq. 11, the paper's); or
         ``'physical'``, :math:`X = x`.
@@ -165,11 +160,8 @@ def _steady_quantity(quantity: str, summary: str, returns: str, notes: str, equa
 
     Notes
     -----
-    {notes}On a profile the steady loop's ends solve :math:`x + Q_\\pm(x)/S = \\pm\\Delta^*` by
-    first passage from where the last stroke ended, the pad jumping where
-    :math:`x + Q_+(x)/S` falls; :math:`\\delta^* = (x_+ - x_-)/2` and :math:`E_d` is the
-    area of the loop the return map draws (:mod:`ecofmaps.model.first_passage`). The regime
-    ``BEYOND_PROFILE`` marks a stroke that runs off the trace.
+    {notes}On a profile the loop's ends are found by first passage and :math:`E_d` is the area
+    of the loop the return map draws (``docs/model.md``).
 
     References
     ----------
