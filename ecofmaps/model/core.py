@@ -1,9 +1,6 @@
-r"""The dimensionless core of the model on (μ, κ, λ), and the SI-unit functions over it.
-
-The core functions (:func:`traction_ratio`, :func:`slip_ratio`, :func:`ecof_ratio`, ...)
-are pure ``jax.numpy`` functions of ``mu``, the curvature number ``kappa`` and the
-compliance ratio ``lam``, which broadcast, work under ``jit``, ``vmap`` and ``grad`` and do
-no input checking. The model and the dimensionless core are explained in ``docs/model.md``.
+r"""The dimensionless core of the model: pure ``jax.numpy`` functions of ``mu``, the curvature
+number ``kappa`` and the compliance ratio ``lam`` that broadcast, work under ``jit``, ``vmap``
+and ``grad`` and check nothing (``docs/model.md``); and the checks of the SI inputs.
 """
 
 from __future__ import annotations
@@ -141,10 +138,8 @@ def traction_ratio(position, mu, kappa, direction=1.0):
     ----------
     position : array_like
         Contact position :math:`\xi = x/L`. [1]
-    mu : array_like
-        Contact coefficient of friction. [1]
-    kappa : array_like
-        Curvature number. [1]
+    mu, kappa : array_like
+        Friction coefficient, curvature number. [1]
     direction : array_like
         Sign :math:`s` of the slip velocity, +1 or -1. [1]
 

@@ -198,10 +198,8 @@ def ridged_profile(
 
     Inside the edges the parabola of :func:`parabolic_profile`; outside them a ridge
     :math:`z = H\sin^2(\pi v)`, :math:`v = (|X| - W)/w`, for :math:`0 \le v \le 1`, then the
-    flat unworn surface. The ridge's crest, :math:`H` high at :math:`w/2` beyond the edge,
-    bends the slope down at the rate :math:`2\pi^2 H/w^2`: when the rig's compliance
-    :math:`P/S` times :math:`(1 + \mu^2)` times that rate exceeds 1 (in the units of the
-    mapping), :math:`x + Q_+(x)/S` falls over the crest and the pad jumps across it.
+    flat unworn surface. Where :math:`(1 + \mu^2) (P/S)` times the crest's slope rate
+    :math:`2\pi^2 H/w^2` exceeds 1, the pad jumps across the crest (``docs/model.md``).
 
     Parameters
     ----------
