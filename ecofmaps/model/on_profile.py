@@ -85,9 +85,8 @@ def check_mapping(mapping, groove_half_width) -> bool:
 
 
 def _valid(amplitude, load, stiffness, mu, half_width):
-    return (
-        valid_geometry(amplitude, load, stiffness, 0.0, half_width) & (mu > 0.0) & jnp.isfinite(mu)
-    )
+    valid = valid_geometry(amplitude, load, stiffness, 0.0, half_width)
+    return valid & (mu > 0.0) & jnp.isfinite(mu)
 
 
 def _stroke(half_width, key, physical: bool):

@@ -114,12 +114,11 @@ def _wall_line_edge(x, r, start, inner, step, tolerance, edge, rise):
         below = np.flatnonzero(deep[inner : start + 1])
         last = inner + int(below[0]) if below.size else start
         span = slice(inner, last + 1)
-    if span.stop - span.start < 3:
-        return edge, rise
-    slope, offset = np.polyfit(x[span], r[span], 1)
-    if not slope * rise > 0.0:
-        return edge, rise
-    return -offset / slope, slope
+    if span.stop - span.start >= 3:
+        slope, offset = np.polyfit(x[span], r[span], 1)
+        if slope * rise > 0.0:
+            return -offset / slope, slope
+    return edge, rise
 
 
 def _band_end(x, r, outer, step, threshold, gap):
