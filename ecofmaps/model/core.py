@@ -181,9 +181,8 @@ def slip_roots(target, mu, kappa, lam):
 def slip_position(target, mu, kappa, lam):
     r"""Contact position reached by forward slip when the actuator is at ``target``.
 
-    Solves :math:`\xi + \lambda\, Q_+(\xi)/P = D` (eq. 9 with eq. 10) for the root below
-    the locking point :math:`\mu\kappa\xi = 1`; with :math:`D = 1` this is eq. 16. The
-    quadratic's root is taken without cancellation (``docs/model.md``).
+    Solves :math:`\xi + \lambda\, Q_+(\xi)/P = D` (eq. 9 with eq. 10; eq. 16 at :math:`D = 1`)
+    for the root below the locking point :math:`\mu\kappa\xi = 1`, without cancellation.
 
     Parameters
     ----------

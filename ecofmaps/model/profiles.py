@@ -367,13 +367,11 @@ def scar_profile(
         :data:`AUTO_SMOOTHING` times the detected half-width. It is raised to the median
         sample spacing if smaller, and must not exceed a fifth of the half-width. [m]
     level : bool
-        Subtract the unworn surface's line (tilt and offset fitted on the shoulders) from
-        the heights and its tilt from the slopes. Off by default: the arrays are taken as
-        the pad feels them, so a genuinely tilted scar stays tilted.
+        Subtract the unworn surface's line (fitted on the shoulders) from the heights and
+        its tilt from the slopes; off by default, so a genuinely tilted scar stays tilted.
     remove_outliers : bool
-        Replace outliers (spikes, dropouts: :func:`outlying_samples`) by linear
-        interpolation between the nearest samples kept, before anything else (on by
-        default; ``replaced`` marks them).
+        Replace outliers (:func:`outlying_samples`) by linear interpolation between the
+        nearest samples kept, before anything else (``replaced`` marks them).
 
     Returns
     -------
