@@ -1,9 +1,6 @@
-r"""The dimensionless core of the model on (μ, κ, λ), and the SI-unit functions over it.
-
-The core functions (:func:`traction_ratio`, :func:`slip_ratio`, :func:`ecof_ratio`, ...)
-are pure ``jax.numpy`` functions of ``mu``, the curvature number ``kappa`` and the
-compliance ratio ``lam``, which broadcast, work under ``jit``, ``vmap`` and ``grad`` and do
-no input checking. The model and the dimensionless core are explained in ``docs/model.md``.
+r"""The dimensionless core of the model: pure ``jax.numpy`` functions of ``mu``, the curvature
+number ``kappa`` and the compliance ratio ``lam`` that broadcast, work under ``jit``, ``vmap``
+and ``grad`` and check nothing (``docs/model.md``); and the checks of the SI inputs.
 """
 
 from __future__ import annotations
@@ -27,6 +24,7 @@ __all__ = [
     "slip_position",
     "slip_ratio",
     "slip_roots",
+    "steady_inputs",
     "traction_ratio",
     "valid_geometry",
 ]
@@ -48,6 +46,20 @@ def checked(**inputs) -> list:
         if value is not None:
             check(name, value, *_RULES[name])
     return [as_float64(value) for value in inputs.values() if value is not None]
+
+
+def steady_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width) -> list:
+    """:func:`checked` inputs of a steady loop (no aspect ratio on a profile); x_o defaults to
+    the amplitude."""
+    values = checked(
+        amplitude=amplitude,
+        load=load,
+        stiffness=stiffness,
+        mu=mu,
+        aspect_ratio=aspect_ratio,
+        groove_half_width=groove_half_width,
+    )
+    return values if groove_half_width is not None else [*values, values[0]]
 
 
 def _positive(value):
@@ -126,10 +138,8 @@ def traction_ratio(position, mu, kappa, direction=1.0):
     ----------
     position : array_like
         Contact position :math:`\xi = x/L`. [1]
-    mu : array_like
-        Contact coefficient of friction. [1]
-    kappa : array_like
-        Curvature number. [1]
+    mu, kappa : array_like
+        Friction coefficient, curvature number. [1]
     direction : array_like
         Sign :math:`s` of the slip velocity, +1 or -1. [1]
 
@@ -171,9 +181,8 @@ def slip_roots(target, mu, kappa, lam):
 def slip_position(target, mu, kappa, lam):
     r"""Contact position reached by forward slip when the actuator is at ``target``.
 
-    Solves :math:`\xi + \lambda\, Q_+(\xi)/P = D` (eq. 9 with eq. 10) for the root below
-    the locking point :math:`\mu\kappa\xi = 1`; with :math:`D = 1` this is eq. 16. The
-    quadratic's root is taken without cancellation (``docs/model.md``).
+    Solves :math:`\xi + \lambda\, Q_+(\xi)/P = D` (eq. 9 with eq. 10; eq. 16 at :math:`D = 1`)
+    for the root below the locking point :math:`\mu\kappa\xi = 1`, without cancellation.
 
     Parameters
     ----------

@@ -1,9 +1,6 @@
-r"""The steady loop on a scar profile, read off the tables of :mod:`ecofmaps.model.profile_core`.
-
-:func:`steady_loop` finds the loop's ends by first passage, :func:`jump_area` adds the
-areas of the jumps, :func:`draw_loop` draws the loop, and :func:`simulation_tables` and
-:func:`simulation_step` run the quasi-static return map in time. Pure ``jax.numpy``, no
-checks. The method is explained in ``docs/model.md`` (the model on a scar profile).
+r"""The steady loop on a scar profile, read off the tables of :mod:`ecofmaps.model.profile_core`
+by first passage, its jumps' areas, its drawing, and the return map in time. Pure ``jax.numpy``,
+no checks; the method is explained in ``docs/model.md`` (the model on a scar profile).
 """
 
 from __future__ import annotations
@@ -38,9 +35,7 @@ __all__ = [
 ]
 
 #: Peak traction ratio |Q|/P beyond which a steady loop is reported self-locking, 1/sqrt(eps)
-#: (about 6.7e7): the pad stops so close to a locking point (mu g = 1) that the loop's area,
-#: a difference of forces of that size, is left to rounding (at 1e11 its energy CoF is off
-#: by half, at 1e13 by orders of magnitude). No rig is that stiff: lambda below about 1e-11.
+#: (about 6.7e7): the loop's area, a difference of forces of that size, is left to rounding.
 JAMMED_TRACTION = sys.float_info.epsilon**-0.5
 
 
@@ -57,8 +52,7 @@ class SteadyLoop(NamedTuple):
 
 
 def _at(table, group, *index):
-    """``table[group, *index]`` as one gather from the flattened table (XLA's gathers with several
-    index dimensions are several times slower on CPU)."""
+    """``table[group, *index]`` as one gather from the flattened table (faster on CPU)."""
     flat = group
     for size, i in zip(table.shape[1:], index, strict=True):
         flat = flat * size + i
@@ -177,10 +171,8 @@ def steady_loop(tables: Tables, group, lam, sparse: bool = True) -> SteadyLoop:
 
     peak = largest(tables.peak, slope_minus, slope_plus)
     trough = largest(tables.trough, -slope_minus, -slope_plus)
-    # A rigid rig passes a locking point; a rig stiff enough to stop the pad within rounding
-    # of one (lambda ~ 1e-17 of the stroke) gives an infinite force there too. Short of
-    # that, a force above JAMMED_TRACTION times the load leaves the loop's area to rounding
-    # (the pad stops within ~1e-8 of the stroke from the locking point): reported jammed.
+    # Infinite at a locking point (a rigid rig, or one stiff to within rounding); jammed above
+    # JAMMED_TRACTION (docs/model.md).
     locked = ~(jnp.isfinite(peak) & jnp.isfinite(trough) & jnp.isfinite(integral))
     locked = locked | (jnp.maximum(peak, trough) > JAMMED_TRACTION)
     stick_force = (1.0 - plus) / jnp.where(lam > 0.0, lam, 1.0)  # the stick line at D = 1

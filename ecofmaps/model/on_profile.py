@@ -1,10 +1,6 @@
-r"""The model on a scar profile in SI units: steady loops, drawn loops and time histories.
-
-:func:`steady_numbers` evaluates the steady loop of :mod:`ecofmaps.model.first_passage` at
-any broadcast set of points, sharing the tables between points that share :math:`\mu` and
-the stroke. The public functions of :mod:`ecofmaps.model.steady_state` and
-:mod:`ecofmaps.model.simulation` call in here when given ``profile=``. The method is
-explained in ``docs/model.md`` (the model on a scar profile).
+r"""The model on a scar profile in SI units (``profile=`` of the public functions): steady loops
+at any broadcast set of points, the tables shared between points of one :math:`\mu` and
+stroke; drawn loops and time histories. The method is explained in ``docs/model.md``.
 """
 
 from __future__ import annotations
@@ -19,7 +15,7 @@ import numpy as np
 from ecofmaps._inputs import as_float64, float64, is_concrete
 from ecofmaps.model import first_passage
 from ecofmaps.model import profile_core as core
-from ecofmaps.model.core import checked, compliance_ratio, valid_geometry
+from ecofmaps.model.core import checked, compliance_ratio, steady_inputs, valid_geometry
 from ecofmaps.model.profiles import ScarProfile
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
 
@@ -88,24 +84,9 @@ def check_mapping(mapping, groove_half_width) -> bool:
     return mapping == "physical"
 
 
-def _inputs(amplitude, load, stiffness, mu, groove_half_width):
-    """The SI inputs, checked, as broadcast float64 arrays; x_o defaults to the amplitude."""
-    values = checked(
-        amplitude=amplitude,
-        load=load,
-        stiffness=stiffness,
-        mu=mu,
-        groove_half_width=groove_half_width,
-    )
-    if groove_half_width is None:
-        values.append(values[0])
-    return jnp.broadcast_arrays(*values)
-
-
 def _valid(amplitude, load, stiffness, mu, half_width):
-    return (
-        valid_geometry(amplitude, load, stiffness, 0.0, half_width) & (mu > 0.0) & jnp.isfinite(mu)
-    )
+    valid = valid_geometry(amplitude, load, stiffness, 0.0, half_width)
+    return valid & (mu > 0.0) & jnp.isfinite(mu)
 
 
 def _stroke(half_width, key, physical: bool):
@@ -272,7 +253,9 @@ def _points(profile, amplitude, load, stiffness, mu, groove_half_width, mapping)
     """The checked profile, the SI inputs broadcast, the mapping and :func:`_prepare`'s values."""
     physical = check_mapping(mapping, groove_half_width)
     profile = as_profile(profile)
-    values = _inputs(amplitude, load, stiffness, mu, groove_half_width)
+    values = jnp.broadcast_arrays(
+        *steady_inputs(amplitude, load, stiffness, mu, None, groove_half_width)
+    )
     return profile, values, physical, _prepare(*values, profile.half_width, physical)
 
 
@@ -366,6 +349,14 @@ def _histories(position, slope, mu, lam, targets):
     return jax.lax.map(partial(_history, position, slope), (mu, lam, targets))
 
 
+def broadcast_history(displacement, *values):
+    """``displacement`` (time last) as float64 and ``values`` broadcast to one batch shape."""
+    displacement = as_float64(displacement)
+    batch = jnp.broadcast_shapes(displacement.shape[:-1], *(jnp.shape(v) for v in values))
+    values = [jnp.broadcast_to(v, batch) for v in values]
+    return jnp.broadcast_to(displacement, batch + displacement.shape[-1:]), values
+
+
 def profile_simulation(profile, displacement, load, stiffness, mu, groove_half_width, mapping):
     """Tangential force history on ``profile`` (see simulate); displacement has time last."""
     physical = check_mapping(mapping, groove_half_width)
@@ -380,13 +371,10 @@ def profile_simulation(profile, displacement, load, stiffness, mu, groove_half_w
         load=load, stiffness=stiffness, mu=mu, groove_half_width=groove_half_width
     )
     x_o = profile.half_width if physical else x_o[0]
-    displacement = as_float64(displacement)
-    batch = jnp.broadcast_shapes(
-        displacement.shape[:-1], load.shape, stiffness.shape, mu.shape, x_o.shape
+    displacement, (load, stiffness, mu, x_o) = broadcast_history(
+        displacement, load, stiffness, mu, x_o
     )
-    steps = displacement.shape[-1]
-    displacement = jnp.broadcast_to(displacement, (*batch, steps))
-    load, stiffness, mu, x_o = (jnp.broadcast_to(v, batch) for v in (load, stiffness, mu, x_o))
+    batch, steps = load.shape, displacement.shape[-1]
     valid = _valid(jnp.ones(batch), load, stiffness, mu, x_o)
     # Units of the scar's half-width W: X/W = x/x_o, D = Δ/x_o, λ = P/(S x_o).
     lam = jnp.where(valid, compliance_ratio(x_o, load, stiffness), 0.1).reshape(-1)

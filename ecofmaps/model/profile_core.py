@@ -1,10 +1,7 @@
-r"""The dimensionless core on a scar profile: slip branches and their tables.
-
-The pad at contact position :math:`x` feels the profile's slope :math:`g(X)` at
-:math:`X = xW/x_o`, and eq. 9 holds pointwise. :func:`profile_tables` computes once what
-depends on the profile, :math:`\mu` and the stroke only; :mod:`ecofmaps.model.first_passage`
-reads the steady loop off them. Pure ``jax.numpy``, no checks. The units, the exactness
-and the tables are explained in ``docs/model.md`` (the model on a scar profile).
+r"""The dimensionless core on a scar profile: slip branches (eq. 9 pointwise) and the tables
+of what depends on the profile, :math:`\mu` and the stroke only, which
+:mod:`ecofmaps.model.first_passage` reads the steady loop off. Pure ``jax.numpy``, no checks;
+the method is explained in ``docs/model.md`` (the model on a scar profile).
 """
 
 from __future__ import annotations
@@ -24,7 +21,6 @@ __all__ = [
     "mean_excess",
     "mean_traction",
     "profile_tables",
-    "sparse_table",
     "table_levels",
     "traction_forward",
 ]
@@ -148,16 +144,13 @@ def table_levels(count: int) -> int:
     return max(1, int(np.ceil(np.log2(count + 1))))
 
 
-def _shift(values, step: int, fill):
-    return jnp.concatenate([values[step:], jnp.full((step,), fill, values.dtype)])
-
-
 def sparse_table(values, levels: int, combine, identity):
     """Table ``T[l, i] = combine(values[i : i + 2**l])`` with ``identity`` past the end."""
     table = [values]
     for level in range(1, levels):
-        previous = table[-1]
-        table.append(combine(previous, _shift(previous, 2 ** (level - 1), identity)))
+        previous, step = table[-1], 2 ** (level - 1)
+        shifted = jnp.concatenate([previous[step:], jnp.full((step,), identity, previous.dtype)])
+        table.append(combine(previous, shifted))
     return jnp.stack(table)
 
 

@@ -1,9 +1,6 @@
-"""The edges of a measured scar: the reference line, the groove, the band and its ridges.
-
-The unworn surface's line fitted to the shoulders, the groove's edges where its walls reach
-that line, the disturbed band and its pile-up ridges, and the warnings of ambiguous or
-uncertain edges, for :func:`ecofmaps.model.profiles.scar_profile`. The rules are explained
-in ``docs/profiles.md``.
+"""The edges of a measured scar for :func:`ecofmaps.model.profiles.scar_profile`: the unworn
+surface's line, the groove, the disturbed band and its pile-up ridges, and the warnings of
+ambiguous or uncertain edges. The rules are explained in ``docs/profiles.md``.
 """
 
 from __future__ import annotations
@@ -13,7 +10,6 @@ from typing import NamedTuple
 import numpy as np
 
 __all__ = ["AMBIGUOUS_EDGES", "UNCERTAIN_EDGES", "Extent", "ScarProfileWarning", "scar_extent"]
-
 
 #: The edges are ambiguous when an edge of the band between the ridges lies beyond the
 #: groove's by more than this fraction of the groove's half-width. [1]
@@ -62,12 +58,10 @@ class ScarProfileWarning(UserWarning):
         self.details = tuple(details)
         self.alternative = alternative
         self.alternative_name = alternative_name
-        hint = (
-            ""
-            if alternative is None
-            else (f"; half_width={alternative:.6g} (m) takes the {alternative_name}")
-        )
-        super().__init__(self.text([f"sample {i}" for i in self.samples]) + hint)
+        text = self.text([f"sample {i}" for i in self.samples])
+        if alternative is not None:
+            text += f"; half_width={alternative:.6g} (m) takes the {alternative_name}"
+        super().__init__(text)
 
     def text(self, labels) -> str:
         """The finding with each sample named by ``labels`` (at most 10 listed)."""
@@ -120,12 +114,11 @@ def _wall_line_edge(x, r, start, inner, step, tolerance, edge, rise):
         below = np.flatnonzero(deep[inner : start + 1])
         last = inner + int(below[0]) if below.size else start
         span = slice(inner, last + 1)
-    if span.stop - span.start < 3:
-        return edge, rise
-    slope, offset = np.polyfit(x[span], r[span], 1)
-    if not slope * rise > 0.0:
-        return edge, rise
-    return -offset / slope, slope
+    if span.stop - span.start >= 3:
+        slope, offset = np.polyfit(x[span], r[span], 1)
+        if slope * rise > 0.0:
+            return -offset / slope, slope
+    return edge, rise
 
 
 def _band_end(x, r, outer, step, threshold, gap):

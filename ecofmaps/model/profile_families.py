@@ -1,11 +1,6 @@
-r"""Analytic families of wear-scar profiles, for studies of the groove's shape.
-
-Each family is built from the scar's depth :math:`D` and half-width :math:`W` and its shape
-parameters, with an optional tilt, from the exact heights and slopes of the shape, sampled
-with every breakpoint among the samples, as a :class:`~ecofmaps.model.profiles.ScarProfile`:
-:func:`parabolic_profile` (the paper's groove), :func:`flat_bottomed_profile` (U-shaped),
-:func:`w_shaped_profile` (a hump between two troughs) and :func:`ridged_profile` (ploughing
-ridges beside the edges, Figure 1b).
+r"""Analytic families of wear-scar profiles, for studies of the groove's shape: each a
+:class:`~ecofmaps.model.profiles.ScarProfile` of the exact heights and slopes of its shape,
+sampled with every breakpoint among the samples, with an optional tilt.
 """
 
 from __future__ import annotations
@@ -25,10 +20,10 @@ def _positive(name: str, value) -> float:
     return value
 
 
-def _fraction(name: str, value, low=0.0, high=1.0) -> float:
+def _fraction(name: str, value) -> float:
     value = float(value)
-    if not (np.isfinite(value) and low <= value < high):
-        raise ValueError(f"{name} must satisfy {low} <= {name} < {high}, got {value!r}")
+    if not (np.isfinite(value) and 0.0 <= value < 1.0):
+        raise ValueError(f"{name} must satisfy 0.0 <= {name} < 1.0, got {value!r}")
     return value
 
 
@@ -84,10 +79,8 @@ def parabolic_profile(depth, half_width, *, tilt=0.0, samples=2001, extent=2.0) 
 
     Parameters
     ----------
-    depth : float
-        Scar depth :math:`D`. [m]
-    half_width : float
-        Scar half-width :math:`W`. [m]
+    depth, half_width : float
+        Scar depth :math:`D` and half-width :math:`W`. [m]
     tilt : float
         Slope added to the whole trace, :math:`z + tX` (a tilted specimen). [1]
     samples : int
@@ -205,10 +198,8 @@ def ridged_profile(
 
     Inside the edges the parabola of :func:`parabolic_profile`; outside them a ridge
     :math:`z = H\sin^2(\pi v)`, :math:`v = (|X| - W)/w`, for :math:`0 \le v \le 1`, then the
-    flat unworn surface. The ridge's crest, :math:`H` high at :math:`w/2` beyond the edge,
-    bends the slope down at the rate :math:`2\pi^2 H/w^2`: when the rig's compliance
-    :math:`P/S` times :math:`(1 + \mu^2)` times that rate exceeds 1 (in the units of the
-    mapping), :math:`x + Q_+(x)/S` falls over the crest and the pad jumps across it.
+    flat unworn surface. Where :math:`(1 + \mu^2) (P/S)` times the crest's slope rate
+    :math:`2\pi^2 H/w^2` exceeds 1, the pad jumps across the crest (``docs/model.md``).
 
     Parameters
     ----------

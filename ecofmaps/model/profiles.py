@@ -1,8 +1,6 @@
-"""The wear-scar profile the model uses, and its construction from a measured trace.
-
-:class:`ScarProfile` holds the groove of any shape the pad slides in (a JAX pytree).
-:func:`scar_profile` builds one from a measured trace: outliers replaced (a Hampel filter),
-heights and slopes smoothed (local quadratic fits), the edges found by
+"""The wear-scar profile the model uses (:class:`ScarProfile`, a JAX pytree), and
+:func:`scar_profile`, which builds one from a measured trace: outliers replaced (a Hampel
+filter), heights and slopes smoothed (local quadratic fits), the edges found by
 :mod:`ecofmaps.model.profile_edges`. The method is explained in ``docs/profiles.md``.
 """
 
@@ -58,9 +56,8 @@ _CHUNK = 2**21
 
 
 class ScarProfile(NamedTuple):
-    """A wear-scar profile as the model uses it (a JAX pytree of float64 arrays: NumPy's when
-    made from numbers, so that arithmetic on them stays float64; JAX's inside a traced
-    function). A batch of profiles has a leading batch axis on every array.
+    """A wear-scar profile as the model uses it: a JAX pytree of float64 arrays (NumPy's when
+    made from numbers, JAX's inside a traced function; a batch has a leading axis on each).
 
     Attributes
     ----------
@@ -111,8 +108,7 @@ class ScarProfile(NamedTuple):
 
 
 def profile_of(*parts) -> ScarProfile:
-    """A :class:`ScarProfile` of ``parts`` (its defaults after them) as NumPy float64 arrays, so
-    that a user's arithmetic on them (``profile.half_width * 1e6``) stays float64."""
+    """A :class:`ScarProfile` of ``parts`` (its defaults after them) as NumPy float64 arrays."""
     return ScarProfile(*(np.asarray(part, dtype=np.float64) for part in ScarProfile(*parts)))
 
 
@@ -139,17 +135,6 @@ def _trace(x, z):
     if x.size != z.size:
         raise ValueError(f"x and z must have the same length, got {x.size} and {z.size}")
     return x, z
-
-
-def _check_positions(x: np.ndarray) -> None:
-    steps = np.diff(x)
-    if np.any(steps <= 0.0):
-        i = int(np.argmax(steps <= 0.0)) + 1
-        kind = "repeated" if steps[i - 1] == 0.0 else "decreasing"
-        raise ValueError(
-            f"x must be strictly increasing; x[{i}] = {x[i]!r} after x[{i - 1}] = {x[i - 1]!r} "
-            f"({kind}); sort the trace and drop repeated positions"
-        )
 
 
 def _neighbours(n: int, count: int) -> np.ndarray:
@@ -180,8 +165,7 @@ def outlying_samples(x, z, neighbours=OUTLIER_NEIGHBOURS, threshold=OUTLIER_THRE
 
     Notes
     -----
-    A sample is an outlier when it is farther from the median of its ``2 neighbours``
-    nearest neighbours than ``threshold`` times a robust scale (``docs/profiles.md``).
+    The robust scale is explained in ``docs/profiles.md``.
 
     References
     ----------
@@ -243,7 +227,14 @@ def _checked_trace(x, z, half_width, smoothing):
     x, z = _trace(x, z)
     if x.size < 2 * MIN_SCAR_SAMPLES:
         raise ValueError(f"x: a trace needs at least {2 * MIN_SCAR_SAMPLES} samples, got {x.size}")
-    _check_positions(x)
+    steps = np.diff(x)
+    if np.any(steps <= 0.0):
+        i = int(np.argmax(steps <= 0.0)) + 1
+        kind = "repeated" if steps[i - 1] == 0.0 else "decreasing"
+        raise ValueError(
+            f"x must be strictly increasing; x[{i}] = {x[i]!r} after x[{i - 1}] = {x[i - 1]!r} "
+            f"({kind}); sort the trace and drop repeated positions"
+        )
     if half_width is not None:
         half_width = float(_array("half_width", [half_width])[0])
         if half_width <= 0.0:
@@ -270,11 +261,8 @@ def local_quadratic(x: np.ndarray, z: np.ndarray, smoothing: float):
     Returns
     -------
     height, slope : numpy.ndarray
-        [m], [1]
-
-    Notes
-    -----
-    The weights, and their widening where the samples are sparse, follow ``docs/profiles.md``.
+        [m], [1]: the weights, widened where the samples are sparse, follow
+        ``docs/profiles.md``.
     """
     if smoothing == 0.0:
         return z.copy(), np.gradient(z, x, edge_order=2)
@@ -314,17 +302,14 @@ def scar_profile_and_findings(
     -------
     profile : ScarProfile
     findings : list of ScarProfileWarning
-        Outliers replaced (with their sample indices), ambiguous or uncertain edges.
     """
     x, z, half_width, smoothing = _checked_trace(x, z, half_width, smoothing)
-    findings = []
-    replaced = np.zeros(x.size, dtype=bool)
+    findings, replaced = [], np.zeros(x.size, dtype=bool)
     if remove_outliers:
         z, replaced, finding = _outliers_replaced(x, z)
         findings += [finding] if finding is not None else []
     spacing = float(np.median(np.diff(x)))
-    # The edges are found on lightly smoothed heights (a kink at an edge would move under
-    # heavier smoothing).
+    # The edges are found on lightly smoothed heights (heavier smoothing moves a kink).
     light = 0.0 if smoothing == 0.0 else _EDGE_SMOOTHING * spacing
     zs, _ = local_quadratic(x, z, light)
     extent, alternative, edge_findings = scar_extent(
@@ -354,11 +339,9 @@ def scar_profile_and_findings(
     area_r = np.concatenate([[ends[0]], r[inside], [ends[1]]])
     worn = float(np.trapezoid(np.maximum(-area_r, 0.0), area_x))
     if level:
-        height, slope = z - line(x), gs - tilt
-        reference = (0.0, 0.0)
+        height, slope, reference = z - line(x), gs - tilt, (0.0, 0.0)
     else:
-        height, slope = z, gs
-        reference = (float(line(centre)), float(tilt))
+        height, slope, reference = z, gs, (float(line(centre)), float(tilt))
     parts = (depth, width, worn, centre, *reference, alternative, replaced)
     return profile_of(x - centre, height, slope, *parts), findings
 
@@ -384,21 +367,16 @@ def scar_profile(
         :data:`AUTO_SMOOTHING` times the detected half-width. It is raised to the median
         sample spacing if smaller, and must not exceed a fifth of the half-width. [m]
     level : bool
-        Subtract the unworn surface's line (tilt and offset fitted on the shoulders) from
-        the heights and its tilt from the slopes. Off by default: the arrays are taken as
-        the pad feels them, so a genuinely tilted scar stays tilted.
+        Subtract the unworn surface's line (fitted on the shoulders) from the heights and
+        its tilt from the slopes; off by default, so a genuinely tilted scar stays tilted.
     remove_outliers : bool
-        Replace outliers (spikes, dropouts: :func:`outlying_samples`) by linear
-        interpolation between the nearest samples kept, before anything else (on by
-        default; ``replaced`` marks them).
+        Replace outliers (:func:`outlying_samples`) by linear interpolation between the
+        nearest samples kept, before anything else (``replaced`` marks them).
 
     Returns
     -------
     profile : ScarProfile
-        Positions relative to the detected centre, the heights (levelled if asked), the
-        smoothed slopes, and the depth, half-width, worn area, centre and reference line;
-        the other plausible half-width if the edges were ambiguous, and the samples
-        replaced.
+        Positions relative to the detected centre; heights levelled if asked.
 
     Warns
     -----
@@ -418,8 +396,8 @@ def scar_profile(
 
     Notes
     -----
-    The edges, the reference line and the smoothing follow ``docs/profiles.md``. The model
-    maps a pad position :math:`x` to :math:`X = xW/x_o` (eq. 11).
+    The edges, the reference line and the smoothing follow ``docs/profiles.md``; the model maps
+    a pad position :math:`x` to :math:`X = xW/x_o` (eq. 11).
 
     References
     ----------

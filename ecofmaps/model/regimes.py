@@ -24,27 +24,15 @@ __all__ = [
 
 class Regime(Code):
     """Regime codes returned by :func:`ecofmaps.slip_regime`, stored in maps and in the
-    results of :func:`ecofmaps.analyze_loops` (``docs/model.md``, ``docs/loops.md``).
+    results of :func:`ecofmaps.analyze_loops`; ``docs/model.md`` and ``docs/loops.md`` say
+    when each holds.
 
     Attributes
     ----------
-    GROSS_SLIP
-        :math:`\\mu\\lambda < 1`: the contact slips over part of every cycle (a measured
-        loop: its energy ratio :math:`A` above the threshold).
-    NO_GROSS_SLIP
-        The model's full stick, :math:`\\mu\\lambda \\ge 1`: :math:`\\delta^* = 0`,
-        :math:`E_d = 0`, :math:`\\mu_E` undefined.
-    SELF_LOCKING
-        Rigid rig and :math:`\\mu\\kappa \\ge 1` (on a scar profile :math:`\\mu|g| \\ge 1`
-        in the stroke), or a force above ``first_passage.JAMMED_TRACTION`` times the load:
-        the pad jams on the groove flank.
-    INVALID
-        An input outside its valid range (or NaN).
-    BEYOND_PROFILE
-        On a scar profile: the pad slips past an end of the measured trace.
+    GROSS_SLIP, NO_GROSS_SLIP, SELF_LOCKING, INVALID, BEYOND_PROFILE
+        The model's regimes: codes 0 to 4.
     PARTIAL_SLIP
-        A measured loop in partial slip (Mindlin's regime): its energy ratio :math:`A` at
-        most the threshold; :math:`Q^*/P` is a lower bound of :math:`\\mu`.
+        A measured loop in partial slip (Mindlin's regime): code 5.
 
     References
     ----------

@@ -1,10 +1,6 @@
-r"""Fretting loops from the model: the steady loop and a time-domain simulation.
-
-:func:`fretting_loop` draws the steady loop of a sinusoid-like stroke between
-:math:`\pm\Delta^*` in closed form (Figures 5 and 6 of the paper). :func:`simulate` runs
-the stick/slip return map over any displacement history :math:`\Delta(t)` with
-``jax.lax.scan``, solving the slip exactly at each step, so it has no time-step error
-and follows any change of amplitude.
+r"""Fretting loops from the model: :func:`fretting_loop` draws the steady loop in closed form
+(Figures 5 and 6 of the paper); :func:`simulate` runs the stick/slip return map over any
+displacement history, exactly at each step (``docs/model.md``).
 """
 
 from __future__ import annotations
@@ -14,11 +10,17 @@ from functools import partial
 import jax
 import jax.numpy as jnp
 
-from ecofmaps._inputs import as_float64, check, float64, is_concrete
-from ecofmaps.model.core import checked, locking_margin, slip_ratio, slip_roots, traction_ratio
-from ecofmaps.model.on_profile import profile_loop, profile_simulation
+from ecofmaps._inputs import check, float64, is_concrete
+from ecofmaps.model.core import (
+    locking_margin,
+    slip_ratio,
+    slip_roots,
+    steady_inputs,
+    traction_ratio,
+)
+from ecofmaps.model.on_profile import broadcast_history, profile_loop, profile_simulation
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
-from ecofmaps.model.steady_state import dimensionless, groove_inputs, one_geometry
+from ecofmaps.model.steady_state import dimensionless, one_geometry
 
 __all__ = ["fretting_loop", "simulate"]
 
@@ -31,10 +33,8 @@ def _steady_loop(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width
     mu, kappa, lam, code = (x[..., None] for x in (mu, kappa, lam, code))
     d = slip_ratio(mu, kappa, lam)
     t = jnp.linspace(-1.0, 1.0, num)
-    # Forward-slip branch from -d to d (eq. 9, 10). A shallow groove (u = mu*kappa*d < 1/2)
-    # is sampled uniformly in position; a deep one so that the margin to the locking
-    # point, w = 1 - mu*kappa*xi, falls geometrically from 1 + u to its end value, which
-    # puts the points where the force rises steeply and keeps the digits of w there.
+    # Forward-slip branch from -d to d (eq. 9, 10), sampled as docs/model.md explains: the
+    # margin w = 1 - mu*kappa*xi falls geometrically on a deep groove (u = mu*kappa*d >= 1/2).
     a = mu * kappa
     u = a * d
     shallow = u < 0.5
@@ -78,26 +78,12 @@ def fretting_loop(
 
     Parameters
     ----------
-    amplitude : array_like
-        Displacement amplitude :math:`\Delta^*`. [m]
-    load : array_like
-        Normal load :math:`P`. [N]
-    stiffness : array_like
-        Rig stiffness :math:`S`; ``numpy.inf`` for a rigid rig. [N/m]
-    mu : array_like
-        Contact coefficient of friction. [1]
-    aspect_ratio : array_like, optional
-        Groove depth over half-width :math:`z_o/x_o` (a parabolic groove). Give this or
-        ``profile``. [1]
-    groove_half_width : array_like, optional
-        Groove half-width :math:`x_o`; defaults to ``amplitude``. [m]
+    amplitude, load, stiffness, mu, aspect_ratio, groove_half_width, profile, mapping
+        As for :func:`ecofmaps.slip_amplitude`: :math:`\Delta^*` [m], :math:`P` [N], :math:`S`
+        [N/m], :math:`\mu` [1], :math:`z_o/x_o` [1] or a scar ``profile``, :math:`x_o` [m]
+        (default ``amplitude``) and the mapping onto the profile.
     num : int
         Points on each slip branch (>= 2). [1]
-    profile : ScarProfile, optional
-        A scar profile of any shape instead of ``aspect_ratio`` (see
-        :func:`ecofmaps.slip_amplitude`).
-    mapping : {'scaled', 'physical'}
-        On a profile: :math:`X = xW/x_o` (eq. 11) or :math:`X = x`.
 
     Returns
     -------
@@ -116,10 +102,8 @@ def fretting_loop(
 
     Notes
     -----
-    The slip branches are eq. 9 with eq. 10, :math:`\Delta = x + Q_\pm(x)/S`, the stick
-    segments lines of slope :math:`S`; with no gross slip the loop collapses onto
-    :math:`Q = S\Delta`. Self-locking points and points off a profile's trace give NaN. The
-    sampling of the branches is explained in ``docs/model.md``.
+    The slip branches are :math:`\Delta = x + Q_\pm(x)/S` (eq. 9, 10), sampled as
+    ``docs/model.md`` explains. Self-locking points and points off a profile's trace give NaN.
 
     References
     ----------
@@ -133,7 +117,7 @@ def fretting_loop(
         return profile_loop(
             profile, amplitude, load, stiffness, mu, groove_half_width, mapping, num
         )
-    values = groove_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
+    values = steady_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
     return _steady_loop(*jnp.broadcast_arrays(*values), num=num)
 
 
@@ -183,21 +167,13 @@ def simulate(
     displacement : array_like
         Actuator displacement :math:`\Delta` at successive instants, time along the last
         axis; any leading axes broadcast against the other parameters. [m]
-    load : array_like
-        Normal load :math:`P`. [N]
-    stiffness : array_like
-        Rig stiffness :math:`S`; ``numpy.inf`` for a rigid rig. [N/m]
-    mu : array_like
-        Contact coefficient of friction. [1]
-    aspect_ratio : array_like, optional
-        Groove depth over half-width :math:`z_o/x_o` (a parabolic groove). Give this or
-        ``profile``. [1]
+    load, stiffness, mu, aspect_ratio, profile
+        As for :func:`ecofmaps.slip_amplitude`: :math:`P` [N], :math:`S` [N/m], :math:`\mu`
+        [1], and :math:`z_o/x_o` [1] or a scar ``profile``.
     groove_half_width : array_like
         Groove half-width :math:`x_o`: required with ``aspect_ratio`` and with a profile in
         the scaled mapping :math:`X = xW/x_o` (use the amplitude to match the steady loop
         of :func:`ecofmaps.fretting_loop`). [m]
-    profile : ScarProfile, optional
-        A scar profile of any shape instead of ``aspect_ratio``.
     mapping : {'scaled', 'physical'}
         On a profile: :math:`X = xW/x_o` (eq. 11) or :math:`X = x` (no ``groove_half_width``).
 
@@ -215,11 +191,8 @@ def simulate(
 
     Notes
     -----
-    The pad starts at rest at the groove centre. At each new :math:`\Delta` it sticks while
-    :math:`Q_-(x) \le S(\Delta - x) \le Q_+(x)` (eq. 9, 10); otherwise it slips to the exact
-    equilibrium :math:`x' + Q_\pm(x')/S = \Delta` (the quadratic of eq. 16; on a profile the
-    first one beyond the pad), so the result does not depend on the sampling
-    (``docs/model.md``). A pad that runs off a profile's trace gives NaN.
+    From rest at the groove centre, the pad sticks or slips to the exact equilibrium at each
+    step (eq. 9, 10, 16; ``docs/model.md``). A pad that runs off a profile's trace gives NaN.
 
     References
     ----------
@@ -236,20 +209,12 @@ def simulate(
         )
     if groove_half_width is None:
         raise ValueError("simulate with aspect_ratio needs groove_half_width (x_o) [m]")
-    load, stiffness, mu, aspect_ratio, length = checked(
-        load=load,
-        stiffness=stiffness,
-        mu=mu,
-        aspect_ratio=aspect_ratio,
-        groove_half_width=groove_half_width,
+    load, stiffness, mu, aspect_ratio, length = steady_inputs(
+        None, load, stiffness, mu, aspect_ratio, groove_half_width
     )
     mu, kappa, lam, code = dimensionless(length, load, stiffness, mu, aspect_ratio, length)
-    displacement = as_float64(displacement)
-    shapes = (jnp.shape(x) for x in (mu, kappa, lam, code))
-    batch = jnp.broadcast_shapes(displacement.shape[:-1], *shapes)
-    displacement = jnp.broadcast_to(displacement, batch + displacement.shape[-1:])
-    mu, kappa, lam, length, load, code = (
-        jnp.broadcast_to(x, batch) for x in (mu, kappa, lam, length, load, code)
+    displacement, (mu, kappa, lam, length, load, code) = broadcast_history(
+        displacement, mu, kappa, lam, length, load, code
     )
     force = _return_map(displacement, mu, kappa, lam, length) * load[..., None]
     return jnp.where(code[..., None] == int(INVALID), jnp.nan, force)

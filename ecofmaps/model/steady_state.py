@@ -1,9 +1,6 @@
-r"""The model in SI units: slip amplitude, energy, ECoF, peak force and regime of the steady loop.
-
-Each function validates concrete inputs (a ``ValueError`` names the parameter and its
-range), is jit-compiled and always computes in float64; under ``jit``/``vmap`` invalid
-points are NaN with the ``INVALID`` regime. The numbers come from the dimensionless core
-(:mod:`ecofmaps.model.core`) with :math:`L = \Delta^*`.
+r"""The model in SI units: slip amplitude, energy, ECoF, peak force and regime of the steady loop,
+from the dimensionless core (:mod:`ecofmaps.model.core`) with :math:`L = \Delta^*`, or on a scar
+profile (:mod:`ecofmaps.model.on_profile`).
 """
 
 from __future__ import annotations
@@ -14,7 +11,6 @@ import jax.numpy as jnp
 from ecofmaps._codes import warn_nan
 from ecofmaps._inputs import as_float64, float64, is_concrete
 from ecofmaps.model.core import (
-    checked,
     compliance_ratio,
     curvature_number,
     ecof_ratio,
@@ -22,6 +18,7 @@ from ecofmaps.model.core import (
     normalized_max_force,
     regime_code,
     slip_ratio,
+    steady_inputs,
     valid_geometry,
 )
 from ecofmaps.model.on_profile import steady_numbers, steady_values
@@ -58,19 +55,6 @@ def dimensionless(amplitude, load, stiffness, mu, aspect_ratio, groove_half_widt
     return mu, kappa, lam, code
 
 
-def groove_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width) -> list:
-    """The inputs of a parabolic groove, checked, as float64; x_o defaults to the amplitude."""
-    values = checked(
-        amplitude=amplitude,
-        load=load,
-        stiffness=stiffness,
-        mu=mu,
-        aspect_ratio=aspect_ratio,
-        groove_half_width=groove_half_width,
-    )
-    return values if groove_half_width is not None else [*values, values[0]]
-
-
 @jax.jit(static_argnames="quantity")
 def _steady_state(quantity, amplitude, load, stiffness, mu, aspect_ratio, groove_half_width):
     """One steady-loop quantity and the regime, NaN where the input is invalid."""
@@ -104,24 +88,6 @@ def _profile_quantity(quantity, numbers, amplitude, load, mu):
     return jnp.broadcast_to(value, numbers["regime"].shape)
 
 
-def _evaluate(quantity, arguments, profile, mapping):
-    one_geometry(arguments[4], profile, mapping)
-    if profile is None:
-        result, code = _steady_state(quantity, *groove_inputs(*arguments))
-        concrete = is_concrete(*arguments)
-    else:
-        amplitude, load, stiffness, mu, _, groove_half_width = arguments
-        numbers = steady_numbers(
-            profile, amplitude, load, stiffness, mu, groove_half_width, mapping
-        )
-        si = (as_float64(v) for v in (amplitude, load, mu))
-        result, code = _profile_quantity(quantity, numbers, *si), numbers["regime"]
-        concrete = is_concrete(result)
-    if concrete and quantity != "slip_regime":
-        warn_nan(result, code, Regime, quantity)
-    return result
-
-
 def _steady_quantity(quantity: str, summary: str, returns: str, notes: str, equations: str):
     """The public function ``quantity`` of the steady loop, with its docstring."""
 
@@ -136,8 +102,21 @@ def _steady_quantity(quantity: str, summary: str, returns: str, notes: str, equa
         profile=None,
         mapping="scaled",
     ):
-        arguments = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
-        return _evaluate(quantity, arguments, profile, mapping)
+        one_geometry(aspect_ratio, profile, mapping)
+        if profile is None:
+            arguments = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
+            result, code = _steady_state(quantity, *steady_inputs(*arguments))
+            concrete = is_concrete(*arguments)
+        else:
+            numbers = steady_numbers(
+                profile, amplitude, load, stiffness, mu, groove_half_width, mapping
+            )
+            si = (as_float64(v) for v in (amplitude, load, mu))
+            result, code = _profile_quantity(quantity, numbers, *si), numbers["regime"]
+            concrete = is_concrete(result)
+        if concrete and quantity != "slip_regime":
+            warn_nan(result, code, Regime, quantity)
+        return result
 
     steady_quantity.__name__ = steady_quantity.__qualname__ = quantity
     steady_quantity.__doc__ = f"""{summary}
@@ -159,11 +138,9 @@ def _steady_quantity(quantity: str, summary: str, returns: str, notes: str, equa
         Groove half-width :math:`x_o`; defaults to ``amplitude`` as in the paper. On a
         profile it sets the mapping :math:`X = xW/x_o` of eq. 11. [m]
     profile : ScarProfile, optional
-        A wear-scar profile of any shape (:func:`ecofmaps.scar_profile`,
-        :func:`ecofmaps.read_scar_profile`, the profile families), instead of
-        ``aspect_ratio``: the pad at contact position :math:`x` feels its slope at
-        :math:`X = xW/x_o` (eq. 9 pointwise). A parabolic profile reproduces the closed
-        forms with ``aspect_ratio=D/W``.
+        A wear-scar profile of any shape (:func:`ecofmaps.scar_profile`, the families),
+        instead of ``aspect_ratio``: the pad at :math:`x` feels its slope at :math:`X` (eq. 9
+        pointwise). A parabolic profile reproduces the closed forms with ``aspect_ratio=D/W``.
     mapping : {{'scaled', 'physical'}}
         On a profile: ``'scaled'``, :math:`X = xW/x_o` (eq. 11, the paper's); or
         ``'physical'``, :math:`X = x`.
@@ -183,11 +160,8 @@ def _steady_quantity(quantity: str, summary: str, returns: str, notes: str, equa
 
     Notes
     -----
-    {notes}On a profile the steady loop's ends solve :math:`x + Q_\\pm(x)/S = \\pm\\Delta^*` by
-    first passage from where the last stroke ended, the pad jumping where
-    :math:`x + Q_+(x)/S` falls; :math:`\\delta^* = (x_+ - x_-)/2` and :math:`E_d` is the
-    area of the loop the return map draws (:mod:`ecofmaps.model.first_passage`). The regime
-    ``BEYOND_PROFILE`` marks a stroke that runs off the trace.
+    {notes}On a profile the loop's ends are found by first passage and :math:`E_d` is the area
+    of the loop the return map draws (``docs/model.md``).
 
     References
     ----------

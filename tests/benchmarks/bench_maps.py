@@ -943,9 +943,7 @@ def _jump_fraction(scar, amplitude, stiffness) -> float:
     """Fraction of the grid's gross-slip points where the pad jumps (the O(N) pass runs)."""
     from ecofmaps.model import on_profile
 
-    prepared = on_profile._prepare(
-        *on_profile._inputs(amplitude, LOAD, stiffness, MU, None), scar.half_width, False
-    )
+    *_, prepared = on_profile._points(scar, amplitude, LOAD, stiffness, MU, None, "scaled")
     mu, key, lam, _ = (np.asarray(v) for v in prepared)
     unique, group = on_profile._groups(mu, key)
     loops, _ = on_profile._shared(scar, unique, group, lam, False)
