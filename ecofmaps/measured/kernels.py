@@ -496,7 +496,8 @@ def _fitted_peak(values, first, n, at, span, sign):
     for j in range(sixth.size):
         for k in range(7):
             sixth[j] += _SIXTH[k] * near[half - eighth + j + k - 3]
-    sd = np.partition(np.abs(sixth), eighth // 2)[eighth // 2] / _QUARTILE_SIXTH_DIFFERENCE
+        sixth[j] = abs(sixth[j])
+    sd = np.partition(sixth, eighth // 2)[eighth // 2] / _QUARTILE_SIXTH_DIFFERENCE
     if not sd > _NOISE_FREE * span:
         return 0.0
     ends = np.ones(2, np.int64)  # the last sample within the depth each side, before 3 are not
@@ -522,7 +523,8 @@ def _fitted_peak(values, first, n, at, span, sign):
     for col in range(3):  # Gaussian elimination (positive definite: no pivoting)
         for r in range(col + 1, 4):
             factor = normal[r, col] / normal[col, col]
-            normal[r, col:] -= factor * normal[col, col:]
+            for c in range(col, 4):
+                normal[r, c] -= factor * normal[col, c]
             sums[r] -= factor * sums[col]
     step = abs(sums[3]) > _STEP_T * sd * np.sqrt(normal[3, 3])  # its t over its standard error
     return _intercept(normal, sums, 4 if 0 < steps < ends[0] + ends[1] - 2 and step else 3)
