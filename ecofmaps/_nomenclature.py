@@ -200,13 +200,15 @@ def attrs(name: str, comments=None) -> dict:
     return described | ({"comment": comments[name]} if name in (comments or {}) else {})
 
 
-def axis_label(name: str) -> str:
-    r"""A plot axis label: words, symbol and display unit, ``Slip amplitude $\delta^*$ [µm]``."""
+def axis_label(name: str, plain: bool = False) -> str:
+    r"""A plot axis label: words, symbol and display unit, ``Slip amplitude $\delta^*$ [µm]``
+    (``Slip amplitude δ* [µm]`` if ``plain``, for a page's plots)."""
     quantity = QUANTITIES[name]
     words = quantity.words if quantity.label is None else quantity.label
     parts = [words[:1].upper() + words[1:]] if words else []
-    if quantity.latex:
-        parts.append(f"${quantity.latex}$")
+    mark = quantity.symbol if plain else quantity.latex and f"${quantity.latex}$"
+    if mark:
+        parts.append(mark)
     unit = quantity.axis_unit or quantity.display_unit or "1"
     return " ".join(parts) + f" [{unit}]"
 

@@ -35,7 +35,7 @@ from bokeh.palettes import Category10_10
 from bokeh.plotting import figure
 from bokeh.resources import INLINE
 
-from ecofmaps._nomenclature import QUANTITIES, transition_texts, with_se
+from ecofmaps._nomenclature import QUANTITIES, axis_label, transition_texts, with_se
 from ecofmaps._version import __version__
 from ecofmaps.io.files import atomic_path
 from ecofmaps.io.tables import results_table
@@ -220,14 +220,6 @@ def report_document(results: xr.Dataset, *, loops=None, inputs=None, lab=None):
     return column(*parts, styles={"font-family": "sans-serif", "margin": "0 12px"})
 
 
-def _label(name: str) -> str:
-    """An axis label in plain text: words, symbol and display unit, ``Slip amplitude δ* [µm]``."""
-    quantity = QUANTITIES[name]
-    words = quantity.words if quantity.label is None else quantity.label
-    text = " ".join(part for part in (words[:1].upper() + words[1:], quantity.symbol) if part)
-    return f"{text} [{quantity.axis_unit or quantity.display_unit or '1'}]"
-
-
 def _rows_table(rows: Mapping, css_class: str) -> str:
     """An HTML table of ``rows``, a name and its value on each row."""
     cells = "".join(
@@ -322,7 +314,10 @@ def _evolution_figures(results: xr.Dataset, flagged: dict):
 def _cycle_figure(**options):
     """A plot over the cycles, its frame lined up with the other's."""
     plot = figure(
-        frame_width=_FRAME[0], min_border_left=_FRAME[1], x_axis_label=_label("cycle"), **options
+        frame_width=_FRAME[0],
+        min_border_left=_FRAME[1],
+        x_axis_label=axis_label("cycle", plain=True),
+        **options,
     )
     plot.xaxis.formatter = BasicTickFormatter(use_scientific=False)
     return plot
@@ -449,8 +444,8 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
         width=700,
         height=460,
         title="Measured loops (lines) and the model's (dashed)",
-        x_axis_label=_label("displacement"),
-        y_axis_label=_label("force"),
+        x_axis_label=axis_label("displacement", plain=True),
+        y_axis_label=axis_label("force", plain=True),
         tools="pan,box_zoom,wheel_zoom,reset,save",
     )
     plot.multi_line(
