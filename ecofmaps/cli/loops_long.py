@@ -15,7 +15,6 @@ import dataclasses
 import functools
 import hashlib
 import json
-import os
 import sys
 import zlib
 from pathlib import Path
@@ -37,6 +36,7 @@ from ecofmaps.measured.pipeline import (
     only,
     runner_for,
     temporary_file,
+    write_whole,
 )
 from ecofmaps.measured.resolve import ReadingOptions
 from ecofmaps.measured.samples import MissingSampleError
@@ -98,7 +98,7 @@ class _Partial:
         self.made = not self.folder.exists()  # else --resume: LongRun checked it
         if self.made:
             self.folder.mkdir()
-            _write(record, json.dumps(fingerprint))
+            write_whole(record, json.dumps(fingerprint))
             return
         try:
             found = json.loads(record.read_text(encoding="utf-8"))
@@ -168,7 +168,7 @@ class _Partial:
 
     def keep_cycles(self, index: int, cycles) -> None:
         path = self.folder / f"file{index}-cycles.npz"
-        _write(path, dataclasses.asdict(cycles))
+        write_whole(path, dataclasses.asdict(cycles))
         self._record(path, file=index, block="cycles")
 
     def blocks(self, index: int) -> Path:
@@ -223,20 +223,6 @@ class _Partial:
         self.remove_temporaries()
         with contextlib.suppress(OSError):  # not empty: left as it is
             self.folder.rmdir()
-
-
-def _write(path: Path, content) -> None:
-    """Write ``content`` (text, or arrays by name: ``.npz``) to ``path``, whole or nothing."""
-    temporary = temporary_file(path)
-    try:
-        if isinstance(content, str):
-            temporary.write_text(content, "utf-8")
-        else:
-            with open(temporary, "wb") as stream:
-                np.savez(stream, **content)
-        os.replace(temporary, path)
-    finally:
-        temporary.unlink(missing_ok=True)
 
 
 class LongRun:

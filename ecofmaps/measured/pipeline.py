@@ -52,6 +52,7 @@ __all__ = [
     "only",
     "runner_for",
     "temporary_file",
+    "write_whole",
 ]
 
 #: Samples of the recording measured by one chunk of a long recording (about; whole cycles).
@@ -318,21 +319,31 @@ def block_file(prefix: Path, index: int) -> Path:
 
 
 def temporary_file(path: Path) -> Path:
-    """The temporary that :func:`keep_block` writes before renaming it onto ``path``."""
+    """The temporary that :func:`write_whole` writes before renaming it onto ``path``."""
     return path.with_name(f".{path.name}.tmp")
+
+
+def write_whole(path: Path, content) -> None:
+    """Write ``content`` (text, or arrays by name: ``.npz``) to ``path``, whole or nothing,
+    through :func:`temporary_file`."""
+    temporary = temporary_file(path)
+    try:
+        if isinstance(content, str):
+            temporary.write_text(content, "utf-8")
+        else:
+            with open(temporary, "wb") as stream:
+                np.savez(stream, **content)
+        os.replace(temporary, path)
+    finally:
+        temporary.unlink(missing_ok=True)
 
 
 def keep_block(path: Path, values: dict, flags: dict) -> None:
     """Keep what a chunk measured, its ``values`` and ``flags``, in ``path`` (``.npz``), whole
     or not at all."""
-    stored = {f"v:{k}": v for k, v in values.items()} | {f"f:{k}": v for k, v in flags.items()}
-    temporary = temporary_file(path)
-    try:
-        with open(temporary, "wb") as stream:
-            np.savez(stream, **stored)
-        os.replace(temporary, path)
-    finally:
-        temporary.unlink(missing_ok=True)
+    write_whole(
+        path, {f"v:{k}": v for k, v in values.items()} | {f"f:{k}": v for k, v in flags.items()}
+    )
 
 
 def kept_block(path: Path) -> tuple[dict, dict]:
