@@ -45,7 +45,8 @@ _NOISE_REACH = 4
 NEIGHBOURS = _NOISE_REACH + 1
 #: The median of the absolute second difference of white noise over its standard deviation.
 SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
-_QUARTILE_SECOND_DIFFERENCE = 0.3186393639643752 * np.sqrt(6.0)  # the lower quartile
+#: The same of its lower quartile.
+_QUARTILE_SECOND_DIFFERENCE = 0.3186393639643752 * np.sqrt(6.0)
 #: Fewest samples of a cycle whose noise is read from its second differences (in fewer, a
 #: loop's corners are most of them).
 _NOISE_SAMPLES = 4 * MIN_SAMPLES
