@@ -34,8 +34,13 @@ MINDLIN_OPENING_RATIO = 2 ** (1 / 3) - 1
 _SAME_AMPLITUDE = 0.01
 #: Cycles where the regime changes that :func:`sliding_condition_line` names.
 _CHANGES_SHOWN = 5
-#: Fewest ``mindlin-stick`` cycles whose spring stands for an unknown rig's stiffness.
+#: Fewest ``mindlin-stick`` cycles whose spring stands for an unknown rig's stiffness, and
+#: fewest sure gross-slip cycles whose GICoF stands for the sliding friction.
 _SPRINGS = 3
+#: Q*/P within this many robust standard deviations of the sliding friction has saturated.
+_SATURATED_SPREAD = 3.0
+#: Q*/P within this share of the sliding friction has saturated, whatever the spread. [1]
+_SATURATED_SHARE = 1e-3
 #: Why μ_t from Q*/P has no standard error.
 _PEAK_BIASED = (
     "no GICoF in the results: mu is Q*/P of the first gross-slip cycles, a peak read through "
@@ -111,14 +116,34 @@ def _spring(tests: list, rig_stiffness):
 
 def _ratios(cycles: dict, rig_stiffness):
     """The cycles' energy and opening ratios (on the contact's displacement NaN without the
-    rig's stiffness), the energy ratio that decides the regime, and where it says gross slip."""
+    rig's stiffness), the energy ratio that decides the regime, where the cycles are in gross
+    slip, and whether that was decided by the force (:func:`_saturated`)."""
     if rig_stiffness is not None:
         check("rig_stiffness", rig_stiffness, "positive_or_inf", "N/m")
     names = ("amplitude", "max_force", "dissipated_energy")
     slip = cycles.get("slip_amplitude", np.nan)
     ratios = loop_ratios(*(cycles[n] for n in names), slip, rig_stiffness)
     ratio = regime_ratio(ratios, rig_stiffness)
-    return ratios, ratio, ratio > MINDLIN_ENERGY_RATIO
+    gross = ratio > MINDLIN_ENERGY_RATIO
+    saturated = None if rig_stiffness is not None else _saturated(cycles, gross)
+    if saturated is None:
+        return ratios, ratio, gross, False
+    return ratios, ratio, gross | saturated, True
+
+
+def _saturated(cycles: dict, gross):
+    """Where Q*/P has reached the sliding friction μ: the median GICoF of the cycles whose
+    energy ratio on the applied displacement already says gross slip, less three times the
+    robust scatter of their Q*/P (at least a thousandth of μ); None with fewer than three."""
+    cof = cycles["max_force"] / cycles["load"]
+    friction = cycles.get("gicof", np.full(cof.shape, np.nan))
+    sure = gross & np.isfinite(friction) & np.isfinite(cof)
+    if np.count_nonzero(sure) < _SPRINGS:
+        return None
+    mu = float(np.median(friction[sure]))
+    spread = 1.4826 * float(np.median(np.abs(cof[sure] - np.median(cof[sure]))))
+    with np.errstate(invalid="ignore"):
+        return cof >= mu - max(_SATURATED_SPREAD * spread, _SATURATED_SHARE * mu)
 
 
 @si_units(rig_stiffness="stiffness")
@@ -136,7 +161,8 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
         one ``results`` were analysed with (``results.attrs["rig_stiffness"]``, from
         ``analyze_loops(..., rig_stiffness=)`` or ``--rig-stiffness``), else the median
         spring behind the stick of three ``mindlin-stick`` cycles or more (a sphere's), if
-        any. [N/m]
+        any; else a cycle whose Q*/P has reached the sliding friction is in gross slip
+        too. [N/m]
 
     Returns
     -------
@@ -172,8 +198,8 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
     """
     (results,) = tests_of(results)
     names = ("amplitude", "max_force", "dissipated_energy", "slip_amplitude")
-    cycles = per_cycle(results, names)
-    ratios, ratio, gross = _ratios(cycles, _spring([results], rig_stiffness))
+    cycles = per_cycle(results, names + ("gicof",) * ("gicof" in results))
+    ratios, ratio, gross, _ = _ratios(cycles, _spring([results], rig_stiffness))
     gross = np.where(np.isfinite(ratio), gross, np.nan)
     condition, changes = sliding_condition_of(cycles["cycle"], gross)
     data = {name: ("cycle", value, nomenclature.attrs(name)) for name, value in ratios.items()}
@@ -212,7 +238,9 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
         one load and several amplitudes.
     rig_stiffness : float, optional
         The rig's own stiffness :math:`S`, as for :func:`sliding_condition` (by default the
-        one every test was analysed with); without it ``contact_amplitude`` is NaN. [N/m]
+        one every test was analysed with); without it ``contact_amplitude`` is NaN, and
+        where the force decides the regime, :math:`\Delta_t` is midway between the two
+        amplitudes where :math:`Q^*` first stays at :math:`\mu P`. [N/m]
 
     Returns
     -------
@@ -260,7 +288,7 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     names += ("gicof",) * all("gicof" in test for test in tests)
     cycles = [per_cycle(test, names) for test in tests]
     pooled = {name: np.concatenate([c[name] for c in cycles]) for name in (*names, "load")}
-    _, ratio, gross = _ratios(pooled, rig_stiffness)
+    _, ratio, gross, by_force = _ratios(pooled, rig_stiffness)
     known = np.isfinite(ratio) & np.isfinite(pooled["load"])
     order = np.argsort(pooled["amplitude"][known], kind="stable")
     cof = pooled["max_force"] / pooled["load"]
@@ -300,10 +328,13 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     if low == high:  # the split falls among the cycles at one amplitude: the next ones too
         low, high = low - 1, high + 1
     fitted = (level >= low) & (level <= high)
-    at, at_se = line_root(*fitted_line(amplitude[fitted], ratio[fitted]), MINDLIN_ENERGY_RATIO)
+    below, above = amplitude[level == low].mean(), amplitude[level == high].mean()
+    if by_force:  # where Q* reaches μP: between the two amplitudes
+        at, at_se = 0.5 * (below + above), np.nan
+    else:
+        at, at_se = line_root(*fitted_line(amplitude[fitted], ratio[fitted]), MINDLIN_ENERGY_RATIO)
     # the crossing may lie anywhere between the two amplitudes
-    bracket = (amplitude[level == high].mean() - amplitude[level == low].mean()) / np.sqrt(12)
-    at_se = float(np.hypot(np.nan_to_num(at_se), bracket))
+    at_se = float(np.hypot(np.nan_to_num(at_se), (above - below) / np.sqrt(12)))
     mu, mu_se = _sliding_friction(gross, level, split, cof, friction)
     force = float(np.mean(load[fitted])) / (np.nan if rig_stiffness is None else rig_stiffness)
     values = {
