@@ -220,7 +220,8 @@ def test_the_lab_numbers_on_a_spheres_sweep(stiffness, noise, record_property):
     """The sweep 0.45 to 1.8 Δ_t behind each rig, noise-free and with 1 % noise, the rig's
     stiffness known: the GICoF on >= 80 % of the gross-slip cycles within 2 % of μ; <= 5 % of
     the cycles more than 5 % from Δ_t in the wrong regime, with the rig's stiffness and
-    without it; Δ_t within 5 %, μ_t within 3 %."""
+    without it; Δ_t within 5 %, μ_t within 3 %; without the rig's stiffness or the quality
+    column (where the force decides), Δ_t within 5 % and ±2 se."""
     at = mindlin.transition_amplitude(MU, LOAD, DELTA_T, stiffness)
     results, factor = _noisy_sweep(stiffness, noise, 1, stiffness)
     assert results.cycle.size == SWEEP.size
@@ -232,17 +233,21 @@ def test_the_lab_numbers_on_a_spheres_sweep(stiffness, noise, record_property):
         bare = results.drop_attrs(deep=False)
         called = ecofmaps.sliding_condition(bare, rig).gross_slip.values == 1
         wrong[known] = float(((called != gross) & far).sum() / far.sum())
+    by_force = ecofmaps.transition(results.drop_attrs(deep=False).drop_vars("quality"))
     numbers = {"gicof": read, "wrong": wrong, "amplitude": float(found.amplitude) / at - 1,
-               "mu": float(found.mu) / MU - 1}  # fmt: skip
+               "mu": float(found.mu) / MU - 1,
+               "by_force": float(by_force.amplitude) / at - 1}  # fmt: skip
     record_property("numbers", numbers)
     print(f"S = {stiffness / 1e6:g} MN/m, noise {noise:.0%}: GICoF on {read:.0%} of the "
           f"gross-slip cycles; wrong regime {wrong['known']:.1%} (S known), "
           f"{wrong['unknown']:.1%} (S unknown); Δ_t {numbers['amplitude']:+.2%}, "
-          f"μ_t {numbers['mu']:+.3%}")  # fmt: skip
+          f"μ_t {numbers['mu']:+.3%}; Δ_t by the force {numbers['by_force']:+.2%}")  # fmt: skip
     assert read >= 0.8
     assert wrong["known"] <= 0.05 and wrong["unknown"] <= 0.05
     assert float(found.amplitude) == pytest.approx(at, rel=0.05)
     assert float(found.mu) == pytest.approx(MU, rel=0.03)
+    assert float(by_force.amplitude) == pytest.approx(at, rel=0.05)
+    assert abs(float(by_force.amplitude) - at) <= 2 * float(by_force.amplitude_se)
 
 
 @pytest.mark.slow
