@@ -54,10 +54,9 @@ __all__ = [
 
 
 def quantity(name: str, grid: bool = False, option: str | None = None):
-    """An argparse ``type`` reading a value of quantity ``name`` with units (with ``grid``, a
-    list ``a,b,c`` or a range ``start:stop:num``), checked against its dimension, valid
-    range and the model's domain (:data:`ecofmaps.units.DOMAIN`); a bare number implausible
-    in SI is warned of, naming ``option`` (``--name``)."""
+    """An argparse ``type`` reading quantity ``name`` [SI] with units (``grid``: ``a,b,c`` or
+    ``start:stop:num``), checked against its dimension, range and :data:`ecofmaps.units.DOMAIN`;
+    a bare number implausible in SI is warned of, naming ``option`` (``--name``)."""
     described = QUANTITIES[name]
     kind, option = described.kind, option or "--" + name.replace("_", "-")
 
@@ -96,9 +95,8 @@ def quantity(name: str, grid: bool = False, option: str | None = None):
 
 
 def unit(kind: str):
-    """An argparse ``type`` reading a unit of ``kind`` (``'um'``, ``'kN'``), kept as text: a
-    unit of that dimension whose size is positive and finite (not a number, ``'0um'``)."""
-
+    """An argparse ``type`` reading a unit of ``kind`` (``'um'``), kept as text: one of that
+    dimension whose size is positive and finite (not a number, ``'0um'``)."""
     example = DIMENSIONS[kind][1]
 
     def parse(text: str) -> str:
@@ -121,8 +119,7 @@ def unit(kind: str):
 
 
 def count(what: str, least: int = 1):
-    """An argparse ``type`` reading a whole number of ``what`` >= ``least`` (``4194304``,
-    ``4e6``)."""
+    """An argparse ``type`` reading a whole number of ``what`` >= ``least`` (``4e6``)."""
 
     def parse(text: str) -> int:
         try:
@@ -156,8 +153,7 @@ _RECORDING_HELP = {
 
 
 def command_parser(subparsers, name: str, **texts) -> argparse.ArgumentParser:
-    """The parser of subcommand ``name``, its ``description`` filled to 80 columns and its
-    ``epilog`` kept as written (``texts``: ``help``, ``description``, ``epilog``)."""
+    """The parser of subcommand ``name``: ``description`` filled to 80 columns, ``epilog`` as is."""
     texts["description"] = textwrap.fill(texts["description"], width=80)
     formatter = argparse.RawDescriptionHelpFormatter
     return subparsers.add_parser(name, formatter_class=formatter, **texts)
@@ -202,8 +198,7 @@ def recording_options(args) -> dict:
     }
 
 
-#: The ``--scar-profile`` options that ``ecofmaps model`` and ``ecofmaps correct`` share: a
-#: measured wear-scar profile instead of the parabolic groove of eq. 11 (docs/profiles.md).
+#: The ``--scar-profile`` options of ``model`` and ``correct`` (docs/profiles.md).
 _PROFILE_HELP = {
     "--scar-profile": "the scar's profile (CSV, TSV or whitespace-separated text)",
     "--x-column": "name of the position column (default: x)",
@@ -245,10 +240,9 @@ def add_profile_options(parser: argparse.ArgumentParser) -> None:
 
 
 def read_profile(args, conflicting=()):
-    """The profile ``--scar-profile`` names (read with its options), or ``None``; an option
-    of the parabola (the destinations ``conflicting``) with it, or of the reading without it,
-    is a :class:`CommandError`. The reader's warnings are printed one line each, naming the
-    ``--profile-half-width`` of the other half-width for ambiguous edges."""
+    """The profile ``--scar-profile`` names, or None; with it an option of the parabola
+    (destinations ``conflicting``), or without it one of the reading, is a :class:`CommandError`.
+    The reader's warnings are one line each, naming ``--profile-half-width`` of the other W."""
     given = [name for name in args.profile_options if getattr(args, name) is not None]
     if args.scar_profile is None and given:
         raise CommandError(f"{_options(given)} reads a --scar-profile: give the FILE too")
@@ -262,9 +256,8 @@ def read_profile(args, conflicting=()):
             f"give --scar-profile or {_options(given)}, not both (the profile gives the "
             "scar's shape, and its D/W)"
         )
-    # JAX and the readers load with the first profile read, not with the command line
-    from ecofmaps.io.scar_profiles import read_scar_profile
-    from ecofmaps.model.profiles import ScarProfileWarning  # with the reader, as above
+    from ecofmaps.io.scar_profiles import read_scar_profile  # JAX: not with the command line
+    from ecofmaps.model.profiles import ScarProfileWarning
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ScarProfileWarning)
@@ -297,15 +290,13 @@ def _options(names) -> str:
 
 
 def profile_rows(args, profile) -> list:
-    """Rows naming the profile: its file and samples, depth D, half-width W (and the
-    alternative when the edges were ambiguous), D/W."""
+    """Rows of the profile: file and samples, depth D, half-width W (and the other), D/W."""
     reading = [f"{profile.position.shape[-1]} samples", "as given" if args.no_level else "levelled"]
     if replaced := int(np.count_nonzero(np.asarray(profile.replaced))):
         reading.append(f"{replaced} outlier(s) replaced")
     if args.smoothing is not None:
         reading.append(f"slopes smoothed over {args.smoothing * 1e6:.6g} µm")
-    # the other half-width is the groove's, the band's, or that of the edges read within
-    # the roughness (the warning names it)
+    # the other W is the groove's, the band's, or the edges' read within the roughness
     other, alternative = args.profile_alternative, float(profile.alternative_half_width)
     how = "(given)" if args.profile_half_width is not None else "(detected)"
     if not math.isnan(alternative):
@@ -336,8 +327,7 @@ def _length(text: str) -> float:
 
 
 def add_contact_options(parser, required: bool) -> None:
-    """``--length L`` (a line contact) or ``--sphere`` (a round scar), one of them: the contact
-    whose wear volume :func:`ecofmaps.energy_wear` reads on a scar profile."""
+    """``--length L`` (a line contact) or ``--sphere`` (a round scar), for the wear volume."""
     option = option_adder(parser.add_mutually_exclusive_group(required=required), _CONTACT_HELP)
     option("--length", type=_length, metavar="L")
     option("--sphere", action="store_true")
@@ -349,8 +339,7 @@ def contact(args) -> str | None:
 
 
 def read_scar_file(path, command: str, x_unit=None, z_unit=None):
-    """The levelled profile in ``path``; what the reading decided printed on standard error as
-    a warning of ``command``, an error naming ``path``."""
+    """The levelled profile in ``path``, the reading's warnings printed as ``command``'s."""
     from ecofmaps.io.scar_profiles import read_scar_profile
 
     with warnings.catch_warnings(record=True) as caught:
@@ -367,11 +356,15 @@ def read_scar_file(path, command: str, x_unit=None, z_unit=None):
 
 def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=()) -> None:
     """Raise :class:`CommandError` unless the command may write its ``outputs`` and into its
-    ``folders`` (each (option, path or None)), the one rule: never over an input; over a file
-    only with ``overwrite`` if ecofmaps wrote it, unchanged since; into a folder holding
-    anything only with ``overwrite`` (:func:`ecofmaps.io.files.written_by_ecofmaps`)."""
+    ``folders`` (each (option, path or None)), the one rule: into an existing directory (a
+    ``folders`` one is made); never over an input; over a file only with ``overwrite`` if
+    ecofmaps wrote it, unchanged since; into a folder holding anything only with ``overwrite``."""
     outputs = [(option, Path(path)) for option, path in outputs if path is not None]
     sources = [Path(path) for path in inputs]
+    made = [option for option, _ in folders]
+    for option, target in outputs:
+        if option not in made and not target.parent.is_dir():
+            raise CommandError(f"cannot write {target} ({option}): its directory does not exist")
     for option, target in outputs:
         for source in sources:
             same = (
@@ -413,8 +406,8 @@ def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=())
 
 @contextlib.contextmanager
 def made_folder(folder: Path):
-    """Create ``folder`` and its missing parents for the block; if the block fails (a full
-    disk, an interrupt), remove those it created that are still empty, and only those."""
+    """Create ``folder`` and its parents for the block; if it fails, remove those it made
+    that are still empty."""
     missing = [path for path in (folder, *folder.parents) if not path.exists()]
     folder.mkdir(parents=True, exist_ok=True)
     try:
@@ -468,14 +461,13 @@ def print_rows(title: str, rows) -> None:
         print("" if item is None else f"  {item[0]:<32} {item[1]:<8} {item[2]}".rstrip())
 
 
-#: Width of the first value column when a profile's values stand beside the parabola's, and
-#: the header row over them (:func:`two_values`).
+#: Width of the profile's column beside the parabola's, and their header row (:func:`two_values`).
 _COLUMN = 18
 TWO_COLUMNS = ("", "", f"{'on the profile':<{_COLUMN}} parabola of the same D/W (eq. 11 shortcut)")
 
 
 def two_values(name: str, on_profile, on_parabola, note: str = "") -> tuple[str, str, str]:
-    """One row of :func:`ecofmaps.cli._common.row` with two values: profile, parabola."""
+    """One :func:`row` with two values: profile, parabola."""
     words, symbol, first = row(name, on_profile, note)
     return words, symbol, f"{first:<{_COLUMN}} {row(name, on_parabola)[2]}"
 

@@ -59,8 +59,6 @@ def run(args) -> int:
             f"cannot tell the format of {destination} from its suffix: use one of "
             f"{', '.join(WRITE_FORMATS)}"
         )
-    if not destination.parent.is_dir():
-        raise CommandError(f"cannot write {destination}: its directory does not exist")
     refuse_to_overwrite([("the destination", destination)], [source], overwrite=args.overwrite)
     options = recording_options(args)
     convert_recording(

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import sys
 import warnings
-from pathlib import Path
 
 from ecofmaps._version import __version__
 from ecofmaps.cli._common import (
@@ -79,8 +78,6 @@ def run(args) -> int:
         if given:
             options = ", ".join("--" + name.replace("_", "-") for name in given)
             raise CommandError(f"give a TABLE or one point's options, not both ({options})")
-        if args.out is not None and not Path(args.out).parent.is_dir():
-            raise CommandError(f"cannot write {args.out}: its directory does not exist")
         inputs = [path for path in (args.table, args.scar_profile) if path is not None]
         refuse_to_overwrite([("--out", args.out)], inputs, overwrite=args.overwrite)
         return _table(args, read_profile(args))

@@ -350,9 +350,6 @@ def _checked_inputs(args) -> tuple[list[Path], float]:
 def _checked_outputs(args, paths) -> list:
     """The command's outputs as ``(option, path)``, checked by :func:`refuse_to_overwrite`."""
     outputs = [("--out", args.out), ("--resolved", args.resolved), ("--report", args.report)]
-    for option, target in outputs:
-        if target is not None and not Path(target).parent.is_dir():
-            raise CommandError(f"cannot write {target} ({option}): its directory does not exist")
     if args.plots is not None:
         kinds = ("loops", "evolution") + (() if args.no_resolve else ("resolved",))
         kinds += ("closure",) if args.scar_profile is not None else ()

@@ -86,15 +86,9 @@ def _unknown_arguments(unknown, args) -> str:
     )
 
 
-#: Exit status of a run stopped by Ctrl-C (128 + SIGINT), as shells report it.
-EXIT_INTERRUPTED = 130
-
-#: Exit status of a run stopped by SIGTERM (128 + SIGTERM).
-EXIT_TERMINATED = 143
-
-#: Exit status once the reader of the output has gone (``| head``): 128 + SIGPIPE, as Unix
-#: tools end.
-EXIT_BROKEN_PIPE = 141
+#: Exit statuses (128 + the signal, as shells report them) of a run stopped by Ctrl-C, by
+#: SIGTERM, and once the reader of the output has gone (``| head``).
+EXIT_INTERRUPTED, EXIT_TERMINATED, EXIT_BROKEN_PIPE = 130, 143, 141
 
 
 def main(argv=None) -> int:

@@ -102,8 +102,6 @@ def run(args) -> int:
     from ecofmaps.maps.grid import compute_map
 
     out = Path(args.out)
-    if not out.parent.is_dir():
-        raise CommandError(f"cannot write {out}: the directory {out.parent} does not exist")
     refuse_to_overwrite([("--out", out)], [], overwrite=args.overwrite)
     axes = {name: getattr(args, name) for name in _AXES}
     grid = {name: values[0] if values.size == 1 else values for name, values in axes.items()}

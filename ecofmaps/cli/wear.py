@@ -6,8 +6,6 @@ and the transition to gross slip if they span it (:func:`ecofmaps.transition`, d
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from ecofmaps._nomenclature import TRANSITION
 from ecofmaps.cli._common import (
     CommandError,
@@ -91,8 +89,6 @@ def run(args) -> int:
     from ecofmaps.io.tables import csv_text, read_results
     from ecofmaps.lab import energy_wear, sliding_condition, transition
 
-    if args.out is not None and not Path(args.out).parent.is_dir():
-        raise CommandError(f"cannot write {args.out}: its directory does not exist")
     inputs = [*args.tables, *args.profile]
     refuse_to_overwrite([("--out", args.out)], inputs, overwrite=args.overwrite)
     tests = []

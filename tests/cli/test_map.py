@@ -158,7 +158,7 @@ def test_missing_directory_ends_with_one_line(tmp_path, capsys):
     out = tmp_path / "missing" / "x.nc"
     status, _, stderr = run(capsys, "map", *FIG11, "--out", str(out))
     assert status == 2
-    message = f"cannot write {out}: the directory {out.parent} does not exist"
+    message = f"cannot write {out} (--out): its directory does not exist"
     assert stderr == f"ecofmaps: error: {message}\n"
 
 
