@@ -11,11 +11,10 @@ def add(subparsers) -> None:
     parser = subparsers.add_parser(
         "cache",
         help="list or clear the cache of computed maps",
-        description="Computed maps are kept as netCDF files, one per grid and package version, in "
-        "the directory given by --cache-dir, else the ECOFMAPS_CACHE environment variable, else "
-        "the per-user cache directory. 'list' shows them with their sizes; 'clear' removes them "
-        "(with the kernels JAX compiled for ecofmaps figures, in its jax/ folder, and temporary "
-        "files of interrupted writes; other files are left alone).",
+        description="Computed maps are netCDF files, one per grid and package version, in "
+        "--cache-dir, else $ECOFMAPS_CACHE, else the per-user cache directory. 'list' shows "
+        "them with their sizes; 'clear' removes them, the kernels JAX compiled for ecofmaps "
+        "figures (jax/) and temporaries of interrupted writes (other files are left alone).",
     )
     actions = parser.add_subparsers(title="actions", metavar="ACTION", required=True)
     for name, text in (
@@ -28,8 +27,7 @@ def add(subparsers) -> None:
 
 
 def run(args) -> int:
-    """Run ``ecofmaps cache list`` or ``clear``: the cached maps with their sizes, or every
-    cached map removed; the exit status."""
+    """Run ``ecofmaps cache list`` or ``clear``; the exit status."""
     from ecofmaps.maps.cache import cache_directory, cache_entries, clear_cache
 
     directory = cache_directory(args.cache_dir)

@@ -32,12 +32,11 @@ def add(subparsers) -> None:
         subparsers,
         "convert",
         help="copy a recording (e.g. a large CSV file) into a chunked zarr, HDF5 or TDMS file",
-        description="Copy the displacement, force (and cycle) columns of a recording that "
-        "'ecofmaps loops' reads (text, TDMS, HDF5/netCDF-4, zarr) into a new file whose format is "
-        "given by its suffix: .zarr, .h5/.nc, .tdms or .csv. The samples are stored in SI "
-        "units (m, N) with their units, missing ones as NaN, a block at a time (memory "
-        "stays near a few blocks whatever the size), and DST appears only once complete. "
-        "A large text file converted once is read lazily, in parallel, by 'ecofmaps loops'.",
+        description="Copy the displacement, force (and cycle) columns of a recording 'ecofmaps "
+        "loops' reads (text, TDMS, HDF5/netCDF-4, zarr) into a file of the format its suffix "
+        "names: .zarr, .h5/.nc, .tdms or .csv; in SI units (m, N), missing samples NaN, a block "
+        "at a time (memory stays a few blocks), DST appearing once complete. A large text file "
+        "converted once is read lazily, in parallel, by 'ecofmaps loops'.",
         epilog="example:\n  ecofmaps convert test.csv test.zarr --displacement-unit um",
     )
     option = option_adder(parser, _HELP)

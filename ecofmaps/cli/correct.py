@@ -45,20 +45,18 @@ def add(subparsers) -> None:
     parser = subparsers.add_parser(
         "correct",
         help="correct reported ECoF values to the contact CoF (one point or a CSV table)",
-        description="Correct a reported energy coefficient of friction μ_E to the contact CoF μ "
-        "the model puts behind it, given the test's amplitude, load and rig stiffness and the wear "
-        "scar's depth over half-width z_o/x_o = D/W (eq. 11; x_o = Δ*). One point: --ecof "
-        "--amplitude --load --stiffness and --aspect-ratio (or --scar-depth and "
-        "--scar-half-width). A table: TABLE.csv with columns ecof, amplitude_um, load_N, "
+        description="Correct a reported energy CoF μ_E to the contact CoF μ behind it, given the "
+        "amplitude, load, rig stiffness and scar depth over half-width z_o/x_o = D/W (eq. 11; "
+        "x_o = Δ*). One point: --ecof --amplitude --load --stiffness and --aspect-ratio (or "
+        "--scar-depth and --scar-half-width). A TABLE: columns ecof, amplitude_um, load_N, "
         "stiffness_MN_per_m and aspect_ratio or scar_depth_um + scar_half_width_um, separated by "
-        "commas, semicolons (decimal commas allowed) or tabs, '#' lines skipped as comments; the "
-        "output, in the table's own separator, keeps every column and adds mu and "
-        "correction_factor. With --scar-profile FILE a measured wear-scar profile gives the scar "
-        "instead (of the point, or of every row of a table, which then has no scar columns), and "
-        "the parabola of the same D/W is given beside it (mu_parabolic in a table). A row that "
-        "cannot be corrected (a cell that is not a number, an ECoF no gross-slip loop gives) gets "
-        "NaN and its reason in a status column, with one error line naming the file, line (the "
-        "header is line 1) and column; the other rows are written, and the exit status is 1.",
+        "commas, semicolons (decimal commas allowed) or tabs, '#' lines skipped; the output, in "
+        "its separator, keeps every column and adds mu and correction_factor. --scar-profile "
+        "FILE: a measured scar instead (of the point, or every row of a table without scar "
+        "columns), beside the parabola of the same D/W (mu_parabolic in a table). A row that "
+        "cannot be corrected (a cell not a number, an ECoF no gross-slip loop gives) gets NaN, "
+        "its reason in a status column and an error line naming file, line (the header is 1) "
+        "and column; the other rows are written, exit status 1.",
     )
     option = option_adder(parser, _HELP)
     option("table", nargs="?", metavar="TABLE")

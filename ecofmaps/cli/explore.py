@@ -39,13 +39,13 @@ def add(subparsers) -> None:
     parser = subparsers.add_parser(
         "explore",
         help="explore the model in the browser: δ*, E_d, μ_E/μ, the loop, the map, a correction",
-        description="Serve a page at http://127.0.0.1:PORT/ (this machine only) where the "
-        "amplitude, load, rig stiffness, contact CoF and groove aspect ratio are typed with units "
-        "(50um, 450N, 35MN/m), and it shows at that point the slip amplitude, the dissipated "
-        "energy and μ_E/μ, the steady loop, the map of μ_E/μ over S/P and z_o/x_o with the point "
-        "marked, and the contact CoF behind an ECoF you type. The URL keeps the inputs "
-        "(?amplitude=50um&load=450N&stiffness=35MN/m&mu=0.8&aspect_ratio=0.2): share a view as a "
-        'link. Ctrl-C stops the server. Needs the extra web: pip install "ecofmaps[web]".',
+        description="Serve a page at http://127.0.0.1:PORT/ (this machine only): type the "
+        "amplitude, load, rig stiffness, contact CoF and groove aspect ratio with units (50um, "
+        "450N, 35MN/m); it shows there the slip amplitude, dissipated energy and μ_E/μ, the "
+        "steady loop, the map of μ_E/μ over S/P and z_o/x_o with the point, and the contact CoF "
+        "behind an ECoF you type. The URL keeps the inputs (?amplitude=50um&load=450N&"
+        "stiffness=35MN/m&mu=0.8&aspect_ratio=0.2): share a view as a link. Ctrl-C stops the "
+        'server. Needs pip install "ecofmaps[web]".',
     )
     option = option_adder(parser, _HELP)
     option("--port", type=_port, default=DEFAULT_PORT, metavar="N")
@@ -56,10 +56,8 @@ def add(subparsers) -> None:
 def run(args) -> int:
     if missing_web_packages():
         raise CommandError(INSTALL_WEB)
-    # Panel and Bokeh load only when the explorer runs (the command's lazy boundary), in a
-    # thread: a stop while they load (seconds) is acted on at once.
+    # Panel and Bokeh load in a thread: a stop while they load (seconds) is acted on at once
     server = interrupted_waiting(functools.partial(importlib.import_module, "ecofmaps.web.server"))
-
     announce = functools.partial(print, flush=True)  # the address at once, also in a pipe
     try:
         server.serve_explorer(

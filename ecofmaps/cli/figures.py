@@ -1,8 +1,7 @@
 """``ecofmaps figures``: the paper's figures, drawn by groups sharing one Dataset
 (:func:`ecofmaps.figures.figure_groups`), the costliest first, on ``--jobs`` processes, the
 parts of a costly Dataset (:func:`ecofmaps.figures.figure_parts`) computed in parallel before
-it; JAX keeps its compiled kernels in ``<cache>/jax`` for the run (never on importing the
-library)."""
+it; JAX keeps its compiled kernels in ``<cache>/jax`` for the run."""
 
 from __future__ import annotations
 
@@ -42,7 +41,7 @@ _HELP = {
 
 
 def _figure_formats(text: str) -> tuple[str, ...]:
-    """An argparse ``type`` reading a comma-separated list of figure file formats."""
+    """An argparse ``type``: comma-separated figure file formats."""
     formats = tuple(dict.fromkeys(item.strip().lower() for item in text.split(",")))
     unknown = [item for item in formats if item not in _FORMATS]
     if unknown or not formats:
@@ -69,13 +68,13 @@ def add(subparsers) -> None:
         "figures",
         help="write the paper's Figures 5-8 and 11, the universal map and the scar shapes "
         "(default: figures/)",
-        description="Write the paper's Figures 5, 6, 7a, 7b, 8, 11a, 11b, the universal map of the "
-        "ECoF ratio and the comparison of scar shapes at equal D/W (shapes), one file per figure "
-        "and format (fig5.png, ...). Parameters are the paper's: amplitude 50um (= groove "
-        "half-width), load 450N, stiffness 35MN/m, mu 0.8. Maps and loops are read from the cache "
-        "when there (see ECOFMAPS_CACHE) and stored there otherwise, with JAX's compiled kernels "
-        "in its jax/ folder; files are written atomically. Figures sharing their numbers are drawn "
-        "by one process, several processes at once (--jobs). Progress goes to stderr.",
+        description="Write the paper's Figures 5, 6, 7a, 7b, 8, 11a, 11b, the universal map of "
+        "the ECoF ratio and the scar shapes compared at equal D/W (shapes), a file per figure "
+        "and format (fig5.png, ...), with the paper's parameters: amplitude 50um (= groove "
+        "half-width), load 450N, stiffness 35MN/m, mu 0.8. Maps and loops are read from the "
+        "cache (ECOFMAPS_CACHE), else stored there, with JAX's compiled kernels in its jax/; "
+        "files are written atomically. Figures sharing their numbers are drawn by one process, "
+        "--jobs at once. Progress goes to stderr.",
         epilog=f"figures:\n{listing}",
     )
     only = f"write only these figures; NAME is one of: {', '.join(FIGURES)}"
@@ -89,7 +88,7 @@ def add(subparsers) -> None:
 
 def _set_jax_options(options: dict | None = None) -> dict:
     """Set JAX's ``options`` (default: cache every kernel, however quick); their values before."""
-    import jax  # the CLI's lazy boundary: other commands start without JAX
+    import jax
 
     if options is None:
         from ecofmaps.maps.cache import JAX_CACHE_FOLDER, cache_directory
@@ -107,7 +106,7 @@ def _set_jax_options(options: dict | None = None) -> dict:
 
 def _write_figure_group(names, directory, formats) -> list[tuple[str, list[Path], float]]:
     """Each figure of the group ``names`` drawn into ``directory``: its name, files, time [s]."""
-    from ecofmaps.figures import make_figures, save_figure  # the CLI's lazy boundary
+    from ecofmaps.figures import make_figures, save_figure
 
     written = []
     start = time.perf_counter()
@@ -130,39 +129,20 @@ def _in_worker(work, *arguments):
     try:
         with interrupts_stop_writes():  # SIGTERM from the parent: stop at a safe point
             return work(*arguments)
-    except KeyboardInterrupt:
-        # Its file was removed on the way out; end now, without drawing queued figures (and
-        # without tearing down JAX's threads, like the command itself: cli.main.console).
+    except KeyboardInterrupt:  # its file removed; end without JAX's teardown, as console does
         os._exit(128 + signal.SIGTERM)
 
 
 class TaskQueue:
     """The order of the parallel work: parts first, then groups, never more at once than
-    processes (``jobs``), so that a group whose parts are done is drawn next (it is the
-    costliest). A task is ``('part', index, callable)`` or ``('group', index, names)``.
-
-    Examples
-    --------
-    >>> queue = TaskQueue([["a"], ["b"], ["c"]], [["p", "q"], [], []], jobs=2)
-    >>> [task[2] for task in queue.started()]
-    ['p', 'q']
-    >>> [task[2] for task in queue.finished(("part", 0, "p"))]
-    [['b']]
-    >>> [task[2] for task in queue.finished(("part", 0, "q"))]
-    [['a']]
-    """
+    ``jobs``, a group whose parts are done drawn next (the costliest). A task is
+    ``('part', index, callable)`` or ``('group', index, names)``."""
 
     def __init__(self, groups, parts, jobs: int):
-        self.groups = groups
+        self.groups, self.jobs, self.running = groups, jobs, 0
         self.missing = [len(group_parts) for group_parts in parts]
-        self.ready = deque(
-            ("part", index, part) for index, group in enumerate(parts) for part in group
-        )
-        self.ready.extend(
-            ("group", index, group) for index, group in enumerate(groups) if not self.missing[index]
-        )
-        self.jobs = jobs
-        self.running = 0
+        self.ready = deque(("part", i, part) for i, group in enumerate(parts) for part in group)
+        self.ready.extend(("group", i, group) for i, group in enumerate(groups) if not parts[i])
 
     def started(self) -> list:
         """The tasks to start now, as many as there are idle processes."""
@@ -229,7 +209,7 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
 
 
 def _written_here(groups, out: Path, formats):
-    """Yield each group's :func:`_write_figure_group` result, drawn in this process."""
+    """Each group's :func:`_write_figure_group`, drawn in this process."""
     previous = _set_jax_options()
     try:
         for group in groups:
@@ -239,7 +219,7 @@ def _written_here(groups, out: Path, formats):
 
 
 def run(args) -> int:
-    from ecofmaps.figures.recipes import figure_groups, figure_parts  # the CLI's lazy boundary
+    from ecofmaps.figures.recipes import figure_groups, figure_parts
 
     names = list(dict.fromkeys(args.only or ())) or None
     groups, parts = figure_groups(names), figure_parts(names)

@@ -44,28 +44,27 @@ _HELP = {
     "--load": "normal load P, e.g. 450N; or the name of the recording's normal-load column "
     "(e.g. Fz), used sample by sample (required unless --example)",
     "--out": "CSV file to write (its directory must exist); default: print the table",
-    "--plots": "also write, per file, its loops with the line Q = SΔ (<name>_loops.png), the "
-    "ECoF and GICoF over the cycles (<name>_evolution.png) and the loops read along the "
-    "stroke (<name>_resolved.png) into DIR",
+    "--plots": "also write into DIR per file: loops with the line Q = SΔ (<name>_loops.png), ECoF "
+    "and GICoF over the cycles (<name>_evolution.png), loops read along the stroke "
+    "(<name>_resolved.png)",
     "--overwrite": "replace the outputs ecofmaps wrote before (--out, --resolved, the plots in "
     "--plots); a file or folder ecofmaps did not write is never replaced",
     "--resolved": "also write the loops read along the stroke (one FILE): μ(ξ), the groove "
     "slope g(ξ) and the felt profile h(ξ) over (cycle, position), a netCDF file",
-    "--report": "also write the results of one recording as one HTML page that opens offline: "
-    "the friction over the cycles with the quality flags, picked loops with the model's, the "
-    'table (needs pip install "ecofmaps[web]")',
+    "--report": "also write one recording's results as an offline HTML page: friction over the "
+    "cycles with quality flags, picked loops with the model's, the table (needs pip install "
+    '"ecofmaps[web]")',
     "--no-resolve": "skip the reading along the stroke (about ten times faster; no "
     "mu_resolved, mu_resolved_se, aspect_ratio)",
     "--flip-force": "read the force with the other sign (a rig recording it positive against "
     "the displacement: its loops run anticlockwise)",
-    "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m (the loops' stick slope is the rig "
-    "and the contact in series): the ratios also on the contact's displacement, the regime there, "
-    "a sweep's δ_t",
+    "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m (in series with the contact in the "
+    "stick slope): adds the ratios on the contact's displacement, the regime there, a sweep's δ_t",
     "--scar-profile": "the scar's profile after the test (x and z columns, in um unless their "
     "names say): the loop-scar closure of its last loop with a GICoF, printed, in the report "
     "and with --plots (<name>_closure.png); with --length or --sphere, its energy wear",
-    "--nan-policy": "a cycle with a missing sample (NaN or an empty cell) is skipped and counted "
-    "(skip, the default), or any missing sample stops the command naming its line",
+    "--nan-policy": "skip (default): a cycle with a missing sample (NaN, an empty cell) is skipped "
+    "and counted; raise: any missing sample stops the command naming its line",
     "--workers": "analyse out of core on a local dask cluster of N processes",
     "--scheduler": "analyse out of core on the dask cluster at ADDRESS (tcp://host:8786); its "
     "workers must have ecofmaps and see the files at the same paths",
@@ -81,18 +80,17 @@ def add(subparsers) -> None:
         "loops",
         help="analyse recorded fretting loops cycle by cycle: ECoF, GICoF, stiffness, ...",
         description="Read recordings of fretting loops (text with a header line in any common "
-        "dialect, TDMS, HDF5/netCDF-4 or zarr), cut them into cycles at the displacement reversals "
-        "or by a cycle column, check every loop, and write one row per cycle: cycle, amplitude_um, "
-        "slip_amplitude_um, normal_load_N (with a recorded load, --load COLUMN), max_force_N, "
+        "dialect, TDMS, HDF5/netCDF-4, zarr), cut them into cycles at the displacement reversals "
+        "or by a cycle column, check each loop, and write a row per cycle: cycle, amplitude_um, "
+        "slip_amplitude_um, normal_load_N (with --load COLUMN), max_force_N, "
         "dissipated_energy_mJ, ecof, cof_max, energy_ratio, stiffness_MN_per_m, gicof, regime, "
-        "then mu_resolved, mu_resolved_se and aspect_ratio (friction and groove read along the "
-        "whole stroke) and quality ('ok', or why values are NaN); first a file column when several "
-        "files are given. The columns are found by name as rigs write them (displacement, disp, "
-        "delta, stroke, ...; force, Fx, Ft, Q, friction, ...) with units from their names or the "
-        "file, else um and N, and an optional 'cycle'. With several files, one that cannot be "
-        "analysed is one error line naming it and the others are written (exit status 1); files "
-        "are written atomically and never over an input or a file ecofmaps did not write. "
-        "--example analyses the synthetic recording shipped with ecofmaps.",
+        "mu_resolved, mu_resolved_se, aspect_ratio (read along the whole stroke) and quality "
+        "('ok', or why values are NaN); first a file column for several files. Columns are found "
+        "by the names rigs write (displacement, disp, delta, stroke, ...; force, Fx, Ft, Q, "
+        "friction, ...; an optional 'cycle'), units from their names or the file, else um and N. "
+        "Of several files, one that cannot be analysed is an error line naming it, the others "
+        "are written (exit status 1). Files are written atomically, never over an input or a "
+        "file ecofmaps did not write.",
         epilog="examples:\n  ecofmaps loops test.csv --load 450N --out results.csv --plots plots\n"
         "  ecofmaps loops --example --out results.csv --plots plots",
     )
@@ -135,7 +133,7 @@ def _workers(text: str) -> int:
 
 
 def _load_or_column(text: str):
-    """``--load``: a load with its unit (a float, [N]), or the name of a column (a str)."""
+    """``--load``: a load [N] (a float), or the name of a column (a str)."""
     try:
         return quantity("load")(text)
     except argparse.ArgumentTypeError:
@@ -206,9 +204,7 @@ def _with_assumptions(message: str, recording) -> str:
     return message if not said else f"{message} Here {'; '.join(said)}."
 
 
-#: The variables of a recording's results that its summary lines read (:func:`_summary`,
-#: :func:`_lab_lines`): all that is kept of a long recording's results once their lines are
-#: written.
+#: The variables the summary lines read: all that is kept of a long recording's results.
 SUMMARY_VARIABLES = (
     *("regime", "gicof", "mu_resolved", "ecof", "quality", "amplitude"),
     *("max_force", "dissipated_energy", "normal_load"),
@@ -223,10 +219,8 @@ class _Table:
 
     def write(self, text: str) -> None:
         header, _, lines = text.partition("\n")
-        if not self.started:
-            self.stream.write(f"{header}\n")
-            self.started = True
-        self.stream.write(lines)
+        self.stream.write(lines if self.started else f"{header}\n{lines}")
+        self.started = True
         self.stream.flush()  # on disk as it comes: a block is a few MB
 
 
@@ -348,21 +342,16 @@ def _checked_inputs(args) -> tuple[list[Path], float]:
 
 
 def _checked_outputs(args, paths) -> list:
-    """The command's outputs as ``(option, path)``, checked by :func:`refuse_to_overwrite`."""
+    """The command's outputs as ``(option, path)``, checked."""
     outputs = [("--out", args.out), ("--resolved", args.resolved), ("--report", args.report)]
     if args.plots is not None:
         kinds = ("loops", "evolution") + (() if args.no_resolve else ("resolved",))
         kinds += ("closure",) if args.scar_profile is not None else ()
-        folder = Path(args.plots)
-        outputs += [
-            ("--plots", folder / f"{name}_{kind}.png")
-            for name in _plot_names(paths)
-            for kind in kinds
-        ]
+        names = _plot_names(paths)
+        outputs += [("--plots", Path(args.plots, f"{n}_{k}.png")) for n in names for k in kinds]
     inputs = [*paths, *([args.scar_profile] if args.scar_profile is not None else [])]
-    refuse_to_overwrite(
-        outputs, inputs, overwrite=args.overwrite, folders=[("--plots", args.plots)]
-    )
+    folders = [("--plots", args.plots)]
+    refuse_to_overwrite(outputs, inputs, overwrite=args.overwrite, folders=folders)
     return outputs
 
 
@@ -433,8 +422,7 @@ def _write_extras(args, done: list[_Analysed], lab: dict, closure) -> None:
 
 
 def run(args) -> int:
-    """Run ``ecofmaps loops`` with the parsed ``args``: 0, or 1 when some of several
-    recordings could not be analysed (each named in an error line; the others written)."""
+    """Run ``ecofmaps loops``: 0, or 1 when some of several recordings could not be analysed."""
     from ecofmaps.cli.loops_long import LongRun
 
     paths, load = _checked_inputs(args)

@@ -39,11 +39,10 @@ def add(subparsers) -> None:
     parser = subparsers.add_parser(
         "model",
         help="evaluate the model at one point (default: the paper's Example 2)",
-        description="Evaluate the compliant wear-scar interaction model at one point and print the "
-        "slip amplitude, peak force, dissipated energy, energy CoF and regime. Defaults are the "
-        "paper's Example 2: amplitude 50um, load 450N, stiffness 35MN/m, mu 0.8, aspect ratio 0.2. "
-        "With --scar-profile FILE the groove is a measured wear-scar profile instead, and the "
-        "parabola of the same depth over half-width D/W is printed beside it.",
+        description="Print the compliant wear-scar interaction model's slip amplitude, peak "
+        "force, dissipated energy, energy CoF and regime at one point (default: the paper's "
+        "Example 2). --scar-profile FILE: a measured wear-scar profile instead of the groove, "
+        "beside the parabola of the same depth over half-width D/W.",
     )
     option = option_adder(parser, _HELP)
     for name in ("amplitude", "load", "stiffness", "mu"):
@@ -54,8 +53,7 @@ def add(subparsers) -> None:
 
 
 def run(args) -> int:
-    """Run ``ecofmaps model`` with the parsed ``args``; the exit status. On a measured
-    profile, the values on the parabola of the same D/W (eq. 11) are printed beside."""
+    """Run ``ecofmaps model``; the exit status."""
     from ecofmaps import model
     from ecofmaps._codes import RegimeWarning
 

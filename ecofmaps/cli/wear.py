@@ -1,8 +1,5 @@
-"""``ecofmaps wear``: energy wear of fretting tests from their results tables (``ecofmaps
-loops --out``) and scar profiles: ΣE_d, the wear volume of a line contact or a sphere's round
-scar, α and Archard's k
-with the sliding condition; over three tests or more, α and E_th (:func:`ecofmaps.energy_wear`)
-and the transition to gross slip if they span it (:func:`ecofmaps.transition`, docs/lab.md)."""
+"""``ecofmaps wear``: energy wear of fretting tests from their ``ecofmaps loops --out`` tables
+and scar profiles (:func:`ecofmaps.energy_wear`, :func:`ecofmaps.transition`, docs/lab.md)."""
 
 from __future__ import annotations
 
@@ -26,11 +23,8 @@ __all__ = ["add", "run"]
 
 #: The per-test numbers, in the order printed and written.
 _WEAR = (
-    "cumulated_energy",
-    "wear_volume",
-    "energy_wear_coefficient",
-    "archard_slip",
-    "archard_nominal",
+    *("cumulated_energy", "wear_volume", "energy_wear_coefficient"),
+    *("archard_slip", "archard_nominal"),
 )
 
 _HELP = {
@@ -48,15 +42,14 @@ def add(subparsers) -> None:
     parser = subparsers.add_parser(
         "wear",
         help="energy wear coefficient and Archard's k from results tables and scar profiles",
-        description="Energy wear of fretting tests: for each test, the dissipated energy summed "
-        "over every cycle (a rig records every N-th), the wear volume (of a line contact the "
-        "scar's worn area times --length; of a sphere's round scar, --sphere, the volume of "
-        "revolution of the worn depth, both sides averaged; the pile-up apart), α = V/ΣE_d and "
-        "Archard's k on the slip and on the applied amplitude, each with its standard error, "
-        "and the sliding condition; over three tests or more, α and the threshold energy E_th "
-        "of V = α(ΣE_d - E_th), and the transition to gross slip Δ_t, δ_t and μ_t when they "
-        "span it (a last row 'campaign' of --out). One --profile per test, in the order of the "
-        "tests (a table of several recordings holds several tests).",
+        description="Per test: the dissipated energy summed over every cycle (a rig records "
+        "every N-th), the wear volume (a line contact: the worn area times --length; --sphere: "
+        "the revolution of the worn depth, both sides averaged; pile-up apart), α = V/ΣE_d, "
+        "Archard's k on the slip and on the applied amplitude, each ± its standard error, and "
+        "the sliding condition. Over three tests or more: α and E_th of V = α(ΣE_d - E_th), and "
+        "the transition to gross slip Δ_t, δ_t, μ_t if they span it (row 'campaign' of --out). "
+        "One --profile per test, in the tests' order (a table of several recordings holds "
+        "several tests).",
     )
     option = option_adder(parser, _HELP)
     option("tables", nargs="+", metavar="TABLE")
