@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ecofmaps._nomenclature import QUANTITIES, RANGES, texts_with_se, transition_texts, within
+from ecofmaps._nomenclature import QUANTITIES, RANGES, transition_texts, within
 from ecofmaps.cli.main import CommandError
 from ecofmaps.io.files import MANIFEST, written_by_ecofmaps
 from ecofmaps.units import (
@@ -46,7 +46,6 @@ __all__ = [
     "recording_options",
     "refuse_to_overwrite",
     "row",
-    "se_rows",
     "transition_rows",
     "two_values",
     "unit",
@@ -442,11 +441,6 @@ def row(name: str, value, note: str = "") -> tuple[str, str, str]:
         return words, quantity.symbol, "inf (rigid)"
     shown = f"{value * quantity.display_factor:.6g}"
     return words, quantity.symbol, f"{shown} {quantity.display_unit}".strip()
-
-
-def se_rows(found, names, quantity="{}") -> list:
-    """The printed rows of ``names`` (of ``quantity``), each value ± its standard error."""
-    return [row(q, text) for q, text in texts_with_se(found, names, quantity)]
 
 
 def transition_rows(found) -> list:

@@ -1,11 +1,9 @@
 """``ecofmaps loops`` on long tests: out of core, in parallel, resumable, with progress.
 
-A recording read lazily (a rig file of more than :data:`ecofmaps.io.recordings.LAZY_SAMPLES`
-samples, or any file with ``--workers``, ``--scheduler`` or ``--resume``) is analysed by
-:class:`ecofmaps.measured.pipeline.Analysis` on local threads, ``--workers`` processes or the
-cluster at ``--scheduler``, its lines written in order as the blocks come. With ``--out``, each
-block measured is kept as it completes in ``<out>.partial/``, so that a stop keeps what was
-finished and ``--resume`` goes on from it (docs/parallel.md).
+A recording read lazily (more than :data:`ecofmaps.io.recordings.LAZY_SAMPLES` samples, or
+``--workers``, ``--scheduler``, ``--resume``) is analysed on local threads, ``--workers``
+processes or the ``--scheduler`` cluster, its lines written in order as the blocks come; with
+``--out`` each block is kept in ``<out>.partial/`` for ``--resume`` (docs/parallel.md).
 """
 
 from __future__ import annotations
@@ -41,16 +39,12 @@ from ecofmaps.measured.pipeline import (
 from ecofmaps.measured.resolve import ReadingOptions
 from ecofmaps.measured.samples import MissingSampleError
 
-__all__ = ["MISSING", "PARTIAL_SUFFIX", "LongRun"]
-
-#: What a missing sample is, with ``--nan-policy raise`` (the file and line before it).
-MISSING = "missing sample (an empty cell or NaN)"
+__all__ = ["PARTIAL_SUFFIX", "LongRun"]
 
 #: Suffix of the folder that holds an unfinished run's blocks beside ``--out``.
 PARTIAL_SUFFIX = ".partial"
 
-#: The files of a run's ``.partial`` folder that hold its work (each file's cycles and
-#: finished blocks), and all the files it keeps there (with the run's record), as patterns.
+#: The files of a ``.partial`` folder holding work (cycles, blocks), and all it keeps there.
 _WORK = "file*.npz"
 _KEPT = (_WORK, "run.json", "kept.jsonl")
 
@@ -60,7 +54,6 @@ _RUNTIME = ("workers", "scheduler", "resume", "quiet", "out", "plots", "handler"
 
 def _checksums(path: Path) -> list:
     """[name, size, CRC-32] of a recording's file, or of every file of a store by its name."""
-    path = Path(path)
     files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
     sums = []
     for file in files:
@@ -75,7 +68,7 @@ def _checksums(path: Path) -> list:
 
 def _fingerprint(args, paths) -> dict:
     """What the run computes: the files' content as it is now and the options that matter."""
-    files = [[str(Path(path).resolve()), _checksums(path)] for path in paths]
+    files = [[str(path.resolve()), _checksums(path)] for path in paths]
     options = {
         key: value
         for key, value in sorted(vars(args).items())
@@ -127,13 +120,12 @@ class _Partial:
         return found
 
     def _record(self, path: Path, **entry) -> None:
-        """Record in the manifest the checksum of ``path`` just kept, with ``entry``."""
+        """Add the checksum of ``path`` just kept, with ``entry``, to the manifest."""
         entry["sha256"] = _sha256(path)
         with open(self.folder / "kept.jsonl", "a", encoding="utf-8") as lines:
             lines.write(json.dumps(entry) + "\n")
 
     def _refused(self, path: Path, reason: str) -> None:
-        """Say that the kept ``path`` is not used, and why; remove it."""
         print(f"ecofmaps loops: warning: {path} {reason}: it is measured again", file=sys.stderr)
         path.unlink(missing_ok=True)
 
@@ -159,12 +151,9 @@ class _Partial:
             for block in self.kept(index).values():
                 self._refused(block, "was measured on the cycles refused")
             return None
-        with np.load(path) as stored:
+        with np.load(path) as stored:  # the scalars as Python's
             fields = {f.name: stored[f.name] for f in dataclasses.fields(Cycles)}
-        fields["continuous"] = bool(fields["continuous"])
-        for name in ("incomplete_cycles", "dropped_samples", "missing_samples", "first_missing"):
-            fields[name] = int(fields[name])
-        return Cycles(**fields)
+        return Cycles(**{name: v.item() if v.ndim == 0 else v for name, v in fields.items()})
 
     def keep_cycles(self, index: int, cycles) -> None:
         path = self.folder / f"file{index}-cycles.npz"
@@ -176,7 +165,6 @@ class _Partial:
         return self.folder / f"file{index}-block"
 
     def record_block(self, index: int, block: int, rows: slice) -> None:
-        """Record in the manifest the block kept of file ``index`` and its cycle rows."""
         path = block_file(self.blocks(index), block)
         self._record(path, file=index, block=block, rows=[rows.start, rows.stop])
 
@@ -226,10 +214,8 @@ class _Partial:
 
 
 class LongRun:
-    """The recordings ``paths`` of one ``ecofmaps loops`` command with options ``args``
-    through the pipeline, what each chunk reads (:attr:`reading`) decided once. ``lazy`` is
-    for :func:`ecofmaps.read_recording`: True when a long run was asked for (``--workers``,
-    ``--scheduler``, ``--resume``), else None."""
+    """The recordings ``paths`` of one ``ecofmaps loops`` through the pipeline; ``lazy`` for
+    :func:`ecofmaps.read_recording`: True if ``--workers``, ``--scheduler`` or ``--resume``."""
 
     def __init__(self, args, paths):
         if args.workers and args.scheduler:
@@ -255,9 +241,8 @@ class LongRun:
         )
 
     def analyse(self, index, path, recording, load, write, columns):
-        """The results of recording ``index`` (the variables ``columns``, if given) and its
-        reading along the stroke if handed back; each chunk's lines (a header line first)
-        given to ``write`` in order."""
+        """The results of recording ``index`` (its ``columns`` if given) and its reading along
+        the stroke if handed back; each chunk's lines given to ``write`` in order."""
         args, runner = self.args, contextlib.nullcontext(IN_PROCESS)
         if recording.lazy:
             runner = runner_for("processes" if args.workers else args.scheduler, args.workers)
@@ -265,7 +250,6 @@ class LongRun:
         try:
             with runner as runner:  # a cluster that does not answer: nothing written
                 if recording.lazy and args.out is not None and self.partial is None:
-                    # the files' checksums are read only for this
                     self.partial = _Partial(args.out, _fingerprint(args, self.paths))
                     add_stop_note(self.stop_note)  # asked when the line is written
                 analysis, parts, resolved = _analyse(
@@ -279,7 +263,7 @@ class LongRun:
             note = self.stop_note()
             raise (stop if note is None else Interrupted(note)) from None
         except MissingSampleError as error:
-            what = error.what or MISSING
+            what = error.what or "missing sample (an empty cell or NaN)"
             raise recording.error(
                 f"{what}; --nan-policy skip {error.skips}", error.sample
             ) from None
@@ -287,8 +271,8 @@ class LongRun:
         return analysis.finish([parts.pop(k) for k in sorted(parts)]), resolved
 
     def stop_note(self) -> str | None:
-        """The sentence naming the folder a stop leaves beside ``--out`` as it is now, or None
-        (a folder this run made that holds no work yet is removed)."""
+        """The sentence naming the folder a stop leaves beside ``--out``, or None (one this run
+        made that holds no work yet is removed)."""
         partial = self.partial
         if partial is None or not partial.folder.exists():
             return None

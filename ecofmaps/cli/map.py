@@ -1,10 +1,5 @@
-"""``ecofmaps map``: the model over a grid of test conditions, into a netCDF file or zarr store.
-
-A grid of more than ``--chunk-points`` points, and any grid written to a zarr store, is
-computed block by block straight into the output (:func:`ecofmaps.maps.write_map`), with a
-progress bar on a terminal; a smaller one at once. The map's size is stated before any work,
-and a map that would not fit on the disk refused.
-"""
+"""``ecofmaps map``: the model over a grid of test conditions, into a netCDF file or zarr store
+(block by block through :func:`ecofmaps.maps.write_map` past ``--chunk-points`` or to zarr)."""
 
 from __future__ import annotations
 
@@ -61,21 +56,18 @@ def add(subparsers) -> None:
         subparsers,
         "map",
         help="compute the model over a grid of test conditions into a netCDF file or zarr store",
-        description="Compute the steady-loop quantities of the model (slip amplitude and slip "
-        "ratio, energy CoF and its ratio to mu, compliance ratio P/(S*amplitude), regime, and with "
-        "--load the dissipated energy and peak force) over a grid, and write them as an xarray "
-        "Dataset to a netCDF file, or to a zarr store if --out ends in .zarr (atomically; an "
-        "existing output is replaced only with --overwrite, if ecofmaps wrote it, and only once "
-        "the new one is complete). The map's size is printed first, and a map that would not fit "
-        "on the disk is refused. The groove half-width equals the amplitude, as in the paper. Each "
-        "of --stiffness-ratio, --aspect-ratio, --amplitude and --mu takes one value (a scalar "
-        "coordinate of the result), a comma-separated list or a range start:stop:num (num evenly "
-        "spaced points, both ends included); each list or range is a dimension, in this order. "
-        "Values take units (50um, 0.08/um, 450N); a bare number is SI. A grid of more than "
-        "--chunk-points points, and any zarr store, is computed block by block straight into the "
-        "output, with a few blocks in memory at a time (grids far beyond memory work), and a "
-        "progress bar on a terminal. The map is not cached: it computes faster than the cache "
-        "would read it back, and --out keeps it.",
+        description="Compute the model's steady-loop quantities (slip amplitude and ratio, energy "
+        "CoF and its ratio to mu, compliance ratio P/(S*amplitude), regime; with --load the "
+        "dissipated energy and peak force) over a grid into an xarray Dataset in a netCDF file, "
+        "or a zarr store if --out ends in .zarr, atomically. Its size is printed first; a map "
+        "that would not fit on the disk is refused. The groove half-width is the amplitude, as "
+        "in the paper. --stiffness-ratio, --aspect-ratio, --amplitude and --mu each take one "
+        "value (a scalar coordinate), a list a,b,c or a range start:stop:num (num points, both "
+        "ends included); each list or range is a dimension, in this order. Values take units "
+        "(50um, 0.08/um, 450N); a bare number is SI. A grid of more than --chunk-points points, "
+        "and any zarr store, is computed block by block into the output, a few blocks in memory "
+        "(grids far beyond memory work), with a progress bar on a terminal. The map is not "
+        "cached: it computes faster than the cache would read it, and --out keeps it.",
         epilog="example (the grid of Figure 11):\n  ecofmaps map "
         "--stiffness-ratio 0.01/um:0.3/um:30 --aspect-ratio 0:0.3:31 \\\n      --amplitude "
         "25um,50um --mu 0.8 --load 450N --out fig11.nc\n"
@@ -97,7 +89,7 @@ def add(subparsers) -> None:
 
 
 def run(args) -> int:
-    """Run ``ecofmaps map`` with the parsed ``args``; the exit status."""
+    """Run ``ecofmaps map``; the exit status."""
     from ecofmaps.maps.files import ZARR_SUFFIX
     from ecofmaps.maps.grid import compute_map
 
@@ -134,7 +126,7 @@ def _map_bytes(grid: dict, load) -> int:
     from ecofmaps.maps.grid import compute_map
 
     small = {name: values[:2] if np.ndim(values) else values for name, values in grid.items()}
-    sample = compute_map(**small, load=load, chunks=1)  # lazy: nothing computed
+    sample = compute_map(**small, load=load, chunks=1)
     sizes = {name: np.size(values) for name, values in grid.items() if np.ndim(values)}
     return sum(
         variable.dtype.itemsize * math.prod(sizes[dim] for dim in variable.dims)

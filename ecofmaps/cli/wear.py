@@ -3,7 +3,7 @@ and scar profiles (:func:`ecofmaps.energy_wear`, :func:`ecofmaps.transition`, do
 
 from __future__ import annotations
 
-from ecofmaps._nomenclature import TRANSITION
+from ecofmaps._nomenclature import TRANSITION, texts_with_se
 from ecofmaps.cli._common import (
     CommandError,
     add_contact_options,
@@ -13,7 +13,7 @@ from ecofmaps.cli._common import (
     quantity,
     read_scar_file,
     refuse_to_overwrite,
-    se_rows,
+    row,
     transition_rows,
     unit,
 )
@@ -102,13 +102,16 @@ def run(args) -> int:
         except ValueError as error:
             raise CommandError(f"{name}: {error}") from None
         slip = condition.attrs["sliding_condition"]
-        print_rows(f"{name} (scar profile {path}, {slip})", se_rows(wear, _WEAR))
+        rows = [row(q, text) for q, text in texts_with_se(wear, _WEAR)]
+        print_rows(f"{name} (scar profile {path}, {slip})", rows)
         line = {"test": str(name), "profile": str(path), "sliding_condition": str(slip)}
         table.append(line | _columns(wear, _WEAR))
     if len(tests) > 2:
         fit = energy_wear([r for _, r in tests], profiles, args.length, contact(args))
         names = ("campaign_energy_wear_coefficient", "threshold_energy")
-        print_rows("campaign: V = α(ΣE_d - E_th)", se_rows(fit, names))
+        print_rows(
+            "campaign: V = α(ΣE_d - E_th)", [row(q, t) for q, t in texts_with_se(fit, names)]
+        )
         try:
             found = transition([r for _, r in tests], rig_stiffness=args.rig_stiffness)
         except ValueError as error:
