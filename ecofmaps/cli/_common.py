@@ -17,13 +17,7 @@ import numpy as np
 from ecofmaps._nomenclature import QUANTITIES, RANGES, transition_texts, within
 from ecofmaps.cli.main import CommandError
 from ecofmaps.io.files import MANIFEST, written_by_ecofmaps
-from ecofmaps.units import (
-    DIMENSIONS,
-    DOMAIN,
-    bare_number_warning,
-    parse_quantity,
-    parse_values,
-)
+from ecofmaps.units import DIMENSIONS, DOMAIN, bare_number_warning, parse_quantity, parse_values
 
 __all__ = [
     "CACHE_DIR_HELP",

@@ -89,15 +89,12 @@ def run(args) -> int:
     title = f"ecofmaps {__version__}: reported ECoF corrected to the contact CoF"
     if profile is not None:  # beside the D/W shortcut (eq. 11)
         mu = float(correct_ecof(args.ecof, **rig, profile=profile, mapping=args.mapping))
-        shortcut, _ = correct_ecof(
+        shortcut, _ = correct_ecof(  # NaN (printed 'undefined') where the parabola cannot
             args.ecof, **rig, aspect_ratio=float(profile.aspect_ratio), return_status=True
         )
-        shortcut = float(shortcut)  # NaN (printed 'undefined') where the parabola cannot
-        rows += [*profile_rows(args, profile), None, TWO_COLUMNS]
-        rows += [
-            two_values("mu", mu, shortcut),
-            two_values("correction_factor", mu / args.ecof, shortcut / args.ecof),
-        ]
+        shortcut = float(shortcut)
+        rows += [*profile_rows(args, profile), None, TWO_COLUMNS, two_values("mu", mu, shortcut)]
+        rows.append(two_values("correction_factor", mu / args.ecof, shortcut / args.ecof))
         mapping = "X = x" if args.mapping == "physical" else "X = x W/Δ*, eq. 11"
         print_rows(f"{title} on a measured scar profile ({mapping})", rows)
         return 0

@@ -163,6 +163,12 @@ class TaskQueue:
         return self.started()
 
 
+def _call(task, out: Path, formats) -> tuple:
+    """The function and arguments of a :class:`TaskQueue` task."""
+    kind, _, work = task
+    return (work,) if kind == "part" else (_write_figure_group, work, out, formats)
+
+
 def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
     """Each group's :func:`_write_figure_group` from ``jobs`` processes (:class:`TaskQueue`)."""
     others = set(multiprocessing.active_children())
@@ -174,16 +180,11 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
     )
     queue = TaskQueue(groups, parts, jobs)
 
-    def submitted(tasks) -> dict:
-        futures = {}
-        for task in tasks:
-            kind, _, work = task
-            call = (work,) if kind == "part" else (_write_figure_group, work, out, formats)
-            futures[executor.submit(_in_worker, *call)] = task
-        return futures
+    def submitted(tasks) -> dict:  # each future: its task
+        return {executor.submit(_in_worker, *_call(task, out, formats)): task for task in tasks}
 
     try:
-        pending = submitted(queue.started())  # each future: its task
+        pending = submitted(queue.started())
         while pending:  # waits of a quarter second, so Ctrl-C is seen at once
             done, _ = wait(pending, timeout=0.25, return_when=FIRST_COMPLETED)
             check_interrupted()
@@ -194,8 +195,7 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
                 if task[0] == "group":
                     yield written
     finally:
-        # The drawing processes are stopped rather than left to tear JAX down (half a second
-        # when idle); a busy one stops at its next safe point, writing nothing.
+        # stopped, not left to tear JAX down; a busy one stops at a safe point, writing nothing
         executor.shutdown(wait=False, cancel_futures=True)
         ours = set(multiprocessing.active_children()) - others
         for process in ours:
@@ -203,9 +203,7 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
         for process in ours:
             process.join()
         executor.shutdown(wait=True)
-        # An interrupt's traceback keeps this frame: its queues' semaphores are released now
-        # (else multiprocessing's resource tracker prints a line about them after ours).
-        executor = None
+        executor = None  # an interrupt's traceback keeps the frame: its semaphores released now
 
 
 def _written_here(groups, out: Path, formats):

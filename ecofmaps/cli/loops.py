@@ -149,10 +149,7 @@ def _load_or_column(text: str):
 def _plot_names(paths) -> list[str]:
     """A distinct file-name stem for each recording's plots."""
     stems = [path.stem for path in paths]
-    return [
-        stem if stems.count(stem) == 1 else f"{stem}_{index}"
-        for index, stem in enumerate(stems, start=1)
-    ]
+    return [s if stems.count(s) == 1 else f"{s}_{i}" for i, s in enumerate(stems, start=1)]
 
 
 #: The options that need what a long recording analysed out of core does not keep.

@@ -263,10 +263,8 @@ class LongRun:
             note = self.stop_note()
             raise (stop if note is None else Interrupted(note)) from None
         except MissingSampleError as error:
-            what = error.what or "missing sample (an empty cell or NaN)"
-            raise recording.error(
-                f"{what}; --nan-policy skip {error.skips}", error.sample
-            ) from None
+            what = f"{error.what or 'missing sample (an empty cell or NaN)'}; --nan-policy skip"
+            raise recording.error(f"{what} {error.skips}", error.sample) from None
         self.analysed = (index, path, len(analysis.tasks))
         return analysis.finish([parts.pop(k) for k in sorted(parts)]), resolved
 

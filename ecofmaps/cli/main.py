@@ -65,10 +65,9 @@ def build_parser() -> argparse.ArgumentParser:
     for name in _COMMANDS:
         module = importlib.import_module(f"ecofmaps.cli.{name}")
         module.add(subparsers)
-        subparsers.choices[name].set_defaults(handler=module.run)
-    for command in subparsers.choices.values():  # for an unknown argument's error
-        options = [o for action in command._actions for o in action.option_strings]
-        command.set_defaults(command_prog=command.prog, command_options=options)
+        command = subparsers.choices[name]
+        options = [o for action in command._actions for o in action.option_strings]  # did you mean
+        command.set_defaults(handler=module.run, command_prog=command.prog, command_options=options)
     return parser
 
 
@@ -180,8 +179,7 @@ def _warning_line(command: str):
     """A ``warnings.showwarning`` that prints ``<command>: warning: <message>`` on one line."""
 
     def show(message, category, filename, lineno, file=None, line=None) -> None:
-        text = " ".join(str(message).strip().splitlines())
-        print(f"{command}: warning: {text}", file=sys.stderr)
+        print(f"{command}: warning: {' '.join(str(message).strip().splitlines())}", file=sys.stderr)
 
     return show
 
