@@ -19,32 +19,6 @@ from ecofmaps.cli.main import CommandError
 from ecofmaps.io.files import MANIFEST, written_by_ecofmaps
 from ecofmaps.units import DIMENSIONS, DOMAIN, bare_number_warning, parse_quantity, parse_values
 
-__all__ = [
-    "CACHE_DIR_HELP",
-    "TWO_COLUMNS",
-    "CommandError",
-    "add_contact_options",
-    "add_profile_options",
-    "add_recording_options",
-    "byte_size",
-    "command_parser",
-    "contact",
-    "count",
-    "made_folder",
-    "option_adder",
-    "print_rows",
-    "profile_rows",
-    "quantity",
-    "read_profile",
-    "read_scar_file",
-    "recording_options",
-    "refuse_to_overwrite",
-    "row",
-    "transition_rows",
-    "two_values",
-    "unit",
-]
-
 
 def quantity(name: str, grid: bool = False, option: str | None = None):
     """An argparse ``type`` reading quantity ``name`` [SI] with units (``grid``: ``a,b,c`` or
@@ -136,8 +110,7 @@ _RECORDING_HELP = {
     "--force-col": "name of the tangential force column (default: force)",
     "--cycle-col": "name of a column of cycle numbers, which must exist (default: 'cycle' if "
     "the file has it; else, or with 'none', cycles are cut at the reversals)",
-    "--skip-rows": "lines of a text file to skip before its header line (default: metadata "
-    "lines before the header are found)",
+    "--skip-rows": "lines before a text file's header to skip (default: found as metadata)",
     "--displacement-unit": "unit of the displacement column (default: the one its name or the "
     "file gives, as in 'displacement [mm]' or a channel's unit, else um)",
     "--force-unit": "unit of the force column (default: from its name or the file, else N)",
@@ -199,10 +172,8 @@ _PROFILE_HELP = {
     "--x-unit": "unit of the positions (default: the one the column's name gives, else um)",
     "--z-unit": "unit of the heights (default: the one the column's name gives, else um)",
     "--no-level": "keep the trace's tilt and offset (default: level it on the unworn shoulders)",
-    "--profile-half-width": "the scar's half-width W, e.g. 500um (default: the one detected at "
-    "the edges)",
-    "--smoothing": "length over which the slopes are smoothed, e.g. 10um; 0 for none (default: "
-    "2%% of the half-width)",
+    "--profile-half-width": "the scar's half-width W, e.g. 500um (default: detected at the edges)",
+    "--smoothing": "length the slopes are smoothed over, e.g. 10um, 0 for none (default: 2%% of W)",
     "--mapping": "where the pad at slip position x sits on the profile: 'scaled', X = x W/x_o "
     "(eq. 11, the paper's; default), or 'physical', X = x",
 }

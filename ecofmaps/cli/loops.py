@@ -68,8 +68,7 @@ _HELP = {
     "--workers": "analyse out of core on a local dask cluster of N processes",
     "--scheduler": "analyse out of core on the dask cluster at ADDRESS (tcp://host:8786); its "
     "workers must have ecofmaps and see the files at the same paths",
-    "--resume": "continue an interrupted run from the blocks kept in <out>.partial/ (needs "
-    "--out and the same files and options)",
+    "--resume": "continue a stopped run from <out>.partial/ (the same --out, files and options)",
     "--quiet": "no progress bar (none is shown off a terminal)",
 }
 

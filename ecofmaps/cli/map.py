@@ -38,10 +38,8 @@ _HELP = {
     "--amplitude": "displacement amplitude Δ* [m], e.g. 25um,50um" + _GRID_HELP,
     "--mu": "contact coefficient of friction μ (> 0)" + _GRID_HELP,
     "--load": "normal load P [N], one value; adds dissipated_energy [J] and max_force [N]",
-    "--out": "netCDF file, or zarr store if the name ends in .zarr, to write (its directory must "
-    "exist)",
-    "--overwrite": "replace --out if it exists and ecofmaps wrote it (once the new map is "
-    "complete)",
+    "--out": "netCDF file, or zarr store if it ends in .zarr, to write (its directory must exist)",
+    "--overwrite": "replace --out if ecofmaps wrote it (once the new map is complete)",
     "--chunk-points": f"grid points per block (default {_CHUNK_POINTS}); a larger grid is "
     "computed block by block into --out",
     "--quiet": "no progress bar (there is none either when standard error is not a terminal)",
@@ -90,8 +88,9 @@ def add(subparsers) -> None:
 
 def run(args) -> int:
     """Run ``ecofmaps map``; the exit status."""
-    from ecofmaps.maps.files import ZARR_SUFFIX
+    from ecofmaps.maps.files import ZARR_SUFFIX, write_map
     from ecofmaps.maps.grid import compute_map
+    from ecofmaps.model import Regime
 
     out = Path(args.out)
     refuse_to_overwrite([("--out", out)], [], overwrite=args.overwrite)
@@ -118,7 +117,21 @@ def run(args) -> int:
         dataset = compute_map(
             **grid, load=args.load, cache=False if args.no_cache else None, cache_dir=args.cache_dir
         )
-    return _write(dataset, out, shown=chunked and not args.quiet and sys.stderr.isatty())
+    summary = [(dataset.regime == code).sum().data for code in Regime]
+    summary += [dataset.ecof_ratio.min().data, dataset.ecof_ratio.max().data]
+    shown = chunked and not args.quiet and sys.stderr.isatty()  # a progress bar
+    with _progress(dataset) if shown else contextlib.nullcontext():
+        *counts, low, high = write_map(dataset, out, also=summary)
+    record_written([out])
+    shape = " x ".join(f"{size} {dim}" for dim, size in dataset.sizes.items()) or "1 point"
+    regimes = ", ".join(
+        f"{code.label} {int(n)}" for code, n in zip(Regime, counts, strict=True) if n
+    )
+    print(f"wrote {out}: {shape}")
+    print(f"  regimes: {regimes}")
+    if math.isfinite(low := float(low)):  # NaN-skipping
+        print(f"  ECoF / contact CoF: {low:.6g} to {float(high):.6g}")
+    return 0
 
 
 def _map_bytes(grid: dict, load) -> int:
@@ -132,27 +145,6 @@ def _map_bytes(grid: dict, load) -> int:
         variable.dtype.itemsize * math.prod(sizes[dim] for dim in variable.dims)
         for variable in sample.variables.values()
     )
-
-
-def _write(dataset, out: Path, shown: bool) -> int:
-    """Write ``dataset`` to ``out`` (a progress bar if ``shown``); print what was written."""
-    from ecofmaps.maps.files import write_map
-    from ecofmaps.model import Regime
-
-    summary = [(dataset.regime == code).sum().data for code in Regime]
-    summary += [dataset.ecof_ratio.min().data, dataset.ecof_ratio.max().data]
-    with _progress(dataset) if shown else contextlib.nullcontext():
-        *counts, low, high = write_map(dataset, out, also=summary)
-    record_written([out])
-    shape = " x ".join(f"{size} {dim}" for dim, size in dataset.sizes.items()) or "1 point"
-    regimes = ", ".join(
-        f"{code.label} {int(n)}" for code, n in zip(Regime, counts, strict=True) if n
-    )
-    print(f"wrote {out}: {shape}")
-    print(f"  regimes: {regimes}")
-    if math.isfinite(low := float(low)):  # NaN-skipping
-        print(f"  ECoF / contact CoF: {low:.6g} to {float(high):.6g}")
-    return 0
 
 
 @contextlib.contextmanager
