@@ -18,9 +18,8 @@ DEFAULT_PORT = 5006
 _HELP = {
     "--port": f"the port to listen on (default {DEFAULT_PORT})",
     "--no-browser": "do not open the page in a browser",
-    "--allow-origin": "also answer pages of this host (a tunnel or proxy's name; without a port, "
-    "--port's); by default only 127.0.0.1 and localhost at --port, and any other Host "
-    "or Origin gets 403 (repeat the option for more hosts)",
+    "--allow-origin": "also answer this host (a tunnel's or proxy's; without a port, --port's), "
+    "repeatable; by default only 127.0.0.1 and localhost at --port: any other Host or Origin 403",
 }
 
 

@@ -44,16 +44,14 @@ _HELP = {
     "--load": "normal load P, e.g. 450N; or the name of the recording's normal-load column "
     "(e.g. Fz), used sample by sample (required unless --example)",
     "--out": "CSV file to write (its directory must exist); default: print the table",
-    "--plots": "also write into DIR per file: loops with the line Q = SΔ (<name>_loops.png), ECoF "
-    "and GICoF over the cycles (<name>_evolution.png), loops read along the stroke "
-    "(<name>_resolved.png)",
+    "--plots": "also write into DIR per file: loops with Q = SΔ (<name>_loops.png), ECoF and "
+    "GICoF over the cycles (<name>_evolution.png), loops along the stroke (<name>_resolved.png)",
     "--overwrite": "replace the outputs ecofmaps wrote before (--out, --resolved, the plots in "
     "--plots); a file or folder ecofmaps did not write is never replaced",
     "--resolved": "also write the loops read along the stroke (one FILE): μ(ξ), the groove "
     "slope g(ξ) and the felt profile h(ξ) over (cycle, position), a netCDF file",
-    "--report": "also write one recording's results as an offline HTML page: friction over the "
-    "cycles with quality flags, picked loops with the model's, the table (needs pip install "
-    '"ecofmaps[web]")',
+    "--report": "also write one recording as an offline HTML page: friction and quality flags "
+    'per cycle, picked loops with the model\'s, the table (needs pip install "ecofmaps[web]")',
     "--no-resolve": "skip the reading along the stroke (about ten times faster; no "
     "mu_resolved, mu_resolved_se, aspect_ratio)",
     "--flip-force": "read the force with the other sign (a rig recording it positive against "
@@ -109,14 +107,12 @@ def add(subparsers) -> None:
     add_contact_options(parser, required=False)
     option("--nan-policy", choices=("skip", "raise"), default="skip")
     add_recording_options(parser)
-    option = option_adder(
-        parser.add_argument_group(
-            "long tests",
-            "a rig file of more than 2**24 samples is analysed out of core, a block of whole "
-            "cycles at a time (the numbers are those of the analysis in memory)",
-        ),
-        _HELP,
+    long_tests = parser.add_argument_group(
+        "long tests",
+        "a rig file of more than 2**24 samples is analysed out of core, a block of whole cycles "
+        "at a time (the numbers are those of the analysis in memory)",
     )
+    option = option_adder(long_tests, _HELP)
     option("--workers", type=_workers, metavar="N")
     option("--scheduler", metavar="ADDRESS")
     option("--resume", action="store_true")
@@ -290,10 +286,9 @@ def _lab_lines(results, rig_stiffness) -> list[str]:
     from ecofmaps.lab import transition
     from ecofmaps.lab.wear import cumulated_energy
 
-    cycle = results["cycle"].values.astype(np.float64)
     try:
         energy = with_se("cumulated_energy", *cumulated_energy(results))
-        lines = [f"ΣE_d = {energy} over cycles 1 to {cycle[-1]:.0f}"]
+        lines = [f"ΣE_d = {energy} over cycles 1 to {float(results['cycle'][-1]):.0f}"]
     except ValueError as error:
         lines = [f"ΣE_d: {error}"]
     try:

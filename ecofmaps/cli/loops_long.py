@@ -297,7 +297,6 @@ def _analyse(run, index, path, recording, load, runner, write, columns):
     if isinstance(load, str):  # the load recorded sample by sample (--load COLUMN)
         force, load = force_at_mean_load(force, recording.load)
         recorded = recording.load
-    options = LoopOptions(load, flip_force=args.flip_force, rig_stiffness=args.rig_stiffness)
     shown = recording.lazy and not args.quiet and sys.stderr.isatty()
     if shown:
         print(f"{path.name}: finding the cycles of {recording.size} samples", file=sys.stderr)
@@ -305,7 +304,7 @@ def _analyse(run, index, path, recording, load, runner, write, columns):
         recording.displacement,
         force,
         recording.cycle,
-        options=options,
+        options=LoopOptions(load, flip_force=args.flip_force, rig_stiffness=args.rig_stiffness),
         recorded_load=recorded,
         runner=runner,
         nan_policy=args.nan_policy,
