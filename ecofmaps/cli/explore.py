@@ -19,7 +19,7 @@ _HELP = {
     "--port": f"the port to listen on (default {DEFAULT_PORT})",
     "--no-browser": "do not open the page in a browser",
     "--allow-origin": "also answer this host (a tunnel's or proxy's; without a port, --port's), "
-    "repeatable; by default only 127.0.0.1 and localhost at --port: any other Host or Origin 403",
+    "repeatable; by default only 127.0.0.1 and localhost at --port, others (Host, Origin) get 403",
 }
 
 

@@ -1,10 +1,9 @@
 """The ``ecofmaps`` command: its parser, and the run of one subcommand.
 
-Each subcommand is one module of :mod:`ecofmaps.cli` with ``add(subparsers)``, which declares
-its options, and ``run(args)``, which does the work through the public API and imports JAX,
-xarray, numba, dask and matplotlib only then, so that ``--help`` answers at once. Quantities
-are read with units (``50um``, ``35MN/m``); a bare number is SI. Errors in the input end the
-command with exit status 2 and a one-line message, never a traceback.
+Each subcommand is a module of :mod:`ecofmaps.cli`: ``add(subparsers)`` declares its options,
+``run(args)`` works through the public API, importing JAX, xarray, numba, dask and matplotlib
+only then (``--help`` answers at once). Quantities take units (``50um``); a bare number is SI.
+Errors in the input end with exit status 2 and one line, never a traceback.
 """
 
 from __future__ import annotations

@@ -32,7 +32,7 @@ _GRID_HELP = "; one value, a list or a range start:stop:num"
 #: Default of --chunk-points: blocks of 2**22 points (about 220 MB of results with a load).
 _CHUNK_POINTS = 2**22
 _HELP = {
-    "--stiffness-ratio": "rig stiffness over normal load S/P [1/m], 'inf' for a rigid rig"
+    "--stiffness-ratio": "rig stiffness over normal load S/P [1/m], inf for a rigid rig"
     + _GRID_HELP,
     "--aspect-ratio": "groove depth over half-width z_o/x_o (>= 0)" + _GRID_HELP,
     "--amplitude": "displacement amplitude Δ* [m], e.g. 25um,50um" + _GRID_HELP,
@@ -40,11 +40,10 @@ _HELP = {
     "--load": "normal load P [N], one value; adds dissipated_energy [J] and max_force [N]",
     "--out": "netCDF file, or zarr store if it ends in .zarr, to write (its directory must exist)",
     "--overwrite": "replace --out if ecofmaps wrote it (once the new map is complete)",
-    "--chunk-points": f"grid points per block (default {_CHUNK_POINTS}); a larger grid is "
-    "computed block by block into --out",
+    "--chunk-points": f"points per block (default {_CHUNK_POINTS}); a larger grid is computed "
+    "block by block into --out",
     "--quiet": "no progress bar (there is none either when standard error is not a terminal)",
-    "--no-cache": "do not read or store the result in the cache (a map of the parabolic groove "
-    "is not cached anyway: kept for scripts that give it)",
+    "--no-cache": "do not use the cache (no map of the parabolic groove is cached: for scripts)",
     "--cache-dir": CACHE_DIR_HELP,
 }
 
@@ -59,13 +58,12 @@ def add(subparsers) -> None:
         "dissipated energy and peak force) over a grid into an xarray Dataset in a netCDF file, "
         "or a zarr store if --out ends in .zarr, atomically. Its size is printed first; a map "
         "that would not fit on the disk is refused. The groove half-width is the amplitude, as "
-        "in the paper. --stiffness-ratio, --aspect-ratio, --amplitude and --mu each take one "
-        "value (a scalar coordinate), a list a,b,c or a range start:stop:num (num points, both "
-        "ends included); each list or range is a dimension, in this order. Values take units "
-        "(50um, 0.08/um, 450N); a bare number is SI. A grid of more than --chunk-points points, "
-        "and any zarr store, is computed block by block into the output, a few blocks in memory "
-        "(grids far beyond memory work), with a progress bar on a terminal. The map is not "
-        "cached: it computes faster than the cache would read it, and --out keeps it.",
+        "in the paper. Of the grid options, one value is a scalar coordinate, a list a,b,c or a "
+        "range start:stop:num (num points, both ends included) a dimension, in this order. "
+        "Values take units (50um, 0.08/um, 450N); a bare number is SI. A zarr store, or more "
+        "than --chunk-points points, is computed block by block, a few in memory (grids far "
+        "beyond memory work). The map is not cached: it computes faster than the cache would "
+        "read it, and --out keeps it.",
         epilog="example (the grid of Figure 11):\n  ecofmaps map "
         "--stiffness-ratio 0.01/um:0.3/um:30 --aspect-ratio 0:0.3:31 \\\n      --amplitude "
         "25um,50um --mu 0.8 --load 450N --out fig11.nc\n"

@@ -61,10 +61,10 @@ def run(args) -> int:
     rig = dict(amplitude=args.amplitude, load=args.load, stiffness=args.stiffness, mu=args.mu)
     rows = [row(name, value) for name, value in rig.items()]
     point = dict(rig, groove_half_width=args.groove_half_width)
+    x_o = args.groove_half_width or args.amplitude
     if profile is None:
         ratio = paper.EXAMPLE_2["aspect_ratio"] if args.aspect_ratio is None else args.aspect_ratio
         points = [dict(point, aspect_ratio=ratio)]
-        x_o = args.groove_half_width or args.amplitude
         rows += [row("aspect_ratio", ratio), row("groove_half_width", x_o), None]
         show, title = row, ""
     else:
@@ -73,19 +73,16 @@ def run(args) -> int:
             # the paper's shortcut z_o/x_o = D/W (eq. 11), x_o as given whatever the mapping
             dict(point, aspect_ratio=float(profile.aspect_ratio)),
         ]
+        mapping = f"X = x W/x_o, x_o = {x_o * 1e6:.6g} µm (eq. 11)"
         if args.mapping == "physical":
             mapping = "X = x (physical)"
-        else:
-            x_o = args.groove_half_width or args.amplitude
-            mapping = f"X = x W/x_o, x_o = {x_o * 1e6:.6g} µm (eq. 11)"
         rows += [*profile_rows(args, profile), ("position on the profile", "X", mapping), None]
         rows.append(TWO_COLUMNS)
         show, title = two_values, " on a measured scar profile"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RegimeWarning)
-        rows.append(
-            show("regime", *(model.Regime(int(model.slip_regime(**p))).label for p in points))
-        )
+        regimes = [model.Regime(int(model.slip_regime(**p))).label for p in points]
+        rows.append(show("regime", *regimes))
         values = {name: [float(getattr(model, name)(**p)) for p in points] for name in _RESULTS}
     ecof = values.pop("energy_cof")
     rows += [show(name, *value) for name, value in values.items()]
