@@ -329,7 +329,6 @@ def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=())
     for option, target in outputs:
         if option not in made and not target.parent.is_dir():
             raise CommandError(f"cannot write {target} ({option}): its directory does not exist")
-    for option, target in outputs:
         for source in sources:
             same = (
                 os.path.samefile(source, target)

@@ -108,8 +108,7 @@ def _write_figure_group(names, directory, formats) -> list[tuple[str, list[Path]
     """Each figure of the group ``names`` drawn into ``directory``: its name, files, time [s]."""
     from ecofmaps.figures import make_figures, save_figure
 
-    written = []
-    start = time.perf_counter()
+    written, start = [], time.perf_counter()
     for name, figure in make_figures(names):
         paths = [save_figure(figure, Path(directory) / f"{name}.{suffix}") for suffix in formats]
         now = time.perf_counter()
@@ -146,11 +145,9 @@ class TaskQueue:
 
     def started(self) -> list:
         """The tasks to start now, as many as there are idle processes."""
-        tasks = []
-        while self.ready and self.running < self.jobs:
-            tasks.append(self.ready.popleft())
-            self.running += 1
-        return tasks
+        idle = min(len(self.ready), self.jobs - self.running)
+        self.running += idle
+        return [self.ready.popleft() for _ in range(idle)]
 
     def finished(self, task) -> list:
         """The tasks to start once ``task`` has finished."""
