@@ -10,13 +10,10 @@ from ecofmaps._interrupts import interrupted_waiting
 from ecofmaps.cli._common import CommandError, option_adder
 from ecofmaps.web import INSTALL_WEB, missing_web_packages
 
-__all__ = ["DEFAULT_PORT", "add", "run"]
-
-#: The port the explorer listens on unless --port says otherwise.
-DEFAULT_PORT = 5006
+__all__ = ["add", "run"]
 
 _HELP = {
-    "--port": f"the port to listen on (default {DEFAULT_PORT})",
+    "--port": "the port to listen on (default %(default)s)",
     "--no-browser": "do not open the page in a browser",
     "--allow-origin": "also answer this host (a tunnel's or proxy's; without a port, --port's), "
     "repeatable; by default only 127.0.0.1 and localhost at --port, others (Host, Origin) get 403",
@@ -47,7 +44,7 @@ def add(subparsers) -> None:
         'server. Needs pip install "ecofmaps[web]".',
     )
     option = option_adder(parser, _HELP)
-    option("--port", type=_port, default=DEFAULT_PORT, metavar="N")
+    option("--port", type=_port, default=5006, metavar="N")
     option("--no-browser", action="store_true")
     option("--allow-origin", action="append", default=[], metavar="HOST[:PORT]")
 

@@ -29,8 +29,6 @@ __all__ = ["add", "run"]
 #: The grid's axes, in the order of the map's dimensions, and their metavars.
 _AXES = {"stiffness_ratio": "S/P", "aspect_ratio": "Z/X", "amplitude": "DELTA", "mu": "MU"}
 _GRID_HELP = "; one value, a list or a range start:stop:num"
-#: Default of --chunk-points: blocks of 2**22 points (about 220 MB of results with a load).
-_CHUNK_POINTS = 2**22
 _HELP = {
     "--stiffness-ratio": "rig stiffness over normal load S/P [1/m], inf for a rigid rig"
     + _GRID_HELP,
@@ -40,7 +38,7 @@ _HELP = {
     "--load": "normal load P [N], one value; adds dissipated_energy [J] and max_force [N]",
     "--out": "netCDF file, or zarr store if it ends in .zarr, to write (its directory must exist)",
     "--overwrite": "replace --out if ecofmaps wrote it (once the new map is complete)",
-    "--chunk-points": f"points per block (default {_CHUNK_POINTS}); a larger grid is computed "
+    "--chunk-points": "grid points per block (default %(default)s); a larger grid is computed "
     "block by block into --out",
     "--quiet": "no progress bar (there is none either when standard error is not a terminal)",
     "--no-cache": "do not use the cache (no map of the parabolic groove is cached: for scripts)",
@@ -78,7 +76,8 @@ def add(subparsers) -> None:
     option("--load", type=quantity("load"), metavar="P")
     option("--out", required=True, metavar="FILE.nc|FILE.zarr")
     option("--overwrite", action="store_true")
-    option("--chunk-points", type=count("points"), default=_CHUNK_POINTS, metavar="N")
+    # blocks of 2**22 points by default: about 220 MB of results with a load
+    option("--chunk-points", type=count("points"), default=2**22, metavar="N")
     option("--quiet", action="store_true")
     option("--no-cache", action="store_true")
     option("--cache-dir", metavar="DIR")
