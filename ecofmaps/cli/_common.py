@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ecofmaps._nomenclature import QUANTITIES, RANGES, transition_texts, within
+from ecofmaps._nomenclature import QUANTITIES, RANGES, within
 from ecofmaps.cli.main import CommandError
 from ecofmaps.io.files import MANIFEST, written_by_ecofmaps
 from ecofmaps.units import DIMENSIONS, DOMAIN, bare_number_warning, parse_quantity, parse_values
@@ -405,11 +405,6 @@ def row(name: str, value, note: str = "") -> tuple[str, str, str]:
         return words, quantity.symbol, "inf (rigid)"
     shown = f"{value * quantity.display_factor:.6g}"
     return words, quantity.symbol, f"{shown} {quantity.display_unit}".strip()
-
-
-def transition_rows(found) -> list:
-    """The printed rows of :func:`ecofmaps.transition`'s ``found``: Δ_t, δ_t and μ_t."""
-    return [row(q, text) for q, text in transition_texts(found)]
 
 
 def print_rows(title: str, rows) -> None:

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps._interrupts import interrupts_deferred
-from ecofmaps._nomenclature import QUANTITIES, texts_with_se, with_se
+from ecofmaps._nomenclature import QUANTITIES, texts_with_se, transition_texts, with_se
 from ecofmaps._parallel import worker_limit
 from ecofmaps.cli._common import (
     CommandError,
@@ -30,7 +30,6 @@ from ecofmaps.cli._common import (
     read_scar_file,
     recording_options,
     refuse_to_overwrite,
-    transition_rows,
 )
 from ecofmaps.cli.main import option_names
 from ecofmaps.io.files import FileLineError, atomic_path, record_written
@@ -295,12 +294,12 @@ def _lab_lines(results, rig_stiffness) -> list[str]:
         found = transition(results, rig_stiffness=rig_stiffness)
     except ValueError:  # never crosses: nothing to say
         return lines
-    shown = ", ".join(f"{symbol} = {value}" for _, symbol, value in transition_rows(found))
+    shown = ", ".join(f"{QUANTITIES[q].symbol} = {text}" for q, text in transition_texts(found))
     return [*lines, f"transition to gross slip: {shown}"]
 
 
-def _checked_inputs(args) -> tuple[list[Path], float]:
-    """The recordings and the load of the command, its options checked against each other."""
+def _checked(args) -> tuple[list[Path], float | str, list]:
+    """The recordings, load and outputs ``(option, path)`` of the command, its options checked."""
     from ecofmaps.measured.synthetic import EXAMPLE, example_path
 
     if args.example == bool(args.files):
@@ -329,11 +328,6 @@ def _checked_inputs(args) -> tuple[list[Path], float]:
         raise CommandError("--length or --sphere reads the wear on a --scar-profile: give it")
     if args.report is not None and missing_web_packages():
         raise CommandError(INSTALL_WEB)
-    return paths, load
-
-
-def _checked_outputs(args, paths) -> list:
-    """The command's outputs as ``(option, path)``, checked."""
     outputs = [("--out", args.out), ("--resolved", args.resolved), ("--report", args.report)]
     if args.plots is not None:
         kinds = ("loops", "evolution") + (() if args.no_resolve else ("resolved",))
@@ -343,7 +337,7 @@ def _checked_outputs(args, paths) -> list:
     inputs = [*paths, *([args.scar_profile] if args.scar_profile is not None else [])]
     folders = [("--plots", args.plots)]
     refuse_to_overwrite(outputs, inputs, overwrite=args.overwrite, folders=folders)
-    return outputs
+    return paths, load, outputs
 
 
 class _NothingAnalysed(Exception):
@@ -416,8 +410,7 @@ def run(args) -> int:
     """Run ``ecofmaps loops``: 0, or 1 when some of several recordings could not be analysed."""
     from ecofmaps.cli.loops_long import LongRun
 
-    paths, load = _checked_inputs(args)
-    outputs = _checked_outputs(args, paths)
+    paths, load, outputs = _checked(args)
     scar = None if args.scar_profile is None else read_scar_file(args.scar_profile, "loops")
     long_run = LongRun(args, paths)
     try:

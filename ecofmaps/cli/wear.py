@@ -3,7 +3,7 @@ and scar profiles (:func:`ecofmaps.energy_wear`, :func:`ecofmaps.transition`, do
 
 from __future__ import annotations
 
-from ecofmaps._nomenclature import TRANSITION, texts_with_se
+from ecofmaps._nomenclature import TRANSITION, texts_with_se, transition_texts
 from ecofmaps.cli._common import (
     CommandError,
     add_contact_options,
@@ -14,7 +14,6 @@ from ecofmaps.cli._common import (
     read_scar_file,
     refuse_to_overwrite,
     row,
-    transition_rows,
     unit,
 )
 from ecofmaps.io.files import record_written, write_text
@@ -109,15 +108,15 @@ def run(args) -> int:
     if len(tests) > 2:
         fit = energy_wear([r for _, r in tests], profiles, args.length, contact(args))
         names = ("campaign_energy_wear_coefficient", "threshold_energy")
-        print_rows(
-            "campaign: V = α(ΣE_d - E_th)", [row(q, t) for q, t in texts_with_se(fit, names)]
-        )
+        rows = [row(q, text) for q, text in texts_with_se(fit, names)]
+        print_rows("campaign: V = α(ΣE_d - E_th)", rows)
         try:
             found = transition([r for _, r in tests], rig_stiffness=args.rig_stiffness)
         except ValueError as error:
             print(f"campaign: no transition to gross slip: {error}")
         else:
-            print_rows("campaign: transition to gross slip", transition_rows(found))
+            rows = [row(q, text) for q, text in transition_texts(found)]
+            print_rows("campaign: transition to gross slip", rows)
             table.append(
                 {"test": "campaign", "profile": "", "sliding_condition": ""}
                 | _columns(found, TRANSITION, "transition_{}")
