@@ -45,17 +45,16 @@ def add(subparsers) -> None:
         "correct",
         help="correct reported ECoF values to the contact CoF (one point or a CSV table)",
         description="Correct a reported energy CoF μ_E to the contact CoF μ behind it, given the "
-        "amplitude, load, rig stiffness and scar depth over half-width z_o/x_o = D/W (eq. 11; "
-        "x_o = Δ*). One point: --ecof --amplitude --load --stiffness and --aspect-ratio (or "
+        "amplitude, load, rig stiffness and scar depth over half-width z_o/x_o = D/W (eq. 11; x_o "
+        "= Δ*). One point: --ecof --amplitude --load --stiffness and --aspect-ratio (or "
         "--scar-depth and --scar-half-width). A TABLE: columns ecof, amplitude_um, load_N, "
-        "stiffness_MN_per_m and aspect_ratio or scar_depth_um + scar_half_width_um, separated by "
-        "commas, semicolons (decimal commas allowed) or tabs, '#' lines skipped; the output, in "
-        "its separator, keeps every column and adds mu and correction_factor. --scar-profile "
-        "FILE: a measured scar instead (of the point, or every row of a table without scar "
-        "columns), beside the parabola of the same D/W (mu_parabolic in a table). A row that "
-        "cannot be corrected (a cell not a number, an ECoF no gross-slip loop gives) gets NaN, "
-        "its reason in a status column and an error line naming file, line (the header is 1) "
-        "and column; the other rows are written, exit status 1.",
+        "stiffness_MN_per_m and aspect_ratio or scar_depth_um + scar_half_width_um ('#' lines "
+        "skipped; decimal commas with ';'); the output keeps every column and adds mu and "
+        "correction_factor. --scar-profile FILE: a measured scar instead (of the point, or every "
+        "row of a table without scar columns), beside the parabola of the same D/W (mu_parabolic "
+        "in a table). A row that cannot be corrected (a cell not a number, an ECoF no gross-slip "
+        "loop gives) gets NaN, its reason in a status column and an error line naming file, line "
+        "(the header is 1) and column; the other rows are written, exit status 1.",
     )
     option = option_adder(parser, _HELP)
     option("table", nargs="?", metavar="TABLE")

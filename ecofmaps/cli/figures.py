@@ -68,13 +68,11 @@ def add(subparsers) -> None:
         "figures",
         help="write the paper's Figures 5-8 and 11, the universal map and the scar shapes "
         "(default: figures/)",
-        description="Write the paper's Figures 5, 6, 7a, 7b, 8, 11a, 11b, the universal map of "
-        "the ECoF ratio and the scar shapes compared at equal D/W (shapes), a file per figure "
-        "and format (fig5.png, ...), with the paper's parameters: amplitude 50um (= groove "
-        "half-width), load 450N, stiffness 35MN/m, mu 0.8. Maps and loops are read from the "
-        "cache (ECOFMAPS_CACHE), else stored there, with JAX's compiled kernels in its jax/; "
-        "files are written atomically. Figures sharing their numbers are drawn by one process, "
-        "--jobs at once. Progress goes to stderr.",
+        description="Write the paper's figures listed below, a file each per format (fig5.png, "
+        "...), at the paper's parameters: amplitude 50um (= groove half-width), load 450N, "
+        "stiffness 35MN/m, mu 0.8. Maps, loops and JAX's compiled kernels (jax/) are read from "
+        "the cache (ECOFMAPS_CACHE), else stored there; files are written atomically. Progress "
+        "goes to stderr.",
         epilog=f"figures:\n{listing}",
     )
     only = f"write only these figures; NAME is one of: {', '.join(FIGURES)}"

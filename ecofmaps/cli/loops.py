@@ -75,18 +75,17 @@ def add(subparsers) -> None:
         subparsers,
         "loops",
         help="analyse recorded fretting loops cycle by cycle: ECoF, GICoF, stiffness, ...",
-        description="Read recordings of fretting loops (text with a header line in any common "
-        "dialect, TDMS, HDF5/netCDF-4, zarr), cut them into cycles at the displacement reversals "
-        "or by a cycle column, check each loop, and write a row per cycle: cycle, amplitude_um, "
-        "slip_amplitude_um, normal_load_N (with --load COLUMN), max_force_N, "
-        "dissipated_energy_mJ, ecof, cof_max, energy_ratio, stiffness_MN_per_m, gicof, regime, "
-        "mu_resolved, mu_resolved_se, aspect_ratio (read along the whole stroke) and quality "
-        "('ok', or why values are NaN); first a file column for several files. Columns are found "
-        "by the names rigs write (displacement, disp, delta, stroke, ...; force, Fx, Ft, Q, "
-        "friction, ...; an optional 'cycle'), units from their names or the file, else um and N. "
-        "Of several files, one that cannot be analysed is an error line naming it, the others "
-        "are written (exit status 1). Files are written atomically, never over an input or a "
-        "file ecofmaps did not write.",
+        description="Read recordings of fretting loops (text: a header line in any common "
+        "dialect), cut them into cycles at the displacement reversals or by a cycle column, check "
+        "each loop, and write a row per cycle: cycle, amplitude_um, slip_amplitude_um, "
+        "normal_load_N (with --load COLUMN), max_force_N, dissipated_energy_mJ, ecof, cof_max, "
+        "energy_ratio, stiffness_MN_per_m, gicof, regime, mu_resolved, mu_resolved_se, "
+        "aspect_ratio (read along the whole stroke) and quality ('ok', or why values are NaN); "
+        "first a file column for several files. Columns are found by the names rigs write "
+        "(displacement, disp, delta, stroke, ...; force, Fx, Ft, Q, friction, ...; an optional "
+        "'cycle'), units from their names or the file, else um and N. Of several files, one that "
+        "cannot be analysed is an error line naming it, the others are written (exit status 1). "
+        "Files are written atomically, never over an input or a file ecofmaps did not write.",
         epilog="examples:\n  ecofmaps loops test.csv --load 450N --out results.csv --plots plots\n"
         "  ecofmaps loops --example --out results.csv --plots plots",
     )

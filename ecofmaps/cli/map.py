@@ -53,15 +53,14 @@ def add(subparsers) -> None:
         help="compute the model over a grid of test conditions into a netCDF file or zarr store",
         description="Compute the model's steady-loop quantities (slip amplitude and ratio, energy "
         "CoF and its ratio to mu, compliance ratio P/(S*amplitude), regime; with --load the "
-        "dissipated energy and peak force) over a grid into an xarray Dataset in a netCDF file, "
-        "or a zarr store if --out ends in .zarr, atomically. Its size is printed first; a map "
-        "that would not fit on the disk is refused. The groove half-width is the amplitude, as "
-        "in the paper. Of the grid options, one value is a scalar coordinate, a list a,b,c or a "
-        "range start:stop:num (num points, both ends included) a dimension, in this order. "
-        "Values take units (50um, 0.08/um, 450N); a bare number is SI. A zarr store, or more "
-        "than --chunk-points points, is computed block by block, a few in memory (grids far "
-        "beyond memory work). The map is not cached: it computes faster than the cache would "
-        "read it, and --out keeps it.",
+        "dissipated energy and peak force) over a grid into an xarray Dataset in --out, "
+        "atomically. Its size is printed first; a map that would not fit on the disk is refused. "
+        "The groove half-width is the amplitude, as in the paper. Of the grid options, one value "
+        "is a scalar coordinate, a list a,b,c or a range start:stop:num (num points, both ends "
+        "included) a dimension, in this order. Values take units (50um, 0.08/um, 450N); a bare "
+        "number is SI. A zarr store, or more than --chunk-points points, is computed block by "
+        "block, a few in memory (grids far beyond memory work). The map is not cached (it "
+        "computes faster than the cache would read it).",
         epilog="example (the grid of Figure 11):\n  ecofmaps map "
         "--stiffness-ratio 0.01/um:0.3/um:30 --aspect-ratio 0:0.3:31 \\\n      --amplitude "
         "25um,50um --mu 0.8 --load 450N --out fig11.nc\n"

@@ -41,14 +41,13 @@ def add(subparsers) -> None:
     parser = subparsers.add_parser(
         "wear",
         help="energy wear coefficient and Archard's k from results tables and scar profiles",
-        description="Per test: the dissipated energy summed over every cycle (a rig records "
-        "every N-th), the wear volume (a line contact: the worn area times --length; --sphere: "
-        "the revolution of the worn depth, both sides averaged; pile-up apart), α = V/ΣE_d, "
-        "Archard's k on the slip and on the applied amplitude, each ± its standard error, and "
-        "the sliding condition. Over three tests or more: α and E_th of V = α(ΣE_d - E_th), and "
-        "the transition to gross slip Δ_t, δ_t, μ_t if they span it (row 'campaign' of --out). "
-        "One --profile per test, in the tests' order (a table of several recordings holds "
-        "several tests).",
+        description="Per test: the dissipated energy summed over every cycle (a rig records every "
+        "N-th), the wear volume (a line contact: the worn area times --length; --sphere: the "
+        "revolution of the worn depth, both sides averaged; pile-up apart), α = V/ΣE_d, Archard's "
+        "k on the slip and on the applied amplitude, each ± its standard error, and the sliding "
+        "condition. Over three tests or more: α and E_th of V = α(ΣE_d - E_th), and the "
+        "transition to gross slip Δ_t, δ_t, μ_t if they span it (row 'campaign' of --out). "
+        "--profile in the tests' order (a table of several recordings holds several tests).",
     )
     option = option_adder(parser, _HELP)
     option("tables", nargs="+", metavar="TABLE")
