@@ -200,7 +200,7 @@ def add_profile_options(parser: argparse.ArgumentParser) -> None:
     option("--smoothing", type=quantity("smoothing"), metavar="LENGTH")
     option("--mapping", choices=("scaled", "physical"))
     reading = tuple(action.dest for action in group._group_actions[1:])  # need --scar-profile
-    parser.set_defaults(profile_command=parser.prog, profile_options=reading)
+    parser.set_defaults(profile_options=reading)
 
 
 def read_profile(args, conflicting=()):
@@ -245,7 +245,7 @@ def read_profile(args, conflicting=()):
             args.profile_alternative = said.alternative_name
             hint = f"; --profile-half-width {said.alternative * 1e6:.6g}um takes the "
             hint += said.alternative_name
-        print(f"{args.profile_command}: warning: {said.summary}{hint}", file=sys.stderr)
+        print(f"{args.command_prog}: warning: {said.summary}{hint}", file=sys.stderr)
     return profile
 
 
