@@ -33,7 +33,6 @@ from ecofmaps.measured.quality import (
 from ecofmaps.measured.samples import MissingSampleError, no_cycle_error
 
 __all__ = [
-    "AT_OWN_LOAD",
     "IN_PROCESS",
     "NAN_POLICIES",
     "TASK_SAMPLES",
@@ -42,12 +41,9 @@ __all__ = [
     "LoopOptions",
     "Reading",
     "Task",
-    "at_own_load",
     "block_file",
     "force_at_mean_load",
-    "keep_block",
     "kept_block",
-    "load_sample_error",
     "measure_chunk",
     "only",
     "runner_for",
@@ -82,25 +78,21 @@ class LoopOptions:
         threshold = resolve.within("gross_slip_threshold", self.gross_slip_threshold, 1.0)
         if not isinstance(self.flip_force, bool | np.bool_):
             raise ValueError(f"flip_force must be True or False; got {self.flip_force!r}")
-        rig = self.rig_stiffness
+        flip, rig = bool(self.flip_force), self.rig_stiffness
         if rig is not None:
             check("rig_stiffness", rig, "positive_or_inf", "N/m")
             rig = float(rig)
-        flip = bool(self.flip_force)
         resolve.settle(self, load, hysteresis, window, crossing, threshold, flip, rig)
 
 
 class _InProcess:
     """Runs the chunks one after the other in this process (a recording in memory)."""
 
-    workers = 1
     local = True
-    kind = "this process"
 
     @staticmethod
     def map(function, tasks):
-        for arguments in tasks:
-            yield function(*arguments)
+        yield from itertools.starmap(function, tasks)
 
 
 #: The runner of a recording in memory: its chunks run in this process, in order.
@@ -144,7 +136,7 @@ class Reading:
 class Task:
     """One chunk's work besides its samples: its cycles with their halo, its own ``rows``
     among them, the first sample ``low`` of its stretch, and what the analysis asks: ``then``
-    made of its results, the file to ``keep`` its values and flags in (:func:`keep_block`) or
+    made of its results, the file to ``keep`` its values and flags in (:func:`_keep_block`) or
     True to hand them back, and the ``columns`` of its results handed back."""
 
     cycles: Cycles
@@ -170,29 +162,9 @@ class Chunk:
 
 
 def force_at_mean_load(force, load):
-    r"""The force of a recording whose normal load was recorded sample by sample, as at the
-    mean load: :math:`Q(t)\,\bar P/P(t)`, and :math:`\bar P` (see ``docs/loops.md``).
-
-    Parameters
-    ----------
-    force : numpy.ndarray or dask.array.Array
-        Tangential force at each sample. [N]
-    load : numpy.ndarray or dask.array.Array
-        Normal load at each sample (NaN where missing; a load that is not positive is
-        missing too, and its cycle flagged ``load-not-positive``). [N]
-
-    Returns
-    -------
-    force : numpy.ndarray or dask.array.Array
-        :math:`Q\,\bar P/P` at each sample, NaN where the load is missing. [N]
-    mean_load : float
-        :math:`\bar P`, the mean of the finite positive loads. [N]
-
-    Raises
-    ------
-    ValueError
-        If no load is finite, or none is positive.
-    """
+    r"""The force at each sample as at the mean load, :math:`Q(t)\,\bar P/P(t)` [N] (NaN where
+    the recorded ``load`` is missing or not positive), and :math:`\bar P`, the mean of the
+    finite positive loads [N] (see ``docs/loops.md``); a ValueError if none is positive."""
     if isinstance(load, np.ndarray):
         finite = load[np.isfinite(load)]
         usable = np.where(np.isfinite(load) & (load > 0.0), load, np.nan)
@@ -227,34 +199,13 @@ def _with_loops(results: xr.Dataset, loops) -> xr.Dataset:
     return results
 
 
-def load_sample_error(sample: int, load: float, cycle=None) -> MissingSampleError:
-    """The error for sample ``sample`` (0-based, of ``cycle`` if known) whose recorded normal
-    ``load`` [N] is not positive, with ``nan_policy='raise'``."""
-    at = f"sample {sample}" + ("" if cycle is None else f" (cycle {cycle})")
-    return MissingSampleError(
-        sample,
-        f"the recorded normal load at {at} is {load:g} N, not positive, and the force is "
-        "scaled by it",
-        "flags its cycle load-not-positive and analyses the others"
-        + (f": {COMPRESSION}" if load < 0 else ""),
-    )
-
-
-#: The values that scale with the normal load: with a recorded load, they are reported at
-#: each cycle's own load (``normal_load``), the rest being read at the mean load.
-AT_OWN_LOAD = (*LOAD_SCALED, "loop_force", "force_forward", "force_backward")
-
-
-def at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
-    """``dataset`` with its variables of :data:`AT_OWN_LOAD` times ``ratio``, each cycle's
-    load over the mean load."""
+def _at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
+    """``dataset`` with the variables that scale with the normal load times ``ratio``, each
+    cycle's load over the mean load (the rest are read at the mean load)."""
     ratio = np.asarray(ratio, dtype=np.float64)
+    scaled = (*LOAD_SCALED, "loop_force", "force_forward", "force_backward")
     return dataset.assign(
-        {
-            name: dataset[name].copy(data=(dataset[name].values.T * ratio).T)
-            for name in AT_OWN_LOAD
-            if name in dataset
-        }
+        {k: dataset[k].copy(data=(dataset[k].values.T * ratio).T) for k in scaled if k in dataset}
     )
 
 
@@ -302,11 +253,11 @@ def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
     part = _part(values, flags, labels, options, loops if reading.keep_loops else None)
     handed = resolved if reading.hand_back else None
     if handed is not None and "normal_load" in values:  # as the part: at each cycle's load
-        handed = at_own_load(handed, values["normal_load"] / options.load)
+        handed = _at_own_load(handed, values["normal_load"] / options.load)
     tally = Tally()
     tally.add(part["quality"].values, flags, values["amplitude"])
     if isinstance(task.keep, Path):
-        keep_block(task.keep, values, flags)
+        _keep_block(task.keep, values, flags)
     if task.keep is not True:
         values = flags = None
     made = None if task.then is None else task.then(part)
@@ -314,7 +265,7 @@ def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
 
 
 def block_file(prefix: Path, index: int) -> Path:
-    """The file of chunk ``index`` kept at ``prefix`` (:func:`keep_block`)."""
+    """The file of chunk ``index`` kept at ``prefix`` (:func:`_keep_block`)."""
     return prefix.with_name(f"{prefix.name}{index:06d}.npz")
 
 
@@ -338,7 +289,7 @@ def write_whole(path: Path, content) -> None:
         temporary.unlink(missing_ok=True)
 
 
-def keep_block(path: Path, values: dict, flags: dict) -> None:
+def _keep_block(path: Path, values: dict, flags: dict) -> None:
     """Keep what a chunk measured, its ``values`` and ``flags``, in ``path`` (``.npz``), whole
     or not at all."""
     write_whole(
@@ -347,7 +298,7 @@ def keep_block(path: Path, values: dict, flags: dict) -> None:
 
 
 def kept_block(path: Path) -> tuple[dict, dict]:
-    """The values and flags :func:`keep_block` kept in ``path``."""
+    """The values and flags :func:`_keep_block` kept in ``path``."""
     with np.load(path) as stored:
         values = {k[2:]: stored[k] for k in stored.files if k.startswith("v:")}
         return values, {k[2:]: stored[k] for k in stored.files if k.startswith("f:")}
@@ -369,20 +320,14 @@ def _part(values: dict, flags: dict, labels, options, loops=None) -> xr.Dataset:
     if loops is not None:
         part = _with_loops(part, loops)
     if "normal_load" in part:
-        part = at_own_load(part, part["normal_load"].values / options.load)
+        part = _at_own_load(part, part["normal_load"].values / options.load)
     return part
 
 
 class Analysis:
-    """The analysis of one recording through the pipeline, in steps that a caller can
-    follow: the command line writes each chunk's results as it comes.
-
-    ``options`` is a :class:`LoopOptions`; ``runner`` where the passes and the chunks run
-    (:func:`runner_for`, entered; by default this process); ``cycles`` those found before
-    (a resumed run); ``samples`` per chunk (about; default :data:`TASK_SAMPLES`);
-    ``one_chunk`` for a recording in memory. With a ``recorded_load`` (the load at each
-    sample), ``force`` is at the mean load ``options.load`` (:func:`force_at_mean_load`).
-    """
+    """One recording through the pipeline in steps a caller can follow, chunk by chunk, on
+    ``runner`` (:func:`runner_for`, entered), from ``cycles`` found before (a resumed run);
+    with a ``recorded_load``, ``force`` is at the mean load (:func:`force_at_mean_load`)."""
 
     def __init__(
         self,
@@ -420,7 +365,14 @@ class Analysis:
             if load <= 0.0:
                 row = np.searchsorted(cycles.start, first, side="right") - 1
                 within = row >= 0 and first < cycles.start[row] + cycles.count[row]
-                raise load_sample_error(first, load, cycles.label[row] if within else None)
+                at = f"sample {first}" + (f" (cycle {cycles.label[row]})" if within else "")
+                raise MissingSampleError(
+                    first,
+                    f"the recorded normal load at {at} is {load:g} N, not positive, and the "
+                    "force is scaled by it",
+                    "flags its cycle load-not-positive and analyses the others"
+                    + (f": {COMPRESSION}" if load < 0 else ""),
+                )
             raise MissingSampleError(first)
         if cycles.label.size == 0:
             raise no_cycle_error(int(displacement.shape[0]))
@@ -468,7 +420,7 @@ class Analysis:
             for index, chunk in zip(wanted, results, strict=False):
                 self.tally.merge(chunk.tally)
                 if isinstance(keep, Path) and chunk.values is not None:  # measured elsewhere
-                    keep_block(block_file(keep, index), chunk.values, chunk.flags)
+                    _keep_block(block_file(keep, index), chunk.values, chunk.flags)
                     chunk.values = chunk.flags = None
                 yield index, chunk
         finally:  # closed with this generator: the chunks left are cancelled now, not later
@@ -491,12 +443,9 @@ class Analysis:
     def run(self):
         """Every chunk, joined (:meth:`finish`); and the reading along the stroke, joined,
         with :attr:`Reading.hand_back` (else None)."""
-        parts, read = [], []
-        for _, chunk in self.measured():
-            parts.append(chunk.part)
-            if chunk.resolved is not None:
-                read.append(chunk.resolved)
-        return self.finish(parts), _joined(read) if read else None
+        chunks = [chunk for _, chunk in self.measured()]
+        read = [chunk.resolved for chunk in chunks if chunk.resolved is not None]
+        return self.finish(chunk.part for chunk in chunks), _joined(read) if read else None
 
 
 def _joined(parts: list) -> xr.Dataset:

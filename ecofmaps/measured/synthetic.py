@@ -175,19 +175,8 @@ _HEADER = """\
 
 
 def example_recording():
-    """The shipped example: the cycle number, displacement and force of every sample.
-
-    Returns
-    -------
-    cycle : numpy.ndarray of int64
-        The test cycle at which each recorded loop was taken. [1]
-    displacement, force : numpy.ndarray
-        [m], [N]
-
-    Notes
-    -----
-    Deterministic: a fixed seed, see :data:`EXAMPLE` for the parameters.
-    """
+    """The shipped example (:data:`EXAMPLE`, a fixed seed): the test cycle at which each
+    sample's loop was taken [1], the displacement [m] and the force [N] of every sample."""
     p = EXAMPLE
     recorded = np.arange(1, p["test_cycles"] // p["recorded_every"] + 1) * p["recorded_every"]
     ratio = p["final_aspect_ratio"] * np.sqrt(recorded / p["test_cycles"])
@@ -216,17 +205,8 @@ def _on_rig(p, ratio, samples_per_cycle, offset, drift, seed):
 
 
 def write_example(path):
-    """Write :func:`example_recording` as the shipped CSV file (atomically).
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        Destination file.
-
-    Returns
-    -------
-    path : pathlib.Path
-    """
+    """Write :func:`example_recording` to ``path`` as the shipped CSV file (atomically);
+    returns the :class:`pathlib.Path`."""
     cycle, displacement, force = example_recording()
     rows = "\n".join(
         f"{c:d},{d:.4f},{f:.3f}" for c, d, f in zip(cycle, displacement * 1e6, force, strict=True)
@@ -275,21 +255,8 @@ _SCAR_HEADER = """\
 
 
 def scar_example_trace():
-    """The shipped example scar profile as a profilometer records it.
-
-    Returns
-    -------
-    x, z : numpy.ndarray
-        Positions from the start of the trace and heights. [m]
-
-    Notes
-    -----
-    Deterministic: a fixed seed, see :data:`SCAR_EXAMPLE` for the parameters. The scar is
-    the U shape of :func:`ecofmaps.flat_bottomed_profile` with a Gaussian hump at the
-    centre, :math:`H\\sin^2(\\pi v)` ridges beside the edges (as
-    :func:`ecofmaps.ridged_profile`) and a waviness of random phase in the scar; then the
-    tilt, offset and noise of the recording.
-    """
+    """The shipped example scar profile (:data:`SCAR_EXAMPLE`, a fixed seed) as a
+    profilometer records it: positions from the start of the trace and heights [m]."""
     p = SCAR_EXAMPLE
     rng = np.random.default_rng(p["seed"])
     x = np.arange(round(p["length"] / p["spacing"]) + 1) * p["spacing"]
@@ -312,17 +279,8 @@ def scar_example_trace():
 
 
 def write_scar_example(path):
-    """Write :func:`scar_example_trace` as the shipped CSV file (atomically), in µm.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        Destination file.
-
-    Returns
-    -------
-    path : pathlib.Path
-    """
+    """Write :func:`scar_example_trace` to ``path`` as the shipped CSV file (atomically), in
+    µm; returns the :class:`pathlib.Path`."""
     x, z = scar_example_trace()
     rows = "\n".join(f"{a:.1f},{b:.4f}" for a, b in zip(x * 1e6, z * 1e6, strict=True))
     return write_text(path, f"{_SCAR_HEADER}x,z\n{rows}\n")
