@@ -72,7 +72,8 @@ def analyze_loops(
     scheduler=None,
     workers=None,
 ) -> xr.Dataset:
-    r"""Per-cycle friction quantities of a recording of fretting loops, each checked.
+    r"""Per-cycle friction quantities of a recording of fretting loops, each checked (the
+    method, the checks and the reading out of core: ``docs/method-loops.md``).
 
     Parameters
     ----------
@@ -149,11 +150,6 @@ def analyze_loops(
         When cycles were flagged (other than for partial slip), with the one-line summary,
         or have a coefficient of friction outside 0.01 to 3 (``implausible-cof``).
 
-    Notes
-    -----
-    The method, the checks and the reading out of core are explained in
-    ``docs/method-loops.md``.
-
     References
     ----------
     X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
@@ -192,7 +188,7 @@ def _run(
     cycle,
     options: LoopOptions,
     reading: Reading,
-    recorded_load=None,
+    recorded=None,
     missing=None,
     nan_policy="skip",
     scheduler=None,
@@ -214,13 +210,13 @@ def _run(
     settings = dict(
         options=options,
         missing=mask,
-        recorded_load=recorded_load,
+        recorded_load=recorded,
         nan_policy=nan_policy,
         reading=reading,
     )
     if not any(is_lazy(a) for a in (x, q, label, mask)):
         if nan_policy == "raise":
-            _raise_at_missing(x, q, label, mask, recorded_load)
+            _raise_at_missing(x, q, label, mask, recorded)
         return Analysis(x, q, label, one_chunk=True, **settings).run()
     if reading.keep_loops:
         raise ValueError(
@@ -268,7 +264,8 @@ def resolve_loops(
     hysteresis=LoopOptions.hysteresis,
     gross_slip_threshold=LoopOptions.gross_slip_threshold,
 ) -> xr.Dataset:
-    r"""Friction and groove slope read along the whole stroke of every loop of a recording.
+    r"""Friction and groove slope read along the whole stroke of every loop of a recording (the
+    method and the quality flags: ``docs/method-loops.md``).
 
     Parameters
     ----------
@@ -320,10 +317,6 @@ def resolve_loops(
     --------
     resolve_analyzed_loops : the same from :func:`ecofmaps.analyze_loops`'s result.
 
-    Notes
-    -----
-    The method and the quality flags are explained in ``docs/method-loops.md``.
-
     References
     ----------
     X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
@@ -344,4 +337,4 @@ def resolve_loops(
     reading = Reading(resolve=True, along_stroke=along_stroke, hand_back=True)
     force, load, recorded = _at_mean_load(force, load)
     options = LoopOptions(load, hysteresis, stick_window, gross_slip_threshold=gross_slip_threshold)
-    return _run(displacement, force, cycle, options, reading, recorded_load=recorded)[1]
+    return _run(displacement, force, cycle, options, reading, recorded)[1]

@@ -298,10 +298,7 @@ def displacement_percentiles(samples: Samples, gaps, line, sample_at, sampled, c
         return _percentiles(samples, gaps, line)
     virtual = (count - 1) * _QUANTILES  # NumPy's virtual index, method "linear"
     rank = np.floor(virtual).astype(np.int64)
-    missing = np.zeros(sample_at.size, dtype=bool)
-    if gaps.size:
-        run = np.searchsorted(gaps[:, 0], sample_at, side="right") - 1
-        missing = (run >= 0) & (sample_at < gaps[np.maximum(run, 0), 1])
+    missing = missing_in(gaps, sample_at, 1) if gaps.size else np.zeros(sample_at.size, bool)
     sample = (sampled - mean) - ((sample_at - middle) - mean_t) * slope
     sample = np.sort(sample[~missing & np.isfinite(sample)])
     drawn = sample.size
@@ -342,9 +339,7 @@ def ends_of_runs(run, valued, values, runs: int, first: bool):
     if not pieces.size:
         return result
     owner = run[pieces]
-    pick = np.searchsorted(owner, np.arange(runs), side="left" if first else "right")
-    if not first:
-        pick -= 1
+    pick = np.searchsorted(owner, np.arange(runs), side="left" if first else "right") - (not first)
     inside = (pick >= 0) & (pick < pieces.size)
     pick = np.clip(pick, 0, pieces.size - 1)
     ok = inside & (owner[pick] == np.arange(runs))
@@ -357,8 +352,7 @@ def part_extremes(start, stop, arguments, x):
     displacement with their first samples, and its highest and lowest detrended one."""
     chunk, gaps, line, begin, end = arguments
     found = [np.empty((7, 0))]
-    for a in range(start, stop, chunk):
-        b = min(a + chunk, stop)
+    for a, b in _chunks(start, stop, chunk):
         first, last = np.searchsorted(end, a, side="right"), np.searchsorted(begin, b)
         if first >= last:
             continue
@@ -411,13 +405,8 @@ class Samples:
 
     def constant_cycle(self) -> Samples:
         """These samples with every cycle number 0 (the whole recording one cycle)."""
-        if self.lazy:
-            import dask.array as da
-
-            cycle = da.zeros(self.size, dtype=np.int64, chunks=self.arrays[0].chunks)
-        else:
-            cycle = np.zeros(self.size, dtype=np.int64)
         constant = copy.copy(self)
+        cycle = np.zeros_like(self.arrays[0], dtype=np.int64)  # dask's, for a lazy recording
         constant.arrays = (*self.arrays[:2], cycle, self.arrays[3])
         return constant
 
