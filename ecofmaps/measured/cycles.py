@@ -12,14 +12,7 @@ import numpy as np
 from ecofmaps.measured import samples as passes
 from ecofmaps.measured.samples import Samples
 
-__all__ = [
-    "LEAST_LEVEL",
-    "MIN_SAMPLES",
-    "NOISE_LEVEL",
-    "Cycles",
-    "find_cycles",
-    "loop_points",
-]
+__all__ = ["LEAST_LEVEL", "MIN_SAMPLES", "NOISE_LEVEL", "Cycles", "find_cycles", "loop_points"]
 
 #: Fewest samples in one complete cycle: two branches, each with a stick and a slip part.
 MIN_SAMPLES = 8
@@ -418,9 +411,7 @@ def _split(samples: Samples, hysteresis: float) -> Cycles:
     half_range = 0.5 * (high - low)
     if not half_range > 0.0:
         raise ValueError("the displacement does not oscillate: no reversal can be found")
-    centre = 0.5 * (high + low)
-    stroke = 2.0 * half_range
-    band = (centre, hysteresis * half_range)
+    band = (0.5 * (high + low), hysteresis * half_range)
     starts, kind, extreme, value = _trigger(samples, gaps, line, band)
     period = _period(starts, kind)
     # every other cycle under the band: the bottom runs two periods apart, half a period
@@ -440,7 +431,7 @@ def _split(samples: Samples, hysteresis: float) -> Cycles:
     # A gap shorter than half the samples beyond the band in a half period of a triangle
     # wave cannot have hidden a run of the other kind: the trigger goes on over it.
     long_gaps = gaps[gaps[:, 1] - gaps[:, 0] >= 0.25 * (1.0 - hysteresis) * period]
-    gapped, margin = (gaps, long_gaps), _TOLERANCE * stroke
+    gapped, margin = (gaps, long_gaps), _TOLERANCE * (high - low)
     parts = _parts_after_gaps(samples, gapped, line, band, (starts, kind, extreme, value))
     kind_of_part, extreme_of_part = kind[parts[0]], parts[2]
     # Beside a long gap, as at the ends of the recording: an extreme within the tolerance of

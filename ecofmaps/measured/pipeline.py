@@ -209,9 +209,10 @@ def _at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
     )
 
 
-def _cycle_loads(series, cycles: Cycles, rows: slice) -> tuple:
-    """The mean, lowest and highest finite value of ``series`` over each cycle of ``rows``."""
-    first, stop, _ = rows.indices(cycles.label.size)
+def _cycle_loads(load, task: Task) -> tuple:
+    """The mean, lowest and highest finite ``load`` [N] over each of the task's own cycles."""
+    series, cycles = Stretch(load, task.low), task.cycles
+    first, stop, _ = task.rows.indices(cycles.label.size)
     start, count = cycles.start[first:stop], cycles.count[first:stop]
     if start.size == 0:
         return np.empty(0), np.empty(0), np.empty(0)
@@ -238,9 +239,7 @@ def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
         task.cycles, x, q, options, rows=task.rows, keep_loops=kept
     )
     if recorded_load is not None:
-        mean, lowest, highest = _cycle_loads(
-            Stretch(recorded_load, task.low), task.cycles, task.rows
-        )
+        mean, lowest, highest = _cycle_loads(recorded_load, task)
         values["normal_load"] = mean
         flags |= load_flags(flags["missing-samples"], mean, lowest, highest)
     flags |= scale_flags(values, options)

@@ -66,10 +66,8 @@ LOAD_SCALED = ("max_force", "dissipated_energy", "stiffness", "force_offset", "f
 #: A loop whose area :math:`\oint Q\,d\Delta` is below minus this share of
 #: :math:`4\Delta^*Q^*` runs anticlockwise; a smaller negative area is noise.
 ANTICLOCKWISE_SHARE = 0.05
-#: A cycle's amplitude of displacement or force stands clear of the noise when the bound
-#: σ√(2 ln n) on the lift of an extreme by white noise of its n samples is below this share
-#: of it (the lift itself is less, the sine falling away from its peak: half the
-#: peak-to-peak then reads the amplitude about 10 % too large at most).
+#: The noise's bound on the lift of an extreme, σ√(2 ln n), must be below this share of a
+#: cycle's amplitudes (``noise-amplitude``; half the peak-to-peak is then at most 10 % high).
 NOISE_SHARE = 0.15
 #: A stick segment must explain all but this share of the displacement's variance along it.
 UNEXPLAINED_SHARE = 0.2
@@ -365,18 +363,18 @@ class Tally:
 
     def add(self, quality, flags: dict, amplitude) -> None:
         """Count the cycles of a part: their ``quality``, ``flags`` and amplitudes as measured."""
-        part = Tally()
-        part.counts.update(np.asarray(quality).tolist())
+        self.counts.update(np.asarray(quality).tolist())
         quiet = {"ok", "partial-slip", "mindlin-stick", *READING_REASONS}
         loud = _by_text(quality, lambda text: bool(set(text.split(SEPARATOR)) - quiet))
-        part.flagged, part.cycles = int(loud.sum()), amplitude.size
-        part.refused = int(_refusing(flags, amplitude.size).sum())
-        part.every = {reason: reason in flags and bool(flags[reason].all()) for reason in _HINTS}
-        part.negative_stiffness = bool(flags["negative-stiffness"].any())
-        part.amplitudes = [amplitude]
-        part.implausible_cof = int(flags["implausible-cof"].sum())
-        part.scaled = int(flags["implausible-amplitude"].sum())
-        self.merge(part)
+        self.flagged += int(loud.sum())
+        self.cycles += amplitude.size
+        self.refused += int(_refusing(flags, amplitude.size).sum())
+        for reason in _HINTS:
+            self.every[reason] &= reason in flags and bool(flags[reason].all())
+        self.negative_stiffness |= bool(flags["negative-stiffness"].any())
+        self.amplitudes.append(amplitude)
+        self.implausible_cof += int(flags["implausible-cof"].sum())
+        self.scaled += int(flags["implausible-amplitude"].sum())
 
     def merge(self, other: Tally) -> None:
         """Count the parts ``other`` counted (in another process, say) as well."""

@@ -127,13 +127,9 @@ def synthetic_recording(
     force = np.asarray(
         simulate(imposed, load, stiffness, mu, np.broadcast_to(ratio, (cycles,)), half_width)
     )[:, n:].ravel()
-    displacement = imposed[:, n:].ravel()
-    displacement = (
-        displacement
-        + displacement_offset
-        + displacement_drift * instants / n
-        + rng.normal(0.0, 1.0, displacement.size) * displacement_noise
-    )
+    displacement = imposed[:, n:].ravel() + displacement_offset
+    displacement = displacement + displacement_drift * instants / n
+    displacement = displacement + rng.normal(0.0, 1.0, displacement.size) * displacement_noise
     force = force + force_offset + rng.normal(0.0, 1.0, force.size) * force_noise
     return displacement, force
 
@@ -341,8 +337,7 @@ def long_recording(cycles, samples_per_cycle=200, *, block_cycles=4096, seed=0, 
     coefficient of friction from fretting loops exhibiting non-Coulomb frictional
     behaviour: eq. 9, 10.
     """
-    unknown = set(parameters) - set(LONG_TEST)
-    if unknown:
+    if unknown := set(parameters) - set(LONG_TEST):
         raise TypeError(f"unknown parameters: {', '.join(sorted(unknown))}")
     p = {**LONG_TEST, **parameters}
     for name, value in (("cycles", cycles), ("block_cycles", block_cycles)):
