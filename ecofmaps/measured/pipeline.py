@@ -30,7 +30,7 @@ from ecofmaps.measured.quality import (
     load_flags,
     scale_flags,
 )
-from ecofmaps.measured.samples import MissingSampleError, no_cycle_error
+from ecofmaps.measured.samples import MissingSampleError
 
 __all__ = [
     "IN_PROCESS",
@@ -348,16 +348,9 @@ class Analysis:
         self.reading = Reading() if reading is None else reading
         self.options, self.runner = options, runner
         self.cycles_from = "displacement reversals" if cycle is None else "cycle numbers"
-        if cycles is None:
-            cycles = find_cycles(
-                displacement,
-                cycle,
-                options.hysteresis,
-                force=force,
-                missing=missing,
-                runner=None if runner is IN_PROCESS else runner,
-            )
-        self.cycles = cycles
+        self.cycles = cycles = cycles or find_cycles(
+            displacement, cycle, options.hysteresis, force=force, missing=missing, runner=runner
+        )
         if nan_policy == "raise" and cycles.first_missing >= 0:
             first = cycles.first_missing
             load = np.nan if recorded_load is None else float(recorded_load[first])
@@ -374,7 +367,10 @@ class Analysis:
                 )
             raise MissingSampleError(first)
         if cycles.label.size == 0:
-            raise no_cycle_error(int(displacement.shape[0]))
+            raise ValueError(
+                f"too few samples for one cycle: no complete cycle in {displacement.shape[0]} "
+                "samples (the loop does not close, or the recording does not oscillate)"
+            )
         whole = [slice(0, cycles.label.size)]
         self.tasks = whole if one_chunk else _tasks(cycles.count, samples or TASK_SAMPLES)
         grid = self.reading.resolve and isinstance(self.reading.along_stroke.positions, int)

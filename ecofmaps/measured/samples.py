@@ -27,7 +27,6 @@ __all__ = [
     "level_at",
     "local_extremes",
     "missing_in",
-    "no_cycle_error",
     "part_extremes",
     "survey",
     "trigger_runs",
@@ -441,11 +440,3 @@ class MissingSampleError(ValueError):
         )
         what = what or f"sample {self.sample} is missing (NaN or empty)"
         super().__init__(f"{what}; nan_policy='skip' {self.skips}")
-
-
-def no_cycle_error(samples: int) -> ValueError:
-    """The error for a recording of ``samples`` samples without a complete cycle."""
-    return ValueError(
-        f"too few samples for one cycle: no complete cycle in {samples} samples "
-        "(the loop does not close, or the recording does not oscillate)"
-    )
