@@ -127,14 +127,10 @@ def analyze_loops(
     Returns
     -------
     results : xarray.Dataset
-        Over ``cycle``, each column of ``docs/loops.md`` in SI units: amplitude and
-        slip_amplitude [m], max_force [N], dissipated_energy [J], ecof, cof_max,
-        energy_ratio, stiffness [N/m], gicof and its branches, the crossings and offsets
-        [m], [N], force_drift_se [N], regime (:class:`ecofmaps.Regime` codes), stick_residual
-        [m] and quality ('ok', or why values are NaN: :mod:`ecofmaps.measured.quality`); with
-        ``resolve``, mu_resolved, mu_resolved_se and aspect_ratio; with a recorded load,
-        normal_load [N]. The load is a scalar coordinate; the attributes (quality_summary,
-        the counts of what was dropped or missing, motion) are listed there too.
+        Over ``cycle``, each column of ``docs/loops.md`` in SI units (amplitude [m], ecof,
+        gicof, ..., regime as :class:`ecofmaps.Regime` codes, quality: 'ok' or why values
+        are NaN; with ``resolve``, mu_resolved; with a recorded load, normal_load [N]); the
+        load is a scalar coordinate; the attributes are listed there too.
 
     Raises
     ------

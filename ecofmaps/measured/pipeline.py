@@ -37,7 +37,6 @@ __all__ = [
     "NAN_POLICIES",
     "TASK_SAMPLES",
     "Analysis",
-    "Chunk",
     "LoopOptions",
     "Reading",
     "Task",
@@ -305,9 +304,7 @@ def kept_block(path: Path) -> tuple[dict, dict]:
 
 def only(part: xr.Dataset, columns=None) -> xr.Dataset:
     """``part`` with only the variables ``columns`` that it holds (all of them if None)."""
-    if columns is None:
-        return part
-    return part[[name for name in columns if name in part.data_vars]]
+    return part if columns is None else part[[k for k in columns if k in part.data_vars]]
 
 
 def _part(values: dict, flags: dict, labels, options, loops=None) -> xr.Dataset:
@@ -399,8 +396,7 @@ class Analysis:
         if isinstance(keep, Path):
             keep = block_file(keep, index) if self.runner.local else True
         inner = slice(rows.start - first, rows.stop - first)
-        task = Task(table, inner, low, self.options, self.reading, then, keep, columns)
-        return task, x, q, p
+        return Task(table, inner, low, self.options, self.reading, then, keep, columns), x, q, p
 
     def measured(self, skip=(), then=None, keep=False, columns=None):
         """Each chunk's :class:`Chunk`, in order, as they come; counted in :attr:`tally`.

@@ -241,11 +241,9 @@ def labelled_runs(start, stop, arguments, x, cycle):
 
 
 def detrended(x, a: int, line):
-    """The displacements ``x`` of samples ``a`` on less the straight ``line``."""
-    mean, mean_t, slope, middle = (float(value) for value in line)
-    return kernels.detrended(
-        np.ascontiguousarray(x, dtype=np.float64), a, mean, mean_t, slope, middle
-    )
+    """The displacements ``x`` of samples ``a`` on less the straight ``line`` (see
+    :func:`displacement_line`)."""
+    return kernels.detrended(np.ascontiguousarray(x, dtype=np.float64), a, *map(float, line))
 
 
 def survey(samples: Samples):
@@ -382,10 +380,8 @@ def is_lazy(value) -> bool:
     """Whether ``value`` is a dask collection, or an xarray object backed by one."""
     if "dask" not in sys.modules:  # nothing can be lazy before dask is imported
         return False
-    import dask
-
     data = getattr(value, "data", None) if hasattr(value, "dims") else value
-    return dask.is_dask_collection(data)
+    return sys.modules["dask"].is_dask_collection(data)
 
 
 class Samples:

@@ -287,9 +287,8 @@ def scar_example_path() -> Path:
     return Path(str(importlib.resources.files("ecofmaps") / "data" / SCAR_EXAMPLE_FILE))
 
 
-#: The default parameters of :func:`long_recording`: the example's rig (the paper's Example 2,
-#: Section 3) and sensors, a groove deepening to z_o/x_o = 0.2 over the test, and a
-#: displacement drift of 2 um over the whole test.
+#: The default parameters of :func:`long_recording`: :data:`EXAMPLE`'s rig, sensors, groove
+#: (z_o/x_o = 0.2 at the end of the test) and drift (2 um over the whole test).
 LONG_TEST = {
     name: value
     for name, value in EXAMPLE.items()
