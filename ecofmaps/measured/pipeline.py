@@ -403,8 +403,7 @@ class Analysis:
         ``keep``: True to hand back each chunk's values and flags, or the path (a prefix) to
         keep them at (:func:`block_file`), where the chunk runs if the runner is local, else
         here as it comes."""
-        skip = set(skip)
-        wanted = [k for k in range(len(self.tasks)) if k not in skip]
+        wanted = sorted(set(range(len(self.tasks))) - set(skip))
         tasks = (self._task(k, then, keep, columns) for k in wanted)
         results = self.runner.map(measure_chunk, tasks)
         try:
@@ -419,8 +418,7 @@ class Analysis:
 
     def part(self, index: int, values: dict, flags: dict) -> xr.Dataset:
         """The per-cycle results of chunk ``index`` from what it measured (kept by
-        :meth:`measured`), as in :func:`ecofmaps.analyze_loops`'s Dataset (without the
-        recording's attributes); counted in :attr:`tally`."""
+        :meth:`measured`), without the recording's attributes; counted in :attr:`tally`."""
         labels = self.cycles.label[self.tasks[index]]
         part = _part(values, flags, labels, self.options)
         self.tally.add(part["quality"].values, flags, values["amplitude"])

@@ -333,7 +333,12 @@ def judged(values: dict, flags: dict, options):
     size = next(iter(flags.values())).size
     refused = _refusing(flags, size)
     recorded = {k: values[k] for k in _RECORDED if k in values}  # a refused cycle's too
-    values = _apply_quality({k: v for k, v in values.items() if k not in recorded}, flags, refused)
+    values = {k: np.where(refused, np.nan, v) for k, v in values.items() if k not in recorded}
+    for reason, flag in flags.items():
+        scope = REASONS[reason][1]
+        if scope != ALL:  # NaN where a flag's scope reaches
+            for name in set(scope) & set(values):
+                values[name] = np.where(flag, np.nan, values[name])
     sliding = gross_slip(values, options)
     regime = np.where(refused, INVALID, np.where(sliding, GROSS_SLIP, PARTIAL_SLIP))
     return values | recorded, quality_strings(flags, size), refused, regime
@@ -508,17 +513,6 @@ def refused(quality) -> np.ndarray:
         quality,
         lambda text: any(REASONS.get(r, ("", ()))[1] == ALL for r in text.split(SEPARATOR)),
     )
-
-
-def _apply_quality(values: dict, flags: dict, refusing) -> dict:
-    """``values`` (name -> per-cycle array) with NaN where a flag's scope reaches."""
-    result = {name: np.where(refusing, np.nan, value) for name, value in values.items()}
-    for reason, flag in flags.items():
-        scope = REASONS[reason][1]
-        if scope != ALL:
-            for name in set(scope) & set(result):
-                result[name] = np.where(flag, np.nan, result[name])
-    return result
 
 
 def quality_summary(quality) -> str:

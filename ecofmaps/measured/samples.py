@@ -390,7 +390,7 @@ class Samples:
     def __init__(self, displacement, force, cycle=None, missing=None, *, runner=None):
         self.arrays = (displacement, force, cycle, missing)
         self.size = int(displacement.shape[0])
-        self.lazy = any(is_lazy(a) for a in self.arrays if a is not None)
+        self.lazy = any(is_lazy(a) for a in self.arrays)
         self.runner = runner
         if self.lazy and runner is None:
             raise ValueError("a lazy recording needs a runner")
