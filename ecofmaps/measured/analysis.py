@@ -12,15 +12,8 @@ import xarray as xr
 
 from ecofmaps._inputs import si_units
 from ecofmaps._parallel import check_workers
+from ecofmaps.measured import pipeline
 from ecofmaps.measured.cycles import MIN_SAMPLES
-from ecofmaps.measured.pipeline import (
-    NAN_POLICIES,
-    Analysis,
-    LoopOptions,
-    Reading,
-    force_at_mean_load,
-    runner_for,
-)
 from ecofmaps.measured.resolve import ReadingOptions
 from ecofmaps.measured.samples import MissingSampleError, is_lazy
 
@@ -59,10 +52,10 @@ def analyze_loops(
     load,
     cycle=None,
     *,
-    hysteresis=LoopOptions.hysteresis,
-    stick_window=LoopOptions.stick_window,
-    crossing_window=LoopOptions.crossing_window,
-    gross_slip_threshold=LoopOptions.gross_slip_threshold,
+    hysteresis=pipeline.LoopOptions.hysteresis,
+    stick_window=pipeline.LoopOptions.stick_window,
+    crossing_window=pipeline.LoopOptions.crossing_window,
+    gross_slip_threshold=pipeline.LoopOptions.gross_slip_threshold,
     rig_stiffness=None,
     flip_force=False,
     resolve=False,
@@ -163,7 +156,7 @@ def analyze_loops(
     ok | 1 cycle: 1 ok
     """
     force, load, loads = _at_mean_load(force, load)
-    options = LoopOptions(
+    options = pipeline.LoopOptions(
         load,
         hysteresis,
         stick_window,
@@ -172,7 +165,7 @@ def analyze_loops(
         flip_force,
         rig_stiffness,
     )
-    reading = Reading(resolve=bool(resolve), keep_loops=bool(keep_loops))
+    reading = pipeline.Reading(resolve=bool(resolve), keep_loops=bool(keep_loops))
     return _run(
         displacement, force, cycle, options, reading, loads, missing, nan_policy, scheduler, workers
     )[0]
@@ -182,8 +175,8 @@ def _run(
     displacement,
     force,
     cycle,
-    options: LoopOptions,
-    reading: Reading,
+    options: pipeline.LoopOptions,
+    reading: pipeline.Reading,
     recorded=None,
     missing=None,
     nan_policy="skip",
@@ -191,8 +184,8 @@ def _run(
     workers=None,
 ):
     """The recording checked, through the pipeline: the results and the reading handed back."""
-    if nan_policy not in NAN_POLICIES:
-        raise ValueError(f"nan_policy must be one of {NAN_POLICIES}; got {nan_policy!r}")
+    if nan_policy not in pipeline.NAN_POLICIES:
+        raise ValueError(f"nan_policy must be one of {pipeline.NAN_POLICIES}; got {nan_policy!r}")
     if scheduler in (None, "threads", "processes"):  # on this machine: checked before any work
         check_workers(workers, processes=scheduler == "processes")
     x = _series("displacement", displacement)
@@ -213,14 +206,14 @@ def _run(
     if not any(is_lazy(a) for a in (x, q, label, mask)):
         if nan_policy == "raise":
             _raise_at_missing(x, q, label, mask, recorded)
-        return Analysis(x, q, label, one_chunk=True, **settings).run()
+        return pipeline.Analysis(x, q, label, one_chunk=True, **settings).run()
     if reading.keep_loops:
         raise ValueError(
             "keep_loops needs the recording in memory: give NumPy arrays (a long "
             "recording's loops would not fit)"
         )
-    with runner_for(scheduler, workers) as runner:
-        return Analysis(x, q, label, runner=runner, **settings).run()
+    with pipeline.runner_for(scheduler, workers) as runner:
+        return pipeline.Analysis(x, q, label, runner=runner, **settings).run()
 
 
 def _at_mean_load(force, load):
@@ -229,7 +222,7 @@ def _at_mean_load(force, load):
         return force, load, None
     force = _series("force", force)
     recorded = _series("load", load, force.shape[0])
-    return *force_at_mean_load(force, recorded), recorded
+    return *pipeline.force_at_mean_load(force, recorded), recorded
 
 
 def _raise_at_missing(x, q, label, mask, load=None) -> None:
@@ -257,8 +250,8 @@ def resolve_loops(
     central=ReadingOptions.central,
     slip_threshold=ReadingOptions.slip_threshold,
     stick_window=ReadingOptions.stick_window,
-    hysteresis=LoopOptions.hysteresis,
-    gross_slip_threshold=LoopOptions.gross_slip_threshold,
+    hysteresis=pipeline.LoopOptions.hysteresis,
+    gross_slip_threshold=pipeline.LoopOptions.gross_slip_threshold,
 ) -> xr.Dataset:
     r"""Friction and groove slope read along the whole stroke of every loop of a recording (the
     method and the quality flags: ``docs/method-loops.md``).
@@ -330,7 +323,9 @@ def resolve_loops(
     along_stroke = ReadingOptions(
         stiffness, force_offset, positions, central, slip_threshold, stick_window
     )
-    reading = Reading(resolve=True, along_stroke=along_stroke, hand_back=True)
+    reading = pipeline.Reading(resolve=True, along_stroke=along_stroke, hand_back=True)
     force, load, recorded = _at_mean_load(force, load)
-    options = LoopOptions(load, hysteresis, stick_window, gross_slip_threshold=gross_slip_threshold)
+    options = pipeline.LoopOptions(
+        load, hysteresis, stick_window, gross_slip_threshold=gross_slip_threshold
+    )
     return _run(displacement, force, cycle, options, reading, recorded)[1]

@@ -18,18 +18,9 @@ import xarray as xr
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._inputs import check
 from ecofmaps._parallel import Runner, stretch
-from ecofmaps.measured import resolve
+from ecofmaps.measured import quality, resolve
 from ecofmaps.measured.cycles import Cycles, find_cycles
 from ecofmaps.measured.measure import GROSS_SLIP_THRESHOLD, NEIGHBOURS, Stretch, measure_cycles
-from ecofmaps.measured.quality import (
-    COMPRESSION,
-    LOAD_SCALED,
-    RESOLVED,
-    Tally,
-    cycle_results,
-    load_flags,
-    scale_flags,
-)
 from ecofmaps.measured.samples import MissingSampleError
 
 __all__ = [
@@ -153,7 +144,7 @@ class Chunk:
     """What one chunk hands back (see :func:`measure_chunk`)."""
 
     part: xr.Dataset
-    tally: Tally
+    tally: quality.Tally
     values: dict | None = None
     flags: dict | None = None
     made: object = None
@@ -182,7 +173,7 @@ def force_at_mean_load(force, load):
     if np.isnan(mean):
         hint = "is it the normal load?"
         if lowest < 0.0:
-            hint = COMPRESSION
+            hint = quality.COMPRESSION
         raise ValueError(
             f"the recorded normal load is nowhere positive (from {lowest:g} N to "
             f"{highest + 0.0:g} N): {hint}"
@@ -202,7 +193,7 @@ def _at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
     """``dataset`` with the variables that scale with the normal load times ``ratio``, each
     cycle's load over the mean load (the rest are read at the mean load)."""
     ratio = np.asarray(ratio, dtype=np.float64)
-    scaled = (*LOAD_SCALED, "loop_force", "force_forward", "force_backward")
+    scaled = (*quality.LOAD_SCALED, "loop_force", "force_forward", "force_backward")
     return dataset.assign(
         {k: dataset[k].copy(data=(dataset[k].values.T * ratio).T) for k in scaled if k in dataset}
     )
@@ -240,19 +231,19 @@ def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
     if recorded_load is not None:
         mean, lowest, highest = _cycle_loads(recorded_load, task)
         values["normal_load"] = mean
-        flags |= load_flags(flags["missing-samples"], mean, lowest, highest)
-    flags |= scale_flags(values, options)
+        flags |= quality.load_flags(flags["missing-samples"], mean, lowest, highest)
+    flags |= quality.scale_flags(values, options)
     resolved = None
     if reading.resolve:
-        judged = _with_loops(cycle_results(values, flags, labels, options), loops)
+        judged = _with_loops(quality.cycle_results(values, flags, labels, options), loops)
         resolved, read = resolve.read_along_stroke(judged, reading.along_stroke)
-        values = values | {name: resolved[name].values for name in RESOLVED}
+        values = values | {name: resolved[name].values for name in quality.RESOLVED}
         flags = flags | read
     part = _part(values, flags, labels, options, loops if reading.keep_loops else None)
     handed = resolved if reading.hand_back else None
     if handed is not None and "normal_load" in values:  # as the part: at each cycle's load
         handed = _at_own_load(handed, values["normal_load"] / options.load)
-    tally = Tally()
+    tally = quality.Tally()
     tally.add(part["quality"].values, flags, values["amplitude"])
     if isinstance(task.keep, Path):
         _keep_block(task.keep, values, flags)
@@ -309,9 +300,9 @@ def only(part: xr.Dataset, columns=None) -> xr.Dataset:
 
 def _part(values: dict, flags: dict, labels, options, loops=None) -> xr.Dataset:
     """A chunk's results from what it measured, judged once, at each cycle's recorded load."""
-    measured = {k: v for k, v in values.items() if k not in RESOLVED}
-    part = cycle_results(measured, flags, labels, options)
-    read = [name for name in RESOLVED if name in values]
+    measured = {k: v for k, v in values.items() if k not in quality.RESOLVED}
+    part = quality.cycle_results(measured, flags, labels, options)
+    read = [name for name in quality.RESOLVED if name in values]
     part = part.assign({k: ("cycle", values[k], resolve.resolved_attrs(k)) for k in read})
     if loops is not None:
         part = _with_loops(part, loops)
@@ -360,7 +351,7 @@ class Analysis:
                     f"the recorded normal load at {at} is {load:g} N, not positive, and the "
                     "force is scaled by it",
                     "flags its cycle load-not-positive and analyses the others"
-                    + (f": {COMPRESSION}" if load < 0 else ""),
+                    + (f": {quality.COMPRESSION}" if load < 0 else ""),
                 )
             raise MissingSampleError(first)
         if cycles.label.size == 0:
@@ -376,7 +367,7 @@ class Analysis:
                 "the reading along the stroke on a grid of positions common to all cycles "
                 "needs the recording in one chunk (in memory); give the positions themselves"
             )
-        self.tally = Tally()
+        self.tally = quality.Tally()
         self._whole = np.flatnonzero(cycles.whole)  # the cycles a halo may hold
 
     def _task(self, index: int, then, keep, columns=None) -> tuple:
