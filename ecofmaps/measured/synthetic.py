@@ -19,10 +19,8 @@ from ecofmaps.model.simulation import simulate
 
 __all__ = [
     "EXAMPLE",
-    "EXAMPLE_FILE",
     "LONG_TEST",
     "SCAR_EXAMPLE",
-    "SCAR_EXAMPLE_FILE",
     "example_path",
     "example_recording",
     "long_recording",
@@ -134,9 +132,8 @@ def synthetic_recording(
     return displacement, force
 
 
-#: The parameters of the shipped example: the paper's Example 2 rig (Section 3) with a
-#: groove that deepens from flat to z_o/x_o = 0.2 over a 300 000-cycle test, one loop
-#: recorded every 2000 cycles.
+#: The parameters of the shipped example (SI units): the paper's Example 2 rig (Section 3),
+#: a groove deepening from flat over the test, one loop recorded every ``recorded_every``.
 EXAMPLE = {
     "amplitude": 50e-6,
     "load": 450.0,
@@ -153,9 +150,6 @@ EXAMPLE = {
     "displacement_drift": 2.0e-6,
     "seed": 20160101,
 }
-
-#: File name of the shipped example in ``ecofmaps/data``.
-EXAMPLE_FILE = "synthetic_fretting_test.csv"
 
 _HEADER = """\
 # SYNTHETIC DATA, not a measurement: made by ecofmaps.measured.synthetic.example_recording().
@@ -212,7 +206,7 @@ def write_example(path):
 
 def example_path() -> Path:
     """Path of the shipped example recording (see :func:`example_recording`)."""
-    return Path(str(importlib.resources.files("ecofmaps") / "data" / EXAMPLE_FILE))
+    return Path(str(importlib.resources.files("ecofmaps") / "data" / "synthetic_fretting_test.csv"))
 
 
 #: Parameters of the shipped example scar profile (SI units).
@@ -234,9 +228,6 @@ SCAR_EXAMPLE = {
     "centre": 1.34e-3,  # scar centre in the trace [m]
     "seed": 20161125,
 }
-
-#: File name of the shipped example scar profile in ``ecofmaps/data``.
-SCAR_EXAMPLE_FILE = "synthetic_scar_profile.csv"
 
 _SCAR_HEADER = """\
 # SYNTHETIC DATA, not a measurement: made by ecofmaps.measured.synthetic.scar_example_trace().
@@ -284,7 +275,7 @@ def write_scar_example(path):
 
 def scar_example_path() -> Path:
     """Path of the shipped example scar profile (see :func:`scar_example_trace`)."""
-    return Path(str(importlib.resources.files("ecofmaps") / "data" / SCAR_EXAMPLE_FILE))
+    return Path(str(importlib.resources.files("ecofmaps") / "data" / "synthetic_scar_profile.csv"))
 
 
 #: The default parameters of :func:`long_recording`: :data:`EXAMPLE`'s rig, sensors, groove
