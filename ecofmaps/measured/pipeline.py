@@ -171,9 +171,7 @@ def force_at_mean_load(force, load):
     if np.isnan(lowest):
         raise ValueError("the recorded normal load holds no value")
     if np.isnan(mean):
-        hint = "is it the normal load?"
-        if lowest < 0.0:
-            hint = quality.COMPRESSION
+        hint = quality.COMPRESSION if lowest < 0.0 else "is it the normal load?"
         raise ValueError(
             f"the recorded normal load is nowhere positive (from {lowest:g} N to "
             f"{highest + 0.0:g} N): {hint}"
