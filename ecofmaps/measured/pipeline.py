@@ -124,10 +124,9 @@ class Reading:
 
 @dataclasses.dataclass(frozen=True)
 class Task:
-    """One chunk's work besides its samples: its cycles with their halo, its own ``rows``
-    among them, the first sample ``low`` of its stretch, and what the analysis asks: ``then``
-    made of its results, the file to ``keep`` its values and flags in (:func:`_keep_block`) or
-    True to hand them back, and the ``columns`` of its results handed back."""
+    """One chunk's work besides its samples: its cycles with their halo, its own ``rows`` among
+    them, the first sample ``low`` of its stretch; ``then`` made of its results, the file to
+    ``keep`` its values and flags in (True: handed back) and the ``columns`` handed back."""
 
     cycles: Cycles
     rows: slice
@@ -389,9 +388,8 @@ class Analysis:
 
     def measured(self, skip=(), then=None, keep=False, columns=None):
         """Each chunk's :class:`Chunk`, in order, as they come; counted in :attr:`tally`.
-        ``keep``: True to hand back each chunk's values and flags, or the path (a prefix) to
-        keep them at (:func:`block_file`), where the chunk runs if the runner is local, else
-        here as it comes."""
+        ``keep``: True to hand back each chunk's values and flags, or the prefix to keep them at
+        (:func:`block_file`), where the chunk runs if the runner is local, else here."""
         wanted = sorted(set(range(len(self.tasks))) - set(skip))
         tasks = (self._task(k, then, keep, columns) for k in wanted)
         results = self.runner.map(measure_chunk, tasks)
