@@ -509,10 +509,8 @@ def has_reason(quality, reason: str) -> np.ndarray:
 
 def refused(quality) -> np.ndarray:
     """True for the cycles refused (a reason whose scope is every quantity)."""
-    return _by_text(
-        quality,
-        lambda text: any(REASONS.get(r, ("", ()))[1] == ALL for r in text.split(SEPARATOR)),
-    )
+    refusing = {reason for reason, (_, scope) in REASONS.items() if scope == ALL}
+    return _by_text(quality, lambda text: bool(refusing & set(text.split(SEPARATOR))))
 
 
 def quality_summary(quality) -> str:
