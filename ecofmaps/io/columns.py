@@ -173,16 +173,8 @@ _SYNONYM_KEYS = {role: frozenset(map(_plain, names)) for role, names in SYNONYMS
 
 
 def split_unit(name: str) -> tuple[str, str | None]:
-    """A column, channel or variable name's base (without its unit, surrounding quotes and
-    blanks) and the unit it carries as written (``'N'``, ``'mm'``, ``'µm'``), or None.
-
-    Examples
-    --------
-    >>> split_unit("force [N]"), split_unit("Displacement/µm"), split_unit("Ftr_kN")
-    (('force', 'N'), ('Displacement', 'µm'), ('Ftr', 'kN'))
-    >>> split_unit("time_s"), split_unit("Force (tangential)"), split_unit("Disp in mm")
-    (('time_s', None), ('Force (tangential)', None), ('Disp', 'mm'))
-    """
+    """A column name's base (without unit, quotes and surrounding blanks) and the unit it
+    carries as written (``'force [N]'``, ``'Displacement/µm'``, ``'Ftr_kN'``), or None."""
     text = name.strip().strip("\"'").strip()
     match = _BRACKETED.match(text)
     if match and match.group("base"):
@@ -197,23 +189,9 @@ def split_unit(name: str) -> tuple[str, str | None]:
 
 
 def find_column(names, wanted: str, role: str, *, required: bool = True) -> int | None:
-    """The index of the column ``wanted`` (matched as :func:`matching_columns` says) among
-    ``names``, the file's header cells, channels or variables; None for one not found and
-    not ``required``. The ``role`` (``'displacement'``, ``'force'``, ``'load'``,
-    ``'cycle'``, ``'x'``, ``'z'``) gives the synonyms and the messages.
-
-    A :class:`ColumnError` if no name matches (the message lists the columns and suggests
-    the nearest), or several do (it names them and the option that chooses).
-
-    Examples
-    --------
-    >>> find_column(["time", "Displacement [µm]", "Ftr_kN"], "displacement", "displacement")
-    1
-    >>> find_column(["time", "Displacement [µm]", "Ftr_kN"], "FTR", "force")
-    2
-    >>> find_column(["t [s]", "stroke_um", "friction_force_N"], "force", "force")
-    2
-    """
+    """The index among ``names`` of the column ``wanted`` (as :func:`matching_columns`), the
+    ``role`` giving synonyms and messages; None if not found and not ``required``, else a
+    :class:`ColumnError` listing the columns, or the matches and the option that chooses."""
     matches = matching_columns(names, wanted, role)
     if len(matches) > 1:
         found = listed_names([names[k] for k in matches])
@@ -319,15 +297,10 @@ def role_scale(role: str, name: str, option_unit, metadata=(), column=None) -> t
 
 
 def column_scale(role: str, option_unit, carried, column: str) -> tuple[float, str]:
-    """The factor from a column's values to SI (m or N), and the unit it stands for: the
-    unit ``option_unit`` (the option ``<role>_unit``; None to take the file's), else the
-    units ``carried`` by the file (its name and metadata), else :data:`DEFAULT_UNITS`.
-
-    A ValueError naming the option if ``option_unit`` is not a unit of the role's kind; a
-    :class:`ColumnError` naming the ``column`` if units disagree (an option against the
-    file, or two in the file), or the file gives a unit of another kind and no option
-    overrules it.
-    """
+    """The factor to SI of a column and its unit: ``option_unit`` (``<role>_unit``), else the
+    units ``carried`` by the file, else :data:`DEFAULT_UNITS`. A ValueError naming the option
+    for a unit not of the role's kind; a :class:`ColumnError` naming ``column`` if units
+    disagree, or the file's is of another kind and no option overrules it."""
     kind = KINDS[role]
     option = f"{role}_unit"
     given = None if option_unit is None else (option_unit, _factor(option_unit, kind, option))

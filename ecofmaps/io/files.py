@@ -56,11 +56,9 @@ def atomic_path(path, *, exclusive: bool = True):
 
     Parameters
     ----------
-    path : str or os.PathLike
-        The file to create or replace; its directory must exist.
-    exclusive : bool
-        Whether a ``path`` that did not exist is created, never replaced; False for a file
-        any writer may replace with the same content (a cache entry).
+    path, exclusive
+        As for :func:`atomic_store` (``exclusive=False`` for a file any writer may replace
+        with the same content, a cache entry).
 
     Returns
     -------
@@ -99,16 +97,16 @@ def _remove_dead_temporaries(path: Path) -> None:
 def _create(temporary: Path, path: Path) -> None:
     """Rename ``temporary`` to ``path``, or :class:`FileExistsError` if that exists by now."""
     try:
-        os.link(temporary, path)  # fails if path exists, unlike a rename
+        try:
+            os.link(temporary, path)  # fails if path exists, unlike a rename
+        except FileExistsError:
+            raise
+        except OSError:  # a file system without hard links: claim the name, then rename
+            open(path, "x").close()
+            os.replace(temporary, path)
+            return
     except FileExistsError:
         raise FileExistsError(errno.EEXIST, _RACED, str(path)) from None
-    except OSError:  # a file system without hard links: claim the name, then rename
-        try:
-            open(path, "x").close()
-        except FileExistsError:
-            raise FileExistsError(errno.EEXIST, _RACED, str(path)) from None
-        os.replace(temporary, path)
-        return
     temporary.unlink()
 
 
@@ -239,11 +237,9 @@ def _entry(path: Path) -> dict:
     """What the manifest keeps of ``path``."""
     if path.is_dir():
         return {"store": True}
-    digest = hashlib.sha256()
     with open(path, "rb") as stream:
-        for block in iter(lambda: stream.read(1 << 20), b""):
-            digest.update(block)
-    return {"size": path.stat().st_size, "sha256": digest.hexdigest()}
+        digest = hashlib.file_digest(stream, "sha256").hexdigest()
+    return {"size": path.stat().st_size, "sha256": digest}
 
 
 def written_by_ecofmaps(path) -> bool:

@@ -48,16 +48,8 @@ SI_UNITS = {"displacement": "m", "force": "N", "cycle": "1", "load": "N"}
 
 
 def si_values(values: np.ndarray, factor: float) -> np.ndarray:
-    """``values`` (in the file's unit, changed in place) times ``factor`` to SI; for a factor
-    10^-k, divided by the exact 10^k instead, so that a ``25`` read in µm is the float
-    nearest 25e-6 (one rounding, not two).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> bool(si_values(np.array([25.0]), 1e-6)[0] == 25e-6)
-    True
-    """
+    """``values`` (changed in place) times ``factor`` to SI; a factor 10^-k divides by the
+    exact 10^k, so that ``25`` in µm is the float nearest 25e-6 (one rounding, not two)."""
     if factor == 1.0:
         return values
     inverse = round(1.0 / factor)
@@ -103,12 +95,8 @@ class _MissingFile(FileNotFoundError):
 
 
 def check_regular_file(path) -> None:
-    """Raise :class:`RecordingError` unless ``path`` (a link followed) is a regular file.
-
-    A pipe, a device or a socket never ends, or blocks until another program writes: it
-    is refused by name before it is opened. ``FileNotFoundError`` for a missing one, with
-    the nearest name in its folder; ``OSError`` if it cannot be looked at.
-    """
+    """Refuse (:class:`RecordingError`) a ``path`` that is not a regular file: a pipe, device or
+    socket blocks or never ends. ``FileNotFoundError`` names the nearest name in its folder."""
     try:
         mode = os.stat(path).st_mode
     except FileNotFoundError:

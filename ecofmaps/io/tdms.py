@@ -219,14 +219,7 @@ def open_tdms_group(path, group: str | None = None) -> xr.Dataset:
 class TdmsBackendEntrypoint(BackendEntrypoint):
     """xarray's engine ``ecofmaps-tdms``: a TDMS group as a Dataset (channels as variables,
     named as in the file, ``units`` from ``unit_string``/``NI_UnitDescription``, read
-    lazily through npTDMS); the whole file as a DataTree.
-
-    Examples
-    --------
-    >>> from ecofmaps.io.tdms import TdmsBackendEntrypoint
-    >>> TdmsBackendEntrypoint().guess_can_open("rig.tdms")
-    True
-    """
+    lazily through npTDMS); the whole file as a DataTree."""
 
     description = "TDMS (LabVIEW) files through npTDMS, one group a Dataset (ecofmaps)"
     open_dataset_parameters = ("filename_or_obj", "drop_variables", "group")

@@ -17,16 +17,7 @@ __all__ = ["TextBackendEntrypoint"]
 
 class TextBackendEntrypoint(BackendEntrypoint):
     """xarray's engine ``ecofmaps-text``: a text recording (CSV, TSV, whitespace columns
-    under a header line) as a Dataset over ``sample``, variables named as its columns.
-
-    Examples
-    --------
-    >>> import xarray as xr
-    >>> from ecofmaps.measured.synthetic import example_path
-    >>> dataset = xr.open_dataset(example_path(), engine=TextBackendEntrypoint)
-    >>> [(name, dataset[name].attrs["units"]) for name in dataset.data_vars]
-    [('displacement', 'm'), ('force', 'N'), ('cycle', '1')]
-    """
+    under a header line) as a Dataset over ``sample``, variables named as its columns."""
 
     description = "Text recordings of fretting loops (CSV, TSV), in SI units (ecofmaps)"
     open_dataset_parameters = (
@@ -54,13 +45,8 @@ class TextBackendEntrypoint(BackendEntrypoint):
         nan_policy="propagate",
         block_bytes=None,
     ) -> xr.Dataset:
-        """The recording's columns (see :func:`ecofmaps.io.read_recording` for the options).
-
-        Raises
-        ------
-        RecordingError
-            For a file that is not a text recording, or a damaged one (naming the line).
-        """
+        """The recording's columns (options of :func:`ecofmaps.io.read_recording`); a
+        :class:`RecordingError` for a damaged file or one that is not text."""
         path = engine_path(filename_or_obj, "ecofmaps-text")
         kind = recording_format(path)
         if kind != "text":
