@@ -182,35 +182,31 @@ def _units(attrs) -> tuple:
     return ()
 
 
-def _listed(group: str, dataset: xr.Dataset) -> list[Variable]:
-    group = group.strip("/")
-    return [
-        Variable(
-            name=f"{group}/{name}" if group else str(name),
-            group=group,
-            short=str(name),
-            size=int(item.shape[0]),
-            units=_units(item.attrs),
-            chunk=_chunk(item),
-        )
-        for name, item in dataset.variables.items()
-        if item.ndim == 1 and np.issubdtype(item.dtype, np.number)
-    ]
-
-
-def _chunk(variable: xr.Variable) -> int:
-    chunks = variable.encoding.get("chunksizes") or variable.encoding.get("chunks")
-    return int(chunks[0]) if chunks else 0
-
-
 def variables(path, kind: str) -> list[Variable]:
     """The one-dimensional numeric channels or variables of a rig file."""
     groups = _GROUPS[kind](Path(path))
+    found = []
     try:
-        return [variable for name, ds in groups.items() for variable in _listed(name, ds)]
+        for key, dataset in groups.items():
+            group = key.strip("/")
+            for name, item in dataset.variables.items():
+                if item.ndim != 1 or not np.issubdtype(item.dtype, np.number):
+                    continue
+                chunks = item.encoding.get("chunksizes") or item.encoding.get("chunks")
+                found.append(
+                    Variable(
+                        name=f"{group}/{name}" if group else str(name),
+                        group=group,
+                        short=str(name),
+                        size=int(item.shape[0]),
+                        units=_units(item.attrs),
+                        chunk=int(chunks[0]) if chunks else 0,
+                    )
+                )
     finally:
         for dataset in groups.values():
             dataset.close()
+    return found
 
 
 def open_group(path, kind: str, group: str) -> xr.Dataset:

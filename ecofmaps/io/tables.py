@@ -77,19 +77,8 @@ def results_csv(results: xr.Dataset, *, file: str | None = None, header: bool = 
 
 
 def csv_text(table: pd.DataFrame, *, header: bool = True) -> str:
-    """``table`` (columns of floats, integers, booleans or text) as CSV text, numbers to 6
-    significant digits: what ``table.to_csv(index=False, float_format="%.6g",
-    lineterminator="\\n", header=header)`` writes, in half the time.
-
-    Examples
-    --------
-    >>> import pandas as pd
-    >>> print(csv_text(pd.DataFrame({"ecof": [0.8123456789, float("nan")], "note": ["a,b", "ok"]})))
-    ecof,note
-    0.812346,"a,b"
-    ,ok
-    <BLANKLINE>
-    """
+    """``table`` as CSV text, numbers to 6 significant digits: what ``table.to_csv(index=False,
+    float_format="%.6g", lineterminator="\\n", header=header)`` writes, in half the time."""
     stream = io.StringIO()
     writer = csv.writer(stream, lineterminator="\n")
     if header:
@@ -110,13 +99,9 @@ def csv_text(table: pd.DataFrame, *, header: bool = True) -> str:
 
 
 def read_results(path) -> list[xr.Dataset]:
-    """The per-cycle results, in SI units, of a CSV table that ``ecofmaps loops --out`` wrote
-    (in the tribologist's units) or of a netCDF file of :func:`ecofmaps.analyze_loops`'
-    results (``.nc``): one Dataset over ``cycle`` per recording (a table of several has a
-    ``file`` column), the quantities under their names in the API (the load is
-    ``normal_load`` when the table has it); a ValueError naming a file that is not such a
-    table.
-    """
+    """The per-cycle results in SI of a table ``ecofmaps loops --out`` wrote (CSV) or of a
+    netCDF file of :func:`ecofmaps.analyze_loops`: a Dataset over ``cycle`` per recording
+    (per value of a ``file`` column); a ValueError naming a file that is not such a table."""
     try:
         if str(path).endswith(".nc"):
             with xr.open_dataset(path) as results:

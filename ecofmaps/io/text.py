@@ -214,17 +214,6 @@ def _wanted(options: dict) -> dict:
     return wanted
 
 
-def _is_header(line: str, following: str | None, wanted: dict) -> bool:
-    """Whether ``line`` reads as the header."""
-    separator = _separator(line)
-    names = _header_names(line, separator)
-    if _numeric(names):
-        return False
-    if following is not None and len(_fields(following, separator)) != len(names):
-        return False
-    return all(matching_columns(names, name, role) for role, name in wanted.items())
-
-
 def _header_index(lines: list[str], options: dict) -> int | None:
     """The index in ``lines`` (the file's first lines) of the header line."""
     skip = options.get("skip_rows")
@@ -234,8 +223,12 @@ def _header_index(lines: list[str], options: dict) -> int | None:
         return data[0] if data else None
     wanted = _wanted(options)
     following = [lines[k] for k in data[1:]] + [None]
-    for k, after in zip(data, following, strict=True):
-        if _is_header(lines[k], after, wanted):
+    for k, after in zip(data, following, strict=True):  # the first line naming the columns
+        separator = _separator(lines[k])
+        names = _header_names(lines[k], separator)
+        if _numeric(names) or (after is not None and len(_fields(after, separator)) != len(names)):
+            continue
+        if all(matching_columns(names, name, role) for role, name in wanted.items()):
             return k
     numbers = [i for i, k in enumerate(data) if _numeric(_fields(lines[k], _separator(lines[k])))]
     return data[numbers[0] - 1] if numbers and numbers[0] > 0 else data[0]

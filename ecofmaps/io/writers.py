@@ -20,14 +20,8 @@ from ecofmaps.io.recordings import recording_blocks
 __all__ = ["WRITE_FORMATS", "RecordingWriter", "convert_recording"]
 
 #: The format written for each suffix.
-WRITE_FORMATS = {
-    ".zarr": "zarr",
-    ".h5": "hdf5",
-    ".hdf5": "hdf5",
-    ".nc": "hdf5",
-    ".tdms": "tdms",
-    ".csv": "text",
-}
+WRITE_FORMATS = {".zarr": "zarr", **dict.fromkeys((".h5", ".hdf5", ".nc"), "hdf5")}
+WRITE_FORMATS |= {".tdms": "tdms", ".csv": "text"}
 
 #: The attributes of each role's channel (SI units).
 ATTRS = {role: nomenclature.attrs(role) for role in ("displacement", "force", "cycle")}
