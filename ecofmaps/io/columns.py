@@ -151,11 +151,10 @@ def _unit_kind(unit: str) -> str | None:
     for kind in ("length", "force"):
         try:
             parse_quantity(f"1 {text}", kind)
+            return kind
         except ValueError as error:
             if "is not a" not in str(error):
                 return None  # not a unit at all
-            continue
-        return kind
     return "other"
 
 

@@ -296,29 +296,15 @@ def read_recording(
     )
 
 
-def open_recording(
-    path,
-    *,
-    displacement_column="displacement",
-    force_column="force",
-    cycle_column=None,
-    displacement_unit=None,
-    force_unit=None,
-    group=None,
-    nan_policy="propagate",
-    lazy=None,
-    chunks=None,
-    block_bytes=None,
-    load_column=None,
-    skip_rows=None,
-) -> xr.Dataset:
+def open_recording(path, **options) -> xr.Dataset:
     """A recording as one xarray Dataset over the dimension ``sample``, in SI units.
 
     Parameters
     ----------
-    path, displacement_column, force_column, cycle_column, displacement_unit, force_unit, \
-group, nan_policy, lazy, chunks, block_bytes, load_column, skip_rows
+    path : str or os.PathLike
         As for :func:`read_recording`.
+    **options
+        The options of :func:`read_recording`.
 
     Returns
     -------
@@ -340,7 +326,7 @@ group, nan_policy, lazy, chunks, block_bytes, load_column, skip_rows
     >>> dataset.displacement.attrs["unit_assumed"]  # the header gives no unit
     1
     """
-    return read_recording(**locals()).to_dataset()  # the parameters, passed on
+    return read_recording(path, **options).to_dataset()
 
 
 def recording_blocks(path, samples: int = 1 << 20, **options) -> Iterator[Recording]:

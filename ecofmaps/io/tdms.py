@@ -159,18 +159,7 @@ class TdmsArray(BackendArray):
 
 def _plain(value):
     """A property as an attribute value netCDF can hold (a time as ISO text)."""
-    if isinstance(value, str | int | float | np.number):
-        return value
-    return str(value)
-
-
-def _channel_attrs(properties) -> dict:
-    attrs = {key: _plain(value) for key, value in properties.items()}
-    for key in UNIT_PROPERTIES:
-        unit = attrs.get(key)
-        if isinstance(unit, str) and unit.strip() and "units" not in attrs:
-            attrs["units"] = unit.strip()
-    return attrs
+    return value if isinstance(value, str | int | float | np.number) else str(value)
 
 
 def _group_dataset(reader: TdmsReader, group) -> xr.Dataset:
@@ -181,8 +170,12 @@ def _group_dataset(reader: TdmsReader, group) -> xr.Dataset:
         size = len(channel)
         dim = "sample" if common and size == common[0][0] else f"sample_{size}"
         array = TdmsArray(reader, group.name, channel.name, size, channel.dtype)
-        data = indexing.LazilyIndexedArray(array)
-        variables[channel.name] = xr.Variable((dim,), data, _channel_attrs(channel.properties))
+        attrs = {key: _plain(value) for key, value in channel.properties.items()}
+        for key in UNIT_PROPERTIES:
+            unit = attrs.get(key)
+            if isinstance(unit, str) and unit.strip() and "units" not in attrs:
+                attrs["units"] = unit.strip()
+        variables[channel.name] = xr.Variable((dim,), indexing.LazilyIndexedArray(array), attrs)
     dataset = xr.Dataset(variables, attrs={k: _plain(v) for k, v in group.properties.items()})
     dataset.set_close(reader.close)
     return dataset

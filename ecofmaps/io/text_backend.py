@@ -47,24 +47,14 @@ class TextBackendEntrypoint(BackendEntrypoint):
     ) -> xr.Dataset:
         """The recording's columns (options of :func:`ecofmaps.io.read_recording`); a
         :class:`RecordingError` for a damaged file or one that is not text."""
+        options = {k: v for k, v in locals().items() if k in self.open_dataset_parameters[2:]}
         path = engine_path(filename_or_obj, "ecofmaps-text")
         kind = recording_format(path)
         if kind != "text":
             engine = "ecofmaps-tdms" if kind == "tdms" else {"hdf5": "h5netcdf"}.get(kind, kind)
             raise RecordingError(path, None, f"a {kind} file, not text: use engine={engine!r}")
-        dataset = open_recording(
-            path,
-            displacement_column=displacement_column,
-            force_column=force_column,
-            cycle_column=cycle_column,
-            displacement_unit=displacement_unit,
-            force_unit=force_unit,
-            nan_policy=nan_policy,
-            block_bytes=block_bytes,
-        )
-        dataset = dataset.rename_vars(
-            {name: v.attrs["source_column"] for name, v in dataset.items()}
-        )
+        dataset = open_recording(path, **options)
+        dataset = dataset.rename_vars({k: v.attrs["source_column"] for k, v in dataset.items()})
         return dataset.drop_vars(drop_variables or [], errors="ignore")
 
     def guess_can_open(self, filename_or_obj) -> bool:
