@@ -15,10 +15,9 @@ import zarr
 from nptdms import ChannelObject, GroupObject, RootObject, TdmsWriter
 
 from ecofmaps._parallel import Slice, stretch
-from ecofmaps.io.binary import Column
+from ecofmaps.io.binary import Column, variables
 from ecofmaps.io.recording_types import RecordingError, RecordingWarning
 from ecofmaps.io.recordings import read_recording, recording_blocks, recording_format
-from ecofmaps.io.rig_formats import variables
 
 SIZE = 5003
 RNG = np.random.default_rng(7)

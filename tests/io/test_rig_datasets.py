@@ -276,7 +276,7 @@ def test_stores_written_by_zarr_alone(tmp_path, zarr_format):
     attributes decoded by xarray; a store that is one array is its one variable."""
     import zarr
 
-    from ecofmaps.io.rig_formats import open_group, variables
+    from ecofmaps.io.binary import open_group, variables
 
     path = tmp_path / "plain.zarr"
     root = zarr.open_group(str(path), mode="w", zarr_format=zarr_format)

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 import xarray as xr
 
+from ecofmaps.io.binary import variables
 from ecofmaps.io.files import TEMPORARY_NAME, atomic_path, atomic_store
 from ecofmaps.io.recording_types import RecordingError
 from ecofmaps.io.recordings import read_recording
-from ecofmaps.io.rig_formats import variables
 from ecofmaps.io.writers import CHUNK_BYTES, RecordingWriter, convert_recording
 from ecofmaps.measured.synthetic import example_path
 
