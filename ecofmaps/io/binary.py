@@ -148,25 +148,19 @@ def _plain_zarr_groups(path: Path, root) -> dict[str, xr.Dataset]:
     return {name: xr.decode_cf(xr.Dataset(found), **_DECODING) for name, found in groups.items()}
 
 
-def _xarray_zarr_groups(path: Path, root, key: str | None = None) -> dict | None:
-    """The groups xarray opens (all, or the one at ``key``); None for a store without
-    dimension names."""
-    consolidated = root.metadata.consolidated_metadata is not None  # else xarray looks
-    try:
-        if key is None:
-            return xr.open_groups(path, consolidated=consolidated, **_ZARR)
-        return {key: xr.open_dataset(path, group=key, consolidated=consolidated, **_ZARR)}
-    except Exception as error:
-        if isinstance(error, KeyError) and any(name in str(error) for name in _NO_DIMENSIONS):
-            return None
-        raise RecordingError(path, None, f"cannot open as a zarr store: {error}") from None
-
-
 def _zarr_groups(path: Path, key: str | None = None) -> dict[str, xr.Dataset]:
     """The groups of a store (all, or the one at ``key``), by path (``'/'``, ``'/rig/run1'``)."""
     root = _zarr_root(path)
-    groups = _xarray_zarr_groups(path, root, key) if hasattr(root, "members") else None
-    return _plain_zarr_groups(path, root) if groups is None else groups
+    if hasattr(root, "members"):  # a group; a store without dimension names is read as plain
+        consolidated = root.metadata.consolidated_metadata is not None  # else xarray looks
+        try:
+            if key is None:
+                return xr.open_groups(path, consolidated=consolidated, **_ZARR)
+            return {key: xr.open_dataset(path, group=key, consolidated=consolidated, **_ZARR)}
+        except Exception as error:
+            if not isinstance(error, KeyError) or all(n not in str(error) for n in _NO_DIMENSIONS):
+                raise RecordingError(path, None, f"cannot open as a zarr store: {error}") from None
+    return _plain_zarr_groups(path, root)
 
 
 def _zarr_group(path: Path, group: str | None) -> xr.Dataset:
