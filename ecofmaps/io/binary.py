@@ -216,23 +216,6 @@ def open_group(path, kind: str, group: str) -> xr.Dataset:
     return _GROUP[kind](Path(path), group or None)
 
 
-def _check_complete(path, kind: str, variable: Variable) -> None:
-    """Refuse a zarr variable some of whose chunks are missing (zarr reads a missing chunk
-    as its fill value, so a truncated or partly copied store would read); other formats
-    check themselves when opened."""
-    if kind != "zarr":
-        return
-    root = _zarr_root(Path(path))
-    array = root[variable.name] if hasattr(root, "members") else root
-    expected = int(array.nchunks)
-    if missing := expected - int(array.nchunks_initialized):
-        raise RecordingError(
-            path,
-            f"variable {variable.name!r}",
-            f"{missing} of its {expected} chunks are missing (a truncated or partly copied store)",
-        )
-
-
 #: Samples per dask block when the file does not suggest a chunking.
 DEFAULT_CHUNK = 1 << 22
 
@@ -407,8 +390,18 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
     """A rig file as a :class:`~ecofmaps.io.recording_types.Recording` (see
     :func:`ecofmaps.io.read_recording` for the options)."""
     chosen = _select(path, kind, variables(path, kind), options)
-    for variable in chosen.values():
-        _check_complete(path, kind, variable)
+    if kind == "zarr":  # zarr reads a missing chunk as its fill value: refuse a partial store
+        root = _zarr_root(path)
+        for variable in chosen.values():
+            array = root[variable.name] if hasattr(root, "members") else root
+            expected = int(array.nchunks)
+            if missing := expected - int(array.nchunks_initialized):
+                raise RecordingError(
+                    path,
+                    f"variable {variable.name!r}",
+                    f"{missing} of its {expected} chunks are missing (a truncated or partly "
+                    "copied store)",
+                )
     columns, units, assumed = {}, {}, ()
     stat = path.stat()
     stamp = (stat.st_mtime_ns, stat.st_size)

@@ -280,10 +280,17 @@ class FileLineError(ValueError):
     path : pathlib.Path
         The file.
     line : int
-        1-based line number in the file.
+        1-based line number in the file (None in a :class:`~ecofmaps.io.RecordingError`
+        placed otherwise).
     """
 
-    def __init__(self, path, line: int, message: str):
+    def __init__(self, path, line, message: str):
         self.path = Path(path)
-        self.line = int(line)
-        super().__init__(f"{self.path}, line {self.line}: {message}")
+        self.message = message
+        if line is None or isinstance(line, str):  # a place in a file without lines
+            self.line, self.position = None, line or ""
+        else:
+            self.line = int(line)
+            self.position = f"line {self.line}"
+        where = f"{self.path}, {self.position}" if self.position else self.path
+        super().__init__(f"{where}: {message}")

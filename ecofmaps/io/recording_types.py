@@ -75,17 +75,6 @@ class RecordingError(FileLineError):
         given or ``''``).
     """
 
-    def __init__(self, path, line, message: str):
-        self.path = Path(path)
-        self.message = message
-        if line is None or isinstance(line, str):
-            self.line, self.position = None, line or ""
-        else:
-            self.line = int(line)
-            self.position = f"line {self.line}"
-        where = f"{self.path}, {self.position}" if self.position else self.path
-        ValueError.__init__(self, f"{where}: {message}")
-
 
 class _MissingFile(FileNotFoundError):
     """A file that is not there, said as ``<path>: no such file[: did you mean ...]``."""
