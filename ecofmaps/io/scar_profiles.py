@@ -53,9 +53,7 @@ def read_scar_profile(
     Returns
     -------
     profile : ScarProfile
-        In SI units (m), positions relative to the scar's centre; ``replaced`` marks the
-        samples replaced, ``alternative_half_width`` is the half-width not taken when the
-        edges were ambiguous (else NaN).
+        In SI units (m), positions relative to the scar's centre.
 
     Warns
     -----
