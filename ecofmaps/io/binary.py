@@ -24,7 +24,7 @@ from xarray.core import indexing
 from ecofmaps._parallel import SOURCE
 from ecofmaps.io.columns import ColumnError, listed_names, matching_columns, role_scale
 from ecofmaps.io.recording_types import LAZY_SAMPLES, Recording, RecordingError, si_values
-from ecofmaps.io.tdms import open_tdms_group, tdms_groups
+from ecofmaps.io.tdms import UNIT_PROPERTIES, open_tdms_group, tdms_groups
 
 __all__ = ["DEFAULT_CHUNK", "Column", "Variable", "open_group", "read_binary", "variables"]
 
@@ -32,7 +32,7 @@ __all__ = ["DEFAULT_CHUNK", "Column", "Variable", "open_group", "read_binary", "
 _NOUNS = {"tdms": "channel", "hdf5": "variable", "zarr": "variable"}
 
 #: Attributes that give a variable's unit, in the order they are looked at.
-UNIT_ATTRIBUTES = ("units", "unit", "Units", "Unit", "unit_string", "NI_UnitDescription")
+UNIT_ATTRIBUTES = ("units", "unit", "Units", "Unit", *UNIT_PROPERTIES)
 
 #: xarray's decoding: CF packing and fill values decoded, numbers left as numbers.
 _DECODING = dict(

@@ -158,10 +158,9 @@ class _Decoder:
                 return data.decode("utf-8")
             except UnicodeDecodeError as error:
                 line = first_line + data.count(b"\n", 0, error.start)
-                byte = data[error.start]
                 warn(
-                    f"{self.path}, line {line}: byte 0x{byte:02x} is not UTF-8; the file is "
-                    "read as Latin-1 from this line on (numbers are the same in both)",
+                    f"{self.path}, line {line}: byte 0x{data[error.start]:02x} is not UTF-8; the "
+                    "file is read as Latin-1 from this line on (numbers are the same in both)",
                     RecordingWarning,
                 )
                 self.encoding = "latin-1"

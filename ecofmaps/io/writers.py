@@ -151,8 +151,7 @@ class RecordingWriter:
         self.size += count
 
     def _first_chunks(self, arrays) -> tuple[int]:
-        """The variables' chunks, chosen at the first write: the recording's samples if fewer
-        than a chunk (the first write is then the last)."""
+        """The chunks, chosen at the first write: fewer samples if the recording has fewer."""
         return (max(1, min(self.chunk, next(iter(arrays.values())).size)),)
 
     def _open_zarr(self, stack) -> None:
