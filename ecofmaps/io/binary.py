@@ -390,6 +390,7 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
     """A rig file as a :class:`~ecofmaps.io.recording_types.Recording` (see
     :func:`ecofmaps.io.read_recording` for the options)."""
     chosen = _select(path, kind, variables(path, kind), options)
+    noun = _NOUNS[kind]
     if kind == "zarr":  # zarr reads a missing chunk as its fill value: refuse a partial store
         root = _zarr_root(path)
         for variable in chosen.values():
@@ -413,14 +414,12 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
                     role, variable.short, options[f"{role}_unit"], variable.units, variable.name
                 )
             except ColumnError as error:
-                raise RecordingError(
-                    path, f"{_NOUNS[kind]} {variable.name!r}", str(error)
-                ) from None
+                raise RecordingError(path, f"{noun} {variable.name!r}", str(error)) from None
         assumed += (role,) if unknown else ()
         columns[role] = Column(path, kind, variable, factor, options["nan_policy"], stamp)
     size = chosen["displacement"].size
     if size == 0:
-        raise RecordingError(path, f"{_NOUNS[kind]} {chosen['displacement'].name!r}", "no samples")
+        raise RecordingError(path, f"{noun} {chosen['displacement'].name!r}", "no samples")
     lazy = size > LAZY_SAMPLES if lazy is None else lazy
     if lazy:
         import dask.array as da
