@@ -20,7 +20,6 @@ __all__ = [
     "loop_measures",
     "path_means",
     "second_difference_medians",
-    "stick_line_fit",
     "stick_lines",
     "stretch_ranges",
     "zero_force_crossings",
@@ -52,12 +51,6 @@ _FIT_SAMPLES = 5
 #: below this share of its variance (a constant sliding force), the line :math:`Q = a + b\xi`
 #: is fitted.
 _COLLINEAR = 1e-24
-
-
-@numba.njit(**_COMPILE)
-def _maximum(a, b):
-    """The larger of ``a`` and ``b``, NaN if either is (as ``np.maximum``)."""
-    return a if a >= b or math.isnan(a) else b
 
 
 @numba.njit(**_COMPILE)
@@ -106,17 +99,6 @@ def _line_sums(u, v, end, segment, sums):
             uu += du * du
             vv += dv * dv
     sums[0], sums[1], sums[2], sums[3], sums[4], sums[5] = count, mean_u, mean_v, uv, uu, vv
-
-
-@numba.njit(**_COMPILE)
-def _squares_off(x, y, end, segment, intercept, slope):
-    """Sum of the squared displacements of the marked points off :math:`\\Delta = c + sQ`."""
-    squares = 0.0
-    for j in range(end):
-        if segment[j]:
-            residual = x[j] - intercept - slope * y[j]
-            squares += residual * residual
-    return squares
 
 
 @numba.njit(**_COMPILE)
@@ -186,9 +168,11 @@ def stick_lines(x, y, length, span, low, high):
         squares = 0.0
         for k in range(2):
             r, first = c + k * cycles, lines[k, 2] - slope * lines[k, 1]
-            squares += _squares_off(x[r], y[r], ends[k], segments[k], first, slope)
+            squares += _curved(x[r], y[r], ends[k], segments[k], first, slope, lines[k])[0]
         spread = math.sqrt(squares / max(lines[0, 0] + lines[1, 0] - 3.0, 1.0))
-        tolerance = _maximum(_STICK_SPREAD * spread, 1e-9 * span[c])
+        tolerance = _STICK_SPREAD * spread  # NaN if the spread is, as np.maximum
+        if not (tolerance >= 1e-9 * span[c] or math.isnan(tolerance)):
+            tolerance = 1e-9 * span[c]
         for k in range(2):
             r, first = c + k * cycles, lines[k, 2] - slope * lines[k, 1]
             ends[k] = _grow(x[r], y[r], length[r], segments[k], ends[k], first, slope, tolerance)
@@ -390,21 +374,14 @@ def interpolated(first, count, points, values):
             result[k] = values[j]
             k += 1
         slope = (values[j + 1] - values[j]) / (points[j + 1] - points[j])
-        for i in range(k, stop):
-            result[i] = _interpolated_at(first + i, points, values, j, slope)
+        for i in range(k, stop):  # from the segment's other end where the first try is NaN
+            result[i] = slope * (first + i - points[j]) + values[j]
+            if math.isnan(result[i]):
+                result[i] = slope * (first + i - points[j + 1]) + values[j + 1]
+                if math.isnan(result[i]) and values[j] == values[j + 1]:
+                    result[i] = values[j]
         k = stop
     return result
-
-
-@numba.njit(**_COMPILE)
-def _interpolated_at(at, points, values, j, slope):
-    """``np.interp`` at ``at`` on segment ``j``: from its other end where the first try is NaN."""
-    value = slope * (at - points[j]) + values[j]
-    if math.isnan(value):
-        value = slope * (at - points[j + 1]) + values[j + 1]
-        if math.isnan(value) and values[j] == values[j + 1]:
-            value = values[j]
-    return value
 
 
 @numba.njit(**_COMPILE)
@@ -527,18 +504,12 @@ def _fitted_peak(values, first, n, at, span, sign):
                 normal[r, c] -= factor * normal[col, c]
             sums[r] -= factor * sums[col]
     step = abs(sums[3]) > _STEP_T * sd * np.sqrt(normal[3, 3])  # its t over its standard error
-    return _intercept(normal, sums, 4 if 0 < steps < ends[0] + ends[1] - 2 and step else 3)
-
-
-@numba.njit(**_COMPILE)
-def _intercept(upper, right, m):
-    """The first unknown of the upper triangular system ``upper[:m, :m] x = right[:m]``."""
-    x = right[:m].copy()
-    for r in range(m - 1, -1, -1):
+    m = 4 if 0 < steps < ends[0] + ends[1] - 2 and step else 3  # the unknowns: with the step?
+    for r in range(m - 1, -1, -1):  # back substitution, for the first unknown
         for k in range(r + 1, m):
-            x[r] -= upper[r, k] * x[k]
-        x[r] /= upper[r, r]
-    return x[0]
+            sums[r] -= normal[r, k] * sums[k]
+        sums[r] /= normal[r, r]
+    return sums[0]
 
 
 @numba.njit(**_COMPILE)
@@ -582,18 +553,3 @@ def branch_stretches(values, start, end, length, width):
             rows[r, j] = values[start[r] + j]
         rows[r, length[r] - 1 :] = values[end[r]]
     return rows
-
-
-def stick_line_fit(u, regressors, stick):
-    """Least squares of ``u`` on 1 and ``regressors`` over the ``stick`` samples of each row:
-    the coefficients and the inverse of the normal matrix (identity below four samples)."""
-    columns = [stick.astype(np.float64), *(np.where(stick, r, 0.0) for r in regressors)]
-    normal = np.stack([np.stack([(a * b).sum(axis=1) for b in columns], -1) for a in columns], -2)
-    normal[stick.sum(axis=1) < 4] = np.eye(len(columns))
-    try:
-        inverse = np.linalg.inv(normal)
-    except np.linalg.LinAlgError:  # a degenerate loop (a constant force): least norm
-        inverse = np.linalg.pinv(normal)
-    return np.einsum(
-        "rik,rk->ri", inverse, np.stack([(a * u).sum(axis=1) for a in columns], -1)
-    ), inverse

@@ -323,32 +323,9 @@ def _drift(low: int, high: int, points, values, near: slice):
 
 
 def loop_ratios(amplitude, max_force, energy, slip, rig_stiffness=None) -> dict:
-    r"""The energy and opening ratios of loops, on the applied displacement and on the
-    contact's.
-
-    Parameters
-    ----------
-    amplitude, max_force, energy, slip : numpy.ndarray
-        Each loop's displacement amplitude :math:`\Delta^*` [m], force amplitude
-        :math:`Q^*` [N], dissipated energy :math:`E_d` [J] and slip amplitude
-        :math:`\delta^*` [m].
-    rig_stiffness : float, optional
-        The rig's own stiffness :math:`S` (not the loops' stick slope, the rig and the
-        contact in series). [N/m]
-
-    Returns
-    -------
-    ratios : dict of str to numpy.ndarray
-        ``energy_ratio`` :math:`A = E_d/(4\Delta^*Q^*)` and ``opening_ratio``
-        :math:`B = \delta^*/\Delta^*`; ``contact_amplitude`` :math:`\Delta^* - Q^*/S` [m],
-        ``contact_energy_ratio`` and ``contact_opening_ratio``, the same ratios on the
-        contact's displacement (NaN without ``rig_stiffness``). [1]
-
-    References
-    ----------
-    S. Fouvry, P. Kapsa, L. Vincent (1995), Analysis of sliding behaviour for fretting
-    loadings: determination of transition criteria, Wear 185, 35-46.
-    """
+    r"""The energy ratio :math:`A = E_d/(4\Delta^*Q^*)` and opening ratio
+    :math:`B = \delta^*/\Delta^*` of loops [1], and on the contact's displacement
+    :math:`\Delta^* - Q^*/S` [m] the same (NaN without the rig's ``rig_stiffness`` [N/m])."""
     contact = amplitude - max_force / (np.nan if rig_stiffness is None else rig_stiffness)
     with np.errstate(divide="ignore", invalid="ignore"):
         return {
@@ -472,7 +449,7 @@ def _mindlin_sliding(rows, max_force, span, candidates):
         rise = (q + force) / (2.0 * force)
         stick = valid & (rise < _MINDLIN_STICK)
         curve = 1.0 - np.cbrt(1.0 - np.minimum(rise, 1.0)) ** 2
-        line, inverse = kernels.stick_line_fit(u, (curve, q), stick)
+        line, inverse = _stick_line_fit(u, (curve, q), stick)
         share = line[:, 1] / (line[:, 1] + 2.0 * line[:, 2] * force[:, 0])
         # curved by a share of the stick's extent, its spring's compliance not below zero by
         # more: else not a sphere's (a flat contact's straight stick), and not fitted further
@@ -503,13 +480,24 @@ def _mindlin_sliding(rows, max_force, span, candidates):
     return found
 
 
+def _stick_line_fit(u, regressors, stick):
+    """Least squares of ``u`` on 1 and ``regressors`` over the ``stick`` samples of each row:
+    the coefficients and the inverse of the normal matrix (identity below four samples)."""
+    columns = [stick.astype(np.float64), *(np.where(stick, r, 0.0) for r in regressors)]
+    normal = np.stack([np.stack([(a * b).sum(axis=1) for b in columns], -1) for a in columns], -2)
+    normal[stick.sum(axis=1) < 4] = np.eye(len(columns))
+    try:
+        inverse = np.linalg.inv(normal)
+    except np.linalg.LinAlgError:  # a degenerate loop (a constant force): least norm
+        inverse = np.linalg.pinv(normal)
+    return np.einsum(
+        "rik,rk->ri", inverse, np.stack([(a * u).sum(axis=1) for a in columns], -1)
+    ), inverse
+
+
 def _noise_lift(block, values):
-    """Per cycle of ``block``, the highest the white noise on its ``values`` lifts an extreme
-    over the cycle's n samples, σ√(2 ln n), over :data:`NOISE_SHARE` (NaN for fewer than
-    :data:`_NOISE_SAMPLES` samples); σ from the lower quartile of the absolute second
-    differences, less a sine's own (-4 sin²(π/n) x, the loops centred) or as they are (a force
-    sliding at a constant value), whichever is less: the reversals and the stick do not reach
-    it. [m] or [N]"""
+    """Per cycle of ``block``, the highest the white noise on its ``values`` lifts an extreme,
+    over :data:`NOISE_SHARE` (NaN for too few samples). [m] or [N]"""
     count, offset = block.count, block.offset
     lift = np.full(count.size, np.nan)
     (rows,) = np.nonzero(count >= _NOISE_SAMPLES)
@@ -542,11 +530,9 @@ def _turns_back(x, band):
 
 
 def measure_cycles(cycles: Cycles, displacement, force, options, *, rows=None, keep_loops=False):
-    """The per-cycle values of :func:`ecofmaps.analyze_loops` for cycles already found, as
-    measured (not yet NaN where a check fails), the flags of the checks each cycle failed
-    (reason -> per cycle), and the centred loops NaN-padded over (cycle, point) if
-    ``keep_loops``. ``displacement`` and ``force`` give stretches by sample index [m], [N];
-    ``options`` is a :class:`~ecofmaps.measured.pipeline.LoopOptions`."""
+    """The per-cycle values of :func:`ecofmaps.analyze_loops` as measured (not yet NaN where a
+    check fails), the flags of the checks each cycle failed, and the centred loops NaN-padded
+    over (cycle, point) if ``keep_loops``."""
     first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
     names = _PER_CYCLE if options.rig_stiffness is None else _PER_CYCLE + _RIG_RATIOS
     values = {name: np.full(stop - first, np.nan) for name in names}
