@@ -268,8 +268,7 @@ def _checked_samples(displacement, force, load, hysteresis):
     if np.ndim(load) != 0:
         raise ValueError(f"load must be a single number [N], got shape {np.shape(load)}")
     within("hysteresis", hysteresis, 1.0)
-    all_x = np.asarray(displacement, dtype=np.float64)
-    all_y = np.asarray(force, dtype=np.float64)
+    all_x, all_y = (np.asarray(values, dtype=np.float64) for values in (displacement, force))
     for name, values in (("displacement", all_x), ("force", all_y)):
         if values.ndim != 1:
             raise ValueError(f"{name} must be one-dimensional, got shape {values.shape}")

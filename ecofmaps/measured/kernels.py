@@ -28,28 +28,23 @@ __all__ = [
 #: How numba compiles the kernels: cached on disk, NumPy's division by zero, no GIL held.
 _COMPILE = {"cache": True, "error_model": "numpy", "nogil": True}
 #: The lower quartile of the absolute sixth difference of white noise over its standard
-#: deviation (√924 times the noise's): a smooth loop's, sampled a few dozen times a cycle or
-#: more, is far below it.
+#: deviation: a smooth loop's, sampled a few dozen times a cycle or more, is far below it.
 _QUARTILE_SIXTH_DIFFERENCE = 0.3186393639643752 * np.sqrt(924.0)
 _SIXTH = np.array([1.0, -6.0, 15.0, -20.0, 15.0, -6.0, 1.0])
-#: A loop's extreme is read from the parabola fitted over the samples within this many
-#: noise standard deviations of it ...
-_EXTREME_DEPTH = 3.0
-#: ... where the noise exceeds this share of the loop's range (below, it is rounding); a
-#: step between the loop's last samples and its first counts beyond this many standard errors.
-_NOISE_FREE, _STEP_T = 1e-6, 3.0
+#: A loop's extreme is read from the parabola fitted over the samples within this many noise
+#: standard deviations of it, where the noise exceeds this share of the loop's range (below,
+#: it is rounding); a step where the loop closes counts beyond this many standard errors.
+_EXTREME_DEPTH, _NOISE_FREE, _STEP_T = 3.0, 1e-6, 3.0
 #: A stick segment grows until two samples in a row are this many standard deviations off.
 _STICK_SPREAD = 3.0
 #: A stick segment is curved when a term in the squared force, added to its line, is
-#: significant by more than this many standard errors ...
-_CURVATURE_T = 8.0
-#: ... and changes its slope from one end to the other by more than this share.
-_CURVATURE_CHANGE = 0.05
+#: significant by more than this many standard errors and changes its slope from one end to
+#: the other by more than this share.
+_CURVATURE_T, _CURVATURE_CHANGE = 8.0, 0.05
 #: Fewest samples in the window of the curve fitted at a GICoF crossing.
 _FIT_SAMPLES = 5
 #: In a GICoF window where the part of :math:`\xi Q` that :math:`\xi` does not explain has
-#: below this share of its variance (a constant sliding force), the line :math:`Q = a + b\xi`
-#: is fitted.
+#: below this share of its variance (a constant sliding force), :math:`Q = a + b\xi` is fitted.
 _COLLINEAR = 1e-24
 
 
@@ -245,10 +240,10 @@ def zero_force_crossings(x, y, length, band, intercept, across, rounding):
 
 
 @numba.njit(**_COMPILE)
-def _curve_intercept(scaled, product, window, y, begin, end):
+def _curve_intercept(scaled, product, window, y, n):
     r"""Intercept :math:`a` of :math:`Q = a + b\xi + c\xi Q` through the window, and its count."""
     count, sum_s, sum_z, sum_q = 0.0, 0.0, 0.0, 0.0
-    for j in range(begin, end):
+    for j in range(n):
         if window[j]:
             count += 1.0
             sum_s += scaled[j]
@@ -256,13 +251,13 @@ def _curve_intercept(scaled, product, window, y, begin, end):
             sum_q += y[j]
     mean_s, mean_z, mean_q = sum_s / count, sum_z / count, sum_q / count
     ss, sz, zz, sq = 0.0, 0.0, 0.0, 0.0
-    for j in range(begin, end):
+    for j in range(n):
         if window[j]:
             ds, dz, dq = scaled[j] - mean_s, product[j] - mean_z, y[j] - mean_q
             ss, sz, zz, sq = ss + ds * ds, sz + ds * dz, zz + dz * dz, sq + ds * dq
     ratio = sz / ss
     rr, rq = 0.0, 0.0
-    for j in range(begin, end):
+    for j in range(n):
         if window[j]:
             ds, dz, dq = scaled[j] - mean_s, product[j] - mean_z, y[j] - mean_q
             rest = dz - ratio * ds  # the part of ξQ that ξ does not explain
@@ -272,10 +267,10 @@ def _curve_intercept(scaled, product, window, y, begin, end):
 
 
 @numba.njit(**_COMPILE)
-def _window_holds(force, y, before, window, begin, end, pair, with_pair, rounding):
+def _window_holds(force, y, before, window, n, pair, with_pair, rounding):
     """Whether the window (and ``pair``) has samples both sides of the crossing, force within."""
     sides, lowest, highest = 0, np.inf, -np.inf
-    for j in range(begin, end):
+    for j in range(n):
         if window[j]:
             sides |= 1 if before[j] else 2
             lowest, highest = min(lowest, y[j]), max(highest, y[j])
@@ -302,14 +297,8 @@ def line_crossings(x, y, length, compliance, half_width, load, rounding):
             before[j] = side
             count += side
             window[j] = abs(position) <= h
-        begin, end = 0, n  # the window lies between these columns
-        while begin < n and not window[begin]:
-            begin += 1
-        while end > begin and not window[end - 1]:
-            end -= 1
-        for j in range(begin, end):
             if window[j]:
-                scaled[j] = (x[r, j] - y[r, j] * compliance[r]) / h
+                scaled[j] = position / h
                 product[j] = scaled[j] * y[r, j] / load
         previous, after = _sample_pair(n, count, width)
         before[previous] &= previous < n  # column -1: padding, never before the crossing
@@ -317,13 +306,13 @@ def line_crossings(x, y, length, compliance, half_width, load, rounding):
         v1 = x[r, after] - y[r, after] * compliance[r]
         q0, q1 = y[r, previous], y[r, after]
         share = v0 / (v0 - v1) if v0 - v1 != 0.0 else 0.5
-        intercept, fitted = _curve_intercept(scaled, product, window, y[r], begin, end)
+        intercept, fitted = _curve_intercept(scaled, product, window, y[r], n)
         # On the loop: the fitted window, or the pair interpolated between, holds samples
         # on both sides of ξ = 0, and the crossing's force lies within theirs.
         fits = fitted >= _FIT_SAMPLES
         force[r] = intercept if fits else q0 + share * (q1 - q0)
         holds = _window_holds(
-            force[r], y[r], before, window, begin, end, (previous, after), not fits, rounding[r]
+            force[r], y[r], before, window, n, (previous, after), not fits, rounding[r]
         )
         on_loop[r] = holds and (fits or (share >= 0.0 and share <= 1.0))
     return force, on_loop

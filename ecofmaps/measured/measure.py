@@ -140,8 +140,7 @@ class LoopBlock:
 
     def loops(self, width: int):
         """The loops as padded rows (cycle, point) of ``width`` points, NaN past each end."""
-        point = np.minimum(np.arange(width), self.count[:, None])
-        index = self.samples(point)
+        index = self.samples(np.minimum(np.arange(width), self.count[:, None]))
         inside = np.arange(width) <= self.count[:, None]
         return tuple(
             np.where(inside, values[index], np.nan) for values in (self.displacement, self.force)
@@ -163,15 +162,14 @@ def loop_blocks(
     if begin == end:  # no whole cycle among the rows
         return
     start, count = cycles.start[kept], cycles.count[kept]
-    size = kept.size
     middle, centre_x = _displacement_centres(start, count, displacement, begin, end)
-    centre_q = np.empty(size)
+    centre_q = np.empty(kept.size)
     ready = max(begin - _NOISE_REACH, 0)  # the force's centres are known below this cycle
     for block in _whole_blocks(cycles, kept, begin, end):
         # The centred values depend on the sample index alone. The force's drift within
         # the block needs the centres of the cycles on both sides of it, their noise
         # those of _NOISE_REACH cycles.
-        needed = min(block.stop + _NOISE_REACH, size)
+        needed = min(block.stop + _NOISE_REACH, kept.size)
         lower, upper = min(ready, block.start), max(needed, block.stop)
         low, high = int(start[lower]), int(start[upper - 1] + count[upper - 1])
         around = slice(max(lower - 1, 0), upper + 1)
@@ -201,10 +199,8 @@ def loop_blocks(
 
 def _drift_se(middle, count, centre, rows: slice):
     """``force_drift_se`` of the loops ``rows``: the branch offset the drift correction leaves."""
-    size = centre.size
-    first, stop = rows.start, rows.stop
-    noise = kernels.second_difference_medians(centre, first, stop, _NOISE_REACH)
-    noise /= SECOND_DIFFERENCE
+    first, stop, size = rows.start, rows.stop, centre.size
+    noise = kernels.second_difference_medians(centre, first, stop, _NOISE_REACH) / SECOND_DIFFERENCE
     if size == 2:  # no second difference: the one first difference, noise and drift
         noise = np.full(stop - first, abs(centre[1] - centre[0]) / np.sqrt(2.0))
     # The weights a_j of the centres in the offset, in the cycle's own period: a quarter
@@ -340,8 +336,7 @@ def loop_ratios(amplitude, max_force, energy, slip, rig_stiffness=None) -> dict:
 def _loop_values(block, options):
     """Every per-cycle quantity of a block of centred loops, and the checks it failed."""
     load = options.load
-    # The extremes, the loop's area by trapezoids (the segment that closes it included)
-    # and its top, where the rising branch ends.
+    # The extremes, the loop's area and its top, where the rising branch ends.
     highest, lowest, peak_force, energy, top = kernels.loop_measures(
         block.displacement, block.force, block.offset, block.count, block.rotation
     )
@@ -352,7 +347,6 @@ def _loop_values(block, options):
         for v in (block.displacement, block.force)
     )
     rows = branch_rows(block, top)
-    # Lines Δ = c + Q/S through the stick segments after the two reversals.
     compliance, intercept, across, residual, unexplained, curved = kernels.stick_lines(
         *rows, span, *options.stick_window
     )
@@ -362,7 +356,6 @@ def _loop_values(block, options):
     cycles = block.count.size
     slip = 0.5 * (crossing[cycles:] - crossing[:cycles])
     slope, half_width = np.tile(compliance, 2), np.tile(options.crossing_window * np.abs(slip), 2)
-    # Where each branch row crosses Q = SΔ: force, whether on the loop, displacement.
     force, on_loop = kernels.line_crossings(
         *rows, slope, half_width, float(load), 1e-9 * np.tile(peak_force, 2)
     )
@@ -398,8 +391,7 @@ def _loop_values(block, options):
     read |= {"gicof": (forward + backward) / (2.0 * load), "stiffness": spring}
     for name, value in read.items():
         values[name] = np.where(mindlin, value, values[name])
-    plateau = np.abs(values["gicof"] / values["cof_max"] - 1.0) <= _PLATEAU
-    on_plateau = sliding & plateau
+    on_plateau = sliding & (np.abs(values["gicof"] / values["cof_max"] - 1.0) <= _PLATEAU)
     flags = {
         "few-samples": block.count < MIN_SAMPLES,
         "constant-force": ~(block.force_swing > 0.0),

@@ -263,10 +263,6 @@ _CENTRAL_POINTS = 201
 _MAD = 1.482602218505602
 
 
-# Arrays of shape (cycles, width), rows running once round a loop from its lowest
-# displacement; ``valid`` marks the loop's points, NaN padding elsewhere.
-
-
 def _central_values(forward, backward, central, load):
     """mu_resolved, its variance, k and g0 of g ≈ g0 + kξ, the sensitivity to 1/S."""
     width = forward[0].shape[1]
@@ -422,7 +418,6 @@ def _along_stroke_values(x, q, load, stiffness, amplitude, inherited, options, d
     flags["gicof-varies"] = wavers & ((flag == 0) | (flag == 4)) & ~inherited
     lowest, highest = joined("lowest"), joined("highest")
     nan = np.where(ok, 1.0, np.nan)
-    compliance = joined("compliance")
     per_cycle = {
         "mu_resolved": mu_resolved * nan,
         "mu_resolved_se": np.sqrt(
@@ -434,11 +429,10 @@ def _along_stroke_values(x, q, load, stiffness, amplitude, inherited, options, d
         * nan,
         "aspect_ratio": 0.5 * k * amplitude * nan,
         "tilt": tilt * nan,
-        "stiffness": 1.0 / compliance,
+        "stiffness": 1.0 / joined("compliance"),
         "position_min": lowest * nan,
         "position_max": highest * nan,
     }
-    # Over the grid of positions common to all cycles: the values along the stroke.
     grid = options.positions
     if grid is None:
         return {}, per_cycle, flags, None

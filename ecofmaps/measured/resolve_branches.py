@@ -73,8 +73,7 @@ def _before(mask, branch):
 
 def _compliance(x, q, sticks):
     """Least-squares compliance common to lines Δ = ξ_s + cQ through each stick set."""
-    covariance = np.zeros(x.shape[0])
-    variance = np.zeros(x.shape[0])
+    covariance, variance = np.zeros((2, x.shape[0]))
     centred = []
     for mask in sticks:
         count = np.count_nonzero(mask, axis=1)[:, None]
@@ -251,10 +250,8 @@ def read_branches(forward, backward, grid, scale, inside, load):
     """Q+, Q-, μ and g at the positions ``scale * grid``, and the line weights of each branch."""
     q_forward, *line_forward = _resample(*forward, grid, scale, inside)
     q_backward, *line_backward = _resample(*backward, grid, scale, inside)
-    up = np.arctan(q_forward / load)
-    down = np.arctan(q_backward / load)
-    mu = np.tan(0.5 * (up - down))
-    slope = np.tan(0.5 * (up + down))
+    up, down = np.arctan(q_forward / load), np.arctan(q_backward / load)
+    mu, slope = np.tan(0.5 * (up - down)), np.tan(0.5 * (up + down))
     return q_forward, q_backward, mu, slope, (line_forward, line_backward)
 
 
