@@ -1,7 +1,5 @@
-r"""The model's steady loop fitted to a measured fretting loop (the paper's Figure 10):
-:func:`fit_loop`. The method is explained in ``docs/method-loops.md`` ("Fitting the model's
-loop").
-"""
+"""The model's steady loop fitted to a measured fretting loop (the paper's Figure 10):
+:func:`fit_loop`; ``docs/method-loops.md`` ("Fitting the model's loop")."""
 
 from __future__ import annotations
 
@@ -111,8 +109,7 @@ class LoopFit:
 
 def _rising_branch(target, mu, kappa, lam):
     r""":math:`Q/P` of the steady loop's rising branch at actuator position ``target``."""
-    d = slip_position(1.0, mu, kappa, lam)
-    stick = (target + d) / lam
+    stick = (target + slip_position(1.0, mu, kappa, lam)) / lam
     slip = traction_ratio(slip_position(target, mu, kappa, lam), mu, kappa)
     return jnp.minimum(stick, slip)
 
@@ -120,8 +117,7 @@ def _rising_branch(target, mu, kappa, lam):
 def _model_force(parameters, displacement, rising):
     """Model Q/P at each scaled sample; parameters (mu, s, a, A, c, q) as in :func:`fit_loop`."""
     mu, s, a, amplitude, centre, offset = parameters
-    lam = 1.0 / (s * amplitude)
-    kappa = 2.0 * a / amplitude
+    lam, kappa = 1.0 / (s * amplitude), 2.0 * a / amplitude
     target = (displacement - centre) / amplitude
     up = _rising_branch(target, mu, kappa, lam)
     down = -_rising_branch(-target, mu, kappa, lam)

@@ -1,8 +1,6 @@
-r"""Compiled (numba) kernels of the centring and the measuring steps
-(:mod:`ecofmaps.measured.measure`) and of the passes (:mod:`ecofmaps.measured.samples`), a loop
-or a branch row at a time, cached on disk; every array float64 and C-contiguous.
-The method is explained in ``docs/method-loops.md``.
-"""
+"""Compiled (numba) kernels of the measuring steps (:mod:`ecofmaps.measured.measure`, ``samples``),
+a loop or a branch row at a time, cached on disk; every array float64 and C-contiguous
+(``docs/method-loops.md``)."""
 
 from __future__ import annotations
 

@@ -1,8 +1,6 @@
-r"""Steps 3 and 4 of the loop pipeline: each loop centred (offsets and drift removed, a block of
-cycles at a time) and measured along its branch rows (amplitude, slip amplitude, energy,
-ECoF, stiffness, GICoF ...), with the flags of the checks each cycle failed.
-The method is explained in ``docs/method-loops.md`` ("Centring the loops", "Measuring each loop").
-"""
+"""Steps 3 and 4 of the loop pipeline: each loop centred (offsets and drift removed) and measured
+(amplitude, slip amplitude, energy, ECoF, stiffness, GICoF ...), with the flags of the checks
+each cycle failed; ``docs/method-loops.md`` ("Centring the loops", "Measuring each loop")."""
 
 from __future__ import annotations
 
@@ -416,10 +414,9 @@ def _loop_values(block, options):
         "mindlin-stick": mindlin,
         "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]) & ~mindlin,
         "partial-slip": ~sliding,
+        "noise-amplitude": (_noise_lift(block, block.displacement) > 0.5 * span)
+        | (_noise_lift(block, block.force) > peak_force),
     }
-    flags["noise-amplitude"] = (_noise_lift(block, block.displacement) > 0.5 * span) | (
-        _noise_lift(block, block.force) > peak_force
-    )
     return values, flags
 
 
@@ -446,8 +443,7 @@ def _mindlin_sliding(rows, max_force, span, candidates):
         # curved by a share of the stick's extent, its spring's compliance not below zero by
         # more: else not a sphere's (a flat contact's straight stick), and not fitted further
         curved = (share > _MINDLIN_SHARE) & (share < 1.0 / (1.0 - _MINDLIN_SHARE))
-        kept = curved[: pick.size] & curved[pick.size :]
-        both = np.tile(kept, 2)
+        both = np.tile(curved[: pick.size] & curved[pick.size :], 2)
         pick, line, inverse, u, q, valid, stick, curve, force = (
             v[both] for v in (np.tile(pick, 2), line, inverse, u, q, valid, stick, curve, force)
         )

@@ -1,8 +1,6 @@
-r"""Step 5 of the loop pipeline: friction and groove slope read along the whole stroke of each
-loop (:func:`resolve_analyzed_loops`), with the flags of its checks; the numerics of the slip
-branches are in :mod:`ecofmaps.measured.resolve_branches`.
-The method is explained in ``docs/method-loops.md`` ("Reading the loop along the stroke").
-"""
+"""Step 5 of the loop pipeline: friction and groove slope read along the whole stroke of each
+loop, with the flags of its checks (its numerics in ``resolve_branches``);
+``docs/method-loops.md`` ("Reading the loop along the stroke")."""
 
 from __future__ import annotations
 
@@ -216,7 +214,7 @@ def read_along_stroke(loops: xr.Dataset, options: ReadingOptions):
     given = options.stiffness is not None
     rig = np.full(x.shape[0], options.stiffness) if given else values("stiffness")
     quality, amplitude = loops["quality"].values, values("amplitude")
-    inherited = _reaches_resolved(quality)
+    inherited = np.logical_or.reduce([has_reason(quality, reason) for reason in _REACHING])
     with np.errstate(divide="ignore", invalid="ignore"):
         per_position, per_cycle, flags, grid = _along_stroke_values(
             x, q, load, rig, amplitude, inherited, options, values("force_drift_se")
@@ -361,20 +359,13 @@ def _along_stroke(part, grid, tilt, load, level):
     pieces = np.nan_to_num(0.5 * (slope[:, 1:] + slope[:, :-1]) * np.diff(grid))
     profile = np.concatenate([np.zeros((cycles, 1)), np.cumsum(pieces, axis=1)], axis=1)
     profile -= profile[:, np.searchsorted(grid, 0.0)][:, None]
-    felt = np.where(inside, profile, np.nan)
-    return dict(zip(_ALONG, (mu, slope, felt, q_forward, q_backward), strict=True))
+    return mu, slope, np.where(inside, profile, np.nan), q_forward, q_backward
 
 
-#: The values along the stroke, over (cycle, position).
+#: The values along the stroke, over (cycle, position), as :func:`_along_stroke` returns them.
 _ALONG = ("mu", "slope", "felt_profile", "force_forward", "force_backward")
-
-
-def _reaches_resolved(quality) -> np.ndarray:
-    """True for the cycles whose ``quality`` lists a reason that leaves the resolved values NaN."""
-    reaching = [
-        r for r, (_, scope) in REASONS.items() if scope == ALL or set(RESOLVED) & set(scope)
-    ]
-    return np.logical_or.reduce([has_reason(quality, reason) for reason in reaching])
+#: The reasons that leave the resolved values NaN.
+_REACHING = [r for r, (_, scope) in REASONS.items() if scope == ALL or set(RESOLVED) & set(scope)]
 
 
 def _blocks(cycles):
@@ -440,10 +431,10 @@ def _along_stroke_values(x, q, load, stiffness, amplitude, inherited, options, d
         reach = np.maximum(highest, -lowest)[ok]
         half = reach.max() if reach.size else np.max(amplitude, initial=0.0, where=amplitude > 0)
         grid = np.linspace(-1.0, 1.0, grid) * (half if half > 0.0 else 1.0)
-    per_position = {name: np.empty((cycles, grid.size)) for name in _ALONG}
     level = options.force_offset is None
-    for part, block in zip(parts, _blocks(cycles), strict=True):
-        along = _along_stroke(part, grid, per_cycle["tilt"][block], load, level)
-        for name in _ALONG:
-            per_position[name][block] = along[name]
+    along = [
+        _along_stroke(part, grid, per_cycle["tilt"][block], load, level)
+        for part, block in zip(parts, _blocks(cycles), strict=True)
+    ]
+    per_position = {name: np.concatenate([a[i] for a in along]) for i, name in enumerate(_ALONG)}
     return per_position, per_cycle, flags, grid

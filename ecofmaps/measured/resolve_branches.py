@@ -1,7 +1,6 @@
-r"""The numerics of the reading along the stroke (:mod:`ecofmaps.measured.resolve`): the stiffness
-and the slip of each branch, the branches resampled at contact positions, their noise and the
-weights of their samples in the standard errors; explained in ``docs/method-loops.md``.
-"""
+"""The numerics of the reading along the stroke: the stiffness and the slip of each branch, the
+branches resampled at contact positions, their noise and the weights of their samples in the
+standard errors (``docs/method-loops.md``)."""
 
 from __future__ import annotations
 
