@@ -191,8 +191,7 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
     Returns
     -------
     fit : LoopFit
-        The fitted :math:`\mu`, :math:`S`, :math:`z_o`, :math:`\Delta^*` (= :math:`x_o`),
-        the loop's centre, the residual, convergence information and the samples fitted.
+        The fitted model, its residual and convergence, and the samples fitted.
 
     Raises
     ------
@@ -326,8 +325,7 @@ def _solution(scaled_x, scaled_y, rising, start):
     """The least-squares fit of the model's loop to the scaled samples (scipy's result)."""
     # Padded with zero-weight samples to a multiple of _BUCKET, so that loops of nearly the
     # same length share one compiled residual and Jacobian.
-    size = _BUCKET * -(-scaled_x.size // _BUCKET)
-    pad = size - scaled_x.size
+    pad = -scaled_x.size % _BUCKET
     arguments = tuple(
         jnp.asarray(np.pad(values, (0, pad)))
         for values in (scaled_x, scaled_y, rising, np.ones(scaled_x.size))

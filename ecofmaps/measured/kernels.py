@@ -13,7 +13,6 @@ __all__ = [
     "branch_stretches",
     "detrended",
     "fitted_extremes",
-    "interpolated",
     "line_crossings",
     "loop_measures",
     "path_means",
@@ -345,30 +344,6 @@ def path_means(path, values, offset, count, closed):
             length += gap
         mean[k] = total / length
     return mean
-
-
-@numba.njit(**_COMPILE)
-def interpolated(first, count, points, values):
-    """``values`` interpolated linearly over ``points`` at the sample indices ``first`` to
-    ``first + count - 1``, to the bit as ``np.interp``."""
-    result = np.empty(count)
-    j, k = 0, 0
-    while k < count:  # the samples on segment j, from points[j] to before points[j + 1]
-        while points[j + 1] <= first + k:
-            j += 1
-        stop = min(count, math.ceil(points[j + 1]) - first)
-        if points[j] == first + k:
-            result[k] = values[j]
-            k += 1
-        slope = (values[j + 1] - values[j]) / (points[j + 1] - points[j])
-        for i in range(k, stop):  # from the segment's other end where the first try is NaN
-            result[i] = slope * (first + i - points[j]) + values[j]
-            if math.isnan(result[i]):
-                result[i] = slope * (first + i - points[j + 1]) + values[j + 1]
-                if math.isnan(result[i]) and values[j] == values[j + 1]:
-                    result[i] = values[j]
-        k = stop
-    return result
 
 
 @numba.njit(**_COMPILE)

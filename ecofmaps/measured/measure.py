@@ -289,30 +289,22 @@ def _displacement_centres(start, count, displacement, first: int, stop: int):
 
 
 def _drift(low: int, high: int, points, values, near: slice):
-    """``values`` interpolated over ``points`` at the samples ``low`` to ``high - 1``."""
-    xp, fp = points[near], values[near]
-    # Sample i lies on segment j when xp[j] <= i < xp[j + 1].
-    edges = np.clip(np.ceil(xp).astype(np.int64), low, high) - low
-    result = np.empty(high - low)
-    result[: edges[0]] = fp[0]
-    result[edges[-1] :] = fp[-1]
-    if xp.size > 1:  # every sample here lies on a segment between points
-        result[edges[0] : edges[-1]] = kernels.interpolated(
-            low + int(edges[0]), int(edges[-1] - edges[0]), xp, fp
-        )
+    """``values`` over ``points`` at the samples ``low`` to ``high - 1``: interpolated between the
+    points ``near``, extrapolated along the end segment beyond the first or last of all."""
+    at = np.arange(low, high, dtype=np.float64)
+    result = np.interp(at, points[near], values[near])
     if points.size < 2:
         return result
-    if near.start == 0 and edges[0] > 0:
-        at = np.arange(low, low + edges[0], dtype=np.float64)
-        result[: edges[0]] = values[0] + (at - points[0]) * (values[1] - values[0]) / (
+    if near.start == 0:
+        before = at < points[0]
+        result[before] = values[0] + (at[before] - points[0]) * (values[1] - values[0]) / (
             points[1] - points[0]
         )
     if near.stop >= points.size:
-        at = np.arange(low + edges[-1], high, dtype=np.float64)
         beyond = at > points[-1]
-        result[edges[-1] :][beyond] = values[-1] + (at[beyond] - points[-1]) * (
-            values[-1] - values[-2]
-        ) / (points[-1] - points[-2])
+        result[beyond] = values[-1] + (at[beyond] - points[-1]) * (values[-1] - values[-2]) / (
+            points[-1] - points[-2]
+        )
     return result
 
 
@@ -486,12 +478,11 @@ def _stick_line_fit(u, regressors, stick):
 def _noise_lift(block, values):
     """Per cycle of ``block``, the highest the white noise on its ``values`` lifts an extreme,
     over :data:`NOISE_SHARE` (NaN for too few samples). [m] or [N]"""
-    count, offset = block.count, block.offset
-    lift = np.full(count.size, np.nan)
-    (rows,) = np.nonzero(count >= _NOISE_SAMPLES)
+    lift = np.full(block.count.size, np.nan)
+    (rows,) = np.nonzero(block.count >= _NOISE_SAMPLES)
     if not rows.size:
         return lift
-    offset, count = offset[rows], count[rows]
+    offset, count = block.offset[rows], block.count[rows]
     j = np.arange(1, int(count.max()) - 1)
     inside = j < count[:, None] - 1
     at = offset[:, None] + np.where(inside, j, 1)
@@ -510,8 +501,7 @@ def _noise_lift(block, values):
 
 def _turns_back(x, band):
     """True for the cycles whose displacement turns back within a branch row by over ``band``."""
-    cycles = band.size
-    rising, falling = x[:cycles], x[cycles:]
+    rising, falling = x[: band.size], x[band.size :]
     drop = np.max(np.maximum.accumulate(rising, axis=1) - rising, axis=1)
     rise = np.max(falling - np.minimum.accumulate(falling, axis=1), axis=1)
     return np.maximum(drop, rise) > band
@@ -548,14 +538,13 @@ def measure_cycles(cycles: Cycles, displacement, force, options, *, rows=None, k
 
 def branch_rows(block, top):
     """The rising branches (start to top) and falling ones (top to the end) as rows."""
-    cycles = top.size
     first = np.concatenate([np.zeros_like(top), top])
     last = np.concatenate([top, block.count])
     length = last - first + 1
     width = int(length.max())
     if not block.continuous:  # a loop may begin inside its stretch and wrap round it
         point = np.minimum(first[:, None] + np.arange(width), last[:, None])
-        index = block.samples(point, np.tile(np.arange(cycles), 2))
+        index = block.samples(point, np.tile(np.arange(top.size), 2))
         return block.displacement[index], block.force[index], length
     # Each row is a stretch of the samples from its reversal on, up to its last point:
     # the top of a rising branch; the loop's first sample, which closes a falling one.
