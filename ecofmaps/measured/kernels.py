@@ -185,12 +185,6 @@ def stick_lines(x, y, length, span, low, high):
 
 
 @numba.njit(**_COMPILE)
-def _before(value, rising):
-    """Whether a sample lies before the crossing (below zero rising, above falling)."""
-    return value < 0.0 if rising else value > 0.0
-
-
-@numba.njit(**_COMPILE)
 def _sample_pair(length, count, width):
     """The columns of the two samples around a row's crossing (-1 read as NumPy does)."""
     after = min(max(count, 1), length - 1)
@@ -206,9 +200,9 @@ def zero_force_crossings(x, y, length, band, intercept, across, rounding):
     near, line = np.zeros(width, np.bool_), np.empty(6)
     for r in range(rows):
         n, rising = length[r], r < rows // 2
-        count = 0
+        count = 0  # samples before the crossing: below zero rising, above falling
         for j in range(n):
-            count += _before(y[r, j], rising)
+            count += y[r, j] < 0.0 if rising else y[r, j] > 0.0
             near[j] = abs(y[r, j]) <= band[r]
         previous, after = _sample_pair(n, count, width)
         near[after] = True
@@ -290,7 +284,7 @@ def line_crossings(x, y, length, compliance, half_width, load, rounding):
         count = 0
         for j in range(n):
             position = x[r, j] - y[r, j] * compliance[r]  # the contact position (eq. 10)
-            side = _before(position, rising)
+            side = position < 0.0 if rising else position > 0.0
             before[j] = side
             count += side
             window[j] = abs(position) <= h

@@ -88,16 +88,14 @@ _MEASURED = tuple(
 #: A gross-slip loop whose GICoF lies within this share of Q*/P is crossed by its stick line
 #: where it slides at a constant force: its GICoF is read even if its stick sides are curved.
 _PLATEAU = 0.02
-#: A sphere's stick part is fitted with Mindlin's law where the force has risen by less than
-#: this share of the way to its sliding value (the law is steep beyond), ...
-_MINDLIN_STICK = 0.9
-#: ... and follows it when the fit leaves no more than this many times the displacement's
-#: noise, or this share of the stroke, and each branch slides over this many samples; its
-#: curved part must be this share of the stick's extent and this many standard errors.
-_MINDLIN_SPREAD, _MINDLIN_ROUNDING, _MINDLIN_SLIDING = 3.0, 1e-3, 3
-_MINDLIN_SHARE, _MINDLIN_T = 0.05, 5.0
-#: The samples of a branch of which the first pass of the fit reads about this many.
-_MINDLIN_SIFT = 32
+#: Mindlin's law (docs/method-loops.md) is fitted to the stick where the force has risen by less
+#: than this share of the way to its sliding value (the law is steep beyond); it is followed when
+#: its curved part is this share of the stick's extent and this many standard errors, the fit
+#: leaves no more than this many times the displacement's noise or this share of the stroke, and
+#: each branch slides over this many samples. The first of three passes reads about this many
+#: samples a branch.
+_MINDLIN_STICK, _MINDLIN_SHARE, _MINDLIN_T = 0.9, 0.05, 5.0
+_MINDLIN_SPREAD, _MINDLIN_ROUNDING, _MINDLIN_SLIDING, _MINDLIN_SIFT = 3.0, 1e-3, 3, 32
 #: Samples with :math:`|Q|` below this share of :math:`Q^*` locate a zero-force crossing
 #: that is not on a stick segment.
 _ZERO_FORCE_BAND = 0.25
@@ -204,10 +202,9 @@ def _drift_se(middle, count, centre, rows: slice):
     # The weights a_j of the centres in the offset, in the cycle's own period: a quarter
     # of the slope to each neighbour, or half the one line over the whole cycle at an end.
     i = np.arange(first, stop)
-    period = count[i].astype(np.float64)
     has_left, has_right = i > 0, i < size - 1
-    left = (middle[i] - middle[np.maximum(i - 1, 0)]) / period
-    right = (middle[np.minimum(i + 1, size - 1)] - middle[i]) / period
+    left = (middle[i] - middle[np.maximum(i - 1, 0)]) / count[i]
+    right = (middle[np.minimum(i + 1, size - 1)] - middle[i]) / count[i]
     share = np.where(has_left & has_right, 0.25, 0.5)
     a_left = np.where(has_left, -share / np.where(has_left, left, 1.0), 0.0)
     a_right = np.where(has_right, share / np.where(has_right, right, 1.0), 0.0)
@@ -522,9 +519,8 @@ def measure_cycles(cycles: Cycles, displacement, force, options, *, rows=None, k
         width = int(cycles.count[first:stop].max()) + 1
         loops = tuple(np.full((stop - first, width), np.nan) for _ in range(2))
     sign = -1.0 if options.flip_force else 1.0
-    blocks = loop_blocks(cycles, displacement, force, slice(first, stop), sign)
     with np.errstate(divide="ignore", invalid="ignore"):  # degenerate cycles give NaN
-        for block in blocks:
+        for block in loop_blocks(cycles, displacement, force, slice(first, stop), sign):
             check_interrupted()
             out = slice(block.rows.start - first, block.rows.stop - first)
             for table, part in zip((values, flags), _loop_values(block, options), strict=True):

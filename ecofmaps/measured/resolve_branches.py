@@ -220,10 +220,9 @@ def _resample(xs, qs, count, grid, scale, inside):
     # The three samples around the position: left - 1, left, left + 1, or 0, 1, 2 at the start.
     middle = np.clip(left, 1, np.maximum(count - 2, 1)[:, None])
     last = np.maximum(count - 1, 0)[:, None]
-    flat_x, flat_q = xs.ravel(), qs.ravel()
     index = [base + np.minimum(middle + k, last) for k in (-1, 0, 1)]
-    xa, xb, xc = (flat_x[i] for i in index)
-    qa, qb, qc = (flat_q[i] for i in index)
+    xa, xb, xc = (xs.ravel()[i] for i in index)
+    qa, qb, qc = (qs.ravel()[i] for i in index)
     first = left == middle
     x0, x1 = np.where(first, xb, xa), np.where(first, xc, xb)
     q0, q1 = np.where(first, qb, qa), np.where(first, qc, qb)
