@@ -47,8 +47,7 @@ class LoopFit:
     aspect_ratio : float
         Groove aspect ratio :math:`z_o/x_o` with :math:`x_o = \Delta^*`. [1]
     amplitude : float
-        Displacement amplitude :math:`\Delta^*` of the fitted loop, also the groove's
-        :math:`x_o`. [m]
+        Displacement amplitude :math:`\Delta^*` of the fitted loop. [m]
     displacement_offset, force_offset : float
         Centre of the fitted loop in displacement [m] and in force [N] (sensor offsets).
     load : float

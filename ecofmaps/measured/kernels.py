@@ -220,9 +220,8 @@ def zero_force_crossings(x, y, length, band, intercept, across, rounding):
         # zero force there, or the chord.
         x0, x1, y0, y1 = x[r, previous], x[r, after], y[r, previous], y[r, after]
         if not inside:
-            low, high = min(x0, x1) - rounding[r], max(x0, x1) + rounding[r]
             share = y0 / (y0 - y1) if y0 != y1 else 0.5
-            between = intercept[r] >= low and intercept[r] <= high
+            between = min(x0, x1) - rounding[r] <= intercept[r] <= max(x0, x1) + rounding[r]
             at = intercept[r] if between else x0 + share * (x1 - x0)
         crossing[r] = at
         straddle = y0 * y1 <= 0.0 and y0 != y1
@@ -481,11 +480,10 @@ def fitted_extremes(values, offset, count, least):
             top = i if values[first + i] > values[first + top] else top
             bottom = i if values[first + i] < values[first + bottom] else bottom
         highest[k], lowest[k] = values[first + top], values[first + bottom]
-        if n < least:
-            continue
-        span = highest[k] - lowest[k]
-        highest[k] += _fitted_peak(values, first, n, top, span, 1.0)
-        lowest[k] -= _fitted_peak(values, first, n, bottom, span, -1.0)
+        if n >= least:
+            span = highest[k] - lowest[k]
+            highest[k] += _fitted_peak(values, first, n, top, span, 1.0)
+            lowest[k] -= _fitted_peak(values, first, n, bottom, span, -1.0)
     return highest, lowest
 
 

@@ -299,8 +299,7 @@ def _central_values(forward, backward, central, load):
     varies = (np.abs(variation) > VARIATION * np.abs(mu_resolved)) & (
         np.abs(variation) > VARIATION_SIGNIFICANCE * np.sqrt(variation_variance)
     )
-    mean_xi = masked_sum(at, finite) / points
-    mean_g = masked_sum(slope, finite) / points
+    mean_xi, mean_g = masked_sum(at, finite) / points, masked_sum(slope, finite) / points
     dxi = at - mean_xi[:, None]
     k = masked_sum(dxi * (slope - mean_g[:, None]), finite) / masked_sum(dxi**2, finite)
     # The sensitivities of mu_resolved to the compliance 1/S and to a shift of the rising
@@ -368,16 +367,12 @@ _ALONG = ("mu", "slope", "felt_profile", "force_forward", "force_backward")
 _REACHING = [r for r, (_, scope) in REASONS.items() if scope == ALL or set(RESOLVED) & set(scope)]
 
 
-def _blocks(cycles):
-    """Slices of at most ``_BLOCK`` cycles: the arrays of a block stay in the cache."""
-    return [slice(start, start + _BLOCK) for start in range(0, max(cycles, 1), _BLOCK)]
-
-
 def _along_stroke_values(x, q, load, stiffness, amplitude, inherited, options, drift_se):
     """Every resolved quantity of the centred loops ``x``, ``q``."""
     cycles, valid = x.shape[0], np.isfinite(x) & np.isfinite(q)
+    blocks = [slice(start, start + _BLOCK) for start in range(0, max(cycles, 1), _BLOCK)]
     parts = []
-    for block in _blocks(cycles):
+    for block in blocks:
         check_interrupted()
         part = slip_branches(*(a[block] for a in (x, q, valid, stiffness, amplitude)), options)
         lowest, highest = part["lowest"], part["highest"]
@@ -434,7 +429,7 @@ def _along_stroke_values(x, q, load, stiffness, amplitude, inherited, options, d
     level = options.force_offset is None
     along = [
         _along_stroke(part, grid, per_cycle["tilt"][block], load, level)
-        for part, block in zip(parts, _blocks(cycles), strict=True)
+        for part, block in zip(parts, blocks, strict=True)
     ]
     per_position = {name: np.concatenate([a[i] for a in along]) for i, name in enumerate(_ALONG)}
     return per_position, per_cycle, flags, grid
