@@ -154,8 +154,7 @@ def _starting_values(x, y, rising, analysis, length, load):
             "the loop shows no gross slip (no slip segment between the stick segments, or "
             "too few samples on it), so mu and the groove depth cannot be fitted"
         )
-    sign = np.where(rising, 1.0, -1.0)
-    design = np.stack([sign[slipping], contact[slipping]], axis=1)
+    design = np.stack([np.where(rising, 1.0, -1.0)[slipping], contact[slipping]], axis=1)
     (mu, slope), *_ = np.linalg.lstsq(design, y[slipping], rcond=None)
     if mu <= 0:
         raise ValueError("the loop's slip segments give mu <= 0: it is not a fretting loop")

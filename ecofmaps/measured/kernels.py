@@ -148,9 +148,7 @@ def stick_lines(x, y, length, span, low, high):
     compliance, intercept = np.empty(cycles), np.empty(rows)
     residual, unexplained = np.empty(cycles), np.empty(cycles)
     across, curved = np.zeros(rows, np.bool_), np.zeros(cycles, np.bool_)
-    segments = np.zeros((2, width), np.bool_)
-    ends = np.empty(2, np.int64)  # each segment lies before its column
-    lines = np.empty((2, 6))
+    segments, ends, lines = np.zeros((2, width), np.bool_), np.empty(2, np.int64), np.empty((2, 6))
     for c in range(cycles):
         for k in range(2):
             r = c + k * cycles
@@ -162,7 +160,7 @@ def stick_lines(x, y, length, span, low, high):
             r, first = c + k * cycles, lines[k, 2] - slope * lines[k, 1]
             squares += _curved(x[r], y[r], ends[k], segments[k], first, slope, lines[k])[0]
         spread = math.sqrt(squares / max(lines[0, 0] + lines[1, 0] - 3.0, 1.0))
-        tolerance = _STICK_SPREAD * spread  # NaN if the spread is, as np.maximum
+        tolerance = _STICK_SPREAD * spread  # the larger, NaN if either is (as np.maximum)
         if not (tolerance >= 1e-9 * span[c] or math.isnan(tolerance)):
             tolerance = 1e-9 * span[c]
         for k in range(2):

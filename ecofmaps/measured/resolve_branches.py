@@ -114,7 +114,7 @@ def _stick_and_slip(xi, branches, sticks, floor, slip_threshold):
     return sigma, slips, levels
 
 
-def _branch_shift(xi, branches, slips, levels):
+def _branch_shift(xi, slips, levels):
     r"""How far the rising branch's slip lies beyond the falling one's, in ξ, per cycle."""
     gaps = []
     for slip, level in zip(slips, levels[::-1], strict=True):
@@ -185,7 +185,7 @@ def slip_branches(x, q, valid, stiffness, amplitude, options):
     sigma, slips, levels = _stick_and_slip(xi, branches, sticks, floor, slip_threshold)
     if given:  # a stiffness that does not fit the stick sides tilts both alike in ξ
         mismatch = mismatch | _tilted_alike(xi, q, sticks, _TILT_SPREAD * sigma + floor, floor)
-    shift = _branch_shift(xi, branches, slips, levels)
+    shift = _branch_shift(xi, slips, levels)
     forward, backward = (_sorted_branch(xi, q, slip) for slip in slips)
     ends = []
     for xs, _, count in (forward, backward):
