@@ -1,7 +1,5 @@
-r"""The model's steady loop fitted to a measured fretting loop (the paper's Figure 10):
-:func:`fit_loop`. The method is explained in ``docs/method-loops.md`` ("Fitting the model's
-loop").
-"""
+"""The model's steady loop fitted to a measured fretting loop (the paper's Figure 10):
+:func:`fit_loop`; ``docs/method-loops.md`` ("Fitting the model's loop")."""
 
 from __future__ import annotations
 
@@ -49,8 +47,7 @@ class LoopFit:
     aspect_ratio : float
         Groove aspect ratio :math:`z_o/x_o` with :math:`x_o = \Delta^*`. [1]
     amplitude : float
-        Displacement amplitude :math:`\Delta^*` of the fitted loop, also the groove's
-        :math:`x_o`. [m]
+        Displacement amplitude :math:`\Delta^*` of the fitted loop. [m]
     displacement_offset, force_offset : float
         Centre of the fitted loop in displacement [m] and in force [N] (sensor offsets).
     load : float
@@ -111,8 +108,7 @@ class LoopFit:
 
 def _rising_branch(target, mu, kappa, lam):
     r""":math:`Q/P` of the steady loop's rising branch at actuator position ``target``."""
-    d = slip_position(1.0, mu, kappa, lam)
-    stick = (target + d) / lam
+    stick = (target + slip_position(1.0, mu, kappa, lam)) / lam
     slip = traction_ratio(slip_position(target, mu, kappa, lam), mu, kappa)
     return jnp.minimum(stick, slip)
 
@@ -120,8 +116,7 @@ def _rising_branch(target, mu, kappa, lam):
 def _model_force(parameters, displacement, rising):
     """Model Q/P at each scaled sample; parameters (mu, s, a, A, c, q) as in :func:`fit_loop`."""
     mu, s, a, amplitude, centre, offset = parameters
-    lam = 1.0 / (s * amplitude)
-    kappa = 2.0 * a / amplitude
+    lam, kappa = 1.0 / (s * amplitude), 2.0 * a / amplitude
     target = (displacement - centre) / amplitude
     up = _rising_branch(target, mu, kappa, lam)
     down = -_rising_branch(-target, mu, kappa, lam)
@@ -159,8 +154,7 @@ def _starting_values(x, y, rising, analysis, length, load):
             "the loop shows no gross slip (no slip segment between the stick segments, or "
             "too few samples on it), so mu and the groove depth cannot be fitted"
         )
-    sign = np.where(rising, 1.0, -1.0)
-    design = np.stack([sign[slipping], contact[slipping]], axis=1)
+    design = np.stack([np.where(rising, 1.0, -1.0)[slipping], contact[slipping]], axis=1)
     (mu, slope), *_ = np.linalg.lstsq(design, y[slipping], rcond=None)
     if mu <= 0:
         raise ValueError("the loop's slip segments give mu <= 0: it is not a fretting loop")
@@ -195,8 +189,7 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
     Returns
     -------
     fit : LoopFit
-        The fitted :math:`\mu`, :math:`S`, :math:`z_o`, :math:`\Delta^*` (= :math:`x_o`),
-        the loop's centre, the residual, convergence information and the samples fitted.
+        The fitted model, its residual and convergence, and the samples fitted.
 
     Raises
     ------
@@ -268,8 +261,7 @@ def _checked_samples(displacement, force, load, hysteresis):
     if np.ndim(load) != 0:
         raise ValueError(f"load must be a single number [N], got shape {np.shape(load)}")
     within("hysteresis", hysteresis, 1.0)
-    all_x = np.asarray(displacement, dtype=np.float64)
-    all_y = np.asarray(force, dtype=np.float64)
+    all_x, all_y = (np.asarray(values, dtype=np.float64) for values in (displacement, force))
     for name, values in (("displacement", all_x), ("force", all_y)):
         if values.ndim != 1:
             raise ValueError(f"{name} must be one-dimensional, got shape {values.shape}")
@@ -331,8 +323,7 @@ def _solution(scaled_x, scaled_y, rising, start):
     """The least-squares fit of the model's loop to the scaled samples (scipy's result)."""
     # Padded with zero-weight samples to a multiple of _BUCKET, so that loops of nearly the
     # same length share one compiled residual and Jacobian.
-    size = _BUCKET * -(-scaled_x.size // _BUCKET)
-    pad = size - scaled_x.size
+    pad = -scaled_x.size % _BUCKET
     arguments = tuple(
         jnp.asarray(np.pad(values, (0, pad)))
         for values in (scaled_x, scaled_y, rising, np.ones(scaled_x.size))

@@ -1,8 +1,6 @@
-r"""Compiled (numba) kernels of the centring and the measuring steps
-(:mod:`ecofmaps.measured.measure`) and of the passes (:mod:`ecofmaps.measured.samples`), a loop
-or a branch row at a time, cached on disk; every array float64 and C-contiguous.
-The method is explained in ``docs/method-loops.md``.
-"""
+"""Compiled (numba) kernels of the measuring steps (:mod:`ecofmaps.measured.measure`, ``samples``),
+a loop or a branch row at a time, cached on disk; every array float64 and C-contiguous
+(``docs/method-loops.md``)."""
 
 from __future__ import annotations
 
@@ -15,12 +13,10 @@ __all__ = [
     "branch_stretches",
     "detrended",
     "fitted_extremes",
-    "interpolated",
     "line_crossings",
     "loop_measures",
     "path_means",
     "second_difference_medians",
-    "stick_line_fit",
     "stick_lines",
     "stretch_ranges",
     "zero_force_crossings",
@@ -29,35 +25,24 @@ __all__ = [
 #: How numba compiles the kernels: cached on disk, NumPy's division by zero, no GIL held.
 _COMPILE = {"cache": True, "error_model": "numpy", "nogil": True}
 #: The lower quartile of the absolute sixth difference of white noise over its standard
-#: deviation (√924 times the noise's): a smooth loop's, sampled a few dozen times a cycle or
-#: more, is far below it.
+#: deviation: a smooth loop's, sampled a few dozen times a cycle or more, is far below it.
 _QUARTILE_SIXTH_DIFFERENCE = 0.3186393639643752 * np.sqrt(924.0)
 _SIXTH = np.array([1.0, -6.0, 15.0, -20.0, 15.0, -6.0, 1.0])
-#: A loop's extreme is read from the parabola fitted over the samples within this many
-#: noise standard deviations of it ...
-_EXTREME_DEPTH = 3.0
-#: ... where the noise exceeds this share of the loop's range (below, it is rounding); a
-#: step between the loop's last samples and its first counts beyond this many standard errors.
-_NOISE_FREE, _STEP_T = 1e-6, 3.0
+#: A loop's extreme is read from the parabola fitted over the samples within this many noise
+#: standard deviations of it, where the noise exceeds this share of the loop's range (below,
+#: it is rounding); a step where the loop closes counts beyond this many standard errors.
+_EXTREME_DEPTH, _NOISE_FREE, _STEP_T = 3.0, 1e-6, 3.0
 #: A stick segment grows until two samples in a row are this many standard deviations off.
 _STICK_SPREAD = 3.0
 #: A stick segment is curved when a term in the squared force, added to its line, is
-#: significant by more than this many standard errors ...
-_CURVATURE_T = 8.0
-#: ... and changes its slope from one end to the other by more than this share.
-_CURVATURE_CHANGE = 0.05
+#: significant by more than this many standard errors and changes its slope from one end to
+#: the other by more than this share.
+_CURVATURE_T, _CURVATURE_CHANGE = 8.0, 0.05
 #: Fewest samples in the window of the curve fitted at a GICoF crossing.
 _FIT_SAMPLES = 5
 #: In a GICoF window where the part of :math:`\xi Q` that :math:`\xi` does not explain has
-#: below this share of its variance (a constant sliding force), the line :math:`Q = a + b\xi`
-#: is fitted.
+#: below this share of its variance (a constant sliding force), :math:`Q = a + b\xi` is fitted.
 _COLLINEAR = 1e-24
-
-
-@numba.njit(**_COMPILE)
-def _maximum(a, b):
-    """The larger of ``a`` and ``b``, NaN if either is (as ``np.maximum``)."""
-    return a if a >= b or math.isnan(a) else b
 
 
 @numba.njit(**_COMPILE)
@@ -106,17 +91,6 @@ def _line_sums(u, v, end, segment, sums):
             uu += du * du
             vv += dv * dv
     sums[0], sums[1], sums[2], sums[3], sums[4], sums[5] = count, mean_u, mean_v, uv, uu, vv
-
-
-@numba.njit(**_COMPILE)
-def _squares_off(x, y, end, segment, intercept, slope):
-    """Sum of the squared displacements of the marked points off :math:`\\Delta = c + sQ`."""
-    squares = 0.0
-    for j in range(end):
-        if segment[j]:
-            residual = x[j] - intercept - slope * y[j]
-            squares += residual * residual
-    return squares
 
 
 @numba.njit(**_COMPILE)
@@ -174,9 +148,7 @@ def stick_lines(x, y, length, span, low, high):
     compliance, intercept = np.empty(cycles), np.empty(rows)
     residual, unexplained = np.empty(cycles), np.empty(cycles)
     across, curved = np.zeros(rows, np.bool_), np.zeros(cycles, np.bool_)
-    segments = np.zeros((2, width), np.bool_)
-    ends = np.empty(2, np.int64)  # each segment lies before its column
-    lines = np.empty((2, 6))
+    segments, ends, lines = np.zeros((2, width), np.bool_), np.empty(2, np.int64), np.empty((2, 6))
     for c in range(cycles):
         for k in range(2):
             r = c + k * cycles
@@ -186,9 +158,11 @@ def stick_lines(x, y, length, span, low, high):
         squares = 0.0
         for k in range(2):
             r, first = c + k * cycles, lines[k, 2] - slope * lines[k, 1]
-            squares += _squares_off(x[r], y[r], ends[k], segments[k], first, slope)
+            squares += _curved(x[r], y[r], ends[k], segments[k], first, slope, lines[k])[0]
         spread = math.sqrt(squares / max(lines[0, 0] + lines[1, 0] - 3.0, 1.0))
-        tolerance = _maximum(_STICK_SPREAD * spread, 1e-9 * span[c])
+        tolerance = _STICK_SPREAD * spread  # the larger, NaN if either is (as np.maximum)
+        if not (tolerance >= 1e-9 * span[c] or math.isnan(tolerance)):
+            tolerance = 1e-9 * span[c]
         for k in range(2):
             r, first = c + k * cycles, lines[k, 2] - slope * lines[k, 1]
             ends[k] = _grow(x[r], y[r], length[r], segments[k], ends[k], first, slope, tolerance)
@@ -209,12 +183,6 @@ def stick_lines(x, y, length, span, low, high):
 
 
 @numba.njit(**_COMPILE)
-def _before(value, rising):
-    """Whether a sample lies before the crossing (below zero rising, above falling)."""
-    return value < 0.0 if rising else value > 0.0
-
-
-@numba.njit(**_COMPILE)
 def _sample_pair(length, count, width):
     """The columns of the two samples around a row's crossing (-1 read as NumPy does)."""
     after = min(max(count, 1), length - 1)
@@ -230,9 +198,9 @@ def zero_force_crossings(x, y, length, band, intercept, across, rounding):
     near, line = np.zeros(width, np.bool_), np.empty(6)
     for r in range(rows):
         n, rising = length[r], r < rows // 2
-        count = 0
+        count = 0  # samples before the crossing: below zero rising, above falling
         for j in range(n):
-            count += _before(y[r, j], rising)
+            count += y[r, j] < 0.0 if rising else y[r, j] > 0.0
             near[j] = abs(y[r, j]) <= band[r]
         previous, after = _sample_pair(n, count, width)
         near[after] = True
@@ -250,9 +218,8 @@ def zero_force_crossings(x, y, length, band, intercept, across, rounding):
         # zero force there, or the chord.
         x0, x1, y0, y1 = x[r, previous], x[r, after], y[r, previous], y[r, after]
         if not inside:
-            low, high = min(x0, x1) - rounding[r], max(x0, x1) + rounding[r]
             share = y0 / (y0 - y1) if y0 != y1 else 0.5
-            between = intercept[r] >= low and intercept[r] <= high
+            between = min(x0, x1) - rounding[r] <= intercept[r] <= max(x0, x1) + rounding[r]
             at = intercept[r] if between else x0 + share * (x1 - x0)
         crossing[r] = at
         straddle = y0 * y1 <= 0.0 and y0 != y1
@@ -261,10 +228,10 @@ def zero_force_crossings(x, y, length, band, intercept, across, rounding):
 
 
 @numba.njit(**_COMPILE)
-def _curve_intercept(scaled, product, window, y, begin, end):
+def _curve_intercept(scaled, product, window, y, n):
     r"""Intercept :math:`a` of :math:`Q = a + b\xi + c\xi Q` through the window, and its count."""
     count, sum_s, sum_z, sum_q = 0.0, 0.0, 0.0, 0.0
-    for j in range(begin, end):
+    for j in range(n):
         if window[j]:
             count += 1.0
             sum_s += scaled[j]
@@ -272,13 +239,13 @@ def _curve_intercept(scaled, product, window, y, begin, end):
             sum_q += y[j]
     mean_s, mean_z, mean_q = sum_s / count, sum_z / count, sum_q / count
     ss, sz, zz, sq = 0.0, 0.0, 0.0, 0.0
-    for j in range(begin, end):
+    for j in range(n):
         if window[j]:
             ds, dz, dq = scaled[j] - mean_s, product[j] - mean_z, y[j] - mean_q
             ss, sz, zz, sq = ss + ds * ds, sz + ds * dz, zz + dz * dz, sq + ds * dq
     ratio = sz / ss
     rr, rq = 0.0, 0.0
-    for j in range(begin, end):
+    for j in range(n):
         if window[j]:
             ds, dz, dq = scaled[j] - mean_s, product[j] - mean_z, y[j] - mean_q
             rest = dz - ratio * ds  # the part of ξQ that ξ does not explain
@@ -288,10 +255,10 @@ def _curve_intercept(scaled, product, window, y, begin, end):
 
 
 @numba.njit(**_COMPILE)
-def _window_holds(force, y, before, window, begin, end, pair, with_pair, rounding):
+def _window_holds(force, y, before, window, n, pair, with_pair, rounding):
     """Whether the window (and ``pair``) has samples both sides of the crossing, force within."""
     sides, lowest, highest = 0, np.inf, -np.inf
-    for j in range(begin, end):
+    for j in range(n):
         if window[j]:
             sides |= 1 if before[j] else 2
             lowest, highest = min(lowest, y[j]), max(highest, y[j])
@@ -314,18 +281,12 @@ def line_crossings(x, y, length, compliance, half_width, load, rounding):
         count = 0
         for j in range(n):
             position = x[r, j] - y[r, j] * compliance[r]  # the contact position (eq. 10)
-            side = _before(position, rising)
+            side = position < 0.0 if rising else position > 0.0
             before[j] = side
             count += side
             window[j] = abs(position) <= h
-        begin, end = 0, n  # the window lies between these columns
-        while begin < n and not window[begin]:
-            begin += 1
-        while end > begin and not window[end - 1]:
-            end -= 1
-        for j in range(begin, end):
             if window[j]:
-                scaled[j] = (x[r, j] - y[r, j] * compliance[r]) / h
+                scaled[j] = position / h
                 product[j] = scaled[j] * y[r, j] / load
         previous, after = _sample_pair(n, count, width)
         before[previous] &= previous < n  # column -1: padding, never before the crossing
@@ -333,13 +294,13 @@ def line_crossings(x, y, length, compliance, half_width, load, rounding):
         v1 = x[r, after] - y[r, after] * compliance[r]
         q0, q1 = y[r, previous], y[r, after]
         share = v0 / (v0 - v1) if v0 - v1 != 0.0 else 0.5
-        intercept, fitted = _curve_intercept(scaled, product, window, y[r], begin, end)
+        intercept, fitted = _curve_intercept(scaled, product, window, y[r], n)
         # On the loop: the fitted window, or the pair interpolated between, holds samples
         # on both sides of ξ = 0, and the crossing's force lies within theirs.
         fits = fitted >= _FIT_SAMPLES
         force[r] = intercept if fits else q0 + share * (q1 - q0)
         holds = _window_holds(
-            force[r], y[r], before, window, begin, end, (previous, after), not fits, rounding[r]
+            force[r], y[r], before, window, n, (previous, after), not fits, rounding[r]
         )
         on_loop[r] = holds and (fits or (share >= 0.0 and share <= 1.0))
     return force, on_loop
@@ -374,37 +335,6 @@ def path_means(path, values, offset, count, closed):
             length += gap
         mean[k] = total / length
     return mean
-
-
-@numba.njit(**_COMPILE)
-def interpolated(first, count, points, values):
-    """``values`` interpolated linearly over ``points`` at the sample indices ``first`` to
-    ``first + count - 1``, to the bit as ``np.interp``."""
-    result = np.empty(count)
-    j, k = 0, 0
-    while k < count:  # the samples on segment j, from points[j] to before points[j + 1]
-        while points[j + 1] <= first + k:
-            j += 1
-        stop = min(count, math.ceil(points[j + 1]) - first)
-        if points[j] == first + k:
-            result[k] = values[j]
-            k += 1
-        slope = (values[j + 1] - values[j]) / (points[j + 1] - points[j])
-        for i in range(k, stop):
-            result[i] = _interpolated_at(first + i, points, values, j, slope)
-        k = stop
-    return result
-
-
-@numba.njit(**_COMPILE)
-def _interpolated_at(at, points, values, j, slope):
-    """``np.interp`` at ``at`` on segment ``j``: from its other end where the first try is NaN."""
-    value = slope * (at - points[j]) + values[j]
-    if math.isnan(value):
-        value = slope * (at - points[j + 1]) + values[j + 1]
-        if math.isnan(value) and values[j] == values[j + 1]:
-            value = values[j]
-    return value
 
 
 @numba.njit(**_COMPILE)
@@ -527,18 +457,12 @@ def _fitted_peak(values, first, n, at, span, sign):
                 normal[r, c] -= factor * normal[col, c]
             sums[r] -= factor * sums[col]
     step = abs(sums[3]) > _STEP_T * sd * np.sqrt(normal[3, 3])  # its t over its standard error
-    return _intercept(normal, sums, 4 if 0 < steps < ends[0] + ends[1] - 2 and step else 3)
-
-
-@numba.njit(**_COMPILE)
-def _intercept(upper, right, m):
-    """The first unknown of the upper triangular system ``upper[:m, :m] x = right[:m]``."""
-    x = right[:m].copy()
-    for r in range(m - 1, -1, -1):
+    m = 4 if 0 < steps < ends[0] + ends[1] - 2 and step else 3  # the unknowns: with the step?
+    for r in range(m - 1, -1, -1):  # back substitution, for the first unknown
         for k in range(r + 1, m):
-            x[r] -= upper[r, k] * x[k]
-        x[r] /= upper[r, r]
-    return x[0]
+            sums[r] -= normal[r, k] * sums[k]
+        sums[r] /= normal[r, r]
+    return sums[0]
 
 
 @numba.njit(**_COMPILE)
@@ -554,11 +478,10 @@ def fitted_extremes(values, offset, count, least):
             top = i if values[first + i] > values[first + top] else top
             bottom = i if values[first + i] < values[first + bottom] else bottom
         highest[k], lowest[k] = values[first + top], values[first + bottom]
-        if n < least:
-            continue
-        span = highest[k] - lowest[k]
-        highest[k] += _fitted_peak(values, first, n, top, span, 1.0)
-        lowest[k] -= _fitted_peak(values, first, n, bottom, span, -1.0)
+        if n >= least:
+            span = highest[k] - lowest[k]
+            highest[k] += _fitted_peak(values, first, n, top, span, 1.0)
+            lowest[k] -= _fitted_peak(values, first, n, bottom, span, -1.0)
     return highest, lowest
 
 
@@ -582,18 +505,3 @@ def branch_stretches(values, start, end, length, width):
             rows[r, j] = values[start[r] + j]
         rows[r, length[r] - 1 :] = values[end[r]]
     return rows
-
-
-def stick_line_fit(u, regressors, stick):
-    """Least squares of ``u`` on 1 and ``regressors`` over the ``stick`` samples of each row:
-    the coefficients and the inverse of the normal matrix (identity below four samples)."""
-    columns = [stick.astype(np.float64), *(np.where(stick, r, 0.0) for r in regressors)]
-    normal = np.stack([np.stack([(a * b).sum(axis=1) for b in columns], -1) for a in columns], -2)
-    normal[stick.sum(axis=1) < 4] = np.eye(len(columns))
-    try:
-        inverse = np.linalg.inv(normal)
-    except np.linalg.LinAlgError:  # a degenerate loop (a constant force): least norm
-        inverse = np.linalg.pinv(normal)
-    return np.einsum(
-        "rik,rk->ri", inverse, np.stack([(a * u).sum(axis=1) for a in columns], -1)
-    ), inverse

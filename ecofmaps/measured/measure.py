@@ -1,8 +1,6 @@
-r"""Steps 3 and 4 of the loop pipeline: each loop centred (offsets and drift removed, a block of
-cycles at a time) and measured along its branch rows (amplitude, slip amplitude, energy,
-ECoF, stiffness, GICoF ...), with the flags of the checks each cycle failed.
-The method is explained in ``docs/method-loops.md`` ("Centring the loops", "Measuring each loop").
-"""
+"""Steps 3 and 4 of the loop pipeline: each loop centred (offsets and drift removed) and measured
+(amplitude, slip amplitude, energy, ECoF, stiffness, GICoF ...), with the flags of the checks
+each cycle failed; ``docs/method-loops.md`` ("Centring the loops", "Measuring each loop")."""
 
 from __future__ import annotations
 
@@ -90,16 +88,14 @@ _MEASURED = tuple(
 #: A gross-slip loop whose GICoF lies within this share of Q*/P is crossed by its stick line
 #: where it slides at a constant force: its GICoF is read even if its stick sides are curved.
 _PLATEAU = 0.02
-#: A sphere's stick part is fitted with Mindlin's law where the force has risen by less than
-#: this share of the way to its sliding value (the law is steep beyond), ...
-_MINDLIN_STICK = 0.9
-#: ... and follows it when the fit leaves no more than this many times the displacement's
-#: noise, or this share of the stroke, and each branch slides over this many samples; its
-#: curved part must be this share of the stick's extent and this many standard errors.
-_MINDLIN_SPREAD, _MINDLIN_ROUNDING, _MINDLIN_SLIDING = 3.0, 1e-3, 3
-_MINDLIN_SHARE, _MINDLIN_T = 0.05, 5.0
-#: The samples of a branch of which the first pass of the fit reads about this many.
-_MINDLIN_SIFT = 32
+#: Mindlin's law (docs/method-loops.md) is fitted to the stick where the force has risen by less
+#: than this share of the way to its sliding value (the law is steep beyond); it is followed when
+#: its curved part is this share of the stick's extent and this many standard errors, the fit
+#: leaves no more than this many times the displacement's noise or this share of the stroke, and
+#: each branch slides over this many samples. The first of three passes reads about this many
+#: samples a branch.
+_MINDLIN_STICK, _MINDLIN_SHARE, _MINDLIN_T = 0.9, 0.05, 5.0
+_MINDLIN_SPREAD, _MINDLIN_ROUNDING, _MINDLIN_SLIDING, _MINDLIN_SIFT = 3.0, 1e-3, 3, 32
 #: Samples with :math:`|Q|` below this share of :math:`Q^*` locate a zero-force crossing
 #: that is not on a stick segment.
 _ZERO_FORCE_BAND = 0.25
@@ -140,8 +136,7 @@ class LoopBlock:
 
     def loops(self, width: int):
         """The loops as padded rows (cycle, point) of ``width`` points, NaN past each end."""
-        point = np.minimum(np.arange(width), self.count[:, None])
-        index = self.samples(point)
+        index = self.samples(np.minimum(np.arange(width), self.count[:, None]))
         inside = np.arange(width) <= self.count[:, None]
         return tuple(
             np.where(inside, values[index], np.nan) for values in (self.displacement, self.force)
@@ -163,15 +158,14 @@ def loop_blocks(
     if begin == end:  # no whole cycle among the rows
         return
     start, count = cycles.start[kept], cycles.count[kept]
-    size = kept.size
     middle, centre_x = _displacement_centres(start, count, displacement, begin, end)
-    centre_q = np.empty(size)
+    centre_q = np.empty(kept.size)
     ready = max(begin - _NOISE_REACH, 0)  # the force's centres are known below this cycle
     for block in _whole_blocks(cycles, kept, begin, end):
         # The centred values depend on the sample index alone. The force's drift within
         # the block needs the centres of the cycles on both sides of it, their noise
         # those of _NOISE_REACH cycles.
-        needed = min(block.stop + _NOISE_REACH, size)
+        needed = min(block.stop + _NOISE_REACH, kept.size)
         lower, upper = min(ready, block.start), max(needed, block.stop)
         low, high = int(start[lower]), int(start[upper - 1] + count[upper - 1])
         around = slice(max(lower - 1, 0), upper + 1)
@@ -201,19 +195,16 @@ def loop_blocks(
 
 def _drift_se(middle, count, centre, rows: slice):
     """``force_drift_se`` of the loops ``rows``: the branch offset the drift correction leaves."""
-    size = centre.size
-    first, stop = rows.start, rows.stop
-    noise = kernels.second_difference_medians(centre, first, stop, _NOISE_REACH)
-    noise /= SECOND_DIFFERENCE
+    first, stop, size = rows.start, rows.stop, centre.size
+    noise = kernels.second_difference_medians(centre, first, stop, _NOISE_REACH) / SECOND_DIFFERENCE
     if size == 2:  # no second difference: the one first difference, noise and drift
         noise = np.full(stop - first, abs(centre[1] - centre[0]) / np.sqrt(2.0))
     # The weights a_j of the centres in the offset, in the cycle's own period: a quarter
     # of the slope to each neighbour, or half the one line over the whole cycle at an end.
     i = np.arange(first, stop)
-    period = count[i].astype(np.float64)
     has_left, has_right = i > 0, i < size - 1
-    left = (middle[i] - middle[np.maximum(i - 1, 0)]) / period
-    right = (middle[np.minimum(i + 1, size - 1)] - middle[i]) / period
+    left = (middle[i] - middle[np.maximum(i - 1, 0)]) / count[i]
+    right = (middle[np.minimum(i + 1, size - 1)] - middle[i]) / count[i]
     share = np.where(has_left & has_right, 0.25, 0.5)
     a_left = np.where(has_left, -share / np.where(has_left, left, 1.0), 0.0)
     a_right = np.where(has_right, share / np.where(has_right, right, 1.0), 0.0)
@@ -295,60 +286,29 @@ def _displacement_centres(start, count, displacement, first: int, stop: int):
 
 
 def _drift(low: int, high: int, points, values, near: slice):
-    """``values`` interpolated over ``points`` at the samples ``low`` to ``high - 1``."""
-    xp, fp = points[near], values[near]
-    # Sample i lies on segment j when xp[j] <= i < xp[j + 1].
-    edges = np.clip(np.ceil(xp).astype(np.int64), low, high) - low
-    result = np.empty(high - low)
-    result[: edges[0]] = fp[0]
-    result[edges[-1] :] = fp[-1]
-    if xp.size > 1:  # every sample here lies on a segment between points
-        result[edges[0] : edges[-1]] = kernels.interpolated(
-            low + int(edges[0]), int(edges[-1] - edges[0]), xp, fp
-        )
+    """``values`` over ``points`` at the samples ``low`` to ``high - 1``: interpolated between the
+    points ``near``, extrapolated along the end segment beyond the first or last of all."""
+    at = np.arange(low, high, dtype=np.float64)
+    result = np.interp(at, points[near], values[near])
     if points.size < 2:
         return result
-    if near.start == 0 and edges[0] > 0:
-        at = np.arange(low, low + edges[0], dtype=np.float64)
-        result[: edges[0]] = values[0] + (at - points[0]) * (values[1] - values[0]) / (
+    if near.start == 0:
+        before = at < points[0]
+        result[before] = values[0] + (at[before] - points[0]) * (values[1] - values[0]) / (
             points[1] - points[0]
         )
     if near.stop >= points.size:
-        at = np.arange(low + edges[-1], high, dtype=np.float64)
         beyond = at > points[-1]
-        result[edges[-1] :][beyond] = values[-1] + (at[beyond] - points[-1]) * (
-            values[-1] - values[-2]
-        ) / (points[-1] - points[-2])
+        result[beyond] = values[-1] + (at[beyond] - points[-1]) * (values[-1] - values[-2]) / (
+            points[-1] - points[-2]
+        )
     return result
 
 
 def loop_ratios(amplitude, max_force, energy, slip, rig_stiffness=None) -> dict:
-    r"""The energy and opening ratios of loops, on the applied displacement and on the
-    contact's.
-
-    Parameters
-    ----------
-    amplitude, max_force, energy, slip : numpy.ndarray
-        Each loop's displacement amplitude :math:`\Delta^*` [m], force amplitude
-        :math:`Q^*` [N], dissipated energy :math:`E_d` [J] and slip amplitude
-        :math:`\delta^*` [m].
-    rig_stiffness : float, optional
-        The rig's own stiffness :math:`S` (not the loops' stick slope, the rig and the
-        contact in series). [N/m]
-
-    Returns
-    -------
-    ratios : dict of str to numpy.ndarray
-        ``energy_ratio`` :math:`A = E_d/(4\Delta^*Q^*)` and ``opening_ratio``
-        :math:`B = \delta^*/\Delta^*`; ``contact_amplitude`` :math:`\Delta^* - Q^*/S` [m],
-        ``contact_energy_ratio`` and ``contact_opening_ratio``, the same ratios on the
-        contact's displacement (NaN without ``rig_stiffness``). [1]
-
-    References
-    ----------
-    S. Fouvry, P. Kapsa, L. Vincent (1995), Analysis of sliding behaviour for fretting
-    loadings: determination of transition criteria, Wear 185, 35-46.
-    """
+    r"""The energy ratio :math:`A = E_d/(4\Delta^*Q^*)` and opening ratio
+    :math:`B = \delta^*/\Delta^*` of loops [1], and on the contact's displacement
+    :math:`\Delta^* - Q^*/S` [m] the same (NaN without the rig's ``rig_stiffness`` [N/m])."""
     contact = amplitude - max_force / (np.nan if rig_stiffness is None else rig_stiffness)
     with np.errstate(divide="ignore", invalid="ignore"):
         return {
@@ -363,8 +323,7 @@ def loop_ratios(amplitude, max_force, energy, slip, rig_stiffness=None) -> dict:
 def _loop_values(block, options):
     """Every per-cycle quantity of a block of centred loops, and the checks it failed."""
     load = options.load
-    # The extremes, the loop's area by trapezoids (the segment that closes it included)
-    # and its top, where the rising branch ends.
+    # The extremes, the loop's area and its top, where the rising branch ends.
     highest, lowest, peak_force, energy, top = kernels.loop_measures(
         block.displacement, block.force, block.offset, block.count, block.rotation
     )
@@ -375,7 +334,6 @@ def _loop_values(block, options):
         for v in (block.displacement, block.force)
     )
     rows = branch_rows(block, top)
-    # Lines Δ = c + Q/S through the stick segments after the two reversals.
     compliance, intercept, across, residual, unexplained, curved = kernels.stick_lines(
         *rows, span, *options.stick_window
     )
@@ -385,7 +343,6 @@ def _loop_values(block, options):
     cycles = block.count.size
     slip = 0.5 * (crossing[cycles:] - crossing[:cycles])
     slope, half_width = np.tile(compliance, 2), np.tile(options.crossing_window * np.abs(slip), 2)
-    # Where each branch row crosses Q = SΔ: force, whether on the loop, displacement.
     force, on_loop = kernels.line_crossings(
         *rows, slope, half_width, float(load), 1e-9 * np.tile(peak_force, 2)
     )
@@ -421,8 +378,7 @@ def _loop_values(block, options):
     read |= {"gicof": (forward + backward) / (2.0 * load), "stiffness": spring}
     for name, value in read.items():
         values[name] = np.where(mindlin, value, values[name])
-    plateau = np.abs(values["gicof"] / values["cof_max"] - 1.0) <= _PLATEAU
-    on_plateau = sliding & plateau
+    on_plateau = sliding & (np.abs(values["gicof"] / values["cof_max"] - 1.0) <= _PLATEAU)
     flags = {
         "few-samples": block.count < MIN_SAMPLES,
         "constant-force": ~(block.force_swing > 0.0),
@@ -447,10 +403,9 @@ def _loop_values(block, options):
         "mindlin-stick": mindlin,
         "no-crossing": ~(on_loop[:cycles] & on_loop[cycles:]) & ~mindlin,
         "partial-slip": ~sliding,
+        "noise-amplitude": (_noise_lift(block, block.displacement) > 0.5 * span)
+        | (_noise_lift(block, block.force) > peak_force),
     }
-    flags["noise-amplitude"] = (_noise_lift(block, block.displacement) > 0.5 * span) | (
-        _noise_lift(block, block.force) > peak_force
-    )
     return values, flags
 
 
@@ -472,13 +427,12 @@ def _mindlin_sliding(rows, max_force, span, candidates):
         rise = (q + force) / (2.0 * force)
         stick = valid & (rise < _MINDLIN_STICK)
         curve = 1.0 - np.cbrt(1.0 - np.minimum(rise, 1.0)) ** 2
-        line, inverse = kernels.stick_line_fit(u, (curve, q), stick)
+        line, inverse = _stick_line_fit(u, (curve, q), stick)
         share = line[:, 1] / (line[:, 1] + 2.0 * line[:, 2] * force[:, 0])
         # curved by a share of the stick's extent, its spring's compliance not below zero by
         # more: else not a sphere's (a flat contact's straight stick), and not fitted further
         curved = (share > _MINDLIN_SHARE) & (share < 1.0 / (1.0 - _MINDLIN_SHARE))
-        kept = curved[: pick.size] & curved[pick.size :]
-        both = np.tile(kept, 2)
+        both = np.tile(curved[: pick.size] & curved[pick.size :], 2)
         pick, line, inverse, u, q, valid, stick, curve, force = (
             v[both] for v in (np.tile(pick, 2), line, inverse, u, q, valid, stick, curve, force)
         )
@@ -503,19 +457,29 @@ def _mindlin_sliding(rows, max_force, span, candidates):
     return found
 
 
+def _stick_line_fit(u, regressors, stick):
+    """Least squares of ``u`` on 1 and ``regressors`` over the ``stick`` samples of each row:
+    the coefficients and the inverse of the normal matrix (identity below four samples)."""
+    columns = [stick.astype(np.float64), *(np.where(stick, r, 0.0) for r in regressors)]
+    normal = np.stack([np.stack([(a * b).sum(axis=1) for b in columns], -1) for a in columns], -2)
+    normal[stick.sum(axis=1) < 4] = np.eye(len(columns))
+    try:
+        inverse = np.linalg.inv(normal)
+    except np.linalg.LinAlgError:  # a degenerate loop (a constant force): least norm
+        inverse = np.linalg.pinv(normal)
+    return np.einsum(
+        "rik,rk->ri", inverse, np.stack([(a * u).sum(axis=1) for a in columns], -1)
+    ), inverse
+
+
 def _noise_lift(block, values):
-    """Per cycle of ``block``, the highest the white noise on its ``values`` lifts an extreme
-    over the cycle's n samples, σ√(2 ln n), over :data:`NOISE_SHARE` (NaN for fewer than
-    :data:`_NOISE_SAMPLES` samples); σ from the lower quartile of the absolute second
-    differences, less a sine's own (-4 sin²(π/n) x, the loops centred) or as they are (a force
-    sliding at a constant value), whichever is less: the reversals and the stick do not reach
-    it. [m] or [N]"""
-    count, offset = block.count, block.offset
-    lift = np.full(count.size, np.nan)
-    (rows,) = np.nonzero(count >= _NOISE_SAMPLES)
+    """Per cycle of ``block``, the highest the white noise on its ``values`` lifts an extreme,
+    over :data:`NOISE_SHARE` (NaN for too few samples). [m] or [N]"""
+    lift = np.full(block.count.size, np.nan)
+    (rows,) = np.nonzero(block.count >= _NOISE_SAMPLES)
     if not rows.size:
         return lift
-    offset, count = offset[rows], count[rows]
+    offset, count = block.offset[rows], block.count[rows]
     j = np.arange(1, int(count.max()) - 1)
     inside = j < count[:, None] - 1
     at = offset[:, None] + np.where(inside, j, 1)
@@ -534,19 +498,16 @@ def _noise_lift(block, values):
 
 def _turns_back(x, band):
     """True for the cycles whose displacement turns back within a branch row by over ``band``."""
-    cycles = band.size
-    rising, falling = x[:cycles], x[cycles:]
+    rising, falling = x[: band.size], x[band.size :]
     drop = np.max(np.maximum.accumulate(rising, axis=1) - rising, axis=1)
     rise = np.max(falling - np.minimum.accumulate(falling, axis=1), axis=1)
     return np.maximum(drop, rise) > band
 
 
 def measure_cycles(cycles: Cycles, displacement, force, options, *, rows=None, keep_loops=False):
-    """The per-cycle values of :func:`ecofmaps.analyze_loops` for cycles already found, as
-    measured (not yet NaN where a check fails), the flags of the checks each cycle failed
-    (reason -> per cycle), and the centred loops NaN-padded over (cycle, point) if
-    ``keep_loops``. ``displacement`` and ``force`` give stretches by sample index [m], [N];
-    ``options`` is a :class:`~ecofmaps.measured.pipeline.LoopOptions`."""
+    """The per-cycle values of :func:`ecofmaps.analyze_loops` as measured (not yet NaN where a
+    check fails), the flags of the checks each cycle failed, and the centred loops NaN-padded
+    over (cycle, point) if ``keep_loops``."""
     first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
     names = _PER_CYCLE if options.rig_stiffness is None else _PER_CYCLE + _RIG_RATIOS
     values = {name: np.full(stop - first, np.nan) for name in names}
@@ -558,9 +519,8 @@ def measure_cycles(cycles: Cycles, displacement, force, options, *, rows=None, k
         width = int(cycles.count[first:stop].max()) + 1
         loops = tuple(np.full((stop - first, width), np.nan) for _ in range(2))
     sign = -1.0 if options.flip_force else 1.0
-    blocks = loop_blocks(cycles, displacement, force, slice(first, stop), sign)
     with np.errstate(divide="ignore", invalid="ignore"):  # degenerate cycles give NaN
-        for block in blocks:
+        for block in loop_blocks(cycles, displacement, force, slice(first, stop), sign):
             check_interrupted()
             out = slice(block.rows.start - first, block.rows.stop - first)
             for table, part in zip((values, flags), _loop_values(block, options), strict=True):
@@ -574,14 +534,13 @@ def measure_cycles(cycles: Cycles, displacement, force, options, *, rows=None, k
 
 def branch_rows(block, top):
     """The rising branches (start to top) and falling ones (top to the end) as rows."""
-    cycles = top.size
     first = np.concatenate([np.zeros_like(top), top])
     last = np.concatenate([top, block.count])
     length = last - first + 1
     width = int(length.max())
     if not block.continuous:  # a loop may begin inside its stretch and wrap round it
         point = np.minimum(first[:, None] + np.arange(width), last[:, None])
-        index = block.samples(point, np.tile(np.arange(cycles), 2))
+        index = block.samples(point, np.tile(np.arange(top.size), 2))
         return block.displacement[index], block.force[index], length
     # Each row is a stretch of the samples from its reversal on, up to its last point:
     # the top of a rising branch; the loop's first sample, which closes a falling one.

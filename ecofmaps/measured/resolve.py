@@ -1,8 +1,6 @@
-r"""Step 5 of the loop pipeline: friction and groove slope read along the whole stroke of each
-loop (:func:`resolve_analyzed_loops`), with the flags of its checks; the numerics of the slip
-branches are in :mod:`ecofmaps.measured.resolve_branches`.
-The method is explained in ``docs/method-loops.md`` ("Reading the loop along the stroke").
-"""
+"""Step 5 of the loop pipeline: friction and groove slope read along the whole stroke of each
+loop, with the flags of its checks (its numerics in ``resolve_branches``);
+``docs/method-loops.md`` ("Reading the loop along the stroke")."""
 
 from __future__ import annotations
 
@@ -216,7 +214,7 @@ def read_along_stroke(loops: xr.Dataset, options: ReadingOptions):
     given = options.stiffness is not None
     rig = np.full(x.shape[0], options.stiffness) if given else values("stiffness")
     quality, amplitude = loops["quality"].values, values("amplitude")
-    inherited = _reaches_resolved(quality)
+    inherited = np.logical_or.reduce([has_reason(quality, reason) for reason in _REACHING])
     with np.errstate(divide="ignore", invalid="ignore"):
         per_position, per_cycle, flags, grid = _along_stroke_values(
             x, q, load, rig, amplitude, inherited, options, values("force_drift_se")
@@ -263,10 +261,6 @@ _CENTRAL_POINTS = 201
 _MAD = 1.482602218505602
 
 
-# Arrays of shape (cycles, width), rows running once round a loop from its lowest
-# displacement; ``valid`` marks the loop's points, NaN padding elsewhere.
-
-
 def _central_values(forward, backward, central, load):
     """mu_resolved, its variance, k and g0 of g ≈ g0 + kξ, the sensitivity to 1/S."""
     width = forward[0].shape[1]
@@ -305,8 +299,7 @@ def _central_values(forward, backward, central, load):
     varies = (np.abs(variation) > VARIATION * np.abs(mu_resolved)) & (
         np.abs(variation) > VARIATION_SIGNIFICANCE * np.sqrt(variation_variance)
     )
-    mean_xi = masked_sum(at, finite) / points
-    mean_g = masked_sum(slope, finite) / points
+    mean_xi, mean_g = masked_sum(at, finite) / points, masked_sum(slope, finite) / points
     dxi = at - mean_xi[:, None]
     k = masked_sum(dxi * (slope - mean_g[:, None]), finite) / masked_sum(dxi**2, finite)
     # The sensitivities of mu_resolved to the compliance 1/S and to a shift of the rising
@@ -365,32 +358,21 @@ def _along_stroke(part, grid, tilt, load, level):
     pieces = np.nan_to_num(0.5 * (slope[:, 1:] + slope[:, :-1]) * np.diff(grid))
     profile = np.concatenate([np.zeros((cycles, 1)), np.cumsum(pieces, axis=1)], axis=1)
     profile -= profile[:, np.searchsorted(grid, 0.0)][:, None]
-    felt = np.where(inside, profile, np.nan)
-    return dict(zip(_ALONG, (mu, slope, felt, q_forward, q_backward), strict=True))
+    return mu, slope, np.where(inside, profile, np.nan), q_forward, q_backward
 
 
-#: The values along the stroke, over (cycle, position).
+#: The values along the stroke, over (cycle, position), as :func:`_along_stroke` returns them.
 _ALONG = ("mu", "slope", "felt_profile", "force_forward", "force_backward")
-
-
-def _reaches_resolved(quality) -> np.ndarray:
-    """True for the cycles whose ``quality`` lists a reason that leaves the resolved values NaN."""
-    reaching = [
-        r for r, (_, scope) in REASONS.items() if scope == ALL or set(RESOLVED) & set(scope)
-    ]
-    return np.logical_or.reduce([has_reason(quality, reason) for reason in reaching])
-
-
-def _blocks(cycles):
-    """Slices of at most ``_BLOCK`` cycles: the arrays of a block stay in the cache."""
-    return [slice(start, start + _BLOCK) for start in range(0, max(cycles, 1), _BLOCK)]
+#: The reasons that leave the resolved values NaN.
+_REACHING = [r for r, (_, scope) in REASONS.items() if scope == ALL or set(RESOLVED) & set(scope)]
 
 
 def _along_stroke_values(x, q, load, stiffness, amplitude, inherited, options, drift_se):
     """Every resolved quantity of the centred loops ``x``, ``q``."""
     cycles, valid = x.shape[0], np.isfinite(x) & np.isfinite(q)
+    blocks = [slice(start, start + _BLOCK) for start in range(0, max(cycles, 1), _BLOCK)]
     parts = []
-    for block in _blocks(cycles):
+    for block in blocks:
         check_interrupted()
         part = slip_branches(*(a[block] for a in (x, q, valid, stiffness, amplitude)), options)
         lowest, highest = part["lowest"], part["highest"]
@@ -422,7 +404,6 @@ def _along_stroke_values(x, q, load, stiffness, amplitude, inherited, options, d
     flags["gicof-varies"] = wavers & ((flag == 0) | (flag == 4)) & ~inherited
     lowest, highest = joined("lowest"), joined("highest")
     nan = np.where(ok, 1.0, np.nan)
-    compliance = joined("compliance")
     per_cycle = {
         "mu_resolved": mu_resolved * nan,
         "mu_resolved_se": np.sqrt(
@@ -434,11 +415,10 @@ def _along_stroke_values(x, q, load, stiffness, amplitude, inherited, options, d
         * nan,
         "aspect_ratio": 0.5 * k * amplitude * nan,
         "tilt": tilt * nan,
-        "stiffness": 1.0 / compliance,
+        "stiffness": 1.0 / joined("compliance"),
         "position_min": lowest * nan,
         "position_max": highest * nan,
     }
-    # Over the grid of positions common to all cycles: the values along the stroke.
     grid = options.positions
     if grid is None:
         return {}, per_cycle, flags, None
@@ -446,10 +426,10 @@ def _along_stroke_values(x, q, load, stiffness, amplitude, inherited, options, d
         reach = np.maximum(highest, -lowest)[ok]
         half = reach.max() if reach.size else np.max(amplitude, initial=0.0, where=amplitude > 0)
         grid = np.linspace(-1.0, 1.0, grid) * (half if half > 0.0 else 1.0)
-    per_position = {name: np.empty((cycles, grid.size)) for name in _ALONG}
     level = options.force_offset is None
-    for part, block in zip(parts, _blocks(cycles), strict=True):
-        along = _along_stroke(part, grid, per_cycle["tilt"][block], load, level)
-        for name in _ALONG:
-            per_position[name][block] = along[name]
+    along = [
+        _along_stroke(part, grid, per_cycle["tilt"][block], load, level)
+        for part, block in zip(parts, blocks, strict=True)
+    ]
+    per_position = {name: np.concatenate([a[i] for a in along]) for i, name in enumerate(_ALONG)}
     return per_position, per_cycle, flags, grid

@@ -1,7 +1,6 @@
-r"""The numerics of the reading along the stroke (:mod:`ecofmaps.measured.resolve`): the stiffness
-and the slip of each branch, the branches resampled at contact positions, their noise and the
-weights of their samples in the standard errors; explained in ``docs/method-loops.md``.
-"""
+"""The numerics of the reading along the stroke: the stiffness and the slip of each branch, the
+branches resampled at contact positions, their noise and the weights of their samples in the
+standard errors (``docs/method-loops.md``)."""
 
 from __future__ import annotations
 
@@ -73,8 +72,7 @@ def _before(mask, branch):
 
 def _compliance(x, q, sticks):
     """Least-squares compliance common to lines Δ = ξ_s + cQ through each stick set."""
-    covariance = np.zeros(x.shape[0])
-    variance = np.zeros(x.shape[0])
+    covariance, variance = np.zeros((2, x.shape[0]))
     centred = []
     for mask in sticks:
         count = np.count_nonzero(mask, axis=1)[:, None]
@@ -116,7 +114,7 @@ def _stick_and_slip(xi, branches, sticks, floor, slip_threshold):
     return sigma, slips, levels
 
 
-def _branch_shift(xi, branches, slips, levels):
+def _branch_shift(xi, slips, levels):
     r"""How far the rising branch's slip lies beyond the falling one's, in ξ, per cycle."""
     gaps = []
     for slip, level in zip(slips, levels[::-1], strict=True):
@@ -187,7 +185,7 @@ def slip_branches(x, q, valid, stiffness, amplitude, options):
     sigma, slips, levels = _stick_and_slip(xi, branches, sticks, floor, slip_threshold)
     if given:  # a stiffness that does not fit the stick sides tilts both alike in ξ
         mismatch = mismatch | _tilted_alike(xi, q, sticks, _TILT_SPREAD * sigma + floor, floor)
-    shift = _branch_shift(xi, branches, slips, levels)
+    shift = _branch_shift(xi, slips, levels)
     forward, backward = (_sorted_branch(xi, q, slip) for slip in slips)
     ends = []
     for xs, _, count in (forward, backward):
@@ -222,10 +220,9 @@ def _resample(xs, qs, count, grid, scale, inside):
     # The three samples around the position: left - 1, left, left + 1, or 0, 1, 2 at the start.
     middle = np.clip(left, 1, np.maximum(count - 2, 1)[:, None])
     last = np.maximum(count - 1, 0)[:, None]
-    flat_x, flat_q = xs.ravel(), qs.ravel()
     index = [base + np.minimum(middle + k, last) for k in (-1, 0, 1)]
-    xa, xb, xc = (flat_x[i] for i in index)
-    qa, qb, qc = (flat_q[i] for i in index)
+    xa, xb, xc = (xs.ravel()[i] for i in index)
+    qa, qb, qc = (qs.ravel()[i] for i in index)
     first = left == middle
     x0, x1 = np.where(first, xb, xa), np.where(first, xc, xb)
     q0, q1 = np.where(first, qb, qa), np.where(first, qc, qb)
@@ -251,10 +248,8 @@ def read_branches(forward, backward, grid, scale, inside, load):
     """Q+, Q-, μ and g at the positions ``scale * grid``, and the line weights of each branch."""
     q_forward, *line_forward = _resample(*forward, grid, scale, inside)
     q_backward, *line_backward = _resample(*backward, grid, scale, inside)
-    up = np.arctan(q_forward / load)
-    down = np.arctan(q_backward / load)
-    mu = np.tan(0.5 * (up - down))
-    slope = np.tan(0.5 * (up + down))
+    up, down = np.arctan(q_forward / load), np.arctan(q_backward / load)
+    mu, slope = np.tan(0.5 * (up - down)), np.tan(0.5 * (up + down))
     return q_forward, q_backward, mu, slope, (line_forward, line_backward)
 
 

@@ -1,12 +1,12 @@
 """The compiled kernels of ecofmaps.measured.kernels against plain computations, row by row.
 
 Each kernel is checked against an independent computation in plain Python and NumPy
-(``np.linalg.lstsq`` and ``np.polyfit`` for the fits, an explicit search for each crossing,
-``np.interp`` and per-loop NumPy reductions) on branch rows of noisy model loops and on
+(``np.linalg.lstsq`` and ``np.polyfit`` for the fits, an explicit search for each crossing
+and per-loop NumPy reductions) on branch rows of noisy model loops and on
 random rows: short rows, rows padded with NaN past their points (a kernel reads no point
 past a row's length, or NaN would show), rows with no crossing. Fits are compared to a
 relative 1e-9 (sums in another order, and least squares by QR: well-conditioned rows agree
-to about 1e-13); the interpolation, extremes and tops are compared to the bit.
+to about 1e-13); the extremes and tops are compared to the bit.
 """
 
 import numpy as np
@@ -327,20 +327,6 @@ def test_path_means(closed):
         expected.append(np.sum(weight * (v[1:] + v[:-1]) / 2) / np.sum(weight))
     np.testing.assert_allclose(kernels.path_means(path, values, offset, count, closed),
                                expected, rtol=1e-12)  # fmt: skip
-
-
-@pytest.mark.parametrize("seed", range(4))
-def test_interpolated_is_np_interp_to_the_bit(seed):
-    rng = np.random.default_rng(seed)
-    points = np.cumsum(rng.uniform(1.0, 40.0, 30)) + 0.5 * rng.integers(-400, 400)
-    points[5] = np.round(points[5])  # a sample index on a point
-    values = rng.normal(size=30) * 10.0 ** rng.integers(-9, 4)
-    values[[10, 11, 20]] = [np.nan, np.nan, np.inf]  # np.interp's fallbacks
-    first = int(np.ceil(points[0]))
-    count = int(np.ceil(points[-1])) - first
-    result = kernels.interpolated(first, count, points, values)
-    expected = np.interp(np.arange(first, first + count, dtype=np.float64), points, values)
-    np.testing.assert_array_equal(result, expected)
 
 
 def test_stretch_ranges_and_loop_measures():
