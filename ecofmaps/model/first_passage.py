@@ -110,8 +110,7 @@ def _point(side: Side, group, segment, fraction):
 
 
 def _actuator(position, force, lam):
-    """The actuator position :math:`F = \\xi + \\lambda q` at which the pad at ``position``
-    slips with ``force`` :math:`q = Q/P` (:math:`\\xi` on a rigid rig)."""
+    """Actuator position :math:`\\xi + \\lambda q` at which the pad slips with ``force`` q."""
     return position + jnp.where(lam > 0.0, lam * force, 0.0)
 
 

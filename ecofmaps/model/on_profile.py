@@ -23,7 +23,6 @@ __all__ = [
     "MAPPINGS",
     "as_profile",
     "check_mapping",
-    "profile_loop",
     "profile_simulation",
     "steady_numbers",
     "steady_numbers_and_loops",
@@ -162,43 +161,28 @@ def _shared(profile, unique, group, lam, physical):
     arguments = (profile.position, profile.slope, profile.half_width)
     unique = np.pad(unique, ((0, 0), (0, -count % batch)), mode="edge")
     lam = np.asarray(lam)
-    if count <= batch:  # one batch, the points in order
-        padded = _pad(np.arange(lam.size))
-        tables = _shared_tables(*arguments, *unique, physical, True)
-        loops = _shared_loops(tables, group[padded], lam[padded])
-    else:  # every batch padded to one shape: one compilation
-        parts, order = [], []
-        starts = range(0, count, batch)
-        members_of = [np.flatnonzero((group >= f) & (group < f + batch)) for f in starts]
-        width = _bucket(max(m.size for m in members_of))
-        for first, members in zip(starts, members_of, strict=True):
-            padded = np.pad(members, (0, width - members.size), mode="edge")
-            tables = _shared_tables(*arguments, *unique[:, first : first + batch], physical, True)
-            part = _shared_loops(tables, group[padded] - first, lam[padded])
-            parts.append(jax.tree.map(lambda leaf, m=members.size: leaf[:m], part))
-            order.append(members)
-        order = np.concatenate(order)
-        inverse = np.empty_like(order)
-        inverse[order] = np.arange(order.size)
-        loops = jax.tree.map(lambda *leaves: jnp.concatenate(leaves)[inverse], *parts)
+    parts, order = [], []
+    starts = range(0, count, batch)
+    members_of = [np.flatnonzero((group >= f) & (group < f + batch)) for f in starts]
+    width = _bucket(max(m.size for m in members_of))
+    for first, members in zip(starts, members_of, strict=True):  # every batch of one shape
+        padded = np.pad(members, (0, width - members.size), mode="edge")
+        tables = _shared_tables(*arguments, *unique[:, first : first + batch], physical, True)
+        part = _shared_loops(tables, group[padded] - first, lam[padded])
+        parts.append(jax.tree.map(lambda leaf, m=members.size: leaf[:m], part))
+        order.append(members)
+    order = np.concatenate(order)
+    inverse = np.empty_like(order)
+    inverse[order] = np.arange(order.size)
+    loops = jax.tree.map(lambda *leaves: jnp.concatenate(leaves)[inverse], *parts)
     dense = _shared_tables(*arguments, *unique[:, :count], physical, False)
-    size = loops.monotone.shape[0]
-    group = np.pad(group, (0, size - group.size), mode="edge")
-    lam = np.pad(lam, (0, size - lam.size), mode="edge")
-    if is_concrete(loops.monotone):
-        jumps = np.zeros(size)
-        where = np.flatnonzero(~np.asarray(loops.monotone))
-        if where.size:
-            padded = _pad(where)
-            ends = jax.tree.map(lambda leaf: leaf[padded], loops.ends)
-            values = _shared_jumps(dense, group[padded], lam[padded], ends)
-            jumps[where] = np.asarray(values)[: where.size]
-    else:
-        jumps = jax.lax.cond(
-            jnp.any(~loops.monotone),
-            lambda: _shared_jumps(dense, group, lam, loops.ends),
-            lambda: jnp.zeros(size),
-        )
+    jumps = np.zeros(lam.size)
+    where = np.flatnonzero(~np.asarray(loops.monotone))
+    if where.size:
+        padded = _pad(where)
+        ends = jax.tree.map(lambda leaf: leaf[padded], loops.ends)
+        values = _shared_jumps(dense, group[padded], lam[padded], ends)
+        jumps[where] = np.asarray(values)[: where.size]
     return loops, jumps
 
 
@@ -307,32 +291,6 @@ def steady_numbers_and_loops(
     numbers["displacement"] = _scaled(actuator, settled, values[0], shape)
     numbers["force"] = _scaled(force, settled, values[1], shape)
     return numbers
-
-
-def _drawn(position, slope, half_width, physical, num, point):
-    mu, key, lam = point
-    tables = core.profile_tables(position, slope, mu, _stroke(half_width, key, physical), False)
-    loop = first_passage.steady_loop(tables, 0, lam, False)
-    actuator, force = first_passage.draw_loop(tables, 0, lam, loop, num)
-    ok = (loop.regime == int(GROSS_SLIP)) | (loop.regime == int(NO_GROSS_SLIP))
-    return jnp.where(ok, actuator, jnp.nan), jnp.where(ok, force, jnp.nan)
-
-
-@partial(jax.jit, static_argnames=("physical", "num"))
-def _drawn_loops(position, slope, half_width, mu, key, lam, physical, num):
-    one = partial(_drawn, position, slope, half_width, physical, num)
-    return jax.lax.map(one, (mu, key, lam), batch_size=_POINT_BATCH)
-
-
-def profile_loop(profile, amplitude, load, stiffness, mu, groove_half_width, mapping, num):
-    """Displacement and force around the steady loop on ``profile`` (see fretting_loop)."""
-    profile, values, physical, (mu, key, lam, valid) = _points(
-        profile, amplitude, load, stiffness, mu, groove_half_width, mapping
-    )
-    arguments = (profile.position, profile.slope, profile.half_width)
-    actuator, force = _drawn_loops(*arguments, mu, key, lam, physical, num)
-    shape = values[0].shape
-    return _scaled(actuator, valid, values[0], shape), _scaled(force, valid, values[1], shape)
 
 
 def _history(position, slope, history):

@@ -140,7 +140,7 @@ def centre_segment(position) -> dict:
 
 
 def table_levels(count: int) -> int:
-    """Levels of a first-passage table over ``count`` samples: sum of 2**l >= count."""
+    """Levels of a sparse table over ``count`` samples: the fewest whose 2**l sum to >= count."""
     return max(1, int(np.ceil(np.log2(count + 1))))
 
 
@@ -191,10 +191,6 @@ def _side(position, slope, mu, sparse: bool) -> Side:
     return Side(position, slope, force, _intervals(position, force, levels))
 
 
-def _range_levels(count: int) -> int:
-    return int(np.floor(np.log2(max(count, 1)))) + 1
-
-
 def profile_tables(position, slope, mu, length, sparse: bool = True) -> Tables:
     r"""The tables of one profile for one :math:`\mu` and one stroke length :math:`A`."""
     p = position / length
@@ -217,14 +213,12 @@ def profile_tables(position, slope, mu, length, sparse: bool = True) -> Tables:
         falling, margin / ((1.0 + mu * mu) * jnp.where(falling, -rate, 1.0)), jnp.inf
     )
     trough = backward.force[::-1]  # -q_- at the samples, in the original order
-    levels = _range_levels(n) if sparse else 1
+    levels = table_levels(n) if sparse else 1
     tables = Tables(
         forward=forward,
         backward=backward,
         excess=excess,
-        critical=sparse_table(
-            critical, _range_levels(n - 1) if sparse else 1, jnp.minimum, jnp.inf
-        ),
+        critical=sparse_table(critical, table_levels(n - 1) if sparse else 1, jnp.minimum, jnp.inf),
         peak=sparse_table(forward.force, levels, jnp.maximum, -jnp.inf),
         trough=sparse_table(trough, levels, jnp.maximum, -jnp.inf),
         mu=mu,

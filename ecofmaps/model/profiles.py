@@ -14,20 +14,13 @@ import numpy as np
 
 from ecofmaps._codes import warn
 from ecofmaps._inputs import is_concrete, si_units
-from ecofmaps.model.profile_edges import (
-    AMBIGUOUS_EDGES,
-    UNCERTAIN_EDGES,
-    ScarProfileWarning,
-    scar_extent,
-)
+from ecofmaps.model.profile_edges import ScarProfileWarning, scar_extent
 
 __all__ = [
-    "AMBIGUOUS_EDGES",
     "AUTO_SMOOTHING",
     "MIN_SCAR_SAMPLES",
     "OUTLIER_NEIGHBOURS",
     "OUTLIER_THRESHOLD",
-    "UNCERTAIN_EDGES",
     "ScarProfile",
     "ScarProfileWarning",
     "local_quadratic",
@@ -147,40 +140,9 @@ def _neighbours(n: int, count: int) -> np.ndarray:
 
 
 def outlying_samples(x, z, neighbours=OUTLIER_NEIGHBOURS, threshold=OUTLIER_THRESHOLD):
-    r"""Which samples of a trace are outliers (spikes, dropouts): a Hampel filter.
-
-    Parameters
-    ----------
-    x, z : array_like, shape (N,)
-        Positions (strictly increasing) and heights. [m]
-    neighbours : int
-        Samples on each side that a sample is judged by (shifted inwards at the ends of the
-        trace). A run of up to ``neighbours - 1`` outliers is found.
-    threshold : float
-        How many scaled MADs from the neighbours' median make an outlier. [1]
-
-    Returns
-    -------
-    outlier : numpy.ndarray of bool, shape (N,)
-
-    Notes
-    -----
-    The robust scale is explained in ``docs/profiles.md``.
-
-    References
-    ----------
-    F.R. Hampel (1974), The influence curve and its role in robust estimation, J. Am. Stat.
-    Assoc. 69, 383-393.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> x = np.linspace(0.0, 1e-3, 101)
-    >>> z = 1e-6 * np.sin(x / 1e-4)
-    >>> z[40] += 5e-6
-    >>> np.flatnonzero(outlying_samples(x, z)).tolist()
-    [40]
-    """
+    """Which samples of a trace are outliers (bool, shape (N,)): a Hampel filter (Hampel 1974)
+    judging each sample by the median and scaled MAD of ``neighbours`` samples on each side
+    (``docs/profiles.md``); a run of up to ``neighbours - 1`` outliers is found."""
     x, z = _trace(x, z)
     if not (isinstance(neighbours, int | np.integer) and 1 <= neighbours < z.size / 2):
         raise ValueError(
@@ -247,23 +209,9 @@ def _checked_trace(x, z, half_width, smoothing):
 
 
 def local_quadratic(x: np.ndarray, z: np.ndarray, smoothing: float):
-    """Heights and slopes of a Gaussian-weighted local quadratic fit at every sample.
-
-    Parameters
-    ----------
-    x, z : numpy.ndarray
-        Positions (strictly increasing) and heights. [m]
-    smoothing : float
-        Standard deviation of the Gaussian weights; 0 returns ``z`` itself and the slope of
-        the parabola through each sample and its neighbours (``numpy.gradient``, second
-        order at the ends). [m]
-
-    Returns
-    -------
-    height, slope : numpy.ndarray
-        [m], [1]: the weights, widened where the samples are sparse, follow
-        ``docs/profiles.md``.
-    """
+    """Heights [m] and slopes [1] of Gaussian-weighted local quadratic fits at every sample,
+    of standard deviation ``smoothing`` [m] (``docs/profiles.md``); 0: ``z`` and
+    ``numpy.gradient``."""
     if smoothing == 0.0:
         return z.copy(), np.gradient(z, x, edge_order=2)
     n = x.size
@@ -294,15 +242,7 @@ def local_quadratic(x: np.ndarray, z: np.ndarray, smoothing: float):
 def scar_profile_and_findings(
     x, z, half_width=None, smoothing=None, level=False, remove_outliers=True
 ):
-    """:func:`scar_profile` and its warnings, not issued: ``(profile, findings)``.
-
-    Parameters and Raises are those of :func:`scar_profile`.
-
-    Returns
-    -------
-    profile : ScarProfile
-    findings : list of ScarProfileWarning
-    """
+    """:func:`scar_profile` and its warnings, not issued: ``(profile, findings)``."""
     x, z, half_width, smoothing = _checked_trace(x, z, half_width, smoothing)
     findings, replaced = [], np.zeros(x.size, dtype=bool)
     if remove_outliers:
