@@ -354,53 +354,6 @@ def _too_short_message(x, centre, width, given: bool) -> str:
     )
 
 
-def _scar_extent(x, zs, half_width, reach=0) -> Extent:
-    """The :class:`Extent` of the scar in the smoothed heights ``zs``."""
-    span = x[-1] - x[0]
-    mask = (x < x[0] + span / 5.0) | (x > x[-1] - span / 5.0)
-    previous = None
-    for _ in range(20):
-        line, tilt = _line(x, zs, mask)
-        r = zs - line(x)
-        noise = 1.4826 * np.median(np.abs(r[mask] - np.median(r[mask])))
-        deepest = int(np.argmin(r))
-        depth = -r[deepest]
-        if not depth > max(_NOISE_FACTOR * noise, _MIN_RELIEF * (r.max() - r.min())):
-            raise ValueError(
-                "z: no depression found: the deepest point is "
-                f"{_micrometres(depth)} below the unworn surface (a straight line fitted to "
-                f"the trace's ends): not more than {_NOISE_FACTOR:g} times its noise "
-                f"({_micrometres(noise)}) and {_MIN_RELIEF:.0%} of the trace's relief "
-                f"({_micrometres(r.max() - r.min())}). Heights must increase upwards (the scar "
-                "is a depression), in metres."
-            )
-        groove, band, ridges, outer, threshold, rough = _edges(x, r, deepest, depth, noise, reach)
-        tolerance = AMBIGUOUS_EDGES * 0.5 * (groove[1] - groove[0])
-        apart = [abs(b - g) > tolerance for b, g in zip(band, groove, strict=True)]
-        wide = all(apart)  # one side apart alone is most often debris beside the groove
-        if any(apart) and half_width is not None:  # the centre of the edges nearer that width
-            wide = abs(band[1] - band[0] - 2 * half_width) < abs(
-                groove[1] - groove[0] - 2 * half_width
-            )
-        edges = band if wide else groove
-        centre = 0.5 * (edges[0] + edges[1])
-        width = 0.5 * (edges[1] - edges[0]) if half_width is None else half_width
-        if half_width is not None and (centre - width < x[0] or centre + width > x[-1]):
-            raise ValueError(
-                f"half_width = {half_width:g} m does not fit the trace: {_micrometres(width)} "
-                f"either side of the scar centre at x = {_micrometres(centre)} reaches beyond "
-                f"the trace, which spans {_micrometres(x[0])} to {_micrometres(x[-1])}"
-            )
-        mask = _shoulders(x, centre, width, outer, np.abs(r) <= threshold)
-        if mask is None:
-            raise ValueError(_too_short_message(x, centre, width, given=half_width is not None))
-        if edges == previous:
-            break
-        previous = edges
-    band = band if any(apart) else groove
-    return Extent(line, tilt, centre, width, r, groove, band, wide, ridges, rough)
-
-
 def _ambiguity(extent: Extent, given: bool):
     """The warning of ambiguous edges (or None) and the half-width not taken. [m]"""
     if extent.band == extent.groove or given:
@@ -458,8 +411,51 @@ def _uncertainty(extent: Extent, given: bool):
 
 
 def scar_extent(x, zs, half_width, reach):
-    """The scar's :class:`Extent`, the half-width not taken [m] (NaN if none) and the warnings."""
-    extent = _scar_extent(x, zs, half_width, reach)
+    """The scar's :class:`Extent` in the smoothed heights ``zs``, the half-width not taken [m]
+    (NaN if none) and the warnings."""
+    span = x[-1] - x[0]
+    mask = (x < x[0] + span / 5.0) | (x > x[-1] - span / 5.0)
+    previous = None
+    for _ in range(20):
+        line, tilt = _line(x, zs, mask)
+        r = zs - line(x)
+        noise = 1.4826 * np.median(np.abs(r[mask] - np.median(r[mask])))
+        deepest = int(np.argmin(r))
+        depth = -r[deepest]
+        if not depth > max(_NOISE_FACTOR * noise, _MIN_RELIEF * (r.max() - r.min())):
+            raise ValueError(
+                "z: no depression found: the deepest point is "
+                f"{_micrometres(depth)} below the unworn surface (a straight line fitted to "
+                f"the trace's ends): not more than {_NOISE_FACTOR:g} times its noise "
+                f"({_micrometres(noise)}) and {_MIN_RELIEF:.0%} of the trace's relief "
+                f"({_micrometres(r.max() - r.min())}). Heights must increase upwards (the scar "
+                "is a depression), in metres."
+            )
+        groove, band, ridges, outer, threshold, rough = _edges(x, r, deepest, depth, noise, reach)
+        tolerance = AMBIGUOUS_EDGES * 0.5 * (groove[1] - groove[0])
+        apart = [abs(b - g) > tolerance for b, g in zip(band, groove, strict=True)]
+        wide = all(apart)  # one side apart alone is most often debris beside the groove
+        if any(apart) and half_width is not None:  # the centre of the edges nearer that width
+            wide = abs(band[1] - band[0] - 2 * half_width) < abs(
+                groove[1] - groove[0] - 2 * half_width
+            )
+        edges = band if wide else groove
+        centre = 0.5 * (edges[0] + edges[1])
+        width = 0.5 * (edges[1] - edges[0]) if half_width is None else half_width
+        if half_width is not None and (centre - width < x[0] or centre + width > x[-1]):
+            raise ValueError(
+                f"half_width = {half_width:g} m does not fit the trace: {_micrometres(width)} "
+                f"either side of the scar centre at x = {_micrometres(centre)} reaches beyond "
+                f"the trace, which spans {_micrometres(x[0])} to {_micrometres(x[-1])}"
+            )
+        mask = _shoulders(x, centre, width, outer, np.abs(r) <= threshold)
+        if mask is None:
+            raise ValueError(_too_short_message(x, centre, width, given=half_width is not None))
+        if edges == previous:
+            break
+        previous = edges
+    band = band if any(apart) else groove
+    extent = Extent(line, tilt, centre, width, r, groove, band, wide, ridges, rough)
     finding, alternative = _ambiguity(extent, half_width is not None)
     if finding is None:
         finding, alternative = _uncertainty(extent, half_width is not None)

@@ -13,10 +13,11 @@ from ecofmaps.model.profiles import MIN_SCAR_SAMPLES, ScarProfile, profile_of
 __all__ = ["flat_bottomed_profile", "parabolic_profile", "ridged_profile", "w_shaped_profile"]
 
 
-def _positive(name: str, value) -> float:
+def _above(name: str, value, bound=0.0, unit="") -> float:
+    """``value`` as a float; ``ValueError`` unless it is finite and > ``bound``."""
     value = float(value)
-    if not (np.isfinite(value) and value > 0.0):
-        raise ValueError(f"{name} must be finite and > 0, got {value!r}")
+    if not (np.isfinite(value) and value > bound):
+        raise ValueError(f"{name} must be finite and > {bound:g}{unit}, got {value!r}")
     return value
 
 
@@ -66,13 +67,6 @@ def _family(position, height, slope, depth, half_width, tilt):
     )
 
 
-def _extent(extent, needed=1.0) -> float:
-    extent = float(extent)
-    if not (np.isfinite(extent) and extent > needed):
-        raise ValueError(f"extent must be finite and > {needed:g} (half-widths), got {extent!r}")
-    return extent
-
-
 @si_units(depth="length", half_width="length")
 def parabolic_profile(depth, half_width, *, tilt=0.0, samples=2001, extent=2.0) -> ScarProfile:
     r"""A parabolic scar, the paper's groove: :math:`z = -D(1 - (X/W)^2)` for :math:`|X| \le W`.
@@ -107,8 +101,8 @@ def parabolic_profile(depth, half_width, *, tilt=0.0, samples=2001, extent=2.0) 
     >>> float(p.aspect_ratio)
     0.2
     """
-    depth, half_width = _positive("depth", depth), _positive("half_width", half_width)
-    extent = _extent(extent)
+    depth, half_width = _above("depth", depth), _above("half_width", half_width)
+    extent = _above("extent", extent, 1.0, " (half-widths)")
     x = _grid([half_width, extent * half_width], samples)
     inside = np.abs(x) <= half_width
     u = x / half_width
@@ -141,9 +135,9 @@ def flat_bottomed_profile(
     -------
     profile : ScarProfile
     """
-    depth, half_width = _positive("depth", depth), _positive("half_width", half_width)
+    depth, half_width = _above("depth", depth), _above("half_width", half_width)
     flat = _fraction("flat_fraction", flat_fraction) * half_width
-    extent = _extent(extent)
+    extent = _above("extent", extent, 1.0, " (half-widths)")
     x = _grid([flat, half_width, extent * half_width], samples)
     s = np.clip((np.abs(x) - flat) / (half_width - flat), 0.0, None)
     inside = np.abs(x) <= half_width
@@ -176,9 +170,9 @@ def w_shaped_profile(
     -------
     profile : ScarProfile
     """
-    depth, half_width = _positive("depth", depth), _positive("half_width", half_width)
+    depth, half_width = _above("depth", depth), _above("half_width", half_width)
     hump = _fraction("hump", hump)
-    extent = _extent(extent)
+    extent = _above("extent", extent, 1.0, " (half-widths)")
     m2 = np.sqrt(hump) / (1.0 + np.sqrt(hump))
     trough = np.sqrt(m2) * half_width
     x = _grid([trough, half_width, extent * half_width], samples)
@@ -217,10 +211,10 @@ def ridged_profile(
     -------
     profile : ScarProfile
     """
-    depth, half_width = _positive("depth", depth), _positive("half_width", half_width)
-    height = _positive("ridge_height", ridge_height)
-    width = _positive("ridge_width", ridge_width)
-    extent = _extent(extent, 1.0 + width / half_width)
+    depth, half_width = _above("depth", depth), _above("half_width", half_width)
+    height = _above("ridge_height", ridge_height)
+    width = _above("ridge_width", ridge_width)
+    extent = _above("extent", extent, 1.0 + width / half_width, " (half-widths)")
     edges = [half_width, half_width + 0.5 * width, half_width + width, extent * half_width]
     x = _grid(edges, samples)
     u = x / half_width

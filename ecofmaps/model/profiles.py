@@ -163,10 +163,10 @@ def outlying_samples(x, z, neighbours=OUTLIER_NEIGHBOURS, threshold=OUTLIER_THRE
 
 
 def _outliers_replaced(x, z):
-    """Heights with their outliers interpolated, the outliers' mask and the warning (or None)."""
+    """Heights with their outliers interpolated, the outliers' mask and the warnings."""
     outlier = outlying_samples(x, z)
     if not outlier.any():
-        return z, outlier, None
+        return z, outlier, []
     kept = ~outlier
     cleaned = z.copy()
     cleaned[outlier] = np.interp(x[outlier], x[kept], z[kept])
@@ -181,7 +181,7 @@ def _outliers_replaced(x, z):
         f"scaled MADs from the median of its {2 * OUTLIER_NEIGHBOURS} neighbours) replaced by "
         "linear interpolation between the nearest samples kept"
     )
-    return cleaned, outlier, ScarProfileWarning(summary, samples, details)
+    return cleaned, outlier, [ScarProfileWarning(summary, samples, details)]
 
 
 def _checked_trace(x, z, half_width, smoothing):
@@ -246,8 +246,7 @@ def scar_profile_and_findings(
     x, z, half_width, smoothing = _checked_trace(x, z, half_width, smoothing)
     findings, replaced = [], np.zeros(x.size, dtype=bool)
     if remove_outliers:
-        z, replaced, finding = _outliers_replaced(x, z)
-        findings += [finding] if finding is not None else []
+        z, replaced, findings = _outliers_replaced(x, z)
     spacing = float(np.median(np.diff(x)))
     # The edges are found on lightly smoothed heights (heavier smoothing moves a kink).
     light = 0.0 if smoothing == 0.0 else _EDGE_SMOOTHING * spacing
