@@ -207,9 +207,7 @@ energy_cof = _steady_quantity(
     """energy_cof : jax.Array of float64
         :math:`\\mu_E \\ge \\mu`; NaN with no gross slip (a :class:`RegimeWarning` says so
         for concrete inputs) and when self-locking. [1]""",
-    """The paper's eq. 13-15 print the coefficient of the logarithm as
-    :math:`(x_o^2/2z_o)(1 + 1/\\mu)`; it must be :math:`(x_o^2/2z_o)(1 + 1/\\mu^2)`
-    (:func:`ecofmaps.model.ecof_ratio`, ``docs/model.md``).
+    """With eq. 13-15 corrected as :func:`ecofmaps.model.ecof_ratio` says.
 
     """,
     "1, 9, 11, 13-15",
