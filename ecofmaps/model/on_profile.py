@@ -219,10 +219,8 @@ def _finish(loops, jumps, mu, lam, valid) -> dict:
 
 
 def steady_values(numbers, amplitude, load, mu) -> dict:
-    r"""The steady loop's values in SI units from the numbers of :func:`steady_numbers` (in
-    the core's units): ``slip_amplitude`` :math:`\delta^*` [m] and ``ecof`` :math:`\mu_E`
-    [1]; with a ``load``, ``dissipated_energy`` :math:`E_d` [J] and ``max_force``
-    :math:`Q^*` [N]. The arguments broadcast (NumPy or JAX arrays)."""
+    """:func:`steady_numbers` in SI units, broadcast: ``slip_amplitude`` [m], ``ecof`` [1] and,
+    with a ``load``, ``dissipated_energy`` [J] and ``max_force`` [N]."""
     values = {
         "slip_amplitude": amplitude * numbers["slip_ratio"],
         "ecof": mu * numbers["ecof_ratio"],

@@ -29,8 +29,7 @@ def _fraction(name: str, value) -> float:
 
 
 def _grid(breakpoints, samples: int) -> np.ndarray:
-    """Exactly ``samples`` positions, about evenly spread, with 0 and every breakpoint (> 0)
-    and its mirror image among them."""
+    """``samples`` positions about evenly spread, with 0, each breakpoint and its mirror."""
     if not (isinstance(samples, int | np.integer) and samples >= 2 * MIN_SCAR_SAMPLES):
         raise ValueError(f"samples must be an integer >= {2 * MIN_SCAR_SAMPLES}, got {samples!r}")
     breakpoints = np.asarray(breakpoints, dtype=np.float64)
