@@ -23,6 +23,7 @@ __all__ = [
     "MAPPINGS",
     "as_profile",
     "check_mapping",
+    "profile_loop",
     "profile_simulation",
     "steady_numbers",
     "steady_numbers_and_loops",
@@ -289,6 +290,32 @@ def steady_numbers_and_loops(
     numbers["displacement"] = _scaled(actuator, settled, values[0], shape)
     numbers["force"] = _scaled(force, settled, values[1], shape)
     return numbers
+
+
+def _drawn(position, slope, half_width, physical, num, point):
+    mu, key, lam = point
+    tables = core.profile_tables(position, slope, mu, _stroke(half_width, key, physical), False)
+    loop = first_passage.steady_loop(tables, 0, lam, False)
+    actuator, force = first_passage.draw_loop(tables, 0, lam, loop, num)
+    ok = (loop.regime == int(GROSS_SLIP)) | (loop.regime == int(NO_GROSS_SLIP))
+    return jnp.where(ok, actuator, jnp.nan), jnp.where(ok, force, jnp.nan)
+
+
+@partial(jax.jit, static_argnames=("physical", "num"))
+def _drawn_loops(position, slope, half_width, mu, key, lam, physical, num):
+    one = partial(_drawn, position, slope, half_width, physical, num)
+    return jax.lax.map(one, (mu, key, lam), batch_size=_POINT_BATCH)
+
+
+def profile_loop(profile, amplitude, load, stiffness, mu, groove_half_width, mapping, num):
+    """Displacement and force around the steady loop on ``profile`` (see fretting_loop)."""
+    profile, values, physical, (mu, key, lam, valid) = _points(
+        profile, amplitude, load, stiffness, mu, groove_half_width, mapping
+    )
+    arguments = (profile.position, profile.slope, profile.half_width)
+    actuator, force = _drawn_loops(*arguments, mu, key, lam, physical, num)
+    shape = values[0].shape
+    return _scaled(actuator, valid, values[0], shape), _scaled(force, valid, values[1], shape)
 
 
 def _history(position, slope, history):

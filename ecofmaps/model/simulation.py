@@ -18,11 +18,7 @@ from ecofmaps.model.core import (
     steady_inputs,
     traction_ratio,
 )
-from ecofmaps.model.on_profile import (
-    broadcast_history,
-    profile_simulation,
-    steady_numbers_and_loops,
-)
+from ecofmaps.model.on_profile import broadcast_history, profile_loop, profile_simulation
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
 from ecofmaps.model.steady_state import dimensionless, one_geometry
 
@@ -118,10 +114,9 @@ def fretting_loop(
         raise ValueError(f"num must be an integer >= 2, got {num!r}")
     one_geometry(aspect_ratio, profile, mapping)
     if profile is not None:
-        loops = steady_numbers_and_loops(
-            profile, amplitude, load, stiffness, mu, num, groove_half_width, mapping
+        return profile_loop(
+            profile, amplitude, load, stiffness, mu, groove_half_width, mapping, num
         )
-        return loops["displacement"], loops["force"]
     values = steady_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
     return _steady_loop(*jnp.broadcast_arrays(*values), num=num)
 
