@@ -95,51 +95,10 @@ model.data = model_data;
 
 
 def write_report(path, results: xr.Dataset, *, loops=None, inputs=None, lab=None) -> Path:
-    """Write the results of a fretting test as one HTML page that opens offline.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The HTML file to write (atomically: a temporary file renamed into place); its
-        directory must exist.
-    results : xarray.Dataset
-        From :func:`ecofmaps.analyze_loops`; with ``resolve=True`` the page also shows the
-        friction read along the stroke, and with ``keep_loops=True`` the loops.
-    loops : sequence of int, optional
-        Cycle numbers whose loops the page carries, for the reader to pick from; by
-        default :data:`LOOPS_CARRIED` spread evenly over the test, the first and the last
-        included. Needs ``keep_loops=True``.
-    inputs : mapping of str to str, optional
-        What the results were made from, shown as given (``{"files": "test.csv", "load":
-        "450 N", "units assumed": "displacement um, force N"}``); the ecofmaps version and
-        the date are added.
-    lab : mapping of str to str, optional
-        More of the lab's numbers, shown as given under theirs (the energy wear and the
-        loop-scar closure ``ecofmaps loops --scar-profile`` reads).
-
-    Returns
-    -------
-    path : pathlib.Path
-        The file written.
-
-    Raises
-    ------
-    ValueError
-        If ``results`` lack a variable of :func:`ecofmaps.analyze_loops`, ``loops`` names a
-        cycle not in them, or ``loops`` is given for results without loops.
-
-    Examples
-    --------
-    >>> import ecofmaps, tempfile, os
-    >>> displacement, force = ecofmaps.synthetic_recording(
-    ...     50e-6, 450.0, 35e6, 0.8, [0.1, 0.15, 0.2], samples_per_cycle=160)
-    >>> results = ecofmaps.analyze_loops(displacement, force, 450.0, resolve=True,
-    ...                                  keep_loops=True)
-    >>> folder = tempfile.mkdtemp()
-    >>> page = write_report(os.path.join(folder, "report.html"), results,
-    ...                     inputs={"load": "450 N"})
-    >>> page.read_text(encoding="utf-8").count("<script src=")  # nothing fetched
-    0
+    """Write the results of :func:`ecofmaps.analyze_loops` as one HTML page that opens offline, at
+    ``path`` (atomically; its folder must exist); return the path. ``loops``: the cycles whose loops
+    the page carries (default :data:`LOOPS_CARRIED` spread evenly); ``inputs`` and ``lab``: rows
+    shown as given (what the results were made from; more of the lab's numbers).
     """
     document = report_document(results, loops=loops, inputs=inputs, lab=lab)
     title = "ecofmaps report" + (f": {inputs['files']}" if inputs and "files" in inputs else "")
@@ -162,28 +121,8 @@ def write_report(path, results: xr.Dataset, *, loops=None, inputs=None, lab=None
 
 
 def recording_inputs(recording, load: float, *, flip_force: bool = False) -> dict[str, str]:
-    """What a report of one recording says it was made from (``inputs`` of :func:`write_report`).
-
-    Parameters
-    ----------
-    recording : ecofmaps.io.recordings.Recording
-        From :func:`ecofmaps.io.recordings.read_recording`.
-    load : float
-        Normal load :math:`P` the recording was analysed with. [N]
-    flip_force : bool
-        Whether the force was read with the other sign.
-
-    Returns
-    -------
-    inputs : dict of str to str
-        The file, the load, and each column read with the unit it was read in.
-
-    Examples
-    --------
-    >>> from ecofmaps.io.recordings import read_recording
-    >>> from ecofmaps.measured.synthetic import example_path
-    >>> recording_inputs(read_recording(example_path()), 450.0)["columns and units assumed"]
-    "displacement: 'displacement' in um; force: 'force' in N; cycle: 'cycle'"
+    """The ``inputs`` of :func:`write_report` for a recording analysed at ``load`` [N]: its file,
+    the load and each column read with its unit.
     """
     read = []
     for name, column_name in recording.columns.items():
@@ -231,7 +170,7 @@ def _rows_table(rows: Mapping, css_class: str) -> str:
 
 
 def _header(results: xr.Dataset, inputs: Mapping) -> Div:
-    """The title, the inputs, the version and date, and the summary of the quality."""
+    """The title, the inputs, the version and date, and the quality's summary."""
     rows = dict(inputs)
     rows["ecofmaps version"] = __version__
     rows["written"] = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
