@@ -1,6 +1,5 @@
 r"""The maps of μ_E/μ over the rig (S/P, or λ = P/(SΔ*)) and z_o/x_o: the paper's Figure 11 and
-the universal map, each a pure function of the Dataset that holds its numbers (docs/model.md).
-"""
+the universal map, each a pure function of the Dataset that holds its numbers (docs/model.md)."""
 
 from __future__ import annotations
 

@@ -1,7 +1,6 @@
 r"""Figures of measured loops: the loops with :math:`Q = S\Delta`, the friction over the test (as
 the paper's Figure 9), the fitted model (as its Figure 10) and the loops read along the stroke,
-titled by the recording's name (``source``), legends clear of the data (docs/method-loops.md).
-"""
+titled by the recording's name (``source``), legends clear of the data (docs/method-loops.md)."""
 
 from __future__ import annotations
 

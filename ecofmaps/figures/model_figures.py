@@ -1,7 +1,6 @@
 r"""The paper's figures of the model's loops and curves (Figures 5-8): each a pure function of a
 Dataset of :mod:`ecofmaps.maps` (and of the points it marks), in µm, N, MN/m and mJ.
-:mod:`ecofmaps.figures.recipes` builds the Datasets with the paper's parameters.
-"""
+:mod:`ecofmaps.figures.recipes` builds the Datasets with the paper's parameters."""
 
 from __future__ import annotations
 

@@ -1,6 +1,5 @@
 r"""Figures of wear-scar profiles: a measured profile as the model reads it, and the ``shapes``
-figure, scars of four shapes at one :math:`D/W` against the parabola (docs/profiles.md).
-"""
+figure, scars of four shapes at one :math:`D/W` against the parabola (docs/profiles.md)."""
 
 from __future__ import annotations
 

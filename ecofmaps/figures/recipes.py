@@ -1,7 +1,6 @@
 r"""The figures ``ecofmaps figures`` writes: :data:`FIGURES`, for each figure the function that
 builds its Dataset with the paper's parameters (:mod:`ecofmaps.paper`), the function that draws
-it and what it marks; :func:`make_figure` does both, :func:`make_figures` for several.
-"""
+it and what it marks; :func:`make_figure` does both, :func:`make_figures` for several."""
 
 from __future__ import annotations
 
@@ -421,7 +420,7 @@ def make_figures(names=None) -> Iterator[tuple[str, Figure]]:
     Raises
     ------
     ValueError
-        If a name is not a key of :data:`FIGURES` (before anything is computed).
+        As :func:`make_figure`, before anything is computed.
     """
     recipes = [_recipe(name) for name in (FIGURES if names is None else names)]
     datasets: dict = {}
@@ -448,7 +447,7 @@ def figure_groups(names=None) -> list[list[str]]:
     Raises
     ------
     ValueError
-        If a name is not a key of :data:`FIGURES`.
+        As :func:`make_figure`.
 
     Examples
     --------
@@ -469,7 +468,7 @@ def figure_parts(names=None) -> list[list[Callable[[], xr.Dataset]]]:
     Parameters
     ----------
     names : iterable of str, optional
-        Keys of :data:`FIGURES`; default all of them.
+        As for :func:`figure_groups`.
 
     Returns
     -------
@@ -480,6 +479,6 @@ def figure_parts(names=None) -> list[list[Callable[[], xr.Dataset]]]:
     Raises
     ------
     ValueError
-        If a name is not a key of :data:`FIGURES`.
+        As :func:`make_figure`.
     """
     return [list(_recipe(group[0]).parts) for group in figure_groups(names)]

@@ -2,8 +2,7 @@
 
 One page per session: the parameters typed with units, the model's numbers and steady loop at
 that point, Figure 11's map with the point marked, and the contact CoF behind a typed ECoF.
-The inputs live in the page's URL query, so a view is shared as a link.
-"""
+The inputs live in the page's URL query, so a view is shared as a link."""
 
 from __future__ import annotations
 
@@ -57,8 +56,7 @@ _MAPS_KEPT = 32
 def parameter_value(key: str, text: str) -> float:
     """The SI value [m, N, N/m or 1] of input ``key`` of :data:`INPUTS` from its text (``'50um'``,
     ``'inf'``; a bare number is SI); a ValueError naming the input if the text cannot be read, or
-    the value is out of range or beyond the model's domain (:data:`ecofmaps.units.DOMAIN`).
-    """
+    the value is out of range or beyond the model's domain (:data:`ecofmaps.units.DOMAIN`)."""
     name, label, _ = INPUTS[key]
     quantity, (low, high) = QUANTITIES[name], DOMAIN[name]
     text = str(text)
@@ -81,8 +79,7 @@ def parameter_value(key: str, text: str) -> float:
 
 def bare_number_warnings(texts: dict) -> list[str]:
     """The warnings for ``texts`` (by key of :data:`INPUTS`) typed as bare numbers implausible in
-    SI, each naming the input and the unit probably meant.
-    """
+    SI, each naming the input and the unit probably meant."""
     found = []
     for key, text in texts.items():
         if len(str(text)) > TEXT_LIMIT:  # refused as too long: not read as a number here

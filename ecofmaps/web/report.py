@@ -1,11 +1,7 @@
-"""A fretting test's results as one HTML page that opens offline (``ecofmaps loops --report``).
-
-Bokeh's page with its JavaScript and CSS inline, so it fetches nothing: the ECoF, the GICoF
-and the friction read along the stroke over the cycles with the quality flags and their
-counts, the lab's numbers (ΣE_d, the transition of a sweep: docs/lab.md), measured loops of
-a few cycles beside the model's, the table of ``ecofmaps loops`` (sortable), and the inputs,
-version and date.
-"""
+"""A fretting test's results as one HTML page that opens offline (``ecofmaps loops --report``):
+Bokeh's, its JavaScript and CSS inline. The coefficients of friction over the cycles with the
+quality flags, the lab's numbers (docs/lab.md), measured loops beside the model's, the table of
+``ecofmaps loops`` and the inputs, version and date."""
 
 from __future__ import annotations
 
@@ -47,8 +43,8 @@ from ecofmaps.model.simulation import fretting_loop
 
 __all__ = ["LOOPS_CARRIED", "recording_inputs", "report_document", "write_report"]
 
-#: Cycles whose loops a report carries by default, spread evenly over the test: the reader
-#: picks among them in the page. Their loops are the bulk of a report of a short test.
+#: Cycles whose loops a report carries by default, spread evenly over the test, for the reader
+#: to pick from: the bulk of a short test's report.
 LOOPS_CARRIED = 60
 
 _MODEL_POINTS = 40  # points on each slip branch of a model loop
@@ -58,10 +54,9 @@ _MODEL_BATCH = 64  # model loops are computed in batches of a multiple of this m
 _FRAME = (560, 130)
 _WIDTH = 1240
 _NEEDED = ("cycle", "ecof", "gicof", "quality", "regime", "load")
-# The table: significant digits as the CSV's (each column with the decimals of its largest
-# value), a number cell (nothing for NaN, as the CSV's empty field), the width of a character
-# and the room around it, the table's width (every column of a recording's table in a window
-# 1400 px wide) and the room for its scroll bar. [px]
+# The table: the CSV's significant digits, a number cell (empty for NaN, as in the CSV), the
+# width of a character and the room around it, the table's width (fits a 1400 px window) and
+# the room for its scroll bar. [px]
 _DIGITS = 6
 _NUMBER_CELL = (
     '<div style="text-align: right"><%= (value == null || value !== value) ? "" : '
@@ -70,8 +65,7 @@ _NUMBER_CELL = (
 _CHARACTER, _CELL_ROOM = 6.5, 10
 _TABLE_WIDTH, _TABLE_ROOM = 1350, 20
 
-# Shows the loops of the cycles picked in the page: the measured loop and, where the cycle
-# has one, the model's, each pair in one colour.
+# Shows the measured loops of the cycles picked and their model's, each pair in one colour.
 _PICK_LOOPS = """
 const all = carried.data;
 const measured_data = {xs: [], ys: [], label: [], color: []};
@@ -98,8 +92,7 @@ def write_report(path, results: xr.Dataset, *, loops=None, inputs=None, lab=None
     """Write the results of :func:`ecofmaps.analyze_loops` as one HTML page that opens offline, at
     ``path`` (atomically; its folder must exist); return the path. ``loops``: the cycles whose loops
     the page carries (default :data:`LOOPS_CARRIED` spread evenly); ``inputs`` and ``lab``: rows
-    shown as given (what the results were made from; more of the lab's numbers).
-    """
+    shown as given (what the results were made from; more of the lab's numbers)."""
     document = report_document(results, loops=loops, inputs=inputs, lab=lab)
     title = "ecofmaps report" + (f": {inputs['files']}" if inputs and "files" in inputs else "")
     # Bokeh's own JavaScript and CSS, written in. Not file_html(..., INLINE): that also asks
@@ -122,8 +115,7 @@ def write_report(path, results: xr.Dataset, *, loops=None, inputs=None, lab=None
 
 def recording_inputs(recording, load: float, *, flip_force: bool = False) -> dict[str, str]:
     """The ``inputs`` of :func:`write_report` for a recording analysed at ``load`` [N]: its file,
-    the load and each column read with its unit.
-    """
+    the load and each column read with its unit."""
     read = []
     for name, column_name in recording.columns.items():
         unit = recording.units.get(name, "1")
