@@ -77,9 +77,8 @@ def ecof_ratio_contours(
     Returns
     -------
     figure : matplotlib.figure.Figure
-        Filled contours with labelled lines at :data:`ECOF_RATIO_LEVELS` (the 5 % line
-        heavier), :math:`S/P` in (MN/m)/kN (= 1/mm); the area with no gross slip hatched;
-        the markers.
+        Contours at :data:`ECOF_RATIO_LEVELS` (5 % heavier) over :math:`S/P` [(MN/m)/kN],
+        no gross slip hatched, and the markers.
 
     Notes
     -----
@@ -117,19 +116,18 @@ def universal_ecof_ratio_map(
         From :func:`ecofmaps.compute_universal_map` with 1-D ``compliance_ratio``
         (positive: the axis is logarithmic) and ``aspect_ratio`` and a scalar ``mu``.
     markers : mapping of str to mapping, optional
-        Test conditions to mark, by legend name: keyword arguments of
-        :func:`ecofmaps.energy_cof` (``amplitude``, ``load``, ``stiffness``, ``mu``,
-        ``aspect_ratio``), e.g. :data:`ecofmaps.paper.FIGURE_10_FITS`. Each is drawn at its
-        own :math:`\lambda` with its own :math:`\mu_E/\mu` (at its own :math:`\mu`).
+        Test conditions to mark at their own :math:`\lambda` and :math:`\mu_E/\mu`, by legend
+        name: keyword arguments of :func:`ecofmaps.energy_cof`, e.g.
+        :data:`ecofmaps.paper.FIGURE_10_FITS`.
     windows : mapping of str to tuple, optional
-        Spans of :math:`\lambda` to show as bars, by figure name: ``(amplitude,
-        stiffness_ratios)`` [m], [1/m], the span of the ``stiffness_ratios`` at that amplitude.
+        Spans of :math:`\lambda` shown as bars, by figure name: ``(amplitude,
+        stiffness_ratios)`` [m], [1/m].
 
     Returns
     -------
     figure : matplotlib.figure.Figure
-        Labelled contours at :data:`ECOF_RATIO_LEVELS` on a logarithmic :math:`\lambda`
-        axis, the windows, and the markers.
+        Contours at :data:`ECOF_RATIO_LEVELS` on a logarithmic :math:`\lambda` axis, the
+        windows and the markers.
 
     Notes
     -----

@@ -1,6 +1,6 @@
 r"""Figures of measured loops: the loops with :math:`Q = S\Delta`, the friction over the test (as
-the paper's Figure 9), the fitted model (as its Figure 10) and the loops read along the stroke,
-titled by the recording's name (``source``), legends clear of the data (docs/method-loops.md)."""
+the paper's Figure 9), the fitted model (its Figure 10) and the loops read along the stroke
+(docs/method-loops.md)."""
 
 from __future__ import annotations
 
@@ -90,23 +90,22 @@ def measured_loops(
     results : xarray.Dataset
         From :func:`ecofmaps.analyze_loops` with ``keep_loops=True``.
     cycles : sequence of int, optional
-        Cycle numbers to draw, one panel each; by default six spread evenly over the
-        recording, the first and the last included.
+        Cycle numbers to draw, one panel each; by default six spread evenly, the first and
+        the last included.
     columns : int
         Panels per row.
     resolved : xarray.Dataset, optional
-        From :func:`ecofmaps.resolve_analyzed_loops` of the same ``results``: the part of
-        the stroke it read is shaded.
+        From :func:`ecofmaps.resolve_analyzed_loops` of ``results``: the part of the stroke
+        it read is shaded.
     source : str, optional
         The recording's name (its file's), which the title begins with.
 
     Returns
     -------
     figure : matplotlib.figure.Figure
-        One panel per cycle: the centred loop, :math:`Q` [N] against :math:`\Delta` [µm],
-        the line :math:`Q = S\Delta`, the crossings whose :math:`Q/P` is the GICoF (the
-        paper's eq. 17-18) and, with ``resolved``, the band of :math:`\Delta - Q/S` where
-        both branches were read; titled by the GICoF, ECoF and flags of the cycle.
+        Per cycle, titled by its GICoF, ECoF and flags: the centred loop, :math:`Q` [N]
+        against :math:`\Delta` [µm], the line :math:`Q = S\Delta` and the crossings whose
+        :math:`Q/P` is the GICoF (eq. 17-18).
     """
     if "loop_displacement" not in results:
         raise ValueError("results hold no loops: call analyze_loops(..., keep_loops=True)")
@@ -199,14 +198,13 @@ def cof_evolution(results: xr.Dataset, *, source: str | None = None) -> Figure:
     results : xarray.Dataset
         From :func:`ecofmaps.analyze_loops`.
     source : str, optional
-        The recording's name (its file's), which the title begins with.
+        As for :func:`measured_loops`.
 
     Returns
     -------
     figure : matplotlib.figure.Figure
-        Top: :math:`\mu_E` (eq. 1) and the GICoF against the cycle number. Bottom: how far
-        the ECoF is above the GICoF, :math:`\mu_E/\text{GICoF} - 1` [%]. A panel with
-        nothing to draw says why (the count of each flag, or no cycle in gross slip).
+        Top: :math:`\mu_E` (eq. 1) and the GICoF against the cycle. Bottom:
+        :math:`\mu_E/\text{GICoF} - 1` [%]. A panel with nothing to draw says why.
 
     Notes
     -----
@@ -253,17 +251,15 @@ def measured_and_fitted_loops(fits, *, source: str | None = None) -> Figure:
     Parameters
     ----------
     fits : LoopFit or mapping of str to LoopFit
-        From :func:`ecofmaps.fit_loop`. A mapping draws one panel per entry, titled by
-        its key, side by side (the paper's Figure 10 has Example 1 and Example 2).
+        From :func:`ecofmaps.fit_loop`; a mapping draws a panel per entry, titled by its key.
     source : str, optional
-        The recording's name (its file's), which the title begins with.
+        As for :func:`measured_loops`.
 
     Returns
     -------
     figure : matplotlib.figure.Figure
-        In each panel the measured samples (dots) and the fitted model loop (line), Q [N]
-        (left) and Q/P (right) against Δ [µm]; the title gives the fitted μ, S [MN/m],
-        z_o [µm] and the RMS force residual [N].
+        Per panel the samples (dots) and the fitted loop, Q [N] and Q/P against Δ [µm],
+        titled by the fitted μ, S [MN/m], z_o [µm] and the RMS force residual [N].
 
     Notes
     -----
@@ -313,32 +309,28 @@ def resolved_loops(
     resolved : xarray.Dataset
         From :func:`ecofmaps.resolve_loops` (with its ``position`` dimension).
     results : xarray.Dataset, optional
-        From :func:`ecofmaps.analyze_loops` for the same recording: its ECoF and GICoF are
-        drawn beside the resolved :math:`\mu` for comparison.
+        From :func:`ecofmaps.analyze_loops` of the same recording: its ECoF and GICoF are
+        drawn beside the resolved :math:`\mu`.
     cycles : sequence of int, optional
-        Cycle numbers drawn along the stroke; by default up to five cycles whose quality is
-        ``'ok'``, spread evenly over the test, the first and the last included.
+        Cycles drawn along the stroke; by default up to five of quality ``'ok'``, spread
+        evenly, the first and the last included.
     source : str, optional
-        The recording's name (its file's), which the title begins with.
+        As for :func:`measured_loops`.
 
     Returns
     -------
     figure : matplotlib.figure.Figure
-        (a) :math:`\mu(\xi)` against the contact position :math:`\xi` [µm], each cycle's
-        ``mu_resolved`` dashed and the central part it averages shaded; (b) the felt
-        profile :math:`h(\xi)` [µm] with each cycle's equivalent parabola
-        :math:`k\xi^2/2` dotted; (c) :math:`h` over (position, cycle), the groove deepening
-        as the test runs; (d) ``mu_resolved`` :math:`\pm 2` standard errors over the cycles
-        (with the ECoF and GICoF when ``results`` is given) and the equivalent
-        ``aspect_ratio`` on a right-hand axis, cycles with no resolved value marked along
-        the bottom with their quality. A panel with nothing to draw says why.
+        (a) :math:`\mu(\xi)` against the contact position :math:`\xi` [µm], with
+        ``mu_resolved`` dashed over the central part it averages; (b) the felt profile
+        :math:`h(\xi)` [µm] and its equivalent parabola :math:`k\xi^2/2`; (c) :math:`h` over
+        (position, cycle); (d) ``mu_resolved`` :math:`\pm 2` standard errors, the ECoF and
+        GICoF, and ``aspect_ratio`` over the cycles, those without a value marked with
+        their quality. A panel with nothing to draw says why.
 
     Notes
     -----
-    :math:`\mu(\xi) = \tan((\arctan q_+ - \arctan q_-)/2)` and
-    :math:`g(\xi) = \tan((\arctan q_+ + \arctan q_-)/2)` with :math:`q_\pm = Q_\pm/P` on the
-    two slip branches at the same :math:`\xi = \Delta - Q/S` (eq. 9, 10); the GICoF
-    (eq. 17-18) is :math:`\mu(0)`: docs/method-loops.md.
+    :math:`\mu(\xi)` and :math:`g(\xi)` from the two slip branches at the same
+    :math:`\xi = \Delta - Q/S` (eq. 9, 10): docs/method-loops.md.
     """
     if "position" not in resolved.dims:
         raise ValueError("resolved holds no positions: call resolve_loops(..., positions=201)")

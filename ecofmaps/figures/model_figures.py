@@ -93,13 +93,12 @@ def loops_by_aspect_ratio(loops: xr.Dataset) -> Figure:
     Returns
     -------
     figure : matplotlib.figure.Figure
-        One loop per :math:`z_o/x_o`, the line :math:`Q = S\Delta` and its two crossings
-        :math:`Q = \pm\mu P` marked (the GICoF points).
+        One loop per :math:`z_o/x_o`, and the line :math:`Q = S\Delta`.
 
     Notes
     -----
     Every loop crosses :math:`Q = S\Delta` where the contact is at the groove centre, so
-    :math:`Q = \pm\mu P` there whatever the groove (eq. 17-18): the GICoF.
+    :math:`Q = \pm\mu P` there whatever the groove (eq. 17-18): the GICoF, marked.
     """
     figure = Figure(figsize=(6.4, 5.6), layout="constrained")
     ax = figure.add_subplot()
@@ -166,8 +165,8 @@ def slip_amplitude_curves(dataset: xr.Dataset) -> Figure:
     Parameters
     ----------
     dataset : xarray.Dataset
-        From :func:`ecofmaps.maps.compute_map` with a load, a 1-D ``stiffness_ratio`` and
-        ``aspect_ratio`` and scalar ``amplitude`` and ``mu``.
+        From :func:`ecofmaps.maps.compute_map` with a load, 1-D ``stiffness_ratio`` and
+        ``aspect_ratio``, scalar ``amplitude`` and ``mu``.
 
     Returns
     -------
@@ -217,7 +216,7 @@ def ecof_ratio_curves(dataset: xr.Dataset, markers: Mapping[str, Mapping] | None
     Returns
     -------
     figure : matplotlib.figure.Figure
-        The curves, and each marked point with its :math:`\mu_E/\mu` read off the Dataset.
+        The curves, each marked point with its :math:`\mu_E/\mu` read off the Dataset.
 
     Notes
     -----
