@@ -153,10 +153,9 @@ def measured_loops(
     for ax in axes.flat[: len(chosen)]:
         for handle, name in zip(*ax.get_legend_handles_labels(), strict=True):
             entries.setdefault(name, handle)
-    if entries:
-        ncols = min(len(entries), 2 if len(chosen) == 1 else 4)
-        options = dict(loc="outside lower center", ncols=ncols, fontsize="x-small")
-        figure.legend(list(entries.values()), list(entries), **options)
+    ncols = min(len(entries), 2 if len(chosen) == 1 else 4)
+    options = dict(loc="outside lower center", ncols=ncols, fontsize="x-small")
+    figure.legend(list(entries.values()), list(entries), **options)
     return figure
 
 

@@ -55,7 +55,6 @@ def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
     figure = Figure(figsize=FIGSIZE, layout="constrained")
     ax = figure.add_subplot()
     stiffnesses = loops["stiffness"].values
-    styles = {True: dict(linestyle="--", linewidth=1.8), False: dict(linewidth=2.2)}
     for stiffness, color in zip(stiffnesses, stiffness_colors(stiffnesses), strict=True):
         loop = loops.sel(stiffness=stiffness)
         label = (
@@ -63,7 +62,7 @@ def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
             rf"$\delta^*$ = {float(loop.slip_amplitude) * MICRO:.1f} µm, "
             rf"$E_d$ = {float(loop.dissipated_energy) * MILLI:.1f} mJ"
         )
-        style = styles[bool(np.isinf(stiffness))]
+        style = dict(linestyle="--", linewidth=1.8) if np.isinf(stiffness) else dict(linewidth=2.2)
         ax.plot(loop.displacement * MICRO, loop.force, color=color, label=label, **style)
     _loop_axes(ax, loops)
     rig = parameters_of(loops, "amplitude", "load", "aspect_ratio", "mu")

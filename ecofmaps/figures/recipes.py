@@ -103,13 +103,8 @@ def _loops() -> xr.Dataset:
 def _stiffness_curves_data() -> xr.Dataset:
     from ecofmaps.maps.grid import compute_map
 
-    return compute_map(
-        stiffness_ratio=np.array(paper.FIGURE_7_STIFFNESSES) / paper.LOAD,
-        aspect_ratio=ASPECT_RATIOS,
-        amplitude=paper.AMPLITUDE,
-        mu=paper.MU,
-        load=paper.LOAD,
-    )
+    ratios = np.array(paper.FIGURE_7_STIFFNESSES) / paper.LOAD
+    return compute_map(ratios, ASPECT_RATIOS, paper.AMPLITUDE, paper.MU, paper.LOAD)
 
 
 def _ecof_ratio_map(panel: str) -> Callable[[], xr.Dataset]:

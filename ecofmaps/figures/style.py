@@ -59,7 +59,6 @@ PER_MM = QUANTITIES["stiffness_ratio"].display_factor  # 1/m -> 1/mm = (MN/m)/kN
 
 
 def scalar(dataset: xr.Dataset, name: str) -> float:
-    """A parameter held as a scalar coordinate of ``dataset``, as a float."""
     return float(dataset[name].values)
 
 

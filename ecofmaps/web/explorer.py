@@ -288,7 +288,6 @@ def _map_figure():
 
 
 def _show_map(values: dict, parts: dict) -> None:
-    """Draw the map for the point's amplitude and μ, with the point marked."""
     ratio = values["stiffness"] / values["load"]
     window = map_window(ratio, values["aspect_ratio"])
     grid, stuck = _ecof_ratio_map(values["amplitude"], values["mu"], window)

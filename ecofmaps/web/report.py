@@ -134,7 +134,9 @@ def report_document(results: xr.Dataset, *, loops=None, inputs=None, lab=None):
         raise ValueError(
             f"results lack {', '.join(missing)}: give the Dataset of ecofmaps.analyze_loops"
         )
-    flagged = _flagged_cycles(results)
+    cycle, quality = results["cycle"].values, results["quality"].values
+    flagged = {reason: cycle[has_reason(quality, reason)] for reason in REASONS}
+    flagged = {reason: cycles for reason, cycles in flagged.items() if cycles.size}  # in order
     evolution, flags = _evolution_figures(results, flagged)
     parts = [
         _header(results, inputs or {}),
@@ -254,13 +256,6 @@ def _cycle_figure(**options):
     return plot
 
 
-def _flagged_cycles(results: xr.Dataset) -> dict[str, np.ndarray]:
-    """The cycles each quality reason flags, in the order of :data:`REASONS`."""
-    cycle = results["cycle"].values
-    flagged = {reason: cycle[has_reason(results["quality"].values, reason)] for reason in REASONS}
-    return {reason: cycles for reason, cycles in flagged.items() if cycles.size}
-
-
 def _flags_figure(flagged: dict, evolution):
     """A strip below the coefficients: a mark at each cycle a quality reason flags."""
     if not flagged:
@@ -303,7 +298,6 @@ def _quality_counts(results: xr.Dataset, flagged: dict) -> Div:
 
 
 def _carried_cycles(results: xr.Dataset, loops) -> np.ndarray:
-    """The cycle numbers whose loops the page carries (see :func:`write_report`)."""
     labels = results["cycle"].values
     if loops is None:
         count = min(LOOPS_CARRIED, labels.size)
@@ -350,18 +344,15 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
     kept = np.isfinite(measured_x) & np.isfinite(measured_y)
     xs = [x[keep] for x, keep in zip(measured_x, kept, strict=True)]
     ys = [y[keep] for y, keep in zip(measured_y, kept, strict=True)]
-    all_loops = ColumnDataSource(
-        dict(label=names, xs=xs, ys=ys, model_xs=model_xs, model_ys=model_ys)
-    )
+    loops = dict(label=names, xs=xs, ys=ys, model_xs=model_xs, model_ys=model_ys)
+    all_loops = ColumnDataSource(loops)
     first = list(dict.fromkeys([names[0], names[len(names) // 2], names[-1]]))
     palette = list(Category10_10)
     # The loops first shown, as _PICK_LOOPS shows those picked (at most three: a colour each)
     at = [names.index(name) for name in first]
     colors = palette[: len(first)]
-    measured = ColumnDataSource(
-        {"xs": [xs[i] for i in at], "ys": [ys[i] for i in at], "label": first, "color": colors},
-        name="shown-loops",
-    )
+    shown = {"xs": [xs[i] for i in at], "ys": [ys[i] for i in at], "label": first, "color": colors}
+    measured = ColumnDataSource(shown, name="shown-loops")
     modelled = [(i, color) for i, color in zip(at, colors, strict=True) if len(model_xs[i])]
     model = ColumnDataSource(
         {
@@ -392,8 +383,8 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
         width=480,
         name="loop-picker",
     )
-    shown = dict(carried=all_loops, choice=choice, measured=measured, model=model, palette=palette)
-    choice.js_on_change("value", CustomJS(args=shown, code=_PICK_LOOPS))
+    picked = dict(carried=all_loops, choice=choice, measured=measured, model=model, palette=palette)
+    choice.js_on_change("value", CustomJS(args=picked, code=_PICK_LOOPS))
     note = Div(
         text="<p>Each loop is centred (the sensors' offsets removed). The dashed loop is the "
         "model's steady loop (eq. 9, 10, 16) for the cycle's amplitude, rig stiffness S, "
