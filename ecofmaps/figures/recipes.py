@@ -86,9 +86,8 @@ class FigureRecipe:
 
 
 def _loops() -> xr.Dataset:
-    """The loops of Figures 5 and 6 (imports inside, as below: the registry reads without JAX)."""
+    """The loops of Figures 5 and 6 (the registry reads without JAX: imports on first use)."""
     from ecofmaps.maps.cache import cached_dataset
-    from ecofmaps.maps.grid import compute_loops
 
     inputs = dict(
         stiffness=np.array([np.inf, paper.STIFFNESS]),
@@ -97,32 +96,27 @@ def _loops() -> xr.Dataset:
         load=paper.LOAD,
         mu=paper.MU,
     )
-    return cached_dataset("compute_loops", inputs, lambda: compute_loops(**inputs))
+    return cached_dataset("compute_loops", inputs, lambda: ecofmaps.compute_loops(**inputs))
 
 
 def _stiffness_curves_data() -> xr.Dataset:
-    from ecofmaps.maps.grid import compute_map
-
     ratios = np.array(paper.FIGURE_7_STIFFNESSES) / paper.LOAD
-    return compute_map(ratios, ASPECT_RATIOS, paper.AMPLITUDE, paper.MU, paper.LOAD)
+    return ecofmaps.compute_map(ratios, ASPECT_RATIOS, paper.AMPLITUDE, paper.MU, paper.LOAD)
 
 
 def _ecof_ratio_map(panel: str) -> Callable[[], xr.Dataset]:
     amplitude = paper.FIGURE_11_AMPLITUDES[panel]
 
     def data() -> xr.Dataset:
-        from ecofmaps.maps.grid import compute_map
-
-        return compute_map(paper.FIGURE_11_STIFFNESS_RATIOS, ASPECT_RATIOS, amplitude, paper.MU)
+        ratios = paper.FIGURE_11_STIFFNESS_RATIOS
+        return ecofmaps.compute_map(ratios, ASPECT_RATIOS, amplitude, paper.MU)
 
     data.__name__ = f"_ecof_ratio_map_{panel}"
     return data
 
 
 def _universal_map() -> xr.Dataset:
-    from ecofmaps.maps.grid import compute_universal_map
-
-    return compute_universal_map(COMPLIANCE_RATIOS, ASPECT_RATIOS, paper.MU)
+    return ecofmaps.compute_universal_map(COMPLIANCE_RATIOS, ASPECT_RATIOS, paper.MU)
 
 
 #: The ``shapes`` figure's scar families at Example 2's D/W = 0.2, W = x_o = Δ*: the function
@@ -224,14 +218,12 @@ def scar_shape_model_dataset() -> xr.Dataset:
 def scar_shape_parabola_dataset() -> xr.Dataset:
     """The parabola of Example 2's D/W (steady values over S/P, the loop of Example 2's rig)
     and the heights of the scar families."""
-    from ecofmaps.maps.grid import compute_map
-
     ratios = _SHAPES_STIFFNESS_RATIOS
     position = np.linspace(-1.6, 1.6, 321) * paper.AMPLITUDE
     heights = [np.interp(position, p.position, p.height) for p in _scar_profiles()]
     # Not cached on its own: the figure's part is cached whole (_scar_shape_parabola).
     grid = dict(amplitude=paper.AMPLITUDE, mu=paper.MU, load=paper.LOAD, cache=False)
-    parabola = compute_map(ratios, paper.ASPECT_RATIO, **grid)
+    parabola = ecofmaps.compute_map(ratios, paper.ASPECT_RATIO, **grid)
     loop = np.asarray(ecofmaps.fretting_loop(**_SHAPES_RIG, aspect_ratio=paper.ASPECT_RATIO))
     variables = {
         "scar_height": (("shape", "scar_position"), np.array(heights)),

@@ -6,7 +6,6 @@ The inputs live in the page's URL query, so a view is shared as a link."""
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import html
 import math
@@ -29,7 +28,7 @@ from ecofmaps.model.steady_state import dissipated_energy, energy_cof, slip_ampl
 from ecofmaps.paper import FIGURE_11_STIFFNESS_RATIOS
 from ecofmaps.units import DIMENSIONS, DOMAIN, TEXT_LIMIT, bare_number_warning, parse_quantity
 
-__all__ = ["INPUTS", "ExplorerPoint", "bare_number_warnings", "explorer_page", "parameter_value"]
+__all__ = ["INPUTS", "bare_number_warnings", "explorer_page", "parameter_value", "point_values"]
 
 #: The page's inputs: URL query key -> (quantity of the nomenclature, label, default text);
 #: each takes the values of its quantity in the model's domain, :data:`ecofmaps.units.DOMAIN`.
@@ -91,23 +90,15 @@ def bare_number_warnings(texts: dict) -> list[str]:
     return found
 
 
-@dataclasses.dataclass(frozen=True)
-class ExplorerPoint:
-    """The model at one point of the explorer, in SI units."""
-
-    slip_amplitude: float
-    dissipated_energy: float
-    ecof_ratio: float
-    loop: tuple
-
-    @classmethod
-    def at(cls, amplitude, load, stiffness, mu, aspect_ratio) -> ExplorerPoint:
-        """The model's values for one test (parameters in SI, as :func:`ecofmaps.energy_cof`)."""
-        point = (amplitude, load, stiffness, mu, aspect_ratio)
-        with warnings.catch_warnings(action="ignore"):  # no gross slip: the page says so
-            ratio = float(energy_cof(*point)) / mu
-        loop = tuple(np.asarray(values) for values in fretting_loop(*point))
-        return cls(float(slip_amplitude(*point)), float(dissipated_energy(*point)), ratio, loop)
+def point_values(amplitude, load, stiffness, mu, aspect_ratio) -> dict:
+    """The model's slip amplitude [m], dissipated energy [J], μ_E/μ [1] and steady loop [m, N]
+    for one test (parameters in SI, as :func:`ecofmaps.energy_cof`)."""
+    point = (amplitude, load, stiffness, mu, aspect_ratio)
+    with warnings.catch_warnings(action="ignore"):  # no gross slip: the page says so
+        ratio = float(energy_cof(*point)) / mu
+    loop = tuple(np.asarray(values) for values in fretting_loop(*point))
+    slip, energy = float(slip_amplitude(*point)), float(dissipated_energy(*point))
+    return dict(slip_amplitude=slip, dissipated_energy=energy, ecof_ratio=ratio, loop=loop)
 
 
 def _grown(value: float, upward: bool) -> float:
@@ -148,7 +139,7 @@ def _number(value: float, factor: float = 1.0) -> str:
     return format(shown, ".3f" if abs(shown) < 1e5 else ".6g")
 
 
-def _values_html(point: ExplorerPoint, values: dict) -> str:
+def _values_html(point: dict, values: dict) -> str:
     """The inputs as read and the model's numbers at the point, each in a span the tests find."""
     read = []
     for key in _MODEL_INPUTS:
@@ -157,10 +148,10 @@ def _values_html(point: ExplorerPoint, values: dict) -> str:
         text = "inf (a rigid rig)" if math.isinf(value) else f"{value:g} {quantity.display_unit}"
         read.append(f"{quantity.symbol} = {text.strip()}")
     rows = [
-        ("slip_amplitude", "Slip amplitude δ*", point.slip_amplitude),
-        ("dissipated_energy", "Dissipated energy E_d", point.dissipated_energy),
-        ("ecof_ratio", "μ_E/μ", point.ecof_ratio),
-        ("ecof", "μ_E", point.ecof_ratio * values["mu"]),
+        ("slip_amplitude", "Slip amplitude δ*", point["slip_amplitude"]),
+        ("dissipated_energy", "Dissipated energy E_d", point["dissipated_energy"]),
+        ("ecof_ratio", "μ_E/μ", point["ecof_ratio"]),
+        ("ecof", "μ_E", point["ecof_ratio"] * values["mu"]),
     ]
     cells = []
     for key, label, value in rows:
@@ -172,7 +163,7 @@ def _values_html(point: ExplorerPoint, values: dict) -> str:
             f"{_number(value, quantity.display_factor)}</span> {unit}</td></tr>"
         )
     inputs = f"<p style='margin:0 0 6px 0;color:#555'>Read as {', '.join(read)}.</p>"
-    gross = math.isfinite(point.ecof_ratio)
+    gross = math.isfinite(point["ecof_ratio"])
     regime = "" if gross else "<p><b>No gross slip</b> (μP/S ≥ Δ*): μ_E is undefined.</p>"
     return f"{inputs}<table style='font-size:14px'>{''.join(cells)}</table>{regime}"
 
@@ -358,9 +349,9 @@ def explorer_page():
             message.object = f"<p style='margin:2px 0'>{html.escape(str(error))}</p>"
             return
         try:
-            point = ExplorerPoint.at(*(values[key] for key in _MODEL_INPUTS))
+            point = point_values(*(values[key] for key in _MODEL_INPUTS))
             values_pane.object = _values_html(point, values)
-            loop_source.data = {"x": point.loop[0] * 1e6, "y": point.loop[1]}
+            loop_source.data = {"x": point["loop"][0] * 1e6, "y": point["loop"][1]}
             _show_map(values, map_parts)
             correction_pane.object = _correction_html(values)
         except Exception as error:  # a page must stay up whatever the model says
@@ -397,7 +388,7 @@ def explorer_page():
 def warm_up() -> None:
     """Compile the model and fill the default point's map, so the first page comes at once."""
     values = {key: parameter_value(key, default) for key, (_, _, default) in INPUTS.items()}
-    ExplorerPoint.at(*(values[key] for key in _MODEL_INPUTS))
+    point_values(*(values[key] for key in _MODEL_INPUTS))
     window = map_window(values["stiffness"] / values["load"], values["aspect_ratio"])
     _ecof_ratio_map(values["amplitude"], values["mu"], window)
     _correction_html(values)
