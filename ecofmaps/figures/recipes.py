@@ -262,14 +262,13 @@ def scar_shapes_dataset() -> xr.Dataset:
         "ecof_ratio": ((*groove, "stiffness_ratio"), by_groove("ecof_ratio")),
         "shortcut_error": (("shape", "stiffness_ratio"), np.array(errors)),
     }
-    depth = paper.ASPECT_RATIO * paper.AMPLITUDE
     coords = {
         "shape": list(SCAR_SHAPES),
         "groove": ["profile", "parabola"],
         "scar_position": parabola["scar_position"].values,
         "stiffness_ratio": ratios,
         **_SHAPES_RIG,
-        "scar_depth": depth,
+        "scar_depth": paper.ASPECT_RATIO * paper.AMPLITUDE,
         "scar_half_width": paper.AMPLITUDE,
     }
     dataset = _labelled(variables, coords)
