@@ -127,8 +127,6 @@ SCAR_SHAPES = {
     "W-shaped": ("w_shaped_profile", {"hump": 0.25}),
     "ridged": ("ridged_profile", {"ridge_height": 0.3, "ridge_width": 0.6}),
 }
-
-
 #: The sources beside the model's revision that decide the ``shapes`` Dataset.
 _SCAR_SHAPES_SOURCES = ("figures/recipes.py", "correction/*.py")
 

@@ -32,13 +32,10 @@ __all__ = [
 
 #: Contour levels of μ_E/μ shared by Figure 11 and the universal map, so they read alike.
 ECOF_RATIO_LEVELS = (1.01, 1.02, 1.03, 1.04, 1.05, 1.06, 1.08, 1.10, 1.12, 1.14, 1.17, 1.20, 1.25)
-
 #: The level drawn heavier: the paper's "most tests are within 5 %".
 HIGHLIGHT_LEVEL = 1.05
-
 #: Resolution of the paper's figures (``ecofmaps figures``) written as PNG. [1/inch]
 PAPER_DPI = 300
-
 #: Resolution of the plots of a user's recording (``ecofmaps loops --plots``). [1/inch]
 RECORDING_DPI = 300
 
@@ -117,8 +114,6 @@ _PARAMETERS = {
     "aspect_ratio": (r"$z_o/x_o$ = {:g}", 1.0),
     "mu": (r"$\mu$ = {:g}", 1.0),
 }
-
-
 #: The parameters a subtitle gives through their own label.
 _LABELS = {"stiffness": stiffness_label, "load": load_label}
 
