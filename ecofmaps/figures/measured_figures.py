@@ -60,10 +60,12 @@ def _why_none(results: xr.Dataset) -> str:
     return "every cycle flagged:\n" + ", ".join(f"{reason} {n}" for reason, n in counts.items())
 
 
-def _note(ax, text: str, height: float = 0.5, fontsize: str | None = "small") -> None:
-    """Write ``text`` across ``ax``, which has nothing else to show, ``height`` up the panel."""
+def _note(ax, text: str, clear: str = "", height: float = 0.5, fontsize="small") -> None:
+    """Write ``text`` across ``ax``, which has nothing else to show, ``height`` up the panel; no
+    ticks on its axes ``clear`` (``'x'``, ``'y'`` or ``'xy'``)."""
     where = dict(transform=ax.transAxes, ha="center", va="center")
     ax.text(0.5, height, text, color="0.3", fontsize=fontsize, **where)
+    ax.set(**{f"{axis}ticks": [] for axis in clear})
 
 
 def _cycle_axis(ax, cycle) -> None:
@@ -223,15 +225,13 @@ def cof_evolution(results: xr.Dataset, *, source: str | None = None) -> Figure:
     top.set_ylabel("Coefficient of friction [1]")
     top.grid(alpha=0.3)
     if not top.get_lines():
-        _note(top, "no ECoF or GICoF in any cycle:\n" + _why_none(results))
-        top.set_yticks([])
+        _note(top, "no ECoF or GICoF in any cycle:\n" + _why_none(results), "y")
     excess = (results["ecof"] / results["gicof"] - 1.0).values * 100.0
     if np.isfinite(excess).any():
         bottom.plot(cycle, excess, color="tab:purple", linewidth=1.2, **marker)
         bottom.axhline(0.0, color="0.5", linewidth=0.8)
     else:
-        _note(bottom, "no cycle with both an ECoF and a GICoF")
-        bottom.set_yticks([])
+        _note(bottom, "no cycle with both an ECoF and a GICoF", "y")
     bottom.set(ylabel="ECoF / GICoF − 1 [%]", xlabel=axis_label("cycle"))
     bottom.grid(alpha=0.3)
     _cycle_axis(bottom, cycle)
@@ -362,10 +362,9 @@ def resolved_loops(
     if chosen:
         felt.plot([], [], color="0.4", linestyle=":", label=r"equivalent parabola $k\xi^2/2$")
     else:
-        _note(stroke, "no cycle was read along the stroke\n(none has quality 'ok')", fontsize=None)
-        _note(felt, "no felt profile: no cycle was read along the stroke")
-        for ax in (stroke, felt):
-            ax.set(xticks=[], yticks=[])
+        unread = "no cycle was read along the stroke"
+        _note(stroke, f"{unread}\n(none has quality 'ok')", "xy", fontsize=None)
+        _note(felt, f"no felt profile: {unread}", "xy")
     for ax in (stroke, felt, test):
         ax.grid(alpha=0.3)
     _profile_over_test(figure, image, resolved)
@@ -394,8 +393,7 @@ def _profile_over_test(figure: Figure, image, resolved: xr.Dataset) -> None:
     image.set_yticks(ticks, [str(labels[i]) for i in ticks])
     image.set_ylim(rows[0], rows[-1])
     if not np.isfinite(profile).any():
-        _note(image, "no felt profile:\n" + _why_none(resolved))
-        image.set_xticks([])  # no position was read
+        _note(image, "no felt profile:\n" + _why_none(resolved), "x")  # no position was read
         return
     # Cell edges halfway between the positions, and between the rows: one cycle is a band.
     middle = (xi[1:] + xi[:-1]) / 2.0
