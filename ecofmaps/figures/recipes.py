@@ -88,6 +88,7 @@ class FigureRecipe:
 def _loops() -> xr.Dataset:
     """The loops of Figures 5 and 6 (the registry reads without JAX: imports on first use)."""
     from ecofmaps.maps.cache import cached_dataset
+    from ecofmaps.maps.grid import compute_loops
 
     inputs = dict(
         stiffness=np.array([np.inf, paper.STIFFNESS]),
@@ -96,7 +97,7 @@ def _loops() -> xr.Dataset:
         load=paper.LOAD,
         mu=paper.MU,
     )
-    return cached_dataset("compute_loops", inputs, lambda: ecofmaps.compute_loops(**inputs))
+    return cached_dataset("compute_loops", inputs, lambda: compute_loops(**inputs))
 
 
 def _stiffness_curves_data() -> xr.Dataset:
