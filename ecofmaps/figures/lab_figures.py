@@ -35,8 +35,7 @@ def running_condition_map(results, transition: xr.Dataset, rig_stiffness: float)
     results : list of xarray.Dataset
         Each test's results from :func:`ecofmaps.analyze_loops`.
     transition : xarray.Dataset
-        From :func:`ecofmaps.transition`: the contact's transition amplitude
-        :math:`\delta_t` and :math:`\mu_t`.
+        From :func:`ecofmaps.transition`: the contact's :math:`\delta_t` and :math:`\mu_t`.
     rig_stiffness : float
         The rig's own stiffness :math:`S`. [N/m]
 

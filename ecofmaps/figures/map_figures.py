@@ -66,8 +66,7 @@ def ecof_ratio_contours(
     Parameters
     ----------
     dataset : xarray.Dataset
-        From :func:`ecofmaps.compute_map` with 1-D ``stiffness_ratio`` and
-        ``aspect_ratio`` and scalar ``amplitude`` and ``mu``.
+        From :func:`ecofmaps.compute_map` over ``stiffness_ratio`` and ``aspect_ratio`` alone.
     number : str
         The figure's number in its title (``'11a'``).
     markers : mapping of str to mapping, optional
@@ -113,8 +112,8 @@ def universal_ecof_ratio_map(
     Parameters
     ----------
     dataset : xarray.Dataset
-        From :func:`ecofmaps.compute_universal_map` with 1-D ``compliance_ratio``
-        (positive: the axis is logarithmic) and ``aspect_ratio`` and a scalar ``mu``.
+        From :func:`ecofmaps.compute_universal_map` over ``compliance_ratio`` (> 0: a
+        logarithmic axis) and ``aspect_ratio`` alone.
     markers : mapping of str to mapping, optional
         Test conditions to mark at their own :math:`\lambda` and :math:`\mu_E/\mu`, by legend
         name: keyword arguments of :func:`ecofmaps.energy_cof`, e.g.

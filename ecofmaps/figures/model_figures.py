@@ -39,14 +39,13 @@ def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
     Parameters
     ----------
     loops : xarray.Dataset
-        From :func:`ecofmaps.maps.compute_loops` with a 1-D ``stiffness`` dimension (one
-        entry may be ``inf``) and scalar ``aspect_ratio``, ``amplitude``, ``load``, ``mu``.
+        From :func:`ecofmaps.maps.compute_loops` over ``stiffness`` alone (``inf``: rigid).
 
     Returns
     -------
     figure : matplotlib.figure.Figure
-        :math:`Q` [N] (left) and :math:`Q/P` (right) against :math:`\Delta` [µm]; the
-        legend gives each loop's :math:`\delta^*` [µm] and :math:`E_d` [mJ].
+        :math:`Q` [N] and :math:`Q/P` against :math:`\Delta` [µm], each loop's :math:`\delta^*`
+        [µm] and :math:`E_d` [mJ] in the legend.
 
     Notes
     -----
@@ -86,8 +85,7 @@ def loops_by_aspect_ratio(loops: xr.Dataset) -> Figure:
     Parameters
     ----------
     loops : xarray.Dataset
-        From :func:`ecofmaps.maps.compute_loops` with a 1-D ``aspect_ratio`` dimension and
-        scalar ``stiffness`` (finite), ``amplitude``, ``load``, ``mu``.
+        From :func:`ecofmaps.maps.compute_loops` over ``aspect_ratio`` alone, ``stiffness`` finite.
 
     Returns
     -------
@@ -164,8 +162,8 @@ def slip_amplitude_curves(dataset: xr.Dataset) -> Figure:
     Parameters
     ----------
     dataset : xarray.Dataset
-        From :func:`ecofmaps.maps.compute_map` with a load, 1-D ``stiffness_ratio`` and
-        ``aspect_ratio``, scalar ``amplitude`` and ``mu``.
+        From :func:`ecofmaps.maps.compute_map` with a load, over ``stiffness_ratio`` and
+        ``aspect_ratio`` alone.
 
     Returns
     -------
