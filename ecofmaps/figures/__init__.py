@@ -1,8 +1,7 @@
 """Figures (needs matplotlib): the paper's, drawn from Datasets, and those of measured loops,
 scar profiles and a lab's numbers, one module each; ``ecofmaps figures`` writes the set of
 :mod:`~ecofmaps.figures.recipes`. Names are imported on first use: the registry of figures
-reads without matplotlib.
-"""
+reads without matplotlib."""
 
 from ecofmaps._lazy import lazy_names
 

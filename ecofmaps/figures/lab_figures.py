@@ -35,17 +35,15 @@ def running_condition_map(results, transition: xr.Dataset, rig_stiffness: float)
     results : list of xarray.Dataset
         Each test's results from :func:`ecofmaps.analyze_loops`.
     transition : xarray.Dataset
-        From :func:`ecofmaps.transition`: the contact's transition amplitude
-        :math:`\delta_t` and :math:`\mu_t`.
+        From :func:`ecofmaps.transition`: the contact's :math:`\delta_t` and :math:`\mu_t`.
     rig_stiffness : float
         The rig's own stiffness :math:`S`. [N/m]
 
     Returns
     -------
     figure : matplotlib.figure.Figure
-        Each test at its median amplitude :math:`\Delta^*` [µm] and load :math:`P` [N],
-        marked by its sliding condition (:func:`ecofmaps.sliding_condition`), and the line
-        :math:`\Delta_t(P) = \delta_t + \mu_t P/S` between partial and gross slip.
+        Each test at its median :math:`\Delta^*` [µm] and :math:`P` [N], marked by its
+        sliding condition, and the transition :math:`\Delta_t(P) = \delta_t + \mu_t P/S`.
 
     References
     ----------
@@ -90,11 +88,9 @@ def loop_scar_closure_figure(closure: xr.Dataset) -> Figure:
     Returns
     -------
     figure : matplotlib.figure.Figure
-        (a) The measured loop and the model's steady loop on the measured profile
-        (:math:`\mu` = the GICoF), force :math:`Q` [N] against the applied displacement
-        :math:`\Delta` [µm]; (b) the profilometer's profile and the scar the loops imply,
-        :math:`\int g\,d\xi`, height [µm] across the scar [µm] over the slip range. Each
-        panel's title gives its root mean square residual.
+        (a) The measured loop and the model's on the profile (:math:`\mu` = the GICoF),
+        :math:`Q` [N] against :math:`\Delta` [µm]; (b) the profile and the scar the loops
+        imply, :math:`\int g\,d\xi` [µm]; each titled by its RMS residual.
 
     References
     ----------

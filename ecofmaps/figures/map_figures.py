@@ -1,6 +1,5 @@
 r"""The maps of μ_E/μ over the rig (S/P, or λ = P/(SΔ*)) and z_o/x_o: the paper's Figure 11 and
-the universal map, each a pure function of the Dataset that holds its numbers (docs/model.md).
-"""
+the universal map, each a pure function of the Dataset that holds its numbers (docs/model.md)."""
 
 from __future__ import annotations
 
@@ -67,8 +66,7 @@ def ecof_ratio_contours(
     Parameters
     ----------
     dataset : xarray.Dataset
-        From :func:`ecofmaps.compute_map` with 1-D ``stiffness_ratio`` and
-        ``aspect_ratio`` and scalar ``amplitude`` and ``mu``.
+        From :func:`ecofmaps.compute_map` over ``stiffness_ratio`` and ``aspect_ratio`` alone.
     number : str
         The figure's number in its title (``'11a'``).
     markers : mapping of str to mapping, optional
@@ -78,9 +76,8 @@ def ecof_ratio_contours(
     Returns
     -------
     figure : matplotlib.figure.Figure
-        Filled contours with labelled lines at :data:`ECOF_RATIO_LEVELS` (the 5 % line
-        heavier), :math:`S/P` in (MN/m)/kN (= 1/mm); the area with no gross slip hatched;
-        the markers.
+        Contours at :data:`ECOF_RATIO_LEVELS` (5 % heavier) over :math:`S/P` [(MN/m)/kN],
+        no gross slip hatched, and the markers.
 
     Notes
     -----
@@ -115,22 +112,21 @@ def universal_ecof_ratio_map(
     Parameters
     ----------
     dataset : xarray.Dataset
-        From :func:`ecofmaps.compute_universal_map` with 1-D ``compliance_ratio``
-        (positive: the axis is logarithmic) and ``aspect_ratio`` and a scalar ``mu``.
+        From :func:`ecofmaps.compute_universal_map` over ``compliance_ratio`` (> 0: a
+        logarithmic axis) and ``aspect_ratio`` alone.
     markers : mapping of str to mapping, optional
-        Test conditions to mark, by legend name: keyword arguments of
-        :func:`ecofmaps.energy_cof` (``amplitude``, ``load``, ``stiffness``, ``mu``,
-        ``aspect_ratio``), e.g. :data:`ecofmaps.paper.FIGURE_10_FITS`. Each is drawn at its
-        own :math:`\lambda` with its own :math:`\mu_E/\mu` (at its own :math:`\mu`).
+        Test conditions to mark at their own :math:`\lambda` and :math:`\mu_E/\mu`, by legend
+        name: keyword arguments of :func:`ecofmaps.energy_cof`, e.g.
+        :data:`ecofmaps.paper.FIGURE_10_FITS`.
     windows : mapping of str to tuple, optional
-        Spans of :math:`\lambda` to show as bars, by figure name: ``(amplitude,
-        stiffness_ratios)`` [m], [1/m], the span of the ``stiffness_ratios`` at that amplitude.
+        Spans of :math:`\lambda` shown as bars, by figure name: ``(amplitude,
+        stiffness_ratios)`` [m], [1/m].
 
     Returns
     -------
     figure : matplotlib.figure.Figure
-        Labelled contours at :data:`ECOF_RATIO_LEVELS` on a logarithmic :math:`\lambda`
-        axis, the windows, and the markers.
+        Contours at :data:`ECOF_RATIO_LEVELS` on a logarithmic :math:`\lambda` axis, the
+        windows and the markers.
 
     Notes
     -----

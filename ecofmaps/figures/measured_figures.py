@@ -1,7 +1,6 @@
 r"""Figures of measured loops: the loops with :math:`Q = S\Delta`, the friction over the test (as
-the paper's Figure 9), the fitted model (as its Figure 10) and the loops read along the stroke,
-titled by the recording's name (``source``), legends clear of the data (docs/method-loops.md).
-"""
+the paper's Figure 9), the fitted model (its Figure 10) and the loops read along the stroke
+(docs/method-loops.md)."""
 
 from __future__ import annotations
 
@@ -61,10 +60,12 @@ def _why_none(results: xr.Dataset) -> str:
     return "every cycle flagged:\n" + ", ".join(f"{reason} {n}" for reason, n in counts.items())
 
 
-def _note(ax, text: str, height: float = 0.5, fontsize: str | None = "small") -> None:
-    """Write ``text`` across ``ax``, which has nothing else to show, ``height`` up the panel."""
+def _note(ax, text: str, clear: str = "", height: float = 0.5, fontsize="small") -> None:
+    """Write ``text`` across ``ax``, which has nothing else to show, ``height`` up the panel; no
+    ticks on its axes ``clear`` (``'x'``, ``'y'`` or ``'xy'``)."""
     where = dict(transform=ax.transAxes, ha="center", va="center")
     ax.text(0.5, height, text, color="0.3", fontsize=fontsize, **where)
+    ax.set(**{f"{axis}ticks": [] for axis in clear})
 
 
 def _cycle_axis(ax, cycle) -> None:
@@ -91,23 +92,22 @@ def measured_loops(
     results : xarray.Dataset
         From :func:`ecofmaps.analyze_loops` with ``keep_loops=True``.
     cycles : sequence of int, optional
-        Cycle numbers to draw, one panel each; by default six spread evenly over the
-        recording, the first and the last included.
+        Cycle numbers to draw, one panel each; by default six spread evenly, the first and
+        the last included.
     columns : int
         Panels per row.
     resolved : xarray.Dataset, optional
-        From :func:`ecofmaps.resolve_analyzed_loops` of the same ``results``: the part of
-        the stroke it read is shaded.
+        From :func:`ecofmaps.resolve_analyzed_loops` of ``results``: the part of the stroke
+        it read is shaded.
     source : str, optional
         The recording's name (its file's), which the title begins with.
 
     Returns
     -------
     figure : matplotlib.figure.Figure
-        One panel per cycle: the centred loop, :math:`Q` [N] against :math:`\Delta` [µm],
-        the line :math:`Q = S\Delta`, the crossings whose :math:`Q/P` is the GICoF (the
-        paper's eq. 17-18) and, with ``resolved``, the band of :math:`\Delta - Q/S` where
-        both branches were read; titled by the GICoF, ECoF and flags of the cycle.
+        Per cycle, titled by its GICoF, ECoF and flags: the centred loop, :math:`Q` [N]
+        against :math:`\Delta` [µm], the line :math:`Q = S\Delta` and the crossings whose
+        :math:`Q/P` is the GICoF (eq. 17-18).
     """
     if "loop_displacement" not in results:
         raise ValueError("results hold no loops: call analyze_loops(..., keep_loops=True)")
@@ -155,10 +155,9 @@ def measured_loops(
     for ax in axes.flat[: len(chosen)]:
         for handle, name in zip(*ax.get_legend_handles_labels(), strict=True):
             entries.setdefault(name, handle)
-    if entries:
-        ncols = min(len(entries), 2 if len(chosen) == 1 else 4)
-        options = dict(loc="outside lower center", ncols=ncols, fontsize="x-small")
-        figure.legend(list(entries.values()), list(entries), **options)
+    ncols = min(len(entries), 2 if len(chosen) == 1 else 4)
+    options = dict(loc="outside lower center", ncols=ncols, fontsize="x-small")
+    figure.legend(list(entries.values()), list(entries), **options)
     return figure
 
 
@@ -200,14 +199,13 @@ def cof_evolution(results: xr.Dataset, *, source: str | None = None) -> Figure:
     results : xarray.Dataset
         From :func:`ecofmaps.analyze_loops`.
     source : str, optional
-        The recording's name (its file's), which the title begins with.
+        As for :func:`measured_loops`.
 
     Returns
     -------
     figure : matplotlib.figure.Figure
-        Top: :math:`\mu_E` (eq. 1) and the GICoF against the cycle number. Bottom: how far
-        the ECoF is above the GICoF, :math:`\mu_E/\text{GICoF} - 1` [%]. A panel with
-        nothing to draw says why (the count of each flag, or no cycle in gross slip).
+        Top: :math:`\mu_E` (eq. 1) and the GICoF against the cycle. Bottom:
+        :math:`\mu_E/\text{GICoF} - 1` [%]. A panel with nothing to draw says why.
 
     Notes
     -----
@@ -227,15 +225,13 @@ def cof_evolution(results: xr.Dataset, *, source: str | None = None) -> Figure:
     top.set_ylabel("Coefficient of friction [1]")
     top.grid(alpha=0.3)
     if not top.get_lines():
-        _note(top, "no ECoF or GICoF in any cycle:\n" + _why_none(results))
-        top.set_yticks([])
+        _note(top, "no ECoF or GICoF in any cycle:\n" + _why_none(results), "y")
     excess = (results["ecof"] / results["gicof"] - 1.0).values * 100.0
     if np.isfinite(excess).any():
         bottom.plot(cycle, excess, color="tab:purple", linewidth=1.2, **marker)
         bottom.axhline(0.0, color="0.5", linewidth=0.8)
     else:
-        _note(bottom, "no cycle with both an ECoF and a GICoF")
-        bottom.set_yticks([])
+        _note(bottom, "no cycle with both an ECoF and a GICoF", "y")
     bottom.set(ylabel="ECoF / GICoF − 1 [%]", xlabel=axis_label("cycle"))
     bottom.grid(alpha=0.3)
     _cycle_axis(bottom, cycle)
@@ -254,17 +250,15 @@ def measured_and_fitted_loops(fits, *, source: str | None = None) -> Figure:
     Parameters
     ----------
     fits : LoopFit or mapping of str to LoopFit
-        From :func:`ecofmaps.fit_loop`. A mapping draws one panel per entry, titled by
-        its key, side by side (the paper's Figure 10 has Example 1 and Example 2).
+        From :func:`ecofmaps.fit_loop`; a mapping draws a panel per entry, titled by its key.
     source : str, optional
-        The recording's name (its file's), which the title begins with.
+        As for :func:`measured_loops`.
 
     Returns
     -------
     figure : matplotlib.figure.Figure
-        In each panel the measured samples (dots) and the fitted model loop (line), Q [N]
-        (left) and Q/P (right) against Δ [µm]; the title gives the fitted μ, S [MN/m],
-        z_o [µm] and the RMS force residual [N].
+        Per panel the samples (dots) and the fitted loop, Q [N] and Q/P against Δ [µm],
+        titled by the fitted μ, S [MN/m], z_o [µm] and the RMS force residual [N].
 
     Notes
     -----
@@ -314,32 +308,28 @@ def resolved_loops(
     resolved : xarray.Dataset
         From :func:`ecofmaps.resolve_loops` (with its ``position`` dimension).
     results : xarray.Dataset, optional
-        From :func:`ecofmaps.analyze_loops` for the same recording: its ECoF and GICoF are
-        drawn beside the resolved :math:`\mu` for comparison.
+        From :func:`ecofmaps.analyze_loops` of the same recording: its ECoF and GICoF are
+        drawn beside the resolved :math:`\mu`.
     cycles : sequence of int, optional
-        Cycle numbers drawn along the stroke; by default up to five cycles whose quality is
-        ``'ok'``, spread evenly over the test, the first and the last included.
+        Cycles drawn along the stroke; by default up to five of quality ``'ok'``, spread
+        evenly, the first and the last included.
     source : str, optional
-        The recording's name (its file's), which the title begins with.
+        As for :func:`measured_loops`.
 
     Returns
     -------
     figure : matplotlib.figure.Figure
-        (a) :math:`\mu(\xi)` against the contact position :math:`\xi` [µm], each cycle's
-        ``mu_resolved`` dashed and the central part it averages shaded; (b) the felt
-        profile :math:`h(\xi)` [µm] with each cycle's equivalent parabola
-        :math:`k\xi^2/2` dotted; (c) :math:`h` over (position, cycle), the groove deepening
-        as the test runs; (d) ``mu_resolved`` :math:`\pm 2` standard errors over the cycles
-        (with the ECoF and GICoF when ``results`` is given) and the equivalent
-        ``aspect_ratio`` on a right-hand axis, cycles with no resolved value marked along
-        the bottom with their quality. A panel with nothing to draw says why.
+        (a) :math:`\mu(\xi)` against the contact position :math:`\xi` [µm], with
+        ``mu_resolved`` dashed over the central part it averages; (b) the felt profile
+        :math:`h(\xi)` [µm] and its equivalent parabola :math:`k\xi^2/2`; (c) :math:`h` over
+        (position, cycle); (d) ``mu_resolved`` :math:`\pm 2` standard errors, the ECoF and
+        GICoF, and ``aspect_ratio`` over the cycles, those without a value marked with
+        their quality. A panel with nothing to draw says why.
 
     Notes
     -----
-    :math:`\mu(\xi) = \tan((\arctan q_+ - \arctan q_-)/2)` and
-    :math:`g(\xi) = \tan((\arctan q_+ + \arctan q_-)/2)` with :math:`q_\pm = Q_\pm/P` on the
-    two slip branches at the same :math:`\xi = \Delta - Q/S` (eq. 9, 10); the GICoF
-    (eq. 17-18) is :math:`\mu(0)`: docs/method-loops.md.
+    :math:`\mu(\xi)` and :math:`g(\xi)` from the two slip branches at the same
+    :math:`\xi = \Delta - Q/S` (eq. 9, 10): docs/method-loops.md.
     """
     if "position" not in resolved.dims:
         raise ValueError("resolved holds no positions: call resolve_loops(..., positions=201)")
@@ -372,10 +362,9 @@ def resolved_loops(
     if chosen:
         felt.plot([], [], color="0.4", linestyle=":", label=r"equivalent parabola $k\xi^2/2$")
     else:
-        _note(stroke, "no cycle was read along the stroke\n(none has quality 'ok')", fontsize=None)
-        _note(felt, "no felt profile: no cycle was read along the stroke")
-        for ax in (stroke, felt):
-            ax.set(xticks=[], yticks=[])
+        unread = "no cycle was read along the stroke"
+        _note(stroke, f"{unread}\n(none has quality 'ok')", "xy", fontsize=None)
+        _note(felt, f"no felt profile: {unread}", "xy")
     for ax in (stroke, felt, test):
         ax.grid(alpha=0.3)
     _profile_over_test(figure, image, resolved)
@@ -404,8 +393,7 @@ def _profile_over_test(figure: Figure, image, resolved: xr.Dataset) -> None:
     image.set_yticks(ticks, [str(labels[i]) for i in ticks])
     image.set_ylim(rows[0], rows[-1])
     if not np.isfinite(profile).any():
-        _note(image, "no felt profile:\n" + _why_none(resolved))
-        image.set_xticks([])  # no position was read
+        _note(image, "no felt profile:\n" + _why_none(resolved), "x")  # no position was read
         return
     # Cell edges halfway between the positions, and between the rows: one cycle is a band.
     middle = (xi[1:] + xi[:-1]) / 2.0

@@ -1,7 +1,6 @@
 r"""The paper's figures of the model's loops and curves (Figures 5-8): each a pure function of a
 Dataset of :mod:`ecofmaps.maps` (and of the points it marks), in µm, N, MN/m and mJ.
-:mod:`ecofmaps.figures.recipes` builds the Datasets with the paper's parameters.
-"""
+:mod:`ecofmaps.figures.recipes` builds the Datasets with the paper's parameters."""
 
 from __future__ import annotations
 
@@ -40,14 +39,13 @@ def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
     Parameters
     ----------
     loops : xarray.Dataset
-        From :func:`ecofmaps.maps.compute_loops` with a 1-D ``stiffness`` dimension (one
-        entry may be ``inf``) and scalar ``aspect_ratio``, ``amplitude``, ``load``, ``mu``.
+        From :func:`ecofmaps.maps.compute_loops` over ``stiffness`` alone (``inf``: rigid).
 
     Returns
     -------
     figure : matplotlib.figure.Figure
-        :math:`Q` [N] (left) and :math:`Q/P` (right) against :math:`\Delta` [µm]; the
-        legend gives each loop's :math:`\delta^*` [µm] and :math:`E_d` [mJ].
+        :math:`Q` [N] and :math:`Q/P` against :math:`\Delta` [µm], each loop's :math:`\delta^*`
+        [µm] and :math:`E_d` [mJ] in the legend.
 
     Notes
     -----
@@ -56,7 +54,6 @@ def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
     figure = Figure(figsize=FIGSIZE, layout="constrained")
     ax = figure.add_subplot()
     stiffnesses = loops["stiffness"].values
-    styles = {True: dict(linestyle="--", linewidth=1.8), False: dict(linewidth=2.2)}
     for stiffness, color in zip(stiffnesses, stiffness_colors(stiffnesses), strict=True):
         loop = loops.sel(stiffness=stiffness)
         label = (
@@ -64,7 +61,7 @@ def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
             rf"$\delta^*$ = {float(loop.slip_amplitude) * MICRO:.1f} µm, "
             rf"$E_d$ = {float(loop.dissipated_energy) * MILLI:.1f} mJ"
         )
-        style = styles[bool(np.isinf(stiffness))]
+        style = dict(linestyle="--", linewidth=1.8) if np.isinf(stiffness) else dict(linewidth=2.2)
         ax.plot(loop.displacement * MICRO, loop.force, color=color, label=label, **style)
     _loop_axes(ax, loops)
     rig = parameters_of(loops, "amplitude", "load", "aspect_ratio", "mu")
@@ -88,19 +85,17 @@ def loops_by_aspect_ratio(loops: xr.Dataset) -> Figure:
     Parameters
     ----------
     loops : xarray.Dataset
-        From :func:`ecofmaps.maps.compute_loops` with a 1-D ``aspect_ratio`` dimension and
-        scalar ``stiffness`` (finite), ``amplitude``, ``load``, ``mu``.
+        From :func:`ecofmaps.maps.compute_loops` over ``aspect_ratio`` alone, ``stiffness`` finite.
 
     Returns
     -------
     figure : matplotlib.figure.Figure
-        One loop per :math:`z_o/x_o`, the line :math:`Q = S\Delta` and its two crossings
-        :math:`Q = \pm\mu P` marked (the GICoF points).
+        One loop per :math:`z_o/x_o`, and the line :math:`Q = S\Delta`.
 
     Notes
     -----
     Every loop crosses :math:`Q = S\Delta` where the contact is at the groove centre, so
-    :math:`Q = \pm\mu P` there whatever the groove (eq. 17-18): the GICoF.
+    :math:`Q = \pm\mu P` there whatever the groove (eq. 17-18): the GICoF, marked.
     """
     figure = Figure(figsize=(6.4, 5.6), layout="constrained")
     ax = figure.add_subplot()
@@ -167,8 +162,8 @@ def slip_amplitude_curves(dataset: xr.Dataset) -> Figure:
     Parameters
     ----------
     dataset : xarray.Dataset
-        From :func:`ecofmaps.maps.compute_map` with a load, a 1-D ``stiffness_ratio`` and
-        ``aspect_ratio`` and scalar ``amplitude`` and ``mu``.
+        From :func:`ecofmaps.maps.compute_map` with a load, over ``stiffness_ratio`` and
+        ``aspect_ratio`` alone.
 
     Returns
     -------
@@ -218,7 +213,7 @@ def ecof_ratio_curves(dataset: xr.Dataset, markers: Mapping[str, Mapping] | None
     Returns
     -------
     figure : matplotlib.figure.Figure
-        The curves, and each marked point with its :math:`\mu_E/\mu` read off the Dataset.
+        The curves, each marked point with its :math:`\mu_E/\mu` read off the Dataset.
 
     Notes
     -----

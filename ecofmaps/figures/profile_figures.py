@@ -1,6 +1,5 @@
 r"""Figures of wear-scar profiles: a measured profile as the model reads it, and the ``shapes``
-figure, scars of four shapes at one :math:`D/W` against the parabola (docs/profiles.md).
-"""
+figure, scars of four shapes at one :math:`D/W` against the parabola (docs/profiles.md)."""
 
 from __future__ import annotations
 
@@ -48,12 +47,10 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
     Returns
     -------
     figure : matplotlib.figure.Figure
-        Two panels over the position :math:`X` [µm] relative to the scar centre: the height
-        :math:`z` [µm] with the unworn surface (the reference line of the levelling), the
-        depth :math:`D` and the parabola of the same :math:`D/W`; and the slope
-        :math:`g = dz/dX` the model uses (after smoothing), with the parabola's slope
-        :math:`2DX/W^2` (plus the tilt of the unworn surface, if not levelled). Both mark
-        the detected edges :math:`\pm W`.
+        Over the position :math:`X` [µm] from the scar centre, with the edges :math:`\pm W`:
+        the height :math:`z` [µm], the unworn surface (the levelling line), the depth
+        :math:`D` and the parabola of the same :math:`D/W`; the slope :math:`g = dz/dX` the
+        model uses and the parabola's (plus the unworn surface's tilt).
 
     Notes
     -----
@@ -119,22 +116,17 @@ def scar_shape_comparison(dataset: xr.Dataset) -> Figure:
     Parameters
     ----------
     dataset : xarray.Dataset
-        The ``shapes`` figure's Dataset (:data:`ecofmaps.figures.FIGURES`): dimensions
-        ``shape`` (the scar families), ``groove`` (``'profile'``, ``'parabola'``),
-        ``scar_position``, ``point`` and ``stiffness_ratio``; variables ``scar_height``,
-        ``displacement``, ``force``, ``slip_amplitude``, ``dissipated_energy``, ``ecof``,
-        ``ecof_ratio`` and ``shortcut_error``; scalar ``amplitude``, ``load``,
-        ``stiffness``, ``mu``, ``scar_depth``, ``scar_half_width``.
+        The ``shapes`` figure's Dataset (:data:`ecofmaps.figures.FIGURES`), over ``shape``,
+        ``groove`` (``'profile'``, ``'parabola'``), ``scar_position``, ``point`` and
+        ``stiffness_ratio``.
 
     Returns
     -------
     figure : matplotlib.figure.Figure
-        Top row: the profiles, then the steady loop on each non-parabolic scar against the
-        parabola's (legends give :math:`\delta^*`, :math:`E_d` and :math:`\mu_E`). Bottom
-        row: :math:`\mu_E/\mu` over :math:`S/P` for every shape and the parabola; and the
-        error :math:`\mu'/\mu - 1` [%] of the contact CoF :math:`\mu'` that the paper's
-        shortcut (the parabola of the scar's :math:`D/W`) makes of each scar's
-        :math:`\mu_E`.
+        Top: the profiles, and the steady loop on each other scar against the parabola's.
+        Bottom: :math:`\mu_E/\mu` over :math:`S/P` for each, and the error
+        :math:`\mu'/\mu - 1` [%] of the contact CoF the paper's shortcut (the parabola of
+        the scar's :math:`D/W`) makes of each scar's :math:`\mu_E`.
 
     Notes
     -----

@@ -1,7 +1,6 @@
 r"""The figures ``ecofmaps figures`` writes: :data:`FIGURES`, for each figure the function that
 builds its Dataset with the paper's parameters (:mod:`ecofmaps.paper`), the function that draws
-it and what it marks; :func:`make_figure` does both, :func:`make_figures` for several.
-"""
+it and what it marks; :func:`make_figure` does both, :func:`make_figures` for several."""
 
 from __future__ import annotations
 
@@ -87,7 +86,7 @@ class FigureRecipe:
 
 
 def _loops() -> xr.Dataset:
-    """The loops of Figures 5 and 6 (imports inside, as below: the registry reads without JAX)."""
+    """The loops of Figures 5 and 6 (the registry reads without JAX: imports on first use)."""
     from ecofmaps.maps.cache import cached_dataset
     from ecofmaps.maps.grid import compute_loops
 
@@ -102,33 +101,23 @@ def _loops() -> xr.Dataset:
 
 
 def _stiffness_curves_data() -> xr.Dataset:
-    from ecofmaps.maps.grid import compute_map
-
-    return compute_map(
-        stiffness_ratio=np.array(paper.FIGURE_7_STIFFNESSES) / paper.LOAD,
-        aspect_ratio=ASPECT_RATIOS,
-        amplitude=paper.AMPLITUDE,
-        mu=paper.MU,
-        load=paper.LOAD,
-    )
+    ratios = np.array(paper.FIGURE_7_STIFFNESSES) / paper.LOAD
+    return ecofmaps.compute_map(ratios, ASPECT_RATIOS, paper.AMPLITUDE, paper.MU, paper.LOAD)
 
 
 def _ecof_ratio_map(panel: str) -> Callable[[], xr.Dataset]:
     amplitude = paper.FIGURE_11_AMPLITUDES[panel]
 
     def data() -> xr.Dataset:
-        from ecofmaps.maps.grid import compute_map
-
-        return compute_map(paper.FIGURE_11_STIFFNESS_RATIOS, ASPECT_RATIOS, amplitude, paper.MU)
+        ratios = paper.FIGURE_11_STIFFNESS_RATIOS
+        return ecofmaps.compute_map(ratios, ASPECT_RATIOS, amplitude, paper.MU)
 
     data.__name__ = f"_ecof_ratio_map_{panel}"
     return data
 
 
 def _universal_map() -> xr.Dataset:
-    from ecofmaps.maps.grid import compute_universal_map
-
-    return compute_universal_map(COMPLIANCE_RATIOS, ASPECT_RATIOS, paper.MU)
+    return ecofmaps.compute_universal_map(COMPLIANCE_RATIOS, ASPECT_RATIOS, paper.MU)
 
 
 #: The ``shapes`` figure's scar families at Example 2's D/W = 0.2, W = x_o = Δ*: the function
@@ -139,8 +128,6 @@ SCAR_SHAPES = {
     "W-shaped": ("w_shaped_profile", {"hump": 0.25}),
     "ridged": ("ridged_profile", {"ridge_height": 0.3, "ridge_width": 0.6}),
 }
-
-
 #: The sources beside the model's revision that decide the ``shapes`` Dataset.
 _SCAR_SHAPES_SOURCES = ("figures/recipes.py", "correction/*.py")
 
@@ -230,14 +217,12 @@ def scar_shape_model_dataset() -> xr.Dataset:
 def scar_shape_parabola_dataset() -> xr.Dataset:
     """The parabola of Example 2's D/W (steady values over S/P, the loop of Example 2's rig)
     and the heights of the scar families."""
-    from ecofmaps.maps.grid import compute_map
-
     ratios = _SHAPES_STIFFNESS_RATIOS
     position = np.linspace(-1.6, 1.6, 321) * paper.AMPLITUDE
     heights = [np.interp(position, p.position, p.height) for p in _scar_profiles()]
     # Not cached on its own: the figure's part is cached whole (_scar_shape_parabola).
     grid = dict(amplitude=paper.AMPLITUDE, mu=paper.MU, load=paper.LOAD, cache=False)
-    parabola = compute_map(ratios, paper.ASPECT_RATIO, **grid)
+    parabola = ecofmaps.compute_map(ratios, paper.ASPECT_RATIO, **grid)
     loop = np.asarray(ecofmaps.fretting_loop(**_SHAPES_RIG, aspect_ratio=paper.ASPECT_RATIO))
     variables = {
         "scar_height": (("shape", "scar_position"), np.array(heights)),
@@ -276,14 +261,13 @@ def scar_shapes_dataset() -> xr.Dataset:
         "ecof_ratio": ((*groove, "stiffness_ratio"), by_groove("ecof_ratio")),
         "shortcut_error": (("shape", "stiffness_ratio"), np.array(errors)),
     }
-    depth = paper.ASPECT_RATIO * paper.AMPLITUDE
     coords = {
         "shape": list(SCAR_SHAPES),
         "groove": ["profile", "parabola"],
         "scar_position": parabola["scar_position"].values,
         "stiffness_ratio": ratios,
         **_SHAPES_RIG,
-        "scar_depth": depth,
+        "scar_depth": paper.ASPECT_RATIO * paper.AMPLITUDE,
         "scar_half_width": paper.AMPLITUDE,
     }
     dataset = _labelled(variables, coords)
@@ -421,7 +405,7 @@ def make_figures(names=None) -> Iterator[tuple[str, Figure]]:
     Raises
     ------
     ValueError
-        If a name is not a key of :data:`FIGURES` (before anything is computed).
+        As :func:`make_figure`, before anything is computed.
     """
     recipes = [_recipe(name) for name in (FIGURES if names is None else names)]
     datasets: dict = {}
@@ -448,7 +432,7 @@ def figure_groups(names=None) -> list[list[str]]:
     Raises
     ------
     ValueError
-        If a name is not a key of :data:`FIGURES`.
+        As :func:`make_figure`.
 
     Examples
     --------
@@ -469,7 +453,7 @@ def figure_parts(names=None) -> list[list[Callable[[], xr.Dataset]]]:
     Parameters
     ----------
     names : iterable of str, optional
-        Keys of :data:`FIGURES`; default all of them.
+        As for :func:`figure_groups`.
 
     Returns
     -------
@@ -480,6 +464,6 @@ def figure_parts(names=None) -> list[list[Callable[[], xr.Dataset]]]:
     Raises
     ------
     ValueError
-        If a name is not a key of :data:`FIGURES`.
+        As :func:`make_figure`.
     """
     return [list(_recipe(group[0]).parts) for group in figure_groups(names)]

@@ -1,7 +1,6 @@
 """The look shared by every figure: sizes, labels from the nomenclature, colours, legends
 clear of the data, saving. Figures are :class:`matplotlib.figure.Figure` objects built without
-pyplot state, so they can be made in a loop or a server.
-"""
+pyplot state, so they can be made in a loop or a server."""
 
 from __future__ import annotations
 
@@ -33,13 +32,10 @@ __all__ = [
 
 #: Contour levels of μ_E/μ shared by Figure 11 and the universal map, so they read alike.
 ECOF_RATIO_LEVELS = (1.01, 1.02, 1.03, 1.04, 1.05, 1.06, 1.08, 1.10, 1.12, 1.14, 1.17, 1.20, 1.25)
-
 #: The level drawn heavier: the paper's "most tests are within 5 %".
 HIGHLIGHT_LEVEL = 1.05
-
 #: Resolution of the paper's figures (``ecofmaps figures``) written as PNG. [1/inch]
 PAPER_DPI = 300
-
 #: Resolution of the plots of a user's recording (``ecofmaps loops --plots``). [1/inch]
 RECORDING_DPI = 300
 
@@ -60,29 +56,12 @@ PER_MM = QUANTITIES["stiffness_ratio"].display_factor  # 1/m -> 1/mm = (MN/m)/kN
 
 
 def scalar(dataset: xr.Dataset, name: str) -> float:
-    """A parameter held as a scalar coordinate of ``dataset``, as a float."""
     return float(dataset[name].values)
 
 
 def number_text(value: float, digits: int = 3) -> str:
-    """``value`` for a label: ``digits`` significant digits, no exponent, no trailing zeros.
-
-    Parameters
-    ----------
-    value : float
-    digits : int
-        Significant digits at most; whole numbers keep all theirs. [1]
-
-    Returns
-    -------
-    text : str
-        A dash for NaN, ``∞`` for an infinite value.
-
-    Examples
-    --------
-    >>> [number_text(v) for v in (35.0, 0.02, 35.04, 12345.6, 0.0, float("nan"))]
-    ['35', '0.02', '35', '12346', '0', '–']
-    """
+    """``value`` for a label: at most ``digits`` significant digits (a whole number keeps all its
+    own), no exponent, no trailing zeros; a dash for NaN, ``∞`` for an infinite value."""
     value = float(value)
     if np.isnan(value):
         return "–"
@@ -98,13 +77,7 @@ def number_text(value: float, digits: int = 3) -> str:
 
 
 def stiffness_text(stiffness: float) -> str:
-    """A rig stiffness [N/m] in MN/m for a label: ``'35 MN/m'``, ``'0.02 MN/m'``, ``'rigid'``.
-
-    Examples
-    --------
-    >>> [stiffness_text(s) for s in (35e6, 0.02e6, 35.04e6, float("inf"))]
-    ['35 MN/m', '0.02 MN/m', '35 MN/m', 'rigid']
-    """
+    """A rig stiffness [N/m] in MN/m for a label: ``'35 MN/m'``, ``'0.02 MN/m'``, ``'rigid'``."""
     if np.isinf(stiffness):
         return "rigid"
     return f"{number_text(stiffness * MEGA)} MN/m"
@@ -141,8 +114,6 @@ _PARAMETERS = {
     "aspect_ratio": (r"$z_o/x_o$ = {:g}", 1.0),
     "mu": (r"$\mu$ = {:g}", 1.0),
 }
-
-
 #: The parameters a subtitle gives through their own label.
 _LABELS = {"stiffness": stiffness_label, "load": load_label}
 
@@ -209,8 +180,8 @@ def legend_clear_of_data(ax, *, twins=(), **options):
 
 
 def _covers(ax, box) -> bool:
-    """Whether anything drawn in ``ax`` (lines, their markers, filled areas, texts) meets the
-    display-space ``box``; spans of the whole panel's height (a shaded background) do not."""
+    """Whether anything drawn in ``ax`` meets the display-space ``box``; a span of the panel's whole
+    height (a shaded background) does not."""
     for line in ax.get_lines():
         path = line.get_transform().transform_path(line.get_path()).cleaned(remove_nans=True)
         points = path.vertices[np.isin(path.codes, (DrawnPath.MOVETO, DrawnPath.LINETO))]

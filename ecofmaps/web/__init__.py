@@ -2,8 +2,7 @@
 
 Both need the extra ``web`` (Bokeh, Panel): ``pip install "ecofmaps[web]"``. Importing this
 package needs neither; :mod:`ecofmaps.web.report`, :mod:`ecofmaps.web.explorer` and its server,
-:mod:`ecofmaps.web.server`, do.
-"""
+:mod:`ecofmaps.web.server`, do."""
 
 from __future__ import annotations
 

@@ -2,12 +2,10 @@
 
 One page per session: the parameters typed with units, the model's numbers and steady loop at
 that point, Figure 11's map with the point marked, and the contact CoF behind a typed ECoF.
-The inputs live in the page's URL query, so a view is shared as a link.
-"""
+The inputs live in the page's URL query, so a view is shared as a link."""
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import html
 import math
@@ -30,7 +28,7 @@ from ecofmaps.model.steady_state import dissipated_energy, energy_cof, slip_ampl
 from ecofmaps.paper import FIGURE_11_STIFFNESS_RATIOS
 from ecofmaps.units import DIMENSIONS, DOMAIN, TEXT_LIMIT, bare_number_warning, parse_quantity
 
-__all__ = ["INPUTS", "ExplorerPoint", "bare_number_warnings", "explorer_page", "parameter_value"]
+__all__ = ["INPUTS", "bare_number_warnings", "explorer_page", "parameter_value", "point_values"]
 
 #: The page's inputs: URL query key -> (quantity of the nomenclature, label, default text);
 #: each takes the values of its quantity in the model's domain, :data:`ecofmaps.units.DOMAIN`.
@@ -55,35 +53,9 @@ _MAPS_KEPT = 32
 
 
 def parameter_value(key: str, text: str) -> float:
-    """The SI value of one of the page's inputs, from its text.
-
-    Parameters
-    ----------
-    key : str
-        A key of :data:`INPUTS` (``'amplitude'``, ``'stiffness'``, ...).
-    text : str
-        A number with an optional unit, as on the command line: ``'50um'``, ``'35MN/m'``,
-        ``'inf'``; a bare number is SI.
-
-    Returns
-    -------
-    value : float
-        [SI unit of the quantity: m, N, N/m or 1]
-
-    Raises
-    ------
-    ValueError
-        Naming the input, if :func:`ecofmaps.units.parse_quantity` cannot read the text
-        (too long, not a plain number with a plain unit, not a quantity of its kind), or the
-        value is out of its range or beyond the model's domain (:data:`ecofmaps.units.DOMAIN`).
-
-    Examples
-    --------
-    >>> parameter_value("stiffness", "35MN/m")
-    35000000.0
-    >>> parameter_value("amplitude", "5e-5")
-    5e-05
-    """
+    """The SI value [m, N, N/m or 1] of input ``key`` of :data:`INPUTS` from its text (``'50um'``,
+    ``'inf'``; a bare number is SI); a ValueError naming the input if the text cannot be read, or
+    the value is out of range or beyond the model's domain (:data:`ecofmaps.units.DOMAIN`)."""
     name, label, _ = INPUTS[key]
     quantity, (low, high) = QUANTITIES[name], DOMAIN[name]
     text = str(text)
@@ -105,23 +77,8 @@ def parameter_value(key: str, text: str) -> float:
 
 
 def bare_number_warnings(texts: dict) -> list[str]:
-    """The warnings for inputs typed as bare numbers implausible in SI, each naming the input
-    and the unit probably meant (:func:`ecofmaps.units.bare_number_warning`).
-
-    Parameters
-    ----------
-    texts : dict
-        Text typed, by key of :data:`INPUTS`.
-
-    Returns
-    -------
-    warnings : list of str
-
-    Examples
-    --------
-    >>> bare_number_warnings({"amplitude": "50", "stiffness": "35MN/m"})
-    ['Displacement amplitude Δ*: 50 is 50 m; did you mean 50um?']
-    """
+    """The warnings for ``texts`` (by key of :data:`INPUTS`) typed as bare numbers implausible in
+    SI, each naming the input and the unit probably meant."""
     found = []
     for key, text in texts.items():
         if len(str(text)) > TEXT_LIMIT:  # refused as too long: not read as a number here
@@ -133,23 +90,15 @@ def bare_number_warnings(texts: dict) -> list[str]:
     return found
 
 
-@dataclasses.dataclass(frozen=True)
-class ExplorerPoint:
-    """The model at one point of the explorer, in SI units."""
-
-    slip_amplitude: float
-    dissipated_energy: float
-    ecof_ratio: float
-    loop: tuple
-
-    @classmethod
-    def at(cls, amplitude, load, stiffness, mu, aspect_ratio) -> ExplorerPoint:
-        """The model's values for one test (parameters in SI, as :func:`ecofmaps.energy_cof`)."""
-        point = (amplitude, load, stiffness, mu, aspect_ratio)
-        with warnings.catch_warnings(action="ignore"):  # no gross slip: the page says so
-            ratio = float(energy_cof(*point)) / mu
-        loop = tuple(np.asarray(values) for values in fretting_loop(*point))
-        return cls(float(slip_amplitude(*point)), float(dissipated_energy(*point)), ratio, loop)
+def point_values(amplitude, load, stiffness, mu, aspect_ratio) -> dict:
+    """The model's slip amplitude [m], dissipated energy [J], μ_E/μ [1] and steady loop [m, N]
+    for one test (parameters in SI, as :func:`ecofmaps.energy_cof`)."""
+    point = (amplitude, load, stiffness, mu, aspect_ratio)
+    with warnings.catch_warnings(action="ignore"):  # no gross slip: the page says so
+        ratio = float(energy_cof(*point)) / mu
+    loop = tuple(np.asarray(values) for values in fretting_loop(*point))
+    slip, energy = float(slip_amplitude(*point)), float(dissipated_energy(*point))
+    return dict(slip_amplitude=slip, dissipated_energy=energy, ecof_ratio=ratio, loop=loop)
 
 
 def _grown(value: float, upward: bool) -> float:
@@ -160,19 +109,8 @@ def _grown(value: float, upward: bool) -> float:
 
 
 def map_window(stiffness_ratio: float, aspect_ratio: float) -> tuple[float, float, float]:
-    """The map's window holding a point: S/P from, S/P to [1/m], and the largest z_o/x_o [1].
-
-    Figure 11's window (20 to 200 (MN/m)/kN, z_o/x_o up to 0.4), grown in steps of 1, 2, 5
-    where the point lies beyond it (a rigid rig, S/P infinite, is not drawn), within the
-    model's domain (:data:`ecofmaps.units.DOMAIN`).
-
-    Examples
-    --------
-    >>> map_window(35e6 / 450, 0.2)
-    (20000.0, 200000.0, 0.4)
-    >>> map_window(3e5, 0.45)
-    (20000.0, 500000.0, 0.5)
-    """
+    """The map's window holding a point: S/P from, S/P to [1/m], the largest z_o/x_o [1]:
+    Figure 11's, grown in steps of 1, 2, 5 to hold the point (not a rigid rig's), in the domain."""
     low, high, deepest = _MAP_WINDOW
     if math.isfinite(stiffness_ratio):
         low = min(low, _grown(stiffness_ratio * 0.9, upward=False))
@@ -185,8 +123,7 @@ def map_window(stiffness_ratio: float, aspect_ratio: float) -> tuple[float, floa
 
 @functools.lru_cache(maxsize=_MAPS_KEPT)
 def _ecof_ratio_map(amplitude: float, mu: float, window: tuple) -> tuple:
-    """μ_E/μ over (z_o/x_o, S/P) in the window, by :func:`ecofmaps.compute_map`, and where
-    there is no gross slip (1.0, else 0.0)."""
+    """μ_E/μ over (z_o/x_o, S/P) in the window, and where there is no gross slip (1.0, else 0.0)."""
     low, high, deepest = window
     x, y = np.linspace(low, high, _MAP_POINTS[0]), np.linspace(0.0, deepest, _MAP_POINTS[1])
     dataset = compute_map(x, y, amplitude=amplitude, mu=mu, cache=False)
@@ -195,17 +132,15 @@ def _ecof_ratio_map(amplitude: float, mu: float, window: tuple) -> tuple:
 
 
 def _number(value: float, factor: float = 1.0) -> str:
-    """``value * factor`` with 3 decimals (6 significant digits from 100000 up), or
-    'undefined' where it is NaN."""
+    """``value * factor`` to 3 decimals (6 significant digits from 1e5 up); NaN 'undefined'."""
     if math.isnan(value):
         return "undefined"
     shown = value * factor
     return format(shown, ".3f" if abs(shown) < 1e5 else ".6g")
 
 
-def _values_html(point: ExplorerPoint, values: dict) -> str:
-    """The inputs as read (a bare number is SI) and the model's numbers at the point, each with
-    its unit in a span the page and its tests can find."""
+def _values_html(point: dict, values: dict) -> str:
+    """The inputs as read and the model's numbers at the point, each in a span the tests find."""
     read = []
     for key in _MODEL_INPUTS:
         quantity = QUANTITIES[INPUTS[key][0]]
@@ -213,10 +148,10 @@ def _values_html(point: ExplorerPoint, values: dict) -> str:
         text = "inf (a rigid rig)" if math.isinf(value) else f"{value:g} {quantity.display_unit}"
         read.append(f"{quantity.symbol} = {text.strip()}")
     rows = [
-        ("slip_amplitude", "Slip amplitude δ*", point.slip_amplitude),
-        ("dissipated_energy", "Dissipated energy E_d", point.dissipated_energy),
-        ("ecof_ratio", "μ_E/μ", point.ecof_ratio),
-        ("ecof", "μ_E", point.ecof_ratio * values["mu"]),
+        ("slip_amplitude", "Slip amplitude δ*", point["slip_amplitude"]),
+        ("dissipated_energy", "Dissipated energy E_d", point["dissipated_energy"]),
+        ("ecof_ratio", "μ_E/μ", point["ecof_ratio"]),
+        ("ecof", "μ_E", point["ecof_ratio"] * values["mu"]),
     ]
     cells = []
     for key, label, value in rows:
@@ -228,7 +163,7 @@ def _values_html(point: ExplorerPoint, values: dict) -> str:
             f"{_number(value, quantity.display_factor)}</span> {unit}</td></tr>"
         )
     inputs = f"<p style='margin:0 0 6px 0;color:#555'>Read as {', '.join(read)}.</p>"
-    gross = math.isfinite(point.ecof_ratio)
+    gross = math.isfinite(point["ecof_ratio"])
     regime = "" if gross else "<p><b>No gross slip</b> (μP/S ≥ Δ*): μ_E is undefined.</p>"
     return f"{inputs}<table style='font-size:14px'>{''.join(cells)}</table>{regime}"
 
@@ -260,8 +195,7 @@ def _fill_levels(top: float) -> list:
 
 
 def _contour_labels(line_data, scale: tuple) -> dict:
-    """A label for each contour line drawn: its level, at the middle of its longest piece,
-    turned along it; ``scale`` is the plot's pixels per unit of x and of y."""
+    """Each contour line's level, upright mid its longest piece; ``scale`` [px per unit]."""
     labels = {"x": [], "y": [], "text": [], "angle": []}
     for level, xs, ys in zip(line_data.levels, line_data.xs, line_data.ys, strict=True):
         pieces = np.split(np.arange(len(xs)), np.flatnonzero(np.isnan(xs)))
@@ -293,8 +227,7 @@ _MAP_FRAME = (440, 290)
 
 
 def _map_figure():
-    """The μ_E/μ map's figure and what an update changes in it, by name: the filled bands,
-    the labelled lines, the hatched no-gross-slip area, the hover's image and the marker."""
+    """The μ_E/μ map's figure and, by name, what an update changes in it."""
     plot = figure(
         width=600,
         height=470,
@@ -346,7 +279,6 @@ def _map_figure():
 
 
 def _show_map(values: dict, parts: dict) -> None:
-    """Draw the map for the point's amplitude and μ, with the point marked."""
     ratio = values["stiffness"] / values["load"]
     window = map_window(ratio, values["aspect_ratio"])
     grid, stuck = _ecof_ratio_map(values["amplitude"], values["mu"], window)
@@ -417,9 +349,9 @@ def explorer_page():
             message.object = f"<p style='margin:2px 0'>{html.escape(str(error))}</p>"
             return
         try:
-            point = ExplorerPoint.at(*(values[key] for key in _MODEL_INPUTS))
+            point = point_values(*(values[key] for key in _MODEL_INPUTS))
             values_pane.object = _values_html(point, values)
-            loop_source.data = {"x": point.loop[0] * 1e6, "y": point.loop[1]}
+            loop_source.data = {"x": point["loop"][0] * 1e6, "y": point["loop"][1]}
             _show_map(values, map_parts)
             correction_pane.object = _correction_html(values)
         except Exception as error:  # a page must stay up whatever the model says
@@ -454,10 +386,9 @@ def explorer_page():
 
 
 def warm_up() -> None:
-    """Compile the model's functions and fill the map for the default point, so the first
-    page comes at once."""
+    """Compile the model and fill the default point's map, so the first page comes at once."""
     values = {key: parameter_value(key, default) for key, (_, _, default) in INPUTS.items()}
-    ExplorerPoint.at(*(values[key] for key in _MODEL_INPUTS))
+    point_values(*(values[key] for key in _MODEL_INPUTS))
     window = map_window(values["stiffness"] / values["load"], values["aspect_ratio"])
     _ecof_ratio_map(values["amplitude"], values["mu"], window)
     _correction_html(values)

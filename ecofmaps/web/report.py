@@ -1,11 +1,7 @@
-"""A fretting test's results as one HTML page that opens offline (``ecofmaps loops --report``).
-
-Bokeh's page with its JavaScript and CSS inline, so it fetches nothing: the ECoF, the GICoF
-and the friction read along the stroke over the cycles with the quality flags and their
-counts, the lab's numbers (ΣE_d, the transition of a sweep: docs/lab.md), measured loops of
-a few cycles beside the model's, the table of ``ecofmaps loops`` (sortable), and the inputs,
-version and date.
-"""
+"""A fretting test's results as one HTML page that opens offline (``ecofmaps loops --report``):
+Bokeh's, its JavaScript and CSS inline. The coefficients of friction over the cycles with the
+quality flags, the lab's numbers (docs/lab.md), measured loops beside the model's, the table of
+``ecofmaps loops`` and the inputs, version and date."""
 
 from __future__ import annotations
 
@@ -47,8 +43,8 @@ from ecofmaps.model.simulation import fretting_loop
 
 __all__ = ["LOOPS_CARRIED", "recording_inputs", "report_document", "write_report"]
 
-#: Cycles whose loops a report carries by default, spread evenly over the test: the reader
-#: picks among them in the page. Their loops are the bulk of a report of a short test.
+#: Cycles whose loops a report carries by default, spread evenly over the test, for the reader
+#: to pick from: the bulk of a short test's report.
 LOOPS_CARRIED = 60
 
 _MODEL_POINTS = 40  # points on each slip branch of a model loop
@@ -58,10 +54,9 @@ _MODEL_BATCH = 64  # model loops are computed in batches of a multiple of this m
 _FRAME = (560, 130)
 _WIDTH = 1240
 _NEEDED = ("cycle", "ecof", "gicof", "quality", "regime", "load")
-# The table: significant digits as the CSV's (each column with the decimals of its largest
-# value), a number cell (nothing for NaN, as the CSV's empty field), the width of a character
-# and the room around it, the table's width (every column of a recording's table in a window
-# 1400 px wide) and the room for its scroll bar. [px]
+# The table: the CSV's significant digits, a number cell (empty for NaN, as in the CSV), the
+# width of a character and the room around it, the table's width (fits a 1400 px window) and
+# the room for its scroll bar. [px]
 _DIGITS = 6
 _NUMBER_CELL = (
     '<div style="text-align: right"><%= (value == null || value !== value) ? "" : '
@@ -70,8 +65,7 @@ _NUMBER_CELL = (
 _CHARACTER, _CELL_ROOM = 6.5, 10
 _TABLE_WIDTH, _TABLE_ROOM = 1350, 20
 
-# Shows the loops of the cycles picked in the page: the measured loop and, where the cycle
-# has one, the model's, each pair in one colour.
+# Shows the measured loops of the cycles picked and their model's, each pair in one colour.
 _PICK_LOOPS = """
 const all = carried.data;
 const measured_data = {xs: [], ys: [], label: [], color: []};
@@ -95,52 +89,10 @@ model.data = model_data;
 
 
 def write_report(path, results: xr.Dataset, *, loops=None, inputs=None, lab=None) -> Path:
-    """Write the results of a fretting test as one HTML page that opens offline.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The HTML file to write (atomically: a temporary file renamed into place); its
-        directory must exist.
-    results : xarray.Dataset
-        From :func:`ecofmaps.analyze_loops`; with ``resolve=True`` the page also shows the
-        friction read along the stroke, and with ``keep_loops=True`` the loops.
-    loops : sequence of int, optional
-        Cycle numbers whose loops the page carries, for the reader to pick from; by
-        default :data:`LOOPS_CARRIED` spread evenly over the test, the first and the last
-        included. Needs ``keep_loops=True``.
-    inputs : mapping of str to str, optional
-        What the results were made from, shown as given (``{"files": "test.csv", "load":
-        "450 N", "units assumed": "displacement um, force N"}``); the ecofmaps version and
-        the date are added.
-    lab : mapping of str to str, optional
-        More of the lab's numbers, shown as given under theirs (the energy wear and the
-        loop-scar closure ``ecofmaps loops --scar-profile`` reads).
-
-    Returns
-    -------
-    path : pathlib.Path
-        The file written.
-
-    Raises
-    ------
-    ValueError
-        If ``results`` lack a variable of :func:`ecofmaps.analyze_loops`, ``loops`` names a
-        cycle not in them, or ``loops`` is given for results without loops.
-
-    Examples
-    --------
-    >>> import ecofmaps, tempfile, os
-    >>> displacement, force = ecofmaps.synthetic_recording(
-    ...     50e-6, 450.0, 35e6, 0.8, [0.1, 0.15, 0.2], samples_per_cycle=160)
-    >>> results = ecofmaps.analyze_loops(displacement, force, 450.0, resolve=True,
-    ...                                  keep_loops=True)
-    >>> folder = tempfile.mkdtemp()
-    >>> page = write_report(os.path.join(folder, "report.html"), results,
-    ...                     inputs={"load": "450 N"})
-    >>> page.read_text(encoding="utf-8").count("<script src=")  # nothing fetched
-    0
-    """
+    """Write the results of :func:`ecofmaps.analyze_loops` as one HTML page that opens offline, at
+    ``path`` (atomically; its folder must exist); return the path. ``loops``: the cycles whose loops
+    the page carries (default :data:`LOOPS_CARRIED` spread evenly); ``inputs`` and ``lab``: rows
+    shown as given (what the results were made from; more of the lab's numbers)."""
     document = report_document(results, loops=loops, inputs=inputs, lab=lab)
     title = "ecofmaps report" + (f": {inputs['files']}" if inputs and "files" in inputs else "")
     # Bokeh's own JavaScript and CSS, written in. Not file_html(..., INLINE): that also asks
@@ -162,29 +114,8 @@ def write_report(path, results: xr.Dataset, *, loops=None, inputs=None, lab=None
 
 
 def recording_inputs(recording, load: float, *, flip_force: bool = False) -> dict[str, str]:
-    """What a report of one recording says it was made from (``inputs`` of :func:`write_report`).
-
-    Parameters
-    ----------
-    recording : ecofmaps.io.recordings.Recording
-        From :func:`ecofmaps.io.recordings.read_recording`.
-    load : float
-        Normal load :math:`P` the recording was analysed with. [N]
-    flip_force : bool
-        Whether the force was read with the other sign.
-
-    Returns
-    -------
-    inputs : dict of str to str
-        The file, the load, and each column read with the unit it was read in.
-
-    Examples
-    --------
-    >>> from ecofmaps.io.recordings import read_recording
-    >>> from ecofmaps.measured.synthetic import example_path
-    >>> recording_inputs(read_recording(example_path()), 450.0)["columns and units assumed"]
-    "displacement: 'displacement' in um; force: 'force' in N; cycle: 'cycle'"
-    """
+    """The ``inputs`` of :func:`write_report` for a recording analysed at ``load`` [N]: its file,
+    the load and each column read with its unit."""
     read = []
     for name, column_name in recording.columns.items():
         unit = recording.units.get(name, "1")
@@ -203,7 +134,9 @@ def report_document(results: xr.Dataset, *, loops=None, inputs=None, lab=None):
         raise ValueError(
             f"results lack {', '.join(missing)}: give the Dataset of ecofmaps.analyze_loops"
         )
-    flagged = _flagged_cycles(results)
+    cycle, quality = results["cycle"].values, results["quality"].values
+    flagged = {reason: cycle[has_reason(quality, reason)] for reason in REASONS}
+    flagged = {reason: cycles for reason, cycles in flagged.items() if cycles.size}  # in order
     evolution, flags = _evolution_figures(results, flagged)
     parts = [
         _header(results, inputs or {}),
@@ -231,7 +164,7 @@ def _rows_table(rows: Mapping, css_class: str) -> str:
 
 
 def _header(results: xr.Dataset, inputs: Mapping) -> Div:
-    """The title, the inputs, the version and date, and the summary of the quality."""
+    """The title, the inputs, the version and date, and the quality's summary."""
     rows = dict(inputs)
     rows["ecofmaps version"] = __version__
     rows["written"] = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
@@ -323,13 +256,6 @@ def _cycle_figure(**options):
     return plot
 
 
-def _flagged_cycles(results: xr.Dataset) -> dict[str, np.ndarray]:
-    """The cycles each quality reason flags, in the order of :data:`REASONS`."""
-    cycle = results["cycle"].values
-    flagged = {reason: cycle[has_reason(results["quality"].values, reason)] for reason in REASONS}
-    return {reason: cycles for reason, cycles in flagged.items() if cycles.size}
-
-
 def _flags_figure(flagged: dict, evolution):
     """A strip below the coefficients: a mark at each cycle a quality reason flags."""
     if not flagged:
@@ -372,7 +298,6 @@ def _quality_counts(results: xr.Dataset, flagged: dict) -> Div:
 
 
 def _carried_cycles(results: xr.Dataset, loops) -> np.ndarray:
-    """The cycle numbers whose loops the page carries (see :func:`write_report`)."""
     labels = results["cycle"].values
     if loops is None:
         count = min(LOOPS_CARRIED, labels.size)
@@ -419,18 +344,15 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
     kept = np.isfinite(measured_x) & np.isfinite(measured_y)
     xs = [x[keep] for x, keep in zip(measured_x, kept, strict=True)]
     ys = [y[keep] for y, keep in zip(measured_y, kept, strict=True)]
-    all_loops = ColumnDataSource(
-        dict(label=names, xs=xs, ys=ys, model_xs=model_xs, model_ys=model_ys)
-    )
+    loops = dict(label=names, xs=xs, ys=ys, model_xs=model_xs, model_ys=model_ys)
+    all_loops = ColumnDataSource(loops)
     first = list(dict.fromkeys([names[0], names[len(names) // 2], names[-1]]))
     palette = list(Category10_10)
     # The loops first shown, as _PICK_LOOPS shows those picked (at most three: a colour each)
     at = [names.index(name) for name in first]
     colors = palette[: len(first)]
-    measured = ColumnDataSource(
-        {"xs": [xs[i] for i in at], "ys": [ys[i] for i in at], "label": first, "color": colors},
-        name="shown-loops",
-    )
+    shown = {"xs": [xs[i] for i in at], "ys": [ys[i] for i in at], "label": first, "color": colors}
+    measured = ColumnDataSource(shown, name="shown-loops")
     modelled = [(i, color) for i, color in zip(at, colors, strict=True) if len(model_xs[i])]
     model = ColumnDataSource(
         {
@@ -461,8 +383,8 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
         width=480,
         name="loop-picker",
     )
-    shown = dict(carried=all_loops, choice=choice, measured=measured, model=model, palette=palette)
-    choice.js_on_change("value", CustomJS(args=shown, code=_PICK_LOOPS))
+    picked = dict(carried=all_loops, choice=choice, measured=measured, model=model, palette=palette)
+    choice.js_on_change("value", CustomJS(args=picked, code=_PICK_LOOPS))
     note = Div(
         text="<p>Each loop is centred (the sensors' offsets removed). The dashed loop is the "
         "model's steady loop (eq. 9, 10, 16) for the cycle's amplitude, rig stiffness S, "

@@ -67,8 +67,7 @@ class _LongQuery(Matcher):
 
 
 class _CutQuery(RequestHandler):
-    """See Other: the same page with each overlong query value cut, so Panel never parses a
-    huge number and the page names the input."""
+    """See Other: the page with each overlong query value cut (Panel fails on a huge number)."""
 
     def prepare(self):
         pairs = urllib.parse.parse_qsl(self.request.query, keep_blank_values=True)
@@ -77,29 +76,11 @@ class _CutQuery(RequestHandler):
 
 
 def serve_explorer(port: int, *, open_browser: bool = True, announce=print, allow_origin=()):
-    """Serve the explorer at ``http://127.0.0.1:<port>/`` until Ctrl-C or SIGTERM.
-
-    Every HTTP request (the page, its resources, the websocket) whose ``Host`` header, or
-    ``Origin`` header if it has one, is not one of :data:`LOCAL_HOSTS` with ``port`` gets a
-    403: another web page, or a DNS rebinding, cannot make it compute.
-
-    Parameters
-    ----------
-    port : int
-        The local port to listen on (only on 127.0.0.1). [1]
-    open_browser : bool
-        Open the page in the default browser once the server listens.
-    announce : callable
-        Called with the line that gives the page's address, once the server listens.
-    allow_origin : sequence of str
-        More hosts to answer, ``host`` or ``host:port`` (without a port, ``port``): for a
-        page reached through a tunnel or a proxy under another name.
-
-    Raises
-    ------
-    OSError
-        If the port cannot be listened on (in use, or not allowed).
-    """
+    """Serve the explorer at ``http://127.0.0.1:<port>/`` until Ctrl-C or SIGTERM; ``announce`` gets
+    the line with its address once it listens. A request whose Host, or Origin if it has one, is
+    not one of :data:`LOCAL_HOSTS` or ``allow_origin`` (``host[:port]``, by default at ``port``)
+    gets a 403, so another page or a DNS rebinding cannot make it compute. OSError if the port
+    cannot be listened on."""
     previous = {number: signal.getsignal(number) for number in (signal.SIGINT, signal.SIGTERM)}
     ours = [number for number, before in previous.items() if before not in (signal.SIG_IGN, None)]
     url = f"http://127.0.0.1:{port}/"

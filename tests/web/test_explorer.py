@@ -442,7 +442,7 @@ def test_a_failure_while_updating_is_a_message_on_the_page(monkeypatch):
     def fails(*args):
         raise OverflowError("math range error")
 
-    monkeypatch.setattr(explorer.ExplorerPoint, "at", fails)
+    monkeypatch.setattr(explorer, "point_values", fails)
     inputs["Contact CoF μ"].value = "0.7"
     shown = " ".join(str(pane.object) for pane in page.select(pn.pane.HTML))
     assert "Cannot show this point (OverflowError: math range error)" in shown
