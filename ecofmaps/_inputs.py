@@ -1,9 +1,6 @@
-"""Input handling shared by the public entry points: units, float64 and validation.
-
-Numbers or pint Quantities (converted to SI by the parameter's name, :func:`si_units`),
-concrete inputs checked with a :class:`ValueError` naming the parameter and its range or
-domain (:func:`check`), traced inputs left to the kernels (NaN and the ``INVALID`` regime), and
-broadcasts too large for memory refused before JAX would abort (:func:`check_broadcast_size`).
+"""Input handling shared by the public entry points: pint Quantities to SI by parameter name,
+float64, concrete inputs checked (traced ones are left to the kernels: NaN and ``INVALID``),
+and broadcasts too large for memory refused before JAX would abort.
 """
 
 from __future__ import annotations
@@ -23,7 +20,7 @@ from ecofmaps.units import DIMENSIONS, DOMAIN
 
 
 def _is_quantity(value) -> bool:
-    """True for a pint Quantity of any registry (without importing pint)."""
+    """Whether ``value`` is a pint Quantity of any registry (without importing pint)."""
     return type(value).__module__.split(".")[0] == "pint" and hasattr(value, "magnitude")
 
 
@@ -88,8 +85,8 @@ def _clashes(shapes: list):
 
 
 def si_units(function=None, **kinds):
-    """Accept pint Quantities for ``function``'s parameters, converted to SI by name (or by
-    the quantity ``kinds`` names), and refuse a broadcast of them too large for memory."""
+    """``function`` taking pint Quantities, in SI by parameter name (or the quantity ``kinds``
+    names), and refusing a broadcast of them too large for memory."""
     if function is None:
         return functools.partial(si_units, **kinds)
     parameters = inspect.signature(function)
@@ -116,8 +113,7 @@ def si_units(function=None, **kinds):
 
 
 def available_memory() -> int | None:
-    """The memory available to a new array: Linux's ``MemAvailable``, else the physical
-    memory; ``None`` where neither is known. [B]"""
+    """The memory available to a new array (``MemAvailable``, else physical; or None). [B]"""
     try:
         with open("/proc/meminfo", encoding="ascii") as meminfo:
             for line in meminfo:
@@ -174,13 +170,12 @@ def float64(function):
 
 
 def _to_numpy(leaf):
-    """A JAX array as a (read-only, uncopied) NumPy array; anything else as it is."""
+    """A JAX array as a read-only NumPy view; anything else as it is."""
     return np.asarray(leaf) if isinstance(leaf, sys.modules["jax"].Array) else leaf
 
 
 def is_concrete(*values) -> bool:
-    """True when no leaf of ``values`` (pytrees such as a scar profile included) is a JAX
-    tracer, so they can be inspected."""
+    """Whether no leaf of the pytrees ``values`` is a JAX tracer."""
     jax = sys.modules.get("jax")
     if jax is None:  # no tracer exists before JAX is imported
         return True
@@ -195,9 +190,8 @@ def as_float64(value):
 
 
 def check(name: str, value, rule: str | None = None, unit: str | None = None) -> None:
-    """Raise ``ValueError`` if a concrete ``value`` breaks ``rule`` or, for a quantity of
-    :data:`ecofmaps.units.DOMAIN` (``name``'s first word), lies beyond the model's domain;
-    do nothing for tracers (a traced value cannot be looked at)."""
+    """``ValueError`` if a concrete ``value`` breaks ``rule`` or lies beyond the model's
+    :data:`ecofmaps.units.DOMAIN` for ``name``'s first word; tracers pass unchecked."""
     if not is_concrete(value):
         return
     described = QUANTITIES.get(name)

@@ -1,6 +1,5 @@
-"""Ctrl-C and SIGTERM that stop the command line cleanly, at the next safe point, writing
-nothing more (standard library only: installed before anything heavy is imported).
-"""
+"""Ctrl-C and SIGTERM stop the command line at the next safe point, writing nothing more
+(standard library only: installed before anything heavy is imported)."""
 
 from __future__ import annotations
 
@@ -8,14 +7,13 @@ import contextlib
 import signal
 import threading
 
-#: The signals :func:`interrupts_stop_writes` turns into a clean stop: Ctrl-C (SIGINT) and
-#: SIGTERM (``kill``, a batch system ending a job).
+#: The signals :func:`interrupts_stop_writes` turns into a clean stop.
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
 class Stop(threading.Event):
-    """Set once a stop signal came; :attr:`signal` is the first one (None before), and
-    :attr:`notes` the functions :func:`add_stop_note` gave to tell what a stop left."""
+    """Set once a stop signal came: the first ``signal``, and the ``notes`` that tell what a
+    stop left (:func:`add_stop_note`)."""
 
     def __init__(self):
         super().__init__()
@@ -24,19 +22,17 @@ class Stop(threading.Event):
         self.deferred = 0
 
     def note(self):
-        """What the stop left (the sentence after ``interrupted;``): the first of :attr:`notes`
-        that has something to say, or None."""
+        """What the stop left (after ``interrupted;``): the first note that says something."""
         return next((told for told in (note() for note in self.notes) if told), None)
 
 
-#: Set by the handler of :func:`interrupts_stop_writes`, only while it is installed; its
-#: :attr:`Stop.notes` are the block's while one runs, None outside.
+#: Set by the handler of :func:`interrupts_stop_writes` while it is installed (notes None outside).
 INTERRUPTED = Stop()
 INTERRUPTED.notes = None
 
 
 class Interrupted(KeyboardInterrupt):
-    """A stop by Ctrl-C or SIGTERM that has something to tell: what was kept, how to go on."""
+    """A stop that tells what was kept and how to go on."""
 
     def __init__(self, note: str):
         super().__init__(note)
@@ -44,23 +40,20 @@ class Interrupted(KeyboardInterrupt):
 
 
 def add_stop_note(note) -> None:
-    """Have the line that reports a stop in the running :func:`interrupts_stop_writes`
-    block say what ``note()`` returns when the line is written."""
+    """Have the line that reports a stop in this block say what ``note()`` returns."""
     if INTERRUPTED.notes is not None:
         INTERRUPTED.notes.append(note)
 
 
 def check_interrupted() -> None:
-    """Raise ``KeyboardInterrupt`` if Ctrl-C was pressed (or SIGTERM came) under
-    :func:`interrupts_stop_writes`."""
+    """Raise ``KeyboardInterrupt`` if a stop signal came under :func:`interrupts_stop_writes`."""
     if INTERRUPTED.is_set() and not INTERRUPTED.deferred:
         raise KeyboardInterrupt
 
 
 def interrupted_waiting(function):
-    """``function()`` run in a thread of its own, its exception raised here, while this one
-    acts on a stop within 0.1 s (a signal's handler waits for a call into C, such as XLA's
-    compiling, to return); on a stop the thread is left running."""
+    """``function()`` in a thread of its own while this one acts on a stop within 0.1 s (a
+    handler waits for a call into C, such as XLA's compiling, to return)."""
     check_interrupted()
     outcome = []
 
@@ -83,8 +76,7 @@ def interrupted_waiting(function):
 
 @contextlib.contextmanager
 def interrupts_deferred():
-    """Within the block, :func:`check_interrupted` lets a first stop signal pass: for what
-    completes an output already in place (the record of the files a command wrote)."""
+    """Within the block a first stop signal is let pass (to complete an output in place)."""
     INTERRUPTED.deferred += 1
     try:
         yield
@@ -94,8 +86,7 @@ def interrupts_deferred():
 
 @contextlib.contextmanager
 def interrupts_stop_writes():
-    """Within the block, Ctrl-C or SIGTERM stops the program at the next safe point, writing
-    nothing more."""
+    """Within the block, Ctrl-C or SIGTERM stops at the next safe point, writing nothing more."""
     interrupted = Stop()
     if threading.current_thread() is not threading.main_thread():
         yield interrupted

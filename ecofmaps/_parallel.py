@@ -1,9 +1,5 @@
-"""Blocks of work run on local threads or on a dask cluster, their results as they come.
-
-:class:`Runner` runs independent tasks (each reading its own stretch of a recording) with a
-bounded number in flight, on threads, a local cluster or an existing one, and gives the
-results back in order as soon as each is ready; Ctrl-C stops it at the next block
-(``docs/parallel.md``).
+"""Blocks of work run on local threads or on a dask cluster, their results in order as they
+come; Ctrl-C stops at the next block (``docs/parallel.md``).
 """
 
 from __future__ import annotations
@@ -33,8 +29,8 @@ WORKER_MEMORY = 512 * 2**20
 #: Seconds between looks at a running task (and at Ctrl-C).
 _POLL = 0.01
 
-#: The attribute of a dask array made by ``dask.array.from_array`` that holds the array-like
-#: it was made of, when that reads a range of samples itself (see :func:`stretch`).
+#: The attribute of a dask array that holds the array-like it was made of, when that reads a
+#: range of samples itself (see :func:`stretch`).
 SOURCE = "ecofmaps_source"
 
 
@@ -43,8 +39,7 @@ class SchedulerError(OSError):
 
 
 class Slice:
-    """Samples ``start`` to ``stop - 1`` of ``source`` (an array-like read by a slice),
-    read where the task that receives it runs."""
+    """``source[start:stop]``, read where the task that receives it runs."""
 
     __slots__ = ("source", "start", "stop")
 
@@ -52,7 +47,6 @@ class Slice:
         self.source, self.start, self.stop = source, int(start), int(stop)
 
     def read(self):
-        """The samples, as the source gives them (a NumPy array)."""
         return self.source[self.start : self.stop]
 
 
@@ -73,11 +67,9 @@ def _call(function, arguments):
 
 
 class Runner:
-    """Run tasks, a bounded number at a time, in a ``with`` block (which closes what it
-    started): on ``workers`` threads (default one per core); with ``cluster=True`` on the
-    ``workers`` one-thread processes of a new ``LocalCluster``; or on the cluster of the
-    scheduler at the address ``scheduler`` (``tcp://host:8786``; ``timeout`` seconds for it to
-    answer, default :data:`CONNECT_TIMEOUT`) or of the connected ``client`` (left open)."""
+    """Run tasks, a bounded number at a time, in a ``with`` block: on ``workers`` threads, on
+    a new ``LocalCluster`` (``cluster=True``), on the ``scheduler`` at an address, or on a
+    connected ``client`` (left open)."""
 
     def __init__(self, workers=None, *, scheduler=None, cluster=False, client=None, timeout=None):
         if scheduler is not None and cluster:
@@ -90,7 +82,7 @@ class Runner:
 
     @property
     def local(self) -> bool:
-        """Whether the tasks run on this machine, where they see its files at the same paths."""
+        """Whether the tasks run on this machine (they see its files)."""
         return self.scheduler is None and self._given is None
 
     def __enter__(self) -> Runner:
@@ -156,10 +148,8 @@ class Runner:
             return self._client.submit(_call, function, arguments, pure=False)
 
     def map(self, function, tasks):
-        """``function(*arguments)`` (a module-level function, picklable by name) for each tuple
-        of ``tasks``, its dask collections computed where it runs: the results in order, each
-        once it and the earlier ones are done, with twice as many calls in flight as workers
-        (about as many blocks in memory)."""
+        """``function(*arguments)`` (picklable by name) for each tuple of ``tasks``: the results
+        in order as they come, with twice as many calls in flight as workers."""
         if self._pool is None and self._client is None:
             raise RuntimeError("a Runner is used within a with block")
         pending = collections.deque()
@@ -184,8 +174,7 @@ class Runner:
 
 
 def check_workers(workers, processes: bool, here: bool = True) -> None:
-    """Raise ``ValueError`` naming ``workers`` unless it is None or a whole number of
-    workers, which this machine can run (:func:`worker_limit`) when they run ``here``."""
+    """``ValueError`` unless ``workers`` is None or a whole number this machine can run."""
     if workers is None:
         return
     if isinstance(workers, bool) or int(workers) != workers or workers < 1:
@@ -217,8 +206,7 @@ def worker_limit(processes: bool) -> tuple[int, str]:
 
 @contextlib.contextmanager
 def _sigint_held():
-    """Ctrl-C (SIGINT) held back from this thread while the block runs, and for good from the
-    threads it starts and from the processes those start."""
+    """SIGINT blocked in this thread for the block, and for good in the threads it starts."""
     if threading.current_thread() is not threading.main_thread() or not hasattr(
         signal, "pthread_sigmask"
     ):
@@ -244,7 +232,7 @@ def start_resource_tracker_quietly() -> None:
 
 
 def _connect(address: str, timeout: float):
-    """A client of the dask scheduler at ``address`` once it answers in ``timeout`` seconds."""
+    """A client of the dask scheduler at ``address``, once it answers within ``timeout`` [s]."""
     from distributed import Client
 
     async def identity() -> dict:

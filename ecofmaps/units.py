@@ -1,6 +1,5 @@
-"""Quantities with units, as the command line and the explorer read them: ``50um``,
-``35MN/m`` or ``450 N`` (a plain number and a plain unit: pint evaluates no arithmetic typed)
-to SI floats with pint, the dimension checked; a bare number is SI.
+"""Quantities typed with units (``50um``, ``35MN/m``, ``450 N``: a plain number and a plain
+unit, no arithmetic) read as SI floats with pint, the dimension checked; a bare number is SI.
 """
 
 from __future__ import annotations
@@ -67,17 +66,9 @@ DOMAIN = {
 
 
 def bare_number_warning(name: str, text: str, kind: str) -> str | None:
-    """Why ``text``, a bare number for quantity ``name`` (of ``kind``, a key of
-    :data:`DIMENSIONS`), is implausible in SI, with the unit probably meant; None if ``text``
-    has a unit or is plausible (:data:`PLAUSIBLE`).
-
-    Examples
-    --------
-    >>> bare_number_warning("amplitude", "50", "length")
-    '50 is 50 m; did you mean 50um?'
-    >>> bare_number_warning("amplitude", "50um", "length") is None
-    True
-    """
+    """Why ``text``, a bare (SI) number for quantity ``name`` of ``kind``, is implausible
+    (:data:`PLAUSIBLE`), with the unit probably meant (``'50 is 50 m; did you mean 50um?'``);
+    None if it has a unit or is plausible."""
     if name not in PLAUSIBLE:
         return None
     try:
@@ -102,7 +93,7 @@ def bare_number_warning(name: str, text: str, kind: str) -> str | None:
     return f"{said}; a fretting test's is {span} {DIMENSIONS[kind][1]}"
 
 
-#: A number as typed: a decimal with an optional exponent, inf or nan.
+#: A decimal with an optional exponent, inf or nan.
 _NUMBER = r"[+-]?(?:(?i:inf|nan)|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)"
 #: A unit's name (um, MN, parsecs, %) with an optional power of one digit (mm**3, s^-1).
 _NAME = r"[A-Za-zµμ°%_]+(?:\s*(?:\*\*|\^)\s*[+-]?\d)?"
@@ -124,41 +115,16 @@ PLAIN_QUANTITY = re.compile(rf"\s*(?P<number>{_NUMBER})\s*(?P<unit>{_UNIT})?\s*"
 
 @functools.cache
 def _registry():
-    """pint's unit registry (pint imported on first use: most commands parse no unit)."""
+    """pint's unit registry, imported on first use (most commands parse no unit)."""
     import pint
 
     return pint.UnitRegistry()
 
 
 def parse_quantity(text: str, kind: str) -> float:
-    """One quantity as an SI float, from a plain number and an optional plain unit.
-
-    Parameters
-    ----------
-    text : str
-        A number (``'5e-5'``, ``'inf'``, ``'nan'``), taken as SI, or a number and a unit
-        (``'50um'``, ``'35 MN/m'``, ``'0.08/um'``): :data:`PLAIN_QUANTITY`.
-    kind : str
-        A key of :data:`DIMENSIONS`, the dimension the unit must have.
-
-    Returns
-    -------
-    value : float
-        [SI unit of ``kind``] The float nearest the typed decimal times its unit's factor
-        (``'25um'`` is ``25e-6``).
-
-    Raises
-    ------
-    ValueError
-        If ``text`` is longer than :data:`TEXT_LIMIT`, is not a plain number with a plain
-        unit (an expression such as ``'9**9**9 N'``), names no known unit, has a unit of
-        another dimension, or is finite but beyond the largest float in SI.
-
-    Examples
-    --------
-    >>> parse_quantity("35MN/m", "stiffness")
-    35000000.0
-    """
+    """``text`` (:data:`PLAIN_QUANTITY`: ``'5e-5'``, ``'inf'``, ``'35 MN/m'``) as an SI float of
+    ``kind`` (a key of :data:`DIMENSIONS`), the float nearest the typed decimal times its
+    unit's factor (``'25um'`` is ``25e-6``)."""
     dimension, si_unit, example = DIMENSIONS[kind]
     if len(text) > TEXT_LIMIT:
         raise ValueError(

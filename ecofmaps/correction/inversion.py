@@ -231,11 +231,25 @@ def _correct(factor, ecof, amplitude, load, stiffness, scar, profile, mapping, r
                 "give the groove one way: aspect_ratio, scar_depth and scar_half_width, or "
                 "profile, not several"
             )
-        return _correct_on_profile(
-            ecof, amplitude, load, stiffness, profile, mapping, return_status, factor, caller
-        )
-    if mapping != "scaled":
+        rig = (ecof, amplitude, load, stiffness)
+        values, status, failure = _correct_on_profile(*rig, profile, mapping, factor, caller)
+    elif mapping != "scaled":
         raise ValueError("mapping applies to a profile only (profile=...)")
+    else:
+        values, status, failure = _correct_on_groove(factor, ecof, amplitude, load, stiffness, scar)
+    if return_status:
+        return values, status
+    if is_concrete(status, values):  # under jax.grad the values alone are traced
+        codes = np.asarray(status)
+        if codes.ndim == 0 and codes != CorrectionStatus.CORRECTED:
+            raise ValueError(failure())
+        first = values[0] if isinstance(values, Interval) else values
+        warn_nan(first, codes, CorrectionStatus, caller)
+    return values
+
+
+def _correct_on_groove(factor, ecof, amplitude, load, stiffness, scar):
+    """Values, status and the reason a single point failed, on a parabolic groove."""
     check_test(ecof, amplitude, load, stiffness)
     ratio = groove_aspect_ratio(*scar)
     ecof, amplitude, load, stiffness = (as_float64(v) for v in (ecof, amplitude, load, stiffness))
@@ -244,21 +258,17 @@ def _correct(factor, ecof, amplitude, load, stiffness, scar, profile, mapping, r
     values = [mu / ecof if factor else mu for mu, _, _ in results]
     status = results[0][1]
     if len(results) == 2:  # the larger aspect ratio allows the smaller mu (docs/model.md)
-        high_end = results[1][1]
-        status = jnp.where(status == int(CorrectionStatus.CORRECTED), high_end, status)
+        status = jnp.where(status == int(CorrectionStatus.CORRECTED), results[1][1], status)
         both = status == int(CorrectionStatus.CORRECTED)
         values = Interval(*(jnp.where(both, v, jnp.nan) for v in (values[1], values[0])))
     else:
         values = values[0]
-    concrete = is_concrete(status, values)  # under jax.grad the values alone are traced
-    if concrete and not return_status:
-        codes = np.asarray(status)
-        if codes.ndim == 0 and codes != CorrectionStatus.CORRECTED:
-            failed = next(r for r in results if np.asarray(r[1]) != CorrectionStatus.CORRECTED)
-            raise ValueError(_failure_message(CorrectionStatus(int(codes)), float(ecof), failed[2]))
-        first = values[0] if isinstance(values, Interval) else values
-        warn_nan(first, codes, CorrectionStatus, caller)
-    return (values, status) if return_status else values
+
+    def failure() -> str:
+        failed = next(r for r in results if np.asarray(r[1]) != CorrectionStatus.CORRECTED)
+        return _failure_message(CorrectionStatus(int(status)), float(ecof), failed[2])
+
+    return values, status, failure
 
 
 def _residual(profile, mu, target, rig, mapping):
@@ -268,10 +278,8 @@ def _residual(profile, mu, target, rig, mapping):
         return np.asarray(numbers["ecof_ratio"]) * np.asarray(mu) - target
 
 
-def _correct_on_profile(
-    ecof, amplitude, load, stiffness, profile, mapping, return_status, factor, caller
-):
-    """correct_ecof / correction_factor on a profile (see correct_ecof's Notes)."""
+def _correct_on_profile(ecof, amplitude, load, stiffness, profile, mapping, factor, caller):
+    """Values, status and the reason a single point failed, on a profile (docs/model.md)."""
     check_mapping(mapping, None)
     profile = as_profile(profile)
     check_test(ecof, amplitude, load, stiffness)
@@ -297,8 +305,7 @@ def _correct_on_profile(
         grid = np.geomspace(_PROFILE_SPAN * target.min(), top, _PROFILE_GRID)
         above = ~(_residual(profile, grid[None, :], target[:, None], rig, mapping) <= 0.0)
         rises = ~above[:, :-1] & above[:, 1:]
-        count = rises.sum(axis=1) + above[:, 0]
-        ambiguous = count > 1
+        ambiguous = rises.sum(axis=1) + above[:, 0] > 1
         first = np.argmax(rises, axis=1)
         low = np.where(above[:, 0], 0.0, grid[first])
         high = np.where(above[:, 0], grid[0], grid[first + 1])
@@ -310,19 +317,15 @@ def _correct_on_profile(
         mu[todo[keep]] = np.where(reached, root, np.nan)
         status[todo[keep][~reached]] = CorrectionStatus.UNREACHABLE
     values = mu / ecof if factor else mu
-    values, status = values.reshape(shape), status.reshape(shape)
-    if not return_status:
-        if status.ndim == 0 and status != CorrectionStatus.CORRECTED:
-            code = CorrectionStatus(int(status))
-            if code == CorrectionStatus.NO_GROSS_SLIP:
-                detail = f"it is at or above stiffness * amplitude / load = {1.0 / lam[0]:.6g}"
-            else:
-                detail = code.reason
-            raise ValueError(
-                f"ecof = {float(ecof[0]):.6g} cannot be corrected on this profile: {detail}"
-            )
-        warn_nan(values, status, CorrectionStatus, caller)
-    return (values, status) if return_status else values
+
+    def failure() -> str:
+        code = CorrectionStatus(int(status[0]))
+        detail = code.reason
+        if code == CorrectionStatus.NO_GROSS_SLIP:
+            detail = f"it is at or above stiffness * amplitude / load = {1.0 / lam[0]:.6g}"
+        return f"ecof = {float(ecof[0]):.6g} cannot be corrected on this profile: {detail}"
+
+    return values.reshape(shape), status.reshape(shape), failure
 
 
 def _illinois(profile, target, low, high, rig, mapping):

@@ -7,7 +7,6 @@ import csv
 import io
 import warnings
 from pathlib import Path
-from typing import NamedTuple
 
 import numpy as np
 
@@ -21,7 +20,6 @@ __all__ = [
     "COLUMNS",
     "SHORTCUT_COLUMN",
     "STATUS_COLUMN",
-    "TableDialect",
     "TableError",
     "TableRowWarning",
     "correct_table",
@@ -63,20 +61,12 @@ class TableRowWarning(UserWarning):
     the 1-based line number and the column, as :class:`TableError` does."""
 
 
-class TableDialect(NamedTuple):
-    """How a table is written: its separator, and whether its numbers use decimal commas."""
-
-    delimiter: str
-    decimal_comma: bool
-
-
-def table_dialect(header_line: str) -> TableDialect:
+def table_dialect(header_line: str) -> str:
     """The separator the header line uses (tab, else ``;``, else ``,``)."""
-    delimiter = "\t" if "\t" in header_line else ";" if ";" in header_line else ","
-    return TableDialect(delimiter, False)
+    return "\t" if "\t" in header_line else ";" if ";" in header_line else ","
 
 
-def _number(path, line: int, name: str, text: str, decimal_comma: bool = False) -> float:
+def _number(path, line: int, name: str, text: str, decimal_comma: bool) -> float:
     """The cell ``text`` of column ``name`` in SI, range-checked (``0,83`` read as 0.83 when the
     table's separator is not a comma)."""
     quantity = nomenclature.QUANTITIES[COLUMNS[name]]
@@ -95,15 +85,15 @@ def _number(path, line: int, name: str, text: str, decimal_comma: bool = False) 
     return value / quantity.display_factor
 
 
-def _read(path: Path, on_profile: bool = False, keep_bad: bool = False):
-    """Header, (row, line) records, SI columns (NaN in a bad row), dialect, and the errors of
-    the bad rows by index (raised at once unless ``keep_bad``)."""
+def _read(path: Path, on_profile: bool, keep_bad: bool):
+    """Header, (row, line) records, SI columns (NaN in a bad row), separator, whether it has
+    decimal commas, and the errors of the bad rows by index (raised at once unless ``keep_bad``)."""
     try:
         with open(path, encoding="utf-8-sig", newline="") as stream:
             lines = ["\n" if line.lstrip().startswith("#") else line for line in stream]
         header_line = next((line for line in lines if line.strip()), ",")
-        dialect = table_dialect(header_line)
-        reader = csv.reader(lines, delimiter=dialect.delimiter)
+        delimiter = table_dialect(header_line)
+        reader = csv.reader(lines, delimiter=delimiter)
         # each non-blank row with the file line it ends on (csv counts the lines it reads)
         records = [(row, reader.line_num) for row in reader if any(cell.strip() for cell in row)]
     except UnicodeDecodeError as error:
@@ -118,7 +108,7 @@ def _read(path: Path, on_profile: bool = False, keep_bad: bool = False):
     if not records:
         raise TableError(path, header_line, "the table has a header but no data rows")
     column = {name: header.index(name) for name in COLUMNS if name in header}
-    commas = dialect.delimiter != ","
+    commas = delimiter != ","
     names = _REQUIRED if on_profile else (*_REQUIRED, "aspect_ratio")
     rows, bad = [], {}
     for index, (row, line) in enumerate(records):
@@ -135,8 +125,7 @@ def _read(path: Path, on_profile: bool = False, keep_bad: bool = False):
             rows.append(dict.fromkeys(names, np.nan))
     si = {name: np.asarray([values[name] for values in rows]) for name in names}
     cells = [row[column[name]] for row, _ in records for name in column]
-    decimal_comma = commas and any("," in cell for cell in cells)
-    return header, records, si, dialect._replace(decimal_comma=decimal_comma), bad
+    return header, records, si, delimiter, commas and any("," in cell for cell in cells), bad
 
 
 def _row_values(path, line: int, row, column: dict, on_profile: bool, commas: bool) -> dict:
@@ -195,44 +184,14 @@ def _check_header(path, line: int, header: list[str], on_profile: bool, keep_bad
 
 
 def correct_table(path, profile=None, mapping="scaled", bad_rows="raise") -> tuple[str, int]:
-    r"""Correct every row of a table of reported ECoF values (format: ``docs/formats.md``).
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The table: separated by commas, semicolons or tabs, with ``#`` comment lines.
-    profile : ScarProfile, optional
-        A measured wear-scar profile that gives every row's scar (the table then has no
-        scar columns).
-    mapping : {'scaled', 'physical'}
-        On a profile: :math:`X = xW/\Delta^*` (eq. 11) or :math:`X = x`.
-    bad_rows : {'raise', 'nan'}
-        A row with a bad value or an ECoF that cannot be corrected raises, or (``'nan'``)
-        gets NaN, with a :class:`TableRowWarning` naming it and a ``status`` column.
-
-    Returns
-    -------
-    text : str
-        The output table with the input's separator: the input columns and cells, then
-        ``mu`` and ``correction_factor`` (both to 10 significant digits, with a decimal
-        comma if the input has them), on a profile ``mu_parabolic``, and when a row could
-        not be corrected ``status`` (each row's :class:`CorrectionStatus` label).
-    rows : int
-        The number of data rows.
-
-    Raises
-    ------
-    TableError
-        For a file that cannot be read as such a table, or (``bad_rows='raise'``) a bad
-        value or a row whose ECoF cannot be corrected (the reason, as
-        :func:`ecofmaps.correct_ecof` gives it); the first such row is named by its line.
-    OSError
-        If the file cannot be opened.
-    """
+    """The table at ``path`` (``docs/formats.md``) with each row's ``mu`` and
+    ``correction_factor`` (on a ``profile``, ``mu_parabolic`` too), as text in the input's
+    dialect, and its number of rows; ``bad_rows='nan'`` gives a bad row NaN, a ``status``
+    and a :class:`TableRowWarning` instead of raising :class:`TableError`."""
     if bad_rows not in ("raise", "nan"):
         raise ValueError(f"bad_rows must be 'raise' or 'nan', got {bad_rows!r}")
     path = Path(path)
-    header, records, si, dialect, bad = _read(path, profile is not None, bad_rows == "nan")
+    header, records, si, sep, commas, bad = _read(path, profile is not None, bad_rows == "nan")
     read = np.ones(len(records), bool)
     read[list(bad)] = False
     rig = {name: si[nomenclature.column(name)][read] for name in ("amplitude", "load", "stiffness")}
@@ -246,7 +205,7 @@ def correct_table(path, profile=None, mapping="scaled", bad_rows="raise") -> tup
         shortcut[read], _ = correct_ecof(
             si["ecof"][read], **rig, aspect_ratio=float(profile.aspect_ratio), return_status=True
         )
-        added = [[_written(value, dialect)] for value in shortcut]
+        added = [[_written(value, commas)] for value in shortcut]
     if read.any():
         mu[read], status[read] = correct_ecof(si["ecof"][read], **rig, **scar, return_status=True)
     for i, index in enumerate(np.flatnonzero(read)):
@@ -261,7 +220,7 @@ def correct_table(path, profile=None, mapping="scaled", bad_rows="raise") -> tup
             raise bad[index]
         warnings.warn(str(bad[index]), TableRowWarning, stacklevel=2)
     stream = io.StringIO()
-    writer = csv.writer(stream, delimiter=dialect.delimiter, lineterminator="\n")
+    writer = csv.writer(stream, delimiter=sep, lineterminator="\n")
     more = ([] if profile is None else [SHORTCUT_COLUMN]) + ([STATUS_COLUMN] if bad else [])
     writer.writerow([*header, *ADDED_COLUMNS, *more])
     for (row, _), value, ecof, cells, code in zip(
@@ -269,12 +228,12 @@ def correct_table(path, profile=None, mapping="scaled", bad_rows="raise") -> tup
     ):
         label = [CorrectionStatus(int(code)).label] if bad else []
         writer.writerow(
-            [*row, _written(value, dialect), _written(value / ecof, dialect), *cells, *label]
+            [*row, _written(value, commas), _written(value / ecof, commas), *cells, *label]
         )
     return stream.getvalue(), len(records)
 
 
-def _written(value: float, dialect: TableDialect) -> str:
+def _written(value: float, decimal_comma: bool) -> str:
     """A result cell: 10 significant digits, with a decimal comma if the table uses them."""
     text = f"{value:.10g}"
-    return text.replace(".", ",") if dialect.decimal_comma else text
+    return text.replace(".", ",") if decimal_comma else text

@@ -90,9 +90,8 @@ class CacheWarning(UserWarning):
 
 @dataclass(frozen=True)
 class CacheEntry:
-    """One file of the cache: its path, the function whose result it holds (``compute_map``,
-    ...), its size [byte], and the times (UTC) of its last write and its last use (read or
-    write; the least recently used entries are removed first)."""
+    """One file of the cache: the function whose result it holds, its size [byte], and the
+    times (UTC) of its last write and last use (the least recently used go first)."""
 
     path: Path
     function: str
@@ -102,17 +101,14 @@ class CacheEntry:
 
 
 def cache_directory(cache_dir=None) -> Path:
-    """The cache directory in use (it need not exist yet): ``cache_dir`` if given, else the
-    ``ECOFMAPS_CACHE`` environment variable, else ``platformdirs.user_cache_dir("ecofmaps")``."""
+    """The cache directory: ``cache_dir``, else ``$ECOFMAPS_CACHE``, else the user's."""
     if cache_dir is not None:
         return Path(cache_dir)
     return Path(os.environ.get(ENVIRONMENT_VARIABLE) or platformdirs.user_cache_dir("ecofmaps"))
 
 
 def cache_size_bound() -> int:
-    """The bytes the cache's entries may take together (0 stores nothing):
-    ``ECOFMAPS_CACHE_SIZE``, else 1 GB; ``ValueError`` if that is not a size (bytes, or a
-    number with a unit among B, kB, MB, GB, TB, KiB, MiB, GiB, TiB: ``500MB``)."""
+    """The bytes the cache may take (0 stores nothing): ``$ECOFMAPS_CACHE_SIZE``, else 1 GB."""
     text = os.environ.get(SIZE_VARIABLE, "").strip()
     if not text:
         return DEFAULT_SIZE_BOUND
@@ -127,8 +123,7 @@ def cache_size_bound() -> int:
 
 @functools.cache
 def model_revision() -> str:
-    """SHA-256 (64 hex digits) of the source of the modules that compute maps: any edit of
-    them gives other cache keys."""
+    """SHA-256 (hex) of the source of the modules that compute maps."""
     package = Path(__file__).resolve().parents[1]
     digest = hashlib.sha256()
     for pattern in _MODEL_SOURCES:
@@ -143,9 +138,8 @@ def _chunked(variable: xr.Variable) -> bool:
 
 
 def metadata_checksum(dataset: xr.Dataset) -> str:
-    """SHA-256 (64 hex digits) of what the chunks' checksums do not cover: every name,
-    dimension, type, shape and attribute (but the checksum's own), and the values of text and
-    scalar variables, of ``dataset`` as read from the file."""
+    """SHA-256 (hex) of what the chunks' checksums do not cover: names, dimensions, types,
+    shapes, attributes, and the values of text and scalar variables."""
     digest = hashlib.sha256()
 
     def add(*parts) -> None:
@@ -168,9 +162,8 @@ def metadata_checksum(dataset: xr.Dataset) -> str:
 
 
 def cache_key(function: str, inputs: Mapping[str, object]) -> str:
-    """SHA-256 key (64 hex digits) of a computation: version, model revision, ``function``,
-    and each of ``inputs`` by name as little-endian float64 bytes with its shape (so a scalar
-    and a one-element array differ)."""
+    """SHA-256 key (hex) of version, model revision, ``function`` and ``inputs`` (by name, as
+    float64 bytes with their shape: a scalar and a one-element array differ)."""
     digest = hashlib.sha256(f"ecofmaps {__version__}\0{model_revision()}\0{function}\0".encode())
     for name, value in inputs.items():
         digest.update(f"{name}\0".encode())
@@ -184,9 +177,8 @@ def cache_key(function: str, inputs: Mapping[str, object]) -> str:
 
 
 def write_netcdf(dataset: xr.Dataset, path, *, exclusive: bool = True) -> Path:
-    """Write ``dataset`` to the netCDF file ``path`` (engine h5netcdf; its directory must
-    exist) atomically, as :func:`ecofmaps.io.files.atomic_path` with ``exclusive``: on any
-    failure ``path`` is left as it was. Returns ``path`` as a :class:`pathlib.Path`."""
+    """``path``, where ``dataset`` is written as netCDF atomically (``path`` is left as it was
+    on any failure)."""
     path = Path(path)
     with atomic_path(path, exclusive=exclusive) as temporary:
         check_room(temporary, dataset.nbytes)
@@ -246,7 +238,7 @@ def _read(path: Path, key: str) -> xr.Dataset:
 
 def _stored(path: Path, key: str) -> xr.Dataset | None:
     """The dataset stored at ``path``, or None: an unusable one is removed, with one warning
-    (and no lines on standard error from finalizers of half-opened HDF5 objects)."""
+    (and no noise from finalizers of half-opened HDF5 objects)."""
     hook = sys.unraisablehook
     sys.unraisablehook = _ignored
     try:
@@ -265,11 +257,10 @@ def _stored(path: Path, key: str) -> xr.Dataset | None:
 
 
 def _ignored(unraisable) -> None:
-    """Ignore an exception raised in a finalizer."""
+    pass
 
 
 def _reason(error: BaseException) -> str:
-    """``error`` in one line."""
     text = " ".join(str(error).split()) or "no reason given"
     if isinstance(error, OSError) and error.strerror:
         text = error.strerror  # h5py's messages run over several lines with their buffers
@@ -300,13 +291,8 @@ def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
 def cached_dataset(
     function: str, inputs: Mapping[str, object], compute: Callable[[], xr.Dataset], cache_dir=None
 ) -> xr.Dataset:
-    """The result of ``compute()`` (called without arguments), read from the cache, else
-    computed and stored: identical either way. ``function`` (a Python identifier) and
-    ``inputs`` (everything the result depends on) make the key (:func:`cache_key`); the cache
-    is :func:`cache_directory` ``(cache_dir)``. ``ValueError`` if ``ECOFMAPS_CACHE_SIZE`` is
-    not a size (:func:`cache_size_bound`); a :class:`CacheWarning` in one line when the file
-    is unusable (it is removed, the result recomputed) or the result cannot be stored for any
-    reason (it is returned all the same)."""
+    """``compute()``, read from the cache under the key of ``function`` and ``inputs`` (all
+    the result depends on), else computed and stored (a :class:`CacheWarning` if it cannot)."""
     directory = cache_directory(cache_dir)
     bound = cache_size_bound()  # a bad ECOFMAPS_CACHE_SIZE is refused before any work
     key = cache_key(function, inputs)

@@ -433,18 +433,18 @@ def compute_profile_map(
         grid = [np.atleast_1d(a) for a in axes.values()]
         points = [axis.ravel() for axis in np.meshgrid(*grid, indexing="ij")]
         names = ("slip_ratio", "ecof_ratio", "regime", "normalized_energy", "normalized_max_force")
+        # λ = P/(S Δ*) = 1/((S/P) Δ*): a unit load and the stiffness ratio
+        tiles = [
+            steady_numbers(profile, a, 1.0, s, m, mapping=mapping)
+            for s, a, m in zip(
+                *(np.split(p, range(max_chunk, p.size, max_chunk)) for p in points), strict=True
+            )
+        ]
+        shape = tuple(axis.size for axis in grid)
         values = {
-            name: np.empty(points[0].shape, dtype=np.int32 if name == "regime" else np.float64)
+            name: np.concatenate([np.asarray(t[name]) for t in tiles]).reshape(shape)
             for name in names
         }
-        for start in range(0, points[0].size, max_chunk):
-            stiffness, amplitude, mu = (p[start : start + max_chunk] for p in points)
-            # λ = P/(S Δ*) = 1/((S/P) Δ*): a unit load and the stiffness ratio
-            numbers = steady_numbers(profile, amplitude, 1.0, stiffness, mu, mapping=mapping)
-            for name in names:
-                values[name][start : start + max_chunk] = np.asarray(numbers[name])
-        shape = tuple(axis.size for axis in grid)
-        values = {name: value.reshape(shape) for name, value in values.items()}
         values.update(steady_values(values, grid[1][None, :, None], load, grid[2][None, None, :]))
         del values["normalized_energy"], values["normalized_max_force"]
         title = "ECoF map of the compliant wear-scar model on a scar profile"

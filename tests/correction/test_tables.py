@@ -47,9 +47,9 @@ def test_tabs_and_semicolons_without_decimal_commas(tmp_path):
 
 
 def test_dialect_is_the_header_s_separator():
-    assert table_dialect("ecof\tload_N;x,y").delimiter == "\t"
-    assert table_dialect("ecof;load_N").delimiter == ";"
-    assert table_dialect("ecof,load_N").delimiter == ","
+    assert table_dialect("ecof\tload_N;x,y") == "\t"
+    assert table_dialect("ecof;load_N") == ";"
+    assert table_dialect("ecof,load_N") == ","
 
 
 @pytest.mark.parametrize(
