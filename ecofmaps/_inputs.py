@@ -61,21 +61,6 @@ def to_si(name: str, value, quantity: str | None = None):
     return value
 
 
-@contextlib.contextmanager
-def _shapes_named(caller: str, shapes: list):
-    """A failed broadcast inside as a ``ValueError`` naming the first two ``shapes`` that clash."""
-    try:
-        yield
-    except (TypeError, ValueError) as error:
-        clash = "broadcast" in str(error) and next(_clashes(shapes), None)
-        if not clash:
-            raise
-        raise ValueError(
-            f"ecofmaps.{caller}: the shapes of {clash} do not broadcast together: give arrays "
-            "of one shape, or shapes NumPy broadcasts (equal or 1 in each trailing axis)"
-        ) from None
-
-
 def _clashes(shapes: list):
     for (first, one), (second, other) in itertools.combinations(shapes, 2):
         try:
@@ -106,8 +91,17 @@ def si_units(function=None, **kinds):
                     with contextlib.suppress(TypeError, ValueError):  # ragged: checked elsewhere
                         shapes.append((name, tuple(np.shape(item))))
         check_broadcast_size(function.__name__, [shape for _, shape in shapes])
-        with _shapes_named(function.__name__, shapes):
+        try:
             return function(*bound.args, **bound.kwargs)
+        except (TypeError, ValueError) as error:
+            clash = "broadcast" in str(error) and next(_clashes(shapes), None)
+            if not clash:
+                raise
+            raise ValueError(
+                f"ecofmaps.{function.__name__}: the shapes of {clash} do not broadcast together: "
+                "give arrays of one shape, or shapes NumPy broadcasts (equal or 1 in each "
+                "trailing axis)"
+            ) from None
 
     return wrapper
 

@@ -216,9 +216,7 @@ def axis_label(name: str, plain: bool = False) -> str:
 def column(name: str) -> str:
     """The column name of quantity ``name`` in tables: the name and its display unit."""
     unit = QUANTITIES[name].display_unit
-    if not unit:
-        return name
-    return f"{name}_{unit.replace('µ', 'u').replace('/', '_per_')}"
+    return f"{name}_{unit.replace('µ', 'u').replace('/', '_per_')}" if unit else name
 
 
 def display(name: str, value) -> np.ndarray:

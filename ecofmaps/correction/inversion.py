@@ -65,10 +65,8 @@ def _root(ecof, kappa, lam):
         following = jnp.where(done, mu, following)
         return following, low, high, jnp.abs(following - mu), done | converged, step + 1
 
-    done = jnp.zeros(ecof.shape, dtype=bool)
-    state = (start, low, high, high - low, done, 0)
-    mu, *_ = jax.lax.while_loop(unfinished, newton, state)
-    return mu
+    state = (start, low, high, high - low, jnp.zeros(ecof.shape, dtype=bool), 0)
+    return jax.lax.while_loop(unfinished, newton, state)[0]
 
 
 @_root.defjvp

@@ -3,8 +3,6 @@ and SciPy: docs/model.md, "Correcting a reported ECoF"."""
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from ecofmaps._codes import warn_nan
@@ -131,11 +129,8 @@ def lookup_correction(
     query = {"stiffness_ratio": stiffness / load, "aspect_ratio": ratio, "amplitude": amplitude}
     query = {name: value.ravel() for name, value in query.items()}
     inside = np.ones(ecof.size, dtype=bool)
-    for name, value in fixed.items():
-        if math.isfinite(value):
-            inside &= np.abs(query[name] - value) <= 1e-9 * abs(value)
-        else:  # a rigid rig
-            inside &= query[name] == value
+    for name, value in fixed.items():  # inf (a rigid rig) is close to itself only
+        inside &= np.isclose(query[name], value, rtol=1e-9, atol=0.0)
     points = []
     for name, values, _ in axes:
         coordinate = 1.0 / query[name] if name == "stiffness_ratio" else query[name]

@@ -185,11 +185,8 @@ def ecof_fall(kappa, lam):
         return jnp.where(up, middle, rise), jnp.where(up, fall, middle)
 
     rise, fall = jax.lax.fori_loop(0, _FALL_BISECTIONS, halve, (rise, fall))
-    extremum = jnp.exp(0.5 * (rise + fall))
-    value, _ = ecof_and_slope(extremum, kappa, lam)
-    high = jnp.where(found, value[..., 0], jnp.nan)
-    low = jnp.where(found, value[..., 1], jnp.nan)
-    return high, low
+    value, _ = ecof_and_slope(jnp.exp(0.5 * (rise + fall)), kappa, lam)
+    return jnp.where(found, value[..., 0], jnp.nan), jnp.where(found, value[..., 1], jnp.nan)
 
 
 def ambiguity_marked(mu, status, ecof, high, low):

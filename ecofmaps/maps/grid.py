@@ -176,10 +176,9 @@ def compute_map(
 
     Notes
     -----
-    The closed forms of eq. 16 (slip amplitude), the corrected eq. 13-15 (:math:`\mu_E`),
-    eq. 12 (:math:`E_d = 4P\delta^*\mu_E`) and eq. 9 (:math:`Q^*`); through :math:`S`,
-    :math:`P` and :math:`\Delta^*` the map depends on :math:`\lambda` only
-    (:func:`compute_universal_map`).
+    Closed forms: eq. 16 (:math:`\delta^*`), the corrected eq. 13-15 (:math:`\mu_E`), eq. 12
+    (:math:`E_d`), eq. 9 (:math:`Q^*`); they depend on :math:`S`, :math:`P` and
+    :math:`\Delta^*` only through :math:`\lambda` (:func:`compute_universal_map`).
 
     References
     ----------
@@ -339,8 +338,8 @@ def compute_loops(stiffness, aspect_ratio, amplitude, load, mu, num=201) -> xr.D
 
     Notes
     -----
-    Slip branches from eq. 9 with eq. 10, stick segments of slope :math:`S`; the per-loop
-    quantities from eq. 16 (:math:`\delta^*`), eq. 9 (:math:`Q^*`) and eq. 12 (:math:`E_d`).
+    Slip branches of eq. 9-10 joined by stick segments of slope :math:`S`; eq. 16 gives
+    :math:`\delta^*`, eq. 9 :math:`Q^*`, eq. 12 :math:`E_d`.
 
     References
     ----------
@@ -353,8 +352,9 @@ def compute_loops(stiffness, aspect_ratio, amplitude, load, mu, num=201) -> xr.D
     )
     grid = jnp.broadcast_arrays(*_mesh(*(np.atleast_1d(a) for a in axes.values())))
     values = jax.device_get(_loop_kernel(*grid))
-    loop = fretting_loop(grid[2], grid[3], grid[0], grid[4], grid[1], num=num)
-    values["displacement"], values["force"] = loop
+    values["displacement"], values["force"] = fretting_loop(
+        grid[2], grid[3], grid[0], grid[4], grid[1], num=num
+    )
     values = {name: np.asarray(value) for name, value in values.items()}
     return grid_dataset(axes, values, "Steady fretting loops", {"point": np.arange(2 * num + 1)})
 

@@ -145,15 +145,14 @@ def _evaluate_grid(kernel, axes, extra, max_chunk: int) -> dict[str, np.ndarray]
 
 def _block_lengths(chunks, shape, dims, split) -> list[int]:
     """The block length along each axis that ``chunks`` asks for (see :func:`compute_map`)."""
-    usage = (
-        "chunks must be 'auto', an integer >= 1 (grid points per block) or a dict of block "
-        "lengths by dimension name"
-    )
     if isinstance(chunks, str) and chunks == "auto":
         chunks = BLOCK_POINTS
     whole = isinstance(chunks, (int, np.integer)) and not isinstance(chunks, bool)
     if not ((whole and chunks >= 1) or isinstance(chunks, Mapping)):
-        raise ValueError(f"{usage}, got {chunks!r}")
+        raise ValueError(
+            "chunks must be 'auto', an integer >= 1 (grid points per block) or a dict of block "
+            f"lengths by dimension name, got {chunks!r}"
+        )
     if whole:
         k, rows = _split(shape, int(chunks))
         if k == split[0] and rows > split[1]:  # whole tiles: none is evaluated twice
