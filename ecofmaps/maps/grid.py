@@ -85,8 +85,8 @@ def _universal_kernel(compliance_ratio, aspect_ratio, mu):
     return _broadcast(_steady_state(mu, kappa, lam), axes)
 
 
-def _cached(cache, chunks) -> bool:
-    """Whether a closed-form map is cached; ``cache=True`` for a chunked map is refused."""
+def _cached(function: str, inputs: dict, compute, cache, chunks, cache_dir) -> xr.Dataset:
+    """``compute()``, through the disk cache if ``cache`` (refused for a chunked map)."""
     if cache not in (None, True, False):
         raise ValueError(f"cache must be True, False or None, got {cache!r}")
     if cache and chunks is not None:
@@ -94,7 +94,7 @@ def _cached(cache, chunks) -> bool:
             "cache=True with chunks: a chunked map is not cached (it is evaluated block by "
             "block where it is written); leave cache out"
         )
-    return bool(cache)
+    return cached_dataset(function, inputs, compute, cache_dir) if cache else compute()
 
 
 @float64
@@ -227,9 +227,7 @@ def compute_map(
         values = grid_values(_map_kernel, axes, (load,), max_chunk, chunks)
         return map_dataset(axes, values, load, "ECoF map of the compliant wear-scar model")
 
-    if not _cached(cache, chunks):
-        return compute()
-    return cached_dataset("compute_map", {**axes, "load": load}, compute, cache_dir)
+    return _cached("compute_map", {**axes, "load": load}, compute, cache, chunks, cache_dir)
 
 
 @float64
@@ -287,9 +285,7 @@ def compute_universal_map(
         values = grid_values(_universal_kernel, axes, (), max_chunk, chunks)
         return grid_dataset(axes, values, "Universal ECoF map of the compliant wear-scar model")
 
-    if not _cached(cache, chunks):
-        return compute()
-    return cached_dataset("compute_universal_map", axes, compute, cache_dir)
+    return _cached("compute_universal_map", axes, compute, cache, chunks, cache_dir)
 
 
 @jax.jit
