@@ -202,24 +202,6 @@ def groove_aspect_ratio(aspect_ratio, scar_depth, scar_half_width):
     return as_float64(scar_depth) / as_float64(scar_half_width)
 
 
-def _failure_message(status, ecof, details) -> str:
-    """The reason a concrete single-point correction failed, with the numbers."""
-    kappa, lam, high, low = (float(np.asarray(v)) for v in details)
-    if status == CorrectionStatus.NO_GROSS_SLIP:
-        return (
-            f"ecof = {ecof:.6g} cannot be corrected: it is at or above stiffness * amplitude "
-            f"/ load = {1.0 / lam:.6g}, and every gross-slip loop with these test conditions "
-            "has a smaller energy CoF (a contact CoF that high would stop gross slip). "
-            "Check the amplitude, load and stiffness."
-        )
-    return (
-        f"ecof = {ecof:.6g} cannot be corrected uniquely: with this deep groove "
-        f"(z_o/x_o = {kappa / 2.0:.6g}) and stiff rig (load / (stiffness * amplitude) = "
-        f"{lam:.6g}) the energy CoF falls from {high:.6g} to {low:.6g} as mu rises, and "
-        "three contact CoFs give any value between."
-    )
-
-
 def _correct(factor, ecof, amplitude, load, stiffness, scar, profile, mapping, return_status):
     """correct_ecof, or correction_factor if ``factor``; ``scar``: the three ways to give it."""
     caller = "correction_factor" if factor else "correct_ecof"
@@ -264,7 +246,20 @@ def _correct_on_groove(factor, ecof, amplitude, load, stiffness, scar):
 
     def failure() -> str:
         failed = next(r for r in results if np.asarray(r[1]) != CorrectionStatus.CORRECTED)
-        return _failure_message(CorrectionStatus(int(status)), float(ecof), failed[2])
+        kappa, lam, high, low = (float(np.asarray(v)) for v in failed[2])
+        if int(status) == CorrectionStatus.NO_GROSS_SLIP:
+            return (
+                f"ecof = {float(ecof):.6g} cannot be corrected: it is at or above stiffness * "
+                f"amplitude / load = {1.0 / lam:.6g}, and every gross-slip loop with these test "
+                "conditions has a smaller energy CoF (a contact CoF that high would stop gross "
+                "slip). Check the amplitude, load and stiffness."
+            )
+        return (
+            f"ecof = {float(ecof):.6g} cannot be corrected uniquely: with this deep groove "
+            f"(z_o/x_o = {kappa / 2.0:.6g}) and stiff rig (load / (stiffness * amplitude) = "
+            f"{lam:.6g}) the energy CoF falls from {high:.6g} to {low:.6g} as mu rises, and "
+            "three contact CoFs give any value between."
+        )
 
     return values, status, failure
 
