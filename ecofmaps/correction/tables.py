@@ -104,7 +104,9 @@ def _read(path: Path, on_profile: bool, keep_bad: bool):
         raise TableError(path, 1, "the file is empty; expected a header line")
     (header, header_line), records = records[0], records[1:]
     header = [name.strip() for name in header]
-    _check_header(path, header_line, header, on_profile, keep_bad)
+    problem = _header_problem(header, on_profile, keep_bad)
+    if problem:
+        raise TableError(path, header_line, problem)
     if not records:
         raise TableError(path, header_line, "the table has a header but no data rows")
     column = {name: header.index(name) for name in COLUMNS if name in header}
@@ -152,35 +154,28 @@ def _row_values(path, line: int, row, column: dict, on_profile: bool, commas: bo
     return values
 
 
-def _check_header(path, line: int, header: list[str], on_profile: bool, keep_bad: bool) -> None:
+def _header_problem(header: list[str], on_profile: bool, keep_bad: bool) -> str | None:
+    """What is wrong with the header line, or None."""
     duplicates = sorted({name for name in header if header.count(name) > 1})
     if duplicates:
-        raise TableError(path, line, f"repeated column(s) {', '.join(duplicates)}")
-    if on_profile:
-        shapes = [name for name in ("aspect_ratio", *_SCAR) if name in header]
-        if shapes:
-            raise TableError(
-                path,
-                line,
-                f"column(s) {', '.join(shapes)} give the scar, but so does the "
-                "profile: drop the columns, or correct without the profile",
-            )
+        return f"repeated column(s) {', '.join(duplicates)}"
+    shapes = [name for name in ("aspect_ratio", *_SCAR) if name in header] if on_profile else []
+    if shapes:
+        return (
+            f"column(s) {', '.join(shapes)} give the scar, but so does the profile: drop the "
+            "columns, or correct without the profile"
+        )
     missing = [name for name in _REQUIRED if name not in header]
     if not on_profile and "aspect_ratio" not in header and not all(n in header for n in _SCAR):
         missing.append("aspect_ratio (or " + " + ".join(_SCAR) + ")")
     if missing:
-        raise TableError(
-            path,
-            line,
+        return (
             f"missing column(s) {', '.join(missing)}; the table needs {', '.join(_REQUIRED)} "
-            f"and aspect_ratio or {' + '.join(_SCAR)}",
+            f"and aspect_ratio or {' + '.join(_SCAR)}"
         )
     added = (*ADDED_COLUMNS, *[SHORTCUT_COLUMN] * on_profile, *[STATUS_COLUMN] * keep_bad)
     taken = [name for name in added if name in header]
-    if taken:
-        raise TableError(
-            path, line, f"column(s) {', '.join(taken)} would be overwritten by the results"
-        )
+    return f"column(s) {', '.join(taken)} would be overwritten by the results" if taken else None
 
 
 def correct_table(path, profile=None, mapping="scaled", bad_rows="raise") -> tuple[str, int]:
