@@ -15,6 +15,7 @@ from ecofmaps.model.regimes import regime_condition, sliding_condition_of
 __all__ = [
     "MINDLIN_ENERGY_RATIO",
     "MINDLIN_OPENING_RATIO",
+    "campaign_of",
     "fitted_line",
     "line_root",
     "per_cycle",
@@ -22,7 +23,6 @@ __all__ = [
     "set_with_se",
     "sliding_condition",
     "sliding_condition_line",
-    "tests_of",
     "transition",
 ]
 
@@ -49,7 +49,7 @@ _PEAK_BIASED = (
 )
 
 
-def tests_of(results) -> list:
+def campaign_of(results) -> list:
     """``results`` as a list of Datasets (one test, or a campaign)."""
     tests = list(results) if isinstance(results, list | tuple) else [results]
     for test in tests:
@@ -196,7 +196,7 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
     >>> condition.attrs["sliding_condition"], round(float(condition.contact_energy_ratio[0]), 3)
     ('gross slip', 1.0)
     """
-    (results,) = tests_of(results)
+    (results,) = campaign_of(results)
     names = ("amplitude", "max_force", "dissipated_energy", "slip_amplitude")
     cycles = per_cycle(results, names + ("gicof",) * ("gicof" in results))
     ratios, ratio, gross, _ = _ratios(cycles, _spring([results], rig_stiffness))
@@ -283,7 +283,7 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     16.0 µm, mu_t = 0.80
     """
     names = ("amplitude", "max_force", "dissipated_energy")
-    tests = tests_of(results)
+    tests = campaign_of(results)
     rig_stiffness = _spring(tests, rig_stiffness)
     names += ("gicof",) * all("gicof" in test for test in tests)
     cycles = [per_cycle(test, names) for test in tests]

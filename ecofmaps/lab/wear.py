@@ -10,12 +10,12 @@ import xarray as xr
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._inputs import check, si_units
 from ecofmaps.lab.regime import (
+    campaign_of,
     fitted_line,
     line_root,
     per_cycle,
     rig_of,
     set_with_se,
-    tests_of,
 )
 from ecofmaps.model.profiles import ScarProfile
 from ecofmaps.model.simulation import fretting_loop
@@ -191,7 +191,7 @@ def energy_wear(results, profile, length=None, contact="line") -> xr.Dataset:
     >>> print(f"{float(round_scar.wear_volume) * 1e18:.0f} µm³")
     47119 µm³
     """
-    tests = tests_of(results)
+    tests = campaign_of(results)
     single = not isinstance(results, list | tuple)
     several = isinstance(profile, list | tuple) and not isinstance(profile, ScarProfile)
     profiles = list(profile) if several else [profile]
@@ -232,7 +232,7 @@ def energy_wear(results, profile, length=None, contact="line") -> xr.Dataset:
 
 def _reading(results, resolved):
     """The rows of the last cycle with a GICoF, a kept loop and a reading along the stroke."""
-    (results,) = tests_of(results)
+    (results,) = campaign_of(results)
     if "loop_displacement" not in results or "gicof" not in results:
         raise ValueError(
             "results: no loops ('loop_displacement', 'loop_force') or no 'gicof': give "
