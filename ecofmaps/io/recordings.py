@@ -156,20 +156,8 @@ def _text_recordings(path: Path, options: dict, block_bytes, samples=None) -> It
             joined = {role: np.concatenate([p[0][role] for p in pending]) for role in columns}
             lines = np.concatenate([p[1] for p in pending])
             count = held if samples is None else min(samples, held)
-            empty = [
-                role for role in joined if samples is None and not np.isfinite(joined[role]).any()
-            ]
-            if empty:  # a column of which every sample is missing
-                role = empty[0]
-                hint = "is it the right column?"
-                if role == "cycle":
-                    hint = "cycle_column=False (--cycle-col none) reads no cycle column"
-                raise RecordingError(
-                    path,
-                    layout.header_line,
-                    f"the {role} column {columns[role]!r} holds no number: "
-                    f"all its {joined[role].size} samples are missing; {hint}",
-                )
+            if samples is None:
+                _check_not_empty(path, layout.header_line, joined, columns)
             yield Recording(
                 path=path,
                 **{role: values[:count] for role, values in joined.items()},
@@ -186,6 +174,21 @@ def _text_recordings(path: Path, options: dict, block_bytes, samples=None) -> It
             first += count
     if first == 0:
         raise RecordingError(path, layout.header_line, "no data after the header")
+
+
+def _check_not_empty(path: Path, header_line: int, values: dict, columns: dict) -> None:
+    """Refuse a column of which every sample is missing."""
+    for role, data in values.items():
+        if not np.isfinite(data).any():
+            hint = "is it the right column?"
+            if role == "cycle":
+                hint = "cycle_column=False (--cycle-col none) reads no cycle column"
+            raise RecordingError(
+                path,
+                header_line,
+                f"the {role} column {columns[role]!r} holds no number: "
+                f"all its {data.size} samples are missing; {hint}",
+            )
 
 
 def read_recording(
