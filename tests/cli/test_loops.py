@@ -392,3 +392,12 @@ def test_a_sweep_prints_its_transition(tmp_path, capsys, rig):
     assert float(contact.split()[0]) == pytest.approx(contact_at, abs=0.01)  # printed to 0.01
     docs = (Path(__file__).parents[2] / "docs" / "lab.md").read_text()
     assert "".join(f"    {line.strip()}\n" for line in err.splitlines()[-2:]) in docs
+
+
+def test_the_help_names_every_column_of_the_table(capsys):
+    """``ecofmaps loops --help`` lists each column the table can hold."""
+    status, out, _ = run(capsys, "--help")
+    assert status == 0
+    text = " ".join(out.split())
+    missing = [column for column in RESULT_COLUMNS if column not in text]
+    assert not missing, missing
