@@ -35,8 +35,6 @@ __all__ = [
 ]
 
 _NAN_POLICIES = ("propagate", "raise")
-#: The parameters of :func:`read_recording` that are not options of the readers.
-_NOT_READ = ("path", "lazy", "chunks", "block_bytes")
 _MAGIC = {b"TDSm": "tdms", b"\x89HDF\r\n\x1a\n": "hdf5"}
 _NETCDF3 = (b"CDF\x01", b"CDF\x02")
 _SUFFIXES = {
@@ -275,7 +273,17 @@ def read_recording(
     >>> recording.size, recording.units["displacement"], recording.lazy
     (24000, 'um', False)
     """
-    options = _options(**{name: value for name, value in locals().items() if name not in _NOT_READ})
+    options = _options(
+        displacement_column,
+        force_column,
+        cycle_column,
+        displacement_unit,
+        force_unit,
+        group,
+        nan_policy,
+        load_column,
+        skip_rows,
+    )
     if lazy not in (None, True, False):
         raise ValueError(f"lazy must be True, False or None; got {lazy!r}")
     _check_count("chunks", chunks)
