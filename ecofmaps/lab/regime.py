@@ -34,9 +34,10 @@ MINDLIN_OPENING_RATIO = 2 ** (1 / 3) - 1
 _SAME_AMPLITUDE = 0.01
 #: Cycles where the regime changes that :func:`sliding_condition_line` names.
 _CHANGES_SHOWN = 5
-#: Fewest ``mindlin-stick`` cycles whose spring stands for an unknown rig's stiffness, and
-#: fewest sure gross-slip cycles whose GICoF stands for the sliding friction.
+#: Fewest ``mindlin-stick`` cycles whose spring stands for an unknown rig's stiffness.
 _SPRINGS = 3
+#: Fewest cycles surely in gross slip whose GICoF stands for the sliding friction.
+_SURE_CYCLES = 3
 #: Q*/P within this many robust standard deviations of the sliding friction has saturated.
 _SATURATED_SPREAD = 3.0
 #: Q*/P within this share of the sliding friction has saturated, whatever the spread. [1]
@@ -126,9 +127,9 @@ def _ratios(cycles: dict, rig_stiffness):
     ratio = regime_ratio(ratios, rig_stiffness)
     gross = ratio > MINDLIN_ENERGY_RATIO
     saturated = None if rig_stiffness is not None else _saturated(cycles, gross)
-    if saturated is None:
-        return ratios, ratio, gross, False
-    return ratios, ratio, gross | saturated, True
+    if saturated is not None:
+        gross = gross | saturated
+    return ratios, ratio, gross, saturated is not None
 
 
 def _saturated(cycles: dict, gross):
@@ -138,7 +139,7 @@ def _saturated(cycles: dict, gross):
     cof = cycles["max_force"] / cycles["load"]
     friction = cycles.get("gicof", np.full(cof.shape, np.nan))
     sure = gross & np.isfinite(friction) & np.isfinite(cof)
-    if np.count_nonzero(sure) < _SPRINGS:
+    if np.count_nonzero(sure) < _SURE_CYCLES:
         return None
     mu = float(np.median(friction[sure]))
     spread = 1.4826 * float(np.median(np.abs(cof[sure] - np.median(cof[sure]))))
@@ -330,7 +331,7 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     fitted = (level >= low) & (level <= high)
     below, above = amplitude[level == low].mean(), amplitude[level == high].mean()
     if by_force:  # where Q* reaches μP: between the two amplitudes
-        at, at_se = 0.5 * (below + above), np.nan
+        at, at_se = 0.5 * (below + above), 0.0
     else:
         at, at_se = line_root(*fitted_line(amplitude[fitted], ratio[fitted]), MINDLIN_ENERGY_RATIO)
     # the crossing may lie anywhere between the two amplitudes
