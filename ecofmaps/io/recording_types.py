@@ -48,8 +48,8 @@ SI_UNITS = {"displacement": "m", "force": "N", "cycle": "1", "load": "N"}
 
 
 def si_values(values: np.ndarray, factor: float) -> np.ndarray:
-    """``values`` (changed in place) times ``factor`` to SI; a factor 10^-k divides by the
-    exact 10^k, so that ``25`` in µm is the float nearest 25e-6 (one rounding, not two)."""
+    """``values`` (changed in place) times ``factor``; a factor 10^-k divides by the exact 10^k,
+    so that ``25`` µm is the float nearest 25e-6 m (one rounding, not two)."""
     if factor == 1.0:
         return values
     inverse = round(1.0 / factor)
@@ -67,25 +67,24 @@ class RecordingError(FileLineError):
     ----------
     path : str or os.PathLike
     line : int, str or None
-        The 1-based line of a text file; or, in a file without lines, a position such as
-        ``"channel 'Rig/force', sample 1200"``; or None for the file as a whole.
+        The 1-based line of a text file; in a file without lines, a position such as
+        ``"channel 'Rig/force', sample 1200"``; None for the file as a whole.
     message : str
-        What is wrong, without the file and the position (kept as the attribute
-        ``message``; ``line`` is the line or None, ``position`` ``'line 12'``, the position
-        given or ``''``).
+        What is wrong (the attribute ``message``; ``position`` is ``'line 12'``, the
+        position given, or ``''``).
     """
 
 
 class _MissingFile(FileNotFoundError):
-    """A file that is not there, said as ``<path>: no such file[: did you mean ...]``."""
+    """Said as ``<path>: no such file[: did you mean ...]``."""
 
     def __str__(self) -> str:
         return f"{self.filename}: {self.strerror}"
 
 
 def check_regular_file(path) -> None:
-    """Refuse (:class:`RecordingError`) a ``path`` that is not a regular file: a pipe, device or
-    socket blocks or never ends. ``FileNotFoundError`` names the nearest name in its folder."""
+    """Refuse a pipe, device or socket (it blocks or never ends); a missing file's error names
+    the nearest name in its folder."""
     try:
         mode = os.stat(path).st_mode
     except FileNotFoundError:
@@ -103,20 +102,19 @@ def check_regular_file(path) -> None:
 
 
 class RecordingWarning(UserWarning):
-    """Something in a recording was read in a way the user should know (e.g. as Latin-1)."""
+    """A recording read in a way the user should know (e.g. as Latin-1)."""
 
 
 @dataclasses.dataclass(frozen=True)
 class LineIndex:
     """The 1-based line of each sample of a text file, as runs: from sample ``starts[k]`` on,
-    line = sample + ``offsets[k]`` (comment and blank lines start new runs)."""
+    line = sample + ``offsets[k]``."""
 
     starts: np.ndarray
     offsets: np.ndarray
 
     @classmethod
     def build(cls, lines: np.ndarray, first: int = 0) -> LineIndex:
-        """From the line numbers of consecutive samples, the first being sample ``first``."""
         offset = lines - np.arange(first, first + lines.size)
         runs = np.concatenate([[0], np.flatnonzero(np.diff(offset)) + 1])
         return cls(runs + first, offset[runs])
@@ -129,36 +127,29 @@ class LineIndex:
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class Recording:
-    """The samples read from a recording file, in SI units.
-
-    The arrays are NumPy arrays, or dask arrays for a rig file read lazily:
-    ``recording[start:stop]`` reads one range into memory and :meth:`compute` all of it.
+    """The samples read from a recording file, in SI units: NumPy arrays, or dask arrays for a
+    rig file read lazily (``recording[start:stop]`` reads a range, :meth:`compute` all).
 
     Attributes
     ----------
     path : pathlib.Path
-    displacement : numpy.ndarray or dask.array.Array
-        [m]; NaN where a sample is missing.
-    force : numpy.ndarray or dask.array.Array
-        [N]; NaN where a sample is missing.
+    displacement, force : numpy.ndarray or dask.array.Array
+        [m] and [N]; NaN where a sample is missing.
     cycle : numpy.ndarray or dask.array.Array or None
         The cycle number of each sample, if the file has a cycle column. [1]
     load : numpy.ndarray or dask.array.Array or None
-        The recorded normal load, if a load column was asked for (``load_column``). [N]
+        The recorded normal load, if ``load_column`` was given. [N]
     last_line : int or None
         1-based line number of the last sample, for a text file.
-    columns : Mapping[str, str]
-        For each of ``'displacement'``, ``'force'`` (and ``'cycle'``): the column, channel
-        or variable it was read from, as named in the file.
-    units : Mapping[str, str]
-        The unit each column was read in (``'um'``, ``'kN'``, ...).
+    columns, units : Mapping[str, str]
+        For each role read: the column, channel or variable as named in the file, and the
+        unit it was read in (``'um'``, ``'kN'``, ...).
     start : int
         0-based index in the file of the first sample (non-zero for a block).
     format : str or None
-        The file's format: ``'text'``, ``'tdms'``, ``'hdf5'`` or ``'zarr'``.
+        ``'text'``, ``'tdms'``, ``'hdf5'`` or ``'zarr'``.
     assumed_units : tuple of str
-        The roles (``'displacement'``, ``'force'``, ``'load'``) whose unit was assumed (the
-        default, µm or N) because neither the file nor an option gave one.
+        The roles whose unit neither the file nor an option gave (the default, µm or N).
     """
 
     path: Path
@@ -194,32 +185,20 @@ class Recording:
 
     @functools.cached_property
     def missing(self):
-        """Mask of the missing samples (NaN in any column read): numpy or dask, as the data.
-
-        Examples
-        --------
-        The lines of the missing samples of a text file:
-        ``recording.line(np.flatnonzero(recording.missing))``.
-        """
+        """Mask of the missing samples (NaN in any column read): numpy or dask, as the data."""
         return ~functools.reduce(np.logical_and, map(np.isfinite, self.arrays().values()))
 
     def line(self, index):
-        """1-based line numbers of samples in a text file (None for other formats).
-
-        Parameters
-        ----------
-        index : int or array_like of int
-            0-based sample indices in this recording (or block).
-        """
+        """1-based line numbers in a text file (None for other formats) of samples ``index``
+        (int or array_like, 0-based in this recording or block)."""
         if self.lines is None:
             return None
         lines = self.lines(np.asarray(index) + self.start)
         return int(lines) if np.ndim(lines) == 0 else lines
 
     def position(self, index=None) -> str | int | None:
-        """Where sample ``index`` is in the file: its line (int) for a text file, else
-        ``'sample N'`` (0-based in the file); for ``index=None`` the end of the file (its
-        last line, or None)."""
+        """Where sample ``index`` is: its line (int) in a text file, else ``'sample N'`` (0-based
+        in the file); for ``index=None`` the end of the file (its last line, or None)."""
         if index is None:
             return self.last_line
         if self.lines is not None:
@@ -227,8 +206,8 @@ class Recording:
         return f"sample {self.start + int(index)}"
 
     def error(self, message: str, index=None) -> RecordingError:
-        """A :class:`RecordingError` naming the file and the position of sample ``index``
-        (by default the end of the file), e.g. for an analysis that fails on the samples."""
+        """A :class:`RecordingError` naming the file and the position of sample ``index`` (by
+        default the end of the file)."""
         return RecordingError(self.path, self.position(index), message)
 
     def __getitem__(self, key: slice) -> Recording:
@@ -248,9 +227,8 @@ class Recording:
         return dataclasses.replace(self, **taken, last_line=last, start=self.start + first)
 
     def close(self) -> None:
-        """Close the files a lazy recording reads from (a later read opens them again). A
-        recording is also a context manager that closes them on leaving:
-        ``with read_recording(path) as recording: ...``."""
+        """Close the files a lazy recording reads from (a later read opens them again); also done
+        on leaving ``with read_recording(path) as recording:``."""
         for array in self.arrays().values():
             source = getattr(array, SOURCE, None)
             if source is not None:
@@ -267,25 +245,16 @@ class Recording:
         return self[:] if self.lazy else self
 
     def to_dataset(self) -> xr.Dataset:
-        """The recording as one Dataset over the dimension ``sample`` (dask-backed if lazy).
+        """The recording as one Dataset over ``sample`` (dask-backed if lazy).
 
         Returns
         -------
         dataset : xarray.Dataset
-            ``displacement`` [m], ``force`` [N] and, if read, ``cycle`` [1] and ``load``
-            [N], each with the attributes ``units`` (SI), ``long_name``, ``source_column``
-            (as named in the file), ``source_units`` (the unit read) and ``unit_assumed`` (1
-            if the file and the options gave no unit and the default was assumed, else 0);
-            the Dataset's attributes ``source`` (the path), ``format`` and ``first_sample``
-            (the index of the first sample in the file).
-
-        Examples
-        --------
-        >>> from ecofmaps.io import read_recording
-        >>> from ecofmaps.measured.synthetic import example_path
-        >>> dataset = read_recording(example_path()).to_dataset()
-        >>> dataset.displacement.attrs["units"], dataset.attrs["format"], dataset.sizes["sample"]
-        ('m', 'text', 24000)
+            ``displacement`` [m], ``force`` [N] and, if read, ``cycle`` [1] and ``load`` [N],
+            each with the attributes ``units`` (SI), ``long_name``, ``source_column`` (as
+            named in the file), ``source_units`` (the unit read) and ``unit_assumed`` (1 if
+            the default unit was assumed, else 0); the Dataset's attributes ``source`` (the
+            path), ``format`` and ``first_sample`` (the index in the file of the first).
         """
         variables = {}
         for role, data in self.arrays().items():

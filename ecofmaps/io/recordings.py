@@ -45,7 +45,8 @@ _SUFFIXES = {
 
 
 def recording_format(path) -> str:
-    """The format of a recording file: ``'text'``, ``'tdms'``, ``'hdf5'`` or ``'zarr'``.
+    """The format of a recording: ``'text'``, ``'tdms'``, ``'hdf5'`` or ``'zarr'``, from its
+    first bytes (a directory: its zarr metadata); any other file is text.
 
     Parameters
     ----------
@@ -55,8 +56,6 @@ def recording_format(path) -> str:
     Returns
     -------
     format : str
-        Found from the first bytes or, for a directory, its zarr metadata; any other file
-        is text.
 
     Raises
     ------
@@ -207,48 +206,44 @@ def read_recording(
 ) -> Recording:
     """Read the displacement and force (and cycle) columns of a recording, in SI units.
 
-    How formats, columns and units are found is in ``docs/formats.md``.
+    Formats, columns and units are found as ``docs/formats.md`` says.
 
     Parameters
     ----------
     path : str or os.PathLike
-        A text file (a header line of column names, then one sample per line), a TDMS file,
-        an HDF5 or netCDF-4 file, or a zarr store (a directory); the format is found from
-        the content.
+        A text file (a header line of column names, then a sample per line), a TDMS file, an
+        HDF5 or netCDF-4 file, or a zarr store (a directory); the format is found from content.
     displacement_column, force_column : str
-        Names of the displacement and tangential force columns (channels, variables),
-        without regard to case and to a unit in the name; in a text file the defaults also
-        find the usual names (:data:`ecofmaps.io.columns.SYNONYMS`).
+        The displacement and tangential force columns (channels, variables), without regard
+        to case and to a unit in the name; in a text file the defaults also find the usual
+        names (:data:`ecofmaps.io.columns.SYNONYMS`).
     cycle_column : str or False, optional
-        Name of a column of cycle numbers, which must then exist. By default a column
-        named ``cycle`` is used if there is one; False reads none (cycles are then cut at
-        the displacement reversals).
+        A column of cycle numbers, which must then exist. By default a column ``cycle`` if
+        there is one; False reads none (cycles are then cut at the displacement reversals).
     displacement_unit, force_unit : str, optional
-        Units of the displacement and force columns (``'um'``, ``'mm'``, ``'N'``,
-        ``'kN'``, ...). By default the unit the file gives, else µm and N; one given here
-        that disagrees with the file's is an error.
+        Their units (``'um'``, ``'kN'``, ...): by default the file's, else µm and N; one that
+        disagrees with the file's is an error.
     group : str, optional
-        TDMS group, or HDF5/netCDF/zarr group path, holding the channels. By default the
-        channels are sought in all groups (and must be found in only one).
+        TDMS group, or HDF5/netCDF/zarr group path, of the channels; by default all groups
+        are searched (and the channels must be in only one).
     nan_policy : {'propagate', 'raise'}
-        Missing samples are NaN, marked by :attr:`Recording.missing` (``'propagate'``), or
-        an error naming the line or sample (``'raise'``; when its block is read if lazy).
+        Missing samples are NaN, marked by :attr:`Recording.missing`, or an error naming the
+        line or sample (when its block is read if lazy).
     lazy : bool, optional
-        Return dask arrays read block by block (True), or NumPy arrays (False). By default
-        lazy for rig files of more than :data:`LAZY_SAMPLES` samples. A text file is always
-        parsed whole (in blocks, into memory); ``lazy=True`` then wraps the arrays in dask.
+        Dask arrays read block by block (True) or NumPy arrays (False); by default lazy for
+        rig files of more than :data:`LAZY_SAMPLES` samples. A text file is always parsed
+        into memory; ``lazy=True`` then wraps its arrays in dask.
     chunks : int, optional
         Samples per dask block; by default a multiple of the file's own chunks near 2**22.
     block_bytes : int, optional
-        Bytes of a text file parsed at a time (default :data:`ecofmaps.io.text.BLOCK_BYTES`):
-        the memory the parsing needs, beyond the arrays, is a small multiple of it.
+        Bytes of a text file parsed at a time (default :data:`ecofmaps.io.text.BLOCK_BYTES`);
+        the parsing needs a small multiple of it beyond the arrays.
     load_column : str, optional
-        Name of a recorded normal-load column of a text file, read into
-        :attr:`Recording.load` [N]; ``'load'`` also finds the usual names. By default none.
+        A recorded normal-load column of a text file, read into :attr:`Recording.load` [N];
+        ``'load'`` also finds the usual names. By default none.
     skip_rows : int, optional
-        Lines of a text file to skip before its header line. By default the header is the
-        first line naming the columns asked for, among the first
-        :data:`ecofmaps.io.text.PREAMBLE_LINES`.
+        Lines of a text file before its header line; by default the header is the first line
+        naming the columns, among the first :data:`ecofmaps.io.text.PREAMBLE_LINES`.
 
     Returns
     -------
@@ -258,11 +253,10 @@ def read_recording(
     Raises
     ------
     RecordingError
-        For a missing, ambiguous or doubtful column, a bad line or cell, no data, channels
-        of different lengths, a truncated or damaged file; the message names the file and
-        the line (text) or the channel and sample (other formats).
+        For a missing, ambiguous or doubtful column, a bad line or cell, no data, channels of
+        different lengths, a damaged file: naming the file and the line, or channel and sample.
     ValueError
-        For options of the wrong kind (the message names the option).
+        For an option of the wrong kind, naming it.
     OSError
         If the file cannot be read.
 
@@ -313,7 +307,7 @@ def open_recording(path, **options) -> xr.Dataset:
     Parameters
     ----------
     path : str or os.PathLike
-        As for :func:`read_recording`.
+        As in :func:`read_recording`.
     **options
         The options of :func:`read_recording`.
 
@@ -332,10 +326,8 @@ def open_recording(path, **options) -> xr.Dataset:
     >>> from ecofmaps.io import open_recording
     >>> from ecofmaps.measured.synthetic import example_path
     >>> dataset = open_recording(example_path())
-    >>> dataset.displacement.attrs["units"], dataset.displacement.attrs["source_units"]
-    ('m', 'um')
-    >>> dataset.displacement.attrs["unit_assumed"]  # the header gives no unit
-    1
+    >>> dataset.displacement.attrs["units"], dataset.displacement.attrs["unit_assumed"]
+    ('m', 1)
     """
     return read_recording(path, **options).to_dataset()
 
@@ -346,12 +338,11 @@ def recording_blocks(path, samples: int = 1 << 20, **options) -> Iterator[Record
     Parameters
     ----------
     path : str or os.PathLike
-        As for :func:`read_recording`.
+        As in :func:`read_recording`.
     samples : int
-        Samples per block (the last block may be shorter).
+        Samples per block (the last may be shorter).
     **options
-        The options of :func:`read_recording` (columns, units, group, nan_policy,
-        block_bytes).
+        The options of :func:`read_recording` but ``lazy`` and ``chunks``.
 
     Yields
     ------
