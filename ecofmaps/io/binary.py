@@ -1,10 +1,7 @@
-"""Recordings in rig formats: TDMS (:mod:`ecofmaps.io.tdms`), HDF5 / netCDF-4 and zarr
-(through xarray's ``h5netcdf`` and ``zarr`` engines), each group a lazily read Dataset (CF
-attributes decoded, times left as numbers, arrays without dimension names over "phony"
-dimensions, a damaged file refused when opened), each channel read through :class:`Column`: a
-range of samples on demand, in float64 and SI, pickled without its open file (so a dask
-cluster's workers read their own blocks), any error naming the file, channel and samples.
-``docs/formats.md`` describes the formats.
+"""Recordings in rig formats: TDMS (:mod:`ecofmaps.io.tdms`), HDF5 / netCDF-4 and zarr (through
+xarray's engines), each group a lazily read Dataset, each channel read through :class:`Column`
+range by range in SI, pickled without its open file (a dask worker reads its own blocks), any
+error naming the file, channel and samples. ``docs/formats.md`` describes the formats.
 """
 
 from __future__ import annotations
@@ -39,10 +36,8 @@ _DECODING = dict(
     mask_and_scale=True, decode_times=False, decode_timedelta=False, decode_coords=False
 )
 
-#: xarray's options for HDF5: no copy of a whole variable kept in memory once read, and no
-#: lock of xarray's (one for all HDF5 files of the process: h5py already serialises its calls,
-#: each :class:`Column` holds a lock of its own, and a forked process could inherit that one
-#: held by a thread of its parent for good).
+#: xarray's options for HDF5: no copy kept once read, and no lock of xarray's (h5py serialises
+#: its calls, each :class:`Column` has a lock, and a fork could inherit xarray's held for good).
 _HDF5 = {"engine": "h5netcdf", "lock": False, "phony_dims": "access", "cache": False, **_DECODING}
 
 #: xarray's options for zarr: lazily indexed arrays (no dask), no copy kept once read.
@@ -72,9 +67,8 @@ def _hdf5_refused(path: Path, error: Exception) -> RecordingError:
 
 
 def _checked_hdf5(path: Path) -> None:
-    """Open every group's and variable's attributes with h5py: a damaged file raises here,
-    cleanly (h5netcdf would raise anything from KeyError to RuntimeError, and its half-made
-    file object print a traceback when it is collected)."""
+    """Refuse a damaged file by reading every attribute with h5py (h5netcdf would raise anything
+    and print a traceback when its half-made file object is collected)."""
 
     def visit(_name, item):
         for name in item.attrs:
@@ -88,21 +82,16 @@ def _checked_hdf5(path: Path) -> None:
         raise _hdf5_refused(path, error) from None
 
 
-def _hdf5_groups(path: Path) -> dict[str, xr.Dataset]:
+def _hdf5_groups(path: Path, key: str | None = None) -> dict[str, xr.Dataset]:
+    """As :func:`_zarr_groups`, for an HDF5 file."""
     _checked_hdf5(path)
     try:
-        return xr.open_groups(path, **_HDF5)
+        if key is None:
+            return xr.open_groups(path, **_HDF5)
+        return {key: xr.open_dataset(path, group=key, **_HDF5)}
     except _DAMAGE as error:
-        raise _hdf5_refused(path, error) from None
-
-
-def _hdf5_group(path: Path, group: str | None) -> xr.Dataset:
-    _checked_hdf5(path)
-    try:
-        return xr.open_dataset(path, group=group, **_HDF5)
-    except OSError as error:
-        if "not found" in str(error).lower() and group:
-            raise RecordingError(path, None, f"no group {group!r}") from None
+        if key is not None and isinstance(error, OSError) and "not found" in str(error).lower():
+            return {}
         raise _hdf5_refused(path, error) from None
 
 
@@ -163,16 +152,7 @@ def _zarr_groups(path: Path, key: str | None = None) -> dict[str, xr.Dataset]:
     return _plain_zarr_groups(path, root)
 
 
-def _zarr_group(path: Path, group: str | None) -> xr.Dataset:
-    key = "/" + (group or "").strip("/")
-    groups = _zarr_groups(path, key)
-    if key not in groups:
-        raise RecordingError(path, None, f"no group {group!r}")
-    return groups[key]
-
-
 _GROUPS = {"tdms": tdms_groups, "hdf5": _hdf5_groups, "zarr": _zarr_groups}
-_GROUP = {"tdms": open_tdms_group, "hdf5": _hdf5_group, "zarr": _zarr_group}
 
 
 def _units(attrs) -> tuple:
@@ -194,16 +174,9 @@ def variables(path, kind: str) -> list[Variable]:
                 if item.ndim != 1 or not np.issubdtype(item.dtype, np.number):
                     continue
                 chunks = item.encoding.get("chunksizes") or item.encoding.get("chunks")
-                found.append(
-                    Variable(
-                        name=f"{group}/{name}" if group else str(name),
-                        group=group,
-                        short=str(name),
-                        size=int(item.shape[0]),
-                        units=_units(item.attrs),
-                        chunk=int(chunks[0]) if chunks else 0,
-                    )
-                )
+                full, size = f"{group}/{name}" if group else str(name), int(item.shape[0])
+                chunk = int(chunks[0]) if chunks else 0
+                found.append(Variable(full, group, str(name), size, _units(item.attrs), chunk))
     finally:
         for dataset in groups.values():
             dataset.close()
@@ -213,7 +186,13 @@ def variables(path, kind: str) -> list[Variable]:
 def open_group(path, kind: str, group: str) -> xr.Dataset:
     """The group ``group`` (``''`` for the root) of a rig file, as a lazily read Dataset
     whose variables are named by :attr:`Variable.short`; close it after reading."""
-    return _GROUP[kind](Path(path), group or None)
+    if kind == "tdms":
+        return open_tdms_group(path, group or None)
+    key = "/" + group.strip("/")
+    groups = _GROUPS[kind](Path(path), key)
+    if key not in groups:
+        raise RecordingError(path, None, f"no group {group!r}")
+    return groups[key]
 
 
 #: Samples per dask block when the file does not suggest a chunking.
@@ -226,9 +205,7 @@ class Column:
     def __init__(self, path: Path, kind: str, variable: Variable, factor: float, nan_policy, stamp):
         self.arguments = (path, kind, variable, factor, nan_policy, stamp)
         self.path, self.kind, self.variable, self.factor, self.nan_policy, _ = self.arguments
-        self.shape = (variable.size,)
-        self.dtype = np.dtype(np.float64)
-        self.ndim = 1
+        self.shape, self.dtype, self.ndim = (variable.size,), np.dtype(np.float64), 1
         self._handle = None
         self._lock = threading.Lock()
         _COLUMNS.add(self)
@@ -265,11 +242,9 @@ class Column:
     def __getitem__(self, key):
         if isinstance(key, tuple) and len(key) == 1:
             key = key[0]
-        if not isinstance(key, slice):
-            raise TypeError("a Column is read by a slice start:stop")
-        start, stop, step = key.indices(self.variable.size)
-        if step != 1:
+        if not isinstance(key, slice) or key.step not in (None, 1):
             raise TypeError("a Column is read by a slice start:stop (step 1)")
+        start, stop, _ = key.indices(self.variable.size)
         stop = max(start, stop)
         noun = _NOUNS[self.kind]
         where = f"{noun} {self.variable.name!r}, samples {start} to {stop - 1}"
