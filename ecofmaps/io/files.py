@@ -52,24 +52,24 @@ STORE_MARKERS = ("zarr.json", ".zgroup", ".zarray")
 
 
 def atomic_path(path, *, exclusive: bool = True):
-    """A temporary path to write, renamed onto ``path`` when the block succeeds.
+    """:func:`atomic_store` with ``overwrite=True``: a temporary path to write, renamed onto
+    ``path`` when the block succeeds.
 
     Parameters
     ----------
     path, exclusive
-        As for :func:`atomic_store` (``exclusive=False`` for a file any writer may replace
+        As in :func:`atomic_store` (``exclusive=False`` for a file any writer may replace
         with the same content, a cache entry).
 
     Returns
     -------
     context : contextlib.AbstractContextManager
-        :func:`atomic_store` with ``overwrite=True``.
     """
     return atomic_store(path, overwrite=True, exclusive=exclusive)
 
 
 def write_text(path, text: str) -> Path:
-    """Write ``text`` (UTF-8) to ``path`` atomically (a temporary file, then a rename)."""
+    """Write ``text`` (UTF-8) to ``path`` atomically."""
     path = Path(path)
     with atomic_path(path) as temporary:
         temporary.write_text(text, encoding="utf-8", newline="")
@@ -140,8 +140,7 @@ def atomic_store(path, *, overwrite: bool = False, exclusive: bool = True):
     path : str or os.PathLike
         The file or directory to create; its directory must exist.
     overwrite : bool
-        Replace an existing ``path``; otherwise an existing one is an error, raised before
-        anything is written.
+        Replace an existing ``path``; else an existing one is an error, before any writing.
     exclusive : bool
         Whether a file ``path`` that did not exist when the block began is created
         exclusively: if another program created it meanwhile, this result is not written.
@@ -149,11 +148,10 @@ def atomic_store(path, *, overwrite: bool = False, exclusive: bool = True):
     Yields
     ------
     temporary : pathlib.Path
-        ``.<name>.<process id>.<32 hex digits>.tmp`` beside ``path``, not yet existing:
-        create the file or directory there. On success it is flushed to disk and renamed to
-        ``path`` (an old ``path`` moved aside first, removed after); if the block raises, it
-        is removed and ``path`` is left as it was. A crash leaves only the temporary
-        (:data:`TEMPORARY_NAME`), which the next write of ``path`` removes.
+        ``.<name>.<process id>.<32 hex digits>.tmp`` beside ``path``, not yet existing. On
+        success it is flushed to disk and renamed to ``path`` (an old one moved aside, then
+        removed); if the block raises, it is removed and ``path`` left as it was. A crash
+        leaves only the temporary (:data:`TEMPORARY_NAME`); the next write removes it.
 
     Raises
     ------
@@ -205,9 +203,8 @@ def atomic_store(path, *, overwrite: bool = False, exclusive: bool = True):
 
 
 def check_room(path, size: int) -> None:
-    """Raise ``OSError`` (ENOSPC) naming ``path`` unless its disk has ``size`` bytes free and a
-    few chunks to spare [byte]: asked before HDF5 writes, as HDF5 cannot recover from a failed
-    write (the half-written file then crashes the process when it is closed)."""
+    """Raise ``OSError`` (ENOSPC) naming ``path`` unless its disk has ``size`` [byte] free and a
+    few chunks to spare: HDF5 cannot recover from a failed write (it crashes on closing)."""
     free = shutil.disk_usage(Path(path).parent).free
     if free < size + 4 * CHUNK_BYTES:
         message = f"No space left on device: {size:,} bytes to write, {free:,} free"
@@ -278,7 +275,6 @@ class FileLineError(ValueError):
     Attributes
     ----------
     path : pathlib.Path
-        The file.
     line : int
         1-based line number in the file (None in a :class:`~ecofmaps.io.RecordingError`
         placed otherwise).

@@ -14,40 +14,24 @@ from ecofmaps.io.tdms import engine_path, has_suffix
 
 __all__ = ["TextBackendEntrypoint"]
 
+#: The options of :func:`ecofmaps.io.read_recording` the engine takes.
+_OPTIONS = ("displacement_column", "force_column", "cycle_column", "displacement_unit")
+_OPTIONS += ("force_unit", "nan_policy", "block_bytes")
+
 
 class TextBackendEntrypoint(BackendEntrypoint):
     """xarray's engine ``ecofmaps-text``: a text recording (CSV, TSV, whitespace columns
     under a header line) as a Dataset over ``sample``, variables named as its columns."""
 
     description = "Text recordings of fretting loops (CSV, TSV), in SI units (ecofmaps)"
-    open_dataset_parameters = (
-        "filename_or_obj",
-        "drop_variables",
-        "displacement_column",
-        "force_column",
-        "cycle_column",
-        "displacement_unit",
-        "force_unit",
-        "nan_policy",
-        "block_bytes",
-    )
+    open_dataset_parameters = ("filename_or_obj", "drop_variables", *_OPTIONS)
 
-    def open_dataset(
-        self,
-        filename_or_obj,
-        *,
-        drop_variables=None,
-        displacement_column="displacement",
-        force_column="force",
-        cycle_column=None,
-        displacement_unit=None,
-        force_unit=None,
-        nan_policy="propagate",
-        block_bytes=None,
-    ) -> xr.Dataset:
-        """The recording's columns (options of :func:`ecofmaps.io.read_recording`); a
-        :class:`RecordingError` for a damaged file or one that is not text."""
-        options = {k: v for k, v in locals().items() if k in self.open_dataset_parameters[2:]}
+    def open_dataset(self, filename_or_obj, *, drop_variables=None, **options) -> xr.Dataset:
+        """The recording's columns (``options`` of :func:`ecofmaps.io.read_recording`, those of
+        ``open_dataset_parameters``); a :class:`RecordingError` for a damaged file or one that
+        is not text."""
+        if unknown := sorted(set(options) - set(_OPTIONS)):
+            raise TypeError(f"the ecofmaps-text engine takes no option {unknown[0]!r}")
         path = engine_path(filename_or_obj, "ecofmaps-text")
         kind = recording_format(path)
         if kind != "text":

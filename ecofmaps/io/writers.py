@@ -42,13 +42,12 @@ class RecordingWriter:
     cycle : bool
         Whether a ``cycle`` column (int64) is written too.
     chunk_samples : int
-        Samples per chunk (zarr, HDF5) or per segment (TDMS); the data are written a
-        chunk at a time. A chunk of zarr or HDF5 holds at most :data:`CHUNK_BYTES`, and no
-        more samples than the recording, so a short recording takes the room of its samples.
+        Samples per chunk (zarr, HDF5) or segment (TDMS), written a chunk at a time; a chunk
+        of zarr or HDF5 holds at most :data:`CHUNK_BYTES`, and no more than the recording.
     overwrite : bool
         Replace an existing ``path`` (only once the new one is complete).
     attrs : dict, optional
-        Attributes of the file (zarr, HDF5) or the TDMS root: text or numbers.
+        Attributes (text or numbers) of the file (zarr, HDF5) or the TDMS root.
 
     Examples
     --------
@@ -89,7 +88,6 @@ class RecordingWriter:
         self.size = 0
         self._pending: dict[str, list] = {role: [] for role in self.roles}
         self._held = 0
-        self._stack = contextlib.ExitStack()
 
     def __enter__(self) -> RecordingWriter:
         with contextlib.ExitStack() as stack:
@@ -109,21 +107,10 @@ class RecordingWriter:
         return self._stack.__exit__(kind, value, traceback)
 
     def write(self, displacement, force, cycle=None) -> None:
-        """Append samples.
-
-        Parameters
-        ----------
-        displacement : array_like
-            [m]
-        force : array_like
-            [N]
-        cycle : array_like, optional
-            Cycle numbers (required if the writer was made with ``cycle=True``). [1]
-        """
-        arrays = {
-            "displacement": np.asarray(displacement, dtype=np.float64).reshape(-1),
-            "force": np.asarray(force, dtype=np.float64).reshape(-1),
-        }
+        """Append samples: ``displacement`` [m], ``force`` [N] and, if the writer was made with
+        ``cycle=True``, ``cycle`` numbers [1] (array_like, of one length)."""
+        given = {"displacement": displacement, "force": force}
+        arrays = {role: np.asarray(a, dtype=np.float64).reshape(-1) for role, a in given.items()}
         if "cycle" in self.roles:
             if cycle is None:
                 raise ValueError("cycle numbers are required: the writer has a cycle column")
@@ -257,12 +244,10 @@ def convert_recording(
         Any recording :func:`ecofmaps.io.read_recording` reads.
     destination : str or os.PathLike
         The file or store to create: ``.zarr``, ``.h5``/``.nc``, ``.tdms`` or ``.csv``.
-    format : str, optional
-        See :class:`RecordingWriter`; by default from the suffix.
+    format, overwrite
+        As in :class:`RecordingWriter`.
     chunk_samples : int
-        Samples per block read from ``source``, and per chunk (see :class:`RecordingWriter`).
-    overwrite : bool
-        Replace an existing ``destination`` (only once the new one is complete).
+        Samples per block read from ``source``, and per chunk (as in :class:`RecordingWriter`).
     **options
         Reading options of :func:`ecofmaps.io.read_recording` (columns, units, group,
         nan_policy).
@@ -270,6 +255,8 @@ def convert_recording(
     Returns
     -------
     destination : pathlib.Path
+        Samples in SI units (m, N), missing ones NaN; its attributes name the source, its
+        columns and their units. Memory stays near a few blocks, whatever the size.
 
     Raises
     ------
@@ -279,11 +266,6 @@ def convert_recording(
         If ``destination`` exists and ``overwrite`` is false.
     ValueError
         If ``destination`` is ``source``, or for bad options.
-
-    Notes
-    -----
-    Samples in SI units (m, N), missing ones NaN; the store's attributes name the source,
-    its columns and their units. Memory stays near a few blocks, whatever the size.
     """
     source, destination = Path(source), Path(destination)
     if destination.resolve() == source.resolve():
