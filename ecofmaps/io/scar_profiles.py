@@ -39,16 +39,16 @@ def read_scar_profile(
     Parameters
     ----------
     path : str or os.PathLike
-        A text file: a header line of column names, then one sample per line, in any of
-        the dialects :func:`ecofmaps.read_recording` reads.
+        A text file as :func:`ecofmaps.read_recording` reads: a header line of column names,
+        then one sample per line.
     x_column, z_column : str
-        Names of the position and height columns (matched without regard to case or to a
-        unit in the name: ``x`` finds ``X [mm]``).
+        The position and height columns, found as :func:`ecofmaps.read_recording` finds
+        columns (``x`` finds ``X [mm]``).
     x_unit, z_unit : str, optional
-        Their units of length (``'um'``, ``'mm'``, ...); by default the unit the column's
-        name gives, else µm. A unit given that disagrees with the name's is an error.
+        Their units of length (``'um'``, ``'mm'``, ...): by default the column name's, else
+        µm; one that disagrees with the name's is an error.
     level, half_width, smoothing, remove_outliers
-        As for :func:`ecofmaps.scar_profile` (lengths in m), but levelled by default.
+        As in :func:`ecofmaps.scar_profile` (lengths in m), but levelled by default.
 
     Returns
     -------
@@ -64,7 +64,7 @@ def read_scar_profile(
     ------
     ScarProfileError
         For a damaged file (a missing column, a bad line or cell, positions not strictly
-        increasing, no data) or a trace that is not a usable scar, naming the file and line.
+        increasing, no data) or a trace that is not a usable scar: naming the file and line.
     ValueError
         For a unit that is not a length.
     OSError
@@ -79,12 +79,8 @@ def read_scar_profile(
     (500, 0.16)
     """
     path = Path(path)
-    options = {
-        "columns": {"x": x_column, "z": z_column},
-        "x_unit": x_unit,
-        "z_unit": z_unit,
-        "nan_policy": "raise",
-    }
+    columns = {"x": x_column, "z": z_column}
+    options = {"columns": columns, "x_unit": x_unit, "z_unit": z_unit, "nan_policy": "raise"}
     try:
         blocks = text_blocks(path, options)
         layout = next(blocks)
@@ -107,10 +103,9 @@ def read_scar_profile(
             f"column {x_column!r} must increase strictly (sort the trace and drop repeated "
             "positions)",
         )
-    options = {"half_width": half_width, "smoothing": smoothing, "level": level}
     try:
         profile, findings = scar_profile_and_findings(
-            x, z, **options, remove_outliers=remove_outliers
+            x, z, half_width, smoothing, level, remove_outliers
         )
     except ValueError as error:
         raise ScarProfileError(

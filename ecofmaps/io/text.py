@@ -56,12 +56,12 @@ _EXACT = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "
 
 def _is_data(line: str) -> bool:
     """Whether a line is not blank and not a ``#`` comment."""
-    stripped = line.strip()
-    return bool(stripped) and not stripped.startswith("#")
+    return line.strip()[:1] not in ("", "#")
 
 
 def _first_bytes(path: Path, stream, compressed: bool) -> bytes:
-    """For a UTF-16 file, read whole, all of its text as UTF-8."""
+    """A UTF-16 file's text, read whole, as UTF-8 (else none, past a BOM); a gzipped rig file
+    refused."""
     head = stream.read(8)
     if compressed and head.startswith((b"TDSm", b"\x89HDF")):
         kind = "TDMS" if head.startswith(b"TDSm") else "HDF5"
@@ -85,9 +85,8 @@ def _first_bytes(path: Path, stream, compressed: bool) -> bytes:
 
 
 def _long_line(data: bytes) -> int | None:
-    """The offset of the first line longer than :data:`LINE_BYTES` (the last may go on
-    beyond ``data``), or None: it holds a whole aligned window of half that without a line end.
-    """
+    """The offset of the first line longer than :data:`LINE_BYTES` (the last may go on beyond
+    ``data``), or None: it holds a whole aligned window of half that without a line end."""
     step = LINE_BYTES // 2
     for offset in range(0, len(data) - step + 1, step):
         if data.find(b"\n", offset, offset + step) == -1:
@@ -149,8 +148,7 @@ class _Decoder:
     """UTF-8 text, falling back to Latin-1 (with a warning) from the first bad line on."""
 
     def __init__(self, path: Path):
-        self.path = path
-        self.encoding = "utf-8"
+        self.path, self.encoding = path, "utf-8"
 
     def __call__(self, data: bytes, first_line: int) -> str:
         if self.encoding == "utf-8":
@@ -237,8 +235,7 @@ class _Layout:
     """What the header says: separator, names, the columns wanted and their scales."""
 
     def __init__(self, path: Path, header_line: int, header: str, options: dict):
-        self.path = path
-        self.header_line = header_line
+        self.path, self.header_line = path, header_line
         self.separator = _separator(header)
         self.names = _header_names(header, self.separator)
         if self.names and all(_NUMBER.match(name) for name in self.names):
@@ -292,10 +289,9 @@ class _Layout:
         if self.decimal is None:
             text = body.decode("utf-8", errors="replace") if raw else body
             comma = _QUOTED_COMMA_DECIMAL if self.separator == "," else _COMMA_DECIMAL
-            if comma.search(text):
-                self.decimal = ","
-            elif _POINT_DECIMAL.search(text):
-                self.decimal = "."
+            self.decimal = (
+                "," if comma.search(text) else "." if _POINT_DECIMAL.search(text) else None
+            )
         count = numbers.size
         separator = self.separator.encode() if raw and self.separator else self.separator
         counted = (
@@ -337,7 +333,6 @@ class _Layout:
         values = {}
         for role, index in self.columns.items():
             column = frame[index]
-            name = self.names[index]
             if not pd.api.types.is_numeric_dtype(column.dtype):
                 if not careful:
                     return None
@@ -350,7 +345,7 @@ class _Layout:
                     self.path,
                     numbers[first],
                     f"non-numeric value {listed_names([column.iloc[first]])} in column "
-                    f"{listed_names([name])}",
+                    f"{listed_names([self.names[index]])}",
                 )
             values[role] = column.to_numpy(dtype=np.float64)
         missing = {role: ~np.isfinite(data) for role, data in values.items()}
@@ -403,8 +398,7 @@ def _head(blocks, decoder: _Decoder, options: dict) -> list[str]:
     """The first lines of the file, decoded."""
     skip = options.get("skip_rows")
     needed = 1 if skip is not None else PREAMBLE_LINES + 1
-    lines: list[str] = []
-    found = 0
+    lines, found = [], 0
     for raw, start, _ in blocks:
         check_interrupted()
         new = _text_lines(decoder(raw, start))
