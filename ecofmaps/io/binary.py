@@ -403,19 +403,13 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
         native = max(v.chunk for v in chosen.values()) or 1
         block = int(chunks) if chunks else max(native, DEFAULT_CHUNK // native * native)
         token = tokenize(str(path.resolve()), *stamp, options, block)
-        arrays = {
-            role: da.from_array(
-                column,
-                chunks=(min(block, size),),
-                asarray=False,
-                lock=False,
-                name=f"ecofmaps-{kind}-{role}-{token}",
-                meta=np.empty(0, np.float64),
+        arrays, meta = {}, np.empty(0, np.float64)
+        for role, column in columns.items():
+            name = f"ecofmaps-{kind}-{role}-{token}"
+            arrays[role] = da.from_array(
+                column, (min(block, size),), name, asarray=False, meta=meta
             )
-            for role, column in columns.items()
-        }
-        for role, column in columns.items():  # read directly by the tasks of an analysis
-            setattr(arrays[role], SOURCE, column)
+            setattr(arrays[role], SOURCE, column)  # read directly by the tasks of an analysis
     else:
         arrays = {}
         for role, column in columns.items():

@@ -58,8 +58,8 @@ def atomic_path(path, *, exclusive: bool = True):
     Parameters
     ----------
     path, exclusive
-        As in :func:`atomic_store` (``exclusive=False`` for a file any writer may replace
-        with the same content, a cache entry).
+        As in :func:`atomic_store` (``exclusive=False``: a file any writer may replace with the
+        same content, a cache entry).
 
     Returns
     -------

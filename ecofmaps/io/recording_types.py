@@ -67,11 +67,10 @@ class RecordingError(FileLineError):
     ----------
     path : str or os.PathLike
     line : int, str or None
-        The 1-based line of a text file; in a file without lines, a position such as
-        ``"channel 'Rig/force', sample 1200"``; None for the file as a whole.
+        The 1-based line of a text file; elsewhere a position such as ``"channel 'Rig/force',
+        sample 1200"``; None for the whole file (``position`` is ``'line 12'``, it, or ``''``).
     message : str
-        What is wrong (the attribute ``message``; ``position`` is ``'line 12'``, the
-        position given, or ``''``).
+        What is wrong (the attribute ``message``).
     """
 
 

@@ -16,7 +16,7 @@ import xarray as xr
 
 from ecofmaps.io.binary import read_binary
 from ecofmaps.io.columns import column_scale
-from ecofmaps.io.files import STORE_MARKERS
+from ecofmaps.io.files import is_store
 from ecofmaps.io.recording_types import (
     LAZY_SAMPLES,
     LineIndex,
@@ -67,7 +67,7 @@ def recording_format(path) -> str:
     """
     path = Path(path)
     if path.is_dir():
-        if any((path / name).exists() for name in STORE_MARKERS):
+        if is_store(path):
             return "zarr"
         raise RecordingError(path, None, "a directory, and not a zarr store (no zarr.json)")
     check_regular_file(path)
@@ -174,7 +174,6 @@ def _text_recordings(path: Path, options: dict, block_bytes, samples=None) -> It
 
 
 def _check_not_empty(path: Path, header_line: int, values: dict, columns: dict) -> None:
-    """Refuse a column of which every sample is missing."""
     for role, data in values.items():
         if not np.isfinite(data).any():
             hint = "is it the right column?"
@@ -206,44 +205,36 @@ def read_recording(
 ) -> Recording:
     """Read the displacement and force (and cycle) columns of a recording, in SI units.
 
-    Formats, columns and units are found as ``docs/formats.md`` says.
+    How formats, columns and units are found: ``docs/formats.md``.
 
     Parameters
     ----------
     path : str or os.PathLike
-        A text file (a header line of column names, then a sample per line), a TDMS file, an
-        HDF5 or netCDF-4 file, or a zarr store (a directory); the format is found from content.
+        A text, TDMS, HDF5 or netCDF-4 file, or a zarr store (a directory), found by content.
     displacement_column, force_column : str
-        The displacement and tangential force columns (channels, variables), without regard
-        to case and to a unit in the name; in a text file the defaults also find the usual
-        names (:data:`ecofmaps.io.columns.SYNONYMS`).
+        Their columns (channels, variables), without regard to case and to a unit in the
+        name; in a text file the defaults also find :data:`ecofmaps.io.columns.SYNONYMS`.
     cycle_column : str or False, optional
-        A column of cycle numbers, which must then exist. By default a column ``cycle`` if
-        there is one; False reads none (cycles are then cut at the displacement reversals).
+        A column of cycle numbers; by default ``cycle`` if there is one; False reads none
+        (cycles are then cut at the displacement reversals).
     displacement_unit, force_unit : str, optional
-        Their units (``'um'``, ``'kN'``, ...): by default the file's, else µm and N; one that
-        disagrees with the file's is an error.
+        Their units (``'um'``, ``'kN'``, ...); by default the file's, else µm and N.
     group : str, optional
-        TDMS group, or HDF5/netCDF/zarr group path, of the channels; by default all groups
-        are searched (and the channels must be in only one).
+        TDMS group or HDF5/netCDF/zarr group path; by default the one holding the channels.
     nan_policy : {'propagate', 'raise'}
-        Missing samples are NaN, marked by :attr:`Recording.missing`, or an error naming the
-        line or sample (when its block is read if lazy).
+        Missing samples are NaN (:attr:`Recording.missing`), or an error naming the first.
     lazy : bool, optional
-        Dask arrays read block by block (True) or NumPy arrays (False); by default lazy for
-        rig files of more than :data:`LAZY_SAMPLES` samples. A text file is always parsed
-        into memory; ``lazy=True`` then wraps its arrays in dask.
+        Dask arrays (True) or NumPy arrays (False); by default lazy for a rig file of more
+        than :data:`LAZY_SAMPLES` samples. A text file is parsed into memory either way.
     chunks : int, optional
         Samples per dask block; by default a multiple of the file's own chunks near 2**22.
     block_bytes : int, optional
-        Bytes of a text file parsed at a time (default :data:`ecofmaps.io.text.BLOCK_BYTES`);
-        the parsing needs a small multiple of it beyond the arrays.
+        Bytes of a text file parsed at a time (:data:`ecofmaps.io.text.BLOCK_BYTES`).
     load_column : str, optional
-        A recorded normal-load column of a text file, read into :attr:`Recording.load` [N];
-        ``'load'`` also finds the usual names. By default none.
+        A normal-load column of a text file, read into :attr:`Recording.load` [N].
     skip_rows : int, optional
-        Lines of a text file before its header line; by default the header is the first line
-        naming the columns, among the first :data:`ecofmaps.io.text.PREAMBLE_LINES`.
+        Lines of a text file before its header; by default the header is the first line
+        naming the columns among the first :data:`ecofmaps.io.text.PREAMBLE_LINES`.
 
     Returns
     -------
@@ -302,19 +293,17 @@ def read_recording(
 
 
 def open_recording(path, **options) -> xr.Dataset:
-    """A recording as one xarray Dataset over the dimension ``sample``, in SI units.
+    """A recording as one xarray Dataset over ``sample`` in SI units (as
+    :meth:`Recording.to_dataset` gives it).
 
     Parameters
     ----------
-    path : str or os.PathLike
+    path, **options
         As in :func:`read_recording`.
-    **options
-        The options of :func:`read_recording`.
 
     Returns
     -------
     dataset : xarray.Dataset
-        As :meth:`Recording.to_dataset` gives it.
 
     Raises
     ------
@@ -337,12 +326,10 @@ def recording_blocks(path, samples: int = 1 << 20, **options) -> Iterator[Record
 
     Parameters
     ----------
-    path : str or os.PathLike
-        As in :func:`read_recording`.
+    path, **options
+        As in :func:`read_recording` (but ``lazy`` and ``chunks``).
     samples : int
         Samples per block (the last may be shorter).
-    **options
-        The options of :func:`read_recording` but ``lazy`` and ``chunks``.
 
     Yields
     ------

@@ -289,9 +289,10 @@ class _Layout:
         if self.decimal is None:
             text = body.decode("utf-8", errors="replace") if raw else body
             comma = _QUOTED_COMMA_DECIMAL if self.separator == "," else _COMMA_DECIMAL
-            self.decimal = (
-                "," if comma.search(text) else "." if _POINT_DECIMAL.search(text) else None
-            )
+            if comma.search(text):
+                self.decimal = ","
+            elif _POINT_DECIMAL.search(text):
+                self.decimal = "."
         count = numbers.size
         separator = self.separator.encode() if raw and self.separator else self.separator
         counted = (
