@@ -211,26 +211,6 @@ def _wanted(options: dict) -> dict:
     return wanted
 
 
-def _header_index(lines: list[str], options: dict) -> int | None:
-    """The index in ``lines`` (the file's first lines) of the header line."""
-    skip = options.get("skip_rows")
-    found = (k for k in range(skip or 0, len(lines)) if _is_data(lines[k]))
-    data = list(itertools.islice(found, 1 if skip is not None else PREAMBLE_LINES + 1))
-    if skip is not None or not data:
-        return data[0] if data else None
-    wanted = _wanted(options)
-    following = [lines[k] for k in data[1:]] + [None]
-    for k, after in zip(data, following, strict=True):  # the first line naming the columns
-        separator = _separator(lines[k])
-        names = _header_names(lines[k], separator)
-        if _numeric(names) or (after is not None and len(_fields(after, separator)) != len(names)):
-            continue
-        if all(matching_columns(names, name, role) for role, name in wanted.items()):
-            return k
-    numbers = [i for i, k in enumerate(data) if _numeric(_fields(lines[k], _separator(lines[k])))]
-    return data[numbers[0] - 1] if numbers and numbers[0] > 0 else data[0]
-
-
 class _Layout:
     """What the header says: separator, names, the columns wanted and their scales."""
 
@@ -374,8 +354,7 @@ def text_blocks(path: Path, options: dict, block_bytes: int = BLOCK_BYTES):
     """Parse a text recording block by block."""
     decoder = _Decoder(path)
     with contextlib.closing(_line_blocks(path, block_bytes)) as blocks:
-        lines = _head(blocks, decoder, options)
-        header = _header_index(lines, options)
+        lines, header = _head(blocks, decoder, options)
         if header is None:
             raise RecordingError(path, max(len(lines), 1), "no header line and no data")
         layout = _Layout(path, header + 1, lines[header], options)
@@ -395,20 +374,33 @@ def text_blocks(path: Path, options: dict, block_bytes: int = BLOCK_BYTES):
             yield from _parsed_lines(layout, _text_lines(decoder(raw, start)), start)
 
 
-def _head(blocks, decoder: _Decoder, options: dict) -> list[str]:
-    """The first lines of the file, decoded."""
+def _head(blocks, decoder: _Decoder, options: dict) -> tuple[list[str], int | None]:
+    """The first lines of the file, decoded, and the index among them of the header line."""
     skip = options.get("skip_rows")
     needed = 1 if skip is not None else PREAMBLE_LINES + 1
-    lines, found = [], 0
+    lines: list[str] = []
+    data: list[int] = []  # the indices of the lines after ``skip`` that are not blank or comments
     for raw, start, _ in blocks:
         check_interrupted()
-        new = _text_lines(decoder(raw, start))
-        after = itertools.islice(new, max((skip or 0) - len(lines), 0), None)
-        found += len(list(itertools.islice(filter(_is_data, after), needed - found)))
-        lines = lines + new if lines else new
-        if found >= needed:
+        first = len(lines)
+        lines += _text_lines(decoder(raw, start))
+        found = (k for k in range(max(skip or 0, first), len(lines)) if _is_data(lines[k]))
+        data += itertools.islice(found, needed - len(data))
+        if len(data) >= needed:
             break
-    return lines
+    if skip is not None or not data:
+        return lines, data[0] if data else None
+    wanted = _wanted(options)
+    following = [lines[k] for k in data[1:]] + [None]
+    for k, after in zip(data, following, strict=True):  # the first line naming the columns
+        separator = _separator(lines[k])
+        names = _header_names(lines[k], separator)
+        if _numeric(names) or (after is not None and len(_fields(after, separator)) != len(names)):
+            continue
+        if all(matching_columns(names, name, role) for role, name in wanted.items()):
+            return lines, k
+    numbers = [i for i, k in enumerate(data) if _numeric(_fields(lines[k], _separator(lines[k])))]
+    return lines, data[numbers[0] - 1] if numbers and numbers[0] > 0 else data[0]
 
 
 def _parsed_lines(layout: _Layout, lines: list[str], start: int):
