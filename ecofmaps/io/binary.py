@@ -19,7 +19,7 @@ from xarray.backends import BackendArray
 from xarray.core import indexing
 
 from ecofmaps._parallel import SOURCE
-from ecofmaps.io.columns import ColumnError, listed_names, matching_columns, role_scale
+from ecofmaps.io.columns import ColumnError, column_scale, listed_names, matching_columns
 from ecofmaps.io.recording_types import LAZY_SAMPLES, Recording, RecordingError, si_values
 from ecofmaps.io.tdms import UNIT_PROPERTIES, open_tdms_group, tdms_groups
 
@@ -382,14 +382,12 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
     stat = path.stat()
     stamp = (stat.st_mtime_ns, stat.st_size)
     for role, variable in chosen.items():
-        factor, units[role], unknown = 1.0, "1", False
-        if role != "cycle":
-            try:
-                factor, units[role], unknown = role_scale(
-                    role, variable.short, options[f"{role}_unit"], variable.units, variable.name
-                )
-            except ColumnError as error:
-                raise RecordingError(path, f"{noun} {variable.name!r}", str(error)) from None
+        try:
+            factor, units[role], unknown = column_scale(
+                role, variable.short, options.get(f"{role}_unit"), variable.units, variable.name
+            )
+        except ColumnError as error:
+            raise RecordingError(path, f"{noun} {variable.name!r}", str(error)) from None
         assumed += (role,) if unknown else ()
         columns[role] = Column(path, kind, variable, factor, options["nan_policy"], stamp)
     size = chosen["displacement"].size

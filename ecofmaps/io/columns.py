@@ -1,6 +1,6 @@
 """Column names as labs write them: the unit a name carries (:func:`split_unit`), a column
 found by its name, its base or the usual names of :data:`SYNONYMS` (:func:`find_column`), and
-the factor to SI (:func:`column_scale`). The rules are in ``docs/formats.md``.
+its factor to SI (:func:`column_scale`). The rules are in ``docs/formats.md``.
 """
 
 from __future__ import annotations
@@ -21,7 +21,6 @@ __all__ = [
     "find_column",
     "listed_names",
     "matching_columns",
-    "role_scale",
     "split_unit",
 ]
 
@@ -287,19 +286,16 @@ def _factor(unit: str, kind: str, option: str | None) -> float:
         raise ValueError(f"{option}={unit!r} is not a {kind} unit ({error})") from None
 
 
-def role_scale(role: str, name: str, option_unit, metadata=(), column=None) -> tuple:
-    """:func:`column_scale` of a column from the unit in its ``name`` and the file's
-    ``metadata`` units, and whether its unit was assumed (none given anywhere)."""
+def column_scale(role: str, name: str, option_unit, metadata=(), column=None) -> tuple:
+    """The factor to SI of column ``name``, its unit, and whether that was assumed: the unit
+    ``option_unit`` (``<role>_unit``), else those carried by the name and the file's
+    ``metadata``, else :data:`DEFAULT_UNITS` (a cycle number's is 1). A ValueError naming the
+    option for a unit not of the role's kind; a :class:`ColumnError` naming ``column`` (by
+    default ``name``) if units disagree, or the file's is of another kind and no option says."""
+    if role == "cycle":
+        return 1.0, "1", False
     carried = [unit for unit in [split_unit(name)[1], *metadata] if unit is not None]
-    unknown = not carried and option_unit is None
-    return *column_scale(role, option_unit, carried, column or name), unknown
-
-
-def column_scale(role: str, option_unit, carried, column: str) -> tuple[float, str]:
-    """The factor to SI of a column and its unit: ``option_unit`` (``<role>_unit``), else the
-    units ``carried`` by the file, else :data:`DEFAULT_UNITS`. A ValueError naming the option
-    for a unit not of the role's kind; a :class:`ColumnError` naming ``column`` if units
-    disagree, or the file's is of another kind and no option overrules it."""
+    column = column or name
     kind = KINDS[role]
     option = f"{role}_unit"
     given = None if option_unit is None else (option_unit, _factor(option_unit, kind, option))
@@ -320,7 +316,7 @@ def column_scale(role: str, option_unit, carried, column: str) -> tuple[float, s
                     f"the {role} column {column!r} is in {unit!r}, but {told} says otherwise "
                     f"(a factor {factor / other_factor:.6g}); remove one or make them agree"
                 )
-    if given is None and not readable:
-        return _factor(DEFAULT_UNITS[role], kind, None), DEFAULT_UNITS[role]
+    if given is None and not carried:  # none readable: an error above
+        return _factor(DEFAULT_UNITS[role], kind, None), DEFAULT_UNITS[role], True
     unit, factor = given or readable[0]
-    return factor, unit
+    return factor, unit, False

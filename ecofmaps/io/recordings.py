@@ -121,7 +121,7 @@ def _options(
     _check_count("skip_rows", skip_rows, 0, "a non-negative integer or None")
     for role, unit in (("displacement", displacement_unit), ("force", force_unit)):
         if unit is not None:
-            column_scale(role, unit, [], role)  # a ValueError naming the option
+            column_scale(role, role, unit)  # a ValueError naming the option
     return {**options, "skip_rows": None if skip_rows is None else int(skip_rows)}
 
 

@@ -21,7 +21,13 @@ import pandas as pd
 
 from ecofmaps._codes import warn
 from ecofmaps._interrupts import check_interrupted
-from ecofmaps.io.columns import ColumnError, find_column, listed_names, matching_columns, role_scale
+from ecofmaps.io.columns import (
+    ColumnError,
+    column_scale,
+    find_column,
+    listed_names,
+    matching_columns,
+)
 from ecofmaps.io.recording_types import (
     RecordingError,
     RecordingWarning,
@@ -239,13 +245,12 @@ class _Layout:
                         f"the {other} and {role} columns are the same column "
                         f"{self.names[self.columns[role]]!r}"
                     )
-            self.scales, self.units, self.assumed = {"cycle": 1.0}, {"cycle": "1"}, ()
+            self.scales, self.units, self.assumed = {}, {}, ()
             for role, index in self.columns.items():
-                if role != "cycle":
-                    self.scales[role], self.units[role], unknown = role_scale(
-                        role, self.names[index], options.get(f"{role}_unit")
-                    )
-                    self.assumed += (role,) if unknown else ()
+                self.scales[role], self.units[role], unknown = column_scale(
+                    role, self.names[index], options.get(f"{role}_unit")
+                )
+                self.assumed += (role,) if unknown else ()
         except ColumnError as error:
             raise RecordingError(path, header_line, str(error)) from None
         self.width = len(self.names)

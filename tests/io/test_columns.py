@@ -81,7 +81,7 @@ def test_find_column_prefers_the_whole_name():
     ],
 )
 def test_column_scale(role, option, carried, expected):
-    factor, unit = column_scale(role, option, carried, "column")
+    factor, unit, _ = column_scale(role, "column", option, carried)
     assert factor == pytest.approx(expected[0], rel=1e-15) and unit == expected[1]
 
 
@@ -97,7 +97,7 @@ def test_column_scale(role, option, carried, expected):
 )
 def test_column_scale_errors(role, option, carried, error, message):
     with pytest.raises(error, match=message):
-        column_scale(role, option, carried, "column")
+        column_scale(role, "column", option, carried)
 
 
 @pytest.mark.parametrize("unit", sorted(COMMON_UNITS))
