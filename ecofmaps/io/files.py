@@ -1,8 +1,6 @@
-"""Writing files safely, and reporting where a file is damaged (:class:`FileLineError`).
-
-Every file ecofmaps writes goes through :func:`atomic_store` (written beside the destination,
-flushed and renamed onto it); each folder the command line writes into keeps a manifest,
-:data:`MANIFEST`, of what it wrote (``docs/formats.md``).
+"""Writing files safely (:func:`atomic_store`: beside the destination, flushed, renamed onto it;
+a manifest, :data:`MANIFEST`, of what the command line wrote in each folder), and reporting
+where a file is damaged (:class:`FileLineError`); ``docs/formats.md``.
 """
 
 from __future__ import annotations

@@ -142,7 +142,6 @@ def _text_recordings(path: Path, options: dict, block_bytes, samples=None) -> It
     parts = text_blocks(path, options, block_bytes or BLOCK_BYTES)
     layout = next(parts)
     columns = {role: layout.names[k] for role, k in layout.columns.items()}
-    units = {role: layout.units[role] for role in layout.columns}
     pending: list = []  # parsed blocks not yet given out: (values by role, line numbers)
     held = first = 0
     for part in itertools.chain(parts, [None]):  # None: the end, give out the rest
@@ -160,7 +159,7 @@ def _text_recordings(path: Path, options: dict, block_bytes, samples=None) -> It
                 **{role: values[:count] for role, values in joined.items()},
                 last_line=int(lines[count - 1]),
                 columns=columns,
-                units=units,
+                units=layout.units,
                 start=first,
                 lines=LineIndex.build(lines[:count], first),
                 format="text",

@@ -208,11 +208,10 @@ class RecordingWriter:
         self._handle = stack.enter_context(
             open(self._temporary, "w", encoding="utf-8", newline="\n")  # noqa: SIM115
         )
-        for key, value in self.attrs.items():
-            self._handle.write(f"# {key}: {value}\n")
-        names = [
+        self._handle.writelines(f"# {key}: {value}\n" for key, value in self.attrs.items())
+        names = (
             role if role == "cycle" else f"{role} [{ATTRS[role]['units']}]" for role in self.roles
-        ]
+        )
         self._handle.write(",".join(names) + "\n")
 
     def _append_text(self, arrays) -> None:
