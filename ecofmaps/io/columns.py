@@ -204,10 +204,8 @@ def find_column(names, wanted: str, role: str, *, required: bool = True) -> int 
 
 
 def matching_columns(names, wanted: str, role: str | None = None) -> list[int]:
-    """The indices of the names that match ``wanted``, without regard to case or repeated
-    blanks: the one whole name equal to it, else those whose base (:func:`split_unit`) is
-    its base, else (for ``wanted`` the name of ``role``) those whose base is one of the
-    role's :data:`SYNONYMS`."""
+    """The indices of the names matching ``wanted`` (case and blanks aside): the one equal to it,
+    else those of its base (:func:`split_unit`), else (``wanted`` the ``role``) its synonyms."""
     target = _normal(wanted)
     whole = [k for k, name in enumerate(names) if _normal(name) == target]
     if len(whole) == 1:
@@ -287,11 +285,9 @@ def _factor(unit: str, kind: str, option: str | None) -> float:
 
 
 def column_scale(role: str, name: str, option_unit, metadata=(), column=None) -> tuple:
-    """The factor to SI of column ``name``, its unit, and whether that was assumed: the unit
-    ``option_unit`` (``<role>_unit``), else those carried by the name and the file's
-    ``metadata``, else :data:`DEFAULT_UNITS` (a cycle number's is 1). A ValueError naming the
-    option for a unit not of the role's kind; a :class:`ColumnError` naming ``column`` (by
-    default ``name``) if units disagree, or the file's is of another kind and no option says."""
+    """The factor to SI of column ``name``, its unit and whether that was assumed: the unit
+    ``option_unit``, else those its name and the file's ``metadata`` carry, else
+    :data:`DEFAULT_UNITS` (1 for a cycle number); a :class:`ColumnError` naming ``column``."""
     if role == "cycle":
         return 1.0, "1", False
     carried = [unit for unit in [split_unit(name)[1], *metadata] if unit is not None]

@@ -182,10 +182,8 @@ def _group_dataset(reader: TdmsReader, group) -> xr.Dataset:
 
 
 def tdms_groups(path) -> dict[str, xr.Dataset]:
-    """Every group of a TDMS file as a lazily read Dataset, by its path (``'/Rig'``; the
-    root, ``'/'``, holds the file's properties), all read through one :class:`TdmsReader`
-    (closing any closes the file, opened again on the next read); :class:`RecordingError`
-    for a file that is not TDMS, or is truncated or damaged."""
+    """Every group of a TDMS file as a lazily read Dataset by its path (``'/Rig'``; the root
+    ``'/'`` holds the file's properties), all read through one :class:`TdmsReader`."""
     path = Path(path)
     handle = opened_tdms(path)
     reader = TdmsReader(path, handle)  # reads through the file opened to list the groups
