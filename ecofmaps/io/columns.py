@@ -31,70 +31,26 @@ KINDS = {"displacement": "length", "force": "force", "load": "force", "x": "leng
 #: The unit of a column whose name, metadata and options say none.
 DEFAULT_UNITS = {"displacement": "um", "force": "N", "load": "N", "x": "um", "z": "um"}
 
-#: The usual names of a recording's columns by role, compared with a column's base (its
-#: name without unit) without regard to case, blanks and punctuation (``Friction_Force``
-#: is ``friction force``, ``Disp.`` is ``disp``).
+#: The usual names of a recording's columns by role (written as a list in prose, split at the
+#: commas), compared with a column's base (its name without unit) without regard to case,
+#: blanks and punctuation (``Friction_Force`` is ``friction force``, ``Disp.`` is ``disp``).
 SYNONYMS = {
-    "displacement": (
-        "displacement",
-        "disp",
-        "delta",
-        "stroke",
-        "position",
-        "x",
-        "s",
-        "displ",
-        "dx",
-        "delta x",
-        "Δ",
-        "Δx",
-        "pos",
-        "travel",
-        "relative displacement",
-        "tangential displacement",
-        "sliding displacement",
-    ),
-    "force": (
-        "force",
-        "Fx",
-        "Ft",
-        "Q",
-        "Ftr",
-        "tangential force",
-        "friction force",
-        "F",
-        "tangential",
-        "tangential load",
-        "friction",
-        "Ff",
-        "Fr",
-        "shear force",
-        "traction",
-    ),
-    "load": (
-        "load",
-        "Fz",
-        "Fn",
-        "normal load",
-        "normal force",
-        "P",
-        "normal",
-        "applied load",
-    ),
-    "cycle": (
-        "cycle",
-        "cycles",
-        "n",
-        "cycle number",
-        "cycle no",
-        "cycle nr",
-        "cycle count",
-        "cycle index",
-        "n cycle",
-        "n cycles",
-        "cyc",
-        "number of cycles",
-    ),
+    role: tuple(names.split(", "))
+    for role, names in {
+        "displacement": (
+            "displacement, disp, delta, stroke, position, x, s, displ, dx, delta x, Δ, Δx, pos, "
+            "travel, relative displacement, tangential displacement, sliding displacement"
+        ),
+        "force": (
+            "force, Fx, Ft, Q, Ftr, tangential force, friction force, F, tangential, "
+            "tangential load, friction, Ff, Fr, shear force, traction"
+        ),
+        "load": "load, Fz, Fn, normal load, normal force, P, normal, applied load",
+        "cycle": (
+            "cycle, cycles, n, cycle number, cycle no, cycle nr, cycle count, cycle index, "
+            "n cycle, n cycles, cyc, number of cycles"
+        ),
+    }.items()
 }
 
 #: How the user chooses a role's column: the keyword of the Python API and the option of
@@ -108,20 +64,13 @@ _CHOOSE = {
     "z": "z_column (--z-column)",
 }
 
-#: The units rigs write most, with their kind and factor to SI, read without starting pint
-#: (whose registry takes a good part of a second to build); any other goes to pint.
-COMMON_UNITS = {
-    "m": ("length", 1.0),
-    "mm": ("length", 1e-3),
-    "um": ("length", 1e-6),
-    "µm": ("length", 1e-6),
-    "μm": ("length", 1e-6),
-    "nm": ("length", 1e-9),
-    "in": ("length", 0.0254),
-    "N": ("force", 1.0),
-    "kN": ("force", 1e3),
-    "mN": ("force", 1e-3),
-    "kip": ("force", 4448.221615260501),
+# The factors to SI of the lengths and forces rigs write most, read without starting pint
+# (whose registry takes a good part of a second to build); any other unit goes to pint.
+_LENGTHS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "μm": 1e-6, "nm": 1e-9, "in": 0.0254}
+_FORCES = {"N": 1.0, "kN": 1e3, "mN": 1e-3, "kip": 4448.221615260501}
+#: Those units, with their kind and factor to SI.
+COMMON_UNITS = {unit: ("length", factor) for unit, factor in _LENGTHS.items()} | {
+    unit: ("force", factor) for unit, factor in _FORCES.items()
 }
 
 _BRACKETED = re.compile(r"^(?P<base>.*?)\s*(?:\[(?P<square>[^\[\]]*)\]|\((?P<round>[^()]*)\))$")
