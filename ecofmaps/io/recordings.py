@@ -60,8 +60,8 @@ def recording_format(path) -> str:
     Raises
     ------
     RecordingError
-        For a directory that is not a zarr store, a pipe, device or socket, a netCDF-3
-        file, or a file whose suffix names a rig format its content is not.
+        For a directory not a zarr store, a pipe, device or socket, a netCDF-3 file, or a
+        file whose suffix names a rig format its content is not.
     OSError
         If the file cannot be read.
     """
