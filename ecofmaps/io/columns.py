@@ -55,14 +55,9 @@ SYNONYMS = {
 
 #: How the user chooses a role's column: the keyword of the Python API and the option of
 #: the command line, for messages.
-_CHOOSE = {
-    "displacement": "displacement_column (--displacement-col)",
-    "force": "force_column (--force-col)",
-    "cycle": "cycle_column (--cycle-col)",
-    "load": "load_column (--load COLUMN)",
-    "x": "x_column (--x-column)",
-    "z": "z_column (--z-column)",
-}
+_CHOOSE = {role: f"{role}_column (--{role}-col)" for role in ("displacement", "force", "cycle")}
+_CHOOSE |= {"load": "load_column (--load COLUMN)"}
+_CHOOSE |= {role: f"{role}_column (--{role}-column)" for role in ("x", "z")}
 
 # The factors to SI of the lengths and forces rigs write most, read without starting pint
 # (whose registry takes a good part of a second to build); any other unit goes to pint.

@@ -37,11 +37,8 @@ __all__ = [
 _NAN_POLICIES = ("propagate", "raise")
 _MAGIC = {b"TDSm": "tdms", b"\x89HDF\r\n\x1a\n": "hdf5"}
 _NETCDF3 = (b"CDF\x01", b"CDF\x02")
-_SUFFIXES = {
-    **dict.fromkeys((".h5", ".hdf5", ".hdf", ".nc", ".nc4"), "hdf5"),
-    ".tdms": "tdms",
-    ".zarr": "zarr",
-}
+_SUFFIXES = dict.fromkeys((".h5", ".hdf5", ".hdf", ".nc", ".nc4"), "hdf5")
+_SUFFIXES |= {".tdms": "tdms", ".zarr": "zarr"}
 
 
 def recording_format(path) -> str:
