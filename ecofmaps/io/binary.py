@@ -219,9 +219,7 @@ class Column:
 
     def _source(self):
         """The open channel or dataset (opened on first use in this process)."""
-        if self._handle is not None and self._handle[2] != os.getpid():
-            self._handle = None  # the parent's, left to the parent
-        if self._handle is None:
+        if self._handle is None or self._handle[2] != os.getpid():  # none, or the parent's
             dataset = open_group(self.path, self.kind, self.variable.group)
             self._handle = (dataset, dataset[self.variable.short].variable, os.getpid())
         return self._handle[1]

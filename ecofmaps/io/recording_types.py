@@ -113,7 +113,7 @@ class LineIndex:
     offsets: np.ndarray
 
     @classmethod
-    def build(cls, lines: np.ndarray, first: int = 0) -> LineIndex:
+    def build(cls, lines: np.ndarray, first: int) -> LineIndex:
         offset = lines - np.arange(first, first + lines.size)
         runs = np.concatenate([[0], np.flatnonzero(np.diff(offset)) + 1])
         return cls(runs + first, offset[runs])
@@ -200,9 +200,7 @@ class Recording:
         in the file); for ``index=None`` the end of the file (its last line, or None)."""
         if index is None:
             return self.last_line
-        if self.lines is not None:
-            return self.line(index)
-        return f"sample {self.start + int(index)}"
+        return self.line(index) if self.lines is not None else f"sample {self.start + int(index)}"
 
     def error(self, message: str, index=None) -> RecordingError:
         """A :class:`RecordingError` naming the file and the position of sample ``index`` (by
