@@ -85,9 +85,8 @@ class RecordingWriter:
         self.roles = ["displacement", "force"] + (["cycle"] if cycle else [])
         self.attrs = dict(attrs or {})
         self.overwrite = overwrite
-        self.size = 0
+        self.size = self._held = 0
         self._pending: dict[str, list] = {role: [] for role in self.roles}
-        self._held = 0
 
     def __enter__(self) -> RecordingWriter:
         with contextlib.ExitStack() as stack:
