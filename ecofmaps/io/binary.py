@@ -85,12 +85,13 @@ def _checked_hdf5(path: Path) -> None:
 def _hdf5_groups(path: Path, key: str | None = None) -> dict[str, xr.Dataset]:
     """As :func:`_zarr_groups`, for an HDF5 file."""
     _checked_hdf5(path)
+    caught = _DAMAGE if key is None else OSError
     try:
         if key is None:
             return xr.open_groups(path, **_HDF5)
         return {key: xr.open_dataset(path, group=key, **_HDF5)}
-    except _DAMAGE as error:
-        if key is not None and isinstance(error, OSError) and "not found" in str(error).lower():
+    except caught as error:
+        if key not in (None, "/") and "not found" in str(error).lower():
             return {}
         raise _hdf5_refused(path, error) from None
 
