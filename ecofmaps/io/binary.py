@@ -15,13 +15,12 @@ from pathlib import Path
 import h5py
 import numpy as np
 import xarray as xr
-from xarray.backends import BackendArray
 from xarray.core import indexing
 
 from ecofmaps._parallel import SOURCE
 from ecofmaps.io.columns import ColumnError, column_scale, listed_names, matching_columns
 from ecofmaps.io.recording_types import LAZY_SAMPLES, Recording, RecordingError, si_values
-from ecofmaps.io.tdms import UNIT_PROPERTIES, open_tdms_group, tdms_groups
+from ecofmaps.io.tdms import UNIT_PROPERTIES, LazyArray, open_tdms_group, tdms_groups
 
 __all__ = ["DEFAULT_CHUNK", "Column", "Variable", "open_group", "read_binary", "variables"]
 
@@ -105,18 +104,6 @@ def _zarr_root(path: Path):
         raise RecordingError(path, None, f"cannot open as a zarr store: {error}") from None
 
 
-class _ZarrRange(BackendArray):
-    """A zarr array as a lazily indexed array (slices and indices read only their chunks)."""
-
-    def __init__(self, array):
-        self.array, self.shape, self.dtype = array, array.shape, array.dtype
-
-    def __getitem__(self, key):
-        return indexing.explicit_indexing_adapter(
-            key, self.shape, indexing.IndexingSupport.BASIC, self.array.__getitem__
-        )
-
-
 def _plain_zarr_groups(path: Path, root) -> dict[str, xr.Dataset]:
     """The groups of a store without dimension names (read over phony dimensions)."""
     import zarr  # as in _zarr_root
@@ -131,7 +118,7 @@ def _plain_zarr_groups(path: Path, root) -> dict[str, xr.Dataset]:
         group, _, short = (name or path.stem).rpartition("/")
         size = int(item.shape[0])
         lengths += [] if size in lengths else [size]
-        data = indexing.LazilyIndexedArray(_ZarrRange(item))
+        data = indexing.LazilyIndexedArray(LazyArray(item.__getitem__, size, item.dtype))
         variable = xr.Variable((f"phony_dim_{lengths.index(size)}",), data, dict(item.attrs))
         variable.encoding["chunks"] = tuple(item.chunks)
         groups["/" + group][short] = variable

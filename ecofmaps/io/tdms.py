@@ -130,17 +130,25 @@ class TdmsReader:
             self._handle = None
 
 
-class TdmsArray(BackendArray):
-    """A channel as a lazily indexed array: a slice or an index reads only its samples."""
+class LazyArray(BackendArray):
+    """A one-dimensional array xarray indexes lazily, ``read`` given each basic key (a tuple of
+    a slice or an index), so that only the samples asked for are read."""
 
-    def __init__(self, reader: TdmsReader, group: str, channel: str, size: int, dtype):
-        self.reader, self.group, self.channel = reader, group, channel
-        self.shape, self.dtype = (int(size),), np.dtype(dtype)
+    def __init__(self, read, size: int, dtype):
+        self.read, self.shape, self.dtype = read, (int(size),), np.dtype(dtype)
 
     def __getitem__(self, key):
         return indexing.explicit_indexing_adapter(
-            key, self.shape, indexing.IndexingSupport.BASIC, self._read
+            key, self.shape, indexing.IndexingSupport.BASIC, self.read
         )
+
+
+class TdmsArray(LazyArray):
+    """A channel of a TDMS file, lazily indexed."""
+
+    def __init__(self, reader: TdmsReader, group: str, channel: str, size: int, dtype):
+        super().__init__(self._read, size, dtype)
+        self.reader, self.group, self.channel = reader, group, channel
 
     def _read(self, key: tuple):
         (index,) = key
