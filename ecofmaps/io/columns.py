@@ -31,26 +31,70 @@ KINDS = {"displacement": "length", "force": "force", "load": "force", "x": "leng
 #: The unit of a column whose name, metadata and options say none.
 DEFAULT_UNITS = {"displacement": "um", "force": "N", "load": "N", "x": "um", "z": "um"}
 
-#: The usual names of a recording's columns by role (written as a list in prose, split at the
-#: commas), compared with a column's base (its name without unit) without regard to case,
-#: blanks and punctuation (``Friction_Force`` is ``friction force``, ``Disp.`` is ``disp``).
+#: The usual names of a recording's columns by role, compared with a column's base (its
+#: name without unit) without regard to case, blanks and punctuation (``Friction_Force``
+#: is ``friction force``, ``Disp.`` is ``disp``).
 SYNONYMS = {
-    role: tuple(names.split(", "))
-    for role, names in {
-        "displacement": (
-            "displacement, disp, delta, stroke, position, x, s, displ, dx, delta x, Δ, Δx, pos, "
-            "travel, relative displacement, tangential displacement, sliding displacement"
-        ),
-        "force": (
-            "force, Fx, Ft, Q, Ftr, tangential force, friction force, F, tangential, "
-            "tangential load, friction, Ff, Fr, shear force, traction"
-        ),
-        "load": "load, Fz, Fn, normal load, normal force, P, normal, applied load",
-        "cycle": (
-            "cycle, cycles, n, cycle number, cycle no, cycle nr, cycle count, cycle index, "
-            "n cycle, n cycles, cyc, number of cycles"
-        ),
-    }.items()
+    "displacement": (
+        "displacement",
+        "disp",
+        "delta",
+        "stroke",
+        "position",
+        "x",
+        "s",
+        "displ",
+        "dx",
+        "delta x",
+        "Δ",
+        "Δx",
+        "pos",
+        "travel",
+        "relative displacement",
+        "tangential displacement",
+        "sliding displacement",
+    ),
+    "force": (
+        "force",
+        "Fx",
+        "Ft",
+        "Q",
+        "Ftr",
+        "tangential force",
+        "friction force",
+        "F",
+        "tangential",
+        "tangential load",
+        "friction",
+        "Ff",
+        "Fr",
+        "shear force",
+        "traction",
+    ),
+    "load": (
+        "load",
+        "Fz",
+        "Fn",
+        "normal load",
+        "normal force",
+        "P",
+        "normal",
+        "applied load",
+    ),
+    "cycle": (
+        "cycle",
+        "cycles",
+        "n",
+        "cycle number",
+        "cycle no",
+        "cycle nr",
+        "cycle count",
+        "cycle index",
+        "n cycle",
+        "n cycles",
+        "cyc",
+        "number of cycles",
+    ),
 }
 
 #: How the user chooses a role's column: the keyword of the Python API and the option of
