@@ -71,16 +71,7 @@ SYNONYMS = {
         "shear force",
         "traction",
     ),
-    "load": (
-        "load",
-        "Fz",
-        "Fn",
-        "normal load",
-        "normal force",
-        "P",
-        "normal",
-        "applied load",
-    ),
+    "load": ("load", "Fz", "Fn", "normal load", "normal force", "P", "normal", "applied load"),
     "cycle": (
         "cycle",
         "cycles",
