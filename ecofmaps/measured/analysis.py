@@ -71,73 +71,67 @@ def analyze_loops(
     Parameters
     ----------
     displacement : array_like, dask.array.Array or xarray.DataArray
-        Applied displacement :math:`\Delta` at each sample, in time order (the sampling
-        need not be uniform); a dask array is analysed out of core. [m]
+        Applied displacement :math:`\Delta` at each sample, in time order (any sampling); a
+        dask array is analysed out of core. [m]
     force : array_like, dask.array.Array or xarray.DataArray
-        Tangential force :math:`Q` at each sample, positive in the direction of positive
-        displacement (the loops then run clockwise). [N]
+        Tangential force :math:`Q` at each sample, positive along positive displacement. [N]
     load : float or array_like
-        Normal load :math:`P`; or the load recorded at each sample, to which each cycle's
-        forces, energy and stiffness are then given (``normal_load``;
-        :func:`ecofmaps.measured.pipeline.force_at_mean_load`). [N]
+        Normal load :math:`P`, or the load recorded at each sample (each cycle's values are
+        then at its own load, ``normal_load``). [N]
     cycle : array_like, optional
-        Cycle number of each sample: each run of equal numbers is one loop. Without it the
-        recording is cut at its displacement reversals, or read as a single loop. [1]
+        Cycle number of each sample (a run of equal numbers is one loop); by default the
+        recording is cut at its displacement reversals. [1]
     hysteresis : float
         Half-width of the reversal detector's band, as a share of the displacement's
         half-range (0 < hysteresis < 1). [1]
     stick_window : tuple of float
-        Shares of a branch's force swing, away from its reversal, between which the
-        stick segment is first sought (0 <= low < high <= 1). [1]
+        Shares of a branch's force swing, from its reversal, where the stick segment is
+        first sought (0 <= low < high <= 1). [1]
     crossing_window : float
-        Half-width of the window fitted at each GICoF crossing, in contact position, as a
-        share of the slip amplitude (> 0). [1]
+        Half-width of the window fitted at each GICoF crossing, as a share of the slip
+        amplitude (> 0). [1]
     gross_slip_threshold : float
         Energy ratio :math:`A` above which a loop is gross slip (0 < threshold < 1). [1]
     rig_stiffness : float, optional
-        The rig's own stiffness :math:`S`, when known: the ratios are then also read on the
-        contact's displacement :math:`\Delta - Q/S`, which decides the regime. [N/m]
+        The rig's own stiffness :math:`S`, when known: the regime is then decided on the
+        contact's displacement :math:`\Delta - Q/S`. [N/m]
     flip_force : bool
-        Read the force with the other sign (a rig whose loops run anticlockwise).
+        Read the force with the other sign (loops that run anticlockwise).
     resolve : bool
-        Also read each loop along the stroke (:func:`ecofmaps.resolve_loops`), about ten
-        times the work.
+        Also read each loop along the stroke (:func:`ecofmaps.resolve_loops`, ``mu_resolved``;
+        about ten times the work).
     keep_loops : bool
         Also return the centred loops, ``loop_displacement`` and ``loop_force`` over
-        ``(cycle, point)`` (NaN-padded), for plotting (recordings in memory only).
+        ``(cycle, point)`` (NaN-padded; recordings in memory only).
     missing : array_like of bool, optional
         True for samples to treat as missing besides the non-finite ones.
     nan_policy : {'skip', 'raise'}
-        A cycle that holds a missing sample is skipped, its ``quality``
-        ``'missing-samples'``; or any missing sample raises :class:`MissingSampleError`.
+        Skip a cycle that holds a missing sample (``quality`` ``'missing-samples'``), or raise
+        :class:`MissingSampleError`.
     scheduler : {None, 'threads', 'processes'}, str or distributed.Client
-        Where a dask recording's blocks run: the current ``distributed`` client if there
-        is one, else threads (None); threads; a ``LocalCluster`` of ``workers``
-        processes; the dask scheduler at an address (``'tcp://host:8786'``); or a client.
+        Where a dask recording's blocks run: the current ``distributed`` client, else threads
+        (None); threads; a local cluster of ``workers`` processes; a scheduler's address.
     workers : int, optional
         Threads, or processes of the local cluster (default: one per core; 2).
 
     Returns
     -------
     results : xarray.Dataset
-        Over ``cycle``, each column of ``docs/loops.md`` in SI units (amplitude [m], ecof,
-        gicof, ..., regime as :class:`ecofmaps.Regime` codes, quality: 'ok' or why values
-        are NaN; with ``resolve``, mu_resolved; with a recorded load, normal_load [N]); the
-        load is a scalar coordinate; the attributes are listed there too.
+        Over ``cycle``, the columns and attributes of ``docs/loops.md`` in SI units (``regime``
+        as :class:`ecofmaps.Regime` codes, ``quality`` 'ok' or why values are NaN); the load is
+        a scalar coordinate.
 
     Raises
     ------
     ValueError
-        For inputs of the wrong shape, a load that is not positive (a recorded one:
-        nowhere), options out of range, a recording without a complete cycle, or one whose
-        every cycle is refused (the message says what to do); :class:`MissingSampleError`
-        for a missing sample with ``nan_policy='raise'``.
+        For inputs of the wrong shape, options out of range, a load nowhere positive, or a
+        recording without a usable cycle; :class:`MissingSampleError` with ``nan_policy='raise'``.
 
     Warns
     -----
     LoopQualityWarning
-        When cycles were flagged (other than for partial slip), with the one-line summary,
-        or have a coefficient of friction outside 0.01 to 3 (``implausible-cof``).
+        When cycles were flagged (other than for partial slip) or have a coefficient of
+        friction outside 0.01 to 3, with the one-line summary.
 
     References
     ----------
@@ -152,8 +146,6 @@ def analyze_loops(
     >>> results = ecofmaps.analyze_loops(np.asarray(displacement), np.asarray(force), 450.0)
     >>> print(f"{float(results.gicof[0]):.6f} {float(results.ecof[0]):.3f}")
     0.800000 0.831
-    >>> print(results.quality.values[0], "|", results.attrs["quality_summary"])
-    ok | 1 cycle: 1 ok
     """
     force, load, loads = _at_mean_load(force, load)
     options = pipeline.LoopOptions(
@@ -259,43 +251,32 @@ def resolve_loops(
     Parameters
     ----------
     displacement, force, load, cycle
-        As for :func:`ecofmaps.analyze_loops`: [m], [N], [N] (a recorded load gives the
-        forces and the stiffness at each cycle's own load), [1].
+        As for :func:`ecofmaps.analyze_loops`. [m], [N], [N], [1]
     stiffness : float, optional
-        Rig stiffness :math:`S` (``numpy.inf`` for a rigid rig); by default measured on
-        each loop. [N/m]
+        Rig stiffness :math:`S` (``numpy.inf``: rigid); by default measured on each loop. [N/m]
     force_offset : float, optional
-        The force sensor's offset, subtracted from the recorded force. By default each
-        loop is centred on its own force instead, which also takes away the force a
-        tilted groove adds to both branches: give the offset (0 for a zeroed sensor) to
-        read a groove's tilt. [N]
+        The force sensor's offset, subtracted from the force; by default each loop is centred
+        on its own force, which also levels a tilted groove (give it to read the tilt). [N]
     positions : int or array_like or None
-        Points of the grid of contact positions common to all cycles, odd (>= 5) so that
-        :math:`\xi = 0` is one, spread over the widest resolved range; or the positions
-        themselves, increasing and with 0 among them; or None for the per-cycle values
-        alone. [1] or [m]
+        An odd count (>= 5) of positions common to all cycles, over the widest resolved range;
+        or the positions, increasing, 0 among them; or None for per-cycle values only. [1], [m]
     central : float
-        Share of the resolved half-range, about :math:`\xi = 0`, averaged for
-        ``mu_resolved`` and fitted for ``aspect_ratio`` (0 < central <= 1). [1]
+        Share of the resolved half-range about :math:`\xi = 0` averaged for ``mu_resolved``
+        and fitted for ``aspect_ratio`` (0 < central <= 1). [1]
     slip_threshold : float
-        How many noise standard deviations of :math:`\xi` a sample must lie beyond the
-        stick level to count as slipping (> 0). [1]
+        Noise standard deviations of :math:`\xi` beyond the stick level that count as slip
+        (> 0). [1]
     stick_window, hysteresis, gross_slip_threshold
-        As for :func:`ecofmaps.analyze_loops` (``stick_window`` bounds the first stick
-        window here too). [1]
+        As for :func:`ecofmaps.analyze_loops`. [1]
 
     Returns
     -------
     resolved : xarray.Dataset
-        Over ``(cycle, position)``: ``mu`` :math:`\mu(\xi)`, ``slope`` :math:`g(\xi)`,
-        ``felt_profile`` :math:`h(\xi)` [m], ``force_forward`` and ``force_backward``
-        :math:`Q_\pm(\xi)` [N]; NaN outside the range where both branches slip (``slope``
-        and ``felt_profile`` levelled when the force is centred). Over ``cycle``:
-        ``mu_resolved``, ``mu_resolved_se``, ``aspect_ratio``, ``tilt`` (:math:`g_0`),
-        ``stiffness`` (the one used) [N/m], ``position_offset``, ``position_min``,
-        ``position_max`` [m], ``amplitude`` (:math:`\Delta^*`, the :math:`x_o` of
-        ``aspect_ratio``) [m] and ``quality``. The ``position`` coordinate is :math:`\xi`
-        [m]; the load is a scalar coordinate.
+        Over ``(cycle, position)`` (``position``: :math:`\xi` [m]): ``mu``, ``slope``,
+        ``felt_profile`` [m], ``force_forward``, ``force_backward`` [N], NaN where a branch
+        does not slip. Over ``cycle``: ``mu_resolved``, ``mu_resolved_se``, ``aspect_ratio``,
+        ``tilt``, ``stiffness`` [N/m], ``position_offset``, ``position_min``,
+        ``position_max``, ``amplitude`` [m] and ``quality``; the load is a scalar coordinate.
 
     Raises
     ------

@@ -1,6 +1,6 @@
 """Step 5 of the loop pipeline: friction and groove slope read along the whole stroke of each
-loop, with the flags of its checks (its numerics in ``resolve_branches``);
-``docs/method-loops.md`` ("Reading the loop along the stroke")."""
+loop, its options checked and its Dataset with the flags of its checks (its numerics in
+``resolve_branches``); ``docs/method-loops.md`` ("Reading the loop along the stroke")."""
 
 from __future__ import annotations
 
@@ -11,28 +11,8 @@ import xarray as xr
 
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._inputs import check
-from ecofmaps._interrupts import check_interrupted
-from ecofmaps.measured.quality import (
-    ALL,
-    GICOF_WIGGLE,
-    READING_REASONS,
-    REASONS,
-    RESOLVED,
-    SCATTER_BLOCKS,
-    SLIP_SAMPLES,
-    VARIATION,
-    VARIATION_SIGNIFICANCE,
-    add_reason,
-    has_reason,
-)
-from ecofmaps.measured.resolve_branches import (
-    branch_noise,
-    masked_median,
-    masked_sum,
-    read_branches,
-    sample_weights,
-    slip_branches,
-)
+from ecofmaps.measured.quality import ALL, REASONS, RESOLVED, add_reason, has_reason
+from ecofmaps.measured.resolve_branches import along_stroke_values
 
 __all__ = [
     "ReadingOptions",
@@ -199,6 +179,10 @@ def resolve_analyzed_loops(
     return read_along_stroke(loops, options)[0]
 
 
+#: The reasons that leave the resolved values NaN.
+_REACHING = [r for r, (_, scope) in REASONS.items() if scope == ALL or set(RESOLVED) & set(scope)]
+
+
 def read_along_stroke(loops: xr.Dataset, options: ReadingOptions):
     """:func:`resolve_analyzed_loops` on options checked, and the flags of its reasons
     (reason -> per cycle) besides the Dataset."""
@@ -216,7 +200,7 @@ def read_along_stroke(loops: xr.Dataset, options: ReadingOptions):
     quality, amplitude = loops["quality"].values, values("amplitude")
     inherited = np.logical_or.reduce([has_reason(quality, reason) for reason in _REACHING])
     with np.errstate(divide="ignore", invalid="ignore"):
-        per_position, per_cycle, flags, grid = _along_stroke_values(
+        per_position, per_cycle, flags, grid = along_stroke_values(
             x, q, load, rig, amplitude, inherited, options, values("force_drift_se")
         )
         per_cycle["position_offset"] = (
@@ -244,192 +228,3 @@ def read_along_stroke(loops: xr.Dataset, options: ReadingOptions):
         "stick_window": list(options.stick_window),
     }
     return xr.Dataset(data, coords=coords, attrs=attrs), flags
-
-
-#: The reasons this reading adds to a cycle's ``quality`` that leave its values NaN, in the
-#: order they are tested (``'gicof-varies'``, which reaches the GICoF only, comes besides).
-_QUALITY_FLAGS = READING_REASONS[:4]
-#: Values of μ(ξ) beyond this many robust standard deviations of the median are clipped.
-_WINSOR = 3.0
-#: The largest lag-one autocorrelation of the block means that is believed.
-_R1 = 0.8
-#: Cycles analysed together: a block's arrays stay in the processor's cache.
-_BLOCK = 512
-#: Points of each cycle's own grid over its central part, for the per-cycle values.
-_CENTRAL_POINTS = 201
-#: The median absolute deviation of a normal distribution over its standard deviation.
-_MAD = 1.482602218505602
-
-
-def _central_values(forward, backward, central, load):
-    """mu_resolved, its variance, k and g0 of g ≈ g0 + kξ, the sensitivity to 1/S."""
-    width = forward[0].shape[1]
-    unit = np.linspace(-1.0, 1.0, _CENTRAL_POINTS)
-    at = central[:, None] * unit[None, :]
-    inside = np.broadcast_to(np.isfinite(central)[:, None], at.shape)
-    q_forward, q_backward, mu, slope, lines = read_branches(
-        forward, backward, unit, central, inside, load
-    )
-    finite = np.isfinite(mu)
-    points = np.count_nonzero(finite, axis=1)
-    middle = masked_median(mu, finite)
-    bound = (_WINSOR * _MAD * masked_median(np.abs(mu - middle[:, None]), finite))[:, None]
-    clipped = np.clip(mu, middle[:, None] - bound, middle[:, None] + bound)
-    mu_resolved = masked_sum(clipped, finite) / points
-    # The noise variance: each branch's noise through the weights of its samples. The same
-    # for the difference between the means over the inner and the outer half of the part.
-    kept = finite & (np.abs(mu - middle[:, None]) <= bound)
-    inner = kept & (np.abs(unit) <= 0.5)
-    outer = kept & ~inner
-    inner_points = np.count_nonzero(inner, axis=1)[:, None]
-    outer_points = np.count_nonzero(outer, axis=1)[:, None]
-    contrast = np.where(inner, 1.0 / inner_points, np.where(outer, -1.0 / outer_points, 0.0))
-    variation = masked_sum(mu * contrast, kept)
-    factor = 0.5 * (1.0 + mu**2) / load
-    variance, variation_variance = np.zeros((2, central.size))
-    for branch, force, (left, share), sign in zip(
-        (forward, backward), (q_forward, q_backward), lines, (1.0, -1.0), strict=True
-    ):
-        gain = np.where(kept, sign * factor / (1.0 + (force / load) ** 2), 0.0)
-        noise = branch_noise(*branch, central) ** 2
-        weight = sample_weights(left, share, gain / points[:, None], width)
-        variance += noise * np.sum(weight**2, axis=1)
-        weight = sample_weights(left, share, gain * contrast, width)
-        variation_variance += noise * np.sum(weight**2, axis=1)
-    varies = (np.abs(variation) > VARIATION * np.abs(mu_resolved)) & (
-        np.abs(variation) > VARIATION_SIGNIFICANCE * np.sqrt(variation_variance)
-    )
-    mean_xi, mean_g = masked_sum(at, finite) / points, masked_sum(slope, finite) / points
-    dxi = at - mean_xi[:, None]
-    k = masked_sum(dxi * (slope - mean_g[:, None]), finite) / masked_sum(dxi**2, finite)
-    # The sensitivities of mu_resolved to the compliance 1/S and to a shift of the rising
-    # branch against the falling one along ξ.
-    turning = k[:, None] / (1.0 + slope**2)
-    factor = 0.5 * (1.0 + mu_resolved**2) / points
-    sensitivity = factor * masked_sum(turning * (q_forward - q_backward), finite)
-    shifting = -factor * masked_sum(turning, finite)
-    # An offset ε of the falling branch's force against the rising one's moves Q± by ∓ε/2.
-    lifts = 1.0 / (1.0 + (q_forward / load) ** 2) + 1.0 / (1.0 + (q_backward / load) ** 2)
-    offsetting = 0.5 * factor * masked_sum(lifts, finite) / load
-    # The scatter of μ(ξ) beyond the noise: correlated residuals, the model's misfit.
-    scatter, wiggle = _scatter_variance(mu, finite, unit)
-    # μ(ξ) wiggles along the stroke beyond the noise: the GICoF, read at one position,
-    # is not the mean friction (a straight trend is the same at the centre).
-    excess = np.sqrt(np.maximum(wiggle - variance * SCATTER_BLOCKS, 0.0))
-    wavers = excess > GICOF_WIGGLE * np.abs(mu_resolved)
-    variance = np.fmax(variance, scatter)  # the noise alone where too few blocks
-    tilt = mean_g - k * mean_xi
-    return mu_resolved, variance, k, tilt, sensitivity, varies, shifting, wavers, offsetting
-
-
-def _scatter_variance(mu, kept, unit):
-    r"""Variance of the mean of ``mu`` over ``kept`` from the scatter of its block means."""
-    member = np.minimum((0.5 * (unit + 1.0) * SCATTER_BLOCKS).astype(int), SCATTER_BLOCKS - 1)
-    blocks = member[:, None] == np.arange(SCATTER_BLOCKS)[None, :]
-    counts = kept.astype(np.float64) @ blocks
-    means = (np.where(kept, mu, 0.0) @ blocks) / np.maximum(counts, 1.0)
-    used = counts > 0
-    number = np.count_nonzero(used, axis=1)
-    centre = masked_sum(means, used) / number
-    residual = np.where(used, means - centre[:, None], 0.0)
-    squares = np.sum(residual**2, axis=1)
-    lagged = np.sum(residual[:, 1:] * residual[:, :-1], axis=1)
-    r1 = np.clip(np.divide(lagged, squares, out=np.zeros_like(squares), where=squares > 0), 0, _R1)
-    spread = squares / np.maximum(number - 1, 1) / np.maximum(number, 1)
-    place = np.where(used, np.arange(SCATTER_BLOCKS)[None, :], 0.0)
-    place = np.where(used, place - (masked_sum(place, used) / number)[:, None], 0.0)
-    trend = np.sum(residual * place, axis=1) / np.sum(place**2, axis=1)
-    wiggle = np.sum((residual - trend[:, None] * place) ** 2, axis=1) / (number - 2)
-    few = number < 3
-    return np.where(few, np.nan, spread * (1.0 + r1) / (1.0 - r1)), np.where(few, np.nan, wiggle)
-
-
-def _along_stroke(part, grid, tilt, load, level):
-    """Q±, μ, g (levelled by ``tilt`` if ``level``) and h of a block over the common ``grid``."""
-    lowest, highest = part["lowest"][:, None], part["highest"][:, None]
-    cycles = tilt.size
-    inside = np.isfinite(tilt)[:, None] & (grid >= lowest) & (grid <= highest)
-    q_forward, q_backward, mu, slope, _ = read_branches(
-        part["forward"], part["backward"], grid, np.ones(cycles), inside, load
-    )
-    if level:
-        slope = slope - tilt[:, None]
-    # The felt profile: trapezoidal integral of g, zero at ξ = 0.
-    pieces = np.nan_to_num(0.5 * (slope[:, 1:] + slope[:, :-1]) * np.diff(grid))
-    profile = np.concatenate([np.zeros((cycles, 1)), np.cumsum(pieces, axis=1)], axis=1)
-    profile -= profile[:, np.searchsorted(grid, 0.0)][:, None]
-    return mu, slope, np.where(inside, profile, np.nan), q_forward, q_backward
-
-
-#: The values along the stroke, over (cycle, position), as :func:`_along_stroke` returns them.
-_ALONG = ("mu", "slope", "felt_profile", "force_forward", "force_backward")
-#: The reasons that leave the resolved values NaN.
-_REACHING = [r for r, (_, scope) in REASONS.items() if scope == ALL or set(RESOLVED) & set(scope)]
-
-
-def _along_stroke_values(x, q, load, stiffness, amplitude, inherited, options, drift_se):
-    """Every resolved quantity of the centred loops ``x``, ``q``."""
-    cycles, valid = x.shape[0], np.isfinite(x) & np.isfinite(q)
-    blocks = [slice(start, start + _BLOCK) for start in range(0, max(cycles, 1), _BLOCK)]
-    parts = []
-    for block in blocks:
-        check_interrupted()
-        part = slip_branches(*(a[block] for a in (x, q, valid, stiffness, amplitude)), options)
-        lowest, highest = part["lowest"], part["highest"]
-        overlap = (lowest < 0.0) & (highest > 0.0)
-        usable = ~inherited[block] & ~part["mismatch"] & overlap
-        central = np.where(usable, options.central * np.minimum(highest, -lowest), np.nan)
-        values = _central_values(part["forward"], part["backward"], central, load)
-        samples = [
-            np.count_nonzero(np.abs(np.where(np.isfinite(xs), xs, np.inf)) <= central[:, None], 1)
-            for xs, _, _ in (part["forward"], part["backward"])
-        ]
-        few = (np.minimum(*samples) < SLIP_SAMPLES) | ~np.isfinite(values[0])
-        flags = (part["mismatch"], ~overlap, few, values[5])
-        part["flags"] = np.where(inherited[block], 0, np.select(flags, range(1, 5), 0))
-        part["values"] = values
-        if options.positions is None:  # the branches are not read again: not held
-            del part["forward"], part["backward"]
-        parts.append(part)
-
-    def joined(name):
-        return np.concatenate([part[name] for part in parts])
-
-    flag = joined("flags")
-    flags = {reason: flag == code for code, reason in enumerate(_QUALITY_FLAGS, start=1)}
-    ok = ~inherited & (flag == 0)
-    mu_resolved, variance, k, tilt, sensitivity, _, shifting, wavers, offsetting = (
-        np.concatenate(values) for values in zip(*(part["values"] for part in parts), strict=True)
-    )
-    flags["gicof-varies"] = wavers & ((flag == 0) | (flag == 4)) & ~inherited
-    lowest, highest = joined("lowest"), joined("highest")
-    nan = np.where(ok, 1.0, np.nan)
-    per_cycle = {
-        "mu_resolved": mu_resolved * nan,
-        "mu_resolved_se": np.sqrt(
-            variance
-            + (sensitivity * joined("compliance_se")) ** 2
-            + (shifting * joined("shift")) ** 2
-            + (offsetting * drift_se) ** 2
-        )
-        * nan,
-        "aspect_ratio": 0.5 * k * amplitude * nan,
-        "tilt": tilt * nan,
-        "stiffness": 1.0 / joined("compliance"),
-        "position_min": lowest * nan,
-        "position_max": highest * nan,
-    }
-    grid = options.positions
-    if grid is None:
-        return {}, per_cycle, flags, None
-    if np.ndim(grid) == 0:  # over the widest resolved range, or the stroke if none is
-        reach = np.maximum(highest, -lowest)[ok]
-        half = reach.max() if reach.size else np.max(amplitude, initial=0.0, where=amplitude > 0)
-        grid = np.linspace(-1.0, 1.0, grid) * (half if half > 0.0 else 1.0)
-    level = options.force_offset is None
-    along = [
-        _along_stroke(part, grid, per_cycle["tilt"][block], load, level)
-        for part, block in zip(parts, blocks, strict=True)
-    ]
-    per_position = {name: np.concatenate([a[i] for a in along]) for i, name in enumerate(_ALONG)}
-    return per_position, per_cycle, flags, grid
