@@ -20,7 +20,6 @@ from ecofmaps.model.simulation import simulate
 __all__ = [
     "EXAMPLE",
     "LONG_TEST",
-    "SCAR_EXAMPLE",
     "example_path",
     "example_recording",
     "long_recording",
@@ -53,7 +52,9 @@ def synthetic_recording(
     sampling_jitter=0.0,
     seed=0,
 ):
-    r"""A recording of consecutive fretting cycles under a sinusoidal displacement.
+    r"""A recording of consecutive fretting cycles under the displacement
+    :math:`\Delta(t) = -\Delta^*\cos 2\pi t`, the force :func:`ecofmaps.simulate`'s (eq. 9, 10),
+    with noise, offsets and drift added to the recorded signals only, as a sensor would.
 
     Parameters
     ----------
@@ -68,34 +69,25 @@ def synthetic_recording(
     cycles : int, optional
         Number of cycles; by default one per value of ``aspect_ratio``. [1]
     samples_per_cycle : int
-        Samples in each cycle (at least :data:`~ecofmaps.measured.cycles.MIN_SAMPLES`). [1]
+        Samples in each cycle (>= 8). [1]
     start_phase : float
-        Phase of the first sample, in cycles: 0 starts at the lowest displacement,
-        0.25 at zero displacement on the rise. [1]
+        Phase of the first sample: 0 at the lowest displacement, 0.25 at zero on the rise. [1]
     displacement_noise, force_noise : float
-        Standard deviations of the Gaussian noise added to the recorded displacement [m]
-        and force [N].
+        Standard deviations of the Gaussian noise on the displacement [m] and force [N].
     displacement_offset, force_offset : float
-        Constant offsets added to the recorded displacement [m] and force [N].
+        Constant offsets of the displacement [m] and force [N].
     displacement_drift : float
-        Drift of the recorded displacement per cycle, growing linearly in time. [m]
+        Drift of the displacement per cycle, linear in time. [m]
     sampling_jitter : float
-        Each sampling instant moves at random by up to this share of the sampling
-        interval either way (0 <= jitter < 0.5), for a non-uniform clock. [1]
+        Each sampling instant moves at random by up to this share of the sampling interval
+        either way (0 <= jitter < 0.5). [1]
     seed : int
         Seed of the random numbers (noise and jitter).
 
     Returns
     -------
     displacement, force : numpy.ndarray
-        The recorded signals, ``cycles * samples_per_cycle`` samples. [m], [N]
-
-    Notes
-    -----
-    The actuator imposes :math:`\Delta(t) = -\Delta^*\cos 2\pi t`; the force is
-    :func:`ecofmaps.simulate`'s stick/slip history for it (eq. 9, 10), which does not
-    depend on the sampling. The noise, offsets and drift are added to the recorded
-    signals only, as a sensor would.
+        ``cycles * samples_per_cycle`` samples. [m], [N]
 
     References
     ----------
@@ -288,7 +280,9 @@ LONG_TEST = {
 
 
 def long_recording(cycles, samples_per_cycle=200, *, block_cycles=4096, seed=0, **parameters):
-    r"""A long fretting test, generated block by block with bounded memory.
+    r"""A long fretting test, generated block by block with bounded memory: cycle :math:`N` of
+    :func:`synthetic_recording` with the groove :math:`z_o/x_o = r_f \sqrt{N / N_{total}}`,
+    :math:`x_o = \Delta^*`, as in :func:`example_recording`, the drift running on over blocks.
 
     Parameters
     ----------
@@ -297,15 +291,14 @@ def long_recording(cycles, samples_per_cycle=200, *, block_cycles=4096, seed=0, 
     samples_per_cycle : int
         Samples per cycle (>= 8). [1]
     block_cycles : int
-        Cycles simulated at a time: the memory used is a few arrays of
-        ``block_cycles * samples_per_cycle`` samples. [1]
+        Cycles simulated at a time (memory: a few arrays of ``block_cycles *
+        samples_per_cycle`` samples). [1]
     seed : int
-        Seed of the noise: block ``k`` uses its own stream derived from ``(seed, k)``, so the
-        recording depends on ``seed`` and ``block_cycles`` only.
+        Seed of the noise: block ``k`` uses a stream derived from ``(seed, k)``.
     **parameters
-        Any of :data:`LONG_TEST`, in SI units as for :func:`synthetic_recording`:
-        ``final_aspect_ratio`` is the groove's z_o/x_o at the end of the test [1],
-        ``displacement_drift`` the drift over the whole test [m].
+        Any of :data:`LONG_TEST`, in SI units as for :func:`synthetic_recording`;
+        ``final_aspect_ratio`` is :math:`r_f` [1], ``displacement_drift`` the drift over the
+        whole test [m].
 
     Yields
     ------
@@ -313,13 +306,6 @@ def long_recording(cycles, samples_per_cycle=200, *, block_cycles=4096, seed=0, 
         The 1-based test cycle of each sample of the block. [1]
     displacement, force : numpy.ndarray
         The recorded signals of the block. [m], [N]
-
-    Notes
-    -----
-    Cycle :math:`N` (1-based) has the groove :math:`z_o/x_o = r_f \sqrt{N / N_{total}}`,
-    :math:`x_o = \Delta^*`, as in :func:`example_recording`; each block is
-    :func:`synthetic_recording`'s steady loops (eq. 9, 10), its offset advanced by the drift
-    so far, so the drift runs on without a step from block to block.
 
     References
     ----------
