@@ -19,6 +19,9 @@ from ecofmaps.measured.samples import MissingSampleError, is_lazy
 
 __all__ = ["analyze_loops", "resolve_loops"]
 
+#: What the analysis does with missing samples: skip their cycles, or raise.
+NAN_POLICIES = ("skip", "raise")
+
 
 def _series(name, values, size=None, dtype=np.float64):
     """``values`` as a 1-D array (NumPy, or dask as it is) of ``size`` samples."""
@@ -71,25 +74,21 @@ def analyze_loops(
     Parameters
     ----------
     displacement : array_like, dask.array.Array or xarray.DataArray
-        Applied displacement :math:`\Delta` at each sample, in time order (any sampling); a
-        dask array is analysed out of core. [m]
+        Applied displacement :math:`\Delta` at each sample, in time order (dask: out of core). [m]
     force : array_like, dask.array.Array or xarray.DataArray
         Tangential force :math:`Q` at each sample, positive along positive displacement. [N]
     load : float or array_like
         Normal load :math:`P`, or the load recorded at each sample (each cycle's values are
         then at its own load, ``normal_load``). [N]
     cycle : array_like, optional
-        Cycle number of each sample (a run of equal numbers is one loop); by default the
-        recording is cut at its displacement reversals. [1]
+        Cycle number of each sample (a run of equal numbers is one loop; default: reversals). [1]
     hysteresis : float
-        Half-width of the reversal detector's band, as a share of the displacement's
-        half-range (0 < hysteresis < 1). [1]
+        Half-width of the reversal band, as a share of the displacement's half-range (< 1). [1]
     stick_window : tuple of float
         Shares of a branch's force swing, from its reversal, where the stick segment is
         first sought (0 <= low < high <= 1). [1]
     crossing_window : float
-        Half-width of the window fitted at each GICoF crossing, as a share of the slip
-        amplitude (> 0). [1]
+        Half-width of the fit at each GICoF crossing, as a share of the slip amplitude. [1]
     gross_slip_threshold : float
         Energy ratio :math:`A` above which a loop is gross slip (0 < threshold < 1). [1]
     rig_stiffness : float, optional
@@ -106,8 +105,7 @@ def analyze_loops(
     missing : array_like of bool, optional
         True for samples to treat as missing besides the non-finite ones.
     nan_policy : {'skip', 'raise'}
-        Skip a cycle that holds a missing sample (``quality`` ``'missing-samples'``), or raise
-        :class:`MissingSampleError`.
+        Skip a cycle with a missing sample (``'missing-samples'``), or raise at the first one.
     scheduler : {None, 'threads', 'processes'}, str or distributed.Client
         Where a dask recording's blocks run: the current ``distributed`` client, else threads
         (None); threads; a local cluster of ``workers`` processes; a scheduler's address.
@@ -176,8 +174,8 @@ def _run(
     workers=None,
 ):
     """The recording checked, through the pipeline: the results and the reading handed back."""
-    if nan_policy not in pipeline.NAN_POLICIES:
-        raise ValueError(f"nan_policy must be one of {pipeline.NAN_POLICIES}; got {nan_policy!r}")
+    if nan_policy not in NAN_POLICIES:
+        raise ValueError(f"nan_policy must be one of {NAN_POLICIES}; got {nan_policy!r}")
     if scheduler in (None, "threads", "processes"):  # on this machine: checked before any work
         check_workers(workers, processes=scheduler == "processes")
     x = _series("displacement", displacement)
@@ -188,24 +186,25 @@ def _run(
         raise ValueError(
             f"too few samples for one cycle: {x.shape[0]} (a cycle needs at least {MIN_SAMPLES})"
         )
-    settings = dict(
-        options=options,
-        missing=mask,
-        recorded_load=recorded,
-        nan_policy=nan_policy,
-        reading=reading,
-    )
+    settings = dict(missing=mask, recorded_load=recorded, nan_policy=nan_policy, reading=reading)
     if not any(is_lazy(a) for a in (x, q, label, mask)):
-        if nan_policy == "raise":
-            _raise_at_missing(x, q, label, mask, recorded)
-        return pipeline.Analysis(x, q, label, one_chunk=True, **settings).run()
+        if nan_policy == "raise":  # the first missing sample (a load not positive: its cycle)
+            bad = ~np.isfinite(x) | ~np.isfinite(q)
+            if label is not None and label.dtype.kind not in "iub":
+                bad |= ~np.isfinite(label)
+            if mask is not None:
+                bad |= mask
+            sample = int(np.argmax(bad))
+            if bad[sample] and not (recorded is not None and recorded[sample] <= 0.0):
+                raise MissingSampleError(sample)
+        return pipeline.Analysis(x, q, label, options=options, one_chunk=True, **settings).run()
     if reading.keep_loops:
         raise ValueError(
             "keep_loops needs the recording in memory: give NumPy arrays (a long "
             "recording's loops would not fit)"
         )
     with pipeline.runner_for(scheduler, workers) as runner:
-        return pipeline.Analysis(x, q, label, runner=runner, **settings).run()
+        return pipeline.Analysis(x, q, label, options=options, runner=runner, **settings).run()
 
 
 def _at_mean_load(force, load):
@@ -215,18 +214,6 @@ def _at_mean_load(force, load):
     force = _series("force", force)
     recorded = _series("load", load, force.shape[0])
     return *pipeline.force_at_mean_load(force, recorded), recorded
-
-
-def _raise_at_missing(x, q, label, mask, load=None) -> None:
-    """Raise for the first missing sample in memory (one of a load not positive: at its cycle)."""
-    bad = ~np.isfinite(x) | ~np.isfinite(q)
-    if label is not None and label.dtype.kind not in "iub":
-        bad |= ~np.isfinite(label)
-    if mask is not None:
-        bad |= mask
-    sample = int(np.argmax(bad))
-    if bad[sample] and not (load is not None and load[sample] <= 0.0):
-        raise MissingSampleError(sample)
 
 
 @si_units
@@ -264,8 +251,7 @@ def resolve_loops(
         Share of the resolved half-range about :math:`\xi = 0` averaged for ``mu_resolved``
         and fitted for ``aspect_ratio`` (0 < central <= 1). [1]
     slip_threshold : float
-        Noise standard deviations of :math:`\xi` beyond the stick level that count as slip
-        (> 0). [1]
+        Noise standard deviations of :math:`\xi` beyond the stick level that are slip. [1]
     stick_window, hysteresis, gross_slip_threshold
         As for :func:`ecofmaps.analyze_loops`. [1]
 

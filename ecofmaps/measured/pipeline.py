@@ -1,9 +1,7 @@
-r"""The driver of the loop pipeline, whatever the way in: the options, the chunks of whole cycles
-(each with a halo for the centring), each chunk measured, read along the stroke and judged
-where it runs, on this process or a dask runner, and the parts joined into the table; a
-recorded load is converted here, to the mean load and back to each cycle's own.
-The method is explained in ``docs/method-loops.md`` ("One pipeline, in memory and out of core").
-"""
+r"""The driver of the loop pipeline, whatever the way in: chunks of whole cycles (with a halo for
+the centring), each measured, read along the stroke and judged where it runs (this process or a
+dask runner), the parts joined; a recorded load is converted to the mean load and back here.
+``docs/method-loops.md`` ("One pipeline, in memory and out of core")."""
 
 from __future__ import annotations
 
@@ -25,12 +23,10 @@ from ecofmaps.measured.samples import MissingSampleError
 
 __all__ = [
     "IN_PROCESS",
-    "NAN_POLICIES",
     "TASK_SAMPLES",
     "Analysis",
     "LoopOptions",
     "Reading",
-    "Task",
     "block_file",
     "force_at_mean_load",
     "kept_block",
@@ -43,14 +39,11 @@ __all__ = [
 
 #: Samples of the recording measured by one chunk of a long recording (about; whole cycles).
 TASK_SAMPLES = 1 << 22
-#: What the analysis does with missing samples: skip their cycles, or raise.
-NAN_POLICIES = ("skip", "raise")
 
 
 @dataclasses.dataclass(frozen=True)
 class LoopOptions:
-    """The load and the options of :func:`ecofmaps.analyze_loops` (see there), checked once:
-    a ValueError names the one that is not valid."""
+    """The load and the options of :func:`ecofmaps.analyze_loops`, checked (a ValueError)."""
 
     load: float
     hysteresis: float = 0.5
@@ -90,8 +83,7 @@ IN_PROCESS = _InProcess()
 
 
 def runner_for(scheduler=None, workers=None):
-    """The runner of :func:`ecofmaps.analyze_loops`' ``scheduler`` and ``workers`` (see
-    there), the one place where it is chosen."""
+    """The runner of :func:`ecofmaps.analyze_loops`' ``scheduler`` and ``workers``."""
     if scheduler is None:
         try:
             from distributed import default_client  # only where dask's cluster is used
@@ -110,9 +102,8 @@ def runner_for(scheduler=None, workers=None):
 
 @dataclasses.dataclass(frozen=True)
 class Reading:
-    """What each chunk reads besides the per-cycle values: the reading along the stroke
-    (``resolve``, with its options), the centred loops (``keep_loops``), and whether the
-    whole reading is handed back (``hand_back``)."""
+    """What each chunk reads besides the per-cycle values, and whether the reading along the
+    stroke is handed back whole."""
 
     resolve: bool = False
     keep_loops: bool = False
@@ -124,9 +115,9 @@ class Reading:
 
 @dataclasses.dataclass(frozen=True)
 class Task:
-    """One chunk's work besides its samples: its cycles with their halo, its own ``rows`` among
-    them, the first sample ``low`` of its stretch; ``then`` made of its results, the file to
-    ``keep`` its values and flags in (True: handed back) and the ``columns`` handed back."""
+    """One chunk's work besides its samples: its cycles with their halo, its own ``rows``, its
+    first sample ``low``; ``then`` of its results, where to ``keep`` its values and flags
+    (True: handed back) and the ``columns`` handed back."""
 
     cycles: Cycles
     rows: slice
@@ -140,7 +131,7 @@ class Task:
 
 @dataclasses.dataclass
 class Chunk:
-    """What one chunk hands back (see :func:`measure_chunk`)."""
+    """What :func:`measure_chunk` hands back."""
 
     part: xr.Dataset
     tally: quality.Tally
@@ -187,8 +178,7 @@ def _with_loops(results: xr.Dataset, loops) -> xr.Dataset:
 
 
 def _at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
-    """``dataset`` with the variables that scale with the normal load times ``ratio``, each
-    cycle's load over the mean load (the rest are read at the mean load)."""
+    """``dataset`` with the variables that scale with the load times ``ratio`` (own / mean)."""
     ratio = np.asarray(ratio, dtype=np.float64)
     scaled = (*quality.LOAD_SCALED, "loop_force", "force_forward", "force_backward")
     return dataset.assign(
@@ -198,13 +188,9 @@ def _at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
 
 def _cycle_loads(load, task: Task) -> tuple:
     """The mean, lowest and highest finite ``load`` [N] over each of the task's own cycles."""
-    series, cycles = Stretch(load, task.low), task.cycles
-    first, stop, _ = task.rows.indices(cycles.label.size)
-    start, count = cycles.start[first:stop], cycles.count[first:stop]
-    if start.size == 0:
-        return np.empty(0), np.empty(0), np.empty(0)
+    start, count = task.cycles.start[task.rows], task.cycles.count[task.rows]
     low = int(start.min())
-    values = np.asarray(series[low : int((start + count).max())], dtype=np.float64)
+    values = np.asarray(Stretch(load, task.low)[low : int((start + count).max())], dtype=np.float64)
     finite = np.isfinite(values)
     sums, counts = (
         np.concatenate([[0.0], np.cumsum(a)]) for a in (np.where(finite, values, 0.0), finite)
@@ -218,13 +204,11 @@ def _cycle_loads(load, task: Task) -> tuple:
 
 
 def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
-    """One chunk through the steps: its cycles measured on its stretch ``x``, ``q`` (and the
-    load recorded over it), read along the stroke and judged once."""
-    options, reading, labels = task.options, task.reading, task.cycles.label[task.rows]
+    """One chunk's cycles measured on its stretch ``x``, ``q`` (and load), read and judged."""
+    options, reading, rows = task.options, task.reading, task.rows
     x, q, kept = Stretch(x, task.low), Stretch(q, task.low), reading.resolve or reading.keep_loops
-    values, flags, loops = measure_cycles(
-        task.cycles, x, q, options, rows=task.rows, keep_loops=kept
-    )
+    values, flags, loops = measure_cycles(task.cycles, x, q, options, rows=rows, keep_loops=kept)
+    labels, tally = task.cycles.label[rows], quality.Tally()
     if recorded_load is not None:
         mean, lowest, highest = _cycle_loads(recorded_load, task)
         values["normal_load"] = mean
@@ -236,12 +220,10 @@ def measure_chunk(task: Task, x, q, recorded_load=None) -> Chunk:
         resolved, read = resolve.read_along_stroke(judged, reading.along_stroke)
         values = values | {name: resolved[name].values for name in quality.RESOLVED}
         flags = flags | read
-    part = _part(values, flags, labels, options, loops if reading.keep_loops else None)
+    part = _part(values, flags, labels, options, tally, loops if reading.keep_loops else None)
     handed = resolved if reading.hand_back else None
     if handed is not None and "normal_load" in values:  # as the part: at each cycle's load
         handed = _at_own_load(handed, values["normal_load"] / options.load)
-    tally = quality.Tally()
-    tally.add(part["quality"].values, flags, values["amplitude"])
     if isinstance(task.keep, Path):
         _keep_block(task.keep, values, flags)
     if task.keep is not True:
@@ -261,8 +243,7 @@ def temporary_file(path: Path) -> Path:
 
 
 def write_whole(path: Path, content) -> None:
-    """Write ``content`` (text, or arrays by name: ``.npz``) to ``path``, whole or nothing,
-    through :func:`temporary_file`."""
+    """Write ``content`` (text, or arrays by name: ``.npz``) to ``path``, whole or nothing."""
     temporary = temporary_file(path)
     try:
         if isinstance(content, str):
@@ -276,8 +257,7 @@ def write_whole(path: Path, content) -> None:
 
 
 def _keep_block(path: Path, values: dict, flags: dict) -> None:
-    """Keep what a chunk measured, its ``values`` and ``flags``, in ``path`` (``.npz``), whole
-    or not at all."""
+    """Keep a chunk's measured ``values`` and ``flags`` in ``path`` (``.npz``)."""
     write_whole(
         path, {f"v:{k}": v for k, v in values.items()} | {f"f:{k}": v for k, v in flags.items()}
     )
@@ -295,8 +275,9 @@ def only(part: xr.Dataset, columns=None) -> xr.Dataset:
     return part if columns is None else part[[k for k in columns if k in part.data_vars]]
 
 
-def _part(values: dict, flags: dict, labels, options, loops=None) -> xr.Dataset:
-    """A chunk's results from what it measured, judged once, at each cycle's recorded load."""
+def _part(values: dict, flags: dict, labels, options, tally, loops=None) -> xr.Dataset:
+    """A chunk's results from what it measured, judged once (counted in ``tally``), at each
+    cycle's recorded load."""
     measured = {k: v for k, v in values.items() if k not in quality.RESOLVED}
     part = quality.cycle_results(measured, flags, labels, options)
     read = [name for name in quality.RESOLVED if name in values]
@@ -305,13 +286,13 @@ def _part(values: dict, flags: dict, labels, options, loops=None) -> xr.Dataset:
         part = _with_loops(part, loops)
     if "normal_load" in part:
         part = _at_own_load(part, part["normal_load"].values / options.load)
+    tally.add(part["quality"].values, flags, values["amplitude"])
     return part
 
 
 class Analysis:
-    """One recording through the pipeline in steps a caller can follow, chunk by chunk, on
-    ``runner`` (:func:`runner_for`, entered), from ``cycles`` found before (a resumed run);
-    with a ``recorded_load``, ``force`` is at the mean load (:func:`force_at_mean_load`)."""
+    """One recording through the pipeline chunk by chunk on ``runner`` (entered), from
+    ``cycles`` found before if given; with a ``recorded_load``, ``force`` is at the mean load."""
 
     def __init__(
         self,
@@ -387,9 +368,8 @@ class Analysis:
         return Task(table, inner, low, self.options, self.reading, then, keep, columns), x, q, p
 
     def measured(self, skip=(), then=None, keep=False, columns=None):
-        """Each chunk's :class:`Chunk`, in order, as they come; counted in :attr:`tally`.
-        ``keep``: True to hand back each chunk's values and flags, or the prefix to keep them at
-        (:func:`block_file`), where the chunk runs if the runner is local, else here."""
+        """Each chunk's :class:`Chunk`, in order, counted in :attr:`tally`; ``keep``: True to hand
+        back its values and flags, or the prefix to keep them at (where it ran if local)."""
         wanted = sorted(set(range(len(self.tasks))) - set(skip))
         tasks = (self._task(k, then, keep, columns) for k in wanted)
         results = self.runner.map(measure_chunk, tasks)
@@ -404,21 +384,16 @@ class Analysis:
             results.close()
 
     def part(self, index: int, values: dict, flags: dict) -> xr.Dataset:
-        """The per-cycle results of chunk ``index`` from what it measured (kept by
-        :meth:`measured`), without the recording's attributes; counted in :attr:`tally`."""
+        """Chunk ``index``'s results from what it measured (as kept), counted in :attr:`tally`."""
         labels = self.cycles.label[self.tasks[index]]
-        part = _part(values, flags, labels, self.options)
-        self.tally.add(part["quality"].values, flags, values["amplitude"])
-        return part
+        return _part(values, flags, labels, self.options, self.tally)
 
     def finish(self, parts) -> xr.Dataset:
-        """The parts (all of them, in order) joined, with the recording's attributes, after
-        the checks of the whole recording (see :meth:`ecofmaps.measured.quality.Tally.finish`)."""
+        """All the parts, in order, joined and checked as a whole (:meth:`quality.Tally.finish`)."""
         return self.tally.finish(_joined(list(parts)), self.cycles, self.cycles_from, self.options)
 
     def run(self):
-        """Every chunk, joined (:meth:`finish`); and the reading along the stroke, joined,
-        with :attr:`Reading.hand_back` (else None)."""
+        """Every chunk, joined; and the reading along the stroke if handed back (else None)."""
         chunks = [chunk for _, chunk in self.measured()]
         read = [chunk.resolved for chunk in chunks if chunk.resolved is not None]
         return self.finish(chunk.part for chunk in chunks), _joined(read) if read else None

@@ -169,20 +169,16 @@ def example_recording():
 
 def _on_rig(p, ratio, samples_per_cycle, offset, drift, seed):
     """:func:`synthetic_recording` on the rig of ``p`` from zero on the rise, offset more."""
+    sensors = {k: p[k] for k in ("displacement_noise", "force_noise", "force_offset")}
     return synthetic_recording(
-        p["amplitude"],
-        p["load"],
-        p["stiffness"],
-        p["mu"],
+        *(p[k] for k in ("amplitude", "load", "stiffness", "mu")),
         ratio,
         samples_per_cycle=samples_per_cycle,
         start_phase=0.25,
-        displacement_noise=p["displacement_noise"],
-        force_noise=p["force_noise"],
         displacement_offset=p["displacement_offset"] + offset,
-        force_offset=p["force_offset"],
         displacement_drift=drift,
         seed=seed,
+        **sensors,
     )
 
 
@@ -349,12 +345,11 @@ def write_long_recording(
     Parameters
     ----------
     path : str or os.PathLike
-        ``.tdms``, ``.h5``/``.nc``, ``.zarr`` or ``.csv`` (the format from the suffix, or
-        ``format``).
+        ``.tdms``, ``.h5``/``.nc``, ``.zarr`` or ``.csv``.
     cycles, samples_per_cycle, block_cycles, seed, **parameters
         As for :func:`long_recording`.
     format : str, optional
-        See :class:`ecofmaps.io.writers.RecordingWriter`.
+        The format, if not the suffix's (:class:`ecofmaps.io.writers.RecordingWriter`).
     cycle_numbers : bool
         Also write the cycle number of each sample (a ``cycle`` column).
     chunk_samples : int
@@ -387,14 +382,8 @@ def write_long_recording(
         "seed": int(seed),
         **{name: float(value) for name, value in {**LONG_TEST, **parameters}.items()},
     }
-    with RecordingWriter(
-        path,
-        format=format,
-        cycle=cycle_numbers,
-        chunk_samples=chunk_samples,
-        overwrite=overwrite,
-        attrs=attrs,
-    ) as writer:
+    options = dict(format=format, chunk_samples=chunk_samples, overwrite=overwrite, attrs=attrs)
+    with RecordingWriter(path, cycle=cycle_numbers, **options) as writer:
         for cycle, displacement, force in blocks:
             writer.write(displacement, force, cycle if cycle_numbers else None)
     return Path(path)
