@@ -78,7 +78,6 @@ class _InProcess:
         yield from itertools.starmap(function, tasks)
 
 
-#: The runner of a recording in memory: its chunks run in this process, in order.
 IN_PROCESS = _InProcess()
 
 
@@ -102,8 +101,7 @@ def runner_for(scheduler=None, workers=None):
 
 @dataclasses.dataclass(frozen=True)
 class Reading:
-    """What each chunk reads besides the per-cycle values, and whether the reading along the
-    stroke is handed back whole."""
+    """What each chunk reads besides the per-cycle values, and what it hands back."""
 
     resolve: bool = False
     keep_loops: bool = False
@@ -115,9 +113,8 @@ class Reading:
 
 @dataclasses.dataclass(frozen=True)
 class Task:
-    """One chunk's work besides its samples: its cycles with their halo, its own ``rows``, its
-    first sample ``low``; ``then`` of its results, where to ``keep`` its values and flags
-    (True: handed back) and the ``columns`` handed back."""
+    """One chunk's work besides its samples (its cycles with their halo, its own ``rows``, ...);
+    ``keep``: the file for its values and flags, or True to hand them back."""
 
     cycles: Cycles
     rows: slice
@@ -142,9 +139,8 @@ class Chunk:
 
 
 def force_at_mean_load(force, load):
-    r"""The force at each sample as at the mean load, :math:`Q(t)\,\bar P/P(t)` [N] (NaN where
-    the recorded ``load`` is missing or not positive), and :math:`\bar P`, the mean of the
-    finite positive loads [N] (see ``docs/loops.md``); a ValueError if none is positive."""
+    r"""The force as at the mean load, :math:`Q(t)\,\bar P/P(t)` [N] (NaN where the ``load`` is
+    not positive), and :math:`\bar P`, the mean of the positive loads [N]; ``docs/loops.md``."""
     if isinstance(load, np.ndarray):
         finite = load[np.isfinite(load)]
         usable = np.where(np.isfinite(load) & (load > 0.0), load, np.nan)
@@ -276,8 +272,7 @@ def only(part: xr.Dataset, columns=None) -> xr.Dataset:
 
 
 def _part(values: dict, flags: dict, labels, options, tally, loops=None) -> xr.Dataset:
-    """A chunk's results from what it measured, judged once (counted in ``tally``), at each
-    cycle's recorded load."""
+    """A chunk's results from what it measured, judged (counted in ``tally``), at own load."""
     measured = {k: v for k, v in values.items() if k not in quality.RESOLVED}
     part = quality.cycle_results(measured, flags, labels, options)
     read = [name for name in quality.RESOLVED if name in values]

@@ -49,8 +49,7 @@ def single_value(name: str, value, kind: str, unit: str) -> float:
 
 
 def within(name: str, value, high=None, *, inclusive=False) -> float:
-    """``value`` as a float if ``0 < value`` (and ``< high``, or ``<= high`` if ``inclusive``),
-    else a ValueError that says so."""
+    """``value`` as a float if ``0 < value`` (``< high``, or ``<= high`` if ``inclusive``)."""
     if high is None:
         holds, condition = value > 0.0, f"{name} > 0"
     else:
@@ -97,8 +96,7 @@ def _grid_positions(positions):
 
 @dataclasses.dataclass(frozen=True)
 class ReadingOptions:
-    """The options of the reading along the stroke (see :func:`ecofmaps.resolve_loops`),
-    checked: a ValueError names the one out of range."""
+    """The options of :func:`ecofmaps.resolve_loops`' reading along the stroke, checked."""
 
     stiffness: float | None = None
     force_offset: float | None = None
@@ -184,8 +182,7 @@ _REACHING = [r for r, (_, scope) in REASONS.items() if scope == ALL or set(RESOL
 
 
 def read_along_stroke(loops: xr.Dataset, options: ReadingOptions):
-    """:func:`resolve_analyzed_loops` on options checked, and the flags of its reasons
-    (reason -> per cycle) besides the Dataset."""
+    """:func:`resolve_analyzed_loops` on options checked, and its flags (reason -> per cycle)."""
 
     def values(name):
         return np.asarray(loops[name].values, dtype=np.float64)

@@ -87,8 +87,7 @@ def _compliance(x, q, sticks):
 
 def _stick_and_slip(xi, branches, sticks, floor, slip_threshold):
     """Noise and the slip of each branch."""
-    # σ from the second differences within the stick sets: a smooth trend of ξ (a rounded
-    # loop, a wrong stiffness) hardly enters them, white noise does with variance 6σ².
+    # σ from the second differences in the stick sets (a smooth trend of ξ hardly enters them).
     second = np.abs(xi[:, :-2] - 2.0 * xi[:, 1:-1] + xi[:, 2:])
     triples = np.zeros_like(second, dtype=bool)
     for stick in sticks:
@@ -98,8 +97,7 @@ def _stick_and_slip(xi, branches, sticks, floor, slip_threshold):
     threshold = slip_threshold * sigma + floor
     slips, levels = [], []
     for branch, stick, sign in zip(branches, sticks, (1.0, -1.0), strict=True):
-        # The stick level: the set's median, or the reversal's ξ where the set has too few
-        # samples to judge (a sparse loop, or the model's loop drawn with straight sides).
+        # The stick level: the set's median, or the reversal's ξ where the set is too small.
         level = np.where(_enough(stick), masked_median(xi, stick), _at_first(xi, branch)[:, 0])
         # Slip: beyond the threshold, and every later sample of the branch too.
         beyond = np.where(branch, sign * xi, np.inf)
@@ -143,8 +141,7 @@ def _sorted_branch(xi, q, slip):
 
 
 def slip_branches(x, q, valid, stiffness, amplitude, options):
-    """The stiffness (given in ``options``, else fitted), the checks of the stick sets, and the
-    two slip branches."""
+    """The stiffness (given, else fitted), the checks of the stick sets and the slip branches."""
     cycles, given = x.shape[0], options.stiffness is not None
     floor = _ROUNDING * amplitude
     branches = _branches(x, valid)
@@ -155,8 +152,7 @@ def slip_branches(x, q, valid, stiffness, amplitude, options):
         _before(share > high, branch) & (share >= low)
         for share, branch in zip(moved, branches, strict=True)
     ]
-    # First pass, with the given stiffness or analyze_loops's and the stick windows: where
-    # does the slip start?
+    # First pass, with the given or analyze_loops's stiffness and the windows: where is slip?
     start = np.where(np.isinf(stiffness), 0.0, 1.0 / stiffness)
     xi = x - start[:, None] * q
     _, slips, _ = _stick_and_slip(xi, branches, windows, floor, slip_threshold)
@@ -203,8 +199,7 @@ def _resample(xs, qs, count, grid, scale, inside):
     cycles, width = xs.shape
     points = grid.size
     at = scale[:, None] * grid[None, :]
-    # How many samples lie at or below each position: each sample counts from the first
-    # grid point at or above it on (a histogram over the grid, summed).
+    # How many samples lie at or below each position: a histogram over the grid, summed.
     with np.errstate(invalid="ignore", divide="ignore"):
         bins = np.searchsorted(grid, xs / scale[:, None], side="left")
     rows = (points + 1) * np.arange(cycles)[:, None]
@@ -302,8 +297,7 @@ def _central_values(forward, backward, central, load):
     bound = (_WINSOR * _MAD * masked_median(np.abs(mu - middle[:, None]), finite))[:, None]
     clipped = np.clip(mu, middle[:, None] - bound, middle[:, None] + bound)
     mu_resolved = masked_sum(clipped, finite) / points
-    # The noise variance: each branch's noise through the weights of its samples. The same
-    # for the difference between the means over the inner and the outer half of the part.
+    # The noise variance through each branch's sample weights, of the mean and of the contrast.
     kept = finite & (np.abs(mu - middle[:, None]) <= bound)
     inner = kept & (np.abs(unit) <= 0.5)
     outer = kept & ~inner
@@ -328,8 +322,7 @@ def _central_values(forward, backward, central, load):
     mean_xi, mean_g = masked_sum(at, finite) / points, masked_sum(slope, finite) / points
     dxi = at - mean_xi[:, None]
     k = masked_sum(dxi * (slope - mean_g[:, None]), finite) / masked_sum(dxi**2, finite)
-    # The sensitivities of mu_resolved to the compliance 1/S and to a shift of the rising
-    # branch against the falling one along ξ.
+    # The sensitivities of mu_resolved to the compliance 1/S and to a shift of a branch along ξ.
     turning = k[:, None] / (1.0 + slope**2)
     factor = 0.5 * (1.0 + mu_resolved**2) / points
     sensitivity = factor * masked_sum(turning * (q_forward - q_backward), finite)
@@ -339,8 +332,7 @@ def _central_values(forward, backward, central, load):
     offsetting = 0.5 * factor * masked_sum(lifts, finite) / load
     # The scatter of μ(ξ) beyond the noise: correlated residuals, the model's misfit.
     scatter, wiggle = _scatter_variance(mu, finite, unit)
-    # μ(ξ) wiggles along the stroke beyond the noise: the GICoF, read at one position,
-    # is not the mean friction (a straight trend is the same at the centre).
+    # μ(ξ) wiggles beyond the noise: the GICoF, read at one position, is not the mean friction.
     excess = np.sqrt(np.maximum(wiggle - variance * quality.SCATTER_BLOCKS, 0.0))
     wavers = excess > quality.GICOF_WIGGLE * np.abs(mu_resolved)
     variance = np.fmax(variance, scatter)  # the noise alone where too few blocks

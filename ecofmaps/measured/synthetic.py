@@ -1,8 +1,6 @@
-r"""Synthetic fretting recordings made with the model: :func:`synthetic_recording`, the
-example shipped in the package (:func:`example_path`, :func:`scar_example_path`), and a long
-test generated and written block by block (:func:`long_recording`,
-:func:`write_long_recording`).
-"""
+r"""Synthetic fretting recordings made with the model: :func:`synthetic_recording`, the examples
+shipped in the package (:func:`example_path`, :func:`scar_example_path`), and a long test made
+and written block by block (:func:`long_recording`, :func:`write_long_recording`)."""
 
 from __future__ import annotations
 
@@ -124,8 +122,7 @@ def synthetic_recording(
     return displacement, force
 
 
-#: The parameters of the shipped example (SI units): the paper's Example 2 rig (Section 3),
-#: a groove deepening from flat over the test, one loop recorded every ``recorded_every``.
+#: The shipped example's parameters (SI): the paper's Example 2 rig, a groove deepening from flat.
 EXAMPLE = {
     "amplitude": 50e-6,
     "load": 450.0,
@@ -183,8 +180,7 @@ def _on_rig(p, ratio, samples_per_cycle, offset, drift, seed):
 
 
 def write_example(path):
-    """Write :func:`example_recording` to ``path`` as the shipped CSV file (atomically);
-    returns the :class:`pathlib.Path`."""
+    """Write :func:`example_recording` to ``path`` as the shipped CSV file; its Path."""
     cycle, displacement, force = example_recording()
     rows = "\n".join(
         f"{c:d},{d:.4f},{f:.3f}" for c, d, f in zip(cycle, displacement * 1e6, force, strict=True)
@@ -254,8 +250,7 @@ def scar_example_trace():
 
 
 def write_scar_example(path):
-    """Write :func:`scar_example_trace` to ``path`` as the shipped CSV file (atomically), in
-    µm; returns the :class:`pathlib.Path`."""
+    """Write :func:`scar_example_trace` to ``path`` as the shipped CSV file (µm); its Path."""
     x, z = scar_example_trace()
     rows = "\n".join(f"{a:.1f},{b:.4f}" for a, b in zip(x * 1e6, z * 1e6, strict=True))
     return write_text(path, f"{_SCAR_HEADER}x,z\n{rows}\n")
@@ -266,8 +261,7 @@ def scar_example_path() -> Path:
     return Path(str(importlib.resources.files("ecofmaps") / "data" / "synthetic_scar_profile.csv"))
 
 
-#: The default parameters of :func:`long_recording`: :data:`EXAMPLE`'s rig, sensors, groove
-#: (z_o/x_o = 0.2 at the end of the test) and drift (2 um over the whole test).
+#: The default parameters of :func:`long_recording`: :data:`EXAMPLE`'s rig, sensors, groove, drift.
 LONG_TEST = {
     name: value
     for name, value in EXAMPLE.items()
