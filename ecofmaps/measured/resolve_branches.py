@@ -38,13 +38,6 @@ def masked_median(values, mask):
     return np.where(count > 0, 0.5 * (low + high), np.nan)
 
 
-def _branches(x, valid):
-    """Masks of the rising branch (start to top) and of the falling one (top to the end)."""
-    top = np.argmax(np.where(valid, x, -np.inf), axis=1)
-    j = np.arange(x.shape[1])[None, :]
-    return valid & (j <= top[:, None]), valid & (j >= top[:, None])
-
-
 def _span(q, mask):
     """Range of ``q`` over ``mask``, per row."""
     return np.max(np.where(mask, q, -np.inf), axis=1) - np.min(np.where(mask, q, np.inf), axis=1)
@@ -107,16 +100,6 @@ def _stick_and_slip(xi, branches, sticks, floor, slip_threshold):
     return sigma, slips, levels
 
 
-def _branch_shift(xi, slips, levels):
-    r"""How far the rising branch's slip lies beyond the falling one's, in ξ, per cycle."""
-    gaps = []
-    for slip, level in zip(slips, levels[::-1], strict=True):
-        # The last slip samples of the branch in time: its slip runs to the reversal.
-        last = slip & (np.cumsum(slip[:, ::-1], axis=1)[:, ::-1] <= _END_SAMPLES)
-        gaps.append(masked_median(xi, last) - level)
-    return 0.5 * (gaps[0] - gaps[1])
-
-
 def _tilted_alike(xi, q, sticks, tolerance, floor):
     """True where the stick sets tilt alike in ξ beyond ``tolerance`` (a wrong compliance)."""
     span = np.max([_span(q, stick) for stick in sticks], axis=0)
@@ -144,7 +127,9 @@ def slip_branches(x, q, valid, stiffness, amplitude, options):
     """The stiffness (given, else fitted), the checks of the stick sets and the slip branches."""
     cycles, given = x.shape[0], options.stiffness is not None
     floor = _ROUNDING * amplitude
-    branches = _branches(x, valid)
+    top = np.argmax(np.where(valid, x, -np.inf), axis=1)[:, None]
+    j = np.arange(x.shape[1])[None, :]
+    branches = valid & (j <= top), valid & (j >= top)  # rising to the top, falling from it
     # The share of its branch's force swing by which each sample has moved from the reversal.
     moved = [np.abs(q - _at_first(q, branch)) / _span(q, branch)[:, None] for branch in branches]
     (low, high), slip_threshold = options.stick_window, options.slip_threshold
@@ -176,7 +161,12 @@ def slip_branches(x, q, valid, stiffness, amplitude, options):
     sigma, slips, levels = _stick_and_slip(xi, branches, sticks, floor, slip_threshold)
     if given:  # a stiffness that does not fit the stick sides tilts both alike in ξ
         mismatch = mismatch | _tilted_alike(xi, q, sticks, _TILT_SPREAD * sigma + floor, floor)
-    shift = _branch_shift(xi, slips, levels)
+    gaps = []  # how far the rising branch's slip lies beyond the falling one's, in ξ
+    for slip, level in zip(slips, levels[::-1], strict=True):
+        # The last slip samples of the branch in time: its slip runs to the reversal.
+        last = slip & (np.cumsum(slip[:, ::-1], axis=1)[:, ::-1] <= _END_SAMPLES)
+        gaps.append(masked_median(xi, last) - level)
+    shift = 0.5 * (gaps[0] - gaps[1])
     forward, backward = (_sorted_branch(xi, q, slip) for slip in slips)
     ends = []
     for xs, _, count in (forward, backward):

@@ -166,7 +166,6 @@ def example_recording():
 
 def _on_rig(p, ratio, samples_per_cycle, offset, drift, seed):
     """:func:`synthetic_recording` on the rig of ``p`` from zero on the rise, offset more."""
-    sensors = {k: p[k] for k in ("displacement_noise", "force_noise", "force_offset")}
     return synthetic_recording(
         *(p[k] for k in ("amplitude", "load", "stiffness", "mu")),
         ratio,
@@ -175,7 +174,7 @@ def _on_rig(p, ratio, samples_per_cycle, offset, drift, seed):
         displacement_offset=p["displacement_offset"] + offset,
         displacement_drift=drift,
         seed=seed,
-        **sensors,
+        **{k: p[k] for k in ("displacement_noise", "force_noise", "force_offset")},
     )
 
 
