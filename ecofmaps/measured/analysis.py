@@ -1,7 +1,6 @@
 r"""The public entry points of the loop analysis: :func:`analyze_loops` and :func:`resolve_loops`
-check their inputs and options and run the recording through :mod:`ecofmaps.measured.pipeline`.
-The method is explained in ``docs/method-loops.md``.
-"""
+check their inputs and options and run the recording through :mod:`ecofmaps.measured.pipeline`
+(the method: ``docs/method-loops.md``)."""
 
 from __future__ import annotations
 
@@ -78,8 +77,7 @@ def analyze_loops(
     force : array_like, dask.array.Array or xarray.DataArray
         Tangential force :math:`Q` at each sample, positive along positive displacement. [N]
     load : float or array_like
-        Normal load :math:`P`, or the load recorded at each sample (each cycle's values are
-        then at its own load, ``normal_load``). [N]
+        Normal load :math:`P`, or the load at each sample (then each cycle at its own). [N]
     cycle : array_like, optional
         Cycle number of each sample (a run of equal numbers is one loop; default: reversals). [1]
     hysteresis : float
@@ -92,13 +90,11 @@ def analyze_loops(
     gross_slip_threshold : float
         Energy ratio :math:`A` above which a loop is gross slip (0 < threshold < 1). [1]
     rig_stiffness : float, optional
-        The rig's own stiffness :math:`S`, when known: the regime is then decided on the
-        contact's displacement :math:`\Delta - Q/S`. [N/m]
+        Rig stiffness :math:`S`, if known: the regime is then read on :math:`\Delta - Q/S`. [N/m]
     flip_force : bool
         Read the force with the other sign (loops that run anticlockwise).
     resolve : bool
-        Also read each loop along the stroke (:func:`ecofmaps.resolve_loops`, ``mu_resolved``;
-        about ten times the work).
+        Also read each loop along the stroke (``mu_resolved``; about ten times the work).
     keep_loops : bool
         Also return the centred loops, ``loop_displacement`` and ``loop_force`` over
         ``(cycle, point)`` (NaN-padded; recordings in memory only).
@@ -199,10 +195,7 @@ def _run(
                 raise MissingSampleError(sample)
         return pipeline.Analysis(x, q, label, options=options, one_chunk=True, **settings).run()
     if reading.keep_loops:
-        raise ValueError(
-            "keep_loops needs the recording in memory: give NumPy arrays (a long "
-            "recording's loops would not fit)"
-        )
+        raise ValueError("keep_loops needs the recording in memory: give NumPy arrays")
     with pipeline.runner_for(scheduler, workers) as runner:
         return pipeline.Analysis(x, q, label, options=options, runner=runner, **settings).run()
 

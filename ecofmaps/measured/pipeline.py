@@ -337,8 +337,7 @@ class Analysis:
         grid = self.reading.resolve and isinstance(self.reading.along_stroke.positions, int)
         if grid and len(self.tasks) > 1:  # a grid made from all the cycles
             raise ValueError(
-                "the reading along the stroke on a grid of positions common to all cycles "
-                "needs the recording in one chunk (in memory); give the positions themselves"
+                "a count of positions needs the recording in memory: give the positions themselves"
             )
         self.tally = quality.Tally()
         self._whole = np.flatnonzero(cycles.whole)  # the cycles a halo may hold

@@ -24,12 +24,12 @@ _ROUNDING = 1e-9
 _END_SAMPLES = 4
 
 
-def masked_sum(values, mask):
+def _masked_sum(values, mask):
     """Sum of each row over ``mask`` (NaN elsewhere is ignored)."""
     return np.sum(np.where(mask, values, 0.0), axis=-1)
 
 
-def masked_median(values, mask):
+def _masked_median(values, mask):
     """Median of each row over ``mask`` (NaN for an empty row)."""
     ordered = np.sort(np.where(mask, values, np.inf), axis=-1)
     count = np.count_nonzero(mask, axis=-1)
@@ -64,14 +64,14 @@ def _compliance(x, q, sticks):
     centred = []
     for mask in sticks:
         count = np.count_nonzero(mask, axis=1)[:, None]
-        dq = q - masked_sum(q, mask)[:, None] / count
-        dx = x - masked_sum(x, mask)[:, None] / count
-        covariance += masked_sum(dq * dx, mask)
-        variance += masked_sum(dq * dq, mask)
+        dq = q - _masked_sum(q, mask)[:, None] / count
+        dx = x - _masked_sum(x, mask)[:, None] / count
+        covariance += _masked_sum(dq * dx, mask)
+        variance += _masked_sum(dq * dq, mask)
         centred.append((dq, dx))
     compliance = covariance / variance
     squares = sum(
-        masked_sum((dx - compliance[:, None] * dq) ** 2, mask)
+        _masked_sum((dx - compliance[:, None] * dq) ** 2, mask)
         for (dq, dx), mask in zip(centred, sticks, strict=True)
     )
     points = sum(np.count_nonzero(mask, axis=1) for mask in sticks)
@@ -85,13 +85,13 @@ def _stick_and_slip(xi, branches, sticks, floor, slip_threshold):
     triples = np.zeros_like(second, dtype=bool)
     for stick in sticks:
         triples |= stick[:, :-2] & stick[:, 1:-1] & stick[:, 2:]
-    sigma = masked_median(second, triples) / SECOND_DIFFERENCE
+    sigma = _masked_median(second, triples) / SECOND_DIFFERENCE
     sigma = np.where(np.isfinite(sigma), sigma, 0.0)
     threshold = slip_threshold * sigma + floor
     slips, levels = [], []
     for branch, stick, sign in zip(branches, sticks, (1.0, -1.0), strict=True):
         # The stick level: the set's median, or the reversal's ξ where the set is too small.
-        level = np.where(_enough(stick), masked_median(xi, stick), _at_first(xi, branch)[:, 0])
+        level = np.where(_enough(stick), _masked_median(xi, stick), _at_first(xi, branch)[:, 0])
         # Slip: beyond the threshold, and every later sample of the branch too.
         beyond = np.where(branch, sign * xi, np.inf)
         least = np.minimum.accumulate(beyond[:, ::-1], axis=1)[:, ::-1]
@@ -123,7 +123,7 @@ def _sorted_branch(xi, q, slip):
     )
 
 
-def slip_branches(x, q, valid, stiffness, amplitude, options):
+def _slip_branches(x, q, valid, stiffness, amplitude, options):
     """The stiffness (given, else fitted), the checks of the stick sets and the slip branches."""
     cycles, given = x.shape[0], options.stiffness is not None
     floor = _ROUNDING * amplitude
@@ -165,7 +165,7 @@ def slip_branches(x, q, valid, stiffness, amplitude, options):
     for slip, level in zip(slips, levels[::-1], strict=True):
         # The last slip samples of the branch in time: its slip runs to the reversal.
         last = slip & (np.cumsum(slip[:, ::-1], axis=1)[:, ::-1] <= _END_SAMPLES)
-        gaps.append(masked_median(xi, last) - level)
+        gaps.append(_masked_median(xi, last) - level)
     shift = 0.5 * (gaps[0] - gaps[1])
     forward, backward = (_sorted_branch(xi, q, slip) for slip in slips)
     ends = []
@@ -224,7 +224,7 @@ def _resample(xs, qs, count, grid, scale, inside):
     return np.where(inside & (count[:, None] >= 2), value, np.nan), left, share
 
 
-def read_branches(forward, backward, grid, scale, inside, load):
+def _read_branches(forward, backward, grid, scale, inside, load):
     """Q+, Q-, μ and g at the positions ``scale * grid``, and the line weights of each branch."""
     q_forward, *line_forward = _resample(*forward, grid, scale, inside)
     q_backward, *line_backward = _resample(*backward, grid, scale, inside)
@@ -233,7 +233,7 @@ def read_branches(forward, backward, grid, scale, inside, load):
     return q_forward, q_backward, mu, slope, (line_forward, line_backward)
 
 
-def branch_noise(xs, qs, count, central):
+def _branch_noise(xs, qs, count, central):
     """Standard deviation of a branch's samples about the branch, in its central part."""
     x0, x1, x2 = xs[:, :-2], xs[:, 1:-1], xs[:, 2:]
     q0, q1, q2 = qs[:, :-2], qs[:, 1:-1], qs[:, 2:]
@@ -242,10 +242,10 @@ def branch_noise(xs, qs, count, central):
     use = (np.arange(1, xs.shape[1] - 1)[None, :] < (count - 1)[:, None]) & (
         np.abs(x1) <= central[:, None]
     )
-    return np.sqrt(masked_sum(residual**2, use) / masked_sum(1.0 + u**2 + (1.0 - u) ** 2, use))
+    return np.sqrt(_masked_sum(residual**2, use) / _masked_sum(1.0 + u**2 + (1.0 - u) ** 2, use))
 
 
-def sample_weights(left, share, gain, width):
+def _sample_weights(left, share, gain, width):
     """Weight of each sample of a branch in a sum over grid points of ``gain`` times its value."""
     cycles = left.shape[0]
     base = (width * np.arange(cycles))[:, None]
@@ -278,15 +278,15 @@ def _central_values(forward, backward, central, load):
     unit = np.linspace(-1.0, 1.0, _CENTRAL_POINTS)
     at = central[:, None] * unit[None, :]
     inside = np.broadcast_to(np.isfinite(central)[:, None], at.shape)
-    q_forward, q_backward, mu, slope, lines = read_branches(
+    q_forward, q_backward, mu, slope, lines = _read_branches(
         forward, backward, unit, central, inside, load
     )
     finite = np.isfinite(mu)
     points = np.count_nonzero(finite, axis=1)
-    middle = masked_median(mu, finite)
-    bound = (_WINSOR * _MAD * masked_median(np.abs(mu - middle[:, None]), finite))[:, None]
+    middle = _masked_median(mu, finite)
+    bound = (_WINSOR * _MAD * _masked_median(np.abs(mu - middle[:, None]), finite))[:, None]
     clipped = np.clip(mu, middle[:, None] - bound, middle[:, None] + bound)
-    mu_resolved = masked_sum(clipped, finite) / points
+    mu_resolved = _masked_sum(clipped, finite) / points
     # The noise variance through each branch's sample weights, of the mean and of the contrast.
     kept = finite & (np.abs(mu - middle[:, None]) <= bound)
     inner = kept & (np.abs(unit) <= 0.5)
@@ -294,32 +294,32 @@ def _central_values(forward, backward, central, load):
     inner_points = np.count_nonzero(inner, axis=1)[:, None]
     outer_points = np.count_nonzero(outer, axis=1)[:, None]
     contrast = np.where(inner, 1.0 / inner_points, np.where(outer, -1.0 / outer_points, 0.0))
-    variation = masked_sum(mu * contrast, kept)
+    variation = _masked_sum(mu * contrast, kept)
     factor = 0.5 * (1.0 + mu**2) / load
     variance, variation_variance = np.zeros((2, central.size))
     for branch, force, (left, share), sign in zip(
         (forward, backward), (q_forward, q_backward), lines, (1.0, -1.0), strict=True
     ):
         gain = np.where(kept, sign * factor / (1.0 + (force / load) ** 2), 0.0)
-        noise = branch_noise(*branch, central) ** 2
-        weight = sample_weights(left, share, gain / points[:, None], width)
+        noise = _branch_noise(*branch, central) ** 2
+        weight = _sample_weights(left, share, gain / points[:, None], width)
         variance += noise * np.sum(weight**2, axis=1)
-        weight = sample_weights(left, share, gain * contrast, width)
+        weight = _sample_weights(left, share, gain * contrast, width)
         variation_variance += noise * np.sum(weight**2, axis=1)
     varies = (np.abs(variation) > quality.VARIATION * np.abs(mu_resolved)) & (
         np.abs(variation) > quality.VARIATION_SIGNIFICANCE * np.sqrt(variation_variance)
     )
-    mean_xi, mean_g = masked_sum(at, finite) / points, masked_sum(slope, finite) / points
+    mean_xi, mean_g = _masked_sum(at, finite) / points, _masked_sum(slope, finite) / points
     dxi = at - mean_xi[:, None]
-    k = masked_sum(dxi * (slope - mean_g[:, None]), finite) / masked_sum(dxi**2, finite)
+    k = _masked_sum(dxi * (slope - mean_g[:, None]), finite) / _masked_sum(dxi**2, finite)
     # The sensitivities of mu_resolved to the compliance 1/S and to a shift of a branch along ξ.
     turning = k[:, None] / (1.0 + slope**2)
     factor = 0.5 * (1.0 + mu_resolved**2) / points
-    sensitivity = factor * masked_sum(turning * (q_forward - q_backward), finite)
-    shifting = -factor * masked_sum(turning, finite)
+    sensitivity = factor * _masked_sum(turning * (q_forward - q_backward), finite)
+    shifting = -factor * _masked_sum(turning, finite)
     # An offset ε of the falling branch's force against the rising one's moves Q± by ∓ε/2.
     lifts = 1.0 / (1.0 + (q_forward / load) ** 2) + 1.0 / (1.0 + (q_backward / load) ** 2)
-    offsetting = 0.5 * factor * masked_sum(lifts, finite) / load
+    offsetting = 0.5 * factor * _masked_sum(lifts, finite) / load
     # The scatter of μ(ξ) beyond the noise: correlated residuals, the model's misfit.
     scatter, wiggle = _scatter_variance(mu, finite, unit)
     # μ(ξ) wiggles beyond the noise: the GICoF, read at one position, is not the mean friction.
@@ -339,14 +339,14 @@ def _scatter_variance(mu, kept, unit):
     means = (np.where(kept, mu, 0.0) @ blocks) / np.maximum(counts, 1.0)
     used = counts > 0
     number = np.count_nonzero(used, axis=1)
-    centre = masked_sum(means, used) / number
+    centre = _masked_sum(means, used) / number
     residual = np.where(used, means - centre[:, None], 0.0)
     squares = np.sum(residual**2, axis=1)
     lagged = np.sum(residual[:, 1:] * residual[:, :-1], axis=1)
     r1 = np.clip(np.divide(lagged, squares, out=np.zeros_like(squares), where=squares > 0), 0, _R1)
     spread = squares / np.maximum(number - 1, 1) / np.maximum(number, 1)
     place = np.where(used, np.arange(n_blocks)[None, :], 0.0)
-    place = np.where(used, place - (masked_sum(place, used) / number)[:, None], 0.0)
+    place = np.where(used, place - (_masked_sum(place, used) / number)[:, None], 0.0)
     trend = np.sum(residual * place, axis=1) / np.sum(place**2, axis=1)
     wiggle = np.sum((residual - trend[:, None] * place) ** 2, axis=1) / (number - 2)
     few = number < 3
@@ -358,7 +358,7 @@ def _along_stroke(part, grid, tilt, load, level):
     lowest, highest = part["lowest"][:, None], part["highest"][:, None]
     cycles = tilt.size
     inside = np.isfinite(tilt)[:, None] & (grid >= lowest) & (grid <= highest)
-    q_forward, q_backward, mu, slope, _ = read_branches(
+    q_forward, q_backward, mu, slope, _ = _read_branches(
         part["forward"], part["backward"], grid, np.ones(cycles), inside, load
     )
     if level:
@@ -381,7 +381,7 @@ def along_stroke_values(x, q, load, stiffness, amplitude, inherited, options, dr
     parts = []
     for block in blocks:
         check_interrupted()
-        part = slip_branches(*(a[block] for a in (x, q, valid, stiffness, amplitude)), options)
+        part = _slip_branches(*(a[block] for a in (x, q, valid, stiffness, amplitude)), options)
         lowest, highest = part["lowest"], part["highest"]
         overlap = (lowest < 0.0) & (highest > 0.0)
         usable = ~inherited[block] & ~part["mismatch"] & overlap
