@@ -157,31 +157,18 @@ def analyze_loops(
     )[0]
 
 
-def _run(
-    displacement,
-    force,
-    cycle,
-    options: pipeline.LoopOptions,
-    reading: pipeline.Reading,
-    recorded=None,
-    missing=None,
-    nan_policy="skip",
-    scheduler=None,
-    workers=None,
-):
+def _run(x, q, cycle, options, reading, recorded, missing, nan_policy, scheduler, workers):
     """The recording checked, through the pipeline: the results and the reading handed back."""
     if nan_policy not in NAN_POLICIES:
         raise ValueError(f"nan_policy must be one of {NAN_POLICIES}; got {nan_policy!r}")
     if scheduler in (None, "threads", "processes"):  # on this machine: checked before any work
         check_workers(workers, processes=scheduler == "processes")
-    x = _series("displacement", displacement)
-    q = _series("force", force, x.shape[0])
+    x = _series("displacement", x)
+    q = _series("force", q, x.shape[0])
     label = None if cycle is None else _series("cycle", cycle, x.shape[0], dtype=None)
     mask = None if missing is None else _series("missing", missing, x.shape[0], dtype=bool)
     if x.shape[0] < MIN_SAMPLES:
-        raise ValueError(
-            f"too few samples for one cycle: {x.shape[0]} (a cycle needs at least {MIN_SAMPLES})"
-        )
+        raise ValueError(f"too few samples for one cycle: {x.shape[0]} (at least {MIN_SAMPLES})")
     settings = dict(missing=mask, recorded_load=recorded, nan_policy=nan_policy, reading=reading)
     if not any(is_lazy(a) for a in (x, q, label, mask)):
         if nan_policy == "raise":  # the first missing sample (a load not positive: its cycle)
@@ -288,4 +275,4 @@ def resolve_loops(
     options = pipeline.LoopOptions(
         load, hysteresis, stick_window, gross_slip_threshold=gross_slip_threshold
     )
-    return _run(displacement, force, cycle, options, reading, recorded)[1]
+    return _run(displacement, force, cycle, options, reading, recorded, None, "skip", None, None)[1]

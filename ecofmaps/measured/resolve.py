@@ -171,10 +171,8 @@ def resolve_analyzed_loops(
             "loops must be the Dataset of analyze_loops(..., keep_loops=True), with "
             + ", ".join(_NEEDED)
         )
-    options = ReadingOptions(
-        stiffness, force_offset, positions, central, slip_threshold, stick_window
-    )
-    return read_along_stroke(loops, options)[0]
+    opts = ReadingOptions(stiffness, force_offset, positions, central, slip_threshold, stick_window)
+    return read_along_stroke(loops, opts)[0]
 
 
 #: The reasons that leave the resolved values NaN.

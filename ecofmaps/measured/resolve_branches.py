@@ -248,13 +248,11 @@ def _branch_noise(xs, qs, count, central):
 def _sample_weights(left, share, gain, width):
     """Weight of each sample of a branch in a sum over grid points of ``gain`` times its value."""
     cycles = left.shape[0]
-    base = (width * np.arange(cycles))[:, None]
+    size, base = cycles * width, (width * np.arange(cycles))[:, None]
     gain = np.where(np.isfinite(gain), gain, 0.0)
     index = np.concatenate([(base + left).ravel(), (base + left + 1).ravel()])
     weight = np.concatenate([(gain * (1.0 - share)).ravel(), (gain * share).ravel()])
-    return np.bincount(index, weight, minlength=cycles * width + 1)[: cycles * width].reshape(
-        cycles, width
-    )
+    return np.bincount(index, weight, minlength=size + 1)[:size].reshape(cycles, width)
 
 
 #: The reasons this reading adds to a cycle's ``quality`` that leave its values NaN, in the

@@ -154,8 +154,7 @@ _HEADER = """\
 
 
 def example_recording():
-    """The shipped example (:data:`EXAMPLE`, a fixed seed): the test cycle at which each
-    sample's loop was taken [1], the displacement [m] and the force [N] of every sample."""
+    """The shipped example: each sample's test cycle [1], displacement [m] and force [N]."""
     p = EXAMPLE
     recorded = np.arange(1, p["test_cycles"] // p["recorded_every"] + 1) * p["recorded_every"]
     ratio = p["final_aspect_ratio"] * np.sqrt(recorded / p["test_cycles"])
@@ -225,8 +224,7 @@ _SCAR_HEADER = """\
 
 
 def scar_example_trace():
-    """The shipped example scar profile (:data:`SCAR_EXAMPLE`, a fixed seed) as a
-    profilometer records it: positions from the start of the trace and heights [m]."""
+    """The shipped example scar profile as recorded: positions and heights [m]."""
     p = SCAR_EXAMPLE
     rng = np.random.default_rng(p["seed"])
     x = np.arange(round(p["length"] / p["spacing"]) + 1) * p["spacing"]
@@ -280,14 +278,12 @@ def long_recording(cycles, samples_per_cycle=200, *, block_cycles=4096, seed=0, 
     samples_per_cycle : int
         Samples per cycle (>= 8). [1]
     block_cycles : int
-        Cycles simulated at a time (memory: a few arrays of ``block_cycles *
-        samples_per_cycle`` samples). [1]
+        Cycles simulated at a time (the memory: a few arrays of that many cycles). [1]
     seed : int
         Seed of the noise: block ``k`` uses a stream derived from ``(seed, k)``.
     **parameters
-        Any of :data:`LONG_TEST`, in SI units as for :func:`synthetic_recording`;
-        ``final_aspect_ratio`` is :math:`r_f` [1], ``displacement_drift`` the drift over the
-        whole test [m].
+        Any of :data:`LONG_TEST` (SI, as for :func:`synthetic_recording`): ``final_aspect_ratio``
+        is :math:`r_f` [1], ``displacement_drift`` the drift over the whole test [m].
 
     Yields
     ------
