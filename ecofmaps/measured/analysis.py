@@ -239,10 +239,10 @@ def resolve_loops(
     -------
     resolved : xarray.Dataset
         Over ``(cycle, position)`` (``position``: :math:`\xi` [m]): ``mu``, ``slope``,
-        ``felt_profile`` [m], ``force_forward``, ``force_backward`` [N], NaN where a branch
-        does not slip. Over ``cycle``: ``mu_resolved``, ``mu_resolved_se``, ``aspect_ratio``,
-        ``tilt``, ``stiffness`` [N/m], ``position_offset``, ``position_min``,
-        ``position_max``, ``amplitude`` [m] and ``quality``; the load is a scalar coordinate.
+        ``felt_profile`` [m], ``force_forward``, ``force_backward`` [N], NaN where a branch does not
+        slip. Over ``cycle``: ``mu_resolved``, ``mu_resolved_se``, ``aspect_ratio``, ``tilt``,
+        ``stiffness`` [N/m], ``position_offset``, ``position_min``, ``position_max``, ``amplitude``
+        [m] and ``quality``; the load is a scalar coordinate.
 
     Raises
     ------

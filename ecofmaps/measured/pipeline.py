@@ -5,9 +5,11 @@ dask runner), the parts joined; a recorded load is converted to the mean load an
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import itertools
 import os
+import types
 from pathlib import Path
 
 import numpy as np
@@ -68,29 +70,23 @@ class LoopOptions:
         resolve.settle(self, load, hysteresis, window, crossing, threshold, flip, rig)
 
 
-class _InProcess:
-    """Runs the chunks one after the other in this process (a recording in memory)."""
-
-    local = True
-
-    @staticmethod
-    def map(function, tasks):
-        yield from itertools.starmap(function, tasks)
+def _in_order(function, tasks):
+    """Each chunk run in this process, one after the other (a recording in memory)."""
+    yield from itertools.starmap(function, tasks)
 
 
-IN_PROCESS = _InProcess()
+#: The runner of a recording in memory (as :class:`ecofmaps._parallel.Runner` is used).
+IN_PROCESS = types.SimpleNamespace(local=True, map=_in_order)
 
 
 def runner_for(scheduler=None, workers=None):
     """The runner of :func:`ecofmaps.analyze_loops`' ``scheduler`` and ``workers``."""
     if scheduler is None:
-        try:
+        with contextlib.suppress(ImportError, ValueError):  # no client: threads
             from distributed import default_client  # only where dask's cluster is used
 
             return Runner(client=default_client())
-        except (ImportError, ValueError):  # no client: threads
-            return Runner(workers)
-    if scheduler == "threads":
+    if scheduler in (None, "threads"):
         return Runner(workers)
     if scheduler == "processes":
         return Runner(workers or 2, cluster=True)
@@ -113,8 +109,7 @@ class Reading:
 
 @dataclasses.dataclass(frozen=True)
 class Task:
-    """One chunk's work besides its samples (its cycles with their halo, its own ``rows``, ...);
-    ``keep``: the file for its values and flags, or True to hand them back."""
+    """One chunk's work besides its samples; ``keep``: its values' file, or True: hand them back."""
 
     cycles: Cycles
     rows: slice
@@ -175,7 +170,6 @@ def _with_loops(results: xr.Dataset, loops) -> xr.Dataset:
 
 def _at_own_load(dataset: xr.Dataset, ratio) -> xr.Dataset:
     """``dataset`` with the variables that scale with the load times ``ratio`` (own / mean)."""
-    ratio = np.asarray(ratio, dtype=np.float64)
     scaled = (*quality.LOAD_SCALED, "loop_force", "force_forward", "force_backward")
     return dataset.assign(
         {k: dataset[k].copy(data=(dataset[k].values.T * ratio).T) for k in scaled if k in dataset}
@@ -306,8 +300,7 @@ class Analysis:
         one_chunk=False,
     ):
         self.arrays = (displacement, force, recorded_load)
-        self.reading = Reading() if reading is None else reading
-        self.options, self.runner = options, runner
+        self.options, self.runner, self.reading = options, runner, reading or Reading()
         self.cycles_from = "displacement reversals" if cycle is None else "cycle numbers"
         self.cycles = cycles = cycles or find_cycles(
             displacement, cycle, options.hysteresis, force=force, missing=missing, runner=runner
@@ -332,8 +325,7 @@ class Analysis:
                 f"too few samples for one cycle: no complete cycle in {displacement.shape[0]} "
                 "samples (the loop does not close, or the recording does not oscillate)"
             )
-        whole = [slice(0, cycles.label.size)]
-        self.tasks = whole if one_chunk else _tasks(cycles.count, samples or TASK_SAMPLES)
+        self.tasks = _tasks(cycles.count, None if one_chunk else samples or TASK_SAMPLES)
         grid = self.reading.resolve and isinstance(self.reading.along_stroke.positions, int)
         if grid and len(self.tasks) > 1:  # a grid made from all the cycles
             raise ValueError(
@@ -400,9 +392,9 @@ def _joined(parts: list) -> xr.Dataset:
     return xr.concat(parts, "cycle", coords="minimal", compat="override", join="outer")
 
 
-def _tasks(count, samples: int) -> list[slice]:
-    """Consecutive rows of cycles of about ``samples`` samples in all (at least one)."""
+def _tasks(count, samples) -> list[slice]:
+    """Consecutive rows of cycles of about ``samples`` samples in all (all in one if None)."""
     ends = np.cumsum(count)
-    targets = np.arange(samples, int(ends[-1]), samples)
+    targets = np.arange(samples, int(ends[-1]), samples) if samples else np.empty(0)
     bounds = np.unique(np.concatenate([[0], np.searchsorted(ends, targets), [count.size]]))
     return [slice(int(a), int(b)) for a, b in itertools.pairwise(bounds)]

@@ -1,6 +1,5 @@
-"""Step 5 of the loop pipeline: friction and groove slope read along the whole stroke of each
-loop, its options checked and its Dataset with the flags of its checks (its numerics in
-``resolve_branches``); ``docs/method-loops.md`` ("Reading the loop along the stroke")."""
+"""Step 5 of the loop pipeline, friction and groove slope read along the stroke: its options, its
+Dataset and flags (numerics: ``resolve_branches``); ``docs/method-loops.md``."""
 
 from __future__ import annotations
 
@@ -81,9 +80,7 @@ def _grid_positions(positions):
     if np.ndim(positions) == 0:
         count = isinstance(positions, int | np.integer) and not isinstance(positions, bool)
         if not (count and positions >= 5 and positions % 2):
-            raise ValueError(
-                f"positions must be an odd integer >= 5 or an array of positions; got {positions!r}"
-            )
+            raise ValueError(f"positions must be an odd integer >= 5 or an array: {positions!r}")
         return int(positions)
     check("positions", positions, "finite", "m")
     positions = np.asarray(positions, dtype=np.float64)

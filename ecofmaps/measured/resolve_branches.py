@@ -116,11 +116,8 @@ def _sorted_branch(xi, q, slip):
     """The slip samples of a branch sorted by ξ (padded with +inf / NaN), and their count."""
     key = np.where(slip, xi, np.inf)
     order = np.argsort(key, axis=1, kind="stable")
-    return (
-        np.take_along_axis(key, order, axis=1),
-        np.take_along_axis(np.where(slip, q, np.nan), order, axis=1),
-        np.count_nonzero(slip, axis=1),
-    )
+    qs = np.take_along_axis(np.where(slip, q, np.nan), order, axis=1)
+    return np.take_along_axis(key, order, axis=1), qs, np.count_nonzero(slip, axis=1)
 
 
 def _slip_branches(x, q, valid, stiffness, amplitude, options):
@@ -186,8 +183,7 @@ def _slip_branches(x, q, valid, stiffness, amplitude, options):
 
 def _resample(xs, qs, count, grid, scale, inside):
     r"""``qs(xs)`` at the positions ``scale * grid`` (one row per cycle), by 3-point fractions."""
-    cycles, width = xs.shape
-    points = grid.size
+    (cycles, width), points = xs.shape, grid.size
     at = scale[:, None] * grid[None, :]
     # How many samples lie at or below each position: a histogram over the grid, summed.
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -255,8 +251,7 @@ def _sample_weights(left, share, gain, width):
     return np.bincount(index, weight, minlength=size + 1)[:size].reshape(cycles, width)
 
 
-#: The reasons this reading adds to a cycle's ``quality`` that leave its values NaN, in the
-#: order they are tested (``'gicof-varies'``, which reaches the GICoF only, comes besides).
+#: The reasons that leave a cycle's values NaN, by code (``'gicof-varies'`` comes besides).
 _QUALITY_FLAGS = quality.READING_REASONS[:4]
 #: Values of μ(ξ) beyond this many robust standard deviations of the median are clipped.
 _WINSOR = 3.0
@@ -289,8 +284,7 @@ def _central_values(forward, backward, central, load):
     kept = finite & (np.abs(mu - middle[:, None]) <= bound)
     inner = kept & (np.abs(unit) <= 0.5)
     outer = kept & ~inner
-    inner_points = np.count_nonzero(inner, axis=1)[:, None]
-    outer_points = np.count_nonzero(outer, axis=1)[:, None]
+    inner_points, outer_points = (np.count_nonzero(m, axis=1)[:, None] for m in (inner, outer))
     contrast = np.where(inner, 1.0 / inner_points, np.where(outer, -1.0 / outer_points, 0.0))
     variation = _masked_sum(mu * contrast, kept)
     factor = 0.5 * (1.0 + mu**2) / load
@@ -409,15 +403,11 @@ def along_stroke_values(x, q, load, stiffness, amplitude, inherited, options, dr
     flags["gicof-varies"] = wavers & ((flag == 0) | (flag == 4)) & ~inherited
     lowest, highest = joined("lowest"), joined("highest")
     nan = np.where(ok, 1.0, np.nan)
+    squares = variance + (sensitivity * joined("compliance_se")) ** 2
+    squares = squares + (shifting * joined("shift")) ** 2 + (offsetting * drift_se) ** 2
     per_cycle = {
         "mu_resolved": mu_resolved * nan,
-        "mu_resolved_se": np.sqrt(
-            variance
-            + (sensitivity * joined("compliance_se")) ** 2
-            + (shifting * joined("shift")) ** 2
-            + (offsetting * drift_se) ** 2
-        )
-        * nan,
+        "mu_resolved_se": np.sqrt(squares) * nan,
         "aspect_ratio": 0.5 * k * amplitude * nan,
         "tilt": tilt * nan,
         "stiffness": 1.0 / joined("compliance"),

@@ -115,8 +115,7 @@ def synthetic_recording(
     force = np.asarray(
         simulate(imposed, load, stiffness, mu, np.broadcast_to(ratio, (cycles,)), half_width)
     )[:, n:].ravel()
-    displacement = imposed[:, n:].ravel() + displacement_offset
-    displacement = displacement + displacement_drift * instants / n
+    displacement = imposed[:, n:].ravel() + displacement_offset + displacement_drift * instants / n
     displacement = displacement + rng.normal(0.0, 1.0, displacement.size) * displacement_noise
     force = force + force_offset + rng.normal(0.0, 1.0, force.size) * force_noise
     return displacement, force
@@ -179,10 +178,8 @@ def _on_rig(p, ratio, samples_per_cycle, offset, drift, seed):
 
 def write_example(path):
     """Write :func:`example_recording` to ``path`` as the shipped CSV file; its Path."""
-    cycle, displacement, force = example_recording()
-    rows = "\n".join(
-        f"{c:d},{d:.4f},{f:.3f}" for c, d, f in zip(cycle, displacement * 1e6, force, strict=True)
-    )
+    cycle, x, q = example_recording()
+    rows = "\n".join(f"{c:d},{d:.4f},{f:.3f}" for c, d, f in zip(cycle, x * 1e6, q, strict=True))
     return write_text(path, f"{_HEADER}cycle,displacement,force\n{rows}\n")
 
 
@@ -258,18 +255,14 @@ def scar_example_path() -> Path:
     return Path(str(importlib.resources.files("ecofmaps") / "data" / "synthetic_scar_profile.csv"))
 
 
+_EXAMPLE_ONLY = ("test_cycles", "recorded_every", "samples_per_cycle", "seed")
 #: The default parameters of :func:`long_recording`: :data:`EXAMPLE`'s rig, sensors, groove, drift.
-LONG_TEST = {
-    name: value
-    for name, value in EXAMPLE.items()
-    if name not in ("test_cycles", "recorded_every", "samples_per_cycle", "seed")
-}
+LONG_TEST = {k: v for k, v in EXAMPLE.items() if k not in _EXAMPLE_ONLY}
 
 
 def long_recording(cycles, samples_per_cycle=200, *, block_cycles=4096, seed=0, **parameters):
-    r"""A long fretting test, generated block by block with bounded memory: cycle :math:`N` of
-    :func:`synthetic_recording` with the groove :math:`z_o/x_o = r_f \sqrt{N / N_{total}}`,
-    :math:`x_o = \Delta^*`, as in :func:`example_recording`, the drift running on over blocks.
+    r"""A long fretting test made block by block in bounded memory: :func:`synthetic_recording`,
+    cycle :math:`N` in the groove :math:`z_o/x_o = r_f \sqrt{N/N_{total}}`, :math:`x_o = \Delta^*`.
 
     Parameters
     ----------
