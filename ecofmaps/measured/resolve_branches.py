@@ -403,11 +403,11 @@ def along_stroke_values(x, q, load, stiffness, amplitude, inherited, options, dr
     flags["gicof-varies"] = wavers & ((flag == 0) | (flag == 4)) & ~inherited
     lowest, highest = joined("lowest"), joined("highest")
     nan = np.where(ok, 1.0, np.nan)
-    squares = variance + (sensitivity * joined("compliance_se")) ** 2
-    squares = squares + (shifting * joined("shift")) ** 2 + (offsetting * drift_se) ** 2
+    se_squared = variance + (sensitivity * joined("compliance_se")) ** 2
+    se_squared = se_squared + (shifting * joined("shift")) ** 2 + (offsetting * drift_se) ** 2
     per_cycle = {
         "mu_resolved": mu_resolved * nan,
-        "mu_resolved_se": np.sqrt(squares) * nan,
+        "mu_resolved_se": np.sqrt(se_squared) * nan,
         "aspect_ratio": 0.5 * k * amplitude * nan,
         "tilt": tilt * nan,
         "stiffness": 1.0 / joined("compliance"),
