@@ -267,10 +267,8 @@ def resolve_loops(
     >>> print(f"{float(resolved.mu_resolved[0]):.9f} {float(resolved.aspect_ratio[0]):.9f}")
     0.800000000 0.200000000
     """
-    along_stroke = ReadingOptions(
-        stiffness, force_offset, positions, central, slip_threshold, stick_window
-    )
-    reading = pipeline.Reading(resolve=True, along_stroke=along_stroke, hand_back=True)
+    opts = ReadingOptions(stiffness, force_offset, positions, central, slip_threshold, stick_window)
+    reading = pipeline.Reading(resolve=True, along_stroke=opts, hand_back=True)
     force, load, recorded = _at_mean_load(force, load)
     options = pipeline.LoopOptions(
         load, hysteresis, stick_window, gross_slip_threshold=gross_slip_threshold

@@ -41,6 +41,8 @@ __all__ = [
 
 #: Samples of the recording measured by one chunk of a long recording (about; whole cycles).
 TASK_SAMPLES = 1 << 22
+#: The reading along the stroke of the per-cycle values alone (no grid of positions).
+_PER_CYCLE = resolve.ReadingOptions(positions=None)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -101,9 +103,7 @@ class Reading:
 
     resolve: bool = False
     keep_loops: bool = False
-    along_stroke: resolve.ReadingOptions = dataclasses.field(
-        default_factory=lambda: resolve.ReadingOptions(positions=None)
-    )
+    along_stroke: resolve.ReadingOptions = _PER_CYCLE
     hand_back: bool = False
 
 
@@ -248,9 +248,8 @@ def write_whole(path: Path, content) -> None:
 
 def _keep_block(path: Path, values: dict, flags: dict) -> None:
     """Keep a chunk's measured ``values`` and ``flags`` in ``path`` (``.npz``)."""
-    write_whole(
-        path, {f"v:{k}": v for k, v in values.items()} | {f"f:{k}": v for k, v in flags.items()}
-    )
+    kept = {f"v:{k}": v for k, v in values.items()}
+    write_whole(path, kept | {f"f:{k}": v for k, v in flags.items()})
 
 
 def kept_block(path: Path) -> tuple[dict, dict]:

@@ -80,7 +80,9 @@ def _grid_positions(positions):
     if np.ndim(positions) == 0:
         count = isinstance(positions, int | np.integer) and not isinstance(positions, bool)
         if not (count and positions >= 5 and positions % 2):
-            raise ValueError(f"positions must be an odd integer >= 5 or an array: {positions!r}")
+            raise ValueError(
+                f"positions must be an odd integer >= 5 or an array of positions; got {positions!r}"
+            )
         return int(positions)
     check("positions", positions, "finite", "m")
     positions = np.asarray(positions, dtype=np.float64)
