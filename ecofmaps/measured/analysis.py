@@ -157,7 +157,18 @@ def analyze_loops(
     )[0]
 
 
-def _run(x, q, cycle, options, reading, recorded, missing, nan_policy, scheduler, workers):
+def _run(
+    x,
+    q,
+    cycle,
+    options,
+    reading,
+    recorded=None,
+    missing=None,
+    nan_policy="skip",
+    scheduler=None,
+    workers=None,
+):
     """The recording checked, through the pipeline: the results and the reading handed back."""
     if nan_policy not in NAN_POLICIES:
         raise ValueError(f"nan_policy must be one of {NAN_POLICIES}; got {nan_policy!r}")
@@ -273,4 +284,4 @@ def resolve_loops(
     options = pipeline.LoopOptions(
         load, hysteresis, stick_window, gross_slip_threshold=gross_slip_threshold
     )
-    return _run(displacement, force, cycle, options, reading, recorded, None, "skip", None, None)[1]
+    return _run(displacement, force, cycle, options, reading, recorded)[1]
