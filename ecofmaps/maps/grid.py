@@ -1,10 +1,7 @@
-r"""Parameter maps: the model over whole grids, as labelled xarray Datasets.
-
-Each function takes one value or one 1-D array per parameter; the arrays become the
-Dataset's dimensions, the single values its scalar coordinates. As in the paper,
-:math:`x_o = \Delta^*`. Tiles, blocks and the cache: docs/performance.md; the model on a scar
-profile: docs/model.md, "The model on a scar profile".
-"""
+r"""Parameter maps: the model over whole grids, as labelled xarray Datasets. Each function takes
+one value or one 1-D array per parameter (the Dataset's scalar coordinates and dimensions), with
+:math:`x_o = \Delta^*` as in the paper. The method: docs/model.md; tiles, blocks and the cache:
+docs/performance.md."""
 
 from __future__ import annotations
 
@@ -125,60 +122,47 @@ def compute_map(
     mu : float or 1-D array_like
         Contact coefficient of friction :math:`\mu`. [1]
     load : float, optional
-        Normal load :math:`P`; when given, the map also holds ``dissipated_energy`` and
-        ``max_force`` and a scalar coordinate ``load``. [N]
+        Normal load :math:`P`: adds ``dissipated_energy``, ``max_force`` and a coordinate. [N]
     chunks : 'auto', int or dict, optional
-        Return a chunked map, of dask arrays evaluated block by block when computed or
+        Return a chunked map of dask arrays, evaluated block by block when computed or
         written (:func:`ecofmaps.maps.write_map`): an int is the most grid points in a
         block, ``'auto'`` :data:`ecofmaps.maps.tiles.BLOCK_POINTS`, a dict the block
         length by dimension name (-1 or None, or not named: whole). Default: in memory.
     profile : ScarProfile, optional
-        A wear-scar profile of any shape instead of ``aspect_ratio``: see
-        :func:`compute_profile_map`.
+        A scar profile instead of ``aspect_ratio``: see :func:`compute_profile_map`.
     mapping : {'scaled', 'physical'}
         With a profile: :math:`X = xW/\Delta^*` (eq. 11) or :math:`X = x`.
     cache : bool, optional
-        Read the result from the disk cache, or store it there. Default: only a map on a
-        profile; a chunked map is never cached (docs/performance.md, "The cache").
+        Use the disk cache. Default: only for a map on a profile; never for a chunked map.
     cache_dir : str or os.PathLike, optional
         Cache directory; default ``$ECOFMAPS_CACHE`` or the per-user cache directory.
     max_chunk : int
-        Most grid points evaluated in one call of the compiled kernel (a tile; tiles run on
-        every core). [1]
+        Most grid points in one call of the compiled kernel (a tile, one core each). [1]
 
     Returns
     -------
     map : xarray.Dataset
-        Dimensions ``stiffness_ratio``, ``aspect_ratio``, ``amplitude``, ``mu`` (in this
-        order; only those given as arrays, the others are scalar coordinates). Variables:
-        ``slip_amplitude`` [m], ``slip_ratio`` [1], ``ecof`` [1], ``ecof_ratio`` [1],
-        ``regime`` (:class:`ecofmaps.Regime` codes, int32), ``compliance_ratio`` [1] (over
-        ``stiffness_ratio`` and ``amplitude`` only) and, with a load, ``dissipated_energy``
-        [J] and ``max_force`` [N]. Every variable and coordinate has ``long_name`` and
-        ``units``. ECoF values are NaN where there is no gross slip; every value but the
-        regime is NaN when self-locking (rigid rig, :math:`\mu\kappa \ge 1`). A chunked
-        map, computed, is identical to the map in memory. Arrays of a single tile are
-        read-only (docs/performance.md, "Maps").
+        Dimensions ``stiffness_ratio``, ``aspect_ratio``, ``amplitude``, ``mu`` (those given
+        as arrays, in this order). Variables, each with ``long_name`` and ``units``:
+        ``slip_amplitude`` [m] (eq. 16), ``slip_ratio`` [1], ``ecof`` [1] (eq. 13-15),
+        ``ecof_ratio`` [1], ``regime`` (:class:`ecofmaps.Regime` codes), ``compliance_ratio``
+        [1] (over S/P and amplitude only) and, with a load, ``dissipated_energy`` [J]
+        (eq. 12) and ``max_force`` [N] (eq. 9). ECoFs are NaN without gross slip; all but the
+        regime are NaN when self-locking. Computed, a chunked map equals the map in memory;
+        arrays of a single tile are read-only.
 
     Raises
     ------
     ValueError
-        If a parameter is not a scalar or a non-empty 1-D array, or is out of range:
-        stiffness_ratio > 0 (inf allowed); aspect_ratio >= 0; amplitude, mu, load > 0;
-        all finite except stiffness_ratio, each within :data:`ecofmaps.units.DOMAIN`. For
-        a bad ``chunks``, ``cache=True`` with ``chunks``, and a map in memory that would
-        not fit in the memory available (before allocating it).
+        For a parameter that is not a scalar or a non-empty 1-D array or is out of range
+        (stiffness_ratio > 0, inf allowed; aspect_ratio >= 0; amplitude, mu, load > 0;
+        within :data:`ecofmaps.units.DOMAIN`); a bad ``chunks``; ``cache=True`` with
+        ``chunks``; a map in memory that would not fit in the memory available.
 
     Warns
     -----
     ecofmaps.maps.cache.CacheWarning
         When a cache file is unusable (it is removed and the map recomputed).
-
-    Notes
-    -----
-    Closed forms: eq. 16 (:math:`\delta^*`), the corrected eq. 13-15 (:math:`\mu_E`), eq. 12
-    (:math:`E_d`), eq. 9 (:math:`Q^*`); they depend on :math:`S`, :math:`P` and
-    :math:`\Delta^*` only through :math:`\lambda` (:func:`compute_universal_map`).
 
     References
     ----------
@@ -188,19 +172,13 @@ def compute_map(
 
     Examples
     --------
+    A map in blocks of 2 values of S/P, evaluated when it is computed or written:
+
     >>> import numpy as np
-    >>> m = compute_map(np.geomspace(2e4, 2e5, 5), np.linspace(0, 0.3, 4), 50e-6, 0.8)
-    >>> m.ecof_ratio.dims
-    ('stiffness_ratio', 'aspect_ratio')
-
-    The same map in blocks of 2 values of S/P, evaluated when it is computed or written:
-
-    >>> lazy = compute_map(np.geomspace(2e4, 2e5, 5), np.linspace(0, 0.3, 4), 50e-6, 0.8,
-    ...                    chunks={"stiffness_ratio": 2})
-    >>> lazy.ecof_ratio.chunks
+    >>> m = compute_map(np.geomspace(2e4, 2e5, 5), np.linspace(0, 0.3, 4), 50e-6, 0.8,
+    ...                 chunks={"stiffness_ratio": 2})
+    >>> m.ecof_ratio.chunks
     ((2, 2, 1), (4,))
-    >>> lazy.compute().identical(m)
-    True
     """
     if profile is not None or aspect_ratio is None:
         if aspect_ratio is not None:
@@ -241,7 +219,8 @@ def compute_universal_map(
     cache_dir=None,
     max_chunk=MAX_CHUNK,
 ) -> xr.Dataset:
-    r"""The dimensionless map: :math:`\mu_E/\mu` and :math:`\delta^*/\Delta^*` over :math:`\lambda`.
+    r"""The dimensionless map: :math:`\mu_E/\mu` and :math:`\delta^*/\Delta^*` over :math:`\lambda`,
+    which holds both panels of Figure 11 (docs/model.md, "The dimensionless core").
 
     Parameters
     ----------
@@ -264,14 +243,7 @@ def compute_universal_map(
     Raises
     ------
     ValueError
-        If a parameter is not a scalar or a non-empty 1-D array, or out of range; for
-        ``chunks``, ``cache`` and memory, as :func:`compute_map`.
-
-    Notes
-    -----
-    :math:`\mu_E/\mu` depends on :math:`(\mu, z_o/x_o, \lambda)` only (eq. 13-16): this one
-    chart holds both panels of Figure 11, whose axes :math:`S/P` map onto
-    :math:`\lambda = 1/((S/P)\Delta^*)`.
+        As for :func:`compute_map`.
 
     References
     ----------
@@ -322,20 +294,14 @@ def compute_loops(stiffness, aspect_ratio, amplitude, load, mu, num=201) -> xr.D
         Dimensions: those of the parameters given as arrays (in the order of the
         arguments), then ``point``. Variables ``displacement`` [m] and ``force`` [N] around
         each loop (see :func:`ecofmaps.fretting_loop`: it starts and ends at the reversal
-        :math:`(-\Delta^*, -Q^*)` and runs clockwise), and per loop ``slip_amplitude`` [m],
-        ``max_force`` [N], ``dissipated_energy`` [J] (the loop's area) and ``regime``.
-        Self-locking loops are NaN.
+        :math:`(-\Delta^*, -Q^*)` and runs clockwise; slip branches of eq. 9-10), and per loop
+        ``slip_amplitude`` [m] (eq. 16), ``max_force`` [N], ``dissipated_energy`` [J] (the
+        loop's area, eq. 12) and ``regime``. Self-locking loops are NaN.
 
     Raises
     ------
     ValueError
-        If a parameter is not a scalar or a non-empty 1-D array, or out of range (see
-        :func:`ecofmaps.slip_amplitude`), or ``num < 2``.
-
-    Notes
-    -----
-    Slip branches of eq. 9-10 joined by stick segments of slope :math:`S`; eq. 16 gives
-    :math:`\delta^*`, eq. 9 :math:`Q^*`, eq. 12 :math:`E_d`.
+        As for :func:`compute_map` (stiffness > 0, inf allowed), or ``num < 2``.
 
     References
     ----------
@@ -395,12 +361,6 @@ def compute_profile_map(
     ValueError
         As for :func:`compute_map`, and for a missing or bad profile or mapping.
 
-    Notes
-    -----
-    With the scaled mapping the map depends on :math:`S/P` and :math:`\Delta^*` only through
-    :math:`\lambda = P/(S\Delta^*)`, as in eq. 16; the steady loop comes from
-    :func:`ecofmaps.model.on_profile.steady_numbers` (one set of tables per :math:`\mu`).
-
     References
     ----------
     X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
@@ -428,7 +388,6 @@ def compute_profile_map(
     def compute() -> xr.Dataset:
         grid = [np.atleast_1d(a) for a in axes.values()]
         points = [axis.ravel() for axis in np.meshgrid(*grid, indexing="ij")]
-        names = ("slip_ratio", "ecof_ratio", "regime", "normalized_energy", "normalized_max_force")
         # λ = P/(S Δ*) = 1/((S/P) Δ*): a unit load and the stiffness ratio
         tiles = [
             steady_numbers(profile, a, 1.0, s, m, mapping=mapping)
@@ -437,6 +396,7 @@ def compute_profile_map(
             )
         ]
         shape = tuple(axis.size for axis in grid)
+        names = ("slip_ratio", "ecof_ratio", "regime", "normalized_energy", "normalized_max_force")
         values = {
             name: np.concatenate([np.asarray(t[name]) for t in tiles]).reshape(shape)
             for name in names
@@ -444,8 +404,7 @@ def compute_profile_map(
         values.update(steady_values(values, grid[1][None, :, None], load, grid[2][None, None, :]))
         del values["normalized_energy"], values["normalized_max_force"]
         title = "ECoF map of the compliant wear-scar model on a scar profile"
-        dataset = map_dataset(axes, values, load, title)
-        dataset.attrs.update(
+        return map_dataset(axes, values, load, title).assign_attrs(
             model=MODEL_ON_PROFILE,
             scar_depth=float(profile.depth),
             scar_half_width=float(profile.half_width),
@@ -453,7 +412,6 @@ def compute_profile_map(
             scar_samples=int(profile.position.shape[-1]),
             mapping=mapping,
         )
-        return dataset
 
     if not cache:
         return compute()
