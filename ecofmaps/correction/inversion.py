@@ -94,10 +94,8 @@ def _root_and_status(ecof, kappa, lam):
 
 
 def contact_cof(ecof, kappa, lam):
-    r"""The contact CoF :math:`\mu` whose energy CoF is ``ecof``: the dimensionless core.
-
-    A pure ``jax.numpy`` function of the core numbers of :mod:`ecofmaps.model`; it
-    broadcasts and works under ``jax.jit`` and ``jax.vmap``, and checks nothing.
+    r"""The contact CoF :math:`\mu` whose energy CoF is ``ecof`` (eq. 13-15, 16 inverted), in the
+    dimensionless core: pure ``jax.numpy`` (``jax.jit``, ``jax.vmap``); it checks nothing.
 
     Parameters
     ----------
@@ -115,10 +113,6 @@ def contact_cof(ecof, kappa, lam):
         unless the status is ``CORRECTED``. [1]
     status : jax.Array of int32
         :class:`CorrectionStatus` codes.
-
-    Notes
-    -----
-    Inverts the corrected eq. 13-15 with eq. 16 (``docs/model.md``).
 
     References
     ----------
@@ -347,9 +341,7 @@ def _illinois(profile, target, low, high, rig, mapping):
         done = (value == 0.0) | (high - low <= 4.0 * _EPS * high)
         active &= ~done
     root = np.where(np.abs(f_low) <= np.abs(np.nan_to_num(f_high, nan=np.inf)), low, high)
-    check_value = _residual(profile, root, target, rig, mapping) + target
-    reached = np.abs(check_value - target) <= 1e-9 * target
-    return root, reached
+    return root, np.abs(_residual(profile, root, target, rig, mapping)) <= 1e-9 * target
 
 
 _PARAMETERS = """
@@ -373,9 +365,8 @@ _PARAMETERS = """
     scar_half_width : array_like, optional
         Wear scar half-width :math:`W`. [m]
     profile : ScarProfile, optional
-        The wear scar's profile, of any shape, instead of an aspect ratio (the correction
-        then inverts the model on that profile; concrete inputs only, not under
-        ``jax.jit``/``jax.vmap``).
+        The scar's profile, of any shape, instead of an aspect ratio (concrete inputs only,
+        not under ``jax.jit``/``jax.vmap``).
     mapping : {'scaled', 'physical'}
         With a profile: :math:`X = xW/\\Delta^*` (eq. 11) or :math:`X = x`.
     return_status : bool
@@ -399,6 +390,12 @@ _RAISES = """
     ecofmaps.RegimeWarning
         For concrete arrays (without ``return_status``) with points that cannot be
         corrected, naming the reasons; those points are NaN.
+
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 11, 13-15, 16.
 """
 
 
@@ -422,35 +419,19 @@ def correct_ecof(
 
 correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy CoF :math:`\\mu_E`.
 
-    The exact inversion of the model's :math:`\\mu_E(\\mu; \\Delta^*, P, S, z_o/x_o)`, with
-    :math:`x_o = \\Delta^*`, vectorised and jit-compiled, in float64.
+    The model's :math:`\\mu_E(\\mu)` inverted exactly (docs/model.md, "Correcting a reported
+    ECoF"), under ``jax.grad``, ``jax.jit`` and ``jax.vmap`` too without a profile (docs/api.md).
 {_PARAMETERS}
     Returns
     -------
     mu : jax.Array of float64, or Interval
-        The contact CoF, within a few ulp of the exact root, so that :math:`|\\mu_E(\\mu) - `
-        ``ecof`` :math:`| \\le 10^{{-12}}` ``ecof`` except on a rigid rig next to locking
-        (:math:`1 - \\mu\\kappa < 10^{{-5}}`), where one ulp of :math:`\\mu` moves :math:`\\mu_E` by
-        more; NaN where it cannot be corrected. With ``aspect_ratio=(low, high)``, an
-        :class:`Interval` ``(low, high)`` of arrays: every contact CoF that gives ``ecof``
-        with an aspect ratio in the interval (``low`` from the deeper scar). [1]
+        The contact CoF, within a few ulp of the exact root; NaN where it cannot be
+        corrected. With ``aspect_ratio=(low, high)``, an :class:`Interval` of arrays: every
+        contact CoF that gives ``ecof`` with an aspect ratio in the interval. [1]
     status : jax.Array of int32
         Only with ``return_status=True``: :class:`CorrectionStatus` codes (for an interval,
         the first failure of its two ends).
 {_RAISES}
-    Notes
-    -----
-    Inverts the corrected eq. 13-15 with eq. 16 by bracketed Newton steps; which ECoFs can
-    be reached, where the inversion is unique, why the interval is exact, and the scan on a
-    profile: ``docs/model.md``. :math:`\\mu \\le \\mu_E`, with equality for a flat scar.
-    ``jax.grad``, ``jax.jit`` and ``jax.vmap`` work without a profile (``docs/api.md``).
-
-    References
-    ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 11, 13-15, 16.
-
     Examples
     --------
     >>> import ecofmaps
@@ -479,7 +460,8 @@ def correction_factor(
     return _correct(True, ecof, amplitude, load, stiffness, scar, profile, mapping, return_status)
 
 
-correction_factor.__doc__ = f"""The ratio :math:`\\mu/\\mu_E` of contact CoF to reported ECoF.
+correction_factor.__doc__ = f"""The ratio :math:`\\mu/\\mu_E` of contact CoF to reported ECoF: the
+    reciprocal of the :math:`\\mu_E/\\mu` of Figures 8 and 11, read at the reported ECoF.
 {_PARAMETERS}
     Returns
     -------
@@ -488,15 +470,4 @@ correction_factor.__doc__ = f"""The ratio :math:`\\mu/\\mu_E` of contact CoF to 
         :func:`correct_ecof`; an :class:`Interval` for an aspect-ratio interval. [1]
     status : jax.Array of int32
         Only with ``return_status=True``: :class:`CorrectionStatus` codes.
-{_RAISES}
-    Notes
-    -----
-    The reciprocal of the :math:`\\mu_E/\\mu` of Figures 8 and 11, read at the contact CoF
-    that gives the reported :math:`\\mu_E` rather than at a chosen :math:`\\mu`.
-
-    References
-    ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 11, 13-15, 16.
-    """
+{_RAISES}"""

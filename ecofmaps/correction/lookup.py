@@ -61,12 +61,8 @@ def lookup_correction(
     *,
     return_status=False,
 ):
-    r"""The contact CoF behind a reported ECoF, read off a map by interpolation.
-
-    The same correction as :func:`correct_ecof`, for users who work from the maps: the
-    map's :math:`\mu_E` is interpolated linearly to the test conditions, giving a curve
-    :math:`\mu_E(\mu)` over the map's :math:`\mu` grid, and that curve is inverted
-    linearly.
+    r"""The contact CoF behind a reported ECoF, read off a map by interpolation: the correction
+    of :func:`correct_ecof` up to its error (docs/model.md, "Correcting a reported ECoF").
 
     Parameters
     ----------
@@ -99,11 +95,6 @@ def lookup_correction(
     -----
     ecofmaps.RegimeWarning
         For arrays (without ``return_status``) with points that cannot be read off the map.
-
-    Notes
-    -----
-    Multilinear in :math:`P/S`, :math:`z_o/x_o` and :math:`\Delta^*`, then linear in
-    :math:`\mu`; its error: ``docs/model.md`` (correcting a reported ECoF).
 
     References
     ----------

@@ -46,19 +46,17 @@ class CorrectionStatus(Code):
     CORRECTED
         One contact CoF gives the ECoF; it is returned.
     NO_GROSS_SLIP
-        The ECoF is at or above :math:`S\\Delta^*/P`: a contact CoF that high would stop
-        gross slip (:math:`\\mu P \\ge S\\Delta^*`).
+        The ECoF is at or above :math:`S\\Delta^*/P` (such a contact CoF stops gross slip).
     AMBIGUOUS
-        Several contact CoFs give the ECoF (:math:`\\kappa > 1` and :math:`\\lambda <`
-        :data:`LAMBDA_INFINITY`, where :math:`\\mu_E(\\mu)` falls over part of its range).
+        Several contact CoFs give the ECoF (:math:`\\kappa > 1`, :math:`\\lambda <`
+        :data:`LAMBDA_INFINITY`: :math:`\\mu_E(\\mu)` falls over part of its range).
     INVALID
-        An input out of its range or NaN (only under ``jax.jit``/``jax.vmap``: concrete
-        inputs raise ``ValueError``).
+        An input out of range or NaN (under ``jax.jit``/``jax.vmap``; else ``ValueError``).
     OUTSIDE_MAP
         :func:`lookup_correction` only: the point, or the ECoF, is outside the map.
     UNREACHABLE
-        On a scar profile only: no contact CoF gives the ECoF although it is below
-        :math:`S\\Delta^*/P` (a jump of :math:`\\mu_E(\\mu)`, or a slip off the trace).
+        On a scar profile: no contact CoF gives the ECoF below :math:`S\\Delta^*/P` (a jump of
+        :math:`\\mu_E(\\mu)`, or a slip off the trace).
     """
 
     CORRECTED = 0, "corrected"
@@ -129,7 +127,9 @@ def may_fall(kappa, lam):
 
 
 def ecof_fall(kappa, lam):
-    r"""Where :math:`\mu_E(\mu)` falls: its local maximum and minimum, or NaN where it rises.
+    r"""Where :math:`\mu_E(\mu)` falls: its local maximum and minimum, or NaN where it rises
+    (only for :math:`\kappa > 1` and :math:`0 < \lambda <` :data:`LAMBDA_INFINITY`; how it is
+    found: docs/model.md, "Correcting a reported ECoF").
 
     Parameters
     ----------
@@ -146,11 +146,6 @@ def ecof_fall(kappa, lam):
     low : jax.Array
         :math:`\mu_E` at the local minimum, where it ends. An ECoF in ``[low, high]``
         comes from three contact CoFs (two at the ends). [1]
-
-    Notes
-    -----
-    The fall exists only for :math:`\kappa > 1` and :math:`0 < \lambda <` :data:`LAMBDA_INFINITY`;
-    how it is found, and what it can miss: ``docs/model.md`` (correcting a reported ECoF).
 
     References
     ----------
