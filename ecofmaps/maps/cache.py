@@ -1,8 +1,6 @@
 """The disk cache of results that are expensive to recompute: one netCDF file
-``<function>-<key>.nc`` per result in :func:`cache_directory`, keyed by :func:`cache_key`, its
-arrays in Fletcher-32 checksummed chunks and the rest under :func:`metadata_checksum`. What is
-cached, how entries are checked, written and evicted, and what that costs against computing:
-docs/performance.md, "The cache"."""
+``<function>-<key>.nc`` per result, its arrays in Fletcher-32 checksummed chunks and the rest
+under :func:`metadata_checksum` (docs/performance.md, "The cache")."""
 
 from __future__ import annotations
 
@@ -90,8 +88,7 @@ class CacheWarning(UserWarning):
 
 @dataclass(frozen=True)
 class CacheEntry:
-    """One file of the cache: the function whose result it holds, its size [byte], and the
-    times (UTC) of its last write and last use (the least recently used go first)."""
+    """One file of the cache: its function, size [byte], last write and last use (UTC)."""
 
     path: Path
     function: str
@@ -138,8 +135,7 @@ def _chunked(variable: xr.Variable) -> bool:
 
 
 def metadata_checksum(dataset: xr.Dataset) -> str:
-    """SHA-256 (hex) of what the chunks' checksums do not cover: names, dimensions, types,
-    shapes, attributes, and the values of text and scalar variables."""
+    """SHA-256 (hex) of all that the chunks' checksums do not cover."""
     digest = hashlib.sha256()
 
     def add(*parts) -> None:
@@ -177,8 +173,7 @@ def cache_key(function: str, inputs: Mapping[str, object]) -> str:
 
 
 def write_netcdf(dataset: xr.Dataset, path, *, exclusive: bool = True) -> Path:
-    """``path``, where ``dataset`` is written as netCDF atomically (``path`` is left as it was
-    on any failure)."""
+    """``path``, where ``dataset`` is written as netCDF atomically (or left as it was)."""
     path = Path(path)
     with atomic_path(path, exclusive=exclusive) as temporary:
         check_room(temporary, dataset.nbytes)
@@ -237,10 +232,9 @@ def _read(path: Path, key: str) -> xr.Dataset:
 
 
 def _stored(path: Path, key: str) -> xr.Dataset | None:
-    """The dataset stored at ``path``, or None: an unusable one is removed, with one warning
-    (and no noise from finalizers of half-opened HDF5 objects)."""
+    """The dataset stored at ``path``, or None: an unusable one is removed, with one warning."""
     hook = sys.unraisablehook
-    sys.unraisablehook = _ignored
+    sys.unraisablehook = lambda unraisable: None  # finalizers of half-opened HDF5 objects
     try:
         try:
             return _read(path, key)
@@ -256,10 +250,6 @@ def _stored(path: Path, key: str) -> xr.Dataset | None:
     return None
 
 
-def _ignored(unraisable) -> None:
-    pass
-
-
 def _reason(error: BaseException) -> str:
     text = " ".join(str(error).split()) or "no reason given"
     if isinstance(error, OSError) and error.strerror:
@@ -268,8 +258,8 @@ def _reason(error: BaseException) -> str:
 
 
 def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
-    """Store ``dataset`` at ``path`` if it fits in ``bound`` [byte], then remove the least
-    recently used other entries until they all take at most ``bound``."""
+    """Store ``dataset`` at ``path`` if it fits in ``bound`` [byte], then evict the least
+    recently used other entries to fit."""
     if dataset.nbytes > bound:
         return
     image = _file_image(dataset.assign_attrs({_KEY_ATTRIBUTE: key}))

@@ -24,12 +24,10 @@ def write_map(dataset: xr.Dataset, path, *, also: Sequence = ()) -> tuple:
     Parameters
     ----------
     dataset : xarray.Dataset
-        A map, in memory or chunked (its dask-backed variables are evaluated block by
-        block as they are written, on one thread per core).
+        A map, in memory or chunked (evaluated block by block as it is written).
     path : str or os.PathLike
-        The file (netCDF 4, engine h5netcdf) or zarr store (a directory, zarr format 2
-        with consolidated metadata, read by ``xarray.open_zarr``) to create or replace;
-        its parent directory must exist.
+        The file (netCDF 4, engine h5netcdf) or zarr store (format 2, consolidated, a
+        directory) to create or replace, complete or not at all; its parent must exist.
     also : sequence of dask or NumPy arrays, optional
         Values computed in the same pass over the blocks (a chunked map's summary, e.g.
         ``dataset.regime.max().data``), so that the blocks are not evaluated twice.
@@ -46,12 +44,6 @@ def write_map(dataset: xr.Dataset, path, *, also: Sequence = ()) -> tuple:
         netCDF file is asked for (nothing is replaced).
     OSError
         If the output cannot be written (the temporary output is removed).
-
-    Notes
-    -----
-    The output appears under its name only when complete; on any failure, Ctrl-C included,
-    the running blocks finish and an existing ``path`` is left as it was. A zarr store's
-    chunks are the map's blocks.
 
     Examples
     --------

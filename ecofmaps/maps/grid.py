@@ -227,11 +227,7 @@ def compute_universal_map(
     compliance_ratio : float or 1-D array_like
         :math:`\lambda = P/(S\Delta^*)`, the rig's deflection at :math:`Q = P` over the
         displacement amplitude, >= 0 (0 for a rigid rig). [1]
-    aspect_ratio : float or 1-D array_like
-        Groove depth over half-width :math:`z_o/x_o` with :math:`x_o = \Delta^*`, >= 0. [1]
-    mu : float or 1-D array_like
-        Contact coefficient of friction, > 0. [1]
-    chunks, cache, cache_dir, max_chunk
+    aspect_ratio, mu, chunks, cache, cache_dir, max_chunk
         As for :func:`compute_map`.
 
     Returns
@@ -277,14 +273,10 @@ def compute_loops(stiffness, aspect_ratio, amplitude, load, mu, num=201) -> xr.D
     ----------
     stiffness : float or 1-D array_like
         Rig stiffness :math:`S`; ``numpy.inf`` for a rigid rig. [N/m]
-    aspect_ratio : float or 1-D array_like
-        Groove depth over half-width :math:`z_o/x_o`. [1]
-    amplitude : float or 1-D array_like
-        Displacement amplitude :math:`\Delta^*` (also the groove half-width). [m]
+    aspect_ratio, amplitude, mu
+        As for :func:`compute_map`. [1], [m], [1]
     load : float or 1-D array_like
         Normal load :math:`P`. [N]
-    mu : float or 1-D array_like
-        Contact coefficient of friction. [1]
     num : int
         Points on each slip branch (>= 2); each loop has ``2 * num + 1`` points. [1]
 
@@ -343,10 +335,8 @@ def compute_profile_map(
     profile : ScarProfile
         The scar (:func:`ecofmaps.scar_profile`, :func:`ecofmaps.read_scar_profile`, a
         profile family).
-    mapping : {'scaled', 'physical'}
-        :math:`X = xW/x_o` with :math:`x_o = \Delta^*` (eq. 11), or :math:`X = x`.
-    cache, cache_dir, max_chunk
-        As for :func:`compute_map`; the cache key holds every array of the profile.
+    mapping, cache, cache_dir, max_chunk
+        As for :func:`compute_map` (the cache key holds every array of the profile).
 
     Returns
     -------
