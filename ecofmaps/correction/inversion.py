@@ -13,17 +13,8 @@ import numpy as np
 from ecofmaps import model
 from ecofmaps._codes import warn_nan
 from ecofmaps._inputs import as_float64, check, float64, is_concrete
-from ecofmaps.correction.outcomes import (
-    CorrectionStatus,
-    Interval,
-    ambiguity_marked,
-    check_test,
-    ecof_and_slope,
-    ecof_fall,
-    ecof_fall_where_needed,
-    may_fall,
-    reachability_status,
-)
+from ecofmaps.correction import outcomes
+from ecofmaps.correction.outcomes import CorrectionStatus
 from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers
 from ecofmaps.model.steady_state import valid_geometry
 
@@ -51,7 +42,7 @@ def _root(ecof, kappa, lam):
 
     def newton(state):
         mu, low, high, previous, done, step = state
-        value, slope = ecof_and_slope(mu, kappa, lam)
+        value, slope = outcomes.ecof_and_slope(mu, kappa, lam)
         residual = value - ecof
         above = ~(residual <= 0.0)  # NaN: beyond the gross-slip (or locking) limit
         low = jnp.where(above, low, mu)
@@ -75,7 +66,7 @@ def _root_tangent(primals, tangents):
     ecof, kappa, lam = primals
     d_ecof, d_kappa, d_lam = tangents
     mu = _root(ecof, kappa, lam)
-    _, slope = ecof_and_slope(mu, kappa, lam)
+    _, slope = outcomes.ecof_and_slope(mu, kappa, lam)
     _, moved = jax.jvp(lambda k, m: mu * model.ecof_ratio(mu, k, m), (kappa, lam), (d_kappa, d_lam))
     return mu, (d_ecof - moved) / slope
 
@@ -83,7 +74,7 @@ def _root_tangent(primals, tangents):
 def _root_and_status(ecof, kappa, lam):
     """The root and status without the ambiguity check, NaN wherever it is not corrected."""
     ecof, kappa, lam = jnp.broadcast_arrays(ecof, kappa, lam)
-    status = reachability_status(ecof, kappa, lam)
+    status = outcomes.reachability_status(ecof, kappa, lam)
     corrected = status == int(CorrectionStatus.CORRECTED)
     mu = _root(
         jnp.where(corrected, ecof, 0.5),
@@ -122,7 +113,9 @@ def contact_cof(ecof, kappa, lam):
     """
     ecof, kappa, lam = jnp.broadcast_arrays(*(as_float64(v) for v in (ecof, kappa, lam)))
     mu, status = _root_and_status(ecof, kappa, lam)
-    return ambiguity_marked(mu, status, ecof, *ecof_fall_where_needed(status, kappa, lam))
+    return outcomes.ambiguity_marked(
+        mu, status, ecof, *outcomes.ecof_fall_where_needed(status, kappa, lam)
+    )
 
 
 @jax.jit
@@ -137,17 +130,17 @@ def _si_root(ecof, amplitude, load, stiffness, aspect_ratio):
     return mu, status, *jnp.broadcast_arrays(kappa, lam, mu)[:2]
 
 
-_ecof_fall = jax.jit(ecof_fall)
+_ecof_fall = jax.jit(outcomes.ecof_fall)
 
 
 def _si_correct(ecof, amplitude, load, stiffness, aspect_ratio):
     """μ, status and the fall (high, low) at concrete or traced SI inputs."""
     mu, status, kappa, lam = _si_root(ecof, amplitude, load, stiffness, aspect_ratio)
     if not is_concrete(mu):
-        high, low = ecof_fall_where_needed(status, kappa, lam)
+        high, low = outcomes.ecof_fall_where_needed(status, kappa, lam)
     else:  # only the few points where mu_E(mu) may fall are scanned, in one padded batch
         where = np.flatnonzero(
-            np.asarray(may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
+            np.asarray(outcomes.may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
         )
         high, low = np.full((2, mu.size), np.nan)
         if where.size:
@@ -157,7 +150,7 @@ def _si_correct(ecof, amplitude, load, stiffness, aspect_ratio):
             high[where], low[where] = (np.asarray(v)[: where.size] for v in fall)
         high, low = high.reshape(mu.shape), low.reshape(mu.shape)
     ecof = jnp.broadcast_to(ecof, mu.shape)
-    mu, status = ambiguity_marked(mu, status, ecof, jnp.asarray(high), jnp.asarray(low))
+    mu, status = outcomes.ambiguity_marked(mu, status, ecof, jnp.asarray(high), jnp.asarray(low))
     return mu, status, (kappa, lam, high, low)
 
 
@@ -217,14 +210,14 @@ def _correct(factor, ecof, amplitude, load, stiffness, scar, profile, mapping, r
         codes = np.asarray(status)
         if codes.ndim == 0 and codes != CorrectionStatus.CORRECTED:
             raise ValueError(failure())
-        first = values[0] if isinstance(values, Interval) else values
+        first = values[0] if isinstance(values, outcomes.Interval) else values
         warn_nan(first, codes, CorrectionStatus, caller)
     return values
 
 
 def _correct_on_groove(factor, ecof, amplitude, load, stiffness, scar):
     """Values, status and the reason a single point failed, on a parabolic groove."""
-    check_test(ecof, amplitude, load, stiffness)
+    outcomes.check_test(ecof, amplitude, load, stiffness)
     ratio = groove_aspect_ratio(*scar)
     ecof, amplitude, load, stiffness = (as_float64(v) for v in (ecof, amplitude, load, stiffness))
     ends = ratio if isinstance(ratio, tuple) else (ratio,)
@@ -234,7 +227,7 @@ def _correct_on_groove(factor, ecof, amplitude, load, stiffness, scar):
     if len(results) == 2:  # the larger aspect ratio allows the smaller mu (docs/model.md)
         status = jnp.where(status == int(CorrectionStatus.CORRECTED), results[1][1], status)
         both = status == int(CorrectionStatus.CORRECTED)
-        values = Interval(*(jnp.where(both, v, jnp.nan) for v in (values[1], values[0])))
+        values = outcomes.Interval(*(jnp.where(both, v, jnp.nan) for v in (values[1], values[0])))
     else:
         values = values[0]
 
@@ -269,7 +262,7 @@ def _correct_on_profile(ecof, amplitude, load, stiffness, profile, mapping, fact
     """Values, status and the reason a single point failed, on a profile (docs/model.md)."""
     check_mapping(mapping, None)
     profile = as_profile(profile)
-    check_test(ecof, amplitude, load, stiffness)
+    outcomes.check_test(ecof, amplitude, load, stiffness)
     if not is_concrete(ecof, amplitude, load, stiffness, *profile):
         raise ValueError(
             f"{caller} on a profile needs concrete inputs: it does not run under "
