@@ -1,8 +1,6 @@
-r"""Reported energy coefficients of friction corrected to the contact one: the model's
-:math:`\mu_E(\mu)` inverted exactly by a bracketed Newton iteration in the dimensionless core,
-or on a scar profile by a scan narrowed by the Illinois method (NumPy, concrete inputs). Where
-the inversion is unique, ambiguous or impossible: ``docs/model.md`` (correcting a reported ECoF).
-"""
+r"""Reported energy coefficients of friction corrected to the contact one: :math:`\mu_E(\mu)`
+inverted by bracketed Newton steps in the dimensionless core, or on a scar profile by a scan and
+the Illinois method (NumPy): docs/model.md, "Correcting a reported ECoF"."""
 
 from __future__ import annotations
 
@@ -74,7 +72,13 @@ def _root_tangent(primals, tangents):
 def _root_and_status(ecof, kappa, lam):
     """The root and status without the ambiguity check, NaN wherever it is not corrected."""
     ecof, kappa, lam = jnp.broadcast_arrays(ecof, kappa, lam)
-    status = outcomes.reachability_status(ecof, kappa, lam)
+    valid = (ecof > 0.0) & jnp.isfinite(ecof)
+    for value in (kappa, lam):
+        valid &= (value >= 0.0) & jnp.isfinite(value)
+    code = jnp.where(
+        ecof * lam < 1.0, int(CorrectionStatus.CORRECTED), int(CorrectionStatus.NO_GROSS_SLIP)
+    )
+    status = jnp.where(valid, code, int(CorrectionStatus.INVALID)).astype(jnp.int32)
     corrected = status == int(CorrectionStatus.CORRECTED)
     mu = _root(
         jnp.where(corrected, ecof, 0.5),
@@ -343,16 +347,14 @@ _PARAMETERS = """
     ecof : array_like
         The reported energy coefficient of friction :math:`\\mu_E = E_d/(4P\\delta^*)`. [1]
     amplitude : array_like
-        Displacement amplitude :math:`\\Delta^*` of the test (also the groove half-width
-        :math:`x_o`, as in the paper). [m]
+        Displacement amplitude :math:`\\Delta^*` (also the groove half-width :math:`x_o`). [m]
     load : array_like
         Normal load :math:`P`. [N]
     stiffness : array_like
         Rig stiffness :math:`S`; ``numpy.inf`` for a rigid rig. [N/m]
     aspect_ratio : array_like or tuple (low, high), optional
-        The wear scar's depth over half-width, :math:`z_o/x_o = D/W` (eq. 11). A ``tuple``
-        of two values (or arrays) is an interval for a scar known only roughly; give
-        per-point values as a list or an array. [1]
+        The scar's depth over half-width, :math:`z_o/x_o = D/W` (eq. 11); a ``tuple`` of two
+        is an interval for a scar known only roughly (per-point values: a list or array). [1]
     scar_depth : array_like, optional
         Wear scar depth :math:`D`, instead of ``aspect_ratio`` (with ``scar_half_width``). [m]
     scar_half_width : array_like, optional
@@ -363,26 +365,24 @@ _PARAMETERS = """
     mapping : {'scaled', 'physical'}
         With a profile: :math:`X = xW/\\Delta^*` (eq. 11) or :math:`X = x`.
     return_status : bool
-        Also return the :class:`CorrectionStatus` of every point, and never raise or warn
-        for a point that cannot be corrected.
+        Also return each point's :class:`CorrectionStatus`, and never raise or warn for one.
 """
 
 _RAISES = """
     Raises
     ------
     ValueError
-        For a concrete input out of its range (ecof, amplitude, load and scar_half_width
-        finite and > 0, stiffness > 0 with inf allowed, aspect_ratio and scar_depth finite
-        and >= 0, an interval with low <= high; each within :data:`ecofmaps.units.DOMAIN`),
-        for the aspect ratio given neither or both ways, and, without ``return_status``,
-        for a single point that cannot be corrected (the message says why). Under
-        ``jax.jit``/``jax.vmap`` such points are NaN with the status ``INVALID``.
+        For a concrete input out of range (ecof, amplitude, load, scar_half_width > 0;
+        stiffness > 0, inf allowed; aspect_ratio, scar_depth >= 0; an interval's low <= high;
+        all within :data:`ecofmaps.units.DOMAIN`; traced: NaN and ``INVALID``), the aspect
+        ratio given neither or both ways, and (without ``return_status``) a single point
+        that cannot be corrected (the message says why).
 
     Warns
     -----
     ecofmaps.RegimeWarning
-        For concrete arrays (without ``return_status``) with points that cannot be
-        corrected, naming the reasons; those points are NaN.
+        For concrete arrays (without ``return_status``) with points that cannot be corrected
+        (NaN), naming the reasons.
 
     References
     ----------

@@ -67,24 +67,19 @@ def lookup_correction(
     Parameters
     ----------
     map_dataset : xarray.Dataset
-        A map from :func:`ecofmaps.compute_map` with a ``mu`` dimension of at least two
-        values and the variable ``ecof``; ``stiffness_ratio``, ``aspect_ratio`` and
-        ``amplitude`` are dimensions or scalar coordinates.
-    ecof, amplitude, load, stiffness, aspect_ratio, scar_depth, scar_half_width
+        A map of :func:`ecofmaps.compute_map` with ``ecof`` over at least two values of
+        ``mu``; ``stiffness_ratio``, ``aspect_ratio``, ``amplitude`` as dimensions or scalars.
+    ecof, amplitude, load, stiffness, aspect_ratio, scar_depth, scar_half_width, return_status
         As for :func:`correct_ecof` (no interval). [1], [m], [N], [N/m], [1], [m], [m]
-    return_status : bool
-        Also return the :class:`CorrectionStatus` of every point (and do not raise or warn).
 
     Returns
     -------
     mu : numpy.ndarray of float64
         The contact CoF; NaN where it cannot be read off the map. [1]
     status : numpy.ndarray of int32
-        Only with ``return_status=True``: :class:`CorrectionStatus` codes, among them
-        ``OUTSIDE_MAP`` for test conditions outside the map's grid (or off a scalar
-        coordinate, by more than 1e-9 relative) and for an ECoF beyond the map's
-        :math:`\mu` range; ``AMBIGUOUS`` where the interpolated curve crosses the ECoF more
-        than once; ``NO_GROSS_SLIP`` as for :func:`correct_ecof`.
+        Only with ``return_status=True``: :class:`CorrectionStatus` codes; ``OUTSIDE_MAP`` off
+        the map's grid (a scalar coordinate: by more than 1e-9 relative) or :math:`\mu`
+        range, ``AMBIGUOUS`` where the interpolated curve crosses the ECoF more than once.
 
     Raises
     ------

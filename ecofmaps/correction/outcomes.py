@@ -24,7 +24,6 @@ __all__ = [
     "ecof_fall",
     "ecof_fall_where_needed",
     "may_fall",
-    "reachability_status",
 ]
 
 #: :math:`\lambda_\infty`: :math:`\mu_E(\mu)` falls over part of its range only where
@@ -39,24 +38,18 @@ AMBIGUOUS_ECOF_MIN = 1.6
 
 
 class CorrectionStatus(Code):
-    """Outcome of a correction, per point (``return_status=True``).
+    """Outcome of a correction, per point (``return_status=True``); each code's ``reason``
+    says why, docs/model.md ("Correcting a reported ECoF") when.
 
     Attributes
     ----------
-    CORRECTED
-        One contact CoF gives the ECoF; it is returned.
-    NO_GROSS_SLIP
-        The ECoF is at or above :math:`S\\Delta^*/P` (such a contact CoF stops gross slip).
-    AMBIGUOUS
-        Several contact CoFs give the ECoF (:math:`\\kappa > 1`, :math:`\\lambda <`
-        :data:`LAMBDA_INFINITY`: :math:`\\mu_E(\\mu)` falls over part of its range).
+    CORRECTED, NO_GROSS_SLIP, AMBIGUOUS
+        One contact CoF gives the ECoF (returned); the ECoF is at or above
+        :math:`S\\Delta^*/P`; several contact CoFs give it.
     INVALID
         An input out of range or NaN (under ``jax.jit``/``jax.vmap``; else ``ValueError``).
-    OUTSIDE_MAP
-        :func:`lookup_correction` only: the point, or the ECoF, is outside the map.
-    UNREACHABLE
-        On a scar profile: no contact CoF gives the ECoF below :math:`S\\Delta^*/P` (a jump of
-        :math:`\\mu_E(\\mu)`, or a slip off the trace).
+    OUTSIDE_MAP, UNREACHABLE
+        :func:`lookup_correction`: off the map; on a scar profile: no contact CoF gives it.
     """
 
     CORRECTED = 0, "corrected"
@@ -110,17 +103,6 @@ def ecof_and_slope(mu, kappa, lam):
     return jax.jvp(lambda m: m * model.ecof_ratio(m, kappa, lam), (mu,), (jnp.ones_like(mu),))
 
 
-def reachability_status(ecof, kappa, lam):
-    """The status before the ambiguity check: which ECoFs the model can reach."""
-    valid = (ecof > 0.0) & jnp.isfinite(ecof)
-    for value in (kappa, lam):
-        valid &= (value >= 0.0) & jnp.isfinite(value)
-    code = jnp.where(
-        ecof * lam < 1.0, int(CorrectionStatus.CORRECTED), int(CorrectionStatus.NO_GROSS_SLIP)
-    )
-    return jnp.where(valid, code, int(CorrectionStatus.INVALID)).astype(jnp.int32)
-
-
 def may_fall(kappa, lam):
     """Where :math:`\\mu_E(\\mu)` may fall over part of its range."""
     return (kappa > _FALL_KAPPA) & (lam > 0.0) & (lam < _FALL_LAMBDA)
@@ -133,10 +115,8 @@ def ecof_fall(kappa, lam):
 
     Parameters
     ----------
-    kappa : array_like
-        Curvature number :math:`\kappa = 2 z_o/x_o` (with :math:`x_o = \Delta^*`). [1]
-    lam : array_like
-        Compliance ratio :math:`\lambda = P/(S\Delta^*)`. [1]
+    kappa, lam
+        As for :func:`contact_cof`. [1]
 
     Returns
     -------
