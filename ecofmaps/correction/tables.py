@@ -57,8 +57,7 @@ class TableError(FileLineError):
 
 
 class TableRowWarning(UserWarning):
-    """A row that could not be corrected (``bad_rows="nan"``): the message names the file,
-    the 1-based line number and the column, as :class:`TableError` does."""
+    """A row that could not be corrected (``bad_rows="nan"``), named as by :class:`TableError`."""
 
 
 def table_dialect(header_line: str) -> str:
@@ -67,8 +66,7 @@ def table_dialect(header_line: str) -> str:
 
 
 def _number(path, line: int, name: str, text: str, decimal_comma: bool) -> float:
-    """The cell ``text`` of column ``name`` in SI, range-checked (``0,83`` read as 0.83 when the
-    table's separator is not a comma)."""
+    """The cell ``text`` of column ``name`` in SI, range-checked (``0,83`` if ``decimal_comma``)."""
     quantity = nomenclature.QUANTITIES[COLUMNS[name]]
     unit = f" in {quantity.display_unit}" if quantity.display_unit else ""
     if decimal_comma and text.count(",") == 1 and "." not in text:
@@ -179,10 +177,9 @@ def _header_problem(header: list[str], on_profile: bool, keep_bad: bool) -> str 
 
 
 def correct_table(path, profile=None, mapping="scaled", bad_rows="raise") -> tuple[str, int]:
-    """The table at ``path`` (``docs/formats.md``) with each row's ``mu`` and
-    ``correction_factor`` (on a ``profile``, ``mu_parabolic`` too), as text in the input's
-    dialect, and its number of rows; ``bad_rows='nan'`` gives a bad row NaN, a ``status``
-    and a :class:`TableRowWarning` instead of raising :class:`TableError`."""
+    """The table at ``path`` (``docs/formats.md``) with each row's results, as text in its dialect,
+    and its number of rows; ``bad_rows='nan'`` gives a bad row NaN, a ``status`` and a
+    :class:`TableRowWarning` instead of raising :class:`TableError`."""
     if bad_rows not in ("raise", "nan"):
         raise ValueError(f"bad_rows must be 'raise' or 'nan', got {bad_rows!r}")
     path = Path(path)

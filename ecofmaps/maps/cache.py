@@ -158,8 +158,7 @@ def metadata_checksum(dataset: xr.Dataset) -> str:
 
 
 def cache_key(function: str, inputs: Mapping[str, object]) -> str:
-    """SHA-256 key (hex) of version, model revision, ``function`` and ``inputs`` (by name, as
-    float64 bytes with their shape: a scalar and a one-element array differ)."""
+    """SHA-256 key (hex) of version, model revision, ``function`` and ``inputs`` (float64 bytes)."""
     digest = hashlib.sha256(f"ecofmaps {__version__}\0{model_revision()}\0{function}\0".encode())
     for name, value in inputs.items():
         digest.update(f"{name}\0".encode())
@@ -281,8 +280,8 @@ def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
 def cached_dataset(
     function: str, inputs: Mapping[str, object], compute: Callable[[], xr.Dataset], cache_dir=None
 ) -> xr.Dataset:
-    """``compute()``, read from the cache under the key of ``function`` and ``inputs`` (all
-    the result depends on), else computed and stored (a :class:`CacheWarning` if it cannot)."""
+    """``compute()``, read from the cache under the key of ``function`` and ``inputs`` (all the
+    result depends on), else computed and stored."""
     directory = cache_directory(cache_dir)
     bound = cache_size_bound()  # a bad ECOFMAPS_CACHE_SIZE is refused before any work
     key = cache_key(function, inputs)

@@ -19,15 +19,9 @@ from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers,
 from ecofmaps.model.simulation import fretting_loop
 from ecofmaps.model.steady_state import dimensionless
 
-__all__ = [
-    "MODEL_ON_PROFILE",
-    "compute_loops",
-    "compute_map",
-    "compute_profile_map",
-    "compute_universal_map",
-]
+__all__ = ["compute_loops", "compute_map", "compute_profile_map", "compute_universal_map"]
 
-MODEL_ON_PROFILE = (
+_MODEL_ON_PROFILE = (
     "compliant wear-scar interaction model on a measured or modelled scar profile: a rigid "
     "round-ended pad with Coulomb friction feels the profile's slope g(X) (eq. 9 pointwise), "
     "driven through a spring of stiffness S (the rig); steady loops of displacement amplitude "
@@ -172,8 +166,6 @@ def compute_map(
 
     Examples
     --------
-    A map in blocks of 2 values of S/P, evaluated when it is computed or written:
-
     >>> import numpy as np
     >>> m = compute_map(np.geomspace(2e4, 2e5, 5), np.linspace(0, 0.3, 4), 50e-6, 0.8,
     ...                 chunks={"stiffness_ratio": 2})
@@ -395,7 +387,7 @@ def compute_profile_map(
         del values["normalized_energy"], values["normalized_max_force"]
         title = "ECoF map of the compliant wear-scar model on a scar profile"
         return map_dataset(axes, values, load, title).assign_attrs(
-            model=MODEL_ON_PROFILE,
+            model=_MODEL_ON_PROFILE,
             scar_depth=float(profile.depth),
             scar_half_width=float(profile.half_width),
             scar_aspect_ratio=float(profile.aspect_ratio),
