@@ -23,7 +23,6 @@ __all__ = [
     "TableError",
     "TableRowWarning",
     "correct_table",
-    "table_dialect",
 ]
 
 #: Input columns: column name -> quantity name (its unit and range in the nomenclature).
@@ -60,11 +59,6 @@ class TableRowWarning(UserWarning):
     """A row that could not be corrected (``bad_rows="nan"``), named as by :class:`TableError`."""
 
 
-def table_dialect(header_line: str) -> str:
-    """The separator the header line uses (tab, else ``;``, else ``,``)."""
-    return "\t" if "\t" in header_line else ";" if ";" in header_line else ","
-
-
 def _number(path, line: int, name: str, text: str, decimal_comma: bool) -> float:
     """The cell ``text`` of column ``name`` in SI, range-checked (``0,83`` if ``decimal_comma``)."""
     quantity = nomenclature.QUANTITIES[COLUMNS[name]]
@@ -90,7 +84,7 @@ def _read(path: Path, on_profile: bool, keep_bad: bool):
         with open(path, encoding="utf-8-sig", newline="") as stream:
             lines = ["\n" if line.lstrip().startswith("#") else line for line in stream]
         header_line = next((line for line in lines if line.strip()), ",")
-        delimiter = table_dialect(header_line)
+        delimiter = "\t" if "\t" in header_line else ";" if ";" in header_line else ","
         reader = csv.reader(lines, delimiter=delimiter)
         # each non-blank row with the file line it ends on (csv counts the lines it reads)
         records = [(row, reader.line_num) for row in reader if any(cell.strip() for cell in row)]
