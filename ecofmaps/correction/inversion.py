@@ -335,8 +335,7 @@ def _illinois(profile, target, low, high, rig, mapping):
         high = np.where(up, trial, b)
         low = np.where(down, trial, a)
         side = np.where(up, 1, np.where(down, -1, side))
-        done = (value == 0.0) | (high - low <= 4.0 * _EPS * high)
-        active &= ~done
+        active &= ~((value == 0.0) | (high - low <= 4.0 * _EPS * high))
     root = np.where(np.abs(f_low) <= np.abs(np.nan_to_num(f_high, nan=np.inf)), low, high)
     return root, np.abs(_residual(profile, root, target, rig, mapping)) <= 1e-9 * target
 

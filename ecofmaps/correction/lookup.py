@@ -34,14 +34,11 @@ def _map_axes(ecof_map):
 
 def _crossing(curves, mu_grid, ecof):
     """Invert each curve ``ecof(mu)`` by linear interpolation; count its crossings."""
-    above = curves > ecof[:, None]
-    finite = np.isfinite(curves)
-    pair = finite[:, :-1] & finite[:, 1:]
-    crossing = pair & (above[:, :-1] != above[:, 1:])
+    above, finite = curves > ecof[:, None], np.isfinite(curves)
+    crossing = finite[:, :-1] & finite[:, 1:] & (above[:, :-1] != above[:, 1:])
     count = crossing.sum(axis=1)
     index = np.argmax(crossing, axis=1)
-    rows = np.arange(curves.shape[0])
-    c0, c1 = curves[rows, index], curves[rows, index + 1]
+    c0, c1 = np.take_along_axis(curves, index[:, None] + np.arange(2), axis=1).T
     with np.errstate(invalid="ignore", divide="ignore"):
         fraction = (ecof - c0) / (c1 - c0)
     mu = mu_grid[index] + fraction * (mu_grid[index + 1] - mu_grid[index])

@@ -137,8 +137,7 @@ def ecof_fall(kappa, lam):
     falls = may_fall(kappa, lam)
     kappa = jnp.where(falls, kappa, 2.0)[..., None]  # harmless values elsewhere
     lam = jnp.where(falls, lam, 0.01)[..., None]
-    fraction = jnp.linspace(0.0, 1.0, _FALL_GRID)
-    log_mu = -jnp.log(kappa) * (1.0 - fraction)  # from 1/kappa to 1
+    log_mu = -jnp.log(kappa) * (1.0 - jnp.linspace(0.0, 1.0, _FALL_GRID))  # from 1/kappa to 1
     _, slope = ecof_and_slope(jnp.exp(log_mu), kappa, lam)
     falling = slope <= 0.0
     found = falls & jnp.any(falling, axis=-1)
@@ -146,11 +145,9 @@ def ecof_fall(kappa, lam):
     last = jnp.clip(_FALL_GRID - 1 - jnp.argmax(falling[..., ::-1], axis=-1), 1, _FALL_GRID - 2)
 
     # Brackets of the slope's sign changes: rising at `rise`, falling at `fall`.
-    def at(index):
-        return jnp.take_along_axis(log_mu, index[..., None], axis=-1)[..., 0]
-
-    rise = jnp.stack([at(first - 1), at(last + 1)], axis=-1)
-    fall = jnp.stack([at(first), at(last)], axis=-1)
+    ends = jnp.stack([first, last], axis=-1)
+    rise = jnp.take_along_axis(log_mu, ends + jnp.array([-1, 1]), axis=-1)
+    fall = jnp.take_along_axis(log_mu, ends, axis=-1)
 
     def halve(_, bracket):
         rise, fall = bracket

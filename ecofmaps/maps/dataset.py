@@ -103,13 +103,8 @@ def grid_dataset(axes: dict, values: dict, title: str, extra=None) -> xr.Dataset
             value = np.squeeze(value, axis=squeeze)
             value = dims + trailing[: value.ndim - len(dims)], value
         variables[name] = xr.Variable(*value, _attrs(name))
-    attrs = {
-        "title": title,
-        "model": paper.MODEL,
-        "references": paper.CITATION,
-        "source": f"ecofmaps {__version__}",
-        "ecofmaps_version": __version__,
-    }
+    attrs = {"title": title, "model": paper.MODEL, "references": paper.CITATION}
+    attrs.update(source=f"ecofmaps {__version__}", ecofmaps_version=__version__)
     # What xarray.Dataset(data_vars, coords, attrs) builds, without its merging and alignment
     # of variables that are consistent by construction.
     return xr.Dataset._construct_direct(variables, coords, attrs=attrs, indexes=indexes)

@@ -47,15 +47,14 @@ def write_map(dataset: xr.Dataset, path, *, also: Sequence = ()) -> tuple:
 
     Examples
     --------
-    >>> import numpy as np, tempfile, xarray as xr
+    >>> import numpy as np, tempfile
     >>> from ecofmaps import compute_map
     >>> lazy = compute_map(np.geomspace(2e4, 2e5, 30), np.linspace(0, 0.3, 20), 50e-6, 0.8,
     ...                    chunks=100)
     >>> with tempfile.TemporaryDirectory() as directory:
     ...     (top,) = write_map(lazy, f"{directory}/map.zarr", also=[lazy.ecof_ratio.max().data])
-    ...     stored = xr.open_zarr(f"{directory}/map.zarr").compute()
-    >>> stored.identical(lazy.compute()), round(float(top), 4)
-    (True, 1.1361)
+    >>> round(float(top), 4)
+    1.1361
     """
     import dask
 
