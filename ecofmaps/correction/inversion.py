@@ -160,37 +160,34 @@ def _si_correct(ecof, amplitude, load, stiffness, aspect_ratio):
 
 def groove_aspect_ratio(aspect_ratio, scar_depth, scar_half_width):
     """The groove's aspect ratio from either way of giving it, checked."""
-    if aspect_ratio is not None:
-        if scar_depth is not None or scar_half_width is not None:
+    if aspect_ratio is None:
+        if scar_depth is None or scar_half_width is None:
             raise ValueError(
-                "give the groove aspect ratio one way: aspect_ratio, or scar_depth and "
-                "scar_half_width (z_o/x_o = D/W, eq. 11), not both"
+                "give the groove aspect ratio: aspect_ratio, or both scar_depth and "
+                "scar_half_width (z_o/x_o = D/W, eq. 11)"
             )
-        if isinstance(aspect_ratio, tuple):
-            if len(aspect_ratio) != 2:
-                raise ValueError(
-                    "aspect_ratio as a tuple is an interval (low, high) of two values or "
-                    f"arrays, got {len(aspect_ratio)} items (use a list or an array for "
-                    "per-point values)"
-                )
-            low, high = aspect_ratio
-            for end, value in (("low", low), ("high", high)):
-                check(f"aspect_ratio {end}", value, "non_negative", "1")
-            if is_concrete(low, high) and np.any(np.asarray(low) > np.asarray(high)):
-                raise ValueError(
-                    f"aspect_ratio interval must have low <= high, got ({low!r}, {high!r})"
-                )
-            return as_float64(low), as_float64(high)
+        check("scar_depth", scar_depth, "non_negative", "m")
+        check("scar_half_width", scar_half_width, "positive", "m")
+        return as_float64(scar_depth) / as_float64(scar_half_width)
+    if scar_depth is not None or scar_half_width is not None:
+        raise ValueError(
+            "give the groove aspect ratio one way: aspect_ratio, or scar_depth and "
+            "scar_half_width (z_o/x_o = D/W, eq. 11), not both"
+        )
+    if not isinstance(aspect_ratio, tuple):
         check("aspect_ratio", aspect_ratio, "non_negative", "1")
         return as_float64(aspect_ratio)
-    if scar_depth is None or scar_half_width is None:
+    if len(aspect_ratio) != 2:
         raise ValueError(
-            "give the groove aspect ratio: aspect_ratio, or both scar_depth and "
-            "scar_half_width (z_o/x_o = D/W, eq. 11)"
+            "aspect_ratio as a tuple is an interval (low, high) of two values or arrays, got "
+            f"{len(aspect_ratio)} items (use a list or an array for per-point values)"
         )
-    check("scar_depth", scar_depth, "non_negative", "m")
-    check("scar_half_width", scar_half_width, "positive", "m")
-    return as_float64(scar_depth) / as_float64(scar_half_width)
+    low, high = aspect_ratio
+    for end, value in (("low", low), ("high", high)):
+        check(f"aspect_ratio {end}", value, "non_negative", "1")
+    if is_concrete(low, high) and np.any(np.asarray(low) > np.asarray(high)):
+        raise ValueError(f"aspect_ratio interval must have low <= high, got ({low!r}, {high!r})")
+    return as_float64(low), as_float64(high)
 
 
 def _correct(factor, ecof, amplitude, load, stiffness, scar, profile, mapping, return_status):

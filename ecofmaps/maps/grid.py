@@ -217,8 +217,7 @@ def compute_universal_map(
     Parameters
     ----------
     compliance_ratio : float or 1-D array_like
-        :math:`\lambda = P/(S\Delta^*)`, the rig's deflection at :math:`Q = P` over the
-        displacement amplitude, >= 0 (0 for a rigid rig). [1]
+        :math:`\lambda = P/(S\Delta^*)`, >= 0 (0 for a rigid rig). [1]
     aspect_ratio, mu, chunks, cache, cache_dir, max_chunk
         As for :func:`compute_map`.
 
@@ -275,12 +274,11 @@ def compute_loops(stiffness, aspect_ratio, amplitude, load, mu, num=201) -> xr.D
     Returns
     -------
     loops : xarray.Dataset
-        Dimensions: those of the parameters given as arrays (in the order of the
-        arguments), then ``point``. Variables ``displacement`` [m] and ``force`` [N] around
-        each loop (see :func:`ecofmaps.fretting_loop`: it starts and ends at the reversal
-        :math:`(-\Delta^*, -Q^*)` and runs clockwise; slip branches of eq. 9-10), and per loop
-        ``slip_amplitude`` [m] (eq. 16), ``max_force`` [N], ``dissipated_energy`` [J] (the
-        loop's area, eq. 12) and ``regime``. Self-locking loops are NaN.
+        Dimensions: the parameters given as arrays (in order), then ``point``. Variables
+        ``displacement`` [m] and ``force`` [N] around each loop (as
+        :func:`ecofmaps.fretting_loop`: eq. 9-10), and per loop ``slip_amplitude`` [m]
+        (eq. 16), ``max_force`` [N], ``dissipated_energy`` [J] (eq. 12) and ``regime``.
+        Self-locking loops are NaN.
 
     Raises
     ------
@@ -333,10 +331,9 @@ def compute_profile_map(
     Returns
     -------
     map : xarray.Dataset
-        Dimensions ``stiffness_ratio``, ``amplitude``, ``mu`` (those given as arrays), the
-        variables of :func:`compute_map`, and the profile's depth, half-width, aspect ratio,
-        sample count and the mapping as global attributes. Points where the pad slips off
-        the trace have the regime ``BEYOND_PROFILE`` and NaN values.
+        As :func:`compute_map` (no ``aspect_ratio``), with the profile's depth, half-width,
+        aspect ratio, sample count and the mapping as global attributes. Points where the
+        pad slips off the trace have the regime ``BEYOND_PROFILE`` and NaN values.
 
     Raises
     ------
@@ -395,8 +392,6 @@ def compute_profile_map(
             mapping=mapping,
         )
 
-    if not cache:
-        return compute()
     inputs = {**axes, "load": load, "mapping": float(physical)}
     inputs.update({f"profile_{name}": value for name, value in profile._asdict().items()})
-    return cached_dataset("compute_profile_map", inputs, compute, cache_dir)
+    return _cached("compute_profile_map", inputs, compute, cache, None, cache_dir)
