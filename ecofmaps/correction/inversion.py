@@ -88,6 +88,21 @@ def _root_and_status(ecof, kappa, lam):
     return jnp.where(corrected, mu, jnp.nan), status
 
 
+def _ambiguity_marked(mu, status, ecof, high, low):
+    """The contact CoF and status, NaN and ``AMBIGUOUS`` where ``ecof`` lies in the fall."""
+    ambiguous = (status == int(CorrectionStatus.CORRECTED)) & (ecof >= low) & (ecof <= high)
+    status = jnp.where(ambiguous, int(CorrectionStatus.AMBIGUOUS), status).astype(jnp.int32)
+    return jnp.where(ambiguous, jnp.nan, mu), status
+
+
+def _ecof_fall_where_needed(status, kappa, lam):
+    """:func:`ecof_fall` at every point, scanned only if a corrected point may fall."""
+    kappa, lam = jax.lax.stop_gradient(kappa), jax.lax.stop_gradient(lam)
+    needed = jnp.any(outcomes.may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
+    nan = jnp.full(status.shape, jnp.nan)
+    return jax.lax.cond(needed, lambda: outcomes.ecof_fall(kappa, lam), lambda: (nan, nan))
+
+
 def contact_cof(ecof, kappa, lam):
     r"""The contact CoF :math:`\mu` whose energy CoF is ``ecof`` (eq. 13-15, 16 inverted), in the
     dimensionless core: pure ``jax.numpy`` (``jax.jit``, ``jax.vmap``); it checks nothing.
@@ -117,9 +132,7 @@ def contact_cof(ecof, kappa, lam):
     """
     ecof, kappa, lam = jnp.broadcast_arrays(*(as_float64(v) for v in (ecof, kappa, lam)))
     mu, status = _root_and_status(ecof, kappa, lam)
-    return outcomes.ambiguity_marked(
-        mu, status, ecof, *outcomes.ecof_fall_where_needed(status, kappa, lam)
-    )
+    return _ambiguity_marked(mu, status, ecof, *_ecof_fall_where_needed(status, kappa, lam))
 
 
 @jax.jit
@@ -141,7 +154,7 @@ def _si_correct(ecof, amplitude, load, stiffness, aspect_ratio):
     """μ, status and the fall (high, low) at concrete or traced SI inputs."""
     mu, status, kappa, lam = _si_root(ecof, amplitude, load, stiffness, aspect_ratio)
     if not is_concrete(mu):
-        high, low = outcomes.ecof_fall_where_needed(status, kappa, lam)
+        high, low = _ecof_fall_where_needed(status, kappa, lam)
     else:  # only the few points where mu_E(mu) may fall are scanned, in one padded batch
         where = np.flatnonzero(
             np.asarray(outcomes.may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
@@ -153,8 +166,7 @@ def _si_correct(ecof, amplitude, load, stiffness, aspect_ratio):
             fall = _ecof_fall(kappa.ravel()[padded], lam.ravel()[padded])
             high[where], low[where] = (np.asarray(v)[: where.size] for v in fall)
         high, low = high.reshape(mu.shape), low.reshape(mu.shape)
-    ecof = jnp.broadcast_to(ecof, mu.shape)
-    mu, status = outcomes.ambiguity_marked(mu, status, ecof, jnp.asarray(high), jnp.asarray(low))
+    mu, status = _ambiguity_marked(mu, status, ecof, jnp.asarray(high), jnp.asarray(low))
     return mu, status, (kappa, lam, high, low)
 
 
@@ -364,7 +376,10 @@ _PARAMETERS = """
         Also return each point's :class:`CorrectionStatus`, and never raise or warn for one.
 """
 
-_RAISES = """
+_STATUS_RAISES_REFERENCES = """    status : jax.Array of int32
+        Only with ``return_status=True``: :class:`CorrectionStatus` codes (for an interval,
+        the first failure of its two ends).
+
     Raises
     ------
     ValueError
@@ -417,10 +432,7 @@ correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy
         The contact CoF, within a few ulp of the exact root; NaN where it cannot be
         corrected. With ``aspect_ratio=(low, high)``, an :class:`Interval` of arrays: every
         contact CoF that gives ``ecof`` with an aspect ratio in the interval. [1]
-    status : jax.Array of int32
-        Only with ``return_status=True``: :class:`CorrectionStatus` codes (for an interval,
-        the first failure of its two ends).
-{_RAISES}
+{_STATUS_RAISES_REFERENCES}
     Examples
     --------
     >>> import ecofmaps
@@ -457,6 +469,4 @@ correction_factor.__doc__ = f"""The ratio :math:`\\mu/\\mu_E` of contact CoF to 
     factor : jax.Array of float64, or Interval
         :math:`\\mu/\\mu_E \\le 1` (1 for a flat scar), with :math:`\\mu` from
         :func:`correct_ecof`; an :class:`Interval` for an aspect-ratio interval. [1]
-    status : jax.Array of int32
-        Only with ``return_status=True``: :class:`CorrectionStatus` codes.
-{_RAISES}"""
+{_STATUS_RAISES_REFERENCES}"""

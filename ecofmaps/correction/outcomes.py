@@ -18,11 +18,9 @@ __all__ = [
     "LAMBDA_INFINITY",
     "CorrectionStatus",
     "Interval",
-    "ambiguity_marked",
     "check_test",
     "ecof_and_slope",
     "ecof_fall",
-    "ecof_fall_where_needed",
     "may_fall",
 ]
 
@@ -159,18 +157,3 @@ def ecof_fall(kappa, lam):
     rise, fall = jax.lax.fori_loop(0, _FALL_BISECTIONS, halve, (rise, fall))
     value, _ = ecof_and_slope(jnp.exp(0.5 * (rise + fall)), kappa, lam)
     return jnp.where(found, value[..., 0], jnp.nan), jnp.where(found, value[..., 1], jnp.nan)
-
-
-def ambiguity_marked(mu, status, ecof, high, low):
-    """The contact CoF and status, NaN and ``AMBIGUOUS`` where ``ecof`` lies in the fall."""
-    ambiguous = (status == int(CorrectionStatus.CORRECTED)) & (ecof >= low) & (ecof <= high)
-    status = jnp.where(ambiguous, int(CorrectionStatus.AMBIGUOUS), status).astype(jnp.int32)
-    return jnp.where(ambiguous, jnp.nan, mu), status
-
-
-def ecof_fall_where_needed(status, kappa, lam):
-    """:func:`ecof_fall` at every point, scanned only if a corrected point may fall."""
-    kappa, lam = jax.lax.stop_gradient(kappa), jax.lax.stop_gradient(lam)
-    needed = jnp.any(may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
-    nan = jnp.full(status.shape, jnp.nan)
-    return jax.lax.cond(needed, lambda: ecof_fall(kappa, lam), lambda: (nan, nan))

@@ -147,7 +147,6 @@ def _row_values(path, line: int, row, column: dict, on_profile: bool, commas: bo
 
 
 def _header_problem(header: list[str], on_profile: bool, keep_bad: bool) -> str | None:
-    """What is wrong with the header line, or None."""
     duplicates = sorted({name for name in header if header.count(name) > 1})
     if duplicates:
         return f"repeated column(s) {', '.join(duplicates)}"

@@ -205,8 +205,7 @@ def _file_image(dataset: xr.Dataset) -> bytes:
     )
     try:
         with h5netcdf.File(memory, "w") as netcdf:  # leaves `memory` open
-            store = xr.backends.H5NetCDFStore(netcdf, mode="w")
-            dataset.dump_to_store(store, encoding=encoding)
+            dataset.dump_to_store(xr.backends.H5NetCDFStore(netcdf, mode="w"), encoding=encoding)
             written = xr.open_dataset(xr.backends.H5NetCDFStore(netcdf, mode="r"))
             netcdf.attrs[_CHECKSUM_ATTRIBUTE] = metadata_checksum(written)
         memory.flush()

@@ -105,8 +105,7 @@ def grid_dataset(axes: dict, values: dict, title: str, extra=None) -> xr.Dataset
         variables[name] = xr.Variable(*value, _attrs(name))
     attrs = {"title": title, "model": paper.MODEL, "references": paper.CITATION}
     attrs.update(source=f"ecofmaps {__version__}", ecofmaps_version=__version__)
-    # What xarray.Dataset(data_vars, coords, attrs) builds, without its merging and alignment
-    # of variables that are consistent by construction.
+    # xarray.Dataset(data_vars, coords, attrs) without aligning variables consistent by design.
     return xr.Dataset._construct_direct(variables, coords, attrs=attrs, indexes=indexes)
 
 

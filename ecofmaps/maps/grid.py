@@ -1,7 +1,6 @@
-r"""Parameter maps: the model over whole grids, as labelled xarray Datasets. Each function takes
-one value or one 1-D array per parameter (the Dataset's scalar coordinates and dimensions), with
-:math:`x_o = \Delta^*` as in the paper. The method: docs/model.md; tiles, blocks and the cache:
-docs/performance.md."""
+r"""The model over whole grids, as labelled xarray Datasets: one value or one 1-D array per
+parameter (a scalar coordinate or a dimension), :math:`x_o = \Delta^*` as in the paper. The
+method: docs/model.md; tiles, blocks and the cache: docs/performance.md."""
 
 from __future__ import annotations
 
@@ -29,15 +28,6 @@ _MODEL_ON_PROFILE = (
 )
 
 
-def _mesh(*axes):
-    """The 1-D ``axes`` reshaped to broadcast against each other, axis ``i`` along dim ``i``."""
-    count = len(axes)
-    return [
-        jnp.reshape(axis, tuple(-1 if j == i else 1 for j in range(count)))
-        for i, axis in enumerate(axes)
-    ]
-
-
 def _steady_state(mu, kappa, lam, amplitude=None, load=None) -> dict:
     """The steady-loop quantities of the core numbers, by variable name (eq. 1, 9, 12, 16)."""
     values = {
@@ -61,7 +51,7 @@ def _broadcast(values: dict, axes) -> dict:
 
 @jax.jit
 def _map_kernel(stiffness_ratio, aspect_ratio, amplitude, mu, load):
-    axes = _mesh(stiffness_ratio, aspect_ratio, amplitude, mu)
+    axes = jnp.ix_(stiffness_ratio, aspect_ratio, amplitude, mu)
     stiffness_ratio, aspect_ratio, amplitude, mu = axes
     kappa = model.curvature_number(1.0, aspect_ratio, 1.0)  # x_o = Δ*: κ = 2 z_o/x_o
     lam = model.compliance_ratio(amplitude, 1.0, stiffness_ratio)  # 1/((S/P) Δ*)
@@ -70,7 +60,7 @@ def _map_kernel(stiffness_ratio, aspect_ratio, amplitude, mu, load):
 
 @jax.jit
 def _universal_kernel(compliance_ratio, aspect_ratio, mu):
-    axes = _mesh(compliance_ratio, aspect_ratio, mu)
+    axes = jnp.ix_(compliance_ratio, aspect_ratio, mu)
     lam, aspect_ratio, mu = axes
     kappa = model.curvature_number(1.0, aspect_ratio, 1.0)
     return _broadcast(_steady_state(mu, kappa, lam), axes)
@@ -137,21 +127,20 @@ def compute_map(
     -------
     map : xarray.Dataset
         Dimensions ``stiffness_ratio``, ``aspect_ratio``, ``amplitude``, ``mu`` (those given
-        as arrays, in this order). Variables, each with ``long_name`` and ``units``:
-        ``slip_amplitude`` [m] (eq. 16), ``slip_ratio`` [1], ``ecof`` [1] (eq. 13-15),
-        ``ecof_ratio`` [1], ``regime`` (:class:`ecofmaps.Regime` codes), ``compliance_ratio``
-        [1] (over S/P and amplitude only) and, with a load, ``dissipated_energy`` [J]
-        (eq. 12) and ``max_force`` [N] (eq. 9). ECoFs are NaN without gross slip; all but the
-        regime are NaN when self-locking. Computed, a chunked map equals the map in memory;
-        arrays of a single tile are read-only.
+        as arrays, in order); variables with ``long_name`` and ``units``: ``slip_amplitude``
+        [m] (eq. 16), ``slip_ratio`` [1], ``ecof`` [1] (eq. 13-15), ``ecof_ratio`` [1],
+        ``regime`` (:class:`ecofmaps.Regime`), ``compliance_ratio`` [1] (over S/P and
+        amplitude), with a load ``dissipated_energy`` [J] (eq. 12) and ``max_force`` [N]
+        (eq. 9). ECoFs are NaN without gross slip, all but the regime when self-locking.
+        Computed, a chunked map equals the map in memory; a single tile's arrays are read-only.
 
     Raises
     ------
     ValueError
-        For a parameter that is not a scalar or a non-empty 1-D array or is out of range
-        (stiffness_ratio > 0, inf allowed; aspect_ratio >= 0; amplitude, mu, load > 0;
-        within :data:`ecofmaps.units.DOMAIN`); a bad ``chunks``; ``cache=True`` with
-        ``chunks``; a map in memory that would not fit in the memory available.
+        For a parameter not a scalar or non-empty 1-D array, or out of range (stiffness_ratio
+        > 0, inf allowed; aspect_ratio >= 0; amplitude, mu, load > 0; within
+        :data:`ecofmaps.units.DOMAIN`); a bad ``chunks``; ``cache=True`` with ``chunks``; a
+        map in memory that would not fit in the memory available.
 
     Warns
     -----
@@ -294,7 +283,7 @@ def compute_loops(stiffness, aspect_ratio, amplitude, load, mu, num=201) -> xr.D
     axes = checked_axes(
         stiffness=stiffness, aspect_ratio=aspect_ratio, amplitude=amplitude, load=load, mu=mu
     )
-    grid = jnp.broadcast_arrays(*_mesh(*(np.atleast_1d(a) for a in axes.values())))
+    grid = jnp.broadcast_arrays(*jnp.ix_(*(np.atleast_1d(a) for a in axes.values())))
     values = jax.device_get(_loop_kernel(*grid))
     values["displacement"], values["force"] = fretting_loop(
         grid[2], grid[3], grid[0], grid[4], grid[1], num=num
@@ -323,8 +312,7 @@ def compute_profile_map(
     stiffness_ratio, amplitude, mu, load
         As for :func:`compute_map`. [1/m], [m], [1], [N]
     profile : ScarProfile
-        The scar (:func:`ecofmaps.scar_profile`, :func:`ecofmaps.read_scar_profile`, a
-        profile family).
+        The scar (:func:`ecofmaps.scar_profile`, :func:`ecofmaps.read_scar_profile`, ...).
     mapping, cache, cache_dir, max_chunk
         As for :func:`compute_map` (the cache key holds every array of the profile).
 
