@@ -363,17 +363,17 @@ _PARAMETERS = """
     aspect_ratio : array_like or tuple (low, high), optional
         The scar's depth over half-width, :math:`z_o/x_o = D/W` (eq. 11); a ``tuple`` of two
         is an interval for a scar known only roughly (per-point values: a list or array). [1]
-    scar_depth : array_like, optional
-        Wear scar depth :math:`D`, instead of ``aspect_ratio`` (with ``scar_half_width``). [m]
-    scar_half_width : array_like, optional
-        Wear scar half-width :math:`W`. [m]
+    scar_depth, scar_half_width : array_like, optional
+        Wear scar depth :math:`D` and half-width :math:`W`, both instead of ``aspect_ratio``. [m]
     profile : ScarProfile, optional
         The scar's profile, of any shape, instead of an aspect ratio (concrete inputs only,
         not under ``jax.jit``/``jax.vmap``).
     mapping : {'scaled', 'physical'}
         With a profile: :math:`X = xW/\\Delta^*` (eq. 11) or :math:`X = x`.
     return_status : bool
-        Also return each point's :class:`CorrectionStatus`, and never raise or warn for one.
+        Also return each point's :class:`CorrectionStatus`, and never raise or warn; without
+        it, a concrete array's points that cannot be corrected are NaN with a
+        :class:`~ecofmaps.RegimeWarning` naming the reasons.
 """
 
 _STATUS_RAISES_REFERENCES = """    status : jax.Array of int32
@@ -388,12 +388,6 @@ _STATUS_RAISES_REFERENCES = """    status : jax.Array of int32
         all within :data:`ecofmaps.units.DOMAIN`; traced: NaN and ``INVALID``), the aspect
         ratio given neither or both ways, and (without ``return_status``) a single point
         that cannot be corrected (the message says why).
-
-    Warns
-    -----
-    ecofmaps.RegimeWarning
-        For concrete arrays (without ``return_status``) with points that cannot be corrected
-        (NaN), naming the reasons.
 
     References
     ----------

@@ -72,7 +72,8 @@ def lookup_correction(
     Returns
     -------
     mu : numpy.ndarray of float64
-        The contact CoF; NaN where it cannot be read off the map. [1]
+        The contact CoF; NaN where it cannot be read off the map (for an array without
+        ``return_status``, with a :class:`~ecofmaps.RegimeWarning`). [1]
     status : numpy.ndarray of int32
         Only with ``return_status=True``: :class:`CorrectionStatus` codes; ``OUTSIDE_MAP`` off
         the map's grid (a scalar coordinate: by more than 1e-9 relative) or :math:`\mu`
@@ -82,11 +83,6 @@ def lookup_correction(
     ------
     ValueError
         As for :func:`correct_ecof`, and for a map without the coordinates above.
-
-    Warns
-    -----
-    ecofmaps.RegimeWarning
-        For arrays (without ``return_status``) with points that cannot be read off the map.
 
     References
     ----------

@@ -119,8 +119,7 @@ def ecof_fall(kappa, lam):
     Returns
     -------
     high : jax.Array
-        :math:`\mu_E` at the local maximum, where the fall starts; NaN where
-        :math:`\mu_E(\mu)` rises over the whole gross-slip range. [1]
+        :math:`\mu_E` at the local maximum, where the fall starts (NaN where it rises). [1]
     low : jax.Array
         :math:`\mu_E` at the local minimum, where it ends. An ECoF in ``[low, high]``
         comes from three contact CoFs (two at the ends). [1]

@@ -177,8 +177,7 @@ def correct_table(path, profile=None, mapping="scaled", bad_rows="raise") -> tup
         raise ValueError(f"bad_rows must be 'raise' or 'nan', got {bad_rows!r}")
     path = Path(path)
     header, records, si, sep, commas, bad = _read(path, profile is not None, bad_rows == "nan")
-    read = np.ones(len(records), bool)
-    read[list(bad)] = False
+    read = ~np.isin(np.arange(len(records)), list(bad))
     rig = {name: si[nomenclature.column(name)][read] for name in ("amplitude", "load", "stiffness")}
     mu, added = np.full(len(records), np.nan), [[] for _ in records]
     status = np.full(len(records), int(CorrectionStatus.INVALID))

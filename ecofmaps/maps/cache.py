@@ -315,8 +315,7 @@ def cache_entries(cache_dir=None) -> list[CacheEntry]:
     Returns
     -------
     entries : list of CacheEntry
-        Only files named like cache entries (``<function>-<32 hex digits>.nc``); other
-        files in the directory are ignored.
+        The files named ``<function>-<32 hex digits>.nc`` (no other file in the directory).
     """
     entries = []
     for path in _files(cache_directory(cache_dir), _ENTRY):

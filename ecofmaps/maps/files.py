@@ -29,8 +29,7 @@ def write_map(dataset: xr.Dataset, path, *, also: Sequence = ()) -> tuple:
         The file (netCDF 4, engine h5netcdf) or zarr store (format 2, consolidated, a
         directory) to create or replace, complete or not at all; its parent must exist.
     also : sequence of dask or NumPy arrays, optional
-        Values computed in the same pass over the blocks (a chunked map's summary, e.g.
-        ``dataset.regime.max().data``), so that the blocks are not evaluated twice.
+        Values computed in the same pass over the blocks (e.g. ``dataset.regime.max().data``).
 
     Returns
     -------

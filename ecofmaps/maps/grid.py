@@ -117,7 +117,8 @@ def compute_map(
     mapping : {'scaled', 'physical'}
         With a profile: :math:`X = xW/\Delta^*` (eq. 11) or :math:`X = x`.
     cache : bool, optional
-        Use the disk cache. Default: only for a map on a profile; never for a chunked map.
+        Use the disk cache (default: only on a profile; never chunked); an unusable file is
+        removed with a :class:`~ecofmaps.maps.cache.CacheWarning` and the map recomputed.
     cache_dir : str or os.PathLike, optional
         Cache directory; default ``$ECOFMAPS_CACHE`` or the per-user cache directory.
     max_chunk : int
@@ -141,11 +142,6 @@ def compute_map(
         > 0, inf allowed; aspect_ratio >= 0; amplitude, mu, load > 0; within
         :data:`ecofmaps.units.DOMAIN`); a bad ``chunks``; ``cache=True`` with ``chunks``; a
         map in memory that would not fit in the memory available.
-
-    Warns
-    -----
-    ecofmaps.maps.cache.CacheWarning
-        When a cache file is unusable (it is removed and the map recomputed).
 
     References
     ----------
