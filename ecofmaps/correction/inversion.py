@@ -30,7 +30,6 @@ _PROFILE_STEPS = 200  # at most this many Illinois steps (each at least halves e
 def _root(ecof, kappa, lam):
     r"""The :math:`\mu` with :math:`\mu_E(\mu) =` ``ecof``, by bracketed Newton."""
     mu_max = jnp.where(lam > 0.0, 1.0 / lam, 1.0 / kappa)
-    low = jnp.zeros_like(ecof)
     high = jnp.minimum(ecof, mu_max)
     start = jnp.where(ecof < mu_max, ecof, 0.5 * high)
 
@@ -54,7 +53,7 @@ def _root(ecof, kappa, lam):
         following = jnp.where(done, mu, following)
         return following, low, high, jnp.abs(following - mu), done | converged, step + 1
 
-    state = (start, low, high, high - low, jnp.zeros(ecof.shape, dtype=bool), 0)
+    state = (start, jnp.zeros_like(ecof), high, high, jnp.zeros(ecof.shape, dtype=bool), 0)
     return jax.lax.while_loop(unfinished, newton, state)[0]
 
 

@@ -1,6 +1,5 @@
-r"""What a correction comes out as: the status of each point, the interval of contact CoFs of an
-aspect-ratio interval, and where :math:`\mu_E(\mu)` falls so that an ECoF comes from three
-contact CoFs (``docs/model.md``, correcting a reported ECoF)."""
+r"""A correction's outcomes: each point's status, the contact CoFs of an aspect-ratio interval, and
+where :math:`\mu_E(\mu)` falls (docs/model.md, "Correcting a reported ECoF")."""
 
 from __future__ import annotations
 
@@ -25,13 +24,11 @@ __all__ = [
 ]
 
 #: :math:`\lambda_\infty`: :math:`\mu_E(\mu)` falls over part of its range only where
-#: :math:`\lambda = P/(S\Delta^*)` is below this (its :math:`\kappa \to \infty` limit; the tests
-#: check it on dense grids). [1]
+#: :math:`\lambda = P/(S\Delta^*)` is below this (its :math:`\kappa \to \infty` limit). [1]
 LAMBDA_INFINITY = 0.07102
 
-#: No ECoF below this is ever ambiguous: the infimum of the local minimum of a falling
-#: :math:`\mu_E(\mu)`, reached as :math:`\kappa \to \infty` and
-#: :math:`\lambda \to \lambda_\infty`. [1]
+#: No ECoF below this is ever ambiguous: the infimum of a falling :math:`\mu_E(\mu)`'s local
+#: minimum, reached as :math:`\kappa \to \infty` and :math:`\lambda \to \lambda_\infty`. [1]
 AMBIGUOUS_ECOF_MIN = 1.6
 
 

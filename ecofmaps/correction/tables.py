@@ -130,19 +130,17 @@ def _row_values(path, line: int, row, column: dict, on_profile: bool, commas: bo
 
     values = {name: number(name) for name in _REQUIRED}
     if not on_profile:
-        given_ratio = "aspect_ratio" in column and row[column["aspect_ratio"]].strip() != ""
-        given_scar = [name in column and row[column[name]].strip() != "" for name in _SCAR]
-        if given_ratio == any(given_scar) or (any(given_scar) and not all(given_scar)):
+        depth, width = _SCAR
+        given = [n in column and row[column[n]].strip() != "" for n in ("aspect_ratio", *_SCAR)]
+        if given not in ([True, False, False], [False, True, True]):  # the ratio, or D and W
             raise TableError(
                 path,
                 line,
                 "give the aspect ratio one way: aspect_ratio, or both scar_depth_um and "
                 "scar_half_width_um",
             )
-        depth, width = _SCAR
-        values["aspect_ratio"] = (
-            number("aspect_ratio") if given_ratio else number(depth) / number(width)
-        )
+        ratio = number("aspect_ratio") if given[0] else number(depth) / number(width)
+        values["aspect_ratio"] = ratio
     return values
 
 

@@ -1,6 +1,5 @@
-"""The disk cache of results that are expensive to recompute: one netCDF file
-``<function>-<key>.nc`` per result, its arrays in Fletcher-32 checksummed chunks and the rest
-under :func:`metadata_checksum` (docs/performance.md, "The cache")."""
+"""The disk cache of costly results: a netCDF file ``<function>-<key>.nc`` each, its arrays in
+Fletcher-32 checksummed chunks, the rest under :func:`metadata_checksum` (docs/performance.md)."""
 
 from __future__ import annotations
 
@@ -256,8 +255,7 @@ def _reason(error: BaseException) -> str:
 
 
 def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
-    """Store ``dataset`` at ``path`` if it fits in ``bound`` [byte], then evict the least
-    recently used other entries to fit."""
+    """Store ``dataset`` if it fits in ``bound`` [byte], evicting the least recently used others."""
     if dataset.nbytes > bound:
         return
     image = _file_image(dataset.assign_attrs({_KEY_ATTRIBUTE: key}))
@@ -279,12 +277,10 @@ def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
 def cached_dataset(
     function: str, inputs: Mapping[str, object], compute: Callable[[], xr.Dataset], cache_dir=None
 ) -> xr.Dataset:
-    """``compute()``, read from the cache under the key of ``function`` and ``inputs`` (all the
-    result depends on), else computed and stored."""
-    directory = cache_directory(cache_dir)
+    """``compute()``, read from the cache under the key of all it depends on, else stored."""
     bound = cache_size_bound()  # a bad ECOFMAPS_CACHE_SIZE is refused before any work
     key = cache_key(function, inputs)
-    path = directory / f"{function}-{key[:_NAME_DIGITS]}.nc"
+    path = cache_directory(cache_dir) / f"{function}-{key[:_NAME_DIGITS]}.nc"
     dataset = _stored(path, key) if path.is_file() else None  # not a folder of the user's
     if dataset is not None:
         with contextlib.suppress(OSError):  # the access time orders eviction; only a hint

@@ -41,10 +41,7 @@ _AXES = {
 
 
 def _attrs(name: str) -> dict:
-    attrs = nomenclature.attrs(name)
-    if name == "regime":
-        attrs.update(model.Regime.flag_attrs())
-    return attrs
+    return nomenclature.attrs(name) | (model.Regime.flag_attrs() if name == "regime" else {})
 
 
 def checked_axes(**values) -> dict:
@@ -63,10 +60,9 @@ def checked_axis(name: str, value) -> np.ndarray:
     unique, counts = np.unique(array, return_counts=True)
     if np.any(counts > 1):
         repeated = unique[counts > 1][0]
-        where = np.flatnonzero(array == repeated)
         raise ValueError(
-            f"{name} repeats the value {repeated!r} (at indices {where.tolist()}): a grid axis "
-            "takes each value once"
+            f"{name} repeats the value {repeated!r} (at indices "
+            f"{np.flatnonzero(array == repeated).tolist()}): a grid axis takes each value once"
         )
     return array
 

@@ -47,8 +47,7 @@ def write_map(dataset: xr.Dataset, path, *, also: Sequence = ()) -> tuple:
     Examples
     --------
     >>> import numpy as np, tempfile, ecofmaps
-    >>> lazy = ecofmaps.compute_map(np.geomspace(2e4, 2e5, 30), np.linspace(0, 0.3, 20), 50e-6,
-    ...                             0.8, chunks=100)
+    >>> lazy = ecofmaps.compute_map(np.geomspace(2e4, 2e5, 30), 0.3, 50e-6, 0.8, chunks=10)
     >>> with tempfile.TemporaryDirectory() as directory:
     ...     (top,) = write_map(lazy, f"{directory}/map.zarr", also=[lazy.ecof_ratio.max().data])
     >>> round(float(top), 4)

@@ -93,8 +93,7 @@ def _tiles(split: tuple[int, int], region):
 
 
 def _fill(out, kernel, axes, extra, split, region, tiles, stop=None) -> None:
-    """Evaluate ``tiles`` and copy their part inside ``region`` into the arrays ``out``; end
-    early once ``stop`` (a ``threading.Event``) is set."""
+    """Evaluate ``tiles`` into ``out`` (their part inside ``region``) until ``stop`` is set."""
     k, rows = split
     offset = tuple(start for start, _ in region)
     trailing = tuple(slice(start, stop) for start, stop in region[k + 1 :])
