@@ -131,16 +131,15 @@ def _row_values(path, line: int, row, column: dict, on_profile: bool, commas: bo
     values = {name: number(name) for name in _REQUIRED}
     if not on_profile:
         depth, width = _SCAR
-        given = [n in column and row[column[n]].strip() != "" for n in ("aspect_ratio", *_SCAR)]
-        if given not in ([True, False, False], [False, True, True]):  # the ratio, or D and W
+        has = [n in column and row[column[n]].strip() != "" for n in ("aspect_ratio", *_SCAR)]
+        if has not in ([True, False, False], [False, True, True]):  # the ratio, or D and W
             raise TableError(
                 path,
                 line,
                 "give the aspect ratio one way: aspect_ratio, or both scar_depth_um and "
                 "scar_half_width_um",
             )
-        ratio = number("aspect_ratio") if given[0] else number(depth) / number(width)
-        values["aspect_ratio"] = ratio
+        values["aspect_ratio"] = number("aspect_ratio") if has[0] else number(depth) / number(width)
     return values
 
 

@@ -277,7 +277,7 @@ def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
 def cached_dataset(
     function: str, inputs: Mapping[str, object], compute: Callable[[], xr.Dataset], cache_dir=None
 ) -> xr.Dataset:
-    """``compute()``, read from the cache under the key of all it depends on, else stored."""
+    """``compute()``, from the cache under the key of ``function`` and ``inputs``, or stored."""
     bound = cache_size_bound()  # a bad ECOFMAPS_CACHE_SIZE is refused before any work
     key = cache_key(function, inputs)
     path = cache_directory(cache_dir) / f"{function}-{key[:_NAME_DIGITS]}.nc"
