@@ -1,8 +1,6 @@
-r"""Reported energy coefficients of friction corrected to the contact one: the model's
-:math:`\mu_E(\mu)` inverted exactly by a bracketed Newton iteration in the dimensionless core,
-or on a scar profile by a scan narrowed by the Illinois method (NumPy, concrete inputs). Where
-the inversion is unique, ambiguous or impossible: ``docs/model.md`` (correcting a reported ECoF).
-"""
+r"""Reported energy coefficients of friction corrected to the contact one: :math:`\mu_E(\mu)`
+inverted by bracketed Newton steps in the dimensionless core, or on a scar profile by a scan and
+the Illinois method (NumPy): docs/model.md, "Correcting a reported ECoF"."""
 
 from __future__ import annotations
 
@@ -13,17 +11,8 @@ import numpy as np
 from ecofmaps import model
 from ecofmaps._codes import warn_nan
 from ecofmaps._inputs import as_float64, check, float64, is_concrete
-from ecofmaps.correction.outcomes import (
-    CorrectionStatus,
-    Interval,
-    ambiguity_marked,
-    check_test,
-    ecof_and_slope,
-    ecof_fall,
-    ecof_fall_where_needed,
-    may_fall,
-    reachability_status,
-)
+from ecofmaps.correction import outcomes
+from ecofmaps.correction.outcomes import CorrectionStatus
 from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers
 from ecofmaps.model.steady_state import valid_geometry
 
@@ -41,7 +30,6 @@ _PROFILE_STEPS = 200  # at most this many Illinois steps (each at least halves e
 def _root(ecof, kappa, lam):
     r"""The :math:`\mu` with :math:`\mu_E(\mu) =` ``ecof``, by bracketed Newton."""
     mu_max = jnp.where(lam > 0.0, 1.0 / lam, 1.0 / kappa)
-    low = jnp.zeros_like(ecof)
     high = jnp.minimum(ecof, mu_max)
     start = jnp.where(ecof < mu_max, ecof, 0.5 * high)
 
@@ -51,7 +39,7 @@ def _root(ecof, kappa, lam):
 
     def newton(state):
         mu, low, high, previous, done, step = state
-        value, slope = ecof_and_slope(mu, kappa, lam)
+        value, slope = outcomes.ecof_and_slope(mu, kappa, lam)
         residual = value - ecof
         above = ~(residual <= 0.0)  # NaN: beyond the gross-slip (or locking) limit
         low = jnp.where(above, low, mu)
@@ -65,7 +53,7 @@ def _root(ecof, kappa, lam):
         following = jnp.where(done, mu, following)
         return following, low, high, jnp.abs(following - mu), done | converged, step + 1
 
-    state = (start, low, high, high - low, jnp.zeros(ecof.shape, dtype=bool), 0)
+    state = (start, jnp.zeros_like(ecof), high, high, jnp.zeros(ecof.shape, dtype=bool), 0)
     return jax.lax.while_loop(unfinished, newton, state)[0]
 
 
@@ -75,7 +63,7 @@ def _root_tangent(primals, tangents):
     ecof, kappa, lam = primals
     d_ecof, d_kappa, d_lam = tangents
     mu = _root(ecof, kappa, lam)
-    _, slope = ecof_and_slope(mu, kappa, lam)
+    _, slope = outcomes.ecof_and_slope(mu, kappa, lam)
     _, moved = jax.jvp(lambda k, m: mu * model.ecof_ratio(mu, k, m), (kappa, lam), (d_kappa, d_lam))
     return mu, (d_ecof - moved) / slope
 
@@ -83,7 +71,13 @@ def _root_tangent(primals, tangents):
 def _root_and_status(ecof, kappa, lam):
     """The root and status without the ambiguity check, NaN wherever it is not corrected."""
     ecof, kappa, lam = jnp.broadcast_arrays(ecof, kappa, lam)
-    status = reachability_status(ecof, kappa, lam)
+    valid = (ecof > 0.0) & jnp.isfinite(ecof)
+    for value in (kappa, lam):
+        valid &= (value >= 0.0) & jnp.isfinite(value)
+    code = jnp.where(
+        ecof * lam < 1.0, int(CorrectionStatus.CORRECTED), int(CorrectionStatus.NO_GROSS_SLIP)
+    )
+    status = jnp.where(valid, code, int(CorrectionStatus.INVALID)).astype(jnp.int32)
     corrected = status == int(CorrectionStatus.CORRECTED)
     mu = _root(
         jnp.where(corrected, ecof, 0.5),
@@ -93,11 +87,24 @@ def _root_and_status(ecof, kappa, lam):
     return jnp.where(corrected, mu, jnp.nan), status
 
 
-def contact_cof(ecof, kappa, lam):
-    r"""The contact CoF :math:`\mu` whose energy CoF is ``ecof``: the dimensionless core.
+def _ambiguity_marked(mu, status, ecof, high, low):
+    """The contact CoF and status, NaN and ``AMBIGUOUS`` where ``ecof`` lies in the fall."""
+    ambiguous = (status == int(CorrectionStatus.CORRECTED)) & (ecof >= low) & (ecof <= high)
+    status = jnp.where(ambiguous, int(CorrectionStatus.AMBIGUOUS), status).astype(jnp.int32)
+    return jnp.where(ambiguous, jnp.nan, mu), status
 
-    A pure ``jax.numpy`` function of the core numbers of :mod:`ecofmaps.model`; it
-    broadcasts and works under ``jax.jit`` and ``jax.vmap``, and checks nothing.
+
+def _ecof_fall_where_needed(status, kappa, lam):
+    """:func:`ecof_fall` at every point, scanned only if a corrected point may fall."""
+    kappa, lam = jax.lax.stop_gradient(kappa), jax.lax.stop_gradient(lam)
+    needed = jnp.any(outcomes.may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
+    nan = jnp.full(status.shape, jnp.nan)
+    return jax.lax.cond(needed, lambda: outcomes.ecof_fall(kappa, lam), lambda: (nan, nan))
+
+
+def contact_cof(ecof, kappa, lam):
+    r"""The contact CoF :math:`\mu` whose energy CoF is ``ecof`` (eq. 13-15, 16 inverted), in the
+    dimensionless core: pure ``jax.numpy`` (``jax.jit``, ``jax.vmap``); it checks nothing.
 
     Parameters
     ----------
@@ -116,10 +123,6 @@ def contact_cof(ecof, kappa, lam):
     status : jax.Array of int32
         :class:`CorrectionStatus` codes.
 
-    Notes
-    -----
-    Inverts the corrected eq. 13-15 with eq. 16 (``docs/model.md``).
-
     References
     ----------
     X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
@@ -128,7 +131,7 @@ def contact_cof(ecof, kappa, lam):
     """
     ecof, kappa, lam = jnp.broadcast_arrays(*(as_float64(v) for v in (ecof, kappa, lam)))
     mu, status = _root_and_status(ecof, kappa, lam)
-    return ambiguity_marked(mu, status, ecof, *ecof_fall_where_needed(status, kappa, lam))
+    return _ambiguity_marked(mu, status, ecof, *_ecof_fall_where_needed(status, kappa, lam))
 
 
 @jax.jit
@@ -143,17 +146,17 @@ def _si_root(ecof, amplitude, load, stiffness, aspect_ratio):
     return mu, status, *jnp.broadcast_arrays(kappa, lam, mu)[:2]
 
 
-_ecof_fall = jax.jit(ecof_fall)
+_ecof_fall = jax.jit(outcomes.ecof_fall)
 
 
 def _si_correct(ecof, amplitude, load, stiffness, aspect_ratio):
     """μ, status and the fall (high, low) at concrete or traced SI inputs."""
     mu, status, kappa, lam = _si_root(ecof, amplitude, load, stiffness, aspect_ratio)
     if not is_concrete(mu):
-        high, low = ecof_fall_where_needed(status, kappa, lam)
+        high, low = _ecof_fall_where_needed(status, kappa, lam)
     else:  # only the few points where mu_E(mu) may fall are scanned, in one padded batch
         where = np.flatnonzero(
-            np.asarray(may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
+            np.asarray(outcomes.may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
         )
         high, low = np.full((2, mu.size), np.nan)
         if where.size:
@@ -162,44 +165,40 @@ def _si_correct(ecof, amplitude, load, stiffness, aspect_ratio):
             fall = _ecof_fall(kappa.ravel()[padded], lam.ravel()[padded])
             high[where], low[where] = (np.asarray(v)[: where.size] for v in fall)
         high, low = high.reshape(mu.shape), low.reshape(mu.shape)
-    ecof = jnp.broadcast_to(ecof, mu.shape)
-    mu, status = ambiguity_marked(mu, status, ecof, jnp.asarray(high), jnp.asarray(low))
+    mu, status = _ambiguity_marked(mu, status, ecof, jnp.asarray(high), jnp.asarray(low))
     return mu, status, (kappa, lam, high, low)
 
 
 def groove_aspect_ratio(aspect_ratio, scar_depth, scar_half_width):
     """The groove's aspect ratio from either way of giving it, checked."""
-    if aspect_ratio is not None:
-        if scar_depth is not None or scar_half_width is not None:
+    if aspect_ratio is None:
+        if scar_depth is None or scar_half_width is None:
             raise ValueError(
-                "give the groove aspect ratio one way: aspect_ratio, or scar_depth and "
-                "scar_half_width (z_o/x_o = D/W, eq. 11), not both"
+                "give the groove aspect ratio: aspect_ratio, or both scar_depth and "
+                "scar_half_width (z_o/x_o = D/W, eq. 11)"
             )
-        if isinstance(aspect_ratio, tuple):
-            if len(aspect_ratio) != 2:
-                raise ValueError(
-                    "aspect_ratio as a tuple is an interval (low, high) of two values or "
-                    f"arrays, got {len(aspect_ratio)} items (use a list or an array for "
-                    "per-point values)"
-                )
-            low, high = aspect_ratio
-            for end, value in (("low", low), ("high", high)):
-                check(f"aspect_ratio {end}", value, "non_negative", "1")
-            if is_concrete(low, high) and np.any(np.asarray(low) > np.asarray(high)):
-                raise ValueError(
-                    f"aspect_ratio interval must have low <= high, got ({low!r}, {high!r})"
-                )
-            return as_float64(low), as_float64(high)
+        check("scar_depth", scar_depth, "non_negative", "m")
+        check("scar_half_width", scar_half_width, "positive", "m")
+        return as_float64(scar_depth) / as_float64(scar_half_width)
+    if scar_depth is not None or scar_half_width is not None:
+        raise ValueError(
+            "give the groove aspect ratio one way: aspect_ratio, or scar_depth and "
+            "scar_half_width (z_o/x_o = D/W, eq. 11), not both"
+        )
+    if not isinstance(aspect_ratio, tuple):
         check("aspect_ratio", aspect_ratio, "non_negative", "1")
         return as_float64(aspect_ratio)
-    if scar_depth is None or scar_half_width is None:
+    if len(aspect_ratio) != 2:
         raise ValueError(
-            "give the groove aspect ratio: aspect_ratio, or both scar_depth and "
-            "scar_half_width (z_o/x_o = D/W, eq. 11)"
+            "aspect_ratio as a tuple is an interval (low, high) of two values or arrays, got "
+            f"{len(aspect_ratio)} items (use a list or an array for per-point values)"
         )
-    check("scar_depth", scar_depth, "non_negative", "m")
-    check("scar_half_width", scar_half_width, "positive", "m")
-    return as_float64(scar_depth) / as_float64(scar_half_width)
+    low, high = aspect_ratio
+    for end, value in (("low", low), ("high", high)):
+        check(f"aspect_ratio {end}", value, "non_negative", "1")
+    if is_concrete(low, high) and np.any(np.asarray(low) > np.asarray(high)):
+        raise ValueError(f"aspect_ratio interval must have low <= high, got ({low!r}, {high!r})")
+    return as_float64(low), as_float64(high)
 
 
 def _correct(factor, ecof, amplitude, load, stiffness, scar, profile, mapping, return_status):
@@ -223,14 +222,14 @@ def _correct(factor, ecof, amplitude, load, stiffness, scar, profile, mapping, r
         codes = np.asarray(status)
         if codes.ndim == 0 and codes != CorrectionStatus.CORRECTED:
             raise ValueError(failure())
-        first = values[0] if isinstance(values, Interval) else values
+        first = values[0] if isinstance(values, outcomes.Interval) else values
         warn_nan(first, codes, CorrectionStatus, caller)
     return values
 
 
 def _correct_on_groove(factor, ecof, amplitude, load, stiffness, scar):
     """Values, status and the reason a single point failed, on a parabolic groove."""
-    check_test(ecof, amplitude, load, stiffness)
+    outcomes.check_test(ecof, amplitude, load, stiffness)
     ratio = groove_aspect_ratio(*scar)
     ecof, amplitude, load, stiffness = (as_float64(v) for v in (ecof, amplitude, load, stiffness))
     ends = ratio if isinstance(ratio, tuple) else (ratio,)
@@ -240,7 +239,7 @@ def _correct_on_groove(factor, ecof, amplitude, load, stiffness, scar):
     if len(results) == 2:  # the larger aspect ratio allows the smaller mu (docs/model.md)
         status = jnp.where(status == int(CorrectionStatus.CORRECTED), results[1][1], status)
         both = status == int(CorrectionStatus.CORRECTED)
-        values = Interval(*(jnp.where(both, v, jnp.nan) for v in (values[1], values[0])))
+        values = outcomes.Interval(*(jnp.where(both, v, jnp.nan) for v in (values[1], values[0])))
     else:
         values = values[0]
 
@@ -275,7 +274,7 @@ def _correct_on_profile(ecof, amplitude, load, stiffness, profile, mapping, fact
     """Values, status and the reason a single point failed, on a profile (docs/model.md)."""
     check_mapping(mapping, None)
     profile = as_profile(profile)
-    check_test(ecof, amplitude, load, stiffness)
+    outcomes.check_test(ecof, amplitude, load, stiffness)
     if not is_concrete(ecof, amplitude, load, stiffness, *profile):
         raise ValueError(
             f"{caller} on a profile needs concrete inputs: it does not run under "
@@ -344,12 +343,9 @@ def _illinois(profile, target, low, high, rig, mapping):
         high = np.where(up, trial, b)
         low = np.where(down, trial, a)
         side = np.where(up, 1, np.where(down, -1, side))
-        done = (value == 0.0) | (high - low <= 4.0 * _EPS * high)
-        active &= ~done
+        active &= ~((value == 0.0) | (high - low <= 4.0 * _EPS * high))
     root = np.where(np.abs(f_low) <= np.abs(np.nan_to_num(f_high, nan=np.inf)), low, high)
-    check_value = _residual(profile, root, target, rig, mapping) + target
-    reached = np.abs(check_value - target) <= 1e-9 * target
-    return root, reached
+    return root, np.abs(_residual(profile, root, target, rig, mapping)) <= 1e-9 * target
 
 
 _PARAMETERS = """
@@ -358,47 +354,45 @@ _PARAMETERS = """
     ecof : array_like
         The reported energy coefficient of friction :math:`\\mu_E = E_d/(4P\\delta^*)`. [1]
     amplitude : array_like
-        Displacement amplitude :math:`\\Delta^*` of the test (also the groove half-width
-        :math:`x_o`, as in the paper). [m]
+        Displacement amplitude :math:`\\Delta^*` (also the groove half-width :math:`x_o`). [m]
     load : array_like
         Normal load :math:`P`. [N]
     stiffness : array_like
         Rig stiffness :math:`S`; ``numpy.inf`` for a rigid rig. [N/m]
     aspect_ratio : array_like or tuple (low, high), optional
-        The wear scar's depth over half-width, :math:`z_o/x_o = D/W` (eq. 11). A ``tuple``
-        of two values (or arrays) is an interval for a scar known only roughly; give
-        per-point values as a list or an array. [1]
-    scar_depth : array_like, optional
-        Wear scar depth :math:`D`, instead of ``aspect_ratio`` (with ``scar_half_width``). [m]
-    scar_half_width : array_like, optional
-        Wear scar half-width :math:`W`. [m]
+        The scar's depth over half-width, :math:`z_o/x_o = D/W` (eq. 11); a ``tuple`` of two
+        is an interval for a scar known only roughly (per-point values: a list or array). [1]
+    scar_depth, scar_half_width : array_like, optional
+        Wear scar depth :math:`D` and half-width :math:`W`, both instead of ``aspect_ratio``. [m]
     profile : ScarProfile, optional
-        The wear scar's profile, of any shape, instead of an aspect ratio (the correction
-        then inverts the model on that profile; concrete inputs only, not under
-        ``jax.jit``/``jax.vmap``).
+        The scar's profile, of any shape, instead of an aspect ratio (concrete inputs only,
+        not under ``jax.jit``/``jax.vmap``).
     mapping : {'scaled', 'physical'}
         With a profile: :math:`X = xW/\\Delta^*` (eq. 11) or :math:`X = x`.
     return_status : bool
-        Also return the :class:`CorrectionStatus` of every point, and never raise or warn
-        for a point that cannot be corrected.
+        Also return each point's :class:`CorrectionStatus`, and never raise or warn; without
+        it, a concrete array's points that cannot be corrected are NaN with a
+        :class:`~ecofmaps.RegimeWarning` naming the reasons.
 """
 
-_RAISES = """
+_STATUS_RAISES_REFERENCES = """    status : jax.Array of int32
+        Only with ``return_status=True``: :class:`CorrectionStatus` codes (for an interval,
+        the first failure of its two ends).
+
     Raises
     ------
     ValueError
-        For a concrete input out of its range (ecof, amplitude, load and scar_half_width
-        finite and > 0, stiffness > 0 with inf allowed, aspect_ratio and scar_depth finite
-        and >= 0, an interval with low <= high; each within :data:`ecofmaps.units.DOMAIN`),
-        for the aspect ratio given neither or both ways, and, without ``return_status``,
-        for a single point that cannot be corrected (the message says why). Under
-        ``jax.jit``/``jax.vmap`` such points are NaN with the status ``INVALID``.
+        For a concrete input out of range (ecof, amplitude, load, scar_half_width > 0;
+        stiffness > 0, inf allowed; aspect_ratio, scar_depth >= 0; an interval's low <= high;
+        all within :data:`ecofmaps.units.DOMAIN`; traced: NaN and ``INVALID``), the aspect
+        ratio given neither or both ways, and (without ``return_status``) a single point
+        that cannot be corrected (the message says why).
 
-    Warns
-    -----
-    ecofmaps.RegimeWarning
-        For concrete arrays (without ``return_status``) with points that cannot be
-        corrected, naming the reasons; those points are NaN.
+    References
+    ----------
+    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
+    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
+    behaviour: eq. 11, 13-15, 16.
 """
 
 
@@ -422,35 +416,16 @@ def correct_ecof(
 
 correct_ecof.__doc__ = f"""The contact CoF :math:`\\mu` behind a reported energy CoF :math:`\\mu_E`.
 
-    The exact inversion of the model's :math:`\\mu_E(\\mu; \\Delta^*, P, S, z_o/x_o)`, with
-    :math:`x_o = \\Delta^*`, vectorised and jit-compiled, in float64.
+    The model's :math:`\\mu_E(\\mu)` inverted exactly (docs/model.md, "Correcting a reported
+    ECoF"), under ``jax.grad``, ``jax.jit`` and ``jax.vmap`` too without a profile (docs/api.md).
 {_PARAMETERS}
     Returns
     -------
     mu : jax.Array of float64, or Interval
-        The contact CoF, within a few ulp of the exact root, so that :math:`|\\mu_E(\\mu) - `
-        ``ecof`` :math:`| \\le 10^{{-12}}` ``ecof`` except on a rigid rig next to locking
-        (:math:`1 - \\mu\\kappa < 10^{{-5}}`), where one ulp of :math:`\\mu` moves :math:`\\mu_E` by
-        more; NaN where it cannot be corrected. With ``aspect_ratio=(low, high)``, an
-        :class:`Interval` ``(low, high)`` of arrays: every contact CoF that gives ``ecof``
-        with an aspect ratio in the interval (``low`` from the deeper scar). [1]
-    status : jax.Array of int32
-        Only with ``return_status=True``: :class:`CorrectionStatus` codes (for an interval,
-        the first failure of its two ends).
-{_RAISES}
-    Notes
-    -----
-    Inverts the corrected eq. 13-15 with eq. 16 by bracketed Newton steps; which ECoFs can
-    be reached, where the inversion is unique, why the interval is exact, and the scan on a
-    profile: ``docs/model.md``. :math:`\\mu \\le \\mu_E`, with equality for a flat scar.
-    ``jax.grad``, ``jax.jit`` and ``jax.vmap`` work without a profile (``docs/api.md``).
-
-    References
-    ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 11, 13-15, 16.
-
+        The contact CoF, within a few ulp of the exact root; NaN where it cannot be
+        corrected. With ``aspect_ratio=(low, high)``, an :class:`Interval` of arrays: every
+        contact CoF that gives ``ecof`` with an aspect ratio in the interval. [1]
+{_STATUS_RAISES_REFERENCES}
     Examples
     --------
     >>> import ecofmaps
@@ -479,24 +454,12 @@ def correction_factor(
     return _correct(True, ecof, amplitude, load, stiffness, scar, profile, mapping, return_status)
 
 
-correction_factor.__doc__ = f"""The ratio :math:`\\mu/\\mu_E` of contact CoF to reported ECoF.
+correction_factor.__doc__ = f"""The ratio :math:`\\mu/\\mu_E` of contact CoF to reported ECoF: the
+    reciprocal of the :math:`\\mu_E/\\mu` of Figures 8 and 11, read at the reported ECoF.
 {_PARAMETERS}
     Returns
     -------
     factor : jax.Array of float64, or Interval
         :math:`\\mu/\\mu_E \\le 1` (1 for a flat scar), with :math:`\\mu` from
         :func:`correct_ecof`; an :class:`Interval` for an aspect-ratio interval. [1]
-    status : jax.Array of int32
-        Only with ``return_status=True``: :class:`CorrectionStatus` codes.
-{_RAISES}
-    Notes
-    -----
-    The reciprocal of the :math:`\\mu_E/\\mu` of Figures 8 and 11, read at the contact CoF
-    that gives the reported :math:`\\mu_E` rather than at a chosen :math:`\\mu`.
-
-    References
-    ----------
-    X. Jin, W. Sun, P.H. Shipway (2016), Derivation of a wear scar geometry-independent
-    coefficient of friction from fretting loops exhibiting non-Coulomb frictional
-    behaviour: eq. 11, 13-15, 16.
-    """
+{_STATUS_RAISES_REFERENCES}"""

@@ -34,14 +34,11 @@ def _map_axes(ecof_map):
 
 def _crossing(curves, mu_grid, ecof):
     """Invert each curve ``ecof(mu)`` by linear interpolation; count its crossings."""
-    above = curves > ecof[:, None]
-    finite = np.isfinite(curves)
-    pair = finite[:, :-1] & finite[:, 1:]
-    crossing = pair & (above[:, :-1] != above[:, 1:])
+    above, finite = curves > ecof[:, None], np.isfinite(curves)
+    crossing = finite[:, :-1] & finite[:, 1:] & (above[:, :-1] != above[:, 1:])
     count = crossing.sum(axis=1)
     index = np.argmax(crossing, axis=1)
-    rows = np.arange(curves.shape[0])
-    c0, c1 = curves[rows, index], curves[rows, index + 1]
+    c0, c1 = np.take_along_axis(curves, index[:, None] + np.arange(2), axis=1).T
     with np.errstate(invalid="ignore", divide="ignore"):
         fraction = (ecof - c0) / (c1 - c0)
     mu = mu_grid[index] + fraction * (mu_grid[index + 1] - mu_grid[index])
@@ -61,49 +58,31 @@ def lookup_correction(
     *,
     return_status=False,
 ):
-    r"""The contact CoF behind a reported ECoF, read off a map by interpolation.
-
-    The same correction as :func:`correct_ecof`, for users who work from the maps: the
-    map's :math:`\mu_E` is interpolated linearly to the test conditions, giving a curve
-    :math:`\mu_E(\mu)` over the map's :math:`\mu` grid, and that curve is inverted
-    linearly.
+    r"""The contact CoF behind a reported ECoF, read off a map by interpolation: the correction
+    of :func:`correct_ecof` up to its error (docs/model.md, "Correcting a reported ECoF").
 
     Parameters
     ----------
     map_dataset : xarray.Dataset
-        A map from :func:`ecofmaps.compute_map` with a ``mu`` dimension of at least two
-        values and the variable ``ecof``; ``stiffness_ratio``, ``aspect_ratio`` and
-        ``amplitude`` are dimensions or scalar coordinates.
-    ecof, amplitude, load, stiffness, aspect_ratio, scar_depth, scar_half_width
+        A map of :func:`ecofmaps.compute_map` with ``ecof`` over at least two values of
+        ``mu``; ``stiffness_ratio``, ``aspect_ratio``, ``amplitude`` as dimensions or scalars.
+    ecof, amplitude, load, stiffness, aspect_ratio, scar_depth, scar_half_width, return_status
         As for :func:`correct_ecof` (no interval). [1], [m], [N], [N/m], [1], [m], [m]
-    return_status : bool
-        Also return the :class:`CorrectionStatus` of every point (and do not raise or warn).
 
     Returns
     -------
     mu : numpy.ndarray of float64
-        The contact CoF; NaN where it cannot be read off the map. [1]
+        The contact CoF; NaN where it cannot be read off the map (for an array without
+        ``return_status``, with a :class:`~ecofmaps.RegimeWarning`). [1]
     status : numpy.ndarray of int32
-        Only with ``return_status=True``: :class:`CorrectionStatus` codes, among them
-        ``OUTSIDE_MAP`` for test conditions outside the map's grid (or off a scalar
-        coordinate, by more than 1e-9 relative) and for an ECoF beyond the map's
-        :math:`\mu` range; ``AMBIGUOUS`` where the interpolated curve crosses the ECoF more
-        than once; ``NO_GROSS_SLIP`` as for :func:`correct_ecof`.
+        Only with ``return_status=True``: :class:`CorrectionStatus` codes; ``OUTSIDE_MAP`` off
+        the map's grid (a scalar coordinate: by more than 1e-9 relative) or :math:`\mu`
+        range, ``AMBIGUOUS`` where the interpolated curve crosses the ECoF more than once.
 
     Raises
     ------
     ValueError
         As for :func:`correct_ecof`, and for a map without the coordinates above.
-
-    Warns
-    -----
-    ecofmaps.RegimeWarning
-        For arrays (without ``return_status``) with points that cannot be read off the map.
-
-    Notes
-    -----
-    Multilinear in :math:`P/S`, :math:`z_o/x_o` and :math:`\Delta^*`, then linear in
-    :math:`\mu`; its error: ``docs/model.md`` (correcting a reported ECoF).
 
     References
     ----------

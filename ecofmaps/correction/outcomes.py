@@ -1,6 +1,5 @@
-r"""What a correction comes out as: the status of each point, the interval of contact CoFs of an
-aspect-ratio interval, and where :math:`\mu_E(\mu)` falls so that an ECoF comes from three
-contact CoFs (``docs/model.md``, correcting a reported ECoF)."""
+r"""A correction's outcomes: each point's status, the contact CoFs of an aspect-ratio interval, and
+where :math:`\mu_E(\mu)` falls (docs/model.md, "Correcting a reported ECoF")."""
 
 from __future__ import annotations
 
@@ -18,47 +17,34 @@ __all__ = [
     "LAMBDA_INFINITY",
     "CorrectionStatus",
     "Interval",
-    "ambiguity_marked",
     "check_test",
     "ecof_and_slope",
     "ecof_fall",
-    "ecof_fall_where_needed",
     "may_fall",
-    "reachability_status",
 ]
 
 #: :math:`\lambda_\infty`: :math:`\mu_E(\mu)` falls over part of its range only where
-#: :math:`\lambda = P/(S\Delta^*)` is below this (its :math:`\kappa \to \infty` limit; the tests
-#: check it on dense grids). [1]
+#: :math:`\lambda = P/(S\Delta^*)` is below this (its :math:`\kappa \to \infty` limit). [1]
 LAMBDA_INFINITY = 0.07102
 
-#: No ECoF below this is ever ambiguous: the infimum of the local minimum of a falling
-#: :math:`\mu_E(\mu)`, reached as :math:`\kappa \to \infty` and
-#: :math:`\lambda \to \lambda_\infty`. [1]
+#: No ECoF below this is ever ambiguous: the infimum of a falling :math:`\mu_E(\mu)`'s local
+#: minimum, reached as :math:`\kappa \to \infty` and :math:`\lambda \to \lambda_\infty`. [1]
 AMBIGUOUS_ECOF_MIN = 1.6
 
 
 class CorrectionStatus(Code):
-    """Outcome of a correction, per point (``return_status=True``).
+    """Outcome of a correction, per point (``return_status=True``); each code's ``reason``
+    says why, docs/model.md ("Correcting a reported ECoF") when.
 
     Attributes
     ----------
-    CORRECTED
-        One contact CoF gives the ECoF; it is returned.
-    NO_GROSS_SLIP
-        The ECoF is at or above :math:`S\\Delta^*/P`: a contact CoF that high would stop
-        gross slip (:math:`\\mu P \\ge S\\Delta^*`).
-    AMBIGUOUS
-        Several contact CoFs give the ECoF (:math:`\\kappa > 1` and :math:`\\lambda <`
-        :data:`LAMBDA_INFINITY`, where :math:`\\mu_E(\\mu)` falls over part of its range).
+    CORRECTED, NO_GROSS_SLIP, AMBIGUOUS
+        One contact CoF gives the ECoF (returned); the ECoF is at or above
+        :math:`S\\Delta^*/P`; several contact CoFs give it.
     INVALID
-        An input out of its range or NaN (only under ``jax.jit``/``jax.vmap``: concrete
-        inputs raise ``ValueError``).
-    OUTSIDE_MAP
-        :func:`lookup_correction` only: the point, or the ECoF, is outside the map.
-    UNREACHABLE
-        On a scar profile only: no contact CoF gives the ECoF although it is below
-        :math:`S\\Delta^*/P` (a jump of :math:`\\mu_E(\\mu)`, or a slip off the trace).
+        An input out of range or NaN (under ``jax.jit``/``jax.vmap``; else ``ValueError``).
+    OUTSIDE_MAP, UNREACHABLE
+        :func:`lookup_correction`: off the map; on a scar profile: no contact CoF gives it.
     """
 
     CORRECTED = 0, "corrected"
@@ -112,45 +98,28 @@ def ecof_and_slope(mu, kappa, lam):
     return jax.jvp(lambda m: m * model.ecof_ratio(m, kappa, lam), (mu,), (jnp.ones_like(mu),))
 
 
-def reachability_status(ecof, kappa, lam):
-    """The status before the ambiguity check: which ECoFs the model can reach."""
-    valid = (ecof > 0.0) & jnp.isfinite(ecof)
-    for value in (kappa, lam):
-        valid &= (value >= 0.0) & jnp.isfinite(value)
-    code = jnp.where(
-        ecof * lam < 1.0, int(CorrectionStatus.CORRECTED), int(CorrectionStatus.NO_GROSS_SLIP)
-    )
-    return jnp.where(valid, code, int(CorrectionStatus.INVALID)).astype(jnp.int32)
-
-
 def may_fall(kappa, lam):
     """Where :math:`\\mu_E(\\mu)` may fall over part of its range."""
     return (kappa > _FALL_KAPPA) & (lam > 0.0) & (lam < _FALL_LAMBDA)
 
 
 def ecof_fall(kappa, lam):
-    r"""Where :math:`\mu_E(\mu)` falls: its local maximum and minimum, or NaN where it rises.
+    r"""Where :math:`\mu_E(\mu)` falls: its local maximum and minimum, or NaN where it rises
+    (only for :math:`\kappa > 1` and :math:`0 < \lambda <` :data:`LAMBDA_INFINITY`; how it is
+    found: docs/model.md, "Correcting a reported ECoF").
 
     Parameters
     ----------
-    kappa : array_like
-        Curvature number :math:`\kappa = 2 z_o/x_o` (with :math:`x_o = \Delta^*`). [1]
-    lam : array_like
-        Compliance ratio :math:`\lambda = P/(S\Delta^*)`. [1]
+    kappa, lam
+        As for :func:`contact_cof`. [1]
 
     Returns
     -------
     high : jax.Array
-        :math:`\mu_E` at the local maximum, where the fall starts; NaN where
-        :math:`\mu_E(\mu)` rises over the whole gross-slip range. [1]
+        :math:`\mu_E` at the local maximum, where the fall starts (NaN where it rises). [1]
     low : jax.Array
         :math:`\mu_E` at the local minimum, where it ends. An ECoF in ``[low, high]``
         comes from three contact CoFs (two at the ends). [1]
-
-    Notes
-    -----
-    The fall exists only for :math:`\kappa > 1` and :math:`0 < \lambda <` :data:`LAMBDA_INFINITY`;
-    how it is found, and what it can miss: ``docs/model.md`` (correcting a reported ECoF).
 
     References
     ----------
@@ -162,8 +131,7 @@ def ecof_fall(kappa, lam):
     falls = may_fall(kappa, lam)
     kappa = jnp.where(falls, kappa, 2.0)[..., None]  # harmless values elsewhere
     lam = jnp.where(falls, lam, 0.01)[..., None]
-    fraction = jnp.linspace(0.0, 1.0, _FALL_GRID)
-    log_mu = -jnp.log(kappa) * (1.0 - fraction)  # from 1/kappa to 1
+    log_mu = -jnp.log(kappa) * (1.0 - jnp.linspace(0.0, 1.0, _FALL_GRID))  # from 1/kappa to 1
     _, slope = ecof_and_slope(jnp.exp(log_mu), kappa, lam)
     falling = slope <= 0.0
     found = falls & jnp.any(falling, axis=-1)
@@ -171,11 +139,9 @@ def ecof_fall(kappa, lam):
     last = jnp.clip(_FALL_GRID - 1 - jnp.argmax(falling[..., ::-1], axis=-1), 1, _FALL_GRID - 2)
 
     # Brackets of the slope's sign changes: rising at `rise`, falling at `fall`.
-    def at(index):
-        return jnp.take_along_axis(log_mu, index[..., None], axis=-1)[..., 0]
-
-    rise = jnp.stack([at(first - 1), at(last + 1)], axis=-1)
-    fall = jnp.stack([at(first), at(last)], axis=-1)
+    ends = jnp.stack([first, last], axis=-1)
+    rise = jnp.take_along_axis(log_mu, ends + jnp.array([-1, 1]), axis=-1)
+    fall = jnp.take_along_axis(log_mu, ends, axis=-1)
 
     def halve(_, bracket):
         rise, fall = bracket
@@ -187,18 +153,3 @@ def ecof_fall(kappa, lam):
     rise, fall = jax.lax.fori_loop(0, _FALL_BISECTIONS, halve, (rise, fall))
     value, _ = ecof_and_slope(jnp.exp(0.5 * (rise + fall)), kappa, lam)
     return jnp.where(found, value[..., 0], jnp.nan), jnp.where(found, value[..., 1], jnp.nan)
-
-
-def ambiguity_marked(mu, status, ecof, high, low):
-    """The contact CoF and status, NaN and ``AMBIGUOUS`` where ``ecof`` lies in the fall."""
-    ambiguous = (status == int(CorrectionStatus.CORRECTED)) & (ecof >= low) & (ecof <= high)
-    status = jnp.where(ambiguous, int(CorrectionStatus.AMBIGUOUS), status).astype(jnp.int32)
-    return jnp.where(ambiguous, jnp.nan, mu), status
-
-
-def ecof_fall_where_needed(status, kappa, lam):
-    """:func:`ecof_fall` at every point, scanned only if a corrected point may fall."""
-    kappa, lam = jax.lax.stop_gradient(kappa), jax.lax.stop_gradient(lam)
-    needed = jnp.any(may_fall(kappa, lam) & (status == int(CorrectionStatus.CORRECTED)))
-    nan = jnp.full(status.shape, jnp.nan)
-    return jax.lax.cond(needed, lambda: ecof_fall(kappa, lam), lambda: (nan, nan))

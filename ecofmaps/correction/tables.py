@@ -23,7 +23,6 @@ __all__ = [
     "TableError",
     "TableRowWarning",
     "correct_table",
-    "table_dialect",
 ]
 
 #: Input columns: column name -> quantity name (its unit and range in the nomenclature).
@@ -57,18 +56,11 @@ class TableError(FileLineError):
 
 
 class TableRowWarning(UserWarning):
-    """A row that could not be corrected (``bad_rows="nan"``): the message names the file,
-    the 1-based line number and the column, as :class:`TableError` does."""
-
-
-def table_dialect(header_line: str) -> str:
-    """The separator the header line uses (tab, else ``;``, else ``,``)."""
-    return "\t" if "\t" in header_line else ";" if ";" in header_line else ","
+    """A row that could not be corrected (``bad_rows="nan"``), named as by :class:`TableError`."""
 
 
 def _number(path, line: int, name: str, text: str, decimal_comma: bool) -> float:
-    """The cell ``text`` of column ``name`` in SI, range-checked (``0,83`` read as 0.83 when the
-    table's separator is not a comma)."""
+    """The cell ``text`` of column ``name`` in SI, range-checked (``0,83`` if ``decimal_comma``)."""
     quantity = nomenclature.QUANTITIES[COLUMNS[name]]
     unit = f" in {quantity.display_unit}" if quantity.display_unit else ""
     if decimal_comma and text.count(",") == 1 and "." not in text:
@@ -92,7 +84,7 @@ def _read(path: Path, on_profile: bool, keep_bad: bool):
         with open(path, encoding="utf-8-sig", newline="") as stream:
             lines = ["\n" if line.lstrip().startswith("#") else line for line in stream]
         header_line = next((line for line in lines if line.strip()), ",")
-        delimiter = table_dialect(header_line)
+        delimiter = "\t" if "\t" in header_line else ";" if ";" in header_line else ","
         reader = csv.reader(lines, delimiter=delimiter)
         # each non-blank row with the file line it ends on (csv counts the lines it reads)
         records = [(row, reader.line_num) for row in reader if any(cell.strip() for cell in row)]
@@ -138,24 +130,20 @@ def _row_values(path, line: int, row, column: dict, on_profile: bool, commas: bo
 
     values = {name: number(name) for name in _REQUIRED}
     if not on_profile:
-        given_ratio = "aspect_ratio" in column and row[column["aspect_ratio"]].strip() != ""
-        given_scar = [name in column and row[column[name]].strip() != "" for name in _SCAR]
-        if given_ratio == any(given_scar) or (any(given_scar) and not all(given_scar)):
+        depth, width = _SCAR
+        has = [n in column and row[column[n]].strip() != "" for n in ("aspect_ratio", *_SCAR)]
+        if has not in ([True, False, False], [False, True, True]):  # the ratio, or D and W
             raise TableError(
                 path,
                 line,
                 "give the aspect ratio one way: aspect_ratio, or both scar_depth_um and "
                 "scar_half_width_um",
             )
-        depth, width = _SCAR
-        values["aspect_ratio"] = (
-            number("aspect_ratio") if given_ratio else number(depth) / number(width)
-        )
+        values["aspect_ratio"] = number("aspect_ratio") if has[0] else number(depth) / number(width)
     return values
 
 
 def _header_problem(header: list[str], on_profile: bool, keep_bad: bool) -> str | None:
-    """What is wrong with the header line, or None."""
     duplicates = sorted({name for name in header if header.count(name) > 1})
     if duplicates:
         return f"repeated column(s) {', '.join(duplicates)}"
@@ -179,16 +167,14 @@ def _header_problem(header: list[str], on_profile: bool, keep_bad: bool) -> str 
 
 
 def correct_table(path, profile=None, mapping="scaled", bad_rows="raise") -> tuple[str, int]:
-    """The table at ``path`` (``docs/formats.md``) with each row's ``mu`` and
-    ``correction_factor`` (on a ``profile``, ``mu_parabolic`` too), as text in the input's
-    dialect, and its number of rows; ``bad_rows='nan'`` gives a bad row NaN, a ``status``
-    and a :class:`TableRowWarning` instead of raising :class:`TableError`."""
+    """The table at ``path`` (``docs/formats.md``) with each row's results, as text in its dialect,
+    and its number of rows; ``bad_rows='nan'`` gives a bad row NaN, a ``status`` and a
+    :class:`TableRowWarning` instead of raising :class:`TableError`."""
     if bad_rows not in ("raise", "nan"):
         raise ValueError(f"bad_rows must be 'raise' or 'nan', got {bad_rows!r}")
     path = Path(path)
     header, records, si, sep, commas, bad = _read(path, profile is not None, bad_rows == "nan")
-    read = np.ones(len(records), bool)
-    read[list(bad)] = False
+    read = ~np.isin(np.arange(len(records)), list(bad))
     rig = {name: si[nomenclature.column(name)][read] for name in ("amplitude", "load", "stiffness")}
     mu, added = np.full(len(records), np.nan), [[] for _ in records]
     status = np.full(len(records), int(CorrectionStatus.INVALID))

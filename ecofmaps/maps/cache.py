@@ -1,8 +1,5 @@
-"""The disk cache of results that are expensive to recompute: one netCDF file
-``<function>-<key>.nc`` per result in :func:`cache_directory`, keyed by :func:`cache_key`, its
-arrays in Fletcher-32 checksummed chunks and the rest under :func:`metadata_checksum`. What is
-cached, how entries are checked, written and evicted, and what that costs against computing:
-docs/performance.md, "The cache"."""
+"""The disk cache of costly results: a netCDF file ``<function>-<key>.nc`` each, its arrays in
+Fletcher-32 checksummed chunks, the rest under :func:`metadata_checksum` (docs/performance.md)."""
 
 from __future__ import annotations
 
@@ -90,8 +87,7 @@ class CacheWarning(UserWarning):
 
 @dataclass(frozen=True)
 class CacheEntry:
-    """One file of the cache: the function whose result it holds, its size [byte], and the
-    times (UTC) of its last write and last use (the least recently used go first)."""
+    """One file of the cache: its function, size [byte], last write and last use (UTC)."""
 
     path: Path
     function: str
@@ -138,8 +134,7 @@ def _chunked(variable: xr.Variable) -> bool:
 
 
 def metadata_checksum(dataset: xr.Dataset) -> str:
-    """SHA-256 (hex) of what the chunks' checksums do not cover: names, dimensions, types,
-    shapes, attributes, and the values of text and scalar variables."""
+    """SHA-256 (hex) of all that the chunks' checksums do not cover."""
     digest = hashlib.sha256()
 
     def add(*parts) -> None:
@@ -162,8 +157,7 @@ def metadata_checksum(dataset: xr.Dataset) -> str:
 
 
 def cache_key(function: str, inputs: Mapping[str, object]) -> str:
-    """SHA-256 key (hex) of version, model revision, ``function`` and ``inputs`` (by name, as
-    float64 bytes with their shape: a scalar and a one-element array differ)."""
+    """SHA-256 key (hex) of version, model revision, ``function`` and ``inputs`` (float64 bytes)."""
     digest = hashlib.sha256(f"ecofmaps {__version__}\0{model_revision()}\0{function}\0".encode())
     for name, value in inputs.items():
         digest.update(f"{name}\0".encode())
@@ -177,8 +171,7 @@ def cache_key(function: str, inputs: Mapping[str, object]) -> str:
 
 
 def write_netcdf(dataset: xr.Dataset, path, *, exclusive: bool = True) -> Path:
-    """``path``, where ``dataset`` is written as netCDF atomically (``path`` is left as it was
-    on any failure)."""
+    """``path``, where ``dataset`` is written as netCDF atomically (or left as it was)."""
     path = Path(path)
     with atomic_path(path, exclusive=exclusive) as temporary:
         check_room(temporary, dataset.nbytes)
@@ -211,8 +204,7 @@ def _file_image(dataset: xr.Dataset) -> bytes:
     )
     try:
         with h5netcdf.File(memory, "w") as netcdf:  # leaves `memory` open
-            store = xr.backends.H5NetCDFStore(netcdf, mode="w")
-            dataset.dump_to_store(store, encoding=encoding)
+            dataset.dump_to_store(xr.backends.H5NetCDFStore(netcdf, mode="w"), encoding=encoding)
             written = xr.open_dataset(xr.backends.H5NetCDFStore(netcdf, mode="r"))
             netcdf.attrs[_CHECKSUM_ATTRIBUTE] = metadata_checksum(written)
         memory.flush()
@@ -237,10 +229,9 @@ def _read(path: Path, key: str) -> xr.Dataset:
 
 
 def _stored(path: Path, key: str) -> xr.Dataset | None:
-    """The dataset stored at ``path``, or None: an unusable one is removed, with one warning
-    (and no noise from finalizers of half-opened HDF5 objects)."""
+    """The dataset stored at ``path``, or None: an unusable one is removed, with one warning."""
     hook = sys.unraisablehook
-    sys.unraisablehook = _ignored
+    sys.unraisablehook = lambda unraisable: None  # finalizers of half-opened HDF5 objects
     try:
         try:
             return _read(path, key)
@@ -256,10 +247,6 @@ def _stored(path: Path, key: str) -> xr.Dataset | None:
     return None
 
 
-def _ignored(unraisable) -> None:
-    pass
-
-
 def _reason(error: BaseException) -> str:
     text = " ".join(str(error).split()) or "no reason given"
     if isinstance(error, OSError) and error.strerror:
@@ -268,8 +255,7 @@ def _reason(error: BaseException) -> str:
 
 
 def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
-    """Store ``dataset`` at ``path`` if it fits in ``bound`` [byte], then remove the least
-    recently used other entries until they all take at most ``bound``."""
+    """Store ``dataset`` if it fits in ``bound`` [byte], evicting the least recently used others."""
     if dataset.nbytes > bound:
         return
     image = _file_image(dataset.assign_attrs({_KEY_ATTRIBUTE: key}))
@@ -291,12 +277,10 @@ def _store(dataset: xr.Dataset, path: Path, key: str, bound: int) -> None:
 def cached_dataset(
     function: str, inputs: Mapping[str, object], compute: Callable[[], xr.Dataset], cache_dir=None
 ) -> xr.Dataset:
-    """``compute()``, read from the cache under the key of ``function`` and ``inputs`` (all
-    the result depends on), else computed and stored (a :class:`CacheWarning` if it cannot)."""
-    directory = cache_directory(cache_dir)
+    """``compute()``, from the cache under the key of ``function`` and ``inputs``, or stored."""
     bound = cache_size_bound()  # a bad ECOFMAPS_CACHE_SIZE is refused before any work
     key = cache_key(function, inputs)
-    path = directory / f"{function}-{key[:_NAME_DIGITS]}.nc"
+    path = cache_directory(cache_dir) / f"{function}-{key[:_NAME_DIGITS]}.nc"
     dataset = _stored(path, key) if path.is_file() else None  # not a folder of the user's
     if dataset is not None:
         with contextlib.suppress(OSError):  # the access time orders eviction; only a hint
@@ -327,8 +311,7 @@ def cache_entries(cache_dir=None) -> list[CacheEntry]:
     Returns
     -------
     entries : list of CacheEntry
-        Only files named like cache entries (``<function>-<32 hex digits>.nc``); other
-        files in the directory are ignored.
+        The files named ``<function>-<32 hex digits>.nc`` (no other file in the directory).
     """
     entries = []
     for path in _files(cache_directory(cache_dir), _ENTRY):

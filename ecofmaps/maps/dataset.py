@@ -41,10 +41,7 @@ _AXES = {
 
 
 def _attrs(name: str) -> dict:
-    attrs = nomenclature.attrs(name)
-    if name == "regime":
-        attrs.update(model.Regime.flag_attrs())
-    return attrs
+    return nomenclature.attrs(name) | (model.Regime.flag_attrs() if name == "regime" else {})
 
 
 def checked_axes(**values) -> dict:
@@ -63,10 +60,9 @@ def checked_axis(name: str, value) -> np.ndarray:
     unique, counts = np.unique(array, return_counts=True)
     if np.any(counts > 1):
         repeated = unique[counts > 1][0]
-        where = np.flatnonzero(array == repeated)
         raise ValueError(
-            f"{name} repeats the value {repeated!r} (at indices {where.tolist()}): a grid axis "
-            "takes each value once"
+            f"{name} repeats the value {repeated!r} (at indices "
+            f"{np.flatnonzero(array == repeated).tolist()}): a grid axis takes each value once"
         )
     return array
 
@@ -103,15 +99,9 @@ def grid_dataset(axes: dict, values: dict, title: str, extra=None) -> xr.Dataset
             value = np.squeeze(value, axis=squeeze)
             value = dims + trailing[: value.ndim - len(dims)], value
         variables[name] = xr.Variable(*value, _attrs(name))
-    attrs = {
-        "title": title,
-        "model": paper.MODEL,
-        "references": paper.CITATION,
-        "source": f"ecofmaps {__version__}",
-        "ecofmaps_version": __version__,
-    }
-    # What xarray.Dataset(data_vars, coords, attrs) builds, without its merging and alignment
-    # of variables that are consistent by construction.
+    attrs = {"title": title, "model": paper.MODEL, "references": paper.CITATION}
+    attrs.update(source=f"ecofmaps {__version__}", ecofmaps_version=__version__)
+    # xarray.Dataset(data_vars, coords, attrs) without aligning variables consistent by design.
     return xr.Dataset._construct_direct(variables, coords, attrs=attrs, indexes=indexes)
 
 

@@ -1,10 +1,6 @@
-r"""Parameter maps: the model over whole grids, as labelled xarray Datasets.
-
-Each function takes one value or one 1-D array per parameter; the arrays become the
-Dataset's dimensions, the single values its scalar coordinates. As in the paper,
-:math:`x_o = \Delta^*`. Tiles, blocks and the cache: docs/performance.md; the model on a scar
-profile: docs/model.md, "The model on a scar profile".
-"""
+r"""The model over whole grids, as labelled xarray Datasets: one value or one 1-D array per
+parameter (a scalar coordinate or a dimension), :math:`x_o = \Delta^*` as in the paper. The
+method: docs/model.md; tiles, blocks and the cache: docs/performance.md."""
 
 from __future__ import annotations
 
@@ -22,29 +18,14 @@ from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers,
 from ecofmaps.model.simulation import fretting_loop
 from ecofmaps.model.steady_state import dimensionless
 
-__all__ = [
-    "MODEL_ON_PROFILE",
-    "compute_loops",
-    "compute_map",
-    "compute_profile_map",
-    "compute_universal_map",
-]
+__all__ = ["compute_loops", "compute_map", "compute_profile_map", "compute_universal_map"]
 
-MODEL_ON_PROFILE = (
+_MODEL_ON_PROFILE = (
     "compliant wear-scar interaction model on a measured or modelled scar profile: a rigid "
     "round-ended pad with Coulomb friction feels the profile's slope g(X) (eq. 9 pointwise), "
     "driven through a spring of stiffness S (the rig); steady loops of displacement amplitude "
     "Delta* by first passage of the quasi-static return map"
 )
-
-
-def _mesh(*axes):
-    """The 1-D ``axes`` reshaped to broadcast against each other, axis ``i`` along dim ``i``."""
-    count = len(axes)
-    return [
-        jnp.reshape(axis, tuple(-1 if j == i else 1 for j in range(count)))
-        for i, axis in enumerate(axes)
-    ]
 
 
 def _steady_state(mu, kappa, lam, amplitude=None, load=None) -> dict:
@@ -70,7 +51,7 @@ def _broadcast(values: dict, axes) -> dict:
 
 @jax.jit
 def _map_kernel(stiffness_ratio, aspect_ratio, amplitude, mu, load):
-    axes = _mesh(stiffness_ratio, aspect_ratio, amplitude, mu)
+    axes = jnp.ix_(stiffness_ratio, aspect_ratio, amplitude, mu)
     stiffness_ratio, aspect_ratio, amplitude, mu = axes
     kappa = model.curvature_number(1.0, aspect_ratio, 1.0)  # x_o = Δ*: κ = 2 z_o/x_o
     lam = model.compliance_ratio(amplitude, 1.0, stiffness_ratio)  # 1/((S/P) Δ*)
@@ -79,7 +60,7 @@ def _map_kernel(stiffness_ratio, aspect_ratio, amplitude, mu, load):
 
 @jax.jit
 def _universal_kernel(compliance_ratio, aspect_ratio, mu):
-    axes = _mesh(compliance_ratio, aspect_ratio, mu)
+    axes = jnp.ix_(compliance_ratio, aspect_ratio, mu)
     lam, aspect_ratio, mu = axes
     kappa = model.curvature_number(1.0, aspect_ratio, 1.0)
     return _broadcast(_steady_state(mu, kappa, lam), axes)
@@ -125,60 +106,42 @@ def compute_map(
     mu : float or 1-D array_like
         Contact coefficient of friction :math:`\mu`. [1]
     load : float, optional
-        Normal load :math:`P`; when given, the map also holds ``dissipated_energy`` and
-        ``max_force`` and a scalar coordinate ``load``. [N]
+        Normal load :math:`P`: adds ``dissipated_energy``, ``max_force`` and a coordinate. [N]
     chunks : 'auto', int or dict, optional
-        Return a chunked map, of dask arrays evaluated block by block when computed or
+        Return a chunked map of dask arrays, evaluated block by block when computed or
         written (:func:`ecofmaps.maps.write_map`): an int is the most grid points in a
         block, ``'auto'`` :data:`ecofmaps.maps.tiles.BLOCK_POINTS`, a dict the block
         length by dimension name (-1 or None, or not named: whole). Default: in memory.
     profile : ScarProfile, optional
-        A wear-scar profile of any shape instead of ``aspect_ratio``: see
-        :func:`compute_profile_map`.
+        A scar profile instead of ``aspect_ratio``: see :func:`compute_profile_map`.
     mapping : {'scaled', 'physical'}
         With a profile: :math:`X = xW/\Delta^*` (eq. 11) or :math:`X = x`.
     cache : bool, optional
-        Read the result from the disk cache, or store it there. Default: only a map on a
-        profile; a chunked map is never cached (docs/performance.md, "The cache").
+        Use the disk cache (default: only on a profile; never chunked); an unusable file is
+        removed with a :class:`~ecofmaps.maps.cache.CacheWarning` and the map recomputed.
     cache_dir : str or os.PathLike, optional
         Cache directory; default ``$ECOFMAPS_CACHE`` or the per-user cache directory.
     max_chunk : int
-        Most grid points evaluated in one call of the compiled kernel (a tile; tiles run on
-        every core). [1]
+        Most grid points in one call of the compiled kernel (a tile, one core each). [1]
 
     Returns
     -------
     map : xarray.Dataset
-        Dimensions ``stiffness_ratio``, ``aspect_ratio``, ``amplitude``, ``mu`` (in this
-        order; only those given as arrays, the others are scalar coordinates). Variables:
-        ``slip_amplitude`` [m], ``slip_ratio`` [1], ``ecof`` [1], ``ecof_ratio`` [1],
-        ``regime`` (:class:`ecofmaps.Regime` codes, int32), ``compliance_ratio`` [1] (over
-        ``stiffness_ratio`` and ``amplitude`` only) and, with a load, ``dissipated_energy``
-        [J] and ``max_force`` [N]. Every variable and coordinate has ``long_name`` and
-        ``units``. ECoF values are NaN where there is no gross slip; every value but the
-        regime is NaN when self-locking (rigid rig, :math:`\mu\kappa \ge 1`). A chunked
-        map, computed, is identical to the map in memory. Arrays of a single tile are
-        read-only (docs/performance.md, "Maps").
+        Dimensions ``stiffness_ratio``, ``aspect_ratio``, ``amplitude``, ``mu`` (those given
+        as arrays, in order); variables with ``long_name`` and ``units``: ``slip_amplitude``
+        [m] (eq. 16), ``slip_ratio`` [1], ``ecof`` [1] (eq. 13-15), ``ecof_ratio`` [1],
+        ``regime`` (:class:`ecofmaps.Regime`), ``compliance_ratio`` [1] (over S/P and
+        amplitude), with a load ``dissipated_energy`` [J] (eq. 12) and ``max_force`` [N]
+        (eq. 9). ECoFs are NaN without gross slip, all but the regime when self-locking.
+        Computed, a chunked map equals the map in memory; a single tile's arrays are read-only.
 
     Raises
     ------
     ValueError
-        If a parameter is not a scalar or a non-empty 1-D array, or is out of range:
-        stiffness_ratio > 0 (inf allowed); aspect_ratio >= 0; amplitude, mu, load > 0;
-        all finite except stiffness_ratio, each within :data:`ecofmaps.units.DOMAIN`. For
-        a bad ``chunks``, ``cache=True`` with ``chunks``, and a map in memory that would
-        not fit in the memory available (before allocating it).
-
-    Warns
-    -----
-    ecofmaps.maps.cache.CacheWarning
-        When a cache file is unusable (it is removed and the map recomputed).
-
-    Notes
-    -----
-    Closed forms: eq. 16 (:math:`\delta^*`), the corrected eq. 13-15 (:math:`\mu_E`), eq. 12
-    (:math:`E_d`), eq. 9 (:math:`Q^*`); they depend on :math:`S`, :math:`P` and
-    :math:`\Delta^*` only through :math:`\lambda` (:func:`compute_universal_map`).
+        For a parameter not a scalar or non-empty 1-D array, or out of range (stiffness_ratio
+        > 0, inf allowed; aspect_ratio >= 0; amplitude, mu, load > 0; within
+        :data:`ecofmaps.units.DOMAIN`); a bad ``chunks``; ``cache=True`` with ``chunks``; a
+        map in memory that would not fit in the memory available.
 
     References
     ----------
@@ -189,18 +152,10 @@ def compute_map(
     Examples
     --------
     >>> import numpy as np
-    >>> m = compute_map(np.geomspace(2e4, 2e5, 5), np.linspace(0, 0.3, 4), 50e-6, 0.8)
-    >>> m.ecof_ratio.dims
-    ('stiffness_ratio', 'aspect_ratio')
-
-    The same map in blocks of 2 values of S/P, evaluated when it is computed or written:
-
-    >>> lazy = compute_map(np.geomspace(2e4, 2e5, 5), np.linspace(0, 0.3, 4), 50e-6, 0.8,
-    ...                    chunks={"stiffness_ratio": 2})
-    >>> lazy.ecof_ratio.chunks
+    >>> m = compute_map(np.geomspace(2e4, 2e5, 5), np.linspace(0, 0.3, 4), 50e-6, 0.8,
+    ...                 chunks={"stiffness_ratio": 2})
+    >>> m.ecof_ratio.chunks
     ((2, 2, 1), (4,))
-    >>> lazy.compute().identical(m)
-    True
     """
     if profile is not None or aspect_ratio is None:
         if aspect_ratio is not None:
@@ -241,18 +196,14 @@ def compute_universal_map(
     cache_dir=None,
     max_chunk=MAX_CHUNK,
 ) -> xr.Dataset:
-    r"""The dimensionless map: :math:`\mu_E/\mu` and :math:`\delta^*/\Delta^*` over :math:`\lambda`.
+    r"""The dimensionless map: :math:`\mu_E/\mu` and :math:`\delta^*/\Delta^*` over :math:`\lambda`,
+    which holds both panels of Figure 11 (docs/model.md, "The dimensionless core").
 
     Parameters
     ----------
     compliance_ratio : float or 1-D array_like
-        :math:`\lambda = P/(S\Delta^*)`, the rig's deflection at :math:`Q = P` over the
-        displacement amplitude, >= 0 (0 for a rigid rig). [1]
-    aspect_ratio : float or 1-D array_like
-        Groove depth over half-width :math:`z_o/x_o` with :math:`x_o = \Delta^*`, >= 0. [1]
-    mu : float or 1-D array_like
-        Contact coefficient of friction, > 0. [1]
-    chunks, cache, cache_dir, max_chunk
+        :math:`\lambda = P/(S\Delta^*)`, >= 0 (0 for a rigid rig). [1]
+    aspect_ratio, mu, chunks, cache, cache_dir, max_chunk
         As for :func:`compute_map`.
 
     Returns
@@ -264,14 +215,7 @@ def compute_universal_map(
     Raises
     ------
     ValueError
-        If a parameter is not a scalar or a non-empty 1-D array, or out of range; for
-        ``chunks``, ``cache`` and memory, as :func:`compute_map`.
-
-    Notes
-    -----
-    :math:`\mu_E/\mu` depends on :math:`(\mu, z_o/x_o, \lambda)` only (eq. 13-16): this one
-    chart holds both panels of Figure 11, whose axes :math:`S/P` map onto
-    :math:`\lambda = 1/((S/P)\Delta^*)`.
+        As for :func:`compute_map`.
 
     References
     ----------
@@ -305,37 +249,26 @@ def compute_loops(stiffness, aspect_ratio, amplitude, load, mu, num=201) -> xr.D
     ----------
     stiffness : float or 1-D array_like
         Rig stiffness :math:`S`; ``numpy.inf`` for a rigid rig. [N/m]
-    aspect_ratio : float or 1-D array_like
-        Groove depth over half-width :math:`z_o/x_o`. [1]
-    amplitude : float or 1-D array_like
-        Displacement amplitude :math:`\Delta^*` (also the groove half-width). [m]
+    aspect_ratio, amplitude, mu
+        As for :func:`compute_map`. [1], [m], [1]
     load : float or 1-D array_like
         Normal load :math:`P`. [N]
-    mu : float or 1-D array_like
-        Contact coefficient of friction. [1]
     num : int
         Points on each slip branch (>= 2); each loop has ``2 * num + 1`` points. [1]
 
     Returns
     -------
     loops : xarray.Dataset
-        Dimensions: those of the parameters given as arrays (in the order of the
-        arguments), then ``point``. Variables ``displacement`` [m] and ``force`` [N] around
-        each loop (see :func:`ecofmaps.fretting_loop`: it starts and ends at the reversal
-        :math:`(-\Delta^*, -Q^*)` and runs clockwise), and per loop ``slip_amplitude`` [m],
-        ``max_force`` [N], ``dissipated_energy`` [J] (the loop's area) and ``regime``.
+        Dimensions: the parameters given as arrays (in order), then ``point``. Variables
+        ``displacement`` [m] and ``force`` [N] around each loop (as
+        :func:`ecofmaps.fretting_loop`: eq. 9-10), and per loop ``slip_amplitude`` [m]
+        (eq. 16), ``max_force`` [N], ``dissipated_energy`` [J] (eq. 12) and ``regime``.
         Self-locking loops are NaN.
 
     Raises
     ------
     ValueError
-        If a parameter is not a scalar or a non-empty 1-D array, or out of range (see
-        :func:`ecofmaps.slip_amplitude`), or ``num < 2``.
-
-    Notes
-    -----
-    Slip branches of eq. 9-10 joined by stick segments of slope :math:`S`; eq. 16 gives
-    :math:`\delta^*`, eq. 9 :math:`Q^*`, eq. 12 :math:`E_d`.
+        As for :func:`compute_map` (stiffness > 0, inf allowed), or ``num < 2``.
 
     References
     ----------
@@ -346,7 +279,7 @@ def compute_loops(stiffness, aspect_ratio, amplitude, load, mu, num=201) -> xr.D
     axes = checked_axes(
         stiffness=stiffness, aspect_ratio=aspect_ratio, amplitude=amplitude, load=load, mu=mu
     )
-    grid = jnp.broadcast_arrays(*_mesh(*(np.atleast_1d(a) for a in axes.values())))
+    grid = jnp.broadcast_arrays(*jnp.ix_(*(np.atleast_1d(a) for a in axes.values())))
     values = jax.device_get(_loop_kernel(*grid))
     values["displacement"], values["force"] = fretting_loop(
         grid[2], grid[3], grid[0], grid[4], grid[1], num=num
@@ -375,31 +308,21 @@ def compute_profile_map(
     stiffness_ratio, amplitude, mu, load
         As for :func:`compute_map`. [1/m], [m], [1], [N]
     profile : ScarProfile
-        The scar (:func:`ecofmaps.scar_profile`, :func:`ecofmaps.read_scar_profile`, a
-        profile family).
-    mapping : {'scaled', 'physical'}
-        :math:`X = xW/x_o` with :math:`x_o = \Delta^*` (eq. 11), or :math:`X = x`.
-    cache, cache_dir, max_chunk
-        As for :func:`compute_map`; the cache key holds every array of the profile.
+        The scar (:func:`ecofmaps.scar_profile`, :func:`ecofmaps.read_scar_profile`, ...).
+    mapping, cache, cache_dir, max_chunk
+        As for :func:`compute_map` (the cache key holds every array of the profile).
 
     Returns
     -------
     map : xarray.Dataset
-        Dimensions ``stiffness_ratio``, ``amplitude``, ``mu`` (those given as arrays), the
-        variables of :func:`compute_map`, and the profile's depth, half-width, aspect ratio,
-        sample count and the mapping as global attributes. Points where the pad slips off
-        the trace have the regime ``BEYOND_PROFILE`` and NaN values.
+        As :func:`compute_map` (no ``aspect_ratio``), with the profile's depth, half-width,
+        aspect ratio, sample count and the mapping as global attributes. Points where the
+        pad slips off the trace have the regime ``BEYOND_PROFILE`` and NaN values.
 
     Raises
     ------
     ValueError
         As for :func:`compute_map`, and for a missing or bad profile or mapping.
-
-    Notes
-    -----
-    With the scaled mapping the map depends on :math:`S/P` and :math:`\Delta^*` only through
-    :math:`\lambda = P/(S\Delta^*)`, as in eq. 16; the steady loop comes from
-    :func:`ecofmaps.model.on_profile.steady_numbers` (one set of tables per :math:`\mu`).
 
     References
     ----------
@@ -428,7 +351,6 @@ def compute_profile_map(
     def compute() -> xr.Dataset:
         grid = [np.atleast_1d(a) for a in axes.values()]
         points = [axis.ravel() for axis in np.meshgrid(*grid, indexing="ij")]
-        names = ("slip_ratio", "ecof_ratio", "regime", "normalized_energy", "normalized_max_force")
         # λ = P/(S Δ*) = 1/((S/P) Δ*): a unit load and the stiffness ratio
         tiles = [
             steady_numbers(profile, a, 1.0, s, m, mapping=mapping)
@@ -437,6 +359,7 @@ def compute_profile_map(
             )
         ]
         shape = tuple(axis.size for axis in grid)
+        names = ("slip_ratio", "ecof_ratio", "regime", "normalized_energy", "normalized_max_force")
         values = {
             name: np.concatenate([np.asarray(t[name]) for t in tiles]).reshape(shape)
             for name in names
@@ -444,19 +367,15 @@ def compute_profile_map(
         values.update(steady_values(values, grid[1][None, :, None], load, grid[2][None, None, :]))
         del values["normalized_energy"], values["normalized_max_force"]
         title = "ECoF map of the compliant wear-scar model on a scar profile"
-        dataset = map_dataset(axes, values, load, title)
-        dataset.attrs.update(
-            model=MODEL_ON_PROFILE,
+        return map_dataset(axes, values, load, title).assign_attrs(
+            model=_MODEL_ON_PROFILE,
             scar_depth=float(profile.depth),
             scar_half_width=float(profile.half_width),
             scar_aspect_ratio=float(profile.aspect_ratio),
             scar_samples=int(profile.position.shape[-1]),
             mapping=mapping,
         )
-        return dataset
 
-    if not cache:
-        return compute()
     inputs = {**axes, "load": load, "mapping": float(physical)}
     inputs.update({f"profile_{name}": value for name, value in profile._asdict().items()})
-    return cached_dataset("compute_profile_map", inputs, compute, cache_dir)
+    return _cached("compute_profile_map", inputs, compute, cache, None, cache_dir)

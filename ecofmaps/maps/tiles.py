@@ -93,8 +93,7 @@ def _tiles(split: tuple[int, int], region):
 
 
 def _fill(out, kernel, axes, extra, split, region, tiles, stop=None) -> None:
-    """Evaluate ``tiles`` and copy their part inside ``region`` into the arrays ``out``; end
-    early once ``stop`` (a ``threading.Event``) is set."""
+    """Evaluate ``tiles`` into ``out`` (their part inside ``region``) until ``stop`` is set."""
     k, rows = split
     offset = tuple(start for start, _ in region)
     trailing = tuple(slice(start, stop) for start, stop in region[k + 1 :])
@@ -110,16 +109,12 @@ def _fill(out, kernel, axes, extra, split, region, tiles, stop=None) -> None:
             values = kernel(*tile_axes, along, *axes[k + 1 :], *extra)
             low, high = max(start, region[k][0]), min(start + rows, region[k][1])
             source = (0,) * k + (slice(low - start, high - start), *trailing)
-            target = (
-                *(i - o for i, o in zip(index, offset, strict=False)),
-                slice(low - offset[k], high - offset[k]),
-            )
+            target = (*np.subtract(index, offset[:k]), slice(low - offset[k], high - offset[k]))
             for name, value in values.items():
                 out[name][target] = np.asarray(value)[source]
 
 
 def _evaluate_grid(kernel, axes, extra, max_chunk: int) -> dict[str, np.ndarray]:
-    """Evaluate ``kernel(*block_axes, *extra)`` over the grid spanned by 1-D ``axes``."""
     _check_memory(kernel, axes, extra, max_chunk)
     shape = tuple(axis.size for axis in axes)
     if math.prod(shape) <= max_chunk:

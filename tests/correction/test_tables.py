@@ -2,7 +2,7 @@
 
 import pytest
 
-from ecofmaps.correction.tables import TableError, correct_table, table_dialect
+from ecofmaps.correction.tables import TableError, correct_table
 
 COMMA = "ecof,amplitude_um,load_N,stiffness_MN_per_m,aspect_ratio\n0.8308,50,450,35,0.2\n"
 
@@ -46,10 +46,13 @@ def test_tabs_and_semicolons_without_decimal_commas(tmp_path):
     assert cells(text, ";") == cells(reference, ",")  # decimal points stay points
 
 
-def test_dialect_is_the_header_s_separator():
-    assert table_dialect("ecof\tload_N;x,y") == "\t"
-    assert table_dialect("ecof;load_N") == ";"
-    assert table_dialect("ecof,load_N") == ","
+@pytest.mark.parametrize(("separator", "other"), [("\t", ";"), (";", ","), (",", " ")])
+def test_the_separator_is_a_tab_else_a_semicolon_else_a_comma(tmp_path, separator, other):
+    table = COMMA.replace(",", separator).replace(
+        "aspect_ratio", f"aspect_ratio{separator}x{other}y"
+    )
+    text, _ = correct_table(written(tmp_path, table.replace("0.2", f"0.2{separator}z")))
+    assert cells(text, separator)[0][-3:] == [f"x{other}y", "mu", "correction_factor"]
 
 
 @pytest.mark.parametrize(
