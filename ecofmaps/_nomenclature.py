@@ -3,14 +3,6 @@ r"""Every quantity ecofmaps names, once: symbol, long name, units, display, rang
 Dataset attributes, plot labels, table columns, the command line's rows and the range checks
 all read :data:`QUANTITIES`, keyed by the quantity's name in the Python API. ``units`` is the
 SI unit in CF/UDUNITS spelling; ``display_unit`` and ``display_factor`` the tribologist's.
-
-Examples
---------
->>> from ecofmaps._nomenclature import QUANTITIES, attrs, column
->>> attrs("slip_amplitude")
-{'long_name': 'slip amplitude δ*', 'units': 'm'}
->>> column("stiffness"), QUANTITIES["stiffness"].display_factor
-('stiffness_MN_per_m', 1e-06)
 """
 
 from __future__ import annotations
@@ -63,10 +55,11 @@ RANGES = {
     "finite": (lambda a: (a > -math.inf) & (a < math.inf), "-inf < {name} < inf"),
 }
 
-# Units of energy wear: SI, kind, display unit, factor.
+# Units of energy wear, and of S/P: SI, kind, display unit, factor (range, label, axis unit).
 _JOULES = ("J", "energy", "J")
 _PER_JOULE = ("m3 J-1", "wear_rate", "µm³/J", 1e18)
 _PER_NEWTON_METRE = ("m3 N-1 m-1", "archard", "mm³/(N·m)", 1e9)
+_PER_METRE = ("m-1", "stiffness_ratio", "1/mm", 1e-3, "positive_or_inf", "stiffness over load")
 
 #: Every quantity by its name in the API.
 QUANTITIES: dict[str, Quantity] = {
@@ -88,16 +81,7 @@ QUANTITIES: dict[str, Quantity] = {
     "shape": _number("scar shape"),
     "groove": _number("groove: the scar profile, or the parabola of the same D/W (eq. 11)"),
     "stiffness_ratio": Quantity(
-        "rig stiffness over normal load",
-        "S/P",
-        "S/P",
-        "m-1",
-        "stiffness_ratio",
-        "1/mm",
-        1e-3,
-        "positive_or_inf",
-        label="stiffness over load",
-        axis_unit="(MN/m)/kN = 1/mm",
+        "rig stiffness over normal load", "S/P", "S/P", *_PER_METRE, "(MN/m)/kN = 1/mm"
     ),
     "compliance_ratio": _number(
         "compliance ratio", "λ = P/(S Δ*)", r"\lambda = P/(S\Delta^*)", "non_negative"
@@ -194,8 +178,8 @@ QUANTITIES: dict[str, Quantity] = {
 
 
 def attrs(name: str, comments=None) -> dict:
-    """The netCDF attributes ``long_name`` and ``units`` of quantity ``name``, and its
-    ``comment`` if ``comments`` (name -> how a module reads it) holds one."""
+    """The netCDF ``long_name`` and ``units`` of quantity ``name``, and its ``comment`` if
+    ``comments`` holds one."""
     described = {"long_name": QUANTITIES[name].long_name, "units": QUANTITIES[name].units}
     return described | ({"comment": comments[name]} if name in (comments or {}) else {})
 
@@ -205,12 +189,9 @@ def axis_label(name: str, plain: bool = False) -> str:
     (``Slip amplitude δ* [µm]`` if ``plain``, for a page's plots)."""
     quantity = QUANTITIES[name]
     words = quantity.words if quantity.label is None else quantity.label
-    parts = [words[:1].upper() + words[1:]] if words else []
     mark = quantity.symbol if plain else quantity.latex and f"${quantity.latex}$"
-    if mark:
-        parts.append(mark)
     unit = quantity.axis_unit or quantity.display_unit or "1"
-    return " ".join(parts) + f" [{unit}]"
+    return " ".join(part for part in (words[:1].upper() + words[1:], mark, f"[{unit}]") if part)
 
 
 def column(name: str) -> str:
@@ -225,9 +206,8 @@ def display(name: str, value) -> np.ndarray:
 
 
 def with_se(name: str, value: float, se: float) -> str:
-    """``value ± se`` of quantity ``name`` [SI] in its display unit, as a measurement is written:
-    the standard error to two significant digits and the value to the same decimal place (to
-    four significant digits where the error is zero or unknown).
+    """``value ± se`` of quantity ``name`` [SI] in its display unit: the error to two
+    significant digits, the value to its decimal place (else to four significant digits).
 
     >>> with_se("transition_amplitude", 16.1959e-6, 0.347947e-6), with_se("mu", 0.8, 0.0)
     ('16.20 ± 0.35 µm', '0.8000 ± 0')
@@ -258,8 +238,7 @@ TRANSITION = ("amplitude", "contact_amplitude", "mu")
 
 
 def transition_texts(found) -> list[tuple[str, str]]:
-    """:func:`texts_with_se` of :func:`ecofmaps.transition`'s ``found``: Δ_t, δ_t (without the
-    rig's stiffness, what it needs) and μ_t."""
+    """:func:`texts_with_se` of :func:`ecofmaps.transition`'s Δ_t, δ_t (or what it needs), μ_t."""
     texts = texts_with_se(found, TRANSITION, "transition_{}")
     if np.isnan(float(found.contact_amplitude)):
         texts[1] = (

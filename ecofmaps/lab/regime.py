@@ -66,8 +66,8 @@ def campaign_of(results) -> list:
 
 def per_cycle(results: xr.Dataset, names) -> dict:
     """The cycle numbers, the normal load [N] and the variables ``names`` [SI] of a test, as
-    float arrays over its cycles; the forces and energies of cycles flagged ``implausible-cof``
-    NaN where they are fewer than half (a force sample gone wild, not a wrong load)."""
+    float arrays over its cycles; the forces and energies of a minority of cycles flagged
+    ``implausible-cof`` NaN."""
     if "cycle" not in results.coords and "cycle" not in results:
         raise ValueError(
             "results: no cycle numbers (a 'cycle' coordinate or column): give the results of "
@@ -104,8 +104,7 @@ def rig_of(tests: list, rig_stiffness):
 
 
 def _spring(tests: list, rig_stiffness):
-    """:func:`rig_of`, else the median spring behind the stick of the tests' ``mindlin-stick``
-    cycles (three or more: a sphere's gross-slip loops), else None. [N/m]"""
+    """:func:`rig_of`, else the median spring of three ``mindlin-stick`` cycles or more. [N/m]"""
     rig_stiffness = rig_of(tests, rig_stiffness)
     if rig_stiffness is not None or not all("quality" in t and "stiffness" in t for t in tests):
         return rig_stiffness
@@ -116,9 +115,8 @@ def _spring(tests: list, rig_stiffness):
 
 
 def _ratios(cycles: dict, rig_stiffness):
-    """The cycles' energy and opening ratios (on the contact's displacement NaN without the
-    rig's stiffness), the energy ratio that decides the regime, where the cycles are in gross
-    slip, and whether that was decided by the force (:func:`_saturated`)."""
+    """The cycles' ratios, the energy ratio that decides the regime, where the cycles are in
+    gross slip, and whether the force decided that (:func:`_saturated`)."""
     if rig_stiffness is not None:
         check("rig_stiffness", rig_stiffness, "positive_or_inf", "N/m")
     names = ("amplitude", "max_force", "dissipated_energy")
@@ -133,9 +131,8 @@ def _ratios(cycles: dict, rig_stiffness):
 
 
 def _saturated(cycles: dict, gross):
-    """Where Q*/P has reached the sliding friction μ: the median GICoF of the cycles whose
-    energy ratio on the applied displacement already says gross slip, less three times the
-    robust scatter of their Q*/P (at least a thousandth of μ); None with fewer than three."""
+    """Where Q*/P has reached the sliding friction (docs/lab.md, "Which S"); None without
+    enough cycles surely in gross slip."""
     cof = cycles["max_force"] / cycles["load"]
     friction = cycles.get("gicof", np.full(cof.shape, np.nan))
     sure = gross & np.isfinite(friction) & np.isfinite(cof)
@@ -151,35 +148,27 @@ def _saturated(cycles: dict, gross):
 def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
     r"""The energy and opening ratios of each cycle of a test, and its sliding condition.
 
+    Gross slip where the energy ratio exceeds Mindlin's :math:`A_t = 0.2` (docs/lab.md).
+
     Parameters
     ----------
     results : xarray.Dataset
         One test's results from :func:`ecofmaps.analyze_loops`.
     rig_stiffness : float, optional
-        The rig's own stiffness :math:`S` (not the loops' stick slope, which is the rig and
-        the contact in series). With it the ratios are also read on the contact's
-        displacement :math:`\Delta - Q/S` and the regime is decided there. By default the
-        one ``results`` were analysed with (``results.attrs["rig_stiffness"]``, from
-        ``analyze_loops(..., rig_stiffness=)`` or ``--rig-stiffness``), else the median
-        spring behind the stick of three ``mindlin-stick`` cycles or more (a sphere's), if
-        any; else a cycle whose Q*/P has reached the sliding friction is in gross slip
-        too. [N/m]
+        The rig's own stiffness :math:`S` (not the loops' stick slope), to read the ratios on
+        the contact's displacement :math:`\Delta - Q/S` too and decide the regime there; by
+        default ``results.attrs["rig_stiffness"]``, else a sphere's spring, else the force
+        decides (docs/lab.md, "Which S"). [N/m]
 
     Returns
     -------
     condition : xarray.Dataset
-        Over ``cycle``: ``energy_ratio`` :math:`A = E_d/(4\Delta^*Q^*)` and
-        ``opening_ratio`` :math:`B = \delta^*/\Delta^*` on the applied displacement;
-        ``contact_amplitude`` :math:`\Delta^* - Q^*/S` [m], ``contact_energy_ratio`` and
-        ``contact_opening_ratio`` on the contact's (NaN without ``rig_stiffness``);
-        ``gross_slip`` (1, 0, or NaN for a cycle without an energy ratio). Attributes
+        Over ``cycle``: ``energy_ratio`` :math:`A = E_d/(4\Delta^*Q^*)`, ``opening_ratio``
+        :math:`B = \delta^*/\Delta^*`; ``contact_amplitude`` :math:`\Delta^* - Q^*/S` [m],
+        ``contact_energy_ratio``, ``contact_opening_ratio`` (NaN without :math:`S`);
+        ``gross_slip`` (1, 0, or NaN without an energy ratio). Attributes
         ``sliding_condition`` (``'partial slip'``, ``'mixed slip'`` or ``'gross slip'``) and
         ``regime_changes_at`` (the cycles where the regime changes).
-
-    Notes
-    -----
-    Gross slip where the energy ratio exceeds Mindlin's :math:`A_t = 0.2`: docs/lab.md,
-    "Energy and opening ratios, on which displacement".
 
     References
     ----------
@@ -231,38 +220,29 @@ def line_root(x0, a, b, cov, level):
 def transition(results, rig_stiffness=None) -> xr.Dataset:
     r"""The transition from partial to gross slip, from an amplitude sweep or a campaign.
 
+    The method: docs/lab.md, "The transition".
+
     Parameters
     ----------
     results : xarray.Dataset or list of xarray.Dataset
-        The results of :func:`ecofmaps.analyze_loops` of one test at amplitudes that vary
-        across the transition (the variable-displacement method), or of several tests at
-        one load and several amplitudes.
+        :func:`ecofmaps.analyze_loops`' results of one test at amplitudes across the
+        transition, or of several tests at one load and several amplitudes.
     rig_stiffness : float, optional
-        The rig's own stiffness :math:`S`, as for :func:`sliding_condition` (by default the
-        one every test was analysed with); without it ``contact_amplitude`` is NaN, and
-        where the force decides the regime, :math:`\Delta_t` is midway between the two
-        amplitudes where :math:`Q^*` first stays at :math:`\mu P`. [N/m]
+        As in :func:`sliding_condition`; without it ``contact_amplitude`` is NaN. [N/m]
 
     Returns
     -------
     transition : xarray.Dataset
         ``amplitude`` :math:`\Delta_t` [m], ``contact_amplitude``
-        :math:`\delta_t = \Delta_t - \mu_t P/S` [m] and ``mu``
-        :math:`\mu_t = Q^*/P` at the transition (read as the gross-slip cycles' GICoF), each
-        with its standard error (``_se``; ``mu_se`` NaN, its ``comment`` saying why, for
-        results without a GICoF).
+        :math:`\delta_t = \Delta_t - \mu_t P/S` [m] and ``mu`` :math:`\mu_t = Q^*/P`, each
+        with its standard error (``_se``; ``mu_se`` NaN, its ``comment`` saying why,
+        without a GICoF).
 
     Raises
     ------
     ValueError
-        When the cycles never cross the transition (all in partial slip, or all in gross
-        slip), naming the amplitudes they span, or are all at one amplitude.
-
-    Notes
-    -----
-    The cycles split by amplitude where the fewest fall on the wrong side of
-    :math:`A_t = 0.2`, and a line through the energy ratios either side: docs/lab.md,
-    "The transition".
+        When the cycles never cross the transition, naming the amplitudes they span, or are
+        all at one amplitude.
 
     References
     ----------
@@ -270,8 +250,8 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
 
     Examples
     --------
-    Four tests on a sphere (Mindlin: μ = 0.8, δ_t = 6 µm) at 450 N behind a 35 MN/m rig,
-    one cycle each (Δ* [m], Q* [N], E_d [J]); the true Δ_t = δ_t + μP/S is 16.3 µm:
+    Four tests on a sphere (μ = 0.8) at 450 N behind a 35 MN/m rig, one cycle each
+    (Δ* [m], Q* [N], E_d [J]); the true Δ_t is 16.3 µm:
 
     >>> import xarray as xr, ecofmaps
     >>> cycles = [(14e-6, 324.7, 0.7016e-3), (15.5e-6, 350.8, 1.194e-3),

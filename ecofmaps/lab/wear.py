@@ -25,7 +25,7 @@ __all__ = ["cumulated_energy", "cycle_sum", "energy_wear", "loop_scar_closure"]
 
 def cycle_sum(cycle, value):
     """Σ of a per-cycle ``value`` over cycles 1 to the last recorded, and its standard error
-    (docs/lab.md, "Energy wear"); ``ValueError`` if no cycle has a value."""
+    (docs/lab.md, "Energy wear")."""
     kept = np.isfinite(value)
     n, v = cycle[kept], value[kept]
     if n.size == 0:
@@ -45,15 +45,14 @@ def cycle_sum(cycle, value):
 
 
 def cumulated_energy(results) -> tuple[float, float]:
-    """ΣE_d [J] of a test over cycles 1 to the last recorded, and its standard error
-    (:func:`cycle_sum` of :func:`~ecofmaps.lab.regime.per_cycle`'s energies)."""
+    """ΣE_d [J] of a test over cycles 1 to the last recorded, and its standard error."""
     cycles = per_cycle(results, ("dissipated_energy",))
     return cycle_sum(cycles["cycle"], cycles["dissipated_energy"])
 
 
 def _worn_volume(profile: ScarProfile, length) -> tuple[float, float]:
     """Worn volume [m³] of a line contact of ``length``, or of a round scar (``length`` None),
-    and its standard error from the shoulders' noise."""
+    and its standard error."""
     x = np.asarray(profile.position)
     residual = np.asarray(profile.height) - profile.reference_height - profile.reference_slope * x
     width = float(profile.half_width)
@@ -121,21 +120,22 @@ def _one_test(results, profile, length) -> dict:
 def energy_wear(results, profile, length=None, contact="line") -> xr.Dataset:
     r"""Energy wear of a fretting test, or of a campaign: ΣE_d, V, α and Archard's k.
 
+    The sums, volumes and fit: docs/lab.md, "Energy wear".
+
     Parameters
     ----------
     results : xarray.Dataset or list of xarray.Dataset
         Each test's results from :func:`ecofmaps.analyze_loops` over its recorded cycles
-        (a rig may record every N-th cycle: ``cycle`` numbers them as driven).
+        (``cycle`` numbers them as driven: a rig may record every N-th).
     profile : ScarProfile or list of ScarProfile
-        Each test's levelled wear-scar profile across the scar
-        (:func:`ecofmaps.read_scar_profile`); of a sphere's, through its centre.
+        Each test's levelled scar profile (:func:`ecofmaps.read_scar_profile`); of a
+        sphere's, through its centre.
     length : float or list of float
-        Length of the line contact, along which the worn area is the same; none for a
-        sphere. [m]
+        Length of the line contact; none for a sphere. [m]
     contact : {'line', 'sphere'}
-        ``'line'``: :math:`V = L\int d\,dx`, the worn area times ``length``; ``'sphere'``
-        (a round scar): :math:`V = \pi\int_{-W}^{W}|x|\,d(x)\,dx`, the volume of
-        revolution of the worn depth :math:`d`, the two sides averaged. The pile-up apart.
+        ``'line'``: :math:`V = L\int d\,dx`; ``'sphere'`` (a round scar):
+        :math:`V = \pi\int_{-W}^{W}|x|\,d(x)\,dx`, the worn depth :math:`d` turned about
+        the scar's axis, the two sides averaged.
 
     Returns
     -------
@@ -153,12 +153,6 @@ def energy_wear(results, profile, length=None, contact="line") -> xr.Dataset:
         For results without cycles, energies (or all NaN) or a load, a profile without a
         scar, a length not in metres (0 < L < 1 m), a line without a length or a sphere with
         one, or lists of unequal length.
-
-    Notes
-    -----
-    Sums over the cycles driven, linear between those recorded; a round scar's volume by
-    cylindrical shells; a campaign's fit needs three tests for its errors: docs/lab.md,
-    "Energy wear".
 
     References
     ----------
@@ -183,13 +177,6 @@ def energy_wear(results, profile, length=None, contact="line") -> xr.Dataset:
     60 J, 0.002 mm³
     >>> print(f"alpha = {float(wear.energy_wear_coefficient) * 1e18:.4g} µm³/J")
     alpha = 3.333e+04 µm³/J
-
-    The same trace through the centre of a sphere's round scar, a paraboloid of volume
-    :math:`\pi D W^2/2` = 47 124 µm³:
-
-    >>> round_scar = ecofmaps.energy_wear(results, profile, contact="sphere")
-    >>> print(f"{float(round_scar.wear_volume) * 1e18:.0f} µm³")
-    47119 µm³
     """
     tests = campaign_of(results)
     single = not isinstance(results, list | tuple)
@@ -268,6 +255,9 @@ def _branch_force(displacement, loop_displacement, loop_force):
 def loop_scar_closure(results, resolved, profile, rig_stiffness=None) -> xr.Dataset:
     r"""How well a test's last loop and its loops' felt groove close on the measured scar.
 
+    On the last cycle with a GICoF and a reading along the stroke: docs/lab.md, "Loop-scar
+    closure".
+
     Parameters
     ----------
     results : xarray.Dataset
@@ -275,37 +265,29 @@ def loop_scar_closure(results, resolved, profile, rig_stiffness=None) -> xr.Data
     resolved : xarray.Dataset
         The same recording read along the stroke, :func:`ecofmaps.resolve_loops`.
     profile : ScarProfile
-        The scar's levelled profilometer trace (:func:`ecofmaps.read_scar_profile`), in
-        metres, centred on the scar, which is taken to lie under the loops' centre.
+        The scar's levelled trace (:func:`ecofmaps.read_scar_profile`) [m], centred on the
+        scar, which is taken to lie under the loops' centre.
     rig_stiffness : float, optional
-        The rig's stiffness :math:`S` for the model's loop; by default the one ``results``
-        were analysed with, as for :func:`sliding_condition`, else the stiffness the reading
-        along the stroke used (the loops' stick slope, unless given to it). [N/m]
+        The rig's stiffness :math:`S` for the model's loop; by default as in
+        :func:`sliding_condition`, else the one the reading along the stroke used. [N/m]
 
     Returns
     -------
     closure : xarray.Dataset
-        ``loop_residual``: root mean square of the measured loop's force less the model's
-        at the same displacement on the same branch, over :math:`Q^*` [1];
-        ``scar_residual`` [m] and ``scar_relative_residual`` (over the depth :math:`D`) [1]:
-        root mean square height of the implied scar less the profile's over the slip
-        range. The curves: ``loop_displacement``, ``loop_force`` (the measured loop, over
-        ``point``) [m], [N]; ``model_displacement``, ``model_force`` (over
-        ``model_point``) [m], [N]; ``implied_scar`` :math:`h(\xi)` and ``scar_height``
-        :math:`z(\xi)` over ``position`` :math:`\xi` [m]. Scalars ``cycle``, ``mu`` (the
-        GICoF) and ``stiffness`` [N/m].
+        ``loop_residual``: root mean square of the measured force less the model's on the
+        same branch, over :math:`Q^*` [1]; ``scar_residual`` [m], ``scar_relative_residual``
+        (over the depth :math:`D`) [1]: root mean square height of the implied scar less the
+        profile's. The curves: ``loop_displacement``, ``loop_force`` (over ``point``) and
+        ``model_displacement``, ``model_force`` (over ``model_point``) [m], [N];
+        ``implied_scar`` :math:`h(\xi)`, ``scar_height`` :math:`z(\xi)` over ``position``
+        :math:`\xi` [m]. Scalars ``cycle``, ``mu`` (the GICoF), ``stiffness`` [N/m].
 
     Raises
     ------
     ValueError
-        For results without kept loops or a GICoF, a ``resolved`` that is not a reading
-        along the stroke, no cycle with both, a profile without a scar or not in the loops'
-        units (metres), or a ``rig_stiffness`` below half the loops' stick slope.
-
-    Notes
-    -----
-    On the last cycle with a GICoF (eq. 17-18) and a reading along the stroke, against the
-    model's loop on the profile (eq. 9-10): docs/lab.md, "Loop-scar closure".
+        For results without kept loops or a GICoF, a ``resolved`` not read along the stroke,
+        no cycle with both, a profile without a scar or not in metres, or a
+        ``rig_stiffness`` below half the loops' stick slope.
 
     References
     ----------
