@@ -12,20 +12,6 @@ from ecofmaps.measured.measure import loop_ratios
 from ecofmaps.measured.quality import has_reason, regime_ratio
 from ecofmaps.model.regimes import regime_condition, sliding_condition_of
 
-__all__ = [
-    "MINDLIN_ENERGY_RATIO",
-    "MINDLIN_OPENING_RATIO",
-    "campaign_of",
-    "fitted_line",
-    "line_root",
-    "per_cycle",
-    "rig_of",
-    "set_with_se",
-    "sliding_condition",
-    "sliding_condition_line",
-    "transition",
-]
-
 #: Energy ratio A of a sphere on a flat at the transition, on the contact's displacement. [1]
 MINDLIN_ENERGY_RATIO = 0.2
 #: Opening ratio B of a sphere on a flat at the transition, on the contact's displacement. [1]
