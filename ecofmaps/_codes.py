@@ -25,8 +25,7 @@ class Code(enum.IntEnum):
     def __new__(cls, value: int, label: str, reason: str = ""):
         member = int.__new__(cls, value)
         member._value_ = value
-        member.label = label
-        member.reason = reason
+        member.label, member.reason = label, reason
         return member
 
     @classmethod

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import concurrent.futures
 import contextlib
 import signal
 import threading
@@ -55,23 +56,13 @@ def interrupted_waiting(function):
     """``function()`` in a thread of its own while this one acts on a stop within 0.1 s (a
     handler waits for a call into C, such as XLA's compiling, to return)."""
     check_interrupted()
-    outcome = []
-
-    def run():
-        try:
-            outcome.append((function(), None))
-        except BaseException as error:  # raised in the waiting thread
-            outcome.append((None, error))
-
-    thread = threading.Thread(target=run)
-    thread.start()
-    while thread.is_alive():
-        thread.join(0.1)
+    pool = concurrent.futures.ThreadPoolExecutor(1)
+    future = pool.submit(function)
+    pool.shutdown(wait=False)
+    while not future.done():
+        concurrent.futures.wait([future], 0.1)
         check_interrupted()
-    result, error = outcome[0]
-    if error is not None:
-        raise error
-    return result
+    return future.result()  # raised in the waiting thread, if it raised
 
 
 @contextlib.contextmanager

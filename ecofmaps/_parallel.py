@@ -249,10 +249,9 @@ def _connect(address: str, timeout: float):
         try:
             answer = pool.submit(asyncio.run, asyncio.wait_for(identity(), timeout)).result()
         except Exception as error:  # whatever went wrong, no scheduler answered
-            reason = str(error) or f"no answer after {timeout:g} s"
-            answer = (
-                reason if isinstance(error, ValueError) else f"{type(error).__name__}: {reason}"
-            )
+            answer = str(error) or f"no answer after {timeout:g} s"
+            if not isinstance(error, ValueError):
+                answer = f"{type(error).__name__}: {answer}"
     if not isinstance(answer, dict) or answer.get("type") != "Scheduler":
         if isinstance(answer, dict):
             answer = f"it answers as a {answer.get('type', 'something else')}"

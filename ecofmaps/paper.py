@@ -70,13 +70,7 @@ EXAMPLE_2 = {
 
 #: The two tests whose final loops Figure 10 fits (Section 4.2): :math:`\mu` = GICoF = 0.825,
 #: :math:`S` = 45 and 35 MN/m, :math:`z_o` = 1.8 and 8.0 µm with :math:`x_o = \Delta^*`.
-EXAMPLE_1 = {
-    "amplitude": AMPLITUDE,
-    "load": LOAD,
-    "stiffness": 45e6,
-    "mu": 0.825,
-    "aspect_ratio": 1.8e-6 / AMPLITUDE,
-}
+EXAMPLE_1 = {**EXAMPLE_2, "stiffness": 45e6, "mu": 0.825, "aspect_ratio": 1.8e-6 / AMPLITUDE}
 EXAMPLE_2_FIT = {**EXAMPLE_1, "stiffness": 35e6, "aspect_ratio": 8.0e-6 / AMPLITUDE}
 
 #: Figure 10's fits by name, and Section 3's Example 2: the points marked on the maps.

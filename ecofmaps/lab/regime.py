@@ -54,7 +54,7 @@ def per_cycle(results: xr.Dataset, names) -> dict:
     """The cycle numbers, the normal load [N] and the variables ``names`` [SI] of a test, as
     float arrays over its cycles; the forces and energies of a minority of cycles flagged
     ``implausible-cof`` NaN."""
-    if "cycle" not in results.coords and "cycle" not in results:
+    if "cycle" not in results:
         raise ValueError(
             "results: no cycle numbers (a 'cycle' coordinate or column): give the results of "
             "ecofmaps.analyze_loops or the table ecofmaps loops writes"
@@ -71,7 +71,7 @@ def per_cycle(results: xr.Dataset, names) -> dict:
                 values[name] = np.where(wild, np.nan, values[name])
     if "normal_load" in results:
         values["load"] = np.asarray(results["normal_load"].values, dtype=np.float64)
-    elif "load" in results.coords or "load" in results:
+    elif "load" in results:
         values["load"] = np.broadcast_to(float(results["load"]), values["cycle"].shape)
     elif "cof_max" in results and "max_force" in results:  # a table without the load
         values["load"] = np.asarray(results.max_force / results.cof_max, dtype=np.float64)

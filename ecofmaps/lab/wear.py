@@ -139,9 +139,9 @@ def energy_wear(results, profile, length=None, contact="line") -> xr.Dataset:
     Raises
     ------
     ValueError
-        For results without cycles, energies (or all NaN) or a load, a profile without a
-        scar, a length not in metres (0 < L < 1 m), a line without a length or a sphere with
-        one, or lists of unequal length.
+        For results without cycles, energies or a load, a profile without a scar, a length
+        not in metres (0 < L < 1 m), missing for a line or given for a sphere, or lists of
+        unequal length.
 
     References
     ----------
