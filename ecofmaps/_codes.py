@@ -1,6 +1,5 @@
 """Integer codes that carry their own words: the regimes and statuses results hold per point,
-stored as integers, each knowing its ``label`` (as printed) and ``reason`` (why a value is NaN).
-"""
+stored as integers, each knowing its ``label`` (as printed) and ``reason`` (why a value is NaN)."""
 
 from __future__ import annotations
 

@@ -13,8 +13,7 @@ STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
 class Stop(threading.Event):
-    """Set once a stop signal came: the first ``signal``, and the ``notes`` that tell what a
-    stop left (:func:`add_stop_note`)."""
+    """Set once a stop signal came: the first ``signal``, and ``notes`` (:func:`add_stop_note`)."""
 
     def __init__(self):
         super().__init__()

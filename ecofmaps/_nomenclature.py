@@ -2,8 +2,7 @@ r"""Every quantity ecofmaps names, once: symbol, long name, units, display, rang
 
 Dataset attributes, plot labels, table columns, the command line's rows and the range checks
 all read :data:`QUANTITIES`, keyed by the quantity's name in the Python API. ``units`` is the
-SI unit in CF/UDUNITS spelling; ``display_unit`` and ``display_factor`` the tribologist's.
-"""
+SI unit in CF/UDUNITS spelling; ``display_unit`` and ``display_factor`` the tribologist's."""
 
 from __future__ import annotations
 
@@ -178,15 +177,13 @@ QUANTITIES: dict[str, Quantity] = {
 
 
 def attrs(name: str, comments=None) -> dict:
-    """The netCDF ``long_name`` and ``units`` of quantity ``name``, and its ``comment`` if
-    ``comments`` holds one."""
+    """The netCDF ``long_name`` and ``units`` of ``name``, and its ``comment`` in ``comments``."""
     described = {"long_name": QUANTITIES[name].long_name, "units": QUANTITIES[name].units}
     return described | ({"comment": comments[name]} if name in (comments or {}) else {})
 
 
 def axis_label(name: str, plain: bool = False) -> str:
-    r"""A plot axis label: words, symbol and display unit, ``Slip amplitude $\delta^*$ [µm]``
-    (``Slip amplitude δ* [µm]`` if ``plain``, for a page's plots)."""
+    r"""A plot axis label, ``Slip amplitude $\delta^*$ [µm]`` (``δ*`` if ``plain``)."""
     quantity = QUANTITIES[name]
     words = quantity.words if quantity.label is None else quantity.label
     mark = quantity.symbol if plain else quantity.latex and f"${quantity.latex}$"

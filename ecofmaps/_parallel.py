@@ -1,6 +1,5 @@
 """Blocks of work run on local threads or on a dask cluster, their results in order as they
-come; Ctrl-C stops at the next block (``docs/parallel.md``).
-"""
+come; Ctrl-C stops at the next block (``docs/parallel.md``)."""
 
 from __future__ import annotations
 

@@ -1,6 +1,5 @@
 """Quantities typed with units (``50um``, ``35MN/m``, ``450 N``: a plain number and a plain
-unit, no arithmetic) read as SI floats with pint, the dimension checked; a bare number is SI.
-"""
+unit, no arithmetic) read as SI floats with pint, the dimension checked; a bare number is SI."""
 
 from __future__ import annotations
 
@@ -123,8 +122,7 @@ def _registry():
 
 def parse_quantity(text: str, kind: str) -> float:
     """``text`` (:data:`PLAIN_QUANTITY`: ``'5e-5'``, ``'inf'``, ``'35 MN/m'``) as an SI float of
-    ``kind`` (a key of :data:`DIMENSIONS`), the float nearest the typed decimal times its
-    unit's factor (``'25um'`` is ``25e-6``)."""
+    ``kind`` (:data:`DIMENSIONS`), nearest the typed decimal times the unit (``'25um'``: 25e-6)."""
     dimension, si_unit, example = DIMENSIONS[kind]
     if len(text) > TEXT_LIMIT:
         raise ValueError(

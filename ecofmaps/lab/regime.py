@@ -1,5 +1,4 @@
-"""A test's sliding condition and the transition to gross slip, from the per-cycle results of
-:func:`ecofmaps.analyze_loops` (docs/lab.md)."""
+"""A test's sliding condition and the transition to gross slip (docs/lab.md)."""
 
 from __future__ import annotations
 
@@ -51,9 +50,8 @@ def campaign_of(results) -> list:
 
 
 def per_cycle(results: xr.Dataset, names) -> dict:
-    """The cycle numbers, the normal load [N] and the variables ``names`` [SI] of a test, as
-    float arrays over its cycles; the forces and energies of a minority of cycles flagged
-    ``implausible-cof`` NaN."""
+    """The cycle numbers, normal load [N] and variables ``names`` [SI] of a test over its cycles;
+    the forces and energies of a minority of cycles flagged ``implausible-cof`` NaN."""
     if "cycle" not in results:
         raise ValueError(
             "results: no cycle numbers (a 'cycle' coordinate or column): give the results of "
@@ -81,8 +79,7 @@ def per_cycle(results: xr.Dataset, names) -> dict:
 
 
 def rig_of(tests: list, rig_stiffness):
-    """``rig_stiffness``, else the one the tests were analysed with (``rig_stiffness`` in their
-    attrs, all the same), else None."""
+    """``rig_stiffness``, else the one every test was analysed with (attrs), else None. [N/m]"""
     if rig_stiffness is not None:
         return rig_stiffness
     given = {test.attrs.get("rig_stiffness") for test in tests}
@@ -185,8 +182,7 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
 
 
 def fitted_line(x, y):
-    """Least-squares line ``y = a + b (x - x0)``: x0, a, b and their covariance (NaN below
-    three points)."""
+    """Least-squares line ``y = a + b (x - x0)``: x0, a, b and their covariance."""
     x0 = float(np.mean(x))
     design = np.stack([np.ones_like(x), x - x0], axis=-1)
     (a, b), rss, *_ = np.linalg.lstsq(design, y, rcond=None)
@@ -236,8 +232,7 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
 
     Examples
     --------
-    Four tests on a sphere (μ = 0.8) at 450 N behind a 35 MN/m rig, one cycle each
-    (Δ* [m], Q* [N], E_d [J]); the true Δ_t is 16.3 µm:
+    Four one-cycle tests (Δ*, Q*, E_d) on a sphere at 450 N behind 35 MN/m (Δ_t = 16.3 µm):
 
     >>> import xarray as xr, ecofmaps
     >>> cycles = [(14e-6, 324.7, 0.7016e-3), (15.5e-6, 350.8, 1.194e-3),
@@ -318,8 +313,7 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
 
 
 def _sliding_friction(gross, level, split, cof, friction):
-    """μ_t and its standard error: the mean GICoF of each amplitude in the upper half of the
-    gross-slip cycles', averaged; else Q*/P above the ``split`` (se NaN: :data:`_PEAK_BIASED`)."""
+    """μ_t and its standard error (docs/lab.md, "The transition")."""
     sliding = gross & np.isfinite(friction)
     if not sliding.any():
         first = gross & (level == level[split:][gross[split:]][0])
@@ -346,8 +340,7 @@ def set_with_se(data: dict, name: str, value, se, dims=(), quantity=None) -> Non
 
 
 def sliding_condition_line(results: xr.Dataset) -> str:
-    """The sliding condition of :func:`ecofmaps.analyze_loops`' results in words
-    (:func:`regime_condition`), with the first cycles where the regime changes."""
+    """The sliding condition of results in words, with the first cycles where it changes."""
     condition, changes = regime_condition(results)
     changes = changes.tolist()
     if not changes:

@@ -1,6 +1,4 @@
-"""Energy wear and Archard's coefficients from the per-cycle results of
-:func:`ecofmaps.analyze_loops` and a scar profile, and the closure of the loops on the scar
-(docs/lab.md)."""
+"""Energy wear, Archard's coefficients and the closure of the loops on the scar (docs/lab.md)."""
 
 from __future__ import annotations
 
@@ -15,8 +13,7 @@ from ecofmaps.model.simulation import fretting_loop
 
 
 def cycle_sum(cycle, value):
-    """Σ of a per-cycle ``value`` over cycles 1 to the last recorded, and its standard error
-    (docs/lab.md, "Energy wear")."""
+    """Σ of a per-cycle ``value`` over cycles 1 to the last recorded, and its standard error."""
     kept = np.isfinite(value)
     n, v = cycle[kept], value[kept]
     if n.size == 0:
@@ -42,8 +39,7 @@ def cumulated_energy(results) -> tuple[float, float]:
 
 
 def _worn_volume(profile: ScarProfile, length) -> tuple[float, float]:
-    """Worn volume [m³] of a line contact of ``length``, or of a round scar (``length`` None),
-    and its standard error."""
+    """Worn volume [m³] of a line of ``length``, or of a round scar (None), and its error."""
     x = np.asarray(profile.position)
     residual = np.asarray(profile.height) - profile.reference_height - profile.reference_slope * x
     width = float(profile.half_width)
