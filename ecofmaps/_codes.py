@@ -1,8 +1,6 @@
 """Integer codes that carry their own words: the regimes and statuses results hold per point,
 stored as integers, each knowing its ``label`` (as printed) and ``reason`` (why a value is NaN)."""
 
-from __future__ import annotations
-
 import enum
 import sys
 import warnings

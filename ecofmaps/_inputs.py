@@ -2,8 +2,6 @@
 float64, concrete inputs checked (traced ones are left to the kernels: NaN and ``INVALID``),
 and broadcasts too large for memory refused before JAX would abort."""
 
-from __future__ import annotations
-
 import contextlib
 import functools
 import inspect

@@ -1,8 +1,6 @@
 """Ctrl-C and SIGTERM stop the command line at the next safe point, writing nothing more
 (standard library only: installed before anything heavy is imported)."""
 
-from __future__ import annotations
-
 import concurrent.futures
 import contextlib
 import signal
@@ -17,9 +15,7 @@ class Stop(threading.Event):
 
     def __init__(self):
         super().__init__()
-        self.signal = None
-        self.notes = []
-        self.deferred = 0
+        self.signal, self.notes, self.deferred = None, [], 0
 
     def note(self):
         """What the stop left (after ``interrupted;``): the first note that says something."""

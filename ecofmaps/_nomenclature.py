@@ -4,8 +4,6 @@ Dataset attributes, plot labels, table columns, the command line's rows and the 
 all read :data:`QUANTITIES`, keyed by the quantity's name in the Python API. ``units`` is the
 SI unit in CF/UDUNITS spelling; ``display_unit`` and ``display_factor`` the tribologist's."""
 
-from __future__ import annotations
-
 import dataclasses
 import math
 
@@ -62,7 +60,6 @@ _PER_METRE = ("m-1", "stiffness_ratio", "1/mm", 1e-3, "positive_or_inf", "stiffn
 
 #: Every quantity by its name in the API.
 QUANTITIES: dict[str, Quantity] = {
-    # --- test conditions and the groove -------------------------------------------------
     "amplitude": _length("displacement amplitude", "Δ*", r"\Delta^*", "positive"),
     "load": _force("normal load", "P", "P", "positive"),
     "stiffness": Quantity(
@@ -85,7 +82,6 @@ QUANTITIES: dict[str, Quantity] = {
     "compliance_ratio": _number(
         "compliance ratio", "λ = P/(S Δ*)", r"\lambda = P/(S\Delta^*)", "non_negative"
     ),
-    # --- loops and the steady state -----------------------------------------------------
     "displacement": _length("applied displacement", "Δ", r"\Delta", "finite"),
     "force": _force("tangential force", "Q", "Q", "finite"),
     "force_ratio": _number("tangential force over normal load", "Q/P", "Q/P", label=""),
@@ -101,7 +97,6 @@ QUANTITIES: dict[str, Quantity] = {
     "ecof": _number("energy coefficient of friction", "μ_E", r"\mu_E", "positive"),
     "ecof_ratio": _number("energy CoF over contact CoF", "μ_E/μ", r"\mu_E/\mu", label=""),
     "regime": _number("regime"),
-    # --- measured loops -----------------------------------------------------------------
     "cycle": _number("cycle number"),
     "cof_max": _number("peak coefficient of friction", "Q*/P", "Q^*/P"),
     "energy_ratio": _number("energy ratio", "A = E_d/(4Δ*Q*)", r"A = E_d/(4\Delta^* Q^*)"),
@@ -120,7 +115,6 @@ QUANTITIES: dict[str, Quantity] = {
     "loop_force": _force("tangential force, centred", "Q", "Q"),
     "stick_residual": _length("root mean square displacement off the stick lines"),
     "quality": _number("'ok', or why the values of the cycle are NaN"),
-    # --- a lab's numbers: the sliding condition, the transition, energy wear -------------
     "opening_ratio": _number("opening ratio", "B = δ*/Δ*", r"B = \delta^*/\Delta^*"),
     "contact_amplitude": _length("contact displacement amplitude", "Δ* - Q*/S", ""),
     "contact_energy_ratio": _number("energy ratio on the contact's displacement", "A_c"),
@@ -144,7 +138,6 @@ QUANTITIES: dict[str, Quantity] = {
     "scar_residual": _length("root mean square height of the implied scar off the profile"),
     "scar_relative_residual": _number("scar residual over the scar depth"),
     "implied_scar": _length("scar implied by the loops", "h(ξ) = ∫g dξ", r"h(\xi)"),
-    # --- the loop read along the stroke -------------------------------------------------
     "position": _length("contact position, centred", "ξ = Δ - Q/S", r"\xi = \Delta - Q/S"),
     "slope": _number("groove slope felt by the contact", "g(ξ)", r"g(\xi)"),
     "felt_profile": _length("felt groove profile, zero at the centre", "h(ξ) = ∫g dξ", r"h(\xi)"),
@@ -160,11 +153,9 @@ QUANTITIES: dict[str, Quantity] = {
     "position_offset": _length("contact position of the loop centre in the recording"),
     "position_min": _length("lower end of the range where both branches slip"),
     "position_max": _length("upper end of the range where both branches slip"),
-    # --- synthetic recordings -----------------------------------------------------------
     "displacement_noise": _length("standard deviation of the displacement noise"),
     "force_noise": _force("standard deviation of the force noise"),
     "displacement_drift": _length("displacement drift per cycle"),
-    # --- correction ---------------------------------------------------------------------
     "correction_factor": _number("contact CoF over energy CoF", "μ/μ_E", r"\mu/\mu_E"),
     "shortcut_error": _number(
         "error of the contact CoF corrected with the D/W shortcut",

@@ -1,8 +1,6 @@
 """Blocks of work run on local threads or on a dask cluster, their results in order as they
 come; Ctrl-C stops at the next block (``docs/parallel.md``)."""
 
-from __future__ import annotations
-
 import asyncio
 import collections
 import concurrent.futures
@@ -84,7 +82,7 @@ class Runner:
         """Whether the tasks run on this machine (they see its files)."""
         return self.scheduler is None and self._given is None
 
-    def __enter__(self) -> Runner:
+    def __enter__(self) -> "Runner":
         if not self.local:
             self._client = self._given
             if self._client is None:
@@ -206,9 +204,8 @@ def worker_limit(processes: bool) -> tuple[int, str]:
 @contextlib.contextmanager
 def _sigint_held():
     """SIGINT blocked in this thread for the block, and for good in the threads it starts."""
-    if threading.current_thread() is not threading.main_thread() or not hasattr(
-        signal, "pthread_sigmask"
-    ):
+    main = threading.current_thread() is threading.main_thread()
+    if not main or not hasattr(signal, "pthread_sigmask"):
         yield
         return
     before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})

@@ -11,8 +11,6 @@ Examples
 1.0385
 """
 
-from __future__ import annotations
-
 import numpy as np
 
 __all__ = [

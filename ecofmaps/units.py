@@ -1,8 +1,6 @@
 """Quantities typed with units (``50um``, ``35MN/m``, ``450 N``: a plain number and a plain
 unit, no arithmetic) read as SI floats with pint, the dimension checked; a bare number is SI."""
 
-from __future__ import annotations
-
 import functools
 import math
 import re

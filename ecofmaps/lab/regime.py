@@ -1,7 +1,5 @@
 """A test's sliding condition and the transition to gross slip (docs/lab.md)."""
 
-from __future__ import annotations
-
 import numpy as np
 import xarray as xr
 

@@ -1,7 +1,5 @@
 """Energy wear, Archard's coefficients and the closure of the loops on the scar (docs/lab.md)."""
 
-from __future__ import annotations
-
 import numpy as np
 import xarray as xr
 
