@@ -147,8 +147,6 @@ class Runner:
     def map(self, function, tasks):
         """``function(*arguments)`` (picklable by name) for each tuple of ``tasks``: the results
         in order as they come, with twice as many calls in flight as workers."""
-        if self._pool is None and self._client is None:
-            raise RuntimeError("a Runner is used within a with block")
         pending = collections.deque()
         tasks = iter(tasks)
         try:

@@ -32,7 +32,6 @@ DIMENSIONS = {
     "dimensionless": ("", "1", "0.8"),
 }
 
-
 #: The values [SI] a quantity typed as a bare number (which is SI) plausibly takes in a
 #: fretting test, (low, high; None: no bound), and the units, in the order tried, that such a
 #: number outside them was probably meant in (:func:`bare_number_warning`).
@@ -47,9 +46,8 @@ PLAUSIBLE = {
 }
 
 #: The values [SI] the model takes (low, high), a rigid rig's inf apart: far wider than any
-#: fretting test, and narrow enough that the model's products of them stay finite (a stiffness
-#: beyond any rig's is only nearer a rigid one). The command line, the explorer and the
-#: Python API (concrete values: :func:`ecofmaps._inputs.check`) refuse a value beyond them.
+#: fretting test, and narrow enough that the model's products of them stay finite. The command
+#: line, the explorer and the Python API (:func:`ecofmaps._inputs.check`) refuse others.
 DOMAIN = {
     **dict.fromkeys(("amplitude", "groove_half_width", "scar_half_width"), (1e-12, 1e3)),
     **dict.fromkeys(("scar_depth", "smoothing"), (0.0, 1e3)),

@@ -25,12 +25,6 @@ _SURE_CYCLES = 3
 _SATURATED_SPREAD = 3.0
 #: Q*/P within this share of the sliding friction has saturated, whatever the spread. [1]
 _SATURATED_SHARE = 1e-3
-#: Why μ_t from Q*/P has no standard error.
-_PEAK_BIASED = (
-    "no GICoF in the results: mu is Q*/P of the first gross-slip cycles, a peak read through "
-    "white noise but not through chatter or a force that rises along the stroke, by amounts "
-    "the results do not hold"
-)
 
 
 def campaign_of(results) -> list:
@@ -97,7 +91,8 @@ def _spring(tests: list, rig_stiffness):
 
 def _ratios(cycles: dict, rig_stiffness):
     """The cycles' ratios, the energy ratio that decides the regime, where the cycles are in
-    gross slip, and whether the force decided that (:func:`_saturated`)."""
+    gross slip, and whether the force decided that: without the rig's stiffness, where Q*/P
+    has reached the sliding friction (docs/lab.md, "Which S")."""
     if rig_stiffness is not None:
         check("rig_stiffness", rig_stiffness, "positive_or_inf", "N/m")
     names = ("amplitude", "max_force", "dissipated_energy")
@@ -105,24 +100,18 @@ def _ratios(cycles: dict, rig_stiffness):
     ratios = loop_ratios(*(cycles[n] for n in names), slip, rig_stiffness)
     ratio = regime_ratio(ratios, rig_stiffness)
     gross = ratio > MINDLIN_ENERGY_RATIO
-    saturated = None if rig_stiffness is not None else _saturated(cycles, gross)
-    if saturated is not None:
-        gross = gross | saturated
-    return ratios, ratio, gross, saturated is not None
-
-
-def _saturated(cycles: dict, gross):
-    """Where Q*/P has reached the sliding friction (docs/lab.md, "Which S"); None without
-    enough cycles surely in gross slip."""
+    if rig_stiffness is not None:
+        return ratios, ratio, gross, False
     cof = cycles["max_force"] / cycles["load"]
     friction = cycles.get("gicof", np.full(cof.shape, np.nan))
     sure = gross & np.isfinite(friction) & np.isfinite(cof)
     if np.count_nonzero(sure) < _SURE_CYCLES:
-        return None
+        return ratios, ratio, gross, False
     mu = float(np.median(friction[sure]))
     spread = 1.4826 * float(np.median(np.abs(cof[sure] - np.median(cof[sure]))))
     with np.errstate(invalid="ignore"):
-        return cof >= mu - max(_SATURATED_SPREAD * spread, _SATURATED_SHARE * mu)
+        saturated = cof >= mu - max(_SATURATED_SPREAD * spread, _SATURATED_SHARE * mu)
+    return ratios, ratio, gross | saturated, True
 
 
 @si_units(rig_stiffness="stiffness")
@@ -153,10 +142,9 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
 
     References
     ----------
-    S. Fouvry, P. Kapsa, L. Vincent (1995), Wear 185, 35-46; L. Vincent, Y. Berthier,
-    M. Godet (1992), ASTM STP 1159, 33-48; Z.R. Zhou, L. Vincent (1995), Wear 181-183,
-    531-536; R.D. Mindlin, H. Deresiewicz (1953), J. Appl. Mech. 20, 327-344 (titles in
-    docs/lab.md).
+    S. Fouvry et al. (1995), Wear 185, 35-46; L. Vincent et al. (1992), ASTM STP 1159, 33-48;
+    Z.R. Zhou, L. Vincent (1995), Wear 181-183, 531-536; R.D. Mindlin, H. Deresiewicz (1953),
+    J. Appl. Mech. 20, 327-344 (titles in docs/lab.md).
 
     Examples
     --------
@@ -221,8 +209,7 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     Raises
     ------
     ValueError
-        When the cycles never cross the transition, naming the amplitudes they span, or are
-        all at one amplitude.
+        When the cycles never cross the transition or are all at one amplitude.
 
     References
     ----------
@@ -306,7 +293,11 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     for name, (value, se) in values.items():
         set_with_se(data, name, value, se, quantity=f"transition_{name}")
     if not np.isfinite(friction[gross]).any():
-        data["mu_se"][2]["comment"] = _PEAK_BIASED
+        data["mu_se"][2]["comment"] = (  # why μ_t from Q*/P has no standard error
+            "no GICoF in the results: mu is Q*/P of the first gross-slip cycles, a peak read "
+            "through white noise but not through chatter or a force that rises along the stroke, "
+            "by amounts the results do not hold"
+        )
     return xr.Dataset(data)
 
 

@@ -116,9 +116,8 @@ def energy_wear(results, profile, length=None, contact="line") -> xr.Dataset:
     length : float or list of float
         Length of the line contact; none for a sphere. [m]
     contact : {'line', 'sphere'}
-        ``'line'``: :math:`V = L\int d\,dx`; ``'sphere'`` (a round scar):
-        :math:`V = \pi\int_{-W}^{W}|x|\,d(x)\,dx`, the worn depth :math:`d` turned about
-        the scar's axis, the two sides averaged.
+        ``'line'``, :math:`V = L\int d\,dx`, or ``'sphere'``, a round scar of volume
+        :math:`V = \pi\int_{-W}^{W}|x|\,d(x)\,dx` (each side turned about its axis, averaged).
 
     Returns
     -------
@@ -139,10 +138,9 @@ def energy_wear(results, profile, length=None, contact="line") -> xr.Dataset:
 
     References
     ----------
-    S. Fouvry, P. Kapsa, L. Vincent (1996), Wear 200, 186-205; S. Fouvry, T. Liskiewicz,
-    P. Kapsa, S. Hannel, E. Sauger (2003), Wear 255, 287-298; J.F. Archard (1953), J. Appl.
-    Phys. 24, 981-988; G.B. Thomas et al. (2010), Thomas' Calculus, §6.2 (titles in
-    docs/lab.md).
+    S. Fouvry et al. (1996), Wear 200, 186-205; S. Fouvry et al. (2003), Wear 255, 287-298;
+    J.F. Archard (1953), J. Appl. Phys. 24, 981-988; G.B. Thomas et al. (2010), Thomas'
+    Calculus, §6.2 (titles in docs/lab.md).
 
     Examples
     --------
@@ -221,21 +219,11 @@ def _reading(results, resolved):
     return results.sel(cycle=common[-1]), resolved.sel(cycle=common[-1])
 
 
-def _branch_force(displacement, loop_displacement, loop_force):
-    """The force of the loop (Δ, Q) at ``displacement``, on the branch each point moves along."""
-    top = int(np.nanargmax(loop_displacement))
-    rising = np.interp(displacement, loop_displacement[: top + 1], loop_force[: top + 1])
-    falling = np.interp(displacement, loop_displacement[top:][::-1], loop_force[top:][::-1])
-    step = np.diff(displacement, append=displacement[-1] + (displacement[-1] - displacement[-2]))
-    return np.where(step >= 0, rising, falling)
-
-
 @si_units(rig_stiffness="stiffness")
 def loop_scar_closure(results, resolved, profile, rig_stiffness=None) -> xr.Dataset:
     r"""How well a test's last loop and its loops' felt groove close on the measured scar.
 
-    On the last cycle with a GICoF and a reading along the stroke: docs/lab.md, "Loop-scar
-    closure".
+    On the last cycle with a GICoF and a reading along the stroke (docs/lab.md).
 
     Parameters
     ----------
@@ -303,7 +291,12 @@ def loop_scar_closure(results, resolved, profile, rig_stiffness=None) -> xr.Data
     model_displacement, model_force = (np.asarray(v, dtype=np.float64) for v in model)
     kept = np.isfinite(loop.loop_displacement.values) & np.isfinite(loop.loop_force.values)
     displacement, force = loop.loop_displacement.values[kept], loop.loop_force.values[kept]
-    off = force - _branch_force(displacement, model_displacement, model_force)
+    # the model's force at each point's displacement, on the branch the point moves along
+    top = int(np.nanargmax(model_displacement))
+    rising = np.interp(displacement, model_displacement[: top + 1], model_force[: top + 1])
+    falling = np.interp(displacement, model_displacement[top:][::-1], model_force[top:][::-1])
+    step = np.diff(displacement, append=displacement[-1] + (displacement[-1] - displacement[-2]))
+    off = force - np.where(step >= 0, rising, falling)
     implied = reading.felt_profile.values[np.isfinite(reading.felt_profile.values)]
     height = np.interp(position, trace, np.asarray(profile.height))
     implied = implied + np.mean(height - implied)
