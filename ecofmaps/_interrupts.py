@@ -1,7 +1,6 @@
 """Ctrl-C and SIGTERM stop the command line at the next safe point, writing nothing more
 (standard library only: installed before anything heavy is imported)."""
 
-import concurrent.futures
 import contextlib
 import signal
 import threading
@@ -50,6 +49,8 @@ def check_interrupted() -> None:
 def interrupted_waiting(function):
     """``function()`` in a thread of its own while this one acts on a stop within 0.1 s (a
     handler waits for a call into C, such as XLA's compiling, to return)."""
+    import concurrent.futures  # not when the command line starts
+
     check_interrupted()
     pool = concurrent.futures.ThreadPoolExecutor(1)
     future = pool.submit(function)

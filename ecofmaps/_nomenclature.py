@@ -212,8 +212,7 @@ def with_se(name: str, value: float, se: float) -> str:
 
 
 def texts_with_se(found, names, quantity: str = "{}") -> list[tuple[str, str]]:
-    """Each of ``names`` in ``found`` as (its quantity ``quantity.format(name)``, its
-    :func:`with_se` text with ``found[name + '_se']``)."""
+    """Each of ``names`` in ``found`` as (``quantity.format(name)``, its :func:`with_se` text)."""
     texts = []
     for name in names:
         q = quantity.format(name)

@@ -61,9 +61,8 @@ DOMAIN = {
 
 
 def bare_number_warning(name: str, text: str, kind: str) -> str | None:
-    """Why ``text``, a bare (SI) number for quantity ``name`` of ``kind``, is implausible
-    (:data:`PLAUSIBLE`), with the unit probably meant (``'50 is 50 m; did you mean 50um?'``);
-    None if it has a unit or is plausible."""
+    """Why ``text``, a bare (SI) number for ``name``, is implausible (:data:`PLAUSIBLE`), with the
+    unit probably meant (``'50 is 50 m; did you mean 50um?'``); None if it is plausible."""
     if name not in PLAUSIBLE:
         return None
     try:
