@@ -1,6 +1,5 @@
-"""Input handling shared by the public entry points: pint Quantities to SI by parameter name,
-float64, concrete inputs checked (traced ones are left to the kernels: NaN and ``INVALID``),
-and broadcasts too large for memory refused before JAX would abort."""
+"""The public entry points' inputs: pint Quantities to SI by parameter name, float64, concrete
+inputs checked (tracers left to the kernels' NaN and ``INVALID``), huge broadcasts refused."""
 
 import contextlib
 import functools

@@ -43,8 +43,7 @@ def _number(words, symbol="", latex="", valid=None, **extra) -> Quantity:
     return Quantity(words, symbol, latex, valid=valid, **extra)
 
 
-#: Valid ranges: name -> (test on an array, in words with ``{name}`` for the quantity).
-#: Every range rejects NaN; only ``positive_or_inf`` admits +inf.
+#: Valid ranges: name -> (test on an array, words); each rejects NaN, all but one +inf.
 RANGES = {
     "positive": (lambda a: (a > 0) & (a < math.inf), "0 < {name} < inf"),
     "positive_or_inf": (lambda a: a > 0, "0 < {name} <= inf"),

@@ -19,15 +19,13 @@ from ecofmaps._interrupts import check_interrupted
 #: Seconds to wait for a dask scheduler given by address to answer.
 CONNECT_TIMEOUT = 5.0
 
-#: Memory a worker process of a local cluster needs: its interpreter with NumPy, JAX and
-#: dask loaded, and a block of a recording. [byte]
+#: Memory a local cluster's worker process needs: NumPy, JAX, dask and a block loaded. [byte]
 WORKER_MEMORY = 512 * 2**20
 
 #: Seconds between looks at a running task (and at Ctrl-C).
 _POLL = 0.01
 
-#: The attribute of a dask array that holds the array-like it was made of, when that reads a
-#: range of samples itself (see :func:`stretch`).
+#: The attribute of a dask array holding its source when that reads samples (:func:`stretch`).
 SOURCE = "ecofmaps_source"
 
 
@@ -64,23 +62,18 @@ def _call(function, arguments):
 
 
 class Runner:
-    """Run tasks, a bounded number at a time, in a ``with`` block: on ``workers`` threads, on
-    a new ``LocalCluster`` (``cluster=True``), on the ``scheduler`` at an address, or on a
-    connected ``client`` (left open)."""
+    """Run tasks, a bounded number at a time, in a ``with`` block: on ``workers`` threads, a new
+    ``LocalCluster`` (``cluster=True``), a ``scheduler``'s address or a ``client`` (left open)."""
 
     def __init__(self, workers=None, *, scheduler=None, cluster=False, client=None, timeout=None):
         if scheduler is not None and cluster:
             raise ValueError("give a scheduler address or start a local cluster, not both")
-        check_workers(workers, processes=cluster, here=scheduler is None and client is None)
+        self.local = scheduler is None and client is None  # the tasks see this machine's files
+        check_workers(workers, processes=cluster, here=self.local)
         self.scheduler, self.cluster, self.timeout = scheduler, cluster, timeout
         self.workers = int(workers) if workers else (1 if scheduler else os.cpu_count() or 1)
         self._given = client
         self._client = self._cluster = self._pool = None
-
-    @property
-    def local(self) -> bool:
-        """Whether the tasks run on this machine (they see its files)."""
-        return self.scheduler is None and self._given is None
 
     def __enter__(self) -> "Runner":
         if not self.local:

@@ -2,14 +2,7 @@ r"""The paper ecofmaps implements: its citation, its worked examples and its fig
 
 Jin, Sun and Shipway (2016) add the rig's compliance to the wear-scar interaction model of
 Mulvihill et al. Every value here is the paper's, in SI units, and every other module reads
-it from here (``docs/model.md``).
-
-Examples
---------
->>> from ecofmaps import energy_cof, paper
->>> round(float(energy_cof(**paper.EXAMPLE_2) / paper.EXAMPLE_2["mu"]), 4)  # Section 3
-1.0385
-"""
+it from here (``docs/model.md``)."""
 
 import numpy as np
 

@@ -32,9 +32,8 @@ DIMENSIONS = {
     "dimensionless": ("", "1", "0.8"),
 }
 
-#: The values [SI] a quantity typed as a bare number (which is SI) plausibly takes in a
-#: fretting test, (low, high; None: no bound), and the units, in the order tried, that such a
-#: number outside them was probably meant in (:func:`bare_number_warning`).
+#: The values [SI] a bare (SI) number plausibly takes in a fretting test (low, high; None: no
+#: bound), and the units, in order, it was probably meant in if not (:func:`bare_number_warning`).
 PLAUSIBLE = {
     "amplitude": (0.1e-6, 5e-3, ("um", "mm")),
     "groove_half_width": (0.1e-6, 5e-3, ("um", "mm")),
@@ -97,13 +96,11 @@ _NAMES = rf"{_NAME}(?:(?:\s*[*/]\s*|\s+){_NAME})*"
 _TERM = rf"(?:{_NAME}|\(\s*{_NAMES}\s*\))"
 _UNIT = rf"/?\s*{_TERM}(?:(?:\s*[*/]\s*|\s+){_TERM})*"
 
-#: The longest text a quantity may be (a unit's name is parsed in a time that grows faster
-#: than its length). [1]
+#: The longest text a quantity may be (parsing a unit's name takes superlinear time). [1]
 TEXT_LIMIT = 64
 
-#: What a quantity's text may be: a plain number and an optional plain unit ('25um',
-#: '3.3 MN/m', '0.08/um', 'inf'); no arithmetic for pint to evaluate ('9**9**9 N' would take
-#: forever, '10**400 N' overflows).
+#: What a quantity's text may be: a plain number and an optional plain unit ('25um', '3.3 MN/m',
+#: '0.08/um', 'inf'); no arithmetic for pint ('9**9**9 N' takes forever, '10**400 N' overflows).
 PLAIN_QUANTITY = re.compile(rf"\s*(?P<number>{_NUMBER})\s*(?P<unit>{_UNIT})?\s*")
 
 

@@ -90,9 +90,8 @@ def _spring(tests: list, rig_stiffness):
 
 
 def _ratios(cycles: dict, rig_stiffness):
-    """The cycles' ratios, the energy ratio that decides the regime, where the cycles are in
-    gross slip, and whether the force decided that: without the rig's stiffness, where Q*/P
-    has reached the sliding friction (docs/lab.md, "Which S")."""
+    """The cycles' ratios, the regime's energy ratio, where they are in gross slip, and whether
+    the force decided it (without S, where Q*/P reached the sliding friction: docs/lab.md)."""
     if rig_stiffness is not None:
         check("rig_stiffness", rig_stiffness, "positive_or_inf", "N/m")
     names = ("amplitude", "max_force", "dissipated_energy")
@@ -133,12 +132,10 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
     Returns
     -------
     condition : xarray.Dataset
-        Over ``cycle``: ``energy_ratio`` :math:`A = E_d/(4\Delta^*Q^*)`, ``opening_ratio``
-        :math:`B = \delta^*/\Delta^*`; ``contact_amplitude`` :math:`\Delta^* - Q^*/S` [m],
-        ``contact_energy_ratio``, ``contact_opening_ratio`` (NaN without :math:`S`);
-        ``gross_slip`` (1, 0, or NaN without an energy ratio). Attributes
-        ``sliding_condition`` (``'partial slip'``, ``'mixed slip'`` or ``'gross slip'``) and
-        ``regime_changes_at`` (the cycles where the regime changes).
+        Over ``cycle``: ``energy_ratio`` :math:`A`, ``opening_ratio`` :math:`B`,
+        ``contact_amplitude`` [m], ``contact_energy_ratio``, ``contact_opening_ratio`` (NaN
+        without :math:`S`), ``gross_slip`` (1, 0, NaN); attributes ``sliding_condition``
+        (``'partial slip'``, ``'mixed slip'`` or ``'gross slip'``) and ``regime_changes_at``.
 
     References
     ----------
@@ -148,9 +145,8 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
 
     Examples
     --------
-    >>> import numpy as np, ecofmaps
-    >>> displacement, force = ecofmaps.fretting_loop(50e-6, 450.0, 35e6, 0.8, 0.0)
-    >>> results = ecofmaps.analyze_loops(np.asarray(displacement), np.asarray(force), 450.0)
+    >>> import ecofmaps
+    >>> results = ecofmaps.analyze_loops(*ecofmaps.fretting_loop(50e-6, 450.0, 35e6, 0.8, 0), 450.0)
     >>> condition = ecofmaps.sliding_condition(results, rig_stiffness=35e6)
     >>> condition.attrs["sliding_condition"], round(float(condition.contact_energy_ratio[0]), 3)
     ('gross slip', 1.0)

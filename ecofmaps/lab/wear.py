@@ -16,9 +16,9 @@ def cycle_sum(cycle, value):
     n, v = cycle[kept], value[kept]
     if n.size == 0:
         raise ValueError("no cycle has a value to sum: every one is NaN (skipped or flagged)")
-    if np.any(np.diff(n) <= 0) or n[0] < 1:
-        raise ValueError("results: the cycle numbers must be 1 or more and increasing")
     gaps = np.diff(n)
+    if np.any(gaps <= 0) or n[0] < 1:
+        raise ValueError("results: the cycle numbers must be 1 or more and increasing")
     weight = np.concatenate([gaps, [0.0]]) / 2 + np.concatenate([[0.0], gaps]) / 2
     weight[[0, -1]] += 0.5  # the end cycles count whole
     weight[0] += n[0] - 1
@@ -285,10 +285,9 @@ def loop_scar_closure(results, resolved, profile, rig_stiffness=None) -> xr.Data
         )
     load = float(loop["normal_load" if "normal_load" in loop else "load"])
     mu, peak = float(loop.gicof), float(loop.max_force)
-    model = fretting_loop(
+    model_displacement, model_force = fretting_loop(
         float(loop.amplitude), load, rig_stiffness, mu, profile=profile, mapping="physical"
     )
-    model_displacement, model_force = (np.asarray(v, dtype=np.float64) for v in model)
     kept = np.isfinite(loop.loop_displacement.values) & np.isfinite(loop.loop_force.values)
     displacement, force = loop.loop_displacement.values[kept], loop.loop_force.values[kept]
     # the model's force at each point's displacement, on the branch the point moves along
