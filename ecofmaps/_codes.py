@@ -21,8 +21,7 @@ class Code(enum.IntEnum):
 
     def __new__(cls, value: int, label: str, reason: str = ""):
         member = int.__new__(cls, value)
-        member._value_ = value
-        member.label, member.reason = label, reason
+        member._value_, member.label, member.reason = value, label, reason
         return member
 
     @classmethod
@@ -47,9 +46,8 @@ def warn_nan(values, codes, kind: type[Code], quantity: str) -> None:
     nan = np.isnan(np.asarray(values))
     if not nan.any():
         return
-    codes = np.asarray(codes)
     for code in kind:
-        count = int(np.count_nonzero(nan & (codes == code)))
+        count = int(np.count_nonzero(nan & (np.asarray(codes) == code)))
         if count and code.reason:
             warn(
                 f"{quantity} is NaN at {count} of {nan.size} point(s): {code.reason}", RegimeWarning

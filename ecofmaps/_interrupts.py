@@ -88,8 +88,7 @@ def interrupts_stop_writes():
         INTERRUPTED.set()
 
     INTERRUPTED.clear()
-    INTERRUPTED.signal = None
-    INTERRUPTED.notes = interrupted.notes
+    INTERRUPTED.signal, INTERRUPTED.notes = None, interrupted.notes
     ours = [number for number, before in previous.items() if before not in (signal.SIG_IGN, None)]
     for number in ours:
         signal.signal(number, handler)

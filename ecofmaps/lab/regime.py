@@ -94,9 +94,8 @@ def _ratios(cycles: dict, rig_stiffness):
     the force decided it (without S, where Q*/P reached the sliding friction: docs/lab.md)."""
     if rig_stiffness is not None:
         check("rig_stiffness", rig_stiffness, "positive_or_inf", "N/m")
-    names = ("amplitude", "max_force", "dissipated_energy")
-    slip = cycles.get("slip_amplitude", np.nan)
-    ratios = loop_ratios(*(cycles[n] for n in names), slip, rig_stiffness)
+    values = (cycles[n] for n in ("amplitude", "max_force", "dissipated_energy"))
+    ratios = loop_ratios(*values, cycles.get("slip_amplitude", np.nan), rig_stiffness)
     ratio = regime_ratio(ratios, rig_stiffness)
     gross = ratio > MINDLIN_ENERGY_RATIO
     if rig_stiffness is not None:
@@ -311,8 +310,7 @@ def _sliding_friction(gross, level, split, cof, friction):
         return float(means[0]), np.nan
     from scipy.stats import t  # 0.4 s to import: when a transition is sought
 
-    # ±2 se: Student's 95 % interval of the mean of n
-    widen = float(t.ppf(0.975, means.size - 1)) / 2.0
+    widen = float(t.ppf(0.975, means.size - 1)) / 2.0  # ±2 se: Student's 95 % interval
     return float(np.mean(means)), float(widen * np.std(means, ddof=1) / np.sqrt(means.size))
 
 

@@ -42,14 +42,13 @@ def _worn_volume(profile: ScarProfile, length) -> tuple[float, float]:
     residual = np.asarray(profile.height) - profile.reference_height - profile.reference_slope * x
     width = float(profile.half_width)
     inside = np.abs(x) <= width
-    scale = 1.0 if length is None else length
     if length is not None:
-        weight, total, volume = np.ones(x.size), 2 * width, float(profile.worn_area)
+        weight, total, volume, scale = np.ones(x.size), 2 * width, float(profile.worn_area), length
     else:  # the volume of revolution of each side's depth, the two averaged
         edge = np.interp([-width, width], x, residual)
         at = np.concatenate([[-width], x[inside], [width]])
         depth = np.maximum(-np.concatenate([edge[:1], residual[inside], edge[1:]]), 0.0)
-        weight, total = np.pi * np.abs(x), np.pi * width**2
+        weight, total, scale = np.pi * np.abs(x), np.pi * width**2, 1.0
         volume = float(np.pi * np.trapezoid(np.abs(at) * depth, at))
     shoulders = residual[np.abs(x) > 2 * width]
     if shoulders.size < 5:
