@@ -46,8 +46,9 @@ def warn_nan(values, codes, kind: type[Code], quantity: str) -> None:
     nan = np.isnan(np.asarray(values))
     if not nan.any():
         return
+    codes = np.asarray(codes)
     for code in kind:
-        count = int(np.count_nonzero(nan & (np.asarray(codes) == code)))
+        count = int(np.count_nonzero(nan & (codes == code)))
         if count and code.reason:
             warn(
                 f"{quantity} is NaN at {count} of {nan.size} point(s): {code.reason}", RegimeWarning

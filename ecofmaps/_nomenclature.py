@@ -237,5 +237,4 @@ def transition_texts(found) -> list[tuple[str, str]]:
 
 def within(name: str, value):
     """Boolean array: where ``value`` lies in the valid range of ``name``."""
-    test, _ = RANGES[QUANTITIES[name].valid]
-    return test(value)
+    return RANGES[QUANTITIES[name].valid][0](value)
