@@ -1,9 +1,8 @@
 """ecofmaps: friction from fretting loops, corrected for rig compliance and wear-scar shape.
 
-The public API in SI units (m, N, N/m, J), or pint Quantities: the README, and the paper it
-implements (:mod:`ecofmaps.paper`). Names are imported on first use, so the command line starts
-(and answers Ctrl-C) before JAX, xarray or matplotlib are loaded.
-"""
+The public API in SI units (m, N, N/m, J) or pint Quantities: the README and the paper
+(:mod:`ecofmaps.paper`). Names are imported on first use: the command line starts (and answers
+Ctrl-C) before JAX, xarray or matplotlib load."""
 
 from ecofmaps._lazy import lazy_names
 from ecofmaps._version import __version__ as __version__

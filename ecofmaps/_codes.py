@@ -1,8 +1,5 @@
 """Integer codes that carry their own words: the regimes and statuses results hold per point,
-stored as integers, each knowing its ``label`` (as printed) and ``reason`` (why a value is NaN).
-"""
-
-from __future__ import annotations
+stored as integers, each knowing its ``label`` (as printed) and ``reason`` (why a value is NaN)."""
 
 import enum
 import sys
@@ -24,9 +21,7 @@ class Code(enum.IntEnum):
 
     def __new__(cls, value: int, label: str, reason: str = ""):
         member = int.__new__(cls, value)
-        member._value_ = value
-        member.label = label
-        member.reason = reason
+        member._value_, member.label, member.reason = value, label, reason
         return member
 
     @classmethod

@@ -1,9 +1,5 @@
-"""Input handling shared by the public entry points: pint Quantities to SI by parameter name,
-float64, concrete inputs checked (traced ones are left to the kernels: NaN and ``INVALID``),
-and broadcasts too large for memory refused before JAX would abort.
-"""
-
-from __future__ import annotations
+"""The public entry points' inputs: pint Quantities to SI by parameter name, float64, concrete
+inputs checked (tracers left to the kernels' NaN and ``INVALID``), huge broadcasts refused."""
 
 import contextlib
 import functools
@@ -70,8 +66,8 @@ def _clashes(shapes: list):
 
 
 def si_units(function=None, **kinds):
-    """``function`` taking pint Quantities, in SI by parameter name (or the quantity ``kinds``
-    names), and refusing a broadcast of them too large for memory."""
+    """``function`` taking pint Quantities, in SI by parameter name (or by ``kinds``), and
+    refusing a broadcast of them too large for memory."""
     if function is None:
         return functools.partial(si_units, **kinds)
     parameters = inspect.signature(function)

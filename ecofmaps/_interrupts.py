@@ -1,8 +1,6 @@
 """Ctrl-C and SIGTERM stop the command line at the next safe point, writing nothing more
 (standard library only: installed before anything heavy is imported)."""
 
-from __future__ import annotations
-
 import contextlib
 import signal
 import threading
@@ -12,14 +10,11 @@ STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
 class Stop(threading.Event):
-    """Set once a stop signal came: the first ``signal``, and the ``notes`` that tell what a
-    stop left (:func:`add_stop_note`)."""
+    """Set once a stop signal came: the first ``signal``, and ``notes`` (:func:`add_stop_note`)."""
 
     def __init__(self):
         super().__init__()
-        self.signal = None
-        self.notes = []
-        self.deferred = 0
+        self.signal, self.notes, self.deferred = None, [], 0
 
     def note(self):
         """What the stop left (after ``interrupted;``): the first note that says something."""
@@ -54,24 +49,16 @@ def check_interrupted() -> None:
 def interrupted_waiting(function):
     """``function()`` in a thread of its own while this one acts on a stop within 0.1 s (a
     handler waits for a call into C, such as XLA's compiling, to return)."""
+    import concurrent.futures  # not when the command line starts
+
     check_interrupted()
-    outcome = []
-
-    def run():
-        try:
-            outcome.append((function(), None))
-        except BaseException as error:  # raised in the waiting thread
-            outcome.append((None, error))
-
-    thread = threading.Thread(target=run)
-    thread.start()
-    while thread.is_alive():
-        thread.join(0.1)
+    pool = concurrent.futures.ThreadPoolExecutor(1)
+    future = pool.submit(function)
+    pool.shutdown(wait=False)
+    while not future.done():
+        concurrent.futures.wait([future], 0.1)
         check_interrupted()
-    result, error = outcome[0]
-    if error is not None:
-        raise error
-    return result
+    return future.result()  # raised in the waiting thread, if it raised
 
 
 @contextlib.contextmanager
@@ -101,8 +88,7 @@ def interrupts_stop_writes():
         INTERRUPTED.set()
 
     INTERRUPTED.clear()
-    INTERRUPTED.signal = None
-    INTERRUPTED.notes = interrupted.notes
+    INTERRUPTED.signal, INTERRUPTED.notes = None, interrupted.notes
     ours = [number for number, before in previous.items() if before not in (signal.SIG_IGN, None)]
     for number in ours:
         signal.signal(number, handler)

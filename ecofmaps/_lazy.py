@@ -1,8 +1,5 @@
 """The public names of a package, imported from their modules on first use (PEP 562): the
-command line starts without loading JAX, xarray, pint or SciPy.
-"""
-
-from __future__ import annotations
+command line starts without loading JAX, xarray, pint or SciPy."""
 
 import importlib
 import sys

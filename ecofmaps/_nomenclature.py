@@ -2,18 +2,7 @@ r"""Every quantity ecofmaps names, once: symbol, long name, units, display, rang
 
 Dataset attributes, plot labels, table columns, the command line's rows and the range checks
 all read :data:`QUANTITIES`, keyed by the quantity's name in the Python API. ``units`` is the
-SI unit in CF/UDUNITS spelling; ``display_unit`` and ``display_factor`` the tribologist's.
-
-Examples
---------
->>> from ecofmaps._nomenclature import QUANTITIES, attrs, column
->>> attrs("slip_amplitude")
-{'long_name': 'slip amplitude δ*', 'units': 'm'}
->>> column("stiffness"), QUANTITIES["stiffness"].display_factor
-('stiffness_MN_per_m', 1e-06)
-"""
-
-from __future__ import annotations
+SI unit in CF/UDUNITS spelling; ``display_unit`` and ``display_factor`` the tribologist's."""
 
 import dataclasses
 import math
@@ -54,8 +43,7 @@ def _number(words, symbol="", latex="", valid=None, **extra) -> Quantity:
     return Quantity(words, symbol, latex, valid=valid, **extra)
 
 
-#: Valid ranges: name -> (test on an array, in words with ``{name}`` for the quantity).
-#: Every range rejects NaN; only ``positive_or_inf`` admits +inf.
+#: Valid ranges: name -> (test on an array, words); each rejects NaN, all but one +inf.
 RANGES = {
     "positive": (lambda a: (a > 0) & (a < math.inf), "0 < {name} < inf"),
     "positive_or_inf": (lambda a: a > 0, "0 < {name} <= inf"),
@@ -63,14 +51,14 @@ RANGES = {
     "finite": (lambda a: (a > -math.inf) & (a < math.inf), "-inf < {name} < inf"),
 }
 
-# Units of energy wear: SI, kind, display unit, factor.
+# Units of energy wear, and of S/P: SI, kind, display unit, factor (range, label, axis unit).
 _JOULES = ("J", "energy", "J")
 _PER_JOULE = ("m3 J-1", "wear_rate", "µm³/J", 1e18)
 _PER_NEWTON_METRE = ("m3 N-1 m-1", "archard", "mm³/(N·m)", 1e9)
+_PER_METRE = ("m-1", "stiffness_ratio", "1/mm", 1e-3, "positive_or_inf", "stiffness over load")
 
 #: Every quantity by its name in the API.
 QUANTITIES: dict[str, Quantity] = {
-    # --- test conditions and the groove -------------------------------------------------
     "amplitude": _length("displacement amplitude", "Δ*", r"\Delta^*", "positive"),
     "load": _force("normal load", "P", "P", "positive"),
     "stiffness": Quantity(
@@ -88,21 +76,11 @@ QUANTITIES: dict[str, Quantity] = {
     "shape": _number("scar shape"),
     "groove": _number("groove: the scar profile, or the parabola of the same D/W (eq. 11)"),
     "stiffness_ratio": Quantity(
-        "rig stiffness over normal load",
-        "S/P",
-        "S/P",
-        "m-1",
-        "stiffness_ratio",
-        "1/mm",
-        1e-3,
-        "positive_or_inf",
-        label="stiffness over load",
-        axis_unit="(MN/m)/kN = 1/mm",
+        "rig stiffness over normal load", "S/P", "S/P", *_PER_METRE, "(MN/m)/kN = 1/mm"
     ),
     "compliance_ratio": _number(
         "compliance ratio", "λ = P/(S Δ*)", r"\lambda = P/(S\Delta^*)", "non_negative"
     ),
-    # --- loops and the steady state -----------------------------------------------------
     "displacement": _length("applied displacement", "Δ", r"\Delta", "finite"),
     "force": _force("tangential force", "Q", "Q", "finite"),
     "force_ratio": _number("tangential force over normal load", "Q/P", "Q/P", label=""),
@@ -118,7 +96,6 @@ QUANTITIES: dict[str, Quantity] = {
     "ecof": _number("energy coefficient of friction", "μ_E", r"\mu_E", "positive"),
     "ecof_ratio": _number("energy CoF over contact CoF", "μ_E/μ", r"\mu_E/\mu", label=""),
     "regime": _number("regime"),
-    # --- measured loops -----------------------------------------------------------------
     "cycle": _number("cycle number"),
     "cof_max": _number("peak coefficient of friction", "Q*/P", "Q^*/P"),
     "energy_ratio": _number("energy ratio", "A = E_d/(4Δ*Q*)", r"A = E_d/(4\Delta^* Q^*)"),
@@ -137,7 +114,6 @@ QUANTITIES: dict[str, Quantity] = {
     "loop_force": _force("tangential force, centred", "Q", "Q"),
     "stick_residual": _length("root mean square displacement off the stick lines"),
     "quality": _number("'ok', or why the values of the cycle are NaN"),
-    # --- a lab's numbers: the sliding condition, the transition, energy wear -------------
     "opening_ratio": _number("opening ratio", "B = δ*/Δ*", r"B = \delta^*/\Delta^*"),
     "contact_amplitude": _length("contact displacement amplitude", "Δ* - Q*/S", ""),
     "contact_energy_ratio": _number("energy ratio on the contact's displacement", "A_c"),
@@ -161,7 +137,6 @@ QUANTITIES: dict[str, Quantity] = {
     "scar_residual": _length("root mean square height of the implied scar off the profile"),
     "scar_relative_residual": _number("scar residual over the scar depth"),
     "implied_scar": _length("scar implied by the loops", "h(ξ) = ∫g dξ", r"h(\xi)"),
-    # --- the loop read along the stroke -------------------------------------------------
     "position": _length("contact position, centred", "ξ = Δ - Q/S", r"\xi = \Delta - Q/S"),
     "slope": _number("groove slope felt by the contact", "g(ξ)", r"g(\xi)"),
     "felt_profile": _length("felt groove profile, zero at the centre", "h(ξ) = ∫g dξ", r"h(\xi)"),
@@ -177,11 +152,9 @@ QUANTITIES: dict[str, Quantity] = {
     "position_offset": _length("contact position of the loop centre in the recording"),
     "position_min": _length("lower end of the range where both branches slip"),
     "position_max": _length("upper end of the range where both branches slip"),
-    # --- synthetic recordings -----------------------------------------------------------
     "displacement_noise": _length("standard deviation of the displacement noise"),
     "force_noise": _force("standard deviation of the force noise"),
     "displacement_drift": _length("displacement drift per cycle"),
-    # --- correction ---------------------------------------------------------------------
     "correction_factor": _number("contact CoF over energy CoF", "μ/μ_E", r"\mu/\mu_E"),
     "shortcut_error": _number(
         "error of the contact CoF corrected with the D/W shortcut",
@@ -194,23 +167,18 @@ QUANTITIES: dict[str, Quantity] = {
 
 
 def attrs(name: str, comments=None) -> dict:
-    """The netCDF attributes ``long_name`` and ``units`` of quantity ``name``, and its
-    ``comment`` if ``comments`` (name -> how a module reads it) holds one."""
+    """The netCDF ``long_name`` and ``units`` of ``name``, and its ``comment`` in ``comments``."""
     described = {"long_name": QUANTITIES[name].long_name, "units": QUANTITIES[name].units}
     return described | ({"comment": comments[name]} if name in (comments or {}) else {})
 
 
 def axis_label(name: str, plain: bool = False) -> str:
-    r"""A plot axis label: words, symbol and display unit, ``Slip amplitude $\delta^*$ [µm]``
-    (``Slip amplitude δ* [µm]`` if ``plain``, for a page's plots)."""
+    r"""A plot axis label, ``Slip amplitude $\delta^*$ [µm]`` (``δ*`` if ``plain``)."""
     quantity = QUANTITIES[name]
     words = quantity.words if quantity.label is None else quantity.label
-    parts = [words[:1].upper() + words[1:]] if words else []
     mark = quantity.symbol if plain else quantity.latex and f"${quantity.latex}$"
-    if mark:
-        parts.append(mark)
     unit = quantity.axis_unit or quantity.display_unit or "1"
-    return " ".join(parts) + f" [{unit}]"
+    return " ".join(part for part in (words[:1].upper() + words[1:], mark, f"[{unit}]") if part)
 
 
 def column(name: str) -> str:
@@ -225,9 +193,8 @@ def display(name: str, value) -> np.ndarray:
 
 
 def with_se(name: str, value: float, se: float) -> str:
-    """``value ± se`` of quantity ``name`` [SI] in its display unit, as a measurement is written:
-    the standard error to two significant digits and the value to the same decimal place (to
-    four significant digits where the error is zero or unknown).
+    """``value ± se`` of quantity ``name`` [SI] in its display unit: the error to two
+    significant digits, the value to its decimal place (else to four significant digits).
 
     >>> with_se("transition_amplitude", 16.1959e-6, 0.347947e-6), with_se("mu", 0.8, 0.0)
     ('16.20 ± 0.35 µm', '0.8000 ± 0')
@@ -244,8 +211,7 @@ def with_se(name: str, value: float, se: float) -> str:
 
 
 def texts_with_se(found, names, quantity: str = "{}") -> list[tuple[str, str]]:
-    """Each of ``names`` in ``found`` as (its quantity ``quantity.format(name)``, its
-    :func:`with_se` text with ``found[name + '_se']``)."""
+    """Each of ``names`` in ``found`` as (``quantity.format(name)``, its :func:`with_se` text)."""
     texts = []
     for name in names:
         q = quantity.format(name)
@@ -258,8 +224,7 @@ TRANSITION = ("amplitude", "contact_amplitude", "mu")
 
 
 def transition_texts(found) -> list[tuple[str, str]]:
-    """:func:`texts_with_se` of :func:`ecofmaps.transition`'s ``found``: Δ_t, δ_t (without the
-    rig's stiffness, what it needs) and μ_t."""
+    """:func:`texts_with_se` of :func:`ecofmaps.transition`'s Δ_t, δ_t (or what it needs), μ_t."""
     texts = texts_with_se(found, TRANSITION, "transition_{}")
     if np.isnan(float(found.contact_amplitude)):
         texts[1] = (
@@ -272,5 +237,4 @@ def transition_texts(found) -> list[tuple[str, str]]:
 
 def within(name: str, value):
     """Boolean array: where ``value`` lies in the valid range of ``name``."""
-    test, _ = RANGES[QUANTITIES[name].valid]
-    return test(value)
+    return RANGES[QUANTITIES[name].valid][0](value)

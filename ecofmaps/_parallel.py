@@ -1,8 +1,5 @@
 """Blocks of work run on local threads or on a dask cluster, their results in order as they
-come; Ctrl-C stops at the next block (``docs/parallel.md``).
-"""
-
-from __future__ import annotations
+come; Ctrl-C stops at the next block (``docs/parallel.md``)."""
 
 import asyncio
 import collections
@@ -22,15 +19,13 @@ from ecofmaps._interrupts import check_interrupted
 #: Seconds to wait for a dask scheduler given by address to answer.
 CONNECT_TIMEOUT = 5.0
 
-#: Memory a worker process of a local cluster needs: its interpreter with NumPy, JAX and
-#: dask loaded, and a block of a recording. [byte]
+#: Memory a local cluster's worker process needs: NumPy, JAX, dask and a block loaded. [byte]
 WORKER_MEMORY = 512 * 2**20
 
 #: Seconds between looks at a running task (and at Ctrl-C).
 _POLL = 0.01
 
-#: The attribute of a dask array that holds the array-like it was made of, when that reads a
-#: range of samples itself (see :func:`stretch`).
+#: The attribute of a dask array holding its source when that reads samples (:func:`stretch`).
 SOURCE = "ecofmaps_source"
 
 
@@ -67,25 +62,20 @@ def _call(function, arguments):
 
 
 class Runner:
-    """Run tasks, a bounded number at a time, in a ``with`` block: on ``workers`` threads, on
-    a new ``LocalCluster`` (``cluster=True``), on the ``scheduler`` at an address, or on a
-    connected ``client`` (left open)."""
+    """Run tasks, a bounded number at a time, in a ``with`` block: on ``workers`` threads, a new
+    ``LocalCluster`` (``cluster=True``), a ``scheduler``'s address or a ``client`` (left open)."""
 
     def __init__(self, workers=None, *, scheduler=None, cluster=False, client=None, timeout=None):
         if scheduler is not None and cluster:
             raise ValueError("give a scheduler address or start a local cluster, not both")
-        check_workers(workers, processes=cluster, here=scheduler is None and client is None)
+        self.local = scheduler is None and client is None  # the tasks see this machine's files
+        check_workers(workers, processes=cluster, here=self.local)
         self.scheduler, self.cluster, self.timeout = scheduler, cluster, timeout
         self.workers = int(workers) if workers else (1 if scheduler else os.cpu_count() or 1)
         self._given = client
         self._client = self._cluster = self._pool = None
 
-    @property
-    def local(self) -> bool:
-        """Whether the tasks run on this machine (they see its files)."""
-        return self.scheduler is None and self._given is None
-
-    def __enter__(self) -> Runner:
+    def __enter__(self) -> "Runner":
         if not self.local:
             self._client = self._given
             if self._client is None:
@@ -150,8 +140,6 @@ class Runner:
     def map(self, function, tasks):
         """``function(*arguments)`` (picklable by name) for each tuple of ``tasks``: the results
         in order as they come, with twice as many calls in flight as workers."""
-        if self._pool is None and self._client is None:
-            raise RuntimeError("a Runner is used within a with block")
         pending = collections.deque()
         tasks = iter(tasks)
         try:
@@ -207,9 +195,8 @@ def worker_limit(processes: bool) -> tuple[int, str]:
 @contextlib.contextmanager
 def _sigint_held():
     """SIGINT blocked in this thread for the block, and for good in the threads it starts."""
-    if threading.current_thread() is not threading.main_thread() or not hasattr(
-        signal, "pthread_sigmask"
-    ):
+    main = threading.current_thread() is threading.main_thread()
+    if not main or not hasattr(signal, "pthread_sigmask"):
         yield
         return
     before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
@@ -249,10 +236,9 @@ def _connect(address: str, timeout: float):
         try:
             answer = pool.submit(asyncio.run, asyncio.wait_for(identity(), timeout)).result()
         except Exception as error:  # whatever went wrong, no scheduler answered
-            reason = str(error) or f"no answer after {timeout:g} s"
-            answer = (
-                reason if isinstance(error, ValueError) else f"{type(error).__name__}: {reason}"
-            )
+            answer = str(error) or f"no answer after {timeout:g} s"
+            if not isinstance(error, ValueError):
+                answer = f"{type(error).__name__}: {answer}"
     if not isinstance(answer, dict) or answer.get("type") != "Scheduler":
         if isinstance(answer, dict):
             answer = f"it answers as a {answer.get('type', 'something else')}"

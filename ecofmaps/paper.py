@@ -2,16 +2,7 @@ r"""The paper ecofmaps implements: its citation, its worked examples and its fig
 
 Jin, Sun and Shipway (2016) add the rig's compliance to the wear-scar interaction model of
 Mulvihill et al. Every value here is the paper's, in SI units, and every other module reads
-it from here (``docs/model.md``).
-
-Examples
---------
->>> from ecofmaps import energy_cof, paper
->>> round(float(energy_cof(**paper.EXAMPLE_2) / paper.EXAMPLE_2["mu"]), 4)  # Section 3
-1.0385
-"""
-
-from __future__ import annotations
+it from here (``docs/model.md``)."""
 
 import numpy as np
 
@@ -70,13 +61,7 @@ EXAMPLE_2 = {
 
 #: The two tests whose final loops Figure 10 fits (Section 4.2): :math:`\mu` = GICoF = 0.825,
 #: :math:`S` = 45 and 35 MN/m, :math:`z_o` = 1.8 and 8.0 µm with :math:`x_o = \Delta^*`.
-EXAMPLE_1 = {
-    "amplitude": AMPLITUDE,
-    "load": LOAD,
-    "stiffness": 45e6,
-    "mu": 0.825,
-    "aspect_ratio": 1.8e-6 / AMPLITUDE,
-}
+EXAMPLE_1 = {**EXAMPLE_2, "stiffness": 45e6, "mu": 0.825, "aspect_ratio": 1.8e-6 / AMPLITUDE}
 EXAMPLE_2_FIT = {**EXAMPLE_1, "stiffness": 35e6, "aspect_ratio": 8.0e-6 / AMPLITUDE}
 
 #: Figure 10's fits by name, and Section 3's Example 2: the points marked on the maps.

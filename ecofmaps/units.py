@@ -1,8 +1,5 @@
 """Quantities typed with units (``50um``, ``35MN/m``, ``450 N``: a plain number and a plain
-unit, no arithmetic) read as SI floats with pint, the dimension checked; a bare number is SI.
-"""
-
-from __future__ import annotations
+unit, no arithmetic) read as SI floats with pint, the dimension checked; a bare number is SI."""
 
 import functools
 import math
@@ -35,10 +32,8 @@ DIMENSIONS = {
     "dimensionless": ("", "1", "0.8"),
 }
 
-
-#: The values [SI] a quantity typed as a bare number (which is SI) plausibly takes in a
-#: fretting test, (low, high; None: no bound), and the units, in the order tried, that such a
-#: number outside them was probably meant in (:func:`bare_number_warning`).
+#: The values [SI] a bare (SI) number plausibly takes in a fretting test (low, high; None: no
+#: bound), and the units, in order, it was probably meant in if not (:func:`bare_number_warning`).
 PLAUSIBLE = {
     "amplitude": (0.1e-6, 5e-3, ("um", "mm")),
     "groove_half_width": (0.1e-6, 5e-3, ("um", "mm")),
@@ -50,9 +45,8 @@ PLAUSIBLE = {
 }
 
 #: The values [SI] the model takes (low, high), a rigid rig's inf apart: far wider than any
-#: fretting test, and narrow enough that the model's products of them stay finite (a stiffness
-#: beyond any rig's is only nearer a rigid one). The command line, the explorer and the
-#: Python API (concrete values: :func:`ecofmaps._inputs.check`) refuse a value beyond them.
+#: fretting test, and narrow enough that the model's products of them stay finite. The command
+#: line, the explorer and the Python API (:func:`ecofmaps._inputs.check`) refuse others.
 DOMAIN = {
     **dict.fromkeys(("amplitude", "groove_half_width", "scar_half_width"), (1e-12, 1e3)),
     **dict.fromkeys(("scar_depth", "smoothing"), (0.0, 1e3)),
@@ -66,9 +60,8 @@ DOMAIN = {
 
 
 def bare_number_warning(name: str, text: str, kind: str) -> str | None:
-    """Why ``text``, a bare (SI) number for quantity ``name`` of ``kind``, is implausible
-    (:data:`PLAUSIBLE`), with the unit probably meant (``'50 is 50 m; did you mean 50um?'``);
-    None if it has a unit or is plausible."""
+    """Why ``text``, a bare (SI) number for ``name``, is implausible (:data:`PLAUSIBLE`), with the
+    unit probably meant (``'50 is 50 m; did you mean 50um?'``); None if it is plausible."""
     if name not in PLAUSIBLE:
         return None
     try:
@@ -103,13 +96,11 @@ _NAMES = rf"{_NAME}(?:(?:\s*[*/]\s*|\s+){_NAME})*"
 _TERM = rf"(?:{_NAME}|\(\s*{_NAMES}\s*\))"
 _UNIT = rf"/?\s*{_TERM}(?:(?:\s*[*/]\s*|\s+){_TERM})*"
 
-#: The longest text a quantity may be (a unit's name is parsed in a time that grows faster
-#: than its length). [1]
+#: The longest text a quantity may be (parsing a unit's name takes superlinear time). [1]
 TEXT_LIMIT = 64
 
-#: What a quantity's text may be: a plain number and an optional plain unit ('25um',
-#: '3.3 MN/m', '0.08/um', 'inf'); no arithmetic for pint to evaluate ('9**9**9 N' would take
-#: forever, '10**400 N' overflows).
+#: What a quantity's text may be: a plain number and an optional plain unit ('25um', '3.3 MN/m',
+#: '0.08/um', 'inf'); no arithmetic for pint ('9**9**9 N' takes forever, '10**400 N' overflows).
 PLAIN_QUANTITY = re.compile(rf"\s*(?P<number>{_NUMBER})\s*(?P<unit>{_UNIT})?\s*")
 
 
@@ -123,8 +114,7 @@ def _registry():
 
 def parse_quantity(text: str, kind: str) -> float:
     """``text`` (:data:`PLAIN_QUANTITY`: ``'5e-5'``, ``'inf'``, ``'35 MN/m'``) as an SI float of
-    ``kind`` (a key of :data:`DIMENSIONS`), the float nearest the typed decimal times its
-    unit's factor (``'25um'`` is ``25e-6``)."""
+    ``kind`` (:data:`DIMENSIONS`), nearest the typed decimal times the unit (``'25um'``: 25e-6)."""
     dimension, si_unit, example = DIMENSIONS[kind]
     if len(text) > TEXT_LIMIT:
         raise ValueError(

@@ -1,8 +1,6 @@
-"""A fretting lab's daily numbers from the per-cycle results of :func:`ecofmaps.analyze_loops`:
-a test's sliding condition, the transition to gross slip, energy wear with Archard's
-coefficients, and the closure of the loops on the scar profile. The method, its formulas and
-the field's notation are in docs/lab.md.
-"""
+"""A fretting lab's daily numbers from :func:`ecofmaps.analyze_loops`' results: the sliding
+condition, the transition to gross slip, energy wear and the loops' closure on the scar
+(method, formulas and the field's notation: docs/lab.md)."""
 
 from ecofmaps.lab.regime import (
     MINDLIN_ENERGY_RATIO,

@@ -1,7 +1,4 @@
-"""A test's sliding condition and the transition to gross slip, from the per-cycle results of
-:func:`ecofmaps.analyze_loops` (docs/lab.md)."""
-
-from __future__ import annotations
+"""A test's sliding condition and the transition to gross slip (docs/lab.md)."""
 
 import numpy as np
 import xarray as xr
@@ -11,20 +8,6 @@ from ecofmaps._inputs import check, si_units
 from ecofmaps.measured.measure import loop_ratios
 from ecofmaps.measured.quality import has_reason, regime_ratio
 from ecofmaps.model.regimes import regime_condition, sliding_condition_of
-
-__all__ = [
-    "MINDLIN_ENERGY_RATIO",
-    "MINDLIN_OPENING_RATIO",
-    "campaign_of",
-    "fitted_line",
-    "line_root",
-    "per_cycle",
-    "rig_of",
-    "set_with_se",
-    "sliding_condition",
-    "sliding_condition_line",
-    "transition",
-]
 
 #: Energy ratio A of a sphere on a flat at the transition, on the contact's displacement. [1]
 MINDLIN_ENERGY_RATIO = 0.2
@@ -42,12 +25,6 @@ _SURE_CYCLES = 3
 _SATURATED_SPREAD = 3.0
 #: Q*/P within this share of the sliding friction has saturated, whatever the spread. [1]
 _SATURATED_SHARE = 1e-3
-#: Why μ_t from Q*/P has no standard error.
-_PEAK_BIASED = (
-    "no GICoF in the results: mu is Q*/P of the first gross-slip cycles, a peak read through "
-    "white noise but not through chatter or a force that rises along the stroke, by amounts "
-    "the results do not hold"
-)
 
 
 def campaign_of(results) -> list:
@@ -65,10 +42,9 @@ def campaign_of(results) -> list:
 
 
 def per_cycle(results: xr.Dataset, names) -> dict:
-    """The cycle numbers, the normal load [N] and the variables ``names`` [SI] of a test, as
-    float arrays over its cycles; the forces and energies of cycles flagged ``implausible-cof``
-    NaN where they are fewer than half (a force sample gone wild, not a wrong load)."""
-    if "cycle" not in results.coords and "cycle" not in results:
+    """The cycle numbers, normal load [N] and variables ``names`` [SI] of a test over its cycles;
+    the forces and energies of a minority of cycles flagged ``implausible-cof`` NaN."""
+    if "cycle" not in results:
         raise ValueError(
             "results: no cycle numbers (a 'cycle' coordinate or column): give the results of "
             "ecofmaps.analyze_loops or the table ecofmaps loops writes"
@@ -85,7 +61,7 @@ def per_cycle(results: xr.Dataset, names) -> dict:
                 values[name] = np.where(wild, np.nan, values[name])
     if "normal_load" in results:
         values["load"] = np.asarray(results["normal_load"].values, dtype=np.float64)
-    elif "load" in results.coords or "load" in results:
+    elif "load" in results:
         values["load"] = np.broadcast_to(float(results["load"]), values["cycle"].shape)
     elif "cof_max" in results and "max_force" in results:  # a table without the load
         values["load"] = np.asarray(results.max_force / results.cof_max, dtype=np.float64)
@@ -95,8 +71,7 @@ def per_cycle(results: xr.Dataset, names) -> dict:
 
 
 def rig_of(tests: list, rig_stiffness):
-    """``rig_stiffness``, else the one the tests were analysed with (``rig_stiffness`` in their
-    attrs, all the same), else None."""
+    """``rig_stiffness``, else the one every test was analysed with (attrs), else None. [N/m]"""
     if rig_stiffness is not None:
         return rig_stiffness
     given = {test.attrs.get("rig_stiffness") for test in tests}
@@ -104,8 +79,7 @@ def rig_of(tests: list, rig_stiffness):
 
 
 def _spring(tests: list, rig_stiffness):
-    """:func:`rig_of`, else the median spring behind the stick of the tests' ``mindlin-stick``
-    cycles (three or more: a sphere's gross-slip loops), else None. [N/m]"""
+    """:func:`rig_of`, else the median spring of three ``mindlin-stick`` cycles or more. [N/m]"""
     rig_stiffness = rig_of(tests, rig_stiffness)
     if rig_stiffness is not None or not all("quality" in t and "stiffness" in t for t in tests):
         return rig_stiffness
@@ -116,83 +90,62 @@ def _spring(tests: list, rig_stiffness):
 
 
 def _ratios(cycles: dict, rig_stiffness):
-    """The cycles' energy and opening ratios (on the contact's displacement NaN without the
-    rig's stiffness), the energy ratio that decides the regime, where the cycles are in gross
-    slip, and whether that was decided by the force (:func:`_saturated`)."""
+    """The cycles' ratios, the regime's energy ratio, where they are in gross slip, and whether
+    the force decided it (without S, where Q*/P reached the sliding friction: docs/lab.md)."""
     if rig_stiffness is not None:
         check("rig_stiffness", rig_stiffness, "positive_or_inf", "N/m")
-    names = ("amplitude", "max_force", "dissipated_energy")
-    slip = cycles.get("slip_amplitude", np.nan)
-    ratios = loop_ratios(*(cycles[n] for n in names), slip, rig_stiffness)
+    values = (cycles[n] for n in ("amplitude", "max_force", "dissipated_energy"))
+    ratios = loop_ratios(*values, cycles.get("slip_amplitude", np.nan), rig_stiffness)
     ratio = regime_ratio(ratios, rig_stiffness)
     gross = ratio > MINDLIN_ENERGY_RATIO
-    saturated = None if rig_stiffness is not None else _saturated(cycles, gross)
-    if saturated is not None:
-        gross = gross | saturated
-    return ratios, ratio, gross, saturated is not None
-
-
-def _saturated(cycles: dict, gross):
-    """Where Q*/P has reached the sliding friction μ: the median GICoF of the cycles whose
-    energy ratio on the applied displacement already says gross slip, less three times the
-    robust scatter of their Q*/P (at least a thousandth of μ); None with fewer than three."""
+    if rig_stiffness is not None:
+        return ratios, ratio, gross, False
     cof = cycles["max_force"] / cycles["load"]
     friction = cycles.get("gicof", np.full(cof.shape, np.nan))
     sure = gross & np.isfinite(friction) & np.isfinite(cof)
     if np.count_nonzero(sure) < _SURE_CYCLES:
-        return None
+        return ratios, ratio, gross, False
     mu = float(np.median(friction[sure]))
     spread = 1.4826 * float(np.median(np.abs(cof[sure] - np.median(cof[sure]))))
     with np.errstate(invalid="ignore"):
-        return cof >= mu - max(_SATURATED_SPREAD * spread, _SATURATED_SHARE * mu)
+        saturated = cof >= mu - max(_SATURATED_SPREAD * spread, _SATURATED_SHARE * mu)
+    return ratios, ratio, gross | saturated, True
 
 
 @si_units(rig_stiffness="stiffness")
 def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
     r"""The energy and opening ratios of each cycle of a test, and its sliding condition.
 
+    Gross slip where the energy ratio exceeds Mindlin's :math:`A_t = 0.2` (docs/lab.md).
+
     Parameters
     ----------
     results : xarray.Dataset
         One test's results from :func:`ecofmaps.analyze_loops`.
     rig_stiffness : float, optional
-        The rig's own stiffness :math:`S` (not the loops' stick slope, which is the rig and
-        the contact in series). With it the ratios are also read on the contact's
-        displacement :math:`\Delta - Q/S` and the regime is decided there. By default the
-        one ``results`` were analysed with (``results.attrs["rig_stiffness"]``, from
-        ``analyze_loops(..., rig_stiffness=)`` or ``--rig-stiffness``), else the median
-        spring behind the stick of three ``mindlin-stick`` cycles or more (a sphere's), if
-        any; else a cycle whose Q*/P has reached the sliding friction is in gross slip
-        too. [N/m]
+        The rig's own stiffness :math:`S` (not the loops' stick slope), to read the ratios on
+        the contact's displacement :math:`\Delta - Q/S` too and decide the regime there; by
+        default ``results.attrs["rig_stiffness"]``, else a sphere's spring, else the force
+        decides (docs/lab.md, "Which S"). [N/m]
 
     Returns
     -------
     condition : xarray.Dataset
-        Over ``cycle``: ``energy_ratio`` :math:`A = E_d/(4\Delta^*Q^*)` and
-        ``opening_ratio`` :math:`B = \delta^*/\Delta^*` on the applied displacement;
-        ``contact_amplitude`` :math:`\Delta^* - Q^*/S` [m], ``contact_energy_ratio`` and
-        ``contact_opening_ratio`` on the contact's (NaN without ``rig_stiffness``);
-        ``gross_slip`` (1, 0, or NaN for a cycle without an energy ratio). Attributes
-        ``sliding_condition`` (``'partial slip'``, ``'mixed slip'`` or ``'gross slip'``) and
-        ``regime_changes_at`` (the cycles where the regime changes).
-
-    Notes
-    -----
-    Gross slip where the energy ratio exceeds Mindlin's :math:`A_t = 0.2`: docs/lab.md,
-    "Energy and opening ratios, on which displacement".
+        Over ``cycle``: ``energy_ratio`` :math:`A`, ``opening_ratio`` :math:`B`,
+        ``contact_amplitude`` [m], ``contact_energy_ratio``, ``contact_opening_ratio`` (NaN
+        without :math:`S`), ``gross_slip`` (1, 0, NaN); attributes ``sliding_condition``
+        (``'partial slip'``, ``'mixed slip'`` or ``'gross slip'``) and ``regime_changes_at``.
 
     References
     ----------
-    S. Fouvry, P. Kapsa, L. Vincent (1995), Wear 185, 35-46; L. Vincent, Y. Berthier,
-    M. Godet (1992), ASTM STP 1159, 33-48; Z.R. Zhou, L. Vincent (1995), Wear 181-183,
-    531-536; R.D. Mindlin, H. Deresiewicz (1953), J. Appl. Mech. 20, 327-344 (titles in
-    docs/lab.md).
+    S. Fouvry et al. (1995), Wear 185, 35-46; L. Vincent et al. (1992), ASTM STP 1159, 33-48;
+    Z.R. Zhou, L. Vincent (1995), Wear 181-183, 531-536; R.D. Mindlin, H. Deresiewicz (1953),
+    J. Appl. Mech. 20, 327-344 (titles in docs/lab.md).
 
     Examples
     --------
-    >>> import numpy as np, ecofmaps
-    >>> displacement, force = ecofmaps.fretting_loop(50e-6, 450.0, 35e6, 0.8, 0.0)
-    >>> results = ecofmaps.analyze_loops(np.asarray(displacement), np.asarray(force), 450.0)
+    >>> import ecofmaps
+    >>> results = ecofmaps.analyze_loops(*ecofmaps.fretting_loop(50e-6, 450.0, 35e6, 0.8, 0), 450.0)
     >>> condition = ecofmaps.sliding_condition(results, rig_stiffness=35e6)
     >>> condition.attrs["sliding_condition"], round(float(condition.contact_energy_ratio[0]), 3)
     ('gross slip', 1.0)
@@ -210,8 +163,7 @@ def sliding_condition(results, rig_stiffness=None) -> xr.Dataset:
 
 
 def fitted_line(x, y):
-    """Least-squares line ``y = a + b (x - x0)``: x0, a, b and their covariance (NaN below
-    three points)."""
+    """Least-squares line ``y = a + b (x - x0)``: x0, a, b and their covariance."""
     x0 = float(np.mean(x))
     design = np.stack([np.ones_like(x), x - x0], axis=-1)
     (a, b), rss, *_ = np.linalg.lstsq(design, y, rcond=None)
@@ -231,38 +183,28 @@ def line_root(x0, a, b, cov, level):
 def transition(results, rig_stiffness=None) -> xr.Dataset:
     r"""The transition from partial to gross slip, from an amplitude sweep or a campaign.
 
+    The method: docs/lab.md, "The transition".
+
     Parameters
     ----------
     results : xarray.Dataset or list of xarray.Dataset
-        The results of :func:`ecofmaps.analyze_loops` of one test at amplitudes that vary
-        across the transition (the variable-displacement method), or of several tests at
-        one load and several amplitudes.
+        :func:`ecofmaps.analyze_loops`' results of one test at amplitudes across the
+        transition, or of several tests at one load and several amplitudes.
     rig_stiffness : float, optional
-        The rig's own stiffness :math:`S`, as for :func:`sliding_condition` (by default the
-        one every test was analysed with); without it ``contact_amplitude`` is NaN, and
-        where the force decides the regime, :math:`\Delta_t` is midway between the two
-        amplitudes where :math:`Q^*` first stays at :math:`\mu P`. [N/m]
+        As in :func:`sliding_condition`; without it ``contact_amplitude`` is NaN. [N/m]
 
     Returns
     -------
     transition : xarray.Dataset
         ``amplitude`` :math:`\Delta_t` [m], ``contact_amplitude``
-        :math:`\delta_t = \Delta_t - \mu_t P/S` [m] and ``mu``
-        :math:`\mu_t = Q^*/P` at the transition (read as the gross-slip cycles' GICoF), each
-        with its standard error (``_se``; ``mu_se`` NaN, its ``comment`` saying why, for
-        results without a GICoF).
+        :math:`\delta_t = \Delta_t - \mu_t P/S` [m] and ``mu`` :math:`\mu_t = Q^*/P`, each
+        with its standard error (``_se``; ``mu_se`` NaN, its ``comment`` saying why,
+        without a GICoF).
 
     Raises
     ------
     ValueError
-        When the cycles never cross the transition (all in partial slip, or all in gross
-        slip), naming the amplitudes they span, or are all at one amplitude.
-
-    Notes
-    -----
-    The cycles split by amplitude where the fewest fall on the wrong side of
-    :math:`A_t = 0.2`, and a line through the energy ratios either side: docs/lab.md,
-    "The transition".
+        When the cycles never cross the transition or are all at one amplitude.
 
     References
     ----------
@@ -270,8 +212,7 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
 
     Examples
     --------
-    Four tests on a sphere (Mindlin: μ = 0.8, δ_t = 6 µm) at 450 N behind a 35 MN/m rig,
-    one cycle each (Δ* [m], Q* [N], E_d [J]); the true Δ_t = δ_t + μP/S is 16.3 µm:
+    Four one-cycle tests (Δ*, Q*, E_d) on a sphere at 450 N behind 35 MN/m (Δ_t = 16.3 µm):
 
     >>> import xarray as xr, ecofmaps
     >>> cycles = [(14e-6, 324.7, 0.7016e-3), (15.5e-6, 350.8, 1.194e-3),
@@ -347,13 +288,16 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     for name, (value, se) in values.items():
         set_with_se(data, name, value, se, quantity=f"transition_{name}")
     if not np.isfinite(friction[gross]).any():
-        data["mu_se"][2]["comment"] = _PEAK_BIASED
+        data["mu_se"][2]["comment"] = (  # why μ_t from Q*/P has no standard error
+            "no GICoF in the results: mu is Q*/P of the first gross-slip cycles, a peak read "
+            "through white noise but not through chatter or a force that rises along the stroke, "
+            "by amounts the results do not hold"
+        )
     return xr.Dataset(data)
 
 
 def _sliding_friction(gross, level, split, cof, friction):
-    """μ_t and its standard error: the mean GICoF of each amplitude in the upper half of the
-    gross-slip cycles', averaged; else Q*/P above the ``split`` (se NaN: :data:`_PEAK_BIASED`)."""
+    """μ_t and its standard error (docs/lab.md, "The transition")."""
     sliding = gross & np.isfinite(friction)
     if not sliding.any():
         first = gross & (level == level[split:][gross[split:]][0])
@@ -366,8 +310,7 @@ def _sliding_friction(gross, level, split, cof, friction):
         return float(means[0]), np.nan
     from scipy.stats import t  # 0.4 s to import: when a transition is sought
 
-    # ±2 se: Student's 95 % interval of the mean of n
-    widen = float(t.ppf(0.975, means.size - 1)) / 2.0
+    widen = float(t.ppf(0.975, means.size - 1)) / 2.0  # ±2 se: Student's 95 % interval
     return float(np.mean(means)), float(widen * np.std(means, ddof=1) / np.sqrt(means.size))
 
 
@@ -380,8 +323,7 @@ def set_with_se(data: dict, name: str, value, se, dims=(), quantity=None) -> Non
 
 
 def sliding_condition_line(results: xr.Dataset) -> str:
-    """The sliding condition of :func:`ecofmaps.analyze_loops`' results in words
-    (:func:`regime_condition`), with the first cycles where the regime changes."""
+    """The sliding condition of results in words, with the first cycles where it changes."""
     condition, changes = regime_condition(results)
     changes = changes.tolist()
     if not changes:

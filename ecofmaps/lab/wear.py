@@ -1,38 +1,24 @@
-"""Energy wear and Archard's coefficients from the per-cycle results of
-:func:`ecofmaps.analyze_loops` and a scar profile, and the closure of the loops on the scar
-(docs/lab.md)."""
-
-from __future__ import annotations
+"""Energy wear, Archard's coefficients and the closure of the loops on the scar (docs/lab.md)."""
 
 import numpy as np
 import xarray as xr
 
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._inputs import check, si_units
-from ecofmaps.lab.regime import (
-    campaign_of,
-    fitted_line,
-    line_root,
-    per_cycle,
-    rig_of,
-    set_with_se,
-)
+from ecofmaps.lab.regime import campaign_of, fitted_line, line_root, per_cycle, rig_of, set_with_se
 from ecofmaps.model.profiles import ScarProfile
 from ecofmaps.model.simulation import fretting_loop
 
-__all__ = ["cumulated_energy", "cycle_sum", "energy_wear", "loop_scar_closure"]
-
 
 def cycle_sum(cycle, value):
-    """Σ of a per-cycle ``value`` over cycles 1 to the last recorded, and its standard error
-    (docs/lab.md, "Energy wear"); ``ValueError`` if no cycle has a value."""
+    """Σ of a per-cycle ``value`` over cycles 1 to the last recorded, and its standard error."""
     kept = np.isfinite(value)
     n, v = cycle[kept], value[kept]
     if n.size == 0:
         raise ValueError("no cycle has a value to sum: every one is NaN (skipped or flagged)")
-    if np.any(np.diff(n) <= 0) or n[0] < 1:
-        raise ValueError("results: the cycle numbers must be 1 or more and increasing")
     gaps = np.diff(n)
+    if np.any(gaps <= 0) or n[0] < 1:
+        raise ValueError("results: the cycle numbers must be 1 or more and increasing")
     weight = np.concatenate([gaps, [0.0]]) / 2 + np.concatenate([[0.0], gaps]) / 2
     weight[[0, -1]] += 0.5  # the end cycles count whole
     weight[0] += n[0] - 1
@@ -45,27 +31,24 @@ def cycle_sum(cycle, value):
 
 
 def cumulated_energy(results) -> tuple[float, float]:
-    """ΣE_d [J] of a test over cycles 1 to the last recorded, and its standard error
-    (:func:`cycle_sum` of :func:`~ecofmaps.lab.regime.per_cycle`'s energies)."""
+    """ΣE_d [J] of a test over cycles 1 to the last recorded, and its standard error."""
     cycles = per_cycle(results, ("dissipated_energy",))
     return cycle_sum(cycles["cycle"], cycles["dissipated_energy"])
 
 
 def _worn_volume(profile: ScarProfile, length) -> tuple[float, float]:
-    """Worn volume [m³] of a line contact of ``length``, or of a round scar (``length`` None),
-    and its standard error from the shoulders' noise."""
+    """Worn volume [m³] of a line of ``length``, or of a round scar (None), and its error."""
     x = np.asarray(profile.position)
     residual = np.asarray(profile.height) - profile.reference_height - profile.reference_slope * x
     width = float(profile.half_width)
     inside = np.abs(x) <= width
-    scale = 1.0 if length is None else length
     if length is not None:
-        weight, total, volume = np.ones(x.size), 2 * width, float(profile.worn_area)
+        weight, total, volume, scale = np.ones(x.size), 2 * width, float(profile.worn_area), length
     else:  # the volume of revolution of each side's depth, the two averaged
         edge = np.interp([-width, width], x, residual)
         at = np.concatenate([[-width], x[inside], [width]])
         depth = np.maximum(-np.concatenate([edge[:1], residual[inside], edge[1:]]), 0.0)
-        weight, total = np.pi * np.abs(x), np.pi * width**2
+        weight, total, scale = np.pi * np.abs(x), np.pi * width**2, 1.0
         volume = float(np.pi * np.trapezoid(np.abs(at) * depth, at))
     shoulders = residual[np.abs(x) > 2 * width]
     if shoulders.size < 5:
@@ -106,14 +89,12 @@ def _one_test(results, profile, length) -> dict:
     cycle, load = cycles["cycle"], cycles["load"]
     energy = cycle_sum(cycle, cycles["dissipated_energy"])
     volume = _worn_volume(profile, length)
-    slip = cycle_sum(cycle, 4 * load * cycles["slip_amplitude"])
-    nominal = cycle_sum(cycle, 4 * load * cycles["amplitude"])
     return {
         "cumulated_energy": energy,
         "wear_volume": volume,
         "energy_wear_coefficient": _ratio(*volume, *energy),
-        "archard_slip": _ratio(*volume, *slip),
-        "archard_nominal": _ratio(*volume, *nominal),
+        "archard_slip": _ratio(*volume, *cycle_sum(cycle, 4 * load * cycles["slip_amplitude"])),
+        "archard_nominal": _ratio(*volume, *cycle_sum(cycle, 4 * load * cycles["amplitude"])),
     }
 
 
@@ -121,21 +102,21 @@ def _one_test(results, profile, length) -> dict:
 def energy_wear(results, profile, length=None, contact="line") -> xr.Dataset:
     r"""Energy wear of a fretting test, or of a campaign: ΣE_d, V, α and Archard's k.
 
+    The sums, volumes and fit: docs/lab.md, "Energy wear".
+
     Parameters
     ----------
     results : xarray.Dataset or list of xarray.Dataset
         Each test's results from :func:`ecofmaps.analyze_loops` over its recorded cycles
-        (a rig may record every N-th cycle: ``cycle`` numbers them as driven).
+        (``cycle`` numbers them as driven: a rig may record every N-th).
     profile : ScarProfile or list of ScarProfile
-        Each test's levelled wear-scar profile across the scar
-        (:func:`ecofmaps.read_scar_profile`); of a sphere's, through its centre.
+        Each test's levelled scar profile (:func:`ecofmaps.read_scar_profile`); of a
+        sphere's, through its centre.
     length : float or list of float
-        Length of the line contact, along which the worn area is the same; none for a
-        sphere. [m]
+        Length of the line contact; none for a sphere. [m]
     contact : {'line', 'sphere'}
-        ``'line'``: :math:`V = L\int d\,dx`, the worn area times ``length``; ``'sphere'``
-        (a round scar): :math:`V = \pi\int_{-W}^{W}|x|\,d(x)\,dx`, the volume of
-        revolution of the worn depth :math:`d`, the two sides averaged. The pile-up apart.
+        ``'line'``, :math:`V = L\int d\,dx`, or ``'sphere'``, a round scar of volume
+        :math:`V = \pi\int_{-W}^{W}|x|\,d(x)\,dx` (each side turned about its axis, averaged).
 
     Returns
     -------
@@ -150,46 +131,28 @@ def energy_wear(results, profile, length=None, contact="line") -> xr.Dataset:
     Raises
     ------
     ValueError
-        For results without cycles, energies (or all NaN) or a load, a profile without a
-        scar, a length not in metres (0 < L < 1 m), a line without a length or a sphere with
-        one, or lists of unequal length.
-
-    Notes
-    -----
-    Sums over the cycles driven, linear between those recorded; a round scar's volume by
-    cylindrical shells; a campaign's fit needs three tests for its errors: docs/lab.md,
-    "Energy wear".
+        For results without cycles, energies or a load, a profile without a scar, a length
+        not in metres (0 < L < 1 m), missing for a line or given for a sphere, or lists of
+        unequal length.
 
     References
     ----------
-    S. Fouvry, P. Kapsa, L. Vincent (1996), Wear 200, 186-205; S. Fouvry, T. Liskiewicz,
-    P. Kapsa, S. Hannel, E. Sauger (2003), Wear 255, 287-298; J.F. Archard (1953), J. Appl.
-    Phys. 24, 981-988; G.B. Thomas et al. (2010), Thomas' Calculus, §6.2 (titles in
-    docs/lab.md).
+    S. Fouvry et al. (1996), Wear 200, 186-205; S. Fouvry et al. (2003), Wear 255, 287-298;
+    J.F. Archard (1953), J. Appl. Phys. 24, 981-988; G.B. Thomas et al. (2010), Thomas'
+    Calculus, §6.2 (titles in docs/lab.md).
 
     Examples
     --------
     >>> import numpy as np, xarray as xr, ecofmaps
-    >>> cycles = np.array([1, 500, 1000])  # recorded every 500th cycle
-    >>> results = xr.Dataset(
+    >>> results = xr.Dataset(  # recorded every 500th cycle
     ...     {"amplitude": ("cycle", [50e-6] * 3), "slip_amplitude": ("cycle", [40e-6] * 3),
-    ...      "dissipated_energy": ("cycle", [0.06, 0.06, 0.06])},
-    ...     coords={"cycle": cycles, "load": 450.0})
+    ...      "dissipated_energy": ("cycle", [0.06] * 3)},
+    ...     coords={"cycle": [1, 500, 1000], "load": 450.0})
     >>> x = np.linspace(-400e-6, 400e-6, 801)
     >>> z = np.where(np.abs(x) < 100e-6, 3e-6 * ((x / 100e-6) ** 2 - 1), 0.0)
-    >>> profile = ecofmaps.scar_profile(x, z, smoothing=0)
-    >>> wear = ecofmaps.energy_wear(results, profile, length=5e-3)
-    >>> print(f"{float(wear.cumulated_energy):.0f} J, {float(wear.wear_volume) * 1e9:.3f} mm³")
-    60 J, 0.002 mm³
-    >>> print(f"alpha = {float(wear.energy_wear_coefficient) * 1e18:.4g} µm³/J")
-    alpha = 3.333e+04 µm³/J
-
-    The same trace through the centre of a sphere's round scar, a paraboloid of volume
-    :math:`\pi D W^2/2` = 47 124 µm³:
-
-    >>> round_scar = ecofmaps.energy_wear(results, profile, contact="sphere")
-    >>> print(f"{float(round_scar.wear_volume) * 1e18:.0f} µm³")
-    47119 µm³
+    >>> wear = ecofmaps.energy_wear(results, ecofmaps.scar_profile(x, z), length=5e-3)
+    >>> print(f"{float(wear.cumulated_energy):.0f} J, {float(wear.energy_wear_coefficient):.4g}")
+    60 J, 3.333e-14
     """
     tests = campaign_of(results)
     single = not isinstance(results, list | tuple)
@@ -255,18 +218,11 @@ def _reading(results, resolved):
     return results.sel(cycle=common[-1]), resolved.sel(cycle=common[-1])
 
 
-def _branch_force(displacement, loop_displacement, loop_force):
-    """The force of the loop (Δ, Q) at ``displacement``, on the branch each point moves along."""
-    top = int(np.nanargmax(loop_displacement))
-    rising = np.interp(displacement, loop_displacement[: top + 1], loop_force[: top + 1])
-    falling = np.interp(displacement, loop_displacement[top:][::-1], loop_force[top:][::-1])
-    step = np.diff(displacement, append=displacement[-1] + (displacement[-1] - displacement[-2]))
-    return np.where(step >= 0, rising, falling)
-
-
 @si_units(rig_stiffness="stiffness")
 def loop_scar_closure(results, resolved, profile, rig_stiffness=None) -> xr.Dataset:
     r"""How well a test's last loop and its loops' felt groove close on the measured scar.
+
+    On the last cycle with a GICoF and a reading along the stroke (docs/lab.md).
 
     Parameters
     ----------
@@ -275,37 +231,29 @@ def loop_scar_closure(results, resolved, profile, rig_stiffness=None) -> xr.Data
     resolved : xarray.Dataset
         The same recording read along the stroke, :func:`ecofmaps.resolve_loops`.
     profile : ScarProfile
-        The scar's levelled profilometer trace (:func:`ecofmaps.read_scar_profile`), in
-        metres, centred on the scar, which is taken to lie under the loops' centre.
+        The scar's levelled trace (:func:`ecofmaps.read_scar_profile`) [m], centred on the
+        scar, which is taken to lie under the loops' centre.
     rig_stiffness : float, optional
-        The rig's stiffness :math:`S` for the model's loop; by default the one ``results``
-        were analysed with, as for :func:`sliding_condition`, else the stiffness the reading
-        along the stroke used (the loops' stick slope, unless given to it). [N/m]
+        The rig's stiffness :math:`S` for the model's loop; by default as in
+        :func:`sliding_condition`, else the one the reading along the stroke used. [N/m]
 
     Returns
     -------
     closure : xarray.Dataset
-        ``loop_residual``: root mean square of the measured loop's force less the model's
-        at the same displacement on the same branch, over :math:`Q^*` [1];
-        ``scar_residual`` [m] and ``scar_relative_residual`` (over the depth :math:`D`) [1]:
-        root mean square height of the implied scar less the profile's over the slip
-        range. The curves: ``loop_displacement``, ``loop_force`` (the measured loop, over
-        ``point``) [m], [N]; ``model_displacement``, ``model_force`` (over
-        ``model_point``) [m], [N]; ``implied_scar`` :math:`h(\xi)` and ``scar_height``
-        :math:`z(\xi)` over ``position`` :math:`\xi` [m]. Scalars ``cycle``, ``mu`` (the
-        GICoF) and ``stiffness`` [N/m].
+        ``loop_residual``: root mean square of the measured force less the model's on the
+        same branch, over :math:`Q^*` [1]; ``scar_residual`` [m], ``scar_relative_residual``
+        (over the depth :math:`D`) [1]: root mean square height of the implied scar less the
+        profile's. The curves: ``loop_displacement``, ``loop_force`` (over ``point``) and
+        ``model_displacement``, ``model_force`` (over ``model_point``) [m], [N];
+        ``implied_scar`` :math:`h(\xi)`, ``scar_height`` :math:`z(\xi)` over ``position``
+        :math:`\xi` [m]. Scalars ``cycle``, ``mu`` (the GICoF), ``stiffness`` [N/m].
 
     Raises
     ------
     ValueError
-        For results without kept loops or a GICoF, a ``resolved`` that is not a reading
-        along the stroke, no cycle with both, a profile without a scar or not in the loops'
-        units (metres), or a ``rig_stiffness`` below half the loops' stick slope.
-
-    Notes
-    -----
-    On the last cycle with a GICoF (eq. 17-18) and a reading along the stroke, against the
-    model's loop on the profile (eq. 9-10): docs/lab.md, "Loop-scar closure".
+        For results without kept loops or a GICoF, a ``resolved`` not read along the stroke,
+        no cycle with both, a profile without a scar or not in metres, or a
+        ``rig_stiffness`` below half the loops' stick slope.
 
     References
     ----------
@@ -336,13 +284,17 @@ def loop_scar_closure(results, resolved, profile, rig_stiffness=None) -> xr.Data
         )
     load = float(loop["normal_load" if "normal_load" in loop else "load"])
     mu, peak = float(loop.gicof), float(loop.max_force)
-    model = fretting_loop(
+    model_displacement, model_force = fretting_loop(
         float(loop.amplitude), load, rig_stiffness, mu, profile=profile, mapping="physical"
     )
-    model_displacement, model_force = (np.asarray(v, dtype=np.float64) for v in model)
     kept = np.isfinite(loop.loop_displacement.values) & np.isfinite(loop.loop_force.values)
     displacement, force = loop.loop_displacement.values[kept], loop.loop_force.values[kept]
-    off = force - _branch_force(displacement, model_displacement, model_force)
+    # the model's force at each point's displacement, on the branch the point moves along
+    top = int(np.nanargmax(model_displacement))
+    rising = np.interp(displacement, model_displacement[: top + 1], model_force[: top + 1])
+    falling = np.interp(displacement, model_displacement[top:][::-1], model_force[top:][::-1])
+    step = np.diff(displacement, append=displacement[-1] + (displacement[-1] - displacement[-2]))
+    off = force - np.where(step >= 0, rising, falling)
     implied = reading.felt_profile.values[np.isfinite(reading.felt_profile.values)]
     height = np.interp(position, trace, np.asarray(profile.height))
     implied = implied + np.mean(height - implied)
