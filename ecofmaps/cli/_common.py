@@ -108,11 +108,11 @@ CACHE_DIR_HELP = "cache directory (default: $ECOFMAPS_CACHE, else the per-user c
 _RECORDING_HELP = {
     "--displacement-col": "name of the displacement column (default: displacement)",
     "--force-col": "name of the tangential force column (default: force)",
-    "--cycle-col": "name of a column of cycle numbers, which must exist (default: 'cycle' if "
-    "the file has it; else, or with 'none', cycles are cut at the reversals)",
+    "--cycle-col": "name of a column of cycle numbers (default: 'cycle' if the file has it; else, "
+    "or with 'none', cycles are cut at the reversals)",
     "--skip-rows": "lines before a text file's header to skip (default: found as metadata)",
-    "--displacement-unit": "unit of the displacement column (default: the one its name or the "
-    "file gives, as in 'displacement [mm]' or a channel's unit, else um)",
+    "--displacement-unit": "unit of the displacement column (default: from its name, as in "
+    "'displacement [mm]', or the file, else um)",
     "--force-unit": "unit of the force column (default: from its name or the file, else N)",
     "--group": "TDMS group, or HDF5/netCDF/zarr group, holding the channels (default: any)",
 }
@@ -184,9 +184,8 @@ def add_profile_options(parser: argparse.ArgumentParser) -> None:
     """Add ``--scar-profile FILE`` and its reading options, in a group of their own."""
     group = parser.add_argument_group(
         "measured scar profile",
-        "a profilometer trace across the wear scar (text: a header line, then x and z per "
-        "line, in um unless the names or --x-unit/--z-unit say otherwise), used instead of "
-        "the parabolic groove of eq. 11",
+        "a profilometer trace across the wear scar (text: a header line, then x and z per line), "
+        "used instead of the parabolic groove of eq. 11",
     )
     option = option_adder(group, _PROFILE_HELP)
     option("--scar-profile", metavar="FILE")
@@ -209,7 +208,7 @@ def read_profile(args, conflicting=()):
     The reader's warnings are one line each, naming ``--profile-half-width`` of the other W."""
     given = [name for name in args.profile_options if getattr(args, name) is not None]
     if args.scar_profile is None and given:
-        raise CommandError(f"{_options(given)} reads a --scar-profile: give the FILE too")
+        raise CommandError(f"{options(given)} reads a --scar-profile: give the FILE too")
     for name, value in _PROFILE_DEFAULTS.items():
         if getattr(args, name) is None:
             setattr(args, name, value)
@@ -217,7 +216,7 @@ def read_profile(args, conflicting=()):
         return None
     if given := [name for name in conflicting if getattr(args, name) is not None]:
         raise CommandError(
-            f"give --scar-profile or {_options(given)}, not both (the profile gives the "
+            f"give --scar-profile or {options(given)}, not both (the profile gives the "
             "scar's shape, and its D/W)"
         )
     from ecofmaps.io.scar_profiles import read_scar_profile  # JAX: not with the command line
@@ -249,7 +248,8 @@ def read_profile(args, conflicting=()):
     return profile
 
 
-def _options(names) -> str:
+def options(names) -> str:
+    """The options of the destinations ``names``: ``'--x-unit, --z-unit'``."""
     return ", ".join("--" + name.replace("_", "-") for name in names)
 
 
@@ -369,8 +369,7 @@ def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=())
 
 @contextlib.contextmanager
 def made_folder(folder: Path):
-    """Create ``folder`` and its parents for the block; if it fails, remove those it made
-    that are still empty."""
+    """Create ``folder`` and its parents for the block; if it fails, those made still empty go."""
     missing = [path for path in (folder, *folder.parents) if not path.exists()]
     folder.mkdir(parents=True, exist_ok=True)
     try:
@@ -423,6 +422,13 @@ def two_values(name: str, on_profile, on_parabola, note: str = "") -> tuple[str,
     """One :func:`row` with two values: profile, parabola."""
     words, symbol, first = row(name, on_profile, note)
     return words, symbol, f"{first:<{_COLUMN}} {row(name, on_parabola)[2]}"
+
+
+def progress_bar(total: int, name: str, **options):
+    """A tqdm progress bar of ``total`` steps on standard error, named ``name``."""
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=name, file=sys.stderr, dynamic_ncols=True, **options)
 
 
 def byte_size(size: float) -> str:

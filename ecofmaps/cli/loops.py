@@ -40,31 +40,29 @@ __all__ = ["SUMMARY_VARIABLES", "add", "run"]
 _HELP = {
     "files": "recording files (CSV, TSV or other text, TDMS, HDF5/netCDF-4, zarr)",
     "--example": "analyse the shipped synthetic example (load 450N) instead of FILEs",
-    "--load": "normal load P, e.g. 450N; or the name of the recording's normal-load column "
-    "(e.g. Fz), used sample by sample (required unless --example)",
+    "--load": "normal load P, e.g. 450N, or the name of a normal-load column (e.g. Fz) read "
+    "sample by sample (required unless --example)",
     "--out": "CSV file to write (its directory must exist); default: print the table",
     "--plots": "also write into DIR per file: loops with Q = SΔ (<name>_loops.png), ECoF and "
     "GICoF over the cycles (<name>_evolution.png), loops along the stroke (<name>_resolved.png)",
-    "--overwrite": "replace the outputs ecofmaps wrote before (--out, --resolved, the plots in "
-    "--plots); a file or folder ecofmaps did not write is never replaced",
-    "--resolved": "also write the loops read along the stroke (one FILE): μ(ξ), the groove "
-    "slope g(ξ) and the felt profile h(ξ) over (cycle, position), a netCDF file",
-    "--report": "also write one recording as an offline HTML page: friction and quality flags "
-    'per cycle, picked loops with the model\'s, the table (needs pip install "ecofmaps[web]")',
-    "--no-resolve": "skip the reading along the stroke (about ten times faster; no "
-    "mu_resolved, mu_resolved_se, aspect_ratio)",
-    "--flip-force": "read the force with the other sign (a rig recording it positive against "
-    "the displacement: its loops run anticlockwise)",
-    "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m (in series with the contact in the "
-    "stick slope): adds the ratios on the contact's displacement, the regime there, a sweep's δ_t",
-    "--scar-profile": "the scar's profile after the test (x and z columns, in um unless their "
-    "names say): the loop-scar closure of its last loop with a GICoF, printed, in the report "
-    "and with --plots (<name>_closure.png); with --length or --sphere, its energy wear",
-    "--nan-policy": "skip (default): a cycle with a missing sample (NaN, an empty cell) is skipped "
-    "and counted; raise: any missing sample stops the command naming its line",
+    "--overwrite": "replace what ecofmaps wrote before (never a file or folder it did not write)",
+    "--resolved": "also write the loops read along the stroke of one FILE, a netCDF file: μ(ξ), "
+    "the groove slope g(ξ) and the felt profile h(ξ) over (cycle, position)",
+    "--report": "also write one recording as an offline HTML page: friction and quality flags, "
+    'loops with the model\'s, the table (needs pip install "ecofmaps[web]")',
+    "--no-resolve": "skip the reading along the stroke (ten times faster; no mu_resolved, "
+    "mu_resolved_se, aspect_ratio)",
+    "--flip-force": "read the force with the other sign (loops that run anticlockwise)",
+    "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m, in series with the contact: adds "
+    "the ratios on the contact's displacement, the regime there, a sweep's δ_t",
+    "--scar-profile": "the scar's profile after the test (x and z columns, um unless named): the "
+    "loop-scar closure of its last loop, printed, in the report and with --plots "
+    "(<name>_closure.png); with --length or --sphere, its energy wear",
+    "--nan-policy": "skip (default): skip and count a cycle with a missing sample (NaN, an empty "
+    "cell); raise: stop at one, naming its line",
     "--workers": "analyse out of core on a local dask cluster of N processes",
-    "--scheduler": "analyse out of core on the dask cluster at ADDRESS (tcp://host:8786); its "
-    "workers must have ecofmaps and see the files at the same paths",
+    "--scheduler": "analyse out of core on the dask cluster at ADDRESS (tcp://host:8786), whose "
+    "workers have ecofmaps and see the files at the same paths",
     "--resume": "continue a stopped run from <out>.partial/ (the same --out, files and options)",
     "--quiet": "no progress bar (none is shown off a terminal)",
 }
@@ -76,18 +74,17 @@ def add(subparsers) -> None:
         "loops",
         help="analyse recorded fretting loops cycle by cycle: ECoF, GICoF, stiffness, ...",
         description="Read recordings of fretting loops (text: a header line in any common "
-        "dialect), cut them into cycles at the displacement reversals or by a cycle column, check "
-        "each loop, and write a row per cycle: cycle, amplitude_um, slip_amplitude_um, "
-        "normal_load_N (with --load COLUMN), max_force_N, dissipated_energy_mJ, ecof, cof_max, "
-        "energy_ratio (with --rig-stiffness also opening_ratio, contact_amplitude_um, "
-        "contact_energy_ratio, contact_opening_ratio), stiffness_MN_per_m, gicof, regime, "
-        "mu_resolved, mu_resolved_se, "
-        "aspect_ratio (read along the whole stroke) and quality ('ok', or why values are NaN); "
-        "first a file column for several files. Columns are found by the names rigs write "
-        "(displacement, disp, delta, stroke, ...; force, Fx, Ft, Q, friction, ...; an optional "
-        "'cycle'), units from their names or the file, else um and N. Of several files, one that "
-        "cannot be analysed is an error line naming it, the others are written (exit status 1). "
-        "Files are written atomically, never over an input or a file ecofmaps did not write.",
+        "dialect), cut them into cycles at the displacement reversals or by a cycle column, and "
+        "write a row per cycle: cycle, amplitude_um, slip_amplitude_um, normal_load_N (with --load "
+        "COLUMN), max_force_N, dissipated_energy_mJ, ecof, cof_max, energy_ratio (with "
+        "--rig-stiffness also opening_ratio, contact_amplitude_um, contact_energy_ratio, "
+        "contact_opening_ratio), stiffness_MN_per_m, gicof, regime, mu_resolved, mu_resolved_se, "
+        "aspect_ratio (read along the stroke), quality ('ok', or why values are NaN); first a "
+        "file column for several files. Columns are found by the names rigs write (displacement, "
+        "disp, stroke, ...; force, Fx, Q, ...; 'cycle'), units from their names or the file, else "
+        "um and N. A file that cannot be analysed is an error line, the others are written (exit "
+        "status 1). Files are written atomically, never over an input or a file ecofmaps did not "
+        "write.",
         epilog="examples:\n  ecofmaps loops test.csv --load 450N --out results.csv --plots plots\n"
         "  ecofmaps loops --example --out results.csv --plots plots",
     )
@@ -109,8 +106,8 @@ def add(subparsers) -> None:
     add_recording_options(parser)
     long_tests = parser.add_argument_group(
         "long tests",
-        "a rig file of more than 2**24 samples is analysed out of core, a block of whole cycles "
-        "at a time (the numbers are those of the analysis in memory)",
+        "a file of more than 2**24 samples is analysed out of core, whole cycles a block at a "
+        "time (the numbers are those of the analysis in memory)",
     )
     option = option_adder(long_tests, _HELP)
     option("--workers", type=_workers, metavar="N")

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps._interrupts import INTERRUPTED, Interrupted, add_stop_note
-from ecofmaps.cli._common import CommandError
+from ecofmaps.cli._common import CommandError, progress_bar
 from ecofmaps.io.tables import results_csv
 from ecofmaps.measured.cycles import Cycles
 from ecofmaps.measured.pipeline import (
@@ -364,15 +364,5 @@ class _Interrupted(KeyboardInterrupt):
 
 
 def _bar(analysis, path, shown: bool, initial: int):
-    from tqdm import tqdm
-
-    return tqdm(
-        total=int(analysis.cycles.label.size),
-        initial=initial,
-        unit=" cycles",
-        desc=path.name,
-        file=sys.stderr,
-        disable=not shown,
-        dynamic_ncols=True,
-        smoothing=0.1,
-    )
+    total, options = int(analysis.cycles.label.size), {"disable": not shown, "smoothing": 0.1}
+    return progress_bar(total, path.name, initial=initial, unit=" cycles", **options)

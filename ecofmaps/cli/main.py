@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import difflib
+import functools
 import gc
 import importlib
 import os
@@ -90,11 +91,9 @@ EXIT_INTERRUPTED, EXIT_TERMINATED, EXIT_BROKEN_PIPE = 130, 143, 141
 
 
 def main(argv=None) -> int:
-    """Run the ``ecofmaps`` command; return its exit status: 0 on success; 2 for a user error
-    (one line naming it); 130 after Ctrl-C and 143 after SIGTERM, with one line telling what
-    was left (:func:`ecofmaps._interrupts.add_stop_note`), but not once the work is done; 1
-    for an unexpected failure (``ECOFMAPS_DEBUG=1`` shows the traceback). Warnings are printed
-    as ``ecofmaps COMMAND: warning: ...``, one line each."""
+    """Run the ``ecofmaps`` command; its exit status: 0, 2 for a user error, 130 or 143 after
+    Ctrl-C or SIGTERM (one line on what was left, :func:`ecofmaps._interrupts.add_stop_note`),
+    1 for a bug (``ECOFMAPS_DEBUG=1`` shows the traceback). Warnings print one line each."""
     interrupted = status = None
     try:  # the subcommands import JAX and xarray: an interrupt may come during the imports
         with interrupts_stop_writes() as interrupted, warnings.catch_warnings(record=True) as told:
@@ -106,7 +105,8 @@ def main(argv=None) -> int:
             except SystemExit as stop:  # a usage error (printed), --help or --version
                 status = int(stop.code or 0)
                 return status
-            warnings.showwarning = _warning_line(getattr(args, "command_prog", "ecofmaps"))
+            command = getattr(args, "command_prog", "ecofmaps")
+            warnings.showwarning = functools.partial(_show_warning, command)
             for warning in told:
                 warnings.showwarning(warning.message, warning.category, "", 0)
             status = args.handler(args)
@@ -166,21 +166,15 @@ def option_names(message: str) -> str:
     ``force_column (--force-col)`` and ``force_column`` are ``--force-col``,
     ``force_unit='foo'`` is ``--force-unit 'foo'``."""
 
-    def option(match) -> str:
-        if match[3]:  # the message names the option already
-            return match[3]
-        return _OPTIONS[match[1]] + (f" {match[2]}" if match[2] else "")
+    def option(match) -> str:  # match[3]: the message names the option already
+        return match[3] or _OPTIONS[match[1]] + (f" {match[2]}" if match[2] else "")
 
     return _KEYWORD.sub(option, message)
 
 
-def _warning_line(command: str):
-    """A ``warnings.showwarning`` that prints ``<command>: warning: <message>`` on one line."""
-
-    def show(message, category, filename, lineno, file=None, line=None) -> None:
-        print(f"{command}: warning: {' '.join(str(message).strip().splitlines())}", file=sys.stderr)
-
-    return show
+def _show_warning(command, message, category, filename, lineno, file=None, line=None) -> None:
+    """``warnings.showwarning`` as ``<command>: warning: <message>`` on one line."""
+    print(f"{command}: warning: {' '.join(str(message).strip().splitlines())}", file=sys.stderr)
 
 
 def _report(status: int, message: str) -> int:
@@ -190,12 +184,9 @@ def _report(status: int, message: str) -> int:
 
 
 def console() -> None:
-    """The ``ecofmaps`` console script: run :func:`main` and exit with its status. After a
-    stop the process ends at once (``os._exit``), its messages flushed and the run's objects
-    collected: tearing the interpreter down around JAX's busy threads can crash it. Once
-    :func:`main` has returned, a stop signal is ignored: a complete run stays complete. If
-    the reader of the output goes (``| head``), the command ends at once, quietly, with
-    :data:`EXIT_BROKEN_PIPE`."""
+    """The ``ecofmaps`` console script: exit with :func:`main`'s status; after a stop at once
+    (``os._exit``: tearing down around JAX's busy threads can crash); a stop signal once main
+    has returned is ignored; a reader that goes (``| head``) ends it quietly."""
     after = [n for n in STOP_SIGNALS if signal.getsignal(n) not in (signal.SIG_IGN, None)]
     for number in after:  # ignored once main has returned; until then main's to handle
         signal.signal(number, _nothing_to_stop)
