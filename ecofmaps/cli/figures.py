@@ -1,7 +1,7 @@
-"""``ecofmaps figures``: the paper's figures, drawn by groups sharing one Dataset
-(:func:`ecofmaps.figures.figure_groups`), the costliest first, on ``--jobs`` processes, the
-parts of a costly Dataset (:func:`ecofmaps.figures.figure_parts`) computed in parallel before
-it; JAX keeps its compiled kernels in ``<cache>/jax`` for the run."""
+"""``ecofmaps figures``: the paper's figures, by groups sharing one Dataset (costliest first,
+:func:`ecofmaps.figures.figure_groups`) on ``--jobs`` processes, the parts of a costly Dataset
+(:func:`ecofmaps.figures.figure_parts`) computed in parallel before it; JAX's kernels kept in
+``<cache>/jax``."""
 
 from __future__ import annotations
 
@@ -32,9 +32,9 @@ _FORMATS = ("png", "pdf", "svg")
 
 _HELP = {
     "--out": "directory to write into, created if missing (default: figures)",
+    "--only": "write only these figures (NAME: one of those listed below)",
     "--format": "comma-separated file formats among png, pdf, svg (default: png)",
-    "--overwrite": "replace the figures ecofmaps wrote in DIR before (a DIR that is not empty "
-    "needs it); files ecofmaps did not write are never replaced",
+    "--overwrite": "replace figures ecofmaps wrote in DIR (needed if it is not empty; no others)",
     "--jobs": "processes drawing at once (default: one per core, at most one per group of "
     "figures sharing their numbers; 1: all in this process)",
 }
@@ -68,16 +68,14 @@ def add(subparsers) -> None:
         "figures",
         help="write the paper's Figures 5-8 and 11, the universal map and the scar shapes "
         "(default: figures/)",
-        description="Write the paper's figures listed below, a file each per format (fig5.png, "
-        "...), at the paper's parameters: amplitude 50um (= groove half-width), load 450N, "
-        "stiffness 35MN/m, mu 0.8. Maps, loops and JAX's compiled kernels (jax/) are read from "
-        "the cache (ECOFMAPS_CACHE), else stored there; files are written atomically. Progress "
-        "goes to stderr.",
+        description="Write the paper's figures listed below, a file per format (fig5.png, ...), "
+        "at the paper's parameters: amplitude 50um (= groove half-width), load 450N, stiffness "
+        "35MN/m, mu 0.8. Maps, loops and JAX's kernels (jax/) are read from the cache "
+        "(ECOFMAPS_CACHE), else stored there; files are written atomically, progress to stderr.",
         epilog=f"figures:\n{listing}",
     )
-    only = f"write only these figures; NAME is one of: {', '.join(FIGURES)}"
-    option = option_adder(parser, {**_HELP, "--only": only})
-    option("--out", default="figures", metavar="DIR")
+    option = option_adder(parser, _HELP)
+    option("--out", type=Path, default="figures", metavar="DIR")
     option("--only", nargs="+", choices=list(FIGURES), metavar="NAME")
     option("--format", type=_figure_formats, default=("png",), metavar="FORMATS")
     option("--overwrite", action="store_true")
@@ -109,9 +107,8 @@ def _write_figure_group(names, directory, formats) -> list[tuple[str, list[Path]
     written, start = [], time.perf_counter()
     for name, figure in make_figures(names):
         paths = [save_figure(figure, Path(directory) / f"{name}.{suffix}") for suffix in formats]
-        now = time.perf_counter()
-        written.append((name, paths, now - start))
-        start = now
+        written.append((name, paths, time.perf_counter() - start))
+        start = time.perf_counter()
     return written
 
 
@@ -121,11 +118,12 @@ def _start_worker() -> None:
     _set_jax_options()
 
 
-def _in_worker(work, *arguments):
-    """``work(*arguments)`` in a drawing process, which ends when told to stop."""
+def _in_worker(task, out: Path, formats):
+    """A :class:`TaskQueue` task done in a drawing process, which ends when told to stop."""
+    kind, _, work = task
     try:
         with interrupts_stop_writes():  # SIGTERM from the parent: stop at a safe point
-            return work(*arguments)
+            return work() if kind == "part" else _write_figure_group(work, out, formats)
     except KeyboardInterrupt:  # its file removed; end without JAX's teardown, as console does
         os._exit(128 + signal.SIGTERM)
 
@@ -158,12 +156,6 @@ class TaskQueue:
         return self.started()
 
 
-def _call(task, out: Path, formats) -> tuple:
-    """The function and arguments of a :class:`TaskQueue` task."""
-    kind, _, work = task
-    return (work,) if kind == "part" else (_write_figure_group, work, out, formats)
-
-
 def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
     """Each group's :func:`_write_figure_group` from ``jobs`` processes (:class:`TaskQueue`)."""
     others = set(multiprocessing.active_children())
@@ -176,7 +168,7 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
     queue = TaskQueue(groups, parts, jobs)
 
     def submitted(tasks) -> dict:  # each future: its task
-        return {executor.submit(_in_worker, *_call(task, out, formats)): task for task in tasks}
+        return {executor.submit(_in_worker, task, out, formats): task for task in tasks}
 
     try:
         pending = submitted(queue.started())
@@ -217,21 +209,20 @@ def run(args) -> int:
     names = list(dict.fromkeys(args.only or ())) or None
     groups, parts = figure_groups(names), figure_parts(names)
     jobs = min(args.jobs or _usable_cores(), max(len(groups), *map(len, parts)))
-    out = Path(args.out)
     drawn = [name for group in groups for name in group]
-    planned = [("--out", out / f"{name}.{suffix}") for name in drawn for suffix in args.format]
-    refuse_to_overwrite(planned, [], overwrite=args.overwrite, folders=[("--out", out)])
-    with made_folder(out):
+    planned = [("--out", args.out / f"{name}.{suffix}") for name in drawn for suffix in args.format]
+    refuse_to_overwrite(planned, [], overwrite=args.overwrite, folders=[("--out", args.out)])
+    with made_folder(args.out):
         print(
-            f"ecofmaps figures: {len(drawn)} figure(s) as {', '.join(args.format)} into {out}"
+            f"ecofmaps figures: {len(drawn)} figure(s) as {', '.join(args.format)} into {args.out}"
             + (f", {jobs} processes" if jobs > 1 else ""),
             file=sys.stderr,
         )
         begin = time.perf_counter()
         if jobs > 1:
-            results = _written_in_parallel(groups, parts, out, args.format, jobs)
+            results = _written_in_parallel(groups, parts, args.out, args.format, jobs)
         else:
-            results = _written_here(groups, out, args.format)
+            results = _written_here(groups, args.out, args.format)
         written = (figure for group in results for figure in group)
         for index, (name, paths, seconds) in enumerate(written, start=1):
             record_written(paths)

@@ -332,7 +332,7 @@ def _checked(args) -> tuple[list[Path], float | str, list]:
         kinds += ("closure",) if args.scar_profile is not None else ()
         names = _plot_names(paths)
         outputs += [("--plots", Path(args.plots, f"{n}_{k}.png")) for n in names for k in kinds]
-    inputs = [*paths, *([args.scar_profile] if args.scar_profile is not None else [])]
+    inputs = [path for path in (*paths, args.scar_profile) if path is not None]
     folders = [("--plots", args.plots)]
     refuse_to_overwrite(outputs, inputs, overwrite=args.overwrite, folders=folders)
     return paths, load, outputs
@@ -424,11 +424,8 @@ def run(args) -> int:
             lab, closure = ({}, None) if scar is None else _scar_numbers(args, done[0], scar)
             _write_extras(args, done, lab, closure)
     except _NothingAnalysed:
-        print(
-            f"ecofmaps loops: none of the {len(paths)} recordings could be analysed; "
-            "nothing written",
-            file=sys.stderr,
-        )
+        none = f"none of the {len(paths)} recordings could be analysed; nothing written"
+        print(f"ecofmaps loops: {none}", file=sys.stderr)
         return 1
     with interrupts_deferred():  # the table is in place: a stop now would leave it unrecorded
         record_written(path for _, path in outputs if path is not None)

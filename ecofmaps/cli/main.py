@@ -73,11 +73,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _unknown_arguments(unknown, args) -> str:
     """The error line of arguments unknown to the subcommand, with did-you-means."""
-    guesses = [
-        difflib.get_close_matches(word.split("=")[0], args.command_options, n=1)
-        for word in unknown
-        if word.startswith("--")
-    ]
+    words = [word.split("=")[0] for word in unknown if word.startswith("--")]
+    guesses = [difflib.get_close_matches(word, args.command_options, n=1) for word in words]
     hint = "".join(f"; did you mean {guess[0]}?" for guess in guesses if guess)
     return (
         f"ecofmaps: error: unrecognized arguments: {' '.join(unknown)}{hint} "
@@ -105,7 +102,7 @@ def main(argv=None) -> int:
             except SystemExit as stop:  # a usage error (printed), --help or --version
                 status = int(stop.code or 0)
                 return status
-            command = getattr(args, "command_prog", "ecofmaps")
+            command = getattr(args, "command_prog", "ecofmaps")  # set by every subcommand
             warnings.showwarning = functools.partial(_show_warning, command)
             for warning in told:
                 warnings.showwarning(warning.message, warning.category, "", 0)
@@ -125,11 +122,8 @@ def main(argv=None) -> int:
             return _report(1, "error: not enough memory for this run")
         if os.environ.get("ECOFMAPS_DEBUG"):
             raise
-        return _report(
-            1,
-            f"error: unexpected {type(error).__name__}: {error} (a bug: please report it; "
-            "ECOFMAPS_DEBUG=1 shows the traceback)",
-        )
+        bug = f"error: unexpected {type(error).__name__}: {error} (a bug: please report it"
+        return _report(1, f"{bug}; ECOFMAPS_DEBUG=1 shows the traceback)")
 
 
 def _stopped(interrupted, note) -> int:
