@@ -108,11 +108,9 @@ CACHE_DIR_HELP = "cache directory (default: $ECOFMAPS_CACHE, else the per-user c
 _RECORDING_HELP = {
     "--displacement-col": "name of the displacement column (default: displacement)",
     "--force-col": "name of the tangential force column (default: force)",
-    "--cycle-col": "name of a column of cycle numbers (default: 'cycle' if the file has it; else, "
-    "or with 'none', cycles are cut at the reversals)",
+    "--cycle-col": "cycle-number column (default: 'cycle' if any; 'none': cut at the reversals)",
     "--skip-rows": "lines before a text file's header to skip (default: found as metadata)",
-    "--displacement-unit": "unit of the displacement column (default: from its name, as in "
-    "'displacement [mm]', or the file, else um)",
+    "--displacement-unit": "unit of the displacement (default: from its name or the file, else um)",
     "--force-unit": "unit of the force column (default: from its name or the file, else N)",
     "--group": "TDMS group, or HDF5/netCDF/zarr group, holding the channels (default: any)",
 }

@@ -22,8 +22,7 @@ _HELP = {
     "destination": "the file or store to write",
     "--chunk-samples": "samples per block read, and per chunk of the store (at most "
     f"{CHUNK_BYTES // 8}, and no more than the recording) (default %(default)s)",
-    "--overwrite": "replace DST if ecofmaps wrote it (once the new one is complete); a file or "
-    "folder ecofmaps did not write is never replaced",
+    "--overwrite": "replace DST if ecofmaps wrote it, once the new one is complete (no other)",
 }
 
 

@@ -50,8 +50,7 @@ _HELP = {
     "the groove slope g(ξ) and the felt profile h(ξ) over (cycle, position)",
     "--report": "also write one recording as an offline HTML page: friction and quality flags, "
     'loops with the model\'s, the table (needs pip install "ecofmaps[web]")',
-    "--no-resolve": "skip the reading along the stroke (ten times faster; no mu_resolved, "
-    "mu_resolved_se, aspect_ratio)",
+    "--no-resolve": "skip the reading along the stroke (ten times faster; no mu_resolved, ...)",
     "--flip-force": "read the force with the other sign (loops that run anticlockwise)",
     "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m, in series with the contact: adds "
     "the ratios on the contact's displacement, the regime there, a sweep's δ_t",
