@@ -62,8 +62,7 @@ def quantity(name: str, grid: bool = False, option: str | None = None):
 
 
 def unit(kind: str):
-    """An argparse ``type`` reading a unit of ``kind`` (``'um'``), kept as text: one of that
-    dimension whose size is positive and finite (not a number, ``'0um'``)."""
+    """An argparse ``type`` reading a unit of ``kind`` (``'um'``, not ``'0um'``), kept as text."""
     example = DIMENSIONS[kind][1]
 
     def parse(text: str) -> str:
@@ -220,18 +219,11 @@ def read_profile(args, conflicting=()):
     from ecofmaps.io.scar_profiles import read_scar_profile  # JAX: not with the command line
     from ecofmaps.model.profiles import ScarProfileWarning
 
+    reading = {name: getattr(args, name) for name in ("x_column", "z_column", "x_unit", "z_unit")}
+    reading |= {"level": not args.no_level, "half_width": args.profile_half_width}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ScarProfileWarning)
-        profile = read_scar_profile(
-            args.scar_profile,
-            x_column=args.x_column,
-            z_column=args.z_column,
-            x_unit=args.x_unit,
-            z_unit=args.z_unit,
-            level=not args.no_level,
-            half_width=args.profile_half_width,
-            smoothing=args.smoothing,
-        )
+        profile = read_scar_profile(args.scar_profile, smoothing=args.smoothing, **reading)
     args.profile_alternative = ""  # what the other half-width is, for profile_rows
     for item in caught:
         if not issubclass(item.category, ScarProfileWarning):
@@ -239,9 +231,8 @@ def read_profile(args, conflicting=()):
             continue
         said, hint = item.message, ""
         if said.alternative is not None:
-            args.profile_alternative = said.alternative_name
-            hint = f"; --profile-half-width {said.alternative * 1e6:.6g}um takes the "
-            hint += said.alternative_name
+            args.profile_alternative = other = said.alternative_name
+            hint = f"; --profile-half-width {said.alternative * 1e6:.6g}um takes the {other}"
         print(f"{args.command_prog}: warning: {said.summary}{hint}", file=sys.stderr)
     return profile
 
@@ -317,10 +308,9 @@ def read_scar_file(path, command: str, x_unit=None, z_unit=None):
 
 
 def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=()) -> None:
-    """Raise :class:`CommandError` unless the command may write its ``outputs`` and into its
-    ``folders`` (each (option, path or None)), the one rule: into an existing directory (a
-    ``folders`` one is made); never over an input; over a file only with ``overwrite`` if
-    ecofmaps wrote it, unchanged since; into a folder holding anything only with ``overwrite``."""
+    """:class:`CommandError` unless ``outputs`` and ``folders`` ((option, path or None) each) may
+    be written: into an existing directory (``folders`` are made), never over an input; over a
+    file ecofmaps wrote, unchanged, or into a folder not empty only with ``overwrite``."""
     outputs = [(option, Path(path)) for option, path in outputs if path is not None]
     sources = [Path(path) for path in inputs]
     made = [option for option, _ in folders]
@@ -390,8 +380,7 @@ def _resolved(path: Path) -> Path:
 
 
 def row(name: str, value, note: str = "") -> tuple[str, str, str]:
-    """One printed row: the quantity's words (then ``note``) and symbol, and ``value`` [SI] in
-    its display unit (text as it is; NaN ``undefined``; an infinite stiffness ``inf (rigid)``)."""
+    """One printed row: the quantity's words (and ``note``), symbol, ``value`` [SI] displayed."""
     quantity = QUANTITIES[name]
     words = f"{quantity.words} {note}".strip()
     if isinstance(value, str):

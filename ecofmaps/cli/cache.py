@@ -27,7 +27,6 @@ def add(subparsers) -> None:
 
 
 def run(args) -> int:
-    """Run ``ecofmaps cache list`` or ``clear``; the exit status."""
     from ecofmaps.maps.cache import cache_directory, cache_entries, clear_cache
 
     directory = cache_directory(args.cache_dir)

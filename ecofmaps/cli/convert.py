@@ -47,7 +47,6 @@ def add(subparsers) -> None:
 
 
 def run(args) -> int:
-    """Run ``ecofmaps convert`` with the parsed ``args``; the exit status."""
     from ecofmaps.io.recordings import read_recording
     from ecofmaps.io.writers import WRITE_FORMATS, convert_recording
 

@@ -66,7 +66,6 @@ def add(subparsers) -> None:
 
 
 def run(args) -> int:
-    """Run ``ecofmaps correct`` with the parsed ``args``; the exit status."""
     from ecofmaps.correction.inversion import correct_ecof
 
     given = [name for name in (*POINT_OPTIONS, *GROOVE_OPTIONS) if getattr(args, name) is not None]

@@ -51,13 +51,6 @@ def _figure_formats(text: str) -> tuple[str, ...]:
     return formats
 
 
-def _usable_cores() -> int:
-    """The number of cores this process may run on (its affinity, where the system has one)."""
-    if hasattr(os, "sched_getaffinity"):
-        return max(1, len(os.sched_getaffinity(0)))
-    return os.cpu_count() or 1
-
-
 def add(subparsers) -> None:
     from ecofmaps.figures.recipes import FIGURES  # the names for the parser (no JAX)
 
@@ -128,9 +121,8 @@ def _in_worker(task, out: Path, formats):
 
 
 class TaskQueue:
-    """The order of the parallel work: parts first, then groups, never more at once than
-    ``jobs``, a group whose parts are done drawn next (the costliest). A task is
-    ``('part', index, callable)`` or ``('group', index, names)``."""
+    """The order of the parallel work, ``jobs`` tasks at once: parts, then the groups whose parts
+    are done. A task is ``('part', index, callable)`` or ``('group', index, names)``."""
 
     def __init__(self, groups, parts, jobs: int):
         self.groups, self.jobs, self.running = groups, jobs, 0
@@ -207,7 +199,8 @@ def run(args) -> int:
 
     names = list(dict.fromkeys(args.only or ())) or None
     groups, parts = figure_groups(names), figure_parts(names)
-    jobs = min(args.jobs or _usable_cores(), max(len(groups), *map(len, parts)))
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    jobs = min(args.jobs or cores or 1, max(len(groups), *map(len, parts)))
     drawn = [name for group in groups for name in group]
     planned = [("--out", args.out / f"{name}.{suffix}") for name in drawn for suffix in args.format]
     refuse_to_overwrite(planned, [], overwrite=args.overwrite, folders=[("--out", args.out)])

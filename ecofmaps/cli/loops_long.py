@@ -214,8 +214,7 @@ class _Partial:
 
 
 class LongRun:
-    """The recordings ``paths`` of one ``ecofmaps loops`` through the pipeline; ``lazy`` for
-    :func:`ecofmaps.read_recording`: True if ``--workers``, ``--scheduler`` or ``--resume``."""
+    """The recordings ``paths`` of one ``ecofmaps loops`` through the pipeline."""
 
     def __init__(self, args, paths):
         if args.workers and args.scheduler:
@@ -229,7 +228,7 @@ class LongRun:
                 "to start again"
             )
         self.args, self.paths, self.partial = args, paths, None
-        self.lazy = True if (args.workers or args.scheduler or args.resume) else None
+        self.lazy = True if (args.workers or args.scheduler or args.resume) else None  # else by size
         self.analysed = None  # (index, path, blocks or None) of the recording analysed last
         scar = args.scar_profile is not None
         handed = args.plots is not None or args.resolved is not None or scar  # on 201 positions
@@ -241,8 +240,7 @@ class LongRun:
         )
 
     def analyse(self, index, path, recording, load, write, columns):
-        """The results of recording ``index`` (its ``columns`` if given) and its reading along
-        the stroke if handed back; each chunk's lines given to ``write`` in order."""
+        """Results (of ``columns``) and reading along the stroke of recording ``index``."""
         args, runner = self.args, contextlib.nullcontext(IN_PROCESS)
         if recording.lazy:
             runner = runner_for("processes" if args.workers else args.scheduler, args.workers)
@@ -269,8 +267,7 @@ class LongRun:
         return analysis.finish([parts.pop(k) for k in sorted(parts)]), resolved
 
     def stop_note(self) -> str | None:
-        """The sentence naming the folder a stop leaves beside ``--out``, or None (one this run
-        made that holds no work yet is removed)."""
+        """The sentence naming the folder a stop leaves beside ``--out`` (None: none kept)."""
         partial = self.partial
         if partial is None or not partial.folder.exists():
             return None

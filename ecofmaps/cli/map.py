@@ -80,7 +80,6 @@ def add(subparsers) -> None:
 
 
 def run(args) -> int:
-    """Run ``ecofmaps map``; the exit status."""
     from ecofmaps.maps.files import ZARR_SUFFIX, write_map
     from ecofmaps.maps.grid import compute_map
     from ecofmaps.model import Regime

@@ -53,7 +53,6 @@ def add(subparsers) -> None:
 
 
 def run(args) -> int:
-    """Run ``ecofmaps model``; the exit status."""
     from ecofmaps import model
     from ecofmaps._codes import RegimeWarning
 

@@ -74,7 +74,6 @@ def _columns(found, names, quantity="{}") -> dict:
 
 
 def run(args) -> int:
-    """Run ``ecofmaps wear`` with the parsed ``args``; the exit status."""
     import pandas as pd
 
     from ecofmaps.io.tables import csv_text, read_results
