@@ -228,7 +228,7 @@ class LongRun:
                 "to start again"
             )
         self.args, self.paths, self.partial = args, paths, None
-        self.lazy = True if (args.workers or args.scheduler or args.resume) else None  # else by size
+        self.lazy = True if (args.workers or args.scheduler or args.resume) else None  # or by size
         self.analysed = None  # (index, path, blocks or None) of the recording analysed last
         scar = args.scar_profile is not None
         handed = args.plots is not None or args.resolved is not None or scar  # on 201 positions
