@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ecofmaps.cli._common import CACHE_DIR_HELP, byte_size
+from ecofmaps.cli import common
 
 __all__ = ["add", "run"]
 
@@ -22,7 +22,7 @@ def add(subparsers) -> None:
         ("clear", "remove every cached map"),
     ):
         action = actions.add_parser(name, help=text, description=text + ".")
-        action.add_argument("--cache-dir", metavar="DIR", help=CACHE_DIR_HELP)
+        action.add_argument("--cache-dir", metavar="DIR", help=common.CACHE_DIR_HELP)
         action.set_defaults(action=name)
 
 
@@ -32,7 +32,7 @@ def run(args) -> int:
     directory = cache_directory(args.cache_dir)
     if args.action == "clear":
         files, size = clear_cache(directory)
-        print(f"removed {files} file(s), {byte_size(size)}, from {directory}")
+        print(f"removed {files} file(s), {common.byte_size(size)}, from {directory}")
         return 0
     entries = cache_entries(directory)
     if not entries:
@@ -41,6 +41,6 @@ def run(args) -> int:
     print(f"cached maps in {directory}:")
     for entry in entries:
         modified = entry.modified.astimezone().strftime("%Y-%m-%d %H:%M:%S")
-        print(f"  {byte_size(entry.size):>9}  {modified}  {entry.path.name}")
-    print(f"{len(entries)} file(s), {byte_size(sum(entry.size for entry in entries))}")
+        print(f"  {common.byte_size(entry.size):>9}  {modified}  {entry.path.name}")
+    print(f"{len(entries)} file(s), {common.byte_size(sum(entry.size for entry in entries))}")
     return 0

@@ -4,15 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ecofmaps.cli._common import (
-    CommandError,
-    add_recording_options,
-    command_parser,
-    count,
-    option_adder,
-    recording_options,
-    refuse_to_overwrite,
-)
+from ecofmaps.cli import common
+from ecofmaps.cli.main import CommandError
 from ecofmaps.io.files import CHUNK_BYTES, record_written
 
 __all__ = ["add", "run"]
@@ -27,7 +20,7 @@ _HELP = {
 
 
 def add(subparsers) -> None:
-    parser = command_parser(
+    parser = common.command_parser(
         subparsers,
         "convert",
         help="copy a recording (e.g. a large CSV file) into a chunked zarr, HDF5 or TDMS file",
@@ -38,11 +31,11 @@ def add(subparsers) -> None:
         "converted once is read lazily, in parallel, by 'ecofmaps loops'.",
         epilog="example:\n  ecofmaps convert test.csv test.zarr --displacement-unit um",
     )
-    option = option_adder(parser, _HELP)
+    option = common.option_adder(parser, _HELP)
     option("source", metavar="SRC")
     option("destination", metavar="DST")
-    add_recording_options(parser)
-    option("--chunk-samples", type=count("samples"), default=1 << 20, metavar="N")
+    common.add_recording_options(parser)
+    option("--chunk-samples", type=common.count("samples"), default=1 << 20, metavar="N")
     option("--overwrite", action="store_true")
 
 
@@ -50,18 +43,14 @@ def run(args) -> int:
     from ecofmaps.io.recordings import read_recording
     from ecofmaps.io.writers import WRITE_FORMATS, convert_recording
 
-    source, destination = Path(args.source), Path(args.destination)
-    if destination.suffix.lower() not in WRITE_FORMATS:
-        raise CommandError(
-            f"cannot tell the format of {destination} from its suffix: use one of "
-            f"{', '.join(WRITE_FORMATS)}"
-        )
-    refuse_to_overwrite([("the destination", destination)], [source], overwrite=args.overwrite)
-    options = recording_options(args)
-    convert_recording(
-        source, destination, chunk_samples=args.chunk_samples, overwrite=args.overwrite, **options
-    )
-    record_written([destination])
-    with read_recording(destination, lazy=True) as written:
-        print(f"wrote {destination}: {written.size} samples of {', '.join(written.columns)} (SI)")
+    source, out = Path(args.source), Path(args.destination)
+    if out.suffix.lower() not in WRITE_FORMATS:
+        formats = ", ".join(WRITE_FORMATS)
+        raise CommandError(f"cannot tell the format of {out} from its suffix: use one of {formats}")
+    common.refuse_to_overwrite([("the destination", out)], [source], overwrite=args.overwrite)
+    options = common.recording_options(args) | {"chunk_samples": args.chunk_samples}
+    convert_recording(source, out, overwrite=args.overwrite, **options)
+    record_written([out])
+    with read_recording(out, lazy=True) as written:
+        print(f"wrote {out}: {written.size} samples of {', '.join(written.columns)} (SI)")
     return 0

@@ -6,20 +6,8 @@ import sys
 import warnings
 
 from ecofmaps._version import __version__
-from ecofmaps.cli._common import (
-    TWO_COLUMNS,
-    CommandError,
-    add_profile_options,
-    option_adder,
-    options,
-    print_rows,
-    profile_rows,
-    quantity,
-    read_profile,
-    refuse_to_overwrite,
-    row,
-    two_values,
-)
+from ecofmaps.cli import common
+from ecofmaps.cli.main import CommandError
 from ecofmaps.io.files import record_written, write_text
 
 __all__ = ["add", "run"]
@@ -56,13 +44,13 @@ def add(subparsers) -> None:
         "NaN, its reason in a status column and an error line naming file, line (the header is "
         "1) and column; the others are written, exit status 1.",
     )
-    option = option_adder(parser, _HELP)
+    option = common.option_adder(parser, _HELP)
     option("table", nargs="?", metavar="TABLE")
     option("--out", metavar="OUT")
     option("--overwrite", action="store_true")
     for name in (*POINT_OPTIONS, *GROOVE_OPTIONS):
-        option(options([name]), type=quantity(name))
-    add_profile_options(parser)
+        option(common.options([name]), type=common.quantity(name))
+    common.add_profile_options(parser)
 
 
 def run(args) -> int:
@@ -71,26 +59,30 @@ def run(args) -> int:
     given = [name for name in (*POINT_OPTIONS, *GROOVE_OPTIONS) if getattr(args, name) is not None]
     if args.table is not None:
         if given:
-            raise CommandError(f"give a TABLE or one point's options, not both ({options(given)})")
+            raise CommandError(
+                f"give a TABLE or a point's options, not both ({common.options(given)})"
+            )
         inputs = [path for path in (args.table, args.scar_profile) if path is not None]
-        refuse_to_overwrite([("--out", args.out)], inputs, overwrite=args.overwrite)
-        return _table(args, read_profile(args))
+        common.refuse_to_overwrite([("--out", args.out)], inputs, overwrite=args.overwrite)
+        return _table(args, common.read_profile(args))
     if args.out is not None:
         raise CommandError("--out writes a corrected TABLE; give the TABLE too")
     if missing := ["--" + name for name in POINT_OPTIONS if getattr(args, name) is None]:
         raise CommandError(f"give {', '.join(missing)} (or a TABLE)")
-    profile = read_profile(args, conflicting=GROOVE_OPTIONS)
+    profile = common.read_profile(args, conflicting=GROOVE_OPTIONS)
     rig = {name: getattr(args, name) for name in POINT_OPTIONS[1:]}
-    rows = [row("ecof", args.ecof, "(reported)"), *(row(name, rig[name]) for name in rig)]
+    rows = [common.row("ecof", args.ecof, "(reported)")]
+    rows += [common.row(name, value) for name, value in rig.items()]
     title = f"ecofmaps {__version__}: reported ECoF corrected to the contact CoF"
     if profile is not None:  # beside the D/W shortcut (eq. 11)
         mu = float(correct_ecof(args.ecof, **rig, profile=profile, mapping=args.mapping))
         ratio = float(profile.aspect_ratio)  # the parabola's: NaN ('undefined') where it cannot
         shortcut = float(correct_ecof(args.ecof, **rig, aspect_ratio=ratio, return_status=True)[0])
-        rows += [*profile_rows(args, profile), None, TWO_COLUMNS, two_values("mu", mu, shortcut)]
-        rows.append(two_values("correction_factor", mu / args.ecof, shortcut / args.ecof))
+        rows += [*common.profile_rows(args, profile), None, common.TWO_COLUMNS]
+        rows.append(common.two_values("mu", mu, shortcut))
+        rows.append(common.two_values("correction_factor", mu / args.ecof, shortcut / args.ecof))
         mapping = "X = x" if args.mapping == "physical" else "X = x W/Δ*, eq. 11"
-        print_rows(f"{title} on a measured scar profile ({mapping})", rows)
+        common.print_rows(f"{title} on a measured scar profile ({mapping})", rows)
         return 0
     scar = {name: getattr(args, name) for name in GROOVE_OPTIONS if name in given}
     if list(scar) not in (["aspect_ratio"], ["scar_depth", "scar_half_width"]):
@@ -101,8 +93,9 @@ def run(args) -> int:
         ratio_text = f"{depth / width:.6g} (scar {depth * 1e6:.6g} µm deep, "
         ratio_text += f"{width * 1e6:.6g} µm half-width)"
     mu = float(correct_ecof(args.ecof, **rig, **scar))
-    rows += [row("aspect_ratio", ratio_text), None, row("mu", mu)]
-    print_rows(f"{title} (x_o = Δ*)", [*rows, row("correction_factor", mu / args.ecof)])
+    rows += [common.row("aspect_ratio", ratio_text), None, common.row("mu", mu)]
+    rows.append(common.row("correction_factor", mu / args.ecof))
+    common.print_rows(f"{title} (x_o = Δ*)", rows)
     return 0
 
 

@@ -17,13 +17,7 @@ from pathlib import Path
 
 from ecofmaps._interrupts import check_interrupted, interrupts_stop_writes
 from ecofmaps._parallel import start_resource_tracker_quietly
-from ecofmaps.cli._common import (
-    command_parser,
-    count,
-    made_folder,
-    option_adder,
-    refuse_to_overwrite,
-)
+from ecofmaps.cli import common
 from ecofmaps.io.files import record_written
 
 __all__ = ["TaskQueue", "add", "run"]
@@ -55,7 +49,7 @@ def add(subparsers) -> None:
     from ecofmaps.figures.recipes import FIGURES  # the names for the parser (no JAX)
 
     listing = "\n".join(f"  {name:<10} {recipe.description}" for name, recipe in FIGURES.items())
-    parser = command_parser(
+    parser = common.command_parser(
         subparsers,
         "figures",
         help="write the paper's Figures 5-8 and 11, the universal map and the scar shapes "
@@ -66,12 +60,12 @@ def add(subparsers) -> None:
         "(ECOFMAPS_CACHE), else stored there; files are written atomically, progress to stderr.",
         epilog=f"figures:\n{listing}",
     )
-    option = option_adder(parser, _HELP)
+    option = common.option_adder(parser, _HELP)
     option("--out", type=Path, default="figures", metavar="DIR")
     option("--only", nargs="+", choices=list(FIGURES), metavar="NAME")
     option("--format", type=_figure_formats, default=("png",), metavar="FORMATS")
     option("--overwrite", action="store_true")
-    option("--jobs", type=count("processes"), metavar="N")
+    option("--jobs", type=common.count("processes"), metavar="N")
 
 
 def _set_jax_options(options: dict | None = None) -> dict:
@@ -203,8 +197,8 @@ def run(args) -> int:
     jobs = min(args.jobs or cores or 1, max(len(groups), *map(len, parts)))
     drawn = [name for group in groups for name in group]
     planned = [("--out", args.out / f"{name}.{suffix}") for name in drawn for suffix in args.format]
-    refuse_to_overwrite(planned, [], overwrite=args.overwrite, folders=[("--out", args.out)])
-    with made_folder(args.out):
+    common.refuse_to_overwrite(planned, [], overwrite=args.overwrite, folders=[("--out", args.out)])
+    with common.made_folder(args.out):
         print(
             f"ecofmaps figures: {len(drawn)} figure(s) as {', '.join(args.format)} into {args.out}"
             + (f", {jobs} processes" if jobs > 1 else ""),

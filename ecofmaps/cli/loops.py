@@ -17,21 +17,8 @@ import numpy as np
 from ecofmaps._interrupts import interrupts_deferred
 from ecofmaps._nomenclature import QUANTITIES, texts_with_se, transition_texts, with_se
 from ecofmaps._parallel import worker_limit
-from ecofmaps.cli._common import (
-    CommandError,
-    add_contact_options,
-    add_recording_options,
-    command_parser,
-    contact,
-    count,
-    made_folder,
-    option_adder,
-    quantity,
-    read_scar_file,
-    recording_options,
-    refuse_to_overwrite,
-)
-from ecofmaps.cli.main import option_names
+from ecofmaps.cli import common
+from ecofmaps.cli.main import CommandError, option_names
 from ecofmaps.io.files import FileLineError, atomic_path, record_written
 from ecofmaps.web import INSTALL_WEB, missing_web_packages
 
@@ -68,7 +55,7 @@ _HELP = {
 
 
 def add(subparsers) -> None:
-    parser = command_parser(
+    parser = common.command_parser(
         subparsers,
         "loops",
         help="analyse recorded fretting loops cycle by cycle: ECoF, GICoF, stiffness, ...",
@@ -87,7 +74,7 @@ def add(subparsers) -> None:
         epilog="examples:\n  ecofmaps loops test.csv --load 450N --out results.csv --plots plots\n"
         "  ecofmaps loops --example --out results.csv --plots plots",
     )
-    option = option_adder(parser, _HELP)
+    option = common.option_adder(parser, _HELP)
     option("files", nargs="*", metavar="FILE")
     option("--example", action="store_true")
     option("--load", type=_load_or_column, metavar="P")
@@ -98,17 +85,18 @@ def add(subparsers) -> None:
     option("--report", metavar="FILE.html")
     option("--no-resolve", action="store_true")
     option("--flip-force", action="store_true")
-    option("--rig-stiffness", type=quantity("stiffness", option="--rig-stiffness"), metavar="S")
+    stiffness = common.quantity("stiffness", option="--rig-stiffness")
+    option("--rig-stiffness", type=stiffness, metavar="S")
     option("--scar-profile", metavar="FILE")
-    add_contact_options(parser, required=False)
+    common.add_contact_options(parser, required=False)
     option("--nan-policy", choices=("skip", "raise"), default="skip")
-    add_recording_options(parser)
+    common.add_recording_options(parser)
     long_tests = parser.add_argument_group(
         "long tests",
         "a file of more than 2**24 samples is analysed out of core, whole cycles a block at a "
         "time (the numbers are those of the analysis in memory)",
     )
-    option = option_adder(long_tests, _HELP)
+    option = common.option_adder(long_tests, _HELP)
     option("--workers", type=_workers, metavar="N")
     option("--scheduler", metavar="ADDRESS")
     option("--resume", action="store_true")
@@ -116,7 +104,7 @@ def add(subparsers) -> None:
 
 
 def _workers(text: str) -> int:
-    value = count("workers")(text)
+    value = common.count("workers")(text)
     limit, why = worker_limit(processes=True)
     if value > limit:
         raise argparse.ArgumentTypeError(f"{value} is more than this machine can run: {why}")
@@ -126,7 +114,7 @@ def _workers(text: str) -> int:
 def _load_or_column(text: str):
     """``--load``: a load [N] (a float), or the name of a column (a str)."""
     try:
-        return quantity("load")(text)
+        return common.quantity("load")(text)
     except argparse.ArgumentTypeError:
         name = text.strip()
         try:
@@ -252,7 +240,7 @@ def _scar_numbers(args, each, profile) -> tuple[dict, object]:
     from ecofmaps.lab import energy_wear, loop_scar_closure
 
     rows, closure = {}, None
-    if (kind := contact(args)) is not None:
+    if (kind := common.contact(args)) is not None:
         try:
             wear = energy_wear(each.results, profile, args.length, kind)
         except ValueError as error:
@@ -321,7 +309,7 @@ def _checked(args) -> tuple[list[Path], float | str, list]:
             "--scar-profile is the scar of one recording, closed on its loops read along the "
             "stroke: give one FILE, without --no-resolve"
         )
-    if args.scar_profile is None and contact(args) is not None:
+    if args.scar_profile is None and common.contact(args) is not None:
         raise CommandError("--length or --sphere reads the wear on a --scar-profile: give it")
     if args.report is not None and missing_web_packages():
         raise CommandError(INSTALL_WEB)
@@ -333,7 +321,7 @@ def _checked(args) -> tuple[list[Path], float | str, list]:
         outputs += [("--plots", Path(args.plots, f"{n}_{k}.png")) for n in names for k in kinds]
     inputs = [path for path in (*paths, args.scar_profile) if path is not None]
     folders = [("--plots", args.plots)]
-    refuse_to_overwrite(outputs, inputs, overwrite=args.overwrite, folders=folders)
+    common.refuse_to_overwrite(outputs, inputs, overwrite=args.overwrite, folders=folders)
     return paths, load, outputs
 
 
@@ -353,7 +341,7 @@ def _analyse_each(args, paths, load, long_run, table) -> tuple[list[_Analysed], 
     for index, (path, plot_name) in enumerate(zip(paths, _plot_names(paths), strict=True)):
         held = []  # a recording in memory: its lines once its analysis has succeeded
         try:
-            options = recording_options(args)
+            options = common.recording_options(args)
             options["load_column"] = load if isinstance(load, str) else None  # --load COLUMN
             # closed once analysed: the report reads only its names and units
             with read_recording(path, lazy=long_run.lazy, **options) as recording:
@@ -377,7 +365,7 @@ def _write_extras(args, done: list[_Analysed], lab: dict, closure) -> None:
     if args.plots is not None:
         from ecofmaps import figures  # matplotlib only when plots are asked for
 
-        with made_folder(Path(args.plots)) as folder:  # none left empty behind
+        with common.made_folder(Path(args.plots)) as folder:  # none left empty behind
             for each in done:
                 results, resolved, source = each.results, each.resolved, each.path.name
                 drawn = {
@@ -408,7 +396,7 @@ def run(args) -> int:
     from ecofmaps.cli.loops_long import LongRun
 
     paths, load, outputs = _checked(args)
-    scar = None if args.scar_profile is None else read_scar_file(args.scar_profile, "loops")
+    scar = None if args.scar_profile is None else common.read_scar_file(args.scar_profile, "loops")
     long_run = LongRun(args, paths)
     try:
         with contextlib.ExitStack() as stack:  # the table is written as it comes, renamed last

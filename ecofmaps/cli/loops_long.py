@@ -20,7 +20,8 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps._interrupts import INTERRUPTED, Interrupted, add_stop_note
-from ecofmaps.cli._common import CommandError, progress_bar
+from ecofmaps.cli import common
+from ecofmaps.cli.main import CommandError
 from ecofmaps.io.tables import results_csv
 from ecofmaps.measured.cycles import Cycles
 from ecofmaps.measured.pipeline import (
@@ -362,4 +363,4 @@ class _Interrupted(KeyboardInterrupt):
 
 def _bar(analysis, path, shown: bool, initial: int):
     total, options = int(analysis.cycles.label.size), {"disable": not shown, "smoothing": 0.1}
-    return progress_bar(total, path.name, initial=initial, unit=" cycles", **options)
+    return common.progress_bar(total, path.name, initial=initial, unit=" cycles", **options)

@@ -12,17 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ecofmaps.cli._common import (
-    CACHE_DIR_HELP,
-    CommandError,
-    byte_size,
-    command_parser,
-    count,
-    option_adder,
-    progress_bar,
-    quantity,
-    refuse_to_overwrite,
-)
+from ecofmaps.cli import common
+from ecofmaps.cli.main import CommandError
 from ecofmaps.io.files import record_written
 
 __all__ = ["add", "run"]
@@ -40,12 +31,12 @@ _HELP = {
     "--chunk-points": "grid points per block computed into --out (default %(default)s)",
     "--quiet": "no progress bar (none is shown off a terminal)",
     "--no-cache": "do not use the cache (no map of the parabolic groove is cached: for scripts)",
-    "--cache-dir": CACHE_DIR_HELP,
+    "--cache-dir": common.CACHE_DIR_HELP,
 }
 
 
 def add(subparsers) -> None:
-    parser = command_parser(
+    parser = common.command_parser(
         subparsers,
         "map",
         help="compute the model over a grid of test conditions into a netCDF file or zarr store",
@@ -65,15 +56,15 @@ def add(subparsers) -> None:
         "  ecofmaps map --stiffness-ratio 0.01/um:0.3/um:25000 --aspect-ratio 0:0.4:20000 "
         "\\\n      --amplitude 25um,50um --mu 0.8 --out big.zarr",
     )
-    option = option_adder(parser, _HELP)
+    option = common.option_adder(parser, _HELP)
     for name, metavar in _AXES.items():
-        values = quantity(name, grid=True)
+        values = common.quantity(name, grid=True)
         option(f"--{name.replace('_', '-')}", type=values, required=True, metavar=metavar)
-    option("--load", type=quantity("load"), metavar="P")
+    option("--load", type=common.quantity("load"), metavar="P")
     option("--out", required=True, metavar="FILE.nc|FILE.zarr")
     option("--overwrite", action="store_true")
     # blocks of 2**22 points by default: about 220 MB of results with a load
-    option("--chunk-points", type=count("points"), default=2**22, metavar="N")
+    option("--chunk-points", type=common.count("points"), default=2**22, metavar="N")
     option("--quiet", action="store_true")
     option("--no-cache", action="store_true")
     option("--cache-dir", metavar="DIR")
@@ -85,22 +76,22 @@ def run(args) -> int:
     from ecofmaps.model import Regime
 
     out = Path(args.out)
-    refuse_to_overwrite([("--out", out)], [], overwrite=args.overwrite)
+    common.refuse_to_overwrite([("--out", out)], [], overwrite=args.overwrite)
     grid = {name: getattr(args, name) for name in _AXES}
     grid = {name: values[0] if values.size == 1 else values for name, values in grid.items()}
     points = math.prod(values.size for values in grid.values() if np.ndim(values))
     size = _map_bytes(grid, args.load)
     free = shutil.disk_usage(out.parent).free
     print(
-        f"ecofmaps map: {points:,} points, {byte_size(size)} into {out} "
-        f"({byte_size(free)} free there)",
+        f"ecofmaps map: {points:,} points, {common.byte_size(size)} into {out} "
+        f"({common.byte_size(free)} free there)",
         flush=True,  # before the summary, also when the two streams are read apart
     )
     if size > free:
         raise CommandError(
-            f"--out {out}: the map of {points:.3g} points needs up to {byte_size(size)} on disk, "
-            f"more than the {byte_size(free)} free in {out.parent.resolve()}: use a smaller grid "
-            "or another disk"
+            f"--out {out}: the map of {points:.3g} points needs up to {common.byte_size(size)} on "
+            f"disk, more than the {common.byte_size(free)} free in {out.parent.resolve()}: use a "
+            "smaller grid or another disk"
         )
     chunked = out.suffix == ZARR_SUFFIX or points > args.chunk_points
     options = {"cache": False if args.no_cache else None, "cache_dir": args.cache_dir}
@@ -146,7 +137,7 @@ def _progress(dataset):
 
     blocks, done = math.prod(len(c) for c in dataset.regime.chunks), itertools.count(1)
     options = {"unit": "pt", "unit_scale": True, "postfix": f"0/{blocks} blocks"}
-    bar = progress_bar(dataset.regime.size, "ecofmaps map", **options)
+    bar = common.progress_bar(dataset.regime.size, "ecofmaps map", **options)
 
     def on_task(key, result, dsk, state, worker_id) -> None:
         if isinstance(key, tuple) and str(key[0]).startswith(BLOCK_TASK):

@@ -7,17 +7,7 @@ import warnings
 
 from ecofmaps import paper
 from ecofmaps._version import __version__
-from ecofmaps.cli._common import (
-    TWO_COLUMNS,
-    add_profile_options,
-    option_adder,
-    print_rows,
-    profile_rows,
-    quantity,
-    read_profile,
-    row,
-    two_values,
-)
+from ecofmaps.cli import common
 
 __all__ = ["add", "run"]
 
@@ -44,28 +34,28 @@ def add(subparsers) -> None:
         "Example 2). --scar-profile FILE: a measured wear-scar profile instead of the groove, "
         "beside the parabola of the same depth over half-width D/W.",
     )
-    option = option_adder(parser, _HELP)
+    option = common.option_adder(parser, _HELP)
     for name in ("amplitude", "load", "stiffness", "mu"):
-        option(f"--{name}", type=quantity(name), default=paper.EXAMPLE_2[name])
-    option("--aspect-ratio", type=quantity("aspect_ratio"))
-    option("--groove-half-width", type=quantity("groove_half_width"))
-    add_profile_options(parser)
+        option(f"--{name}", type=common.quantity(name), default=paper.EXAMPLE_2[name])
+    option("--aspect-ratio", type=common.quantity("aspect_ratio"))
+    option("--groove-half-width", type=common.quantity("groove_half_width"))
+    common.add_profile_options(parser)
 
 
 def run(args) -> int:
     from ecofmaps import model
     from ecofmaps._codes import RegimeWarning
 
-    profile = read_profile(args, conflicting=("aspect_ratio",))
+    profile = common.read_profile(args, conflicting=("aspect_ratio",))
     rig = dict(amplitude=args.amplitude, load=args.load, stiffness=args.stiffness, mu=args.mu)
-    rows = [row(name, value) for name, value in rig.items()]
+    rows = [common.row(name, value) for name, value in rig.items()]
     point = dict(rig, groove_half_width=args.groove_half_width)
     x_o = args.groove_half_width or args.amplitude
     if profile is None:
         ratio = paper.EXAMPLE_2["aspect_ratio"] if args.aspect_ratio is None else args.aspect_ratio
         points = [dict(point, aspect_ratio=ratio)]
-        rows += [row("aspect_ratio", ratio), row("groove_half_width", x_o), None]
-        show, title = row, ""
+        rows += [common.row("aspect_ratio", ratio), common.row("groove_half_width", x_o), None]
+        show, title = common.row, ""
     else:
         points = [
             dict(point, profile=profile, mapping=args.mapping),
@@ -75,9 +65,9 @@ def run(args) -> int:
         mapping = f"X = x W/x_o, x_o = {x_o * 1e6:.6g} µm (eq. 11)"
         if args.mapping == "physical":
             mapping = "X = x (physical)"
-        rows += [*profile_rows(args, profile), ("position on the profile", "X", mapping), None]
-        rows.append(TWO_COLUMNS)
-        show, title = two_values, " on a measured scar profile"
+        rows += [*common.profile_rows(args, profile), ("position on the profile", "X", mapping)]
+        rows += [None, common.TWO_COLUMNS]
+        show, title = common.two_values, " on a measured scar profile"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RegimeWarning)
         regimes = [model.Regime(int(model.slip_regime(**p))).label for p in points]
@@ -86,5 +76,5 @@ def run(args) -> int:
     ecof = values.pop("energy_cof")
     rows += [show(name, *value) for name, value in values.items()]
     rows += [show("ecof", *ecof), show("ecof_ratio", *(value / args.mu for value in ecof))]
-    print_rows(f"ecofmaps {__version__}: compliant wear-scar interaction model{title}", rows)
+    common.print_rows(f"ecofmaps {__version__}: compliant wear-scar interaction model{title}", rows)
     return 0
