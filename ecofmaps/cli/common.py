@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps._nomenclature import QUANTITIES, RANGES, within
-from ecofmaps.cli.main import CommandError
+from ecofmaps.cli.main import KEYWORD_OPTIONS, CommandError
 from ecofmaps.io.files import MANIFEST, written_by_ecofmaps
 from ecofmaps.units import DIMENSIONS, DOMAIN, bare_number_warning, parse_quantity, parse_values
 
@@ -150,15 +150,10 @@ def recording_options(args) -> dict:
             f"--cycle-col {args.cycle_col!r} names no column: give the cycle column's name, "
             "or none to read no cycle column"
         )
-    return {
-        "displacement_column": args.displacement_col,
-        "force_column": args.force_col,
-        "cycle_column": False if args.cycle_col == "none" else args.cycle_col,
-        "skip_rows": args.skip_rows,
-        "displacement_unit": args.displacement_unit,
-        "force_unit": args.force_unit,
-        "group": args.group,
-    }
+    given = {key: option[2:].replace("-", "_") for key, option in KEYWORD_OPTIONS.items()}
+    keywords = {key: getattr(args, dest) for key, dest in given.items() if dest != "load"}
+    keywords["cycle_column"] = False if args.cycle_col == "none" else args.cycle_col
+    return {**keywords, "group": args.group}
 
 
 #: The ``--scar-profile`` options of ``model`` and ``correct`` (docs/profiles.md).
@@ -212,10 +207,7 @@ def read_profile(args, conflicting=()):
     if args.scar_profile is None:
         return None
     if given := [name for name in conflicting if getattr(args, name) is not None]:
-        raise CommandError(
-            f"give --scar-profile or {options(given)}, not both (the profile gives the "
-            "scar's shape, and its D/W)"
-        )
+        raise CommandError(f"give --scar-profile or {options(given)}, not both: it gives the D/W")
     from ecofmaps.io.scar_profiles import read_scar_profile  # JAX: not with the command line
     from ecofmaps.model.profiles import ScarProfileWarning
 
@@ -324,10 +316,7 @@ def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=())
                 else _resolved(source) == _resolved(target)
             )
             if same:
-                raise CommandError(
-                    f"{option} {target} would write over the input file {source}: "
-                    "choose another output"
-                )
+                raise CommandError(f"{option} {target} would write over the input file {source}")
     for option, folder in folders:
         if folder is None or overwrite or not Path(folder).is_dir():
             continue

@@ -59,9 +59,8 @@ def run(args) -> int:
     given = [name for name in (*POINT_OPTIONS, *GROOVE_OPTIONS) if getattr(args, name) is not None]
     if args.table is not None:
         if given:
-            raise CommandError(
-                f"give a TABLE or a point's options, not both ({common.options(given)})"
-            )
+            given = common.options(given)
+            raise CommandError(f"give a TABLE or one point's options, not both ({given})")
         inputs = [path for path in (args.table, args.scar_profile) if path is not None]
         common.refuse_to_overwrite([("--out", args.out)], inputs, overwrite=args.overwrite)
         return _table(args, common.read_profile(args))

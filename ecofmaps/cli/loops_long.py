@@ -88,7 +88,7 @@ class _Partial:
 
     def __init__(self, out, fingerprint: dict):
         self.folder = Path(f"{out}{PARTIAL_SUFFIX}")
-        record = self.folder / "run.json"
+        record, self.manifest = self.folder / "run.json", self.folder / "kept.jsonl"
         self.made = not self.folder.exists()  # else --resume: LongRun checked it
         if self.made:
             self.folder.mkdir()
@@ -110,10 +110,7 @@ class _Partial:
     def _manifest(self) -> dict:
         """(file, block or 'cycles') -> its line in ``kept.jsonl`` (one cut short passed over)."""
         found = {}
-        with (
-            contextlib.suppress(OSError),
-            open(self.folder / "kept.jsonl", encoding="utf-8") as lines,
-        ):
+        with contextlib.suppress(OSError), open(self.manifest, encoding="utf-8") as lines:
             for line in lines:
                 with contextlib.suppress(ValueError, TypeError, KeyError, RecursionError):
                     entry = json.loads(line)
@@ -123,7 +120,7 @@ class _Partial:
     def _record(self, path: Path, **entry) -> None:
         """Add the checksum of ``path`` just kept, with ``entry``, to the manifest."""
         entry["sha256"] = _sha256(path)
-        with open(self.folder / "kept.jsonl", "a", encoding="utf-8") as lines:
+        with open(self.manifest, "a", encoding="utf-8") as lines:
             lines.write(json.dumps(entry) + "\n")
 
     def _refused(self, path: Path, reason: str) -> None:
@@ -198,18 +195,15 @@ class _Partial:
                 kept[block] = kept_block(path)
         return kept
 
-    def remove_temporaries(self) -> None:
-        """Remove the temporaries of files being written: a folder kept holds whole files."""
-        for pattern in _KEPT:
-            for path in self.folder.glob(temporary_file(Path(pattern)).name):
+    def remove_temporaries(self, *kept) -> None:
+        """Remove the files ``kept`` (patterns) then the temporaries of files being written."""
+        for pattern in (*kept, *(temporary_file(Path(pattern)).name for pattern in _KEPT)):
+            for path in self.folder.glob(pattern):
                 path.unlink(missing_ok=True)
 
     def remove(self) -> None:
         """Remove the files the run kept, then the folder if nothing else is in it."""
-        for pattern in _KEPT:
-            for path in self.folder.glob(pattern):
-                path.unlink(missing_ok=True)
-        self.remove_temporaries()
+        self.remove_temporaries(*_KEPT)
         with contextlib.suppress(OSError):  # not empty: left as it is
             self.folder.rmdir()
 

@@ -140,8 +140,8 @@ def _nothing_to_stop(signum, frame) -> None:
     """A stop signal outside :func:`main`'s block, where there is no work to stop."""
 
 
-#: The keywords of the Python API that errors of the reading name, by the option giving them.
-_OPTIONS = {
+#: The keywords of the Python API that errors of the reading name, and the options giving them.
+KEYWORD_OPTIONS = {
     "displacement_column": "--displacement-col",
     "force_column": "--force-col",
     "cycle_column": "--cycle-col",
@@ -151,7 +151,7 @@ _OPTIONS = {
     "skip_rows": "--skip-rows",
 }
 _KEYWORD = re.compile(
-    rf"(?<![\w./-])({'|'.join(_OPTIONS)})(?:=(\S+))?(?![\w./-])(?: \((--[^()]*)\))?"
+    rf"(?<![\w./-])({'|'.join(KEYWORD_OPTIONS)})(?:=(\S+))?(?![\w./-])(?: \((--[^()]*)\))?"
 )
 
 
@@ -161,7 +161,7 @@ def option_names(message: str) -> str:
     ``force_unit='foo'`` is ``--force-unit 'foo'``."""
 
     def option(match) -> str:  # match[3]: the message names the option already
-        return match[3] or _OPTIONS[match[1]] + (f" {match[2]}" if match[2] else "")
+        return match[3] or KEYWORD_OPTIONS[match[1]] + (f" {match[2]}" if match[2] else "")
 
     return _KEYWORD.sub(option, message)
 
