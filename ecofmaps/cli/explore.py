@@ -7,8 +7,7 @@ import functools
 import importlib
 
 from ecofmaps._interrupts import interrupted_waiting
-from ecofmaps.cli import common
-from ecofmaps.cli.main import CommandError
+from ecofmaps.cli.common import CommandError, option_adder
 from ecofmaps.web import INSTALL_WEB, missing_web_packages
 
 __all__ = ["add", "run"]
@@ -44,7 +43,7 @@ def add(subparsers) -> None:
         "stiffness=35MN/m&mu=0.8&aspect_ratio=0.2): share a view as a link. Ctrl-C stops the "
         'server. Needs pip install "ecofmaps[web]".',
     )
-    option = common.option_adder(parser, _HELP)
+    option = option_adder(parser, _HELP)
     option("--port", type=_port, default=5006, metavar="N")
     option("--no-browser", action="store_true")
     option("--allow-origin", action="append", default=[], metavar="HOST[:PORT]")

@@ -1,9 +1,8 @@
 """``ecofmaps loops`` on long tests: out of core, in parallel, resumable, with progress.
 
-A recording read lazily (more than :data:`ecofmaps.io.recordings.LAZY_SAMPLES` samples, or
-``--workers``, ``--scheduler``, ``--resume``) is analysed on local threads, ``--workers``
-processes or the ``--scheduler`` cluster, its lines written in order as the blocks come; with
-``--out`` each block is kept in ``<out>.partial/`` for ``--resume`` (docs/parallel.md).
+A recording read lazily (past :data:`ecofmaps.io.recordings.LAZY_SAMPLES` samples, or with
+``--workers``, ``--scheduler``, ``--resume``) is analysed on threads, processes or a cluster, its
+lines written in order; with ``--out`` each block is kept in ``<out>.partial/`` (docs/parallel.md).
 """
 
 from __future__ import annotations
@@ -20,8 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps._interrupts import INTERRUPTED, Interrupted, add_stop_note
-from ecofmaps.cli import common
-from ecofmaps.cli.main import CommandError
+from ecofmaps.cli.common import CommandError, progress_bar
 from ecofmaps.io.tables import results_csv
 from ecofmaps.measured.cycles import Cycles
 from ecofmaps.measured.pipeline import (
@@ -357,4 +355,4 @@ class _Interrupted(KeyboardInterrupt):
 
 def _bar(analysis, path, shown: bool, initial: int):
     total, options = int(analysis.cycles.label.size), {"disable": not shown, "smoothing": 0.1}
-    return common.progress_bar(total, path.name, initial=initial, unit=" cycles", **options)
+    return progress_bar(total, path.name, initial=initial, unit=" cycles", **options)

@@ -1,9 +1,8 @@
 """The ``ecofmaps`` command: its parser, and the run of one subcommand.
 
 Each subcommand is a module of :mod:`ecofmaps.cli`: ``add(subparsers)`` declares its options,
-``run(args)`` works through the public API, importing JAX, xarray, numba, dask and matplotlib
-only then (``--help`` answers at once). Quantities take units (``50um``); a bare number is SI.
-Errors in the input end with exit status 2 and one line, never a traceback.
+``run(args)`` works through the public API, importing JAX and the rest only then (``--help`` is
+quick). An error in the input is one line and exit status 2, never a traceback.
 """
 
 from __future__ import annotations
@@ -22,15 +21,7 @@ import warnings
 from ecofmaps._interrupts import STOP_SIGNALS, interrupts_stop_writes
 from ecofmaps._version import __version__
 
-__all__ = [
-    "EXIT_BROKEN_PIPE",
-    "EXIT_INTERRUPTED",
-    "EXIT_TERMINATED",
-    "CommandError",
-    "build_parser",
-    "console",
-    "main",
-]
+__all__ = ["CommandError", "build_parser", "console", "main"]
 
 
 class CommandError(Exception):
