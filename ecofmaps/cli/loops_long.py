@@ -173,12 +173,9 @@ class _Partial:
 
     def kept(self, index: int) -> dict:
         """The blocks of file ``index`` kept: block -> its file."""
-        prefix = self.blocks(index).name
-        return {
-            int(path.stem[len(prefix) :]): path
-            for path in self.folder.glob(f"{prefix}*.npz")
-            if path.stem[len(prefix) :].isdigit()
-        }
+        name = self.blocks(index).name  # and the block's number
+        found = {file.stem.removeprefix(name): file for file in self.folder.glob(f"{name}*.npz")}
+        return {int(block): path for block, path in found.items() if block.isdigit()}
 
     def done(self, index: int, tasks) -> dict:
         """The blocks of file ``index`` kept and checked: block -> (values, flags) measured."""
@@ -216,10 +213,7 @@ class LongRun:
             raise CommandError("--resume continues the run kept beside --out: give --out")
         folder = Path(f"{args.out}{PARTIAL_SUFFIX}")
         if args.out is not None and folder.exists() and not args.resume:
-            raise CommandError(
-                f"{folder} holds an unfinished run: add --resume to continue it, or delete it "
-                "to start again"
-            )
+            raise CommandError(f"{folder} holds an unfinished run: add --resume, or delete it")
         self.args, self.paths, self.partial = args, paths, None
         self.lazy = True if (args.workers or args.scheduler or args.resume) else None  # or by size
         self.analysed = None  # (index, path, blocks or None) of the recording analysed last
