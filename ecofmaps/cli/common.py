@@ -103,8 +103,9 @@ def count(what: str, least: int = 1):
 #: The help of ``--cache-dir`` (``ecofmaps map``, ``cache``).
 CACHE_DIR_HELP = "cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)"
 
-#: The help of each option of :func:`add_recording_options`.
-_RECORDING_HELP = {
+#: The help of the shared options: a recording's columns, a scar profile's (docs/profiles.md),
+#: the contact's.
+OPTION_HELP = {
     "--displacement-col": "name of the displacement column (default: displacement)",
     "--force-col": "name of the tangential force column (default: force)",
     "--cycle-col": "cycle-number column (default: 'cycle' if any; 'none': cut at the reversals)",
@@ -112,6 +113,18 @@ _RECORDING_HELP = {
     "--displacement-unit": "unit of the displacement (default: from its name or the file, else um)",
     "--force-unit": "unit of the force column (default: from its name or the file, else N)",
     "--group": "TDMS group, or HDF5/netCDF/zarr group, holding the channels (default: any)",
+    "--scar-profile": "the scar's profile (CSV, TSV or whitespace-separated text)",
+    "--x-column": "name of the position column (default: x)",
+    "--z-column": "name of the height column (default: z)",
+    "--x-unit": "unit of the positions (default: the one the column's name gives, else um)",
+    "--z-unit": "unit of the heights (default: the one the column's name gives, else um)",
+    "--no-level": "keep the trace's tilt and offset (default: level it on the unworn shoulders)",
+    "--profile-half-width": "the scar's half-width W, e.g. 500um (default: detected at the edges)",
+    "--smoothing": "length the slopes are smoothed over, e.g. 10um, 0 for none (default: 2%% of W)",
+    "--mapping": "where the pad at slip position x sits on the profile: 'scaled', X = x W/x_o "
+    "(eq. 11, the paper's; default), or 'physical', X = x",
+    "--length": "length of the line contact, with its unit, e.g. 5mm",
+    "--sphere": "a sphere on a flat: the scar is round, its profile traced through its centre",
 }
 
 
@@ -133,7 +146,7 @@ def option_adder(parser, helps: dict):
 
 def add_recording_options(parser) -> None:
     """The options that say where a recording's columns are and in which units."""
-    option = option_adder(parser, _RECORDING_HELP)
+    option = option_adder(parser, OPTION_HELP)
     option("--displacement-col", default="displacement", metavar="NAME")
     option("--force-col", default="force", metavar="NAME")
     option("--cycle-col", metavar="NAME")
@@ -156,19 +169,6 @@ def recording_options(args) -> dict:
     return {**keywords, "group": args.group}
 
 
-#: The ``--scar-profile`` options of ``model`` and ``correct`` (docs/profiles.md).
-_PROFILE_HELP = {
-    "--scar-profile": "the scar's profile (CSV, TSV or whitespace-separated text)",
-    "--x-column": "name of the position column (default: x)",
-    "--z-column": "name of the height column (default: z)",
-    "--x-unit": "unit of the positions (default: the one the column's name gives, else um)",
-    "--z-unit": "unit of the heights (default: the one the column's name gives, else um)",
-    "--no-level": "keep the trace's tilt and offset (default: level it on the unworn shoulders)",
-    "--profile-half-width": "the scar's half-width W, e.g. 500um (default: detected at the edges)",
-    "--smoothing": "length the slopes are smoothed over, e.g. 10um, 0 for none (default: 2%% of W)",
-    "--mapping": "where the pad at slip position x sits on the profile: 'scaled', X = x W/x_o "
-    "(eq. 11, the paper's; default), or 'physical', X = x",
-}
 _PROFILE_DEFAULTS = {"x_column": "x", "z_column": "z", "no_level": False, "mapping": "scaled"}
 
 
@@ -179,7 +179,7 @@ def add_profile_options(parser: argparse.ArgumentParser) -> None:
         "a profilometer trace across the wear scar (text: a header line, then x and z per line), "
         "used instead of the parabolic groove of eq. 11",
     )
-    option = option_adder(group, _PROFILE_HELP)
+    option = option_adder(group, OPTION_HELP)
     option("--scar-profile", metavar="FILE")
     option("--x-column", metavar="NAME")
     option("--z-column", metavar="NAME")
@@ -256,12 +256,6 @@ def profile_rows(args, profile) -> list:
     return [*rows, ("scar aspect ratio", "D/W", f"{float(profile.aspect_ratio):.6g}")]
 
 
-_CONTACT_HELP = {
-    "--length": "length of the line contact, with its unit, e.g. 5mm",
-    "--sphere": "a sphere on a flat: the scar is round, its profile traced through its centre",
-}
-
-
 def _length(text: str) -> float:
     """``--length``: a length that must carry its unit (``5mm``)."""
     try:
@@ -273,7 +267,7 @@ def _length(text: str) -> float:
 
 def add_contact_options(parser, required: bool) -> None:
     """``--length L`` (a line contact) or ``--sphere`` (a round scar), for the wear volume."""
-    option = option_adder(parser.add_mutually_exclusive_group(required=required), _CONTACT_HELP)
+    option = option_adder(parser.add_mutually_exclusive_group(required=required), OPTION_HELP)
     option("--length", type=_length, metavar="L")
     option("--sphere", action="store_true")
 
