@@ -13,8 +13,7 @@ def add(subparsers) -> None:
         help="list or clear the cache of computed maps",
         description="Computed maps are netCDF files, one per grid and package version, in "
         "--cache-dir, else $ECOFMAPS_CACHE, else the per-user cache directory. 'list' shows "
-        "them with their sizes; 'clear' removes them, the kernels JAX compiled for ecofmaps "
-        "figures (jax/) and temporaries of interrupted writes (other files are left alone).",
+        "them; 'clear' removes them, JAX's kernels (jax/) and temporaries (no other file).",
     )
     actions = parser.add_subparsers(title="actions", metavar="ACTION", required=True)
     for name, text in (

@@ -25,10 +25,9 @@ def add(subparsers) -> None:
         "convert",
         help="copy a recording (e.g. a large CSV file) into a chunked zarr, HDF5 or TDMS file",
         description="Copy the displacement, force (and cycle) columns of a recording 'ecofmaps "
-        "loops' reads (text, TDMS, HDF5/netCDF-4, zarr) into a file of the format its suffix "
-        "names: .zarr, .h5/.nc, .tdms or .csv; in SI units (m, N), missing samples NaN, a block "
-        "at a time (memory stays a few blocks), DST appearing once complete. A large text file "
-        "converted once is read lazily, in parallel, by 'ecofmaps loops'.",
+        "loops' reads into a file of the format its suffix names (.zarr, .h5/.nc, .tdms, .csv), "
+        "in SI units (m, N), missing samples NaN, a block at a time, DST appearing once "
+        "complete: 'ecofmaps loops' reads a large text file so converted lazily, in parallel.",
         epilog="example:\n  ecofmaps convert test.csv test.zarr --displacement-unit um",
     )
     option = common.option_adder(parser, _HELP)

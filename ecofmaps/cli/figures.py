@@ -52,8 +52,7 @@ def add(subparsers) -> None:
     parser = common.command_parser(
         subparsers,
         "figures",
-        help="write the paper's Figures 5-8 and 11, the universal map and the scar shapes "
-        "(default: figures/)",
+        help="write the paper's Figures 5-8 and 11, the universal map and the scar shapes",
         description="Write the paper's figures listed below, a file per format (fig5.png, ...), "
         "at the paper's parameters: amplitude 50um (= groove half-width), load 450N, stiffness "
         "35MN/m, mu 0.8. Maps, loops and JAX's kernels (jax/) are read from the cache "

@@ -33,17 +33,13 @@ _HELP = {
     "--plots": "also write into DIR per file: loops with Q = SΔ (<name>_loops.png), ECoF and "
     "GICoF over the cycles (<name>_evolution.png), loops along the stroke (<name>_resolved.png)",
     "--overwrite": "replace what ecofmaps wrote before (never a file or folder it did not write)",
-    "--resolved": "also write the loops read along the stroke of one FILE, a netCDF file: μ(ξ), "
-    "the groove slope g(ξ) and the felt profile h(ξ) over (cycle, position)",
-    "--report": "also write one recording as an offline HTML page: friction and quality flags, "
-    'loops with the model\'s, the table (needs pip install "ecofmaps[web]")',
+    "--resolved": "also write one FILE's loops along the stroke (netCDF): μ(ξ), slope g(ξ), h(ξ)",
+    "--report": 'also write one recording as an offline HTML page (pip install "ecofmaps[web]")',
     "--no-resolve": "skip the reading along the stroke (ten times faster; no mu_resolved, ...)",
     "--flip-force": "read the force with the other sign (loops that run anticlockwise)",
-    "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m, in series with the contact: adds "
-    "the ratios on the contact's displacement, the regime there, a sweep's δ_t",
-    "--scar-profile": "the scar's profile after the test (x and z columns, um unless named): the "
-    "loop-scar closure of its last loop, printed, in the report and with --plots "
-    "(<name>_closure.png); with --length or --sphere, its energy wear",
+    "--rig-stiffness": "rig stiffness, e.g. 35MN/m: adds ratios and regime on the contact, δ_t",
+    "--scar-profile": "the scar's profile after the test (x, z columns): the loop-scar closure of "
+    "its last loop (with --plots <name>_closure.png); with --length or --sphere, its energy wear",
     "--nan-policy": "skip (default): skip and count a cycle with a missing sample (NaN, an empty "
     "cell); raise: stop at one, naming its line",
     "--workers": "analyse out of core on a local dask cluster of N processes",

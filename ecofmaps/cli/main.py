@@ -46,10 +46,9 @@ def build_parser() -> argparse.ArgumentParser:
     """The ``ecofmaps`` argument parser with every subcommand."""
     parser = _Parser(
         prog="ecofmaps",
-        description="Fretting friction maps: how far the energy coefficient of friction drifts "
-        "from the contact one with rig stiffness and wear-scar shape, the paper's figures, "
-        "corrections of reported ECoF values, and the per-cycle analysis of measured loops (ECoF, "
-        "GICoF, rig stiffness). Quantities take units: 50um, 450N, 35MN/m.",
+        description="Fretting friction maps: how far the energy CoF drifts from the contact CoF "
+        "with rig stiffness and wear-scar shape; the paper's figures; reported ECoFs corrected; "
+        "measured loops analysed cycle by cycle. Quantities take units: 50um, 450N, 35MN/m.",
     )
     parser.add_argument("--version", action="version", version=f"ecofmaps {__version__}")
     subparsers = parser.add_subparsers(title="commands", metavar="COMMAND", required=True)
