@@ -21,7 +21,7 @@ def add(subparsers) -> None:
         ("clear", "remove every cached map"),
     ):
         action = actions.add_parser(name, help=text, description=text + ".")
-        action.add_argument("--cache-dir", metavar="DIR", help=common.CACHE_DIR_HELP)
+        action.add_argument("--cache-dir", metavar="DIR", help=common.OPTION_HELP["--cache-dir"])
         action.set_defaults(action=name)
 
 

@@ -100,12 +100,12 @@ def count(what: str, least: int = 1):
     return parse
 
 
-#: The help of ``--cache-dir`` (``ecofmaps map``, ``cache``).
-CACHE_DIR_HELP = "cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)"
-
-#: The help of the shared options: a recording's columns, a scar profile's (docs/profiles.md),
-#: the contact's.
+#: The help of the shared options: outputs, a recording's columns, a scar profile's
+#: (docs/profiles.md), the contact's.
 OPTION_HELP = {
+    "--overwrite": "replace what ecofmaps wrote before (never a file or folder it did not write)",
+    "--quiet": "no progress bar (none is shown off a terminal)",
+    "--cache-dir": "cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)",
     "--displacement-col": "name of the displacement column (default: displacement)",
     "--force-col": "name of the tangential force column (default: force)",
     "--cycle-col": "cycle-number column (default: 'cycle' if any; 'none': cut at the reversals)",
@@ -135,8 +135,9 @@ def command_parser(subparsers, name: str, **texts) -> argparse.ArgumentParser:
     return subparsers.add_parser(name, formatter_class=formatter, **texts)
 
 
-def option_adder(parser, helps: dict):
-    """``add(name, **keywords)``: add option ``name`` to ``parser``, its help ``helps[name]``."""
+def option_adder(parser, helps: dict | None = None):
+    """``add(name, **keywords)``: add option ``name`` to ``parser``, its help from ``helps``."""
+    helps = OPTION_HELP | (helps or {})
 
     def add(name: str, **keywords) -> None:
         parser.add_argument(name, help=helps[name], **keywords)
@@ -146,7 +147,7 @@ def option_adder(parser, helps: dict):
 
 def add_recording_options(parser) -> None:
     """The options that say where a recording's columns are and in which units."""
-    option = option_adder(parser, OPTION_HELP)
+    option = option_adder(parser)
     option("--displacement-col", default="displacement", metavar="NAME")
     option("--force-col", default="force", metavar="NAME")
     option("--cycle-col", metavar="NAME")
@@ -179,7 +180,7 @@ def add_profile_options(parser: argparse.ArgumentParser) -> None:
         "a profilometer trace across the wear scar (text: a header line, then x and z per line), "
         "used instead of the parabolic groove of eq. 11",
     )
-    option = option_adder(group, OPTION_HELP)
+    option = option_adder(group)
     option("--scar-profile", metavar="FILE")
     option("--x-column", metavar="NAME")
     option("--z-column", metavar="NAME")
@@ -267,7 +268,7 @@ def _length(text: str) -> float:
 
 def add_contact_options(parser, required: bool) -> None:
     """``--length L`` (a line contact) or ``--sphere`` (a round scar), for the wear volume."""
-    option = option_adder(parser.add_mutually_exclusive_group(required=required), OPTION_HELP)
+    option = option_adder(parser.add_mutually_exclusive_group(required=required))
     option("--length", type=_length, metavar="L")
     option("--sphere", action="store_true")
 

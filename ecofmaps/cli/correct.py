@@ -18,7 +18,6 @@ GROOVE_OPTIONS = ("aspect_ratio", "scar_depth", "scar_half_width")
 _HELP = {
     "table": "table of reported ECoFs (',', ';' or tab separated)",
     "--out": "write the corrected table here, with the table's separator (default: stdout)",
-    "--overwrite": "replace --out if ecofmaps wrote it (never a file ecofmaps did not write)",
     "--ecof": "reported energy CoF μ_E, e.g. 0.83",
     "--amplitude": "displacement amplitude Δ*, e.g. 50um",
     "--load": "normal load P, e.g. 450N",

@@ -32,7 +32,6 @@ _HELP = {
     "--out": "CSV file to write (its directory must exist); default: print the table",
     "--plots": "also write into DIR per file: loops with Q = SΔ (<name>_loops.png), ECoF and "
     "GICoF over the cycles (<name>_evolution.png), loops along the stroke (<name>_resolved.png)",
-    "--overwrite": "replace what ecofmaps wrote before (never a file or folder it did not write)",
     "--resolved": "also write one FILE's loops along the stroke (netCDF): μ(ξ), slope g(ξ), h(ξ)",
     "--report": 'also write one recording as an offline HTML page (pip install "ecofmaps[web]")',
     "--no-resolve": "skip the reading along the stroke (ten times faster; no mu_resolved, ...)",
@@ -46,7 +45,6 @@ _HELP = {
     "--scheduler": "analyse out of core on the dask cluster at ADDRESS (tcp://host:8786), whose "
     "workers have ecofmaps and see the files at the same paths",
     "--resume": "continue a stopped run from <out>.partial/ (the same --out, files and options)",
-    "--quiet": "no progress bar (none is shown off a terminal)",
 }
 
 

@@ -27,11 +27,8 @@ _HELP = {
     "--mu": "contact coefficient of friction μ (> 0)",
     "--load": "normal load P [N], one value; adds dissipated_energy [J] and max_force [N]",
     "--out": "netCDF file, or zarr store if it ends in .zarr, to write (its directory must exist)",
-    "--overwrite": "replace --out if ecofmaps wrote it (once the new map is complete)",
     "--chunk-points": "grid points per block computed into --out (default %(default)s)",
-    "--quiet": "no progress bar (none is shown off a terminal)",
     "--no-cache": "do not use the cache (no map of the parabolic groove is cached: for scripts)",
-    "--cache-dir": common.CACHE_DIR_HELP,
 }
 
 

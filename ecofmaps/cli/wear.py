@@ -21,7 +21,6 @@ _HELP = {
     "--profile": "a test's wear-scar profile (x and z columns); once per test",
     "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m: regime read on the contact",
     "--out": "write the numbers here (CSV)",
-    "--overwrite": "replace --out if ecofmaps wrote it",
 }
 
 
@@ -37,7 +36,7 @@ def add(subparsers) -> None:
         "transition to gross slip Δ_t, δ_t, μ_t if they span it (row 'campaign' of --out). "
         "--profile in the tests' order (a table of several recordings holds several tests).",
     )
-    option = common.option_adder(parser, common.OPTION_HELP | _HELP)
+    option = common.option_adder(parser, _HELP)
     option("tables", nargs="+", metavar="TABLE")
     option("--profile", action="append", required=True, metavar="FILE")
     common.add_contact_options(parser, required=True)
