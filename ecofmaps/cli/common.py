@@ -136,7 +136,7 @@ def command_parser(subparsers, name: str, **texts) -> argparse.ArgumentParser:
 
 
 def option_adder(parser, helps: dict | None = None):
-    """``add(name, **keywords)``: add option ``name`` to ``parser``, its help from ``helps``."""
+    """``add(name, **keywords)``: add ``name`` to ``parser``, helped by ``helps`` or OPTION_HELP."""
     helps = OPTION_HELP | (helps or {})
 
     def add(name: str, **keywords) -> None:
