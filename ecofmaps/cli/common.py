@@ -299,17 +299,15 @@ def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=())
     be written: into an existing directory (``folders`` are made), never over an input; over a
     file ecofmaps wrote, unchanged, or into a folder not empty only with ``overwrite``."""
     outputs = [(option, Path(path)) for option, path in outputs if path is not None]
-    sources = [Path(path) for path in inputs]
     made = [option for option, _ in folders]
     for option, target in outputs:
         if option not in made and not target.parent.is_dir():
             raise CommandError(f"cannot write {target} ({option}): its directory does not exist")
-        for source in sources:
-            same = (
-                os.path.samefile(source, target)
-                if source.exists() and target.exists()
-                else _resolved(source) == _resolved(target)
-            )
+        for source in map(Path, inputs):
+            if source.exists() and target.exists():
+                same = os.path.samefile(source, target)
+            else:
+                same = _resolved(source) == _resolved(target)
             if same:
                 raise CommandError(f"{option} {target} would write over the input file {source}")
     for option, folder in folders:
@@ -321,12 +319,10 @@ def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=())
                 "or --overwrite to replace the files ecofmaps wrote there (others are kept)"
             )
     for option, target in outputs:
-        if not os.path.lexists(target):
+        if not os.path.lexists(target) or (overwrite and written_by_ecofmaps(target)):
             continue
         if written_by_ecofmaps(target):
-            if not overwrite:
-                raise CommandError(f"{option} {target} exists already: --overwrite replaces it")
-            continue
+            raise CommandError(f"{option} {target} exists already: --overwrite replaces it")
         if not (target.is_dir() or target.is_file()):
             raise CommandError(
                 f"{option} {target} is not a regular file (a device, a pipe or a socket): "
@@ -389,9 +385,9 @@ _COLUMN = 18
 TWO_COLUMNS = ("", "", f"{'on the profile':<{_COLUMN}} parabola of the same D/W (eq. 11 shortcut)")
 
 
-def two_values(name: str, on_profile, on_parabola, note: str = "") -> tuple[str, str, str]:
+def two_values(name: str, on_profile, on_parabola) -> tuple[str, str, str]:
     """One :func:`row` with two values: profile, parabola."""
-    words, symbol, first = row(name, on_profile, note)
+    words, symbol, first = row(name, on_profile)
     return words, symbol, f"{first:<{_COLUMN}} {row(name, on_parabola)[2]}"
 
 

@@ -37,7 +37,7 @@ def _figure_formats(text: str) -> tuple[str, ...]:
     """An argparse ``type``: comma-separated figure file formats."""
     formats = tuple(dict.fromkeys(item.strip().lower() for item in text.split(",")))
     unknown = [item for item in formats if item not in _FORMATS]
-    if unknown or not formats:
+    if unknown:
         raise argparse.ArgumentTypeError(
             f"unknown figure format {', '.join(map(repr, unknown))} in {text!r}; "
             f"give one or more of {', '.join(_FORMATS)}, comma-separated"

@@ -57,11 +57,8 @@ def run(args) -> int:
         rows += [common.row("aspect_ratio", ratio), common.row("groove_half_width", x_o), None]
         show, title = common.row, ""
     else:
-        points = [
-            dict(point, profile=profile, mapping=args.mapping),
-            # the paper's shortcut z_o/x_o = D/W (eq. 11), x_o as given whatever the mapping
-            dict(point, aspect_ratio=float(profile.aspect_ratio)),
-        ]
+        shortcut = dict(point, aspect_ratio=float(profile.aspect_ratio))  # eq. 11, x_o as given
+        points = [dict(point, profile=profile, mapping=args.mapping), shortcut]
         mapping = f"X = x W/x_o, x_o = {x_o * 1e6:.6g} µm (eq. 11)"
         if args.mapping == "physical":
             mapping = "X = x (physical)"
