@@ -144,11 +144,8 @@ def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
     """Each group's :func:`_write_figure_group` from ``jobs`` processes (:class:`TaskQueue`)."""
     others = set(multiprocessing.active_children())
     start_resource_tracker_quietly()
-    executor = ProcessPoolExecutor(
-        jobs,
-        mp_context=multiprocessing.get_context("spawn"),  # JAX's threads do not survive a fork
-        initializer=_start_worker,
-    )
+    spawn = multiprocessing.get_context("spawn")  # JAX's threads do not survive a fork
+    executor = ProcessPoolExecutor(jobs, mp_context=spawn, initializer=_start_worker)
     queue = TaskQueue(groups, parts, jobs)
 
     def submitted(tasks) -> dict:  # each future: its task

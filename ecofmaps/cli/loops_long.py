@@ -21,20 +21,8 @@ import numpy as np
 from ecofmaps._interrupts import INTERRUPTED, Interrupted, add_stop_note
 from ecofmaps.cli.common import CommandError, progress_bar
 from ecofmaps.io.tables import results_csv
+from ecofmaps.measured import pipeline
 from ecofmaps.measured.cycles import Cycles
-from ecofmaps.measured.pipeline import (
-    IN_PROCESS,
-    Analysis,
-    LoopOptions,
-    Reading,
-    block_file,
-    force_at_mean_load,
-    kept_block,
-    only,
-    runner_for,
-    temporary_file,
-    write_whole,
-)
 from ecofmaps.measured.resolve import ReadingOptions
 from ecofmaps.measured.samples import MissingSampleError
 
@@ -90,7 +78,7 @@ class _Partial:
         self.made = not self.folder.exists()  # else --resume: LongRun checked it
         if self.made:
             self.folder.mkdir()
-            write_whole(record, json.dumps(fingerprint))
+            pipeline.write_whole(record, json.dumps(fingerprint))
             return
         try:
             found = json.loads(record.read_text(encoding="utf-8"))
@@ -153,7 +141,7 @@ class _Partial:
 
     def keep_cycles(self, index: int, cycles) -> None:
         path = self.folder / f"file{index}-cycles.npz"
-        write_whole(path, dataclasses.asdict(cycles))
+        pipeline.write_whole(path, dataclasses.asdict(cycles))
         self._record(path, file=index, block="cycles")
 
     def blocks(self, index: int) -> Path:
@@ -161,7 +149,7 @@ class _Partial:
         return self.folder / f"file{index}-block"
 
     def record_block(self, index: int, block: int, rows: slice) -> None:
-        path = block_file(self.blocks(index), block)
+        path = pipeline.block_file(self.blocks(index), block)
         self._record(path, file=index, block=block, rows=[rows.start, rows.stop])
 
     def record_late(self, index: int, tasks) -> None:
@@ -187,12 +175,12 @@ class _Partial:
                 continue
             rows = [tasks[block].start, tasks[block].stop]
             if self._checked(path, manifest.get((index, block)), rows):
-                kept[block] = kept_block(path)
+                kept[block] = pipeline.kept_block(path)
         return kept
 
     def remove_temporaries(self, *kept) -> None:
         """Remove the files ``kept`` (patterns) then the temporaries of files being written."""
-        for pattern in (*kept, *(temporary_file(Path(pattern)).name for pattern in _KEPT)):
+        for pattern in (*kept, *(pipeline.temporary_file(Path(pattern)).name for pattern in _KEPT)):
             for path in self.folder.glob(pattern):
                 path.unlink(missing_ok=True)
 
@@ -219,7 +207,7 @@ class LongRun:
         self.analysed = None  # (index, path, blocks or None) of the recording analysed last
         scar = args.scar_profile is not None
         handed = args.plots is not None or args.resolved is not None or scar  # on 201 positions
-        self.reading = Reading(
+        self.reading = pipeline.Reading(
             resolve=not args.no_resolve,
             keep_loops=args.plots is not None or args.report is not None or scar,
             along_stroke=ReadingOptions(positions=201 if handed else None),
@@ -228,9 +216,10 @@ class LongRun:
 
     def analyse(self, index, path, recording, load, write, columns):
         """Results (of ``columns``) and reading along the stroke of recording ``index``."""
-        args, runner = self.args, contextlib.nullcontext(IN_PROCESS)
+        args, runner = self.args, contextlib.nullcontext(pipeline.IN_PROCESS)
         if recording.lazy:
-            runner = runner_for("processes" if args.workers else args.scheduler, args.workers)
+            cluster = "processes" if args.workers else args.scheduler
+            runner = pipeline.runner_for(cluster, args.workers)
         self.analysed = (index, path, None)
         try:
             with runner as runner:  # a cluster that does not answer: nothing written
@@ -279,16 +268,17 @@ def _analyse(run, index, path, recording, load, runner, write, columns):
     args, partial = run.args, run.partial if recording.lazy else None
     force, recorded = recording.force, None
     if isinstance(load, str):  # the load recorded sample by sample (--load COLUMN)
-        force, load = force_at_mean_load(force, recording.load)
+        force, load = pipeline.force_at_mean_load(force, recording.load)
         recorded = recording.load
     shown = recording.lazy and not args.quiet and sys.stderr.isatty()
     if shown:
         print(f"{path.name}: finding the cycles of {recording.size} samples", file=sys.stderr)
-    analysis = Analysis(
+    keywords = {"flip_force": args.flip_force, "rig_stiffness": args.rig_stiffness}
+    analysis = pipeline.Analysis(
         recording.displacement,
         force,
         recording.cycle,
-        options=LoopOptions(load, flip_force=args.flip_force, rig_stiffness=args.rig_stiffness),
+        options=pipeline.LoopOptions(load, **keywords),
         recorded_load=recorded,
         runner=runner,
         nan_policy=args.nan_policy,
@@ -304,7 +294,7 @@ def _analyse(run, index, path, recording, load, runner, write, columns):
     parts, texts = {}, {}  # texts: the lines of chunks that came before an earlier one
     for block, measured in done.items():
         part = analysis.part(block, *measured)
-        parts[block], texts[block] = only(part, columns), lines(part)
+        parts[block], texts[block] = pipeline.only(part, columns), lines(part)
     written = _in_order(texts, write)
     bar = _bar(analysis, path, shown, sum(parts[b].cycle.size for b in parts))
     keep = False if partial is None else partial.blocks(index)
