@@ -17,8 +17,7 @@ _HELP = {
     "--stiffness": "rig stiffness S, 'inf' for a rigid rig (default 35MN/m)",
     "--mu": "contact coefficient of friction μ (default 0.8)",
     "--aspect-ratio": "groove depth over half-width z_o/x_o of the parabolic groove (default 0.2)",
-    "--groove-half-width": "groove half-width x_o (default: the amplitude, as in the paper); with "
-    "a profile, the x_o of the mapping X = x W/x_o",
+    "--groove-half-width": "groove half-width x_o, also of X = x W/x_o (default: the amplitude)",
 }
 
 #: The model's results printed, after the regime, in this order.
