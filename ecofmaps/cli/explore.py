@@ -53,12 +53,11 @@ def run(args) -> int:
         raise CommandError(INSTALL_WEB)
     # Panel and Bokeh load in a thread: a stop while they load (seconds) is acted on at once
     server = interrupted_waiting(functools.partial(importlib.import_module, "ecofmaps.web.server"))
-    announce = functools.partial(print, flush=True)  # the address at once, also in a pipe
     try:
         server.serve_explorer(
             args.port,
             open_browser=not args.no_browser,
-            announce=announce,
+            announce=functools.partial(print, flush=True),  # the address at once, also in a pipe
             allow_origin=args.allow_origin,
         )
     except OSError as error:
