@@ -160,10 +160,7 @@ def add_recording_options(parser) -> None:
 def recording_options(args) -> dict:
     """The keywords of :func:`ecofmaps.io.recordings.read_recording` the options give."""
     if args.cycle_col is not None and not args.cycle_col.strip():
-        raise CommandError(
-            f"--cycle-col {args.cycle_col!r} names no column: give the cycle column's name, "
-            "or none to read no cycle column"
-        )
+        raise CommandError(f"--cycle-col {args.cycle_col!r} names no column: give a name or 'none'")
     given = {key: option[2:].replace("-", "_") for key, option in KEYWORD_OPTIONS.items()}
     keywords = {key: getattr(args, dest) for key, dest in given.items() if dest != "load"}
     keywords["cycle_column"] = False if args.cycle_col == "none" else args.cycle_col
@@ -325,8 +322,7 @@ def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=())
             raise CommandError(f"{option} {target} exists already: --overwrite replaces it")
         if not (target.is_dir() or target.is_file()):
             raise CommandError(
-                f"{option} {target} is not a regular file (a device, a pipe or a socket): "
-                "ecofmaps writes only regular files; choose a file name"
+                f"{option} {target} is not a regular file (a device, pipe or socket)"
             )
         kind = "a folder" if target.is_dir() else "a file"
         raise CommandError(
