@@ -21,9 +21,8 @@ from ecofmaps.units import DIMENSIONS, DOMAIN, bare_number_warning, parse_quanti
 
 
 def quantity(name: str, grid: bool = False, option: str | None = None):
-    """An argparse ``type`` reading quantity ``name`` [SI] with units (``grid``: ``a,b,c`` or
-    ``start:stop:num``), checked against its dimension, range and :data:`ecofmaps.units.DOMAIN`;
-    a bare number implausible in SI is warned of, naming ``option`` (``--name``)."""
+    """An argparse ``type``: quantity ``name`` [SI] with units (``grid``: ``a,b,c``, ``a:b:num``) in
+    its range and domain; a bare number implausible in SI warned of, naming ``option``."""
     described = QUANTITIES[name]
     kind, option = described.kind, option or "--" + name.replace("_", "-")
 
@@ -193,9 +192,8 @@ def add_profile_options(parser: argparse.ArgumentParser) -> None:
 
 
 def read_profile(args, conflicting=()):
-    """The profile ``--scar-profile`` names, or None; with it an option of the parabola
-    (destinations ``conflicting``), or without it one of the reading, is a :class:`CommandError`.
-    The reader's warnings are one line each, naming ``--profile-half-width`` of the other W."""
+    """The profile ``--scar-profile`` names, or None; refuses with it an option ``conflicting``,
+    without it a reading option; its warnings one line each, naming the other W."""
     given = [name for name in args.profile_options if getattr(args, name) is not None]
     if args.scar_profile is None and given:
         raise CommandError(f"{options(given)} reads a --scar-profile: give the FILE too")

@@ -1,6 +1,5 @@
-"""``ecofmaps loops``: recorded fretting loops analysed cycle by cycle through the one pipeline
-of :mod:`ecofmaps.measured.pipeline` (a long recording out of core: :mod:`.loops_long`), the
-table written as the chunks come, then the summary lines and the extras (docs/loops.md)."""
+"""``ecofmaps loops``: recorded loops analysed cycle by cycle by :mod:`ecofmaps.measured.pipeline`
+(out of core: :mod:`.loops_long`), the table written as it comes, then summaries (docs/loops.md)."""
 
 from __future__ import annotations
 

@@ -146,9 +146,8 @@ _KEYWORD = re.compile(
 
 
 def option_names(message: str) -> str:
-    """An error of the Python API with the command-line options for its keywords:
-    ``force_column (--force-col)`` and ``force_column`` are ``--force-col``,
-    ``force_unit='foo'`` is ``--force-unit 'foo'``."""
+    """An error of the Python API with options for keywords: ``force_column`` (and ``force_column
+    (--force-col)``) is ``--force-col``, ``force_unit='foo'`` is ``--force-unit 'foo'``."""
 
     def option(match) -> str:  # match[3]: the message names the option already
         return match[3] or KEYWORD_OPTIONS[match[1]] + (f" {match[2]}" if match[2] else "")
