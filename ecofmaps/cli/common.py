@@ -120,8 +120,7 @@ OPTION_HELP = {
     "--no-level": "keep the trace's tilt and offset (default: level it on the unworn shoulders)",
     "--profile-half-width": "the scar's half-width W, e.g. 500um (default: detected at the edges)",
     "--smoothing": "length the slopes are smoothed over, e.g. 10um, 0 for none (default: 2%% of W)",
-    "--mapping": "where the pad at slip position x sits on the profile: 'scaled', X = x W/x_o "
-    "(eq. 11, the paper's; default), or 'physical', X = x",
+    "--mapping": "pad at x sits at X = x W/x_o ('scaled', eq. 11; default) or X = x ('physical')",
     "--length": "length of the line contact, with its unit, e.g. 5mm",
     "--sphere": "a sphere on a flat: the scar is round, its profile traced through its centre",
 }

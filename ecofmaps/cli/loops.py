@@ -38,8 +38,7 @@ _HELP = {
     "--rig-stiffness": "rig stiffness, e.g. 35MN/m: adds ratios and regime on the contact, δ_t",
     "--scar-profile": "the scar's profile after the test (x, z columns): the loop-scar closure of "
     "its last loop (with --plots <name>_closure.png); with --length or --sphere, its energy wear",
-    "--nan-policy": "skip (default): skip and count a cycle with a missing sample (NaN, an empty "
-    "cell); raise: stop at one, naming its line",
+    "--nan-policy": "skip (default) and count cycles missing a sample, or raise naming its line",
     "--workers": "analyse out of core on a local dask cluster of N processes",
     "--scheduler": "analyse out of core on the dask cluster at ADDRESS (tcp://host:8786), whose "
     "workers have ecofmaps and see the files at the same paths",
@@ -86,8 +85,8 @@ def add(subparsers) -> None:
     common.add_recording_options(parser)
     long_tests = parser.add_argument_group(
         "long tests",
-        "a file of more than 2**24 samples is analysed out of core, whole cycles a block at a "
-        "time (the numbers are those of the analysis in memory)",
+        "past 2**24 samples a file is analysed out of core, whole cycles a block at a time "
+        "(the numbers of the analysis in memory)",
     )
     option = common.option_adder(long_tests, _HELP)
     option("--workers", type=_workers, metavar="N")

@@ -105,10 +105,8 @@ def run(args) -> int:
         else:
             rows = [common.row(q, text) for q, text in transition_texts(found)]
             common.print_rows("campaign: transition to gross slip", rows)
-            table.append(
-                {"test": "campaign", "profile": "", "sliding_condition": ""}
-                | _columns(found, TRANSITION, "transition_{}")
-            )
+            campaign = {"test": "campaign", "profile": "", "sliding_condition": ""}
+            table.append(campaign | _columns(found, TRANSITION, "transition_{}"))
     if args.out is not None:
         write_text(args.out, csv_text(pd.DataFrame(table)))
         record_written([args.out])
