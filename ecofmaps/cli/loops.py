@@ -26,8 +26,7 @@ __all__ = ["SUMMARY_VARIABLES", "add", "run"]
 _HELP = {
     "files": "recording files (CSV, TSV or other text, TDMS, HDF5/netCDF-4, zarr)",
     "--example": "analyse the shipped synthetic example (load 450N) instead of FILEs",
-    "--load": "normal load P, e.g. 450N, or the name of a normal-load column (e.g. Fz) read "
-    "sample by sample (required unless --example)",
+    "--load": "normal load P, e.g. 450N, or a load column (e.g. Fz); required unless --example",
     "--out": "CSV file to write (its directory must exist); default: print the table",
     "--plots": "also write into DIR per file: loops with Q = SΔ (<name>_loops.png), ECoF and "
     "GICoF over the cycles (<name>_evolution.png), loops along the stroke (<name>_resolved.png)",
@@ -51,18 +50,16 @@ def add(subparsers) -> None:
         subparsers,
         "loops",
         help="analyse recorded fretting loops cycle by cycle: ECoF, GICoF, stiffness, ...",
-        description="Read recordings of fretting loops (text: a header line in any common "
-        "dialect), cut them into cycles at the displacement reversals or by a cycle column, and "
-        "write a row per cycle: cycle, amplitude_um, slip_amplitude_um, normal_load_N (with --load "
-        "COLUMN), max_force_N, dissipated_energy_mJ, ecof, cof_max, energy_ratio (with "
-        "--rig-stiffness also opening_ratio, contact_amplitude_um, contact_energy_ratio, "
-        "contact_opening_ratio), stiffness_MN_per_m, gicof, regime, mu_resolved, mu_resolved_se, "
-        "aspect_ratio (read along the stroke), quality ('ok', or why values are NaN); first a "
-        "file column for several files. Columns are found by the names rigs write (displacement, "
-        "disp, stroke, ...; force, Fx, Q, ...; 'cycle'), units from their names or the file, else "
-        "um and N. A file that cannot be analysed is an error line, the others are written (exit "
-        "status 1). Files are written atomically, never over an input or a file ecofmaps did not "
-        "write.",
+        description="Cut recordings of fretting loops (text: a header line, any dialect) into "
+        "cycles at the displacement reversals or by a cycle column, and write a row per cycle: "
+        "cycle, amplitude_um, slip_amplitude_um, normal_load_N (with --load COLUMN), max_force_N, "
+        "dissipated_energy_mJ, ecof, cof_max, energy_ratio (with --rig-stiffness also "
+        "opening_ratio, contact_amplitude_um, contact_energy_ratio, contact_opening_ratio), "
+        "stiffness_MN_per_m, gicof, regime, mu_resolved, mu_resolved_se, aspect_ratio (read along "
+        "the stroke), quality ('ok', or why values are NaN); first a file column for several "
+        "files. Columns are found by rigs' names (disp, Fx, cycle, ...), units by their names or "
+        "the file, else um and N. A file that fails is an error line, the others are written "
+        "(exit status 1), atomically, never over an input or a file ecofmaps did not write.",
         epilog="examples:\n  ecofmaps loops test.csv --load 450N --out results.csv --plots plots\n"
         "  ecofmaps loops --example --out results.csv --plots plots",
     )
