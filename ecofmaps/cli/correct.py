@@ -32,16 +32,15 @@ def add(subparsers) -> None:
     parser = subparsers.add_parser(
         "correct",
         help="correct reported ECoF values to the contact CoF (one point or a CSV table)",
-        description="Correct a reported energy CoF μ_E to the contact CoF μ behind it, given "
-        "amplitude, load, rig stiffness and scar depth over half-width z_o/x_o = D/W (eq. 11; "
-        "x_o = Δ*). One point: --ecof --amplitude --load --stiffness and --aspect-ratio (or "
-        "--scar-depth and --scar-half-width). A TABLE: columns ecof, amplitude_um, load_N, "
-        "stiffness_MN_per_m and aspect_ratio or scar_depth_um + scar_half_width_um ('#' lines "
-        "skipped; decimal commas with ';'), written with mu and correction_factor added. "
-        "--scar-profile FILE: a measured scar instead (for a table without scar columns too), "
-        "beside the parabola of the same D/W (mu_parabolic). A row that cannot be corrected gets "
-        "NaN, its reason in a status column and an error line naming file, line (the header is "
-        "1) and column; the others are written, exit status 1.",
+        description="Correct a reported energy CoF μ_E to the contact CoF μ, given amplitude, "
+        "load, rig stiffness and scar depth over half-width z_o/x_o = D/W (eq. 11; x_o = Δ*). One "
+        "point: --ecof --amplitude --load --stiffness and --aspect-ratio (or --scar-depth and "
+        "--scar-half-width). A TABLE: columns ecof, amplitude_um, load_N, stiffness_MN_per_m and "
+        "aspect_ratio or scar_depth_um + scar_half_width_um ('#' lines skipped; decimal commas "
+        "with ';'), written with mu and correction_factor. --scar-profile FILE: a measured scar "
+        "instead (also for a table without scar columns), beside the parabola of the same D/W "
+        "(mu_parabolic). A failing row gets NaN, its reason in a status column and an error line "
+        "naming file, line (header: 1) and column (exit status 1).",
     )
     option = common.option_adder(parser, _HELP)
     option("table", nargs="?", metavar="TABLE")

@@ -41,11 +41,10 @@ def add(subparsers) -> None:
         "CoF and its ratio to mu, compliance ratio P/(S*amplitude), regime; with --load the "
         "dissipated energy and peak force) over a grid into an xarray Dataset in --out, "
         "atomically, its size printed first (refused if the disk cannot hold it). The groove "
-        "half-width is the amplitude, as in the paper. Each grid option takes one value (a scalar "
-        "coordinate), a list a,b,c or a range start:stop:num (num points, both ends included) (a "
-        "dimension, in this order), with units (50um, 0.08/um); a bare number is SI. A zarr "
-        "store, or more than --chunk-points points, is computed block by block, a few in memory. "
-        "Maps are not cached (computing them is faster than reading).",
+        "half-width is the amplitude. Each grid option takes one value (a scalar coordinate), a "
+        "list a,b,c or a range start:stop:num (num points, ends included) (a dimension, in this "
+        "order), with units (50um, 0.08/um); a bare number is SI. A zarr store, or more than "
+        "--chunk-points points, is computed block by block, a few in memory. Maps are not cached.",
         epilog="example (the grid of Figure 11):\n  ecofmaps map "
         "--stiffness-ratio 0.01/um:0.3/um:30 --aspect-ratio 0:0.3:31 \\\n      --amplitude "
         "25um,50um --mu 0.8 --load 450N --out fig11.nc\n"
