@@ -30,8 +30,7 @@ def add(subparsers) -> None:
         help="evaluate the model at one point (default: the paper's Example 2)",
         description="Print the compliant wear-scar interaction model's slip amplitude, peak "
         "force, dissipated energy, energy CoF and regime at one point (default: the paper's "
-        "Example 2). --scar-profile FILE: a measured wear-scar profile instead of the groove, "
-        "beside the parabola of the same depth over half-width D/W.",
+        "Example 2); with --scar-profile FILE on a measured scar, beside the parabola of its D/W.",
     )
     option = common.option_adder(parser, _HELP)
     for name in ("amplitude", "load", "stiffness", "mu"):
