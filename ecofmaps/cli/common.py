@@ -87,10 +87,9 @@ def count(what: str, least: int = 1):
     """An argparse ``type`` reading a whole number of ``what`` >= ``least`` (``4e6``)."""
 
     def parse(text: str) -> int:
-        try:
+        value = math.nan
+        with contextlib.suppress(ValueError):
             value = float(text)
-        except ValueError:
-            value = math.nan
         if not (math.isfinite(value) and value.is_integer() and value >= least):
             raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of {what} >= {least}")
         return int(value)

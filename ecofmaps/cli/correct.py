@@ -68,8 +68,7 @@ def run(args) -> int:
         raise CommandError(f"give {', '.join(missing)} (or a TABLE)")
     profile = common.read_profile(args, conflicting=GROOVE_OPTIONS)
     rig = {name: getattr(args, name) for name in POINT_OPTIONS[1:]}
-    rows = [common.row("ecof", args.ecof, "(reported)")]
-    rows += [common.row(name, value) for name, value in rig.items()]
+    rows = [common.row("ecof", args.ecof, "(reported)"), *map(common.row, rig, rig.values())]
     title = f"ecofmaps {__version__}: reported ECoF corrected to the contact CoF"
     if profile is not None:  # beside the D/W shortcut (eq. 11)
         mu = float(correct_ecof(args.ecof, **rig, profile=profile, mapping=args.mapping))

@@ -82,8 +82,7 @@ def add(subparsers) -> None:
     common.add_recording_options(parser)
     long_tests = parser.add_argument_group(
         "long tests",
-        "past 2**24 samples a file is analysed out of core, whole cycles a block at a time "
-        "(the numbers of the analysis in memory)",
+        "past 2**24 samples a file is analysed out of core, by blocks (the same numbers)",
     )
     option = common.option_adder(long_tests, _HELP)
     option("--workers", type=_workers, metavar="N")

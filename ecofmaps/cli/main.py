@@ -66,10 +66,8 @@ def _unknown_arguments(unknown, args) -> str:
     words = [word.split("=")[0] for word in unknown if word.startswith("--")]
     guesses = [difflib.get_close_matches(word, args.command_options, n=1) for word in words]
     hint = "".join(f"; did you mean {guess[0]}?" for guess in guesses if guess)
-    return (
-        f"ecofmaps: error: unrecognized arguments: {' '.join(unknown)}{hint} "
-        f"(see '{args.command_prog} --help')\n"
-    )
+    hint += f" (see '{args.command_prog} --help')\n"
+    return f"ecofmaps: error: unrecognized arguments: {' '.join(unknown)}{hint}"
 
 
 #: Exit statuses (128 + the signal, as shells report them) of a run stopped by Ctrl-C, by
