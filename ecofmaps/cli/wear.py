@@ -78,9 +78,8 @@ def run(args) -> int:
             f"give one --profile per test: {len(tests)} tests in the tables, "
             f"{len(args.profile)} profiles"
         )
-    profiles = [
-        common.read_scar_file(file, "wear", args.x_unit, args.z_unit) for file in args.profile
-    ]
+    units = (args.x_unit, args.z_unit)
+    profiles = [common.read_scar_file(path, "wear", *units) for path in args.profile]
     table = []
     for (name, results), path, profile in zip(tests, args.profile, profiles, strict=True):
         try:
