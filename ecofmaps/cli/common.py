@@ -158,8 +158,8 @@ def recording_options(args) -> dict:
     """The keywords of :func:`ecofmaps.io.recordings.read_recording` the options give."""
     if args.cycle_col is not None and not args.cycle_col.strip():
         raise CommandError(f"--cycle-col {args.cycle_col!r} names no column: give a name or 'none'")
-    given = {key: option[2:].replace("-", "_") for key, option in KEYWORD_OPTIONS.items()}
-    keywords = {key: getattr(args, dest) for key, dest in given.items() if dest != "load"}
+    dests = {key: option[2:].replace("-", "_") for key, option in KEYWORD_OPTIONS.items()}
+    keywords = {key: getattr(args, dest) for key, dest in dests.items() if dest != "load"}
     keywords["cycle_column"] = False if args.cycle_col == "none" else args.cycle_col
     return {**keywords, "group": args.group}
 
