@@ -29,7 +29,7 @@ _HELP = {
     "--only": "write only these figures (NAME: one of those listed below)",
     "--format": "comma-separated file formats among png, pdf, svg (default: png)",
     "--overwrite": "replace figures ecofmaps wrote in DIR (needed if it is not empty; no others)",
-    "--jobs": "processes drawing (default: one per core, at most one per figure group; 1: none)",
+    "--jobs": "processes drawing (default: one per core, at most one per figure group; 1: this)",
 }
 
 
