@@ -34,7 +34,7 @@ _HELP = {
     "--report": 'also write one recording as an offline HTML page (pip install "ecofmaps[web]")',
     "--no-resolve": "skip the reading along the stroke (ten times faster; no mu_resolved, ...)",
     "--flip-force": "read the force with the other sign (loops that run anticlockwise)",
-    "--rig-stiffness": "rig stiffness, e.g. 35MN/m: adds ratios and regime on the contact, δ_t",
+    "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m: the contact's ratios, regime, δ_t",
     "--scar-profile": "the scar's profile after the test (x, z columns): the loop-scar closure of "
     "its last loop (with --plots <name>_closure.png); with --length or --sphere, its energy wear",
     "--nan-policy": "skip (default) and count cycles missing a sample, or raise naming its line",
