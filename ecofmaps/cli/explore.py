@@ -39,7 +39,7 @@ def add(subparsers) -> None:
         "amplitude, load, rig stiffness, contact CoF and groove aspect ratio with units (50um, "
         "450N, 35MN/m) to see the slip amplitude, dissipated energy, μ_E/μ, the steady loop, the "
         "map of μ_E/μ over S/P and z_o/x_o, and the contact CoF behind an ECoF; the URL keeps the "
-        "inputs. Ctrl-C stops it. Needs pip install 'ecofmaps[web]'.",
+        'inputs. Ctrl-C stops it. Needs pip install "ecofmaps[web]".',
     )
     option = option_adder(parser, _HELP)
     option("--port", type=_port, default=5006, metavar="N")
