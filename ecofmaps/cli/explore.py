@@ -7,7 +7,7 @@ import functools
 import importlib
 
 from ecofmaps._interrupts import interrupted_waiting
-from ecofmaps.cli._common import CommandError, option_adder
+from ecofmaps.cli.common import CommandError, option_adder
 from ecofmaps.web import INSTALL_WEB, missing_web_packages
 
 __all__ = ["add", "run"]
@@ -37,11 +37,9 @@ def add(subparsers) -> None:
         help="explore the model in the browser: δ*, E_d, μ_E/μ, the loop, the map, a correction",
         description="Serve a page at http://127.0.0.1:PORT/ (this machine only): type the "
         "amplitude, load, rig stiffness, contact CoF and groove aspect ratio with units (50um, "
-        "450N, 35MN/m); it shows there the slip amplitude, dissipated energy and μ_E/μ, the "
-        "steady loop, the map of μ_E/μ over S/P and z_o/x_o with the point, and the contact CoF "
-        "behind an ECoF you type. The URL keeps the inputs (?amplitude=50um&load=450N&"
-        "stiffness=35MN/m&mu=0.8&aspect_ratio=0.2): share a view as a link. Ctrl-C stops the "
-        'server. Needs pip install "ecofmaps[web]".',
+        "450N, 35MN/m) to see the slip amplitude, dissipated energy, μ_E/μ, the steady loop, the "
+        "map of μ_E/μ over S/P and z_o/x_o, and the contact CoF behind an ECoF; the URL keeps the "
+        'inputs. Ctrl-C stops it. Needs pip install "ecofmaps[web]".',
     )
     option = option_adder(parser, _HELP)
     option("--port", type=_port, default=5006, metavar="N")

@@ -1,7 +1,7 @@
-"""``ecofmaps figures``: the paper's figures, drawn by groups sharing one Dataset
-(:func:`ecofmaps.figures.figure_groups`), the costliest first, on ``--jobs`` processes, the
-parts of a costly Dataset (:func:`ecofmaps.figures.figure_parts`) computed in parallel before
-it; JAX keeps its compiled kernels in ``<cache>/jax`` for the run."""
+"""``ecofmaps figures``: the paper's figures, by groups sharing one Dataset (costliest first,
+:func:`ecofmaps.figures.figure_groups`) on ``--jobs`` processes, the parts of a costly Dataset
+(:func:`ecofmaps.figures.figure_parts`) computed in parallel before it; JAX's kernels kept in
+``<cache>/jax``."""
 
 from __future__ import annotations
 
@@ -17,13 +17,7 @@ from pathlib import Path
 
 from ecofmaps._interrupts import check_interrupted, interrupts_stop_writes
 from ecofmaps._parallel import start_resource_tracker_quietly
-from ecofmaps.cli._common import (
-    command_parser,
-    count,
-    made_folder,
-    option_adder,
-    refuse_to_overwrite,
-)
+from ecofmaps.cli import common
 from ecofmaps.io.files import record_written
 
 __all__ = ["TaskQueue", "add", "run"]
@@ -32,11 +26,10 @@ _FORMATS = ("png", "pdf", "svg")
 
 _HELP = {
     "--out": "directory to write into, created if missing (default: figures)",
+    "--only": "write only these figures (NAME: one of those listed below)",
     "--format": "comma-separated file formats among png, pdf, svg (default: png)",
-    "--overwrite": "replace the figures ecofmaps wrote in DIR before (a DIR that is not empty "
-    "needs it); files ecofmaps did not write are never replaced",
-    "--jobs": "processes drawing at once (default: one per core, at most one per group of "
-    "figures sharing their numbers; 1: all in this process)",
+    "--overwrite": "replace figures ecofmaps wrote in DIR (needed if it is not empty; no others)",
+    "--jobs": "processes drawing (default: one per core, at most one per figure group; 1: this)",
 }
 
 
@@ -44,7 +37,7 @@ def _figure_formats(text: str) -> tuple[str, ...]:
     """An argparse ``type``: comma-separated figure file formats."""
     formats = tuple(dict.fromkeys(item.strip().lower() for item in text.split(",")))
     unknown = [item for item in formats if item not in _FORMATS]
-    if unknown or not formats:
+    if unknown:
         raise argparse.ArgumentTypeError(
             f"unknown figure format {', '.join(map(repr, unknown))} in {text!r}; "
             f"give one or more of {', '.join(_FORMATS)}, comma-separated"
@@ -52,36 +45,26 @@ def _figure_formats(text: str) -> tuple[str, ...]:
     return formats
 
 
-def _usable_cores() -> int:
-    """The number of cores this process may run on (its affinity, where the system has one)."""
-    if hasattr(os, "sched_getaffinity"):
-        return max(1, len(os.sched_getaffinity(0)))
-    return os.cpu_count() or 1
-
-
 def add(subparsers) -> None:
     from ecofmaps.figures.recipes import FIGURES  # the names for the parser (no JAX)
 
     listing = "\n".join(f"  {name:<10} {recipe.description}" for name, recipe in FIGURES.items())
-    parser = command_parser(
+    parser = common.command_parser(
         subparsers,
         "figures",
-        help="write the paper's Figures 5-8 and 11, the universal map and the scar shapes "
-        "(default: figures/)",
-        description="Write the paper's figures listed below, a file each per format (fig5.png, "
-        "...), at the paper's parameters: amplitude 50um (= groove half-width), load 450N, "
-        "stiffness 35MN/m, mu 0.8. Maps, loops and JAX's compiled kernels (jax/) are read from "
-        "the cache (ECOFMAPS_CACHE), else stored there; files are written atomically. Progress "
-        "goes to stderr.",
+        help="write the paper's Figures 5-8 and 11, the universal map and the scar shapes",
+        description="Write the paper's figures listed below, a file per format (fig5.png, ...), "
+        "at the paper's parameters: amplitude 50um (= groove half-width), load 450N, stiffness "
+        "35MN/m, mu 0.8. Maps, loops and JAX's kernels (jax/) are read from the cache "
+        "(ECOFMAPS_CACHE), else stored there; files are written atomically, progress to stderr.",
         epilog=f"figures:\n{listing}",
     )
-    only = f"write only these figures; NAME is one of: {', '.join(FIGURES)}"
-    option = option_adder(parser, {**_HELP, "--only": only})
-    option("--out", default="figures", metavar="DIR")
+    option = common.option_adder(parser, _HELP)
+    option("--out", type=Path, default="figures", metavar="DIR")
     option("--only", nargs="+", choices=list(FIGURES), metavar="NAME")
     option("--format", type=_figure_formats, default=("png",), metavar="FORMATS")
     option("--overwrite", action="store_true")
-    option("--jobs", type=count("processes"), metavar="N")
+    option("--jobs", type=common.count("processes"), metavar="N")
 
 
 def _set_jax_options(options: dict | None = None) -> dict:
@@ -109,9 +92,8 @@ def _write_figure_group(names, directory, formats) -> list[tuple[str, list[Path]
     written, start = [], time.perf_counter()
     for name, figure in make_figures(names):
         paths = [save_figure(figure, Path(directory) / f"{name}.{suffix}") for suffix in formats]
-        now = time.perf_counter()
-        written.append((name, paths, now - start))
-        start = now
+        written.append((name, paths, time.perf_counter() - start))
+        start = time.perf_counter()
     return written
 
 
@@ -121,19 +103,19 @@ def _start_worker() -> None:
     _set_jax_options()
 
 
-def _in_worker(work, *arguments):
-    """``work(*arguments)`` in a drawing process, which ends when told to stop."""
+def _in_worker(task, out: Path, formats):
+    """A :class:`TaskQueue` task done in a drawing process, which ends when told to stop."""
+    kind, _, work = task
     try:
         with interrupts_stop_writes():  # SIGTERM from the parent: stop at a safe point
-            return work(*arguments)
+            return work() if kind == "part" else _write_figure_group(work, out, formats)
     except KeyboardInterrupt:  # its file removed; end without JAX's teardown, as console does
         os._exit(128 + signal.SIGTERM)
 
 
 class TaskQueue:
-    """The order of the parallel work: parts first, then groups, never more at once than
-    ``jobs``, a group whose parts are done drawn next (the costliest). A task is
-    ``('part', index, callable)`` or ``('group', index, names)``."""
+    """The order of the parallel work, ``jobs`` tasks at once: parts, then the groups whose parts
+    are done. A task is ``('part', index, callable)`` or ``('group', index, names)``."""
 
     def __init__(self, groups, parts, jobs: int):
         self.groups, self.jobs, self.running = groups, jobs, 0
@@ -158,25 +140,16 @@ class TaskQueue:
         return self.started()
 
 
-def _call(task, out: Path, formats) -> tuple:
-    """The function and arguments of a :class:`TaskQueue` task."""
-    kind, _, work = task
-    return (work,) if kind == "part" else (_write_figure_group, work, out, formats)
-
-
 def _written_in_parallel(groups, parts, out: Path, formats, jobs: int):
     """Each group's :func:`_write_figure_group` from ``jobs`` processes (:class:`TaskQueue`)."""
     others = set(multiprocessing.active_children())
     start_resource_tracker_quietly()
-    executor = ProcessPoolExecutor(
-        jobs,
-        mp_context=multiprocessing.get_context("spawn"),  # JAX's threads do not survive a fork
-        initializer=_start_worker,
-    )
+    spawn = multiprocessing.get_context("spawn")  # JAX's threads do not survive a fork
+    executor = ProcessPoolExecutor(jobs, mp_context=spawn, initializer=_start_worker)
     queue = TaskQueue(groups, parts, jobs)
 
     def submitted(tasks) -> dict:  # each future: its task
-        return {executor.submit(_in_worker, *_call(task, out, formats)): task for task in tasks}
+        return {executor.submit(_in_worker, task, out, formats): task for task in tasks}
 
     try:
         pending = submitted(queue.started())
@@ -216,22 +189,22 @@ def run(args) -> int:
 
     names = list(dict.fromkeys(args.only or ())) or None
     groups, parts = figure_groups(names), figure_parts(names)
-    jobs = min(args.jobs or _usable_cores(), max(len(groups), *map(len, parts)))
-    out = Path(args.out)
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    jobs = min(args.jobs or cores or 1, max(len(groups), *map(len, parts)))
     drawn = [name for group in groups for name in group]
-    planned = [("--out", out / f"{name}.{suffix}") for name in drawn for suffix in args.format]
-    refuse_to_overwrite(planned, [], overwrite=args.overwrite, folders=[("--out", out)])
-    with made_folder(out):
+    planned = [("--out", args.out / f"{name}.{suffix}") for name in drawn for suffix in args.format]
+    common.refuse_to_overwrite(planned, [], overwrite=args.overwrite, folders=[("--out", args.out)])
+    with common.made_folder(args.out):
         print(
-            f"ecofmaps figures: {len(drawn)} figure(s) as {', '.join(args.format)} into {out}"
+            f"ecofmaps figures: {len(drawn)} figure(s) as {', '.join(args.format)} into {args.out}"
             + (f", {jobs} processes" if jobs > 1 else ""),
             file=sys.stderr,
         )
         begin = time.perf_counter()
         if jobs > 1:
-            results = _written_in_parallel(groups, parts, out, args.format, jobs)
+            results = _written_in_parallel(groups, parts, args.out, args.format, jobs)
         else:
-            results = _written_here(groups, out, args.format)
+            results = _written_here(groups, args.out, args.format)
         written = (figure for group in results for figure in group)
         for index, (name, paths, seconds) in enumerate(written, start=1):
             record_written(paths)

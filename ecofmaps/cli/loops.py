@@ -1,6 +1,5 @@
-"""``ecofmaps loops``: recorded fretting loops analysed cycle by cycle through the one pipeline
-of :mod:`ecofmaps.measured.pipeline` (a long recording out of core: :mod:`.loops_long`), the
-table written as the chunks come, then the summary lines and the extras (docs/loops.md)."""
+"""``ecofmaps loops``: recorded loops analysed cycle by cycle by :mod:`ecofmaps.measured.pipeline`
+(out of core: :mod:`.loops_long`), the table written as it comes, then summaries (docs/loops.md)."""
 
 from __future__ import annotations
 
@@ -17,21 +16,8 @@ import numpy as np
 from ecofmaps._interrupts import interrupts_deferred
 from ecofmaps._nomenclature import QUANTITIES, texts_with_se, transition_texts, with_se
 from ecofmaps._parallel import worker_limit
-from ecofmaps.cli._common import (
-    CommandError,
-    add_contact_options,
-    add_recording_options,
-    command_parser,
-    contact,
-    count,
-    made_folder,
-    option_adder,
-    quantity,
-    read_scar_file,
-    recording_options,
-    refuse_to_overwrite,
-)
-from ecofmaps.cli.main import option_names
+from ecofmaps.cli import common
+from ecofmaps.cli.main import CommandError, option_names
 from ecofmaps.io.files import FileLineError, atomic_path, record_written
 from ecofmaps.web import INSTALL_WEB, missing_web_packages
 
@@ -40,58 +26,44 @@ __all__ = ["SUMMARY_VARIABLES", "add", "run"]
 _HELP = {
     "files": "recording files (CSV, TSV or other text, TDMS, HDF5/netCDF-4, zarr)",
     "--example": "analyse the shipped synthetic example (load 450N) instead of FILEs",
-    "--load": "normal load P, e.g. 450N; or the name of the recording's normal-load column "
-    "(e.g. Fz), used sample by sample (required unless --example)",
+    "--load": "normal load P, e.g. 450N, or a load column (e.g. Fz); required unless --example",
     "--out": "CSV file to write (its directory must exist); default: print the table",
     "--plots": "also write into DIR per file: loops with Q = SΔ (<name>_loops.png), ECoF and "
     "GICoF over the cycles (<name>_evolution.png), loops along the stroke (<name>_resolved.png)",
-    "--overwrite": "replace the outputs ecofmaps wrote before (--out, --resolved, the plots in "
-    "--plots); a file or folder ecofmaps did not write is never replaced",
-    "--resolved": "also write the loops read along the stroke (one FILE): μ(ξ), the groove "
-    "slope g(ξ) and the felt profile h(ξ) over (cycle, position), a netCDF file",
-    "--report": "also write one recording as an offline HTML page: friction and quality flags "
-    'per cycle, picked loops with the model\'s, the table (needs pip install "ecofmaps[web]")',
-    "--no-resolve": "skip the reading along the stroke (about ten times faster; no "
-    "mu_resolved, mu_resolved_se, aspect_ratio)",
-    "--flip-force": "read the force with the other sign (a rig recording it positive against "
-    "the displacement: its loops run anticlockwise)",
-    "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m (in series with the contact in the "
-    "stick slope): adds the ratios on the contact's displacement, the regime there, a sweep's δ_t",
-    "--scar-profile": "the scar's profile after the test (x and z columns, in um unless their "
-    "names say): the loop-scar closure of its last loop with a GICoF, printed, in the report "
-    "and with --plots (<name>_closure.png); with --length or --sphere, its energy wear",
-    "--nan-policy": "skip (default): a cycle with a missing sample (NaN, an empty cell) is skipped "
-    "and counted; raise: any missing sample stops the command naming its line",
+    "--resolved": "also write one FILE's loops along the stroke (netCDF): μ(ξ), slope g(ξ), h(ξ)",
+    "--report": 'also write one recording as an offline HTML page (pip install "ecofmaps[web]")',
+    "--no-resolve": "skip the reading along the stroke (ten times faster; no mu_resolved, ...)",
+    "--flip-force": "read the force with the other sign (loops that run anticlockwise)",
+    "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m: the contact's ratios, regime, δ_t",
+    "--scar-profile": "the scar's profile after the test (x, z columns): the loop-scar closure of "
+    "its last loop (with --plots <name>_closure.png); with --length or --sphere, its energy wear",
+    "--nan-policy": "skip (default) and count cycles missing a sample, or raise naming its line",
     "--workers": "analyse out of core on a local dask cluster of N processes",
-    "--scheduler": "analyse out of core on the dask cluster at ADDRESS (tcp://host:8786); its "
-    "workers must have ecofmaps and see the files at the same paths",
+    "--scheduler": "analyse out of core on the dask cluster at ADDRESS (tcp://host:8786), whose "
+    "workers have ecofmaps and see the files at the same paths",
     "--resume": "continue a stopped run from <out>.partial/ (the same --out, files and options)",
-    "--quiet": "no progress bar (none is shown off a terminal)",
 }
 
 
 def add(subparsers) -> None:
-    parser = command_parser(
+    parser = common.command_parser(
         subparsers,
         "loops",
         help="analyse recorded fretting loops cycle by cycle: ECoF, GICoF, stiffness, ...",
-        description="Read recordings of fretting loops (text: a header line in any common "
-        "dialect), cut them into cycles at the displacement reversals or by a cycle column, check "
-        "each loop, and write a row per cycle: cycle, amplitude_um, slip_amplitude_um, "
-        "normal_load_N (with --load COLUMN), max_force_N, dissipated_energy_mJ, ecof, cof_max, "
-        "energy_ratio (with --rig-stiffness also opening_ratio, contact_amplitude_um, "
-        "contact_energy_ratio, contact_opening_ratio), stiffness_MN_per_m, gicof, regime, "
-        "mu_resolved, mu_resolved_se, "
-        "aspect_ratio (read along the whole stroke) and quality ('ok', or why values are NaN); "
-        "first a file column for several files. Columns are found by the names rigs write "
-        "(displacement, disp, delta, stroke, ...; force, Fx, Ft, Q, friction, ...; an optional "
-        "'cycle'), units from their names or the file, else um and N. Of several files, one that "
-        "cannot be analysed is an error line naming it, the others are written (exit status 1). "
-        "Files are written atomically, never over an input or a file ecofmaps did not write.",
+        description="Cut recordings of fretting loops (text: a header line, any dialect) into "
+        "cycles at the displacement reversals or by a cycle column, and write a row per cycle: "
+        "cycle, amplitude_um, slip_amplitude_um, normal_load_N (with --load COLUMN), max_force_N, "
+        "dissipated_energy_mJ, ecof, cof_max, energy_ratio (with --rig-stiffness also "
+        "opening_ratio, contact_amplitude_um, contact_energy_ratio, contact_opening_ratio), "
+        "stiffness_MN_per_m, gicof, regime, mu_resolved, mu_resolved_se, aspect_ratio (read along "
+        "the stroke), quality ('ok', or why values are NaN); first a file column for several "
+        "files. Columns are found by rigs' names (disp, Fx, cycle, ...), units by their names or "
+        "the file, else um and N. A file that fails is an error line, the others are written "
+        "(exit status 1), atomically, never over an input or a file ecofmaps did not write.",
         epilog="examples:\n  ecofmaps loops test.csv --load 450N --out results.csv --plots plots\n"
         "  ecofmaps loops --example --out results.csv --plots plots",
     )
-    option = option_adder(parser, _HELP)
+    option = common.option_adder(parser, _HELP)
     option("files", nargs="*", metavar="FILE")
     option("--example", action="store_true")
     option("--load", type=_load_or_column, metavar="P")
@@ -102,17 +74,17 @@ def add(subparsers) -> None:
     option("--report", metavar="FILE.html")
     option("--no-resolve", action="store_true")
     option("--flip-force", action="store_true")
-    option("--rig-stiffness", type=quantity("stiffness", option="--rig-stiffness"), metavar="S")
+    stiffness = common.quantity("stiffness", option="--rig-stiffness")
+    option("--rig-stiffness", type=stiffness, metavar="S")
     option("--scar-profile", metavar="FILE")
-    add_contact_options(parser, required=False)
+    common.add_contact_options(parser, required=False)
     option("--nan-policy", choices=("skip", "raise"), default="skip")
-    add_recording_options(parser)
+    common.add_recording_options(parser)
     long_tests = parser.add_argument_group(
         "long tests",
-        "a rig file of more than 2**24 samples is analysed out of core, a block of whole cycles "
-        "at a time (the numbers are those of the analysis in memory)",
+        "past 2**24 samples a file is analysed out of core, by blocks (the same numbers)",
     )
-    option = option_adder(long_tests, _HELP)
+    option = common.option_adder(long_tests, _HELP)
     option("--workers", type=_workers, metavar="N")
     option("--scheduler", metavar="ADDRESS")
     option("--resume", action="store_true")
@@ -120,7 +92,7 @@ def add(subparsers) -> None:
 
 
 def _workers(text: str) -> int:
-    value = count("workers")(text)
+    value = common.count("workers")(text)
     limit, why = worker_limit(processes=True)
     if value > limit:
         raise argparse.ArgumentTypeError(f"{value} is more than this machine can run: {why}")
@@ -130,7 +102,7 @@ def _workers(text: str) -> int:
 def _load_or_column(text: str):
     """``--load``: a load [N] (a float), or the name of a column (a str)."""
     try:
-        return quantity("load")(text)
+        return common.quantity("load")(text)
     except argparse.ArgumentTypeError:
         name = text.strip()
         try:
@@ -256,7 +228,7 @@ def _scar_numbers(args, each, profile) -> tuple[dict, object]:
     from ecofmaps.lab import energy_wear, loop_scar_closure
 
     rows, closure = {}, None
-    if (kind := contact(args)) is not None:
+    if (kind := common.contact(args)) is not None:
         try:
             wear = energy_wear(each.results, profile, args.length, kind)
         except ValueError as error:
@@ -325,7 +297,7 @@ def _checked(args) -> tuple[list[Path], float | str, list]:
             "--scar-profile is the scar of one recording, closed on its loops read along the "
             "stroke: give one FILE, without --no-resolve"
         )
-    if args.scar_profile is None and contact(args) is not None:
+    if args.scar_profile is None and common.contact(args) is not None:
         raise CommandError("--length or --sphere reads the wear on a --scar-profile: give it")
     if args.report is not None and missing_web_packages():
         raise CommandError(INSTALL_WEB)
@@ -335,9 +307,9 @@ def _checked(args) -> tuple[list[Path], float | str, list]:
         kinds += ("closure",) if args.scar_profile is not None else ()
         names = _plot_names(paths)
         outputs += [("--plots", Path(args.plots, f"{n}_{k}.png")) for n in names for k in kinds]
-    inputs = [*paths, *([args.scar_profile] if args.scar_profile is not None else [])]
+    inputs = [path for path in (*paths, args.scar_profile) if path is not None]
     folders = [("--plots", args.plots)]
-    refuse_to_overwrite(outputs, inputs, overwrite=args.overwrite, folders=folders)
+    common.refuse_to_overwrite(outputs, inputs, overwrite=args.overwrite, folders=folders)
     return paths, load, outputs
 
 
@@ -357,7 +329,7 @@ def _analyse_each(args, paths, load, long_run, table) -> tuple[list[_Analysed], 
     for index, (path, plot_name) in enumerate(zip(paths, _plot_names(paths), strict=True)):
         held = []  # a recording in memory: its lines once its analysis has succeeded
         try:
-            options = recording_options(args)
+            options = common.recording_options(args)
             options["load_column"] = load if isinstance(load, str) else None  # --load COLUMN
             # closed once analysed: the report reads only its names and units
             with read_recording(path, lazy=long_run.lazy, **options) as recording:
@@ -381,7 +353,7 @@ def _write_extras(args, done: list[_Analysed], lab: dict, closure) -> None:
     if args.plots is not None:
         from ecofmaps import figures  # matplotlib only when plots are asked for
 
-        with made_folder(Path(args.plots)) as folder:  # none left empty behind
+        with common.made_folder(Path(args.plots)) as folder:  # none left empty behind
             for each in done:
                 results, resolved, source = each.results, each.resolved, each.path.name
                 drawn = {
@@ -412,7 +384,7 @@ def run(args) -> int:
     from ecofmaps.cli.loops_long import LongRun
 
     paths, load, outputs = _checked(args)
-    scar = None if args.scar_profile is None else read_scar_file(args.scar_profile, "loops")
+    scar = None if args.scar_profile is None else common.read_scar_file(args.scar_profile, "loops")
     long_run = LongRun(args, paths)
     try:
         with contextlib.ExitStack() as stack:  # the table is written as it comes, renamed last
@@ -427,11 +399,8 @@ def run(args) -> int:
             lab, closure = ({}, None) if scar is None else _scar_numbers(args, done[0], scar)
             _write_extras(args, done, lab, closure)
     except _NothingAnalysed:
-        print(
-            f"ecofmaps loops: none of the {len(paths)} recordings could be analysed; "
-            "nothing written",
-            file=sys.stderr,
-        )
+        none = f"none of the {len(paths)} recordings could be analysed; nothing written"
+        print(f"ecofmaps loops: {none}", file=sys.stderr)
         return 1
     with interrupts_deferred():  # the table is in place: a stop now would leave it unrecorded
         record_written(path for _, path in outputs if path is not None)

@@ -1,9 +1,8 @@
 """``ecofmaps loops`` on long tests: out of core, in parallel, resumable, with progress.
 
-A recording read lazily (more than :data:`ecofmaps.io.recordings.LAZY_SAMPLES` samples, or
-``--workers``, ``--scheduler``, ``--resume``) is analysed on local threads, ``--workers``
-processes or the ``--scheduler`` cluster, its lines written in order as the blocks come; with
-``--out`` each block is kept in ``<out>.partial/`` for ``--resume`` (docs/parallel.md).
+A recording read lazily (past :data:`ecofmaps.io.recordings.LAZY_SAMPLES` samples, or with
+``--workers``, ``--scheduler``, ``--resume``) is analysed on threads, processes or a cluster, its
+lines written in order; with ``--out`` each block is kept in ``<out>.partial/`` (docs/parallel.md).
 """
 
 from __future__ import annotations
@@ -20,22 +19,10 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps._interrupts import INTERRUPTED, Interrupted, add_stop_note
-from ecofmaps.cli._common import CommandError
+from ecofmaps.cli.common import CommandError, progress_bar
 from ecofmaps.io.tables import results_csv
+from ecofmaps.measured import pipeline
 from ecofmaps.measured.cycles import Cycles
-from ecofmaps.measured.pipeline import (
-    IN_PROCESS,
-    Analysis,
-    LoopOptions,
-    Reading,
-    block_file,
-    force_at_mean_load,
-    kept_block,
-    only,
-    runner_for,
-    temporary_file,
-    write_whole,
-)
 from ecofmaps.measured.resolve import ReadingOptions
 from ecofmaps.measured.samples import MissingSampleError
 
@@ -87,11 +74,11 @@ class _Partial:
 
     def __init__(self, out, fingerprint: dict):
         self.folder = Path(f"{out}{PARTIAL_SUFFIX}")
-        record = self.folder / "run.json"
+        record, self.manifest = self.folder / "run.json", self.folder / "kept.jsonl"
         self.made = not self.folder.exists()  # else --resume: LongRun checked it
         if self.made:
             self.folder.mkdir()
-            write_whole(record, json.dumps(fingerprint))
+            pipeline.write_whole(record, json.dumps(fingerprint))
             return
         try:
             found = json.loads(record.read_text(encoding="utf-8"))
@@ -109,10 +96,7 @@ class _Partial:
     def _manifest(self) -> dict:
         """(file, block or 'cycles') -> its line in ``kept.jsonl`` (one cut short passed over)."""
         found = {}
-        with (
-            contextlib.suppress(OSError),
-            open(self.folder / "kept.jsonl", encoding="utf-8") as lines,
-        ):
+        with contextlib.suppress(OSError), open(self.manifest, encoding="utf-8") as lines:
             for line in lines:
                 with contextlib.suppress(ValueError, TypeError, KeyError, RecursionError):
                     entry = json.loads(line)
@@ -122,7 +106,7 @@ class _Partial:
     def _record(self, path: Path, **entry) -> None:
         """Add the checksum of ``path`` just kept, with ``entry``, to the manifest."""
         entry["sha256"] = _sha256(path)
-        with open(self.folder / "kept.jsonl", "a", encoding="utf-8") as lines:
+        with open(self.manifest, "a", encoding="utf-8") as lines:
             lines.write(json.dumps(entry) + "\n")
 
     def _refused(self, path: Path, reason: str) -> None:
@@ -157,7 +141,7 @@ class _Partial:
 
     def keep_cycles(self, index: int, cycles) -> None:
         path = self.folder / f"file{index}-cycles.npz"
-        write_whole(path, dataclasses.asdict(cycles))
+        pipeline.write_whole(path, dataclasses.asdict(cycles))
         self._record(path, file=index, block="cycles")
 
     def blocks(self, index: int) -> Path:
@@ -165,7 +149,7 @@ class _Partial:
         return self.folder / f"file{index}-block"
 
     def record_block(self, index: int, block: int, rows: slice) -> None:
-        path = block_file(self.blocks(index), block)
+        path = pipeline.block_file(self.blocks(index), block)
         self._record(path, file=index, block=block, rows=[rows.start, rows.stop])
 
     def record_late(self, index: int, tasks) -> None:
@@ -177,12 +161,9 @@ class _Partial:
 
     def kept(self, index: int) -> dict:
         """The blocks of file ``index`` kept: block -> its file."""
-        prefix = self.blocks(index).name
-        return {
-            int(path.stem[len(prefix) :]): path
-            for path in self.folder.glob(f"{prefix}*.npz")
-            if path.stem[len(prefix) :].isdigit()
-        }
+        name = self.blocks(index).name  # and the block's number
+        found = {file.stem.removeprefix(name): file for file in self.folder.glob(f"{name}*.npz")}
+        return {int(block): path for block, path in found.items() if block.isdigit()}
 
     def done(self, index: int, tasks) -> dict:
         """The blocks of file ``index`` kept and checked: block -> (values, flags) measured."""
@@ -194,28 +175,24 @@ class _Partial:
                 continue
             rows = [tasks[block].start, tasks[block].stop]
             if self._checked(path, manifest.get((index, block)), rows):
-                kept[block] = kept_block(path)
+                kept[block] = pipeline.kept_block(path)
         return kept
 
-    def remove_temporaries(self) -> None:
-        """Remove the temporaries of files being written: a folder kept holds whole files."""
-        for pattern in _KEPT:
-            for path in self.folder.glob(temporary_file(Path(pattern)).name):
+    def remove_temporaries(self, *kept) -> None:
+        """Remove the files ``kept`` (patterns) then the temporaries of files being written."""
+        for pattern in (*kept, *(pipeline.temporary_file(Path(pattern)).name for pattern in _KEPT)):
+            for path in self.folder.glob(pattern):
                 path.unlink(missing_ok=True)
 
     def remove(self) -> None:
         """Remove the files the run kept, then the folder if nothing else is in it."""
-        for pattern in _KEPT:
-            for path in self.folder.glob(pattern):
-                path.unlink(missing_ok=True)
-        self.remove_temporaries()
+        self.remove_temporaries(*_KEPT)
         with contextlib.suppress(OSError):  # not empty: left as it is
             self.folder.rmdir()
 
 
 class LongRun:
-    """The recordings ``paths`` of one ``ecofmaps loops`` through the pipeline; ``lazy`` for
-    :func:`ecofmaps.read_recording`: True if ``--workers``, ``--scheduler`` or ``--resume``."""
+    """The recordings ``paths`` of one ``ecofmaps loops`` through the pipeline."""
 
     def __init__(self, args, paths):
         if args.workers and args.scheduler:
@@ -224,16 +201,13 @@ class LongRun:
             raise CommandError("--resume continues the run kept beside --out: give --out")
         folder = Path(f"{args.out}{PARTIAL_SUFFIX}")
         if args.out is not None and folder.exists() and not args.resume:
-            raise CommandError(
-                f"{folder} holds an unfinished run: add --resume to continue it, or delete it "
-                "to start again"
-            )
+            raise CommandError(f"{folder} holds an unfinished run: add --resume, or delete it")
         self.args, self.paths, self.partial = args, paths, None
-        self.lazy = True if (args.workers or args.scheduler or args.resume) else None
+        self.lazy = True if (args.workers or args.scheduler or args.resume) else None  # or by size
         self.analysed = None  # (index, path, blocks or None) of the recording analysed last
         scar = args.scar_profile is not None
         handed = args.plots is not None or args.resolved is not None or scar  # on 201 positions
-        self.reading = Reading(
+        self.reading = pipeline.Reading(
             resolve=not args.no_resolve,
             keep_loops=args.plots is not None or args.report is not None or scar,
             along_stroke=ReadingOptions(positions=201 if handed else None),
@@ -241,11 +215,11 @@ class LongRun:
         )
 
     def analyse(self, index, path, recording, load, write, columns):
-        """The results of recording ``index`` (its ``columns`` if given) and its reading along
-        the stroke if handed back; each chunk's lines given to ``write`` in order."""
-        args, runner = self.args, contextlib.nullcontext(IN_PROCESS)
+        """Results (of ``columns``) and reading along the stroke of recording ``index``."""
+        args, runner = self.args, contextlib.nullcontext(pipeline.IN_PROCESS)
         if recording.lazy:
-            runner = runner_for("processes" if args.workers else args.scheduler, args.workers)
+            cluster = "processes" if args.workers else args.scheduler
+            runner = pipeline.runner_for(cluster, args.workers)
         self.analysed = (index, path, None)
         try:
             with runner as runner:  # a cluster that does not answer: nothing written
@@ -269,8 +243,7 @@ class LongRun:
         return analysis.finish([parts.pop(k) for k in sorted(parts)]), resolved
 
     def stop_note(self) -> str | None:
-        """The sentence naming the folder a stop leaves beside ``--out``, or None (one this run
-        made that holds no work yet is removed)."""
+        """The sentence naming the folder a stop leaves beside ``--out`` (None: none kept)."""
         partial = self.partial
         if partial is None or not partial.folder.exists():
             return None
@@ -295,16 +268,17 @@ def _analyse(run, index, path, recording, load, runner, write, columns):
     args, partial = run.args, run.partial if recording.lazy else None
     force, recorded = recording.force, None
     if isinstance(load, str):  # the load recorded sample by sample (--load COLUMN)
-        force, load = force_at_mean_load(force, recording.load)
+        force, load = pipeline.force_at_mean_load(force, recording.load)
         recorded = recording.load
     shown = recording.lazy and not args.quiet and sys.stderr.isatty()
     if shown:
         print(f"{path.name}: finding the cycles of {recording.size} samples", file=sys.stderr)
-    analysis = Analysis(
+    keywords = {"flip_force": args.flip_force, "rig_stiffness": args.rig_stiffness}
+    analysis = pipeline.Analysis(
         recording.displacement,
         force,
         recording.cycle,
-        options=LoopOptions(load, flip_force=args.flip_force, rig_stiffness=args.rig_stiffness),
+        options=pipeline.LoopOptions(load, **keywords),
         recorded_load=recorded,
         runner=runner,
         nan_policy=args.nan_policy,
@@ -320,7 +294,7 @@ def _analyse(run, index, path, recording, load, runner, write, columns):
     parts, texts = {}, {}  # texts: the lines of chunks that came before an earlier one
     for block, measured in done.items():
         part = analysis.part(block, *measured)
-        parts[block], texts[block] = only(part, columns), lines(part)
+        parts[block], texts[block] = pipeline.only(part, columns), lines(part)
     written = _in_order(texts, write)
     bar = _bar(analysis, path, shown, sum(parts[b].cycle.size for b in parts))
     keep = False if partial is None else partial.blocks(index)
@@ -364,15 +338,5 @@ class _Interrupted(KeyboardInterrupt):
 
 
 def _bar(analysis, path, shown: bool, initial: int):
-    from tqdm import tqdm
-
-    return tqdm(
-        total=int(analysis.cycles.label.size),
-        initial=initial,
-        unit=" cycles",
-        desc=path.name,
-        file=sys.stderr,
-        disable=not shown,
-        dynamic_ncols=True,
-        smoothing=0.1,
-    )
+    total, options = int(analysis.cycles.label.size), {"disable": not shown, "smoothing": 0.1}
+    return progress_bar(total, path.name, initial=initial, unit=" cycles", **options)

@@ -1,15 +1,15 @@
 """The ``ecofmaps`` command: its parser, and the run of one subcommand.
 
 Each subcommand is a module of :mod:`ecofmaps.cli`: ``add(subparsers)`` declares its options,
-``run(args)`` works through the public API, importing JAX, xarray, numba, dask and matplotlib
-only then (``--help`` answers at once). Quantities take units (``50um``); a bare number is SI.
-Errors in the input end with exit status 2 and one line, never a traceback.
+``run(args)`` works through the public API, importing JAX and the rest only then (``--help`` is
+quick). An error in the input is one line and exit status 2, never a traceback.
 """
 
 from __future__ import annotations
 
 import argparse
 import difflib
+import functools
 import gc
 import importlib
 import os
@@ -21,15 +21,7 @@ import warnings
 from ecofmaps._interrupts import STOP_SIGNALS, interrupts_stop_writes
 from ecofmaps._version import __version__
 
-__all__ = [
-    "EXIT_BROKEN_PIPE",
-    "EXIT_INTERRUPTED",
-    "EXIT_TERMINATED",
-    "CommandError",
-    "build_parser",
-    "console",
-    "main",
-]
+__all__ = ["CommandError", "build_parser", "console", "main"]
 
 
 class CommandError(Exception):
@@ -54,10 +46,9 @@ def build_parser() -> argparse.ArgumentParser:
     """The ``ecofmaps`` argument parser with every subcommand."""
     parser = _Parser(
         prog="ecofmaps",
-        description="Fretting friction maps: how far the energy coefficient of friction drifts "
-        "from the contact one with rig stiffness and wear-scar shape, the paper's figures, "
-        "corrections of reported ECoF values, and the per-cycle analysis of measured loops (ECoF, "
-        "GICoF, rig stiffness). Quantities take units: 50um, 450N, 35MN/m.",
+        description="Fretting friction maps: how far the energy CoF drifts from the contact CoF "
+        "with rig stiffness and wear-scar shape; the paper's figures; reported ECoFs corrected; "
+        "measured loops analysed cycle by cycle. Quantities take units: 50um, 450N, 35MN/m.",
     )
     parser.add_argument("--version", action="version", version=f"ecofmaps {__version__}")
     subparsers = parser.add_subparsers(title="commands", metavar="COMMAND", required=True)
@@ -72,16 +63,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _unknown_arguments(unknown, args) -> str:
     """The error line of arguments unknown to the subcommand, with did-you-means."""
-    guesses = [
-        difflib.get_close_matches(word.split("=")[0], args.command_options, n=1)
-        for word in unknown
-        if word.startswith("--")
-    ]
+    words = [word.split("=")[0] for word in unknown if word.startswith("--")]
+    guesses = [difflib.get_close_matches(word, args.command_options, n=1) for word in words]
     hint = "".join(f"; did you mean {guess[0]}?" for guess in guesses if guess)
-    return (
-        f"ecofmaps: error: unrecognized arguments: {' '.join(unknown)}{hint} "
-        f"(see '{args.command_prog} --help')\n"
-    )
+    hint += f" (see '{args.command_prog} --help')\n"
+    return f"ecofmaps: error: unrecognized arguments: {' '.join(unknown)}{hint}"
 
 
 #: Exit statuses (128 + the signal, as shells report them) of a run stopped by Ctrl-C, by
@@ -90,11 +76,9 @@ EXIT_INTERRUPTED, EXIT_TERMINATED, EXIT_BROKEN_PIPE = 130, 143, 141
 
 
 def main(argv=None) -> int:
-    """Run the ``ecofmaps`` command; return its exit status: 0 on success; 2 for a user error
-    (one line naming it); 130 after Ctrl-C and 143 after SIGTERM, with one line telling what
-    was left (:func:`ecofmaps._interrupts.add_stop_note`), but not once the work is done; 1
-    for an unexpected failure (``ECOFMAPS_DEBUG=1`` shows the traceback). Warnings are printed
-    as ``ecofmaps COMMAND: warning: ...``, one line each."""
+    """Run the ``ecofmaps`` command; its exit status: 0, 2 for a user error, 130 or 143 after
+    Ctrl-C or SIGTERM (one line on what was left, :func:`ecofmaps._interrupts.add_stop_note`),
+    1 for a bug (``ECOFMAPS_DEBUG=1`` shows the traceback). Warnings print one line each."""
     interrupted = status = None
     try:  # the subcommands import JAX and xarray: an interrupt may come during the imports
         with interrupts_stop_writes() as interrupted, warnings.catch_warnings(record=True) as told:
@@ -106,7 +90,8 @@ def main(argv=None) -> int:
             except SystemExit as stop:  # a usage error (printed), --help or --version
                 status = int(stop.code or 0)
                 return status
-            warnings.showwarning = _warning_line(getattr(args, "command_prog", "ecofmaps"))
+            command = getattr(args, "command_prog", "ecofmaps")  # set by every subcommand
+            warnings.showwarning = functools.partial(_show_warning, command)
             for warning in told:
                 warnings.showwarning(warning.message, warning.category, "", 0)
             status = args.handler(args)
@@ -125,11 +110,8 @@ def main(argv=None) -> int:
             return _report(1, "error: not enough memory for this run")
         if os.environ.get("ECOFMAPS_DEBUG"):
             raise
-        return _report(
-            1,
-            f"error: unexpected {type(error).__name__}: {error} (a bug: please report it; "
-            "ECOFMAPS_DEBUG=1 shows the traceback)",
-        )
+        bug = f"error: unexpected {type(error).__name__}: {error} (a bug: please report it"
+        return _report(1, f"{bug}; ECOFMAPS_DEBUG=1 shows the traceback)")
 
 
 def _stopped(interrupted, note) -> int:
@@ -146,8 +128,8 @@ def _nothing_to_stop(signum, frame) -> None:
     """A stop signal outside :func:`main`'s block, where there is no work to stop."""
 
 
-#: The keywords of the Python API that errors of the reading name, by the option giving them.
-_OPTIONS = {
+#: The keywords of the Python API that errors of the reading name, and the options giving them.
+KEYWORD_OPTIONS = {
     "displacement_column": "--displacement-col",
     "force_column": "--force-col",
     "cycle_column": "--cycle-col",
@@ -157,30 +139,23 @@ _OPTIONS = {
     "skip_rows": "--skip-rows",
 }
 _KEYWORD = re.compile(
-    rf"(?<![\w./-])({'|'.join(_OPTIONS)})(?:=(\S+))?(?![\w./-])(?: \((--[^()]*)\))?"
+    rf"(?<![\w./-])({'|'.join(KEYWORD_OPTIONS)})(?:=(\S+))?(?![\w./-])(?: \((--[^()]*)\))?"
 )
 
 
 def option_names(message: str) -> str:
-    """An error of the Python API with the command-line options for its keywords:
-    ``force_column (--force-col)`` and ``force_column`` are ``--force-col``,
-    ``force_unit='foo'`` is ``--force-unit 'foo'``."""
+    """An error of the Python API with options for keywords: ``force_column`` (and ``force_column
+    (--force-col)``) is ``--force-col``, ``force_unit='foo'`` is ``--force-unit 'foo'``."""
 
-    def option(match) -> str:
-        if match[3]:  # the message names the option already
-            return match[3]
-        return _OPTIONS[match[1]] + (f" {match[2]}" if match[2] else "")
+    def option(match) -> str:  # match[3]: the message names the option already
+        return match[3] or KEYWORD_OPTIONS[match[1]] + (f" {match[2]}" if match[2] else "")
 
     return _KEYWORD.sub(option, message)
 
 
-def _warning_line(command: str):
-    """A ``warnings.showwarning`` that prints ``<command>: warning: <message>`` on one line."""
-
-    def show(message, category, filename, lineno, file=None, line=None) -> None:
-        print(f"{command}: warning: {' '.join(str(message).strip().splitlines())}", file=sys.stderr)
-
-    return show
+def _show_warning(command, message, category, filename, lineno, file=None, line=None) -> None:
+    """``warnings.showwarning`` as ``<command>: warning: <message>`` on one line."""
+    print(f"{command}: warning: {' '.join(str(message).strip().splitlines())}", file=sys.stderr)
 
 
 def _report(status: int, message: str) -> int:
@@ -190,12 +165,9 @@ def _report(status: int, message: str) -> int:
 
 
 def console() -> None:
-    """The ``ecofmaps`` console script: run :func:`main` and exit with its status. After a
-    stop the process ends at once (``os._exit``), its messages flushed and the run's objects
-    collected: tearing the interpreter down around JAX's busy threads can crash it. Once
-    :func:`main` has returned, a stop signal is ignored: a complete run stays complete. If
-    the reader of the output goes (``| head``), the command ends at once, quietly, with
-    :data:`EXIT_BROKEN_PIPE`."""
+    """The ``ecofmaps`` console script: exit with :func:`main`'s status; after a stop at once
+    (``os._exit``: tearing down around JAX's busy threads can crash); a stop signal once main
+    has returned is ignored; a reader that goes (``| head``) ends it quietly."""
     after = [n for n in STOP_SIGNALS if signal.getsignal(n) not in (signal.SIG_IGN, None)]
     for number in after:  # ignored once main has returned; until then main's to handle
         signal.signal(number, _nothing_to_stop)

@@ -12,55 +12,39 @@ from pathlib import Path
 
 import numpy as np
 
-from ecofmaps.cli._common import (
-    CACHE_DIR_HELP,
-    CommandError,
-    byte_size,
-    command_parser,
-    count,
-    option_adder,
-    quantity,
-    refuse_to_overwrite,
-)
+from ecofmaps.cli import common
+from ecofmaps.cli.main import CommandError
 from ecofmaps.io.files import record_written
 
 __all__ = ["add", "run"]
 
 #: The grid's axes, in the order of the map's dimensions, and their metavars.
 _AXES = {"stiffness_ratio": "S/P", "aspect_ratio": "Z/X", "amplitude": "DELTA", "mu": "MU"}
-_GRID_HELP = "; one value, a list or a range start:stop:num"
 _HELP = {
-    "--stiffness-ratio": "rig stiffness over normal load S/P [1/m], inf for a rigid rig"
-    + _GRID_HELP,
-    "--aspect-ratio": "groove depth over half-width z_o/x_o (>= 0)" + _GRID_HELP,
-    "--amplitude": "displacement amplitude Δ* [m], e.g. 25um,50um" + _GRID_HELP,
-    "--mu": "contact coefficient of friction μ (> 0)" + _GRID_HELP,
+    "--stiffness-ratio": "rig stiffness over normal load S/P [1/m], inf for a rigid rig",
+    "--aspect-ratio": "groove depth over half-width z_o/x_o (>= 0)",
+    "--amplitude": "displacement amplitude Δ* [m], e.g. 25um,50um",
+    "--mu": "contact coefficient of friction μ (> 0)",
     "--load": "normal load P [N], one value; adds dissipated_energy [J] and max_force [N]",
     "--out": "netCDF file, or zarr store if it ends in .zarr, to write (its directory must exist)",
-    "--overwrite": "replace --out if ecofmaps wrote it (once the new map is complete)",
-    "--chunk-points": "grid points per block (default %(default)s); a larger grid is computed "
-    "block by block into --out",
-    "--quiet": "no progress bar (there is none either when standard error is not a terminal)",
+    "--chunk-points": "grid points per block computed into --out (default %(default)s)",
     "--no-cache": "do not use the cache (no map of the parabolic groove is cached: for scripts)",
-    "--cache-dir": CACHE_DIR_HELP,
 }
 
 
 def add(subparsers) -> None:
-    parser = command_parser(
+    parser = common.command_parser(
         subparsers,
         "map",
         help="compute the model over a grid of test conditions into a netCDF file or zarr store",
         description="Compute the model's steady-loop quantities (slip amplitude and ratio, energy "
         "CoF and its ratio to mu, compliance ratio P/(S*amplitude), regime; with --load the "
         "dissipated energy and peak force) over a grid into an xarray Dataset in --out, "
-        "atomically. Its size is printed first; a map that would not fit on the disk is refused. "
-        "The groove half-width is the amplitude, as in the paper. Of the grid options, one value "
-        "is a scalar coordinate, a list a,b,c or a range start:stop:num (num points, both ends "
-        "included) a dimension, in this order. Values take units (50um, 0.08/um, 450N); a bare "
-        "number is SI. A zarr store, or more than --chunk-points points, is computed block by "
-        "block, a few in memory (grids far beyond memory work). The map is not cached (it "
-        "computes faster than the cache would read it).",
+        "atomically, its size printed first (refused if the disk cannot hold it). The groove "
+        "half-width is the amplitude. Each grid option takes one value (a scalar coordinate), a "
+        "list a,b,c or a range start:stop:num (num points, ends included) (a dimension, in this "
+        "order), with units (50um, 0.08/um); a bare number is SI. A zarr store, or more than "
+        "--chunk-points points, is computed block by block, a few in memory. Maps are not cached.",
         epilog="example (the grid of Figure 11):\n  ecofmaps map "
         "--stiffness-ratio 0.01/um:0.3/um:30 --aspect-ratio 0:0.3:31 \\\n      --amplitude "
         "25um,50um --mu 0.8 --load 450N --out fig11.nc\n"
@@ -68,51 +52,48 @@ def add(subparsers) -> None:
         "  ecofmaps map --stiffness-ratio 0.01/um:0.3/um:25000 --aspect-ratio 0:0.4:20000 "
         "\\\n      --amplitude 25um,50um --mu 0.8 --out big.zarr",
     )
-    option = option_adder(parser, _HELP)
+    option = common.option_adder(parser, _HELP)
     for name, metavar in _AXES.items():
-        values = quantity(name, grid=True)
+        values = common.quantity(name, grid=True)
         option(f"--{name.replace('_', '-')}", type=values, required=True, metavar=metavar)
-    option("--load", type=quantity("load"), metavar="P")
+    option("--load", type=common.quantity("load"), metavar="P")
     option("--out", required=True, metavar="FILE.nc|FILE.zarr")
     option("--overwrite", action="store_true")
     # blocks of 2**22 points by default: about 220 MB of results with a load
-    option("--chunk-points", type=count("points"), default=2**22, metavar="N")
+    option("--chunk-points", type=common.count("points"), default=2**22, metavar="N")
     option("--quiet", action="store_true")
     option("--no-cache", action="store_true")
     option("--cache-dir", metavar="DIR")
 
 
 def run(args) -> int:
-    """Run ``ecofmaps map``; the exit status."""
     from ecofmaps.maps.files import ZARR_SUFFIX, write_map
     from ecofmaps.maps.grid import compute_map
     from ecofmaps.model import Regime
 
     out = Path(args.out)
-    refuse_to_overwrite([("--out", out)], [], overwrite=args.overwrite)
-    axes = {name: getattr(args, name) for name in _AXES}
-    grid = {name: values[0] if values.size == 1 else values for name, values in axes.items()}
+    common.refuse_to_overwrite([("--out", out)], [], overwrite=args.overwrite)
+    grid = {name: getattr(args, name) for name in _AXES}
+    grid = {name: values[0] if values.size == 1 else values for name, values in grid.items()}
     points = math.prod(values.size for values in grid.values() if np.ndim(values))
     size = _map_bytes(grid, args.load)
     free = shutil.disk_usage(out.parent).free
     print(
-        f"ecofmaps map: {points:,} points, {byte_size(size)} into {out} "
-        f"({byte_size(free)} free there)",
+        f"ecofmaps map: {points:,} points, {common.byte_size(size)} into {out} "
+        f"({common.byte_size(free)} free there)",
         flush=True,  # before the summary, also when the two streams are read apart
     )
     if size > free:
         raise CommandError(
-            f"--out {out}: the map of {points:.3g} points needs up to {byte_size(size)} on disk, "
-            f"more than the {byte_size(free)} free in {out.parent.resolve()}: use a smaller grid "
-            "or another disk"
+            f"--out {out}: the map of {points:.3g} points needs up to {common.byte_size(size)} on "
+            f"disk, more than the {common.byte_size(free)} free in {out.parent.resolve()}: use a "
+            "smaller grid or another disk"
         )
     chunked = out.suffix == ZARR_SUFFIX or points > args.chunk_points
+    options = {"cache": False if args.no_cache else None, "cache_dir": args.cache_dir}
     if chunked:
-        dataset = compute_map(**grid, load=args.load, chunks=args.chunk_points)
-    else:  # refused there if it would not fit in memory
-        dataset = compute_map(
-            **grid, load=args.load, cache=False if args.no_cache else None, cache_dir=args.cache_dir
-        )
+        options = {"chunks": args.chunk_points}  # else refused if it would not fit in memory
+    dataset = compute_map(**grid, load=args.load, **options)
     summary = [(dataset.regime == code).sum().data for code in Regime]
     summary += [dataset.ecof_ratio.min().data, dataset.ecof_ratio.max().data]
     shown = chunked and not args.quiet and sys.stderr.isatty()  # a progress bar
@@ -147,21 +128,12 @@ def _map_bytes(grid: dict, load) -> int:
 def _progress(dataset):
     """A progress bar of the map's blocks as their dask tasks finish; cleared on an error."""
     from dask.callbacks import Callback
-    from tqdm import tqdm
 
     from ecofmaps.maps.tiles import BLOCK_TASK
 
-    blocks = math.prod(len(c) for c in dataset.regime.chunks)
-    bar = tqdm(
-        total=dataset.regime.size,
-        unit="pt",
-        unit_scale=True,
-        desc="ecofmaps map",
-        file=sys.stderr,
-        dynamic_ncols=True,
-        postfix=f"0/{blocks} blocks",
-    )
-    done = itertools.count(1)
+    blocks, done = math.prod(len(c) for c in dataset.regime.chunks), itertools.count(1)
+    options = {"unit": "pt", "unit_scale": True, "postfix": f"0/{blocks} blocks"}
+    bar = common.progress_bar(dataset.regime.size, "ecofmaps map", **options)
 
     def on_task(key, result, dsk, state, worker_id) -> None:
         if isinstance(key, tuple) and str(key[0]).startswith(BLOCK_TASK):

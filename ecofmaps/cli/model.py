@@ -7,17 +7,7 @@ import warnings
 
 from ecofmaps import paper
 from ecofmaps._version import __version__
-from ecofmaps.cli._common import (
-    TWO_COLUMNS,
-    add_profile_options,
-    option_adder,
-    print_rows,
-    profile_rows,
-    quantity,
-    read_profile,
-    row,
-    two_values,
-)
+from ecofmaps.cli import common
 
 __all__ = ["add", "run"]
 
@@ -27,8 +17,7 @@ _HELP = {
     "--stiffness": "rig stiffness S, 'inf' for a rigid rig (default 35MN/m)",
     "--mu": "contact coefficient of friction μ (default 0.8)",
     "--aspect-ratio": "groove depth over half-width z_o/x_o of the parabolic groove (default 0.2)",
-    "--groove-half-width": "groove half-width x_o (default: the amplitude, as in the paper); with "
-    "a profile, the x_o of the mapping X = x W/x_o",
+    "--groove-half-width": "groove half-width x_o, also of X = x W/x_o (default: the amplitude)",
 }
 
 #: The model's results printed, after the regime, in this order.
@@ -41,44 +30,39 @@ def add(subparsers) -> None:
         help="evaluate the model at one point (default: the paper's Example 2)",
         description="Print the compliant wear-scar interaction model's slip amplitude, peak "
         "force, dissipated energy, energy CoF and regime at one point (default: the paper's "
-        "Example 2). --scar-profile FILE: a measured wear-scar profile instead of the groove, "
-        "beside the parabola of the same depth over half-width D/W.",
+        "Example 2); with --scar-profile FILE on a measured scar, beside the parabola of its D/W.",
     )
-    option = option_adder(parser, _HELP)
+    option = common.option_adder(parser, _HELP)
     for name in ("amplitude", "load", "stiffness", "mu"):
-        option(f"--{name}", type=quantity(name), default=paper.EXAMPLE_2[name])
-    option("--aspect-ratio", type=quantity("aspect_ratio"))
-    option("--groove-half-width", type=quantity("groove_half_width"))
-    add_profile_options(parser)
+        option(f"--{name}", type=common.quantity(name), default=paper.EXAMPLE_2[name])
+    option("--aspect-ratio", type=common.quantity("aspect_ratio"))
+    option("--groove-half-width", type=common.quantity("groove_half_width"))
+    common.add_profile_options(parser)
 
 
 def run(args) -> int:
-    """Run ``ecofmaps model``; the exit status."""
     from ecofmaps import model
     from ecofmaps._codes import RegimeWarning
 
-    profile = read_profile(args, conflicting=("aspect_ratio",))
+    profile = common.read_profile(args, conflicting=("aspect_ratio",))
     rig = dict(amplitude=args.amplitude, load=args.load, stiffness=args.stiffness, mu=args.mu)
-    rows = [row(name, value) for name, value in rig.items()]
+    rows = [common.row(name, value) for name, value in rig.items()]
     point = dict(rig, groove_half_width=args.groove_half_width)
     x_o = args.groove_half_width or args.amplitude
     if profile is None:
         ratio = paper.EXAMPLE_2["aspect_ratio"] if args.aspect_ratio is None else args.aspect_ratio
         points = [dict(point, aspect_ratio=ratio)]
-        rows += [row("aspect_ratio", ratio), row("groove_half_width", x_o), None]
-        show, title = row, ""
+        rows += [common.row("aspect_ratio", ratio), common.row("groove_half_width", x_o), None]
+        show, title = common.row, ""
     else:
-        points = [
-            dict(point, profile=profile, mapping=args.mapping),
-            # the paper's shortcut z_o/x_o = D/W (eq. 11), x_o as given whatever the mapping
-            dict(point, aspect_ratio=float(profile.aspect_ratio)),
-        ]
+        shortcut = dict(point, aspect_ratio=float(profile.aspect_ratio))  # eq. 11, x_o as given
+        points = [dict(point, profile=profile, mapping=args.mapping), shortcut]
         mapping = f"X = x W/x_o, x_o = {x_o * 1e6:.6g} µm (eq. 11)"
         if args.mapping == "physical":
             mapping = "X = x (physical)"
-        rows += [*profile_rows(args, profile), ("position on the profile", "X", mapping), None]
-        rows.append(TWO_COLUMNS)
-        show, title = two_values, " on a measured scar profile"
+        rows += [*common.profile_rows(args, profile), ("position on the profile", "X", mapping)]
+        rows += [None, common.TWO_COLUMNS]
+        show, title = common.two_values, " on a measured scar profile"
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RegimeWarning)
         regimes = [model.Regime(int(model.slip_regime(**p))).label for p in points]
@@ -87,5 +71,5 @@ def run(args) -> int:
     ecof = values.pop("energy_cof")
     rows += [show(name, *value) for name, value in values.items()]
     rows += [show("ecof", *ecof), show("ecof_ratio", *(value / args.mu for value in ecof))]
-    print_rows(f"ecofmaps {__version__}: compliant wear-scar interaction model{title}", rows)
+    common.print_rows(f"ecofmaps {__version__}: compliant wear-scar interaction model{title}", rows)
     return 0

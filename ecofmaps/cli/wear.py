@@ -4,18 +4,8 @@ and scar profiles (:func:`ecofmaps.energy_wear`, :func:`ecofmaps.transition`, do
 from __future__ import annotations
 
 from ecofmaps._nomenclature import TRANSITION, texts_with_se, transition_texts
-from ecofmaps.cli._common import (
-    CommandError,
-    add_contact_options,
-    contact,
-    option_adder,
-    print_rows,
-    quantity,
-    read_scar_file,
-    refuse_to_overwrite,
-    row,
-    unit,
-)
+from ecofmaps.cli import common
+from ecofmaps.cli.main import CommandError
 from ecofmaps.io.files import record_written, write_text
 
 __all__ = ["add", "run"]
@@ -30,10 +20,7 @@ _HELP = {
     "tables": "results of ecofmaps loops (CSV, or .nc)",
     "--profile": "a test's wear-scar profile (x and z columns); once per test",
     "--rig-stiffness": "the rig's own stiffness, e.g. 35MN/m: regime read on the contact",
-    "--x-unit": "unit of the profiles' positions (default: the column name's, else um)",
-    "--z-unit": "unit of the profiles' heights (default: the column name's, else um)",
     "--out": "write the numbers here (CSV)",
-    "--overwrite": "replace --out if ecofmaps wrote it",
 }
 
 
@@ -49,13 +36,14 @@ def add(subparsers) -> None:
         "transition to gross slip Δ_t, δ_t, μ_t if they span it (row 'campaign' of --out). "
         "--profile in the tests' order (a table of several recordings holds several tests).",
     )
-    option = option_adder(parser, _HELP)
+    option = common.option_adder(parser, _HELP)
     option("tables", nargs="+", metavar="TABLE")
     option("--profile", action="append", required=True, metavar="FILE")
-    add_contact_options(parser, required=True)
-    option("--rig-stiffness", type=quantity("stiffness", option="--rig-stiffness"), metavar="S")
-    option("--x-unit", type=unit("length"), metavar="UNIT")
-    option("--z-unit", type=unit("length"), metavar="UNIT")
+    common.add_contact_options(parser, required=True)
+    stiffness = common.quantity("stiffness", option="--rig-stiffness")
+    option("--rig-stiffness", type=stiffness, metavar="S")
+    option("--x-unit", type=common.unit("length"), metavar="UNIT")
+    option("--z-unit", type=common.unit("length"), metavar="UNIT")
     option("--out", metavar="OUT")
     option("--overwrite", action="store_true")
 
@@ -74,14 +62,13 @@ def _columns(found, names, quantity="{}") -> dict:
 
 
 def run(args) -> int:
-    """Run ``ecofmaps wear`` with the parsed ``args``; the exit status."""
     import pandas as pd
 
     from ecofmaps.io.tables import csv_text, read_results
     from ecofmaps.lab import energy_wear, sliding_condition, transition
 
     inputs = [*args.tables, *args.profile]
-    refuse_to_overwrite([("--out", args.out)], inputs, overwrite=args.overwrite)
+    common.refuse_to_overwrite([("--out", args.out)], inputs, overwrite=args.overwrite)
     tests = []
     for path in args.tables:
         found = read_results(path)
@@ -91,35 +78,34 @@ def run(args) -> int:
             f"give one --profile per test: {len(tests)} tests in the tables, "
             f"{len(args.profile)} profiles"
         )
-    profiles = [read_scar_file(path, "wear", args.x_unit, args.z_unit) for path in args.profile]
+    units = (args.x_unit, args.z_unit)
+    profiles = [common.read_scar_file(path, "wear", *units) for path in args.profile]
     table = []
     for (name, results), path, profile in zip(tests, args.profile, profiles, strict=True):
         try:
-            wear = energy_wear(results, profile, args.length, contact(args))
+            wear = energy_wear(results, profile, args.length, common.contact(args))
             condition = sliding_condition(results, rig_stiffness=args.rig_stiffness)
         except ValueError as error:
             raise CommandError(f"{name}: {error}") from None
         slip = condition.attrs["sliding_condition"]
-        rows = [row(q, text) for q, text in texts_with_se(wear, _WEAR)]
-        print_rows(f"{name} (scar profile {path}, {slip})", rows)
+        rows = [common.row(q, text) for q, text in texts_with_se(wear, _WEAR)]
+        common.print_rows(f"{name} (scar profile {path}, {slip})", rows)
         line = {"test": str(name), "profile": str(path), "sliding_condition": str(slip)}
         table.append(line | _columns(wear, _WEAR))
     if len(tests) > 2:
-        fit = energy_wear([r for _, r in tests], profiles, args.length, contact(args))
+        fit = energy_wear([r for _, r in tests], profiles, args.length, common.contact(args))
         names = ("campaign_energy_wear_coefficient", "threshold_energy")
-        rows = [row(q, text) for q, text in texts_with_se(fit, names)]
-        print_rows("campaign: V = α(ΣE_d - E_th)", rows)
+        rows = [common.row(q, text) for q, text in texts_with_se(fit, names)]
+        common.print_rows("campaign: V = α(ΣE_d - E_th)", rows)
         try:
             found = transition([r for _, r in tests], rig_stiffness=args.rig_stiffness)
         except ValueError as error:
             print(f"campaign: no transition to gross slip: {error}")
         else:
-            rows = [row(q, text) for q, text in transition_texts(found)]
-            print_rows("campaign: transition to gross slip", rows)
-            table.append(
-                {"test": "campaign", "profile": "", "sliding_condition": ""}
-                | _columns(found, TRANSITION, "transition_{}")
-            )
+            rows = [common.row(q, text) for q, text in transition_texts(found)]
+            common.print_rows("campaign: transition to gross slip", rows)
+            campaign = {"test": "campaign", "profile": "", "sliding_condition": ""}
+            table.append(campaign | _columns(found, TRANSITION, "transition_{}"))
     if args.out is not None:
         write_text(args.out, csv_text(pd.DataFrame(table)))
         record_written([args.out])

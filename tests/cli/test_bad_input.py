@@ -357,8 +357,7 @@ def test_columns_named_alike_are_chosen_by_position_and_a_cycle_column_ignored(t
     assert status == 0 and out.count(",gross slip,ok\n") == 19, out  # cut at the reversals
     status, out, err = run(capsys, "loops", labelled, "--load", "450N", "--cycle-col", "")
     assert status == 2 and err == (
-        "ecofmaps: error: --cycle-col '' names no column: give the cycle column's name, or none "
-        "to read no cycle column\n"
+        "ecofmaps: error: --cycle-col '' names no column: give a name or 'none'\n"
     )
 
 

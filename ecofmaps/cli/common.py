@@ -15,15 +15,14 @@ from pathlib import Path
 import numpy as np
 
 from ecofmaps._nomenclature import QUANTITIES, RANGES, within
-from ecofmaps.cli.main import CommandError
+from ecofmaps.cli.main import KEYWORD_OPTIONS, CommandError
 from ecofmaps.io.files import MANIFEST, written_by_ecofmaps
 from ecofmaps.units import DIMENSIONS, DOMAIN, bare_number_warning, parse_quantity, parse_values
 
 
 def quantity(name: str, grid: bool = False, option: str | None = None):
-    """An argparse ``type`` reading quantity ``name`` [SI] with units (``grid``: ``a,b,c`` or
-    ``start:stop:num``), checked against its dimension, range and :data:`ecofmaps.units.DOMAIN`;
-    a bare number implausible in SI is warned of, naming ``option`` (``--name``)."""
+    """An argparse ``type``: quantity ``name`` [SI] with units (``grid``: ``a,b,c``, ``a:b:num``) in
+    its range and domain; a bare number implausible in SI warned of, naming ``option``."""
     described = QUANTITIES[name]
     kind, option = described.kind, option or "--" + name.replace("_", "-")
 
@@ -62,8 +61,7 @@ def quantity(name: str, grid: bool = False, option: str | None = None):
 
 
 def unit(kind: str):
-    """An argparse ``type`` reading a unit of ``kind`` (``'um'``), kept as text: one of that
-    dimension whose size is positive and finite (not a number, ``'0um'``)."""
+    """An argparse ``type`` reading a unit of ``kind`` (``'um'``, not ``'0um'``), kept as text."""
     example = DIMENSIONS[kind][1]
 
     def parse(text: str) -> str:
@@ -89,10 +87,9 @@ def count(what: str, least: int = 1):
     """An argparse ``type`` reading a whole number of ``what`` >= ``least`` (``4e6``)."""
 
     def parse(text: str) -> int:
-        try:
+        value = math.nan
+        with contextlib.suppress(ValueError):
             value = float(text)
-        except ValueError:
-            value = math.nan
         if not (math.isfinite(value) and value.is_integer() and value >= least):
             raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of {what} >= {least}")
         return int(value)
@@ -101,20 +98,30 @@ def count(what: str, least: int = 1):
     return parse
 
 
-#: The help of ``--cache-dir`` (``ecofmaps map``, ``cache``).
-CACHE_DIR_HELP = "cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)"
-
-#: The help of each option of :func:`add_recording_options`.
-_RECORDING_HELP = {
+#: The help of the shared options: outputs, a recording's columns, a scar profile's
+#: (docs/profiles.md), the contact's.
+OPTION_HELP = {
+    "--overwrite": "replace what ecofmaps wrote before (never a file or folder it did not write)",
+    "--quiet": "no progress bar (none is shown off a terminal)",
+    "--cache-dir": "cache directory (default: $ECOFMAPS_CACHE, else the per-user cache directory)",
     "--displacement-col": "name of the displacement column (default: displacement)",
     "--force-col": "name of the tangential force column (default: force)",
-    "--cycle-col": "name of a column of cycle numbers, which must exist (default: 'cycle' if "
-    "the file has it; else, or with 'none', cycles are cut at the reversals)",
+    "--cycle-col": "cycle-number column (default: 'cycle' if any; 'none': cut at the reversals)",
     "--skip-rows": "lines before a text file's header to skip (default: found as metadata)",
-    "--displacement-unit": "unit of the displacement column (default: the one its name or the "
-    "file gives, as in 'displacement [mm]' or a channel's unit, else um)",
+    "--displacement-unit": "unit of the displacement (default: from its name or the file, else um)",
     "--force-unit": "unit of the force column (default: from its name or the file, else N)",
     "--group": "TDMS group, or HDF5/netCDF/zarr group, holding the channels (default: any)",
+    "--scar-profile": "the scar's profile (CSV, TSV or whitespace-separated text)",
+    "--x-column": "name of the position column (default: x)",
+    "--z-column": "name of the height column (default: z)",
+    "--x-unit": "unit of the positions (default: the one the column's name gives, else um)",
+    "--z-unit": "unit of the heights (default: the one the column's name gives, else um)",
+    "--no-level": "keep the trace's tilt and offset (default: level it on the unworn shoulders)",
+    "--profile-half-width": "the scar's half-width W, e.g. 500um (default: detected at the edges)",
+    "--smoothing": "length the slopes are smoothed over, e.g. 10um, 0 for none (default: 2%% of W)",
+    "--mapping": "pad at x sits at X = x W/x_o ('scaled', eq. 11; default) or X = x ('physical')",
+    "--length": "length of the line contact, with its unit, e.g. 5mm",
+    "--sphere": "a sphere on a flat: the scar is round, its profile traced through its centre",
 }
 
 
@@ -125,8 +132,9 @@ def command_parser(subparsers, name: str, **texts) -> argparse.ArgumentParser:
     return subparsers.add_parser(name, formatter_class=formatter, **texts)
 
 
-def option_adder(parser, helps: dict):
-    """``add(name, **keywords)``: add option ``name`` to ``parser``, its help ``helps[name]``."""
+def option_adder(parser, helps: dict | None = None):
+    """``add(name, **keywords)``: add ``name`` to ``parser``, helped by ``helps`` or OPTION_HELP."""
+    helps = OPTION_HELP | (helps or {})
 
     def add(name: str, **keywords) -> None:
         parser.add_argument(name, help=helps[name], **keywords)
@@ -136,7 +144,7 @@ def option_adder(parser, helps: dict):
 
 def add_recording_options(parser) -> None:
     """The options that say where a recording's columns are and in which units."""
-    option = option_adder(parser, _RECORDING_HELP)
+    option = option_adder(parser)
     option("--displacement-col", default="displacement", metavar="NAME")
     option("--force-col", default="force", metavar="NAME")
     option("--cycle-col", metavar="NAME")
@@ -149,34 +157,13 @@ def add_recording_options(parser) -> None:
 def recording_options(args) -> dict:
     """The keywords of :func:`ecofmaps.io.recordings.read_recording` the options give."""
     if args.cycle_col is not None and not args.cycle_col.strip():
-        raise CommandError(
-            f"--cycle-col {args.cycle_col!r} names no column: give the cycle column's name, "
-            "or none to read no cycle column"
-        )
-    return {
-        "displacement_column": args.displacement_col,
-        "force_column": args.force_col,
-        "cycle_column": False if args.cycle_col == "none" else args.cycle_col,
-        "skip_rows": args.skip_rows,
-        "displacement_unit": args.displacement_unit,
-        "force_unit": args.force_unit,
-        "group": args.group,
-    }
+        raise CommandError(f"--cycle-col {args.cycle_col!r} names no column: give a name or 'none'")
+    dests = {key: option[2:].replace("-", "_") for key, option in KEYWORD_OPTIONS.items()}
+    keywords = {key: getattr(args, dest) for key, dest in dests.items() if dest != "load"}
+    keywords["cycle_column"] = False if args.cycle_col == "none" else args.cycle_col
+    return {**keywords, "group": args.group}
 
 
-#: The ``--scar-profile`` options of ``model`` and ``correct`` (docs/profiles.md).
-_PROFILE_HELP = {
-    "--scar-profile": "the scar's profile (CSV, TSV or whitespace-separated text)",
-    "--x-column": "name of the position column (default: x)",
-    "--z-column": "name of the height column (default: z)",
-    "--x-unit": "unit of the positions (default: the one the column's name gives, else um)",
-    "--z-unit": "unit of the heights (default: the one the column's name gives, else um)",
-    "--no-level": "keep the trace's tilt and offset (default: level it on the unworn shoulders)",
-    "--profile-half-width": "the scar's half-width W, e.g. 500um (default: detected at the edges)",
-    "--smoothing": "length the slopes are smoothed over, e.g. 10um, 0 for none (default: 2%% of W)",
-    "--mapping": "where the pad at slip position x sits on the profile: 'scaled', X = x W/x_o "
-    "(eq. 11, the paper's; default), or 'physical', X = x",
-}
 _PROFILE_DEFAULTS = {"x_column": "x", "z_column": "z", "no_level": False, "mapping": "scaled"}
 
 
@@ -184,11 +171,10 @@ def add_profile_options(parser: argparse.ArgumentParser) -> None:
     """Add ``--scar-profile FILE`` and its reading options, in a group of their own."""
     group = parser.add_argument_group(
         "measured scar profile",
-        "a profilometer trace across the wear scar (text: a header line, then x and z per "
-        "line, in um unless the names or --x-unit/--z-unit say otherwise), used instead of "
-        "the parabolic groove of eq. 11",
+        "a profilometer trace across the wear scar (text: a header line, then x and z per line), "
+        "used instead of the parabolic groove of eq. 11",
     )
-    option = option_adder(group, _PROFILE_HELP)
+    option = option_adder(group)
     option("--scar-profile", metavar="FILE")
     option("--x-column", metavar="NAME")
     option("--z-column", metavar="NAME")
@@ -204,37 +190,26 @@ def add_profile_options(parser: argparse.ArgumentParser) -> None:
 
 
 def read_profile(args, conflicting=()):
-    """The profile ``--scar-profile`` names, or None; with it an option of the parabola
-    (destinations ``conflicting``), or without it one of the reading, is a :class:`CommandError`.
-    The reader's warnings are one line each, naming ``--profile-half-width`` of the other W."""
+    """The profile ``--scar-profile`` names, or None; refuses with it an option ``conflicting``,
+    without it a reading option; its warnings one line each, naming the other W."""
     given = [name for name in args.profile_options if getattr(args, name) is not None]
     if args.scar_profile is None and given:
-        raise CommandError(f"{_options(given)} reads a --scar-profile: give the FILE too")
+        raise CommandError(f"{options(given)} reads a --scar-profile: give the FILE too")
     for name, value in _PROFILE_DEFAULTS.items():
         if getattr(args, name) is None:
             setattr(args, name, value)
     if args.scar_profile is None:
         return None
     if given := [name for name in conflicting if getattr(args, name) is not None]:
-        raise CommandError(
-            f"give --scar-profile or {_options(given)}, not both (the profile gives the "
-            "scar's shape, and its D/W)"
-        )
+        raise CommandError(f"give --scar-profile or {options(given)}, not both: it gives the D/W")
     from ecofmaps.io.scar_profiles import read_scar_profile  # JAX: not with the command line
     from ecofmaps.model.profiles import ScarProfileWarning
 
+    reading = {name: getattr(args, name) for name in ("x_column", "z_column", "x_unit", "z_unit")}
+    reading |= {"level": not args.no_level, "half_width": args.profile_half_width}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ScarProfileWarning)
-        profile = read_scar_profile(
-            args.scar_profile,
-            x_column=args.x_column,
-            z_column=args.z_column,
-            x_unit=args.x_unit,
-            z_unit=args.z_unit,
-            level=not args.no_level,
-            half_width=args.profile_half_width,
-            smoothing=args.smoothing,
-        )
+        profile = read_scar_profile(args.scar_profile, smoothing=args.smoothing, **reading)
     args.profile_alternative = ""  # what the other half-width is, for profile_rows
     for item in caught:
         if not issubclass(item.category, ScarProfileWarning):
@@ -242,14 +217,14 @@ def read_profile(args, conflicting=()):
             continue
         said, hint = item.message, ""
         if said.alternative is not None:
-            args.profile_alternative = said.alternative_name
-            hint = f"; --profile-half-width {said.alternative * 1e6:.6g}um takes the "
-            hint += said.alternative_name
+            args.profile_alternative = other = said.alternative_name
+            hint = f"; --profile-half-width {said.alternative * 1e6:.6g}um takes the {other}"
         print(f"{args.command_prog}: warning: {said.summary}{hint}", file=sys.stderr)
     return profile
 
 
-def _options(names) -> str:
+def options(names) -> str:
+    """The options of the destinations ``names``: ``'--x-unit, --z-unit'``."""
     return ", ".join("--" + name.replace("_", "-") for name in names)
 
 
@@ -275,12 +250,6 @@ def profile_rows(args, profile) -> list:
     return [*rows, ("scar aspect ratio", "D/W", f"{float(profile.aspect_ratio):.6g}")]
 
 
-_CONTACT_HELP = {
-    "--length": "length of the line contact, with its unit, e.g. 5mm",
-    "--sphere": "a sphere on a flat: the scar is round, its profile traced through its centre",
-}
-
-
 def _length(text: str) -> float:
     """``--length``: a length that must carry its unit (``5mm``)."""
     try:
@@ -292,7 +261,7 @@ def _length(text: str) -> float:
 
 def add_contact_options(parser, required: bool) -> None:
     """``--length L`` (a line contact) or ``--sphere`` (a round scar), for the wear volume."""
-    option = option_adder(parser.add_mutually_exclusive_group(required=required), _CONTACT_HELP)
+    option = option_adder(parser.add_mutually_exclusive_group(required=required))
     option("--length", type=_length, metavar="L")
     option("--sphere", action="store_true")
 
@@ -319,27 +288,21 @@ def read_scar_file(path, command: str, x_unit=None, z_unit=None):
 
 
 def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=()) -> None:
-    """Raise :class:`CommandError` unless the command may write its ``outputs`` and into its
-    ``folders`` (each (option, path or None)), the one rule: into an existing directory (a
-    ``folders`` one is made); never over an input; over a file only with ``overwrite`` if
-    ecofmaps wrote it, unchanged since; into a folder holding anything only with ``overwrite``."""
+    """:class:`CommandError` unless ``outputs`` and ``folders`` ((option, path or None) each) may
+    be written: into an existing directory (``folders`` are made), never over an input; over a
+    file ecofmaps wrote, unchanged, or into a folder not empty only with ``overwrite``."""
     outputs = [(option, Path(path)) for option, path in outputs if path is not None]
-    sources = [Path(path) for path in inputs]
     made = [option for option, _ in folders]
     for option, target in outputs:
         if option not in made and not target.parent.is_dir():
             raise CommandError(f"cannot write {target} ({option}): its directory does not exist")
-        for source in sources:
-            same = (
-                os.path.samefile(source, target)
-                if source.exists() and target.exists()
-                else _resolved(source) == _resolved(target)
-            )
+        for source in map(Path, inputs):
+            if source.exists() and target.exists():
+                same = os.path.samefile(source, target)
+            else:
+                same = _resolved(source) == _resolved(target)
             if same:
-                raise CommandError(
-                    f"{option} {target} would write over the input file {source}: "
-                    "choose another output"
-                )
+                raise CommandError(f"{option} {target} would write over the input file {source}")
     for option, folder in folders:
         if folder is None or overwrite or not Path(folder).is_dir():
             continue
@@ -349,16 +312,13 @@ def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=())
                 "or --overwrite to replace the files ecofmaps wrote there (others are kept)"
             )
     for option, target in outputs:
-        if not os.path.lexists(target):
+        if not os.path.lexists(target) or (overwrite and written_by_ecofmaps(target)):
             continue
         if written_by_ecofmaps(target):
-            if not overwrite:
-                raise CommandError(f"{option} {target} exists already: --overwrite replaces it")
-            continue
+            raise CommandError(f"{option} {target} exists already: --overwrite replaces it")
         if not (target.is_dir() or target.is_file()):
             raise CommandError(
-                f"{option} {target} is not a regular file (a device, a pipe or a socket): "
-                "ecofmaps writes only regular files; choose a file name"
+                f"{option} {target} is not a regular file (a device, pipe or socket)"
             )
         kind = "a folder" if target.is_dir() else "a file"
         raise CommandError(
@@ -369,8 +329,7 @@ def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=())
 
 @contextlib.contextmanager
 def made_folder(folder: Path):
-    """Create ``folder`` and its parents for the block; if it fails, remove those it made
-    that are still empty."""
+    """Create ``folder`` and its parents for the block; if it fails, those made still empty go."""
     missing = [path for path in (folder, *folder.parents) if not path.exists()]
     folder.mkdir(parents=True, exist_ok=True)
     try:
@@ -393,8 +352,7 @@ def _resolved(path: Path) -> Path:
 
 
 def row(name: str, value, note: str = "") -> tuple[str, str, str]:
-    """One printed row: the quantity's words (then ``note``) and symbol, and ``value`` [SI] in
-    its display unit (text as it is; NaN ``undefined``; an infinite stiffness ``inf (rigid)``)."""
+    """One printed row: the quantity's words (and ``note``), symbol, ``value`` [SI] displayed."""
     quantity = QUANTITIES[name]
     words = f"{quantity.words} {note}".strip()
     if isinstance(value, str):
@@ -419,10 +377,17 @@ _COLUMN = 18
 TWO_COLUMNS = ("", "", f"{'on the profile':<{_COLUMN}} parabola of the same D/W (eq. 11 shortcut)")
 
 
-def two_values(name: str, on_profile, on_parabola, note: str = "") -> tuple[str, str, str]:
+def two_values(name: str, on_profile, on_parabola) -> tuple[str, str, str]:
     """One :func:`row` with two values: profile, parabola."""
-    words, symbol, first = row(name, on_profile, note)
+    words, symbol, first = row(name, on_profile)
     return words, symbol, f"{first:<{_COLUMN}} {row(name, on_parabola)[2]}"
+
+
+def progress_bar(total: int, name: str, **options):
+    """A tqdm progress bar of ``total`` steps on standard error, named ``name``."""
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=name, file=sys.stderr, dynamic_ncols=True, **options)
 
 
 def byte_size(size: float) -> str:
