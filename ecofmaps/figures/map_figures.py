@@ -78,11 +78,6 @@ def ecof_ratio_contours(
     figure : matplotlib.figure.Figure
         Contours at :data:`ECOF_RATIO_LEVELS` (5 % heavier) over :math:`S/P` [(MN/m)/kN],
         no gross slip hatched, and the markers.
-
-    Notes
-    -----
-    :math:`\mu_E/\mu` depends on :math:`S/P` and :math:`\Delta^*` only through
-    :math:`\lambda = P/(S\Delta^*)` (eq. 16): see :func:`universal_ecof_ratio_map`.
     """
     figure = Figure(figsize=FIGSIZE, layout="constrained")
     ax = figure.add_subplot()
@@ -127,12 +122,6 @@ def universal_ecof_ratio_map(
     figure : matplotlib.figure.Figure
         Contours at :data:`ECOF_RATIO_LEVELS` on a logarithmic :math:`\lambda` axis, the
         windows and the markers.
-
-    Notes
-    -----
-    With :math:`x_o = \Delta^*` the slip ratio (eq. 16) and :math:`\mu_E/\mu` (eq. 15,
-    corrected) depend on :math:`\mu`, :math:`z_o/x_o` and :math:`\lambda` only: both panels
-    of Figure 11 are windows of this chart, a factor 2 apart. Not in the paper.
     """
     figure = Figure(figsize=(6.8, 5.6), layout="constrained")
     ax = figure.add_subplot()

@@ -206,11 +206,6 @@ def cof_evolution(results: xr.Dataset, *, source: str | None = None) -> Figure:
     figure : matplotlib.figure.Figure
         Top: :math:`\mu_E` (eq. 1) and the GICoF against the cycle. Bottom:
         :math:`\mu_E/\text{GICoF} - 1` [%]. A panel with nothing to draw says why.
-
-    Notes
-    -----
-    With a flat scar the two coefficients agree; as the scar deepens into a groove the ECoF
-    rises above the GICoF, which stays at the contact :math:`\mu`. Partial slip leaves gaps.
     """
     figure = Figure(figsize=(7.0, 5.6), layout="constrained")
     top, bottom = figure.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
@@ -259,11 +254,6 @@ def measured_and_fitted_loops(fits, *, source: str | None = None) -> Figure:
     figure : matplotlib.figure.Figure
         Per panel the samples (dots) and the fitted loop, Q [N] and Q/P against Δ [µm],
         titled by the fitted μ, S [MN/m], z_o [µm] and the RMS force residual [N].
-
-    Notes
-    -----
-    The paper's Figure 10 draws the model with its own parameters (Section 4.2,
-    :data:`ecofmaps.paper.FIGURE_10_FITS`); here they are the least-squares fit.
     """
     panels = dict(fits) if isinstance(fits, Mapping) else {"": fits}
     figure = Figure(figsize=(5.6 * len(panels), 5.2), layout="constrained")
@@ -325,11 +315,6 @@ def resolved_loops(
         (position, cycle); (d) ``mu_resolved`` :math:`\pm 2` standard errors, the ECoF and
         GICoF, and ``aspect_ratio`` over the cycles, those without a value marked with
         their quality. A panel with nothing to draw says why.
-
-    Notes
-    -----
-    :math:`\mu(\xi)` and :math:`g(\xi)` from the two slip branches at the same
-    :math:`\xi = \Delta - Q/S` (eq. 9, 10): docs/method-loops.md.
     """
     if "position" not in resolved.dims:
         raise ValueError("resolved holds no positions: call resolve_loops(..., positions=201)")

@@ -46,10 +46,6 @@ def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
     figure : matplotlib.figure.Figure
         :math:`Q` [N] and :math:`Q/P` against :math:`\Delta` [µm], each loop's :math:`\delta^*`
         [µm] and :math:`E_d` [mJ] in the legend.
-
-    Notes
-    -----
-    The compliant loop's sides have slope :math:`S` (eq. 10); its slip branches follow eq. 9.
     """
     figure = Figure(figsize=FIGSIZE, layout="constrained")
     ax = figure.add_subplot()
@@ -91,11 +87,6 @@ def loops_by_aspect_ratio(loops: xr.Dataset) -> Figure:
     -------
     figure : matplotlib.figure.Figure
         One loop per :math:`z_o/x_o`, and the line :math:`Q = S\Delta`.
-
-    Notes
-    -----
-    Every loop crosses :math:`Q = S\Delta` where the contact is at the groove centre, so
-    :math:`Q = \pm\mu P` there whatever the groove (eq. 17-18): the GICoF, marked.
     """
     figure = Figure(figsize=(6.4, 5.6), layout="constrained")
     ax = figure.add_subplot()
@@ -168,11 +159,6 @@ def slip_amplitude_curves(dataset: xr.Dataset) -> Figure:
     Returns
     -------
     figure : matplotlib.figure.Figure
-
-    Notes
-    -----
-    A rigid rig keeps :math:`\delta^* = \Delta^*`; a compliant one loses more of the stroke
-    to its own deflection as the groove deepens (eq. 16).
     """
     title = "7a  Slip amplitude against the groove aspect ratio"
     return _stiffness_curves(dataset, "slip_amplitude", MICRO, title, "lower left")
@@ -189,11 +175,6 @@ def dissipated_energy_curves(dataset: xr.Dataset) -> Figure:
     Returns
     -------
     figure : matplotlib.figure.Figure
-
-    Notes
-    -----
-    A stiffer rig always dissipates more (eq. 12); :math:`E_d` rises with :math:`z_o/x_o`
-    for stiff rigs and falls for compliant ones.
     """
     title = "7b  Dissipated energy against the groove aspect ratio"
     return _stiffness_curves(dataset, "dissipated_energy", MILLI, title, "upper left")
@@ -214,11 +195,6 @@ def ecof_ratio_curves(dataset: xr.Dataset, markers: Mapping[str, Mapping] | None
     -------
     figure : matplotlib.figure.Figure
         The curves, each marked point with its :math:`\mu_E/\mu` read off the Dataset.
-
-    Notes
-    -----
-    Eq. 1, 12-16, with the corrected eq. 13-15: Example 2's :math:`\mu_E` is about 4 %
-    above :math:`\mu`.
     """
     title = "8  ECoF over the contact CoF against the groove aspect ratio"
     return _stiffness_curves(dataset, "ecof_ratio", 1.0, title, "upper left", markers)

@@ -51,19 +51,6 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
         the height :math:`z` [µm], the unworn surface (the levelling line), the depth
         :math:`D` and the parabola of the same :math:`D/W`; the slope :math:`g = dz/dX` the
         model uses and the parabola's (plus the unworn surface's tilt).
-
-    Notes
-    -----
-    Only the slopes within :math:`|X| \le \delta^* W/\Delta^*` enter a steady loop (eq. 9
-    pointwise, :math:`X = xW/x_o` of eq. 11): docs/profiles.md.
-
-    Examples
-    --------
-    >>> import ecofmaps
-    >>> from ecofmaps.figures import scar_profile_figure
-    >>> figure = scar_profile_figure(ecofmaps.parabolic_profile(10e-6, 50e-6), "a parabola")
-    >>> [ax.get_ylabel() for ax in figure.axes]
-    ['Height of the scar profile $z$ [µm]', 'Slope of the scar profile $g = dz/dX$ [1]']
     """
     position = np.asarray(profile.position)
     if position.ndim != 1:
@@ -127,12 +114,6 @@ def scar_shape_comparison(dataset: xr.Dataset) -> Figure:
         Bottom: :math:`\mu_E/\mu` over :math:`S/P` for each, and the error
         :math:`\mu'/\mu - 1` [%] of the contact CoF the paper's shortcut (the parabola of
         the scar's :math:`D/W`) makes of each scar's :math:`\mu_E`.
-
-    Notes
-    -----
-    The pad only reaches :math:`|X| \le \delta^* W/\Delta^* < W` (eq. 9, 11): ridges beyond
-    the edges are never felt, and a scar flatter in its middle than the parabola biases
-    :math:`\mu_E` less.
     """
     shapes = list(dataset["shape"].values)
     figure = Figure(figsize=(15.0, 9.0), layout="constrained")

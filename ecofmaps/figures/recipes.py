@@ -42,11 +42,13 @@ ASPECT_RATIOS = np.linspace(0.0, 0.3, 61)
 #: λ of the universal map, on a logarithmic scale: near-rigid rigs to well past the end of
 #: gross slip at μλ = 1, covering Figure 11 at both amplitudes. [1]
 COMPLIANCE_RATIOS = np.geomspace(0.01, 2.0, 161)
+#: Example 2's amplitude, load and μ.
+_RIG = dict(amplitude=paper.AMPLITUDE, load=paper.LOAD, mu=paper.MU)
 
 
 @dataclass(frozen=True)
 class FigureRecipe:
-    """How to make one figure: its Dataset (paper's parameters) and its drawing function.
+    """How to make one figure: its Dataset (the paper's parameters) and its drawing function.
 
     Attributes
     ----------
@@ -55,8 +57,7 @@ class FigureRecipe:
     data : callable
         ``data() -> xarray.Dataset`` through the cache; recipes that share it share the Dataset.
     draw, module : str
-        The function ``draw(dataset, **options) -> Figure`` and its module of
-        :mod:`ecofmaps.figures` (imported when a figure is made), by name.
+        ``draw(dataset, **options) -> Figure`` and its module of :mod:`ecofmaps.figures`, by name.
     selection, options : dict
         Coordinates picked with ``.sel`` before drawing; keyword arguments of ``draw``.
     cost : float
@@ -90,13 +91,8 @@ def _loops() -> xr.Dataset:
     from ecofmaps.maps.cache import cached_dataset
     from ecofmaps.maps.grid import compute_loops
 
-    inputs = dict(
-        stiffness=np.array([np.inf, paper.STIFFNESS]),
-        aspect_ratio=np.array([0.0, 0.1, 0.2, 0.3]),
-        amplitude=paper.AMPLITUDE,
-        load=paper.LOAD,
-        mu=paper.MU,
-    )
+    grid = dict(stiffness=np.array([np.inf, paper.STIFFNESS]), aspect_ratio=np.arange(4) / 10)
+    inputs = grid | _RIG
     return cached_dataset("compute_loops", inputs, lambda: compute_loops(**inputs))
 
 
@@ -198,11 +194,10 @@ def scar_shape_model_dataset() -> xr.Dataset:
     from ecofmaps.model.on_profile import steady_numbers_and_loops, steady_values
 
     ratios = _SHAPES_STIFFNESS_RATIOS
-    rig = dict(amplitude=paper.AMPLITUDE, load=paper.LOAD, mu=paper.MU)
     loop = ("displacement", "force")
     values = {name: [] for name in (*_STEADY, *loop)}
     for profile in _scar_profiles():
-        steady = steady_numbers_and_loops(profile, **rig, stiffness=ratios * paper.LOAD)
+        steady = steady_numbers_and_loops(profile, **_RIG, stiffness=ratios * paper.LOAD)
         numbers = {name: np.asarray(value) for name, value in steady.items()}
         numbers |= steady_values(numbers, paper.AMPLITUDE, paper.LOAD, paper.MU)  # as maps
         for name in values:
@@ -221,8 +216,7 @@ def scar_shape_parabola_dataset() -> xr.Dataset:
     position = np.linspace(-1.6, 1.6, 321) * paper.AMPLITUDE
     heights = [np.interp(position, p.position, p.height) for p in _scar_profiles()]
     # Not cached on its own: the figure's part is cached whole (_scar_shape_parabola).
-    grid = dict(amplitude=paper.AMPLITUDE, mu=paper.MU, load=paper.LOAD, cache=False)
-    parabola = ecofmaps.compute_map(ratios, paper.ASPECT_RATIO, **grid)
+    parabola = ecofmaps.compute_map(ratios, paper.ASPECT_RATIO, **_RIG, cache=False)
     loop = np.asarray(ecofmaps.fretting_loop(**_SHAPES_RIG, aspect_ratio=paper.ASPECT_RATIO))
     variables = {
         "scar_height": (("shape", "scar_position"), np.array(heights)),
@@ -400,7 +394,7 @@ def make_figures(names=None) -> Iterator[tuple[str, Figure]]:
     ------
     name : str
     figure : matplotlib.figure.Figure
-        Drawn lazily, so a caller can time each one.
+        Drawn lazily: a caller can time each one.
 
     Raises
     ------
@@ -427,7 +421,7 @@ def figure_groups(names=None) -> list[list[str]]:
     Returns
     -------
     groups : list of list of str
-        The names, each once, by shared Dataset; within a group in the order given.
+        Each name once; within a group in the order given.
 
     Raises
     ------
@@ -458,8 +452,7 @@ def figure_parts(names=None) -> list[list[Callable[[], xr.Dataset]]]:
     Returns
     -------
     parts : list of list of callable
-        One list per group of :func:`figure_groups`, in its order (empty for most): each
-        computes one part into the cache, where the group's Dataset reads it.
+        Per group of :func:`figure_groups` (empty for most), each computing a part into the cache.
 
     Raises
     ------

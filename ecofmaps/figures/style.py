@@ -145,15 +145,9 @@ def zero_lines(ax, color: str = "0.6", x: float = 0.0, y: float = 0.0) -> None:
 
 #: Room kept between a legend and what is drawn, as a fraction of the panel's height. [1]
 _LEGEND_ROOM = 0.03
-#: Where a legend may go inside a panel, in the order tried.
-_CORNERS = (
-    "upper left",
-    "upper right",
-    "lower left",
-    "lower right",
-    "upper center",
-    "lower center",
-)
+#: Where a legend may go inside a panel, in the order tried: the corners, then the middles.
+_CORNERS = ("upper left", "upper right", "lower left", "lower right")
+_CORNERS += ("upper center", "lower center")
 
 
 def legend_clear_of_data(ax, *, twins=(), **options):
@@ -203,17 +197,15 @@ _METADATA = {"pdf": {"CreationDate": None}, "svg": {"Date": None}}
 
 
 def save_figure(figure: Figure, path, dpi: int = PAPER_DPI) -> Path:
-    """Write ``figure`` to ``path`` atomically (a temporary file renamed over it, so a file is
-    never left half written); the format follows the file's suffix.
+    """Write ``figure`` to ``path`` atomically (never half written), in its suffix's format.
 
     Parameters
     ----------
     figure : matplotlib.figure.Figure
     path : str or os.PathLike
-        Destination, ending in ``.png``, ``.pdf`` or ``.svg``. Its directory must exist.
+        Ending in ``.png``, ``.pdf`` or ``.svg``; its directory must exist.
     dpi : int
-        Resolution of raster output: :data:`PAPER_DPI` by default, :data:`RECORDING_DPI`
-        for the plots of a recording. [1/inch]
+        Raster resolution: :data:`PAPER_DPI`, or :data:`RECORDING_DPI` for a recording. [1/inch]
 
     Returns
     -------
