@@ -7,14 +7,8 @@ import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
 
-from ecofmaps.figures.style import (
-    FIGSIZE,
-    MICRO,
-    axis_label,
-    number_text,
-    parameters,
-    stiffness_label,
-)
+from ecofmaps.figures import style
+from ecofmaps.figures.style import MICRO, axis_label, number_text, stiffness_label
 from ecofmaps.lab import per_cycle, sliding_condition
 
 __all__ = ["loop_scar_closure_figure", "running_condition_map"]
@@ -50,16 +44,16 @@ def running_condition_map(results, transition: xr.Dataset, rig_stiffness: float)
     L. Vincent, Y. Berthier, M. Godet (1992), Testing methods in fretting fatigue: a
     critical appraisal, ASTM STP 1159, 33-48.
     """
-    figure = Figure(figsize=FIGSIZE, layout="constrained")
+    figure = Figure(figsize=style.FIGSIZE, layout="constrained")
     ax = figure.add_subplot()
     drawn = set()
     for test in results:
         cycles = per_cycle(test, ("amplitude",))
         condition = sliding_condition(test, rig_stiffness).attrs["sliding_condition"]
         marker, face = _CONDITION_MARKERS[condition]
-        style = dict(marker=marker, markerfacecolor=face, markeredgecolor="black", linestyle="")
+        look = dict(marker=marker, markerfacecolor=face, markeredgecolor="black", linestyle="")
         style["label"] = None if condition in drawn else condition
-        ax.plot(np.nanmedian(cycles["amplitude"]) * MICRO, np.nanmedian(cycles["load"]), **style)
+        ax.plot(np.nanmedian(cycles["amplitude"]) * MICRO, np.nanmedian(cycles["load"]), **look)
         drawn.add(condition)
     top = 1.15 * ax.get_ylim()[1]
     load = np.linspace(0.0, top, 50)
@@ -73,7 +67,7 @@ def running_condition_map(results, transition: xr.Dataset, rig_stiffness: float)
     ax.legend(loc="lower right", fontsize="small")
     contact = [rf"$\delta_t$ = {float(transition.contact_amplitude) * MICRO:.3g} µm"]
     contact += [rf"$\mu_t$ = {float(transition.mu):.3g}", stiffness_label(rig_stiffness)]
-    ax.set_title(f"Running-condition fretting map\n{parameters(*contact)}", fontsize="medium")
+    ax.set_title(f"Running-condition fretting map\n{style.parameters(*contact)}", fontsize="medium")
     return figure
 
 
@@ -98,7 +92,7 @@ def loop_scar_closure_figure(closure: xr.Dataset) -> Figure:
     coefficient of friction from fretting loops exhibiting non-Coulomb frictional
     behaviour: Fig. 10.
     """
-    figure = Figure(figsize=(2 * FIGSIZE[0], FIGSIZE[1]), layout="constrained")
+    figure = Figure(figsize=(2 * style.FIGSIZE[0], style.FIGSIZE[1]), layout="constrained")
     loop, scar = figure.subplots(1, 2)
     measured, model = dict(color="0.55", linewidth=2.5), dict(color="tab:red", linewidth=1.2)
     label = f"measured, cycle {int(closure.cycle)}"
@@ -107,7 +101,9 @@ def loop_scar_closure_figure(closure: xr.Dataset) -> Figure:
     loop.plot(closure.model_displacement * MICRO, closure.model_force, **model, label=label)
     loop.set(xlabel=axis_label("displacement"), ylabel=axis_label("force"))
     off = f"RMS force off the model {number_text(100 * float(closure.loop_residual), 2)} % of Q*"
-    loop.set_title(parameters(off, stiffness_label(float(closure.stiffness))), fontsize="medium")
+    loop.set_title(
+        style.parameters(off, stiffness_label(float(closure.stiffness))), fontsize="medium"
+    )
     position = closure.position * MICRO
     scar.plot(position, closure.scar_height * MICRO, **measured, label="profile")
     label = r"implied by the loops, $\int g\,d\xi$"

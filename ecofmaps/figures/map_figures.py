@@ -13,19 +13,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from ecofmaps.figures.style import (
-    ECOF_RATIO_LEVELS,
-    FIGSIZE,
-    HIGHLIGHT_LEVEL,
-    MICRO,
-    PER_MM,
-    axis_label,
-    ecof_ratio_colors,
-    load_label,
-    parameters_of,
-    scalar,
-    stiffness_label,
-)
+from ecofmaps.figures import style
+from ecofmaps.figures.style import MICRO, axis_label, scalar
 from ecofmaps.model import NO_GROSS_SLIP, compliance_ratio, energy_cof
 
 __all__ = ["ecof_ratio_contours", "universal_ecof_ratio_map"]
@@ -36,12 +25,12 @@ def _ecof_ratio_contours(ax, x, ratio: xr.DataArray, regime: xr.DataArray) -> li
     y = ratio["aspect_ratio"].values
     values = ratio.transpose(..., "aspect_ratio").values.T
     top = np.nanmax(values)
-    levels = [level for level in ECOF_RATIO_LEVELS if level <= top]
-    above = [level for level in ECOF_RATIO_LEVELS if level > top]
+    levels = [level for level in style.ECOF_RATIO_LEVELS if level <= top]
+    above = [level for level in style.ECOF_RATIO_LEVELS if level > top]
     fill_levels = [1.0, *levels, above[0] if above else top]
-    cmap, norm = ecof_ratio_colors()
+    cmap, norm = style.ecof_ratio_colors()
     filled = ax.contourf(x, y, values, levels=fill_levels, cmap=cmap, norm=norm, alpha=0.85)
-    widths = [2.4 if level == HIGHLIGHT_LEVEL else 0.9 for level in levels]
+    widths = [2.4 if level == style.HIGHLIGHT_LEVEL else 0.9 for level in levels]
     lines = ax.contour(x, y, values, levels=levels, colors="black", linewidths=widths)
     ax.clabel(lines, fmt="%.2f", fontsize="small", inline_spacing=3)
     colorbar = ax.figure.colorbar(filled, ax=ax, ticks=fill_levels, format="%.2f")
@@ -79,19 +68,20 @@ def ecof_ratio_contours(
         Contours at :data:`ECOF_RATIO_LEVELS` (5 % heavier) over :math:`S/P` [(MN/m)/kN],
         no gross slip hatched, and the markers.
     """
-    figure = Figure(figsize=FIGSIZE, layout="constrained")
+    figure = Figure(figsize=style.FIGSIZE, layout="constrained")
     ax = figure.add_subplot()
-    x = dataset["stiffness_ratio"].values * PER_MM
+    x = dataset["stiffness_ratio"].values * style.PER_MM
     handles = _ecof_ratio_contours(ax, x, dataset["ecof_ratio"], dataset["regime"])
     ax.set_xlabel(axis_label("stiffness_ratio"))
     for name, point in (markers or {}).items():
-        label = f"{name} ({stiffness_label(point['stiffness'])}, {load_label(point['load'])})"
+        rig = style.stiffness_label(point["stiffness"]), style.load_label(point["load"])
+        label = f"{name} ({', '.join(rig)})"
         dot = dict(color="navy", markersize=8, markeredgecolor="white", label=label)
         handles += ax.plot(
-            point["stiffness"] / point["load"] * PER_MM, point["aspect_ratio"], "o", **dot
+            point["stiffness"] / point["load"] * style.PER_MM, point["aspect_ratio"], "o", **dot
         )
     ax.legend(handles=handles, loc="lower right", fontsize="small", framealpha=0.9)
-    rig = parameters_of(dataset, "amplitude", "mu")
+    rig = style.parameters_of(dataset, "amplitude", "mu")
     title = rf"Fig. {number}  $\mu_E/\mu$ over rig stiffness and groove shape" + "\n" + rig
     ax.set_title(title, fontsize="medium")
     return figure
@@ -150,7 +140,7 @@ def universal_ecof_ratio_map(
             lam = float(compliance_ratio(point["amplitude"], point["load"], point["stiffness"]))
         value = float(energy_cof(**point) / point["mu"])
         label = (
-            rf"{name}: {stiffness_label(point['stiffness'])}, "
+            rf"{name}: {style.stiffness_label(point['stiffness'])}, "
             rf"$z_o/x_o$ = {point['aspect_ratio']:.3g}, "
             rf"$\mu$ = {point['mu']:g}: $\mu_E/\mu$ = {value:.3f}"
         )

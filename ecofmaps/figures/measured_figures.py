@@ -13,17 +13,8 @@ from matplotlib import colormaps
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
-from ecofmaps.figures.style import (
-    MICRO,
-    axis_label,
-    force_ratio_axis,
-    legend_clear_of_data,
-    load_label,
-    parameters,
-    scalar,
-    stiffness_label,
-    zero_lines,
-)
+from ecofmaps.figures import style
+from ecofmaps.figures.style import MICRO, axis_label, load_label, scalar, stiffness_label
 from ecofmaps.measured.quality import SEPARATOR
 from ecofmaps.model.regimes import GROSS_SLIP, Regime
 
@@ -129,7 +120,7 @@ def measured_loops(
         if resolved is not None:
             _resolved_band(ax, resolved.sel(cycle=label), q)
         _crossings(ax, cycle, load)
-        zero_lines(ax, "0.7")
+        style.zero_lines(ax, "0.7")
         ax.grid(alpha=0.3)
         regime = Regime(int(cycle["regime"]))
         reading = f"GICoF {_number(cycle['gicof'])}, ECoF {_number(cycle['ecof'])}"
@@ -231,11 +222,12 @@ def cof_evolution(results: xr.Dataset, *, source: str | None = None) -> Figure:
     bottom.grid(alpha=0.3)
     _cycle_axis(bottom, cycle)
     amplitude = float(results["amplitude"].median()) * MICRO
-    test = parameters(load_label(scalar(results, "load")), rf"$\Delta^*$ ≈ {amplitude:.1f} µm")
+    load = load_label(scalar(results, "load"))
+    test = style.parameters(load, rf"$\Delta^*$ ≈ {amplitude:.1f} µm")
     title = _title("the ECoF and the GICoF over the cycles", source)
     figure.suptitle(f"{title}\n{test}", fontsize="medium")
     if top.get_lines():  # the layout done with the title: the legend's place
-        legend_clear_of_data(top, fontsize="small")
+        style.legend_clear_of_data(top, fontsize="small")
     return figure
 
 
@@ -263,14 +255,14 @@ def measured_and_fitted_loops(fits, *, source: str | None = None) -> Figure:
         displacement, force = fit.model_loop()
         ax.plot(fit.displacement * MICRO, fit.force, "o", **dots)
         ax.plot(displacement * MICRO, force, color="crimson", linewidth=1.8, label="fitted model")
-        zero_lines(ax, x=fit.displacement_offset * MICRO, y=fit.force_offset)
+        style.zero_lines(ax, x=fit.displacement_offset * MICRO, y=fit.force_offset)
         ax.set(xlabel=axis_label("displacement"), ylabel=axis_label("force"))
         ax.grid(alpha=0.3)
-        force_ratio_axis(ax, fit.load)
+        style.force_ratio_axis(ax, fit.load)
         panel = f"({chr(ord('a') + index)}) " if len(panels) > 1 else ""
         panel += f"{name}: " if name else ""
         test = rf"{panel}{load_label(fit.load)}, $x_o = \Delta^*$ = {fit.amplitude * MICRO:.1f} µm"
-        fitted = parameters(
+        fitted = style.parameters(
             rf"fit: $\mu$ = {fit.mu:.3f}",
             stiffness_label(fit.stiffness),
             rf"$z_o$ = {fit.groove_depth * MICRO:.2f} µm",
@@ -280,7 +272,7 @@ def measured_and_fitted_loops(fits, *, source: str | None = None) -> Figure:
     title = _title("measured fretting loops and the fitted model", source)
     figure.suptitle(title, fontsize="medium")
     for ax in axes:  # the layout done with the titles: the legends' places
-        legend_clear_of_data(ax, fontsize="small")
+        style.legend_clear_of_data(ax, fontsize="small")
     return figure
 
 
@@ -361,8 +353,8 @@ def resolved_loops(
     )
     # The layout done with the titles: each legend's place, clear of its panel's data.
     for ax in (stroke, felt) if chosen else ():
-        legend_clear_of_data(ax, fontsize="x-small", ncols=2)
-    legend_clear_of_data(test, twins=twins, fontsize="x-small")
+        style.legend_clear_of_data(ax, fontsize="x-small", ncols=2)
+    style.legend_clear_of_data(test, twins=twins, fontsize="x-small")
     return figure
 
 

@@ -11,18 +11,8 @@ import xarray as xr
 from matplotlib import colormaps
 from matplotlib.figure import Figure
 
-from ecofmaps.figures.style import (
-    FIGSIZE,
-    MICRO,
-    MILLI,
-    axis_label,
-    force_ratio_axis,
-    parameters_of,
-    scalar,
-    stiffness_colors,
-    stiffness_label,
-    zero_lines,
-)
+from ecofmaps.figures import style
+from ecofmaps.figures.style import MICRO, axis_label, scalar
 
 __all__ = [
     "dissipated_energy_curves",
@@ -47,20 +37,20 @@ def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
         :math:`Q` [N] and :math:`Q/P` against :math:`\Delta` [µm], each loop's :math:`\delta^*`
         [µm] and :math:`E_d` [mJ] in the legend.
     """
-    figure = Figure(figsize=FIGSIZE, layout="constrained")
+    figure = Figure(figsize=style.FIGSIZE, layout="constrained")
     ax = figure.add_subplot()
     stiffnesses = loops["stiffness"].values
-    for stiffness, color in zip(stiffnesses, stiffness_colors(stiffnesses), strict=True):
+    for stiffness, color in zip(stiffnesses, style.stiffness_colors(stiffnesses), strict=True):
         loop = loops.sel(stiffness=stiffness)
         label = (
-            f"{stiffness_label(stiffness)}: "
+            f"{style.stiffness_label(stiffness)}: "
             rf"$\delta^*$ = {float(loop.slip_amplitude) * MICRO:.1f} µm, "
-            rf"$E_d$ = {float(loop.dissipated_energy) * MILLI:.1f} mJ"
+            rf"$E_d$ = {float(loop.dissipated_energy) * style.MILLI:.1f} mJ"
         )
-        style = dict(linestyle="--", linewidth=1.8) if np.isinf(stiffness) else dict(linewidth=2.2)
-        ax.plot(loop.displacement * MICRO, loop.force, color=color, label=label, **style)
+        look = dict(linestyle="--", linewidth=1.8) if np.isinf(stiffness) else dict(linewidth=2.2)
+        ax.plot(loop.displacement * MICRO, loop.force, color=color, label=label, **look)
     _loop_axes(ax, loops)
-    rig = parameters_of(loops, "amplitude", "load", "aspect_ratio", "mu")
+    rig = style.parameters_of(loops, "amplitude", "load", "aspect_ratio", "mu")
     title = f"Fig. 5  Fretting loop: rigid rig against a compliant one\n{rig}"
     ax.set_title(title, fontsize="medium")
     ax.legend(loc="upper left", fontsize="small")
@@ -69,10 +59,10 @@ def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
 
 def _loop_axes(ax, loops: xr.Dataset) -> None:
     """Labels, zero lines and the Q/P axis shared by the loop figures."""
-    zero_lines(ax)
+    style.zero_lines(ax)
     ax.set(xlabel=axis_label("displacement"), ylabel=axis_label("force"))
     ax.grid(alpha=0.3)
-    force_ratio_axis(ax, scalar(loops, "load"))
+    style.force_ratio_axis(ax, scalar(loops, "load"))
 
 
 def loops_by_aspect_ratio(loops: xr.Dataset) -> Figure:
@@ -106,7 +96,7 @@ def loops_by_aspect_ratio(loops: xr.Dataset) -> Figure:
     dots = dict(color="crimson", markersize=8, zorder=5, label=label)
     ax.plot(crossings / stiffness * MICRO, crossings, "o", **dots)
     _loop_axes(ax, loops)
-    rig = parameters_of(loops, "amplitude", "load", "stiffness", "mu")
+    rig = style.parameters_of(loops, "amplitude", "load", "stiffness", "mu")
     ax.set_title(f"Fig. 6  Loops for several groove aspect ratios\n{rig}", fontsize="medium")
     figure.legend(loc="outside lower center", fontsize="small", ncols=2)
     return figure
@@ -117,25 +107,25 @@ def _stiffness_curves(
 ) -> Figure:
     """One curve of ``dataset[variable] * scale`` against z_o/x_o per rig stiffness, the
     ``markers`` of :func:`ecof_ratio_curves`, a legend at ``loc`` listing the stiffest first."""
-    figure = Figure(figsize=FIGSIZE, layout="constrained")
+    figure = Figure(figsize=style.FIGSIZE, layout="constrained")
     ax = figure.add_subplot()
     load = scalar(dataset, "load")
     stiffnesses = dataset["stiffness_ratio"].values * load
-    for index, color in enumerate(stiffness_colors(stiffnesses)):
+    for index, color in enumerate(style.stiffness_colors(stiffnesses)):
         curve = dataset[variable].isel(stiffness_ratio=index) * scale
-        style = dict(linestyle="--" if np.isinf(stiffnesses[index]) else "-")
-        label = stiffness_label(stiffnesses[index])
-        ax.plot(dataset["aspect_ratio"], curve, color=color, linewidth=2.0, label=label, **style)
+        look = dict(linestyle="--" if np.isinf(stiffnesses[index]) else "-")
+        label = style.stiffness_label(stiffnesses[index])
+        ax.plot(dataset["aspect_ratio"], curve, color=color, linewidth=2.0, label=label, **look)
     ax.set(xlabel=axis_label("aspect_ratio"), ylabel=axis_label(variable))
     ax.set_xlim(float(dataset["aspect_ratio"].min()), float(dataset["aspect_ratio"].max()))
     ax.grid(alpha=0.3)
-    rig = parameters_of(dataset, "amplitude", "load", "mu")
+    rig = style.parameters_of(dataset, "amplitude", "load", "mu")
     ax.set_title(f"Fig. {number}\n{rig}", fontsize="medium")
     for name, point in (markers or {}).items():
         curve = dataset["ecof_ratio"].sel(stiffness_ratio=point["stiffness"] / load)
         value = float(curve.interp(aspect_ratio=point["aspect_ratio"]))
         label = (
-            rf"{name} ({stiffness_label(point['stiffness'])}, "
+            rf"{name} ({style.stiffness_label(point['stiffness'])}, "
             rf"$z_o/x_o$ = {point['aspect_ratio']:g}): $\mu_E/\mu$ = {value:.3f} "
             rf"(+{(value - 1) * 100:.1f} %)"
         )
@@ -177,7 +167,7 @@ def dissipated_energy_curves(dataset: xr.Dataset) -> Figure:
     figure : matplotlib.figure.Figure
     """
     title = "7b  Dissipated energy against the groove aspect ratio"
-    return _stiffness_curves(dataset, "dissipated_energy", MILLI, title, "upper left")
+    return _stiffness_curves(dataset, "dissipated_energy", style.MILLI, title, "upper left")
 
 
 def ecof_ratio_curves(dataset: xr.Dataset, markers: Mapping[str, Mapping] | None = None) -> Figure:

@@ -7,18 +7,8 @@ import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
 
-from ecofmaps.figures.style import (
-    MICRO,
-    MILLI,
-    PER_MM,
-    axis_label,
-    force_ratio_axis,
-    load_label,
-    parameters,
-    scalar,
-    stiffness_label,
-    zero_lines,
-)
+from ecofmaps.figures import style
+from ecofmaps.figures.style import MICRO, axis_label, scalar
 
 __all__ = ["scar_profile_figure", "scar_shape_comparison"]
 
@@ -93,7 +83,7 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
     title = "Wear-scar profile" + (f": {name}" if name else "")
     sizes = [f"$D$ = {depth * MICRO:.4g} µm", f"$W$ = {width * MICRO:.4g} µm"]
     sizes += [f"$D/W$ = {depth / width:.3g}", f"{position.size} samples"]
-    top.set_title(f"{title}\n{parameters(*sizes)}", fontsize="medium")
+    top.set_title(f"{title}\n{style.parameters(*sizes)}", fontsize="medium")
     return figure
 
 
@@ -129,11 +119,11 @@ def scar_shape_comparison(dataset: xr.Dataset) -> Figure:
     _draw_shape_loops(loop_axes, dataset)
     _draw_ratio_and_error(ax_ratio, ax_error, dataset)
     depth, width = scalar(dataset, "scar_depth"), scalar(dataset, "scar_half_width")
-    rig = parameters(
+    rig = style.parameters(
         rf"$x_o = \Delta^*$ = {scalar(dataset, 'amplitude') * MICRO:g} µm",
         f"$W$ = {width * MICRO:g} µm, $D$ = {depth * MICRO:g} µm",
-        load_label(scalar(dataset, "load")),
-        f"{stiffness_label(scalar(dataset, 'stiffness'))} (loops)",
+        style.load_label(scalar(dataset, "load")),
+        f"{style.stiffness_label(scalar(dataset, 'stiffness'))} (loops)",
         rf"$\mu$ = {scalar(dataset, 'mu'):g}",
     )
     title = "Scar shape at equal depth over half-width: how wrong the D/W shortcut is"
@@ -146,11 +136,11 @@ def _draw_scar_profiles(ax, dataset: xr.Dataset) -> None:
     depth, width = scalar(dataset, "scar_depth"), scalar(dataset, "scar_half_width")
     x = dataset["scar_position"].values * MICRO
     for shape in dataset["shape"].values:  # the parabola on top, thinner: others share parts
-        style = (
+        look = (
             dict(linewidth=1.4, zorder=3) if shape == "parabolic" else dict(linewidth=2.6, zorder=2)
         )
         height = dataset["scar_height"].sel(shape=shape) * MICRO
-        ax.plot(x, height, color=SHAPE_COLORS.get(shape), label=shape, **style)
+        ax.plot(x, height, color=SHAPE_COLORS.get(shape), label=shape, **look)
     reach = float(dataset["slip_amplitude"].sel(shape="parabolic", groove="parabola"))
     reach *= width / scalar(dataset, "amplitude")
     label = "reach of the pad,\n" + r"$|X| \leq \delta^* W/\Delta^*$"
@@ -170,21 +160,21 @@ def _draw_shape_loops(loop_axes, dataset: xr.Dataset) -> None:
     others = [shape for shape in dataset["shape"].values if shape != "parabolic"]
     for ax, shape in zip(loop_axes, others, strict=True):
         own = dict(color=SHAPE_COLORS.get(shape), linewidth=2.0, zorder=2)
-        for groove, style in (("profile", own), ("parabola", dict(_SHORTCUT, zorder=3))):
+        for groove, look in (("profile", own), ("parabola", dict(_SHORTCUT, zorder=3))):
             point = dataset.sel(shape=shape, groove=groove)
             label = (
                 f"{shape + ' scar' if groove == 'profile' else 'parabola, same $D/W$'}\n"
                 rf"$\delta^*$ = {float(point['slip_amplitude']) * MICRO:.1f} µm, "
-                rf"$E_d$ = {float(point['dissipated_energy']) * MILLI:.1f} mJ, "
+                rf"$E_d$ = {float(point['dissipated_energy']) * style.MILLI:.1f} mJ, "
                 rf"$\mu_E$ = {float(point['ecof']):.3f}"
             )
-            ax.plot(point["displacement"] * MICRO, point["force"], **style, label=label)
+            ax.plot(point["displacement"] * MICRO, point["force"], **look, label=label)
         loops = dataset["force"].sel(shape=shape).values
         if np.allclose(loops[0], loops[1], rtol=1e-6, atol=1e-9 * load):
             text = "the parabola's loop: this scar differs\nonly beyond the pad's reach"
             where = dict(transform=ax.transAxes, ha="right", va="bottom")
             ax.text(0.97, 0.04, text, fontsize="small", color=SHAPE_COLORS.get(shape), **where)
-        zero_lines(ax)
+        style.zero_lines(ax)
         ax.set_xlabel(axis_label("displacement"))
         ax.grid(alpha=0.3)
         ax.set_title(f"{shape} scar", fontsize="medium")
@@ -192,7 +182,7 @@ def _draw_shape_loops(loop_axes, dataset: xr.Dataset) -> None:
     loop_axes[0].set_ylabel(axis_label("force"))
     for ax in loop_axes[:-1]:
         ax.tick_params(labelleft=ax is loop_axes[0])
-    force_ratio_axis(loop_axes[-1], load)
+    style.force_ratio_axis(loop_axes[-1], load)
     peak = float(np.nanmax(np.abs(dataset["force"].values)))
     loop_axes[0].set_ylim(-1.08 * peak, 1.75 * peak)  # room for the legends above the loops
 
@@ -201,25 +191,25 @@ def _draw_ratio_and_error(ax_ratio, ax_error, dataset: xr.Dataset) -> None:
     """μ_E/μ over S/P for every shape and the parabola, and the D/W shortcut's error."""
     depth, width = scalar(dataset, "scar_depth"), scalar(dataset, "scar_half_width")
     stiffness = scalar(dataset, "stiffness")
-    ratios = dataset["stiffness_ratio"].values * PER_MM
+    ratios = dataset["stiffness_ratio"].values * style.PER_MM
     shortcut = dataset["ecof_ratio"].sel(shape="parabolic", groove="parabola")
     label = f"parabola, $D/W$ = {depth / width:g}"
     ax_ratio.plot(ratios, shortcut, **_SHORTCUT, zorder=3, label=label)
     ax_error.axhline(0.0, **_SHORTCUT, zorder=3, label="no error (the parabola itself)")
     for shape in dataset["shape"].values:
-        style = dict(color=SHAPE_COLORS.get(shape), linewidth=2.0, zorder=2)
+        look = dict(color=SHAPE_COLORS.get(shape), linewidth=2.0, zorder=2)
         if shape == "parabolic":  # on the parabola's closed form: points, so both show
             dots = dict(marker="o", markersize=4, linestyle="none", markevery=6, zorder=4)
-            style = dict(color=SHAPE_COLORS["parabolic"], **dots)
+            look = dict(color=SHAPE_COLORS["parabolic"], **dots)
         ratio = dataset["ecof_ratio"].sel(shape=shape, groove="profile")
-        ax_ratio.plot(ratios, ratio, label=f"{shape} scar", **style)
+        ax_ratio.plot(ratios, ratio, label=f"{shape} scar", **look)
         if shape != "parabolic":
             error = dataset["shortcut_error"].sel(shape=shape) * 100.0
-            ax_error.plot(ratios, error, label=f"{shape} scar", **style)
-    example = stiffness / scalar(dataset, "load") * PER_MM
+            ax_error.plot(ratios, error, label=f"{shape} scar", **look)
+    example = stiffness / scalar(dataset, "load") * style.PER_MM
     rig = dict(color="crimson", linewidth=1.0, linestyle="-.")
     for ax in (ax_ratio, ax_error):
-        ax.axvline(example, **rig, label=f"Example 2, {stiffness_label(stiffness)}")
+        ax.axvline(example, **rig, label=f"Example 2, {style.stiffness_label(stiffness)}")
         ax.set_xlabel(axis_label("stiffness_ratio"))
         ax.set_xlim(ratios[0], ratios[-1])
         ax.grid(alpha=0.3)
