@@ -27,7 +27,6 @@ __all__ = [
     "number_text",
     "save_figure",
     "stiffness_label",
-    "stiffness_text",
 ]
 
 #: Contour levels of μ_E/μ shared by Figure 11 and the universal map, so they read alike.
@@ -76,18 +75,11 @@ def number_text(value: float, digits: int = 3) -> str:
     return "0" if text == "-0" else text
 
 
-def stiffness_text(stiffness: float) -> str:
-    """A rig stiffness [N/m] in MN/m for a label: ``'35 MN/m'``, ``'0.02 MN/m'``, ``'rigid'``."""
-    if np.isinf(stiffness):
-        return "rigid"
-    return f"{number_text(stiffness * MEGA)} MN/m"
-
-
 def stiffness_label(stiffness: float) -> str:
     r"""Legend text for a rig stiffness [N/m]: ``'$S$ = 35 MN/m'``, ``'rigid ($S = \infty$)'``."""
     if np.isinf(stiffness):
         return r"rigid ($S = \infty$)"
-    return f"$S$ = {stiffness_text(stiffness)}"
+    return f"$S$ = {number_text(stiffness * MEGA)} MN/m"
 
 
 def load_label(load: float) -> str:

@@ -68,23 +68,13 @@ _TABLE_WIDTH, _TABLE_ROOM = 1350, 20
 # Shows the measured loops of the cycles picked and their model's, each pair in one colour.
 _PICK_LOOPS = """
 const all = carried.data;
-const measured_data = {xs: [], ys: [], label: [], color: []};
-const model_data = {xs: [], ys: [], color: []};
-choice.value.forEach((name, index) => {
-    const at = all.label.indexOf(name);
-    const color = palette[index % palette.length];
-    measured_data.xs.push(all.xs[at]);
-    measured_data.ys.push(all.ys[at]);
-    measured_data.label.push(name);
-    measured_data.color.push(color);
-    if (all.model_xs[at].length > 0) {
-        model_data.xs.push(all.model_xs[at]);
-        model_data.ys.push(all.model_ys[at]);
-        model_data.color.push(color);
-    }
-});
-measured.data = measured_data;
-model.data = model_data;
+const at = choice.value.map((name) => all.label.indexOf(name));
+const color = at.map((_, k) => palette[k % palette.length]);
+const label = choice.value.slice();
+measured.data = {xs: at.map((i) => all.xs[i]), ys: at.map((i) => all.ys[i]), label, color};
+const kept = at.map((_, k) => k).filter((k) => all.model_xs[at[k]].length > 0);
+model.data = {xs: kept.map((k) => all.model_xs[at[k]]), ys: kept.map((k) => all.model_ys[at[k]]),
+              color: kept.map((k) => color[k])};
 """
 
 
@@ -353,15 +343,9 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
     colors = palette[: len(first)]
     shown = {"xs": [xs[i] for i in at], "ys": [ys[i] for i in at], "label": first, "color": colors}
     measured = ColumnDataSource(shown, name="shown-loops")
-    modelled = [(i, color) for i, color in zip(at, colors, strict=True) if len(model_xs[i])]
-    model = ColumnDataSource(
-        {
-            "xs": [model_xs[i] for i, _ in modelled],
-            "ys": [model_ys[i] for i, _ in modelled],
-            "color": [color for _, color in modelled],
-        },
-        name="shown-models",
-    )
+    kept = [k for k, i in enumerate(at) if len(model_xs[i])]
+    model = {"xs": [model_xs[at[k]] for k in kept], "ys": [model_ys[at[k]] for k in kept]}
+    model = ColumnDataSource(model | {"color": [colors[k] for k in kept]}, name="shown-models")
     plot = figure(
         width=700,
         height=460,

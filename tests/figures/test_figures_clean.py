@@ -23,7 +23,7 @@ from ecofmaps.figures import (
     resolved_loops,
     scar_profile_figure,
 )
-from ecofmaps.figures.style import number_text, stiffness_label, stiffness_text
+from ecofmaps.figures.style import number_text, stiffness_label
 from ecofmaps.measured.analysis import analyze_loops
 from ecofmaps.measured.fit import fit_loop
 from ecofmaps.measured.quality import add_reason
@@ -133,11 +133,11 @@ def test_resolved_loops_without_a_read_cycle_draws_no_empty_legend(results):
 
 @pytest.mark.parametrize(
     ("stiffness", "text"),
-    [(35e6, "35 MN/m"), (0.02e6, "0.02 MN/m"), (35.04e6, "35 MN/m"), (123.456e6, "123 MN/m"),
-     (np.inf, "rigid"), (2500e6, "2500 MN/m")],
+    [(35e6, "$S$ = 35 MN/m"), (0.02e6, "$S$ = 0.02 MN/m"), (35.04e6, "$S$ = 35 MN/m"),
+     (123.456e6, "$S$ = 123 MN/m"), (np.inf, r"rigid ($S = \infty$)"), (2500e6, "$S$ = 2500 MN/m")],
 )  # fmt: skip
-def test_stiffness_text_has_sensible_digits(stiffness, text):
-    assert stiffness_text(stiffness) == text
+def test_stiffness_label_has_sensible_digits(stiffness, text):
+    assert stiffness_label(stiffness) == text
 
 
 def test_number_text():
