@@ -6,7 +6,6 @@ from __future__ import annotations
 import itertools
 from collections.abc import Mapping
 
-import jax
 import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
@@ -127,8 +126,7 @@ def universal_ecof_ratio_map(
     for index, (name, (amplitude, stiffness_ratios)) in enumerate(windows.items()):
         height = 0.008 + 0.014 * (len(windows) - 1 - index)  # stacked near the bottom
         ratios = np.asarray(stiffness_ratios, dtype=np.float64)
-        with jax.enable_x64(True):  # the core's jax.numpy arithmetic, in float64
-            span = compliance_ratio(amplitude, 1.0, np.array([ratios.max(), ratios.min()]))
+        span = compliance_ratio(amplitude, 1.0, np.array([ratios.max(), ratios.min()]))
         bar = dict(arrowstyle="|-|", color="0.25", shrinkA=0, shrinkB=0)
         ax.annotate("", (float(span[0]), height), (float(span[1]), height), arrowprops=bar)
         label = rf"Fig. {name} ($\Delta^*$ = {amplitude * MICRO:g} µm)"
@@ -136,8 +134,7 @@ def universal_ecof_ratio_map(
         ax.text(0.92 * float(span[0]), height, label, **words)
     legible = dict(boxstyle="round,pad=0.1", facecolor="white", alpha=0.75, edgecolor="none")
     for (name, point), marker in zip((markers or {}).items(), itertools.cycle("soD^v")):
-        with jax.enable_x64(True):
-            lam = float(compliance_ratio(point["amplitude"], point["load"], point["stiffness"]))
+        lam = float(compliance_ratio(point["amplitude"], point["load"], point["stiffness"]))
         value = float(energy_cof(**point) / point["mu"])
         label = (
             rf"{name}: {style.stiffness_label(point['stiffness'])}, "

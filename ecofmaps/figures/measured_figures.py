@@ -119,14 +119,23 @@ def measured_loops(
             ax.plot(ends, stiffness * ends / MICRO, **line)
         if resolved is not None:
             _resolved_band(ax, resolved.sel(cycle=label), q)
-        _crossings(ax, cycle, load)
+        sides = ("forward", "backward")  # the two crossings of the loop with Q = SΔ, if any
+        crossings = np.array([float(cycle[f"crossing_displacement_{side}"]) for side in sides])
+        ratios = np.array([float(cycle["gicof_forward"]), -float(cycle["gicof_backward"])])
+        if np.isfinite(crossings * ratios).any():
+            dots = dict(marker="o", markersize=6, linestyle="none", label="GICoF crossings")
+            face = dict(markerfacecolor="tab:red", markeredgecolor="black")
+            ax.plot(crossings * MICRO, ratios * load, **dots, **face)
         style.zero_lines(ax, "0.7")
         ax.grid(alpha=0.3)
         regime = Regime(int(cycle["regime"]))
         reading = f"GICoF {_number(cycle['gicof'])}, ECoF {_number(cycle['ecof'])}"
         reading = reading if regime == GROSS_SLIP else "no GICoF or ECoF"
-        quality = str(cycle["quality"].values) if "quality" in cycle else "ok"
-        flags = "" if quality == "ok" else "\nflagged: " + _flags_text(quality)
+        reasons = str(cycle["quality"].values).split(SEPARATOR) if "quality" in cycle else ["ok"]
+        flags = ", ".join(reasons)  # or the first and how many more beyond 50 characters
+        if len(flags) > 50 and len(reasons) > 1:
+            flags = f"{reasons[0]} and {len(reasons) - 1} more"
+        flags = "" if reasons == ["ok"] else "\nflagged: " + flags
         title = f"cycle {label}: {reading}\n{stiffness_label(stiffness)}, {regime.label}{flags}"
         ax.set_title(title, fontsize="small")
     for ax in axes.flat[len(chosen) :]:
@@ -150,25 +159,6 @@ def measured_loops(
     options = dict(loc="outside lower center", ncols=ncols, fontsize="x-small")
     figure.legend(list(entries.values()), list(entries), **options)
     return figure
-
-
-def _crossings(ax, cycle: xr.Dataset, load: float) -> None:
-    """Mark the cycle's two crossings of the loop with Q = SΔ, where there are any."""
-    sides = ("forward", "backward")
-    crossings = np.array([float(cycle[f"crossing_displacement_{side}"]) for side in sides])
-    ratios = np.array([float(cycle["gicof_forward"]), -float(cycle["gicof_backward"])])
-    if np.isfinite(crossings * ratios).any():
-        dots = dict(marker="o", markersize=6, markerfacecolor="tab:red", markeredgecolor="black")
-        ax.plot(crossings * MICRO, ratios * load, linestyle="none", label="GICoF crossings", **dots)
-
-
-def _flags_text(quality: str) -> str:
-    """A cycle's flags, comma separated, or the first and how many more beyond 50 characters."""
-    reasons = quality.split(SEPARATOR)
-    text = ", ".join(reasons)
-    if len(text) <= 50 or len(reasons) == 1:
-        return text
-    return f"{reasons[0]} and {len(reasons) - 1} more"
 
 
 def _resolved_band(ax, cycle: xr.Dataset, q) -> None:
@@ -255,10 +245,7 @@ def measured_and_fitted_loops(fits, *, source: str | None = None) -> Figure:
         displacement, force = fit.model_loop()
         ax.plot(fit.displacement * MICRO, fit.force, "o", **dots)
         ax.plot(displacement * MICRO, force, color="crimson", linewidth=1.8, label="fitted model")
-        style.zero_lines(ax, x=fit.displacement_offset * MICRO, y=fit.force_offset)
-        ax.set(xlabel=axis_label("displacement"), ylabel=axis_label("force"))
-        ax.grid(alpha=0.3)
-        style.force_ratio_axis(ax, fit.load)
+        style.loop_axes(ax, fit.load, fit.displacement_offset * MICRO, fit.force_offset)
         panel = f"({chr(ord('a') + index)}) " if len(panels) > 1 else ""
         panel += f"{name}: " if name else ""
         test = rf"{panel}{load_label(fit.load)}, $x_o = \Delta^*$ = {fit.amplitude * MICRO:.1f} µm"

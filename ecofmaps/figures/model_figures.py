@@ -49,20 +49,12 @@ def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
         )
         look = dict(linestyle="--", linewidth=1.8) if np.isinf(stiffness) else dict(linewidth=2.2)
         ax.plot(loop.displacement * MICRO, loop.force, color=color, label=label, **look)
-    _loop_axes(ax, loops)
+    style.loop_axes(ax, scalar(loops, "load"))
     rig = style.parameters_of(loops, "amplitude", "load", "aspect_ratio", "mu")
     title = f"Fig. 5  Fretting loop: rigid rig against a compliant one\n{rig}"
     ax.set_title(title, fontsize="medium")
     ax.legend(loc="upper left", fontsize="small")
     return figure
-
-
-def _loop_axes(ax, loops: xr.Dataset) -> None:
-    """Labels, zero lines and the Q/P axis shared by the loop figures."""
-    style.zero_lines(ax)
-    ax.set(xlabel=axis_label("displacement"), ylabel=axis_label("force"))
-    ax.grid(alpha=0.3)
-    style.force_ratio_axis(ax, scalar(loops, "load"))
 
 
 def loops_by_aspect_ratio(loops: xr.Dataset) -> Figure:
@@ -95,7 +87,7 @@ def loops_by_aspect_ratio(loops: xr.Dataset) -> Figure:
     label = rf"common points $Q = \pm\mu P$ = ±{mu * load:g} N (GICoF)"
     dots = dict(color="crimson", markersize=8, zorder=5, label=label)
     ax.plot(crossings / stiffness * MICRO, crossings, "o", **dots)
-    _loop_axes(ax, loops)
+    style.loop_axes(ax, scalar(loops, "load"))
     rig = style.parameters_of(loops, "amplitude", "load", "stiffness", "mu")
     ax.set_title(f"Fig. 6  Loops for several groove aspect ratios\n{rig}", fontsize="medium")
     figure.legend(loc="outside lower center", fontsize="small", ncols=2)

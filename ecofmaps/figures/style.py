@@ -135,6 +135,14 @@ def zero_lines(ax, color: str = "0.6", x: float = 0.0, y: float = 0.0) -> None:
     ax.axvline(x, color=color, linewidth=0.6)
 
 
+def loop_axes(ax, load: float, x: float = 0.0, y: float = 0.0) -> None:
+    """The axes of a loop: :func:`zero_lines` at ``x`` [µm] and ``y`` [N], labels, grid, Q/P."""
+    zero_lines(ax, x=x, y=y)
+    ax.set(xlabel=axis_label("displacement"), ylabel=axis_label("force"))
+    ax.grid(alpha=0.3)
+    force_ratio_axis(ax, load)
+
+
 #: Room kept between a legend and what is drawn, as a fraction of the panel's height. [1]
 _LEGEND_ROOM = 0.03
 #: Where a legend may go inside a panel, in the order tried: the corners, then the middles.
