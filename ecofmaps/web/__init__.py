@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import importlib.util
 
+from ecofmaps._nomenclature import axis_label
+
 __all__ = ["INSTALL_WEB", "missing_web_packages"]
 
 #: The one line that tells how to install what the pages need.
@@ -36,3 +38,11 @@ def missing_web_packages(packages=_WEB_PACKAGES) -> list[str]:
     ['no_such_package_for_ecofmaps']
     """
     return [name for name in packages if importlib.util.find_spec(name) is None]
+
+
+def quantity_plot(title: str, x: str, y: str, **options):
+    """A Bokeh plot with the pages' tools, its axes labelled by quantities ``x`` and ``y``."""
+    from bokeh.plotting import figure
+
+    labels = dict(x_axis_label=axis_label(x, plain=True), y_axis_label=axis_label(y, plain=True))
+    return figure(title=title, tools="pan,box_zoom,wheel_zoom,reset,save", **labels, **options)

@@ -14,7 +14,6 @@ import warnings
 import numpy as np
 import panel as pn
 from bokeh.models import ColumnDataSource, HoverTool, Legend, LegendItem, Range1d
-from bokeh.plotting import figure
 from bokeh.plotting.contour import contour_data
 from matplotlib.colors import to_hex
 
@@ -27,6 +26,7 @@ from ecofmaps.model.simulation import fretting_loop
 from ecofmaps.model.steady_state import dissipated_energy, energy_cof, slip_amplitude
 from ecofmaps.paper import FIGURE_11_STIFFNESS_RATIOS
 from ecofmaps.units import DIMENSIONS, DOMAIN, TEXT_LIMIT, bare_number_warning, parse_quantity
+from ecofmaps.web import quantity_plot
 
 __all__ = ["INPUTS", "bare_number_warnings", "explorer_page", "parameter_value", "point_values"]
 
@@ -213,14 +213,8 @@ def _contour_labels(line_data, scale: tuple) -> dict:
 
 # How the no-gross-slip area is drawn: hatched over a light grey (Bokeh draws no hatch
 # over a fill of alpha 0).
-_HATCH = {
-    "line_color": "#4d4d4d",
-    "fill_color": "#d9d9d9",
-    "fill_alpha": 0.5,
-    "hatch_pattern": "/",
-    "hatch_color": "#4d4d4d",
-    "hatch_scale": 10,
-}
+_HATCH = dict(line_color="#4d4d4d", fill_color="#d9d9d9", fill_alpha=0.5)
+_HATCH |= dict(hatch_pattern="/", hatch_color="#4d4d4d", hatch_scale=10)
 
 #: The part of the map plot (600 × 470) its axes take, roughly. [px]
 _MAP_FRAME = (440, 290)
@@ -228,16 +222,9 @@ _MAP_FRAME = (440, 290)
 
 def _map_figure():
     """The μ_E/μ map's figure and, by name, what an update changes in it."""
-    plot = figure(
-        width=600,
-        height=470,
-        title="μ_E/μ over rig stiffness and groove shape (x_o = Δ*)",
-        x_axis_label="Stiffness over load S/P [(MN/m)/kN = 1/mm]",
-        y_axis_label="Groove aspect ratio z_o/x_o [1]",
-        tools="pan,box_zoom,wheel_zoom,reset,save",
-        x_range=Range1d(0.0, 1.0),
-        y_range=Range1d(0.0, 1.0),
-    )
+    title = "μ_E/μ over rig stiffness and groove shape (x_o = Δ*)"
+    window = dict(x_range=Range1d(0.0, 1.0), y_range=Range1d(0.0, 1.0), width=600, height=470)
+    plot = quantity_plot(title, "stiffness_ratio", "aspect_ratio", **window)
     empty = ([0, 1], [0, 1], np.full((2, 2), np.nan))
     levels = _fill_levels(ECOF_RATIO_LEVELS[-1])
     cmap, norm = ecof_ratio_colors()  # each band in Figure 11's colour of its middle
@@ -289,8 +276,7 @@ def _show_map(values: dict, parts: dict) -> None:
     finite = grid[np.isfinite(grid)]
     levels = _fill_levels(float(finite.max()) if finite.size else 1.0)
     parts["bands"].set_data(contour_data(x, y, grid, levels, want_line=False))
-    parts["bands"].levels = levels
-    parts["colorbar"].levels = levels
+    parts["bands"].levels = parts["colorbar"].levels = levels
     parts["colorbar"].ticker.ticks = levels[:-1]
     drawn = contour_data(x, y, grid, ECOF_RATIO_LEVELS, want_fill=False)
     parts["lines"].set_data(drawn)
@@ -325,15 +311,8 @@ def explorer_page():
     message = pn.pane.HTML("", width=900, styles={"color": "#b00020"})
     notice = pn.pane.HTML("", width=900, styles={"color": "#8a4b00"})
     loop_source = ColumnDataSource({"x": [], "y": []})
-    loop_plot = figure(
-        width=440,
-        height=380,
-        title="Steady fretting loop",
-        x_axis_label="Applied displacement Δ [µm]",
-        y_axis_label="Tangential force Q [N]",
-        tools="pan,box_zoom,wheel_zoom,reset,save",
-    )
-    loop_plot.line("x", "y", source=loop_source, line_width=2, color="#1f77b4")
+    loop = quantity_plot("Steady fretting loop", "displacement", "force", width=440, height=380)
+    loop.line("x", "y", source=loop_source, line_width=2, color="#1f77b4")
     map_plot, map_parts = _map_figure()
 
     def update(*_events):
@@ -379,7 +358,7 @@ def explorer_page():
         intro,
         message,
         notice,
-        pn.Row(at_point, pn.pane.Bokeh(loop_plot), pn.pane.Bokeh(map_plot)),
+        pn.Row(at_point, pn.pane.Bokeh(loop), pn.pane.Bokeh(map_plot)),
         pn.pane.HTML("<h3 style='margin:0'>Correct a reported ECoF</h3>"),
         pn.Row(*correction_inputs, correction_pane),
     )

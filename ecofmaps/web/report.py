@@ -40,6 +40,7 @@ from ecofmaps.lab.regime import sliding_condition_line
 from ecofmaps.lab.wear import cumulated_energy
 from ecofmaps.measured.quality import REASONS, has_reason, quality_summary
 from ecofmaps.model.simulation import fretting_loop
+from ecofmaps.web import quantity_plot
 
 __all__ = ["LOOPS_CARRIED", "recording_inputs", "report_document", "write_report"]
 
@@ -346,14 +347,8 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
     kept = [k for k, i in enumerate(at) if len(model_xs[i])]
     model = {"xs": [model_xs[at[k]] for k in kept], "ys": [model_ys[at[k]] for k in kept]}
     model = ColumnDataSource(model | {"color": [colors[k] for k in kept]}, name="shown-models")
-    plot = figure(
-        width=700,
-        height=460,
-        title="Measured loops (lines) and the model's (dashed)",
-        x_axis_label=axis_label("displacement", plain=True),
-        y_axis_label=axis_label("force", plain=True),
-        tools="pan,box_zoom,wheel_zoom,reset,save",
-    )
+    title = "Measured loops (lines) and the model's (dashed)"
+    plot = quantity_plot(title, "displacement", "force", width=700, height=460)
     plot.multi_line(
         "xs", "ys", source=measured, color="color", line_width=1.6, legend_field="label"
     )
