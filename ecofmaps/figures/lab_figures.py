@@ -60,8 +60,7 @@ def running_condition_map(results, transition: xr.Dataset, rig_stiffness: float)
     line = float(transition.contact_amplitude) + float(transition.mu) * load / rig_stiffness
     label = r"transition $\Delta_t = \delta_t + \mu_t P/S$"
     ax.plot(line * MICRO, load, color="tab:red", label=label)
-    ax.set_xlim(0.0, None)
-    ax.set_ylim(0.0, top)
+    ax.set(xlim=(0.0, None), ylim=(0.0, top))
     ax.set(xlabel=axis_label("amplitude"), ylabel=axis_label("load"))
     ax.grid(alpha=0.3)
     ax.legend(loc="lower right", fontsize="small")

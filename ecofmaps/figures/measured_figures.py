@@ -52,8 +52,7 @@ def _why_none(results: xr.Dataset) -> str:
 
 
 def _note(ax, text: str, clear: str = "", height: float = 0.5, fontsize="small") -> None:
-    """Write ``text`` across ``ax``, which has nothing else to show, ``height`` up the panel; no
-    ticks on its axes ``clear`` (``'x'``, ``'y'`` or ``'xy'``)."""
+    """Write ``text`` across ``ax``, ``height`` up; no ticks on its axes ``clear`` (``'xy'``)."""
     where = dict(transform=ax.transAxes, ha="center", va="center")
     ax.text(0.5, height, text, color="0.3", fontsize=fontsize, **where)
     ax.set(**{f"{axis}ticks": [] for axis in clear})

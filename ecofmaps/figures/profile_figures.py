@@ -210,8 +210,7 @@ def _draw_ratio_and_error(ax_ratio, ax_error, dataset: xr.Dataset) -> None:
     rig = dict(color="crimson", linewidth=1.0, linestyle="-.")
     for ax in (ax_ratio, ax_error):
         ax.axvline(example, **rig, label=f"Example 2, {style.stiffness_label(stiffness)}")
-        ax.set_xlabel(axis_label("stiffness_ratio"))
-        ax.set_xlim(ratios[0], ratios[-1])
+        ax.set(xlabel=axis_label("stiffness_ratio"), xlim=(ratios[0], ratios[-1]))
         ax.grid(alpha=0.3)
     ax_ratio.set_ylabel(axis_label("ecof_ratio"))
     title = rf"Energy CoF over the contact CoF, $\mu$ = {scalar(dataset, 'mu'):g}"

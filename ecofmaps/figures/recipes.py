@@ -108,7 +108,6 @@ def _ecof_ratio_map(panel: str) -> Callable[[], xr.Dataset]:
         ratios = paper.FIGURE_11_STIFFNESS_RATIOS
         return ecofmaps.compute_map(ratios, ASPECT_RATIOS, amplitude, paper.MU)
 
-    data.__name__ = f"_ecof_ratio_map_{panel}"
     return data
 
 
@@ -240,8 +239,7 @@ def scar_shapes_dataset() -> xr.Dataset:
         )
         errors.append(np.asarray(corrected) / paper.MU - 1.0)
 
-    def by_groove(name, index=...):
-        """The profile's values and the parabola's over (shape, groove, ...)."""
+    def by_groove(name, index=...):  # the profile's values and the parabola's
         on_profile = model[name].values[:, index]
         same = np.broadcast_to(parabola[name].values[index], on_profile.shape)
         return np.stack([on_profile, same], axis=1)
@@ -343,8 +341,7 @@ FIGURES: dict[str, FigureRecipe] = {
         ),
         FigureRecipe(
             "shapes",
-            "four scar shapes at Example 2's D/W: loops, μ_E/μ over S/P, and the D/W shortcut's "
-            "error",
+            "four scar shapes at Example 2's D/W: loops, μ_E/μ over S/P, the D/W shortcut's error",
             _scar_shapes,
             "scar_shape_comparison",
             module="profile_figures",

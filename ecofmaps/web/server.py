@@ -87,16 +87,12 @@ def serve_explorer(port: int, *, open_browser: bool = True, announce=print, allo
     hosts = {f"{host}:{port}" for host in LOCAL_HOSTS}  # and each allowed, at port if none
     for entry in (entry.strip().lower() for entry in allow_origin):
         hosts.add(entry if re.fullmatch(r".*:\d+", entry) else f"{entry}:{port}")
-    server = get_server(
-        {"/": explorer_page},
-        port=port,
-        address="127.0.0.1",
-        show=False,
-        start=False,
-        title="ecofmaps explorer",
-        # Bokeh cannot parse a bracketed host ([::1]:port); _Foreign checks every request.
-        websocket_origin=sorted(h for h in hosts if not h.startswith("[")),
+    # Bokeh cannot parse a bracketed host ([::1]:port); _Foreign checks every request.
+    origins = sorted(h for h in hosts if not h.startswith("["))
+    options = dict(
+        port=port, address="127.0.0.1", websocket_origin=origins, title="ecofmaps explorer"
     )
+    server = get_server({"/": explorer_page}, show=False, start=False, **options)
     signal.signal(signal.SIGINT, previous[signal.SIGINT])  # Panel's would stop at once
     # Before Bokeh's and Panel's routes, for every path: Tornado's documented rule router.
     server._tornado.default_router.rules[:0] = [
