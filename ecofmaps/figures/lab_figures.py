@@ -108,11 +108,9 @@ def loop_scar_closure_figure(closure: xr.Dataset) -> Figure:
     label = r"implied by the loops, $\int g\,d\xi$"
     scar.plot(position, closure.implied_scar * MICRO, **model, label=label)
     scar.set(xlabel=axis_label("scar_position"), ylabel=axis_label("scar_height"))
-    scar.set_title(
-        f"RMS height off the profile {number_text(float(closure.scar_residual) * MICRO, 2)} µm"
-        f" ({number_text(100 * float(closure.scar_relative_residual), 2)} % of the depth)",
-        fontsize="medium",
-    )
+    off = f"RMS height off the profile {number_text(float(closure.scar_residual) * MICRO, 2)} µm"
+    share = number_text(100 * float(closure.scar_relative_residual), 2)
+    scar.set_title(f"{off} ({share} % of the depth)", fontsize="medium")
     for ax in (loop, scar):
         ax.grid(alpha=0.3)
         ax.legend(loc="best", fontsize="small")

@@ -82,13 +82,11 @@ def measured_loops(
     results : xarray.Dataset
         From :func:`ecofmaps.analyze_loops` with ``keep_loops=True``.
     cycles : sequence of int, optional
-        Cycle numbers to draw, one panel each; by default six spread evenly, the first and
-        the last included.
+        Cycles to draw, a panel each; by default six spread evenly, the first and last included.
     columns : int
         Panels per row.
     resolved : xarray.Dataset, optional
-        From :func:`ecofmaps.resolve_analyzed_loops` of ``results``: the part of the stroke
-        it read is shaded.
+        From :func:`ecofmaps.resolve_analyzed_loops` of ``results``: the part read is shaded.
     source : str, optional
         The recording's name (its file's), which the title begins with.
 
@@ -145,11 +143,9 @@ def measured_loops(
         lowest.set_xlabel(axis_label("displacement"))
     for ax in axes[:, 0]:
         ax.set_ylabel(axis_label("force"))
-    figure.suptitle(  # two lines: the figure of a single cycle is only one panel wide
-        _title(rf"measured loops and the line $Q = S\Delta$ ({load_label(load)}):", source)
-        + "\nthe GICoF is $Q/P$ at the crossings",
-        fontsize="medium",
-    )
+    title = _title(rf"measured loops and the line $Q = S\Delta$ ({load_label(load)}):", source)
+    # Two lines: the figure of a single cycle is only one panel wide.
+    figure.suptitle(title + "\nthe GICoF is $Q/P$ at the crossings", fontsize="medium")
     entries = {}  # one legend of every labelled artist of the panels drawn, below them
     for ax in axes.flat[: len(chosen)]:
         for handle, name in zip(*ax.get_legend_handles_labels(), strict=True):
@@ -276,11 +272,9 @@ def resolved_loops(
     resolved : xarray.Dataset
         From :func:`ecofmaps.resolve_loops` (with its ``position`` dimension).
     results : xarray.Dataset, optional
-        From :func:`ecofmaps.analyze_loops` of the same recording: its ECoF and GICoF are
-        drawn beside the resolved :math:`\mu`.
+        From :func:`ecofmaps.analyze_loops` of the recording: its ECoF and GICoF drawn too.
     cycles : sequence of int, optional
-        Cycles drawn along the stroke; by default up to five of quality ``'ok'``, spread
-        evenly, the first and the last included.
+        Cycles drawn along the stroke; by default up to five of quality ``'ok'``, as above.
     source : str, optional
         As for :func:`measured_loops`.
 
@@ -309,8 +303,7 @@ def resolved_loops(
         stroke.axhline(float(cycle["mu_resolved"]), color=color, linestyle="--", linewidth=0.9)
         felt.plot(xi, cycle["felt_profile"] * MICRO, linewidth=1.4, **line)
         k = 2.0 * float(cycle["aspect_ratio"]) / float(cycle["amplitude"])  # z_o/x_o = kΔ*/2
-        parabola = 0.5 * k * (xi / MICRO) ** 2 * MICRO
-        felt.plot(xi, parabola, color=color, linestyle=":", linewidth=1.0)
+        felt.plot(xi, 0.5 * k * (xi / MICRO) ** 2 * MICRO, color=color, linestyle=":", linewidth=1)
     central = float(resolved.attrs.get("central", np.nan))
     if chosen and np.isfinite(central):
         picked = resolved.sel(cycle=chosen)
@@ -332,11 +325,10 @@ def resolved_loops(
         ax.grid(alpha=0.3)
     _profile_over_test(figure, image, resolved)
     twins = _mu_over_test(test, resolved, results)
-    figure.suptitle(
-        _title(f"loops read along the stroke ({load_label(scalar(resolved, 'load'))}): ", source)
-        + r"$\mu(\xi)$ and $g(\xi)$ from the two slip branches at the same $\xi = \Delta - Q/S$",
-        fontsize="medium",
-    )
+    load = load_label(scalar(resolved, "load"))
+    title = _title(f"loops read along the stroke ({load}): ", source)
+    title += r"$\mu(\xi)$ and $g(\xi)$ from the two slip branches at the same $\xi = \Delta - Q/S$"
+    figure.suptitle(title, fontsize="medium")
     # The layout done with the titles: each legend's place, clear of its panel's data.
     for ax in (stroke, felt) if chosen else ():
         style.legend_clear_of_data(ax, fontsize="x-small", ncols=2)

@@ -68,7 +68,6 @@ def loops_by_aspect_ratio(loops: xr.Dataset) -> Figure:
     Returns
     -------
     figure : matplotlib.figure.Figure
-        One loop per :math:`z_o/x_o`, and the line :math:`Q = S\Delta`.
     """
     figure = Figure(figsize=(6.4, 5.6), layout="constrained")
     ax = figure.add_subplot()
@@ -135,8 +134,7 @@ def slip_amplitude_curves(dataset: xr.Dataset) -> Figure:
     Parameters
     ----------
     dataset : xarray.Dataset
-        From :func:`ecofmaps.maps.compute_map` with a load, over ``stiffness_ratio`` and
-        ``aspect_ratio`` alone.
+        From :func:`ecofmaps.compute_map` with a load, over ``stiffness_ratio``, ``aspect_ratio``.
 
     Returns
     -------

@@ -93,9 +93,8 @@ def scar_shape_comparison(dataset: xr.Dataset) -> Figure:
     Parameters
     ----------
     dataset : xarray.Dataset
-        The ``shapes`` figure's Dataset (:data:`ecofmaps.figures.FIGURES`), over ``shape``,
-        ``groove`` (``'profile'``, ``'parabola'``), ``scar_position``, ``point`` and
-        ``stiffness_ratio``.
+        The ``shapes`` figure's (:data:`ecofmaps.figures.FIGURES`), over ``shape``, ``groove``
+        (``'profile'``, ``'parabola'``), ``scar_position``, ``point`` and ``stiffness_ratio``.
 
     Returns
     -------
@@ -217,8 +216,6 @@ def _draw_ratio_and_error(ax_ratio, ax_error, dataset: xr.Dataset) -> None:
     ax_ratio.set_title(title, fontsize="medium")
     ax_ratio.legend(loc="upper left", fontsize="small")
     ax_error.set_ylabel(r"Error of $\mu'$ from the D/W shortcut, $\mu'/\mu - 1$ [%]")
-    ax_error.set_title(
-        r"The D/W shortcut: $\mu_E$ of each scar corrected as if it were the parabola",
-        fontsize="medium",
-    )
+    title = r"The D/W shortcut: $\mu_E$ of each scar corrected as if it were the parabola"
+    ax_error.set_title(title, fontsize="medium")
     ax_error.legend(loc="upper right", fontsize="small")

@@ -179,11 +179,9 @@ def _covers(ax, box) -> bool:
     for line in ax.get_lines():
         path = line.get_transform().transform_path(line.get_path()).cleaned(remove_nans=True)
         points = path.vertices[np.isin(path.codes, (DrawnPath.MOVETO, DrawnPath.LINETO))]
-        if line.get_marker() not in (None, "None", "", " ") and box.count_contains(points):
-            return True
-        if line.get_linestyle() not in ("None", "", " ") and path.intersects_bbox(
-            box, filled=False
-        ):
+        marked = line.get_marker() not in (None, "None", "", " ") and box.count_contains(points)
+        lined = line.get_linestyle() not in ("None", "", " ")
+        if marked or (lined and path.intersects_bbox(box, filled=False)):
             return True
     for collection in ax.collections:
         transform = collection.get_transform()

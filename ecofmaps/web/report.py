@@ -354,14 +354,9 @@ def _loops_panel(results: xr.Dataset, carried: np.ndarray):
     )
     plot.multi_line("xs", "ys", source=model, color="color", line_width=1.4, line_dash="dashed")
     plot.legend.location = "top_left"
-    choice = MultiChoice(
-        title="Cycles shown (pick others; the page carries the loops of "
-        f"{len(names)} cycles spread over the test)",
-        value=first,
-        options=names,
-        width=480,
-        name="loop-picker",
-    )
+    title = f"Cycles shown (pick others; the page carries the loops of {len(names)} cycles "
+    title += "spread over the test)"
+    choice = MultiChoice(title=title, value=first, options=names, width=480, name="loop-picker")
     picked = dict(carried=all_loops, choice=choice, measured=measured, model=model, palette=palette)
     choice.js_on_change("value", CustomJS(args=picked, code=_PICK_LOOPS))
     note = Div(
