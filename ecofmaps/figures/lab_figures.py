@@ -13,11 +13,11 @@ from ecofmaps.lab import per_cycle, sliding_condition
 
 __all__ = ["loop_scar_closure_figure", "running_condition_map"]
 
-#: How each sliding condition is marked on the running-condition map: marker, face colour.
+#: How each sliding condition is marked on the running-condition map.
 _CONDITION_MARKERS = {
-    "partial slip": ("o", "white"),
-    "mixed slip": ("D", "0.6"),
-    "gross slip": ("s", "black"),
+    "partial slip": dict(marker="o", markerfacecolor="white"),
+    "mixed slip": dict(marker="D", markerfacecolor="0.6"),
+    "gross slip": dict(marker="s", markerfacecolor="black"),
 }
 
 
@@ -50,8 +50,7 @@ def running_condition_map(results, transition: xr.Dataset, rig_stiffness: float)
     for test in results:
         cycles = per_cycle(test, ("amplitude",))
         condition = sliding_condition(test, rig_stiffness).attrs["sliding_condition"]
-        marker, face = _CONDITION_MARKERS[condition]
-        look = dict(marker=marker, markerfacecolor=face, markeredgecolor="black", linestyle="")
+        look = dict(_CONDITION_MARKERS[condition], markeredgecolor="black", linestyle="")
         style["label"] = None if condition in drawn else condition
         ax.plot(np.nanmedian(cycles["amplitude"]) * MICRO, np.nanmedian(cycles["load"]), **look)
         drawn.add(condition)

@@ -20,6 +20,9 @@ from ecofmaps.model.regimes import GROSS_SLIP, Regime
 
 __all__ = ["cof_evolution", "measured_and_fitted_loops", "measured_loops", "resolved_loops"]
 
+#: The colour of the ECoF and of the GICoF over the cycles.
+_COLORS = {"ecof": "tab:orange", "gicof": "tab:blue"}
+
 
 def _title(what: str, source: str | None) -> str:
     """A figure's title: the recording's name ``source``, when given, and ``what`` it shows."""
@@ -187,10 +190,8 @@ def cof_evolution(results: xr.Dataset, *, source: str | None = None) -> Figure:
     top, bottom = figure.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
     cycle = results["cycle"].values
     marker = dict(marker="o", markersize=2.5) if cycle.size <= 400 else {}
-    for name, label, color in (
-        ("ecof", r"ECoF $\mu_E = E_d/(4P\delta^*)$", "tab:orange"),
-        ("gicof", r"GICoF ($Q/P$ on $Q = S\Delta$)", "tab:blue"),
-    ):
+    labels = (r"ECoF $\mu_E = E_d/(4P\delta^*)$", r"GICoF ($Q/P$ on $Q = S\Delta$)")
+    for (name, color), label in zip(_COLORS.items(), labels, strict=True):
         if np.isfinite(results[name].values).any():
             top.plot(cycle, results[name].values, color=color, linewidth=1.3, label=label, **marker)
     top.set_ylabel("Coefficient of friction [1]")
@@ -372,10 +373,7 @@ def _mu_over_test(test, resolved: xr.Dataset, results: xr.Dataset | None) -> tup
         test.plot(number, mu, color="tab:green", linewidth=1.4, label=label, **marker)
     drawn = [mu - error]
     if results is not None:
-        for name, label, color in (
-            ("ecof", r"ECoF $\mu_E$", "tab:orange"),
-            ("gicof", "GICoF", "tab:blue"),
-        ):
+        for (name, color), label in zip(_COLORS.items(), (r"ECoF $\mu_E$", "GICoF"), strict=True):
             drawn.append(results[name].values)
             if np.isfinite(drawn[-1]).any():
                 test.plot(number, drawn[-1], color=color, linewidth=1.0, label=label, **marker)

@@ -93,9 +93,7 @@ def loops_by_aspect_ratio(loops: xr.Dataset) -> Figure:
     return figure
 
 
-def _stiffness_curves(
-    dataset: xr.Dataset, variable: str, scale: float, number: str, loc: str, markers=None
-) -> Figure:
+def _stiffness_curves(dataset, variable: str, scale: float, number: str, loc: str, markers=None):
     """One curve of ``dataset[variable] * scale`` against z_o/x_o per rig stiffness, the
     ``markers`` of :func:`ecof_ratio_curves`, a legend at ``loc`` listing the stiffest first."""
     figure = Figure(figsize=style.FIGSIZE, layout="constrained")

@@ -135,9 +135,8 @@ def _draw_scar_profiles(ax, dataset: xr.Dataset) -> None:
     depth, width = scalar(dataset, "scar_depth"), scalar(dataset, "scar_half_width")
     x = dataset["scar_position"].values * MICRO
     for shape in dataset["shape"].values:  # the parabola on top, thinner: others share parts
-        look = (
-            dict(linewidth=1.4, zorder=3) if shape == "parabolic" else dict(linewidth=2.6, zorder=2)
-        )
+        parabola = shape == "parabolic"
+        look = dict(linewidth=1.4 if parabola else 2.6, zorder=3 if parabola else 2)
         height = dataset["scar_height"].sel(shape=shape) * MICRO
         ax.plot(x, height, color=SHAPE_COLORS.get(shape), label=shape, **look)
     reach = float(dataset["slip_amplitude"].sel(shape="parabolic", groove="parabola"))

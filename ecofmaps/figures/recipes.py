@@ -160,12 +160,11 @@ def _scar_profiles() -> list:
     """The scar families of :data:`SCAR_SHAPES`, in order."""
     depth, width = paper.ASPECT_RATIO * paper.AMPLITUDE, paper.AMPLITUDE
     scale = {"ridge_height": depth, "ridge_width": width}
-    return [
-        getattr(ecofmaps, family)(
-            depth, width, **{k: v * scale.get(k, 1.0) for k, v in shape.items()}
-        )
-        for family, shape in SCAR_SHAPES.values()
-    ]
+    profiles = []
+    for family, shape in SCAR_SHAPES.values():
+        options = {name: value * scale.get(name, 1.0) for name, value in shape.items()}
+        profiles.append(getattr(ecofmaps, family)(depth, width, **options))
+    return profiles
 
 
 def _labelled(variables: dict, coords: dict) -> xr.Dataset:
@@ -231,13 +230,12 @@ def scar_shapes_dataset() -> xr.Dataset:
     """The four scar families at Example 2's D/W: profiles, loops, μ_E/μ over S/P (Fig. 11's)."""
     model, parabola = _scar_shape_model(), _scar_shape_parabola()
     ratios = _SHAPES_STIFFNESS_RATIOS
-    errors = []
-    for ratio in model["ecof_ratio"].values:
-        # μ from the profile's μ_E corrected with the parabola of the same D/W (eq. 11)
-        corrected = ecofmaps.correct_ecof(
-            paper.MU * ratio, paper.AMPLITUDE, paper.LOAD, ratios * paper.LOAD, paper.ASPECT_RATIO
-        )
-        errors.append(np.asarray(corrected) / paper.MU - 1.0)
+    # μ from each profile's μ_E corrected with the parabola of the same D/W (eq. 11)
+    rig = (paper.AMPLITUDE, paper.LOAD, ratios * paper.LOAD, paper.ASPECT_RATIO)
+    corrected = [
+        ecofmaps.correct_ecof(paper.MU * ratio, *rig) for ratio in model["ecof_ratio"].values
+    ]
+    errors = [np.asarray(mu) / paper.MU - 1.0 for mu in corrected]
 
     def by_groove(name, index=...):  # the profile's values and the parabola's
         on_profile = model[name].values[:, index]

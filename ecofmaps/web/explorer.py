@@ -147,15 +147,11 @@ def _values_html(point: dict, values: dict) -> str:
         value = values[key] * quantity.display_factor
         text = "inf (a rigid rig)" if math.isinf(value) else f"{value:g} {quantity.display_unit}"
         read.append(f"{quantity.symbol} = {text.strip()}")
-    rows = [
-        ("slip_amplitude", "Slip amplitude δ*", point["slip_amplitude"]),
-        ("dissipated_energy", "Dissipated energy E_d", point["dissipated_energy"]),
-        ("ecof_ratio", "μ_E/μ", point["ecof_ratio"]),
-        ("ecof", "μ_E", point["ecof_ratio"] * values["mu"]),
-    ]
+    shown = dict(point, ecof=point["ecof_ratio"] * values["mu"])
+    labels = {"slip_amplitude": "Slip amplitude δ*", "dissipated_energy": "Dissipated energy E_d"}
     cells = []
-    for key, label, value in rows:
-        quantity = QUANTITIES[key]
+    for key, label in (labels | {"ecof_ratio": "μ_E/μ", "ecof": "μ_E"}).items():
+        quantity, value = QUANTITIES[key], shown[key]
         unit = quantity.display_unit if math.isfinite(value) else ""
         cells.append(
             f"<tr><th style='text-align:left;padding-right:1em'>{label}</th>"
@@ -297,12 +293,10 @@ def explorer_page():
         for key, values in (pn.state.session_args or {}).items()
         if key in INPUTS and values and isinstance(values[-1], bytes)
     }
-    inputs = {
-        key: pn.widgets.TextInput(
-            label=label, value=query.get(key, default), width=220 if key in _MODEL_INPUTS else 160
-        )
-        for key, (_, label, default) in INPUTS.items()
-    }
+    inputs = {}
+    for key, (_, label, default) in INPUTS.items():
+        width = 220 if key in _MODEL_INPUTS else 160
+        inputs[key] = pn.widgets.TextInput(label=label, value=query.get(key, default), width=width)
     if pn.state.location is not None:
         for key, widget in inputs.items():
             pn.state.location.sync(widget, {"value": key})
@@ -342,26 +336,19 @@ def explorer_page():
     for widget in inputs.values():
         widget.param.watch(update, "value")
     update()
-    at_point = pn.Column(
-        *(inputs[key] for key in _MODEL_INPUTS),
-        pn.pane.HTML("<h3 style='margin:8px 0 0 0'>At this point</h3>"),
-        values_pane,
-    )
-    correction_inputs = [inputs[key] for key in ("ecof", "aspect_ratio_low", "aspect_ratio_high")]
+    heading = pn.pane.HTML("<h3 style='margin:8px 0 0 0'>At this point</h3>")
+    at_point = pn.Column(*(inputs[key] for key in _MODEL_INPUTS), heading, values_pane)
     intro = pn.pane.HTML(
         "<h2 style='margin:4px 0'>ecofmaps explorer: the compliant wear-scar model</h2>"
         "<p style='margin:0'>Type quantities with units (50um, 35MN/m; a bare number is SI). "
         "The URL keeps the inputs: copy it to share this view.</p>",
         width=1100,
     )
-    return pn.Column(
-        intro,
-        message,
-        notice,
-        pn.Row(at_point, pn.pane.Bokeh(loop), pn.pane.Bokeh(map_plot)),
-        pn.pane.HTML("<h3 style='margin:0'>Correct a reported ECoF</h3>"),
-        pn.Row(*correction_inputs, correction_pane),
-    )
+    plots = pn.Row(at_point, pn.pane.Bokeh(loop), pn.pane.Bokeh(map_plot))
+    correcting = pn.pane.HTML("<h3 style='margin:0'>Correct a reported ECoF</h3>")
+    correction = [inputs[key] for key in ("ecof", "aspect_ratio_low", "aspect_ratio_high")]
+    correction = pn.Row(*correction, correction_pane)
+    return pn.Column(intro, message, notice, plots, correcting, correction)
 
 
 def warm_up() -> None:

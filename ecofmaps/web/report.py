@@ -205,12 +205,8 @@ def _evolution_figures(results: xr.Dataset, flagged: dict):
     data["mu_low"] = data["mu_resolved"] - 2.0 * data["mu_resolved_se"]
     data["mu_high"] = data["mu_resolved"] + 2.0 * data["mu_resolved_se"]
     source = ColumnDataSource(data)
-    plot = _cycle_figure(
-        frame_height=300,
-        title="Coefficients of friction over the test",
-        y_axis_label="Coefficient of friction [1]",
-        tools="pan,box_zoom,wheel_zoom,reset,save",
-    )
+    plot = _cycle_figure("Coefficients of friction over the test", 300)
+    plot.yaxis.axis_label = "Coefficient of friction [1]"
     if "mu_resolved" in results:
         band = {"color": "#2ca02c", "alpha": 0.25, "legend_label": "μ ± 2 se"}
         plot.varea("cycle", "mu_low", "mu_high", source=source, **band)
@@ -221,12 +217,11 @@ def _evolution_figures(results: xr.Dataset, flagged: dict):
     }
     drawn = {}
     for name, (color, legend) in lines.items():
+        look = dict(source=source, color=color)
         if name in results:
-            drawn[name] = plot.line(
-                "cycle", name, source=source, color=color, line_width=1.5, legend_label=legend
-            )
+            drawn[name] = plot.line("cycle", name, line_width=1.5, legend_label=legend, **look)
         if cycle.size <= 400 and name != "mu_resolved":
-            plot.scatter("cycle", name, source=source, color=color, size=3)
+            plot.scatter("cycle", name, size=3, **look)
     tips = [("cycle", "@cycle"), ("ECoF", "@ecof{0.000000}"), ("GICoF", "@gicof{0.000000}")]
     tips += [("μ", "@mu_resolved{0.000000}"), ("quality", "@quality")]
     plot.add_tools(HoverTool(tooltips=tips, mode="vline", renderers=[drawn["ecof"]]))
@@ -235,14 +230,11 @@ def _evolution_figures(results: xr.Dataset, flagged: dict):
     return plot, _flags_figure(flagged, plot)
 
 
-def _cycle_figure(**options):
-    """A plot over the cycles, its frame lined up with the other's."""
-    plot = figure(
-        frame_width=_FRAME[0],
-        min_border_left=_FRAME[1],
-        x_axis_label=axis_label("cycle", plain=True),
-        **options,
-    )
+def _cycle_figure(title: str, height: int, tools="pan,box_zoom,wheel_zoom,reset,save", **options):
+    """A plot over the cycles, ``height`` [px] high, its frame lined up with the other's."""
+    frame = dict(frame_width=_FRAME[0], frame_height=height, min_border_left=_FRAME[1])
+    labels = dict(title=title, x_axis_label=axis_label("cycle", plain=True))
+    plot = figure(tools=tools, **labels, **frame, **options)
     plot.xaxis.formatter = BasicTickFormatter(use_scientific=False)
     return plot
 
@@ -252,14 +244,9 @@ def _flags_figure(flagged: dict, evolution):
     if not flagged:
         return Div(text="<p>No cycle is flagged: every cycle's quality is 'ok'.</p>")
     reasons = list(flagged)[::-1]  # the first reason at the top
-    plot = _cycle_figure(
-        frame_height=26 * len(reasons),
-        y_range=reasons,
-        x_range=evolution.x_range,
-        toolbar_location=None,
-        title="Quality flags (the values they leave out are NaN)",
-        tools="xpan,xwheel_zoom,reset",
-    )
+    ranges = dict(x_range=evolution.x_range, y_range=reasons, toolbar_location=None)
+    title = "Quality flags (the values they leave out are NaN)"
+    plot = _cycle_figure(title, 26 * len(reasons), tools="xpan,xwheel_zoom,reset", **ranges)
     reason = [reason for reason, cycles in flagged.items() for _ in cycles]
     marks = ColumnDataSource({"cycle": np.concatenate(list(flagged.values())), "reason": reason})
     mark = {"marker": "dash", "size": 10, "line_width": 2, "color": "#d62728"}
@@ -403,15 +390,6 @@ def _table(results: xr.Dataset):
         "writes it; click a column's name to sort)</h3>",
         width=_WIDTH,
     )
-    grid = DataTable(
-        source=ColumnDataSource(data),
-        columns=columns,
-        width=_TABLE_WIDTH,
-        height=380,
-        index_position=None,
-        frozen_columns=1,
-        sortable=True,
-        autosize_mode="none",
-        css_classes=["ecofmaps-table"],
-    )
-    return column(heading, grid)
+    layout = dict(width=_TABLE_WIDTH, height=380, autosize_mode="none", frozen_columns=1)
+    options = dict(index_position=None, sortable=True, css_classes=["ecofmaps-table"], **layout)
+    return column(heading, DataTable(source=ColumnDataSource(data), columns=columns, **options))
