@@ -22,26 +22,19 @@ if TYPE_CHECKING:  # imported when a figure is made: the registry reads without 
     from matplotlib.figure import Figure
 
 __all__ = [
-    "ASPECT_RATIOS",
-    "COMPLIANCE_RATIOS",
     "FIGURES",
-    "SCAR_SHAPES",
     "FigureRecipe",
     "figure_groups",
     "figure_parts",
     "make_figure",
     "make_figures",
-    "scar_shape_model_dataset",
-    "scar_shape_parabola_dataset",
-    "scar_shapes_dataset",
-    "source_digest",
 ]
 
 #: Groove aspect ratios z_o/x_o of Figures 7, 8, 11 and the universal map. [1]
-ASPECT_RATIOS = np.linspace(0.0, 0.3, 61)
+_ASPECT_RATIOS = np.linspace(0.0, 0.3, 61)
 #: λ of the universal map, on a logarithmic scale: near-rigid rigs to well past the end of
 #: gross slip at μλ = 1, covering Figure 11 at both amplitudes. [1]
-COMPLIANCE_RATIOS = np.geomspace(0.01, 2.0, 161)
+_COMPLIANCE_RATIOS = np.geomspace(0.01, 2.0, 161)
 #: Example 2's amplitude, load and μ.
 _RIG = dict(amplitude=paper.AMPLITUDE, load=paper.LOAD, mu=paper.MU)
 
@@ -98,7 +91,7 @@ def _loops() -> xr.Dataset:
 
 def _stiffness_curves_data() -> xr.Dataset:
     ratios = np.array(paper.FIGURE_7_STIFFNESSES) / paper.LOAD
-    return ecofmaps.compute_map(ratios, ASPECT_RATIOS, paper.AMPLITUDE, paper.MU, paper.LOAD)
+    return ecofmaps.compute_map(ratios, _ASPECT_RATIOS, paper.AMPLITUDE, paper.MU, paper.LOAD)
 
 
 def _ecof_ratio_map(panel: str) -> Callable[[], xr.Dataset]:
@@ -106,18 +99,18 @@ def _ecof_ratio_map(panel: str) -> Callable[[], xr.Dataset]:
 
     def data() -> xr.Dataset:
         ratios = paper.FIGURE_11_STIFFNESS_RATIOS
-        return ecofmaps.compute_map(ratios, ASPECT_RATIOS, amplitude, paper.MU)
+        return ecofmaps.compute_map(ratios, _ASPECT_RATIOS, amplitude, paper.MU)
 
     return data
 
 
 def _universal_map() -> xr.Dataset:
-    return ecofmaps.compute_universal_map(COMPLIANCE_RATIOS, ASPECT_RATIOS, paper.MU)
+    return ecofmaps.compute_universal_map(_COMPLIANCE_RATIOS, _ASPECT_RATIOS, paper.MU)
 
 
 #: The ``shapes`` figure's scar families at Example 2's D/W = 0.2, W = x_o = Δ*: the function
 #: and its shape parameters (fractions of D or W). [1]
-SCAR_SHAPES = {
+_SCAR_SHAPES = {
     "parabolic": ("parabolic_profile", {}),
     "flat-bottomed": ("flat_bottomed_profile", {"flat_fraction": 0.5}),
     "W-shaped": ("w_shaped_profile", {"hump": 0.25}),
@@ -157,11 +150,11 @@ def _scar_shapes() -> xr.Dataset:
 
 
 def _scar_profiles() -> list:
-    """The scar families of :data:`SCAR_SHAPES`, in order."""
+    """The scar families of :data:`_SCAR_SHAPES`, in order."""
     depth, width = paper.ASPECT_RATIO * paper.AMPLITUDE, paper.AMPLITUDE
     scale = {"ridge_height": depth, "ridge_width": width}
     profiles = []
-    for family, shape in SCAR_SHAPES.values():
+    for family, shape in _SCAR_SHAPES.values():
         options = {name: value * scale.get(name, 1.0) for name, value in shape.items()}
         profiles.append(getattr(ecofmaps, family)(depth, width, **options))
     return profiles
@@ -204,7 +197,7 @@ def scar_shape_model_dataset() -> xr.Dataset:
         name: (("shape", "point" if name in loop else "stiffness_ratio"), np.array(value))
         for name, value in values.items()
     }
-    return _labelled(variables, {"shape": list(SCAR_SHAPES), "stiffness_ratio": ratios})
+    return _labelled(variables, {"shape": list(_SCAR_SHAPES), "stiffness_ratio": ratios})
 
 
 def scar_shape_parabola_dataset() -> xr.Dataset:
@@ -222,7 +215,7 @@ def scar_shape_parabola_dataset() -> xr.Dataset:
         "displacement": ("point", loop[0]),
         "force": ("point", loop[1]),
     }
-    coords = {"shape": list(SCAR_SHAPES), "scar_position": position, "stiffness_ratio": ratios}
+    coords = {"shape": list(_SCAR_SHAPES), "scar_position": position, "stiffness_ratio": ratios}
     return _labelled(variables, coords)
 
 
@@ -252,7 +245,7 @@ def scar_shapes_dataset() -> xr.Dataset:
         "shortcut_error": (("shape", "stiffness_ratio"), np.array(errors)),
     }
     coords = {
-        "shape": list(SCAR_SHAPES),
+        "shape": list(_SCAR_SHAPES),
         "groove": ["profile", "parabola"],
         "scar_position": parabola["scar_position"].values,
         "stiffness_ratio": ratios,
