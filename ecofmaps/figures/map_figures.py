@@ -136,16 +136,14 @@ def universal_ecof_ratio_map(
     for (name, point), marker in zip((markers or {}).items(), itertools.cycle("soD^v")):
         lam = float(compliance_ratio(point["amplitude"], point["load"], point["stiffness"]))
         value = float(energy_cof(**point) / point["mu"])
-        label = (
-            rf"{name}: {style.stiffness_label(point['stiffness'])}, "
-            rf"$z_o/x_o$ = {point['aspect_ratio']:.3g}, "
-            rf"$\mu$ = {point['mu']:g}: $\mu_E/\mu$ = {value:.3f}"
-        )
+        ratio = point["aspect_ratio"]
+        rig = f"{style.stiffness_label(point['stiffness'])}, $z_o/x_o$ = {ratio:.3g}"
+        label = rf"{name}: {rig}, $\mu$ = {point['mu']:g}: $\mu_E/\mu$ = {value:.3f}"
         dot = dict(color="navy", markersize=8, markeredgecolor="white", zorder=5, label=label)
-        handles += ax.plot(lam, point["aspect_ratio"], marker, **dot)
+        handles += ax.plot(lam, ratio, marker, **dot)
         short = name.replace("Example ", "Ex. ").replace("(Section 3)", "(§3)")
         words = dict(textcoords="offset points", fontsize="x-small", color="navy", bbox=legible)
-        ax.annotate(short, (lam, point["aspect_ratio"]), xytext=(7, -3), **words)
+        ax.annotate(short, (lam, ratio), xytext=(7, -3), **words)
     figure.legend(handles=handles, loc="outside lower center", fontsize="x-small", ncols=1)
     title = [
         rf"Universal map of $\mu_E/\mu$ ($x_o = \Delta^*$, $\mu$ = {mu:g})",

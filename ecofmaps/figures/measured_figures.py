@@ -245,12 +245,9 @@ def measured_and_fitted_loops(fits, *, source: str | None = None) -> Figure:
         panel = f"({chr(ord('a') + index)}) " if len(panels) > 1 else ""
         panel += f"{name}: " if name else ""
         test = rf"{panel}{load_label(fit.load)}, $x_o = \Delta^*$ = {fit.amplitude * MICRO:.1f} µm"
-        fitted = style.parameters(
-            rf"fit: $\mu$ = {fit.mu:.3f}",
-            stiffness_label(fit.stiffness),
-            rf"$z_o$ = {fit.groove_depth * MICRO:.2f} µm",
-            f"RMS residual {fit.rms_residual:.2g} N",
-        )
+        depth = rf"$z_o$ = {fit.groove_depth * MICRO:.2f} µm"
+        fitted = [rf"fit: $\mu$ = {fit.mu:.3f}", stiffness_label(fit.stiffness), depth]
+        fitted = style.parameters(*fitted, f"RMS residual {fit.rms_residual:.2g} N")
         ax.set_title(f"{test}\n{fitted}", fontsize="medium")
     title = _title("measured fretting loops and the fitted model", source)
     figure.suptitle(title, fontsize="medium")

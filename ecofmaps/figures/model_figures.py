@@ -42,11 +42,9 @@ def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
     stiffnesses = loops["stiffness"].values
     for stiffness, color in zip(stiffnesses, style.stiffness_colors(stiffnesses), strict=True):
         loop = loops.sel(stiffness=stiffness)
-        label = (
-            f"{style.stiffness_label(stiffness)}: "
-            rf"$\delta^*$ = {float(loop.slip_amplitude) * MICRO:.1f} µm, "
-            rf"$E_d$ = {float(loop.dissipated_energy) * style.MILLI:.1f} mJ"
-        )
+        slip = rf"$\delta^*$ = {float(loop.slip_amplitude) * MICRO:.1f} µm"
+        label = f"{style.stiffness_label(stiffness)}: {slip}, "
+        label += rf"$E_d$ = {float(loop.dissipated_energy) * style.MILLI:.1f} mJ"
         look = dict(linestyle="--", linewidth=1.8) if np.isinf(stiffness) else dict(linewidth=2.2)
         ax.plot(loop.displacement * MICRO, loop.force, color=color, label=label, **look)
     style.loop_axes(ax, scalar(loops, "load"))
@@ -113,11 +111,8 @@ def _stiffness_curves(dataset, variable: str, scale: float, number: str, loc: st
     for name, point in (markers or {}).items():
         curve = dataset["ecof_ratio"].sel(stiffness_ratio=point["stiffness"] / load)
         value = float(curve.interp(aspect_ratio=point["aspect_ratio"]))
-        label = (
-            rf"{name} ({style.stiffness_label(point['stiffness'])}, "
-            rf"$z_o/x_o$ = {point['aspect_ratio']:g}): $\mu_E/\mu$ = {value:.3f} "
-            rf"(+{(value - 1) * 100:.1f} %)"
-        )
+        rig = rf"{style.stiffness_label(point['stiffness'])}, $z_o/x_o$ = {point['aspect_ratio']:g}"
+        label = rf"{name} ({rig}): $\mu_E/\mu$ = {value:.3f} (+{(value - 1) * 100:.1f} %)"
         dot = dict(color="crimson", markersize=9, zorder=5, label=label)
         ax.plot(point["aspect_ratio"], value, "o", **dot)
     handles, labels = ax.get_legend_handles_labels()  # the curves as they stack, then the rest

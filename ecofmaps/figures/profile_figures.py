@@ -118,15 +118,12 @@ def scar_shape_comparison(dataset: xr.Dataset) -> Figure:
     _draw_shape_loops(loop_axes, dataset)
     _draw_ratio_and_error(ax_ratio, ax_error, dataset)
     depth, width = scalar(dataset, "scar_depth"), scalar(dataset, "scar_half_width")
-    rig = style.parameters(
-        rf"$x_o = \Delta^*$ = {scalar(dataset, 'amplitude') * MICRO:g} µm",
-        f"$W$ = {width * MICRO:g} µm, $D$ = {depth * MICRO:g} µm",
-        style.load_label(scalar(dataset, "load")),
-        f"{style.stiffness_label(scalar(dataset, 'stiffness'))} (loops)",
-        rf"$\mu$ = {scalar(dataset, 'mu'):g}",
-    )
+    sizes = f"$W$ = {width * MICRO:g} µm, $D$ = {depth * MICRO:g} µm"
+    loops = f"{style.stiffness_label(scalar(dataset, 'stiffness'))} (loops)"
+    rig = [rf"$x_o = \Delta^*$ = {scalar(dataset, 'amplitude') * MICRO:g} µm", sizes]
+    rig += [style.load_label(scalar(dataset, "load")), loops, rf"$\mu$ = {scalar(dataset, 'mu'):g}"]
     title = "Scar shape at equal depth over half-width: how wrong the D/W shortcut is"
-    figure.suptitle(f"{title}\n{rig}", fontsize="medium")
+    figure.suptitle(f"{title}\n{style.parameters(*rig)}", fontsize="medium")
     return figure
 
 
@@ -160,12 +157,10 @@ def _draw_shape_loops(loop_axes, dataset: xr.Dataset) -> None:
         own = dict(color=SHAPE_COLORS.get(shape), linewidth=2.0, zorder=2)
         for groove, look in (("profile", own), ("parabola", dict(_SHORTCUT, zorder=3))):
             point = dataset.sel(shape=shape, groove=groove)
-            label = (
-                f"{shape + ' scar' if groove == 'profile' else 'parabola, same $D/W$'}\n"
-                rf"$\delta^*$ = {float(point['slip_amplitude']) * MICRO:.1f} µm, "
-                rf"$E_d$ = {float(point['dissipated_energy']) * style.MILLI:.1f} mJ, "
-                rf"$\mu_E$ = {float(point['ecof']):.3f}"
-            )
+            which = f"{shape} scar" if groove == "profile" else "parabola, same $D/W$"
+            slip = rf"$\delta^*$ = {float(point['slip_amplitude']) * MICRO:.1f} µm"
+            energy = rf"$E_d$ = {float(point['dissipated_energy']) * style.MILLI:.1f} mJ"
+            label = f"{which}\n{slip}, {energy}, $\\mu_E$ = {float(point['ecof']):.3f}"
             ax.plot(point["displacement"] * MICRO, point["force"], **look, label=label)
         loops = dataset["force"].sel(shape=shape).values
         if np.allclose(loops[0], loops[1], rtol=1e-6, atol=1e-9 * load):
