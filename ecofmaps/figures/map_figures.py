@@ -76,9 +76,8 @@ def ecof_ratio_contours(
         rig = style.stiffness_label(point["stiffness"]), style.load_label(point["load"])
         label = f"{name} ({', '.join(rig)})"
         dot = dict(color="navy", markersize=8, markeredgecolor="white", label=label)
-        handles += ax.plot(
-            point["stiffness"] / point["load"] * style.PER_MM, point["aspect_ratio"], "o", **dot
-        )
+        at = point["stiffness"] / point["load"] * style.PER_MM
+        handles += ax.plot(at, point["aspect_ratio"], "o", **dot)
     ax.legend(handles=handles, loc="lower right", fontsize="small", framealpha=0.9)
     rig = style.parameters_of(dataset, "amplitude", "mu")
     title = rf"Fig. {number}  $\mu_E/\mu$ over rig stiffness and groove shape" + "\n" + rig

@@ -1,8 +1,6 @@
-"""Pages for a browser: a test's self-contained HTML report and a live explorer of the model.
-
-Both need the extra ``web`` (Bokeh, Panel): ``pip install "ecofmaps[web]"``. Importing this
-package needs neither; :mod:`ecofmaps.web.report`, :mod:`ecofmaps.web.explorer` and its server,
-:mod:`ecofmaps.web.server`, do."""
+"""Pages for a browser: a test's self-contained HTML report (:mod:`ecofmaps.web.report`) and a
+live explorer of the model (:mod:`ecofmaps.web.explorer`, served by :mod:`ecofmaps.web.server`).
+Those need the extra ``web`` (Bokeh, Panel: ``pip install "ecofmaps[web]"``); this does not."""
 
 from __future__ import annotations
 
@@ -14,7 +12,6 @@ __all__ = ["INSTALL_WEB", "missing_web_packages"]
 
 #: The one line that tells how to install what the pages need.
 INSTALL_WEB = 'the web pages need Bokeh and Panel: pip install "ecofmaps[web]"'
-
 #: The packages of the extra ``web``, by import name.
 _WEB_PACKAGES = ("bokeh", "panel")
 

@@ -1,8 +1,7 @@
-"""A live explorer of the model in the browser (``ecofmaps explore``), built with Panel.
-
-One page per session: the parameters typed with units, the model's numbers and steady loop at
-that point, Figure 11's map with the point marked, and the contact CoF behind a typed ECoF.
-The inputs live in the page's URL query, so a view is shared as a link."""
+"""A live explorer of the model in the browser (``ecofmaps explore``), built with Panel: one page
+per session, the parameters typed with units, the model's numbers and steady loop at that point,
+Figure 11's map with the point marked, and the contact CoF behind a typed ECoF. The inputs live
+in the page's URL query, so a view is shared as a link."""
 
 from __future__ import annotations
 
@@ -42,7 +41,6 @@ INPUTS = {
     "aspect_ratio_low": ("aspect_ratio", "Scar z_o/x_o from", "0.15"),
     "aspect_ratio_high": ("aspect_ratio", "Scar z_o/x_o to", "0.25"),
 }
-
 _MODEL_INPUTS = ("amplitude", "load", "stiffness", "mu", "aspect_ratio")
 _MAP_POINTS = (91, 81)  # grid points of the map along S/P and along z_o/x_o
 # The map's window, widened to hold the point: S/P [1/m] and the largest z_o/x_o [1]; the
@@ -211,7 +209,6 @@ def _contour_labels(line_data, scale: tuple) -> dict:
 # over a fill of alpha 0).
 _HATCH = dict(line_color="#4d4d4d", fill_color="#d9d9d9", fill_alpha=0.5)
 _HATCH |= dict(hatch_pattern="/", hatch_color="#4d4d4d", hatch_scale=10)
-
 #: The part of the map plot (600 × 470) its axes take, roughly. [px]
 _MAP_FRAME = (440, 290)
 

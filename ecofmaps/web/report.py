@@ -47,7 +47,6 @@ __all__ = ["LOOPS_CARRIED", "recording_inputs", "report_document", "write_report
 #: Cycles whose loops a report carries by default, spread evenly over the test, for the reader
 #: to pick from: the bulk of a short test's report.
 LOOPS_CARRIED = 60
-
 _MODEL_POINTS = 40  # points on each slip branch of a model loop
 _MODEL_BATCH = 64  # model loops are computed in batches of a multiple of this many
 # The plots over the cycles: width of their frames, and the room left of them for the axis
@@ -94,10 +93,9 @@ def write_report(path, results: xr.Dataset, *, loops=None, inputs=None, lab=None
         '{% extends "file.html.jinja" %}{% block css_resources %}{{ own_css }}{% endblock %}'
         "{% block js_resources %}{{ own_js }}{% endblock %}"
     )
-    resources = {
-        "own_js": JS_RESOURCES.render(js_files=[], js_raw=own.js_raw, hashes={}),
-        "own_css": CSS_RESOURCES.render(css_files=[], css_raw=own.css_raw),
-    }
+    own_js = JS_RESOURCES.render(js_files=[], js_raw=own.js_raw, hashes={})
+    own_css = CSS_RESOURCES.render(css_files=[], css_raw=own.css_raw)
+    resources = dict(own_js=own_js, own_css=own_css)
     text = file_html(document, None, title=title, template=page, template_variables=resources)
     with atomic_path(path) as temporary:
         Path(temporary).write_text(text, encoding="utf-8")
@@ -156,9 +154,8 @@ def _rows_table(rows: Mapping, css_class: str) -> str:
 
 def _header(results: xr.Dataset, inputs: Mapping) -> Div:
     """The title, the inputs, the version and date, and the quality's summary."""
-    rows = dict(inputs)
-    rows["ecofmaps version"] = __version__
-    rows["written"] = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
+    written = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M UTC")
+    rows = dict(inputs) | {"ecofmaps version": __version__, "written": written}
     rows["cycles"] = quality_summary(results["quality"].values)
     rows["sliding condition"] = sliding_condition_line(results)
     return Div(
