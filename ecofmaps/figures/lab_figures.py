@@ -51,7 +51,7 @@ def running_condition_map(results, transition: xr.Dataset, rig_stiffness: float)
         cycles = per_cycle(test, ("amplitude",))
         condition = sliding_condition(test, rig_stiffness).attrs["sliding_condition"]
         look = dict(_CONDITION_MARKERS[condition], markeredgecolor="black", linestyle="")
-        style["label"] = None if condition in drawn else condition
+        look["label"] = None if condition in drawn else condition
         ax.plot(np.nanmedian(cycles["amplitude"]) * MICRO, np.nanmedian(cycles["load"]), **look)
         drawn.add(condition)
     top = 1.15 * ax.get_ylim()[1]
