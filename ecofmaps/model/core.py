@@ -85,12 +85,9 @@ def curvature_number(length, aspect_ratio, groove_half_width):
 
     Parameters
     ----------
-    length : array_like
-        The reference length :math:`L` (the amplitude :math:`\Delta^*`). [m]
-    aspect_ratio : array_like
-        Groove depth over half-width :math:`z_o/x_o`. [1]
-    groove_half_width : array_like
-        Groove half-width :math:`x_o`. [m]
+    length, aspect_ratio, groove_half_width : array_like
+        The reference length :math:`L` (the amplitude :math:`\Delta^*`) [m], groove depth
+        over half-width :math:`z_o/x_o` [1] and groove half-width :math:`x_o` [m].
 
     Returns
     -------
@@ -110,12 +107,9 @@ def compliance_ratio(length, load, stiffness):
 
     Parameters
     ----------
-    length : array_like
-        The reference length :math:`L` (the amplitude :math:`\Delta^*`). [m]
-    load : array_like
-        Normal load :math:`P`. [N]
-    stiffness : array_like
-        Rig stiffness :math:`S`. [N/m]
+    length, load, stiffness : array_like
+        The reference length :math:`L` (the amplitude :math:`\Delta^*`) [m], normal load
+        :math:`P` [N] and rig stiffness :math:`S` [N/m].
 
     Returns
     -------
@@ -130,9 +124,8 @@ def compliance_ratio(length, load, stiffness):
 
 
 def traction_ratio(position, mu, kappa, direction=1.0):
-    r"""Tangential force over normal load while slipping, :math:`Q/P` (eq. 9).
-
-    .. math:: \frac{Q_s}{P} = \frac{s\mu + \kappa\xi}{1 - s\mu\kappa\xi}
+    r"""Tangential force over normal load while slipping, :math:`Q/P = (s\mu + \kappa\xi)/(1 -
+    s\mu\kappa\xi)` (eq. 9).
 
     Parameters
     ----------
@@ -179,10 +172,8 @@ def slip_roots(target, mu, kappa, lam):
 
 
 def slip_position(target, mu, kappa, lam):
-    r"""Contact position reached by forward slip when the actuator is at ``target``.
-
-    Solves :math:`\xi + \lambda\, Q_+(\xi)/P = D` (eq. 9 with eq. 10; eq. 16 at :math:`D = 1`)
-    for the root below the locking point :math:`\mu\kappa\xi = 1`, without cancellation.
+    r"""Contact position reached by forward slip with the actuator at ``target``: the root of
+    :math:`\xi + \lambda\, Q_+(\xi)/P = D` below the locking point (eq. 9, 10, 16).
 
     Parameters
     ----------
@@ -206,18 +197,13 @@ def slip_position(target, mu, kappa, lam):
 
 
 def locking_margin(target, mu, kappa, lam):
-    r"""Margin :math:`w = 1 - \mu\kappa\xi` of the forward-slip position to the locking point.
-
-    The denominator of eq. 9 at the position :func:`slip_position` returns, as the positive
-    root of the quadratic of eq. 16 in :math:`w`: it keeps its digits close to locking, where
-    :math:`1 - \mu\kappa\xi` would lose them all (``docs/model.md``).
+    r"""Margin :math:`w = 1 - \mu\kappa\xi` of :func:`slip_position` to the locking point, the
+    denominator of eq. 9, with its digits kept close to locking (``docs/model.md``).
 
     Parameters
     ----------
-    target : array_like
-        Actuator displacement :math:`D = \Delta/L`. [1]
-    mu, kappa, lam : array_like
-        Friction coefficient, curvature number, compliance ratio. [1]
+    target, mu, kappa, lam : array_like
+        As in :func:`slip_position`. [1]
 
     Returns
     -------
@@ -267,14 +253,13 @@ def slip_ratio(mu, kappa, lam):
     Parameters
     ----------
     mu, kappa, lam : array_like
-        Friction coefficient, curvature number :math:`2 (z_o/x_o)(\Delta^*/x_o)` and
-        compliance ratio :math:`P/(S\Delta^*)`. [1]
+        Friction coefficient, curvature number, compliance ratio. [1]
 
     Returns
     -------
     d : jax.Array
-        In :math:`(0, 1]` in gross slip, 0 with no gross slip, NaN when self-locking or
-        invalid. Flat groove: :math:`1 - \mu\lambda`; rigid rig: 1. [1]
+        In :math:`(0, 1]` in gross slip (flat groove: :math:`1 - \mu\lambda`; rigid rig: 1), 0
+        with no gross slip, NaN when self-locking or invalid. [1]
 
     References
     ----------
@@ -307,13 +292,9 @@ def _artanh_excess(u, margin):
 
 
 def ecof_ratio(mu, kappa, lam):
-    r"""Energy coefficient of friction over the contact one, :math:`\mu_E/\mu`.
-
-    The corrected eq. 13-15 (the printed coefficient :math:`(1 + 1/\mu)` of the logarithm
-    must read :math:`(1 + 1/\mu^2)`), with :math:`u = \mu\kappa d`:
-
-    .. math:: \frac{\mu_E}{\mu} = 1 + \frac{1 + \mu^2}{\mu^2}
-              \left(\frac{\operatorname{artanh} u}{u} - 1\right)
+    r"""Energy coefficient of friction over the contact one, :math:`\mu_E/\mu = 1 + (1 + 1/\mu^2)
+    (\operatorname{artanh}(u)/u - 1)`, :math:`u = \mu\kappa d`: eq. 13-15, whose printed
+    :math:`(1 + 1/\mu)` must read :math:`(1 + 1/\mu^2)`.
 
     Parameters
     ----------

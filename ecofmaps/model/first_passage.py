@@ -11,17 +11,7 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from ecofmaps.model.profile_core import (
-    Side,
-    Tables,
-    centre_segment,
-    crossing_fraction,
-    interval_table,
-    mean_excess,
-    mean_traction,
-    table_levels,
-    traction_forward,
-)
+from ecofmaps.model import profile_core as core
 from ecofmaps.model.regimes import BEYOND_PROFILE, GROSS_SLIP, NO_GROSS_SLIP, SELF_LOCKING
 
 __all__ = [
@@ -59,7 +49,7 @@ def _at(table, group, *index):
     return table.reshape(-1)[flat]
 
 
-def _first_holding(side: Side, group, value, begin, sparse: bool):
+def _first_holding(side: core.Side, group, value, begin, sparse: bool):
     """First sample index >= ``begin`` whose interval does not hold ``value``, or N."""
     n = side.position.shape[-1]
     if sparse:
@@ -102,7 +92,7 @@ def _mirror(segment, fraction, n: int):
     return _normal(n - 2 - segment, 1.0 - fraction, n)
 
 
-def _point(side: Side, group, segment, fraction):
+def _point(side: core.Side, group, segment, fraction):
     """Position and slope at ``(segment, fraction)``."""
     p0, p1 = _at(side.position, group, segment), _at(side.position, group, segment + 1)
     g0, g1 = _at(side.slope, group, segment), _at(side.slope, group, segment + 1)
@@ -114,11 +104,11 @@ def _actuator(position, force, lam):
     return position + jnp.where(lam > 0.0, lam * force, 0.0)
 
 
-def _passage(side: Side, group, mu, lam, value, level, segment, fraction, sparse: bool):
+def _passage(side: core.Side, group, mu, lam, value, level, segment, fraction, sparse: bool):
     """First passage of ``F_+ >= level`` from ``(segment, fraction)``: new position, ran off."""
     n = side.position.shape[-1]
     start, start_slope = _point(side, group, segment, fraction)
-    stick = _actuator(start, traction_forward(start_slope, mu), lam) >= level
+    stick = _actuator(start, core.traction_forward(start_slope, mu), lam) >= level
     j = _first_holding(side, group, value, segment + 1, sparse)
     off = (j >= n) & ~stick
     j = jnp.clip(j, 1, n - 1)
@@ -127,13 +117,13 @@ def _passage(side: Side, group, mu, lam, value, level, segment, fraction, sparse
     a = jnp.where(same, start, left)
     slope_a = jnp.where(same, start_slope, _at(side.slope, group, j - 1))
     b, slope_b = _at(side.position, group, j), _at(side.slope, group, j)
-    t = crossing_fraction(a, b - a, slope_a, slope_b - slope_a, mu, lam, level)
+    t = core.crossing_fraction(a, b - a, slope_a, slope_b - slope_a, mu, lam, level)
     reached = a + t * (b - a)
     new = _normal(j - 1, (reached - left) / (b - left), n)
     return jnp.where(stick, segment, new[0]), jnp.where(stick, fraction, new[1]), off
 
 
-def steady_loop(tables: Tables, group, lam, sparse: bool = True) -> SteadyLoop:
+def steady_loop(tables: core.Tables, group, lam, sparse: bool = True) -> SteadyLoop:
     r"""The steady loop of one point (``docs/model.md``): ends, :math:`\mu_E/\mu`, peak, regime."""
     forward, backward = tables.forward, tables.backward
     n = forward.position.shape[-1]
@@ -151,7 +141,7 @@ def steady_loop(tables: Tables, group, lam, sparse: bool = True) -> SteadyLoop:
     # pieces, each taken from the sample on the loop's side (a locking point, where e is
     # singular, can lie just beyond either end).
     def piece(a, slope_a, b, slope_b):
-        return (b - a) * mean_excess(slope_a, slope_b, mu)
+        return (b - a) * core.mean_excess(slope_a, slope_b, mu)
 
     after, slope_after = _point(forward, group, k_minus + 1, 0.0)
     before, slope_before = _point(forward, group, k_plus, 0.0)
@@ -165,7 +155,7 @@ def steady_loop(tables: Tables, group, lam, sparse: bool = True) -> SteadyLoop:
 
     def largest(table, slope_a, slope_b):
         inside = _range(table, group, k_minus + 1, k_plus, jnp.maximum, -jnp.inf, sparse)
-        ends = jnp.maximum(traction_forward(slope_a, mu), traction_forward(slope_b, mu))
+        ends = jnp.maximum(core.traction_forward(slope_a, mu), core.traction_forward(slope_b, mu))
         return jnp.maximum(inside, ends)
 
     peak = largest(tables.peak, slope_minus, slope_plus)
@@ -192,7 +182,7 @@ def steady_loop(tables: Tables, group, lam, sparse: bool = True) -> SteadyLoop:
     )
 
 
-def _running_levels(side: Side, group, mu, lam, start, end):
+def _running_levels(side: core.Side, group, mu, lam, start, end):
     """Per segment of a forward stroke from ``start`` to ``end`` (``(k, t)`` pairs)."""
     n = side.position.shape[-1]
     p, g, q = side.position[group], side.slope[group], side.force[group]
@@ -202,7 +192,7 @@ def _running_levels(side: Side, group, mu, lam, start, end):
     values = _actuator(p, q, lam)
     index = jnp.arange(n)
     inside = (index > k_a) & (index <= k_b)
-    fa = _actuator(xa, traction_forward(ga, mu), lam)
+    fa = _actuator(xa, core.traction_forward(ga, mu), lam)
     running = jnp.maximum(fa, jax.lax.cummax(jnp.where(inside, values, -jnp.inf)))
     segment = jnp.arange(n - 1)
     first, last = segment == k_a, segment == k_b
@@ -211,26 +201,26 @@ def _running_levels(side: Side, group, mu, lam, start, end):
     b = jnp.where(last, xb, p[1:])
     slope_b = jnp.where(last, gb, g[1:])
     level = jnp.where(first, fa, running[:-1])
-    value_b = jnp.where(last, _actuator(xb, traction_forward(gb, mu), lam), values[1:])
+    value_b = jnp.where(last, _actuator(xb, core.traction_forward(gb, mu), lam), values[1:])
     active = (segment >= k_a) & (segment <= k_b) & (b > a)
     return a, b, slope_a, slope_b, level, value_b, active
 
 
-def _jump_area(side: Side, group, mu, lam, start, end):
+def _jump_area(side: core.Side, group, mu, lam, start, end):
     r""":math:`\int (M_+ - F_+)\,d\xi` over a forward stroke from ``start`` to ``end``."""
     a, b, slope_a, slope_b, level, value_b, active = _running_levels(
         side, group, mu, lam, start, end
     )
     change = slope_b - slope_a
-    t = crossing_fraction(a, b - a, slope_a, change, mu, lam, level)
+    t = core.crossing_fraction(a, b - a, slope_a, change, mu, lam, level)
     t = jnp.where(value_b >= level, t, 1.0)
     c = a + t * (b - a)
     slope_c = slope_a + t * change
-    area = (c - a) * (level - 0.5 * (a + c) - lam * mean_traction(slope_a, slope_c, mu))
+    area = (c - a) * (level - 0.5 * (a + c) - lam * core.mean_traction(slope_a, slope_c, mu))
     return jnp.sum(jnp.where(active & (c > a), area, 0.0))
 
 
-def _branch(side: Side, group, mu, lam, start, end, num: int):
+def _branch(side: core.Side, group, mu, lam, start, end, num: int):
     """``num`` points of a forward stroke from ``start`` to ``end``: actuator D and Q/P."""
     a, b, slope_a, slope_b, level, _, _ = _running_levels(side, group, mu, lam, start, end)
     xa, _ = _point(side, group, *start)
@@ -242,7 +232,7 @@ def _branch(side: Side, group, mu, lam, start, end, num: int):
     k = jnp.clip(jnp.searchsorted(ends, xi, side="left"), start[0], end[0])
     fraction = jnp.where(b[k] > a[k], (xi - a[k]) / jnp.where(b[k] > a[k], b[k] - a[k], 1.0), 0.0)
     slope = slope_a[k] + fraction * (slope_b[k] - slope_a[k])
-    q = traction_forward(slope, mu)
+    q = core.traction_forward(slope, mu)
     value = _actuator(xi, q, lam)
     actuator = jnp.maximum(level[k], value)
     slipping = value >= level[k]
@@ -250,7 +240,7 @@ def _branch(side: Side, group, mu, lam, start, end, num: int):
     return actuator, q
 
 
-def _both_strokes(stroke, tables: Tables, group, lam, ends, *args):
+def _both_strokes(stroke, tables: core.Tables, group, lam, ends, *args):
     """``stroke`` forward from the lower end to the upper one, and back on the mirrored profile."""
     n = tables.forward.position.shape[-1]
     mu = tables.mu[group]
@@ -260,13 +250,13 @@ def _both_strokes(stroke, tables: Tables, group, lam, ends, *args):
     return forward, stroke(tables.backward, group, mu, lam, *mirrored, *args)
 
 
-def jump_areas(tables: Tables, group, lam, ends):
+def jump_areas(tables: core.Tables, group, lam, ends):
     """The jumps' areas of both strokes of the steady loop with ``ends``."""
     forward, backward = _both_strokes(_jump_area, tables, group, lam, ends)
     return forward + backward
 
 
-def draw_loop(tables: Tables, group, lam, loop: SteadyLoop, num: int):
+def draw_loop(tables: core.Tables, group, lam, loop: SteadyLoop, num: int):
     """The steady loop's actuator positions D and forces Q/P, ``2 num + 1`` points."""
     forward, backward = _both_strokes(_branch, tables, group, lam, loop.ends, num)
     (d_forward, q_forward), (d_back, q_back) = forward, backward
@@ -278,18 +268,18 @@ def draw_loop(tables: Tables, group, lam, loop: SteadyLoop, num: int):
     return jnp.where(stuck, line, actuator), jnp.where(stuck, stick_force, force)
 
 
-def simulation_tables(position, slope, mu, lam) -> Tables:
-    r"""Tables for a time history at one :math:`(\mu, \lambda)`: per sample, the actuator
+def simulation_tables(position, slope, mu, lam) -> core.Tables:
+    r"""core.Tables for a time history at one :math:`(\mu, \lambda)`: per sample, the actuator
     positions :math:`D` at which :math:`F_+ \ge D` fails, :math:`(F_+, \infty)`, sparse."""
 
     def side(p, g):
-        force = traction_forward(g, mu)
+        force = core.traction_forward(g, mu)
         values = _actuator(p, force, lam)
-        bounds = interval_table(values, jnp.full(p.size, jnp.inf), table_levels(p.size))
-        return Side(p, g, force, bounds)
+        bounds = core.interval_table(values, jnp.full(p.size, jnp.inf), core.table_levels(p.size))
+        return core.Side(p, g, force, bounds)
 
     empty = jnp.zeros((1, 1))
-    tables = Tables(
+    tables = core.Tables(
         forward=side(position, slope),
         backward=side(-position[::-1], -slope[::-1]),
         excess=jnp.zeros(1),
@@ -297,12 +287,12 @@ def simulation_tables(position, slope, mu, lam) -> Tables:
         peak=empty,
         trough=empty,
         mu=mu,
-        **centre_segment(position),
+        **core.centre_segment(position),
     )
     return jax.tree.map(lambda leaf: leaf[None], tables)
 
 
-def simulation_step(tables: Tables, lam, state, actuator):
+def simulation_step(tables: core.Tables, lam, state, actuator):
     """One step of the return map: the pad sticks or slips to the exact equilibrium."""
     forward, backward = tables.forward, tables.backward
     n = forward.position.shape[-1]
@@ -310,8 +300,8 @@ def simulation_step(tables: Tables, lam, state, actuator):
     k, t, q, off = state
     x, g = _point(forward, 0, k, t)
     has_lam = lam > 0.0
-    ahead = _actuator(x, traction_forward(g, mu), lam)
-    behind = x - jnp.where(has_lam, lam * traction_forward(-g, mu), 0.0)
+    ahead = _actuator(x, core.traction_forward(g, mu), lam)
+    behind = x - jnp.where(has_lam, lam * core.traction_forward(-g, mu), 0.0)
     go_forward = actuator > ahead
     go_back = actuator < behind
     kf, tf, off_f = _passage(forward, 0, mu, lam, actuator, actuator, k, t, True)
@@ -320,7 +310,9 @@ def simulation_step(tables: Tables, lam, state, actuator):
     k_new = jnp.where(go_forward, kf, jnp.where(go_back, kb, k))
     t_new = jnp.where(go_forward, tf, jnp.where(go_back, tb, t))
     _, g_new = _point(forward, 0, k_new, t_new)
-    q_slip = jnp.where(go_forward, traction_forward(g_new, mu), -traction_forward(-g_new, mu))
+    q_slip = jnp.where(
+        go_forward, core.traction_forward(g_new, mu), -core.traction_forward(-g_new, mu)
+    )
     q_stick = jnp.where(has_lam, (actuator - x) / jnp.where(has_lam, lam, 1.0), q)
     q_new = jnp.where(go_forward | go_back, q_slip, q_stick)
     off = off | (go_forward & off_f) | (go_back & off_b) | ~jnp.isfinite(q_new)

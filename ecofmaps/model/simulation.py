@@ -11,13 +11,7 @@ import jax
 import jax.numpy as jnp
 
 from ecofmaps._inputs import check, float64, is_concrete
-from ecofmaps.model.core import (
-    locking_margin,
-    slip_ratio,
-    slip_roots,
-    steady_inputs,
-    traction_ratio,
-)
+from ecofmaps.model import core
 from ecofmaps.model.on_profile import broadcast_history, profile_loop, profile_simulation
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
 from ecofmaps.model.steady_state import dimensionless, one_geometry
@@ -31,14 +25,14 @@ def _steady_loop(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width
         amplitude, load, stiffness, mu, aspect_ratio, groove_half_width
     )
     mu, kappa, lam, code = (x[..., None] for x in (mu, kappa, lam, code))
-    d = slip_ratio(mu, kappa, lam)
+    d = core.slip_ratio(mu, kappa, lam)
     t = jnp.linspace(-1.0, 1.0, num)
     # Forward-slip branch from -d to d (eq. 9, 10), sampled as docs/model.md explains: the
     # margin w = 1 - mu*kappa*xi falls geometrically on a deep groove (u = mu*kappa*d >= 1/2).
     a = mu * kappa
     u = a * d
     shallow = u < 0.5
-    w_end = locking_margin(1.0, mu, kappa, lam)
+    w_end = core.locking_margin(1.0, mu, kappa, lam)
     w_end = jnp.where(shallow, 0.5, w_end)
     w_deep = (1.0 + u) * jnp.exp((t + 1.0) / 2.0 * jnp.log(w_end / (1.0 + u)))
     xi = jnp.where(shallow, t * d, (1.0 - w_deep) / jnp.where(shallow, 1.0, a))
@@ -117,7 +111,7 @@ def fretting_loop(
         return profile_loop(
             profile, amplitude, load, stiffness, mu, groove_half_width, mapping, num
         )
-    values = steady_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
+    values = core.steady_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
     return _steady_loop(*jnp.broadcast_arrays(*values), num=num)
 
 
@@ -130,10 +124,10 @@ def _return_map(displacement, mu, kappa, lam, length):
     def step(state, d):
         xi, q = state
         gap = d - xi
-        forward = gap > lam * traction_ratio(xi, mu, kappa)
-        backward = gap < lam * traction_ratio(xi, mu, kappa, -1.0)
-        xi_forward, w_forward = slip_roots(d, mu, kappa, lam)
-        xi_backward, w_backward = slip_roots(-d, mu, kappa, lam)
+        forward = gap > lam * core.traction_ratio(xi, mu, kappa)
+        backward = gap < lam * core.traction_ratio(xi, mu, kappa, -1.0)
+        xi_forward, w_forward = core.slip_roots(d, mu, kappa, lam)
+        xi_backward, w_backward = core.slip_roots(-d, mu, kappa, lam)
         q_forward = (mu + kappa * xi_forward) / w_forward  # eq. 9, digits kept near locking
         q_backward = -(mu + kappa * xi_backward) / w_backward
         xi_backward = -xi_backward
@@ -209,7 +203,7 @@ def simulate(
         )
     if groove_half_width is None:
         raise ValueError("simulate with aspect_ratio needs groove_half_width (x_o) [m]")
-    load, stiffness, mu, aspect_ratio, length = steady_inputs(
+    load, stiffness, mu, aspect_ratio, length = core.steady_inputs(
         None, load, stiffness, mu, aspect_ratio, groove_half_width
     )
     mu, kappa, lam, code = dimensionless(length, load, stiffness, mu, aspect_ratio, length)

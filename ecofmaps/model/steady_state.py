@@ -10,17 +10,8 @@ import jax.numpy as jnp
 
 from ecofmaps._codes import warn_nan
 from ecofmaps._inputs import as_float64, float64, is_concrete
-from ecofmaps.model.core import (
-    compliance_ratio,
-    curvature_number,
-    ecof_ratio,
-    normalized_energy,
-    normalized_max_force,
-    regime_code,
-    slip_ratio,
-    steady_inputs,
-    valid_geometry,
-)
+from ecofmaps.model import core
+from ecofmaps.model.core import valid_geometry
 from ecofmaps.model.on_profile import steady_numbers, steady_values
 from ecofmaps.model.regimes import INVALID, Regime
 
@@ -35,12 +26,14 @@ __all__ = [
 ]
 
 _CORE = {
-    "slip_amplitude": lambda mu, kappa, lam, length, load: length * slip_ratio(mu, kappa, lam),
+    "slip_amplitude": lambda mu, kappa, lam, length, load: length * core.slip_ratio(mu, kappa, lam),
     "dissipated_energy": lambda mu, kappa, lam, length, load: (
-        load * length * normalized_energy(mu, kappa, lam)
+        load * length * core.normalized_energy(mu, kappa, lam)
     ),
-    "energy_cof": lambda mu, kappa, lam, length, load: mu * ecof_ratio(mu, kappa, lam),
-    "max_force": lambda mu, kappa, lam, length, load: load * normalized_max_force(mu, kappa, lam),
+    "energy_cof": lambda mu, kappa, lam, length, load: mu * core.ecof_ratio(mu, kappa, lam),
+    "max_force": lambda mu, kappa, lam, length, load: (
+        load * core.normalized_max_force(mu, kappa, lam)
+    ),
 }
 #: The quantities' names among :func:`ecofmaps.model.on_profile.steady_values`, where other.
 _ON_PROFILE = {"energy_cof": "ecof"}
@@ -48,10 +41,10 @@ _ON_PROFILE = {"energy_cof": "ecof"}
 
 def dimensionless(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width):
     """The core numbers ``(mu, kappa, lam)`` of SI inputs, and their regime."""
-    kappa = curvature_number(amplitude, aspect_ratio, groove_half_width)
-    lam = compliance_ratio(amplitude, load, stiffness)
+    kappa = core.curvature_number(amplitude, aspect_ratio, groove_half_width)
+    lam = core.compliance_ratio(amplitude, load, stiffness)
     valid = valid_geometry(amplitude, load, stiffness, aspect_ratio, groove_half_width)
-    code = jnp.where(valid, regime_code(mu, kappa, lam), int(INVALID)).astype(jnp.int32)
+    code = jnp.where(valid, core.regime_code(mu, kappa, lam), int(INVALID)).astype(jnp.int32)
     return mu, kappa, lam, code
 
 
@@ -105,7 +98,7 @@ def _steady_quantity(quantity: str, summary: str, returns: str, notes: str, equa
         one_geometry(aspect_ratio, profile, mapping)
         if profile is None:
             arguments = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
-            result, code = _steady_state(quantity, *steady_inputs(*arguments))
+            result, code = _steady_state(quantity, *core.steady_inputs(*arguments))
             concrete = is_concrete(*arguments)
         else:
             numbers = steady_numbers(
