@@ -68,7 +68,8 @@ def fretting_loop(
     profile=None,
     mapping="scaled",
 ):
-    r"""The steady fretting loop: displacement and tangential force around one cycle.
+    r"""The steady fretting loop: displacement and tangential force around one cycle, its slip
+    branches :math:`\Delta = x + Q_\pm(x)/S` (eq. 9, 10) sampled as ``docs/model.md`` explains.
 
     Parameters
     ----------
@@ -86,18 +87,14 @@ def fretting_loop(
         reversal :math:`(-\Delta^*, -Q^*)`, sticks up to the onset of forward slip, slips
         to :math:`(\Delta^*, Q^*)`, sticks down, slips back and ends where it began
         (first point = last point). It runs clockwise, so the shoelace sum
-        :math:`\oint Q\,d\Delta` is :math:`E_d > 0`. [m], [N]
+        :math:`\oint Q\,d\Delta` is :math:`E_d > 0`. NaN when self-locking or off a
+        profile's trace. [m], [N]
 
     Raises
     ------
     ValueError
         For a concrete input out of range (see :func:`ecofmaps.slip_amplitude`), or
         ``num < 2``.
-
-    Notes
-    -----
-    The slip branches are :math:`\Delta = x + Q_\pm(x)/S` (eq. 9, 10), sampled as
-    ``docs/model.md`` explains. Self-locking points and points off a profile's trace give NaN.
 
     References
     ----------
@@ -154,7 +151,9 @@ def simulate(
     profile=None,
     mapping="scaled",
 ):
-    r"""Tangential force history for any actuator displacement history :math:`\Delta(t)`.
+    r"""Tangential force history for any actuator displacement history :math:`\Delta(t)`: from
+    rest at the groove centre, the pad sticks or slips to the exact equilibrium at each step
+    (eq. 9, 10, 16; ``docs/model.md``).
 
     Parameters
     ----------
@@ -176,17 +175,12 @@ def simulate(
     force : jax.Array of float64
         Tangential force :math:`Q` at each instant, shape of ``displacement`` broadcast
         with the parameters' shape plus the time axis. NaN once a rigid rig drives the pad
-        into the locking point. [N]
+        into the locking point, or the pad runs off a profile's trace. [N]
 
     Raises
     ------
     ValueError
         For a concrete input out of range; ``displacement`` must be finite.
-
-    Notes
-    -----
-    From rest at the groove centre, the pad sticks or slips to the exact equilibrium at each
-    step (eq. 9, 10, 16; ``docs/model.md``). A pad that runs off a profile's trace gives NaN.
 
     References
     ----------
