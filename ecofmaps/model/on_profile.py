@@ -125,11 +125,10 @@ def _own_loop(position, slope, half_width, physical, point, num=0):
     return loop, jumps, first_passage.draw_loop(tables, 0, lam, loop, num)
 
 
-@partial(jax.jit, static_argnames=("physical", "num"))
-def _own_loops(position, slope, half_width, mu, key, lam, physical, num=0):
+@partial(jax.jit, static_argnames=("physical", "num", "batch"))
+def _own_loops(position, slope, half_width, mu, key, lam, physical, num=0, batch=_POINT_BATCH):
     one = partial(_own_loop, position, slope, half_width, physical, num=num)
-    # With loops drawn (a figure's few points) one point at a time: it compiles faster.
-    return jax.lax.map(one, (mu, key, lam), batch_size=None if num else _POINT_BATCH)
+    return jax.lax.map(one, (mu, key, lam), batch_size=batch)
 
 
 def _pad(indices: np.ndarray) -> np.ndarray:
@@ -246,7 +245,9 @@ def _each_own(profile, physical, mu, key, lam, num=0):
     """:func:`_own_loops` of the points padded to a power of two."""
     padded = _pad(np.arange(lam.size))
     arguments = (profile.position, profile.slope, profile.half_width)
-    return _own_loops(*arguments, mu[padded], key[padded], lam[padded], physical, num)
+    # With loops drawn (a figure's few points) one point at a time: it compiles faster.
+    batch = None if num else _POINT_BATCH
+    return _own_loops(*arguments, mu[padded], key[padded], lam[padded], physical, num, batch)
 
 
 def _scaled(curve, ok, scale, shape):
@@ -292,30 +293,16 @@ def steady_numbers_and_loops(
     return numbers
 
 
-def _drawn(position, slope, half_width, physical, num, point):
-    mu, key, lam = point
-    tables = core.profile_tables(position, slope, mu, _stroke(half_width, key, physical), False)
-    loop = first_passage.steady_loop(tables, 0, lam, False)
-    actuator, force = first_passage.draw_loop(tables, 0, lam, loop, num)
-    ok = (loop.regime == int(GROSS_SLIP)) | (loop.regime == int(NO_GROSS_SLIP))
-    return jnp.where(ok, actuator, jnp.nan), jnp.where(ok, force, jnp.nan)
-
-
-@partial(jax.jit, static_argnames=("physical", "num"))
-def _drawn_loops(position, slope, half_width, mu, key, lam, physical, num):
-    one = partial(_drawn, position, slope, half_width, physical, num)
-    return jax.lax.map(one, (mu, key, lam), batch_size=_POINT_BATCH)
-
-
 def profile_loop(profile, amplitude, load, stiffness, mu, groove_half_width, mapping, num):
     """Displacement and force around the steady loop on ``profile`` (see fretting_loop)."""
     profile, values, physical, (mu, key, lam, valid) = _points(
         profile, amplitude, load, stiffness, mu, groove_half_width, mapping
     )
     arguments = (profile.position, profile.slope, profile.half_width)
-    actuator, force = _drawn_loops(*arguments, mu, key, lam, physical, num)
+    loops, _, (actuator, force) = _own_loops(*arguments, mu, key, lam, physical, num)
+    ok = valid & ((loops.regime == int(GROSS_SLIP)) | (loops.regime == int(NO_GROSS_SLIP)))
     shape = values[0].shape
-    return _scaled(actuator, valid, values[0], shape), _scaled(force, valid, values[1], shape)
+    return _scaled(actuator, ok, values[0], shape), _scaled(force, ok, values[1], shape)
 
 
 def _history(position, slope, history):
