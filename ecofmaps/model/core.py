@@ -29,7 +29,8 @@ __all__ = [
     "valid_geometry",
 ]
 
-#: The rule and unit of each SI input, for :func:`ecofmaps._inputs.check`.
+#: The rule and unit of each SI input, for :func:`ecofmaps._inputs.check`, in the order of
+#: :func:`steady_inputs`' arguments.
 _RULES = {
     "amplitude": ("positive", "m"),
     "load": ("positive", "N"),
@@ -51,14 +52,8 @@ def checked(**inputs) -> list:
 def steady_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width) -> list:
     """:func:`checked` inputs of a steady loop (no aspect ratio on a profile); x_o defaults to
     the amplitude."""
-    values = checked(
-        amplitude=amplitude,
-        load=load,
-        stiffness=stiffness,
-        mu=mu,
-        aspect_ratio=aspect_ratio,
-        groove_half_width=groove_half_width,
-    )
+    inputs = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
+    values = checked(**dict(zip(_RULES, inputs, strict=True)))
     return values if groove_half_width is not None else [*values, values[0]]
 
 

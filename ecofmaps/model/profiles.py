@@ -289,7 +289,9 @@ def scar_profile_and_findings(
 def scar_profile(
     x, z, half_width=None, smoothing=None, level=False, remove_outliers=True
 ) -> ScarProfile:
-    r"""A wear-scar profile from a measured trace (arrays in metres).
+    r"""A wear-scar profile from a measured trace (arrays in metres): edges, reference line and
+    smoothing as ``docs/profiles.md`` explains; the model maps a pad at :math:`x` to :math:`X =
+    xW/x_o` (eq. 11).
 
     Parameters
     ----------
@@ -301,10 +303,9 @@ def scar_profile(
         The scar's half-width :math:`W`, overriding the detected one (the centre stays the
         detected one). [m]
     smoothing : float, optional
-        Standard deviation of the Gaussian weights of the local quadratic fits that give
-        the heights and slopes (``docs/profiles.md``); 0 for none. Default:
-        :data:`AUTO_SMOOTHING` times the detected half-width. It is raised to the median
-        sample spacing if smaller, and must not exceed a fifth of the half-width. [m]
+        Standard deviation of the local quadratic fits' Gaussian weights (0: none); default
+        :data:`AUTO_SMOOTHING` times the half-width, at least the median sample spacing, at
+        most a fifth of the half-width. [m]
     level : bool
         Subtract the unworn surface's line (fitted on the shoulders) from the heights and
         its tilt from the slopes; off by default, so a genuinely tilted scar stays tilted.
@@ -320,23 +321,16 @@ def scar_profile(
     Warns
     -----
     ScarProfileWarning
-        For outliers replaced (their count, sample indices and positions), and for
-        ambiguous or uncertain edges: both half-widths, which one was returned and the
-        ``half_width=`` that takes the other (``docs/profiles.md``).
+        For outliers replaced (count, indices, positions), and for ambiguous or uncertain
+        edges: both half-widths, the one returned and the ``half_width=`` taking the other.
 
     Raises
     ------
     ValueError
-        Naming the parameter: ``x`` and ``z`` not 1-D arrays of equal length, NaN or
-        infinite values, ``x`` not strictly increasing (unsorted or repeated positions), no
-        depression deeper than the noise, a scar that reaches an end of the trace or a trace
-        too short to level, fewer than :data:`MIN_SCAR_SAMPLES` samples across the scar, a
-        ``half_width`` that does not fit the trace, or a bad ``smoothing``.
-
-    Notes
-    -----
-    The edges, the reference line and the smoothing follow ``docs/profiles.md``; the model maps
-    a pad position :math:`x` to :math:`X = xW/x_o` (eq. 11).
+        Naming the parameter: ``x``, ``z`` not finite 1-D arrays of equal length or ``x``
+        not strictly increasing; no depression deeper than the noise; a scar reaching an end
+        of the trace, a trace too short to level, fewer than :data:`MIN_SCAR_SAMPLES`
+        samples across the scar, a ``half_width`` off the trace or a bad ``smoothing``.
 
     References
     ----------

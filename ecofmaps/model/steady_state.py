@@ -25,16 +25,6 @@ __all__ = [
     "valid_geometry",
 ]
 
-_CORE = {
-    "slip_amplitude": lambda mu, kappa, lam, length, load: length * core.slip_ratio(mu, kappa, lam),
-    "dissipated_energy": lambda mu, kappa, lam, length, load: (
-        load * length * core.normalized_energy(mu, kappa, lam)
-    ),
-    "energy_cof": lambda mu, kappa, lam, length, load: mu * core.ecof_ratio(mu, kappa, lam),
-    "max_force": lambda mu, kappa, lam, length, load: (
-        load * core.normalized_max_force(mu, kappa, lam)
-    ),
-}
 #: The quantities' names among :func:`ecofmaps.model.on_profile.steady_values`, where other.
 _ON_PROFILE = {"energy_cof": "ecof"}
 
@@ -56,7 +46,11 @@ def _steady_state(quantity, amplitude, load, stiffness, mu, aspect_ratio, groove
     )
     if quantity == "slip_regime":
         return code, code
-    value = _CORE[quantity](mu, kappa, lam, amplitude, load)
+    numbers = {
+        name: getattr(core, name)(mu, kappa, lam)
+        for name in ("slip_ratio", "ecof_ratio", "normalized_energy", "normalized_max_force")
+    }
+    value = steady_values(numbers, amplitude, load, mu)[_ON_PROFILE.get(quantity, quantity)]
     return jnp.where(code == int(INVALID), jnp.nan, value), code
 
 
