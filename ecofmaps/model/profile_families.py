@@ -79,15 +79,13 @@ def parabolic_profile(depth, half_width, *, tilt=0.0, samples=2001, extent=2.0) 
     samples : int
         Number of samples, about evenly spaced, with samples at the edges. [1]
     extent : float
-        The trace runs from :math:`-\text{extent}\,W` to :math:`\text{extent}\,W`; flat
-        unworn surface outside the scar. [1]
+        The trace spans :math:`\pm\text{extent}\,W`, unworn outside the scar. [1]
 
     Returns
     -------
     profile : ScarProfile
-        Exact heights and slopes :math:`g = 2DX/W^2` (eq. 7 with :math:`z_o/x_o = D/W`,
-        eq. 11); piecewise linear slopes are exact for it, so the model on this profile
-        reproduces the closed forms with ``aspect_ratio=D/W`` to rounding.
+        Slopes :math:`g = 2DX/W^2` (eq. 7, 11): on it the model reproduces the closed forms
+        with ``aspect_ratio=D/W`` to rounding.
 
     References
     ----------
@@ -122,13 +120,11 @@ def flat_bottomed_profile(
 
     Parameters
     ----------
-    depth, half_width : float
-        :math:`D` and :math:`W`. [m]
+    depth, half_width, tilt, samples, extent
+        As for :func:`parabolic_profile`: :math:`D`, :math:`W` [m].
     flat_fraction : float
         :math:`f = a/W` in ``[0, 1)``: the flat bottom's half-width over the scar's
         (0 gives the parabola). [1]
-    tilt, samples, extent
-        As for :func:`parabolic_profile`.
 
     Returns
     -------
@@ -158,12 +154,10 @@ def w_shaped_profile(
 
     Parameters
     ----------
-    depth, half_width : float
-        :math:`D` and :math:`W`. [m]
+    depth, half_width, tilt, samples, extent
+        As for :func:`parabolic_profile`: :math:`D`, :math:`W` [m].
     hump : float
         :math:`h` in ``[0, 1)``: the hump's height above the troughs over the depth. [1]
-    tilt, samples, extent
-        As for :func:`parabolic_profile`.
 
     Returns
     -------
@@ -196,15 +190,13 @@ def ridged_profile(
 
     Parameters
     ----------
-    depth, half_width : float
-        :math:`D` and :math:`W`. [m]
+    depth, half_width, tilt, samples, extent
+        As for :func:`parabolic_profile`: :math:`D`, :math:`W` [m].
     ridge_height : float
         :math:`H` > 0. [m]
     ridge_width : float
         :math:`w` > 0, the ridge's width at its foot; :math:`W + w` must lie inside the
         trace (``extent``). [m]
-    tilt, samples, extent
-        As for :func:`parabolic_profile`.
 
     Returns
     -------

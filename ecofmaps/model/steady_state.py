@@ -75,7 +75,7 @@ def _profile_quantity(quantity, numbers, amplitude, load, mu):
     return jnp.broadcast_to(value, numbers["regime"].shape)
 
 
-def _steady_quantity(quantity: str, summary: str, returns: str, notes: str, equations: str):
+def _steady_quantity(quantity: str, summary: str, returns: str, equations: str):
     """The public function ``quantity`` of the steady loop, with its docstring."""
 
     def steady_quantity(
@@ -127,7 +127,8 @@ def _steady_quantity(quantity: str, summary: str, returns: str, notes: str, equa
     profile : ScarProfile, optional
         A wear-scar profile of any shape (:func:`ecofmaps.scar_profile`, the families),
         instead of ``aspect_ratio``: the pad at :math:`x` feels its slope at :math:`X` (eq. 9
-        pointwise). A parabolic profile reproduces the closed forms with ``aspect_ratio=D/W``.
+        pointwise), the loop read by first passage (``docs/model.md``). A parabolic profile
+        reproduces the closed forms with ``aspect_ratio=D/W``.
     mapping : {{'scaled', 'physical'}}
         On a profile: ``'scaled'``, :math:`X = xW/x_o` (eq. 11, the paper's); or
         ``'physical'``, :math:`X = x`.
@@ -139,16 +140,10 @@ def _steady_quantity(quantity: str, summary: str, returns: str, notes: str, equa
     Raises
     ------
     ValueError
-        For a concrete input out of its range: amplitude, load, mu and groove_half_width
-        must be finite and > 0, stiffness > 0 (inf allowed), aspect_ratio finite and >= 0,
-        each within the model's domain (:data:`ecofmaps.units.DOMAIN`); for both or
-        neither of aspect_ratio and profile, or a bad mapping. Under ``jax.jit``/``jax.vmap``
-        a traced value is not checked: out of range, it gives NaN and the ``INVALID`` regime.
-
-    Notes
-    -----
-    {notes}On a profile the loop's ends are found by first passage and :math:`E_d` is the area
-    of the loop the return map draws (``docs/model.md``).
+        For a concrete input out of its range (amplitude, load, mu, groove_half_width finite
+        and > 0, stiffness > 0 or inf, aspect_ratio finite and >= 0, each within
+        :data:`ecofmaps.units.DOMAIN`); for both or neither of aspect_ratio and profile, or a
+        bad mapping. A traced value is not checked: out of range, it gives NaN and ``INVALID``.
 
     References
     ----------
@@ -160,15 +155,12 @@ def _steady_quantity(quantity: str, summary: str, returns: str, notes: str, equa
 
 slip_amplitude = _steady_quantity(
     "slip_amplitude",
-    "Slip amplitude :math:`\\delta^*` of the steady fretting loop (eq. 16).",
+    """Slip amplitude :math:`\\delta^*` of the steady fretting loop, the root of
+    :math:`\\delta^* + Q_+(\\delta^*)/S = \\Delta^*` (eq. 9, 10, 16; :func:`slip_position`).""",
     """slip_amplitude : jax.Array of float64
-        :math:`\\delta^*`, the loop's half-width at :math:`Q = 0`; 0 with no gross slip,
+        :math:`\\delta^*`, the loop's half-width at :math:`Q = 0` (flat groove:
+        :math:`\\Delta^* - \\mu P/S`; rigid rig: :math:`\\Delta^*`); 0 with no gross slip,
         NaN when self-locking. [m]""",
-    """Solves :math:`\\delta^* + Q_+(\\delta^*)/S = \\Delta^*` (eq. 9, 10, 16) in closed form;
-    see :func:`slip_position`. Flat groove: :math:`\\Delta^* - \\mu P/S`; rigid rig:
-    :math:`\\Delta^*`.
-
-    """,
     "9, 10, 11, 16",
 )
 slip_amplitude.__doc__ += """
@@ -179,24 +171,20 @@ slip_amplitude.__doc__ += """
 """
 dissipated_energy = _steady_quantity(
     "dissipated_energy",
-    "Energy dissipated per cycle :math:`E_d`, the loop's area (eq. 12).",
+    "Energy dissipated per cycle :math:`E_d`, the loop's area (eq. 12), as :math:`4 P \\delta^*"
+    "\\mu_E` (eq. 14 corrected).",
     """dissipated_energy : jax.Array of float64
         :math:`E_d = 2\\int_{-\\delta^*}^{\\delta^*} Q_+\\,dx = \\oint Q\\,d\\Delta`; 0 with
         no gross slip, NaN when self-locking. [J]""",
-    """Evaluated as :math:`4 P \\delta^* \\mu_E` with the corrected eq. 14.
-
-    """,
     "9, 11, 12, 14",
 )
 energy_cof = _steady_quantity(
     "energy_cof",
-    "Energy coefficient of friction :math:`\\mu_E = E_d/(4P\\delta^*)` (eq. 1).",
+    "Energy coefficient of friction :math:`\\mu_E = E_d/(4P\\delta^*)` (eq. 1; eq. 13-15 "
+    "corrected as :func:`ecofmaps.model.ecof_ratio` says).",
     """energy_cof : jax.Array of float64
         :math:`\\mu_E \\ge \\mu`; NaN with no gross slip (a :class:`RegimeWarning` says so
         for concrete inputs) and when self-locking. [1]""",
-    """With eq. 13-15 corrected as :func:`ecofmaps.model.ecof_ratio` says.
-
-    """,
     "1, 9, 11, 13-15",
 )
 max_force = _steady_quantity(
@@ -206,7 +194,6 @@ max_force = _steady_quantity(
         :math:`Q^* = Q_+(\\delta^*)`; :math:`S\\Delta^*` with no gross slip; NaN when
         self-locking. On a profile, the largest tangential force over the loop (with no
         gross slip, the rig's force at :math:`\\Delta^*` on the stuck pad). [N]""",
-    "",
     "9, 11, 16",
 )
 slip_regime = _steady_quantity(
@@ -216,6 +203,5 @@ slip_regime = _steady_quantity(
         ``GROSS_SLIP`` (0), ``NO_GROSS_SLIP`` (1), ``SELF_LOCKING`` (2), ``INVALID`` (3,
         only under ``jit``/``vmap``: concrete invalid input raises) or, on a profile,
         ``BEYOND_PROFILE`` (4). Compare with the :class:`Regime` members.""",
-    "",
     "9, 11, 16",
 )
