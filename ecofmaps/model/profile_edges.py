@@ -9,7 +9,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["AMBIGUOUS_EDGES", "UNCERTAIN_EDGES", "Extent", "ScarProfileWarning", "scar_extent"]
+__all__ = ["AMBIGUOUS_EDGES", "UNCERTAIN_EDGES", "ScarProfileWarning", "scar_extent"]
 
 #: The edges are ambiguous when an edge of the band between the ridges lies beyond the
 #: groove's by more than this fraction of the groove's half-width. [1]
@@ -267,21 +267,6 @@ def _shoulders(x, centre, half_width, band, quiet):
     return None
 
 
-class Extent(NamedTuple):
-    """What :func:`scar_extent` found: reference line, centre, half-width, edges and ridges."""
-
-    line: object
-    tilt: float
-    centre: float
-    width: float
-    residual: np.ndarray
-    groove: tuple
-    band: tuple
-    wide: bool
-    ridges: tuple
-    rough_groove: tuple | None
-
-
 def _edges(x, r, deepest, depth, noise, reach):
     """The groove's and the band's edges, the ridges' crests, the band's outer ends, its threshold
     and on a rough surface the edges read within the roughness (else None)."""
@@ -354,19 +339,18 @@ def _too_short_message(x, centre, width, given: bool) -> str:
     )
 
 
-def _ambiguity(extent: Extent, given: bool):
+def _ambiguity(r, groove, band, ridges, wide: bool):
     """The warning of ambiguous edges (or None) and the half-width not taken. [m]"""
-    if extent.band == extent.groove or given:
+    if band == groove:
         return None, np.nan
-    r = extent.residual
-    apart = [b != g for b, g in zip(extent.band, extent.groove, strict=True)]
-    ridged = [crest is not None and far for crest, far in zip(extent.ridges, apart, strict=True)]
+    apart = [b != g for b, g in zip(band, groove, strict=True)]
+    ridged = [crest is not None and far for crest, far in zip(ridges, apart, strict=True)]
     what = "the band between its pile-up ridges' crests" if all(ridged) else "the disturbed band"
     if not all(apart):
         what = f"the groove and the disturbed band on its {'right' if apart[1] else 'left'}"
     marks = [
         f" (a crest {r[crest] * 1e6:.3g} µm high)" if ridge else ""
-        for crest, ridge in zip(extent.ridges, ridged, strict=True)
+        for crest, ridge in zip(ridges, ridged, strict=True)
     ]
 
     def candidate(edges, words, taken, notes=("", "")):
@@ -376,22 +360,21 @@ def _ambiguity(extent: Extent, given: bool):
         )
         return width, f"{width * 1e6:.6g} µm for {words} ({'returned; ' if taken else ''}{where})"
 
-    band = candidate(extent.band, what, extent.wide, marks)
-    groove = candidate(extent.groove, "the groove below the unworn surface's line", not extent.wide)
-    first, second = (band, groove) if extent.wide else (groove, band)
+    band = candidate(band, what, wide, marks)
+    groove = candidate(groove, "the groove below the unworn surface's line", not wide)
+    first, second = (band, groove) if wide else (groove, band)
     summary = (
         f"ambiguous scar edges: half-width {first[1]} or {second[1]}: which the model needs "
         "is a judgement"
     )
-    name = "groove" if extent.wide else "band"
+    name = "groove" if wide else "band"
     finding = ScarProfileWarning(summary, alternative=second[0], alternative_name=name)
     return finding, second[0]
 
 
-def _uncertainty(extent: Extent, given: bool):
+def _uncertainty(groove, other, wide: bool):
     """The warning of uncertain groove edges (or None) and the other half-width. [m]"""
-    groove, other = extent.groove, extent.rough_groove
-    if given or extent.wide or other is None:
+    if wide or other is None:
         return None, np.nan
     width = 0.5 * (groove[1] - groove[0])
     moved = max(abs(a - b) for a, b in zip(groove, other, strict=True))
@@ -411,8 +394,9 @@ def _uncertainty(extent: Extent, given: bool):
 
 
 def scar_extent(x, zs, half_width, reach):
-    """The scar's :class:`Extent` in the smoothed heights ``zs``, the half-width not taken [m]
-    (NaN if none) and the warnings."""
+    """The scar in the smoothed heights ``zs``: its reference line (a function), tilt, centre,
+    half-width and the residual ``zs - line(x)``; the half-width not taken [m] (NaN if none)
+    and the warnings."""
     span = x[-1] - x[0]
     mask = (x < x[0] + span / 5.0) | (x > x[-1] - span / 5.0)
     previous = None
@@ -454,9 +438,9 @@ def scar_extent(x, zs, half_width, reach):
         if edges == previous:
             break
         previous = edges
-    band = band if any(apart) else groove
-    extent = Extent(line, tilt, centre, width, r, groove, band, wide, ridges, rough)
-    finding, alternative = _ambiguity(extent, half_width is not None)
-    if finding is None:
-        finding, alternative = _uncertainty(extent, half_width is not None)
-    return extent, alternative, [] if finding is None else [finding]
+    finding, alternative = None, np.nan
+    if half_width is None:
+        finding, alternative = _ambiguity(r, groove, band if any(apart) else groove, ridges, wide)
+        if finding is None:
+            finding, alternative = _uncertainty(groove, rough, wide)
+    return (line, tilt, centre, width, r), alternative, [] if finding is None else [finding]

@@ -251,11 +251,9 @@ def scar_profile_and_findings(
     # The edges are found on lightly smoothed heights (heavier smoothing moves a kink).
     light = 0.0 if smoothing == 0.0 else _EDGE_SMOOTHING * spacing
     zs, _ = local_quadratic(x, z, light)
-    extent, alternative, edge_findings = scar_extent(
-        x, zs, half_width, int(np.ceil(_REACH * light / spacing))
-    )
-    findings += edge_findings
-    line, tilt, centre, width, r = extent[:5]
+    reach = int(np.ceil(_REACH * light / spacing))
+    (line, tilt, centre, width, r), alternative, more = scar_extent(x, zs, half_width, reach)
+    findings += more
     sigma = AUTO_SMOOTHING * width if smoothing is None else smoothing
     sigma = 0.0 if sigma == 0.0 else max(sigma, spacing)
     if sigma > width / 5.0:

@@ -69,12 +69,7 @@ class Regime(Code):
     )
 
 
-GROSS_SLIP = Regime.GROSS_SLIP
-NO_GROSS_SLIP = Regime.NO_GROSS_SLIP
-SELF_LOCKING = Regime.SELF_LOCKING
-INVALID = Regime.INVALID
-BEYOND_PROFILE = Regime.BEYOND_PROFILE
-PARTIAL_SLIP = Regime.PARTIAL_SLIP
+GROSS_SLIP, NO_GROSS_SLIP, SELF_LOCKING, INVALID, BEYOND_PROFILE, PARTIAL_SLIP = Regime
 
 #: A test's sliding conditions (Vincent et al. 1992; Zhou & Vincent 1995): every cycle in
 #: partial slip, the regime changing during the test, every cycle in gross slip.
