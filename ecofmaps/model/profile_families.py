@@ -28,11 +28,13 @@ def _fraction(name: str, value) -> float:
     return value
 
 
-def _grid(breakpoints, samples: int) -> np.ndarray:
-    """``samples`` positions about evenly spread, with 0, each breakpoint and its mirror."""
+def _grid(breakpoints, half_width, extent, samples: int, reach=1.0) -> np.ndarray:
+    """``samples`` positions over ``extent`` half-widths (> ``reach``) about evenly spread, with
+    0, the edges, each breakpoint and their mirrors."""
+    extent = _above("extent", extent, reach, " (half-widths)")
     if not (isinstance(samples, int | np.integer) and samples >= 2 * MIN_SCAR_SAMPLES):
         raise ValueError(f"samples must be an integer >= {2 * MIN_SCAR_SAMPLES}, got {samples!r}")
-    breakpoints = np.asarray(breakpoints, dtype=np.float64)
+    breakpoints = np.asarray([*breakpoints, half_width, extent * half_width], dtype=np.float64)
     breakpoints = np.unique(np.concatenate([-breakpoints, [0.0], breakpoints]))
     # Breakpoints closer than 1e-9 of the span (a flat bottom of nearly zero width) merge.
     tolerance = 1e-9 * (breakpoints[-1] - breakpoints[0])
@@ -42,16 +44,13 @@ def _grid(breakpoints, samples: int) -> np.ndarray:
             kept.append(point)
     breakpoints = np.array([*kept, breakpoints[-1]])
     lengths = np.diff(breakpoints)
-    if samples - 1 < 2 * lengths.size:
-        raise ValueError(f"samples must be at least {2 * lengths.size + 1} for this shape")
     # Intervals per piece: at least 2 each, the rest by largest remainders of the share.
     share = 2 + (samples - 1 - 2 * lengths.size) * lengths / lengths.sum()
     counts = np.floor(share).astype(int)
     counts[np.argsort(counts - share)[: samples - 1 - counts.sum()]] += 1
-    pieces = [breakpoints[:1]]
-    for left, right, count in zip(breakpoints[:-1], breakpoints[1:], counts, strict=True):
-        pieces.append(np.linspace(left, right, count + 1)[1:])
-    return np.concatenate(pieces)
+    ends = zip(breakpoints[:-1], breakpoints[1:], counts, strict=True)
+    pieces = [np.linspace(left, right, count + 1)[1:] for left, right, count in ends]
+    return np.concatenate([breakpoints[:1], *pieces])
 
 
 def _family(position, height, slope, depth, half_width, tilt):
@@ -99,8 +98,7 @@ def parabolic_profile(depth, half_width, *, tilt=0.0, samples=2001, extent=2.0) 
     0.2
     """
     depth, half_width = _above("depth", depth), _above("half_width", half_width)
-    extent = _above("extent", extent, 1.0, " (half-widths)")
-    x = _grid([half_width, extent * half_width], samples)
+    x = _grid([], half_width, extent, samples)
     inside = np.abs(x) <= half_width
     u = x / half_width
     z = np.where(inside, -depth * (1.0 - u * u), 0.0)
@@ -132,8 +130,7 @@ def flat_bottomed_profile(
     """
     depth, half_width = _above("depth", depth), _above("half_width", half_width)
     flat = _fraction("flat_fraction", flat_fraction) * half_width
-    extent = _above("extent", extent, 1.0, " (half-widths)")
-    x = _grid([flat, half_width, extent * half_width], samples)
+    x = _grid([flat], half_width, extent, samples)
     s = np.clip((np.abs(x) - flat) / (half_width - flat), 0.0, None)
     inside = np.abs(x) <= half_width
     z = np.where(inside, -depth * (1.0 - s * s), 0.0)
@@ -165,10 +162,9 @@ def w_shaped_profile(
     """
     depth, half_width = _above("depth", depth), _above("half_width", half_width)
     hump = _fraction("hump", hump)
-    extent = _above("extent", extent, 1.0, " (half-widths)")
     m2 = np.sqrt(hump) / (1.0 + np.sqrt(hump))
     trough = np.sqrt(m2) * half_width
-    x = _grid([trough, half_width, extent * half_width], samples)
+    x = _grid([trough], half_width, extent, samples)
     u = x / half_width
     inside = np.abs(u) <= 1.0
     scale = depth / (1.0 - m2) ** 2
@@ -205,9 +201,8 @@ def ridged_profile(
     depth, half_width = _above("depth", depth), _above("half_width", half_width)
     height = _above("ridge_height", ridge_height)
     width = _above("ridge_width", ridge_width)
-    extent = _above("extent", extent, 1.0 + width / half_width, " (half-widths)")
-    edges = [half_width, half_width + 0.5 * width, half_width + width, extent * half_width]
-    x = _grid(edges, samples)
+    ridge = [half_width + 0.5 * width, half_width + width]
+    x = _grid(ridge, half_width, extent, samples, 1.0 + width / half_width)
     u = x / half_width
     v = (np.abs(x) - half_width) / width
     inside = np.abs(u) <= 1.0
