@@ -124,12 +124,9 @@ def traction_ratio(position, mu, kappa, direction=1.0):
 
     Parameters
     ----------
-    position : array_like
-        Contact position :math:`\xi = x/L`. [1]
-    mu, kappa : array_like
-        Friction coefficient, curvature number. [1]
-    direction : array_like
-        Sign :math:`s` of the slip velocity, +1 or -1. [1]
+    position, mu, kappa, direction : array_like
+        Contact position :math:`\xi = x/L`, friction coefficient, curvature number and the
+        sign :math:`s` (+1 or -1) of the slip velocity. [1]
 
     Returns
     -------
@@ -172,16 +169,14 @@ def slip_position(target, mu, kappa, lam):
 
     Parameters
     ----------
-    target : array_like
-        Actuator displacement :math:`D = \Delta/L`. [1]
-    mu, kappa, lam : array_like
-        Friction coefficient, curvature number, compliance ratio. [1]
+    target, mu, kappa, lam : array_like
+        Actuator displacement :math:`D = \Delta/L`, friction coefficient, curvature number,
+        compliance ratio. [1]
 
     Returns
     -------
     xi : jax.Array
-        The contact position :math:`x/L`; it equals the locking point :math:`1/(\mu\kappa)`
-        when a rigid rig (``lam = 0``) is pushed beyond it. [1]
+        :math:`x/L`; the locking point :math:`1/(\mu\kappa)` for a rigid rig pushed beyond it. [1]
 
     References
     ----------
@@ -299,8 +294,7 @@ def ecof_ratio(mu, kappa, lam):
     Returns
     -------
     ratio : jax.Array
-        :math:`\ge 1`; exactly 1 for a flat groove; NaN with no gross slip, when
-        self-locking, or for invalid input. [1]
+        :math:`\ge 1` (1 for a flat groove); NaN with no gross slip, self-locking or invalid. [1]
 
     References
     ----------

@@ -32,21 +32,17 @@ def _steady_loop(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width
     a = mu * kappa
     u = a * d
     shallow = u < 0.5
-    w_end = core.locking_margin(1.0, mu, kappa, lam)
-    w_end = jnp.where(shallow, 0.5, w_end)
+    w_end = jnp.where(shallow, 0.5, core.locking_margin(1.0, mu, kappa, lam))
     w_deep = (1.0 + u) * jnp.exp((t + 1.0) / 2.0 * jnp.log(w_end / (1.0 + u)))
     xi = jnp.where(shallow, t * d, (1.0 - w_deep) / jnp.where(shallow, 1.0, a))
     w = jnp.where(shallow, 1.0 - a * xi, w_deep)
     xi = xi.at[..., 0].set(-d[..., 0]).at[..., -1].set(d[..., 0])
     q_slip = (mu + kappa * xi) / w  # eq. 9
-    target_slip = xi + lam * q_slip
     # No gross slip: the contact sticks at the centre and the loop is the line Q = S*Delta.
     stick = code == int(NO_GROSS_SLIP)
-    target = jnp.where(stick, t, target_slip)
-    q = jnp.where(stick, t / jnp.where(stick, lam, 1.0), q_slip)
     ok = (code == int(GROSS_SLIP)) | stick
-    target = jnp.where(ok, target, jnp.nan)
-    q = jnp.where(ok, q, jnp.nan)
+    target = jnp.where(ok, jnp.where(stick, t, xi + lam * q_slip), jnp.nan)
+    q = jnp.where(ok, jnp.where(stick, t / jnp.where(stick, lam, 1.0), q_slip), jnp.nan)
     # The loop starts at the reversal point (-1, -q*); the backward branch is the forward
     # one turned through 180 degrees, and it ends where the loop began.
     start_target = jnp.where(ok[..., :1], -1.0, jnp.nan)
@@ -116,7 +112,6 @@ def fretting_loop(
 def _return_map(displacement, mu, kappa, lam, length):
     """Stick/slip history in the units of ``length``: contact position and Q/P."""
     target = jnp.moveaxis(displacement / length[..., None], -1, 0)
-    batch = target.shape[1:]
 
     def step(state, d):
         xi, q = state
@@ -127,15 +122,13 @@ def _return_map(displacement, mu, kappa, lam, length):
         xi_backward, w_backward = core.slip_roots(-d, mu, kappa, lam)
         q_forward = (mu + kappa * xi_forward) / w_forward  # eq. 9, digits kept near locking
         q_backward = -(mu + kappa * xi_backward) / w_backward
-        xi_backward = -xi_backward
         q_stick = jnp.where(lam > 0.0, gap / jnp.where(lam > 0.0, lam, 1.0), q)
-        xi_new = jnp.where(forward, xi_forward, jnp.where(backward, xi_backward, xi))
+        xi_new = jnp.where(forward, xi_forward, jnp.where(backward, -xi_backward, xi))
         q_new = jnp.where(forward, q_forward, jnp.where(backward, q_backward, q_stick))
         q_new = jnp.where(jnp.isfinite(q_new), q_new, jnp.nan)
         return (xi_new, q_new), q_new
 
-    start = (jnp.zeros(batch), jnp.zeros(batch))
-    _, q = jax.lax.scan(step, start, target)
+    _, q = jax.lax.scan(step, (jnp.zeros(target.shape[1:]),) * 2, target)
     return jnp.moveaxis(q, 0, -1)
 
 
