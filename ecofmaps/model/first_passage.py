@@ -16,7 +16,6 @@ from ecofmaps.model.regimes import BEYOND_PROFILE, GROSS_SLIP, NO_GROSS_SLIP, SE
 
 __all__ = [
     "JAMMED_TRACTION",
-    "SteadyLoop",
     "draw_loop",
     "jump_areas",
     "simulation_step",

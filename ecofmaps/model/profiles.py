@@ -69,11 +69,10 @@ class ScarProfile(NamedTuple):
         Height at the centre [m] and tilt [1] of the unworn surface, in the frame of
         ``height`` and ``slope`` (0 when levelled).
     alternative_half_width : jax.Array, shape ()
-        The other plausible half-width when the edges were ambiguous or uncertain
-        (``docs/profiles.md``), else NaN. [m]
+        The other plausible half-width of ambiguous or uncertain edges, else NaN. [m]
     replaced : jax.Array, shape (N,) or ()
-        1 where the sample was an outlier (:func:`outlying_samples`) and its height was
-        interpolated, else 0; a scalar 0 when no sample was tested (the families). [1]
+        1 where an outlier's height (:func:`outlying_samples`) was interpolated, else 0; a
+        scalar 0 when no sample was tested (the families). [1]
     """
 
     position: jax.Array
@@ -293,10 +292,9 @@ def scar_profile(
 
     Parameters
     ----------
-    x : array_like, shape (N,)
-        Positions along the fretting direction, strictly increasing. [m]
-    z : array_like, shape (N,)
-        Heights, increasing upwards (the scar is a depression). [m]
+    x, z : array_like, shape (N,)
+        Positions along the fretting direction, strictly increasing, and heights, increasing
+        upwards (the scar is a depression). [m]
     half_width : float, optional
         The scar's half-width :math:`W`, overriding the detected one (the centre stays the
         detected one). [m]

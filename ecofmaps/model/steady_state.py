@@ -110,14 +110,10 @@ def _steady_quantity(quantity: str, summary: str, returns: str, equations: str):
 
     Parameters
     ----------
-    amplitude : array_like
-        Displacement amplitude imposed by the actuator, :math:`\\Delta^*`. [m]
-    load : array_like
-        Normal load :math:`P`. [N]
-    stiffness : array_like
-        Rig stiffness :math:`S`; ``numpy.inf`` for a rigid rig. [N/m]
-    mu : array_like
-        Contact coefficient of friction :math:`\\mu`. [1]
+    amplitude, load, stiffness, mu : array_like
+        Displacement amplitude imposed by the actuator :math:`\\Delta^*` [m], normal load
+        :math:`P` [N], rig stiffness :math:`S` (``numpy.inf``: a rigid rig) [N/m] and contact
+        coefficient of friction :math:`\\mu` [1].
     aspect_ratio : array_like, optional
         Groove depth over half-width :math:`z_o/x_o` of a parabolic groove (eq. 11: scar
         depth over half-width :math:`D/W`). Give this or ``profile``. [1]
