@@ -217,19 +217,6 @@ def _highest_run(x, r, outer, step, centre, reach, threshold, gap):
     return _Ridge(crest, run, width, abs(float(x[crest]) - centre), rest)
 
 
-def _narrow_pair(ridges, heights, threshold) -> bool:
-    """Whether two narrow outstanding runs are a pair of pile-up ridges, not two asperities."""
-    widths = [ridge.width for ridge in ridges]
-    distances = [ridge.distance for ridge in ridges]
-    return (
-        all(ridge.run[1] - ridge.run[0] + 1 >= _NARROW_SAMPLES for ridge in ridges)
-        and min(heights) > _NARROW_HEIGHT * threshold
-        and max(heights) < _NARROW_ALIKE * min(heights)
-        and max(widths) < _NARROW_ALIKE * min(widths)
-        and abs(distances[1] - distances[0]) < _NARROW_MIRROR * (widths[0] + widths[1])
-    )
-
-
 def _paired_ridges(x, r, sides, centre, threshold, gap):
     """The band's outer ends (indices) at a pair of pile-up ridges, or None if there is none."""
     reach = max(_RIDGE_REACH * 0.5 * (x[sides[1]] - x[sides[0]]), _RIDGE_SPAN * (x[-1] - x[0]))
@@ -243,10 +230,17 @@ def _paired_ridges(x, r, sides, centre, threshold, gap):
     if any(ridge.rest >= _RIDGE_PROMINENCE * h for ridge, h in zip(ridges, heights, strict=True)):
         return None
     distances = [ridge.distance for ridge in ridges]
-    if all(ridge.width >= gap for ridge in ridges):
+    widths = [ridge.width for ridge in ridges]
+    if all(width >= gap for width in widths):
         paired = max(distances) <= _RIDGE_PAIR * min(distances)
-    else:
-        paired = _narrow_pair(ridges, heights, threshold)
+    else:  # two narrow outstanding runs: a pair of pile-up ridges, or two asperities
+        paired = (
+            all(ridge.run[1] - ridge.run[0] + 1 >= _NARROW_SAMPLES for ridge in ridges)
+            and min(heights) > _NARROW_HEIGHT * threshold
+            and max(heights) < _NARROW_ALIKE * min(heights)
+            and max(widths) < _NARROW_ALIKE * min(widths)
+            and abs(distances[1] - distances[0]) < _NARROW_MIRROR * (widths[0] + widths[1])
+        )
     if not paired:
         return None
     return [

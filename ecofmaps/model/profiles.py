@@ -129,15 +129,6 @@ def _trace(x, z):
     return x, z
 
 
-def _neighbours(n: int, count: int) -> np.ndarray:
-    """Indices of each sample's ``2 count`` nearest other samples, shifted inwards at the ends."""
-    rows = np.arange(n)
-    start = np.clip(rows - count, 0, n - 2 * count - 1)
-    window = start[:, None] + np.arange(2 * count + 1)[None, :]
-    others = np.where(window < rows[:, None], window, window + 1)
-    return others[:, : 2 * count]
-
-
 def outlying_samples(x, z, neighbours=OUTLIER_NEIGHBOURS, threshold=OUTLIER_THRESHOLD):
     """Which samples of a trace are outliers (bool, shape (N,)): a Hampel filter (Hampel 1974)
     judging each sample by the median and scaled MAD of ``neighbours`` samples on each side
@@ -148,7 +139,11 @@ def outlying_samples(x, z, neighbours=OUTLIER_NEIGHBOURS, threshold=OUTLIER_THRE
             f"neighbours must be an integer >= 1 and less than half the {z.size} samples, "
             f"got {neighbours!r}"
         )
-    around = z[_neighbours(z.size, int(neighbours))]
+    # The 2 * neighbours samples nearest each (itself left out), shifted inwards at the ends.
+    rows, count = np.arange(z.size), int(neighbours)
+    start = np.clip(rows - count, 0, z.size - 2 * count - 1)
+    window = start[:, None] + np.arange(2 * count + 1)[None, :]
+    around = z[np.where(window < rows[:, None], window, window + 1)[:, : 2 * count]]
     median = np.median(around, axis=1)
     spread = 1.4826 * np.median(np.abs(around - median[:, None]), axis=1)
     between = z[:-2] + (z[2:] - z[:-2]) * (x[1:-1] - x[:-2]) / (x[2:] - x[:-2])
