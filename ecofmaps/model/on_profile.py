@@ -161,7 +161,7 @@ def _shared(profile, unique, group, lam, physical):
     arguments = (profile.position, profile.slope, profile.half_width)
     unique = np.pad(unique, ((0, 0), (0, -count % batch)), mode="edge")
     lam = np.asarray(lam)
-    parts, order = [], []
+    parts = []
     starts = range(0, count, batch)
     members_of = [np.flatnonzero((group >= f) & (group < f + batch)) for f in starts]
     width = _bucket(max(m.size for m in members_of))
@@ -170,10 +170,7 @@ def _shared(profile, unique, group, lam, physical):
         tables = _shared_tables(*arguments, *unique[:, first : first + batch], physical, True)
         part = _shared_loops(tables, group[padded] - first, lam[padded])
         parts.append(jax.tree.map(lambda leaf, m=members.size: leaf[:m], part))
-        order.append(members)
-    order = np.concatenate(order)
-    inverse = np.empty_like(order)
-    inverse[order] = np.arange(order.size)
+    inverse = np.argsort(np.concatenate(members_of))  # the points back in their order
     loops = jax.tree.map(lambda *leaves: jnp.concatenate(leaves)[inverse], *parts)
     dense = _shared_tables(*arguments, *unique[:, :count], physical, False)
     jumps = np.zeros(lam.size)

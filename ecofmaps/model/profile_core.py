@@ -185,9 +185,8 @@ def interval_table(lower, upper, levels: int):
     )
 
 
-def _side(position, slope, mu, sparse: bool) -> Side:
+def _side(position, slope, mu, levels: int) -> Side:
     force = traction_forward(slope, mu)
-    levels = table_levels(position.size) if sparse else 1
     return Side(position, slope, force, _intervals(position, force, levels))
 
 
@@ -196,8 +195,9 @@ def profile_tables(position, slope, mu, length, sparse: bool = True) -> Tables:
     p = position / length
     g = slope
     n = p.size
-    forward = _side(p, g, mu, sparse)
-    backward = _side(-p[::-1], -g[::-1], mu, sparse)
+    levels = table_levels(n) if sparse else 1
+    forward = _side(p, g, mu, levels)
+    backward = _side(-p[::-1], -g[::-1], mu, levels)
     step = jnp.diff(p)
     segment = step * mean_excess(g[:-1], g[1:], mu)
     segment = jnp.where(jnp.isfinite(segment), segment, 0.0)  # locked segments: never in a loop
@@ -213,7 +213,6 @@ def profile_tables(position, slope, mu, length, sparse: bool = True) -> Tables:
         falling, margin / ((1.0 + mu * mu) * jnp.where(falling, -rate, 1.0)), jnp.inf
     )
     trough = backward.force[::-1]  # -q_- at the samples, in the original order
-    levels = table_levels(n) if sparse else 1
     tables = Tables(
         forward=forward,
         backward=backward,
