@@ -264,10 +264,8 @@ def scar_profile_and_findings(
             f"{MIN_SCAR_SAMPLES} are needed: sample the trace more densely"
         )
     depth = float(-np.min(smooth[inside] - line(x[inside])))
-    edges = (centre - width, centre + width)
-    ends = np.interp(edges, x, r)
-    area_x = np.concatenate([[edges[0]], x[inside], [edges[1]]])
-    area_r = np.concatenate([[ends[0]], r[inside], [ends[1]]])
+    edges = np.array([centre - width, centre + width])  # the samples inside between them
+    area_x, area_r = np.insert(edges, 1, x[inside]), np.insert(np.interp(edges, x, r), 1, r[inside])
     worn = float(np.trapezoid(np.maximum(-area_r, 0.0), area_x))
     if level:
         height, slope, reference = z - line(x), gs - tilt, (0.0, 0.0)
