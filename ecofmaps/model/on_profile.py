@@ -54,10 +54,7 @@ def as_profile(profile) -> ScarProfile:
     if is_concrete(*profile):
         position = np.asarray(profile.position)
         if position.ndim != 1 or position.size < 3:
-            raise ValueError(
-                "profile.position must be a 1-D array of at least 3 samples (a batch of "
-                "profiles is mapped over with jax.vmap)"
-            )
+            raise ValueError("profile.position must be 1-D, >= 3 samples (jax.vmap maps a batch)")
         if profile.slope.shape != position.shape:
             raise ValueError("profile.slope must have the shape of profile.position")
         if not (np.all(np.isfinite(position)) and np.all(np.diff(position) > 0.0)):

@@ -79,12 +79,10 @@ def fretting_loop(
     Returns
     -------
     displacement, force : jax.Array of float64
-        Shape ``broadcast(inputs).shape + (2 * num + 1,)``. The loop starts at the
-        reversal :math:`(-\Delta^*, -Q^*)`, sticks up to the onset of forward slip, slips
-        to :math:`(\Delta^*, Q^*)`, sticks down, slips back and ends where it began
-        (first point = last point). It runs clockwise, so the shoelace sum
-        :math:`\oint Q\,d\Delta` is :math:`E_d > 0`. NaN when self-locking or off a
-        profile's trace. [m], [N]
+        Shape ``broadcast(inputs).shape + (2 * num + 1,)``: from the reversal
+        :math:`(-\Delta^*, -Q^*)` stick, slip to :math:`(\Delta^*, Q^*)`, stick, slip back to
+        the first point, clockwise (the shoelace sum :math:`\oint Q\,d\Delta` is
+        :math:`E_d > 0`); NaN when self-locking or off a profile's trace. [m], [N]
 
     Raises
     ------
@@ -157,9 +155,8 @@ def simulate(
         As for :func:`ecofmaps.slip_amplitude`: :math:`P` [N], :math:`S` [N/m], :math:`\mu`
         [1], and :math:`z_o/x_o` [1] or a scar ``profile``.
     groove_half_width : array_like
-        Groove half-width :math:`x_o`: required with ``aspect_ratio`` and with a profile in
-        the scaled mapping :math:`X = xW/x_o` (use the amplitude to match the steady loop
-        of :func:`ecofmaps.fretting_loop`). [m]
+        Groove half-width :math:`x_o`, required except in the physical mapping (the amplitude
+        matches the steady loop of :func:`ecofmaps.fretting_loop`). [m]
     mapping : {'scaled', 'physical'}
         On a profile: :math:`X = xW/x_o` (eq. 11) or :math:`X = x` (no ``groove_half_width``).
 
