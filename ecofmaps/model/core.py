@@ -64,15 +64,9 @@ def _positive(value):
 def valid_geometry(amplitude, load, stiffness, aspect_ratio, groove_half_width):
     """True where the SI inputs other than mu are in range (traced-input counterpart of
     :func:`checked`): all finite and > 0, stiffness may be inf, aspect ratio >= 0."""
-    return (
-        _positive(amplitude)
-        & _positive(load)
-        & (stiffness > 0.0)
-        & ~jnp.isnan(stiffness)
-        & (aspect_ratio >= 0.0)
-        & jnp.isfinite(aspect_ratio)
-        & _positive(groove_half_width)
-    )
+    rig = (stiffness > 0.0) & ~jnp.isnan(stiffness)
+    groove = (aspect_ratio >= 0.0) & jnp.isfinite(aspect_ratio) & _positive(groove_half_width)
+    return _positive(amplitude) & _positive(load) & rig & groove
 
 
 def curvature_number(length, aspect_ratio, groove_half_width):
@@ -257,8 +251,7 @@ def slip_ratio(mu, kappa, lam):
     of friction from fretting loops exhibiting non-Coulomb frictional behaviour: eq. 16.
     """
     code = regime_code(mu, kappa, lam)
-    d = slip_position(1.0, mu, kappa, lam)
-    d = jnp.where(code == int(NO_GROSS_SLIP), 0.0, d)
+    d = jnp.where(code == int(NO_GROSS_SLIP), 0.0, slip_position(1.0, mu, kappa, lam))
     return jnp.where((code == int(GROSS_SLIP)) | (code == int(NO_GROSS_SLIP)), d, jnp.nan)
 
 
