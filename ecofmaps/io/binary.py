@@ -66,8 +66,7 @@ def _hdf5_refused(path: Path, error: Exception) -> RecordingError:
 
 
 def _checked_hdf5(path: Path) -> None:
-    """Refuse a damaged file by reading every attribute with h5py (h5netcdf would raise anything
-    and print a traceback when its half-made file object is collected)."""
+    """Refuse a damaged file by reading every attribute with h5py (h5netcdf prints tracebacks)."""
 
     def visit(_name, item):
         for name in item.attrs:
@@ -172,8 +171,7 @@ def variables(path, kind: str) -> list[Variable]:
 
 
 def open_group(path, kind: str, group: str) -> xr.Dataset:
-    """The group ``group`` (``''`` for the root) of a rig file, as a lazily read Dataset
-    whose variables are named by :attr:`Variable.short`; close it after reading."""
+    """The group ``group`` (``''``: the root) of a rig file as a lazily read Dataset."""
     if kind == "tdms":
         return open_tdms_group(path, group or None)
     key = "/" + group.strip("/")
@@ -348,8 +346,7 @@ def _select(path: Path, kind: str, found: list[Variable], options: dict) -> dict
 
 
 def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None) -> Recording:
-    """A rig file as a :class:`~ecofmaps.io.recording_types.Recording` (see
-    :func:`ecofmaps.io.read_recording` for the options)."""
+    """A rig file as a Recording (options as in :func:`ecofmaps.io.read_recording`)."""
     chosen = _select(path, kind, variables(path, kind), options)
     noun = _NOUNS[kind]
     if kind == "zarr":  # zarr reads a missing chunk as its fill value: refuse a partial store

@@ -166,9 +166,8 @@ def split_unit(name: str) -> tuple[str, str | None]:
 
 
 def find_column(names, wanted: str, role: str, *, required: bool = True) -> int | None:
-    """The index among ``names`` of the column ``wanted`` (as :func:`matching_columns`), the
-    ``role`` giving synonyms and messages; None if not found and not ``required``, else a
-    :class:`ColumnError` listing the columns, or the matches and the option that chooses."""
+    """The index among ``names`` of the column ``wanted`` (as :func:`matching_columns`); None if
+    not found and not ``required``, else a :class:`ColumnError`."""
     matches = matching_columns(names, wanted, role)
     if len(matches) > 1:
         found = listed_names([names[k] for k in matches])
@@ -242,8 +241,7 @@ def _unknown_unit(names, sought, role: str) -> tuple[str, str] | None:
 
 
 def listed_names(names, quote: bool = True, count: int = 10, width: int = 40) -> str:
-    """``names`` for a message: the first ``count``, each cut to ``width`` characters
-    (quoted with ``repr`` if ``quote``), and how many more there are."""
+    """The first ``count`` of ``names``, cut to ``width`` characters, and how many more."""
     shown = [repr(name) if quote else name for name in itertools.islice(names, count)]
     text = ", ".join(name if len(name) <= width else f"{name[: width - 3]}..." for name in shown)
     more = len(names) - count

@@ -50,14 +50,13 @@ STORE_MARKERS = ("zarr.json", ".zgroup", ".zarray")
 
 
 def atomic_path(path, *, exclusive: bool = True):
-    """:func:`atomic_store` with ``overwrite=True``: a temporary path to write, renamed onto
-    ``path`` when the block succeeds.
+    """:func:`atomic_store` with ``overwrite=True`` (``exclusive=False``: a file any writer
+    may replace with the same content, a cache entry).
 
     Parameters
     ----------
     path, exclusive
-        As in :func:`atomic_store` (``exclusive=False``: a file any writer may replace with the
-        same content, a cache entry).
+        As in :func:`atomic_store`.
 
     Returns
     -------
@@ -131,7 +130,7 @@ def _sync(path: Path) -> None:
 @contextlib.contextmanager
 def atomic_store(path, *, overwrite: bool = False, exclusive: bool = True):
     """A temporary path to write a file or a directory store (zarr) at, moved onto ``path``
-    when the block succeeds.
+    when the block succeeds (flushed to disk; an old ``path`` moved aside, then removed).
 
     Parameters
     ----------
@@ -146,10 +145,9 @@ def atomic_store(path, *, overwrite: bool = False, exclusive: bool = True):
     Yields
     ------
     temporary : pathlib.Path
-        ``.<name>.<process id>.<32 hex digits>.tmp`` beside ``path``, not yet existing. On
-        success it is flushed to disk and renamed to ``path`` (an old one moved aside, then
-        removed); if the block raises, it is removed and ``path`` left as it was. A crash
-        leaves only the temporary (:data:`TEMPORARY_NAME`); the next write removes it.
+        ``.<name>.<process id>.<32 hex digits>.tmp`` beside ``path``, not yet existing;
+        removed if the block raises. A crash leaves only the temporary
+        (:data:`TEMPORARY_NAME`); the next write removes it.
 
     Raises
     ------

@@ -42,8 +42,7 @@ _SUFFIXES |= {".tdms": "tdms", ".zarr": "zarr"}
 
 
 def recording_format(path) -> str:
-    """The format of a recording: ``'text'``, ``'tdms'``, ``'hdf5'`` or ``'zarr'``, from its
-    first bytes (a directory: its zarr metadata); any other file is text.
+    """The format of a recording from its first bytes (a directory: its zarr metadata).
 
     Parameters
     ----------
@@ -52,15 +51,14 @@ def recording_format(path) -> str:
 
     Returns
     -------
-    format : str
+    format : {'text', 'tdms', 'hdf5', 'zarr'}
+        Any file not of a rig format is text.
 
     Raises
     ------
     RecordingError
         For a directory not a zarr store, a pipe, device or socket, a netCDF-3 file, or a
         file whose suffix names a rig format its content is not.
-    OSError
-        If the file cannot be read.
     """
     path = Path(path)
     if path.is_dir():
@@ -172,14 +170,13 @@ def _text_recordings(path: Path, options: dict, block_bytes, samples=None) -> It
 def _check_not_empty(path: Path, header_line: int, values: dict, columns: dict) -> None:
     for role, data in values.items():
         if not np.isfinite(data).any():
-            hint = "is it the right column?"
-            if role == "cycle":
-                hint = "cycle_column=False (--cycle-col none) reads no cycle column"
+            hint = "cycle_column=False (--cycle-col none) reads no cycle column"
             raise RecordingError(
                 path,
                 header_line,
                 f"the {role} column {columns[role]!r} holds no number: "
-                f"all its {data.size} samples are missing; {hint}",
+                f"all its {data.size} samples are missing; "
+                f"{hint if role == 'cycle' else 'is it the right column?'}",
             )
 
 
@@ -199,9 +196,8 @@ def read_recording(
     load_column=None,
     skip_rows=None,
 ) -> Recording:
-    """Read the displacement and force (and cycle) columns of a recording, in SI units.
-
-    How formats, columns and units are found: ``docs/formats.md``.
+    """Read the displacement and force (and cycle) columns of a recording, in SI units
+    (formats, columns and units: ``docs/formats.md``).
 
     Parameters
     ----------
@@ -221,7 +217,7 @@ def read_recording(
         Missing samples are NaN (:attr:`Recording.missing`), or an error naming the first.
     lazy : bool, optional
         Dask arrays (True) or NumPy arrays (False); by default lazy for a rig file of more
-        than :data:`LAZY_SAMPLES` samples. A text file is parsed into memory either way.
+        than :data:`LAZY_SAMPLES` samples (a text file is parsed into memory either way).
     chunks : int, optional
         Samples per dask block; by default a multiple of the file's own chunks near 2**22.
     block_bytes : int, optional
@@ -244,8 +240,6 @@ def read_recording(
         different lengths, a damaged file: naming the file and the line, or channel and sample.
     ValueError
         For an option of the wrong kind, naming it.
-    OSError
-        If the file cannot be read.
 
     Examples
     --------
@@ -289,8 +283,7 @@ def read_recording(
 
 
 def open_recording(path, **options) -> xr.Dataset:
-    """A recording as one xarray Dataset over ``sample`` in SI units (as
-    :meth:`Recording.to_dataset` gives it).
+    """A recording as one xarray Dataset over ``sample`` in SI units.
 
     Parameters
     ----------
@@ -300,10 +293,11 @@ def open_recording(path, **options) -> xr.Dataset:
     Returns
     -------
     dataset : xarray.Dataset
+        As :meth:`Recording.to_dataset` gives it.
 
     Raises
     ------
-    RecordingError, ValueError, OSError
+    RecordingError, ValueError
         As :func:`read_recording`.
 
     Examples
@@ -330,8 +324,7 @@ def recording_blocks(path, samples: int = 1 << 20, **options) -> Iterator[Record
     Yields
     ------
     block : Recording
-        NumPy arrays; ``block.start`` is the index of its first sample in the file, and
-        lines and errors name the file's lines. A text file's text is never held whole.
+        NumPy arrays; ``block.start`` is the index of its first sample in the file.
     """
     _check_count("samples", samples)
     block_bytes = options.pop("block_bytes", None)

@@ -39,14 +39,11 @@ def read_scar_profile(
     Parameters
     ----------
     path : str or os.PathLike
-        A text file as :func:`ecofmaps.read_recording` reads: a header line of column names,
-        then one sample per line.
+        A text file as :func:`ecofmaps.read_recording` reads (a header, a sample a line).
     x_column, z_column : str
-        The position and height columns, found as :func:`ecofmaps.read_recording` finds
-        columns (``x`` finds ``X [mm]``).
+        The position and height columns, found as by :func:`ecofmaps.read_recording`.
     x_unit, z_unit : str, optional
-        Their units of length (``'um'``, ``'mm'``, ...): by default the column name's, else
-        µm; one that disagrees with the name's is an error.
+        Their units of length (``'um'``, ``'mm'``, ...): by default the column name's, else µm.
     level, half_width, smoothing, remove_outliers
         As in :func:`ecofmaps.scar_profile` (lengths in m), but levelled by default.
 
@@ -67,8 +64,6 @@ def read_scar_profile(
         increasing, no data) or a trace that is not a usable scar: naming the file and line.
     ValueError
         For a unit that is not a length.
-    OSError
-        If the file cannot be read.
 
     Examples
     --------
@@ -91,10 +86,10 @@ def read_scar_profile(
         raise ScarProfileError(path, layout.header_line, "no data after the header")
     x, z = (np.concatenate([part[0][role] for part in parts]) for role in ("x", "z"))
     lines = np.concatenate([part[1] for part in parts])
-    typed = x / layout.scales["x"]  # the positions as the file gives them, for messages
     steps = np.diff(x)
     if np.any(steps <= 0.0):
         i = int(np.argmax(steps <= 0.0))
+        typed = x / layout.scales["x"]  # the positions as the file gives them
         kind = "repeats" if steps[i] == 0.0 else "goes back from"
         raise ScarProfileError(
             path,

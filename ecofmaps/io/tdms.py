@@ -29,8 +29,7 @@ UNIT_PROPERTIES = ("unit_string", "NI_UnitDescription")
 
 
 class _Log(logging.Handler):
-    """npTDMS's warnings in this thread: kept while a file is opened (a short last segment, a
-    text property not UTF-8), else each a warning of ecofmaps."""
+    """npTDMS's warnings in this thread: kept while a file is opened, else warned."""
 
     def __init__(self, keep: bool):
         super().__init__(logging.WARNING)
@@ -54,8 +53,7 @@ def _silenced(record) -> bool:
 
 
 class _Quiet:
-    """While npTDMS reads, its log records go to a :class:`_Log` only: not printed by npTDMS
-    itself (``[nptdms.types WARNING] ...``), nor passed on; as they were after the last read."""
+    """While npTDMS reads, its log records go to a :class:`_Log` only (not printed)."""
 
     lock, readers, propagate = threading.Lock(), 0, True
 
@@ -131,8 +129,7 @@ class TdmsReader:
 
 
 class LazyArray(BackendArray):
-    """A one-dimensional array xarray indexes lazily, ``read`` given each basic key (a tuple of
-    a slice or an index), so that only the samples asked for are read."""
+    """A one-dimensional array xarray indexes lazily, ``read`` given each basic key."""
 
     def __init__(self, read, size: int, dtype):
         self.read, self.shape, self.dtype = read, (int(size),), np.dtype(dtype)
@@ -190,8 +187,7 @@ def _group_dataset(reader: TdmsReader, group) -> xr.Dataset:
 
 
 def tdms_groups(path) -> dict[str, xr.Dataset]:
-    """Every group of a TDMS file as a lazily read Dataset by its path (``'/Rig'``; the root
-    ``'/'`` holds the file's properties), all read through one :class:`TdmsReader`."""
+    """Every group of a TDMS file as a lazily read Dataset by its path (``'/'``, ``'/Rig'``)."""
     path = Path(path)
     handle = opened_tdms(path)
     reader = TdmsReader(path, handle)  # reads through the file opened to list the groups

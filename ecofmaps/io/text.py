@@ -66,8 +66,7 @@ def _is_data(line: str) -> bool:
 
 
 def _first_bytes(path: Path, stream, compressed: bool) -> bytes:
-    """A UTF-16 file's text, read whole, as UTF-8 (else none, past a BOM); a gzipped rig file
-    refused."""
+    """A UTF-16 file's text, read whole, as UTF-8 (else none, past a BOM)."""
     head = stream.read(8)
     if compressed and head.startswith((b"TDSm", b"\x89HDF")):
         kind = "TDMS" if head.startswith(b"TDSm") else "HDF5"
@@ -91,8 +90,7 @@ def _first_bytes(path: Path, stream, compressed: bool) -> bytes:
 
 
 def _long_line(data: bytes) -> int | None:
-    """The offset of the first line longer than :data:`LINE_BYTES` (the last may go on beyond
-    ``data``), or None: it holds a whole aligned window of half that without a line end."""
+    """The offset of the first line longer than :data:`LINE_BYTES` in ``data``, or None."""
     step = LINE_BYTES // 2
     for offset in range(0, len(data) - step + 1, step):
         if data.find(b"\n", offset, offset + step) == -1:
@@ -104,9 +102,8 @@ def _long_line(data: bytes) -> int | None:
 
 
 def _line_blocks(path: Path, block_bytes: int):
-    """The file's bytes in blocks of whole lines of about ``block_bytes`` (the last may lack a
-    newline), each with the 1-based number of its first line and its number of lines; a line
-    longer than :data:`LINE_BYTES` refused."""
+    """The file's bytes in blocks of whole lines of about ``block_bytes``, each with the 1-based
+    number of its first line and its number of lines."""
     check_regular_file(path)
     rest, line = b"", 1
     with open(path, "rb") as raw:

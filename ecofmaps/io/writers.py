@@ -242,10 +242,8 @@ def convert_recording(
         Any recording :func:`ecofmaps.io.read_recording` reads.
     destination : str or os.PathLike
         The file or store to create: ``.zarr``, ``.h5``/``.nc``, ``.tdms`` or ``.csv``.
-    format, overwrite
-        As in :class:`RecordingWriter`.
-    chunk_samples : int
-        Samples per block read from ``source``, and per chunk (as in :class:`RecordingWriter`).
+    format, chunk_samples, overwrite
+        As in :class:`RecordingWriter`; ``chunk_samples`` is also the block read.
     **options
         Reading options of :func:`ecofmaps.io.read_recording` (columns, units, group,
         nan_policy).
@@ -254,14 +252,12 @@ def convert_recording(
     -------
     destination : pathlib.Path
         Samples in SI units (m, N), missing ones NaN; its attributes name the source, its
-        columns and their units. Memory stays near a few blocks, whatever the size.
+        columns and their units.
 
     Raises
     ------
     RecordingError
         For a damaged source (nothing is left at ``destination``).
-    FileExistsError
-        If ``destination`` exists and ``overwrite`` is false.
     ValueError
         If ``destination`` is ``source``, or for bad options.
     """
