@@ -266,14 +266,17 @@ def record_written(paths) -> None:
 
 
 class FileLineError(ValueError):
-    """Damaged input: the message names the file and the 1-based line number.
+    """Damaged input: the message names the file and where in it.
 
-    Attributes
+    Parameters
     ----------
-    path : pathlib.Path
-    line : int
-        1-based line number in the file (None in a :class:`~ecofmaps.io.RecordingError`
-        placed otherwise).
+    path : str or os.PathLike
+    line : int, str or None
+        The 1-based line of a text file; elsewhere a position such as ``"channel 'Rig/force',
+        sample 1200"``; None for the whole file (``position`` is ``'line 12'``, it, or ``''``;
+        the attribute ``line`` is None unless an int).
+    message : str
+        What is wrong (the attribute ``message``).
     """
 
     def __init__(self, path, line, message: str):

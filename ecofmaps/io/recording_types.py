@@ -61,17 +61,7 @@ def si_values(values: np.ndarray, factor: float) -> np.ndarray:
 
 
 class RecordingError(FileLineError):
-    """A damaged recording: the message names the file and where in it.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-    line : int, str or None
-        The 1-based line of a text file; elsewhere a position such as ``"channel 'Rig/force',
-        sample 1200"``; None for the whole file (``position`` is ``'line 12'``, it, or ``''``).
-    message : str
-        What is wrong (the attribute ``message``).
-    """
+    """A damaged recording, named as a :class:`~ecofmaps.io.FileLineError` names it."""
 
 
 class _MissingFile(FileNotFoundError):
@@ -134,15 +124,12 @@ class Recording:
     path : pathlib.Path
     displacement, force : numpy.ndarray or dask.array.Array
         [m] and [N]; NaN where a sample is missing.
-    cycle : numpy.ndarray or dask.array.Array or None
-        The cycle number of each sample, if the file has a cycle column. [1]
-    load : numpy.ndarray or dask.array.Array or None
-        The recorded normal load, if ``load_column`` was given. [N]
+    cycle, load : numpy.ndarray or dask.array.Array or None
+        The cycle number of each sample [1] and the normal load [N], if read.
     last_line : int or None
         1-based line number of the last sample, for a text file.
     columns, units : Mapping[str, str]
-        For each role read: the column, channel or variable as named in the file, and the
-        unit it was read in (``'um'``, ``'kN'``, ...).
+        For each role read: the column as named in the file, and the unit it was read in.
     start : int
         0-based index in the file of the first sample (non-zero for a block).
     format : str or None
@@ -242,17 +229,10 @@ class Recording:
         return self[:] if self.lazy else self
 
     def to_dataset(self) -> xr.Dataset:
-        """The recording as one Dataset over ``sample`` (dask-backed if lazy).
-
-        Returns
-        -------
-        dataset : xarray.Dataset
-            ``displacement`` [m], ``force`` [N] and, if read, ``cycle`` [1] and ``load`` [N],
-            each with the attributes ``units`` (SI), ``long_name``, ``source_column`` (as
-            named in the file), ``source_units`` (the unit read) and ``unit_assumed`` (1 if
-            the default unit was assumed, else 0); the Dataset's attributes ``source`` (the
-            path), ``format`` and ``first_sample`` (the index in the file of the first).
-        """
+        """The recording as one Dataset over ``sample`` (dask-backed if lazy): each role a
+        variable with ``units`` (SI), ``long_name``, ``source_column``, ``source_units`` and
+        ``unit_assumed`` (1 or 0); attributes ``source`` (the path), ``format`` and
+        ``first_sample``."""
         variables = {}
         for role, data in self.arrays().items():
             described = attrs(role) if role != "cycle" else {"long_name": "cycle number"}

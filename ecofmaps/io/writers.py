@@ -42,8 +42,7 @@ class RecordingWriter:
     cycle : bool
         Whether a ``cycle`` column (int64) is written too.
     chunk_samples : int
-        Samples per chunk (zarr, HDF5) or segment (TDMS), written a chunk at a time; a chunk
-        of zarr or HDF5 holds at most :data:`CHUNK_BYTES`, and no more than the recording.
+        Samples per chunk (zarr, HDF5; at most :data:`CHUNK_BYTES`) or segment (TDMS).
     overwrite : bool
         Replace an existing ``path`` (only once the new one is complete).
     attrs : dict, optional
