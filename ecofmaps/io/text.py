@@ -60,11 +60,6 @@ _GZIP = b"\x1f\x8b"
 _EXACT = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
 
 
-def _is_data(line: str) -> bool:
-    """Whether a line is not blank and not a ``#`` comment."""
-    return line.strip()[:1] not in ("", "#")
-
-
 def _first_bytes(path: Path, stream, compressed: bool) -> bytes:
     """A UTF-16 file's text, read whole, as UTF-8 (else none, past a BOM)."""
     head = stream.read(8)
@@ -386,7 +381,8 @@ def _head(blocks, decoder: _Decoder, options: dict) -> tuple[list[str], int | No
         check_interrupted()
         first = len(lines)
         lines += _text_lines(decoder(raw, start))
-        found = (k for k in range(max(skip or 0, first), len(lines)) if _is_data(lines[k]))
+        added = range(max(skip or 0, first), len(lines))
+        found = (k for k in added if lines[k].strip()[:1] not in ("", "#"))
         data += itertools.islice(found, needed - len(data))
         if len(data) >= needed:
             break
