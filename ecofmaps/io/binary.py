@@ -1,8 +1,5 @@
-"""Recordings in rig formats: TDMS (:mod:`ecofmaps.io.tdms`), HDF5 / netCDF-4 and zarr (through
-xarray's engines), each group a lazily read Dataset, each channel read through :class:`Column`
-range by range in SI, pickled without its open file (a dask worker reads its own blocks), any
-error naming the file, channel and samples. ``docs/formats.md`` describes the formats.
-"""
+"""Recordings in rig formats (TDMS, HDF5 / netCDF-4, zarr), each channel read range by range in
+SI through :class:`Column`, any error naming the file, channel and samples (``docs/formats.md``)."""
 
 from __future__ import annotations
 
@@ -376,23 +373,21 @@ def read_binary(path: Path, kind: str, options: dict, *, lazy=None, chunks=None)
     size = chosen["displacement"].size
     if size == 0:
         raise RecordingError(path, f"{noun} {chosen['displacement'].name!r}", "no samples")
-    lazy = size > LAZY_SAMPLES if lazy is None else lazy
-    if lazy:
+    arrays = {}
+    if lazy or (lazy is None and size > LAZY_SAMPLES):
         import dask.array as da
         from dask.base import tokenize
 
         native = max(v.chunk for v in chosen.values()) or 1
         block = int(chunks) if chunks else max(native, DEFAULT_CHUNK // native * native)
         token = tokenize(str(path.resolve()), *stamp, options, block)
-        arrays, meta = {}, np.empty(0, np.float64)
         for role, column in columns.items():
-            name = f"ecofmaps-{kind}-{role}-{token}"
+            name, meta = f"ecofmaps-{kind}-{role}-{token}", np.empty(0, np.float64)
             arrays[role] = da.from_array(
                 column, (min(block, size),), name, asarray=False, meta=meta
             )
             setattr(arrays[role], SOURCE, column)  # read directly by the tasks of an analysis
     else:
-        arrays = {}
         for role, column in columns.items():
             arrays[role] = column[0:size]
             column.close()

@@ -1,7 +1,5 @@
-"""Column names as labs write them: the unit a name carries (:func:`split_unit`), a column
-found by its name, its base or the usual names of :data:`SYNONYMS` (:func:`find_column`), and
-its factor to SI (:func:`column_scale`). The rules are in ``docs/formats.md``.
-"""
+"""Column names as labs write them: the unit a name carries, a column found by name or usual
+name (:data:`SYNONYMS`), and its factor to SI; the rules are in ``docs/formats.md``."""
 
 from __future__ import annotations
 

@@ -1,7 +1,5 @@
-"""Writing files safely (:func:`atomic_store`: beside the destination, flushed, renamed onto it;
-a manifest, :data:`MANIFEST`, of what the command line wrote in each folder), and reporting
-where a file is damaged (:class:`FileLineError`); ``docs/formats.md``.
-"""
+"""Writing files safely (:func:`atomic_store`; a :data:`MANIFEST` of what the command line
+wrote), and where a file is damaged (:class:`FileLineError`); ``docs/formats.md``."""
 
 from __future__ import annotations
 

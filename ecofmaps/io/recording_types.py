@@ -1,7 +1,5 @@
-"""A recording as read: :class:`Recording`, its samples in SI units with where each came from
-(a line of a text file, or a sample of a channel), and :class:`RecordingError`, which names
-them; :meth:`Recording.to_dataset` is the one Dataset every way in shares (``docs/formats.md``).
-"""
+"""A recording as read (:class:`Recording`, in SI, with where each sample came from) and the
+error naming that place (:class:`RecordingError`); ``docs/formats.md``."""
 
 from __future__ import annotations
 

@@ -1,7 +1,5 @@
-"""Recordings of fretting loops, text (:mod:`ecofmaps.io.text`) or rig files
-(:mod:`ecofmaps.io.binary`), read whole, in blocks or lazily, in SI units; ``docs/formats.md``
-describes the formats, columns and units.
-"""
+"""Recordings of fretting loops, text or rig files, read whole, in blocks or lazily, in SI
+units; ``docs/formats.md`` describes the formats, columns and units."""
 
 from __future__ import annotations
 

@@ -1,7 +1,5 @@
-"""Wear-scar profiles in text files: a profilometer trace across the scar, read as
-:func:`ecofmaps.read_recording` reads columns, into the model's
-:class:`~ecofmaps.model.profiles.ScarProfile` (``docs/profiles.md``).
-"""
+"""Wear-scar profiles (profilometer traces) in text files, read as recordings are, into the
+model's :class:`~ecofmaps.model.profiles.ScarProfile` (``docs/profiles.md``)."""
 
 from __future__ import annotations
 

@@ -1,7 +1,5 @@
-"""The per-cycle results of measured loops as a table, in the tribologist's units: a quantity
-``name`` in SI becomes the column ``name_<unit>`` (:mod:`ecofmaps._nomenclature`), numbers
-keep their names, the regime is written as its label.
-"""
+"""The per-cycle results of measured loops as a table in the tribologist's units (a quantity
+``name`` becomes the column ``name_<unit>``, the regime its label)."""
 
 from __future__ import annotations
 

@@ -1,7 +1,5 @@
-"""TDMS files (LabVIEW) as lazily read xarray Datasets through npTDMS, one per group, a file
-whose last segment is short refused; :class:`TdmsBackendEntrypoint` is the xarray engine
-``ecofmaps-tdms``. ``docs/formats.md`` says how channels, properties and units map.
-"""
+"""TDMS files (LabVIEW) as lazily read xarray Datasets through npTDMS, one per group, and the
+xarray engine ``ecofmaps-tdms``; ``docs/formats.md`` says how channels and units map."""
 
 from __future__ import annotations
 

@@ -1,8 +1,5 @@
-"""Recordings in text files (CSV, TSV, spreadsheet exports), read in blocks of about
-:data:`BLOCK_BYTES` cut at line ends by pandas' C parser, only the columns asked for, with each
-sample's line number for messages. What the reader accepts (preamble, separators, decimal
-comma, quotes, gzip, encodings, missing cells) is in ``docs/formats.md``.
-"""
+"""Recordings in text files (CSV, TSV, spreadsheet exports), parsed by pandas in blocks of about
+:data:`BLOCK_BYTES`, each sample with its line; what is accepted is in ``docs/formats.md``."""
 
 from __future__ import annotations
 

@@ -1,7 +1,5 @@
-"""Text recordings as the xarray engine ``ecofmaps-text``: the Dataset of
-:func:`ecofmaps.io.recordings.open_recording`, variables named as the file's columns, the file
-parsed whole (in blocks) when opened: a text file has no random access.
-"""
+"""Text recordings as the xarray engine ``ecofmaps-text`` (parsed whole when opened): the
+Dataset of :func:`~ecofmaps.io.recordings.open_recording`, variables named as its columns."""
 
 from __future__ import annotations
 

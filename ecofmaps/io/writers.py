@@ -1,7 +1,5 @@
-"""Writing recordings block by block (zarr, HDF5 / netCDF-4, TDMS, CSV) to a file or store that
-appears under its name only when complete (:func:`ecofmaps.io.files.atomic_store`), and
-converting any recording into a chunked store once, with bounded memory (``docs/formats.md``).
-"""
+"""Writing recordings block by block (zarr, HDF5 / netCDF-4, TDMS, CSV), atomically, and
+converting any recording into a chunked store with bounded memory (``docs/formats.md``)."""
 
 from __future__ import annotations
 
