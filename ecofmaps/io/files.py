@@ -135,10 +135,9 @@ def atomic_store(path, *, overwrite: bool = False, exclusive: bool = True):
     path : str or os.PathLike
         The file or directory to create; its directory must exist.
     overwrite : bool
-        Replace an existing ``path``; else an existing one is an error, before any writing.
+        Replace an existing ``path``.
     exclusive : bool
-        Whether a file ``path`` that did not exist when the block began is created
-        exclusively: if another program created it meanwhile, this result is not written.
+        Whether a file ``path`` that did not exist when the block began is created exclusively.
 
     Yields
     ------
@@ -150,8 +149,8 @@ def atomic_store(path, *, overwrite: bool = False, exclusive: bool = True):
     Raises
     ------
     FileExistsError
-        If ``path`` exists and ``overwrite`` is false, or (``exclusive``) a file ``path``
-        was created meanwhile (another run writing it).
+        If ``path`` exists and ``overwrite`` is false (before any writing), or (``exclusive``)
+        another program created it meanwhile (this result is then not written).
     IsADirectoryError
         If ``path`` is a directory that is not a store (:func:`is_store`), or a store and
         a file was written: a folder is never removed to make room.

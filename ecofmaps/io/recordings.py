@@ -202,11 +202,11 @@ def read_recording(
     path : str or os.PathLike
         A text, TDMS, HDF5 or netCDF-4 file, or a zarr store (a directory), found by content.
     displacement_column, force_column : str
-        Their columns (channels, variables), without regard to case and to a unit in the
-        name; in a text file the defaults also find :data:`ecofmaps.io.columns.SYNONYMS`.
+        Their columns (channels, variables), case and a unit in the name aside; in a text
+        file the defaults also find :data:`ecofmaps.io.columns.SYNONYMS`.
     cycle_column : str or False, optional
-        A column of cycle numbers; by default ``cycle`` if there is one; False reads none
-        (cycles are then cut at the displacement reversals).
+        A column of cycle numbers; by default ``cycle`` if any; False: none (cycles are cut
+        at the displacement reversals).
     displacement_unit, force_unit : str, optional
         Their units (``'um'``, ``'kN'``, ...); by default the file's, else µm and N.
     group : str, optional
