@@ -17,7 +17,7 @@ from xarray.core import indexing
 from ecofmaps._parallel import SOURCE
 from ecofmaps.io.columns import ColumnError, column_scale, listed_names, matching_columns
 from ecofmaps.io.recording_types import LAZY_SAMPLES, Recording, RecordingError, si_values
-from ecofmaps.io.tdms import UNIT_PROPERTIES, LazyArray, open_tdms_group, tdms_groups
+from ecofmaps.io.tdms import UNIT_PROPERTIES, LazyArray, carried_unit, open_tdms_group, tdms_groups
 
 __all__ = ["DEFAULT_CHUNK", "Column", "Variable", "open_group", "read_binary", "variables"]
 
@@ -139,14 +139,6 @@ def _zarr_groups(path: Path, key: str | None = None) -> dict[str, xr.Dataset]:
 _GROUPS = {"tdms": tdms_groups, "hdf5": _hdf5_groups, "zarr": _zarr_groups}
 
 
-def _units(attrs) -> tuple:
-    for key in UNIT_ATTRIBUTES:
-        unit = attrs.get(key)
-        if isinstance(unit, str) and unit.strip():
-            return (unit.strip(),)
-    return ()
-
-
 def variables(path, kind: str) -> list[Variable]:
     """The one-dimensional numeric channels or variables of a rig file."""
     groups = _GROUPS[kind](Path(path))
@@ -160,7 +152,8 @@ def variables(path, kind: str) -> list[Variable]:
                 chunks = item.encoding.get("chunksizes") or item.encoding.get("chunks")
                 full, size = f"{group}/{name}" if group else str(name), int(item.shape[0])
                 chunk = int(chunks[0]) if chunks else 0
-                found.append(Variable(full, group, str(name), size, _units(item.attrs), chunk))
+                units = tuple(filter(None, [carried_unit(item.attrs, UNIT_ATTRIBUTES)]))
+                found.append(Variable(full, group, str(name), size, units, chunk))
     finally:
         for dataset in groups.values():
             dataset.close()

@@ -112,13 +112,13 @@ def read_results(path) -> list[xr.Dataset]:
     if not known:
         raise ValueError(f"{path}: not a results table (none of the columns of ecofmaps loops)")
     groups = table.groupby("file", sort=False) if "file" in table else [(None, table)]
+    factor = {c: nomenclature.QUANTITIES[columns[c]].display_factor for c in known}
     found = []
     for name, rows in groups:
-        factor = {c: nomenclature.QUANTITIES[columns[c]].display_factor for c in known}
         data = {columns[c]: ("row", rows[c].to_numpy() / factor[c]) for c in known if c != "cycle"}
         results = xr.Dataset(data, attrs={} if name is None else {"file": name})
         if "cycle" in known:
-            results = results.assign_coords(cycle=("row", rows["cycle"].to_numpy()))
-            results = results.swap_dims(row="cycle")
+            cycles = ("row", rows["cycle"].to_numpy())
+            results = results.assign_coords(cycle=cycles).swap_dims(row="cycle")
         found.append(results)
     return found

@@ -160,6 +160,12 @@ class TdmsArray(LazyArray):
         return data if isinstance(index, slice) else data[0]
 
 
+def carried_unit(attrs, keys=UNIT_PROPERTIES) -> str | None:
+    """The first non-blank text among the ``keys`` of ``attrs`` (a unit), stripped, or None."""
+    units = (attrs.get(key) for key in keys)
+    return next((unit.strip() for unit in units if isinstance(unit, str) and unit.strip()), None)
+
+
 def _plain(value):
     """A property as an attribute value netCDF can hold (a time as ISO text)."""
     return value if isinstance(value, str | int | float | np.number) else str(value)
@@ -174,10 +180,8 @@ def _group_dataset(reader: TdmsReader, group) -> xr.Dataset:
         dim = "sample" if common and size == common[0][0] else f"sample_{size}"
         array = TdmsArray(reader, group.name, channel.name, size, channel.dtype)
         attrs = {key: _plain(value) for key, value in channel.properties.items()}
-        for key in UNIT_PROPERTIES:
-            unit = attrs.get(key)
-            if isinstance(unit, str) and unit.strip() and "units" not in attrs:
-                attrs["units"] = unit.strip()
+        if "units" not in attrs and (unit := carried_unit(attrs)):
+            attrs["units"] = unit
         variables[channel.name] = xr.Variable((dim,), indexing.LazilyIndexedArray(array), attrs)
     dataset = xr.Dataset(variables, attrs={k: _plain(v) for k, v in group.properties.items()})
     dataset.set_close(reader.close)

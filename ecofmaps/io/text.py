@@ -213,15 +213,13 @@ class _Layout:
         self.path, self.header_line = path, header_line
         self.separator = _separator(header)
         self.names = _header_names(header, self.separator)
-        if self.names and all(_NUMBER.match(name) for name in self.names):
-            raise RecordingError(
-                path,
-                header_line,
-                "the first line holds numbers, not column names: add a header line "
-                "(e.g. displacement,force)",
-            )
         wanted = _wanted(options)
         try:
+            if self.names and all(_NUMBER.match(name) for name in self.names):
+                raise ColumnError(
+                    "the first line holds numbers, not column names: add a header line "
+                    "(e.g. displacement,force)"
+                )
             optional = "columns" not in options and options.get("cycle_column") is None
             if optional and find_column(self.names, "cycle", "cycle", required=False) is not None:
                 wanted["cycle"] = "cycle"  # a cycle column if there is one
