@@ -182,8 +182,7 @@ class Column:
         self.arguments = (path, kind, variable, factor, nan_policy, stamp)
         self.path, self.kind, self.variable, self.factor, self.nan_policy, _ = self.arguments
         self.shape, self.dtype, self.ndim = (variable.size,), np.dtype(np.float64), 1
-        self._handle = None
-        self._lock = threading.Lock()
+        self._handle, self._lock = None, threading.Lock()
         _COLUMNS.add(self)
 
     def __reduce__(self):

@@ -265,15 +265,13 @@ def column_scale(role: str, name: str, option_unit, metadata=(), column=None) ->
     :data:`DEFAULT_UNITS` (1 for a cycle number); a :class:`ColumnError` naming ``column``."""
     if role == "cycle":
         return 1.0, "1", False
-    carried = [unit for unit in [split_unit(name)[1], *metadata] if unit is not None]
+    carried = [unit for unit in dict.fromkeys([split_unit(name)[1], *metadata]) if unit is not None]
     column = column or name
     kind = KINDS[role]
     option = f"{role}_unit"
     given = None if option_unit is None else (option_unit, _factor(option_unit, kind, option))
-    readable = [
-        (u, _factor(u, kind, None)) for u in dict.fromkeys(carried) if _unit_kind(u) == kind
-    ]
-    for unit in dict.fromkeys(carried):
+    readable = [(u, _factor(u, kind, None)) for u in carried if _unit_kind(u) == kind]
+    for unit in carried:
         if _unit_kind(unit) != kind and given is None:
             raise ColumnError(
                 f"the {role} column {column!r} is in {unit!r}, which is not a {kind} unit; "

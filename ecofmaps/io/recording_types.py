@@ -203,9 +203,7 @@ class Recording:
             import dask
 
             taken = dict(zip(taken, dask.compute(*taken.values()), strict=True))
-        last = None
-        if self.lines is not None and stop > first:
-            last = int(self.lines(self.start + stop - 1))
+        last = int(self.lines(self.start + stop - 1)) if self.lines and stop > first else None
         return dataclasses.replace(self, **taken, last_line=last, start=self.start + first)
 
     def close(self) -> None:

@@ -221,8 +221,7 @@ class RecordingWriter:
         if self.format == "zarr":
             import zarr
 
-            # Consolidated metadata lets xarray open the store without a warning; zarr
-            # notes that it is not yet part of the format-3 specification.
+            # xarray opens a consolidated store without a warning (zarr's: not in format 3 yet)
             with warnings.catch_warnings():
                 warnings.filterwarnings("ignore", "Consolidated metadata", UserWarning)
                 zarr.consolidate_metadata(str(self._temporary))
