@@ -105,8 +105,7 @@ def _plain_zarr_groups(path: Path, root) -> dict[str, xr.Dataset]:
     import zarr  # as in _zarr_root
 
     members = [("", root)] if isinstance(root, zarr.Array) else list(root.members(max_depth=None))
-    groups = {"/": {}}
-    groups.update({"/" + name: {} for name, item in members if isinstance(item, zarr.Group)})
+    groups = {"/": {}} | {"/" + name: {} for name, item in members if isinstance(item, zarr.Group)}
     lengths: list[int] = []
     for name, item in members:
         if not isinstance(item, zarr.Array) or item.ndim != 1:

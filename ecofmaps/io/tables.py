@@ -47,9 +47,8 @@ RESULT_COLUMNS = tuple(nomenclature.column(name) for name in RESULT_QUANTITIES)
 
 
 def results_table(results: xr.Dataset) -> pd.DataFrame:
-    """The per-cycle results of :func:`ecofmaps.analyze_loops` in the tribologist's units, one
-    row per cycle: the columns of :data:`RESULT_COLUMNS` it holds, in order (each explained
-    in ``docs/loops.md``)."""
+    """The per-cycle results of :func:`ecofmaps.analyze_loops` in the tribologist's units, a row
+    per cycle, in the columns of :data:`RESULT_COLUMNS` they hold (see ``docs/loops.md``)."""
     columns = {}
     for name, column in zip(RESULT_QUANTITIES, RESULT_COLUMNS, strict=True):
         if name not in results:

@@ -32,8 +32,7 @@ class _Log(logging.Handler):
     def __init__(self, keep: bool):
         super().__init__(logging.WARNING)
         self.keep, self.thread = keep, threading.get_ident()
-        self.messages: list[str] = []
-        self.undecoded = False
+        self.messages, self.undecoded = [], False
 
     def emit(self, record):
         if record.thread != self.thread:
@@ -215,8 +214,7 @@ def open_tdms_group(path, group: str | None = None) -> xr.Dataset:
 
 class TdmsBackendEntrypoint(BackendEntrypoint):
     """xarray's engine ``ecofmaps-tdms``: a TDMS group as a Dataset (channels as variables,
-    named as in the file, ``units`` from ``unit_string``/``NI_UnitDescription``, read
-    lazily through npTDMS); the whole file as a DataTree."""
+    ``units`` from :data:`UNIT_PROPERTIES`, read lazily); the whole file as a DataTree."""
 
     description = "TDMS (LabVIEW) files through npTDMS, one group a Dataset (ecofmaps)"
     open_dataset_parameters = ("filename_or_obj", "drop_variables", "group")

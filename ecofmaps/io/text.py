@@ -267,11 +267,10 @@ class _Layout:
                 self.decimal = "."
         count = numbers.size
         separator = self.separator.encode() if raw and self.separator else self.separator
-        counted = (
-            body.count(separator) == count * (self.width - 1)
-            if separator is not None
-            else len(body.split()) == count * self.width
-        )
+        if separator is None:
+            counted = len(body.split()) == count * self.width
+        else:
+            counted = body.count(separator) == count * (self.width - 1)
         if not counted:  # a line with too few or too many cells, or separators in quotes
             if not careful:
                 return None

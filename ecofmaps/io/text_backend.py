@@ -25,9 +25,8 @@ class TextBackendEntrypoint(BackendEntrypoint):
     open_dataset_parameters = ("filename_or_obj", "drop_variables", *_OPTIONS)
 
     def open_dataset(self, filename_or_obj, *, drop_variables=None, **options) -> xr.Dataset:
-        """The recording's columns (``options`` of :func:`ecofmaps.io.read_recording`, those of
-        ``open_dataset_parameters``); a :class:`RecordingError` for a damaged file or one that
-        is not text."""
+        """The recording's columns (``options``: those of ``open_dataset_parameters``, as in
+        :func:`ecofmaps.io.read_recording`); a RecordingError for a file that is not text."""
         if unknown := sorted(set(options) - set(_OPTIONS)):
             raise TypeError(f"the ecofmaps-text engine takes no option {unknown[0]!r}")
         path = engine_path(filename_or_obj, "ecofmaps-text")

@@ -241,8 +241,7 @@ def convert_recording(
     format, chunk_samples, overwrite
         As in :class:`RecordingWriter`; ``chunk_samples`` is also the block read.
     **options
-        Reading options of :func:`ecofmaps.io.read_recording` (columns, units, group,
-        nan_policy).
+        As in :func:`ecofmaps.io.read_recording` (columns, units, group, nan_policy).
 
     Returns
     -------
