@@ -146,17 +146,15 @@ class TdmsArray(LazyArray):
 
     def _read(self, key: tuple):
         (index,) = key
-        if isinstance(index, slice):
-            wanted = range(*index.indices(self.shape[0]))
-        else:
-            wanted = range(int(index), int(index) + 1)
+        single = not isinstance(index, slice)
+        wanted = range(int(index), int(index) + 1) if single else range(self.shape[0])[index]
         if not wanted:
             return np.zeros(0, self.dtype)
         low, high = min(wanted[0], wanted[-1]), max(wanted[0], wanted[-1]) + 1
         data = self.reader.samples(self.group, self.channel, low, high - low)
         if wanted.step != 1:
             data = data[np.asarray(wanted) - low]
-        return data if isinstance(index, slice) else data[0]
+        return data[0] if single else data
 
 
 def carried_unit(attrs, keys=UNIT_PROPERTIES) -> str | None:
