@@ -1,8 +1,7 @@
 """Files: atomic writers, file-and-line errors, recordings of fretting loops (text, TDMS,
-HDF5/netCDF, zarr), read whole, in blocks or lazily, or opened as one xarray Dataset
-(:func:`open_recording`), written block by block; scar profiles. TDMS and text recordings
-also open in xarray itself: ``xr.open_dataset(path, engine="ecofmaps-tdms")`` and
-``engine="ecofmaps-text"``."""
+HDF5/netCDF, zarr) read whole, in blocks, lazily or as one Dataset (:func:`open_recording`),
+written block by block; scar profiles. TDMS and text recordings also open in xarray itself:
+``xr.open_dataset(path, engine="ecofmaps-tdms")`` (or ``"ecofmaps-text"``)."""
 
 from ecofmaps._lazy import lazy_names
 

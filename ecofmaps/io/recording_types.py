@@ -231,12 +231,11 @@ class Recording:
         ``first_sample``."""
         variables = {}
         for role, data in self.arrays().items():
-            described = attrs(role) if role != "cycle" else {"long_name": "cycle number"}
             variables[role] = xr.Variable(
                 ("sample",),
                 data,
                 {
-                    **described,
+                    **attrs(role),
                     "units": SI_UNITS[role],
                     "source_column": self.columns.get(role, role),
                     "source_units": self.units.get(role, SI_UNITS[role]),

@@ -172,9 +172,8 @@ def _check_not_empty(path: Path, header_line: int, values: dict, columns: dict) 
             raise RecordingError(
                 path,
                 header_line,
-                f"the {role} column {columns[role]!r} holds no number: "
-                f"all its {data.size} samples are missing; "
-                f"{hint if role == 'cycle' else 'is it the right column?'}",
+                f"the {role} column {columns[role]!r} holds no number: all its {data.size} "
+                f"samples are missing; {hint if role == 'cycle' else 'is it the right column?'}",
             )
 
 

@@ -199,7 +199,6 @@ def tdms_groups(path) -> dict[str, xr.Dataset]:
 
 def open_tdms_group(path, group: str | None = None) -> xr.Dataset:
     """One group of a TDMS file as a lazily read Dataset (see :func:`tdms_groups`)."""
-    path = Path(path)
     groups = {name: ds for name, ds in tdms_groups(path).items() if name != "/"}
     if group is None and groups:
         return next(iter(groups.values()))
