@@ -142,9 +142,8 @@ def atomic_store(path, *, overwrite: bool = False, exclusive: bool = True):
     Yields
     ------
     temporary : pathlib.Path
-        ``.<name>.<process id>.<32 hex digits>.tmp`` beside ``path``, not yet existing;
-        removed if the block raises. A crash leaves only the temporary
-        (:data:`TEMPORARY_NAME`); the next write removes it.
+        ``.<name>.<process id>.<32 hex digits>.tmp`` beside ``path``, removed if the block
+        raises; one a crash left (:data:`TEMPORARY_NAME`) is removed by the next write.
 
     Raises
     ------
@@ -270,8 +269,7 @@ class FileLineError(ValueError):
     path : str or os.PathLike
     line : int, str or None
         The 1-based line of a text file; elsewhere a position such as ``"channel 'Rig/force',
-        sample 1200"``; None for the whole file (``position`` is ``'line 12'``, it, or ``''``;
-        the attribute ``line`` is None unless an int).
+        sample 1200"``; None for the whole file (``position`` is ``'line 12'``, it, or ``''``).
     message : str
         What is wrong (the attribute ``message``).
     """

@@ -173,8 +173,7 @@ class Recording:
         return ~functools.reduce(np.logical_and, map(np.isfinite, self.arrays().values()))
 
     def line(self, index):
-        """1-based line numbers in a text file (None for other formats) of samples ``index``
-        (int or array_like, 0-based in this recording or block)."""
+        """The 1-based lines in a text file (else None) of samples ``index`` (int or array_like)."""
         if self.lines is None:
             return None
         lines = self.lines(np.asarray(index) + self.start)
@@ -188,8 +187,7 @@ class Recording:
         return self.line(index) if self.lines is not None else f"sample {self.start + int(index)}"
 
     def error(self, message: str, index=None) -> RecordingError:
-        """A :class:`RecordingError` naming the file and the position of sample ``index`` (by
-        default the end of the file)."""
+        """A :class:`RecordingError` at sample ``index`` (by default the end of the file)."""
         return RecordingError(self.path, self.position(index), message)
 
     def __getitem__(self, key: slice) -> Recording:
@@ -207,8 +205,7 @@ class Recording:
         return dataclasses.replace(self, **taken, last_line=last, start=self.start + first)
 
     def close(self) -> None:
-        """Close the files a lazy recording reads from (a later read opens them again); also done
-        on leaving ``with read_recording(path) as recording:``."""
+        """Close the files a lazy recording reads (a later read opens them), as ``with`` does."""
         for array in self.arrays().values():
             source = getattr(array, SOURCE, None)
             if source is not None:

@@ -94,8 +94,7 @@ def _long_line(data: bytes) -> int | None:
 
 
 def _line_blocks(path: Path, block_bytes: int):
-    """The file's bytes in blocks of whole lines of about ``block_bytes``, each with the 1-based
-    number of its first line and its number of lines."""
+    """Blocks of about ``block_bytes`` of whole lines, with their first line's number and count."""
     check_regular_file(path)
     rest, line = b"", 1
     with open(path, "rb") as raw:
@@ -254,8 +253,7 @@ class _Layout:
                 )
 
     def parse(self, body, numbers: np.ndarray, lines: list[str] | None = None):
-        """The wanted columns of the data lines ``body`` (text or UTF-8), in SI, by role;
-        without their ``lines``, None for anything amiss (to be parsed again with them)."""
+        """The wanted columns of ``body`` (text or UTF-8) in SI; None if amiss and no ``lines``."""
         careful = lines is not None
         raw = isinstance(body, bytes)
         if self.decimal is None:
