@@ -110,9 +110,7 @@ def _parts_after_gaps(samples, gaps, line, band, runs):
     )
     part = part.astype(np.int64)
     first_piece = np.searchsorted(part, np.arange(begin.size))
-    centre, level = band
-    if isinstance(level, tuple):  # a local band: its centre and level where each part begins
-        centre, level = passes.level_at(centre, begin), passes.level_at(level, begin)
+    centre, level = (passes.level_at(v, begin) for v in band)  # where each part begins
     own = kind[run_of]
     decided = np.where(
         own > 0,
@@ -121,8 +119,10 @@ def _parts_after_gaps(samples, gaps, line, band, runs):
     )
     # A part that decides nothing (inside the band) joins the part before it in its run,
     # or the one after it if it comes first.
-    before = np.concatenate([[False], run_of[1:] == run_of[:-1]])
-    new_group = ~before | (decided & _decided_earlier_in_run(decided, run_of))
+    first = np.concatenate([[True], run_of[1:] != run_of[:-1]])
+    count = np.cumsum(decided) - decided  # the parts before that decided their run's kind
+    at_first = count[np.maximum.accumulate(np.where(first, np.arange(first.size), 0))]
+    new_group = first | (decided & (count > at_first))
     first_part = np.flatnonzero(new_group)
     piece_group = (np.cumsum(new_group) - 1)[part]
     group_extreme, group_value = _run_extremes(
@@ -146,23 +146,6 @@ def _run_extremes(run, first, rising, pieces):
         passes.first_of_runs(run, lowest, bottom, low),
     )
     return extreme.astype(np.int64), np.where(rising, high, low)
-
-
-def _decided_earlier_in_run(decided, run_of):
-    """For each part, whether a part before it in the same run decided its kind."""
-    count = np.cumsum(decided) - decided
-    first = np.concatenate([[True], run_of[1:] != run_of[:-1]])
-    at_first = count[np.maximum.accumulate(np.where(first, np.arange(first.size), 0))]
-    return count > at_first
-
-
-def _half_period(kind, extreme) -> float:
-    """The lesser of the median distances from a top reversal to the next bottom and back."""
-    gone = np.diff(extreme)
-    falling, rising = gone[kind[:-1] > 0], gone[kind[:-1] < 0]
-    if not (falling.size and rising.size):
-        return np.nan
-    return float(min(np.median(falling), np.median(rising)))
 
 
 def _period(starts, kind) -> float:
@@ -416,7 +399,9 @@ def _split(samples: Samples, hysteresis: float) -> Cycles:
     period = _period(starts, kind)
     # every other cycle under the band: the bottom runs two periods apart, half a period
     # from a top to the next bottom (or back) still
-    half = _half_period(kind, extreme)
+    gone = np.diff(extreme)
+    falling, rising = gone[kind[:-1] > 0], gone[kind[:-1] < 0]
+    half = min(np.median(falling), np.median(rising)) if falling.size and rising.size else np.nan
     step = 2 if 2 * half < 0.75 * period else 1
     runs = (starts, kind, period / step, step)
     level = _local_level(samples, gaps, line, runs, hysteresis, band)
@@ -492,15 +477,12 @@ def _labelled(samples: Samples) -> Cycles:
     run = np.cumsum(new) - 1
     starts = piece_start[first_piece].astype(np.int64)
     count = np.add.reduceat(size, first_piece).astype(np.int64)
-    top = np.fmax.reduceat(highest, first_piece)
-    floor = np.fmin.reduceat(lowest, first_piece)
+    top, floor = np.fmax.reduceat(highest, first_piece), np.fmin.reduceat(lowest, first_piece)
     lowest_at = passes.first_of_runs(run, lowest, bottom, floor)
     valued = np.isfinite(x_first)
     begin = passes.ends_of_runs(run, valued, x_first, starts.size, first=True)
     end = passes.ends_of_runs(run, valued, x_last, starts.size, first=False)
-    largest = np.fmax.reduceat(step, first_piece)
-    stroke = top - floor
-    gap = np.abs(end - begin)
+    largest, stroke, gap = np.fmax.reduceat(step, first_piece), top - floor, np.abs(end - begin)
     typical = np.nanmedian(stroke) if np.isfinite(floor).any() else np.nan
     # A cycle with missing samples is kept whatever its shape: skipped as missing, not dropped.
     gapped = passes.missing_in(gaps, starts, count) if gaps.size else False

@@ -15,6 +15,7 @@ from ecofmaps.measured import kernels
 from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles, loop_points
 from ecofmaps.measured.quality import (
     ANTICLOCKWISE_SHARE,
+    GICOF,
     NOISE_SHARE,
     READING_REASONS,
     REASONS,
@@ -71,11 +72,7 @@ _PER_CYCLE = (
     "cof_max",
     "energy_ratio",
     "stiffness",
-    "gicof",
-    "gicof_forward",
-    "gicof_backward",
-    "crossing_displacement_forward",
-    "crossing_displacement_backward",
+    *GICOF,
     "displacement_offset",
     "force_offset",
     "force_drift_se",
@@ -171,7 +168,7 @@ def loop_blocks(
         around = slice(max(lower - 1, 0), upper + 1)
         x = displacement[low:high] - _drift(low, high, middle, centre_x, around)
         if ready < needed:
-            cut, q = slice(ready, needed), _signed(force[low:high], force_sign)
+            cut, q = slice(ready, needed), force_sign * force[low:high]
             centre_q[cut] = _path_means(x, q, start[cut] - low, count[cut], closed=False)
             ready = needed
         a, b = int(start[block.start]), int(start[block.stop - 1] + count[block.stop - 1])
@@ -181,7 +178,7 @@ def loop_blocks(
         yield LoopBlock(
             rows=slice(int(kept[block.start]), int(kept[block.stop - 1]) + 1),
             displacement=x[a - low : b - low],
-            force=_signed(force[a:b], force_sign) - _drift(a, b, middle, centre_q, near),
+            force=force_sign * force[a:b] - _drift(a, b, middle, centre_q, near),
             offset=offset,
             count=count[block],
             rotation=cycles.rotation[kept[block]],
@@ -219,17 +216,12 @@ def _whole_blocks(cycles: Cycles, kept, begin: int, end: int) -> Iterator[slice]
         yield from _blocks(cycles.count[kept[a:b]] + 1, a)
 
 
-def _signed(values, sign):
-    """``values``, or ``-values`` if ``sign`` is negative."""
-    return values if sign > 0 else -values
-
-
 def _labelled_block(cycles: Cycles, displacement, force, block, sign) -> LoopBlock:
     """The loops of consecutive labelled cycles (rows ``block``), each by its own centre."""
     start, count = cycles.start[block], cycles.count[block]
     offset = np.concatenate([[0], np.cumsum(count[:-1])])
     index = np.repeat(start - offset, count) + np.arange(int(count.sum()))
-    x, q = displacement[index], _signed(force[index], sign)
+    x, q = displacement[index], sign * force[index]
     swing = kernels.stretch_ranges(q, offset, count)
     centre_x = _path_means(x, x, offset, count, closed=True)
     x -= np.repeat(centre_x, count)
@@ -292,16 +284,13 @@ def _drift(low: int, high: int, points, values, near: slice):
     result = np.interp(at, points[near], values[near])
     if points.size < 2:
         return result
-    if near.start == 0:
-        before = at < points[0]
-        result[before] = values[0] + (at[before] - points[0]) * (values[1] - values[0]) / (
-            points[1] - points[0]
-        )
-    if near.stop >= points.size:
-        beyond = at > points[-1]
-        result[beyond] = values[-1] + (at[beyond] - points[-1]) * (values[-1] - values[-2]) / (
-            points[-1] - points[-2]
-        )
+    for end, inner, beyond, extrapolated in (
+        (0, 1, at < points[0], near.start == 0),
+        (-1, -2, at > points[-1], near.stop >= points.size),
+    ):
+        if extrapolated:
+            step = (at[beyond] - points[end]) * (values[inner] - values[end])
+            result[beyond] = values[end] + step / (points[inner] - points[end])
     return result
 
 

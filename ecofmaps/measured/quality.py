@@ -20,6 +20,7 @@ __all__ = [
     "ALL",
     "ANTICLOCKWISE_SHARE",
     "COMPRESSION",
+    "GICOF",
     "LOAD_SCALED",
     "LOAD_SWING",
     "NOISE_SHARE",
@@ -93,7 +94,7 @@ _COMMENTS = {
     "quality": "'ok' or the reasons for NaN, joined by '+' (ecofmaps.measured.quality)",
 }
 #: The GICoF and the crossings it is read at; the slip and what it gives.
-_GICOF = (
+GICOF = (
     "gicof",
     "gicof_forward",
     "gicof_backward",
@@ -107,10 +108,7 @@ RESOLVED = ("mu_resolved", "mu_resolved_se", "aspect_ratio")
 #: Every reason a cycle can be flagged for, in the order they are listed in ``quality``:
 #: name -> (what it means, the quantities it leaves NaN).
 REASONS = {
-    "missing-samples": (
-        "the cycle holds a missing sample (NaN or an empty cell): skipped, not analysed",
-        ALL,
-    ),
+    "missing-samples": ("a missing sample (NaN or an empty cell): skipped, not analysed", ALL),
     "no-reversal": (
         "no reversal where the drive's period puts this cycle: smaller than the reversal "
         f"detector's least band ({LEAST_LEVEL * 100:g} % of the whole recording's, and "
@@ -126,16 +124,14 @@ REASONS = {
     "few-samples": (f"fewer than {MIN_SAMPLES} samples in the cycle, fewer than a loop needs", ALL),
     "constant-force": ("the force does not vary over the cycle (a dead channel)", ALL),
     "implausible-amplitude": (
-        f"the displacement amplitude is below {AMPLITUDE_RANGE[0] * 1e6:g} µm or above "
-        f"{AMPLITUDE_RANGE[1] * 1e3:g} mm: the displacement is not in the unit assumed (a "
-        "column without a unit is read in µm)",
+        f"the displacement amplitude is outside {_AMPLITUDES}: the displacement is not in the "
+        "unit assumed (a column without a unit is read in µm)",
         ALL,
     ),
     "noise-amplitude": (
-        "the displacement or force amplitude does not stand clear of the noise: the highest "
-        "that the noise of the cycle's n samples is expected to lift an extreme, σ√(2 ln n) "
-        "(σ from the second differences), exceeds "
-        f"{NOISE_SHARE * 100:g} % of half the peak-to-peak, which reads the amplitude too large",
+        "the displacement or force amplitude does not stand clear of the noise: σ√(2 ln n), the "
+        "most the noise of n samples is expected to lift an extreme (σ from second differences), "
+        f"exceeds {NOISE_SHARE * 100:g} % of half the peak-to-peak (read too large)",
         ALL,
     ),
     "several-loops": (
@@ -156,10 +152,7 @@ REASONS = {
         f"{UNEXPLAINED_SHARE * 100:g} % of the displacement's variance along them unexplained",
         ALL,
     ),
-    "no-zero-crossing": (
-        "a branch does not cross zero force between its measured samples: no loop",
-        ALL,
-    ),
+    "no-zero-crossing": ("a branch does not cross Q = 0 between measured samples: no loop", ALL),
     "negative-area": (
         f"no area within the noise (-{ANTICLOCKWISE_SHARE * 100:g} % of 4Δ*Q* < area < 0)",
         ("dissipated_energy", "energy_ratio", "ecof"),
@@ -167,7 +160,7 @@ REASONS = {
     "negative-slip": ("δ* <= 0: the zero-force crossings in the wrong order", _SLIP),
     "curved-stick": (
         "the stick sides are curved (a polymer, micro-slip): no straight line gives S",
-        ("stiffness", *_GICOF, *RESOLVED),
+        ("stiffness", *GICOF, *RESOLVED),
     ),
     "curved-stick-sliding": (
         "the stick sides are curved (a sphere's Mindlin stick, micro-slip) but the loop slides "
@@ -182,12 +175,12 @@ REASONS = {
     "no-crossing": (
         "a branch's crossing with Q = SΔ is not on the measured loop (between its samples, "
         "within their force range)",
-        _GICOF,
+        GICOF,
     ),
     "implausible-cof": (
         f"a coefficient of friction outside {COF_RANGE[0]:g} to {COF_RANGE[1]:g} (the ECoF or "
         "GICoF in gross slip): the load given or the force's unit is wrong, not the contact",
-        ("ecof", "cof_max", *_GICOF, *RESOLVED),
+        ("ecof", "cof_max", *GICOF, *RESOLVED),
     ),
     "load-swing": (
         f"the recorded normal load swings by more than {LOAD_SWING * 100:g} % of its mean "
@@ -197,7 +190,7 @@ REASONS = {
     "partial-slip": (
         "partial slip: the energy ratio A is not above the threshold; the contact slips only "
         "at its edges, and Q*/P (cof_max, kept) is a lower bound of μ",
-        ("ecof", *_GICOF, *RESOLVED),
+        ("ecof", *GICOF, *RESOLVED),
     ),
     "stiffness-mismatch": (
         "the stiffness does not fit the stick sides: a given S tilts them beyond the noise, "
@@ -225,7 +218,7 @@ REASONS = {
         f"{SCATTER_BLOCKS} blocks of the central part scatter about a straight line by more "
         f"than {GICOF_WIGGLE * 100:g} % of μ: chatter): the GICoF, read at one position, is "
         "not the contact's mean friction",
-        _GICOF,
+        GICOF,
     ),
 }
 

@@ -155,10 +155,9 @@ def _tails(start, stop, arguments, x):
 
 
 def level_at(level, samples):
-    """The trigger's half-band (or centre) at ``samples`` [m] when it is local: ``level =
-    (width, levels)``, one level per stretch of ``width`` samples counted from sample 0."""
-    width, levels = level
-    return levels[samples // width]
+    """The trigger's half-band (or centre) at ``samples`` [m]: ``level``, or if it is local,
+    ``(width, levels)``, one level per stretch of ``width`` samples counted from sample 0."""
+    return level[1][samples // level[0]] if isinstance(level, tuple) else level
 
 
 def local_extremes(start, stop, arguments, x):
@@ -190,8 +189,7 @@ def trigger_runs(start, stop, arguments, x):
     for a, b in _chunks(start, stop, chunk):
         xa = _blanked(x[a - start : b - start], a, b, gaps)
         d = detrended(xa, a, line)
-        level = level_at(band, np.arange(a, b)) if isinstance(band, tuple) else band
-        middle = level_at(centre, np.arange(a, b)) if isinstance(centre, tuple) else centre
+        level, middle = (level_at(v, np.arange(a, b)) for v in (band, centre))
         state = (d > middle + level).view(np.int8) - (d < middle - level).view(np.int8)
         entry = np.concatenate([[0], np.flatnonzero(state[1:] != state[:-1]) + 1])
         kind = state[entry]
