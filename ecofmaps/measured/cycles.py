@@ -1,7 +1,6 @@
 r"""Step 2 of the loop pipeline: the cycles of a recording (at the displacement reversals, or by
 its cycle numbers), found by passes a block at a time, and the runs of missing samples.
-The method is explained in ``docs/method-loops.md`` ("Finding the cycles").
-"""
+The method is explained in ``docs/method-loops.md`` ("Finding the cycles")."""
 
 from __future__ import annotations
 
@@ -29,8 +28,7 @@ _REGULAR = 0.1
 _STEP = 0.05
 #: A recording longer than this with fewer than two bottom reversals is not read as one loop.
 _ONE_LOOP = 1 << 24
-#: Share of the stroke within which two displacements are one (a loop's ends, an extreme and
-#: the sample beside a gap).
+#: Share of the stroke within which two displacements are one (a loop's ends, beside a gap).
 _TOLERANCE = 0.01
 
 
@@ -104,10 +102,8 @@ def _parts_after_gaps(samples, gaps, line, band, runs):
     affected = np.isin(part_run, part_run[np.isin(part_start, cut)])
     begin, run_of = part_start[affected], part_run[affected]
     end = np.append(part_start, samples.size)[1:][affected]
-    arguments = (passes._CHUNK, gaps, line, begin, end)
-    part, highest, top, lowest, bottom, most, least = _joined(
-        samples, passes.part_extremes, arguments
-    )
+    found = _joined(samples, passes.part_extremes, (passes._CHUNK, gaps, line, begin, end))
+    part, highest, top, lowest, bottom, most, least = found
     part = part.astype(np.int64)
     first_piece = np.searchsorted(part, np.arange(begin.size))
     centre, level = (passes.level_at(v, begin) for v in band)  # where each part begins
@@ -117,8 +113,7 @@ def _parts_after_gaps(samples, gaps, line, band, runs):
         np.fmax.reduceat(most, first_piece) > centre + level,
         np.fmin.reduceat(least, first_piece) < centre - level,
     )
-    # A part that decides nothing (inside the band) joins the part before it in its run,
-    # or the one after it if it comes first.
+    # A part inside the band joins the one before it in its run (after it, if it comes first).
     first = np.concatenate([[True], run_of[1:] != run_of[:-1]])
     count = np.cumsum(decided) - decided  # the parts before that decided their run's kind
     at_first = count[np.maximum.accumulate(np.where(first, np.arange(first.size), 0))]
@@ -291,12 +286,10 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
         return None
     width = max(int(period) // 2, MIN_SAMPLES)
     sine = (centre, 4.0 * np.sin(np.pi / period) ** 2)  # Δ²x = -4 sin²(π/T) x
-    arguments = (passes._CHUNK, gaps, line, width, sine)
-    found = _joined(samples, passes.local_extremes, arguments)
+    found = _joined(samples, passes.local_extremes, (passes._CHUNK, gaps, line, width, sine))
     stretch, highest, lowest, finite, rough, counted = found
     first = np.flatnonzero(np.diff(stretch, prepend=-1.0))
     # the noise: the median stretch's mean absolute second difference less a sine's own
-    # (white noise's is √6 σ)
     rough, counted = np.add.reduceat(rough, first), np.add.reduceat(counted, first)
     noise = np.nanmedian(np.where(counted > 0, rough / np.maximum(counted, 1), np.nan))
     least = max(LEAST_LEVEL * level, NOISE_LEVEL * noise / _MEAN_SECOND_DIFFERENCE)
@@ -428,8 +421,7 @@ def _split(samples: Samples, hysteresis: float) -> Cycles:
         accepted &= _deep_ends(parts[3], accepted)
     bottoms = extreme_of_part[(kind_of_part < 0) & accepted]
     if bottoms.size < 2:
-        # Not two bottom reversals: the recording may still be one closed loop that starts
-        # and ends elsewhere on the loop.
+        # Not two bottom reversals: the recording may still be one loop, begun anywhere on it.
         if n > _ONE_LOOP:
             raise ValueError(
                 f"no complete cycle in {n} samples: fewer than two displacement reversals"
@@ -440,8 +432,7 @@ def _split(samples: Samples, hysteresis: float) -> Cycles:
         tops = extreme_of_part[(kind_of_part > 0) & accepted]
         found = _drive_cycles(bottoms, tops, n, float(np.median(np.diff(bottoms))))
         return _drive_numbers(_with_missing(found, gaps), merged=True)
-    # Each loop runs from its bottom reversal to the next and back to its first sample, so
-    # it is closed even if the displacement drifted in between.
+    # Each loop runs from its bottom reversal to the next and back, closed despite a drift.
     start = bottoms[:-1]
     leading, trailing = int(bottoms[0]), int(n - 1 - bottoms[-1])
     cycles = Cycles(

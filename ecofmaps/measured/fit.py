@@ -164,27 +164,24 @@ def _starting_values(x, y, rising, analysis, length, load):
 
 @float64
 def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hysteresis=0.5):
-    r"""Fit the model's steady loop to a measured fretting loop (the paper's Figure 10).
+    r"""Fit the model's steady loop to a measured fretting loop (the paper's Figure 10), by the
+    method of ``docs/method-loops.md`` ("Fitting the model's loop").
 
     Parameters
     ----------
     displacement : array_like
-        Applied displacement :math:`\Delta` at each sample, in time order: a single loop
-        (about one period, starting anywhere on it) or a recording of many cycles. [m]
+        Applied displacement :math:`\Delta` at each sample, in time order: one loop (starting
+        anywhere on it) or a recording of many cycles. [m]
     force : array_like
-        Tangential force :math:`Q` at each sample, positive in the direction of positive
-        displacement. [N]
+        Tangential force :math:`Q` at each sample, positive along positive displacement. [N]
     load : float
         Normal load :math:`P`. [N]
     cycle : array_like, optional
-        Cycle number of each sample, as for :func:`ecofmaps.analyze_loops`; without it
-        the recording is cut at its displacement reversals, or read as a single loop. [1]
+        Cycle number of each sample, as in :func:`ecofmaps.analyze_loops`. [1]
     cycle_number : int, optional
-        The cycle to fit, a value of the ``cycle`` coordinate of
-        :func:`ecofmaps.analyze_loops`'s result; default the last complete cycle. [1]
+        The ``cycle`` of :func:`ecofmaps.analyze_loops`'s result to fit; default the last. [1]
     hysteresis : float
-        Band of the reversal detector, as a share of the displacement's half-range
-        (0 < hysteresis < 1); see :mod:`ecofmaps.measured.cycles`. [1]
+        The reversal detector's band, as in :func:`ecofmaps.analyze_loops`. [1]
 
     Returns
     -------
@@ -194,16 +191,11 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
     Raises
     ------
     ValueError
-        If ``load`` is not a positive finite number; the arrays are not one-dimensional of
-        one length, or hold NaN or infinity; the recording has no complete cycle, or none
-        numbered ``cycle_number``; the cycle has fewer than :data:`MIN_SAMPLES` samples;
-        or the loop shows no gross slip, runs anticlockwise, has vertical stick segments
-        (a rigid rig), or is refused by the checks of :func:`ecofmaps.analyze_loops`
-        (:mod:`ecofmaps.measured.quality`).
-
-    Notes
-    -----
-    The method is explained in ``docs/method-loops.md`` ("Fitting the model's loop").
+        If ``load`` is not positive and finite; the arrays are not one-dimensional of one
+        length, or not finite; there is no complete cycle (numbered ``cycle_number``) of
+        :data:`MIN_SAMPLES` samples; or the loop shows no gross slip, runs anticlockwise, has
+        vertical stick segments (a rigid rig), or is refused by the checks of
+        :func:`ecofmaps.analyze_loops`.
 
     References
     ----------
@@ -213,8 +205,7 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
     """
     load, all_x, all_y = _checked_samples(displacement, force, load, hysteresis)
     index, number, analysis = _measured_cycle(all_x, all_y, load, cycle, cycle_number, hysteresis)
-    # The last point closes the loop (it is the first point of the next cycle, or the
-    # first point again): fit each sample once.
+    # The last point closes the loop (the next cycle's first, or the first again): fit it once.
     x, y = all_x[index[:-1]], all_y[index[:-1]]
     if x.size < MIN_SAMPLES:
         raise ValueError(f"a loop needs at least {MIN_SAMPLES} samples, got {x.size}")
@@ -321,8 +312,7 @@ def _measured_cycle(all_x, all_y, load, cycle, cycle_number, hysteresis):
 
 def _solution(scaled_x, scaled_y, rising, start):
     """The least-squares fit of the model's loop to the scaled samples (scipy's result)."""
-    # Padded with zero-weight samples to a multiple of _BUCKET, so that loops of nearly the
-    # same length share one compiled residual and Jacobian.
+    # Padded with zero-weight samples so that loops of about one length share the compiled code.
     pad = -scaled_x.size % _BUCKET
     arguments = tuple(
         jnp.asarray(np.pad(values, (0, pad)))

@@ -228,21 +228,12 @@ def zero_force_crossings(x, y, length, band, intercept, across, rounding):
 
 
 @numba.njit(**_COMPILE)
-def _curve_intercept(scaled, product, window, y, n):
+def _curve_intercept(scaled, product, window, y, n, sums):
     r"""Intercept :math:`a` of :math:`Q = a + b\xi + c\xi Q` through the window, and its count."""
-    count, sum_s, sum_z, sum_q = 0.0, 0.0, 0.0, 0.0
-    for j in range(n):
-        if window[j]:
-            count += 1.0
-            sum_s += scaled[j]
-            sum_z += product[j]
-            sum_q += y[j]
-    mean_s, mean_z, mean_q = sum_s / count, sum_z / count, sum_q / count
-    ss, sz, zz, sq = 0.0, 0.0, 0.0, 0.0
-    for j in range(n):
-        if window[j]:
-            ds, dz, dq = scaled[j] - mean_s, product[j] - mean_z, y[j] - mean_q
-            ss, sz, zz, sq = ss + ds * ds, sz + ds * dz, zz + dz * dz, sq + ds * dq
+    _line_sums(scaled, product, n, window, sums[0])
+    _line_sums(scaled, y, n, window, sums[1])
+    count, mean_s, mean_z, sz, ss, zz = sums[0]
+    mean_q, sq = sums[1, 2], sums[1, 3]
     ratio = sz / ss
     rr, rq = 0.0, 0.0
     for j in range(n):
@@ -276,6 +267,7 @@ def line_crossings(x, y, length, compliance, half_width, load, rounding):
     force, on_loop = np.empty(rows), np.zeros(rows, np.bool_)
     scaled, product = np.empty(width), np.empty(width)
     window, before = np.zeros(width, np.bool_), np.zeros(width, np.bool_)
+    sums = np.empty((2, 6))
     for r in range(rows):
         n, rising, h = length[r], r < rows // 2, half_width[r]
         count = 0
@@ -294,7 +286,7 @@ def line_crossings(x, y, length, compliance, half_width, load, rounding):
         v1 = x[r, after] - y[r, after] * compliance[r]
         q0, q1 = y[r, previous], y[r, after]
         share = v0 / (v0 - v1) if v0 - v1 != 0.0 else 0.5
-        intercept, fitted = _curve_intercept(scaled, product, window, y[r], n)
+        intercept, fitted = _curve_intercept(scaled, product, window, y[r], n, sums)
         # On the loop: the fitted window, or the pair interpolated between, holds samples
         # on both sides of ξ = 0, and the crossing's force lies within theirs.
         fits = fitted >= _FIT_SAMPLES
@@ -339,9 +331,8 @@ def path_means(path, values, offset, count, closed):
 
 @numba.njit(**_COMPILE)
 def second_difference_medians(values, first, stop, reach):
-    """The median of the finite :math:`|v_{j-1} - 2v_j + v_{j+1}|` over
-    :math:`|j - i| < ` ``reach`` (``1 <= j <= values.size - 2``), for each ``i`` from
-    ``first`` to ``stop - 1``; NaN where there is none (in the unit of ``values``)."""
+    """Per ``i`` from ``first`` to ``stop - 1``, the median of the finite :math:`|v_{j-1} - 2v_j
+    + v_{j+1}|` over :math:`|j - i| <` ``reach`` within the values, or NaN."""
     result = np.empty(stop - first)
     window = np.empty(2 * reach - 1)
     for i in range(first, stop):
@@ -366,8 +357,7 @@ def second_difference_medians(values, first, stop, reach):
 
 @numba.njit(**_COMPILE)
 def stretch_ranges(values, offset, count):
-    """Largest less smallest of ``values`` over each stretch ``offset``, ``count`` (in the
-    unit of ``values``)."""
+    """Largest less smallest of ``values`` over each stretch ``offset``, ``count``."""
     ranges = np.empty(offset.size)
     for k in range(offset.size):
         highest = lowest = values[offset[k]]
@@ -415,8 +405,7 @@ def loop_measures(x, y, offset, count, rotation):
 
 @numba.njit(**_COMPILE)
 def _fitted_peak(values, first, n, at, span, sign):
-    """How far the parabola fitted to ``sign`` times the loop's samples round its sample ``at``
-    lies below that sample there (docs/method-loops.md, "The quantities, per cycle")."""
+    """How far below ``sign`` times the loop's sample ``at`` the parabola fitted round it lies."""
     reach, eighth = n // 4, n // 8
     half = max(reach, eighth + 3)
     near = np.empty(2 * half + 1)  # sign times the samples at + j, the loop taken as closed
@@ -467,9 +456,8 @@ def _fitted_peak(values, first, n, at, span, sign):
 
 @numba.njit(**_COMPILE)
 def fitted_extremes(values, offset, count, least):
-    r"""Highest and lowest of each loop of ``count`` samples from ``offset``: the samples',
-    or, where white noise lifts them (``least`` samples or more), the values there of
-    parabolas fitted round them (:func:`_fitted_peak`; docs/method-loops.md). [m] or [N]"""
+    """Highest and lowest of each loop: the samples', or from ``least`` samples on, the fitted
+    parabolas' there (through the noise; docs/method-loops.md). [m] or [N]"""
     highest, lowest = np.empty(offset.size), np.empty(offset.size)
     for k in range(offset.size):
         first, n = offset[k], count[k]
@@ -497,8 +485,7 @@ def detrended(x, first, mean, mean_t, slope, middle):
 
 @numba.njit(**_COMPILE)
 def branch_stretches(values, start, end, length, width):
-    """Rows of ``width`` points: ``length - 1`` samples of ``values`` from ``start`` on,
-    then ``values[end]`` (a branch's last point) repeated to the row's end."""
+    """Rows of ``width``: ``length - 1`` samples from ``start`` on, then ``values[end]``."""
     rows = np.empty((start.size, width))
     for r in range(start.size):
         for j in range(length[r] - 1):

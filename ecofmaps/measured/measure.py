@@ -46,14 +46,12 @@ NEIGHBOURS = _NOISE_REACH + 1
 SECOND_DIFFERENCE = 0.6744897501960817 * np.sqrt(6.0)
 #: The same of its lower quartile.
 _QUARTILE_SECOND_DIFFERENCE = 0.3186393639643752 * np.sqrt(6.0)
-#: Fewest samples of a cycle whose noise is read from its second differences (in fewer, a
-#: loop's corners are most of them).
+#: Fewest samples of a cycle whose noise is read from its second differences (not its corners).
 _NOISE_SAMPLES = 4 * MIN_SAMPLES
 #: Fewest samples of a cycle whose extremes are read through its noise: in fewer, the
 #: parabola round a peak follows its few samples' shape more than it averages the noise.
 _EXTREME_SAMPLES = 8 * MIN_SAMPLES
-#: Energy ratio :math:`A = E_d/(4\Delta^* Q^*)` above which a loop is gross slip (the
-#: sliding transition of Fouvry, Kapsa and Vincent).
+#: Energy ratio :math:`A = E_d/(4\Delta^* Q^*)` above which a loop is gross slip (Fouvry et al.).
 GROSS_SLIP_THRESHOLD = 0.2
 #: The ratios of :func:`loop_ratios` reported when the rig's stiffness is given.
 _RIG_RATIOS = (
@@ -93,8 +91,7 @@ _PLATEAU = 0.02
 #: samples a branch.
 _MINDLIN_STICK, _MINDLIN_SHARE, _MINDLIN_T = 0.9, 0.05, 5.0
 _MINDLIN_SPREAD, _MINDLIN_ROUNDING, _MINDLIN_SLIDING, _MINDLIN_SIFT = 3.0, 1e-3, 3, 32
-#: Samples with :math:`|Q|` below this share of :math:`Q^*` locate a zero-force crossing
-#: that is not on a stick segment.
+#: Samples with :math:`|Q|` below this share of :math:`Q^*` locate a crossing off the stick.
 _ZERO_FORCE_BAND = 0.25
 
 
@@ -371,8 +368,7 @@ def _loop_values(block, options):
     flags = {
         "few-samples": block.count < MIN_SAMPLES,
         "constant-force": ~(block.force_swing > 0.0),
-        # A cycle cut at the reversals cannot turn back by more than the band: that
-        # would have been a reversal.
+        # A cycle cut at the reversals cannot turn back by more than the band (a reversal).
         "several-loops": np.zeros(cycles, dtype=bool)
         if block.continuous
         else _turns_back(rows[0], options.hysteresis * span),

@@ -1,8 +1,7 @@
 r"""Steps 6 and 7 of the loop pipeline: the judgement of each cycle (the reasons of
 :data:`REASONS`, flags turned into NaN, ``quality`` strings and refusals, once), the tally of a
 whole recording, and the per-cycle table.
-The vocabulary is explained in ``docs/method-loops.md`` ("Judging each cycle").
-"""
+The vocabulary is explained in ``docs/method-loops.md`` ("Judging each cycle")."""
 
 from __future__ import annotations
 
@@ -51,11 +50,11 @@ SEPARATOR = "+"
 ALL = "all"
 #: Plausible displacement amplitudes: outside, the unit is wrong (``implausible-amplitude``). [m]
 AMPLITUDE_RANGE = (0.5e-6, 50e-3)
-#: The amplitudes that :data:`AMPLITUDE_RANGE` allows, in words.
-_AMPLITUDES = f"{AMPLITUDE_RANGE[0] * 1e6:g} µm to {AMPLITUDE_RANGE[1] * 1e3:g} mm"
-#: Plausible coefficients of friction: outside, the load or the force's unit is wrong
-#: (``implausible-cof``). [1]
+#: Plausible coefficients of friction: outside, the load or force is wrong (``implausible-cof``).
 COF_RANGE = (0.01, 3.0)
+#: The amplitudes and coefficients of friction that the ranges allow, in words.
+_AMPLITUDES = f"{AMPLITUDE_RANGE[0] * 1e6:g} µm to {AMPLITUDE_RANGE[1] * 1e3:g} mm"
+_COFS = f"{COF_RANGE[0]:g} to {COF_RANGE[1]:g}"
 #: Displacement amplitudes above this are reciprocating sliding rather than fretting (still
 #: analysed the same way; the results' ``motion`` attribute says so). [m]
 FRETTING_AMPLITUDE = 300e-6
@@ -64,8 +63,8 @@ FRETTING_AMPLITUDE = 300e-6
 LOAD_SWING = 0.2
 #: The per-cycle values that scale with the normal load (given at each cycle's own load).
 LOAD_SCALED = ("max_force", "dissipated_energy", "stiffness", "force_offset", "force_drift_se")
-#: A loop whose area :math:`\oint Q\,d\Delta` is below minus this share of
-#: :math:`4\Delta^*Q^*` runs anticlockwise; a smaller negative area is noise.
+#: A loop whose area :math:`\oint Q\,d\Delta` is below minus this share of :math:`4\Delta^*Q^*`
+#: runs anticlockwise; a smaller negative area is noise.
 ANTICLOCKWISE_SHARE = 0.05
 #: The noise's bound on the lift of an extreme, σ√(2 ln n), must be below this share of a
 #: cycle's amplitudes (``noise-amplitude``; half the peak-to-peak is then at most 10 % high).
@@ -105,8 +104,7 @@ _SLIP = ("slip_amplitude", "ecof")
 #: The values read along the stroke (:func:`ecofmaps.resolve_loops`).
 RESOLVED = ("mu_resolved", "mu_resolved_se", "aspect_ratio")
 
-#: Every reason a cycle can be flagged for, in the order they are listed in ``quality``:
-#: name -> (what it means, the quantities it leaves NaN).
+#: Each reason a cycle can be flagged for, in ``quality``'s order: (meaning, quantities NaN).
 REASONS = {
     "missing-samples": ("a missing sample (NaN or an empty cell): skipped, not analysed", ALL),
     "no-reversal": (
@@ -178,8 +176,8 @@ REASONS = {
         GICOF,
     ),
     "implausible-cof": (
-        f"a coefficient of friction outside {COF_RANGE[0]:g} to {COF_RANGE[1]:g} (the ECoF or "
-        "GICoF in gross slip): the load given or the force's unit is wrong, not the contact",
+        f"a coefficient of friction outside {_COFS} (the ECoF or GICoF in gross slip): the load "
+        "given or the force's unit is wrong, not the contact",
         ("ecof", "cof_max", *GICOF, *RESOLVED),
     ),
     "load-swing": (
@@ -222,14 +220,8 @@ REASONS = {
     ),
 }
 
-#: The reasons that the reading along the stroke adds (its flags do not warn).
-READING_REASONS = (
-    "stiffness-mismatch",
-    "no-overlap",
-    "few-slip-samples",
-    "mu-varies",
-    "gicof-varies",
-)
+#: The reasons that the reading along the stroke adds, the last five (their flags do not warn).
+READING_REASONS = tuple(REASONS)[-5:]
 
 #: What to do about a recorded normal load that is negative.
 COMPRESSION = "is it recorded negative in compression? Give it with the other sign (-Fz)."
@@ -401,16 +393,14 @@ class Tally:
             raise error(f"no plausible cycle in the recording ({summary}). {hint}")
         if scaled:
             warn(
-                f"{scaled} cycles have an amplitude outside {_AMPLITUDES}: is the displacement "
-                "in metres (on the command line --displacement-unit; a column without a unit "
-                "is read in µm)?",
+                f"{scaled} cycles have an amplitude outside {_AMPLITUDES}: is the displacement in "
+                "metres (--displacement-unit; a column without a unit is read in µm)?",
                 ImplausibleScaleWarning,
             )
         if self.implausible_cof:
             warn(
-                f"{self.implausible_cof} cycles have a coefficient of friction outside "
-                f"{COF_RANGE[0]:g} to {COF_RANGE[1]:g} with the load of "
-                f"{float(results['load']):g} N: is the load right (load=, on the command line "
+                f"{self.implausible_cof} cycles have a coefficient of friction outside {_COFS} "
+                f"with the load of {float(results['load']):g} N: is the load right (load=, "
                 "--load) and the force in newtons (--force-unit; a column without a unit is "
                 "read in N)?",
                 ImplausibleScaleWarning,

@@ -1,8 +1,7 @@
 r"""Step 1 of the loop pipeline: the channels of a recording (:class:`Samples`, NumPy or dask),
 read a block at a time, and the passes over them that find the cycles (the straight line, the
 percentiles, the trigger's runs, the runs of cycle numbers).
-The method is explained in ``docs/method-loops.md`` ("Finding the cycles").
-"""
+The method is explained in ``docs/method-loops.md`` ("Finding the cycles")."""
 
 from __future__ import annotations
 
@@ -76,14 +75,9 @@ def _piece_extremes(x, cuts, a: int):
 
 
 def first_of_runs(run, value, index, target):
-    """The first ``index`` of each run whose piece ``value`` equals the run's ``target``
-    (-1 for a run with none)."""
-    hits = np.flatnonzero(value == target[run])
-    runs = np.arange(target.size)
-    if not hits.size:
-        return np.full(target.size, -1, dtype=np.int64)
-    at = np.minimum(np.searchsorted(run[hits], runs), hits.size - 1)
-    return np.where(run[hits[at]] == runs, index[hits[at]], -1).astype(np.int64)
+    """The first ``index`` of each run whose piece ``value`` is the run's ``target``, or -1."""
+    found = ends_of_runs(run, value == target[run], index, target.size, first=True)
+    return np.where(np.isnan(found), -1, found).astype(np.int64)
 
 
 def _finite_ends(x, cuts):
@@ -161,11 +155,9 @@ def level_at(level, samples):
 
 
 def local_extremes(start, stop, arguments, x):
-    """The largest and smallest detrended displacement of each stretch of ``width``
-    samples (counted from sample 0) that the block's chunks cut: rows of the stretch's
-    number, its largest, its smallest (NaN where none is finite), its finite samples, and
-    the sum and number of the finite absolute second differences within the chunk, each
-    less a sine's own, ``-curvature`` × the displacement about ``centre``."""
+    """Per stretch of ``width`` samples that a chunk cuts: its number, largest and smallest
+    detrended displacement, finite samples, and sum and number of the finite absolute second
+    differences less a sine's own (``-curvature`` × the displacement about ``centre``)."""
     chunk, gaps, line, width, (centre, curvature) = arguments
     found = [np.empty((6, 0))]
     for a, b in _chunks(start, stop, chunk):
@@ -206,10 +198,9 @@ def trigger_runs(start, stop, arguments, x):
 
 
 def labelled_runs(start, stop, arguments, x, cycle):
-    """Pieces of runs of equal cycle numbers in the block, cut at its chunks: first
-    sample, cycle number, samples, largest and smallest finite displacement, the first
-    sample of the smallest, the first and last finite displacement, and the largest step
-    between consecutive samples of the run (to the sample after the block too)."""
+    """Pieces of runs of equal cycle numbers cut at the chunks: first sample, number, samples,
+    largest and smallest displacement, the smallest's sample, the first and last finite one,
+    and the largest step between samples of the run (to the one after the block too)."""
     chunk, gaps, carries = arguments
     carry = carries[start]
     pieces = []
@@ -239,8 +230,7 @@ def labelled_runs(start, stop, arguments, x, cycle):
 
 
 def detrended(x, a: int, line):
-    """The displacements ``x`` of samples ``a`` on less the straight ``line`` (see
-    :func:`displacement_line`)."""
+    """The displacements ``x`` of samples ``a`` on less the :func:`displacement_line`."""
     return kernels.detrended(np.ascontiguousarray(x, dtype=np.float64), a, *map(float, line))
 
 
@@ -286,8 +276,7 @@ def _percentiles(samples: Samples, gaps, line):
 
 
 def displacement_percentiles(samples: Samples, gaps, line, sample_at, sampled, count: int):
-    """``np.percentile`` of the finite detrended displacements at the 1st and 99th
-    percentile, exactly."""
+    """The 1st and 99th percentile of the finite detrended displacements, exactly."""
     mean, mean_t, slope, middle = line
     if count <= _CHUNK:
         return _percentiles(samples, gaps, line)
@@ -423,9 +412,8 @@ class Samples:
 
 
 class MissingSampleError(ValueError):
-    """A missing sample where ``nan_policy='raise'``: ``sample`` is its 0-based index, ``what``
-    is wrong with it (None: it is NaN or empty) and ``skips`` is what ``nan_policy='skip'``
-    does instead."""
+    """A missing sample (0-based index ``sample``) where ``nan_policy='raise'``: ``what`` is
+    wrong (None: NaN or empty), ``skips`` what ``nan_policy='skip'`` does instead."""
 
     def __init__(self, sample: int, what=None, skips=None):
         self.sample, self.what = int(sample), what
