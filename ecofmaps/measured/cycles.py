@@ -187,12 +187,8 @@ def _accepted_reversals(parts, hidden, edges, scale):
             near[mine] |= exists & (np.abs(value[mine] - value[other]) <= tolerance)
     accepted = np.where(at_edge, near, ~hidden)
     # Twins: the parts of one run either side of a gap, both taken for reversals.
-    twins = np.flatnonzero(
-        (run[1:] == run[:-1])
-        & accepted[1:]
-        & accepted[:-1]
-        & (np.abs(extreme[1:] - extreme[:-1]) < least)
-    )
+    close = (run[1:] == run[:-1]) & (np.abs(extreme[1:] - extreme[:-1]) < least)
+    twins = np.flatnonzero(close & accepted[1:] & accepted[:-1])
     outer = kind[twins] * (value[twins + 1] - value[twins]) > 0
     accepted[np.where(outer, twins, twins + 1)] = False
     return accepted
@@ -270,8 +266,7 @@ def _trigger(samples: Samples, gaps, line, band):
     piece_start, highest, top, lowest, bottom = np.concatenate([f[2] for f in found], axis=1)
     run = np.searchsorted(starts, piece_start.astype(np.int64), side="right") - 1
     first_piece = np.searchsorted(run, np.arange(starts.size))
-    pieces = (highest, top, lowest, bottom)
-    return starts, kind, *_run_extremes(run, first_piece, kind > 0, pieces)
+    return starts, kind, *_run_extremes(run, first_piece, kind > 0, (highest, top, lowest, bottom))
 
 
 def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
@@ -280,9 +275,8 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
     centre, level = band
     bottoms = starts[kind < 0]
     regular = np.abs(np.diff(bottoms) / (step * period) - 1.0) <= _REGULAR
-    if not (np.count_nonzero(regular) >= 2 and regular.mean() >= 0.5):
-        return None
-    if np.diff(bottoms, prepend=0, append=samples.size).max() <= 1.5 * period:
+    longest = np.diff(bottoms, prepend=0, append=samples.size).max()
+    if np.count_nonzero(regular) < 2 or regular.mean() < 0.5 or longest <= 1.5 * period:
         return None
     width = max(int(period) // 2, MIN_SAMPLES)
     sine = (centre, 4.0 * np.sin(np.pi / period) ** 2)  # Δ²x = -4 sin²(π/T) x
@@ -302,9 +296,7 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
     amplitude = np.pad(np.fmax(highest - middle, middle - lowest), 1, mode="edge")
     local = hysteresis * np.fmin(np.fmin(amplitude[:-2], amplitude[1:-1]), amplitude[2:])
     local = np.clip(np.where(np.isnan(local), level, local), min(least, level), level)
-    if (local >= level).all():
-        return None
-    return (width, middle), (width, local)
+    return None if (local >= level).all() else ((width, middle), (width, local))
 
 
 def _local_centre(highest, lowest):

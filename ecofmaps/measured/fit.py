@@ -113,18 +113,14 @@ def _rising_branch(target, mu, kappa, lam):
     return jnp.minimum(stick, slip)
 
 
-def _model_force(parameters, displacement, rising):
-    """Model Q/P at each scaled sample; parameters (mu, s, a, A, c, q) as in :func:`fit_loop`."""
+def _residual(parameters, displacement, force, rising, weight):
+    """Weighted model less measured Q/P at each scaled sample; parameters (mu, s, a, A, c, q)."""
     mu, s, a, amplitude, centre, offset = parameters
     lam, kappa = 1.0 / (s * amplitude), 2.0 * a / amplitude
     target = (displacement - centre) / amplitude
     up = _rising_branch(target, mu, kappa, lam)
     down = -_rising_branch(-target, mu, kappa, lam)
-    return jnp.where(rising, up, down) + offset
-
-
-def _residual(parameters, displacement, force, rising, weight):
-    return weight * (_model_force(parameters, displacement, rising) - force)
+    return weight * (jnp.where(rising, up, down) + offset - force)
 
 
 _residual_jit = jax.jit(_residual)
@@ -210,9 +206,7 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
     if x.size < MIN_SAMPLES:
         raise ValueError(f"a loop needs at least {MIN_SAMPLES} samples, got {x.size}")
     rising = np.arange(x.size) <= np.argmax(x)
-    length, centre, offset = (
-        analysis[k] for k in ("amplitude", "displacement_offset", "force_offset")
-    )
+    length, centre, offset = map(analysis.get, ("amplitude", "displacement_offset", "force_offset"))
     scaled_x, scaled_y = (x - centre) / length, (y - offset) / load
     start = _starting_values(scaled_x, scaled_y, rising, analysis, length, load)
     solution = _solution(scaled_x, scaled_y, rising, start)
@@ -220,9 +214,9 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
     model_force = y + load * solution.fun[: x.size]
     residual = y - model_force
     gross_slip = mu / (s * amplitude) < 1.0
-    message = solution.message
-    if not gross_slip:
-        message = f"{message} (but the fitted loop has no gross slip: mu * P / (S Δ*) >= 1)"
+    message = solution.message + (
+        "" if gross_slip else " (but the fitted loop has no gross slip: mu * P / (S Δ*) >= 1)"
+    )
     return LoopFit(
         mu=mu,
         stiffness=float(s * load / length),
