@@ -418,7 +418,9 @@ def _split(samples: Samples, hysteresis: float) -> Cycles:
             raise ValueError(
                 f"no complete cycle in {n} samples: fewer than two displacement reversals"
             )
-        return _labelled(samples.constant_cycle())
+        x, q, _, missing = samples.arrays  # as one cycle, numbered 0 (dask's if lazy)
+        cycle = np.zeros_like(x, dtype=np.int64)
+        return _labelled(Samples(x, q, cycle, missing, runner=samples.runner))
     # the amplitude varies: cut where the drive's cycles meet
     if level is not None or _steps(kind_of_part[accepted], *(p[accepted] for p in parts[2:])):
         tops = extreme_of_part[(kind_of_part > 0) & accepted]
@@ -511,14 +513,6 @@ def _check_labels(number, start) -> None:
 def find_cycles(
     displacement, cycle=None, hysteresis: float = 0.5, *, force=None, missing=None, runner=None
 ) -> Cycles:
-    """The complete cycles of a recording: numbered ones, or cut at the reversals."""
-    if cycle is not None:
-        if getattr(cycle, "ndim", np.ndim(cycle)) != 1:
-            raise ValueError("cycle must be one-dimensional (one value per sample)")
-        if cycle.shape[0] != displacement.shape[0]:
-            raise ValueError(
-                f"cycle must have one value per sample: {cycle.shape[0]} values for "
-                f"{displacement.shape[0]} samples"
-            )
+    """The complete cycles of a recording (arrays checked): numbered, or cut at the reversals."""
     samples = Samples(displacement, force, cycle, missing, runner=runner)
     return _split(samples, hysteresis) if cycle is None else _labelled(samples)

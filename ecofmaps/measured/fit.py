@@ -199,7 +199,7 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
     coefficient of friction from fretting loops exhibiting non-Coulomb frictional
     behaviour: eq. 9, 10, 16.
     """
-    load, all_x, all_y = _checked_samples(displacement, force, load, hysteresis)
+    load, all_x, all_y, cycle = _checked_samples(displacement, force, cycle, load, hysteresis)
     index, number, analysis = _measured_cycle(all_x, all_y, load, cycle, cycle_number, hysteresis)
     # The last point closes the loop (the next cycle's first, or the first again): fit it once.
     x, y = all_x[index[:-1]], all_y[index[:-1]]
@@ -240,27 +240,29 @@ def fit_loop(displacement, force, load, cycle=None, *, cycle_number=None, hyster
     )
 
 
-def _checked_samples(displacement, force, load, hysteresis):
-    """The load and the samples of :func:`fit_loop`, checked. [N], [m], [N]"""
+def _checked_samples(displacement, force, cycle, load, hysteresis):
+    """The load and the samples of :func:`fit_loop` (and their cycle numbers), checked."""
     check("load", load, "positive", "N")
     if np.ndim(load) != 0:
         raise ValueError(f"load must be a single number [N], got shape {np.shape(load)}")
     within("hysteresis", hysteresis, 1.0)
     all_x, all_y = (np.asarray(values, dtype=np.float64) for values in (displacement, force))
-    for name, values in (("displacement", all_x), ("force", all_y)):
+    arrays = {"displacement": all_x, "force": all_y, "cycle": cycle}
+    for name, values in ((k, np.asarray(v)) for k, v in arrays.items() if v is not None):
         if values.ndim != 1:
             raise ValueError(f"{name} must be one-dimensional, got shape {values.shape}")
-    if all_x.size != all_y.size:
-        raise ValueError(
-            f"displacement and force must have the same length, got {all_x.size} and {all_y.size}"
-        )
+        if values.size != all_x.size:
+            raise ValueError(
+                f"displacement and {name} must have the same length, got {all_x.size} and "
+                f"{values.size}"
+            )
     check("displacement", all_x, "finite", "m")
     check("force", all_y, "finite", "N")
     if all_x.size < MIN_SAMPLES:
         raise ValueError(f"a loop needs at least {MIN_SAMPLES} samples, got {all_x.size}")
     if not np.ptp(all_x) > 0:
         raise ValueError("displacement does not vary: a loop needs a displacement stroke")
-    return float(load), all_x, all_y
+    return float(load), all_x, all_y, None if cycle is None else np.asarray(cycle)
 
 
 def _measured_cycle(all_x, all_y, load, cycle, cycle_number, hysteresis):

@@ -186,8 +186,7 @@ def stick_lines(x, y, length, span, low, high):
 def _sample_pair(length, count, width):
     """The columns of the two samples around a row's crossing (-1 read as NumPy does)."""
     after = min(max(count, 1), length - 1)
-    previous = after - 1
-    return (previous + width if previous < 0 else previous), after
+    return (after - 1) % width, after
 
 
 @numba.njit(**_COMPILE)

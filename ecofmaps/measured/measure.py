@@ -132,9 +132,7 @@ class LoopBlock:
         """The loops as padded rows (cycle, point) of ``width`` points, NaN past each end."""
         index = self.samples(np.minimum(np.arange(width), self.count[:, None]))
         inside = np.arange(width) <= self.count[:, None]
-        return tuple(
-            np.where(inside, values[index], np.nan) for values in (self.displacement, self.force)
-        )
+        return tuple(np.where(inside, v[index], np.nan) for v in (self.displacement, self.force))
 
 
 def loop_blocks(
@@ -156,9 +154,8 @@ def loop_blocks(
     centre_q = np.empty(kept.size)
     ready = max(begin - _NOISE_REACH, 0)  # the force's centres are known below this cycle
     for block in _whole_blocks(cycles, kept, begin, end):
-        # The centred values depend on the sample index alone. The force's drift within
-        # the block needs the centres of the cycles on both sides of it, their noise
-        # those of _NOISE_REACH cycles.
+        # The centred values depend on the sample index alone. The force's drift within the
+        # block needs the centres of the cycles either side, their noise _NOISE_REACH more.
         needed = min(block.stop + _NOISE_REACH, kept.size)
         lower, upper = min(ready, block.start), max(needed, block.stop)
         low, high = int(start[lower]), int(start[upper - 1] + count[upper - 1])
@@ -452,9 +449,8 @@ def _stick_line_fit(u, regressors, stick):
         inverse = np.linalg.inv(normal)
     except np.linalg.LinAlgError:  # a degenerate loop (a constant force): least norm
         inverse = np.linalg.pinv(normal)
-    return np.einsum(
-        "rik,rk->ri", inverse, np.stack([(a * u).sum(axis=1) for a in columns], -1)
-    ), inverse
+    moments = np.stack([(a * u).sum(axis=1) for a in columns], -1)
+    return np.einsum("rik,rk->ri", inverse, moments), inverse
 
 
 def _noise_lift(block, values):

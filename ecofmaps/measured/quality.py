@@ -278,8 +278,7 @@ def _attrs(name: str) -> dict:
 
 
 def regime_ratio(values: dict, rig_stiffness) -> np.ndarray:
-    """The energy ratio deciding each cycle's regime: on the contact's displacement if
-    the rig's stiffness is known. [1]"""
+    """The energy ratio deciding each cycle's regime (the contact's if the rig's is known). [1]"""
     return values["energy_ratio" if rig_stiffness is None else "contact_energy_ratio"]
 
 

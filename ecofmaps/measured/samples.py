@@ -5,7 +5,6 @@ The method is explained in ``docs/method-loops.md`` ("Finding the cycles")."""
 
 from __future__ import annotations
 
-import copy
 import sys
 
 import numpy as np
@@ -176,8 +175,7 @@ def local_extremes(start, stop, arguments, x):
 def trigger_runs(start, stop, arguments, x):
     """The Schmitt trigger's runs begun in the block, and the extremes of its pieces."""
     chunk, gaps, line, (centre, band) = arguments
-    entries, kinds, pieces = [], [], []
-    previous = 0
+    entries, kinds, pieces, previous = [], [], [], 0
     for a, b in _chunks(start, stop, chunk):
         xa = _blanked(x[a - start : b - start], a, b, gaps)
         d = detrended(xa, a, line)
@@ -384,13 +382,6 @@ class Samples:
         chunks = getattr(displacement, "chunks", None)
         block = int(chunks[0][0]) if chunks and chunks[0] else _BLOCK
         self.block = max(1, round(block / _CHUNK)) * _CHUNK  # whole chunks of the passes
-
-    def constant_cycle(self) -> Samples:
-        """These samples with every cycle number 0 (the whole recording one cycle)."""
-        constant = copy.copy(self)
-        cycle = np.zeros_like(self.arrays[0], dtype=np.int64)  # dask's, for a lazy recording
-        constant.arrays = (*self.arrays[:2], cycle, self.arrays[3])
-        return constant
 
     def blocks(self):
         """``(start, stop)`` of each block of a lazy recording (the grid)."""
