@@ -291,24 +291,18 @@ def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
     # a stretch cut short (by a gap or the end) may miss its peak: its neighbours' instead
     short = np.add.reduceat(finite, first) < width
     highest[short], lowest[short] = np.nan, np.nan
-    middle = _local_centre(np.pad(highest, 1, mode="edge"), np.pad(lowest, 1, mode="edge"))
-    middle = np.where(np.isnan(middle), centre, middle)
+    # the middle of the narrower period holding each stretch if the amplitude is held
+    high, low = np.pad(highest, 1, mode="edge"), np.pad(lowest, 1, mode="edge")
+    top, bottom = np.maximum(high[:-1], high[1:]), np.minimum(low[:-1], low[1:])  # NaN if short
+    span, own = top - bottom, high - low
+    held = np.fmin(span[:-1], span[1:]) <= 2.5 * np.fmin(np.fmin(own[:-2], own[1:-1]), own[2:])
+    before = np.fmin(span[:-1], span[1:]) == span[:-1]
+    middle = 0.5 * np.where(before, top[:-1] + bottom[:-1], top[1:] + bottom[1:])
+    middle = np.where(held & ~np.isnan(middle), middle, centre)
     amplitude = np.pad(np.fmax(highest - middle, middle - lowest), 1, mode="edge")
     local = hysteresis * np.fmin(np.fmin(amplitude[:-2], amplitude[1:-1]), amplitude[2:])
     local = np.clip(np.where(np.isnan(local), level, local), min(least, level), level)
     return None if (local >= level).all() else ((width, middle), (width, local))
-
-
-def _local_centre(highest, lowest):
-    """Per stretch, the middle of the narrower period holding it if the amplitude is held."""
-    top = np.maximum(highest[:-1], highest[1:])  # NaN with a stretch cut short
-    bottom = np.minimum(lowest[:-1], lowest[1:])
-    span, own = top - bottom, highest - lowest
-    before = np.fmin(span[:-1], span[1:]) == span[:-1]
-    least = np.fmin(np.fmin(own[:-2], own[1:-1]), own[2:])
-    held = np.fmin(span[:-1], span[1:]) <= 2.5 * least
-    middle = 0.5 * np.where(before, top[:-1] + bottom[:-1], top[1:] + bottom[1:])
-    return np.where(held, middle, np.nan)
 
 
 def _drive_cycles(bottoms, tops, n: int, period: float) -> Cycles:

@@ -245,21 +245,6 @@ def _curve_intercept(scaled, product, window, y, n, sums):
 
 
 @numba.njit(**_COMPILE)
-def _window_holds(force, y, before, window, n, pair, with_pair, rounding):
-    """Whether the window (and ``pair``) has samples both sides of the crossing, force within."""
-    sides, lowest, highest = 0, np.inf, -np.inf
-    for j in range(n):
-        if window[j]:
-            sides |= 1 if before[j] else 2
-            lowest, highest = min(lowest, y[j]), max(highest, y[j])
-    if with_pair:
-        for j in pair:
-            sides |= 1 if before[j] else 2
-            lowest, highest = min(lowest, y[j]), max(highest, y[j])
-    return sides == 3 and lowest - rounding <= force <= highest + rounding
-
-
-@numba.njit(**_COMPILE)
 def line_crossings(x, y, length, compliance, half_width, load, rounding):
     r"""Force where each branch row crosses :math:`Q = S\Delta`, and whether on the loop."""
     rows, width = x.shape
@@ -272,9 +257,8 @@ def line_crossings(x, y, length, compliance, half_width, load, rounding):
         count = 0
         for j in range(n):
             position = x[r, j] - y[r, j] * compliance[r]  # the contact position (eq. 10)
-            side = position < 0.0 if rising else position > 0.0
-            before[j] = side
-            count += side
+            before[j] = position < 0.0 if rising else position > 0.0
+            count += before[j]
             window[j] = abs(position) <= h
             if window[j]:
                 scaled[j] = position / h
@@ -290,10 +274,17 @@ def line_crossings(x, y, length, compliance, half_width, load, rounding):
         # on both sides of ξ = 0, and the crossing's force lies within theirs.
         fits = fitted >= _FIT_SAMPLES
         force[r] = intercept if fits else q0 + share * (q1 - q0)
-        holds = _window_holds(
-            force[r], y[r], before, window, n, (previous, after), not fits, rounding[r]
-        )
-        on_loop[r] = holds and (fits or (share >= 0.0 and share <= 1.0))
+        sides, lowest, highest = 0, np.inf, -np.inf
+        for j in range(n):
+            if window[j]:
+                sides |= 1 if before[j] else 2
+                lowest, highest = min(lowest, y[r, j]), max(highest, y[r, j])
+        if not fits:
+            for j in (previous, after):
+                sides |= 1 if before[j] else 2
+                lowest, highest = min(lowest, y[r, j]), max(highest, y[r, j])
+        within = lowest - rounding[r] <= force[r] <= highest + rounding[r]
+        on_loop[r] = sides == 3 and within and (fits or (share >= 0.0 and share <= 1.0))
     return force, on_loop
 
 

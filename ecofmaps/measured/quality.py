@@ -393,15 +393,16 @@ class Tally:
         if scaled:
             warn(
                 f"{scaled} cycles have an amplitude outside {_AMPLITUDES}: is the displacement in "
-                "metres (--displacement-unit; a column without a unit is read in µm)?",
+                "metres (on the command line --displacement-unit; a column without a unit is read "
+                "in µm)?",
                 ImplausibleScaleWarning,
             )
         if self.implausible_cof:
             warn(
                 f"{self.implausible_cof} cycles have a coefficient of friction outside {_COFS} "
-                f"with the load of {float(results['load']):g} N: is the load right (load=, "
-                "--load) and the force in newtons (--force-unit; a column without a unit is "
-                "read in N)?",
+                f"with the load of {float(results['load']):g} N: is the load right (load=, on the "
+                "command line --load) and the force in newtons (--force-unit; a column without a "
+                "unit is read in N)?",
                 ImplausibleScaleWarning,
             )
         if self.flagged:
