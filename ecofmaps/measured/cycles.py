@@ -9,7 +9,6 @@ import dataclasses
 import numpy as np
 
 from ecofmaps.measured import samples as passes
-from ecofmaps.measured.samples import Samples
 
 __all__ = ["LEAST_LEVEL", "MIN_SAMPLES", "NOISE_LEVEL", "Cycles", "find_cycles", "loop_points"]
 
@@ -83,7 +82,7 @@ def loop_points(first, count, rotation, continuous: bool, point):
     return first + position - count * (position >= count)
 
 
-def _joined(samples: Samples, function, arguments, channels=("displacement",), extra=0):
+def _joined(samples: passes.Samples, function, arguments, channels=("displacement",), extra=0):
     """What ``function`` found in each block of ``samples``, joined in order."""
     return np.concatenate(samples.map(function, channels, arguments, extra), axis=-1)
 
@@ -247,7 +246,7 @@ def _drive_numbers(cycles: Cycles, merged: bool = False) -> Cycles:
     return dataclasses.replace(cycles, label=label)
 
 
-def _trigger(samples: Samples, gaps, line, band):
+def _trigger(samples: passes.Samples, gaps, line, band):
     """The trigger's runs: first sample, kind (+1 high, -1 low), extreme and its value."""
     found = samples.map(passes.trigger_runs, ("displacement",), (passes._CHUNK, gaps, line, band))
     # A run begins where the state (+1 above the band, -1 below it, 0 inside) differs from
@@ -269,7 +268,7 @@ def _trigger(samples: Samples, gaps, line, band):
     return starts, kind, *_run_extremes(run, first_piece, kind > 0, (highest, top, lowest, bottom))
 
 
-def _local_level(samples: Samples, gaps, line, runs, hysteresis: float, band):
+def _local_level(samples: passes.Samples, gaps, line, runs, hysteresis: float, band):
     """The trigger's local ``((width, centres), (width, half-bands))``, or None if not needed."""
     starts, kind, period, step = runs
     centre, level = band
@@ -361,7 +360,7 @@ def _drive_cycles(bottoms, tops, n: int, period: float) -> Cycles:
     )
 
 
-def _split(samples: Samples, hysteresis: float) -> Cycles:
+def _split(samples: passes.Samples, hysteresis: float) -> Cycles:
     """The cycles of ``samples`` cut at the displacement reversals."""
     n = samples.size
     if n < 2:
@@ -414,7 +413,7 @@ def _split(samples: Samples, hysteresis: float) -> Cycles:
             )
         x, q, _, missing = samples.arrays  # as one cycle, numbered 0 (dask's if lazy)
         cycle = np.zeros_like(x, dtype=np.int64)
-        return _labelled(Samples(x, q, cycle, missing, runner=samples.runner))
+        return _labelled(passes.Samples(x, q, cycle, missing, runner=samples.runner))
     # the amplitude varies: cut where the drive's cycles meet
     if level is not None or _steps(kind_of_part[accepted], *(p[accepted] for p in parts[2:])):
         tops = extreme_of_part[(kind_of_part > 0) & accepted]
@@ -435,7 +434,7 @@ def _split(samples: Samples, hysteresis: float) -> Cycles:
     return _drive_numbers(_with_missing(cycles, gaps))
 
 
-def _labelled(samples: Samples) -> Cycles:
+def _labelled(samples: passes.Samples) -> Cycles:
     """The cycles of ``samples`` by their cycle numbers."""
     n = samples.size
     _, gaps, _, _, _, labels = passes.survey(samples)
@@ -508,5 +507,5 @@ def find_cycles(
     displacement, cycle=None, hysteresis: float = 0.5, *, force=None, missing=None, runner=None
 ) -> Cycles:
     """The complete cycles of a recording (arrays checked): numbered, or cut at the reversals."""
-    samples = Samples(displacement, force, cycle, missing, runner=runner)
+    samples = passes.Samples(displacement, force, cycle, missing, runner=runner)
     return _split(samples, hysteresis) if cycle is None else _labelled(samples)

@@ -18,7 +18,6 @@ __all__ = [
     "path_means",
     "second_difference_medians",
     "stick_lines",
-    "stretch_ranges",
     "zero_force_crossings",
 ]
 
@@ -346,18 +345,6 @@ def second_difference_medians(values, first, stop, reach):
 
 
 @numba.njit(**_COMPILE)
-def stretch_ranges(values, offset, count):
-    """Largest less smallest of ``values`` over each stretch ``offset``, ``count``."""
-    ranges = np.empty(offset.size)
-    for k in range(offset.size):
-        highest = lowest = values[offset[k]]
-        for i in range(offset[k] + 1, offset[k] + count[k]):
-            highest, lowest = max(highest, values[i]), min(lowest, values[i])
-        ranges[k] = highest - lowest
-    return ranges
-
-
-@numba.njit(**_COMPILE)
 def loop_measures(x, y, offset, count, rotation):
     """Extremes, area and top of each centred loop, in one pass over its samples."""
     loops = offset.size
@@ -446,8 +433,8 @@ def _fitted_peak(values, first, n, at, span, sign):
 
 @numba.njit(**_COMPILE)
 def fitted_extremes(values, offset, count, least):
-    """Highest and lowest of each loop: the samples', or from ``least`` samples on, the fitted
-    parabolas' there (through the noise; docs/method-loops.md). [m] or [N]"""
+    """Highest and lowest of each loop: the samples', or from ``least`` samples on (inf: never),
+    the fitted parabolas' there (through the noise; docs/method-loops.md). [m] or [N]"""
     highest, lowest = np.empty(offset.size), np.empty(offset.size)
     for k in range(offset.size):
         first, n = offset[k], count[k]

@@ -11,17 +11,8 @@ from collections.abc import Iterator
 import numpy as np
 
 from ecofmaps._interrupts import check_interrupted
-from ecofmaps.measured import kernels
+from ecofmaps.measured import kernels, quality
 from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles, loop_points
-from ecofmaps.measured.quality import (
-    ANTICLOCKWISE_SHARE,
-    GICOF,
-    NOISE_SHARE,
-    READING_REASONS,
-    REASONS,
-    UNEXPLAINED_SHARE,
-    gross_slip,
-)
 
 __all__ = [
     "GROSS_SLIP_THRESHOLD",
@@ -70,16 +61,15 @@ _PER_CYCLE = (
     "cof_max",
     "energy_ratio",
     "stiffness",
-    *GICOF,
+    *quality.GICOF,
     "displacement_offset",
     "force_offset",
     "force_drift_se",
     "stick_residual",
 )
-#: The reasons this step flags (not those of the scale or of the reading along the stroke).
-_MEASURED = tuple(
-    r for r in REASONS if r not in ("implausible-amplitude", "implausible-cof", *READING_REASONS)
-)
+#: The reasons this step flags: not those of the scale or of the reading along the stroke.
+_UNMEASURED = ("implausible-amplitude", "implausible-cof", *quality.READING_REASONS)
+_MEASURED = tuple(r for r in quality.REASONS if r not in _UNMEASURED)
 #: A gross-slip loop whose GICoF lies within this share of Q*/P is crossed by its stick line
 #: where it slides at a constant force: its GICoF is read even if its stick sides are curved.
 _PLATEAU = 0.02
@@ -168,7 +158,9 @@ def loop_blocks(
         a, b = int(start[block.start]), int(start[block.stop - 1] + count[block.stop - 1])
         near = slice(max(block.start - 1, 0), block.stop + 1)
         offset = start[block] - a
-        swing = kernels.stretch_ranges(np.ascontiguousarray(force[a:b]), offset, count[block])
+        highest, lowest = kernels.fitted_extremes(  # the samples' (the least: inf)
+            np.ascontiguousarray(force[a:b]), offset, count[block], np.inf
+        )
         yield LoopBlock(
             rows=slice(int(kept[block.start]), int(kept[block.stop - 1]) + 1),
             displacement=x[a - low : b - low],
@@ -179,7 +171,7 @@ def loop_blocks(
             continuous=True,
             displacement_centre=centre_x[block],
             force_centre=centre_q[block],
-            force_swing=swing,
+            force_swing=highest - lowest,
             force_drift_se=_drift_se(middle, count, centre_q, block),
         )
 
@@ -216,7 +208,7 @@ def _labelled_block(cycles: Cycles, displacement, force, block, sign) -> LoopBlo
     offset = np.concatenate([[0], np.cumsum(count[:-1])])
     index = np.repeat(start - offset, count) + np.arange(int(count.sum()))
     x, q = displacement[index], sign * force[index]
-    swing = kernels.stretch_ranges(q, offset, count)
+    swing = np.subtract(*kernels.fitted_extremes(q, offset, count, np.inf))  # the range
     centre_x = _path_means(x, x, offset, count, closed=True)
     x -= np.repeat(centre_x, count)
     # The force's weights come from the centred displacement, as for drifting loops.
@@ -353,8 +345,8 @@ def _loop_values(block, options):
     }
     if options.rig_stiffness is not None:
         values |= {name: ratios[name] for name in _RIG_RATIOS}
-    anticlockwise = energy_ratio < -ANTICLOCKWISE_SHARE
-    sliding = gross_slip(values, options)
+    anticlockwise = energy_ratio < -quality.ANTICLOCKWISE_SHARE
+    sliding = quality.gross_slip(values, options)
     forward, backward, spring = _mindlin_sliding(rows, peak_force, span, sliding)
     mindlin = np.isfinite(forward)
     read = {"gicof_forward": forward / load, "gicof_backward": backward / load}
@@ -373,7 +365,7 @@ def _loop_values(block, options):
         "energy-ratio-above-1": energy_ratio > 1.0 + 1e-9,  # beyond rounding
         "negative-stiffness": compliance < 0.0,
         "no-stick": (
-            (~(unexplained <= UNEXPLAINED_SHARE) & ~np.isinf(values["stiffness"]))
+            (~(unexplained <= quality.UNEXPLAINED_SHARE) & ~np.isinf(values["stiffness"]))
             | np.isnan(compliance)
         )  # a rigid rig's vertical stick sides explain all but 0/0
         & ~mindlin,
@@ -455,7 +447,7 @@ def _stick_line_fit(u, regressors, stick):
 
 def _noise_lift(block, values):
     """Per cycle of ``block``, the highest the white noise on its ``values`` lifts an extreme,
-    over :data:`NOISE_SHARE` (NaN for too few samples). [m] or [N]"""
+    over ``quality.NOISE_SHARE`` (NaN for too few samples). [m] or [N]"""
     lift = np.full(block.count.size, np.nan)
     (rows,) = np.nonzero(block.count >= _NOISE_SAMPLES)
     if not rows.size:
@@ -473,7 +465,7 @@ def _noise_lift(block, values):
         for d in (second, second + sine * middle)
     ]
     sigma = np.fmin(*quartiles) / _QUARTILE_SECOND_DIFFERENCE
-    lift[rows] = sigma * np.sqrt(2.0 * np.log(count)) / NOISE_SHARE
+    lift[rows] = sigma * np.sqrt(2.0 * np.log(count)) / quality.NOISE_SHARE
     return lift
 
 

@@ -329,13 +329,14 @@ def test_path_means(closed):
                                expected, rtol=1e-12)  # fmt: skip
 
 
-def test_stretch_ranges_and_loop_measures():
+def test_ranges_and_loop_measures():
     rng = np.random.default_rng(9)
     x, y, offset, count = random_stretches(rng)
     rotation = rng.integers(0, count)
     x[offset + count // 2] = x[offset + count - 1] = 10.0  # two tops: the first one counts
     highest, lowest, max_force, area, top = kernels.loop_measures(x, y, offset, count, rotation)
-    np.testing.assert_array_equal(kernels.stretch_ranges(y, offset, count), 2 * max_force)
+    ranges = np.subtract(*kernels.fitted_extremes(y, offset, count, np.inf))
+    np.testing.assert_array_equal(ranges, 2 * max_force)
     for k, (a, n) in enumerate(zip(offset, count, strict=True)):
         d, q = x[a : a + n], y[a : a + n]
         assert (highest[k], lowest[k], max_force[k]) == (d.max(), d.min(), np.ptp(q) / 2)
