@@ -78,17 +78,13 @@ def _line_sums(u, v, end, segment, sums):
     count, sum_u, sum_v = 0.0, 0.0, 0.0
     for j in range(end):
         if segment[j]:
-            count += 1.0
-            sum_u += u[j]
-            sum_v += v[j]
+            count, sum_u, sum_v = count + 1.0, sum_u + u[j], sum_v + v[j]
     mean_u, mean_v = sum_u / count, sum_v / count
     uv, uu, vv = 0.0, 0.0, 0.0
     for j in range(end):
         if segment[j]:
             du, dv = u[j] - mean_u, v[j] - mean_v
-            uv += du * dv
-            uu += du * du
-            vv += dv * dv
+            uv, uu, vv = uv + du * dv, uu + du * du, vv + dv * dv
     sums[0], sums[1], sums[2], sums[3], sums[4], sums[5] = count, mean_u, mean_v, uv, uu, vv
 
 
@@ -124,8 +120,7 @@ def _curved(x, y, end, segment, intercept, compliance, line):
             fourth += square * square
             product += residual * square
             largest = max(largest, square)
-            negative |= y[j] < 0.0
-            positive |= y[j] > 0.0
+            negative, positive = negative or y[j] < 0.0, positive or y[j] > 0.0
     # The residual sums to zero (its own intercept): the squared force needs no centring.
     spread = fourth - force_variance**2 / count
     bend = product / spread
