@@ -487,10 +487,8 @@ def measure_cycles(cycles: Cycles, displacement, force, options, *, rows=None, k
     flags = {reason: np.zeros(stop - first, dtype=bool) for reason in _MEASURED}
     flags["missing-samples"] = cycles.missing[first:stop].copy()  # not measured: NaN
     flags["no-reversal"] = cycles.hidden[first:stop].copy()
-    loops = None
-    if keep_loops:
-        width = int(cycles.count[first:stop].max()) + 1
-        loops = tuple(np.full((stop - first, width), np.nan) for _ in range(2))
+    width = int(cycles.count[first:stop].max()) + 1 if keep_loops else 0
+    loops = tuple(np.full((stop - first, width), np.nan) for _ in range(2)) if keep_loops else None
     sign = -1.0 if options.flip_force else 1.0
     with np.errstate(divide="ignore", invalid="ignore"):  # degenerate cycles give NaN
         for block in loop_blocks(cycles, displacement, force, slice(first, stop), sign):
@@ -500,7 +498,7 @@ def measure_cycles(cycles: Cycles, displacement, force, options, *, rows=None, k
                 for name, value in part.items():
                     table[name][out] = value
             if keep_loops:
-                for loop, centred in zip(loops, block.loops(loops[0].shape[1]), strict=True):
+                for loop, centred in zip(loops, block.loops(width), strict=True):
                     loop[out] = centred
     return values, flags, loops
 
