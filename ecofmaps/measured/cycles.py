@@ -65,8 +65,7 @@ class Cycles:
         return dataclasses.replace(self, **{name: getattr(self, name)[rows] for name in per_cycle})
 
     def indices(self, rows=slice(None)):
-        """Sample indices round the loops ``rows``, one row per loop padded with its last, and
-        the number of points of each."""
+        """Sample indices round the loops ``rows`` (a row each, padded), and their points."""
         count = self.count[rows][:, None]
         point = np.minimum(np.arange(int(count.max()) + 1), count)
         first, rotation = self.start[rows][:, None], self.rotation[rows][:, None]

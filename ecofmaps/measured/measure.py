@@ -264,8 +264,7 @@ def _displacement_centres(start, count, displacement, first: int, stop: int):
 
 
 def _drift(low: int, high: int, points, values, near: slice):
-    """``values`` over ``points`` at the samples ``low`` to ``high - 1``: interpolated between the
-    points ``near``, extrapolated along the end segment beyond the first or last of all."""
+    """``values`` over ``points`` at samples ``low`` on, between those ``near``, or beyond all."""
     at = np.arange(low, high, dtype=np.float64)
     result = np.interp(at, points[near], values[near])
     if points.size < 2:
@@ -432,8 +431,7 @@ def _mindlin_sliding(rows, max_force, span, candidates):
 
 
 def _stick_line_fit(u, regressors, stick):
-    """Least squares of ``u`` on 1 and ``regressors`` over the ``stick`` samples of each row:
-    the coefficients and the inverse of the normal matrix (identity below four samples)."""
+    """Least squares of ``u`` on 1 and ``regressors`` over each row's ``stick``, and (JᵀJ)⁻¹."""
     columns = [stick.astype(np.float64), *(np.where(stick, r, 0.0) for r in regressors)]
     normal = np.stack([np.stack([(a * b).sum(axis=1) for b in columns], -1) for a in columns], -2)
     normal[stick.sum(axis=1) < 4] = np.eye(len(columns))
@@ -446,8 +444,7 @@ def _stick_line_fit(u, regressors, stick):
 
 
 def _noise_lift(block, values):
-    """Per cycle of ``block``, the highest the white noise on its ``values`` lifts an extreme,
-    over ``quality.NOISE_SHARE`` (NaN for too few samples). [m] or [N]"""
+    """Per cycle, how high noise lifts an extreme of ``values`` over NOISE_SHARE, or NaN. [m|N]"""
     lift = np.full(block.count.size, np.nan)
     (rows,) = np.nonzero(block.count >= _NOISE_SAMPLES)
     if not rows.size:
@@ -478,9 +475,8 @@ def _turns_back(x, band):
 
 
 def measure_cycles(cycles: Cycles, displacement, force, options, *, rows=None, keep_loops=False):
-    """The per-cycle values of :func:`ecofmaps.analyze_loops` as measured (not yet NaN where a
-    check fails), the flags of the checks each cycle failed, and the centred loops NaN-padded
-    over (cycle, point) if ``keep_loops``."""
+    """The per-cycle values of :func:`ecofmaps.analyze_loops` before the checks' NaN, their flags,
+    and the centred loops NaN-padded over (cycle, point) if ``keep_loops``."""
     first, stop, _ = (rows or slice(None)).indices(cycles.label.size)
     names = _PER_CYCLE if options.rig_stiffness is None else _PER_CYCLE + _RIG_RATIOS
     values = {name: np.full(stop - first, np.nan) for name in names}

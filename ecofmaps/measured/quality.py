@@ -256,9 +256,6 @@ _LAST_HINT = (
 #: The recorded values that a refused cycle keeps.
 _RECORDED = ("normal_load",)
 
-#: The counts of :class:`Tally` that parts add up.
-_SUMS = ("cycles", "refused", "flagged", "implausible_cof", "scaled")
-
 
 class LoopQualityWarning(UserWarning):
     """Cycles of a recording were flagged in ``quality``, or its units look wrong."""
@@ -312,8 +309,7 @@ def load_flags(missing, mean, lowest, highest) -> dict:
 
 
 def judged(values: dict, flags: dict, options):
-    """The one judgement of a part's cycles: ``values`` (name -> per cycle) NaN where a flag
-    (reason -> per cycle) reaches, the ``quality`` strings, the cycles refused and regimes."""
+    """``values`` NaN where a flag reaches, the ``quality`` strings, the refusals and regimes."""
     size = next(iter(flags.values())).size
     refused = _refusing(flags, size)
     recorded = {k: values[k] for k in _RECORDED if k in values}  # a refused cycle's too
@@ -368,7 +364,7 @@ class Tally:
     def merge(self, other: Tally) -> None:
         """Count the parts ``other`` counted (in another process, say) as well."""
         self.counts.update(other.counts)
-        for name in _SUMS:
+        for name in ("cycles", "refused", "flagged", "implausible_cof", "scaled"):
             setattr(self, name, getattr(self, name) + getattr(other, name))
         for reason in _HINTS:
             self.every[reason] &= other.every[reason]
@@ -497,8 +493,7 @@ def refused(quality) -> np.ndarray:
 
 
 def quality_summary(quality) -> str:
-    """One line: how many cycles are ``'ok'``, how many were skipped for missing samples,
-    and how many carry each other reason."""
+    """One line: the cycles ``'ok'``, skipped for missing samples, and with each other reason."""
     texts, counts = np.unique(np.ravel(quality), return_counts=True)
     return _summary_of_counts(dict(zip(texts.tolist(), counts.tolist(), strict=True)))
 
