@@ -340,39 +340,24 @@ def second_difference_medians(values, first, stop, reach):
 
 
 @numba.njit(**_COMPILE)
-def loop_measures(x, y, offset, count, rotation):
-    """Extremes, area and top of each centred loop, in one pass over its samples."""
-    loops = offset.size
-    highest, lowest, max_force = np.empty(loops), np.empty(loops), np.empty(loops)
-    area, top = np.empty(loops), np.empty(loops, np.int64)
-    for k in range(loops):
+def loop_measures(x, y, offset, count, rotation, highest):
+    """Area of each centred loop, and its top: its first point from its start at ``highest``."""
+    area, top = np.empty(offset.size), np.empty(offset.size, np.int64)
+    for k in range(offset.size):
         first, last = offset[k], offset[k] + count[k] - 1
-        # Two interleaved chains (even and odd segments), as in path_means.
-        high = high_odd = low = low_odd = x[first]
-        strongest = strongest_odd = weakest = weakest_odd = y[first]
-        total, total_odd = 0.0, 0.0
+        total, total_odd = 0.0, 0.0  # two interleaved chains of segments, as in path_means
         for i in range(first, last - 1, 2):
             total += (y[i + 1] + y[i]) * (x[i + 1] - x[i])
             total_odd += (y[i + 2] + y[i + 1]) * (x[i + 2] - x[i + 1])
-            high, low = max(high, x[i + 1]), min(low, x[i + 1])
-            high_odd, low_odd = max(high_odd, x[i + 2]), min(low_odd, x[i + 2])
-            strongest, weakest = max(strongest, y[i + 1]), min(weakest, y[i + 1])
-            strongest_odd, weakest_odd = max(strongest_odd, y[i + 2]), min(weakest_odd, y[i + 2])
         if (last - first) % 2:  # the last segment
             total += (y[last] + y[last - 1]) * (x[last] - x[last - 1])
-            high, low = max(high, x[last]), min(low, x[last])
-            strongest, weakest = max(strongest, y[last]), min(weakest, y[last])
-        total += total_odd
-        high, low = max(high, high_odd), min(low, low_odd)
-        strongest, weakest = max(strongest, strongest_odd), min(weakest, weakest_odd)
-        highest[k], lowest[k], max_force[k] = high, low, 0.5 * (strongest - weakest)
-        area[k] = 0.5 * (total + (y[first] + y[last]) * (x[first] - x[last]))
+        area[k] = 0.5 * (total + total_odd + (y[first] + y[last]) * (x[first] - x[last]))
         for point in range(count[k]):
             position = rotation[k] + point
-            if x[first + position - (count[k] if position >= count[k] else 0)] == high:
+            if x[first + position - (count[k] if position >= count[k] else 0)] == highest[k]:
                 top[k] = point
                 break
-    return highest, lowest, max_force, area, top
+    return area, top
 
 
 @numba.njit(**_COMPILE)
@@ -428,9 +413,10 @@ def _fitted_peak(values, first, n, at, span, sign):
 
 @numba.njit(**_COMPILE)
 def fitted_extremes(values, offset, count, least):
-    """Highest and lowest of each loop: the samples', or from ``least`` samples on (inf: never),
-    the fitted parabolas' there (through the noise; docs/method-loops.md). [m] or [N]"""
+    """Highest and lowest sample of each loop, and the same or, from ``least`` samples on, the
+    fitted parabolas' values there (through the noise; docs/method-loops.md). [m] or [N]"""
     highest, lowest = np.empty(offset.size), np.empty(offset.size)
+    fitted_high, fitted_low = np.empty(offset.size), np.empty(offset.size)
     for k in range(offset.size):
         first, n = offset[k], count[k]
         top = bottom = 0
@@ -438,11 +424,12 @@ def fitted_extremes(values, offset, count, least):
             top = i if values[first + i] > values[first + top] else top
             bottom = i if values[first + i] < values[first + bottom] else bottom
         highest[k], lowest[k] = values[first + top], values[first + bottom]
+        fitted_high[k], fitted_low[k] = highest[k], lowest[k]
         if n >= least:
             span = highest[k] - lowest[k]
-            highest[k] += _fitted_peak(values, first, n, top, span, 1.0)
-            lowest[k] -= _fitted_peak(values, first, n, bottom, span, -1.0)
-    return highest, lowest
+            fitted_high[k] += _fitted_peak(values, first, n, top, span, 1.0)
+            fitted_low[k] -= _fitted_peak(values, first, n, bottom, span, -1.0)
+    return highest, lowest, fitted_high, fitted_low
 
 
 @numba.njit(**_COMPILE)

@@ -158,7 +158,7 @@ def loop_blocks(
         a, b = int(start[block.start]), int(start[block.stop - 1] + count[block.stop - 1])
         near = slice(max(block.start - 1, 0), block.stop + 1)
         offset = start[block] - a
-        highest, lowest = kernels.fitted_extremes(  # the samples' (the least: inf)
+        highest, lowest, _, _ = kernels.fitted_extremes(  # the samples' (no fit)
             np.ascontiguousarray(force[a:b]), offset, count[block], np.inf
         )
         yield LoopBlock(
@@ -208,7 +208,7 @@ def _labelled_block(cycles: Cycles, displacement, force, block, sign) -> LoopBlo
     offset = np.concatenate([[0], np.cumsum(count[:-1])])
     index = np.repeat(start - offset, count) + np.arange(int(count.sum()))
     x, q = displacement[index], sign * force[index]
-    swing = np.subtract(*kernels.fitted_extremes(q, offset, count, np.inf))  # the range
+    swing = np.subtract(*kernels.fitted_extremes(q, offset, count, np.inf)[:2])  # the range
     centre_x = _path_means(x, x, offset, count, closed=True)
     x -= np.repeat(centre_x, count)
     # The force's weights come from the centred displacement, as for drifting loops.
@@ -297,15 +297,16 @@ def loop_ratios(amplitude, max_force, energy, slip, rig_stiffness=None) -> dict:
 def _loop_values(block, options):
     """Every per-cycle quantity of a block of centred loops, and the checks it failed."""
     load = options.load
-    # The extremes, the loop's area and its top, where the rising branch ends.
-    highest, lowest, peak_force, energy, top = kernels.loop_measures(
-        block.displacement, block.force, block.offset, block.count, block.rotation
-    )
-    span = highest - lowest
-    # Δ* and Q*: half the range between the extremes, read through the noise if any
-    amplitude, max_force = (
-        0.5 * np.subtract(*kernels.fitted_extremes(v, block.offset, block.count, _EXTREME_SAMPLES))
+    # The samples' extremes; Δ* and Q*, half the range between them read through the noise if any
+    (highest, lowest, *x_fitted), (strongest, weakest, *q_fitted) = (
+        kernels.fitted_extremes(v, block.offset, block.count, _EXTREME_SAMPLES)
         for v in (block.displacement, block.force)
+    )
+    span, peak_force = highest - lowest, 0.5 * (strongest - weakest)
+    amplitude, max_force = 0.5 * np.subtract(*x_fitted), 0.5 * np.subtract(*q_fitted)
+    # The loop's area and its top, where the rising branch ends.
+    energy, top = kernels.loop_measures(
+        block.displacement, block.force, block.offset, block.count, block.rotation, highest
     )
     rows = branch_rows(block, top)
     compliance, intercept, across, residual, unexplained, curved = kernels.stick_lines(

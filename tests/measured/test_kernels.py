@@ -33,9 +33,15 @@ def model_rows(seed, cycles=6, noise=0.005):
         seed=seed,
     )
     block = next(iter(loop_blocks(find_cycles(displacement), displacement, force)))
-    highest, lowest, max_force, _, top = kernels.loop_measures(
-        block.displacement, block.force, block.offset, block.count, block.rotation
+    highest, lowest, strongest, weakest = (
+        extreme
+        for values in (block.displacement, block.force)
+        for extreme in kernels.fitted_extremes(values, block.offset, block.count, np.inf)[:2]
     )
+    _, top = kernels.loop_measures(
+        block.displacement, block.force, block.offset, block.count, block.rotation, highest
+    )
+    max_force = 0.5 * (strongest - weakest)
     x, y, length = branch_rows(block, top)
     return x, y, length, highest - lowest, max_force
 
@@ -334,9 +340,9 @@ def test_ranges_and_loop_measures():
     x, y, offset, count = random_stretches(rng)
     rotation = rng.integers(0, count)
     x[offset + count // 2] = x[offset + count - 1] = 10.0  # two tops: the first one counts
-    highest, lowest, max_force, area, top = kernels.loop_measures(x, y, offset, count, rotation)
-    ranges = np.subtract(*kernels.fitted_extremes(y, offset, count, np.inf))
-    np.testing.assert_array_equal(ranges, 2 * max_force)
+    highest, lowest, _, _ = kernels.fitted_extremes(x, offset, count, np.inf)
+    area, top = kernels.loop_measures(x, y, offset, count, rotation, highest)
+    max_force = np.subtract(*kernels.fitted_extremes(y, offset, count, np.inf)[:2]) / 2
     for k, (a, n) in enumerate(zip(offset, count, strict=True)):
         d, q = x[a : a + n], y[a : a + n]
         assert (highest[k], lowest[k], max_force[k]) == (d.max(), d.min(), np.ptp(q) / 2)
