@@ -132,13 +132,9 @@ def _parts_after_gaps(samples, gaps, line, band, runs):
 def _run_extremes(run, first, rising, pieces):
     """Each run's extreme (its pieces' highest if ``rising``, else lowest): sample and value."""
     highest, top, lowest, bottom = pieces
-    high, low = np.fmax.reduceat(highest, first), np.fmin.reduceat(lowest, first)
-    extreme = np.where(
-        rising,
-        passes.first_of_runs(run, highest, top, high),
-        passes.first_of_runs(run, lowest, bottom, low),
-    )
-    return extreme.astype(np.int64), np.where(rising, high, low)
+    high, high_at = passes.extremes_of_runs(np.fmax, highest, top, run, first)
+    low, low_at = passes.extremes_of_runs(np.fmin, lowest, bottom, run, first)
+    return np.where(rising, high_at, low_at), np.where(rising, high, low)
 
 
 def _period(starts, kind) -> float:
@@ -454,8 +450,8 @@ def _labelled(samples: passes.Samples) -> Cycles:
     run = np.cumsum(new) - 1
     starts = piece_start[first_piece].astype(np.int64)
     count = np.add.reduceat(size, first_piece).astype(np.int64)
-    top, floor = np.fmax.reduceat(highest, first_piece), np.fmin.reduceat(lowest, first_piece)
-    lowest_at = passes.first_of_runs(run, lowest, bottom, floor)
+    top = np.fmax.reduceat(highest, first_piece)
+    floor, lowest_at = passes.extremes_of_runs(np.fmin, lowest, bottom, run, first_piece)
     valued = np.isfinite(x_first)
     begin = passes.ends_of_runs(run, valued, x_first, starts.size, first=True)
     end = passes.ends_of_runs(run, valued, x_last, starts.size, first=False)

@@ -19,7 +19,7 @@ __all__ = [
     "displacement_line",
     "displacement_percentiles",
     "ends_of_runs",
-    "first_of_runs",
+    "extremes_of_runs",
     "is_lazy",
     "labelled_runs",
     "level_at",
@@ -61,17 +61,17 @@ def _blanked(x, a: int, b: int, gaps) -> np.ndarray:
 
 def _piece_extremes(x, cuts, a: int):
     """Largest and smallest finite value of each piece of ``x`` and its first sample (or -1)."""
-    piece, found = np.repeat(np.arange(cuts.size), np.diff(cuts, append=x.size)), []
-    for reduce in (np.fmax, np.fmin):
-        value = reduce.reduceat(x, cuts)
-        found += [value, first_of_runs(piece, x, np.arange(a, a + x.size), value)]
-    return found
+    piece = np.repeat(np.arange(cuts.size), np.diff(cuts, append=x.size))
+    index = np.arange(a, a + x.size)
+    return [e for f in (np.fmax, np.fmin) for e in extremes_of_runs(f, x, index, piece, cuts)]
 
 
-def first_of_runs(run, value, index, target):
-    """The first ``index`` of each run whose piece ``value`` is the run's ``target``, or -1."""
-    found = ends_of_runs(run, value == target[run], index, target.size, first=True)
-    return np.where(np.isnan(found), -1, found).astype(np.int64)
+def extremes_of_runs(reduce, values, index, run, first):
+    """Each run's ``reduce`` (``np.fmax`` or ``np.fmin``) of ``values`` from its ``first``, and
+    the first ``index`` where a value is it (-1 if none)."""
+    extreme = reduce.reduceat(values, first)
+    found = ends_of_runs(run, values == extreme[run], index, first.size, first=True)
+    return extreme, np.where(np.isnan(found), -1, found).astype(np.int64)
 
 
 def _survey(start, stop, arguments, x, q, cycle, mask):
