@@ -97,13 +97,10 @@ class LoopFit:
 
     def model_loop(self, num=201):
         """The fitted steady loop, offsets included, for plotting."""
-        displacement, force = fretting_loop(
+        x, q = fretting_loop(
             self.amplitude, self.load, self.stiffness, self.mu, self.aspect_ratio, num=num
         )
-        return (
-            np.asarray(displacement) + self.displacement_offset,
-            np.asarray(force) + self.force_offset,
-        )
+        return np.asarray(x) + self.displacement_offset, np.asarray(q) + self.force_offset
 
 
 def _rising_branch(target, mu, kappa, lam):
@@ -283,21 +280,12 @@ def _measured_cycle(all_x, all_y, load, cycle, cycle_number, hysteresis):
             )
         row = int(rows[0])
     index, number, chosen = cycles.indices([row])[0][0], int(cycles.label[row]), slice(row, row + 1)
-    analysis, flags, _ = max(
-        (
-            measure_cycles(
-                cycles, all_x, all_y, LoopOptions(load, stick_window=window), rows=chosen
-            )
-            for window in _STICK_WINDOWS
-        ),
-        key=lambda measured: float(measured[0]["stiffness"][0]),
-    )
+    options = (LoopOptions(load, stick_window=window) for window in _STICK_WINDOWS)
+    measured = (measure_cycles(cycles, all_x, all_y, o, rows=chosen) for o in options)
+    analysis, flags, _ = max(measured, key=lambda values: float(values[0]["stiffness"][0]))
     analysis = {name: float(value[0]) for name, value in analysis.items()}
-    refusals = [
-        reason
-        for reason, flag in flags.items()
-        if flag[0] and REASONS[reason][1] == ALL and reason != "anticlockwise"
-    ]
+    refusing = [r for r, (_, scope) in REASONS.items() if scope == ALL and r != "anticlockwise"]
+    refusals = [reason for reason in refusing if reason in flags and flags[reason][0]]
     if refusals and not flags["anticlockwise"][0]:
         raise ValueError(
             f"cycle {number} is no fretting loop that can be read as recorded: "
@@ -309,11 +297,8 @@ def _measured_cycle(all_x, all_y, load, cycle, cycle_number, hysteresis):
 def _solution(scaled_x, scaled_y, rising, start):
     """The least-squares fit of the model's loop to the scaled samples (scipy's result)."""
     # Padded with zero-weight samples so that loops of about one length share the compiled code.
-    pad = -scaled_x.size % _BUCKET
-    arguments = tuple(
-        jnp.asarray(np.pad(values, (0, pad)))
-        for values in (scaled_x, scaled_y, rising, np.ones(scaled_x.size))
-    )
+    padded = (scaled_x, scaled_y, rising, np.ones(scaled_x.size))
+    arguments = tuple(jnp.asarray(np.pad(v, (0, -scaled_x.size % _BUCKET))) for v in padded)
     # scipy.optimize costs 0.4 s to import: load it when a fit runs, not with `import ecofmaps`.
     from scipy.optimize import least_squares
 

@@ -293,10 +293,8 @@ def scale_flags(values: dict, options) -> dict:
     a gross-slip ECoF or GICoF outside :data:`COF_RANGE` (not Q*/P: a deep groove raises it)."""
     scaled = _outside(values["amplitude"], AMPLITUDE_RANGE)
     cof = _outside(values["ecof"], COF_RANGE) | _outside(values["gicof"], COF_RANGE)
-    return {
-        "implausible-amplitude": scaled,
-        "implausible-cof": gross_slip(values, options) & cof & ~scaled,
-    }
+    cof &= gross_slip(values, options) & ~scaled
+    return {"implausible-amplitude": scaled, "implausible-cof": cof}
 
 
 def load_flags(missing, mean, lowest, highest) -> dict:
