@@ -244,9 +244,8 @@ def _drive_numbers(cycles: Cycles, merged: bool = False) -> Cycles:
 def _trigger(samples: passes.Samples, gaps, line, band):
     """The trigger's runs: first sample, kind (+1 high, -1 low), extreme and its value."""
     found = samples.map(passes.trigger_runs, ("displacement",), (passes._CHUNK, gaps, line, band))
-    # A run begins where the state (+1 above the band, -1 below it, 0 inside) differs from
-    # the last one decided; samples before the first decision take that first one. The 99th
-    # percentile lies above the band, so some state is decided.
+    # A run begins where the state (+1 above the band, -1 below, 0 inside) differs from the last
+    # decided; samples before the first decision (the 99th percentile is above the band) take it.
     starts, kinds, previous = [], [], 0
     for entry, kind, _ in found:
         if kind.size and kind[0] == previous:
@@ -466,18 +465,16 @@ def _labelled(samples: passes.Samples) -> Cycles:
         & (gap <= 1.5 * np.where(np.isnan(largest), 0.0, largest) + _TOLERANCE * stroke)
     )
     start, count = starts[complete], count[complete]
-    return _with_missing(
-        Cycles(
-            start=start,
-            count=count,
-            rotation=lowest_at[complete] - start,
-            label=np.rint(label[first_piece][complete]).astype(np.int64),
-            continuous=False,
-            incomplete_cycles=int(np.count_nonzero(~complete)),
-            dropped_samples=int(n - count.sum()),
-        ),
-        gaps,
+    cycles = Cycles(
+        start=start,
+        count=count,
+        rotation=lowest_at[complete] - start,
+        label=np.rint(label[first_piece][complete]).astype(np.int64),
+        continuous=False,
+        incomplete_cycles=int(np.count_nonzero(~complete)),
+        dropped_samples=int(n - count.sum()),
     )
+    return _with_missing(cycles, gaps)
 
 
 def _check_labels(number, start) -> None:

@@ -405,23 +405,21 @@ class Tally:
         amplitude = np.concatenate(self.amplitudes) if self.amplitudes else np.zeros(0)
         amplitude = amplitude[np.isfinite(amplitude)]
         sliding = amplitude.size and float(np.median(amplitude)) > FRETTING_AMPLITUDE
-        results.attrs.update(
-            {
-                "title": "Fretting loops analysed cycle by cycle (ecofmaps.analyze_loops)",
-                "cycles_from": cycles_from,
-                "incomplete_cycles": cycles.incomplete_cycles,
-                "dropped_samples": cycles.dropped_samples,
-                "missing_samples": cycles.missing_samples,
-                "first_missing_sample": cycles.first_missing,
-                "skipped_cycles": _per_reason(self.counts)["missing-samples"],
-                "gross_slip_threshold": options.gross_slip_threshold,
-                "flip_force": int(options.flip_force),
-                "quality_summary": summary,
-                "sliding_condition": condition,
-                "regime_changes_at": changes,
-                "motion": "reciprocating sliding" if sliding else "fretting",
-            }
-        )
+        results.attrs |= {
+            "title": "Fretting loops analysed cycle by cycle (ecofmaps.analyze_loops)",
+            "cycles_from": cycles_from,
+            "incomplete_cycles": cycles.incomplete_cycles,
+            "dropped_samples": cycles.dropped_samples,
+            "missing_samples": cycles.missing_samples,
+            "first_missing_sample": cycles.first_missing,
+            "skipped_cycles": _per_reason(self.counts)["missing-samples"],
+            "gross_slip_threshold": options.gross_slip_threshold,
+            "flip_force": int(options.flip_force),
+            "quality_summary": summary,
+            "sliding_condition": condition,
+            "regime_changes_at": changes,
+            "motion": "reciprocating sliding" if sliding else "fretting",
+        }
         if options.rig_stiffness is not None:
             results.attrs["rig_stiffness"] = options.rig_stiffness
         return results

@@ -206,9 +206,8 @@ def labelled_runs(start, stop, arguments, x, cycle):
         piece, finite = np.repeat(np.arange(cuts.size), sizes), np.isfinite(xa)
         ends = [ends_of_runs(piece, finite, xa, cuts.size, first) for first in (True, False)]
         runs = [cuts + a, label[cuts].astype(np.float64), sizes]
-        pieces.append(
-            np.stack([*runs, highest, lowest, bottom, *ends, np.fmax.reduceat(step, cuts)])
-        )
+        largest = np.fmax.reduceat(step, cuts)
+        pieces.append(np.stack([*runs, highest, lowest, bottom, *ends, largest]))
     return np.concatenate(pieces, axis=1)
 
 
