@@ -197,8 +197,7 @@ def zero_force_crossings(x, y, length, band, intercept, across, rounding):
             near[j] = abs(y[r, j]) <= band[r]
         previous, after = _sample_pair(n, count, width)
         near[after] = True
-        if after >= 1:
-            near[previous] = True
+        near[previous] |= after >= 1  # not column -1, the padding
         _line_sums(y[r], x[r], n, near, line)
         local = line[2] - line[3] / line[4] * line[1]
         lowest, highest = np.inf, -np.inf
