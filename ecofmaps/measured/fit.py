@@ -57,8 +57,7 @@ class LoopFit:
     r_squared : float
         Coefficient of determination :math:`1 - \sum r_i^2 / \sum (Q_i - \bar Q)^2`. [1]
     standard_errors : dict of str to float
-        Standard error of each fitted quantity above, by its name, in its unit (linearised:
-        see ``docs/method-loops.md``).
+        Standard error of each quantity above, by name, in its unit (linearised; method-loops.md).
     success : bool
         True when the least squares converged to a loop in gross slip.
     evaluations : int

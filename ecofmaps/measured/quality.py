@@ -1,7 +1,6 @@
-r"""Steps 6 and 7 of the loop pipeline: the judgement of each cycle (the reasons of
-:data:`REASONS`, flags turned into NaN, ``quality`` strings and refusals, once), the tally of a
-whole recording, and the per-cycle table.
-The vocabulary is explained in ``docs/method-loops.md`` ("Judging each cycle")."""
+r"""Steps 6 and 7 of the loop pipeline: the judgement of each cycle (the :data:`REASONS`, flags
+turned into NaN, ``quality`` strings and refusals, once), the tally of a whole recording, and
+the per-cycle table; ``docs/method-loops.md`` ("Judging each cycle")."""
 
 from __future__ import annotations
 

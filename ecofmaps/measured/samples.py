@@ -1,7 +1,6 @@
-r"""Step 1 of the loop pipeline: the channels of a recording (:class:`Samples`, NumPy or dask),
-read a block at a time, and the passes over them that find the cycles (the straight line, the
-percentiles, the trigger's runs, the runs of cycle numbers).
-The method is explained in ``docs/method-loops.md`` ("Finding the cycles")."""
+r"""Step 1 of the loop pipeline: a recording's channels (:class:`Samples`, NumPy or dask) read a
+block at a time, and the passes that find the cycles (the straight line, the percentiles, the
+trigger's runs, the runs of cycle numbers); ``docs/method-loops.md`` ("Finding the cycles")."""
 
 from __future__ import annotations
 
