@@ -2,15 +2,11 @@ r"""Step 2 of the loop pipeline: the cycles of a recording (at the displacement 
 its cycle numbers), found by passes a block at a time, and the runs of missing samples.
 The method is explained in ``docs/method-loops.md`` ("Finding the cycles")."""
 
-from __future__ import annotations
-
 import dataclasses
 
 import numpy as np
 
 from ecofmaps.measured import samples as passes
-
-__all__ = ["LEAST_LEVEL", "MIN_SAMPLES", "NOISE_LEVEL", "Cycles", "find_cycles", "loop_points"]
 
 #: Fewest samples in one complete cycle: two branches, each with a stick and a slip part.
 MIN_SAMPLES = 8
@@ -59,7 +55,7 @@ class Cycles:
         """True for the cycles without a missing sample, found at their reversals."""
         return ~(self.missing | self.hidden)
 
-    def rows(self, rows: slice) -> Cycles:
+    def rows(self, rows: slice) -> "Cycles":
         """The cycles ``rows`` (a slice of consecutive rows) as a table of their own."""
         per_cycle = ("start", "count", "rotation", "label", "missing", "hidden")
         return dataclasses.replace(self, **{name: getattr(self, name)[rows] for name in per_cycle})

@@ -1,8 +1,6 @@
 """The model's steady loop fitted to a measured fretting loop (the paper's Figure 10):
 :func:`fit_loop`; ``docs/method-loops.md`` ("Fitting the model's loop")."""
 
-from __future__ import annotations
-
 import dataclasses
 
 import jax
@@ -17,8 +15,6 @@ from ecofmaps.measured.quality import ALL, ANTICLOCKWISE_SHARE, REASONS, SEPARAT
 from ecofmaps.measured.resolve import within
 from ecofmaps.model.core import slip_position, traction_ratio
 from ecofmaps.model.simulation import fretting_loop
-
-__all__ = ["LoopFit", "fit_loop"]
 
 #: The stick windows of the loop's own analysis: the one with the steeper stick sides starts.
 _STICK_WINDOWS = ((0.05, 0.45), (0.0, 0.15))

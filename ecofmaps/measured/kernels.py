@@ -2,24 +2,10 @@
 a loop or a branch row at a time, cached on disk; every array float64 and C-contiguous
 (``docs/method-loops.md``)."""
 
-from __future__ import annotations
-
 import math
 
 import numba
 import numpy as np
-
-__all__ = [
-    "branch_stretches",
-    "detrended",
-    "fitted_extremes",
-    "line_crossings",
-    "loop_measures",
-    "path_means",
-    "second_difference_medians",
-    "stick_lines",
-    "zero_force_crossings",
-]
 
 #: How numba compiles the kernels: cached on disk, NumPy's division by zero, no GIL held.
 _COMPILE = {"cache": True, "error_model": "numpy", "nogil": True}

@@ -2,8 +2,6 @@
 (amplitude, slip amplitude, energy, ECoF, stiffness, GICoF ...), with the flags of the checks
 each cycle failed; ``docs/method-loops.md`` ("Centring the loops", "Measuring each loop")."""
 
-from __future__ import annotations
-
 import dataclasses
 import itertools
 from collections.abc import Iterator
@@ -13,18 +11,6 @@ import numpy as np
 from ecofmaps._interrupts import check_interrupted
 from ecofmaps.measured import kernels, quality
 from ecofmaps.measured.cycles import MIN_SAMPLES, Cycles, loop_points
-
-__all__ = [
-    "GROSS_SLIP_THRESHOLD",
-    "NEIGHBOURS",
-    "SECOND_DIFFERENCE",
-    "LoopBlock",
-    "Stretch",
-    "branch_rows",
-    "loop_blocks",
-    "loop_ratios",
-    "measure_cycles",
-]
 
 #: Samples of the cycles laid out at once by :func:`loop_blocks`.
 _BLOCK = 1 << 17

@@ -2,8 +2,6 @@ r"""Steps 6 and 7 of the loop pipeline: the judgement of each cycle (the :data:`
 turned into NaN, ``quality`` strings and refusals, once), the tally of a whole recording, and
 the per-cycle table; ``docs/method-loops.md`` ("Judging each cycle")."""
 
-from __future__ import annotations
-
 import collections
 
 import numpy as np
@@ -13,35 +11,6 @@ from ecofmaps import _nomenclature as nomenclature
 from ecofmaps._codes import warn
 from ecofmaps.measured.cycles import LEAST_LEVEL, MIN_SAMPLES, NOISE_LEVEL, Cycles
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, PARTIAL_SLIP, Regime, regime_condition
-
-__all__ = [
-    "ALL",
-    "ANTICLOCKWISE_SHARE",
-    "COMPRESSION",
-    "GICOF",
-    "LOAD_SCALED",
-    "LOAD_SWING",
-    "NOISE_SHARE",
-    "READING_REASONS",
-    "REASONS",
-    "RESOLVED",
-    "SEPARATOR",
-    "ImplausibleScaleError",
-    "ImplausibleScaleWarning",
-    "LoopQualityWarning",
-    "Tally",
-    "add_reason",
-    "cycle_results",
-    "gross_slip",
-    "has_reason",
-    "judged",
-    "load_flags",
-    "quality_strings",
-    "quality_summary",
-    "refused",
-    "regime_ratio",
-]
-
 
 #: Joins the reasons of one cycle in ``quality``.
 SEPARATOR = "+"
@@ -358,7 +327,7 @@ class Tally:
         self.implausible_cof += int(flags["implausible-cof"].sum())
         self.scaled += int(flags["implausible-amplitude"].sum())
 
-    def merge(self, other: Tally) -> None:
+    def merge(self, other: "Tally") -> None:
         """Count the parts ``other`` counted (in another process, say) as well."""
         self.counts.update(other.counts)
         for name in ("cycles", "refused", "flagged", "implausible_cof", "scaled"):

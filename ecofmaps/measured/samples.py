@@ -2,33 +2,12 @@ r"""Step 1 of the loop pipeline: a recording's channels (:class:`Samples`, NumPy
 block at a time, and the passes that find the cycles (the straight line, the percentiles, the
 trigger's runs, the runs of cycle numbers); ``docs/method-loops.md`` ("Finding the cycles")."""
 
-from __future__ import annotations
-
 import sys
 
 import numpy as np
 
 from ecofmaps._parallel import stretch
 from ecofmaps.measured import kernels
-
-__all__ = [
-    "MissingSampleError",
-    "Samples",
-    "detrended",
-    "displacement_line",
-    "displacement_percentiles",
-    "ends_of_runs",
-    "extremes_of_runs",
-    "is_lazy",
-    "labelled_runs",
-    "level_at",
-    "local_extremes",
-    "missing_in",
-    "part_extremes",
-    "survey",
-    "trigger_runs",
-    "values_at",
-]
 
 #: Samples read at once by the passes over the whole recording.
 _CHUNK = 1 << 18
@@ -215,7 +194,7 @@ def detrended(x, a: int, line):
     return kernels.detrended(np.ascontiguousarray(x, dtype=np.float64), a, *map(float, line))
 
 
-def survey(samples: Samples):
+def survey(samples: "Samples"):
     """Pass one: the straight line, the runs of missing samples, the percentile sample."""
     size = samples.size
     # The sample's order does not matter: its values are sorted.
@@ -250,13 +229,13 @@ def displacement_line(sums, size: int):
     return mean, mean_t, (stx - st * mean) / spread if spread > 0 else 0.0, middle
 
 
-def _percentiles(samples: Samples, gaps, line):
+def _percentiles(samples: "Samples", gaps, line):
     """The percentiles of every finite detrended displacement, held at once."""
     every = samples.map(_tails, ("displacement",), (_CHUNK, gaps, line, (np.inf, -np.inf)))
     return np.percentile(np.concatenate(every), _QUANTILES * 100.0, overwrite_input=True)
 
 
-def displacement_percentiles(samples: Samples, gaps, line, sample_at, sampled, count: int):
+def displacement_percentiles(samples: "Samples", gaps, line, sample_at, sampled, count: int):
     """The 1st and 99th percentile of the finite detrended displacements, exactly."""
     mean, mean_t, slope, middle = line
     if count <= _CHUNK:
