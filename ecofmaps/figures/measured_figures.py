@@ -47,7 +47,6 @@ def _reasons(qualities) -> list[str]:
 
 
 def _why_none(results: xr.Dataset) -> str:
-    """Why no cycle of ``results`` has a value."""
     if "quality" not in results or (results["quality"].values == "ok").any():
         return "no cycle in gross slip"
     counts = Counter(_reasons(results["quality"].values))
