@@ -4,7 +4,6 @@ it and what it marks; :func:`make_figure` does both, :func:`make_figures` for se
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import importlib
 from collections.abc import Callable, Iterator
@@ -132,12 +131,22 @@ def source_digest(patterns) -> np.ndarray:
     return np.frombuffer(digest.digest(), dtype=np.uint8)
 
 
-def _cached_shapes_part(compute: Callable[[], xr.Dataset]) -> xr.Dataset:
-    """``compute()`` through the cache, under its name without ``_dataset``."""
+def _cached_shapes_part(function: str, compute: Callable[[], xr.Dataset]) -> xr.Dataset:
     from ecofmaps.maps.cache import cached_dataset
 
-    function = compute.__name__.removesuffix("_dataset")
     return cached_dataset(function, {"sources": source_digest(_SCAR_SHAPES_SOURCES)}, compute)
+
+
+def _scar_shape_model() -> xr.Dataset:
+    return _cached_shapes_part("scar_shape_model", scar_shape_model_dataset)
+
+
+def _scar_shape_parabola() -> xr.Dataset:
+    return _cached_shapes_part("scar_shape_parabola", scar_shape_parabola_dataset)
+
+
+def _scar_shapes() -> xr.Dataset:
+    return _cached_shapes_part("scar_shapes", scar_shapes_dataset)
 
 
 def _scar_profiles() -> list:
@@ -252,9 +261,6 @@ def scar_shapes_dataset() -> xr.Dataset:
     return dataset
 
 
-_scar_shape_model = functools.partial(_cached_shapes_part, scar_shape_model_dataset)
-_scar_shape_parabola = functools.partial(_cached_shapes_part, scar_shape_parabola_dataset)
-_scar_shapes = functools.partial(_cached_shapes_part, scar_shapes_dataset)
 _EXAMPLE_2 = {"Example 2": paper.EXAMPLE_2}
 
 FIGURES: dict[str, FigureRecipe] = {

@@ -120,8 +120,7 @@ def test_the_shapes_dataset_has_parts_computed_first():
     figure is drawn."""
     parts = figures.figure_parts()
     assert len(parts) == len(figures.figure_groups())
-    computed = [part.args[0].__name__ for part in parts[0]]
-    assert computed == ["scar_shape_model_dataset", "scar_shape_parabola_dataset"]
+    assert [part.__name__ for part in parts[0]] == ["_scar_shape_model", "_scar_shape_parabola"]
     assert all(not group_parts for group_parts in parts[1:])
     assert figures.figure_parts(["fig8", "fig7a"]) == [[]]
 
