@@ -64,8 +64,7 @@ def ecof_ratio_contours(
     Returns
     -------
     figure : matplotlib.figure.Figure
-        Contours at :data:`ECOF_RATIO_LEVELS` (5 % heavier) over :math:`S/P` [(MN/m)/kN],
-        no gross slip hatched, and the markers.
+        Contours at :data:`ECOF_RATIO_LEVELS` over :math:`S/P` [(MN/m)/kN], no gross slip hatched.
     """
     figure = Figure(figsize=style.FIGSIZE, layout="constrained")
     ax = figure.add_subplot()
@@ -98,9 +97,8 @@ def universal_ecof_ratio_map(
         From :func:`ecofmaps.compute_universal_map` over ``compliance_ratio`` (> 0: a
         logarithmic axis) and ``aspect_ratio`` alone.
     markers : mapping of str to mapping, optional
-        Test conditions to mark at their own :math:`\lambda` and :math:`\mu_E/\mu`, by legend
-        name: keyword arguments of :func:`ecofmaps.energy_cof`, e.g.
-        :data:`ecofmaps.paper.FIGURE_10_FITS`.
+        Points to mark, by legend name: keyword arguments of :func:`ecofmaps.energy_cof`
+        (e.g. :data:`ecofmaps.paper.FIGURE_10_FITS`).
     windows : mapping of str to tuple, optional
         Spans of :math:`\lambda` shown as bars, by figure name: ``(amplitude,
         stiffness_ratios)`` [m], [1/m].
@@ -108,8 +106,7 @@ def universal_ecof_ratio_map(
     Returns
     -------
     figure : matplotlib.figure.Figure
-        Contours at :data:`ECOF_RATIO_LEVELS` on a logarithmic :math:`\lambda` axis, the
-        windows and the markers.
+        Contours at :data:`ECOF_RATIO_LEVELS` on a logarithmic :math:`\lambda` axis.
     """
     figure = Figure(figsize=(6.8, 5.6), layout="constrained")
     ax = figure.add_subplot()

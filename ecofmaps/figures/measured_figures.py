@@ -47,7 +47,6 @@ def _reasons(qualities) -> list[str]:
 
 
 def _why_none(results: xr.Dataset) -> str:
-    """Why no cycle of ``results`` has a value."""
     if "quality" not in results or (results["quality"].values == "ok").any():
         return "no cycle in gross slip"
     counts = Counter(_reasons(results["quality"].values))
@@ -96,9 +95,8 @@ def measured_loops(
     Returns
     -------
     figure : matplotlib.figure.Figure
-        Per cycle, titled by its GICoF, ECoF and flags: the centred loop, :math:`Q` [N]
-        against :math:`\Delta` [µm], the line :math:`Q = S\Delta` and the crossings whose
-        :math:`Q/P` is the GICoF (eq. 17-18).
+        A panel per cycle titled by its GICoF, ECoF and flags: :math:`Q` [N] against
+        :math:`\Delta` [µm]; the GICoF is :math:`Q/P` at the crossings (eq. 17-18).
     """
     if "loop_displacement" not in results:
         raise ValueError("results hold no loops: call analyze_loops(..., keep_loops=True)")
@@ -230,8 +228,7 @@ def measured_and_fitted_loops(fits, *, source: str | None = None) -> Figure:
     Returns
     -------
     figure : matplotlib.figure.Figure
-        Per panel the samples (dots) and the fitted loop, Q [N] and Q/P against Δ [µm],
-        titled by the fitted μ, S [MN/m], z_o [µm] and the RMS force residual [N].
+        Q [N] and Q/P against Δ [µm], titled by the fitted μ, S, z_o and RMS residual.
     """
     panels = dict(fits) if isinstance(fits, Mapping) else {"": fits}
     figure = Figure(figsize=(5.6 * len(panels), 5.2), layout="constrained")
@@ -279,12 +276,10 @@ def resolved_loops(
     Returns
     -------
     figure : matplotlib.figure.Figure
-        (a) :math:`\mu(\xi)` against the contact position :math:`\xi` [µm], with
-        ``mu_resolved`` dashed over the central part it averages; (b) the felt profile
-        :math:`h(\xi)` [µm] and its equivalent parabola :math:`k\xi^2/2`; (c) :math:`h` over
-        (position, cycle); (d) ``mu_resolved`` :math:`\pm 2` standard errors, the ECoF and
-        GICoF, and ``aspect_ratio`` over the cycles, those without a value marked with
-        their quality. A panel with nothing to draw says why.
+        (a) :math:`\mu(\xi)` against :math:`\xi` [µm], ``mu_resolved`` dashed; (b) the felt
+        profile :math:`h(\xi)` [µm] and its parabola; (c) :math:`h` over (position, cycle);
+        (d) ``mu_resolved`` :math:`\pm 2` standard errors, ECoF, GICoF and ``aspect_ratio``
+        over the cycles, those without a value marked with their quality.
     """
     if "position" not in resolved.dims:
         raise ValueError("resolved holds no positions: call resolve_loops(..., positions=201)")

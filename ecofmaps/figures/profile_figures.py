@@ -37,10 +37,9 @@ def scar_profile_figure(profile, name: str | None = None) -> Figure:
     Returns
     -------
     figure : matplotlib.figure.Figure
-        Over the position :math:`X` [µm] from the scar centre, with the edges :math:`\pm W`:
-        the height :math:`z` [µm], the unworn surface (the levelling line), the depth
-        :math:`D` and the parabola of the same :math:`D/W`; the slope :math:`g = dz/dX` the
-        model uses and the parabola's (plus the unworn surface's tilt).
+        Over :math:`X` [µm], edges :math:`\pm W` marked: the height :math:`z` [µm] with the
+        unworn surface, :math:`D` and the parabola of the same :math:`D/W`; the slope
+        :math:`g = dz/dX` the model uses and the parabola's.
     """
     position = np.asarray(profile.position)
     if position.ndim != 1:
@@ -99,10 +98,9 @@ def scar_shape_comparison(dataset: xr.Dataset) -> Figure:
     Returns
     -------
     figure : matplotlib.figure.Figure
-        Top: the profiles, and the steady loop on each other scar against the parabola's.
-        Bottom: :math:`\mu_E/\mu` over :math:`S/P` for each, and the error
-        :math:`\mu'/\mu - 1` [%] of the contact CoF the paper's shortcut (the parabola of
-        the scar's :math:`D/W`) makes of each scar's :math:`\mu_E`.
+        Top: the profiles and each scar's steady loop against the parabola's. Bottom:
+        :math:`\mu_E/\mu` over :math:`S/P`, and the error :math:`\mu'/\mu - 1` [%] of the
+        paper's shortcut (the parabola of the same :math:`D/W`) on each scar's :math:`\mu_E`.
     """
     shapes = list(dataset["shape"].values)
     figure = Figure(figsize=(15.0, 9.0), layout="constrained")

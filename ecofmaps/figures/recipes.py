@@ -201,8 +201,7 @@ def scar_shape_model_dataset() -> xr.Dataset:
 
 
 def scar_shape_parabola_dataset() -> xr.Dataset:
-    """The parabola of Example 2's D/W (steady values over S/P, the loop of Example 2's rig)
-    and the heights of the scar families."""
+    """The parabola of Example 2's D/W (values over S/P, loop) and the scar families' heights."""
     ratios = _SHAPES_STIFFNESS_RATIOS
     position = np.linspace(-1.6, 1.6, 321) * paper.AMPLITUDE
     heights = [np.interp(position, p.position, p.height) for p in _scar_profiles()]

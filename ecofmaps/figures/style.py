@@ -163,8 +163,7 @@ def legend_clear_of_data(ax, *, twins=(), **options):
 
 
 def _covers(ax, box) -> bool:
-    """Whether anything drawn in ``ax`` meets the display-space ``box``; a span of the panel's whole
-    height (a shaded background) does not."""
+    """Whether anything drawn in ``ax`` (not a shaded background) meets the display ``box``."""
     for line in ax.get_lines():
         path = line.get_transform().transform_path(line.get_path()).cleaned(remove_nans=True)
         points = path.vertices[np.isin(path.codes, (DrawnPath.MOVETO, DrawnPath.LINETO))]

@@ -50,8 +50,7 @@ def checked(**inputs) -> list:
 
 
 def steady_inputs(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width) -> list:
-    """:func:`checked` inputs of a steady loop (no aspect ratio on a profile); x_o defaults to
-    the amplitude."""
+    """:func:`checked` inputs of a steady loop; x_o defaults to the amplitude."""
     inputs = (amplitude, load, stiffness, mu, aspect_ratio, groove_half_width)
     values = checked(**dict(zip(_RULES, inputs, strict=True)))
     return values if groove_half_width is not None else [*values, values[0]]
@@ -62,8 +61,7 @@ def _positive(value):
 
 
 def valid_geometry(amplitude, load, stiffness, aspect_ratio, groove_half_width):
-    """True where the SI inputs other than mu are in range (traced-input counterpart of
-    :func:`checked`): all finite and > 0, stiffness may be inf, aspect ratio >= 0."""
+    """True where the SI inputs other than mu are in range (:func:`checked` for traced inputs)."""
     rig = (stiffness > 0.0) & ~jnp.isnan(stiffness)
     groove = (aspect_ratio >= 0.0) & jnp.isfinite(aspect_ratio) & _positive(groove_half_width)
     return _positive(amplitude) & _positive(load) & rig & groove

@@ -87,7 +87,6 @@ def _normal(segment, fraction, n: int):
 
 
 def _mirror(segment, fraction, n: int):
-    """The same position on the mirrored profile."""
     return _normal(n - 2 - segment, 1.0 - fraction, n)
 
 

@@ -53,10 +53,8 @@ class ScarProfileWarning(UserWarning):
     """What reading a measured profile decided that its user must see."""
 
     def __init__(self, summary: str, samples=(), details=(), alternative=None, alternative_name=""):
-        self.summary = summary
-        self.samples = tuple(int(i) for i in samples)
-        self.details = tuple(details)
-        self.alternative = alternative
+        self.summary, self.samples = summary, tuple(int(i) for i in samples)
+        self.details, self.alternative = tuple(details), alternative
         self.alternative_name = alternative_name
         text = self.text([f"sample {i}" for i in self.samples])
         if alternative is not None:

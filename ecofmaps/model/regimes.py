@@ -77,10 +77,8 @@ SLIDING_CONDITIONS = ("partial slip", "mixed slip", "gross slip")
 
 
 def sliding_condition_of(cycle, gross_slip) -> tuple[str, np.ndarray]:
-    """A test's sliding condition, one of :data:`SLIDING_CONDITIONS` (``'mixed slip'`` when
-    the regime changes during the test), and the cycles where the regime changes (each the
-    first cycle in the new regime), from each cycle's number and ``gross_slip`` (1 or 0, NaN
-    for a cycle without a regime, left out). See docs/lab.md."""
+    """A test's sliding condition (:data:`SLIDING_CONDITIONS`) and the first cycles of each new
+    regime, from each cycle's number and ``gross_slip`` (1 or 0; NaN: no regime, left out)."""
     gross_slip = np.asarray(gross_slip, dtype=np.float64)
     known = np.isfinite(gross_slip)
     if not known.any():
@@ -92,8 +90,7 @@ def sliding_condition_of(cycle, gross_slip) -> tuple[str, np.ndarray]:
 
 
 def regime_condition(results) -> tuple[str, np.ndarray]:
-    """:func:`sliding_condition_of` the ``regime`` column of :func:`ecofmaps.analyze_loops`'
-    results (a refused cycle left out)."""
+    """:func:`sliding_condition_of` the ``regime`` column of :func:`ecofmaps.analyze_loops`."""
     regime = results["regime"].values
     gross = np.where(regime == INVALID, np.nan, regime == GROSS_SLIP)
     return sliding_condition_of(results["cycle"].values, gross)

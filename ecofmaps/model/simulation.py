@@ -151,14 +151,12 @@ def simulate(
     displacement : array_like
         Actuator displacement :math:`\Delta` at successive instants, time along the last
         axis; any leading axes broadcast against the other parameters. [m]
-    load, stiffness, mu, aspect_ratio, profile
+    load, stiffness, mu, aspect_ratio, profile, mapping
         As for :func:`ecofmaps.slip_amplitude`: :math:`P` [N], :math:`S` [N/m], :math:`\mu`
-        [1], and :math:`z_o/x_o` [1] or a scar ``profile``.
+        [1], and :math:`z_o/x_o` [1] or a scar ``profile`` and its mapping.
     groove_half_width : array_like
         Groove half-width :math:`x_o`, required except in the physical mapping (the amplitude
         matches the steady loop of :func:`ecofmaps.fretting_loop`). [m]
-    mapping : {'scaled', 'physical'}
-        On a profile: :math:`X = xW/x_o` (eq. 11) or :math:`X = x` (no ``groove_half_width``).
 
     Returns
     -------

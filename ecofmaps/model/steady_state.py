@@ -121,13 +121,10 @@ def _steady_quantity(quantity: str, summary: str, returns: str, equations: str):
         Groove half-width :math:`x_o`; defaults to ``amplitude`` as in the paper. On a
         profile it sets the mapping :math:`X = xW/x_o` of eq. 11. [m]
     profile : ScarProfile, optional
-        A wear-scar profile of any shape (:func:`ecofmaps.scar_profile`, the families),
-        instead of ``aspect_ratio``: the pad at :math:`x` feels its slope at :math:`X` (eq. 9
-        pointwise), the loop read by first passage (``docs/model.md``). A parabolic profile
-        reproduces the closed forms with ``aspect_ratio=D/W``.
+        A scar profile of any shape instead of ``aspect_ratio`` (``docs/model.md``); a
+        parabolic one reproduces the closed forms with ``aspect_ratio=D/W``.
     mapping : {{'scaled', 'physical'}}
-        On a profile: ``'scaled'``, :math:`X = xW/x_o` (eq. 11, the paper's); or
-        ``'physical'``, :math:`X = x`.
+        On a profile: :math:`X = xW/x_o` (eq. 11, the paper's) or :math:`X = x`.
 
     Returns
     -------

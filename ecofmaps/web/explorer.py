@@ -75,8 +75,7 @@ def parameter_value(key: str, text: str) -> float:
 
 
 def bare_number_warnings(texts: dict) -> list[str]:
-    """The warnings for ``texts`` (by key of :data:`INPUTS`) typed as bare numbers implausible in
-    SI, each naming the input and the unit probably meant."""
+    """The warnings, naming the input, of ``texts`` (by key of :data:`INPUTS`) implausible in SI."""
     found = []
     for key, text in texts.items():
         if len(str(text)) > TEXT_LIMIT:  # refused as too long: not read as a number here

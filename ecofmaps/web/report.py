@@ -79,10 +79,9 @@ model.data = {xs: kept.map((k) => all.model_xs[at[k]]), ys: kept.map((k) => all.
 
 
 def write_report(path, results: xr.Dataset, *, loops=None, inputs=None, lab=None) -> Path:
-    """Write the results of :func:`ecofmaps.analyze_loops` as one HTML page that opens offline, at
-    ``path`` (atomically; its folder must exist); return the path. ``loops``: the cycles whose loops
-    the page carries (default :data:`LOOPS_CARRIED` spread evenly); ``inputs`` and ``lab``: rows
-    shown as given (what the results were made from; more of the lab's numbers)."""
+    """``path``, written atomically: the results of :func:`ecofmaps.analyze_loops` as an offline
+    HTML page carrying the loops of cycles ``loops`` (default :data:`LOOPS_CARRIED` spread
+    evenly), and the rows ``inputs`` (what the results came from) and ``lab`` as given."""
     document = report_document(results, loops=loops, inputs=inputs, lab=lab)
     title = "ecofmaps report" + (f": {inputs['files']}" if inputs and "files" in inputs else "")
     # Bokeh's own JavaScript and CSS, written in. Not file_html(..., INLINE): that also asks
@@ -103,8 +102,7 @@ def write_report(path, results: xr.Dataset, *, loops=None, inputs=None, lab=None
 
 
 def recording_inputs(recording, load: float, *, flip_force: bool = False) -> dict[str, str]:
-    """The ``inputs`` of :func:`write_report` for a recording analysed at ``load`` [N]: its file,
-    the load and each column read with its unit."""
+    """The ``inputs`` of :func:`write_report`: file, ``load`` [N], each column read and its unit."""
     read = []
     for name, column_name in recording.columns.items():
         unit = recording.units.get(name, "1")
@@ -361,8 +359,7 @@ def _column_decimals(values) -> int:
 
 
 def _table(results: xr.Dataset):
-    """The table of ``ecofmaps loops --out``: every column, numbers to 6 significant digits
-    with the same decimals down each column, the first column frozen while the others scroll."""
+    """The table of ``ecofmaps loops --out``, 6 significant digits, the first column frozen."""
     table = results_table(results)
     data, columns = {}, []
     for name in table.columns:

@@ -76,11 +76,9 @@ class _CutQuery(RequestHandler):
 
 
 def serve_explorer(port: int, *, open_browser: bool = True, announce=print, allow_origin=()):
-    """Serve the explorer at ``http://127.0.0.1:<port>/`` until Ctrl-C or SIGTERM; ``announce`` gets
-    the line with its address once it listens. A request whose Host, or Origin if it has one, is
-    not one of :data:`LOCAL_HOSTS` or ``allow_origin`` (``host[:port]``, by default at ``port``)
-    gets a 403, so another page or a DNS rebinding cannot make it compute. OSError if the port
-    cannot be listened on."""
+    """Serve the explorer at ``http://127.0.0.1:<port>/`` until Ctrl-C or SIGTERM, its address
+    ``announce``d once it listens (OSError if it cannot); a Host or Origin not in
+    :data:`LOCAL_HOSTS` or ``allow_origin`` (``host[:port]``, at ``port`` if none) gets a 403."""
     previous = {number: signal.getsignal(number) for number in (signal.SIGINT, signal.SIGTERM)}
     ours = [number for number, before in previous.items() if before not in (signal.SIG_IGN, None)]
     url = f"http://127.0.0.1:{port}/"
