@@ -204,13 +204,11 @@ def correct_table(path, profile=None, mapping="scaled", bad_rows="raise") -> tup
     writer = csv.writer(stream, delimiter=sep, lineterminator="\n")
     more = ([] if profile is None else [SHORTCUT_COLUMN]) + ([STATUS_COLUMN] if bad else [])
     writer.writerow([*header, *ADDED_COLUMNS, *more])
-    for (row, _), value, ecof, cells, code in zip(
-        records, mu, si["ecof"], added, status, strict=True
+    for (row, _), value, factor, cells, code in zip(
+        records, mu, mu / si["ecof"], added, status, strict=True
     ):
         label = [CorrectionStatus(int(code)).label] if bad else []
-        writer.writerow(
-            [*row, _written(value, commas), _written(value / ecof, commas), *cells, *label]
-        )
+        writer.writerow([*row, *(_written(v, commas) for v in (value, factor)), *cells, *label])
     return stream.getvalue(), len(records)
 
 

@@ -319,15 +319,10 @@ def cache_entries(cache_dir=None) -> list[CacheEntry]:
             status = path.stat()
         except FileNotFoundError:  # removed meanwhile by another process
             continue
-        entries.append(
-            CacheEntry(
-                path=path,
-                function=_ENTRY.match(path.name)["function"],
-                size=status.st_size,
-                modified=datetime.fromtimestamp(status.st_mtime, tz=UTC),
-                used=datetime.fromtimestamp(max(status.st_atime, status.st_mtime), tz=UTC),
-            )
-        )
+        times = (status.st_mtime, max(status.st_atime, status.st_mtime))
+        modified, used = (datetime.fromtimestamp(t, tz=UTC) for t in times)
+        function = _ENTRY.match(path.name)["function"]
+        entries.append(CacheEntry(path, function, status.st_size, modified, used))
     return entries
 
 

@@ -142,19 +142,11 @@ def analyze_loops(
     0.800000 0.831
     """
     force, load, loads = _at_mean_load(force, load)
-    options = pipeline.LoopOptions(
-        load,
-        hysteresis,
-        stick_window,
-        crossing_window,
-        gross_slip_threshold,
-        flip_force,
-        rig_stiffness,
-    )
+    loop = (load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force)
+    options = pipeline.LoopOptions(*loop, rig_stiffness)
     reading = pipeline.Reading(resolve=bool(resolve), keep_loops=bool(keep_loops))
-    return _run(
-        displacement, force, cycle, options, reading, loads, missing, nan_policy, scheduler, workers
-    )[0]
+    settings = (loads, missing, nan_policy, scheduler, workers)
+    return _run(displacement, force, cycle, options, reading, *settings)[0]
 
 
 def _run(
