@@ -16,9 +16,6 @@ from ecofmaps.correction.outcomes import CorrectionStatus
 from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers
 from ecofmaps.model.steady_state import valid_geometry
 
-__all__ = ["contact_cof", "correct_ecof", "correction_factor", "groove_aspect_ratio"]
-
-
 _EPS = float(np.finfo(np.float64).eps)
 _MAX_STEPS = 300  # the bracket [0, mu_E] halves at least every two steps
 _PROFILE_GRID = 400  # contact CoFs scanned per point on a profile

@@ -15,16 +15,6 @@ from ecofmaps.correction.inversion import correct_ecof
 from ecofmaps.correction.outcomes import CorrectionStatus
 from ecofmaps.io.files import FileLineError
 
-__all__ = [
-    "ADDED_COLUMNS",
-    "COLUMNS",
-    "SHORTCUT_COLUMN",
-    "STATUS_COLUMN",
-    "TableError",
-    "TableRowWarning",
-    "correct_table",
-]
-
 #: Input columns: column name -> quantity name (its unit and range in the nomenclature).
 COLUMNS = {
     nomenclature.column(name): name

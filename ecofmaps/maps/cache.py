@@ -24,24 +24,6 @@ from ecofmaps._codes import warn
 from ecofmaps._version import __version__
 from ecofmaps.io.files import TEMPORARY_NAME, atomic_path, check_room
 
-__all__ = [
-    "DEFAULT_SIZE_BOUND",
-    "ENVIRONMENT_VARIABLE",
-    "JAX_CACHE_FOLDER",
-    "SIZE_VARIABLE",
-    "CacheEntry",
-    "CacheWarning",
-    "cache_directory",
-    "cache_entries",
-    "cache_key",
-    "cache_size_bound",
-    "cached_dataset",
-    "clear_cache",
-    "metadata_checksum",
-    "model_revision",
-    "write_netcdf",
-]
-
 #: Environment variable that overrides the per-user cache directory.
 ENVIRONMENT_VARIABLE = "ECOFMAPS_CACHE"
 

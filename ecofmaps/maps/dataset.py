@@ -13,8 +13,6 @@ from ecofmaps import model, paper
 from ecofmaps._inputs import check
 from ecofmaps._version import __version__
 
-__all__ = ["checked_axes", "checked_axis", "checked_load", "grid_dataset", "map_dataset"]
-
 # The order of the variables in a Dataset (xarray orders the dimensions as they first appear).
 _VARIABLES = (
     "displacement",

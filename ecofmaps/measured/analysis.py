@@ -16,8 +16,6 @@ from ecofmaps.measured.cycles import MIN_SAMPLES
 from ecofmaps.measured.resolve import ReadingOptions
 from ecofmaps.measured.samples import MissingSampleError, is_lazy
 
-__all__ = ["analyze_loops", "resolve_loops"]
-
 #: What the analysis does with missing samples: skip their cycles, or raise.
 NAN_POLICIES = ("skip", "raise")
 
