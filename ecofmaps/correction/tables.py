@@ -123,12 +123,8 @@ def _row_values(path, line: int, row, column: dict, on_profile: bool, commas: bo
         depth, width = _SCAR
         has = [n in column and row[column[n]].strip() != "" for n in ("aspect_ratio", *_SCAR)]
         if has not in ([True, False, False], [False, True, True]):  # the ratio, or D and W
-            raise TableError(
-                path,
-                line,
-                "give the aspect ratio one way: aspect_ratio, or both scar_depth_um and "
-                "scar_half_width_um",
-            )
+            message = "give the aspect ratio one way: aspect_ratio, or both " + " and ".join(_SCAR)
+            raise TableError(path, line, message)
         values["aspect_ratio"] = number("aspect_ratio") if has[0] else number(depth) / number(width)
     return values
 
