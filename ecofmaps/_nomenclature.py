@@ -212,11 +212,8 @@ def with_se(name: str, value: float, se: float) -> str:
 
 def texts_with_se(found, names, quantity: str = "{}") -> list[tuple[str, str]]:
     """Each of ``names`` in ``found`` as (``quantity.format(name)``, its :func:`with_se` text)."""
-    texts = []
-    for name in names:
-        q = quantity.format(name)
-        texts.append((q, with_se(q, float(found[name]), float(found[f"{name}_se"]))))
-    return texts
+    rows = [(quantity.format(n), float(found[n]), float(found[f"{n}_se"])) for n in names]
+    return [(q, with_se(q, value, se)) for q, value, se in rows]
 
 
 #: The numbers of :func:`ecofmaps.transition` (quantities ``transition_<name>``), in order.

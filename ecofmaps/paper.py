@@ -51,13 +51,9 @@ ASPECT_RATIO = 0.2
 
 #: Example 2 as Section 3 states it (Figures 5 and 8): :math:`\mu_E` is about 4 % above
 #: :math:`\mu`. Keyword arguments of :func:`ecofmaps.energy_cof` and friends.
-EXAMPLE_2 = {
-    "amplitude": AMPLITUDE,
-    "load": LOAD,
-    "stiffness": STIFFNESS,
-    "mu": MU,
-    "aspect_ratio": ASPECT_RATIO,
-}
+EXAMPLE_2 = dict(
+    amplitude=AMPLITUDE, load=LOAD, stiffness=STIFFNESS, mu=MU, aspect_ratio=ASPECT_RATIO
+)
 
 #: The two tests whose final loops Figure 10 fits (Section 4.2): :math:`\mu` = GICoF = 0.825,
 #: :math:`S` = 45 and 35 MN/m, :math:`z_o` = 1.8 and 8.0 µm with :math:`x_o = \Delta^*`.

@@ -16,9 +16,6 @@ from ecofmaps.correction.outcomes import CorrectionStatus
 from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers
 from ecofmaps.model.steady_state import valid_geometry
 
-__all__ = ["contact_cof", "correct_ecof", "correction_factor", "groove_aspect_ratio"]
-
-
 _EPS = float(np.finfo(np.float64).eps)
 _MAX_STEPS = 300  # the bracket [0, mu_E] halves at least every two steps
 _PROFILE_GRID = 400  # contact CoFs scanned per point on a profile
@@ -211,7 +208,7 @@ def _correct(factor, ecof, amplitude, load, stiffness, scar, profile, mapping, r
                 "profile, not several"
             )
         rig = (ecof, amplitude, load, stiffness)
-        values, status, failure = _correct_on_profile(*rig, profile, mapping, factor, caller)
+        values, status, failure = _correct_on_profile(rig, profile, mapping, factor, caller)
     elif mapping != "scaled":
         raise ValueError("mapping applies to a profile only (profile=...)")
     else:
@@ -270,21 +267,19 @@ def _residual(profile, mu, target, rig, mapping):
         return np.asarray(numbers["ecof_ratio"]) * np.asarray(mu) - target
 
 
-def _correct_on_profile(ecof, amplitude, load, stiffness, profile, mapping, factor, caller):
-    """Values, status and the reason a single point failed, on a profile (docs/model.md)."""
+def _correct_on_profile(test, profile, mapping, factor, caller):
+    """Values, status and why one point failed, for ``test`` (ecof, amplitude, load, stiffness)."""
     check_mapping(mapping, None)
     profile = as_profile(profile)
-    outcomes.check_test(ecof, amplitude, load, stiffness)
-    if not is_concrete(ecof, amplitude, load, stiffness, *profile):
+    outcomes.check_test(*test)
+    if not is_concrete(*test, *profile):
         raise ValueError(
             f"{caller} on a profile needs concrete inputs: it does not run under "
             "jax.jit or jax.vmap"
         )
-    ecof, amplitude, load, stiffness = np.broadcast_arrays(
-        *(np.asarray(v, dtype=np.float64) for v in (ecof, amplitude, load, stiffness))
-    )
-    shape = ecof.shape
-    ecof, amplitude, load, stiffness = (v.ravel() for v in (ecof, amplitude, load, stiffness))
+    test = np.broadcast_arrays(*(np.asarray(v, dtype=np.float64) for v in test))
+    shape = test[0].shape
+    ecof, amplitude, load, stiffness = (v.ravel() for v in test)
     lam = load / (stiffness * amplitude)
     status = np.where(ecof * lam < 1.0, CorrectionStatus.CORRECTED, CorrectionStatus.NO_GROSS_SLIP)
     status = status.astype(np.int32)

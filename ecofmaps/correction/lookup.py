@@ -10,8 +10,6 @@ from ecofmaps._inputs import si_units
 from ecofmaps.correction.inversion import groove_aspect_ratio
 from ecofmaps.correction.outcomes import CorrectionStatus, check_test
 
-__all__ = ["lookup_correction"]
-
 
 def _map_axes(ecof_map):
     """The map's grid axes as ``(name, sorted values, order)`` and its fixed coordinates."""

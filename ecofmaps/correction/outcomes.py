@@ -12,17 +12,6 @@ from ecofmaps import model
 from ecofmaps._codes import Code
 from ecofmaps._inputs import as_float64, check
 
-__all__ = [
-    "AMBIGUOUS_ECOF_MIN",
-    "LAMBDA_INFINITY",
-    "CorrectionStatus",
-    "Interval",
-    "check_test",
-    "ecof_and_slope",
-    "ecof_fall",
-    "may_fall",
-]
-
 #: :math:`\lambda_\infty`: :math:`\mu_E(\mu)` falls over part of its range only where
 #: :math:`\lambda = P/(S\Delta^*)` is below this (its :math:`\kappa \to \infty` limit). [1]
 LAMBDA_INFINITY = 0.07102

@@ -15,16 +15,6 @@ from ecofmaps.correction.inversion import correct_ecof
 from ecofmaps.correction.outcomes import CorrectionStatus
 from ecofmaps.io.files import FileLineError
 
-__all__ = [
-    "ADDED_COLUMNS",
-    "COLUMNS",
-    "SHORTCUT_COLUMN",
-    "STATUS_COLUMN",
-    "TableError",
-    "TableRowWarning",
-    "correct_table",
-]
-
 #: Input columns: column name -> quantity name (its unit and range in the nomenclature).
 COLUMNS = {
     nomenclature.column(name): name
@@ -133,12 +123,8 @@ def _row_values(path, line: int, row, column: dict, on_profile: bool, commas: bo
         depth, width = _SCAR
         has = [n in column and row[column[n]].strip() != "" for n in ("aspect_ratio", *_SCAR)]
         if has not in ([True, False, False], [False, True, True]):  # the ratio, or D and W
-            raise TableError(
-                path,
-                line,
-                "give the aspect ratio one way: aspect_ratio, or both scar_depth_um and "
-                "scar_half_width_um",
-            )
+            message = "give the aspect ratio one way: aspect_ratio, or both " + " and ".join(_SCAR)
+            raise TableError(path, line, message)
         values["aspect_ratio"] = number("aspect_ratio") if has[0] else number(depth) / number(width)
     return values
 
@@ -204,13 +190,11 @@ def correct_table(path, profile=None, mapping="scaled", bad_rows="raise") -> tup
     writer = csv.writer(stream, delimiter=sep, lineterminator="\n")
     more = ([] if profile is None else [SHORTCUT_COLUMN]) + ([STATUS_COLUMN] if bad else [])
     writer.writerow([*header, *ADDED_COLUMNS, *more])
-    for (row, _), value, ecof, cells, code in zip(
-        records, mu, si["ecof"], added, status, strict=True
+    for (row, _), value, factor, cells, code in zip(
+        records, mu, mu / si["ecof"], added, status, strict=True
     ):
         label = [CorrectionStatus(int(code)).label] if bad else []
-        writer.writerow(
-            [*row, _written(value, commas), _written(value / ecof, commas), *cells, *label]
-        )
+        writer.writerow([*row, *(_written(v, commas) for v in (value, factor)), *cells, *label])
     return stream.getvalue(), len(records)
 
 

@@ -279,13 +279,9 @@ def transition(results, rig_stiffness=None) -> xr.Dataset:
     at_se = float(np.hypot(np.nan_to_num(at_se), (above - below) / np.sqrt(12)))
     mu, mu_se = _sliding_friction(gross, level, split, cof, friction)
     force = float(np.mean(load[fitted])) / (np.nan if rig_stiffness is None else rig_stiffness)
-    values = {
-        "amplitude": (at, at_se),
-        "contact_amplitude": (at - mu * force, float(np.hypot(at_se, force * mu_se))),
-        "mu": (mu, mu_se),
-    }
+    found = ((at, at_se), (at - mu * force, float(np.hypot(at_se, force * mu_se))), (mu, mu_se))
     data = {}
-    for name, (value, se) in values.items():
+    for name, (value, se) in zip(nomenclature.TRANSITION, found, strict=True):
         set_with_se(data, name, value, se, quantity=f"transition_{name}")
     if not np.isfinite(friction[gross]).any():
         data["mu_se"][2]["comment"] = (  # why μ_t from Q*/P has no standard error

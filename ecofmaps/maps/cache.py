@@ -24,24 +24,6 @@ from ecofmaps._codes import warn
 from ecofmaps._version import __version__
 from ecofmaps.io.files import TEMPORARY_NAME, atomic_path, check_room
 
-__all__ = [
-    "DEFAULT_SIZE_BOUND",
-    "ENVIRONMENT_VARIABLE",
-    "JAX_CACHE_FOLDER",
-    "SIZE_VARIABLE",
-    "CacheEntry",
-    "CacheWarning",
-    "cache_directory",
-    "cache_entries",
-    "cache_key",
-    "cache_size_bound",
-    "cached_dataset",
-    "clear_cache",
-    "metadata_checksum",
-    "model_revision",
-    "write_netcdf",
-]
-
 #: Environment variable that overrides the per-user cache directory.
 ENVIRONMENT_VARIABLE = "ECOFMAPS_CACHE"
 
@@ -319,15 +301,10 @@ def cache_entries(cache_dir=None) -> list[CacheEntry]:
             status = path.stat()
         except FileNotFoundError:  # removed meanwhile by another process
             continue
-        entries.append(
-            CacheEntry(
-                path=path,
-                function=_ENTRY.match(path.name)["function"],
-                size=status.st_size,
-                modified=datetime.fromtimestamp(status.st_mtime, tz=UTC),
-                used=datetime.fromtimestamp(max(status.st_atime, status.st_mtime), tz=UTC),
-            )
-        )
+        times = (status.st_mtime, max(status.st_atime, status.st_mtime))
+        modified, used = (datetime.fromtimestamp(t, tz=UTC) for t in times)
+        function = _ENTRY.match(path.name)["function"]
+        entries.append(CacheEntry(path, function, status.st_size, modified, used))
     return entries
 
 

@@ -13,8 +13,6 @@ from ecofmaps import model, paper
 from ecofmaps._inputs import check
 from ecofmaps._version import __version__
 
-__all__ = ["checked_axes", "checked_axis", "checked_load", "grid_dataset", "map_dataset"]
-
 # The order of the variables in a Dataset (xarray orders the dimensions as they first appear).
 _VARIABLES = (
     "displacement",
@@ -109,9 +107,8 @@ def map_dataset(axes: dict, values: dict, load, title: str) -> xr.Dataset:
     """The Dataset of a map of :func:`compute_map`: ``values``, the load as a coordinate, and
     λ = P/(SΔ*) = 1/((S/P)Δ*) over the axes ``stiffness_ratio`` and ``amplitude`` (eq. 16)."""
     stiffness, amplitude = axes["stiffness_ratio"], axes["amplitude"]
-    lam = model.compliance_ratio(
-        amplitude, 1.0, stiffness[..., None] if amplitude.ndim else stiffness
-    )
+    column = stiffness[..., None] if amplitude.ndim else stiffness
+    lam = model.compliance_ratio(amplitude, 1.0, column)
     dims = tuple(name for name in ("stiffness_ratio", "amplitude") if axes[name].ndim)
     values = {**values, "compliance_ratio": (dims, lam)}
     return grid_dataset(axes, values, title, {} if load is None else {"load": load})

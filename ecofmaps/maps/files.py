@@ -12,8 +12,6 @@ import xarray as xr
 from ecofmaps.io.files import atomic_store, check_room
 from ecofmaps.maps.tiles import tile_workers
 
-__all__ = ["ZARR_SUFFIX", "write_map"]
-
 #: The suffix of the paths that :func:`write_map` writes as zarr stores.
 ZARR_SUFFIX = ".zarr"
 

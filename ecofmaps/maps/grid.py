@@ -18,8 +18,6 @@ from ecofmaps.model.on_profile import as_profile, check_mapping, steady_numbers,
 from ecofmaps.model.simulation import fretting_loop
 from ecofmaps.model.steady_state import dimensionless
 
-__all__ = ["compute_loops", "compute_map", "compute_profile_map", "compute_universal_map"]
-
 _MODEL_ON_PROFILE = (
     "compliant wear-scar interaction model on a measured or modelled scar profile: a rigid "
     "round-ended pad with Coulomb friction feels the profile's slope g(X) (eq. 9 pointwise), "
@@ -352,18 +350,12 @@ def compute_profile_map(
         grid = [np.atleast_1d(a) for a in axes.values()]
         points = [axis.ravel() for axis in np.meshgrid(*grid, indexing="ij")]
         # λ = P/(S Δ*) = 1/((S/P) Δ*): a unit load and the stiffness ratio
-        tiles = [
-            steady_numbers(profile, a, 1.0, s, m, mapping=mapping)
-            for s, a, m in zip(
-                *(np.split(p, range(max_chunk, p.size, max_chunk)) for p in points), strict=True
-            )
-        ]
+        bounds = range(max_chunk, points[0].size, max_chunk)
+        pieces = zip(*(np.split(p, bounds) for p in points), strict=True)
+        tiles = [steady_numbers(profile, a, 1.0, s, m, mapping=mapping) for s, a, m in pieces]
         shape = tuple(axis.size for axis in grid)
         names = ("slip_ratio", "ecof_ratio", "regime", "normalized_energy", "normalized_max_force")
-        values = {
-            name: np.concatenate([np.asarray(t[name]) for t in tiles]).reshape(shape)
-            for name in names
-        }
+        values = {n: np.concatenate([t[n] for t in tiles]).reshape(shape) for n in names}
         values.update(steady_values(values, grid[1][None, :, None], load, grid[2][None, None, :]))
         del values["normalized_energy"], values["normalized_max_force"]
         title = "ECoF map of the compliant wear-scar model on a scar profile"

@@ -18,16 +18,6 @@ import numpy as np
 from ecofmaps._inputs import available_memory
 from ecofmaps._interrupts import check_interrupted
 
-__all__ = [
-    "BLOCK_POINTS",
-    "BLOCK_TASK",
-    "MAX_CHUNK",
-    "check_max_chunk",
-    "grid_values",
-    "tile_workers",
-]
-
-
 #: Default bound on the grid points evaluated in one call of a kernel (a tile; its working
 #: arrays stay in the processor's cache: docs/performance.md, "Maps").
 MAX_CHUNK = 2**14

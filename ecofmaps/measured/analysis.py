@@ -16,8 +16,6 @@ from ecofmaps.measured.cycles import MIN_SAMPLES
 from ecofmaps.measured.resolve import ReadingOptions
 from ecofmaps.measured.samples import MissingSampleError, is_lazy
 
-__all__ = ["analyze_loops", "resolve_loops"]
-
 #: What the analysis does with missing samples: skip their cycles, or raise.
 NAN_POLICIES = ("skip", "raise")
 
@@ -142,19 +140,11 @@ def analyze_loops(
     0.800000 0.831
     """
     force, load, loads = _at_mean_load(force, load)
-    options = pipeline.LoopOptions(
-        load,
-        hysteresis,
-        stick_window,
-        crossing_window,
-        gross_slip_threshold,
-        flip_force,
-        rig_stiffness,
-    )
+    loop = (load, hysteresis, stick_window, crossing_window, gross_slip_threshold, flip_force)
+    options = pipeline.LoopOptions(*loop, rig_stiffness)
     reading = pipeline.Reading(resolve=bool(resolve), keep_loops=bool(keep_loops))
-    return _run(
-        displacement, force, cycle, options, reading, loads, missing, nan_policy, scheduler, workers
-    )[0]
+    settings = (loads, missing, nan_policy, scheduler, workers)
+    return _run(displacement, force, cycle, options, reading, *settings)[0]
 
 
 def _run(

@@ -23,22 +23,6 @@ from ecofmaps.measured.cycles import Cycles, find_cycles
 from ecofmaps.measured.measure import GROSS_SLIP_THRESHOLD, NEIGHBOURS, Stretch, measure_cycles
 from ecofmaps.measured.samples import MissingSampleError
 
-__all__ = [
-    "IN_PROCESS",
-    "TASK_SAMPLES",
-    "Analysis",
-    "LoopOptions",
-    "Reading",
-    "block_file",
-    "force_at_mean_load",
-    "kept_block",
-    "measure_chunk",
-    "only",
-    "runner_for",
-    "temporary_file",
-    "write_whole",
-]
-
 #: Samples of the recording measured by one chunk of a long recording (about; whole cycles).
 TASK_SAMPLES = 1 << 22
 #: The reading along the stroke of the per-cycle values alone (no grid of positions).

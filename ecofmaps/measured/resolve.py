@@ -13,18 +13,6 @@ from ecofmaps._inputs import check
 from ecofmaps.measured.quality import ALL, REASONS, RESOLVED, add_reason, has_reason
 from ecofmaps.measured.resolve_branches import along_stroke_values
 
-__all__ = [
-    "ReadingOptions",
-    "checked_stick_window",
-    "read_along_stroke",
-    "resolve_analyzed_loops",
-    "resolved_attrs",
-    "settle",
-    "single_value",
-    "within",
-]
-
-
 # How this module reads the quantities that have a general meaning elsewhere (netCDF comment).
 _COMMENTS = {
     "mu": "read along the stroke: tan((atan(Q+/P) - atan(Q-/P))/2) at each position",

@@ -10,8 +10,6 @@ from ecofmaps._interrupts import check_interrupted
 from ecofmaps.measured import quality
 from ecofmaps.measured.measure import SECOND_DIFFERENCE
 
-__all__ = ["along_stroke_values"]
-
 #: A given stiffness does not fit when it tilts the stick sets by this many σ.
 _TILT_SPREAD = 3.0
 #: Fewest samples in a stick set to measure the stiffness, the stick level and the noise.
