@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from ecofmaps.cli import common
 
-__all__ = ["add", "run"]
-
 
 def add(subparsers) -> None:
     parser = subparsers.add_parser(

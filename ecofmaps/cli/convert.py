@@ -8,8 +8,6 @@ from ecofmaps.cli import common
 from ecofmaps.cli.main import CommandError
 from ecofmaps.io.files import CHUNK_BYTES, record_written
 
-__all__ = ["add", "run"]
-
 _HELP = {
     "source": "the recording to read",
     "destination": "the file or store to write",

@@ -10,8 +10,6 @@ from ecofmaps.cli import common
 from ecofmaps.cli.main import CommandError
 from ecofmaps.io.files import record_written, write_text
 
-__all__ = ["add", "run"]
-
 POINT_OPTIONS = ("ecof", "amplitude", "load", "stiffness")
 GROOVE_OPTIONS = ("aspect_ratio", "scar_depth", "scar_half_width")
 

@@ -10,8 +10,6 @@ from ecofmaps._interrupts import interrupted_waiting
 from ecofmaps.cli.common import CommandError, option_adder
 from ecofmaps.web import INSTALL_WEB, missing_web_packages
 
-__all__ = ["add", "run"]
-
 _HELP = {
     "--port": "the port to listen on (default %(default)s)",
     "--no-browser": "do not open the page in a browser",

@@ -20,8 +20,6 @@ from ecofmaps._parallel import start_resource_tracker_quietly
 from ecofmaps.cli import common
 from ecofmaps.io.files import record_written
 
-__all__ = ["TaskQueue", "add", "run"]
-
 _FORMATS = ("png", "pdf", "svg")
 
 _HELP = {

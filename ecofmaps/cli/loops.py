@@ -21,8 +21,6 @@ from ecofmaps.cli.main import CommandError, option_names
 from ecofmaps.io.files import FileLineError, atomic_path, record_written
 from ecofmaps.web import INSTALL_WEB, missing_web_packages
 
-__all__ = ["SUMMARY_VARIABLES", "add", "run"]
-
 _HELP = {
     "files": "recording files (CSV, TSV or other text, TDMS, HDF5/netCDF-4, zarr)",
     "--example": "analyse the shipped synthetic example (load 450N) instead of FILEs",

@@ -1,6 +1,6 @@
 """``ecofmaps loops`` on long tests: out of core, in parallel, resumable, with progress.
 
-A recording read lazily (past :data:`ecofmaps.io.recordings.LAZY_SAMPLES` samples, or with
+A recording read lazily (past :data:`ecofmaps.io.recording_types.LAZY_SAMPLES` samples, or with
 ``--workers``, ``--scheduler``, ``--resume``) is analysed on threads, processes or a cluster, its
 lines written in order; with ``--out`` each block is kept in ``<out>.partial/`` (docs/parallel.md).
 """
@@ -25,8 +25,6 @@ from ecofmaps.measured import pipeline
 from ecofmaps.measured.cycles import Cycles
 from ecofmaps.measured.resolve import ReadingOptions
 from ecofmaps.measured.samples import MissingSampleError
-
-__all__ = ["PARTIAL_SUFFIX", "LongRun"]
 
 #: Suffix of the folder that holds an unfinished run's blocks beside ``--out``.
 PARTIAL_SUFFIX = ".partial"

@@ -21,8 +21,6 @@ import warnings
 from ecofmaps._interrupts import STOP_SIGNALS, interrupts_stop_writes
 from ecofmaps._version import __version__
 
-__all__ = ["CommandError", "build_parser", "console", "main"]
-
 
 class CommandError(Exception):
     """A user error found after parsing (bad file, bad value): reported in one line."""

@@ -16,8 +16,6 @@ from ecofmaps.cli import common
 from ecofmaps.cli.main import CommandError
 from ecofmaps.io.files import record_written
 
-__all__ = ["add", "run"]
-
 #: The grid's axes, in the order of the map's dimensions, and their metavars.
 _AXES = {"stiffness_ratio": "S/P", "aspect_ratio": "Z/X", "amplitude": "DELTA", "mu": "MU"}
 _HELP = {

@@ -9,8 +9,6 @@ from ecofmaps import paper
 from ecofmaps._version import __version__
 from ecofmaps.cli import common
 
-__all__ = ["add", "run"]
-
 _HELP = {
     "--amplitude": "displacement amplitude Δ* (default 50um)",
     "--load": "normal load P (default 450N)",

@@ -8,8 +8,6 @@ from ecofmaps.cli import common
 from ecofmaps.cli.main import CommandError
 from ecofmaps.io.files import record_written, write_text
 
-__all__ = ["add", "run"]
-
 #: The per-test numbers, in the order printed and written.
 _WEAR = (
     *("cumulated_energy", "wear_volume", "energy_wear_coefficient"),

@@ -11,8 +11,6 @@ from ecofmaps.figures import style
 from ecofmaps.figures.style import MICRO, axis_label, number_text, stiffness_label
 from ecofmaps.lab import per_cycle, sliding_condition
 
-__all__ = ["loop_scar_closure_figure", "running_condition_map"]
-
 #: How each sliding condition is marked on the running-condition map.
 _CONDITION_MARKERS = {
     "partial slip": dict(marker="o", markerfacecolor="white"),

@@ -16,8 +16,6 @@ from ecofmaps.figures import style
 from ecofmaps.figures.style import MICRO, axis_label, scalar
 from ecofmaps.model import NO_GROSS_SLIP, compliance_ratio, energy_cof
 
-__all__ = ["ecof_ratio_contours", "universal_ecof_ratio_map"]
-
 
 def _ecof_ratio_contours(ax, x, ratio: xr.DataArray, regime: xr.DataArray) -> list:
     """Filled and labelled contours of μ_E/μ over (x, z_o/x_o), no-gross-slip area hatched."""

@@ -18,8 +18,6 @@ from ecofmaps.figures.style import MICRO, axis_label, load_label, scalar, stiffn
 from ecofmaps.measured.quality import SEPARATOR
 from ecofmaps.model.regimes import GROSS_SLIP, Regime
 
-__all__ = ["cof_evolution", "measured_and_fitted_loops", "measured_loops", "resolved_loops"]
-
 #: The colour of the ECoF and of the GICoF over the cycles.
 _COLORS = {"ecof": "tab:orange", "gicof": "tab:blue"}
 

@@ -14,14 +14,6 @@ from matplotlib.figure import Figure
 from ecofmaps.figures import style
 from ecofmaps.figures.style import MICRO, axis_label, scalar
 
-__all__ = [
-    "dissipated_energy_curves",
-    "ecof_ratio_curves",
-    "loops_by_aspect_ratio",
-    "rigid_and_compliant_loops",
-    "slip_amplitude_curves",
-]
-
 
 def rigid_and_compliant_loops(loops: xr.Dataset) -> Figure:
     r"""Figure 5: the steady loop of a rigid rig against that of a compliant one.

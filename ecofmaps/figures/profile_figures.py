@@ -10,8 +10,6 @@ from matplotlib.figure import Figure
 from ecofmaps.figures import style
 from ecofmaps.figures.style import MICRO, axis_label, scalar
 
-__all__ = ["scar_profile_figure", "scar_shape_comparison"]
-
 #: Colour of each scar shape; the parabola of the same D/W (the shortcut) is black, dashed.
 SHAPE_COLORS = {
     "parabolic": "tab:orange",

@@ -21,15 +21,6 @@ if TYPE_CHECKING:  # imported when a figure is made: the registry reads without 
     import xarray as xr
     from matplotlib.figure import Figure
 
-__all__ = [
-    "FIGURES",
-    "FigureRecipe",
-    "figure_groups",
-    "figure_parts",
-    "make_figure",
-    "make_figures",
-]
-
 #: Groove aspect ratios z_o/x_o of Figures 7, 8, 11 and the universal map. [1]
 _ASPECT_RATIOS = np.linspace(0.0, 0.3, 61)
 #: λ of the universal map, on a logarithmic scale: near-rigid rigs to well past the end of

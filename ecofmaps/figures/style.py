@@ -16,8 +16,6 @@ from matplotlib.path import Path as DrawnPath
 from ecofmaps._nomenclature import QUANTITIES, axis_label
 from ecofmaps.io.files import atomic_path
 
-__all__ = ["ECOF_RATIO_LEVELS", "RECORDING_DPI", "save_figure"]
-
 #: Contour levels of μ_E/μ shared by Figure 11 and the universal map, so they read alike.
 ECOF_RATIO_LEVELS = (1.01, 1.02, 1.03, 1.04, 1.05, 1.06, 1.08, 1.10, 1.12, 1.14, 1.17, 1.20, 1.25)
 #: The level drawn heavier: the paper's "most tests are within 5 %".

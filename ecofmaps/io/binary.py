@@ -19,8 +19,6 @@ from ecofmaps.io.columns import ColumnError, column_scale, listed_names, matchin
 from ecofmaps.io.recording_types import LAZY_SAMPLES, Recording, RecordingError, si_values
 from ecofmaps.io.tdms import UNIT_PROPERTIES, LazyArray, carried_unit, open_tdms_group, tdms_groups
 
-__all__ = ["DEFAULT_CHUNK", "Column", "Variable", "open_group", "read_binary", "variables"]
-
 #: What each rig format calls a column, for messages.
 _NOUNS = {"tdms": "channel", "hdf5": "variable", "zarr": "variable"}
 

@@ -9,19 +9,6 @@ import itertools
 import math
 import re
 
-__all__ = [
-    "COMMON_UNITS",
-    "DEFAULT_UNITS",
-    "KINDS",
-    "SYNONYMS",
-    "ColumnError",
-    "column_scale",
-    "find_column",
-    "listed_names",
-    "matching_columns",
-    "split_unit",
-]
-
 #: The kind of quantity of each column role, as :func:`ecofmaps.units.parse_quantity` names it:
 #: a recording's displacement, force and normal load, a scar profile's position x and height z.
 KINDS = {"displacement": "length", "force": "force", "load": "force", "x": "length", "z": "length"}

@@ -16,20 +16,6 @@ from pathlib import Path
 
 from ecofmaps._interrupts import check_interrupted
 
-__all__ = [
-    "CHUNK_BYTES",
-    "MANIFEST",
-    "TEMPORARY_NAME",
-    "FileLineError",
-    "atomic_path",
-    "atomic_store",
-    "check_room",
-    "is_store",
-    "record_written",
-    "write_text",
-    "written_by_ecofmaps",
-]
-
 #: The most bytes of one chunk of a zarr or HDF5 variable: HDF5 keeps a chunk this size in
 #: its cache (1 MiB per variable by default), so reads of parts of a chunk read it once.
 CHUNK_BYTES = 1 << 20

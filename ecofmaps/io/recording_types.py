@@ -20,16 +20,6 @@ from ecofmaps._nomenclature import attrs
 from ecofmaps._parallel import SOURCE
 from ecofmaps.io.files import FileLineError
 
-__all__ = [
-    "LAZY_SAMPLES",
-    "LineIndex",
-    "Recording",
-    "RecordingError",
-    "RecordingWarning",
-    "check_regular_file",
-    "si_values",
-]
-
 #: What a path that is not a regular file is, by ``stat`` test.
 _NOT_FILES = {
     stat.S_ISFIFO: "a named pipe (FIFO)",

@@ -16,21 +16,12 @@ from ecofmaps.io.binary import read_binary
 from ecofmaps.io.columns import column_scale
 from ecofmaps.io.files import is_store
 from ecofmaps.io.recording_types import (
-    LAZY_SAMPLES,
     LineIndex,
     Recording,
     RecordingError,
     check_regular_file,
 )
 from ecofmaps.io.text import BLOCK_BYTES, text_blocks
-
-__all__ = [
-    "LAZY_SAMPLES",
-    "open_recording",
-    "read_recording",
-    "recording_blocks",
-    "recording_format",
-]
 
 _NAN_POLICIES = ("propagate", "raise")
 _MAGIC = {b"TDSm": "tdms", b"\x89HDF\r\n\x1a\n": "hdf5"}
@@ -213,8 +204,9 @@ def read_recording(
     nan_policy : {'propagate', 'raise'}
         Missing samples are NaN (:attr:`Recording.missing`), or an error naming the first.
     lazy : bool, optional
-        Dask arrays (True) or NumPy arrays (False); by default lazy for a rig file of more
-        than :data:`LAZY_SAMPLES` samples (a text file is parsed into memory either way).
+        Dask arrays (True) or NumPy arrays (False); by default lazy for a rig file of more than
+        :data:`~ecofmaps.io.recording_types.LAZY_SAMPLES` samples (a text file is parsed into
+        memory either way).
     chunks : int, optional
         Samples per dask block; by default a multiple of the file's own chunks near 2**22.
     block_bytes : int, optional

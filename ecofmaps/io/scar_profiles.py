@@ -13,8 +13,6 @@ from ecofmaps.io.recording_types import RecordingError
 from ecofmaps.io.text import text_blocks
 from ecofmaps.model.profiles import ScarProfile, ScarProfileWarning, scar_profile_and_findings
 
-__all__ = ["ScarProfileError", "read_scar_profile"]
-
 
 class ScarProfileError(FileLineError):
     """A damaged or unusable scar-profile file: the message names the file and the line."""

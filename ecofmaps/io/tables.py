@@ -13,8 +13,6 @@ import xarray as xr
 from ecofmaps import _nomenclature as nomenclature
 from ecofmaps.model.regimes import Regime
 
-__all__ = ["RESULT_COLUMNS", "csv_text", "read_results", "results_csv", "results_table"]
-
 #: The quantities of :func:`ecofmaps.analyze_loops` in the results table, in order.
 RESULT_QUANTITIES = (
     "cycle",

@@ -20,8 +20,6 @@ from ecofmaps._codes import warn
 from ecofmaps.io.columns import listed_names
 from ecofmaps.io.recording_types import RecordingError, RecordingWarning
 
-__all__ = ["TdmsBackendEntrypoint", "TdmsReader", "open_tdms_group", "tdms_groups"]
-
 #: A channel's properties that give its unit, in the order they are looked at.
 UNIT_PROPERTIES = ("unit_string", "NI_UnitDescription")
 

@@ -32,8 +32,6 @@ from ecofmaps.io.recording_types import (
     si_values,
 )
 
-__all__ = ["BLOCK_BYTES", "LINE_BYTES", "MISSING", "PREAMBLE_LINES", "text_blocks"]
-
 #: Bytes of text parsed at a time (cut at the last line end within).
 BLOCK_BYTES = 1 << 24
 

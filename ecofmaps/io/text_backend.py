@@ -10,8 +10,6 @@ from ecofmaps.io.recording_types import RecordingError
 from ecofmaps.io.recordings import open_recording, recording_format
 from ecofmaps.io.tdms import engine_path, has_suffix
 
-__all__ = ["TextBackendEntrypoint"]
-
 #: The options of :func:`ecofmaps.io.read_recording` the engine takes.
 _OPTIONS = ("displacement_column", "force_column", "cycle_column", "displacement_unit")
 _OPTIONS += ("force_unit", "nan_policy", "block_bytes")

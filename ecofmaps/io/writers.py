@@ -15,8 +15,6 @@ from ecofmaps import _nomenclature as nomenclature
 from ecofmaps.io.files import CHUNK_BYTES, atomic_store, check_room
 from ecofmaps.io.recordings import recording_blocks
 
-__all__ = ["WRITE_FORMATS", "RecordingWriter", "convert_recording"]
-
 #: The format written for each suffix.
 WRITE_FORMATS = {".zarr": "zarr", **dict.fromkeys((".h5", ".hdf5", ".nc"), "hdf5")}
 WRITE_FORMATS |= {".tdms": "tdms", ".csv": "text"}

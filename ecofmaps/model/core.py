@@ -12,23 +12,6 @@ import numpy as np
 from ecofmaps._inputs import as_float64, check
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP, SELF_LOCKING
 
-__all__ = [
-    "checked",
-    "compliance_ratio",
-    "curvature_number",
-    "ecof_ratio",
-    "locking_margin",
-    "normalized_energy",
-    "normalized_max_force",
-    "regime_code",
-    "slip_position",
-    "slip_ratio",
-    "slip_roots",
-    "steady_inputs",
-    "traction_ratio",
-    "valid_geometry",
-]
-
 #: The rule and unit of each SI input, for :func:`ecofmaps._inputs.check`, in the order of
 #: :func:`steady_inputs`' arguments.
 _RULES = {

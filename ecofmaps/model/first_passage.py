@@ -14,15 +14,6 @@ import jax.numpy as jnp
 from ecofmaps.model import profile_core as core
 from ecofmaps.model.regimes import BEYOND_PROFILE, GROSS_SLIP, NO_GROSS_SLIP, SELF_LOCKING
 
-__all__ = [
-    "JAMMED_TRACTION",
-    "draw_loop",
-    "jump_areas",
-    "simulation_step",
-    "simulation_tables",
-    "steady_loop",
-]
-
 #: Peak traction ratio |Q|/P beyond which a steady loop is reported self-locking, 1/sqrt(eps)
 #: (about 6.7e7): the loop's area, a difference of forces of that size, is left to rounding.
 JAMMED_TRACTION = sys.float_info.epsilon**-0.5

@@ -19,17 +19,6 @@ from ecofmaps.model.core import checked, compliance_ratio, steady_inputs, valid_
 from ecofmaps.model.profiles import ScarProfile
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
 
-__all__ = [
-    "MAPPINGS",
-    "as_profile",
-    "check_mapping",
-    "profile_loop",
-    "profile_simulation",
-    "steady_numbers",
-    "steady_numbers_and_loops",
-    "steady_values",
-]
-
 #: How a pad position x maps onto the profile: eq. 11, X = x W/x_o; or X = x.
 MAPPINGS = ("scaled", "physical")
 

@@ -12,19 +12,6 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-__all__ = [
-    "Side",
-    "Tables",
-    "centre_segment",
-    "crossing_fraction",
-    "interval_table",
-    "mean_excess",
-    "mean_traction",
-    "profile_tables",
-    "table_levels",
-    "traction_forward",
-]
-
 _TINY = float(np.nextafter(0.0, 1.0))  # the interval [0, _TINY) holds only lambda = 0
 
 # log1p(r)/r - 1 + r/2 = sum_{m>=0} (-1)^m r^(m+2)/(m+3) for |r| < 1/8, where the first

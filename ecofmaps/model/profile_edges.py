@@ -9,8 +9,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["AMBIGUOUS_EDGES", "UNCERTAIN_EDGES", "ScarProfileWarning", "scar_extent"]
-
 #: The edges are ambiguous when an edge of the band between the ridges lies beyond the
 #: groove's by more than this fraction of the groove's half-width. [1]
 AMBIGUOUS_EDGES = 0.1

@@ -10,8 +10,6 @@ import numpy as np
 from ecofmaps._inputs import si_units
 from ecofmaps.model.profiles import MIN_SCAR_SAMPLES, ScarProfile, profile_of
 
-__all__ = ["flat_bottomed_profile", "parabolic_profile", "ridged_profile", "w_shaped_profile"]
-
 
 def _above(name: str, value, bound=0.0, unit="") -> float:
     """``value`` as a float; ``ValueError`` unless it is finite and > ``bound``."""

@@ -16,20 +16,6 @@ from ecofmaps._codes import warn
 from ecofmaps._inputs import is_concrete, si_units
 from ecofmaps.model.profile_edges import ScarProfileWarning, scar_extent
 
-__all__ = [
-    "AUTO_SMOOTHING",
-    "MIN_SCAR_SAMPLES",
-    "OUTLIER_NEIGHBOURS",
-    "OUTLIER_THRESHOLD",
-    "ScarProfile",
-    "ScarProfileWarning",
-    "local_quadratic",
-    "outlying_samples",
-    "profile_of",
-    "scar_profile",
-    "scar_profile_and_findings",
-]
-
 #: Fewest samples a measured profile must have between the scar's edges.
 MIN_SCAR_SAMPLES = 20
 #: Outliers: neighbours on each side of a sample whose median and MAD it is judged by.

@@ -8,19 +8,6 @@ import numpy as np
 
 from ecofmaps._codes import Code
 
-__all__ = [
-    "BEYOND_PROFILE",
-    "GROSS_SLIP",
-    "INVALID",
-    "NO_GROSS_SLIP",
-    "PARTIAL_SLIP",
-    "SELF_LOCKING",
-    "SLIDING_CONDITIONS",
-    "Regime",
-    "regime_condition",
-    "sliding_condition_of",
-]
-
 
 class Regime(Code):
     """Regime codes returned by :func:`ecofmaps.slip_regime`, stored in maps and in the

@@ -16,8 +16,6 @@ from ecofmaps.model.on_profile import broadcast_history, profile_loop, profile_s
 from ecofmaps.model.regimes import GROSS_SLIP, INVALID, NO_GROSS_SLIP
 from ecofmaps.model.steady_state import dimensionless, one_geometry
 
-__all__ = ["fretting_loop", "simulate"]
-
 
 @partial(jax.jit, static_argnames="num")
 def _steady_loop(amplitude, load, stiffness, mu, aspect_ratio, groove_half_width, num):

@@ -15,16 +15,6 @@ from ecofmaps.model.core import valid_geometry
 from ecofmaps.model.on_profile import steady_numbers, steady_values
 from ecofmaps.model.regimes import INVALID, Regime
 
-__all__ = [
-    "dimensionless",
-    "dissipated_energy",
-    "energy_cof",
-    "max_force",
-    "slip_amplitude",
-    "slip_regime",
-    "valid_geometry",
-]
-
 #: The quantities' names among :func:`ecofmaps.model.on_profile.steady_values`, where other.
 _ON_PROFILE = {"energy_cof": "ecof"}
 

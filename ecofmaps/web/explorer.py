@@ -27,8 +27,6 @@ from ecofmaps.paper import FIGURE_11_STIFFNESS_RATIOS
 from ecofmaps.units import DIMENSIONS, DOMAIN, TEXT_LIMIT, bare_number_warning, parse_quantity
 from ecofmaps.web import quantity_plot
 
-__all__ = ["INPUTS", "bare_number_warnings", "explorer_page", "parameter_value", "point_values"]
-
 #: The page's inputs: URL query key -> (quantity of the nomenclature, label, default text);
 #: each takes the values of its quantity in the model's domain, :data:`ecofmaps.units.DOMAIN`.
 INPUTS = {

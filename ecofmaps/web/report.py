@@ -42,8 +42,6 @@ from ecofmaps.measured.quality import REASONS, has_reason, quality_summary
 from ecofmaps.model.simulation import fretting_loop
 from ecofmaps.web import quantity_plot
 
-__all__ = ["LOOPS_CARRIED", "recording_inputs", "report_document", "write_report"]
-
 #: Cycles whose loops a report carries by default, spread evenly over the test, for the reader
 #: to pick from: the bulk of a short test's report.
 LOOPS_CARRIED = 60

@@ -17,8 +17,6 @@ from ecofmaps._interrupts import check_interrupted, interrupted_waiting
 from ecofmaps.units import TEXT_LIMIT
 from ecofmaps.web.explorer import explorer_page, warm_up
 
-__all__ = ["LOCAL_HOSTS", "serve_explorer"]
-
 # The longest query value let through to Panel, whose reading of the query fails on an
 # integer of more than 4300 digits; a longer one is cut to one character over TEXT_LIMIT.
 _QUERY_LIMIT = 1000
