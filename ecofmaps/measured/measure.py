@@ -357,6 +357,7 @@ def _loop_values(block, options):
         & ~mindlin,
         "negative-area": (energy_ratio < 0.0) & ~anticlockwise,
         "negative-slip": ~(slip > 0.0),
+        "slip-beyond-amplitude": slip > amplitude * (1.0 + 1e-9),  # beyond rounding
         "no-zero-crossing": ~(zero_on_loop[:cycles] & zero_on_loop[cycles:]),
         "curved-stick": curved & ~on_plateau & ~mindlin,
         "curved-stick-sliding": curved & on_plateau & ~mindlin,

@@ -124,6 +124,11 @@ REASONS = {
         ("dissipated_energy", "energy_ratio", "ecof"),
     ),
     "negative-slip": ("δ* <= 0: the zero-force crossings in the wrong order", _SLIP),
+    "slip-beyond-amplitude": (
+        "δ* > Δ* beyond rounding: the zero-force crossings lie outside the loop's extremes as "
+        "read through the noise (the noise of a near-rigid loop, or a misread extreme)",
+        (*_SLIP, "opening_ratio", "contact_opening_ratio"),
+    ),
     "curved-stick": (
         "the stick sides are curved (a polymer, micro-slip): no straight line gives S",
         ("stiffness", *GICOF, *RESOLVED),

@@ -503,6 +503,33 @@ def assert_plausible(result):
         assert np.all(at[read] <= np.nanmax(loops_x, axis=1) + 1e-9 * amplitude[read])
 
 
+def test_slip_beyond_amplitude():
+    """A slip amplitude beyond the amplitude, impossible on a loop, is never reported: a noisy
+    cycle (a model loop's columns swapped, 96 samples) whose crossings at Q = 0 lie outside its
+    extremes as read through the noise."""
+    recording = np.load(Path(__file__).with_name("slip_beyond_amplitude.npz"))
+    result = quiet(
+        recording["displacement"], recording["force"], LOAD, keep_loops=True, rig_stiffness=1e9
+    )
+    assert result.quality.values.tolist() == ["slip-beyond-amplitude"]
+    for name in ("slip_amplitude", "ecof", "opening_ratio", "contact_opening_ratio"):
+        assert np.isnan(result[name]).all(), name
+    assert_plausible(result)
+
+
+@pytest.mark.parametrize("stiffness", [1e12, np.inf])
+def test_near_rigid_gross_slip_is_ok(stiffness):
+    """On a noise-free loop of a (near-)rigid rig the crossings at Q = 0 are (almost) at the
+    extremes: δ* = Δ* - μP/S, not flagged however close."""
+    loop = ecofmaps.fretting_loop(50e-6, LOAD, stiffness, 0.8, 0.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", LoopQualityWarning)
+        result = analyze_loops(*(np.asarray(a) for a in loop), LOAD)
+    assert result.quality.values.tolist() == ["ok"]
+    slip, amplitude = float(result.slip_amplitude[0]), float(result.amplitude[0])
+    np.testing.assert_allclose(amplitude - slip, 0.8 * LOAD / stiffness, rtol=1e-6, atol=1e-18)
+
+
 @st.composite
 def odd_recordings(draw):
     """Random (Δ, Q) recordings: model loops as a rig records them, noise, random walks,
