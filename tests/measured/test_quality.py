@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 import ecofmaps
 from ecofmaps.lab.regime import sliding_condition_line
 from ecofmaps.measured.analysis import analyze_loops
+from ecofmaps.measured.measure import _RIG_RATIOS
 from ecofmaps.measured.pipeline import LoopOptions
 from ecofmaps.measured.quality import (
     ALL,
@@ -424,7 +425,8 @@ def test_vocabulary():
     """Reasons are lower-case words joined by hyphens; joined by '+', split back alike."""
     for reason, (meaning, scope) in REASONS.items():
         assert re.fullmatch(r"[a-z0-9]+(-[a-z0-9]+)*", reason), reason
-        assert meaning and (scope == ALL or set(scope) <= {*PER_CYCLE, *RESOLVED}), reason
+        known = {*PER_CYCLE, *_RIG_RATIOS, *RESOLVED}
+        assert meaning and (scope == ALL or set(scope) <= known), reason
     flags = {
         "negative-slip": np.array([True, False, False, True]),
         "curved-stick": np.array([True, False, True, False]),
