@@ -312,10 +312,12 @@ def refuse_to_overwrite(outputs, inputs, *, overwrite: bool = False, folders=())
                 "or --overwrite to replace the files ecofmaps wrote there (others are kept)"
             )
     for option, target in outputs:
-        if not os.path.lexists(target) or (overwrite and written_by_ecofmaps(target)):
+        if not os.path.lexists(target):
             continue
         if written_by_ecofmaps(target):
-            raise CommandError(f"{option} {target} exists already: --overwrite replaces it")
+            if not overwrite:
+                raise CommandError(f"{option} {target} exists already: --overwrite replaces it")
+            continue
         if not (target.is_dir() or target.is_file()):
             raise CommandError(
                 f"{option} {target} is not a regular file (a device, pipe or socket)"
