@@ -193,8 +193,14 @@ REASONS = {
     ),
 }
 
-#: The reasons that the reading along the stroke adds, the last five (their flags do not warn).
-READING_REASONS = tuple(REASONS)[-5:]
+#: The reasons that the reading along the stroke adds (their flags do not warn).
+READING_REASONS = (
+    "stiffness-mismatch",
+    "no-overlap",
+    "few-slip-samples",
+    "mu-varies",
+    "gicof-varies",
+)
 
 #: What to do about a recorded normal load that is negative.
 COMPRESSION = "is it recorded negative in compression? Give it with the other sign (-Fz)."
