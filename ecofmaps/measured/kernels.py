@@ -206,12 +206,21 @@ def zero_force_crossings(x, y, length, band, intercept, across, rounding):
 
 
 @numba.njit(**_COMPILE)
-def _curve_intercept(scaled, product, window, y, n, sums):
+def _curve_intercept(scaled, product, window, y, n):
     r"""Intercept :math:`a` of :math:`Q = a + b\xi + c\xi Q` through the window, and its count."""
-    _line_sums(scaled, product, n, window, sums[0])
-    _line_sums(scaled, y, n, window, sums[1])
-    count, mean_s, mean_z, sz, ss, zz = sums[0]
-    mean_q, sq = sums[1, 2], sums[1, 3]
+    count, sum_s, sum_z, sum_q = 0.0, 0.0, 0.0, 0.0
+    for j in range(n):
+        if window[j]:
+            count += 1.0
+            sum_s += scaled[j]
+            sum_z += product[j]
+            sum_q += y[j]
+    mean_s, mean_z, mean_q = sum_s / count, sum_z / count, sum_q / count
+    ss, sz, zz, sq = 0.0, 0.0, 0.0, 0.0
+    for j in range(n):
+        if window[j]:
+            ds, dz, dq = scaled[j] - mean_s, product[j] - mean_z, y[j] - mean_q
+            ss, sz, zz, sq = ss + ds * ds, sz + ds * dz, zz + dz * dz, sq + ds * dq
     ratio = sz / ss
     rr, rq = 0.0, 0.0
     for j in range(n):
@@ -230,7 +239,6 @@ def line_crossings(x, y, length, compliance, half_width, load, rounding):
     force, on_loop = np.empty(rows), np.zeros(rows, np.bool_)
     scaled, product = np.empty(width), np.empty(width)
     window, before = np.zeros(width, np.bool_), np.zeros(width, np.bool_)
-    sums = np.empty((2, 6))
     for r in range(rows):
         n, rising, h = length[r], r < rows // 2, half_width[r]
         count = 0
@@ -248,7 +256,7 @@ def line_crossings(x, y, length, compliance, half_width, load, rounding):
         v1 = x[r, after] - y[r, after] * compliance[r]
         q0, q1 = y[r, previous], y[r, after]
         share = v0 / (v0 - v1) if v0 - v1 != 0.0 else 0.5
-        intercept, fitted = _curve_intercept(scaled, product, window, y[r], n, sums)
+        intercept, fitted = _curve_intercept(scaled, product, window, y[r], n)
         # On the loop: the fitted window, or the pair interpolated between, holds samples
         # on both sides of ξ = 0, and the crossing's force lies within theirs.
         fits = fitted >= _FIT_SAMPLES
@@ -322,6 +330,18 @@ def second_difference_medians(values, first, stop, reach):
         else:
             result[i - first] = 0.5 * (window[n // 2 - 1] + window[n // 2])
     return result
+
+
+@numba.njit(**_COMPILE)
+def stretch_ranges(values, offset, count):
+    """Largest less smallest of ``values`` over each stretch ``offset``, ``count`` (their unit)."""
+    ranges = np.empty(offset.size)
+    for k in range(offset.size):
+        highest = lowest = values[offset[k]]
+        for i in range(offset[k] + 1, offset[k] + count[k]):
+            highest, lowest = max(highest, values[i]), min(lowest, values[i])
+        ranges[k] = highest - lowest
+    return ranges
 
 
 @numba.njit(**_COMPILE)

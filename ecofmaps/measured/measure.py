@@ -138,26 +138,24 @@ def loop_blocks(
         around = slice(max(lower - 1, 0), upper + 1)
         x = displacement[low:high] - _drift(low, high, middle, centre_x, around)
         if ready < needed:
-            cut, q = slice(ready, needed), force_sign * force[low:high]
+            cut, q = slice(ready, needed), _signed(force[low:high], force_sign)
             centre_q[cut] = _path_means(x, q, start[cut] - low, count[cut], closed=False)
             ready = needed
         a, b = int(start[block.start]), int(start[block.stop - 1] + count[block.stop - 1])
         near = slice(max(block.start - 1, 0), block.stop + 1)
         offset = start[block] - a
-        highest, lowest, _, _ = kernels.fitted_extremes(  # the samples' (no fit)
-            np.ascontiguousarray(force[a:b]), offset, count[block], np.inf
-        )
+        swing = kernels.stretch_ranges(np.ascontiguousarray(force[a:b]), offset, count[block])
         yield LoopBlock(
             rows=slice(int(kept[block.start]), int(kept[block.stop - 1]) + 1),
             displacement=x[a - low : b - low],
-            force=force_sign * force[a:b] - _drift(a, b, middle, centre_q, near),
+            force=_signed(force[a:b], force_sign) - _drift(a, b, middle, centre_q, near),
             offset=offset,
             count=count[block],
             rotation=cycles.rotation[kept[block]],
             continuous=True,
             displacement_centre=centre_x[block],
             force_centre=centre_q[block],
-            force_swing=highest - lowest,
+            force_swing=swing,
             force_drift_se=_drift_se(middle, count, centre_q, block),
         )
 
@@ -194,7 +192,7 @@ def _labelled_block(cycles: Cycles, displacement, force, block, sign) -> LoopBlo
     offset = np.concatenate([[0], np.cumsum(count[:-1])])
     index = np.repeat(start - offset, count) + np.arange(int(count.sum()))
     x, q = displacement[index], sign * force[index]
-    swing = np.subtract(*kernels.fitted_extremes(q, offset, count, np.inf)[:2])  # the range
+    swing = kernels.stretch_ranges(q, offset, count)
     centre_x = _path_means(x, x, offset, count, closed=True)
     x -= np.repeat(centre_x, count)
     # The force's weights come from the centred displacement, as for drifting loops.
@@ -247,6 +245,11 @@ def _displacement_centres(start, count, displacement, first: int, stop: int):
         x = displacement[low:high]
         centre[a:b] = _path_means(x, x, start[a:b] - low, count[a:b], closed=False)
     return middle, centre
+
+
+def _signed(values, sign):
+    """``values`` times ``sign`` (±1), without a copy when it is +1."""
+    return values if sign > 0 else -values
 
 
 def _drift(low: int, high: int, points, values, near: slice):

@@ -343,6 +343,7 @@ def test_ranges_and_loop_measures():
     highest, lowest, _, _ = kernels.fitted_extremes(x, offset, count, np.inf)
     area, top = kernels.loop_measures(x, y, offset, count, rotation, highest)
     max_force = np.subtract(*kernels.fitted_extremes(y, offset, count, np.inf)[:2]) / 2
+    np.testing.assert_array_equal(kernels.stretch_ranges(y, offset, count), 2 * max_force)
     for k, (a, n) in enumerate(zip(offset, count, strict=True)):
         d, q = x[a : a + n], y[a : a + n]
         assert (highest[k], lowest[k], max_force[k]) == (d.max(), d.min(), np.ptp(q) / 2)
