@@ -18,6 +18,7 @@ from ecofmaps.model.simulation import simulate
 __all__ = [
     "EXAMPLE",
     "LONG_TEST",
+    "SCAR_EXAMPLE",
     "example_path",
     "example_recording",
     "long_recording",
