@@ -38,10 +38,30 @@ def _blanked(x, a: int, b: int, gaps) -> np.ndarray:
 
 
 def _piece_extremes(x, cuts, a: int):
-    """Largest and smallest finite value of each piece of ``x`` and its first sample (or -1)."""
-    piece = np.repeat(np.arange(cuts.size), np.diff(cuts, append=x.size))
-    index = np.arange(a, a + x.size)
-    return [e for f in (np.fmax, np.fmin) for e in extremes_of_runs(f, x, index, piece, cuts)]
+    """Largest and smallest finite value of each piece of ``x`` and its first sample (or -1),
+    found among the samples equal to it (not by a run index over every sample)."""
+    lengths = np.diff(cuts, append=x.size)
+    found = []
+    for reduce in (np.fmax, np.fmin):
+        value = reduce.reduceat(x, cuts)
+        hits = np.flatnonzero(x == np.repeat(value, lengths))
+        after = np.searchsorted(hits, cuts)
+        index = hits[np.minimum(after, max(hits.size - 1, 0))] if hits.size else cuts
+        inside = (after < hits.size) & (index < cuts + lengths)
+        found += [value, np.where(inside, index + a, -1)]
+    return found
+
+
+def _finite_ends(x, cuts):
+    """The first and last finite value of each piece ``x[cuts[k]:cuts[k + 1]]``, or NaN."""
+    finite = np.flatnonzero(np.isfinite(x))
+    ends = np.append(cuts[1:], x.size)
+    if not finite.size:
+        return np.full(cuts.size, np.nan), np.full(cuts.size, np.nan)
+    first = np.minimum(np.searchsorted(finite, cuts), finite.size - 1)
+    last = np.maximum(np.searchsorted(finite, ends) - 1, 0)
+    has = (finite[first] >= cuts) & (finite[first] < ends)
+    return np.where(has, x[finite[first]], np.nan), np.where(has, x[finite[last]], np.nan)
 
 
 def extremes_of_runs(reduce, values, index, run, first):
@@ -180,10 +200,8 @@ def labelled_runs(start, stop, arguments, x, cycle):
             step = np.append(step, np.nan)
         cuts = np.concatenate([[0], np.flatnonzero(label[1:] != label[:-1]) + 1])
         highest, _, lowest, bottom = _piece_extremes(xa, cuts, a)
-        sizes = np.diff(np.append(cuts, b - a))
-        piece, finite = np.repeat(np.arange(cuts.size), sizes), np.isfinite(xa)
-        ends = [ends_of_runs(piece, finite, xa, cuts.size, first) for first in (True, False)]
-        runs = [cuts + a, label[cuts].astype(np.float64), sizes]
+        runs = [cuts + a, label[cuts].astype(np.float64), np.diff(np.append(cuts, b - a))]
+        ends = _finite_ends(xa, cuts)
         largest = np.fmax.reduceat(step, cuts)
         pieces.append(np.stack([*runs, highest, lowest, bottom, *ends, largest]))
     return np.concatenate(pieces, axis=1)
